@@ -1,0 +1,1 @@
+//! Shared helpers of the scatter examples (see `examples/`).

@@ -1,0 +1,28 @@
+//! The CPU side of scatter: everything the GPU kernels are measured against.
+//!
+//! - [`scene`]: the serde scene description (camera, light, medium, geometry) with validation;
+//! - [`suite`]: the named scene suite (`sphere`, `columns`, `window`, `foliage`, `terrain`,
+//!   `spot_grate`), its camera poses and medium presets;
+//! - [`geometry`] and [`bvh`]: primitives and a binned-SAH bounding volume hierarchy;
+//! - [`buffers`]: the inputs every method gets: the camera depth buffer and a standard light
+//!   shadow map, both produced by ray casting (standing in for an engine's rasteriser);
+//! - [`model`]: the single-scattering model (phase functions, light falloff, closed forms);
+//! - [`truth`]: the two ground truths, `exact` and `shadow_map`, accumulated in f64;
+//! - [`metrics`]: error metrics between images and over image sequences;
+//! - [`image`]: float images, PFM and PNG output, tone mapping and composites;
+//! - [`kernels`]: a line-comparable CPU mirror of every GPU kernel.
+//!
+//! Conventions (used everywhere in the workspace): right-handed world, `+y` up, lengths in
+//! metres, `sigma_t` in 1/m. A directional light's `direction` is the direction the light
+//! *travels* (from the sun into the scene).
+
+pub mod buffers;
+pub mod bvh;
+pub mod geometry;
+pub mod image;
+pub mod kernels;
+pub mod metrics;
+pub mod model;
+pub mod scene;
+pub mod suite;
+pub mod truth;

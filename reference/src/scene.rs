@@ -1,0 +1,610 @@
+//! Scene description: camera, light, participating medium and geometry, loadable from JSON
+//! and validated so that every later stage can trust it.
+//!
+//! Validation rejects NaN/infinite numbers, zero-length directions, a vertical field of view
+//! outside (0, 180) degrees, `near >= far`, a negative `sigma_t`, `|g| >= 1` and malformed
+//! geometry, each with a message that names the offending field (`camera.fov_y_deg`, ...).
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Why a scene was rejected.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// A field has a value outside its allowed range.
+    #[error("invalid scene: {field} {problem}")]
+    Invalid {
+        /// Path of the offending field, e.g. `camera.fov_y_deg` or `geometry[3].radius`.
+        field: String,
+        /// What is wrong with it, including the value.
+        problem: String,
+    },
+    /// The JSON could not be parsed.
+    #[error("invalid scene JSON: {0}")]
+    Json(#[from] serde_json::Error),
+    /// The file could not be read.
+    #[error("cannot read scene file {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+}
+
+fn invalid(field: impl Into<String>, problem: impl Into<String>) -> SceneError {
+    SceneError::Invalid {
+        field: field.into(),
+        problem: problem.into(),
+    }
+}
+
+/// A complete scene: what the reference renders and what every method gets as input.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Scene {
+    /// Scene name (suite name, possibly with pose and medium preset).
+    pub name: String,
+    /// The viewer.
+    pub camera: Camera,
+    /// The one light of this pass.
+    pub light: Light,
+    /// The homogeneous participating medium.
+    pub medium: Medium,
+    /// Occluders and receivers.
+    pub geometry: Vec<Shape>,
+    /// Radiance of the sky behind the far plane (RGB), used only for composites.
+    #[serde(default = "default_sky")]
+    pub sky: [f64; 3],
+}
+
+fn default_sky() -> [f64; 3] {
+    [0.02, 0.025, 0.035]
+}
+
+/// Which way the camera looks.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Orientation {
+    /// Look at a point, with an approximate up vector.
+    LookAt {
+        /// Point the view axis passes through.
+        target: DVec3,
+        /// Approximate up direction (made orthogonal to the view axis).
+        up: DVec3,
+    },
+    /// Look along a direction, with an approximate up vector.
+    Forward {
+        /// View axis direction (need not be normalised).
+        forward: DVec3,
+        /// Approximate up direction (made orthogonal to the view axis).
+        up: DVec3,
+    },
+}
+
+/// A pinhole camera. Pixel (0, 0) is the top-left corner of the image.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Camera {
+    /// Eye position.
+    pub position: DVec3,
+    /// View direction.
+    pub orientation: Orientation,
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov_y_deg: f64,
+    /// Near plane distance along the view axis (geometry closer than this is clipped).
+    pub near: f64,
+    /// Far plane distance along the view axis (sky pixels integrate up to it).
+    pub far: f64,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+}
+
+/// An orthonormal camera frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// View axis.
+    pub forward: DVec3,
+    /// Image right.
+    pub right: DVec3,
+    /// Image up.
+    pub up: DVec3,
+}
+
+impl Camera {
+    /// The orthonormal frame (forward, right, up) of a validated camera.
+    pub fn frame(&self) -> Frame {
+        let (forward, up) = match &self.orientation {
+            Orientation::LookAt { target, up } => (*target - self.position, *up),
+            Orientation::Forward { forward, up } => (*forward, *up),
+        };
+        let forward = forward.normalize();
+        let right = forward.cross(up).normalize();
+        let up = right.cross(forward);
+        Frame { forward, right, up }
+    }
+
+    /// Width over height.
+    pub fn aspect(&self) -> f64 {
+        f64::from(self.width) / f64::from(self.height)
+    }
+
+    /// tan(fov_y / 2).
+    pub fn tan_half_fov(&self) -> f64 {
+        (self.fov_y_deg.to_radians() * 0.5).tan()
+    }
+
+    /// Unit direction of the ray through image position (`px`, `py`) in pixels, measured
+    /// from the top-left corner; pixel centres are at half-integers.
+    pub fn ray_dir(&self, frame: &Frame, px: f64, py: f64) -> DVec3 {
+        let t = self.tan_half_fov();
+        let ndc_x = 2.0 * px / f64::from(self.width) - 1.0;
+        let ndc_y = 1.0 - 2.0 * py / f64::from(self.height);
+        (frame.forward + frame.right * (ndc_x * t * self.aspect()) + frame.up * (ndc_y * t))
+            .normalize()
+    }
+
+    /// Where a world direction lands on the image plane, in pixels from the top-left
+    /// corner, or `None` if it points behind the camera (or parallel to the image plane).
+    pub fn project_direction(&self, frame: &Frame, dir: DVec3) -> Option<(f64, f64)> {
+        let z = dir.dot(frame.forward);
+        if z <= 1e-12 {
+            return None;
+        }
+        let t = self.tan_half_fov();
+        let ndc_x = dir.dot(frame.right) / (z * t * self.aspect());
+        let ndc_y = dir.dot(frame.up) / (z * t);
+        Some((
+            (ndc_x + 1.0) * 0.5 * f64::from(self.width),
+            (1.0 - ndc_y) * 0.5 * f64::from(self.height),
+        ))
+    }
+
+    /// The eight corners of the view frustum (near quad then far quad).
+    pub fn frustum_corners(&self) -> [DVec3; 8] {
+        let f = self.frame();
+        let t = self.tan_half_fov();
+        let a = self.aspect();
+        let mut out = [DVec3::ZERO; 8];
+        for (i, d) in [self.near, self.far].into_iter().enumerate() {
+            for (j, (sx, sy)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .into_iter()
+                .enumerate()
+            {
+                out[i * 4 + j] = self.position
+                    + f.forward * d
+                    + f.right * (sx * d * t * a)
+                    + f.up * (sy * d * t);
+            }
+        }
+        out
+    }
+}
+
+/// The light of one pass (several lights are several passes whose results add).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Light {
+    /// A distant light (the sun): parallel rays, no extinction along the light path.
+    Directional {
+        /// Direction the light travels (from the sun into the scene); need not be normalised.
+        direction: DVec3,
+        /// Irradiance E (RGB) on a surface facing the light, before any shadowing.
+        irradiance: [f64; 3],
+    },
+    /// A spot light: L_in = I * cone(angle) * exp(-sigma_t d) / d^2.
+    Spot {
+        /// Light position.
+        position: DVec3,
+        /// Cone axis (direction the light points); need not be normalised.
+        direction: DVec3,
+        /// Full intensity inside this half-angle (degrees).
+        inner_angle_deg: f64,
+        /// Zero intensity beyond this half-angle (degrees); 180 means no cone (a point light).
+        outer_angle_deg: f64,
+        /// Radiant intensity I (RGB) on the axis.
+        intensity: [f64; 3],
+    },
+}
+
+impl Light {
+    /// RGB scale of the light (irradiance or intensity).
+    pub fn color(&self) -> [f64; 3] {
+        match self {
+            Light::Directional { irradiance, .. } => *irradiance,
+            Light::Spot { intensity, .. } => *intensity,
+        }
+    }
+}
+
+/// A homogeneous participating medium.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Medium {
+    /// Extinction coefficient sigma_t (1/m), >= 0.
+    pub sigma_t: f64,
+    /// Single-scattering albedo in [0, 1]: sigma_s = albedo * sigma_t.
+    pub albedo: f64,
+    /// Henyey-Greenstein asymmetry g in (-1, 1); 0 is isotropic.
+    pub g: f64,
+}
+
+impl Medium {
+    /// Scattering coefficient sigma_s = albedo * sigma_t.
+    pub fn sigma_s(&self) -> f64 {
+        self.albedo * self.sigma_t
+    }
+}
+
+/// A piece of geometry. Every shape both receives light and casts shadows.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Shape {
+    /// An infinite plane.
+    Plane {
+        /// A point on the plane.
+        point: DVec3,
+        /// Normal (need not be normalised).
+        normal: DVec3,
+        /// Diffuse albedo (RGB) for composites.
+        #[serde(default = "default_albedo")]
+        albedo: [f64; 3],
+    },
+    /// An axis-aligned box.
+    Box {
+        /// Minimum corner.
+        min: DVec3,
+        /// Maximum corner (every component > `min`).
+        max: DVec3,
+        /// Diffuse albedo (RGB) for composites.
+        #[serde(default = "default_albedo")]
+        albedo: [f64; 3],
+    },
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        center: DVec3,
+        /// Radius (> 0).
+        radius: f64,
+        /// Diffuse albedo (RGB) for composites.
+        #[serde(default = "default_albedo")]
+        albedo: [f64; 3],
+    },
+    /// A capped cylinder between two points.
+    Cylinder {
+        /// Centre of one cap.
+        a: DVec3,
+        /// Centre of the other cap (distinct from `a`).
+        b: DVec3,
+        /// Radius (> 0).
+        radius: f64,
+        /// Diffuse albedo (RGB) for composites.
+        #[serde(default = "default_albedo")]
+        albedo: [f64; 3],
+    },
+    /// A regular-grid heightfield over the xz plane, triangulated.
+    Heightfield {
+        /// World position of grid sample (0, 0) at height 0.
+        origin: DVec3,
+        /// Extent in x and z (> 0).
+        size: [f64; 2],
+        /// Samples in x and z (>= 2 each).
+        samples: [u32; 2],
+        /// Heights, row-major (`samples[0]` per row, `samples[1]` rows).
+        heights: Vec<f64>,
+        /// Diffuse albedo (RGB) for composites.
+        #[serde(default = "default_albedo")]
+        albedo: [f64; 3],
+    },
+    /// A triangle mesh.
+    Mesh {
+        /// Vertex positions.
+        vertices: Vec<DVec3>,
+        /// Triangles as vertex index triples.
+        triangles: Vec<[u32; 3]>,
+        /// Diffuse albedo (RGB) for composites.
+        #[serde(default = "default_albedo")]
+        albedo: [f64; 3],
+    },
+}
+
+fn default_albedo() -> [f64; 3] {
+    [0.6, 0.6, 0.6]
+}
+
+impl Shape {
+    /// Diffuse albedo of the shape.
+    pub fn albedo(&self) -> [f64; 3] {
+        match self {
+            Shape::Plane { albedo, .. }
+            | Shape::Box { albedo, .. }
+            | Shape::Sphere { albedo, .. }
+            | Shape::Cylinder { albedo, .. }
+            | Shape::Heightfield { albedo, .. }
+            | Shape::Mesh { albedo, .. } => *albedo,
+        }
+    }
+
+    /// How many occluders this shape counts as: one per shape, one per mesh triangle.
+    pub fn occluder_count(&self) -> usize {
+        match self {
+            Shape::Mesh { triangles, .. } => triangles.len(),
+            _ => 1,
+        }
+    }
+}
+
+fn check_finite(field: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(invalid(field, format!("must be finite, got {v}")))
+    }
+}
+
+fn check_vec(field: &str, v: DVec3) -> Result<(), SceneError> {
+    for (c, x) in ["x", "y", "z"].iter().zip(v.to_array()) {
+        check_finite(&format!("{field}.{c}"), x)?;
+    }
+    Ok(())
+}
+
+fn check_dir(field: &str, v: DVec3) -> Result<(), SceneError> {
+    check_vec(field, v)?;
+    if v.length() < 1e-9 {
+        return Err(invalid(field, format!("must not be zero-length, got {v}")));
+    }
+    Ok(())
+}
+
+fn check_rgb(field: &str, v: [f64; 3]) -> Result<(), SceneError> {
+    for (c, x) in ["r", "g", "b"].iter().zip(v) {
+        let f = format!("{field}.{c}");
+        check_finite(&f, x)?;
+        if x < 0.0 {
+            return Err(invalid(f, format!("must be >= 0, got {x}")));
+        }
+    }
+    Ok(())
+}
+
+fn check_positive(field: &str, v: f64) -> Result<(), SceneError> {
+    check_finite(field, v)?;
+    if v <= 0.0 {
+        return Err(invalid(field, format!("must be > 0, got {v}")));
+    }
+    Ok(())
+}
+
+impl Scene {
+    /// Parses and validates a scene from JSON text.
+    pub fn from_json(text: &str) -> Result<Scene, SceneError> {
+        let scene: Scene = serde_json::from_str(text)?;
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// Reads, parses and validates a scene file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Scene::from_json(&text)
+    }
+
+    /// Serialises the scene as pretty JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a validated scene always serialises")
+    }
+
+    /// Number of occluders (shapes, counting each mesh triangle and each heightfield as one).
+    pub fn occluder_count(&self) -> usize {
+        self.geometry.iter().map(Shape::occluder_count).sum()
+    }
+
+    /// Checks every field; the error names the first offending one.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let c = &self.camera;
+        check_vec("camera.position", c.position)?;
+        match &c.orientation {
+            Orientation::LookAt { target, up } => {
+                check_vec("camera.orientation.target", *target)?;
+                check_dir("camera.orientation.up", *up)?;
+                check_dir(
+                    "camera.orientation.(target - position)",
+                    *target - c.position,
+                )?;
+                if (*target - c.position)
+                    .normalize()
+                    .cross(up.normalize())
+                    .length()
+                    < 1e-6
+                {
+                    return Err(invalid(
+                        "camera.orientation.up",
+                        "must not be parallel to the view direction",
+                    ));
+                }
+            }
+            Orientation::Forward { forward, up } => {
+                check_dir("camera.orientation.forward", *forward)?;
+                check_dir("camera.orientation.up", *up)?;
+                if forward.normalize().cross(up.normalize()).length() < 1e-6 {
+                    return Err(invalid(
+                        "camera.orientation.up",
+                        "must not be parallel to camera.orientation.forward",
+                    ));
+                }
+            }
+        }
+        check_finite("camera.fov_y_deg", c.fov_y_deg)?;
+        if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
+            return Err(invalid(
+                "camera.fov_y_deg",
+                format!("must be in (0, 180) degrees, got {}", c.fov_y_deg),
+            ));
+        }
+        check_positive("camera.near", c.near)?;
+        check_finite("camera.far", c.far)?;
+        if c.near >= c.far {
+            return Err(invalid(
+                "camera.far",
+                format!(
+                    "must be greater than camera.near ({}), got {}",
+                    c.near, c.far
+                ),
+            ));
+        }
+        if c.width == 0 || c.height == 0 {
+            return Err(invalid(
+                "camera.width/height",
+                format!("must be at least 1x1, got {}x{}", c.width, c.height),
+            ));
+        }
+        match &self.light {
+            Light::Directional {
+                direction,
+                irradiance,
+            } => {
+                check_dir("light.direction", *direction)?;
+                check_rgb("light.irradiance", *irradiance)?;
+            }
+            Light::Spot {
+                position,
+                direction,
+                inner_angle_deg,
+                outer_angle_deg,
+                intensity,
+            } => {
+                check_vec("light.position", *position)?;
+                check_dir("light.direction", *direction)?;
+                check_finite("light.inner_angle_deg", *inner_angle_deg)?;
+                check_finite("light.outer_angle_deg", *outer_angle_deg)?;
+                if !(*outer_angle_deg > 0.0 && *outer_angle_deg <= 180.0) {
+                    return Err(invalid(
+                        "light.outer_angle_deg",
+                        format!("must be in (0, 180] degrees, got {outer_angle_deg}"),
+                    ));
+                }
+                if !(*inner_angle_deg >= 0.0 && inner_angle_deg <= outer_angle_deg) {
+                    return Err(invalid(
+                        "light.inner_angle_deg",
+                        format!(
+                            "must be in [0, light.outer_angle_deg = {outer_angle_deg}], got {inner_angle_deg}"
+                        ),
+                    ));
+                }
+                check_rgb("light.intensity", *intensity)?;
+            }
+        }
+        let m = &self.medium;
+        check_finite("medium.sigma_t", m.sigma_t)?;
+        if m.sigma_t < 0.0 {
+            return Err(invalid(
+                "medium.sigma_t",
+                format!("must be >= 0, got {}", m.sigma_t),
+            ));
+        }
+        check_finite("medium.albedo", m.albedo)?;
+        if !(0.0..=1.0).contains(&m.albedo) {
+            return Err(invalid(
+                "medium.albedo",
+                format!("must be in [0, 1], got {}", m.albedo),
+            ));
+        }
+        check_finite("medium.g", m.g)?;
+        if m.g.abs() >= 1.0 {
+            return Err(invalid(
+                "medium.g",
+                format!("must satisfy |g| < 1, got {}", m.g),
+            ));
+        }
+        check_rgb("sky", self.sky)?;
+        for (i, s) in self.geometry.iter().enumerate() {
+            validate_shape(&format!("geometry[{i}]"), s)?;
+        }
+        Ok(())
+    }
+}
+
+fn validate_shape(p: &str, s: &Shape) -> Result<(), SceneError> {
+    check_rgb(&format!("{p}.albedo"), s.albedo())?;
+    match s {
+        Shape::Plane { point, normal, .. } => {
+            check_vec(&format!("{p}.point"), *point)?;
+            check_dir(&format!("{p}.normal"), *normal)?;
+        }
+        Shape::Box { min, max, .. } => {
+            check_vec(&format!("{p}.min"), *min)?;
+            check_vec(&format!("{p}.max"), *max)?;
+            if !(max.cmpgt(*min).all()) {
+                return Err(invalid(
+                    format!("{p}.max"),
+                    format!("must exceed {p}.min = {min} in every component, got {max}"),
+                ));
+            }
+        }
+        Shape::Sphere { center, radius, .. } => {
+            check_vec(&format!("{p}.center"), *center)?;
+            check_positive(&format!("{p}.radius"), *radius)?;
+        }
+        Shape::Cylinder { a, b, radius, .. } => {
+            check_vec(&format!("{p}.a"), *a)?;
+            check_vec(&format!("{p}.b"), *b)?;
+            check_dir(&format!("{p}.(b - a)"), *b - *a)?;
+            check_positive(&format!("{p}.radius"), *radius)?;
+        }
+        Shape::Heightfield {
+            origin,
+            size,
+            samples,
+            heights,
+            ..
+        } => {
+            check_vec(&format!("{p}.origin"), *origin)?;
+            check_positive(&format!("{p}.size[0]"), size[0])?;
+            check_positive(&format!("{p}.size[1]"), size[1])?;
+            if samples[0] < 2 || samples[1] < 2 {
+                return Err(invalid(
+                    format!("{p}.samples"),
+                    format!("must be at least 2x2, got {}x{}", samples[0], samples[1]),
+                ));
+            }
+            let n = samples[0] as usize * samples[1] as usize;
+            if heights.len() != n {
+                return Err(invalid(
+                    format!("{p}.heights"),
+                    format!(
+                        "must hold samples[0] * samples[1] = {n} values, got {}",
+                        heights.len()
+                    ),
+                ));
+            }
+            for (i, h) in heights.iter().enumerate() {
+                check_finite(&format!("{p}.heights[{i}]"), *h)?;
+            }
+        }
+        Shape::Mesh {
+            vertices,
+            triangles,
+            ..
+        } => {
+            for (i, v) in vertices.iter().enumerate() {
+                check_vec(&format!("{p}.vertices[{i}]"), *v)?;
+            }
+            for (i, t) in triangles.iter().enumerate() {
+                for k in t {
+                    if *k as usize >= vertices.len() {
+                        return Err(invalid(
+                            format!("{p}.triangles[{i}]"),
+                            format!("index {k} out of range for {} vertices", vertices.len()),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,221 @@
+//! Ground truth of the single-scattering model, accumulated in f64 and parallel over rows.
+//!
+//! Two truths differ only in the visibility term `V`:
+//! - [`Visibility::Exact`]: a ray is cast from the sample point to the light;
+//! - [`Visibility::ShadowMap`]: the same standard shadow map the methods get (nearest texel,
+//!   biased; see [`crate::buffers`]), which isolates a method's own error from the shadow
+//!   map's discretisation.
+//!
+//! Quadrature. The view ray `[0, s]` is cut into `segments` equal cells and `V` is sampled at
+//! the cell centres. Between two centres whose visibility differs, the transition is located
+//! by `bisections` halvings, so a lit interval's ends are exact to `s / (segments 2^b)`. The
+//! smooth rest of the integrand is integrated exactly over each lit interval (directional:
+//! closed form) or by 16-point Gauss-Legendre per cell (spot). A feature thinner than a cell
+//! that is crossed twice between two centres can be missed: the convergence test doubles
+//! `segments` to show that this changes the result by far less than any method's error.
+
+use crate::buffers::{GBuffer, ShadowMap, camera_ray};
+use crate::bvh::Bvh;
+use crate::geometry::Ray;
+use crate::image::Image;
+use crate::model::RayIntegrand;
+use crate::scene::{Light, Scene};
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// How the truth decides whether a point sees the light.
+#[derive(Clone, Copy, Debug)]
+pub enum Visibility<'a> {
+    /// Unshadowed (V = 1): the closed-form part every method shares.
+    None,
+    /// Cast a ray to the light through the scene.
+    Exact(&'a Bvh),
+    /// Look up the given shadow map.
+    ShadowMap(&'a ShadowMap),
+}
+
+/// Quadrature settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TruthSettings {
+    /// Equal cells per view ray.
+    pub segments: usize,
+    /// Bisection steps per visibility transition.
+    pub bisections: u32,
+}
+
+impl Default for TruthSettings {
+    /// 256 cells and 12 bisections: converged to well under 0.1 % rel L1 on the suite (see
+    /// the convergence test).
+    fn default() -> Self {
+        TruthSettings {
+            segments: 256,
+            bisections: 12,
+        }
+    }
+}
+
+/// Distance a shadow ray starts away from its origin (metres).
+const SHADOW_EPS: f64 = 1e-5;
+
+/// Visibility of a world point from the scene's light.
+pub fn visibility(vis: &Visibility, light: &Light, p: DVec3) -> bool {
+    match vis {
+        Visibility::None => true,
+        Visibility::ShadowMap(sm) => sm.visibility(p) > 0.5,
+        Visibility::Exact(bvh) => match light {
+            Light::Directional { direction, .. } => !bvh.occluded(
+                &Ray::new(p, -direction.normalize()),
+                SHADOW_EPS,
+                f64::INFINITY,
+            ),
+            Light::Spot { position, .. } => {
+                let to = *position - p;
+                let d = to.length();
+                d <= SHADOW_EPS || !bvh.occluded(&Ray::new(p, to / d), SHADOW_EPS, d - SHADOW_EPS)
+            }
+        },
+    }
+}
+
+/// In-scattered radiance along one view ray (`dir` unit) of length `s`, scalar (multiply by
+/// `Light::color`).
+pub fn ray_inscatter(
+    scene: &Scene,
+    vis: &Visibility,
+    settings: &TruthSettings,
+    origin: DVec3,
+    dir: DVec3,
+    s: f64,
+) -> f64 {
+    let f = RayIntegrand::new(origin, dir, &scene.light, &scene.medium);
+    let n = settings.segments.max(1);
+    let h = s / n as f64;
+    if let Visibility::None = vis {
+        return f.integrate(0.0, s, n);
+    }
+    let v = |t: f64| visibility(vis, &scene.light, origin + dir * t);
+    let pieces = |a: f64, b: f64| ((b - a) / h).ceil().max(1.0) as usize;
+    let mut total = 0.0;
+    let mut start = 0.0;
+    let mut prev_t = 0.5 * h;
+    let mut cur = v(prev_t);
+    for i in 1..n {
+        let t = (i as f64 + 0.5) * h;
+        let vi = v(t);
+        if vi != cur {
+            let (mut lo, mut hi) = (prev_t, t);
+            for _ in 0..settings.bisections {
+                let mid = 0.5 * (lo + hi);
+                if v(mid) == cur {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let b = 0.5 * (lo + hi);
+            if cur {
+                total += f.integrate(start, b, pieces(start, b));
+            }
+            start = b;
+            cur = vi;
+        }
+        prev_t = t;
+    }
+    if cur {
+        total += f.integrate(start, s, pieces(start, s));
+    }
+    total
+}
+
+/// Renders the in-scattered radiance image (RGB) of a scene with the given visibility;
+/// `on_row` is called once per finished row (for progress bars).
+pub fn render(
+    scene: &Scene,
+    gbuf: &GBuffer,
+    vis: &Visibility,
+    settings: &TruthSettings,
+    on_row: &(dyn Fn() + Sync),
+) -> Image {
+    let cam = &scene.camera;
+    let frame = cam.frame();
+    let color = scene.light.color();
+    let (w, h) = (gbuf.width, gbuf.height);
+    let rows: Vec<Vec<[f32; 3]>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let row = (0..w)
+                .map(|x| {
+                    let i = (y * w + x) as usize;
+                    let dir = camera_ray(scene, &frame, x, y);
+                    let l =
+                        ray_inscatter(scene, vis, settings, cam.position, dir, gbuf.ray_length[i]);
+                    color.map(|c| (c * l) as f32)
+                })
+                .collect();
+            on_row();
+            row
+        })
+        .collect();
+    Image::from_pixels(w, h, rows.into_iter().flatten().collect())
+}
+
+/// Radiance reaching the eye from surfaces and sky, attenuated by the medium, for
+/// composites: diffuse surfaces lit by the light (exact shadows) plus a uniform sky ambient.
+pub fn surface_radiance(scene: &Scene, gbuf: &GBuffer, bvh: &Bvh) -> Image {
+    let cam = &scene.camera;
+    let frame = cam.frame();
+    let color = scene.light.color();
+    let sigma_t = scene.medium.sigma_t;
+    let (w, h) = (gbuf.width, gbuf.height);
+    let exact = Visibility::Exact(bvh);
+    let px: Vec<[f32; 3]> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let i = i as usize;
+            let s = gbuf.ray_length[i];
+            let trans = (-sigma_t * s).exp();
+            let shape = gbuf.shape[i];
+            if shape == crate::buffers::SKY {
+                return scene.sky.map(|c| (c * trans) as f32);
+            }
+            let dir = camera_ray(scene, &frame, x, y);
+            let n = gbuf.normal[i];
+            let p = cam.position + dir * s + n * 1e-4;
+            let (to_light, l_in) = match &scene.light {
+                Light::Directional { direction, .. } => (-direction.normalize(), 1.0),
+                Light::Spot {
+                    position,
+                    direction,
+                    inner_angle_deg,
+                    outer_angle_deg,
+                    ..
+                } => {
+                    let d = *position - p;
+                    let dist = d.length().max(1e-9);
+                    let cone = crate::model::cone_falloff(
+                        (-d / dist).dot(direction.normalize()),
+                        *inner_angle_deg,
+                        *outer_angle_deg,
+                    );
+                    (d / dist, cone * (-sigma_t * dist).exp() / (dist * dist))
+                }
+            };
+            let cos = n.dot(to_light).max(0.0);
+            let lit = if cos > 0.0 && visibility(&exact, &scene.light, p) {
+                1.0
+            } else {
+                0.0
+            };
+            let albedo = scene.geometry[shape as usize].albedo();
+            let mut out = [0f32; 3];
+            for k in 0..3 {
+                let direct = albedo[k] / std::f64::consts::PI * color[k] * l_in * cos * lit;
+                let ambient = albedo[k] * scene.sky[k];
+                out[k] = ((direct + ambient) * trans) as f32;
+            }
+            out
+        })
+        .collect();
+    Image::from_pixels(w, h, px)
+}

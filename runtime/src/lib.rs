@@ -1,0 +1,20 @@
+//! `scatter-runtime`: a thin wgpu driver for the scatter kernels.
+//!
+//! [`Context`] picks an adapter (a real GPU when there is one, otherwise a CPU adapter such
+//! as lavapipe), reports which, and enables GPU timestamps where the adapter has them;
+//! [`Context::from_env`] applies the `SCATTER_GPU` policy that tests and tools share. Each
+//! kernel has a pass type that builds its pipeline from `scatter-shaderlib` and encodes it
+//! ([`RowPrefixPass`]), plus a one-call convenience for tests ([`row_prefix`]).
+
+mod context;
+mod error;
+pub mod row_prefix;
+mod timer;
+
+pub use context::{AdapterReport, Context, ContextError, GpuPolicy};
+pub use error::RuntimeError;
+pub use row_prefix::{ArraySize, RowPrefixOutput, RowPrefixPass, row_prefix};
+pub use timer::GpuTimer;
+
+pub use scatter_shaderlib as shaderlib;
+pub use wgpu;

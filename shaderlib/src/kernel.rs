@@ -1,0 +1,34 @@
+//! The [`Kernel`] enum: one variant per WGSL template, named like its template file, its CPU
+//! mirror (`reference/src/kernels/<name>.rs`) and its conformance trials.
+
+use std::fmt;
+
+/// Every kernel the library ships. Matches on it must stay exhaustive, so that a new kernel
+/// cannot be added without its template, CPU mirror and tests.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Kernel {
+    /// Per-row running prefix (sum or mean) over an rgba texture array; the filtering step
+    /// of the prefiltered method (Klehm et al. 2014, Listing 1).
+    RowPrefix,
+}
+
+impl Kernel {
+    /// All kernels, sorted by name.
+    pub const ALL: &'static [Self] = &[Self::RowPrefix];
+
+    /// The kernel's name: template file stem, entry point, mirror module and trial name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::RowPrefix => "row_prefix",
+        }
+    }
+}
+
+impl fmt::Display for Kernel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}

@@ -1,0 +1,147 @@
+//! `scatter-shaderlib`: the WGSL kernels of the scatter library and the pipeline that turns a
+//! kernel choice into a validated shader.
+//!
+//! Every kernel is an askama template (`templates/<kernel>.wgsl`) that may import shared WGSL
+//! modules (`templates/common/*.wgsl`, naga_oil `#define_import_path scatter::...`). [`build`]
+//! renders the template with the kernel's parameters, composes it with naga_oil, validates it
+//! with naga and returns the [`naga::Module`], its [`naga::valid::ModuleInfo`] and WGSL text.
+//!
+//! ```
+//! use scatter_shaderlib::{build, KernelParams, RowPrefixMode, RowPrefixParams};
+//!
+//! let built = build(&KernelParams::RowPrefix(RowPrefixParams {
+//!     mode: RowPrefixMode::Mean,
+//!     ..RowPrefixParams::default()
+//! }))?;
+//! assert_eq!(built.entry_point, "row_prefix");
+//! assert_eq!(built.workgroup_size, [64, 1, 1]);
+//! # Ok::<(), scatter_shaderlib::ShaderError>(())
+//! ```
+
+mod compose;
+mod error;
+mod kernel;
+pub mod row_prefix;
+
+pub use error::ShaderError;
+pub use kernel::Kernel;
+pub use row_prefix::{RowPrefixMode, RowPrefixParams};
+
+/// A kernel together with the template parameters it is rendered with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kernel", rename_all = "snake_case")]
+pub enum KernelParams {
+    /// [`Kernel::RowPrefix`]: per-row running sum or mean.
+    RowPrefix(RowPrefixParams),
+}
+
+impl KernelParams {
+    /// The kernel these parameters belong to.
+    pub fn kernel(&self) -> Kernel {
+        match self {
+            Self::RowPrefix(_) => Kernel::RowPrefix,
+        }
+    }
+
+    /// Every parameter set the conformance suite checks: each kernel in each of its modes,
+    /// with default workgroup sizes.
+    pub fn all_modes() -> Vec<Self> {
+        RowPrefixMode::ALL
+            .iter()
+            .map(|&mode| {
+                Self::RowPrefix(RowPrefixParams {
+                    mode,
+                    ..RowPrefixParams::default()
+                })
+            })
+            .collect()
+    }
+}
+
+/// A rendered, composed and validated kernel.
+#[derive(Debug, Clone)]
+pub struct BuiltKernel {
+    /// Which kernel this is.
+    pub kernel: Kernel,
+    /// The parameters it was rendered with.
+    pub params: KernelParams,
+    /// Name of the compute entry point (the kernel's name).
+    pub entry_point: &'static str,
+    /// Workgroup size, read back from the naga IR.
+    pub workgroup_size: [u32; 3],
+    /// The composed module (imported names are mangled by naga_oil).
+    pub module: naga::Module,
+    /// Validation info for [`Self::module`], needed by naga's back-ends.
+    pub info: naga::valid::ModuleInfo,
+    /// The module written back as WGSL by naga's WGSL back-end.
+    pub wgsl: String,
+}
+
+/// Renders, composes and validates one kernel.
+///
+/// # Errors
+///
+/// [`ShaderError`] naming the kernel when a parameter is out of range or a stage of the
+/// pipeline (render, compose, validate, write WGSL) fails.
+pub fn build(params: &KernelParams) -> Result<BuiltKernel, ShaderError> {
+    let kernel = params.kernel();
+    let source = render(params)?;
+    let module = compose::compose(kernel, &source)?;
+    let info = compose::validate(kernel, &module)?;
+    let wgsl =
+        naga::back::wgsl::write_string(&module, &info, naga::back::wgsl::WriterFlags::empty())
+            .map_err(|source| ShaderError::WriteWgsl { kernel, source })?;
+    let entry_point = kernel.name();
+    let workgroup_size = module
+        .entry_points
+        .iter()
+        .find(|ep| ep.name == entry_point)
+        .map(|ep| ep.workgroup_size)
+        .ok_or(ShaderError::MissingEntryPoint {
+            kernel,
+            entry_point,
+        })?;
+    Ok(BuiltKernel {
+        kernel,
+        params: *params,
+        entry_point,
+        workgroup_size,
+        module,
+        info,
+        wgsl,
+    })
+}
+
+/// Renders a kernel's askama template to WGSL source that still contains naga_oil
+/// `#import` directives (the input of composition).
+///
+/// # Errors
+///
+/// [`ShaderError::InvalidParameter`] for out-of-range parameters, [`ShaderError::Render`]
+/// when askama fails.
+pub fn render(params: &KernelParams) -> Result<String, ShaderError> {
+    match params {
+        KernelParams::RowPrefix(p) => row_prefix::render(p),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_kernel_and_mode_validates() {
+        for params in KernelParams::all_modes() {
+            let built = build(&params).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(built.entry_point, params.kernel().name());
+            assert!(built.wgsl.contains("fn row_prefix"), "{}", built.wgsl);
+        }
+    }
+
+    #[test]
+    fn params_round_trip_through_serde_names() {
+        assert_eq!(Kernel::RowPrefix.name(), "row_prefix");
+        assert_eq!(RowPrefixMode::Sum.name(), "sum");
+        assert_eq!(RowPrefixMode::Mean.name(), "mean");
+    }
+}
