@@ -52,7 +52,7 @@ struct Args {
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=16384))]
     shadow_map_size: u32,
     /// Quadrature cells per view ray (16..=65536).
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(16..=65536))]
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=65536))]
     segments: u32,
     /// Output PNG (composite).
     #[arg(long)]

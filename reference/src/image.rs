@@ -269,7 +269,7 @@ impl Image {
         let file = std::fs::File::open(path).map_err(io_err(path))?;
         let mut r = std::io::BufReader::new(file);
         let mut header = Vec::new();
-        while header.len() < 3 {
+        while header.len() < 4 {
             let mut line = String::new();
             if r.read_line(&mut line).map_err(io_err(path))? == 0 {
                 return Err(fmt("truncated header"));

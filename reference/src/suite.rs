@@ -22,8 +22,8 @@
 //! For the spot light every pose makes sense, with these meanings: `ordinary` (lamp above
 //! the grate, outside the image), `epipole_on_screen` (the lamp itself projects inside the
 //! image), `light_behind` (a distant narrow lamp behind the camera, which stands inside its cone) and
-//! `grazing` (the lamp to the side, its axis 10 degrees below the horizontal, so the light
-//! crosses the grate's bars at grazing incidence).
+//! `grazing` (the lamp to the side, its axis 18 degrees below the horizontal, so the light
+//! crosses the grate's bars at grazing incidence and only thin sheets pass between them).
 //!
 //! Fog densities are chosen so that the optical depth across the visible scene is about 1:
 //! shafts are clearly visible. `thick` multiplies `sigma_t` by 6, `thin` divides it by 20.
@@ -385,7 +385,7 @@ fn foliage(pose: Pose) -> Def {
         [
             (v(0.0, 1.7, 16.0), v(0.0, 3.0, 0.0), 100.0, 40.0),
             (v(0.0, 1.7, 16.0), v(0.0, 4.0, 0.0), 10.0, 22.0),
-            (v(0.0, 3.0, 17.0), v(0.0, 2.0, 0.0), 195.0, 35.0),
+            (v(0.0, 3.0, 17.0), v(0.0, 2.0, 0.0), 195.0, 28.0),
             (v(0.0, 1.7, 16.0), v(0.0, 3.0, 0.0), 90.0, 5.0),
         ],
         1.0,
@@ -532,9 +532,9 @@ fn spot_grate(pose: Pose) -> Def {
             v(0.0, 0.0, -0.5),
         ),
         Pose::Grazing => (
-            v(7.0, 2.2, 7.0),
-            v(0.0, 0.5, 0.0),
-            v(-6.0, 3.4, 0.0),
+            v(-4.0, 2.5, 7.0),
+            v(2.5, 1.0, -1.0),
+            v(-6.0, 4.6, 0.0),
             v(2.0, 2.0, 0.0),
         ),
     };
