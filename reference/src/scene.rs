@@ -325,10 +325,14 @@ impl Shape {
         }
     }
 
-    /// How many occluders this shape counts as: one per shape, one per mesh triangle.
+    /// How many occluders this shape counts as: one per analytic shape, one per triangle of
+    /// a mesh or heightfield.
     pub fn occluder_count(&self) -> usize {
         match self {
             Shape::Mesh { triangles, .. } => triangles.len(),
+            Shape::Heightfield { samples, .. } => {
+                2 * (samples[0] as usize - 1) * (samples[1] as usize - 1)
+            }
             _ => 1,
         }
     }
@@ -399,7 +403,7 @@ impl Scene {
         serde_json::to_string_pretty(self).expect("a validated scene always serialises")
     }
 
-    /// Number of occluders (shapes, counting each mesh triangle and each heightfield as one).
+    /// Number of occluders (analytic shapes, plus every mesh and heightfield triangle).
     pub fn occluder_count(&self) -> usize {
         self.geometry.iter().map(Shape::occluder_count).sum()
     }

@@ -21,6 +21,7 @@
 mod compose;
 mod error;
 mod kernel;
+pub mod prefiltered;
 pub mod row_prefix;
 
 pub use error::ShaderError;

@@ -1,0 +1,729 @@
+//! Per-frame parameters of the prefiltered family: the epipolar rectification of the current
+//! camera and light, packed into the uniform block ([`FrameUniforms`]) and the per-slice table
+//! ([`SliceParams`]) that the `rectify`, `prefilter` and `scatter` kernels read.
+//!
+//! # Rectified space (epipolar, Klehm et al. 2014 Sec. 4.1 after Baran et al. 2010)
+//!
+//! The *axis* `A` is the unit direction from the eye towards the light (the sun, or the spot
+//! position). Every view ray lies in one half-plane bounded by the axis (an epipolar slice),
+//! at angle `phi = atan2(dir . e2, dir . e1)` around it, and makes the angle
+//! `theta = acos(dir . A)` with it.
+//!
+//! - row `y`: slice; `phi = phi0 + (y + 0.5) dphi` at the centre of row `y`, uniform over the
+//!   slices that the screen covers (all of them when the epipole or the anti-epipole is on
+//!   screen);
+//! - column `x`: one light ray of the slice. Directional: the light ray at distance
+//!   `v = (x + 0.5) delta` from the axis (light rays are parallel to it). Spot: the ray
+//!   leaving the light at angle `psi = (x + 0.5) delta` from the direction light -> eye.
+//!   Column 0 passes through the eye, so every view ray is the row segment `[0, x_s]`;
+//! - stored depth: the view angle `theta` of the first occluder on that light ray, normalised
+//!   to `d = (theta - theta_lo) / (theta_hi - theta_lo)` and clamped to [0, 1]. A point of a
+//!   view ray with normalised angle `d_r` is lit iff `d_r <= d` (Klehm's `H(z_i - z_r)`).
+//!
+//! Per slice the reference ray is the bisectrix of the slice's view-angle range inside the
+//! frustum (`theta_ref`), `delta` is chosen so the row spans the slice's far-plane extent.
+//! Occluders between the light and the frustum project to `d = 0` (clamped): they shadow
+//! the whole light ray, as in the paper.
+
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+use std::f64::consts::PI;
+
+use super::variant::{LightKind, Variant};
+
+/// The camera of one frame (the engine's view).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraDesc {
+    /// Eye position (world).
+    pub position: DVec3,
+    /// Unit view axis.
+    pub forward: DVec3,
+    /// Unit image right.
+    pub right: DVec3,
+    /// Unit image up.
+    pub up: DVec3,
+    /// tan(vertical fov / 2).
+    pub tan_half_fov_y: f64,
+    /// Near plane distance (> 0).
+    pub near: f64,
+    /// Far plane distance (> near).
+    pub far: f64,
+}
+
+/// The light of one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightDesc {
+    /// Directional light.
+    Directional {
+        /// Direction the light travels.
+        direction: DVec3,
+        /// Irradiance E (RGB).
+        color: [f64; 3],
+    },
+    /// Spot light.
+    Spot {
+        /// Position.
+        position: DVec3,
+        /// Cone axis (direction the light travels along the axis).
+        direction: DVec3,
+        /// Full-intensity half-angle (degrees).
+        inner_deg: f64,
+        /// Zero-intensity half-angle (degrees).
+        outer_deg: f64,
+        /// Intensity I (RGB).
+        color: [f64; 3],
+    },
+}
+
+/// The homogeneous medium.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MediumDesc {
+    /// Extinction (1/m).
+    pub sigma_t: f64,
+    /// Single-scattering albedo.
+    pub albedo: f64,
+    /// Henyey-Greenstein g.
+    pub g: f64,
+}
+
+/// Projection of the engine's standard shadow map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShadowProjectionDesc {
+    /// Orthographic window in light space.
+    Orthographic {
+        /// Left.
+        x0: f64,
+        /// Right.
+        x1: f64,
+        /// Bottom.
+        y0: f64,
+        /// Top.
+        y1: f64,
+    },
+    /// Perspective with a square field of view.
+    Perspective {
+        /// tan(fov / 2).
+        tan_half: f64,
+    },
+}
+
+/// The engine's standard shadow map: a square map of normalised *linear* light depth
+/// (`(z - near) / (far - near)`, 1 where nothing was hit), texel (0, 0) top-left.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowMapDesc {
+    /// Light-space origin.
+    pub origin: DVec3,
+    /// Light-space right, up, forward (forward = direction light travels).
+    pub basis: [DVec3; 3],
+    /// Projection.
+    pub projection: ShadowProjectionDesc,
+    /// Light-space depth of stored 0.
+    pub near: f64,
+    /// Light-space depth of stored 1.
+    pub far: f64,
+    /// Texels per side.
+    pub size: u32,
+    /// Depth bias in texel footprints (the reference uses 1.5).
+    pub bias_texels: f64,
+}
+
+/// Texture sizes of one configuration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Resolutions {
+    /// Screen (depth buffer and output) width and height.
+    pub screen: [u32; 2],
+    /// Rectified map width (light rays per slice) and height (slices).
+    pub rectified: [u32; 2],
+}
+
+/// Runtime parameters that are not part of the compiled variant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameSettings {
+    /// Pixels within this radius (pixels) of the epipole or the anti-epipole, when on screen,
+    /// are ray-marched against the standard shadow map (Sec. 5, Fig. 8).
+    pub epipole_radius_px: f64,
+    /// Samples of that ray march.
+    pub march_steps: u32,
+    /// Gauss-Legendre nodes (a multiple of 4) of the per-pixel unshadowed spot integral.
+    pub spot_quadrature: u32,
+}
+
+impl Default for FrameSettings {
+    fn default() -> Self {
+        FrameSettings {
+            epipole_radius_px: 24.0,
+            march_steps: 128,
+            spot_quadrature: 32,
+        }
+    }
+}
+
+/// Why a frame cannot be set up.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum FrameError {
+    /// A number is NaN or infinite, or a direction has zero length.
+    #[error("frame parameter {0} is not finite or is degenerate")]
+    Degenerate(&'static str),
+    /// The light type differs from the variant's.
+    #[error("the variant is compiled for a {expected} light but the frame has a {got} light")]
+    LightMismatch {
+        /// The variant's light.
+        expected: LightKind,
+        /// The frame's light.
+        got: LightKind,
+    },
+    /// A size is zero or too large.
+    #[error("{what} must be in 1..={max}, got {value}")]
+    Size {
+        /// Which size.
+        what: &'static str,
+        /// Its value.
+        value: u32,
+        /// The largest allowed.
+        max: u32,
+    },
+    /// The eye sits on the spot light.
+    #[error("the camera is at the spot light's position: epipolar rectification is undefined")]
+    EyeAtLight,
+}
+
+/// The uniform block shared by the three kernels (WGSL `struct Frame` in
+/// `templates/common/prefiltered.wgsl`). Every field is a 16-byte vector, so the WGSL
+/// uniform layout is the plain C layout; the asserts below pin it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct FrameUniforms {
+    /// Eye position; w unused.
+    pub eye: [f32; 4],
+    /// Axis A (towards the light); w = eye-light distance D (spot), 0 (directional).
+    pub axis: [f32; 4],
+    /// Slice basis e1 (perpendicular to A); w = phi0.
+    pub e1: [f32; 4],
+    /// Slice basis e2 = A x e1; w = dphi (radians per row).
+    pub e2: [f32; 4],
+    /// Camera forward; w = tan(fov_y / 2).
+    pub cam_forward: [f32; 4],
+    /// Camera right; w = aspect (width / height).
+    pub cam_right: [f32; 4],
+    /// Camera up; w = near.
+    pub cam_up: [f32; 4],
+    /// x = theta_lo, y = theta_hi, z = far, w = 1 / (theta_hi - theta_lo).
+    pub theta: [f32; 4],
+    /// x = sigma_t, y = sigma_s, z = g, w unused.
+    pub medium: [f32; 4],
+    /// Light colour (E or I); w unused.
+    pub light_color: [f32; 4],
+    /// Spot position; w = cos(inner angle).
+    pub light_pos: [f32; 4],
+    /// Direction the light travels (spot axis); w = cos(outer angle).
+    pub light_dir: [f32; 4],
+    /// Shadow-map right; w = shadow-map near.
+    pub sm_right: [f32; 4],
+    /// Shadow-map up; w = shadow-map far.
+    pub sm_up: [f32; 4],
+    /// Shadow-map forward; w = bias in texel footprints.
+    pub sm_forward: [f32; 4],
+    /// Shadow-map origin; w = 0 orthographic, 1 perspective.
+    pub sm_origin: [f32; 4],
+    /// Orthographic: x0, x1, y0, y1. Perspective: tan_half, 0, 0, 0.
+    pub sm_proj: [f32; 4],
+    /// Epipole pixel position x, y; z = 1 if it is on screen; w = march radius (pixels).
+    pub epipole: [f32; 4],
+    /// Anti-epipole pixel position x, y; z = 1 if on screen; w = 1 if the slices wrap around
+    /// (full circle: sample rows with wrap-around).
+    pub anti_epipole: [f32; 4],
+    /// Screen width, height, rectified width, rectified height.
+    pub sizes: [u32; 4],
+    /// Shadow-map size, march steps, spot quadrature nodes, unused.
+    pub sizes2: [u32; 4],
+}
+
+/// Per-slice parameters (WGSL `array<vec4<f32>>`): `delta` (world units or radians per
+/// column), `theta_ref`, and the slice's view-angle range inside the frustum.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct SliceParams {
+    /// Column spacing: `v` per column (directional) or `psi` per column (spot).
+    pub delta: f32,
+    /// View angle of the slice's reference ray.
+    pub theta_ref: f32,
+    /// Smallest view angle of the slice inside the frustum.
+    pub theta_lo: f32,
+    /// Largest view angle of the slice inside the frustum.
+    pub theta_hi: f32,
+}
+
+const _: () = {
+    assert!(size_of::<FrameUniforms>() == 21 * 16);
+    assert!(std::mem::offset_of!(FrameUniforms, theta) == 7 * 16);
+    assert!(std::mem::offset_of!(FrameUniforms, medium) == 8 * 16);
+    assert!(std::mem::offset_of!(FrameUniforms, epipole) == 17 * 16);
+    assert!(std::mem::offset_of!(FrameUniforms, sizes) == 19 * 16);
+    assert!(std::mem::offset_of!(FrameUniforms, sizes2) == 20 * 16);
+    assert!(size_of::<SliceParams>() == 16);
+};
+
+/// What the frame setup decided, for the frame report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameReport {
+    /// The epipole (direction towards the light) projects inside the screen.
+    pub epipole_on_screen: bool,
+    /// The anti-epipole projects inside the screen (light behind the camera).
+    pub anti_epipole_on_screen: bool,
+    /// Slices cover the full circle around the axis.
+    pub full_circle: bool,
+    /// Largest distance in pixels between neighbouring slice centres along the screen border
+    /// (a pixel lies at most half of this away from a slice).
+    pub max_slice_gap_px: f64,
+    /// Slices that do not meet the screen (given the frame-wide parameters).
+    pub empty_slices: u32,
+}
+
+/// Everything the kernels need for one frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrefilteredFrame {
+    /// The uniform block.
+    pub uniforms: FrameUniforms,
+    /// One entry per rectified row.
+    pub slices: Vec<SliceParams>,
+    /// What was decided.
+    pub report: FrameReport,
+}
+
+fn v4(v: DVec3, w: f64) -> [f32; 4] {
+    [v.x as f32, v.y as f32, v.z as f32, w as f32]
+}
+
+fn finite(v: DVec3) -> bool {
+    v.is_finite()
+}
+
+/// Wraps an angle into (-pi, pi].
+fn wrap(a: f64) -> f64 {
+    let mut a = a % (2.0 * PI);
+    if a > PI {
+        a -= 2.0 * PI;
+    } else if a <= -PI {
+        a += 2.0 * PI;
+    }
+    a
+}
+
+struct Setup {
+    cam: CameraDesc,
+    aspect: f64,
+    width: f64,
+    height: f64,
+    axis: DVec3,
+    e1: DVec3,
+    e2: DVec3,
+}
+
+impl Setup {
+    /// Pixel position of a direction, or None if it does not point in front of the camera.
+    fn project(&self, d: DVec3) -> Option<(f64, f64)> {
+        let z = d.dot(self.cam.forward);
+        if z <= 1e-12 {
+            return None;
+        }
+        let t = self.cam.tan_half_fov_y;
+        let nx = d.dot(self.cam.right) / (z * t * self.aspect);
+        let ny = d.dot(self.cam.up) / (z * t);
+        Some((
+            (nx + 1.0) * 0.5 * self.width,
+            (1.0 - ny) * 0.5 * self.height,
+        ))
+    }
+
+    fn on_screen(&self, d: DVec3) -> Option<(f64, f64)> {
+        self.project(d)
+            .filter(|&(x, y)| (0.0..=self.width).contains(&x) && (0.0..=self.height).contains(&y))
+    }
+
+    /// Direction through pixel position (x, y) (pixels from the top-left corner).
+    fn dir(&self, x: f64, y: f64) -> DVec3 {
+        let t = self.cam.tan_half_fov_y;
+        let nx = 2.0 * x / self.width - 1.0;
+        let ny = 1.0 - 2.0 * y / self.height;
+        (self.cam.forward + self.cam.right * (nx * t * self.aspect) + self.cam.up * (ny * t))
+            .normalize()
+    }
+
+    fn phi(&self, d: DVec3) -> f64 {
+        d.dot(self.e2).atan2(d.dot(self.e1))
+    }
+
+    fn slice_dir(&self, phi: f64, theta: f64) -> DVec3 {
+        let e = self.e1 * phi.cos() + self.e2 * phi.sin();
+        self.axis * theta.cos() + e * theta.sin()
+    }
+
+    fn inside(&self, d: DVec3) -> bool {
+        let z = d.dot(self.cam.forward);
+        if z <= 1e-9 {
+            return false;
+        }
+        let t = self.cam.tan_half_fov_y;
+        let eps = 1e-9;
+        (d.dot(self.cam.right) / z).abs() <= t * self.aspect + eps
+            && (d.dot(self.cam.up) / z).abs() <= t + eps
+    }
+
+    /// The view-angle interval of slice `phi` inside the frustum (None if it misses it).
+    fn slice_theta_range(&self, phi: f64) -> Option<(f64, f64)> {
+        let e = self.e1 * phi.cos() + self.e2 * phi.sin();
+        let (f, r, u) = (self.cam.forward, self.cam.right, self.cam.up);
+        let tx = self.cam.tan_half_fov_y * self.aspect;
+        let ty = self.cam.tan_half_fov_y;
+        let mut cand = vec![0.0, PI];
+        // Boundary lines: dot(d, n) = 0 for the four side planes and the image plane.
+        let normals = [r - f * tx, r + f * tx, u - f * ty, u + f * ty, f];
+        for n in normals {
+            let (p, q) = (self.axis.dot(n), e.dot(n));
+            // cos(t) p + sin(t) q = 0  ->  t = atan2(-p, q) (mod pi)
+            if p.abs() + q.abs() > 1e-15 {
+                let mut t = (-p).atan2(q);
+                if t < 0.0 {
+                    t += PI;
+                }
+                cand.push(t.clamp(0.0, PI));
+            }
+        }
+        cand.sort_by(f64::total_cmp);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for w in cand.windows(2) {
+            if w[1] - w[0] < 1e-12 {
+                continue;
+            }
+            let mid = 0.5 * (w[0] + w[1]);
+            if self.inside(self.slice_dir(phi, mid)) {
+                lo = lo.min(w[0]);
+                hi = hi.max(w[1]);
+            }
+        }
+        (lo <= hi).then_some((lo, hi))
+    }
+}
+
+/// Sets up one frame of the prefiltered method with epipolar rectification.
+pub fn prepare_frame(
+    variant: &Variant,
+    res: &Resolutions,
+    camera: &CameraDesc,
+    light: &LightDesc,
+    medium: &MediumDesc,
+    shadow: &ShadowMapDesc,
+    settings: &FrameSettings,
+) -> Result<PrefilteredFrame, FrameError> {
+    for (what, value, max) in [
+        ("screen width", res.screen[0], 16384),
+        ("screen height", res.screen[1], 16384),
+        ("rectified width", res.rectified[0], 16384),
+        ("rectified height", res.rectified[1], 16384),
+        ("shadow map size", shadow.size, 16384),
+        ("march steps", settings.march_steps, 4096),
+    ] {
+        if value == 0 || value > max {
+            return Err(FrameError::Size { what, value, max });
+        }
+    }
+    if settings.spot_quadrature == 0
+        || !settings.spot_quadrature.is_multiple_of(4)
+        || settings.spot_quadrature > 256
+    {
+        return Err(FrameError::Size {
+            what: "spot quadrature nodes (a multiple of 4)",
+            value: settings.spot_quadrature,
+            max: 256,
+        });
+    }
+    let got = match light {
+        LightDesc::Directional { .. } => LightKind::Directional,
+        LightDesc::Spot { .. } => LightKind::Spot,
+    };
+    if got != variant.light {
+        return Err(FrameError::LightMismatch {
+            expected: variant.light,
+            got,
+        });
+    }
+    let cam = *camera;
+    if !(finite(cam.position) && finite(cam.forward) && finite(cam.right) && finite(cam.up)) {
+        return Err(FrameError::Degenerate("camera position/orientation"));
+    }
+    if !(cam.tan_half_fov_y.is_finite() && cam.tan_half_fov_y > 0.0) {
+        return Err(FrameError::Degenerate("camera fov"));
+    }
+    if !(cam.near > 0.0 && cam.far > cam.near && cam.far.is_finite()) {
+        return Err(FrameError::Degenerate("camera near/far"));
+    }
+    if !(medium.sigma_t.is_finite()
+        && medium.sigma_t >= 0.0
+        && medium.albedo.is_finite()
+        && medium.g.abs() < 1.0)
+    {
+        return Err(FrameError::Degenerate("medium"));
+    }
+    let (axis, dist, light_pos, light_dir, color, cos_in, cos_out) = match *light {
+        LightDesc::Directional { direction, color } => {
+            if !finite(direction) || direction.length() < 1e-12 {
+                return Err(FrameError::Degenerate("light direction"));
+            }
+            let l = direction.normalize();
+            (-l, 0.0, DVec3::ZERO, l, color, 1.0, 1.0)
+        }
+        LightDesc::Spot {
+            position,
+            direction,
+            inner_deg,
+            outer_deg,
+            color,
+        } => {
+            if !finite(position) || !finite(direction) || direction.length() < 1e-12 {
+                return Err(FrameError::Degenerate("light position/direction"));
+            }
+            if !(inner_deg.is_finite() && outer_deg.is_finite()) {
+                return Err(FrameError::Degenerate("light cone angles"));
+            }
+            let to = position - cam.position;
+            let d = to.length();
+            if d < 1e-6 * cam.far.max(1.0) {
+                return Err(FrameError::EyeAtLight);
+            }
+            (
+                to / d,
+                d,
+                position,
+                direction.normalize(),
+                color,
+                inner_deg.to_radians().cos(),
+                outer_deg.to_radians().cos(),
+            )
+        }
+    };
+    if color.iter().any(|c| !c.is_finite()) {
+        return Err(FrameError::Degenerate("light colour"));
+    }
+    // e1: the view axis made perpendicular to A (so phi = 0 looks ahead), else any.
+    let mut e1 = cam.forward - axis * cam.forward.dot(axis);
+    if e1.length() < 1e-6 {
+        e1 = axis.any_orthonormal_vector();
+    }
+    let e1 = e1.normalize();
+    let e2 = axis.cross(e1);
+    let (w, h) = (f64::from(res.screen[0]), f64::from(res.screen[1]));
+    let s = Setup {
+        cam,
+        aspect: w / h,
+        width: w,
+        height: h,
+        axis,
+        e1,
+        e2,
+    };
+    let epi = s.on_screen(axis);
+    let anti = s.on_screen(-axis);
+    let full_circle = epi.is_some() || anti.is_some();
+
+    // Border samples: every pixel edge position along the four sides.
+    let mut border = Vec::new();
+    let (wi, hi) = (res.screen[0], res.screen[1]);
+    for i in 0..=wi {
+        border.push((f64::from(i), 0.0));
+        border.push((f64::from(i), h));
+    }
+    for j in 0..=hi {
+        border.push((0.0, f64::from(j)));
+        border.push((w, f64::from(j)));
+    }
+    let dirs: Vec<DVec3> = border.iter().map(|&(x, y)| s.dir(x, y)).collect();
+    let (mut theta_lo, mut theta_hi) = (PI, 0.0f64);
+    for d in &dirs {
+        let t = d.dot(axis).clamp(-1.0, 1.0).acos();
+        theta_lo = theta_lo.min(t);
+        theta_hi = theta_hi.max(t);
+    }
+    if epi.is_some() {
+        theta_lo = 0.0;
+    }
+    if anti.is_some() {
+        theta_hi = PI;
+    }
+    let (phi0, phi_range) = if full_circle {
+        (-PI, 2.0 * PI)
+    } else {
+        let pc = s.phi(cam.forward);
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for d in &dirs {
+            let dp = wrap(s.phi(*d) - pc);
+            lo = lo.min(dp);
+            hi = hi.max(dp);
+        }
+        (pc + lo, (hi - lo).max(1e-9))
+    };
+    let rows = res.rectified[1] as usize;
+    let cols = f64::from(res.rectified[0]);
+    let dphi = phi_range / rows as f64;
+
+    // The largest gap between neighbouring slices on the screen border.
+    let mut max_gap: f64 = 0.0;
+    {
+        let centre = epi.or(anti);
+        for &(x, y) in &border {
+            let r = match centre {
+                Some((cx, cy)) => ((x - cx).powi(2) + (y - cy).powi(2)).sqrt(),
+                None => 0.0,
+            };
+            if centre.is_some() {
+                max_gap = max_gap.max(r * dphi);
+            }
+        }
+        if centre.is_none() {
+            // Off-screen epipole: gap between border crossings of neighbouring slices,
+            // measured by projecting slice directions at the border.
+            let mut prev: Option<(f64, f64)> = None;
+            let mut sorted: Vec<(f64, (f64, f64))> = border
+                .iter()
+                .zip(&dirs)
+                .map(|(&p, d)| (wrap(s.phi(*d) - s.phi(cam.forward)), p))
+                .collect();
+            sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut acc_angle = 0.0;
+            for (a, p) in sorted {
+                if let Some(q) = prev {
+                    let dist = ((p.0 - q.0).powi(2) + (p.1 - q.1).powi(2)).sqrt();
+                    let da = (a - acc_angle).abs();
+                    if da > 1e-12 {
+                        max_gap = max_gap.max(dist / da * dphi);
+                    }
+                }
+                prev = Some(p);
+                acc_angle = a;
+            }
+        }
+    }
+
+    // Per-slice parameters.
+    let mut slices = Vec::with_capacity(rows);
+    let mut empty = 0u32;
+    let mut fallback_delta: f64 = 0.0;
+    let mut missing = Vec::new();
+    for j in 0..rows {
+        let phi = phi0 + (j as f64 + 0.5) * dphi;
+        let range = s.slice_theta_range(phi);
+        let (lo, hi) = match range {
+            Some(r) => r,
+            None => {
+                empty += 1;
+                missing.push(j);
+                (theta_lo, theta_hi)
+            }
+        };
+        let theta_ref = 0.5 * (lo + hi);
+        let far_t = |theta: f64| {
+            let d = s.slice_dir(phi, theta);
+            cam.far / d.dot(cam.forward).max(1e-6)
+        };
+        let extent = match variant.light {
+            LightKind::Directional => [lo, hi]
+                .into_iter()
+                .map(|t| far_t(t) * t.sin())
+                .fold(0.0, f64::max),
+            LightKind::Spot => (0..=32)
+                .map(|k| lo + (hi - lo) * f64::from(k) / 32.0)
+                .map(|t| {
+                    let tf = far_t(t);
+                    (tf * t.sin()).atan2(dist - tf * t.cos())
+                })
+                .fold(0.0, f64::max),
+        };
+        let delta = extent * 1.001 / cols;
+        if range.is_some() {
+            fallback_delta = fallback_delta.max(delta);
+        }
+        slices.push(SliceParams {
+            delta: delta as f32,
+            theta_ref: theta_ref as f32,
+            theta_lo: lo as f32,
+            theta_hi: hi as f32,
+        });
+    }
+    for j in missing {
+        if slices[j].delta <= 0.0 || !slices[j].delta.is_finite() {
+            slices[j].delta = fallback_delta.max(1e-6) as f32;
+        }
+    }
+    let (sm_kind, sm_proj) = match shadow.projection {
+        ShadowProjectionDesc::Orthographic { x0, x1, y0, y1 } => {
+            (0.0, [x0 as f32, x1 as f32, y0 as f32, y1 as f32])
+        }
+        ShadowProjectionDesc::Perspective { tan_half } => (1.0, [tan_half as f32, 0.0, 0.0, 0.0]),
+    };
+    let (ex, ey) = s.project(axis).unwrap_or((-1e9, -1e9));
+    let (ax, ay) = s.project(-axis).unwrap_or((-1e9, -1e9));
+    let theta_span = (theta_hi - theta_lo).max(1e-9);
+    let uniforms = FrameUniforms {
+        eye: v4(cam.position, 0.0),
+        axis: v4(axis, dist),
+        e1: v4(e1, phi0),
+        e2: v4(e2, dphi),
+        cam_forward: v4(cam.forward, cam.tan_half_fov_y),
+        cam_right: v4(cam.right, w / h),
+        cam_up: v4(cam.up, cam.near),
+        theta: [
+            theta_lo as f32,
+            theta_hi as f32,
+            cam.far as f32,
+            (1.0 / theta_span) as f32,
+        ],
+        medium: [
+            medium.sigma_t as f32,
+            (medium.sigma_t * medium.albedo) as f32,
+            medium.g as f32,
+            0.0,
+        ],
+        light_color: [color[0] as f32, color[1] as f32, color[2] as f32, 0.0],
+        light_pos: v4(light_pos, cos_in),
+        light_dir: v4(light_dir, cos_out),
+        sm_right: v4(shadow.basis[0], shadow.near),
+        sm_up: v4(shadow.basis[1], shadow.far),
+        sm_forward: v4(shadow.basis[2], shadow.bias_texels),
+        sm_origin: v4(shadow.origin, sm_kind),
+        sm_proj,
+        epipole: [
+            ex as f32,
+            ey as f32,
+            if epi.is_some() { 1.0 } else { 0.0 },
+            settings.epipole_radius_px as f32,
+        ],
+        anti_epipole: [
+            ax as f32,
+            ay as f32,
+            if anti.is_some() { 1.0 } else { 0.0 },
+            if full_circle { 1.0 } else { 0.0 },
+        ],
+        sizes: [
+            res.screen[0],
+            res.screen[1],
+            res.rectified[0],
+            res.rectified[1],
+        ],
+        sizes2: [
+            shadow.size,
+            settings.march_steps,
+            settings.spot_quadrature,
+            0,
+        ],
+    };
+    Ok(PrefilteredFrame {
+        uniforms,
+        slices,
+        report: FrameReport {
+            epipole_on_screen: epi.is_some(),
+            anti_epipole_on_screen: anti.is_some(),
+            full_circle,
+            max_slice_gap_px: max_gap,
+            empty_slices: empty,
+        },
+    })
+}

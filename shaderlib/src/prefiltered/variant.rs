@@ -1,0 +1,239 @@
+//! [`Variant`]: the knobs of the prefiltered family (DESIGN.md, "Variant space"), validated
+//! with errors that name the knob, the value and the allowed range.
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// How visibility samples along a view ray are weighted (Klehm et al. 2014, Sec. 3.1/3.2).
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum VisibilityMode {
+    /// Plain average visibility along the ray (Listing 1): each texel weighted by the length
+    /// of the reference ray it covers.
+    Average,
+    /// Transmittance-weighted visibility (Eq. 11, Listing 2): each texel weighted by the
+    /// transmittance integral over its span of the slice's reference ray (times the cone
+    /// falloff and 1/d^2 for a spot light).
+    #[default]
+    Weighted,
+}
+
+/// The light type a variant is compiled for.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum LightKind {
+    /// A distant light (parallel rays).
+    #[default]
+    Directional,
+    /// A spot light (rays from a point, cone falloff, 1/d^2, extinction along the light path).
+    Spot,
+}
+
+/// Storage format of the filtered-basis texture array.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Storage {
+    /// 8-bit unsigned normalised (the paper's choice: "no improvement above 8 bit").
+    #[default]
+    Rgba8unorm,
+    /// 16-bit float.
+    Rgba16float,
+    /// 32-bit float (sampling it needs the FLOAT32_FILTERABLE feature).
+    Rgba32float,
+}
+
+/// How the standard shadow map becomes a rectified one.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Rectification {
+    /// Epipolar resampling of a standard shadow map (Sec. 4.1, Baran et al.); always valid.
+    #[default]
+    Epipolar,
+    /// One 4x4 matrix the engine rasterises its shadow map with (Sec. 4.2).
+    Projective,
+}
+
+macro_rules! names {
+    ($t:ty, [$($v:ident => $s:literal),* $(,)?]) => {
+        impl $t {
+            /// Every value, sorted by name.
+            pub const ALL: &'static [$t] = &[$(<$t>::$v),*];
+            /// The value's name (serde, CLI, variant ids).
+            pub const fn name(self) -> &'static str {
+                match self { $(<$t>::$v => $s),* }
+            }
+            /// The allowed names, for error messages.
+            pub const ALLOWED: &'static str = concat!($($s, " "),*);
+        }
+        impl fmt::Display for $t {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+        impl std::str::FromStr for $t {
+            type Err = VariantError;
+            fn from_str(s: &str) -> Result<Self, VariantError> {
+                match s {
+                    $($s => Ok(<$t>::$v),)*
+                    _ => Err(VariantError {
+                        knob: stringify_knob::<$t>(),
+                        value: s.to_owned(),
+                        allowed: Self::ALLOWED.trim_end().replace(' ', " | "),
+                    }),
+                }
+            }
+        }
+    };
+}
+
+fn stringify_knob<T: 'static>() -> &'static str {
+    let t = std::any::type_name::<T>();
+    if t.ends_with("VisibilityMode") {
+        "visibility"
+    } else if t.ends_with("LightKind") {
+        "light"
+    } else if t.ends_with("Storage") {
+        "storage"
+    } else {
+        "rectification"
+    }
+}
+
+names!(VisibilityMode, [Average => "average", Weighted => "weighted"]);
+names!(LightKind, [Directional => "directional", Spot => "spot"]);
+names!(Storage, [Rgba16float => "rgba16float", Rgba32float => "rgba32float", Rgba8unorm => "rgba8unorm"]);
+names!(Rectification, [Epipolar => "epipolar", Projective => "projective"]);
+
+/// A knob outside its allowed range.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{knob} must be {allowed}, got {value}")]
+pub struct VariantError {
+    /// The knob's name (`bases`, `bases_per_thread`, ...).
+    pub knob: &'static str,
+    /// The rejected value.
+    pub value: String,
+    /// The allowed range, in words.
+    pub allowed: String,
+}
+
+/// One compiled configuration of the prefiltered family. `Default` is the paper's choice:
+/// 32 bases, 8 per thread, 3 regions, weighted visibility, rgba8unorm, epipolar, directional.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Variant {
+    /// Fourier bases M (M/2 frequencies, sine and cosine): 4..=128, a multiple of 4.
+    pub bases: u32,
+    /// Bases filtered by one invocation: a multiple of 4 that divides `bases`.
+    pub bases_per_thread: u32,
+    /// Independent prefix regions per rectified row: 1..=8.
+    pub regions: u32,
+    /// Visibility weighting.
+    pub visibility: VisibilityMode,
+    /// Light type.
+    pub light: LightKind,
+    /// Filtered-basis storage format.
+    pub storage: Storage,
+    /// Rectification scheme.
+    pub rectification: Rectification,
+}
+
+impl Default for Variant {
+    fn default() -> Self {
+        Variant {
+            bases: 32,
+            bases_per_thread: 8,
+            regions: 3,
+            visibility: VisibilityMode::Weighted,
+            light: LightKind::Directional,
+            storage: Storage::Rgba8unorm,
+            rectification: Rectification::Epipolar,
+        }
+    }
+}
+
+impl Variant {
+    /// Allowed `bases`.
+    pub const BASES: std::ops::RangeInclusive<u32> = 4..=128;
+    /// Allowed `regions`.
+    pub const REGIONS: std::ops::RangeInclusive<u32> = 1..=8;
+
+    /// Checks every knob; the error names the first offending one.
+    pub fn validate(&self) -> Result<(), VariantError> {
+        if !Self::BASES.contains(&self.bases) || !self.bases.is_multiple_of(4) {
+            return Err(VariantError {
+                knob: "bases",
+                value: self.bases.to_string(),
+                allowed: "a multiple of 4 in 4..=128".into(),
+            });
+        }
+        if self.bases_per_thread == 0
+            || !self.bases_per_thread.is_multiple_of(4)
+            || !self.bases.is_multiple_of(self.bases_per_thread)
+        {
+            return Err(VariantError {
+                knob: "bases_per_thread",
+                value: self.bases_per_thread.to_string(),
+                allowed: format!("a multiple of 4 that divides bases = {}", self.bases),
+            });
+        }
+        if !Self::REGIONS.contains(&self.regions) {
+            return Err(VariantError {
+                knob: "regions",
+                value: self.regions.to_string(),
+                allowed: "in 1..=8".into(),
+            });
+        }
+        if self.rectification == Rectification::Projective {
+            return Err(VariantError {
+                knob: "rectification",
+                value: "projective".into(),
+                allowed: "epipolar (projective rectification is not implemented yet)".into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Every valid `bases_per_thread` for `bases`.
+    pub fn bases_per_thread_options(bases: u32) -> Vec<u32> {
+        (4..=bases).step_by(4).filter(|b| bases.is_multiple_of(*b)).collect()
+    }
+
+    /// rgba layers of the filtered-basis texture array: `bases / 4`.
+    pub fn layers(&self) -> u32 {
+        self.bases / 4
+    }
+
+    /// Invocations per (row, region): `bases / bases_per_thread`.
+    pub fn threads_per_row_region(&self) -> u32 {
+        self.bases / self.bases_per_thread
+    }
+
+    /// A short stable id, used in file names and trial names:
+    /// `m32-t8-r3-weighted-directional-rgba8unorm-epipolar`.
+    pub fn id(&self) -> String {
+        format!(
+            "m{}-t{}-r{}-{}-{}-{}-{}",
+            self.bases,
+            self.bases_per_thread,
+            self.regions,
+            self.visibility,
+            self.light,
+            self.storage,
+            self.rectification
+        )
+    }
+}
+
+impl fmt::Display for Variant {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.id())
+    }
+}
