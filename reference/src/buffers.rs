@@ -358,7 +358,7 @@ impl ShadowMap {
             ShadowProjection::Orthographic { x0, x1, y0, y1 } => (x1 - x0).max(y1 - y0),
             ShadowProjection::Perspective { tan_half } => 2.0 * z.max(0.0) * tan_half,
         } / f64::from(self.size);
-        1.5 * texel
+        crate::desc::SHADOW_BIAS_TEXELS * texel
     }
 
     /// Nearest-texel stored depth at texture coordinate (u, v) in [0, 1].

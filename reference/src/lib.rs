@@ -18,6 +18,7 @@
 
 pub mod buffers;
 pub mod bvh;
+pub mod desc;
 pub mod geometry;
 pub mod image;
 pub mod kernels;

@@ -1,5 +1,91 @@
 //! CPU mirrors of the GPU kernels, one module per kernel, named like its template
 //! (`shaderlib/templates/<kernel>.wgsl`) and written line by line like the WGSL, so that a
-//! GPU result can be compared with its mirror at quantisation-level tolerance.
+//! GPU result can be compared with its mirror at quantisation-level tolerance. Shared WGSL
+//! modules (`templates/common/<name>.wgsl`) are mirrored by `common_<name>.rs`.
 
+pub mod common_model;
+pub mod common_prefiltered;
+pub mod prefilter;
+pub mod rectify;
 pub mod row_prefix;
+pub mod scatter;
+
+use crate::buffers::{GBuffer, ShadowMap};
+use crate::image::Image;
+use crate::scene::Scene;
+use common_prefiltered::{Tex, TexArray};
+use scatter_shaderlib::prefiltered::{
+    FrameError, FrameSettings, LightKind, PrefilteredFrame, Resolutions, Variant, prepare_frame,
+};
+
+/// Every intermediate of one CPU run of the prefiltered family.
+#[derive(Clone, Debug)]
+pub struct PrefilteredRun {
+    /// The frame set-up (uniforms, slices, report).
+    pub frame: PrefilteredFrame,
+    /// The rectified shadow map.
+    pub rectified: Tex,
+    /// The filtered-basis array.
+    pub filtered: TexArray,
+    /// In-scattered radiance (as stored in rgba16float).
+    pub output: Image,
+}
+
+/// Runs `rectify`, `prefilter` and `scatter` on the CPU for a scene, its depth buffer and
+/// its standard shadow map.
+pub fn run_prefiltered(
+    variant: &Variant,
+    rectified_size: [u32; 2],
+    scene: &Scene,
+    gbuf: &GBuffer,
+    shadow_map: &ShadowMap,
+    settings: &FrameSettings,
+) -> Result<PrefilteredRun, FrameError> {
+    let res = Resolutions {
+        screen: [gbuf.width, gbuf.height],
+        rectified: rectified_size,
+    };
+    let frame = prepare_frame(
+        variant,
+        &res,
+        &scene.camera_desc(),
+        &scene.light_desc(),
+        &scene.medium_desc(),
+        &shadow_map.desc(),
+        settings,
+    )?;
+    let spot = variant.light == LightKind::Spot;
+    let sm = Tex {
+        width: shadow_map.size,
+        height: shadow_map.size,
+        data: shadow_map.depth.clone(),
+    };
+    let depth = Tex {
+        width: gbuf.width,
+        height: gbuf.height,
+        data: gbuf.view_depth.clone(),
+    };
+    let rectified = rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot);
+    let filtered = prefilter::prefilter(variant, &frame.uniforms, &frame.slices, &rectified);
+    let out = scatter::scatter(
+        variant,
+        &scatter::ScatterInputs {
+            frame: &frame.uniforms,
+            slices: &frame.slices,
+            depth: &depth,
+            shadow_map: &sm,
+            filtered: &filtered,
+        },
+    );
+    let output = Image::from_pixels(
+        gbuf.width,
+        gbuf.height,
+        out.data.iter().map(|c| [c[0], c[1], c[2]]).collect(),
+    );
+    Ok(PrefilteredRun {
+        frame,
+        rectified,
+        filtered,
+        output,
+    })
+}

@@ -727,3 +727,70 @@ pub fn prepare_frame(
         },
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn setup(forward: DVec3, axis: DVec3) -> Setup {
+        let forward = forward.normalize();
+        let right = forward.cross(DVec3::Y).normalize();
+        let up = right.cross(forward);
+        let axis = axis.normalize();
+        let mut e1 = forward - axis * forward.dot(axis);
+        if e1.length() < 1e-6 {
+            e1 = axis.any_orthonormal_vector();
+        }
+        let e1 = e1.normalize();
+        Setup {
+            cam: CameraDesc {
+                position: DVec3::ZERO,
+                forward,
+                right,
+                up,
+                tan_half_fov_y: (30f64).to_radians().tan(),
+                near: 0.1,
+                far: 50.0,
+            },
+            aspect: 16.0 / 9.0,
+            width: 320.0,
+            height: 180.0,
+            axis,
+            e1,
+            e2: axis.cross(e1),
+        }
+    }
+
+    /// The analytic slice clipping agrees with dense sampling of the slice.
+    #[test]
+    fn slice_theta_range_matches_sampling() {
+        let cases = [
+            (DVec3::new(0.0, 0.0, -1.0), DVec3::new(0.5, 0.6, 0.4)),
+            (DVec3::new(0.0, -0.1, -1.0), DVec3::new(0.1, 0.3, -1.0)),
+            (DVec3::new(0.3, -0.2, -1.0), DVec3::new(-0.2, -0.5, 1.0)),
+            (DVec3::new(1.0, 0.0, 0.2), DVec3::new(0.0, 0.07, -1.0)),
+        ];
+        for (fwd, axis) in cases {
+            let s = setup(fwd, axis);
+            for k in 0..64 {
+                let phi = -PI + (f64::from(k) + 0.5) * 2.0 * PI / 64.0;
+                let n = 20000;
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                for i in 0..=n {
+                    let t = PI * f64::from(i) / f64::from(n);
+                    if s.inside(s.slice_dir(phi, t)) {
+                        lo = lo.min(t);
+                        hi = hi.max(t);
+                    }
+                }
+                let got = s.slice_theta_range(phi);
+                if lo > hi {
+                    assert!(got.is_none() || got.is_some_and(|(a, b)| b - a < 1e-3), "phi {phi}: {got:?}");
+                } else {
+                    let (a, b) = got.unwrap_or_else(|| panic!("phi {phi}: expected [{lo}, {hi}]"));
+                    assert!((a - lo).abs() < 1e-3 && (b - hi).abs() < 1e-3, "phi {phi}: [{a}, {b}] vs [{lo}, {hi}]");
+                }
+            }
+        }
+    }
+}

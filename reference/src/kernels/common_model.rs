@@ -1,0 +1,103 @@
+//! CPU mirror of `shaderlib/templates/common/model.wgsl` (`scatter::model`): the
+//! single-scattering model's terms in f32, as the kernels evaluate them.
+
+use glam::Vec3;
+
+/// `PI` as in the WGSL module.
+pub const PI: f32 = std::f32::consts::PI;
+
+/// Henyey-Greenstein phase function of `cos_theta`.
+pub fn phase_hg(g: f32, cos_theta: f32) -> f32 {
+    let denom = max(1.0 + g * g - 2.0 * g * cos_theta, 1e-8);
+    (1.0 - g * g) / (4.0 * PI * denom * sqrt(denom))
+}
+
+/// `(1 - exp(-sigma_t len)) / sigma_t`, and `len` as `sigma_t len -> 0` (series below 1e-4).
+pub fn transmittance_integral(sigma_t: f32, len: f32) -> f32 {
+    let x = sigma_t * len;
+    if x < 1e-4 {
+        return len * (1.0 - 0.5 * x);
+    }
+    (1.0 - exp(-x)) / sigma_t
+}
+
+/// `integral_a^b exp(-sigma_t t) dt`.
+pub fn transmittance_between(sigma_t: f32, a: f32, b: f32) -> f32 {
+    exp(-sigma_t * a) * transmittance_integral(sigma_t, b - a)
+}
+
+/// Smoothstep cone falloff from the cosines of the outer and inner half-angles.
+pub fn cone_falloff(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    if cos_inner - cos_outer <= 1e-6 {
+        return select(0.0, 1.0, cos_angle >= cos_outer);
+    }
+    let x = clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
+}
+
+/// Spot-light integrand `sigma_s p I_cone exp(-sigma_t (d + t)) / d^2` at ray parameter
+/// `t` (without the light colour), for the view ray `eye + t dir`.
+#[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+pub fn spot_integrand(
+    eye: Vec3,
+    dir: Vec3,
+    t: f32,
+    light_pos: Vec3,
+    light_dir: Vec3,
+    cos_inner: f32,
+    cos_outer: f32,
+    medium: [f32; 4],
+) -> f32 {
+    let x = eye + dir * t;
+    let to_x = x - light_pos;
+    let d2 = max(to_x.dot(to_x), 1e-12);
+    let d = sqrt(d2);
+    let travel = to_x / d;
+    let cone = cone_falloff(travel.dot(light_dir), cos_inner, cos_outer);
+    let p = phase_hg(medium[2], -travel.dot(dir));
+    medium[1] * p * cone * exp(-medium[0] * (d + t)) / d2
+}
+
+/// 4-point Gauss-Legendre abscissae on [-1, 1] (ascending).
+pub const GL4_X: [f32; 4] = [-0.861_136_3, -0.339_981_04, 0.339_981_04, 0.861_136_3];
+/// 4-point Gauss-Legendre weights.
+pub const GL4_W: [f32; 4] = [0.347_854_85, 0.652_145_15, 0.652_145_15, 0.347_854_85];
+
+// WGSL built-ins, so the mirrors read like the shaders.
+
+/// WGSL `max` on f32.
+pub fn max(a: f32, b: f32) -> f32 {
+    a.max(b)
+}
+/// WGSL `min` on f32.
+pub fn min(a: f32, b: f32) -> f32 {
+    a.min(b)
+}
+/// WGSL `max` on u32.
+pub fn max_u(a: u32, b: u32) -> u32 {
+    a.max(b)
+}
+/// WGSL `min` on u32.
+pub fn min_u(a: u32, b: u32) -> u32 {
+    a.min(b)
+}
+/// WGSL `clamp` on f32.
+pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    x.max(lo).min(hi)
+}
+/// WGSL `sqrt`.
+pub fn sqrt(x: f32) -> f32 {
+    x.sqrt()
+}
+/// WGSL `exp`.
+pub fn exp(x: f32) -> f32 {
+    x.exp()
+}
+/// WGSL `select(f, t, cond)`.
+pub fn select(f: f32, t: f32, cond: bool) -> f32 {
+    if cond { t } else { f }
+}
+/// WGSL `mix` on f32.
+pub fn mix(a: f32, b: f32, t: f32) -> f32 {
+    a * (1.0 - t) + b * t
+}

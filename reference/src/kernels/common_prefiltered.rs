@@ -1,0 +1,317 @@
+//! CPU mirror of `shaderlib/templates/common/prefiltered.wgsl` (`scatter::prefiltered`): the
+//! rectified-space mapping, the Fourier basis and coefficients, reference-ray weights, the
+//! standard shadow-map lookup, and the texture operations (loads, stores in the variant's
+//! format, bilinear sampling) the three kernels use.
+//!
+//! Conventions are documented in `scatter_shaderlib::prefiltered::frame`.
+
+use super::common_model::{
+    PI, clamp, cone_falloff, exp, max, min, select, transmittance_between,
+};
+use glam::Vec3;
+use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams, Storage};
+
+/// Stand-in for "no occluder": a travel distance far beyond any scene.
+pub const NO_OCCLUDER: f32 = 1e30;
+
+/// An r32float texture (row-major from the top-left texel).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tex {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Texels.
+    pub data: Vec<f32>,
+}
+
+impl Tex {
+    /// A zeroed texture.
+    pub fn new(width: u32, height: u32) -> Tex {
+        Tex {
+            width,
+            height,
+            data: vec![0.0; width as usize * height as usize],
+        }
+    }
+    /// WGSL `textureLoad` (coordinates must be in range).
+    pub fn load(&self, x: u32, y: u32) -> f32 {
+        self.data[(y * self.width + x) as usize]
+    }
+    /// WGSL `textureStore`.
+    pub fn store(&mut self, x: u32, y: u32, v: f32) {
+        self.data[(y * self.width + x) as usize] = v;
+    }
+}
+
+/// An rgba texture array (layer-major, then row-major).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TexArray {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Layers.
+    pub layers: u32,
+    /// Texels, index `(layer * height + y) * width + x`.
+    pub data: Vec<[f32; 4]>,
+}
+
+impl TexArray {
+    /// A zeroed array.
+    pub fn new(width: u32, height: u32, layers: u32) -> TexArray {
+        TexArray {
+            width,
+            height,
+            layers,
+            data: vec![[0.0; 4]; width as usize * height as usize * layers as usize],
+        }
+    }
+    fn index(&self, x: u32, y: u32, layer: u32) -> usize {
+        ((layer * self.height + y) * self.width + x) as usize
+    }
+    /// WGSL `textureLoad`.
+    pub fn load(&self, x: u32, y: u32, layer: u32) -> [f32; 4] {
+        self.data[self.index(x, y, layer)]
+    }
+    /// WGSL `textureStore` into a storage texture of format `storage` (quantised as the
+    /// format stores it).
+    pub fn store(&mut self, x: u32, y: u32, layer: u32, v: [f32; 4], storage: Storage) {
+        let i = self.index(x, y, layer);
+        self.data[i] = v.map(|c| quantise(c, storage));
+    }
+}
+
+/// The value a storage texture of `storage` format keeps for `v`.
+pub fn quantise(v: f32, storage: Storage) -> f32 {
+    match storage {
+        Storage::Rgba8unorm => (v.clamp(0.0, 1.0) * 255.0).round() / 255.0,
+        Storage::Rgba16float => round_f16(v),
+        Storage::Rgba32float => v,
+    }
+}
+
+/// Rounds an f32 to the nearest f16 value (ties to even), returned as f32.
+pub fn round_f16(v: f32) -> f32 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let e = v.abs().log2().floor() as i32;
+    // Spacing of f16 values around v: 2^(e - 10) for normals, 2^-24 for subnormals.
+    let q = if e < -14 {
+        2f32.powi(-24)
+    } else {
+        2f32.powi(e - 10)
+    };
+    let r = (v / q).round_ties_even() * q;
+    if r.abs() > 65504.0 {
+        v.signum() * f32::INFINITY
+    } else {
+        r
+    }
+}
+
+/// Bilinear sample of layer `layer` at texel-space position (`x`, `y`) (texel `i`'s centre at
+/// `i + 0.5`), clamp-to-edge in x, wrap-around in y when `wrap_y`, else clamp-to-edge.
+pub fn sample_bilinear(t: &TexArray, layer: u32, x: f32, y: f32, wrap_y: bool) -> [f32; 4] {
+    let (x0, fx) = split(x - 0.5);
+    let (y0, fy) = split(y - 0.5);
+    let cx = |i: i64| i.clamp(0, i64::from(t.width) - 1) as u32;
+    let h = i64::from(t.height);
+    let cy = |j: i64| {
+        if wrap_y {
+            j.rem_euclid(h) as u32
+        } else {
+            j.clamp(0, h - 1) as u32
+        }
+    };
+    let a = t.load(cx(x0), cy(y0), layer);
+    let b = t.load(cx(x0 + 1), cy(y0), layer);
+    let c = t.load(cx(x0), cy(y0 + 1), layer);
+    let d = t.load(cx(x0 + 1), cy(y0 + 1), layer);
+    let mut out = [0.0; 4];
+    for k in 0..4 {
+        let top = a[k] * (1.0 - fx) + b[k] * fx;
+        let bottom = c[k] * (1.0 - fx) + d[k] * fx;
+        out[k] = top * (1.0 - fy) + bottom * fy;
+    }
+    out
+}
+
+fn split(x: f32) -> (i64, f32) {
+    let f = x.floor();
+    (f as i64, x - f)
+}
+
+/// `.xyz` of a vec4.
+pub fn xyz(v: [f32; 4]) -> Vec3 {
+    Vec3::new(v[0], v[1], v[2])
+}
+
+/// Unit vector of slice angle `phi` (perpendicular to the axis).
+pub fn slice_e(f: &FrameUniforms, phi: f32) -> Vec3 {
+    xyz(f.e1) * phi.cos() + xyz(f.e2) * phi.sin()
+}
+
+/// Slice angle at the centre of row `row`.
+pub fn row_phi(f: &FrameUniforms, row: u32) -> f32 {
+    f.e1[3] + (row as f32 + 0.5) * f.e2[3]
+}
+
+/// Normalised rectified depth of view angle `theta`, the frame's view angles spanning
+/// [`lo`, `hi`] (`FrameUniforms::theta`).
+pub fn normalised_depth(theta: f32, lo: f32, hi: f32) -> f32 {
+    DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp((theta - lo) / max(hi - lo, 1e-6), 0.0, 1.0)
+}
+
+/// Rectified depths use [`DEPTH_MARGIN`, 1 - `DEPTH_MARGIN`]: the Fourier series of the step
+/// is 2-periodic, so depth differences near +-1 (a ray at the very start of the range
+/// against an empty light ray) would fall on the periodic copy's discontinuity.
+pub const DEPTH_MARGIN: f32 = 0.1;
+
+/// Fourier frequency `c_k = pi (2k - 1)`.
+pub fn freq(k: u32) -> f32 {
+    PI * (2 * k - 1) as f32
+}
+
+/// Basis values of layer `layer` at depth `d`: `(sin c1 d, cos c1 d, sin c2 d, cos c2 d)`
+/// with `k1 = 2 layer + 1`, `k2 = 2 layer + 2` (Klehm Eq. 8: B_{2k-1} = sin, B_{2k} = cos).
+pub fn basis4(d: f32, layer: u32) -> [f32; 4] {
+    let c1 = freq(2 * layer + 1);
+    let c2 = freq(2 * layer + 2);
+    [(c1 * d).sin(), (c1 * d).cos(), (c2 * d).sin(), (c2 * d).cos()]
+}
+
+/// Coefficients of layer `layer` for a ray of depth `d`:
+/// `(2/c1 cos c1 d, -2/c1 sin c1 d, 2/c2 cos c2 d, -2/c2 sin c2 d)`, so that
+/// `V = 0.5 + sum a . B` approximates the step `H(d_i - d)`.
+pub fn coeff4(d: f32, layer: u32) -> [f32; 4] {
+    let c1 = freq(2 * layer + 1);
+    let c2 = freq(2 * layer + 2);
+    [
+        2.0 / c1 * (c1 * d).cos(),
+        -2.0 / c1 * (c1 * d).sin(),
+        2.0 / c2 * (c2 * d).cos(),
+        -2.0 / c2 * (c2 * d).sin(),
+    ]
+}
+
+/// Distance from the eye, along the slice's reference ray, of column edge `x` (continuous,
+/// in columns), capped at four far-plane distances.
+pub fn ref_t(f: &FrameUniforms, s: &SliceParams, x: f32, spot: bool) -> f32 {
+    let cap = 4.0 * f.theta[2];
+    if spot {
+        let psi = x * s.delta;
+        let den = (s.theta_ref + psi).sin();
+        if den <= 1e-4 || s.theta_ref + psi >= PI {
+            return cap;
+        }
+        min(f.axis[3] * psi.sin() / den, cap)
+    } else {
+        min(x * s.delta / max(s.theta_ref.sin(), 1e-4), cap)
+    }
+}
+
+/// Prefilter weight of column `i` of row `row`: the length of the reference ray it covers
+/// (average), or the transmittance integral over that span (weighted), times the cone
+/// falloff and `exp(-sigma_t r) / r^2` at the span's middle for a spot light.
+pub fn texel_weight(f: &FrameUniforms, s: &SliceParams, row: u32, i: u32, weighted: bool, spot: bool) -> f32 {
+    let t0 = ref_t(f, s, i as f32, spot);
+    let t1 = ref_t(f, s, (i + 1) as f32, spot);
+    if !weighted {
+        return t1 - t0;
+    }
+    let mut w = transmittance_between(f.medium[0], t0, t1);
+    if spot {
+        let psi = (i as f32 + 0.5) * s.delta;
+        let e = slice_e(f, row_phi(f, row));
+        let l = -xyz(f.axis) * psi.cos() + e * psi.sin();
+        let den = max((s.theta_ref + psi).sin(), 1e-4);
+        let r = max(f.axis[3] * s.theta_ref.sin() / den, 1e-4);
+        let cone = cone_falloff(l.dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]);
+        w *= cone * exp(-f.medium[0] * r) / (r * r);
+    }
+    w
+}
+
+/// Light-space coordinates of a world point in the standard shadow map.
+pub fn sm_light_space(f: &FrameUniforms, p: Vec3) -> Vec3 {
+    let q = p - xyz(f.sm_origin);
+    Vec3::new(q.dot(xyz(f.sm_right)), q.dot(xyz(f.sm_up)), q.dot(xyz(f.sm_forward)))
+}
+
+/// Texture coordinates (u, v) in [0, 1] of light-space point `ls` (outside: no coverage).
+pub fn sm_uv(f: &FrameUniforms, ls: Vec3) -> [f32; 2] {
+    if f.sm_origin[3] > 0.5 {
+        let z = max(ls.z, 1e-6);
+        let t = f.sm_proj[0];
+        [0.5 + 0.5 * ls.x / (z * t), 0.5 - 0.5 * ls.y / (z * t)]
+    } else {
+        [
+            (ls.x - f.sm_proj[0]) / (f.sm_proj[1] - f.sm_proj[0]),
+            (f.sm_proj[3] - ls.y) / (f.sm_proj[3] - f.sm_proj[2]),
+        ]
+    }
+}
+
+/// Depth bias in world units at light-space depth `z`.
+pub fn sm_bias(f: &FrameUniforms, z: f32) -> f32 {
+    let size = f.sizes2[0] as f32;
+    let texel = if f.sm_origin[3] > 0.5 {
+        2.0 * max(z, 0.0) * f.sm_proj[0] / size
+    } else {
+        max(f.sm_proj[1] - f.sm_proj[0], f.sm_proj[3] - f.sm_proj[2]) / size
+    };
+    f.sm_forward[3] * texel
+}
+
+/// Stored depth of the nearest texel at (u, v), or 2 (beyond everything) outside the map.
+pub fn sm_fetch(f: &FrameUniforms, sm: &Tex, uv: [f32; 2]) -> f32 {
+    if uv[0] < 0.0 || uv[0] > 1.0 || uv[1] < 0.0 || uv[1] > 1.0 {
+        return 2.0;
+    }
+    let n = f.sizes2[0];
+    let x = ((uv[0] * n as f32) as u32).min(n - 1);
+    let y = ((uv[1] * n as f32) as u32).min(n - 1);
+    sm.load(x, y)
+}
+
+/// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed): nearest texel,
+/// biased, exactly the test of the `shadow_map` ground truth.
+pub fn sm_visibility(f: &FrameUniforms, sm: &Tex, p: Vec3) -> f32 {
+    let ls = sm_light_space(f, p);
+    let (near, far) = (f.sm_right[3], f.sm_up[3]);
+    if f.sm_origin[3] > 0.5 && ls.z <= near {
+        return 1.0;
+    }
+    let stored = sm_fetch(f, sm, sm_uv(f, ls));
+    let depth = (ls.z - near) / (far - near);
+    select(0.0, 1.0, depth <= stored + sm_bias(f, ls.z) / (far - near))
+}
+
+/// Travel distance from `o` along the light ray `o + s l` to its first occluder, biased as
+/// [`sm_visibility`] biases (points before it are lit), or [`NO_OCCLUDER`]. For a spot the
+/// ray must start at the shadow map's origin (the light).
+pub fn sm_occluder_distance(f: &FrameUniforms, sm: &Tex, o: Vec3, l: Vec3) -> f32 {
+    let ls = sm_light_space(f, o);
+    let (near, far) = (f.sm_right[3], f.sm_up[3]);
+    if f.sm_origin[3] > 0.5 {
+        let dir = Vec3::new(l.dot(xyz(f.sm_right)), l.dot(xyz(f.sm_up)), l.dot(xyz(f.sm_forward)));
+        if dir.z <= 1e-6 {
+            return NO_OCCLUDER;
+        }
+        let stored = sm_fetch(f, sm, sm_uv(f, dir));
+        if stored >= 1.0 {
+            return NO_OCCLUDER;
+        }
+        let z = near + stored * (far - near);
+        (z + sm_bias(f, z)) / dir.z
+    } else {
+        let stored = sm_fetch(f, sm, sm_uv(f, ls));
+        if stored >= 1.0 {
+            return NO_OCCLUDER;
+        }
+        let z = near + stored * (far - near);
+        z + sm_bias(f, z) - ls.z
+    }
+}

@@ -1,0 +1,74 @@
+//! CPU mirror of `shaderlib/templates/prefilter.wgsl`: the Fourier basis transform fused with
+//! the weighted running mean along each rectified row (Klehm et al. 2014 Listings 1-3,
+//! Table 1's regions and bases per thread).
+//!
+//! One invocation per (row, region, thread): thread `t` of a row-region filters the
+//! `bases_per_thread` bases of layers `t * bpt / 4 ..`. Each region restarts the running mean.
+//! Stored per texel: the normalised weighted mean `F_k = sum w_i B_k(d_i) / sum w_i` over the
+//! region up to the texel, mapped to [0, 1] as `F / 2 + 0.5` in the variant's storage format.
+//! `scatter` weights each region by the pixel's own unshadowed integral over the part of its
+//! ray inside the region, so no weight sums need to be stored.
+
+use super::common_model::select;
+use super::common_prefiltered::{Tex, TexArray, basis4, texel_weight};
+use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams, Variant, VisibilityMode, LightKind};
+
+/// First column of region `r` of `regions` in a row of `width` columns.
+pub fn region_start(r: u32, regions: u32, width: u32) -> u32 {
+    r * width / regions
+}
+
+/// The kernel body for invocation `id` = (row, region, thread).
+#[allow(clippy::too_many_arguments, reason = "bindings of the kernel")]
+pub fn prefilter_main(
+    id: [u32; 3],
+    variant: &Variant,
+    frame: &FrameUniforms,
+    slices: &[SliceParams],
+    rectified: &Tex,
+    filtered: &mut TexArray,
+) {
+    let (row, region, thread) = (id[0], id[1], id[2]);
+    let width = frame.sizes[2];
+    if row >= frame.sizes[3] || region >= variant.regions || thread >= variant.threads_per_row_region() {
+        return;
+    }
+    let weighted = variant.visibility == VisibilityMode::Weighted;
+    let spot = variant.light == LightKind::Spot;
+    let layers_per_thread = variant.bases_per_thread / 4;
+    let slice = slices[row as usize];
+    let start = region_start(region, variant.regions, width);
+    let end = region_start(region + 1, variant.regions, width);
+    let mut acc = vec![[0.0f32; 4]; layers_per_thread as usize];
+    let mut wsum = 0.0f32;
+    for i in start..end {
+        let d = rectified.load(i, row);
+        let w = texel_weight(frame, &slice, row, i, weighted, spot);
+        wsum += w;
+        let blend = select(0.0, w / wsum, wsum > 0.0);
+        for q in 0..layers_per_thread {
+            let layer = thread * layers_per_thread + q;
+            let b = basis4(d, layer);
+            let a = &mut acc[q as usize];
+            for c in 0..4 {
+                a[c] = a[c] * (1.0 - blend) + b[c] * blend;
+            }
+            let stored = [a[0] * 0.5 + 0.5, a[1] * 0.5 + 0.5, a[2] * 0.5 + 0.5, a[3] * 0.5 + 0.5];
+            filtered.store(i, row, layer, stored, variant.storage);
+        }
+    }
+}
+
+/// Runs every invocation; returns the filtered-basis array.
+pub fn prefilter(variant: &Variant, frame: &FrameUniforms, slices: &[SliceParams], rectified: &Tex) -> TexArray {
+    let (w, h) = (frame.sizes[2], frame.sizes[3]);
+    let mut filtered = TexArray::new(w, h, variant.layers());
+    for row in 0..h {
+        for region in 0..variant.regions {
+            for thread in 0..variant.threads_per_row_region() {
+                prefilter_main([row, region, thread], variant, frame, slices, rectified, &mut filtered);
+            }
+        }
+    }
+    filtered
+}

@@ -1,0 +1,240 @@
+//! CPU mirror of `shaderlib/templates/scatter.wgsl`: per pixel, the prefiltered estimate
+//! (Klehm et al. 2014 Listing 4) and a ray march against the standard shadow map for pixels
+//! near the epipole or the anti-epipole (Sec. 5, Fig. 8).
+//!
+//! Weighted visibility: `L = sum_j U_j Vbar_j` over the regions the ray crosses, `U_j` the
+//! pixel's own unshadowed integral over its part of the ray inside region `j` (closed form
+//! for the sun, Gauss-Legendre for a spot) and `Vbar_j = clamp(0.5 + a(d) . F_j, 0, 1)` the
+//! region's prefiltered visibility. With one region this is the paper's `L_unshadowed * Vbar`;
+//! with more, each region's visibility is weighted by the true integrand instead of the
+//! reference ray's. Average visibility: `L = L_unshadowed * sum_j len_j Vbar_j / s`.
+
+use super::common_model::{
+    GL4_W, GL4_X, PI, clamp, max, max_u, min, mix, phase_hg, select, spot_integrand,
+    transmittance_between, transmittance_integral,
+};
+use super::common_prefiltered::{
+    Tex, TexArray, coeff4, normalised_depth, quantise, sample_bilinear, sm_visibility, xyz,
+};
+use super::prefilter::region_start;
+use glam::Vec3;
+use scatter_shaderlib::prefiltered::{
+    FrameUniforms, LightKind, SliceParams, Storage, Variant, VisibilityMode,
+};
+
+/// Most regions a variant may have (the size of the per-pixel region arrays).
+pub const MAX_REGIONS: usize = 8;
+
+/// The bindings of `scatter`.
+pub struct ScatterInputs<'a> {
+    /// Frame uniforms.
+    pub frame: &'a FrameUniforms,
+    /// Per-slice table.
+    pub slices: &'a [SliceParams],
+    /// Linear view depth, screen-sized.
+    pub depth: &'a Tex,
+    /// The standard shadow map.
+    pub shadow_map: &'a Tex,
+    /// Filtered bases (from `prefilter`).
+    pub filtered: &'a TexArray,
+}
+
+/// Unit view direction through the centre of pixel (x, y).
+pub fn pixel_dir(f: &FrameUniforms, x: u32, y: u32) -> Vec3 {
+    let ndc_x = 2.0 * (x as f32 + 0.5) / f.sizes[0] as f32 - 1.0;
+    let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / f.sizes[1] as f32;
+    let t = f.cam_forward[3];
+    (xyz(f.cam_forward) + xyz(f.cam_right) * (ndc_x * t * f.cam_right[3]) + xyz(f.cam_up) * (ndc_y * t))
+        .normalize()
+}
+
+/// In-scattering by ray marching `steps` midpoints against the standard shadow map.
+pub fn march(inp: &ScatterInputs, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f32 {
+    let f = inp.frame;
+    let steps = f.sizes2[1];
+    let h = s / steps as f32;
+    let mut sum = 0.0;
+    for k in 0..steps {
+        let t = (k as f32 + 0.5) * h;
+        let v = sm_visibility(f, inp.shadow_map, eye + dir * t);
+        if spot {
+            sum += v * h * spot_integrand(eye, dir, t, xyz(f.light_pos), xyz(f.light_dir), f.light_pos[3], f.light_dir[3], f.medium);
+        } else {
+            sum += v * transmittance_between(f.medium[0], k as f32 * h, (k + 1) as f32 * h);
+        }
+    }
+    if spot {
+        sum
+    } else {
+        f.medium[1] * phase_hg(f.medium[2], -xyz(f.light_dir).dot(dir)) * sum
+    }
+}
+
+/// The kernel body for pixel `id`; returns the rgba16float texel it stores.
+pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Option<[f32; 4]> {
+    let f = inp.frame;
+    let (x, y) = (id[0], id[1]);
+    if x >= f.sizes[0] || y >= f.sizes[1] {
+        return None;
+    }
+    let spot = variant.light == LightKind::Spot;
+    let weighted = variant.visibility == VisibilityMode::Weighted;
+    let eye = xyz(f.eye);
+    let dir = pixel_dir(f, x, y);
+    let s = max(inp.depth.load(x, y), 0.0) / max(dir.dot(xyz(f.cam_forward)), 1e-6);
+    let color = xyz(f.light_color);
+
+    // Near the epipole and the anti-epipole the rectification degenerates: march instead.
+    let px = Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 0.0);
+    let radius = f.epipole[3];
+    let near_epi = f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
+    let near_anti =
+        f.anti_epipole[2] > 0.5 && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
+    if near_epi || near_anti {
+        let l = march(inp, eye, dir, s, spot) * color;
+        return Some([l.x, l.y, l.z, 1.0]);
+    }
+
+    // Rectified coordinates of the surface point.
+    let axis = xyz(f.axis);
+    let theta = clamp(dir.dot(axis), -1.0, 1.0).acos();
+    let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
+    let rows = f.sizes[3];
+    let wrap = f.anti_epipole[3] > 0.5;
+    let mut yc = (phi - f.e1[3]) / f.e2[3];
+    if wrap {
+        yc -= (yc / rows as f32).floor() * rows as f32;
+    } else {
+        yc = clamp(yc, 0.0, rows as f32);
+    }
+    // Slice parameters, interpolated between the two nearest slices like the bilinear fetch.
+    let yy = yc - 0.5;
+    let j0 = yy.floor();
+    let fy = yy - j0;
+    let row_index = |j: f32| -> usize {
+        let j = j as i64;
+        if wrap {
+            j.rem_euclid(i64::from(rows)) as usize
+        } else {
+            j.clamp(0, i64::from(rows) - 1) as usize
+        }
+    };
+    let s0 = inp.slices[row_index(j0)];
+    let s1 = inp.slices[row_index(j0 + 1.0)];
+    let delta = mix(s0.delta, s1.delta, fy);
+    let d = normalised_depth(theta, f.theta[0], f.theta[1]);
+    let xs = if spot {
+        let q = (eye + dir * s - xyz(f.light_pos)).normalize();
+        clamp(q.dot(-axis), -1.0, 1.0).acos() / delta
+    } else {
+        s * theta.sin() / delta
+    };
+
+    // Regions: every region before the surface's, whole, and the surface's up to x_s. Each
+    // is weighted by this pixel's own unshadowed integral over its part of the ray.
+    let width = f.sizes[2];
+    let regions = variant.regions;
+    let last = min(max(xs, 0.0), width as f32 - 1.0) as u32;
+    let mut pos = [0.0f32; MAX_REGIONS];
+    let mut t0 = [0.0f32; MAX_REGIONS];
+    let mut t1 = [0.0f32; MAX_REGIONS];
+    let mut count = 0u32;
+    for r in 0..regions {
+        let b0 = region_start(r, regions, width) as f32;
+        let b1 = region_start(r + 1, regions, width) as f32;
+        let is_last = last < b1 as u32 || r + 1 == regions;
+        pos[r as usize] = if is_last { clamp(xs - 0.5, b0 + 0.5, b1 - 0.5) } else { b1 - 0.5 };
+        t0[r as usize] = ray_t(f, b0, delta, theta, s, spot);
+        t1[r as usize] = if is_last { s } else { ray_t(f, b1, delta, theta, s, spot) };
+        count = r + 1;
+        if is_last {
+            break;
+        }
+    }
+    let cos_theta_l = -xyz(f.light_dir).dot(dir);
+    let panels = max_u(f.sizes2[2] / 4 / count, 1);
+    let mut total = 0.0;
+    let mut norm = 0.0;
+    for r in 0..count {
+        let (a, b) = (t0[r as usize], t1[r as usize]);
+        let weight = if !weighted {
+            b - a
+        } else if spot {
+            spot_segment(f, eye, dir, a, b, panels)
+        } else {
+            f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_between(f.medium[0], a, b)
+        };
+        let mut vis = 0.5;
+        for layer in 0..variant.layers() {
+            let coeff = coeff4(d, layer);
+            let texel = sample_bilinear(inp.filtered, layer, pos[r as usize], yc, wrap);
+            for k in 0..4 {
+                vis += coeff[k] * (texel[k] * 2.0 - 1.0);
+            }
+        }
+        total += weight * clamp(vis, 0.0, 1.0);
+        norm += weight;
+    }
+    let l = if weighted {
+        total
+    } else {
+        // Average visibility times the unshadowed integral of the whole ray.
+        let unshadowed = if spot {
+            spot_segment(f, eye, dir, 0.0, s, max_u(f.sizes2[2] / 4, 1))
+        } else {
+            f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_integral(f.medium[0], s)
+        };
+        unshadowed * select(1.0, total / norm, norm > 0.0)
+    };
+    let c = color * l;
+    Some([c.x, c.y, c.z, 1.0])
+}
+
+/// Distance along the pixel's own ray (angle `theta` to the axis) of column edge `x`, capped
+/// at the surface distance `s`.
+pub fn ray_t(f: &FrameUniforms, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
+    if spot {
+        let psi = x * delta;
+        let den = (theta + psi).sin();
+        if den <= 1e-6 || theta + psi >= PI {
+            return s;
+        }
+        min(f.axis[3] * psi.sin() / den, s)
+    } else {
+        min(x * delta / max(theta.sin(), 1e-6), s)
+    }
+}
+
+/// Unshadowed spot in-scattering over `[a, b]` of the ray: `panels` 4-point Gauss-Legendre
+/// panels.
+pub fn spot_segment(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, panels: u32) -> f32 {
+    let h = (b - a) / panels as f32;
+    let mut sum = 0.0;
+    for k in 0..panels {
+        let mid = a + (k as f32 + 0.5) * h;
+        for q in 0..4 {
+            let t = mid + 0.5 * h * GL4_X[q];
+            sum += GL4_W[q]
+                * spot_integrand(eye, dir, t, xyz(f.light_pos), xyz(f.light_dir), f.light_pos[3], f.light_dir[3], f.medium);
+        }
+    }
+    sum * 0.5 * h
+}
+
+/// Runs every pixel (rows in parallel); returns the screen-sized output as stored in
+/// rgba16float.
+pub fn scatter(variant: &Variant, inp: &ScatterInputs) -> TexArray {
+    use rayon::prelude::*;
+    let (w, h) = (inp.frame.sizes[0], inp.frame.sizes[1]);
+    let data = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (0..w).map(move |x| {
+                scatter_main([x, y, 0], variant, inp)
+                    .unwrap_or([0.0; 4])
+                    .map(|c| quantise(c, Storage::Rgba16float))
+            })
+        })
+        .collect();
+    TexArray { width: w, height: h, layers: 1, data }
+}
