@@ -13,9 +13,18 @@ use super::common_model::select;
 use super::common_prefiltered::{Tex, TexArray, basis4, texel_weight};
 use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams, Variant, VisibilityMode, LightKind};
 
-/// First column of region `r` of `regions` in a row of `width` columns.
-pub fn region_start(r: u32, regions: u32, width: u32) -> u32 {
-    r * width / regions
+/// First column of region `r` of `regions` in a row of `width` columns. Directional lights
+/// split rows quadratically (`width r^2 / regions^2`): transmittance concentrates the
+/// integrand near the eye (column 0), and finer regions there cut the reference-ray
+/// weighting error (measured: foliage/epipole_on_screen 12.9 % -> 4.0 % rel L1 at 3
+/// regions). Spot lights split uniformly (`width r / regions`), as in the paper: their
+/// integrand peaks near the lamp, not the eye.
+pub fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
+    if spot {
+        r * width / regions
+    } else {
+        r * r * width / (regions * regions)
+    }
 }
 
 /// The kernel body for invocation `id` = (row, region, thread).
@@ -37,8 +46,8 @@ pub fn prefilter_main(
     let spot = variant.light == LightKind::Spot;
     let layers_per_thread = variant.bases_per_thread / 4;
     let slice = slices[row as usize];
-    let start = region_start(region, variant.regions, width);
-    let end = region_start(region + 1, variant.regions, width);
+    let start = region_start(region, variant.regions, width, spot);
+    let end = region_start(region + 1, variant.regions, width, spot);
     let mut acc = vec![[0.0f32; 4]; layers_per_thread as usize];
     let mut wsum = 0.0f32;
     for i in start..end {

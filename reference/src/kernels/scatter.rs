@@ -140,8 +140,8 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
     let mut t1 = [0.0f32; MAX_REGIONS];
     let mut count = 0u32;
     for r in 0..regions {
-        let b0 = region_start(r, regions, width) as f32;
-        let b1 = region_start(r + 1, regions, width) as f32;
+        let b0 = region_start(r, regions, width, spot) as f32;
+        let b1 = region_start(r + 1, regions, width, spot) as f32;
         let is_last = last < b1 as u32 || r + 1 == regions;
         pos[r as usize] = if is_last { clamp(xs - 0.5, b0 + 0.5, b1 - 0.5) } else { b1 - 0.5 };
         t0[r as usize] = ray_t(f, b0, delta, theta, s, spot);

@@ -182,6 +182,18 @@ pub enum FrameError {
         /// The largest allowed.
         max: u32,
     },
+    /// Too few rectified columns for the variant's regions.
+    #[error(
+        "rectified width must be at least {min} for {regions} regions (every region needs a column), got {width}"
+    )]
+    RectifiedTooNarrow {
+        /// The rectified width.
+        width: u32,
+        /// The variant's regions.
+        regions: u32,
+        /// The smallest allowed width.
+        min: u32,
+    },
     /// The eye sits on the spot light.
     #[error("the camera is at the spot light's position: epipolar rectification is undefined")]
     EyeAtLight,
@@ -435,6 +447,14 @@ pub fn prepare_frame(
             what: "spot quadrature nodes (a multiple of 4)",
             value: settings.spot_quadrature,
             max: 256,
+        });
+    }
+    let min_width = variant.regions * variant.regions;
+    if res.rectified[0] < min_width {
+        return Err(FrameError::RectifiedTooNarrow {
+            width: res.rectified[0],
+            regions: variant.regions,
+            min: min_width,
         });
     }
     let got = match light {
