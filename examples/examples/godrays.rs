@@ -7,16 +7,35 @@
 //! Writes `<out>` (composite: surfaces attenuated by the fog plus in-scattering), and beside
 //! it `<stem>.inscatter.png` (in-scattered radiance only, tone-mapped) and
 //! `<stem>.inscatter.pfm` (the same as linear float RGB).
+//!
+//! `--method prefiltered` renders with the prefiltered family (Klehm et al. 2014) instead of
+//! a ground truth, through the CPU mirror of its kernels (the same arithmetic as the GPU
+//! kernels; the conformance suite checks that they agree). `--compare` also renders the
+//! `shadow_map` truth from the same shadow map, prints the error and writes
+//! `<stem>.compare.png`: truth | prefiltered | 4x difference.
 
 use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
+use scatter_reference::image::Image;
+use scatter_reference::kernels::run_prefiltered;
+use scatter_reference::metrics;
+use scatter_reference::scene::Scene;
 use scatter_reference::truth::{self, TruthSettings, Visibility};
+use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Variant, VariantError};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
+
+#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
+enum Method {
+    /// A ground truth (see `--truth`).
+    Truth,
+    /// The prefiltered method (Klehm et al. 2014), CPU mirror of the GPU kernels.
+    Prefiltered,
+}
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum Truth {
@@ -39,9 +58,23 @@ struct Args {
     /// Medium preset: default, thick, thin.
     #[arg(long, default_value = "default", value_parser = |s: &str| s.parse::<MediumPreset>())]
     medium: MediumPreset,
-    /// Which ground truth to render.
+    /// What renders the in-scattering.
+    #[arg(long, value_enum, default_value = "truth")]
+    method: Method,
+    /// Which ground truth to render (`--method truth`).
     #[arg(long, value_enum, default_value = "exact")]
     truth: Truth,
+    /// Prefiltered variant, e.g. `bases=64,regions=8,visibility=average,storage=rgba16float`
+    /// (knobs not named keep the paper's defaults; the light follows the scene).
+    #[arg(long, default_value = "")]
+    variant: String,
+    /// Rectified map size for `--method prefiltered`, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x1024")]
+    rectified: String,
+    /// With `--method prefiltered`: also render the `shadow_map` truth, print the error and
+    /// write `<stem>.compare.png` (truth | prefiltered | 4x difference).
+    #[arg(long)]
+    compare: bool,
     /// Image width in pixels (1..=8192).
     #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=8192))]
     width: u32,
@@ -70,6 +103,51 @@ fn main() -> ExitCode {
     }
 }
 
+/// Parses `--variant` (`knob=value` pairs separated by commas).
+fn parse_variant(text: &str, light: LightKind) -> Result<Variant, String> {
+    let mut v = Variant {
+        light,
+        ..Variant::default()
+    };
+    for pair in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (k, val) = pair
+            .split_once('=')
+            .ok_or_else(|| format!("--variant: expected knob=value, got '{pair}'"))?;
+        let num = || {
+            val.parse::<u32>()
+                .map_err(|_| format!("--variant: {k} must be a number, got '{val}'"))
+        };
+        match k {
+            "bases" => v.bases = num()?,
+            "bases_per_thread" => v.bases_per_thread = num()?,
+            "regions" => v.regions = num()?,
+            "visibility" => v.visibility = val.parse().map_err(|e: VariantError| e.to_string())?,
+            "storage" => v.storage = val.parse().map_err(|e: VariantError| e.to_string())?,
+            "rectification" => {
+                v.rectification = val.parse().map_err(|e: VariantError| e.to_string())?
+            }
+            _ => {
+                return Err(format!(
+                    "--variant: unknown knob '{k}' (bases, bases_per_thread, regions, visibility, storage, rectification)"
+                ));
+            }
+        }
+    }
+    v.validate().map_err(|e| format!("--variant: {e}"))?;
+    Ok(v)
+}
+
+fn parse_size(text: &str) -> Result<[u32; 2], String> {
+    let err = || format!("--rectified must be WIDTHxHEIGHT with both in 1..=16384, got '{text}'");
+    let (w, h) = text.split_once('x').ok_or_else(err)?;
+    let w: u32 = w.parse().map_err(|_| err())?;
+    let h: u32 = h.parse().map_err(|_| err())?;
+    if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+        return Err(err());
+    }
+    Ok([w, h])
+}
+
 fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if args.out.extension().and_then(|e| e.to_str()) != Some("png") {
         return Err(format!("--out must name a .png file, got {}", args.out.display()).into());
@@ -88,6 +166,9 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         args.height,
         t0.elapsed()
     );
+    if args.method == Method::Prefiltered {
+        return run_prefiltered_method(args, &scene, &bvh, &gbuf);
+    }
     let sm;
     let vis = match args.truth {
         Truth::Exact => Visibility::Exact(&bvh),
@@ -117,6 +198,10 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     eprintln!("truth in {:.2?}", t.elapsed());
     let composite = truth::surface_radiance(&scene, &gbuf, &bvh).add(&inscatter)?;
 
+    write_outputs(args, &composite, &inscatter)
+}
+
+fn write_outputs(args: &Args, composite: &Image, inscatter: &Image) -> Result<(), Box<dyn std::error::Error>> {
     let stem = args.out.with_extension("");
     let ins_png = stem.with_extension("inscatter.png");
     let ins_pfm = stem.with_extension("inscatter.pfm");
@@ -129,5 +214,55 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         ins_png.display(),
         ins_pfm.display()
     );
+    Ok(())
+}
+
+fn run_prefiltered_method(
+    args: &Args,
+    scene: &Scene,
+    bvh: &Bvh,
+    gbuf: &GBuffer,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let light = match scene.light {
+        scatter_reference::scene::Light::Directional { .. } => LightKind::Directional,
+        scatter_reference::scene::Light::Spot { .. } => LightKind::Spot,
+    };
+    let variant = parse_variant(&args.variant, light)?;
+    let rectified = parse_size(&args.rectified)?;
+    let t = Instant::now();
+    let sm = ShadowMap::build(scene, bvh, args.shadow_map_size)?;
+    eprintln!("shadow map {0}x{0} in {1:.2?}", args.shadow_map_size, t.elapsed());
+    let t = Instant::now();
+    let settings = FrameSettings::for_screen(args.width, args.height);
+    let run = run_prefiltered(&variant, rectified, scene, gbuf, &sm, &settings)?;
+    eprintln!(
+        "prefiltered {variant} ({}x{} rectified) on the CPU mirror in {:.2?}; {:?}",
+        rectified[0],
+        rectified[1],
+        t.elapsed(),
+        run.frame.report
+    );
+    let composite = truth::surface_radiance(scene, gbuf, bvh).add(&run.output)?;
+    write_outputs(args, &composite, &run.output)?;
+    if args.compare {
+        let bar = ProgressBar::new(u64::from(args.height)).with_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, eta {eta}")?
+                .progress_chars("=> "),
+        );
+        bar.set_message("shadow_map truth");
+        let settings = TruthSettings {
+            segments: args.segments as usize,
+            ..TruthSettings::default()
+        };
+        let truth = truth::render(scene, gbuf, &Visibility::ShadowMap(&sm), &settings, &|| bar.inc(1));
+        bar.finish_and_clear();
+        let report = metrics::compare(&run.output, &truth)?;
+        println!("{}: prefiltered {variant} vs shadow_map truth: {report}", scene.name);
+        let diff = run.output.abs_diff(&truth, 4.0)?;
+        let strip = Image::hstack(&[&truth, &run.output, &diff])?;
+        let path = args.out.with_extension("").with_extension("compare.png");
+        strip.write_png(&path, Some(truth.auto_exposure()))?;
+        eprintln!("wrote {} (truth | prefiltered | 4x difference)", path.display());
+    }
     Ok(())
 }

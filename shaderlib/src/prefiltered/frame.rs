@@ -149,9 +149,18 @@ pub struct FrameSettings {
 }
 
 impl Default for FrameSettings {
+    /// The settings for a 320x180 screen (see [`FrameSettings::for_screen`]).
     fn default() -> Self {
+        FrameSettings::for_screen(320, 180)
+    }
+}
+
+impl FrameSettings {
+    /// Defaults for a screen: march radius 7.5 % of the larger screen side (24 pixels at
+    /// 320x180, 96 at 1280x720), 128 march steps, 32 spot quadrature nodes.
+    pub fn for_screen(width: u32, height: u32) -> FrameSettings {
         FrameSettings {
-            epipole_radius_px: 24.0,
+            epipole_radius_px: 0.075 * f64::from(width.max(height)),
             march_steps: 128,
             spot_quadrature: 32,
         }
