@@ -594,41 +594,15 @@ pub fn prepare_frame(
     let cols = f64::from(res.rectified[0]);
     let dphi = phi_range / rows as f64;
 
-    // The largest gap between neighbouring slices on the screen border.
+    // The largest gap between neighbouring slices on the screen border (where they are
+    // farthest apart): the image distance between a border point and the point at the same
+    // view angle on the next slice.
     let mut max_gap: f64 = 0.0;
-    {
-        let centre = epi.or(anti);
-        for &(x, y) in &border {
-            let r = match centre {
-                Some((cx, cy)) => ((x - cx).powi(2) + (y - cy).powi(2)).sqrt(),
-                None => 0.0,
-            };
-            if centre.is_some() {
-                max_gap = max_gap.max(r * dphi);
-            }
-        }
-        if centre.is_none() {
-            // Off-screen epipole: gap between border crossings of neighbouring slices,
-            // measured by projecting slice directions at the border.
-            let mut prev: Option<(f64, f64)> = None;
-            let mut sorted: Vec<(f64, (f64, f64))> = border
-                .iter()
-                .zip(&dirs)
-                .map(|(&p, d)| (wrap(s.phi(*d) - s.phi(cam.forward)), p))
-                .collect();
-            sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let mut acc_angle = 0.0;
-            for (a, p) in sorted {
-                if let Some(q) = prev {
-                    let dist = ((p.0 - q.0).powi(2) + (p.1 - q.1).powi(2)).sqrt();
-                    let da = (a - acc_angle).abs();
-                    if da > 1e-12 {
-                        max_gap = max_gap.max(dist / da * dphi);
-                    }
-                }
-                prev = Some(p);
-                acc_angle = a;
-            }
+    for (&(x, y), d) in border.iter().zip(&dirs) {
+        let theta = d.dot(axis).clamp(-1.0, 1.0).acos();
+        let next = s.slice_dir(s.phi(*d) + dphi, theta);
+        if let Some((nx, ny)) = s.project(next) {
+            max_gap = max_gap.max(((nx - x).powi(2) + (ny - y).powi(2)).sqrt());
         }
     }
 
@@ -814,10 +788,16 @@ mod tests {
                 }
                 let got = s.slice_theta_range(phi);
                 if lo > hi {
-                    assert!(got.is_none() || got.is_some_and(|(a, b)| b - a < 1e-3), "phi {phi}: {got:?}");
+                    assert!(
+                        got.is_none() || got.is_some_and(|(a, b)| b - a < 1e-3),
+                        "phi {phi}: {got:?}"
+                    );
                 } else {
                     let (a, b) = got.unwrap_or_else(|| panic!("phi {phi}: expected [{lo}, {hi}]"));
-                    assert!((a - lo).abs() < 1e-3 && (b - hi).abs() < 1e-3, "phi {phi}: [{a}, {b}] vs [{lo}, {hi}]");
+                    assert!(
+                        (a - lo).abs() < 1e-3 && (b - hi).abs() < 1e-3,
+                        "phi {phi}: [{a}, {b}] vs [{lo}, {hi}]"
+                    );
                 }
             }
         }
