@@ -1,6 +1,7 @@
 //! Composition (naga_oil) of a rendered kernel with the shared modules in
 //! `templates/common/`, and validation (naga) of the result.
 
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::error::Error as _;
 
@@ -12,13 +13,30 @@ use naga_oil::compose::{
 use crate::{Kernel, ShaderError};
 
 /// Shared WGSL modules, in dependency order (a module may import only earlier ones).
-const COMMON_MODULES: &[(&str, &str)] = &[(
-    "common/indexing.wgsl",
-    include_str!("../templates/common/indexing.wgsl"),
-)];
+const COMMON_MODULES: &[(&str, &str)] = &[
+    (
+        "common/indexing.wgsl",
+        include_str!("../templates/common/indexing.wgsl"),
+    ),
+    (
+        "common/model.wgsl",
+        include_str!("../templates/common/model.wgsl"),
+    ),
+    (
+        "common/prefiltered.wgsl",
+        include_str!("../templates/common/prefiltered.wgsl"),
+    ),
+];
 
-/// Composes the rendered source of `kernel` with every shared module.
-pub(crate) fn compose(kernel: Kernel, source: &str) -> Result<naga::Module, ShaderError> {
+thread_local! {
+    /// A composer with every shared module added, built once per thread: adding the shared
+    /// modules costs more than composing a kernel, and the generator and the tests build
+    /// thousands of kernels.
+    static COMPOSER: RefCell<Option<Composer>> = const { RefCell::new(None) };
+}
+
+/// A fresh composer with every shared module of [`COMMON_MODULES`] added.
+fn new_composer(kernel: Kernel) -> Result<Composer, ShaderError> {
     let mut composer = Composer::default();
     for &(file, common) in COMMON_MODULES {
         composer
@@ -37,6 +55,32 @@ pub(crate) fn compose(kernel: Kernel, source: &str) -> Result<naga::Module, Shad
                 message: e.emit_to_string(&composer),
             })?;
     }
+    Ok(composer)
+}
+
+/// Composes the rendered source of `kernel` with every shared module.
+pub(crate) fn compose(kernel: Kernel, source: &str) -> Result<naga::Module, ShaderError> {
+    COMPOSER.with(|cell| {
+        let mut cached = cell.borrow_mut();
+        let composer = match &mut *cached {
+            Some(composer) => composer,
+            empty => empty.insert(new_composer(kernel)?),
+        };
+        let result = make_module(composer, kernel, source);
+        if result.is_err() {
+            // Start the next kernel from a fresh composer, whatever state the failure left.
+            *cached = None;
+        }
+        result
+    })
+}
+
+/// Composes `source` with the shared modules already in `composer`.
+fn make_module(
+    composer: &mut Composer,
+    kernel: Kernel,
+    source: &str,
+) -> Result<naga::Module, ShaderError> {
     let file = template_path(kernel);
     composer
         .make_naga_module(NagaModuleDescriptor {
@@ -49,7 +93,7 @@ pub(crate) fn compose(kernel: Kernel, source: &str) -> Result<naga::Module, Shad
         .map_err(|e| ShaderError::Compose {
             kernel,
             file,
-            message: e.emit_to_string(&composer),
+            message: e.emit_to_string(composer),
         })
 }
 
@@ -72,6 +116,43 @@ pub(crate) fn validate(kernel: Kernel, module: &naga::Module) -> Result<ModuleIn
 /// The template file of a kernel, relative to `shaderlib/templates`.
 pub(crate) const fn template_path(kernel: Kernel) -> &'static str {
     match kernel {
+        Kernel::Prefilter => "prefilter.wgsl",
+        Kernel::Rectify => "rectify.wgsl",
         Kernel::RowPrefix => "row_prefix.wgsl",
+        Kernel::Scatter => "scatter.wgsl",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::prefiltered::{LightKind, Variant};
+    use crate::{KernelParams, render};
+
+    fn wgsl(module: &naga::Module) -> String {
+        let info = validate(Kernel::Scatter, module).expect("valid");
+        naga::back::wgsl::write_string(module, &info, naga::back::wgsl::WriterFlags::empty())
+            .expect("writes")
+    }
+
+    /// The per-thread cached composer gives the same module as a fresh one, whatever was
+    /// composed before, and survives a failed composition.
+    #[test]
+    fn cached_composer_matches_a_fresh_one() {
+        let spot = Variant {
+            light: LightKind::Spot,
+            ..Variant::default()
+        };
+        let mut all = KernelParams::all_modes();
+        all.extend(KernelParams::prefiltered(spot));
+        assert!(compose(Kernel::Scatter, "fn broken( {").is_err());
+        for params in all.iter().chain(all.iter().rev()) {
+            let kernel = params.kernel();
+            let source = render(params).expect("renders");
+            let cached = compose(kernel, &source).expect("composes");
+            let mut fresh = new_composer(kernel).expect("shared modules compose");
+            let fresh = make_module(&mut fresh, kernel, &source).expect("composes");
+            assert_eq!(wgsl(&cached), wgsl(&fresh), "{kernel}");
+        }
     }
 }

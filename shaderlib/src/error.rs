@@ -18,6 +18,16 @@ pub enum ShaderError {
         /// The allowed range, in words.
         allowed: &'static str,
     },
+    /// A prefiltered-family [`Variant`](crate::prefiltered::Variant) knob is outside its
+    /// allowed range (the message names the knob, the value and the range).
+    #[error("kernel `{kernel}`: invalid variant: {source}")]
+    Variant {
+        /// The kernel being built.
+        kernel: Kernel,
+        /// Which knob, its value and the allowed range.
+        #[source]
+        source: crate::prefiltered::VariantError,
+    },
     /// askama failed to render the template.
     #[error("kernel `{kernel}`: rendering template `{template}` failed: {source}")]
     Render {

@@ -10,19 +10,36 @@ use std::fmt;
 )]
 #[serde(rename_all = "snake_case")]
 pub enum Kernel {
+    /// Fourier basis transform fused with the weighted running mean along each rectified
+    /// row, per region (Klehm et al. 2014, Listings 1-3, Table 1).
+    Prefilter,
+    /// Epipolar resampling of a standard shadow map into the rectified shadow map (Klehm et
+    /// al. 2014, Sec. 4.1, after Baran et al. 2010).
+    Rectify,
     /// Per-row running prefix (sum or mean) over an rgba texture array; the filtering step
     /// of the prefiltered method (Klehm et al. 2014, Listing 1).
     RowPrefix,
+    /// Per pixel: prefiltered visibility times the unshadowed integral, one dot product per
+    /// region; pixels near the epipole ray-marched (Klehm et al. 2014, Listing 4, Sec. 5).
+    Scatter,
 }
 
 impl Kernel {
     /// All kernels, sorted by name.
-    pub const ALL: &'static [Self] = &[Self::RowPrefix];
+    pub const ALL: &'static [Self] = &[
+        Self::Prefilter,
+        Self::Rectify,
+        Self::RowPrefix,
+        Self::Scatter,
+    ];
 
     /// The kernel's name: template file stem, entry point, mirror module and trial name.
     pub const fn name(self) -> &'static str {
         match self {
+            Self::Prefilter => "prefilter",
+            Self::Rectify => "rectify",
             Self::RowPrefix => "row_prefix",
+            Self::Scatter => "scatter",
         }
     }
 }

@@ -6,6 +6,10 @@
 //! renders the template with the kernel's parameters, composes it with naga_oil, validates it
 //! with naga and returns the [`naga::Module`], its [`naga::valid::ModuleInfo`] and WGSL text.
 //!
+//! Kernels: `row_prefix` ([`RowPrefixParams`]) and the prefiltered family (Klehm et al. 2014)
+//! `rectify`, `prefilter`, `scatter`, all three rendered from one
+//! [`prefiltered::Variant`] ([`KernelParams::prefiltered`]).
+//!
 //! ```
 //! use scatter_shaderlib::{build, KernelParams, RowPrefixMode, RowPrefixParams};
 //!
@@ -26,26 +30,48 @@ pub mod row_prefix;
 
 pub use error::ShaderError;
 pub use kernel::Kernel;
+use prefiltered::Variant;
 pub use row_prefix::{RowPrefixMode, RowPrefixParams};
 
 /// A kernel together with the template parameters it is rendered with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "kernel", rename_all = "snake_case")]
 pub enum KernelParams {
+    /// [`Kernel::Prefilter`] of a prefiltered-family variant.
+    Prefilter(Variant),
+    /// [`Kernel::Rectify`] of a prefiltered-family variant (only `light` changes the code).
+    Rectify(Variant),
     /// [`Kernel::RowPrefix`]: per-row running sum or mean.
     RowPrefix(RowPrefixParams),
+    /// [`Kernel::Scatter`] of a prefiltered-family variant (`bases_per_thread` and `storage`
+    /// do not change the code).
+    Scatter(Variant),
 }
 
 impl KernelParams {
     /// The kernel these parameters belong to.
     pub fn kernel(&self) -> Kernel {
         match self {
+            Self::Prefilter(_) => Kernel::Prefilter,
+            Self::Rectify(_) => Kernel::Rectify,
             Self::RowPrefix(_) => Kernel::RowPrefix,
+            Self::Scatter(_) => Kernel::Scatter,
         }
     }
 
+    /// The three kernels of a prefiltered-family variant, in pass order: `rectify`,
+    /// `prefilter`, `scatter`.
+    pub const fn prefiltered(variant: Variant) -> [Self; 3] {
+        [
+            Self::Rectify(variant),
+            Self::Prefilter(variant),
+            Self::Scatter(variant),
+        ]
+    }
+
     /// Every parameter set the conformance suite checks: each kernel in each of its modes,
-    /// with default workgroup sizes.
+    /// with default workgroup sizes, then the prefiltered kernels of the default
+    /// [`Variant`].
     pub fn all_modes() -> Vec<Self> {
         RowPrefixMode::ALL
             .iter()
@@ -55,6 +81,7 @@ impl KernelParams {
                     ..RowPrefixParams::default()
                 })
             })
+            .chain(Self::prefiltered(Variant::default()))
             .collect()
     }
 }
@@ -118,11 +145,14 @@ pub fn build(params: &KernelParams) -> Result<BuiltKernel, ShaderError> {
 ///
 /// # Errors
 ///
-/// [`ShaderError::InvalidParameter`] for out-of-range parameters, [`ShaderError::Render`]
-/// when askama fails.
+/// [`ShaderError::InvalidParameter`] or [`ShaderError::Variant`] for out-of-range
+/// parameters, [`ShaderError::Render`] when askama fails.
 pub fn render(params: &KernelParams) -> Result<String, ShaderError> {
     match params {
+        KernelParams::Prefilter(v) => prefiltered::kernels::render_prefilter(v),
+        KernelParams::Rectify(v) => prefiltered::kernels::render_rectify(v),
         KernelParams::RowPrefix(p) => row_prefix::render(p),
+        KernelParams::Scatter(v) => prefiltered::kernels::render_scatter(v),
     }
 }
 
@@ -135,7 +165,8 @@ mod tests {
         for params in KernelParams::all_modes() {
             let built = build(&params).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(built.entry_point, params.kernel().name());
-            assert!(built.wgsl.contains("fn row_prefix"), "{}", built.wgsl);
+            let entry = format!("fn {}", params.kernel().name());
+            assert!(built.wgsl.contains(&entry), "{}", built.wgsl);
         }
     }
 

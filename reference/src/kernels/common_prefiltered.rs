@@ -5,9 +5,7 @@
 //!
 //! Conventions are documented in `scatter_shaderlib::prefiltered::frame`.
 
-use super::common_model::{
-    PI, clamp, cone_falloff, exp, max, min, select, transmittance_between,
-};
+use super::common_model::{PI, clamp, cone_falloff, exp, max, min, select, transmittance_between};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams, Storage};
 
@@ -179,7 +177,12 @@ pub fn freq(k: u32) -> f32 {
 pub fn basis4(d: f32, layer: u32) -> [f32; 4] {
     let c1 = freq(2 * layer + 1);
     let c2 = freq(2 * layer + 2);
-    [(c1 * d).sin(), (c1 * d).cos(), (c2 * d).sin(), (c2 * d).cos()]
+    [
+        (c1 * d).sin(),
+        (c1 * d).cos(),
+        (c2 * d).sin(),
+        (c2 * d).cos(),
+    ]
 }
 
 /// Coefficients of layer `layer` for a ray of depth `d`:
@@ -215,7 +218,14 @@ pub fn ref_t(f: &FrameUniforms, s: &SliceParams, x: f32, spot: bool) -> f32 {
 /// Prefilter weight of column `i` of row `row`: the length of the reference ray it covers
 /// (average), or the transmittance integral over that span (weighted), times the cone
 /// falloff and `exp(-sigma_t r) / r^2` at the span's middle for a spot light.
-pub fn texel_weight(f: &FrameUniforms, s: &SliceParams, row: u32, i: u32, weighted: bool, spot: bool) -> f32 {
+pub fn texel_weight(
+    f: &FrameUniforms,
+    s: &SliceParams,
+    row: u32,
+    i: u32,
+    weighted: bool,
+    spot: bool,
+) -> f32 {
     let t0 = ref_t(f, s, i as f32, spot);
     let t1 = ref_t(f, s, (i + 1) as f32, spot);
     if !weighted {
@@ -237,7 +247,11 @@ pub fn texel_weight(f: &FrameUniforms, s: &SliceParams, row: u32, i: u32, weight
 /// Light-space coordinates of a world point in the standard shadow map.
 pub fn sm_light_space(f: &FrameUniforms, p: Vec3) -> Vec3 {
     let q = p - xyz(f.sm_origin);
-    Vec3::new(q.dot(xyz(f.sm_right)), q.dot(xyz(f.sm_up)), q.dot(xyz(f.sm_forward)))
+    Vec3::new(
+        q.dot(xyz(f.sm_right)),
+        q.dot(xyz(f.sm_up)),
+        q.dot(xyz(f.sm_forward)),
+    )
 }
 
 /// Texture coordinates (u, v) in [0, 1] of light-space point `ls` (outside: no coverage).
@@ -296,7 +310,11 @@ pub fn sm_occluder_distance(f: &FrameUniforms, sm: &Tex, o: Vec3, l: Vec3) -> f3
     let ls = sm_light_space(f, o);
     let (near, far) = (f.sm_right[3], f.sm_up[3]);
     if f.sm_origin[3] > 0.5 {
-        let dir = Vec3::new(l.dot(xyz(f.sm_right)), l.dot(xyz(f.sm_up)), l.dot(xyz(f.sm_forward)));
+        let dir = Vec3::new(
+            l.dot(xyz(f.sm_right)),
+            l.dot(xyz(f.sm_up)),
+            l.dot(xyz(f.sm_forward)),
+        );
         if dir.z <= 1e-6 {
             return NO_OCCLUDER;
         }
@@ -313,5 +331,19 @@ pub fn sm_occluder_distance(f: &FrameUniforms, sm: &Tex, o: Vec3, l: Vec3) -> f3
         }
         let z = near + stored * (far - near);
         z + sm_bias(f, z) - ls.z
+    }
+}
+
+/// First column of region `r` of `regions` in a row of `width` columns. Directional lights
+/// split rows quadratically (`width r^2 / regions^2`): transmittance concentrates the
+/// integrand near the eye (column 0), and finer regions there cut the reference-ray
+/// weighting error (measured: foliage/epipole_on_screen 12.9 % -> 4.0 % rel L1 at 3
+/// regions). Spot lights split uniformly (`width r / regions`), as in the paper: their
+/// integrand peaks near the lamp, not the eye.
+pub fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
+    if spot {
+        r * width / regions
+    } else {
+        r * r * width / (regions * regions)
     }
 }

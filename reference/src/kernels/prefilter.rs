@@ -10,22 +10,10 @@
 //! ray inside the region, so no weight sums need to be stored.
 
 use super::common_model::select;
-use super::common_prefiltered::{Tex, TexArray, basis4, texel_weight};
-use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams, Variant, VisibilityMode, LightKind};
-
-/// First column of region `r` of `regions` in a row of `width` columns. Directional lights
-/// split rows quadratically (`width r^2 / regions^2`): transmittance concentrates the
-/// integrand near the eye (column 0), and finer regions there cut the reference-ray
-/// weighting error (measured: foliage/epipole_on_screen 12.9 % -> 4.0 % rel L1 at 3
-/// regions). Spot lights split uniformly (`width r / regions`), as in the paper: their
-/// integrand peaks near the lamp, not the eye.
-pub fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
-    if spot {
-        r * width / regions
-    } else {
-        r * r * width / (regions * regions)
-    }
-}
+use super::common_prefiltered::{Tex, TexArray, basis4, region_start, texel_weight};
+use scatter_shaderlib::prefiltered::{
+    FrameUniforms, LightKind, SliceParams, Variant, VisibilityMode,
+};
 
 /// The kernel body for invocation `id` = (row, region, thread).
 #[allow(clippy::too_many_arguments, reason = "bindings of the kernel")]
@@ -39,7 +27,10 @@ pub fn prefilter_main(
 ) {
     let (row, region, thread) = (id[0], id[1], id[2]);
     let width = frame.sizes[2];
-    if row >= frame.sizes[3] || region >= variant.regions || thread >= variant.threads_per_row_region() {
+    if row >= frame.sizes[3]
+        || region >= variant.regions
+        || thread >= variant.threads_per_row_region()
+    {
         return;
     }
     let weighted = variant.visibility == VisibilityMode::Weighted;
@@ -62,20 +53,37 @@ pub fn prefilter_main(
             for c in 0..4 {
                 a[c] = a[c] * (1.0 - blend) + b[c] * blend;
             }
-            let stored = [a[0] * 0.5 + 0.5, a[1] * 0.5 + 0.5, a[2] * 0.5 + 0.5, a[3] * 0.5 + 0.5];
+            let stored = [
+                a[0] * 0.5 + 0.5,
+                a[1] * 0.5 + 0.5,
+                a[2] * 0.5 + 0.5,
+                a[3] * 0.5 + 0.5,
+            ];
             filtered.store(i, row, layer, stored, variant.storage);
         }
     }
 }
 
 /// Runs every invocation; returns the filtered-basis array.
-pub fn prefilter(variant: &Variant, frame: &FrameUniforms, slices: &[SliceParams], rectified: &Tex) -> TexArray {
+pub fn prefilter(
+    variant: &Variant,
+    frame: &FrameUniforms,
+    slices: &[SliceParams],
+    rectified: &Tex,
+) -> TexArray {
     let (w, h) = (frame.sizes[2], frame.sizes[3]);
     let mut filtered = TexArray::new(w, h, variant.layers());
     for row in 0..h {
         for region in 0..variant.regions {
             for thread in 0..variant.threads_per_row_region() {
-                prefilter_main([row, region, thread], variant, frame, slices, rectified, &mut filtered);
+                prefilter_main(
+                    [row, region, thread],
+                    variant,
+                    frame,
+                    slices,
+                    rectified,
+                    &mut filtered,
+                );
             }
         }
     }

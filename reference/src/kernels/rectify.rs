@@ -56,8 +56,14 @@ pub fn rectify(frame: &FrameUniforms, slices: &[SliceParams], shadow_map: &Tex, 
     let data = (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
-            (0..w).map(move |x| rectify_main([x, y, 0], frame, slices, shadow_map, spot).unwrap_or(0.0))
+            (0..w).map(move |x| {
+                rectify_main([x, y, 0], frame, slices, shadow_map, spot).unwrap_or(0.0)
+            })
         })
         .collect();
-    Tex { width: w, height: h, data }
+    Tex {
+        width: w,
+        height: h,
+        data,
+    }
 }

@@ -14,9 +14,9 @@ use super::common_model::{
     transmittance_between, transmittance_integral,
 };
 use super::common_prefiltered::{
-    Tex, TexArray, coeff4, normalised_depth, quantise, sample_bilinear, sm_visibility, xyz,
+    Tex, TexArray, coeff4, normalised_depth, quantise, region_start, sample_bilinear,
+    sm_visibility, xyz,
 };
-use super::prefilter::region_start;
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
     FrameUniforms, LightKind, SliceParams, Storage, Variant, VisibilityMode,
@@ -44,7 +44,9 @@ pub fn pixel_dir(f: &FrameUniforms, x: u32, y: u32) -> Vec3 {
     let ndc_x = 2.0 * (x as f32 + 0.5) / f.sizes[0] as f32 - 1.0;
     let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / f.sizes[1] as f32;
     let t = f.cam_forward[3];
-    (xyz(f.cam_forward) + xyz(f.cam_right) * (ndc_x * t * f.cam_right[3]) + xyz(f.cam_up) * (ndc_y * t))
+    (xyz(f.cam_forward)
+        + xyz(f.cam_right) * (ndc_x * t * f.cam_right[3])
+        + xyz(f.cam_up) * (ndc_y * t))
         .normalize()
 }
 
@@ -58,7 +60,18 @@ pub fn march(inp: &ScatterInputs, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f
         let t = (k as f32 + 0.5) * h;
         let v = sm_visibility(f, inp.shadow_map, eye + dir * t);
         if spot {
-            sum += v * h * spot_integrand(eye, dir, t, xyz(f.light_pos), xyz(f.light_dir), f.light_pos[3], f.light_dir[3], f.medium);
+            sum += v
+                * h
+                * spot_integrand(
+                    eye,
+                    dir,
+                    t,
+                    xyz(f.light_pos),
+                    xyz(f.light_dir),
+                    f.light_pos[3],
+                    f.light_dir[3],
+                    f.medium,
+                );
         } else {
             sum += v * transmittance_between(f.medium[0], k as f32 * h, (k + 1) as f32 * h);
         }
@@ -87,9 +100,10 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
     // Near the epipole and the anti-epipole the rectification degenerates: march instead.
     let px = Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 0.0);
     let radius = f.epipole[3];
-    let near_epi = f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
-    let near_anti =
-        f.anti_epipole[2] > 0.5 && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
+    let near_epi =
+        f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
+    let near_anti = f.anti_epipole[2] > 0.5
+        && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
     if near_epi || near_anti {
         let l = march(inp, eye, dir, s, spot) * color;
         return Some([l.x, l.y, l.z, 1.0]);
@@ -143,9 +157,17 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         let b0 = region_start(r, regions, width, spot) as f32;
         let b1 = region_start(r + 1, regions, width, spot) as f32;
         let is_last = last < b1 as u32 || r + 1 == regions;
-        pos[r as usize] = if is_last { clamp(xs - 0.5, b0 + 0.5, b1 - 0.5) } else { b1 - 0.5 };
+        pos[r as usize] = if is_last {
+            clamp(xs - 0.5, b0 + 0.5, b1 - 0.5)
+        } else {
+            b1 - 0.5
+        };
         t0[r as usize] = ray_t(f, b0, delta, theta, s, spot);
-        t1[r as usize] = if is_last { s } else { ray_t(f, b1, delta, theta, s, spot) };
+        t1[r as usize] = if is_last {
+            s
+        } else {
+            ray_t(f, b1, delta, theta, s, spot)
+        };
         count = r + 1;
         if is_last {
             break;
@@ -162,7 +184,9 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         } else if spot {
             spot_segment(f, eye, dir, a, b, panels)
         } else {
-            f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_between(f.medium[0], a, b)
+            f.medium[1]
+                * phase_hg(f.medium[2], cos_theta_l)
+                * transmittance_between(f.medium[0], a, b)
         };
         let mut vis = 0.5;
         for layer in 0..variant.layers() {
@@ -182,7 +206,9 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         let unshadowed = if spot {
             spot_segment(f, eye, dir, 0.0, s, max_u(f.sizes2[2] / 4, 1))
         } else {
-            f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_integral(f.medium[0], s)
+            f.medium[1]
+                * phase_hg(f.medium[2], cos_theta_l)
+                * transmittance_integral(f.medium[0], s)
         };
         unshadowed * select(1.0, total / norm, norm > 0.0)
     };
@@ -215,7 +241,16 @@ pub fn spot_segment(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, pan
         for q in 0..4 {
             let t = mid + 0.5 * h * GL4_X[q];
             sum += GL4_W[q]
-                * spot_integrand(eye, dir, t, xyz(f.light_pos), xyz(f.light_dir), f.light_pos[3], f.light_dir[3], f.medium);
+                * spot_integrand(
+                    eye,
+                    dir,
+                    t,
+                    xyz(f.light_pos),
+                    xyz(f.light_dir),
+                    f.light_pos[3],
+                    f.light_dir[3],
+                    f.medium,
+                );
         }
     }
     sum * 0.5 * h
@@ -236,5 +271,10 @@ pub fn scatter(variant: &Variant, inp: &ScatterInputs) -> TexArray {
             })
         })
         .collect();
-    TexArray { width: w, height: h, layers: 1, data }
+    TexArray {
+        width: w,
+        height: h,
+        layers: 1,
+        data,
+    }
 }

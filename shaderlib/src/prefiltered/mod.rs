@@ -1,13 +1,17 @@
 //! The `prefiltered` family (Klehm et al. 2014): variant knobs, per-frame parameters and the
 //! three kernels `rectify`, `prefilter` and `scatter`.
 //!
-//! CPU mirrors: `reference/src/kernels/{prefiltered_common,rectify,prefilter,scatter}.rs`.
+//! CPU mirrors: `reference/src/kernels/{common_model,common_prefiltered,rectify,prefilter,scatter}.rs`.
 
 pub mod frame;
+pub mod kernels;
 pub mod variant;
 
 pub use frame::{
     CameraDesc, FrameError, FrameReport, FrameSettings, FrameUniforms, LightDesc, MediumDesc,
     PrefilteredFrame, Resolutions, ShadowMapDesc, ShadowProjectionDesc, SliceParams, prepare_frame,
+};
+pub use kernels::{
+    MAX_REGIONS, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE,
 };
 pub use variant::{LightKind, Rectification, Storage, Variant, VariantError, VisibilityMode};

@@ -203,7 +203,10 @@ impl Variant {
 
     /// Every valid `bases_per_thread` for `bases`.
     pub fn bases_per_thread_options(bases: u32) -> Vec<u32> {
-        (4..=bases).step_by(4).filter(|b| bases.is_multiple_of(*b)).collect()
+        (4..=bases)
+            .step_by(4)
+            .filter(|b| bases.is_multiple_of(*b))
+            .collect()
     }
 
     /// rgba layers of the filtered-basis texture array: `bases / 4`.

@@ -1,0 +1,122 @@
+//! The askama views of the prefiltered family's templates (`templates/rectify.wgsl`,
+//! `templates/prefilter.wgsl`, `templates/scatter.wgsl`) and their rendering from a
+//! [`Variant`]. CPU mirrors: `reference/src/kernels/{rectify,prefilter,scatter}.rs`.
+//!
+//! Every value the templates print is computed here (plain numbers, booleans and names);
+//! the templates do no arithmetic or string building.
+
+use askama::Template;
+
+use super::variant::{LightKind, Variant, VisibilityMode};
+use crate::compose::template_path;
+use crate::{Kernel, ShaderError};
+
+/// Workgroup size of `rectify`: one invocation per rectified texel.
+pub const RECTIFY_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
+/// Workgroup size of `prefilter`: one invocation per (row, region, thread).
+pub const PREFILTER_WORKGROUP_SIZE: [u32; 3] = [64, 1, 1];
+/// Workgroup size of `scatter`: one invocation per screen pixel.
+pub const SCATTER_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
+/// Largest `regions` the `scatter` kernel's per-pixel arrays hold (`MAX_REGIONS` in WGSL).
+pub const MAX_REGIONS: u32 = 8;
+
+/// `rectify`: epipolar resampling of the standard shadow map.
+#[derive(Template)]
+#[template(path = "rectify.wgsl")]
+struct RectifyTemplate {
+    light_name: &'static str,
+    spot: bool,
+}
+
+/// `prefilter`: Fourier basis transform and weighted running mean per row and region.
+#[derive(Template)]
+#[template(path = "prefilter.wgsl")]
+struct PrefilterTemplate {
+    light_name: &'static str,
+    visibility_name: &'static str,
+    storage: &'static str,
+    spot: bool,
+    weighted: bool,
+    bases: u32,
+    layers: u32,
+    bases_per_thread: u32,
+    layers_per_thread: u32,
+    threads_per_row_region: u32,
+    regions: u32,
+}
+
+/// `scatter`: per-pixel prefiltered estimate plus the epipole ray march.
+#[derive(Template)]
+#[template(path = "scatter.wgsl")]
+struct ScatterTemplate {
+    light_name: &'static str,
+    visibility_name: &'static str,
+    spot: bool,
+    weighted: bool,
+    bases: u32,
+    layers: u32,
+    regions: u32,
+}
+
+/// Checks `variant` on behalf of `kernel`.
+fn validate(kernel: Kernel, variant: &Variant) -> Result<(), ShaderError> {
+    variant
+        .validate()
+        .map_err(|source| ShaderError::Variant { kernel, source })
+}
+
+fn render_error(kernel: Kernel) -> impl FnOnce(askama::Error) -> ShaderError {
+    move |source| ShaderError::Render {
+        kernel,
+        template: template_path(kernel),
+        source,
+    }
+}
+
+/// Renders `templates/rectify.wgsl` for `variant` (only its light matters).
+pub(crate) fn render_rectify(variant: &Variant) -> Result<String, ShaderError> {
+    validate(Kernel::Rectify, variant)?;
+    RectifyTemplate {
+        light_name: variant.light.name(),
+        spot: variant.light == LightKind::Spot,
+    }
+    .render()
+    .map_err(render_error(Kernel::Rectify))
+}
+
+/// Renders `templates/prefilter.wgsl` for `variant`.
+pub(crate) fn render_prefilter(variant: &Variant) -> Result<String, ShaderError> {
+    validate(Kernel::Prefilter, variant)?;
+    PrefilterTemplate {
+        light_name: variant.light.name(),
+        visibility_name: variant.visibility.name(),
+        storage: variant.storage.name(),
+        spot: variant.light == LightKind::Spot,
+        weighted: variant.visibility == VisibilityMode::Weighted,
+        bases: variant.bases,
+        layers: variant.layers(),
+        bases_per_thread: variant.bases_per_thread,
+        layers_per_thread: variant.bases_per_thread / 4,
+        threads_per_row_region: variant.threads_per_row_region(),
+        regions: variant.regions,
+    }
+    .render()
+    .map_err(render_error(Kernel::Prefilter))
+}
+
+/// Renders `templates/scatter.wgsl` for `variant` (`bases_per_thread` and `storage` do not
+/// matter).
+pub(crate) fn render_scatter(variant: &Variant) -> Result<String, ShaderError> {
+    validate(Kernel::Scatter, variant)?;
+    ScatterTemplate {
+        light_name: variant.light.name(),
+        visibility_name: variant.visibility.name(),
+        spot: variant.light == LightKind::Spot,
+        weighted: variant.visibility == VisibilityMode::Weighted,
+        bases: variant.bases,
+        layers: variant.layers(),
+        regions: variant.regions,
+    }
+    .render()
+    .map_err(render_error(Kernel::Scatter))
+}

@@ -1,0 +1,67 @@
+// scatter::model: the single-scattering model's terms in f32, as every kernel evaluates them:
+// Henyey-Greenstein phase, transmittance integrals of a homogeneous medium, the spot light's
+// cone falloff and in-scattering integrand, 4-point Gauss-Legendre nodes.
+//
+// Composed into kernels by naga_oil (`#import scatter::model::{...}`); plain WGSL, not an
+// askama template. Mirrored line by line by reference/src/kernels/common_model.rs.
+
+#define_import_path scatter::model
+
+const PI: f32 = 3.14159265358979323846f;
+
+// Henyey-Greenstein phase function of `cos_theta`.
+fn phase_hg(g: f32, cos_theta: f32) -> f32 {
+    let denom = max(1.0 + g * g - 2.0 * g * cos_theta, 1e-8);
+    return (1.0 - g * g) / (4.0 * PI * denom * sqrt(denom));
+}
+
+// `(1 - exp(-sigma_t len)) / sigma_t`, and `len` as `sigma_t len -> 0` (series below 1e-4).
+fn transmittance_integral(sigma_t: f32, len: f32) -> f32 {
+    let x = sigma_t * len;
+    if x < 1e-4 {
+        return len * (1.0 - 0.5 * x);
+    }
+    return (1.0 - exp(-x)) / sigma_t;
+}
+
+// `integral_a^b exp(-sigma_t t) dt`.
+fn transmittance_between(sigma_t: f32, a: f32, b: f32) -> f32 {
+    return exp(-sigma_t * a) * transmittance_integral(sigma_t, b - a);
+}
+
+// Smoothstep cone falloff from the cosines of the outer and inner half-angles.
+fn cone_falloff(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    if cos_inner - cos_outer <= 1e-6 {
+        return select(0.0, 1.0, cos_angle >= cos_outer);
+    }
+    let x = clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return x * x * (3.0 - 2.0 * x);
+}
+
+// Spot-light integrand `sigma_s p I_cone exp(-sigma_t (d + t)) / d^2` at ray parameter
+// `t` (without the light colour), for the view ray `eye + t dir`.
+// `medium` = (sigma_t, sigma_s, g, unused), as in the `Frame` uniform.
+fn spot_integrand(
+    eye: vec3<f32>,
+    dir: vec3<f32>,
+    t: f32,
+    light_pos: vec3<f32>,
+    light_dir: vec3<f32>,
+    cos_inner: f32,
+    cos_outer: f32,
+    medium: vec4<f32>,
+) -> f32 {
+    let x = eye + dir * t;
+    let to_x = x - light_pos;
+    let d2 = max(dot(to_x, to_x), 1e-12);
+    let d = sqrt(d2);
+    let travel = to_x / d;
+    let cone = cone_falloff(dot(travel, light_dir), cos_inner, cos_outer);
+    let p = phase_hg(medium[2], -dot(travel, dir));
+    return medium[1] * p * cone * exp(-medium[0] * (d + t)) / d2;
+}
+
+// 4-point Gauss-Legendre abscissae on [-1, 1] (ascending).
+const GL4_X: array<f32, 4> = array<f32, 4>(-0.8611363f, -0.33998104f, 0.33998104f, 0.8611363f);
+// 4-point Gauss-Legendre weights.
+const GL4_W: array<f32, 4> = array<f32, 4>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);

@@ -1,0 +1,269 @@
+// scatter::prefiltered: what the three kernels of the prefiltered family (Klehm et al. 2014)
+// share: the `Frame` uniform block, the per-slice parameters, the rectified-space mapping
+// (Sec. 4.1), the Fourier basis and its coefficients (Sec. 3, Eq. 8), the prefilter's
+// reference-ray weights (Eq. 11/12), region bounds (Table 1) and the standard shadow-map
+// lookup used by `rectify` and by the epipole ray march of `scatter` (Sec. 5).
+//
+// Composed into kernels by naga_oil (`#import scatter::prefiltered::{...}`); plain WGSL, not
+// an askama template. Conventions: `scatter_shaderlib::prefiltered::frame`. Mirrored line by
+// line by reference/src/kernels/common_prefiltered.rs; functions that read a texture take it
+// as a parameter (a shared module cannot see the kernel's bindings), the texture operations
+// themselves (`Tex::load`, `TexArray::store`, `sample_bilinear`) are textureLoad,
+// textureStore and textureSampleLevel in the kernels. `region_start` is mirrored by
+// reference/src/kernels/prefilter.rs.
+
+#define_import_path scatter::prefiltered
+
+#import scatter::model::{PI, cone_falloff, transmittance_between}
+
+// The uniform block (host: `scatter_shaderlib::prefiltered::FrameUniforms`, field by field;
+// every member is 16 bytes, 21 * 16 = 336 bytes in all). The host's `e1`, `e2` and `sizes2`
+// are spelled `e1_`, `e2_` and `sizes2_`: naga's back-ends append `_` to identifiers that end
+// in a digit, and naga_oil requires shared modules to use the written-back spelling.
+struct Frame {
+    // Eye position; w unused.
+    eye: vec4<f32>,
+    // Axis A (towards the light); w = eye-light distance D (spot), 0 (directional).
+    axis: vec4<f32>,
+    // Slice basis e1 (perpendicular to A); w = phi0.
+    e1_: vec4<f32>,
+    // Slice basis e2 = A x e1; w = dphi (radians per row).
+    e2_: vec4<f32>,
+    // Camera forward; w = tan(fov_y / 2).
+    cam_forward: vec4<f32>,
+    // Camera right; w = aspect (width / height).
+    cam_right: vec4<f32>,
+    // Camera up; w = near.
+    cam_up: vec4<f32>,
+    // x = theta_lo, y = theta_hi, z = far, w = 1 / (theta_hi - theta_lo).
+    theta: vec4<f32>,
+    // x = sigma_t, y = sigma_s, z = g, w unused.
+    medium: vec4<f32>,
+    // Light colour (E or I); w unused.
+    light_color: vec4<f32>,
+    // Spot position; w = cos(inner angle).
+    light_pos: vec4<f32>,
+    // Direction the light travels (spot axis); w = cos(outer angle).
+    light_dir: vec4<f32>,
+    // Shadow-map right; w = shadow-map near.
+    sm_right: vec4<f32>,
+    // Shadow-map up; w = shadow-map far.
+    sm_up: vec4<f32>,
+    // Shadow-map forward; w = bias in texel footprints.
+    sm_forward: vec4<f32>,
+    // Shadow-map origin; w = 0 orthographic, 1 perspective.
+    sm_origin: vec4<f32>,
+    // Orthographic: x0, x1, y0, y1. Perspective: tan_half, 0, 0, 0.
+    sm_proj: vec4<f32>,
+    // Epipole pixel position x, y; z = 1 if it is on screen; w = march radius (pixels).
+    epipole: vec4<f32>,
+    // Anti-epipole pixel position x, y; z = 1 if on screen; w = 1 if the slices wrap around.
+    anti_epipole: vec4<f32>,
+    // Screen width, height, rectified width, rectified height.
+    sizes: vec4<u32>,
+    // Shadow-map size, march steps, spot quadrature nodes, unused.
+    sizes2_: vec4<u32>,
+}
+
+// One rectified row's parameters (host: `SliceParams`), unpacked from the kernels'
+// `slices: array<vec4<f32>>` binding by `slice_params`.
+struct SliceParams {
+    // Column spacing: `v` per column (directional) or `psi` per column (spot).
+    delta: f32,
+    // View angle of the slice's reference ray.
+    theta_ref: f32,
+    // Smallest view angle of the slice inside the frustum.
+    theta_lo: f32,
+    // Largest view angle of the slice inside the frustum.
+    theta_hi: f32,
+}
+
+// Unpacks one entry of the `slices` binding (x = delta, y = theta_ref, z = theta_lo,
+// w = theta_hi). No mirror: the CPU reads `SliceParams` directly.
+fn slice_params(v: vec4<f32>) -> SliceParams {
+    return SliceParams(v.x, v.y, v.z, v.w);
+}
+
+// Stand-in for "no occluder": a travel distance far beyond any scene.
+const NO_OCCLUDER: f32 = 1e30f;
+
+// Unit vector of slice angle `phi` (perpendicular to the axis).
+fn slice_e(f: Frame, phi: f32) -> vec3<f32> {
+    return f.e1_.xyz * cos(phi) + f.e2_.xyz * sin(phi);
+}
+
+// Slice angle at the centre of row `row`.
+fn row_phi(f: Frame, row: u32) -> f32 {
+    return f.e1_[3] + (f32(row) + 0.5) * f.e2_[3];
+}
+
+// Normalised rectified depth of view angle `theta`, the frame's view angles spanning
+// [`lo`, `hi`] (`Frame::theta`).
+fn normalised_depth(theta: f32, lo: f32, hi: f32) -> f32 {
+    return DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp((theta - lo) / max(hi - lo, 1e-6), 0.0, 1.0);
+}
+
+// Rectified depths use [DEPTH_MARGIN, 1 - DEPTH_MARGIN]: the Fourier series of the step
+// is 2-periodic, so depth differences near +-1 (a ray at the very start of the range
+// against an empty light ray) would fall on the periodic copy's discontinuity.
+const DEPTH_MARGIN: f32 = 0.1f;
+
+// Fourier frequency `c_k = pi (2k - 1)`.
+fn freq(k: u32) -> f32 {
+    return PI * f32(2u * k - 1u);
+}
+
+// Basis values of layer `layer` at depth `d`: `(sin c1 d, cos c1 d, sin c2 d, cos c2 d)`
+// with `k1 = 2 layer + 1`, `k2 = 2 layer + 2` (Klehm Eq. 8: B_{2k-1} = sin, B_{2k} = cos).
+fn basis4(d: f32, layer: u32) -> vec4<f32> {
+    let c1 = freq(2u * layer + 1u);
+    let c2 = freq(2u * layer + 2u);
+    return vec4<f32>(sin(c1 * d), cos(c1 * d), sin(c2 * d), cos(c2 * d));
+}
+
+// Coefficients of layer `layer` for a ray of depth `d`:
+// `(2/c1 cos c1 d, -2/c1 sin c1 d, 2/c2 cos c2 d, -2/c2 sin c2 d)`, so that
+// `V = 0.5 + sum a . B` approximates the step `H(d_i - d)`.
+fn coeff4(d: f32, layer: u32) -> vec4<f32> {
+    let c1 = freq(2u * layer + 1u);
+    let c2 = freq(2u * layer + 2u);
+    return vec4<f32>(
+        2.0 / c1 * cos(c1 * d),
+        -2.0 / c1 * sin(c1 * d),
+        2.0 / c2 * cos(c2 * d),
+        -2.0 / c2 * sin(c2 * d),
+    );
+}
+
+// First column of region `r` of `regions` in a row of `width` columns. Directional lights
+// split rows quadratically (`width r^2 / regions^2`): transmittance concentrates the
+// integrand near the eye (column 0), and finer regions there cut the reference-ray
+// weighting error. Spot lights split uniformly (`width r / regions`), as in the paper.
+fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
+    if spot {
+        return r * width / regions;
+    }
+    return r * r * width / (regions * regions);
+}
+
+// Distance from the eye, along the slice's reference ray, of column edge `x` (continuous,
+// in columns), capped at four far-plane distances.
+fn ref_t(f: Frame, s: SliceParams, x: f32, spot: bool) -> f32 {
+    let cap = 4.0 * f.theta[2];
+    if spot {
+        let psi = x * s.delta;
+        let den = sin(s.theta_ref + psi);
+        if den <= 1e-4 || s.theta_ref + psi >= PI {
+            return cap;
+        }
+        return min(f.axis[3] * sin(psi) / den, cap);
+    } else {
+        return min(x * s.delta / max(sin(s.theta_ref), 1e-4), cap);
+    }
+}
+
+// Prefilter weight of column `i` of row `row`: the length of the reference ray it covers
+// (average), or the transmittance integral over that span (weighted), times the cone
+// falloff and `exp(-sigma_t r) / r^2` at the span's middle for a spot light.
+fn texel_weight(f: Frame, s: SliceParams, row: u32, i: u32, weighted: bool, spot: bool) -> f32 {
+    let t0 = ref_t(f, s, f32(i), spot);
+    let t1 = ref_t(f, s, f32(i + 1u), spot);
+    if !weighted {
+        return t1 - t0;
+    }
+    var w = transmittance_between(f.medium[0], t0, t1);
+    if spot {
+        let psi = (f32(i) + 0.5) * s.delta;
+        let e = slice_e(f, row_phi(f, row));
+        let l = -f.axis.xyz * cos(psi) + e * sin(psi);
+        let den = max(sin(s.theta_ref + psi), 1e-4);
+        let r = max(f.axis[3] * sin(s.theta_ref) / den, 1e-4);
+        let cone = cone_falloff(dot(l, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]);
+        w *= cone * exp(-f.medium[0] * r) / (r * r);
+    }
+    return w;
+}
+
+// Light-space coordinates of a world point in the standard shadow map.
+fn sm_light_space(f: Frame, p: vec3<f32>) -> vec3<f32> {
+    let q = p - f.sm_origin.xyz;
+    return vec3<f32>(dot(q, f.sm_right.xyz), dot(q, f.sm_up.xyz), dot(q, f.sm_forward.xyz));
+}
+
+// Texture coordinates (u, v) in [0, 1] of light-space point `ls` (outside: no coverage).
+fn sm_uv(f: Frame, ls: vec3<f32>) -> vec2<f32> {
+    if f.sm_origin[3] > 0.5 {
+        let z = max(ls.z, 1e-6);
+        let t = f.sm_proj[0];
+        return vec2<f32>(0.5 + 0.5 * ls.x / (z * t), 0.5 - 0.5 * ls.y / (z * t));
+    } else {
+        return vec2<f32>(
+            (ls.x - f.sm_proj[0]) / (f.sm_proj[1] - f.sm_proj[0]),
+            (f.sm_proj[3] - ls.y) / (f.sm_proj[3] - f.sm_proj[2]),
+        );
+    }
+}
+
+// Depth bias in world units at light-space depth `z`.
+fn sm_bias(f: Frame, z: f32) -> f32 {
+    let size = f32(f.sizes2_[0]);
+    var texel: f32;
+    if f.sm_origin[3] > 0.5 {
+        texel = 2.0 * max(z, 0.0) * f.sm_proj[0] / size;
+    } else {
+        texel = max(f.sm_proj[1] - f.sm_proj[0], f.sm_proj[3] - f.sm_proj[2]) / size;
+    }
+    return f.sm_forward[3] * texel;
+}
+
+// Stored depth of the nearest texel at (u, v), or 2 (beyond everything) outside the map.
+// `sm`: the kernel's r32float `shadow_map` binding.
+fn sm_fetch(f: Frame, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
+    if uv[0] < 0.0 || uv[0] > 1.0 || uv[1] < 0.0 || uv[1] > 1.0 {
+        return 2.0;
+    }
+    let n = f.sizes2_[0];
+    let x = min(u32(uv[0] * f32(n)), n - 1u);
+    let y = min(u32(uv[1] * f32(n)), n - 1u);
+    return textureLoad(sm, vec2<u32>(x, y), 0).x;
+}
+
+// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed): nearest texel,
+// biased, exactly the test of the `shadow_map` ground truth.
+fn sm_visibility(f: Frame, sm: texture_2d<f32>, p: vec3<f32>) -> f32 {
+    let ls = sm_light_space(f, p);
+    let near = f.sm_right[3]; let far = f.sm_up[3];
+    if f.sm_origin[3] > 0.5 && ls.z <= near {
+        return 1.0;
+    }
+    let stored = sm_fetch(f, sm, sm_uv(f, ls));
+    let depth = (ls.z - near) / (far - near);
+    return select(0.0, 1.0, depth <= stored + sm_bias(f, ls.z) / (far - near));
+}
+
+// Travel distance from `o` along the light ray `o + s l` to its first occluder, biased as
+// `sm_visibility` biases (points before it are lit), or NO_OCCLUDER. For a spot the
+// ray must start at the shadow map's origin (the light).
+fn sm_occluder_distance(f: Frame, sm: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
+    let ls = sm_light_space(f, o);
+    let near = f.sm_right[3]; let far = f.sm_up[3];
+    if f.sm_origin[3] > 0.5 {
+        let dir = vec3<f32>(dot(l, f.sm_right.xyz), dot(l, f.sm_up.xyz), dot(l, f.sm_forward.xyz));
+        if dir.z <= 1e-6 {
+            return NO_OCCLUDER;
+        }
+        let stored = sm_fetch(f, sm, sm_uv(f, dir));
+        if stored >= 1.0 {
+            return NO_OCCLUDER;
+        }
+        let z = near + stored * (far - near);
+        return (z + sm_bias(f, z)) / dir.z;
+    } else {
+        let stored = sm_fetch(f, sm, sm_uv(f, ls));
+        if stored >= 1.0 {
+            return NO_OCCLUDER;
+        }
+        let z = near + stored * (far - near);
+        return z + sm_bias(f, z) - ls.z;
+    }
+}

@@ -1,0 +1,70 @@
+// prefilter ({{ bases }} bases, {{ bases_per_thread }} per thread, {{ regions }} regions, {{ visibility_name }} visibility, {{ light_name }} light, {{ storage }}):
+// the Fourier basis transform fused with the weighted running mean along each rectified row
+// (Klehm et al. 2014, Sec. 3.3 and 5, Listings 1-3, Table 1's regions and bases per thread).
+//
+// One invocation per (row, region, thread): thread t of a row-region filters the
+// {{ bases_per_thread }} bases of layers t * {{ layers_per_thread }} .. (t + 1) * {{ layers_per_thread }}, four bases packed per vec4.
+// Each region restarts the running mean. Stored per texel: the normalised weighted mean
+// F_k = sum w_i B_k(d_i) / sum w_i over the region up to the texel, mapped to [0, 1] as
+// F / 2 + 0.5 in {{ storage }}.
+//
+// Bindings (group 0):
+// | binding | name      | type                                            | access       |
+// |---------|-----------|-------------------------------------------------|--------------|
+// | 0       | frame     | var<uniform> Frame (336 bytes)                  | uniform      |
+// | 1       | slices    | var<storage, read> array<vec4<f32>>             | read         |
+// | 2       | rectified | texture_2d<f32> (r32float)                      | textureLoad  |
+// | 3       | filtered  | texture_storage_2d_array<FORMAT, write>         | textureStore |
+// filtered: FORMAT = {{ storage }}; Wr x Hr x {{ layers }} layers (bases / 4), Wr x Hr = the rectified
+// size (frame.sizes.zw).
+//
+// Dispatch: (ceil(Hr / 64), {{ regions }}, {{ threads_per_row_region }}) workgroups of (64, 1, 1);
+// invocation id x = row, y = region, z = thread.
+//
+// Mirrors reference/src/kernels/prefilter.rs
+
+#import scatter::prefiltered::{Frame, basis4, region_start, slice_params, texel_weight}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
+@group(0) @binding(2) var rectified: texture_2d<f32>;
+@group(0) @binding(3) var filtered: texture_storage_2d_array<{{ storage }}, write>;
+
+// Independent prefix regions per row.
+const REGIONS: u32 = {{ regions }}u;
+// Bases filtered by one invocation.
+const BASES_PER_THREAD: u32 = {{ bases_per_thread }}u;
+// Invocations per (row, region): bases / bases_per_thread.
+const THREADS_PER_ROW_REGION: u32 = {{ threads_per_row_region }}u;
+
+// The kernel body for invocation `id` = (row, region, thread).
+@compute @workgroup_size(64, 1, 1)
+fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
+    let row = id.x; let region = id.y; let thread = id.z;
+    let width = frame.sizes[2];
+    if row >= frame.sizes[3] || region >= REGIONS || thread >= THREADS_PER_ROW_REGION {
+        return;
+    }
+    let weighted = {{ weighted }};
+    let spot = {{ spot }};
+    let layers_per_thread = BASES_PER_THREAD / 4u;
+    let slice = slice_params(slices[row]);
+    let start = region_start(region, REGIONS, width, spot);
+    let end = region_start(region + 1u, REGIONS, width, spot);
+    var acc: array<vec4<f32>, {{ layers_per_thread }}>;
+    var wsum = 0.0;
+    for (var i = start; i < end; i++) {
+        let d = textureLoad(rectified, vec2<u32>(i, row), 0).x;
+        let w = texel_weight(frame, slice, row, i, weighted, spot);
+        wsum += w;
+        let blend = select(0.0, w / wsum, wsum > 0.0);
+        for (var q = 0u; q < layers_per_thread; q++) {
+            let layer = thread * layers_per_thread + q;
+            let b = basis4(d, layer);
+            let a = acc[q];
+            acc[q] = a * (1.0 - blend) + b * blend;
+            let stored = acc[q] * 0.5 + 0.5;
+            textureStore(filtered, vec2<u32>(i, row), layer, stored);
+        }
+    }
+}

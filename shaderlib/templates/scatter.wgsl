@@ -1,0 +1,237 @@
+// scatter ({{ layers }} layers = {{ bases }} bases, {{ regions }} regions, {{ visibility_name }} visibility, {{ light_name }} light): per pixel, the
+// prefiltered estimate of in-scattered light (Klehm et al. 2014, Sec. 3, Listing 4: one dot
+// product of the pixel's Fourier coefficients with the filtered bases per region) and a ray
+// march against the standard shadow map for pixels near the epipole or the anti-epipole,
+// where the rectification degenerates (Sec. 5, Fig. 8).
+//
+// Weighted visibility: L = sum_j U_j Vbar_j over the regions the ray crosses, U_j the
+// pixel's own unshadowed integral over its part of the ray inside region j (closed form
+// for the sun, Gauss-Legendre for a spot) and Vbar_j = clamp(0.5 + a(d) . F_j, 0, 1) the
+// region's prefiltered visibility. Average visibility: L = L_unshadowed * sum_j len_j Vbar_j / s.
+//
+// Bindings (group 0):
+// | binding | name             | type                                     | access             |
+// |---------|------------------|------------------------------------------|--------------------|
+// | 0       | frame            | var<uniform> Frame (336 bytes)           | uniform            |
+// | 1       | slices           | var<storage, read> array<vec4<f32>>      | read               |
+// | 2       | depth            | texture_2d<f32> (r32float, view depth)   | textureLoad        |
+// | 3       | shadow_map       | texture_2d<f32> (r32float)               | textureLoad        |
+// | 4       | filtered         | texture_2d_array<f32> (prefilter's)      | textureSampleLevel |
+// | 5       | filtered_sampler | sampler (filtering, linear)              | textureSampleLevel |
+// | 6       | output           | texture_storage_2d<rgba16float, write>   | textureStore       |
+// filtered: Wr x Hr x {{ layers }} layers, Wr x Hr = the rectified size (frame.sizes.zw).
+// filtered_sampler: clamp-to-edge in u; in v repeat when the slices wrap around
+// (frame.anti_epipole.w > 0.5), else clamp-to-edge.
+//
+// Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
+// (frame.sizes.xy); invocation id x = pixel column, y = pixel row.
+//
+// Mirrors reference/src/kernels/scatter.rs
+
+#import scatter::model::{GL4_W, GL4_X, PI, phase_hg, spot_integrand, transmittance_between, transmittance_integral}
+#import scatter::prefiltered::{Frame, coeff4, normalised_depth, region_start, slice_params, sm_visibility}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
+@group(0) @binding(2) var depth: texture_2d<f32>;
+@group(0) @binding(3) var shadow_map: texture_2d<f32>;
+@group(0) @binding(4) var filtered: texture_2d_array<f32>;
+@group(0) @binding(5) var filtered_sampler: sampler;
+@group(0) @binding(6) var output: texture_storage_2d<rgba16float, write>;
+
+// Most regions a variant may have (the size of the per-pixel region arrays).
+const MAX_REGIONS: u32 = 8u;
+// Independent prefix regions per rectified row.
+const REGIONS: u32 = {{ regions }}u;
+// rgba layers of `filtered` (bases / 4).
+const LAYERS: u32 = {{ layers }}u;
+
+// Unit view direction through the centre of pixel (x, y).
+fn pixel_dir(f: Frame, x: u32, y: u32) -> vec3<f32> {
+    let ndc_x = 2.0 * (f32(x) + 0.5) / f32(f.sizes[0]) - 1.0;
+    let ndc_y = 1.0 - 2.0 * (f32(y) + 0.5) / f32(f.sizes[1]);
+    let t = f.cam_forward[3];
+    return normalize(f.cam_forward.xyz + f.cam_right.xyz * (ndc_x * t * f.cam_right[3]) + f.cam_up.xyz * (ndc_y * t));
+}
+
+// In-scattering by ray marching `steps` midpoints against the standard shadow map.
+fn march(eye: vec3<f32>, dir: vec3<f32>, s: f32, spot: bool) -> f32 {
+    let f = frame;
+    let steps = f.sizes2_[1];
+    let h = s / f32(steps);
+    var sum = 0.0;
+    for (var k = 0u; k < steps; k++) {
+        let t = (f32(k) + 0.5) * h;
+        let v = sm_visibility(f, shadow_map, eye + dir * t);
+        if spot {
+            sum += v * h * spot_integrand(eye, dir, t, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
+        } else {
+            sum += v * transmittance_between(f.medium[0], f32(k) * h, f32(k + 1u) * h);
+        }
+    }
+    if spot {
+        return sum;
+    } else {
+        return f.medium[1] * phase_hg(f.medium[2], -dot(f.light_dir.xyz, dir)) * sum;
+    }
+}
+
+// Row of the `slices` table for row coordinate `j` (a whole number): wrapped around when
+// the slices cover the full circle, else clamped (the mirror's `row_index` closure).
+fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = i32(j);
+    if wrap {
+        return u32(((ji % i32(rows)) + i32(rows)) % i32(rows));
+    } else {
+        return u32(clamp(ji, 0, i32(rows) - 1));
+    }
+}
+
+// The kernel body for pixel `id`; stores the pixel's in-scattered radiance.
+@compute @workgroup_size(8, 8, 1)
+fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
+    let f = frame;
+    let x = id.x; let y = id.y;
+    if x >= f.sizes[0] || y >= f.sizes[1] {
+        return;
+    }
+    let spot = {{ spot }};
+    let weighted = {{ weighted }};
+    let eye = f.eye.xyz;
+    let dir = pixel_dir(f, x, y);
+    let s = max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0) / max(dot(dir, f.cam_forward.xyz), 1e-6);
+    let color = f.light_color.xyz;
+
+    // Near the epipole and the anti-epipole the rectification degenerates: march instead.
+    let px = vec3<f32>(f32(x) + 0.5, f32(y) + 0.5, 0.0);
+    let radius = f.epipole[3];
+    let near_epi = f.epipole[2] > 0.5 && length(px - vec3<f32>(f.epipole[0], f.epipole[1], 0.0)) < radius;
+    let near_anti =
+        f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
+    if near_epi || near_anti {
+        let l = march(eye, dir, s, spot) * color;
+        textureStore(output, vec2<u32>(x, y), vec4<f32>(l.x, l.y, l.z, 1.0));
+        return;
+    }
+
+    // Rectified coordinates of the surface point.
+    let axis = f.axis.xyz;
+    let theta = acos(clamp(dot(dir, axis), -1.0, 1.0));
+    let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
+    let rows = f.sizes[3];
+    let wrap = f.anti_epipole[3] > 0.5;
+    var yc = (phi - f.e1_[3]) / f.e2_[3];
+    if wrap {
+        yc -= floor(yc / f32(rows)) * f32(rows);
+    } else {
+        yc = clamp(yc, 0.0, f32(rows));
+    }
+    // Slice parameters, interpolated between the two nearest slices like the bilinear fetch.
+    let yy = yc - 0.5;
+    let j0 = floor(yy);
+    let fy = yy - j0;
+    let s0 = slice_params(slices[row_index(j0, rows, wrap)]);
+    let s1 = slice_params(slices[row_index(j0 + 1.0, rows, wrap)]);
+    let delta = mix(s0.delta, s1.delta, fy);
+    let d = normalised_depth(theta, f.theta[0], f.theta[1]);
+    var xs: f32;
+    if spot {
+        let q = normalize(eye + dir * s - f.light_pos.xyz);
+        xs = acos(clamp(dot(q, -axis), -1.0, 1.0)) / delta;
+    } else {
+        xs = s * sin(theta) / delta;
+    }
+
+    // Regions: every region before the surface's, whole, and the surface's up to x_s. Each
+    // is weighted by this pixel's own unshadowed integral over its part of the ray.
+    let width = f.sizes[2];
+    let regions = REGIONS;
+    let last = u32(min(max(xs, 0.0), f32(width) - 1.0));
+    var pos: array<f32, MAX_REGIONS>;
+    var t0: array<f32, MAX_REGIONS>;
+    var t1: array<f32, MAX_REGIONS>;
+    var count = 0u;
+    for (var r = 0u; r < regions; r++) {
+        let b0 = f32(region_start(r, regions, width, spot));
+        let b1 = f32(region_start(r + 1u, regions, width, spot));
+        let is_last = last < u32(b1) || r + 1u == regions;
+        pos[r] = select(b1 - 0.5, clamp(xs - 0.5, b0 + 0.5, b1 - 0.5), is_last);
+        t0[r] = ray_t(f, b0, delta, theta, s, spot);
+        t1[r] = select(ray_t(f, b1, delta, theta, s, spot), s, is_last);
+        count = r + 1u;
+        if is_last {
+            break;
+        }
+    }
+    let cos_theta_l = -dot(f.light_dir.xyz, dir);
+    let panels = max(f.sizes2_[2] / 4u / count, 1u);
+    var total = 0.0;
+    var norm = 0.0;
+    for (var r = 0u; r < count; r++) {
+        let a = t0[r]; let b = t1[r];
+        var weight: f32;
+        if !weighted {
+            weight = b - a;
+        } else if spot {
+            weight = spot_segment(f, eye, dir, a, b, panels);
+        } else {
+            weight = f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_between(f.medium[0], a, b);
+        }
+        var vis = 0.5;
+        for (var layer = 0u; layer < LAYERS; layer++) {
+            let coeff = coeff4(d, layer);
+            let texel = textureSampleLevel(filtered, filtered_sampler, vec2<f32>(pos[r] / f32(width), yc / f32(rows)), layer, 0.0);
+            for (var k = 0u; k < 4u; k++) {
+                vis += coeff[k] * (texel[k] * 2.0 - 1.0);
+            }
+        }
+        total += weight * clamp(vis, 0.0, 1.0);
+        norm += weight;
+    }
+    var l: f32;
+    if weighted {
+        l = total;
+    } else {
+        // Average visibility times the unshadowed integral of the whole ray.
+        var unshadowed: f32;
+        if spot {
+            unshadowed = spot_segment(f, eye, dir, 0.0, s, max(f.sizes2_[2] / 4u, 1u));
+        } else {
+            unshadowed = f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_integral(f.medium[0], s);
+        }
+        l = unshadowed * select(1.0, total / norm, norm > 0.0);
+    }
+    let c = color * l;
+    textureStore(output, vec2<u32>(x, y), vec4<f32>(c.x, c.y, c.z, 1.0));
+}
+
+// Distance along the pixel's own ray (angle `theta` to the axis) of column edge `x`, capped
+// at the surface distance `s`.
+fn ray_t(f: Frame, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
+    if spot {
+        let psi = x * delta;
+        let den = sin(theta + psi);
+        if den <= 1e-6 || theta + psi >= PI {
+            return s;
+        }
+        return min(f.axis[3] * sin(psi) / den, s);
+    } else {
+        return min(x * delta / max(sin(theta), 1e-6), s);
+    }
+}
+
+// Unshadowed spot in-scattering over `[a, b]` of the ray: `panels` 4-point Gauss-Legendre
+// panels.
+fn spot_segment(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, panels: u32) -> f32 {
+    let h = (b - a) / f32(panels);
+    var sum = 0.0;
+    for (var k = 0u; k < panels; k++) {
+        let mid = a + (f32(k) + 0.5) * h;
+        for (var q = 0u; q < 4u; q++) {
+            let t = mid + 0.5 * h * GL4_X[q];
+            sum += GL4_W[q]
+                * spot_integrand(eye, dir, t, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
+        }
+    }
+    return sum * 0.5 * h;
+}
