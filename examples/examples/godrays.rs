@@ -18,11 +18,11 @@ use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
-use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::image::Image;
 use scatter_reference::kernels::run_prefiltered;
 use scatter_reference::metrics;
 use scatter_reference::scene::Scene;
+use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Variant, VariantError};
 use std::path::PathBuf;
@@ -201,7 +201,11 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     write_outputs(args, &composite, &inscatter)
 }
 
-fn write_outputs(args: &Args, composite: &Image, inscatter: &Image) -> Result<(), Box<dyn std::error::Error>> {
+fn write_outputs(
+    args: &Args,
+    composite: &Image,
+    inscatter: &Image,
+) -> Result<(), Box<dyn std::error::Error>> {
     let stem = args.out.with_extension("");
     let ins_png = stem.with_extension("inscatter.png");
     let ins_pfm = stem.with_extension("inscatter.pfm");
@@ -231,7 +235,11 @@ fn run_prefiltered_method(
     let rectified = parse_size(&args.rectified)?;
     let t = Instant::now();
     let sm = ShadowMap::build(scene, bvh, args.shadow_map_size)?;
-    eprintln!("shadow map {0}x{0} in {1:.2?}", args.shadow_map_size, t.elapsed());
+    eprintln!(
+        "shadow map {0}x{0} in {1:.2?}",
+        args.shadow_map_size,
+        t.elapsed()
+    );
     let t = Instant::now();
     let settings = FrameSettings::for_screen(args.width, args.height);
     let run = run_prefiltered(&variant, rectified, scene, gbuf, &sm, &settings)?;
@@ -254,15 +262,23 @@ fn run_prefiltered_method(
             segments: args.segments as usize,
             ..TruthSettings::default()
         };
-        let truth = truth::render(scene, gbuf, &Visibility::ShadowMap(&sm), &settings, &|| bar.inc(1));
+        let truth = truth::render(scene, gbuf, &Visibility::ShadowMap(&sm), &settings, &|| {
+            bar.inc(1)
+        });
         bar.finish_and_clear();
         let report = metrics::compare(&run.output, &truth)?;
-        println!("{}: prefiltered {variant} vs shadow_map truth: {report}", scene.name);
+        println!(
+            "{}: prefiltered {variant} vs shadow_map truth: {report}",
+            scene.name
+        );
         let diff = run.output.abs_diff(&truth, 4.0)?;
         let strip = Image::hstack(&[&truth, &run.output, &diff])?;
         let path = args.out.with_extension("").with_extension("compare.png");
         strip.write_png(&path, Some(truth.auto_exposure()))?;
-        eprintln!("wrote {} (truth | prefiltered | 4x difference)", path.display());
+        eprintln!(
+            "wrote {} (truth | prefiltered | 4x difference)",
+            path.display()
+        );
     }
     Ok(())
 }
