@@ -1,6 +1,8 @@
 //! [`RuntimeError`]: failures of a pass (bad input sizes, device limits, wgpu errors),
-//! always naming the kernel.
+//! always naming the kernel or the family; plus the helpers every pass shares to produce
+//! them (limit checks, wgpu error scopes).
 
+use scatter_shaderlib::prefiltered::{FrameError, VariantError};
 use scatter_shaderlib::{Kernel, ShaderError};
 
 /// Failure to build, encode or run a pass.
@@ -70,4 +72,127 @@ pub enum RuntimeError {
         /// What went wrong.
         message: String,
     },
+    /// A `prefiltered` variant has a knob outside its range.
+    #[error("prefiltered variant `{variant}`: {source}")]
+    InvalidVariant {
+        /// The variant's id.
+        variant: String,
+        /// Which knob, its value and the allowed range.
+        #[source]
+        source: VariantError,
+    },
+    /// The per-frame parameters of the `prefiltered` family cannot be set up (NaN or
+    /// degenerate camera, light or medium, wrong light type, bad sizes).
+    #[error("prefiltered: frame set-up failed: {0}")]
+    Frame(#[from] FrameError),
+    /// The shadow map of a frame differs in size from the one the pipelines were made for.
+    #[error(
+        "prefiltered: the shadow map is {actual}x{actual} texels but the pass was created for \
+         {expected}x{expected}; create a new `Scatter` for the new size"
+    )]
+    ShadowMapSize {
+        /// The size given at creation.
+        expected: u32,
+        /// The size of this frame's shadow map.
+        actual: u32,
+    },
+    /// The variant needs a device feature the adapter lacks.
+    #[error(
+        "kernel `{kernel}`: {what} needs the device feature {feature}, which adapter {adapter:?} lacks"
+    )]
+    MissingFeature {
+        /// The kernel.
+        kernel: Kernel,
+        /// What needs it, e.g. `storage = rgba32float`.
+        what: String,
+        /// The `wgpu::Features` flag.
+        feature: &'static str,
+        /// The adapter's name.
+        adapter: String,
+    },
+    /// Too few rectified columns for the variant's prefix regions (the sun's regions split a
+    /// row quadratically, so the first has `width / regions^2` columns).
+    #[error(
+        "kernel `{kernel}`: regions = {regions} needs a rectified width of at least {min} \
+         columns (regions^2, so that every region has a column), got {width}"
+    )]
+    TooFewColumns {
+        /// The kernel.
+        kernel: Kernel,
+        /// Regions of the variant.
+        regions: u32,
+        /// Rectified width.
+        width: u32,
+        /// Smallest allowed width.
+        min: u32,
+    },
+    /// A texture handed to a pass has the wrong format or size.
+    #[error("kernel `{kernel}`: {what} must be {expected}, got {actual}")]
+    InputMismatch {
+        /// The kernel.
+        kernel: Kernel,
+        /// Which input property, e.g. `shadow map format`.
+        what: &'static str,
+        /// What the pass needs.
+        expected: String,
+        /// What was given.
+        actual: String,
+    },
+    /// A pass was encoded before its per-frame parameters were uploaded.
+    #[error("kernel `{kernel}`: encode called before prepare; upload a frame first")]
+    NotPrepared {
+        /// The first kernel of the family.
+        kernel: Kernel,
+    },
+}
+
+/// Fails with [`RuntimeError::LimitExceeded`] when `value > max`.
+pub(crate) fn check_limit(
+    kernel: Kernel,
+    what: &'static str,
+    value: u64,
+    limit: &'static str,
+    max: u64,
+) -> Result<(), RuntimeError> {
+    if value > max {
+        return Err(RuntimeError::LimitExceeded {
+            kernel,
+            what,
+            value,
+            limit,
+            max,
+        });
+    }
+    Ok(())
+}
+
+/// Validation and out-of-memory error scopes around a group of wgpu calls, turned into a
+/// [`RuntimeError::Wgpu`] instead of wgpu's default panic.
+pub(crate) struct ErrorScopes {
+    validation: wgpu::ErrorScopeGuard,
+    out_of_memory: wgpu::ErrorScopeGuard,
+}
+
+impl ErrorScopes {
+    pub(crate) fn push(device: &wgpu::Device) -> Self {
+        let out_of_memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        Self {
+            validation,
+            out_of_memory,
+        }
+    }
+
+    pub(crate) fn pop(self, kernel: Kernel, stage: &'static str) -> Result<(), RuntimeError> {
+        let validation = pollster::block_on(self.validation.pop());
+        let out_of_memory = pollster::block_on(self.out_of_memory.pop());
+        match validation.or(out_of_memory) {
+            None => Ok(()),
+            Some(e) => Err(RuntimeError::Wgpu {
+                kernel,
+                stage,
+                message: e.to_string(),
+            }),
+        }
+    }
 }

@@ -1,18 +1,24 @@
 //! `scatter-runtime`: a thin wgpu driver for the scatter kernels.
 //!
 //! [`Context`] picks an adapter (a real GPU when there is one, otherwise a CPU adapter such
-//! as lavapipe), reports which, and enables GPU timestamps where the adapter has them;
+//! as lavapipe), reports which, and enables GPU timestamps and `FLOAT32_FILTERABLE` (filtered
+//! sampling of rgba32float) where the adapter has them;
 //! [`Context::from_env`] applies the `SCATTER_GPU` policy that tests and tools share. Each
 //! kernel has a pass type that builds its pipeline from `scatter-shaderlib` and encodes it
-//! ([`RowPrefixPass`]), plus a one-call convenience for tests ([`row_prefix`]).
+//! ([`RowPrefixPass`]), plus a one-call convenience for tests ([`row_prefix`]). Kernel
+//! families with several passes have one type for the whole family: [`Scatter`] runs the
+//! `prefiltered` method (`rectify`, `prefilter`, `scatter`) once per frame, [`run_once`] is
+//! its test convenience.
 
 mod context;
 mod error;
+pub mod prefiltered;
 pub mod row_prefix;
 mod timer;
 
 pub use context::{AdapterReport, Context, ContextError, GpuPolicy};
 pub use error::RuntimeError;
+pub use prefiltered::{CpuInputs, FrameInput, PassTimes, Scatter, ScatterReadback, run_once};
 pub use row_prefix::{ArraySize, RowPrefixOutput, RowPrefixPass, row_prefix};
 pub use timer::GpuTimer;
 

@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use scatter_shaderlib::{Kernel, KernelParams, RowPrefixParams};
 
+use crate::error::ErrorScopes;
 use crate::timer::read_buffer;
 use crate::{Context, GpuTimer, RuntimeError};
 
@@ -150,7 +151,7 @@ impl RowPrefixPass {
             compilation_options: wgpu::PipelineCompilationOptions::default(),
             cache: None,
         });
-        scope.pop("pipeline creation")?;
+        scope.pop(KERNEL, "pipeline creation")?;
         Ok(Self {
             params,
             layout,
@@ -364,7 +365,7 @@ pub fn row_prefix(
     }
     let start = Instant::now();
     queue.submit([encoder.finish()]);
-    scope.pop("dispatch")?;
+    scope.pop(KERNEL, "dispatch")?;
 
     let bytes = read_buffer(ctx, KERNEL, &readback)?;
     let wall_time = start.elapsed();
@@ -402,45 +403,5 @@ fn check_limit(
     limit: &'static str,
     max: u64,
 ) -> Result<(), RuntimeError> {
-    if value > max {
-        return Err(RuntimeError::LimitExceeded {
-            kernel: KERNEL,
-            what,
-            value,
-            limit,
-            max,
-        });
-    }
-    Ok(())
-}
-
-/// Validation and out-of-memory error scopes around a group of wgpu calls, turned into a
-/// [`RuntimeError::Wgpu`] instead of wgpu's default panic.
-struct ErrorScopes {
-    validation: wgpu::ErrorScopeGuard,
-    out_of_memory: wgpu::ErrorScopeGuard,
-}
-
-impl ErrorScopes {
-    fn push(device: &wgpu::Device) -> Self {
-        let out_of_memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        Self {
-            validation,
-            out_of_memory,
-        }
-    }
-
-    fn pop(self, stage: &'static str) -> Result<(), RuntimeError> {
-        let validation = pollster::block_on(self.validation.pop());
-        let out_of_memory = pollster::block_on(self.out_of_memory.pop());
-        match validation.or(out_of_memory) {
-            None => Ok(()),
-            Some(e) => Err(RuntimeError::Wgpu {
-                kernel: KERNEL,
-                stage,
-                message: e.to_string(),
-            }),
-        }
-    }
+    crate::error::check_limit(KERNEL, what, value, limit, max)
 }

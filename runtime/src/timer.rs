@@ -1,4 +1,4 @@
-//! [`GpuTimer`]: a pair of GPU timestamps around a compute pass, and the readback helper
+//! [`GpuTimer`]: GPU timestamps around one or more compute passes, and the readback helper
 //! shared by every pass.
 
 use std::sync::mpsc;
@@ -8,48 +8,65 @@ use scatter_shaderlib::Kernel;
 
 use crate::{Context, RuntimeError};
 
-/// Two timestamp queries (start and end of one pass) with their resolve and readback
-/// buffers.
+/// Timestamp queries at the start and end of one or more compute passes, with their resolve
+/// and readback buffers.
 #[derive(Debug)]
 pub struct GpuTimer {
     query_set: wgpu::QuerySet,
     resolve: wgpu::Buffer,
     readback: wgpu::Buffer,
     period_ns: f64,
+    passes: u32,
 }
 
 impl GpuTimer {
-    const BYTES: u64 = 2 * size_of::<u64>() as u64;
-
-    /// A timer, or `None` when the device has no `TIMESTAMP_QUERY`.
+    /// A timer for one pass, or `None` when the device has no `TIMESTAMP_QUERY`.
     pub fn new(ctx: &Context) -> Option<Self> {
+        Self::with_passes(ctx, 1)
+    }
+
+    /// A timer for `passes` passes (at least one), or `None` when the device has no
+    /// `TIMESTAMP_QUERY`.
+    pub fn with_passes(ctx: &Context, passes: u32) -> Option<Self> {
         if !ctx.has_timestamps() {
             return None;
         }
+        let passes = passes.max(1);
+        let bytes = Self::bytes(passes);
         let device = ctx.device();
         Some(Self {
             query_set: device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("scatter timestamps"),
                 ty: wgpu::QueryType::Timestamp,
-                count: 2,
+                count: 2 * passes,
             }),
             resolve: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("scatter timestamps resolve"),
-                size: Self::BYTES,
+                size: bytes,
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
             readback: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("scatter timestamps readback"),
-                size: Self::BYTES,
+                size: bytes,
                 usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
             period_ns: f64::from(ctx.queue().get_timestamp_period()),
+            passes,
         })
     }
 
-    /// Timestamp writes at the beginning and end of a compute pass.
+    fn bytes(passes: u32) -> u64 {
+        2 * u64::from(passes) * size_of::<u64>() as u64
+    }
+
+    /// Number of passes this timer measures.
+    pub fn passes(&self) -> u32 {
+        self.passes
+    }
+
+    /// Timestamp writes at the beginning and end of a compute pass (the first pass).
     pub fn compute_pass_writes(&self) -> wgpu::ComputePassTimestampWrites<'_> {
         wgpu::ComputePassTimestampWrites {
             query_set: &self.query_set,
@@ -58,33 +75,73 @@ impl GpuTimer {
         }
     }
 
-    /// Resolves the queries into the readback buffer; encode after the timed pass.
-    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.resolve_query_set(&self.query_set, 0..2, &self.resolve, 0);
-        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, Self::BYTES);
+    /// Timestamp writes for pass `pass` (0-based), or `None` when `pass >= passes()`.
+    pub fn pass_writes(&self, pass: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        (pass < self.passes).then(|| wgpu::ComputePassTimestampWrites {
+            query_set: &self.query_set,
+            beginning_of_pass_write_index: Some(2 * pass),
+            end_of_pass_write_index: Some(2 * pass + 1),
+        })
     }
 
-    /// Reads the elapsed time between the two timestamps; call after the submission that
-    /// resolved them.
+    /// Resolves the queries into the readback buffer; encode after the timed passes.
+    pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.resolve_query_set(&self.query_set, 0..2 * self.passes, &self.resolve, 0);
+        encoder.copy_buffer_to_buffer(
+            &self.resolve,
+            0,
+            &self.readback,
+            0,
+            Self::bytes(self.passes),
+        );
+    }
+
+    /// Reads the elapsed time of the first pass; call after the submission that resolved
+    /// the queries.
     ///
     /// # Errors
     ///
     /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
     pub fn read(&self, ctx: &Context, kernel: Kernel) -> Result<Duration, RuntimeError> {
+        self.read_all(ctx, kernel)?
+            .first()
+            .copied()
+            .ok_or_else(|| RuntimeError::Readback {
+                kernel,
+                message: "no timestamps".to_owned(),
+            })
+    }
+
+    /// Reads the elapsed time of every pass, in pass order; call after the submission that
+    /// resolved the queries.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
+    pub fn read_all(&self, ctx: &Context, kernel: Kernel) -> Result<Vec<Duration>, RuntimeError> {
         let bytes = read_buffer(ctx, kernel, &self.readback)?;
         let ticks: &[u64] =
             bytemuck::try_cast_slice(&bytes).map_err(|e| RuntimeError::Readback {
                 kernel,
                 message: format!("timestamp buffer: {e}"),
             })?;
-        let [start, end] = ticks else {
+        if ticks.len() != 2 * self.passes as usize {
             return Err(RuntimeError::Readback {
                 kernel,
-                message: format!("expected 2 timestamps, got {}", ticks.len()),
+                message: format!(
+                    "expected {} timestamps, got {}",
+                    2 * self.passes,
+                    ticks.len()
+                ),
             });
-        };
-        let ns = end.saturating_sub(*start) as f64 * self.period_ns;
-        Ok(Duration::from_secs_f64(ns * 1e-9))
+        }
+        Ok(ticks
+            .chunks_exact(2)
+            .map(|pair| {
+                let ns = pair[1].saturating_sub(pair[0]) as f64 * self.period_ns;
+                Duration::from_secs_f64(ns * 1e-9)
+            })
+            .collect())
     }
 }
 

@@ -1,0 +1,1072 @@
+//! The `prefiltered` family (Klehm et al. 2014) on wgpu: [`Scatter`] owns the three
+//! pipelines (`rectify`, `prefilter`, `scatter`) of one [`Variant`], the intermediate
+//! textures and the per-frame buffers; an engine calls [`Scatter::prepare`] and
+//! [`Scatter::encode`] once per frame with its depth buffer and standard shadow map.
+//! [`run_once`] is the upload-run-readback convenience the conformance tests use.
+//!
+//! Pass order and bindings (group 0 of every kernel):
+//!
+//! | pass | bindings | dispatch |
+//! |---|---|---|
+//! | `rectify` | 0 uniform `Frame`, 1 slices, 2 shadow map r32float, 3 rectified r32float (storage, write) | `ceil(Wr/8) x ceil(Hr/8) x 1` |
+//! | `prefilter` | 0, 1, 2 rectified r32float, 3 filtered bases (storage array, write, the variant's format) | `ceil(Hr/64) x regions x bases/bases_per_thread` |
+//! | `scatter` | 0, 1, 2 depth r32float, 3 shadow map r32float, 4 filtered bases (sampled array), 5 linear sampler, 6 output rgba16float (storage, write) | `ceil(W/8) x ceil(H/8) x 1` |
+//!
+//! The sampler clamps along rows (u) and wraps across slices (v) when the slices go round the
+//! full circle (`FrameUniforms::anti_epipole[3] > 0.5`), else clamps: [`Scatter`] keeps both
+//! samplers and picks one per frame.
+
+use std::borrow::Cow;
+use std::time::{Duration, Instant};
+
+use scatter_shaderlib::prefiltered::{
+    CameraDesc, FrameReport, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame,
+    Resolutions, ShadowMapDesc, SliceParams, Storage, Variant, prepare_frame,
+};
+use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams};
+
+use crate::error::{ErrorScopes, check_limit};
+use crate::timer::read_buffer;
+use crate::{Context, GpuTimer, RuntimeError};
+
+const RECTIFY: Kernel = Kernel::Rectify;
+const PREFILTER: Kernel = Kernel::Prefilter;
+const SCATTER: Kernel = Kernel::Scatter;
+
+/// Format of the rectified map, the depth buffer and the standard shadow map.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// Format of the output (in-scattered radiance, rgb; alpha 1).
+pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The texture format of a filtered-basis storage choice.
+pub const fn storage_format(storage: Storage) -> wgpu::TextureFormat {
+    match storage {
+        Storage::Rgba8unorm => wgpu::TextureFormat::Rgba8Unorm,
+        Storage::Rgba16float => wgpu::TextureFormat::Rgba16Float,
+        Storage::Rgba32float => wgpu::TextureFormat::Rgba32Float,
+    }
+}
+
+/// Bytes per texel of a filtered-basis storage choice.
+const fn storage_texel_bytes(storage: Storage) -> u32 {
+    match storage {
+        Storage::Rgba8unorm => 4,
+        Storage::Rgba16float => 8,
+        Storage::Rgba32float => 16,
+    }
+}
+
+/// Everything [`Scatter::prepare`] needs about one frame besides the textures: the engine's
+/// camera, light, medium and standard shadow map, and the runtime settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameInput {
+    /// The camera.
+    pub camera: CameraDesc,
+    /// The light (its type must match the variant's).
+    pub light: LightDesc,
+    /// The homogeneous medium.
+    pub medium: MediumDesc,
+    /// The standard shadow map's projection and size (must match [`Scatter::new`]).
+    pub shadow_map: ShadowMapDesc,
+    /// Epipole march radius and steps, spot quadrature.
+    pub settings: FrameSettings,
+}
+
+/// GPU time of each pass of one frame (from timestamps at the start and end of each pass).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PassTimes {
+    /// The `rectify` pass.
+    pub rectify: Duration,
+    /// The `prefilter` pass.
+    pub prefilter: Duration,
+    /// The `scatter` pass.
+    pub scatter: Duration,
+}
+
+impl PassTimes {
+    /// Sum of the three passes.
+    pub fn total(&self) -> Duration {
+        self.rectify + self.prefilter + self.scatter
+    }
+}
+
+/// One compute pipeline with its bind group layout and workgroup size.
+#[derive(Debug)]
+struct Pipeline {
+    kernel: Kernel,
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+    workgroup_size: [u32; 3],
+}
+
+/// The `prefiltered` method for one [`Variant`], sized for one set of [`Resolutions`] and one
+/// shadow-map size.
+#[derive(Debug)]
+pub struct Scatter {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    variant: Variant,
+    res: Resolutions,
+    shadow_map_size: u32,
+    rectify: Pipeline,
+    prefilter: Pipeline,
+    scatter: Pipeline,
+    uniforms: wgpu::Buffer,
+    slices: wgpu::Buffer,
+    rectified: wgpu::Texture,
+    rectified_view: wgpu::TextureView,
+    filtered: wgpu::Texture,
+    /// `D2Array` view (also for one layer).
+    filtered_view: wgpu::TextureView,
+    output: wgpu::Texture,
+    output_view: wgpu::TextureView,
+    sampler_clamp: wgpu::Sampler,
+    sampler_wrap: wgpu::Sampler,
+    prefilter_bind_group: wgpu::BindGroup,
+    timer: Option<GpuTimer>,
+    frame: Option<PrefilteredFrame>,
+}
+
+/// Workgroup counts `ceil(n / size)` of one dispatch.
+fn groups(n: [u32; 3], size: [u32; 3]) -> [u32; 3] {
+    [0, 1, 2].map(|i| n[i].div_ceil(size[i].max(1)))
+}
+
+impl Scatter {
+    /// Validates the variant and the sizes against the device, builds the three kernels and
+    /// creates their pipelines and every texture and buffer they need.
+    ///
+    /// `res.rectified` is the rectified map (`Wr` light rays per slice by `Hr` slices);
+    /// `shadow_map_size` the side of the engine's square standard shadow map.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::InvalidVariant`] naming the knob; [`RuntimeError::EmptyInput`] for a
+    /// zero size; [`RuntimeError::TooFewColumns`] when `Wr < regions^2`;
+    /// [`RuntimeError::LimitExceeded`] naming the device limit;
+    /// [`RuntimeError::MissingFeature`] for `rgba32float` without `FLOAT32_FILTERABLE`;
+    /// [`RuntimeError::Shader`] when a kernel does not build; [`RuntimeError::Wgpu`] when wgpu
+    /// rejects a pipeline or resource. Nothing is created on the GPU unless every check
+    /// passes.
+    pub fn new(
+        ctx: &Context,
+        variant: &Variant,
+        res: Resolutions,
+        shadow_map_size: u32,
+    ) -> Result<Self, RuntimeError> {
+        variant
+            .validate()
+            .map_err(|source| RuntimeError::InvalidVariant {
+                variant: variant.id(),
+                source,
+            })?;
+        let [w, h] = res.screen;
+        let [wr, hr] = res.rectified;
+        for (kernel, what, size, empty) in [
+            (SCATTER, "screen", format!("{w}x{h}"), w == 0 || h == 0),
+            (
+                RECTIFY,
+                "rectified",
+                format!("{wr}x{hr}"),
+                wr == 0 || hr == 0,
+            ),
+            (
+                RECTIFY,
+                "shadow map",
+                format!("{shadow_map_size}x{shadow_map_size}"),
+                shadow_map_size == 0,
+            ),
+        ] {
+            if empty {
+                return Err(RuntimeError::EmptyInput {
+                    kernel,
+                    size: format!("{what} {size}"),
+                });
+            }
+        }
+        // As `prepare_frame` requires: the first of the sun's quadratically split regions has
+        // `Wr / regions^2` columns.
+        let min_width = variant.regions * variant.regions;
+        if wr < min_width {
+            return Err(RuntimeError::TooFewColumns {
+                kernel: PREFILTER,
+                regions: variant.regions,
+                width: wr,
+                min: min_width,
+            });
+        }
+        let device = ctx.device();
+        let limits = device.limits();
+        let max_2d = u64::from(limits.max_texture_dimension_2d);
+        for (kernel, what, value) in [
+            (SCATTER, "screen width", w),
+            (SCATTER, "screen height", h),
+            (RECTIFY, "rectified width", wr),
+            (RECTIFY, "rectified height", hr),
+            (RECTIFY, "shadow map size", shadow_map_size),
+        ] {
+            check_limit(
+                kernel,
+                what,
+                value.into(),
+                "max_texture_dimension_2d",
+                max_2d,
+            )?;
+        }
+        check_limit(
+            PREFILTER,
+            "filtered-basis layers (bases / 4)",
+            variant.layers().into(),
+            "max_texture_array_layers",
+            limits.max_texture_array_layers.into(),
+        )?;
+        let slice_bytes = u64::from(hr) * size_of::<SliceParams>() as u64;
+        check_limit(
+            RECTIFY,
+            "slice table bytes (16 per rectified row)",
+            slice_bytes,
+            "max_storage_buffer_binding_size",
+            limits.max_storage_buffer_binding_size,
+        )?;
+        check_limit(
+            RECTIFY,
+            "uniform block bytes",
+            size_of::<FrameUniforms>() as u64,
+            "max_uniform_buffer_binding_size",
+            limits.max_uniform_buffer_binding_size,
+        )?;
+        if variant.storage == Storage::Rgba32float
+            && !device
+                .features()
+                .contains(wgpu::Features::FLOAT32_FILTERABLE)
+        {
+            return Err(RuntimeError::MissingFeature {
+                kernel: SCATTER,
+                what: format!(
+                    "storage = {} (bilinear sampling of the filtered bases)",
+                    variant.storage
+                ),
+                feature: "FLOAT32_FILTERABLE",
+                adapter: ctx.report().name.clone(),
+            });
+        }
+
+        // CPU work only: render, compose and validate the three kernels.
+        let built_rectify = scatter_shaderlib::build(&KernelParams::Rectify(*variant))?;
+        let built_prefilter = scatter_shaderlib::build(&KernelParams::Prefilter(*variant))?;
+        let built_scatter = scatter_shaderlib::build(&KernelParams::Scatter(*variant))?;
+        let dispatches = [
+            (&built_rectify, [wr, hr, 1]),
+            (
+                &built_prefilter,
+                [hr, variant.regions, variant.threads_per_row_region()],
+            ),
+            (&built_scatter, [w, h, 1]),
+        ];
+        for (built, invocations) in dispatches {
+            check_workgroup(&limits, built)?;
+            let counts = groups(invocations, built.workgroup_size);
+            for (count, what) in counts.into_iter().zip([
+                "workgroups along x",
+                "workgroups along y",
+                "workgroups along z",
+            ]) {
+                check_limit(
+                    built.kernel,
+                    what,
+                    count.into(),
+                    "max_compute_workgroups_per_dimension",
+                    limits.max_compute_workgroups_per_dimension.into(),
+                )?;
+            }
+        }
+
+        // Every check passed: create the GPU objects.
+        let uniform = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(size_of::<FrameUniforms>() as u64),
+            },
+            count: None,
+        };
+        let slices_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(size_of::<SliceParams>() as u64),
+            },
+            count: None,
+        };
+        let texture = |binding, filterable, view_dimension| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable },
+                view_dimension,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let storage = |binding, format, view_dimension| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format,
+                view_dimension,
+            },
+            count: None,
+        };
+        let d2 = wgpu::TextureViewDimension::D2;
+        let d2_array = wgpu::TextureViewDimension::D2Array;
+        let filtered_format = storage_format(variant.storage);
+
+        let rectify = create_pipeline(
+            device,
+            built_rectify,
+            &[
+                uniform(0),
+                slices_entry(1),
+                texture(2, false, d2),
+                storage(3, DEPTH_FORMAT, d2),
+            ],
+        )?;
+        let prefilter = create_pipeline(
+            device,
+            built_prefilter,
+            &[
+                uniform(0),
+                slices_entry(1),
+                texture(2, false, d2),
+                storage(3, filtered_format, d2_array),
+            ],
+        )?;
+        let scatter = create_pipeline(
+            device,
+            built_scatter,
+            &[
+                uniform(0),
+                slices_entry(1),
+                texture(2, false, d2),
+                texture(3, false, d2),
+                texture(4, true, d2_array),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+                storage(6, OUTPUT_FORMAT, d2),
+            ],
+        )?;
+
+        let scope = ErrorScopes::push(device);
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("prefiltered frame uniforms"),
+            size: size_of::<FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let slices = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("prefiltered slice table"),
+            size: slice_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let readable = wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        let make_texture = |label, [width, height]: [u32; 2], layers, format| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: layers,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: readable,
+                view_formats: &[],
+            })
+        };
+        let rectified = make_texture("prefiltered rectified map", res.rectified, 1, DEPTH_FORMAT);
+        let filtered = make_texture(
+            "prefiltered filtered bases",
+            res.rectified,
+            variant.layers(),
+            filtered_format,
+        );
+        let output = make_texture("prefiltered output", res.screen, 1, OUTPUT_FORMAT);
+        let rectified_view = rectified.create_view(&wgpu::TextureViewDescriptor::default());
+        // A one-layer texture defaults to a D2 view: ask for D2Array explicitly.
+        let filtered_view = filtered.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(d2_array),
+            ..wgpu::TextureViewDescriptor::default()
+        });
+        let output_view = output.create_view(&wgpu::TextureViewDescriptor::default());
+        let sampler = |label, address_mode_v| {
+            device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(label),
+                address_mode_u: wgpu::AddressMode::ClampToEdge,
+                address_mode_v,
+                address_mode_w: wgpu::AddressMode::ClampToEdge,
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                ..wgpu::SamplerDescriptor::default()
+            })
+        };
+        let sampler_clamp = sampler("prefiltered bases (clamp)", wgpu::AddressMode::ClampToEdge);
+        let sampler_wrap = sampler("prefiltered bases (wrap)", wgpu::AddressMode::Repeat);
+        let prefilter_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("prefilter"),
+            layout: &prefilter.layout,
+            entries: &[
+                buffer_entry(0, &uniforms),
+                buffer_entry(1, &slices),
+                view_entry(2, &rectified_view),
+                view_entry(3, &filtered_view),
+            ],
+        });
+        let timer = GpuTimer::with_passes(ctx, 3);
+        scope.pop(PREFILTER, "creating textures and buffers")?;
+        Ok(Self {
+            device: device.clone(),
+            queue: ctx.queue().clone(),
+            variant: *variant,
+            res,
+            shadow_map_size,
+            rectify,
+            prefilter,
+            scatter,
+            uniforms,
+            slices,
+            rectified,
+            rectified_view,
+            filtered,
+            filtered_view,
+            output,
+            output_view,
+            sampler_clamp,
+            sampler_wrap,
+            prefilter_bind_group,
+            timer,
+            frame: None,
+        })
+    }
+
+    /// Sets up one frame ([`prepare_frame`]) and uploads its uniforms and slice table.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::ShadowMapSize`] when `frame.shadow_map.size` differs from the size
+    /// given to [`Self::new`]; [`RuntimeError::Frame`] for NaN or degenerate parameters or a
+    /// light of the wrong type; [`RuntimeError::Wgpu`] when an upload fails.
+    pub fn prepare(
+        &mut self,
+        ctx: &Context,
+        frame: &FrameInput,
+    ) -> Result<FrameReport, RuntimeError> {
+        if frame.shadow_map.size != self.shadow_map_size {
+            return Err(RuntimeError::ShadowMapSize {
+                expected: self.shadow_map_size,
+                actual: frame.shadow_map.size,
+            });
+        }
+        let prepared = prepare_frame(
+            &self.variant,
+            &self.res,
+            &frame.camera,
+            &frame.light,
+            &frame.medium,
+            &frame.shadow_map,
+            &frame.settings,
+        )?;
+        let rows = self.res.rectified[1] as usize;
+        if prepared.slices.len() != rows {
+            return Err(RuntimeError::DataLength {
+                kernel: RECTIFY,
+                size: format!("slice table of {rows} rows"),
+                expected: rows as u64,
+                actual: prepared.slices.len() as u64,
+            });
+        }
+        let scope = ErrorScopes::push(ctx.device());
+        let queue = ctx.queue();
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&prepared.uniforms));
+        queue.write_buffer(&self.slices, 0, bytemuck::cast_slice(&prepared.slices));
+        scope.pop(RECTIFY, "uploading frame parameters")?;
+        let report = prepared.report.clone();
+        self.frame = Some(prepared);
+        Ok(report)
+    }
+
+    /// Records `rectify`, `prefilter` and `scatter` (each with GPU timestamps when the device
+    /// has them; read them with [`Self::pass_times`] after submitting) and returns the output
+    /// view: in-scattered radiance, rgba16float, screen-sized.
+    ///
+    /// `depth` is linear view depth (r32float, screen-sized), `shadow_map` the standard
+    /// shadow map (r32float, `shadow_map_size` squared), both with `TEXTURE_BINDING` usage.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::NotPrepared`] before the first [`Self::prepare`];
+    /// [`RuntimeError::InputMismatch`] for a view of the wrong format, size or usage;
+    /// [`RuntimeError::Wgpu`] when wgpu rejects a bind group.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        depth: &wgpu::TextureView,
+        shadow_map: &wgpu::TextureView,
+    ) -> Result<&wgpu::TextureView, RuntimeError> {
+        let frame = self
+            .frame
+            .as_ref()
+            .ok_or(RuntimeError::NotPrepared { kernel: RECTIFY })?;
+        check_view(SCATTER, &DEPTH_NAMES, depth, self.res.screen)?;
+        check_view(
+            RECTIFY,
+            &SHADOW_NAMES,
+            shadow_map,
+            [self.shadow_map_size; 2],
+        )?;
+        let wrap = frame.uniforms.anti_epipole[3] > 0.5;
+        let sampler = if wrap {
+            &self.sampler_wrap
+        } else {
+            &self.sampler_clamp
+        };
+
+        let scope = ErrorScopes::push(&self.device);
+        let rectify_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("rectify"),
+            layout: &self.rectify.layout,
+            entries: &[
+                buffer_entry(0, &self.uniforms),
+                buffer_entry(1, &self.slices),
+                view_entry(2, shadow_map),
+                view_entry(3, &self.rectified_view),
+            ],
+        });
+        scope.pop(RECTIFY, "creating the bind group")?;
+        let scope = ErrorScopes::push(&self.device);
+        let scatter_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scatter"),
+            layout: &self.scatter.layout,
+            entries: &[
+                buffer_entry(0, &self.uniforms),
+                buffer_entry(1, &self.slices),
+                view_entry(2, depth),
+                view_entry(3, shadow_map),
+                view_entry(4, &self.filtered_view),
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::Sampler(sampler),
+                },
+                view_entry(6, &self.output_view),
+            ],
+        });
+        scope.pop(SCATTER, "creating the bind group")?;
+
+        let [w, h] = self.res.screen;
+        let [wr, hr] = self.res.rectified;
+        let v = &self.variant;
+        let passes: [(&Pipeline, &wgpu::BindGroup, [u32; 3]); 3] = [
+            (&self.rectify, &rectify_group, [wr, hr, 1]),
+            (
+                &self.prefilter,
+                &self.prefilter_bind_group,
+                [hr, v.regions, v.threads_per_row_region()],
+            ),
+            (&self.scatter, &scatter_group, [w, h, 1]),
+        ];
+        for (index, (pipeline, group, invocations)) in (0u32..).zip(passes) {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(pipeline.kernel.name()),
+                timestamp_writes: self.timer.as_ref().and_then(|t| t.pass_writes(index)),
+            });
+            pass.set_pipeline(&pipeline.pipeline);
+            pass.set_bind_group(0, group, &[]);
+            let [x, y, z] = groups(invocations, pipeline.workgroup_size);
+            pass.dispatch_workgroups(x, y, z);
+        }
+        if let Some(timer) = &self.timer {
+            timer.resolve(encoder);
+        }
+        Ok(&self.output_view)
+    }
+
+    /// GPU time of each pass of the last submitted [`Self::encode`], or `None` when the
+    /// device has no timestamps. Blocks until the GPU is done.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
+    pub fn pass_times(&self, ctx: &Context) -> Result<Option<PassTimes>, RuntimeError> {
+        let Some(timer) = &self.timer else {
+            return Ok(None);
+        };
+        let times = timer.read_all(ctx, SCATTER)?;
+        match times[..] {
+            [rectify, prefilter, scatter] => Ok(Some(PassTimes {
+                rectify,
+                prefilter,
+                scatter,
+            })),
+            _ => Err(RuntimeError::Readback {
+                kernel: SCATTER,
+                message: format!("expected 3 pass times, got {}", times.len()),
+            }),
+        }
+    }
+
+    /// The variant the pipelines were built for.
+    pub fn variant(&self) -> &Variant {
+        &self.variant
+    }
+
+    /// The screen and rectified sizes.
+    pub fn resolutions(&self) -> Resolutions {
+        self.res
+    }
+
+    /// Side of the standard shadow map the pass expects.
+    pub fn shadow_map_size(&self) -> u32 {
+        self.shadow_map_size
+    }
+
+    /// The last prepared frame (uniforms, slice table, report).
+    pub fn frame(&self) -> Option<&PrefilteredFrame> {
+        self.frame.as_ref()
+    }
+
+    /// The rectified map: r32float, `Wr x Hr`, normalised rectified depth (written by
+    /// `rectify`).
+    pub fn rectified_texture(&self) -> &wgpu::Texture {
+        &self.rectified
+    }
+
+    /// A 2D view of [`Self::rectified_texture`].
+    pub fn rectified_view(&self) -> &wgpu::TextureView {
+        &self.rectified_view
+    }
+
+    /// The filtered bases: `Wr x Hr x bases/4` layers in the variant's storage format,
+    /// values `F / 2 + 0.5` in [0, 1] (written by `prefilter`).
+    pub fn filtered_texture(&self) -> &wgpu::Texture {
+        &self.filtered
+    }
+
+    /// A `D2Array` view of [`Self::filtered_texture`].
+    pub fn filtered_view(&self) -> &wgpu::TextureView {
+        &self.filtered_view
+    }
+
+    /// The output: rgba16float, screen-sized, in-scattered radiance (written by `scatter`).
+    pub fn output_texture(&self) -> &wgpu::Texture {
+        &self.output
+    }
+
+    /// A 2D view of [`Self::output_texture`].
+    pub fn output_view(&self) -> &wgpu::TextureView {
+        &self.output_view
+    }
+
+    /// The queue the pass was created with.
+    fn queue(&self) -> &wgpu::Queue {
+        &self.queue
+    }
+}
+
+fn buffer_entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}
+
+fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: wgpu::BindingResource::TextureView(view),
+    }
+}
+
+/// Names of the properties of one engine-provided texture, for [`check_view`].
+struct ViewNames {
+    format: &'static str,
+    size: &'static str,
+    usage: &'static str,
+}
+
+const DEPTH_NAMES: ViewNames = ViewNames {
+    format: "depth buffer format",
+    size: "depth buffer size",
+    usage: "depth buffer usage",
+};
+
+const SHADOW_NAMES: ViewNames = ViewNames {
+    format: "shadow map format",
+    size: "shadow map size",
+    usage: "shadow map usage",
+};
+
+/// Checks an engine-provided r32float texture view: format, size, sampling usage.
+fn check_view(
+    kernel: Kernel,
+    names: &ViewNames,
+    view: &wgpu::TextureView,
+    size: [u32; 2],
+) -> Result<(), RuntimeError> {
+    let texture = view.texture();
+    let mismatch = |what, expected: String, actual: String| {
+        Err(RuntimeError::InputMismatch {
+            kernel,
+            what,
+            expected,
+            actual,
+        })
+    };
+    if texture.format() != DEPTH_FORMAT {
+        return mismatch(
+            names.format,
+            format!("{DEPTH_FORMAT:?}"),
+            format!("{:?}", texture.format()),
+        );
+    }
+    let extent = texture.size();
+    if [extent.width, extent.height] != size {
+        return mismatch(
+            names.size,
+            format!("{}x{}", size[0], size[1]),
+            format!("{}x{}", extent.width, extent.height),
+        );
+    }
+    if !texture
+        .usage()
+        .contains(wgpu::TextureUsages::TEXTURE_BINDING)
+    {
+        return mismatch(
+            names.usage,
+            "TEXTURE_BINDING".to_owned(),
+            format!("{:?}", texture.usage()),
+        );
+    }
+    Ok(())
+}
+
+/// Checks a kernel's workgroup size against the device limits.
+fn check_workgroup(limits: &wgpu::Limits, built: &BuiltKernel) -> Result<(), RuntimeError> {
+    let [x, y, z] = built.workgroup_size;
+    let kernel = built.kernel;
+    check_limit(
+        kernel,
+        "workgroup invocations",
+        u64::from(x) * u64::from(y) * u64::from(z),
+        "max_compute_invocations_per_workgroup",
+        limits.max_compute_invocations_per_workgroup.into(),
+    )?;
+    check_limit(
+        kernel,
+        "workgroup size x",
+        x.into(),
+        "max_compute_workgroup_size_x",
+        limits.max_compute_workgroup_size_x.into(),
+    )?;
+    check_limit(
+        kernel,
+        "workgroup size y",
+        y.into(),
+        "max_compute_workgroup_size_y",
+        limits.max_compute_workgroup_size_y.into(),
+    )?;
+    check_limit(
+        kernel,
+        "workgroup size z",
+        z.into(),
+        "max_compute_workgroup_size_z",
+        limits.max_compute_workgroup_size_z.into(),
+    )
+}
+
+/// Creates a kernel's bind group layout and compute pipeline inside an error scope.
+fn create_pipeline(
+    device: &wgpu::Device,
+    built: BuiltKernel,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> Result<Pipeline, RuntimeError> {
+    let kernel = built.kernel;
+    let scope = ErrorScopes::push(device);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(kernel.name()),
+        source: wgpu::ShaderSource::Naga(Cow::Owned(built.module)),
+    });
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(kernel.name()),
+        entries,
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(kernel.name()),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(kernel.name()),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some(built.entry_point),
+        compilation_options: wgpu::PipelineCompilationOptions::default(),
+        cache: None,
+    });
+    scope.pop(kernel, "pipeline creation")?;
+    Ok(Pipeline {
+        kernel,
+        layout,
+        pipeline,
+        workgroup_size: built.workgroup_size,
+    })
+}
+
+/// CPU-side inputs of [`run_once`]: the frame's parameters plus the two textures an engine
+/// would render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CpuInputs {
+    /// Camera, light, medium, shadow-map description and settings.
+    pub frame: FrameInput,
+    /// Linear view depth, `screen[0] * screen[1]` values, row-major from the top-left pixel.
+    pub depth: Vec<f32>,
+    /// Standard shadow map, `frame.shadow_map.size` squared values (normalised linear light
+    /// depth), row-major from the top-left texel.
+    pub shadow_map: Vec<f32>,
+}
+
+/// Everything [`run_once`] reads back.
+#[derive(Clone, Debug)]
+pub struct ScatterReadback {
+    /// The frame set-up that was uploaded.
+    pub frame: PrefilteredFrame,
+    /// In-scattered radiance per pixel (rgba16float converted to f32), row-major.
+    pub output: Vec<[f32; 4]>,
+    /// Rectified map, `Wr * Hr` values, row-major.
+    pub rectified: Vec<f32>,
+    /// Filtered bases, `Wr * Hr * bases/4` texels indexed `(layer * Hr + y) * Wr + x`,
+    /// converted from the storage format to f32 (values in [0, 1]).
+    pub filtered: Vec<[f32; 4]>,
+    /// GPU time per pass, when the device has timestamps.
+    pub gpu_times: Option<PassTimes>,
+    /// Wall time from submission until every result was mapped (includes the copies back).
+    pub wall_time: Duration,
+}
+
+/// Test helper: creates a [`Scatter`] for `variant` and `res`, uploads `inputs.depth` and
+/// `inputs.shadow_map` as r32float textures, prepares, encodes and submits one frame, and
+/// reads back the output, the rectified map, the filtered bases and the pass times.
+///
+/// Builds the pipelines on every call: an engine keeps a [`Scatter`] instead.
+///
+/// # Errors
+///
+/// Whatever [`Scatter::new`], [`Scatter::prepare`] or [`Scatter::encode`] fail with;
+/// [`RuntimeError::DataLength`] when a buffer does not match its size;
+/// [`RuntimeError::Wgpu`], [`RuntimeError::Poll`] or [`RuntimeError::Readback`] when the
+/// GPU work or the readback fails.
+pub fn run_once(
+    ctx: &Context,
+    variant: &Variant,
+    res: Resolutions,
+    inputs: &CpuInputs,
+) -> Result<ScatterReadback, RuntimeError> {
+    let sm_size = inputs.frame.shadow_map.size;
+    let mut pass = Scatter::new(ctx, variant, res, sm_size)?;
+    let [w, h] = res.screen;
+    for (kernel, what, [tw, th], data) in [
+        (SCATTER, "depth buffer", [w, h], &inputs.depth),
+        (RECTIFY, "shadow map", [sm_size; 2], &inputs.shadow_map),
+    ] {
+        let expected = u64::from(tw) * u64::from(th);
+        if data.len() as u64 != expected {
+            return Err(RuntimeError::DataLength {
+                kernel,
+                size: format!("{what} {tw}x{th}"),
+                expected,
+                actual: data.len() as u64,
+            });
+        }
+    }
+    pass.prepare(ctx, &inputs.frame)?;
+
+    let device = ctx.device();
+    let queue = pass.queue();
+    let scope = ErrorScopes::push(device);
+    let upload = |label, [width, height]: [u32; 2], data: &[f32]| {
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        queue.write_texture(
+            texture.as_image_copy(),
+            bytemuck::cast_slice(data),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(width * 4),
+                rows_per_image: Some(height),
+            },
+            size,
+        );
+        texture
+    };
+    let depth = upload("prefiltered depth (test upload)", res.screen, &inputs.depth);
+    let shadow = upload(
+        "prefiltered shadow map (test upload)",
+        [sm_size; 2],
+        &inputs.shadow_map,
+    );
+    scope.pop(SCATTER, "uploading test inputs")?;
+    let depth_view = depth.create_view(&wgpu::TextureViewDescriptor::default());
+    let shadow_view = shadow.create_view(&wgpu::TextureViewDescriptor::default());
+
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("prefiltered run_once"),
+    });
+    pass.encode(&mut encoder, &depth_view, &shadow_view)?;
+    let scope = ErrorScopes::push(device);
+    let rectified = Readback::encode(device, &mut encoder, pass.rectified_texture(), 4);
+    let filtered = Readback::encode(
+        device,
+        &mut encoder,
+        pass.filtered_texture(),
+        storage_texel_bytes(variant.storage),
+    );
+    let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8);
+    let start = Instant::now();
+    queue.submit([encoder.finish()]);
+    scope.pop(SCATTER, "dispatch")?;
+
+    let rectified = rectified
+        .read(ctx, RECTIFY)?
+        .chunks_exact(4)
+        .map(|t| f32::from_le_bytes([t[0], t[1], t[2], t[3]]))
+        .collect();
+    let filtered = filtered
+        .read(ctx, PREFILTER)?
+        .chunks_exact(storage_texel_bytes(variant.storage) as usize)
+        .map(|t| decode_rgba(t, variant.storage))
+        .collect();
+    let output = output
+        .read(ctx, SCATTER)?
+        .chunks_exact(8)
+        .map(|t| decode_rgba(t, Storage::Rgba16float))
+        .collect();
+    let wall_time = start.elapsed();
+    let gpu_times = pass.pass_times(ctx)?;
+    let frame = pass
+        .frame
+        .take()
+        .ok_or(RuntimeError::NotPrepared { kernel: RECTIFY })?;
+    Ok(ScatterReadback {
+        frame,
+        output,
+        rectified,
+        filtered,
+        gpu_times,
+        wall_time,
+    })
+}
+
+/// Decodes one rgba texel of a storage format to f32.
+fn decode_rgba(texel: &[u8], storage: Storage) -> [f32; 4] {
+    match storage {
+        Storage::Rgba8unorm => [0, 1, 2, 3].map(|c| f32::from(texel[c]) / 255.0),
+        Storage::Rgba16float => [0, 1, 2, 3].map(|c| {
+            half::f16::from_bits(u16::from_le_bytes([texel[2 * c], texel[2 * c + 1]])).to_f32()
+        }),
+        Storage::Rgba32float => [0, 1, 2, 3].map(|c| {
+            f32::from_le_bytes([
+                texel[4 * c],
+                texel[4 * c + 1],
+                texel[4 * c + 2],
+                texel[4 * c + 3],
+            ])
+        }),
+    }
+}
+
+/// A texture copied into a mappable buffer (rows padded to 256 bytes).
+struct Readback {
+    buffer: wgpu::Buffer,
+    extent: wgpu::Extent3d,
+    texel_bytes: u32,
+    padded_row: u32,
+}
+
+impl Readback {
+    /// Records the copy of every layer of `texture` (`texel_bytes` per texel).
+    fn encode(
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+        texel_bytes: u32,
+    ) -> Self {
+        let extent = texture.size();
+        let padded_row =
+            (extent.width * texel_bytes).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("prefiltered readback"),
+            size: u64::from(padded_row)
+                * u64::from(extent.height)
+                * u64::from(extent.depth_or_array_layers),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(extent.height),
+                },
+            },
+            extent,
+        );
+        Self {
+            buffer,
+            extent,
+            texel_bytes,
+            padded_row,
+        }
+    }
+
+    /// Maps the buffer and returns the texels' bytes without row padding, layer by layer,
+    /// row by row.
+    fn read(self, ctx: &Context, kernel: Kernel) -> Result<Vec<u8>, RuntimeError> {
+        let bytes = read_buffer(ctx, kernel, &self.buffer)?;
+        let row_bytes = (self.extent.width * self.texel_bytes) as usize;
+        let mut packed = Vec::with_capacity(
+            row_bytes * self.extent.height as usize * self.extent.depth_or_array_layers as usize,
+        );
+        for row in bytes.chunks_exact(self.padded_row as usize) {
+            packed.extend_from_slice(&row[..row_bytes]);
+        }
+        Ok(packed)
+    }
+}
