@@ -24,7 +24,10 @@ use scatter_reference::metrics;
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
-use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Variant, VariantError};
+use scatter_runtime::{Context, CpuInputs, FrameInput, PassTimes, run_once};
+use scatter_shaderlib::prefiltered::{
+    FrameSettings, LightKind, Resolutions, Variant, VariantError,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -75,6 +78,14 @@ struct Args {
     /// write `<stem>.compare.png` (truth | prefiltered | 4x difference).
     #[arg(long)]
     compare: bool,
+    /// With `--method prefiltered`: run the GPU kernels through `scatter-runtime` (lavapipe
+    /// when there is no GPU) instead of the CPU mirror, and print GPU time per pass (the
+    /// minimum over `--frames` runs).
+    #[arg(long)]
+    gpu: bool,
+    /// Frames timed with `--gpu` (1..=100).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100))]
+    frames: u32,
     /// Image width in pixels (1..=8192).
     #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=8192))]
     width: u32,
@@ -242,16 +253,21 @@ fn run_prefiltered_method(
     );
     let t = Instant::now();
     let settings = FrameSettings::for_screen(args.width, args.height);
-    let run = run_prefiltered(&variant, rectified, scene, gbuf, &sm, &settings)?;
-    eprintln!(
-        "prefiltered {variant} ({}x{} rectified) on the CPU mirror in {:.2?}; {:?}",
-        rectified[0],
-        rectified[1],
-        t.elapsed(),
-        run.frame.report
-    );
-    let composite = truth::surface_radiance(scene, gbuf, bvh).add(&run.output)?;
-    write_outputs(args, &composite, &run.output)?;
+    let output = if args.gpu {
+        run_on_gpu(args, &variant, rectified, scene, gbuf, &sm, settings)?
+    } else {
+        let run = run_prefiltered(&variant, rectified, scene, gbuf, &sm, &settings)?;
+        eprintln!(
+            "prefiltered {variant} ({}x{} rectified) on the CPU mirror in {:.2?}; {:?}",
+            rectified[0],
+            rectified[1],
+            t.elapsed(),
+            run.frame.report
+        );
+        run.output
+    };
+    let composite = truth::surface_radiance(scene, gbuf, bvh).add(&output)?;
+    write_outputs(args, &composite, &output)?;
     if args.compare {
         let bar = ProgressBar::new(u64::from(args.height)).with_style(
             ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, eta {eta}")?
@@ -266,13 +282,13 @@ fn run_prefiltered_method(
             bar.inc(1)
         });
         bar.finish_and_clear();
-        let report = metrics::compare(&run.output, &truth)?;
+        let report = metrics::compare(&output, &truth)?;
         println!(
             "{}: prefiltered {variant} vs shadow_map truth: {report}",
             scene.name
         );
-        let diff = run.output.abs_diff(&truth, 4.0)?;
-        let strip = Image::hstack(&[&truth, &run.output, &diff])?;
+        let diff = output.abs_diff(&truth, 4.0)?;
+        let strip = Image::hstack(&[&truth, &output, &diff])?;
         let path = args.out.with_extension("").with_extension("compare.png");
         strip.write_png(&path, Some(truth.auto_exposure()))?;
         eprintln!(
@@ -281,4 +297,73 @@ fn run_prefiltered_method(
         );
     }
     Ok(())
+}
+
+/// Runs the prefiltered kernels on the GPU `--frames` times; prints the adapter and the
+/// fastest GPU time per pass, returns the last output.
+#[allow(clippy::too_many_arguments, reason = "the demo's inputs")]
+fn run_on_gpu(
+    args: &Args,
+    variant: &Variant,
+    rectified: [u32; 2],
+    scene: &Scene,
+    gbuf: &GBuffer,
+    sm: &ShadowMap,
+    settings: FrameSettings,
+) -> Result<Image, Box<dyn std::error::Error>> {
+    let ctx = Context::new()?;
+    eprintln!("GPU adapter: {}", ctx.report());
+    let res = Resolutions {
+        screen: [gbuf.width, gbuf.height],
+        rectified,
+    };
+    let inputs = CpuInputs {
+        frame: FrameInput {
+            camera: scene.camera_desc(),
+            light: scene.light_desc(),
+            medium: scene.medium_desc(),
+            shadow_map: sm.desc(),
+            settings,
+        },
+        depth: gbuf.view_depth.clone(),
+        shadow_map: sm.depth.clone(),
+    };
+    let mut best: Option<PassTimes> = None;
+    let mut last = None;
+    for _ in 0..args.frames {
+        let rb = run_once(&ctx, variant, res, &inputs)?;
+        if let Some(t) = rb.gpu_times {
+            best = Some(match best {
+                None => t,
+                Some(b) => PassTimes {
+                    rectify: b.rectify.min(t.rectify),
+                    prefilter: b.prefilter.min(t.prefilter),
+                    scatter: b.scatter.min(t.scatter),
+                },
+            });
+        }
+        last = Some(rb);
+    }
+    let rb = last.ok_or("no frame ran")?;
+    eprintln!("prefiltered {variant} on the GPU; {:?}", rb.frame.report);
+    match best {
+        Some(t) => println!(
+            "GPU time per pass (min of {} frames, {}x{} screen, {}x{} rectified): rectify {:.3} ms, prefilter {:.3} ms, scatter {:.3} ms, total {:.3} ms",
+            args.frames,
+            gbuf.width,
+            gbuf.height,
+            rectified[0],
+            rectified[1],
+            t.rectify.as_secs_f64() * 1e3,
+            t.prefilter.as_secs_f64() * 1e3,
+            t.scatter.as_secs_f64() * 1e3,
+            t.total().as_secs_f64() * 1e3
+        ),
+        None => println!("the adapter has no timestamp queries: no GPU times"),
+    }
+    Ok(Image::from_pixels(
+        gbuf.width,
+        gbuf.height,
+        rb.output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
+    ))
 }
