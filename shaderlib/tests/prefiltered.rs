@@ -16,29 +16,7 @@ use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams, ShaderError, build, r
 /// Every valid variant: bases {4, .., 128} x every bases_per_thread x regions 1..=8 x
 /// visibility x light x storage (rectification: epipolar, the only valid one).
 fn cross_product() -> Vec<Variant> {
-    let mut out = Vec::new();
-    for bases in [4, 8, 16, 32, 64, 128] {
-        for bases_per_thread in Variant::bases_per_thread_options(bases) {
-            for regions in Variant::REGIONS {
-                for &visibility in VisibilityMode::ALL {
-                    for &light in LightKind::ALL {
-                        for &storage in Storage::ALL {
-                            out.push(Variant {
-                                bases,
-                                bases_per_thread,
-                                regions,
-                                visibility,
-                                light,
-                                storage,
-                                rectification: Rectification::Epipolar,
-                            });
-                        }
-                    }
-                }
-            }
-        }
-    }
-    out
+    Variant::grid(Variant::REGIONS)
 }
 
 /// Renders every kernel of every variant and validates each distinct rendered source once

@@ -209,6 +209,35 @@ impl Variant {
             .collect()
     }
 
+    /// Every valid variant with bases in {4, 8, 16, 32, 64, 128} (the powers of two of the
+    /// design card), every `bases_per_thread`, the given `regions`, both visibilities, both
+    /// lights and every storage format, epipolar rectification; sorted by those knobs.
+    pub fn grid(regions: std::ops::RangeInclusive<u32>) -> Vec<Variant> {
+        let mut out = Vec::new();
+        for bases in [4, 8, 16, 32, 64, 128] {
+            for bases_per_thread in Self::bases_per_thread_options(bases) {
+                for r in regions.clone() {
+                    for &visibility in VisibilityMode::ALL {
+                        for &light in LightKind::ALL {
+                            for &storage in Storage::ALL {
+                                out.push(Variant {
+                                    bases,
+                                    bases_per_thread,
+                                    regions: r,
+                                    visibility,
+                                    light,
+                                    storage,
+                                    rectification: Rectification::Epipolar,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// rgba layers of the filtered-basis texture array: `bases / 4`.
     pub fn layers(&self) -> u32 {
         self.bases / 4
