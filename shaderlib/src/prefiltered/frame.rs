@@ -29,7 +29,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 use std::f64::consts::PI;
 
-use super::variant::{LightKind, Variant};
+use super::variant::{LightKind, Rectification, Variant};
 
 /// The camera of one frame (the engine's view).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -287,6 +287,12 @@ const _: () = {
 /// What the frame setup decided, for the frame report.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrameReport {
+    /// The rectification actually used this frame (always epipolar until projective
+    /// rectification lands).
+    pub rectification: Rectification,
+    /// Whether pixels near the epipole or the anti-epipole are ray-marched this frame (one of
+    /// them is on screen), and within which radius (pixels).
+    pub marched_radius_px: Option<f64>,
     /// The epipole (direction towards the light) projects inside the screen.
     pub epipole_on_screen: bool,
     /// The anti-epipole projects inside the screen (light behind the camera).
@@ -722,6 +728,9 @@ pub fn prepare_frame(
         uniforms,
         slices,
         report: FrameReport {
+            rectification: Rectification::Epipolar,
+            marched_radius_px: (epi.is_some() || anti.is_some())
+                .then_some(settings.epipole_radius_px),
             epipole_on_screen: epi.is_some(),
             anti_epipole_on_screen: anti.is_some(),
             full_circle,
