@@ -54,6 +54,11 @@ fn pixel_dir(f: Frame, x: u32, y: u32) -> vec3<f32> {
     return normalize(f.cam_forward.xyz + f.cam_right.xyz * (ndc_x * t * f.cam_right[3]) + f.cam_up.xyz * (ndc_y * t));
 }
 
+// The spot integrand at ray parameter `t` with the light and medium of the frame.
+fn frame_spot_integrand(f: Frame, eye: vec3<f32>, dir: vec3<f32>, t: f32) -> f32 {
+    return spot_integrand(eye, dir, t, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
+}
+
 // In-scattering by ray marching `steps` midpoints against the standard shadow map.
 fn march(eye: vec3<f32>, dir: vec3<f32>, s: f32, spot: bool) -> f32 {
     let f = frame;
@@ -64,7 +69,7 @@ fn march(eye: vec3<f32>, dir: vec3<f32>, s: f32, spot: bool) -> f32 {
         let t = (f32(k) + 0.5) * h;
         let v = sm_visibility(f, shadow_map, eye + dir * t);
         if spot {
-            sum += v * h * spot_integrand(eye, dir, t, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
+            sum += v * h * frame_spot_integrand(f, eye, dir, t);
         } else {
             sum += v * transmittance_between(f.medium[0], f32(k) * h, f32(k + 1u) * h);
         }
@@ -230,7 +235,7 @@ fn spot_segment(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, panels
         for (var q = 0u; q < 4u; q++) {
             let t = mid + 0.5 * h * GL4_X[q];
             sum += GL4_W[q]
-                * spot_integrand(eye, dir, t, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
+                * frame_spot_integrand(f, eye, dir, t);
         }
     }
     return sum * 0.5 * h;

@@ -50,6 +50,20 @@ pub fn pixel_dir(f: &FrameUniforms, x: u32, y: u32) -> Vec3 {
         .normalize()
 }
 
+/// The spot integrand at ray parameter `t` with the light and medium of the frame.
+pub fn frame_spot_integrand(f: &FrameUniforms, eye: Vec3, dir: Vec3, t: f32) -> f32 {
+    spot_integrand(
+        eye,
+        dir,
+        t,
+        xyz(f.light_pos),
+        xyz(f.light_dir),
+        f.light_pos[3],
+        f.light_dir[3],
+        f.medium,
+    )
+}
+
 /// In-scattering by ray marching `steps` midpoints against the standard shadow map.
 pub fn march(inp: &ScatterInputs, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f32 {
     let f = inp.frame;
@@ -60,18 +74,7 @@ pub fn march(inp: &ScatterInputs, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f
         let t = (k as f32 + 0.5) * h;
         let v = sm_visibility(f, inp.shadow_map, eye + dir * t);
         if spot {
-            sum += v
-                * h
-                * spot_integrand(
-                    eye,
-                    dir,
-                    t,
-                    xyz(f.light_pos),
-                    xyz(f.light_dir),
-                    f.light_pos[3],
-                    f.light_dir[3],
-                    f.medium,
-                );
+            sum += v * h * frame_spot_integrand(f, eye, dir, t);
         } else {
             sum += v * transmittance_between(f.medium[0], k as f32 * h, (k + 1) as f32 * h);
         }
@@ -240,17 +243,7 @@ pub fn spot_segment(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, pan
         let mid = a + (k as f32 + 0.5) * h;
         for q in 0..4 {
             let t = mid + 0.5 * h * GL4_X[q];
-            sum += GL4_W[q]
-                * spot_integrand(
-                    eye,
-                    dir,
-                    t,
-                    xyz(f.light_pos),
-                    xyz(f.light_dir),
-                    f.light_pos[3],
-                    f.light_dir[3],
-                    f.medium,
-                );
+            sum += GL4_W[q] * frame_spot_integrand(f, eye, dir, t);
         }
     }
     sum * 0.5 * h
