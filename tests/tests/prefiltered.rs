@@ -3,10 +3,13 @@
 //! (`reference/src/kernels/{rectify,prefilter,scatter}.rs`, driven by
 //! `scatter_reference::kernels::run_prefiltered`) for every variant of the design card:
 //! bases {4, 8, 16, 32, 64, 128} x every valid bases_per_thread x regions {1, 2, 3, 4} x
-//! visibility x light x storage (epipolar rectification only). Directional variants run on
+//! visibility x light x storage x rectification. Directional variants run on
 //! `columns/ordinary`, spot variants on `spot_grate/ordinary`, 64x36 pixels, a 128^2 shadow
 //! map and a 64x64 rectified map. Trials are named
-//! `prefiltered::<variant id>::<scene>::<pose>`.
+//! `prefiltered::<variant id>::<scene>::<pose>`. Both poses are projective frames for the
+//! projective variants (asserted): their rectified map is the reference's ray-cast stand-in
+//! for the engine's rasteriser, uploaded to the GPU, and `rectify` does not run. The
+//! fallback to epipolar is tested on `columns/epipole_on_screen`.
 //!
 //! Tolerances:
 //! - rectified map: `|gpu - cpu| <= 1e-4` (a normalised view angle: acos/atan2 differ by a
@@ -32,9 +35,10 @@ use scatter_reference::bvh::Bvh;
 use scatter_reference::kernels::{PrefilteredRun, run_prefiltered};
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
-use scatter_runtime::{Context, CpuInputs, FrameInput, RuntimeError, Scatter, run_once};
+use scatter_runtime::wgpu::TextureView;
+use scatter_runtime::{Context, CpuInputs, FrameInput, Inputs, RuntimeError, Scatter, run_once};
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightKind, Rectification, Resolutions, Storage, Variant,
+    FrameSettings, LightKind, Resolutions, Storage, Variant,
 };
 
 const SCREEN: [u32; 2] = [64, 36];
@@ -48,6 +52,7 @@ const RECTIFIED_TOL: f32 = 1e-4;
 struct Fixture {
     name: SceneName,
     scene: Scene,
+    bvh: Bvh,
     gbuf: GBuffer,
     shadow_map: ShadowMap,
 }
@@ -69,6 +74,7 @@ impl Fixture {
             Fixture {
                 name,
                 scene,
+                bvh,
                 gbuf,
                 shadow_map,
             }
@@ -90,6 +96,7 @@ impl Fixture {
             frame: self.frame_input(),
             depth: self.gbuf.view_depth.clone(),
             shadow_map: self.shadow_map.depth.clone(),
+            rectified: None,
         }
     }
 
@@ -101,8 +108,8 @@ impl Fixture {
     }
 }
 
-/// Every variant of the design card for one light type (epipolar rectification), regions
-/// 1..=4 as the conformance grid asks.
+/// Every variant of the design card for one light type, regions 1..=4 as the issue's
+/// conformance grid asks.
 fn variants(light: LightKind) -> Vec<Variant> {
     Variant::grid(1..=4)
         .into_iter()
@@ -186,18 +193,30 @@ fn trial_name(variant: &Variant, fixture: &Fixture) -> String {
 fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<TrialResult, String> {
     let trial = trial_name(variant, fixture);
     let start = Instant::now();
-    let gpu = run_once(ctx, variant, fixture.resolutions(), &fixture.cpu_inputs())
-        .map_err(|e| format!("{trial}: GPU run failed: {e}"))?;
-    let gpu_wall = start.elapsed();
     let cpu: PrefilteredRun = run_prefiltered(
         variant,
         RECTIFIED,
         &fixture.scene,
+        &fixture.bvh,
         &fixture.gbuf,
         &fixture.shadow_map,
         &FrameSettings::default(),
     )
     .map_err(|e| format!("{trial}: CPU mirror failed: {e}"))?;
+    if cpu.frame.report.rectification != variant.rectification {
+        return Err(format!(
+            "{trial}: expected a {} frame, got {} ({:?})",
+            variant.rectification, cpu.frame.report.rectification, cpu.frame.report.fallback
+        ));
+    }
+    let mut inputs = fixture.cpu_inputs();
+    if cpu.frame.report.projective.is_some() {
+        inputs.rectified = Some(cpu.rectified.data.clone());
+    }
+    let gpu_start = Instant::now();
+    let gpu = run_once(ctx, variant, fixture.resolutions(), &inputs)
+        .map_err(|e| format!("{trial}: GPU run failed: {e}"))?;
+    let gpu_wall = gpu_start.elapsed();
     if gpu.frame != cpu.frame {
         return Err(format!(
             "{trial}: the runtime uploaded a different frame set-up than the mirror used"
@@ -442,7 +461,7 @@ fn wrong_shadow_map_size_is_an_error() {
     let mut encoder = ctx.device().create_command_encoder(&Default::default());
     let small = texture([SHADOW_MAP / 2; 2], r32);
     let err = pass
-        .encode(&mut encoder, &depth, &small)
+        .encode(&mut encoder, &inputs(&depth, &small))
         .expect_err("a 64^2 shadow-map view");
     assert!(err.to_string().contains("shadow map size"), "{err}");
     eprintln!("ok   prefiltered::errors::shadow_map_view_size: {err}");
@@ -451,19 +470,31 @@ fn wrong_shadow_map_size_is_an_error() {
         scatter_runtime::wgpu::TextureFormat::Rgba8Unorm,
     );
     let err = pass
-        .encode(&mut encoder, &depth, &rgba)
+        .encode(&mut encoder, &inputs(&depth, &rgba))
         .expect_err("an rgba8 shadow-map view");
     assert!(err.to_string().contains("shadow map format"), "{err}");
     eprintln!("ok   prefiltered::errors::shadow_map_view_format: {err}");
     let small_depth = texture([SCREEN[0], SCREEN[1] - 1], r32);
     let sm = texture([SHADOW_MAP; 2], r32);
     let err = pass
-        .encode(&mut encoder, &small_depth, &sm)
+        .encode(&mut encoder, &inputs(&small_depth, &sm))
         .expect_err("a short depth buffer");
     assert!(err.to_string().contains("depth buffer size"), "{err}");
     eprintln!("ok   prefiltered::errors::depth_view_size: {err}");
     // The right views encode, and the encoder still finishes cleanly.
-    pass.encode(&mut encoder, &depth, &sm)
+    let err = pass
+        .encode(
+            &mut encoder,
+            &Inputs {
+                depth: &depth,
+                shadow_map: None,
+                rectified: None,
+            },
+        )
+        .expect_err("an epipolar frame without a shadow map");
+    assert!(matches!(err, RuntimeError::MissingInput { .. }), "{err}");
+    eprintln!("ok   prefiltered::errors::missing_shadow_map: {err}");
+    pass.encode(&mut encoder, &inputs(&depth, &sm))
         .unwrap_or_else(|e| panic!("{e}"));
     ctx.queue().submit([encoder.finish()]);
 }
@@ -550,14 +581,6 @@ fn invalid_variant_names_the_knob() {
             "bases_per_thread",
             "12",
         ),
-        (
-            Variant {
-                rectification: Rectification::Projective,
-                ..base_variant()
-            },
-            "rectification",
-            "projective",
-        ),
     ];
     for (variant, knob, value) in cases {
         let err = Scatter::new(ctx, &variant, columns_res(), SHADOW_MAP).expect_err(knob);
@@ -582,7 +605,10 @@ fn bad_frames_are_errors_not_panics() {
     // Encoding before any frame was prepared.
     let mut encoder = ctx.device().create_command_encoder(&Default::default());
     let err = pass
-        .encode(&mut encoder, pass.rectified_view(), pass.rectified_view())
+        .encode(
+            &mut encoder,
+            &inputs(pass.rectified_view(), pass.rectified_view()),
+        )
         .expect_err("encode before prepare");
     assert!(matches!(err, RuntimeError::NotPrepared { .. }), "{err}");
     eprintln!("ok   prefiltered::errors::not_prepared: {err}");
@@ -618,4 +644,13 @@ fn bad_frames_are_errors_not_panics() {
     // After the errors, a good frame still works.
     pass.prepare(ctx, &fixture.frame_input())
         .unwrap_or_else(|e| panic!("{e}"));
+}
+
+/// An epipolar frame's inputs: depth and standard shadow map.
+fn inputs<'a>(depth: &'a TextureView, shadow_map: &'a TextureView) -> Inputs<'a> {
+    Inputs {
+        depth,
+        shadow_map: Some(shadow_map),
+        rectified: None,
+    }
 }

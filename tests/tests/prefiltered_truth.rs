@@ -87,6 +87,7 @@ const EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
 
 struct Fixture {
     scene: scatter_reference::scene::Scene,
+    bvh: Bvh,
     gbuf: GBuffer,
     shadow_map: ShadowMap,
     truth: Image,
@@ -117,6 +118,7 @@ fn fixture(name: SceneName, pose: Pose, medium: MediumPreset) -> Arc<Fixture> {
         );
         Arc::new(Fixture {
             scene,
+            bvh,
             gbuf,
             shadow_map,
             truth,
@@ -139,6 +141,7 @@ fn error(f: &Fixture, variant: &Variant) -> f64 {
         variant,
         RECTIFIED,
         &f.scene,
+        &f.bvh,
         &f.gbuf,
         &f.shadow_map,
         &FrameSettings::default(),
