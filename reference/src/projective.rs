@@ -55,10 +55,12 @@ pub fn rasterise_rectified(
                             Ray::new(p0 - l * reach, l)
                         }
                         LightDesc::Spot { position, .. } => {
-                            // Both unprojected points lie on the texel's light ray through
-                            // the lamp; it leaves the lamp towards them.
-                            let mut v = (p1 - position).normalize();
-                            if (p0 - position).dot(v) < 0.0 {
+                            // Both unprojected points lie on the texel's line through the
+                            // lamp (maybe on its far side); the light ray leaves the lamp
+                            // towards the frustum's side, where clip w (the distance along
+                            // the bisectrix) grows.
+                            let mut v = (p1 - p0).normalize();
+                            if (*m * v.extend(0.0)).w < 0.0 {
                                 v = -v;
                             }
                             Ray::new(position, v)

@@ -11,6 +11,10 @@ use super::common_model::{
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams, Storage};
 
+/// Smallest cone factor of a spot texel weight (see the WGSL): a region of the reference ray
+/// outside the cone still averages its texels instead of storing an undefined mean.
+pub const CONE_FLOOR: f32 = 1e-3;
+
 /// Stand-in for "no occluder": a travel distance far beyond any scene.
 pub const NO_OCCLUDER: f32 = 1e30;
 
@@ -240,7 +244,10 @@ pub fn texel_weight(
         let l = -xyz(f.axis) * psi.cos() + e * psi.sin();
         let den = max((s.theta_ref + psi).sin(), 1e-4);
         let r = max(f.axis[3] * s.theta_ref.sin() / den, 1e-4);
-        let cone = cone_falloff(l.dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]);
+        let cone = max(
+            cone_falloff(l.dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]),
+            CONE_FLOOR,
+        );
         w *= cone * exp(-f.medium[0] * r) / (r * r);
     }
     w
@@ -449,7 +456,10 @@ pub fn proj_texel_weight(
         let dir = (xyz(f.e1) + xyz(f.e2) * k + xyz(f.axis) * m) / len;
         let to = xyz(f.eye) + dir * (0.5 * (t0 + t1)) - xyz(f.light_pos);
         let dl = max(to.length(), 1e-4);
-        let cone = cone_falloff((to / dl).dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]);
+        let cone = max(
+            cone_falloff((to / dl).dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]),
+            CONE_FLOOR,
+        );
         w *= cone * exp(-f.medium[0] * dl) / (dl * dl);
     }
     w

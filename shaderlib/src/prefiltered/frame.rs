@@ -874,9 +874,12 @@ pub fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
 /// stored normalised as `(m_hi - m) / (m_hi - m_lo)`) and the column invariant
 /// `G = 1 / qx` (sun) or `G = (D - qz) / qx` (spot at distance `D`), constant along a light
 /// ray. Each region `r` maps `G` linearly from `G_r` to `G_(r+1)` onto its columns; the
-/// boundaries are geometric in `qx` (sun) or in the light-ray angle `acot G` (spot)
-/// between the frustum's extremes, which limits the hyperbolic crowding of columns near
-/// the eye that one projective map over the whole depth range would have.
+/// boundaries are geometric in `qx` (sun) between the frustum's extremes, which limits the
+/// hyperbolic crowding of columns near the eye that one projective map over the whole
+/// depth range would have, and uniform in the light-ray angle `acot G` (spot), like the
+/// epipolar spot's uniform regions (geometric angles measured 85.6 % rel L1 on
+/// spot_grate/grazing: the last region then spans most of the ray and the per-region
+/// unshadowed quadrature misses the cone).
 fn projective_frame(
     variant: &Variant,
     res: &Resolutions,
@@ -934,7 +937,7 @@ fn projective_frame(
         let psi1 = (1.0f64.atan2(gmin) * (1.0 + 1e-3)).min(PI - 1e-3);
         (0..=regions)
             .map(|r| {
-                let psi = psi0 * (psi1 / psi0).powf(f64::from(r) / f64::from(regions));
+                let psi = psi0 + (psi1 - psi0) * f64::from(r) / f64::from(regions);
                 psi.cos() / psi.sin()
             })
             .collect()

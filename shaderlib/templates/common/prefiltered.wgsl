@@ -120,6 +120,12 @@ fn normalised_depth(theta: f32, lo: f32, hi: f32) -> f32 {
 // against an empty light ray) would fall on the periodic copy's discontinuity.
 const DEPTH_MARGIN: f32 = 0.1f;
 
+// Smallest cone factor of a spot texel weight: where a region of the reference ray lies
+// outside the cone, its texels still average (nearly uniformly) instead of leaving the
+// region's mean undefined (all-zero weights store F = 0, i.e. visibility 0.5), because a
+// pixel's own ray may cross the cone where the reference ray does not.
+const CONE_FLOOR: f32 = 1e-3f;
+
 // Fourier frequency `c_k = pi (2k - 1)`.
 fn freq(k: u32) -> f32 {
     return PI * f32(2u * k - 1u);
@@ -190,7 +196,7 @@ fn texel_weight(f: Frame, s: SliceParams, row: u32, i: u32, weighted: bool, spot
         let l = -f.axis.xyz * cos(psi) + e * sin(psi);
         let den = max(sin(s.theta_ref + psi), 1e-4);
         let r = max(f.axis[3] * sin(s.theta_ref) / den, 1e-4);
-        let cone = cone_falloff(dot(l, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]);
+        let cone = max(cone_falloff(dot(l, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]), CONE_FLOOR);
         w *= cone * exp(-f.medium[0] * r) / (r * r);
     }
     return w;
@@ -369,7 +375,7 @@ fn proj_texel_weight(f: Frame, s: SliceParams, i: u32, r: u32, regions: u32, wei
         let dir = (f.e1_.xyz + f.e2_.xyz * k + f.axis.xyz * m) / len;
         let to = f.eye.xyz + dir * (0.5 * (t0 + t1)) - f.light_pos.xyz;
         let dl = max(length(to), 1e-4);
-        let cone = cone_falloff(dot(to / dl, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]);
+        let cone = max(cone_falloff(dot(to / dl, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]), CONE_FLOOR);
         w *= cone * exp(-f.medium[0] * dl) / (dl * dl);
     }
     return w;
