@@ -41,11 +41,10 @@ fn check(name: SceneName, pose: Pose, regions: u32) {
         &FrameSettings::for_screen(160, 90),
     )
     .expect("frame");
-    let maps = frame
-        .report
-        .projective
-        .as_ref()
-        .unwrap_or_else(|| panic!("{name}/{pose}: not projective: {:?}", frame.report.fallback));
+    let maps =
+        frame.report.projective.as_ref().unwrap_or_else(|| {
+            panic!("{name}/{pose}: not projective: {:?}", frame.report.fallback)
+        });
     let f = &frame.uniforms;
     let spot = light == LightKind::Spot;
     let corners = sc.camera.frustum_corners();
@@ -58,7 +57,10 @@ fn check(name: SceneName, pose: Pose, regions: u32) {
         for j in 0..n {
             for k in 1..=n {
                 // A point inside the frustum: bilinear on the far plane, scaled towards the eye.
-                let (u, v) = ((f64::from(i) + 0.5) / f64::from(n), (f64::from(j) + 0.5) / f64::from(n));
+                let (u, v) = (
+                    (f64::from(i) + 0.5) / f64::from(n),
+                    (f64::from(j) + 0.5) / f64::from(n),
+                );
                 let far = corners[4] * (1.0 - u) * (1.0 - v)
                     + corners[5] * u * (1.0 - v)
                     + corners[6] * u * v
@@ -70,7 +72,11 @@ fn check(name: SceneName, pose: Pose, regions: u32) {
                 let q = Vec3::new(q3.dot(xyz(f.e1)), q3.dot(xyz(f.e2)), q3.dot(xyz(f.axis)));
                 let kk = q.y / q.x;
                 let m = q.z / q.x;
-                let g = if spot { (f.axis[3] - q.z) / q.x } else { 1.0 / q.x };
+                let g = if spot {
+                    (f.axis[3] - q.z) / q.x
+                } else {
+                    1.0 / q.x
+                };
                 let col = f64::from(proj_column(f, g, regions, RECT[0], spot));
                 let row = f64::from((kk + f.proj[1]) / (2.0 * f.proj[1]) * RECT[1] as f32);
                 let raw = f64::from((f.proj[2] - m) * f.proj[3]);
@@ -107,7 +113,10 @@ fn check(name: SceneName, pose: Pose, regions: u32) {
                     (col2 - mcol).abs() < 1e-6 && (row2 - mrow).abs() < 1e-6,
                     "{name}/{pose}: a light ray crosses texels"
                 );
-                assert!(c2.z / c2.w > mdepth, "{name}/{pose}: depth must grow along the light");
+                assert!(
+                    c2.z / c2.w > mdepth,
+                    "{name}/{pose}: depth must grow along the light"
+                );
                 let _ = DVec3::ZERO;
             }
         }
@@ -115,9 +124,18 @@ fn check(name: SceneName, pose: Pose, regions: u32) {
     eprintln!(
         "{name}/{pose} R={regions}: kernel vs matrix mapping: column {worst_col:.2e}, row {worst_row:.2e}, depth {worst_depth:.2e}"
     );
-    assert!(worst_col < 0.02, "{name}/{pose}: column differs by {worst_col}");
-    assert!(worst_row < 0.02, "{name}/{pose}: row differs by {worst_row}");
-    assert!(worst_depth < 1e-4, "{name}/{pose}: depth differs by {worst_depth}");
+    assert!(
+        worst_col < 0.02,
+        "{name}/{pose}: column differs by {worst_col}"
+    );
+    assert!(
+        worst_row < 0.02,
+        "{name}/{pose}: row differs by {worst_row}"
+    );
+    assert!(
+        worst_depth < 1e-4,
+        "{name}/{pose}: depth differs by {worst_depth}"
+    );
 }
 
 #[test]
@@ -170,7 +188,10 @@ fn map_matches_shadow_rays(name: SceneName, pose: Pose) -> f64 {
     let n = 40;
     for i in 0..n {
         for j in 0..n {
-            let (u, v) = ((f64::from(i) + 0.5) / f64::from(n), (f64::from(j) + 0.5) / f64::from(n));
+            let (u, v) = (
+                (f64::from(i) + 0.5) / f64::from(n),
+                (f64::from(j) + 0.5) / f64::from(n),
+            );
             let far = corners[4] * (1.0 - u) * (1.0 - v)
                 + corners[5] * u * (1.0 - v)
                 + corners[6] * u * v
@@ -208,7 +229,10 @@ fn map_matches_shadow_rays(name: SceneName, pose: Pose) -> f64 {
         }
     }
     let frac = f64::from(disagree) / f64::from(total.max(1));
-    eprintln!("{name}/{pose}: rasterised map vs shadow rays disagree on {disagree} of {total} points ({:.2} %)", 100.0 * frac);
+    eprintln!(
+        "{name}/{pose}: rasterised map vs shadow rays disagree on {disagree} of {total} points ({:.2} %)",
+        100.0 * frac
+    );
     frac
 }
 

@@ -542,6 +542,78 @@ impl Scatter {
         encoder: &mut wgpu::CommandEncoder,
         inputs: &Inputs<'_>,
     ) -> Result<&wgpu::TextureView, RuntimeError> {
+        self.encode_selected(encoder, inputs, None)
+    }
+
+    /// Records one pass of the frame (`rectify`, `prefilter` or `scatter`) without
+    /// timestamps, for timing passes one submission at a time
+    /// ([`Self::measure_pass_wall_times`]). A projective frame records nothing for
+    /// `rectify`. Errors as [`Self::encode`].
+    ///
+    /// # Errors
+    ///
+    /// As [`Self::encode`].
+    pub fn encode_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &Inputs<'_>,
+        kernel: Kernel,
+    ) -> Result<(), RuntimeError> {
+        self.encode_selected(encoder, inputs, Some(kernel))
+            .map(|_| ())
+    }
+
+    /// Wall time of each pass submitted on its own and waited for, the median over
+    /// `frames` frames after one warm-up frame. On a software rasteriser such as lavapipe,
+    /// where the GPU is the CPU, this is the pass's real cost (its GPU timestamps are not:
+    /// they are not ordered after the compute work). Includes one submission and one
+    /// blocking poll per pass.
+    ///
+    /// # Errors
+    ///
+    /// As [`Self::encode`]; [`RuntimeError::Poll`] when waiting fails.
+    pub fn measure_pass_wall_times(
+        &self,
+        ctx: &Context,
+        inputs: &Inputs<'_>,
+        frames: u32,
+    ) -> Result<PassTimes, RuntimeError> {
+        let mut samples: [Vec<Duration>; 3] = Default::default();
+        for frame in 0..=frames.max(1) {
+            for (slot, kernel) in [RECTIFY, PREFILTER, SCATTER].into_iter().enumerate() {
+                let mut encoder =
+                    self.device
+                        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                            label: Some(kernel.name()),
+                        });
+                self.encode_pass(&mut encoder, inputs, kernel)?;
+                let start = Instant::now();
+                ctx.queue().submit([encoder.finish()]);
+                ctx.device()
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|source| RuntimeError::Poll { kernel, source })?;
+                if frame > 0 {
+                    samples[slot].push(start.elapsed());
+                }
+            }
+        }
+        let [rectify, prefilter, scatter] = samples.map(|mut v| {
+            v.sort();
+            v[v.len() / 2]
+        });
+        Ok(PassTimes {
+            rectify,
+            prefilter,
+            scatter,
+        })
+    }
+
+    fn encode_selected(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &Inputs<'_>,
+        only: Option<Kernel>,
+    ) -> Result<&wgpu::TextureView, RuntimeError> {
         let frame = self
             .frame
             .as_ref()
@@ -627,25 +699,32 @@ impl Scatter {
             (&self.rectify, &rectify_group, [wr, hr, 1]),
             (
                 &self.prefilter,
-                prefilter_group.as_ref().unwrap_or(&self.prefilter_bind_group),
+                prefilter_group
+                    .as_ref()
+                    .unwrap_or(&self.prefilter_bind_group),
                 [hr, v.regions, v.threads_per_row_region()],
             ),
             (&self.scatter, &scatter_group, [w, h, 1]),
         ];
         for (index, (pipeline, group, invocations)) in (0u32..).zip(passes) {
-            if projective && index == 0 {
+            if (projective && index == 0) || only.is_some_and(|k| k != pipeline.kernel) {
                 continue;
             }
+            let timestamps = if only.is_none() {
+                self.timer.as_ref().and_then(|t| t.pass_writes(index))
+            } else {
+                None
+            };
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(pipeline.kernel.name()),
-                timestamp_writes: self.timer.as_ref().and_then(|t| t.pass_writes(index)),
+                timestamp_writes: timestamps,
             });
             pass.set_pipeline(&pipeline.pipeline);
             pass.set_bind_group(0, group, &[]);
             let [x, y, z] = groups(invocations, pipeline.workgroup_size);
             pass.dispatch_workgroups(x, y, z);
         }
-        if let Some(timer) = &self.timer {
+        if let Some(timer) = self.timer.as_ref().filter(|_| only.is_none()) {
             timer.resolve(encoder);
         }
         Ok(&self.output_view)
@@ -906,6 +985,9 @@ pub struct CpuInputs {
     /// The engine's rasterised rectified map (`Wr * Hr` clip depths, row-major), used when
     /// the frame turns out projective (it must then be present).
     pub rectified: Option<Vec<f32>>,
+    /// When non-zero, [`run_once`] also measures each pass on its own
+    /// ([`Scatter::measure_pass_wall_times`]) over this many frames.
+    pub pass_wall_frames: u32,
 }
 
 /// Everything [`run_once`] reads back.
@@ -922,6 +1004,9 @@ pub struct ScatterReadback {
     pub filtered: Vec<[f32; 4]>,
     /// GPU time per pass, when the device has timestamps.
     pub gpu_times: Option<PassTimes>,
+    /// Median wall time per pass submitted on its own, when
+    /// [`CpuInputs::pass_wall_frames`] is non-zero.
+    pub pass_wall_times: Option<PassTimes>,
     /// Wall time from submission until every result was mapped (includes the copies back).
     pub wall_time: Duration,
 }
@@ -1018,7 +1103,11 @@ pub fn run_once(
                 });
             }
             let scope = ErrorScopes::push(device);
-            let t = upload("prefiltered rasterised rectified map (test upload)", res.rectified, data);
+            let t = upload(
+                "prefiltered rasterised rectified map (test upload)",
+                res.rectified,
+                data,
+            );
             scope.pop(PREFILTER, "uploading test inputs")?;
             Some(t.create_view(&wgpu::TextureViewDescriptor::default()))
         }
@@ -1070,6 +1159,19 @@ pub fn run_once(
         .collect();
     let wall_time = start.elapsed();
     let gpu_times = pass.pass_times(ctx)?;
+    let pass_wall_times = if inputs.pass_wall_frames > 0 {
+        Some(pass.measure_pass_wall_times(
+            ctx,
+            &Inputs {
+                depth: &depth_view,
+                shadow_map: Some(&shadow_view),
+                rectified: engine_rectified.as_ref(),
+            },
+            inputs.pass_wall_frames,
+        )?)
+    } else {
+        None
+    };
     let frame = pass
         .frame
         .take()
@@ -1080,6 +1182,7 @@ pub fn run_once(
         rectified,
         filtered,
         gpu_times,
+        pass_wall_times,
         wall_time,
     })
 }

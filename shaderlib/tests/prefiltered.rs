@@ -8,8 +8,8 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use scatter_shaderlib::prefiltered::{
-    LightKind, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE,
-    SCATTER_WORKGROUP_SIZE, Storage, Variant, VisibilityMode,
+    LightKind, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE, Storage,
+    Variant, VisibilityMode,
 };
 use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams, ShaderError, build, render};
 

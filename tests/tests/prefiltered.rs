@@ -38,19 +38,19 @@ use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
 use scatter_runtime::wgpu::TextureView;
 use scatter_runtime::{Context, CpuInputs, FrameInput, Inputs, RuntimeError, Scatter, run_once};
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightKind, Resolutions, Storage, Variant,
+    FrameSettings, LightKind, Rectification, Resolutions, Storage, Variant,
 };
 
 const SCREEN: [u32; 2] = [64, 36];
 const RECTIFIED: [u32; 2] = [64, 64];
 const SHADOW_MAP: u32 = 128;
-const POSE: Pose = Pose::Ordinary;
 
 const RECTIFIED_TOL: f32 = 1e-4;
 
 /// A suite scene with its depth buffer and shadow map, built once.
 struct Fixture {
     name: SceneName,
+    pose: Pose,
     scene: Scene,
     bvh: Bvh,
     gbuf: GBuffer,
@@ -58,27 +58,41 @@ struct Fixture {
 }
 
 impl Fixture {
-    fn for_light(light: LightKind) -> &'static Fixture {
+    /// Directional variants run on `columns/ordinary`; spot variants on
+    /// `spot_grate/ordinary`, except projective ones on `spot_grate/grazing` (the ordinary
+    /// pose's slices fan out too wide for a projective map: it falls back to epipolar).
+    fn get(light: LightKind, rectification: Rectification) -> &'static Fixture {
         static COLUMNS: OnceLock<Fixture> = OnceLock::new();
         static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
-        let (cell, name) = match light {
-            LightKind::Directional => (&COLUMNS, SceneName::Columns),
-            LightKind::Spot => (&SPOT_GRATE, SceneName::SpotGrate),
+        static SPOT_GRATE_GRAZING: OnceLock<Fixture> = OnceLock::new();
+        let (cell, name, pose) = match (light, rectification) {
+            (LightKind::Directional, _) => (&COLUMNS, SceneName::Columns, Pose::Ordinary),
+            (LightKind::Spot, Rectification::Epipolar) => {
+                (&SPOT_GRATE, SceneName::SpotGrate, Pose::Ordinary)
+            }
+            (LightKind::Spot, Rectification::Projective) => {
+                (&SPOT_GRATE_GRAZING, SceneName::SpotGrate, Pose::Grazing)
+            }
         };
         cell.get_or_init(|| {
-            let scene = scene(name, POSE, MediumPreset::Default, SCREEN[0], SCREEN[1]);
+            let scene = scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
             let bvh = Bvh::build(&scene.geometry);
             let gbuf = GBuffer::cast(&scene, &bvh);
             let shadow_map = ShadowMap::build(&scene, &bvh, SHADOW_MAP)
                 .unwrap_or_else(|e| panic!("shadow map of {name}: {e}"));
             Fixture {
                 name,
+                pose,
                 scene,
                 bvh,
                 gbuf,
                 shadow_map,
             }
         })
+    }
+
+    fn for_light(light: LightKind) -> &'static Fixture {
+        Fixture::get(light, Rectification::Epipolar)
     }
 
     fn frame_input(&self) -> FrameInput {
@@ -97,6 +111,7 @@ impl Fixture {
             depth: self.gbuf.view_depth.clone(),
             shadow_map: self.shadow_map.depth.clone(),
             rectified: None,
+            pass_wall_frames: 0,
         }
     }
 
@@ -187,7 +202,12 @@ fn f16_ulp(v: f32) -> f32 {
 }
 
 fn trial_name(variant: &Variant, fixture: &Fixture) -> String {
-    format!("prefiltered::{}::{}::{}", variant.id(), fixture.name, POSE)
+    format!(
+        "prefiltered::{}::{}::{}",
+        variant.id(),
+        fixture.name,
+        fixture.pose
+    )
 }
 
 fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<TrialResult, String> {
@@ -302,11 +322,14 @@ fn describe(what: &str, w: &Worst, layout: impl Fn(usize) -> String) -> String {
     )
 }
 
-fn conformance(light: LightKind) {
+fn conformance(light: LightKind, rectification: Rectification) {
     let Some(ctx) = gpu() else { return };
-    let fixture = Fixture::for_light(light);
+    let fixture = Fixture::get(light, rectification);
     let filter = std::env::var("SCATTER_TRIALS").unwrap_or_default();
-    let all = variants(light);
+    let all: Vec<Variant> = variants(light)
+        .into_iter()
+        .filter(|v| v.rectification == rectification)
+        .collect();
     let chosen: Vec<_> = all
         .iter()
         .filter(|v| trial_name(v, fixture).contains(filter.as_str()))
@@ -369,7 +392,7 @@ fn conformance(light: LightKind) {
     }
     let total = start.elapsed();
     eprintln!(
-        "prefiltered::*-{light}-*: {} trials in {:.1} s ({:.0} ms per trial), {} failed",
+        "prefiltered::*-{light}-*-{rectification}: {} trials in {:.1} s ({:.0} ms per trial), {} failed",
         chosen.len(),
         total.as_secs_f64(),
         total.as_secs_f64() * 1e3 / chosen.len().max(1) as f64,
@@ -377,7 +400,7 @@ fn conformance(light: LightKind) {
     );
     for (storage, rect, filt, out) in &worst_by_storage {
         eprintln!(
-            "prefiltered::*-{light}-{storage}-*: max rectified |diff| {rect:.3e}, max filtered |diff| {filt:.3e}, max output |diff| / max radiance {out:.3e}"
+            "prefiltered::*-{light}-{storage}-{rectification}: max rectified |diff| {rect:.3e}, max filtered |diff| {filt:.3e}, max output |diff| / max radiance {out:.3e}"
         );
     }
     assert!(
@@ -390,13 +413,23 @@ fn conformance(light: LightKind) {
 }
 
 #[test]
-fn directional_variants_match_mirror() {
-    conformance(LightKind::Directional);
+fn directional_epipolar_variants_match_mirror() {
+    conformance(LightKind::Directional, Rectification::Epipolar);
 }
 
 #[test]
-fn spot_variants_match_mirror() {
-    conformance(LightKind::Spot);
+fn spot_epipolar_variants_match_mirror() {
+    conformance(LightKind::Spot, Rectification::Epipolar);
+}
+
+#[test]
+fn directional_projective_variants_match_mirror() {
+    conformance(LightKind::Directional, Rectification::Projective);
+}
+
+#[test]
+fn spot_projective_variants_match_mirror() {
+    conformance(LightKind::Spot, Rectification::Projective);
 }
 
 /// The variant the error tests start from.

@@ -371,10 +371,21 @@ pub fn proj_boundary(f: &FrameUniforms, r: u32) -> f32 {
 }
 
 /// Column invariant at continuous column `x` of region `r`.
-pub fn proj_region_g(f: &FrameUniforms, x: f32, r: u32, regions: u32, width: u32, spot: bool) -> f32 {
+pub fn proj_region_g(
+    f: &FrameUniforms,
+    x: f32,
+    r: u32,
+    regions: u32,
+    width: u32,
+    spot: bool,
+) -> f32 {
     let b0 = region_start(r, regions, width, spot) as f32;
     let b1 = region_start(r + 1, regions, width, spot) as f32;
-    mix(proj_boundary(f, r), proj_boundary(f, r + 1), (x - b0) / (b1 - b0))
+    mix(
+        proj_boundary(f, r),
+        proj_boundary(f, r + 1),
+        (x - b0) / (b1 - b0),
+    )
 }
 
 /// Continuous column of column invariant `g` (outside the map: extrapolated from the first
@@ -438,8 +449,13 @@ pub fn proj_texel_weight(
     let cap = 4.0 * f.theta[2];
     let mut t0 = 0.0;
     if i > 0 {
-        t0 = proj_reach(f, proj_region_g(f, i as f32, r, regions, width, spot), m, spot, cap / len)
-            * len;
+        t0 = proj_reach(
+            f,
+            proj_region_g(f, i as f32, r, regions, width, spot),
+            m,
+            spot,
+            cap / len,
+        ) * len;
     }
     let t1 = proj_reach(
         f,
@@ -457,7 +473,11 @@ pub fn proj_texel_weight(
         let to = xyz(f.eye) + dir * (0.5 * (t0 + t1)) - xyz(f.light_pos);
         let dl = max(to.length(), 1e-4);
         let cone = max(
-            cone_falloff((to / dl).dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]),
+            cone_falloff(
+                (to / dl).dot(xyz(f.light_dir)),
+                f.light_pos[3],
+                f.light_dir[3],
+            ),
             CONE_FLOOR,
         );
         w *= cone * exp(-f.medium[0] * dl) / (dl * dl);

@@ -13,8 +13,8 @@ pub mod scatter;
 use crate::buffers::{GBuffer, ShadowMap};
 use crate::bvh::Bvh;
 use crate::geometry::Aabb;
-use crate::projective::rasterise_rectified;
 use crate::image::Image;
+use crate::projective::rasterise_rectified;
 use crate::scene::Scene;
 use common_prefiltered::{Tex, TexArray};
 use scatter_shaderlib::prefiltered::{
@@ -105,7 +105,11 @@ pub fn run_prefiltered(
 
 /// For a projective frame, the rectified map the engine would rasterise (see
 /// [`rasterise_rectified`]); `None` for an epipolar frame.
-pub fn engine_rectified_map(scene: &Scene, bvh: &Bvh, frame: &PrefilteredFrame) -> Option<Vec<f32>> {
+pub fn engine_rectified_map(
+    scene: &Scene,
+    bvh: &Bvh,
+    frame: &PrefilteredFrame,
+) -> Option<Vec<f32>> {
     let maps = frame.report.projective.as_ref()?;
     let [_, _, width, height] = frame.uniforms.sizes;
     Some(rasterise_rectified(

@@ -133,7 +133,11 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         qd = max(q.x, 1e-6);
         let k = q.y / qd;
         m = q.z / qd;
-        yc = clamp((k + f.proj[1]) / (2.0 * f.proj[1]) * rows as f32, 0.0, rows as f32);
+        yc = clamp(
+            (k + f.proj[1]) / (2.0 * f.proj[1]) * rows as f32,
+            0.0,
+            rows as f32,
+        );
         d = proj_ray_depth(f, m);
         let qs = max(s * qd, 1e-6);
         let mut g = 1.0 / qs;
@@ -201,7 +205,10 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
             t1[r as usize] = if is_last {
                 s
             } else {
-                min(proj_reach(f, proj_boundary(f, r + 1), m, spot, s * qd) / qd, s)
+                min(
+                    proj_reach(f, proj_boundary(f, r + 1), m, spot, s * qd) / qd,
+                    s,
+                )
             };
         } else {
             t0[r as usize] = ray_t(f, b0, delta, theta, s, spot);

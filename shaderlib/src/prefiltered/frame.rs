@@ -24,6 +24,15 @@
 //! frustum (`theta_ref`), `delta` is chosen so the row spans the slice's far-plane extent.
 //! Occluders between the light and the frustum project to `d = 0` (clamped): they shadow
 //! the whole light ray, as in the paper.
+//!
+//! # Rectified space (projective, Sec. 4.2)
+//!
+//! For a variant with `rectification = projective`, a frame whose slices fan out by at most
+//! [`FrameSettings::projective_max_half_angle_deg`] around their bisectrix (so neither
+//! epipole is on screen) uses a projective map instead: see [`ProjectiveMaps`] for what the
+//! engine rasterises and `projective_frame` (private) for the coordinates. Other frames fall
+//! back to the epipolar map above and say why in [`FrameReport::fallback`]; the same
+//! kernels handle both (`FrameUniforms::proj[0]` selects).
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, DVec4};
@@ -907,7 +916,12 @@ fn projective_frame(
     // Ray depths over the screen: extremes at the screen corners (m is linear-fractional
     // on the image plane with a positive denominator).
     let (mut m_lo, mut m_hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for (x, y) in [(0.0, 0.0), (s.width, 0.0), (0.0, s.height), (s.width, s.height)] {
+    for (x, y) in [
+        (0.0, 0.0),
+        (s.width, 0.0),
+        (0.0, s.height),
+        (s.width, s.height),
+    ] {
         let d = s.dir(x, y);
         let m = d.dot(axis) / d.dot(e1).max(1e-12);
         m_lo = m_lo.min(m);
