@@ -3,9 +3,9 @@
 //!
 //! CPU mirrors: `reference/src/kernels/{common_model,common_prefiltered,rectify,prefilter,scatter}.rs`.
 
-pub mod frame;
 pub mod kernels;
-pub mod variant;
+
+pub use scatter_frame::{frame, variant};
 
 pub use frame::{
     CameraDesc, FrameError, FrameReport, FrameSettings, FrameUniforms, LightDesc, MediumDesc,

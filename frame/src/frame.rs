@@ -38,7 +38,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, DVec4};
 use std::f64::consts::PI;
 
-use super::variant::{LightKind, Rectification, Variant};
+use crate::variant::{LightKind, Rectification, Variant};
 
 /// The camera of one frame (the engine's view).
 #[derive(Clone, Copy, Debug, PartialEq)]

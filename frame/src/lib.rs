@@ -1,0 +1,13 @@
+//! `scatter-frame`: what a host needs besides the shaders to drive the scatter kernels, with
+//! no shader tooling (no naga, no askama): the prefiltered family's variant knobs
+//! ([`variant`]) and its per-frame set-up ([`frame`]: the `Frame` uniform block, the
+//! per-row slice table and, for projective rectification, the matrices the engine
+//! rasterises with).
+//!
+//! `scatter-shaderlib` re-exports both modules as `scatter_shaderlib::prefiltered::*`; an
+//! engine that only uses shaders emitted by `scatter-gen` links this crate alone (see
+//! `examples/foreign_engine`). A C++ engine ports [`frame::prepare_frame`]; its inputs and
+//! outputs are plain numbers, documented field by field.
+
+pub mod frame;
+pub mod variant;
