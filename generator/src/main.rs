@@ -155,7 +155,7 @@ fn list() -> String {
         s.push_str("  knobs:\n");
         for k in f.knobs() {
             s.push_str(&format!(
-                "    --{:<18} {:<36} default {:<12} {}\n",
+                "    --{:<18} {:<38} default {:<12} {}\n",
                 k.flag(),
                 k.allowed,
                 k.default,
