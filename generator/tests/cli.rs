@@ -238,9 +238,7 @@ fn never_overwrites_or_deletes_foreign_files_without_force() {
     assert_eq!(files(&out).len(), 13);
 
     // A foreign file with a kernel's name next to our manifest: refused.
-    let stray = out.join(format!(
-        "prefilter.m16-t8-r3-weighted-directional-rgba8unorm-epipolar.wgsl"
-    ));
+    let stray = out.join("prefilter.m16-t8-r3-weighted-directional-rgba8unorm-epipolar.wgsl");
     fs::write(&stray, "// someone else's\n").unwrap_or_else(|e| panic!("{e}"));
     let line = fails(&["--out", o, "--bases", "16"], 1);
     assert!(line.contains("not listed in manifest.json"), "{line}");
