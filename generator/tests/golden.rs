@@ -127,6 +127,17 @@ fn canonical_variants_match_golden_files() {
             Ok(_) => {}
         }
     }
+    for entry in std::fs::read_dir(&dir).unwrap_or_else(|e| panic!("{e}")) {
+        let name = entry
+            .unwrap_or_else(|e| panic!("{e}"))
+            .file_name()
+            .to_string_lossy()
+            .into_owned();
+        let spvasm_unchecked = !spirv_dis && name.ends_with(".spvasm");
+        if name != "README.md" && !spvasm_unchecked && !expected.iter().any(|(p, _)| *p == name) {
+            problems.push(format!("{name}: golden file no longer generated"));
+        }
+    }
     assert!(
         problems.is_empty(),
         "{}\n\nIf the change is intended, review it and rerun with \

@@ -2,10 +2,10 @@
 //! shaderlib [`Variant`]) and its plan: the textures, buffers and samplers and the three
 //! passes, exactly as `runtime/src/prefiltered.rs` allocates and dispatches them.
 
-use scatter_shaderlib::Kernel;
 use scatter_shaderlib::prefiltered::{
     LightKind, Rectification, Storage, Variant, VariantError, VisibilityMode,
 };
+use scatter_shaderlib::{Kernel, KernelParams};
 
 use super::{
     Alternative, BindingSource, BufferDesc, KnobInfo, Parameter, PassPlan, Plan, Resource,
@@ -326,9 +326,11 @@ pub fn plan(v: &Variant) -> Plan {
             sampler: Some(linear_sampler("repeat")),
         },
     ];
-    let passes = [Kernel::Rectify, Kernel::Prefilter, Kernel::Scatter]
-        .into_iter()
-        .filter_map(|k| pass(v, k))
+    // One pass per kernel shaderlib lists for the variant, in its order; a kernel this
+    // module does not know gets no pass, and generation names it.
+    let passes = KernelParams::prefiltered(*v)
+        .iter()
+        .filter_map(|p| pass(v, p.kernel()))
         .collect();
     Plan {
         parameters,
