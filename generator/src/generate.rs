@@ -296,6 +296,7 @@ fn pass_entry(
         entry_point: out.entry_point,
         workgroup_size: out.workgroup_size,
         dispatch,
+        skip_when: pass.skip_when,
         bindings,
         files,
     })

@@ -153,6 +153,9 @@ pub struct ManifestPass {
     pub workgroup_size: [u32; 3],
     /// Workgroups to dispatch along x, y, z.
     pub dispatch: Vec<DispatchDim>,
+    /// A per-frame condition under which the pass does not run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skip_when: Option<&'static str>,
     /// Every binding the kernel uses.
     pub bindings: Vec<ManifestBinding>,
     /// The kernel's file per target.

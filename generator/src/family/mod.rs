@@ -290,6 +290,8 @@ pub struct PassPlan {
     pub kernel: Kernel,
     /// Invocations along x, y, z (the dispatch is `ceil(invocations / workgroup size)`).
     pub invocations: [Formula; 3],
+    /// A per-frame condition under which the pass does not run.
+    pub skip_when: Option<&'static str>,
     /// What each binding of group 0 gets.
     pub bindings: Vec<BindingSource>,
 }

@@ -122,6 +122,12 @@ pub fn parse(knobs: &[(String, String)]) -> Result<Variant, GenError> {
 /// Format of the depth buffer, the standard shadow map and the rectified map
 /// (`scatter_runtime::prefiltered::DEPTH_FORMAT`).
 pub const DEPTH_FORMAT: &str = "r32float";
+/// The per-frame condition of a projective frame (the frame set-up falls back to epipolar
+/// when the epipole is on screen).
+const PROJECTIVE_FRAME: &str = "frame.proj.x > 0.5 (a projective frame)";
+/// The engine's rasterised rectified map of projective variants.
+const RECTIFIED_RASTER: &str = "rectified_raster";
+
 /// Format of the output (`scatter_runtime::prefiltered::OUTPUT_FORMAT`).
 pub const OUTPUT_FORMAT: &str = "rgba16float";
 
@@ -199,7 +205,7 @@ pub fn plan(v: &Variant) -> Plan {
             constraint: "1..=max_texture_dimension_2d".into(),
         },
     ];
-    let resources = vec![
+    let mut resources = vec![
         Resource {
             name: "frame",
             kind: "uniform_buffer",
@@ -326,35 +332,65 @@ pub fn plan(v: &Variant) -> Plan {
             sampler: Some(linear_sampler("repeat")),
         },
     ];
+    if v.rectification == Rectification::Projective {
+        resources.push(Resource {
+            name: RECTIFIED_RASTER,
+            kind: "texture",
+            provided_by: "engine",
+            contents: "projective frames only: the rectified depth map the engine rasterises \
+                       with the frame's per-region matrices and viewports (Rust: \
+                       FrameReport::projective from prepare_frame), clip depth in [0, 1]",
+            texture: Some(texture(
+                DEPTH_FORMAT,
+                "rectified.width",
+                "rectified.height",
+                "1".into(),
+                SAMPLED,
+            )),
+            buffer: None,
+            sampler: None,
+        });
+    }
     // One pass per kernel shaderlib lists for the variant, in its order; a kernel this
     // module does not know gets no pass, and generation names it.
     let passes = KernelParams::prefiltered(*v)
         .iter()
         .filter_map(|p| pass(v, p.kernel()))
         .collect();
+    let mut notes = vec![
+        "Run the passes in order; each reads what the previous ones wrote: put a \
+             compute-to-compute memory barrier (and, in Vulkan, the image layout transition \
+             from storage to sampled) between them.",
+        "Write `frame` and `slices` once per frame before the first pass; the host code \
+             that computes them is scatter_shaderlib::prefiltered::prepare_frame (Rust).",
+        "Group 0 holds every binding; bind by group and binding number, not by name: \
+             emitted names may be mangled (naga_oil) or carry a trailing `_` (naga).",
+    ];
+    if v.rectification == Rectification::Projective {
+        notes.push(
+            "Projective variant: the frame set-up decides per frame (FrameReport::rectification) \
+             whether the frame is projective or falls back to epipolar (epipole on screen). In \
+             a projective frame skip `rectify`, rasterise `rectified_raster` with the frame's \
+             matrices and bind it where the passes say; epipolar frames run as usual.",
+        );
+    }
     Plan {
         parameters,
         resources,
         passes,
-        notes: vec![
-            "Run the passes in order; each reads what the previous ones wrote: put a \
-             compute-to-compute memory barrier (and, in Vulkan, the image layout transition \
-             from storage to sampled) between them.",
-            "Write `frame` and `slices` once per frame before the first pass; the host code \
-             that computes them is scatter_shaderlib::prefiltered::prepare_frame (Rust).",
-            "Group 0 holds every binding; bind by group and binding number, not by name: \
-             emitted names may be mangled (naga_oil) or carry a trailing `_` (naga).",
-        ],
+        notes,
     }
 }
 
 /// The pass of one kernel, or `None` for a kernel that is not in this family.
 pub fn pass(v: &Variant, kernel: Kernel) -> Option<PassPlan> {
     let f = |s: &str| s.to_owned();
+    let projective = v.rectification == Rectification::Projective;
     match kernel {
         Kernel::Rectify => Some(PassPlan {
             kernel,
             invocations: [f("rectified.width"), f("rectified.height"), f("1")],
+            skip_when: projective.then_some(PROJECTIVE_FRAME),
             bindings: vec![
                 bind(0, "frame"),
                 bind(1, "slices"),
@@ -369,21 +405,38 @@ pub fn pass(v: &Variant, kernel: Kernel) -> Option<PassPlan> {
                 v.regions.to_string(),
                 v.threads_per_row_region().to_string(),
             ],
+            skip_when: None,
             bindings: vec![
                 bind(0, "frame"),
                 bind(1, "slices"),
-                bind(2, "rectified"),
+                BindingSource {
+                    binding: 2,
+                    resource: "rectified",
+                    alternative: projective.then_some(Alternative {
+                        resource: RECTIFIED_RASTER,
+                        when: PROJECTIVE_FRAME,
+                    }),
+                },
                 bind(3, "filtered"),
             ],
         }),
         Kernel::Scatter => Some(PassPlan {
             kernel,
             invocations: [f("screen.width"), f("screen.height"), f("1")],
+            skip_when: None,
             bindings: vec![
                 bind(0, "frame"),
                 bind(1, "slices"),
                 bind(2, "depth"),
-                bind(3, "shadow_map"),
+                BindingSource {
+                    binding: 3,
+                    resource: "shadow_map",
+                    alternative: projective.then_some(Alternative {
+                        resource: RECTIFIED_RASTER,
+                        when: "the frame is projective and the engine has no standard shadow \
+                               map (the binding is not read then)",
+                    }),
+                },
                 bind(4, "filtered"),
                 BindingSource {
                     binding: 5,
