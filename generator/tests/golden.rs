@@ -156,10 +156,20 @@ fn c_header_compiles_with_static_asserts() {
     for (path, bytes) in generated.all_files() {
         std::fs::write(dir.join(path), bytes).unwrap_or_else(|e| panic!("{e}"));
     }
+    // The size the manifest states for the frame block.
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&generated.manifest).unwrap_or_else(|e| panic!("{e}"));
+    let frame_size = manifest["structs"]
+        .as_array()
+        .and_then(|s| s.iter().find(|s| s["c_type"] == "ScatterPrefilteredFrame"))
+        .and_then(|s| s["size"].as_u64())
+        .unwrap_or_else(|| panic!("no ScatterPrefilteredFrame in the manifest"));
     let c = dir.join("check.c");
     std::fs::write(
         &c,
-        "#include \"scatter_uniforms.h\"\nint main(void) { return sizeof(ScatterPrefilteredFrame) == 336 ? 0 : 1; }\n",
+        format!(
+            "#include \"scatter_uniforms.h\"\nint main(void) {{ return sizeof(ScatterPrefilteredFrame) == {frame_size} ? 0 : 1; }}\n"
+        ),
     )
     .unwrap_or_else(|e| panic!("{e}"));
     let mut compiled = 0;
@@ -205,7 +215,7 @@ fn c_header_compiles_with_static_asserts() {
             .unwrap_or_else(|e| panic!("{e}"));
         assert!(
             run.status.success(),
-            "sizeof(ScatterPrefilteredFrame) != 336"
+            "sizeof(ScatterPrefilteredFrame) != {frame_size}"
         );
         compiled += 1;
     }

@@ -369,8 +369,9 @@ pub fn plan(v: &Variant) -> Plan {
     if v.rectification == Rectification::Projective {
         notes.push(
             "Projective variant: the frame set-up decides per frame (FrameReport::rectification) \
-             whether the frame is projective or falls back to epipolar (epipole on screen). In \
-             a projective frame skip `rectify`, rasterise `rectified_raster` with the frame's \
+             whether the frame is projective or falls back to epipolar (FrameReport::fallback \
+             says why: epipole or anti-epipole on screen, slices fanning out too wide). In a \
+             projective frame skip `rectify`, rasterise `rectified_raster` with the frame's \
              matrices and bind it where the passes say; epipolar frames run as usual.",
         );
     }
