@@ -19,14 +19,14 @@ use indicatif::{ProgressBar, ProgressStyle};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
-use scatter_reference::kernels::run_prefiltered;
+use scatter_reference::kernels::{engine_rectified_map, run_prefiltered};
 use scatter_reference::metrics;
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::{Context, CpuInputs, FrameInput, PassTimes, run_once};
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightKind, Resolutions, Variant, VariantError,
+    FrameSettings, LightKind, Resolutions, Variant, VariantError, prepare_frame,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -86,6 +86,11 @@ struct Args {
     /// Frames timed with `--gpu` (1..=100).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100))]
     frames: u32,
+    /// With `--gpu`: also time each pass submitted on its own and waited for (median of this
+    /// many frames after a warm-up; 0 = off). On lavapipe this wall time is the pass's real
+    /// cost, unlike its timestamps.
+    #[arg(long, default_value_t = 0)]
+    pass_wall_frames: u32,
     /// Image width in pixels (1..=8192).
     #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=8192))]
     width: u32,
@@ -254,9 +259,9 @@ fn run_prefiltered_method(
     let t = Instant::now();
     let settings = FrameSettings::for_screen(args.width, args.height);
     let output = if args.gpu {
-        run_on_gpu(args, &variant, rectified, scene, gbuf, &sm, settings)?
+        run_on_gpu(args, &variant, rectified, scene, bvh, gbuf, &sm, settings)?
     } else {
-        let run = run_prefiltered(&variant, rectified, scene, gbuf, &sm, &settings)?;
+        let run = run_prefiltered(&variant, rectified, scene, bvh, gbuf, &sm, &settings)?;
         eprintln!(
             "prefiltered {variant} ({}x{} rectified) on the CPU mirror in {:.2?}; {:?}",
             rectified[0],
@@ -307,6 +312,7 @@ fn run_on_gpu(
     variant: &Variant,
     rectified: [u32; 2],
     scene: &Scene,
+    bvh: &Bvh,
     gbuf: &GBuffer,
     sm: &ShadowMap,
     settings: FrameSettings,
@@ -317,16 +323,29 @@ fn run_on_gpu(
         screen: [gbuf.width, gbuf.height],
         rectified,
     };
+    let frame = FrameInput {
+        camera: scene.camera_desc(),
+        light: scene.light_desc(),
+        medium: scene.medium_desc(),
+        shadow_map: sm.desc(),
+        settings,
+    };
+    // A projective frame needs the engine's rasterised rectified map (ray cast here).
+    let prepared = prepare_frame(
+        variant,
+        &res,
+        &frame.camera,
+        &frame.light,
+        &frame.medium,
+        &frame.shadow_map,
+        &frame.settings,
+    )?;
     let inputs = CpuInputs {
-        frame: FrameInput {
-            camera: scene.camera_desc(),
-            light: scene.light_desc(),
-            medium: scene.medium_desc(),
-            shadow_map: sm.desc(),
-            settings,
-        },
+        frame,
         depth: gbuf.view_depth.clone(),
         shadow_map: sm.depth.clone(),
+        rectified: engine_rectified_map(scene, bvh, &prepared),
+        pass_wall_frames: args.pass_wall_frames,
     };
     let mut best: Option<PassTimes> = None;
     let mut last = None;
@@ -367,6 +386,21 @@ fn run_on_gpu(
             t.total().as_secs_f64() * 1e3
         ),
         None => println!("the adapter has no timestamp queries: no GPU times"),
+    }
+    if let Some(t) = rb.pass_wall_times {
+        println!(
+            "wall time per pass, each submitted alone (median of {} frames, {}x{} screen, {}x{} rectified, {}): rectify {:.3} ms, prefilter {:.3} ms, scatter {:.3} ms, total {:.3} ms",
+            args.pass_wall_frames,
+            gbuf.width,
+            gbuf.height,
+            rectified[0],
+            rectified[1],
+            rb.frame.report.rectification,
+            t.rectify.as_secs_f64() * 1e3,
+            t.prefilter.as_secs_f64() * 1e3,
+            t.scatter.as_secs_f64() * 1e3,
+            t.total().as_secs_f64() * 1e3
+        );
     }
     Ok(Image::from_pixels(
         gbuf.width,

@@ -24,6 +24,7 @@ pub mod image;
 pub mod kernels;
 pub mod metrics;
 pub mod model;
+pub mod projective;
 pub mod scene;
 pub mod suite;
 pub mod truth;

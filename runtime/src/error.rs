@@ -138,6 +138,14 @@ pub enum RuntimeError {
         /// What was given.
         actual: String,
     },
+    /// A texture the frame's rectification needs was not given.
+    #[error("kernel `{kernel}`: missing input: {what}")]
+    MissingInput {
+        /// The kernel that reads it.
+        kernel: Kernel,
+        /// What is missing and why it is needed.
+        what: &'static str,
+    },
     /// A pass was encoded before its per-frame parameters were uploaded.
     #[error("kernel `{kernel}`: encode called before prepare; upload a frame first")]
     NotPrepared {

@@ -18,7 +18,9 @@ mod timer;
 
 pub use context::{AdapterReport, Context, ContextError, GpuPolicy};
 pub use error::RuntimeError;
-pub use prefiltered::{CpuInputs, FrameInput, PassTimes, Scatter, ScatterReadback, run_once};
+pub use prefiltered::{
+    CpuInputs, FrameInput, Inputs, PassTimes, Scatter, ScatterReadback, run_once,
+};
 pub use row_prefix::{ArraySize, RowPrefixOutput, RowPrefixPass, row_prefix};
 pub use timer::GpuTimer;
 

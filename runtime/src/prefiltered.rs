@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 
 use scatter_shaderlib::prefiltered::{
     CameraDesc, FrameReport, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame,
-    Resolutions, ShadowMapDesc, SliceParams, Storage, Variant, prepare_frame,
+    Rectification, Resolutions, ShadowMapDesc, SliceParams, Storage, Variant, prepare_frame,
 };
 use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams};
 
@@ -72,10 +72,24 @@ pub struct FrameInput {
     pub settings: FrameSettings,
 }
 
+/// The engine's textures for one frame ([`Scatter::encode`]). All are r32float with
+/// `TEXTURE_BINDING` usage.
+#[derive(Clone, Copy, Debug)]
+pub struct Inputs<'a> {
+    /// Linear view depth, screen-sized.
+    pub depth: &'a wgpu::TextureView,
+    /// The standard shadow map (`shadow_map_size` squared): needed by every epipolar frame
+    /// (`rectify` resamples it, `scatter` marches it near the epipole).
+    pub shadow_map: Option<&'a wgpu::TextureView>,
+    /// The rectified depth map the engine rasterised with [`FrameReport::projective`]'s
+    /// matrices (`Wr x Hr`): needed by every projective frame.
+    pub rectified: Option<&'a wgpu::TextureView>,
+}
+
 /// GPU time of each pass of one frame (from timestamps at the start and end of each pass).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PassTimes {
-    /// The `rectify` pass.
+    /// The `rectify` pass (zero in a projective frame, where it does not run).
     pub rectify: Duration,
     /// The `prefilter` pass.
     pub prefilter: Duration,
@@ -508,35 +522,124 @@ impl Scatter {
         Ok(report)
     }
 
-    /// Records `rectify`, `prefilter` and `scatter` (each with GPU timestamps when the device
-    /// has them; read them with [`Self::pass_times`] after submitting) and returns the output
-    /// view: in-scattered radiance, rgba16float, screen-sized.
+    /// Records the frame's passes (each with GPU timestamps when the device has them; read
+    /// them with [`Self::pass_times`] after submitting) and returns the output view:
+    /// in-scattered radiance, rgba16float, screen-sized.
     ///
-    /// `depth` is linear view depth (r32float, screen-sized), `shadow_map` the standard
-    /// shadow map (r32float, `shadow_map_size` squared), both with `TEXTURE_BINDING` usage.
+    /// Epipolar frames run `rectify`, `prefilter` and `scatter` and need
+    /// `inputs.shadow_map`; projective frames ([`FrameReport::rectification`] is
+    /// `projective`) skip `rectify` and need `inputs.rectified`, the map the engine
+    /// rasterised with the frame's matrices.
     ///
     /// # Errors
     ///
     /// [`RuntimeError::NotPrepared`] before the first [`Self::prepare`];
-    /// [`RuntimeError::InputMismatch`] for a view of the wrong format, size or usage;
-    /// [`RuntimeError::Wgpu`] when wgpu rejects a bind group.
+    /// [`RuntimeError::MissingInput`] when the frame's rectification needs a texture that
+    /// is `None`; [`RuntimeError::InputMismatch`] for a view of the wrong format, size or
+    /// usage; [`RuntimeError::Wgpu`] when wgpu rejects a bind group.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        depth: &wgpu::TextureView,
-        shadow_map: &wgpu::TextureView,
+        inputs: &Inputs<'_>,
+    ) -> Result<&wgpu::TextureView, RuntimeError> {
+        self.encode_selected(encoder, inputs, None)
+    }
+
+    /// Records one pass of the frame (`rectify`, `prefilter` or `scatter`) without
+    /// timestamps, for timing passes one submission at a time
+    /// ([`Self::measure_pass_wall_times`]). A projective frame records nothing for
+    /// `rectify`. Errors as [`Self::encode`].
+    ///
+    /// # Errors
+    ///
+    /// As [`Self::encode`].
+    pub fn encode_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &Inputs<'_>,
+        kernel: Kernel,
+    ) -> Result<(), RuntimeError> {
+        self.encode_selected(encoder, inputs, Some(kernel))
+            .map(|_| ())
+    }
+
+    /// Wall time of each pass submitted on its own and waited for, the median over
+    /// `frames` frames after one warm-up frame. On a software rasteriser such as lavapipe,
+    /// where the GPU is the CPU, this is the pass's real cost (its GPU timestamps are not:
+    /// they are not ordered after the compute work). Includes one submission and one
+    /// blocking poll per pass.
+    ///
+    /// # Errors
+    ///
+    /// As [`Self::encode`]; [`RuntimeError::Poll`] when waiting fails.
+    pub fn measure_pass_wall_times(
+        &self,
+        ctx: &Context,
+        inputs: &Inputs<'_>,
+        frames: u32,
+    ) -> Result<PassTimes, RuntimeError> {
+        let mut samples: [Vec<Duration>; 3] = Default::default();
+        for frame in 0..=frames.max(1) {
+            for (slot, kernel) in [RECTIFY, PREFILTER, SCATTER].into_iter().enumerate() {
+                let mut encoder =
+                    self.device
+                        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                            label: Some(kernel.name()),
+                        });
+                self.encode_pass(&mut encoder, inputs, kernel)?;
+                let start = Instant::now();
+                ctx.queue().submit([encoder.finish()]);
+                ctx.device()
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|source| RuntimeError::Poll { kernel, source })?;
+                if frame > 0 {
+                    samples[slot].push(start.elapsed());
+                }
+            }
+        }
+        let [rectify, prefilter, scatter] = samples.map(|mut v| {
+            v.sort();
+            v[v.len() / 2]
+        });
+        Ok(PassTimes {
+            rectify,
+            prefilter,
+            scatter,
+        })
+    }
+
+    fn encode_selected(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &Inputs<'_>,
+        only: Option<Kernel>,
     ) -> Result<&wgpu::TextureView, RuntimeError> {
         let frame = self
             .frame
             .as_ref()
             .ok_or(RuntimeError::NotPrepared { kernel: RECTIFY })?;
-        check_view(SCATTER, &DEPTH_NAMES, depth, self.res.screen)?;
-        check_view(
-            RECTIFY,
-            &SHADOW_NAMES,
-            shadow_map,
-            [self.shadow_map_size; 2],
-        )?;
+        let projective = frame.report.rectification == Rectification::Projective;
+        check_view(SCATTER, &DEPTH_NAMES, inputs.depth, self.res.screen)?;
+        // The texture `scatter` binds as its shadow map (only read near the epipole, which a
+        // projective frame never has) and the one `prefilter` reads.
+        let (shadow_map, rectified) = if projective {
+            let rectified = inputs.rectified.ok_or(RuntimeError::MissingInput {
+                kernel: PREFILTER,
+                what: "the rasterised rectified map (this frame is projective; render it \
+                       with FrameReport::projective)",
+            })?;
+            check_view(PREFILTER, &RECTIFIED_NAMES, rectified, self.res.rectified)?;
+            (inputs.shadow_map.unwrap_or(rectified), rectified)
+        } else {
+            let shadow_map = inputs.shadow_map.ok_or(RuntimeError::MissingInput {
+                kernel: RECTIFY,
+                what: "the standard shadow map (this frame is epipolar)",
+            })?;
+            (shadow_map, &self.rectified_view)
+        };
+        if let Some(sm) = inputs.shadow_map {
+            check_view(RECTIFY, &SHADOW_NAMES, sm, [self.shadow_map_size; 2])?;
+        }
         let wrap = frame.uniforms.anti_epipole[3] > 0.5;
         let sampler = if wrap {
             &self.sampler_wrap
@@ -557,13 +660,27 @@ impl Scatter {
         });
         scope.pop(RECTIFY, "creating the bind group")?;
         let scope = ErrorScopes::push(&self.device);
+        let prefilter_group = projective.then(|| {
+            self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("prefilter (projective)"),
+                layout: &self.prefilter.layout,
+                entries: &[
+                    buffer_entry(0, &self.uniforms),
+                    buffer_entry(1, &self.slices),
+                    view_entry(2, rectified),
+                    view_entry(3, &self.filtered_view),
+                ],
+            })
+        });
+        scope.pop(PREFILTER, "creating the bind group")?;
+        let scope = ErrorScopes::push(&self.device);
         let scatter_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scatter"),
             layout: &self.scatter.layout,
             entries: &[
                 buffer_entry(0, &self.uniforms),
                 buffer_entry(1, &self.slices),
-                view_entry(2, depth),
+                view_entry(2, inputs.depth),
                 view_entry(3, shadow_map),
                 view_entry(4, &self.filtered_view),
                 wgpu::BindGroupEntry {
@@ -582,22 +699,32 @@ impl Scatter {
             (&self.rectify, &rectify_group, [wr, hr, 1]),
             (
                 &self.prefilter,
-                &self.prefilter_bind_group,
+                prefilter_group
+                    .as_ref()
+                    .unwrap_or(&self.prefilter_bind_group),
                 [hr, v.regions, v.threads_per_row_region()],
             ),
             (&self.scatter, &scatter_group, [w, h, 1]),
         ];
         for (index, (pipeline, group, invocations)) in (0u32..).zip(passes) {
+            if (projective && index == 0) || only.is_some_and(|k| k != pipeline.kernel) {
+                continue;
+            }
+            let timestamps = if only.is_none() {
+                self.timer.as_ref().and_then(|t| t.pass_writes(index))
+            } else {
+                None
+            };
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(pipeline.kernel.name()),
-                timestamp_writes: self.timer.as_ref().and_then(|t| t.pass_writes(index)),
+                timestamp_writes: timestamps,
             });
             pass.set_pipeline(&pipeline.pipeline);
             pass.set_bind_group(0, group, &[]);
             let [x, y, z] = groups(invocations, pipeline.workgroup_size);
             pass.dispatch_workgroups(x, y, z);
         }
-        if let Some(timer) = &self.timer {
+        if let Some(timer) = self.timer.as_ref().filter(|_| only.is_none()) {
             timer.resolve(encoder);
         }
         Ok(&self.output_view)
@@ -614,9 +741,13 @@ impl Scatter {
             return Ok(None);
         };
         let times = timer.read_all(ctx, SCATTER)?;
+        let projective = self
+            .frame
+            .as_ref()
+            .is_some_and(|f| f.report.rectification == Rectification::Projective);
         match times[..] {
             [rectify, prefilter, scatter] => Ok(Some(PassTimes {
-                rectify,
+                rectify: if projective { Duration::ZERO } else { rectify },
                 prefilter,
                 scatter,
             })),
@@ -710,6 +841,12 @@ const DEPTH_NAMES: ViewNames = ViewNames {
     format: "depth buffer format",
     size: "depth buffer size",
     usage: "depth buffer usage",
+};
+
+const RECTIFIED_NAMES: ViewNames = ViewNames {
+    format: "rasterised rectified map format",
+    size: "rasterised rectified map size",
+    usage: "rasterised rectified map usage",
 };
 
 const SHADOW_NAMES: ViewNames = ViewNames {
@@ -845,6 +982,12 @@ pub struct CpuInputs {
     /// Standard shadow map, `frame.shadow_map.size` squared values (normalised linear light
     /// depth), row-major from the top-left texel.
     pub shadow_map: Vec<f32>,
+    /// The engine's rasterised rectified map (`Wr * Hr` clip depths, row-major), used when
+    /// the frame turns out projective (it must then be present).
+    pub rectified: Option<Vec<f32>>,
+    /// When non-zero, [`run_once`] also measures each pass on its own
+    /// ([`Scatter::measure_pass_wall_times`]) over this many frames.
+    pub pass_wall_frames: u32,
 }
 
 /// Everything [`run_once`] reads back.
@@ -861,6 +1004,9 @@ pub struct ScatterReadback {
     pub filtered: Vec<[f32; 4]>,
     /// GPU time per pass, when the device has timestamps.
     pub gpu_times: Option<PassTimes>,
+    /// Median wall time per pass submitted on its own, when
+    /// [`CpuInputs::pass_wall_frames`] is non-zero.
+    pub pass_wall_times: Option<PassTimes>,
     /// Wall time from submission until every result was mapped (includes the copies back).
     pub wall_time: Duration,
 }
@@ -918,7 +1064,9 @@ pub fn run_once(
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
         queue.write_texture(
@@ -942,13 +1090,47 @@ pub fn run_once(
     scope.pop(SCATTER, "uploading test inputs")?;
     let depth_view = depth.create_view(&wgpu::TextureViewDescriptor::default());
     let shadow_view = shadow.create_view(&wgpu::TextureViewDescriptor::default());
+    let engine_rectified = match &inputs.rectified {
+        Some(data) => {
+            let [wr, hr] = res.rectified;
+            let expected = u64::from(wr) * u64::from(hr);
+            if data.len() as u64 != expected {
+                return Err(RuntimeError::DataLength {
+                    kernel: PREFILTER,
+                    size: format!("rasterised rectified map {wr}x{hr}"),
+                    expected,
+                    actual: data.len() as u64,
+                });
+            }
+            let scope = ErrorScopes::push(device);
+            let t = upload(
+                "prefiltered rasterised rectified map (test upload)",
+                res.rectified,
+                data,
+            );
+            scope.pop(PREFILTER, "uploading test inputs")?;
+            Some(t.create_view(&wgpu::TextureViewDescriptor::default()))
+        }
+        None => None,
+    };
 
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
         label: Some("prefiltered run_once"),
     });
-    pass.encode(&mut encoder, &depth_view, &shadow_view)?;
+    pass.encode(
+        &mut encoder,
+        &Inputs {
+            depth: &depth_view,
+            shadow_map: Some(&shadow_view),
+            rectified: engine_rectified.as_ref(),
+        },
+    )?;
     let scope = ErrorScopes::push(device);
-    let rectified = Readback::encode(device, &mut encoder, pass.rectified_texture(), 4);
+    let rectified_texture = match &engine_rectified {
+        Some(view) if pass.frame().is_some_and(|f| f.report.projective.is_some()) => view.texture(),
+        _ => pass.rectified_texture(),
+    };
+    let rectified = Readback::encode(device, &mut encoder, rectified_texture, 4);
     let filtered = Readback::encode(
         device,
         &mut encoder,
@@ -977,6 +1159,19 @@ pub fn run_once(
         .collect();
     let wall_time = start.elapsed();
     let gpu_times = pass.pass_times(ctx)?;
+    let pass_wall_times = if inputs.pass_wall_frames > 0 {
+        Some(pass.measure_pass_wall_times(
+            ctx,
+            &Inputs {
+                depth: &depth_view,
+                shadow_map: Some(&shadow_view),
+                rectified: engine_rectified.as_ref(),
+            },
+            inputs.pass_wall_frames,
+        )?)
+    } else {
+        None
+    };
     let frame = pass
         .frame
         .take()
@@ -987,6 +1182,7 @@ pub fn run_once(
         rectified,
         filtered,
         gpu_times,
+        pass_wall_times,
         wall_time,
     })
 }

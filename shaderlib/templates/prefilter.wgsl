@@ -1,4 +1,4 @@
-// prefilter ({{ bases }} bases, {{ bases_per_thread }} per thread, {{ regions }} regions, {{ visibility_name }} visibility, {{ light_name }} light, {{ storage }}):
+// prefilter ({{ bases }} bases, {{ bases_per_thread }} per thread, {{ regions }} regions, {{ visibility_name }} visibility, {{ light_name }} light, {{ storage }}, {{ rectification_name }}):
 // the Fourier basis transform fused with the weighted running mean along each rectified row
 // (Klehm et al. 2014, Sec. 3.3 and 5, Listings 1-3, Table 1's regions and bases per thread).
 //
@@ -7,11 +7,17 @@
 // Each region restarts the running mean. Stored per texel: the normalised weighted mean
 // F_k = sum w_i B_k(d_i) / sum w_i over the region up to the texel, mapped to [0, 1] as
 // F / 2 + 0.5 in {{ storage }}.
+{%- if projective %}
+//
+// Projective variant: in a projective frame (frame.proj.x = 1) `rectified` is the engine's
+// rasterised map (clip z / w in [0, 1], r32float or depth32float) and the weights follow the
+// projective map's texel spans (`proj_texel_weight`); other frames are epipolar as usual.
+{%- endif %}
 //
 // Bindings (group 0):
 // | binding | name      | type                                            | access       |
 // |---------|-----------|-------------------------------------------------|--------------|
-// | 0       | frame     | var<uniform> Frame (336 bytes)                  | uniform      |
+// | 0       | frame     | var<uniform> Frame (400 bytes)                  | uniform      |
 // | 1       | slices    | var<storage, read> array<vec4<f32>>             | read         |
 // | 2       | rectified | texture_2d<f32> (r32float)                      | textureLoad  |
 // | 3       | filtered  | texture_storage_2d_array<FORMAT, write>         | textureStore |
@@ -23,7 +29,7 @@
 //
 // Mirrors reference/src/kernels/prefilter.rs
 
-#import scatter::prefiltered::{Frame, basis4, region_start, slice_params, texel_weight}
+#import scatter::prefiltered::{Frame, basis4, region_start, slice_params, texel_weight{% if projective %}, proj_stored_depth, proj_texel_weight{% endif %}}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
@@ -47,6 +53,9 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let weighted = {{ weighted }};
     let spot = {{ spot }};
+{%- if projective %}
+    let proj = frame.proj[0] > 0.5;
+{%- endif %}
     let layers_per_thread = BASES_PER_THREAD / 4u;
     let slice = slice_params(slices[row]);
     let start = region_start(region, REGIONS, width, spot);
@@ -54,8 +63,19 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var acc: array<vec4<f32>, {{ layers_per_thread }}>;
     var wsum = 0.0;
     for (var i = start; i < end; i++) {
+{%- if projective %}
+        var d = textureLoad(rectified, vec2<u32>(i, row), 0).x;
+        var w: f32;
+        if proj {
+            d = proj_stored_depth(d);
+            w = proj_texel_weight(frame, slice, i, region, REGIONS, weighted, spot);
+        } else {
+            w = texel_weight(frame, slice, row, i, weighted, spot);
+        }
+{%- else %}
         let d = textureLoad(rectified, vec2<u32>(i, row), 0).x;
         let w = texel_weight(frame, slice, row, i, weighted, spot);
+{%- endif %}
         wsum += w;
         let blend = select(0.0, w / wsum, wsum > 0.0);
         for (var q = 0u; q < layers_per_thread; q++) {

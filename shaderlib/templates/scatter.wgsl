@@ -1,4 +1,4 @@
-// scatter ({{ layers }} layers = {{ bases }} bases, {{ regions }} regions, {{ visibility_name }} visibility, {{ light_name }} light): per pixel, the
+// scatter ({{ layers }} layers = {{ bases }} bases, {{ regions }} regions, {{ visibility_name }} visibility, {{ light_name }} light, {{ rectification_name }}): per pixel, the
 // prefiltered estimate of in-scattered light (Klehm et al. 2014, Sec. 3, Listing 4: one dot
 // product of the pixel's Fourier coefficients with the filtered bases per region) and a ray
 // march against the standard shadow map for pixels near the epipole or the anti-epipole,
@@ -12,7 +12,7 @@
 // Bindings (group 0):
 // | binding | name             | type                                     | access             |
 // |---------|------------------|------------------------------------------|--------------------|
-// | 0       | frame            | var<uniform> Frame (336 bytes)           | uniform            |
+// | 0       | frame            | var<uniform> Frame (400 bytes)           | uniform            |
 // | 1       | slices           | var<storage, read> array<vec4<f32>>      | read               |
 // | 2       | depth            | texture_2d<f32> (r32float, view depth)   | textureLoad        |
 // | 3       | shadow_map       | texture_2d<f32> (r32float)               | textureLoad        |
@@ -26,10 +26,17 @@
 // Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
 // (frame.sizes.xy); invocation id x = pixel column, y = pixel row.
 //
+{%- if projective %}
+// Projective variant: in a projective frame (frame.proj.x = 1) the pixel's rectified
+// coordinates come from the projective map (row k = qy / qx, depth m = qz / qx, column from
+// the invariant G of its surface point); neither epipole is on screen then, so nothing is
+// marched.
+{%- endif %}
+//
 // Mirrors reference/src/kernels/scatter.rs
 
 #import scatter::model::{GL4_W, GL4_X, PI, phase_hg, spot_integrand, transmittance_between, transmittance_integral}
-#import scatter::prefiltered::{Frame, coeff4, normalised_depth, region_start, slice_params, sm_visibility}
+#import scatter::prefiltered::{Frame, coeff4, normalised_depth, region_start, slice_params, sm_visibility{% if projective %}, proj_boundary, proj_column, proj_ray_depth, proj_reach{% endif %}}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
@@ -121,36 +128,64 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
 
     // Rectified coordinates of the surface point.
     let axis = f.axis.xyz;
-    let theta = acos(clamp(dot(dir, axis), -1.0, 1.0));
-    let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
     let rows = f.sizes[3];
+    let width = f.sizes[2];
+    let regions = REGIONS;
     let wrap = f.anti_epipole[3] > 0.5;
-    var yc = (phi - f.e1_[3]) / f.e2_[3];
-    if wrap {
-        yc -= floor(yc / f32(rows)) * f32(rows);
-    } else {
-        yc = clamp(yc, 0.0, f32(rows));
-    }
-    // Slice parameters, interpolated between the two nearest slices like the bilinear fetch.
-    let yy = yc - 0.5;
-    let j0 = floor(yy);
-    let fy = yy - j0;
-    let s0 = slice_params(slices[row_index(j0, rows, wrap)]);
-    let s1 = slice_params(slices[row_index(j0 + 1.0, rows, wrap)]);
-    let delta = mix(s0.delta, s1.delta, fy);
-    let d = normalised_depth(theta, f.theta[0], f.theta[1]);
+    var yc: f32;
+    var d: f32;
     var xs: f32;
-    if spot {
-        let q = normalize(eye + dir * s - f.light_pos.xyz);
-        xs = acos(clamp(dot(q, -axis), -1.0, 1.0)) / delta;
+    // Epipolar: the slice's column spacing and the ray's view angle.
+    var delta = 1.0;
+    var theta = 0.0;
+{%- if projective %}
+    // Projective: the ray's e1 component and depth m.
+    var qd = 1.0;
+    var m = 0.0;
+    let proj = f.proj[0] > 0.5;
+    if proj {
+        let q = vec3<f32>(dot(dir, f.e1_.xyz), dot(dir, f.e2_.xyz), dot(dir, axis));
+        qd = max(q.x, 1e-6);
+        let k = q.y / qd;
+        m = q.z / qd;
+        yc = clamp((k + f.proj[1]) / (2.0 * f.proj[1]) * f32(rows), 0.0, f32(rows));
+        d = proj_ray_depth(f, m);
+        let qs = max(s * qd, 1e-6);
+        var g = 1.0 / qs;
+        if spot {
+            g = (f.axis[3] - s * q.z) / qs;
+        }
+        xs = proj_column(f, g, regions, width, spot);
     } else {
-        xs = s * sin(theta) / delta;
+{%- else %}
+    {
+{%- endif %}
+        theta = acos(clamp(dot(dir, axis), -1.0, 1.0));
+        let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
+        yc = (phi - f.e1_[3]) / f.e2_[3];
+        if wrap {
+            yc -= floor(yc / f32(rows)) * f32(rows);
+        } else {
+            yc = clamp(yc, 0.0, f32(rows));
+        }
+        // Slice parameters, interpolated between the two nearest slices like the bilinear fetch.
+        let yy = yc - 0.5;
+        let j0 = floor(yy);
+        let fy = yy - j0;
+        let s0 = slice_params(slices[row_index(j0, rows, wrap)]);
+        let s1 = slice_params(slices[row_index(j0 + 1.0, rows, wrap)]);
+        delta = mix(s0.delta, s1.delta, fy);
+        d = normalised_depth(theta, f.theta[0], f.theta[1]);
+        if spot {
+            let q = normalize(eye + dir * s - f.light_pos.xyz);
+            xs = acos(clamp(dot(q, -axis), -1.0, 1.0)) / delta;
+        } else {
+            xs = s * sin(theta) / delta;
+        }
     }
 
     // Regions: every region before the surface's, whole, and the surface's up to x_s. Each
     // is weighted by this pixel's own unshadowed integral over its part of the ray.
-    let width = f.sizes[2];
-    let regions = REGIONS;
     let last = u32(min(max(xs, 0.0), f32(width) - 1.0));
     var pos: array<f32, MAX_REGIONS>;
     var t0: array<f32, MAX_REGIONS>;
@@ -161,8 +196,22 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         let b1 = f32(region_start(r + 1u, regions, width, spot));
         let is_last = last < u32(b1) || r + 1u == regions;
         pos[r] = select(b1 - 0.5, clamp(xs - 0.5, b0 + 0.5, b1 - 0.5), is_last);
+{%- if projective %}
+        if proj {
+            var a = 0.0;
+            if r > 0u {
+                a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
+            }
+            t0[r] = a;
+            t1[r] = select(min(proj_reach(f, proj_boundary(f, r + 1u), m, spot, s * qd) / qd, s), s, is_last);
+        } else {
+            t0[r] = ray_t(f, b0, delta, theta, s, spot);
+            t1[r] = select(ray_t(f, b1, delta, theta, s, spot), s, is_last);
+        }
+{%- else %}
         t0[r] = ray_t(f, b0, delta, theta, s, spot);
         t1[r] = select(ray_t(f, b1, delta, theta, s, spot), s, is_last);
+{%- endif %}
         count = r + 1u;
         if is_last {
             break;

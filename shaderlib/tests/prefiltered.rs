@@ -8,13 +8,13 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use scatter_shaderlib::prefiltered::{
-    LightKind, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE, Rectification,
-    SCATTER_WORKGROUP_SIZE, Storage, Variant, VisibilityMode,
+    LightKind, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE, Storage,
+    Variant, VisibilityMode,
 };
 use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams, ShaderError, build, render};
 
 /// Every valid variant: bases {4, .., 128} x every bases_per_thread x regions 1..=8 x
-/// visibility x light x storage (rectification: epipolar, the only valid one).
+/// visibility x light x storage x rectification.
 fn cross_product() -> Vec<Variant> {
     Variant::grid(Variant::REGIONS)
 }
@@ -27,7 +27,7 @@ fn full_cross_product_validates() {
     let variants = cross_product();
     assert_eq!(
         variants.len(),
-        21 * 8 * 2 * 2 * 3,
+        21 * 8 * 2 * 2 * 3 * 2,
         "21 (bases, bases_per_thread) pairs"
     );
     let start = Instant::now();
@@ -70,7 +70,7 @@ fn full_cross_product_validates() {
         2,
         "rectify depends on the light only"
     );
-    assert_eq!(per_kernel[&Kernel::Scatter], 6 * 8 * 2 * 2);
+    assert_eq!(per_kernel[&Kernel::Scatter], 6 * 8 * 2 * 2 * 2);
     assert_eq!(per_kernel[&Kernel::Prefilter], variants.len());
     eprintln!(
         "{} variants, {rendered} kernels rendered in {:.2?}; {total} distinct sources \
@@ -115,13 +115,6 @@ fn bad_variants_are_rejected_naming_the_knob() {
                 ..Variant::default()
             },
             "regions",
-        ),
-        (
-            Variant {
-                rectification: Rectification::Projective,
-                ..Variant::default()
-            },
-            "rectification",
         ),
     ];
     for (variant, knob) in cases {
@@ -282,7 +275,8 @@ fn bindings_match_the_documented_tables() {
     }
 }
 
-/// The `Frame` struct has the host `FrameUniforms` layout: 19 vec4<f32> then 2 vec4<u32>.
+/// The `Frame` struct has the host `FrameUniforms` layout: 19 vec4<f32>, 2 vec4<u32>, then
+/// 4 vec4<f32>.
 #[test]
 fn frame_layout_matches_the_host_struct() {
     let built = built(KernelParams::Scatter(Variant::default()));
@@ -299,17 +293,17 @@ fn frame_layout_matches_the_host_struct() {
         *span as usize,
         size_of::<scatter_shaderlib::prefiltered::FrameUniforms>()
     );
-    assert_eq!(members.len(), 21);
+    assert_eq!(members.len(), 25);
     for (i, member) in members.iter().enumerate() {
         assert_eq!(member.offset as usize, 16 * i, "{:?}", member.name);
         let naga::TypeInner::Vector { size, scalar } = m.types[member.ty].inner else {
             panic!("{:?} is not a vector", member.name);
         };
         assert_eq!(size, naga::VectorSize::Quad);
-        let kind = if i < 19 {
-            naga::ScalarKind::Float
-        } else {
+        let kind = if (19..21).contains(&i) {
             naga::ScalarKind::Uint
+        } else {
+            naga::ScalarKind::Float
         };
         assert_eq!(scalar, naga::Scalar { kind, width: 4 }, "{:?}", member.name);
     }
@@ -338,6 +332,10 @@ fn frame_layout_matches_the_host_struct() {
             "anti_epipole",
             "sizes",
             "sizes2_",
+            "proj",
+            "proj_g0_",
+            "proj_g1_",
+            "proj_g2_",
         ]
     );
 }

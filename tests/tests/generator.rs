@@ -148,6 +148,10 @@ fn manifest_frame_layout_matches_the_host_struct() {
         ("anti_epipole", offset_of!(FrameUniforms, anti_epipole)),
         ("sizes", offset_of!(FrameUniforms, sizes)),
         ("sizes2_", offset_of!(FrameUniforms, sizes2)),
+        ("proj", offset_of!(FrameUniforms, proj)),
+        ("proj_g0_", offset_of!(FrameUniforms, proj_g0)),
+        ("proj_g1_", offset_of!(FrameUniforms, proj_g1)),
+        ("proj_g2_", offset_of!(FrameUniforms, proj_g2)),
     ];
     let fields = get(frame, "fields").as_array().cloned().unwrap_or_default();
     assert_eq!(fields.len(), host.len(), "{fields:?}");

@@ -3,10 +3,13 @@
 //! (`reference/src/kernels/{rectify,prefilter,scatter}.rs`, driven by
 //! `scatter_reference::kernels::run_prefiltered`) for every variant of the design card:
 //! bases {4, 8, 16, 32, 64, 128} x every valid bases_per_thread x regions {1, 2, 3, 4} x
-//! visibility x light x storage (epipolar rectification only). Directional variants run on
+//! visibility x light x storage x rectification. Directional variants run on
 //! `columns/ordinary`, spot variants on `spot_grate/ordinary`, 64x36 pixels, a 128^2 shadow
 //! map and a 64x64 rectified map. Trials are named
-//! `prefiltered::<variant id>::<scene>::<pose>`.
+//! `prefiltered::<variant id>::<scene>::<pose>`. Both poses are projective frames for the
+//! projective variants (asserted): their rectified map is the reference's ray-cast stand-in
+//! for the engine's rasteriser, uploaded to the GPU, and `rectify` does not run. The
+//! fallback to epipolar is tested on `columns/epipole_on_screen`.
 //!
 //! Tolerances:
 //! - rectified map: `|gpu - cpu| <= 1e-4` (a normalised view angle: acos/atan2 differ by a
@@ -32,7 +35,8 @@ use scatter_reference::bvh::Bvh;
 use scatter_reference::kernels::{PrefilteredRun, run_prefiltered};
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
-use scatter_runtime::{Context, CpuInputs, FrameInput, RuntimeError, Scatter, run_once};
+use scatter_runtime::wgpu::TextureView;
+use scatter_runtime::{Context, CpuInputs, FrameInput, Inputs, RuntimeError, Scatter, run_once};
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, Rectification, Resolutions, Storage, Variant,
 };
@@ -40,39 +44,55 @@ use scatter_shaderlib::prefiltered::{
 const SCREEN: [u32; 2] = [64, 36];
 const RECTIFIED: [u32; 2] = [64, 64];
 const SHADOW_MAP: u32 = 128;
-const POSE: Pose = Pose::Ordinary;
 
 const RECTIFIED_TOL: f32 = 1e-4;
 
 /// A suite scene with its depth buffer and shadow map, built once.
 struct Fixture {
     name: SceneName,
+    pose: Pose,
     scene: Scene,
+    bvh: Bvh,
     gbuf: GBuffer,
     shadow_map: ShadowMap,
 }
 
 impl Fixture {
-    fn for_light(light: LightKind) -> &'static Fixture {
+    /// Directional variants run on `columns/ordinary`; spot variants on
+    /// `spot_grate/ordinary`, except projective ones on `spot_grate/grazing` (the ordinary
+    /// pose's slices fan out too wide for a projective map: it falls back to epipolar).
+    fn get(light: LightKind, rectification: Rectification) -> &'static Fixture {
         static COLUMNS: OnceLock<Fixture> = OnceLock::new();
         static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
-        let (cell, name) = match light {
-            LightKind::Directional => (&COLUMNS, SceneName::Columns),
-            LightKind::Spot => (&SPOT_GRATE, SceneName::SpotGrate),
+        static SPOT_GRATE_GRAZING: OnceLock<Fixture> = OnceLock::new();
+        let (cell, name, pose) = match (light, rectification) {
+            (LightKind::Directional, _) => (&COLUMNS, SceneName::Columns, Pose::Ordinary),
+            (LightKind::Spot, Rectification::Epipolar) => {
+                (&SPOT_GRATE, SceneName::SpotGrate, Pose::Ordinary)
+            }
+            (LightKind::Spot, Rectification::Projective) => {
+                (&SPOT_GRATE_GRAZING, SceneName::SpotGrate, Pose::Grazing)
+            }
         };
         cell.get_or_init(|| {
-            let scene = scene(name, POSE, MediumPreset::Default, SCREEN[0], SCREEN[1]);
+            let scene = scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
             let bvh = Bvh::build(&scene.geometry);
             let gbuf = GBuffer::cast(&scene, &bvh);
             let shadow_map = ShadowMap::build(&scene, &bvh, SHADOW_MAP)
                 .unwrap_or_else(|e| panic!("shadow map of {name}: {e}"));
             Fixture {
                 name,
+                pose,
                 scene,
+                bvh,
                 gbuf,
                 shadow_map,
             }
         })
+    }
+
+    fn for_light(light: LightKind) -> &'static Fixture {
+        Fixture::get(light, Rectification::Epipolar)
     }
 
     fn frame_input(&self) -> FrameInput {
@@ -90,6 +110,8 @@ impl Fixture {
             frame: self.frame_input(),
             depth: self.gbuf.view_depth.clone(),
             shadow_map: self.shadow_map.depth.clone(),
+            rectified: None,
+            pass_wall_frames: 0,
         }
     }
 
@@ -101,8 +123,8 @@ impl Fixture {
     }
 }
 
-/// Every variant of the design card for one light type (epipolar rectification), regions
-/// 1..=4 as the conformance grid asks.
+/// Every variant of the design card for one light type, regions 1..=4 as the issue's
+/// conformance grid asks.
 fn variants(light: LightKind) -> Vec<Variant> {
     Variant::grid(1..=4)
         .into_iter()
@@ -180,24 +202,41 @@ fn f16_ulp(v: f32) -> f32 {
 }
 
 fn trial_name(variant: &Variant, fixture: &Fixture) -> String {
-    format!("prefiltered::{}::{}::{}", variant.id(), fixture.name, POSE)
+    format!(
+        "prefiltered::{}::{}::{}",
+        variant.id(),
+        fixture.name,
+        fixture.pose
+    )
 }
 
 fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<TrialResult, String> {
     let trial = trial_name(variant, fixture);
     let start = Instant::now();
-    let gpu = run_once(ctx, variant, fixture.resolutions(), &fixture.cpu_inputs())
-        .map_err(|e| format!("{trial}: GPU run failed: {e}"))?;
-    let gpu_wall = start.elapsed();
     let cpu: PrefilteredRun = run_prefiltered(
         variant,
         RECTIFIED,
         &fixture.scene,
+        &fixture.bvh,
         &fixture.gbuf,
         &fixture.shadow_map,
         &FrameSettings::default(),
     )
     .map_err(|e| format!("{trial}: CPU mirror failed: {e}"))?;
+    if cpu.frame.report.rectification != variant.rectification {
+        return Err(format!(
+            "{trial}: expected a {} frame, got {} ({:?})",
+            variant.rectification, cpu.frame.report.rectification, cpu.frame.report.fallback
+        ));
+    }
+    let mut inputs = fixture.cpu_inputs();
+    if cpu.frame.report.projective.is_some() {
+        inputs.rectified = Some(cpu.rectified.data.clone());
+    }
+    let gpu_start = Instant::now();
+    let gpu = run_once(ctx, variant, fixture.resolutions(), &inputs)
+        .map_err(|e| format!("{trial}: GPU run failed: {e}"))?;
+    let gpu_wall = gpu_start.elapsed();
     if gpu.frame != cpu.frame {
         return Err(format!(
             "{trial}: the runtime uploaded a different frame set-up than the mirror used"
@@ -283,11 +322,14 @@ fn describe(what: &str, w: &Worst, layout: impl Fn(usize) -> String) -> String {
     )
 }
 
-fn conformance(light: LightKind) {
+fn conformance(light: LightKind, rectification: Rectification) {
     let Some(ctx) = gpu() else { return };
-    let fixture = Fixture::for_light(light);
+    let fixture = Fixture::get(light, rectification);
     let filter = std::env::var("SCATTER_TRIALS").unwrap_or_default();
-    let all = variants(light);
+    let all: Vec<Variant> = variants(light)
+        .into_iter()
+        .filter(|v| v.rectification == rectification)
+        .collect();
     let chosen: Vec<_> = all
         .iter()
         .filter(|v| trial_name(v, fixture).contains(filter.as_str()))
@@ -350,7 +392,7 @@ fn conformance(light: LightKind) {
     }
     let total = start.elapsed();
     eprintln!(
-        "prefiltered::*-{light}-*: {} trials in {:.1} s ({:.0} ms per trial), {} failed",
+        "prefiltered::*-{light}-*-{rectification}: {} trials in {:.1} s ({:.0} ms per trial), {} failed",
         chosen.len(),
         total.as_secs_f64(),
         total.as_secs_f64() * 1e3 / chosen.len().max(1) as f64,
@@ -358,7 +400,7 @@ fn conformance(light: LightKind) {
     );
     for (storage, rect, filt, out) in &worst_by_storage {
         eprintln!(
-            "prefiltered::*-{light}-{storage}-*: max rectified |diff| {rect:.3e}, max filtered |diff| {filt:.3e}, max output |diff| / max radiance {out:.3e}"
+            "prefiltered::*-{light}-{storage}-{rectification}: max rectified |diff| {rect:.3e}, max filtered |diff| {filt:.3e}, max output |diff| / max radiance {out:.3e}"
         );
     }
     assert!(
@@ -371,13 +413,23 @@ fn conformance(light: LightKind) {
 }
 
 #[test]
-fn directional_variants_match_mirror() {
-    conformance(LightKind::Directional);
+fn directional_epipolar_variants_match_mirror() {
+    conformance(LightKind::Directional, Rectification::Epipolar);
 }
 
 #[test]
-fn spot_variants_match_mirror() {
-    conformance(LightKind::Spot);
+fn spot_epipolar_variants_match_mirror() {
+    conformance(LightKind::Spot, Rectification::Epipolar);
+}
+
+#[test]
+fn directional_projective_variants_match_mirror() {
+    conformance(LightKind::Directional, Rectification::Projective);
+}
+
+#[test]
+fn spot_projective_variants_match_mirror() {
+    conformance(LightKind::Spot, Rectification::Projective);
 }
 
 /// The variant the error tests start from.
@@ -442,7 +494,7 @@ fn wrong_shadow_map_size_is_an_error() {
     let mut encoder = ctx.device().create_command_encoder(&Default::default());
     let small = texture([SHADOW_MAP / 2; 2], r32);
     let err = pass
-        .encode(&mut encoder, &depth, &small)
+        .encode(&mut encoder, &inputs(&depth, &small))
         .expect_err("a 64^2 shadow-map view");
     assert!(err.to_string().contains("shadow map size"), "{err}");
     eprintln!("ok   prefiltered::errors::shadow_map_view_size: {err}");
@@ -451,19 +503,31 @@ fn wrong_shadow_map_size_is_an_error() {
         scatter_runtime::wgpu::TextureFormat::Rgba8Unorm,
     );
     let err = pass
-        .encode(&mut encoder, &depth, &rgba)
+        .encode(&mut encoder, &inputs(&depth, &rgba))
         .expect_err("an rgba8 shadow-map view");
     assert!(err.to_string().contains("shadow map format"), "{err}");
     eprintln!("ok   prefiltered::errors::shadow_map_view_format: {err}");
     let small_depth = texture([SCREEN[0], SCREEN[1] - 1], r32);
     let sm = texture([SHADOW_MAP; 2], r32);
     let err = pass
-        .encode(&mut encoder, &small_depth, &sm)
+        .encode(&mut encoder, &inputs(&small_depth, &sm))
         .expect_err("a short depth buffer");
     assert!(err.to_string().contains("depth buffer size"), "{err}");
     eprintln!("ok   prefiltered::errors::depth_view_size: {err}");
     // The right views encode, and the encoder still finishes cleanly.
-    pass.encode(&mut encoder, &depth, &sm)
+    let err = pass
+        .encode(
+            &mut encoder,
+            &Inputs {
+                depth: &depth,
+                shadow_map: None,
+                rectified: None,
+            },
+        )
+        .expect_err("an epipolar frame without a shadow map");
+    assert!(matches!(err, RuntimeError::MissingInput { .. }), "{err}");
+    eprintln!("ok   prefiltered::errors::missing_shadow_map: {err}");
+    pass.encode(&mut encoder, &inputs(&depth, &sm))
         .unwrap_or_else(|e| panic!("{e}"));
     ctx.queue().submit([encoder.finish()]);
 }
@@ -550,14 +614,6 @@ fn invalid_variant_names_the_knob() {
             "bases_per_thread",
             "12",
         ),
-        (
-            Variant {
-                rectification: Rectification::Projective,
-                ..base_variant()
-            },
-            "rectification",
-            "projective",
-        ),
     ];
     for (variant, knob, value) in cases {
         let err = Scatter::new(ctx, &variant, columns_res(), SHADOW_MAP).expect_err(knob);
@@ -582,7 +638,10 @@ fn bad_frames_are_errors_not_panics() {
     // Encoding before any frame was prepared.
     let mut encoder = ctx.device().create_command_encoder(&Default::default());
     let err = pass
-        .encode(&mut encoder, pass.rectified_view(), pass.rectified_view())
+        .encode(
+            &mut encoder,
+            &inputs(pass.rectified_view(), pass.rectified_view()),
+        )
         .expect_err("encode before prepare");
     assert!(matches!(err, RuntimeError::NotPrepared { .. }), "{err}");
     eprintln!("ok   prefiltered::errors::not_prepared: {err}");
@@ -618,4 +677,13 @@ fn bad_frames_are_errors_not_panics() {
     // After the errors, a good frame still works.
     pass.prepare(ctx, &fixture.frame_input())
         .unwrap_or_else(|e| panic!("{e}"));
+}
+
+/// An epipolar frame's inputs: depth and standard shadow map.
+fn inputs<'a>(depth: &'a TextureView, shadow_map: &'a TextureView) -> Inputs<'a> {
+    Inputs {
+        depth,
+        shadow_map: Some(shadow_map),
+        rectified: None,
+    }
 }

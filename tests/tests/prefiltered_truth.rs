@@ -12,16 +12,24 @@
 //! - reference-ray weighting (epipole on screen, spot light): visibility is averaged with the
 //!   slice reference ray's transmittance, not the pixel's; 8 regions cut the error 2-4x.
 //!
+//! Projective rectification (Sec. 4.2, [`projective_rectification_on_every_pose`]): the
+//! frame is projective on every `ordinary` and `grazing` pose except spot_grate/ordinary
+//! (its slices fan out 84 degrees, beyond the 60 degree limit) and falls back to epipolar,
+//! with the reason in the frame report and the epipolar variant's exact output, everywhere
+//! else. Projective frames meet the same bars except the poses in [`PROJECTIVE_EXCEPTIONS`].
+//!
 //! Trials are named `prefiltered::<variant id>::<scene>::<pose>` in the report.
 
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
-use scatter_reference::kernels::run_prefiltered;
+use scatter_reference::kernels::{PrefilteredRun, run_prefiltered};
 use scatter_reference::metrics;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
-use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Variant, VisibilityMode};
+use scatter_shaderlib::prefiltered::{
+    FrameSettings, LightKind, ProjectiveFallback, Rectification, Variant, VisibilityMode,
+};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -85,8 +93,32 @@ const EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
     ),
 ];
 
+/// Projective frames of the default variant (rectification = projective) that miss the bar:
+/// (scene/pose, measured rel L1 in %, asserted bound in %, dominating error source).
+const PROJECTIVE_EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
+    (
+        "window/ordinary",
+        16.37,
+        18.0,
+        "Fourier ringing, as epipolar (15.2 %)",
+    ),
+    (
+        "window/grazing",
+        7.49,
+        8.3,
+        "Fourier ringing, as epipolar (9.48 %)",
+    ),
+    (
+        "spot_grate/grazing",
+        7.38,
+        8.2,
+        "reference-ray weighting of 1/d^2 (8 regions: 1.10 %; epipolar 4.51 %, 8 regions 0.83 %)",
+    ),
+];
+
 struct Fixture {
     scene: scatter_reference::scene::Scene,
+    bvh: Bvh,
     gbuf: GBuffer,
     shadow_map: ShadowMap,
     truth: Image,
@@ -117,6 +149,7 @@ fn fixture(name: SceneName, pose: Pose, medium: MediumPreset) -> Arc<Fixture> {
         );
         Arc::new(Fixture {
             scene,
+            bvh,
             gbuf,
             shadow_map,
             truth,
@@ -135,10 +168,16 @@ fn light_of(name: SceneName) -> LightKind {
 
 /// rel L1 of the CPU mirror of `variant` against the truth; panics on NaN/Inf.
 fn error(f: &Fixture, variant: &Variant) -> f64 {
+    run(f, variant).1
+}
+
+/// The CPU mirror's run of `variant` and its rel L1 against the truth; panics on NaN/Inf.
+fn run(f: &Fixture, variant: &Variant) -> (PrefilteredRun, f64) {
     let run = run_prefiltered(
         variant,
         RECTIFIED,
         &f.scene,
+        &f.bvh,
         &f.gbuf,
         &f.shadow_map,
         &FrameSettings::default(),
@@ -152,7 +191,7 @@ fn error(f: &Fixture, variant: &Variant) -> f64 {
         variant.id(),
         f.scene.name
     );
-    report.rel_l1
+    (run, report.rel_l1)
 }
 
 fn all_poses() -> Vec<(SceneName, Pose)> {
@@ -277,5 +316,91 @@ fn weighted_beats_average_in_thick_fog() {
             ));
         }
     }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn projective_rectification_on_every_pose() {
+    let mut failures = Vec::new();
+    let mut projective_frames = 0;
+    for (name, pose) in all_poses() {
+        let f = fixture(name, pose, MediumPreset::Default);
+        let light = light_of(name);
+        let variant = Variant {
+            light,
+            rectification: Rectification::Projective,
+            ..Variant::default()
+        };
+        let (proj, e) = run(&f, &variant);
+        let e = 100.0 * e;
+        let key = format!("{name}/{pose}");
+        let report = &proj.frame.report;
+        let expect_projective =
+            matches!(pose, Pose::Ordinary | Pose::Grazing) && key != "spot_grate/ordinary";
+        match (expect_projective, report.rectification) {
+            (true, Rectification::Projective) => {
+                projective_frames += 1;
+                let bar = if light == LightKind::Spot { 5.0 } else { 3.0 };
+                let bound = match PROJECTIVE_EXCEPTIONS.iter().find(|x| x.0 == key) {
+                    Some(&(_, measured, bound, source)) => {
+                        println!(
+                            "prefiltered::{}::{name}::{pose}: projective frame, rel L1 {e:.3} % (bar {bar} % missed: {source}; measured {measured} %, bound {bound} %)",
+                            variant.id()
+                        );
+                        assert!(
+                            e > bar,
+                            "{key} now meets the bar: remove it from PROJECTIVE_EXCEPTIONS"
+                        );
+                        bound
+                    }
+                    None => {
+                        println!(
+                            "prefiltered::{}::{name}::{pose}: projective frame, rel L1 {e:.3} % (bar {bar} %)",
+                            variant.id()
+                        );
+                        bar
+                    }
+                };
+                if e > bound {
+                    failures.push(format!("{key}: projective {e:.3} % > {bound} %"));
+                }
+                let maps = report.projective.as_ref().expect("projective maps");
+                assert_eq!(maps.matrices.len(), variant.regions as usize);
+            }
+            (false, Rectification::Epipolar) => {
+                let reason = report.fallback.expect("a fallback reason");
+                let expected = match pose {
+                    Pose::EpipoleOnScreen => matches!(reason, ProjectiveFallback::EpipoleOnScreen),
+                    Pose::LightBehind => matches!(reason, ProjectiveFallback::AntiEpipoleOnScreen),
+                    _ => matches!(reason, ProjectiveFallback::WideFan { .. }),
+                };
+                if !expected {
+                    failures.push(format!("{key}: unexpected fallback reason: {reason}"));
+                }
+                // The fallback is exactly the epipolar variant.
+                let (epi, _) = run(
+                    &f,
+                    &Variant {
+                        light,
+                        ..Variant::default()
+                    },
+                );
+                if epi.output.data != proj.output.data {
+                    failures.push(format!(
+                        "{key}: the fallback differs from the epipolar variant"
+                    ));
+                }
+                println!(
+                    "prefiltered::{}::{name}::{pose}: fell back to epipolar ({reason}), rel L1 {e:.3} %",
+                    variant.id()
+                );
+            }
+            (_, got) => failures.push(format!(
+                "{key}: unexpected {got} frame ({:?})",
+                report.fallback
+            )),
+        }
+    }
+    println!("{projective_frames} projective frames of 24 poses");
     assert!(failures.is_empty(), "{failures:#?}");
 }

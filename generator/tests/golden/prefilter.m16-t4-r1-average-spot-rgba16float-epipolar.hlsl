@@ -22,6 +22,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float4 anti_epipole;
     uint4 sizes;
     uint4 sizes2_;
+    float4 proj;
+    float4 proj_g0_;
+    float4 proj_g1_;
+    float4 proj_g2_;
 };
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
@@ -32,6 +36,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
 };
 
 static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+static const float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
 static const uint REGIONS = 1u;
 static const uint BASES_PER_THREAD = 4u;
 static const uint THREADS_PER_ROW_REGION = 4u;
@@ -156,11 +161,12 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
         float r_1 = max(((f_3.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
         const float _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
-        float _e54 = w;
-        w = (_e54 * ((_e53 * exp((-(f_3.medium.x) * r_1))) / (r_1 * r_1)));
+        float cone = max(_e53, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
+        float _e56 = w;
+        w = (_e56 * ((cone * exp((-(f_3.medium.x) * r_1))) / (r_1 * r_1)));
     }
-    float _e64 = w;
-    return _e64;
+    float _e66 = w;
+    return _e66;
 }
 
 [numthreads(64, 1, 1)]

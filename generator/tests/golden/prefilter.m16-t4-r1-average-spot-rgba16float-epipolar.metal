@@ -32,6 +32,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     metal::float4 anti_epipole;
     metal::uint4 sizes;
     metal::uint4 sizes2_;
+    metal::float4 proj;
+    metal::float4 proj_g0_;
+    metal::float4 proj_g1_;
+    metal::float4 proj_g2_;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float delta;
@@ -44,6 +48,7 @@ struct type_10 {
     metal::float4 inner[1];
 };
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+constant float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
 constant uint REGIONS = 1u;
 constant uint BASES_PER_THREAD = 4u;
 constant uint THREADS_PER_ROW_REGION = 4u;
@@ -181,11 +186,12 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
         float den_1 = metal::max(metal::sin(s_1.theta_ref + psi_1), 0.0001);
         float r_1 = metal::max((f_3.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
         float _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
-        float _e54 = w;
-        w = _e54 * ((_e53 * metal::exp(-(f_3.medium.x) * r_1)) / (r_1 * r_1));
+        float cone = metal::max(_e53, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
+        float _e56 = w;
+        w = _e56 * ((cone * metal::exp(-(f_3.medium.x) * r_1)) / (r_1 * r_1));
     }
-    float _e64 = w;
-    return _e64;
+    float _e66 = w;
+    return _e66;
 }
 
 struct prefilterInput {

@@ -22,6 +22,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     anti_epipole: vec4<f32>,
     sizes: vec4<u32>,
     sizes2_: vec4<u32>,
+    proj: vec4<f32>,
+    proj_g0_: vec4<f32>,
+    proj_g1_: vec4<f32>,
+    proj_g2_: vec4<f32>,
 }
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
@@ -32,6 +36,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
 }
 
 const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
+const CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX: f32 = 0.001f;
 const REGIONS: u32 = 1u;
 const BASES_PER_THREAD: u32 = 4u;
 const THREADS_PER_ROW_REGION: u32 = 4u;
@@ -135,11 +140,12 @@ fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3: FrameX_nag
         let den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001f);
         let r_1 = max(((f_3.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
         let _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
-        let _e54 = w;
-        w = (_e54 * ((_e53 * exp((-(f_3.medium.x) * r_1))) / (r_1 * r_1)));
+        let cone = max(_e53, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
+        let _e56 = w;
+        w = (_e56 * ((cone * exp((-(f_3.medium.x) * r_1))) / (r_1 * r_1)));
     }
-    let _e64 = w;
-    return _e64;
+    let _e66 = w;
+    return _e66;
 }
 
 @compute @workgroup_size(64, 1, 1) 

@@ -27,6 +27,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     vec4 anti_epipole;
     uvec4 sizes;
     uvec4 sizes2_;
+    vec4 proj;
+    vec4 proj_g0_;
+    vec4 proj_g1_;
+    vec4 proj_g2_;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float delta;
@@ -35,6 +39,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float theta_hi;
 };
 const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+const float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
 const uint REGIONS = 3u;
 const uint BASES_PER_THREAD = 8u;
 const uint THREADS_PER_ROW_REGION = 4u;
@@ -136,11 +141,12 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
         float r_1 = max(((f_3.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
         float _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
-        float _e54 = w;
-        w = (_e54 * ((_e53 * exp((-(f_3.medium.x) * r_1))) / (r_1 * r_1)));
+        float cone = max(_e53, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
+        float _e56 = w;
+        w = (_e56 * ((cone * exp((-(f_3.medium.x) * r_1))) / (r_1 * r_1)));
     }
-    float _e64 = w;
-    return _e64;
+    float _e66 = w;
+    return _e66;
 }
 
 void main() {

@@ -27,6 +27,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     vec4 anti_epipole;
     uvec4 sizes;
     uvec4 sizes2_;
+    vec4 proj;
+    vec4 proj_g0_;
+    vec4 proj_g1_;
+    vec4 proj_g2_;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float delta;

@@ -22,6 +22,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     anti_epipole: vec4<f32>,
     sizes: vec4<u32>,
     sizes2_: vec4<u32>,
+    proj: vec4<f32>,
+    proj_g0_: vec4<f32>,
+    proj_g1_: vec4<f32>,
+    proj_g2_: vec4<f32>,
 }
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {

@@ -22,6 +22,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float4 anti_epipole;
     uint4 sizes;
     uint4 sizes2_;
+    float4 proj;
+    float4 proj_g0_;
+    float4 proj_g1_;
+    float4 proj_g2_;
 };
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {

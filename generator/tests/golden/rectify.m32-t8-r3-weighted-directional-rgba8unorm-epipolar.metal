@@ -32,6 +32,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     metal::float4 anti_epipole;
     metal::uint4 sizes;
     metal::uint4 sizes2_;
+    metal::float4 proj;
+    metal::float4 proj_g0_;
+    metal::float4 proj_g1_;
+    metal::float4 proj_g2_;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float delta;

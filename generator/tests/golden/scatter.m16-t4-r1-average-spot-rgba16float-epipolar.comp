@@ -27,6 +27,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     vec4 anti_epipole;
     uvec4 sizes;
     uvec4 sizes2_;
+    vec4 proj;
+    vec4 proj_g0_;
+    vec4 proj_g1_;
+    vec4 proj_g2_;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float delta;
@@ -80,18 +84,18 @@ SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_
     return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v.x, v.y, v.z, v.w);
 }
 
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float theta, float lo, float hi) {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float theta_1, float lo, float hi) {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * clamp(((theta_1 - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
 }
 
 float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_1) {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_1) - 1u)));
 }
 
-vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d, uint layer_1) {
+vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d_1, uint layer_1) {
     float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 1u));
     float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 2u));
-    return vec4(((2.0 / _e5) * cos((_e5 * d))), ((-2.0 / _e5) * sin((_e5 * d))), ((2.0 / _e10) * cos((_e10 * d))), ((-2.0 / _e10) * sin((_e10 * d))));
+    return vec4(((2.0 / _e5) * cos((_e5 * d_1))), ((-2.0 / _e5) * sin((_e5 * d_1))), ((2.0 / _e10) * cos((_e10 * d_1))), ((-2.0 / _e10) * sin((_e10 * d_1))));
 }
 
 uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_2, uint regions, uint width, bool spot) {
@@ -191,11 +195,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir,
     vec3 x_5 = (eye + (dir * t));
     vec3 to_x = (x_5 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d_1 = sqrt(d2_);
-    vec3 travel = (to_x / vec3(d_1));
+    float d_2 = sqrt(d2_);
+    vec3 travel = (to_x / vec3(d_2));
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
 vec3 pixel_dir(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5, uint x, uint y) {
@@ -264,13 +268,13 @@ uint row_index(float j, uint rows, bool wrap) {
     }
 }
 
-float ray_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7, float x_1, float delta, float theta_1, float s_1, bool spot_2) {
+float ray_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7, float x_1, float delta_1, float theta_2, float s_1, bool spot_2) {
     bool local_9 = false;
     if (spot_2) {
-        float psi = (x_1 * delta);
-        float den = sin((theta_1 + psi));
+        float psi = (x_1 * delta_1);
+        float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local_9 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
             local_9 = true;
         }
@@ -280,7 +284,7 @@ float ray_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7, float x_
         }
         return min(((f_7.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_1 * delta) / max(sin(theta_1), 1e-6)), s_1);
+        return min(((x_1 * delta_1) / max(sin(theta_2), 1e-6)), s_1);
     }
 }
 
@@ -339,7 +343,10 @@ void main() {
     bool local_2 = false;
     bool local_3 = false;
     float yc = 0.0;
+    float d = 0.0;
     float xs = 0.0;
+    float delta = 1.0;
+    float theta = 0.0;
     float pos[8] = float[8](0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     float t0_[8] = float[8](0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     float t1_[8] = float[8](0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
@@ -363,15 +370,15 @@ void main() {
     } else {
         local = true;
     }
-    bool _e17 = local;
-    if (_e17) {
+    bool _e18 = local;
+    if (_e18) {
         return;
     }
     vec3 eye_4 = f_10.eye.xyz;
-    vec3 _e20 = pixel_dir(f_10, x_6, y_2);
-    int _e24_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e24 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e24_clamped_lod) - ivec2(1)), _e24_clamped_lod);
-    float s_2 = (max(_e24.x, 0.0) / max(dot(_e20, f_10.cam_forward.xyz), 1e-6));
+    vec3 _e21 = pixel_dir(f_10, x_6, y_2);
+    int _e25_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+    vec4 _e25 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e25_clamped_lod) - ivec2(1)), _e25_clamped_lod);
+    float s_2 = (max(_e25.x, 0.0) / max(dot(_e21, f_10.cam_forward.xyz), 1e-6));
     vec3 color = f_10.light_color.xyz;
     vec3 px = vec3((float(x_6) + 0.5), (float(y_2) + 0.5), 0.0);
     float radius = f_10.epipole.w;
@@ -392,122 +399,133 @@ void main() {
     } else {
         local_3 = true;
     }
-    bool _e84 = local_3;
-    if (_e84) {
-        float _e86 = march(eye_4, _e20, s_2, true);
-        vec3 l_1 = (_e86 * color);
+    bool _e85 = local_3;
+    if (_e85) {
+        float _e87 = march(eye_4, _e21, s_2, true);
+        vec3 l_1 = (_e87 * color);
         imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_6, y_2)), vec4(l_1.x, l_1.y, l_1.z, 1.0));
         return;
     }
     vec3 axis = f_10.axis.xyz;
-    float theta_2 = acos(clamp(dot(_e20, axis), -1.0, 1.0));
-    float phi = atan(dot(_e20, f_10.e2_.xyz), dot(_e20, f_10.e1_.xyz));
     uint rows_1 = f_10.sizes.w;
-    bool wrap_1 = (f_10.anti_epipole.w > 0.5);
-    yc = ((phi - f_10.e1_.w) / f_10.e2_.w);
-    if (wrap_1) {
-        float _e122 = yc;
-        float _e123 = yc;
-        yc = (_e122 - (floor((_e123 / float(rows_1))) * float(rows_1)));
-    } else {
-        float _e130 = yc;
-        yc = clamp(_e130, 0.0, float(rows_1));
-    }
-    float _e134 = yc;
-    float yy = (_e134 - 0.5);
-    float j0_ = floor(yy);
-    float fy = (yy - j0_);
-    uint _e139 = row_index(j0_, rows_1, wrap_1);
-    vec4 _e142 = _group_0_binding_1_cs[_e139];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e143 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e142);
-    uint _e146 = row_index((j0_ + 1.0), rows_1, wrap_1);
-    vec4 _e149 = _group_0_binding_1_cs[_e146];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
-    float delta_1 = mix(_e143.delta, _e150.delta, fy);
-    float _e158 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_2, f_10.theta.x, f_10.theta.y);
-    if (true) {
-        vec3 q_2 = normalize(((eye_4 + (_e20 * s_2)) - f_10.light_pos.xyz));
-        xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / delta_1);
-    } else {
-        xs = ((s_2 * sin(theta_2)) / delta_1);
-    }
     uint width_1 = f_10.sizes.z;
-    float _e178 = xs;
-    uint last = uint(min(max(_e178, 0.0), (float(width_1) - 1.0)));
+    bool wrap_1 = (f_10.anti_epipole.w > 0.5);
+    {
+        theta = acos(clamp(dot(_e21, axis), -1.0, 1.0));
+        float phi = atan(dot(_e21, f_10.e2_.xyz), dot(_e21, f_10.e1_.xyz));
+        yc = ((phi - f_10.e1_.w) / f_10.e2_.w);
+        if (wrap_1) {
+            float _e126 = yc;
+            float _e127 = yc;
+            yc = (_e126 - (floor((_e127 / float(rows_1))) * float(rows_1)));
+        } else {
+            float _e134 = yc;
+            yc = clamp(_e134, 0.0, float(rows_1));
+        }
+        float _e138 = yc;
+        float yy = (_e138 - 0.5);
+        float j0_ = floor(yy);
+        float fy = (yy - j0_);
+        uint _e143 = row_index(j0_, rows_1, wrap_1);
+        vec4 _e146 = _group_0_binding_1_cs[_e143];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e147 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e146);
+        uint _e150 = row_index((j0_ + 1.0), rows_1, wrap_1);
+        vec4 _e153 = _group_0_binding_1_cs[_e150];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e154 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e153);
+        delta = mix(_e147.delta, _e154.delta, fy);
+        float _e159 = theta;
+        float _e164 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e159, f_10.theta.x, f_10.theta.y);
+        d = _e164;
+        if (true) {
+            vec3 q_2 = normalize(((eye_4 + (_e21 * s_2)) - f_10.light_pos.xyz));
+            float _e178 = delta;
+            xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / _e178);
+        } else {
+            float _e181 = theta;
+            float _e184 = delta;
+            xs = ((s_2 * sin(_e181)) / _e184);
+        }
+    }
+    float _e186 = xs;
+    uint last = uint(min(max(_e186, 0.0), (float(width_1) - 1.0)));
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e237 = r;
-            r = (_e237 + 1u);
+            uint _e249 = r;
+            r = (_e249 + 1u);
         }
         loop_init_3 = false;
-        uint _e188 = r;
-        if ((_e188 < REGIONS)) {
+        uint _e196 = r;
+        if ((_e196 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e190 = r;
-            uint _e191 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e190, REGIONS, width_1, true);
-            float b0_ = float(_e191);
-            uint _e193 = r;
-            uint _e196 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e193 + 1u), REGIONS, width_1, true);
-            float b1_ = float(_e196);
+            uint _e198 = r;
+            uint _e199 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, width_1, true);
+            float b0_ = float(_e199);
+            uint _e201 = r;
+            uint _e204 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e201 + 1u), REGIONS, width_1, true);
+            float b1_ = float(_e204);
             if (!((last < uint(b1_)))) {
-                uint _e201 = r;
-                local_4 = ((_e201 + 1u) == REGIONS);
+                uint _e209 = r;
+                local_4 = ((_e209 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             bool is_last = local_4;
-            uint _e210 = r;
-            float _e214 = xs;
-            pos[_e210] = (is_last ? clamp((_e214 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            uint _e224 = r;
-            float _e226 = ray_t(f_10, b0_, delta_1, theta_2, s_2, true);
-            t0_[_e224] = _e226;
-            uint _e228 = r;
-            float _e230 = ray_t(f_10, b1_, delta_1, theta_2, s_2, true);
-            t1_[_e228] = (is_last ? s_2 : _e230);
+            uint _e218 = r;
+            float _e222 = xs;
+            pos[_e218] = (is_last ? clamp((_e222 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
             uint _e232 = r;
-            count = (_e232 + 1u);
+            float _e234 = delta;
+            float _e235 = theta;
+            float _e236 = ray_t(f_10, b0_, _e234, _e235, s_2, true);
+            t0_[_e232] = _e236;
+            uint _e238 = r;
+            float _e240 = delta;
+            float _e241 = theta;
+            float _e242 = ray_t(f_10, b1_, _e240, _e241, s_2, true);
+            t1_[_e238] = (is_last ? s_2 : _e242);
+            uint _e244 = r;
+            count = (_e244 + 1u);
             if (is_last) {
                 break;
             }
         }
     }
-    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e20));
-    uint _e247 = count;
-    uint panels_1 = max(((f_10.sizes2_.z / 4u) / _e247), 1u);
+    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e21));
+    uint _e259 = count;
+    uint panels_1 = max(((f_10.sizes2_.z / 4u) / _e259), 1u);
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e336 = r_1;
-            r_1 = (_e336 + 1u);
+            uint _e349 = r_1;
+            r_1 = (_e349 + 1u);
         }
         loop_init_4 = false;
-        uint _e252 = r_1;
-        uint _e253 = count;
-        if ((_e252 < _e253)) {
+        uint _e264 = r_1;
+        uint _e265 = count;
+        if ((_e264 < _e265)) {
         } else {
             break;
         }
         {
-            uint _e255 = r_1;
-            float a_2 = t0_[_e255];
-            uint _e258 = r_1;
-            float b_2 = t1_[_e258];
+            uint _e267 = r_1;
+            float a_2 = t0_[_e267];
+            uint _e270 = r_1;
+            float b_2 = t1_[_e270];
             weight = 0.0;
             if (!(false)) {
                 weight = (b_2 - a_2);
             } else {
                 if (true) {
-                    float _e266 = spot_segment(f_10, eye_4, _e20, a_2, b_2, panels_1);
-                    weight = _e266;
+                    float _e278 = spot_segment(f_10, eye_4, _e21, a_2, b_2, panels_1);
+                    weight = _e278;
                 } else {
-                    float _e271 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-                    float _e275 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, a_2, b_2);
-                    weight = ((f_10.medium.y * _e271) * _e275);
+                    float _e283 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+                    float _e287 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, a_2, b_2);
+                    weight = ((f_10.medium.y * _e283) * _e287);
                 }
             }
             vis = 0.5;
@@ -515,74 +533,75 @@ void main() {
             bool loop_init_5 = true;
             while(true) {
                 if (!loop_init_5) {
-                    uint _e320 = layer;
-                    layer = (_e320 + 1u);
+                    uint _e333 = layer;
+                    layer = (_e333 + 1u);
                 }
                 loop_init_5 = false;
-                uint _e281 = layer;
-                if ((_e281 < LAYERS)) {
+                uint _e293 = layer;
+                if ((_e293 < LAYERS)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e284 = layer;
-                    vec4 _e285 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e158, _e284);
-                    uint _e286 = r_1;
-                    float _e288 = pos[_e286];
-                    float _e291 = yc;
-                    uint _e295 = layer;
-                    vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e288 / float(width_1)), (_e291 / float(rows_1))), _e295), 0.0);
+                    float _e296 = d;
+                    uint _e297 = layer;
+                    vec4 _e298 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e296, _e297);
+                    uint _e299 = r_1;
+                    float _e301 = pos[_e299];
+                    float _e304 = yc;
+                    uint _e308 = layer;
+                    vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e301 / float(width_1)), (_e304 / float(rows_1))), _e308), 0.0);
                     k = 0u;
                     bool loop_init_6 = true;
                     while(true) {
                         if (!loop_init_6) {
-                            uint _e317 = k;
-                            k = (_e317 + 1u);
+                            uint _e330 = k;
+                            k = (_e330 + 1u);
                         }
                         loop_init_6 = false;
-                        uint _e302 = k;
-                        if ((_e302 < 4u)) {
+                        uint _e315 = k;
+                        if ((_e315 < 4u)) {
                         } else {
                             break;
                         }
                         {
-                            float _e305 = vis;
-                            uint _e306 = k;
-                            uint _e308 = k;
-                            vis = (_e305 + (_e285[_e306] * ((texel_1[_e308] * 2.0) - 1.0)));
+                            float _e318 = vis;
+                            uint _e319 = k;
+                            uint _e321 = k;
+                            vis = (_e318 + (_e298[_e319] * ((texel_1[_e321] * 2.0) - 1.0)));
                         }
                     }
                 }
             }
-            float _e323 = total;
-            float _e324 = weight;
-            float _e325 = vis;
-            total = (_e323 + (_e324 * clamp(_e325, 0.0, 1.0)));
-            float _e332 = norm;
-            float _e333 = weight;
-            norm = (_e332 + _e333);
+            float _e336 = total;
+            float _e337 = weight;
+            float _e338 = vis;
+            total = (_e336 + (_e337 * clamp(_e338, 0.0, 1.0)));
+            float _e345 = norm;
+            float _e346 = weight;
+            norm = (_e345 + _e346);
         }
     }
     if (false) {
-        float _e338 = total;
-        l = _e338;
+        float _e351 = total;
+        l = _e351;
     } else {
         if (true) {
-            float _e347 = spot_segment(f_10, eye_4, _e20, 0.0, s_2, max((f_10.sizes2_.z / 4u), 1u));
-            unshadowed = _e347;
+            float _e360 = spot_segment(f_10, eye_4, _e21, 0.0, s_2, max((f_10.sizes2_.z / 4u), 1u));
+            unshadowed = _e360;
         } else {
-            float _e353 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-            float _e357 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, s_2);
-            unshadowed = ((f_10.medium.y * _e353) * _e357);
+            float _e366 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+            float _e370 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, s_2);
+            unshadowed = ((f_10.medium.y * _e366) * _e370);
         }
-        float _e359 = unshadowed;
-        float _e360 = total;
-        float _e361 = norm;
-        float _e363 = norm;
-        l = (_e359 * ((_e363 > 0.0) ? (_e360 / _e361) : 1.0));
+        float _e372 = unshadowed;
+        float _e373 = total;
+        float _e374 = norm;
+        float _e376 = norm;
+        l = (_e372 * ((_e376 > 0.0) ? (_e373 / _e374) : 1.0));
     }
-    float _e369 = l;
-    vec3 c = (color * _e369);
+    float _e382 = l;
+    vec3 c = (color * _e382);
     imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_6, y_2)), vec4(c.x, c.y, c.z, 1.0));
     return;
 }

@@ -22,6 +22,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     anti_epipole: vec4<f32>,
     sizes: vec4<u32>,
     sizes2_: vec4<u32>,
+    proj: vec4<f32>,
+    proj_g0_: vec4<f32>,
+    proj_g1_: vec4<f32>,
+    proj_g2_: vec4<f32>,
 }
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
@@ -79,18 +83,18 @@ fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v: vec4<f32>) -
     return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v.x, v.y, v.z, v.w);
 }
 
-fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta: f32, lo: f32, hi: f32) -> f32 {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8f * clamp(((theta - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
+fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_1: f32, lo: f32, hi: f32) -> f32 {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8f * clamp(((theta_1 - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
 }
 
 fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_1: u32) -> f32 {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_1) - 1u)));
 }
 
-fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d: f32, layer_1: u32) -> vec4<f32> {
+fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_1: f32, layer_1: u32) -> vec4<f32> {
     let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 1u));
     let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 2u));
-    return vec4<f32>(((2f / _e5) * cos((_e5 * d))), ((-2f / _e5) * sin((_e5 * d))), ((2f / _e10) * cos((_e10 * d))), ((-2f / _e10) * sin((_e10 * d))));
+    return vec4<f32>(((2f / _e5) * cos((_e5 * d_1))), ((-2f / _e5) * sin((_e5 * d_1))), ((2f / _e10) * cos((_e10 * d_1))), ((-2f / _e10) * sin((_e10 * d_1))));
 }
 
 fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_2: u32, regions: u32, width: u32, spot: bool) -> u32 {
@@ -192,11 +196,11 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     let x_5 = (eye + (dir * t));
     let to_x = (x_5 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
-    let d_1 = sqrt(d2_);
-    let travel = (to_x / vec3(d_1));
+    let d_2 = sqrt(d2_);
+    let travel = (to_x / vec3(d_2));
     let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
 fn pixel_dir(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x: u32, y: u32) -> vec3<f32> {
@@ -264,14 +268,14 @@ fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
     }
 }
 
-fn ray_t(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_1: f32, delta: f32, theta_1: f32, s_1: f32, spot_2: bool) -> f32 {
+fn ray_t(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_1: f32, delta_1: f32, theta_2: f32, s_1: f32, spot_2: bool) -> f32 {
     var local_9: bool;
 
     if spot_2 {
-        let psi = (x_1 * delta);
-        let den = sin((theta_1 + psi));
+        let psi = (x_1 * delta_1);
+        let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
-            local_9 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
             local_9 = true;
         }
@@ -281,7 +285,7 @@ fn ray_t(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_1: f32, 
         }
         return min(((f_7.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_1 * delta) / max(sin(theta_1), 0.000001f)), s_1);
+        return min(((x_1 * delta_1) / max(sin(theta_2), 0.000001f)), s_1);
     }
 }
 
@@ -337,7 +341,10 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     var local_2: bool;
     var local_3: bool;
     var yc: f32;
+    var d: f32;
     var xs: f32;
+    var delta: f32 = 1f;
+    var theta: f32 = 0f;
     var pos: array<f32, 8>;
     var t0_: array<f32, 8>;
     var t1_: array<f32, 8>;
@@ -362,14 +369,14 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         local = true;
     }
-    let _e17 = local;
-    if _e17 {
+    let _e18 = local;
+    if _e18 {
         return;
     }
     let eye_4 = f_10.eye.xyz;
-    let _e20 = pixel_dir(f_10, x_6, y_2);
-    let _e24 = textureLoad(depth, vec2<u32>(x_6, y_2), 0i);
-    let s_2 = (max(_e24.x, 0f) / max(dot(_e20, f_10.cam_forward.xyz), 0.000001f));
+    let _e21 = pixel_dir(f_10, x_6, y_2);
+    let _e25 = textureLoad(depth, vec2<u32>(x_6, y_2), 0i);
+    let s_2 = (max(_e25.x, 0f) / max(dot(_e21, f_10.cam_forward.xyz), 0.000001f));
     let color = f_10.light_color.xyz;
     let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_2) + 0.5f), 0f);
     let radius = f_10.epipole.w;
@@ -390,189 +397,201 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         local_3 = true;
     }
-    let _e84 = local_3;
-    if _e84 {
-        let _e86 = march(eye_4, _e20, s_2, true);
-        let l_1 = (_e86 * color);
+    let _e85 = local_3;
+    if _e85 {
+        let _e87 = march(eye_4, _e21, s_2, true);
+        let l_1 = (_e87 * color);
         textureStore(output, vec2<u32>(x_6, y_2), vec4<f32>(l_1.x, l_1.y, l_1.z, 1f));
         return;
     }
     let axis = f_10.axis.xyz;
-    let theta_2 = acos(clamp(dot(_e20, axis), -1f, 1f));
-    let phi = atan2(dot(_e20, f_10.e2_.xyz), dot(_e20, f_10.e1_.xyz));
     let rows_1 = f_10.sizes.w;
-    let wrap_1 = (f_10.anti_epipole.w > 0.5f);
-    yc = ((phi - f_10.e1_.w) / f_10.e2_.w);
-    if wrap_1 {
-        let _e122 = yc;
-        let _e123 = yc;
-        yc = (_e122 - (floor((_e123 / f32(rows_1))) * f32(rows_1)));
-    } else {
-        let _e130 = yc;
-        yc = clamp(_e130, 0f, f32(rows_1));
-    }
-    let _e134 = yc;
-    let yy = (_e134 - 0.5f);
-    let j0_ = floor(yy);
-    let fy = (yy - j0_);
-    let _e139 = row_index(j0_, rows_1, wrap_1);
-    let _e142 = slices[_e139];
-    let _e143 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e142);
-    let _e146 = row_index((j0_ + 1f), rows_1, wrap_1);
-    let _e149 = slices[_e146];
-    let _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
-    let delta_1 = mix(_e143.delta, _e150.delta, fy);
-    let _e158 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_2, f_10.theta.x, f_10.theta.y);
-    if true {
-        let q_2 = normalize(((eye_4 + (_e20 * s_2)) - f_10.light_pos.xyz));
-        xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / delta_1);
-    } else {
-        xs = ((s_2 * sin(theta_2)) / delta_1);
-    }
     let width_1 = f_10.sizes.z;
-    let _e178 = xs;
-    let last = u32(min(max(_e178, 0f), (f32(width_1) - 1f)));
+    let wrap_1 = (f_10.anti_epipole.w > 0.5f);
+    {
+        theta = acos(clamp(dot(_e21, axis), -1f, 1f));
+        let phi = atan2(dot(_e21, f_10.e2_.xyz), dot(_e21, f_10.e1_.xyz));
+        yc = ((phi - f_10.e1_.w) / f_10.e2_.w);
+        if wrap_1 {
+            let _e126 = yc;
+            let _e127 = yc;
+            yc = (_e126 - (floor((_e127 / f32(rows_1))) * f32(rows_1)));
+        } else {
+            let _e134 = yc;
+            yc = clamp(_e134, 0f, f32(rows_1));
+        }
+        let _e138 = yc;
+        let yy = (_e138 - 0.5f);
+        let j0_ = floor(yy);
+        let fy = (yy - j0_);
+        let _e143 = row_index(j0_, rows_1, wrap_1);
+        let _e146 = slices[_e143];
+        let _e147 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e146);
+        let _e150 = row_index((j0_ + 1f), rows_1, wrap_1);
+        let _e153 = slices[_e150];
+        let _e154 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e153);
+        delta = mix(_e147.delta, _e154.delta, fy);
+        let _e159 = theta;
+        let _e164 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e159, f_10.theta.x, f_10.theta.y);
+        d = _e164;
+        if true {
+            let q_2 = normalize(((eye_4 + (_e21 * s_2)) - f_10.light_pos.xyz));
+            let _e178 = delta;
+            xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / _e178);
+        } else {
+            let _e181 = theta;
+            let _e184 = delta;
+            xs = ((s_2 * sin(_e181)) / _e184);
+        }
+    }
+    let _e186 = xs;
+    let last = u32(min(max(_e186, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e188 = r;
-        if (_e188 < REGIONS) {
+        let _e196 = r;
+        if (_e196 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e190 = r;
-            let _e191 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e190, REGIONS, width_1, true);
-            let b0_ = f32(_e191);
-            let _e193 = r;
-            let _e196 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e193 + 1u), REGIONS, width_1, true);
-            let b1_ = f32(_e196);
+            let _e198 = r;
+            let _e199 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, width_1, true);
+            let b0_ = f32(_e199);
+            let _e201 = r;
+            let _e204 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e201 + 1u), REGIONS, width_1, true);
+            let b1_ = f32(_e204);
             if !((last < u32(b1_))) {
-                let _e201 = r;
-                local_4 = ((_e201 + 1u) == REGIONS);
+                let _e209 = r;
+                local_4 = ((_e209 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             let is_last = local_4;
-            let _e210 = r;
-            let _e214 = xs;
-            pos[_e210] = select((b1_ - 0.5f), clamp((_e214 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
-            let _e224 = r;
-            let _e226 = ray_t(f_10, b0_, delta_1, theta_2, s_2, true);
-            t0_[_e224] = _e226;
-            let _e228 = r;
-            let _e230 = ray_t(f_10, b1_, delta_1, theta_2, s_2, true);
-            t1_[_e228] = select(_e230, s_2, is_last);
+            let _e218 = r;
+            let _e222 = xs;
+            pos[_e218] = select((b1_ - 0.5f), clamp((_e222 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
             let _e232 = r;
-            count = (_e232 + 1u);
+            let _e234 = delta;
+            let _e235 = theta;
+            let _e236 = ray_t(f_10, b0_, _e234, _e235, s_2, true);
+            t0_[_e232] = _e236;
+            let _e238 = r;
+            let _e240 = delta;
+            let _e241 = theta;
+            let _e242 = ray_t(f_10, b1_, _e240, _e241, s_2, true);
+            t1_[_e238] = select(_e242, s_2, is_last);
+            let _e244 = r;
+            count = (_e244 + 1u);
             if is_last {
                 break;
             }
         }
         continuing {
-            let _e237 = r;
-            r = (_e237 + 1u);
+            let _e249 = r;
+            r = (_e249 + 1u);
         }
     }
-    let cos_theta_l = -(dot(f_10.light_dir.xyz, _e20));
-    let _e247 = count;
-    let panels_1 = max(((f_10.sizes2_.z / 4u) / _e247), 1u);
+    let cos_theta_l = -(dot(f_10.light_dir.xyz, _e21));
+    let _e259 = count;
+    let panels_1 = max(((f_10.sizes2_.z / 4u) / _e259), 1u);
     loop {
-        let _e252 = r_1;
-        let _e253 = count;
-        if (_e252 < _e253) {
+        let _e264 = r_1;
+        let _e265 = count;
+        if (_e264 < _e265) {
         } else {
             break;
         }
         {
-            let _e255 = r_1;
-            let a_2 = t0_[_e255];
-            let _e258 = r_1;
-            let b_2 = t1_[_e258];
+            let _e267 = r_1;
+            let a_2 = t0_[_e267];
+            let _e270 = r_1;
+            let b_2 = t1_[_e270];
             weight = f32();
             if !(false) {
                 weight = (b_2 - a_2);
             } else {
                 if true {
-                    let _e266 = spot_segment(f_10, eye_4, _e20, a_2, b_2, panels_1);
-                    weight = _e266;
+                    let _e278 = spot_segment(f_10, eye_4, _e21, a_2, b_2, panels_1);
+                    weight = _e278;
                 } else {
-                    let _e271 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-                    let _e275 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, a_2, b_2);
-                    weight = ((f_10.medium.y * _e271) * _e275);
+                    let _e283 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+                    let _e287 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, a_2, b_2);
+                    weight = ((f_10.medium.y * _e283) * _e287);
                 }
             }
             vis = 0.5f;
             layer = 0u;
             loop {
-                let _e281 = layer;
-                if (_e281 < LAYERS) {
+                let _e293 = layer;
+                if (_e293 < LAYERS) {
                 } else {
                     break;
                 }
                 {
-                    let _e284 = layer;
-                    let _e285 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e158, _e284);
-                    let _e286 = r_1;
-                    let _e288 = pos[_e286];
-                    let _e291 = yc;
-                    let _e295 = layer;
-                    let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e288 / f32(width_1)), (_e291 / f32(rows_1))), _e295, 0f);
+                    let _e296 = d;
+                    let _e297 = layer;
+                    let _e298 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e296, _e297);
+                    let _e299 = r_1;
+                    let _e301 = pos[_e299];
+                    let _e304 = yc;
+                    let _e308 = layer;
+                    let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e301 / f32(width_1)), (_e304 / f32(rows_1))), _e308, 0f);
                     k = 0u;
                     loop {
-                        let _e302 = k;
-                        if (_e302 < 4u) {
+                        let _e315 = k;
+                        if (_e315 < 4u) {
                         } else {
                             break;
                         }
                         {
-                            let _e305 = vis;
-                            let _e306 = k;
-                            let _e308 = k;
-                            vis = (_e305 + (_e285[_e306] * ((texel_1[_e308] * 2f) - 1f)));
+                            let _e318 = vis;
+                            let _e319 = k;
+                            let _e321 = k;
+                            vis = (_e318 + (_e298[_e319] * ((texel_1[_e321] * 2f) - 1f)));
                         }
                         continuing {
-                            let _e317 = k;
-                            k = (_e317 + 1u);
+                            let _e330 = k;
+                            k = (_e330 + 1u);
                         }
                     }
                 }
                 continuing {
-                    let _e320 = layer;
-                    layer = (_e320 + 1u);
+                    let _e333 = layer;
+                    layer = (_e333 + 1u);
                 }
             }
-            let _e323 = total;
-            let _e324 = weight;
-            let _e325 = vis;
-            total = (_e323 + (_e324 * clamp(_e325, 0f, 1f)));
-            let _e332 = norm;
-            let _e333 = weight;
-            norm = (_e332 + _e333);
+            let _e336 = total;
+            let _e337 = weight;
+            let _e338 = vis;
+            total = (_e336 + (_e337 * clamp(_e338, 0f, 1f)));
+            let _e345 = norm;
+            let _e346 = weight;
+            norm = (_e345 + _e346);
         }
         continuing {
-            let _e336 = r_1;
-            r_1 = (_e336 + 1u);
+            let _e349 = r_1;
+            r_1 = (_e349 + 1u);
         }
     }
     if false {
-        let _e338 = total;
-        l = _e338;
+        let _e351 = total;
+        l = _e351;
     } else {
         if true {
-            let _e347 = spot_segment(f_10, eye_4, _e20, 0f, s_2, max((f_10.sizes2_.z / 4u), 1u));
-            unshadowed = _e347;
+            let _e360 = spot_segment(f_10, eye_4, _e21, 0f, s_2, max((f_10.sizes2_.z / 4u), 1u));
+            unshadowed = _e360;
         } else {
-            let _e353 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-            let _e357 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, s_2);
-            unshadowed = ((f_10.medium.y * _e353) * _e357);
+            let _e366 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+            let _e370 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, s_2);
+            unshadowed = ((f_10.medium.y * _e366) * _e370);
         }
-        let _e359 = unshadowed;
-        let _e360 = total;
-        let _e361 = norm;
-        let _e363 = norm;
-        l = (_e359 * select(1f, (_e360 / _e361), (_e363 > 0f)));
+        let _e372 = unshadowed;
+        let _e373 = total;
+        let _e374 = norm;
+        let _e376 = norm;
+        l = (_e372 * select(1f, (_e373 / _e374), (_e376 > 0f)));
     }
-    let _e369 = l;
-    let c = (color * _e369);
+    let _e382 = l;
+    let c = (color * _e382);
     textureStore(output, vec2<u32>(x_6, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

@@ -32,6 +32,10 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     metal::float4 anti_epipole;
     metal::uint4 sizes;
     metal::uint4 sizes2_;
+    metal::float4 proj;
+    metal::float4 proj_g0_;
+    metal::float4 proj_g1_;
+    metal::float4 proj_g2_;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float delta;
@@ -93,11 +97,11 @@ SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_
 }
 
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    float theta,
+    float theta_1,
     float lo,
     float hi
 ) {
-    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * metal::clamp((theta - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
+    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * metal::clamp((theta_1 - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
 }
 
 float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -107,12 +111,12 @@ float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 }
 
 metal::float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    float d,
+    float d_1,
     uint layer_1
 ) {
     float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_1) + 1u);
     float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_1) + 2u);
-    return metal::float4((2.0 / _e5) * metal::cos(_e5 * d), (-2.0 / _e5) * metal::sin(_e5 * d), (2.0 / _e10) * metal::cos(_e10 * d), (-2.0 / _e10) * metal::sin(_e10 * d));
+    return metal::float4((2.0 / _e5) * metal::cos(_e5 * d_1), (-2.0 / _e5) * metal::sin(_e5 * d_1), (2.0 / _e10) * metal::cos(_e10 * d_1), (-2.0 / _e10) * metal::sin(_e10 * d_1));
 }
 
 uint naga_div(uint lhs, uint rhs) {
@@ -254,11 +258,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 x_5 = eye + (dir * t);
     metal::float3 to_x = x_5 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
-    float d_1 = metal::sqrt(d2_);
-    metal::float3 travel = to_x / metal::float3(d_1);
+    float d_2 = metal::sqrt(d2_);
+    metal::float3 travel = to_x / metal::float3(d_2);
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_1 + t))) / d2_;
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_2 + t))) / d2_;
 }
 
 metal::float3 pixel_dir(
@@ -362,17 +366,17 @@ uint row_index(
 float ray_t(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7,
     float x_1,
-    float delta,
-    float theta_1,
+    float delta_1,
+    float theta_2,
     float s_1,
     bool spot_2
 ) {
     bool local_9 = {};
     if (spot_2) {
-        float psi = x_1 * delta;
-        float den = metal::sin(theta_1 + psi);
+        float psi = x_1 * delta_1;
+        float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
-            local_9 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_9 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
             local_9 = true;
         }
@@ -382,7 +386,7 @@ float ray_t(
         }
         return metal::min((f_7.axis.w * metal::sin(psi)) / den, s_1);
     } else {
-        return metal::min((x_1 * delta) / metal::max(metal::sin(theta_1), 0.000001), s_1);
+        return metal::min((x_1 * delta_1) / metal::max(metal::sin(theta_2), 0.000001), s_1);
     }
 }
 
@@ -465,7 +469,10 @@ kernel void scatter(
     bool local_2 = {};
     bool local_3 = {};
     float yc = {};
+    float d = {};
     float xs = {};
+    float delta = 1.0;
+    float theta = 0.0;
     type_15 pos = {};
     type_15 t0_ = {};
     type_15 t1_ = {};
@@ -489,15 +496,15 @@ kernel void scatter(
     } else {
         local = true;
     }
-    bool _e17 = local;
-    if (_e17) {
+    bool _e18 = local;
+    if (_e18) {
         return;
     }
     metal::float3 eye_4 = f_10.eye.xyz;
-    metal::float3 _e20 = pixel_dir(f_10, x_6, y_2);
-    uint clamped_lod_e24 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e24 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_2)), metal::uint2(depth.get_width(clamped_lod_e24), depth.get_height(clamped_lod_e24)) - 1), clamped_lod_e24);
-    float s_2 = metal::max(_e24.x, 0.0) / metal::max(metal::dot(_e20, f_10.cam_forward.xyz), 0.000001);
+    metal::float3 _e21 = pixel_dir(f_10, x_6, y_2);
+    uint clamped_lod_e25 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e25 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_2)), metal::uint2(depth.get_width(clamped_lod_e25), depth.get_height(clamped_lod_e25)) - 1), clamped_lod_e25);
+    float s_2 = metal::max(_e25.x, 0.0) / metal::max(metal::dot(_e21, f_10.cam_forward.xyz), 0.000001);
     metal::float3 color = f_10.light_color.xyz;
     metal::float3 px = metal::float3(static_cast<float>(x_6) + 0.5, static_cast<float>(y_2) + 0.5, 0.0);
     float radius = f_10.epipole.w;
@@ -518,128 +525,139 @@ kernel void scatter(
     } else {
         local_3 = true;
     }
-    bool _e84 = local_3;
-    if (_e84) {
-        float _e86 = march(eye_4, _e20, s_2, false, frame, shadow_map);
-        metal::float3 l_1 = _e86 * color;
+    bool _e85 = local_3;
+    if (_e85) {
+        float _e87 = march(eye_4, _e21, s_2, false, frame, shadow_map);
+        metal::float3 l_1 = _e87 * color;
         output.write(metal::float4(l_1.x, l_1.y, l_1.z, 1.0), metal::uint2(metal::uint2(x_6, y_2)));
         return;
     }
     metal::float3 axis = f_10.axis.xyz;
-    float theta_2 = metal::acos(metal::clamp(metal::dot(_e20, axis), -1.0, 1.0));
-    float phi = metal::atan2(metal::dot(_e20, f_10.e2_.xyz), metal::dot(_e20, f_10.e1_.xyz));
     uint rows_1 = f_10.sizes.w;
-    bool wrap_1 = f_10.anti_epipole.w > 0.5;
-    yc = (phi - f_10.e1_.w) / f_10.e2_.w;
-    if (wrap_1) {
-        float _e122 = yc;
-        float _e123 = yc;
-        yc = _e122 - (metal::floor(_e123 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
-    } else {
-        float _e130 = yc;
-        yc = metal::clamp(_e130, 0.0, static_cast<float>(rows_1));
-    }
-    float _e134 = yc;
-    float yy = _e134 - 0.5;
-    float j0_ = metal::floor(yy);
-    float fy = yy - j0_;
-    uint _e139 = row_index(j0_, rows_1, wrap_1);
-    metal::float4 _e142 = slices[metal::min(unsigned(_e139), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e143 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e142);
-    uint _e146 = row_index(j0_ + 1.0, rows_1, wrap_1);
-    metal::float4 _e149 = slices[metal::min(unsigned(_e146), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
-    float delta_1 = metal::mix(_e143.delta, _e150.delta, fy);
-    float _e158 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_2, f_10.theta.x, f_10.theta.y);
-    if (false) {
-        metal::float3 q_2 = metal::normalize((eye_4 + (_e20 * s_2)) - f_10.light_pos.xyz);
-        xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / delta_1;
-    } else {
-        xs = (s_2 * metal::sin(theta_2)) / delta_1;
-    }
     uint width_1 = f_10.sizes.z;
-    float _e178 = xs;
-    uint last = naga_f2u32(metal::min(metal::max(_e178, 0.0), static_cast<float>(width_1) - 1.0));
+    bool wrap_1 = f_10.anti_epipole.w > 0.5;
+    {
+        theta = metal::acos(metal::clamp(metal::dot(_e21, axis), -1.0, 1.0));
+        float phi = metal::atan2(metal::dot(_e21, f_10.e2_.xyz), metal::dot(_e21, f_10.e1_.xyz));
+        yc = (phi - f_10.e1_.w) / f_10.e2_.w;
+        if (wrap_1) {
+            float _e126 = yc;
+            float _e127 = yc;
+            yc = _e126 - (metal::floor(_e127 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+        } else {
+            float _e134 = yc;
+            yc = metal::clamp(_e134, 0.0, static_cast<float>(rows_1));
+        }
+        float _e138 = yc;
+        float yy = _e138 - 0.5;
+        float j0_ = metal::floor(yy);
+        float fy = yy - j0_;
+        uint _e143 = row_index(j0_, rows_1, wrap_1);
+        metal::float4 _e146 = slices[metal::min(unsigned(_e143), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e147 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e146);
+        uint _e150 = row_index(j0_ + 1.0, rows_1, wrap_1);
+        metal::float4 _e153 = slices[metal::min(unsigned(_e150), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e154 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e153);
+        delta = metal::mix(_e147.delta, _e154.delta, fy);
+        float _e159 = theta;
+        float _e164 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e159, f_10.theta.x, f_10.theta.y);
+        d = _e164;
+        if (false) {
+            metal::float3 q_2 = metal::normalize((eye_4 + (_e21 * s_2)) - f_10.light_pos.xyz);
+            float _e178 = delta;
+            xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / _e178;
+        } else {
+            float _e181 = theta;
+            float _e184 = delta;
+            xs = (s_2 * metal::sin(_e181)) / _e184;
+        }
+    }
+    float _e186 = xs;
+    uint last = naga_f2u32(metal::min(metal::max(_e186, 0.0), static_cast<float>(width_1) - 1.0));
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e237 = r;
-            r = _e237 + 1u;
+            uint _e249 = r;
+            r = _e249 + 1u;
         }
         loop_init_3 = false;
-        uint _e188 = r;
-        if (_e188 < REGIONS) {
+        uint _e196 = r;
+        if (_e196 < REGIONS) {
         } else {
             break;
         }
         {
-            uint _e190 = r;
-            uint _e191 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e190, REGIONS, width_1, false);
-            float b0_ = static_cast<float>(_e191);
-            uint _e193 = r;
-            uint _e196 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e193 + 1u, REGIONS, width_1, false);
-            float b1_ = static_cast<float>(_e196);
+            uint _e198 = r;
+            uint _e199 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, width_1, false);
+            float b0_ = static_cast<float>(_e199);
+            uint _e201 = r;
+            uint _e204 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e201 + 1u, REGIONS, width_1, false);
+            float b1_ = static_cast<float>(_e204);
             if (!((last < naga_f2u32(b1_)))) {
-                uint _e201 = r;
-                local_4 = (_e201 + 1u) == REGIONS;
+                uint _e209 = r;
+                local_4 = (_e209 + 1u) == REGIONS;
             } else {
                 local_4 = true;
             }
             bool is_last = local_4;
-            uint _e210 = r;
-            float _e214 = xs;
-            pos.inner[metal::min(unsigned(_e210), 7u)] = is_last ? metal::clamp(_e214 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-            uint _e224 = r;
-            float _e226 = ray_t(f_10, b0_, delta_1, theta_2, s_2, false);
-            t0_.inner[metal::min(unsigned(_e224), 7u)] = _e226;
-            uint _e228 = r;
-            float _e230 = ray_t(f_10, b1_, delta_1, theta_2, s_2, false);
-            t1_.inner[metal::min(unsigned(_e228), 7u)] = is_last ? s_2 : _e230;
+            uint _e218 = r;
+            float _e222 = xs;
+            pos.inner[metal::min(unsigned(_e218), 7u)] = is_last ? metal::clamp(_e222 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
             uint _e232 = r;
-            count = _e232 + 1u;
+            float _e234 = delta;
+            float _e235 = theta;
+            float _e236 = ray_t(f_10, b0_, _e234, _e235, s_2, false);
+            t0_.inner[metal::min(unsigned(_e232), 7u)] = _e236;
+            uint _e238 = r;
+            float _e240 = delta;
+            float _e241 = theta;
+            float _e242 = ray_t(f_10, b1_, _e240, _e241, s_2, false);
+            t1_.inner[metal::min(unsigned(_e238), 7u)] = is_last ? s_2 : _e242;
+            uint _e244 = r;
+            count = _e244 + 1u;
             if (is_last) {
                 break;
             }
         }
     }
-    float cos_theta_l = -(metal::dot(f_10.light_dir.xyz, _e20));
-    uint _e247 = count;
-    uint panels_1 = metal::max(naga_div(naga_div(f_10.sizes2_.z, 4u), _e247), 1u);
+    float cos_theta_l = -(metal::dot(f_10.light_dir.xyz, _e21));
+    uint _e259 = count;
+    uint panels_1 = metal::max(naga_div(naga_div(f_10.sizes2_.z, 4u), _e259), 1u);
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e336 = r_1;
-            r_1 = _e336 + 1u;
+            uint _e349 = r_1;
+            r_1 = _e349 + 1u;
         }
         loop_init_4 = false;
-        uint _e252 = r_1;
-        uint _e253 = count;
-        if (_e252 < _e253) {
+        uint _e264 = r_1;
+        uint _e265 = count;
+        if (_e264 < _e265) {
         } else {
             break;
         }
         {
-            uint _e255 = r_1;
-            float a_2 = t0_.inner[metal::min(unsigned(_e255), 7u)];
-            uint _e258 = r_1;
-            float b_2 = t1_.inner[metal::min(unsigned(_e258), 7u)];
+            uint _e267 = r_1;
+            float a_2 = t0_.inner[metal::min(unsigned(_e267), 7u)];
+            uint _e270 = r_1;
+            float b_2 = t1_.inner[metal::min(unsigned(_e270), 7u)];
             weight = float {};
             if (!(true)) {
                 weight = b_2 - a_2;
             } else {
                 if (false) {
-                    float _e266 = spot_segment(f_10, eye_4, _e20, a_2, b_2, panels_1);
-                    weight = _e266;
+                    float _e278 = spot_segment(f_10, eye_4, _e21, a_2, b_2, panels_1);
+                    weight = _e278;
                 } else {
-                    float _e271 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-                    float _e275 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, a_2, b_2);
-                    weight = (f_10.medium.y * _e271) * _e275;
+                    float _e283 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+                    float _e287 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, a_2, b_2);
+                    weight = (f_10.medium.y * _e283) * _e287;
                 }
             }
             vis = 0.5;
@@ -650,23 +668,24 @@ kernel void scatter(
                 if (metal::all(loop_bound_5 == uint2(0u))) { break; }
                 loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                 if (!loop_init_5) {
-                    uint _e320 = layer;
-                    layer = _e320 + 1u;
+                    uint _e333 = layer;
+                    layer = _e333 + 1u;
                 }
                 loop_init_5 = false;
-                uint _e281 = layer;
-                if (_e281 < LAYERS) {
+                uint _e293 = layer;
+                if (_e293 < LAYERS) {
                 } else {
                     break;
                 }
                 {
-                    uint _e284 = layer;
-                    metal::float4 _e285 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e158, _e284);
-                    uint _e286 = r_1;
-                    float _e288 = pos.inner[metal::min(unsigned(_e286), 7u)];
-                    float _e291 = yc;
-                    uint _e295 = layer;
-                    metal::float4 texel_1 = filtered.sample(filtered_sampler, metal::float2(_e288 / static_cast<float>(width_1), _e291 / static_cast<float>(rows_1)), _e295, metal::level(0.0));
+                    float _e296 = d;
+                    uint _e297 = layer;
+                    metal::float4 _e298 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e296, _e297);
+                    uint _e299 = r_1;
+                    float _e301 = pos.inner[metal::min(unsigned(_e299), 7u)];
+                    float _e304 = yc;
+                    uint _e308 = layer;
+                    metal::float4 texel_1 = filtered.sample(filtered_sampler, metal::float2(_e301 / static_cast<float>(width_1), _e304 / static_cast<float>(rows_1)), _e308, metal::level(0.0));
                     k = 0u;
                     uint2 loop_bound_6 = uint2(4294967295u);
                     bool loop_init_6 = true;
@@ -674,53 +693,53 @@ kernel void scatter(
                         if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                         if (!loop_init_6) {
-                            uint _e317 = k;
-                            k = _e317 + 1u;
+                            uint _e330 = k;
+                            k = _e330 + 1u;
                         }
                         loop_init_6 = false;
-                        uint _e302 = k;
-                        if (_e302 < 4u) {
+                        uint _e315 = k;
+                        if (_e315 < 4u) {
                         } else {
                             break;
                         }
                         {
-                            float _e305 = vis;
-                            uint _e306 = k;
-                            uint _e308 = k;
-                            vis = _e305 + (_e285[metal::min(unsigned(_e306), 3u)] * ((texel_1[metal::min(unsigned(_e308), 3u)] * 2.0) - 1.0));
+                            float _e318 = vis;
+                            uint _e319 = k;
+                            uint _e321 = k;
+                            vis = _e318 + (_e298[metal::min(unsigned(_e319), 3u)] * ((texel_1[metal::min(unsigned(_e321), 3u)] * 2.0) - 1.0));
                         }
                     }
                 }
             }
-            float _e323 = total;
-            float _e324 = weight;
-            float _e325 = vis;
-            total = _e323 + (_e324 * metal::clamp(_e325, 0.0, 1.0));
-            float _e332 = norm;
-            float _e333 = weight;
-            norm = _e332 + _e333;
+            float _e336 = total;
+            float _e337 = weight;
+            float _e338 = vis;
+            total = _e336 + (_e337 * metal::clamp(_e338, 0.0, 1.0));
+            float _e345 = norm;
+            float _e346 = weight;
+            norm = _e345 + _e346;
         }
     }
     if (true) {
-        float _e338 = total;
-        l = _e338;
+        float _e351 = total;
+        l = _e351;
     } else {
         if (false) {
-            float _e347 = spot_segment(f_10, eye_4, _e20, 0.0, s_2, metal::max(naga_div(f_10.sizes2_.z, 4u), 1u));
-            unshadowed = _e347;
+            float _e360 = spot_segment(f_10, eye_4, _e21, 0.0, s_2, metal::max(naga_div(f_10.sizes2_.z, 4u), 1u));
+            unshadowed = _e360;
         } else {
-            float _e353 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-            float _e357 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, s_2);
-            unshadowed = (f_10.medium.y * _e353) * _e357;
+            float _e366 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+            float _e370 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, s_2);
+            unshadowed = (f_10.medium.y * _e366) * _e370;
         }
-        float _e359 = unshadowed;
-        float _e360 = total;
-        float _e361 = norm;
-        float _e363 = norm;
-        l = _e359 * ((_e363 > 0.0) ? (_e360 / _e361) : 1.0);
+        float _e372 = unshadowed;
+        float _e373 = total;
+        float _e374 = norm;
+        float _e376 = norm;
+        l = _e372 * ((_e376 > 0.0) ? (_e373 / _e374) : 1.0);
     }
-    float _e369 = l;
-    metal::float3 c = color * _e369;
+    float _e382 = l;
+    metal::float3 c = color * _e382;
     output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_6, y_2)));
     return;
 }

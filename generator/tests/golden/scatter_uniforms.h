@@ -16,7 +16,7 @@
 #define SCATTER_STATIC_ASSERT(cond, msg) _Static_assert(cond, msg)
 #endif
 
-/* WGSL `Frame` of family prefiltered (scatter::prefiltered), 336 bytes, alignment 16. */
+/* WGSL `Frame` of family prefiltered (scatter::prefiltered), 400 bytes, alignment 16. */
 typedef struct ScatterPrefilteredFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
     float axis[4]; /* vec4<f32>, offset 16 */
@@ -39,8 +39,12 @@ typedef struct ScatterPrefilteredFrame {
     float anti_epipole[4]; /* vec4<f32>, offset 288 */
     uint32_t sizes[4]; /* vec4<u32>, offset 304 */
     uint32_t sizes2_[4]; /* vec4<u32>, offset 320 */
+    float proj[4]; /* vec4<f32>, offset 336 */
+    float proj_g0_[4]; /* vec4<f32>, offset 352 */
+    float proj_g1_[4]; /* vec4<f32>, offset 368 */
+    float proj_g2_[4]; /* vec4<f32>, offset 384 */
 } ScatterPrefilteredFrame;
-SCATTER_STATIC_ASSERT(sizeof(ScatterPrefilteredFrame) == 336, "ScatterPrefilteredFrame size");
+SCATTER_STATIC_ASSERT(sizeof(ScatterPrefilteredFrame) == 400, "ScatterPrefilteredFrame size");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, eye) == 0, "ScatterPrefilteredFrame.eye offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, axis) == 16, "ScatterPrefilteredFrame.axis offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, e1_) == 32, "ScatterPrefilteredFrame.e1_ offset");
@@ -62,5 +66,9 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, epipole) == 272, "Scatte
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, anti_epipole) == 288, "ScatterPrefilteredFrame.anti_epipole offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, sizes) == 304, "ScatterPrefilteredFrame.sizes offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, sizes2_) == 320, "ScatterPrefilteredFrame.sizes2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj) == 336, "ScatterPrefilteredFrame.proj offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g0_) == 352, "ScatterPrefilteredFrame.proj_g0_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g1_) == 368, "ScatterPrefilteredFrame.proj_g1_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g2_) == 384, "ScatterPrefilteredFrame.proj_g2_ offset");
 
 #endif /* SCATTER_UNIFORMS_H */

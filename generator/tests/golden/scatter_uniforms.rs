@@ -8,7 +8,7 @@
 /// Uniform structs of the `prefiltered` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod prefiltered {
-    /// WGSL `Frame` (scatter::prefiltered), 336 bytes, alignment 16.
+    /// WGSL `Frame` (scatter::prefiltered), 400 bytes, alignment 16.
     #[repr(C)]
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct Frame {
@@ -54,10 +54,18 @@ pub mod prefiltered {
         pub sizes: [u32; 4],
         /// `vec4<u32>` at byte 320.
         pub sizes2_: [u32; 4],
+        /// `vec4<f32>` at byte 336.
+        pub proj: [f32; 4],
+        /// `vec4<f32>` at byte 352.
+        pub proj_g0_: [f32; 4],
+        /// `vec4<f32>` at byte 368.
+        pub proj_g1_: [f32; 4],
+        /// `vec4<f32>` at byte 384.
+        pub proj_g2_: [f32; 4],
     }
 
     const _: () = {
-        assert!(::core::mem::size_of::<Frame>() == 336);
+        assert!(::core::mem::size_of::<Frame>() == 400);
         assert!(::core::mem::offset_of!(Frame, eye) == 0);
         assert!(::core::mem::offset_of!(Frame, axis) == 16);
         assert!(::core::mem::offset_of!(Frame, e1_) == 32);
@@ -79,5 +87,9 @@ pub mod prefiltered {
         assert!(::core::mem::offset_of!(Frame, anti_epipole) == 288);
         assert!(::core::mem::offset_of!(Frame, sizes) == 304);
         assert!(::core::mem::offset_of!(Frame, sizes2_) == 320);
+        assert!(::core::mem::offset_of!(Frame, proj) == 336);
+        assert!(::core::mem::offset_of!(Frame, proj_g0_) == 352);
+        assert!(::core::mem::offset_of!(Frame, proj_g1_) == 368);
+        assert!(::core::mem::offset_of!(Frame, proj_g2_) == 384);
     };
 }

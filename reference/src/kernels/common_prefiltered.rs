@@ -5,9 +5,15 @@
 //!
 //! Conventions are documented in `scatter_shaderlib::prefiltered::frame`.
 
-use super::common_model::{PI, clamp, cone_falloff, exp, max, min, select, transmittance_between};
+use super::common_model::{
+    PI, clamp, cone_falloff, exp, max, min, mix, select, sqrt, transmittance_between,
+};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams, Storage};
+
+/// Smallest cone factor of a spot texel weight (see the WGSL): a region of the reference ray
+/// outside the cone still averages its texels instead of storing an undefined mean.
+pub const CONE_FLOOR: f32 = 1e-3;
 
 /// Stand-in for "no occluder": a travel distance far beyond any scene.
 pub const NO_OCCLUDER: f32 = 1e30;
@@ -238,7 +244,10 @@ pub fn texel_weight(
         let l = -xyz(f.axis) * psi.cos() + e * psi.sin();
         let den = max((s.theta_ref + psi).sin(), 1e-4);
         let r = max(f.axis[3] * s.theta_ref.sin() / den, 1e-4);
-        let cone = cone_falloff(l.dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]);
+        let cone = max(
+            cone_falloff(l.dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]),
+            CONE_FLOOR,
+        );
         w *= cone * exp(-f.medium[0] * r) / (r * r);
     }
     w
@@ -346,4 +355,132 @@ pub fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
     } else {
         r * r * width / (regions * regions)
     }
+}
+
+// ---- Projective rectification (Sec. 4.2), mirroring the WGSL section of the same name.
+
+/// Column invariant `G_r` of region boundary `r` (0..=8).
+pub fn proj_boundary(f: &FrameUniforms, r: u32) -> f32 {
+    let mut v = f.proj_g2;
+    if r < 4 {
+        v = f.proj_g0;
+    } else if r < 8 {
+        v = f.proj_g1;
+    }
+    v[(r % 4) as usize]
+}
+
+/// Column invariant at continuous column `x` of region `r`.
+pub fn proj_region_g(
+    f: &FrameUniforms,
+    x: f32,
+    r: u32,
+    regions: u32,
+    width: u32,
+    spot: bool,
+) -> f32 {
+    let b0 = region_start(r, regions, width, spot) as f32;
+    let b1 = region_start(r + 1, regions, width, spot) as f32;
+    mix(
+        proj_boundary(f, r),
+        proj_boundary(f, r + 1),
+        (x - b0) / (b1 - b0),
+    )
+}
+
+/// Continuous column of column invariant `g` (outside the map: extrapolated from the first
+/// or last region).
+pub fn proj_column(f: &FrameUniforms, g: f32, regions: u32, width: u32, spot: bool) -> f32 {
+    let mut r = 0u32;
+    while r + 1 < regions {
+        if g > proj_boundary(f, r + 1) {
+            break;
+        }
+        r += 1;
+    }
+    let g0 = proj_boundary(f, r);
+    let g1 = proj_boundary(f, r + 1);
+    let b0 = region_start(r, regions, width, spot) as f32;
+    let b1 = region_start(r + 1, regions, width, spot) as f32;
+    b0 + (b1 - b0) * (g0 - g) / (g0 - g1)
+}
+
+/// `qx` where a view ray of depth `m` meets the light rays of invariant `g`: `1 / g` (sun),
+/// `D / (g + m)` (spot); `cap` when it never does or lies beyond `cap`.
+pub fn proj_reach(f: &FrameUniforms, g: f32, m: f32, spot: bool, cap: f32) -> f32 {
+    let mut num = 1.0;
+    let mut den = g;
+    if spot {
+        num = f.axis[3];
+        den = g + m;
+    }
+    if den * cap <= num {
+        return cap;
+    }
+    num / den
+}
+
+/// Normalised rectified depth of a view ray of depth `m`.
+pub fn proj_ray_depth(f: &FrameUniforms, m: f32) -> f32 {
+    DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp((f.proj[2] - m) * f.proj[3], 0.0, 1.0)
+}
+
+/// Normalised rectified depth of a rasterised texel (clip `z / w` in [0, 1]).
+pub fn proj_stored_depth(raw: f32) -> f32 {
+    DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp(raw, 0.0, 1.0)
+}
+
+/// Projective counterpart of [`texel_weight`] for column `i` of region `r`: the exact span
+/// of the row's reference ray that the texel covers (column 0 from the eye).
+#[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+pub fn proj_texel_weight(
+    f: &FrameUniforms,
+    s: &SliceParams,
+    i: u32,
+    r: u32,
+    regions: u32,
+    weighted: bool,
+    spot: bool,
+) -> f32 {
+    let width = f.sizes[2];
+    let k = s.delta;
+    let m = s.theta_ref;
+    let len = sqrt(1.0 + k * k + m * m);
+    let cap = 4.0 * f.theta[2];
+    let mut t0 = 0.0;
+    if i > 0 {
+        t0 = proj_reach(
+            f,
+            proj_region_g(f, i as f32, r, regions, width, spot),
+            m,
+            spot,
+            cap / len,
+        ) * len;
+    }
+    let t1 = proj_reach(
+        f,
+        proj_region_g(f, (i + 1) as f32, r, regions, width, spot),
+        m,
+        spot,
+        cap / len,
+    ) * len;
+    if !weighted {
+        return t1 - t0;
+    }
+    let mut w = transmittance_between(f.medium[0], t0, t1);
+    if spot {
+        let dir = (xyz(f.e1) + xyz(f.e2) * k + xyz(f.axis) * m) / len;
+        let to = xyz(f.eye) + dir * (0.5 * (t0 + t1)) - xyz(f.light_pos);
+        let dl = max(to.length(), 1e-4);
+        let cone = max(
+            cone_falloff(
+                (to / dl).dot(xyz(f.light_dir)),
+                f.light_pos[3],
+                f.light_dir[3],
+            ),
+            CONE_FLOOR,
+        );
+        w *= cone * exp(-f.medium[0] * dl) / (dl * dl);
+    }
+    w
 }

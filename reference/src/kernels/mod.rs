@@ -11,7 +11,10 @@ pub mod row_prefix;
 pub mod scatter;
 
 use crate::buffers::{GBuffer, ShadowMap};
+use crate::bvh::Bvh;
+use crate::geometry::Aabb;
 use crate::image::Image;
+use crate::projective::rasterise_rectified;
 use crate::scene::Scene;
 use common_prefiltered::{Tex, TexArray};
 use scatter_shaderlib::prefiltered::{
@@ -32,11 +35,14 @@ pub struct PrefilteredRun {
 }
 
 /// Runs `rectify`, `prefilter` and `scatter` on the CPU for a scene, its depth buffer and
-/// its standard shadow map.
+/// its standard shadow map. In a projective frame (a `projective` variant whose frame allows
+/// it) `rectify` is replaced by the engine's rasterisation of the rectified map
+/// ([`crate::projective::rasterise_rectified`], ray cast in `bvh`).
 pub fn run_prefiltered(
     variant: &Variant,
     rectified_size: [u32; 2],
     scene: &Scene,
+    bvh: &Bvh,
     gbuf: &GBuffer,
     shadow_map: &ShadowMap,
     settings: &FrameSettings,
@@ -65,7 +71,14 @@ pub fn run_prefiltered(
         height: gbuf.height,
         data: gbuf.view_depth.clone(),
     };
-    let rectified = rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot);
+    let rectified = match engine_rectified_map(scene, bvh, &frame) {
+        Some(data) => Tex {
+            width: rectified_size[0],
+            height: rectified_size[1],
+            data,
+        },
+        None => rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot),
+    };
     let filtered = prefilter::prefilter(variant, &frame.uniforms, &frame.slices, &rectified);
     let out = scatter::scatter(
         variant,
@@ -88,4 +101,37 @@ pub fn run_prefiltered(
         filtered,
         output,
     })
+}
+
+/// For a projective frame, the rectified map the engine would rasterise (see
+/// [`rasterise_rectified`]); `None` for an epipolar frame.
+pub fn engine_rectified_map(
+    scene: &Scene,
+    bvh: &Bvh,
+    frame: &PrefilteredFrame,
+) -> Option<Vec<f32>> {
+    let maps = frame.report.projective.as_ref()?;
+    let [_, _, width, height] = frame.uniforms.sizes;
+    Some(rasterise_rectified(
+        bvh,
+        &scene.light_desc(),
+        maps,
+        width,
+        height,
+        scene_reach(scene, bvh),
+    ))
+}
+
+/// A distance that reaches across the scene's bounded geometry and the camera frustum (the
+/// start offset of directional light rays in [`rasterise_rectified`]).
+pub fn scene_reach(scene: &Scene, bvh: &Bvh) -> f64 {
+    let mut b = bvh.bounds();
+    for c in scene.camera.frustum_corners() {
+        b = b.grow(c);
+    }
+    b = b.grow(scene.camera.position);
+    if b == Aabb::EMPTY {
+        return 1.0;
+    }
+    2.0 * (b.max - b.min).length() + 1.0
 }

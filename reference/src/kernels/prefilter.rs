@@ -10,9 +10,11 @@
 //! ray inside the region, so no weight sums need to be stored.
 
 use super::common_model::select;
-use super::common_prefiltered::{Tex, TexArray, basis4, region_start, texel_weight};
+use super::common_prefiltered::{
+    Tex, TexArray, basis4, proj_stored_depth, proj_texel_weight, region_start, texel_weight,
+};
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, SliceParams, Variant, VisibilityMode,
+    FrameUniforms, LightKind, Rectification, SliceParams, Variant, VisibilityMode,
 };
 
 /// The kernel body for invocation `id` = (row, region, thread).
@@ -35,6 +37,7 @@ pub fn prefilter_main(
     }
     let weighted = variant.visibility == VisibilityMode::Weighted;
     let spot = variant.light == LightKind::Spot;
+    let proj = variant.rectification == Rectification::Projective && frame.proj[0] > 0.5;
     let layers_per_thread = variant.bases_per_thread / 4;
     let slice = slices[row as usize];
     let start = region_start(region, variant.regions, width, spot);
@@ -42,8 +45,14 @@ pub fn prefilter_main(
     let mut acc = vec![[0.0f32; 4]; layers_per_thread as usize];
     let mut wsum = 0.0f32;
     for i in start..end {
-        let d = rectified.load(i, row);
-        let w = texel_weight(frame, &slice, row, i, weighted, spot);
+        let mut d = rectified.load(i, row);
+        let w;
+        if proj {
+            d = proj_stored_depth(d);
+            w = proj_texel_weight(frame, &slice, i, region, variant.regions, weighted, spot);
+        } else {
+            w = texel_weight(frame, &slice, row, i, weighted, spot);
+        }
         wsum += w;
         let blend = select(0.0, w / wsum, wsum > 0.0);
         for q in 0..layers_per_thread {

@@ -14,12 +14,12 @@ use super::common_model::{
     transmittance_between, transmittance_integral,
 };
 use super::common_prefiltered::{
-    Tex, TexArray, coeff4, normalised_depth, quantise, region_start, sample_bilinear,
-    sm_visibility, xyz,
+    Tex, TexArray, coeff4, normalised_depth, proj_boundary, proj_column, proj_ray_depth,
+    proj_reach, quantise, region_start, sample_bilinear, sm_visibility, xyz,
 };
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, SliceParams, Storage, Variant, VisibilityMode,
+    FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant, VisibilityMode,
 };
 
 /// Most regions a variant may have (the size of the per-pixel region arrays).
@@ -114,43 +114,74 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
 
     // Rectified coordinates of the surface point.
     let axis = xyz(f.axis);
-    let theta = clamp(dir.dot(axis), -1.0, 1.0).acos();
-    let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
     let rows = f.sizes[3];
+    let width = f.sizes[2];
+    let regions = variant.regions;
     let wrap = f.anti_epipole[3] > 0.5;
-    let mut yc = (phi - f.e1[3]) / f.e2[3];
-    if wrap {
-        yc -= (yc / rows as f32).floor() * rows as f32;
-    } else {
-        yc = clamp(yc, 0.0, rows as f32);
-    }
-    // Slice parameters, interpolated between the two nearest slices like the bilinear fetch.
-    let yy = yc - 0.5;
-    let j0 = yy.floor();
-    let fy = yy - j0;
-    let row_index = |j: f32| -> usize {
-        let j = j as i64;
-        if wrap {
-            j.rem_euclid(i64::from(rows)) as usize
-        } else {
-            j.clamp(0, i64::from(rows) - 1) as usize
+    let yc: f32;
+    let d: f32;
+    let xs: f32;
+    // Epipolar: the slice's column spacing and the ray's view angle.
+    let mut delta = 1.0;
+    let mut theta = 0.0;
+    // Projective: the ray's e1 component and depth m.
+    let mut qd = 1.0;
+    let mut m = 0.0;
+    let proj = variant.rectification == Rectification::Projective && f.proj[0] > 0.5;
+    if proj {
+        let q = Vec3::new(dir.dot(xyz(f.e1)), dir.dot(xyz(f.e2)), dir.dot(axis));
+        qd = max(q.x, 1e-6);
+        let k = q.y / qd;
+        m = q.z / qd;
+        yc = clamp(
+            (k + f.proj[1]) / (2.0 * f.proj[1]) * rows as f32,
+            0.0,
+            rows as f32,
+        );
+        d = proj_ray_depth(f, m);
+        let qs = max(s * qd, 1e-6);
+        let mut g = 1.0 / qs;
+        if spot {
+            g = (f.axis[3] - s * q.z) / qs;
         }
-    };
-    let s0 = inp.slices[row_index(j0)];
-    let s1 = inp.slices[row_index(j0 + 1.0)];
-    let delta = mix(s0.delta, s1.delta, fy);
-    let d = normalised_depth(theta, f.theta[0], f.theta[1]);
-    let xs = if spot {
-        let q = (eye + dir * s - xyz(f.light_pos)).normalize();
-        clamp(q.dot(-axis), -1.0, 1.0).acos() / delta
+        xs = proj_column(f, g, regions, width, spot);
     } else {
-        s * theta.sin() / delta
-    };
+        theta = clamp(dir.dot(axis), -1.0, 1.0).acos();
+        let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
+        let mut y = (phi - f.e1[3]) / f.e2[3];
+        if wrap {
+            y -= (y / rows as f32).floor() * rows as f32;
+        } else {
+            y = clamp(y, 0.0, rows as f32);
+        }
+        yc = y;
+        // Slice parameters, interpolated between the two nearest slices like the bilinear
+        // fetch.
+        let yy = yc - 0.5;
+        let j0 = yy.floor();
+        let fy = yy - j0;
+        let row_index = |j: f32| -> usize {
+            let j = j as i64;
+            if wrap {
+                j.rem_euclid(i64::from(rows)) as usize
+            } else {
+                j.clamp(0, i64::from(rows) - 1) as usize
+            }
+        };
+        let s0 = inp.slices[row_index(j0)];
+        let s1 = inp.slices[row_index(j0 + 1.0)];
+        delta = mix(s0.delta, s1.delta, fy);
+        d = normalised_depth(theta, f.theta[0], f.theta[1]);
+        xs = if spot {
+            let q = (eye + dir * s - xyz(f.light_pos)).normalize();
+            clamp(q.dot(-axis), -1.0, 1.0).acos() / delta
+        } else {
+            s * theta.sin() / delta
+        };
+    }
 
     // Regions: every region before the surface's, whole, and the surface's up to x_s. Each
     // is weighted by this pixel's own unshadowed integral over its part of the ray.
-    let width = f.sizes[2];
-    let regions = variant.regions;
     let last = min(max(xs, 0.0), width as f32 - 1.0) as u32;
     let mut pos = [0.0f32; MAX_REGIONS];
     let mut t0 = [0.0f32; MAX_REGIONS];
@@ -165,12 +196,28 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         } else {
             b1 - 0.5
         };
-        t0[r as usize] = ray_t(f, b0, delta, theta, s, spot);
-        t1[r as usize] = if is_last {
-            s
+        if proj {
+            let mut a = 0.0;
+            if r > 0 {
+                a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
+            }
+            t0[r as usize] = a;
+            t1[r as usize] = if is_last {
+                s
+            } else {
+                min(
+                    proj_reach(f, proj_boundary(f, r + 1), m, spot, s * qd) / qd,
+                    s,
+                )
+            };
         } else {
-            ray_t(f, b1, delta, theta, s, spot)
-        };
+            t0[r as usize] = ray_t(f, b0, delta, theta, s, spot);
+            t1[r as usize] = if is_last {
+                s
+            } else {
+                ray_t(f, b1, delta, theta, s, spot)
+            };
+        }
         count = r + 1;
         if is_last {
             break;

@@ -24,9 +24,18 @@
 //! frustum (`theta_ref`), `delta` is chosen so the row spans the slice's far-plane extent.
 //! Occluders between the light and the frustum project to `d = 0` (clamped): they shadow
 //! the whole light ray, as in the paper.
+//!
+//! # Rectified space (projective, Sec. 4.2)
+//!
+//! For a variant with `rectification = projective`, a frame whose slices fan out by at most
+//! [`FrameSettings::projective_max_half_angle_deg`] around their bisectrix (so neither
+//! epipole is on screen) uses a projective map instead: see [`ProjectiveMaps`] for what the
+//! engine rasterises and `projective_frame` (private) for the coordinates. Other frames fall
+//! back to the epipolar map above and say why in [`FrameReport::fallback`]; the same
+//! kernels handle both (`FrameUniforms::proj[0]` selects).
 
 use bytemuck::{Pod, Zeroable};
-use glam::DVec3;
+use glam::{DMat4, DVec3, DVec4};
 use std::f64::consts::PI;
 
 use super::variant::{LightKind, Rectification, Variant};
@@ -146,6 +155,12 @@ pub struct FrameSettings {
     pub march_steps: u32,
     /// Gauss-Legendre nodes (a multiple of 4) of the per-pixel unshadowed spot integral.
     pub spot_quadrature: u32,
+    /// Projective rectification (variants with `rectification = projective`) is used only
+    /// while the screen's slices fan out by at most this half-angle (degrees) around the
+    /// bisectrix; wider fans (the epipole near or on the screen) fall back to epipolar
+    /// resampling. Rows are uniform in `tan` of the slice angle, so at the fan's edge the
+    /// slices are `cos^2(half-angle)` times as dense as in the middle.
+    pub projective_max_half_angle_deg: f64,
 }
 
 impl Default for FrameSettings {
@@ -157,12 +172,14 @@ impl Default for FrameSettings {
 
 impl FrameSettings {
     /// Defaults for a screen: march radius 7.5 % of the larger screen side (24 pixels at
-    /// 320x180, 96 at 1280x720), 128 march steps, 32 spot quadrature nodes.
+    /// 320x180, 96 at 1280x720), 128 march steps, 32 spot quadrature nodes, projective
+    /// rectification up to a 60 degree half-angle fan.
     pub fn for_screen(width: u32, height: u32) -> FrameSettings {
         FrameSettings {
             epipole_radius_px: 0.075 * f64::from(width.max(height)),
             march_steps: 128,
             spot_quadrature: 32,
+            projective_max_half_angle_deg: 60.0,
         }
     }
 }
@@ -257,10 +274,24 @@ pub struct FrameUniforms {
     pub sizes: [u32; 4],
     /// Shadow-map size, march steps, spot quadrature nodes, unused.
     pub sizes2: [u32; 4],
+    /// x = 1 for a projective frame (the rectified map was rasterised with
+    /// [`ProjectiveMaps`]), 0 for epipolar; y = `kh` (rows span `k = qy / qx` in
+    /// `[-kh, kh]`); z = `m_hi`; w = `1 / (m_hi - m_lo)` (ray depths `m = qz / qx`).
+    pub proj: [f32; 4],
+    /// Projective column invariants `G_0..G_3` at the region boundaries (see the module docs).
+    pub proj_g0: [f32; 4],
+    /// `G_4..G_7`.
+    pub proj_g1: [f32; 4],
+    /// `G_8`; yzw unused.
+    pub proj_g2: [f32; 4],
 }
 
 /// Per-slice parameters (WGSL `array<vec4<f32>>`): `delta` (world units or radians per
 /// column), `theta_ref`, and the slice's view-angle range inside the frustum.
+///
+/// In a projective frame the same four floats hold the row's `k` (in `delta`), the depth
+/// `m_ref` of its reference ray (in `theta_ref`) and the row's depth range `m_lo`, `m_hi`
+/// inside the frustum (in `theta_lo`, `theta_hi`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct SliceParams {
@@ -275,7 +306,9 @@ pub struct SliceParams {
 }
 
 const _: () = {
-    assert!(size_of::<FrameUniforms>() == 21 * 16);
+    assert!(size_of::<FrameUniforms>() == 25 * 16);
+    assert!(std::mem::offset_of!(FrameUniforms, proj) == 21 * 16);
+    assert!(std::mem::offset_of!(FrameUniforms, proj_g2) == 24 * 16);
     assert!(std::mem::offset_of!(FrameUniforms, theta) == 7 * 16);
     assert!(std::mem::offset_of!(FrameUniforms, medium) == 8 * 16);
     assert!(std::mem::offset_of!(FrameUniforms, epipole) == 17 * 16);
@@ -284,12 +317,68 @@ const _: () = {
     assert!(size_of::<SliceParams>() == 16);
 };
 
+/// Why a `projective` variant fell back to epipolar resampling this frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ProjectiveFallback {
+    /// The epipole (the direction towards the light) is on screen: some view ray is
+    /// parallel to the light.
+    EpipoleOnScreen,
+    /// The anti-epipole is on screen (light behind the camera).
+    AntiEpipoleOnScreen,
+    /// The slices fan out wider than `FrameSettings::projective_max_half_angle_deg`.
+    WideFan {
+        /// The fan's half-angle (degrees).
+        half_angle_deg: f64,
+        /// The allowed half-angle (degrees).
+        max_deg: f64,
+    },
+}
+
+impl std::fmt::Display for ProjectiveFallback {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::EpipoleOnScreen => f.write_str("the epipole is on screen"),
+            Self::AntiEpipoleOnScreen => f.write_str("the anti-epipole is on screen"),
+            Self::WideFan {
+                half_angle_deg,
+                max_deg,
+            } => write!(
+                f,
+                "the slices fan out {half_angle_deg:.1} degrees from the bisectrix (more than {max_deg:.1})"
+            ),
+        }
+    }
+}
+
+/// The projective rectification of one frame (Klehm et al. 2014 Sec. 4.2, split per region
+/// as the paper suggests): what the engine rasterises its rectified shadow map with.
+///
+/// For region `r`, render the scene's occluders with `matrices[r]` (world to clip, column
+/// vectors: `clip = M * vec4(p, 1)`) into the columns `viewports[r][0] ..
+/// viewports[r][0] + viewports[r][1]` and every row of the `Wr x Hr` rectified depth target:
+/// depth test LESS, cleared to 1.0, depth clamping on (occluders between the light and the
+/// frustum must still land in the map), no culling, no bias. Clip `z / w` is in [0, 1]
+/// (wgpu / D3D / Metal convention); clip `y = +1` is row 0. The stored depth is what
+/// `prefilter` reads (r32float or depth32float).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProjectiveMaps {
+    /// World-to-clip matrix per region.
+    pub matrices: Vec<DMat4>,
+    /// First column and column count of each region.
+    pub viewports: Vec<[u32; 2]>,
+}
+
 /// What the frame setup decided, for the frame report.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrameReport {
-    /// The rectification actually used this frame (always epipolar until projective
-    /// rectification lands).
+    /// The rectification actually used this frame: `projective` only for a projective
+    /// variant whose frame allows it, else `epipolar`.
     pub rectification: Rectification,
+    /// For a projective variant that fell back to epipolar resampling this frame: why.
+    pub fallback: Option<ProjectiveFallback>,
+    /// For a projective frame: the matrices the engine must rasterise the rectified map
+    /// with (then `rectify` is not dispatched).
+    pub projective: Option<ProjectiveMaps>,
     /// Whether pixels near the epipole or the anti-epipole are ray-marched this frame (one of
     /// them is on screen), and within which radius (pixels).
     pub marched_radius_px: Option<f64>,
@@ -463,6 +552,12 @@ pub fn prepare_frame(
             value: settings.spot_quadrature,
             max: 256,
         });
+    }
+    let max_half = settings.projective_max_half_angle_deg;
+    if !(max_half.is_finite() && max_half > 0.0 && max_half <= 89.0) {
+        return Err(FrameError::Degenerate(
+            "projective_max_half_angle_deg (must be in (0, 89])",
+        ));
     }
     let min_width = variant.regions * variant.regions;
     if res.rectified[0] < min_width {
@@ -723,12 +818,44 @@ pub fn prepare_frame(
             settings.spot_quadrature,
             0,
         ],
+        proj: [0.0; 4],
+        proj_g0: [0.0; 4],
+        proj_g1: [0.0; 4],
+        proj_g2: [0.0; 4],
     };
+    let half_fan = if full_circle { PI } else { 0.5 * phi_range };
+    let fallback = if variant.rectification != Rectification::Projective {
+        None
+    } else if epi.is_some() {
+        Some(ProjectiveFallback::EpipoleOnScreen)
+    } else if anti.is_some() {
+        Some(ProjectiveFallback::AntiEpipoleOnScreen)
+    } else if half_fan > max_half.to_radians() {
+        Some(ProjectiveFallback::WideFan {
+            half_angle_deg: half_fan.to_degrees(),
+            max_deg: max_half,
+        })
+    } else {
+        None
+    };
+    if variant.rectification == Rectification::Projective && fallback.is_none() {
+        return Ok(projective_frame(
+            variant,
+            res,
+            &s,
+            dist,
+            phi0 + 0.5 * phi_range,
+            half_fan,
+            uniforms,
+        ));
+    }
     Ok(PrefilteredFrame {
         uniforms,
         slices,
         report: FrameReport {
             rectification: Rectification::Epipolar,
+            fallback,
+            projective: None,
             marched_radius_px: (epi.is_some() || anti.is_some())
                 .then_some(settings.epipole_radius_px),
             epipole_on_screen: epi.is_some(),
@@ -738,6 +865,204 @@ pub fn prepare_frame(
             empty_slices: empty,
         },
     })
+}
+
+/// First column of region `r` of `regions` in a row of `width` columns: quadratic for the
+/// sun, uniform for a spot (WGSL `region_start` in `templates/common/prefiltered.wgsl`).
+pub fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
+    if spot {
+        r * width / regions
+    } else {
+        r * r * width / (regions * regions)
+    }
+}
+
+/// The projective frame (Sec. 4.2): light space with the eye at the origin, `x` the
+/// bisectrix `e1` of the slices' fan, `y = e2`, `z` the axis towards the light. A point
+/// `q` maps to row `k = qy / qx`, ray depth `m = qz / qx` (constant along a view ray,
+/// stored normalised as `(m_hi - m) / (m_hi - m_lo)`) and the column invariant
+/// `G = 1 / qx` (sun) or `G = (D - qz) / qx` (spot at distance `D`), constant along a light
+/// ray. Each region `r` maps `G` linearly from `G_r` to `G_(r+1)` onto its columns; the
+/// boundaries are geometric in `qx` (sun) between the frustum's extremes, which limits the
+/// hyperbolic crowding of columns near the eye that one projective map over the whole
+/// depth range would have, and uniform in the light-ray angle `acot G` (spot), like the
+/// epipolar spot's uniform regions (geometric angles measured 85.6 % rel L1 on
+/// spot_grate/grazing: the last region then spans most of the ray and the per-region
+/// unshadowed quadrature misses the cone).
+fn projective_frame(
+    variant: &Variant,
+    res: &Resolutions,
+    s: &Setup,
+    dist: f64,
+    phi_c: f64,
+    half_fan: f64,
+    mut uniforms: FrameUniforms,
+) -> PrefilteredFrame {
+    let spot = variant.light == LightKind::Spot;
+    let axis = s.axis;
+    let e1 = (s.e1 * phi_c.cos() + s.e2 * phi_c.sin()).normalize();
+    let e2 = axis.cross(e1);
+    let rot = Setup {
+        cam: s.cam,
+        aspect: s.aspect,
+        width: s.width,
+        height: s.height,
+        axis,
+        e1,
+        e2,
+    };
+    let cam = s.cam;
+    let kh = half_fan.tan() * (1.0 + 1e-4) + 1e-9;
+    // Ray depths over the screen: extremes at the screen corners (m is linear-fractional
+    // on the image plane with a positive denominator).
+    let (mut m_lo, mut m_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (x, y) in [
+        (0.0, 0.0),
+        (s.width, 0.0),
+        (0.0, s.height),
+        (s.width, s.height),
+    ] {
+        let d = s.dir(x, y);
+        let m = d.dot(axis) / d.dot(e1).max(1e-12);
+        m_lo = m_lo.min(m);
+        m_hi = m_hi.max(m);
+    }
+    let span = (m_hi - m_lo).max(1e-6);
+    m_lo -= 1e-4 * span;
+    m_hi += 1e-4 * span;
+    // Column invariants at the frustum corners.
+    let tx = cam.tan_half_fov_y * s.aspect;
+    let ty = cam.tan_half_fov_y;
+    let mut corners = Vec::with_capacity(8);
+    for dpt in [cam.near, cam.far] {
+        for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            corners.push((cam.forward + cam.right * (sx * tx) + cam.up * (sy * ty)) * dpt);
+        }
+    }
+    let regions = variant.regions;
+    let g: Vec<f64> = if spot {
+        let gs = corners
+            .iter()
+            .map(|c| (dist - c.dot(axis)) / c.dot(e1).max(1e-12));
+        let (gmin, gmax) = gs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+        let psi0 = 1.0f64.atan2(gmax) * (1.0 - 1e-3);
+        let psi1 = (1.0f64.atan2(gmin) * (1.0 + 1e-3)).min(PI - 1e-3);
+        (0..=regions)
+            .map(|r| {
+                let psi = psi0 + (psi1 - psi0) * f64::from(r) / f64::from(regions);
+                psi.cos() / psi.sin()
+            })
+            .collect()
+    } else {
+        let (n, f) = corners
+            .iter()
+            .map(|c| c.dot(e1))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            });
+        let (n, f) = (n.max(1e-9) * (1.0 - 1e-3), f * (1.0 + 1e-3));
+        (0..=regions)
+            .map(|r| 1.0 / (n * (f / n).powf(f64::from(r) / f64::from(regions))))
+            .collect()
+    };
+    let rows = res.rectified[1];
+    let width = res.rectified[0];
+    let dk = 2.0 * kh / f64::from(rows);
+    let slices = (0..rows)
+        .map(|j| {
+            let k = -kh + (f64::from(j) + 0.5) * dk;
+            let phi = k.atan();
+            let (lo, hi) = rot
+                .slice_theta_range(phi)
+                .unwrap_or((m_hi.recip().atan(), PI / 2.0));
+            let m_of = |theta: f64| theta.cos() / (theta.sin().max(1e-12) * phi.cos());
+            let theta_ref = 0.5 * (lo + hi);
+            SliceParams {
+                delta: k as f32,
+                theta_ref: m_of(theta_ref).clamp(m_lo, m_hi) as f32,
+                theta_lo: m_of(hi).clamp(m_lo, m_hi) as f32,
+                theta_hi: m_of(lo).clamp(m_lo, m_hi) as f32,
+            }
+        })
+        .collect();
+    // The engine's matrices: light space, then the per-region projection.
+    let eye = cam.position;
+    let view = DMat4::from_cols(
+        DVec4::new(e1.x, e2.x, axis.x, 0.0),
+        DVec4::new(e1.y, e2.y, axis.y, 0.0),
+        DVec4::new(e1.z, e2.z, axis.z, 0.0),
+        DVec4::new(-e1.dot(eye), -e2.dot(eye), -axis.dot(eye), 1.0),
+    );
+    let inv = 1.0 / (m_hi - m_lo);
+    let mut matrices = Vec::with_capacity(regions as usize);
+    let mut viewports = Vec::with_capacity(regions as usize);
+    for r in 0..regions {
+        let dg = g[r as usize] - g[r as usize + 1];
+        let gr = g[r as usize];
+        // Rows of the projection acting on (qx, qy, qz, 1).
+        let px = if spot {
+            DVec4::new(2.0 * gr / dg - 1.0, 0.0, 2.0 / dg, -2.0 * dist / dg)
+        } else {
+            DVec4::new(2.0 * gr / dg - 1.0, 0.0, 0.0, -2.0 / dg)
+        };
+        let py = DVec4::new(0.0, -1.0 / kh, 0.0, 0.0);
+        let pz = DVec4::new(m_hi * inv, 0.0, -inv, 0.0);
+        let pw = DVec4::new(1.0, 0.0, 0.0, 0.0);
+        let proj = DMat4::from_cols(px, py, pz, pw).transpose();
+        matrices.push(proj * view);
+        let b0 = region_start(r, regions, width, spot);
+        let b1 = region_start(r + 1, regions, width, spot);
+        viewports.push([b0, b1 - b0]);
+    }
+    let mut gv = [0.0f32; 12];
+    for (i, v) in g.iter().enumerate() {
+        gv[i] = *v as f32;
+    }
+    uniforms.e1 = v4(e1, -half_fan);
+    uniforms.e2 = v4(e2, 2.0 * half_fan / f64::from(rows));
+    uniforms.proj = [1.0, kh as f32, m_hi as f32, inv as f32];
+    uniforms.proj_g0 = [gv[0], gv[1], gv[2], gv[3]];
+    uniforms.proj_g1 = [gv[4], gv[5], gv[6], gv[7]];
+    uniforms.proj_g2 = [gv[8], gv[9], gv[10], gv[11]];
+    // Neither epipole is on screen in a projective frame: nothing is ray-marched and rows
+    // never wrap.
+    uniforms.epipole[2] = 0.0;
+    uniforms.anti_epipole[2] = 0.0;
+    uniforms.anti_epipole[3] = 0.0;
+    // Largest gap between neighbouring rows on the screen border.
+    let mut max_gap: f64 = 0.0;
+    let (w, h) = (res.screen[0], res.screen[1]);
+    let border = (0..=w)
+        .flat_map(|i| [(f64::from(i), 0.0), (f64::from(i), s.height)])
+        .chain((0..=h).flat_map(|j| [(0.0, f64::from(j)), (s.width, f64::from(j))]));
+    for (x, y) in border {
+        let d = s.dir(x, y);
+        let (qx, qy, qz) = (d.dot(e1), d.dot(e2), d.dot(axis));
+        let next = e1 * qx + e2 * (qy + dk * qx) + axis * qz;
+        if let Some((nx, ny)) = s.project(next) {
+            max_gap = max_gap.max(((nx - x).powi(2) + (ny - y).powi(2)).sqrt());
+        }
+    }
+    PrefilteredFrame {
+        uniforms,
+        slices,
+        report: FrameReport {
+            rectification: Rectification::Projective,
+            fallback: None,
+            projective: Some(ProjectiveMaps {
+                matrices,
+                viewports,
+            }),
+            marched_radius_px: None,
+            epipole_on_screen: false,
+            anti_epipole_on_screen: false,
+            full_circle: false,
+            max_slice_gap_px: max_gap,
+            empty_slices: 0,
+        },
+    }
 }
 
 #[cfg(test)]

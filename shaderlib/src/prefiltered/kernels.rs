@@ -7,7 +7,7 @@
 
 use askama::Template;
 
-use super::variant::{LightKind, Variant, VisibilityMode};
+use super::variant::{LightKind, Rectification, Variant, VisibilityMode};
 use crate::compose::template_path;
 use crate::{Kernel, ShaderError};
 
@@ -43,6 +43,8 @@ struct PrefilterTemplate {
     layers_per_thread: u32,
     threads_per_row_region: u32,
     regions: u32,
+    rectification_name: &'static str,
+    projective: bool,
 }
 
 /// `scatter`: per-pixel prefiltered estimate plus the epipole ray march.
@@ -56,6 +58,8 @@ struct ScatterTemplate {
     bases: u32,
     layers: u32,
     regions: u32,
+    rectification_name: &'static str,
+    projective: bool,
 }
 
 /// Checks `variant` on behalf of `kernel`.
@@ -99,6 +103,8 @@ pub(crate) fn render_prefilter(variant: &Variant) -> Result<String, ShaderError>
         layers_per_thread: variant.bases_per_thread / 4,
         threads_per_row_region: variant.threads_per_row_region(),
         regions: variant.regions,
+        rectification_name: variant.rectification.name(),
+        projective: variant.rectification == Rectification::Projective,
     }
     .render()
     .map_err(render_error(Kernel::Prefilter))
@@ -116,6 +122,8 @@ pub(crate) fn render_scatter(variant: &Variant) -> Result<String, ShaderError> {
         bases: variant.bases,
         layers: variant.layers(),
         regions: variant.regions,
+        rectification_name: variant.rectification.name(),
+        projective: variant.rectification == Rectification::Projective,
     }
     .render()
     .map_err(render_error(Kernel::Scatter))

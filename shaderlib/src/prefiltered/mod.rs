@@ -9,7 +9,8 @@ pub mod variant;
 
 pub use frame::{
     CameraDesc, FrameError, FrameReport, FrameSettings, FrameUniforms, LightDesc, MediumDesc,
-    PrefilteredFrame, Resolutions, ShadowMapDesc, ShadowProjectionDesc, SliceParams, prepare_frame,
+    PrefilteredFrame, ProjectiveFallback, ProjectiveMaps, Resolutions, ShadowMapDesc,
+    ShadowProjectionDesc, SliceParams, prepare_frame, region_start,
 };
 pub use kernels::{
     MAX_REGIONS, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE,

@@ -191,13 +191,6 @@ impl Variant {
                 allowed: "in 1..=8".into(),
             });
         }
-        if self.rectification == Rectification::Projective {
-            return Err(VariantError {
-                knob: "rectification",
-                value: "projective".into(),
-                allowed: "epipolar (projective rectification is not implemented yet)".into(),
-            });
-        }
         Ok(())
     }
 
@@ -211,7 +204,7 @@ impl Variant {
 
     /// Every valid variant with bases in {4, 8, 16, 32, 64, 128} (the powers of two of the
     /// design card), every `bases_per_thread`, the given `regions`, both visibilities, both
-    /// lights and every storage format, epipolar rectification; sorted by those knobs.
+    /// lights, every storage format and both rectifications; sorted by those knobs.
     pub fn grid(regions: std::ops::RangeInclusive<u32>) -> Vec<Variant> {
         let mut out = Vec::new();
         for bases in [4, 8, 16, 32, 64, 128] {
@@ -220,15 +213,17 @@ impl Variant {
                     for &visibility in VisibilityMode::ALL {
                         for &light in LightKind::ALL {
                             for &storage in Storage::ALL {
-                                out.push(Variant {
-                                    bases,
-                                    bases_per_thread,
-                                    regions: r,
-                                    visibility,
-                                    light,
-                                    storage,
-                                    rectification: Rectification::Epipolar,
-                                });
+                                for &rectification in Rectification::ALL {
+                                    out.push(Variant {
+                                        bases,
+                                        bases_per_thread,
+                                        regions: r,
+                                        visibility,
+                                        light,
+                                        storage,
+                                        rectification,
+                                    });
+                                }
                             }
                         }
                     }

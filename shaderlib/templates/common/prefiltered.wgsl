@@ -17,9 +17,10 @@
 #import scatter::model::{PI, cone_falloff, transmittance_between}
 
 // The uniform block (host: `scatter_shaderlib::prefiltered::FrameUniforms`, field by field;
-// every member is 16 bytes, 21 * 16 = 336 bytes in all). The host's `e1`, `e2` and `sizes2`
-// are spelled `e1_`, `e2_` and `sizes2_`: naga's back-ends append `_` to identifiers that end
-// in a digit, and naga_oil requires shared modules to use the written-back spelling.
+// every member is 16 bytes, 25 * 16 = 400 bytes in all). The host's `e1`, `e2`, `sizes2` and
+// `proj_g0..2` are spelled `e1_`, `e2_`, `sizes2_` and `proj_g0_..2_`: naga's back-ends append
+// `_` to identifiers that end in a digit, and naga_oil requires shared modules to use the
+// written-back spelling.
 struct Frame {
     // Eye position; w unused.
     eye: vec4<f32>,
@@ -63,10 +64,21 @@ struct Frame {
     sizes: vec4<u32>,
     // Shadow-map size, march steps, spot quadrature nodes, unused.
     sizes2_: vec4<u32>,
+    // x = 1 projective frame, 0 epipolar; y = kh (rows span k = qy / qx in [-kh, kh]);
+    // z = m_hi; w = 1 / (m_hi - m_lo) (ray depths m = qz / qx).
+    proj: vec4<f32>,
+    // Projective column invariants G_0..G_3 at the region boundaries.
+    proj_g0_: vec4<f32>,
+    // G_4..G_7.
+    proj_g1_: vec4<f32>,
+    // G_8; yzw unused.
+    proj_g2_: vec4<f32>,
 }
 
 // One rectified row's parameters (host: `SliceParams`), unpacked from the kernels'
-// `slices: array<vec4<f32>>` binding by `slice_params`.
+// `slices: array<vec4<f32>>` binding by `slice_params`. In a projective frame the fields hold
+// the row's k (delta), its reference ray's depth m_ref (theta_ref) and its depth range
+// m_lo, m_hi (theta_lo, theta_hi).
 struct SliceParams {
     // Column spacing: `v` per column (directional) or `psi` per column (spot).
     delta: f32,
@@ -107,6 +119,12 @@ fn normalised_depth(theta: f32, lo: f32, hi: f32) -> f32 {
 // is 2-periodic, so depth differences near +-1 (a ray at the very start of the range
 // against an empty light ray) would fall on the periodic copy's discontinuity.
 const DEPTH_MARGIN: f32 = 0.1f;
+
+// Smallest cone factor of a spot texel weight: where a region of the reference ray lies
+// outside the cone, its texels still average (nearly uniformly) instead of leaving the
+// region's mean undefined (all-zero weights store F = 0, i.e. visibility 0.5), because a
+// pixel's own ray may cross the cone where the reference ray does not.
+const CONE_FLOOR: f32 = 1e-3f;
 
 // Fourier frequency `c_k = pi (2k - 1)`.
 fn freq(k: u32) -> f32 {
@@ -178,7 +196,7 @@ fn texel_weight(f: Frame, s: SliceParams, row: u32, i: u32, weighted: bool, spot
         let l = -f.axis.xyz * cos(psi) + e * sin(psi);
         let den = max(sin(s.theta_ref + psi), 1e-4);
         let r = max(f.axis[3] * sin(s.theta_ref) / den, 1e-4);
-        let cone = cone_falloff(dot(l, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]);
+        let cone = max(cone_falloff(dot(l, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]), CONE_FLOOR);
         w *= cone * exp(-f.medium[0] * r) / (r * r);
     }
     return w;
@@ -266,4 +284,99 @@ fn sm_occluder_distance(f: Frame, sm: texture_2d<f32>, o: vec3<f32>, l: vec3<f32
         let z = near + stored * (far - near);
         return z + sm_bias(f, z) - ls.z;
     }
+}
+
+// ---- Projective rectification (Sec. 4.2; conventions: `ProjectiveMaps` and
+// `projective_frame` in scatter_shaderlib::prefiltered::frame). Light space: eye at the
+// origin, x = e1 (the fan's bisectrix), y = e2, z = axis. Row k = qy / qx, ray depth
+// m = qz / qx, column invariant G = 1 / qx (sun) or (D - qz) / qx (spot); region r maps G
+// linearly from G_r to G_(r+1) onto its columns.
+
+// Column invariant G_r of region boundary `r` (0..=8).
+fn proj_boundary(f: Frame, r: u32) -> f32 {
+    var v = f.proj_g2_;
+    if r < 4u {
+        v = f.proj_g0_;
+    } else if r < 8u {
+        v = f.proj_g1_;
+    }
+    return v[r % 4u];
+}
+
+// Column invariant at continuous column `x` of region `r`.
+fn proj_region_g(f: Frame, x: f32, r: u32, regions: u32, width: u32, spot: bool) -> f32 {
+    let b0 = f32(region_start(r, regions, width, spot));
+    let b1 = f32(region_start(r + 1u, regions, width, spot));
+    return mix(proj_boundary(f, r), proj_boundary(f, r + 1u), (x - b0) / (b1 - b0));
+}
+
+// Continuous column of column invariant `g` (outside the map: extrapolated from the first
+// or last region).
+fn proj_column(f: Frame, g: f32, regions: u32, width: u32, spot: bool) -> f32 {
+    var r = 0u;
+    for (; r + 1u < regions; r++) {
+        if g > proj_boundary(f, r + 1u) {
+            break;
+        }
+    }
+    let g0 = proj_boundary(f, r);
+    let g1 = proj_boundary(f, r + 1u);
+    let b0 = f32(region_start(r, regions, width, spot));
+    let b1 = f32(region_start(r + 1u, regions, width, spot));
+    return b0 + (b1 - b0) * (g0 - g) / (g0 - g1);
+}
+
+// qx where a view ray of depth `m` meets the light rays of invariant `g`: 1 / g (sun),
+// D / (g + m) (spot); `cap` when it never does or lies beyond `cap`.
+fn proj_reach(f: Frame, g: f32, m: f32, spot: bool, cap: f32) -> f32 {
+    var num = 1.0;
+    var den = g;
+    if spot {
+        num = f.axis[3];
+        den = g + m;
+    }
+    if den * cap <= num {
+        return cap;
+    }
+    return num / den;
+}
+
+// Normalised rectified depth of a view ray of depth `m` (lit iff it is <= the stored depth).
+fn proj_ray_depth(f: Frame, m: f32) -> f32 {
+    return DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp((f.proj[2] - m) * f.proj[3], 0.0, 1.0);
+}
+
+// Normalised rectified depth of a rasterised texel (clip z / w in [0, 1]).
+fn proj_stored_depth(raw: f32) -> f32 {
+    return DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp(raw, 0.0, 1.0);
+}
+
+// Projective counterpart of `texel_weight` for column `i` of region `r`: the exact span of
+// the row's reference ray (direction e1 + k e2 + m_ref axis) that the texel covers, from the
+// projective map itself (Klehm's Eq. 12 assumes a constant growth factor per texel; the
+// spans of a perspective map grow hyperbolically, so the exact spans are used instead).
+// Column 0 also covers the ray from the eye to the map's first light ray.
+fn proj_texel_weight(f: Frame, s: SliceParams, i: u32, r: u32, regions: u32, weighted: bool, spot: bool) -> f32 {
+    let width = f.sizes[2];
+    let k = s.delta;
+    let m = s.theta_ref;
+    let len = sqrt(1.0 + k * k + m * m);
+    let cap = 4.0 * f.theta[2];
+    var t0 = 0.0;
+    if i > 0u {
+        t0 = proj_reach(f, proj_region_g(f, f32(i), r, regions, width, spot), m, spot, cap / len) * len;
+    }
+    let t1 = proj_reach(f, proj_region_g(f, f32(i + 1u), r, regions, width, spot), m, spot, cap / len) * len;
+    if !weighted {
+        return t1 - t0;
+    }
+    var w = transmittance_between(f.medium[0], t0, t1);
+    if spot {
+        let dir = (f.e1_.xyz + f.e2_.xyz * k + f.axis.xyz * m) / len;
+        let to = f.eye.xyz + dir * (0.5 * (t0 + t1)) - f.light_pos.xyz;
+        let dl = max(length(to), 1e-4);
+        let cone = max(cone_falloff(dot(to / dl, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]), CONE_FLOOR);
+        w *= cone * exp(-f.medium[0] * dl) / (dl * dl);
+    }
+    return w;
 }
