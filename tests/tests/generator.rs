@@ -7,7 +7,7 @@
 use scatter_gen::{FamilyVariant, Request, Target, generate};
 use scatter_runtime::prefiltered::{DEPTH_FORMAT, OUTPUT_FORMAT, storage_format};
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, SliceParams, Storage, Variant, VisibilityMode,
+    FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant, VisibilityMode,
 };
 use scatter_shaderlib::{KernelParams, build};
 use serde_json::Value;
@@ -70,11 +70,12 @@ fn eval(formula: &str, sizes: &[(&str, u32)]) -> u32 {
 
 #[test]
 fn manifest_resources_match_the_runtime() {
-    for &storage in Storage::ALL {
+    for (&storage, &rectification) in Storage::ALL.iter().zip(Rectification::ALL.iter().cycle()) {
         for &light in LightKind::ALL {
             let v = Variant {
                 storage,
                 light,
+                rectification,
                 bases: 64,
                 ..Variant::default()
             };
@@ -96,6 +97,13 @@ fn manifest_resources_match_the_runtime() {
                 );
             }
             assert_eq!(str_of(&tex("output"), "format"), wgpu_name(OUTPUT_FORMAT));
+            if rectification == Rectification::Projective {
+                // The map the engine rasterises (checked by the runtime as DEPTH_FORMAT).
+                assert_eq!(
+                    str_of(&tex("rectified_raster"), "format"),
+                    wgpu_name(DEPTH_FORMAT)
+                );
+            }
             let frame = get(resource(variant, "frame"), "buffer");
             assert_eq!(
                 str_of(frame, "size_bytes"),
