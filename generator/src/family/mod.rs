@@ -1,0 +1,310 @@
+//! The family registry: what the generator knows about each kernel family beyond what
+//! shaderlib's IR says (its knobs, how a variant is parsed, which textures and buffers the
+//! engine allocates and how each pass is dispatched).
+//!
+//! Adding a family (`raymarch`, `minmax`, ...) means adding a [`Family`] value, a
+//! [`FamilyVariant`] arm and a module like [`prefiltered`]; the CLI, the config file, the
+//! manifest and the tests pick it up from [`Family::ALL`] without changing shape.
+
+pub mod prefiltered;
+
+use std::fmt;
+
+use scatter_shaderlib::{Kernel, KernelParams};
+use serde::Serialize;
+
+use crate::GenError;
+
+/// A kernel family the generator can emit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Family {
+    /// Klehm et al. 2014: `rectify`, `prefilter`, `scatter`.
+    Prefiltered,
+}
+
+/// One knob of a family, as the CLI, `scatter-gen list` and the config file show it.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct KnobInfo {
+    /// The knob's name (config key and manifest key), e.g. `bases_per_thread`.
+    pub name: &'static str,
+    /// Placeholder for its value in `--help`, e.g. `N`.
+    pub value_name: &'static str,
+    /// What it does, one sentence.
+    pub help: &'static str,
+    /// The allowed values, in words (`a multiple of 4 in 4..=128`, `average | weighted`).
+    pub allowed: String,
+    /// The default (the paper's choice).
+    pub default: String,
+}
+
+impl KnobInfo {
+    /// The command-line flag: the name with `-` for `_`.
+    pub fn flag(&self) -> String {
+        self.name.replace('_', "-")
+    }
+}
+
+impl Family {
+    /// Every family, sorted by name.
+    pub const ALL: &'static [Family] = &[Family::Prefiltered];
+
+    /// The family's name (`--family`, config key `family`, manifest).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Prefiltered => "prefiltered",
+        }
+    }
+
+    /// One line: the method and its paper.
+    pub const fn summary(self) -> &'static str {
+        match self {
+            Self::Prefiltered => {
+                "Klehm et al. 2014, prefiltered single scattering: Fourier-basis visibility \
+                 prefiltered along epipolar rows of a rectified shadow map"
+            }
+        }
+    }
+
+    /// The knobs, in the order `--help` and `list` show them.
+    pub fn knobs(self) -> Vec<KnobInfo> {
+        match self {
+            Self::Prefiltered => prefiltered::knobs(),
+        }
+    }
+
+    /// The variant with every knob at its default (the paper's choice).
+    pub fn default_variant(self) -> FamilyVariant {
+        match self {
+            Self::Prefiltered => FamilyVariant::Prefiltered(Default::default()),
+        }
+    }
+
+    /// The kernels of a variant, in pass order (read from shaderlib, not listed here).
+    pub fn kernels(self) -> Vec<Kernel> {
+        self.default_variant()
+            .kernel_params()
+            .iter()
+            .map(KernelParams::kernel)
+            .collect()
+    }
+
+    /// Parses a variant from `(knob, value)` pairs; knobs not named keep their defaults.
+    ///
+    /// # Errors
+    ///
+    /// [`GenError::Knob`] naming the knob, the value and the allowed range, or
+    /// [`GenError::Usage`] for a knob the family does not have.
+    pub fn variant(self, knobs: &[(String, String)]) -> Result<FamilyVariant, GenError> {
+        let known = self.knobs();
+        for (name, _) in knobs {
+            if !known.iter().any(|k| k.name == name.as_str()) {
+                let names: Vec<_> = known.iter().map(|k| k.name).collect();
+                return Err(GenError::Usage(format!(
+                    "knob `{name}` does not apply to family {self} (its knobs: {})",
+                    names.join(", ")
+                )));
+            }
+        }
+        match self {
+            Self::Prefiltered => prefiltered::parse(knobs).map(FamilyVariant::Prefiltered),
+        }
+    }
+}
+
+impl fmt::Display for Family {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Family {
+    type Err = GenError;
+
+    fn from_str(s: &str) -> Result<Self, GenError> {
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|f| f.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Self::ALL.iter().map(|f| f.name()).collect();
+                GenError::Usage(format!("family must be {}, got {s}", names.join(" | ")))
+            })
+    }
+}
+
+/// One validated variant of some family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FamilyVariant {
+    /// A prefiltered-family variant.
+    Prefiltered(scatter_shaderlib::prefiltered::Variant),
+}
+
+impl FamilyVariant {
+    /// The family.
+    pub const fn family(&self) -> Family {
+        match self {
+            Self::Prefiltered(_) => Family::Prefiltered,
+        }
+    }
+
+    /// The variant id used in file names (`<kernel>.<id>.<ext>`).
+    pub fn id(&self) -> String {
+        match self {
+            Self::Prefiltered(v) => v.id(),
+        }
+    }
+
+    /// The knobs as a JSON object (serde names, sorted).
+    pub fn knobs_json(&self) -> serde_json::Value {
+        match self {
+            Self::Prefiltered(v) => serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
+        }
+    }
+
+    /// The kernel parameters of every kernel, in pass order, as shaderlib defines them.
+    pub fn kernel_params(&self) -> Vec<KernelParams> {
+        match self {
+            Self::Prefiltered(v) => KernelParams::prefiltered(*v).to_vec(),
+        }
+    }
+
+    /// The resources, parameters and passes an engine needs to run the variant.
+    pub fn plan(&self) -> Plan {
+        match self {
+            Self::Prefiltered(v) => prefiltered::plan(v),
+        }
+    }
+}
+
+/// A size expression over the [`Plan::parameters`]: an integer, a parameter name
+/// (`screen.width`), or a product `16 * rectified.height`.
+pub type Formula = String;
+
+/// A symbol that formulas use, with its meaning and constraints.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Parameter {
+    /// The symbol, e.g. `rectified.width`.
+    pub name: &'static str,
+    /// What it is and who chooses it.
+    pub description: &'static str,
+    /// Allowed values, in words.
+    pub constraint: String,
+}
+
+/// A texture's allocation.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct TextureDesc {
+    /// WebGPU format name (`r32float`, `rgba8unorm`, ...).
+    pub format: String,
+    /// Texture dimension (`2d`).
+    pub dimension: &'static str,
+    /// Width in texels.
+    pub width: Formula,
+    /// Height in texels.
+    pub height: Formula,
+    /// Array layers.
+    pub layers: Formula,
+    /// Mip levels.
+    pub mip_levels: u32,
+    /// Usages the passes need (`texture_binding`, `storage_binding`).
+    pub usage: Vec<&'static str>,
+}
+
+/// A buffer's allocation; its size is filled in from the IR layout.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct BufferDesc {
+    /// For a runtime-sized array: how many elements (the byte size is this times the
+    /// element stride).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub elements: Option<Formula>,
+    /// Usages the passes need (`uniform`, `storage`, `copy_dst`).
+    pub usage: Vec<&'static str>,
+}
+
+/// A sampler's state.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct SamplerDesc {
+    /// `linear` or `nearest`.
+    pub mag_filter: &'static str,
+    /// `linear` or `nearest`.
+    pub min_filter: &'static str,
+    /// `linear` or `nearest`.
+    pub mipmap_filter: &'static str,
+    /// `clamp_to_edge`, `repeat`, ...
+    pub address_mode_u: &'static str,
+    /// As `address_mode_u`.
+    pub address_mode_v: &'static str,
+    /// As `address_mode_u`.
+    pub address_mode_w: &'static str,
+}
+
+/// Something a pass binds.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Resource {
+    /// Its name, used by the passes' bindings.
+    pub name: &'static str,
+    /// `texture`, `uniform_buffer`, `storage_buffer` or `sampler`.
+    pub kind: &'static str,
+    /// `engine` (the engine renders it: depth buffer, shadow map) or `scatter` (the engine
+    /// allocates it once for the passes).
+    pub provided_by: &'static str,
+    /// What it holds.
+    pub contents: &'static str,
+    /// Allocation of a texture.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture: Option<TextureDesc>,
+    /// Allocation of a buffer.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub buffer: Option<BufferDesc>,
+    /// State of a sampler.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sampler: Option<SamplerDesc>,
+}
+
+/// Which resource a binding gets.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct BindingSource {
+    /// The binding number (group 0).
+    pub binding: u32,
+    /// The resource bound by default.
+    pub resource: &'static str,
+    /// Another resource bound instead when a per-frame condition holds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alternative: Option<Alternative>,
+}
+
+/// A resource bound instead of the default one under a per-frame condition.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Alternative {
+    /// The resource.
+    pub resource: &'static str,
+    /// When (an expression over the uniform block).
+    pub when: &'static str,
+}
+
+/// One pass: its kernel, its invocation grid and what each binding gets.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PassPlan {
+    /// The kernel.
+    pub kernel: Kernel,
+    /// Invocations along x, y, z (the dispatch is `ceil(invocations / workgroup size)`).
+    pub invocations: [Formula; 3],
+    /// A per-frame condition under which the pass does not run.
+    pub skip_when: Option<&'static str>,
+    /// What each binding of group 0 gets.
+    pub bindings: Vec<BindingSource>,
+}
+
+/// Everything about a variant that the IR does not say.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Plan {
+    /// Symbols the formulas use.
+    pub parameters: Vec<Parameter>,
+    /// Textures, buffers and samplers.
+    pub resources: Vec<Resource>,
+    /// Passes, one per kernel.
+    pub passes: Vec<PassPlan>,
+    /// What the engine must know besides the bindings (barriers, per-frame data).
+    pub notes: Vec<&'static str>,
+}

@@ -1,0 +1,223 @@
+//! Generator round trips: what `manifest.json` tells a foreign engine agrees with what
+//! `scatter-runtime` really allocates and dispatches and with the host structs the runtime
+//! uploads: texture formats and layers, the uniform block's size and every field offset,
+//! the slice table's stride, and the dispatch formulas evaluated at real sizes against the
+//! workgroup sizes of the kernels the runtime builds.
+
+use scatter_gen::{FamilyVariant, Request, Target, generate};
+use scatter_runtime::prefiltered::{DEPTH_FORMAT, OUTPUT_FORMAT, storage_format};
+use scatter_shaderlib::prefiltered::{
+    FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant, VisibilityMode,
+};
+use scatter_shaderlib::{KernelParams, build};
+use serde_json::Value;
+
+/// The manifest of one variant, parsed.
+fn manifest(v: Variant) -> Value {
+    let g = generate(&Request {
+        variants: vec![FamilyVariant::Prefiltered(v)],
+        targets: vec![Target::Wgsl],
+    })
+    .unwrap_or_else(|e| panic!("{}: {e}", v.id()));
+    serde_json::from_slice(&g.manifest).unwrap_or_else(|e| panic!("manifest: {e}"))
+}
+
+fn wgpu_name(format: impl std::fmt::Debug) -> String {
+    format!("{format:?}").to_lowercase()
+}
+
+fn get<'a>(v: &'a Value, key: &str) -> &'a Value {
+    v.get(key)
+        .unwrap_or_else(|| panic!("manifest lacks `{key}` in {v}"))
+}
+
+fn str_of<'a>(v: &'a Value, key: &str) -> &'a str {
+    get(v, key)
+        .as_str()
+        .unwrap_or_else(|| panic!("`{key}` is not a string in {v}"))
+}
+
+fn resource<'a>(variant: &'a Value, name: &str) -> &'a Value {
+    get(variant, "resources")
+        .as_array()
+        .and_then(|a| {
+            a.iter()
+                .find(|r| r.get("name").and_then(Value::as_str) == Some(name))
+        })
+        .unwrap_or_else(|| panic!("no resource `{name}`"))
+}
+
+/// Evaluates a manifest formula at the given sizes.
+fn eval(formula: &str, sizes: &[(&str, u32)]) -> u32 {
+    let f = formula.trim();
+    if let Some(inner) = f.strip_prefix("ceil(").and_then(|s| s.strip_suffix(')')) {
+        let (a, b) = inner
+            .split_once(" / ")
+            .unwrap_or_else(|| panic!("{formula}"));
+        return eval(a, sizes).div_ceil(eval(b, sizes));
+    }
+    if let Some((a, b)) = f.split_once(" * ") {
+        return eval(a, sizes) * eval(b, sizes);
+    }
+    f.parse().unwrap_or_else(|_| {
+        sizes
+            .iter()
+            .find(|(n, _)| *n == f)
+            .map(|(_, v)| *v)
+            .unwrap_or_else(|| panic!("unknown symbol in formula {formula}"))
+    })
+}
+
+#[test]
+fn manifest_resources_match_the_runtime() {
+    for (&storage, &rectification) in Storage::ALL.iter().zip(Rectification::ALL.iter().cycle()) {
+        for &light in LightKind::ALL {
+            let v = Variant {
+                storage,
+                light,
+                rectification,
+                bases: 64,
+                ..Variant::default()
+            };
+            let m = manifest(v);
+            let variant = &get(&m, "variants")[0];
+            let tex = |name: &str| get(resource(variant, name), "texture").clone();
+            assert_eq!(
+                str_of(&tex("filtered"), "format"),
+                wgpu_name(storage_format(storage)),
+                "{}",
+                v.id()
+            );
+            assert_eq!(str_of(&tex("filtered"), "layers"), v.layers().to_string());
+            for name in ["depth", "shadow_map", "rectified"] {
+                assert_eq!(
+                    str_of(&tex(name), "format"),
+                    wgpu_name(DEPTH_FORMAT),
+                    "{name}"
+                );
+            }
+            assert_eq!(str_of(&tex("output"), "format"), wgpu_name(OUTPUT_FORMAT));
+            if rectification == Rectification::Projective {
+                // The map the engine rasterises (checked by the runtime as DEPTH_FORMAT).
+                assert_eq!(
+                    str_of(&tex("rectified_raster"), "format"),
+                    wgpu_name(DEPTH_FORMAT)
+                );
+            }
+            let frame = get(resource(variant, "frame"), "buffer");
+            assert_eq!(
+                str_of(frame, "size_bytes"),
+                size_of::<FrameUniforms>().to_string()
+            );
+            let slices = get(resource(variant, "slices"), "buffer");
+            assert_eq!(
+                str_of(slices, "size_bytes"),
+                format!("{} * rectified.height", size_of::<SliceParams>())
+            );
+        }
+    }
+}
+
+#[test]
+fn manifest_frame_layout_matches_the_host_struct() {
+    let m = manifest(Variant::default());
+    let frame = get(&m, "structs")
+        .as_array()
+        .and_then(|a| {
+            a.iter()
+                .find(|s| s.get("name").and_then(Value::as_str) == Some("Frame"))
+        })
+        .unwrap_or_else(|| panic!("no struct Frame"));
+    assert_eq!(
+        get(frame, "size").as_u64(),
+        Some(size_of::<FrameUniforms>() as u64)
+    );
+    use std::mem::offset_of;
+    // Shader spelling (naga appends `_` to names ending in a digit) -> host offset.
+    let host = [
+        ("eye", offset_of!(FrameUniforms, eye)),
+        ("axis", offset_of!(FrameUniforms, axis)),
+        ("e1_", offset_of!(FrameUniforms, e1)),
+        ("e2_", offset_of!(FrameUniforms, e2)),
+        ("cam_forward", offset_of!(FrameUniforms, cam_forward)),
+        ("cam_right", offset_of!(FrameUniforms, cam_right)),
+        ("cam_up", offset_of!(FrameUniforms, cam_up)),
+        ("theta", offset_of!(FrameUniforms, theta)),
+        ("medium", offset_of!(FrameUniforms, medium)),
+        ("light_color", offset_of!(FrameUniforms, light_color)),
+        ("light_pos", offset_of!(FrameUniforms, light_pos)),
+        ("light_dir", offset_of!(FrameUniforms, light_dir)),
+        ("sm_right", offset_of!(FrameUniforms, sm_right)),
+        ("sm_up", offset_of!(FrameUniforms, sm_up)),
+        ("sm_forward", offset_of!(FrameUniforms, sm_forward)),
+        ("sm_origin", offset_of!(FrameUniforms, sm_origin)),
+        ("sm_proj", offset_of!(FrameUniforms, sm_proj)),
+        ("epipole", offset_of!(FrameUniforms, epipole)),
+        ("anti_epipole", offset_of!(FrameUniforms, anti_epipole)),
+        ("sizes", offset_of!(FrameUniforms, sizes)),
+        ("sizes2_", offset_of!(FrameUniforms, sizes2)),
+        ("proj", offset_of!(FrameUniforms, proj)),
+        ("proj_g0_", offset_of!(FrameUniforms, proj_g0)),
+        ("proj_g1_", offset_of!(FrameUniforms, proj_g1)),
+        ("proj_g2_", offset_of!(FrameUniforms, proj_g2)),
+    ];
+    let fields = get(frame, "fields").as_array().cloned().unwrap_or_default();
+    assert_eq!(fields.len(), host.len(), "{fields:?}");
+    for (f, (name, offset)) in fields.iter().zip(host) {
+        assert_eq!(str_of(f, "name"), name);
+        assert_eq!(get(f, "offset").as_u64(), Some(offset as u64), "{name}");
+    }
+}
+
+/// The dispatch formulas, evaluated at odd sizes, give `ceil(invocations / workgroup)` with
+/// the invocation grid of `scatter_runtime::prefiltered::Scatter::encode` and the workgroup
+/// sizes of the kernels it builds.
+#[test]
+fn manifest_dispatch_matches_the_runtime_grid() {
+    let (w, h, wr, hr) = (333u32, 187u32, 509u32, 257u32);
+    let sizes = [
+        ("screen.width", w),
+        ("screen.height", h),
+        ("rectified.width", wr),
+        ("rectified.height", hr),
+        ("shadow.size", 1024),
+    ];
+    for (bases, bases_per_thread, regions, visibility) in [
+        (32, 8, 3, VisibilityMode::Weighted),
+        (128, 4, 8, VisibilityMode::Average),
+        (4, 4, 1, VisibilityMode::Weighted),
+    ] {
+        let v = Variant {
+            bases,
+            bases_per_thread,
+            regions,
+            visibility,
+            ..Variant::default()
+        };
+        let m = manifest(v);
+        let passes = get(&get(&m, "variants")[0], "passes")
+            .as_array()
+            .cloned()
+            .unwrap_or_default();
+        // Scatter::encode's invocation grids, in pass order.
+        let grids = [
+            [wr, hr, 1],
+            [hr, v.regions, v.threads_per_row_region()],
+            [w, h, 1],
+        ];
+        assert_eq!(passes.len(), grids.len());
+        for ((pass, params), grid) in passes.iter().zip(KernelParams::prefiltered(v)).zip(grids) {
+            let built = build(&params).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(str_of(pass, "kernel"), built.kernel.name());
+            let dispatch = get(pass, "dispatch")
+                .as_array()
+                .cloned()
+                .unwrap_or_default();
+            for i in 0..3 {
+                let got = eval(str_of(&dispatch[i], "workgroups"), &sizes);
+                let want = grid[i].div_ceil(built.workgroup_size[i]);
+                assert_eq!(got, want, "{} {} dim {i}", v.id(), built.kernel);
+            }
+        }
+    }
+}
