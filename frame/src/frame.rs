@@ -220,6 +220,9 @@ pub enum FrameError {
         /// The smallest allowed width.
         min: u32,
     },
+    /// A variant knob is out of range.
+    #[error(transparent)]
+    Variant(#[from] crate::variant::VariantError),
     /// The eye sits on the spot light.
     #[error("the camera is at the spot light's position: epipolar rectification is undefined")]
     EyeAtLight,
@@ -406,7 +409,7 @@ pub struct PrefilteredFrame {
     pub report: FrameReport,
 }
 
-fn v4(v: DVec3, w: f64) -> [f32; 4] {
+pub(crate) fn v4(v: DVec3, w: f64) -> [f32; 4] {
     [v.x as f32, v.y as f32, v.z as f32, w as f32]
 }
 
@@ -521,59 +524,43 @@ impl Setup {
     }
 }
 
-/// Sets up one frame of the prefiltered method with epipolar rectification.
-pub fn prepare_frame(
-    variant: &Variant,
-    res: &Resolutions,
+/// The validated camera, light and medium of a frame, as every family's uniform block
+/// stores them.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ScenePart {
+    /// The camera.
+    pub(crate) cam: CameraDesc,
+    /// Unit direction from the eye towards the light.
+    pub(crate) axis: DVec3,
+    /// Eye-light distance (spot), 0 (directional).
+    pub(crate) dist: f64,
+    /// Spot position (zero for the sun).
+    pub(crate) light_pos: DVec3,
+    /// Unit direction the light travels (spot axis).
+    pub(crate) light_dir: DVec3,
+    /// Light colour.
+    pub(crate) color: [f64; 3],
+    /// Cosine of the inner cone angle (1 for the sun).
+    pub(crate) cos_in: f64,
+    /// Cosine of the outer cone angle (1 for the sun).
+    pub(crate) cos_out: f64,
+}
+
+/// Checks the camera, light and medium of a frame for a variant compiled for `expected`
+/// lights.
+pub(crate) fn validate_scene(
+    expected: LightKind,
     camera: &CameraDesc,
     light: &LightDesc,
     medium: &MediumDesc,
-    shadow: &ShadowMapDesc,
-    settings: &FrameSettings,
-) -> Result<PrefilteredFrame, FrameError> {
-    for (what, value, max) in [
-        ("screen width", res.screen[0], 16384),
-        ("screen height", res.screen[1], 16384),
-        ("rectified width", res.rectified[0], 16384),
-        ("rectified height", res.rectified[1], 16384),
-        ("shadow map size", shadow.size, 16384),
-        ("march steps", settings.march_steps, 4096),
-    ] {
-        if value == 0 || value > max {
-            return Err(FrameError::Size { what, value, max });
-        }
-    }
-    if settings.spot_quadrature == 0
-        || !settings.spot_quadrature.is_multiple_of(4)
-        || settings.spot_quadrature > 256
-    {
-        return Err(FrameError::Size {
-            what: "spot quadrature nodes (a multiple of 4)",
-            value: settings.spot_quadrature,
-            max: 256,
-        });
-    }
-    let max_half = settings.projective_max_half_angle_deg;
-    if !(max_half.is_finite() && max_half > 0.0 && max_half <= 89.0) {
-        return Err(FrameError::Degenerate(
-            "projective_max_half_angle_deg (must be in (0, 89])",
-        ));
-    }
-    let min_width = variant.regions * variant.regions;
-    if res.rectified[0] < min_width {
-        return Err(FrameError::RectifiedTooNarrow {
-            width: res.rectified[0],
-            regions: variant.regions,
-            min: min_width,
-        });
-    }
+) -> Result<ScenePart, FrameError> {
     let got = match light {
         LightDesc::Directional { .. } => LightKind::Directional,
         LightDesc::Spot { .. } => LightKind::Spot,
     };
-    if got != variant.light {
+    if got != expected {
         return Err(FrameError::LightMismatch {
-            expected: variant.light,
+            expected,
             got,
         });
     }
@@ -634,6 +621,85 @@ pub fn prepare_frame(
     if color.iter().any(|c| !c.is_finite()) {
         return Err(FrameError::Degenerate("light colour"));
     }
+    Ok(ScenePart {
+        cam,
+        axis,
+        dist,
+        light_pos,
+        light_dir,
+        color,
+        cos_in,
+        cos_out,
+    })
+}
+
+/// The shadow-map kind (0 orthographic, 1 perspective) and projection vector of the
+/// uniform blocks.
+pub(crate) fn shadow_projection(shadow: &ShadowMapDesc) -> (f64, [f32; 4]) {
+    match shadow.projection {
+        ShadowProjectionDesc::Orthographic { x0, x1, y0, y1 } => {
+            (0.0, [x0 as f32, x1 as f32, y0 as f32, y1 as f32])
+        }
+        ShadowProjectionDesc::Perspective { tan_half } => (1.0, [tan_half as f32, 0.0, 0.0, 0.0]),
+    }
+}
+
+/// Sets up one frame of the prefiltered method with epipolar rectification.
+pub fn prepare_frame(
+    variant: &Variant,
+    res: &Resolutions,
+    camera: &CameraDesc,
+    light: &LightDesc,
+    medium: &MediumDesc,
+    shadow: &ShadowMapDesc,
+    settings: &FrameSettings,
+) -> Result<PrefilteredFrame, FrameError> {
+    for (what, value, max) in [
+        ("screen width", res.screen[0], 16384),
+        ("screen height", res.screen[1], 16384),
+        ("rectified width", res.rectified[0], 16384),
+        ("rectified height", res.rectified[1], 16384),
+        ("shadow map size", shadow.size, 16384),
+        ("march steps", settings.march_steps, 4096),
+    ] {
+        if value == 0 || value > max {
+            return Err(FrameError::Size { what, value, max });
+        }
+    }
+    if settings.spot_quadrature == 0
+        || !settings.spot_quadrature.is_multiple_of(4)
+        || settings.spot_quadrature > 256
+    {
+        return Err(FrameError::Size {
+            what: "spot quadrature nodes (a multiple of 4)",
+            value: settings.spot_quadrature,
+            max: 256,
+        });
+    }
+    let max_half = settings.projective_max_half_angle_deg;
+    if !(max_half.is_finite() && max_half > 0.0 && max_half <= 89.0) {
+        return Err(FrameError::Degenerate(
+            "projective_max_half_angle_deg (must be in (0, 89])",
+        ));
+    }
+    let min_width = variant.regions * variant.regions;
+    if res.rectified[0] < min_width {
+        return Err(FrameError::RectifiedTooNarrow {
+            width: res.rectified[0],
+            regions: variant.regions,
+            min: min_width,
+        });
+    }
+    let ScenePart {
+        cam,
+        axis,
+        dist,
+        light_pos,
+        light_dir,
+        color,
+        cos_in,
+        cos_out,
+    } = validate_scene(variant.light, camera, light, medium)?;
     // e1: the view axis made perpendicular to A (so phi = 0 looks ahead), else any.
     let mut e1 = cam.forward - axis * cam.forward.dot(axis);
     if e1.length() < 1e-6 {
@@ -757,12 +823,7 @@ pub fn prepare_frame(
             slices[j].delta = fallback_delta.max(1e-6) as f32;
         }
     }
-    let (sm_kind, sm_proj) = match shadow.projection {
-        ShadowProjectionDesc::Orthographic { x0, x1, y0, y1 } => {
-            (0.0, [x0 as f32, x1 as f32, y0 as f32, y1 as f32])
-        }
-        ShadowProjectionDesc::Perspective { tan_half } => (1.0, [tan_half as f32, 0.0, 0.0, 0.0]),
-    };
+    let (sm_kind, sm_proj) = shadow_projection(shadow);
     let (ex, ey) = s.project(axis).unwrap_or((-1e9, -1e9));
     let (ax, ay) = s.project(-axis).unwrap_or((-1e9, -1e9));
     let theta_span = (theta_hi - theta_lo).max(1e-9);

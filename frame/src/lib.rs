@@ -10,4 +10,5 @@
 //! outputs are plain numbers, documented field by field.
 
 pub mod frame;
+pub mod raymarch;
 pub mod variant;

@@ -23,6 +23,14 @@ const COMMON_MODULES: &[(&str, &str)] = &[
         include_str!("../templates/common/model.wgsl"),
     ),
     (
+        "common/shadow.wgsl",
+        include_str!("../templates/common/shadow.wgsl"),
+    ),
+    (
+        "common/raymarch.wgsl",
+        include_str!("../templates/common/raymarch.wgsl"),
+    ),
+    (
         "common/prefiltered.wgsl",
         include_str!("../templates/common/prefiltered.wgsl"),
     ),
@@ -116,7 +124,9 @@ pub(crate) fn validate(kernel: Kernel, module: &naga::Module) -> Result<ModuleIn
 /// The template file of a kernel, relative to `shaderlib/templates`.
 pub(crate) const fn template_path(kernel: Kernel) -> &'static str {
     match kernel {
+        Kernel::InterleaveSum => "interleave_sum.wgsl",
         Kernel::Prefilter => "prefilter.wgsl",
+        Kernel::Raymarch => "raymarch.wgsl",
         Kernel::Rectify => "rectify.wgsl",
         Kernel::RowPrefix => "row_prefix.wgsl",
         Kernel::Scatter => "scatter.wgsl",

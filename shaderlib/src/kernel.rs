@@ -10,9 +10,15 @@ use std::fmt;
 )]
 #[serde(rename_all = "snake_case")]
 pub enum Kernel {
+    /// Separable sum filter of interleaved sampling over the `raymarch` partial sums (Tóth &
+    /// Umenhoffer 2009).
+    InterleaveSum,
     /// Fourier basis transform fused with the weighted running mean along each rectified
     /// row, per region (Klehm et al. 2014, Listings 1-3, Table 1).
     Prefilter,
+    /// Brute-force ray marching through the standard shadow map, optionally interleaved
+    /// (Tóth & Umenhoffer 2009).
+    Raymarch,
     /// Epipolar resampling of a standard shadow map into the rectified shadow map (Klehm et
     /// al. 2014, Sec. 4.1, after Baran et al. 2010).
     Rectify,
@@ -27,7 +33,9 @@ pub enum Kernel {
 impl Kernel {
     /// All kernels, sorted by name.
     pub const ALL: &'static [Self] = &[
+        Self::InterleaveSum,
         Self::Prefilter,
+        Self::Raymarch,
         Self::Rectify,
         Self::RowPrefix,
         Self::Scatter,
@@ -36,7 +44,9 @@ impl Kernel {
     /// The kernel's name: template file stem, entry point, mirror module and trial name.
     pub const fn name(self) -> &'static str {
         match self {
+            Self::InterleaveSum => "interleave_sum",
             Self::Prefilter => "prefilter",
+            Self::Raymarch => "raymarch",
             Self::Rectify => "rectify",
             Self::RowPrefix => "row_prefix",
             Self::Scatter => "scatter",

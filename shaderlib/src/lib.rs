@@ -6,9 +6,11 @@
 //! renders the template with the kernel's parameters, composes it with naga_oil, validates it
 //! with naga and returns the [`naga::Module`], its [`naga::valid::ModuleInfo`] and WGSL text.
 //!
-//! Kernels: `row_prefix` ([`RowPrefixParams`]) and the prefiltered family (Klehm et al. 2014)
+//! Kernels: `row_prefix` ([`RowPrefixParams`]), the prefiltered family (Klehm et al. 2014)
 //! `rectify`, `prefilter`, `scatter`, all three rendered from one
-//! [`prefiltered::Variant`] ([`KernelParams::prefiltered`]).
+//! [`prefiltered::Variant`] ([`KernelParams::prefiltered`]), and the raymarch family (Tóth &
+//! Umenhoffer 2009) `raymarch`, `interleave_sum` from a [`raymarch::RaymarchVariant`]
+//! ([`KernelParams::raymarch`]).
 //!
 //! ```
 //! use scatter_shaderlib::{build, KernelParams, RowPrefixMode, RowPrefixParams};
@@ -26,19 +28,27 @@ mod compose;
 mod error;
 mod kernel;
 pub mod prefiltered;
+pub mod raymarch;
 pub mod row_prefix;
 
 pub use error::ShaderError;
 pub use kernel::Kernel;
 use prefiltered::Variant;
+use raymarch::RaymarchVariant;
 pub use row_prefix::{RowPrefixMode, RowPrefixParams};
 
 /// A kernel together with the template parameters it is rendered with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "kernel", rename_all = "snake_case")]
 pub enum KernelParams {
+    /// [`Kernel::InterleaveSum`] of an interleaved raymarch-family variant (the code does
+    /// not depend on the variant).
+    InterleaveSum(RaymarchVariant),
     /// [`Kernel::Prefilter`] of a prefiltered-family variant.
     Prefilter(Variant),
+    /// [`Kernel::Raymarch`] of a raymarch-family variant (only `light` and whether it
+    /// interleaves change the code).
+    Raymarch(RaymarchVariant),
     /// [`Kernel::Rectify`] of a prefiltered-family variant (only `light` changes the code).
     Rectify(Variant),
     /// [`Kernel::RowPrefix`]: per-row running sum or mean.
@@ -52,7 +62,9 @@ impl KernelParams {
     /// The kernel these parameters belong to.
     pub fn kernel(&self) -> Kernel {
         match self {
+            Self::InterleaveSum(_) => Kernel::InterleaveSum,
             Self::Prefilter(_) => Kernel::Prefilter,
+            Self::Raymarch(_) => Kernel::Raymarch,
             Self::Rectify(_) => Kernel::Rectify,
             Self::RowPrefix(_) => Kernel::RowPrefix,
             Self::Scatter(_) => Kernel::Scatter,
@@ -69,6 +81,16 @@ impl KernelParams {
         ]
     }
 
+    /// The kernels of a raymarch-family variant, in pass order: `raymarch`, then
+    /// `interleave_sum` when it interleaves.
+    pub fn raymarch(variant: RaymarchVariant) -> Vec<Self> {
+        let mut out = vec![Self::Raymarch(variant)];
+        if variant.interleaved() {
+            out.push(Self::InterleaveSum(variant));
+        }
+        out
+    }
+
     /// Every parameter set the conformance suite checks: each kernel in each of its modes,
     /// with default workgroup sizes, then the prefiltered kernels of the default
     /// [`Variant`].
@@ -82,6 +104,10 @@ impl KernelParams {
                 })
             })
             .chain(Self::prefiltered(Variant::default()))
+            .chain(Self::raymarch(RaymarchVariant {
+                interleave: 2,
+                ..RaymarchVariant::default()
+            }))
             .collect()
     }
 }
@@ -149,7 +175,9 @@ pub fn build(params: &KernelParams) -> Result<BuiltKernel, ShaderError> {
 /// parameters, [`ShaderError::Render`] when askama fails.
 pub fn render(params: &KernelParams) -> Result<String, ShaderError> {
     match params {
+        KernelParams::InterleaveSum(v) => raymarch::render_interleave_sum(v),
         KernelParams::Prefilter(v) => prefiltered::kernels::render_prefilter(v),
+        KernelParams::Raymarch(v) => raymarch::render_raymarch(v),
         KernelParams::Rectify(v) => prefiltered::kernels::render_rectify(v),
         KernelParams::RowPrefix(p) => row_prefix::render(p),
         KernelParams::Scatter(v) => prefiltered::kernels::render_scatter(v),

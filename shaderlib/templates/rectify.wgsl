@@ -21,7 +21,8 @@
 // Mirrors reference/src/kernels/rectify.rs
 
 #import scatter::model::PI
-#import scatter::prefiltered::{Frame, NO_OCCLUDER, normalised_depth, row_phi, slice_e, slice_params, sm_occluder_distance}
+#import scatter::prefiltered::{Frame, normalised_depth, row_phi, slice_e, slice_params, sm_occluder_distance}
+#import scatter::shadow::NO_OCCLUDER
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;

@@ -6,17 +6,16 @@
 //! Conventions are documented in `scatter_shaderlib::prefiltered::frame`.
 
 use super::common_model::{
-    PI, clamp, cone_falloff, exp, max, min, mix, select, sqrt, transmittance_between,
+    PI, clamp, cone_falloff, exp, max, min, mix, sqrt, transmittance_between,
 };
+pub use super::common_shadow::NO_OCCLUDER;
+use super::common_shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams, Storage};
 
 /// Smallest cone factor of a spot texel weight (see the WGSL): a region of the reference ray
 /// outside the cone still averages its texels instead of storing an undefined mean.
 pub const CONE_FLOOR: f32 = 1e-3;
-
-/// Stand-in for "no occluder": a travel distance far beyond any scene.
-pub const NO_OCCLUDER: f32 = 1e30;
 
 /// An r32float texture (row-major from the top-left texel).
 #[derive(Clone, Debug, PartialEq)]
@@ -253,94 +252,27 @@ pub fn texel_weight(
     w
 }
 
-/// Light-space coordinates of a world point in the standard shadow map.
-pub fn sm_light_space(f: &FrameUniforms, p: Vec3) -> Vec3 {
-    let q = p - xyz(f.sm_origin);
-    Vec3::new(
-        q.dot(xyz(f.sm_right)),
-        q.dot(xyz(f.sm_up)),
-        q.dot(xyz(f.sm_forward)),
-    )
-}
-
-/// Texture coordinates (u, v) in [0, 1] of light-space point `ls` (outside: no coverage).
-pub fn sm_uv(f: &FrameUniforms, ls: Vec3) -> [f32; 2] {
-    if f.sm_origin[3] > 0.5 {
-        let z = max(ls.z, 1e-6);
-        let t = f.sm_proj[0];
-        [0.5 + 0.5 * ls.x / (z * t), 0.5 - 0.5 * ls.y / (z * t)]
-    } else {
-        [
-            (ls.x - f.sm_proj[0]) / (f.sm_proj[1] - f.sm_proj[0]),
-            (f.sm_proj[3] - ls.y) / (f.sm_proj[3] - f.sm_proj[2]),
-        ]
+/// The frame's standard shadow map ([`super::common_shadow`]).
+pub fn sm_view(f: &FrameUniforms) -> ShadowMapView {
+    ShadowMapView {
+        right: f.sm_right,
+        up: f.sm_up,
+        forward: f.sm_forward,
+        origin: f.sm_origin,
+        proj: f.sm_proj,
+        size: [f.sizes2[0], 0, 0, 0],
     }
 }
 
-/// Depth bias in world units at light-space depth `z`.
-pub fn sm_bias(f: &FrameUniforms, z: f32) -> f32 {
-    let size = f.sizes2[0] as f32;
-    let texel = if f.sm_origin[3] > 0.5 {
-        2.0 * max(z, 0.0) * f.sm_proj[0] / size
-    } else {
-        max(f.sm_proj[1] - f.sm_proj[0], f.sm_proj[3] - f.sm_proj[2]) / size
-    };
-    f.sm_forward[3] * texel
-}
-
-/// Stored depth of the nearest texel at (u, v), or 2 (beyond everything) outside the map.
-pub fn sm_fetch(f: &FrameUniforms, sm: &Tex, uv: [f32; 2]) -> f32 {
-    if uv[0] < 0.0 || uv[0] > 1.0 || uv[1] < 0.0 || uv[1] > 1.0 {
-        return 2.0;
-    }
-    let n = f.sizes2[0];
-    let x = ((uv[0] * n as f32) as u32).min(n - 1);
-    let y = ((uv[1] * n as f32) as u32).min(n - 1);
-    sm.load(x, y)
-}
-
-/// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed): nearest texel,
-/// biased, exactly the test of the `shadow_map` ground truth.
+/// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed).
 pub fn sm_visibility(f: &FrameUniforms, sm: &Tex, p: Vec3) -> f32 {
-    let ls = sm_light_space(f, p);
-    let (near, far) = (f.sm_right[3], f.sm_up[3]);
-    if f.sm_origin[3] > 0.5 && ls.z <= near {
-        return 1.0;
-    }
-    let stored = sm_fetch(f, sm, sm_uv(f, ls));
-    let depth = (ls.z - near) / (far - near);
-    select(0.0, 1.0, depth <= stored + sm_bias(f, ls.z) / (far - near))
+    shadow_visibility(&sm_view(f), sm, p)
 }
 
-/// Travel distance from `o` along the light ray `o + s l` to its first occluder, biased as
-/// [`sm_visibility`] biases (points before it are lit), or [`NO_OCCLUDER`]. For a spot the
-/// ray must start at the shadow map's origin (the light).
+/// Travel distance from `o` along the light ray `o + s l` to its first occluder, or
+/// [`NO_OCCLUDER`].
 pub fn sm_occluder_distance(f: &FrameUniforms, sm: &Tex, o: Vec3, l: Vec3) -> f32 {
-    let ls = sm_light_space(f, o);
-    let (near, far) = (f.sm_right[3], f.sm_up[3]);
-    if f.sm_origin[3] > 0.5 {
-        let dir = Vec3::new(
-            l.dot(xyz(f.sm_right)),
-            l.dot(xyz(f.sm_up)),
-            l.dot(xyz(f.sm_forward)),
-        );
-        if dir.z <= 1e-6 {
-            return NO_OCCLUDER;
-        }
-        let stored = sm_fetch(f, sm, sm_uv(f, dir));
-        if stored >= 1.0 {
-            return NO_OCCLUDER;
-        }
-        let z = near + stored * (far - near);
-        (z + sm_bias(f, z)) / dir.z
-    } else {
-        let stored = sm_fetch(f, sm, sm_uv(f, ls));
-        if stored >= 1.0 {
-            return NO_OCCLUDER;
-        }
-        let z = near + stored * (far - near);
-        z + sm_bias(f, z) - ls.z
-    }
+    shadow_occluder_distance(&sm_view(f), sm, o, l)
 }
 
 /// First column of region `r` of `regions` in a row of `width` columns. Directional lights

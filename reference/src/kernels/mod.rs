@@ -5,7 +5,11 @@
 
 pub mod common_model;
 pub mod common_prefiltered;
+pub mod common_raymarch;
+pub mod common_shadow;
+pub mod interleave_sum;
 pub mod prefilter;
+pub mod raymarch;
 pub mod rectify;
 pub mod row_prefix;
 pub mod scatter;
@@ -134,4 +138,60 @@ pub fn scene_reach(scene: &Scene, bvh: &Bvh) -> f64 {
         return 1.0;
     }
     2.0 * (b.max - b.min).length() + 1.0
+}
+
+/// Every intermediate of one CPU run of the raymarch family.
+#[derive(Clone, Debug)]
+pub struct RaymarchRun {
+    /// The uniform block.
+    pub uniforms: scatter_shaderlib::raymarch::MarchUniforms,
+    /// The partial sums of an interleaved variant (rgba32float), `None` otherwise.
+    pub partial: Option<TexArray>,
+    /// In-scattered radiance (as stored in rgba16float).
+    pub output: Image,
+}
+
+/// Runs `raymarch` (and `interleave_sum` when the variant interleaves) on the CPU for a
+/// scene, its depth buffer and its standard shadow map.
+pub fn run_raymarch(
+    variant: &scatter_shaderlib::raymarch::RaymarchVariant,
+    scene: &Scene,
+    gbuf: &GBuffer,
+    shadow_map: &ShadowMap,
+) -> Result<RaymarchRun, FrameError> {
+    let uniforms = scatter_shaderlib::raymarch::prepare_march(
+        variant,
+        [gbuf.width, gbuf.height],
+        &scene.camera_desc(),
+        &scene.light_desc(),
+        &scene.medium_desc(),
+        &shadow_map.desc(),
+    )?;
+    let sm = Tex {
+        width: shadow_map.size,
+        height: shadow_map.size,
+        data: shadow_map.depth.clone(),
+    };
+    let depth = Tex {
+        width: gbuf.width,
+        height: gbuf.height,
+        data: gbuf.view_depth.clone(),
+    };
+    let marched = raymarch::raymarch(variant, &uniforms, &depth, &sm);
+    let (partial, out) = if variant.interleaved() {
+        let out = interleave_sum::interleave_sum(&uniforms, &marched);
+        (Some(marched), out)
+    } else {
+        (None, marched)
+    };
+    let output = Image::from_pixels(
+        gbuf.width,
+        gbuf.height,
+        out.data.iter().map(|c| [c[0], c[1], c[2]]).collect(),
+    );
+    Ok(RaymarchRun {
+        uniforms,
+        partial,
+        output,
+    })
 }

@@ -1,8 +1,8 @@
 // scatter::prefiltered: what the three kernels of the prefiltered family (Klehm et al. 2014)
 // share: the `Frame` uniform block, the per-slice parameters, the rectified-space mapping
 // (Sec. 4.1), the Fourier basis and its coefficients (Sec. 3, Eq. 8), the prefilter's
-// reference-ray weights (Eq. 11/12), region bounds (Table 1) and the standard shadow-map
-// lookup used by `rectify` and by the epipole ray march of `scatter` (Sec. 5).
+// reference-ray weights (Eq. 11/12), region bounds (Table 1) and the frame's standard
+// shadow map (`scatter::shadow`) for `rectify` and the epipole ray march of `scatter` (Sec. 5).
 //
 // Composed into kernels by naga_oil (`#import scatter::prefiltered::{...}`); plain WGSL, not
 // an askama template. Conventions: `scatter_shaderlib::prefiltered::frame`. Mirrored line by
@@ -15,6 +15,7 @@
 #define_import_path scatter::prefiltered
 
 #import scatter::model::{PI, cone_falloff, transmittance_between}
+#import scatter::shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility}
 
 // The uniform block (host: `scatter_shaderlib::prefiltered::FrameUniforms`, field by field;
 // every member is 16 bytes, 25 * 16 = 400 bytes in all). The host's `e1`, `e2`, `sizes2` and
@@ -95,9 +96,6 @@ struct SliceParams {
 fn slice_params(v: vec4<f32>) -> SliceParams {
     return SliceParams(v.x, v.y, v.z, v.w);
 }
-
-// Stand-in for "no occluder": a travel distance far beyond any scene.
-const NO_OCCLUDER: f32 = 1e30f;
 
 // Unit vector of slice angle `phi` (perpendicular to the axis).
 fn slice_e(f: Frame, phi: f32) -> vec3<f32> {
@@ -202,88 +200,21 @@ fn texel_weight(f: Frame, s: SliceParams, row: u32, i: u32, weighted: bool, spot
     return w;
 }
 
-// Light-space coordinates of a world point in the standard shadow map.
-fn sm_light_space(f: Frame, p: vec3<f32>) -> vec3<f32> {
-    let q = p - f.sm_origin.xyz;
-    return vec3<f32>(dot(q, f.sm_right.xyz), dot(q, f.sm_up.xyz), dot(q, f.sm_forward.xyz));
+// The frame's standard shadow map (`scatter::shadow`).
+fn sm_view(f: Frame) -> ShadowMapView {
+    return ShadowMapView(f.sm_right, f.sm_up, f.sm_forward, f.sm_origin, f.sm_proj, vec4<u32>(f.sizes2_[0], 0u, 0u, 0u));
 }
 
-// Texture coordinates (u, v) in [0, 1] of light-space point `ls` (outside: no coverage).
-fn sm_uv(f: Frame, ls: vec3<f32>) -> vec2<f32> {
-    if f.sm_origin[3] > 0.5 {
-        let z = max(ls.z, 1e-6);
-        let t = f.sm_proj[0];
-        return vec2<f32>(0.5 + 0.5 * ls.x / (z * t), 0.5 - 0.5 * ls.y / (z * t));
-    } else {
-        return vec2<f32>(
-            (ls.x - f.sm_proj[0]) / (f.sm_proj[1] - f.sm_proj[0]),
-            (f.sm_proj[3] - ls.y) / (f.sm_proj[3] - f.sm_proj[2]),
-        );
-    }
-}
-
-// Depth bias in world units at light-space depth `z`.
-fn sm_bias(f: Frame, z: f32) -> f32 {
-    let size = f32(f.sizes2_[0]);
-    var texel: f32;
-    if f.sm_origin[3] > 0.5 {
-        texel = 2.0 * max(z, 0.0) * f.sm_proj[0] / size;
-    } else {
-        texel = max(f.sm_proj[1] - f.sm_proj[0], f.sm_proj[3] - f.sm_proj[2]) / size;
-    }
-    return f.sm_forward[3] * texel;
-}
-
-// Stored depth of the nearest texel at (u, v), or 2 (beyond everything) outside the map.
-// `sm`: the kernel's r32float `shadow_map` binding.
-fn sm_fetch(f: Frame, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    if uv[0] < 0.0 || uv[0] > 1.0 || uv[1] < 0.0 || uv[1] > 1.0 {
-        return 2.0;
-    }
-    let n = f.sizes2_[0];
-    let x = min(u32(uv[0] * f32(n)), n - 1u);
-    let y = min(u32(uv[1] * f32(n)), n - 1u);
-    return textureLoad(sm, vec2<u32>(x, y), 0).x;
-}
-
-// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed): nearest texel,
-// biased, exactly the test of the `shadow_map` ground truth.
+// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed), as the `shadow_map`
+// ground truth tests it. `sm`: the kernel's r32float `shadow_map` binding.
 fn sm_visibility(f: Frame, sm: texture_2d<f32>, p: vec3<f32>) -> f32 {
-    let ls = sm_light_space(f, p);
-    let near = f.sm_right[3]; let far = f.sm_up[3];
-    if f.sm_origin[3] > 0.5 && ls.z <= near {
-        return 1.0;
-    }
-    let stored = sm_fetch(f, sm, sm_uv(f, ls));
-    let depth = (ls.z - near) / (far - near);
-    return select(0.0, 1.0, depth <= stored + sm_bias(f, ls.z) / (far - near));
+    return shadow_visibility(sm_view(f), sm, p);
 }
 
-// Travel distance from `o` along the light ray `o + s l` to its first occluder, biased as
-// `sm_visibility` biases (points before it are lit), or NO_OCCLUDER. For a spot the
-// ray must start at the shadow map's origin (the light).
+// Travel distance from `o` along the light ray `o + s l` to its first occluder, or
+// NO_OCCLUDER (`scatter::shadow::shadow_occluder_distance`).
 fn sm_occluder_distance(f: Frame, sm: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
-    let ls = sm_light_space(f, o);
-    let near = f.sm_right[3]; let far = f.sm_up[3];
-    if f.sm_origin[3] > 0.5 {
-        let dir = vec3<f32>(dot(l, f.sm_right.xyz), dot(l, f.sm_up.xyz), dot(l, f.sm_forward.xyz));
-        if dir.z <= 1e-6 {
-            return NO_OCCLUDER;
-        }
-        let stored = sm_fetch(f, sm, sm_uv(f, dir));
-        if stored >= 1.0 {
-            return NO_OCCLUDER;
-        }
-        let z = near + stored * (far - near);
-        return (z + sm_bias(f, z)) / dir.z;
-    } else {
-        let stored = sm_fetch(f, sm, sm_uv(f, ls));
-        if stored >= 1.0 {
-            return NO_OCCLUDER;
-        }
-        let z = near + stored * (far - near);
-        return z + sm_bias(f, z) - ls.z;
-    }
+    return shadow_occluder_distance(sm_view(f), sm, o, l);
 }
 
 // ---- Projective rectification (Sec. 4.2; conventions: `ProjectiveMaps` and

@@ -1,0 +1,229 @@
+//! The `raymarch` family (Tóth & Umenhoffer 2009): brute-force ray marching through the
+//! standard shadow map, optionally with interleaved sampling. [`RaymarchVariant`] holds its
+//! knobs; [`prepare_march`] fills its uniform block ([`MarchUniforms`], WGSL `struct March`
+//! in `shaderlib/templates/common/raymarch.wgsl`).
+//!
+//! # The estimate
+//!
+//! A view ray `[0, s]` is cut into `samples` (N) cells of length `h = s / N`; cell `j` is
+//! sampled at `t_j = (j + u) h` with `u = 0.5`, or a per-pixel jitter `u` in [0, 1).
+//! Directional light: each cell contributes `V(t_j)` times the exact transmittance integral
+//! over the cell (`sigma_s p E` applied once per pixel); spot light: `V(t_j) f(t_j) h`, `f`
+//! the shadow-free integrand (cone, `exp(-sigma_t (d + t)) / d^2`, phase).
+//!
+//! Interleaved sampling with `interleave` M > 1: pixel `(x, y)` belongs to class
+//! `c = (x mod Mx) + Mx (y mod My)` with `Mx = min(M, width)`, `My = min(M, height)`, and
+//! sums only the cells `j = c, c + Mx My, c + 2 Mx My, ...`; a separable sum filter
+//! (`interleave_sum`, M taps along x, then along y, windows clamped inside the screen so each
+//! holds every class once) adds the classes of the neighbourhood. With a constant integrand
+//! the result is exactly the full-N sum; elsewhere it trades noise for blur across depth
+//! edges (the paper's "halos").
+
+use bytemuck::{Pod, Zeroable};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+use crate::frame::{
+    CameraDesc, FrameError, LightDesc, MediumDesc, ShadowMapDesc, shadow_projection, v4,
+    validate_scene,
+};
+use crate::variant::{LightKind, VariantError};
+
+/// The knobs of the `raymarch` family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RaymarchVariant {
+    /// Cells per view ray N (4..=1024, a multiple of `interleave^2`).
+    pub samples: u32,
+    /// Interleaving tile side M (1..=8; 1 = every pixel takes all N samples, no filter).
+    pub interleave: u32,
+    /// Per-pixel jitter of the sample positions inside their cells.
+    pub jitter: bool,
+    /// Light type.
+    pub light: LightKind,
+}
+
+impl Default for RaymarchVariant {
+    /// 64 samples, no interleaving, no jitter, directional light.
+    fn default() -> Self {
+        RaymarchVariant {
+            samples: 64,
+            interleave: 1,
+            jitter: false,
+            light: LightKind::Directional,
+        }
+    }
+}
+
+impl RaymarchVariant {
+    /// Allowed `samples`.
+    pub const SAMPLES: std::ops::RangeInclusive<u32> = 4..=1024;
+    /// Allowed `interleave`.
+    pub const INTERLEAVE: std::ops::RangeInclusive<u32> = 1..=8;
+
+    /// Checks every knob; the error names the first offending one.
+    pub fn validate(&self) -> Result<(), VariantError> {
+        if !Self::INTERLEAVE.contains(&self.interleave) {
+            return Err(VariantError {
+                knob: "interleave",
+                value: self.interleave.to_string(),
+                allowed: "in 1..=8".into(),
+            });
+        }
+        let m2 = self.interleave * self.interleave;
+        if !Self::SAMPLES.contains(&self.samples) || !self.samples.is_multiple_of(m2) {
+            return Err(VariantError {
+                knob: "samples",
+                value: self.samples.to_string(),
+                allowed: format!(
+                    "in 4..=1024 and a multiple of interleave^2 = {m2} (every pixel class gets the same number of samples)"
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Whether the variant has the `interleave_sum` passes.
+    pub fn interleaved(&self) -> bool {
+        self.interleave > 1
+    }
+
+    /// A short stable id: `n64-i4-jitter-directional`, `n128-i1-nojitter-spot`.
+    pub fn id(&self) -> String {
+        format!(
+            "n{}-i{}-{}-{}",
+            self.samples,
+            self.interleave,
+            if self.jitter { "jitter" } else { "nojitter" },
+            self.light
+        )
+    }
+
+    /// The conformance grid: samples {8, 32, 128} x interleave {1, 2, 4} x jitter x light
+    /// (pairs whose samples are not a multiple of interleave^2 skipped).
+    pub fn grid() -> Vec<RaymarchVariant> {
+        let mut out = Vec::new();
+        for samples in [8, 32, 128] {
+            for interleave in [1, 2, 4] {
+                for jitter in [false, true] {
+                    for &light in LightKind::ALL {
+                        let v = RaymarchVariant {
+                            samples,
+                            interleave,
+                            jitter,
+                            light,
+                        };
+                        if v.validate().is_ok() {
+                            out.push(v);
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+impl fmt::Display for RaymarchVariant {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.id())
+    }
+}
+
+/// The uniform block of the `raymarch` and `interleave_sum` kernels (WGSL `struct March`).
+/// Every field is a 16-byte vector; the asserts below pin the layout.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct MarchUniforms {
+    /// Eye position; w unused.
+    pub eye: [f32; 4],
+    /// Camera forward; w = tan(fov_y / 2).
+    pub cam_forward: [f32; 4],
+    /// Camera right; w = aspect (width / height).
+    pub cam_right: [f32; 4],
+    /// Camera up; w = near.
+    pub cam_up: [f32; 4],
+    /// x = sigma_t, y = sigma_s, z = g, w unused.
+    pub medium: [f32; 4],
+    /// Light colour (E or I); w unused.
+    pub light_color: [f32; 4],
+    /// Spot position; w = cos(inner angle).
+    pub light_pos: [f32; 4],
+    /// Direction the light travels (spot axis); w = cos(outer angle).
+    pub light_dir: [f32; 4],
+    /// Shadow-map right; w = shadow-map near.
+    pub sm_right: [f32; 4],
+    /// Shadow-map up; w = shadow-map far.
+    pub sm_up: [f32; 4],
+    /// Shadow-map forward; w = bias in texel footprints.
+    pub sm_forward: [f32; 4],
+    /// Shadow-map origin; w = 0 orthographic, 1 perspective.
+    pub sm_origin: [f32; 4],
+    /// Orthographic: x0, x1, y0, y1. Perspective: tan_half, 0, 0, 0.
+    pub sm_proj: [f32; 4],
+    /// Screen width, height, shadow-map size, samples N.
+    pub sizes: [u32; 4],
+    /// Mx = min(M, width), My = min(M, height), jitter (0 or 1), M.
+    pub interleave: [u32; 4],
+}
+
+const _: () = {
+    assert!(size_of::<MarchUniforms>() == 15 * 16);
+    assert!(std::mem::offset_of!(MarchUniforms, sm_proj) == 12 * 16);
+    assert!(std::mem::offset_of!(MarchUniforms, sizes) == 13 * 16);
+    assert!(std::mem::offset_of!(MarchUniforms, interleave) == 14 * 16);
+};
+
+/// Fills the `raymarch` uniform block for one frame.
+///
+/// # Errors
+///
+/// [`FrameError::Size`] for a zero or oversized screen or shadow map,
+/// [`FrameError::LightMismatch`] for a light of the other type, [`FrameError::Degenerate`]
+/// for NaN or degenerate camera, light or medium, [`FrameError::EyeAtLight`]; a variant error
+/// for bad knobs is reported as [`FrameError::Variant`].
+pub fn prepare_march(
+    variant: &RaymarchVariant,
+    screen: [u32; 2],
+    camera: &CameraDesc,
+    light: &LightDesc,
+    medium: &MediumDesc,
+    shadow: &ShadowMapDesc,
+) -> Result<MarchUniforms, FrameError> {
+    variant.validate().map_err(FrameError::Variant)?;
+    for (what, value, max) in [
+        ("screen width", screen[0], 16384),
+        ("screen height", screen[1], 16384),
+        ("shadow map size", shadow.size, 16384),
+    ] {
+        if value == 0 || value > max {
+            return Err(FrameError::Size { what, value, max });
+        }
+    }
+    let sc = validate_scene(variant.light, camera, light, medium)?;
+    let (sm_kind, sm_proj) = shadow_projection(shadow);
+    let cam = sc.cam;
+    let m = variant.interleave;
+    Ok(MarchUniforms {
+        eye: v4(cam.position, 0.0),
+        cam_forward: v4(cam.forward, cam.tan_half_fov_y),
+        cam_right: v4(cam.right, f64::from(screen[0]) / f64::from(screen[1])),
+        cam_up: v4(cam.up, cam.near),
+        medium: [
+            medium.sigma_t as f32,
+            (medium.sigma_t * medium.albedo) as f32,
+            medium.g as f32,
+            0.0,
+        ],
+        light_color: [sc.color[0] as f32, sc.color[1] as f32, sc.color[2] as f32, 0.0],
+        light_pos: v4(sc.light_pos, sc.cos_in),
+        light_dir: v4(sc.light_dir, sc.cos_out),
+        sm_right: v4(shadow.basis[0], shadow.near),
+        sm_up: v4(shadow.basis[1], shadow.far),
+        sm_forward: v4(shadow.basis[2], shadow.bias_texels),
+        sm_origin: v4(shadow.origin, sm_kind),
+        sm_proj,
+        sizes: [screen[0], screen[1], shadow.size, variant.samples],
+        interleave: [m.min(screen[0]), m.min(screen[1]), u32::from(variant.jitter), m],
+    })
+}

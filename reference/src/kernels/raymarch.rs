@@ -1,0 +1,102 @@
+//! CPU mirror of `shaderlib/templates/raymarch.wgsl`: brute-force ray marching through the
+//! standard shadow map, optionally one interleaving class per pixel (Tóth & Umenhoffer
+//! 2009). Conventions: `scatter_frame::raymarch`.
+
+use super::common_model::{max, phase_hg, spot_integrand, transmittance_between};
+use super::common_prefiltered::{Tex, TexArray, quantise, xyz};
+use super::common_raymarch::{march_pixel_dir, march_shadow_view, pixel_jitter};
+use super::common_shadow::shadow_visibility;
+use scatter_shaderlib::prefiltered::{LightKind, Storage};
+use scatter_shaderlib::raymarch::{MarchUniforms, RaymarchVariant};
+
+/// The kernel body for pixel `id`; returns the texel it stores (radiance, or the partial
+/// sum of an interleaved variant), before the storage format's rounding.
+pub fn raymarch_main(
+    id: [u32; 3],
+    variant: &RaymarchVariant,
+    m: &MarchUniforms,
+    depth: &Tex,
+    shadow_map: &Tex,
+) -> Option<[f32; 4]> {
+    let (x, y) = (id[0], id[1]);
+    if x >= m.sizes[0] || y >= m.sizes[1] {
+        return None;
+    }
+    let spot = variant.light == LightKind::Spot;
+    let eye = xyz(m.eye);
+    let dir = march_pixel_dir(m, x, y);
+    let s = max(depth.load(x, y), 0.0) / max(dir.dot(xyz(m.cam_forward)), 1e-6);
+    let n = m.sizes[3];
+    let h = s / n as f32;
+    let mx = m.interleave[0];
+    let my = m.interleave[1];
+    let stride = mx * my;
+    let pixel_class = (x % mx) + mx * (y % my);
+    let mut u = 0.5;
+    if m.interleave[2] != 0 {
+        u = pixel_jitter(x, y);
+    }
+    let view = march_shadow_view(m);
+    let mut sum = 0.0;
+    let mut j = pixel_class;
+    while j < n {
+        let t = (j as f32 + u) * h;
+        let v = shadow_visibility(&view, shadow_map, eye + dir * t);
+        if spot {
+            sum += v
+                * h
+                * spot_integrand(
+                    eye,
+                    dir,
+                    t,
+                    xyz(m.light_pos),
+                    xyz(m.light_dir),
+                    m.light_pos[3],
+                    m.light_dir[3],
+                    m.medium,
+                );
+        } else {
+            sum += v * transmittance_between(m.medium[0], j as f32 * h, (j + 1) as f32 * h);
+        }
+        j += stride;
+    }
+    let mut l = sum;
+    if !spot {
+        l = m.medium[1] * phase_hg(m.medium[2], -xyz(m.light_dir).dot(dir)) * sum;
+    }
+    let c = xyz(m.light_color) * l;
+    Some([c.x, c.y, c.z, 1.0])
+}
+
+/// Runs every pixel (rows in parallel): radiance as stored in rgba16float, or the partial
+/// sums (rgba32float) of an interleaved variant.
+pub fn raymarch(
+    variant: &RaymarchVariant,
+    m: &MarchUniforms,
+    depth: &Tex,
+    shadow_map: &Tex,
+) -> TexArray {
+    use rayon::prelude::*;
+    let (w, h) = (m.sizes[0], m.sizes[1]);
+    let storage = if variant.interleaved() {
+        Storage::Rgba32float
+    } else {
+        Storage::Rgba16float
+    };
+    let data = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (0..w).map(move |x| {
+                raymarch_main([x, y, 0], variant, m, depth, shadow_map)
+                    .unwrap_or([0.0; 4])
+                    .map(|c| quantise(c, storage))
+            })
+        })
+        .collect();
+    TexArray {
+        width: w,
+        height: h,
+        layers: 1,
+        data,
+    }
+}

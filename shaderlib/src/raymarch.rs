@@ -1,0 +1,82 @@
+//! The `raymarch` family (Tóth & Umenhoffer 2009): the askama views of
+//! `templates/raymarch.wgsl` and `templates/interleave_sum.wgsl` and their rendering from a
+//! [`RaymarchVariant`]. CPU mirrors: `reference/src/kernels/{raymarch,interleave_sum}.rs`.
+//! Host-side knobs and uniforms: [`scatter_frame::raymarch`] (re-exported here).
+
+use askama::Template;
+
+pub use scatter_frame::raymarch::{MarchUniforms, RaymarchVariant, prepare_march};
+
+use crate::compose::template_path;
+use crate::prefiltered::LightKind;
+use crate::{Kernel, ShaderError};
+
+/// Workgroup size of `raymarch` and `interleave_sum`: one invocation per pixel.
+pub const RAYMARCH_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
+
+/// Format of the partial sums `raymarch` stores for `interleave_sum` (interleaved variants).
+pub const PARTIAL_FORMAT: &str = "rgba32float";
+
+/// `raymarch`: per-pixel march, full or one interleaving class.
+#[derive(Template)]
+#[template(path = "raymarch.wgsl")]
+struct RaymarchTemplate {
+    light_name: &'static str,
+    spot: bool,
+    interleaved: bool,
+    output_format: &'static str,
+}
+
+/// `interleave_sum`: the separable window sum.
+#[derive(Template)]
+#[template(path = "interleave_sum.wgsl")]
+struct InterleaveSumTemplate {}
+
+fn validate(kernel: Kernel, variant: &RaymarchVariant) -> Result<(), ShaderError> {
+    variant
+        .validate()
+        .map_err(|source| ShaderError::Variant { kernel, source })
+}
+
+/// Renders `templates/raymarch.wgsl` for `variant` (`samples` is a uniform, not compiled
+/// in: only the light and whether the variant interleaves change the code).
+pub(crate) fn render_raymarch(variant: &RaymarchVariant) -> Result<String, ShaderError> {
+    validate(Kernel::Raymarch, variant)?;
+    RaymarchTemplate {
+        light_name: variant.light.name(),
+        spot: variant.light == LightKind::Spot,
+        interleaved: variant.interleaved(),
+        output_format: if variant.interleaved() {
+            PARTIAL_FORMAT
+        } else {
+            "rgba16float"
+        },
+    }
+    .render()
+    .map_err(|source| ShaderError::Render {
+        kernel: Kernel::Raymarch,
+        template: template_path(Kernel::Raymarch),
+        source,
+    })
+}
+
+/// Renders `templates/interleave_sum.wgsl` (the same code for every interleaved variant;
+/// an error for a variant without interleaving, which has no such pass).
+pub(crate) fn render_interleave_sum(variant: &RaymarchVariant) -> Result<String, ShaderError> {
+    validate(Kernel::InterleaveSum, variant)?;
+    if !variant.interleaved() {
+        return Err(ShaderError::InvalidParameter {
+            kernel: Kernel::InterleaveSum,
+            knob: "interleave",
+            value: variant.interleave.to_string(),
+            allowed: "2..=8 (a variant with interleave = 1 has no interleave_sum pass)",
+        });
+    }
+    InterleaveSumTemplate {}
+        .render()
+        .map_err(|source| ShaderError::Render {
+            kernel: Kernel::InterleaveSum,
+            template: template_path(Kernel::InterleaveSum),
+            source,
+        })
+}
