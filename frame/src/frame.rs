@@ -559,10 +559,7 @@ pub(crate) fn validate_scene(
         LightDesc::Spot { .. } => LightKind::Spot,
     };
     if got != expected {
-        return Err(FrameError::LightMismatch {
-            expected,
-            got,
-        });
+        return Err(FrameError::LightMismatch { expected, got });
     }
     let cam = *camera;
     if !(finite(cam.position) && finite(cam.forward) && finite(cam.right) && finite(cam.up)) {

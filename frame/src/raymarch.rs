@@ -215,7 +215,12 @@ pub fn prepare_march(
             medium.g as f32,
             0.0,
         ],
-        light_color: [sc.color[0] as f32, sc.color[1] as f32, sc.color[2] as f32, 0.0],
+        light_color: [
+            sc.color[0] as f32,
+            sc.color[1] as f32,
+            sc.color[2] as f32,
+            0.0,
+        ],
         light_pos: v4(sc.light_pos, sc.cos_in),
         light_dir: v4(sc.light_dir, sc.cos_out),
         sm_right: v4(shadow.basis[0], shadow.near),
@@ -224,6 +229,11 @@ pub fn prepare_march(
         sm_origin: v4(shadow.origin, sm_kind),
         sm_proj,
         sizes: [screen[0], screen[1], shadow.size, variant.samples],
-        interleave: [m.min(screen[0]), m.min(screen[1]), u32::from(variant.jitter), m],
+        interleave: [
+            m.min(screen[0]),
+            m.min(screen[1]),
+            u32::from(variant.jitter),
+            m,
+        ],
     })
 }

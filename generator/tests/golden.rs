@@ -1,5 +1,6 @@
-//! Golden files: the complete output for two canonical variants (the paper's default, and a
-//! small spot-light variant with average visibility and rgba16float) in every target, kept
+//! Golden files: the complete output for three canonical variants (the paper's default, a
+//! small spot-light variant with average visibility and rgba16float, and an interleaved
+//! raymarch variant) in every target, kept
 //! as reviewable text in `tests/golden/` (SPIR-V as `spirv-dis` text; its exact bytes are
 //! pinned by the sha256 in the golden `manifest.json`). Any change to a template, to naga or
 //! to the generator shows up here as a diff.
@@ -29,8 +30,15 @@ fn canonical() -> Generated {
             ("storage".into(), "rgba16float".into()),
         ])
         .unwrap_or_else(|e| panic!("{e}"));
+    let march = Family::Raymarch
+        .variant(&[
+            ("samples".into(), "64".into()),
+            ("interleave".into(), "4".into()),
+            ("jitter".into(), "true".into()),
+        ])
+        .unwrap_or_else(|e| panic!("{e}"));
     generate(&Request {
-        variants: vec![Family::Prefiltered.default_variant(), spot],
+        variants: vec![Family::Prefiltered.default_variant(), spot, march],
         targets: Target::ALL.to_vec(),
     })
     .unwrap_or_else(|e| panic!("{e}"))

@@ -1,6 +1,8 @@
 //! The whole default grid (`Variant::grid(1..=4)`: every `bases` power of two with every
 //! `bases_per_thread`, 1-4 regions, both visibilities and lights, every storage format and
-//! every rectification the variant grid lists) through the generator with every target, then every
+//! every rectification the variant grid lists) plus the raymarch grid
+//! (`RaymarchVariant::grid()`: samples 8/32/128, interleave 1/2/4, jitter, both lights)
+//! through the generator with every target, then every
 //! distinct emitted SPIR-V through `spirv-val` and every distinct GLSL through
 //! `glslangValidator`. Identical files (e.g. `rectify` only depends on the light) are
 //! validated once.
@@ -15,6 +17,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use scatter_gen::{FamilyVariant, Request, Target, generate, manifest};
 use scatter_shaderlib::prefiltered::Variant;
+use scatter_shaderlib::raymarch::RaymarchVariant;
 
 use common::{require, scratch};
 
@@ -23,6 +26,11 @@ fn grid() -> Vec<FamilyVariant> {
     Variant::grid(1..=4)
         .into_iter()
         .map(FamilyVariant::Prefiltered)
+        .chain(
+            RaymarchVariant::grid()
+                .into_iter()
+                .map(FamilyVariant::Raymarch),
+        )
         .collect()
 }
 

@@ -81,14 +81,14 @@ pub enum RuntimeError {
         #[source]
         source: VariantError,
     },
-    /// The per-frame parameters of the `prefiltered` family cannot be set up (NaN or
-    /// degenerate camera, light or medium, wrong light type, bad sizes).
-    #[error("prefiltered: frame set-up failed: {0}")]
+    /// The per-frame parameters cannot be set up (NaN or degenerate camera, light or
+    /// medium, wrong light type, bad sizes).
+    #[error("frame set-up failed: {0}")]
     Frame(#[from] FrameError),
     /// The shadow map of a frame differs in size from the one the pipelines were made for.
     #[error(
-        "prefiltered: the shadow map is {actual}x{actual} texels but the pass was created for \
-         {expected}x{expected}; create a new `Scatter` for the new size"
+        "the shadow map is {actual}x{actual} texels but the pass was created for \
+         {expected}x{expected}; create a new pass (`Scatter`, `Raymarch`) for the new size"
     )]
     ShadowMapSize {
         /// The size given at creation.
@@ -137,6 +137,15 @@ pub enum RuntimeError {
         expected: String,
         /// What was given.
         actual: String,
+    },
+    /// A raymarch-family variant knob is out of range.
+    #[error("raymarch variant {variant}: {source}")]
+    InvalidRaymarchVariant {
+        /// The variant's id.
+        variant: String,
+        /// Which knob and why.
+        #[source]
+        source: VariantError,
     },
     /// A texture the frame's rectification needs was not given.
     #[error("kernel `{kernel}`: missing input: {what}")]

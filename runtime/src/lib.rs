@@ -8,11 +8,13 @@
 //! ([`RowPrefixPass`]), plus a one-call convenience for tests ([`row_prefix`]). Kernel
 //! families with several passes have one type for the whole family: [`Scatter`] runs the
 //! `prefiltered` method (`rectify`, `prefilter`, `scatter`) once per frame, [`run_once`] is
-//! its test convenience.
+//! its test convenience; [`Raymarch`] runs the `raymarch` family (`raymarch`, then
+//! `interleave_sum` when interleaved), [`run_raymarch_once`] its test convenience.
 
 mod context;
 mod error;
 pub mod prefiltered;
+pub mod raymarch;
 pub mod row_prefix;
 mod timer;
 
@@ -21,6 +23,7 @@ pub use error::RuntimeError;
 pub use prefiltered::{
     CpuInputs, FrameInput, Inputs, PassTimes, Scatter, ScatterReadback, run_once,
 };
+pub use raymarch::{MarchInput, MarchReadback, MarchTimes, Raymarch, run_raymarch_once};
 pub use row_prefix::{ArraySize, RowPrefixOutput, RowPrefixPass, row_prefix};
 pub use timer::GpuTimer;
 

@@ -106,11 +106,11 @@ impl PassTimes {
 
 /// One compute pipeline with its bind group layout and workgroup size.
 #[derive(Debug)]
-struct Pipeline {
-    kernel: Kernel,
-    layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::ComputePipeline,
-    workgroup_size: [u32; 3],
+pub(crate) struct Pipeline {
+    pub(crate) kernel: Kernel,
+    pub(crate) layout: wgpu::BindGroupLayout,
+    pub(crate) pipeline: wgpu::ComputePipeline,
+    pub(crate) workgroup_size: [u32; 3],
 }
 
 /// The `prefiltered` method for one [`Variant`], sized for one set of [`Resolutions`] and one
@@ -142,7 +142,7 @@ pub struct Scatter {
 }
 
 /// Workgroup counts `ceil(n / size)` of one dispatch.
-fn groups(n: [u32; 3], size: [u32; 3]) -> [u32; 3] {
+pub(crate) fn groups(n: [u32; 3], size: [u32; 3]) -> [u32; 3] {
     [0, 1, 2].map(|i| n[i].div_ceil(size[i].max(1)))
 }
 
@@ -816,14 +816,14 @@ impl Scatter {
     }
 }
 
-fn buffer_entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+pub(crate) fn buffer_entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry {
         binding,
         resource: buffer.as_entire_binding(),
     }
 }
 
-fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+pub(crate) fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry {
         binding,
         resource: wgpu::BindingResource::TextureView(view),
@@ -831,13 +831,13 @@ fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_
 }
 
 /// Names of the properties of one engine-provided texture, for [`check_view`].
-struct ViewNames {
+pub(crate) struct ViewNames {
     format: &'static str,
     size: &'static str,
     usage: &'static str,
 }
 
-const DEPTH_NAMES: ViewNames = ViewNames {
+pub(crate) const DEPTH_NAMES: ViewNames = ViewNames {
     format: "depth buffer format",
     size: "depth buffer size",
     usage: "depth buffer usage",
@@ -849,14 +849,14 @@ const RECTIFIED_NAMES: ViewNames = ViewNames {
     usage: "rasterised rectified map usage",
 };
 
-const SHADOW_NAMES: ViewNames = ViewNames {
+pub(crate) const SHADOW_NAMES: ViewNames = ViewNames {
     format: "shadow map format",
     size: "shadow map size",
     usage: "shadow map usage",
 };
 
 /// Checks an engine-provided r32float texture view: format, size, sampling usage.
-fn check_view(
+pub(crate) fn check_view(
     kernel: Kernel,
     names: &ViewNames,
     view: &wgpu::TextureView,
@@ -900,7 +900,10 @@ fn check_view(
 }
 
 /// Checks a kernel's workgroup size against the device limits.
-fn check_workgroup(limits: &wgpu::Limits, built: &BuiltKernel) -> Result<(), RuntimeError> {
+pub(crate) fn check_workgroup(
+    limits: &wgpu::Limits,
+    built: &BuiltKernel,
+) -> Result<(), RuntimeError> {
     let [x, y, z] = built.workgroup_size;
     let kernel = built.kernel;
     check_limit(
@@ -934,7 +937,7 @@ fn check_workgroup(limits: &wgpu::Limits, built: &BuiltKernel) -> Result<(), Run
 }
 
 /// Creates a kernel's bind group layout and compute pipeline inside an error scope.
-fn create_pipeline(
+pub(crate) fn create_pipeline(
     device: &wgpu::Device,
     built: BuiltKernel,
     entries: &[wgpu::BindGroupLayoutEntry],
@@ -1188,7 +1191,7 @@ pub fn run_once(
 }
 
 /// Decodes one rgba texel of a storage format to f32.
-fn decode_rgba(texel: &[u8], storage: Storage) -> [f32; 4] {
+pub(crate) fn decode_rgba(texel: &[u8], storage: Storage) -> [f32; 4] {
     match storage {
         Storage::Rgba8unorm => [0, 1, 2, 3].map(|c| f32::from(texel[c]) / 255.0),
         Storage::Rgba16float => [0, 1, 2, 3].map(|c| {
@@ -1206,7 +1209,7 @@ fn decode_rgba(texel: &[u8], storage: Storage) -> [f32; 4] {
 }
 
 /// A texture copied into a mappable buffer (rows padded to 256 bytes).
-struct Readback {
+pub(crate) struct Readback {
     buffer: wgpu::Buffer,
     extent: wgpu::Extent3d,
     texel_bytes: u32,
@@ -1215,7 +1218,7 @@ struct Readback {
 
 impl Readback {
     /// Records the copy of every layer of `texture` (`texel_bytes` per texel).
-    fn encode(
+    pub(crate) fn encode(
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         texture: &wgpu::Texture,
@@ -1254,7 +1257,7 @@ impl Readback {
 
     /// Maps the buffer and returns the texels' bytes without row padding, layer by layer,
     /// row by row.
-    fn read(self, ctx: &Context, kernel: Kernel) -> Result<Vec<u8>, RuntimeError> {
+    pub(crate) fn read(self, ctx: &Context, kernel: Kernel) -> Result<Vec<u8>, RuntimeError> {
         let bytes = read_buffer(ctx, kernel, &self.buffer)?;
         let row_bytes = (self.extent.width * self.texel_bytes) as usize;
         let mut packed = Vec::with_capacity(

@@ -7,6 +7,7 @@
 //! manifest and the tests pick it up from [`Family::ALL`] without changing shape.
 
 pub mod prefiltered;
+pub mod raymarch;
 
 use std::fmt;
 
@@ -21,6 +22,8 @@ use crate::GenError;
 pub enum Family {
     /// Klehm et al. 2014: `rectify`, `prefilter`, `scatter`.
     Prefiltered,
+    /// Tóth & Umenhoffer 2009: `raymarch`, `interleave_sum` (interleaved variants).
+    Raymarch,
 }
 
 /// One knob of a family, as the CLI, `scatter-gen list` and the config file show it.
@@ -47,12 +50,13 @@ impl KnobInfo {
 
 impl Family {
     /// Every family, sorted by name.
-    pub const ALL: &'static [Family] = &[Family::Prefiltered];
+    pub const ALL: &'static [Family] = &[Family::Prefiltered, Family::Raymarch];
 
     /// The family's name (`--family`, config key `family`, manifest).
     pub const fn name(self) -> &'static str {
         match self {
             Self::Prefiltered => "prefiltered",
+            Self::Raymarch => "raymarch",
         }
     }
 
@@ -63,6 +67,10 @@ impl Family {
                 "Klehm et al. 2014, prefiltered single scattering: Fourier-basis visibility \
                  prefiltered along epipolar rows of a rectified shadow map"
             }
+            Self::Raymarch => {
+                "Toth & Umenhoffer 2009, ray marching through the standard shadow map, \
+                 optionally with interleaved sampling and a separable sum filter"
+            }
         }
     }
 
@@ -70,6 +78,7 @@ impl Family {
     pub fn knobs(self) -> Vec<KnobInfo> {
         match self {
             Self::Prefiltered => prefiltered::knobs(),
+            Self::Raymarch => raymarch::knobs(),
         }
     }
 
@@ -77,12 +86,23 @@ impl Family {
     pub fn default_variant(self) -> FamilyVariant {
         match self {
             Self::Prefiltered => FamilyVariant::Prefiltered(Default::default()),
+            Self::Raymarch => FamilyVariant::Raymarch(Default::default()),
         }
     }
 
-    /// The kernels of a variant, in pass order (read from shaderlib, not listed here).
+    /// The kernels of a variant, in pass order (read from shaderlib, not listed here), for
+    /// the variant that has the most passes.
     pub fn kernels(self) -> Vec<Kernel> {
-        self.default_variant()
+        let variant = match self {
+            Self::Raymarch => {
+                FamilyVariant::Raymarch(scatter_shaderlib::raymarch::RaymarchVariant {
+                    interleave: 2,
+                    ..Default::default()
+                })
+            }
+            _ => self.default_variant(),
+        };
+        variant
             .kernel_params()
             .iter()
             .map(KernelParams::kernel)
@@ -108,6 +128,7 @@ impl Family {
         }
         match self {
             Self::Prefiltered => prefiltered::parse(knobs).map(FamilyVariant::Prefiltered),
+            Self::Raymarch => raymarch::parse(knobs).map(FamilyVariant::Raymarch),
         }
     }
 }
@@ -138,6 +159,8 @@ impl std::str::FromStr for Family {
 pub enum FamilyVariant {
     /// A prefiltered-family variant.
     Prefiltered(scatter_shaderlib::prefiltered::Variant),
+    /// A raymarch-family variant.
+    Raymarch(scatter_shaderlib::raymarch::RaymarchVariant),
 }
 
 impl FamilyVariant {
@@ -145,6 +168,7 @@ impl FamilyVariant {
     pub const fn family(&self) -> Family {
         match self {
             Self::Prefiltered(_) => Family::Prefiltered,
+            Self::Raymarch(_) => Family::Raymarch,
         }
     }
 
@@ -152,6 +176,7 @@ impl FamilyVariant {
     pub fn id(&self) -> String {
         match self {
             Self::Prefiltered(v) => v.id(),
+            Self::Raymarch(v) => v.id(),
         }
     }
 
@@ -159,6 +184,7 @@ impl FamilyVariant {
     pub fn knobs_json(&self) -> serde_json::Value {
         match self {
             Self::Prefiltered(v) => serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
+            Self::Raymarch(v) => serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
         }
     }
 
@@ -166,6 +192,7 @@ impl FamilyVariant {
     pub fn kernel_params(&self) -> Vec<KernelParams> {
         match self {
             Self::Prefiltered(v) => KernelParams::prefiltered(*v).to_vec(),
+            Self::Raymarch(v) => KernelParams::raymarch(*v),
         }
     }
 
@@ -173,6 +200,7 @@ impl FamilyVariant {
     pub fn plan(&self) -> Plan {
         match self {
             Self::Prefiltered(v) => prefiltered::plan(v),
+            Self::Raymarch(v) => raymarch::plan(v),
         }
     }
 }

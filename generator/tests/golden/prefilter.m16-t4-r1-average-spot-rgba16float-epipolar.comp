@@ -5,6 +5,14 @@
 #extension GL_ARB_shader_storage_buffer_object : require
 layout(local_size_x = 64, local_size_y = 1, local_size_z = 1) in;
 
+struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+    vec4 right;
+    vec4 up;
+    vec4 forward;
+    vec4 origin;
+    vec4 proj;
+    uvec4 size;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     vec4 eye;
     vec4 axis;
@@ -39,6 +47,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float theta_hi;
 };
 const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 const float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
 const uint REGIONS = 1u;
 const uint BASES_PER_THREAD = 4u;
@@ -46,7 +55,7 @@ const uint THREADS_PER_ROW_REGION = 4u;
 
 layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _group_0_binding_0_cs; };
 
-layout(std430, binding = 1) readonly buffer type_6_block_1Compute { vec4 _group_0_binding_1_cs[]; };
+layout(std430, binding = 1) readonly buffer type_9_block_1Compute { vec4 _group_0_binding_1_cs[]; };
 
 layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
@@ -74,8 +83,118 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     return ((x_2 * x_2) * (3.0 - (2.0 * x_2)));
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec4 v) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v.x, v.y, v.z, v.w);
+vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
+    vec3 q_1 = (p - v.origin.xyz);
+    return vec3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+}
+
+vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
+    if ((v_1.origin.w > 0.5)) {
+        float z_1 = max(ls.z, 1e-6);
+        float t = v_1.proj.x;
+        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t))), (0.5 - ((0.5 * ls.y) / (z_1 * t))));
+    } else {
+        return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
+    }
+}
+
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
+    bool local_2 = false;
+    bool local_3 = false;
+    bool local_4 = false;
+    if (!((uv.x < 0.0))) {
+        local_2 = (uv.x > 1.0);
+    } else {
+        local_2 = true;
+    }
+    bool _e11 = local_2;
+    if (!(_e11)) {
+        local_3 = (uv.y < 0.0);
+    } else {
+        local_3 = true;
+    }
+    bool _e19 = local_3;
+    if (!(_e19)) {
+        local_4 = (uv.y > 1.0);
+    } else {
+        local_4 = true;
+    }
+    bool _e27 = local_4;
+    if (_e27) {
+        return 2.0;
+    }
+    uint n = v_2.size.x;
+    uint x_3 = min(uint((uv.x * float(n))), (n - 1u));
+    uint y = min(uint((uv.y * float(n))), (n - 1u));
+    int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_3, y)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    return _e49.x;
+}
+
+float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
+    float texel = 0.0;
+    float size = float(v_3.size.x);
+    if ((v_3.origin.w > 0.5)) {
+        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
+    } else {
+        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
+    }
+    float _e32 = texel;
+    return (v_3.forward.w * _e32);
+}
+
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_1) {
+    bool local_5 = false;
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
+    float near = v_4.right.w;
+    float far = v_4.up.w;
+    if ((v_4.origin.w > 0.5)) {
+        local_5 = (_e2.z <= near);
+    } else {
+        local_5 = false;
+    }
+    bool _e16 = local_5;
+    if (_e16) {
+        return 1.0;
+    }
+    vec2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
+    float depth = ((_e2.z - near) / (far - near));
+    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
+    return ((depth <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+}
+
+float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5, sampler2D sm_2, vec3 o, vec3 l) {
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
+    float near_1 = v_5.right.w;
+    float far_1 = v_5.up.w;
+    if ((v_5.origin.w > 0.5)) {
+        vec3 dir = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir.z <= 1e-6)) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
+        if ((_e28 >= 1.0)) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
+        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
+        return ((z_2 + _e35) / dir.z);
+    } else {
+        vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
+        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
+        if ((_e40 >= 1.0)) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        float z_3 = (near_1 + (_e40 * (far_1 - near_1)));
+        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
+        return ((z_3 + _e47) - _e2.z);
+    }
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec4 v_6) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
 }
 
 float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k) {
@@ -96,17 +215,17 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
 }
 
 float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX s, float x, bool spot_1) {
-    bool local_2 = false;
+    bool local_6 = false;
     float cap = (4.0 * f.theta.z);
     if (spot_1) {
         float psi = (x * s.delta);
         float den = sin((s.theta_ref + psi));
         if (!((den <= 0.0001))) {
-            local_2 = ((s.theta_ref + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_6 = ((s.theta_ref + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_2 = true;
+            local_6 = true;
         }
-        bool _e23 = local_2;
+        bool _e23 = local_6;
         if (_e23) {
             return cap;
         }
@@ -137,10 +256,10 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_
         float psi_1 = ((float(i_1) + 0.5) * s_1.delta);
         float _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, row_1);
         vec3 _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, _e23);
-        vec3 l = ((-(f_3.axis.xyz) * cos(psi_1)) + (_e24 * sin(psi_1)));
+        vec3 l_1 = ((-(f_3.axis.xyz) * cos(psi_1)) + (_e24 * sin(psi_1)));
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
         float r_1 = max(((f_3.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
-        float _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
+        float _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
         float cone = max(_e53, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         float _e56 = w;
         w = (_e56 * ((cone * exp((-(f_3.medium.x) * r_1))) / (r_1 * r_1)));

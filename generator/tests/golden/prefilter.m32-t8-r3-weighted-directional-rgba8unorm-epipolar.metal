@@ -10,6 +10,14 @@ struct _mslBufferSizes {
     uint size1;
 };
 
+struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+    metal::float4 right;
+    metal::float4 up;
+    metal::float4 forward;
+    metal::float4 origin;
+    metal::float4 proj;
+    metal::uint4 size;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     metal::float4 eye;
     metal::float4 axis;
@@ -43,11 +51,12 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float theta_lo;
     float theta_hi;
 };
-typedef metal::float4 type_6[1];
-struct type_10 {
+typedef metal::float4 type_9[1];
+struct type_12 {
     metal::float4 inner[2];
 };
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
 constant uint REGIONS = 3u;
 constant uint BASES_PER_THREAD = 8u;
@@ -85,10 +94,146 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     return (x_2 * x_2) * (3.0 - (2.0 * x_2));
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float4 v
+metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
+    metal::float3 p
 ) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {v.x, v.y, v.z, v.w};
+    metal::float3 q_1 = p - v.origin.xyz;
+    return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
+}
+
+metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
+    metal::float3 ls
+) {
+    if (v_1.origin.w > 0.5) {
+        float z_1 = metal::max(ls.z, 0.000001);
+        float t = v_1.proj.x;
+        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t)), 0.5 - ((0.5 * ls.y) / (z_1 * t)));
+    } else {
+        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
+    }
+}
+
+uint naga_f2u32(float value) {
+    return static_cast<uint>(metal::clamp(value, 0.0, 4294967000.0));
+}
+
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2,
+    metal::texture2d<float, metal::access::sample> sm,
+    metal::float2 uv
+) {
+    bool local_2 = {};
+    bool local_3 = {};
+    bool local_4 = {};
+    if (!((uv.x < 0.0))) {
+        local_2 = uv.x > 1.0;
+    } else {
+        local_2 = true;
+    }
+    bool _e11 = local_2;
+    if (!(_e11)) {
+        local_3 = uv.y < 0.0;
+    } else {
+        local_3 = true;
+    }
+    bool _e19 = local_3;
+    if (!(_e19)) {
+        local_4 = uv.y > 1.0;
+    } else {
+        local_4 = true;
+    }
+    bool _e27 = local_4;
+    if (_e27) {
+        return 2.0;
+    }
+    uint n = v_2.size.x;
+    uint x_3 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
+    uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
+    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_3, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    return _e49.x;
+}
+
+float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
+    float z
+) {
+    float texel = {};
+    float size = static_cast<float>(v_3.size.x);
+    if (v_3.origin.w > 0.5) {
+        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
+    } else {
+        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
+    }
+    float _e32 = texel;
+    return v_3.forward.w * _e32;
+}
+
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
+    metal::texture2d<float, metal::access::sample> sm_1,
+    metal::float3 p_1
+) {
+    bool local_5 = {};
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
+    float near = v_4.right.w;
+    float far = v_4.up.w;
+    if (v_4.origin.w > 0.5) {
+        local_5 = _e2.z <= near;
+    } else {
+        local_5 = false;
+    }
+    bool _e16 = local_5;
+    if (_e16) {
+        return 1.0;
+    }
+    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
+    float depth = (_e2.z - near) / (far - near);
+    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
+    return (depth <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
+}
+
+float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5,
+    metal::texture2d<float, metal::access::sample> sm_2,
+    metal::float3 o,
+    metal::float3 l
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
+    float near_1 = v_5.right.w;
+    float far_1 = v_5.up.w;
+    if (v_5.origin.w > 0.5) {
+        metal::float3 dir = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir.z <= 0.000001) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
+        if (_e28 >= 1.0) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        float z_2 = near_1 + (_e28 * (far_1 - near_1));
+        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
+        return (z_2 + _e35) / dir.z;
+    } else {
+        metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
+        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
+        if (_e40 >= 1.0) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        float z_3 = near_1 + (_e40 * (far_1 - near_1));
+        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
+        return (z_3 + _e47) - _e2.z;
+    }
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    metal::float4 v_6
+) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {v_6.x, v_6.y, v_6.z, v_6.w};
 }
 
 float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -128,17 +273,17 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     float x,
     bool spot_1
 ) {
-    bool local_2 = {};
+    bool local_6 = {};
     float cap = 4.0 * f.theta.z;
     if (spot_1) {
         float psi = x * s.delta;
         float den = metal::sin(s.theta_ref + psi);
         if (!((den <= 0.0001))) {
-            local_2 = (s.theta_ref + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_6 = (s.theta_ref + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local_2 = true;
+            local_6 = true;
         }
-        bool _e23 = local_2;
+        bool _e23 = local_6;
         if (_e23) {
             return cap;
         }
@@ -182,10 +327,10 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
         float psi_1 = (static_cast<float>(i_1) + 0.5) * s_1.delta;
         float _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, row_1);
         metal::float3 _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, _e23);
-        metal::float3 l = (-(f_3.axis.xyz) * metal::cos(psi_1)) + (_e24 * metal::sin(psi_1));
+        metal::float3 l_1 = (-(f_3.axis.xyz) * metal::cos(psi_1)) + (_e24 * metal::sin(psi_1));
         float den_1 = metal::max(metal::sin(s_1.theta_ref + psi_1), 0.0001);
         float r_1 = metal::max((f_3.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
-        float _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
+        float _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
         float cone = metal::max(_e53, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         float _e56 = w;
         w = _e56 * ((cone * metal::exp(-(f_3.medium.x) * r_1)) / (r_1 * r_1));
@@ -199,14 +344,14 @@ struct prefilterInput {
 kernel void prefilter(
   metal::uint3 id [[thread_position_in_grid]]
 , constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX& frame [[buffer(0)]]
-, device type_6 const& slices [[buffer(1)]]
+, device type_9 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(0)]]
 , metal::texture2d_array<float, metal::access::write> filtered [[texture(1)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
 ) {
     bool local = {};
     bool local_1 = {};
-    type_10 acc = {};
+    type_12 acc = {};
     float wsum = 0.0;
     uint i = {};
     uint q = {};

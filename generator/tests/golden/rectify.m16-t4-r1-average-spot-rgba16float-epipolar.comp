@@ -5,6 +5,14 @@
 #extension GL_ARB_shader_storage_buffer_object : require
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
+struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+    vec4 right;
+    vec4 up;
+    vec4 forward;
+    vec4 origin;
+    vec4 proj;
+    uvec4 size;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     vec4 eye;
     vec4 axis;
@@ -39,7 +47,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float theta_hi;
 };
 const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 1e30;
+const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.1;
 
 layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _group_0_binding_0_cs; };
@@ -72,38 +80,22 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     return ((x_1 * x_1) * (3.0 - (2.0 * x_1)));
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec4 v) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v.x, v.y, v.z, v.w);
+vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
+    vec3 q = (p - v.origin.xyz);
+    return vec3(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
 }
 
-vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f, float phi) {
-    return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
-}
-
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1, uint row) {
-    return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
-}
-
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float theta, float lo, float hi) {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
-}
-
-vec3 sm_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2, vec3 p) {
-    vec3 q = (p - f_2.sm_origin.xyz);
-    return vec3(dot(q, f_2.sm_right.xyz), dot(q, f_2.sm_up.xyz), dot(q, f_2.sm_forward.xyz));
-}
-
-vec2 sm_uvX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, vec3 ls) {
-    if ((f_3.sm_origin.w > 0.5)) {
+vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
+    if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t = f_3.sm_proj.x;
+        float t = v_1.proj.x;
         return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t))), (0.5 - ((0.5 * ls.y) / (z_1 * t))));
     } else {
-        return vec2(((ls.x - f_3.sm_proj.x) / (f_3.sm_proj.y - f_3.sm_proj.x)), ((f_3.sm_proj.w - ls.y) / (f_3.sm_proj.w - f_3.sm_proj.z)));
+        return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
 }
 
-float sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4, sampler2D sm, vec2 uv) {
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
     bool local_1 = false;
     bool local_2 = false;
     bool local_3 = false;
@@ -128,7 +120,7 @@ float sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_
     if (_e27) {
         return 2.0;
     }
-    uint n = f_4.sizes2_.x;
+    uint n = v_2.size.x;
     uint x_2 = min(uint((uv.x * float(n))), (n - 1u));
     uint y = min(uint((uv.y * float(n))), (n - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
@@ -136,45 +128,92 @@ float sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_
     return _e49.x;
 }
 
-float sm_biasX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5, float z) {
+float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
     float texel = 0.0;
-    float size = float(f_5.sizes2_.x);
-    if ((f_5.sm_origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * f_5.sm_proj.x) / size);
+    float size = float(v_3.size.x);
+    if ((v_3.origin.w > 0.5)) {
+        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
     } else {
-        texel = (max((f_5.sm_proj.y - f_5.sm_proj.x), (f_5.sm_proj.w - f_5.sm_proj.z)) / size);
+        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
     }
     float _e32 = texel;
-    return (f_5.sm_forward.w * _e32);
+    return (v_3.forward.w * _e32);
 }
 
-float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_6, sampler2D sm_1, vec3 o, vec3 l) {
-    vec3 _e2 = sm_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, o);
-    float near = f_6.sm_right.w;
-    float far = f_6.sm_up.w;
-    if ((f_6.sm_origin.w > 0.5)) {
-        vec3 dir = vec3(dot(l, f_6.sm_right.xyz), dot(l, f_6.sm_up.xyz), dot(l, f_6.sm_forward.xyz));
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_1) {
+    bool local_4 = false;
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
+    float near = v_4.right.w;
+    float far = v_4.up.w;
+    if ((v_4.origin.w > 0.5)) {
+        local_4 = (_e2.z <= near);
+    } else {
+        local_4 = false;
+    }
+    bool _e16 = local_4;
+    if (_e16) {
+        return 1.0;
+    }
+    vec2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
+    float depth = ((_e2.z - near) / (far - near));
+    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
+    return ((depth <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+}
+
+float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5, sampler2D sm_2, vec3 o, vec3 l) {
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
+    float near_1 = v_5.right.w;
+    float far_1 = v_5.up.w;
+    if ((v_5.origin.w > 0.5)) {
+        vec3 dir = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
         if ((dir.z <= 1e-6)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX;
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        vec2 _e26 = sm_uvX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, dir);
-        float _e28 = sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, sm_1, _e26);
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX;
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        float z_2 = (near + (_e28 * (far - near)));
-        float _e35 = sm_biasX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, z_2);
+        float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
+        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
         return ((z_2 + _e35) / dir.z);
     } else {
-        vec2 _e39 = sm_uvX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, _e2);
-        float _e40 = sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, sm_1, _e39);
+        vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
+        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
         if ((_e40 >= 1.0)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX;
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        float z_3 = (near + (_e40 * (far - near)));
-        float _e47 = sm_biasX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, z_3);
+        float z_3 = (near_1 + (_e40 * (far_1 - near_1)));
+        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
         return ((z_3 + _e47) - _e2.z);
     }
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec4 v_6) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
+}
+
+vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f, float phi) {
+    return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1, uint row) {
+    return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
+}
+
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float theta, float lo, float hi) {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
+}
+
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2) {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, uvec4(f_2.sizes2_.x, 0u, 0u, 0u));
+}
+
+float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, sampler2D sm_3, vec3 o_1, vec3 l_1) {
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3);
+    float _e5 = shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, o_1, l_1);
+    return _e5;
 }
 
 void main() {
@@ -204,20 +243,20 @@ void main() {
     vec4 _e36 = _group_0_binding_0_cs.axis;
     vec3 axis = _e36.xyz;
     if (true) {
-        vec3 l_1 = ((-(axis) * cos(col)) + (_e28 * sin(col)));
+        vec3 l_2 = ((-(axis) * cos(col)) + (_e28 * sin(col)));
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e46 = _group_0_binding_0_cs;
         vec4 _e49 = _group_0_binding_0_cs.light_pos;
-        float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e46, _group_0_binding_2_cs, _e49.xyz, l_1);
-        if ((_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX)) {
+        float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e46, _group_0_binding_2_cs, _e49.xyz, l_2);
+        if ((_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
             float dist = _group_0_binding_0_cs.axis.w;
             theta_occ = atan((_e52 * sin(col)), (dist - (_e52 * cos(col))));
         }
     } else {
         vec4 _e68 = _group_0_binding_0_cs.eye;
-        vec3 o_1 = (_e68.xyz + (_e28 * col));
+        vec3 o_2 = (_e68.xyz + (_e28 * col));
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e73 = _group_0_binding_0_cs;
-        float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e73, _group_0_binding_2_cs, o_1, -(axis));
-        if ((_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX)) {
+        float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e73, _group_0_binding_2_cs, o_2, -(axis));
+        if ((_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
             theta_occ = atan(col, -(_e76));
         }
     }

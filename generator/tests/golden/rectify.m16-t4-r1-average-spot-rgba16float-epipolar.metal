@@ -10,6 +10,14 @@ struct _mslBufferSizes {
     uint size1;
 };
 
+struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+    metal::float4 right;
+    metal::float4 up;
+    metal::float4 forward;
+    metal::float4 origin;
+    metal::float4 proj;
+    metal::uint4 size;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     metal::float4 eye;
     metal::float4 axis;
@@ -45,7 +53,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
 };
 typedef metal::float4 type_9[1];
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 1000000000000000000000000000000.0;
+constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.1;
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -80,52 +88,24 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     return (x_1 * x_1) * (3.0 - (2.0 * x_1));
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float4 v
-) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {v.x, v.y, v.z, v.w};
-}
-
-metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f,
-    float phi
-) {
-    return (f.e1_.xyz * metal::cos(phi)) + (f.e2_.xyz * metal::sin(phi));
-}
-
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1,
-    uint row
-) {
-    return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
-}
-
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    float theta,
-    float lo,
-    float hi
-) {
-    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * metal::clamp((theta - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
-}
-
-metal::float3 sm_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2,
+metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
     metal::float3 p
 ) {
-    metal::float3 q = p - f_2.sm_origin.xyz;
-    return metal::float3(metal::dot(q, f_2.sm_right.xyz), metal::dot(q, f_2.sm_up.xyz), metal::dot(q, f_2.sm_forward.xyz));
+    metal::float3 q = p - v.origin.xyz;
+    return metal::float3(metal::dot(q, v.right.xyz), metal::dot(q, v.up.xyz), metal::dot(q, v.forward.xyz));
 }
 
-metal::float2 sm_uvX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3,
+metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
     metal::float3 ls
 ) {
-    if (f_3.sm_origin.w > 0.5) {
+    if (v_1.origin.w > 0.5) {
         float z_1 = metal::max(ls.z, 0.000001);
-        float t = f_3.sm_proj.x;
+        float t = v_1.proj.x;
         return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t)), 0.5 - ((0.5 * ls.y) / (z_1 * t)));
     } else {
-        return metal::float2((ls.x - f_3.sm_proj.x) / (f_3.sm_proj.y - f_3.sm_proj.x), (f_3.sm_proj.w - ls.y) / (f_3.sm_proj.w - f_3.sm_proj.z));
+        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
     }
 }
 
@@ -133,8 +113,8 @@ uint naga_f2u32(float value) {
     return static_cast<uint>(metal::clamp(value, 0.0, 4294967000.0));
 }
 
-float sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4,
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2,
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
@@ -162,7 +142,7 @@ float sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     if (_e27) {
         return 2.0;
     }
-    uint n = f_4.sizes2_.x;
+    uint n = v_2.size.x;
     uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
     uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
@@ -170,53 +150,123 @@ float sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     return _e49.x;
 }
 
-float sm_biasX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5,
+float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
     float z
 ) {
     float texel = {};
-    float size = static_cast<float>(f_5.sizes2_.x);
-    if (f_5.sm_origin.w > 0.5) {
-        texel = ((2.0 * metal::max(z, 0.0)) * f_5.sm_proj.x) / size;
+    float size = static_cast<float>(v_3.size.x);
+    if (v_3.origin.w > 0.5) {
+        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
     } else {
-        texel = metal::max(f_5.sm_proj.y - f_5.sm_proj.x, f_5.sm_proj.w - f_5.sm_proj.z) / size;
+        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
     }
     float _e32 = texel;
-    return f_5.sm_forward.w * _e32;
+    return v_3.forward.w * _e32;
 }
 
-float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_6,
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
     metal::texture2d<float, metal::access::sample> sm_1,
+    metal::float3 p_1
+) {
+    bool local_4 = {};
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
+    float near = v_4.right.w;
+    float far = v_4.up.w;
+    if (v_4.origin.w > 0.5) {
+        local_4 = _e2.z <= near;
+    } else {
+        local_4 = false;
+    }
+    bool _e16 = local_4;
+    if (_e16) {
+        return 1.0;
+    }
+    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
+    float depth = (_e2.z - near) / (far - near);
+    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
+    return (depth <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
+}
+
+float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5,
+    metal::texture2d<float, metal::access::sample> sm_2,
     metal::float3 o,
     metal::float3 l
 ) {
-    metal::float3 _e2 = sm_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, o);
-    float near = f_6.sm_right.w;
-    float far = f_6.sm_up.w;
-    if (f_6.sm_origin.w > 0.5) {
-        metal::float3 dir = metal::float3(metal::dot(l, f_6.sm_right.xyz), metal::dot(l, f_6.sm_up.xyz), metal::dot(l, f_6.sm_forward.xyz));
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
+    float near_1 = v_5.right.w;
+    float far_1 = v_5.up.w;
+    if (v_5.origin.w > 0.5) {
+        metal::float3 dir = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
         if (dir.z <= 0.000001) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX;
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = sm_uvX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, dir);
-        float _e28 = sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, sm_1, _e26);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX;
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        float z_2 = near + (_e28 * (far - near));
-        float _e35 = sm_biasX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, z_2);
+        float z_2 = near_1 + (_e28 * (far_1 - near_1));
+        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
         return (z_2 + _e35) / dir.z;
     } else {
-        metal::float2 _e39 = sm_uvX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, _e2);
-        float _e40 = sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, sm_1, _e39);
+        metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
+        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
         if (_e40 >= 1.0) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX;
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        float z_3 = near + (_e40 * (far - near));
-        float _e47 = sm_biasX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, z_3);
+        float z_3 = near_1 + (_e40 * (far_1 - near_1));
+        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
         return (z_3 + _e47) - _e2.z;
     }
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    metal::float4 v_6
+) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {v_6.x, v_6.y, v_6.z, v_6.w};
+}
+
+metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f,
+    float phi
+) {
+    return (f.e1_.xyz * metal::cos(phi)) + (f.e2_.xyz * metal::sin(phi));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1,
+    uint row
+) {
+    return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
+}
+
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    float theta,
+    float lo,
+    float hi
+) {
+    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * metal::clamp((theta - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
+}
+
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2
+) {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, metal::uint4(f_2.sizes2_.x, 0u, 0u, 0u)};
+}
+
+float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3,
+    metal::texture2d<float, metal::access::sample> sm_3,
+    metal::float3 o_1,
+    metal::float3 l_1
+) {
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3);
+    float _e5 = shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, o_1, l_1);
+    return _e5;
 }
 
 struct rectifyInput {
@@ -254,20 +304,20 @@ kernel void rectify(
     metal::float4 _e36 = frame.axis;
     metal::float3 axis = _e36.xyz;
     if (true) {
-        metal::float3 l_1 = (-(axis) * metal::cos(col)) + (_e28 * metal::sin(col));
+        metal::float3 l_2 = (-(axis) * metal::cos(col)) + (_e28 * metal::sin(col));
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e46 = frame;
         metal::float4 _e49 = frame.light_pos;
-        float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e46, shadow_map, _e49.xyz, l_1);
-        if (_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX) {
+        float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e46, shadow_map, _e49.xyz, l_2);
+        if (_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
             float dist = frame.axis.w;
             theta_occ = metal::atan2(_e52 * metal::sin(col), dist - (_e52 * metal::cos(col)));
         }
     } else {
         metal::float4 _e68 = frame.eye;
-        metal::float3 o_1 = _e68.xyz + (_e28 * col);
+        metal::float3 o_2 = _e68.xyz + (_e28 * col);
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e73 = frame;
-        float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e73, shadow_map, o_1, -(axis));
-        if (_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX) {
+        float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e73, shadow_map, o_2, -(axis));
+        if (_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
             theta_occ = metal::atan2(col, -(_e76));
         }
     }

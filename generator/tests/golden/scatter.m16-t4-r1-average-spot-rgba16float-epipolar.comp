@@ -5,6 +5,14 @@
 #extension GL_ARB_shader_storage_buffer_object : require
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
+struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+    vec4 right;
+    vec4 up;
+    vec4 forward;
+    vec4 origin;
+    vec4 proj;
+    uvec4 size;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     vec4 eye;
     vec4 axis;
@@ -39,6 +47,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float theta_hi;
 };
 const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.1;
 const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](0.34785485, 0.65214515, 0.65214515, 0.34785485);
@@ -80,47 +89,22 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     return ((x_3 * x_3) * (3.0 - (2.0 * x_3)));
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec4 v) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v.x, v.y, v.z, v.w);
+vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
+    vec3 q_1 = (p - v.origin.xyz);
+    return vec3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float theta_1, float lo, float hi) {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * clamp(((theta_1 - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
-}
-
-float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_1) {
-    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_1) - 1u)));
-}
-
-vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d_1, uint layer_1) {
-    float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 1u));
-    float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 2u));
-    return vec4(((2.0 / _e5) * cos((_e5 * d_1))), ((-2.0 / _e5) * sin((_e5 * d_1))), ((2.0 / _e10) * cos((_e10 * d_1))), ((-2.0 / _e10) * sin((_e10 * d_1))));
-}
-
-uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_2, uint regions, uint width, bool spot) {
-    if (spot) {
-        return ((r_2 * width) / regions);
-    }
-    return (((r_2 * r_2) * width) / (regions * regions));
-}
-
-vec3 sm_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f, vec3 p) {
-    vec3 q_1 = (p - f.sm_origin.xyz);
-    return vec3(dot(q_1, f.sm_right.xyz), dot(q_1, f.sm_up.xyz), dot(q_1, f.sm_forward.xyz));
-}
-
-vec2 sm_uvX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1, vec3 ls) {
-    if ((f_1.sm_origin.w > 0.5)) {
+vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
+    if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t_2 = f_1.sm_proj.x;
+        float t_2 = v_1.proj.x;
         return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_2))), (0.5 - ((0.5 * ls.y) / (z_1 * t_2))));
     } else {
-        return vec2(((ls.x - f_1.sm_proj.x) / (f_1.sm_proj.y - f_1.sm_proj.x)), ((f_1.sm_proj.w - ls.y) / (f_1.sm_proj.w - f_1.sm_proj.z)));
+        return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
 }
 
-float sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2, sampler2D sm, vec2 uv) {
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
     bool local_5 = false;
     bool local_6 = false;
     bool local_7 = false;
@@ -145,7 +129,7 @@ float sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_
     if (_e27) {
         return 2.0;
     }
-    uint n = f_2.sizes2_.x;
+    uint n = v_2.size.x;
     uint x_4 = min(uint((uv.x * float(n))), (n - 1u));
     uint y_1 = min(uint((uv.y * float(n))), (n - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
@@ -153,24 +137,24 @@ float sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_
     return _e49.x;
 }
 
-float sm_biasX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, float z) {
+float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
     float texel = 0.0;
-    float size = float(f_3.sizes2_.x);
-    if ((f_3.sm_origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * f_3.sm_proj.x) / size);
+    float size = float(v_3.size.x);
+    if ((v_3.origin.w > 0.5)) {
+        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
     } else {
-        texel = (max((f_3.sm_proj.y - f_3.sm_proj.x), (f_3.sm_proj.w - f_3.sm_proj.z)) / size);
+        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
     }
     float _e32 = texel;
-    return (f_3.sm_forward.w * _e32);
+    return (v_3.forward.w * _e32);
 }
 
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4, sampler2D sm_1, vec3 p_1) {
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_1) {
     bool local_8 = false;
-    vec3 _e2 = sm_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_4, p_1);
-    float near = f_4.sm_right.w;
-    float far = f_4.sm_up.w;
-    if ((f_4.sm_origin.w > 0.5)) {
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
+    float near = v_4.right.w;
+    float far = v_4.up.w;
+    if ((v_4.origin.w > 0.5)) {
         local_8 = (_e2.z <= near);
     } else {
         local_8 = false;
@@ -179,11 +163,75 @@ float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga
     if (_e16) {
         return 1.0;
     }
-    vec2 _e18 = sm_uvX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_4, _e2);
-    float _e20 = sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_4, sm_1, _e18);
+    vec2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
     float depth_1 = ((_e2.z - near) / (far - near));
-    float _e26 = sm_biasX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_4, _e2.z);
+    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
     return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+}
+
+float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5, sampler2D sm_2, vec3 o, vec3 l_1) {
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
+    float near_1 = v_5.right.w;
+    float far_1 = v_5.up.w;
+    if ((v_5.origin.w > 0.5)) {
+        vec3 dir_4 = vec3(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
+        if ((dir_4.z <= 1e-6)) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_4);
+        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
+        if ((_e28 >= 1.0)) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
+        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
+        return ((z_2 + _e35) / dir_4.z);
+    } else {
+        vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
+        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
+        if ((_e40 >= 1.0)) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        float z_3 = (near_1 + (_e40 * (far_1 - near_1)));
+        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
+        return ((z_3 + _e47) - _e2.z);
+    }
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec4 v_6) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
+}
+
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float theta_1, float lo, float hi) {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * clamp(((theta_1 - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
+}
+
+float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_1) {
+    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_1) - 1u)));
+}
+
+vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d_1, uint layer_1) {
+    float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 1u));
+    float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 2u));
+    return vec4(((2.0 / _e5) * cos((_e5 * d_1))), ((-2.0 / _e5) * sin((_e5 * d_1))), ((2.0 / _e10) * cos((_e10 * d_1))), ((-2.0 / _e10) * sin((_e10 * d_1))));
+}
+
+uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_2, uint regions, uint width, bool spot) {
+    if (spot) {
+        return ((r_2 * width) / regions);
+    }
+    return (((r_2 * r_2) * width) / (regions * regions));
+}
+
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f) {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f.sm_right, f.sm_up, f.sm_forward, f.sm_origin, f.sm_proj, uvec4(f.sizes2_.x, 0u, 0u, 0u));
+}
+
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1, sampler2D sm_3, vec3 p_2) {
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_1);
+    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
+    return _e4;
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta) {
@@ -202,23 +250,23 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir,
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
-vec3 pixel_dir(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5, uint x, uint y) {
-    float ndc_x = (((2.0 * (float(x) + 0.5)) / float(f_5.sizes.x)) - 1.0);
-    float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(f_5.sizes.y)));
-    float t_3 = f_5.cam_forward.w;
-    return normalize(((f_5.cam_forward.xyz + (f_5.cam_right.xyz * ((ndc_x * t_3) * f_5.cam_right.w))) + (f_5.cam_up.xyz * (ndc_y * t_3))));
+vec3 pixel_dir(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2, uint x, uint y) {
+    float ndc_x = (((2.0 * (float(x) + 0.5)) / float(f_2.sizes.x)) - 1.0);
+    float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(f_2.sizes.y)));
+    float t_3 = f_2.cam_forward.w;
+    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc_x * t_3) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc_y * t_3))));
 }
 
-float frame_spot_integrand(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_6, vec3 eye_1, vec3 dir_1, float t_1) {
-    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+float frame_spot_integrand(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, vec3 eye_1, vec3 dir_1, float t_1) {
+    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
 float march(vec3 eye_2, vec3 dir_2, float s, bool spot_1) {
     float sum = 0.0;
     uint k_2 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_9 = _group_0_binding_0_cs;
-    uint steps = f_9.sizes2_.y;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_6 = _group_0_binding_0_cs;
+    uint steps = f_6.sizes2_.y;
     float h = (s / float(steps));
     bool loop_init = true;
     while(true) {
@@ -235,16 +283,16 @@ float march(vec3 eye_2, vec3 dir_2, float s, bool spot_1) {
         {
             uint _e12 = k_2;
             float t_4 = ((float(_e12) + 0.5) * h);
-            float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_9, _group_0_binding_3_cs, (eye_2 + (dir_2 * t_4)));
+            float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, _group_0_binding_3_cs, (eye_2 + (dir_2 * t_4)));
             if (spot_1) {
                 float _e25 = sum;
-                float _e27 = frame_spot_integrand(f_9, eye_2, dir_2, t_4);
+                float _e27 = frame_spot_integrand(f_6, eye_2, dir_2, t_4);
                 sum = (_e25 + ((_e22 * h) * _e27));
             } else {
                 float _e30 = sum;
                 uint _e33 = k_2;
                 uint _e36 = k_2;
-                float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (float(_e33) * h), (float((_e36 + 1u)) * h));
+                float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, (float(_e33) * h), (float((_e36 + 1u)) * h));
                 sum = (_e30 + (_e22 * _e41));
             }
         }
@@ -253,9 +301,9 @@ float march(vec3 eye_2, vec3 dir_2, float s, bool spot_1) {
         float _e47 = sum;
         return _e47;
     } else {
-        float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(dot(f_9.light_dir.xyz, dir_2)));
+        float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_2)));
         float _e58 = sum;
-        return ((f_9.medium.y * _e56) * _e58);
+        return ((f_6.medium.y * _e56) * _e58);
     }
 }
 
@@ -268,7 +316,7 @@ uint row_index(float j, uint rows, bool wrap) {
     }
 }
 
-float ray_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7, float x_1, float delta_1, float theta_2, float s_1, bool spot_2) {
+float ray_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4, float x_1, float delta_1, float theta_2, float s_1, bool spot_2) {
     bool local_9 = false;
     if (spot_2) {
         float psi = (x_1 * delta_1);
@@ -282,13 +330,13 @@ float ray_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7, float x_
         if (_e16) {
             return s_1;
         }
-        return min(((f_7.axis.w * sin(psi)) / den), s_1);
+        return min(((f_4.axis.w * sin(psi)) / den), s_1);
     } else {
         return min(((x_1 * delta_1) / max(sin(theta_2), 1e-6)), s_1);
     }
 }
 
-float spot_segment(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_8, vec3 eye_3, vec3 dir_3, float a_1, float b_1, uint panels) {
+float spot_segment(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5, vec3 eye_3, vec3 dir_3, float a_1, float b_1, uint panels) {
     float sum_1 = 0.0;
     uint k_3 = 0u;
     uint q = 0u;
@@ -326,7 +374,7 @@ float spot_segment(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_8, v
                     float t_5 = (mid + ((0.5 * h_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e25]));
                     float _e30 = sum_1;
                     uint _e32 = q;
-                    float _e37 = frame_spot_integrand(f_8, eye_3, dir_3, t_5);
+                    float _e37 = frame_spot_integrand(f_5, eye_3, dir_3, t_5);
                     sum_1 = (_e30 + (GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e32] * _e37));
                 }
             }
@@ -362,11 +410,11 @@ void main() {
     uint k = 0u;
     float l = 0.0;
     float unshadowed = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_10 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7 = _group_0_binding_0_cs;
     uint x_6 = id.x;
     uint y_2 = id.y;
-    if (!((x_6 >= f_10.sizes.x))) {
-        local = (y_2 >= f_10.sizes.y);
+    if (!((x_6 >= f_7.sizes.x))) {
+        local = (y_2 >= f_7.sizes.y);
     } else {
         local = true;
     }
@@ -374,22 +422,22 @@ void main() {
     if (_e18) {
         return;
     }
-    vec3 eye_4 = f_10.eye.xyz;
-    vec3 _e21 = pixel_dir(f_10, x_6, y_2);
+    vec3 eye_4 = f_7.eye.xyz;
+    vec3 _e21 = pixel_dir(f_7, x_6, y_2);
     int _e25_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e25 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e25_clamped_lod) - ivec2(1)), _e25_clamped_lod);
-    float s_2 = (max(_e25.x, 0.0) / max(dot(_e21, f_10.cam_forward.xyz), 1e-6));
-    vec3 color = f_10.light_color.xyz;
+    float s_2 = (max(_e25.x, 0.0) / max(dot(_e21, f_7.cam_forward.xyz), 1e-6));
+    vec3 color = f_7.light_color.xyz;
     vec3 px = vec3((float(x_6) + 0.5), (float(y_2) + 0.5), 0.0);
-    float radius = f_10.epipole.w;
-    if ((f_10.epipole.z > 0.5)) {
-        local_1 = (length((px - vec3(f_10.epipole.x, f_10.epipole.y, 0.0))) < radius);
+    float radius = f_7.epipole.w;
+    if ((f_7.epipole.z > 0.5)) {
+        local_1 = (length((px - vec3(f_7.epipole.x, f_7.epipole.y, 0.0))) < radius);
     } else {
         local_1 = false;
     }
     bool near_epi = local_1;
-    if ((f_10.anti_epipole.z > 0.5)) {
-        local_2 = (length((px - vec3(f_10.anti_epipole.x, f_10.anti_epipole.y, 0.0))) < radius);
+    if ((f_7.anti_epipole.z > 0.5)) {
+        local_2 = (length((px - vec3(f_7.anti_epipole.x, f_7.anti_epipole.y, 0.0))) < radius);
     } else {
         local_2 = false;
     }
@@ -402,18 +450,18 @@ void main() {
     bool _e85 = local_3;
     if (_e85) {
         float _e87 = march(eye_4, _e21, s_2, true);
-        vec3 l_1 = (_e87 * color);
-        imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_6, y_2)), vec4(l_1.x, l_1.y, l_1.z, 1.0));
+        vec3 l_2 = (_e87 * color);
+        imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_6, y_2)), vec4(l_2.x, l_2.y, l_2.z, 1.0));
         return;
     }
-    vec3 axis = f_10.axis.xyz;
-    uint rows_1 = f_10.sizes.w;
-    uint width_1 = f_10.sizes.z;
-    bool wrap_1 = (f_10.anti_epipole.w > 0.5);
+    vec3 axis = f_7.axis.xyz;
+    uint rows_1 = f_7.sizes.w;
+    uint width_1 = f_7.sizes.z;
+    bool wrap_1 = (f_7.anti_epipole.w > 0.5);
     {
         theta = acos(clamp(dot(_e21, axis), -1.0, 1.0));
-        float phi = atan(dot(_e21, f_10.e2_.xyz), dot(_e21, f_10.e1_.xyz));
-        yc = ((phi - f_10.e1_.w) / f_10.e2_.w);
+        float phi = atan(dot(_e21, f_7.e2_.xyz), dot(_e21, f_7.e1_.xyz));
+        yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
         if (wrap_1) {
             float _e126 = yc;
             float _e127 = yc;
@@ -434,10 +482,10 @@ void main() {
         SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e154 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e153);
         delta = mix(_e147.delta, _e154.delta, fy);
         float _e159 = theta;
-        float _e164 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e159, f_10.theta.x, f_10.theta.y);
+        float _e164 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e159, f_7.theta.x, f_7.theta.y);
         d = _e164;
         if (true) {
-            vec3 q_2 = normalize(((eye_4 + (_e21 * s_2)) - f_10.light_pos.xyz));
+            vec3 q_2 = normalize(((eye_4 + (_e21 * s_2)) - f_7.light_pos.xyz));
             float _e178 = delta;
             xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / _e178);
         } else {
@@ -480,12 +528,12 @@ void main() {
             uint _e232 = r;
             float _e234 = delta;
             float _e235 = theta;
-            float _e236 = ray_t(f_10, b0_, _e234, _e235, s_2, true);
+            float _e236 = ray_t(f_7, b0_, _e234, _e235, s_2, true);
             t0_[_e232] = _e236;
             uint _e238 = r;
             float _e240 = delta;
             float _e241 = theta;
-            float _e242 = ray_t(f_10, b1_, _e240, _e241, s_2, true);
+            float _e242 = ray_t(f_7, b1_, _e240, _e241, s_2, true);
             t1_[_e238] = (is_last ? s_2 : _e242);
             uint _e244 = r;
             count = (_e244 + 1u);
@@ -494,9 +542,9 @@ void main() {
             }
         }
     }
-    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e21));
+    float cos_theta_l = -(dot(f_7.light_dir.xyz, _e21));
     uint _e259 = count;
-    uint panels_1 = max(((f_10.sizes2_.z / 4u) / _e259), 1u);
+    uint panels_1 = max(((f_7.sizes2_.z / 4u) / _e259), 1u);
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
@@ -520,12 +568,12 @@ void main() {
                 weight = (b_2 - a_2);
             } else {
                 if (true) {
-                    float _e278 = spot_segment(f_10, eye_4, _e21, a_2, b_2, panels_1);
+                    float _e278 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
                     weight = _e278;
                 } else {
-                    float _e283 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-                    float _e287 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, a_2, b_2);
-                    weight = ((f_10.medium.y * _e283) * _e287);
+                    float _e283 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+                    float _e287 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
+                    weight = ((f_7.medium.y * _e283) * _e287);
                 }
             }
             vis = 0.5;
@@ -587,12 +635,12 @@ void main() {
         l = _e351;
     } else {
         if (true) {
-            float _e360 = spot_segment(f_10, eye_4, _e21, 0.0, s_2, max((f_10.sizes2_.z / 4u), 1u));
+            float _e360 = spot_segment(f_7, eye_4, _e21, 0.0, s_2, max((f_7.sizes2_.z / 4u), 1u));
             unshadowed = _e360;
         } else {
-            float _e366 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-            float _e370 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, s_2);
-            unshadowed = ((f_10.medium.y * _e366) * _e370);
+            float _e366 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+            float _e370 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
+            unshadowed = ((f_7.medium.y * _e366) * _e370);
         }
         float _e372 = unshadowed;
         float _e373 = total;

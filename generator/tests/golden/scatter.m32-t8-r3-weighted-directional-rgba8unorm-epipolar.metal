@@ -10,6 +10,14 @@ struct _mslBufferSizes {
     uint size1;
 };
 
+struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+    metal::float4 right;
+    metal::float4 up;
+    metal::float4 forward;
+    metal::float4 origin;
+    metal::float4 proj;
+    metal::uint4 size;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     metal::float4 eye;
     metal::float4 axis;
@@ -51,6 +59,7 @@ struct type_15 {
     float inner[8];
 };
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.1;
 constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
 constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
@@ -90,10 +99,146 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     return (x_3 * x_3) * (3.0 - (2.0 * x_3));
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float4 v
+metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
+    metal::float3 p
 ) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {v.x, v.y, v.z, v.w};
+    metal::float3 q_1 = p - v.origin.xyz;
+    return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
+}
+
+metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
+    metal::float3 ls
+) {
+    if (v_1.origin.w > 0.5) {
+        float z_1 = metal::max(ls.z, 0.000001);
+        float t_2 = v_1.proj.x;
+        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_2)), 0.5 - ((0.5 * ls.y) / (z_1 * t_2)));
+    } else {
+        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
+    }
+}
+
+uint naga_f2u32(float value) {
+    return static_cast<uint>(metal::clamp(value, 0.0, 4294967000.0));
+}
+
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2,
+    metal::texture2d<float, metal::access::sample> sm,
+    metal::float2 uv
+) {
+    bool local_5 = {};
+    bool local_6 = {};
+    bool local_7 = {};
+    if (!((uv.x < 0.0))) {
+        local_5 = uv.x > 1.0;
+    } else {
+        local_5 = true;
+    }
+    bool _e11 = local_5;
+    if (!(_e11)) {
+        local_6 = uv.y < 0.0;
+    } else {
+        local_6 = true;
+    }
+    bool _e19 = local_6;
+    if (!(_e19)) {
+        local_7 = uv.y > 1.0;
+    } else {
+        local_7 = true;
+    }
+    bool _e27 = local_7;
+    if (_e27) {
+        return 2.0;
+    }
+    uint n = v_2.size.x;
+    uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
+    uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
+    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    return _e49.x;
+}
+
+float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
+    float z
+) {
+    float texel = {};
+    float size = static_cast<float>(v_3.size.x);
+    if (v_3.origin.w > 0.5) {
+        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
+    } else {
+        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
+    }
+    float _e32 = texel;
+    return v_3.forward.w * _e32;
+}
+
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
+    metal::texture2d<float, metal::access::sample> sm_1,
+    metal::float3 p_1
+) {
+    bool local_8 = {};
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
+    float near = v_4.right.w;
+    float far = v_4.up.w;
+    if (v_4.origin.w > 0.5) {
+        local_8 = _e2.z <= near;
+    } else {
+        local_8 = false;
+    }
+    bool _e16 = local_8;
+    if (_e16) {
+        return 1.0;
+    }
+    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
+    float depth_1 = (_e2.z - near) / (far - near);
+    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
+    return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
+}
+
+float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5,
+    metal::texture2d<float, metal::access::sample> sm_2,
+    metal::float3 o,
+    metal::float3 l_1
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
+    float near_1 = v_5.right.w;
+    float far_1 = v_5.up.w;
+    if (v_5.origin.w > 0.5) {
+        metal::float3 dir_4 = metal::float3(metal::dot(l_1, v_5.right.xyz), metal::dot(l_1, v_5.up.xyz), metal::dot(l_1, v_5.forward.xyz));
+        if (dir_4.z <= 0.000001) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_4);
+        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
+        if (_e28 >= 1.0) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        float z_2 = near_1 + (_e28 * (far_1 - near_1));
+        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
+        return (z_2 + _e35) / dir_4.z;
+    } else {
+        metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
+        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
+        if (_e40 >= 1.0) {
+            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+        }
+        float z_3 = near_1 + (_e40 * (far_1 - near_1));
+        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
+        return (z_3 + _e47) - _e2.z;
+    }
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    metal::float4 v_6
+) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {v_6.x, v_6.y, v_6.z, v_6.w};
 }
 
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -135,106 +280,20 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     return naga_div((r_2 * r_2) * width, regions * regions);
 }
 
-metal::float3 sm_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f,
-    metal::float3 p
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f
 ) {
-    metal::float3 q_1 = p - f.sm_origin.xyz;
-    return metal::float3(metal::dot(q_1, f.sm_right.xyz), metal::dot(q_1, f.sm_up.xyz), metal::dot(q_1, f.sm_forward.xyz));
-}
-
-metal::float2 sm_uvX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1,
-    metal::float3 ls
-) {
-    if (f_1.sm_origin.w > 0.5) {
-        float z_1 = metal::max(ls.z, 0.000001);
-        float t_2 = f_1.sm_proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_2)), 0.5 - ((0.5 * ls.y) / (z_1 * t_2)));
-    } else {
-        return metal::float2((ls.x - f_1.sm_proj.x) / (f_1.sm_proj.y - f_1.sm_proj.x), (f_1.sm_proj.w - ls.y) / (f_1.sm_proj.w - f_1.sm_proj.z));
-    }
-}
-
-uint naga_f2u32(float value) {
-    return static_cast<uint>(metal::clamp(value, 0.0, 4294967000.0));
-}
-
-float sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2,
-    metal::texture2d<float, metal::access::sample> sm,
-    metal::float2 uv
-) {
-    bool local_5 = {};
-    bool local_6 = {};
-    bool local_7 = {};
-    if (!((uv.x < 0.0))) {
-        local_5 = uv.x > 1.0;
-    } else {
-        local_5 = true;
-    }
-    bool _e11 = local_5;
-    if (!(_e11)) {
-        local_6 = uv.y < 0.0;
-    } else {
-        local_6 = true;
-    }
-    bool _e19 = local_6;
-    if (!(_e19)) {
-        local_7 = uv.y > 1.0;
-    } else {
-        local_7 = true;
-    }
-    bool _e27 = local_7;
-    if (_e27) {
-        return 2.0;
-    }
-    uint n = f_2.sizes2_.x;
-    uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
-    uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
-    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
-    return _e49.x;
-}
-
-float sm_biasX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3,
-    float z
-) {
-    float texel = {};
-    float size = static_cast<float>(f_3.sizes2_.x);
-    if (f_3.sm_origin.w > 0.5) {
-        texel = ((2.0 * metal::max(z, 0.0)) * f_3.sm_proj.x) / size;
-    } else {
-        texel = metal::max(f_3.sm_proj.y - f_3.sm_proj.x, f_3.sm_proj.w - f_3.sm_proj.z) / size;
-    }
-    float _e32 = texel;
-    return f_3.sm_forward.w * _e32;
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f.sm_right, f.sm_up, f.sm_forward, f.sm_origin, f.sm_proj, metal::uint4(f.sizes2_.x, 0u, 0u, 0u)};
 }
 
 float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4,
-    metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_1
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1,
+    metal::texture2d<float, metal::access::sample> sm_3,
+    metal::float3 p_2
 ) {
-    bool local_8 = {};
-    metal::float3 _e2 = sm_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_4, p_1);
-    float near = f_4.sm_right.w;
-    float far = f_4.sm_up.w;
-    if (f_4.sm_origin.w > 0.5) {
-        local_8 = _e2.z <= near;
-    } else {
-        local_8 = false;
-    }
-    bool _e16 = local_8;
-    if (_e16) {
-        return 1.0;
-    }
-    metal::float2 _e18 = sm_uvX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_4, _e2);
-    float _e20 = sm_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_4, sm_1, _e18);
-    float depth_1 = (_e2.z - near) / (far - near);
-    float _e26 = sm_biasX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_4, _e2.z);
-    return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_1);
+    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
+    return _e4;
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -266,23 +325,23 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 }
 
 metal::float3 pixel_dir(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2,
     uint x,
     uint y
 ) {
-    float ndc_x = ((2.0 * (static_cast<float>(x) + 0.5)) / static_cast<float>(f_5.sizes.x)) - 1.0;
-    float ndc_y = 1.0 - ((2.0 * (static_cast<float>(y) + 0.5)) / static_cast<float>(f_5.sizes.y));
-    float t_3 = f_5.cam_forward.w;
-    return metal::normalize((f_5.cam_forward.xyz + (f_5.cam_right.xyz * ((ndc_x * t_3) * f_5.cam_right.w))) + (f_5.cam_up.xyz * (ndc_y * t_3)));
+    float ndc_x = ((2.0 * (static_cast<float>(x) + 0.5)) / static_cast<float>(f_2.sizes.x)) - 1.0;
+    float ndc_y = 1.0 - ((2.0 * (static_cast<float>(y) + 0.5)) / static_cast<float>(f_2.sizes.y));
+    float t_3 = f_2.cam_forward.w;
+    return metal::normalize((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc_x * t_3) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc_y * t_3)));
 }
 
 float frame_spot_integrand(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_6,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3,
     metal::float3 eye_1,
     metal::float3 dir_1,
     float t_1
 ) {
-    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
@@ -296,8 +355,8 @@ float march(
 ) {
     float sum = 0.0;
     uint k_2 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_9 = frame;
-    uint steps = f_9.sizes2_.y;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_6 = frame;
+    uint steps = f_6.sizes2_.y;
     float h = s / static_cast<float>(steps);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
@@ -317,16 +376,16 @@ float march(
         {
             uint _e12 = k_2;
             float t_4 = (static_cast<float>(_e12) + 0.5) * h;
-            float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_9, shadow_map, eye_2 + (dir_2 * t_4));
+            float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, shadow_map, eye_2 + (dir_2 * t_4));
             if (spot_1) {
                 float _e25 = sum;
-                float _e27 = frame_spot_integrand(f_9, eye_2, dir_2, t_4);
+                float _e27 = frame_spot_integrand(f_6, eye_2, dir_2, t_4);
                 sum = _e25 + ((_e22 * h) * _e27);
             } else {
                 float _e30 = sum;
                 uint _e33 = k_2;
                 uint _e36 = k_2;
-                float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, static_cast<float>(_e33) * h, static_cast<float>(_e36 + 1u) * h);
+                float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, static_cast<float>(_e33) * h, static_cast<float>(_e36 + 1u) * h);
                 sum = _e30 + (_e22 * _e41);
             }
         }
@@ -335,9 +394,9 @@ float march(
         float _e47 = sum;
         return _e47;
     } else {
-        float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(metal::dot(f_9.light_dir.xyz, dir_2)));
+        float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(metal::dot(f_6.light_dir.xyz, dir_2)));
         float _e58 = sum;
-        return (f_9.medium.y * _e56) * _e58;
+        return (f_6.medium.y * _e56) * _e58;
     }
 }
 
@@ -364,7 +423,7 @@ uint row_index(
 }
 
 float ray_t(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4,
     float x_1,
     float delta_1,
     float theta_2,
@@ -384,14 +443,14 @@ float ray_t(
         if (_e16) {
             return s_1;
         }
-        return metal::min((f_7.axis.w * metal::sin(psi)) / den, s_1);
+        return metal::min((f_4.axis.w * metal::sin(psi)) / den, s_1);
     } else {
         return metal::min((x_1 * delta_1) / metal::max(metal::sin(theta_2), 0.000001), s_1);
     }
 }
 
 float spot_segment(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5,
     metal::float3 eye_3,
     metal::float3 dir_3,
     float a_1,
@@ -441,7 +500,7 @@ float spot_segment(
                     float t_5 = mid + ((0.5 * h_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e25), 3u)]);
                     float _e30 = sum_1;
                     uint _e32 = q;
-                    float _e37 = frame_spot_integrand(f_8, eye_3, dir_3, t_5);
+                    float _e37 = frame_spot_integrand(f_5, eye_3, dir_3, t_5);
                     sum_1 = _e30 + (GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e32), 3u)] * _e37);
                 }
             }
@@ -488,11 +547,11 @@ kernel void scatter(
     uint k = {};
     float l = {};
     float unshadowed = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_10 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7 = frame;
     uint x_6 = id.x;
     uint y_2 = id.y;
-    if (!((x_6 >= f_10.sizes.x))) {
-        local = y_2 >= f_10.sizes.y;
+    if (!((x_6 >= f_7.sizes.x))) {
+        local = y_2 >= f_7.sizes.y;
     } else {
         local = true;
     }
@@ -500,22 +559,22 @@ kernel void scatter(
     if (_e18) {
         return;
     }
-    metal::float3 eye_4 = f_10.eye.xyz;
-    metal::float3 _e21 = pixel_dir(f_10, x_6, y_2);
+    metal::float3 eye_4 = f_7.eye.xyz;
+    metal::float3 _e21 = pixel_dir(f_7, x_6, y_2);
     uint clamped_lod_e25 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e25 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_2)), metal::uint2(depth.get_width(clamped_lod_e25), depth.get_height(clamped_lod_e25)) - 1), clamped_lod_e25);
-    float s_2 = metal::max(_e25.x, 0.0) / metal::max(metal::dot(_e21, f_10.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_10.light_color.xyz;
+    float s_2 = metal::max(_e25.x, 0.0) / metal::max(metal::dot(_e21, f_7.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_7.light_color.xyz;
     metal::float3 px = metal::float3(static_cast<float>(x_6) + 0.5, static_cast<float>(y_2) + 0.5, 0.0);
-    float radius = f_10.epipole.w;
-    if (f_10.epipole.z > 0.5) {
-        local_1 = metal::length(px - metal::float3(f_10.epipole.x, f_10.epipole.y, 0.0)) < radius;
+    float radius = f_7.epipole.w;
+    if (f_7.epipole.z > 0.5) {
+        local_1 = metal::length(px - metal::float3(f_7.epipole.x, f_7.epipole.y, 0.0)) < radius;
     } else {
         local_1 = false;
     }
     bool near_epi = local_1;
-    if (f_10.anti_epipole.z > 0.5) {
-        local_2 = metal::length(px - metal::float3(f_10.anti_epipole.x, f_10.anti_epipole.y, 0.0)) < radius;
+    if (f_7.anti_epipole.z > 0.5) {
+        local_2 = metal::length(px - metal::float3(f_7.anti_epipole.x, f_7.anti_epipole.y, 0.0)) < radius;
     } else {
         local_2 = false;
     }
@@ -528,18 +587,18 @@ kernel void scatter(
     bool _e85 = local_3;
     if (_e85) {
         float _e87 = march(eye_4, _e21, s_2, false, frame, shadow_map);
-        metal::float3 l_1 = _e87 * color;
-        output.write(metal::float4(l_1.x, l_1.y, l_1.z, 1.0), metal::uint2(metal::uint2(x_6, y_2)));
+        metal::float3 l_2 = _e87 * color;
+        output.write(metal::float4(l_2.x, l_2.y, l_2.z, 1.0), metal::uint2(metal::uint2(x_6, y_2)));
         return;
     }
-    metal::float3 axis = f_10.axis.xyz;
-    uint rows_1 = f_10.sizes.w;
-    uint width_1 = f_10.sizes.z;
-    bool wrap_1 = f_10.anti_epipole.w > 0.5;
+    metal::float3 axis = f_7.axis.xyz;
+    uint rows_1 = f_7.sizes.w;
+    uint width_1 = f_7.sizes.z;
+    bool wrap_1 = f_7.anti_epipole.w > 0.5;
     {
         theta = metal::acos(metal::clamp(metal::dot(_e21, axis), -1.0, 1.0));
-        float phi = metal::atan2(metal::dot(_e21, f_10.e2_.xyz), metal::dot(_e21, f_10.e1_.xyz));
-        yc = (phi - f_10.e1_.w) / f_10.e2_.w;
+        float phi = metal::atan2(metal::dot(_e21, f_7.e2_.xyz), metal::dot(_e21, f_7.e1_.xyz));
+        yc = (phi - f_7.e1_.w) / f_7.e2_.w;
         if (wrap_1) {
             float _e126 = yc;
             float _e127 = yc;
@@ -560,10 +619,10 @@ kernel void scatter(
         SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e154 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e153);
         delta = metal::mix(_e147.delta, _e154.delta, fy);
         float _e159 = theta;
-        float _e164 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e159, f_10.theta.x, f_10.theta.y);
+        float _e164 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e159, f_7.theta.x, f_7.theta.y);
         d = _e164;
         if (false) {
-            metal::float3 q_2 = metal::normalize((eye_4 + (_e21 * s_2)) - f_10.light_pos.xyz);
+            metal::float3 q_2 = metal::normalize((eye_4 + (_e21 * s_2)) - f_7.light_pos.xyz);
             float _e178 = delta;
             xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / _e178;
         } else {
@@ -609,12 +668,12 @@ kernel void scatter(
             uint _e232 = r;
             float _e234 = delta;
             float _e235 = theta;
-            float _e236 = ray_t(f_10, b0_, _e234, _e235, s_2, false);
+            float _e236 = ray_t(f_7, b0_, _e234, _e235, s_2, false);
             t0_.inner[metal::min(unsigned(_e232), 7u)] = _e236;
             uint _e238 = r;
             float _e240 = delta;
             float _e241 = theta;
-            float _e242 = ray_t(f_10, b1_, _e240, _e241, s_2, false);
+            float _e242 = ray_t(f_7, b1_, _e240, _e241, s_2, false);
             t1_.inner[metal::min(unsigned(_e238), 7u)] = is_last ? s_2 : _e242;
             uint _e244 = r;
             count = _e244 + 1u;
@@ -623,9 +682,9 @@ kernel void scatter(
             }
         }
     }
-    float cos_theta_l = -(metal::dot(f_10.light_dir.xyz, _e21));
+    float cos_theta_l = -(metal::dot(f_7.light_dir.xyz, _e21));
     uint _e259 = count;
-    uint panels_1 = metal::max(naga_div(naga_div(f_10.sizes2_.z, 4u), _e259), 1u);
+    uint panels_1 = metal::max(naga_div(naga_div(f_7.sizes2_.z, 4u), _e259), 1u);
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
@@ -652,12 +711,12 @@ kernel void scatter(
                 weight = b_2 - a_2;
             } else {
                 if (false) {
-                    float _e278 = spot_segment(f_10, eye_4, _e21, a_2, b_2, panels_1);
+                    float _e278 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
                     weight = _e278;
                 } else {
-                    float _e283 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-                    float _e287 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, a_2, b_2);
-                    weight = (f_10.medium.y * _e283) * _e287;
+                    float _e283 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+                    float _e287 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
+                    weight = (f_7.medium.y * _e283) * _e287;
                 }
             }
             vis = 0.5;
@@ -725,12 +784,12 @@ kernel void scatter(
         l = _e351;
     } else {
         if (false) {
-            float _e360 = spot_segment(f_10, eye_4, _e21, 0.0, s_2, metal::max(naga_div(f_10.sizes2_.z, 4u), 1u));
+            float _e360 = spot_segment(f_7, eye_4, _e21, 0.0, s_2, metal::max(naga_div(f_7.sizes2_.z, 4u), 1u));
             unshadowed = _e360;
         } else {
-            float _e366 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-            float _e370 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, s_2);
-            unshadowed = (f_10.medium.y * _e366) * _e370;
+            float _e366 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+            float _e370 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
+            unshadowed = (f_7.medium.y * _e366) * _e370;
         }
         float _e372 = unshadowed;
         float _e373 = total;

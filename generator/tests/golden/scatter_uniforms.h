@@ -71,4 +71,39 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g0_) == 352, "Scatt
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g1_) == 368, "ScatterPrefilteredFrame.proj_g1_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g2_) == 384, "ScatterPrefilteredFrame.proj_g2_ offset");
 
+/* WGSL `March` of family raymarch (scatter::raymarch), 240 bytes, alignment 16. */
+typedef struct ScatterRaymarchMarch {
+    float eye[4]; /* vec4<f32>, offset 0 */
+    float cam_forward[4]; /* vec4<f32>, offset 16 */
+    float cam_right[4]; /* vec4<f32>, offset 32 */
+    float cam_up[4]; /* vec4<f32>, offset 48 */
+    float medium[4]; /* vec4<f32>, offset 64 */
+    float light_color[4]; /* vec4<f32>, offset 80 */
+    float light_pos[4]; /* vec4<f32>, offset 96 */
+    float light_dir[4]; /* vec4<f32>, offset 112 */
+    float sm_right[4]; /* vec4<f32>, offset 128 */
+    float sm_up[4]; /* vec4<f32>, offset 144 */
+    float sm_forward[4]; /* vec4<f32>, offset 160 */
+    float sm_origin[4]; /* vec4<f32>, offset 176 */
+    float sm_proj[4]; /* vec4<f32>, offset 192 */
+    uint32_t sizes[4]; /* vec4<u32>, offset 208 */
+    uint32_t interleave[4]; /* vec4<u32>, offset 224 */
+} ScatterRaymarchMarch;
+SCATTER_STATIC_ASSERT(sizeof(ScatterRaymarchMarch) == 240, "ScatterRaymarchMarch size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, eye) == 0, "ScatterRaymarchMarch.eye offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, cam_forward) == 16, "ScatterRaymarchMarch.cam_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, cam_right) == 32, "ScatterRaymarchMarch.cam_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, cam_up) == 48, "ScatterRaymarchMarch.cam_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, medium) == 64, "ScatterRaymarchMarch.medium offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, light_color) == 80, "ScatterRaymarchMarch.light_color offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, light_pos) == 96, "ScatterRaymarchMarch.light_pos offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, light_dir) == 112, "ScatterRaymarchMarch.light_dir offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sm_right) == 128, "ScatterRaymarchMarch.sm_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sm_up) == 144, "ScatterRaymarchMarch.sm_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sm_forward) == 160, "ScatterRaymarchMarch.sm_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sm_origin) == 176, "ScatterRaymarchMarch.sm_origin offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sm_proj) == 192, "ScatterRaymarchMarch.sm_proj offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sizes) == 208, "ScatterRaymarchMarch.sizes offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, interleave) == 224, "ScatterRaymarchMarch.interleave offset");
+
 #endif /* SCATTER_UNIFORMS_H */

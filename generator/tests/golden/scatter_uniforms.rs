@@ -93,3 +93,62 @@ pub mod prefiltered {
         assert!(::core::mem::offset_of!(Frame, proj_g2_) == 384);
     };
 }
+
+/// Uniform structs of the `raymarch` kernels.
+#[allow(dead_code, reason = "generated")]
+pub mod raymarch {
+    /// WGSL `March` (scatter::raymarch), 240 bytes, alignment 16.
+    #[repr(C)]
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct March {
+        /// `vec4<f32>` at byte 0.
+        pub eye: [f32; 4],
+        /// `vec4<f32>` at byte 16.
+        pub cam_forward: [f32; 4],
+        /// `vec4<f32>` at byte 32.
+        pub cam_right: [f32; 4],
+        /// `vec4<f32>` at byte 48.
+        pub cam_up: [f32; 4],
+        /// `vec4<f32>` at byte 64.
+        pub medium: [f32; 4],
+        /// `vec4<f32>` at byte 80.
+        pub light_color: [f32; 4],
+        /// `vec4<f32>` at byte 96.
+        pub light_pos: [f32; 4],
+        /// `vec4<f32>` at byte 112.
+        pub light_dir: [f32; 4],
+        /// `vec4<f32>` at byte 128.
+        pub sm_right: [f32; 4],
+        /// `vec4<f32>` at byte 144.
+        pub sm_up: [f32; 4],
+        /// `vec4<f32>` at byte 160.
+        pub sm_forward: [f32; 4],
+        /// `vec4<f32>` at byte 176.
+        pub sm_origin: [f32; 4],
+        /// `vec4<f32>` at byte 192.
+        pub sm_proj: [f32; 4],
+        /// `vec4<u32>` at byte 208.
+        pub sizes: [u32; 4],
+        /// `vec4<u32>` at byte 224.
+        pub interleave: [u32; 4],
+    }
+
+    const _: () = {
+        assert!(::core::mem::size_of::<March>() == 240);
+        assert!(::core::mem::offset_of!(March, eye) == 0);
+        assert!(::core::mem::offset_of!(March, cam_forward) == 16);
+        assert!(::core::mem::offset_of!(March, cam_right) == 32);
+        assert!(::core::mem::offset_of!(March, cam_up) == 48);
+        assert!(::core::mem::offset_of!(March, medium) == 64);
+        assert!(::core::mem::offset_of!(March, light_color) == 80);
+        assert!(::core::mem::offset_of!(March, light_pos) == 96);
+        assert!(::core::mem::offset_of!(March, light_dir) == 112);
+        assert!(::core::mem::offset_of!(March, sm_right) == 128);
+        assert!(::core::mem::offset_of!(March, sm_up) == 144);
+        assert!(::core::mem::offset_of!(March, sm_forward) == 160);
+        assert!(::core::mem::offset_of!(March, sm_origin) == 176);
+        assert!(::core::mem::offset_of!(March, sm_proj) == 192);
+        assert!(::core::mem::offset_of!(March, sizes) == 208);
+        assert!(::core::mem::offset_of!(March, interleave) == 224);
+    };
+}

@@ -31,11 +31,7 @@ pub struct ShadowMapView {
 /// Light-space coordinates of a world point in the standard shadow map.
 pub fn shadow_light_space(v: &ShadowMapView, p: Vec3) -> Vec3 {
     let q = p - xyz(v.origin);
-    Vec3::new(
-        q.dot(xyz(v.right)),
-        q.dot(xyz(v.up)),
-        q.dot(xyz(v.forward)),
-    )
+    Vec3::new(q.dot(xyz(v.right)), q.dot(xyz(v.up)), q.dot(xyz(v.forward)))
 }
 
 /// Texture coordinates (u, v) in [0, 1] of light-space point `ls` (outside: no coverage).
@@ -84,7 +80,11 @@ pub fn shadow_visibility(v: &ShadowMapView, sm: &Tex, p: Vec3) -> f32 {
     }
     let stored = shadow_fetch(v, sm, shadow_uv(v, ls));
     let depth = (ls.z - near) / (far - near);
-    select(0.0, 1.0, depth <= stored + shadow_bias(v, ls.z) / (far - near))
+    select(
+        0.0,
+        1.0,
+        depth <= stored + shadow_bias(v, ls.z) / (far - near),
+    )
 }
 
 /// Travel distance from `o` along the light ray `o + s l` to its first occluder, biased as
@@ -94,11 +94,7 @@ pub fn shadow_occluder_distance(v: &ShadowMapView, sm: &Tex, o: Vec3, l: Vec3) -
     let ls = shadow_light_space(v, o);
     let (near, far) = (v.right[3], v.up[3]);
     if v.origin[3] > 0.5 {
-        let dir = Vec3::new(
-            l.dot(xyz(v.right)),
-            l.dot(xyz(v.up)),
-            l.dot(xyz(v.forward)),
-        );
+        let dir = Vec3::new(l.dot(xyz(v.right)), l.dot(xyz(v.up)), l.dot(xyz(v.forward)));
         if dir.z <= 1e-6 {
             return NO_OCCLUDER;
         }

@@ -58,7 +58,13 @@ pub fn interleave_sum_workgroup(
             for i in 0..my {
                 total += hsum[(start + i) as usize][(x - x0) as usize];
             }
-            output.store(x, y, 0, [total.x, total.y, total.z, 1.0], Storage::Rgba16float);
+            output.store(
+                x,
+                y,
+                0,
+                [total.x, total.y, total.z, 1.0],
+                Storage::Rgba16float,
+            );
         }
     }
 }

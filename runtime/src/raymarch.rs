@@ -1,0 +1,506 @@
+//! The `raymarch` family (Tóth & Umenhoffer 2009) on wgpu: [`Raymarch`] owns the `raymarch`
+//! pipeline (and `interleave_sum` for interleaved variants), the partial-sum and output
+//! textures and the uniform buffer; an engine calls [`Raymarch::prepare`] and
+//! [`Raymarch::encode`] once per frame with its depth buffer and standard shadow map.
+//! [`run_raymarch_once`] is the upload-run-readback convenience the conformance tests use.
+//!
+//! | pass | bindings | dispatch |
+//! |---|---|---|
+//! | `raymarch` | 0 uniform `March`, 1 depth r32float, 2 shadow map r32float, 3 output (storage, write: rgba16float radiance, or rgba32float partial sums when interleaved) | `ceil(W/8) x ceil(H/8) x 1` |
+//! | `interleave_sum` (interleaved only) | 0 uniform `March`, 1 partial sums rgba32float, 2 output rgba16float (storage, write) | `ceil(W/8) x ceil(H/8) x 1` |
+
+use std::time::{Duration, Instant};
+
+use scatter_shaderlib::prefiltered::{CameraDesc, LightDesc, MediumDesc, ShadowMapDesc};
+use scatter_shaderlib::raymarch::{MarchUniforms, RaymarchVariant, prepare_march};
+use scatter_shaderlib::{Kernel, KernelParams};
+
+use crate::error::{ErrorScopes, check_limit};
+use crate::prefiltered::{
+    DEPTH_FORMAT, DEPTH_NAMES, OUTPUT_FORMAT, Pipeline, Readback, SHADOW_NAMES, buffer_entry,
+    check_view, check_workgroup, create_pipeline, decode_rgba, groups, view_entry,
+};
+use crate::{Context, GpuTimer, RuntimeError};
+
+const RAYMARCH: Kernel = Kernel::Raymarch;
+const INTERLEAVE_SUM: Kernel = Kernel::InterleaveSum;
+
+/// Format of the partial sums of an interleaved variant.
+pub const PARTIAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// One frame's camera, light, medium and standard shadow map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MarchInput {
+    /// The camera.
+    pub camera: CameraDesc,
+    /// The light (its type must match the variant's).
+    pub light: LightDesc,
+    /// The homogeneous medium.
+    pub medium: MediumDesc,
+    /// The standard shadow map's projection and size (must match [`Raymarch::new`]).
+    pub shadow_map: ShadowMapDesc,
+}
+
+/// GPU time of each pass of one frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MarchTimes {
+    /// The `raymarch` pass.
+    pub raymarch: Duration,
+    /// The `interleave_sum` pass (zero without interleaving).
+    pub interleave_sum: Duration,
+}
+
+/// The raymarch family for one [`RaymarchVariant`], sized for one screen and one shadow-map
+/// size.
+#[derive(Debug)]
+pub struct Raymarch {
+    variant: RaymarchVariant,
+    screen: [u32; 2],
+    shadow_map_size: u32,
+    raymarch: Pipeline,
+    interleave_sum: Option<Pipeline>,
+    uniforms: wgpu::Buffer,
+    partial: Option<(wgpu::Texture, wgpu::TextureView)>,
+    output: wgpu::Texture,
+    output_view: wgpu::TextureView,
+    timer: Option<GpuTimer>,
+    prepared: Option<MarchUniforms>,
+}
+
+impl Raymarch {
+    /// Validates the variant and the sizes against the device and creates the pipelines,
+    /// textures and buffers.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::InvalidRaymarchVariant`] naming the knob; [`RuntimeError::EmptyInput`]
+    /// for a zero size; [`RuntimeError::LimitExceeded`] naming the device limit;
+    /// [`RuntimeError::Shader`] or [`RuntimeError::Wgpu`] when a kernel or resource fails.
+    pub fn new(
+        ctx: &Context,
+        variant: &RaymarchVariant,
+        screen: [u32; 2],
+        shadow_map_size: u32,
+    ) -> Result<Self, RuntimeError> {
+        variant
+            .validate()
+            .map_err(|source| RuntimeError::InvalidRaymarchVariant {
+                variant: variant.id(),
+                source,
+            })?;
+        let [w, h] = screen;
+        for (what, size, empty) in [
+            ("screen", format!("{w}x{h}"), w == 0 || h == 0),
+            (
+                "shadow map",
+                format!("{shadow_map_size}x{shadow_map_size}"),
+                shadow_map_size == 0,
+            ),
+        ] {
+            if empty {
+                return Err(RuntimeError::EmptyInput {
+                    kernel: RAYMARCH,
+                    size: format!("{what} {size}"),
+                });
+            }
+        }
+        let device = ctx.device();
+        let limits = device.limits();
+        for (what, value) in [
+            ("screen width", w),
+            ("screen height", h),
+            ("shadow map size", shadow_map_size),
+        ] {
+            check_limit(
+                RAYMARCH,
+                what,
+                value.into(),
+                "max_texture_dimension_2d",
+                limits.max_texture_dimension_2d.into(),
+            )?;
+        }
+        let built: Vec<_> = KernelParams::raymarch(*variant)
+            .iter()
+            .map(scatter_shaderlib::build)
+            .collect::<Result<_, _>>()?;
+        for b in &built {
+            check_workgroup(&limits, b)?;
+            for (count, what) in groups([w, h, 1], b.workgroup_size).into_iter().zip([
+                "workgroups along x",
+                "workgroups along y",
+                "workgroups along z",
+            ]) {
+                check_limit(
+                    b.kernel,
+                    what,
+                    count.into(),
+                    "max_compute_workgroups_per_dimension",
+                    limits.max_compute_workgroups_per_dimension.into(),
+                )?;
+            }
+        }
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty,
+            count: None,
+        };
+        let uniform = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: wgpu::BufferSize::new(size_of::<MarchUniforms>() as u64),
+        };
+        let texture = wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        };
+        let storage = |format| wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        };
+        let interleaved = variant.interleaved();
+        let march_out = if interleaved {
+            PARTIAL_FORMAT
+        } else {
+            OUTPUT_FORMAT
+        };
+        let mut built = built.into_iter();
+        let raymarch = create_pipeline(
+            device,
+            built
+                .next()
+                .ok_or(RuntimeError::NotPrepared { kernel: RAYMARCH })?,
+            &[
+                entry(0, uniform),
+                entry(1, texture),
+                entry(2, texture),
+                entry(3, storage(march_out)),
+            ],
+        )?;
+        let interleave_sum = match built.next() {
+            Some(b) => Some(create_pipeline(
+                device,
+                b,
+                &[
+                    entry(0, uniform),
+                    entry(1, texture),
+                    entry(2, storage(OUTPUT_FORMAT)),
+                ],
+            )?),
+            None => None,
+        };
+        let scope = ErrorScopes::push(device);
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("raymarch uniforms"),
+            size: size_of::<MarchUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let make = |label, format| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::STORAGE_BINDING
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        };
+        let partial = interleaved.then(|| {
+            let t = make("raymarch partial sums", PARTIAL_FORMAT);
+            let v = t.create_view(&wgpu::TextureViewDescriptor::default());
+            (t, v)
+        });
+        let output = make("raymarch output", OUTPUT_FORMAT);
+        let output_view = output.create_view(&wgpu::TextureViewDescriptor::default());
+        scope.pop(RAYMARCH, "creating resources")?;
+        Ok(Raymarch {
+            variant: *variant,
+            screen,
+            shadow_map_size,
+            raymarch,
+            interleave_sum,
+            uniforms,
+            partial,
+            output,
+            output_view,
+            timer: GpuTimer::with_passes(ctx, 2),
+            prepared: None,
+        })
+    }
+
+    /// Fills and uploads the uniform block of one frame.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::ShadowMapSize`] when the shadow map's size differs from
+    /// [`Self::new`]'s; [`RuntimeError::Frame`] for NaN or degenerate parameters or a light
+    /// of the wrong type.
+    pub fn prepare(&mut self, ctx: &Context, input: &MarchInput) -> Result<(), RuntimeError> {
+        if input.shadow_map.size != self.shadow_map_size {
+            return Err(RuntimeError::ShadowMapSize {
+                expected: self.shadow_map_size,
+                actual: input.shadow_map.size,
+            });
+        }
+        let u = prepare_march(
+            &self.variant,
+            self.screen,
+            &input.camera,
+            &input.light,
+            &input.medium,
+            &input.shadow_map,
+        )?;
+        let scope = ErrorScopes::push(ctx.device());
+        ctx.queue()
+            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        scope.pop(RAYMARCH, "uploading frame parameters")?;
+        self.prepared = Some(u);
+        Ok(())
+    }
+
+    /// Records the passes (with GPU timestamps when the device has them) and returns the
+    /// output view: in-scattered radiance, rgba16float, screen-sized. `depth` is linear view
+    /// depth (r32float, screen-sized), `shadow_map` the standard shadow map (r32float).
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::NotPrepared`] before [`Self::prepare`];
+    /// [`RuntimeError::InputMismatch`] for a view of the wrong format, size or usage;
+    /// [`RuntimeError::Wgpu`] when wgpu rejects a bind group.
+    pub fn encode(
+        &self,
+        ctx: &Context,
+        encoder: &mut wgpu::CommandEncoder,
+        depth: &wgpu::TextureView,
+        shadow_map: &wgpu::TextureView,
+    ) -> Result<&wgpu::TextureView, RuntimeError> {
+        if self.prepared.is_none() {
+            return Err(RuntimeError::NotPrepared { kernel: RAYMARCH });
+        }
+        check_view(RAYMARCH, &DEPTH_NAMES, depth, self.screen)?;
+        check_view(
+            RAYMARCH,
+            &SHADOW_NAMES,
+            shadow_map,
+            [self.shadow_map_size; 2],
+        )?;
+        let device = ctx.device();
+        let march_target = self.partial.as_ref().map_or(&self.output_view, |(_, v)| v);
+        let scope = ErrorScopes::push(device);
+        let march_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("raymarch"),
+            layout: &self.raymarch.layout,
+            entries: &[
+                buffer_entry(0, &self.uniforms),
+                view_entry(1, depth),
+                view_entry(2, shadow_map),
+                view_entry(3, march_target),
+            ],
+        });
+        scope.pop(RAYMARCH, "creating the bind group")?;
+        let scope = ErrorScopes::push(device);
+        let sum_group = match (&self.interleave_sum, &self.partial) {
+            (Some(p), Some((_, partial))) => {
+                Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("interleave_sum"),
+                    layout: &p.layout,
+                    entries: &[
+                        buffer_entry(0, &self.uniforms),
+                        view_entry(1, partial),
+                        view_entry(2, &self.output_view),
+                    ],
+                }))
+            }
+            _ => None,
+        };
+        scope.pop(INTERLEAVE_SUM, "creating the bind group")?;
+        let [w, h] = self.screen;
+        let passes = std::iter::once((&self.raymarch, &march_group))
+            .chain(self.interleave_sum.as_ref().zip(sum_group.as_ref()));
+        for (index, (pipeline, group)) in (0u32..).zip(passes) {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(pipeline.kernel.name()),
+                timestamp_writes: self.timer.as_ref().and_then(|t| t.pass_writes(index)),
+            });
+            pass.set_pipeline(&pipeline.pipeline);
+            pass.set_bind_group(0, group, &[]);
+            let [x, y, z] = groups([w, h, 1], pipeline.workgroup_size);
+            pass.dispatch_workgroups(x, y, z);
+        }
+        if let Some(timer) = &self.timer {
+            timer.resolve(encoder);
+        }
+        Ok(&self.output_view)
+    }
+
+    /// GPU time of each pass of the last submitted [`Self::encode`], or `None` without
+    /// timestamps. Blocks until the GPU is done.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
+    pub fn pass_times(&self, ctx: &Context) -> Result<Option<MarchTimes>, RuntimeError> {
+        let Some(timer) = &self.timer else {
+            return Ok(None);
+        };
+        let times = timer.read_all(ctx, RAYMARCH)?;
+        Ok(Some(MarchTimes {
+            raymarch: times.first().copied().unwrap_or_default(),
+            interleave_sum: if self.interleave_sum.is_some() {
+                times.get(1).copied().unwrap_or_default()
+            } else {
+                Duration::ZERO
+            },
+        }))
+    }
+
+    /// The uniform block of the last [`Self::prepare`].
+    pub fn uniforms(&self) -> Option<&MarchUniforms> {
+        self.prepared.as_ref()
+    }
+
+    /// The output texture (rgba16float, screen-sized).
+    pub fn output_texture(&self) -> &wgpu::Texture {
+        &self.output
+    }
+
+    /// The partial sums of an interleaved variant (rgba32float).
+    pub fn partial_texture(&self) -> Option<&wgpu::Texture> {
+        self.partial.as_ref().map(|(t, _)| t)
+    }
+}
+
+/// Everything [`run_raymarch_once`] reads back.
+#[derive(Clone, Debug)]
+pub struct MarchReadback {
+    /// The uploaded uniform block.
+    pub uniforms: MarchUniforms,
+    /// In-scattered radiance per pixel (rgba16float converted to f32), row-major.
+    pub output: Vec<[f32; 4]>,
+    /// The partial sums of an interleaved variant, row-major.
+    pub partial: Option<Vec<[f32; 4]>>,
+    /// GPU time per pass, when the device has timestamps.
+    pub gpu_times: Option<MarchTimes>,
+    /// Wall time from submission until every result was mapped.
+    pub wall_time: Duration,
+}
+
+/// Test helper: creates a [`Raymarch`], uploads `depth` (screen-sized) and `shadow_map`
+/// (`input.shadow_map.size` squared) as r32float textures, runs one frame and reads back.
+///
+/// # Errors
+///
+/// Whatever [`Raymarch::new`], [`Raymarch::prepare`] or [`Raymarch::encode`] fail with;
+/// [`RuntimeError::DataLength`] when a buffer does not match its size; GPU errors.
+pub fn run_raymarch_once(
+    ctx: &Context,
+    variant: &RaymarchVariant,
+    screen: [u32; 2],
+    input: &MarchInput,
+    depth: &[f32],
+    shadow_map: &[f32],
+) -> Result<MarchReadback, RuntimeError> {
+    let sm_size = input.shadow_map.size;
+    let mut pass = Raymarch::new(ctx, variant, screen, sm_size)?;
+    for (what, [tw, th], data) in [
+        ("depth buffer", screen, depth),
+        ("shadow map", [sm_size; 2], shadow_map),
+    ] {
+        let expected = u64::from(tw) * u64::from(th);
+        if data.len() as u64 != expected {
+            return Err(RuntimeError::DataLength {
+                kernel: RAYMARCH,
+                size: format!("{what} {tw}x{th}"),
+                expected,
+                actual: data.len() as u64,
+            });
+        }
+    }
+    pass.prepare(ctx, input)?;
+    let device = ctx.device();
+    let scope = ErrorScopes::push(device);
+    let upload = |label, [width, height]: [u32; 2], data: &[f32]| {
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        ctx.queue().write_texture(
+            texture.as_image_copy(),
+            bytemuck::cast_slice(data),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(width * 4),
+                rows_per_image: Some(height),
+            },
+            size,
+        );
+        texture.create_view(&wgpu::TextureViewDescriptor::default())
+    };
+    let depth_view = upload("raymarch depth (test upload)", screen, depth);
+    let shadow_view = upload(
+        "raymarch shadow map (test upload)",
+        [sm_size; 2],
+        shadow_map,
+    );
+    scope.pop(RAYMARCH, "uploading test inputs")?;
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("raymarch run_once"),
+    });
+    pass.encode(ctx, &mut encoder, &depth_view, &shadow_view)?;
+    let scope = ErrorScopes::push(device);
+    let partial = pass
+        .partial_texture()
+        .map(|t| Readback::encode(device, &mut encoder, t, 16));
+    let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8);
+    let start = Instant::now();
+    ctx.queue().submit([encoder.finish()]);
+    scope.pop(RAYMARCH, "dispatch")?;
+    let partial = match partial {
+        Some(r) => Some(
+            r.read(ctx, RAYMARCH)?
+                .chunks_exact(16)
+                .map(|t| decode_rgba(t, scatter_shaderlib::prefiltered::Storage::Rgba32float))
+                .collect(),
+        ),
+        None => None,
+    };
+    let output = output
+        .read(ctx, RAYMARCH)?
+        .chunks_exact(8)
+        .map(|t| decode_rgba(t, scatter_shaderlib::prefiltered::Storage::Rgba16float))
+        .collect();
+    let wall_time = start.elapsed();
+    let gpu_times = pass.pass_times(ctx)?;
+    let uniforms = pass
+        .prepared
+        .ok_or(RuntimeError::NotPrepared { kernel: RAYMARCH })?;
+    Ok(MarchReadback {
+        uniforms,
+        output,
+        partial,
+        gpu_times,
+        wall_time,
+    })
+}

@@ -1,0 +1,238 @@
+//! Conformance of the `raymarch` family (`raymarch`, `interleave_sum`): the GPU
+//! (`scatter_runtime::run_raymarch_once`) against the CPU mirrors
+//! (`reference/src/kernels/{raymarch,interleave_sum}.rs`, driven by
+//! `scatter_reference::kernels::run_raymarch`) for every variant of
+//! `RaymarchVariant::grid()` (samples {8, 32, 128} x interleave {1, 2, 4} x jitter x light),
+//! directional on `columns/ordinary`, spot on `spot_grate/ordinary`, at 67x37 pixels (not a
+//! multiple of the 8x8 workgroups, nor of the interleaving tiles) with a 128^2 shadow map.
+//! Trials are named `raymarch::<variant id>::<scene>::<pose>`.
+//!
+//! Tolerance: `|gpu - cpu| <= 1e-4 * max radiance` plus one f16 step of the mirror's value
+//! for the output (both round to rgba16float), `1e-4 * max` for the rgba32float partial sums.
+
+use std::sync::OnceLock;
+
+use scatter_conformance::gpu;
+use scatter_reference::buffers::{GBuffer, ShadowMap};
+use scatter_reference::bvh::Bvh;
+use scatter_reference::kernels::run_raymarch;
+use scatter_reference::scene::Scene;
+use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
+use scatter_runtime::{MarchInput, Raymarch, RuntimeError, run_raymarch_once};
+use scatter_shaderlib::prefiltered::LightKind;
+use scatter_shaderlib::raymarch::RaymarchVariant;
+
+const SCREEN: [u32; 2] = [67, 37];
+const SHADOW_MAP: u32 = 128;
+const REL_TOL: f32 = 1e-4;
+
+struct Fixture {
+    name: SceneName,
+    scene: Scene,
+    gbuf: GBuffer,
+    shadow_map: ShadowMap,
+}
+
+impl Fixture {
+    fn for_light(light: LightKind) -> &'static Fixture {
+        static COLUMNS: OnceLock<Fixture> = OnceLock::new();
+        static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
+        let (cell, name) = match light {
+            LightKind::Directional => (&COLUMNS, SceneName::Columns),
+            LightKind::Spot => (&SPOT_GRATE, SceneName::SpotGrate),
+        };
+        cell.get_or_init(|| {
+            let scene = scene(
+                name,
+                Pose::Ordinary,
+                MediumPreset::Default,
+                SCREEN[0],
+                SCREEN[1],
+            );
+            let bvh = Bvh::build(&scene.geometry);
+            let gbuf = GBuffer::cast(&scene, &bvh);
+            let shadow_map = ShadowMap::build(&scene, &bvh, SHADOW_MAP)
+                .unwrap_or_else(|e| panic!("shadow map of {name}: {e}"));
+            Fixture {
+                name,
+                scene,
+                gbuf,
+                shadow_map,
+            }
+        })
+    }
+
+    fn input(&self) -> MarchInput {
+        MarchInput {
+            camera: self.scene.camera_desc(),
+            light: self.scene.light_desc(),
+            medium: self.scene.medium_desc(),
+            shadow_map: self.shadow_map.desc(),
+        }
+    }
+}
+
+/// Spacing of f16 values at `v`.
+fn f16_ulp(v: f32) -> f32 {
+    let a = v.abs();
+    if !a.is_finite() || a < 2f32.powi(-14) {
+        return 2f32.powi(-24);
+    }
+    2f32.powi(a.log2().floor() as i32 - 10)
+}
+
+fn trial(ctx: &scatter_runtime::Context, variant: &RaymarchVariant) -> Result<String, String> {
+    let f = Fixture::for_light(variant.light);
+    let name = format!("raymarch::{variant}::{}::ordinary", f.name);
+    let cpu = run_raymarch(variant, &f.scene, &f.gbuf, &f.shadow_map)
+        .map_err(|e| format!("{name}: CPU mirror failed: {e}"))?;
+    let gpu = run_raymarch_once(
+        ctx,
+        variant,
+        SCREEN,
+        &f.input(),
+        &f.gbuf.view_depth,
+        &f.shadow_map.depth,
+    )
+    .map_err(|e| format!("{name}: GPU run failed: {e}"))?;
+    if gpu.uniforms != cpu.uniforms {
+        return Err(format!("{name}: different uniform blocks"));
+    }
+    let max = cpu
+        .output
+        .data
+        .iter()
+        .flatten()
+        .fold(0.0f32, |m, &v| m.max(v));
+    if !(max > 0.0) {
+        return Err(format!("{name}: the mirror's image is black"));
+    }
+    let mut worst: f32 = 0.0;
+    let mut over = 0;
+    for (g, c) in gpu.output.iter().zip(&cpu.output.data) {
+        for k in 0..3 {
+            let d = (g[k] - c[k]).abs();
+            let d = if d.is_nan() { f32::INFINITY } else { d };
+            worst = worst.max(d);
+            if d > REL_TOL * max + f16_ulp(c[k]) {
+                over += 1;
+            }
+        }
+    }
+    let mut worst_partial: f32 = 0.0;
+    match (&gpu.partial, &cpu.partial) {
+        (Some(g), Some(c)) => {
+            let pmax = c.data.iter().flatten().fold(0.0f32, |m, &v| m.max(v));
+            for (a, b) in g.iter().zip(&c.data) {
+                for k in 0..3 {
+                    let d = (a[k] - b[k]).abs();
+                    worst_partial = worst_partial.max(if d.is_nan() { f32::INFINITY } else { d });
+                }
+            }
+            if worst_partial > REL_TOL * pmax {
+                return Err(format!(
+                    "{name}: partial sums differ by {worst_partial:e} > {:e}",
+                    REL_TOL * pmax
+                ));
+            }
+        }
+        (None, None) => {}
+        _ => return Err(format!("{name}: partial sums on one side only")),
+    }
+    if over > 0 {
+        return Err(format!(
+            "{name}: {over} output values over tolerance, worst |diff| {worst:e} ({:.2e} of max {max:e})",
+            worst / max
+        ));
+    }
+    let times = gpu.gpu_times.map_or_else(
+        || "gpu n/a".to_owned(),
+        |t| {
+            format!(
+                "gpu raymarch {:.2} ms interleave_sum {:.2} ms",
+                t.raymarch.as_secs_f64() * 1e3,
+                t.interleave_sum.as_secs_f64() * 1e3
+            )
+        },
+    );
+    Ok(format!(
+        "{name}: output max |diff| {worst:.2e} ({:.2e} of max {max:.3e}); partial {worst_partial:.2e}; {times}",
+        worst / max
+    ))
+}
+
+#[test]
+fn every_variant_matches_the_mirror() {
+    let Some(ctx) = gpu() else { return };
+    let filter = std::env::var("SCATTER_TRIALS").unwrap_or_default();
+    let mut failures = Vec::new();
+    let mut count = 0;
+    let start = std::time::Instant::now();
+    for variant in RaymarchVariant::grid() {
+        if !format!("raymarch::{variant}").contains(filter.as_str()) {
+            continue;
+        }
+        count += 1;
+        match trial(ctx, &variant) {
+            Ok(line) => eprintln!("ok   {line}"),
+            Err(e) => {
+                eprintln!("FAIL {e}");
+                failures.push(e);
+            }
+        }
+    }
+    eprintln!(
+        "raymarch: {count} trials in {:.1} s, {} failed",
+        start.elapsed().as_secs_f64(),
+        failures.len()
+    );
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let Some(ctx) = gpu() else { return };
+    let bad = RaymarchVariant {
+        samples: 30,
+        interleave: 2,
+        ..RaymarchVariant::default()
+    };
+    let err = Raymarch::new(ctx, &bad, SCREEN, SHADOW_MAP).expect_err("30 samples, interleave 2");
+    assert!(
+        matches!(&err, RuntimeError::InvalidRaymarchVariant { source, .. } if source.knob == "samples")
+            && err.to_string().contains("30"),
+        "{err}"
+    );
+    eprintln!("ok   raymarch::errors::samples: {err}");
+    let err = Raymarch::new(ctx, &RaymarchVariant::default(), [0, 4], SHADOW_MAP)
+        .expect_err("zero width");
+    assert!(matches!(err, RuntimeError::EmptyInput { .. }), "{err}");
+    eprintln!("ok   raymarch::errors::zero_size: {err}");
+    let f = Fixture::for_light(LightKind::Directional);
+    let mut pass = Raymarch::new(ctx, &RaymarchVariant::default(), SCREEN, SHADOW_MAP / 2)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let err = pass.prepare(ctx, &f.input()).expect_err("shadow map size");
+    assert!(matches!(err, RuntimeError::ShadowMapSize { .. }), "{err}");
+    eprintln!("ok   raymarch::errors::shadow_map_size: {err}");
+    let mut input = f.input();
+    input.camera.forward.y = f64::NAN;
+    let mut pass = Raymarch::new(ctx, &RaymarchVariant::default(), SCREEN, SHADOW_MAP)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let err = pass.prepare(ctx, &input).expect_err("NaN camera");
+    assert!(err.to_string().contains("camera"), "{err}");
+    eprintln!("ok   raymarch::errors::nan_camera: {err}");
+    // A 1x1 screen with interleaving (windows shrink to the screen) runs.
+    let tiny = run_raymarch_once(
+        ctx,
+        &RaymarchVariant {
+            interleave: 4,
+            ..RaymarchVariant::default()
+        },
+        [1, 1],
+        &f.input(),
+        &[5.0],
+        &f.shadow_map.depth,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(tiny.output[0].iter().all(|v| v.is_finite()));
+}
