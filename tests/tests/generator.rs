@@ -221,3 +221,94 @@ fn manifest_dispatch_matches_the_runtime_grid() {
         }
     }
 }
+
+/// The raymarch family's manifest against `scatter_runtime::raymarch`: formats, the `March`
+/// block's size and field offsets, and the dispatch of both passes at odd sizes.
+#[test]
+fn raymarch_manifest_matches_the_runtime() {
+    use scatter_runtime::raymarch::PARTIAL_FORMAT;
+    use scatter_shaderlib::raymarch::{MarchUniforms, RaymarchVariant};
+    use std::mem::offset_of;
+    let v = RaymarchVariant {
+        samples: 64,
+        interleave: 4,
+        jitter: true,
+        light: LightKind::Spot,
+    };
+    let g = generate(&Request {
+        variants: vec![FamilyVariant::Raymarch(v)],
+        targets: vec![Target::Wgsl],
+    })
+    .unwrap_or_else(|e| panic!("{v}: {e}"));
+    let m: Value = serde_json::from_slice(&g.manifest).unwrap_or_else(|e| panic!("{e}"));
+    let variant = &get(&m, "variants")[0];
+    let tex = |name: &str| get(resource(variant, name), "texture").clone();
+    assert_eq!(str_of(&tex("partial"), "format"), wgpu_name(PARTIAL_FORMAT));
+    assert_eq!(str_of(&tex("output"), "format"), wgpu_name(OUTPUT_FORMAT));
+    for name in ["depth", "shadow_map"] {
+        assert_eq!(str_of(&tex(name), "format"), wgpu_name(DEPTH_FORMAT));
+    }
+    assert_eq!(
+        str_of(get(resource(variant, "march"), "buffer"), "size_bytes"),
+        size_of::<MarchUniforms>().to_string()
+    );
+    let march = get(&m, "structs")
+        .as_array()
+        .and_then(|a| {
+            a.iter()
+                .find(|s| s.get("name").and_then(Value::as_str) == Some("March"))
+        })
+        .unwrap_or_else(|| panic!("no struct March"));
+    let host = [
+        ("eye", offset_of!(MarchUniforms, eye)),
+        ("cam_forward", offset_of!(MarchUniforms, cam_forward)),
+        ("cam_right", offset_of!(MarchUniforms, cam_right)),
+        ("cam_up", offset_of!(MarchUniforms, cam_up)),
+        ("medium", offset_of!(MarchUniforms, medium)),
+        ("light_color", offset_of!(MarchUniforms, light_color)),
+        ("light_pos", offset_of!(MarchUniforms, light_pos)),
+        ("light_dir", offset_of!(MarchUniforms, light_dir)),
+        ("sm_right", offset_of!(MarchUniforms, sm_right)),
+        ("sm_up", offset_of!(MarchUniforms, sm_up)),
+        ("sm_forward", offset_of!(MarchUniforms, sm_forward)),
+        ("sm_origin", offset_of!(MarchUniforms, sm_origin)),
+        ("sm_proj", offset_of!(MarchUniforms, sm_proj)),
+        ("sizes", offset_of!(MarchUniforms, sizes)),
+        ("interleave", offset_of!(MarchUniforms, interleave)),
+    ];
+    let fields = get(march, "fields").as_array().cloned().unwrap_or_default();
+    assert_eq!(fields.len(), host.len(), "{fields:?}");
+    for (f, (name, offset)) in fields.iter().zip(host) {
+        assert_eq!(str_of(f, "name"), name);
+        assert_eq!(get(f, "offset").as_u64(), Some(offset as u64), "{name}");
+    }
+    let (w, h) = (333u32, 187u32);
+    let sizes = [
+        ("screen.width", w),
+        ("screen.height", h),
+        ("shadow.size", 512),
+    ];
+    let passes = get(variant, "passes")
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let params = KernelParams::raymarch(v);
+    assert_eq!(passes.len(), params.len());
+    for (pass, p) in passes.iter().zip(params) {
+        let built = build(&p).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(str_of(pass, "kernel"), built.kernel.name());
+        let dispatch = get(pass, "dispatch")
+            .as_array()
+            .cloned()
+            .unwrap_or_default();
+        for (i, n) in [w, h, 1].into_iter().enumerate() {
+            let got = eval(str_of(&dispatch[i], "workgroups"), &sizes);
+            assert_eq!(
+                got,
+                n.div_ceil(built.workgroup_size[i]),
+                "{} dim {i}",
+                built.kernel
+            );
+        }
+    }
+}

@@ -104,7 +104,7 @@ fn trial(ctx: &scatter_runtime::Context, variant: &RaymarchVariant) -> Result<St
         .iter()
         .flatten()
         .fold(0.0f32, |m, &v| m.max(v));
-    if !(max > 0.0) {
+    if max.is_nan() || max <= 0.0 {
         return Err(format!("{name}: the mirror's image is black"));
     }
     let mut worst: f32 = 0.0;
