@@ -5,7 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(mesa-vulkan-drivers libvulkan1 spirv-tools glslang-tools)
+# fonts-dejavu-core: the bench draws its chart with DejaVu Sans.
+packages=(mesa-vulkan-drivers libvulkan1 spirv-tools glslang-tools fonts-dejavu-core)
 missing=()
 if command -v dpkg-query >/dev/null 2>&1; then
     for pkg in "${packages[@]}"; do

@@ -1,1 +1,3 @@
 //! Shared helpers of the scatter examples (see `examples/`).
+
+pub mod bench;

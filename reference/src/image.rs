@@ -79,6 +79,28 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     res
 }
 
+/// Writes 8-bit RGB pixels (already display-encoded, row-major) as a PNG, atomically.
+pub fn write_png_rgb8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[u8],
+) -> Result<(), ImageError> {
+    let mut buf = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut buf, width, height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let png_err = |e: png::EncodingError| ImageError::Png {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        };
+        let mut w = enc.write_header().map_err(png_err)?;
+        w.write_image_data(pixels).map_err(png_err)?;
+    }
+    write_atomic(path, &buf).map_err(io_err(path))
+}
+
 /// Rec. 709 luminance.
 pub fn luminance(c: [f32; 3]) -> f32 {
     0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]

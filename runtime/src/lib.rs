@@ -16,6 +16,7 @@ mod error;
 pub mod prefiltered;
 pub mod raymarch;
 pub mod row_prefix;
+pub mod textures;
 mod timer;
 
 pub use context::{AdapterReport, Context, ContextError, GpuPolicy};

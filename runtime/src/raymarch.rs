@@ -50,6 +50,13 @@ pub struct MarchTimes {
     pub interleave_sum: Duration,
 }
 
+impl MarchTimes {
+    /// Sum of the passes.
+    pub fn total(&self) -> Duration {
+        self.raymarch + self.interleave_sum
+    }
+}
+
 /// The raymarch family for one [`RaymarchVariant`], sized for one screen and one shadow-map
 /// size.
 #[derive(Debug)]
@@ -285,6 +292,63 @@ impl Raymarch {
         depth: &wgpu::TextureView,
         shadow_map: &wgpu::TextureView,
     ) -> Result<&wgpu::TextureView, RuntimeError> {
+        self.encode_selected(ctx, encoder, depth, shadow_map, None)
+    }
+
+    /// Wall time of each pass submitted on its own and waited for, the median over
+    /// `frames` frames after one warm-up frame (on a CPU adapter such as lavapipe this is
+    /// the pass's real cost; its timestamps are not).
+    ///
+    /// # Errors
+    ///
+    /// As [`Self::encode`]; [`RuntimeError::Poll`] when waiting fails.
+    pub fn measure_pass_wall_times(
+        &self,
+        ctx: &Context,
+        depth: &wgpu::TextureView,
+        shadow_map: &wgpu::TextureView,
+        frames: u32,
+    ) -> Result<MarchTimes, RuntimeError> {
+        let mut samples: [Vec<Duration>; 2] = Default::default();
+        for frame in 0..=frames.max(1) {
+            for (slot, kernel) in [RAYMARCH, INTERLEAVE_SUM].into_iter().enumerate() {
+                if kernel == INTERLEAVE_SUM && self.interleave_sum.is_none() {
+                    continue;
+                }
+                let mut encoder =
+                    ctx.device()
+                        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                            label: Some(kernel.name()),
+                        });
+                self.encode_selected(ctx, &mut encoder, depth, shadow_map, Some(kernel))?;
+                let start = Instant::now();
+                ctx.queue().submit([encoder.finish()]);
+                ctx.device()
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|source| RuntimeError::Poll { kernel, source })?;
+                if frame > 0 {
+                    samples[slot].push(start.elapsed());
+                }
+            }
+        }
+        let [raymarch, interleave_sum] = samples.map(|mut v| {
+            v.sort();
+            v.get(v.len() / 2).copied().unwrap_or_default()
+        });
+        Ok(MarchTimes {
+            raymarch,
+            interleave_sum,
+        })
+    }
+
+    fn encode_selected(
+        &self,
+        ctx: &Context,
+        encoder: &mut wgpu::CommandEncoder,
+        depth: &wgpu::TextureView,
+        shadow_map: &wgpu::TextureView,
+        only: Option<Kernel>,
+    ) -> Result<&wgpu::TextureView, RuntimeError> {
         if self.prepared.is_none() {
             return Err(RuntimeError::NotPrepared { kernel: RAYMARCH });
         }
@@ -329,16 +393,24 @@ impl Raymarch {
         let passes = std::iter::once((&self.raymarch, &march_group))
             .chain(self.interleave_sum.as_ref().zip(sum_group.as_ref()));
         for (index, (pipeline, group)) in (0u32..).zip(passes) {
+            if only.is_some_and(|k| k != pipeline.kernel) {
+                continue;
+            }
+            let timestamps = if only.is_none() {
+                self.timer.as_ref().and_then(|t| t.pass_writes(index))
+            } else {
+                None
+            };
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(pipeline.kernel.name()),
-                timestamp_writes: self.timer.as_ref().and_then(|t| t.pass_writes(index)),
+                timestamp_writes: timestamps,
             });
             pass.set_pipeline(&pipeline.pipeline);
             pass.set_bind_group(0, group, &[]);
             let [x, y, z] = groups([w, h, 1], pipeline.workgroup_size);
             pass.dispatch_workgroups(x, y, z);
         }
-        if let Some(timer) = &self.timer {
+        if let Some(timer) = self.timer.as_ref().filter(|_| only.is_none()) {
             timer.resolve(encoder);
         }
         Ok(&self.output_view)

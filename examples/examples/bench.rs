@@ -1,0 +1,75 @@
+//! `bench`: speed against accuracy for every family and variant of a grid on the suite
+//! (`scatter_examples::bench`): CSV, markdown report with the ratios, chart (SVG, PNG).
+//!
+//! ```sh
+//! cargo run --release -p scatter-examples --example bench -- --out-dir docs/bench
+//! cargo run --release -p scatter-examples --example bench -- --quick --out-dir out/bench
+//! ```
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Parser;
+use scatter_examples::bench::{BenchConfig, run, write_outputs};
+use scatter_runtime::Context;
+
+/// Speed against accuracy of every scatter family on the scene suite.
+#[derive(Debug, Parser)]
+#[command(name = "bench")]
+struct Args {
+    /// Directory for bench.csv, bench.md, bench.svg and bench.png.
+    #[arg(long, default_value = "out/bench")]
+    out_dir: PathBuf,
+    /// The smoke run: two scenes, three variants, 160x90 (under 2 minutes).
+    #[arg(long)]
+    quick: bool,
+    /// Timed frames per run after the warm-up (1..=20).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=20))]
+    frames: Option<u32>,
+    /// Skip the prefiltered scaling runs (rectified width 512..4096, screen sizes).
+    #[arg(long)]
+    no_scaling: bool,
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    let mut config = if args.quick {
+        BenchConfig::quick()
+    } else {
+        BenchConfig::default_sweep()
+    };
+    if let Some(f) = args.frames {
+        config.frames = f;
+    }
+    if args.no_scaling {
+        config.scaling = false;
+    }
+    let command = std::env::args().collect::<Vec<_>>().join(" ");
+    let result = Context::new()
+        .map_err(|e| e.to_string())
+        .and_then(|ctx| {
+            eprintln!("GPU adapter: {}", ctx.report());
+            run(&ctx, &config, true).map_err(|e| e.to_string())
+        })
+        .and_then(|r| {
+            write_outputs(&r, &args.out_dir, &command)
+                .map(|paths| (r, paths))
+                .map_err(|e| e.to_string())
+        });
+    match result {
+        Ok((r, paths)) => {
+            for line in scatter_examples::bench::ratios(&r) {
+                println!("{line}");
+            }
+            for p in paths {
+                eprintln!("wrote {}", p.display());
+            }
+            eprintln!("bench done in {:.1} s", r.elapsed.as_secs_f64());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

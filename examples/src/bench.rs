@@ -1,0 +1,836 @@
+//! The speed-accuracy bench: every family and variant of a grid on suite scenes and poses,
+//! each run through `scatter-runtime` on the GPU (lavapipe when there is none), its error
+//! measured against both ground truths, its passes timed; written as CSV, a markdown table
+//! with the ratios, and a chart (SVG and PNG) of error against time with the Pareto front.
+//!
+//! Timing. Each pass is submitted on its own and waited for; the median of `frames` frames
+//! after a warm-up is its time ("pass wall time"). On a CPU adapter (lavapipe) that is the
+//! pass's real cost, and GPU timestamps are not usable (they are not ordered after the
+//! compute work: passes read 0.03 ms whatever their size), so the chart uses wall times.
+//! The GPU timestamps are recorded too, for real GPUs. Speed is reported as ratios measured
+//! in one run, never asserted.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use scatter_reference::buffers::{GBuffer, ShadowMap};
+use scatter_reference::bvh::Bvh;
+use scatter_reference::image::{Image, write_atomic, write_png_rgb8};
+use scatter_reference::metrics;
+use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
+use scatter_reference::truth::{self, TruthSettings, Visibility};
+use scatter_runtime::prefiltered::{FrameInput, Inputs};
+use scatter_runtime::raymarch::MarchInput;
+use scatter_runtime::shaderlib::Kernel;
+use scatter_runtime::shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions, Variant};
+use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
+use scatter_runtime::textures::{read_rgba16float, upload_r32float};
+use scatter_runtime::{Context, Raymarch, Scatter};
+
+/// A method of one family with its knobs (the light is set per scene).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// The prefiltered family.
+    Prefiltered(Variant),
+    /// The raymarch family.
+    Raymarch(RaymarchVariant),
+}
+
+impl Method {
+    /// The family's name.
+    pub fn family(&self) -> &'static str {
+        match self {
+            Self::Prefiltered(_) => "prefiltered",
+            Self::Raymarch(_) => "raymarch",
+        }
+    }
+
+    /// The variant id (light included).
+    pub fn id(&self) -> String {
+        match self {
+            Self::Prefiltered(v) => v.id(),
+            Self::Raymarch(v) => v.id(),
+        }
+    }
+
+    /// The variant id without the light (the chart's marker).
+    pub fn knobs(&self) -> String {
+        match self {
+            Self::Prefiltered(v) => format!("m{}-r{}", v.bases, v.regions),
+            Self::Raymarch(v) => format!("n{}-i{}", v.samples, v.interleave),
+        }
+    }
+
+    fn with_light(self, light: LightKind) -> Self {
+        match self {
+            Self::Prefiltered(v) => Self::Prefiltered(Variant { light, ..v }),
+            Self::Raymarch(v) => Self::Raymarch(RaymarchVariant { light, ..v }),
+        }
+    }
+}
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct BenchConfig {
+    /// Scene and pose pairs.
+    pub cases: Vec<(SceneName, Pose)>,
+    /// Methods (their light is the scene's).
+    pub methods: Vec<Method>,
+    /// Screen size of the accuracy and timing runs.
+    pub screen: [u32; 2],
+    /// Rectified map of the prefiltered family.
+    pub rectified: [u32; 2],
+    /// Standard shadow-map size.
+    pub shadow_map: u32,
+    /// Timed frames per run (after one warm-up).
+    pub frames: u32,
+    /// Quadrature cells of the ground truths.
+    pub truth_segments: usize,
+    /// Also time the prefiltered default at 1280x720 over rectified widths 512..4096 and
+    /// screen sizes (no accuracy).
+    pub scaling: bool,
+}
+
+impl BenchConfig {
+    /// The default sweep: every scene at `ordinary` and `epipole_on_screen`, prefiltered
+    /// (M, R) in {(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)} and raymarch N in {16, 32,
+    /// 64, 128, 256} plus interleaved (64, 4x4) and (256, 4x4), at 320x180 with a 512x512
+    /// rectified map and a 1024^2 shadow map, 3 frames; plus the scaling runs.
+    pub fn default_sweep() -> BenchConfig {
+        let mut methods: Vec<Method> = [(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)]
+            .into_iter()
+            .map(|(bases, regions)| {
+                Method::Prefiltered(Variant {
+                    bases,
+                    regions,
+                    ..Variant::default()
+                })
+            })
+            .collect();
+        for (samples, interleave) in [
+            (16, 1),
+            (32, 1),
+            (64, 1),
+            (128, 1),
+            (256, 1),
+            (64, 4),
+            (256, 4),
+        ] {
+            methods.push(Method::Raymarch(RaymarchVariant {
+                samples,
+                interleave,
+                ..RaymarchVariant::default()
+            }));
+        }
+        BenchConfig {
+            cases: SceneName::ALL
+                .iter()
+                .flat_map(|&s| [(s, Pose::Ordinary), (s, Pose::EpipoleOnScreen)])
+                .collect(),
+            methods,
+            screen: [320, 180],
+            rectified: [512, 512],
+            shadow_map: 1024,
+            frames: 3,
+            truth_segments: TruthSettings::default().segments,
+            scaling: true,
+        }
+    }
+
+    /// The smoke run (CI): sphere and foliage at `ordinary`, the prefiltered default and two
+    /// raymarch variants, 160x90, 256^2 rectified, 512^2 shadow map, 1 frame, coarse truths.
+    pub fn quick() -> BenchConfig {
+        BenchConfig {
+            cases: vec![
+                (SceneName::Sphere, Pose::Ordinary),
+                (SceneName::Foliage, Pose::Ordinary),
+            ],
+            methods: vec![
+                Method::Prefiltered(Variant::default()),
+                Method::Raymarch(RaymarchVariant {
+                    samples: 32,
+                    ..RaymarchVariant::default()
+                }),
+                Method::Raymarch(RaymarchVariant {
+                    samples: 64,
+                    interleave: 4,
+                    ..RaymarchVariant::default()
+                }),
+            ],
+            screen: [160, 90],
+            rectified: [256, 256],
+            shadow_map: 512,
+            frames: 1,
+            truth_segments: 256,
+            scaling: false,
+        }
+    }
+}
+
+/// One measured run.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Family.
+    pub family: &'static str,
+    /// Variant id.
+    pub variant: String,
+    /// Variant knobs without the light.
+    pub knobs: String,
+    /// Scene.
+    pub scene: SceneName,
+    /// Pose.
+    pub pose: Pose,
+    /// rel L1 against the `exact` truth.
+    pub rel_l1_exact: f64,
+    /// rel L1 against the `shadow_map` truth.
+    pub rel_l1_shadow_map: f64,
+    /// NaN/Inf pixels.
+    pub non_finite: usize,
+    /// Median wall time of each pass submitted alone: (pass, time).
+    pub passes: Vec<(&'static str, Duration)>,
+    /// GPU timestamps summed over the passes of one frame, when the adapter has them.
+    pub gpu_timestamps: Option<Duration>,
+}
+
+impl Row {
+    /// Sum of the pass wall times.
+    pub fn total(&self) -> Duration {
+        self.passes.iter().map(|p| p.1).sum()
+    }
+}
+
+/// A timing-only run (scaling of the prefiltered method).
+#[derive(Clone, Debug)]
+pub struct ScalingRow {
+    /// Screen size.
+    pub screen: [u32; 2],
+    /// Rectified size.
+    pub rectified: [u32; 2],
+    /// Pass wall times: rectify, prefilter, scatter.
+    pub passes: [Duration; 3],
+}
+
+/// Everything a bench run measured.
+#[derive(Clone, Debug)]
+pub struct BenchResult {
+    /// The adapter.
+    pub adapter: String,
+    /// The configuration.
+    pub config: BenchConfig,
+    /// Accuracy and timing runs.
+    pub rows: Vec<Row>,
+    /// Scaling runs.
+    pub scaling: Vec<ScalingRow>,
+    /// Wall time of the whole bench.
+    pub elapsed: Duration,
+}
+
+type BoxError = Box<dyn std::error::Error>;
+
+fn light_of(name: SceneName) -> LightKind {
+    if name == SceneName::SpotGrate {
+        LightKind::Spot
+    } else {
+        LightKind::Directional
+    }
+}
+
+/// Runs the bench.
+///
+/// # Errors
+///
+/// Any runtime, reference or I/O error, with context.
+pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchResult, BoxError> {
+    let start = Instant::now();
+    let bar = if progress {
+        ProgressBar::new((config.cases.len() * (config.methods.len() + 2)) as u64).with_style(
+            ProgressStyle::with_template("{msg:40} [{bar:40}] {pos}/{len}, eta {eta}")?
+                .progress_chars("=> "),
+        )
+    } else {
+        ProgressBar::hidden()
+    };
+    let mut rows = Vec::new();
+    let [w, h] = config.screen;
+    for &(name, pose) in &config.cases {
+        let scene = suite::scene(name, pose, MediumPreset::Default, w, h);
+        let bvh = Bvh::build(&scene.geometry);
+        let gbuf = GBuffer::cast(&scene, &bvh);
+        let sm = ShadowMap::build(&scene, &bvh, config.shadow_map)?;
+        let settings = TruthSettings {
+            segments: config.truth_segments,
+            ..TruthSettings::default()
+        };
+        bar.set_message(format!("{name}/{pose}: exact truth"));
+        let exact = truth::render(&scene, &gbuf, &Visibility::Exact(&bvh), &settings, &|| ());
+        bar.inc(1);
+        bar.set_message(format!("{name}/{pose}: shadow_map truth"));
+        let sm_truth = truth::render(
+            &scene,
+            &gbuf,
+            &Visibility::ShadowMap(&sm),
+            &settings,
+            &|| (),
+        );
+        bar.inc(1);
+        let depth = upload_r32float(
+            ctx,
+            Kernel::Scatter,
+            "bench depth",
+            [w, h],
+            &gbuf.view_depth,
+        )?;
+        let shadow = upload_r32float(
+            ctx,
+            Kernel::Rectify,
+            "bench shadow map",
+            [sm.size; 2],
+            &sm.depth,
+        )?;
+        let depth_view = depth.create_view(&Default::default());
+        let shadow_view = shadow.create_view(&Default::default());
+        for &method in &config.methods {
+            let method = method.with_light(light_of(name));
+            bar.set_message(format!("{name}/{pose}: {}", method.id()));
+            let (output, passes, gpu_timestamps) = match method {
+                Method::Prefiltered(v) => {
+                    let res = Resolutions {
+                        screen: config.screen,
+                        rectified: config.rectified,
+                    };
+                    let mut pass = Scatter::new(ctx, &v, res, sm.size)?;
+                    pass.prepare(
+                        ctx,
+                        &FrameInput {
+                            camera: scene.camera_desc(),
+                            light: scene.light_desc(),
+                            medium: scene.medium_desc(),
+                            shadow_map: sm.desc(),
+                            settings: FrameSettings::for_screen(w, h),
+                        },
+                    )?;
+                    let inputs = Inputs {
+                        depth: &depth_view,
+                        shadow_map: Some(&shadow_view),
+                        rectified: None,
+                    };
+                    let mut encoder = ctx.device().create_command_encoder(&Default::default());
+                    pass.encode(&mut encoder, &inputs)?;
+                    ctx.queue().submit([encoder.finish()]);
+                    let ts = pass.pass_times(ctx)?.map(|t| t.total());
+                    let output = read_rgba16float(ctx, Kernel::Scatter, pass.output_texture())?;
+                    let t = pass.measure_pass_wall_times(ctx, &inputs, config.frames)?;
+                    (
+                        output,
+                        vec![
+                            ("rectify", t.rectify),
+                            ("prefilter", t.prefilter),
+                            ("scatter", t.scatter),
+                        ],
+                        ts,
+                    )
+                }
+                Method::Raymarch(v) => {
+                    let mut pass = Raymarch::new(ctx, &v, config.screen, sm.size)?;
+                    pass.prepare(
+                        ctx,
+                        &MarchInput {
+                            camera: scene.camera_desc(),
+                            light: scene.light_desc(),
+                            medium: scene.medium_desc(),
+                            shadow_map: sm.desc(),
+                        },
+                    )?;
+                    let mut encoder = ctx.device().create_command_encoder(&Default::default());
+                    pass.encode(ctx, &mut encoder, &depth_view, &shadow_view)?;
+                    ctx.queue().submit([encoder.finish()]);
+                    let ts = pass.pass_times(ctx)?.map(|t| t.total());
+                    let output = read_rgba16float(ctx, Kernel::Raymarch, pass.output_texture())?;
+                    let t = pass.measure_pass_wall_times(
+                        ctx,
+                        &depth_view,
+                        &shadow_view,
+                        config.frames,
+                    )?;
+                    let mut passes = vec![("raymarch", t.raymarch)];
+                    if v.interleaved() {
+                        passes.push(("interleave_sum", t.interleave_sum));
+                    }
+                    (output, passes, ts)
+                }
+            };
+            let image =
+                Image::from_pixels(w, h, output.iter().map(|c| [c[0], c[1], c[2]]).collect());
+            let e = metrics::compare(&image, &exact)?;
+            let s = metrics::compare(&image, &sm_truth)?;
+            rows.push(Row {
+                family: method.family(),
+                variant: method.id(),
+                knobs: method.knobs(),
+                scene: name,
+                pose,
+                rel_l1_exact: e.rel_l1,
+                rel_l1_shadow_map: s.rel_l1,
+                non_finite: e.non_finite,
+                passes,
+                gpu_timestamps,
+            });
+            bar.inc(1);
+        }
+    }
+    let scaling = if config.scaling {
+        bar.set_message("prefiltered scaling");
+        scaling_runs(ctx, config.frames)?
+    } else {
+        Vec::new()
+    };
+    bar.finish_and_clear();
+    Ok(BenchResult {
+        adapter: ctx.report().to_string(),
+        config: config.clone(),
+        rows,
+        scaling,
+        elapsed: start.elapsed(),
+    })
+}
+
+/// The prefiltered default on sphere/ordinary at 1280x720 with rectified widths 512..4096
+/// (1024 rows), and at 320x180 / 640x360 / 1280x720 with a 1024x1024 map.
+fn scaling_runs(ctx: &Context, frames: u32) -> Result<Vec<ScalingRow>, BoxError> {
+    let mut out = Vec::new();
+    let configs = [512, 1024, 2048, 4096]
+        .map(|wr| ([1280, 720], [wr, 1024]))
+        .into_iter()
+        .chain([([320, 180], [1024, 1024]), ([640, 360], [1024, 1024])]);
+    for (screen, rectified) in configs {
+        let scene = suite::scene(
+            SceneName::Sphere,
+            Pose::Ordinary,
+            MediumPreset::Default,
+            screen[0],
+            screen[1],
+        );
+        let bvh = Bvh::build(&scene.geometry);
+        let gbuf = GBuffer::cast(&scene, &bvh);
+        let sm = ShadowMap::build(&scene, &bvh, 1024)?;
+        let depth = upload_r32float(
+            ctx,
+            Kernel::Scatter,
+            "bench depth",
+            screen,
+            &gbuf.view_depth,
+        )?;
+        let shadow = upload_r32float(
+            ctx,
+            Kernel::Rectify,
+            "bench shadow map",
+            [sm.size; 2],
+            &sm.depth,
+        )?;
+        let (dv, sv) = (
+            depth.create_view(&Default::default()),
+            shadow.create_view(&Default::default()),
+        );
+        let mut pass = Scatter::new(
+            ctx,
+            &Variant::default(),
+            Resolutions { screen, rectified },
+            sm.size,
+        )?;
+        pass.prepare(
+            ctx,
+            &FrameInput {
+                camera: scene.camera_desc(),
+                light: scene.light_desc(),
+                medium: scene.medium_desc(),
+                shadow_map: sm.desc(),
+                settings: FrameSettings::for_screen(screen[0], screen[1]),
+            },
+        )?;
+        let t = pass.measure_pass_wall_times(
+            ctx,
+            &Inputs {
+                depth: &dv,
+                shadow_map: Some(&sv),
+                rectified: None,
+            },
+            frames,
+        )?;
+        out.push(ScalingRow {
+            screen,
+            rectified,
+            passes: [t.rectify, t.prefilter, t.scatter],
+        });
+    }
+    Ok(out)
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// Per-variant means over the runs: (family, knobs, mean total ms, mean rel L1 vs shadow
+/// map truth, mean rel L1 vs exact), sorted by family then time.
+pub fn per_variant(rows: &[Row]) -> Vec<(&'static str, String, f64, f64, f64)> {
+    let mut keys: Vec<(&'static str, String)> = Vec::new();
+    for r in rows {
+        if !keys.iter().any(|k| k.0 == r.family && k.1 == r.knobs) {
+            keys.push((r.family, r.knobs.clone()));
+        }
+    }
+    let mut out: Vec<_> = keys
+        .into_iter()
+        .map(|(family, knobs)| {
+            let sel: Vec<&Row> = rows
+                .iter()
+                .filter(|r| r.family == family && r.knobs == knobs)
+                .collect();
+            let n = sel.len().max(1) as f64;
+            let t = sel.iter().map(|r| ms(r.total())).sum::<f64>() / n;
+            let es = sel.iter().map(|r| r.rel_l1_shadow_map).sum::<f64>() / n;
+            let ee = sel.iter().map(|r| r.rel_l1_exact).sum::<f64>() / n;
+            (family, knobs, t, es, ee)
+        })
+        .collect();
+    out.sort_by(|a, b| a.0.cmp(b.0).then(a.2.total_cmp(&b.2)));
+    out
+}
+
+/// The Pareto front (cheaper or more accurate than every other point) of (time, error)
+/// points, sorted by time.
+pub fn pareto(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut sorted: Vec<_> = points.to_vec();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let mut front: Vec<(f64, f64)> = Vec::new();
+    for p in sorted {
+        if front.last().is_none_or(|l| p.1 < l.1) {
+            front.push(p);
+        }
+    }
+    front
+}
+
+/// The ratio lines of the report.
+pub fn ratios(result: &BenchResult) -> Vec<String> {
+    let mut out = Vec::new();
+    let variants = per_variant(&result.rows);
+    let reference = variants
+        .iter()
+        .find(|v| v.0 == "prefiltered" && v.1 == "m32-r3");
+    if let Some(p) = reference {
+        let matching = variants
+            .iter()
+            .filter(|v| v.0 == "raymarch" && v.3 <= p.3)
+            .min_by(|a, b| a.2.total_cmp(&b.2));
+        match matching {
+            Some(r) => out.push(format!(
+                "prefiltered m32-r3 ({:.2} ms, mean rel L1 {:.2} %) vs the cheapest raymarch at equal or better error, {} ({:.2} ms, {:.2} %): raymarch takes {:.2}x the time",
+                p.2,
+                100.0 * p.3,
+                r.1,
+                r.2,
+                100.0 * r.3,
+                r.2 / p.2
+            )),
+            None => {
+                let best = variants
+                    .iter()
+                    .filter(|v| v.0 == "raymarch")
+                    .min_by(|a, b| a.3.total_cmp(&b.3));
+                out.push(match best {
+                    Some(b) => format!(
+                        "prefiltered m32-r3 ({:.2} ms, mean rel L1 {:.2} %): no raymarch variant in the sweep reaches its error; the most accurate, {} ({:.2} ms), has {:.2} % ({:.2}x the time)",
+                        p.2,
+                        100.0 * p.3,
+                        b.1,
+                        b.2,
+                        100.0 * b.3,
+                        b.2 / p.2
+                    ),
+                    None => "no raymarch variant in the sweep".to_owned(),
+                });
+            }
+        }
+    }
+    out.push(
+        "prefiltered vs minmax on foliage and terrain: not measured (the minmax family is not in this build)"
+            .to_owned(),
+    );
+    for (family, knobs) in [("prefiltered", "m32-r3"), ("raymarch", "n64-i1")] {
+        let time = |scene: SceneName| {
+            result
+                .rows
+                .iter()
+                .find(|r| {
+                    r.family == family
+                        && r.knobs == knobs
+                        && r.scene == scene
+                        && r.pose == Pose::Ordinary
+                })
+                .map(|r| ms(r.total()))
+        };
+        if let (Some(f), Some(s)) = (time(SceneName::Foliage), time(SceneName::Sphere)) {
+            out.push(format!(
+                "scene independence, {family} {knobs}: time(foliage) / time(sphere) = {f:.2} / {s:.2} ms = {:.2}",
+                f / s
+            ));
+        }
+    }
+    if let Some(base) = result
+        .scaling
+        .iter()
+        .find(|r| r.screen == [1280, 720] && r.rectified == [512, 1024])
+    {
+        let b: f64 = base.passes.iter().copied().map(ms).sum();
+        for r in &result.scaling {
+            let t: f64 = r.passes.iter().copied().map(ms).sum();
+            out.push(format!(
+                "prefiltered m32-r3 scaling, {}x{} screen, {}x{} rectified: {:.1} ms (rectify {:.1}, prefilter {:.1}, scatter {:.1}) = {:.2}x the 1280x720 / 512x1024 time",
+                r.screen[0],
+                r.screen[1],
+                r.rectified[0],
+                r.rectified[1],
+                t,
+                ms(r.passes[0]),
+                ms(r.passes[1]),
+                ms(r.passes[2]),
+                t / b
+            ));
+        }
+    }
+    out
+}
+
+/// The CSV: one line per run.
+pub fn csv(result: &BenchResult) -> String {
+    let mut s = String::from(
+        "family,variant,scene,pose,rel_l1_exact,rel_l1_shadow_map,non_finite,total_ms,passes,gpu_timestamps_ms\n",
+    );
+    for r in &result.rows {
+        let passes: Vec<String> = r
+            .passes
+            .iter()
+            .map(|(n, d)| format!("{n}={:.3}", ms(*d)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{:.6},{:.6},{},{:.3},{},{}",
+            r.family,
+            r.variant,
+            r.scene,
+            r.pose,
+            r.rel_l1_exact,
+            r.rel_l1_shadow_map,
+            r.non_finite,
+            ms(r.total()),
+            passes.join(";"),
+            r.gpu_timestamps
+                .map_or_else(String::new, |d| format!("{:.3}", ms(d)))
+        );
+    }
+    s
+}
+
+/// The markdown report: configuration, ratios, per-variant means, every run.
+pub fn markdown(result: &BenchResult, command: &str) -> String {
+    let c = &result.config;
+    let mut s = String::new();
+    let _ = writeln!(s, "# scatter bench\n");
+    let _ = writeln!(
+        s,
+        "`{command}` on {} in {:.0} s: {} runs, {}x{} screen, {}x{} rectified map (prefiltered), {}^2 shadow map, times = median pass wall time over {} frame(s) (each pass submitted alone).\n",
+        result.adapter,
+        result.elapsed.as_secs_f64(),
+        result.rows.len(),
+        c.screen[0],
+        c.screen[1],
+        c.rectified[0],
+        c.rectified[1],
+        c.shadow_map,
+        c.frames
+    );
+    let _ = writeln!(s, "## Ratios (one run)\n");
+    for r in ratios(result) {
+        let _ = writeln!(s, "- {r}");
+    }
+    let _ = writeln!(s, "\n## Per variant (means over the scenes and poses)\n");
+    let _ = writeln!(
+        s,
+        "| family | variant | time (ms) | rel L1 vs shadow_map truth | rel L1 vs exact truth |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|");
+    for (family, knobs, t, es, ee) in per_variant(&result.rows) {
+        let _ = writeln!(
+            s,
+            "| {family} | {knobs} | {t:.2} | {:.3} % | {:.3} % |",
+            100.0 * es,
+            100.0 * ee
+        );
+    }
+    let _ = writeln!(s, "\n## Every run\n");
+    let _ = writeln!(
+        s,
+        "| family | variant | scene | pose | rel L1 shadow_map | rel L1 exact | NaN/Inf | time (ms) | passes (ms) |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+    for r in &result.rows {
+        let passes: Vec<String> = r
+            .passes
+            .iter()
+            .map(|(n, d)| format!("{n} {:.2}", ms(*d)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {:.3} % | {:.3} % | {} | {:.2} | {} |",
+            r.family,
+            r.variant,
+            r.scene,
+            r.pose,
+            100.0 * r.rel_l1_shadow_map,
+            100.0 * r.rel_l1_exact,
+            r.non_finite,
+            ms(r.total()),
+            passes.join(", ")
+        );
+    }
+    s
+}
+
+const FONT_PATHS: &[&str] = &[
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+];
+
+/// Draws the chart into any plotters backend: x = time (log), y = mean rel L1 vs the
+/// `shadow_map` truth (log), one marker per variant, one colour per family, the Pareto
+/// front of all variants as a line.
+fn draw<DB: plotters::prelude::DrawingBackend>(
+    root: plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    result: &BenchResult,
+) -> Result<(), BoxError>
+where
+    DB::ErrorType: 'static,
+{
+    use plotters::prelude::*;
+    root.fill(&WHITE)?;
+    let v = per_variant(&result.rows);
+    let pts: Vec<(f64, f64)> = v
+        .iter()
+        .map(|p| (p.2.max(1e-3), (100.0 * p.3).max(1e-3)))
+        .collect();
+    let (xmin, xmax) = pts
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let (ymin, ymax) = pts
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!(
+                "scatter: error vs time ({}x{}, {})",
+                result.config.screen[0],
+                result.config.screen[1],
+                result.adapter.split(" (").next().unwrap_or("")
+            ),
+            ("sans-serif", 18),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(
+            (xmin / 1.5..xmax * 1.5).log_scale(),
+            (ymin / 1.5..ymax * 1.5).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("time per frame, sum of pass wall times (ms, log)")
+        .y_desc("mean rel L1 vs shadow_map truth (%, log)")
+        .label_style(("sans-serif", 12))
+        .draw()?;
+    let front = pareto(&pts);
+    chart
+        .draw_series(LineSeries::new(front.clone(), BLACK.stroke_width(1)))?
+        .label("Pareto front")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK));
+    for (family, colour) in [("prefiltered", RED), ("raymarch", BLUE)] {
+        let sel: Vec<_> = v.iter().zip(&pts).filter(|(p, _)| p.0 == family).collect();
+        if sel.is_empty() {
+            continue;
+        }
+        chart
+            .draw_series(
+                sel.iter()
+                    .map(|(_, p)| Circle::new(**p, 5, colour.filled())),
+            )?
+            .label(family)
+            .legend(move |(x, y)| Circle::new((x + 8, y), 5, colour.filled()));
+        chart.draw_series(
+            sel.iter()
+                .map(|(v, p)| Text::new(v.1.clone(), **p, ("sans-serif", 11).into_font())),
+        )?;
+    }
+    chart
+        .configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.9))
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// Writes `bench.csv`, `bench.md` and, when a DejaVu Sans font is installed (Debian's
+/// fonts-dejavu-core, which `scripts/test.sh` installs), `bench.svg` and `bench.png` into
+/// `dir`, each atomically. Returns the paths written.
+///
+/// # Errors
+///
+/// I/O or drawing errors.
+pub fn write_outputs(
+    result: &BenchResult,
+    dir: &Path,
+    command: &str,
+) -> Result<Vec<PathBuf>, BoxError> {
+    use plotters::prelude::IntoDrawingArea as _;
+    std::fs::create_dir_all(dir)?;
+    let mut written = Vec::new();
+    let csv_path = dir.join("bench.csv");
+    write_atomic(&csv_path, csv(result).as_bytes())?;
+    written.push(csv_path);
+    let md_path = dir.join("bench.md");
+    write_atomic(&md_path, markdown(result, command).as_bytes())?;
+    written.push(md_path);
+    // plotters lays text out with a TTF font (no system font libraries): without one the
+    // chart is skipped, the tables are not.
+    let Some(font) = FONT_PATHS.iter().find_map(|p| std::fs::read(p).ok()) else {
+        eprintln!(
+            "bench: no DejaVu Sans font ({}); install Debian's fonts-dejavu-core for the chart",
+            FONT_PATHS.join(", ")
+        );
+        return Ok(written);
+    };
+    let font: &'static [u8] = Box::leak(font.into_boxed_slice());
+    plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, font)
+        .map_err(|_| "the TTF font could not be registered")?;
+    let mut svg = String::new();
+    {
+        let root =
+            plotters::prelude::SVGBackend::with_string(&mut svg, (900, 600)).into_drawing_area();
+        draw(root, result)?;
+    }
+    let svg_path = dir.join("bench.svg");
+    write_atomic(&svg_path, svg.as_bytes())?;
+    written.push(svg_path);
+    let (w, h) = (900u32, 600u32);
+    let mut pixels = vec![0u8; (w * h * 3) as usize];
+    {
+        let root =
+            plotters::prelude::BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
+        draw(root, result)?;
+    }
+    let png_path = dir.join("bench.png");
+    write_png_rgb8(&png_path, w, h, &pixels)?;
+    written.push(png_path);
+    Ok(written)
+}

@@ -1,0 +1,89 @@
+//! Texture helpers for tools and tests that drive the passes directly (the bench): upload
+//! an r32float image, read back an rgba16float one.
+
+use scatter_shaderlib::Kernel;
+
+use crate::error::ErrorScopes;
+use crate::prefiltered::{DEPTH_FORMAT, Readback, decode_rgba};
+use crate::{Context, RuntimeError};
+
+/// Creates an r32float texture (`TEXTURE_BINDING | COPY_DST | COPY_SRC`) holding `data`
+/// (`size[0] * size[1]` values, row-major from the top-left texel).
+///
+/// # Errors
+///
+/// [`RuntimeError::DataLength`] when `data` does not match `size`; [`RuntimeError::Wgpu`]
+/// when wgpu rejects the texture.
+pub fn upload_r32float(
+    ctx: &Context,
+    kernel: Kernel,
+    label: &str,
+    size: [u32; 2],
+    data: &[f32],
+) -> Result<wgpu::Texture, RuntimeError> {
+    let expected = u64::from(size[0]) * u64::from(size[1]);
+    if data.len() as u64 != expected {
+        return Err(RuntimeError::DataLength {
+            kernel,
+            size: format!("{label} {}x{}", size[0], size[1]),
+            expected,
+            actual: data.len() as u64,
+        });
+    }
+    let scope = ErrorScopes::push(ctx.device());
+    let extent = wgpu::Extent3d {
+        width: size[0],
+        height: size[1],
+        depth_or_array_layers: 1,
+    };
+    let texture = ctx.device().create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: extent,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_DST
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    ctx.queue().write_texture(
+        texture.as_image_copy(),
+        bytemuck::cast_slice(data),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(size[0] * 4),
+            rows_per_image: Some(size[1]),
+        },
+        extent,
+    );
+    scope.pop(kernel, "uploading a texture")?;
+    Ok(texture)
+}
+
+/// Reads back an rgba16float texture (one layer) as f32, row-major.
+///
+/// # Errors
+///
+/// [`RuntimeError::Poll`], [`RuntimeError::Readback`] or [`RuntimeError::Wgpu`].
+pub fn read_rgba16float(
+    ctx: &Context,
+    kernel: Kernel,
+    texture: &wgpu::Texture,
+) -> Result<Vec<[f32; 4]>, RuntimeError> {
+    let mut encoder = ctx
+        .device()
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("read_rgba16float"),
+        });
+    let scope = ErrorScopes::push(ctx.device());
+    let readback = Readback::encode(ctx.device(), &mut encoder, texture, 8);
+    ctx.queue().submit([encoder.finish()]);
+    scope.pop(kernel, "reading back a texture")?;
+    Ok(readback
+        .read(ctx, kernel)?
+        .chunks_exact(8)
+        .map(|t| decode_rgba(t, scatter_shaderlib::prefiltered::Storage::Rgba16float))
+        .collect())
+}
