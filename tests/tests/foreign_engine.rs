@@ -222,12 +222,13 @@ fn trial(ctx: &Context, variant: &Variant) -> Vec<String> {
     );
     let mut lines = Vec::new();
     let mut failures = Vec::new();
+    let shaders = shader_dir();
     for target in [Target::Spirv, Target::Wgsl] {
         let start = Instant::now();
         let mut engine = Engine::load(
             ctx.device(),
             ctx.queue(),
-            shader_dir(),
+            shaders,
             &variant.id(),
             target,
             &fixture.sizes().params(),
@@ -347,7 +348,10 @@ fn foreign_engine_files_round_trip() {
         },
     )
     .unwrap_or_else(|e| panic!("run_dir: {e}"));
-    assert_eq!(summary.frame, frame, "frame.json round trip changed the frame");
+    assert_eq!(
+        summary.frame, frame,
+        "frame.json round trip changed the frame"
+    );
     let mut engine = Engine::load(
         ctx.device(),
         ctx.queue(),
@@ -542,20 +546,26 @@ fn manifest_conditions_are_machine_readable() {
     let variants: Vec<Variant> = [LightKind::Directional, LightKind::Spot]
         .into_iter()
         .flat_map(|light| {
-            Rectification::ALL.iter().map(move |&rectification| Variant {
-                light,
-                rectification,
-                ..Variant::default()
-            })
+            Rectification::ALL
+                .iter()
+                .map(move |&rectification| Variant {
+                    light,
+                    rectification,
+                    ..Variant::default()
+                })
         })
         .collect();
     let generated = generate(&Request {
-        variants: variants.iter().copied().map(FamilyVariant::Prefiltered).collect(),
+        variants: variants
+            .iter()
+            .copied()
+            .map(FamilyVariant::Prefiltered)
+            .collect(),
         targets: vec![scatter_gen::Target::Wgsl],
     })
     .unwrap_or_else(|e| panic!("{e}"));
-    let manifest =
-        Manifest::parse(&generated.manifest, Path::new("generated")).unwrap_or_else(|e| panic!("{e}"));
+    let manifest = Manifest::parse(&generated.manifest, Path::new("generated"))
+        .unwrap_or_else(|e| panic!("{e}"));
     let mut buffer_conditions = 0;
     for v in &manifest.variants {
         for pass in &v.passes {
@@ -565,9 +575,7 @@ fn manifest_conditions_are_machine_readable() {
             }
             for b in &pass.bindings {
                 if let Some(a) = &b.alternative {
-                    let engine_input = v
-                        .resource(&b.resource)
-                        .is_some_and(|r| r.engine_provided());
+                    let engine_input = v.resource(&b.resource).is_some_and(|r| r.engine_provided());
                     conditions.push((&a.when, engine_input));
                 }
             }

@@ -402,19 +402,20 @@ impl Engine {
         let mut passes = Vec::new();
         for pass in &variant.passes {
             let context = |what: &str| format!("pass {} {what}", pass.kernel);
-            let file = pass
-                .files
-                .get(target.name())
-                .ok_or_else(|| EngineError::TargetNotGenerated {
-                    kernel: pass.kernel.clone(),
-                    variant: variant.id.clone(),
-                    target: target.name().to_owned(),
-                })?;
+            let file =
+                pass.files
+                    .get(target.name())
+                    .ok_or_else(|| EngineError::TargetNotGenerated {
+                        kernel: pass.kernel.clone(),
+                        variant: variant.id.clone(),
+                        target: target.name().to_owned(),
+                    })?;
             let (path, bytes) = read_checked(dir, &manifest, &file.path, &file.sha256)?;
             let source = match target {
                 Target::Spirv => wgpu::ShaderSource::SpirV(Cow::Owned(spirv_words(&path, &bytes)?)),
                 Target::Wgsl => wgpu::ShaderSource::Wgsl(Cow::Owned(
-                    String::from_utf8(bytes).map_err(|_| EngineError::BadWgsl { path: path.clone() })?,
+                    String::from_utf8(bytes)
+                        .map_err(|_| EngineError::BadWgsl { path: path.clone() })?,
                 )),
             };
 
@@ -435,7 +436,8 @@ impl Engine {
                             )));
                         }
                         let cond = Condition::parse(&a.when, &manifest, &variant, &ctx)?;
-                        if matches!(cond, Condition::Engine { .. }) && !primary.0.engine_provided() {
+                        if matches!(cond, Condition::Engine { .. }) && !primary.0.engine_provided()
+                        {
                             return Err(EngineError::Condition {
                                 condition: a.when.clone(),
                                 context: ctx.clone(),
@@ -491,7 +493,11 @@ impl Engine {
             }
             let mut workgroups = [1u32; 3];
             for (axis, (d, slot)) in pass.dispatch.iter().zip(&mut workgroups).enumerate() {
-                let what = format!("workgroups of pass {} along {}", pass.kernel, ["x", "y", "z"][axis]);
+                let what = format!(
+                    "workgroups of pass {} along {}",
+                    pass.kernel,
+                    ["x", "y", "z"][axis]
+                );
                 *slot = eval_u32(&d.workgroups, &effective, &what)?;
                 check_constraint(
                     &what,
@@ -504,7 +510,8 @@ impl Engine {
             let label = Some(pass.kernel.as_str());
             let max_group = entries.keys().next_back().copied().unwrap_or(0);
             let (pipeline, layouts) = scoped(device, context("pipeline creation"), || {
-                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label, source });
+                let module =
+                    device.create_shader_module(wgpu::ShaderModuleDescriptor { label, source });
                 let layouts: Vec<wgpu::BindGroupLayout> = (0..=max_group)
                     .map(|g| {
                         device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -513,12 +520,14 @@ impl Engine {
                         })
                     })
                     .collect();
-                let layout_refs: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(Some).collect();
-                let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label,
-                    bind_group_layouts: &layout_refs,
-                    immediate_size: 0,
-                });
+                let layout_refs: Vec<Option<&wgpu::BindGroupLayout>> =
+                    layouts.iter().map(Some).collect();
+                let pipeline_layout =
+                    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                        label,
+                        bind_group_layouts: &layout_refs,
+                        immediate_size: 0,
+                    });
                 let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label,
                     layout: Some(&pipeline_layout),
@@ -603,7 +612,9 @@ impl Engine {
                 let (res, gpu) = &self.resources[name];
                 let missing = match gpu {
                     Gpu::Texture { .. } => res.engine_provided() && !self.supplied.contains(name),
-                    Gpu::Buffer { host_written, .. } => *host_written && !self.uploaded.contains_key(name),
+                    Gpu::Buffer { host_written, .. } => {
+                        *host_written && !self.uploaded.contains_key(name)
+                    }
                     Gpu::Sampler(_) => false,
                 };
                 if missing {
@@ -615,47 +626,53 @@ impl Engine {
                 }
                 chosen.push((b, gpu));
             }
-            let groups = scoped(device, format!("creating the bind groups of {}", pass.kernel), || {
-                let bound: Vec<(&BindingPlan, Bound<'_>)> = chosen
-                    .iter()
-                    .map(|&(b, gpu)| {
-                        let bound = match gpu {
-                            Gpu::Texture { texture, .. } => {
-                                Bound::View(texture.create_view(&wgpu::TextureViewDescriptor {
-                                    dimension: b.view_dimension,
-                                    ..wgpu::TextureViewDescriptor::default()
-                                }))
-                            }
-                            Gpu::Buffer { buffer, .. } => Bound::Buffer(buffer),
-                            Gpu::Sampler(s) => Bound::Sampler(s),
-                        };
-                        (b, bound)
-                    })
-                    .collect();
-                pass.layouts
-                    .iter()
-                    .zip(0u32..)
-                    .map(|(layout, group)| {
-                        let entries: Vec<wgpu::BindGroupEntry<'_>> = bound
-                            .iter()
-                            .filter(|(b, _)| b.group == group)
-                            .map(|(b, bound)| wgpu::BindGroupEntry {
-                                binding: b.binding,
-                                resource: match bound {
-                                    Bound::View(view) => wgpu::BindingResource::TextureView(view),
-                                    Bound::Buffer(buffer) => buffer.as_entire_binding(),
-                                    Bound::Sampler(s) => wgpu::BindingResource::Sampler(s),
-                                },
-                            })
-                            .collect();
-                        device.create_bind_group(&wgpu::BindGroupDescriptor {
-                            label: Some(pass.kernel.as_str()),
-                            layout,
-                            entries: &entries,
+            let groups = scoped(
+                device,
+                format!("creating the bind groups of {}", pass.kernel),
+                || {
+                    let bound: Vec<(&BindingPlan, Bound<'_>)> = chosen
+                        .iter()
+                        .map(|&(b, gpu)| {
+                            let bound = match gpu {
+                                Gpu::Texture { texture, .. } => {
+                                    Bound::View(texture.create_view(&wgpu::TextureViewDescriptor {
+                                        dimension: b.view_dimension,
+                                        ..wgpu::TextureViewDescriptor::default()
+                                    }))
+                                }
+                                Gpu::Buffer { buffer, .. } => Bound::Buffer(buffer),
+                                Gpu::Sampler(s) => Bound::Sampler(s),
+                            };
+                            (b, bound)
                         })
-                    })
-                    .collect::<Vec<_>>()
-            })?;
+                        .collect();
+                    pass.layouts
+                        .iter()
+                        .zip(0u32..)
+                        .map(|(layout, group)| {
+                            let entries: Vec<wgpu::BindGroupEntry<'_>> = bound
+                                .iter()
+                                .filter(|(b, _)| b.group == group)
+                                .map(|(b, bound)| wgpu::BindGroupEntry {
+                                    binding: b.binding,
+                                    resource: match bound {
+                                        Bound::View(view) => {
+                                            wgpu::BindingResource::TextureView(view)
+                                        }
+                                        Bound::Buffer(buffer) => buffer.as_entire_binding(),
+                                        Bound::Sampler(s) => wgpu::BindingResource::Sampler(s),
+                                    },
+                                })
+                                .collect();
+                            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                                label: Some(pass.kernel.as_str()),
+                                layout,
+                                entries: &entries,
+                            })
+                        })
+                        .collect::<Vec<_>>()
+                },
+            )?;
             let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(pass.kernel.as_str()),
                 timestamp_writes: None,
@@ -719,7 +736,10 @@ impl Engine {
                 return Err(not_input(name, "not a texture"));
             };
             if !res.engine_provided() {
-                return Err(not_input(name, "scatter provides it (provided_by: scatter)"));
+                return Err(not_input(
+                    name,
+                    "scatter provides it (provided_by: scatter)",
+                ));
             }
             let Some((channels, Encoding::F32)) = encoding(*format) else {
                 return Err(unsupported(
@@ -774,7 +794,11 @@ impl Engine {
             });
         };
         let (channels, enc) = encoding(*format).ok_or_else(|| {
-            unsupported(format!("reading {name}"), "readback format", &format!("{format:?}"))
+            unsupported(
+                format!("reading {name}"),
+                "readback format",
+                &format!("{format:?}"),
+            )
         })?;
         let texel = channels * enc.bytes();
         let extent = texture.size();
@@ -888,12 +912,21 @@ fn create_resource(
             let format = texture_format(&t.format)
                 .ok_or_else(|| unsupported(ctx("format"), "texture format", &t.format))?;
             if t.dimension != "2d" {
-                return Err(unsupported(ctx("dimension"), "texture dimension", &t.dimension));
+                return Err(unsupported(
+                    ctx("dimension"),
+                    "texture dimension",
+                    &t.dimension,
+                ));
             }
             let width = eval_u32(&t.width, params, &ctx("width"))?;
             let height = eval_u32(&t.height, params, &ctx("height"))?;
             let layers = eval_u32(&t.layers, params, &ctx("layers"))?;
-            check_constraint(&ctx("layers"), layers.into(), "1..=max_texture_array_layers", limits)?;
+            check_constraint(
+                &ctx("layers"),
+                layers.into(),
+                "1..=max_texture_array_layers",
+                limits,
+            )?;
             let mut usage = wgpu::TextureUsages::COPY_SRC;
             if r.engine_provided() {
                 usage |= wgpu::TextureUsages::COPY_DST;

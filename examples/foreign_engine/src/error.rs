@@ -105,7 +105,9 @@ pub enum EngineError {
         path: PathBuf,
     },
     /// A formula names a symbol that is not a parameter of the variant.
-    #[error("formula {formula:?} ({context}) uses {symbol:?}, which is not a parameter (known: {known})")]
+    #[error(
+        "formula {formula:?} ({context}) uses {symbol:?}, which is not a parameter (known: {known})"
+    )]
     UnknownSymbol {
         /// The formula.
         formula: String,

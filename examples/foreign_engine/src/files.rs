@@ -18,8 +18,8 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use scatter_frame::frame::{
-    CameraDesc, FrameSettings, LightDesc, MediumDesc, PrefilteredFrame, Resolutions,
-    ShadowMapDesc, ShadowProjectionDesc, prepare_frame,
+    CameraDesc, FrameSettings, LightDesc, MediumDesc, PrefilteredFrame, Resolutions, ShadowMapDesc,
+    ShadowProjectionDesc, prepare_frame,
 };
 use scatter_frame::variant::Variant;
 
@@ -506,10 +506,7 @@ fn read_sized(path: &Path, expected: [u32; 2]) -> Result<Vec<f32>, EngineError> 
     if [w, h] != expected {
         return Err(EngineError::InputFile {
             path: path.to_path_buf(),
-            reason: format!(
-                "{w}x{h}, frame.json says {}x{}",
-                expected[0], expected[1]
-            ),
+            reason: format!("{w}x{h}, frame.json says {}x{}", expected[0], expected[1]),
         });
     }
     Ok(v)
@@ -618,9 +615,8 @@ pub fn knobs_of(manifest: &crate::Manifest, id: &str) -> Result<Variant, EngineE
             value: entry.family.clone(),
         });
     }
-    let variant: Variant = serde_json::from_value(entry.knobs.clone()).map_err(|e| {
-        EngineError::Inconsistent(format!("knobs of variant {id}: {e}"))
-    })?;
+    let variant: Variant = serde_json::from_value(entry.knobs.clone())
+        .map_err(|e| EngineError::Inconsistent(format!("knobs of variant {id}: {e}")))?;
     if variant.id() != id {
         return Err(EngineError::Inconsistent(format!(
             "the knobs of variant {id} describe variant {}",

@@ -24,10 +24,7 @@ impl Params {
 
     /// A parameter's value.
     pub fn get(&self, name: &str) -> Option<u64> {
-        self.values
-            .iter()
-            .find(|(n, _)| n == name)
-            .map(|&(_, v)| v)
+        self.values.iter().find(|(n, _)| n == name).map(|&(_, v)| v)
     }
 
     /// Parameter names, comma-separated (for messages).
@@ -261,8 +258,19 @@ mod tests {
             matches!(&e, EngineError::UnknownSymbol { symbol, .. } if symbol == "screen.depth"),
             "{e}"
         );
-        assert!(e.to_string().contains("screen.width, rectified.height"), "{e}");
-        for bad in ["", "ceil(8)", "ceil(8 / 0)", "8 +", "3 *", "ceil(8 / 2", "-1"] {
+        assert!(
+            e.to_string().contains("screen.width, rectified.height"),
+            "{e}"
+        );
+        for bad in [
+            "",
+            "ceil(8)",
+            "ceil(8 / 0)",
+            "8 +",
+            "3 *",
+            "ceil(8 / 2",
+            "-1",
+        ] {
             let e = eval(bad, &p, "t").unwrap_err();
             assert!(matches!(e, EngineError::Formula { .. }), "{bad}: {e}");
         }
