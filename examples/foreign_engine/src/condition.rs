@@ -182,14 +182,11 @@ impl Condition {
                     field.ty
                 )));
             }
-            Some(c) => {
-                let lane = ["x", "y", "z", "w"]
-                    .iter()
-                    .position(|&n| n == c)
-                    .filter(|&l| l < lanes)
-                    .ok_or_else(|| error(format!("{c:?} is not a component of {}", field.ty)))?;
-                lane
-            }
+            Some(c) => ["x", "y", "z", "w"]
+                .iter()
+                .position(|&n| n == c)
+                .filter(|&l| l < lanes)
+                .ok_or_else(|| error(format!("{c:?} is not a component of {}", field.ty)))?,
         };
         let offset = field.offset + 4 * lane as u64;
         if offset + 4 > layout.size {
@@ -321,7 +318,7 @@ mod tests {
     fn reads_fields_by_offset() {
         let m = manifest();
         let v = &m.variants[0];
-        let mut bytes = vec![0u8; 48];
+        let mut bytes = [0u8; 48];
         bytes[12..16].copy_from_slice(&0.75f32.to_le_bytes());
         bytes[20..24].copy_from_slice(&7u32.to_le_bytes());
         bytes[32..36].copy_from_slice(&(-1.0f32).to_le_bytes());

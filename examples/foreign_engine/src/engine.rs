@@ -324,7 +324,7 @@ fn spirv_words(path: &Path, bytes: &[u8]) -> Result<Vec<u32>, EngineError> {
         path: path.to_path_buf(),
         reason,
     };
-    if bytes.len() % 4 != 0 || bytes.len() < 20 {
+    if !bytes.len().is_multiple_of(4) || bytes.len() < 20 {
         return Err(bad(format!(
             "{} bytes: not a whole number of 32-bit words with a 5-word header",
             bytes.len()
@@ -393,15 +393,9 @@ impl Engine {
             effective.set(&p.name, value);
         }
 
-        let mut resources = BTreeMap::new();
-        for r in &variant.resources {
-            let gpu = create_resource(device, r, &effective, &limits)?;
-            resources.insert(r.name.clone(), (r.clone(), gpu));
-        }
-
-        let mut passes = Vec::new();
+        // Every shader file first: a stale or missing file fails before any GPU work.
+        let mut shader_sources = Vec::new();
         for pass in &variant.passes {
-            let context = |what: &str| format!("pass {} {what}", pass.kernel);
             let file =
                 pass.files
                     .get(target.name())
@@ -418,6 +412,23 @@ impl Engine {
                         .map_err(|_| EngineError::BadWgsl { path: path.clone() })?,
                 )),
             };
+
+            shader_sources.push((file.entry_point.clone(), source));
+        }
+        let mut sources = shader_sources.into_iter();
+
+        let mut resources = BTreeMap::new();
+        for r in &variant.resources {
+            let gpu = create_resource(device, r, &effective, &limits)?;
+            resources.insert(r.name.clone(), (r.clone(), gpu));
+        }
+
+        let mut passes = Vec::new();
+        for pass in &variant.passes {
+            let context = |what: &str| format!("pass {} {what}", pass.kernel);
+            let (entry_point, source) = sources.next().ok_or_else(|| {
+                EngineError::Inconsistent("pass list changed while loading".to_owned())
+            })?;
 
             // Bindings and their layouts.
             let mut plans = Vec::new();
@@ -532,7 +543,7 @@ impl Engine {
                     label,
                     layout: Some(&pipeline_layout),
                     module: &module,
-                    entry_point: Some(file.entry_point.as_str()),
+                    entry_point: Some(entry_point.as_str()),
                     compilation_options: wgpu::PipelineCompilationOptions::default(),
                     cache: None,
                 });

@@ -59,6 +59,12 @@ pub enum EngineError {
         /// The ids it has, comma-separated.
         available: String,
     },
+    /// The manifest has several variants and none was named.
+    #[error("the manifest has several variants; name one with --variant: {available}")]
+    VariantRequired {
+        /// The ids it has, comma-separated.
+        available: String,
+    },
     /// A pass has no file for the requested target.
     #[error(
         "kernel {kernel} of variant {variant} was not generated for target {target} (re-run scatter-gen with --target {target})"

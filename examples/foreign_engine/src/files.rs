@@ -347,11 +347,8 @@ pub fn read_pfm(path: &Path) -> Result<(u32, u32, Vec<f32>), EngineError> {
             return Err(bad("truncated PFM header".to_owned()));
         }
         tokens.push(String::from_utf8_lossy(&bytes[start..pos]).into_owned());
-        if tokens.len() == 1 && tokens[0] == "Pf" {
-            // width and height may share a line: keep reading tokens.
-        }
     }
-    // Header "Pf", "W H" and scale: tokens are [Pf, W, H] then the scale.
+    // Tokens: type, width, height; the scale follows.
     let magic = &tokens[0];
     if magic != "Pf" {
         return Err(bad(format!(
@@ -531,8 +528,7 @@ pub fn run_dir(
         None => match &manifest.variants[..] {
             [only] => only.id.clone(),
             _ => {
-                return Err(EngineError::UnknownVariant {
-                    id: String::new(),
+                return Err(EngineError::VariantRequired {
                     available: manifest
                         .variants
                         .iter()
