@@ -14,7 +14,8 @@
 //!
 //! Each runs the SPIR-V files (naga's SPIR-V front-end inside wgpu) and the WGSL files.
 //! The projective trial also goes through the binary's file path (`frame.json` and PFM
-//! files, `files::run_dir`). The error tests check the messages of a missing manifest, an
+//! files, `files::run_dir`). A negative control (a depth buffer 10 % short) shows the
+//! comparison fails when the inputs differ. The error tests check the messages of a missing manifest, an
 //! unknown variant, a stale shader hash, an unknown formula symbol and a missing input.
 
 use std::path::{Path, PathBuf};
@@ -305,6 +306,58 @@ fn foreign_engine_matches_runtime() {
         lines.len(),
         start.elapsed().as_secs_f64()
     );
+}
+
+/// The comparison can fail: the foreign engine fed a depth buffer 10 % short differs from
+/// the runtime by far more than the bound.
+#[test]
+fn foreign_engine_comparison_detects_a_wrong_input() {
+    let Some(ctx) = gpu() else { return };
+    let variant = Variant::default();
+    let fixture = Fixture::get(variant.light);
+    let frame = fixture.frame(&variant);
+    let runtime = run_once(
+        ctx,
+        &variant,
+        Resolutions {
+            screen: fixture.sizes().screen,
+            rectified: RECTIFIED,
+        },
+        &CpuInputs {
+            frame: fixture.frame_input(),
+            depth: fixture.gbuf.view_depth.clone(),
+            shadow_map: fixture.shadow_map.depth.clone(),
+            rectified: None,
+            pass_wall_frames: 0,
+        },
+    )
+    .unwrap_or_else(|e| panic!("runtime: {e}"));
+    let mut engine = Engine::load(
+        ctx.device(),
+        ctx.queue(),
+        shader_dir(),
+        &variant.id(),
+        Target::Spirv,
+        &fixture.sizes().params(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let short: Vec<f32> = fixture.gbuf.view_depth.iter().map(|d| 0.9 * d).collect();
+    let out = run_frame(
+        &mut engine,
+        &frame,
+        &Inputs {
+            depth: &short,
+            shadow_map: Some(&fixture.shadow_map.depth),
+            rectified_raster: None,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let (diff, max, _) = compare(&out.radiance, &runtime.output);
+    eprintln!(
+        "negative control: max |diff| {:.3e} of max radiance",
+        diff / max
+    );
+    assert!(diff > 100.0 * REL_TOL * max, "{diff} vs max {max}");
 }
 
 /// The binary's path: `frame.json` + PFM inputs, `run_dir`, a PFM output; the same
