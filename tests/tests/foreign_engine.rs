@@ -425,6 +425,27 @@ fn foreign_engine_files_round_trip() {
     )
     .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(summary.radiance, direct.radiance);
+    // Without a standard shadow map, a projective frame binds the rasterised map to
+    // `scatter`'s shadow-map slot (the manifest's engine-side alternative; not read then).
+    let no_shadow = run_frame(
+        &mut engine,
+        &frame,
+        &Inputs {
+            depth: &fixture.gbuf.view_depth,
+            shadow_map: None,
+            rectified_raster: rectified.as_deref(),
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        no_shadow
+            .run
+            .alternatives
+            .contains(&"scatter 3 -> rectified_raster".to_owned()),
+        "{:?}",
+        no_shadow.run.alternatives
+    );
+    assert_eq!(no_shadow.radiance, direct.radiance);
     let bytes = std::fs::read(&out_path).unwrap_or_else(|e| panic!("{e}"));
     let [w, h] = SCREEN;
     let header = format!("PF\n{w} {h}\n-1.0\n");
