@@ -25,6 +25,7 @@ pub mod layout_code;
 pub mod manifest;
 pub mod output;
 pub mod reflect;
+mod spirv_fixup;
 pub mod target;
 
 pub use error::GenError;

@@ -408,6 +408,10 @@ fn spirv(input: &Input<'_>) -> Result<Output, String> {
     };
     let words = spv::write_vec(input.module, input.info, &options, Some(&pipeline))
         .map_err(|e| e.to_string())?;
+    // naga builds the `Restrict` clamp of unsigned texel coordinates from signed constants:
+    // retype them, or SPIR-V consumers (naga's own front-end, the Vulkan validation layers)
+    // reject the module.
+    let (words, _) = crate::spirv_fixup::fix_constant_composite_signedness(&words)?;
     let bytes = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     let bindings = input
         .bindings

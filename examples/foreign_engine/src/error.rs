@@ -1,0 +1,254 @@
+//! [`EngineError`]: everything that can go wrong between reading a scatter-gen directory and
+//! reading back the output, each with a message that names the file, the key or the
+//! resource involved. Bad files never panic.
+
+use std::path::PathBuf;
+
+/// Why the foreign engine cannot load a shader directory or run a frame.
+#[derive(Debug, thiserror::Error)]
+pub enum EngineError {
+    /// A file could not be read or written.
+    #[error("cannot access {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The directory has no `manifest.json`.
+    #[error(
+        "no manifest.json in {dir}: generate the shaders first (cargo run -p scatter-gen -- --out {dir} --target spirv,wgsl)"
+    )]
+    MissingManifest {
+        /// The shader directory.
+        dir: PathBuf,
+    },
+    /// `manifest.json` is not valid JSON or lacks a key the engine needs.
+    #[error("{path} is not a manifest this engine can read: {source}")]
+    ManifestParse {
+        /// The manifest.
+        path: PathBuf,
+        /// serde's message (names the key and the line).
+        #[source]
+        source: serde_json::Error,
+    },
+    /// `manifest.json` was not written by scatter-gen.
+    #[error("{path} has schema {schema:?}, not \"scatter-gen-manifest\"")]
+    ForeignManifest {
+        /// The manifest.
+        path: PathBuf,
+        /// Its `schema` value.
+        schema: String,
+    },
+    /// The manifest's schema version is not the one this engine reads.
+    #[error("{path} has schema_version {found}; this engine reads version {supported}")]
+    SchemaVersion {
+        /// The manifest.
+        path: PathBuf,
+        /// Its `schema_version`.
+        found: u64,
+        /// The version this engine reads.
+        supported: u64,
+    },
+    /// No variant of the manifest has the requested id.
+    #[error("the manifest has no variant {id:?}; it has: {available}")]
+    UnknownVariant {
+        /// The requested id.
+        id: String,
+        /// The ids it has, comma-separated.
+        available: String,
+    },
+    /// The manifest has several variants and none was named.
+    #[error("the manifest has several variants; name one with --variant: {available}")]
+    VariantRequired {
+        /// The ids it has, comma-separated.
+        available: String,
+    },
+    /// A pass has no file for the requested target.
+    #[error(
+        "kernel {kernel} of variant {variant} was not generated for target {target} (re-run scatter-gen with --target {target})"
+    )]
+    TargetNotGenerated {
+        /// The kernel.
+        kernel: String,
+        /// The variant id.
+        variant: String,
+        /// The target (`spirv`, `wgsl`).
+        target: String,
+    },
+    /// A shader file the manifest lists is not in the directory.
+    #[error("{path} is listed in the manifest but missing (re-run scatter-gen)")]
+    MissingShader {
+        /// The shader file.
+        path: PathBuf,
+    },
+    /// A shader file's SHA-256 differs from the manifest's: the directory was edited or
+    /// only partly regenerated.
+    #[error(
+        "{path} is stale: sha256 {actual}, the manifest says {expected} (re-run scatter-gen on the whole directory)"
+    )]
+    StaleShader {
+        /// The shader file.
+        path: PathBuf,
+        /// The manifest's hash.
+        expected: String,
+        /// The file's hash.
+        actual: String,
+    },
+    /// A `.spv` file is not a SPIR-V module.
+    #[error("{path} is not SPIR-V: {reason}")]
+    BadSpirv {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A WGSL file is not UTF-8.
+    #[error("{path} is not UTF-8 text")]
+    BadWgsl {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A formula names a symbol that is not a parameter of the variant.
+    #[error(
+        "formula {formula:?} ({context}) uses {symbol:?}, which is not a parameter (known: {known})"
+    )]
+    UnknownSymbol {
+        /// The formula.
+        formula: String,
+        /// Where it appears.
+        context: String,
+        /// The unknown symbol.
+        symbol: String,
+        /// The parameters, comma-separated.
+        known: String,
+    },
+    /// A formula does not parse or cannot be evaluated.
+    #[error("formula {formula:?} ({context}): {reason}")]
+    Formula {
+        /// The formula.
+        formula: String,
+        /// Where it appears.
+        context: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A per-frame condition (`skip_when`, `alternative.when`) is not one the engine can
+    /// evaluate.
+    #[error("condition {condition:?} ({context}): {reason}")]
+    Condition {
+        /// The condition.
+        condition: String,
+        /// Where it appears.
+        context: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The manifest names a parameter this engine does not know how to set.
+    #[error(
+        "the manifest's parameter {name:?} is unknown to this engine (it sets: {known}); is the manifest newer than the engine?"
+    )]
+    UnknownParameter {
+        /// The parameter.
+        name: String,
+        /// What the engine sets, comma-separated.
+        known: String,
+    },
+    /// A size is outside its parameter's constraint.
+    #[error("{name} = {value} violates the manifest's constraint {constraint:?} ({reason})")]
+    Constraint {
+        /// The parameter.
+        name: String,
+        /// Its value.
+        value: u64,
+        /// The manifest's constraint.
+        constraint: String,
+        /// Which bound failed.
+        reason: String,
+    },
+    /// The manifest uses something this engine does not implement (a texture format, a
+    /// binding kind, a sampler mode).
+    #[error("{context}: unsupported {what} {value:?}")]
+    Unsupported {
+        /// Where it appears.
+        context: String,
+        /// What kind of thing (`texture format`, `binding kind`, ...).
+        what: &'static str,
+        /// Its value.
+        value: String,
+    },
+    /// The manifest is internally inconsistent (a binding names an unknown resource, a
+    /// struct is missing, ...).
+    #[error("inconsistent manifest: {0}")]
+    Inconsistent(String),
+    /// A resource the frame needs was not supplied.
+    #[error("{kernel} needs {resource:?} this frame ({contents}) but it was not supplied")]
+    MissingInput {
+        /// The kernel that binds it.
+        kernel: String,
+        /// The resource.
+        resource: String,
+        /// The manifest's description of its contents.
+        contents: String,
+    },
+    /// Supplied data has the wrong length.
+    #[error("{resource:?} needs {expected} {unit}, got {actual}")]
+    InputLength {
+        /// The resource.
+        resource: String,
+        /// Expected count.
+        expected: u64,
+        /// Supplied count.
+        actual: u64,
+        /// `bytes` or `texels`.
+        unit: &'static str,
+    },
+    /// Data was supplied for a resource that cannot take it (unknown, or not written by the
+    /// host).
+    #[error("{resource:?} cannot be written by the host: {reason}")]
+    NotAnInput {
+        /// The resource.
+        resource: String,
+        /// Why.
+        reason: String,
+    },
+    /// wgpu rejected something (validation or out of memory).
+    #[error("wgpu error while {stage}: {message}")]
+    Wgpu {
+        /// What the engine was doing.
+        stage: String,
+        /// wgpu's message.
+        message: String,
+    },
+    /// Reading back a texture failed.
+    #[error("readback of {resource:?} failed: {message}")]
+    Readback {
+        /// The resource.
+        resource: String,
+        /// What failed.
+        message: String,
+    },
+    /// No adapter or device (binary only).
+    #[error("no GPU device: {0}")]
+    NoDevice(String),
+    /// The frame set-up rejected the camera, light, medium or shadow map.
+    #[error("frame set-up: {0}")]
+    Frame(#[from] scatter_frame::frame::FrameError),
+    /// An input file of the binary is malformed.
+    #[error("{path}: {reason}")]
+    InputFile {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+impl EngineError {
+    /// An [`EngineError::Io`] for `path`.
+    pub fn io(path: impl Into<PathBuf>) -> impl FnOnce(std::io::Error) -> Self {
+        let path = path.into();
+        move |source| Self::Io { path, source }
+    }
+}

@@ -1,0 +1,623 @@
+//! The binary's input and output files, usable without any scatter crate but
+//! `scatter-frame`:
+//!
+//! - `frame.json` ([`FrameFile`]): screen and rectified sizes, camera, light, medium,
+//!   standard shadow map and (optional) settings, plain numbers in the units of
+//!   [`scatter_frame::frame`];
+//! - `depth.pfm`: linear view depth, screen-sized; `shadow_map.pfm`: the standard shadow map
+//!   (normalised linear light depth); `rectified.pfm` (projective frames only): the rectified
+//!   map rasterised with the frame's matrices. Greyscale PFM (`Pf`), little-endian, rows
+//!   bottom to top as PFM stores them (the reader flips them to top-down);
+//! - the output: colour PFM (`PF`) of the in-scattered radiance.
+//!
+//! [`run_dir`] is the whole binary minus argument parsing and device creation.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use scatter_frame::frame::{
+    CameraDesc, FrameSettings, LightDesc, MediumDesc, PrefilteredFrame, Resolutions, ShadowMapDesc,
+    ShadowProjectionDesc, prepare_frame,
+};
+use scatter_frame::variant::Variant;
+
+use crate::prefiltered::{Inputs, Sizes, run_frame};
+use crate::{Engine, EngineError, FrameRun, Target};
+
+/// `frame.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameFile {
+    /// Screen width and height (of `depth.pfm` and the output).
+    pub screen: [u32; 2],
+    /// Rectified map width and height (the engine's choice).
+    pub rectified: [u32; 2],
+    /// The camera.
+    pub camera: CameraFile,
+    /// The light.
+    pub light: LightFile,
+    /// The medium.
+    pub medium: MediumFile,
+    /// The standard shadow map.
+    pub shadow_map: ShadowMapFile,
+    /// Frame settings; `FrameSettings::for_screen(screen)` when absent.
+    #[serde(default)]
+    pub settings: Option<SettingsFile>,
+}
+
+/// [`CameraDesc`] as plain numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraFile {
+    /// Eye position.
+    pub position: [f64; 3],
+    /// Unit view axis.
+    pub forward: [f64; 3],
+    /// Unit image right.
+    pub right: [f64; 3],
+    /// Unit image up.
+    pub up: [f64; 3],
+    /// tan(vertical fov / 2).
+    pub tan_half_fov_y: f64,
+    /// Near plane.
+    pub near: f64,
+    /// Far plane.
+    pub far: f64,
+}
+
+/// [`LightDesc`] as plain numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LightFile {
+    /// Directional light.
+    Directional {
+        /// Direction the light travels.
+        direction: [f64; 3],
+        /// Irradiance (RGB).
+        color: [f64; 3],
+    },
+    /// Spot light.
+    Spot {
+        /// Position.
+        position: [f64; 3],
+        /// Cone axis.
+        direction: [f64; 3],
+        /// Full-intensity half-angle, degrees.
+        inner_deg: f64,
+        /// Zero-intensity half-angle, degrees.
+        outer_deg: f64,
+        /// Intensity (RGB).
+        color: [f64; 3],
+    },
+}
+
+/// [`MediumDesc`] as plain numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MediumFile {
+    /// Extinction (1/m).
+    pub sigma_t: f64,
+    /// Single-scattering albedo.
+    pub albedo: f64,
+    /// Henyey-Greenstein g.
+    pub g: f64,
+}
+
+/// [`ShadowProjectionDesc`] as plain numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ProjectionFile {
+    /// Orthographic window.
+    Orthographic {
+        /// Left.
+        x0: f64,
+        /// Right.
+        x1: f64,
+        /// Bottom.
+        y0: f64,
+        /// Top.
+        y1: f64,
+    },
+    /// Square perspective.
+    Perspective {
+        /// tan(fov / 2).
+        tan_half: f64,
+    },
+}
+
+/// [`ShadowMapDesc`] as plain numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShadowMapFile {
+    /// Light-space origin.
+    pub origin: [f64; 3],
+    /// Light-space right, up, forward.
+    pub basis: [[f64; 3]; 3],
+    /// Projection.
+    pub projection: ProjectionFile,
+    /// Depth of stored 0.
+    pub near: f64,
+    /// Depth of stored 1.
+    pub far: f64,
+    /// Texels per side (of `shadow_map.pfm`).
+    pub size: u32,
+    /// Depth bias in texel footprints.
+    pub bias_texels: f64,
+}
+
+/// [`FrameSettings`] as plain numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SettingsFile {
+    /// March radius around the epipoles, pixels.
+    pub epipole_radius_px: f64,
+    /// March samples.
+    pub march_steps: u32,
+    /// Spot quadrature nodes (a multiple of 4).
+    pub spot_quadrature: u32,
+    /// Widest slice fan (half-angle, degrees) of a projective frame.
+    pub projective_max_half_angle_deg: f64,
+}
+
+fn v3(v: [f64; 3]) -> DVec3 {
+    DVec3::from_array(v)
+}
+
+impl FrameFile {
+    /// From the frame set-up's descriptions (what a Rust engine has at hand).
+    pub fn new(
+        sizes: Sizes,
+        camera: &CameraDesc,
+        light: &LightDesc,
+        medium: &MediumDesc,
+        shadow_map: &ShadowMapDesc,
+        settings: &FrameSettings,
+    ) -> Self {
+        Self {
+            screen: sizes.screen,
+            rectified: sizes.rectified,
+            camera: CameraFile {
+                position: camera.position.to_array(),
+                forward: camera.forward.to_array(),
+                right: camera.right.to_array(),
+                up: camera.up.to_array(),
+                tan_half_fov_y: camera.tan_half_fov_y,
+                near: camera.near,
+                far: camera.far,
+            },
+            light: match *light {
+                LightDesc::Directional { direction, color } => LightFile::Directional {
+                    direction: direction.to_array(),
+                    color,
+                },
+                LightDesc::Spot {
+                    position,
+                    direction,
+                    inner_deg,
+                    outer_deg,
+                    color,
+                } => LightFile::Spot {
+                    position: position.to_array(),
+                    direction: direction.to_array(),
+                    inner_deg,
+                    outer_deg,
+                    color,
+                },
+            },
+            medium: MediumFile {
+                sigma_t: medium.sigma_t,
+                albedo: medium.albedo,
+                g: medium.g,
+            },
+            shadow_map: ShadowMapFile {
+                origin: shadow_map.origin.to_array(),
+                basis: shadow_map.basis.map(|v| v.to_array()),
+                projection: match shadow_map.projection {
+                    ShadowProjectionDesc::Orthographic { x0, x1, y0, y1 } => {
+                        ProjectionFile::Orthographic { x0, x1, y0, y1 }
+                    }
+                    ShadowProjectionDesc::Perspective { tan_half } => {
+                        ProjectionFile::Perspective { tan_half }
+                    }
+                },
+                near: shadow_map.near,
+                far: shadow_map.far,
+                size: shadow_map.size,
+                bias_texels: shadow_map.bias_texels,
+            },
+            settings: Some(SettingsFile {
+                epipole_radius_px: settings.epipole_radius_px,
+                march_steps: settings.march_steps,
+                spot_quadrature: settings.spot_quadrature,
+                projective_max_half_angle_deg: settings.projective_max_half_angle_deg,
+            }),
+        }
+    }
+
+    /// The sizes of the manifest's parameters.
+    pub fn sizes(&self) -> Sizes {
+        Sizes {
+            screen: self.screen,
+            rectified: self.rectified,
+            shadow_map: self.shadow_map.size,
+        }
+    }
+
+    /// Sets up the frame for `variant` ([`prepare_frame`]).
+    ///
+    /// # Errors
+    ///
+    /// [`EngineError::Frame`] when the frame set-up rejects the numbers.
+    pub fn prepare(&self, variant: &Variant) -> Result<PrefilteredFrame, EngineError> {
+        let c = &self.camera;
+        let camera = CameraDesc {
+            position: v3(c.position),
+            forward: v3(c.forward),
+            right: v3(c.right),
+            up: v3(c.up),
+            tan_half_fov_y: c.tan_half_fov_y,
+            near: c.near,
+            far: c.far,
+        };
+        let light = match self.light {
+            LightFile::Directional { direction, color } => LightDesc::Directional {
+                direction: v3(direction),
+                color,
+            },
+            LightFile::Spot {
+                position,
+                direction,
+                inner_deg,
+                outer_deg,
+                color,
+            } => LightDesc::Spot {
+                position: v3(position),
+                direction: v3(direction),
+                inner_deg,
+                outer_deg,
+                color,
+            },
+        };
+        let medium = MediumDesc {
+            sigma_t: self.medium.sigma_t,
+            albedo: self.medium.albedo,
+            g: self.medium.g,
+        };
+        let s = &self.shadow_map;
+        let shadow = ShadowMapDesc {
+            origin: v3(s.origin),
+            basis: s.basis.map(v3),
+            projection: match s.projection {
+                ProjectionFile::Orthographic { x0, x1, y0, y1 } => {
+                    ShadowProjectionDesc::Orthographic { x0, x1, y0, y1 }
+                }
+                ProjectionFile::Perspective { tan_half } => {
+                    ShadowProjectionDesc::Perspective { tan_half }
+                }
+            },
+            near: s.near,
+            far: s.far,
+            size: s.size,
+            bias_texels: s.bias_texels,
+        };
+        let settings = match self.settings {
+            Some(s) => FrameSettings {
+                epipole_radius_px: s.epipole_radius_px,
+                march_steps: s.march_steps,
+                spot_quadrature: s.spot_quadrature,
+                projective_max_half_angle_deg: s.projective_max_half_angle_deg,
+            },
+            None => FrameSettings::for_screen(self.screen[0], self.screen[1]),
+        };
+        let res = Resolutions {
+            screen: self.screen,
+            rectified: self.rectified,
+        };
+        Ok(prepare_frame(
+            variant, &res, &camera, &light, &medium, &shadow, &settings,
+        )?)
+    }
+}
+
+/// Reads a greyscale PFM: `(width, height, values top row first)`.
+///
+/// # Errors
+///
+/// [`EngineError::Io`]; [`EngineError::InputFile`] for a malformed file.
+pub fn read_pfm(path: &Path) -> Result<(u32, u32, Vec<f32>), EngineError> {
+    let bytes = std::fs::read(path).map_err(EngineError::io(path))?;
+    let bad = |reason: String| EngineError::InputFile {
+        path: path.to_path_buf(),
+        reason,
+    };
+    // Three whitespace-terminated header tokens, then one whitespace byte, then data.
+    let mut tokens = Vec::new();
+    let mut pos = 0;
+    while tokens.len() < 3 {
+        while pos < bytes.len() && bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        let start = pos;
+        while pos < bytes.len() && !bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        if start == pos {
+            return Err(bad("truncated PFM header".to_owned()));
+        }
+        tokens.push(String::from_utf8_lossy(&bytes[start..pos]).into_owned());
+    }
+    // Tokens: type, width, height; the scale follows.
+    let magic = &tokens[0];
+    if magic != "Pf" {
+        return Err(bad(format!(
+            "PFM type {magic:?}: expected a greyscale \"Pf\" file"
+        )));
+    }
+    let width: u32 = tokens[1]
+        .parse()
+        .map_err(|_| bad(format!("bad width {:?}", tokens[1])))?;
+    let height: u32 = tokens[2]
+        .parse()
+        .map_err(|_| bad(format!("bad height {:?}", tokens[2])))?;
+    while pos < bytes.len() && bytes[pos].is_ascii_whitespace() {
+        pos += 1;
+    }
+    let start = pos;
+    while pos < bytes.len() && !bytes[pos].is_ascii_whitespace() {
+        pos += 1;
+    }
+    let scale: f32 = String::from_utf8_lossy(&bytes[start..pos])
+        .parse()
+        .map_err(|_| bad("bad scale".to_owned()))?;
+    if scale == 0.0 {
+        return Err(bad("scale 0".to_owned()));
+    }
+    pos += 1; // the single whitespace byte before the data
+    let count = width as usize * height as usize;
+    let data = bytes.get(pos..).unwrap_or_default();
+    if data.len() != 4 * count {
+        return Err(bad(format!(
+            "{width}x{height} needs {} data bytes, found {}",
+            4 * count,
+            data.len()
+        )));
+    }
+    let little = scale < 0.0;
+    let mut values = vec![0.0f32; count];
+    for (i, c) in data.chunks_exact(4).enumerate() {
+        let b = [c[0], c[1], c[2], c[3]];
+        let v = if little {
+            f32::from_le_bytes(b)
+        } else {
+            f32::from_be_bytes(b)
+        };
+        // PFM rows run bottom to top.
+        let (x, y) = (i % width as usize, i / width as usize);
+        values[(height as usize - 1 - y) * width as usize + x] = v;
+    }
+    Ok((width, height, values))
+}
+
+/// Writes a PFM: greyscale (`channels == 1`) or colour (`channels == 3`, from rgb or rgba
+/// texels when `stride` is 4), values given top row first.
+///
+/// # Errors
+///
+/// [`EngineError::Io`].
+pub fn write_pfm(
+    path: &Path,
+    width: u32,
+    height: u32,
+    values: &[f32],
+    channels: usize,
+    stride: usize,
+) -> Result<(), EngineError> {
+    let magic = if channels == 1 { "Pf" } else { "PF" };
+    let mut out = format!("{magic}\n{width} {height}\n-1.0\n").into_bytes();
+    for y in (0..height as usize).rev() {
+        for x in 0..width as usize {
+            let base = (y * width as usize + x) * stride;
+            for c in 0..channels {
+                let v = values.get(base + c).copied().unwrap_or(0.0);
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+    }
+    std::fs::write(path, out).map_err(EngineError::io(path))
+}
+
+/// Writes an input directory the binary reads: `frame.json`, `depth.pfm`, `shadow_map.pfm`
+/// and, when given, `rectified.pfm`.
+///
+/// # Errors
+///
+/// [`EngineError::Io`].
+pub fn write_inputs(
+    dir: &Path,
+    frame: &FrameFile,
+    depth: &[f32],
+    shadow_map: &[f32],
+    rectified: Option<&[f32]>,
+) -> Result<(), EngineError> {
+    std::fs::create_dir_all(dir).map_err(EngineError::io(dir))?;
+    let json = serde_json::to_string_pretty(frame).map_err(|e| EngineError::InputFile {
+        path: dir.join(FRAME_FILE),
+        reason: e.to_string(),
+    })?;
+    let path = dir.join(FRAME_FILE);
+    std::fs::write(&path, json).map_err(EngineError::io(&path))?;
+    let [w, h] = frame.screen;
+    write_pfm(&dir.join(DEPTH_FILE), w, h, depth, 1, 1)?;
+    let s = frame.shadow_map.size;
+    write_pfm(&dir.join(SHADOW_MAP_FILE), s, s, shadow_map, 1, 1)?;
+    if let Some(r) = rectified {
+        let [wr, hr] = frame.rectified;
+        write_pfm(&dir.join(RECTIFIED_FILE), wr, hr, r, 1, 1)?;
+    }
+    Ok(())
+}
+
+/// The frame description in an input directory.
+pub const FRAME_FILE: &str = "frame.json";
+/// The depth buffer.
+pub const DEPTH_FILE: &str = "depth.pfm";
+/// The standard shadow map.
+pub const SHADOW_MAP_FILE: &str = "shadow_map.pfm";
+/// The rasterised rectified map of a projective frame.
+pub const RECTIFIED_FILE: &str = "rectified.pfm";
+
+/// What [`run_dir`] needs.
+#[derive(Clone, Debug)]
+pub struct RunArgs {
+    /// The scatter-gen directory.
+    pub shaders: PathBuf,
+    /// The variant id; `None` when the manifest has exactly one variant.
+    pub variant: Option<String>,
+    /// The input directory.
+    pub inputs: PathBuf,
+    /// Where to write the radiance (PFM); `None` writes nothing.
+    pub out: Option<PathBuf>,
+    /// SPIR-V or WGSL.
+    pub target: Target,
+}
+
+/// What [`run_dir`] did.
+#[derive(Clone, Debug)]
+pub struct RunSummary {
+    /// The variant id.
+    pub variant: String,
+    /// The frame set-up.
+    pub frame: PrefilteredFrame,
+    /// Passes run and skipped.
+    pub run: FrameRun,
+    /// Radiance, rgba per pixel.
+    pub radiance: Vec<[f32; 4]>,
+    /// Screen size.
+    pub screen: [u32; 2],
+}
+
+fn read_sized(path: &Path, expected: [u32; 2]) -> Result<Vec<f32>, EngineError> {
+    let (w, h, v) = read_pfm(path)?;
+    if [w, h] != expected {
+        return Err(EngineError::InputFile {
+            path: path.to_path_buf(),
+            reason: format!("{w}x{h}, frame.json says {}x{}", expected[0], expected[1]),
+        });
+    }
+    Ok(v)
+}
+
+/// Reads the input directory, loads the variant, runs one frame and writes the output.
+///
+/// The variant's knobs come from the manifest (`knobs`), so the frame is set up for the
+/// variant the shaders were generated for.
+///
+/// # Errors
+///
+/// Every [`EngineError`] of loading, reading inputs and running.
+pub fn run_dir(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    args: &RunArgs,
+) -> Result<RunSummary, EngineError> {
+    let manifest = crate::Manifest::load(&args.shaders)?;
+    let id = match &args.variant {
+        Some(id) => id.clone(),
+        None => match &manifest.variants[..] {
+            [only] => only.id.clone(),
+            _ => {
+                return Err(EngineError::VariantRequired {
+                    available: manifest
+                        .variants
+                        .iter()
+                        .map(|v| v.id.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                });
+            }
+        },
+    };
+    let variant = knobs_of(&manifest, &id)?;
+    let frame_path = args.inputs.join(FRAME_FILE);
+    let text = std::fs::read_to_string(&frame_path).map_err(EngineError::io(&frame_path))?;
+    let file: FrameFile = serde_json::from_str(&text).map_err(|e| EngineError::InputFile {
+        path: frame_path.clone(),
+        reason: e.to_string(),
+    })?;
+    let frame = file.prepare(&variant)?;
+    let depth = read_sized(&args.inputs.join(DEPTH_FILE), file.screen)?;
+    let shadow = read_sized(
+        &args.inputs.join(SHADOW_MAP_FILE),
+        [file.shadow_map.size; 2],
+    )?;
+    let rectified_path = args.inputs.join(RECTIFIED_FILE);
+    let rectified = if frame.report.projective.is_some() {
+        if !rectified_path.exists() {
+            return Err(EngineError::InputFile {
+                path: rectified_path,
+                reason: "this frame is projective: rasterise the rectified map with the \
+                         frame's per-region matrices (FrameReport::projective) and store it here"
+                    .to_owned(),
+            });
+        }
+        Some(read_sized(&rectified_path, file.rectified)?)
+    } else {
+        None
+    };
+    let mut engine = Engine::load(
+        device,
+        queue,
+        &args.shaders,
+        &id,
+        args.target,
+        &file.sizes().params(),
+    )?;
+    let out = run_frame(
+        &mut engine,
+        &frame,
+        &Inputs {
+            depth: &depth,
+            shadow_map: Some(&shadow),
+            rectified_raster: rectified.as_deref(),
+        },
+    )?;
+    if let Some(path) = &args.out {
+        let flat: Vec<f32> = out.radiance.iter().flatten().copied().collect();
+        write_pfm(path, file.screen[0], file.screen[1], &flat, 3, 4)?;
+    }
+    Ok(RunSummary {
+        variant: id,
+        frame,
+        run: out.run,
+        radiance: out.radiance,
+        screen: file.screen,
+    })
+}
+
+/// The [`Variant`] of manifest entry `id`, from its `knobs`.
+///
+/// # Errors
+///
+/// [`EngineError::UnknownVariant`]; [`EngineError::Inconsistent`] when the knobs do not
+/// describe a valid prefiltered variant.
+pub fn knobs_of(manifest: &crate::Manifest, id: &str) -> Result<Variant, EngineError> {
+    let entry = manifest.variant(id)?;
+    if entry.family != "prefiltered" {
+        return Err(EngineError::Unsupported {
+            context: format!("variant {id}"),
+            what: "family",
+            value: entry.family.clone(),
+        });
+    }
+    let variant: Variant = serde_json::from_value(entry.knobs.clone())
+        .map_err(|e| EngineError::Inconsistent(format!("knobs of variant {id}: {e}")))?;
+    if variant.id() != id {
+        return Err(EngineError::Inconsistent(format!(
+            "the knobs of variant {id} describe variant {}",
+            variant.id()
+        )));
+    }
+    Ok(variant)
+}

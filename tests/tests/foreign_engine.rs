@@ -1,0 +1,673 @@
+//! The foreign engine (`examples/foreign_engine`, which links neither scatter-runtime nor
+//! scatter-shaderlib) against the runtime: `scatter-gen` writes SPIR-V and WGSL plus
+//! `manifest.json` into a temporary directory, the foreign engine builds its layouts,
+//! pipelines, resources and dispatches from the manifest alone, and its output must equal
+//! `scatter_runtime::run_once`'s for the same suite scene within `1e-4 * max radiance`.
+//!
+//! Trials (`foreign::<variant id>::<scene>::<pose>::<target>`), 128x72 pixels, a 128x128
+//! rectified map, a 256^2 shadow map:
+//! - the default variant on `columns/ordinary` (directional, epipolar);
+//! - a spot variant (rgba16float bases, 2 regions) on `spot_grate/ordinary`;
+//! - a projective variant on `columns/ordinary`, a projective frame: `rectify` is skipped
+//!   (`skip_when`) and `prefilter` binds the engine's rasterised map (`alternative`), the
+//!   reference's stand-in for the rasteriser (`engine_rectified_map`), on both sides.
+//!
+//! Each runs the SPIR-V files (naga's SPIR-V front-end inside wgpu) and the WGSL files.
+//! The projective trial also goes through the binary's file path (`frame.json` and PFM
+//! files, `files::run_dir`). A negative control (a depth buffer 10 % short) shows the
+//! comparison fails when the inputs differ. The error tests check the messages of a missing manifest, an
+//! unknown variant, a stale shader hash, an unknown formula symbol and a missing input.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::time::Instant;
+
+use scatter_conformance::gpu;
+use scatter_foreign_engine::condition::Condition;
+use scatter_foreign_engine::files::{FrameFile, RunArgs, run_dir, write_inputs};
+use scatter_foreign_engine::prefiltered::{Inputs, Sizes, run_frame};
+use scatter_foreign_engine::{Engine, EngineError, Manifest, Target};
+use scatter_frame::frame::{PrefilteredFrame, prepare_frame};
+use scatter_gen::{FamilyVariant, Request, generate, output};
+use scatter_reference::buffers::{GBuffer, ShadowMap};
+use scatter_reference::bvh::Bvh;
+use scatter_reference::kernels::engine_rectified_map;
+use scatter_reference::scene::Scene;
+use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
+use scatter_runtime::{Context, CpuInputs, FrameInput, run_once};
+use scatter_shaderlib::prefiltered::{
+    FrameSettings, LightKind, Rectification, Resolutions, Storage, Variant,
+};
+
+const SCREEN: [u32; 2] = [128, 72];
+const RECTIFIED: [u32; 2] = [128, 128];
+const SHADOW_MAP: u32 = 256;
+/// The bound: `max |foreign - runtime| <= REL_TOL * max radiance`.
+const REL_TOL: f32 = 1e-4;
+
+/// The three trial variants.
+fn variants() -> [Variant; 3] {
+    [
+        Variant::default(),
+        Variant {
+            light: LightKind::Spot,
+            storage: Storage::Rgba16float,
+            regions: 2,
+            bases: 16,
+            bases_per_thread: 4,
+            ..Variant::default()
+        },
+        Variant {
+            rectification: Rectification::Projective,
+            ..Variant::default()
+        },
+    ]
+}
+
+/// A directory scatter-gen wrote for [`variants`], SPIR-V and WGSL (once per process).
+fn shader_dir() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = scratch("shaders");
+        let generated = generate(&Request {
+            variants: variants().map(FamilyVariant::Prefiltered).to_vec(),
+            targets: vec![scatter_gen::Target::Spirv, scatter_gen::Target::Wgsl],
+        })
+        .unwrap_or_else(|e| panic!("scatter-gen: {e}"));
+        output::write(&dir, &generated, false).unwrap_or_else(|e| panic!("scatter-gen: {e}"));
+        dir
+    })
+}
+
+/// A fresh directory under the system temp dir, unique to this process.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "scatter-foreign-engine-test-{}/{name}",
+        std::process::id()
+    ));
+    // Leftovers of an earlier run with the same pid.
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    dir
+}
+
+/// A suite scene with its depth buffer and standard shadow map.
+struct Fixture {
+    name: SceneName,
+    pose: Pose,
+    scene: Scene,
+    bvh: Bvh,
+    gbuf: GBuffer,
+    shadow_map: ShadowMap,
+}
+
+impl Fixture {
+    fn get(light: LightKind) -> &'static Fixture {
+        static COLUMNS: OnceLock<Fixture> = OnceLock::new();
+        static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
+        let (cell, name) = match light {
+            LightKind::Directional => (&COLUMNS, SceneName::Columns),
+            LightKind::Spot => (&SPOT_GRATE, SceneName::SpotGrate),
+        };
+        cell.get_or_init(|| {
+            let pose = Pose::Ordinary;
+            let scene = scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
+            let bvh = Bvh::build(&scene.geometry);
+            let gbuf = GBuffer::cast(&scene, &bvh);
+            let shadow_map = ShadowMap::build(&scene, &bvh, SHADOW_MAP)
+                .unwrap_or_else(|e| panic!("shadow map of {name}: {e}"));
+            Fixture {
+                name,
+                pose,
+                scene,
+                bvh,
+                gbuf,
+                shadow_map,
+            }
+        })
+    }
+
+    fn frame_input(&self) -> FrameInput {
+        FrameInput {
+            camera: self.scene.camera_desc(),
+            light: self.scene.light_desc(),
+            medium: self.scene.medium_desc(),
+            shadow_map: self.shadow_map.desc(),
+            settings: FrameSettings::default(),
+        }
+    }
+
+    fn sizes(&self) -> Sizes {
+        Sizes {
+            screen: [self.gbuf.width, self.gbuf.height],
+            rectified: RECTIFIED,
+            shadow_map: SHADOW_MAP,
+        }
+    }
+
+    /// The frame set-up, as the foreign engine computes it (scatter-frame only).
+    fn frame(&self, variant: &Variant) -> PrefilteredFrame {
+        let f = self.frame_input();
+        prepare_frame(
+            variant,
+            &Resolutions {
+                screen: self.sizes().screen,
+                rectified: RECTIFIED,
+            },
+            &f.camera,
+            &f.light,
+            &f.medium,
+            &f.shadow_map,
+            &f.settings,
+        )
+        .unwrap_or_else(|e| panic!("frame set-up: {e}"))
+    }
+}
+
+/// `max |a - b|` over rgba, and the runtime's max radiance (rgb).
+fn compare(foreign: &[[f32; 4]], runtime: &[[f32; 4]]) -> (f32, f32, usize) {
+    assert_eq!(foreign.len(), runtime.len(), "output sizes differ");
+    let max = runtime
+        .iter()
+        .flat_map(|p| &p[..3])
+        .fold(0.0f32, |m, &v| m.max(v));
+    let mut worst = (0.0f32, 0usize);
+    for (i, (f, r)) in foreign.iter().zip(runtime).enumerate() {
+        for c in 0..4 {
+            let d = (f[c] - r[c]).abs();
+            let d = if d.is_nan() { f32::INFINITY } else { d };
+            if d > worst.0 {
+                worst = (d, i);
+            }
+        }
+    }
+    (worst.0, max, worst.1)
+}
+
+fn trial(ctx: &Context, variant: &Variant) -> Vec<String> {
+    let fixture = Fixture::get(variant.light);
+    let name = format!(
+        "foreign::{}::{}::{}",
+        variant.id(),
+        fixture.name,
+        fixture.pose
+    );
+    let frame = fixture.frame(variant);
+    assert_eq!(
+        frame.report.rectification, variant.rectification,
+        "{name}: expected a {} frame ({:?})",
+        variant.rectification, frame.report.fallback
+    );
+    let rectified = engine_rectified_map(&fixture.scene, &fixture.bvh, &frame);
+    let start = Instant::now();
+    let runtime = run_once(
+        ctx,
+        variant,
+        Resolutions {
+            screen: fixture.sizes().screen,
+            rectified: RECTIFIED,
+        },
+        &CpuInputs {
+            frame: fixture.frame_input(),
+            depth: fixture.gbuf.view_depth.clone(),
+            shadow_map: fixture.shadow_map.depth.clone(),
+            rectified: rectified.clone(),
+            pass_wall_frames: 0,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
+    let runtime_ms = start.elapsed().as_secs_f64() * 1e3;
+    assert_eq!(
+        runtime.frame, frame,
+        "{name}: the runtime set up a different frame"
+    );
+    let mut lines = Vec::new();
+    let mut failures = Vec::new();
+    let shaders = shader_dir();
+    for target in [Target::Spirv, Target::Wgsl] {
+        let start = Instant::now();
+        let mut engine = Engine::load(
+            ctx.device(),
+            ctx.queue(),
+            shaders,
+            &variant.id(),
+            target,
+            &fixture.sizes().params(),
+        )
+        .unwrap_or_else(|e| panic!("{name}::{target}: load: {e}"));
+        let out = run_frame(
+            &mut engine,
+            &frame,
+            &Inputs {
+                depth: &fixture.gbuf.view_depth,
+                shadow_map: Some(&fixture.shadow_map.depth),
+                rectified_raster: rectified.as_deref(),
+            },
+        )
+        .unwrap_or_else(|e| panic!("{name}::{target}: run: {e}"));
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        // What the manifest made the engine do this frame.
+        let dispatched: Vec<&str> = out.run.dispatched.iter().map(|(k, _)| k.as_str()).collect();
+        if frame.report.projective.is_some() {
+            assert_eq!(out.run.skipped, ["rectify"], "{name}::{target}");
+            assert_eq!(dispatched, ["prefilter", "scatter"], "{name}::{target}");
+            assert!(
+                out.run
+                    .alternatives
+                    .contains(&"prefilter 2 -> rectified_raster".to_owned()),
+                "{name}::{target}: {:?}",
+                out.run.alternatives
+            );
+        } else {
+            assert!(out.run.skipped.is_empty(), "{name}::{target}");
+            assert_eq!(
+                dispatched,
+                ["rectify", "prefilter", "scatter"],
+                "{name}::{target}"
+            );
+        }
+        let wraps = frame.uniforms.anti_epipole[3] > 0.5;
+        assert_eq!(
+            out.run
+                .alternatives
+                .contains(&"scatter 5 -> filtered_sampler_wrap".to_owned()),
+            wraps,
+            "{name}::{target}: sampler choice"
+        );
+        let (diff, max, at) = compare(&out.radiance, &runtime.output);
+        let rel = diff / max.max(f32::MIN_POSITIVE);
+        let [w, _] = SCREEN;
+        let line = format!(
+            "{name}::{target}: max |diff| {diff:.3e} = {rel:.3e} of max radiance {max:.4e} (worst pixel ({}, {})); foreign load+run {ms:.0} ms, runtime run_once {runtime_ms:.0} ms",
+            at as u32 % w,
+            at as u32 / w
+        );
+        eprintln!("{} {line}", if rel <= REL_TOL { "ok  " } else { "FAIL" });
+        assert!(max > 0.0, "{name}: the runtime's output is black");
+        if rel > REL_TOL {
+            failures.push(line.clone());
+        }
+        lines.push(line);
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    lines
+}
+
+#[test]
+fn foreign_engine_matches_runtime() {
+    let Some(ctx) = gpu() else { return };
+    let start = Instant::now();
+    let mut lines = Vec::new();
+    for v in variants() {
+        lines.extend(trial(ctx, &v));
+    }
+    eprintln!(
+        "foreign engine: {} trials in {:.1} s",
+        lines.len(),
+        start.elapsed().as_secs_f64()
+    );
+}
+
+/// The comparison can fail: the foreign engine fed a depth buffer 10 % short differs from
+/// the runtime by far more than the bound.
+#[test]
+fn foreign_engine_comparison_detects_a_wrong_input() {
+    let Some(ctx) = gpu() else { return };
+    let variant = Variant::default();
+    let fixture = Fixture::get(variant.light);
+    let frame = fixture.frame(&variant);
+    let runtime = run_once(
+        ctx,
+        &variant,
+        Resolutions {
+            screen: fixture.sizes().screen,
+            rectified: RECTIFIED,
+        },
+        &CpuInputs {
+            frame: fixture.frame_input(),
+            depth: fixture.gbuf.view_depth.clone(),
+            shadow_map: fixture.shadow_map.depth.clone(),
+            rectified: None,
+            pass_wall_frames: 0,
+        },
+    )
+    .unwrap_or_else(|e| panic!("runtime: {e}"));
+    let mut engine = Engine::load(
+        ctx.device(),
+        ctx.queue(),
+        shader_dir(),
+        &variant.id(),
+        Target::Spirv,
+        &fixture.sizes().params(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let short: Vec<f32> = fixture.gbuf.view_depth.iter().map(|d| 0.9 * d).collect();
+    let out = run_frame(
+        &mut engine,
+        &frame,
+        &Inputs {
+            depth: &short,
+            shadow_map: Some(&fixture.shadow_map.depth),
+            rectified_raster: None,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let (diff, max, _) = compare(&out.radiance, &runtime.output);
+    eprintln!(
+        "negative control: max |diff| {:.3e} of max radiance",
+        diff / max
+    );
+    assert!(diff > 100.0 * REL_TOL * max, "{diff} vs max {max}");
+}
+
+/// The binary's path: `frame.json` + PFM inputs, `run_dir`, a PFM output; the same
+/// radiance as the in-memory path (PFM keeps f32 bit-exact).
+#[test]
+fn foreign_engine_files_round_trip() {
+    let Some(ctx) = gpu() else { return };
+    let variant = variants()[2];
+    let fixture = Fixture::get(variant.light);
+    let frame = fixture.frame(&variant);
+    let rectified = engine_rectified_map(&fixture.scene, &fixture.bvh, &frame);
+    assert!(rectified.is_some(), "expected a projective frame");
+    let f = fixture.frame_input();
+    let file = FrameFile::new(
+        fixture.sizes(),
+        &f.camera,
+        &f.light,
+        &f.medium,
+        &f.shadow_map,
+        &f.settings,
+    );
+    let inputs = scratch("inputs");
+    write_inputs(
+        &inputs,
+        &file,
+        &fixture.gbuf.view_depth,
+        &fixture.shadow_map.depth,
+        rectified.as_deref(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let out_path = inputs.join("out.pfm");
+    let summary = run_dir(
+        ctx.device(),
+        ctx.queue(),
+        &RunArgs {
+            shaders: shader_dir().to_path_buf(),
+            variant: Some(variant.id()),
+            inputs: inputs.clone(),
+            out: Some(out_path.clone()),
+            target: Target::Spirv,
+        },
+    )
+    .unwrap_or_else(|e| panic!("run_dir: {e}"));
+    assert_eq!(
+        summary.frame, frame,
+        "frame.json round trip changed the frame"
+    );
+    let mut engine = Engine::load(
+        ctx.device(),
+        ctx.queue(),
+        shader_dir(),
+        &variant.id(),
+        Target::Spirv,
+        &fixture.sizes().params(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let direct = run_frame(
+        &mut engine,
+        &frame,
+        &Inputs {
+            depth: &fixture.gbuf.view_depth,
+            shadow_map: Some(&fixture.shadow_map.depth),
+            rectified_raster: rectified.as_deref(),
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(summary.radiance, direct.radiance);
+    // Without a standard shadow map, a projective frame binds the rasterised map to
+    // `scatter`'s shadow-map slot (the manifest's engine-side alternative; not read then).
+    let no_shadow = run_frame(
+        &mut engine,
+        &frame,
+        &Inputs {
+            depth: &fixture.gbuf.view_depth,
+            shadow_map: None,
+            rectified_raster: rectified.as_deref(),
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        no_shadow
+            .run
+            .alternatives
+            .contains(&"scatter 3 -> rectified_raster".to_owned()),
+        "{:?}",
+        no_shadow.run.alternatives
+    );
+    assert_eq!(no_shadow.radiance, direct.radiance);
+    let bytes = std::fs::read(&out_path).unwrap_or_else(|e| panic!("{e}"));
+    let [w, h] = SCREEN;
+    let header = format!("PF\n{w} {h}\n-1.0\n");
+    assert!(bytes.starts_with(header.as_bytes()));
+    assert_eq!(
+        bytes.len(),
+        header.len() + (w * h * 3 * 4) as usize,
+        "colour PFM size"
+    );
+    // A projective frame without its rasterised map: a clear error, not a panic.
+    std::fs::remove_file(inputs.join("rectified.pfm")).unwrap_or_else(|e| panic!("{e}"));
+    let err = run_dir(
+        ctx.device(),
+        ctx.queue(),
+        &RunArgs {
+            shaders: shader_dir().to_path_buf(),
+            variant: Some(variant.id()),
+            inputs,
+            out: None,
+            target: Target::Spirv,
+        },
+    )
+    .expect_err("projective frame without rectified.pfm");
+    assert!(err.to_string().contains("projective"), "{err}");
+}
+
+/// Copies the shader directory so a test can damage it.
+fn copy_dir(from: &Path, name: &str) -> PathBuf {
+    let to = scratch(name);
+    for entry in std::fs::read_dir(from).unwrap_or_else(|e| panic!("{e}")) {
+        let entry = entry.unwrap_or_else(|e| panic!("{e}"));
+        std::fs::copy(entry.path(), to.join(entry.file_name())).unwrap_or_else(|e| panic!("{e}"));
+    }
+    to
+}
+
+#[test]
+fn foreign_engine_reports_bad_directories() {
+    let Some(ctx) = gpu() else { return };
+    let variant = Variant::default();
+    let sizes = Sizes {
+        screen: SCREEN,
+        rectified: RECTIFIED,
+        shadow_map: SHADOW_MAP,
+    };
+    let load = |dir: &Path, id: &str| {
+        Engine::load(
+            ctx.device(),
+            ctx.queue(),
+            dir,
+            id,
+            Target::Spirv,
+            &sizes.params(),
+        )
+        .map(|_| ())
+    };
+    let expect = |r: Result<(), EngineError>, what: &str| -> EngineError {
+        let e = r.expect_err(what);
+        eprintln!("{what}: {e}");
+        e
+    };
+
+    let empty = scratch("empty");
+    let e = expect(load(&empty, &variant.id()), "missing manifest");
+    assert!(matches!(e, EngineError::MissingManifest { .. }), "{e}");
+    assert!(e.to_string().contains("scatter-gen"), "{e}");
+
+    let e = expect(load(shader_dir(), "m1-t1-nope"), "unknown variant");
+    assert!(
+        matches!(e, EngineError::UnknownVariant { .. }) && e.to_string().contains(&variant.id()),
+        "{e}"
+    );
+
+    let stale = copy_dir(shader_dir(), "stale");
+    let spv = stale.join(format!("scatter.{}.spv", variant.id()));
+    let mut bytes = std::fs::read(&spv).unwrap_or_else(|e| panic!("{e}"));
+    let last = bytes.len() - 1;
+    bytes[last] ^= 1;
+    std::fs::write(&spv, bytes).unwrap_or_else(|e| panic!("{e}"));
+    let e = expect(load(&stale, &variant.id()), "stale hash");
+    assert!(matches!(e, EngineError::StaleShader { .. }), "{e}");
+    std::fs::remove_file(&spv).unwrap_or_else(|e| panic!("{e}"));
+    let e = expect(load(&stale, &variant.id()), "missing shader");
+    assert!(matches!(e, EngineError::MissingShader { .. }), "{e}");
+
+    let bad = copy_dir(shader_dir(), "formula");
+    let path = bad.join("manifest.json");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert!(text.contains("ceil(screen.width / 8)"));
+    std::fs::write(
+        &path,
+        text.replace("ceil(screen.width / 8)", "ceil(screen.depth / 8)"),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let e = expect(load(&bad, &variant.id()), "unknown formula symbol");
+    assert!(
+        matches!(&e, EngineError::UnknownSymbol { symbol, .. } if symbol == "screen.depth"),
+        "{e}"
+    );
+    std::fs::write(&path, "{\"schema\": \"something-else\"}").unwrap_or_else(|e| panic!("{e}"));
+    let e = expect(load(&bad, &variant.id()), "foreign manifest");
+    assert!(matches!(e, EngineError::ForeignManifest { .. }), "{e}");
+    std::fs::write(&path, "{ not json").unwrap_or_else(|e| panic!("{e}"));
+    let e = expect(load(&bad, &variant.id()), "broken manifest");
+    assert!(matches!(e, EngineError::ManifestParse { .. }), "{e}");
+
+    // Sizes outside the manifest's constraints.
+    let narrow = Sizes {
+        rectified: [variant.regions * variant.regions - 1, 64],
+        ..sizes
+    };
+    let e = Engine::load(
+        ctx.device(),
+        ctx.queue(),
+        shader_dir(),
+        &variant.id(),
+        Target::Spirv,
+        &narrow.params(),
+    )
+    .map(|_| ())
+    .expect_err("too few rectified columns");
+    eprintln!("constraint: {e}");
+    assert!(matches!(e, EngineError::Constraint { .. }), "{e}");
+
+    // An epipolar frame without the standard shadow map: rectify needs it.
+    let fixture = Fixture::get(variant.light);
+    let frame = fixture.frame(&variant);
+    let mut engine = Engine::load(
+        ctx.device(),
+        ctx.queue(),
+        shader_dir(),
+        &variant.id(),
+        Target::Wgsl,
+        &fixture.sizes().params(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let e = run_frame(
+        &mut engine,
+        &frame,
+        &Inputs {
+            depth: &fixture.gbuf.view_depth,
+            shadow_map: None,
+            rectified_raster: None,
+        },
+    )
+    .map(|_| ())
+    .expect_err("no shadow map");
+    eprintln!("missing input: {e}");
+    assert!(
+        matches!(&e, EngineError::MissingInput { resource, .. } if resource == "shadow_map"),
+        "{e}"
+    );
+    let e = run_frame(
+        &mut engine,
+        &frame,
+        &Inputs {
+            depth: &fixture.gbuf.view_depth[1..],
+            shadow_map: Some(&fixture.shadow_map.depth),
+            rectified_raster: None,
+        },
+    )
+    .map(|_| ())
+    .expect_err("short depth buffer");
+    assert!(matches!(e, EngineError::InputLength { .. }), "{e}");
+}
+
+/// Every per-frame condition the generator writes, for each light and rectification, is
+/// one the foreign engine reads: conditions on `frame` parse to buffer reads; the rest are
+/// engine-side alternatives of engine inputs.
+#[test]
+fn manifest_conditions_are_machine_readable() {
+    let variants: Vec<Variant> = [LightKind::Directional, LightKind::Spot]
+        .into_iter()
+        .flat_map(|light| {
+            Rectification::ALL
+                .iter()
+                .map(move |&rectification| Variant {
+                    light,
+                    rectification,
+                    ..Variant::default()
+                })
+        })
+        .collect();
+    let generated = generate(&Request {
+        variants: variants
+            .iter()
+            .copied()
+            .map(FamilyVariant::Prefiltered)
+            .collect(),
+        targets: vec![scatter_gen::Target::Wgsl],
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    let manifest = Manifest::parse(&generated.manifest, Path::new("generated"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut buffer_conditions = 0;
+    for v in &manifest.variants {
+        for pass in &v.passes {
+            let mut conditions: Vec<(&str, bool)> = Vec::new();
+            if let Some(s) = &pass.skip_when {
+                conditions.push((s, false));
+            }
+            for b in &pass.bindings {
+                if let Some(a) = &b.alternative {
+                    let engine_input = v.resource(&b.resource).is_some_and(|r| r.engine_provided());
+                    conditions.push((&a.when, engine_input));
+                }
+            }
+            for (text, may_be_engine_side) in conditions {
+                let c = Condition::parse(text, &manifest, v, &pass.kernel)
+                    .unwrap_or_else(|e| panic!("{}: {e}", v.id));
+                match c {
+                    Condition::Buffer { .. } => buffer_conditions += 1,
+                    Condition::Engine { .. } => assert!(
+                        may_be_engine_side,
+                        "{} {}: {text:?} is neither a buffer condition nor about an engine input",
+                        v.id, pass.kernel
+                    ),
+                }
+            }
+        }
+    }
+    // Per projective variant: skip rectify, prefilter's map, the sampler; per epipolar
+    // variant: the sampler.
+    assert_eq!(buffer_conditions, 2 * 3 + 2, "buffer conditions");
+}
