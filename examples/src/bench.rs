@@ -91,6 +91,11 @@ pub struct BenchConfig {
     /// Also time the prefiltered default at 1280x720 over rectified widths 512..4096 and
     /// screen sizes (no accuracy).
     pub scaling: bool,
+    /// Also time the headline configuration (1280x720 screen, 1024x1024 rectified map) for
+    /// the prefiltered default and raymarch N = 32, 64, 128 and (64, 4x4) on
+    /// `sphere/ordinary` and `foliage/ordinary` (no accuracy: ground truths at 1280x720 cost
+    /// minutes per pose on two cores).
+    pub headline: bool,
 }
 
 impl BenchConfig {
@@ -136,6 +141,7 @@ impl BenchConfig {
             frames: 3,
             truth_segments: TruthSettings::default().segments,
             scaling: true,
+            headline: true,
         }
     }
 
@@ -165,6 +171,7 @@ impl BenchConfig {
             frames: 1,
             truth_segments: 256,
             scaling: false,
+            headline: false,
         }
     }
 }
@@ -212,6 +219,26 @@ pub struct ScalingRow {
     pub passes: [Duration; 3],
 }
 
+/// A timing-only run at the headline configuration.
+#[derive(Clone, Debug)]
+pub struct HeadlineRow {
+    /// Family.
+    pub family: &'static str,
+    /// Variant knobs without the light.
+    pub knobs: String,
+    /// Scene (pose `ordinary`).
+    pub scene: SceneName,
+    /// Pass wall times.
+    pub passes: Vec<(&'static str, Duration)>,
+}
+
+impl HeadlineRow {
+    /// Sum of the pass wall times.
+    pub fn total(&self) -> Duration {
+        self.passes.iter().map(|p| p.1).sum()
+    }
+}
+
 /// Everything a bench run measured.
 #[derive(Clone, Debug)]
 pub struct BenchResult {
@@ -223,6 +250,8 @@ pub struct BenchResult {
     pub rows: Vec<Row>,
     /// Scaling runs.
     pub scaling: Vec<ScalingRow>,
+    /// Headline runs (1280x720, 1024x1024 rectified).
+    pub headline: Vec<HeadlineRow>,
     /// Wall time of the whole bench.
     pub elapsed: Duration,
 }
@@ -386,14 +415,132 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
     } else {
         Vec::new()
     };
+    let headline = if config.headline {
+        bar.set_message("headline 1280x720");
+        headline_runs(ctx, config.frames)?
+    } else {
+        Vec::new()
+    };
     bar.finish_and_clear();
     Ok(BenchResult {
         adapter: ctx.report().to_string(),
         config: config.clone(),
         rows,
         scaling,
+        headline,
         elapsed: start.elapsed(),
     })
+}
+
+/// Times `method` (pass wall times) on `name/ordinary` at `screen` (prefiltered: with a
+/// `rectified` map).
+fn time_method(
+    ctx: &Context,
+    method: Method,
+    name: SceneName,
+    screen: [u32; 2],
+    rectified: [u32; 2],
+    frames: u32,
+) -> Result<Vec<(&'static str, Duration)>, BoxError> {
+    let scene = suite::scene(
+        name,
+        Pose::Ordinary,
+        MediumPreset::Default,
+        screen[0],
+        screen[1],
+    );
+    let bvh = Bvh::build(&scene.geometry);
+    let gbuf = GBuffer::cast(&scene, &bvh);
+    let sm = ShadowMap::build(&scene, &bvh, 1024)?;
+    let depth = upload_r32float(
+        ctx,
+        Kernel::Scatter,
+        "bench depth",
+        screen,
+        &gbuf.view_depth,
+    )?;
+    let shadow = upload_r32float(
+        ctx,
+        Kernel::Rectify,
+        "bench shadow map",
+        [sm.size; 2],
+        &sm.depth,
+    )?;
+    let (dv, sv) = (
+        depth.create_view(&Default::default()),
+        shadow.create_view(&Default::default()),
+    );
+    Ok(match method.with_light(light_of(name)) {
+        Method::Prefiltered(v) => {
+            let mut pass = Scatter::new(ctx, &v, Resolutions { screen, rectified }, sm.size)?;
+            pass.prepare(
+                ctx,
+                &FrameInput {
+                    camera: scene.camera_desc(),
+                    light: scene.light_desc(),
+                    medium: scene.medium_desc(),
+                    shadow_map: sm.desc(),
+                    settings: FrameSettings::for_screen(screen[0], screen[1]),
+                },
+            )?;
+            let t = pass.measure_pass_wall_times(
+                ctx,
+                &Inputs {
+                    depth: &dv,
+                    shadow_map: Some(&sv),
+                    rectified: None,
+                },
+                frames,
+            )?;
+            vec![
+                ("rectify", t.rectify),
+                ("prefilter", t.prefilter),
+                ("scatter", t.scatter),
+            ]
+        }
+        Method::Raymarch(v) => {
+            let mut pass = Raymarch::new(ctx, &v, screen, sm.size)?;
+            pass.prepare(
+                ctx,
+                &MarchInput {
+                    camera: scene.camera_desc(),
+                    light: scene.light_desc(),
+                    medium: scene.medium_desc(),
+                    shadow_map: sm.desc(),
+                },
+            )?;
+            let t = pass.measure_pass_wall_times(ctx, &dv, &sv, frames)?;
+            let mut passes = vec![("raymarch", t.raymarch)];
+            if v.interleaved() {
+                passes.push(("interleave_sum", t.interleave_sum));
+            }
+            passes
+        }
+    })
+}
+
+/// The headline configuration: 1280x720, 1024x1024 rectified, on sphere and foliage.
+fn headline_runs(ctx: &Context, frames: u32) -> Result<Vec<HeadlineRow>, BoxError> {
+    let mut methods = vec![Method::Prefiltered(Variant::default())];
+    for (samples, interleave) in [(32, 1), (64, 1), (128, 1), (64, 4)] {
+        methods.push(Method::Raymarch(RaymarchVariant {
+            samples,
+            interleave,
+            ..RaymarchVariant::default()
+        }));
+    }
+    let mut out = Vec::new();
+    for name in [SceneName::Sphere, SceneName::Foliage] {
+        for &m in &methods {
+            out.push(HeadlineRow {
+                family: m.family(),
+                knobs: m.knobs(),
+                scene: name,
+                passes: time_method(ctx, m, name, [1280, 720], [1024, 1024], frames)?,
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// The prefiltered default on sphere/ordinary at 1280x720 with rectified widths 512..4096
@@ -554,6 +701,58 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             }
         }
     }
+    // The same comparison at the headline configuration (times only; errors from the
+    // sweep above).
+    let matching = reference.and_then(|p| {
+        variants
+            .iter()
+            .filter(|v| v.0 == "raymarch" && v.3 <= p.3)
+            .min_by(|a, b| a.2.total_cmp(&b.2))
+            .map(|r| r.1.clone())
+    });
+    for scene in [SceneName::Sphere, SceneName::Foliage] {
+        let time = |family: &str, knobs: &str| {
+            result
+                .headline
+                .iter()
+                .find(|r| r.family == family && r.knobs == knobs && r.scene == scene)
+                .map(|r| ms(r.total()))
+        };
+        if let Some(p) = time("prefiltered", "m32-r3") {
+            for knobs in ["n32-i1", "n64-i1", "n128-i1", "n64-i4"] {
+                if let Some(r) = time("raymarch", knobs) {
+                    let tag = if matching.as_deref() == Some(knobs) {
+                        " (the cheapest raymarch at equal or better sweep error)"
+                    } else {
+                        ""
+                    };
+                    out.push(format!(
+                        "headline 1280x720, 1024x1024 rectified, {scene}/ordinary: raymarch {knobs}{tag} {r:.1} ms / prefiltered m32-r3 {p:.1} ms = {:.2}",
+                        r / p
+                    ));
+                }
+            }
+        }
+    }
+    for family_knobs in [("prefiltered", "m32-r3"), ("raymarch", "n64-i1")] {
+        let t = |scene: SceneName| {
+            result
+                .headline
+                .iter()
+                .find(|r| {
+                    r.family == family_knobs.0 && r.knobs == family_knobs.1 && r.scene == scene
+                })
+                .map(|r| ms(r.total()))
+        };
+        if let (Some(f), Some(s)) = (t(SceneName::Foliage), t(SceneName::Sphere)) {
+            out.push(format!(
+                "scene independence at 1280x720, {} {}: time(foliage) / time(sphere) = {f:.1} / {s:.1} ms = {:.2}",
+                family_knobs.0,
+                family_knobs.1,
+                f / s
+            ));
+        }
+    }
     out.push(
         "prefiltered vs minmax on foliage and terrain: not measured (the minmax family is not in this build)"
             .to_owned(),
@@ -654,6 +853,30 @@ pub fn markdown(result: &BenchResult, command: &str) -> String {
     let _ = writeln!(s, "## Ratios (one run)\n");
     for r in ratios(result) {
         let _ = writeln!(s, "- {r}");
+    }
+    if !result.headline.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n## Headline configuration (1280x720, 1024x1024 rectified; times only)\n"
+        );
+        let _ = writeln!(s, "| family | variant | scene | time (ms) | passes (ms) |");
+        let _ = writeln!(s, "|---|---|---|---|---|");
+        for r in &result.headline {
+            let passes: Vec<String> = r
+                .passes
+                .iter()
+                .map(|(n, d)| format!("{n} {:.1}", ms(*d)))
+                .collect();
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {:.1} | {} |",
+                r.family,
+                r.knobs,
+                r.scene,
+                ms(r.total()),
+                passes.join(", ")
+            );
+        }
     }
     let _ = writeln!(s, "\n## Per variant (means over the scenes and poses)\n");
     let _ = writeln!(

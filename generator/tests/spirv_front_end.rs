@@ -1,5 +1,5 @@
 //! Every kernel's emitted SPIR-V, for both lights, both rectifications and every storage
-//! format, parses with naga's SPIR-V front-end and validates: what wgpu does with
+//! format (prefiltered) and the raymarch grid, parses with naga's SPIR-V front-end and validates: what wgpu does with
 //! `ShaderSource::SpirV` (`examples/foreign_engine` loads the files that way). naga 30's
 //! back-end alone fails this (a signed constant in an unsigned vector, see
 //! `src/spirv_fixup.rs`); spirv-val 2023.1 does not notice.
@@ -22,6 +22,11 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
             }
         }
     }
+    variants.extend(
+        scatter_shaderlib::raymarch::RaymarchVariant::grid()
+            .into_iter()
+            .map(FamilyVariant::Raymarch),
+    );
     let generated = generate(&Request {
         variants,
         targets: vec![Target::Spirv],
