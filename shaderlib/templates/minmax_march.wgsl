@@ -159,7 +159,8 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     let rows = f.sizes[3];
     let width = f.sizes[2];
     let wrap = f.anti_epipole[3] > 0.5;
-    let theta = acos(clamp(dot(dir, axis), -1.0, 1.0));
+    // atan2 rather than scatter's acos: accurate near the axis, where acos loses digits.
+    let theta = atan2(length(cross(dir, axis)), dot(dir, axis));
     let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
     var yc = (phi - f.e1_[3]) / f.e2_[3];
     if wrap {

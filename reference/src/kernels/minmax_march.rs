@@ -98,6 +98,8 @@ pub struct RowRay {
     pub dir: Vec3,
     /// Distance to the surface.
     pub s: f32,
+    /// Continuous row coordinate (the row is its `floor`; diagnostics only).
+    pub yc: f32,
     /// Rectified row (nearest slice).
     pub row: u32,
     /// The row's column spacing.
@@ -148,7 +150,8 @@ pub fn pixel_ray(id: [u32; 3], spot: bool, inp: &MarchInputs) -> Option<Pixel> {
     let rows = f.sizes[3];
     let width = f.sizes[2];
     let wrap = f.anti_epipole[3] > 0.5;
-    let theta = clamp(dir.dot(axis), -1.0, 1.0).acos();
+    // atan2 rather than scatter's acos: accurate near the axis, where acos loses digits.
+    let theta = dir.cross(axis).length().atan2(dir.dot(axis));
     let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
     let mut yc = (phi - f.e1[3]) / f.e2[3];
     if wrap {
@@ -171,6 +174,7 @@ pub fn pixel_ray(id: [u32; 3], spot: bool, inp: &MarchInputs) -> Option<Pixel> {
         eye,
         dir,
         s,
+        yc,
         row,
         delta,
         theta,
