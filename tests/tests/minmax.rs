@@ -195,7 +195,7 @@ fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> 
     for (i, (g, c)) in gpu.output.iter().zip(&cpu.march.output.data).enumerate() {
         let pixel_over = (0..3).any(|k| {
             let d = (g[k] - c[k]).abs();
-            !(d <= REL_TOL * max + f16_ulp(c[k]))
+            d.is_nan() || d > REL_TOL * max + f16_ulp(c[k])
         });
         let d = (0..3).map(|k| (g[k] - c[k]).abs()).fold(0.0f32, |m, d| {
             if d.is_nan() { f32::INFINITY } else { m.max(d) }
