@@ -7,8 +7,10 @@
 //! `scatter-shaderlib` re-exports both modules as `scatter_shaderlib::prefiltered::*`; an
 //! engine that only uses shaders emitted by `scatter-gen` links this crate alone (see
 //! `examples/foreign_engine`). A C++ engine ports [`frame::prepare_frame`]; its inputs and
-//! outputs are plain numbers, documented field by field.
+//! outputs are plain numbers, documented field by field. The raymarch and minmax families'
+//! knobs and set-up are in [`raymarch`] and [`minmax`].
 
 pub mod frame;
+pub mod minmax;
 pub mod raymarch;
 pub mod variant;

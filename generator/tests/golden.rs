@@ -1,6 +1,6 @@
 //! Golden files: the complete output for three canonical variants (the paper's default, a
-//! small spot-light variant with average visibility and rgba16float, and an interleaved
-//! raymarch variant) in every target, kept
+//! small spot-light variant with average visibility and rgba16float, an interleaved
+//! raymarch variant and the spot-light minmax variant) in every target, kept
 //! as reviewable text in `tests/golden/` (SPIR-V as `spirv-dis` text; its exact bytes are
 //! pinned by the sha256 in the golden `manifest.json`). Any change to a template, to naga or
 //! to the generator shows up here as a diff.
@@ -37,8 +37,11 @@ fn canonical() -> Generated {
             ("jitter".into(), "true".into()),
         ])
         .unwrap_or_else(|e| panic!("{e}"));
+    let minmax = Family::Minmax
+        .variant(&[("light".into(), "spot".into())])
+        .unwrap_or_else(|e| panic!("{e}"));
     generate(&Request {
-        variants: vec![Family::Prefiltered.default_variant(), spot, march],
+        variants: vec![Family::Prefiltered.default_variant(), spot, march, minmax],
         targets: Target::ALL.to_vec(),
     })
     .unwrap_or_else(|e| panic!("{e}"))

@@ -2,7 +2,7 @@
 //! `bases_per_thread`, 1-4 regions, both visibilities and lights, every storage format and
 //! every rectification the variant grid lists) plus the raymarch grid
 //! (`RaymarchVariant::grid()`: samples 8/32/128, interleave 1/2/4, jitter, both lights)
-//! through the generator with every target, then every
+//! plus the minmax grid (`MinmaxVariant::grid()`: both lights) through the generator with every target, then every
 //! distinct emitted SPIR-V through `spirv-val` and every distinct GLSL through
 //! `glslangValidator`. Identical files (e.g. `rectify` only depends on the light) are
 //! validated once.
@@ -16,6 +16,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use scatter_gen::{FamilyVariant, Request, Target, generate, manifest};
+use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::Variant;
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -31,6 +32,7 @@ fn grid() -> Vec<FamilyVariant> {
                 .into_iter()
                 .map(FamilyVariant::Raymarch),
         )
+        .chain(MinmaxVariant::grid().into_iter().map(FamilyVariant::Minmax))
         .collect()
 }
 

@@ -9,10 +9,13 @@
 //! families with several passes have one type for the whole family: [`Scatter`] runs the
 //! `prefiltered` method (`rectify`, `prefilter`, `scatter`) once per frame, [`run_once`] is
 //! its test convenience; [`Raymarch`] runs the `raymarch` family (`raymarch`, then
-//! `interleave_sum` when interleaved), [`run_raymarch_once`] its test convenience.
+//! `interleave_sum` when interleaved), [`run_raymarch_once`] its test convenience;
+//! [`Minmax`] runs the `minmax` family (`rectify`, `minmax_build`, `minmax_march`),
+//! [`run_minmax_once`] its test convenience.
 
 mod context;
 mod error;
+pub mod minmax;
 pub mod prefiltered;
 pub mod raymarch;
 pub mod row_prefix;
@@ -21,6 +24,7 @@ mod timer;
 
 pub use context::{AdapterReport, Context, ContextError, GpuPolicy};
 pub use error::RuntimeError;
+pub use minmax::{Minmax, MinmaxReadback, MinmaxTimes, run_minmax_once};
 pub use prefiltered::{
     CpuInputs, FrameInput, Inputs, PassTimes, Scatter, ScatterReadback, run_once,
 };

@@ -34,6 +34,10 @@ const COMMON_MODULES: &[(&str, &str)] = &[
         "common/prefiltered.wgsl",
         include_str!("../templates/common/prefiltered.wgsl"),
     ),
+    (
+        "common/minmax.wgsl",
+        include_str!("../templates/common/minmax.wgsl"),
+    ),
 ];
 
 thread_local! {
@@ -125,6 +129,8 @@ pub(crate) fn validate(kernel: Kernel, module: &naga::Module) -> Result<ModuleIn
 pub(crate) const fn template_path(kernel: Kernel) -> &'static str {
     match kernel {
         Kernel::InterleaveSum => "interleave_sum.wgsl",
+        Kernel::MinmaxBuild => "minmax_build.wgsl",
+        Kernel::MinmaxMarch => "minmax_march.wgsl",
         Kernel::Prefilter => "prefilter.wgsl",
         Kernel::Raymarch => "raymarch.wgsl",
         Kernel::Rectify => "rectify.wgsl",

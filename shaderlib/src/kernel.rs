@@ -13,6 +13,11 @@ pub enum Kernel {
     /// Separable sum filter of interleaved sampling over the `raymarch` partial sums (Tóth &
     /// Umenhoffer 2009).
     InterleaveSum,
+    /// The 1D min-max tree of every rectified row (Chen et al. 2011).
+    MinmaxBuild,
+    /// Per pixel: the rectified row marched through its min-max tree, skipping nodes wholly
+    /// lit or shadowed; pixels near the epipole ray-marched (Chen et al. 2011).
+    MinmaxMarch,
     /// Fourier basis transform fused with the weighted running mean along each rectified
     /// row, per region (Klehm et al. 2014, Listings 1-3, Table 1).
     Prefilter,
@@ -34,6 +39,8 @@ impl Kernel {
     /// All kernels, sorted by name.
     pub const ALL: &'static [Self] = &[
         Self::InterleaveSum,
+        Self::MinmaxBuild,
+        Self::MinmaxMarch,
         Self::Prefilter,
         Self::Raymarch,
         Self::Rectify,
@@ -45,6 +52,8 @@ impl Kernel {
     pub const fn name(self) -> &'static str {
         match self {
             Self::InterleaveSum => "interleave_sum",
+            Self::MinmaxBuild => "minmax_build",
+            Self::MinmaxMarch => "minmax_march",
             Self::Prefilter => "prefilter",
             Self::Raymarch => "raymarch",
             Self::Rectify => "rectify",

@@ -10,7 +10,8 @@
 //! `rectify`, `prefilter`, `scatter`, all three rendered from one
 //! [`prefiltered::Variant`] ([`KernelParams::prefiltered`]), and the raymarch family (Tóth &
 //! Umenhoffer 2009) `raymarch`, `interleave_sum` from a [`raymarch::RaymarchVariant`]
-//! ([`KernelParams::raymarch`]).
+//! ([`KernelParams::raymarch`]), and the minmax family (Chen et al. 2011) `rectify`,
+//! `minmax_build`, `minmax_march` from a [`minmax::MinmaxVariant`] ([`KernelParams::minmax`]).
 //!
 //! ```
 //! use scatter_shaderlib::{build, KernelParams, RowPrefixMode, RowPrefixParams};
@@ -27,12 +28,14 @@
 mod compose;
 mod error;
 mod kernel;
+pub mod minmax;
 pub mod prefiltered;
 pub mod raymarch;
 pub mod row_prefix;
 
 pub use error::ShaderError;
 pub use kernel::Kernel;
+use minmax::MinmaxVariant;
 use prefiltered::Variant;
 use raymarch::RaymarchVariant;
 pub use row_prefix::{RowPrefixMode, RowPrefixParams};
@@ -44,6 +47,10 @@ pub enum KernelParams {
     /// [`Kernel::InterleaveSum`] of an interleaved raymarch-family variant (the code does
     /// not depend on the variant).
     InterleaveSum(RaymarchVariant),
+    /// [`Kernel::MinmaxBuild`] of a minmax-family variant (the code does not depend on it).
+    MinmaxBuild(MinmaxVariant),
+    /// [`Kernel::MinmaxMarch`] of a minmax-family variant (only `light` changes the code).
+    MinmaxMarch(MinmaxVariant),
     /// [`Kernel::Prefilter`] of a prefiltered-family variant.
     Prefilter(Variant),
     /// [`Kernel::Raymarch`] of a raymarch-family variant (only `light` and whether it
@@ -63,6 +70,8 @@ impl KernelParams {
     pub fn kernel(&self) -> Kernel {
         match self {
             Self::InterleaveSum(_) => Kernel::InterleaveSum,
+            Self::MinmaxBuild(_) => Kernel::MinmaxBuild,
+            Self::MinmaxMarch(_) => Kernel::MinmaxMarch,
             Self::Prefilter(_) => Kernel::Prefilter,
             Self::Raymarch(_) => Kernel::Raymarch,
             Self::Rectify(_) => Kernel::Rectify,
@@ -91,6 +100,16 @@ impl KernelParams {
         out
     }
 
+    /// The kernels of a minmax-family variant, in pass order: the prefiltered family's
+    /// `rectify` (of [`MinmaxVariant::prefiltered`]), `minmax_build`, `minmax_march`.
+    pub fn minmax(variant: MinmaxVariant) -> [Self; 3] {
+        [
+            Self::Rectify(variant.prefiltered()),
+            Self::MinmaxBuild(variant),
+            Self::MinmaxMarch(variant),
+        ]
+    }
+
     /// Every parameter set the conformance suite checks: each kernel in each of its modes,
     /// with default workgroup sizes, then the prefiltered kernels of the default
     /// [`Variant`].
@@ -108,6 +127,7 @@ impl KernelParams {
                 interleave: 2,
                 ..RaymarchVariant::default()
             }))
+            .chain(Self::minmax(MinmaxVariant::default()).into_iter().skip(1))
             .collect()
     }
 }
@@ -176,6 +196,8 @@ pub fn build(params: &KernelParams) -> Result<BuiltKernel, ShaderError> {
 pub fn render(params: &KernelParams) -> Result<String, ShaderError> {
     match params {
         KernelParams::InterleaveSum(v) => raymarch::render_interleave_sum(v),
+        KernelParams::MinmaxBuild(v) => minmax::render_build(v),
+        KernelParams::MinmaxMarch(v) => minmax::render_march(v),
         KernelParams::Prefilter(v) => prefiltered::kernels::render_prefilter(v),
         KernelParams::Raymarch(v) => raymarch::render_raymarch(v),
         KernelParams::Rectify(v) => prefiltered::kernels::render_rectify(v),

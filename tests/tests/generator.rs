@@ -312,3 +312,70 @@ fn raymarch_manifest_matches_the_runtime() {
         }
     }
 }
+
+/// The minmax family's manifest against `scatter_runtime::minmax`: formats (the tree's
+/// rg32float included), the `Frame` block's size, and the dispatch of the three passes at
+/// odd sizes, `tree.width` evaluated with `scatter_frame::minmax::tree_width`.
+#[test]
+fn minmax_manifest_matches_the_runtime() {
+    use scatter_runtime::minmax::TREE_FORMAT;
+    use scatter_shaderlib::minmax::{MinmaxVariant, tree_width};
+    use scatter_shaderlib::prefiltered::FrameUniforms;
+    let v = MinmaxVariant {
+        light: LightKind::Spot,
+    };
+    let g = generate(&Request {
+        variants: vec![FamilyVariant::Minmax(v)],
+        targets: vec![Target::Wgsl],
+    })
+    .unwrap_or_else(|e| panic!("{v}: {e}"));
+    let m: Value = serde_json::from_slice(&g.manifest).unwrap_or_else(|e| panic!("{e}"));
+    let variant = &get(&m, "variants")[0];
+    let tex = |name: &str| get(resource(variant, name), "texture").clone();
+    assert_eq!(str_of(&tex("tree"), "format"), wgpu_name(TREE_FORMAT));
+    assert_eq!(str_of(&tex("output"), "format"), wgpu_name(OUTPUT_FORMAT));
+    for name in ["depth", "shadow_map", "rectified"] {
+        assert_eq!(str_of(&tex(name), "format"), wgpu_name(DEPTH_FORMAT));
+    }
+    assert_eq!(
+        str_of(get(resource(variant, "frame"), "buffer"), "size_bytes"),
+        size_of::<FrameUniforms>().to_string()
+    );
+    let (w, h, wr, hr) = (333u32, 187u32, 300u32, 97u32);
+    let tw = tree_width(wr);
+    let sizes = [
+        ("screen.width", w),
+        ("screen.height", h),
+        ("shadow.size", 512),
+        ("rectified.width", wr),
+        ("rectified.height", hr),
+        ("tree.width", tw),
+    ];
+    let passes = get(variant, "passes")
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let params = KernelParams::minmax(v);
+    assert_eq!(passes.len(), params.len());
+    for ((pass, p), grid) in passes
+        .iter()
+        .zip(params)
+        .zip([[wr, hr, 1], [tw, hr, 1], [w, h, 1]])
+    {
+        let built = build(&p).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(str_of(pass, "kernel"), built.kernel.name());
+        let dispatch = get(pass, "dispatch")
+            .as_array()
+            .cloned()
+            .unwrap_or_default();
+        for (i, n) in grid.into_iter().enumerate() {
+            let got = eval(str_of(&dispatch[i], "workgroups"), &sizes);
+            assert_eq!(
+                got,
+                n.div_ceil(built.workgroup_size[i]),
+                "{} dim {i}",
+                built.kernel
+            );
+        }
+    }
+}

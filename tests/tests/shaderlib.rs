@@ -31,6 +31,9 @@ fn every_kernel_and_mode_validates() {
             KernelParams::Raymarch(v) | KernelParams::InterleaveSum(v) => {
                 format!("raymarch::{}::{}::validate", params.kernel(), v.id())
             }
+            KernelParams::MinmaxBuild(v) | KernelParams::MinmaxMarch(v) => {
+                format!("minmax::{}::{}::validate", params.kernel(), v.id())
+            }
         };
         let built = build(params).unwrap_or_else(|e| panic!("{trial}: {e}"));
         assert_eq!(built.entry_point, params.kernel().name(), "{trial}");

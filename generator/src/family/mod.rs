@@ -6,6 +6,7 @@
 //! [`FamilyVariant`] arm and a module like [`prefiltered`]; the CLI, the config file, the
 //! manifest and the tests pick it up from [`Family::ALL`] without changing shape.
 
+pub mod minmax;
 pub mod prefiltered;
 pub mod raymarch;
 
@@ -20,6 +21,9 @@ use crate::GenError;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Family {
+    /// Chen et al. 2011: `rectify` (the prefiltered family's), `minmax_build`,
+    /// `minmax_march`.
+    Minmax,
     /// Klehm et al. 2014: `rectify`, `prefilter`, `scatter`.
     Prefiltered,
     /// Tóth & Umenhoffer 2009: `raymarch`, `interleave_sum` (interleaved variants).
@@ -50,11 +54,12 @@ impl KnobInfo {
 
 impl Family {
     /// Every family, sorted by name.
-    pub const ALL: &'static [Family] = &[Family::Prefiltered, Family::Raymarch];
+    pub const ALL: &'static [Family] = &[Family::Minmax, Family::Prefiltered, Family::Raymarch];
 
     /// The family's name (`--family`, config key `family`, manifest).
     pub const fn name(self) -> &'static str {
         match self {
+            Self::Minmax => "minmax",
             Self::Prefiltered => "prefiltered",
             Self::Raymarch => "raymarch",
         }
@@ -63,6 +68,10 @@ impl Family {
     /// One line: the method and its paper.
     pub const fn summary(self) -> &'static str {
         match self {
+            Self::Minmax => {
+                "Chen et al. 2011, 1D min-max mipmaps: each pixel marches its rectified row \
+                 through a min-max binary tree, skipping wholly lit or shadowed spans"
+            }
             Self::Prefiltered => {
                 "Klehm et al. 2014, prefiltered single scattering: Fourier-basis visibility \
                  prefiltered along epipolar rows of a rectified shadow map"
@@ -77,6 +86,7 @@ impl Family {
     /// The knobs, in the order `--help` and `list` show them.
     pub fn knobs(self) -> Vec<KnobInfo> {
         match self {
+            Self::Minmax => minmax::knobs(),
             Self::Prefiltered => prefiltered::knobs(),
             Self::Raymarch => raymarch::knobs(),
         }
@@ -85,6 +95,7 @@ impl Family {
     /// The variant with every knob at its default (the paper's choice).
     pub fn default_variant(self) -> FamilyVariant {
         match self {
+            Self::Minmax => FamilyVariant::Minmax(Default::default()),
             Self::Prefiltered => FamilyVariant::Prefiltered(Default::default()),
             Self::Raymarch => FamilyVariant::Raymarch(Default::default()),
         }
@@ -127,6 +138,7 @@ impl Family {
             }
         }
         match self {
+            Self::Minmax => minmax::parse(knobs).map(FamilyVariant::Minmax),
             Self::Prefiltered => prefiltered::parse(knobs).map(FamilyVariant::Prefiltered),
             Self::Raymarch => raymarch::parse(knobs).map(FamilyVariant::Raymarch),
         }
@@ -157,6 +169,8 @@ impl std::str::FromStr for Family {
 /// One validated variant of some family.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum FamilyVariant {
+    /// A minmax-family variant.
+    Minmax(scatter_shaderlib::minmax::MinmaxVariant),
     /// A prefiltered-family variant.
     Prefiltered(scatter_shaderlib::prefiltered::Variant),
     /// A raymarch-family variant.
@@ -167,6 +181,7 @@ impl FamilyVariant {
     /// The family.
     pub const fn family(&self) -> Family {
         match self {
+            Self::Minmax(_) => Family::Minmax,
             Self::Prefiltered(_) => Family::Prefiltered,
             Self::Raymarch(_) => Family::Raymarch,
         }
@@ -175,6 +190,7 @@ impl FamilyVariant {
     /// The variant id used in file names (`<kernel>.<id>.<ext>`).
     pub fn id(&self) -> String {
         match self {
+            Self::Minmax(v) => v.id(),
             Self::Prefiltered(v) => v.id(),
             Self::Raymarch(v) => v.id(),
         }
@@ -183,6 +199,7 @@ impl FamilyVariant {
     /// The knobs as a JSON object (serde names, sorted).
     pub fn knobs_json(&self) -> serde_json::Value {
         match self {
+            Self::Minmax(v) => serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
             Self::Prefiltered(v) => serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
             Self::Raymarch(v) => serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
         }
@@ -191,6 +208,7 @@ impl FamilyVariant {
     /// The kernel parameters of every kernel, in pass order, as shaderlib defines them.
     pub fn kernel_params(&self) -> Vec<KernelParams> {
         match self {
+            Self::Minmax(v) => KernelParams::minmax(*v).to_vec(),
             Self::Prefiltered(v) => KernelParams::prefiltered(*v).to_vec(),
             Self::Raymarch(v) => KernelParams::raymarch(*v),
         }
@@ -199,6 +217,7 @@ impl FamilyVariant {
     /// The resources, parameters and passes an engine needs to run the variant.
     pub fn plan(&self) -> Plan {
         match self {
+            Self::Minmax(v) => minmax::plan(v),
             Self::Prefiltered(v) => prefiltered::plan(v),
             Self::Raymarch(v) => raymarch::plan(v),
         }

@@ -16,6 +16,61 @@
 #define SCATTER_STATIC_ASSERT(cond, msg) _Static_assert(cond, msg)
 #endif
 
+/* WGSL `Frame` of family minmax (scatter::prefiltered), 400 bytes, alignment 16. */
+typedef struct ScatterMinmaxFrame {
+    float eye[4]; /* vec4<f32>, offset 0 */
+    float axis[4]; /* vec4<f32>, offset 16 */
+    float e1_[4]; /* vec4<f32>, offset 32 */
+    float e2_[4]; /* vec4<f32>, offset 48 */
+    float cam_forward[4]; /* vec4<f32>, offset 64 */
+    float cam_right[4]; /* vec4<f32>, offset 80 */
+    float cam_up[4]; /* vec4<f32>, offset 96 */
+    float theta[4]; /* vec4<f32>, offset 112 */
+    float medium[4]; /* vec4<f32>, offset 128 */
+    float light_color[4]; /* vec4<f32>, offset 144 */
+    float light_pos[4]; /* vec4<f32>, offset 160 */
+    float light_dir[4]; /* vec4<f32>, offset 176 */
+    float sm_right[4]; /* vec4<f32>, offset 192 */
+    float sm_up[4]; /* vec4<f32>, offset 208 */
+    float sm_forward[4]; /* vec4<f32>, offset 224 */
+    float sm_origin[4]; /* vec4<f32>, offset 240 */
+    float sm_proj[4]; /* vec4<f32>, offset 256 */
+    float epipole[4]; /* vec4<f32>, offset 272 */
+    float anti_epipole[4]; /* vec4<f32>, offset 288 */
+    uint32_t sizes[4]; /* vec4<u32>, offset 304 */
+    uint32_t sizes2_[4]; /* vec4<u32>, offset 320 */
+    float proj[4]; /* vec4<f32>, offset 336 */
+    float proj_g0_[4]; /* vec4<f32>, offset 352 */
+    float proj_g1_[4]; /* vec4<f32>, offset 368 */
+    float proj_g2_[4]; /* vec4<f32>, offset 384 */
+} ScatterMinmaxFrame;
+SCATTER_STATIC_ASSERT(sizeof(ScatterMinmaxFrame) == 400, "ScatterMinmaxFrame size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, eye) == 0, "ScatterMinmaxFrame.eye offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, axis) == 16, "ScatterMinmaxFrame.axis offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, e1_) == 32, "ScatterMinmaxFrame.e1_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, e2_) == 48, "ScatterMinmaxFrame.e2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, cam_forward) == 64, "ScatterMinmaxFrame.cam_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, cam_right) == 80, "ScatterMinmaxFrame.cam_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, cam_up) == 96, "ScatterMinmaxFrame.cam_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, theta) == 112, "ScatterMinmaxFrame.theta offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, medium) == 128, "ScatterMinmaxFrame.medium offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, light_color) == 144, "ScatterMinmaxFrame.light_color offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, light_pos) == 160, "ScatterMinmaxFrame.light_pos offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, light_dir) == 176, "ScatterMinmaxFrame.light_dir offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, sm_right) == 192, "ScatterMinmaxFrame.sm_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, sm_up) == 208, "ScatterMinmaxFrame.sm_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, sm_forward) == 224, "ScatterMinmaxFrame.sm_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, sm_origin) == 240, "ScatterMinmaxFrame.sm_origin offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, sm_proj) == 256, "ScatterMinmaxFrame.sm_proj offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, epipole) == 272, "ScatterMinmaxFrame.epipole offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, anti_epipole) == 288, "ScatterMinmaxFrame.anti_epipole offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, sizes) == 304, "ScatterMinmaxFrame.sizes offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, sizes2_) == 320, "ScatterMinmaxFrame.sizes2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj) == 336, "ScatterMinmaxFrame.proj offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g0_) == 352, "ScatterMinmaxFrame.proj_g0_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g1_) == 368, "ScatterMinmaxFrame.proj_g1_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g2_) == 384, "ScatterMinmaxFrame.proj_g2_ offset");
+
 /* WGSL `Frame` of family prefiltered (scatter::prefiltered), 400 bytes, alignment 16. */
 typedef struct ScatterPrefilteredFrame {
     float eye[4]; /* vec4<f32>, offset 0 */

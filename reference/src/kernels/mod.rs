@@ -3,11 +3,14 @@
 //! GPU result can be compared with its mirror at quantisation-level tolerance. Shared WGSL
 //! modules (`templates/common/<name>.wgsl`) are mirrored by `common_<name>.rs`.
 
+pub mod common_minmax;
 pub mod common_model;
 pub mod common_prefiltered;
 pub mod common_raymarch;
 pub mod common_shadow;
 pub mod interleave_sum;
+pub mod minmax_build;
+pub mod minmax_march;
 pub mod prefilter;
 pub mod raymarch;
 pub mod rectify;
@@ -21,6 +24,7 @@ use crate::image::Image;
 use crate::projective::rasterise_rectified;
 use crate::scene::Scene;
 use common_prefiltered::{Tex, TexArray};
+use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_shaderlib::prefiltered::{
     FrameError, FrameSettings, LightKind, PrefilteredFrame, Resolutions, Variant, prepare_frame,
 };
@@ -194,4 +198,101 @@ pub fn run_raymarch(
         partial,
         output,
     })
+}
+
+/// Every intermediate of one CPU run of the minmax family.
+#[derive(Clone, Debug)]
+pub struct MinmaxRun {
+    /// The frame set-up (the prefiltered family's, for [`MinmaxVariant::prefiltered`]).
+    pub frame: PrefilteredFrame,
+    /// The rectified shadow map (`rectify`).
+    pub rectified: Tex,
+    /// The min-max trees (`minmax_build`).
+    pub tree: TexArray,
+    /// The hierarchical march (`minmax_march`): radiance, and nodes visited per pixel.
+    pub march: minmax_march::MarchImage,
+    /// The brute-force march over every texel of the same rectified rows.
+    pub brute: minmax_march::MarchImage,
+    /// In-scattered radiance of the hierarchical march (as stored in rgba16float).
+    pub output: Image,
+}
+
+/// Runs `rectify`, `minmax_build` and `minmax_march` on the CPU for a scene, its depth
+/// buffer and its standard shadow map, and the brute-force march over the same rectified
+/// map.
+pub fn run_minmax(
+    variant: &MinmaxVariant,
+    rectified_size: [u32; 2],
+    gbuf: &GBuffer,
+    scene: &Scene,
+    shadow_map: &ShadowMap,
+    settings: &FrameSettings,
+) -> Result<MinmaxRun, FrameError> {
+    let res = Resolutions {
+        screen: [gbuf.width, gbuf.height],
+        rectified: rectified_size,
+    };
+    let frame = prepare_minmax(
+        variant,
+        &res,
+        &scene.camera_desc(),
+        &scene.light_desc(),
+        &scene.medium_desc(),
+        &shadow_map.desc(),
+        settings,
+    )?;
+    let sm = Tex {
+        width: shadow_map.size,
+        height: shadow_map.size,
+        data: shadow_map.depth.clone(),
+    };
+    let spot = variant.light == LightKind::Spot;
+    let rectified = rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot);
+    let depth = Tex {
+        width: gbuf.width,
+        height: gbuf.height,
+        data: gbuf.view_depth.clone(),
+    };
+    Ok(minmax_from_rectified(
+        variant, frame, rectified, &depth, &sm,
+    ))
+}
+
+/// `minmax_build`, `minmax_march` and the brute-force march for a given frame and
+/// rectified map (the GPU's, in the conformance test).
+pub fn minmax_from_rectified(
+    variant: &MinmaxVariant,
+    frame: PrefilteredFrame,
+    rectified: Tex,
+    depth: &Tex,
+    shadow_map: &Tex,
+) -> MinmaxRun {
+    let tree = minmax_build::minmax_build(&frame.uniforms, &rectified);
+    let inputs = minmax_march::MarchInputs {
+        frame: &frame.uniforms,
+        slices: &frame.slices,
+        depth,
+        shadow_map,
+        tree: &tree,
+    };
+    let march = minmax_march::minmax_march(variant, &inputs);
+    let brute = minmax_march::minmax_brute(variant, &inputs, &rectified);
+    let output = Image::from_pixels(
+        depth.width,
+        depth.height,
+        march
+            .output
+            .data
+            .iter()
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+    );
+    MinmaxRun {
+        frame,
+        rectified,
+        tree,
+        march,
+        brute,
+        output,
+    }
 }

@@ -1,0 +1,176 @@
+//! The `minmax` family (Chen et al. 2011, "Real-time volumetric shadows using 1D min-max
+//! mipmaps"): a 1D min-max binary tree over every row of the prefiltered family's rectified
+//! shadow map, and a per-pixel march that steps over tree nodes wholly lit or wholly
+//! shadowed for the ray's depth and descends into the others. [`MinmaxVariant`] holds its
+//! knobs; [`prepare_minmax`] sets up a frame.
+//!
+//! # Rectified map
+//!
+//! `minmax` marches exactly the rectified map of the prefiltered family: its frames come
+//! from [`crate::frame::prepare_frame`] with [`MinmaxVariant::prefiltered`] (epipolar
+//! rectification, one region; the filter knobs have no effect here), so the uniform block is
+//! [`FrameUniforms`](crate::frame::FrameUniforms) (WGSL `struct Frame`) and the first pass is
+//! the prefiltered family's `rectify` kernel. Conventions: [`crate::frame`].
+//!
+//! # Tree layout (`minmax_build`, rg32float, `tree_width(Wr) x Hr`)
+//!
+//! Row `y` of the tree texture holds the tree of rectified row `y`, levels packed left to
+//! right: level `k` has `n_k = ceil(Wr / 2^k)` nodes at columns `off_k .. off_k + n_k`,
+//! `off_k = n_0 + ... + n_(k-1)`; node `j` of level `k` covers the texels
+//! `[j 2^k, min((j + 1) 2^k, Wr))` and stores `(min, max)` of their stored depths in
+//! `(r, g)`. Level 0 is the rectified row itself (`min = max = d_i`); the last level is the
+//! single root (`tree_levels(Wr) = ceil(log2 Wr) + 1` levels). The tree is at most
+//! `2 Wr + tree_levels(Wr)` columns wide ([`tree_width`]).
+//!
+//! # The estimate (`minmax_march`)
+//!
+//! A pixel maps to its rectified row (the nearest slice: `floor` of the continuous row
+//! coordinate, wrapped or clamped as in `scatter`), its column `x_s` and normalised depth `d`
+//! exactly as in `scatter`. Its ray crosses texels `0 .. n`, `n = min(ceil(x_s), Wr)`;
+//! column edge `x` lies at ray distance `ray_t(x)` (`scatter`'s), the last texel's span ends
+//! at the surface `s`. Texel `i` is lit iff `d <= d_i`. Every maximal run of lit texels
+//! `[i0, i1)` contributes the pixel's unshadowed in-scattering over `[ray_t(i0), ray_t(i1)]`:
+//! closed form for the sun (`sigma_s p E` applied once per pixel), `spot_quadrature / 4`
+//! Gauss-Legendre panels for a spot. The march climbs, at texel `i`, to the largest aligned
+//! node that fits inside `[i, n)`, and descends while the node is mixed (`min < d <= max`):
+//! a node with `d <= min` is wholly lit, one with `d > max` wholly shadowed, and either is
+//! skipped whole. Runs therefore begin and end at the same texel edges as a brute-force
+//! march over every texel, which gives the same sum: the hierarchy is exact at texel
+//! resolution. Pixels near the epipole or the anti-epipole are ray-marched against the
+//! standard shadow map, as `scatter` does.
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+use crate::frame::{
+    CameraDesc, FrameError, FrameSettings, LightDesc, MediumDesc, PrefilteredFrame, Resolutions,
+    ShadowMapDesc, prepare_frame,
+};
+use crate::variant::{LightKind, Rectification, Variant, VariantError};
+
+/// The knobs of the `minmax` family.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(deny_unknown_fields, default)]
+pub struct MinmaxVariant {
+    /// Light type.
+    pub light: LightKind,
+}
+
+impl MinmaxVariant {
+    /// Checks every knob (every value of the only knob is valid; kept for symmetry with the
+    /// other families).
+    pub fn validate(&self) -> Result<(), VariantError> {
+        Ok(())
+    }
+
+    /// A short stable id: `directional`, `spot`.
+    pub fn id(&self) -> String {
+        self.light.name().to_owned()
+    }
+
+    /// The conformance grid: both lights.
+    pub fn grid() -> Vec<MinmaxVariant> {
+        LightKind::ALL
+            .iter()
+            .map(|&light| MinmaxVariant { light })
+            .collect()
+    }
+
+    /// The prefiltered-family variant whose frame set-up and `rectify` kernel this family
+    /// uses: the light, epipolar rectification, one region (the other knobs do not matter).
+    pub fn prefiltered(&self) -> Variant {
+        Variant {
+            regions: 1,
+            light: self.light,
+            rectification: Rectification::Epipolar,
+            ..Variant::default()
+        }
+    }
+}
+
+impl fmt::Display for MinmaxVariant {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.id())
+    }
+}
+
+/// Nodes of level `level` of the tree of a row of `width` texels: `ceil(width / 2^level)`.
+pub const fn level_count(level: u32, width: u32) -> u32 {
+    (width + (1 << level) - 1) >> level
+}
+
+/// Levels of the tree of a row of `width` texels (`ceil(log2 width) + 1`; 1 for one texel).
+pub const fn tree_levels(width: u32) -> u32 {
+    let mut k = 0;
+    while level_count(k, width) > 1 {
+        k += 1;
+    }
+    k + 1
+}
+
+/// First column of level `level` in the packed tree row.
+pub const fn level_offset(level: u32, width: u32) -> u32 {
+    let mut off = 0;
+    let mut k = 0;
+    while k < level {
+        off += level_count(k, width);
+        k += 1;
+    }
+    off
+}
+
+/// Width of the tree texture for a rectified width `width`: every level's nodes.
+pub const fn tree_width(width: u32) -> u32 {
+    level_offset(tree_levels(width), width)
+}
+
+/// Sets up one frame of the `minmax` family: [`prepare_frame`] with
+/// [`MinmaxVariant::prefiltered`], so the rectified map is the prefiltered family's.
+///
+/// # Errors
+///
+/// As [`prepare_frame`].
+pub fn prepare_minmax(
+    variant: &MinmaxVariant,
+    res: &Resolutions,
+    camera: &CameraDesc,
+    light: &LightDesc,
+    medium: &MediumDesc,
+    shadow: &ShadowMapDesc,
+    settings: &FrameSettings,
+) -> Result<PrefilteredFrame, FrameError> {
+    variant.validate()?;
+    prepare_frame(
+        &variant.prefiltered(),
+        res,
+        camera,
+        light,
+        medium,
+        shadow,
+        settings,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tree_layout() {
+        assert_eq!(tree_levels(1), 1);
+        assert_eq!(tree_width(1), 1);
+        assert_eq!(tree_levels(2), 2);
+        assert_eq!(tree_levels(256), 9);
+        assert_eq!(tree_width(256), 511);
+        // 5 -> 3 -> 2 -> 1
+        assert_eq!(tree_levels(5), 4);
+        assert_eq!(level_offset(2, 5), 8);
+        assert_eq!(tree_width(5), 11);
+        for w in 1..600 {
+            assert!(tree_width(w) <= 2 * w + tree_levels(w), "{w}");
+            assert_eq!(level_count(tree_levels(w) - 1, w), 1);
+        }
+    }
+}

@@ -1,0 +1,350 @@
+//! CPU mirror of `shaderlib/templates/minmax_march.wgsl`: per pixel, the rectified row
+//! marched through its 1D min-max tree (Chen et al. 2011), skipping nodes wholly lit or
+//! wholly shadowed for the ray's depth; pixels near the epipole or the anti-epipole
+//! ray-marched against the standard shadow map, as in `scatter`. Conventions and the
+//! estimate: `scatter_frame::minmax`.
+//!
+//! The WGSL kernel body is one function; here it is split into the pixel set-up
+//! ([`pixel_ray`]), the walk ([`walk_tree`]) and the final scaling ([`radiance`]), so that
+//! [`minmax_brute_main`], the brute-force march over every texel of the same rectified row
+//! (the reference the hierarchy must equal), shares everything but the walk.
+
+use super::common_minmax::{level_offset, tree_levels};
+use super::common_model::{clamp, max, max_u, min, phase_hg, transmittance_between};
+use super::common_prefiltered::{Tex, TexArray, normalised_depth, quantise, sm_visibility, xyz};
+use super::scatter::{frame_spot_integrand, pixel_dir, ray_t, spot_segment};
+use glam::Vec3;
+use scatter_shaderlib::minmax::MinmaxVariant;
+use scatter_shaderlib::prefiltered::{FrameUniforms, LightKind, SliceParams, Storage};
+
+/// The bindings of `minmax_march`.
+pub struct MarchInputs<'a> {
+    /// Frame uniforms.
+    pub frame: &'a FrameUniforms,
+    /// Per-slice table.
+    pub slices: &'a [SliceParams],
+    /// Linear view depth, screen-sized.
+    pub depth: &'a Tex,
+    /// The standard shadow map.
+    pub shadow_map: &'a Tex,
+    /// The min-max trees (from `minmax_build`).
+    pub tree: &'a TexArray,
+}
+
+/// In-scattering by ray marching `steps` midpoints against the standard shadow map.
+pub fn march(inp: &MarchInputs, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f32 {
+    let f = inp.frame;
+    let steps = f.sizes2[1];
+    let h = s / steps as f32;
+    let mut sum = 0.0;
+    for k in 0..steps {
+        let t = (k as f32 + 0.5) * h;
+        let v = sm_visibility(f, inp.shadow_map, eye + dir * t);
+        if spot {
+            sum += v * h * frame_spot_integrand(f, eye, dir, t);
+        } else {
+            sum += v * transmittance_between(f.medium[0], k as f32 * h, (k + 1) as f32 * h);
+        }
+    }
+    if spot {
+        sum
+    } else {
+        f.medium[1] * phase_hg(f.medium[2], -xyz(f.light_dir).dot(dir)) * sum
+    }
+}
+
+/// Row of the `slices` table for row coordinate `j` (a whole number): wrapped around when
+/// the slices cover the full circle, else clamped.
+pub fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = j as i32;
+    if wrap {
+        (((ji % rows as i32) + rows as i32) % rows as i32) as u32
+    } else {
+        ji.clamp(0, rows as i32 - 1) as u32
+    }
+}
+
+/// Ray distance of column edge `x` of a ray that crosses texels `0 .. n`: the last texel's
+/// span ends at the surface `s`.
+pub fn edge_t(
+    f: &FrameUniforms,
+    x: u32,
+    n: u32,
+    delta: f32,
+    theta: f32,
+    s: f32,
+    spot: bool,
+) -> f32 {
+    if x >= n {
+        return s;
+    }
+    ray_t(f, x as f32, delta, theta, s, spot)
+}
+
+/// Unshadowed in-scattering over `[a, b]` of the ray, without `sigma_s p E` for the sun.
+pub fn lit_span(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, spot: bool) -> f32 {
+    if spot {
+        return spot_segment(f, eye, dir, a, b, max_u(f.sizes2[2] / 4, 1));
+    }
+    transmittance_between(f.medium[0], a, b)
+}
+
+/// A pixel's ray in rectified space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RowRay {
+    /// Eye position.
+    pub eye: Vec3,
+    /// Unit view direction.
+    pub dir: Vec3,
+    /// Distance to the surface.
+    pub s: f32,
+    /// Continuous row coordinate (the row is its `floor`; diagnostics only).
+    pub yc: f32,
+    /// Rectified row (nearest slice).
+    pub row: u32,
+    /// The row's column spacing.
+    pub delta: f32,
+    /// View angle to the axis.
+    pub theta: f32,
+    /// Normalised rectified depth of the ray.
+    pub d: f32,
+    /// Texels the ray crosses (`0 .. n`).
+    pub n: u32,
+}
+
+/// What the set-up of a pixel decided.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Pixel {
+    /// Near the epipole or the anti-epipole: the marched radiance the kernel stores.
+    Marched([f32; 4]),
+    /// The pixel's ray in its rectified row.
+    Row(RowRay),
+}
+
+/// The kernel's pixel set-up for pixel `id` (None: out of range).
+pub fn pixel_ray(id: [u32; 3], spot: bool, inp: &MarchInputs) -> Option<Pixel> {
+    let f = inp.frame;
+    let (x, y) = (id[0], id[1]);
+    if x >= f.sizes[0] || y >= f.sizes[1] {
+        return None;
+    }
+    let eye = xyz(f.eye);
+    let dir = pixel_dir(f, x, y);
+    let s = max(inp.depth.load(x, y), 0.0) / max(dir.dot(xyz(f.cam_forward)), 1e-6);
+    let color = xyz(f.light_color);
+
+    // Near the epipole and the anti-epipole the rectification degenerates: march instead.
+    let px = Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 0.0);
+    let radius = f.epipole[3];
+    let near_epi =
+        f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
+    let near_anti = f.anti_epipole[2] > 0.5
+        && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
+    if near_epi || near_anti {
+        let l = march(inp, eye, dir, s, spot) * color;
+        return Some(Pixel::Marched([l.x, l.y, l.z, 1.0]));
+    }
+
+    // Rectified coordinates of the surface point: the nearest row, its column x_s, depth d.
+    let axis = xyz(f.axis);
+    let rows = f.sizes[3];
+    let width = f.sizes[2];
+    let wrap = f.anti_epipole[3] > 0.5;
+    // atan2 rather than scatter's acos: accurate near the axis, where acos loses digits.
+    let theta = dir.cross(axis).length().atan2(dir.dot(axis));
+    let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
+    let mut yc = (phi - f.e1[3]) / f.e2[3];
+    if wrap {
+        yc -= (yc / rows as f32).floor() * rows as f32;
+    } else {
+        yc = clamp(yc, 0.0, rows as f32);
+    }
+    let row = row_index(yc.floor(), rows, wrap);
+    let delta = inp.slices[row as usize].delta;
+    let d = normalised_depth(theta, f.theta[0], f.theta[1]);
+    let xs = if spot {
+        let q = (eye + dir * s - xyz(f.light_pos)).normalize();
+        clamp(q.dot(-axis), -1.0, 1.0).acos() / delta
+    } else {
+        s * theta.sin() / delta
+    };
+    // Texels the ray crosses (NaN or negative x_s: none).
+    let n = min((if xs > 0.0 { xs } else { 0.0 }).ceil(), width as f32) as u32;
+    Some(Pixel::Row(RowRay {
+        eye,
+        dir,
+        s,
+        yc,
+        row,
+        delta,
+        theta,
+        d,
+        n,
+    }))
+}
+
+/// The kernel's walk of the tree: climb to the largest aligned node inside `[i, n)`, descend
+/// while mixed; every maximal lit run adds [`lit_span`]. Returns the sum and the number of
+/// nodes visited.
+pub fn walk_tree(f: &FrameUniforms, tree: &TexArray, r: &RowRay, spot: bool) -> (f32, u32) {
+    let width = f.sizes[2];
+    let (eye, dir, s, d, n) = (r.eye, r.dir, r.s, r.d, r.n);
+    let levels = tree_levels(width);
+    let mut total = 0.0;
+    let mut in_run = false;
+    let mut run_a = 0.0;
+    let mut visits = 0;
+    let mut i = 0u32;
+    while i < n {
+        let mut k = 0u32;
+        while k + 1 < levels && (i & ((2u32 << k) - 1)) == 0 && i + (2u32 << k) <= n {
+            k += 1;
+        }
+        let mut lit = false;
+        loop {
+            let node = tree.load(level_offset(k, width) + (i >> k), r.row, 0);
+            visits += 1;
+            if d <= node[0] {
+                lit = true;
+                break;
+            }
+            if d > node[1] || k == 0 {
+                break;
+            }
+            k -= 1;
+        }
+        if lit != in_run {
+            let t = edge_t(f, i, n, r.delta, r.theta, s, spot);
+            if lit {
+                run_a = t;
+            } else {
+                total += lit_span(f, eye, dir, run_a, t, spot);
+            }
+            in_run = lit;
+        }
+        i += 1u32 << k;
+    }
+    if in_run {
+        total += lit_span(f, eye, dir, run_a, s, spot);
+    }
+    (total, visits)
+}
+
+/// The brute-force walk: every texel `0 .. n` of the row, lit iff `d <= d_i` read straight
+/// from the rectified map; every maximal lit run adds [`lit_span`]. Returns the sum and the
+/// number of texels visited (`n`).
+pub fn walk_texels(f: &FrameUniforms, rectified: &Tex, r: &RowRay, spot: bool) -> (f32, u32) {
+    let (eye, dir, s, d, n) = (r.eye, r.dir, r.s, r.d, r.n);
+    let mut total = 0.0;
+    let mut in_run = false;
+    let mut run_a = 0.0;
+    for i in 0..n {
+        let lit = d <= rectified.load(i, r.row);
+        if lit != in_run {
+            let t = edge_t(f, i, n, r.delta, r.theta, s, spot);
+            if lit {
+                run_a = t;
+            } else {
+                total += lit_span(f, eye, dir, run_a, t, spot);
+            }
+            in_run = lit;
+        }
+    }
+    if in_run {
+        total += lit_span(f, eye, dir, run_a, s, spot);
+    }
+    (total, n)
+}
+
+/// The stored radiance of a walked ray's sum (`sigma_s p E` for the sun, `I` for a spot).
+pub fn radiance(f: &FrameUniforms, r: &RowRay, total: f32, spot: bool) -> [f32; 4] {
+    let mut l = total;
+    if !spot {
+        l = f.medium[1] * phase_hg(f.medium[2], -xyz(f.light_dir).dot(r.dir)) * total;
+    }
+    let c = xyz(f.light_color) * l;
+    [c.x, c.y, c.z, 1.0]
+}
+
+/// The kernel body for pixel `id`; returns the rgba16float texel it stores (before
+/// rounding) and the tree nodes visited (0 for a marched pixel).
+pub fn minmax_march_main(
+    id: [u32; 3],
+    variant: &MinmaxVariant,
+    inp: &MarchInputs,
+) -> Option<([f32; 4], u32)> {
+    let spot = variant.light == LightKind::Spot;
+    Some(match pixel_ray(id, spot, inp)? {
+        Pixel::Marched(c) => (c, 0),
+        Pixel::Row(r) => {
+            let (total, visits) = walk_tree(inp.frame, inp.tree, &r, spot);
+            (radiance(inp.frame, &r, total, spot), visits)
+        }
+    })
+}
+
+/// The brute-force counterpart of [`minmax_march_main`]: the same pixel, its row walked
+/// texel by texel over `rectified` (not the tree).
+pub fn minmax_brute_main(
+    id: [u32; 3],
+    variant: &MinmaxVariant,
+    inp: &MarchInputs,
+    rectified: &Tex,
+) -> Option<([f32; 4], u32)> {
+    let spot = variant.light == LightKind::Spot;
+    Some(match pixel_ray(id, spot, inp)? {
+        Pixel::Marched(c) => (c, 0),
+        Pixel::Row(r) => {
+            let (total, visits) = walk_texels(inp.frame, rectified, &r, spot);
+            (radiance(inp.frame, &r, total, spot), visits)
+        }
+    })
+}
+
+/// Per-pixel results of a whole-screen march.
+#[derive(Clone, Debug)]
+pub struct MarchImage {
+    /// Radiance as stored in rgba16float, screen-sized.
+    pub output: TexArray,
+    /// Radiance before rounding (f32), row-major.
+    pub exact: Vec<[f32; 4]>,
+    /// Nodes (tree) or texels (brute force) visited per pixel, row-major.
+    pub visits: Vec<u32>,
+}
+
+fn run_pixels(
+    f: &FrameUniforms,
+    body: &(dyn Fn([u32; 3]) -> Option<([f32; 4], u32)> + Sync),
+) -> MarchImage {
+    use rayon::prelude::*;
+    let (w, h) = (f.sizes[0], f.sizes[1]);
+    let results: Vec<([f32; 4], u32)> = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| (0..w).map(move |x| body([x, y, 0]).unwrap_or(([0.0; 4], 0))))
+        .collect();
+    MarchImage {
+        output: TexArray {
+            width: w,
+            height: h,
+            layers: 1,
+            data: results
+                .iter()
+                .map(|(c, _)| c.map(|v| quantise(v, Storage::Rgba16float)))
+                .collect(),
+        },
+        exact: results.iter().map(|(c, _)| *c).collect(),
+        visits: results.iter().map(|(_, v)| *v).collect(),
+    }
+}
+
+/// Runs every pixel through the tree (rows in parallel).
+pub fn minmax_march(variant: &MinmaxVariant, inp: &MarchInputs) -> MarchImage {
+    run_pixels(inp.frame, &|id| minmax_march_main(id, variant, inp))
+}
+
+/// Runs every pixel through the brute-force march over `rectified` (rows in parallel).
+pub fn minmax_brute(variant: &MinmaxVariant, inp: &MarchInputs, rectified: &Tex) -> MarchImage {
+    run_pixels(inp.frame, &|id| {
+        minmax_brute_main(id, variant, inp, rectified)
+    })
+}

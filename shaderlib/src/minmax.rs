@@ -1,0 +1,71 @@
+//! The `minmax` family (Chen et al. 2011): the askama views of `templates/minmax_build.wgsl`
+//! and `templates/minmax_march.wgsl` and their rendering from a [`MinmaxVariant`]. The
+//! family's first pass is the prefiltered family's `rectify`
+//! ([`crate::KernelParams::minmax`] lists it with [`MinmaxVariant::prefiltered`]). CPU
+//! mirrors: `reference/src/kernels/{minmax_build,minmax_march}.rs`. Host-side knobs, tree
+//! layout and frame set-up: [`scatter_frame::minmax`] (re-exported here).
+
+use askama::Template;
+
+pub use scatter_frame::minmax::{
+    MinmaxVariant, level_count, level_offset, prepare_minmax, tree_levels, tree_width,
+};
+
+use crate::compose::template_path;
+use crate::prefiltered::LightKind;
+use crate::{Kernel, ShaderError};
+
+/// Workgroup size of `minmax_build`: one invocation per tree node, 64 along a row.
+pub const BUILD_WORKGROUP_SIZE: [u32; 3] = [64, 1, 1];
+
+/// Workgroup size of `minmax_march`: one invocation per pixel.
+pub const MARCH_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
+
+/// Format of the min-max tree texture (r = min, g = max).
+pub const TREE_FORMAT: &str = "rg32float";
+
+/// `minmax_build`: the per-row trees (the same code for every variant).
+#[derive(Template)]
+#[template(path = "minmax_build.wgsl")]
+struct BuildTemplate {}
+
+/// `minmax_march`: the per-pixel hierarchical march.
+#[derive(Template)]
+#[template(path = "minmax_march.wgsl")]
+struct MarchTemplate {
+    light_name: &'static str,
+    spot: bool,
+}
+
+fn validate(kernel: Kernel, variant: &MinmaxVariant) -> Result<(), ShaderError> {
+    variant
+        .validate()
+        .map_err(|source| ShaderError::Variant { kernel, source })
+}
+
+/// Renders `templates/minmax_build.wgsl` (the same code for every variant).
+pub(crate) fn render_build(variant: &MinmaxVariant) -> Result<String, ShaderError> {
+    validate(Kernel::MinmaxBuild, variant)?;
+    BuildTemplate {}
+        .render()
+        .map_err(|source| ShaderError::Render {
+            kernel: Kernel::MinmaxBuild,
+            template: template_path(Kernel::MinmaxBuild),
+            source,
+        })
+}
+
+/// Renders `templates/minmax_march.wgsl` for `variant` (only the light changes the code).
+pub(crate) fn render_march(variant: &MinmaxVariant) -> Result<String, ShaderError> {
+    validate(Kernel::MinmaxMarch, variant)?;
+    MarchTemplate {
+        light_name: variant.light.name(),
+        spot: variant.light == LightKind::Spot,
+    }
+    .render()
+    .map_err(|source| ShaderError::Render {
+        kernel: Kernel::MinmaxMarch,
+        template: template_path(Kernel::MinmaxMarch),
+        source,
+    })
+}

@@ -1,0 +1,227 @@
+// minmax_march ({{ light_name }} light): per pixel, in-scattered light by marching the pixel's
+// rectified row through its 1D min-max tree (Chen et al. 2011, Sec. 4): at each texel the
+// march climbs to the largest aligned node that fits in the rest of the ray, skips it whole
+// when it is wholly lit (d <= min) or wholly shadowed (d > max) for the ray's depth d, and
+// descends otherwise. Every maximal run of lit texels adds the pixel's unshadowed
+// in-scattering over its span of the ray (closed form for the sun, Gauss-Legendre for a
+// spot), so the result equals a brute-force march over every texel of the row. Pixels near
+// the epipole or the anti-epipole are ray-marched against the standard shadow map, as in
+// `scatter` (conventions: `scatter_frame::minmax`).
+//
+// Bindings (group 0):
+// | binding | name       | type                                   | access       |
+// |---------|------------|----------------------------------------|--------------|
+// | 0       | frame      | var<uniform> Frame (400 bytes)         | uniform      |
+// | 1       | slices     | var<storage, read> array<vec4<f32>>    | read         |
+// | 2       | depth      | texture_2d<f32> (r32float, view depth) | textureLoad  |
+// | 3       | shadow_map | texture_2d<f32> (r32float)             | textureLoad  |
+// | 4       | tree       | texture_2d<f32> (rg32float, minmax_build's) | textureLoad |
+// | 5       | output     | texture_storage_2d<rgba16float, write> | textureStore |
+// slices: one vec4 per rectified row (x = delta, y = theta_ref, z = theta_lo, w = theta_hi).
+//
+// Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
+// (frame.sizes.xy); invocation id x = pixel column, y = pixel row.
+//
+// Mirrors reference/src/kernels/minmax_march.rs
+
+#import scatter::model::{GL4_W, GL4_X, PI, phase_hg, spot_integrand, transmittance_between}
+#import scatter::prefiltered::{Frame, normalised_depth, slice_params, sm_visibility}
+#import scatter::minmax::{level_offset, tree_levels}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
+@group(0) @binding(2) var depth: texture_2d<f32>;
+@group(0) @binding(3) var shadow_map: texture_2d<f32>;
+@group(0) @binding(4) var tree: texture_2d<f32>;
+@group(0) @binding(5) var output: texture_storage_2d<rgba16float, write>;
+
+// Unit view direction through the centre of pixel (x, y).
+fn pixel_dir(f: Frame, x: u32, y: u32) -> vec3<f32> {
+    let ndc_x = 2.0 * (f32(x) + 0.5) / f32(f.sizes[0]) - 1.0;
+    let ndc_y = 1.0 - 2.0 * (f32(y) + 0.5) / f32(f.sizes[1]);
+    let t = f.cam_forward[3];
+    return normalize(f.cam_forward.xyz + f.cam_right.xyz * (ndc_x * t * f.cam_right[3]) + f.cam_up.xyz * (ndc_y * t));
+}
+
+// The spot integrand at ray parameter `t` with the light and medium of the frame.
+fn frame_spot_integrand(f: Frame, eye: vec3<f32>, dir: vec3<f32>, t: f32) -> f32 {
+    return spot_integrand(eye, dir, t, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
+}
+
+// In-scattering by ray marching `steps` midpoints against the standard shadow map.
+fn march(eye: vec3<f32>, dir: vec3<f32>, s: f32, spot: bool) -> f32 {
+    let f = frame;
+    let steps = f.sizes2_[1];
+    let h = s / f32(steps);
+    var sum = 0.0;
+    for (var k = 0u; k < steps; k++) {
+        let t = (f32(k) + 0.5) * h;
+        let v = sm_visibility(f, shadow_map, eye + dir * t);
+        if spot {
+            sum += v * h * frame_spot_integrand(f, eye, dir, t);
+        } else {
+            sum += v * transmittance_between(f.medium[0], f32(k) * h, f32(k + 1u) * h);
+        }
+    }
+    if spot {
+        return sum;
+    } else {
+        return f.medium[1] * phase_hg(f.medium[2], -dot(f.light_dir.xyz, dir)) * sum;
+    }
+}
+
+// Row of the `slices` table for row coordinate `j` (a whole number): wrapped around when
+// the slices cover the full circle, else clamped.
+fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = i32(j);
+    if wrap {
+        return u32(((ji % i32(rows)) + i32(rows)) % i32(rows));
+    } else {
+        return u32(clamp(ji, 0, i32(rows) - 1));
+    }
+}
+
+// Distance along the pixel's own ray (angle `theta` to the axis) of column edge `x`, capped
+// at the surface distance `s`.
+fn ray_t(f: Frame, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
+    if spot {
+        let psi = x * delta;
+        let den = sin(theta + psi);
+        if den <= 1e-6 || theta + psi >= PI {
+            return s;
+        }
+        return min(f.axis[3] * sin(psi) / den, s);
+    } else {
+        return min(x * delta / max(sin(theta), 1e-6), s);
+    }
+}
+
+// Unshadowed spot in-scattering over `[a, b]` of the ray: `panels` 4-point Gauss-Legendre
+// panels.
+fn spot_segment(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, panels: u32) -> f32 {
+    let h = (b - a) / f32(panels);
+    var sum = 0.0;
+    for (var k = 0u; k < panels; k++) {
+        let mid = a + (f32(k) + 0.5) * h;
+        for (var q = 0u; q < 4u; q++) {
+            let t = mid + 0.5 * h * GL4_X[q];
+            sum += GL4_W[q] * frame_spot_integrand(f, eye, dir, t);
+        }
+    }
+    return sum * 0.5 * h;
+}
+
+// Ray distance of column edge `x` of a ray that crosses texels 0 .. n: the last texel's
+// span ends at the surface `s`.
+fn edge_t(f: Frame, x: u32, n: u32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
+    if x >= n {
+        return s;
+    }
+    return ray_t(f, f32(x), delta, theta, s, spot);
+}
+
+// Unshadowed in-scattering over `[a, b]` of the ray, without `sigma_s p E` for the sun.
+fn lit_span(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, spot: bool) -> f32 {
+    if spot {
+        return spot_segment(f, eye, dir, a, b, max(f.sizes2_[2] / 4u, 1u));
+    }
+    return transmittance_between(f.medium[0], a, b);
+}
+
+// The kernel body for pixel `id`; stores the pixel's in-scattered radiance.
+@compute @workgroup_size(8, 8, 1)
+fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
+    let f = frame;
+    let x = id.x; let y = id.y;
+    if x >= f.sizes[0] || y >= f.sizes[1] {
+        return;
+    }
+    let spot = {{ spot }};
+    let eye = f.eye.xyz;
+    let dir = pixel_dir(f, x, y);
+    let s = max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0) / max(dot(dir, f.cam_forward.xyz), 1e-6);
+    let color = f.light_color.xyz;
+
+    // Near the epipole and the anti-epipole the rectification degenerates: march instead.
+    let px = vec3<f32>(f32(x) + 0.5, f32(y) + 0.5, 0.0);
+    let radius = f.epipole[3];
+    let near_epi = f.epipole[2] > 0.5 && length(px - vec3<f32>(f.epipole[0], f.epipole[1], 0.0)) < radius;
+    let near_anti =
+        f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
+    if near_epi || near_anti {
+        let l = march(eye, dir, s, spot) * color;
+        textureStore(output, vec2<u32>(x, y), vec4<f32>(l.x, l.y, l.z, 1.0));
+        return;
+    }
+
+    // Rectified coordinates of the surface point: the nearest row, its column x_s, depth d.
+    let axis = f.axis.xyz;
+    let rows = f.sizes[3];
+    let width = f.sizes[2];
+    let wrap = f.anti_epipole[3] > 0.5;
+    // atan2 rather than scatter's acos: accurate near the axis, where acos loses digits.
+    let theta = atan2(length(cross(dir, axis)), dot(dir, axis));
+    let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
+    var yc = (phi - f.e1_[3]) / f.e2_[3];
+    if wrap {
+        yc -= floor(yc / f32(rows)) * f32(rows);
+    } else {
+        yc = clamp(yc, 0.0, f32(rows));
+    }
+    let row = row_index(floor(yc), rows, wrap);
+    let delta = slice_params(slices[row]).delta;
+    let d = normalised_depth(theta, f.theta[0], f.theta[1]);
+    var xs: f32;
+    if spot {
+        let q = normalize(eye + dir * s - f.light_pos.xyz);
+        xs = acos(clamp(dot(q, -axis), -1.0, 1.0)) / delta;
+    } else {
+        xs = s * sin(theta) / delta;
+    }
+    // Texels the ray crosses (NaN or negative x_s: none).
+    let n = u32(min(ceil(select(0.0, xs, xs > 0.0)), f32(width)));
+
+    // Walk the tree: climb to the largest aligned node inside [i, n), descend while mixed.
+    let levels = tree_levels(width);
+    var total = 0.0;
+    var in_run = false;
+    var run_a = 0.0;
+    var i = 0u;
+    while i < n {
+        var k = 0u;
+        while k + 1u < levels && (i & ((2u << k) - 1u)) == 0u && i + (2u << k) <= n {
+            k++;
+        }
+        var lit = false;
+        loop {
+            let node = textureLoad(tree, vec2<u32>(level_offset(k, width) + (i >> k), row), 0);
+            if d <= node.x {
+                lit = true;
+                break;
+            }
+            if d > node.y || k == 0u {
+                break;
+            }
+            k--;
+        }
+        if lit != in_run {
+            let t = edge_t(f, i, n, delta, theta, s, spot);
+            if lit {
+                run_a = t;
+            } else {
+                total += lit_span(f, eye, dir, run_a, t, spot);
+            }
+            in_run = lit;
+        }
+        i += 1u << k;
+    }
+    if in_run {
+        total += lit_span(f, eye, dir, run_a, s, spot);
+    }
+    var l = total;
+    if !spot {
+        l = f.medium[1] * phase_hg(f.medium[2], -dot(f.light_dir.xyz, dir)) * total;
+    }
+    let c = color * l;
+    textureStore(output, vec2<u32>(x, y), vec4<f32>(c.x, c.y, c.z, 1.0));
+}

@@ -1,0 +1,361 @@
+//! Conformance of the `minmax` family (`rectify`, `minmax_build`, `minmax_march`): the GPU
+//! (`scatter_runtime::run_minmax_once`) against the CPU mirrors
+//! (`reference/src/kernels/{rectify,minmax_build,minmax_march}.rs`) for both variants of
+//! `MinmaxVariant::grid()`, directional on `columns`, spot on `spot_grate`, at the
+//! `ordinary` and `epipole_on_screen` poses (the latter marches pixels near the epipole), at
+//! 67x37 pixels with a 100x60 rectified map (neither a power of two nor a multiple of the
+//! workgroups) and a 128^2 shadow map. Trials are named
+//! `minmax::<variant id>::<scene>::<pose>`.
+//!
+//! The mirror's `minmax_build` and `minmax_march` run on the GPU's rectified map, so that
+//! each kernel is compared on the same input. Tolerances: the trees bit for bit (min and max
+//! of the same floats); the output `|gpu - cpu| <= 1e-4 * max radiance` plus one f16 step of
+//! the mirror's value, except at *ties* (at most 1 % of the pixels): pixels whose ray depth
+//! lies within 1e-4 of a stored depth of their row, or whose row coordinate lies within 1e-3
+//! of a row boundary, where a few ulps of `acos`/`atan2` legitimately flip one texel or the
+//! slice. `rectify` (GPU against its mirror) is reported.
+
+use std::sync::OnceLock;
+
+use scatter_conformance::gpu;
+use scatter_reference::buffers::{GBuffer, ShadowMap};
+use scatter_reference::bvh::Bvh;
+use scatter_reference::kernels::common_prefiltered::Tex;
+use scatter_reference::kernels::minmax_march::{MarchInputs, Pixel, pixel_ray};
+use scatter_reference::kernels::{minmax_from_rectified, rectify};
+use scatter_reference::scene::Scene;
+use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
+use scatter_runtime::{FrameInput, Minmax, RuntimeError, run_minmax_once};
+use scatter_shaderlib::minmax::MinmaxVariant;
+use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions};
+
+const SCREEN: [u32; 2] = [67, 37];
+const RECTIFIED: [u32; 2] = [100, 60];
+const SHADOW_MAP: u32 = 128;
+const REL_TOL: f32 = 1e-4;
+
+struct Fixture {
+    name: SceneName,
+    pose: Pose,
+    scene: Scene,
+    gbuf: GBuffer,
+    shadow_map: ShadowMap,
+}
+
+impl Fixture {
+    fn new(name: SceneName, pose: Pose) -> Fixture {
+        let scene = scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
+        let bvh = Bvh::build(&scene.geometry);
+        let gbuf = GBuffer::cast(&scene, &bvh);
+        let shadow_map = ShadowMap::build(&scene, &bvh, SHADOW_MAP)
+            .unwrap_or_else(|e| panic!("shadow map of {name}: {e}"));
+        Fixture {
+            name,
+            pose,
+            scene,
+            gbuf,
+            shadow_map,
+        }
+    }
+
+    fn all() -> &'static [Fixture] {
+        static ALL: OnceLock<Vec<Fixture>> = OnceLock::new();
+        ALL.get_or_init(|| {
+            let mut out = Vec::new();
+            for name in [SceneName::Columns, SceneName::SpotGrate] {
+                for pose in [Pose::Ordinary, Pose::EpipoleOnScreen] {
+                    out.push(Fixture::new(name, pose));
+                }
+            }
+            out
+        })
+    }
+
+    fn light(&self) -> LightKind {
+        if self.name == SceneName::SpotGrate {
+            LightKind::Spot
+        } else {
+            LightKind::Directional
+        }
+    }
+
+    fn input(&self) -> FrameInput {
+        FrameInput {
+            camera: self.scene.camera_desc(),
+            light: self.scene.light_desc(),
+            medium: self.scene.medium_desc(),
+            shadow_map: self.shadow_map.desc(),
+            settings: FrameSettings::for_screen(SCREEN[0], SCREEN[1]),
+        }
+    }
+}
+
+fn res() -> Resolutions {
+    Resolutions {
+        screen: SCREEN,
+        rectified: RECTIFIED,
+    }
+}
+
+/// Spacing of f16 values at `v`.
+fn f16_ulp(v: f32) -> f32 {
+    let a = v.abs();
+    if !a.is_finite() || a < 2f32.powi(-14) {
+        return 2f32.powi(-24);
+    }
+    2f32.powi(a.log2().floor() as i32 - 10)
+}
+
+fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> {
+    let variant = MinmaxVariant { light: f.light() };
+    let name = format!("minmax::{variant}::{}::{}", f.name, f.pose);
+    let gpu = run_minmax_once(
+        ctx,
+        &variant,
+        res(),
+        &f.input(),
+        &f.gbuf.view_depth,
+        &f.shadow_map.depth,
+    )
+    .map_err(|e| format!("{name}: GPU run failed: {e}"))?;
+    let [wr, hr] = RECTIFIED;
+    let sm = Tex {
+        width: SHADOW_MAP,
+        height: SHADOW_MAP,
+        data: f.shadow_map.depth.clone(),
+    };
+    let depth = Tex {
+        width: SCREEN[0],
+        height: SCREEN[1],
+        data: f.gbuf.view_depth.clone(),
+    };
+    // rectify: reported only (its own conformance lives with the prefiltered family).
+    let cpu_rect = rectify::rectify(
+        &gpu.frame.uniforms,
+        &gpu.frame.slices,
+        &sm,
+        variant.light == LightKind::Spot,
+    );
+    let rect_diff = cpu_rect
+        .data
+        .iter()
+        .zip(&gpu.rectified)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
+    let rect_flips = cpu_rect
+        .data
+        .iter()
+        .zip(&gpu.rectified)
+        .filter(|(a, b)| (*a - *b).abs() > 1e-4)
+        .count();
+    let gpu_rect = Tex {
+        width: wr,
+        height: hr,
+        data: gpu.rectified.clone(),
+    };
+    let cpu = minmax_from_rectified(&variant, gpu.frame.clone(), gpu_rect, &depth, &sm);
+    // minmax_build: bit for bit.
+    if cpu.tree.data.len() != gpu.tree.len() {
+        return Err(format!("{name}: tree sizes differ"));
+    }
+    let tree_bad = cpu
+        .tree
+        .data
+        .iter()
+        .zip(&gpu.tree)
+        .filter(|(c, g)| c[0].to_bits() != g[0].to_bits() || c[1].to_bits() != g[1].to_bits())
+        .count();
+    if tree_bad > 0 {
+        return Err(format!(
+            "{name}: {tree_bad} tree nodes differ from the mirror"
+        ));
+    }
+    // minmax_march.
+    let max = cpu
+        .march
+        .output
+        .data
+        .iter()
+        .flat_map(|c| c[..3].iter().copied())
+        .fold(0.0f32, f32::max);
+    if max.is_nan() || max <= 0.0 {
+        return Err(format!("{name}: the mirror's image is black"));
+    }
+    let mut worst: f32 = 0.0;
+    let mut worst_untied: f32 = 0.0;
+    let mut ties = 0;
+    let mut over = 0;
+    let inputs = MarchInputs {
+        frame: &cpu.frame.uniforms,
+        slices: &cpu.frame.slices,
+        depth: &depth,
+        shadow_map: &sm,
+        tree: &cpu.tree,
+    };
+    for (i, (g, c)) in gpu.output.iter().zip(&cpu.march.output.data).enumerate() {
+        let pixel_over = (0..3).any(|k| {
+            let d = (g[k] - c[k]).abs();
+            d.is_nan() || d > REL_TOL * max + f16_ulp(c[k])
+        });
+        let d = (0..3).map(|k| (g[k] - c[k]).abs()).fold(0.0f32, |m, d| {
+            if d.is_nan() { f32::INFINITY } else { m.max(d) }
+        });
+        worst = worst.max(d);
+        if !pixel_over {
+            worst_untied = worst_untied.max(d);
+            continue;
+        }
+        let (x, y) = (i as u32 % SCREEN[0], i as u32 / SCREEN[0]);
+        if is_tie(
+            &inputs,
+            &cpu.rectified,
+            [x, y, 0],
+            variant.light == LightKind::Spot,
+        ) {
+            ties += 1;
+        } else {
+            worst_untied = worst_untied.max(d);
+            over += 1;
+            if let Some(Pixel::Row(r)) =
+                pixel_ray([x, y, 0], variant.light == LightKind::Spot, &inputs)
+            {
+                let m = (0..r.n)
+                    .map(|i| (r.d - cpu.rectified.load(i, r.row)).abs())
+                    .fold(f32::INFINITY, f32::min);
+                eprintln!(
+                    "  untied pixel ({x}, {y}): gpu {g:?} cpu {c:?}; d {} n {} yc {} row {} min |d - d_i| {m:e} s {}",
+                    r.d, r.n, r.yc, r.row, r.s
+                );
+            }
+        }
+    }
+    let pixels = (SCREEN[0] * SCREEN[1]) as usize;
+    if over > 0 || ties * 100 > pixels {
+        return Err(format!(
+            "{name}: {over} pixels over tolerance that are not ties, {ties} ties (at most 1 % \
+             allowed), worst |diff| {worst:e} ({:.2e} of max {max:e})",
+            worst / max
+        ));
+    }
+    let times = gpu.gpu_times.map_or_else(
+        || "gpu n/a".to_owned(),
+        |t| {
+            format!(
+                "gpu rectify {:.2} ms minmax_build {:.2} ms minmax_march {:.2} ms",
+                t.rectify.as_secs_f64() * 1e3,
+                t.build.as_secs_f64() * 1e3,
+                t.march.as_secs_f64() * 1e3
+            )
+        },
+    );
+    Ok(format!(
+        "{name}: output max |diff| {worst_untied:.2e} ({:.2e} of max {max:.3e}) over pixels \
+         without ties; {ties} tie pixels (worst {worst:.2e}); tree exact; rectify max |diff| \
+         {rect_diff:.2e} ({rect_flips} texels > 1e-4); {times}",
+        worst_untied / max
+    ))
+}
+
+/// Whether the mirror's classification of pixel `id` is within f32 noise of a different
+/// one: its ray depth within `1e-4` of a stored depth of its row (a texel flips between lit
+/// and shadowed), or its continuous row coordinate within `1e-3` rows of a row boundary (it
+/// may fall into the neighbouring slice). GPU and CPU compute `acos`, `atan2` and the
+/// rectified depths to a few ulps, so such pixels may legitimately differ by one texel's
+/// or one row's worth.
+fn is_tie(inp: &MarchInputs, rectified: &Tex, id: [u32; 3], spot: bool) -> bool {
+    match pixel_ray(id, spot, inp) {
+        Some(Pixel::Row(r)) => {
+            let depth_tie = (0..r.n).any(|i| (r.d - rectified.load(i, r.row)).abs() < 1e-4);
+            let row_tie = (r.yc - r.yc.round()).abs() < 1e-3;
+            depth_tie || row_tie
+        }
+        // Marched pixels: a shadow-map texel test or the epipole radius.
+        _ => true,
+    }
+}
+
+#[test]
+fn every_variant_matches_the_mirror() {
+    let Some(ctx) = gpu() else { return };
+    let filter = std::env::var("SCATTER_TRIALS").unwrap_or_default();
+    let mut failures = Vec::new();
+    let mut count = 0;
+    let start = std::time::Instant::now();
+    for f in Fixture::all() {
+        let id = format!("minmax::{}::{}::{}", f.light(), f.name, f.pose);
+        if !id.contains(filter.as_str()) {
+            continue;
+        }
+        count += 1;
+        match trial(ctx, f) {
+            Ok(line) => eprintln!("ok   {line}"),
+            Err(e) => {
+                eprintln!("FAIL {e}");
+                failures.push(e);
+            }
+        }
+    }
+    eprintln!(
+        "minmax: {count} trials in {:.1} s, {} failed",
+        start.elapsed().as_secs_f64(),
+        failures.len()
+    );
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let Some(ctx) = gpu() else { return };
+    let v = MinmaxVariant::default();
+    let err = Minmax::new(
+        ctx,
+        &v,
+        Resolutions {
+            screen: [0, 4],
+            rectified: RECTIFIED,
+        },
+        SHADOW_MAP,
+    )
+    .expect_err("zero width");
+    assert!(matches!(err, RuntimeError::EmptyInput { .. }), "{err}");
+    eprintln!("ok   minmax::errors::zero_size: {err}");
+    let limit = ctx.device().limits().max_texture_dimension_2d;
+    let err = Minmax::new(
+        ctx,
+        &v,
+        Resolutions {
+            screen: SCREEN,
+            rectified: [limit / 2 + 1, 4],
+        },
+        SHADOW_MAP,
+    )
+    .expect_err("tree too wide");
+    assert!(
+        matches!(err, RuntimeError::LimitExceeded { what, .. } if what.contains("tree")),
+        "{err}"
+    );
+    eprintln!("ok   minmax::errors::tree_width: {err}");
+    let f = &Fixture::all()[0];
+    let mut pass = Minmax::new(ctx, &v, res(), SHADOW_MAP / 2).unwrap_or_else(|e| panic!("{e}"));
+    let err = pass.prepare(ctx, &f.input()).expect_err("shadow map size");
+    assert!(matches!(err, RuntimeError::ShadowMapSize { .. }), "{err}");
+    eprintln!("ok   minmax::errors::shadow_map_size: {err}");
+    let mut pass = Minmax::new(
+        ctx,
+        &MinmaxVariant {
+            light: LightKind::Spot,
+        },
+        res(),
+        SHADOW_MAP,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let err = pass.prepare(ctx, &f.input()).expect_err("light mismatch");
+    assert!(err.to_string().contains("light"), "{err}");
+    eprintln!("ok   minmax::errors::light_mismatch: {err}");
+    let mut input = f.input();
+    input.camera.forward.y = f64::NAN;
+    let mut pass = Minmax::new(ctx, &v, res(), SHADOW_MAP).unwrap_or_else(|e| panic!("{e}"));
+    let err = pass.prepare(ctx, &input).expect_err("NaN camera");
+    assert!(err.to_string().contains("camera"), "{err}");
+    eprintln!("ok   minmax::errors::nan_camera: {err}");
+}
