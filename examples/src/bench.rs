@@ -24,10 +24,11 @@ use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::prefiltered::{FrameInput, Inputs};
 use scatter_runtime::raymarch::MarchInput;
 use scatter_runtime::shaderlib::Kernel;
+use scatter_runtime::shaderlib::minmax::MinmaxVariant;
 use scatter_runtime::shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions, Variant};
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
-use scatter_runtime::{Context, Raymarch, Scatter};
+use scatter_runtime::{Context, Minmax, Raymarch, Scatter};
 
 /// A method of one family with its knobs (the light is set per scene).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -36,6 +37,8 @@ pub enum Method {
     Prefiltered(Variant),
     /// The raymarch family.
     Raymarch(RaymarchVariant),
+    /// The minmax family.
+    Minmax(MinmaxVariant),
 }
 
 impl Method {
@@ -44,6 +47,7 @@ impl Method {
         match self {
             Self::Prefiltered(_) => "prefiltered",
             Self::Raymarch(_) => "raymarch",
+            Self::Minmax(_) => "minmax",
         }
     }
 
@@ -52,6 +56,7 @@ impl Method {
         match self {
             Self::Prefiltered(v) => v.id(),
             Self::Raymarch(v) => v.id(),
+            Self::Minmax(v) => v.id(),
         }
     }
 
@@ -60,6 +65,7 @@ impl Method {
         match self {
             Self::Prefiltered(v) => format!("m{}-r{}", v.bases, v.regions),
             Self::Raymarch(v) => format!("n{}-i{}", v.samples, v.interleave),
+            Self::Minmax(_) => "minmax".to_owned(),
         }
     }
 
@@ -67,6 +73,7 @@ impl Method {
         match self {
             Self::Prefiltered(v) => Self::Prefiltered(Variant { light, ..v }),
             Self::Raymarch(v) => Self::Raymarch(RaymarchVariant { light, ..v }),
+            Self::Minmax(_) => Self::Minmax(MinmaxVariant { light }),
         }
     }
 }
@@ -92,8 +99,8 @@ pub struct BenchConfig {
     /// screen sizes (no accuracy).
     pub scaling: bool,
     /// Also time the headline configuration (1280x720 screen, 1024x1024 rectified map) for
-    /// the prefiltered default and raymarch N = 32, 64, 128 and (64, 4x4) on
-    /// `sphere/ordinary` and `foliage/ordinary` (no accuracy: ground truths at 1280x720 cost
+    /// the prefiltered default, minmax and raymarch N = 64, 128 and (64, 4x4) on
+    /// `sphere/ordinary`, `foliage/ordinary` and `terrain/ordinary` (no accuracy: ground truths at 1280x720 cost
     /// minutes per pose on two cores).
     pub headline: bool,
 }
@@ -101,8 +108,9 @@ pub struct BenchConfig {
 impl BenchConfig {
     /// The default sweep: every scene at `ordinary` and `epipole_on_screen`, prefiltered
     /// (M, R) in {(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)} and raymarch N in {16, 32,
-    /// 64, 128, 256} plus interleaved (64, 4x4) and (256, 4x4), at 320x180 with a 512x512
-    /// rectified map and a 1024^2 shadow map, 3 frames; plus the scaling runs.
+    /// 64, 128, 256} plus interleaved (64, 4x4) and (256, 4x4), and minmax, at 320x180 with
+    /// a 512x512 rectified map (prefiltered and minmax) and a 1024^2 shadow map, 3 frames;
+    /// plus the scaling and headline runs.
     pub fn default_sweep() -> BenchConfig {
         let mut methods: Vec<Method> = [(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)]
             .into_iter()
@@ -129,6 +137,7 @@ impl BenchConfig {
                 ..RaymarchVariant::default()
             }));
         }
+        methods.push(Method::Minmax(MinmaxVariant::default()));
         BenchConfig {
             cases: SceneName::ALL
                 .iter()
@@ -145,8 +154,8 @@ impl BenchConfig {
         }
     }
 
-    /// The smoke run (CI): sphere and foliage at `ordinary`, the prefiltered default and two
-    /// raymarch variants, 160x90, 256^2 rectified, 512^2 shadow map, 1 frame, coarse truths.
+    /// The smoke run (CI): sphere and foliage at `ordinary`, the prefiltered default, two
+    /// raymarch variants and minmax, 160x90, 256^2 rectified, 512^2 shadow map, 1 frame, coarse truths.
     pub fn quick() -> BenchConfig {
         BenchConfig {
             cases: vec![
@@ -164,6 +173,7 @@ impl BenchConfig {
                     interleave: 4,
                     ..RaymarchVariant::default()
                 }),
+                Method::Minmax(MinmaxVariant::default()),
             ],
             screen: [160, 90],
             rectified: [256, 256],
@@ -389,6 +399,43 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
                     }
                     (output, passes, ts)
                 }
+                Method::Minmax(v) => {
+                    let res = Resolutions {
+                        screen: config.screen,
+                        rectified: config.rectified,
+                    };
+                    let mut pass = Minmax::new(ctx, &v, res, sm.size)?;
+                    pass.prepare(
+                        ctx,
+                        &FrameInput {
+                            camera: scene.camera_desc(),
+                            light: scene.light_desc(),
+                            medium: scene.medium_desc(),
+                            shadow_map: sm.desc(),
+                            settings: FrameSettings::for_screen(w, h),
+                        },
+                    )?;
+                    let mut encoder = ctx.device().create_command_encoder(&Default::default());
+                    pass.encode(ctx, &mut encoder, &depth_view, &shadow_view)?;
+                    ctx.queue().submit([encoder.finish()]);
+                    let ts = pass.pass_times(ctx)?.map(|t| t.total());
+                    let output = read_rgba16float(ctx, Kernel::MinmaxMarch, pass.output_texture())?;
+                    let t = pass.measure_pass_wall_times(
+                        ctx,
+                        &depth_view,
+                        &shadow_view,
+                        config.frames,
+                    )?;
+                    (
+                        output,
+                        vec![
+                            ("rectify", t.rectify),
+                            ("minmax_build", t.build),
+                            ("minmax_march", t.march),
+                        ],
+                        ts,
+                    )
+                }
             };
             let image =
                 Image::from_pixels(w, h, output.iter().map(|c| [c[0], c[1], c[2]]).collect());
@@ -516,13 +563,36 @@ fn time_method(
             }
             passes
         }
+        Method::Minmax(v) => {
+            let mut pass = Minmax::new(ctx, &v, Resolutions { screen, rectified }, sm.size)?;
+            pass.prepare(
+                ctx,
+                &FrameInput {
+                    camera: scene.camera_desc(),
+                    light: scene.light_desc(),
+                    medium: scene.medium_desc(),
+                    shadow_map: sm.desc(),
+                    settings: FrameSettings::for_screen(screen[0], screen[1]),
+                },
+            )?;
+            let t = pass.measure_pass_wall_times(ctx, &dv, &sv, frames)?;
+            vec![
+                ("rectify", t.rectify),
+                ("minmax_build", t.build),
+                ("minmax_march", t.march),
+            ]
+        }
     })
 }
 
-/// The headline configuration: 1280x720, 1024x1024 rectified, on sphere and foliage.
+/// The headline configuration: 1280x720, 1024x1024 rectified, on sphere, foliage and
+/// terrain.
 fn headline_runs(ctx: &Context, frames: u32) -> Result<Vec<HeadlineRow>, BoxError> {
-    let mut methods = vec![Method::Prefiltered(Variant::default())];
-    for (samples, interleave) in [(32, 1), (64, 1), (128, 1), (64, 4)] {
+    let mut methods = vec![
+        Method::Prefiltered(Variant::default()),
+        Method::Minmax(MinmaxVariant::default()),
+    ];
+    for (samples, interleave) in [(64, 1), (128, 1), (64, 4)] {
         methods.push(Method::Raymarch(RaymarchVariant {
             samples,
             interleave,
@@ -530,7 +600,7 @@ fn headline_runs(ctx: &Context, frames: u32) -> Result<Vec<HeadlineRow>, BoxErro
         }));
     }
     let mut out = Vec::new();
-    for name in [SceneName::Sphere, SceneName::Foliage] {
+    for name in [SceneName::Sphere, SceneName::Foliage, SceneName::Terrain] {
         for &m in &methods {
             out.push(HeadlineRow {
                 family: m.family(),
@@ -719,7 +789,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 .map(|r| ms(r.total()))
         };
         if let Some(p) = time("prefiltered", "m32-r3") {
-            for knobs in ["n32-i1", "n64-i1", "n128-i1", "n64-i4"] {
+            for knobs in ["n64-i1", "n128-i1", "n64-i4"] {
                 if let Some(r) = time("raymarch", knobs) {
                     let tag = if matching.as_deref() == Some(knobs) {
                         " (the cheapest raymarch at equal or better sweep error)"
@@ -734,7 +804,11 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             }
         }
     }
-    for family_knobs in [("prefiltered", "m32-r3"), ("raymarch", "n64-i1")] {
+    for family_knobs in [
+        ("prefiltered", "m32-r3"),
+        ("raymarch", "n64-i1"),
+        ("minmax", "minmax"),
+    ] {
         let t = |scene: SceneName| {
             result
                 .headline
@@ -753,11 +827,48 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             ));
         }
     }
-    out.push(
-        "prefiltered vs minmax on foliage and terrain: not measured (the minmax family is not in this build)"
-            .to_owned(),
-    );
-    for (family, knobs) in [("prefiltered", "m32-r3"), ("raymarch", "n64-i1")] {
+    for scene in [SceneName::Foliage, SceneName::Terrain] {
+        let sweep = |family: &str| {
+            result
+                .rows
+                .iter()
+                .find(|r| {
+                    r.family == family
+                        && (r.knobs == "m32-r3" || family == "minmax")
+                        && r.scene == scene
+                        && r.pose == Pose::Ordinary
+                })
+                .map(|r| (ms(r.total()), r.rel_l1_shadow_map))
+        };
+        if let (Some(p), Some(m)) = (sweep("prefiltered"), sweep("minmax")) {
+            out.push(format!(
+                "{scene}/ordinary at the sweep size: minmax {:.1} ms ({:.2} %) / prefiltered m32-r3 {:.1} ms ({:.2} %) = {:.2}",
+                m.0,
+                100.0 * m.1,
+                p.0,
+                100.0 * p.1,
+                m.0 / p.0
+            ));
+        }
+        let head = |family: &str, knobs: &str| {
+            result
+                .headline
+                .iter()
+                .find(|r| r.family == family && r.knobs == knobs && r.scene == scene)
+                .map(|r| ms(r.total()))
+        };
+        if let (Some(p), Some(m)) = (head("prefiltered", "m32-r3"), head("minmax", "minmax")) {
+            out.push(format!(
+                "{scene}/ordinary at 1280x720, 1024x1024 rectified: minmax {m:.1} ms / prefiltered m32-r3 {p:.1} ms = {:.2}",
+                m / p
+            ));
+        }
+    }
+    for (family, knobs) in [
+        ("prefiltered", "m32-r3"),
+        ("raymarch", "n64-i1"),
+        ("minmax", "minmax"),
+    ] {
         let time = |scene: SceneName| {
             result
                 .rows
@@ -977,7 +1088,7 @@ where
         .draw_series(LineSeries::new(front.clone(), BLACK.stroke_width(1)))?
         .label("Pareto front")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK));
-    for (family, colour) in [("prefiltered", RED), ("raymarch", BLUE)] {
+    for (family, colour) in [("prefiltered", RED), ("raymarch", BLUE), ("minmax", GREEN)] {
         let sel: Vec<_> = v.iter().zip(&pts).filter(|(p, _)| p.0 == family).collect();
         if sel.is_empty() {
             continue;

@@ -44,6 +44,13 @@ pub struct MinmaxTimes {
     pub march: Duration,
 }
 
+impl MinmaxTimes {
+    /// Sum of the passes.
+    pub fn total(&self) -> Duration {
+        self.rectify + self.build + self.march
+    }
+}
+
 /// The minmax family for one [`MinmaxVariant`], sized for one screen, one rectified map and
 /// one shadow-map size.
 #[derive(Debug)]
@@ -341,6 +348,61 @@ impl Minmax {
         depth: &wgpu::TextureView,
         shadow_map: &wgpu::TextureView,
     ) -> Result<&wgpu::TextureView, RuntimeError> {
+        self.encode_selected(ctx, encoder, depth, shadow_map, None)
+    }
+
+    /// Wall time of each pass submitted on its own and waited for, the median over
+    /// `frames` frames after one warm-up frame (on a CPU adapter such as lavapipe this is
+    /// the pass's real cost; its timestamps are not).
+    ///
+    /// # Errors
+    ///
+    /// As [`Self::encode`]; [`RuntimeError::Poll`] when waiting fails.
+    pub fn measure_pass_wall_times(
+        &self,
+        ctx: &Context,
+        depth: &wgpu::TextureView,
+        shadow_map: &wgpu::TextureView,
+        frames: u32,
+    ) -> Result<MinmaxTimes, RuntimeError> {
+        let mut samples: [Vec<Duration>; 3] = Default::default();
+        for frame in 0..=frames.max(1) {
+            for (slot, kernel) in [RECTIFY, BUILD, MARCH].into_iter().enumerate() {
+                let mut encoder =
+                    ctx.device()
+                        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                            label: Some(kernel.name()),
+                        });
+                self.encode_selected(ctx, &mut encoder, depth, shadow_map, Some(kernel))?;
+                let start = Instant::now();
+                ctx.queue().submit([encoder.finish()]);
+                ctx.device()
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|source| RuntimeError::Poll { kernel, source })?;
+                if frame > 0 {
+                    samples[slot].push(start.elapsed());
+                }
+            }
+        }
+        let [rectify, build, march] = samples.map(|mut v| {
+            v.sort();
+            v.get(v.len() / 2).copied().unwrap_or_default()
+        });
+        Ok(MinmaxTimes {
+            rectify,
+            build,
+            march,
+        })
+    }
+
+    fn encode_selected(
+        &self,
+        ctx: &Context,
+        encoder: &mut wgpu::CommandEncoder,
+        depth: &wgpu::TextureView,
+        shadow_map: &wgpu::TextureView,
+        only: Option<Kernel>,
+    ) -> Result<&wgpu::TextureView, RuntimeError> {
         if self.frame.is_none() {
             return Err(RuntimeError::NotPrepared { kernel: MARCH });
         }
@@ -384,16 +446,24 @@ impl Minmax {
             (&self.march, &march_group, [w, h, 1]),
         ];
         for (index, (pipeline, group, invocations)) in (0u32..).zip(passes) {
+            if only.is_some_and(|k| k != pipeline.kernel) {
+                continue;
+            }
+            let timestamps = if only.is_none() {
+                self.timer.as_ref().and_then(|t| t.pass_writes(index))
+            } else {
+                None
+            };
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(pipeline.kernel.name()),
-                timestamp_writes: self.timer.as_ref().and_then(|t| t.pass_writes(index)),
+                timestamp_writes: timestamps,
             });
             pass.set_pipeline(&pipeline.pipeline);
             pass.set_bind_group(0, group, &[]);
             let [x, y, z] = groups(invocations, pipeline.workgroup_size);
             pass.dispatch_workgroups(x, y, z);
         }
-        if let Some(timer) = &self.timer {
+        if let Some(timer) = self.timer.as_ref().filter(|_| only.is_none()) {
             timer.resolve(encoder);
         }
         Ok(&self.output_view)
