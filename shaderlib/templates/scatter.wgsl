@@ -219,6 +219,12 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let cos_theta_l = -dot(f.light_dir.xyz, dir);
     let panels = max(f.sizes2_[2] / 4u / count, 1u);
+    // The ray's Fourier coefficients depend on its depth only: once per pixel, not per
+    // region (they cost four sin/cos per layer).
+    var coeffs: array<vec4<f32>, LAYERS>;
+    for (var layer = 0u; layer < LAYERS; layer++) {
+        coeffs[layer] = coeff4(d, layer);
+    }
     var total = 0.0;
     var norm = 0.0;
     for (var r = 0u; r < count; r++) {
@@ -233,7 +239,7 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         var vis = 0.5;
         for (var layer = 0u; layer < LAYERS; layer++) {
-            let coeff = coeff4(d, layer);
+            let coeff = coeffs[layer];
             let texel = textureSampleLevel(filtered, filtered_sampler, vec2<f32>(pos[r] / f32(width), yc / f32(rows)), layer, 0.0);
             for (var k = 0u; k < 4u; k++) {
                 vis += coeff[k] * (texel[k] * 2.0 - 1.0);

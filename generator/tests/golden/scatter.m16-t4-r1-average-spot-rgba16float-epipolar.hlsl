@@ -241,10 +241,10 @@ float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_1)
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_1) - 1u)));
 }
 
-float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d_1, uint layer_1)
+float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d_1, uint layer_2)
 {
-    const float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 1u));
-    const float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 2u));
+    const float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
+    const float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
     return float4(((2.0 / _e5) * cos((_e5 * d_1))), ((-2.0 / _e5) * sin((_e5 * d_1))), ((2.0 / _e10) * cos((_e10 * d_1))), ((-2.0 / _e10) * sin((_e10 * d_1))));
 }
 
@@ -485,12 +485,14 @@ void scatter(uint3 id : SV_DispatchThreadID)
     uint count = 0u;
     uint r = 0u;
     bool local_4 = (bool)0;
+    float4 coeffs[4] = (float4[4])0;
+    uint layer = 0u;
     float total = 0.0;
     float norm = 0.0;
     uint r_1 = 0u;
     float weight = (float)0;
     float vis = (float)0;
-    uint layer = (uint)0;
+    uint layer_1 = (uint)0;
     uint k = (uint)0;
     float l = (float)0;
     float unshadowed = (float)0;
@@ -638,114 +640,136 @@ void scatter(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e349 = r_1;
-            r_1 = (_e349 + 1u);
+            uint _e274 = layer;
+            layer = (_e274 + 1u);
         }
         loop_init_4 = false;
-        uint _e264 = r_1;
-        uint _e265 = count;
-        if ((_e264 < _e265)) {
+        uint _e264 = layer;
+        if ((_e264 < LAYERS)) {
         } else {
             break;
         }
         {
-            uint _e267 = r_1;
-            float a_2 = t0_[min(uint(_e267), 7u)];
-            uint _e270 = r_1;
-            float b_2 = t1_[min(uint(_e270), 7u)];
+            uint _e268 = layer;
+            float _e270 = d;
+            uint _e271 = layer;
+            const float4 _e272 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e270, _e271);
+            coeffs[min(uint(_e268), 3u)] = _e272;
+        }
+    }
+    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
+    bool loop_init_5 = true;
+    while(true) {
+        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
+            uint _e362 = r_1;
+            r_1 = (_e362 + 1u);
+        }
+        loop_init_5 = false;
+        uint _e277 = r_1;
+        uint _e278 = count;
+        if ((_e277 < _e278)) {
+        } else {
+            break;
+        }
+        {
+            uint _e280 = r_1;
+            float a_2 = t0_[min(uint(_e280), 7u)];
+            uint _e283 = r_1;
+            float b_2 = t1_[min(uint(_e283), 7u)];
             weight = ZeroValuefloat();
             if (!(false)) {
                 weight = (b_2 - a_2);
             } else {
                 if (true) {
-                    const float _e278 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
-                    weight = _e278;
+                    const float _e291 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
+                    weight = _e291;
                 } else {
-                    const float _e283 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-                    const float _e287 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
-                    weight = ((f_7.medium.y * _e283) * _e287);
+                    const float _e296 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+                    const float _e300 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
+                    weight = ((f_7.medium.y * _e296) * _e300);
                 }
             }
             vis = 0.5;
-            layer = 0u;
-            uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
-            bool loop_init_5 = true;
+            layer_1 = 0u;
+            uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
+            bool loop_init_6 = true;
             while(true) {
-                if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
-                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-                if (!loop_init_5) {
-                    uint _e333 = layer;
-                    layer = (_e333 + 1u);
+                if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
+                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                if (!loop_init_6) {
+                    uint _e346 = layer_1;
+                    layer_1 = (_e346 + 1u);
                 }
-                loop_init_5 = false;
-                uint _e293 = layer;
-                if ((_e293 < LAYERS)) {
+                loop_init_6 = false;
+                uint _e306 = layer_1;
+                if ((_e306 < LAYERS)) {
                 } else {
                     break;
                 }
                 {
-                    float _e296 = d;
-                    uint _e297 = layer;
-                    const float4 _e298 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e296, _e297);
-                    uint _e299 = r_1;
-                    float _e301 = pos[min(uint(_e299), 7u)];
-                    float _e304 = yc;
-                    uint _e308 = layer;
-                    float4 texel_1 = filtered.SampleLevel(filtered_sampler, float3(float2((_e301 / float(width_1)), (_e304 / float(rows_1))), _e308), 0.0);
+                    uint _e309 = layer_1;
+                    float4 coeff = coeffs[min(uint(_e309), 3u)];
+                    uint _e312 = r_1;
+                    float _e314 = pos[min(uint(_e312), 7u)];
+                    float _e317 = yc;
+                    uint _e321 = layer_1;
+                    float4 texel_1 = filtered.SampleLevel(filtered_sampler, float3(float2((_e314 / float(width_1)), (_e317 / float(rows_1))), _e321), 0.0);
                     k = 0u;
-                    uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
-                    bool loop_init_6 = true;
+                    uint2 loop_bound_7 = uint2(4294967295u, 4294967295u);
+                    bool loop_init_7 = true;
                     while(true) {
-                        if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
-                        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                        if (!loop_init_6) {
-                            uint _e330 = k;
-                            k = (_e330 + 1u);
+                        if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
+                        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+                        if (!loop_init_7) {
+                            uint _e343 = k;
+                            k = (_e343 + 1u);
                         }
-                        loop_init_6 = false;
-                        uint _e315 = k;
-                        if ((_e315 < 4u)) {
+                        loop_init_7 = false;
+                        uint _e328 = k;
+                        if ((_e328 < 4u)) {
                         } else {
                             break;
                         }
                         {
-                            float _e318 = vis;
-                            uint _e319 = k;
-                            uint _e321 = k;
-                            vis = (_e318 + (_e298[min(uint(_e319), 3u)] * ((texel_1[min(uint(_e321), 3u)] * 2.0) - 1.0)));
+                            float _e331 = vis;
+                            uint _e332 = k;
+                            uint _e334 = k;
+                            vis = (_e331 + (coeff[min(uint(_e332), 3u)] * ((texel_1[min(uint(_e334), 3u)] * 2.0) - 1.0)));
                         }
                     }
                 }
             }
-            float _e336 = total;
-            float _e337 = weight;
-            float _e338 = vis;
-            total = (_e336 + (_e337 * clamp(_e338, 0.0, 1.0)));
-            float _e345 = norm;
-            float _e346 = weight;
-            norm = (_e345 + _e346);
+            float _e349 = total;
+            float _e350 = weight;
+            float _e351 = vis;
+            total = (_e349 + (_e350 * clamp(_e351, 0.0, 1.0)));
+            float _e358 = norm;
+            float _e359 = weight;
+            norm = (_e358 + _e359);
         }
     }
     if (false) {
-        float _e351 = total;
-        l = _e351;
+        float _e364 = total;
+        l = _e364;
     } else {
         if (true) {
-            const float _e360 = spot_segment(f_7, eye_4, _e21, 0.0, s_2, max(naga_div(f_7.sizes2_.z, 4u), 1u));
-            unshadowed = _e360;
+            const float _e373 = spot_segment(f_7, eye_4, _e21, 0.0, s_2, max(naga_div(f_7.sizes2_.z, 4u), 1u));
+            unshadowed = _e373;
         } else {
-            const float _e366 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-            const float _e370 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
-            unshadowed = ((f_7.medium.y * _e366) * _e370);
+            const float _e379 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+            const float _e383 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
+            unshadowed = ((f_7.medium.y * _e379) * _e383);
         }
-        float _e372 = unshadowed;
-        float _e373 = total;
-        float _e374 = norm;
-        float _e376 = norm;
-        l = (_e372 * ((_e376 > 0.0) ? (_e373 / _e374) : 1.0));
+        float _e385 = unshadowed;
+        float _e386 = total;
+        float _e387 = norm;
+        float _e389 = norm;
+        l = (_e385 * ((_e389 > 0.0) ? (_e386 / _e387) : 1.0));
     }
-    float _e382 = l;
-    float3 c = (color * _e382);
+    float _e395 = l;
+    float3 c = (color * _e395);
     output[uint2(x_6, y_2)] = float4(c.x, c.y, c.z, 1.0);
     return;
 }

@@ -213,9 +213,9 @@ fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_1: u32) -> f32 {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_1) - 1u)));
 }
 
-fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_1: f32, layer_1: u32) -> vec4<f32> {
-    let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 1u));
-    let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 2u));
+fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_1: f32, layer_2: u32) -> vec4<f32> {
+    let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
+    let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
     return vec4<f32>(((2f / _e5) * cos((_e5 * d_1))), ((-2f / _e5) * sin((_e5 * d_1))), ((2f / _e10) * cos((_e10 * d_1))), ((-2f / _e10) * sin((_e10 * d_1))));
 }
 
@@ -400,12 +400,14 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     var count: u32 = 0u;
     var r: u32 = 0u;
     var local_4: bool;
+    var coeffs: array<vec4<f32>, 4>;
+    var layer: u32 = 0u;
     var total: f32 = 0f;
     var norm: f32 = 0f;
     var r_1: u32 = 0u;
     var weight: f32;
     var vis: f32;
-    var layer: u32;
+    var layer_1: u32;
     var k: u32;
     var l: f32;
     var unshadowed: f32;
@@ -543,104 +545,121 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e259 = count;
     let panels_1 = max(((f_7.sizes2_.z / 4u) / _e259), 1u);
     loop {
-        let _e264 = r_1;
-        let _e265 = count;
-        if (_e264 < _e265) {
+        let _e264 = layer;
+        if (_e264 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e267 = r_1;
-            let a_2 = t0_[_e267];
-            let _e270 = r_1;
-            let b_2 = t1_[_e270];
+            let _e268 = layer;
+            let _e270 = d;
+            let _e271 = layer;
+            let _e272 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e270, _e271);
+            coeffs[_e268] = _e272;
+        }
+        continuing {
+            let _e274 = layer;
+            layer = (_e274 + 1u);
+        }
+    }
+    loop {
+        let _e277 = r_1;
+        let _e278 = count;
+        if (_e277 < _e278) {
+        } else {
+            break;
+        }
+        {
+            let _e280 = r_1;
+            let a_2 = t0_[_e280];
+            let _e283 = r_1;
+            let b_2 = t1_[_e283];
             weight = f32();
             if !(false) {
                 weight = (b_2 - a_2);
             } else {
                 if true {
-                    let _e278 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
-                    weight = _e278;
+                    let _e291 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
+                    weight = _e291;
                 } else {
-                    let _e283 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-                    let _e287 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
-                    weight = ((f_7.medium.y * _e283) * _e287);
+                    let _e296 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+                    let _e300 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
+                    weight = ((f_7.medium.y * _e296) * _e300);
                 }
             }
             vis = 0.5f;
-            layer = 0u;
+            layer_1 = 0u;
             loop {
-                let _e293 = layer;
-                if (_e293 < LAYERS) {
+                let _e306 = layer_1;
+                if (_e306 < LAYERS) {
                 } else {
                     break;
                 }
                 {
-                    let _e296 = d;
-                    let _e297 = layer;
-                    let _e298 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e296, _e297);
-                    let _e299 = r_1;
-                    let _e301 = pos[_e299];
-                    let _e304 = yc;
-                    let _e308 = layer;
-                    let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e301 / f32(width_1)), (_e304 / f32(rows_1))), _e308, 0f);
+                    let _e309 = layer_1;
+                    let coeff = coeffs[_e309];
+                    let _e312 = r_1;
+                    let _e314 = pos[_e312];
+                    let _e317 = yc;
+                    let _e321 = layer_1;
+                    let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e314 / f32(width_1)), (_e317 / f32(rows_1))), _e321, 0f);
                     k = 0u;
                     loop {
-                        let _e315 = k;
-                        if (_e315 < 4u) {
+                        let _e328 = k;
+                        if (_e328 < 4u) {
                         } else {
                             break;
                         }
                         {
-                            let _e318 = vis;
-                            let _e319 = k;
-                            let _e321 = k;
-                            vis = (_e318 + (_e298[_e319] * ((texel_1[_e321] * 2f) - 1f)));
+                            let _e331 = vis;
+                            let _e332 = k;
+                            let _e334 = k;
+                            vis = (_e331 + (coeff[_e332] * ((texel_1[_e334] * 2f) - 1f)));
                         }
                         continuing {
-                            let _e330 = k;
-                            k = (_e330 + 1u);
+                            let _e343 = k;
+                            k = (_e343 + 1u);
                         }
                     }
                 }
                 continuing {
-                    let _e333 = layer;
-                    layer = (_e333 + 1u);
+                    let _e346 = layer_1;
+                    layer_1 = (_e346 + 1u);
                 }
             }
-            let _e336 = total;
-            let _e337 = weight;
-            let _e338 = vis;
-            total = (_e336 + (_e337 * clamp(_e338, 0f, 1f)));
-            let _e345 = norm;
-            let _e346 = weight;
-            norm = (_e345 + _e346);
+            let _e349 = total;
+            let _e350 = weight;
+            let _e351 = vis;
+            total = (_e349 + (_e350 * clamp(_e351, 0f, 1f)));
+            let _e358 = norm;
+            let _e359 = weight;
+            norm = (_e358 + _e359);
         }
         continuing {
-            let _e349 = r_1;
-            r_1 = (_e349 + 1u);
+            let _e362 = r_1;
+            r_1 = (_e362 + 1u);
         }
     }
     if false {
-        let _e351 = total;
-        l = _e351;
+        let _e364 = total;
+        l = _e364;
     } else {
         if true {
-            let _e360 = spot_segment(f_7, eye_4, _e21, 0f, s_2, max((f_7.sizes2_.z / 4u), 1u));
-            unshadowed = _e360;
+            let _e373 = spot_segment(f_7, eye_4, _e21, 0f, s_2, max((f_7.sizes2_.z / 4u), 1u));
+            unshadowed = _e373;
         } else {
-            let _e366 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-            let _e370 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
-            unshadowed = ((f_7.medium.y * _e366) * _e370);
+            let _e379 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+            let _e383 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
+            unshadowed = ((f_7.medium.y * _e379) * _e383);
         }
-        let _e372 = unshadowed;
-        let _e373 = total;
-        let _e374 = norm;
-        let _e376 = norm;
-        l = (_e372 * select(1f, (_e373 / _e374), (_e376 > 0f)));
+        let _e385 = unshadowed;
+        let _e386 = total;
+        let _e387 = norm;
+        let _e389 = norm;
+        l = (_e385 * select(1f, (_e386 / _e387), (_e389 > 0f)));
     }
-    let _e382 = l;
-    let c = (color * _e382);
+    let _e395 = l;
+    let c = (color * _e395);
     textureStore(output, vec2<u32>(x_6, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

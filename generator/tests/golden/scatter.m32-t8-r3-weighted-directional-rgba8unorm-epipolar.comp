@@ -211,9 +211,9 @@ float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_1) {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_1) - 1u)));
 }
 
-vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d_1, uint layer_1) {
-    float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 1u));
-    float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_1) + 2u));
+vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d_1, uint layer_2) {
+    float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
+    float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
     return vec4(((2.0 / _e5) * cos((_e5 * d_1))), ((-2.0 / _e5) * sin((_e5 * d_1))), ((2.0 / _e10) * cos((_e10 * d_1))), ((-2.0 / _e10) * sin((_e10 * d_1))));
 }
 
@@ -401,12 +401,14 @@ void main() {
     uint count = 0u;
     uint r = 0u;
     bool local_4 = false;
+    vec4 coeffs[8] = vec4[8](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
+    uint layer = 0u;
     float total = 0.0;
     float norm = 0.0;
     uint r_1 = 0u;
     float weight = 0.0;
     float vis = 0.0;
-    uint layer = 0u;
+    uint layer_1 = 0u;
     uint k = 0u;
     float l = 0.0;
     float unshadowed = 0.0;
@@ -548,108 +550,127 @@ void main() {
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e349 = r_1;
-            r_1 = (_e349 + 1u);
+            uint _e274 = layer;
+            layer = (_e274 + 1u);
         }
         loop_init_4 = false;
-        uint _e264 = r_1;
-        uint _e265 = count;
-        if ((_e264 < _e265)) {
+        uint _e264 = layer;
+        if ((_e264 < LAYERS)) {
         } else {
             break;
         }
         {
-            uint _e267 = r_1;
-            float a_2 = t0_[_e267];
-            uint _e270 = r_1;
-            float b_2 = t1_[_e270];
+            uint _e268 = layer;
+            float _e270 = d;
+            uint _e271 = layer;
+            vec4 _e272 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e270, _e271);
+            coeffs[_e268] = _e272;
+        }
+    }
+    bool loop_init_5 = true;
+    while(true) {
+        if (!loop_init_5) {
+            uint _e362 = r_1;
+            r_1 = (_e362 + 1u);
+        }
+        loop_init_5 = false;
+        uint _e277 = r_1;
+        uint _e278 = count;
+        if ((_e277 < _e278)) {
+        } else {
+            break;
+        }
+        {
+            uint _e280 = r_1;
+            float a_2 = t0_[_e280];
+            uint _e283 = r_1;
+            float b_2 = t1_[_e283];
             weight = 0.0;
             if (!(true)) {
                 weight = (b_2 - a_2);
             } else {
                 if (false) {
-                    float _e278 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
-                    weight = _e278;
+                    float _e291 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
+                    weight = _e291;
                 } else {
-                    float _e283 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-                    float _e287 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
-                    weight = ((f_7.medium.y * _e283) * _e287);
+                    float _e296 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+                    float _e300 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
+                    weight = ((f_7.medium.y * _e296) * _e300);
                 }
             }
             vis = 0.5;
-            layer = 0u;
-            bool loop_init_5 = true;
+            layer_1 = 0u;
+            bool loop_init_6 = true;
             while(true) {
-                if (!loop_init_5) {
-                    uint _e333 = layer;
-                    layer = (_e333 + 1u);
+                if (!loop_init_6) {
+                    uint _e346 = layer_1;
+                    layer_1 = (_e346 + 1u);
                 }
-                loop_init_5 = false;
-                uint _e293 = layer;
-                if ((_e293 < LAYERS)) {
+                loop_init_6 = false;
+                uint _e306 = layer_1;
+                if ((_e306 < LAYERS)) {
                 } else {
                     break;
                 }
                 {
-                    float _e296 = d;
-                    uint _e297 = layer;
-                    vec4 _e298 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e296, _e297);
-                    uint _e299 = r_1;
-                    float _e301 = pos[_e299];
-                    float _e304 = yc;
-                    uint _e308 = layer;
-                    vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e301 / float(width_1)), (_e304 / float(rows_1))), _e308), 0.0);
+                    uint _e309 = layer_1;
+                    vec4 coeff = coeffs[_e309];
+                    uint _e312 = r_1;
+                    float _e314 = pos[_e312];
+                    float _e317 = yc;
+                    uint _e321 = layer_1;
+                    vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e314 / float(width_1)), (_e317 / float(rows_1))), _e321), 0.0);
                     k = 0u;
-                    bool loop_init_6 = true;
+                    bool loop_init_7 = true;
                     while(true) {
-                        if (!loop_init_6) {
-                            uint _e330 = k;
-                            k = (_e330 + 1u);
+                        if (!loop_init_7) {
+                            uint _e343 = k;
+                            k = (_e343 + 1u);
                         }
-                        loop_init_6 = false;
-                        uint _e315 = k;
-                        if ((_e315 < 4u)) {
+                        loop_init_7 = false;
+                        uint _e328 = k;
+                        if ((_e328 < 4u)) {
                         } else {
                             break;
                         }
                         {
-                            float _e318 = vis;
-                            uint _e319 = k;
-                            uint _e321 = k;
-                            vis = (_e318 + (_e298[_e319] * ((texel_1[_e321] * 2.0) - 1.0)));
+                            float _e331 = vis;
+                            uint _e332 = k;
+                            uint _e334 = k;
+                            vis = (_e331 + (coeff[_e332] * ((texel_1[_e334] * 2.0) - 1.0)));
                         }
                     }
                 }
             }
-            float _e336 = total;
-            float _e337 = weight;
-            float _e338 = vis;
-            total = (_e336 + (_e337 * clamp(_e338, 0.0, 1.0)));
-            float _e345 = norm;
-            float _e346 = weight;
-            norm = (_e345 + _e346);
+            float _e349 = total;
+            float _e350 = weight;
+            float _e351 = vis;
+            total = (_e349 + (_e350 * clamp(_e351, 0.0, 1.0)));
+            float _e358 = norm;
+            float _e359 = weight;
+            norm = (_e358 + _e359);
         }
     }
     if (true) {
-        float _e351 = total;
-        l = _e351;
+        float _e364 = total;
+        l = _e364;
     } else {
         if (false) {
-            float _e360 = spot_segment(f_7, eye_4, _e21, 0.0, s_2, max((f_7.sizes2_.z / 4u), 1u));
-            unshadowed = _e360;
+            float _e373 = spot_segment(f_7, eye_4, _e21, 0.0, s_2, max((f_7.sizes2_.z / 4u), 1u));
+            unshadowed = _e373;
         } else {
-            float _e366 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-            float _e370 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
-            unshadowed = ((f_7.medium.y * _e366) * _e370);
+            float _e379 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+            float _e383 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
+            unshadowed = ((f_7.medium.y * _e379) * _e383);
         }
-        float _e372 = unshadowed;
-        float _e373 = total;
-        float _e374 = norm;
-        float _e376 = norm;
-        l = (_e372 * ((_e376 > 0.0) ? (_e373 / _e374) : 1.0));
+        float _e385 = unshadowed;
+        float _e386 = total;
+        float _e387 = norm;
+        float _e389 = norm;
+        l = (_e385 * ((_e389 > 0.0) ? (_e386 / _e387) : 1.0));
     }
-    float _e382 = l;
-    vec3 c = (color * _e382);
+    float _e395 = l;
+    vec3 c = (color * _e395);
     imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_6, y_2)), vec4(c.x, c.y, c.z, 1.0));
     return;
 }

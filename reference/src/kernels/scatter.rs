@@ -225,6 +225,10 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
     }
     let cos_theta_l = -xyz(f.light_dir).dot(dir);
     let panels = max_u(f.sizes2[2] / 4 / count, 1);
+    // The ray's Fourier coefficients depend on its depth only: once per pixel.
+    let coeffs: Vec<[f32; 4]> = (0..variant.layers())
+        .map(|layer| coeff4(d, layer))
+        .collect();
     let mut total = 0.0;
     let mut norm = 0.0;
     for r in 0..count {
@@ -240,7 +244,7 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         };
         let mut vis = 0.5;
         for layer in 0..variant.layers() {
-            let coeff = coeff4(d, layer);
+            let coeff = coeffs[layer as usize];
             let texel = sample_bilinear(inp.filtered, layer, pos[r as usize], yc, wrap);
             for k in 0..4 {
                 vis += coeff[k] * (texel[k] * 2.0 - 1.0);
