@@ -148,8 +148,12 @@ fn matrices_agree_with_the_kernels_mapping() {
 }
 
 /// The rasterised map (the reference's stand-in for the engine's rasteriser) shadows what
-/// the scene shadows: for points on the view rays of the screen, the map's test agrees with
-/// an exact shadow ray except near shadow edges (a few texels' worth).
+/// the scene shadows: for points on the view rays of the screen away from the map's shadow
+/// edges (where the answer depends on the map's resolution, not on its correctness), the
+/// map's test agrees with an exact shadow ray. Both rates are printed; measured: columns
+/// 0.28 % / foliage 0.17 % / spot_grate 3.54 % of all points (the spot's uniform
+/// light-angle regions make wide texels next to the eye), and 0.00 / 0.02 / 0.19 % away
+/// from the map's shadow edges.
 fn map_matches_shadow_rays(name: SceneName, pose: Pose) -> f64 {
     use scatter_reference::geometry::Ray;
     use scatter_reference::kernels::engine_rectified_map;
@@ -185,6 +189,7 @@ fn map_matches_shadow_rays(name: SceneName, pose: Pose) -> f64 {
     let corners = sc.camera.frustum_corners();
     let eye = sc.camera.position;
     let (mut disagree, mut total) = (0u32, 0u32);
+    let (mut disagree_interior, mut interior_points) = (0u32, 0u32);
     let n = 40;
     for i in 0..n {
         for j in 0..n {
@@ -215,25 +220,51 @@ fn map_matches_shadow_rays(name: SceneName, pose: Pose) -> f64 {
                     let x = f64::from(first) + (c.x / c.w + 1.0) * 0.5 * f64::from(count);
                     if c.w > 0.0 && x >= f64::from(first) && x < f64::from(first + count) {
                         let y = ((1.0 - c.y / c.w) * 0.5 * f64::from(rect[1])) as u32;
-                        let stored = map[(y.min(rect[1] - 1) * rect[0] + x as u32) as usize];
-                        map_lit = Some(c.z / c.w <= f64::from(stored) + 2e-3);
+                        let (xi, yi) = (x as u32, y.min(rect[1] - 1));
+                        let lit_at = |xx: u32, yy: u32| {
+                            c.z / c.w <= f64::from(map[(yy * rect[0] + xx) as usize]) + 2e-3
+                        };
+                        // Away from a shadow edge of the map (the texel and its four
+                        // neighbours agree) the answer does not depend on the map's
+                        // resolution: only there must it match the shadow ray.
+                        let lit = lit_at(xi, yi);
+                        let interior = [(-1, 0), (1, 0), (0, -1), (0, 1)].into_iter().all(
+                            |(dx, dy): (i64, i64)| {
+                                let nx = (i64::from(xi) + dx).clamp(0, i64::from(rect[0]) - 1);
+                                let ny = (i64::from(yi) + dy).clamp(0, i64::from(rect[1]) - 1);
+                                lit_at(nx as u32, ny as u32) == lit
+                            },
+                        );
+                        map_lit = Some((lit, interior));
                     }
                 }
-                if let Some(lit) = map_lit {
+                if let Some((lit, interior)) = map_lit {
                     total += 1;
                     if lit != exact_lit {
                         disagree += 1;
+                        if interior {
+                            disagree_interior += 1;
+                        }
+                    }
+                    if interior {
+                        interior_points += 1;
                     }
                 }
             }
         }
     }
     let frac = f64::from(disagree) / f64::from(total.max(1));
+    let frac_interior = f64::from(disagree_interior) / f64::from(interior_points.max(1));
     eprintln!(
-        "{name}/{pose}: rasterised map vs shadow rays disagree on {disagree} of {total} points ({:.2} %)",
-        100.0 * frac
+        "{name}/{pose}: rasterised map vs shadow rays disagree on {disagree} of {total} points ({:.2} %), on {disagree_interior} of {interior_points} away from the map's shadow edges ({:.2} %)",
+        100.0 * frac,
+        100.0 * frac_interior
     );
-    frac
+    assert!(
+        interior_points >= total / 2,
+        "{name}/{pose}: only {interior_points} of {total} points away from shadow edges"
+    );
+    frac_interior
 }
 
 #[test]
@@ -244,6 +275,10 @@ fn rasterised_map_shadows_what_the_scene_shadows() {
         (SceneName::SpotGrate, Pose::Grazing),
     ] {
         let frac = map_matches_shadow_rays(name, pose);
-        assert!(frac < 0.02, "{name}/{pose}: {:.2} % disagree", 100.0 * frac);
+        assert!(
+            frac < 0.005,
+            "{name}/{pose}: {:.2} % disagree away from shadow edges",
+            100.0 * frac
+        );
     }
 }
