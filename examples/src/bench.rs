@@ -1168,3 +1168,163 @@ pub fn write_outputs(
     written.push(png_path);
     Ok(written)
 }
+
+/// The `tune` candidate grid: prefiltered (M, R) over {16, 32, 64} x {1, 3, 8}, raymarch
+/// N over {16, 32, 64, 128, 256, 512} plus interleaved (64, 4x4) and (256, 4x4), minmax.
+pub fn tune_candidates() -> Vec<Method> {
+    let mut out = Vec::new();
+    for bases in [16, 32, 64] {
+        for regions in [1, 3, 8] {
+            out.push(Method::Prefiltered(Variant {
+                bases,
+                regions,
+                ..Variant::default()
+            }));
+        }
+    }
+    for (samples, interleave) in [
+        (16, 1),
+        (32, 1),
+        (64, 1),
+        (128, 1),
+        (256, 1),
+        (512, 1),
+        (64, 4),
+        (256, 4),
+    ] {
+        out.push(Method::Raymarch(RaymarchVariant {
+            samples,
+            interleave,
+            ..RaymarchVariant::default()
+        }));
+    }
+    out.push(Method::Minmax(MinmaxVariant::default()));
+    out
+}
+
+/// One `tune` candidate's measurements over a scene's poses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TuneEntry {
+    /// Family.
+    pub family: &'static str,
+    /// Knobs without the light.
+    pub knobs: String,
+    /// Worst rel L1 against the `shadow_map` truth over the poses.
+    pub worst_error: f64,
+    /// Mean time over the poses (ms).
+    pub mean_ms: f64,
+}
+
+/// Per candidate: the worst error and the mean time over the runs of `rows`, sorted by time.
+pub fn tune_table(rows: &[Row]) -> Vec<TuneEntry> {
+    let mut out: Vec<TuneEntry> = Vec::new();
+    for r in rows {
+        let t = ms(r.total());
+        match out
+            .iter_mut()
+            .find(|e| e.family == r.family && e.knobs == r.knobs)
+        {
+            Some(e) => {
+                e.worst_error = e.worst_error.max(r.rel_l1_shadow_map);
+                e.mean_ms += t;
+            }
+            None => out.push(TuneEntry {
+                family: r.family,
+                knobs: r.knobs.clone(),
+                worst_error: r.rel_l1_shadow_map,
+                mean_ms: t,
+            }),
+        }
+    }
+    for e in &mut out {
+        let n = rows
+            .iter()
+            .filter(|r| r.family == e.family && r.knobs == e.knobs)
+            .count()
+            .max(1);
+        e.mean_ms /= n as f64;
+    }
+    out.sort_by(|a, b| a.mean_ms.total_cmp(&b.mean_ms));
+    out
+}
+
+/// The cheapest entry whose worst error is within `budget` (a fraction, 0.02 = 2 %).
+pub fn tune_pick(table: &[TuneEntry], budget: f64) -> Option<&TuneEntry> {
+    table
+        .iter()
+        .filter(|e| e.worst_error <= budget)
+        .min_by(|a, b| a.mean_ms.total_cmp(&b.mean_ms))
+}
+
+/// The `scatter-gen` command line that emits a tune choice for a scene's light.
+pub fn scatter_gen_command(entry: &TuneEntry, light: LightKind) -> String {
+    let knobs = |prefix: char| -> Option<u32> {
+        entry
+            .knobs
+            .split('-')
+            .find_map(|k| k.strip_prefix(prefix).and_then(|v| v.parse().ok()))
+    };
+    match entry.family {
+        "prefiltered" => format!(
+            "scatter-gen --family prefiltered --bases {} --regions {} --light {light} --out shaders/",
+            knobs('m').unwrap_or(32),
+            knobs('r').unwrap_or(3)
+        ),
+        "raymarch" => format!(
+            "scatter-gen --family raymarch --samples {} --interleave {} --light {light} --out shaders/",
+            knobs('n').unwrap_or(64),
+            knobs('i').unwrap_or(1)
+        ),
+        _ => format!("scatter-gen --family minmax --light {light} --out shaders/"),
+    }
+}
+
+/// The light of a suite scene.
+pub fn scene_light(name: SceneName) -> LightKind {
+    light_of(name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entry(family: &'static str, knobs: &str, worst_error: f64, mean_ms: f64) -> TuneEntry {
+        TuneEntry {
+            family,
+            knobs: knobs.into(),
+            worst_error,
+            mean_ms,
+        }
+    }
+
+    #[test]
+    fn tune_picks_the_cheapest_within_budget() {
+        let table = vec![
+            entry("raymarch", "n16-i1", 0.10, 5.0),
+            entry("raymarch", "n64-i1", 0.03, 20.0),
+            entry("prefiltered", "m32-r3", 0.019, 60.0),
+            entry("raymarch", "n256-i1", 0.006, 80.0),
+        ];
+        assert_eq!(
+            tune_pick(&table, 0.05).map(|e| e.knobs.as_str()),
+            Some("n64-i1")
+        );
+        assert_eq!(
+            tune_pick(&table, 0.02).map(|e| e.knobs.as_str()),
+            Some("m32-r3")
+        );
+        assert_eq!(
+            tune_pick(&table, 0.01).map(|e| e.knobs.as_str()),
+            Some("n256-i1")
+        );
+        assert_eq!(tune_pick(&table, 0.001), None);
+        assert_eq!(
+            scatter_gen_command(&table[2], LightKind::Spot),
+            "scatter-gen --family prefiltered --bases 32 --regions 3 --light spot --out shaders/"
+        );
+        assert_eq!(
+            scatter_gen_command(&table[1], LightKind::Directional),
+            "scatter-gen --family raymarch --samples 64 --interleave 1 --light directional --out shaders/"
+        );
+    }
+}
