@@ -24,6 +24,7 @@ use crate::prefiltered::{
     DEPTH_FORMAT, DEPTH_NAMES, FrameInput, OUTPUT_FORMAT, Pipeline, Readback, SHADOW_NAMES,
     buffer_entry, check_view, check_workgroup, create_pipeline, decode_rgba, groups, view_entry,
 };
+use crate::timer::median_pass_wall_times;
 use crate::{Context, GpuTimer, RuntimeError};
 
 const RECTIFY: Kernel = Kernel::Rectify;
@@ -365,29 +366,11 @@ impl Minmax {
         shadow_map: &wgpu::TextureView,
         frames: u32,
     ) -> Result<MinmaxTimes, RuntimeError> {
-        let mut samples: [Vec<Duration>; 3] = Default::default();
-        for frame in 0..=frames.max(1) {
-            for (slot, kernel) in [RECTIFY, BUILD, MARCH].into_iter().enumerate() {
-                let mut encoder =
-                    ctx.device()
-                        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                            label: Some(kernel.name()),
-                        });
-                self.encode_selected(ctx, &mut encoder, depth, shadow_map, Some(kernel))?;
-                let start = Instant::now();
-                ctx.queue().submit([encoder.finish()]);
-                ctx.device()
-                    .poll(wgpu::PollType::wait_indefinitely())
-                    .map_err(|source| RuntimeError::Poll { kernel, source })?;
-                if frame > 0 {
-                    samples[slot].push(start.elapsed());
-                }
-            }
-        }
-        let [rectify, build, march] = samples.map(|mut v| {
-            v.sort();
-            v.get(v.len() / 2).copied().unwrap_or_default()
-        });
+        let [rectify, build, march] =
+            median_pass_wall_times(ctx, [RECTIFY, BUILD, MARCH], frames, |encoder, kernel| {
+                self.encode_selected(ctx, encoder, depth, shadow_map, Some(kernel))
+                    .map(|_| ())
+            })?;
         Ok(MinmaxTimes {
             rectify,
             build,

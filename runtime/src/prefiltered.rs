@@ -26,7 +26,7 @@ use scatter_shaderlib::prefiltered::{
 use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams};
 
 use crate::error::{ErrorScopes, check_limit};
-use crate::timer::read_buffer;
+use crate::timer::{median_pass_wall_times, read_buffer};
 use crate::{Context, GpuTimer, RuntimeError};
 
 const RECTIFY: Kernel = Kernel::Rectify;
@@ -578,29 +578,12 @@ impl Scatter {
         inputs: &Inputs<'_>,
         frames: u32,
     ) -> Result<PassTimes, RuntimeError> {
-        let mut samples: [Vec<Duration>; 3] = Default::default();
-        for frame in 0..=frames.max(1) {
-            for (slot, kernel) in [RECTIFY, PREFILTER, SCATTER].into_iter().enumerate() {
-                let mut encoder =
-                    self.device
-                        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                            label: Some(kernel.name()),
-                        });
-                self.encode_pass(&mut encoder, inputs, kernel)?;
-                let start = Instant::now();
-                ctx.queue().submit([encoder.finish()]);
-                ctx.device()
-                    .poll(wgpu::PollType::wait_indefinitely())
-                    .map_err(|source| RuntimeError::Poll { kernel, source })?;
-                if frame > 0 {
-                    samples[slot].push(start.elapsed());
-                }
-            }
-        }
-        let [rectify, prefilter, scatter] = samples.map(|mut v| {
-            v.sort();
-            v[v.len() / 2]
-        });
+        let [rectify, prefilter, scatter] = median_pass_wall_times(
+            ctx,
+            [RECTIFY, PREFILTER, SCATTER],
+            frames,
+            |encoder, kernel| self.encode_pass(encoder, inputs, kernel),
+        )?;
         Ok(PassTimes {
             rectify,
             prefilter,

@@ -20,6 +20,7 @@ use crate::prefiltered::{
     DEPTH_FORMAT, DEPTH_NAMES, OUTPUT_FORMAT, Pipeline, Readback, SHADOW_NAMES, buffer_entry,
     check_view, check_workgroup, create_pipeline, decode_rgba, groups, view_entry,
 };
+use crate::timer::median_pass_wall_times;
 use crate::{Context, GpuTimer, RuntimeError};
 
 const RAYMARCH: Kernel = Kernel::Raymarch;
@@ -309,35 +310,23 @@ impl Raymarch {
         shadow_map: &wgpu::TextureView,
         frames: u32,
     ) -> Result<MarchTimes, RuntimeError> {
-        let mut samples: [Vec<Duration>; 2] = Default::default();
-        for frame in 0..=frames.max(1) {
-            for (slot, kernel) in [RAYMARCH, INTERLEAVE_SUM].into_iter().enumerate() {
-                if kernel == INTERLEAVE_SUM && self.interleave_sum.is_none() {
-                    continue;
-                }
-                let mut encoder =
-                    ctx.device()
-                        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                            label: Some(kernel.name()),
-                        });
-                self.encode_selected(ctx, &mut encoder, depth, shadow_map, Some(kernel))?;
-                let start = Instant::now();
-                ctx.queue().submit([encoder.finish()]);
-                ctx.device()
-                    .poll(wgpu::PollType::wait_indefinitely())
-                    .map_err(|source| RuntimeError::Poll { kernel, source })?;
-                if frame > 0 {
-                    samples[slot].push(start.elapsed());
-                }
-            }
-        }
-        let [raymarch, interleave_sum] = samples.map(|mut v| {
-            v.sort();
-            v.get(v.len() / 2).copied().unwrap_or_default()
-        });
+        // Without interleaving there is no `interleave_sum` pass: its slot records nothing.
+        let [raymarch, interleave_sum] = median_pass_wall_times(
+            ctx,
+            [RAYMARCH, INTERLEAVE_SUM],
+            frames,
+            |encoder, kernel| {
+                self.encode_selected(ctx, encoder, depth, shadow_map, Some(kernel))
+                    .map(|_| ())
+            },
+        )?;
         Ok(MarchTimes {
             raymarch,
-            interleave_sum,
+            interleave_sum: if self.interleave_sum.is_some() {
+                interleave_sum
+            } else {
+                Duration::ZERO
+            },
         })
     }
 

@@ -171,3 +171,38 @@ pub(crate) fn read_buffer(
     buffer.unmap();
     Ok(bytes)
 }
+
+/// Wall time of each of `kernels` submitted on its own and waited for, the median over
+/// `frames` frames after one warm-up frame. `encode` records one kernel's pass (and may
+/// record nothing, e.g. a pass the frame skips). On a CPU adapter such as lavapipe this is
+/// the pass's real cost; its timestamps are not.
+pub(crate) fn median_pass_wall_times<const N: usize>(
+    ctx: &Context,
+    kernels: [Kernel; N],
+    frames: u32,
+    mut encode: impl FnMut(&mut wgpu::CommandEncoder, Kernel) -> Result<(), RuntimeError>,
+) -> Result<[Duration; N], RuntimeError> {
+    let mut samples: [Vec<Duration>; N] = std::array::from_fn(|_| Vec::new());
+    for frame in 0..=frames.max(1) {
+        for (slot, &kernel) in kernels.iter().enumerate() {
+            let mut encoder =
+                ctx.device()
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some(kernel.name()),
+                    });
+            encode(&mut encoder, kernel)?;
+            let start = std::time::Instant::now();
+            ctx.queue().submit([encoder.finish()]);
+            ctx.device()
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|source| RuntimeError::Poll { kernel, source })?;
+            if frame > 0 {
+                samples[slot].push(start.elapsed());
+            }
+        }
+    }
+    Ok(samples.map(|mut v| {
+        v.sort();
+        v.get(v.len() / 2).copied().unwrap_or_default()
+    }))
+}
