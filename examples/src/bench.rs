@@ -19,6 +19,7 @@ use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::{Image, write_atomic, write_png_rgb8};
 use scatter_reference::metrics;
+use scatter_reference::scene::Scene;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::prefiltered::{FrameInput, Inputs};
@@ -28,6 +29,7 @@ use scatter_runtime::shaderlib::minmax::MinmaxVariant;
 use scatter_runtime::shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions, Variant};
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
+use scatter_runtime::wgpu::TextureView;
 use scatter_runtime::{Context, Minmax, Raymarch, Scatter};
 
 /// A method of one family with its knobs (the light is set per scene).
@@ -268,6 +270,13 @@ pub struct BenchResult {
 
 type BoxError = Box<dyn std::error::Error>;
 
+/// A run's output (rgba, row-major), its pass wall times and its GPU timestamps.
+type MethodRun = (
+    Vec<[f32; 4]>,
+    Vec<(&'static str, Duration)>,
+    Option<Duration>,
+);
+
 fn light_of(name: SceneName) -> LightKind {
     if name == SceneName::SpotGrate {
         LightKind::Spot
@@ -333,110 +342,17 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
         for &method in &config.methods {
             let method = method.with_light(light_of(name));
             bar.set_message(format!("{name}/{pose}: {}", method.id()));
-            let (output, passes, gpu_timestamps) = match method {
-                Method::Prefiltered(v) => {
-                    let res = Resolutions {
-                        screen: config.screen,
-                        rectified: config.rectified,
-                    };
-                    let mut pass = Scatter::new(ctx, &v, res, sm.size)?;
-                    pass.prepare(
-                        ctx,
-                        &FrameInput {
-                            camera: scene.camera_desc(),
-                            light: scene.light_desc(),
-                            medium: scene.medium_desc(),
-                            shadow_map: sm.desc(),
-                            settings: FrameSettings::for_screen(w, h),
-                        },
-                    )?;
-                    let inputs = Inputs {
-                        depth: &depth_view,
-                        shadow_map: Some(&shadow_view),
-                        rectified: None,
-                    };
-                    let mut encoder = ctx.device().create_command_encoder(&Default::default());
-                    pass.encode(&mut encoder, &inputs)?;
-                    ctx.queue().submit([encoder.finish()]);
-                    let ts = pass.pass_times(ctx)?.map(|t| t.total());
-                    let output = read_rgba16float(ctx, Kernel::Scatter, pass.output_texture())?;
-                    let t = pass.measure_pass_wall_times(ctx, &inputs, config.frames)?;
-                    (
-                        output,
-                        vec![
-                            ("rectify", t.rectify),
-                            ("prefilter", t.prefilter),
-                            ("scatter", t.scatter),
-                        ],
-                        ts,
-                    )
-                }
-                Method::Raymarch(v) => {
-                    let mut pass = Raymarch::new(ctx, &v, config.screen, sm.size)?;
-                    pass.prepare(
-                        ctx,
-                        &MarchInput {
-                            camera: scene.camera_desc(),
-                            light: scene.light_desc(),
-                            medium: scene.medium_desc(),
-                            shadow_map: sm.desc(),
-                        },
-                    )?;
-                    let mut encoder = ctx.device().create_command_encoder(&Default::default());
-                    pass.encode(ctx, &mut encoder, &depth_view, &shadow_view)?;
-                    ctx.queue().submit([encoder.finish()]);
-                    let ts = pass.pass_times(ctx)?.map(|t| t.total());
-                    let output = read_rgba16float(ctx, Kernel::Raymarch, pass.output_texture())?;
-                    let t = pass.measure_pass_wall_times(
-                        ctx,
-                        &depth_view,
-                        &shadow_view,
-                        config.frames,
-                    )?;
-                    let mut passes = vec![("raymarch", t.raymarch)];
-                    if v.interleaved() {
-                        passes.push(("interleave_sum", t.interleave_sum));
-                    }
-                    (output, passes, ts)
-                }
-                Method::Minmax(v) => {
-                    let res = Resolutions {
-                        screen: config.screen,
-                        rectified: config.rectified,
-                    };
-                    let mut pass = Minmax::new(ctx, &v, res, sm.size)?;
-                    pass.prepare(
-                        ctx,
-                        &FrameInput {
-                            camera: scene.camera_desc(),
-                            light: scene.light_desc(),
-                            medium: scene.medium_desc(),
-                            shadow_map: sm.desc(),
-                            settings: FrameSettings::for_screen(w, h),
-                        },
-                    )?;
-                    let mut encoder = ctx.device().create_command_encoder(&Default::default());
-                    pass.encode(ctx, &mut encoder, &depth_view, &shadow_view)?;
-                    ctx.queue().submit([encoder.finish()]);
-                    let ts = pass.pass_times(ctx)?.map(|t| t.total());
-                    let output = read_rgba16float(ctx, Kernel::MinmaxMarch, pass.output_texture())?;
-                    let t = pass.measure_pass_wall_times(
-                        ctx,
-                        &depth_view,
-                        &shadow_view,
-                        config.frames,
-                    )?;
-                    (
-                        output,
-                        vec![
-                            ("rectify", t.rectify),
-                            ("minmax_build", t.build),
-                            ("minmax_march", t.march),
-                        ],
-                        ts,
-                    )
-                }
-            };
+            let (output, passes, gpu_timestamps) = run_method(
+                ctx,
+                method,
+                &scene,
+                &sm,
+                &depth_view,
+                &shadow_view,
+                config.screen,
+                config.rectified,
+                config.frames,
+            )?;
             let image =
                 Image::from_pixels(w, h, output.iter().map(|c| [c[0], c[1], c[2]]).collect());
             let e = metrics::compare(&image, &exact)?;
@@ -479,6 +395,114 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
     })
 }
 
+/// Runs `method` once on a prepared scene (the engine's depth buffer `dv` and shadow map
+/// `sv` already uploaded): its output, the median wall time of each pass submitted alone
+/// over `frames` frames, and the GPU timestamps of one frame when the adapter has them.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "the scene's buffers and the sizes"
+)]
+fn run_method(
+    ctx: &Context,
+    method: Method,
+    scene: &Scene,
+    sm: &ShadowMap,
+    dv: &TextureView,
+    sv: &TextureView,
+    screen: [u32; 2],
+    rectified: [u32; 2],
+    frames: u32,
+) -> Result<MethodRun, BoxError> {
+    Ok(match method {
+        Method::Prefiltered(v) => {
+            let res = Resolutions { screen, rectified };
+            let mut pass = Scatter::new(ctx, &v, res, sm.size)?;
+            pass.prepare(
+                ctx,
+                &FrameInput {
+                    camera: scene.camera_desc(),
+                    light: scene.light_desc(),
+                    medium: scene.medium_desc(),
+                    shadow_map: sm.desc(),
+                    settings: FrameSettings::for_screen(screen[0], screen[1]),
+                },
+            )?;
+            let inputs = Inputs {
+                depth: dv,
+                shadow_map: Some(sv),
+                rectified: None,
+            };
+            let mut encoder = ctx.device().create_command_encoder(&Default::default());
+            pass.encode(&mut encoder, &inputs)?;
+            ctx.queue().submit([encoder.finish()]);
+            let ts = pass.pass_times(ctx)?.map(|t| t.total());
+            let output = read_rgba16float(ctx, Kernel::Scatter, pass.output_texture())?;
+            let t = pass.measure_pass_wall_times(ctx, &inputs, frames)?;
+            (
+                output,
+                vec![
+                    ("rectify", t.rectify),
+                    ("prefilter", t.prefilter),
+                    ("scatter", t.scatter),
+                ],
+                ts,
+            )
+        }
+        Method::Raymarch(v) => {
+            let mut pass = Raymarch::new(ctx, &v, screen, sm.size)?;
+            pass.prepare(
+                ctx,
+                &MarchInput {
+                    camera: scene.camera_desc(),
+                    light: scene.light_desc(),
+                    medium: scene.medium_desc(),
+                    shadow_map: sm.desc(),
+                },
+            )?;
+            let mut encoder = ctx.device().create_command_encoder(&Default::default());
+            pass.encode(ctx, &mut encoder, dv, sv)?;
+            ctx.queue().submit([encoder.finish()]);
+            let ts = pass.pass_times(ctx)?.map(|t| t.total());
+            let output = read_rgba16float(ctx, Kernel::Raymarch, pass.output_texture())?;
+            let t = pass.measure_pass_wall_times(ctx, dv, sv, frames)?;
+            let mut passes = vec![("raymarch", t.raymarch)];
+            if v.interleaved() {
+                passes.push(("interleave_sum", t.interleave_sum));
+            }
+            (output, passes, ts)
+        }
+        Method::Minmax(v) => {
+            let res = Resolutions { screen, rectified };
+            let mut pass = Minmax::new(ctx, &v, res, sm.size)?;
+            pass.prepare(
+                ctx,
+                &FrameInput {
+                    camera: scene.camera_desc(),
+                    light: scene.light_desc(),
+                    medium: scene.medium_desc(),
+                    shadow_map: sm.desc(),
+                    settings: FrameSettings::for_screen(screen[0], screen[1]),
+                },
+            )?;
+            let mut encoder = ctx.device().create_command_encoder(&Default::default());
+            pass.encode(ctx, &mut encoder, dv, sv)?;
+            ctx.queue().submit([encoder.finish()]);
+            let ts = pass.pass_times(ctx)?.map(|t| t.total());
+            let output = read_rgba16float(ctx, Kernel::MinmaxMarch, pass.output_texture())?;
+            let t = pass.measure_pass_wall_times(ctx, dv, sv, frames)?;
+            (
+                output,
+                vec![
+                    ("rectify", t.rectify),
+                    ("minmax_build", t.build),
+                    ("minmax_march", t.march),
+                ],
+                ts,
+            )
+        }
+    })
+}
+
 /// Times `method` (pass wall times) on `name/ordinary` at `screen` (prefiltered: with a
 /// `rectified` map).
 fn time_method(
@@ -517,72 +541,18 @@ fn time_method(
         depth.create_view(&Default::default()),
         shadow.create_view(&Default::default()),
     );
-    Ok(match method.with_light(light_of(name)) {
-        Method::Prefiltered(v) => {
-            let mut pass = Scatter::new(ctx, &v, Resolutions { screen, rectified }, sm.size)?;
-            pass.prepare(
-                ctx,
-                &FrameInput {
-                    camera: scene.camera_desc(),
-                    light: scene.light_desc(),
-                    medium: scene.medium_desc(),
-                    shadow_map: sm.desc(),
-                    settings: FrameSettings::for_screen(screen[0], screen[1]),
-                },
-            )?;
-            let t = pass.measure_pass_wall_times(
-                ctx,
-                &Inputs {
-                    depth: &dv,
-                    shadow_map: Some(&sv),
-                    rectified: None,
-                },
-                frames,
-            )?;
-            vec![
-                ("rectify", t.rectify),
-                ("prefilter", t.prefilter),
-                ("scatter", t.scatter),
-            ]
-        }
-        Method::Raymarch(v) => {
-            let mut pass = Raymarch::new(ctx, &v, screen, sm.size)?;
-            pass.prepare(
-                ctx,
-                &MarchInput {
-                    camera: scene.camera_desc(),
-                    light: scene.light_desc(),
-                    medium: scene.medium_desc(),
-                    shadow_map: sm.desc(),
-                },
-            )?;
-            let t = pass.measure_pass_wall_times(ctx, &dv, &sv, frames)?;
-            let mut passes = vec![("raymarch", t.raymarch)];
-            if v.interleaved() {
-                passes.push(("interleave_sum", t.interleave_sum));
-            }
-            passes
-        }
-        Method::Minmax(v) => {
-            let mut pass = Minmax::new(ctx, &v, Resolutions { screen, rectified }, sm.size)?;
-            pass.prepare(
-                ctx,
-                &FrameInput {
-                    camera: scene.camera_desc(),
-                    light: scene.light_desc(),
-                    medium: scene.medium_desc(),
-                    shadow_map: sm.desc(),
-                    settings: FrameSettings::for_screen(screen[0], screen[1]),
-                },
-            )?;
-            let t = pass.measure_pass_wall_times(ctx, &dv, &sv, frames)?;
-            vec![
-                ("rectify", t.rectify),
-                ("minmax_build", t.build),
-                ("minmax_march", t.march),
-            ]
-        }
-    })
+    let (_, passes, _) = run_method(
+        ctx,
+        method.with_light(light_of(name)),
+        &scene,
+        &sm,
+        &dv,
+        &sv,
+        screen,
+        rectified,
+        frames,
+    )?;
+    Ok(passes)
 }
 
 /// The headline configuration: 1280x720, 1024x1024 rectified, on sphere, foliage and

@@ -24,6 +24,7 @@ use crate::prefiltered::{
     DEPTH_FORMAT, DEPTH_NAMES, FrameInput, OUTPUT_FORMAT, Pipeline, Readback, SHADOW_NAMES,
     buffer_entry, check_view, check_workgroup, create_pipeline, decode_rgba, groups, view_entry,
 };
+use crate::textures::upload_r32float;
 use crate::timer::median_pass_wall_times;
 use crate::{Context, GpuTimer, RuntimeError};
 
@@ -542,38 +543,17 @@ pub fn run_minmax_once(
     }
     pass.prepare(ctx, input)?;
     let device = ctx.device();
-    let scope = ErrorScopes::push(device);
-    let upload = |label, [width, height]: [u32; 2], data: &[f32]| {
-        let size = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        ctx.queue().write_texture(
-            texture.as_image_copy(),
-            bytemuck::cast_slice(data),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(width * 4),
-                rows_per_image: Some(height),
-            },
-            size,
-        );
-        texture.create_view(&wgpu::TextureViewDescriptor::default())
-    };
-    let depth_view = upload("minmax depth (test upload)", res.screen, depth);
-    let shadow_view = upload("minmax shadow map (test upload)", [sm_size; 2], shadow_map);
-    scope.pop(MARCH, "uploading test inputs")?;
+    let depth_texture =
+        upload_r32float(ctx, MARCH, "minmax depth (test upload)", res.screen, depth)?;
+    let shadow_texture = upload_r32float(
+        ctx,
+        MARCH,
+        "minmax shadow map (test upload)",
+        [sm_size; 2],
+        shadow_map,
+    )?;
+    let depth_view = depth_texture.create_view(&wgpu::TextureViewDescriptor::default());
+    let shadow_view = shadow_texture.create_view(&wgpu::TextureViewDescriptor::default());
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
         label: Some("minmax run_once"),
     });
