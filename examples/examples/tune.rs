@@ -1,7 +1,10 @@
-//! `tune`: "model no more than a scene needs". Measures every candidate variant of every
-//! family (`scatter_examples::bench::tune_candidates`) on a scene's four poses and picks the
-//! cheapest whose worst rel L1 against the `shadow_map` truth meets the budget; prints the
-//! choice, its error and time, and the `scatter-gen` line that emits it.
+//! `tune`: "model no more than a scene needs". Measures a grid of variants of every family
+//! (`scatter_examples::bench::tune_candidates`: bases, regions, rectified size, ray-march
+//! samples and interleaving) on a scene's four poses, then the knobs the grid held fixed
+//! (bases per thread, storage, the next rectified sizes) around its Pareto front
+//! (`tune_refinements`), and picks the cheapest whose worst rel L1 against the `shadow_map`
+//! truth meets each budget; prints the choice, its error and time, and the `scatter-gen`
+//! line (plus the runtime's rectified size) that emits it.
 //!
 //! ```sh
 //! cargo run --release -p scatter-examples --example tune -- --scene foliage --max-error 0.02
@@ -11,7 +14,8 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use scatter_examples::bench::{
-    BenchConfig, run, scatter_gen_command, scene_light, tune_candidates, tune_pick, tune_table,
+    BenchConfig, pareto_entries, run, scatter_gen_command, tune_candidates, tune_pick,
+    tune_refinements, tune_table,
 };
 use scatter_reference::suite::{Pose, SceneName};
 use scatter_runtime::Context;
@@ -41,39 +45,57 @@ fn main() -> ExitCode {
     }
     let mut config = BenchConfig::default_sweep();
     config.cases = Pose::ALL.iter().map(|&p| (args.scene, p)).collect();
-    config.methods = tune_candidates();
+    config.rectified = [512, 512];
     config.scaling = false;
     config.headline = false;
-    let result = Context::new()
-        .map_err(|e| e.to_string())
-        .and_then(|ctx| run(&ctx, &config, true).map_err(|e| e.to_string()));
-    let result = match result {
+    let measure = |methods: Vec<scatter_examples::bench::Method>| -> Result<_, String> {
+        let config = BenchConfig {
+            methods,
+            ..config.clone()
+        };
+        let ctx = Context::new().map_err(|e| e.to_string())?;
+        run(&ctx, &config, true).map_err(|e| e.to_string())
+    };
+    // Stage 1: the grid; stage 2: the knobs it held fixed, around its Pareto front.
+    let first = match measure(tune_candidates()) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: {e}");
             return ExitCode::from(2);
         }
     };
-    let table = tune_table(&result.rows);
+    let refinements = tune_refinements(&tune_table(&first.rows), config.rectified);
+    let second = match measure(refinements) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let rows: Vec<_> = first.rows.iter().chain(&second.rows).cloned().collect();
+    let table = tune_table(&rows);
+    let front = pareto_entries(&table);
     println!(
-        "{}: {} candidates on {} poses ({}x{}, {} s)",
+        "{}: {} candidates ({} refinements) on {} poses ({}x{}, {} s)",
         args.scene,
         table.len(),
+        table.len() - tune_table(&first.rows).len(),
         config.cases.len(),
         config.screen[0],
         config.screen[1],
-        result.elapsed.as_secs()
+        (first.elapsed + second.elapsed).as_secs()
     );
     for e in &table {
+        let on_front = front.iter().any(|f| std::ptr::eq(*f, e));
         println!(
-            "  {:<12} {:<8} worst rel L1 {:>7.3} %  mean {:>8.2} ms",
+            "  {:<12} {:<28} worst rel L1 {:>7.3} %  mean {:>8.2} ms{}",
             e.family,
             e.knobs,
             100.0 * e.worst_error,
-            e.mean_ms
+            e.mean_ms,
+            if on_front { "  (Pareto)" } else { "" }
         );
     }
-    let light = scene_light(args.scene);
     for budget in &args.max_error {
         match tune_pick(&table, *budget) {
             Some(e) => println!(
@@ -83,7 +105,7 @@ fn main() -> ExitCode {
                 e.knobs,
                 100.0 * e.worst_error,
                 e.mean_ms,
-                scatter_gen_command(e, light)
+                scatter_gen_command(&e.method, config.rectified)
             ),
             None => println!(
                 "budget {:.1} %: no candidate meets it (best worst-pose error {:.3} %)",

@@ -26,7 +26,9 @@ use scatter_runtime::prefiltered::{FrameInput, Inputs};
 use scatter_runtime::raymarch::MarchInput;
 use scatter_runtime::shaderlib::Kernel;
 use scatter_runtime::shaderlib::minmax::MinmaxVariant;
-use scatter_runtime::shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions, Variant};
+use scatter_runtime::shaderlib::prefiltered::{
+    FrameSettings, LightKind, Resolutions, Storage, Variant,
+};
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::wgpu::TextureView;
@@ -35,47 +37,81 @@ use scatter_runtime::{Context, Minmax, Raymarch, Scatter};
 /// A method of one family with its knobs (the light is set per scene).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
-    /// The prefiltered family.
-    Prefiltered(Variant),
+    /// The prefiltered family, with its rectified map when it differs from the run's
+    /// (`BenchConfig::rectified`).
+    Prefiltered(Variant, Option<[u32; 2]>),
     /// The raymarch family.
     Raymarch(RaymarchVariant),
-    /// The minmax family.
-    Minmax(MinmaxVariant),
+    /// The minmax family, with its rectified map when it differs from the run's.
+    Minmax(MinmaxVariant, Option<[u32; 2]>),
 }
 
 impl Method {
     /// The family's name.
     pub fn family(&self) -> &'static str {
         match self {
-            Self::Prefiltered(_) => "prefiltered",
+            Self::Prefiltered(..) => "prefiltered",
             Self::Raymarch(_) => "raymarch",
-            Self::Minmax(_) => "minmax",
+            Self::Minmax(..) => "minmax",
         }
     }
 
     /// The variant id (light included).
     pub fn id(&self) -> String {
         match self {
-            Self::Prefiltered(v) => v.id(),
+            Self::Prefiltered(v, _) => v.id(),
             Self::Raymarch(v) => v.id(),
-            Self::Minmax(v) => v.id(),
+            Self::Minmax(v, _) => v.id(),
+        }
+    }
+
+    /// The prefiltered default (the paper's variant) at the run's rectified size.
+    pub fn prefiltered_default() -> Self {
+        Self::Prefiltered(Variant::default(), None)
+    }
+
+    /// The minmax default at the run's rectified size.
+    pub fn minmax_default() -> Self {
+        Self::Minmax(MinmaxVariant::default(), None)
+    }
+
+    /// The rectified map this method runs with, given the run's (`None` for raymarch).
+    pub fn rectified(&self, run: [u32; 2]) -> Option<[u32; 2]> {
+        match self {
+            Self::Prefiltered(_, r) | Self::Minmax(_, r) => Some(r.unwrap_or(run)),
+            Self::Raymarch(_) => None,
         }
     }
 
     /// The variant id without the light (the chart's marker).
     pub fn knobs(&self) -> String {
         match self {
-            Self::Prefiltered(v) => format!("m{}-r{}", v.bases, v.regions),
+            Self::Prefiltered(v, r) => {
+                let mut k = format!("m{}-r{}", v.bases, v.regions);
+                if v.bases_per_thread != Variant::default().bases_per_thread {
+                    k += &format!("-t{}", v.bases_per_thread);
+                }
+                if v.storage != Variant::default().storage {
+                    k += &format!("-{}", v.storage);
+                }
+                if let Some([w, h]) = r {
+                    k += &format!("-{w}x{h}");
+                }
+                k
+            }
             Self::Raymarch(v) => format!("n{}-i{}", v.samples, v.interleave),
-            Self::Minmax(_) => "minmax".to_owned(),
+            Self::Minmax(_, r) => match r {
+                Some([w, h]) => format!("minmax-{w}x{h}"),
+                None => "minmax".to_owned(),
+            },
         }
     }
 
     fn with_light(self, light: LightKind) -> Self {
         match self {
-            Self::Prefiltered(v) => Self::Prefiltered(Variant { light, ..v }),
+            Self::Prefiltered(v, r) => Self::Prefiltered(Variant { light, ..v }, r),
             Self::Raymarch(v) => Self::Raymarch(RaymarchVariant { light, ..v }),
-            Self::Minmax(_) => Self::Minmax(MinmaxVariant { light }),
+            Self::Minmax(_, r) => Self::Minmax(MinmaxVariant { light }, r),
         }
     }
 }
@@ -117,11 +153,14 @@ impl BenchConfig {
         let mut methods: Vec<Method> = [(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)]
             .into_iter()
             .map(|(bases, regions)| {
-                Method::Prefiltered(Variant {
-                    bases,
-                    regions,
-                    ..Variant::default()
-                })
+                Method::Prefiltered(
+                    Variant {
+                        bases,
+                        regions,
+                        ..Variant::default()
+                    },
+                    None,
+                )
             })
             .collect();
         for (samples, interleave) in [
@@ -139,7 +178,7 @@ impl BenchConfig {
                 ..RaymarchVariant::default()
             }));
         }
-        methods.push(Method::Minmax(MinmaxVariant::default()));
+        methods.push(Method::minmax_default());
         BenchConfig {
             cases: SceneName::ALL
                 .iter()
@@ -165,7 +204,7 @@ impl BenchConfig {
                 (SceneName::Foliage, Pose::Ordinary),
             ],
             methods: vec![
-                Method::Prefiltered(Variant::default()),
+                Method::prefiltered_default(),
                 Method::Raymarch(RaymarchVariant {
                     samples: 32,
                     ..RaymarchVariant::default()
@@ -175,7 +214,7 @@ impl BenchConfig {
                     interleave: 4,
                     ..RaymarchVariant::default()
                 }),
-                Method::Minmax(MinmaxVariant::default()),
+                Method::minmax_default(),
             ],
             screen: [160, 90],
             rectified: [256, 256],
@@ -197,6 +236,8 @@ pub struct Row {
     pub variant: String,
     /// Variant knobs without the light.
     pub knobs: String,
+    /// The method (light set to the scene's).
+    pub method: Method,
     /// Scene.
     pub scene: SceneName,
     /// Pose.
@@ -361,6 +402,7 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
                 family: method.family(),
                 variant: method.id(),
                 knobs: method.knobs(),
+                method,
                 scene: name,
                 pose,
                 rel_l1_exact: e.rel_l1,
@@ -414,8 +456,11 @@ fn run_method(
     frames: u32,
 ) -> Result<MethodRun, BoxError> {
     Ok(match method {
-        Method::Prefiltered(v) => {
-            let res = Resolutions { screen, rectified };
+        Method::Prefiltered(v, r) => {
+            let res = Resolutions {
+                screen,
+                rectified: r.unwrap_or(rectified),
+            };
             let mut pass = Scatter::new(ctx, &v, res, sm.size)?;
             pass.prepare(
                 ctx,
@@ -471,8 +516,11 @@ fn run_method(
             }
             (output, passes, ts)
         }
-        Method::Minmax(v) => {
-            let res = Resolutions { screen, rectified };
+        Method::Minmax(v, r) => {
+            let res = Resolutions {
+                screen,
+                rectified: r.unwrap_or(rectified),
+            };
             let mut pass = Minmax::new(ctx, &v, res, sm.size)?;
             pass.prepare(
                 ctx,
@@ -559,8 +607,8 @@ fn time_method(
 /// terrain.
 fn headline_runs(ctx: &Context, frames: u32) -> Result<Vec<HeadlineRow>, BoxError> {
     let mut methods = vec![
-        Method::Prefiltered(Variant::default()),
-        Method::Minmax(MinmaxVariant::default()),
+        Method::prefiltered_default(),
+        Method::minmax_default(),
     ];
     for (samples, interleave) in [(64, 1), (128, 1), (64, 4)] {
         methods.push(Method::Raymarch(RaymarchVariant {
@@ -1139,17 +1187,24 @@ pub fn write_outputs(
     Ok(written)
 }
 
-/// The `tune` candidate grid: prefiltered (M, R) over {16, 32, 64} x {1, 3, 8}, raymarch
-/// N over {16, 32, 64, 128, 256, 512} plus interleaved (64, 4x4) and (256, 4x4), minmax.
+/// The `tune` first-stage grid: prefiltered (M, R) over {16, 32, 64} x {1, 3, 8} with a
+/// 512x512 and a 256x256 rectified map (the paper's 8 bases per thread, rgba8unorm),
+/// raymarch N over {16, 32, 64, 128, 256, 512} plus interleaved (64, 4x4) and (256, 4x4),
+/// minmax with both maps. Run it with `BenchConfig::rectified` = 512x512.
 pub fn tune_candidates() -> Vec<Method> {
     let mut out = Vec::new();
-    for bases in [16, 32, 64] {
-        for regions in [1, 3, 8] {
-            out.push(Method::Prefiltered(Variant {
-                bases,
-                regions,
-                ..Variant::default()
-            }));
+    for rectified in [None, Some([256, 256])] {
+        for bases in [16, 32, 64] {
+            for regions in [1, 3, 8] {
+                out.push(Method::Prefiltered(
+                    Variant {
+                        bases,
+                        regions,
+                        ..Variant::default()
+                    },
+                    rectified,
+                ));
+            }
         }
     }
     for (samples, interleave) in [
@@ -1168,8 +1223,103 @@ pub fn tune_candidates() -> Vec<Method> {
             ..RaymarchVariant::default()
         }));
     }
-    out.push(Method::Minmax(MinmaxVariant::default()));
+    out.push(Method::minmax_default());
+    out.push(Method::Minmax(MinmaxVariant::default(), Some([256, 256])));
     out
+}
+
+/// Rectified sizes the refinement steps through (square).
+const TUNE_RECTIFIED: [u32; 4] = [128, 256, 512, 1024];
+
+/// The `tune` second stage: around every prefiltered or minmax entry on its family's
+/// Pareto front in the first stage (mean time against worst error; per family, so that a
+/// family another dominates still gets its fixed knobs explored), the neighbours along the
+/// knobs the grid held fixed: every other bases-per-thread (a multiple of 4 dividing M), the other two
+/// storage formats, and the next smaller and larger square rectified map (128..1024).
+/// Knobs already measured are left out. `run` is the run's rectified map.
+pub fn tune_refinements(table: &[TuneEntry], run: [u32; 2]) -> Vec<Method> {
+    let front: Vec<&TuneEntry> = ["prefiltered", "minmax"]
+        .into_iter()
+        .flat_map(|family| {
+            let own: Vec<TuneEntry> = table
+                .iter()
+                .filter(|e| e.family == family)
+                .cloned()
+                .collect();
+            pareto_entries(&own)
+                .into_iter()
+                .filter_map(|f| table.iter().find(|e| e.family == f.family && e.knobs == f.knobs))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let mut out: Vec<Method> = Vec::new();
+    let mut push = |m: Method| {
+        let known = |k: &Method| k.knobs() == m.knobs() && k.family() == m.family();
+        if !out.iter().any(known) && !table.iter().any(|e| known(&e.method)) {
+            out.push(m);
+        }
+    };
+    let rect_steps = |r: [u32; 2]| -> Vec<[u32; 2]> {
+        let Some(i) = TUNE_RECTIFIED.iter().position(|&w| w == r[0] && r[0] == r[1]) else {
+            return Vec::new();
+        };
+        [i.checked_sub(1), Some(i + 1)]
+            .into_iter()
+            .flatten()
+            .filter_map(|j| TUNE_RECTIFIED.get(j).map(|&w| [w, w]))
+            .collect()
+    };
+    let rect_knob = |r: [u32; 2]| (r != run).then_some(r);
+    for e in front {
+        match e.method {
+            Method::Prefiltered(v, r) => {
+                let rect = r.unwrap_or(run);
+                for bpt in (4..=v.bases).step_by(4) {
+                    if bpt != v.bases_per_thread && v.bases.is_multiple_of(bpt) {
+                        push(Method::Prefiltered(
+                            Variant {
+                                bases_per_thread: bpt,
+                                ..v
+                            },
+                            r,
+                        ));
+                    }
+                }
+                for &storage in Storage::ALL {
+                    if storage != v.storage {
+                        push(Method::Prefiltered(Variant { storage, ..v }, r));
+                    }
+                }
+                for step in rect_steps(rect) {
+                    push(Method::Prefiltered(v, rect_knob(step)));
+                }
+            }
+            Method::Minmax(v, r) => {
+                for step in rect_steps(r.unwrap_or(run)) {
+                    push(Method::Minmax(v, rect_knob(step)));
+                }
+            }
+            Method::Raymarch(_) => {}
+        }
+    }
+    out
+}
+
+/// The entries on the Pareto front of (mean time, worst error), cheapest first.
+pub fn pareto_entries(table: &[TuneEntry]) -> Vec<&TuneEntry> {
+    let mut sorted: Vec<&TuneEntry> = table.iter().collect();
+    sorted.sort_by(|a, b| {
+        a.mean_ms
+            .total_cmp(&b.mean_ms)
+            .then(a.worst_error.total_cmp(&b.worst_error))
+    });
+    let mut front: Vec<&TuneEntry> = Vec::new();
+    for e in sorted {
+        if front.last().is_none_or(|l| e.worst_error < l.worst_error) {
+            front.push(e);
+        }
+    }
+    front
 }
 
 /// One `tune` candidate's measurements over a scene's poses.
@@ -1179,6 +1329,8 @@ pub struct TuneEntry {
     pub family: &'static str,
     /// Knobs without the light.
     pub knobs: String,
+    /// The method (with the scene's light).
+    pub method: Method,
     /// Worst rel L1 against the `shadow_map` truth over the poses.
     pub worst_error: f64,
     /// Mean time over the poses (ms).
@@ -1187,33 +1339,37 @@ pub struct TuneEntry {
 
 /// Per candidate: the worst error and the mean time over the runs of `rows`, sorted by time.
 pub fn tune_table(rows: &[Row]) -> Vec<TuneEntry> {
-    let mut out: Vec<TuneEntry> = Vec::new();
+    let mut out: Vec<(TuneEntry, usize)> = Vec::new();
     for r in rows {
         let t = ms(r.total());
         match out
             .iter_mut()
-            .find(|e| e.family == r.family && e.knobs == r.knobs)
+            .find(|(e, _)| e.family == r.family && e.knobs == r.knobs)
         {
-            Some(e) => {
+            Some((e, n)) => {
                 e.worst_error = e.worst_error.max(r.rel_l1_shadow_map);
                 e.mean_ms += t;
+                *n += 1;
             }
-            None => out.push(TuneEntry {
-                family: r.family,
-                knobs: r.knobs.clone(),
-                worst_error: r.rel_l1_shadow_map,
-                mean_ms: t,
-            }),
+            None => out.push((
+                TuneEntry {
+                    family: r.family,
+                    knobs: r.knobs.clone(),
+                    method: r.method,
+                    worst_error: r.rel_l1_shadow_map,
+                    mean_ms: t,
+                },
+                1,
+            )),
         }
     }
-    for e in &mut out {
-        let n = rows
-            .iter()
-            .filter(|r| r.family == e.family && r.knobs == e.knobs)
-            .count()
-            .max(1);
-        e.mean_ms /= n as f64;
-    }
+    let mut out: Vec<TuneEntry> = out
+        .into_iter()
+        .map(|(mut e, n)| {
+            e.mean_ms /= n as f64;
+            e
+        })
+        .collect();
     out.sort_by(|a, b| a.mean_ms.total_cmp(&b.mean_ms));
     out
 }
@@ -1226,26 +1382,33 @@ pub fn tune_pick(table: &[TuneEntry], budget: f64) -> Option<&TuneEntry> {
         .min_by(|a, b| a.mean_ms.total_cmp(&b.mean_ms))
 }
 
-/// The `scatter-gen` command line that emits a tune choice for a scene's light.
-pub fn scatter_gen_command(entry: &TuneEntry, light: LightKind) -> String {
-    let knobs = |prefix: char| -> Option<u32> {
-        entry
-            .knobs
-            .split('-')
-            .find_map(|k| k.strip_prefix(prefix).and_then(|v| v.parse().ok()))
-    };
-    match entry.family {
-        "prefiltered" => format!(
-            "scatter-gen --family prefiltered --bases {} --regions {} --light {light} --out shaders/",
-            knobs('m').unwrap_or(32),
-            knobs('r').unwrap_or(3)
+/// The `scatter-gen` command line that emits a tune choice (every knob spelled out, the
+/// light included), followed for the families with a rectified map by the size to give
+/// the runtime (`Resolutions::rectified`; it is not a shader knob). `run` is the run's
+/// rectified map.
+pub fn scatter_gen_command(method: &Method, run: [u32; 2]) -> String {
+    let rect = method
+        .rectified(run)
+        .map(|[w, h]| format!("  # runtime: rectified map {w}x{h}"))
+        .unwrap_or_default();
+    match method {
+        Method::Prefiltered(v, _) => format!(
+            "scatter-gen --family prefiltered --bases {} --bases-per-thread {} --regions {} --visibility {} --storage {} --rectification {} --light {} --out shaders/{rect}",
+            v.bases,
+            v.bases_per_thread,
+            v.regions,
+            v.visibility,
+            v.storage,
+            v.rectification,
+            v.light
         ),
-        "raymarch" => format!(
-            "scatter-gen --family raymarch --samples {} --interleave {} --light {light} --out shaders/",
-            knobs('n').unwrap_or(64),
-            knobs('i').unwrap_or(1)
+        Method::Raymarch(v) => format!(
+            "scatter-gen --family raymarch --samples {} --interleave {} --jitter {} --light {} --out shaders/",
+            v.samples, v.interleave, v.jitter, v.light
         ),
-        _ => format!("scatter-gen --family minmax --light {light} --out shaders/"),
+        Method::Minmax(v, _) => {
+            format!("scatter-gen --family minmax --light {} --out shaders/{rect}", v.light)
+        }
     }
 }
 
@@ -1258,22 +1421,37 @@ pub fn scene_light(name: SceneName) -> LightKind {
 mod tests {
     use super::*;
 
-    fn entry(family: &'static str, knobs: &str, worst_error: f64, mean_ms: f64) -> TuneEntry {
+    fn entry(method: Method, worst_error: f64, mean_ms: f64) -> TuneEntry {
         TuneEntry {
-            family,
-            knobs: knobs.into(),
+            family: method.family(),
+            knobs: method.knobs(),
+            method,
             worst_error,
             mean_ms,
         }
     }
 
+    fn march(samples: u32) -> Method {
+        Method::Raymarch(RaymarchVariant {
+            samples,
+            ..RaymarchVariant::default()
+        })
+    }
+
     #[test]
     fn tune_picks_the_cheapest_within_budget() {
+        let spot = Method::Prefiltered(
+            Variant {
+                light: LightKind::Spot,
+                ..Variant::default()
+            },
+            Some([256, 256]),
+        );
         let table = vec![
-            entry("raymarch", "n16-i1", 0.10, 5.0),
-            entry("raymarch", "n64-i1", 0.03, 20.0),
-            entry("prefiltered", "m32-r3", 0.019, 60.0),
-            entry("raymarch", "n256-i1", 0.006, 80.0),
+            entry(march(16), 0.10, 5.0),
+            entry(march(64), 0.03, 20.0),
+            entry(spot, 0.019, 60.0),
+            entry(march(256), 0.006, 80.0),
         ];
         assert_eq!(
             tune_pick(&table, 0.05).map(|e| e.knobs.as_str()),
@@ -1281,7 +1459,7 @@ mod tests {
         );
         assert_eq!(
             tune_pick(&table, 0.02).map(|e| e.knobs.as_str()),
-            Some("m32-r3")
+            Some("m32-r3-256x256")
         );
         assert_eq!(
             tune_pick(&table, 0.01).map(|e| e.knobs.as_str()),
@@ -1289,12 +1467,60 @@ mod tests {
         );
         assert_eq!(tune_pick(&table, 0.001), None);
         assert_eq!(
-            scatter_gen_command(&table[2], LightKind::Spot),
-            "scatter-gen --family prefiltered --bases 32 --regions 3 --light spot --out shaders/"
+            scatter_gen_command(&table[2].method, [512, 512]),
+            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 8 --regions 3 --visibility weighted --storage rgba8unorm --rectification epipolar --light spot --out shaders/  # runtime: rectified map 256x256"
         );
         assert_eq!(
-            scatter_gen_command(&table[1], LightKind::Directional),
-            "scatter-gen --family raymarch --samples 64 --interleave 1 --light directional --out shaders/"
+            scatter_gen_command(&table[1].method, [512, 512]),
+            "scatter-gen --family raymarch --samples 64 --interleave 1 --jitter false --light directional --out shaders/"
+        );
+    }
+
+    #[test]
+    fn refinements_step_the_fixed_knobs_around_the_front() {
+        let p = |bases, r| Method::Prefiltered(
+            Variant {
+                bases,
+                ..Variant::default()
+            },
+            r,
+        );
+        // m16 at 256^2 and m32 at 512^2 are on the prefiltered front (m32 despite the
+        // cheaper, better raymarch); m64 is dominated by m32.
+        let table = vec![
+            entry(p(16, Some([256, 256])), 0.05, 10.0),
+            entry(p(32, None), 0.02, 30.0),
+            entry(march(128), 0.01, 25.0),
+            entry(p(64, None), 0.025, 90.0),
+        ];
+        let knobs: Vec<String> = tune_refinements(&table, [512, 512])
+            .iter()
+            .map(Method::knobs)
+            .collect();
+        assert_eq!(
+            knobs,
+            [
+                "m16-r3-t4-256x256",
+                "m16-r3-t16-256x256",
+                "m16-r3-rgba16float-256x256",
+                "m16-r3-rgba32float-256x256",
+                "m16-r3-128x128",
+                "m16-r3", // 512x512 is the run's map
+                "m32-r3-t4",
+                "m32-r3-t16",
+                "m32-r3-t32",
+                "m32-r3-rgba16float",
+                "m32-r3-rgba32float",
+                "m32-r3-256x256",
+                "m32-r3-1024x1024",
+            ]
+        );
+        assert_eq!(
+            pareto_entries(&table)
+                .iter()
+                .map(|e| e.knobs.as_str())
+                .collect::<Vec<_>>(),
+            ["m16-r3-256x256", "n128-i1"]
         );
     }
 }

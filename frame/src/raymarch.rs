@@ -135,7 +135,7 @@ impl fmt::Display for RaymarchVariant {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct MarchUniforms {
-    /// Eye position; w unused.
+    /// Eye position; w = camera far (view depths are clamped to it).
     pub eye: [f32; 4],
     /// Camera forward; w = tan(fov_y / 2).
     pub cam_forward: [f32; 4],
@@ -205,7 +205,7 @@ pub fn prepare_march(
     let cam = sc.cam;
     let m = variant.interleave;
     Ok(MarchUniforms {
-        eye: v4(cam.position, 0.0),
+        eye: v4(cam.position, cam.far),
         cam_forward: v4(cam.forward, cam.tan_half_fov_y),
         cam_right: v4(cam.right, f64::from(screen[0]) / f64::from(screen[1])),
         cam_up: v4(cam.up, cam.near),

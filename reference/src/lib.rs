@@ -3,6 +3,8 @@
 //! - [`scene`]: the serde scene description (camera, light, medium, geometry) with validation;
 //! - [`suite`]: the named scene suite (`sphere`, `columns`, `window`, `foliage`, `terrain`,
 //!   `spot_grate`), its camera poses and medium presets;
+//! - [`stress`]: the stress configurations where methods break (issue 6);
+//! - [`paths`]: 60-frame camera paths and light rotations for the flicker measurements;
 //! - [`geometry`] and [`bvh`]: primitives and a binned-SAH bounding volume hierarchy;
 //! - [`buffers`]: the inputs every method gets: the camera depth buffer and a standard light
 //!   shadow map, both produced by ray casting (standing in for an engine's rasteriser);
@@ -24,7 +26,9 @@ pub mod image;
 pub mod kernels;
 pub mod metrics;
 pub mod model;
+pub mod paths;
 pub mod projective;
 pub mod scene;
+pub mod stress;
 pub mod suite;
 pub mod truth;

@@ -24,7 +24,7 @@
 //
 // Mirrors reference/src/kernels/minmax_march.rs
 
-#import scatter::model::{GL4_W, GL4_X, PI, phase_hg, spot_integrand, transmittance_between}
+#import scatter::model::{PI, phase_hg, spot_integrand, spot_span, transmittance_between}
 #import scatter::prefiltered::{Frame, normalised_depth, slice_params, sm_visibility}
 #import scatter::minmax::{level_offset, tree_levels}
 
@@ -96,19 +96,9 @@ fn ray_t(f: Frame, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
     }
 }
 
-// Unshadowed spot in-scattering over `[a, b]` of the ray: `panels` 4-point Gauss-Legendre
-// panels.
+// Unshadowed spot in-scattering over `[a, b]` of the ray (`scatter::model::spot_span`).
 fn spot_segment(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, panels: u32) -> f32 {
-    let h = (b - a) / f32(panels);
-    var sum = 0.0;
-    for (var k = 0u; k < panels; k++) {
-        let mid = a + (f32(k) + 0.5) * h;
-        for (var q = 0u; q < 4u; q++) {
-            let t = mid + 0.5 * h * GL4_X[q];
-            sum += GL4_W[q] * frame_spot_integrand(f, eye, dir, t);
-        }
-    }
-    return sum * 0.5 * h;
+    return spot_span(eye, dir, a, b, panels, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
 }
 
 // Ray distance of column edge `x` of a ray that crosses texels 0 .. n: the last texel's
@@ -139,7 +129,8 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     let spot = {{ spot }};
     let eye = f.eye.xyz;
     let dir = pixel_dir(f, x, y);
-    let s = max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0) / max(dot(dir, f.cam_forward.xyz), 1e-6);
+    // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
+    let s = min(max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0), f.theta.z) / max(dot(dir, f.cam_forward.xyz), 1e-6);
     let color = f.light_color.xyz;
 
     // Near the epipole and the anti-epipole the rectification degenerates: march instead.

@@ -44,7 +44,8 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
     let spot = {{ spot }};
     let eye = m.eye.xyz;
     let dir = march_pixel_dir(m, x, y);
-    let s = max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0) / max(dot(dir, m.cam_forward.xyz), 1e-6);
+    // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
+    let s = min(max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0), m.eye.w) / max(dot(dir, m.cam_forward.xyz), 1e-6);
     let n = m.sizes[3];
     let h = s / f32(n);
     let mx = m.interleave[0];

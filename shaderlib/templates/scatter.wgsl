@@ -35,7 +35,7 @@
 //
 // Mirrors reference/src/kernels/scatter.rs
 
-#import scatter::model::{GL4_W, GL4_X, PI, phase_hg, spot_integrand, transmittance_between, transmittance_integral}
+#import scatter::model::{PI, phase_hg, spot_integrand, spot_span, transmittance_between, transmittance_integral}
 #import scatter::prefiltered::{Frame, coeff4, normalised_depth, region_start, slice_params, sm_visibility{% if projective %}, proj_boundary, proj_column, proj_ray_depth, proj_reach{% endif %}}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -111,7 +111,8 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     let weighted = {{ weighted }};
     let eye = f.eye.xyz;
     let dir = pixel_dir(f, x, y);
-    let s = max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0) / max(dot(dir, f.cam_forward.xyz), 1e-6);
+    // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
+    let s = min(max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0), f.theta.z) / max(dot(dir, f.cam_forward.xyz), 1e-6);
     let color = f.light_color.xyz;
 
     // Near the epipole and the anti-epipole the rectification degenerates: march instead.
@@ -218,7 +219,10 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     let cos_theta_l = -dot(f.light_dir.xyz, dir);
-    let panels = max(f.sizes2_[2] / 4u / count, 1u);
+    // Every region gets the full spot quadrature: its weight must be as accurate as the
+    // whole ray's (dividing the panels among the regions cost 2.5 % rel L1 on a thick-fog
+    // grazing spot, spot_grate/grazing/thick).
+    let panels = max(f.sizes2_[2] / 4u, 1u);
     // The ray's Fourier coefficients depend on its depth only: once per pixel, not per
     // region (they cost four sin/cos per layer).
     var coeffs: array<vec4<f32>, LAYERS>;
@@ -280,18 +284,7 @@ fn ray_t(f: Frame, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
     }
 }
 
-// Unshadowed spot in-scattering over `[a, b]` of the ray: `panels` 4-point Gauss-Legendre
-// panels.
+// Unshadowed spot in-scattering over `[a, b]` of the ray (`scatter::model::spot_span`).
 fn spot_segment(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, panels: u32) -> f32 {
-    let h = (b - a) / f32(panels);
-    var sum = 0.0;
-    for (var k = 0u; k < panels; k++) {
-        let mid = a + (f32(k) + 0.5) * h;
-        for (var q = 0u; q < 4u; q++) {
-            let t = mid + 0.5 * h * GL4_X[q];
-            sum += GL4_W[q]
-                * frame_spot_integrand(f, eye, dir, t);
-        }
-    }
-    return sum * 0.5 * h;
+    return spot_span(eye, dir, a, b, panels, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
 }

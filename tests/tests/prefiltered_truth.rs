@@ -79,18 +79,6 @@ const EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
         10.5,
         "Fourier ringing (64 bases: 6.10 %)",
     ),
-    (
-        "spot_grate/ordinary",
-        8.10,
-        9.0,
-        "reference-ray weighting of 1/d^2 (8 regions: 2.08 %)",
-    ),
-    (
-        "spot_grate/epipole_on_screen",
-        7.22,
-        8.0,
-        "reference-ray weighting of 1/d^2 (8 regions: 4.29 %)",
-    ),
 ];
 
 /// Projective frames of the default variant (rectification = projective) that miss the bar:
@@ -107,12 +95,6 @@ const PROJECTIVE_EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
         7.49,
         8.3,
         "Fourier ringing, as epipolar (9.48 %)",
-    ),
-    (
-        "spot_grate/grazing",
-        7.38,
-        8.2,
-        "reference-ray weighting of 1/d^2 (8 regions: 1.10 %; epipolar 4.51 %, 8 regions 0.83 %)",
     ),
 ];
 

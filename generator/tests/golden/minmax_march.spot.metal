@@ -51,15 +51,15 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float theta_lo;
     float theta_hi;
 };
-struct type_8 {
+struct type_9 {
     float inner[4];
 };
 typedef metal::float4 type_10[1];
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.1;
-constant type_8 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_8 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
-constant type_8 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_8 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
+constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
+constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
@@ -205,18 +205,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir_5 = metal::float3(metal::dot(l_1, v_5.right.xyz), metal::dot(l_1, v_5.up.xyz), metal::dot(l_1, v_5.forward.xyz));
-        if (dir_5.z <= 0.000001) {
+        metal::float3 dir_6 = metal::float3(metal::dot(l_1, v_5.right.xyz), metal::dot(l_1, v_5.up.xyz), metal::dot(l_1, v_5.forward.xyz));
+        if (dir_6.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_5);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return (z_2 + _e35) / dir_5.z;
+        return (z_2 + _e35) / dir_6.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -287,6 +287,74 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t))) / d2_;
 }
 
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye_1,
+    metal::float3 dir_1,
+    float a_1,
+    float b_1,
+    uint panels,
+    metal::float3 light_pos_1,
+    metal::float3 light_dir_1,
+    float cos_inner_2,
+    float cos_outer_2,
+    metal::float4 medium_1
+) {
+    float sum = 0.0;
+    uint k_1 = 0u;
+    uint q = {};
+    float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
+    float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
+    float g0_ = metal::atan((a_1 - t0_) / h);
+    float w = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
+    uint2 loop_bound = uint2(4294967295u);
+    bool loop_init = true;
+    while(true) {
+        if (metal::all(loop_bound == uint2(0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e73 = k_1;
+            k_1 = _e73 + 1u;
+        }
+        loop_init = false;
+        uint _e30 = k_1;
+        if (_e30 < panels) {
+        } else {
+            break;
+        }
+        {
+            uint _e32 = k_1;
+            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w);
+            q = 0u;
+            uint2 loop_bound_1 = uint2(4294967295u);
+            bool loop_init_1 = true;
+            while(true) {
+                if (metal::all(loop_bound_1 == uint2(0u))) { break; }
+                loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+                if (!loop_init_1) {
+                    uint _e70 = q;
+                    q = _e70 + 1u;
+                }
+                loop_init_1 = false;
+                uint _e40 = q;
+                if (_e40 < 4u) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e46 = q;
+                    float u = metal::tan(mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float _e52 = sum;
+                    uint _e54 = q;
+                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                }
+            }
+        }
+    }
+    float _e75 = sum;
+    return ((_e75 * 0.5) * w) * h;
+}
+
 uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
     uint level,
     uint width
@@ -297,23 +365,23 @@ uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
 uint tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
     uint width_1
 ) {
-    uint k_1 = 0u;
-    uint2 loop_bound = uint2(4294967295u);
+    uint k_2 = 0u;
+    uint2 loop_bound_2 = uint2(4294967295u);
     while(true) {
-        if (metal::all(loop_bound == uint2(0u))) { break; }
-        loop_bound -= uint2(loop_bound.y == 0u, 1u);
-        uint _e2 = k_1;
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        uint _e2 = k_2;
         uint _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
         if (_e4 > 1u) {
         } else {
             break;
         }
         {
-            uint _e8 = k_1;
-            k_1 = _e8 + 1u;
+            uint _e8 = k_2;
+            k_2 = _e8 + 1u;
         }
     }
-    uint _e10 = k_1;
+    uint _e10 = k_2;
     return _e10 + 1u;
 }
 
@@ -322,25 +390,25 @@ uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
     uint width_2
 ) {
     uint off = 0u;
-    uint k_2 = 0u;
-    uint2 loop_bound_1 = uint2(4294967295u);
-    bool loop_init = true;
+    uint k_3 = 0u;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_1 == uint2(0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init) {
-            uint _e12 = k_2;
-            k_2 = _e12 + 1u;
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e12 = k_3;
+            k_3 = _e12 + 1u;
         }
-        loop_init = false;
-        uint _e3 = k_2;
+        loop_init_2 = false;
+        uint _e3 = k_3;
         if (_e3 < level_1) {
         } else {
             break;
         }
         {
             uint _e6 = off;
-            uint _e7 = k_2;
+            uint _e7 = k_3;
             uint _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
             off = _e6 + _e9;
         }
@@ -362,65 +430,65 @@ metal::float3 pixel_dir(
 
 float frame_spot_integrand(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3,
-    metal::float3 eye_1,
-    metal::float3 dir_1,
+    metal::float3 eye_2,
+    metal::float3 dir_2,
     float t_1
 ) {
-    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
+    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
 float march(
-    metal::float3 eye_2,
-    metal::float3 dir_2,
+    metal::float3 eye_3,
+    metal::float3 dir_3,
     float s,
     bool spot,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX& frame,
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
-    float sum = 0.0;
-    uint k_3 = 0u;
+    float sum_1 = 0.0;
+    uint k_4 = 0u;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_8 = frame;
     uint steps = f_8.sizes2_.y;
-    float h = s / static_cast<float>(steps);
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_1 = true;
+    float h_1 = s / static_cast<float>(steps);
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_1) {
-            uint _e45 = k_3;
-            k_3 = _e45 + 1u;
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e45 = k_4;
+            k_4 = _e45 + 1u;
         }
-        loop_init_1 = false;
-        uint _e10 = k_3;
+        loop_init_3 = false;
+        uint _e10 = k_4;
         if (_e10 < steps) {
         } else {
             break;
         }
         {
-            uint _e12 = k_3;
-            float t_4 = (static_cast<float>(_e12) + 0.5) * h;
-            float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_8, shadow_map, eye_2 + (dir_2 * t_4));
+            uint _e12 = k_4;
+            float t_4 = (static_cast<float>(_e12) + 0.5) * h_1;
+            float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_8, shadow_map, eye_3 + (dir_3 * t_4));
             if (spot) {
-                float _e25 = sum;
-                float _e27 = frame_spot_integrand(f_8, eye_2, dir_2, t_4);
-                sum = _e25 + ((_e22 * h) * _e27);
+                float _e25 = sum_1;
+                float _e27 = frame_spot_integrand(f_8, eye_3, dir_3, t_4);
+                sum_1 = _e25 + ((_e22 * h_1) * _e27);
             } else {
-                float _e30 = sum;
-                uint _e33 = k_3;
-                uint _e36 = k_3;
-                float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, static_cast<float>(_e33) * h, static_cast<float>(_e36 + 1u) * h);
-                sum = _e30 + (_e22 * _e41);
+                float _e30 = sum_1;
+                uint _e33 = k_4;
+                uint _e36 = k_4;
+                float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, static_cast<float>(_e33) * h_1, static_cast<float>(_e36 + 1u) * h_1);
+                sum_1 = _e30 + (_e22 * _e41);
             }
         }
     }
     if (spot) {
-        float _e47 = sum;
+        float _e47 = sum_1;
         return _e47;
     } else {
-        float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.z, -(metal::dot(f_8.light_dir.xyz, dir_2)));
-        float _e58 = sum;
+        float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.z, -(metal::dot(f_8.light_dir.xyz, dir_3)));
+        float _e58 = sum_1;
         return (f_8.medium.y * _e56) * _e58;
     }
 }
@@ -476,63 +544,14 @@ float ray_t(
 
 float spot_segment(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5,
-    metal::float3 eye_3,
-    metal::float3 dir_3,
-    float a_1,
-    float b_1,
-    uint panels
+    metal::float3 eye_4,
+    metal::float3 dir_4,
+    float a_2,
+    float b_2,
+    uint panels_1
 ) {
-    float sum_1 = 0.0;
-    uint k_4 = 0u;
-    uint q = {};
-    float h_1 = (b_1 - a_1) / static_cast<float>(panels);
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e44 = k_4;
-            k_4 = _e44 + 1u;
-        }
-        loop_init_2 = false;
-        uint _e9 = k_4;
-        if (_e9 < panels) {
-        } else {
-            break;
-        }
-        {
-            uint _e11 = k_4;
-            float mid = a_1 + ((static_cast<float>(_e11) + 0.5) * h_1);
-            q = 0u;
-            uint2 loop_bound_4 = uint2(4294967295u);
-            bool loop_init_3 = true;
-            while(true) {
-                if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-                if (!loop_init_3) {
-                    uint _e41 = q;
-                    q = _e41 + 1u;
-                }
-                loop_init_3 = false;
-                uint _e19 = q;
-                if (_e19 < 4u) {
-                } else {
-                    break;
-                }
-                {
-                    uint _e25 = q;
-                    float t_5 = mid + ((0.5 * h_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e25), 3u)]);
-                    float _e30 = sum_1;
-                    uint _e32 = q;
-                    float _e37 = frame_spot_integrand(f_5, eye_3, dir_3, t_5);
-                    sum_1 = _e30 + (GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e32), 3u)] * _e37);
-                }
-            }
-        }
-    }
-    float _e46 = sum_1;
-    return (_e46 * 0.5) * h_1;
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_5.light_pos.xyz, f_5.light_dir.xyz, f_5.light_pos.w, f_5.light_dir.w, f_5.medium);
+    return _e15;
 }
 
 float edge_t(
@@ -557,17 +576,17 @@ uint naga_div(uint lhs, uint rhs) {
 
 float lit_span(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7,
-    metal::float3 eye_4,
-    metal::float3 dir_4,
-    float a_2,
-    float b_2,
+    metal::float3 eye_5,
+    metal::float3 dir_5,
+    float a_3,
+    float b_3,
     bool spot_3
 ) {
     if (spot_3) {
-        float _e12 = spot_segment(f_7, eye_4, dir_4, a_2, b_2, metal::max(naga_div(f_7.sizes2_.z, 4u), 1u));
+        float _e12 = spot_segment(f_7, eye_5, dir_5, a_3, b_3, metal::max(naga_div(f_7.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_3, b_3);
     return _e15;
 }
 
@@ -611,11 +630,11 @@ kernel void minmax_march(
     if (_e18) {
         return;
     }
-    metal::float3 eye_5 = f_9.eye.xyz;
+    metal::float3 eye_6 = f_9.eye.xyz;
     metal::float3 _e21 = pixel_dir(f_9, x_7, y_2);
     uint clamped_lod_e25 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e25 = depth.read(metal::min(metal::uint2(metal::uint2(x_7, y_2)), metal::uint2(depth.get_width(clamped_lod_e25), depth.get_height(clamped_lod_e25)) - 1), clamped_lod_e25);
-    float s_3 = metal::max(_e25.x, 0.0) / metal::max(metal::dot(_e21, f_9.cam_forward.xyz), 0.000001);
+    float s_3 = metal::min(metal::max(_e25.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e21, f_9.cam_forward.xyz), 0.000001);
     metal::float3 color = f_9.light_color.xyz;
     metal::float3 px = metal::float3(static_cast<float>(x_7) + 0.5, static_cast<float>(y_2) + 0.5, 0.0);
     float radius = f_9.epipole.w;
@@ -636,10 +655,10 @@ kernel void minmax_march(
     } else {
         local_3 = true;
     }
-    bool _e85 = local_3;
-    if (_e85) {
-        float _e87 = march(eye_5, _e21, s_3, true, frame, shadow_map);
-        metal::float3 l_2 = _e87 * color;
+    bool _e88 = local_3;
+    if (_e88) {
+        float _e90 = march(eye_6, _e21, s_3, true, frame, shadow_map);
+        metal::float3 l_2 = _e90 * color;
         output.write(metal::float4(l_2.x, l_2.y, l_2.z, 1.0), metal::uint2(metal::uint2(x_7, y_2)));
         return;
     }
@@ -651,35 +670,35 @@ kernel void minmax_march(
     float phi = metal::atan2(metal::dot(_e21, f_9.e2_.xyz), metal::dot(_e21, f_9.e1_.xyz));
     yc = (phi - f_9.e1_.w) / f_9.e2_.w;
     if (wrap_1) {
-        float _e124 = yc;
-        float _e125 = yc;
-        yc = _e124 - (metal::floor(_e125 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+        float _e127 = yc;
+        float _e128 = yc;
+        yc = _e127 - (metal::floor(_e128 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
     } else {
-        float _e132 = yc;
-        yc = metal::clamp(_e132, 0.0, static_cast<float>(rows_1));
+        float _e135 = yc;
+        yc = metal::clamp(_e135, 0.0, static_cast<float>(rows_1));
     }
-    float _e136 = yc;
-    uint _e138 = row_index(metal::floor(_e136), rows_1, wrap_1);
-    metal::float4 _e141 = slices[metal::min(unsigned(_e138), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e142 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e141);
-    float delta_2 = _e142.delta;
-    float _e148 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_3, f_9.theta.x, f_9.theta.y);
+    float _e139 = yc;
+    uint _e141 = row_index(metal::floor(_e139), rows_1, wrap_1);
+    metal::float4 _e144 = slices[metal::min(unsigned(_e141), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e145 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e144);
+    float delta_2 = _e145.delta;
+    float _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_3, f_9.theta.x, f_9.theta.y);
     if (true) {
-        metal::float3 q_2 = metal::normalize((eye_5 + (_e21 * s_3)) - f_9.light_pos.xyz);
+        metal::float3 q_2 = metal::normalize((eye_6 + (_e21 * s_3)) - f_9.light_pos.xyz);
         xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / delta_2;
     } else {
         xs = (s_3 * metal::sin(theta_3)) / delta_2;
     }
-    float _e166 = xs;
-    float _e167 = xs;
-    uint n_2 = naga_f2u32(metal::min(metal::ceil((_e167 > 0.0) ? _e166 : 0.0), static_cast<float>(width_3)));
-    uint _e176 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
+    float _e169 = xs;
+    float _e170 = xs;
+    uint n_2 = naga_f2u32(metal::min(metal::ceil((_e170 > 0.0) ? _e169 : 0.0), static_cast<float>(width_3)));
+    uint _e179 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     uint2 loop_bound_5 = uint2(4294967295u);
     while(true) {
         if (metal::all(loop_bound_5 == uint2(0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        uint _e178 = i;
-        if (_e178 < n_2) {
+        uint _e181 = i;
+        if (_e181 < n_2) {
         } else {
             break;
         }
@@ -689,30 +708,30 @@ kernel void minmax_march(
             while(true) {
                 if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                 loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                uint _e182 = k;
-                if ((_e182 + 1u) < _e176) {
-                    uint _e186 = i;
-                    uint _e188 = k;
-                    local_4 = (_e186 & ((2u << _e188) - 1u)) == 0u;
+                uint _e185 = k;
+                if ((_e185 + 1u) < _e179) {
+                    uint _e189 = i;
+                    uint _e191 = k;
+                    local_4 = (_e189 & ((2u << _e191) - 1u)) == 0u;
                 } else {
                     local_4 = false;
                 }
-                bool _e198 = local_4;
-                if (_e198) {
-                    uint _e199 = i;
-                    uint _e201 = k;
-                    local_5 = (_e199 + (2u << _e201)) <= n_2;
+                bool _e201 = local_4;
+                if (_e201) {
+                    uint _e202 = i;
+                    uint _e204 = k;
+                    local_5 = (_e202 + (2u << _e204)) <= n_2;
                 } else {
                     local_5 = false;
                 }
-                bool _e208 = local_5;
-                if (_e208) {
+                bool _e211 = local_5;
+                if (_e211) {
                 } else {
                     break;
                 }
                 {
-                    uint _e210 = k;
-                    k = _e210 + 1u;
+                    uint _e213 = k;
+                    k = _e213 + 1u;
                 }
             }
             lit = false;
@@ -720,67 +739,67 @@ kernel void minmax_march(
             while(true) {
                 if (metal::all(loop_bound_7 == uint2(0u))) { break; }
                 loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-                uint _e214 = k;
-                uint _e215 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e214, width_3);
-                uint _e216 = i;
                 uint _e217 = k;
-                uint clamped_lod_e223 = metal::min(uint(0), tree.get_num_mip_levels() - 1);
-                metal::float4 node = tree.read(metal::min(metal::uint2(metal::uint2(_e215 + (_e216 >> _e217), _e138)), metal::uint2(tree.get_width(clamped_lod_e223), tree.get_height(clamped_lod_e223)) - 1), clamped_lod_e223);
-                if (_e148 <= node.x) {
+                uint _e218 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e217, width_3);
+                uint _e219 = i;
+                uint _e220 = k;
+                uint clamped_lod_e226 = metal::min(uint(0), tree.get_num_mip_levels() - 1);
+                metal::float4 node = tree.read(metal::min(metal::uint2(metal::uint2(_e218 + (_e219 >> _e220), _e141)), metal::uint2(tree.get_width(clamped_lod_e226), tree.get_height(clamped_lod_e226)) - 1), clamped_lod_e226);
+                if (_e151 <= node.x) {
                     lit = true;
                     break;
                 }
-                if (!((_e148 > node.y))) {
-                    uint _e230 = k;
-                    local_6 = _e230 == 0u;
+                if (!((_e151 > node.y))) {
+                    uint _e233 = k;
+                    local_6 = _e233 == 0u;
                 } else {
                     local_6 = true;
                 }
-                bool _e236 = local_6;
-                if (_e236) {
+                bool _e239 = local_6;
+                if (_e239) {
                     break;
                 }
-                uint _e238 = k;
-                k = _e238 - 1u;
+                uint _e241 = k;
+                k = _e241 - 1u;
             }
-            bool _e241 = lit;
-            bool _e242 = in_run;
-            if (_e241 != _e242) {
-                uint _e244 = i;
-                float _e245 = edge_t(f_9, _e244, n_2, delta_2, theta_3, s_3, true);
-                bool _e246 = lit;
-                if (_e246) {
-                    run_a = _e245;
+            bool _e244 = lit;
+            bool _e245 = in_run;
+            if (_e244 != _e245) {
+                uint _e247 = i;
+                float _e248 = edge_t(f_9, _e247, n_2, delta_2, theta_3, s_3, true);
+                bool _e249 = lit;
+                if (_e249) {
+                    run_a = _e248;
                 } else {
-                    float _e249 = total;
-                    float _e250 = run_a;
-                    float _e251 = lit_span(f_9, eye_5, _e21, _e250, _e245, true);
-                    total = _e249 + _e251;
+                    float _e252 = total;
+                    float _e253 = run_a;
+                    float _e254 = lit_span(f_9, eye_6, _e21, _e253, _e248, true);
+                    total = _e252 + _e254;
                 }
-                bool _e253 = lit;
-                in_run = _e253;
+                bool _e256 = lit;
+                in_run = _e256;
             }
-            uint _e254 = i;
-            uint _e256 = k;
-            i = _e254 + (1u << _e256);
+            uint _e257 = i;
+            uint _e259 = k;
+            i = _e257 + (1u << _e259);
         }
     }
-    bool _e259 = in_run;
-    if (_e259) {
-        float _e260 = total;
-        float _e261 = run_a;
-        float _e262 = lit_span(f_9, eye_5, _e21, _e261, s_3, true);
-        total = _e260 + _e262;
+    bool _e262 = in_run;
+    if (_e262) {
+        float _e263 = total;
+        float _e264 = run_a;
+        float _e265 = lit_span(f_9, eye_6, _e21, _e264, s_3, true);
+        total = _e263 + _e265;
     }
-    float _e264 = total;
-    l = _e264;
+    float _e267 = total;
+    l = _e267;
     if (!(true)) {
-        float _e275 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(metal::dot(f_9.light_dir.xyz, _e21)));
-        float _e277 = total;
-        l = (f_9.medium.y * _e275) * _e277;
+        float _e278 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(metal::dot(f_9.light_dir.xyz, _e21)));
+        float _e280 = total;
+        l = (f_9.medium.y * _e278) * _e280;
     }
-    float _e279 = l;
-    metal::float3 c = color * _e279;
+    float _e282 = l;
+    metal::float3 c = color * _e282;
     output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_7, y_2)));
     return;
 }

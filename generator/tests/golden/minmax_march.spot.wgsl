@@ -172,18 +172,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_5 = vec3<f32>(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
-        if (dir_5.z <= 0.000001f) {
+        let dir_6 = vec3<f32>(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
+        if (dir_6.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_5);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_5.z);
+        return ((z_2 + _e35) / dir_6.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -230,48 +230,96 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
 }
 
+fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
+    var sum: f32 = 0f;
+    var k_1: u32 = 0u;
+    var q: u32;
+
+    let t0_ = dot((light_pos_1 - eye_1), dir_1);
+    let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
+    let g0_ = atan(((a_1 - t0_) / h));
+    let w = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
+    loop {
+        let _e30 = k_1;
+        if (_e30 < panels) {
+        } else {
+            break;
+        }
+        {
+            let _e32 = k_1;
+            let mid = (g0_ + ((f32(_e32) + 0.5f) * w));
+            q = 0u;
+            loop {
+                let _e40 = q;
+                if (_e40 < 4u) {
+                } else {
+                    break;
+                }
+                {
+                    let _e46 = q;
+                    let u = tan((mid + ((0.5f * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    let _e52 = sum;
+                    let _e54 = q;
+                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u * u))));
+                }
+                continuing {
+                    let _e70 = q;
+                    q = (_e70 + 1u);
+                }
+            }
+        }
+        continuing {
+            let _e73 = k_1;
+            k_1 = (_e73 + 1u);
+        }
+    }
+    let _e75 = sum;
+    return (((_e75 * 0.5f) * w) * h);
+}
+
 fn level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level: u32, width: u32) -> u32 {
     return (((width + (1u << level)) - 1u) >> level);
 }
 
 fn tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_1: u32) -> u32 {
-    var k_1: u32 = 0u;
+    var k_2: u32 = 0u;
 
     loop {
-        let _e2 = k_1;
+        let _e2 = k_2;
         let _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
         if (_e4 > 1u) {
         } else {
             break;
         }
         {
-            let _e8 = k_1;
-            k_1 = (_e8 + 1u);
+            let _e8 = k_2;
+            k_2 = (_e8 + 1u);
         }
     }
-    let _e10 = k_1;
+    let _e10 = k_2;
     return (_e10 + 1u);
 }
 
 fn level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_1: u32, width_2: u32) -> u32 {
     var off: u32 = 0u;
-    var k_2: u32 = 0u;
+    var k_3: u32 = 0u;
 
     loop {
-        let _e3 = k_2;
+        let _e3 = k_3;
         if (_e3 < level_1) {
         } else {
             break;
         }
         {
             let _e6 = off;
-            let _e7 = k_2;
+            let _e7 = k_3;
             let _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
             off = (_e6 + _e9);
         }
         continuing {
-            let _e12 = k_2;
-            k_2 = (_e12 + 1u);
+            let _e12 = k_3;
+            k_3 = (_e12 + 1u);
         }
     }
     let _e14 = off;
@@ -285,51 +333,51 @@ fn pixel_dir(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x: u32
     return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc_x * t_3) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc_y * t_3))));
 }
 
-fn frame_spot_integrand(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_1: vec3<f32>, dir_1: vec3<f32>, t_1: f32) -> f32 {
-    let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
+fn frame_spot_integrand(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_2: vec3<f32>, dir_2: vec3<f32>, t_1: f32) -> f32 {
+    let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-fn march(eye_2: vec3<f32>, dir_2: vec3<f32>, s: f32, spot: bool) -> f32 {
-    var sum: f32 = 0f;
-    var k_3: u32 = 0u;
+fn march(eye_3: vec3<f32>, dir_3: vec3<f32>, s: f32, spot: bool) -> f32 {
+    var sum_1: f32 = 0f;
+    var k_4: u32 = 0u;
 
     let f_8 = frame;
     let steps = f_8.sizes2_.y;
-    let h = (s / f32(steps));
+    let h_1 = (s / f32(steps));
     loop {
-        let _e10 = k_3;
+        let _e10 = k_4;
         if (_e10 < steps) {
         } else {
             break;
         }
         {
-            let _e12 = k_3;
-            let t_4 = ((f32(_e12) + 0.5f) * h);
-            let _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_8, shadow_map, (eye_2 + (dir_2 * t_4)));
+            let _e12 = k_4;
+            let t_4 = ((f32(_e12) + 0.5f) * h_1);
+            let _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_8, shadow_map, (eye_3 + (dir_3 * t_4)));
             if spot {
-                let _e25 = sum;
-                let _e27 = frame_spot_integrand(f_8, eye_2, dir_2, t_4);
-                sum = (_e25 + ((_e22 * h) * _e27));
+                let _e25 = sum_1;
+                let _e27 = frame_spot_integrand(f_8, eye_3, dir_3, t_4);
+                sum_1 = (_e25 + ((_e22 * h_1) * _e27));
             } else {
-                let _e30 = sum;
-                let _e33 = k_3;
-                let _e36 = k_3;
-                let _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, (f32(_e33) * h), (f32((_e36 + 1u)) * h));
-                sum = (_e30 + (_e22 * _e41));
+                let _e30 = sum_1;
+                let _e33 = k_4;
+                let _e36 = k_4;
+                let _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, (f32(_e33) * h_1), (f32((_e36 + 1u)) * h_1));
+                sum_1 = (_e30 + (_e22 * _e41));
             }
         }
         continuing {
-            let _e45 = k_3;
-            k_3 = (_e45 + 1u);
+            let _e45 = k_4;
+            k_4 = (_e45 + 1u);
         }
     }
     if spot {
-        let _e47 = sum;
+        let _e47 = sum_1;
         return _e47;
     } else {
-        let _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.z, -(dot(f_8.light_dir.xyz, dir_2)));
-        let _e58 = sum;
+        let _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.z, -(dot(f_8.light_dir.xyz, dir_3)));
+        let _e58 = sum_1;
         return ((f_8.medium.y * _e56) * _e58);
     }
 }
@@ -364,49 +412,9 @@ fn ray_t(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_1: f32, 
     }
 }
 
-fn spot_segment(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_3: vec3<f32>, dir_3: vec3<f32>, a_1: f32, b_1: f32, panels: u32) -> f32 {
-    var sum_1: f32 = 0f;
-    var k_4: u32 = 0u;
-    var q: u32;
-
-    let h_1 = ((b_1 - a_1) / f32(panels));
-    loop {
-        let _e9 = k_4;
-        if (_e9 < panels) {
-        } else {
-            break;
-        }
-        {
-            let _e11 = k_4;
-            let mid = (a_1 + ((f32(_e11) + 0.5f) * h_1));
-            q = 0u;
-            loop {
-                let _e19 = q;
-                if (_e19 < 4u) {
-                } else {
-                    break;
-                }
-                {
-                    let _e25 = q;
-                    let t_5 = (mid + ((0.5f * h_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e25]));
-                    let _e30 = sum_1;
-                    let _e32 = q;
-                    let _e37 = frame_spot_integrand(f_5, eye_3, dir_3, t_5);
-                    sum_1 = (_e30 + (GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e32] * _e37));
-                }
-                continuing {
-                    let _e41 = q;
-                    q = (_e41 + 1u);
-                }
-            }
-        }
-        continuing {
-            let _e44 = k_4;
-            k_4 = (_e44 + 1u);
-        }
-    }
-    let _e46 = sum_1;
-    return ((_e46 * 0.5f) * h_1);
+fn spot_segment(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_4: vec3<f32>, dir_4: vec3<f32>, a_2: f32, b_2: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_5.light_pos.xyz, f_5.light_dir.xyz, f_5.light_pos.w, f_5.light_dir.w, f_5.medium);
+    return _e15;
 }
 
 fn edge_t(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_2: u32, n: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
@@ -417,12 +425,12 @@ fn edge_t(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_2: u32,
     return _e9;
 }
 
-fn lit_span(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_4: vec3<f32>, dir_4: vec3<f32>, a_2: f32, b_2: f32, spot_3: bool) -> f32 {
+fn lit_span(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, spot_3: bool) -> f32 {
     if spot_3 {
-        let _e12 = spot_segment(f_7, eye_4, dir_4, a_2, b_2, max((f_7.sizes2_.z / 4u), 1u));
+        let _e12 = spot_segment(f_7, eye_5, dir_5, a_3, b_3, max((f_7.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_3, b_3);
     return _e15;
 }
 
@@ -457,10 +465,10 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e18 {
         return;
     }
-    let eye_5 = f_9.eye.xyz;
+    let eye_6 = f_9.eye.xyz;
     let _e21 = pixel_dir(f_9, x_7, y_2);
     let _e25 = textureLoad(depth, vec2<u32>(x_7, y_2), 0i);
-    let s_3 = (max(_e25.x, 0f) / max(dot(_e21, f_9.cam_forward.xyz), 0.000001f));
+    let s_3 = (min(max(_e25.x, 0f), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 0.000001f));
     let color = f_9.light_color.xyz;
     let px = vec3<f32>((f32(x_7) + 0.5f), (f32(y_2) + 0.5f), 0f);
     let radius = f_9.epipole.w;
@@ -481,10 +489,10 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         local_3 = true;
     }
-    let _e85 = local_3;
-    if _e85 {
-        let _e87 = march(eye_5, _e21, s_3, true);
-        let l_2 = (_e87 * color);
+    let _e88 = local_3;
+    if _e88 {
+        let _e90 = march(eye_6, _e21, s_3, true);
+        let l_2 = (_e90 * color);
         textureStore(output, vec2<u32>(x_7, y_2), vec4<f32>(l_2.x, l_2.y, l_2.z, 1f));
         return;
     }
@@ -496,126 +504,126 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     let phi = atan2(dot(_e21, f_9.e2_.xyz), dot(_e21, f_9.e1_.xyz));
     yc = ((phi - f_9.e1_.w) / f_9.e2_.w);
     if wrap_1 {
-        let _e124 = yc;
-        let _e125 = yc;
-        yc = (_e124 - (floor((_e125 / f32(rows_1))) * f32(rows_1)));
+        let _e127 = yc;
+        let _e128 = yc;
+        yc = (_e127 - (floor((_e128 / f32(rows_1))) * f32(rows_1)));
     } else {
-        let _e132 = yc;
-        yc = clamp(_e132, 0f, f32(rows_1));
+        let _e135 = yc;
+        yc = clamp(_e135, 0f, f32(rows_1));
     }
-    let _e136 = yc;
-    let _e138 = row_index(floor(_e136), rows_1, wrap_1);
-    let _e141 = slices[_e138];
-    let _e142 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e141);
-    let delta_2 = _e142.delta;
-    let _e148 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_3, f_9.theta.x, f_9.theta.y);
+    let _e139 = yc;
+    let _e141 = row_index(floor(_e139), rows_1, wrap_1);
+    let _e144 = slices[_e141];
+    let _e145 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e144);
+    let delta_2 = _e145.delta;
+    let _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_3, f_9.theta.x, f_9.theta.y);
     if true {
-        let q_2 = normalize(((eye_5 + (_e21 * s_3)) - f_9.light_pos.xyz));
+        let q_2 = normalize(((eye_6 + (_e21 * s_3)) - f_9.light_pos.xyz));
         xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / delta_2);
     } else {
         xs = ((s_3 * sin(theta_3)) / delta_2);
     }
-    let _e166 = xs;
-    let _e167 = xs;
-    let n_2 = u32(min(ceil(select(0f, _e166, (_e167 > 0f))), f32(width_3)));
-    let _e176 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
+    let _e169 = xs;
+    let _e170 = xs;
+    let n_2 = u32(min(ceil(select(0f, _e169, (_e170 > 0f))), f32(width_3)));
+    let _e179 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     loop {
-        let _e178 = i;
-        if (_e178 < n_2) {
+        let _e181 = i;
+        if (_e181 < n_2) {
         } else {
             break;
         }
         {
             k = 0u;
             loop {
-                let _e182 = k;
-                if ((_e182 + 1u) < _e176) {
-                    let _e186 = i;
-                    let _e188 = k;
-                    local_4 = ((_e186 & ((2u << _e188) - 1u)) == 0u);
+                let _e185 = k;
+                if ((_e185 + 1u) < _e179) {
+                    let _e189 = i;
+                    let _e191 = k;
+                    local_4 = ((_e189 & ((2u << _e191) - 1u)) == 0u);
                 } else {
                     local_4 = false;
                 }
-                let _e198 = local_4;
-                if _e198 {
-                    let _e199 = i;
-                    let _e201 = k;
-                    local_5 = ((_e199 + (2u << _e201)) <= n_2);
+                let _e201 = local_4;
+                if _e201 {
+                    let _e202 = i;
+                    let _e204 = k;
+                    local_5 = ((_e202 + (2u << _e204)) <= n_2);
                 } else {
                     local_5 = false;
                 }
-                let _e208 = local_5;
-                if _e208 {
+                let _e211 = local_5;
+                if _e211 {
                 } else {
                     break;
                 }
                 {
-                    let _e210 = k;
-                    k = (_e210 + 1u);
+                    let _e213 = k;
+                    k = (_e213 + 1u);
                 }
             }
             lit = false;
             loop {
-                let _e214 = k;
-                let _e215 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e214, width_3);
-                let _e216 = i;
                 let _e217 = k;
-                let node = textureLoad(tree, vec2<u32>((_e215 + (_e216 >> _e217)), _e138), 0i);
-                if (_e148 <= node.x) {
+                let _e218 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e217, width_3);
+                let _e219 = i;
+                let _e220 = k;
+                let node = textureLoad(tree, vec2<u32>((_e218 + (_e219 >> _e220)), _e141), 0i);
+                if (_e151 <= node.x) {
                     lit = true;
                     break;
                 }
-                if !((_e148 > node.y)) {
-                    let _e230 = k;
-                    local_6 = (_e230 == 0u);
+                if !((_e151 > node.y)) {
+                    let _e233 = k;
+                    local_6 = (_e233 == 0u);
                 } else {
                     local_6 = true;
                 }
-                let _e236 = local_6;
-                if _e236 {
+                let _e239 = local_6;
+                if _e239 {
                     break;
                 }
-                let _e238 = k;
-                k = (_e238 - 1u);
+                let _e241 = k;
+                k = (_e241 - 1u);
             }
-            let _e241 = lit;
-            let _e242 = in_run;
-            if (_e241 != _e242) {
-                let _e244 = i;
-                let _e245 = edge_t(f_9, _e244, n_2, delta_2, theta_3, s_3, true);
-                let _e246 = lit;
-                if _e246 {
-                    run_a = _e245;
+            let _e244 = lit;
+            let _e245 = in_run;
+            if (_e244 != _e245) {
+                let _e247 = i;
+                let _e248 = edge_t(f_9, _e247, n_2, delta_2, theta_3, s_3, true);
+                let _e249 = lit;
+                if _e249 {
+                    run_a = _e248;
                 } else {
-                    let _e249 = total;
-                    let _e250 = run_a;
-                    let _e251 = lit_span(f_9, eye_5, _e21, _e250, _e245, true);
-                    total = (_e249 + _e251);
+                    let _e252 = total;
+                    let _e253 = run_a;
+                    let _e254 = lit_span(f_9, eye_6, _e21, _e253, _e248, true);
+                    total = (_e252 + _e254);
                 }
-                let _e253 = lit;
-                in_run = _e253;
+                let _e256 = lit;
+                in_run = _e256;
             }
-            let _e254 = i;
-            let _e256 = k;
-            i = (_e254 + (1u << _e256));
+            let _e257 = i;
+            let _e259 = k;
+            i = (_e257 + (1u << _e259));
         }
     }
-    let _e259 = in_run;
-    if _e259 {
-        let _e260 = total;
-        let _e261 = run_a;
-        let _e262 = lit_span(f_9, eye_5, _e21, _e261, s_3, true);
-        total = (_e260 + _e262);
+    let _e262 = in_run;
+    if _e262 {
+        let _e263 = total;
+        let _e264 = run_a;
+        let _e265 = lit_span(f_9, eye_6, _e21, _e264, s_3, true);
+        total = (_e263 + _e265);
     }
-    let _e264 = total;
-    l = _e264;
+    let _e267 = total;
+    l = _e267;
     if !(true) {
-        let _e275 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(dot(f_9.light_dir.xyz, _e21)));
-        let _e277 = total;
-        l = ((f_9.medium.y * _e275) * _e277);
+        let _e278 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(dot(f_9.light_dir.xyz, _e21)));
+        let _e280 = total;
+        l = ((f_9.medium.y * _e278) * _e280);
     }
-    let _e279 = l;
-    let c = (color * _e279);
+    let _e282 = l;
+    let c = (color * _e282);
     textureStore(output, vec2<u32>(x_7, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

@@ -206,7 +206,7 @@ void main() {
     vec3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_6, y_3);
     int _e24_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
     vec4 _e24 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_6, y_3)), ivec2(0), textureSize(_group_0_binding_1_cs, _e24_clamped_lod) - ivec2(1)), _e24_clamped_lod);
-    float s = (max(_e24.x, 0.0) / max(dot(_e20, m_2.cam_forward.xyz), 1e-6));
+    float s = (min(max(_e24.x, 0.0), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 1e-6));
     uint n_1 = m_2.sizes.w;
     float h_1 = (s / float(n_1));
     uint mx = m_2.interleave.x;
@@ -214,50 +214,50 @@ void main() {
     uint stride = (mx * my);
     uint pixel_class = ((x_6 % mx) + (mx * (y_3 % my)));
     if ((m_2.interleave.z != 0u)) {
-        float _e51 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_6, y_3);
-        u = _e51;
+        float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_6, y_3);
+        u = _e54;
     }
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e53 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     j = pixel_class;
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e96 = j;
-            j = (_e96 + stride);
+            uint _e99 = j;
+            j = (_e99 + stride);
         }
         loop_init = false;
-        uint _e55 = j;
-        if ((_e55 < n_1)) {
+        uint _e58 = j;
+        if ((_e58 < n_1)) {
         } else {
             break;
         }
         {
-            uint _e57 = j;
-            float _e59 = u;
-            float t_3 = ((float(_e57) + _e59) * h_1);
-            float _e65 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e53, _group_0_binding_2_cs, (eye_1 + (_e20 * t_3)));
+            uint _e60 = j;
+            float _e62 = u;
+            float t_3 = ((float(_e60) + _e62) * h_1);
+            float _e68 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, _group_0_binding_2_cs, (eye_1 + (_e20 * t_3)));
             if (false) {
-                float _e68 = sum;
-                float _e79 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, _e20, t_3, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = (_e68 + ((_e65 * h_1) * _e79));
+                float _e71 = sum;
+                float _e82 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, _e20, t_3, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = (_e71 + ((_e68 * h_1) * _e82));
             } else {
-                float _e82 = sum;
-                uint _e85 = j;
+                float _e85 = sum;
                 uint _e88 = j;
-                float _e93 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e85) * h_1), (float((_e88 + 1u)) * h_1));
-                sum = (_e82 + (_e65 * _e93));
+                uint _e91 = j;
+                float _e96 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e88) * h_1), (float((_e91 + 1u)) * h_1));
+                sum = (_e85 + (_e68 * _e96));
             }
         }
     }
-    float _e98 = sum;
-    l = _e98;
+    float _e101 = sum;
+    l = _e101;
     if (!(false)) {
-        float _e109 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
-        float _e111 = sum;
-        l = ((m_2.medium.y * _e109) * _e111);
+        float _e112 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
+        float _e114 = sum;
+        l = ((m_2.medium.y * _e112) * _e114);
     }
-    float _e115 = l;
-    vec3 c = (m_2.light_color.xyz * _e115);
+    float _e118 = l;
+    vec3 c = (m_2.light_color.xyz * _e118);
     imageStore(_group_0_binding_3_cs, ivec2(uvec2(x_6, y_3)), vec4(c.x, c.y, c.z, 1.0));
     return;
 }

@@ -264,7 +264,7 @@ kernel void raymarch(
     metal::float3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_6, y_3);
     uint clamped_lod_e24 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e24 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_3)), metal::uint2(depth.get_width(clamped_lod_e24), depth.get_height(clamped_lod_e24)) - 1), clamped_lod_e24);
-    float s = metal::max(_e24.x, 0.0) / metal::max(metal::dot(_e20, m_2.cam_forward.xyz), 0.000001);
+    float s = metal::min(metal::max(_e24.x, 0.0), m_2.eye.w) / metal::max(metal::dot(_e20, m_2.cam_forward.xyz), 0.000001);
     uint n_1 = m_2.sizes.w;
     float h_1 = s / static_cast<float>(n_1);
     uint mx = m_2.interleave.x;
@@ -272,10 +272,10 @@ kernel void raymarch(
     uint stride = mx * my;
     uint pixel_class = naga_mod(x_6, mx) + (mx * naga_mod(y_3, my));
     if (m_2.interleave.z != 0u) {
-        float _e51 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_6, y_3);
-        u = _e51;
+        float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_6, y_3);
+        u = _e54;
     }
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e53 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     j = pixel_class;
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
@@ -283,42 +283,42 @@ kernel void raymarch(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e96 = j;
-            j = _e96 + stride;
+            uint _e99 = j;
+            j = _e99 + stride;
         }
         loop_init = false;
-        uint _e55 = j;
-        if (_e55 < n_1) {
+        uint _e58 = j;
+        if (_e58 < n_1) {
         } else {
             break;
         }
         {
-            uint _e57 = j;
-            float _e59 = u;
-            float t_3 = (static_cast<float>(_e57) + _e59) * h_1;
-            float _e65 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e53, shadow_map, eye_1 + (_e20 * t_3));
+            uint _e60 = j;
+            float _e62 = u;
+            float t_3 = (static_cast<float>(_e60) + _e62) * h_1;
+            float _e68 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, eye_1 + (_e20 * t_3));
             if (false) {
-                float _e68 = sum;
-                float _e79 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, _e20, t_3, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = _e68 + ((_e65 * h_1) * _e79);
+                float _e71 = sum;
+                float _e82 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, _e20, t_3, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = _e71 + ((_e68 * h_1) * _e82);
             } else {
-                float _e82 = sum;
-                uint _e85 = j;
+                float _e85 = sum;
                 uint _e88 = j;
-                float _e93 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e85) * h_1, static_cast<float>(_e88 + 1u) * h_1);
-                sum = _e82 + (_e65 * _e93);
+                uint _e91 = j;
+                float _e96 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e88) * h_1, static_cast<float>(_e91 + 1u) * h_1);
+                sum = _e85 + (_e68 * _e96);
             }
         }
     }
-    float _e98 = sum;
-    l = _e98;
+    float _e101 = sum;
+    l = _e101;
     if (!(false)) {
-        float _e109 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(metal::dot(m_2.light_dir.xyz, _e20)));
-        float _e111 = sum;
-        l = (m_2.medium.y * _e109) * _e111;
+        float _e112 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(metal::dot(m_2.light_dir.xyz, _e20)));
+        float _e114 = sum;
+        l = (m_2.medium.y * _e112) * _e114;
     }
-    float _e115 = l;
-    metal::float3 c = m_2.light_color.xyz * _e115;
+    float _e118 = l;
+    metal::float3 c = m_2.light_color.xyz * _e118;
     output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_6, y_3)));
     return;
 }

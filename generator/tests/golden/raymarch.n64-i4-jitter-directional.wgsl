@@ -207,7 +207,7 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
     let eye_1 = m_2.eye.xyz;
     let _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_6, y_3);
     let _e24 = textureLoad(depth, vec2<u32>(x_6, y_3), 0i);
-    let s = (max(_e24.x, 0f) / max(dot(_e20, m_2.cam_forward.xyz), 0.000001f));
+    let s = (min(max(_e24.x, 0f), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 0.000001f));
     let n_1 = m_2.sizes.w;
     let h_1 = (s / f32(n_1));
     let mx = m_2.interleave.x;
@@ -215,48 +215,48 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
     let stride = (mx * my);
     let pixel_class = ((x_6 % mx) + (mx * (y_3 % my)));
     if (m_2.interleave.z != 0u) {
-        let _e51 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_6, y_3);
-        u = _e51;
+        let _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_6, y_3);
+        u = _e54;
     }
-    let _e53 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    let _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     j = pixel_class;
     loop {
-        let _e55 = j;
-        if (_e55 < n_1) {
+        let _e58 = j;
+        if (_e58 < n_1) {
         } else {
             break;
         }
         {
-            let _e57 = j;
-            let _e59 = u;
-            let t_3 = ((f32(_e57) + _e59) * h_1);
-            let _e65 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e53, shadow_map, (eye_1 + (_e20 * t_3)));
+            let _e60 = j;
+            let _e62 = u;
+            let t_3 = ((f32(_e60) + _e62) * h_1);
+            let _e68 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, (eye_1 + (_e20 * t_3)));
             if false {
-                let _e68 = sum;
-                let _e79 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, _e20, t_3, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = (_e68 + ((_e65 * h_1) * _e79));
+                let _e71 = sum;
+                let _e82 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, _e20, t_3, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = (_e71 + ((_e68 * h_1) * _e82));
             } else {
-                let _e82 = sum;
-                let _e85 = j;
+                let _e85 = sum;
                 let _e88 = j;
-                let _e93 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e85) * h_1), (f32((_e88 + 1u)) * h_1));
-                sum = (_e82 + (_e65 * _e93));
+                let _e91 = j;
+                let _e96 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e88) * h_1), (f32((_e91 + 1u)) * h_1));
+                sum = (_e85 + (_e68 * _e96));
             }
         }
         continuing {
-            let _e96 = j;
-            j = (_e96 + stride);
+            let _e99 = j;
+            j = (_e99 + stride);
         }
     }
-    let _e98 = sum;
-    l = _e98;
+    let _e101 = sum;
+    l = _e101;
     if !(false) {
-        let _e109 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
-        let _e111 = sum;
-        l = ((m_2.medium.y * _e109) * _e111);
+        let _e112 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
+        let _e114 = sum;
+        l = ((m_2.medium.y * _e112) * _e114);
     }
-    let _e115 = l;
-    let c = (m_2.light_color.xyz * _e115);
+    let _e118 = l;
+    let c = (m_2.light_color.xyz * _e118);
     textureStore(output, vec2<u32>(x_6, y_3), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

@@ -177,18 +177,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_4 = vec3<f32>(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
-        if (dir_4.z <= 0.000001f) {
+        let dir_5 = vec3<f32>(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
+        if (dir_5.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_4);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_5);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_4.z);
+        return ((z_2 + _e35) / dir_5.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -252,6 +252,54 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
+fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
+    var sum: f32 = 0f;
+    var k_2: u32 = 0u;
+    var q: u32;
+
+    let t0_1 = dot((light_pos_1 - eye_1), dir_1);
+    let h = max(length(((eye_1 + (dir_1 * t0_1)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
+    let g0_ = atan(((a_1 - t0_1) / h));
+    let w = ((atan(((b_1 - t0_1) / h)) - g0_) / f32(panels));
+    loop {
+        let _e30 = k_2;
+        if (_e30 < panels) {
+        } else {
+            break;
+        }
+        {
+            let _e32 = k_2;
+            let mid = (g0_ + ((f32(_e32) + 0.5f) * w));
+            q = 0u;
+            loop {
+                let _e40 = q;
+                if (_e40 < 4u) {
+                } else {
+                    break;
+                }
+                {
+                    let _e46 = q;
+                    let u = tan((mid + ((0.5f * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    let _e52 = sum;
+                    let _e54 = q;
+                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_1 + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u * u))));
+                }
+                continuing {
+                    let _e70 = q;
+                    q = (_e70 + 1u);
+                }
+            }
+        }
+        continuing {
+            let _e73 = k_2;
+            k_2 = (_e73 + 1u);
+        }
+    }
+    let _e75 = sum;
+    return (((_e75 * 0.5f) * w) * h);
+}
+
 fn pixel_dir(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x: u32, y: u32) -> vec3<f32> {
     let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(f_2.sizes.x)) - 1f);
     let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(f_2.sizes.y)));
@@ -259,51 +307,51 @@ fn pixel_dir(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x: u32
     return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc_x * t_3) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc_y * t_3))));
 }
 
-fn frame_spot_integrand(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_1: vec3<f32>, dir_1: vec3<f32>, t_1: f32) -> f32 {
-    let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
+fn frame_spot_integrand(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_2: vec3<f32>, dir_2: vec3<f32>, t_1: f32) -> f32 {
+    let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-fn march(eye_2: vec3<f32>, dir_2: vec3<f32>, s: f32, spot_1: bool) -> f32 {
-    var sum: f32 = 0f;
-    var k_2: u32 = 0u;
+fn march(eye_3: vec3<f32>, dir_3: vec3<f32>, s: f32, spot_1: bool) -> f32 {
+    var sum_1: f32 = 0f;
+    var k_3: u32 = 0u;
 
     let f_6 = frame;
     let steps = f_6.sizes2_.y;
-    let h = (s / f32(steps));
+    let h_1 = (s / f32(steps));
     loop {
-        let _e10 = k_2;
+        let _e10 = k_3;
         if (_e10 < steps) {
         } else {
             break;
         }
         {
-            let _e12 = k_2;
-            let t_4 = ((f32(_e12) + 0.5f) * h);
-            let _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, shadow_map, (eye_2 + (dir_2 * t_4)));
+            let _e12 = k_3;
+            let t_4 = ((f32(_e12) + 0.5f) * h_1);
+            let _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, shadow_map, (eye_3 + (dir_3 * t_4)));
             if spot_1 {
-                let _e25 = sum;
-                let _e27 = frame_spot_integrand(f_6, eye_2, dir_2, t_4);
-                sum = (_e25 + ((_e22 * h) * _e27));
+                let _e25 = sum_1;
+                let _e27 = frame_spot_integrand(f_6, eye_3, dir_3, t_4);
+                sum_1 = (_e25 + ((_e22 * h_1) * _e27));
             } else {
-                let _e30 = sum;
-                let _e33 = k_2;
-                let _e36 = k_2;
-                let _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, (f32(_e33) * h), (f32((_e36 + 1u)) * h));
-                sum = (_e30 + (_e22 * _e41));
+                let _e30 = sum_1;
+                let _e33 = k_3;
+                let _e36 = k_3;
+                let _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, (f32(_e33) * h_1), (f32((_e36 + 1u)) * h_1));
+                sum_1 = (_e30 + (_e22 * _e41));
             }
         }
         continuing {
-            let _e45 = k_2;
-            k_2 = (_e45 + 1u);
+            let _e45 = k_3;
+            k_3 = (_e45 + 1u);
         }
     }
     if spot_1 {
-        let _e47 = sum;
+        let _e47 = sum_1;
         return _e47;
     } else {
-        let _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_2)));
-        let _e58 = sum;
+        let _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_3)));
+        let _e58 = sum_1;
         return ((f_6.medium.y * _e56) * _e58);
     }
 }
@@ -338,49 +386,9 @@ fn ray_t(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_1: f32, 
     }
 }
 
-fn spot_segment(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_3: vec3<f32>, dir_3: vec3<f32>, a_1: f32, b_1: f32, panels: u32) -> f32 {
-    var sum_1: f32 = 0f;
-    var k_3: u32 = 0u;
-    var q: u32;
-
-    let h_1 = ((b_1 - a_1) / f32(panels));
-    loop {
-        let _e9 = k_3;
-        if (_e9 < panels) {
-        } else {
-            break;
-        }
-        {
-            let _e11 = k_3;
-            let mid = (a_1 + ((f32(_e11) + 0.5f) * h_1));
-            q = 0u;
-            loop {
-                let _e19 = q;
-                if (_e19 < 4u) {
-                } else {
-                    break;
-                }
-                {
-                    let _e25 = q;
-                    let t_5 = (mid + ((0.5f * h_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e25]));
-                    let _e30 = sum_1;
-                    let _e32 = q;
-                    let _e37 = frame_spot_integrand(f_5, eye_3, dir_3, t_5);
-                    sum_1 = (_e30 + (GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e32] * _e37));
-                }
-                continuing {
-                    let _e41 = q;
-                    q = (_e41 + 1u);
-                }
-            }
-        }
-        continuing {
-            let _e44 = k_3;
-            k_3 = (_e44 + 1u);
-        }
-    }
-    let _e46 = sum_1;
-    return ((_e46 * 0.5f) * h_1);
+fn spot_segment(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_4: vec3<f32>, dir_4: vec3<f32>, a_2: f32, b_2: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_5.light_pos.xyz, f_5.light_dir.xyz, f_5.light_pos.w, f_5.light_dir.w, f_5.medium);
+    return _e15;
 }
 
 @compute @workgroup_size(8, 8, 1) 
@@ -424,10 +432,10 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e18 {
         return;
     }
-    let eye_4 = f_7.eye.xyz;
+    let eye_5 = f_7.eye.xyz;
     let _e21 = pixel_dir(f_7, x_6, y_2);
     let _e25 = textureLoad(depth, vec2<u32>(x_6, y_2), 0i);
-    let s_2 = (max(_e25.x, 0f) / max(dot(_e21, f_7.cam_forward.xyz), 0.000001f));
+    let s_2 = (min(max(_e25.x, 0f), f_7.theta.z) / max(dot(_e21, f_7.cam_forward.xyz), 0.000001f));
     let color = f_7.light_color.xyz;
     let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_2) + 0.5f), 0f);
     let radius = f_7.epipole.w;
@@ -448,10 +456,10 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         local_3 = true;
     }
-    let _e85 = local_3;
-    if _e85 {
-        let _e87 = march(eye_4, _e21, s_2, true);
-        let l_2 = (_e87 * color);
+    let _e88 = local_3;
+    if _e88 {
+        let _e90 = march(eye_5, _e21, s_2, true);
+        let l_2 = (_e90 * color);
         textureStore(output, vec2<u32>(x_6, y_2), vec4<f32>(l_2.x, l_2.y, l_2.z, 1f));
         return;
     }
@@ -464,202 +472,201 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         let phi = atan2(dot(_e21, f_7.e2_.xyz), dot(_e21, f_7.e1_.xyz));
         yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
         if wrap_1 {
-            let _e126 = yc;
-            let _e127 = yc;
-            yc = (_e126 - (floor((_e127 / f32(rows_1))) * f32(rows_1)));
+            let _e129 = yc;
+            let _e130 = yc;
+            yc = (_e129 - (floor((_e130 / f32(rows_1))) * f32(rows_1)));
         } else {
-            let _e134 = yc;
-            yc = clamp(_e134, 0f, f32(rows_1));
+            let _e137 = yc;
+            yc = clamp(_e137, 0f, f32(rows_1));
         }
-        let _e138 = yc;
-        let yy = (_e138 - 0.5f);
+        let _e141 = yc;
+        let yy = (_e141 - 0.5f);
         let j0_ = floor(yy);
         let fy = (yy - j0_);
-        let _e143 = row_index(j0_, rows_1, wrap_1);
-        let _e146 = slices[_e143];
-        let _e147 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e146);
-        let _e150 = row_index((j0_ + 1f), rows_1, wrap_1);
-        let _e153 = slices[_e150];
-        let _e154 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e153);
-        delta = mix(_e147.delta, _e154.delta, fy);
-        let _e159 = theta;
-        let _e164 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e159, f_7.theta.x, f_7.theta.y);
-        d = _e164;
+        let _e146 = row_index(j0_, rows_1, wrap_1);
+        let _e149 = slices[_e146];
+        let _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
+        let _e153 = row_index((j0_ + 1f), rows_1, wrap_1);
+        let _e156 = slices[_e153];
+        let _e157 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156);
+        delta = mix(_e150.delta, _e157.delta, fy);
+        let _e162 = theta;
+        let _e167 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e162, f_7.theta.x, f_7.theta.y);
+        d = _e167;
         if true {
-            let q_2 = normalize(((eye_4 + (_e21 * s_2)) - f_7.light_pos.xyz));
-            let _e178 = delta;
-            xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / _e178);
+            let q_2 = normalize(((eye_5 + (_e21 * s_2)) - f_7.light_pos.xyz));
+            let _e181 = delta;
+            xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / _e181);
         } else {
-            let _e181 = theta;
-            let _e184 = delta;
-            xs = ((s_2 * sin(_e181)) / _e184);
+            let _e184 = theta;
+            let _e187 = delta;
+            xs = ((s_2 * sin(_e184)) / _e187);
         }
     }
-    let _e186 = xs;
-    let last = u32(min(max(_e186, 0f), (f32(width_1) - 1f)));
+    let _e189 = xs;
+    let last = u32(min(max(_e189, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e196 = r;
-        if (_e196 < REGIONS) {
+        let _e199 = r;
+        if (_e199 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e198 = r;
-            let _e199 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, width_1, true);
-            let b0_ = f32(_e199);
             let _e201 = r;
-            let _e204 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e201 + 1u), REGIONS, width_1, true);
-            let b1_ = f32(_e204);
+            let _e202 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e201, REGIONS, width_1, true);
+            let b0_ = f32(_e202);
+            let _e204 = r;
+            let _e207 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e204 + 1u), REGIONS, width_1, true);
+            let b1_ = f32(_e207);
             if !((last < u32(b1_))) {
-                let _e209 = r;
-                local_4 = ((_e209 + 1u) == REGIONS);
+                let _e212 = r;
+                local_4 = ((_e212 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             let is_last = local_4;
-            let _e218 = r;
-            let _e222 = xs;
-            pos[_e218] = select((b1_ - 0.5f), clamp((_e222 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
-            let _e232 = r;
-            let _e234 = delta;
-            let _e235 = theta;
-            let _e236 = ray_t(f_7, b0_, _e234, _e235, s_2, true);
-            t0_[_e232] = _e236;
-            let _e238 = r;
-            let _e240 = delta;
-            let _e241 = theta;
-            let _e242 = ray_t(f_7, b1_, _e240, _e241, s_2, true);
-            t1_[_e238] = select(_e242, s_2, is_last);
-            let _e244 = r;
-            count = (_e244 + 1u);
+            let _e221 = r;
+            let _e225 = xs;
+            pos[_e221] = select((b1_ - 0.5f), clamp((_e225 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
+            let _e235 = r;
+            let _e237 = delta;
+            let _e238 = theta;
+            let _e239 = ray_t(f_7, b0_, _e237, _e238, s_2, true);
+            t0_[_e235] = _e239;
+            let _e241 = r;
+            let _e243 = delta;
+            let _e244 = theta;
+            let _e245 = ray_t(f_7, b1_, _e243, _e244, s_2, true);
+            t1_[_e241] = select(_e245, s_2, is_last);
+            let _e247 = r;
+            count = (_e247 + 1u);
             if is_last {
                 break;
             }
         }
         continuing {
-            let _e249 = r;
-            r = (_e249 + 1u);
+            let _e252 = r;
+            r = (_e252 + 1u);
         }
     }
     let cos_theta_l = -(dot(f_7.light_dir.xyz, _e21));
-    let _e259 = count;
-    let panels_1 = max(((f_7.sizes2_.z / 4u) / _e259), 1u);
+    let panels_2 = max((f_7.sizes2_.z / 4u), 1u);
     loop {
-        let _e264 = layer;
-        if (_e264 < LAYERS) {
+        let _e265 = layer;
+        if (_e265 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e268 = layer;
-            let _e270 = d;
-            let _e271 = layer;
-            let _e272 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e270, _e271);
-            coeffs[_e268] = _e272;
+            let _e269 = layer;
+            let _e271 = d;
+            let _e272 = layer;
+            let _e273 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e271, _e272);
+            coeffs[_e269] = _e273;
         }
         continuing {
-            let _e274 = layer;
-            layer = (_e274 + 1u);
+            let _e275 = layer;
+            layer = (_e275 + 1u);
         }
     }
     loop {
-        let _e277 = r_1;
-        let _e278 = count;
-        if (_e277 < _e278) {
+        let _e278 = r_1;
+        let _e279 = count;
+        if (_e278 < _e279) {
         } else {
             break;
         }
         {
-            let _e280 = r_1;
-            let a_2 = t0_[_e280];
-            let _e283 = r_1;
-            let b_2 = t1_[_e283];
+            let _e281 = r_1;
+            let a_3 = t0_[_e281];
+            let _e284 = r_1;
+            let b_3 = t1_[_e284];
             weight = f32();
             if !(false) {
-                weight = (b_2 - a_2);
+                weight = (b_3 - a_3);
             } else {
                 if true {
-                    let _e291 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
-                    weight = _e291;
+                    let _e292 = spot_segment(f_7, eye_5, _e21, a_3, b_3, panels_2);
+                    weight = _e292;
                 } else {
-                    let _e296 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-                    let _e300 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
-                    weight = ((f_7.medium.y * _e296) * _e300);
+                    let _e297 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+                    let _e301 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_3, b_3);
+                    weight = ((f_7.medium.y * _e297) * _e301);
                 }
             }
             vis = 0.5f;
             layer_1 = 0u;
             loop {
-                let _e306 = layer_1;
-                if (_e306 < LAYERS) {
+                let _e307 = layer_1;
+                if (_e307 < LAYERS) {
                 } else {
                     break;
                 }
                 {
-                    let _e309 = layer_1;
-                    let coeff = coeffs[_e309];
-                    let _e312 = r_1;
-                    let _e314 = pos[_e312];
-                    let _e317 = yc;
-                    let _e321 = layer_1;
-                    let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e314 / f32(width_1)), (_e317 / f32(rows_1))), _e321, 0f);
+                    let _e310 = layer_1;
+                    let coeff = coeffs[_e310];
+                    let _e313 = r_1;
+                    let _e315 = pos[_e313];
+                    let _e318 = yc;
+                    let _e322 = layer_1;
+                    let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e315 / f32(width_1)), (_e318 / f32(rows_1))), _e322, 0f);
                     k = 0u;
                     loop {
-                        let _e328 = k;
-                        if (_e328 < 4u) {
+                        let _e329 = k;
+                        if (_e329 < 4u) {
                         } else {
                             break;
                         }
                         {
-                            let _e331 = vis;
-                            let _e332 = k;
-                            let _e334 = k;
-                            vis = (_e331 + (coeff[_e332] * ((texel_1[_e334] * 2f) - 1f)));
+                            let _e332 = vis;
+                            let _e333 = k;
+                            let _e335 = k;
+                            vis = (_e332 + (coeff[_e333] * ((texel_1[_e335] * 2f) - 1f)));
                         }
                         continuing {
-                            let _e343 = k;
-                            k = (_e343 + 1u);
+                            let _e344 = k;
+                            k = (_e344 + 1u);
                         }
                     }
                 }
                 continuing {
-                    let _e346 = layer_1;
-                    layer_1 = (_e346 + 1u);
+                    let _e347 = layer_1;
+                    layer_1 = (_e347 + 1u);
                 }
             }
-            let _e349 = total;
-            let _e350 = weight;
-            let _e351 = vis;
-            total = (_e349 + (_e350 * clamp(_e351, 0f, 1f)));
-            let _e358 = norm;
-            let _e359 = weight;
-            norm = (_e358 + _e359);
+            let _e350 = total;
+            let _e351 = weight;
+            let _e352 = vis;
+            total = (_e350 + (_e351 * clamp(_e352, 0f, 1f)));
+            let _e359 = norm;
+            let _e360 = weight;
+            norm = (_e359 + _e360);
         }
         continuing {
-            let _e362 = r_1;
-            r_1 = (_e362 + 1u);
+            let _e363 = r_1;
+            r_1 = (_e363 + 1u);
         }
     }
     if false {
-        let _e364 = total;
-        l = _e364;
+        let _e365 = total;
+        l = _e365;
     } else {
         if true {
-            let _e373 = spot_segment(f_7, eye_4, _e21, 0f, s_2, max((f_7.sizes2_.z / 4u), 1u));
-            unshadowed = _e373;
+            let _e374 = spot_segment(f_7, eye_5, _e21, 0f, s_2, max((f_7.sizes2_.z / 4u), 1u));
+            unshadowed = _e374;
         } else {
-            let _e379 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-            let _e383 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
-            unshadowed = ((f_7.medium.y * _e379) * _e383);
+            let _e380 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+            let _e384 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
+            unshadowed = ((f_7.medium.y * _e380) * _e384);
         }
-        let _e385 = unshadowed;
-        let _e386 = total;
-        let _e387 = norm;
-        let _e389 = norm;
-        l = (_e385 * select(1f, (_e386 / _e387), (_e389 > 0f)));
+        let _e386 = unshadowed;
+        let _e387 = total;
+        let _e388 = norm;
+        let _e390 = norm;
+        l = (_e386 * select(1f, (_e387 / _e388), (_e390 > 0f)));
     }
-    let _e395 = l;
-    let c = (color * _e395);
+    let _e396 = l;
+    let c = (color * _e396);
     textureStore(output, vec2<u32>(x_6, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

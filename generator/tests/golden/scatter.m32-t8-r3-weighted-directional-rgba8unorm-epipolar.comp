@@ -175,18 +175,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        vec3 dir_4 = vec3(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
-        if ((dir_4.z <= 1e-6)) {
+        vec3 dir_5 = vec3(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
+        if ((dir_5.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_4);
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_5);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_4.z);
+        return ((z_2 + _e35) / dir_5.z);
     } else {
         vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -250,6 +250,57 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir,
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_1, float b_1, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
+    float sum = 0.0;
+    uint k_2 = 0u;
+    uint q = 0u;
+    float t0_1 = dot((light_pos_1 - eye_1), dir_1);
+    float h = max(length(((eye_1 + (dir_1 * t0_1)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float g0_ = atan(((a_1 - t0_1) / h));
+    float w = ((atan(((b_1 - t0_1) / h)) - g0_) / float(panels));
+    bool loop_init = true;
+    while(true) {
+        if (!loop_init) {
+            uint _e73 = k_2;
+            k_2 = (_e73 + 1u);
+        }
+        loop_init = false;
+        uint _e30 = k_2;
+        if ((_e30 < panels)) {
+        } else {
+            break;
+        }
+        {
+            uint _e32 = k_2;
+            float mid = (g0_ + ((float(_e32) + 0.5) * w));
+            q = 0u;
+            bool loop_init_1 = true;
+            while(true) {
+                if (!loop_init_1) {
+                    uint _e70 = q;
+                    q = (_e70 + 1u);
+                }
+                loop_init_1 = false;
+                uint _e40 = q;
+                if ((_e40 < 4u)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e46 = q;
+                    float u = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    float _e52 = sum;
+                    uint _e54 = q;
+                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_1 + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1.0 + (u * u))));
+                }
+            }
+        }
+    }
+    float _e75 = sum;
+    return (((_e75 * 0.5) * w) * h);
+}
+
 vec3 pixel_dir(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2, uint x, uint y) {
     float ndc_x = (((2.0 * (float(x) + 0.5)) / float(f_2.sizes.x)) - 1.0);
     float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(f_2.sizes.y)));
@@ -257,52 +308,52 @@ vec3 pixel_dir(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2, uint 
     return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc_x * t_3) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc_y * t_3))));
 }
 
-float frame_spot_integrand(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, vec3 eye_1, vec3 dir_1, float t_1) {
-    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
+float frame_spot_integrand(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, vec3 eye_2, vec3 dir_2, float t_1) {
+    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-float march(vec3 eye_2, vec3 dir_2, float s, bool spot_1) {
-    float sum = 0.0;
-    uint k_2 = 0u;
+float march(vec3 eye_3, vec3 dir_3, float s, bool spot_1) {
+    float sum_1 = 0.0;
+    uint k_3 = 0u;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_6 = _group_0_binding_0_cs;
     uint steps = f_6.sizes2_.y;
-    float h = (s / float(steps));
-    bool loop_init = true;
+    float h_1 = (s / float(steps));
+    bool loop_init_2 = true;
     while(true) {
-        if (!loop_init) {
-            uint _e45 = k_2;
-            k_2 = (_e45 + 1u);
+        if (!loop_init_2) {
+            uint _e45 = k_3;
+            k_3 = (_e45 + 1u);
         }
-        loop_init = false;
-        uint _e10 = k_2;
+        loop_init_2 = false;
+        uint _e10 = k_3;
         if ((_e10 < steps)) {
         } else {
             break;
         }
         {
-            uint _e12 = k_2;
-            float t_4 = ((float(_e12) + 0.5) * h);
-            float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, _group_0_binding_3_cs, (eye_2 + (dir_2 * t_4)));
+            uint _e12 = k_3;
+            float t_4 = ((float(_e12) + 0.5) * h_1);
+            float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, _group_0_binding_3_cs, (eye_3 + (dir_3 * t_4)));
             if (spot_1) {
-                float _e25 = sum;
-                float _e27 = frame_spot_integrand(f_6, eye_2, dir_2, t_4);
-                sum = (_e25 + ((_e22 * h) * _e27));
+                float _e25 = sum_1;
+                float _e27 = frame_spot_integrand(f_6, eye_3, dir_3, t_4);
+                sum_1 = (_e25 + ((_e22 * h_1) * _e27));
             } else {
-                float _e30 = sum;
-                uint _e33 = k_2;
-                uint _e36 = k_2;
-                float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, (float(_e33) * h), (float((_e36 + 1u)) * h));
-                sum = (_e30 + (_e22 * _e41));
+                float _e30 = sum_1;
+                uint _e33 = k_3;
+                uint _e36 = k_3;
+                float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, (float(_e33) * h_1), (float((_e36 + 1u)) * h_1));
+                sum_1 = (_e30 + (_e22 * _e41));
             }
         }
     }
     if (spot_1) {
-        float _e47 = sum;
+        float _e47 = sum_1;
         return _e47;
     } else {
-        float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_2)));
-        float _e58 = sum;
+        float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_3)));
+        float _e58 = sum_1;
         return ((f_6.medium.y * _e56) * _e58);
     }
 }
@@ -336,52 +387,9 @@ float ray_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4, float x_
     }
 }
 
-float spot_segment(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5, vec3 eye_3, vec3 dir_3, float a_1, float b_1, uint panels) {
-    float sum_1 = 0.0;
-    uint k_3 = 0u;
-    uint q = 0u;
-    float h_1 = ((b_1 - a_1) / float(panels));
-    bool loop_init_1 = true;
-    while(true) {
-        if (!loop_init_1) {
-            uint _e44 = k_3;
-            k_3 = (_e44 + 1u);
-        }
-        loop_init_1 = false;
-        uint _e9 = k_3;
-        if ((_e9 < panels)) {
-        } else {
-            break;
-        }
-        {
-            uint _e11 = k_3;
-            float mid = (a_1 + ((float(_e11) + 0.5) * h_1));
-            q = 0u;
-            bool loop_init_2 = true;
-            while(true) {
-                if (!loop_init_2) {
-                    uint _e41 = q;
-                    q = (_e41 + 1u);
-                }
-                loop_init_2 = false;
-                uint _e19 = q;
-                if ((_e19 < 4u)) {
-                } else {
-                    break;
-                }
-                {
-                    uint _e25 = q;
-                    float t_5 = (mid + ((0.5 * h_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e25]));
-                    float _e30 = sum_1;
-                    uint _e32 = q;
-                    float _e37 = frame_spot_integrand(f_5, eye_3, dir_3, t_5);
-                    sum_1 = (_e30 + (GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e32] * _e37));
-                }
-            }
-        }
-    }
-    float _e46 = sum_1;
-    return ((_e46 * 0.5) * h_1);
+float spot_segment(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5, vec3 eye_4, vec3 dir_4, float a_2, float b_2, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_5.light_pos.xyz, f_5.light_dir.xyz, f_5.light_pos.w, f_5.light_dir.w, f_5.medium);
+    return _e15;
 }
 
 void main() {
@@ -424,11 +432,11 @@ void main() {
     if (_e18) {
         return;
     }
-    vec3 eye_4 = f_7.eye.xyz;
+    vec3 eye_5 = f_7.eye.xyz;
     vec3 _e21 = pixel_dir(f_7, x_6, y_2);
     int _e25_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e25 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e25_clamped_lod) - ivec2(1)), _e25_clamped_lod);
-    float s_2 = (max(_e25.x, 0.0) / max(dot(_e21, f_7.cam_forward.xyz), 1e-6));
+    float s_2 = (min(max(_e25.x, 0.0), f_7.theta.z) / max(dot(_e21, f_7.cam_forward.xyz), 1e-6));
     vec3 color = f_7.light_color.xyz;
     vec3 px = vec3((float(x_6) + 0.5), (float(y_2) + 0.5), 0.0);
     float radius = f_7.epipole.w;
@@ -449,10 +457,10 @@ void main() {
     } else {
         local_3 = true;
     }
-    bool _e85 = local_3;
-    if (_e85) {
-        float _e87 = march(eye_4, _e21, s_2, false);
-        vec3 l_2 = (_e87 * color);
+    bool _e88 = local_3;
+    if (_e88) {
+        float _e90 = march(eye_5, _e21, s_2, false);
+        vec3 l_2 = (_e90 * color);
         imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_6, y_2)), vec4(l_2.x, l_2.y, l_2.z, 1.0));
         return;
     }
@@ -465,137 +473,136 @@ void main() {
         float phi = atan(dot(_e21, f_7.e2_.xyz), dot(_e21, f_7.e1_.xyz));
         yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
         if (wrap_1) {
-            float _e126 = yc;
-            float _e127 = yc;
-            yc = (_e126 - (floor((_e127 / float(rows_1))) * float(rows_1)));
+            float _e129 = yc;
+            float _e130 = yc;
+            yc = (_e129 - (floor((_e130 / float(rows_1))) * float(rows_1)));
         } else {
-            float _e134 = yc;
-            yc = clamp(_e134, 0.0, float(rows_1));
+            float _e137 = yc;
+            yc = clamp(_e137, 0.0, float(rows_1));
         }
-        float _e138 = yc;
-        float yy = (_e138 - 0.5);
+        float _e141 = yc;
+        float yy = (_e141 - 0.5);
         float j0_ = floor(yy);
         float fy = (yy - j0_);
-        uint _e143 = row_index(j0_, rows_1, wrap_1);
-        vec4 _e146 = _group_0_binding_1_cs[_e143];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e147 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e146);
-        uint _e150 = row_index((j0_ + 1.0), rows_1, wrap_1);
-        vec4 _e153 = _group_0_binding_1_cs[_e150];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e154 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e153);
-        delta = mix(_e147.delta, _e154.delta, fy);
-        float _e159 = theta;
-        float _e164 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e159, f_7.theta.x, f_7.theta.y);
-        d = _e164;
+        uint _e146 = row_index(j0_, rows_1, wrap_1);
+        vec4 _e149 = _group_0_binding_1_cs[_e146];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
+        uint _e153 = row_index((j0_ + 1.0), rows_1, wrap_1);
+        vec4 _e156 = _group_0_binding_1_cs[_e153];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e157 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156);
+        delta = mix(_e150.delta, _e157.delta, fy);
+        float _e162 = theta;
+        float _e167 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e162, f_7.theta.x, f_7.theta.y);
+        d = _e167;
         if (false) {
-            vec3 q_2 = normalize(((eye_4 + (_e21 * s_2)) - f_7.light_pos.xyz));
-            float _e178 = delta;
-            xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / _e178);
+            vec3 q_2 = normalize(((eye_5 + (_e21 * s_2)) - f_7.light_pos.xyz));
+            float _e181 = delta;
+            xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / _e181);
         } else {
-            float _e181 = theta;
-            float _e184 = delta;
-            xs = ((s_2 * sin(_e181)) / _e184);
+            float _e184 = theta;
+            float _e187 = delta;
+            xs = ((s_2 * sin(_e184)) / _e187);
         }
     }
-    float _e186 = xs;
-    uint last = uint(min(max(_e186, 0.0), (float(width_1) - 1.0)));
+    float _e189 = xs;
+    uint last = uint(min(max(_e189, 0.0), (float(width_1) - 1.0)));
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e249 = r;
-            r = (_e249 + 1u);
+            uint _e252 = r;
+            r = (_e252 + 1u);
         }
         loop_init_3 = false;
-        uint _e196 = r;
-        if ((_e196 < REGIONS)) {
+        uint _e199 = r;
+        if ((_e199 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e198 = r;
-            uint _e199 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, width_1, false);
-            float b0_ = float(_e199);
             uint _e201 = r;
-            uint _e204 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e201 + 1u), REGIONS, width_1, false);
-            float b1_ = float(_e204);
+            uint _e202 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e201, REGIONS, width_1, false);
+            float b0_ = float(_e202);
+            uint _e204 = r;
+            uint _e207 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e204 + 1u), REGIONS, width_1, false);
+            float b1_ = float(_e207);
             if (!((last < uint(b1_)))) {
-                uint _e209 = r;
-                local_4 = ((_e209 + 1u) == REGIONS);
+                uint _e212 = r;
+                local_4 = ((_e212 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             bool is_last = local_4;
-            uint _e218 = r;
-            float _e222 = xs;
-            pos[_e218] = (is_last ? clamp((_e222 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            uint _e232 = r;
-            float _e234 = delta;
-            float _e235 = theta;
-            float _e236 = ray_t(f_7, b0_, _e234, _e235, s_2, false);
-            t0_[_e232] = _e236;
-            uint _e238 = r;
-            float _e240 = delta;
-            float _e241 = theta;
-            float _e242 = ray_t(f_7, b1_, _e240, _e241, s_2, false);
-            t1_[_e238] = (is_last ? s_2 : _e242);
-            uint _e244 = r;
-            count = (_e244 + 1u);
+            uint _e221 = r;
+            float _e225 = xs;
+            pos[_e221] = (is_last ? clamp((_e225 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            uint _e235 = r;
+            float _e237 = delta;
+            float _e238 = theta;
+            float _e239 = ray_t(f_7, b0_, _e237, _e238, s_2, false);
+            t0_[_e235] = _e239;
+            uint _e241 = r;
+            float _e243 = delta;
+            float _e244 = theta;
+            float _e245 = ray_t(f_7, b1_, _e243, _e244, s_2, false);
+            t1_[_e241] = (is_last ? s_2 : _e245);
+            uint _e247 = r;
+            count = (_e247 + 1u);
             if (is_last) {
                 break;
             }
         }
     }
     float cos_theta_l = -(dot(f_7.light_dir.xyz, _e21));
-    uint _e259 = count;
-    uint panels_1 = max(((f_7.sizes2_.z / 4u) / _e259), 1u);
+    uint panels_2 = max((f_7.sizes2_.z / 4u), 1u);
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e274 = layer;
-            layer = (_e274 + 1u);
+            uint _e275 = layer;
+            layer = (_e275 + 1u);
         }
         loop_init_4 = false;
-        uint _e264 = layer;
-        if ((_e264 < LAYERS)) {
+        uint _e265 = layer;
+        if ((_e265 < LAYERS)) {
         } else {
             break;
         }
         {
-            uint _e268 = layer;
-            float _e270 = d;
-            uint _e271 = layer;
-            vec4 _e272 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e270, _e271);
-            coeffs[_e268] = _e272;
+            uint _e269 = layer;
+            float _e271 = d;
+            uint _e272 = layer;
+            vec4 _e273 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e271, _e272);
+            coeffs[_e269] = _e273;
         }
     }
     bool loop_init_5 = true;
     while(true) {
         if (!loop_init_5) {
-            uint _e362 = r_1;
-            r_1 = (_e362 + 1u);
+            uint _e363 = r_1;
+            r_1 = (_e363 + 1u);
         }
         loop_init_5 = false;
-        uint _e277 = r_1;
-        uint _e278 = count;
-        if ((_e277 < _e278)) {
+        uint _e278 = r_1;
+        uint _e279 = count;
+        if ((_e278 < _e279)) {
         } else {
             break;
         }
         {
-            uint _e280 = r_1;
-            float a_2 = t0_[_e280];
-            uint _e283 = r_1;
-            float b_2 = t1_[_e283];
+            uint _e281 = r_1;
+            float a_3 = t0_[_e281];
+            uint _e284 = r_1;
+            float b_3 = t1_[_e284];
             weight = 0.0;
             if (!(true)) {
-                weight = (b_2 - a_2);
+                weight = (b_3 - a_3);
             } else {
                 if (false) {
-                    float _e291 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
-                    weight = _e291;
+                    float _e292 = spot_segment(f_7, eye_5, _e21, a_3, b_3, panels_2);
+                    weight = _e292;
                 } else {
-                    float _e296 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-                    float _e300 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
-                    weight = ((f_7.medium.y * _e296) * _e300);
+                    float _e297 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+                    float _e301 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_3, b_3);
+                    weight = ((f_7.medium.y * _e297) * _e301);
                 }
             }
             vis = 0.5;
@@ -603,74 +610,74 @@ void main() {
             bool loop_init_6 = true;
             while(true) {
                 if (!loop_init_6) {
-                    uint _e346 = layer_1;
-                    layer_1 = (_e346 + 1u);
+                    uint _e347 = layer_1;
+                    layer_1 = (_e347 + 1u);
                 }
                 loop_init_6 = false;
-                uint _e306 = layer_1;
-                if ((_e306 < LAYERS)) {
+                uint _e307 = layer_1;
+                if ((_e307 < LAYERS)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e309 = layer_1;
-                    vec4 coeff = coeffs[_e309];
-                    uint _e312 = r_1;
-                    float _e314 = pos[_e312];
-                    float _e317 = yc;
-                    uint _e321 = layer_1;
-                    vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e314 / float(width_1)), (_e317 / float(rows_1))), _e321), 0.0);
+                    uint _e310 = layer_1;
+                    vec4 coeff = coeffs[_e310];
+                    uint _e313 = r_1;
+                    float _e315 = pos[_e313];
+                    float _e318 = yc;
+                    uint _e322 = layer_1;
+                    vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e315 / float(width_1)), (_e318 / float(rows_1))), _e322), 0.0);
                     k = 0u;
                     bool loop_init_7 = true;
                     while(true) {
                         if (!loop_init_7) {
-                            uint _e343 = k;
-                            k = (_e343 + 1u);
+                            uint _e344 = k;
+                            k = (_e344 + 1u);
                         }
                         loop_init_7 = false;
-                        uint _e328 = k;
-                        if ((_e328 < 4u)) {
+                        uint _e329 = k;
+                        if ((_e329 < 4u)) {
                         } else {
                             break;
                         }
                         {
-                            float _e331 = vis;
-                            uint _e332 = k;
-                            uint _e334 = k;
-                            vis = (_e331 + (coeff[_e332] * ((texel_1[_e334] * 2.0) - 1.0)));
+                            float _e332 = vis;
+                            uint _e333 = k;
+                            uint _e335 = k;
+                            vis = (_e332 + (coeff[_e333] * ((texel_1[_e335] * 2.0) - 1.0)));
                         }
                     }
                 }
             }
-            float _e349 = total;
-            float _e350 = weight;
-            float _e351 = vis;
-            total = (_e349 + (_e350 * clamp(_e351, 0.0, 1.0)));
-            float _e358 = norm;
-            float _e359 = weight;
-            norm = (_e358 + _e359);
+            float _e350 = total;
+            float _e351 = weight;
+            float _e352 = vis;
+            total = (_e350 + (_e351 * clamp(_e352, 0.0, 1.0)));
+            float _e359 = norm;
+            float _e360 = weight;
+            norm = (_e359 + _e360);
         }
     }
     if (true) {
-        float _e364 = total;
-        l = _e364;
+        float _e365 = total;
+        l = _e365;
     } else {
         if (false) {
-            float _e373 = spot_segment(f_7, eye_4, _e21, 0.0, s_2, max((f_7.sizes2_.z / 4u), 1u));
-            unshadowed = _e373;
+            float _e374 = spot_segment(f_7, eye_5, _e21, 0.0, s_2, max((f_7.sizes2_.z / 4u), 1u));
+            unshadowed = _e374;
         } else {
-            float _e379 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-            float _e383 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
-            unshadowed = ((f_7.medium.y * _e379) * _e383);
+            float _e380 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+            float _e384 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
+            unshadowed = ((f_7.medium.y * _e380) * _e384);
         }
-        float _e385 = unshadowed;
-        float _e386 = total;
-        float _e387 = norm;
-        float _e389 = norm;
-        l = (_e385 * ((_e389 > 0.0) ? (_e386 / _e387) : 1.0));
+        float _e386 = unshadowed;
+        float _e387 = total;
+        float _e388 = norm;
+        float _e390 = norm;
+        l = (_e386 * ((_e390 > 0.0) ? (_e387 / _e388) : 1.0));
     }
-    float _e395 = l;
-    vec3 c = (color * _e395);
+    float _e396 = l;
+    vec3 c = (color * _e396);
     imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_6, y_2)), vec4(c.x, c.y, c.z, 1.0));
     return;
 }

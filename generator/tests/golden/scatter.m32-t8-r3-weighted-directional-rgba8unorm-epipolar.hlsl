@@ -192,18 +192,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        float3 dir_4 = float3(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
-        if ((dir_4.z <= 1e-6)) {
+        float3 dir_5 = float3(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
+        if ((dir_5.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_4);
+        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_5);
         const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_4.z);
+        return ((z_2 + _e35) / dir_5.z);
     } else {
         const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -302,6 +302,65 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
+{
+    float sum = 0.0;
+    uint k_2 = 0u;
+    uint q = (uint)0;
+
+    float t0_1 = dot((light_pos_1 - eye_1), dir_1);
+    float h = max(length(((eye_1 + (dir_1 * t0_1)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float g0_ = atan(((a_1 - t0_1) / h));
+    float w = ((atan(((b_1 - t0_1) / h)) - g0_) / float(panels));
+    uint2 loop_bound = uint2(4294967295u, 4294967295u);
+    bool loop_init = true;
+    while(true) {
+        if (all(loop_bound == uint2(0u, 0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e73 = k_2;
+            k_2 = (_e73 + 1u);
+        }
+        loop_init = false;
+        uint _e30 = k_2;
+        if ((_e30 < panels)) {
+        } else {
+            break;
+        }
+        {
+            uint _e32 = k_2;
+            float mid = (g0_ + ((float(_e32) + 0.5) * w));
+            q = 0u;
+            uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
+            bool loop_init_1 = true;
+            while(true) {
+                if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
+                loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+                if (!loop_init_1) {
+                    uint _e70 = q;
+                    q = (_e70 + 1u);
+                }
+                loop_init_1 = false;
+                uint _e40 = q;
+                if ((_e40 < 4u)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e46 = q;
+                    float u = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
+                    float _e52 = sum;
+                    uint _e54 = q;
+                    const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_1 + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e54), 3u)] * _e62) * (1.0 + (u * u))));
+                }
+            }
+        }
+    }
+    float _e75 = sum;
+    return (((_e75 * 0.5) * w) * h);
+}
+
 float3 pixel_dir(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2, uint x, uint y)
 {
     float ndc_x = (((2.0 * (float(x) + 0.5)) / float(f_2.sizes.x)) - 1.0);
@@ -310,58 +369,58 @@ float3 pixel_dir(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2, uin
     return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc_x * t_3) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc_y * t_3))));
 }
 
-float frame_spot_integrand(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, float3 eye_1, float3 dir_1, float t_1)
+float frame_spot_integrand(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, float3 eye_2, float3 dir_2, float t_1)
 {
-    const float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
+    const float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-float march(float3 eye_2, float3 dir_2, float s, bool spot_1)
+float march(float3 eye_3, float3 dir_3, float s, bool spot_1)
 {
-    float sum = 0.0;
-    uint k_2 = 0u;
+    float sum_1 = 0.0;
+    uint k_3 = 0u;
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_6 = frame;
     uint steps = f_6.sizes2_.y;
-    float h = (s / float(steps));
-    uint2 loop_bound = uint2(4294967295u, 4294967295u);
-    bool loop_init = true;
+    float h_1 = (s / float(steps));
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (all(loop_bound == uint2(0u, 0u))) { break; }
-        loop_bound -= uint2(loop_bound.y == 0u, 1u);
-        if (!loop_init) {
-            uint _e45 = k_2;
-            k_2 = (_e45 + 1u);
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e45 = k_3;
+            k_3 = (_e45 + 1u);
         }
-        loop_init = false;
-        uint _e10 = k_2;
+        loop_init_2 = false;
+        uint _e10 = k_3;
         if ((_e10 < steps)) {
         } else {
             break;
         }
         {
-            uint _e12 = k_2;
-            float t_4 = ((float(_e12) + 0.5) * h);
-            const float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, shadow_map, (eye_2 + (dir_2 * t_4)));
+            uint _e12 = k_3;
+            float t_4 = ((float(_e12) + 0.5) * h_1);
+            const float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, shadow_map, (eye_3 + (dir_3 * t_4)));
             if (spot_1) {
-                float _e25 = sum;
-                const float _e27 = frame_spot_integrand(f_6, eye_2, dir_2, t_4);
-                sum = (_e25 + ((_e22 * h) * _e27));
+                float _e25 = sum_1;
+                const float _e27 = frame_spot_integrand(f_6, eye_3, dir_3, t_4);
+                sum_1 = (_e25 + ((_e22 * h_1) * _e27));
             } else {
-                float _e30 = sum;
-                uint _e33 = k_2;
-                uint _e36 = k_2;
-                const float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, (float(_e33) * h), (float((_e36 + 1u)) * h));
-                sum = (_e30 + (_e22 * _e41));
+                float _e30 = sum_1;
+                uint _e33 = k_3;
+                uint _e36 = k_3;
+                const float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, (float(_e33) * h_1), (float((_e36 + 1u)) * h_1));
+                sum_1 = (_e30 + (_e22 * _e41));
             }
         }
     }
     if (spot_1) {
-        float _e47 = sum;
+        float _e47 = sum_1;
         return _e47;
     } else {
-        const float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_2)));
-        float _e58 = sum;
+        const float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_3)));
+        float _e58 = sum_1;
         return ((f_6.medium.y * _e56) * _e58);
     }
 }
@@ -407,60 +466,10 @@ float ray_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4, float x_
     }
 }
 
-float spot_segment(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5, float3 eye_3, float3 dir_3, float a_1, float b_1, uint panels)
+float spot_segment(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5, float3 eye_4, float3 dir_4, float a_2, float b_2, uint panels_1)
 {
-    float sum_1 = 0.0;
-    uint k_3 = 0u;
-    uint q = (uint)0;
-
-    float h_1 = ((b_1 - a_1) / float(panels));
-    uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
-    bool loop_init_1 = true;
-    while(true) {
-        if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init_1) {
-            uint _e44 = k_3;
-            k_3 = (_e44 + 1u);
-        }
-        loop_init_1 = false;
-        uint _e9 = k_3;
-        if ((_e9 < panels)) {
-        } else {
-            break;
-        }
-        {
-            uint _e11 = k_3;
-            float mid = (a_1 + ((float(_e11) + 0.5) * h_1));
-            q = 0u;
-            uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
-            bool loop_init_2 = true;
-            while(true) {
-                if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
-                loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-                if (!loop_init_2) {
-                    uint _e41 = q;
-                    q = (_e41 + 1u);
-                }
-                loop_init_2 = false;
-                uint _e19 = q;
-                if ((_e19 < 4u)) {
-                } else {
-                    break;
-                }
-                {
-                    uint _e25 = q;
-                    float t_5 = (mid + ((0.5 * h_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e25), 3u)]));
-                    float _e30 = sum_1;
-                    uint _e32 = q;
-                    const float _e37 = frame_spot_integrand(f_5, eye_3, dir_3, t_5);
-                    sum_1 = (_e30 + (GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e32), 3u)] * _e37));
-                }
-            }
-        }
-    }
-    float _e46 = sum_1;
-    return ((_e46 * 0.5) * h_1);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_5.light_pos.xyz, f_5.light_dir.xyz, f_5.light_pos.w, f_5.light_dir.w, f_5.medium);
+    return _e15;
 }
 
 float ZeroValuefloat() {
@@ -509,10 +518,10 @@ void scatter(uint3 id : SV_DispatchThreadID)
     if (_e18) {
         return;
     }
-    float3 eye_4 = f_7.eye.xyz;
+    float3 eye_5 = f_7.eye.xyz;
     const float3 _e21 = pixel_dir(f_7, x_6, y_2);
     float4 _e25 = depth.Load(int3(uint2(x_6, y_2), int(0)));
-    float s_2 = (max(_e25.x, 0.0) / max(dot(_e21, f_7.cam_forward.xyz), 1e-6));
+    float s_2 = (min(max(_e25.x, 0.0), f_7.theta.z) / max(dot(_e21, f_7.cam_forward.xyz), 1e-6));
     float3 color = f_7.light_color.xyz;
     float3 px = float3((float(x_6) + 0.5), (float(y_2) + 0.5), 0.0);
     float radius = f_7.epipole.w;
@@ -533,10 +542,10 @@ void scatter(uint3 id : SV_DispatchThreadID)
     } else {
         local_3 = true;
     }
-    bool _e85 = local_3;
-    if (_e85) {
-        const float _e87 = march(eye_4, _e21, s_2, false);
-        float3 l_2 = (_e87 * color);
+    bool _e88 = local_3;
+    if (_e88) {
+        const float _e90 = march(eye_5, _e21, s_2, false);
+        float3 l_2 = (_e90 * color);
         output[uint2(x_6, y_2)] = float4(l_2.x, l_2.y, l_2.z, 1.0);
         return;
     }
@@ -549,112 +558,111 @@ void scatter(uint3 id : SV_DispatchThreadID)
         float phi = atan2(dot(_e21, f_7.e2_.xyz), dot(_e21, f_7.e1_.xyz));
         yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
         if (wrap_1) {
-            float _e126 = yc;
-            float _e127 = yc;
-            yc = (_e126 - (floor((_e127 / float(rows_1))) * float(rows_1)));
+            float _e129 = yc;
+            float _e130 = yc;
+            yc = (_e129 - (floor((_e130 / float(rows_1))) * float(rows_1)));
         } else {
-            float _e134 = yc;
-            yc = clamp(_e134, 0.0, float(rows_1));
+            float _e137 = yc;
+            yc = clamp(_e137, 0.0, float(rows_1));
         }
-        float _e138 = yc;
-        float yy = (_e138 - 0.5);
+        float _e141 = yc;
+        float yy = (_e141 - 0.5);
         float j0_ = floor(yy);
         float fy = (yy - j0_);
-        const uint _e143 = row_index(j0_, rows_1, wrap_1);
-        float4 _e146 = asfloat(slices.Load4(_e143*16));
-        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e147 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e146);
-        const uint _e150 = row_index((j0_ + 1.0), rows_1, wrap_1);
-        float4 _e153 = asfloat(slices.Load4(_e150*16));
-        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e154 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e153);
-        delta = lerp(_e147.delta, _e154.delta, fy);
-        float _e159 = theta;
-        const float _e164 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e159, f_7.theta.x, f_7.theta.y);
-        d = _e164;
+        const uint _e146 = row_index(j0_, rows_1, wrap_1);
+        float4 _e149 = asfloat(slices.Load4(_e146*16));
+        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
+        const uint _e153 = row_index((j0_ + 1.0), rows_1, wrap_1);
+        float4 _e156 = asfloat(slices.Load4(_e153*16));
+        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e157 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156);
+        delta = lerp(_e150.delta, _e157.delta, fy);
+        float _e162 = theta;
+        const float _e167 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e162, f_7.theta.x, f_7.theta.y);
+        d = _e167;
         if (false) {
-            float3 q_2 = normalize(((eye_4 + (_e21 * s_2)) - f_7.light_pos.xyz));
-            float _e178 = delta;
-            xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / _e178);
+            float3 q_2 = normalize(((eye_5 + (_e21 * s_2)) - f_7.light_pos.xyz));
+            float _e181 = delta;
+            xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / _e181);
         } else {
-            float _e181 = theta;
-            float _e184 = delta;
-            xs = ((s_2 * sin(_e181)) / _e184);
+            float _e184 = theta;
+            float _e187 = delta;
+            xs = ((s_2 * sin(_e184)) / _e187);
         }
     }
-    float _e186 = xs;
-    uint last = naga_f2u32(min(max(_e186, 0.0), (float(width_1) - 1.0)));
+    float _e189 = xs;
+    uint last = naga_f2u32(min(max(_e189, 0.0), (float(width_1) - 1.0)));
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e249 = r;
-            r = (_e249 + 1u);
+            uint _e252 = r;
+            r = (_e252 + 1u);
         }
         loop_init_3 = false;
-        uint _e196 = r;
-        if ((_e196 < REGIONS)) {
+        uint _e199 = r;
+        if ((_e199 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e198 = r;
-            const uint _e199 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, width_1, false);
-            float b0_ = float(_e199);
             uint _e201 = r;
-            const uint _e204 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e201 + 1u), REGIONS, width_1, false);
-            float b1_ = float(_e204);
+            const uint _e202 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e201, REGIONS, width_1, false);
+            float b0_ = float(_e202);
+            uint _e204 = r;
+            const uint _e207 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e204 + 1u), REGIONS, width_1, false);
+            float b1_ = float(_e207);
             if (!((last < naga_f2u32(b1_)))) {
-                uint _e209 = r;
-                local_4 = ((_e209 + 1u) == REGIONS);
+                uint _e212 = r;
+                local_4 = ((_e212 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             bool is_last = local_4;
-            uint _e218 = r;
-            float _e222 = xs;
-            pos[min(uint(_e218), 7u)] = (is_last ? clamp((_e222 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            uint _e232 = r;
-            float _e234 = delta;
-            float _e235 = theta;
-            const float _e236 = ray_t(f_7, b0_, _e234, _e235, s_2, false);
-            t0_[min(uint(_e232), 7u)] = _e236;
-            uint _e238 = r;
-            float _e240 = delta;
-            float _e241 = theta;
-            const float _e242 = ray_t(f_7, b1_, _e240, _e241, s_2, false);
-            t1_[min(uint(_e238), 7u)] = (is_last ? s_2 : _e242);
-            uint _e244 = r;
-            count = (_e244 + 1u);
+            uint _e221 = r;
+            float _e225 = xs;
+            pos[min(uint(_e221), 7u)] = (is_last ? clamp((_e225 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            uint _e235 = r;
+            float _e237 = delta;
+            float _e238 = theta;
+            const float _e239 = ray_t(f_7, b0_, _e237, _e238, s_2, false);
+            t0_[min(uint(_e235), 7u)] = _e239;
+            uint _e241 = r;
+            float _e243 = delta;
+            float _e244 = theta;
+            const float _e245 = ray_t(f_7, b1_, _e243, _e244, s_2, false);
+            t1_[min(uint(_e241), 7u)] = (is_last ? s_2 : _e245);
+            uint _e247 = r;
+            count = (_e247 + 1u);
             if (is_last) {
                 break;
             }
         }
     }
     float cos_theta_l = -(dot(f_7.light_dir.xyz, _e21));
-    uint _e259 = count;
-    uint panels_1 = max(naga_div(naga_div(f_7.sizes2_.z, 4u), _e259), 1u);
+    uint panels_2 = max(naga_div(f_7.sizes2_.z, 4u), 1u);
     uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e274 = layer;
-            layer = (_e274 + 1u);
+            uint _e275 = layer;
+            layer = (_e275 + 1u);
         }
         loop_init_4 = false;
-        uint _e264 = layer;
-        if ((_e264 < LAYERS)) {
+        uint _e265 = layer;
+        if ((_e265 < LAYERS)) {
         } else {
             break;
         }
         {
-            uint _e268 = layer;
-            float _e270 = d;
-            uint _e271 = layer;
-            const float4 _e272 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e270, _e271);
-            coeffs[min(uint(_e268), 7u)] = _e272;
+            uint _e269 = layer;
+            float _e271 = d;
+            uint _e272 = layer;
+            const float4 _e273 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e271, _e272);
+            coeffs[min(uint(_e269), 7u)] = _e273;
         }
     }
     uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
@@ -663,32 +671,32 @@ void scatter(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e362 = r_1;
-            r_1 = (_e362 + 1u);
+            uint _e363 = r_1;
+            r_1 = (_e363 + 1u);
         }
         loop_init_5 = false;
-        uint _e277 = r_1;
-        uint _e278 = count;
-        if ((_e277 < _e278)) {
+        uint _e278 = r_1;
+        uint _e279 = count;
+        if ((_e278 < _e279)) {
         } else {
             break;
         }
         {
-            uint _e280 = r_1;
-            float a_2 = t0_[min(uint(_e280), 7u)];
-            uint _e283 = r_1;
-            float b_2 = t1_[min(uint(_e283), 7u)];
+            uint _e281 = r_1;
+            float a_3 = t0_[min(uint(_e281), 7u)];
+            uint _e284 = r_1;
+            float b_3 = t1_[min(uint(_e284), 7u)];
             weight = ZeroValuefloat();
             if (!(true)) {
-                weight = (b_2 - a_2);
+                weight = (b_3 - a_3);
             } else {
                 if (false) {
-                    const float _e291 = spot_segment(f_7, eye_4, _e21, a_2, b_2, panels_1);
-                    weight = _e291;
+                    const float _e292 = spot_segment(f_7, eye_5, _e21, a_3, b_3, panels_2);
+                    weight = _e292;
                 } else {
-                    const float _e296 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-                    const float _e300 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_2, b_2);
-                    weight = ((f_7.medium.y * _e296) * _e300);
+                    const float _e297 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+                    const float _e301 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_3, b_3);
+                    weight = ((f_7.medium.y * _e297) * _e301);
                 }
             }
             vis = 0.5;
@@ -699,23 +707,23 @@ void scatter(uint3 id : SV_DispatchThreadID)
                 if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
                 loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                 if (!loop_init_6) {
-                    uint _e346 = layer_1;
-                    layer_1 = (_e346 + 1u);
+                    uint _e347 = layer_1;
+                    layer_1 = (_e347 + 1u);
                 }
                 loop_init_6 = false;
-                uint _e306 = layer_1;
-                if ((_e306 < LAYERS)) {
+                uint _e307 = layer_1;
+                if ((_e307 < LAYERS)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e309 = layer_1;
-                    float4 coeff = coeffs[min(uint(_e309), 7u)];
-                    uint _e312 = r_1;
-                    float _e314 = pos[min(uint(_e312), 7u)];
-                    float _e317 = yc;
-                    uint _e321 = layer_1;
-                    float4 texel_1 = filtered.SampleLevel(filtered_sampler, float3(float2((_e314 / float(width_1)), (_e317 / float(rows_1))), _e321), 0.0);
+                    uint _e310 = layer_1;
+                    float4 coeff = coeffs[min(uint(_e310), 7u)];
+                    uint _e313 = r_1;
+                    float _e315 = pos[min(uint(_e313), 7u)];
+                    float _e318 = yc;
+                    uint _e322 = layer_1;
+                    float4 texel_1 = filtered.SampleLevel(filtered_sampler, float3(float2((_e315 / float(width_1)), (_e318 / float(rows_1))), _e322), 0.0);
                     k = 0u;
                     uint2 loop_bound_7 = uint2(4294967295u, 4294967295u);
                     bool loop_init_7 = true;
@@ -723,53 +731,53 @@ void scatter(uint3 id : SV_DispatchThreadID)
                         if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
                         loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
                         if (!loop_init_7) {
-                            uint _e343 = k;
-                            k = (_e343 + 1u);
+                            uint _e344 = k;
+                            k = (_e344 + 1u);
                         }
                         loop_init_7 = false;
-                        uint _e328 = k;
-                        if ((_e328 < 4u)) {
+                        uint _e329 = k;
+                        if ((_e329 < 4u)) {
                         } else {
                             break;
                         }
                         {
-                            float _e331 = vis;
-                            uint _e332 = k;
-                            uint _e334 = k;
-                            vis = (_e331 + (coeff[min(uint(_e332), 3u)] * ((texel_1[min(uint(_e334), 3u)] * 2.0) - 1.0)));
+                            float _e332 = vis;
+                            uint _e333 = k;
+                            uint _e335 = k;
+                            vis = (_e332 + (coeff[min(uint(_e333), 3u)] * ((texel_1[min(uint(_e335), 3u)] * 2.0) - 1.0)));
                         }
                     }
                 }
             }
-            float _e349 = total;
-            float _e350 = weight;
-            float _e351 = vis;
-            total = (_e349 + (_e350 * clamp(_e351, 0.0, 1.0)));
-            float _e358 = norm;
-            float _e359 = weight;
-            norm = (_e358 + _e359);
+            float _e350 = total;
+            float _e351 = weight;
+            float _e352 = vis;
+            total = (_e350 + (_e351 * clamp(_e352, 0.0, 1.0)));
+            float _e359 = norm;
+            float _e360 = weight;
+            norm = (_e359 + _e360);
         }
     }
     if (true) {
-        float _e364 = total;
-        l = _e364;
+        float _e365 = total;
+        l = _e365;
     } else {
         if (false) {
-            const float _e373 = spot_segment(f_7, eye_4, _e21, 0.0, s_2, max(naga_div(f_7.sizes2_.z, 4u), 1u));
-            unshadowed = _e373;
+            const float _e374 = spot_segment(f_7, eye_5, _e21, 0.0, s_2, max(naga_div(f_7.sizes2_.z, 4u), 1u));
+            unshadowed = _e374;
         } else {
-            const float _e379 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-            const float _e383 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
-            unshadowed = ((f_7.medium.y * _e379) * _e383);
+            const float _e380 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
+            const float _e384 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
+            unshadowed = ((f_7.medium.y * _e380) * _e384);
         }
-        float _e385 = unshadowed;
-        float _e386 = total;
-        float _e387 = norm;
-        float _e389 = norm;
-        l = (_e385 * ((_e389 > 0.0) ? (_e386 / _e387) : 1.0));
+        float _e386 = unshadowed;
+        float _e387 = total;
+        float _e388 = norm;
+        float _e390 = norm;
+        l = (_e386 * ((_e390 > 0.0) ? (_e387 / _e388) : 1.0));
     }
-    float _e395 = l;
-    float3 c = (color * _e395);
+    float _e396 = l;
+    float3 c = (color * _e396);
     output[uint2(x_6, y_2)] = float4(c.x, c.y, c.z, 1.0);
     return;
 }

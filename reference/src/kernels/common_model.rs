@@ -58,6 +58,49 @@ pub fn spot_integrand(
     medium[1] * p * cone * exp(-medium[0] * (d + t)) / d2
 }
 
+/// Unshadowed spot in-scattering over `[a, b]` of the view ray `eye + t dir` (without the
+/// light colour): `panels` 4-point Gauss-Legendre panels in the angle `gamma` under which the
+/// lamp sees the ray point (`t = t0 + h tan(gamma)`, `dt / d^2 = dgamma / h`), so the 1/d^2
+/// peak of a ray passing near the lamp is integrated exactly. See the WGSL comment.
+#[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+pub fn spot_span(
+    eye: Vec3,
+    dir: Vec3,
+    a: f32,
+    b: f32,
+    panels: u32,
+    light_pos: Vec3,
+    light_dir: Vec3,
+    cos_inner: f32,
+    cos_outer: f32,
+    medium: [f32; 4],
+) -> f32 {
+    let t0 = (light_pos - eye).dot(dir);
+    let h = max((eye + dir * t0 - light_pos).length(), 1e-4 * max(b - a, 1e-6));
+    let g0 = ((a - t0) / h).atan();
+    let w = (((b - t0) / h).atan() - g0) / panels as f32;
+    let mut sum = 0.0;
+    for k in 0..panels {
+        let mid = g0 + (k as f32 + 0.5) * w;
+        for q in 0..4 {
+            let u = (mid + 0.5 * w * GL4_X[q]).tan();
+            sum += GL4_W[q]
+                * spot_integrand(
+                    eye,
+                    dir,
+                    t0 + h * u,
+                    light_pos,
+                    light_dir,
+                    cos_inner,
+                    cos_outer,
+                    medium,
+                )
+                * (1.0 + u * u);
+        }
+    }
+    sum * 0.5 * w * h
+}
+
 /// 4-point Gauss-Legendre abscissae on [-1, 1] (ascending).
 pub const GL4_X: [f32; 4] = [-0.861_136_3, -0.339_981_04, 0.339_981_04, 0.861_136_3];
 /// 4-point Gauss-Legendre weights.

@@ -2,7 +2,7 @@
 //! standard shadow map, optionally one interleaving class per pixel (Tóth & Umenhoffer
 //! 2009). Conventions: `scatter_frame::raymarch`.
 
-use super::common_model::{max, phase_hg, spot_integrand, transmittance_between};
+use super::common_model::{max, min, phase_hg, spot_integrand, transmittance_between};
 use super::common_prefiltered::{Tex, TexArray, quantise, xyz};
 use super::common_raymarch::{march_pixel_dir, march_shadow_view, pixel_jitter};
 use super::common_shadow::shadow_visibility;
@@ -25,7 +25,8 @@ pub fn raymarch_main(
     let spot = variant.light == LightKind::Spot;
     let eye = xyz(m.eye);
     let dir = march_pixel_dir(m, x, y);
-    let s = max(depth.load(x, y), 0.0) / max(dir.dot(xyz(m.cam_forward)), 1e-6);
+    // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
+    let s = min(max(depth.load(x, y), 0.0), m.eye[3]) / max(dir.dot(xyz(m.cam_forward)), 1e-6);
     let n = m.sizes[3];
     let h = s / n as f32;
     let mx = m.interleave[0];

@@ -10,7 +10,7 @@
 //! reference ray's. Average visibility: `L = L_unshadowed * sum_j len_j Vbar_j / s`.
 
 use super::common_model::{
-    GL4_W, GL4_X, PI, clamp, max, max_u, min, mix, phase_hg, select, spot_integrand,
+    PI, clamp, max, max_u, min, mix, phase_hg, select, spot_integrand, spot_span,
     transmittance_between, transmittance_integral,
 };
 use super::common_prefiltered::{
@@ -97,7 +97,8 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
     let weighted = variant.visibility == VisibilityMode::Weighted;
     let eye = xyz(f.eye);
     let dir = pixel_dir(f, x, y);
-    let s = max(inp.depth.load(x, y), 0.0) / max(dir.dot(xyz(f.cam_forward)), 1e-6);
+    // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
+    let s = min(max(inp.depth.load(x, y), 0.0), f.theta[2]) / max(dir.dot(xyz(f.cam_forward)), 1e-6);
     let color = xyz(f.light_color);
 
     // Near the epipole and the anti-epipole the rectification degenerates: march instead.
@@ -224,7 +225,8 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         }
     }
     let cos_theta_l = -xyz(f.light_dir).dot(dir);
-    let panels = max_u(f.sizes2[2] / 4 / count, 1);
+    // Every region gets the full spot quadrature (see the WGSL comment).
+    let panels = max_u(f.sizes2[2] / 4, 1);
     // The ray's Fourier coefficients depend on its depth only: once per pixel.
     let coeffs: Vec<[f32; 4]> = (0..variant.layers())
         .map(|layer| coeff4(d, layer))
@@ -285,19 +287,20 @@ pub fn ray_t(f: &FrameUniforms, x: f32, delta: f32, theta: f32, s: f32, spot: bo
     }
 }
 
-/// Unshadowed spot in-scattering over `[a, b]` of the ray: `panels` 4-point Gauss-Legendre
-/// panels.
+/// Unshadowed spot in-scattering over `[a, b]` of the ray (`common_model::spot_span`).
 pub fn spot_segment(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, panels: u32) -> f32 {
-    let h = (b - a) / panels as f32;
-    let mut sum = 0.0;
-    for k in 0..panels {
-        let mid = a + (k as f32 + 0.5) * h;
-        for q in 0..4 {
-            let t = mid + 0.5 * h * GL4_X[q];
-            sum += GL4_W[q] * frame_spot_integrand(f, eye, dir, t);
-        }
-    }
-    sum * 0.5 * h
+    spot_span(
+        eye,
+        dir,
+        a,
+        b,
+        panels,
+        xyz(f.light_pos),
+        xyz(f.light_dir),
+        f.light_pos[3],
+        f.light_dir[3],
+        f.medium,
+    )
 }
 
 /// Runs every pixel (rows in parallel); returns the screen-sized output as stored in

@@ -65,3 +65,37 @@ fn spot_integrand(
 const GL4_X: array<f32, 4> = array<f32, 4>(-0.8611363f, -0.33998104f, 0.33998104f, 0.8611363f);
 // 4-point Gauss-Legendre weights.
 const GL4_W: array<f32, 4> = array<f32, 4>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
+
+// Unshadowed spot in-scattering over `[a, b]` of the view ray `eye + t dir` (without the
+// light colour): `panels` 4-point Gauss-Legendre panels in the angle `gamma` under which the
+// lamp sees the ray point. With `t0` the ray's closest approach to the lamp and `h` its
+// distance there, `t = t0 + h tan(gamma)` and `dt / d^2 = dgamma / h`: the 1/d^2 peak of a
+// ray passing near the lamp becomes flat, and what is left (cone, phase, transmittance) is
+// smooth in `gamma`. Quadrature in `t` missed that peak (18.9 % rel L1 for minmax on
+// `spot_grate/ordinary`, whose top rows pass 0.3 m from the lamp).
+fn spot_span(
+    eye: vec3<f32>,
+    dir: vec3<f32>,
+    a: f32,
+    b: f32,
+    panels: u32,
+    light_pos: vec3<f32>,
+    light_dir: vec3<f32>,
+    cos_inner: f32,
+    cos_outer: f32,
+    medium: vec4<f32>,
+) -> f32 {
+    let t0 = dot(light_pos - eye, dir);
+    let h = max(length(eye + dir * t0 - light_pos), 1e-4 * max(b - a, 1e-6));
+    let g0 = atan((a - t0) / h);
+    let w = (atan((b - t0) / h) - g0) / f32(panels);
+    var sum = 0.0;
+    for (var k = 0u; k < panels; k++) {
+        let mid = g0 + (f32(k) + 0.5) * w;
+        for (var q = 0u; q < 4u; q++) {
+            let u = tan(mid + 0.5 * w * GL4_X[q]);
+            sum += GL4_W[q] * spot_integrand(eye, dir, t0 + h * u, light_pos, light_dir, cos_inner, cos_outer, medium) * (1.0 + u * u);
+        }
+    }
+    return sum * 0.5 * w * h;
+}
