@@ -464,7 +464,7 @@ fn every_family_survives_every_stress_case() {
                         ));
                     }
                 }
-                (None, Rectification::Projective) => notes.push("projective".into()),
+                (None, Rectification::Projective) => notes.push("proj: projective frame".into()),
                 other => failures.push(format!(
                     "stress::prefiltered-proj::{name}: inconsistent report {other:?}"
                 )),
