@@ -839,7 +839,8 @@ pub(crate) fn finite_fields<const N: usize>(
 ///
 /// # Errors
 ///
-/// [`FrameError::Size`] for a zero or oversized size, [`FrameError::RectifiedTooNarrow`],
+/// [`FrameError::Variant`] for a variant that does not validate, [`FrameError::Size`] for
+/// a zero or oversized size, [`FrameError::RectifiedTooNarrow`],
 /// [`FrameError::LightMismatch`], [`FrameError::OutOfRange`] naming the parameter, its
 /// value and the accepted range, [`FrameError::EyeAtLight`]; [`FrameError::NotRepresentable`]
 /// if a uniform still came out non-finite.
@@ -904,6 +905,9 @@ fn prepare_frame_unchecked(
     shadow: &ShadowMapDesc,
     settings: &FrameSettings,
 ) -> Result<PrefilteredFrame, FrameError> {
+    // The variant is plain data: an unvalidated one (regions = u32::MAX) would overflow
+    // `regions^2` and allocate per region below.
+    variant.validate()?;
     for (what, value, max) in [
         ("screen width", res.screen[0], 16384),
         ("screen height", res.screen[1], 16384),

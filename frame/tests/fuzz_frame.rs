@@ -232,6 +232,9 @@ enum Mutation {
     ProjectiveMaxHalfAngle(f64),
     /// The other light type than the variant's.
     SwapLight,
+    /// Prefiltered variants: `regions`, `bases` and `bases_per_thread` set without
+    /// validation (the variant is plain data).
+    Knobs(u32, u32, u32),
 }
 
 impl Mutation {
@@ -265,6 +268,7 @@ impl Mutation {
             Self::SpotQuadrature(_) => &["spot quadrature"],
             Self::ProjectiveMaxHalfAngle(_) => &["projective_max_half_angle_deg"],
             Self::SwapLight => &["light but the frame has a"],
+            Self::Knobs(..) => &["regions", "bases"],
         }
     }
 }
@@ -311,6 +315,7 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         wild_u32().prop_map(Mutation::SpotQuadrature),
         wild_f64().prop_map(Mutation::ProjectiveMaxHalfAngle),
         Just(Mutation::SwapLight),
+        (wild_u32(), wild_u32(), wild_u32()).prop_map(|(r, b, t)| Mutation::Knobs(r, b, t)),
     ]
 }
 
@@ -532,6 +537,13 @@ impl Case {
                 Mutation::ProjectiveMaxHalfAngle(x) => {
                     self.settings.projective_max_half_angle_deg = x;
                 }
+                Mutation::Knobs(regions, bases, bases_per_thread) => {
+                    if let Family::Prefiltered(v) = &mut self.family {
+                        v.regions = regions;
+                        v.bases = bases;
+                        v.bases_per_thread = bases_per_thread;
+                    }
+                }
                 Mutation::SwapLight => {
                     self.light = match self.light {
                         LightDesc::Directional { direction, color } => LightDesc::Spot {
@@ -738,6 +750,12 @@ fn check_case(case: Case) -> Result<(), TestCaseError> {
         .map(|u| check_march_uniforms(&u)),
     };
     tally(result.is_ok());
+    if let (Family::Prefiltered(v), Ok(_)) = (&case.family, &result) {
+        prop_assert!(
+            v.validate().is_ok(),
+            "a frame was set up for an invalid variant {v:?}"
+        );
+    }
     match result {
         Ok(checked) => checked,
         Err(e) => check_error(&case, &e.to_string()),
