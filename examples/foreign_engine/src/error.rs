@@ -173,9 +173,10 @@ pub enum EngineError {
         /// What the engine sets, comma-separated.
         known: String,
     },
-    /// A size is outside its parameter's constraint.
+    /// A size is outside its allowed range: a parameter's constraint from the manifest, or
+    /// a device limit on a size a formula computed.
     #[error(
-        "{} = {value} violates the manifest's constraint {constraint:?} ({})",
+        "{} = {value} violates the constraint {constraint:?} ({})",
         line(.name),
         line(.reason)
     )]
@@ -184,7 +185,7 @@ pub enum EngineError {
         name: String,
         /// Its value.
         value: u64,
-        /// The manifest's constraint.
+        /// The constraint (`lo..=hi`, `hi` possibly a device limit's name).
         constraint: String,
         /// Which bound failed.
         reason: String,
