@@ -16,6 +16,7 @@
 //! Fixed RNG seeds: every run checks the same cases. The case counts are printed.
 
 use std::cell::Cell;
+use std::io::Write as _;
 use std::time::Instant;
 
 use glam::DVec3;
@@ -63,7 +64,9 @@ fn run<S: Strategy>(
         panic!("{name}: {e}");
     }
     let [accepted, rejected] = TALLY.with(Cell::get);
-    eprintln!(
+    // Past libtest's capture (it only catches print!/eprint!): the counts show in every run.
+    let _ = writeln!(
+        std::io::stderr().lock(),
         "fuzz_frame::{name}: {cases} cases ({accepted} accepted, {rejected} rejected with a \
          clear error), 0 panics, {:.2} s",
         start.elapsed().as_secs_f64()

@@ -12,6 +12,7 @@
 mod common;
 
 use std::cell::Cell;
+use std::io::Write as _;
 use std::time::Instant;
 
 use proptest::prelude::*;
@@ -61,7 +62,9 @@ fn run<S: Strategy>(
         panic!("{name}: {e}");
     }
     let [accepted, rejected] = TALLY.with(Cell::get);
-    eprintln!(
+    // Past libtest's capture (it only catches print!/eprint!): the counts show in every run.
+    let _ = writeln!(
+        std::io::stderr().lock(),
         "fuzz_config::{name}: {cases} cases ({accepted} accepted, {rejected} rejected with a \
          clear error), 0 panics, {:.2} s",
         start.elapsed().as_secs_f64()

@@ -9,6 +9,7 @@
 //! accepted frame file gives finite uniforms. Fixed RNG seeds; the case counts are printed.
 
 use std::cell::Cell;
+use std::io::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
@@ -62,7 +63,9 @@ fn run<S: Strategy>(
         panic!("{name}: {e}");
     }
     let [accepted, rejected] = TALLY.with(Cell::get);
-    eprintln!(
+    // Past libtest's capture (it only catches print!/eprint!): the counts show in every run.
+    let _ = writeln!(
+        std::io::stderr().lock(),
         "fuzz_manifest::{name}: {cases} cases ({accepted} accepted, {rejected} rejected with \
          a clear error), 0 panics, {:.2} s",
         start.elapsed().as_secs_f64()
