@@ -187,9 +187,6 @@ impl FrameSettings {
 /// Why a frame cannot be set up.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FrameError {
-    /// A number is NaN or infinite, or a direction has zero length.
-    #[error("frame parameter {0} is not finite or is degenerate")]
-    Degenerate(&'static str),
     /// The light type differs from the variant's.
     #[error("the variant is compiled for a {expected} light but the frame has a {got} light")]
     LightMismatch {
@@ -226,7 +223,41 @@ pub enum FrameError {
     /// The eye sits on the spot light.
     #[error("the camera is at the spot light's position: epipolar rectification is undefined")]
     EyeAtLight,
+    /// A number or vector is outside the range the set-up accepts.
+    #[error("frame parameter {what} must be {allowed}, got {value}")]
+    OutOfRange {
+        /// The parameter (`camera near/far`, `medium albedo`, `shadow map basis`, ...).
+        what: &'static str,
+        /// What is accepted, in words.
+        allowed: &'static str,
+        /// The rejected value(s).
+        value: String,
+    },
+    /// The inputs passed every check but a uniform came out NaN or infinite in `f32` (a
+    /// safety net: the checks above are meant to make this unreachable).
+    #[error(
+        "frame set-up produced a non-finite {what} from these inputs (the numbers are too extreme for f32)"
+    )]
+    NotRepresentable {
+        /// The uniform field or slice-table entry.
+        what: &'static str,
+    },
 }
+
+/// Largest magnitude of a world coordinate (positions, far planes, orthographic windows)
+/// the frame set-up accepts: every uniform then fits in `f32` with room to spare.
+pub const MAX_COORD: f64 = 1e9;
+/// Range of `tan` of a half field of view (camera and perspective shadow map) the frame
+/// set-up accepts: a full angle from about 0.0001 to 179.9999 degrees.
+pub const TAN_HALF_RANGE: std::ops::RangeInclusive<f64> = 1e-6..=1e6;
+/// Smallest camera near plane distance the frame set-up accepts.
+pub const MIN_NEAR: f64 = 1e-9;
+/// Largest extinction coefficient sigma_t (1/m) the frame set-up accepts.
+pub const MAX_SIGMA_T: f64 = 1e6;
+/// Largest light colour channel (irradiance or intensity) the frame set-up accepts.
+pub const MAX_COLOR: f64 = 1e30;
+/// Tolerance on the length and orthogonality of the camera and shadow-map bases.
+pub const BASIS_TOLERANCE: f64 = 1e-3;
 
 /// The uniform block shared by the three kernels (WGSL `struct Frame` in
 /// `templates/common/prefiltered.wgsl`). Every field is a 16-byte vector, so the WGSL
@@ -413,8 +444,56 @@ pub(crate) fn v4(v: DVec3, w: f64) -> [f32; 4] {
     [v.x as f32, v.y as f32, v.z as f32, w as f32]
 }
 
-fn finite(v: DVec3) -> bool {
-    v.is_finite()
+/// A vector for messages: `[x, y, z]`, each number as Rust's `{:?}` writes it (`1e300`,
+/// `NaN`, `inf`).
+fn show(v: DVec3) -> String {
+    format!("[{:?}, {:?}, {:?}]", v.x, v.y, v.z)
+}
+
+/// Fails with [`FrameError::OutOfRange`] unless `ok`.
+fn require(
+    ok: bool,
+    what: &'static str,
+    allowed: &'static str,
+    value: impl FnOnce() -> String,
+) -> Result<(), FrameError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(FrameError::OutOfRange {
+            what,
+            allowed,
+            value: value(),
+        })
+    }
+}
+
+/// Finite and within [`MAX_COORD`] in every coordinate.
+fn in_world(v: DVec3) -> bool {
+    v.is_finite() && v.abs().max_element() <= MAX_COORD
+}
+
+/// The unit vector along `v`, for any finite non-zero `v` (scaled first, so that huge and
+/// tiny vectors normalise without overflow or underflow).
+fn unit(v: DVec3) -> Option<DVec3> {
+    if !v.is_finite() {
+        return None;
+    }
+    let m = v.abs().max_element();
+    if m == 0.0 {
+        return None;
+    }
+    (v / m).try_normalize()
+}
+
+/// Three finite unit vectors, mutually orthogonal, within [`BASIS_TOLERANCE`].
+fn orthonormal(b: [DVec3; 3]) -> bool {
+    let t = BASIS_TOLERANCE;
+    b.iter()
+        .all(|v| v.is_finite() && (v.length() - 1.0).abs() <= t)
+        && b[0].dot(b[1]).abs() <= t
+        && b[0].dot(b[2]).abs() <= t
+        && b[1].dot(b[2]).abs() <= t
 }
 
 /// Wraps an angle into (-pi, pi].
@@ -562,28 +641,65 @@ pub(crate) fn validate_scene(
         return Err(FrameError::LightMismatch { expected, got });
     }
     let cam = *camera;
-    if !(finite(cam.position) && finite(cam.forward) && finite(cam.right) && finite(cam.up)) {
-        return Err(FrameError::Degenerate("camera position/orientation"));
-    }
-    if !(cam.tan_half_fov_y.is_finite() && cam.tan_half_fov_y > 0.0) {
-        return Err(FrameError::Degenerate("camera fov"));
-    }
-    if !(cam.near > 0.0 && cam.far > cam.near && cam.far.is_finite()) {
-        return Err(FrameError::Degenerate("camera near/far"));
-    }
-    if !(medium.sigma_t.is_finite()
-        && medium.sigma_t >= 0.0
-        && medium.albedo.is_finite()
-        && medium.g.abs() < 1.0)
-    {
-        return Err(FrameError::Degenerate("medium"));
-    }
+    require(
+        in_world(cam.position),
+        "camera position",
+        "finite, every coordinate within +-1e9",
+        || show(cam.position),
+    )?;
+    require(
+        orthonormal([cam.forward, cam.right, cam.up]),
+        "camera forward/right/up",
+        "finite unit vectors, mutually orthogonal (within 1e-3)",
+        || {
+            format!(
+                "forward {}, right {}, up {}",
+                show(cam.forward),
+                show(cam.right),
+                show(cam.up)
+            )
+        },
+    )?;
+    require(
+        TAN_HALF_RANGE.contains(&cam.tan_half_fov_y),
+        "camera fov (tan_half_fov_y)",
+        "in [1e-6, 1e6] (a vertical fov between about 0.0001 and 179.9999 degrees)",
+        || format!("{:?}", cam.tan_half_fov_y),
+    )?;
+    require(
+        cam.near >= MIN_NEAR && cam.far > cam.near && cam.far <= MAX_COORD,
+        "camera near/far",
+        "1e-9 <= near < far <= 1e9",
+        || format!("near {:?}, far {:?}", cam.near, cam.far),
+    )?;
+    require(
+        (0.0..=MAX_SIGMA_T).contains(&medium.sigma_t),
+        "medium sigma_t",
+        "in [0, 1e6] (1/m)",
+        || format!("{:?}", medium.sigma_t),
+    )?;
+    require(
+        (0.0..=1.0).contains(&medium.albedo),
+        "medium albedo",
+        "in [0, 1]",
+        || format!("{:?}", medium.albedo),
+    )?;
+    require(
+        medium.g.abs() < 1.0,
+        "medium g (Henyey-Greenstein g)",
+        "in (-1, 1)",
+        || format!("{:?}", medium.g),
+    )?;
+    let light_direction = |direction: DVec3| {
+        unit(direction).ok_or_else(|| FrameError::OutOfRange {
+            what: "light direction",
+            allowed: "a finite non-zero vector",
+            value: show(direction),
+        })
+    };
     let (axis, dist, light_pos, light_dir, color, cos_in, cos_out) = match *light {
         LightDesc::Directional { direction, color } => {
-            if !finite(direction) || direction.length() < 1e-12 {
-                return Err(FrameError::Degenerate("light direction"));
-            }
-            let l = direction.normalize();
+            let l = light_direction(direction)?;
             (-l, 0.0, DVec3::ZERO, l, color, 1.0, 1.0)
         }
         LightDesc::Spot {
@@ -593,31 +709,43 @@ pub(crate) fn validate_scene(
             outer_deg,
             color,
         } => {
-            if !finite(position) || !finite(direction) || direction.length() < 1e-12 {
-                return Err(FrameError::Degenerate("light position/direction"));
-            }
-            if !(inner_deg.is_finite() && outer_deg.is_finite()) {
-                return Err(FrameError::Degenerate("light cone angles"));
-            }
+            require(
+                in_world(position),
+                "light position",
+                "finite, every coordinate within +-1e9",
+                || show(position),
+            )?;
+            let l = light_direction(direction)?;
+            require(
+                0.0 <= inner_deg && inner_deg <= outer_deg && outer_deg <= 180.0,
+                "light cone angles",
+                "0 <= inner_deg <= outer_deg <= 180",
+                || format!("inner_deg {inner_deg:?}, outer_deg {outer_deg:?}"),
+            )?;
             let to = position - cam.position;
             let d = to.length();
-            if d < 1e-6 * cam.far.max(1.0) {
+            // Relative to the coordinates' magnitude (their rounding), not to the far plane:
+            // a far plane of 1e9 must not put a light 12 m away "at the eye".
+            if d <= 1e-9 * (1.0 + cam.position.length().max(position.length())) {
                 return Err(FrameError::EyeAtLight);
             }
             (
                 to / d,
                 d,
                 position,
-                direction.normalize(),
+                l,
                 color,
                 inner_deg.to_radians().cos(),
                 outer_deg.to_radians().cos(),
             )
         }
     };
-    if color.iter().any(|c| !c.is_finite()) {
-        return Err(FrameError::Degenerate("light colour"));
-    }
+    require(
+        color.iter().all(|c| (0.0..=MAX_COLOR).contains(c)),
+        "light colour",
+        "finite and in [0, 1e30] per channel",
+        || format!("{color:?}"),
+    )?;
     Ok(ScenePart {
         cam,
         axis,
@@ -628,6 +756,50 @@ pub(crate) fn validate_scene(
         cos_in,
         cos_out,
     })
+}
+
+/// Checks the engine's standard shadow map description (its `size` is checked with the
+/// other sizes).
+pub(crate) fn validate_shadow_map(shadow: &ShadowMapDesc) -> Result<(), FrameError> {
+    require(
+        in_world(shadow.origin),
+        "shadow map origin",
+        "finite, every coordinate within +-1e9",
+        || show(shadow.origin),
+    )?;
+    let [r, u, f] = shadow.basis;
+    require(
+        orthonormal(shadow.basis),
+        "shadow map basis",
+        "three finite unit vectors (right, up, forward), mutually orthogonal (within 1e-3)",
+        || format!("right {}, up {}, forward {}", show(r), show(u), show(f)),
+    )?;
+    match shadow.projection {
+        ShadowProjectionDesc::Orthographic { x0, x1, y0, y1 } => require(
+            [x0, x1, y0, y1].iter().all(|v| v.abs() <= MAX_COORD) && x0 < x1 && y0 < y1,
+            "shadow map projection (orthographic)",
+            "finite, within +-1e9, x0 < x1 and y0 < y1",
+            || format!("x0 {x0:?}, x1 {x1:?}, y0 {y0:?}, y1 {y1:?}"),
+        )?,
+        ShadowProjectionDesc::Perspective { tan_half } => require(
+            TAN_HALF_RANGE.contains(&tan_half),
+            "shadow map projection (perspective tan_half)",
+            "in [1e-6, 1e6]",
+            || format!("{tan_half:?}"),
+        )?,
+    }
+    require(
+        shadow.near.abs() <= MAX_COORD && shadow.far.abs() <= MAX_COORD && shadow.near < shadow.far,
+        "shadow map near/far",
+        "finite, within +-1e9, near < far",
+        || format!("near {:?}, far {:?}", shadow.near, shadow.far),
+    )?;
+    require(
+        (0.0..=1e3).contains(&shadow.bias_texels),
+        "shadow map bias_texels",
+        "in [0, 1000]",
+        || format!("{:?}", shadow.bias_texels),
+    )
 }
 
 /// The shadow-map kind (0 orthographic, 1 perspective) and projection vector of the
@@ -641,7 +813,37 @@ pub(crate) fn shadow_projection(shadow: &ShadowMapDesc) -> (f64, [f32; 4]) {
     }
 }
 
-/// Sets up one frame of the prefiltered method with epipolar rectification.
+/// Fails with [`FrameError::NotRepresentable`] naming the first uniform field that is not
+/// finite.
+pub(crate) fn finite_fields<const N: usize>(
+    fields: [(&'static str, [f32; 4]); N],
+) -> Result<(), FrameError> {
+    match fields
+        .iter()
+        .find(|(_, v)| v.iter().any(|x| !x.is_finite()))
+    {
+        Some(&(what, _)) => Err(FrameError::NotRepresentable { what }),
+        None => Ok(()),
+    }
+}
+
+/// Sets up one frame of the prefiltered method: epipolar rectification, or projective
+/// rectification for a `projective` variant when the frame allows it.
+///
+/// Every input is checked before use: sizes, settings, camera (a finite position, an
+/// orthonormal basis, `tan_half_fov_y` in [`TAN_HALF_RANGE`], `MIN_NEAR <= near < far <=
+/// MAX_COORD`), light (finite non-zero direction, position within [`MAX_COORD`], cone
+/// angles `0 <= inner <= outer <= 180`, colour in `[0, MAX_COLOR]`), medium (`sigma_t` in
+/// `[0, MAX_SIGMA_T]`, albedo in `[0, 1]`, `|g| < 1`) and shadow map (origin, orthonormal
+/// basis, projection, near < far, bias). Every float of the result is finite.
+///
+/// # Errors
+///
+/// [`FrameError::Variant`] for a variant that does not validate, [`FrameError::Size`] for
+/// a zero or oversized size, [`FrameError::RectifiedTooNarrow`],
+/// [`FrameError::LightMismatch`], [`FrameError::OutOfRange`] naming the parameter, its
+/// value and the accepted range, [`FrameError::EyeAtLight`]; [`FrameError::NotRepresentable`]
+/// if a uniform still came out non-finite.
 pub fn prepare_frame(
     variant: &Variant,
     res: &Resolutions,
@@ -651,6 +853,61 @@ pub fn prepare_frame(
     shadow: &ShadowMapDesc,
     settings: &FrameSettings,
 ) -> Result<PrefilteredFrame, FrameError> {
+    let frame = prepare_frame_unchecked(variant, res, camera, light, medium, shadow, settings)?;
+    let u = &frame.uniforms;
+    finite_fields([
+        ("eye", u.eye),
+        ("axis", u.axis),
+        ("e1", u.e1),
+        ("e2", u.e2),
+        ("cam_forward", u.cam_forward),
+        ("cam_right", u.cam_right),
+        ("cam_up", u.cam_up),
+        ("theta", u.theta),
+        ("medium", u.medium),
+        ("light_color", u.light_color),
+        ("light_pos", u.light_pos),
+        ("light_dir", u.light_dir),
+        ("sm_right", u.sm_right),
+        ("sm_up", u.sm_up),
+        ("sm_forward", u.sm_forward),
+        ("sm_origin", u.sm_origin),
+        ("sm_proj", u.sm_proj),
+        ("epipole", u.epipole),
+        ("anti_epipole", u.anti_epipole),
+        ("proj", u.proj),
+        ("proj_g0", u.proj_g0),
+        ("proj_g1", u.proj_g1),
+        ("proj_g2", u.proj_g2),
+    ])?;
+    for s in &frame.slices {
+        finite_fields([(
+            "slice table entry",
+            [s.delta, s.theta_ref, s.theta_lo, s.theta_hi],
+        )])?;
+    }
+    if let Some(p) = &frame.report.projective
+        && !p.matrices.iter().all(DMat4::is_finite)
+    {
+        return Err(FrameError::NotRepresentable {
+            what: "projective matrix",
+        });
+    }
+    Ok(frame)
+}
+
+fn prepare_frame_unchecked(
+    variant: &Variant,
+    res: &Resolutions,
+    camera: &CameraDesc,
+    light: &LightDesc,
+    medium: &MediumDesc,
+    shadow: &ShadowMapDesc,
+    settings: &FrameSettings,
+) -> Result<PrefilteredFrame, FrameError> {
+    // The variant is plain data: an unvalidated one (regions = u32::MAX) would overflow
+    // `regions^2` and allocate per region below.
+    variant.validate()?;
     for (what, value, max) in [
         ("screen width", res.screen[0], 16384),
         ("screen height", res.screen[1], 16384),
@@ -674,11 +931,18 @@ pub fn prepare_frame(
         });
     }
     let max_half = settings.projective_max_half_angle_deg;
-    if !(max_half.is_finite() && max_half > 0.0 && max_half <= 89.0) {
-        return Err(FrameError::Degenerate(
-            "projective_max_half_angle_deg (must be in (0, 89])",
-        ));
-    }
+    require(
+        max_half > 0.0 && max_half <= 89.0,
+        "projective_max_half_angle_deg",
+        "in (0, 89]",
+        || format!("{max_half:?}"),
+    )?;
+    require(
+        (0.0..=1e6).contains(&settings.epipole_radius_px),
+        "epipole_radius_px",
+        "in [0, 1e6] pixels",
+        || format!("{:?}", settings.epipole_radius_px),
+    )?;
     let min_width = variant.regions * variant.regions;
     if res.rectified[0] < min_width {
         return Err(FrameError::RectifiedTooNarrow {
@@ -697,6 +961,7 @@ pub fn prepare_frame(
         cos_in,
         cos_out,
     } = validate_scene(variant.light, camera, light, medium)?;
+    validate_shadow_map(shadow)?;
     // e1: the view axis made perpendicular to A (so phi = 0 looks ahead), else any.
     let mut e1 = cam.forward - axis * cam.forward.dot(axis);
     if e1.length() < 1e-6 {

@@ -96,9 +96,14 @@ impl fmt::Display for MinmaxVariant {
     }
 }
 
-/// Nodes of level `level` of the tree of a row of `width` texels: `ceil(width / 2^level)`.
+/// Nodes of level `level` of the tree of a row of `width` texels: `ceil(width / 2^level)`
+/// (computed in 64 bits: no overflow for any width; 1 for any level past the root of a
+/// non-empty row).
 pub const fn level_count(level: u32, width: u32) -> u32 {
-    (width + (1 << level) - 1) >> level
+    if level >= 32 {
+        return if width == 0 { 0 } else { 1 };
+    }
+    ((width as u64 + (1u64 << level) - 1) >> level) as u32
 }
 
 /// Levels of the tree of a row of `width` texels (`ceil(log2 width) + 1`; 1 for one texel).
@@ -110,18 +115,20 @@ pub const fn tree_levels(width: u32) -> u32 {
     k + 1
 }
 
-/// First column of level `level` in the packed tree row.
+/// First column of level `level` in the packed tree row (saturating at `u32::MAX`, which
+/// only widths beyond any texture limit reach).
 pub const fn level_offset(level: u32, width: u32) -> u32 {
-    let mut off = 0;
+    let mut off: u32 = 0;
     let mut k = 0;
     while k < level {
-        off += level_count(k, width);
+        off = off.saturating_add(level_count(k, width));
         k += 1;
     }
     off
 }
 
-/// Width of the tree texture for a rectified width `width`: every level's nodes.
+/// Width of the tree texture for a rectified width `width`: every level's nodes
+/// (saturating at `u32::MAX`).
 pub const fn tree_width(width: u32) -> u32 {
     level_offset(tree_levels(width), width)
 }

@@ -24,8 +24,8 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 
 use crate::frame::{
-    CameraDesc, FrameError, LightDesc, MediumDesc, ShadowMapDesc, shadow_projection, v4,
-    validate_scene,
+    CameraDesc, FrameError, LightDesc, MediumDesc, ShadowMapDesc, finite_fields, shadow_projection,
+    v4, validate_scene, validate_shadow_map,
 };
 use crate::variant::{LightKind, VariantError};
 
@@ -179,9 +179,11 @@ const _: () = {
 /// # Errors
 ///
 /// [`FrameError::Size`] for a zero or oversized screen or shadow map,
-/// [`FrameError::LightMismatch`] for a light of the other type, [`FrameError::Degenerate`]
-/// for NaN or degenerate camera, light or medium, [`FrameError::EyeAtLight`]; a variant error
-/// for bad knobs is reported as [`FrameError::Variant`].
+/// [`FrameError::LightMismatch`] for a light of the other type, [`FrameError::OutOfRange`]
+/// naming the parameter for a NaN, infinite, out-of-range or degenerate camera, light,
+/// medium or shadow map, [`FrameError::EyeAtLight`], [`FrameError::NotRepresentable`] if a
+/// uniform still came out non-finite; a variant error for bad knobs is reported as
+/// [`FrameError::Variant`].
 pub fn prepare_march(
     variant: &RaymarchVariant,
     screen: [u32; 2],
@@ -201,10 +203,11 @@ pub fn prepare_march(
         }
     }
     let sc = validate_scene(variant.light, camera, light, medium)?;
+    validate_shadow_map(shadow)?;
     let (sm_kind, sm_proj) = shadow_projection(shadow);
     let cam = sc.cam;
     let m = variant.interleave;
-    Ok(MarchUniforms {
+    let u = MarchUniforms {
         eye: v4(cam.position, cam.far),
         cam_forward: v4(cam.forward, cam.tan_half_fov_y),
         cam_right: v4(cam.right, f64::from(screen[0]) / f64::from(screen[1])),
@@ -235,5 +238,21 @@ pub fn prepare_march(
             u32::from(variant.jitter),
             m,
         ],
-    })
+    };
+    finite_fields([
+        ("eye", u.eye),
+        ("cam_forward", u.cam_forward),
+        ("cam_right", u.cam_right),
+        ("cam_up", u.cam_up),
+        ("medium", u.medium),
+        ("light_color", u.light_color),
+        ("light_pos", u.light_pos),
+        ("light_dir", u.light_dir),
+        ("sm_right", u.sm_right),
+        ("sm_up", u.sm_up),
+        ("sm_forward", u.sm_forward),
+        ("sm_origin", u.sm_origin),
+        ("sm_proj", u.sm_proj),
+    ])?;
+    Ok(u)
 }

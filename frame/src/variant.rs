@@ -112,9 +112,28 @@ names!(LightKind, [Directional => "directional", Spot => "spot"]);
 names!(Storage, [Rgba16float => "rgba16float", Rgba32float => "rgba32float", Rgba8unorm => "rgba8unorm"]);
 names!(Rectification, [Epipolar => "epipolar", Projective => "projective"]);
 
+/// `text` with its control characters (newlines, tabs, escape codes) written as Rust
+/// escapes (`\n`, `\u{1b}`): user text quoted in an error message keeps the message on
+/// one printable line.
+pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.chars().any(char::is_control) {
+        text.chars()
+            .map(|c| {
+                if c.is_control() {
+                    c.escape_default().to_string()
+                } else {
+                    c.to_string()
+                }
+            })
+            .collect()
+    } else {
+        text.into()
+    }
+}
+
 /// A knob outside its allowed range.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{knob} must be {allowed}, got {value}")]
+#[error("{knob} must be {allowed}, got {}", printable(.value))]
 pub struct VariantError {
     /// The knob's name (`bases`, `bases_per_thread`, ...).
     pub knob: &'static str,

@@ -17,6 +17,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use scatter_shaderlib::prefiltered::variant::printable;
 use serde::Deserialize;
 use serde_json::Value;
 
@@ -63,11 +64,19 @@ pub fn load(path: &Path) -> Result<Config, GenError> {
 ///
 /// A message naming the variant table (1-based) and the knob.
 pub fn parse(text: &str) -> Result<Config, String> {
-    let file: File = basic_toml::from_str(text).map_err(|e| e.to_string().replace('\n', " "))?;
+    let file: File = basic_toml::from_str(text)
+        .map_err(|e| printable(&e.to_string().replace('\n', " ")).into_owned())?;
     let targets = file
         .targets
         .map(|t| Target::parse_list(&t).map_err(|e| e.to_string()))
         .transpose()?;
+    if targets.as_ref().is_some_and(Vec::is_empty) {
+        let all: Vec<_> = Target::ALL.iter().map(|t| t.name()).collect();
+        return Err(format!(
+            "targets is empty: list at least one of {} (or leave targets out for the default)",
+            all.join(" | ")
+        ));
+    }
     if file.variant.is_empty() {
         return Err("no [[variant]] tables: list the variants to emit".into());
     }
@@ -83,7 +92,8 @@ pub fn parse(text: &str) -> Result<Config, String> {
                 Value::Bool(b) => b.to_string(),
                 other => {
                     return Err(format!(
-                        "variant {n}: `{key}` must be a number or a string, got {other}"
+                        "variant {n}: `{}` must be a number or a string, got {other}",
+                        printable(key)
                     ));
                 }
             };
@@ -134,5 +144,15 @@ mod tests {
         assert!(e.contains("must be a number or a string"), "{e}");
         assert!(parse("").unwrap_err().contains("no [[variant]]"));
         assert!(parse("colour = 1\n").is_err());
+        let e = parse("targets = []\n[[variant]]\n").unwrap_err();
+        assert!(e.starts_with("targets is empty"), "{e}");
+        // User text in a message stays on one line.
+        let e = parse("[[variant]]\n\"a\\nb\" = 1\n").unwrap_err();
+        assert!(!e.contains('\n') && e.contains("knob `a\\nb`"), "{e}");
+        let e = parse("[[variant]]\nbases = \"3\\n2\"\n").unwrap_err();
+        assert_eq!(
+            e,
+            "variant 1: bases must be a multiple of 4 in 4..=128, got 3\\n2"
+        );
     }
 }

@@ -15,6 +15,8 @@ use std::fs;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
+use scatter_shaderlib::prefiltered::variant::printable;
+
 use crate::GenError;
 use crate::generate::{Generated, MANIFEST};
 use crate::manifest::{self, FileEntry, OwnedFiles};
@@ -48,16 +50,18 @@ pub struct Stale {
 /// [`GenError::Io`] when it cannot be read.
 pub fn owned_files(dir: &Path) -> Result<Option<Vec<FileEntry>>, GenError> {
     let path = dir.join(MANIFEST);
-    let text = match fs::read_to_string(&path) {
-        Ok(t) => t,
+    // Bytes, not text: a manifest.json that is not UTF-8 is foreign, not an I/O error.
+    let bytes = match fs::read(&path) {
+        Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(GenError::io(path, e)),
     };
+    // The manifest's own text (schema, paths) quoted on one printable line.
     let foreign = |why: String| GenError::Foreign {
         path: path.clone(),
-        why,
+        why: printable(&why).into_owned(),
     };
-    let owned: OwnedFiles = serde_json::from_str(&text)
+    let owned: OwnedFiles = serde_json::from_slice(&bytes)
         .map_err(|e| foreign(format!("it is not a scatter-gen manifest ({e})")))?;
     if owned.schema != manifest::SCHEMA {
         return Err(foreign(format!(

@@ -109,7 +109,11 @@ impl Target {
                     .find(|t| t.name() == part)
                     .ok_or_else(|| {
                         let all: Vec<_> = Self::ALL.iter().map(|t| t.name()).collect();
-                        GenError::Usage(format!("target must be {}, got {part}", all.join(" | ")))
+                        GenError::Usage(format!(
+                            "target must be {}, got {}",
+                            all.join(" | "),
+                            scatter_shaderlib::prefiltered::variant::printable(part)
+                        ))
                     })?;
                 if !out.contains(&t) {
                     out.push(t);

@@ -243,6 +243,23 @@ impl Context {
         })
     }
 
+    /// Wraps a device and queue that the engine created itself on `adapter`, with its own
+    /// features and limits. Every pass checks its sizes against `device.limits()`, so a
+    /// device created with lower limits than the adapter's gets errors naming those limits;
+    /// GPU timestamps are recorded only when the device has `TIMESTAMP_QUERY`.
+    pub fn from_device(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
+        let report = AdapterReport::new(
+            &adapter.get_info(),
+            device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
+        );
+        Self {
+            adapter,
+            device,
+            queue,
+            report,
+        }
+    }
+
     /// Creates a context as the `SCATTER_GPU` / `CI` policy says (see [`GpuPolicy`]).
     ///
     /// # Errors

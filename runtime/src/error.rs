@@ -208,7 +208,15 @@ impl ErrorScopes {
             Some(e) => Err(RuntimeError::Wgpu {
                 kernel,
                 stage,
-                message: e.to_string(),
+                // wgpu's reports span several lines ("Validation Error", "Caused by:",
+                // ...): one line, as every error of this crate.
+                message: e
+                    .to_string()
+                    .lines()
+                    .map(str::trim)
+                    .filter(|l| !l.is_empty())
+                    .collect::<Vec<_>>()
+                    .join(" "),
             }),
         }
     }

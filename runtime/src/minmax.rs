@@ -145,6 +145,20 @@ impl Minmax {
             "max_storage_buffer_binding_size",
             limits.max_storage_buffer_binding_size,
         )?;
+        check_limit(
+            RECTIFY,
+            "slice table bytes (16 per rectified row)",
+            slice_bytes,
+            "max_buffer_size",
+            limits.max_buffer_size,
+        )?;
+        check_limit(
+            RECTIFY,
+            "uniform block bytes",
+            size_of::<FrameUniforms>() as u64,
+            "max_uniform_buffer_binding_size",
+            limits.max_uniform_buffer_binding_size,
+        )?;
         let built = KernelParams::minmax(*variant)
             .map(|p| scatter_shaderlib::build(&p))
             .into_iter()
@@ -559,9 +573,9 @@ pub fn run_minmax_once(
     });
     pass.encode(ctx, &mut encoder, &depth_view, &shadow_view)?;
     let scope = ErrorScopes::push(device);
-    let rectified = Readback::encode(device, &mut encoder, pass.rectified_texture(), 4);
-    let tree = Readback::encode(device, &mut encoder, pass.tree_texture(), 8);
-    let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8);
+    let rectified = Readback::encode(device, &mut encoder, pass.rectified_texture(), 4, RECTIFY)?;
+    let tree = Readback::encode(device, &mut encoder, pass.tree_texture(), 8, BUILD)?;
+    let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, MARCH)?;
     let start = Instant::now();
     ctx.queue().submit([encoder.finish()]);
     scope.pop(MARCH, "dispatch")?;

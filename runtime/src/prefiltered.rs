@@ -244,6 +244,13 @@ impl Scatter {
         )?;
         check_limit(
             RECTIFY,
+            "slice table bytes (16 per rectified row)",
+            slice_bytes,
+            "max_buffer_size",
+            limits.max_buffer_size,
+        )?;
+        check_limit(
+            RECTIFY,
             "uniform block bytes",
             size_of::<FrameUniforms>() as u64,
             "max_uniform_buffer_binding_size",
@@ -1116,14 +1123,15 @@ pub fn run_once(
         Some(view) if pass.frame().is_some_and(|f| f.report.projective.is_some()) => view.texture(),
         _ => pass.rectified_texture(),
     };
-    let rectified = Readback::encode(device, &mut encoder, rectified_texture, 4);
+    let rectified = Readback::encode(device, &mut encoder, rectified_texture, 4, RECTIFY)?;
     let filtered = Readback::encode(
         device,
         &mut encoder,
         pass.filtered_texture(),
         storage_texel_bytes(variant.storage),
-    );
-    let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8);
+        PREFILTER,
+    )?;
+    let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, SCATTER)?;
     let start = Instant::now();
     queue.submit([encoder.finish()]);
     scope.pop(SCATTER, "dispatch")?;
@@ -1201,20 +1209,34 @@ pub(crate) struct Readback {
 
 impl Readback {
     /// Records the copy of every layer of `texture` (`texel_bytes` per texel).
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::LimitExceeded`] (for `kernel`) when the readback buffer would exceed
+    /// the device's `max_buffer_size`; nothing is created then.
     pub(crate) fn encode(
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         texture: &wgpu::Texture,
         texel_bytes: u32,
-    ) -> Self {
+        kernel: Kernel,
+    ) -> Result<Self, RuntimeError> {
         let extent = texture.size();
         let padded_row =
             (extent.width * texel_bytes).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let size = u64::from(padded_row)
+            * u64::from(extent.height)
+            * u64::from(extent.depth_or_array_layers);
+        check_limit(
+            kernel,
+            "readback buffer bytes",
+            size,
+            "max_buffer_size",
+            device.limits().max_buffer_size,
+        )?;
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("prefiltered readback"),
-            size: u64::from(padded_row)
-                * u64::from(extent.height)
-                * u64::from(extent.depth_or_array_layers),
+            size,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -1230,12 +1252,12 @@ impl Readback {
             },
             extent,
         );
-        Self {
+        Ok(Self {
             buffer,
             extent,
             texel_bytes,
             padded_row,
-        }
+        })
     }
 
     /// Maps the buffer and returns the texels' bytes without row padding, layer by layer,

@@ -128,6 +128,13 @@ impl Raymarch {
                 limits.max_texture_dimension_2d.into(),
             )?;
         }
+        check_limit(
+            RAYMARCH,
+            "uniform block bytes",
+            size_of::<MarchUniforms>() as u64,
+            "max_uniform_buffer_binding_size",
+            limits.max_uniform_buffer_binding_size,
+        )?;
         let built: Vec<_> = KernelParams::raymarch(*variant)
             .iter()
             .map(scatter_shaderlib::build)
@@ -509,8 +516,9 @@ pub fn run_raymarch_once(
     let scope = ErrorScopes::push(device);
     let partial = pass
         .partial_texture()
-        .map(|t| Readback::encode(device, &mut encoder, t, 16));
-    let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8);
+        .map(|t| Readback::encode(device, &mut encoder, t, 16, RAYMARCH))
+        .transpose()?;
+    let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, RAYMARCH)?;
     let start = Instant::now();
     ctx.queue().submit([encoder.finish()]);
     scope.pop(RAYMARCH, "dispatch")?;

@@ -3,7 +3,7 @@
 
 use scatter_shaderlib::Kernel;
 
-use crate::error::ErrorScopes;
+use crate::error::{ErrorScopes, check_limit};
 use crate::prefiltered::{DEPTH_FORMAT, Readback, decode_rgba};
 use crate::{Context, RuntimeError};
 
@@ -12,8 +12,11 @@ use crate::{Context, RuntimeError};
 ///
 /// # Errors
 ///
-/// [`RuntimeError::DataLength`] when `data` does not match `size`; [`RuntimeError::Wgpu`]
-/// when wgpu rejects the texture.
+/// [`RuntimeError::EmptyInput`] for a zero width or height;
+/// [`RuntimeError::LimitExceeded`] for a side beyond the device's
+/// `max_texture_dimension_2d`; [`RuntimeError::DataLength`] when `data` does not match
+/// `size`; [`RuntimeError::Wgpu`] when wgpu rejects the texture. Nothing is created unless
+/// the checks pass.
 pub fn upload_r32float(
     ctx: &Context,
     kernel: Kernel,
@@ -21,6 +24,27 @@ pub fn upload_r32float(
     size: [u32; 2],
     data: &[f32],
 ) -> Result<wgpu::Texture, RuntimeError> {
+    if size[0] == 0 || size[1] == 0 {
+        return Err(RuntimeError::EmptyInput {
+            kernel,
+            size: format!("{label} {}x{}", size[0], size[1]),
+        });
+    }
+    let max_2d = u64::from(ctx.device().limits().max_texture_dimension_2d);
+    check_limit(
+        kernel,
+        "texture width",
+        size[0].into(),
+        "max_texture_dimension_2d",
+        max_2d,
+    )?;
+    check_limit(
+        kernel,
+        "texture height",
+        size[1].into(),
+        "max_texture_dimension_2d",
+        max_2d,
+    )?;
     let expected = u64::from(size[0]) * u64::from(size[1]);
     if data.len() as u64 != expected {
         return Err(RuntimeError::DataLength {
@@ -78,7 +102,7 @@ pub fn read_rgba16float(
             label: Some("read_rgba16float"),
         });
     let scope = ErrorScopes::push(ctx.device());
-    let readback = Readback::encode(ctx.device(), &mut encoder, texture, 8);
+    let readback = Readback::encode(ctx.device(), &mut encoder, texture, 8, kernel)?;
     ctx.queue().submit([encoder.finish()]);
     scope.pop(kernel, "reading back a texture")?;
     Ok(readback

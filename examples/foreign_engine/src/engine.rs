@@ -932,6 +932,16 @@ fn create_resource(
             let width = eval_u32(&t.width, params, &ctx("width"))?;
             let height = eval_u32(&t.height, params, &ctx("height"))?;
             let layers = eval_u32(&t.layers, params, &ctx("layers"))?;
+            // Sizes the formulas computed (not only the parameters) against the device,
+            // before anything is created.
+            for (what, value) in [("width", width), ("height", height)] {
+                check_constraint(
+                    &ctx(what),
+                    value.into(),
+                    "1..=max_texture_dimension_2d",
+                    limits,
+                )?;
+            }
             check_constraint(
                 &ctx("layers"),
                 layers.into(),
@@ -984,6 +994,21 @@ fn create_resource(
                     "copy_src" => wgpu::BufferUsages::COPY_SRC,
                     other => return Err(unsupported(ctx("usage"), "buffer usage", other)),
                 };
+            }
+            check_constraint(&ctx("size_bytes"), size, "1..=max_buffer_size", limits)?;
+            for (flag, limit) in [
+                (
+                    wgpu::BufferUsages::UNIFORM,
+                    "1..=max_uniform_buffer_binding_size",
+                ),
+                (
+                    wgpu::BufferUsages::STORAGE,
+                    "1..=max_storage_buffer_binding_size",
+                ),
+            ] {
+                if usage.contains(flag) {
+                    check_constraint(&ctx("size_bytes"), size, limit, limits)?;
+                }
             }
             let buffer = scoped(device, ctx("creation"), || {
                 device.create_buffer(&wgpu::BufferDescriptor {

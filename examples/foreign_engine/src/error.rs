@@ -8,7 +8,7 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum EngineError {
     /// A file could not be read or written.
-    #[error("cannot access {path}: {source}")]
+    #[error("cannot access {}: {}", line(.path.display()), line(.source))]
     Io {
         /// The file.
         path: PathBuf,
@@ -18,14 +18,15 @@ pub enum EngineError {
     },
     /// The directory has no `manifest.json`.
     #[error(
-        "no manifest.json in {dir}: generate the shaders first (cargo run -p scatter-gen -- --out {dir} --target spirv,wgsl)"
+        "no manifest.json in {d}: generate the shaders first (cargo run -p scatter-gen -- --out {d} --target spirv,wgsl)",
+        d = line(.dir.display())
     )]
     MissingManifest {
         /// The shader directory.
         dir: PathBuf,
     },
     /// `manifest.json` is not valid JSON or lacks a key the engine needs.
-    #[error("{path} is not a manifest this engine can read: {source}")]
+    #[error("{} is not a manifest this engine can read: {}", line(.path.display()), line(.source))]
     ManifestParse {
         /// The manifest.
         path: PathBuf,
@@ -34,7 +35,7 @@ pub enum EngineError {
         source: serde_json::Error,
     },
     /// `manifest.json` was not written by scatter-gen.
-    #[error("{path} has schema {schema:?}, not \"scatter-gen-manifest\"")]
+    #[error("{} has schema {schema:?}, not \"scatter-gen-manifest\"", line(.path.display()))]
     ForeignManifest {
         /// The manifest.
         path: PathBuf,
@@ -42,7 +43,10 @@ pub enum EngineError {
         schema: String,
     },
     /// The manifest's schema version is not the one this engine reads.
-    #[error("{path} has schema_version {found}; this engine reads version {supported}")]
+    #[error(
+        "{} has schema_version {found}; this engine reads version {supported}",
+        line(.path.display())
+    )]
     SchemaVersion {
         /// The manifest.
         path: PathBuf,
@@ -52,7 +56,7 @@ pub enum EngineError {
         supported: u64,
     },
     /// No variant of the manifest has the requested id.
-    #[error("the manifest has no variant {id:?}; it has: {available}")]
+    #[error("the manifest has no variant {id:?}; it has: {}", line(.available))]
     UnknownVariant {
         /// The requested id.
         id: String,
@@ -60,14 +64,20 @@ pub enum EngineError {
         available: String,
     },
     /// The manifest has several variants and none was named.
-    #[error("the manifest has several variants; name one with --variant: {available}")]
+    #[error(
+        "the manifest has several variants; name one with --variant: {}",
+        line(.available)
+    )]
     VariantRequired {
         /// The ids it has, comma-separated.
         available: String,
     },
     /// A pass has no file for the requested target.
     #[error(
-        "kernel {kernel} of variant {variant} was not generated for target {target} (re-run scatter-gen with --target {target})"
+        "kernel {} of variant {} was not generated for target {t} (re-run scatter-gen with --target {t})",
+        line(.kernel),
+        line(.variant),
+        t = line(.target)
     )]
     TargetNotGenerated {
         /// The kernel.
@@ -78,7 +88,10 @@ pub enum EngineError {
         target: String,
     },
     /// A shader file the manifest lists is not in the directory.
-    #[error("{path} is listed in the manifest but missing (re-run scatter-gen)")]
+    #[error(
+        "{} is listed in the manifest but missing (re-run scatter-gen)",
+        line(.path.display())
+    )]
     MissingShader {
         /// The shader file.
         path: PathBuf,
@@ -86,7 +99,9 @@ pub enum EngineError {
     /// A shader file's SHA-256 differs from the manifest's: the directory was edited or
     /// only partly regenerated.
     #[error(
-        "{path} is stale: sha256 {actual}, the manifest says {expected} (re-run scatter-gen on the whole directory)"
+        "{} is stale: sha256 {actual}, the manifest says {} (re-run scatter-gen on the whole directory)",
+        line(.path.display()),
+        line(.expected)
     )]
     StaleShader {
         /// The shader file.
@@ -97,7 +112,7 @@ pub enum EngineError {
         actual: String,
     },
     /// A `.spv` file is not a SPIR-V module.
-    #[error("{path} is not SPIR-V: {reason}")]
+    #[error("{} is not SPIR-V: {}", line(.path.display()), line(.reason))]
     BadSpirv {
         /// The file.
         path: PathBuf,
@@ -105,14 +120,16 @@ pub enum EngineError {
         reason: String,
     },
     /// A WGSL file is not UTF-8.
-    #[error("{path} is not UTF-8 text")]
+    #[error("{} is not UTF-8 text", line(.path.display()))]
     BadWgsl {
         /// The file.
         path: PathBuf,
     },
     /// A formula names a symbol that is not a parameter of the variant.
     #[error(
-        "formula {formula:?} ({context}) uses {symbol:?}, which is not a parameter (known: {known})"
+        "formula {formula:?} ({}) uses {symbol:?}, which is not a parameter (known: {})",
+        line(.context),
+        line(.known)
     )]
     UnknownSymbol {
         /// The formula.
@@ -125,7 +142,7 @@ pub enum EngineError {
         known: String,
     },
     /// A formula does not parse or cannot be evaluated.
-    #[error("formula {formula:?} ({context}): {reason}")]
+    #[error("formula {formula:?} ({}): {}", line(.context), line(.reason))]
     Formula {
         /// The formula.
         formula: String,
@@ -136,7 +153,7 @@ pub enum EngineError {
     },
     /// A per-frame condition (`skip_when`, `alternative.when`) is not one the engine can
     /// evaluate.
-    #[error("condition {condition:?} ({context}): {reason}")]
+    #[error("condition {condition:?} ({}): {}", line(.context), line(.reason))]
     Condition {
         /// The condition.
         condition: String,
@@ -147,7 +164,8 @@ pub enum EngineError {
     },
     /// The manifest names a parameter this engine does not know how to set.
     #[error(
-        "the manifest's parameter {name:?} is unknown to this engine (it sets: {known}); is the manifest newer than the engine?"
+        "the manifest's parameter {name:?} is unknown to this engine (it sets: {}); is the manifest newer than the engine?",
+        line(.known)
     )]
     UnknownParameter {
         /// The parameter.
@@ -155,21 +173,26 @@ pub enum EngineError {
         /// What the engine sets, comma-separated.
         known: String,
     },
-    /// A size is outside its parameter's constraint.
-    #[error("{name} = {value} violates the manifest's constraint {constraint:?} ({reason})")]
+    /// A size is outside its allowed range: a parameter's constraint from the manifest, or
+    /// a device limit on a size a formula computed.
+    #[error(
+        "{} = {value} violates the constraint {constraint:?} ({})",
+        line(.name),
+        line(.reason)
+    )]
     Constraint {
         /// The parameter.
         name: String,
         /// Its value.
         value: u64,
-        /// The manifest's constraint.
+        /// The constraint (`lo..=hi`, `hi` possibly a device limit's name).
         constraint: String,
         /// Which bound failed.
         reason: String,
     },
     /// The manifest uses something this engine does not implement (a texture format, a
     /// binding kind, a sampler mode).
-    #[error("{context}: unsupported {what} {value:?}")]
+    #[error("{}: unsupported {what} {value:?}", line(.context))]
     Unsupported {
         /// Where it appears.
         context: String,
@@ -180,10 +203,14 @@ pub enum EngineError {
     },
     /// The manifest is internally inconsistent (a binding names an unknown resource, a
     /// struct is missing, ...).
-    #[error("inconsistent manifest: {0}")]
+    #[error("inconsistent manifest: {}", line(.0))]
     Inconsistent(String),
     /// A resource the frame needs was not supplied.
-    #[error("{kernel} needs {resource:?} this frame ({contents}) but it was not supplied")]
+    #[error(
+        "{} needs {resource:?} this frame ({}) but it was not supplied",
+        line(.kernel),
+        line(.contents)
+    )]
     MissingInput {
         /// The kernel that binds it.
         kernel: String,
@@ -206,7 +233,7 @@ pub enum EngineError {
     },
     /// Data was supplied for a resource that cannot take it (unknown, or not written by the
     /// host).
-    #[error("{resource:?} cannot be written by the host: {reason}")]
+    #[error("{resource:?} cannot be written by the host: {}", line(.reason))]
     NotAnInput {
         /// The resource.
         resource: String,
@@ -214,7 +241,7 @@ pub enum EngineError {
         reason: String,
     },
     /// wgpu rejected something (validation or out of memory).
-    #[error("wgpu error while {stage}: {message}")]
+    #[error("wgpu error while {}: {}", line(.stage), line(.message))]
     Wgpu {
         /// What the engine was doing.
         stage: String,
@@ -222,7 +249,7 @@ pub enum EngineError {
         message: String,
     },
     /// Reading back a texture failed.
-    #[error("readback of {resource:?} failed: {message}")]
+    #[error("readback of {resource:?} failed: {}", line(.message))]
     Readback {
         /// The resource.
         resource: String,
@@ -230,19 +257,33 @@ pub enum EngineError {
         message: String,
     },
     /// No adapter or device (binary only).
-    #[error("no GPU device: {0}")]
+    #[error("no GPU device: {}", line(.0))]
     NoDevice(String),
     /// The frame set-up rejected the camera, light, medium or shadow map.
     #[error("frame set-up: {0}")]
     Frame(#[from] scatter_frame::frame::FrameError),
     /// An input file of the binary is malformed.
-    #[error("{path}: {reason}")]
+    #[error("{}: {}", line(.path.display()), line(.reason))]
     InputFile {
         /// The file.
         path: PathBuf,
         /// What is wrong.
         reason: String,
     },
+}
+
+/// `text` on one printable line: each line break, with the blanks around it, becomes one
+/// space and other control characters are written as Rust escapes. The messages quote
+/// manifest text, file paths and wgpu's multi-line reports through it.
+fn line(text: impl std::fmt::Display) -> String {
+    let text = text.to_string();
+    let joined = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ");
+    scatter_frame::variant::printable(&joined).into_owned()
 }
 
 impl EngineError {

@@ -371,19 +371,25 @@ pub fn read_pfm(path: &Path) -> Result<(u32, u32, Vec<f32>), EngineError> {
     let scale: f32 = String::from_utf8_lossy(&bytes[start..pos])
         .parse()
         .map_err(|_| bad("bad scale".to_owned()))?;
-    if scale == 0.0 {
-        return Err(bad("scale 0".to_owned()));
+    if scale == 0.0 || !scale.is_finite() {
+        return Err(bad(format!(
+            "scale {scale}: must be a finite non-zero number (negative for little-endian)"
+        )));
     }
     pos += 1; // the single whitespace byte before the data
-    let count = width as usize * height as usize;
     let data = bytes.get(pos..).unwrap_or_default();
-    if data.len() != 4 * count {
+    // In 64 bits and checked: 4 * width * height overflows even u64 for the largest sizes.
+    let needed = u64::from(width)
+        .checked_mul(u64::from(height))
+        .and_then(|n| n.checked_mul(4));
+    if needed != Some(data.len() as u64) {
         return Err(bad(format!(
             "{width}x{height} needs {} data bytes, found {}",
-            4 * count,
+            needed.map_or_else(|| "more than 2^64".to_owned(), |n| n.to_string()),
             data.len()
         )));
     }
+    let count = data.len() / 4;
     let little = scale < 0.0;
     let mut values = vec![0.0f32; count];
     for (i, c) in data.chunks_exact(4).enumerate() {
@@ -612,6 +618,9 @@ pub fn knobs_of(manifest: &crate::Manifest, id: &str) -> Result<Variant, EngineE
         });
     }
     let variant: Variant = serde_json::from_value(entry.knobs.clone())
+        .map_err(|e| EngineError::Inconsistent(format!("knobs of variant {id}: {e}")))?;
+    variant
+        .validate()
         .map_err(|e| EngineError::Inconsistent(format!("knobs of variant {id}: {e}")))?;
     if variant.id() != id {
         return Err(EngineError::Inconsistent(format!(

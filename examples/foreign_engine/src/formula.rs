@@ -224,6 +224,7 @@ fn limit(limits: &wgpu::Limits, name: &str) -> Option<u64> {
         }
         "max_storage_buffer_binding_size" => limits.max_storage_buffer_binding_size,
         "max_uniform_buffer_binding_size" => limits.max_uniform_buffer_binding_size,
+        "max_buffer_size" => limits.max_buffer_size,
         _ => return None,
     })
 }

@@ -37,7 +37,8 @@ pub fn parse(knobs: &[(String, String)]) -> Result<MinmaxVariant, GenError> {
             "light" => v.light = value.parse()?,
             other => {
                 return Err(GenError::Usage(format!(
-                    "knob `{other}` does not apply to family minmax"
+                    "knob `{}` does not apply to family minmax",
+                    scatter_shaderlib::prefiltered::variant::printable(other)
                 )));
             }
         }

@@ -12,6 +12,7 @@ pub mod raymarch;
 
 use std::fmt;
 
+use scatter_shaderlib::prefiltered::variant::printable;
 use scatter_shaderlib::{Kernel, KernelParams};
 use serde::Serialize;
 
@@ -132,7 +133,8 @@ impl Family {
             if !known.iter().any(|k| k.name == name.as_str()) {
                 let names: Vec<_> = known.iter().map(|k| k.name).collect();
                 return Err(GenError::Usage(format!(
-                    "knob `{name}` does not apply to family {self} (its knobs: {})",
+                    "knob `{}` does not apply to family {self} (its knobs: {})",
+                    printable(name),
                     names.join(", ")
                 )));
             }
@@ -161,7 +163,11 @@ impl std::str::FromStr for Family {
             .find(|f| f.name() == s)
             .ok_or_else(|| {
                 let names: Vec<_> = Self::ALL.iter().map(|f| f.name()).collect();
-                GenError::Usage(format!("family must be {}, got {s}", names.join(" | ")))
+                GenError::Usage(format!(
+                    "family must be {}, got {}",
+                    names.join(" | "),
+                    printable(s)
+                ))
             })
     }
 }

@@ -110,7 +110,8 @@ pub fn parse(knobs: &[(String, String)]) -> Result<Variant, GenError> {
             "rectification" => v.rectification = value.parse()?,
             other => {
                 return Err(GenError::Usage(format!(
-                    "knob `{other}` does not apply to family prefiltered"
+                    "knob `{}` does not apply to family prefiltered",
+                    scatter_shaderlib::prefiltered::variant::printable(other)
                 )));
             }
         }

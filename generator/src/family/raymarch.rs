@@ -93,7 +93,8 @@ pub fn parse(knobs: &[(String, String)]) -> Result<RaymarchVariant, GenError> {
             "light" => v.light = value.parse()?,
             other => {
                 return Err(GenError::Usage(format!(
-                    "knob `{other}` does not apply to family raymarch"
+                    "knob `{}` does not apply to family raymarch",
+                    scatter_shaderlib::prefiltered::variant::printable(other)
                 )));
             }
         }
