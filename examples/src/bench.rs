@@ -606,10 +606,7 @@ fn time_method(
 /// The headline configuration: 1280x720, 1024x1024 rectified, on sphere, foliage and
 /// terrain.
 fn headline_runs(ctx: &Context, frames: u32) -> Result<Vec<HeadlineRow>, BoxError> {
-    let mut methods = vec![
-        Method::prefiltered_default(),
-        Method::minmax_default(),
-    ];
+    let mut methods = vec![Method::prefiltered_default(), Method::minmax_default()];
     for (samples, interleave) in [(64, 1), (128, 1), (64, 4)] {
         methods.push(Method::Raymarch(RaymarchVariant {
             samples,
@@ -1248,7 +1245,11 @@ pub fn tune_refinements(table: &[TuneEntry], run: [u32; 2]) -> Vec<Method> {
                 .collect();
             pareto_entries(&own)
                 .into_iter()
-                .filter_map(|f| table.iter().find(|e| e.family == f.family && e.knobs == f.knobs))
+                .filter_map(|f| {
+                    table
+                        .iter()
+                        .find(|e| e.family == f.family && e.knobs == f.knobs)
+                })
                 .collect::<Vec<_>>()
         })
         .collect();
@@ -1260,7 +1261,10 @@ pub fn tune_refinements(table: &[TuneEntry], run: [u32; 2]) -> Vec<Method> {
         }
     };
     let rect_steps = |r: [u32; 2]| -> Vec<[u32; 2]> {
-        let Some(i) = TUNE_RECTIFIED.iter().position(|&w| w == r[0] && r[0] == r[1]) else {
+        let Some(i) = TUNE_RECTIFIED
+            .iter()
+            .position(|&w| w == r[0] && r[0] == r[1])
+        else {
             return Vec::new();
         };
         [i.checked_sub(1), Some(i + 1)]
@@ -1407,7 +1411,10 @@ pub fn scatter_gen_command(method: &Method, run: [u32; 2]) -> String {
             v.samples, v.interleave, v.jitter, v.light
         ),
         Method::Minmax(v, _) => {
-            format!("scatter-gen --family minmax --light {} --out shaders/{rect}", v.light)
+            format!(
+                "scatter-gen --family minmax --light {} --out shaders/{rect}",
+                v.light
+            )
         }
     }
 }
@@ -1478,13 +1485,15 @@ mod tests {
 
     #[test]
     fn refinements_step_the_fixed_knobs_around_the_front() {
-        let p = |bases, r| Method::Prefiltered(
-            Variant {
-                bases,
-                ..Variant::default()
-            },
-            r,
-        );
+        let p = |bases, r| {
+            Method::Prefiltered(
+                Variant {
+                    bases,
+                    ..Variant::default()
+                },
+                r,
+            )
+        };
         // m16 at 256^2 and m32 at 512^2 are on the prefiltered front (m32 despite the
         // cheaper, better raymarch); m64 is dominated by m32.
         let table = vec![

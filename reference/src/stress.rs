@@ -277,7 +277,15 @@ fn case(
 /// Every stress case at a `width` x `height` screen (the `screen_*` cases use their own).
 pub fn cases(width: u32, height: u32) -> Vec<StressCase> {
     use StressGroup::{Medium, Pose as P, Size};
-    let columns = |w, h| suite::scene(SceneName::Columns, Pose::Ordinary, MediumPreset::Default, w, h);
+    let columns = |w, h| {
+        suite::scene(
+            SceneName::Columns,
+            Pose::Ordinary,
+            MediumPreset::Default,
+            w,
+            h,
+        )
+    };
     let base = columns(width, height);
     let eye = v(0.0, 1.7, 13.0);
     let mut out = Vec::new();
@@ -403,7 +411,15 @@ pub fn cases(width: u32, height: u32) -> Vec<StressCase> {
     }
 
     // Spot light cases on spot_grate.
-    let spot = |pose| suite::scene(SceneName::SpotGrate, pose, MediumPreset::Default, width, height);
+    let spot = |pose| {
+        suite::scene(
+            SceneName::SpotGrate,
+            pose,
+            MediumPreset::Default,
+            width,
+            height,
+        )
+    };
     let mut s = spot(Pose::Ordinary);
     let lamp = match s.light {
         Light::Spot { position, .. } => position,
@@ -439,11 +455,21 @@ pub fn cases(width: u32, height: u32) -> Vec<StressCase> {
 
     // Media on columns/ordinary.
     let far = base.camera.far;
-    let media: [(&'static str, &'static str, fn(&mut crate::scene::Medium, f64)); 7] = [
-        ("sigma_t_0", "no medium (sigma_t = 0)", |m, _| m.sigma_t = 0.0),
-        ("sigma_t_1e-6", "vanishing medium (sigma_t = 1e-6)", |m, _| {
-            m.sigma_t = 1e-6;
+    let media: [(
+        &'static str,
+        &'static str,
+        fn(&mut crate::scene::Medium, f64),
+    ); 7] = [
+        ("sigma_t_0", "no medium (sigma_t = 0)", |m, _| {
+            m.sigma_t = 0.0
         }),
+        (
+            "sigma_t_1e-6",
+            "vanishing medium (sigma_t = 1e-6)",
+            |m, _| {
+                m.sigma_t = 1e-6;
+            },
+        ),
         (
             "optical_depth_10",
             "thick fog: sigma_t * far = 10",

@@ -123,9 +123,21 @@ impl Passes {
     }
 
     /// Every family's output for one frame: (label, image), in `labels()` order.
-    fn render(&mut self, ctx: &Context, scene: &Scene, gbuf: &GBuffer, sm: &ShadowMap) -> Vec<Image> {
-        let depth = upload_r32float(ctx, Kernel::Scatter, "flicker depth", SCREEN, &gbuf.view_depth)
-            .expect("depth upload");
+    fn render(
+        &mut self,
+        ctx: &Context,
+        scene: &Scene,
+        gbuf: &GBuffer,
+        sm: &ShadowMap,
+    ) -> Vec<Image> {
+        let depth = upload_r32float(
+            ctx,
+            Kernel::Scatter,
+            "flicker depth",
+            SCREEN,
+            &gbuf.view_depth,
+        )
+        .expect("depth upload");
         let shadow = upload_r32float(
             ctx,
             Kernel::Rectify,
@@ -153,7 +165,9 @@ impl Passes {
             )
         };
         let mut out = Vec::new();
-        self.prefiltered.prepare(ctx, &input).expect("prefiltered prepare");
+        self.prefiltered
+            .prepare(ctx, &input)
+            .expect("prefiltered prepare");
         let mut encoder = ctx.device().create_command_encoder(&Default::default());
         self.prefiltered
             .encode(
@@ -179,7 +193,8 @@ impl Passes {
         for (_, pass) in &mut self.raymarch {
             pass.prepare(ctx, &march).expect("raymarch prepare");
             let mut encoder = ctx.device().create_command_encoder(&Default::default());
-            pass.encode(ctx, &mut encoder, &dv, &sv).expect("raymarch encode");
+            pass.encode(ctx, &mut encoder, &dv, &sv)
+                .expect("raymarch encode");
             ctx.queue().submit([encoder.finish()]);
             out.push(image(
                 read_rgba16float(ctx, Kernel::Raymarch, pass.output_texture())
@@ -219,10 +234,7 @@ fn prefiltered_flickers_no_more_than_raymarch_at_equal_time() {
         .expect("equal-time N is reported");
     let mut failures = Vec::new();
     let mut table = vec![
-        format!(
-            "| scene | path | {} |",
-            labels.join(" | ")
-        ),
+        format!("| scene | path | {} |", labels.join(" | ")),
         format!("|---|---|{}", "---|".repeat(labels.len())),
     ];
     let mut errors_table = table.clone();
@@ -255,7 +267,11 @@ fn prefiltered_flickers_no_more_than_raymarch_at_equal_time() {
                     },
                     &|| (),
                 ));
-                for (i, image) in passes.render(ctx, &scene, &gbuf, &sm).into_iter().enumerate() {
+                for (i, image) in passes
+                    .render(ctx, &scene, &gbuf, &sm)
+                    .into_iter()
+                    .enumerate()
+                {
                     outputs[i].push(image);
                 }
             }
@@ -264,7 +280,9 @@ fn prefiltered_flickers_no_more_than_raymarch_at_equal_time() {
             for (label, frames) in labels.iter().zip(&outputs) {
                 let nan: usize = frames.iter().map(metrics::non_finite_count).sum();
                 if nan > 0 {
-                    failures.push(format!("flicker::{label}::{name}::{path}: {nan} NaN/Inf pixels"));
+                    failures.push(format!(
+                        "flicker::{label}::{name}::{path}: {nan} NaN/Inf pixels"
+                    ));
                 }
                 flicker.push(metrics::flicker(frames, &truths).expect("sequences"));
                 mean_error.push(

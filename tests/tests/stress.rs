@@ -38,8 +38,8 @@ use scatter_runtime::{
 };
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{
-    FrameReport, FrameSettings, LightKind, ProjectiveFallback, Rectification, Resolutions,
-    Storage, Variant, prepare_frame,
+    FrameReport, FrameSettings, LightKind, ProjectiveFallback, Rectification, Resolutions, Storage,
+    Variant, prepare_frame,
 };
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -171,7 +171,11 @@ impl Prepared {
 
     /// Runs `method` on the GPU (or its CPU mirror without one): the output and, for the
     /// families with a frame set-up, the frame report.
-    fn run(&self, ctx: Option<&Context>, method: Method) -> Result<(Image, Option<FrameReport>), String> {
+    fn run(
+        &self,
+        ctx: Option<&Context>,
+        method: Method,
+    ) -> Result<(Image, Option<FrameReport>), String> {
         let [w, h] = self.screen();
         let depth = self.case.engine_depth(&self.gbuf);
         let to_image = |out: Vec<[f32; 4]>| {
@@ -308,7 +312,10 @@ fn every_family_survives_every_stress_case() {
         "| group | case | truth max | f16 floor | {} | notes |",
         Method::ALL.map(Method::label).join(" | ")
     )];
-    table.push(format!("|---|---|---|---|{}---|", "---|".repeat(Method::ALL.len())));
+    table.push(format!(
+        "|---|---|---|---|{}---|",
+        "---|".repeat(Method::ALL.len())
+    ));
     for case in stress::cases(SCREEN[0], SCREEN[1]) {
         let p = Prepared::new(case);
         let name = p.case.name;
@@ -327,7 +334,9 @@ fn every_family_survives_every_stress_case() {
                 .map(|c| c.map(|v| quantise(v, Storage::Rgba16float)))
                 .collect(),
         );
-        let floor = metrics::compare(&rounded, &p.truth).expect("same size").rel_l1;
+        let floor = metrics::compare(&rounded, &p.truth)
+            .expect("same size")
+            .rel_l1;
         let pixels = p.truth.data.len();
         let truth_max = p
             .truth
@@ -372,9 +381,9 @@ fn every_family_survives_every_stress_case() {
                     c.max_abs
                 ));
             }
-            let exception = PROJECTIVE_EXCEPTIONS
-                .iter()
-                .find(|e| e.0 == name && c.method == Method::Prefiltered(Rectification::Projective));
+            let exception = PROJECTIVE_EXCEPTIONS.iter().find(|e| {
+                e.0 == name && c.method == Method::Prefiltered(Rectification::Projective)
+            });
             let bar = match c.method {
                 Method::Prefiltered(_) if p.case.group == StressGroup::Pose => {
                     Some(exception.map_or(PREFILTERED_POSE_BAR, |e| e.1))
@@ -418,12 +427,7 @@ fn every_family_survives_every_stress_case() {
             ));
         }
         // The safe paths, from the epipolar variant's report.
-        let report = |m: Method| {
-            reports
-                .iter()
-                .find(|r| r.0 == m)
-                .and_then(|r| r.1.clone())
-        };
+        let report = |m: Method| reports.iter().find(|r| r.0 == m).and_then(|r| r.1.clone());
         let mut notes = Vec::new();
         if let Some(r) = report(Method::Prefiltered(Rectification::Epipolar)) {
             let on_screen = r.epipole_on_screen || r.anti_epipole_on_screen;
@@ -494,5 +498,10 @@ fn every_family_survives_every_stress_case() {
     for line in &table {
         println!("{line}");
     }
-    assert!(failures.is_empty(), "{} failures:\n{}", failures.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }

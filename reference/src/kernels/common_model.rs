@@ -76,7 +76,10 @@ pub fn spot_span(
     medium: [f32; 4],
 ) -> f32 {
     let t0 = (light_pos - eye).dot(dir);
-    let h = max((eye + dir * t0 - light_pos).length(), 1e-4 * max(b - a, 1e-6));
+    let h = max(
+        (eye + dir * t0 - light_pos).length(),
+        1e-4 * max(b - a, 1e-6),
+    );
     let g0 = ((a - t0) / h).atan();
     let w = (((b - t0) / h).atan() - g0) / panels as f32;
     let mut sum = 0.0;

@@ -98,7 +98,8 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
     let eye = xyz(f.eye);
     let dir = pixel_dir(f, x, y);
     // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
-    let s = min(max(inp.depth.load(x, y), 0.0), f.theta[2]) / max(dir.dot(xyz(f.cam_forward)), 1e-6);
+    let s =
+        min(max(inp.depth.load(x, y), 0.0), f.theta[2]) / max(dir.dot(xyz(f.cam_forward)), 1e-6);
     let color = xyz(f.light_color);
 
     // Near the epipole and the anti-epipole the rectification degenerates: march instead.
