@@ -231,6 +231,9 @@ impl StressCase {
     }
 }
 
+/// Sets one medium parameter (`far` given for `optical_depth_10`).
+type SetMedium = fn(&mut crate::scene::Medium, f64);
+
 fn v(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
 }
@@ -455,11 +458,7 @@ pub fn cases(width: u32, height: u32) -> Vec<StressCase> {
 
     // Media on columns/ordinary.
     let far = base.camera.far;
-    let media: [(
-        &'static str,
-        &'static str,
-        fn(&mut crate::scene::Medium, f64),
-    ); 7] = [
+    let media: [(&'static str, &'static str, SetMedium); 7] = [
         ("sigma_t_0", "no medium (sigma_t = 0)", |m, _| {
             m.sigma_t = 0.0
         }),
