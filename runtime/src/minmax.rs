@@ -137,28 +137,7 @@ impl Minmax {
                 max_2d,
             )?;
         }
-        let slice_bytes = u64::from(hr) * size_of::<SliceParams>() as u64;
-        check_limit(
-            RECTIFY,
-            "slice table bytes (16 per rectified row)",
-            slice_bytes,
-            "max_storage_buffer_binding_size",
-            limits.max_storage_buffer_binding_size,
-        )?;
-        check_limit(
-            RECTIFY,
-            "slice table bytes (16 per rectified row)",
-            slice_bytes,
-            "max_buffer_size",
-            limits.max_buffer_size,
-        )?;
-        check_limit(
-            RECTIFY,
-            "uniform block bytes",
-            size_of::<FrameUniforms>() as u64,
-            "max_uniform_buffer_binding_size",
-            limits.max_uniform_buffer_binding_size,
-        )?;
+        let slice_bytes = crate::prefiltered::check_frame_buffers(&limits, hr)?;
         let built = KernelParams::minmax(*variant)
             .map(|p| scatter_shaderlib::build(&p))
             .into_iter()

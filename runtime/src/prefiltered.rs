@@ -234,28 +234,7 @@ impl Scatter {
             "max_texture_array_layers",
             limits.max_texture_array_layers.into(),
         )?;
-        let slice_bytes = u64::from(hr) * size_of::<SliceParams>() as u64;
-        check_limit(
-            RECTIFY,
-            "slice table bytes (16 per rectified row)",
-            slice_bytes,
-            "max_storage_buffer_binding_size",
-            limits.max_storage_buffer_binding_size,
-        )?;
-        check_limit(
-            RECTIFY,
-            "slice table bytes (16 per rectified row)",
-            slice_bytes,
-            "max_buffer_size",
-            limits.max_buffer_size,
-        )?;
-        check_limit(
-            RECTIFY,
-            "uniform block bytes",
-            size_of::<FrameUniforms>() as u64,
-            "max_uniform_buffer_binding_size",
-            limits.max_uniform_buffer_binding_size,
-        )?;
+        let slice_bytes = check_frame_buffers(&limits, hr)?;
         if variant.storage == Storage::Rgba32float
             && !device
                 .features()
@@ -1273,4 +1252,34 @@ impl Readback {
         }
         Ok(packed)
     }
+}
+
+/// The slice table (16 bytes per rectified row, `hr` rows) and the uniform block of the
+/// families built on the prefiltered frame set-up, against the device's buffer limits; the
+/// slice table's size in bytes.
+pub(crate) fn check_frame_buffers(limits: &wgpu::Limits, hr: u32) -> Result<u64, RuntimeError> {
+    let slice_bytes = u64::from(hr) * size_of::<SliceParams>() as u64;
+    for (name, limit) in [
+        (
+            "max_storage_buffer_binding_size",
+            limits.max_storage_buffer_binding_size,
+        ),
+        ("max_buffer_size", limits.max_buffer_size),
+    ] {
+        check_limit(
+            RECTIFY,
+            "slice table bytes (16 per rectified row)",
+            slice_bytes,
+            name,
+            limit,
+        )?;
+    }
+    check_limit(
+        RECTIFY,
+        "uniform block bytes",
+        size_of::<FrameUniforms>() as u64,
+        "max_uniform_buffer_binding_size",
+        limits.max_uniform_buffer_binding_size,
+    )?;
+    Ok(slice_bytes)
 }
