@@ -18,9 +18,9 @@
 //! reason. Against N = 128 it flickers less only on `spot_grate` (0.52 against 1.68 %).
 //!
 //! 64x36 pixels, 256x256 rectified map, 512^2 shadow map, truth with 512 cells per ray:
-//! small enough for CI (about 2 minutes here). `SCATTER_FLICKER_SCENE=foliage` runs one
-//! scene. `cargo test --release -p scatter-conformance --test flicker --
-//! --nocapture` prints the table of the closing note.
+//! small enough for CI (75 s here in the test profile with a warm Mesa cache).
+//! `SCATTER_FLICKER_SCENE=foliage` runs one scene. `cargo test --release -p
+//! scatter-conformance --test flicker -- --nocapture` prints the table of the closing note.
 
 use scatter_conformance::gpu;
 use scatter_reference::buffers::{GBuffer, ShadowMap};
