@@ -22,7 +22,7 @@ use scatter_shaderlib::{Kernel, KernelParams};
 use crate::error::{ErrorScopes, check_limit};
 use crate::prefiltered::{
     DEPTH_FORMAT, DEPTH_NAMES, FrameInput, OUTPUT_FORMAT, Pipeline, Readback, SHADOW_NAMES,
-    buffer_entry, check_view, check_workgroup, create_pipeline, decode_rgba, groups, view_entry,
+    buffer_entry, check_dispatch, check_view, create_pipeline, decode_rgba, groups, view_entry,
 };
 use crate::textures::upload_r32float;
 use crate::timer::median_pass_wall_times;
@@ -143,20 +143,7 @@ impl Minmax {
             .into_iter()
             .collect::<Result<Vec<_>, _>>()?;
         for (b, invocations) in built.iter().zip([[wr, hr, 1], [tw, hr, 1], [w, h, 1]]) {
-            check_workgroup(&limits, b)?;
-            for (count, what) in groups(invocations, b.workgroup_size).into_iter().zip([
-                "workgroups along x",
-                "workgroups along y",
-                "workgroups along z",
-            ]) {
-                check_limit(
-                    b.kernel,
-                    what,
-                    count.into(),
-                    "max_compute_workgroups_per_dimension",
-                    limits.max_compute_workgroups_per_dimension.into(),
-                )?;
-            }
+            check_dispatch(&limits, b, invocations)?;
         }
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,

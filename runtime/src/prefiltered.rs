@@ -264,21 +264,7 @@ impl Scatter {
             (&built_scatter, [w, h, 1]),
         ];
         for (built, invocations) in dispatches {
-            check_workgroup(&limits, built)?;
-            let counts = groups(invocations, built.workgroup_size);
-            for (count, what) in counts.into_iter().zip([
-                "workgroups along x",
-                "workgroups along y",
-                "workgroups along z",
-            ]) {
-                check_limit(
-                    built.kernel,
-                    what,
-                    count.into(),
-                    "max_compute_workgroups_per_dimension",
-                    limits.max_compute_workgroups_per_dimension.into(),
-                )?;
-            }
+            check_dispatch(&limits, built, invocations)?;
         }
 
         // Every check passed: create the GPU objects.
@@ -868,11 +854,33 @@ pub(crate) fn check_view(
     Ok(())
 }
 
-/// Checks a kernel's workgroup size against the device limits.
-pub(crate) fn check_workgroup(
+/// Checks a kernel's workgroup size, and the workgroup counts of a dispatch covering
+/// `invocations`, against the device limits.
+pub(crate) fn check_dispatch(
     limits: &wgpu::Limits,
     built: &BuiltKernel,
+    invocations: [u32; 3],
 ) -> Result<(), RuntimeError> {
+    check_workgroup(limits, built)?;
+    let counts = groups(invocations, built.workgroup_size);
+    for (count, what) in counts.into_iter().zip([
+        "workgroups along x",
+        "workgroups along y",
+        "workgroups along z",
+    ]) {
+        check_limit(
+            built.kernel,
+            what,
+            count.into(),
+            "max_compute_workgroups_per_dimension",
+            limits.max_compute_workgroups_per_dimension.into(),
+        )?;
+    }
+    Ok(())
+}
+
+/// Checks a kernel's workgroup size against the device limits.
+fn check_workgroup(limits: &wgpu::Limits, built: &BuiltKernel) -> Result<(), RuntimeError> {
     let [x, y, z] = built.workgroup_size;
     let kernel = built.kernel;
     check_limit(

@@ -17,8 +17,8 @@ use scatter_shaderlib::{Kernel, KernelParams};
 
 use crate::error::{ErrorScopes, check_limit};
 use crate::prefiltered::{
-    DEPTH_NAMES, OUTPUT_FORMAT, Pipeline, Readback, SHADOW_NAMES, buffer_entry, check_view,
-    check_workgroup, create_pipeline, decode_rgba, groups, view_entry,
+    DEPTH_NAMES, OUTPUT_FORMAT, Pipeline, Readback, SHADOW_NAMES, buffer_entry, check_dispatch,
+    check_view, create_pipeline, decode_rgba, groups, view_entry,
 };
 use crate::textures::upload_r32float;
 use crate::timer::median_pass_wall_times;
@@ -140,20 +140,7 @@ impl Raymarch {
             .map(scatter_shaderlib::build)
             .collect::<Result<_, _>>()?;
         for b in &built {
-            check_workgroup(&limits, b)?;
-            for (count, what) in groups([w, h, 1], b.workgroup_size).into_iter().zip([
-                "workgroups along x",
-                "workgroups along y",
-                "workgroups along z",
-            ]) {
-                check_limit(
-                    b.kernel,
-                    what,
-                    count.into(),
-                    "max_compute_workgroups_per_dimension",
-                    limits.max_compute_workgroups_per_dimension.into(),
-                )?;
-            }
+            check_dispatch(&limits, b, [w, h, 1])?;
         }
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
