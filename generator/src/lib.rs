@@ -24,7 +24,7 @@ pub mod generate;
 pub mod layout_code;
 pub mod manifest;
 pub mod output;
-pub mod reflect;
+pub use scatter_shaderlib::reflect;
 mod spirv_fixup;
 pub mod target;
 

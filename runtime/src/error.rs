@@ -161,6 +161,15 @@ pub enum RuntimeError {
         /// The first kernel of the family.
         kernel: Kernel,
     },
+    /// A family's plan and its compiled kernels disagree (a binding the plan does not
+    /// describe, a formula symbol with no value): a defect of the family, not of the input.
+    #[error("kernel `{kernel}`: the plan and the kernel disagree: {message}")]
+    Plan {
+        /// The kernel.
+        kernel: Kernel,
+        /// What disagrees.
+        message: String,
+    },
 }
 
 /// Fails with [`RuntimeError::LimitExceeded`] when `value > max`.

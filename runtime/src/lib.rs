@@ -15,6 +15,8 @@
 
 mod context;
 mod error;
+mod executor;
+pub mod gpu;
 pub mod minmax;
 pub mod prefiltered;
 pub mod raymarch;

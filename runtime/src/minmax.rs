@@ -14,19 +14,16 @@
 use std::time::{Duration, Instant};
 
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax, tree_width};
-use scatter_shaderlib::prefiltered::{
-    FrameUniforms, PrefilteredFrame, Resolutions, SliceParams, Storage,
-};
+use scatter_shaderlib::prefiltered::{PrefilteredFrame, Resolutions, Storage};
 use scatter_shaderlib::{Kernel, KernelParams};
 
 use crate::error::{ErrorScopes, check_limit};
-use crate::prefiltered::{
-    DEPTH_FORMAT, DEPTH_NAMES, FrameInput, OUTPUT_FORMAT, Pipeline, Readback, SHADOW_NAMES,
-    buffer_entry, check_dispatch, check_view, create_pipeline, decode_rgba, groups, view_entry,
-};
+use crate::executor::Executor;
+use crate::gpu::{DEPTH_NAMES, Readback, SHADOW_NAMES, check_view, decode_rgba};
+use crate::prefiltered::FrameInput;
 use crate::textures::upload_r32float;
 use crate::timer::median_pass_wall_times;
-use crate::{Context, GpuTimer, RuntimeError};
+use crate::{Context, RuntimeError};
 
 const RECTIFY: Kernel = Kernel::Rectify;
 const BUILD: Kernel = Kernel::MinmaxBuild;
@@ -60,19 +57,14 @@ pub struct Minmax {
     variant: MinmaxVariant,
     res: Resolutions,
     shadow_map_size: u32,
-    rectify: Pipeline,
-    build: Pipeline,
-    march: Pipeline,
+    /// The plan of the variant, built.
+    exec: Executor,
     uniforms: wgpu::Buffer,
     slices: wgpu::Buffer,
     rectified: wgpu::Texture,
-    rectified_view: wgpu::TextureView,
     tree: wgpu::Texture,
-    tree_view: wgpu::TextureView,
-    build_group: wgpu::BindGroup,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
-    timer: Option<GpuTimer>,
     frame: Option<PrefilteredFrame>,
 }
 
@@ -137,138 +129,36 @@ impl Minmax {
                 max_2d,
             )?;
         }
-        let slice_bytes = crate::prefiltered::check_frame_buffers(&limits, hr)?;
+        crate::prefiltered::check_frame_buffers(&limits, hr)?;
         let built = KernelParams::minmax(*variant)
             .map(|p| scatter_shaderlib::build(&p))
             .into_iter()
             .collect::<Result<Vec<_>, _>>()?;
-        for (b, invocations) in built.iter().zip([[wr, hr, 1], [tw, hr, 1], [w, h, 1]]) {
-            check_dispatch(&limits, b, invocations)?;
-        }
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty,
-            count: None,
-        };
-        let uniform = wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: wgpu::BufferSize::new(size_of::<FrameUniforms>() as u64),
-        };
-        let slices_ty = wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: wgpu::BufferSize::new(size_of::<SliceParams>() as u64),
-        };
-        let texture = wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        };
-        let storage = |format| wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format,
-            view_dimension: wgpu::TextureViewDimension::D2,
-        };
-        let [b_rectify, b_build, b_march]: [_; 3] = built
-            .try_into()
-            .map_err(|_| RuntimeError::NotPrepared { kernel: BUILD })?;
-        let rectify = create_pipeline(
-            device,
-            b_rectify,
+        let exec = Executor::new(
+            ctx,
+            scatter_shaderlib::minmax::plan::plan(variant),
+            built,
             &[
-                entry(0, uniform),
-                entry(1, slices_ty),
-                entry(2, texture),
-                entry(3, storage(DEPTH_FORMAT)),
+                ("screen.width", w.into()),
+                ("screen.height", h.into()),
+                ("shadow.size", shadow_map_size.into()),
+                ("rectified.width", wr.into()),
+                ("rectified.height", hr.into()),
+                ("tree.width", tw.into()),
             ],
         )?;
-        let build = create_pipeline(
-            device,
-            b_build,
-            &[
-                entry(0, uniform),
-                entry(1, texture),
-                entry(2, storage(TREE_FORMAT)),
-            ],
-        )?;
-        let march = create_pipeline(
-            device,
-            b_march,
-            &[
-                entry(0, uniform),
-                entry(1, slices_ty),
-                entry(2, texture),
-                entry(3, texture),
-                entry(4, texture),
-                entry(5, storage(OUTPUT_FORMAT)),
-            ],
-        )?;
-        let scope = ErrorScopes::push(device);
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("minmax frame uniforms"),
-            size: size_of::<FrameUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let slices = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("minmax slice table"),
-            size: slice_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let make = |label, [width, height]: [u32; 2], format| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::STORAGE_BINDING
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
-        };
-        let rectified = make("minmax rectified map", res.rectified, DEPTH_FORMAT);
-        let tree = make("minmax trees", [tw, hr], TREE_FORMAT);
-        let output = make("minmax output", res.screen, OUTPUT_FORMAT);
-        let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
-        let (rectified_view, tree_view, output_view) =
-            (view(&rectified), view(&tree), view(&output));
-        let build_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("minmax_build"),
-            layout: &build.layout,
-            entries: &[
-                buffer_entry(0, &uniforms),
-                view_entry(1, &rectified_view),
-                view_entry(2, &tree_view),
-            ],
-        });
-        scope.pop(BUILD, "creating textures and buffers")?;
+        let (output, output_view) = exec.texture("output")?;
         Ok(Minmax {
             variant: *variant,
             res,
             shadow_map_size,
-            rectify,
-            build,
-            march,
-            uniforms,
-            slices,
-            rectified,
-            rectified_view,
-            tree,
-            tree_view,
-            build_group,
-            output,
-            output_view,
-            timer: GpuTimer::with_passes(ctx, 3),
+            uniforms: exec.buffer("frame")?.clone(),
+            slices: exec.buffer("slices")?.clone(),
+            rectified: exec.texture("rectified")?.0.clone(),
+            tree: exec.texture("tree")?.0.clone(),
+            output: output.clone(),
+            output_view: output_view.clone(),
+            exec,
             frame: None,
         })
     }
@@ -377,59 +267,13 @@ impl Minmax {
             shadow_map,
             [self.shadow_map_size; 2],
         )?;
-        let device = ctx.device();
-        let scope = ErrorScopes::push(device);
-        let rectify_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("minmax rectify"),
-            layout: &self.rectify.layout,
-            entries: &[
-                buffer_entry(0, &self.uniforms),
-                buffer_entry(1, &self.slices),
-                view_entry(2, shadow_map),
-                view_entry(3, &self.rectified_view),
-            ],
-        });
-        let march_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("minmax_march"),
-            layout: &self.march.layout,
-            entries: &[
-                buffer_entry(0, &self.uniforms),
-                buffer_entry(1, &self.slices),
-                view_entry(2, depth),
-                view_entry(3, shadow_map),
-                view_entry(4, &self.tree_view),
-                view_entry(5, &self.output_view),
-            ],
-        });
-        scope.pop(MARCH, "creating the bind groups")?;
-        let [w, h] = self.res.screen;
-        let [wr, hr] = self.res.rectified;
-        let passes = [
-            (&self.rectify, &rectify_group, [wr, hr, 1]),
-            (&self.build, &self.build_group, [tree_width(wr), hr, 1]),
-            (&self.march, &march_group, [w, h, 1]),
-        ];
-        for (index, (pipeline, group, invocations)) in (0u32..).zip(passes) {
-            if only.is_some_and(|k| k != pipeline.kernel) {
-                continue;
-            }
-            let timestamps = if only.is_none() {
-                self.timer.as_ref().and_then(|t| t.pass_writes(index))
-            } else {
-                None
-            };
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(pipeline.kernel.name()),
-                timestamp_writes: timestamps,
-            });
-            pass.set_pipeline(&pipeline.pipeline);
-            pass.set_bind_group(0, group, &[]);
-            let [x, y, z] = groups(invocations, pipeline.workgroup_size);
-            pass.dispatch_workgroups(x, y, z);
-        }
-        if let Some(timer) = self.timer.as_ref().filter(|_| only.is_none()) {
-            timer.resolve(encoder);
-        }
+        self.exec.encode(
+            ctx.device(),
+            encoder,
+            &[("depth", depth), ("shadow_map", shadow_map)],
+            &[],
+            only,
+        )?;
         Ok(&self.output_view)
     }
 
@@ -440,7 +284,7 @@ impl Minmax {
     ///
     /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
     pub fn pass_times(&self, ctx: &Context) -> Result<Option<MinmaxTimes>, RuntimeError> {
-        let Some(timer) = &self.timer else {
+        let Some(timer) = self.exec.timer() else {
             return Ok(None);
         };
         let t = timer.read_all(ctx, MARCH)?;

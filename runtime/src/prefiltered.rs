@@ -16,27 +16,26 @@
 //! full circle (`FrameUniforms::anti_epipole[3] > 0.5`), else clamps: [`Scatter`] keeps both
 //! samplers and picks one per frame.
 
-use std::borrow::Cow;
 use std::time::{Duration, Instant};
 
+use scatter_shaderlib::prefiltered::plan;
 use scatter_shaderlib::prefiltered::{
     CameraDesc, FrameReport, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame,
     Rectification, Resolutions, ShadowMapDesc, SliceParams, Storage, Variant, prepare_frame,
 };
-use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams};
+use scatter_shaderlib::{Kernel, KernelParams};
 
 use crate::error::{ErrorScopes, check_limit};
-use crate::timer::{median_pass_wall_times, read_buffer};
-use crate::{Context, GpuTimer, RuntimeError};
+use crate::executor::Executor;
+use crate::gpu::{DEPTH_NAMES, RECTIFIED_NAMES, Readback, SHADOW_NAMES, check_view, decode_rgba};
+use crate::timer::median_pass_wall_times;
+use crate::{Context, RuntimeError};
 
 const RECTIFY: Kernel = Kernel::Rectify;
 const PREFILTER: Kernel = Kernel::Prefilter;
 const SCATTER: Kernel = Kernel::Scatter;
 
-/// Format of the rectified map, the depth buffer and the standard shadow map.
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
-/// Format of the output (in-scattered radiance, rgb; alpha 1).
-pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub use crate::gpu::{DEPTH_FORMAT, OUTPUT_FORMAT};
 
 /// The texture format of a filtered-basis storage choice.
 pub const fn storage_format(storage: Storage) -> wgpu::TextureFormat {
@@ -104,15 +103,6 @@ impl PassTimes {
     }
 }
 
-/// One compute pipeline with its bind group layout and workgroup size.
-#[derive(Debug)]
-pub(crate) struct Pipeline {
-    pub(crate) kernel: Kernel,
-    pub(crate) layout: wgpu::BindGroupLayout,
-    pub(crate) pipeline: wgpu::ComputePipeline,
-    pub(crate) workgroup_size: [u32; 3],
-}
-
 /// The `prefiltered` method for one [`Variant`], sized for one set of [`Resolutions`] and one
 /// shadow-map size.
 #[derive(Debug)]
@@ -122,9 +112,8 @@ pub struct Scatter {
     variant: Variant,
     res: Resolutions,
     shadow_map_size: u32,
-    rectify: Pipeline,
-    prefilter: Pipeline,
-    scatter: Pipeline,
+    /// The plan of the variant, built.
+    exec: Executor,
     uniforms: wgpu::Buffer,
     slices: wgpu::Buffer,
     rectified: wgpu::Texture,
@@ -134,16 +123,7 @@ pub struct Scatter {
     filtered_view: wgpu::TextureView,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
-    sampler_clamp: wgpu::Sampler,
-    sampler_wrap: wgpu::Sampler,
-    prefilter_bind_group: wgpu::BindGroup,
-    timer: Option<GpuTimer>,
     frame: Option<PrefilteredFrame>,
-}
-
-/// Workgroup counts `ceil(n / size)` of one dispatch.
-pub(crate) fn groups(n: [u32; 3], size: [u32; 3]) -> [u32; 3] {
-    [0, 1, 2].map(|i| n[i].div_ceil(size[i].max(1)))
 }
 
 impl Scatter {
@@ -234,7 +214,7 @@ impl Scatter {
             "max_texture_array_layers",
             limits.max_texture_array_layers.into(),
         )?;
-        let slice_bytes = check_frame_buffers(&limits, hr)?;
+        check_frame_buffers(&limits, hr)?;
         if variant.storage == Storage::Rgba32float
             && !device
                 .features()
@@ -252,198 +232,40 @@ impl Scatter {
         }
 
         // CPU work only: render, compose and validate the three kernels.
-        let built_rectify = scatter_shaderlib::build(&KernelParams::Rectify(*variant))?;
-        let built_prefilter = scatter_shaderlib::build(&KernelParams::Prefilter(*variant))?;
-        let built_scatter = scatter_shaderlib::build(&KernelParams::Scatter(*variant))?;
-        let dispatches = [
-            (&built_rectify, [wr, hr, 1]),
-            (
-                &built_prefilter,
-                [hr, variant.regions, variant.threads_per_row_region()],
-            ),
-            (&built_scatter, [w, h, 1]),
-        ];
-        for (built, invocations) in dispatches {
-            check_dispatch(&limits, built, invocations)?;
-        }
-
-        // Every check passed: create the GPU objects.
-        let uniform = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: wgpu::BufferSize::new(size_of::<FrameUniforms>() as u64),
-            },
-            count: None,
-        };
-        let slices_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: wgpu::BufferSize::new(size_of::<SliceParams>() as u64),
-            },
-            count: None,
-        };
-        let texture = |binding, filterable, view_dimension| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable },
-                view_dimension,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let storage = |binding, format, view_dimension| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format,
-                view_dimension,
-            },
-            count: None,
-        };
-        let d2 = wgpu::TextureViewDimension::D2;
-        let d2_array = wgpu::TextureViewDimension::D2Array;
-        let filtered_format = storage_format(variant.storage);
-
-        let rectify = create_pipeline(
-            device,
-            built_rectify,
+        let built = KernelParams::prefiltered(*variant)
+            .iter()
+            .map(scatter_shaderlib::build)
+            .collect::<Result<Vec<_>, _>>()?;
+        let exec = Executor::new(
+            ctx,
+            plan::plan(variant),
+            built,
             &[
-                uniform(0),
-                slices_entry(1),
-                texture(2, false, d2),
-                storage(3, DEPTH_FORMAT, d2),
+                ("screen.width", w.into()),
+                ("screen.height", h.into()),
+                ("shadow.size", shadow_map_size.into()),
+                ("rectified.width", wr.into()),
+                ("rectified.height", hr.into()),
             ],
         )?;
-        let prefilter = create_pipeline(
-            device,
-            built_prefilter,
-            &[
-                uniform(0),
-                slices_entry(1),
-                texture(2, false, d2),
-                storage(3, filtered_format, d2_array),
-            ],
-        )?;
-        let scatter = create_pipeline(
-            device,
-            built_scatter,
-            &[
-                uniform(0),
-                slices_entry(1),
-                texture(2, false, d2),
-                texture(3, false, d2),
-                texture(4, true, d2_array),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-                storage(6, OUTPUT_FORMAT, d2),
-            ],
-        )?;
-
-        let scope = ErrorScopes::push(device);
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("prefiltered frame uniforms"),
-            size: size_of::<FrameUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let slices = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("prefiltered slice table"),
-            size: slice_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let readable = wgpu::TextureUsages::STORAGE_BINDING
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC;
-        let make_texture = |label, [width, height]: [u32; 2], layers, format| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: layers,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: readable,
-                view_formats: &[],
-            })
-        };
-        let rectified = make_texture("prefiltered rectified map", res.rectified, 1, DEPTH_FORMAT);
-        let filtered = make_texture(
-            "prefiltered filtered bases",
-            res.rectified,
-            variant.layers(),
-            filtered_format,
-        );
-        let output = make_texture("prefiltered output", res.screen, 1, OUTPUT_FORMAT);
-        let rectified_view = rectified.create_view(&wgpu::TextureViewDescriptor::default());
-        // A one-layer texture defaults to a D2 view: ask for D2Array explicitly.
-        let filtered_view = filtered.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(d2_array),
-            ..wgpu::TextureViewDescriptor::default()
-        });
-        let output_view = output.create_view(&wgpu::TextureViewDescriptor::default());
-        let sampler = |label, address_mode_v| {
-            device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some(label),
-                address_mode_u: wgpu::AddressMode::ClampToEdge,
-                address_mode_v,
-                address_mode_w: wgpu::AddressMode::ClampToEdge,
-                mag_filter: wgpu::FilterMode::Linear,
-                min_filter: wgpu::FilterMode::Linear,
-                ..wgpu::SamplerDescriptor::default()
-            })
-        };
-        let sampler_clamp = sampler("prefiltered bases (clamp)", wgpu::AddressMode::ClampToEdge);
-        let sampler_wrap = sampler("prefiltered bases (wrap)", wgpu::AddressMode::Repeat);
-        let prefilter_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("prefilter"),
-            layout: &prefilter.layout,
-            entries: &[
-                buffer_entry(0, &uniforms),
-                buffer_entry(1, &slices),
-                view_entry(2, &rectified_view),
-                view_entry(3, &filtered_view),
-            ],
-        });
-        let timer = GpuTimer::with_passes(ctx, 3);
-        scope.pop(PREFILTER, "creating textures and buffers")?;
+        let (rectified, rectified_view) = exec.texture("rectified")?;
+        let (filtered, filtered_view) = exec.texture("filtered")?;
+        let (output, output_view) = exec.texture("output")?;
         Ok(Self {
             device: device.clone(),
             queue: ctx.queue().clone(),
             variant: *variant,
             res,
             shadow_map_size,
-            rectify,
-            prefilter,
-            scatter,
-            uniforms,
-            slices,
-            rectified,
-            rectified_view,
-            filtered,
-            filtered_view,
-            output,
-            output_view,
-            sampler_clamp,
-            sampler_wrap,
-            prefilter_bind_group,
-            timer,
+            uniforms: exec.buffer("frame")?.clone(),
+            slices: exec.buffer("slices")?.clone(),
+            rectified: rectified.clone(),
+            rectified_view: rectified_view.clone(),
+            filtered: filtered.clone(),
+            filtered_view: filtered_view.clone(),
+            output: output.clone(),
+            output_view: output_view.clone(),
+            exec,
             frame: None,
         })
     }
@@ -575,113 +397,42 @@ impl Scatter {
             .ok_or(RuntimeError::NotPrepared { kernel: RECTIFY })?;
         let projective = frame.report.rectification == Rectification::Projective;
         check_view(SCATTER, &DEPTH_NAMES, inputs.depth, self.res.screen)?;
-        // The texture `scatter` binds as its shadow map (only read near the epipole, which a
-        // projective frame never has) and the one `prefilter` reads.
-        let (shadow_map, rectified) = if projective {
+        // A projective frame needs the rasterised rectified map (`prefilter` reads it;
+        // `scatter` binds it where the shadow map goes when the engine has none, which it
+        // never reads: no epipole on screen); an epipolar frame the standard shadow map.
+        if projective {
             let rectified = inputs.rectified.ok_or(RuntimeError::MissingInput {
                 kernel: PREFILTER,
                 what: "the rasterised rectified map (this frame is projective; render it \
                        with FrameReport::projective)",
             })?;
             check_view(PREFILTER, &RECTIFIED_NAMES, rectified, self.res.rectified)?;
-            (inputs.shadow_map.unwrap_or(rectified), rectified)
-        } else {
-            let shadow_map = inputs.shadow_map.ok_or(RuntimeError::MissingInput {
+        } else if inputs.shadow_map.is_none() {
+            return Err(RuntimeError::MissingInput {
                 kernel: RECTIFY,
                 what: "the standard shadow map (this frame is epipolar)",
-            })?;
-            (shadow_map, &self.rectified_view)
-        };
+            });
+        }
         if let Some(sm) = inputs.shadow_map {
             check_view(RECTIFY, &SHADOW_NAMES, sm, [self.shadow_map_size; 2])?;
         }
-        let wrap = frame.uniforms.anti_epipole[3] > 0.5;
-        let sampler = if wrap {
-            &self.sampler_wrap
-        } else {
-            &self.sampler_clamp
-        };
-
-        let scope = ErrorScopes::push(&self.device);
-        let rectify_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("rectify"),
-            layout: &self.rectify.layout,
-            entries: &[
-                buffer_entry(0, &self.uniforms),
-                buffer_entry(1, &self.slices),
-                view_entry(2, shadow_map),
-                view_entry(3, &self.rectified_view),
-            ],
-        });
-        scope.pop(RECTIFY, "creating the bind group")?;
-        let scope = ErrorScopes::push(&self.device);
-        let prefilter_group = projective.then(|| {
-            self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("prefilter (projective)"),
-                layout: &self.prefilter.layout,
-                entries: &[
-                    buffer_entry(0, &self.uniforms),
-                    buffer_entry(1, &self.slices),
-                    view_entry(2, rectified),
-                    view_entry(3, &self.filtered_view),
-                ],
-            })
-        });
-        scope.pop(PREFILTER, "creating the bind group")?;
-        let scope = ErrorScopes::push(&self.device);
-        let scatter_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scatter"),
-            layout: &self.scatter.layout,
-            entries: &[
-                buffer_entry(0, &self.uniforms),
-                buffer_entry(1, &self.slices),
-                view_entry(2, inputs.depth),
-                view_entry(3, shadow_map),
-                view_entry(4, &self.filtered_view),
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::Sampler(sampler),
-                },
-                view_entry(6, &self.output_view),
-            ],
-        });
-        scope.pop(SCATTER, "creating the bind group")?;
-
-        let [w, h] = self.res.screen;
-        let [wr, hr] = self.res.rectified;
-        let v = &self.variant;
-        let passes: [(&Pipeline, &wgpu::BindGroup, [u32; 3]); 3] = [
-            (&self.rectify, &rectify_group, [wr, hr, 1]),
-            (
-                &self.prefilter,
-                prefilter_group
-                    .as_ref()
-                    .unwrap_or(&self.prefilter_bind_group),
-                [hr, v.regions, v.threads_per_row_region()],
-            ),
-            (&self.scatter, &scatter_group, [w, h, 1]),
-        ];
-        for (index, (pipeline, group, invocations)) in (0u32..).zip(passes) {
-            if (projective && index == 0) || only.is_some_and(|k| k != pipeline.kernel) {
-                continue;
+        let mut engine = vec![("depth", inputs.depth)];
+        engine.extend(inputs.shadow_map.map(|v| ("shadow_map", v)));
+        if projective {
+            engine.extend(inputs.rectified.map(|v| (plan::RECTIFIED_RASTER, v)));
+        }
+        let mut conditions = Vec::new();
+        if projective {
+            conditions.push(plan::PROJECTIVE_FRAME);
+            if inputs.shadow_map.is_none() {
+                conditions.push(plan::PROJECTIVE_WITHOUT_SHADOW_MAP);
             }
-            let timestamps = if only.is_none() {
-                self.timer.as_ref().and_then(|t| t.pass_writes(index))
-            } else {
-                None
-            };
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(pipeline.kernel.name()),
-                timestamp_writes: timestamps,
-            });
-            pass.set_pipeline(&pipeline.pipeline);
-            pass.set_bind_group(0, group, &[]);
-            let [x, y, z] = groups(invocations, pipeline.workgroup_size);
-            pass.dispatch_workgroups(x, y, z);
         }
-        if let Some(timer) = self.timer.as_ref().filter(|_| only.is_none()) {
-            timer.resolve(encoder);
+        if frame.uniforms.anti_epipole[3] > 0.5 {
+            conditions.push(plan::WRAPPING_SLICES);
         }
+        self.exec
+            .encode(&self.device, encoder, &engine, &conditions, only)?;
         Ok(&self.output_view)
     }
 
@@ -692,7 +443,7 @@ impl Scatter {
     ///
     /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
     pub fn pass_times(&self, ctx: &Context) -> Result<Option<PassTimes>, RuntimeError> {
-        let Some(timer) = &self.timer else {
+        let Some(timer) = self.exec.timer() else {
             return Ok(None);
         };
         let times = timer.read_all(ctx, SCATTER)?;
@@ -769,186 +520,6 @@ impl Scatter {
     fn queue(&self) -> &wgpu::Queue {
         &self.queue
     }
-}
-
-pub(crate) fn buffer_entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry {
-        binding,
-        resource: buffer.as_entire_binding(),
-    }
-}
-
-pub(crate) fn view_entry(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry {
-        binding,
-        resource: wgpu::BindingResource::TextureView(view),
-    }
-}
-
-/// Names of the properties of one engine-provided texture, for [`check_view`].
-pub(crate) struct ViewNames {
-    format: &'static str,
-    size: &'static str,
-    usage: &'static str,
-}
-
-pub(crate) const DEPTH_NAMES: ViewNames = ViewNames {
-    format: "depth buffer format",
-    size: "depth buffer size",
-    usage: "depth buffer usage",
-};
-
-const RECTIFIED_NAMES: ViewNames = ViewNames {
-    format: "rasterised rectified map format",
-    size: "rasterised rectified map size",
-    usage: "rasterised rectified map usage",
-};
-
-pub(crate) const SHADOW_NAMES: ViewNames = ViewNames {
-    format: "shadow map format",
-    size: "shadow map size",
-    usage: "shadow map usage",
-};
-
-/// Checks an engine-provided r32float texture view: format, size, sampling usage.
-pub(crate) fn check_view(
-    kernel: Kernel,
-    names: &ViewNames,
-    view: &wgpu::TextureView,
-    size: [u32; 2],
-) -> Result<(), RuntimeError> {
-    let texture = view.texture();
-    let mismatch = |what, expected: String, actual: String| {
-        Err(RuntimeError::InputMismatch {
-            kernel,
-            what,
-            expected,
-            actual,
-        })
-    };
-    if texture.format() != DEPTH_FORMAT {
-        return mismatch(
-            names.format,
-            format!("{DEPTH_FORMAT:?}"),
-            format!("{:?}", texture.format()),
-        );
-    }
-    let extent = texture.size();
-    if [extent.width, extent.height] != size {
-        return mismatch(
-            names.size,
-            format!("{}x{}", size[0], size[1]),
-            format!("{}x{}", extent.width, extent.height),
-        );
-    }
-    if !texture
-        .usage()
-        .contains(wgpu::TextureUsages::TEXTURE_BINDING)
-    {
-        return mismatch(
-            names.usage,
-            "TEXTURE_BINDING".to_owned(),
-            format!("{:?}", texture.usage()),
-        );
-    }
-    Ok(())
-}
-
-/// Checks a kernel's workgroup size, and the workgroup counts of a dispatch covering
-/// `invocations`, against the device limits.
-pub(crate) fn check_dispatch(
-    limits: &wgpu::Limits,
-    built: &BuiltKernel,
-    invocations: [u32; 3],
-) -> Result<(), RuntimeError> {
-    check_workgroup(limits, built)?;
-    let counts = groups(invocations, built.workgroup_size);
-    for (count, what) in counts.into_iter().zip([
-        "workgroups along x",
-        "workgroups along y",
-        "workgroups along z",
-    ]) {
-        check_limit(
-            built.kernel,
-            what,
-            count.into(),
-            "max_compute_workgroups_per_dimension",
-            limits.max_compute_workgroups_per_dimension.into(),
-        )?;
-    }
-    Ok(())
-}
-
-/// Checks a kernel's workgroup size against the device limits.
-fn check_workgroup(limits: &wgpu::Limits, built: &BuiltKernel) -> Result<(), RuntimeError> {
-    let [x, y, z] = built.workgroup_size;
-    let kernel = built.kernel;
-    check_limit(
-        kernel,
-        "workgroup invocations",
-        u64::from(x) * u64::from(y) * u64::from(z),
-        "max_compute_invocations_per_workgroup",
-        limits.max_compute_invocations_per_workgroup.into(),
-    )?;
-    check_limit(
-        kernel,
-        "workgroup size x",
-        x.into(),
-        "max_compute_workgroup_size_x",
-        limits.max_compute_workgroup_size_x.into(),
-    )?;
-    check_limit(
-        kernel,
-        "workgroup size y",
-        y.into(),
-        "max_compute_workgroup_size_y",
-        limits.max_compute_workgroup_size_y.into(),
-    )?;
-    check_limit(
-        kernel,
-        "workgroup size z",
-        z.into(),
-        "max_compute_workgroup_size_z",
-        limits.max_compute_workgroup_size_z.into(),
-    )
-}
-
-/// Creates a kernel's bind group layout and compute pipeline inside an error scope.
-pub(crate) fn create_pipeline(
-    device: &wgpu::Device,
-    built: BuiltKernel,
-    entries: &[wgpu::BindGroupLayoutEntry],
-) -> Result<Pipeline, RuntimeError> {
-    let kernel = built.kernel;
-    let scope = ErrorScopes::push(device);
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(kernel.name()),
-        source: wgpu::ShaderSource::Naga(Cow::Owned(built.module)),
-    });
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(kernel.name()),
-        entries,
-    });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(kernel.name()),
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some(kernel.name()),
-        layout: Some(&pipeline_layout),
-        module: &module,
-        entry_point: Some(built.entry_point),
-        compilation_options: wgpu::PipelineCompilationOptions::default(),
-        cache: None,
-    });
-    scope.pop(kernel, "pipeline creation")?;
-    Ok(Pipeline {
-        kernel,
-        layout,
-        pipeline,
-        workgroup_size: built.workgroup_size,
-    })
 }
 
 /// CPU-side inputs of [`run_once`]: the frame's parameters plus the two textures an engine
@@ -1166,100 +737,6 @@ pub fn run_once(
         pass_wall_times,
         wall_time,
     })
-}
-
-/// Decodes one rgba texel of a storage format to f32.
-pub(crate) fn decode_rgba(texel: &[u8], storage: Storage) -> [f32; 4] {
-    match storage {
-        Storage::Rgba8unorm => [0, 1, 2, 3].map(|c| f32::from(texel[c]) / 255.0),
-        Storage::Rgba16float => [0, 1, 2, 3].map(|c| {
-            half::f16::from_bits(u16::from_le_bytes([texel[2 * c], texel[2 * c + 1]])).to_f32()
-        }),
-        Storage::Rgba32float => [0, 1, 2, 3].map(|c| {
-            f32::from_le_bytes([
-                texel[4 * c],
-                texel[4 * c + 1],
-                texel[4 * c + 2],
-                texel[4 * c + 3],
-            ])
-        }),
-    }
-}
-
-/// A texture copied into a mappable buffer (rows padded to 256 bytes).
-pub(crate) struct Readback {
-    buffer: wgpu::Buffer,
-    extent: wgpu::Extent3d,
-    texel_bytes: u32,
-    padded_row: u32,
-}
-
-impl Readback {
-    /// Records the copy of every layer of `texture` (`texel_bytes` per texel).
-    ///
-    /// # Errors
-    ///
-    /// [`RuntimeError::LimitExceeded`] (for `kernel`) when the readback buffer would exceed
-    /// the device's `max_buffer_size`; nothing is created then.
-    pub(crate) fn encode(
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        texture: &wgpu::Texture,
-        texel_bytes: u32,
-        kernel: Kernel,
-    ) -> Result<Self, RuntimeError> {
-        let extent = texture.size();
-        let padded_row =
-            (extent.width * texel_bytes).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let size = u64::from(padded_row)
-            * u64::from(extent.height)
-            * u64::from(extent.depth_or_array_layers);
-        check_limit(
-            kernel,
-            "readback buffer bytes",
-            size,
-            "max_buffer_size",
-            device.limits().max_buffer_size,
-        )?;
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("prefiltered readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        encoder.copy_texture_to_buffer(
-            texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded_row),
-                    rows_per_image: Some(extent.height),
-                },
-            },
-            extent,
-        );
-        Ok(Self {
-            buffer,
-            extent,
-            texel_bytes,
-            padded_row,
-        })
-    }
-
-    /// Maps the buffer and returns the texels' bytes without row padding, layer by layer,
-    /// row by row.
-    pub(crate) fn read(self, ctx: &Context, kernel: Kernel) -> Result<Vec<u8>, RuntimeError> {
-        let bytes = read_buffer(ctx, kernel, &self.buffer)?;
-        let row_bytes = (self.extent.width * self.texel_bytes) as usize;
-        let mut packed = Vec::with_capacity(
-            row_bytes * self.extent.height as usize * self.extent.depth_or_array_layers as usize,
-        );
-        for row in bytes.chunks_exact(self.padded_row as usize) {
-            packed.extend_from_slice(&row[..row_bytes]);
-        }
-        Ok(packed)
-    }
 }
 
 /// The slice table (16 bytes per rectified row, `hr` rows) and the uniform block of the

@@ -16,18 +16,17 @@ use scatter_shaderlib::raymarch::{MarchUniforms, RaymarchVariant, prepare_march}
 use scatter_shaderlib::{Kernel, KernelParams};
 
 use crate::error::{ErrorScopes, check_limit};
-use crate::prefiltered::{
-    DEPTH_NAMES, OUTPUT_FORMAT, Pipeline, Readback, SHADOW_NAMES, buffer_entry, check_dispatch,
-    check_view, create_pipeline, decode_rgba, groups, view_entry,
-};
+use crate::executor::Executor;
+use crate::gpu::{DEPTH_NAMES, Readback, SHADOW_NAMES, check_view, decode_rgba};
 use crate::textures::upload_r32float;
 use crate::timer::median_pass_wall_times;
-use crate::{Context, GpuTimer, RuntimeError};
+use crate::{Context, RuntimeError};
 
 const RAYMARCH: Kernel = Kernel::Raymarch;
 const INTERLEAVE_SUM: Kernel = Kernel::InterleaveSum;
 
-/// Format of the partial sums of an interleaved variant.
+/// Format of the partial sums of an interleaved variant
+/// (`scatter_shaderlib::raymarch::PARTIAL_FORMAT`).
 pub const PARTIAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// One frame's camera, light, medium and standard shadow map.
@@ -66,13 +65,12 @@ pub struct Raymarch {
     variant: RaymarchVariant,
     screen: [u32; 2],
     shadow_map_size: u32,
-    raymarch: Pipeline,
-    interleave_sum: Option<Pipeline>,
+    /// The plan of the variant, built.
+    exec: Executor,
     uniforms: wgpu::Buffer,
-    partial: Option<(wgpu::Texture, wgpu::TextureView)>,
+    partial: Option<wgpu::Texture>,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
-    timer: Option<GpuTimer>,
     prepared: Option<MarchUniforms>,
 }
 
@@ -139,105 +137,33 @@ impl Raymarch {
             .iter()
             .map(scatter_shaderlib::build)
             .collect::<Result<_, _>>()?;
-        for b in &built {
-            check_dispatch(&limits, b, [w, h, 1])?;
-        }
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty,
-            count: None,
-        };
-        let uniform = wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: wgpu::BufferSize::new(size_of::<MarchUniforms>() as u64),
-        };
-        let texture = wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        };
-        let storage = |format| wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format,
-            view_dimension: wgpu::TextureViewDimension::D2,
-        };
-        let interleaved = variant.interleaved();
-        let march_out = if interleaved {
-            PARTIAL_FORMAT
-        } else {
-            OUTPUT_FORMAT
-        };
-        let mut built = built.into_iter();
-        let raymarch = create_pipeline(
-            device,
-            built
-                .next()
-                .ok_or(RuntimeError::NotPrepared { kernel: RAYMARCH })?,
+        let exec = Executor::new(
+            ctx,
+            scatter_shaderlib::raymarch::plan::plan(variant),
+            built,
             &[
-                entry(0, uniform),
-                entry(1, texture),
-                entry(2, texture),
-                entry(3, storage(march_out)),
+                ("screen.width", w.into()),
+                ("screen.height", h.into()),
+                ("shadow.size", shadow_map_size.into()),
             ],
         )?;
-        let interleave_sum = match built.next() {
-            Some(b) => Some(create_pipeline(
-                device,
-                b,
-                &[
-                    entry(0, uniform),
-                    entry(1, texture),
-                    entry(2, storage(OUTPUT_FORMAT)),
-                ],
-            )?),
-            None => None,
+        let uniforms = exec.buffer("march")?.clone();
+        let partial = if variant.interleaved() {
+            Some(exec.texture("partial")?.0.clone())
+        } else {
+            None
         };
-        let scope = ErrorScopes::push(device);
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("raymarch uniforms"),
-            size: size_of::<MarchUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let make = |label, format| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::STORAGE_BINDING
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
-        };
-        let partial = interleaved.then(|| {
-            let t = make("raymarch partial sums", PARTIAL_FORMAT);
-            let v = t.create_view(&wgpu::TextureViewDescriptor::default());
-            (t, v)
-        });
-        let output = make("raymarch output", OUTPUT_FORMAT);
-        let output_view = output.create_view(&wgpu::TextureViewDescriptor::default());
-        scope.pop(RAYMARCH, "creating resources")?;
+        let (output, output_view) = exec.texture("output")?;
+        let (output, output_view) = (output.clone(), output_view.clone());
         Ok(Raymarch {
             variant: *variant,
             screen,
             shadow_map_size,
-            raymarch,
-            interleave_sum,
+            exec,
             uniforms,
             partial,
             output,
             output_view,
-            timer: GpuTimer::with_passes(ctx, 2),
             prepared: None,
         })
     }
@@ -317,7 +243,7 @@ impl Raymarch {
         )?;
         Ok(MarchTimes {
             raymarch,
-            interleave_sum: if self.interleave_sum.is_some() {
+            interleave_sum: if self.partial.is_some() {
                 interleave_sum
             } else {
                 Duration::ZERO
@@ -343,60 +269,13 @@ impl Raymarch {
             shadow_map,
             [self.shadow_map_size; 2],
         )?;
-        let device = ctx.device();
-        let march_target = self.partial.as_ref().map_or(&self.output_view, |(_, v)| v);
-        let scope = ErrorScopes::push(device);
-        let march_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("raymarch"),
-            layout: &self.raymarch.layout,
-            entries: &[
-                buffer_entry(0, &self.uniforms),
-                view_entry(1, depth),
-                view_entry(2, shadow_map),
-                view_entry(3, march_target),
-            ],
-        });
-        scope.pop(RAYMARCH, "creating the bind group")?;
-        let scope = ErrorScopes::push(device);
-        let sum_group = match (&self.interleave_sum, &self.partial) {
-            (Some(p), Some((_, partial))) => {
-                Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("interleave_sum"),
-                    layout: &p.layout,
-                    entries: &[
-                        buffer_entry(0, &self.uniforms),
-                        view_entry(1, partial),
-                        view_entry(2, &self.output_view),
-                    ],
-                }))
-            }
-            _ => None,
-        };
-        scope.pop(INTERLEAVE_SUM, "creating the bind group")?;
-        let [w, h] = self.screen;
-        let passes = std::iter::once((&self.raymarch, &march_group))
-            .chain(self.interleave_sum.as_ref().zip(sum_group.as_ref()));
-        for (index, (pipeline, group)) in (0u32..).zip(passes) {
-            if only.is_some_and(|k| k != pipeline.kernel) {
-                continue;
-            }
-            let timestamps = if only.is_none() {
-                self.timer.as_ref().and_then(|t| t.pass_writes(index))
-            } else {
-                None
-            };
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(pipeline.kernel.name()),
-                timestamp_writes: timestamps,
-            });
-            pass.set_pipeline(&pipeline.pipeline);
-            pass.set_bind_group(0, group, &[]);
-            let [x, y, z] = groups([w, h, 1], pipeline.workgroup_size);
-            pass.dispatch_workgroups(x, y, z);
-        }
-        if let Some(timer) = self.timer.as_ref().filter(|_| only.is_none()) {
-            timer.resolve(encoder);
-        }
+        self.exec.encode(
+            ctx.device(),
+            encoder,
+            &[("depth", depth), ("shadow_map", shadow_map)],
+            &[],
+            only,
+        )?;
         Ok(&self.output_view)
     }
 
@@ -407,13 +286,13 @@ impl Raymarch {
     ///
     /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
     pub fn pass_times(&self, ctx: &Context) -> Result<Option<MarchTimes>, RuntimeError> {
-        let Some(timer) = &self.timer else {
+        let Some(timer) = self.exec.timer() else {
             return Ok(None);
         };
         let times = timer.read_all(ctx, RAYMARCH)?;
         Ok(Some(MarchTimes {
             raymarch: times.first().copied().unwrap_or_default(),
-            interleave_sum: if self.interleave_sum.is_some() {
+            interleave_sum: if self.partial.is_some() {
                 times.get(1).copied().unwrap_or_default()
             } else {
                 Duration::ZERO
@@ -433,7 +312,7 @@ impl Raymarch {
 
     /// The partial sums of an interleaved variant (rgba32float).
     pub fn partial_texture(&self) -> Option<&wgpu::Texture> {
-        self.partial.as_ref().map(|(t, _)| t)
+        self.partial.as_ref()
     }
 }
 

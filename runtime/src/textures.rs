@@ -4,7 +4,7 @@
 use scatter_shaderlib::Kernel;
 
 use crate::error::{ErrorScopes, check_limit};
-use crate::prefiltered::{DEPTH_FORMAT, Readback, decode_rgba};
+use crate::gpu::{DEPTH_FORMAT, Readback, decode_rgba};
 use crate::{Context, RuntimeError};
 
 /// Creates an r32float texture (`TEXTURE_BINDING | COPY_DST | COPY_SRC`) holding `data`

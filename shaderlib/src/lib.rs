@@ -29,8 +29,10 @@ mod compose;
 mod error;
 mod kernel;
 pub mod minmax;
+pub mod plan;
 pub mod prefiltered;
 pub mod raymarch;
+pub mod reflect;
 pub mod row_prefix;
 
 pub use error::ShaderError;

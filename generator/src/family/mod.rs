@@ -16,6 +16,11 @@ use scatter_shaderlib::prefiltered::variant::printable;
 use scatter_shaderlib::{Kernel, KernelParams};
 use serde::Serialize;
 
+pub use scatter_shaderlib::plan::{
+    Alternative, BindingSource, BufferDesc, Formula, Parameter, PassPlan, Plan, Resource,
+    SamplerDesc, TextureDesc,
+};
+
 use crate::GenError;
 
 /// A kernel family the generator can emit.
@@ -228,136 +233,4 @@ impl FamilyVariant {
             Self::Raymarch(v) => raymarch::plan(v),
         }
     }
-}
-
-/// A size expression over the [`Plan::parameters`]: an integer, a parameter name
-/// (`screen.width`), or a product `16 * rectified.height`.
-pub type Formula = String;
-
-/// A symbol that formulas use, with its meaning and constraints.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct Parameter {
-    /// The symbol, e.g. `rectified.width`.
-    pub name: &'static str,
-    /// What it is and who chooses it.
-    pub description: &'static str,
-    /// Allowed values, in words.
-    pub constraint: String,
-}
-
-/// A texture's allocation.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct TextureDesc {
-    /// WebGPU format name (`r32float`, `rgba8unorm`, ...).
-    pub format: String,
-    /// Texture dimension (`2d`).
-    pub dimension: &'static str,
-    /// Width in texels.
-    pub width: Formula,
-    /// Height in texels.
-    pub height: Formula,
-    /// Array layers.
-    pub layers: Formula,
-    /// Mip levels.
-    pub mip_levels: u32,
-    /// Usages the passes need (`texture_binding`, `storage_binding`).
-    pub usage: Vec<&'static str>,
-}
-
-/// A buffer's allocation; its size is filled in from the IR layout.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct BufferDesc {
-    /// For a runtime-sized array: how many elements (the byte size is this times the
-    /// element stride).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub elements: Option<Formula>,
-    /// Usages the passes need (`uniform`, `storage`, `copy_dst`).
-    pub usage: Vec<&'static str>,
-}
-
-/// A sampler's state.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct SamplerDesc {
-    /// `linear` or `nearest`.
-    pub mag_filter: &'static str,
-    /// `linear` or `nearest`.
-    pub min_filter: &'static str,
-    /// `linear` or `nearest`.
-    pub mipmap_filter: &'static str,
-    /// `clamp_to_edge`, `repeat`, ...
-    pub address_mode_u: &'static str,
-    /// As `address_mode_u`.
-    pub address_mode_v: &'static str,
-    /// As `address_mode_u`.
-    pub address_mode_w: &'static str,
-}
-
-/// Something a pass binds.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct Resource {
-    /// Its name, used by the passes' bindings.
-    pub name: &'static str,
-    /// `texture`, `uniform_buffer`, `storage_buffer` or `sampler`.
-    pub kind: &'static str,
-    /// `engine` (the engine renders it: depth buffer, shadow map) or `scatter` (the engine
-    /// allocates it once for the passes).
-    pub provided_by: &'static str,
-    /// What it holds.
-    pub contents: &'static str,
-    /// Allocation of a texture.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub texture: Option<TextureDesc>,
-    /// Allocation of a buffer.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub buffer: Option<BufferDesc>,
-    /// State of a sampler.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub sampler: Option<SamplerDesc>,
-}
-
-/// Which resource a binding gets.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct BindingSource {
-    /// The binding number (group 0).
-    pub binding: u32,
-    /// The resource bound by default.
-    pub resource: &'static str,
-    /// Another resource bound instead when a per-frame condition holds.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub alternative: Option<Alternative>,
-}
-
-/// A resource bound instead of the default one under a per-frame condition.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct Alternative {
-    /// The resource.
-    pub resource: &'static str,
-    /// When (an expression over the uniform block).
-    pub when: &'static str,
-}
-
-/// One pass: its kernel, its invocation grid and what each binding gets.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct PassPlan {
-    /// The kernel.
-    pub kernel: Kernel,
-    /// Invocations along x, y, z (the dispatch is `ceil(invocations / workgroup size)`).
-    pub invocations: [Formula; 3],
-    /// A per-frame condition under which the pass does not run.
-    pub skip_when: Option<&'static str>,
-    /// What each binding of group 0 gets.
-    pub bindings: Vec<BindingSource>,
-}
-
-/// Everything about a variant that the IR does not say.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Plan {
-    /// Symbols the formulas use.
-    pub parameters: Vec<Parameter>,
-    /// Textures, buffers and samplers.
-    pub resources: Vec<Resource>,
-    /// Passes, one per kernel.
-    pub passes: Vec<PassPlan>,
-    /// What the engine must know besides the bindings (barriers, per-frame data).
-    pub notes: Vec<&'static str>,
 }

@@ -1,15 +1,11 @@
 //! The `raymarch` family (Tóth & Umenhoffer 2009) in the registry: its knobs (parsed into a
-//! shaderlib [`RaymarchVariant`]) and its plan, exactly as `runtime/src/raymarch.rs`
-//! allocates and dispatches it.
+//! shaderlib [`RaymarchVariant`]) and its plan (`scatter_shaderlib::raymarch::plan`, which the runtime
+//! builds and dispatches from).
 
 use scatter_shaderlib::prefiltered::{LightKind, VariantError};
 use scatter_shaderlib::raymarch::RaymarchVariant;
-use scatter_shaderlib::{Kernel, KernelParams};
 
-use super::prefiltered::{DEPTH_FORMAT, OUTPUT_FORMAT};
-use super::{
-    BindingSource, BufferDesc, KnobInfo, Parameter, PassPlan, Plan, Resource, TextureDesc,
-};
+use super::KnobInfo;
 use crate::GenError;
 
 /// Allowed `samples`.
@@ -18,8 +14,6 @@ const SAMPLES_ALLOWED: &str = "in 4..=1024, a multiple of interleave^2";
 const INTERLEAVE_ALLOWED: &str = "in 1..=8";
 /// Allowed `jitter`.
 const JITTER_ALLOWED: &str = "true | false";
-/// Format of the partial sums (`scatter_runtime::raymarch::PARTIAL_FORMAT`).
-const PARTIAL_FORMAT: &str = "rgba32float";
 
 /// The knobs of [`RaymarchVariant`], defaults from [`RaymarchVariant::default`].
 pub fn knobs() -> Vec<KnobInfo> {
@@ -103,149 +97,4 @@ pub fn parse(knobs: &[(String, String)]) -> Result<RaymarchVariant, GenError> {
     Ok(v)
 }
 
-fn texture(format: &str, usage: &[&'static str]) -> TextureDesc {
-    TextureDesc {
-        format: format.to_owned(),
-        dimension: "2d",
-        width: "screen.width".into(),
-        height: "screen.height".into(),
-        layers: "1".into(),
-        mip_levels: 1,
-        usage: usage.to_vec(),
-    }
-}
-
-fn bind(binding: u32, resource: &'static str) -> BindingSource {
-    BindingSource {
-        binding,
-        resource,
-        alternative: None,
-    }
-}
-
-/// The resources and passes of a variant, as `runtime/src/raymarch.rs` creates them.
-pub fn plan(v: &RaymarchVariant) -> Plan {
-    let parameters = vec![
-        Parameter {
-            name: "screen.width",
-            description: "screen width in pixels (depth buffer and output)",
-            constraint: "1..=max_texture_dimension_2d".into(),
-        },
-        Parameter {
-            name: "screen.height",
-            description: "screen height in pixels (depth buffer and output)",
-            constraint: "1..=max_texture_dimension_2d".into(),
-        },
-        Parameter {
-            name: "shadow.size",
-            description: "side of the engine's square standard shadow map in texels",
-            constraint: "1..=max_texture_dimension_2d".into(),
-        },
-    ];
-    let mut resources = vec![
-        Resource {
-            name: "march",
-            kind: "uniform_buffer",
-            provided_by: "scatter",
-            contents: "the uniform block of the frame (Rust: \
-                       scatter_frame::raymarch::MarchUniforms from prepare_march), written \
-                       once per frame",
-            texture: None,
-            buffer: Some(BufferDesc {
-                elements: None,
-                usage: vec!["uniform", "copy_dst"],
-            }),
-            sampler: None,
-        },
-        Resource {
-            name: "depth",
-            kind: "texture",
-            provided_by: "engine",
-            contents: "linear view depth per pixel (far plane distance for sky)",
-            texture: Some(texture(DEPTH_FORMAT, &["texture_binding"])),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "shadow_map",
-            kind: "texture",
-            provided_by: "engine",
-            contents: "standard shadow map: normalised linear light depth, 1 where nothing was \
-                       hit, texel (0, 0) top-left",
-            texture: Some(TextureDesc {
-                width: "shadow.size".into(),
-                height: "shadow.size".into(),
-                ..texture(DEPTH_FORMAT, &["texture_binding"])
-            }),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "output",
-            kind: "texture",
-            provided_by: "scatter",
-            contents: "in-scattered radiance, rgb, alpha 1; add it to the attenuated scene",
-            texture: Some(texture(
-                OUTPUT_FORMAT,
-                &["storage_binding", "texture_binding"],
-            )),
-            buffer: None,
-            sampler: None,
-        },
-    ];
-    if v.interleaved() {
-        resources.push(Resource {
-            name: "partial",
-            kind: "texture",
-            provided_by: "scatter",
-            contents: "each pixel's partial sum over its interleaving class (written by \
-                       raymarch, read by interleave_sum)",
-            texture: Some(texture(
-                PARTIAL_FORMAT,
-                &["storage_binding", "texture_binding"],
-            )),
-            buffer: None,
-            sampler: None,
-        });
-    }
-    let passes = KernelParams::raymarch(*v)
-        .iter()
-        .filter_map(|p| pass(v, p.kernel()))
-        .collect();
-    Plan {
-        parameters,
-        resources,
-        passes,
-        notes: vec![
-            "Run the passes in order with a compute-to-compute memory barrier between them.",
-            "Write `march` once per frame before the first pass; the host code that computes \
-             it is scatter_frame::raymarch::prepare_march (Rust).",
-            "Group 0 holds every binding; bind by group and binding number, not by name.",
-        ],
-    }
-}
-
-/// The pass of one kernel, or `None` for a kernel that is not in this family.
-pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
-    let screen = || ["screen.width".into(), "screen.height".into(), "1".into()];
-    match kernel {
-        Kernel::Raymarch => Some(PassPlan {
-            kernel,
-            invocations: screen(),
-            skip_when: None,
-            bindings: vec![
-                bind(0, "march"),
-                bind(1, "depth"),
-                bind(2, "shadow_map"),
-                bind(3, if v.interleaved() { "partial" } else { "output" }),
-            ],
-        }),
-        Kernel::InterleaveSum => Some(PassPlan {
-            kernel,
-            invocations: screen(),
-            skip_when: None,
-            bindings: vec![bind(0, "march"), bind(1, "partial"), bind(2, "output")],
-        }),
-        _ => None,
-    }
-}
+pub use scatter_shaderlib::raymarch::plan::{pass, plan};

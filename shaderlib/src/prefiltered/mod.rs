@@ -4,6 +4,7 @@
 //! CPU mirrors: `reference/src/kernels/{common_model,common_prefiltered,rectify,prefilter,scatter}.rs`.
 
 pub mod kernels;
+pub mod plan;
 
 pub use scatter_frame::{frame, variant};
 

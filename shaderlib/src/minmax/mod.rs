@@ -5,6 +5,8 @@
 //! mirrors: `reference/src/kernels/{minmax_build,minmax_march}.rs`. Host-side knobs, tree
 //! layout and frame set-up: [`scatter_frame::minmax`] (re-exported here).
 
+pub mod plan;
+
 use askama::Template;
 
 pub use scatter_frame::minmax::{

@@ -3,6 +3,8 @@
 //! [`RaymarchVariant`]. CPU mirrors: `reference/src/kernels/{raymarch,interleave_sum}.rs`.
 //! Host-side knobs and uniforms: [`scatter_frame::raymarch`] (re-exported here).
 
+pub mod plan;
+
 use askama::Template;
 
 pub use scatter_frame::raymarch::{MarchUniforms, RaymarchVariant, prepare_march};

@@ -1,0 +1,231 @@
+//! The plan of a `minmax` variant: its textures and buffers and its passes (`rectify`,
+//! `minmax_build`, `minmax_march`). `scatter-gen` writes it into the manifest;
+//! `scatter-runtime` builds and dispatches from it.
+
+use crate::minmax::{MinmaxVariant, TREE_FORMAT};
+use crate::plan::{
+    BindingSource, BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
+    TextureDesc,
+};
+use crate::{Kernel, KernelParams};
+
+fn texture(format: &str, width: &str, height: &str, usage: &[&'static str]) -> TextureDesc {
+    TextureDesc {
+        format: format.to_owned(),
+        dimension: "2d",
+        width: width.into(),
+        height: height.into(),
+        layers: "1".into(),
+        mip_levels: 1,
+        usage: usage.to_vec(),
+    }
+}
+
+fn bind(binding: u32, resource: &'static str) -> BindingSource {
+    BindingSource {
+        binding,
+        resource,
+        alternative: None,
+    }
+}
+
+const SAMPLED: &[&str] = &["texture_binding"];
+const STORAGE_AND_SAMPLED: &[&str] = &["storage_binding", "texture_binding"];
+
+/// The resources and passes of a variant, as `runtime/src/minmax.rs` creates them.
+pub fn plan(v: &MinmaxVariant) -> Plan {
+    let dim = "1..=max_texture_dimension_2d";
+    let parameters = vec![
+        Parameter {
+            name: "screen.width",
+            description: "screen width in pixels (depth buffer and output)",
+            constraint: dim.into(),
+        },
+        Parameter {
+            name: "screen.height",
+            description: "screen height in pixels (depth buffer and output)",
+            constraint: dim.into(),
+        },
+        Parameter {
+            name: "shadow.size",
+            description: "side of the engine's square standard shadow map in texels",
+            constraint: dim.into(),
+        },
+        Parameter {
+            name: "rectified.width",
+            description: "light rays per epipolar slice (columns of the rectified map), an \
+                          engine choice",
+            constraint: "1..=max_texture_dimension_2d, with tree.width within it too".into(),
+        },
+        Parameter {
+            name: "rectified.height",
+            description: "epipolar slices (rows of the rectified map), an engine choice",
+            constraint: dim.into(),
+        },
+        Parameter {
+            name: "tree.width",
+            description: "columns of the min-max tree texture, derived: the sum over levels \
+                          k = 0, 1, ... of ceil(rectified.width / 2^k) down to the single \
+                          root (Rust: scatter_frame::minmax::tree_width; at most \
+                          2 rectified.width + log2(rectified.width) + 1)",
+            constraint: dim.into(),
+        },
+    ];
+    let resources = vec![
+        Resource {
+            name: "frame",
+            kind: "uniform_buffer",
+            provided_by: "scatter",
+            contents: "the uniform block of the frame (Rust: \
+                       scatter_frame::frame::FrameUniforms from \
+                       scatter_frame::minmax::prepare_minmax), written once per frame",
+            texture: None,
+            buffer: Some(BufferDesc {
+                elements: None,
+                usage: vec!["uniform", "copy_dst"],
+            }),
+            sampler: None,
+        },
+        Resource {
+            name: "slices",
+            kind: "storage_buffer",
+            provided_by: "scatter",
+            contents: "one vec4 per rectified row: delta, theta_ref, theta_lo, theta_hi (Rust: \
+                       SliceParams from prepare_minmax), written once per frame",
+            texture: None,
+            buffer: Some(BufferDesc {
+                elements: Some("rectified.height".into()),
+                usage: vec!["storage", "copy_dst"],
+            }),
+            sampler: None,
+        },
+        Resource {
+            name: "depth",
+            kind: "texture",
+            provided_by: "engine",
+            contents: "linear view depth per pixel (far plane distance for sky)",
+            texture: Some(texture(
+                DEPTH_FORMAT,
+                "screen.width",
+                "screen.height",
+                SAMPLED,
+            )),
+            buffer: None,
+            sampler: None,
+        },
+        Resource {
+            name: "shadow_map",
+            kind: "texture",
+            provided_by: "engine",
+            contents: "standard shadow map: normalised linear light depth, 1 where nothing was \
+                       hit, texel (0, 0) top-left",
+            texture: Some(texture(DEPTH_FORMAT, "shadow.size", "shadow.size", SAMPLED)),
+            buffer: None,
+            sampler: None,
+        },
+        Resource {
+            name: "rectified",
+            kind: "texture",
+            provided_by: "scatter",
+            contents: "rectified shadow map: normalised view angle of the first occluder per \
+                       light ray (written by rectify)",
+            texture: Some(texture(
+                DEPTH_FORMAT,
+                "rectified.width",
+                "rectified.height",
+                STORAGE_AND_SAMPLED,
+            )),
+            buffer: None,
+            sampler: None,
+        },
+        Resource {
+            name: "tree",
+            kind: "texture",
+            provided_by: "scatter",
+            contents: "the 1D min-max tree of every rectified row, levels packed left to \
+                       right (level k: ceil(rectified.width / 2^k) nodes of (min, max)); \
+                       written by minmax_build",
+            texture: Some(texture(
+                TREE_FORMAT,
+                "tree.width",
+                "rectified.height",
+                STORAGE_AND_SAMPLED,
+            )),
+            buffer: None,
+            sampler: None,
+        },
+        Resource {
+            name: "output",
+            kind: "texture",
+            provided_by: "scatter",
+            contents: "in-scattered radiance, rgb, alpha 1 (written by minmax_march); add it \
+                       to the attenuated scene",
+            texture: Some(texture(
+                OUTPUT_FORMAT,
+                "screen.width",
+                "screen.height",
+                STORAGE_AND_SAMPLED,
+            )),
+            buffer: None,
+            sampler: None,
+        },
+    ];
+    let passes = KernelParams::minmax(*v)
+        .iter()
+        .filter_map(|p| pass(p.kernel()))
+        .collect();
+    Plan {
+        parameters,
+        resources,
+        passes,
+        notes: vec![
+            "Run the passes in order; each reads what the previous ones wrote: put a \
+             compute-to-compute memory barrier (and, in Vulkan, the image layout transition \
+             from storage to sampled) between them.",
+            "Write `frame` and `slices` once per frame before the first pass; the host code \
+             that computes them is scatter_frame::minmax::prepare_minmax (Rust): the \
+             prefiltered family's prepare_frame with an epipolar one-region variant of the \
+             same light. `rectify` is the prefiltered family's kernel.",
+            "Group 0 holds every binding; bind by group and binding number, not by name: \
+             emitted names may be mangled (naga_oil) or carry a trailing `_` (naga).",
+        ],
+    }
+}
+
+/// The pass of one kernel, or `None` for a kernel that is not in this family.
+pub fn pass(kernel: Kernel) -> Option<PassPlan> {
+    let f = |s: &str| s.to_owned();
+    match kernel {
+        Kernel::Rectify => Some(PassPlan {
+            kernel,
+            invocations: [f("rectified.width"), f("rectified.height"), f("1")],
+            skip_when: None,
+            bindings: vec![
+                bind(0, "frame"),
+                bind(1, "slices"),
+                bind(2, "shadow_map"),
+                bind(3, "rectified"),
+            ],
+        }),
+        Kernel::MinmaxBuild => Some(PassPlan {
+            kernel,
+            invocations: [f("tree.width"), f("rectified.height"), f("1")],
+            skip_when: None,
+            bindings: vec![bind(0, "frame"), bind(1, "rectified"), bind(2, "tree")],
+        }),
+        Kernel::MinmaxMarch => Some(PassPlan {
+            kernel,
+            invocations: [f("screen.width"), f("screen.height"), f("1")],
+            skip_when: None,
+            bindings: vec![
+                bind(0, "frame"),
+                bind(1, "slices"),
+                bind(2, "depth"),
+                bind(3, "shadow_map"),
+                bind(4, "tree"),
+                bind(5, "output"),
+            ],
+        }),
+        _ => None,
+    }
+}

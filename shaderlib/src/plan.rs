@@ -1,0 +1,216 @@
+//! The plan of a kernel family's variant: everything an engine needs to run it that the
+//! compiled shaders do not say (the textures, buffers and samplers to allocate, what each
+//! binding of each pass gets, the dispatch sizes as formulas of the resolutions, the
+//! per-frame conditions). One description: `scatter-gen` writes it into `manifest.json` and
+//! `scatter-runtime`'s plan executor builds its resources, bind groups and dispatches from it.
+
+use serde::Serialize;
+
+use crate::Kernel;
+
+/// Format of the depth buffer, the standard shadow map and the rectified map.
+pub const DEPTH_FORMAT: &str = "r32float";
+/// Format of every family's output (in-scattered radiance, rgb; alpha 1).
+pub const OUTPUT_FORMAT: &str = "rgba16float";
+
+/// A size expression over the [`Plan::parameters`]: an integer, a parameter name
+/// (`screen.width`), or a product `16 * rectified.height`.
+pub type Formula = String;
+
+/// A symbol that formulas use, with its meaning and constraints.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Parameter {
+    /// The symbol, e.g. `rectified.width`.
+    pub name: &'static str,
+    /// What it is and who chooses it.
+    pub description: &'static str,
+    /// Allowed values, in words.
+    pub constraint: String,
+}
+
+/// A texture's allocation.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct TextureDesc {
+    /// WebGPU format name (`r32float`, `rgba8unorm`, ...).
+    pub format: String,
+    /// Texture dimension (`2d`).
+    pub dimension: &'static str,
+    /// Width in texels.
+    pub width: Formula,
+    /// Height in texels.
+    pub height: Formula,
+    /// Array layers.
+    pub layers: Formula,
+    /// Mip levels.
+    pub mip_levels: u32,
+    /// Usages the passes need (`texture_binding`, `storage_binding`).
+    pub usage: Vec<&'static str>,
+}
+
+/// A buffer's allocation; its size is filled in from the IR layout.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct BufferDesc {
+    /// For a runtime-sized array: how many elements (the byte size is this times the
+    /// element stride).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub elements: Option<Formula>,
+    /// Usages the passes need (`uniform`, `storage`, `copy_dst`).
+    pub usage: Vec<&'static str>,
+}
+
+/// A sampler's state.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct SamplerDesc {
+    /// `linear` or `nearest`.
+    pub mag_filter: &'static str,
+    /// `linear` or `nearest`.
+    pub min_filter: &'static str,
+    /// `linear` or `nearest`.
+    pub mipmap_filter: &'static str,
+    /// `clamp_to_edge`, `repeat`, ...
+    pub address_mode_u: &'static str,
+    /// As `address_mode_u`.
+    pub address_mode_v: &'static str,
+    /// As `address_mode_u`.
+    pub address_mode_w: &'static str,
+}
+
+/// Something a pass binds.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Resource {
+    /// Its name, used by the passes' bindings.
+    pub name: &'static str,
+    /// `texture`, `uniform_buffer`, `storage_buffer` or `sampler`.
+    pub kind: &'static str,
+    /// `engine` (the engine renders it: depth buffer, shadow map) or `scatter` (the engine
+    /// allocates it once for the passes).
+    pub provided_by: &'static str,
+    /// What it holds.
+    pub contents: &'static str,
+    /// Allocation of a texture.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub texture: Option<TextureDesc>,
+    /// Allocation of a buffer.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub buffer: Option<BufferDesc>,
+    /// State of a sampler.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sampler: Option<SamplerDesc>,
+}
+
+/// Which resource a binding gets.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct BindingSource {
+    /// The binding number (group 0).
+    pub binding: u32,
+    /// The resource bound by default.
+    pub resource: &'static str,
+    /// Another resource bound instead when a per-frame condition holds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alternative: Option<Alternative>,
+}
+
+/// A resource bound instead of the default one under a per-frame condition.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Alternative {
+    /// The resource.
+    pub resource: &'static str,
+    /// When (an expression over the uniform block).
+    pub when: &'static str,
+}
+
+/// One pass: its kernel, its invocation grid and what each binding gets.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PassPlan {
+    /// The kernel.
+    pub kernel: Kernel,
+    /// Invocations along x, y, z (the dispatch is `ceil(invocations / workgroup size)`).
+    pub invocations: [Formula; 3],
+    /// A per-frame condition under which the pass does not run.
+    pub skip_when: Option<&'static str>,
+    /// What each binding of group 0 gets.
+    pub bindings: Vec<BindingSource>,
+}
+
+/// Everything about a variant that the IR does not say.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Plan {
+    /// Symbols the formulas use.
+    pub parameters: Vec<Parameter>,
+    /// Textures, buffers and samplers.
+    pub resources: Vec<Resource>,
+    /// Passes, one per kernel.
+    pub passes: Vec<PassPlan>,
+    /// What the engine must know besides the bindings (barriers, per-frame data).
+    pub notes: Vec<&'static str>,
+}
+
+impl Plan {
+    /// The resource named `name`.
+    pub fn resource(&self, name: &str) -> Option<&Resource> {
+        self.resources.iter().find(|r| r.name == name)
+    }
+
+    /// The pass of `kernel`.
+    pub fn pass(&self, kernel: Kernel) -> Option<&PassPlan> {
+        self.passes.iter().find(|p| p.kernel == kernel)
+    }
+}
+
+impl BindingSource {
+    /// The resource bound this frame: the alternative when its condition is among the
+    /// conditions that hold, else the default.
+    pub fn resource_for(&self, conditions: &[&str]) -> &'static str {
+        match &self.alternative {
+            Some(a) if conditions.contains(&a.when) => a.resource,
+            _ => self.resource,
+        }
+    }
+}
+
+/// Evaluates a plan formula (an integer, a parameter name, or a product of those, e.g.
+/// `16 * rectified.height`) with the parameters' values.
+///
+/// # Errors
+///
+/// A message naming the formula and the unknown symbol, the malformed term or the overflow.
+pub fn eval(formula: &str, params: &[(&str, u64)]) -> Result<u64, String> {
+    let mut value: u64 = 1;
+    for term in formula.split('*') {
+        let term = term.trim();
+        let factor = if let Ok(n) = term.parse::<u64>() {
+            n
+        } else if let Some(&(_, v)) = params.iter().find(|(name, _)| *name == term) {
+            v
+        } else if term.is_empty() {
+            return Err(format!("formula `{formula}` has an empty term"));
+        } else {
+            let names: Vec<_> = params.iter().map(|(n, _)| *n).collect();
+            return Err(format!(
+                "formula `{formula}` names `{term}`, which is not a parameter (known: {})",
+                names.join(", ")
+            ));
+        };
+        value = value
+            .checked_mul(factor)
+            .ok_or_else(|| format!("formula `{formula}` overflows 64 bits"))?;
+    }
+    Ok(value)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::eval;
+
+    #[test]
+    fn formulas_evaluate() {
+        let p = [("screen.width", 1280), ("rectified.height", 512)];
+        assert_eq!(eval("1", &p), Ok(1));
+        assert_eq!(eval("screen.width", &p), Ok(1280));
+        assert_eq!(eval("16 * rectified.height", &p), Ok(8192));
+        assert_eq!(eval("2 * screen.width * 3", &p), Ok(7680));
+        assert!(eval("tree.width", &p).unwrap_err().contains("tree.width"));
+        assert!(eval("2 * ", &p).unwrap_err().contains("empty term"));
+        assert!(eval("4294967296 * 4294967296", &p).is_err());
+    }
+}
