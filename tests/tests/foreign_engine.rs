@@ -12,6 +12,11 @@
 //!   (`skip_when`) and `prefilter` binds the engine's rasterised map (`alternative`), the
 //!   reference's stand-in for the rasteriser (`engine_rectified_map`), on both sides.
 //!
+//! - every other family (`foreign_engine_matches_runtime_for_every_family`): raymarch
+//!   default (directional) and interleaved + jittered spot (the engine allocates `partial`
+//!   from the manifest), both minmax variants, against `run_raymarch_once` /
+//!   `run_minmax_once`; and `run_dir` on a raymarch and a minmax directory.
+//!
 //! Each runs the SPIR-V files (naga's SPIR-V front-end inside wgpu) and the WGSL files.
 //! The projective trial also goes through the binary's file path (`frame.json` and PFM
 //! files, `files::run_dir`). A negative control (a depth buffer 10 % short) shows the
@@ -28,13 +33,17 @@ use scatter_foreign_engine::files::{FrameFile, RunArgs, run_dir, write_inputs};
 use scatter_foreign_engine::prefiltered::{Inputs, Sizes, run_frame};
 use scatter_foreign_engine::{Engine, EngineError, Manifest, Target};
 use scatter_frame::frame::{PrefilteredFrame, prepare_frame};
+use scatter_frame::minmax::{MinmaxVariant, prepare_minmax};
+use scatter_frame::raymarch::{RaymarchVariant, prepare_march};
 use scatter_gen::{FamilyVariant, Request, generate, output};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::kernels::engine_rectified_map;
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
-use scatter_runtime::{Context, CpuInputs, FrameInput, run_once};
+use scatter_runtime::{
+    Context, CpuInputs, FrameInput, MarchInput, run_minmax_once, run_once, run_raymarch_once,
+};
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, Rectification, Resolutions, Storage, Variant,
 };
@@ -308,6 +317,266 @@ fn foreign_engine_matches_runtime() {
     );
 }
 
+/// A directory scatter-gen wrote for the other families' trial variants, SPIR-V and WGSL.
+fn other_families_dir() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = scratch("other-families");
+        let variants = raymarch_variants()
+            .map(FamilyVariant::Raymarch)
+            .into_iter()
+            .chain(MinmaxVariant::grid().into_iter().map(FamilyVariant::Minmax))
+            .collect();
+        let generated = generate(&Request {
+            variants,
+            targets: vec![scatter_gen::Target::Spirv, scatter_gen::Target::Wgsl],
+        })
+        .unwrap_or_else(|e| panic!("scatter-gen: {e}"));
+        output::write(&dir, &generated, false).unwrap_or_else(|e| panic!("scatter-gen: {e}"));
+        dir
+    })
+}
+
+/// The raymarch trial variants: plain directional, interleaved and jittered spot.
+fn raymarch_variants() -> [RaymarchVariant; 2] {
+    [
+        RaymarchVariant::default(),
+        RaymarchVariant {
+            samples: 32,
+            interleave: 2,
+            jitter: true,
+            light: LightKind::Spot,
+        },
+    ]
+}
+
+/// Checks one foreign-engine output against the runtime's, on both targets; `run` loads
+/// and runs one target. Returns the report lines, fails with every trial over the bound.
+fn compare_targets(
+    name: &str,
+    runtime: &[[f32; 4]],
+    expect_dispatched: &[&str],
+    mut run: impl FnMut(Target) -> Result<scatter_foreign_engine::prefiltered::Output, EngineError>,
+) -> Vec<String> {
+    let mut lines = Vec::new();
+    let mut failures = Vec::new();
+    for target in [Target::Spirv, Target::Wgsl] {
+        let out = run(target).unwrap_or_else(|e| panic!("{name}::{target}: {e}"));
+        let dispatched: Vec<&str> = out.run.dispatched.iter().map(|(k, _)| k.as_str()).collect();
+        assert_eq!(dispatched, expect_dispatched, "{name}::{target}");
+        assert!(out.run.skipped.is_empty(), "{name}::{target}");
+        let (diff, max, _) = compare(&out.radiance, runtime);
+        assert!(max > 0.0, "{name}: the runtime's output is black");
+        let rel = diff / max;
+        let line = format!(
+            "{name}::{target}: max |diff| {diff:.3e} = {rel:.3e} of max radiance {max:.4e}"
+        );
+        eprintln!("{} {line}", if rel <= REL_TOL { "ok  " } else { "FAIL" });
+        if rel > REL_TOL {
+            failures.push(line.clone());
+        }
+        lines.push(line);
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    lines
+}
+
+/// Every other family runs from its manifest alone too: raymarch (plain and interleaved,
+/// the second with the `partial` texture the engine allocates from the manifest) and both
+/// minmax variants, against the runtime, SPIR-V and WGSL.
+#[test]
+fn foreign_engine_matches_runtime_for_every_family() {
+    let Some(ctx) = gpu() else { return };
+    let dir = other_families_dir();
+    let mut lines = Vec::new();
+    for v in raymarch_variants() {
+        let fixture = Fixture::get(v.light);
+        let name = format!(
+            "foreign::raymarch::{}::{}::{}",
+            v.id(),
+            fixture.name,
+            fixture.pose
+        );
+        let f = fixture.frame_input();
+        let input = MarchInput {
+            camera: f.camera,
+            light: f.light,
+            medium: f.medium,
+            shadow_map: f.shadow_map,
+        };
+        let runtime = run_raymarch_once(
+            ctx,
+            &v,
+            fixture.sizes().screen,
+            &input,
+            &fixture.gbuf.view_depth,
+            &fixture.shadow_map.depth,
+        )
+        .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
+        let uniforms = prepare_march(
+            &v,
+            fixture.sizes().screen,
+            &f.camera,
+            &f.light,
+            &f.medium,
+            &f.shadow_map,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(
+            runtime.uniforms, uniforms,
+            "{name}: the runtime set up another frame"
+        );
+        let expect: &[&str] = if v.interleaved() {
+            &["raymarch", "interleave_sum"]
+        } else {
+            &["raymarch"]
+        };
+        lines.extend(compare_targets(&name, &runtime.output, expect, |target| {
+            let sizes = scatter_foreign_engine::raymarch::Sizes {
+                screen: fixture.sizes().screen,
+                shadow_map: SHADOW_MAP,
+            };
+            let mut engine = Engine::load(
+                ctx.device(),
+                ctx.queue(),
+                dir,
+                &v.id(),
+                target,
+                &sizes.params(),
+            )?;
+            scatter_foreign_engine::raymarch::run_frame(
+                &mut engine,
+                &uniforms,
+                &fixture.gbuf.view_depth,
+                &fixture.shadow_map.depth,
+            )
+        }));
+    }
+    for v in MinmaxVariant::grid() {
+        let fixture = Fixture::get(v.light);
+        let name = format!(
+            "foreign::minmax::{}::{}::{}",
+            v.id(),
+            fixture.name,
+            fixture.pose
+        );
+        let f = fixture.frame_input();
+        let res = Resolutions {
+            screen: fixture.sizes().screen,
+            rectified: RECTIFIED,
+        };
+        let runtime = run_minmax_once(
+            ctx,
+            &v,
+            res,
+            &f,
+            &fixture.gbuf.view_depth,
+            &fixture.shadow_map.depth,
+        )
+        .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
+        let frame = prepare_minmax(
+            &v,
+            &res,
+            &f.camera,
+            &f.light,
+            &f.medium,
+            &f.shadow_map,
+            &f.settings,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(
+            runtime.frame, frame,
+            "{name}: the runtime set up another frame"
+        );
+        lines.extend(compare_targets(
+            &name,
+            &runtime.output,
+            &["rectify", "minmax_build", "minmax_march"],
+            |target| {
+                let sizes = scatter_foreign_engine::minmax::Sizes {
+                    screen: fixture.sizes().screen,
+                    rectified: RECTIFIED,
+                    shadow_map: SHADOW_MAP,
+                };
+                let mut engine = Engine::load(
+                    ctx.device(),
+                    ctx.queue(),
+                    dir,
+                    &v.id(),
+                    target,
+                    &sizes.params(),
+                )?;
+                scatter_foreign_engine::minmax::run_frame(
+                    &mut engine,
+                    &frame,
+                    &fixture.gbuf.view_depth,
+                    &fixture.shadow_map.depth,
+                )
+            },
+        ));
+    }
+    assert_eq!(
+        lines.len(),
+        2 * (raymarch_variants().len() + MinmaxVariant::grid().len())
+    );
+}
+
+/// The binary's path for a raymarch variant: `run_dir` reads the family from the manifest
+/// and gives the same radiance as the in-memory path.
+#[test]
+fn foreign_engine_files_run_every_family() {
+    let Some(ctx) = gpu() else { return };
+    for (id, family) in [
+        (raymarch_variants()[1].id(), "raymarch"),
+        (MinmaxVariant::grid()[0].id(), "minmax"),
+    ] {
+        let light = if family == "raymarch" {
+            raymarch_variants()[1].light
+        } else {
+            MinmaxVariant::grid()[0].light
+        };
+        let fixture = Fixture::get(light);
+        let f = fixture.frame_input();
+        let file = FrameFile::new(
+            fixture.sizes(),
+            &f.camera,
+            &f.light,
+            &f.medium,
+            &f.shadow_map,
+            &f.settings,
+        );
+        let inputs = scratch(&format!("inputs-{family}"));
+        write_inputs(
+            &inputs,
+            &file,
+            &fixture.gbuf.view_depth,
+            &fixture.shadow_map.depth,
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        let summary = run_dir(
+            ctx.device(),
+            ctx.queue(),
+            &RunArgs {
+                shaders: other_families_dir().to_path_buf(),
+                variant: Some(id.clone()),
+                inputs,
+                out: None,
+                target: Target::Spirv,
+            },
+        )
+        .unwrap_or_else(|e| panic!("run_dir {family}: {e}"));
+        assert_eq!(summary.family, family);
+        assert_eq!(summary.frame.is_some(), family == "minmax");
+        let max = summary
+            .radiance
+            .iter()
+            .flat_map(|p| &p[..3])
+            .fold(0.0f32, |m, &v| m.max(v));
+        assert!(max > 0.0, "{family} through run_dir: black output");
+    }
+}
+
 /// The comparison can fail: the foreign engine fed a depth buffer 10 % short differs from
 /// the runtime by far more than the bound.
 #[test]
@@ -402,7 +671,8 @@ fn foreign_engine_files_round_trip() {
     )
     .unwrap_or_else(|e| panic!("run_dir: {e}"));
     assert_eq!(
-        summary.frame, frame,
+        summary.frame,
+        Some(frame.clone()),
         "frame.json round trip changed the frame"
     );
     let mut engine = Engine::load(

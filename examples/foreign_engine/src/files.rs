@@ -21,6 +21,8 @@ use scatter_frame::frame::{
     CameraDesc, FrameSettings, LightDesc, MediumDesc, PrefilteredFrame, Resolutions, ShadowMapDesc,
     ShadowProjectionDesc, prepare_frame,
 };
+use scatter_frame::minmax::{MinmaxVariant, prepare_minmax};
+use scatter_frame::raymarch::{MarchUniforms, RaymarchVariant, prepare_march};
 use scatter_frame::variant::Variant;
 
 use crate::prefiltered::{Inputs, Sizes, run_frame};
@@ -251,6 +253,63 @@ impl FrameFile {
     ///
     /// [`EngineError::Frame`] when the frame set-up rejects the numbers.
     pub fn prepare(&self, variant: &Variant) -> Result<PrefilteredFrame, EngineError> {
+        let d = self.descs();
+        Ok(prepare_frame(
+            variant,
+            &self.resolutions(),
+            &d.camera,
+            &d.light,
+            &d.medium,
+            &d.shadow_map,
+            &d.settings,
+        )?)
+    }
+
+    /// Sets up the frame of a minmax variant ([`prepare_minmax`]).
+    ///
+    /// # Errors
+    ///
+    /// [`EngineError::Frame`] when the frame set-up rejects the numbers.
+    pub fn prepare_minmax(&self, variant: &MinmaxVariant) -> Result<PrefilteredFrame, EngineError> {
+        let d = self.descs();
+        Ok(prepare_minmax(
+            variant,
+            &self.resolutions(),
+            &d.camera,
+            &d.light,
+            &d.medium,
+            &d.shadow_map,
+            &d.settings,
+        )?)
+    }
+
+    /// The uniform block of a raymarch variant ([`prepare_march`]; the rectified size and
+    /// the settings do not apply).
+    ///
+    /// # Errors
+    ///
+    /// [`EngineError::Frame`] when the frame set-up rejects the numbers.
+    pub fn prepare_march(&self, variant: &RaymarchVariant) -> Result<MarchUniforms, EngineError> {
+        let d = self.descs();
+        Ok(prepare_march(
+            variant,
+            self.screen,
+            &d.camera,
+            &d.light,
+            &d.medium,
+            &d.shadow_map,
+        )?)
+    }
+
+    fn resolutions(&self) -> Resolutions {
+        Resolutions {
+            screen: self.screen,
+            rectified: self.rectified,
+        }
+    }
+
+    /// The descriptions the frame set-ups take.
+    pub fn descs(&self) -> Descs {
         let c = &self.camera;
         let camera = CameraDesc {
             position: v3(c.position),
@@ -311,14 +370,29 @@ impl FrameFile {
             },
             None => FrameSettings::for_screen(self.screen[0], self.screen[1]),
         };
-        let res = Resolutions {
-            screen: self.screen,
-            rectified: self.rectified,
-        };
-        Ok(prepare_frame(
-            variant, &res, &camera, &light, &medium, &shadow, &settings,
-        )?)
+        Descs {
+            camera,
+            light,
+            medium,
+            shadow_map: shadow,
+            settings,
+        }
     }
+}
+
+/// A [`FrameFile`]'s numbers as the frame set-ups' descriptions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Descs {
+    /// The camera.
+    pub camera: CameraDesc,
+    /// The light.
+    pub light: LightDesc,
+    /// The medium.
+    pub medium: MediumDesc,
+    /// The standard shadow map.
+    pub shadow_map: ShadowMapDesc,
+    /// Frame settings (epipolar families).
+    pub settings: FrameSettings,
 }
 
 /// Reads a greyscale PFM: `(width, height, values top row first)`.
@@ -494,8 +568,10 @@ pub struct RunArgs {
 pub struct RunSummary {
     /// The variant id.
     pub variant: String,
-    /// The frame set-up.
-    pub frame: PrefilteredFrame,
+    /// The variant's family (`prefiltered`, `raymarch`, `minmax`).
+    pub family: String,
+    /// The epipolar frame set-up (prefiltered and minmax; `None` for raymarch).
+    pub frame: Option<PrefilteredFrame>,
     /// Passes run and skipped.
     pub run: FrameRun,
     /// Radiance, rgba per pixel.
@@ -545,56 +621,80 @@ pub fn run_dir(
             }
         },
     };
-    let variant = knobs_of(&manifest, &id)?;
+    let knobs = knobs_of(&manifest, &id)?;
     let frame_path = args.inputs.join(FRAME_FILE);
     let text = std::fs::read_to_string(&frame_path).map_err(EngineError::io(&frame_path))?;
     let file: FrameFile = serde_json::from_str(&text).map_err(|e| EngineError::InputFile {
         path: frame_path.clone(),
         reason: e.to_string(),
     })?;
-    let frame = file.prepare(&variant)?;
     let depth = read_sized(&args.inputs.join(DEPTH_FILE), file.screen)?;
     let shadow = read_sized(
         &args.inputs.join(SHADOW_MAP_FILE),
         [file.shadow_map.size; 2],
     )?;
-    let rectified_path = args.inputs.join(RECTIFIED_FILE);
-    let rectified = if frame.report.projective.is_some() {
-        if !rectified_path.exists() {
-            return Err(EngineError::InputFile {
-                path: rectified_path,
-                reason: "this frame is projective: rasterise the rectified map with the \
-                         frame's per-region matrices (FrameReport::projective) and store it here"
-                    .to_owned(),
-            });
-        }
-        Some(read_sized(&rectified_path, file.rectified)?)
-    } else {
-        None
+    let load = |params: &crate::formula::Params| {
+        Engine::load(device, queue, &args.shaders, &id, args.target, params)
     };
-    let mut engine = Engine::load(
-        device,
-        queue,
-        &args.shaders,
-        &id,
-        args.target,
-        &file.sizes().params(),
-    )?;
-    let out = run_frame(
-        &mut engine,
-        &frame,
-        &Inputs {
-            depth: &depth,
-            shadow_map: Some(&shadow),
-            rectified_raster: rectified.as_deref(),
-        },
-    )?;
+    let (frame, out) = match &knobs {
+        Knobs::Prefiltered(variant) => {
+            let frame = file.prepare(variant)?;
+            let rectified_path = args.inputs.join(RECTIFIED_FILE);
+            let rectified = if frame.report.projective.is_some() {
+                if !rectified_path.exists() {
+                    return Err(EngineError::InputFile {
+                        path: rectified_path,
+                        reason: "this frame is projective: rasterise the rectified map with \
+                                 the frame's per-region matrices (FrameReport::projective) and \
+                                 store it here"
+                            .to_owned(),
+                    });
+                }
+                Some(read_sized(&rectified_path, file.rectified)?)
+            } else {
+                None
+            };
+            let mut engine = load(&file.sizes().params())?;
+            let out = run_frame(
+                &mut engine,
+                &frame,
+                &Inputs {
+                    depth: &depth,
+                    shadow_map: Some(&shadow),
+                    rectified_raster: rectified.as_deref(),
+                },
+            )?;
+            (Some(frame), out)
+        }
+        Knobs::Minmax(variant) => {
+            let frame = file.prepare_minmax(variant)?;
+            let sizes = crate::minmax::Sizes {
+                screen: file.screen,
+                rectified: file.rectified,
+                shadow_map: file.shadow_map.size,
+            };
+            let mut engine = load(&sizes.params())?;
+            let out = crate::minmax::run_frame(&mut engine, &frame, &depth, &shadow)?;
+            (Some(frame), out)
+        }
+        Knobs::Raymarch(variant) => {
+            let uniforms = file.prepare_march(variant)?;
+            let sizes = crate::raymarch::Sizes {
+                screen: file.screen,
+                shadow_map: file.shadow_map.size,
+            };
+            let mut engine = load(&sizes.params())?;
+            let out = crate::raymarch::run_frame(&mut engine, &uniforms, &depth, &shadow)?;
+            (None, out)
+        }
+    };
     if let Some(path) = &args.out {
         let flat: Vec<f32> = out.radiance.iter().flatten().copied().collect();
         write_pfm(path, file.screen[0], file.screen[1], &flat, 3, 4)?;
     }
     Ok(RunSummary {
         variant: id,
+        family: knobs.family().to_owned(),
         frame,
         run: out.run,
         radiance: out.radiance,
@@ -602,31 +702,80 @@ pub fn run_dir(
     })
 }
 
-/// The [`Variant`] of manifest entry `id`, from its `knobs`.
-///
-/// # Errors
-///
-/// [`EngineError::UnknownVariant`]; [`EngineError::Inconsistent`] when the knobs do not
-/// describe a valid prefiltered variant.
-pub fn knobs_of(manifest: &crate::Manifest, id: &str) -> Result<Variant, EngineError> {
-    let entry = manifest.variant(id)?;
-    if entry.family != "prefiltered" {
-        return Err(EngineError::Unsupported {
-            context: format!("variant {id}"),
-            what: "family",
-            value: entry.family.clone(),
-        });
+/// The validated knobs of a manifest variant, by family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Knobs {
+    /// A `prefiltered` variant.
+    Prefiltered(Variant),
+    /// A `raymarch` variant.
+    Raymarch(RaymarchVariant),
+    /// A `minmax` variant.
+    Minmax(MinmaxVariant),
+}
+
+impl Knobs {
+    /// The family's name as the manifest spells it.
+    pub const fn family(&self) -> &'static str {
+        match self {
+            Self::Prefiltered(_) => "prefiltered",
+            Self::Raymarch(_) => "raymarch",
+            Self::Minmax(_) => "minmax",
+        }
     }
-    let variant: Variant = serde_json::from_value(entry.knobs.clone())
+}
+
+/// Parses and validates one family's knobs and checks they describe variant `id`.
+fn parse_knobs<V: serde::de::DeserializeOwned>(
+    entry: &crate::manifest::VariantEntry,
+    validate: impl Fn(&V) -> Result<(), String>,
+    variant_id: impl Fn(&V) -> String,
+) -> Result<V, EngineError> {
+    let id = &entry.id;
+    let variant: V = serde_json::from_value(entry.knobs.clone())
         .map_err(|e| EngineError::Inconsistent(format!("knobs of variant {id}: {e}")))?;
-    variant
-        .validate()
+    validate(&variant)
         .map_err(|e| EngineError::Inconsistent(format!("knobs of variant {id}: {e}")))?;
-    if variant.id() != id {
+    if variant_id(&variant) != *id {
         return Err(EngineError::Inconsistent(format!(
             "the knobs of variant {id} describe variant {}",
-            variant.id()
+            variant_id(&variant)
         )));
     }
     Ok(variant)
+}
+
+/// The knobs of manifest entry `id`, by its family.
+///
+/// # Errors
+///
+/// [`EngineError::UnknownVariant`]; [`EngineError::Unsupported`] for a family this engine
+/// does not know; [`EngineError::Inconsistent`] when the knobs do not describe a valid
+/// variant of the family, or another variant than `id`.
+pub fn knobs_of(manifest: &crate::Manifest, id: &str) -> Result<Knobs, EngineError> {
+    let entry = manifest.variant(id)?;
+    match entry.family.as_str() {
+        "prefiltered" => parse_knobs(
+            entry,
+            |v: &Variant| v.validate().map_err(|e| e.to_string()),
+            Variant::id,
+        )
+        .map(Knobs::Prefiltered),
+        "raymarch" => parse_knobs(
+            entry,
+            |v: &RaymarchVariant| v.validate().map_err(|e| e.to_string()),
+            RaymarchVariant::id,
+        )
+        .map(Knobs::Raymarch),
+        "minmax" => parse_knobs(
+            entry,
+            |v: &MinmaxVariant| v.validate().map_err(|e| e.to_string()),
+            MinmaxVariant::id,
+        )
+        .map(Knobs::Minmax),
+        _ => Err(EngineError::Unsupported {
+            context: format!("variant {id}"),
+            what: "family",
+            value: entry.family.clone(),
+        }),
+    }
 }

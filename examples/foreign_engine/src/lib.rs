@@ -12,7 +12,9 @@
 //! - [`formula`]: size and dispatch formulas, parameter constraints;
 //! - [`condition`]: per-frame conditions (`skip_when`, `alternative.when`);
 //! - [`engine`]: [`Engine`], family-agnostic;
-//! - [`prefiltered`]: what the prefiltered family's resources hold, one frame end to end;
+//! - [`prefiltered`], [`raymarch`], [`minmax`]: what each family's resources hold, one
+//!   frame end to end (the only family-specific code: which host struct goes into which
+//!   buffer, which engine texture into which resource, the family's size parameters);
 //! - [`files`]: the binary's `frame.json` and PFM files.
 //!
 //! ```no_run
@@ -36,7 +38,9 @@ mod error;
 pub mod files;
 pub mod formula;
 pub mod manifest;
+pub mod minmax;
 pub mod prefiltered;
+pub mod raymarch;
 
 pub use engine::{Engine, FrameData, FrameRun, Target};
 pub use error::EngineError;

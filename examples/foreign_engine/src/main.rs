@@ -83,17 +83,22 @@ fn run(cli: Cli) -> Result<(), EngineError> {
         .flat_map(|p| &p[..3])
         .fold(0.0f32, |m, &v| m.max(v));
     let [w, h] = summary.screen;
+    let frame = summary.frame.as_ref().map_or_else(
+        || "per-pixel march".to_owned(),
+        |f| {
+            format!(
+                "{} frame{}",
+                f.report.rectification,
+                f.report
+                    .fallback
+                    .map(|f| format!(" (fell back: {f})"))
+                    .unwrap_or_default()
+            )
+        },
+    );
     println!(
-        "{} on {adapter} from {}: {w}x{h}, {} frame{}",
-        summary.variant,
-        cli.target,
-        summary.frame.report.rectification,
-        summary
-            .frame
-            .report
-            .fallback
-            .map(|f| format!(" (fell back: {f})"))
-            .unwrap_or_default()
+        "{} ({}) on {adapter} from {}: {w}x{h}, {frame}",
+        summary.variant, summary.family, cli.target,
     );
     for (kernel, [x, y, z]) in &summary.run.dispatched {
         println!("  dispatched {kernel} {x}x{y}x{z}");

@@ -112,15 +112,37 @@ const HOST_FIELDS: [(&str, usize); 25] = [
 ///
 /// [`EngineError::Inconsistent`] naming the first difference.
 pub fn check_frame_layout(engine: &Engine) -> Result<(), EngineError> {
+    check_struct_layout(
+        engine,
+        FRAME,
+        "scatter-frame's FrameUniforms",
+        size_of::<FrameUniforms>(),
+        &HOST_FIELDS,
+    )
+}
+
+/// Checks that the struct the manifest's bindings of `resource` hold has exactly the
+/// fields (manifest spelling, host offset) and size of the host struct `host`.
+///
+/// # Errors
+///
+/// [`EngineError::Inconsistent`] naming the first difference.
+pub fn check_struct_layout(
+    engine: &Engine,
+    resource: &str,
+    host: &str,
+    host_size: usize,
+    host_fields: &[(&str, usize)],
+) -> Result<(), EngineError> {
     let variant = engine.variant();
     let struct_name = variant
         .passes
         .iter()
         .flat_map(|p| &p.bindings)
-        .filter(|b| b.resource == FRAME)
+        .filter(|b| b.resource == resource)
         .find_map(|b| b.struct_name.as_deref())
         .ok_or_else(|| {
-            EngineError::Inconsistent(format!("no binding of `{FRAME}` names its struct"))
+            EngineError::Inconsistent(format!("no binding of `{resource}` names its struct"))
         })?;
     let layout = engine
         .manifest()
@@ -130,19 +152,15 @@ pub fn check_frame_layout(engine: &Engine) -> Result<(), EngineError> {
         })?;
     let differs = |what: String| {
         Err(EngineError::Inconsistent(format!(
-            "the manifest's {struct_name} differs from scatter-frame's FrameUniforms: {what}; \
+            "the manifest's {struct_name} differs from {host}: {what}; \
              regenerate the shaders with the scatter-gen of this scatter-frame"
         )))
     };
-    if layout.size != size_of::<FrameUniforms>() as u64 {
-        return differs(format!(
-            "{} bytes, the host has {}",
-            layout.size,
-            size_of::<FrameUniforms>()
-        ));
+    if layout.size != host_size as u64 {
+        return differs(format!("{} bytes, the host has {host_size}", layout.size));
     }
     for f in &layout.fields {
-        match HOST_FIELDS.iter().find(|(n, _)| *n == f.name) {
+        match host_fields.iter().find(|(n, _)| *n == f.name) {
             None => return differs(format!("field {} is not on the host", f.name)),
             Some(&(_, offset)) if offset as u64 != f.offset => {
                 return differs(format!(
@@ -153,13 +171,31 @@ pub fn check_frame_layout(engine: &Engine) -> Result<(), EngineError> {
             Some(_) => {}
         }
     }
-    if let Some((missing, _)) = HOST_FIELDS
+    if let Some((missing, _)) = host_fields
         .iter()
         .find(|(n, _)| !layout.fields.iter().any(|f| f.name == *n))
     {
         return differs(format!("the host's field {missing} is not in the manifest"));
     }
     Ok(())
+}
+
+/// Reads `output` back as rgba radiance.
+///
+/// # Errors
+///
+/// [`Engine::read_texture`]'s; [`EngineError::Inconsistent`] when `output` is not rgba.
+pub fn read_output(engine: &Engine) -> Result<Vec<[f32; 4]>, EngineError> {
+    let (channels, values) = engine.read_texture(OUTPUT)?;
+    if channels != 4 {
+        return Err(EngineError::Inconsistent(format!(
+            "`{OUTPUT}` has {channels} channels, not rgba"
+        )));
+    }
+    Ok(values
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect())
 }
 
 /// Runs one frame: uploads `frame.uniforms`, `frame.slices` and the engine's textures,
@@ -191,15 +227,6 @@ pub fn run_frame(
         buffers: &buffers,
         textures: &textures,
     })?;
-    let (channels, values) = engine.read_texture(OUTPUT)?;
-    if channels != 4 {
-        return Err(EngineError::Inconsistent(format!(
-            "`{OUTPUT}` has {channels} channels, not rgba"
-        )));
-    }
-    let radiance = values
-        .chunks_exact(4)
-        .map(|c| [c[0], c[1], c[2], c[3]])
-        .collect();
+    let radiance = read_output(engine)?;
     Ok(Output { radiance, run })
 }

@@ -54,8 +54,8 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
         Parameter {
             name: "rectified.width",
             description: "light rays per epipolar slice (columns of the rectified map), an \
-                          engine choice",
-            constraint: "1..=max_texture_dimension_2d, with tree.width within it too".into(),
+                          engine choice (tree.width, derived from it, has its own constraint)",
+            constraint: dim.into(),
         },
         Parameter {
             name: "rectified.height",
