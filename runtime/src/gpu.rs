@@ -282,3 +282,49 @@ impl Readback {
         Ok(packed)
     }
 }
+
+/// Fails with [`RuntimeError::EmptyInput`] for the first size with a zero dimension; each
+/// entry names the kernel to blame and what the size is (`screen`, `shadow map`, ...).
+pub(crate) fn check_nonempty(sizes: &[(Kernel, &str, [u32; 2])]) -> Result<(), RuntimeError> {
+    for &(kernel, what, [w, h]) in sizes {
+        if w == 0 || h == 0 {
+            return Err(RuntimeError::EmptyInput {
+                kernel,
+                size: format!("{what} {w}x{h}"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks CPU textures against their sizes and uploads them as r32float textures (test
+/// conveniences): one `(texture, view)` per entry `(kernel to blame, what, size, texels)`.
+///
+/// # Errors
+///
+/// [`RuntimeError::DataLength`] naming the texture whose length does not match; upload
+/// errors.
+pub(crate) fn upload_inputs(
+    ctx: &Context,
+    inputs: &[(Kernel, &str, [u32; 2], &[f32])],
+) -> Result<Vec<(wgpu::Texture, wgpu::TextureView)>, RuntimeError> {
+    for &(kernel, what, [w, h], data) in inputs {
+        let expected = u64::from(w) * u64::from(h);
+        if data.len() as u64 != expected {
+            return Err(RuntimeError::DataLength {
+                kernel,
+                size: format!("{what} {w}x{h}"),
+                expected,
+                actual: data.len() as u64,
+            });
+        }
+    }
+    inputs
+        .iter()
+        .map(|&(kernel, what, size, data)| {
+            let texture = crate::textures::upload_r32float(ctx, kernel, what, size, data)?;
+            let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+            Ok((texture, view))
+        })
+        .collect()
+}

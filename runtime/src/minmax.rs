@@ -19,9 +19,10 @@ use scatter_shaderlib::{Kernel, KernelParams};
 
 use crate::error::{ErrorScopes, check_limit};
 use crate::executor::Executor;
-use crate::gpu::{DEPTH_NAMES, Readback, SHADOW_NAMES, check_view, decode_rgba};
+use crate::gpu::{
+    DEPTH_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_view, decode_rgba, upload_inputs,
+};
 use crate::prefiltered::FrameInput;
-use crate::textures::upload_r32float;
 use crate::timer::median_pass_wall_times;
 use crate::{Context, RuntimeError};
 
@@ -87,28 +88,11 @@ impl Minmax {
     ) -> Result<Self, RuntimeError> {
         let [w, h] = res.screen;
         let [wr, hr] = res.rectified;
-        for (kernel, what, size, empty) in [
-            (MARCH, "screen", format!("{w}x{h}"), w == 0 || h == 0),
-            (
-                RECTIFY,
-                "rectified",
-                format!("{wr}x{hr}"),
-                wr == 0 || hr == 0,
-            ),
-            (
-                RECTIFY,
-                "shadow map",
-                format!("{shadow_map_size}x{shadow_map_size}"),
-                shadow_map_size == 0,
-            ),
-        ] {
-            if empty {
-                return Err(RuntimeError::EmptyInput {
-                    kernel,
-                    size: format!("{what} {size}"),
-                });
-            }
-        }
+        check_nonempty(&[
+            (MARCH, "screen", res.screen),
+            (RECTIFY, "rectified", res.rectified),
+            (RECTIFY, "shadow map", [shadow_map_size; 2]),
+        ])?;
         let tw = tree_width(wr);
         let device = ctx.device();
         let limits = device.limits();
@@ -351,37 +335,19 @@ pub fn run_minmax_once(
 ) -> Result<MinmaxReadback, RuntimeError> {
     let sm_size = input.shadow_map.size;
     let mut pass = Minmax::new(ctx, variant, res, sm_size)?;
-    for (what, [tw, th], data) in [
-        ("depth buffer", res.screen, depth),
-        ("shadow map", [sm_size; 2], shadow_map),
-    ] {
-        let expected = u64::from(tw) * u64::from(th);
-        if data.len() as u64 != expected {
-            return Err(RuntimeError::DataLength {
-                kernel: MARCH,
-                size: format!("{what} {tw}x{th}"),
-                expected,
-                actual: data.len() as u64,
-            });
-        }
-    }
+    let views = upload_inputs(
+        ctx,
+        &[
+            (MARCH, "depth buffer", res.screen, depth),
+            (RECTIFY, "shadow map", [sm_size; 2], shadow_map),
+        ],
+    )?;
     pass.prepare(ctx, input)?;
     let device = ctx.device();
-    let depth_texture =
-        upload_r32float(ctx, MARCH, "minmax depth (test upload)", res.screen, depth)?;
-    let shadow_texture = upload_r32float(
-        ctx,
-        MARCH,
-        "minmax shadow map (test upload)",
-        [sm_size; 2],
-        shadow_map,
-    )?;
-    let depth_view = depth_texture.create_view(&wgpu::TextureViewDescriptor::default());
-    let shadow_view = shadow_texture.create_view(&wgpu::TextureViewDescriptor::default());
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
         label: Some("minmax run_once"),
     });
-    pass.encode(ctx, &mut encoder, &depth_view, &shadow_view)?;
+    pass.encode(ctx, &mut encoder, &views[0].1, &views[1].1)?;
     let scope = ErrorScopes::push(device);
     let rectified = Readback::encode(device, &mut encoder, pass.rectified_texture(), 4, RECTIFY)?;
     let tree = Readback::encode(device, &mut encoder, pass.tree_texture(), 8, BUILD)?;

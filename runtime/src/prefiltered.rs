@@ -27,7 +27,10 @@ use scatter_shaderlib::{Kernel, KernelParams};
 
 use crate::error::{ErrorScopes, check_limit};
 use crate::executor::Executor;
-use crate::gpu::{DEPTH_NAMES, RECTIFIED_NAMES, Readback, SHADOW_NAMES, check_view, decode_rgba};
+use crate::gpu::{
+    DEPTH_NAMES, RECTIFIED_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_view, decode_rgba,
+    upload_inputs,
+};
 use crate::timer::median_pass_wall_times;
 use crate::{Context, RuntimeError};
 
@@ -108,7 +111,6 @@ impl PassTimes {
 #[derive(Debug)]
 pub struct Scatter {
     device: wgpu::Device,
-    queue: wgpu::Queue,
     variant: Variant,
     res: Resolutions,
     shadow_map_size: u32,
@@ -156,28 +158,11 @@ impl Scatter {
             })?;
         let [w, h] = res.screen;
         let [wr, hr] = res.rectified;
-        for (kernel, what, size, empty) in [
-            (SCATTER, "screen", format!("{w}x{h}"), w == 0 || h == 0),
-            (
-                RECTIFY,
-                "rectified",
-                format!("{wr}x{hr}"),
-                wr == 0 || hr == 0,
-            ),
-            (
-                RECTIFY,
-                "shadow map",
-                format!("{shadow_map_size}x{shadow_map_size}"),
-                shadow_map_size == 0,
-            ),
-        ] {
-            if empty {
-                return Err(RuntimeError::EmptyInput {
-                    kernel,
-                    size: format!("{what} {size}"),
-                });
-            }
-        }
+        check_nonempty(&[
+            (SCATTER, "screen", res.screen),
+            (RECTIFY, "rectified", res.rectified),
+            (RECTIFY, "shadow map", [shadow_map_size; 2]),
+        ])?;
         // As `prepare_frame` requires: the first of the sun's quadratically split regions has
         // `Wr / regions^2` columns.
         let min_width = variant.regions * variant.regions;
@@ -253,7 +238,6 @@ impl Scatter {
         let (output, output_view) = exec.texture("output")?;
         Ok(Self {
             device: device.clone(),
-            queue: ctx.queue().clone(),
             variant: *variant,
             res,
             shadow_map_size,
@@ -515,11 +499,6 @@ impl Scatter {
     pub fn output_view(&self) -> &wgpu::TextureView {
         &self.output_view
     }
-
-    /// The queue the pass was created with.
-    fn queue(&self) -> &wgpu::Queue {
-        &self.queue
-    }
 }
 
 /// CPU-side inputs of [`run_once`]: the frame's parameters plus the two textures an engine
@@ -582,102 +561,35 @@ pub fn run_once(
 ) -> Result<ScatterReadback, RuntimeError> {
     let sm_size = inputs.frame.shadow_map.size;
     let mut pass = Scatter::new(ctx, variant, res, sm_size)?;
-    let [w, h] = res.screen;
-    for (kernel, what, [tw, th], data) in [
-        (SCATTER, "depth buffer", [w, h], &inputs.depth),
-        (RECTIFY, "shadow map", [sm_size; 2], &inputs.shadow_map),
-    ] {
-        let expected = u64::from(tw) * u64::from(th);
-        if data.len() as u64 != expected {
-            return Err(RuntimeError::DataLength {
-                kernel,
-                size: format!("{what} {tw}x{th}"),
-                expected,
-                actual: data.len() as u64,
-            });
-        }
+    let mut cpu = vec![
+        (SCATTER, "depth buffer", res.screen, &inputs.depth[..]),
+        (RECTIFY, "shadow map", [sm_size; 2], &inputs.shadow_map[..]),
+    ];
+    if let Some(data) = &inputs.rectified {
+        cpu.push((
+            PREFILTER,
+            "rasterised rectified map",
+            res.rectified,
+            &data[..],
+        ));
     }
+    let views = upload_inputs(ctx, &cpu)?;
+    let engine_rectified = views.get(2).map(|(_, v)| v);
     pass.prepare(ctx, &inputs.frame)?;
-
     let device = ctx.device();
-    let queue = pass.queue();
-    let scope = ErrorScopes::push(device);
-    let upload = |label, [width, height]: [u32; 2], data: &[f32]| {
-        let size = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_DST
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        queue.write_texture(
-            texture.as_image_copy(),
-            bytemuck::cast_slice(data),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(width * 4),
-                rows_per_image: Some(height),
-            },
-            size,
-        );
-        texture
-    };
-    let depth = upload("prefiltered depth (test upload)", res.screen, &inputs.depth);
-    let shadow = upload(
-        "prefiltered shadow map (test upload)",
-        [sm_size; 2],
-        &inputs.shadow_map,
-    );
-    scope.pop(SCATTER, "uploading test inputs")?;
-    let depth_view = depth.create_view(&wgpu::TextureViewDescriptor::default());
-    let shadow_view = shadow.create_view(&wgpu::TextureViewDescriptor::default());
-    let engine_rectified = match &inputs.rectified {
-        Some(data) => {
-            let [wr, hr] = res.rectified;
-            let expected = u64::from(wr) * u64::from(hr);
-            if data.len() as u64 != expected {
-                return Err(RuntimeError::DataLength {
-                    kernel: PREFILTER,
-                    size: format!("rasterised rectified map {wr}x{hr}"),
-                    expected,
-                    actual: data.len() as u64,
-                });
-            }
-            let scope = ErrorScopes::push(device);
-            let t = upload(
-                "prefiltered rasterised rectified map (test upload)",
-                res.rectified,
-                data,
-            );
-            scope.pop(PREFILTER, "uploading test inputs")?;
-            Some(t.create_view(&wgpu::TextureViewDescriptor::default()))
-        }
-        None => None,
-    };
-
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
         label: Some("prefiltered run_once"),
     });
     pass.encode(
         &mut encoder,
         &Inputs {
-            depth: &depth_view,
-            shadow_map: Some(&shadow_view),
-            rectified: engine_rectified.as_ref(),
+            depth: &views[0].1,
+            shadow_map: Some(&views[1].1),
+            rectified: engine_rectified,
         },
     )?;
     let scope = ErrorScopes::push(device);
-    let rectified_texture = match &engine_rectified {
+    let rectified_texture = match engine_rectified {
         Some(view) if pass.frame().is_some_and(|f| f.report.projective.is_some()) => view.texture(),
         _ => pass.rectified_texture(),
     };
@@ -691,7 +603,7 @@ pub fn run_once(
     )?;
     let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, SCATTER)?;
     let start = Instant::now();
-    queue.submit([encoder.finish()]);
+    ctx.queue().submit([encoder.finish()]);
     scope.pop(SCATTER, "dispatch")?;
 
     let rectified = rectified
@@ -715,9 +627,9 @@ pub fn run_once(
         Some(pass.measure_pass_wall_times(
             ctx,
             &Inputs {
-                depth: &depth_view,
-                shadow_map: Some(&shadow_view),
-                rectified: engine_rectified.as_ref(),
+                depth: &views[0].1,
+                shadow_map: Some(&views[1].1),
+                rectified: engine_rectified,
             },
             inputs.pass_wall_frames,
         )?)

@@ -17,8 +17,9 @@ use scatter_shaderlib::{Kernel, KernelParams};
 
 use crate::error::{ErrorScopes, check_limit};
 use crate::executor::Executor;
-use crate::gpu::{DEPTH_NAMES, Readback, SHADOW_NAMES, check_view, decode_rgba};
-use crate::textures::upload_r32float;
+use crate::gpu::{
+    DEPTH_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_view, decode_rgba, upload_inputs,
+};
 use crate::timer::median_pass_wall_times;
 use crate::{Context, RuntimeError};
 
@@ -96,21 +97,10 @@ impl Raymarch {
                 source,
             })?;
         let [w, h] = screen;
-        for (what, size, empty) in [
-            ("screen", format!("{w}x{h}"), w == 0 || h == 0),
-            (
-                "shadow map",
-                format!("{shadow_map_size}x{shadow_map_size}"),
-                shadow_map_size == 0,
-            ),
-        ] {
-            if empty {
-                return Err(RuntimeError::EmptyInput {
-                    kernel: RAYMARCH,
-                    size: format!("{what} {size}"),
-                });
-            }
-        }
+        check_nonempty(&[
+            (RAYMARCH, "screen", screen),
+            (RAYMARCH, "shadow map", [shadow_map_size; 2]),
+        ])?;
         let device = ctx.device();
         let limits = device.limits();
         for (what, value) in [
@@ -348,37 +338,19 @@ pub fn run_raymarch_once(
 ) -> Result<MarchReadback, RuntimeError> {
     let sm_size = input.shadow_map.size;
     let mut pass = Raymarch::new(ctx, variant, screen, sm_size)?;
-    for (what, [tw, th], data) in [
-        ("depth buffer", screen, depth),
-        ("shadow map", [sm_size; 2], shadow_map),
-    ] {
-        let expected = u64::from(tw) * u64::from(th);
-        if data.len() as u64 != expected {
-            return Err(RuntimeError::DataLength {
-                kernel: RAYMARCH,
-                size: format!("{what} {tw}x{th}"),
-                expected,
-                actual: data.len() as u64,
-            });
-        }
-    }
+    let views = upload_inputs(
+        ctx,
+        &[
+            (RAYMARCH, "depth buffer", screen, depth),
+            (RAYMARCH, "shadow map", [sm_size; 2], shadow_map),
+        ],
+    )?;
     pass.prepare(ctx, input)?;
     let device = ctx.device();
-    let depth_texture =
-        upload_r32float(ctx, RAYMARCH, "raymarch depth (test upload)", screen, depth)?;
-    let shadow_texture = upload_r32float(
-        ctx,
-        RAYMARCH,
-        "raymarch shadow map (test upload)",
-        [sm_size; 2],
-        shadow_map,
-    )?;
-    let depth_view = depth_texture.create_view(&wgpu::TextureViewDescriptor::default());
-    let shadow_view = shadow_texture.create_view(&wgpu::TextureViewDescriptor::default());
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
         label: Some("raymarch run_once"),
     });
-    pass.encode(ctx, &mut encoder, &depth_view, &shadow_view)?;
+    pass.encode(ctx, &mut encoder, &views[0].1, &views[1].1)?;
     let scope = ErrorScopes::push(device);
     let partial = pass
         .partial_texture()

@@ -12,6 +12,134 @@ use crate::Kernel;
 pub const DEPTH_FORMAT: &str = "r32float";
 /// Format of every family's output (in-scattered radiance, rgb; alpha 1).
 pub const OUTPUT_FORMAT: &str = "rgba16float";
+/// Usages of a texture the passes only sample or load.
+pub const SAMPLED: &[&str] = &["texture_binding"];
+/// Usages of a texture one pass writes and a later one reads.
+pub const STORAGE_AND_SAMPLED: &[&str] = &["storage_binding", "texture_binding"];
+/// The constraint of a parameter that sizes a 2D texture.
+pub const TEXTURE_DIMENSION: &str = "1..=max_texture_dimension_2d";
+
+/// A one-mip 2D texture of `layers` layers.
+pub fn texture_2d(
+    format: &str,
+    width: &str,
+    height: &str,
+    layers: &str,
+    usage: &[&'static str],
+) -> TextureDesc {
+    TextureDesc {
+        format: format.to_owned(),
+        dimension: "2d",
+        width: width.to_owned(),
+        height: height.to_owned(),
+        layers: layers.to_owned(),
+        mip_levels: 1,
+        usage: usage.to_vec(),
+    }
+}
+
+/// A binding that always gets `resource`.
+pub fn bind(binding: u32, resource: &'static str) -> BindingSource {
+    BindingSource {
+        binding,
+        resource,
+        alternative: None,
+    }
+}
+
+/// `screen.width`, `screen.height` and `shadow.size`: the parameters every family has.
+pub fn screen_and_shadow_parameters() -> Vec<Parameter> {
+    vec![
+        Parameter {
+            name: "screen.width",
+            description: "screen width in pixels (depth buffer and output)",
+            constraint: TEXTURE_DIMENSION.into(),
+        },
+        Parameter {
+            name: "screen.height",
+            description: "screen height in pixels (depth buffer and output)",
+            constraint: TEXTURE_DIMENSION.into(),
+        },
+        Parameter {
+            name: "shadow.size",
+            description: "side of the engine's square standard shadow map in texels",
+            constraint: TEXTURE_DIMENSION.into(),
+        },
+    ]
+}
+
+/// A resource scatter allocates.
+pub fn scatter_resource(name: &'static str, contents: &'static str) -> Resource {
+    Resource {
+        name,
+        kind: "texture",
+        provided_by: "scatter",
+        contents,
+        texture: None,
+        buffer: None,
+        sampler: None,
+    }
+}
+
+/// A per-frame buffer scatter allocates and the host writes: a uniform block, or with
+/// `elements` a storage array.
+pub fn frame_buffer(
+    name: &'static str,
+    contents: &'static str,
+    elements: Option<&str>,
+) -> Resource {
+    let (kind, usage) = match elements {
+        None => ("uniform_buffer", vec!["uniform", "copy_dst"]),
+        Some(_) => ("storage_buffer", vec!["storage", "copy_dst"]),
+    };
+    Resource {
+        kind,
+        buffer: Some(BufferDesc {
+            elements: elements.map(str::to_owned),
+            usage,
+        }),
+        ..scatter_resource(name, contents)
+    }
+}
+
+/// A 2D texture scatter allocates (one layer, written by one pass and read by a later one
+/// or by the engine).
+pub fn scatter_texture(
+    name: &'static str,
+    contents: &'static str,
+    format: &str,
+    width: &str,
+    height: &str,
+) -> Resource {
+    Resource {
+        texture: Some(texture_2d(format, width, height, "1", STORAGE_AND_SAMPLED)),
+        ..scatter_resource(name, contents)
+    }
+}
+
+/// The engine's inputs every family reads: `depth` (screen-sized) and `shadow_map`.
+pub fn depth_and_shadow_map() -> [Resource; 2] {
+    let input = |name, contents, width, height| Resource {
+        provided_by: "engine",
+        texture: Some(texture_2d(DEPTH_FORMAT, width, height, "1", SAMPLED)),
+        ..scatter_resource(name, contents)
+    };
+    [
+        input(
+            "depth",
+            "linear view depth per pixel (far plane distance for sky)",
+            "screen.width",
+            "screen.height",
+        ),
+        input(
+            "shadow_map",
+            "standard shadow map: normalised linear light depth, 1 where nothing was hit, \
+             texel (0, 0) top-left",
+            "shadow.size",
+            "shadow.size",
+        ),
+    ]
+}
 
 /// A size expression over the [`Plan::parameters`]: an integer, a parameter name
 /// (`screen.width`), or a product `16 * rectified.height`.

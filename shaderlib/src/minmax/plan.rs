@@ -4,53 +4,16 @@
 
 use crate::minmax::{MinmaxVariant, TREE_FORMAT};
 use crate::plan::{
-    BindingSource, BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
-    TextureDesc,
+    DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, TEXTURE_DIMENSION, bind,
+    depth_and_shadow_map, frame_buffer, scatter_texture, screen_and_shadow_parameters,
 };
 use crate::{Kernel, KernelParams};
 
-fn texture(format: &str, width: &str, height: &str, usage: &[&'static str]) -> TextureDesc {
-    TextureDesc {
-        format: format.to_owned(),
-        dimension: "2d",
-        width: width.into(),
-        height: height.into(),
-        layers: "1".into(),
-        mip_levels: 1,
-        usage: usage.to_vec(),
-    }
-}
-
-fn bind(binding: u32, resource: &'static str) -> BindingSource {
-    BindingSource {
-        binding,
-        resource,
-        alternative: None,
-    }
-}
-
-const SAMPLED: &[&str] = &["texture_binding"];
-const STORAGE_AND_SAMPLED: &[&str] = &["storage_binding", "texture_binding"];
-
 /// The resources and passes of a variant, as `runtime/src/minmax.rs` creates them.
 pub fn plan(v: &MinmaxVariant) -> Plan {
-    let dim = "1..=max_texture_dimension_2d";
-    let parameters = vec![
-        Parameter {
-            name: "screen.width",
-            description: "screen width in pixels (depth buffer and output)",
-            constraint: dim.into(),
-        },
-        Parameter {
-            name: "screen.height",
-            description: "screen height in pixels (depth buffer and output)",
-            constraint: dim.into(),
-        },
-        Parameter {
-            name: "shadow.size",
-            description: "side of the engine's square standard shadow map in texels",
-            constraint: dim.into(),
-        },
+    let dim = TEXTURE_DIMENSION;
+    let mut parameters = screen_and_shadow_parameters();
+    parameters.extend([
         Parameter {
             name: "rectified.width",
             description: "light rays per epipolar slice (columns of the rectified map), an \
@@ -70,105 +33,47 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
                           2 rectified.width + log2(rectified.width) + 1)",
             constraint: dim.into(),
         },
-    ];
+    ]);
+    let [depth, shadow_map] = depth_and_shadow_map();
     let resources = vec![
-        Resource {
-            name: "frame",
-            kind: "uniform_buffer",
-            provided_by: "scatter",
-            contents: "the uniform block of the frame (Rust: \
-                       scatter_frame::frame::FrameUniforms from \
-                       scatter_frame::minmax::prepare_minmax), written once per frame",
-            texture: None,
-            buffer: Some(BufferDesc {
-                elements: None,
-                usage: vec!["uniform", "copy_dst"],
-            }),
-            sampler: None,
-        },
-        Resource {
-            name: "slices",
-            kind: "storage_buffer",
-            provided_by: "scatter",
-            contents: "one vec4 per rectified row: delta, theta_ref, theta_lo, theta_hi (Rust: \
-                       SliceParams from prepare_minmax), written once per frame",
-            texture: None,
-            buffer: Some(BufferDesc {
-                elements: Some("rectified.height".into()),
-                usage: vec!["storage", "copy_dst"],
-            }),
-            sampler: None,
-        },
-        Resource {
-            name: "depth",
-            kind: "texture",
-            provided_by: "engine",
-            contents: "linear view depth per pixel (far plane distance for sky)",
-            texture: Some(texture(
-                DEPTH_FORMAT,
-                "screen.width",
-                "screen.height",
-                SAMPLED,
-            )),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "shadow_map",
-            kind: "texture",
-            provided_by: "engine",
-            contents: "standard shadow map: normalised linear light depth, 1 where nothing was \
-                       hit, texel (0, 0) top-left",
-            texture: Some(texture(DEPTH_FORMAT, "shadow.size", "shadow.size", SAMPLED)),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "rectified",
-            kind: "texture",
-            provided_by: "scatter",
-            contents: "rectified shadow map: normalised view angle of the first occluder per \
-                       light ray (written by rectify)",
-            texture: Some(texture(
-                DEPTH_FORMAT,
-                "rectified.width",
-                "rectified.height",
-                STORAGE_AND_SAMPLED,
-            )),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "tree",
-            kind: "texture",
-            provided_by: "scatter",
-            contents: "the 1D min-max tree of every rectified row, levels packed left to \
-                       right (level k: ceil(rectified.width / 2^k) nodes of (min, max)); \
-                       written by minmax_build",
-            texture: Some(texture(
-                TREE_FORMAT,
-                "tree.width",
-                "rectified.height",
-                STORAGE_AND_SAMPLED,
-            )),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "output",
-            kind: "texture",
-            provided_by: "scatter",
-            contents: "in-scattered radiance, rgb, alpha 1 (written by minmax_march); add it \
-                       to the attenuated scene",
-            texture: Some(texture(
-                OUTPUT_FORMAT,
-                "screen.width",
-                "screen.height",
-                STORAGE_AND_SAMPLED,
-            )),
-            buffer: None,
-            sampler: None,
-        },
+        frame_buffer(
+            "frame",
+            "the uniform block of the frame (Rust: scatter_frame::frame::FrameUniforms from \
+             scatter_frame::minmax::prepare_minmax), written once per frame",
+            None,
+        ),
+        frame_buffer(
+            "slices",
+            "one vec4 per rectified row: delta, theta_ref, theta_lo, theta_hi (Rust: \
+             SliceParams from prepare_minmax), written once per frame",
+            Some("rectified.height"),
+        ),
+        depth,
+        shadow_map,
+        scatter_texture(
+            "rectified",
+            "rectified shadow map: normalised view angle of the first occluder per light ray \
+             (written by rectify)",
+            DEPTH_FORMAT,
+            "rectified.width",
+            "rectified.height",
+        ),
+        scatter_texture(
+            "tree",
+            "the 1D min-max tree of every rectified row, levels packed left to right (level \
+             k: ceil(rectified.width / 2^k) nodes of (min, max)); written by minmax_build",
+            TREE_FORMAT,
+            "tree.width",
+            "rectified.height",
+        ),
+        scatter_texture(
+            "output",
+            "in-scattered radiance, rgb, alpha 1 (written by minmax_march); add it to the \
+             attenuated scene",
+            OUTPUT_FORMAT,
+            "screen.width",
+            "screen.height",
+        ),
     ];
     let passes = KernelParams::minmax(*v)
         .iter()

@@ -3,8 +3,9 @@
 //! `scatter-runtime` builds and dispatches from it.
 
 use crate::plan::{
-    Alternative, BindingSource, BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan,
-    Resource, SamplerDesc, TextureDesc,
+    Alternative, BindingSource, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
+    SAMPLED, STORAGE_AND_SAMPLED, SamplerDesc, TEXTURE_DIMENSION, bind, depth_and_shadow_map,
+    frame_buffer, scatter_resource, scatter_texture, screen_and_shadow_parameters, texture_2d,
 };
 use crate::prefiltered::{Rectification, Variant};
 use crate::{Kernel, KernelParams};
@@ -23,27 +24,6 @@ pub const WRAPPING_SLICES: &str = "frame.anti_epipole.w > 0.5";
 /// The engine's rasterised rectified map of projective variants.
 pub const RECTIFIED_RASTER: &str = "rectified_raster";
 
-const SAMPLED: &[&str] = &["texture_binding"];
-const STORAGE_AND_SAMPLED: &[&str] = &["storage_binding", "texture_binding"];
-
-fn texture(
-    format: &str,
-    width: &str,
-    height: &str,
-    layers: String,
-    usage: &[&'static str],
-) -> TextureDesc {
-    TextureDesc {
-        format: format.to_owned(),
-        dimension: "2d",
-        width: width.to_owned(),
-        height: height.to_owned(),
-        layers,
-        mip_levels: 1,
-        usage: usage.to_vec(),
-    }
-}
-
 fn linear_sampler(address_mode_v: &'static str) -> SamplerDesc {
     SamplerDesc {
         mag_filter: "linear",
@@ -55,32 +35,10 @@ fn linear_sampler(address_mode_v: &'static str) -> SamplerDesc {
     }
 }
 
-fn bind(binding: u32, resource: &'static str) -> BindingSource {
-    BindingSource {
-        binding,
-        resource,
-        alternative: None,
-    }
-}
-
 /// The resources and passes of a variant, as `runtime/src/prefiltered.rs` creates them.
 pub fn plan(v: &Variant) -> Plan {
-    let parameters = vec![
-        Parameter {
-            name: "screen.width",
-            description: "screen width in pixels (depth buffer and output)",
-            constraint: "1..=max_texture_dimension_2d".into(),
-        },
-        Parameter {
-            name: "screen.height",
-            description: "screen height in pixels (depth buffer and output)",
-            constraint: "1..=max_texture_dimension_2d".into(),
-        },
-        Parameter {
-            name: "shadow.size",
-            description: "side of the engine's square standard shadow map in texels",
-            constraint: "1..=max_texture_dimension_2d".into(),
-        },
+    let mut parameters = screen_and_shadow_parameters();
+    parameters.extend([
         Parameter {
             name: "rectified.width",
             description: "light rays per epipolar slice (columns of the rectified map), an \
@@ -94,153 +52,90 @@ pub fn plan(v: &Variant) -> Plan {
             name: "rectified.height",
             description: "epipolar slices (rows of the rectified map), an engine choice (the \
                           demo uses 1024)",
-            constraint: "1..=max_texture_dimension_2d".into(),
+            constraint: TEXTURE_DIMENSION.into(),
         },
-    ];
+    ]);
+    let [depth, shadow_map] = depth_and_shadow_map();
     let mut resources = vec![
+        frame_buffer(
+            "frame",
+            "the uniform block of the frame (Rust: \
+             scatter_shaderlib::prefiltered::FrameUniforms from prepare_frame), written once \
+             per frame",
+            None,
+        ),
+        frame_buffer(
+            "slices",
+            "one vec4 per rectified row: delta, theta_ref, theta_lo, theta_hi (Rust: \
+             SliceParams from prepare_frame), written once per frame",
+            Some("rectified.height"),
+        ),
+        depth,
+        shadow_map,
+        scatter_texture(
+            "rectified",
+            "rectified shadow map: normalised view angle of the first occluder per light ray \
+             (written by rectify)",
+            DEPTH_FORMAT,
+            "rectified.width",
+            "rectified.height",
+        ),
         Resource {
-            name: "frame",
-            kind: "uniform_buffer",
-            provided_by: "scatter",
-            contents: "the uniform block of the frame (Rust: \
-                       scatter_shaderlib::prefiltered::FrameUniforms from prepare_frame), \
-                       written once per frame",
-            texture: None,
-            buffer: Some(BufferDesc {
-                elements: None,
-                usage: vec!["uniform", "copy_dst"],
-            }),
-            sampler: None,
-        },
-        Resource {
-            name: "slices",
-            kind: "storage_buffer",
-            provided_by: "scatter",
-            contents: "one vec4 per rectified row: delta, theta_ref, theta_lo, theta_hi (Rust: \
-                       SliceParams from prepare_frame), written once per frame",
-            texture: None,
-            buffer: Some(BufferDesc {
-                elements: Some("rectified.height".into()),
-                usage: vec!["storage", "copy_dst"],
-            }),
-            sampler: None,
-        },
-        Resource {
-            name: "depth",
-            kind: "texture",
-            provided_by: "engine",
-            contents: "linear view depth per pixel (far plane distance for sky)",
-            texture: Some(texture(
-                DEPTH_FORMAT,
-                "screen.width",
-                "screen.height",
-                "1".into(),
-                SAMPLED,
-            )),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "shadow_map",
-            kind: "texture",
-            provided_by: "engine",
-            contents: "standard shadow map: normalised linear light depth, 1 where nothing was \
-                       hit, texel (0, 0) top-left",
-            texture: Some(texture(
-                DEPTH_FORMAT,
-                "shadow.size",
-                "shadow.size",
-                "1".into(),
-                SAMPLED,
-            )),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "rectified",
-            kind: "texture",
-            provided_by: "scatter",
-            contents: "rectified shadow map: normalised view angle of the first occluder per \
-                       light ray (written by rectify)",
-            texture: Some(texture(
-                DEPTH_FORMAT,
-                "rectified.width",
-                "rectified.height",
-                "1".into(),
-                STORAGE_AND_SAMPLED,
-            )),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "filtered",
-            kind: "texture",
-            provided_by: "scatter",
-            contents: "filtered Fourier bases, four per layer, stored as F / 2 + 0.5 (written \
-                       by prefilter); view it as a 2d array even with one layer",
-            texture: Some(texture(
+            texture: Some(texture_2d(
                 v.storage.name(),
                 "rectified.width",
                 "rectified.height",
-                v.layers().to_string(),
+                &v.layers().to_string(),
                 STORAGE_AND_SAMPLED,
             )),
-            buffer: None,
-            sampler: None,
+            ..scatter_resource(
+                "filtered",
+                "filtered Fourier bases, four per layer, stored as F / 2 + 0.5 (written by \
+                 prefilter); view it as a 2d array even with one layer",
+            )
         },
+        scatter_texture(
+            "output",
+            "in-scattered radiance, rgb, alpha 1 (written by scatter); add it to the \
+             attenuated scene",
+            OUTPUT_FORMAT,
+            "screen.width",
+            "screen.height",
+        ),
         Resource {
-            name: "output",
-            kind: "texture",
-            provided_by: "scatter",
-            contents: "in-scattered radiance, rgb, alpha 1 (written by scatter); add it to the \
-                       attenuated scene",
-            texture: Some(texture(
-                OUTPUT_FORMAT,
-                "screen.width",
-                "screen.height",
-                "1".into(),
-                STORAGE_AND_SAMPLED,
-            )),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "filtered_sampler_clamp",
             kind: "sampler",
-            provided_by: "scatter",
-            contents: "bilinear sampler of the filtered bases when the slices do not wrap",
-            texture: None,
-            buffer: None,
             sampler: Some(linear_sampler("clamp_to_edge")),
+            ..scatter_resource(
+                "filtered_sampler_clamp",
+                "bilinear sampler of the filtered bases when the slices do not wrap",
+            )
         },
         Resource {
-            name: "filtered_sampler_wrap",
             kind: "sampler",
-            provided_by: "scatter",
-            contents: "bilinear sampler of the filtered bases when the slices go round the \
-                       full circle (repeat across slices)",
-            texture: None,
-            buffer: None,
             sampler: Some(linear_sampler("repeat")),
+            ..scatter_resource(
+                "filtered_sampler_wrap",
+                "bilinear sampler of the filtered bases when the slices go round the full \
+                 circle (repeat across slices)",
+            )
         },
     ];
     if v.rectification == Rectification::Projective {
         resources.push(Resource {
-            name: RECTIFIED_RASTER,
-            kind: "texture",
             provided_by: "engine",
-            contents: "projective frames only: the rectified depth map the engine rasterises \
-                       with the frame's per-region matrices and viewports (Rust: \
-                       FrameReport::projective from prepare_frame), clip depth in [0, 1]",
-            texture: Some(texture(
+            texture: Some(texture_2d(
                 DEPTH_FORMAT,
                 "rectified.width",
                 "rectified.height",
-                "1".into(),
+                "1",
                 SAMPLED,
             )),
-            buffer: None,
-            sampler: None,
+            ..scatter_resource(
+                RECTIFIED_RASTER,
+                "projective frames only: the rectified depth map the engine rasterises with the \
+                 frame's per-region matrices and viewports (Rust: FrameReport::projective from \
+                 prepare_frame), clip depth in [0, 1]",
+            )
         });
     }
     // One pass per kernel shaderlib lists for the variant, in its order; a kernel this

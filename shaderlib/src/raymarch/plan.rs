@@ -3,116 +3,42 @@
 //! `scatter-runtime` builds and dispatches from it.
 
 use crate::plan::{
-    BindingSource, BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
-    TextureDesc,
+    OUTPUT_FORMAT, PassPlan, Plan, bind, depth_and_shadow_map, frame_buffer, scatter_texture,
+    screen_and_shadow_parameters,
 };
 use crate::raymarch::{PARTIAL_FORMAT, RaymarchVariant};
 use crate::{Kernel, KernelParams};
 
-fn texture(format: &str, usage: &[&'static str]) -> TextureDesc {
-    TextureDesc {
-        format: format.to_owned(),
-        dimension: "2d",
-        width: "screen.width".into(),
-        height: "screen.height".into(),
-        layers: "1".into(),
-        mip_levels: 1,
-        usage: usage.to_vec(),
-    }
-}
-
-fn bind(binding: u32, resource: &'static str) -> BindingSource {
-    BindingSource {
-        binding,
-        resource,
-        alternative: None,
-    }
-}
-
 /// The resources and passes of a variant, as `runtime/src/raymarch.rs` creates them.
 pub fn plan(v: &RaymarchVariant) -> Plan {
-    let parameters = vec![
-        Parameter {
-            name: "screen.width",
-            description: "screen width in pixels (depth buffer and output)",
-            constraint: "1..=max_texture_dimension_2d".into(),
-        },
-        Parameter {
-            name: "screen.height",
-            description: "screen height in pixels (depth buffer and output)",
-            constraint: "1..=max_texture_dimension_2d".into(),
-        },
-        Parameter {
-            name: "shadow.size",
-            description: "side of the engine's square standard shadow map in texels",
-            constraint: "1..=max_texture_dimension_2d".into(),
-        },
-    ];
+    let parameters = screen_and_shadow_parameters();
+    let [depth, shadow_map] = depth_and_shadow_map();
     let mut resources = vec![
-        Resource {
-            name: "march",
-            kind: "uniform_buffer",
-            provided_by: "scatter",
-            contents: "the uniform block of the frame (Rust: \
-                       scatter_frame::raymarch::MarchUniforms from prepare_march), written \
-                       once per frame",
-            texture: None,
-            buffer: Some(BufferDesc {
-                elements: None,
-                usage: vec!["uniform", "copy_dst"],
-            }),
-            sampler: None,
-        },
-        Resource {
-            name: "depth",
-            kind: "texture",
-            provided_by: "engine",
-            contents: "linear view depth per pixel (far plane distance for sky)",
-            texture: Some(texture(DEPTH_FORMAT, &["texture_binding"])),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "shadow_map",
-            kind: "texture",
-            provided_by: "engine",
-            contents: "standard shadow map: normalised linear light depth, 1 where nothing was \
-                       hit, texel (0, 0) top-left",
-            texture: Some(TextureDesc {
-                width: "shadow.size".into(),
-                height: "shadow.size".into(),
-                ..texture(DEPTH_FORMAT, &["texture_binding"])
-            }),
-            buffer: None,
-            sampler: None,
-        },
-        Resource {
-            name: "output",
-            kind: "texture",
-            provided_by: "scatter",
-            contents: "in-scattered radiance, rgb, alpha 1; add it to the attenuated scene",
-            texture: Some(texture(
-                OUTPUT_FORMAT,
-                &["storage_binding", "texture_binding"],
-            )),
-            buffer: None,
-            sampler: None,
-        },
+        frame_buffer(
+            "march",
+            "the uniform block of the frame (Rust: scatter_frame::raymarch::MarchUniforms from \
+             prepare_march), written once per frame",
+            None,
+        ),
+        depth,
+        shadow_map,
+        scatter_texture(
+            "output",
+            "in-scattered radiance, rgb, alpha 1; add it to the attenuated scene",
+            OUTPUT_FORMAT,
+            "screen.width",
+            "screen.height",
+        ),
     ];
     if v.interleaved() {
-        resources.push(Resource {
-            name: "partial",
-            kind: "texture",
-            provided_by: "scatter",
-            contents: "each pixel's partial sum over its interleaving class (written by \
-                       raymarch, read by interleave_sum)",
-            texture: Some(texture(
-                PARTIAL_FORMAT,
-                &["storage_binding", "texture_binding"],
-            )),
-            buffer: None,
-            sampler: None,
-        });
+        resources.push(scatter_texture(
+            "partial",
+            "each pixel's partial sum over its interleaving class (written by raymarch, read \
+             by interleave_sum)",
+            PARTIAL_FORMAT,
+            "screen.width",
+            "screen.height",
+        ));
     }
     let passes = KernelParams::raymarch(*v)
         .iter()
