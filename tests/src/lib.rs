@@ -4,13 +4,28 @@
 //! `SCATTER_GPU` / `CI` policy says (see [`scatter_runtime::GpuPolicy`]): locally a missing
 //! adapter skips GPU trials, under CI it fails them. Trials are named
 //! `family::kernel::variant::case` (e.g. `common::row_prefix::mean::37x5x2`) in every message.
+//!
+//! [`run_trials`] runs a family's conformance as libtest trials (libtest-mimic), one per
+//! variant x scene x pose, named `family::variant::scene::pose`: `cargo test -p
+//! scatter-conformance -- minmax::` runs one family, `-- --list` lists the trials, and a
+//! failure names its trial. Expected failures are data: a trial listed in
+//! `expected_failures` must fail, and the run fails when it starts passing or when the list
+//! names a trial that does not exist.
 
 use std::io::Write as _;
+use std::process::ExitCode;
 use std::sync::OnceLock;
 
+use libtest_mimic::{Arguments, Failed, Trial};
+
+use scatter_reference::buffers::{GBuffer, ShadowMap};
+use scatter_reference::bvh::Bvh;
 use scatter_reference::kernels::row_prefix as row_prefix_mirror;
-use scatter_runtime::{ArraySize, Context, GpuPolicy};
+use scatter_reference::scene::Scene;
+use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
+use scatter_runtime::{ArraySize, Context, FrameInput, GpuPolicy, MarchInput};
 use scatter_shaderlib::RowPrefixMode;
+use scatter_shaderlib::prefiltered::{FrameSettings, LightKind};
 
 /// The shared GPU context, or `None` when GPU trials must be skipped.
 ///
@@ -49,6 +64,135 @@ pub fn gpu() -> Option<&'static Context> {
         eprintln!("scatter-conformance: GPU trial skipped (no GPU context)");
     }
     ctx.as_ref()
+}
+
+/// The suite scene the conformance trials use for a light type: `columns` for the sun,
+/// `spot_grate` for the spot lamp.
+pub const fn scene_for(light: LightKind) -> SceneName {
+    match light {
+        LightKind::Directional => SceneName::Columns,
+        LightKind::Spot => SceneName::SpotGrate,
+    }
+}
+
+/// A suite scene at one pose with its ray-cast depth buffer and standard shadow map: the
+/// inputs every family's trial takes.
+pub struct Fixture {
+    /// The scene's name.
+    pub name: SceneName,
+    /// The pose.
+    pub pose: Pose,
+    /// The scene (default medium).
+    pub scene: Scene,
+    /// Its BVH (the projective stand-in ray-casts it).
+    pub bvh: Bvh,
+    /// Depth buffer (and the rest of the G-buffer).
+    pub gbuf: GBuffer,
+    /// Standard shadow map.
+    pub shadow_map: ShadowMap,
+}
+
+impl Fixture {
+    /// Builds the scene at `screen` pixels with a `shadow_map_size`^2 shadow map.
+    ///
+    /// # Panics
+    ///
+    /// When the suite's shadow map cannot be built (a defect of the suite).
+    pub fn new(name: SceneName, pose: Pose, screen: [u32; 2], shadow_map_size: u32) -> Self {
+        let scene = scene(name, pose, MediumPreset::Default, screen[0], screen[1]);
+        let bvh = Bvh::build(&scene.geometry);
+        let gbuf = GBuffer::cast(&scene, &bvh);
+        let shadow_map = ShadowMap::build(&scene, &bvh, shadow_map_size)
+            .unwrap_or_else(|e| panic!("shadow map of {name}/{pose}: {e}"));
+        Self {
+            name,
+            pose,
+            scene,
+            bvh,
+            gbuf,
+            shadow_map,
+        }
+    }
+
+    /// `scene::pose`, the tail of trial names.
+    pub fn trial_tail(&self) -> String {
+        format!("{}::{}", self.name, self.pose)
+    }
+
+    /// The frame input of the epipolar families with `settings`.
+    pub fn frame_input(&self, settings: FrameSettings) -> FrameInput {
+        FrameInput {
+            camera: self.scene.camera_desc(),
+            light: self.scene.light_desc(),
+            medium: self.scene.medium_desc(),
+            shadow_map: self.shadow_map.desc(),
+            settings,
+        }
+    }
+
+    /// The frame input of the raymarch family.
+    pub fn march_input(&self) -> MarchInput {
+        MarchInput {
+            camera: self.scene.camera_desc(),
+            light: self.scene.light_desc(),
+            medium: self.scene.medium_desc(),
+            shadow_map: self.shadow_map.desc(),
+        }
+    }
+}
+
+/// One conformance check: `Err` carries the failure's message (naming the trial).
+pub type Check = Box<dyn FnOnce() -> Result<(), String> + Send>;
+
+/// Runs `trials` (name, check) as libtest trials with the command line's filters and
+/// options, in parallel. `expected_failures` lists `(trial name, reason)`: such a trial
+/// passes when its check fails, and fails when the check passes (remove it from the list)
+/// or when no trial has its name.
+pub fn run_trials(trials: Vec<(String, Check)>, expected_failures: &[(&str, &str)]) -> ExitCode {
+    run_trials_with(&Arguments::from_args(), trials, expected_failures).exit_code()
+}
+
+/// [`run_trials`] with explicit arguments, returning libtest-mimic's conclusion.
+pub fn run_trials_with(
+    args: &Arguments,
+    trials: Vec<(String, Check)>,
+    expected_failures: &[(&str, &str)],
+) -> libtest_mimic::Conclusion {
+    let mut stale: Vec<Trial> = expected_failures
+        .iter()
+        .filter(|(n, _)| !trials.iter().any(|(t, _)| t == n))
+        .map(|&(n, why)| {
+            let msg =
+                format!("expected failure `{n}` ({why}) names no trial: remove it from the list");
+            Trial::test(format!("expected_failures::{n}"), move || {
+                Err(Failed::from(msg))
+            })
+        })
+        .collect();
+    let mut out: Vec<Trial> = trials
+        .into_iter()
+        .map(|(name, check)| {
+            let expected = expected_failures
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, why)| (*why).to_owned());
+            let trial_name = name.clone();
+            Trial::test(trial_name, move || match (check(), expected) {
+                (Ok(()), None) => Ok(()),
+                (Err(e), None) => Err(Failed::from(e)),
+                (Err(e), Some(why)) => {
+                    loud(&format!("expected failure {name} ({why}): {e}"));
+                    Ok(())
+                }
+                (Ok(()), Some(why)) => Err(Failed::from(format!(
+                    "{name} is listed as an expected failure ({why}) but passes: remove it \
+                     from the list"
+                ))),
+            })
+        })
+        .collect();
+    out.append(&mut stale);
+    libtest_mimic::run(args, out)
 }
 
 /// Writes a line straight to the process's stderr, past libtest's output capture (which
@@ -108,6 +252,41 @@ pub fn ulp_distance(a: f32, b: f32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn check(ok: bool) -> Check {
+        Box::new(move || {
+            if ok {
+                Ok(())
+            } else {
+                Err("it failed".to_owned())
+            }
+        })
+    }
+
+    #[test]
+    fn expected_failures_are_data() {
+        let args = Arguments {
+            test_threads: Some(1),
+            quiet: true,
+            ..Arguments::default()
+        };
+        let trials = || {
+            vec![
+                ("family::passes".to_owned(), check(true)),
+                ("family::fails".to_owned(), check(false)),
+            ]
+        };
+        // A failing trial fails the run; listed as expected, it passes.
+        let plain = run_trials_with(&args, trials(), &[]);
+        assert_eq!((plain.num_passed, plain.num_failed), (1, 1));
+        let listed = run_trials_with(&args, trials(), &[("family::fails", "known")]);
+        assert_eq!((listed.num_passed, listed.num_failed), (2, 0));
+        // A listed trial that passes fails, and so does an entry that names no trial.
+        let fixed = run_trials_with(&args, trials(), &[("family::passes", "was known")]);
+        assert_eq!((fixed.num_passed, fixed.num_failed), (0, 2));
+        let stale = run_trials_with(&args, vec![], &[("family::gone", "renamed")]);
+        assert_eq!((stale.num_passed, stale.num_failed), (0, 1));
+    }
 
     #[test]
     fn ulp_distance_counts_representable_steps() {

@@ -5,7 +5,9 @@
 //! `ordinary` and `epipole_on_screen` poses (the latter marches pixels near the epipole), at
 //! 67x37 pixels with a 100x60 rectified map (neither a power of two nor a multiple of the
 //! workgroups) and a 128^2 shadow map. Trials are named
-//! `minmax::<variant id>::<scene>::<pose>`.
+//! `minmax::<variant id>::<scene>::<pose>` (libtest trials: `cargo test -p scatter-conformance
+//! -- minmax::` runs this family, `-- --list` lists them); `minmax::errors` checks the error
+//! paths.
 //!
 //! The mirror's `minmax_build` and `minmax_march` run on the GPU's rectified map, so that
 //! each kernel is compared on the same input. Tolerances: the trees bit for bit (min and max
@@ -15,16 +17,14 @@
 //! of a row boundary, where a few ulps of `acos`/`atan2` legitimately flip one texel or the
 //! slice. `rectify` (GPU against its mirror) is reported.
 
+use std::process::ExitCode;
 use std::sync::OnceLock;
 
-use scatter_conformance::gpu;
-use scatter_reference::buffers::{GBuffer, ShadowMap};
-use scatter_reference::bvh::Bvh;
+use scatter_conformance::{Check, Fixture, gpu, run_trials, scene_for};
 use scatter_reference::kernels::common_prefiltered::Tex;
 use scatter_reference::kernels::minmax_march::{MarchInputs, Pixel, pixel_ray};
 use scatter_reference::kernels::{minmax_from_rectified, rectify};
-use scatter_reference::scene::Scene;
-use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
+use scatter_reference::suite::Pose;
 use scatter_runtime::{FrameInput, Minmax, RuntimeError, run_minmax_once};
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions};
@@ -34,60 +34,44 @@ const RECTIFIED: [u32; 2] = [100, 60];
 const SHADOW_MAP: u32 = 128;
 const REL_TOL: f32 = 1e-4;
 
-struct Fixture {
-    name: SceneName,
-    pose: Pose,
-    scene: Scene,
-    gbuf: GBuffer,
-    shadow_map: ShadowMap,
+/// The (light, scene, pose) of every trial: both lights (the grid), at the `ordinary` and
+/// `epipole_on_screen` poses.
+const CASES: [(LightKind, Pose); 4] = [
+    (LightKind::Directional, Pose::Ordinary),
+    (LightKind::Directional, Pose::EpipoleOnScreen),
+    (LightKind::Spot, Pose::Ordinary),
+    (LightKind::Spot, Pose::EpipoleOnScreen),
+];
+
+/// The fixture of case `i` of [`CASES`] (all built once, on first use).
+fn fixture(i: usize) -> &'static Fixture {
+    static ALL: OnceLock<Vec<Fixture>> = OnceLock::new();
+    &ALL.get_or_init(|| {
+        CASES
+            .iter()
+            .map(|&(light, pose)| Fixture::new(scene_for(light), pose, SCREEN, SHADOW_MAP))
+            .collect()
+    })[i]
 }
 
-impl Fixture {
-    fn new(name: SceneName, pose: Pose) -> Fixture {
-        let scene = scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
-        let bvh = Bvh::build(&scene.geometry);
-        let gbuf = GBuffer::cast(&scene, &bvh);
-        let shadow_map = ShadowMap::build(&scene, &bvh, SHADOW_MAP)
-            .unwrap_or_else(|e| panic!("shadow map of {name}: {e}"));
-        Fixture {
-            name,
-            pose,
-            scene,
-            gbuf,
-            shadow_map,
-        }
+fn light_of(f: &Fixture) -> LightKind {
+    if f.name == scene_for(LightKind::Spot) {
+        LightKind::Spot
+    } else {
+        LightKind::Directional
     }
+}
 
-    fn all() -> &'static [Fixture] {
-        static ALL: OnceLock<Vec<Fixture>> = OnceLock::new();
-        ALL.get_or_init(|| {
-            let mut out = Vec::new();
-            for name in [SceneName::Columns, SceneName::SpotGrate] {
-                for pose in [Pose::Ordinary, Pose::EpipoleOnScreen] {
-                    out.push(Fixture::new(name, pose));
-                }
-            }
-            out
-        })
-    }
+fn input(f: &Fixture) -> FrameInput {
+    f.frame_input(FrameSettings::for_screen(SCREEN[0], SCREEN[1]))
+}
 
-    fn light(&self) -> LightKind {
-        if self.name == SceneName::SpotGrate {
-            LightKind::Spot
-        } else {
-            LightKind::Directional
-        }
-    }
-
-    fn input(&self) -> FrameInput {
-        FrameInput {
-            camera: self.scene.camera_desc(),
-            light: self.scene.light_desc(),
-            medium: self.scene.medium_desc(),
-            shadow_map: self.shadow_map.desc(),
-            settings: FrameSettings::for_screen(SCREEN[0], SCREEN[1]),
-        }
-    }
+fn trial_name(light: LightKind, pose: Pose) -> String {
+    format!(
+        "minmax::{}::{}::{pose}",
+        MinmaxVariant { light },
+        scene_for(light)
+    )
 }
 
 fn res() -> Resolutions {
@@ -107,13 +91,13 @@ fn f16_ulp(v: f32) -> f32 {
 }
 
 fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> {
-    let variant = MinmaxVariant { light: f.light() };
-    let name = format!("minmax::{variant}::{}::{}", f.name, f.pose);
+    let variant = MinmaxVariant { light: light_of(f) };
+    let name = trial_name(variant.light, f.pose);
     let gpu = run_minmax_once(
         ctx,
         &variant,
         res(),
-        &f.input(),
+        &input(f),
         &f.gbuf.view_depth,
         &f.shadow_map.depth,
     )
@@ -274,36 +258,28 @@ fn is_tie(inp: &MarchInputs, rectified: &Tex, id: [u32; 3], spot: bool) -> bool 
     }
 }
 
-#[test]
-fn every_variant_matches_the_mirror() {
-    let Some(ctx) = gpu() else { return };
-    let filter = std::env::var("SCATTER_TRIALS").unwrap_or_default();
-    let mut failures = Vec::new();
-    let mut count = 0;
-    let start = std::time::Instant::now();
-    for f in Fixture::all() {
-        let id = format!("minmax::{}::{}::{}", f.light(), f.name, f.pose);
-        if !id.contains(filter.as_str()) {
-            continue;
-        }
-        count += 1;
-        match trial(ctx, f) {
-            Ok(line) => eprintln!("ok   {line}"),
-            Err(e) => {
-                eprintln!("FAIL {e}");
-                failures.push(e);
-            }
-        }
-    }
-    eprintln!(
-        "minmax: {count} trials in {:.1} s, {} failed",
-        start.elapsed().as_secs_f64(),
-        failures.len()
-    );
-    assert!(failures.is_empty(), "{failures:#?}");
+fn main() -> ExitCode {
+    let mut trials: Vec<(String, Check)> = CASES
+        .iter()
+        .enumerate()
+        .map(|(i, &(light, pose))| {
+            let check: Check = Box::new(move || {
+                let Some(ctx) = gpu() else { return Ok(()) };
+                trial(ctx, fixture(i)).map(drop)
+            });
+            (trial_name(light, pose), check)
+        })
+        .collect();
+    trials.push((
+        "minmax::errors".to_owned(),
+        Box::new(|| {
+            bad_input_is_an_error();
+            Ok(())
+        }),
+    ));
+    run_trials(trials, &[])
 }
 
-#[test]
 fn bad_input_is_an_error() {
     let Some(ctx) = gpu() else { return };
     let v = MinmaxVariant::default();
@@ -335,9 +311,9 @@ fn bad_input_is_an_error() {
         "{err}"
     );
     eprintln!("ok   minmax::errors::tree_width: {err}");
-    let f = &Fixture::all()[0];
+    let f = fixture(0);
     let mut pass = Minmax::new(ctx, &v, res(), SHADOW_MAP / 2).unwrap_or_else(|e| panic!("{e}"));
-    let err = pass.prepare(ctx, &f.input()).expect_err("shadow map size");
+    let err = pass.prepare(ctx, &input(f)).expect_err("shadow map size");
     assert!(matches!(err, RuntimeError::ShadowMapSize { .. }), "{err}");
     eprintln!("ok   minmax::errors::shadow_map_size: {err}");
     let mut pass = Minmax::new(
@@ -349,10 +325,10 @@ fn bad_input_is_an_error() {
         SHADOW_MAP,
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    let err = pass.prepare(ctx, &f.input()).expect_err("light mismatch");
+    let err = pass.prepare(ctx, &input(f)).expect_err("light mismatch");
     assert!(err.to_string().contains("light"), "{err}");
     eprintln!("ok   minmax::errors::light_mismatch: {err}");
-    let mut input = f.input();
+    let mut input = input(f);
     input.camera.forward.y = f64::NAN;
     let mut pass = Minmax::new(ctx, &v, res(), SHADOW_MAP).unwrap_or_else(|e| panic!("{e}"));
     let err = pass.prepare(ctx, &input).expect_err("NaN camera");

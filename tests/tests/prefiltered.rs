@@ -24,17 +24,17 @@
 //!   step is up to 2^-10 ~ 1e-3 of it). The summary lines print the raw ratio
 //!   `max |diff| / max radiance` without that allowance.
 //!
-//! `SCATTER_TRIALS=<substring>` runs only the trials whose name contains it.
+//! Each variant is one libtest trial (`cargo test -p scatter-conformance --test prefiltered
+//! -- m32-t8-r3` runs those whose name contains the filter, `-- --list` lists the 2016);
+//! `prefiltered::errors::*` check the error paths.
 
+use std::process::ExitCode;
 use std::sync::OnceLock;
 use std::time::Instant;
 
-use scatter_conformance::gpu;
-use scatter_reference::buffers::{GBuffer, ShadowMap};
-use scatter_reference::bvh::Bvh;
+use scatter_conformance::{Check, Fixture, gpu, run_trials};
 use scatter_reference::kernels::{PrefilteredRun, run_prefiltered};
-use scatter_reference::scene::Scene;
-use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
+use scatter_reference::suite::{Pose, SceneName};
 use scatter_runtime::wgpu::TextureView;
 use scatter_runtime::{Context, CpuInputs, FrameInput, Inputs, RuntimeError, Scatter, run_once};
 use scatter_shaderlib::prefiltered::{
@@ -47,89 +47,55 @@ const SHADOW_MAP: u32 = 128;
 
 const RECTIFIED_TOL: f32 = 1e-4;
 
-/// A suite scene with its depth buffer and shadow map, built once.
-struct Fixture {
-    name: SceneName,
-    pose: Pose,
-    scene: Scene,
-    bvh: Bvh,
-    gbuf: GBuffer,
-    shadow_map: ShadowMap,
-}
-
-impl Fixture {
-    /// Directional variants run on `columns/ordinary`; spot variants on
-    /// `spot_grate/ordinary`, except projective ones on `spot_grate/grazing` (the ordinary
-    /// pose's slices fan out too wide for a projective map: it falls back to epipolar).
-    fn get(light: LightKind, rectification: Rectification) -> &'static Fixture {
-        static COLUMNS: OnceLock<Fixture> = OnceLock::new();
-        static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
-        static SPOT_GRATE_GRAZING: OnceLock<Fixture> = OnceLock::new();
-        let (cell, name, pose) = match (light, rectification) {
-            (LightKind::Directional, _) => (&COLUMNS, SceneName::Columns, Pose::Ordinary),
-            (LightKind::Spot, Rectification::Epipolar) => {
-                (&SPOT_GRATE, SceneName::SpotGrate, Pose::Ordinary)
-            }
-            (LightKind::Spot, Rectification::Projective) => {
-                (&SPOT_GRATE_GRAZING, SceneName::SpotGrate, Pose::Grazing)
-            }
-        };
-        cell.get_or_init(|| {
-            let scene = scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
-            let bvh = Bvh::build(&scene.geometry);
-            let gbuf = GBuffer::cast(&scene, &bvh);
-            let shadow_map = ShadowMap::build(&scene, &bvh, SHADOW_MAP)
-                .unwrap_or_else(|e| panic!("shadow map of {name}: {e}"));
-            Fixture {
-                name,
-                pose,
-                scene,
-                bvh,
-                gbuf,
-                shadow_map,
-            }
-        })
-    }
-
-    fn for_light(light: LightKind) -> &'static Fixture {
-        Fixture::get(light, Rectification::Epipolar)
-    }
-
-    fn frame_input(&self) -> FrameInput {
-        FrameInput {
-            camera: self.scene.camera_desc(),
-            light: self.scene.light_desc(),
-            medium: self.scene.medium_desc(),
-            shadow_map: self.shadow_map.desc(),
-            settings: FrameSettings::default(),
-        }
-    }
-
-    fn cpu_inputs(&self) -> CpuInputs {
-        CpuInputs {
-            frame: self.frame_input(),
-            depth: self.gbuf.view_depth.clone(),
-            shadow_map: self.shadow_map.depth.clone(),
-            rectified: None,
-            pass_wall_frames: 0,
-        }
-    }
-
-    fn resolutions(&self) -> Resolutions {
-        Resolutions {
-            screen: [self.gbuf.width, self.gbuf.height],
-            rectified: RECTIFIED,
-        }
+/// The scene and pose of a light and rectification (see [`Fixture::get`]).
+const fn case(light: LightKind, rectification: Rectification) -> (SceneName, Pose) {
+    match (light, rectification) {
+        (LightKind::Directional, _) => (SceneName::Columns, Pose::Ordinary),
+        (LightKind::Spot, Rectification::Epipolar) => (SceneName::SpotGrate, Pose::Ordinary),
+        (LightKind::Spot, Rectification::Projective) => (SceneName::SpotGrate, Pose::Grazing),
     }
 }
 
-/// Every variant of the design card for one light type, regions 1..=4 as the issue's
-/// conformance grid asks.
-fn variants(light: LightKind) -> Vec<Variant> {
-    Variant::grid(1..=4)
-        .into_iter()
-        .filter(|v| v.light == light)
-        .collect()
+/// The fixture of a light and rectification (built once, on first use): directional
+/// variants run on `columns/ordinary`; spot variants on `spot_grate/ordinary`, except
+/// projective ones on `spot_grate/grazing` (the ordinary pose's slices fan out too wide for
+/// a projective map: it falls back to epipolar).
+fn fixture(light: LightKind, rectification: Rectification) -> &'static Fixture {
+    static COLUMNS: OnceLock<Fixture> = OnceLock::new();
+    static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
+    static SPOT_GRATE_GRAZING: OnceLock<Fixture> = OnceLock::new();
+    let cell = match (light, rectification) {
+        (LightKind::Directional, _) => &COLUMNS,
+        (LightKind::Spot, Rectification::Epipolar) => &SPOT_GRATE,
+        (LightKind::Spot, Rectification::Projective) => &SPOT_GRATE_GRAZING,
+    };
+    let (name, pose) = case(light, rectification);
+    cell.get_or_init(|| Fixture::new(name, pose, SCREEN, SHADOW_MAP))
+}
+
+fn for_light(light: LightKind) -> &'static Fixture {
+    fixture(light, Rectification::Epipolar)
+}
+
+fn frame_input(f: &Fixture) -> FrameInput {
+    f.frame_input(FrameSettings::default())
+}
+
+fn cpu_inputs(f: &Fixture) -> CpuInputs {
+    CpuInputs {
+        frame: frame_input(f),
+        depth: f.gbuf.view_depth.clone(),
+        shadow_map: f.shadow_map.depth.clone(),
+        rectified: None,
+        pass_wall_frames: 0,
+    }
+}
+
+fn resolutions(f: &Fixture) -> Resolutions {
+    Resolutions {
+        screen: [f.gbuf.width, f.gbuf.height],
+        rectified: RECTIFIED,
+    }
 }
 
 /// Largest deviations of one trial (and where the worst one was).
@@ -174,7 +140,6 @@ struct TrialResult {
     rectified: Worst,
     filtered: Worst,
     output: Worst,
-    max_radiance: f32,
     line: String,
 }
 
@@ -201,17 +166,13 @@ fn f16_ulp(v: f32) -> f32 {
     2f32.powi(a.log2().floor() as i32 - 10)
 }
 
-fn trial_name(variant: &Variant, fixture: &Fixture) -> String {
-    format!(
-        "prefiltered::{}::{}::{}",
-        variant.id(),
-        fixture.name,
-        fixture.pose
-    )
+fn trial_name(variant: &Variant) -> String {
+    let (name, pose) = case(variant.light, variant.rectification);
+    format!("prefiltered::{}::{name}::{pose}", variant.id())
 }
 
 fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<TrialResult, String> {
-    let trial = trial_name(variant, fixture);
+    let trial = trial_name(variant);
     let start = Instant::now();
     let cpu: PrefilteredRun = run_prefiltered(
         variant,
@@ -229,12 +190,12 @@ fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<Tria
             variant.rectification, cpu.frame.report.rectification, cpu.frame.report.fallback
         ));
     }
-    let mut inputs = fixture.cpu_inputs();
+    let mut inputs = cpu_inputs(fixture);
     if cpu.frame.report.projective.is_some() {
         inputs.rectified = Some(cpu.rectified.data.clone());
     }
     let gpu_start = Instant::now();
-    let gpu = run_once(ctx, variant, fixture.resolutions(), &inputs)
+    let gpu = run_once(ctx, variant, resolutions(fixture), &inputs)
         .map_err(|e| format!("{trial}: GPU run failed: {e}"))?;
     let gpu_wall = gpu_start.elapsed();
     if gpu.frame != cpu.frame {
@@ -304,7 +265,6 @@ fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<Tria
         rectified,
         filtered,
         output,
-        max_radiance,
         line,
     })
 }
@@ -322,114 +282,69 @@ fn describe(what: &str, w: &Worst, layout: impl Fn(usize) -> String) -> String {
     )
 }
 
-fn conformance(light: LightKind, rectification: Rectification) {
-    let Some(ctx) = gpu() else { return };
-    let fixture = Fixture::get(light, rectification);
-    let filter = std::env::var("SCATTER_TRIALS").unwrap_or_default();
-    let all: Vec<Variant> = variants(light)
-        .into_iter()
-        .filter(|v| v.rectification == rectification)
-        .collect();
-    let chosen: Vec<_> = all
-        .iter()
-        .filter(|v| trial_name(v, fixture).contains(filter.as_str()))
-        .collect();
-    let start = Instant::now();
-    let mut failures = Vec::new();
-    // Largest output deviation relative to the max radiance, and largest filtered
-    // deviation, per storage format.
-    let mut worst_by_storage: Vec<(Storage, f32, f32, f32)> =
-        Storage::ALL.iter().map(|&s| (s, 0.0, 0.0, 0.0)).collect();
+/// One variant's trial: the GPU against the mirror on its fixture, every output within its
+/// tolerance.
+fn conformance(variant: &Variant) -> Result<(), String> {
+    let Some(ctx) = gpu() else { return Ok(()) };
+    let fixture = fixture(variant.light, variant.rectification);
     let [wr, hr] = RECTIFIED;
     let [w, _] = SCREEN;
-    for variant in &chosen {
-        match run_trial(ctx, variant, fixture) {
-            Err(e) => {
-                eprintln!("FAIL {e}");
-                failures.push(e);
-            }
-            Ok(r) => {
-                if let Some(entry) = worst_by_storage.iter_mut().find(|e| e.0 == variant.storage) {
-                    entry.1 = entry.1.max(r.rectified.diff);
-                    entry.2 = entry.2.max(r.filtered.diff);
-                    entry.3 = entry
-                        .3
-                        .max(r.output.diff / r.max_radiance.max(f32::MIN_POSITIVE));
-                }
-                let mut problems = Vec::new();
-                if !r.rectified.ok() {
-                    problems.push(describe("rectify", &r.rectified, |i| {
-                        format!("(x {}, row {})", i as u32 % wr, i as u32 / wr)
-                    }));
-                }
-                if !r.filtered.ok() {
-                    problems.push(describe("prefilter", &r.filtered, |i| {
-                        let texel = (i / 4) as u32;
-                        format!(
-                            "(x {}, row {}, layer {}) channel {}",
-                            texel % wr,
-                            (texel / wr) % hr,
-                            texel / (wr * hr),
-                            i % 4
-                        )
-                    }));
-                }
-                if !r.output.ok() {
-                    problems.push(describe("scatter", &r.output, |i| {
-                        let pixel = (i / 3) as u32;
-                        format!("pixel ({}, {}) channel {}", pixel % w, pixel / w, i % 3)
-                    }));
-                }
-                if problems.is_empty() {
-                    eprintln!("ok   {}", r.line);
-                } else {
-                    let msg = format!("{}\n    {}", r.line, problems.join("\n    "));
-                    eprintln!("FAIL {msg}");
-                    failures.push(msg);
-                }
-            }
-        }
+    let r = run_trial(ctx, variant, fixture)?;
+    let mut problems = Vec::new();
+    if !r.rectified.ok() {
+        problems.push(describe("rectify", &r.rectified, |i| {
+            format!("(x {}, row {})", i as u32 % wr, i as u32 / wr)
+        }));
     }
-    let total = start.elapsed();
-    eprintln!(
-        "prefiltered::*-{light}-*-{rectification}: {} trials in {:.1} s ({:.0} ms per trial), {} failed",
-        chosen.len(),
-        total.as_secs_f64(),
-        total.as_secs_f64() * 1e3 / chosen.len().max(1) as f64,
-        failures.len()
-    );
-    for (storage, rect, filt, out) in &worst_by_storage {
-        eprintln!(
-            "prefiltered::*-{light}-{storage}-{rectification}: max rectified |diff| {rect:.3e}, max filtered |diff| {filt:.3e}, max output |diff| / max radiance {out:.3e}"
-        );
+    if !r.filtered.ok() {
+        problems.push(describe("prefilter", &r.filtered, |i| {
+            let texel = (i / 4) as u32;
+            format!(
+                "(x {}, row {}, layer {}) channel {}",
+                texel % wr,
+                (texel / wr) % hr,
+                texel / (wr * hr),
+                i % 4
+            )
+        }));
     }
-    assert!(
-        failures.is_empty(),
-        "{} of {} trial(s) failed:\n{}",
-        failures.len(),
-        chosen.len(),
-        failures.join("\n")
-    );
+    if !r.output.ok() {
+        problems.push(describe("scatter", &r.output, |i| {
+            let pixel = (i / 3) as u32;
+            format!("pixel ({}, {}) channel {}", pixel % w, pixel / w, i % 3)
+        }));
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(format!("{}\n    {}", r.line, problems.join("\n    ")))
+    }
 }
 
-#[test]
-fn directional_epipolar_variants_match_mirror() {
-    conformance(LightKind::Directional, Rectification::Epipolar);
-}
-
-#[test]
-fn spot_epipolar_variants_match_mirror() {
-    conformance(LightKind::Spot, Rectification::Epipolar);
-}
-
-#[test]
-fn directional_projective_variants_match_mirror() {
-    conformance(LightKind::Directional, Rectification::Projective);
-}
-
-#[test]
-fn spot_projective_variants_match_mirror() {
-    conformance(LightKind::Spot, Rectification::Projective);
+fn main() -> ExitCode {
+    let mut trials: Vec<(String, Check)> = Variant::grid(1..=4)
+        .into_iter()
+        .map(|variant| {
+            let check: Check = Box::new(move || conformance(&variant));
+            (trial_name(&variant), check)
+        })
+        .collect();
+    let errors: [(&str, fn()); 4] = [
+        ("wrong_shadow_map_size", wrong_shadow_map_size_is_an_error),
+        ("zero_resolution", zero_resolution_is_an_error),
+        ("invalid_variant", invalid_variant_names_the_knob),
+        ("bad_frames", bad_frames_are_errors_not_panics),
+    ];
+    for (name, f) in errors {
+        trials.push((
+            format!("prefiltered::errors::{name}"),
+            Box::new(move || {
+                f();
+                Ok(())
+            }),
+        ));
+    }
+    run_trials(trials, &[])
 }
 
 /// The variant the error tests start from.
@@ -444,14 +359,13 @@ fn columns_res() -> Resolutions {
     }
 }
 
-#[test]
 fn wrong_shadow_map_size_is_an_error() {
     let Some(ctx) = gpu() else { return };
-    let fixture = Fixture::for_light(LightKind::Directional);
+    let fixture = for_light(LightKind::Directional);
     let mut pass = Scatter::new(ctx, &base_variant(), columns_res(), 2 * SHADOW_MAP)
         .unwrap_or_else(|e| panic!("{e}"));
     let err = pass
-        .prepare(ctx, &fixture.frame_input())
+        .prepare(ctx, &frame_input(fixture))
         .expect_err("a 128 shadow map on a pass made for 256");
     let text = err.to_string();
     assert!(
@@ -469,7 +383,7 @@ fn wrong_shadow_map_size_is_an_error() {
     // A shadow-map view of the wrong size at encode time.
     let mut pass = Scatter::new(ctx, &base_variant(), columns_res(), SHADOW_MAP)
         .unwrap_or_else(|e| panic!("{e}"));
-    pass.prepare(ctx, &fixture.frame_input())
+    pass.prepare(ctx, &frame_input(fixture))
         .unwrap_or_else(|e| panic!("{e}"));
     let texture = |size: [u32; 2], format| {
         ctx.device()
@@ -532,7 +446,6 @@ fn wrong_shadow_map_size_is_an_error() {
     ctx.queue().submit([encoder.finish()]);
 }
 
-#[test]
 fn zero_resolution_is_an_error() {
     let Some(ctx) = gpu() else { return };
     let cases = [
@@ -586,7 +499,6 @@ fn zero_resolution_is_an_error() {
     eprintln!("ok   prefiltered::errors::too_few_columns: {err}");
 }
 
-#[test]
 fn invalid_variant_names_the_knob() {
     let Some(ctx) = gpu() else { return };
     let cases = [
@@ -628,10 +540,9 @@ fn invalid_variant_names_the_knob() {
     }
 }
 
-#[test]
 fn bad_frames_are_errors_not_panics() {
     let Some(ctx) = gpu() else { return };
-    let fixture = Fixture::for_light(LightKind::Directional);
+    let fixture = for_light(LightKind::Directional);
     let mut pass = Scatter::new(ctx, &base_variant(), columns_res(), SHADOW_MAP)
         .unwrap_or_else(|e| panic!("{e}"));
 
@@ -646,7 +557,7 @@ fn bad_frames_are_errors_not_panics() {
     assert!(matches!(err, RuntimeError::NotPrepared { .. }), "{err}");
     eprintln!("ok   prefiltered::errors::not_prepared: {err}");
 
-    let mut nan = fixture.frame_input();
+    let mut nan = frame_input(fixture);
     nan.camera.position.x = f64::NAN;
     let err = pass.prepare(ctx, &nan).expect_err("NaN camera");
     assert!(
@@ -655,8 +566,8 @@ fn bad_frames_are_errors_not_panics() {
     );
     eprintln!("ok   prefiltered::errors::nan_camera: {err}");
 
-    let spot = Fixture::for_light(LightKind::Spot).frame_input();
-    let mut wrong_light = fixture.frame_input();
+    let spot = frame_input(for_light(LightKind::Spot));
+    let mut wrong_light = frame_input(fixture);
     wrong_light.light = spot.light;
     let err = pass
         .prepare(ctx, &wrong_light)
@@ -665,7 +576,7 @@ fn bad_frames_are_errors_not_panics() {
     eprintln!("ok   prefiltered::errors::light_mismatch: {err}");
 
     // A short depth buffer in the test helper.
-    let mut inputs = fixture.cpu_inputs();
+    let mut inputs = cpu_inputs(fixture);
     inputs.depth.pop();
     let err = run_once(ctx, &base_variant(), columns_res(), &inputs).expect_err("short depth");
     assert!(
@@ -675,7 +586,7 @@ fn bad_frames_are_errors_not_panics() {
     eprintln!("ok   prefiltered::errors::short_depth: {err}");
 
     // After the errors, a good frame still works.
-    pass.prepare(ctx, &fixture.frame_input())
+    pass.prepare(ctx, &frame_input(fixture))
         .unwrap_or_else(|e| panic!("{e}"));
 }
 

@@ -5,20 +5,20 @@
 //! `RaymarchVariant::grid()` (samples {8, 32, 128} x interleave {1, 2, 4} x jitter x light),
 //! directional on `columns/ordinary`, spot on `spot_grate/ordinary`, at 67x37 pixels (not a
 //! multiple of the 8x8 workgroups, nor of the interleaving tiles) with a 128^2 shadow map.
-//! Trials are named `raymarch::<variant id>::<scene>::<pose>`.
+//! Trials are named `raymarch::<variant id>::<scene>::<pose>` (libtest trials: `cargo test -p
+//! scatter-conformance --test raymarch -- n32-i2` runs a few, `-- --list` lists them);
+//! `raymarch::errors` checks the error paths.
 //!
 //! Tolerance: `|gpu - cpu| <= 1e-4 * max radiance` plus one f16 step of the mirror's value
 //! for the output (both round to rgba16float), `1e-4 * max` for the rgba32float partial sums.
 
+use std::process::ExitCode;
 use std::sync::OnceLock;
 
-use scatter_conformance::gpu;
-use scatter_reference::buffers::{GBuffer, ShadowMap};
-use scatter_reference::bvh::Bvh;
+use scatter_conformance::{Check, Fixture, gpu, run_trials, scene_for};
 use scatter_reference::kernels::run_raymarch;
-use scatter_reference::scene::Scene;
-use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
-use scatter_runtime::{MarchInput, Raymarch, RuntimeError, run_raymarch_once};
+use scatter_reference::suite::Pose;
+use scatter_runtime::{Raymarch, RuntimeError, run_raymarch_once};
 use scatter_shaderlib::prefiltered::LightKind;
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -26,50 +26,23 @@ const SCREEN: [u32; 2] = [67, 37];
 const SHADOW_MAP: u32 = 128;
 const REL_TOL: f32 = 1e-4;
 
-struct Fixture {
-    name: SceneName,
-    scene: Scene,
-    gbuf: GBuffer,
-    shadow_map: ShadowMap,
+/// The fixture of a light type (built once, on first use).
+fn fixture(light: LightKind) -> &'static Fixture {
+    static COLUMNS: OnceLock<Fixture> = OnceLock::new();
+    static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
+    let cell = match light {
+        LightKind::Directional => &COLUMNS,
+        LightKind::Spot => &SPOT_GRATE,
+    };
+    cell.get_or_init(|| Fixture::new(scene_for(light), Pose::Ordinary, SCREEN, SHADOW_MAP))
 }
 
-impl Fixture {
-    fn for_light(light: LightKind) -> &'static Fixture {
-        static COLUMNS: OnceLock<Fixture> = OnceLock::new();
-        static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
-        let (cell, name) = match light {
-            LightKind::Directional => (&COLUMNS, SceneName::Columns),
-            LightKind::Spot => (&SPOT_GRATE, SceneName::SpotGrate),
-        };
-        cell.get_or_init(|| {
-            let scene = scene(
-                name,
-                Pose::Ordinary,
-                MediumPreset::Default,
-                SCREEN[0],
-                SCREEN[1],
-            );
-            let bvh = Bvh::build(&scene.geometry);
-            let gbuf = GBuffer::cast(&scene, &bvh);
-            let shadow_map = ShadowMap::build(&scene, &bvh, SHADOW_MAP)
-                .unwrap_or_else(|e| panic!("shadow map of {name}: {e}"));
-            Fixture {
-                name,
-                scene,
-                gbuf,
-                shadow_map,
-            }
-        })
-    }
-
-    fn input(&self) -> MarchInput {
-        MarchInput {
-            camera: self.scene.camera_desc(),
-            light: self.scene.light_desc(),
-            medium: self.scene.medium_desc(),
-            shadow_map: self.shadow_map.desc(),
-        }
-    }
+fn trial_name(variant: &RaymarchVariant) -> String {
+    format!(
+        "raymarch::{variant}::{}::{}",
+        scene_for(variant.light),
+        Pose::Ordinary
+    )
 }
 
 /// Spacing of f16 values at `v`.
@@ -82,15 +55,15 @@ fn f16_ulp(v: f32) -> f32 {
 }
 
 fn trial(ctx: &scatter_runtime::Context, variant: &RaymarchVariant) -> Result<String, String> {
-    let f = Fixture::for_light(variant.light);
-    let name = format!("raymarch::{variant}::{}::ordinary", f.name);
+    let f = fixture(variant.light);
+    let name = trial_name(variant);
     let cpu = run_raymarch(variant, &f.scene, &f.gbuf, &f.shadow_map)
         .map_err(|e| format!("{name}: CPU mirror failed: {e}"))?;
     let gpu = run_raymarch_once(
         ctx,
         variant,
         SCREEN,
-        &f.input(),
+        &f.march_input(),
         &f.gbuf.view_depth,
         &f.shadow_map.depth,
     )
@@ -161,35 +134,27 @@ fn trial(ctx: &scatter_runtime::Context, variant: &RaymarchVariant) -> Result<St
     ))
 }
 
-#[test]
-fn every_variant_matches_the_mirror() {
-    let Some(ctx) = gpu() else { return };
-    let filter = std::env::var("SCATTER_TRIALS").unwrap_or_default();
-    let mut failures = Vec::new();
-    let mut count = 0;
-    let start = std::time::Instant::now();
-    for variant in RaymarchVariant::grid() {
-        if !format!("raymarch::{variant}").contains(filter.as_str()) {
-            continue;
-        }
-        count += 1;
-        match trial(ctx, &variant) {
-            Ok(line) => eprintln!("ok   {line}"),
-            Err(e) => {
-                eprintln!("FAIL {e}");
-                failures.push(e);
-            }
-        }
-    }
-    eprintln!(
-        "raymarch: {count} trials in {:.1} s, {} failed",
-        start.elapsed().as_secs_f64(),
-        failures.len()
-    );
-    assert!(failures.is_empty(), "{failures:#?}");
+fn main() -> ExitCode {
+    let mut trials: Vec<(String, Check)> = RaymarchVariant::grid()
+        .into_iter()
+        .map(|variant| {
+            let check: Check = Box::new(move || {
+                let Some(ctx) = gpu() else { return Ok(()) };
+                trial(ctx, &variant).map(drop)
+            });
+            (trial_name(&variant), check)
+        })
+        .collect();
+    trials.push((
+        "raymarch::errors".to_owned(),
+        Box::new(|| {
+            bad_input_is_an_error();
+            Ok(())
+        }),
+    ));
+    run_trials(trials, &[])
 }
 
-#[test]
 fn bad_input_is_an_error() {
     let Some(ctx) = gpu() else { return };
     let bad = RaymarchVariant {
@@ -208,13 +173,15 @@ fn bad_input_is_an_error() {
         .expect_err("zero width");
     assert!(matches!(err, RuntimeError::EmptyInput { .. }), "{err}");
     eprintln!("ok   raymarch::errors::zero_size: {err}");
-    let f = Fixture::for_light(LightKind::Directional);
+    let f = fixture(LightKind::Directional);
     let mut pass = Raymarch::new(ctx, &RaymarchVariant::default(), SCREEN, SHADOW_MAP / 2)
         .unwrap_or_else(|e| panic!("{e}"));
-    let err = pass.prepare(ctx, &f.input()).expect_err("shadow map size");
+    let err = pass
+        .prepare(ctx, &f.march_input())
+        .expect_err("shadow map size");
     assert!(matches!(err, RuntimeError::ShadowMapSize { .. }), "{err}");
     eprintln!("ok   raymarch::errors::shadow_map_size: {err}");
-    let mut input = f.input();
+    let mut input = f.march_input();
     input.camera.forward.y = f64::NAN;
     let mut pass = Raymarch::new(ctx, &RaymarchVariant::default(), SCREEN, SHADOW_MAP)
         .unwrap_or_else(|e| panic!("{e}"));
@@ -229,7 +196,7 @@ fn bad_input_is_an_error() {
             ..RaymarchVariant::default()
         },
         [1, 1],
-        &f.input(),
+        &f.march_input(),
         &[5.0],
         &f.shadow_map.depth,
     )
