@@ -8,8 +8,10 @@
 //! engine that only uses shaders emitted by `scatter-gen` links this crate alone (see
 //! `examples/foreign_engine`). A C++ engine ports [`frame::prepare_frame`]; its inputs and
 //! outputs are plain numbers, documented field by field. The raymarch and minmax families'
-//! knobs and set-up are in [`raymarch`] and [`minmax`].
+//! knobs and set-up are in [`raymarch`] and [`minmax`]. [`family`] lists the families and
+//! holds the one enum of every family's variant ([`family::FamilyVariant`]).
 
+pub mod family;
 pub mod frame;
 pub mod minmax;
 pub mod raymarch;

@@ -22,6 +22,7 @@ use std::time::Instant;
 use glam::DVec3;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
+use scatter_frame::family::FamilyVariant;
 use scatter_frame::frame::{
     CameraDesc, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame, Resolutions,
     ShadowMapDesc, ShadowProjectionDesc, prepare_frame,
@@ -322,28 +323,10 @@ fn mutation() -> impl Strategy<Value = Mutation> {
     ]
 }
 
-/// Which family's set-up a case runs.
-#[derive(Clone, Copy, Debug)]
-enum Family {
-    Prefiltered(Variant),
-    Raymarch(RaymarchVariant),
-    Minmax(MinmaxVariant),
-}
-
-impl Family {
-    fn light(&self) -> LightKind {
-        match self {
-            Self::Prefiltered(v) => v.light,
-            Self::Raymarch(v) => v.light,
-            Self::Minmax(v) => v.light,
-        }
-    }
-}
-
 /// One frame: a valid base plus mutations.
 #[derive(Clone, Debug)]
 struct Case {
-    family: Family,
+    family: FamilyVariant,
     res: Resolutions,
     camera: CameraDesc,
     light: LightDesc,
@@ -385,7 +368,7 @@ enum LightAim {
 
 #[allow(clippy::too_many_arguments, reason = "one argument per random choice")]
 fn base_case(
-    family: Family,
+    family: FamilyVariant,
     screen: [u32; 2],
     rectified: [u32; 2],
     sm_size: u32,
@@ -541,7 +524,7 @@ impl Case {
                     self.settings.projective_max_half_angle_deg = x;
                 }
                 Mutation::Knobs(regions, bases, bases_per_thread) => {
-                    if let Family::Prefiltered(v) = &mut self.family {
+                    if let FamilyVariant::Prefiltered(v) = &mut self.family {
                         v.regions = regions;
                         v.bases = bases;
                         v.bases_per_thread = bases_per_thread;
@@ -566,12 +549,12 @@ impl Case {
     }
 }
 
-fn family() -> impl Strategy<Value = Family> {
+fn family() -> impl Strategy<Value = FamilyVariant> {
     let grid = Variant::grid(1..=8);
     prop_oneof![
-        prop::sample::select(grid).prop_map(Family::Prefiltered),
-        prop::sample::select(RaymarchVariant::grid()).prop_map(Family::Raymarch),
-        prop::sample::select(MinmaxVariant::grid()).prop_map(Family::Minmax),
+        prop::sample::select(grid).prop_map(FamilyVariant::Prefiltered),
+        prop::sample::select(RaymarchVariant::grid()).prop_map(FamilyVariant::Raymarch),
+        prop::sample::select(MinmaxVariant::grid()).prop_map(FamilyVariant::Minmax),
     ]
 }
 
@@ -588,7 +571,7 @@ fn light_aim() -> impl Strategy<Value = LightAim> {
 }
 
 /// A valid base frame of `family` (any family when `None`) with up to three mutations.
-fn case(family_of: impl Strategy<Value = Family>) -> impl Strategy<Value = Case> {
+fn case(family_of: impl Strategy<Value = FamilyVariant>) -> impl Strategy<Value = Case> {
     (
         family_of,
         (1..=48u32, 1..=48u32),
@@ -722,7 +705,7 @@ fn check_march_uniforms(u: &MarchUniforms) -> Result<(), TestCaseError> {
 
 fn check_case(case: Case) -> Result<(), TestCaseError> {
     let result = match case.family {
-        Family::Prefiltered(v) => prepare_frame(
+        FamilyVariant::Prefiltered(v) => prepare_frame(
             &v,
             &case.res,
             &case.camera,
@@ -732,7 +715,7 @@ fn check_case(case: Case) -> Result<(), TestCaseError> {
             &case.settings,
         )
         .map(|f| check_prefiltered_frame(&case, &f)),
-        Family::Minmax(v) => prepare_minmax(
+        FamilyVariant::Minmax(v) => prepare_minmax(
             &v,
             &case.res,
             &case.camera,
@@ -742,7 +725,7 @@ fn check_case(case: Case) -> Result<(), TestCaseError> {
             &case.settings,
         )
         .map(|f| check_prefiltered_frame(&case, &f)),
-        Family::Raymarch(v) => prepare_march(
+        FamilyVariant::Raymarch(v) => prepare_march(
             &v,
             case.res.screen,
             &case.camera,
@@ -753,7 +736,7 @@ fn check_case(case: Case) -> Result<(), TestCaseError> {
         .map(|u| check_march_uniforms(&u)),
     };
     tally(result.is_ok());
-    if let (Family::Prefiltered(v), Ok(_)) = (&case.family, &result) {
+    if let (FamilyVariant::Prefiltered(v), Ok(_)) = (&case.family, &result) {
         prop_assert!(
             v.validate().is_ok(),
             "a frame was set up for an invalid variant {v:?}"
@@ -772,7 +755,7 @@ fn prepare_frame_on_mutated_frames() {
         "prepare_frame",
         PREFILTERED_CASES,
         0x5ca7_0001,
-        case(prop::sample::select(grid).prop_map(Family::Prefiltered)),
+        case(prop::sample::select(grid).prop_map(FamilyVariant::Prefiltered)),
         check_case,
     );
 }
@@ -783,7 +766,7 @@ fn prepare_march_on_mutated_frames() {
         "prepare_march",
         RAYMARCH_CASES,
         0x5ca7_0002,
-        case(prop::sample::select(RaymarchVariant::grid()).prop_map(Family::Raymarch)),
+        case(prop::sample::select(RaymarchVariant::grid()).prop_map(FamilyVariant::Raymarch)),
         check_case,
     );
 }
@@ -794,7 +777,7 @@ fn prepare_minmax_on_mutated_frames() {
         "prepare_minmax",
         MINMAX_CASES,
         0x5ca7_0003,
-        case(prop::sample::select(MinmaxVariant::grid()).prop_map(Family::Minmax)),
+        case(prop::sample::select(MinmaxVariant::grid()).prop_map(FamilyVariant::Minmax)),
         check_case,
     );
 }

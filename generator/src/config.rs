@@ -22,7 +22,7 @@ use serde::Deserialize;
 use serde_json::Value;
 
 use crate::GenError;
-use crate::family::{Family, FamilyVariant};
+use crate::family::{Family, FamilyCli, FamilyVariant};
 use crate::target::Target;
 
 /// A parsed config file.
@@ -100,7 +100,9 @@ pub fn parse(text: &str) -> Result<Config, String> {
             if key == "family" {
                 family = value
                     .parse()
-                    .map_err(|e: GenError| format!("variant {n}: {e}"))?;
+                    .map_err(|e: scatter_shaderlib::family::UnknownFamily| {
+                        format!("variant {n}: {e}")
+                    })?;
             } else {
                 knobs.push((key.clone(), value));
             }

@@ -105,3 +105,9 @@ impl GenError {
         }
     }
 }
+
+impl From<scatter_shaderlib::family::UnknownFamily> for GenError {
+    fn from(e: scatter_shaderlib::family::UnknownFamily) -> Self {
+        Self::Usage(e.to_string())
+    }
+}

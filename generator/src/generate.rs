@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use scatter_shaderlib::{Kernel, KernelParams};
 
 use crate::GenError;
-use crate::family::{FamilyVariant, PassPlan, Plan, Resource};
+use crate::family::{FamilyVariant, KernelFamily, PassPlan, Plan, Resource, knobs_json};
 use crate::layout_code::{self, FamilyStruct};
 use crate::manifest::{
     self, DispatchDim, FileEntry, HostFiles, KernelFile, Manifest, ManifestBinding, ManifestBuffer,
@@ -483,7 +483,7 @@ pub fn generate(request: &Request) -> Result<Generated, GenError> {
         manifest_variants.push(ManifestVariant {
             family: v.family().name(),
             id: v.id(),
-            knobs: v.knobs_json(),
+            knobs: knobs_json(v),
             parameters: plan.parameters.clone(),
             resources,
             passes,

@@ -9,7 +9,7 @@
 //! memory, [`output`] writes them atomically (or `--check`s them).
 //!
 //! ```no_run
-//! use scatter_gen::{Family, Request, Target, generate, output};
+//! use scatter_gen::{Family, FamilyCli, Request, Target, generate, output};
 //!
 //! let variant = Family::Prefiltered.variant(&[("bases".into(), "16".into())])?;
 //! let files = generate(&Request { variants: vec![variant], targets: Target::DEFAULT.to_vec() })?;
@@ -29,6 +29,6 @@ mod spirv_fixup;
 pub mod target;
 
 pub use error::GenError;
-pub use family::{Family, FamilyVariant};
+pub use family::{Family, FamilyCli, FamilyVariant, KernelFamily};
 pub use generate::{Generated, Request, generate};
 pub use target::Target;

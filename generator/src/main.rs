@@ -12,7 +12,7 @@ use std::process::ExitCode;
 
 use clap::{Arg, ArgMatches, Args, Command, FromArgMatches, Parser, Subcommand};
 use scatter_gen::family::KnobInfo;
-use scatter_gen::{Family, GenError, Request, Target, generate, output};
+use scatter_gen::{Family, FamilyCli, GenError, Request, Target, generate, output};
 
 /// Every knob of every family, deduplicated by name (first family wins the help text).
 fn all_knobs() -> Vec<(KnobInfo, Vec<Family>)> {

@@ -346,7 +346,7 @@ fn list_and_help_document_every_knob() {
     let r = scatter_gen(&["--help"]);
     assert!(r.status.success());
     let (help, _) = text(&r);
-    for k in scatter_gen::Family::Prefiltered.knobs() {
+    for k in scatter_gen::FamilyCli::knobs(scatter_gen::Family::Prefiltered) {
         let flag = format!("--{}", k.flag());
         assert!(list.contains(&flag), "list lacks {flag}");
         assert!(list.contains(&k.allowed), "list lacks {}", k.allowed);

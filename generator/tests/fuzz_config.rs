@@ -18,7 +18,7 @@ use std::time::Instant;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
 use scatter_gen::family::FamilyVariant;
-use scatter_gen::{Family, GenError, Request, Target, config, generate, output};
+use scatter_gen::{Family, FamilyCli, GenError, Request, Target, config, generate, output};
 use scatter_shaderlib::prefiltered::variant::printable;
 use scatter_shaderlib::prefiltered::{LightKind, Rectification, Storage, Variant, VisibilityMode};
 use scatter_shaderlib::raymarch::RaymarchVariant;

@@ -15,7 +15,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use scatter_gen::{Family, Generated, Request, Target, generate};
+use scatter_gen::{Family, FamilyCli, Generated, Request, Target, generate};
 
 use common::{have, require, scratch};
 

@@ -15,7 +15,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use scatter_gen::{FamilyVariant, Request, Target, generate, manifest};
+use scatter_gen::{FamilyVariant, KernelFamily, Request, Target, generate, manifest};
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::Variant;
 use scatter_shaderlib::raymarch::RaymarchVariant;

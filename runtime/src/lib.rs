@@ -16,6 +16,7 @@
 mod context;
 mod error;
 mod executor;
+pub mod family;
 pub mod gpu;
 pub mod minmax;
 pub mod prefiltered;
@@ -26,6 +27,7 @@ mod timer;
 
 pub use context::{AdapterReport, Context, ContextError, GpuPolicy};
 pub use error::RuntimeError;
+pub use family::FamilyPasses;
 pub use minmax::{Minmax, MinmaxReadback, MinmaxTimes, run_minmax_once};
 pub use prefiltered::{
     CpuInputs, FrameInput, Inputs, PassTimes, Scatter, ScatterReadback, run_once,

@@ -280,6 +280,11 @@ impl Minmax {
         }))
     }
 
+    /// The variant the pipelines were built for.
+    pub fn variant(&self) -> &MinmaxVariant {
+        &self.variant
+    }
+
     /// The frame set-up of the last [`Self::prepare`].
     pub fn frame(&self) -> Option<&PrefilteredFrame> {
         self.frame.as_ref()

@@ -20,6 +20,7 @@ use crate::executor::Executor;
 use crate::gpu::{
     DEPTH_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_view, decode_rgba, upload_inputs,
 };
+use crate::prefiltered::FrameInput;
 use crate::timer::median_pass_wall_times;
 use crate::{Context, RuntimeError};
 
@@ -41,6 +42,18 @@ pub struct MarchInput {
     pub medium: MediumDesc,
     /// The standard shadow map's projection and size (must match [`Raymarch::new`]).
     pub shadow_map: ShadowMapDesc,
+}
+
+impl From<&FrameInput> for MarchInput {
+    /// The raymarch family's part of an epipolar family's frame input (it has no settings).
+    fn from(f: &FrameInput) -> Self {
+        Self {
+            camera: f.camera,
+            light: f.light,
+            medium: f.medium,
+            shadow_map: f.shadow_map,
+        }
+    }
 }
 
 /// GPU time of each pass of one frame.
@@ -288,6 +301,11 @@ impl Raymarch {
                 Duration::ZERO
             },
         }))
+    }
+
+    /// The variant the pipelines were built for.
+    pub fn variant(&self) -> &RaymarchVariant {
+        &self.variant
     }
 
     /// The uniform block of the last [`Self::prepare`].

@@ -27,6 +27,7 @@
 
 mod compose;
 mod error;
+pub mod family;
 mod kernel;
 pub mod minmax;
 pub mod plan;

@@ -33,10 +33,10 @@ use scatter_reference::scene::Scene;
 use scatter_reference::suite::SceneName;
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::prefiltered::Inputs;
-use scatter_runtime::raymarch::MarchInput;
 use scatter_runtime::shaderlib::Kernel;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
-use scatter_runtime::{Context, FrameInput, Minmax, Raymarch, Scatter};
+use scatter_runtime::{Context, FamilyPasses, FrameInput};
+use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions, Variant};
 use scatter_shaderlib::raymarch::RaymarchVariant;
@@ -77,143 +77,22 @@ const SMOOTH: &str = "one clean shadow volume, where a 64-sample march is alread
 /// Raymarch sample counts reported.
 const SAMPLES: [u32; 4] = [32, 64, 128, 256];
 
-/// The passes of every family, created once per scene.
-struct Passes {
-    prefiltered: Scatter,
-    raymarch: Vec<(u32, Raymarch)>,
-    minmax: Minmax,
-}
-
-impl Passes {
-    fn new(ctx: &Context, light: LightKind) -> Passes {
-        let res = Resolutions {
-            screen: SCREEN,
-            rectified: RECTIFIED,
-        };
-        let prefiltered = Scatter::new(
-            ctx,
-            &Variant {
-                light,
-                ..Variant::default()
-            },
-            res,
-            SHADOW_MAP,
-        )
-        .expect("prefiltered pass");
-        let raymarch = SAMPLES
-            .iter()
-            .map(|&samples| {
-                let v = RaymarchVariant {
-                    samples,
-                    light,
-                    ..RaymarchVariant::default()
-                };
-                (
-                    samples,
-                    Raymarch::new(ctx, &v, SCREEN, SHADOW_MAP).expect("raymarch pass"),
-                )
-            })
-            .collect();
-        let minmax =
-            Minmax::new(ctx, &MinmaxVariant { light }, res, SHADOW_MAP).expect("minmax pass");
-        Passes {
-            prefiltered,
-            raymarch,
-            minmax,
-        }
-    }
-
-    /// Every family's output for one frame: (label, image), in `labels()` order.
-    fn render(
-        &mut self,
-        ctx: &Context,
-        scene: &Scene,
-        gbuf: &GBuffer,
-        sm: &ShadowMap,
-    ) -> Vec<Image> {
-        let depth = upload_r32float(
-            ctx,
-            Kernel::Scatter,
-            "flicker depth",
-            SCREEN,
-            &gbuf.view_depth,
-        )
-        .expect("depth upload");
-        let shadow = upload_r32float(
-            ctx,
-            Kernel::Rectify,
-            "flicker shadow map",
-            [SHADOW_MAP; 2],
-            &sm.depth,
-        )
-        .expect("shadow-map upload");
-        let (dv, sv) = (
-            depth.create_view(&Default::default()),
-            shadow.create_view(&Default::default()),
-        );
-        let input = FrameInput {
-            camera: scene.camera_desc(),
-            light: scene.light_desc(),
-            medium: scene.medium_desc(),
-            shadow_map: sm.desc(),
-            settings: FrameSettings::for_screen(SCREEN[0], SCREEN[1]),
-        };
-        let image = |data: Vec<[f32; 4]>| {
-            Image::from_pixels(
-                SCREEN[0],
-                SCREEN[1],
-                data.iter().map(|c| [c[0], c[1], c[2]]).collect(),
-            )
-        };
-        let mut out = Vec::new();
-        self.prefiltered
-            .prepare(ctx, &input)
-            .expect("prefiltered prepare");
-        let mut encoder = ctx.device().create_command_encoder(&Default::default());
-        self.prefiltered
-            .encode(
-                &mut encoder,
-                &Inputs {
-                    depth: &dv,
-                    shadow_map: Some(&sv),
-                    rectified: None,
-                },
-            )
-            .expect("prefiltered encode");
-        ctx.queue().submit([encoder.finish()]);
-        out.push(image(
-            read_rgba16float(ctx, Kernel::Scatter, self.prefiltered.output_texture())
-                .expect("prefiltered readback"),
-        ));
-        let march = MarchInput {
-            camera: input.camera,
-            light: input.light,
-            medium: input.medium,
-            shadow_map: input.shadow_map,
-        };
-        for (_, pass) in &mut self.raymarch {
-            pass.prepare(ctx, &march).expect("raymarch prepare");
-            let mut encoder = ctx.device().create_command_encoder(&Default::default());
-            pass.encode(ctx, &mut encoder, &dv, &sv)
-                .expect("raymarch encode");
-            ctx.queue().submit([encoder.finish()]);
-            out.push(image(
-                read_rgba16float(ctx, Kernel::Raymarch, pass.output_texture())
-                    .expect("raymarch readback"),
-            ));
-        }
-        self.minmax.prepare(ctx, &input).expect("minmax prepare");
-        let mut encoder = ctx.device().create_command_encoder(&Default::default());
-        self.minmax
-            .encode(ctx, &mut encoder, &dv, &sv)
-            .expect("minmax encode");
-        ctx.queue().submit([encoder.finish()]);
-        out.push(image(
-            read_rgba16float(ctx, Kernel::MinmaxMarch, self.minmax.output_texture())
-                .expect("minmax readback"),
-        ));
-        out
-    }
+/// The variants reported, in column order: the prefiltered default, raymarch at every
+/// `SAMPLES`, minmax.
+fn variants(light: LightKind) -> Vec<FamilyVariant> {
+    let mut v = vec![FamilyVariant::Prefiltered(Variant {
+        light,
+        ..Variant::default()
+    })];
+    v.extend(SAMPLES.iter().map(|&samples| {
+        FamilyVariant::Raymarch(RaymarchVariant {
+            samples,
+            light,
+            ..RaymarchVariant::default()
+        })
+    }));
+    v.push(FamilyVariant::Minmax(MinmaxVariant { light }));
+    v
 }
 
 fn labels() -> Vec<String> {
@@ -221,6 +100,79 @@ fn labels() -> Vec<String> {
     l.extend(SAMPLES.iter().map(|n| format!("raymarch n{n}")));
     l.push("minmax".into());
     l
+}
+
+/// The passes of every reported variant, created once per scene (as an engine keeps them).
+fn passes(ctx: &Context, light: LightKind) -> Vec<FamilyPasses> {
+    let res = Resolutions {
+        screen: SCREEN,
+        rectified: RECTIFIED,
+    };
+    variants(light)
+        .iter()
+        .map(|v| FamilyPasses::new(ctx, v, res, SHADOW_MAP).unwrap_or_else(|e| panic!("{v}: {e}")))
+        .collect()
+}
+
+/// Every variant's output for one frame, in `labels()` order.
+fn render(
+    ctx: &Context,
+    passes: &mut [FamilyPasses],
+    scene: &Scene,
+    gbuf: &GBuffer,
+    sm: &ShadowMap,
+) -> Vec<Image> {
+    let depth = upload_r32float(
+        ctx,
+        Kernel::Scatter,
+        "flicker depth",
+        SCREEN,
+        &gbuf.view_depth,
+    )
+    .expect("depth upload");
+    let shadow = upload_r32float(
+        ctx,
+        Kernel::Rectify,
+        "flicker shadow map",
+        [SHADOW_MAP; 2],
+        &sm.depth,
+    )
+    .expect("shadow-map upload");
+    let (dv, sv) = (
+        depth.create_view(&Default::default()),
+        shadow.create_view(&Default::default()),
+    );
+    let input = FrameInput {
+        camera: scene.camera_desc(),
+        light: scene.light_desc(),
+        medium: scene.medium_desc(),
+        shadow_map: sm.desc(),
+        settings: FrameSettings::for_screen(SCREEN[0], SCREEN[1]),
+    };
+    let inputs = Inputs {
+        depth: &dv,
+        shadow_map: Some(&sv),
+        rectified: None,
+    };
+    passes
+        .iter_mut()
+        .map(|pass| {
+            let v = pass.variant();
+            pass.prepare(ctx, &input)
+                .unwrap_or_else(|e| panic!("{v}: prepare: {e}"));
+            let mut encoder = ctx.device().create_command_encoder(&Default::default());
+            pass.encode(ctx, &mut encoder, &inputs)
+                .unwrap_or_else(|e| panic!("{v}: encode: {e}"));
+            ctx.queue().submit([encoder.finish()]);
+            let data = read_rgba16float(ctx, Kernel::Scatter, pass.output_texture())
+                .unwrap_or_else(|e| panic!("{v}: readback: {e}"));
+            Image::from_pixels(
+                SCREEN[0],
+                SCREEN[1],
+                data.iter().map(|c| [c[0], c[1], c[2]]).collect(),
+            )
+        })
+        .collect()
 }
 
 #[test]
@@ -249,7 +201,7 @@ fn frames_are_finite_and_prefiltered_flicker_is_within_raymarch_or_its_listed_ce
         } else {
             LightKind::Directional
         };
-        let mut passes = Passes::new(ctx, light);
+        let mut passes = passes(ctx, light);
         for path in Path::ALL {
             let mut outputs: Vec<Vec<Image>> = vec![Vec::new(); labels.len()];
             let mut truths = Vec::new();
@@ -268,8 +220,7 @@ fn frames_are_finite_and_prefiltered_flicker_is_within_raymarch_or_its_listed_ce
                     },
                     &|| (),
                 ));
-                for (i, image) in passes
-                    .render(ctx, &scene, &gbuf, &sm)
+                for (i, image) in render(ctx, &mut passes, &scene, &gbuf, &sm)
                     .into_iter()
                     .enumerate()
                 {
