@@ -24,7 +24,7 @@ use scatter_reference::metrics;
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
-use scatter_runtime::{Context, CpuInputs, FrameInput, PassTimes, run_once};
+use scatter_runtime::{Context, CpuInputs, FrameInput, PrefilteredTimes, run_prefiltered_once};
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, Resolutions, Variant, VariantError, prepare_frame,
 };
@@ -347,16 +347,16 @@ fn run_on_gpu(
         rectified: engine_rectified_map(scene, bvh, &prepared),
         pass_wall_frames: args.pass_wall_frames,
     };
-    let mut best: Option<PassTimes> = None;
+    let mut best: Option<PrefilteredTimes> = None;
     let mut last = None;
     let mut best_wall = std::time::Duration::MAX;
     for _ in 0..args.frames {
-        let rb = run_once(&ctx, variant, res, &inputs)?;
+        let rb = run_prefiltered_once(&ctx, variant, res, &inputs)?;
         best_wall = best_wall.min(rb.wall_time);
         if let Some(t) = rb.gpu_times {
             best = Some(match best {
                 None => t,
-                Some(b) => PassTimes {
+                Some(b) => PrefilteredTimes {
                     rectify: b.rectify.min(t.rectify),
                     prefilter: b.prefilter.min(t.prefilter),
                     scatter: b.scatter.min(t.scatter),

@@ -23,7 +23,7 @@ use scatter_reference::scene::Scene;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::prefiltered::{FrameInput, Inputs};
-use scatter_runtime::raymarch::MarchInput;
+use scatter_runtime::raymarch::RaymarchInput;
 use scatter_runtime::shaderlib::Kernel;
 use scatter_runtime::shaderlib::minmax::MinmaxVariant;
 use scatter_runtime::shaderlib::prefiltered::{
@@ -32,7 +32,7 @@ use scatter_runtime::shaderlib::prefiltered::{
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::wgpu::TextureView;
-use scatter_runtime::{Context, Minmax, Raymarch, Scatter};
+use scatter_runtime::{Context, Minmax, Prefiltered, Raymarch};
 
 /// A method of one family with its knobs (the light is set per scene).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -461,7 +461,7 @@ fn run_method(
                 screen,
                 rectified: r.unwrap_or(rectified),
             };
-            let mut pass = Scatter::new(ctx, &v, res, sm.size)?;
+            let mut pass = Prefiltered::new(ctx, &v, res, sm.size)?;
             pass.prepare(
                 ctx,
                 &FrameInput {
@@ -497,7 +497,7 @@ fn run_method(
             let mut pass = Raymarch::new(ctx, &v, screen, sm.size)?;
             pass.prepare(
                 ctx,
-                &MarchInput {
+                &RaymarchInput {
                     camera: scene.camera_desc(),
                     light: scene.light_desc(),
                     medium: scene.medium_desc(),
@@ -665,7 +665,7 @@ fn scaling_runs(ctx: &Context, frames: u32) -> Result<Vec<ScalingRow>, BoxError>
             depth.create_view(&Default::default()),
             shadow.create_view(&Default::default()),
         );
-        let mut pass = Scatter::new(
+        let mut pass = Prefiltered::new(
             ctx,
             &Variant::default(),
             Resolutions { screen, rectified },

@@ -88,7 +88,7 @@ pub enum RuntimeError {
     /// The shadow map of a frame differs in size from the one the pipelines were made for.
     #[error(
         "the shadow map is {actual}x{actual} texels but the pass was created for \
-         {expected}x{expected}; create a new pass (`Scatter`, `Raymarch`) for the new size"
+         {expected}x{expected}; create a new pass (`Prefiltered`, `Raymarch`) for the new size"
     )]
     ShadowMapSize {
         /// The size given at creation.

@@ -10,13 +10,13 @@ use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::prefiltered::{FrameReport, Resolutions};
 
 use crate::prefiltered::{FrameInput, Inputs};
-use crate::{Context, Minmax, Raymarch, RuntimeError, Scatter};
+use crate::{Context, Minmax, Prefiltered, Raymarch, RuntimeError};
 
 /// The passes of one variant of any family, sized for one set of resolutions.
 #[derive(Debug)]
 pub enum FamilyPasses {
     /// The prefiltered family.
-    Prefiltered(Scatter),
+    Prefiltered(Prefiltered),
     /// The raymarch family (it uses only the screen size of the resolutions).
     Raymarch(Raymarch),
     /// The minmax family.
@@ -24,7 +24,7 @@ pub enum FamilyPasses {
 }
 
 impl FamilyPasses {
-    /// Builds the variant's passes ([`Scatter::new`], [`Raymarch::new`], [`Minmax::new`]).
+    /// Builds the variant's passes ([`Prefiltered::new`], [`Raymarch::new`], [`Minmax::new`]).
     ///
     /// # Errors
     ///
@@ -37,7 +37,7 @@ impl FamilyPasses {
     ) -> Result<Self, RuntimeError> {
         Ok(match variant {
             FamilyVariant::Prefiltered(v) => {
-                Self::Prefiltered(Scatter::new(ctx, v, res, shadow_map_size)?)
+                Self::Prefiltered(Prefiltered::new(ctx, v, res, shadow_map_size)?)
             }
             FamilyVariant::Raymarch(v) => {
                 Self::Raymarch(Raymarch::new(ctx, v, res.screen, shadow_map_size)?)

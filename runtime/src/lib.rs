@@ -6,12 +6,19 @@
 //! [`Context::from_env`] applies the `SCATTER_GPU` policy that tests and tools share. Each
 //! kernel has a pass type that builds its pipeline from `scatter-shaderlib` and encodes it
 //! ([`RowPrefixPass`]), plus a one-call convenience for tests ([`row_prefix`]). Kernel
-//! families with several passes have one type for the whole family: [`Scatter`] runs the
-//! `prefiltered` method (`rectify`, `prefilter`, `scatter`) once per frame, [`run_once`] is
-//! its test convenience; [`Raymarch`] runs the `raymarch` family (`raymarch`, then
-//! `interleave_sum` when interleaved), [`run_raymarch_once`] its test convenience;
-//! [`Minmax`] runs the `minmax` family (`rectify`, `minmax_build`, `minmax_march`),
-//! [`run_minmax_once`] its test convenience.
+//! families with several passes have one type for the whole family: [`Prefiltered`] runs the
+//! `prefiltered` method (`rectify`, `prefilter`, `scatter`) once per frame,
+//! [`run_prefiltered_once`] is its test convenience; [`Raymarch`] runs the `raymarch` family
+//! (`raymarch`, then `interleave_sum` when interleaved), [`run_raymarch_once`] its test
+//! convenience; [`Minmax`] runs the `minmax` family (`rectify`, `minmax_build`,
+//! `minmax_march`), [`run_minmax_once`] its test convenience. [`FamilyPasses`] drives any of
+//! them from the one enum of every family's variant.
+//!
+//! Every family runs on one plan-driven executor (`executor`, crate-private): the family's
+//! plan (`scatter_shaderlib::<family>::plan`, the one `scatter-gen` writes into the
+//! manifest) and the bindings reflected from its compiled kernels give the layouts,
+//! pipelines, resources and dispatches; a family type keeps only its input checks, its
+//! per-frame upload and its frame report. [`gpu`] holds the toolkit no family owns.
 
 mod context;
 mod error;
@@ -28,11 +35,16 @@ mod timer;
 pub use context::{AdapterReport, Context, ContextError, GpuPolicy};
 pub use error::RuntimeError;
 pub use family::FamilyPasses;
+
+/// The prefiltered family's passes under their name before the redesign.
+#[deprecated(note = "renamed `Prefiltered`: `Scatter` is also the crate and a kernel")]
+pub type Scatter = Prefiltered;
 pub use minmax::{Minmax, MinmaxReadback, MinmaxTimes, run_minmax_once};
 pub use prefiltered::{
-    CpuInputs, FrameInput, Inputs, PassTimes, Scatter, ScatterReadback, run_once,
+    CpuInputs, FrameInput, Inputs, Prefiltered, PrefilteredReadback, PrefilteredTimes,
+    run_prefiltered_once,
 };
-pub use raymarch::{MarchInput, MarchReadback, MarchTimes, Raymarch, run_raymarch_once};
+pub use raymarch::{Raymarch, RaymarchInput, RaymarchReadback, RaymarchTimes, run_raymarch_once};
 pub use row_prefix::{ArraySize, RowPrefixOutput, RowPrefixPass, row_prefix};
 pub use timer::GpuTimer;
 

@@ -350,7 +350,7 @@ pub fn run_minmax_once(
     pass.prepare(ctx, input)?;
     let device = ctx.device();
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-        label: Some("minmax run_once"),
+        label: Some("minmax run_prefiltered_once"),
     });
     pass.encode(ctx, &mut encoder, &views[0].1, &views[1].1)?;
     let scope = ErrorScopes::push(device);

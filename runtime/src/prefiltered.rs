@@ -1,8 +1,8 @@
-//! The `prefiltered` family (Klehm et al. 2014) on wgpu: [`Scatter`] owns the three
+//! The `prefiltered` family (Klehm et al. 2014) on wgpu: [`Prefiltered`] owns the three
 //! pipelines (`rectify`, `prefilter`, `scatter`) of one [`Variant`], the intermediate
-//! textures and the per-frame buffers; an engine calls [`Scatter::prepare`] and
-//! [`Scatter::encode`] once per frame with its depth buffer and standard shadow map.
-//! [`run_once`] is the upload-run-readback convenience the conformance tests use.
+//! textures and the per-frame buffers; an engine calls [`Prefiltered::prepare`] and
+//! [`Prefiltered::encode`] once per frame with its depth buffer and standard shadow map.
+//! [`run_prefiltered_once`] is the upload-run-readback convenience the conformance tests use.
 //!
 //! Pass order and bindings (group 0 of every kernel):
 //!
@@ -13,7 +13,7 @@
 //! | `scatter` | 0, 1, 2 depth r32float, 3 shadow map r32float, 4 filtered bases (sampled array), 5 linear sampler, 6 output rgba16float (storage, write) | `ceil(W/8) x ceil(H/8) x 1` |
 //!
 //! The sampler clamps along rows (u) and wraps across slices (v) when the slices go round the
-//! full circle (`FrameUniforms::anti_epipole[3] > 0.5`), else clamps: [`Scatter`] keeps both
+//! full circle (`FrameUniforms::anti_epipole[3] > 0.5`), else clamps: [`Prefiltered`] keeps both
 //! samplers and picks one per frame.
 
 use std::time::{Duration, Instant};
@@ -58,7 +58,7 @@ const fn storage_texel_bytes(storage: Storage) -> u32 {
     }
 }
 
-/// Everything [`Scatter::prepare`] needs about one frame besides the textures: the engine's
+/// Everything [`Prefiltered::prepare`] needs about one frame besides the textures: the engine's
 /// camera, light, medium and standard shadow map, and the runtime settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameInput {
@@ -68,13 +68,13 @@ pub struct FrameInput {
     pub light: LightDesc,
     /// The homogeneous medium.
     pub medium: MediumDesc,
-    /// The standard shadow map's projection and size (must match [`Scatter::new`]).
+    /// The standard shadow map's projection and size (must match [`Prefiltered::new`]).
     pub shadow_map: ShadowMapDesc,
     /// Epipole march radius and steps, spot quadrature.
     pub settings: FrameSettings,
 }
 
-/// The engine's textures for one frame ([`Scatter::encode`]). All are r32float with
+/// The engine's textures for one frame ([`Prefiltered::encode`]). All are r32float with
 /// `TEXTURE_BINDING` usage.
 #[derive(Clone, Copy, Debug)]
 pub struct Inputs<'a> {
@@ -90,7 +90,7 @@ pub struct Inputs<'a> {
 
 /// GPU time of each pass of one frame (from timestamps at the start and end of each pass).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct PassTimes {
+pub struct PrefilteredTimes {
     /// The `rectify` pass (zero in a projective frame, where it does not run).
     pub rectify: Duration,
     /// The `prefilter` pass.
@@ -99,7 +99,7 @@ pub struct PassTimes {
     pub scatter: Duration,
 }
 
-impl PassTimes {
+impl PrefilteredTimes {
     /// Sum of the three passes.
     pub fn total(&self) -> Duration {
         self.rectify + self.prefilter + self.scatter
@@ -109,7 +109,7 @@ impl PassTimes {
 /// The `prefiltered` method for one [`Variant`], sized for one set of [`Resolutions`] and one
 /// shadow-map size.
 #[derive(Debug)]
-pub struct Scatter {
+pub struct Prefiltered {
     device: wgpu::Device,
     variant: Variant,
     res: Resolutions,
@@ -128,7 +128,7 @@ pub struct Scatter {
     frame: Option<PrefilteredFrame>,
 }
 
-impl Scatter {
+impl Prefiltered {
     /// Validates the variant and the sizes against the device, builds the three kernels and
     /// creates their pipelines and every texture and buffer they need.
     ///
@@ -355,14 +355,14 @@ impl Scatter {
         ctx: &Context,
         inputs: &Inputs<'_>,
         frames: u32,
-    ) -> Result<PassTimes, RuntimeError> {
+    ) -> Result<PrefilteredTimes, RuntimeError> {
         let [rectify, prefilter, scatter] = median_pass_wall_times(
             ctx,
             [RECTIFY, PREFILTER, SCATTER],
             frames,
             |encoder, kernel| self.encode_pass(encoder, inputs, kernel),
         )?;
-        Ok(PassTimes {
+        Ok(PrefilteredTimes {
             rectify,
             prefilter,
             scatter,
@@ -426,7 +426,7 @@ impl Scatter {
     /// # Errors
     ///
     /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
-    pub fn pass_times(&self, ctx: &Context) -> Result<Option<PassTimes>, RuntimeError> {
+    pub fn pass_times(&self, ctx: &Context) -> Result<Option<PrefilteredTimes>, RuntimeError> {
         let Some(timer) = self.exec.timer() else {
             return Ok(None);
         };
@@ -436,7 +436,7 @@ impl Scatter {
             .as_ref()
             .is_some_and(|f| f.report.rectification == Rectification::Projective);
         match times[..] {
-            [rectify, prefilter, scatter] => Ok(Some(PassTimes {
+            [rectify, prefilter, scatter] => Ok(Some(PrefilteredTimes {
                 rectify: if projective { Duration::ZERO } else { rectify },
                 prefilter,
                 scatter,
@@ -501,7 +501,7 @@ impl Scatter {
     }
 }
 
-/// CPU-side inputs of [`run_once`]: the frame's parameters plus the two textures an engine
+/// CPU-side inputs of [`run_prefiltered_once`]: the frame's parameters plus the two textures an engine
 /// would render.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CpuInputs {
@@ -515,14 +515,14 @@ pub struct CpuInputs {
     /// The engine's rasterised rectified map (`Wr * Hr` clip depths, row-major), used when
     /// the frame turns out projective (it must then be present).
     pub rectified: Option<Vec<f32>>,
-    /// When non-zero, [`run_once`] also measures each pass on its own
-    /// ([`Scatter::measure_pass_wall_times`]) over this many frames.
+    /// When non-zero, [`run_prefiltered_once`] also measures each pass on its own
+    /// ([`Prefiltered::measure_pass_wall_times`]) over this many frames.
     pub pass_wall_frames: u32,
 }
 
-/// Everything [`run_once`] reads back.
+/// Everything [`run_prefiltered_once`] reads back.
 #[derive(Clone, Debug)]
-pub struct ScatterReadback {
+pub struct PrefilteredReadback {
     /// The frame set-up that was uploaded.
     pub frame: PrefilteredFrame,
     /// In-scattered radiance per pixel (rgba16float converted to f32), row-major.
@@ -533,34 +533,34 @@ pub struct ScatterReadback {
     /// converted from the storage format to f32 (values in [0, 1]).
     pub filtered: Vec<[f32; 4]>,
     /// GPU time per pass, when the device has timestamps.
-    pub gpu_times: Option<PassTimes>,
+    pub gpu_times: Option<PrefilteredTimes>,
     /// Median wall time per pass submitted on its own, when
     /// [`CpuInputs::pass_wall_frames`] is non-zero.
-    pub pass_wall_times: Option<PassTimes>,
+    pub pass_wall_times: Option<PrefilteredTimes>,
     /// Wall time from submission until every result was mapped (includes the copies back).
     pub wall_time: Duration,
 }
 
-/// Test helper: creates a [`Scatter`] for `variant` and `res`, uploads `inputs.depth` and
+/// Test helper: creates a [`Prefiltered`] for `variant` and `res`, uploads `inputs.depth` and
 /// `inputs.shadow_map` as r32float textures, prepares, encodes and submits one frame, and
 /// reads back the output, the rectified map, the filtered bases and the pass times.
 ///
-/// Builds the pipelines on every call: an engine keeps a [`Scatter`] instead.
+/// Builds the pipelines on every call: an engine keeps a [`Prefiltered`] instead.
 ///
 /// # Errors
 ///
-/// Whatever [`Scatter::new`], [`Scatter::prepare`] or [`Scatter::encode`] fail with;
+/// Whatever [`Prefiltered::new`], [`Prefiltered::prepare`] or [`Prefiltered::encode`] fail with;
 /// [`RuntimeError::DataLength`] when a buffer does not match its size;
 /// [`RuntimeError::Wgpu`], [`RuntimeError::Poll`] or [`RuntimeError::Readback`] when the
 /// GPU work or the readback fails.
-pub fn run_once(
+pub fn run_prefiltered_once(
     ctx: &Context,
     variant: &Variant,
     res: Resolutions,
     inputs: &CpuInputs,
-) -> Result<ScatterReadback, RuntimeError> {
+) -> Result<PrefilteredReadback, RuntimeError> {
     let sm_size = inputs.frame.shadow_map.size;
-    let mut pass = Scatter::new(ctx, variant, res, sm_size)?;
+    let mut pass = Prefiltered::new(ctx, variant, res, sm_size)?;
     let mut cpu = vec![
         (SCATTER, "depth buffer", res.screen, &inputs.depth[..]),
         (RECTIFY, "shadow map", [sm_size; 2], &inputs.shadow_map[..]),
@@ -578,7 +578,7 @@ pub fn run_once(
     pass.prepare(ctx, &inputs.frame)?;
     let device = ctx.device();
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-        label: Some("prefiltered run_once"),
+        label: Some("prefiltered run_prefiltered_once"),
     });
     pass.encode(
         &mut encoder,
@@ -640,7 +640,7 @@ pub fn run_once(
         .frame
         .take()
         .ok_or(RuntimeError::NotPrepared { kernel: RECTIFY })?;
-    Ok(ScatterReadback {
+    Ok(PrefilteredReadback {
         frame,
         output,
         rectified,

@@ -33,7 +33,7 @@ pub const PARTIAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float
 
 /// One frame's camera, light, medium and standard shadow map.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MarchInput {
+pub struct RaymarchInput {
     /// The camera.
     pub camera: CameraDesc,
     /// The light (its type must match the variant's).
@@ -44,7 +44,7 @@ pub struct MarchInput {
     pub shadow_map: ShadowMapDesc,
 }
 
-impl From<&FrameInput> for MarchInput {
+impl From<&FrameInput> for RaymarchInput {
     /// The raymarch family's part of an epipolar family's frame input (it has no settings).
     fn from(f: &FrameInput) -> Self {
         Self {
@@ -58,14 +58,14 @@ impl From<&FrameInput> for MarchInput {
 
 /// GPU time of each pass of one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct MarchTimes {
+pub struct RaymarchTimes {
     /// The `raymarch` pass.
     pub raymarch: Duration,
     /// The `interleave_sum` pass (zero without interleaving).
     pub interleave_sum: Duration,
 }
 
-impl MarchTimes {
+impl RaymarchTimes {
     /// Sum of the passes.
     pub fn total(&self) -> Duration {
         self.raymarch + self.interleave_sum
@@ -178,7 +178,7 @@ impl Raymarch {
     /// [`RuntimeError::ShadowMapSize`] when the shadow map's size differs from
     /// [`Self::new`]'s; [`RuntimeError::Frame`] for NaN or degenerate parameters or a light
     /// of the wrong type.
-    pub fn prepare(&mut self, ctx: &Context, input: &MarchInput) -> Result<(), RuntimeError> {
+    pub fn prepare(&mut self, ctx: &Context, input: &RaymarchInput) -> Result<(), RuntimeError> {
         if input.shadow_map.size != self.shadow_map_size {
             return Err(RuntimeError::ShadowMapSize {
                 expected: self.shadow_map_size,
@@ -233,7 +233,7 @@ impl Raymarch {
         depth: &wgpu::TextureView,
         shadow_map: &wgpu::TextureView,
         frames: u32,
-    ) -> Result<MarchTimes, RuntimeError> {
+    ) -> Result<RaymarchTimes, RuntimeError> {
         // Without interleaving there is no `interleave_sum` pass: its slot records nothing.
         let [raymarch, interleave_sum] = median_pass_wall_times(
             ctx,
@@ -244,7 +244,7 @@ impl Raymarch {
                     .map(|_| ())
             },
         )?;
-        Ok(MarchTimes {
+        Ok(RaymarchTimes {
             raymarch,
             interleave_sum: if self.partial.is_some() {
                 interleave_sum
@@ -288,12 +288,12 @@ impl Raymarch {
     /// # Errors
     ///
     /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
-    pub fn pass_times(&self, ctx: &Context) -> Result<Option<MarchTimes>, RuntimeError> {
+    pub fn pass_times(&self, ctx: &Context) -> Result<Option<RaymarchTimes>, RuntimeError> {
         let Some(timer) = self.exec.timer() else {
             return Ok(None);
         };
         let times = timer.read_all(ctx, RAYMARCH)?;
-        Ok(Some(MarchTimes {
+        Ok(Some(RaymarchTimes {
             raymarch: times.first().copied().unwrap_or_default(),
             interleave_sum: if self.partial.is_some() {
                 times.get(1).copied().unwrap_or_default()
@@ -326,7 +326,7 @@ impl Raymarch {
 
 /// Everything [`run_raymarch_once`] reads back.
 #[derive(Clone, Debug)]
-pub struct MarchReadback {
+pub struct RaymarchReadback {
     /// The uploaded uniform block.
     pub uniforms: MarchUniforms,
     /// In-scattered radiance per pixel (rgba16float converted to f32), row-major.
@@ -334,7 +334,7 @@ pub struct MarchReadback {
     /// The partial sums of an interleaved variant, row-major.
     pub partial: Option<Vec<[f32; 4]>>,
     /// GPU time per pass, when the device has timestamps.
-    pub gpu_times: Option<MarchTimes>,
+    pub gpu_times: Option<RaymarchTimes>,
     /// Wall time from submission until every result was mapped.
     pub wall_time: Duration,
 }
@@ -350,10 +350,10 @@ pub fn run_raymarch_once(
     ctx: &Context,
     variant: &RaymarchVariant,
     screen: [u32; 2],
-    input: &MarchInput,
+    input: &RaymarchInput,
     depth: &[f32],
     shadow_map: &[f32],
-) -> Result<MarchReadback, RuntimeError> {
+) -> Result<RaymarchReadback, RuntimeError> {
     let sm_size = input.shadow_map.size;
     let mut pass = Raymarch::new(ctx, variant, screen, sm_size)?;
     let views = upload_inputs(
@@ -366,7 +366,7 @@ pub fn run_raymarch_once(
     pass.prepare(ctx, input)?;
     let device = ctx.device();
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-        label: Some("raymarch run_once"),
+        label: Some("raymarch run_prefiltered_once"),
     });
     pass.encode(ctx, &mut encoder, &views[0].1, &views[1].1)?;
     let scope = ErrorScopes::push(device);
@@ -397,7 +397,7 @@ pub fn run_raymarch_once(
     let uniforms = pass
         .prepared
         .ok_or(RuntimeError::NotPrepared { kernel: RAYMARCH })?;
-    Ok(MarchReadback {
+    Ok(RaymarchReadback {
         uniforms,
         output,
         partial,

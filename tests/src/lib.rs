@@ -23,7 +23,7 @@ use scatter_reference::bvh::Bvh;
 use scatter_reference::kernels::row_prefix as row_prefix_mirror;
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
-use scatter_runtime::{ArraySize, Context, FrameInput, GpuPolicy, MarchInput};
+use scatter_runtime::{ArraySize, Context, FrameInput, GpuPolicy, RaymarchInput};
 use scatter_shaderlib::RowPrefixMode;
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind};
 
@@ -131,8 +131,8 @@ impl Fixture {
     }
 
     /// The frame input of the raymarch family.
-    pub fn march_input(&self) -> MarchInput {
-        MarchInput {
+    pub fn march_input(&self) -> RaymarchInput {
+        RaymarchInput {
             camera: self.scene.camera_desc(),
             light: self.scene.light_desc(),
             medium: self.scene.medium_desc(),

@@ -25,7 +25,7 @@ use scatter_reference::kernels::engine_rectified_map;
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
 use scatter_runtime::{
-    CpuInputs, FrameInput, MarchInput, run_minmax_once, run_once, run_raymarch_once,
+    CpuInputs, FrameInput, RaymarchInput, run_minmax_once, run_prefiltered_once, run_raymarch_once,
 };
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{
@@ -146,7 +146,7 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
             } else {
                 None
             };
-            let gpu = run_once(
+            let gpu = run_prefiltered_once(
                 ctx,
                 v,
                 res(),
@@ -173,7 +173,7 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
                 ctx,
                 &v,
                 SCREEN,
-                &MarchInput {
+                &RaymarchInput {
                     camera: input.camera,
                     light: input.light,
                     medium: input.medium,

@@ -2,7 +2,7 @@
 //! scatter-shaderlib) against the runtime: `scatter-gen` writes SPIR-V and WGSL plus
 //! `manifest.json` into a temporary directory, the foreign engine builds its layouts,
 //! pipelines, resources and dispatches from the manifest alone, and its output must equal
-//! `scatter_runtime::run_once`'s for the same suite scene within `1e-4 * max radiance`.
+//! `scatter_runtime::run_prefiltered_once`'s for the same suite scene within `1e-4 * max radiance`.
 //!
 //! Trials (`foreign::<variant id>::<scene>::<pose>::<target>`), 128x72 pixels, a 128x128
 //! rectified map, a 256^2 shadow map:
@@ -42,7 +42,8 @@ use scatter_reference::kernels::engine_rectified_map;
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
 use scatter_runtime::{
-    Context, CpuInputs, FrameInput, MarchInput, run_minmax_once, run_once, run_raymarch_once,
+    Context, CpuInputs, FrameInput, RaymarchInput, run_minmax_once, run_prefiltered_once,
+    run_raymarch_once,
 };
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, Rectification, Resolutions, Storage, Variant,
@@ -209,7 +210,7 @@ fn trial(ctx: &Context, variant: &Variant) -> Vec<String> {
     );
     let rectified = engine_rectified_map(&fixture.scene, &fixture.bvh, &frame);
     let start = Instant::now();
-    let runtime = run_once(
+    let runtime = run_prefiltered_once(
         ctx,
         variant,
         Resolutions {
@@ -287,7 +288,7 @@ fn trial(ctx: &Context, variant: &Variant) -> Vec<String> {
         let rel = diff / max.max(f32::MIN_POSITIVE);
         let [w, _] = SCREEN;
         let line = format!(
-            "{name}::{target}: max |diff| {diff:.3e} = {rel:.3e} of max radiance {max:.4e} (worst pixel ({}, {})); foreign load+run {ms:.0} ms, runtime run_once {runtime_ms:.0} ms",
+            "{name}::{target}: max |diff| {diff:.3e} = {rel:.3e} of max radiance {max:.4e} (worst pixel ({}, {})); foreign load+run {ms:.0} ms, runtime run_prefiltered_once {runtime_ms:.0} ms",
             at as u32 % w,
             at as u32 / w
         );
@@ -398,7 +399,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
             fixture.pose
         );
         let f = fixture.frame_input();
-        let input = MarchInput {
+        let input = RaymarchInput {
             camera: f.camera,
             light: f.light,
             medium: f.medium,
@@ -585,7 +586,7 @@ fn foreign_engine_comparison_detects_a_wrong_input() {
     let variant = Variant::default();
     let fixture = Fixture::get(variant.light);
     let frame = fixture.frame(&variant);
-    let runtime = run_once(
+    let runtime = run_prefiltered_once(
         ctx,
         &variant,
         Resolutions {

@@ -199,7 +199,7 @@ fn manifest_dispatch_matches_the_runtime_grid() {
             .as_array()
             .cloned()
             .unwrap_or_default();
-        // Scatter::encode's invocation grids, in pass order.
+        // Prefiltered::encode's invocation grids, in pass order.
         let grids = [
             [wr, hr, 1],
             [hr, v.regions, v.threads_per_row_region()],

@@ -13,7 +13,7 @@
 
 use scatter_conformance::gpu;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
-use scatter_runtime::{Context, Minmax, Raymarch, RuntimeError, Scatter, wgpu};
+use scatter_runtime::{Context, Minmax, Prefiltered, Raymarch, RuntimeError, wgpu};
 use scatter_shaderlib::Kernel;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{Resolutions, Variant};
@@ -67,35 +67,35 @@ fn texture_sizes_beyond_the_device_are_refused() {
     let v = Variant::default();
     assert_limit(
         "scatter_rectified_width",
-        Scatter::new(ctx, &v, res([64, 36], [max + 1, 64]), 64),
+        Prefiltered::new(ctx, &v, res([64, 36], [max + 1, 64]), 64),
         limit,
         over,
         m,
     );
     assert_limit(
         "scatter_rectified_height",
-        Scatter::new(ctx, &v, res([64, 36], [64, max + 1]), 64),
+        Prefiltered::new(ctx, &v, res([64, 36], [64, max + 1]), 64),
         limit,
         over,
         m,
     );
     assert_limit(
         "scatter_screen_width",
-        Scatter::new(ctx, &v, res([max + 1, 36], [64, 64]), 64),
+        Prefiltered::new(ctx, &v, res([max + 1, 36], [64, 64]), 64),
         limit,
         over,
         m,
     );
     assert_limit(
         "scatter_screen_height",
-        Scatter::new(ctx, &v, res([64, max + 1], [64, 64]), 64),
+        Prefiltered::new(ctx, &v, res([64, max + 1], [64, 64]), 64),
         limit,
         over,
         m,
     );
     assert_limit(
         "scatter_shadow_map",
-        Scatter::new(ctx, &v, res([64, 36], [64, 64]), max + 1),
+        Prefiltered::new(ctx, &v, res([64, 36], [64, 64]), max + 1),
         limit,
         over,
         m,
@@ -157,17 +157,17 @@ fn zero_sizes_are_refused_with_the_input_named() {
     let v = Variant::default();
     assert_empty(
         "scatter_screen",
-        Scatter::new(ctx, &v, res([0, 36], [64, 64]), 64),
+        Prefiltered::new(ctx, &v, res([0, 36], [64, 64]), 64),
         "screen 0x36",
     );
     assert_empty(
         "scatter_rectified",
-        Scatter::new(ctx, &v, res([64, 36], [64, 0]), 64),
+        Prefiltered::new(ctx, &v, res([64, 36], [64, 0]), 64),
         "rectified 64x0",
     );
     assert_empty(
         "scatter_shadow_map",
-        Scatter::new(ctx, &v, res([64, 36], [64, 64]), 0),
+        Prefiltered::new(ctx, &v, res([64, 36], [64, 64]), 0),
         "shadow map 0x0",
     );
     assert_empty(
@@ -218,7 +218,7 @@ fn lowered_device_limits_are_named() {
     let v32 = Variant::default();
     assert_limit(
         "scatter_layers",
-        Scatter::new(ctx, &v32, res([64, 36], [64, 16]), 64),
+        Prefiltered::new(ctx, &v32, res([64, 36], [64, 16]), 64),
         "max_texture_array_layers",
         8,
         4,
@@ -230,7 +230,7 @@ fn lowered_device_limits_are_named() {
     // 65 rows of 16 bytes in the slice table.
     assert_limit(
         "scatter_slice_table",
-        Scatter::new(ctx, &v16, res([64, 36], [64, 65]), 64),
+        Prefiltered::new(ctx, &v16, res([64, 36], [64, 65]), 64),
         "max_storage_buffer_binding_size",
         65 * 16,
         1024,
@@ -245,7 +245,7 @@ fn lowered_device_limits_are_named() {
     // 256 pixels wide in 8x8 workgroups: 32 workgroups along x.
     assert_limit(
         "scatter_workgroups",
-        Scatter::new(ctx, &v16, res([256, 8], [64, 16]), 64),
+        Prefiltered::new(ctx, &v16, res([256, 8], [64, 16]), 64),
         "max_compute_workgroups_per_dimension",
         32,
         16,
@@ -275,7 +275,7 @@ fn lowered_device_limits_are_named() {
     let ctx = &ctx;
     assert_limit(
         "scatter_uniform_block",
-        Scatter::new(ctx, &v16, res([64, 36], [64, 16]), 64),
+        Prefiltered::new(ctx, &v16, res([64, 36], [64, 16]), 64),
         "max_uniform_buffer_binding_size",
         400,
         128,
@@ -296,7 +296,7 @@ fn lowered_device_limits_are_named() {
     );
     assert_limit(
         "scatter_slice_table_buffer",
-        Scatter::new(ctx, &v16, res([64, 36], [64, 65]), 64),
+        Prefiltered::new(ctx, &v16, res([64, 36], [64, 65]), 64),
         "max_buffer_size",
         65 * 16,
         1024,

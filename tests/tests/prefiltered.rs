@@ -1,5 +1,5 @@
 //! Conformance of the `prefiltered` family (`rectify`, `prefilter`, `scatter`): the GPU
-//! (`scatter_runtime::run_once`) against the CPU mirrors
+//! (`scatter_runtime::run_prefiltered_once`) against the CPU mirrors
 //! (`reference/src/kernels/{rectify,prefilter,scatter}.rs`, driven by
 //! `scatter_reference::kernels::run_prefiltered`) for every variant of the design card:
 //! bases {4, 8, 16, 32, 64, 128} x every valid bases_per_thread x regions {1, 2, 3, 4} x
@@ -36,7 +36,9 @@ use scatter_conformance::{Check, Fixture, gpu, run_trials};
 use scatter_reference::kernels::{PrefilteredRun, run_prefiltered};
 use scatter_reference::suite::{Pose, SceneName};
 use scatter_runtime::wgpu::TextureView;
-use scatter_runtime::{Context, CpuInputs, FrameInput, Inputs, RuntimeError, Scatter, run_once};
+use scatter_runtime::{
+    Context, CpuInputs, FrameInput, Inputs, Prefiltered, RuntimeError, run_prefiltered_once,
+};
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, Rectification, Resolutions, Storage, Variant,
 };
@@ -195,7 +197,7 @@ fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<Tria
         inputs.rectified = Some(cpu.rectified.data.clone());
     }
     let gpu_start = Instant::now();
-    let gpu = run_once(ctx, variant, resolutions(fixture), &inputs)
+    let gpu = run_prefiltered_once(ctx, variant, resolutions(fixture), &inputs)
         .map_err(|e| format!("{trial}: GPU run failed: {e}"))?;
     let gpu_wall = gpu_start.elapsed();
     if gpu.frame != cpu.frame {
@@ -252,7 +254,7 @@ fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<Tria
         },
     );
     let line = format!(
-        "{trial}: rectified max |diff| {:.2e}; filtered {:.2e}; output {:.2e} ({:.2e} of max {:.3e}); {times}; run_once {:.0} ms, total {:.0} ms",
+        "{trial}: rectified max |diff| {:.2e}; filtered {:.2e}; output {:.2e} ({:.2e} of max {:.3e}); {times}; run_prefiltered_once {:.0} ms, total {:.0} ms",
         rectified.diff,
         filtered.diff,
         output.diff,
@@ -362,7 +364,7 @@ fn columns_res() -> Resolutions {
 fn wrong_shadow_map_size_is_an_error() {
     let Some(ctx) = gpu() else { return };
     let fixture = for_light(LightKind::Directional);
-    let mut pass = Scatter::new(ctx, &base_variant(), columns_res(), 2 * SHADOW_MAP)
+    let mut pass = Prefiltered::new(ctx, &base_variant(), columns_res(), 2 * SHADOW_MAP)
         .unwrap_or_else(|e| panic!("{e}"));
     let err = pass
         .prepare(ctx, &frame_input(fixture))
@@ -381,7 +383,7 @@ fn wrong_shadow_map_size_is_an_error() {
     eprintln!("ok   prefiltered::errors::shadow_map_size: {text}");
 
     // A shadow-map view of the wrong size at encode time.
-    let mut pass = Scatter::new(ctx, &base_variant(), columns_res(), SHADOW_MAP)
+    let mut pass = Prefiltered::new(ctx, &base_variant(), columns_res(), SHADOW_MAP)
         .unwrap_or_else(|e| panic!("{e}"));
     pass.prepare(ctx, &frame_input(fixture))
         .unwrap_or_else(|e| panic!("{e}"));
@@ -457,7 +459,7 @@ fn zero_resolution_is_an_error() {
     ];
     for (screen, rectified, sm, expected) in cases {
         let res = Resolutions { screen, rectified };
-        let err = Scatter::new(ctx, &base_variant(), res, sm).expect_err(expected);
+        let err = Prefiltered::new(ctx, &base_variant(), res, sm).expect_err(expected);
         let text = err.to_string();
         assert!(
             matches!(err, RuntimeError::EmptyInput { .. }) && text.contains(expected),
@@ -471,7 +473,7 @@ fn zero_resolution_is_an_error() {
         screen: [max_2d + 1, 4],
         rectified: RECTIFIED,
     };
-    let err = Scatter::new(ctx, &base_variant(), res, SHADOW_MAP).expect_err("too wide");
+    let err = Prefiltered::new(ctx, &base_variant(), res, SHADOW_MAP).expect_err("too wide");
     assert!(
         err.to_string().contains("max_texture_dimension_2d"),
         "{err}"
@@ -483,7 +485,7 @@ fn zero_resolution_is_an_error() {
         rectified: [8, 64],
     };
     let err =
-        Scatter::new(ctx, &base_variant(), res, SHADOW_MAP).expect_err("8 columns, 3 regions");
+        Prefiltered::new(ctx, &base_variant(), res, SHADOW_MAP).expect_err("8 columns, 3 regions");
     assert!(
         matches!(
             err,
@@ -528,7 +530,7 @@ fn invalid_variant_names_the_knob() {
         ),
     ];
     for (variant, knob, value) in cases {
-        let err = Scatter::new(ctx, &variant, columns_res(), SHADOW_MAP).expect_err(knob);
+        let err = Prefiltered::new(ctx, &variant, columns_res(), SHADOW_MAP).expect_err(knob);
         let text = err.to_string();
         assert!(
             matches!(&err, RuntimeError::InvalidVariant { source, .. } if source.knob == knob)
@@ -543,7 +545,7 @@ fn invalid_variant_names_the_knob() {
 fn bad_frames_are_errors_not_panics() {
     let Some(ctx) = gpu() else { return };
     let fixture = for_light(LightKind::Directional);
-    let mut pass = Scatter::new(ctx, &base_variant(), columns_res(), SHADOW_MAP)
+    let mut pass = Prefiltered::new(ctx, &base_variant(), columns_res(), SHADOW_MAP)
         .unwrap_or_else(|e| panic!("{e}"));
 
     // Encoding before any frame was prepared.
@@ -578,7 +580,8 @@ fn bad_frames_are_errors_not_panics() {
     // A short depth buffer in the test helper.
     let mut inputs = cpu_inputs(fixture);
     inputs.depth.pop();
-    let err = run_once(ctx, &base_variant(), columns_res(), &inputs).expect_err("short depth");
+    let err = run_prefiltered_once(ctx, &base_variant(), columns_res(), &inputs)
+        .expect_err("short depth");
     assert!(
         matches!(err, RuntimeError::DataLength { .. }) && err.to_string().contains("depth"),
         "{err}"

@@ -32,9 +32,9 @@ use scatter_reference::metrics;
 use scatter_reference::scene::Light;
 use scatter_reference::stress::{self, StressCase, StressGroup};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
-use scatter_runtime::raymarch::MarchInput;
+use scatter_runtime::raymarch::RaymarchInput;
 use scatter_runtime::{
-    Context, CpuInputs, FrameInput, run_minmax_once, run_once, run_raymarch_once,
+    Context, CpuInputs, FrameInput, run_minmax_once, run_prefiltered_once, run_raymarch_once,
 };
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{
@@ -213,7 +213,7 @@ impl Prepared {
                 )
                 .map_err(|e| e.to_string())?;
                 let rectified = engine_rectified_map(&self.case.scene, &self.bvh, &frame);
-                let out = run_once(
+                let out = run_prefiltered_once(
                     ctx,
                     &variant,
                     self.resolutions(),
@@ -248,7 +248,7 @@ impl Prepared {
                     ctx,
                     &variant,
                     self.screen(),
-                    &MarchInput {
+                    &RaymarchInput {
                         camera: s.camera_desc(),
                         light: s.light_desc(),
                         medium: s.medium_desc(),
