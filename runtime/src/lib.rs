@@ -5,7 +5,7 @@
 //! sampling of rgba32float) where the adapter has them;
 //! [`Context::from_env`] applies the `SCATTER_GPU` policy that tests and tools share. Each
 //! kernel has a pass type that builds its pipeline from `scatter-shaderlib` and encodes it
-//! ([`RowPrefixPass`]), plus a one-call convenience for tests ([`row_prefix`]). Kernel
+//! ([`RowPrefixPass`]), plus a one-call convenience for tests ([`row_prefix()`]). Kernel
 //! families with several passes have one type for the whole family: [`Prefiltered`] runs the
 //! `prefiltered` method (`rectify`, `prefilter`, `scatter`) once per frame,
 //! [`run_prefiltered_once`] is its test convenience; [`Raymarch`] runs the `raymarch` family
