@@ -31,6 +31,10 @@ const COMMON_MODULES: &[(&str, &str)] = &[
         include_str!("../templates/common/raymarch.wgsl"),
     ),
     (
+        "common/epipolar.wgsl",
+        include_str!("../templates/common/epipolar.wgsl"),
+    ),
+    (
         "common/prefiltered.wgsl",
         include_str!("../templates/common/prefiltered.wgsl"),
     ),

@@ -19,7 +19,7 @@
 //
 // Mirrors reference/src/kernels/minmax_build.rs
 
-#import scatter::prefiltered::Frame
+#import scatter::epipolar::Frame
 #import scatter::minmax::{level_count, tree_width}
 
 @group(0) @binding(0) var<uniform> frame: Frame;

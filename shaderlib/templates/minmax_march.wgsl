@@ -24,8 +24,8 @@
 //
 // Mirrors reference/src/kernels/minmax_march.rs
 
-#import scatter::model::{PI, phase_hg, spot_integrand, spot_span, transmittance_between}
-#import scatter::prefiltered::{Frame, normalised_depth, slice_params, sm_visibility}
+#import scatter::model::{phase_hg, transmittance_between}
+#import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, slice_params, spot_segment}
 #import scatter::minmax::{level_offset, tree_levels}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -34,72 +34,6 @@
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) var tree: texture_2d<f32>;
 @group(0) @binding(5) var output: texture_storage_2d<rgba16float, write>;
-
-// Unit view direction through the centre of pixel (x, y).
-fn pixel_dir(f: Frame, x: u32, y: u32) -> vec3<f32> {
-    let ndc_x = 2.0 * (f32(x) + 0.5) / f32(f.sizes[0]) - 1.0;
-    let ndc_y = 1.0 - 2.0 * (f32(y) + 0.5) / f32(f.sizes[1]);
-    let t = f.cam_forward[3];
-    return normalize(f.cam_forward.xyz + f.cam_right.xyz * (ndc_x * t * f.cam_right[3]) + f.cam_up.xyz * (ndc_y * t));
-}
-
-// The spot integrand at ray parameter `t` with the light and medium of the frame.
-fn frame_spot_integrand(f: Frame, eye: vec3<f32>, dir: vec3<f32>, t: f32) -> f32 {
-    return spot_integrand(eye, dir, t, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
-}
-
-// In-scattering by ray marching `steps` midpoints against the standard shadow map.
-fn march(eye: vec3<f32>, dir: vec3<f32>, s: f32, spot: bool) -> f32 {
-    let f = frame;
-    let steps = f.sizes2_[1];
-    let h = s / f32(steps);
-    var sum = 0.0;
-    for (var k = 0u; k < steps; k++) {
-        let t = (f32(k) + 0.5) * h;
-        let v = sm_visibility(f, shadow_map, eye + dir * t);
-        if spot {
-            sum += v * h * frame_spot_integrand(f, eye, dir, t);
-        } else {
-            sum += v * transmittance_between(f.medium[0], f32(k) * h, f32(k + 1u) * h);
-        }
-    }
-    if spot {
-        return sum;
-    } else {
-        return f.medium[1] * phase_hg(f.medium[2], -dot(f.light_dir.xyz, dir)) * sum;
-    }
-}
-
-// Row of the `slices` table for row coordinate `j` (a whole number): wrapped around when
-// the slices cover the full circle, else clamped.
-fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
-    let ji = i32(j);
-    if wrap {
-        return u32(((ji % i32(rows)) + i32(rows)) % i32(rows));
-    } else {
-        return u32(clamp(ji, 0, i32(rows) - 1));
-    }
-}
-
-// Distance along the pixel's own ray (angle `theta` to the axis) of column edge `x`, capped
-// at the surface distance `s`.
-fn ray_t(f: Frame, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
-    if spot {
-        let psi = x * delta;
-        let den = sin(theta + psi);
-        if den <= 1e-6 || theta + psi >= PI {
-            return s;
-        }
-        return min(f.axis[3] * sin(psi) / den, s);
-    } else {
-        return min(x * delta / max(sin(theta), 1e-6), s);
-    }
-}
-
-// Unshadowed spot in-scattering over `[a, b]` of the ray (`scatter::model::spot_span`).
-fn spot_segment(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, panels: u32) -> f32 {
-    return spot_span(eye, dir, a, b, panels, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
-}
 
 // Ray distance of column edge `x` of a ray that crosses texels 0 .. n: the last texel's
 // span ends at the surface `s`.
@@ -140,7 +74,7 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     let near_anti =
         f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
     if near_epi || near_anti {
-        let l = march(eye, dir, s, spot) * color;
+        let l = epipole_march(frame, shadow_map, eye, dir, s, spot) * color;
         textureStore(output, vec2<u32>(x, y), vec4<f32>(l.x, l.y, l.z, 1.0));
         return;
     }

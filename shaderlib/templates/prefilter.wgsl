@@ -29,7 +29,8 @@
 //
 // Mirrors reference/src/kernels/prefilter.rs
 
-#import scatter::prefiltered::{Frame, basis4, region_start, slice_params, texel_weight{% if projective %}, proj_stored_depth, proj_texel_weight{% endif %}}
+#import scatter::epipolar::{Frame, slice_params}
+#import scatter::prefiltered::{basis4, region_start, texel_weight{% if projective %}, proj_stored_depth, proj_texel_weight{% endif %}}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;

@@ -21,7 +21,7 @@
 // Mirrors reference/src/kernels/rectify.rs
 
 #import scatter::model::PI
-#import scatter::prefiltered::{Frame, normalised_depth, row_phi, slice_e, slice_params, sm_occluder_distance}
+#import scatter::epipolar::{Frame, normalised_depth, row_phi, slice_e, slice_params, sm_occluder_distance}
 #import scatter::shadow::NO_OCCLUDER
 
 @group(0) @binding(0) var<uniform> frame: Frame;

@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     uint4 size;
 };
 
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float4 eye;
     float4 axis;
     float4 e1_;
@@ -37,49 +37,33 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float4 proj_g2_;
 };
 
-static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-static const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
+typedef float ret_Constructarray4_float_[4];
+ret_Constructarray4_float_ Constructarray4_float_(float arg0, float arg1, float arg2, float arg3) {
+    float ret[4] = { arg0, arg1, arg2, arg3 };
+    return ret;
+}
 
-cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX frame; }
+static const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
+static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+static const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+static const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(0.34785485, 0.65214515, 0.65214515, 0.34785485);
+
+cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX frame; }
 Texture2D<float4> rectified : register(t1);
 RWTexture2D<float4> tree : register(u2);
 
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
-{
-    float x = (sigma_t * len);
-    if ((x < 0.0001)) {
-        return (len * (1.0 - (0.5 * x)));
-    }
-    return ((1.0 - exp(-(x))) / sigma_t);
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
-{
-    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
-{
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
-    float x_1 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_1 * x_1) * (3.0 - (2.0 * x_1)));
-}
-
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
-    float3 q = (p - v.origin.xyz);
-    return float3(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
+    float3 q_1 = (p - v.origin.xyz);
+    return float3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
 float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
 {
     if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t))), (0.5 - ((0.5 * ls.y) / (z_1 * t))));
+        float t_1 = v_1.proj.x;
+        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_1))), (0.5 - ((0.5 * ls.y) / (z_1 * t_1))));
     } else {
         return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -117,9 +101,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
         return 2.0;
     }
     uint n = v_2.size.x;
-    uint x_2 = min(naga_f2u32((uv.x * float(n))), (n - 1u));
+    uint x = min(naga_f2u32((uv.x * float(n))), (n - 1u));
     uint y = min(naga_f2u32((uv.y * float(n))), (n - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_2, y), int(0)));
+    float4 _e49 = sm.Load(int3(uint2(x, y), int(0)));
     return _e49.x;
 }
 
@@ -166,18 +150,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        float3 dir = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir.z <= 1e-6)) {
+        float3 dir_2 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_2.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
         const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir.z);
+        return ((z_2 + _e35) / dir_2.z);
     } else {
         const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -190,6 +174,107 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     }
 }
 
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
+{
+    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
+    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
+{
+    float x_1 = (sigma_t * len);
+    if ((x_1 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_1)));
+    }
+    return ((1.0 - exp(-(x_1))) / sigma_t);
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
+{
+    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
+{
+    if (((cos_inner - cos_outer) <= 1e-6)) {
+        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
+    }
+    float x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_2 * x_2) * (3.0 - (2.0 * x_2)));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
+{
+    float3 x_3 = (eye + (dir * t));
+    float3 to_x = (x_3 - light_pos);
+    float d2_ = max(dot(to_x, to_x), 1e-12);
+    float d = sqrt(d2_);
+    float3 travel = (to_x / (d).xxx);
+    const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
+}
+
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
+{
+    float sum = 0.0;
+    uint k = 0u;
+    uint q = (uint)0;
+
+    float t0_ = dot((light_pos_1 - eye_1), dir_1);
+    float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float g0_ = atan(((a_1 - t0_) / h));
+    float w = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
+    uint2 loop_bound = uint2(4294967295u, 4294967295u);
+    bool loop_init = true;
+    while(true) {
+        if (all(loop_bound == uint2(0u, 0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e73 = k;
+            k = (_e73 + 1u);
+        }
+        loop_init = false;
+        uint _e30 = k;
+        if ((_e30 < panels)) {
+        } else {
+            break;
+        }
+        {
+            uint _e32 = k;
+            float mid = (g0_ + ((float(_e32) + 0.5) * w));
+            q = 0u;
+            uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
+            bool loop_init_1 = true;
+            while(true) {
+                if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
+                loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+                if (!loop_init_1) {
+                    uint _e70 = q;
+                    q = (_e70 + 1u);
+                }
+                loop_init_1 = false;
+                uint _e40 = q;
+                if ((_e40 < 4u)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e46 = q;
+                    float u = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
+                    float _e52 = sum;
+                    uint _e54 = q;
+                    const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e54), 3u)] * _e62) * (1.0 + (u * u))));
+                }
+            }
+        }
+    }
+    float _e75 = sum;
+    return (((_e75 * 0.5) * w) * h);
+}
+
 uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_1, uint width)
 {
     return (((width + (1u << level_1)) - 1u) >> level_1);
@@ -197,50 +282,50 @@ uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_1, uint wid
 
 uint tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint width_1)
 {
-    uint k = 0u;
+    uint k_1 = 0u;
 
-    uint2 loop_bound = uint2(4294967295u, 4294967295u);
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     while(true) {
-        if (all(loop_bound == uint2(0u, 0u))) { break; }
-        loop_bound -= uint2(loop_bound.y == 0u, 1u);
-        uint _e2 = k;
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        uint _e2 = k_1;
         const uint _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
         if ((_e4 > 1u)) {
         } else {
             break;
         }
         {
-            uint _e8 = k;
-            k = (_e8 + 1u);
+            uint _e8 = k_1;
+            k_1 = (_e8 + 1u);
         }
     }
-    uint _e10 = k;
+    uint _e10 = k_1;
     return (_e10 + 1u);
 }
 
 uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_2, uint width_2)
 {
     uint off_1 = 0u;
-    uint k_1 = 0u;
+    uint k_2 = 0u;
 
-    uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
-    bool loop_init = true;
+    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init) {
-            uint _e12 = k_1;
-            k_1 = (_e12 + 1u);
+        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e12 = k_2;
+            k_2 = (_e12 + 1u);
         }
-        loop_init = false;
-        uint _e3 = k_1;
+        loop_init_2 = false;
+        uint _e3 = k_2;
         if ((_e3 < level_2)) {
         } else {
             break;
         }
         {
             uint _e6 = off_1;
-            uint _e7 = k_1;
+            uint _e7 = k_2;
             const uint _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
             off_1 = (_e6 + _e9);
         }
@@ -280,10 +365,10 @@ void minmax_build(uint3 id : SV_DispatchThreadID)
     if (_e19) {
         return;
     }
-    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
     while(true) {
-        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         uint _e21 = level;
         const uint _e22 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e21, width_4);
         uint _e24 = off;
@@ -305,16 +390,16 @@ void minmax_build(uint3 id : SV_DispatchThreadID)
     lo = d0_;
     hi = d0_;
     i = (first + 1u);
-    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
-    bool loop_init_1 = true;
+    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_1) {
+        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e64 = i;
             i = (_e64 + 1u);
         }
-        loop_init_1 = false;
+        loop_init_3 = false;
         uint _e51 = i;
         if ((_e51 < end)) {
         } else {
@@ -323,11 +408,11 @@ void minmax_build(uint3 id : SV_DispatchThreadID)
         {
             uint _e53 = i;
             float4 _e57 = rectified.Load(int3(uint2(_e53, y_1), int(0)));
-            float d = _e57.x;
+            float d_1 = _e57.x;
             float _e59 = lo;
-            lo = min(_e59, d);
+            lo = min(_e59, d_1);
             float _e61 = hi;
-            hi = max(_e61, d);
+            hi = max(_e61, d_1);
         }
     }
     float _e67 = lo;

@@ -14,7 +14,10 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct type_9 {
+    float inner[4];
+};
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 eye;
     metal::float4 axis;
     metal::float4 e1_;
@@ -41,47 +44,17 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
 };
-constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
-
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float sigma_t,
-    float len
-) {
-    float x = sigma_t * len;
-    if (x < 0.0001) {
-        return len * (1.0 - (0.5 * x));
-    }
-    return (1.0 - metal::exp(-(x))) / sigma_t;
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float sigma_t_1,
-    float a,
-    float b
-) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
-    return metal::exp(-(sigma_t_1) * a) * _e7;
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float cos_angle,
-    float cos_inner,
-    float cos_outer
-) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
-    float x_1 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_1 * x_1) * (3.0 - (2.0 * x_1));
-}
+constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
+constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
 
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
     metal::float3 p
 ) {
-    metal::float3 q = p - v.origin.xyz;
-    return metal::float3(metal::dot(q, v.right.xyz), metal::dot(q, v.up.xyz), metal::dot(q, v.forward.xyz));
+    metal::float3 q_1 = p - v.origin.xyz;
+    return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
 }
 
 metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
@@ -90,8 +63,8 @@ metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     if (v_1.origin.w > 0.5) {
         float z_1 = metal::max(ls.z, 0.000001);
-        float t = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t)), 0.5 - ((0.5 * ls.y) / (z_1 * t)));
+        float t_1 = v_1.proj.x;
+        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_1)), 0.5 - ((0.5 * ls.y) / (z_1 * t_1)));
     } else {
         return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
     }
@@ -131,10 +104,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
         return 2.0;
     }
     uint n = v_2.size.x;
-    uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
+    uint x = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
     uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -188,18 +161,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir.z <= 0.000001) {
+        metal::float3 dir_2 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_2.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return (z_2 + _e35) / dir.z;
+        return (z_2 + _e35) / dir_2.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -212,6 +185,134 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     }
 }
 
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float g,
+    float cos_theta
+) {
+    float denom = metal::max((1.0 + (g * g)) - ((2.0 * g) * cos_theta), 0.00000001);
+    return (1.0 - (g * g)) / ((12.566371 * denom) * metal::sqrt(denom));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float sigma_t,
+    float len
+) {
+    float x_1 = sigma_t * len;
+    if (x_1 < 0.0001) {
+        return len * (1.0 - (0.5 * x_1));
+    }
+    return (1.0 - metal::exp(-(x_1))) / sigma_t;
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float sigma_t_1,
+    float a,
+    float b
+) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
+    return metal::exp(-(sigma_t_1) * a) * _e7;
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float cos_angle,
+    float cos_inner,
+    float cos_outer
+) {
+    if ((cos_inner - cos_outer) <= 0.000001) {
+        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
+    }
+    float x_2 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_2 * x_2) * (3.0 - (2.0 * x_2));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye,
+    metal::float3 dir,
+    float t,
+    metal::float3 light_pos,
+    metal::float3 light_dir,
+    float cos_inner_1,
+    float cos_outer_1,
+    metal::float4 medium
+) {
+    metal::float3 x_3 = eye + (dir * t);
+    metal::float3 to_x = x_3 - light_pos;
+    float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
+    float d = metal::sqrt(d2_);
+    metal::float3 travel = to_x / metal::float3(d);
+    float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t))) / d2_;
+}
+
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye_1,
+    metal::float3 dir_1,
+    float a_1,
+    float b_1,
+    uint panels,
+    metal::float3 light_pos_1,
+    metal::float3 light_dir_1,
+    float cos_inner_2,
+    float cos_outer_2,
+    metal::float4 medium_1
+) {
+    float sum = 0.0;
+    uint k = 0u;
+    uint q = {};
+    float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
+    float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
+    float g0_ = metal::atan((a_1 - t0_) / h);
+    float w = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
+    uint2 loop_bound = uint2(4294967295u);
+    bool loop_init = true;
+    while(true) {
+        if (metal::all(loop_bound == uint2(0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e73 = k;
+            k = _e73 + 1u;
+        }
+        loop_init = false;
+        uint _e30 = k;
+        if (_e30 < panels) {
+        } else {
+            break;
+        }
+        {
+            uint _e32 = k;
+            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w);
+            q = 0u;
+            uint2 loop_bound_1 = uint2(4294967295u);
+            bool loop_init_1 = true;
+            while(true) {
+                if (metal::all(loop_bound_1 == uint2(0u))) { break; }
+                loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+                if (!loop_init_1) {
+                    uint _e70 = q;
+                    q = _e70 + 1u;
+                }
+                loop_init_1 = false;
+                uint _e40 = q;
+                if (_e40 < 4u) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e46 = q;
+                    float u = metal::tan(mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float _e52 = sum;
+                    uint _e54 = q;
+                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                }
+            }
+        }
+    }
+    float _e75 = sum;
+    return ((_e75 * 0.5) * w) * h;
+}
+
 uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
     uint level_1,
     uint width
@@ -222,23 +323,23 @@ uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
 uint tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
     uint width_1
 ) {
-    uint k = 0u;
-    uint2 loop_bound = uint2(4294967295u);
+    uint k_1 = 0u;
+    uint2 loop_bound_2 = uint2(4294967295u);
     while(true) {
-        if (metal::all(loop_bound == uint2(0u))) { break; }
-        loop_bound -= uint2(loop_bound.y == 0u, 1u);
-        uint _e2 = k;
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        uint _e2 = k_1;
         uint _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
         if (_e4 > 1u) {
         } else {
             break;
         }
         {
-            uint _e8 = k;
-            k = _e8 + 1u;
+            uint _e8 = k_1;
+            k_1 = _e8 + 1u;
         }
     }
-    uint _e10 = k;
+    uint _e10 = k_1;
     return _e10 + 1u;
 }
 
@@ -247,25 +348,25 @@ uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
     uint width_2
 ) {
     uint off_1 = 0u;
-    uint k_1 = 0u;
-    uint2 loop_bound_1 = uint2(4294967295u);
-    bool loop_init = true;
+    uint k_2 = 0u;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_1 == uint2(0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init) {
-            uint _e12 = k_1;
-            k_1 = _e12 + 1u;
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e12 = k_2;
+            k_2 = _e12 + 1u;
         }
-        loop_init = false;
-        uint _e3 = k_1;
+        loop_init_2 = false;
+        uint _e3 = k_2;
         if (_e3 < level_2) {
         } else {
             break;
         }
         {
             uint _e6 = off_1;
-            uint _e7 = k_1;
+            uint _e7 = k_2;
             uint _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
             off_1 = _e6 + _e9;
         }
@@ -286,7 +387,7 @@ struct minmax_buildInput {
 };
 kernel void minmax_build(
   metal::uint3 id [[thread_position_in_grid]]
-, constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX& frame [[buffer(0)]]
+, constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(0)]]
 , metal::texture2d<float, metal::access::write> tree [[texture(1)]]
 ) {
@@ -310,10 +411,10 @@ kernel void minmax_build(
     if (_e19) {
         return;
     }
-    uint2 loop_bound_2 = uint2(4294967295u);
+    uint2 loop_bound_4 = uint2(4294967295u);
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         uint _e21 = level;
         uint _e22 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e21, width_4);
         uint _e24 = off;
@@ -336,16 +437,16 @@ kernel void minmax_build(
     lo = d0_;
     hi = d0_;
     i = first + 1u;
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_1 = true;
+    uint2 loop_bound_5 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_1) {
+        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e64 = i;
             i = _e64 + 1u;
         }
-        loop_init_1 = false;
+        loop_init_3 = false;
         uint _e51 = i;
         if (_e51 < end) {
         } else {
@@ -355,11 +456,11 @@ kernel void minmax_build(
             uint _e53 = i;
             uint clamped_lod_e57 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
             metal::float4 _e57 = rectified.read(metal::min(metal::uint2(metal::uint2(_e53, y_1)), metal::uint2(rectified.get_width(clamped_lod_e57), rectified.get_height(clamped_lod_e57)) - 1), clamped_lod_e57);
-            float d = _e57.x;
+            float d_1 = _e57.x;
             float _e59 = lo;
-            lo = metal::min(_e59, d);
+            lo = metal::min(_e59, d_1);
             float _e61 = hi;
-            hi = metal::max(_e61, d);
+            hi = metal::max(_e61, d_1);
         }
     }
     float _e67 = lo;

@@ -13,7 +13,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     vec4 proj;
     uvec4 size;
 };
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 eye;
     vec4 axis;
     vec4 e1_;
@@ -40,19 +40,19 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     vec4 proj_g1_;
     vec4 proj_g2_;
 };
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
     float theta_ref;
     float theta_lo;
     float theta_hi;
 };
-const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
-const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.1;
+const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](0.34785485, 0.65214515, 0.65214515, 0.34785485);
+const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 
-layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _group_0_binding_0_cs; };
+layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _group_0_binding_0_cs; };
 
 layout(std430, binding = 1) readonly buffer type_10_block_1Compute { vec4 _group_0_binding_1_cs[]; };
 
@@ -64,27 +64,6 @@ layout(binding = 4) uniform sampler2D _group_0_binding_4_cs;
 
 layout(binding = 5,rgba16f) writeonly uniform image2D _group_0_binding_5_cs;
 
-
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_3 = (sigma_t * len);
-    if ((x_3 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_3)));
-    }
-    return ((1.0 - exp(-(x_3))) / sigma_t);
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
-    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
-}
 
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
     vec3 q_1 = (p - v.origin.xyz);
@@ -127,10 +106,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_5 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_3 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
     uint y_1 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_5, y_1)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_3, y_1)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
     return _e49.x;
 }
 
@@ -196,27 +175,30 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     }
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec4 v_6) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
-}
-
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float theta, float lo, float hi) {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
-}
-
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f) {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f.sm_right, f.sm_up, f.sm_forward, f.sm_origin, f.sm_proj, uvec4(f.sizes2_.x, 0u, 0u, 0u));
-}
-
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1, sampler2D sm_3, vec3 p_2) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_1);
-    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
-}
-
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta) {
     float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
     return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
+    float x_4 = (sigma_t * len);
+    if ((x_4 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_4)));
+    }
+    return ((1.0 - exp(-(x_4))) / sigma_t);
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
+    if (((cos_inner - cos_outer) <= 1e-6)) {
+        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
+    }
+    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
@@ -281,112 +263,81 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     return (((_e75 * 0.5) * w) * h);
 }
 
-uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level, uint width) {
-    return (((width + (1u << level)) - 1u) >> level);
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec4 v_6) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
 }
 
-uint tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint width_1) {
-    uint k_2 = 0u;
-    while(true) {
-        uint _e2 = k_2;
-        uint _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
-        if ((_e4 > 1u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = k_2;
-            k_2 = (_e8 + 1u);
-        }
-    }
-    uint _e10 = k_2;
-    return (_e10 + 1u);
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi) {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
 }
 
-uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_1, uint width_2) {
-    uint off = 0u;
-    uint k_3 = 0u;
-    bool loop_init_2 = true;
-    while(true) {
-        if (!loop_init_2) {
-            uint _e12 = k_3;
-            k_3 = (_e12 + 1u);
-        }
-        loop_init_2 = false;
-        uint _e3 = k_3;
-        if ((_e3 < level_1)) {
-        } else {
-            break;
-        }
-        {
-            uint _e6 = off;
-            uint _e7 = k_3;
-            uint _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
-            off = (_e6 + _e9);
-        }
-    }
-    uint _e14 = off;
-    return _e14;
+vec3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, uint x, uint y) {
+    float ndc_x = (((2.0 * (float(x) + 0.5)) / float(f.sizes.x)) - 1.0);
+    float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(f.sizes.y)));
+    float t_3 = f.cam_forward.w;
+    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_3) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_3))));
 }
 
-vec3 pixel_dir(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2, uint x, uint y) {
-    float ndc_x = (((2.0 * (float(x) + 0.5)) / float(f_2.sizes.x)) - 1.0);
-    float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(f_2.sizes.y)));
-    float t_3 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc_x * t_3) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc_y * t_3))));
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1) {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_1.sm_right, f_1.sm_up, f_1.sm_forward, f_1.sm_origin, f_1.sm_proj, uvec4(f_1.sizes2_.x, 0u, 0u, 0u));
 }
 
-float frame_spot_integrand(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, vec3 eye_2, vec3 dir_2, float t_1) {
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, sampler2D sm_3, vec3 p_2) {
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2);
+    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
+    return _e4;
+}
+
+float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec3 eye_2, vec3 dir_2, float t_1) {
     float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-float march(vec3 eye_3, vec3 dir_3, float s, bool spot) {
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, sampler2D sm_4, vec3 eye_3, vec3 dir_3, float s, bool spot) {
     float sum_1 = 0.0;
-    uint k_4 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_8 = _group_0_binding_0_cs;
-    uint steps = f_8.sizes2_.y;
+    uint k_2 = 0u;
+    uint steps = f_4.sizes2_.y;
     float h_1 = (s / float(steps));
-    bool loop_init_3 = true;
+    bool loop_init_2 = true;
     while(true) {
-        if (!loop_init_3) {
-            uint _e45 = k_4;
-            k_4 = (_e45 + 1u);
+        if (!loop_init_2) {
+            uint _e44 = k_2;
+            k_2 = (_e44 + 1u);
         }
-        loop_init_3 = false;
-        uint _e10 = k_4;
-        if ((_e10 < steps)) {
+        loop_init_2 = false;
+        uint _e9 = k_2;
+        if ((_e9 < steps)) {
         } else {
             break;
         }
         {
-            uint _e12 = k_4;
-            float t_4 = ((float(_e12) + 0.5) * h_1);
-            float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_8, _group_0_binding_3_cs, (eye_3 + (dir_3 * t_4)));
+            uint _e11 = k_2;
+            float t_4 = ((float(_e11) + 0.5) * h_1);
+            float _e21 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_3 + (dir_3 * t_4)));
             if (spot) {
-                float _e25 = sum_1;
-                float _e27 = frame_spot_integrand(f_8, eye_3, dir_3, t_4);
-                sum_1 = (_e25 + ((_e22 * h_1) * _e27));
+                float _e24 = sum_1;
+                float _e26 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_3, dir_3, t_4);
+                sum_1 = (_e24 + ((_e21 * h_1) * _e26));
             } else {
-                float _e30 = sum_1;
-                uint _e33 = k_4;
-                uint _e36 = k_4;
-                float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, (float(_e33) * h_1), (float((_e36 + 1u)) * h_1));
-                sum_1 = (_e30 + (_e22 * _e41));
+                float _e29 = sum_1;
+                uint _e32 = k_2;
+                uint _e35 = k_2;
+                float _e40 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (float(_e32) * h_1), (float((_e35 + 1u)) * h_1));
+                sum_1 = (_e29 + (_e21 * _e40));
             }
         }
     }
     if (spot) {
-        float _e47 = sum_1;
-        return _e47;
+        float _e46 = sum_1;
+        return _e46;
     } else {
-        float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.z, -(dot(f_8.light_dir.xyz, dir_3)));
-        float _e58 = sum_1;
-        return ((f_8.medium.y * _e56) * _e58);
+        float _e55 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_3)));
+        float _e57 = sum_1;
+        return ((f_4.medium.y * _e55) * _e57);
     }
 }
 
-uint row_index(float j, uint rows, bool wrap) {
+uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, bool wrap) {
     int ji = int(j);
     if (wrap) {
         return uint((((ji % int(rows)) + int(rows)) % int(rows)));
@@ -395,7 +346,7 @@ uint row_index(float j, uint rows, bool wrap) {
     }
 }
 
-float ray_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4, float x_1, float delta, float theta_1, float s_1, bool spot_1) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float x_1, float delta, float theta_1, float s_1, bool spot_1) {
     bool local_11 = false;
     if (spot_1) {
         float psi = (x_1 * delta);
@@ -409,31 +360,79 @@ float ray_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4, float x_
         if (_e16) {
             return s_1;
         }
-        return min(((f_4.axis.w * sin(psi)) / den), s_1);
+        return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
         return min(((x_1 * delta) / max(sin(theta_1), 1e-6)), s_1);
     }
 }
 
-float spot_segment(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5, vec3 eye_4, vec3 dir_4, float a_2, float b_2, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_5.light_pos.xyz, f_5.light_dir.xyz, f_5.light_pos.w, f_5.light_dir.w, f_5.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 eye_4, vec3 dir_4, float a_2, float b_2, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
-float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_6, uint x_2, uint n, float delta_1, float theta_2, float s_2, bool spot_2) {
+uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level, uint width) {
+    return (((width + (1u << level)) - 1u) >> level);
+}
+
+uint tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint width_1) {
+    uint k_3 = 0u;
+    while(true) {
+        uint _e2 = k_3;
+        uint _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
+        if ((_e4 > 1u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = k_3;
+            k_3 = (_e8 + 1u);
+        }
+    }
+    uint _e10 = k_3;
+    return (_e10 + 1u);
+}
+
+uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_1, uint width_2) {
+    uint off = 0u;
+    uint k_4 = 0u;
+    bool loop_init_3 = true;
+    while(true) {
+        if (!loop_init_3) {
+            uint _e12 = k_4;
+            k_4 = (_e12 + 1u);
+        }
+        loop_init_3 = false;
+        uint _e3 = k_4;
+        if ((_e3 < level_1)) {
+        } else {
+            break;
+        }
+        {
+            uint _e6 = off;
+            uint _e7 = k_4;
+            uint _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
+            off = (_e6 + _e9);
+        }
+    }
+    uint _e14 = off;
+    return _e14;
+}
+
+float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, uint x_2, uint n, float delta_1, float theta_2, float s_2, bool spot_2) {
     if ((x_2 >= n)) {
         return s_2;
     }
-    float _e9 = ray_t(f_6, float(x_2), delta_1, theta_2, s_2, spot_2);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, float(x_2), delta_1, theta_2, s_2, spot_2);
     return _e9;
 }
 
-float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7, vec3 eye_5, vec3 dir_5, float a_3, float b_3, bool spot_3) {
+float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_5, vec3 dir_5, float a_3, float b_3, bool spot_3) {
     if (spot_3) {
-        float _e12 = spot_segment(f_7, eye_5, dir_5, a_3, b_3, max((f_7.sizes2_.z / 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_5, dir_5, a_3, b_3, max((f_8.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_3, b_3);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_3, b_3);
     return _e15;
 }
 
@@ -455,7 +454,7 @@ void main() {
     bool lit = false;
     bool local_6 = false;
     float l = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_9 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = _group_0_binding_0_cs;
     uint x_7 = id.x;
     uint y_2 = id.y;
     if (!((x_7 >= f_9.sizes.x))) {
@@ -468,7 +467,7 @@ void main() {
         return;
     }
     vec3 eye_6 = f_9.eye.xyz;
-    vec3 _e21 = pixel_dir(f_9, x_7, y_2);
+    vec3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_7, y_2);
     int _e25_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e25 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_7, y_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e25_clamped_lod) - ivec2(1)), _e25_clamped_lod);
     float s_3 = (min(max(_e25.x, 0.0), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 1e-6));
@@ -494,8 +493,9 @@ void main() {
     }
     bool _e88 = local_3;
     if (_e88) {
-        float _e90 = march(eye_6, _e21, s_3, true);
-        vec3 l_2 = (_e90 * color);
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = _group_0_binding_0_cs;
+        float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, _group_0_binding_3_cs, eye_6, _e21, s_3, true);
+        vec3 l_2 = (_e93 * color);
         imageStore(_group_0_binding_5_cs, ivec2(uvec2(x_7, y_2)), vec4(l_2.x, l_2.y, l_2.z, 1.0));
         return;
     }
@@ -507,127 +507,127 @@ void main() {
     float phi = atan(dot(_e21, f_9.e2_.xyz), dot(_e21, f_9.e1_.xyz));
     yc = ((phi - f_9.e1_.w) / f_9.e2_.w);
     if (wrap_1) {
-        float _e127 = yc;
-        float _e128 = yc;
-        yc = (_e127 - (floor((_e128 / float(rows_1))) * float(rows_1)));
+        float _e130 = yc;
+        float _e131 = yc;
+        yc = (_e130 - (floor((_e131 / float(rows_1))) * float(rows_1)));
     } else {
-        float _e135 = yc;
-        yc = clamp(_e135, 0.0, float(rows_1));
+        float _e138 = yc;
+        yc = clamp(_e138, 0.0, float(rows_1));
     }
-    float _e139 = yc;
-    uint _e141 = row_index(floor(_e139), rows_1, wrap_1);
-    vec4 _e144 = _group_0_binding_1_cs[_e141];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e145 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e144);
-    float delta_2 = _e145.delta;
-    float _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_3, f_9.theta.x, f_9.theta.y);
+    float _e142 = yc;
+    uint _e144 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e142), rows_1, wrap_1);
+    vec4 _e147 = _group_0_binding_1_cs[_e144];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e148 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e147);
+    float delta_2 = _e148.delta;
+    float _e154 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_3, f_9.theta.x, f_9.theta.y);
     if (true) {
         vec3 q_2 = normalize(((eye_6 + (_e21 * s_3)) - f_9.light_pos.xyz));
         xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / delta_2);
     } else {
         xs = ((s_3 * sin(theta_3)) / delta_2);
     }
-    float _e169 = xs;
-    float _e170 = xs;
-    uint n_2 = uint(min(ceil(((_e170 > 0.0) ? _e169 : 0.0)), float(width_3)));
-    uint _e179 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
+    float _e172 = xs;
+    float _e173 = xs;
+    uint n_2 = uint(min(ceil(((_e173 > 0.0) ? _e172 : 0.0)), float(width_3)));
+    uint _e182 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     while(true) {
-        uint _e181 = i;
-        if ((_e181 < n_2)) {
+        uint _e184 = i;
+        if ((_e184 < n_2)) {
         } else {
             break;
         }
         {
             k = 0u;
             while(true) {
-                uint _e185 = k;
-                if (((_e185 + 1u) < _e179)) {
-                    uint _e189 = i;
-                    uint _e191 = k;
-                    local_4 = ((_e189 & ((2u << _e191) - 1u)) == 0u);
+                uint _e188 = k;
+                if (((_e188 + 1u) < _e182)) {
+                    uint _e192 = i;
+                    uint _e194 = k;
+                    local_4 = ((_e192 & ((2u << _e194) - 1u)) == 0u);
                 } else {
                     local_4 = false;
                 }
-                bool _e201 = local_4;
-                if (_e201) {
-                    uint _e202 = i;
-                    uint _e204 = k;
-                    local_5 = ((_e202 + (2u << _e204)) <= n_2);
+                bool _e204 = local_4;
+                if (_e204) {
+                    uint _e205 = i;
+                    uint _e207 = k;
+                    local_5 = ((_e205 + (2u << _e207)) <= n_2);
                 } else {
                     local_5 = false;
                 }
-                bool _e211 = local_5;
-                if (_e211) {
+                bool _e214 = local_5;
+                if (_e214) {
                 } else {
                     break;
                 }
                 {
-                    uint _e213 = k;
-                    k = (_e213 + 1u);
+                    uint _e216 = k;
+                    k = (_e216 + 1u);
                 }
             }
             lit = false;
             while(true) {
-                uint _e217 = k;
-                uint _e218 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e217, width_3);
-                uint _e219 = i;
                 uint _e220 = k;
-                int _e226_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 node = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((_e218 + (_e219 >> _e220)), _e141)), ivec2(0), textureSize(_group_0_binding_4_cs, _e226_clamped_lod) - ivec2(1)), _e226_clamped_lod);
-                if ((_e151 <= node.x)) {
+                uint _e221 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e220, width_3);
+                uint _e222 = i;
+                uint _e223 = k;
+                int _e229_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 node = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((_e221 + (_e222 >> _e223)), _e144)), ivec2(0), textureSize(_group_0_binding_4_cs, _e229_clamped_lod) - ivec2(1)), _e229_clamped_lod);
+                if ((_e154 <= node.x)) {
                     lit = true;
                     break;
                 }
-                if (!((_e151 > node.y))) {
-                    uint _e233 = k;
-                    local_6 = (_e233 == 0u);
+                if (!((_e154 > node.y))) {
+                    uint _e236 = k;
+                    local_6 = (_e236 == 0u);
                 } else {
                     local_6 = true;
                 }
-                bool _e239 = local_6;
-                if (_e239) {
+                bool _e242 = local_6;
+                if (_e242) {
                     break;
                 }
-                uint _e241 = k;
-                k = (_e241 - 1u);
+                uint _e244 = k;
+                k = (_e244 - 1u);
             }
-            bool _e244 = lit;
-            bool _e245 = in_run;
-            if ((_e244 != _e245)) {
-                uint _e247 = i;
-                float _e248 = edge_t(f_9, _e247, n_2, delta_2, theta_3, s_3, true);
-                bool _e249 = lit;
-                if (_e249) {
-                    run_a = _e248;
+            bool _e247 = lit;
+            bool _e248 = in_run;
+            if ((_e247 != _e248)) {
+                uint _e250 = i;
+                float _e251 = edge_t(f_9, _e250, n_2, delta_2, theta_3, s_3, true);
+                bool _e252 = lit;
+                if (_e252) {
+                    run_a = _e251;
                 } else {
-                    float _e252 = total;
-                    float _e253 = run_a;
-                    float _e254 = lit_span(f_9, eye_6, _e21, _e253, _e248, true);
-                    total = (_e252 + _e254);
+                    float _e255 = total;
+                    float _e256 = run_a;
+                    float _e257 = lit_span(f_9, eye_6, _e21, _e256, _e251, true);
+                    total = (_e255 + _e257);
                 }
-                bool _e256 = lit;
-                in_run = _e256;
+                bool _e259 = lit;
+                in_run = _e259;
             }
-            uint _e257 = i;
-            uint _e259 = k;
-            i = (_e257 + (1u << _e259));
+            uint _e260 = i;
+            uint _e262 = k;
+            i = (_e260 + (1u << _e262));
         }
     }
-    bool _e262 = in_run;
-    if (_e262) {
-        float _e263 = total;
-        float _e264 = run_a;
-        float _e265 = lit_span(f_9, eye_6, _e21, _e264, s_3, true);
-        total = (_e263 + _e265);
+    bool _e265 = in_run;
+    if (_e265) {
+        float _e266 = total;
+        float _e267 = run_a;
+        float _e268 = lit_span(f_9, eye_6, _e21, _e267, s_3, true);
+        total = (_e266 + _e268);
     }
-    float _e267 = total;
-    l = _e267;
+    float _e270 = total;
+    l = _e270;
     if (!(true)) {
-        float _e278 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(dot(f_9.light_dir.xyz, _e21)));
-        float _e280 = total;
-        l = ((f_9.medium.y * _e278) * _e280);
+        float _e281 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(dot(f_9.light_dir.xyz, _e21)));
+        float _e283 = total;
+        l = ((f_9.medium.y * _e281) * _e283);
     }
-    float _e282 = l;
-    vec3 c = (color * _e282);
+    float _e285 = l;
+    vec3 c = (color * _e285);
     imageStore(_group_0_binding_5_cs, ivec2(uvec2(x_7, y_2)), vec4(c.x, c.y, c.z, 1.0));
     return;
 }

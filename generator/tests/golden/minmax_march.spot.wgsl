@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     size: vec4<u32>,
 }
 
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     eye: vec4<f32>,
     axis: vec4<f32>,
     e1_: vec4<f32>,
@@ -37,21 +37,21 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     proj_g2_: vec4<f32>,
 }
 
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     delta: f32,
     theta_ref: f32,
     theta_lo: f32,
     theta_hi: f32,
 }
 
-const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX: f32 = 1000000000000000000000000000000f;
-const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX: f32 = 0.1f;
+const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
+const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
 
 @group(0) @binding(0) 
-var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX;
+var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX;
 @group(0) @binding(1) 
 var<storage> slices: array<vec4<f32>>;
 @group(0) @binding(2) 
@@ -62,27 +62,6 @@ var shadow_map: texture_2d<f32>;
 var tree: texture_2d<f32>;
 @group(0) @binding(5) 
 var output: texture_storage_2d<rgba16float,write>;
-
-fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_3 = (sigma_t * len);
-    if (x_3 < 0.0001f) {
-        return (len * (1f - (0.5f * x_3)));
-    }
-    return ((1f - exp(-(x_3))) / sigma_t);
-}
-
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
-    let x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_4 * x_4) * (3f - (2f * x_4)));
-}
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
     let q_1 = (p - v.origin.xyz);
@@ -126,9 +105,9 @@ fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_nag
         return 2f;
     }
     let n_1 = v_2.size.x;
-    let x_5 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let x_3 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y_1 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_5, y_1), 0i);
+    let _e49 = textureLoad(sm, vec2<u32>(x_3, y_1), 0i);
     return _e49.x;
 }
 
@@ -196,27 +175,30 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     }
 }
 
-fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
-}
-
-fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta: f32, lo: f32, hi: f32) -> f32 {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8f * clamp(((theta - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
-}
-
-fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f.sm_right, f.sm_up, f.sm_forward, f.sm_origin, f.sm_proj, vec4<u32>(f.sizes2_.x, 0u, 0u, 0u));
-}
-
-fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, sm_3: texture_2d<f32>, p_2: vec3<f32>) -> f32 {
-    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_1);
-    let _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
-}
-
 fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
     let denom = max(((1f + (g * g)) - ((2f * g) * cos_theta)), 0.00000001f);
     return ((1f - (g * g)) / ((12.566371f * denom) * sqrt(denom)));
+}
+
+fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
+    let x_4 = (sigma_t * len);
+    if (x_4 < 0.0001f) {
+        return (len * (1f - (0.5f * x_4)));
+    }
+    return ((1f - exp(-(x_4))) / sigma_t);
+}
+
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    if ((cos_inner - cos_outer) <= 0.000001f) {
+        return select(0f, 1f, (cos_angle >= cos_outer));
+    }
+    let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_5 * x_5) * (3f - (2f * x_5)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
@@ -278,111 +260,80 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     return (((_e75 * 0.5f) * w) * h);
 }
 
-fn level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level: u32, width: u32) -> u32 {
-    return (((width + (1u << level)) - 1u) >> level);
+fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
 }
 
-fn tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_1: u32) -> u32 {
-    var k_2: u32 = 0u;
-
-    loop {
-        let _e2 = k_2;
-        let _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
-        if (_e4 > 1u) {
-        } else {
-            break;
-        }
-        {
-            let _e8 = k_2;
-            k_2 = (_e8 + 1u);
-        }
-    }
-    let _e10 = k_2;
-    return (_e10 + 1u);
+fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta: f32, lo: f32, hi: f32) -> f32 {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * clamp(((theta - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
 }
 
-fn level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_1: u32, width_2: u32) -> u32 {
-    var off: u32 = 0u;
-    var k_3: u32 = 0u;
-
-    loop {
-        let _e3 = k_3;
-        if (_e3 < level_1) {
-        } else {
-            break;
-        }
-        {
-            let _e6 = off;
-            let _e7 = k_3;
-            let _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
-            off = (_e6 + _e9);
-        }
-        continuing {
-            let _e12 = k_3;
-            k_3 = (_e12 + 1u);
-        }
-    }
-    let _e14 = off;
-    return _e14;
+fn pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x: u32, y: u32) -> vec3<f32> {
+    let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(f.sizes.x)) - 1f);
+    let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(f.sizes.y)));
+    let t_3 = f.cam_forward.w;
+    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_3) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_3))));
 }
 
-fn pixel_dir(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x: u32, y: u32) -> vec3<f32> {
-    let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(f_2.sizes.x)) - 1f);
-    let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(f_2.sizes.y)));
-    let t_3 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc_x * t_3) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc_y * t_3))));
+fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_1.sm_right, f_1.sm_up, f_1.sm_forward, f_1.sm_origin, f_1.sm_proj, vec4<u32>(f_1.sizes2_.x, 0u, 0u, 0u));
 }
 
-fn frame_spot_integrand(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_2: vec3<f32>, dir_2: vec3<f32>, t_1: f32) -> f32 {
+fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_3: texture_2d<f32>, p_2: vec3<f32>) -> f32 {
+    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2);
+    let _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
+    return _e4;
+}
+
+fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_2: vec3<f32>, dir_2: vec3<f32>, t_1: f32) -> f32 {
     let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-fn march(eye_3: vec3<f32>, dir_3: vec3<f32>, s: f32, spot: bool) -> f32 {
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_3: vec3<f32>, dir_3: vec3<f32>, s: f32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
-    var k_4: u32 = 0u;
+    var k_2: u32 = 0u;
 
-    let f_8 = frame;
-    let steps = f_8.sizes2_.y;
+    let steps = f_4.sizes2_.y;
     let h_1 = (s / f32(steps));
     loop {
-        let _e10 = k_4;
-        if (_e10 < steps) {
+        let _e9 = k_2;
+        if (_e9 < steps) {
         } else {
             break;
         }
         {
-            let _e12 = k_4;
-            let t_4 = ((f32(_e12) + 0.5f) * h_1);
-            let _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_8, shadow_map, (eye_3 + (dir_3 * t_4)));
+            let _e11 = k_2;
+            let t_4 = ((f32(_e11) + 0.5f) * h_1);
+            let _e21 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_3 + (dir_3 * t_4)));
             if spot {
-                let _e25 = sum_1;
-                let _e27 = frame_spot_integrand(f_8, eye_3, dir_3, t_4);
-                sum_1 = (_e25 + ((_e22 * h_1) * _e27));
+                let _e24 = sum_1;
+                let _e26 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_3, dir_3, t_4);
+                sum_1 = (_e24 + ((_e21 * h_1) * _e26));
             } else {
-                let _e30 = sum_1;
-                let _e33 = k_4;
-                let _e36 = k_4;
-                let _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, (f32(_e33) * h_1), (f32((_e36 + 1u)) * h_1));
-                sum_1 = (_e30 + (_e22 * _e41));
+                let _e29 = sum_1;
+                let _e32 = k_2;
+                let _e35 = k_2;
+                let _e40 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e32) * h_1), (f32((_e35 + 1u)) * h_1));
+                sum_1 = (_e29 + (_e21 * _e40));
             }
         }
         continuing {
-            let _e45 = k_4;
-            k_4 = (_e45 + 1u);
+            let _e44 = k_2;
+            k_2 = (_e44 + 1u);
         }
     }
     if spot {
-        let _e47 = sum_1;
-        return _e47;
+        let _e46 = sum_1;
+        return _e46;
     } else {
-        let _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.z, -(dot(f_8.light_dir.xyz, dir_3)));
-        let _e58 = sum_1;
-        return ((f_8.medium.y * _e56) * _e58);
+        let _e55 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_3)));
+        let _e57 = sum_1;
+        return ((f_4.medium.y * _e55) * _e57);
     }
 }
 
-fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
+fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
     let ji = i32(j);
     if wrap {
         return u32((((ji % i32(rows)) + i32(rows)) % i32(rows)));
@@ -391,7 +342,7 @@ fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
     }
 }
 
-fn ray_t(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_1: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
     var local_11: bool;
 
     if spot_1 {
@@ -406,31 +357,79 @@ fn ray_t(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_1: f32, 
         if _e16 {
             return s_1;
         }
-        return min(((f_4.axis.w * sin(psi)) / den), s_1);
+        return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
         return min(((x_1 * delta) / max(sin(theta_1), 0.000001f)), s_1);
     }
 }
 
-fn spot_segment(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_4: vec3<f32>, dir_4: vec3<f32>, a_2: f32, b_2: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_5.light_pos.xyz, f_5.light_dir.xyz, f_5.light_pos.w, f_5.light_dir.w, f_5.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_4: vec3<f32>, dir_4: vec3<f32>, a_2: f32, b_2: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
-fn edge_t(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_2: u32, n: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
+fn level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level: u32, width: u32) -> u32 {
+    return (((width + (1u << level)) - 1u) >> level);
+}
+
+fn tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_1: u32) -> u32 {
+    var k_3: u32 = 0u;
+
+    loop {
+        let _e2 = k_3;
+        let _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
+        if (_e4 > 1u) {
+        } else {
+            break;
+        }
+        {
+            let _e8 = k_3;
+            k_3 = (_e8 + 1u);
+        }
+    }
+    let _e10 = k_3;
+    return (_e10 + 1u);
+}
+
+fn level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_1: u32, width_2: u32) -> u32 {
+    var off: u32 = 0u;
+    var k_4: u32 = 0u;
+
+    loop {
+        let _e3 = k_4;
+        if (_e3 < level_1) {
+        } else {
+            break;
+        }
+        {
+            let _e6 = off;
+            let _e7 = k_4;
+            let _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
+            off = (_e6 + _e9);
+        }
+        continuing {
+            let _e12 = k_4;
+            k_4 = (_e12 + 1u);
+        }
+    }
+    let _e14 = off;
+    return _e14;
+}
+
+fn edge_t(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
     if (x_2 >= n) {
         return s_2;
     }
-    let _e9 = ray_t(f_6, f32(x_2), delta_1, theta_2, s_2, spot_2);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, f32(x_2), delta_1, theta_2, s_2, spot_2);
     return _e9;
 }
 
-fn lit_span(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, spot_3: bool) -> f32 {
+fn lit_span(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, spot_3: bool) -> f32 {
     if spot_3 {
-        let _e12 = spot_segment(f_7, eye_5, dir_5, a_3, b_3, max((f_7.sizes2_.z / 4u), 1u));
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_5, dir_5, a_3, b_3, max((f_8.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_3, b_3);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_3, b_3);
     return _e15;
 }
 
@@ -466,7 +465,7 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let eye_6 = f_9.eye.xyz;
-    let _e21 = pixel_dir(f_9, x_7, y_2);
+    let _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_7, y_2);
     let _e25 = textureLoad(depth, vec2<u32>(x_7, y_2), 0i);
     let s_3 = (min(max(_e25.x, 0f), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 0.000001f));
     let color = f_9.light_color.xyz;
@@ -491,8 +490,9 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let _e88 = local_3;
     if _e88 {
-        let _e90 = march(eye_6, _e21, s_3, true);
-        let l_2 = (_e90 * color);
+        let _e90 = frame;
+        let _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_6, _e21, s_3, true);
+        let l_2 = (_e93 * color);
         textureStore(output, vec2<u32>(x_7, y_2), vec4<f32>(l_2.x, l_2.y, l_2.z, 1f));
         return;
     }
@@ -504,126 +504,126 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     let phi = atan2(dot(_e21, f_9.e2_.xyz), dot(_e21, f_9.e1_.xyz));
     yc = ((phi - f_9.e1_.w) / f_9.e2_.w);
     if wrap_1 {
-        let _e127 = yc;
-        let _e128 = yc;
-        yc = (_e127 - (floor((_e128 / f32(rows_1))) * f32(rows_1)));
+        let _e130 = yc;
+        let _e131 = yc;
+        yc = (_e130 - (floor((_e131 / f32(rows_1))) * f32(rows_1)));
     } else {
-        let _e135 = yc;
-        yc = clamp(_e135, 0f, f32(rows_1));
+        let _e138 = yc;
+        yc = clamp(_e138, 0f, f32(rows_1));
     }
-    let _e139 = yc;
-    let _e141 = row_index(floor(_e139), rows_1, wrap_1);
-    let _e144 = slices[_e141];
-    let _e145 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e144);
-    let delta_2 = _e145.delta;
-    let _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_3, f_9.theta.x, f_9.theta.y);
+    let _e142 = yc;
+    let _e144 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e142), rows_1, wrap_1);
+    let _e147 = slices[_e144];
+    let _e148 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e147);
+    let delta_2 = _e148.delta;
+    let _e154 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_3, f_9.theta.x, f_9.theta.y);
     if true {
         let q_2 = normalize(((eye_6 + (_e21 * s_3)) - f_9.light_pos.xyz));
         xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / delta_2);
     } else {
         xs = ((s_3 * sin(theta_3)) / delta_2);
     }
-    let _e169 = xs;
-    let _e170 = xs;
-    let n_2 = u32(min(ceil(select(0f, _e169, (_e170 > 0f))), f32(width_3)));
-    let _e179 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
+    let _e172 = xs;
+    let _e173 = xs;
+    let n_2 = u32(min(ceil(select(0f, _e172, (_e173 > 0f))), f32(width_3)));
+    let _e182 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     loop {
-        let _e181 = i;
-        if (_e181 < n_2) {
+        let _e184 = i;
+        if (_e184 < n_2) {
         } else {
             break;
         }
         {
             k = 0u;
             loop {
-                let _e185 = k;
-                if ((_e185 + 1u) < _e179) {
-                    let _e189 = i;
-                    let _e191 = k;
-                    local_4 = ((_e189 & ((2u << _e191) - 1u)) == 0u);
+                let _e188 = k;
+                if ((_e188 + 1u) < _e182) {
+                    let _e192 = i;
+                    let _e194 = k;
+                    local_4 = ((_e192 & ((2u << _e194) - 1u)) == 0u);
                 } else {
                     local_4 = false;
                 }
-                let _e201 = local_4;
-                if _e201 {
-                    let _e202 = i;
-                    let _e204 = k;
-                    local_5 = ((_e202 + (2u << _e204)) <= n_2);
+                let _e204 = local_4;
+                if _e204 {
+                    let _e205 = i;
+                    let _e207 = k;
+                    local_5 = ((_e205 + (2u << _e207)) <= n_2);
                 } else {
                     local_5 = false;
                 }
-                let _e211 = local_5;
-                if _e211 {
+                let _e214 = local_5;
+                if _e214 {
                 } else {
                     break;
                 }
                 {
-                    let _e213 = k;
-                    k = (_e213 + 1u);
+                    let _e216 = k;
+                    k = (_e216 + 1u);
                 }
             }
             lit = false;
             loop {
-                let _e217 = k;
-                let _e218 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e217, width_3);
-                let _e219 = i;
                 let _e220 = k;
-                let node = textureLoad(tree, vec2<u32>((_e218 + (_e219 >> _e220)), _e141), 0i);
-                if (_e151 <= node.x) {
+                let _e221 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e220, width_3);
+                let _e222 = i;
+                let _e223 = k;
+                let node = textureLoad(tree, vec2<u32>((_e221 + (_e222 >> _e223)), _e144), 0i);
+                if (_e154 <= node.x) {
                     lit = true;
                     break;
                 }
-                if !((_e151 > node.y)) {
-                    let _e233 = k;
-                    local_6 = (_e233 == 0u);
+                if !((_e154 > node.y)) {
+                    let _e236 = k;
+                    local_6 = (_e236 == 0u);
                 } else {
                     local_6 = true;
                 }
-                let _e239 = local_6;
-                if _e239 {
+                let _e242 = local_6;
+                if _e242 {
                     break;
                 }
-                let _e241 = k;
-                k = (_e241 - 1u);
+                let _e244 = k;
+                k = (_e244 - 1u);
             }
-            let _e244 = lit;
-            let _e245 = in_run;
-            if (_e244 != _e245) {
-                let _e247 = i;
-                let _e248 = edge_t(f_9, _e247, n_2, delta_2, theta_3, s_3, true);
-                let _e249 = lit;
-                if _e249 {
-                    run_a = _e248;
+            let _e247 = lit;
+            let _e248 = in_run;
+            if (_e247 != _e248) {
+                let _e250 = i;
+                let _e251 = edge_t(f_9, _e250, n_2, delta_2, theta_3, s_3, true);
+                let _e252 = lit;
+                if _e252 {
+                    run_a = _e251;
                 } else {
-                    let _e252 = total;
-                    let _e253 = run_a;
-                    let _e254 = lit_span(f_9, eye_6, _e21, _e253, _e248, true);
-                    total = (_e252 + _e254);
+                    let _e255 = total;
+                    let _e256 = run_a;
+                    let _e257 = lit_span(f_9, eye_6, _e21, _e256, _e251, true);
+                    total = (_e255 + _e257);
                 }
-                let _e256 = lit;
-                in_run = _e256;
+                let _e259 = lit;
+                in_run = _e259;
             }
-            let _e257 = i;
-            let _e259 = k;
-            i = (_e257 + (1u << _e259));
+            let _e260 = i;
+            let _e262 = k;
+            i = (_e260 + (1u << _e262));
         }
     }
-    let _e262 = in_run;
-    if _e262 {
-        let _e263 = total;
-        let _e264 = run_a;
-        let _e265 = lit_span(f_9, eye_6, _e21, _e264, s_3, true);
-        total = (_e263 + _e265);
+    let _e265 = in_run;
+    if _e265 {
+        let _e266 = total;
+        let _e267 = run_a;
+        let _e268 = lit_span(f_9, eye_6, _e21, _e267, s_3, true);
+        total = (_e266 + _e268);
     }
-    let _e267 = total;
-    l = _e267;
+    let _e270 = total;
+    l = _e270;
     if !(true) {
-        let _e278 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(dot(f_9.light_dir.xyz, _e21)));
-        let _e280 = total;
-        l = ((f_9.medium.y * _e278) * _e280);
+        let _e281 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(dot(f_9.light_dir.xyz, _e21)));
+        let _e283 = total;
+        l = ((f_9.medium.y * _e281) * _e283);
     }
-    let _e282 = l;
-    let c = (color * _e282);
+    let _e285 = l;
+    let c = (color * _e285);
     textureStore(output, vec2<u32>(x_7, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

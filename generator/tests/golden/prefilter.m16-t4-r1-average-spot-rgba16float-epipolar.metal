@@ -18,7 +18,10 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct type_9 {
+    float inner[4];
+};
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 eye;
     metal::float4 axis;
     metal::float4 e1_;
@@ -45,61 +48,32 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
 };
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
     float theta_ref;
     float theta_lo;
     float theta_hi;
 };
-typedef metal::float4 type_9[1];
-struct type_12 {
+typedef metal::float4 type_10[1];
+struct type_13 {
     metal::float4 inner[1];
 };
-constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
+constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
+constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
+constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 constant float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
 constant uint REGIONS = 1u;
 constant uint BASES_PER_THREAD = 4u;
 constant uint THREADS_PER_ROW_REGION = 4u;
 
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float sigma_t,
-    float len
-) {
-    float x_1 = sigma_t * len;
-    if (x_1 < 0.0001) {
-        return len * (1.0 - (0.5 * x_1));
-    }
-    return (1.0 - metal::exp(-(x_1))) / sigma_t;
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float sigma_t_1,
-    float a,
-    float b
-) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
-    return metal::exp(-(sigma_t_1) * a) * _e7;
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float cos_angle,
-    float cos_inner,
-    float cos_outer
-) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
-    float x_2 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_2 * x_2) * (3.0 - (2.0 * x_2));
-}
-
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
     metal::float3 p
 ) {
-    metal::float3 q_1 = p - v.origin.xyz;
-    return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
+    metal::float3 q_2 = p - v.origin.xyz;
+    return metal::float3(metal::dot(q_2, v.right.xyz), metal::dot(q_2, v.up.xyz), metal::dot(q_2, v.forward.xyz));
 }
 
 metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
@@ -108,8 +82,8 @@ metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     if (v_1.origin.w > 0.5) {
         float z_1 = metal::max(ls.z, 0.000001);
-        float t = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t)), 0.5 - ((0.5 * ls.y) / (z_1 * t)));
+        float t_1 = v_1.proj.x;
+        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_1)), 0.5 - ((0.5 * ls.y) / (z_1 * t_1)));
     } else {
         return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
     }
@@ -149,10 +123,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
         return 2.0;
     }
     uint n = v_2.size.x;
-    uint x_3 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
+    uint x_1 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
     uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_3, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_1, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -206,18 +180,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir.z <= 0.000001) {
+        metal::float3 dir_2 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_2.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return (z_2 + _e35) / dir.z;
+        return (z_2 + _e35) / dir_2.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -230,16 +204,158 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     }
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float g,
+    float cos_theta
+) {
+    float denom = metal::max((1.0 + (g * g)) - ((2.0 * g) * cos_theta), 0.00000001);
+    return (1.0 - (g * g)) / ((12.566371 * denom) * metal::sqrt(denom));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float sigma_t,
+    float len
+) {
+    float x_2 = sigma_t * len;
+    if (x_2 < 0.0001) {
+        return len * (1.0 - (0.5 * x_2));
+    }
+    return (1.0 - metal::exp(-(x_2))) / sigma_t;
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float sigma_t_1,
+    float a,
+    float b
+) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
+    return metal::exp(-(sigma_t_1) * a) * _e7;
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float cos_angle,
+    float cos_inner,
+    float cos_outer
+) {
+    if ((cos_inner - cos_outer) <= 0.000001) {
+        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
+    }
+    float x_3 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_3 * x_3) * (3.0 - (2.0 * x_3));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye,
+    metal::float3 dir,
+    float t,
+    metal::float3 light_pos,
+    metal::float3 light_dir,
+    float cos_inner_1,
+    float cos_outer_1,
+    metal::float4 medium
+) {
+    metal::float3 x_4 = eye + (dir * t);
+    metal::float3 to_x = x_4 - light_pos;
+    float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
+    float d_1 = metal::sqrt(d2_);
+    metal::float3 travel = to_x / metal::float3(d_1);
+    float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_1 + t))) / d2_;
+}
+
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye_1,
+    metal::float3 dir_1,
+    float a_1,
+    float b_1,
+    uint panels,
+    metal::float3 light_pos_1,
+    metal::float3 light_dir_1,
+    float cos_inner_2,
+    float cos_outer_2,
+    metal::float4 medium_1
+) {
+    float sum = 0.0;
+    uint k = 0u;
+    uint q_1 = {};
+    float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
+    float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
+    float g0_ = metal::atan((a_1 - t0_) / h);
+    float w_1 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
+    uint2 loop_bound = uint2(4294967295u);
+    bool loop_init = true;
+    while(true) {
+        if (metal::all(loop_bound == uint2(0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e73 = k;
+            k = _e73 + 1u;
+        }
+        loop_init = false;
+        uint _e30 = k;
+        if (_e30 < panels) {
+        } else {
+            break;
+        }
+        {
+            uint _e32 = k;
+            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
+            q_1 = 0u;
+            uint2 loop_bound_1 = uint2(4294967295u);
+            bool loop_init_1 = true;
+            while(true) {
+                if (metal::all(loop_bound_1 == uint2(0u))) { break; }
+                loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+                if (!loop_init_1) {
+                    uint _e70 = q_1;
+                    q_1 = _e70 + 1u;
+                }
+                loop_init_1 = false;
+                uint _e40 = q_1;
+                if (_e40 < 4u) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e46 = q_1;
+                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float _e52 = sum;
+                    uint _e54 = q_1;
+                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                }
+            }
+        }
+    }
+    float _e75 = sum;
+    return ((_e75 * 0.5) * w_1) * h;
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float4 v_6
 ) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {v_6.x, v_6.y, v_6.z, v_6.w};
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {v_6.x, v_6.y, v_6.z, v_6.w};
+}
+
+metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f,
+    float phi
+) {
+    return (f.e1_.xyz * metal::cos(phi)) + (f.e2_.xyz * metal::sin(phi));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1,
+    uint row
+) {
+    return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
 }
 
 float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    uint k
+    uint k_1
 ) {
-    return PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * static_cast<float>((2u * k) - 1u);
+    return PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * static_cast<float>((2u * k_1) - 1u);
 }
 
 metal::float4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -268,13 +384,13 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 }
 
 float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f,
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX s,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s,
     float x,
     bool spot_1
 ) {
     bool local_6 = {};
-    float cap = 4.0 * f.theta.z;
+    float cap = 4.0 * f_2.theta.z;
     if (spot_1) {
         float psi = x * s.delta;
         float den = metal::sin(s.theta_ref + psi);
@@ -287,29 +403,15 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
         if (_e23) {
             return cap;
         }
-        return metal::min((f.axis.w * metal::sin(psi)) / den, cap);
+        return metal::min((f_2.axis.w * metal::sin(psi)) / den, cap);
     } else {
         return metal::min((x * s.delta) / metal::max(metal::sin(s.theta_ref), 0.0001), cap);
     }
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1,
-    uint row
-) {
-    return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
-}
-
-metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2,
-    float phi
-) {
-    return (f_2.e1_.xyz * metal::cos(phi)) + (f_2.e2_.xyz * metal::sin(phi));
-}
-
 float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3,
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX s_1,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1,
     uint row_1,
     uint i_1,
     bool weighted,
@@ -325,8 +427,8 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     w = _e15;
     if (spot_2) {
         float psi_1 = (static_cast<float>(i_1) + 0.5) * s_1.delta;
-        float _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, row_1);
-        metal::float3 _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, _e23);
+        float _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, row_1);
+        metal::float3 _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e23);
         metal::float3 l_1 = (-(f_3.axis.xyz) * metal::cos(psi_1)) + (_e24 * metal::sin(psi_1));
         float den_1 = metal::max(metal::sin(s_1.theta_ref + psi_1), 0.0001);
         float r_1 = metal::max((f_3.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
@@ -343,15 +445,15 @@ struct prefilterInput {
 };
 kernel void prefilter(
   metal::uint3 id [[thread_position_in_grid]]
-, constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX& frame [[buffer(0)]]
-, device type_9 const& slices [[buffer(1)]]
+, constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
+, device type_10 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(0)]]
 , metal::texture2d_array<float, metal::access::write> filtered [[texture(1)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
 ) {
     bool local = {};
     bool local_1 = {};
-    type_12 acc = {};
+    type_13 acc = {};
     float wsum = 0.0;
     uint i = {};
     uint q = {};
@@ -376,20 +478,20 @@ kernel void prefilter(
         return;
     }
     metal::float4 _e30 = slices[metal::min(unsigned(row_2), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e31 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e30);
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e31 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e30);
     uint _e34 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
     uint _e38 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, true);
     i = _e34;
-    uint2 loop_bound = uint2(4294967295u);
-    bool loop_init = true;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound == uint2(0u))) { break; }
-        loop_bound -= uint2(loop_bound.y == 0u, 1u);
-        if (!loop_init) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e98 = i;
             i = _e98 + 1u;
         }
-        loop_init = false;
+        loop_init_2 = false;
         uint _e40 = i;
         if (_e40 < _e38) {
         } else {
@@ -399,8 +501,8 @@ kernel void prefilter(
             uint _e42 = i;
             uint clamped_lod_e46 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
             metal::float4 _e46 = rectified.read(metal::min(metal::uint2(metal::uint2(_e42, row_2)), metal::uint2(rectified.get_width(clamped_lod_e46), rectified.get_height(clamped_lod_e46)) - 1), clamped_lod_e46);
-            float d_1 = _e46.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e49 = frame;
+            float d_2 = _e46.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e49 = frame;
             uint _e50 = i;
             float _e52 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e49, _e31, row_2, _e50, false, true);
             float _e54 = wsum;
@@ -409,16 +511,16 @@ kernel void prefilter(
             float _e58 = wsum;
             float blend = (_e58 > 0.0) ? (_e52 / _e56) : 0.0;
             q = 0u;
-            uint2 loop_bound_1 = uint2(4294967295u);
-            bool loop_init_1 = true;
+            uint2 loop_bound_3 = uint2(4294967295u);
+            bool loop_init_3 = true;
             while(true) {
-                if (metal::all(loop_bound_1 == uint2(0u))) { break; }
-                loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-                if (!loop_init_1) {
+                if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+                loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+                if (!loop_init_3) {
                     uint _e95 = q;
                     q = _e95 + 1u;
                 }
-                loop_init_1 = false;
+                loop_init_3 = false;
                 uint _e66 = q;
                 if (_e66 < 1u) {
                 } else {
@@ -427,11 +529,11 @@ kernel void prefilter(
                 {
                     uint _e69 = q;
                     uint layer_1 = (thread_ * 1u) + _e69;
-                    metal::float4 _e71 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_1, layer_1);
+                    metal::float4 _e71 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
                     uint _e73 = q;
-                    metal::float4 a_1 = acc.inner[metal::min(unsigned(_e73), 0u)];
+                    metal::float4 a_2 = acc.inner[metal::min(unsigned(_e73), 0u)];
                     uint _e76 = q;
-                    acc.inner[metal::min(unsigned(_e76), 0u)] = (a_1 * (1.0 - blend)) + (_e71 * blend);
+                    acc.inner[metal::min(unsigned(_e76), 0u)] = (a_2 * (1.0 - blend)) + (_e71 * blend);
                     uint _e83 = q;
                     metal::float4 _e85 = acc.inner[metal::min(unsigned(_e83), 0u)];
                     metal::float4 stored = (_e85 * 0.5) + metal::float4(0.5);

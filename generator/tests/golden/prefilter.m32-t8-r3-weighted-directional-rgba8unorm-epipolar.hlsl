@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     uint4 size;
 };
 
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float4 eye;
     float4 axis;
     float4 e1_;
@@ -37,61 +37,46 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float4 proj_g2_;
 };
 
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
     float theta_ref;
     float theta_lo;
     float theta_hi;
 };
 
-static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+typedef float ret_Constructarray4_float_[4];
+ret_Constructarray4_float_ Constructarray4_float_(float arg0, float arg1, float arg2, float arg3) {
+    float ret[4] = { arg0, arg1, arg2, arg3 };
+    return ret;
+}
+
 static const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
+static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+static const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+static const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(0.34785485, 0.65214515, 0.65214515, 0.34785485);
+static const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 static const float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
 static const uint REGIONS = 3u;
 static const uint BASES_PER_THREAD = 8u;
 static const uint THREADS_PER_ROW_REGION = 4u;
 
-cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX frame; }
+cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX frame; }
 ByteAddressBuffer slices : register(t1);
 Texture2D<float4> rectified : register(t2);
 RWTexture2DArray<unorm float4> filtered : register(u3);
 
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
-{
-    float x_1 = (sigma_t * len);
-    if ((x_1 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_1)));
-    }
-    return ((1.0 - exp(-(x_1))) / sigma_t);
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
-{
-    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
-{
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
-    float x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_2 * x_2) * (3.0 - (2.0 * x_2)));
-}
-
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
-    float3 q_1 = (p - v.origin.xyz);
-    return float3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+    float3 q_2 = (p - v.origin.xyz);
+    return float3(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
 }
 
 float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
 {
     if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t))), (0.5 - ((0.5 * ls.y) / (z_1 * t))));
+        float t_1 = v_1.proj.x;
+        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_1))), (0.5 - ((0.5 * ls.y) / (z_1 * t_1))));
     } else {
         return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -129,9 +114,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
         return 2.0;
     }
     uint n = v_2.size.x;
-    uint x_3 = min(naga_f2u32((uv.x * float(n))), (n - 1u));
+    uint x_1 = min(naga_f2u32((uv.x * float(n))), (n - 1u));
     uint y = min(naga_f2u32((uv.y * float(n))), (n - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_3, y), int(0)));
+    float4 _e49 = sm.Load(int3(uint2(x_1, y), int(0)));
     return _e49.x;
 }
 
@@ -178,18 +163,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        float3 dir = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir.z <= 1e-6)) {
+        float3 dir_2 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_2.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
         const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir.z);
+        return ((z_2 + _e35) / dir_2.z);
     } else {
         const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -202,8 +187,109 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     }
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float arg0, float arg1, float arg2, float arg3) {
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX ret = (SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX)0;
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
+{
+    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
+    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
+{
+    float x_2 = (sigma_t * len);
+    if ((x_2 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_2)));
+    }
+    return ((1.0 - exp(-(x_2))) / sigma_t);
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
+{
+    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
+{
+    if (((cos_inner - cos_outer) <= 1e-6)) {
+        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
+    }
+    float x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_3 * x_3) * (3.0 - (2.0 * x_3)));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
+{
+    float3 x_4 = (eye + (dir * t));
+    float3 to_x = (x_4 - light_pos);
+    float d2_ = max(dot(to_x, to_x), 1e-12);
+    float d_1 = sqrt(d2_);
+    float3 travel = (to_x / (d_1).xxx);
+    const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+}
+
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
+{
+    float sum = 0.0;
+    uint k = 0u;
+    uint q_1 = (uint)0;
+
+    float t0_ = dot((light_pos_1 - eye_1), dir_1);
+    float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float g0_ = atan(((a_1 - t0_) / h));
+    float w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
+    uint2 loop_bound = uint2(4294967295u, 4294967295u);
+    bool loop_init = true;
+    while(true) {
+        if (all(loop_bound == uint2(0u, 0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e73 = k;
+            k = (_e73 + 1u);
+        }
+        loop_init = false;
+        uint _e30 = k;
+        if ((_e30 < panels)) {
+        } else {
+            break;
+        }
+        {
+            uint _e32 = k;
+            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
+            q_1 = 0u;
+            uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
+            bool loop_init_1 = true;
+            while(true) {
+                if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
+                loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+                if (!loop_init_1) {
+                    uint _e70 = q_1;
+                    q_1 = (_e70 + 1u);
+                }
+                loop_init_1 = false;
+                uint _e40 = q_1;
+                if ((_e40 < 4u)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e46 = q_1;
+                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
+                    float _e52 = sum;
+                    uint _e54 = q_1;
+                    const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e54), 3u)] * _e62) * (1.0 + (u * u))));
+                }
+            }
+        }
+    }
+    float _e75 = sum;
+    return (((_e75 * 0.5) * w_1) * h);
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float arg0, float arg1, float arg2, float arg3) {
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX ret = (SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX)0;
     ret.delta = arg0;
     ret.theta_ref = arg1;
     ret.theta_lo = arg2;
@@ -211,15 +297,25 @@ SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX ConstructSliceParam
     return ret;
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float4 v_6)
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float4 v_6)
 {
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX sliceparamsx_naga_oil_mod_xonrwc5dumvzduotqojswm2lmorsxezlex = ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
-    return sliceparamsx_naga_oil_mod_xonrwc5dumvzduotqojswm2lmorsxezlex;
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax = ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+    return sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax;
 }
 
-float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k)
+float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, float phi)
 {
-    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k) - 1u)));
+    return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row)
+{
+    return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
+}
+
+float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_1)
+{
+    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_1) - 1u)));
 }
 
 float4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d, uint layer)
@@ -241,11 +337,11 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return naga_div(((r * r) * width), (regions * regions));
 }
 
-float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX s, float x, bool spot_1)
+float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x, bool spot_1)
 {
     bool local_6 = (bool)0;
 
-    float cap = (4.0 * f.theta.z);
+    float cap = (4.0 * f_2.theta.z);
     if (spot_1) {
         float psi = (x * s.delta);
         float den = sin((s.theta_ref + psi));
@@ -258,23 +354,13 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod
         if (_e23) {
             return cap;
         }
-        return min(((f.axis.w * sin(psi)) / den), cap);
+        return min(((f_2.axis.w * sin(psi)) / den), cap);
     } else {
         return min(((x * s.delta) / max(sin(s.theta_ref), 0.0001)), cap);
     }
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1, uint row)
-{
-    return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
-}
-
-float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2, float phi)
-{
-    return ((f_2.e1_.xyz * cos(phi)) + (f_2.e2_.xyz * sin(phi)));
-}
-
-float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX s_1, uint row_1, uint i_1, bool weighted, bool spot_2)
+float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, uint row_1, uint i_1, bool weighted, bool spot_2)
 {
     float w = (float)0;
 
@@ -287,8 +373,8 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_
     w = _e15;
     if (spot_2) {
         float psi_1 = ((float(i_1) + 0.5) * s_1.delta);
-        const float _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, row_1);
-        const float3 _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, _e23);
+        const float _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, row_1);
+        const float3 _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e23);
         float3 l_1 = ((-(f_3.axis.xyz) * cos(psi_1)) + (_e24 * sin(psi_1)));
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
         float r_1 = max(((f_3.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
@@ -332,20 +418,20 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         return;
     }
     float4 _e30 = asfloat(slices.Load4(row_2*16));
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e31 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e30);
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e31 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e30);
     const uint _e34 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     const uint _e38 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
     i = _e34;
-    uint2 loop_bound = uint2(4294967295u, 4294967295u);
-    bool loop_init = true;
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (all(loop_bound == uint2(0u, 0u))) { break; }
-        loop_bound -= uint2(loop_bound.y == 0u, 1u);
-        if (!loop_init) {
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e98 = i;
             i = (_e98 + 1u);
         }
-        loop_init = false;
+        loop_init_2 = false;
         uint _e40 = i;
         if ((_e40 < _e38)) {
         } else {
@@ -354,8 +440,8 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         {
             uint _e42 = i;
             float4 _e46 = rectified.Load(int3(uint2(_e42, row_2), int(0)));
-            float d_1 = _e46.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e49 = frame;
+            float d_2 = _e46.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e49 = frame;
             uint _e50 = i;
             const float _e52 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e49, _e31, row_2, _e50, true, false);
             float _e54 = wsum;
@@ -364,16 +450,16 @@ void prefilter(uint3 id : SV_DispatchThreadID)
             float _e58 = wsum;
             float blend = ((_e58 > 0.0) ? (_e52 / _e56) : 0.0);
             q = 0u;
-            uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
-            bool loop_init_1 = true;
+            uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
+            bool loop_init_3 = true;
             while(true) {
-                if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
-                loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-                if (!loop_init_1) {
+                if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
+                loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+                if (!loop_init_3) {
                     uint _e95 = q;
                     q = (_e95 + 1u);
                 }
-                loop_init_1 = false;
+                loop_init_3 = false;
                 uint _e66 = q;
                 if ((_e66 < 2u)) {
                 } else {
@@ -382,11 +468,11 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 {
                     uint _e69 = q;
                     uint layer_1 = ((thread * 2u) + _e69);
-                    const float4 _e71 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_1, layer_1);
+                    const float4 _e71 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
                     uint _e73 = q;
-                    float4 a_1 = acc[min(uint(_e73), 1u)];
+                    float4 a_2 = acc[min(uint(_e73), 1u)];
                     uint _e76 = q;
-                    acc[min(uint(_e76), 1u)] = ((a_1 * (1.0 - blend)) + (_e71 * blend));
+                    acc[min(uint(_e76), 1u)] = ((a_2 * (1.0 - blend)) + (_e71 * blend));
                     uint _e83 = q;
                     float4 _e85 = acc[min(uint(_e83), 1u)];
                     float4 stored = ((_e85 * 0.5) + (0.5).xxxx);

@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     size: vec4<u32>,
 }
 
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     eye: vec4<f32>,
     axis: vec4<f32>,
     e1_: vec4<f32>,
@@ -37,22 +37,25 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     proj_g2_: vec4<f32>,
 }
 
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     delta: f32,
     theta_ref: f32,
     theta_lo: f32,
     theta_hi: f32,
 }
 
-const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX: f32 = 1000000000000000000000000000000f;
+const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
+const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
+const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
+const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
 const CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX: f32 = 0.001f;
 const REGIONS: u32 = 3u;
 const BASES_PER_THREAD: u32 = 8u;
 const THREADS_PER_ROW_REGION: u32 = 4u;
 
 @group(0) @binding(0) 
-var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX;
+var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX;
 @group(0) @binding(1) 
 var<storage> slices: array<vec4<f32>>;
 @group(0) @binding(2) 
@@ -60,37 +63,16 @@ var rectified: texture_2d<f32>;
 @group(0) @binding(3) 
 var filtered: texture_storage_2d_array<rgba8unorm,write>;
 
-fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_1 = (sigma_t * len);
-    if (x_1 < 0.0001f) {
-        return (len * (1f - (0.5f * x_1)));
-    }
-    return ((1f - exp(-(x_1))) / sigma_t);
-}
-
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
-    let x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_2 * x_2) * (3f - (2f * x_2)));
-}
-
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
-    let q_1 = (p - v.origin.xyz);
-    return vec3<f32>(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+    let q_2 = (p - v.origin.xyz);
+    return vec3<f32>(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
 }
 
 fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
     if (v_1.origin.w > 0.5f) {
         let z_1 = max(ls.z, 0.000001f);
-        let t = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t))), (0.5f - ((0.5f * ls.y) / (z_1 * t))));
+        let t_1 = v_1.proj.x;
+        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_1))), (0.5f - ((0.5f * ls.y) / (z_1 * t_1))));
     } else {
         return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -123,9 +105,9 @@ fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_nag
         return 2f;
     }
     let n = v_2.size.x;
-    let x_3 = min(u32((uv.x * f32(n))), (n - 1u));
+    let x_1 = min(u32((uv.x * f32(n))), (n - 1u));
     let y = min(u32((uv.y * f32(n))), (n - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_3, y), 0i);
+    let _e49 = textureLoad(sm, vec2<u32>(x_1, y), 0i);
     return _e49.x;
 }
 
@@ -169,18 +151,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir.z <= 0.000001f) {
+        let dir_2 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_2.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir.z);
+        return ((z_2 + _e35) / dir_2.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -193,12 +175,105 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     }
 }
 
-fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
+fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
+    let denom = max(((1f + (g * g)) - ((2f * g) * cos_theta)), 0.00000001f);
+    return ((1f - (g * g)) / ((12.566371f * denom) * sqrt(denom)));
 }
 
-fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k: u32) -> f32 {
-    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k) - 1u)));
+fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
+    let x_2 = (sigma_t * len);
+    if (x_2 < 0.0001f) {
+        return (len * (1f - (0.5f * x_2)));
+    }
+    return ((1f - exp(-(x_2))) / sigma_t);
+}
+
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    if ((cos_inner - cos_outer) <= 0.000001f) {
+        return select(0f, 1f, (cos_angle >= cos_outer));
+    }
+    let x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_3 * x_3) * (3f - (2f * x_3)));
+}
+
+fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
+    let x_4 = (eye + (dir * t));
+    let to_x = (x_4 - light_pos);
+    let d2_ = max(dot(to_x, to_x), 0.000000000001f);
+    let d_1 = sqrt(d2_);
+    let travel = (to_x / vec3(d_1));
+    let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+}
+
+fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
+    var sum: f32 = 0f;
+    var k: u32 = 0u;
+    var q_1: u32;
+
+    let t0_ = dot((light_pos_1 - eye_1), dir_1);
+    let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
+    let g0_ = atan(((a_1 - t0_) / h));
+    let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
+    loop {
+        let _e30 = k;
+        if (_e30 < panels) {
+        } else {
+            break;
+        }
+        {
+            let _e32 = k;
+            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
+            q_1 = 0u;
+            loop {
+                let _e40 = q_1;
+                if (_e40 < 4u) {
+                } else {
+                    break;
+                }
+                {
+                    let _e46 = q_1;
+                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    let _e52 = sum;
+                    let _e54 = q_1;
+                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u * u))));
+                }
+                continuing {
+                    let _e70 = q_1;
+                    q_1 = (_e70 + 1u);
+                }
+            }
+        }
+        continuing {
+            let _e73 = k;
+            k = (_e73 + 1u);
+        }
+    }
+    let _e75 = sum;
+    return (((_e75 * 0.5f) * w_1) * h);
+}
+
+fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+}
+
+fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
+    return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
+}
+
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    return (f_1.e1_.w + ((f32(row) + 0.5f) * f_1.e2_.w));
+}
+
+fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_1: u32) -> f32 {
+    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_1) - 1u)));
 }
 
 fn basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d: f32, layer: u32) -> vec4<f32> {
@@ -214,10 +289,10 @@ fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions
     return (((r * r) * width) / (regions * regions));
 }
 
-fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, s: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x: f32, spot_1: bool) -> f32 {
+fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x: f32, spot_1: bool) -> f32 {
     var local_6: bool;
 
-    let cap = (4f * f.theta.z);
+    let cap = (4f * f_2.theta.z);
     if spot_1 {
         let psi = (x * s.delta);
         let den = sin((s.theta_ref + psi));
@@ -230,21 +305,13 @@ fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f: FrameX_naga_oil_mod
         if _e23 {
             return cap;
         }
-        return min(((f.axis.w * sin(psi)) / den), cap);
+        return min(((f_2.axis.w * sin(psi)) / den), cap);
     } else {
         return min(((x * s.delta) / max(sin(s.theta_ref), 0.0001f)), cap);
     }
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, row: u32) -> f32 {
-    return (f_1.e1_.w + ((f32(row) + 0.5f) * f_1.e2_.w));
-}
-
-fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, phi: f32) -> vec3<f32> {
-    return ((f_2.e1_.xyz * cos(phi)) + (f_2.e2_.xyz * sin(phi)));
-}
-
-fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, row_1: u32, i_1: u32, weighted: bool, spot_2: bool) -> f32 {
+fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32, i_1: u32, weighted: bool, spot_2: bool) -> f32 {
     var w: f32;
 
     let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, s_1, f32(i_1), spot_2);
@@ -256,8 +323,8 @@ fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3: FrameX_nag
     w = _e15;
     if spot_2 {
         let psi_1 = ((f32(i_1) + 0.5f) * s_1.delta);
-        let _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, row_1);
-        let _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, _e23);
+        let _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, row_1);
+        let _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e23);
         let l_1 = ((-(f_3.axis.xyz) * cos(psi_1)) + (_e24 * sin(psi_1)));
         let den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001f);
         let r_1 = max(((f_3.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
@@ -300,7 +367,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let _e30 = slices[row_2];
-    let _e31 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e30);
+    let _e31 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e30);
     let _e34 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     let _e38 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
     i = _e34;
@@ -313,7 +380,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         {
             let _e42 = i;
             let _e46 = textureLoad(rectified, vec2<u32>(_e42, row_2), 0i);
-            let d_1 = _e46.x;
+            let d_2 = _e46.x;
             let _e49 = frame;
             let _e50 = i;
             let _e52 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e49, _e31, row_2, _e50, true, false);
@@ -332,11 +399,11 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
                 {
                     let _e69 = q;
                     let layer_1 = ((thread * 2u) + _e69);
-                    let _e71 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_1, layer_1);
+                    let _e71 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
                     let _e73 = q;
-                    let a_1 = acc[_e73];
+                    let a_2 = acc[_e73];
                     let _e76 = q;
-                    acc[_e76] = ((a_1 * (1f - blend)) + (_e71 * blend));
+                    acc[_e76] = ((a_2 * (1f - blend)) + (_e71 * blend));
                     let _e83 = q;
                     let _e85 = acc[_e83];
                     let stored = ((_e85 * 0.5f) + vec4(0.5f));

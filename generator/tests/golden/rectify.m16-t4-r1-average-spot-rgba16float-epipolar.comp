@@ -13,7 +13,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     vec4 proj;
     uvec4 size;
 };
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 eye;
     vec4 axis;
     vec4 e1_;
@@ -40,56 +40,37 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     vec4 proj_g1_;
     vec4 proj_g2_;
 };
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
     float theta_ref;
     float theta_lo;
     float theta_hi;
 };
-const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
-const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.1;
+const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](0.34785485, 0.65214515, 0.65214515, 0.34785485);
+const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 
-layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _group_0_binding_0_cs; };
+layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _group_0_binding_0_cs; };
 
-layout(std430, binding = 1) readonly buffer type_9_block_1Compute { vec4 _group_0_binding_1_cs[]; };
+layout(std430, binding = 1) readonly buffer type_10_block_1Compute { vec4 _group_0_binding_1_cs[]; };
 
 layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
 layout(binding = 3,r32f) writeonly uniform image2D _group_0_binding_3_cs;
 
 
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x = (sigma_t * len);
-    if ((x < 0.0001)) {
-        return (len * (1.0 - (0.5 * x)));
-    }
-    return ((1.0 - exp(-(x))) / sigma_t);
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
-    float x_1 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_1 * x_1) * (3.0 - (2.0 * x_1)));
-}
-
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
-    vec3 q = (p - v.origin.xyz);
-    return vec3(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
+    vec3 q_1 = (p - v.origin.xyz);
+    return vec3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
 vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
     if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t = v_1.proj.x;
-        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t))), (0.5 - ((0.5 * ls.y) / (z_1 * t))));
+        float t_1 = v_1.proj.x;
+        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_1))), (0.5 - ((0.5 * ls.y) / (z_1 * t_1))));
     } else {
         return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -121,10 +102,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
         return 2.0;
     }
     uint n = v_2.size.x;
-    uint x_2 = min(uint((uv.x * float(n))), (n - 1u));
+    uint x = min(uint((uv.x * float(n))), (n - 1u));
     uint y = min(uint((uv.y * float(n))), (n - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_2, y)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x, y)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
     return _e49.x;
 }
 
@@ -166,18 +147,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        vec3 dir = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir.z <= 1e-6)) {
+        vec3 dir_2 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_2.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir.z);
+        return ((z_2 + _e35) / dir_2.z);
     } else {
         vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -190,28 +171,116 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     }
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec4 v_6) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta) {
+    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
+    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
 }
 
-vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f, float phi) {
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
+    float x_1 = (sigma_t * len);
+    if ((x_1 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_1)));
+    }
+    return ((1.0 - exp(-(x_1))) / sigma_t);
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
+    if (((cos_inner - cos_outer) <= 1e-6)) {
+        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
+    }
+    float x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_2 * x_2) * (3.0 - (2.0 * x_2)));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
+    vec3 x_3 = (eye + (dir * t));
+    vec3 to_x = (x_3 - light_pos);
+    float d2_ = max(dot(to_x, to_x), 1e-12);
+    float d = sqrt(d2_);
+    vec3 travel = (to_x / vec3(d));
+    float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
+}
+
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_1, float b_1, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
+    float sum = 0.0;
+    uint k = 0u;
+    uint q = 0u;
+    float t0_ = dot((light_pos_1 - eye_1), dir_1);
+    float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float g0_ = atan(((a_1 - t0_) / h));
+    float w = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
+    bool loop_init = true;
+    while(true) {
+        if (!loop_init) {
+            uint _e73 = k;
+            k = (_e73 + 1u);
+        }
+        loop_init = false;
+        uint _e30 = k;
+        if ((_e30 < panels)) {
+        } else {
+            break;
+        }
+        {
+            uint _e32 = k;
+            float mid = (g0_ + ((float(_e32) + 0.5) * w));
+            q = 0u;
+            bool loop_init_1 = true;
+            while(true) {
+                if (!loop_init_1) {
+                    uint _e70 = q;
+                    q = (_e70 + 1u);
+                }
+                loop_init_1 = false;
+                uint _e40 = q;
+                if ((_e40 < 4u)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e46 = q;
+                    float u = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    float _e52 = sum;
+                    uint _e54 = q;
+                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1.0 + (u * u))));
+                }
+            }
+        }
+    }
+    float _e75 = sum;
+    return (((_e75 * 0.5) * w) * h);
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec4 v_6) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+}
+
+vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, float phi) {
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1, uint row) {
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row) {
     return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
 }
 
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float theta, float lo, float hi) {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi) {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
 }
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2) {
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2) {
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, uvec4(f_2.sizes2_.x, 0u, 0u, 0u));
 }
 
-float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, sampler2D sm_3, vec3 o_1, vec3 l_1) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3);
+float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, sampler2D sm_3, vec3 o_1, vec3 l_1) {
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
     float _e5 = shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, o_1, l_1);
     return _e5;
 }
@@ -220,10 +289,10 @@ void main() {
     uvec3 id = gl_GlobalInvocationID;
     bool local = false;
     float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
-    uint x_3 = id.x;
+    uint x_4 = id.x;
     uint y_1 = id.y;
     uint _e7 = _group_0_binding_0_cs.sizes.z;
-    if (!((x_3 >= _e7))) {
+    if (!((x_4 >= _e7))) {
         uint _e13 = _group_0_binding_0_cs.sizes.w;
         local = (y_1 >= _e13);
     } else {
@@ -234,19 +303,19 @@ void main() {
         return;
     }
     vec4 _e21 = _group_0_binding_1_cs[y_1];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e21);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e24 = _group_0_binding_0_cs;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e26 = _group_0_binding_0_cs;
-    float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e26, y_1);
-    vec3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e24, _e27);
-    float col = ((float(x_3) + 0.5) * _e22.delta);
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e24 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e26 = _group_0_binding_0_cs;
+    float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
+    vec3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
+    float col = ((float(x_4) + 0.5) * _e22.delta);
     vec4 _e36 = _group_0_binding_0_cs.axis;
     vec3 axis = _e36.xyz;
     if (true) {
         vec3 l_2 = ((-(axis) * cos(col)) + (_e28 * sin(col)));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e46 = _group_0_binding_0_cs;
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e46 = _group_0_binding_0_cs;
         vec4 _e49 = _group_0_binding_0_cs.light_pos;
-        float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e46, _group_0_binding_2_cs, _e49.xyz, l_2);
+        float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, _group_0_binding_2_cs, _e49.xyz, l_2);
         if ((_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
             float dist = _group_0_binding_0_cs.axis.w;
             theta_occ = atan((_e52 * sin(col)), (dist - (_e52 * cos(col))));
@@ -254,8 +323,8 @@ void main() {
     } else {
         vec4 _e68 = _group_0_binding_0_cs.eye;
         vec3 o_2 = (_e68.xyz + (_e28 * col));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e73 = _group_0_binding_0_cs;
-        float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e73, _group_0_binding_2_cs, o_2, -(axis));
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e73 = _group_0_binding_0_cs;
+        float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e73, _group_0_binding_2_cs, o_2, -(axis));
         if ((_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
             theta_occ = atan(col, -(_e76));
         }
@@ -263,8 +332,8 @@ void main() {
     float _e81 = theta_occ;
     float _e85 = _group_0_binding_0_cs.theta.x;
     float _e89 = _group_0_binding_0_cs.theta.y;
-    float _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e81, _e85, _e89);
-    imageStore(_group_0_binding_3_cs, ivec2(uvec2(x_3, y_1)), vec4(_e90, 0.0, 0.0, 0.0));
+    float _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
+    imageStore(_group_0_binding_3_cs, ivec2(uvec2(x_4, y_1)), vec4(_e90, 0.0, 0.0, 0.0));
     return;
 }
 

@@ -18,7 +18,10 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct type_9 {
+    float inner[4];
+};
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 eye;
     metal::float4 axis;
     metal::float4 e1_;
@@ -45,55 +48,25 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
 };
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
     float theta_ref;
     float theta_lo;
     float theta_hi;
 };
-typedef metal::float4 type_9[1];
-constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+typedef metal::float4 type_10[1];
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
-constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.1;
-
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float sigma_t,
-    float len
-) {
-    float x = sigma_t * len;
-    if (x < 0.0001) {
-        return len * (1.0 - (0.5 * x));
-    }
-    return (1.0 - metal::exp(-(x))) / sigma_t;
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float sigma_t_1,
-    float a,
-    float b
-) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
-    return metal::exp(-(sigma_t_1) * a) * _e7;
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float cos_angle,
-    float cos_inner,
-    float cos_outer
-) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
-    float x_1 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_1 * x_1) * (3.0 - (2.0 * x_1));
-}
+constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
+constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
+constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
     metal::float3 p
 ) {
-    metal::float3 q = p - v.origin.xyz;
-    return metal::float3(metal::dot(q, v.right.xyz), metal::dot(q, v.up.xyz), metal::dot(q, v.forward.xyz));
+    metal::float3 q_1 = p - v.origin.xyz;
+    return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
 }
 
 metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
@@ -102,8 +75,8 @@ metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     if (v_1.origin.w > 0.5) {
         float z_1 = metal::max(ls.z, 0.000001);
-        float t = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t)), 0.5 - ((0.5 * ls.y) / (z_1 * t)));
+        float t_1 = v_1.proj.x;
+        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_1)), 0.5 - ((0.5 * ls.y) / (z_1 * t_1)));
     } else {
         return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
     }
@@ -143,10 +116,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
         return 2.0;
     }
     uint n = v_2.size.x;
-    uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
+    uint x = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
     uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -200,18 +173,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir.z <= 0.000001) {
+        metal::float3 dir_2 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_2.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return (z_2 + _e35) / dir.z;
+        return (z_2 + _e35) / dir_2.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -224,47 +197,175 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     }
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float4 v_6
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float g,
+    float cos_theta
 ) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {v_6.x, v_6.y, v_6.z, v_6.w};
+    float denom = metal::max((1.0 + (g * g)) - ((2.0 * g) * cos_theta), 0.00000001);
+    return (1.0 - (g * g)) / ((12.566371 * denom) * metal::sqrt(denom));
 }
 
-metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f,
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float sigma_t,
+    float len
+) {
+    float x_1 = sigma_t * len;
+    if (x_1 < 0.0001) {
+        return len * (1.0 - (0.5 * x_1));
+    }
+    return (1.0 - metal::exp(-(x_1))) / sigma_t;
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float sigma_t_1,
+    float a,
+    float b
+) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
+    return metal::exp(-(sigma_t_1) * a) * _e7;
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float cos_angle,
+    float cos_inner,
+    float cos_outer
+) {
+    if ((cos_inner - cos_outer) <= 0.000001) {
+        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
+    }
+    float x_2 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_2 * x_2) * (3.0 - (2.0 * x_2));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye,
+    metal::float3 dir,
+    float t,
+    metal::float3 light_pos,
+    metal::float3 light_dir,
+    float cos_inner_1,
+    float cos_outer_1,
+    metal::float4 medium
+) {
+    metal::float3 x_3 = eye + (dir * t);
+    metal::float3 to_x = x_3 - light_pos;
+    float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
+    float d = metal::sqrt(d2_);
+    metal::float3 travel = to_x / metal::float3(d);
+    float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t))) / d2_;
+}
+
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye_1,
+    metal::float3 dir_1,
+    float a_1,
+    float b_1,
+    uint panels,
+    metal::float3 light_pos_1,
+    metal::float3 light_dir_1,
+    float cos_inner_2,
+    float cos_outer_2,
+    metal::float4 medium_1
+) {
+    float sum = 0.0;
+    uint k = 0u;
+    uint q = {};
+    float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
+    float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
+    float g0_ = metal::atan((a_1 - t0_) / h);
+    float w = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
+    uint2 loop_bound = uint2(4294967295u);
+    bool loop_init = true;
+    while(true) {
+        if (metal::all(loop_bound == uint2(0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e73 = k;
+            k = _e73 + 1u;
+        }
+        loop_init = false;
+        uint _e30 = k;
+        if (_e30 < panels) {
+        } else {
+            break;
+        }
+        {
+            uint _e32 = k;
+            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w);
+            q = 0u;
+            uint2 loop_bound_1 = uint2(4294967295u);
+            bool loop_init_1 = true;
+            while(true) {
+                if (metal::all(loop_bound_1 == uint2(0u))) { break; }
+                loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+                if (!loop_init_1) {
+                    uint _e70 = q;
+                    q = _e70 + 1u;
+                }
+                loop_init_1 = false;
+                uint _e40 = q;
+                if (_e40 < 4u) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e46 = q;
+                    float u = metal::tan(mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float _e52 = sum;
+                    uint _e54 = q;
+                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                }
+            }
+        }
+    }
+    float _e75 = sum;
+    return ((_e75 * 0.5) * w) * h;
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    metal::float4 v_6
+) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {v_6.x, v_6.y, v_6.z, v_6.w};
+}
+
+metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f,
     float phi
 ) {
     return (f.e1_.xyz * metal::cos(phi)) + (f.e2_.xyz * metal::sin(phi));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1,
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1,
     uint row
 ) {
     return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
 }
 
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float theta,
     float lo,
     float hi
 ) {
-    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * metal::clamp((theta - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
+    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * metal::clamp((theta - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
 }
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2
 ) {
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, metal::uint4(f_2.sizes2_.x, 0u, 0u, 0u)};
 }
 
-float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3,
+float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
     metal::texture2d<float, metal::access::sample> sm_3,
     metal::float3 o_1,
     metal::float3 l_1
 ) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3);
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
     float _e5 = shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, o_1, l_1);
     return _e5;
 }
@@ -273,18 +374,18 @@ struct rectifyInput {
 };
 kernel void rectify(
   metal::uint3 id [[thread_position_in_grid]]
-, constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX& frame [[buffer(0)]]
-, device type_9 const& slices [[buffer(1)]]
+, constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
+, device type_10 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(0)]]
 , metal::texture2d<float, metal::access::write> rectified [[texture(1)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
 ) {
     bool local = {};
     float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
-    uint x_3 = id.x;
+    uint x_4 = id.x;
     uint y_1 = id.y;
     uint _e7 = frame.sizes.z;
-    if (!((x_3 >= _e7))) {
+    if (!((x_4 >= _e7))) {
         uint _e13 = frame.sizes.w;
         local = y_1 >= _e13;
     } else {
@@ -295,19 +396,19 @@ kernel void rectify(
         return;
     }
     metal::float4 _e21 = slices[metal::min(unsigned(y_1), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e21);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e24 = frame;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e26 = frame;
-    float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e26, y_1);
-    metal::float3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e24, _e27);
-    float col = (static_cast<float>(x_3) + 0.5) * _e22.delta;
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e24 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e26 = frame;
+    float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
+    metal::float3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
+    float col = (static_cast<float>(x_4) + 0.5) * _e22.delta;
     metal::float4 _e36 = frame.axis;
     metal::float3 axis = _e36.xyz;
     if (false) {
         metal::float3 l_2 = (-(axis) * metal::cos(col)) + (_e28 * metal::sin(col));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e46 = frame;
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e46 = frame;
         metal::float4 _e49 = frame.light_pos;
-        float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e46, shadow_map, _e49.xyz, l_2);
+        float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, shadow_map, _e49.xyz, l_2);
         if (_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
             float dist = frame.axis.w;
             theta_occ = metal::atan2(_e52 * metal::sin(col), dist - (_e52 * metal::cos(col)));
@@ -315,8 +416,8 @@ kernel void rectify(
     } else {
         metal::float4 _e68 = frame.eye;
         metal::float3 o_2 = _e68.xyz + (_e28 * col);
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e73 = frame;
-        float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e73, shadow_map, o_2, -(axis));
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e73 = frame;
+        float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e73, shadow_map, o_2, -(axis));
         if (_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
             theta_occ = metal::atan2(col, -(_e76));
         }
@@ -324,7 +425,7 @@ kernel void rectify(
     float _e81 = theta_occ;
     float _e85 = frame.theta.x;
     float _e89 = frame.theta.y;
-    float _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e81, _e85, _e89);
-    rectified.write(metal::float4(_e90, 0.0, 0.0, 0.0), metal::uint2(metal::uint2(x_3, y_1)));
+    float _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
+    rectified.write(metal::float4(_e90, 0.0, 0.0, 0.0), metal::uint2(metal::uint2(x_4, y_1)));
     return;
 }

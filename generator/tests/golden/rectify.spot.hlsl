@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     uint4 size;
 };
 
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float4 eye;
     float4 axis;
     float4 e1_;
@@ -37,58 +37,42 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     float4 proj_g2_;
 };
 
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
     float theta_ref;
     float theta_lo;
     float theta_hi;
 };
 
-static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-static const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
-static const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.1;
+typedef float ret_Constructarray4_float_[4];
+ret_Constructarray4_float_ Constructarray4_float_(float arg0, float arg1, float arg2, float arg3) {
+    float ret[4] = { arg0, arg1, arg2, arg3 };
+    return ret;
+}
 
-cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX frame; }
+static const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
+static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
+static const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+static const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(0.34785485, 0.65214515, 0.65214515, 0.34785485);
+static const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
+
+cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX frame; }
 ByteAddressBuffer slices : register(t1);
 Texture2D<float4> shadow_map : register(t2);
 RWTexture2D<float> rectified : register(u3);
 
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
-{
-    float x = (sigma_t * len);
-    if ((x < 0.0001)) {
-        return (len * (1.0 - (0.5 * x)));
-    }
-    return ((1.0 - exp(-(x))) / sigma_t);
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
-{
-    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
-{
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
-    float x_1 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_1 * x_1) * (3.0 - (2.0 * x_1)));
-}
-
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
-    float3 q = (p - v.origin.xyz);
-    return float3(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
+    float3 q_1 = (p - v.origin.xyz);
+    return float3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
 float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
 {
     if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t))), (0.5 - ((0.5 * ls.y) / (z_1 * t))));
+        float t_1 = v_1.proj.x;
+        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_1))), (0.5 - ((0.5 * ls.y) / (z_1 * t_1))));
     } else {
         return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -126,9 +110,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
         return 2.0;
     }
     uint n = v_2.size.x;
-    uint x_2 = min(naga_f2u32((uv.x * float(n))), (n - 1u));
+    uint x = min(naga_f2u32((uv.x * float(n))), (n - 1u));
     uint y = min(naga_f2u32((uv.y * float(n))), (n - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_2, y), int(0)));
+    float4 _e49 = sm.Load(int3(uint2(x, y), int(0)));
     return _e49.x;
 }
 
@@ -175,18 +159,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        float3 dir = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir.z <= 1e-6)) {
+        float3 dir_2 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_2.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
         const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir.z);
+        return ((z_2 + _e35) / dir_2.z);
     } else {
         const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -199,8 +183,109 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     }
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float arg0, float arg1, float arg2, float arg3) {
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX ret = (SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX)0;
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
+{
+    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
+    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
+{
+    float x_1 = (sigma_t * len);
+    if ((x_1 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_1)));
+    }
+    return ((1.0 - exp(-(x_1))) / sigma_t);
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
+{
+    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
+{
+    if (((cos_inner - cos_outer) <= 1e-6)) {
+        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
+    }
+    float x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_2 * x_2) * (3.0 - (2.0 * x_2)));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
+{
+    float3 x_3 = (eye + (dir * t));
+    float3 to_x = (x_3 - light_pos);
+    float d2_ = max(dot(to_x, to_x), 1e-12);
+    float d = sqrt(d2_);
+    float3 travel = (to_x / (d).xxx);
+    const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
+}
+
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
+{
+    float sum = 0.0;
+    uint k = 0u;
+    uint q = (uint)0;
+
+    float t0_ = dot((light_pos_1 - eye_1), dir_1);
+    float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float g0_ = atan(((a_1 - t0_) / h));
+    float w = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
+    uint2 loop_bound = uint2(4294967295u, 4294967295u);
+    bool loop_init = true;
+    while(true) {
+        if (all(loop_bound == uint2(0u, 0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e73 = k;
+            k = (_e73 + 1u);
+        }
+        loop_init = false;
+        uint _e30 = k;
+        if ((_e30 < panels)) {
+        } else {
+            break;
+        }
+        {
+            uint _e32 = k;
+            float mid = (g0_ + ((float(_e32) + 0.5) * w));
+            q = 0u;
+            uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
+            bool loop_init_1 = true;
+            while(true) {
+                if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
+                loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+                if (!loop_init_1) {
+                    uint _e70 = q;
+                    q = (_e70 + 1u);
+                }
+                loop_init_1 = false;
+                uint _e40 = q;
+                if ((_e40 < 4u)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e46 = q;
+                    float u = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
+                    float _e52 = sum;
+                    uint _e54 = q;
+                    const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e54), 3u)] * _e62) * (1.0 + (u * u))));
+                }
+            }
+        }
+    }
+    float _e75 = sum;
+    return (((_e75 * 0.5) * w) * h);
+}
+
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float arg0, float arg1, float arg2, float arg3) {
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX ret = (SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX)0;
     ret.delta = arg0;
     ret.theta_ref = arg1;
     ret.theta_lo = arg2;
@@ -208,25 +293,25 @@ SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX ConstructSliceParam
     return ret;
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float4 v_6)
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float4 v_6)
 {
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX sliceparamsx_naga_oil_mod_xonrwc5dumvzduotqojswm2lmorsxezlex = ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
-    return sliceparamsx_naga_oil_mod_xonrwc5dumvzduotqojswm2lmorsxezlex;
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax = ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+    return sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax;
 }
 
-float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f, float phi)
+float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, float phi)
 {
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1, uint row)
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row)
 {
     return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
 }
 
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float theta, float lo, float hi)
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi)
 {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
 }
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(float4 arg0, float4 arg1, float4 arg2, float4 arg3, float4 arg4, uint4 arg5) {
@@ -240,15 +325,15 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ConstructShadowMapViewX_n
     return ret;
 }
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2)
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2)
 {
     const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx = ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, uint4(f_2.sizes2_.x, 0u, 0u, 0u));
     return shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx;
 }
 
-float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3, Texture2D<float4> sm_3, float3 o_1, float3 l_1)
+float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, Texture2D<float4> sm_3, float3 o_1, float3 l_1)
 {
-    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3);
+    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
     const float _e5 = shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, o_1, l_1);
     return _e5;
 }
@@ -259,10 +344,10 @@ void rectify(uint3 id : SV_DispatchThreadID)
     bool local = (bool)0;
     float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
 
-    uint x_3 = id.x;
+    uint x_4 = id.x;
     uint y_1 = id.y;
     uint _e7 = frame.sizes.z;
-    if (!((x_3 >= _e7))) {
+    if (!((x_4 >= _e7))) {
         uint _e13 = frame.sizes.w;
         local = (y_1 >= _e13);
     } else {
@@ -273,19 +358,19 @@ void rectify(uint3 id : SV_DispatchThreadID)
         return;
     }
     float4 _e21 = asfloat(slices.Load4(y_1*16));
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e21);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e24 = frame;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e26 = frame;
-    const float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e26, y_1);
-    const float3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e24, _e27);
-    float col = ((float(x_3) + 0.5) * _e22.delta);
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e24 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e26 = frame;
+    const float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
+    const float3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
+    float col = ((float(x_4) + 0.5) * _e22.delta);
     float4 _e36 = frame.axis;
     float3 axis = _e36.xyz;
     if (true) {
         float3 l_2 = ((-(axis) * cos(col)) + (_e28 * sin(col)));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e46 = frame;
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e46 = frame;
         float4 _e49 = frame.light_pos;
-        const float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e46, shadow_map, _e49.xyz, l_2);
+        const float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, shadow_map, _e49.xyz, l_2);
         if ((_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
             float dist = frame.axis.w;
             theta_occ = atan2((_e52 * sin(col)), (dist - (_e52 * cos(col))));
@@ -293,8 +378,8 @@ void rectify(uint3 id : SV_DispatchThreadID)
     } else {
         float4 _e68 = frame.eye;
         float3 o_2 = (_e68.xyz + (_e28 * col));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e73 = frame;
-        const float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e73, shadow_map, o_2, -(axis));
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e73 = frame;
+        const float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e73, shadow_map, o_2, -(axis));
         if ((_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
             theta_occ = atan2(col, -(_e76));
         }
@@ -302,7 +387,7 @@ void rectify(uint3 id : SV_DispatchThreadID)
     float _e81 = theta_occ;
     float _e85 = frame.theta.x;
     float _e89 = frame.theta.y;
-    const float _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e81, _e85, _e89);
-    rectified[uint2(x_3, y_1)] = float4(_e90, 0.0, 0.0, 0.0);
+    const float _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
+    rectified[uint2(x_4, y_1)] = float4(_e90, 0.0, 0.0, 0.0);
     return;
 }

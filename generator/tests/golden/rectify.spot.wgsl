@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     size: vec4<u32>,
 }
 
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     eye: vec4<f32>,
     axis: vec4<f32>,
     e1_: vec4<f32>,
@@ -37,19 +37,21 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     proj_g2_: vec4<f32>,
 }
 
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     delta: f32,
     theta_ref: f32,
     theta_lo: f32,
     theta_hi: f32,
 }
 
-const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX: f32 = 1000000000000000000000000000000f;
-const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX: f32 = 0.1f;
+const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
+const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
+const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
+const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
 
 @group(0) @binding(0) 
-var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX;
+var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX;
 @group(0) @binding(1) 
 var<storage> slices: array<vec4<f32>>;
 @group(0) @binding(2) 
@@ -57,37 +59,16 @@ var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) 
 var rectified: texture_storage_2d<r32float,write>;
 
-fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x = (sigma_t * len);
-    if (x < 0.0001f) {
-        return (len * (1f - (0.5f * x)));
-    }
-    return ((1f - exp(-(x))) / sigma_t);
-}
-
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
-    let x_1 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_1 * x_1) * (3f - (2f * x_1)));
-}
-
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
-    let q = (p - v.origin.xyz);
-    return vec3<f32>(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
+    let q_1 = (p - v.origin.xyz);
+    return vec3<f32>(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
 fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
     if (v_1.origin.w > 0.5f) {
         let z_1 = max(ls.z, 0.000001f);
-        let t = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t))), (0.5f - ((0.5f * ls.y) / (z_1 * t))));
+        let t_1 = v_1.proj.x;
+        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_1))), (0.5f - ((0.5f * ls.y) / (z_1 * t_1))));
     } else {
         return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -120,9 +101,9 @@ fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_nag
         return 2f;
     }
     let n = v_2.size.x;
-    let x_2 = min(u32((uv.x * f32(n))), (n - 1u));
+    let x = min(u32((uv.x * f32(n))), (n - 1u));
     let y = min(u32((uv.y * f32(n))), (n - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_2, y), 0i);
+    let _e49 = textureLoad(sm, vec2<u32>(x, y), 0i);
     return _e49.x;
 }
 
@@ -166,18 +147,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir.z <= 0.000001f) {
+        let dir_2 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_2.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir.z);
+        return ((z_2 + _e35) / dir_2.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -190,28 +171,113 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     }
 }
 
-fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
+fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
+    let denom = max(((1f + (g * g)) - ((2f * g) * cos_theta)), 0.00000001f);
+    return ((1f - (g * g)) / ((12.566371f * denom) * sqrt(denom)));
 }
 
-fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, phi: f32) -> vec3<f32> {
+fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
+    let x_1 = (sigma_t * len);
+    if (x_1 < 0.0001f) {
+        return (len * (1f - (0.5f * x_1)));
+    }
+    return ((1f - exp(-(x_1))) / sigma_t);
+}
+
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    if ((cos_inner - cos_outer) <= 0.000001f) {
+        return select(0f, 1f, (cos_angle >= cos_outer));
+    }
+    let x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_2 * x_2) * (3f - (2f * x_2)));
+}
+
+fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
+    let x_3 = (eye + (dir * t));
+    let to_x = (x_3 - light_pos);
+    let d2_ = max(dot(to_x, to_x), 0.000000000001f);
+    let d = sqrt(d2_);
+    let travel = (to_x / vec3(d));
+    let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
+}
+
+fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
+    var sum: f32 = 0f;
+    var k: u32 = 0u;
+    var q: u32;
+
+    let t0_ = dot((light_pos_1 - eye_1), dir_1);
+    let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
+    let g0_ = atan(((a_1 - t0_) / h));
+    let w = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
+    loop {
+        let _e30 = k;
+        if (_e30 < panels) {
+        } else {
+            break;
+        }
+        {
+            let _e32 = k;
+            let mid = (g0_ + ((f32(_e32) + 0.5f) * w));
+            q = 0u;
+            loop {
+                let _e40 = q;
+                if (_e40 < 4u) {
+                } else {
+                    break;
+                }
+                {
+                    let _e46 = q;
+                    let u = tan((mid + ((0.5f * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    let _e52 = sum;
+                    let _e54 = q;
+                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u * u))));
+                }
+                continuing {
+                    let _e70 = q;
+                    q = (_e70 + 1u);
+                }
+            }
+        }
+        continuing {
+            let _e73 = k;
+            k = (_e73 + 1u);
+        }
+    }
+    let _e75 = sum;
+    return (((_e75 * 0.5f) * w) * h);
+}
+
+fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+}
+
+fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, row: u32) -> f32 {
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
     return (f_1.e1_.w + ((f32(row) + 0.5f) * f_1.e2_.w));
 }
 
-fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta: f32, lo: f32, hi: f32) -> f32 {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8f * clamp(((theta - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
+fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta: f32, lo: f32, hi: f32) -> f32 {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * clamp(((theta - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
 }
 
-fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, vec4<u32>(f_2.sizes2_.x, 0u, 0u, 0u));
 }
 
-fn sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, sm_3: texture_2d<f32>, o_1: vec3<f32>, l_1: vec3<f32>) -> f32 {
-    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3);
+fn sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_3: texture_2d<f32>, o_1: vec3<f32>, l_1: vec3<f32>) -> f32 {
+    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
     let _e5 = shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, o_1, l_1);
     return _e5;
 }
@@ -221,10 +287,10 @@ fn rectify(@builtin(global_invocation_id) id: vec3<u32>) {
     var local: bool;
     var theta_occ: f32 = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
 
-    let x_3 = id.x;
+    let x_4 = id.x;
     let y_1 = id.y;
     let _e7 = frame.sizes.z;
-    if !((x_3 >= _e7)) {
+    if !((x_4 >= _e7)) {
         let _e13 = frame.sizes.w;
         local = (y_1 >= _e13);
     } else {
@@ -235,19 +301,19 @@ fn rectify(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let _e21 = slices[y_1];
-    let _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e21);
+    let _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21);
     let _e24 = frame;
     let _e26 = frame;
-    let _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e26, y_1);
-    let _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e24, _e27);
-    let col = ((f32(x_3) + 0.5f) * _e22.delta);
+    let _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
+    let _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
+    let col = ((f32(x_4) + 0.5f) * _e22.delta);
     let _e36 = frame.axis;
     let axis = _e36.xyz;
     if true {
         let l_2 = ((-(axis) * cos(col)) + (_e28 * sin(col)));
         let _e46 = frame;
         let _e49 = frame.light_pos;
-        let _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e46, shadow_map, _e49.xyz, l_2);
+        let _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, shadow_map, _e49.xyz, l_2);
         if (_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
             let dist = frame.axis.w;
             theta_occ = atan2((_e52 * sin(col)), (dist - (_e52 * cos(col))));
@@ -256,7 +322,7 @@ fn rectify(@builtin(global_invocation_id) id: vec3<u32>) {
         let _e68 = frame.eye;
         let o_2 = (_e68.xyz + (_e28 * col));
         let _e73 = frame;
-        let _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e73, shadow_map, o_2, -(axis));
+        let _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e73, shadow_map, o_2, -(axis));
         if (_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
             theta_occ = atan2(col, -(_e76));
         }
@@ -264,7 +330,7 @@ fn rectify(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e81 = theta_occ;
     let _e85 = frame.theta.x;
     let _e89 = frame.theta.y;
-    let _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e81, _e85, _e89);
-    textureStore(rectified, vec2<u32>(x_3, y_1), vec4<f32>(_e90, 0f, 0f, 0f));
+    let _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
+    textureStore(rectified, vec2<u32>(x_4, y_1), vec4<f32>(_e90, 0f, 0f, 0f));
     return;
 }

@@ -18,7 +18,10 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct type_9 {
+    float inner[4];
+};
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 eye;
     metal::float4 axis;
     metal::float4 e1_;
@@ -45,14 +48,11 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
 };
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
     float theta_ref;
     float theta_lo;
     float theta_hi;
-};
-struct type_9 {
-    float inner[4];
 };
 typedef metal::float4 type_10[1];
 struct type_15 {
@@ -61,46 +61,14 @@ struct type_15 {
 struct type_16 {
     metal::float4 inner[4];
 };
-constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
-constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.1;
+constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
 constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
+constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 constant uint MAX_REGIONS = 8u;
 constant uint REGIONS = 1u;
 constant uint LAYERS = 4u;
-
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float sigma_t,
-    float len
-) {
-    float x_2 = sigma_t * len;
-    if (x_2 < 0.0001) {
-        return len * (1.0 - (0.5 * x_2));
-    }
-    return (1.0 - metal::exp(-(x_2))) / sigma_t;
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float sigma_t_1,
-    float a,
-    float b
-) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
-    return metal::exp(-(sigma_t_1) * a) * _e7;
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float cos_angle,
-    float cos_inner,
-    float cos_outer
-) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
-    float x_3 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_3 * x_3) * (3.0 - (2.0 * x_3));
-}
 
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
@@ -157,10 +125,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
         return 2.0;
     }
     uint n = v_2.size.x;
-    uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
+    uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
     uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -238,73 +206,44 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     }
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float4 v_6
-) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {v_6.x, v_6.y, v_6.z, v_6.w};
-}
-
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    float theta_1,
-    float lo,
-    float hi
-) {
-    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8 * metal::clamp((theta_1 - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
-}
-
-float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    uint k_1
-) {
-    return PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * static_cast<float>((2u * k_1) - 1u);
-}
-
-metal::float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    float d_1,
-    uint layer_2
-) {
-    float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_2) + 1u);
-    float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_2) + 2u);
-    return metal::float4((2.0 / _e5) * metal::cos(_e5 * d_1), (-2.0 / _e5) * metal::sin(_e5 * d_1), (2.0 / _e10) * metal::cos(_e10 * d_1), (-2.0 / _e10) * metal::sin(_e10 * d_1));
-}
-
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / metal::select(rhs, 1u, rhs == 0u);
-}
-
-uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    uint r_2,
-    uint regions,
-    uint width,
-    bool spot
-) {
-    if (spot) {
-        return naga_div(r_2 * width, regions);
-    }
-    return naga_div((r_2 * r_2) * width, regions * regions);
-}
-
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f
-) {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f.sm_right, f.sm_up, f.sm_forward, f.sm_origin, f.sm_proj, metal::uint4(f.sizes2_.x, 0u, 0u, 0u)};
-}
-
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_1,
-    metal::texture2d<float, metal::access::sample> sm_3,
-    metal::float3 p_2
-) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_1);
-    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
-}
-
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float g,
     float cos_theta
 ) {
     float denom = metal::max((1.0 + (g * g)) - ((2.0 * g) * cos_theta), 0.00000001);
     return (1.0 - (g * g)) / ((12.566371 * denom) * metal::sqrt(denom));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float sigma_t,
+    float len
+) {
+    float x_3 = sigma_t * len;
+    if (x_3 < 0.0001) {
+        return len * (1.0 - (0.5 * x_3));
+    }
+    return (1.0 - metal::exp(-(x_3))) / sigma_t;
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float sigma_t_1,
+    float a,
+    float b
+) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
+    return metal::exp(-(sigma_t_1) * a) * _e7;
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float cos_angle,
+    float cos_inner,
+    float cos_outer
+) {
+    if ((cos_inner - cos_outer) <= 0.000001) {
+        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
+    }
+    float x_4 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_4 * x_4) * (3.0 - (2.0 * x_4));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -340,7 +279,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float4 medium_1
 ) {
     float sum = 0.0;
-    uint k_2 = 0u;
+    uint k_1 = 0u;
     uint q = {};
     float t0_1 = metal::dot(light_pos_1 - eye_1, dir_1);
     float h = metal::max(metal::length((eye_1 + (dir_1 * t0_1)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
@@ -352,17 +291,17 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k_2;
-            k_2 = _e73 + 1u;
+            uint _e73 = k_1;
+            k_1 = _e73 + 1u;
         }
         loop_init = false;
-        uint _e30 = k_2;
+        uint _e30 = k_1;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            uint _e32 = k_2;
+            uint _e32 = k_1;
             float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
@@ -395,19 +334,49 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     return ((_e75 * 0.5) * w) * h;
 }
 
-metal::float3 pixel_dir(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_2,
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    metal::float4 v_6
+) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {v_6.x, v_6.y, v_6.z, v_6.w};
+}
+
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    float theta_1,
+    float lo,
+    float hi
+) {
+    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * metal::clamp((theta_1 - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
+}
+
+metal::float3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f,
     uint x,
     uint y
 ) {
-    float ndc_x = ((2.0 * (static_cast<float>(x) + 0.5)) / static_cast<float>(f_2.sizes.x)) - 1.0;
-    float ndc_y = 1.0 - ((2.0 * (static_cast<float>(y) + 0.5)) / static_cast<float>(f_2.sizes.y));
-    float t_3 = f_2.cam_forward.w;
-    return metal::normalize((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc_x * t_3) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc_y * t_3)));
+    float ndc_x = ((2.0 * (static_cast<float>(x) + 0.5)) / static_cast<float>(f.sizes.x)) - 1.0;
+    float ndc_y = 1.0 - ((2.0 * (static_cast<float>(y) + 0.5)) / static_cast<float>(f.sizes.y));
+    float t_3 = f.cam_forward.w;
+    return metal::normalize((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_3) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_3)));
 }
 
-float frame_spot_integrand(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_3,
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1
+) {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f_1.sm_right, f_1.sm_up, f_1.sm_forward, f_1.sm_origin, f_1.sm_proj, metal::uint4(f_1.sizes2_.x, 0u, 0u, 0u)};
+}
+
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    metal::texture2d<float, metal::access::sample> sm_3,
+    metal::float3 p_2
+) {
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2);
+    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
+    return _e4;
+}
+
+float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
     metal::float3 eye_2,
     metal::float3 dir_2,
     float t_1
@@ -416,18 +385,17 @@ float frame_spot_integrand(
     return _e13;
 }
 
-float march(
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
+    metal::texture2d<float, metal::access::sample> sm_4,
     metal::float3 eye_3,
     metal::float3 dir_3,
     float s,
-    bool spot_1,
-    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX& frame,
-    metal::texture2d<float, metal::access::sample> shadow_map
+    bool spot
 ) {
     float sum_1 = 0.0;
-    uint k_3 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_6 = frame;
-    uint steps = f_6.sizes2_.y;
+    uint k_2 = 0u;
+    uint steps = f_4.sizes2_.y;
     float h_1 = s / static_cast<float>(steps);
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
@@ -435,39 +403,39 @@ float march(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e45 = k_3;
-            k_3 = _e45 + 1u;
+            uint _e44 = k_2;
+            k_2 = _e44 + 1u;
         }
         loop_init_2 = false;
-        uint _e10 = k_3;
-        if (_e10 < steps) {
+        uint _e9 = k_2;
+        if (_e9 < steps) {
         } else {
             break;
         }
         {
-            uint _e12 = k_3;
-            float t_4 = (static_cast<float>(_e12) + 0.5) * h_1;
-            float _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, shadow_map, eye_3 + (dir_3 * t_4));
-            if (spot_1) {
-                float _e25 = sum_1;
-                float _e27 = frame_spot_integrand(f_6, eye_3, dir_3, t_4);
-                sum_1 = _e25 + ((_e22 * h_1) * _e27);
+            uint _e11 = k_2;
+            float t_4 = (static_cast<float>(_e11) + 0.5) * h_1;
+            float _e21 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, eye_3 + (dir_3 * t_4));
+            if (spot) {
+                float _e24 = sum_1;
+                float _e26 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_3, dir_3, t_4);
+                sum_1 = _e24 + ((_e21 * h_1) * _e26);
             } else {
-                float _e30 = sum_1;
-                uint _e33 = k_3;
-                uint _e36 = k_3;
-                float _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, static_cast<float>(_e33) * h_1, static_cast<float>(_e36 + 1u) * h_1);
-                sum_1 = _e30 + (_e22 * _e41);
+                float _e29 = sum_1;
+                uint _e32 = k_2;
+                uint _e35 = k_2;
+                float _e40 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, static_cast<float>(_e32) * h_1, static_cast<float>(_e35 + 1u) * h_1);
+                sum_1 = _e29 + (_e21 * _e40);
             }
         }
     }
-    if (spot_1) {
-        float _e47 = sum_1;
-        return _e47;
+    if (spot) {
+        float _e46 = sum_1;
+        return _e46;
     } else {
-        float _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(metal::dot(f_6.light_dir.xyz, dir_3)));
-        float _e58 = sum_1;
-        return (f_6.medium.y * _e56) * _e58;
+        float _e55 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(metal::dot(f_4.light_dir.xyz, dir_3)));
+        float _e57 = sum_1;
+        return (f_4.medium.y * _e55) * _e57;
     }
 }
 
@@ -480,7 +448,7 @@ int naga_mod(int lhs, int rhs) {
     return lhs - (lhs / divisor) * divisor;
 }
 
-uint row_index(
+uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float j,
     uint rows,
     bool wrap
@@ -493,16 +461,16 @@ uint row_index(
     }
 }
 
-float ray_t(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_4,
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
     float x_1,
     float delta_1,
     float theta_2,
     float s_1,
-    bool spot_2
+    bool spot_1
 ) {
     bool local_9 = {};
-    if (spot_2) {
+    if (spot_1) {
         float psi = x_1 * delta_1;
         float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
@@ -514,29 +482,74 @@ float ray_t(
         if (_e16) {
             return s_1;
         }
-        return metal::min((f_4.axis.w * metal::sin(psi)) / den, s_1);
+        return metal::min((f_5.axis.w * metal::sin(psi)) / den, s_1);
     } else {
         return metal::min((x_1 * delta_1) / metal::max(metal::sin(theta_2), 0.000001), s_1);
     }
 }
 
-float spot_segment(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_5,
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
     metal::float3 eye_4,
     metal::float3 dir_4,
     float a_2,
     float b_2,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_5.light_pos.xyz, f_5.light_dir.xyz, f_5.light_pos.w, f_5.light_dir.w, f_5.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
+}
+
+metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    float phi
+) {
+    return (f_7.e1_.xyz * metal::cos(phi)) + (f_7.e2_.xyz * metal::sin(phi));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    uint row
+) {
+    return f_8.e1_.w + ((static_cast<float>(row) + 0.5) * f_8.e2_.w);
+}
+
+float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    uint k_3
+) {
+    return PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * static_cast<float>((2u * k_3) - 1u);
+}
+
+metal::float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    float d_1,
+    uint layer_2
+) {
+    float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_2) + 1u);
+    float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_2) + 2u);
+    return metal::float4((2.0 / _e5) * metal::cos(_e5 * d_1), (-2.0 / _e5) * metal::sin(_e5 * d_1), (2.0 / _e10) * metal::cos(_e10 * d_1), (-2.0 / _e10) * metal::sin(_e10 * d_1));
+}
+
+uint naga_div(uint lhs, uint rhs) {
+    return lhs / metal::select(rhs, 1u, rhs == 0u);
+}
+
+uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    uint r_2,
+    uint regions,
+    uint width,
+    bool spot_2
+) {
+    if (spot_2) {
+        return naga_div(r_2 * width, regions);
+    }
+    return naga_div((r_2 * r_2) * width, regions * regions);
 }
 
 struct scatterInput {
 };
 kernel void scatter(
   metal::uint3 id [[thread_position_in_grid]]
-, constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX& frame [[buffer(0)]]
+, constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
 , device type_10 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
@@ -571,11 +584,11 @@ kernel void scatter(
     uint k = {};
     float l = {};
     float unshadowed = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX f_7 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
     uint x_6 = id.x;
     uint y_2 = id.y;
-    if (!((x_6 >= f_7.sizes.x))) {
-        local = y_2 >= f_7.sizes.y;
+    if (!((x_6 >= f_9.sizes.x))) {
+        local = y_2 >= f_9.sizes.y;
     } else {
         local = true;
     }
@@ -583,22 +596,22 @@ kernel void scatter(
     if (_e18) {
         return;
     }
-    metal::float3 eye_5 = f_7.eye.xyz;
-    metal::float3 _e21 = pixel_dir(f_7, x_6, y_2);
+    metal::float3 eye_5 = f_9.eye.xyz;
+    metal::float3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_6, y_2);
     uint clamped_lod_e25 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e25 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_2)), metal::uint2(depth.get_width(clamped_lod_e25), depth.get_height(clamped_lod_e25)) - 1), clamped_lod_e25);
-    float s_2 = metal::min(metal::max(_e25.x, 0.0), f_7.theta.z) / metal::max(metal::dot(_e21, f_7.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_7.light_color.xyz;
+    float s_2 = metal::min(metal::max(_e25.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e21, f_9.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_9.light_color.xyz;
     metal::float3 px = metal::float3(static_cast<float>(x_6) + 0.5, static_cast<float>(y_2) + 0.5, 0.0);
-    float radius = f_7.epipole.w;
-    if (f_7.epipole.z > 0.5) {
-        local_1 = metal::length(px - metal::float3(f_7.epipole.x, f_7.epipole.y, 0.0)) < radius;
+    float radius = f_9.epipole.w;
+    if (f_9.epipole.z > 0.5) {
+        local_1 = metal::length(px - metal::float3(f_9.epipole.x, f_9.epipole.y, 0.0)) < radius;
     } else {
         local_1 = false;
     }
     bool near_epi = local_1;
-    if (f_7.anti_epipole.z > 0.5) {
-        local_2 = metal::length(px - metal::float3(f_7.anti_epipole.x, f_7.anti_epipole.y, 0.0)) < radius;
+    if (f_9.anti_epipole.z > 0.5) {
+        local_2 = metal::length(px - metal::float3(f_9.anti_epipole.x, f_9.anti_epipole.y, 0.0)) < radius;
     } else {
         local_2 = false;
     }
@@ -610,125 +623,126 @@ kernel void scatter(
     }
     bool _e88 = local_3;
     if (_e88) {
-        float _e90 = march(eye_5, _e21, s_2, true, frame, shadow_map);
-        metal::float3 l_2 = _e90 * color;
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = frame;
+        float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_5, _e21, s_2, true);
+        metal::float3 l_2 = _e93 * color;
         output.write(metal::float4(l_2.x, l_2.y, l_2.z, 1.0), metal::uint2(metal::uint2(x_6, y_2)));
         return;
     }
-    metal::float3 axis = f_7.axis.xyz;
-    uint rows_1 = f_7.sizes.w;
-    uint width_1 = f_7.sizes.z;
-    bool wrap_1 = f_7.anti_epipole.w > 0.5;
+    metal::float3 axis = f_9.axis.xyz;
+    uint rows_1 = f_9.sizes.w;
+    uint width_1 = f_9.sizes.z;
+    bool wrap_1 = f_9.anti_epipole.w > 0.5;
     {
         theta = metal::acos(metal::clamp(metal::dot(_e21, axis), -1.0, 1.0));
-        float phi = metal::atan2(metal::dot(_e21, f_7.e2_.xyz), metal::dot(_e21, f_7.e1_.xyz));
-        yc = (phi - f_7.e1_.w) / f_7.e2_.w;
+        float phi_1 = metal::atan2(metal::dot(_e21, f_9.e2_.xyz), metal::dot(_e21, f_9.e1_.xyz));
+        yc = (phi_1 - f_9.e1_.w) / f_9.e2_.w;
         if (wrap_1) {
-            float _e129 = yc;
-            float _e130 = yc;
-            yc = _e129 - (metal::floor(_e130 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+            float _e132 = yc;
+            float _e133 = yc;
+            yc = _e132 - (metal::floor(_e133 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
         } else {
-            float _e137 = yc;
-            yc = metal::clamp(_e137, 0.0, static_cast<float>(rows_1));
+            float _e140 = yc;
+            yc = metal::clamp(_e140, 0.0, static_cast<float>(rows_1));
         }
-        float _e141 = yc;
-        float yy = _e141 - 0.5;
+        float _e144 = yc;
+        float yy = _e144 - 0.5;
         float j0_ = metal::floor(yy);
         float fy = yy - j0_;
-        uint _e146 = row_index(j0_, rows_1, wrap_1);
-        metal::float4 _e149 = slices[metal::min(unsigned(_e146), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
-        uint _e153 = row_index(j0_ + 1.0, rows_1, wrap_1);
-        metal::float4 _e156 = slices[metal::min(unsigned(_e153), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX _e157 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156);
-        delta = metal::mix(_e150.delta, _e157.delta, fy);
-        float _e162 = theta;
-        float _e167 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e162, f_7.theta.x, f_7.theta.y);
-        d = _e167;
+        uint _e149 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
+        metal::float4 _e152 = slices[metal::min(unsigned(_e149), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e153 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e152);
+        uint _e156 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_ + 1.0, rows_1, wrap_1);
+        metal::float4 _e159 = slices[metal::min(unsigned(_e156), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e160 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e159);
+        delta = metal::mix(_e153.delta, _e160.delta, fy);
+        float _e165 = theta;
+        float _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_9.theta.x, f_9.theta.y);
+        d = _e170;
         if (true) {
-            metal::float3 q_2 = metal::normalize((eye_5 + (_e21 * s_2)) - f_7.light_pos.xyz);
-            float _e181 = delta;
-            xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / _e181;
+            metal::float3 q_2 = metal::normalize((eye_5 + (_e21 * s_2)) - f_9.light_pos.xyz);
+            float _e184 = delta;
+            xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / _e184;
         } else {
-            float _e184 = theta;
-            float _e187 = delta;
-            xs = (s_2 * metal::sin(_e184)) / _e187;
+            float _e187 = theta;
+            float _e190 = delta;
+            xs = (s_2 * metal::sin(_e187)) / _e190;
         }
     }
-    float _e189 = xs;
-    uint last = naga_f2u32(metal::min(metal::max(_e189, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e192 = xs;
+    uint last = naga_f2u32(metal::min(metal::max(_e192, 0.0), static_cast<float>(width_1) - 1.0));
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e252 = r;
-            r = _e252 + 1u;
+            uint _e255 = r;
+            r = _e255 + 1u;
         }
         loop_init_3 = false;
-        uint _e199 = r;
-        if (_e199 < REGIONS) {
+        uint _e202 = r;
+        if (_e202 < REGIONS) {
         } else {
             break;
         }
         {
-            uint _e201 = r;
-            uint _e202 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e201, REGIONS, width_1, true);
-            float b0_ = static_cast<float>(_e202);
             uint _e204 = r;
-            uint _e207 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e204 + 1u, REGIONS, width_1, true);
-            float b1_ = static_cast<float>(_e207);
+            uint _e205 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e204, REGIONS, width_1, true);
+            float b0_ = static_cast<float>(_e205);
+            uint _e207 = r;
+            uint _e210 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e207 + 1u, REGIONS, width_1, true);
+            float b1_ = static_cast<float>(_e210);
             if (!((last < naga_f2u32(b1_)))) {
-                uint _e212 = r;
-                local_4 = (_e212 + 1u) == REGIONS;
+                uint _e215 = r;
+                local_4 = (_e215 + 1u) == REGIONS;
             } else {
                 local_4 = true;
             }
             bool is_last = local_4;
-            uint _e221 = r;
-            float _e225 = xs;
-            pos.inner[metal::min(unsigned(_e221), 7u)] = is_last ? metal::clamp(_e225 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-            uint _e235 = r;
-            float _e237 = delta;
-            float _e238 = theta;
-            float _e239 = ray_t(f_7, b0_, _e237, _e238, s_2, true);
-            t0_.inner[metal::min(unsigned(_e235), 7u)] = _e239;
-            uint _e241 = r;
-            float _e243 = delta;
-            float _e244 = theta;
-            float _e245 = ray_t(f_7, b1_, _e243, _e244, s_2, true);
-            t1_.inner[metal::min(unsigned(_e241), 7u)] = is_last ? s_2 : _e245;
-            uint _e247 = r;
-            count = _e247 + 1u;
+            uint _e224 = r;
+            float _e228 = xs;
+            pos.inner[metal::min(unsigned(_e224), 7u)] = is_last ? metal::clamp(_e228 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            uint _e238 = r;
+            float _e240 = delta;
+            float _e241 = theta;
+            float _e242 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e240, _e241, s_2, true);
+            t0_.inner[metal::min(unsigned(_e238), 7u)] = _e242;
+            uint _e244 = r;
+            float _e246 = delta;
+            float _e247 = theta;
+            float _e248 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e246, _e247, s_2, true);
+            t1_.inner[metal::min(unsigned(_e244), 7u)] = is_last ? s_2 : _e248;
+            uint _e250 = r;
+            count = _e250 + 1u;
             if (is_last) {
                 break;
             }
         }
     }
-    float cos_theta_l = -(metal::dot(f_7.light_dir.xyz, _e21));
-    uint panels_2 = metal::max(naga_div(f_7.sizes2_.z, 4u), 1u);
+    float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e21));
+    uint panels_2 = metal::max(naga_div(f_9.sizes2_.z, 4u), 1u);
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e275 = layer;
-            layer = _e275 + 1u;
+            uint _e278 = layer;
+            layer = _e278 + 1u;
         }
         loop_init_4 = false;
-        uint _e265 = layer;
-        if (_e265 < LAYERS) {
+        uint _e268 = layer;
+        if (_e268 < LAYERS) {
         } else {
             break;
         }
         {
-            uint _e269 = layer;
-            float _e271 = d;
             uint _e272 = layer;
-            metal::float4 _e273 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e271, _e272);
-            coeffs.inner[metal::min(unsigned(_e269), 3u)] = _e273;
+            float _e274 = d;
+            uint _e275 = layer;
+            metal::float4 _e276 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e274, _e275);
+            coeffs.inner[metal::min(unsigned(_e272), 3u)] = _e276;
         }
     }
     uint2 loop_bound_5 = uint2(4294967295u);
@@ -737,32 +751,32 @@ kernel void scatter(
         if (metal::all(loop_bound_5 == uint2(0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e363 = r_1;
-            r_1 = _e363 + 1u;
+            uint _e366 = r_1;
+            r_1 = _e366 + 1u;
         }
         loop_init_5 = false;
-        uint _e278 = r_1;
-        uint _e279 = count;
-        if (_e278 < _e279) {
+        uint _e281 = r_1;
+        uint _e282 = count;
+        if (_e281 < _e282) {
         } else {
             break;
         }
         {
-            uint _e281 = r_1;
-            float a_3 = t0_.inner[metal::min(unsigned(_e281), 7u)];
             uint _e284 = r_1;
-            float b_3 = t1_.inner[metal::min(unsigned(_e284), 7u)];
+            float a_3 = t0_.inner[metal::min(unsigned(_e284), 7u)];
+            uint _e287 = r_1;
+            float b_3 = t1_.inner[metal::min(unsigned(_e287), 7u)];
             weight = float {};
             if (!(false)) {
                 weight = b_3 - a_3;
             } else {
                 if (true) {
-                    float _e292 = spot_segment(f_7, eye_5, _e21, a_3, b_3, panels_2);
-                    weight = _e292;
+                    float _e295 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, a_3, b_3, panels_2);
+                    weight = _e295;
                 } else {
-                    float _e297 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-                    float _e301 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_3, b_3);
-                    weight = (f_7.medium.y * _e297) * _e301;
+                    float _e300 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                    float _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3, b_3);
+                    weight = (f_9.medium.y * _e300) * _e304;
                 }
             }
             vis = 0.5;
@@ -773,23 +787,23 @@ kernel void scatter(
                 if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                 loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                 if (!loop_init_6) {
-                    uint _e347 = layer_1;
-                    layer_1 = _e347 + 1u;
+                    uint _e350 = layer_1;
+                    layer_1 = _e350 + 1u;
                 }
                 loop_init_6 = false;
-                uint _e307 = layer_1;
-                if (_e307 < LAYERS) {
+                uint _e310 = layer_1;
+                if (_e310 < LAYERS) {
                 } else {
                     break;
                 }
                 {
-                    uint _e310 = layer_1;
-                    metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e310), 3u)];
-                    uint _e313 = r_1;
-                    float _e315 = pos.inner[metal::min(unsigned(_e313), 7u)];
-                    float _e318 = yc;
-                    uint _e322 = layer_1;
-                    metal::float4 texel_1 = filtered.sample(filtered_sampler, metal::float2(_e315 / static_cast<float>(width_1), _e318 / static_cast<float>(rows_1)), _e322, metal::level(0.0));
+                    uint _e313 = layer_1;
+                    metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e313), 3u)];
+                    uint _e316 = r_1;
+                    float _e318 = pos.inner[metal::min(unsigned(_e316), 7u)];
+                    float _e321 = yc;
+                    uint _e325 = layer_1;
+                    metal::float4 texel_1 = filtered.sample(filtered_sampler, metal::float2(_e318 / static_cast<float>(width_1), _e321 / static_cast<float>(rows_1)), _e325, metal::level(0.0));
                     k = 0u;
                     uint2 loop_bound_7 = uint2(4294967295u);
                     bool loop_init_7 = true;
@@ -797,53 +811,53 @@ kernel void scatter(
                         if (metal::all(loop_bound_7 == uint2(0u))) { break; }
                         loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
                         if (!loop_init_7) {
-                            uint _e344 = k;
-                            k = _e344 + 1u;
+                            uint _e347 = k;
+                            k = _e347 + 1u;
                         }
                         loop_init_7 = false;
-                        uint _e329 = k;
-                        if (_e329 < 4u) {
+                        uint _e332 = k;
+                        if (_e332 < 4u) {
                         } else {
                             break;
                         }
                         {
-                            float _e332 = vis;
-                            uint _e333 = k;
-                            uint _e335 = k;
-                            vis = _e332 + (coeff[metal::min(unsigned(_e333), 3u)] * ((texel_1[metal::min(unsigned(_e335), 3u)] * 2.0) - 1.0));
+                            float _e335 = vis;
+                            uint _e336 = k;
+                            uint _e338 = k;
+                            vis = _e335 + (coeff[metal::min(unsigned(_e336), 3u)] * ((texel_1[metal::min(unsigned(_e338), 3u)] * 2.0) - 1.0));
                         }
                     }
                 }
             }
-            float _e350 = total;
-            float _e351 = weight;
-            float _e352 = vis;
-            total = _e350 + (_e351 * metal::clamp(_e352, 0.0, 1.0));
-            float _e359 = norm;
-            float _e360 = weight;
-            norm = _e359 + _e360;
+            float _e353 = total;
+            float _e354 = weight;
+            float _e355 = vis;
+            total = _e353 + (_e354 * metal::clamp(_e355, 0.0, 1.0));
+            float _e362 = norm;
+            float _e363 = weight;
+            norm = _e362 + _e363;
         }
     }
     if (false) {
-        float _e365 = total;
-        l = _e365;
+        float _e368 = total;
+        l = _e368;
     } else {
         if (true) {
-            float _e374 = spot_segment(f_7, eye_5, _e21, 0.0, s_2, metal::max(naga_div(f_7.sizes2_.z, 4u), 1u));
-            unshadowed = _e374;
+            float _e377 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, 0.0, s_2, metal::max(naga_div(f_9.sizes2_.z, 4u), 1u));
+            unshadowed = _e377;
         } else {
-            float _e380 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-            float _e384 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
-            unshadowed = (f_7.medium.y * _e380) * _e384;
+            float _e383 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+            float _e387 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, s_2);
+            unshadowed = (f_9.medium.y * _e383) * _e387;
         }
-        float _e386 = unshadowed;
-        float _e387 = total;
-        float _e388 = norm;
-        float _e390 = norm;
-        l = _e386 * ((_e390 > 0.0) ? (_e387 / _e388) : 1.0);
+        float _e389 = unshadowed;
+        float _e390 = total;
+        float _e391 = norm;
+        float _e393 = norm;
+        l = _e389 * ((_e393 > 0.0) ? (_e390 / _e391) : 1.0);
     }
-    float _e396 = l;
-    metal::float3 c = color * _e396;
+    float _e399 = l;
+    metal::float3 c = color * _e399;
     output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_6, y_2)));
     return;
 }

@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     size: vec4<u32>,
 }
 
-struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     eye: vec4<f32>,
     axis: vec4<f32>,
     e1_: vec4<f32>,
@@ -37,24 +37,24 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
     proj_g2_: vec4<f32>,
 }
 
-struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
+struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     delta: f32,
     theta_ref: f32,
     theta_lo: f32,
     theta_hi: f32,
 }
 
-const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX: f32 = 1000000000000000000000000000000f;
-const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX: f32 = 0.1f;
+const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
+const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
 const MAX_REGIONS: u32 = 8u;
 const REGIONS: u32 = 3u;
 const LAYERS: u32 = 8u;
 
 @group(0) @binding(0) 
-var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX;
+var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX;
 @group(0) @binding(1) 
 var<storage> slices: array<vec4<f32>>;
 @group(0) @binding(2) 
@@ -67,27 +67,6 @@ var filtered: texture_2d_array<f32>;
 var filtered_sampler: sampler;
 @group(0) @binding(6) 
 var output: texture_storage_2d<rgba16float,write>;
-
-fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_2 = (sigma_t * len);
-    if (x_2 < 0.0001f) {
-        return (len * (1f - (0.5f * x_2)));
-    }
-    return ((1f - exp(-(x_2))) / sigma_t);
-}
-
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
-    let x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_3 * x_3) * (3f - (2f * x_3)));
-}
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
     let q_1 = (p - v.origin.xyz);
@@ -131,9 +110,9 @@ fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_nag
         return 2f;
     }
     let n = v_2.size.x;
-    let x_4 = min(u32((uv.x * f32(n))), (n - 1u));
+    let x_2 = min(u32((uv.x * f32(n))), (n - 1u));
     let y_1 = min(u32((uv.y * f32(n))), (n - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_4, y_1), 0i);
+    let _e49 = textureLoad(sm, vec2<u32>(x_2, y_1), 0i);
     return _e49.x;
 }
 
@@ -201,44 +180,30 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     }
 }
 
-fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(v_6.x, v_6.y, v_6.z, v_6.w);
-}
-
-fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(theta_1: f32, lo: f32, hi: f32) -> f32 {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX + (0.8f * clamp(((theta_1 - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
-}
-
-fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_1: u32) -> f32 {
-    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_1) - 1u)));
-}
-
-fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_1: f32, layer_2: u32) -> vec4<f32> {
-    let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
-    let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
-    return vec4<f32>(((2f / _e5) * cos((_e5 * d_1))), ((-2f / _e5) * sin((_e5 * d_1))), ((2f / _e10) * cos((_e10 * d_1))), ((-2f / _e10) * sin((_e10 * d_1))));
-}
-
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_2: u32, regions: u32, width: u32, spot: bool) -> u32 {
-    if spot {
-        return ((r_2 * width) / regions);
-    }
-    return (((r_2 * r_2) * width) / (regions * regions));
-}
-
-fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f.sm_right, f.sm_up, f.sm_forward, f.sm_origin, f.sm_proj, vec4<u32>(f.sizes2_.x, 0u, 0u, 0u));
-}
-
-fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, sm_3: texture_2d<f32>, p_2: vec3<f32>) -> f32 {
-    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_1);
-    let _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
-}
-
 fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
     let denom = max(((1f + (g * g)) - ((2f * g) * cos_theta)), 0.00000001f);
     return ((1f - (g * g)) / ((12.566371f * denom) * sqrt(denom)));
+}
+
+fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
+    let x_3 = (sigma_t * len);
+    if (x_3 < 0.0001f) {
+        return (len * (1f - (0.5f * x_3)));
+    }
+    return ((1f - exp(-(x_3))) / sigma_t);
+}
+
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    if ((cos_inner - cos_outer) <= 0.000001f) {
+        return select(0f, 1f, (cos_angle >= cos_outer));
+    }
+    let x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_4 * x_4) * (3f - (2f * x_4)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
@@ -254,7 +219,7 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
 
 fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
     var sum: f32 = 0f;
-    var k_2: u32 = 0u;
+    var k_1: u32 = 0u;
     var q: u32;
 
     let t0_1 = dot((light_pos_1 - eye_1), dir_1);
@@ -262,13 +227,13 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let g0_ = atan(((a_1 - t0_1) / h));
     let w = ((atan(((b_1 - t0_1) / h)) - g0_) / f32(panels));
     loop {
-        let _e30 = k_2;
+        let _e30 = k_1;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            let _e32 = k_2;
+            let _e32 = k_1;
             let mid = (g0_ + ((f32(_e32) + 0.5f) * w));
             q = 0u;
             loop {
@@ -292,71 +257,88 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
             }
         }
         continuing {
-            let _e73 = k_2;
-            k_2 = (_e73 + 1u);
+            let _e73 = k_1;
+            k_1 = (_e73 + 1u);
         }
     }
     let _e75 = sum;
     return (((_e75 * 0.5f) * w) * h);
 }
 
-fn pixel_dir(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x: u32, y: u32) -> vec3<f32> {
-    let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(f_2.sizes.x)) - 1f);
-    let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(f_2.sizes.y)));
-    let t_3 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc_x * t_3) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc_y * t_3))));
+fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
 }
 
-fn frame_spot_integrand(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_2: vec3<f32>, dir_2: vec3<f32>, t_1: f32) -> f32 {
+fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_1: f32, lo: f32, hi: f32) -> f32 {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * clamp(((theta_1 - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
+}
+
+fn pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x: u32, y: u32) -> vec3<f32> {
+    let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(f.sizes.x)) - 1f);
+    let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(f.sizes.y)));
+    let t_3 = f.cam_forward.w;
+    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_3) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_3))));
+}
+
+fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_1.sm_right, f_1.sm_up, f_1.sm_forward, f_1.sm_origin, f_1.sm_proj, vec4<u32>(f_1.sizes2_.x, 0u, 0u, 0u));
+}
+
+fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_3: texture_2d<f32>, p_2: vec3<f32>) -> f32 {
+    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2);
+    let _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
+    return _e4;
+}
+
+fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_2: vec3<f32>, dir_2: vec3<f32>, t_1: f32) -> f32 {
     let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-fn march(eye_3: vec3<f32>, dir_3: vec3<f32>, s: f32, spot_1: bool) -> f32 {
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_3: vec3<f32>, dir_3: vec3<f32>, s: f32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
-    var k_3: u32 = 0u;
+    var k_2: u32 = 0u;
 
-    let f_6 = frame;
-    let steps = f_6.sizes2_.y;
+    let steps = f_4.sizes2_.y;
     let h_1 = (s / f32(steps));
     loop {
-        let _e10 = k_3;
-        if (_e10 < steps) {
+        let _e9 = k_2;
+        if (_e9 < steps) {
         } else {
             break;
         }
         {
-            let _e12 = k_3;
-            let t_4 = ((f32(_e12) + 0.5f) * h_1);
-            let _e22 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, shadow_map, (eye_3 + (dir_3 * t_4)));
-            if spot_1 {
-                let _e25 = sum_1;
-                let _e27 = frame_spot_integrand(f_6, eye_3, dir_3, t_4);
-                sum_1 = (_e25 + ((_e22 * h_1) * _e27));
+            let _e11 = k_2;
+            let t_4 = ((f32(_e11) + 0.5f) * h_1);
+            let _e21 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_3 + (dir_3 * t_4)));
+            if spot {
+                let _e24 = sum_1;
+                let _e26 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_3, dir_3, t_4);
+                sum_1 = (_e24 + ((_e21 * h_1) * _e26));
             } else {
-                let _e30 = sum_1;
-                let _e33 = k_3;
-                let _e36 = k_3;
-                let _e41 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, (f32(_e33) * h_1), (f32((_e36 + 1u)) * h_1));
-                sum_1 = (_e30 + (_e22 * _e41));
+                let _e29 = sum_1;
+                let _e32 = k_2;
+                let _e35 = k_2;
+                let _e40 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e32) * h_1), (f32((_e35 + 1u)) * h_1));
+                sum_1 = (_e29 + (_e21 * _e40));
             }
         }
         continuing {
-            let _e45 = k_3;
-            k_3 = (_e45 + 1u);
+            let _e44 = k_2;
+            k_2 = (_e44 + 1u);
         }
     }
-    if spot_1 {
-        let _e47 = sum_1;
-        return _e47;
+    if spot {
+        let _e46 = sum_1;
+        return _e46;
     } else {
-        let _e56 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_3)));
-        let _e58 = sum_1;
-        return ((f_6.medium.y * _e56) * _e58);
+        let _e55 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_3)));
+        let _e57 = sum_1;
+        return ((f_4.medium.y * _e55) * _e57);
     }
 }
 
-fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
+fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
     let ji = i32(j);
     if wrap {
         return u32((((ji % i32(rows)) + i32(rows)) % i32(rows)));
@@ -365,10 +347,10 @@ fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
     }
 }
 
-fn ray_t(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_1: f32, delta_1: f32, theta_2: f32, s_1: f32, spot_2: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta_1: f32, theta_2: f32, s_1: f32, spot_1: bool) -> f32 {
     var local_9: bool;
 
-    if spot_2 {
+    if spot_1 {
         let psi = (x_1 * delta_1);
         let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
@@ -380,15 +362,40 @@ fn ray_t(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, x_1: f32, 
         if _e16 {
             return s_1;
         }
-        return min(((f_4.axis.w * sin(psi)) / den), s_1);
+        return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
         return min(((x_1 * delta_1) / max(sin(theta_2), 0.000001f)), s_1);
     }
 }
 
-fn spot_segment(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX, eye_4: vec3<f32>, dir_4: vec3<f32>, a_2: f32, b_2: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_5.light_pos.xyz, f_5.light_dir.xyz, f_5.light_pos.w, f_5.light_dir.w, f_5.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_4: vec3<f32>, dir_4: vec3<f32>, a_2: f32, b_2: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
+}
+
+fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
+    return ((f_7.e1_.xyz * cos(phi)) + (f_7.e2_.xyz * sin(phi)));
+}
+
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    return (f_8.e1_.w + ((f32(row) + 0.5f) * f_8.e2_.w));
+}
+
+fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_3: u32) -> f32 {
+    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_3) - 1u)));
+}
+
+fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_1: f32, layer_2: u32) -> vec4<f32> {
+    let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
+    let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
+    return vec4<f32>(((2f / _e5) * cos((_e5 * d_1))), ((-2f / _e5) * sin((_e5 * d_1))), ((2f / _e10) * cos((_e10 * d_1))), ((-2f / _e10) * sin((_e10 * d_1))));
+}
+
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_2: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
+    if spot_2 {
+        return ((r_2 * width) / regions);
+    }
+    return (((r_2 * r_2) * width) / (regions * regions));
 }
 
 @compute @workgroup_size(8, 8, 1) 
@@ -420,11 +427,11 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     var l: f32;
     var unshadowed: f32;
 
-    let f_7 = frame;
+    let f_9 = frame;
     let x_6 = id.x;
     let y_2 = id.y;
-    if !((x_6 >= f_7.sizes.x)) {
-        local = (y_2 >= f_7.sizes.y);
+    if !((x_6 >= f_9.sizes.x)) {
+        local = (y_2 >= f_9.sizes.y);
     } else {
         local = true;
     }
@@ -432,21 +439,21 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e18 {
         return;
     }
-    let eye_5 = f_7.eye.xyz;
-    let _e21 = pixel_dir(f_7, x_6, y_2);
+    let eye_5 = f_9.eye.xyz;
+    let _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_6, y_2);
     let _e25 = textureLoad(depth, vec2<u32>(x_6, y_2), 0i);
-    let s_2 = (min(max(_e25.x, 0f), f_7.theta.z) / max(dot(_e21, f_7.cam_forward.xyz), 0.000001f));
-    let color = f_7.light_color.xyz;
+    let s_2 = (min(max(_e25.x, 0f), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 0.000001f));
+    let color = f_9.light_color.xyz;
     let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_2) + 0.5f), 0f);
-    let radius = f_7.epipole.w;
-    if (f_7.epipole.z > 0.5f) {
-        local_1 = (length((px - vec3<f32>(f_7.epipole.x, f_7.epipole.y, 0f))) < radius);
+    let radius = f_9.epipole.w;
+    if (f_9.epipole.z > 0.5f) {
+        local_1 = (length((px - vec3<f32>(f_9.epipole.x, f_9.epipole.y, 0f))) < radius);
     } else {
         local_1 = false;
     }
     let near_epi = local_1;
-    if (f_7.anti_epipole.z > 0.5f) {
-        local_2 = (length((px - vec3<f32>(f_7.anti_epipole.x, f_7.anti_epipole.y, 0f))) < radius);
+    if (f_9.anti_epipole.z > 0.5f) {
+        local_2 = (length((px - vec3<f32>(f_9.anti_epipole.x, f_9.anti_epipole.y, 0f))) < radius);
     } else {
         local_2 = false;
     }
@@ -458,215 +465,216 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let _e88 = local_3;
     if _e88 {
-        let _e90 = march(eye_5, _e21, s_2, false);
-        let l_2 = (_e90 * color);
+        let _e90 = frame;
+        let _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_5, _e21, s_2, false);
+        let l_2 = (_e93 * color);
         textureStore(output, vec2<u32>(x_6, y_2), vec4<f32>(l_2.x, l_2.y, l_2.z, 1f));
         return;
     }
-    let axis = f_7.axis.xyz;
-    let rows_1 = f_7.sizes.w;
-    let width_1 = f_7.sizes.z;
-    let wrap_1 = (f_7.anti_epipole.w > 0.5f);
+    let axis = f_9.axis.xyz;
+    let rows_1 = f_9.sizes.w;
+    let width_1 = f_9.sizes.z;
+    let wrap_1 = (f_9.anti_epipole.w > 0.5f);
     {
         theta = acos(clamp(dot(_e21, axis), -1f, 1f));
-        let phi = atan2(dot(_e21, f_7.e2_.xyz), dot(_e21, f_7.e1_.xyz));
-        yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
+        let phi_1 = atan2(dot(_e21, f_9.e2_.xyz), dot(_e21, f_9.e1_.xyz));
+        yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
         if wrap_1 {
-            let _e129 = yc;
-            let _e130 = yc;
-            yc = (_e129 - (floor((_e130 / f32(rows_1))) * f32(rows_1)));
+            let _e132 = yc;
+            let _e133 = yc;
+            yc = (_e132 - (floor((_e133 / f32(rows_1))) * f32(rows_1)));
         } else {
-            let _e137 = yc;
-            yc = clamp(_e137, 0f, f32(rows_1));
+            let _e140 = yc;
+            yc = clamp(_e140, 0f, f32(rows_1));
         }
-        let _e141 = yc;
-        let yy = (_e141 - 0.5f);
+        let _e144 = yc;
+        let yy = (_e144 - 0.5f);
         let j0_ = floor(yy);
         let fy = (yy - j0_);
-        let _e146 = row_index(j0_, rows_1, wrap_1);
-        let _e149 = slices[_e146];
-        let _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
-        let _e153 = row_index((j0_ + 1f), rows_1, wrap_1);
-        let _e156 = slices[_e153];
-        let _e157 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156);
-        delta = mix(_e150.delta, _e157.delta, fy);
-        let _e162 = theta;
-        let _e167 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e162, f_7.theta.x, f_7.theta.y);
-        d = _e167;
+        let _e149 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
+        let _e152 = slices[_e149];
+        let _e153 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e152);
+        let _e156 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1f), rows_1, wrap_1);
+        let _e159 = slices[_e156];
+        let _e160 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e159);
+        delta = mix(_e153.delta, _e160.delta, fy);
+        let _e165 = theta;
+        let _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_9.theta.x, f_9.theta.y);
+        d = _e170;
         if false {
-            let q_2 = normalize(((eye_5 + (_e21 * s_2)) - f_7.light_pos.xyz));
-            let _e181 = delta;
-            xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / _e181);
+            let q_2 = normalize(((eye_5 + (_e21 * s_2)) - f_9.light_pos.xyz));
+            let _e184 = delta;
+            xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / _e184);
         } else {
-            let _e184 = theta;
-            let _e187 = delta;
-            xs = ((s_2 * sin(_e184)) / _e187);
+            let _e187 = theta;
+            let _e190 = delta;
+            xs = ((s_2 * sin(_e187)) / _e190);
         }
     }
-    let _e189 = xs;
-    let last = u32(min(max(_e189, 0f), (f32(width_1) - 1f)));
+    let _e192 = xs;
+    let last = u32(min(max(_e192, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e199 = r;
-        if (_e199 < REGIONS) {
+        let _e202 = r;
+        if (_e202 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e201 = r;
-            let _e202 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e201, REGIONS, width_1, false);
-            let b0_ = f32(_e202);
             let _e204 = r;
-            let _e207 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e204 + 1u), REGIONS, width_1, false);
-            let b1_ = f32(_e207);
+            let _e205 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e204, REGIONS, width_1, false);
+            let b0_ = f32(_e205);
+            let _e207 = r;
+            let _e210 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e207 + 1u), REGIONS, width_1, false);
+            let b1_ = f32(_e210);
             if !((last < u32(b1_))) {
-                let _e212 = r;
-                local_4 = ((_e212 + 1u) == REGIONS);
+                let _e215 = r;
+                local_4 = ((_e215 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             let is_last = local_4;
-            let _e221 = r;
-            let _e225 = xs;
-            pos[_e221] = select((b1_ - 0.5f), clamp((_e225 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
-            let _e235 = r;
-            let _e237 = delta;
-            let _e238 = theta;
-            let _e239 = ray_t(f_7, b0_, _e237, _e238, s_2, false);
-            t0_[_e235] = _e239;
-            let _e241 = r;
-            let _e243 = delta;
-            let _e244 = theta;
-            let _e245 = ray_t(f_7, b1_, _e243, _e244, s_2, false);
-            t1_[_e241] = select(_e245, s_2, is_last);
-            let _e247 = r;
-            count = (_e247 + 1u);
+            let _e224 = r;
+            let _e228 = xs;
+            pos[_e224] = select((b1_ - 0.5f), clamp((_e228 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
+            let _e238 = r;
+            let _e240 = delta;
+            let _e241 = theta;
+            let _e242 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e240, _e241, s_2, false);
+            t0_[_e238] = _e242;
+            let _e244 = r;
+            let _e246 = delta;
+            let _e247 = theta;
+            let _e248 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e246, _e247, s_2, false);
+            t1_[_e244] = select(_e248, s_2, is_last);
+            let _e250 = r;
+            count = (_e250 + 1u);
             if is_last {
                 break;
             }
         }
         continuing {
-            let _e252 = r;
-            r = (_e252 + 1u);
+            let _e255 = r;
+            r = (_e255 + 1u);
         }
     }
-    let cos_theta_l = -(dot(f_7.light_dir.xyz, _e21));
-    let panels_2 = max((f_7.sizes2_.z / 4u), 1u);
+    let cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
+    let panels_2 = max((f_9.sizes2_.z / 4u), 1u);
     loop {
-        let _e265 = layer;
-        if (_e265 < LAYERS) {
+        let _e268 = layer;
+        if (_e268 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e269 = layer;
-            let _e271 = d;
             let _e272 = layer;
-            let _e273 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e271, _e272);
-            coeffs[_e269] = _e273;
+            let _e274 = d;
+            let _e275 = layer;
+            let _e276 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e274, _e275);
+            coeffs[_e272] = _e276;
         }
         continuing {
-            let _e275 = layer;
-            layer = (_e275 + 1u);
+            let _e278 = layer;
+            layer = (_e278 + 1u);
         }
     }
     loop {
-        let _e278 = r_1;
-        let _e279 = count;
-        if (_e278 < _e279) {
+        let _e281 = r_1;
+        let _e282 = count;
+        if (_e281 < _e282) {
         } else {
             break;
         }
         {
-            let _e281 = r_1;
-            let a_3 = t0_[_e281];
             let _e284 = r_1;
-            let b_3 = t1_[_e284];
+            let a_3 = t0_[_e284];
+            let _e287 = r_1;
+            let b_3 = t1_[_e287];
             weight = f32();
             if !(true) {
                 weight = (b_3 - a_3);
             } else {
                 if false {
-                    let _e292 = spot_segment(f_7, eye_5, _e21, a_3, b_3, panels_2);
-                    weight = _e292;
+                    let _e295 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, a_3, b_3, panels_2);
+                    weight = _e295;
                 } else {
-                    let _e297 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-                    let _e301 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, a_3, b_3);
-                    weight = ((f_7.medium.y * _e297) * _e301);
+                    let _e300 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                    let _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3, b_3);
+                    weight = ((f_9.medium.y * _e300) * _e304);
                 }
             }
             vis = 0.5f;
             layer_1 = 0u;
             loop {
-                let _e307 = layer_1;
-                if (_e307 < LAYERS) {
+                let _e310 = layer_1;
+                if (_e310 < LAYERS) {
                 } else {
                     break;
                 }
                 {
-                    let _e310 = layer_1;
-                    let coeff = coeffs[_e310];
-                    let _e313 = r_1;
-                    let _e315 = pos[_e313];
-                    let _e318 = yc;
-                    let _e322 = layer_1;
-                    let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e315 / f32(width_1)), (_e318 / f32(rows_1))), _e322, 0f);
+                    let _e313 = layer_1;
+                    let coeff = coeffs[_e313];
+                    let _e316 = r_1;
+                    let _e318 = pos[_e316];
+                    let _e321 = yc;
+                    let _e325 = layer_1;
+                    let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e318 / f32(width_1)), (_e321 / f32(rows_1))), _e325, 0f);
                     k = 0u;
                     loop {
-                        let _e329 = k;
-                        if (_e329 < 4u) {
+                        let _e332 = k;
+                        if (_e332 < 4u) {
                         } else {
                             break;
                         }
                         {
-                            let _e332 = vis;
-                            let _e333 = k;
-                            let _e335 = k;
-                            vis = (_e332 + (coeff[_e333] * ((texel_1[_e335] * 2f) - 1f)));
+                            let _e335 = vis;
+                            let _e336 = k;
+                            let _e338 = k;
+                            vis = (_e335 + (coeff[_e336] * ((texel_1[_e338] * 2f) - 1f)));
                         }
                         continuing {
-                            let _e344 = k;
-                            k = (_e344 + 1u);
+                            let _e347 = k;
+                            k = (_e347 + 1u);
                         }
                     }
                 }
                 continuing {
-                    let _e347 = layer_1;
-                    layer_1 = (_e347 + 1u);
+                    let _e350 = layer_1;
+                    layer_1 = (_e350 + 1u);
                 }
             }
-            let _e350 = total;
-            let _e351 = weight;
-            let _e352 = vis;
-            total = (_e350 + (_e351 * clamp(_e352, 0f, 1f)));
-            let _e359 = norm;
-            let _e360 = weight;
-            norm = (_e359 + _e360);
+            let _e353 = total;
+            let _e354 = weight;
+            let _e355 = vis;
+            total = (_e353 + (_e354 * clamp(_e355, 0f, 1f)));
+            let _e362 = norm;
+            let _e363 = weight;
+            norm = (_e362 + _e363);
         }
         continuing {
-            let _e363 = r_1;
-            r_1 = (_e363 + 1u);
+            let _e366 = r_1;
+            r_1 = (_e366 + 1u);
         }
     }
     if true {
-        let _e365 = total;
-        l = _e365;
+        let _e368 = total;
+        l = _e368;
     } else {
         if false {
-            let _e374 = spot_segment(f_7, eye_5, _e21, 0f, s_2, max((f_7.sizes2_.z / 4u), 1u));
-            unshadowed = _e374;
+            let _e377 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, 0f, s_2, max((f_9.sizes2_.z / 4u), 1u));
+            unshadowed = _e377;
         } else {
-            let _e380 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.z, cos_theta_l);
-            let _e384 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, s_2);
-            unshadowed = ((f_7.medium.y * _e380) * _e384);
+            let _e383 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+            let _e387 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, s_2);
+            unshadowed = ((f_9.medium.y * _e383) * _e387);
         }
-        let _e386 = unshadowed;
-        let _e387 = total;
-        let _e388 = norm;
-        let _e390 = norm;
-        l = (_e386 * select(1f, (_e387 / _e388), (_e390 > 0f)));
+        let _e389 = unshadowed;
+        let _e390 = total;
+        let _e391 = norm;
+        let _e393 = norm;
+        l = (_e389 * select(1f, (_e390 / _e391), (_e393 > 0f)));
     }
-    let _e396 = l;
-    let c = (color * _e396);
+    let _e399 = l;
+    let c = (color * _e399);
     textureStore(output, vec2<u32>(x_6, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

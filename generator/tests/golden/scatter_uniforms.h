@@ -16,7 +16,7 @@
 #define SCATTER_STATIC_ASSERT(cond, msg) _Static_assert(cond, msg)
 #endif
 
-/* WGSL `Frame` of family minmax (scatter::prefiltered), 400 bytes, alignment 16. */
+/* WGSL `Frame` of family minmax (scatter::epipolar), 400 bytes, alignment 16. */
 typedef struct ScatterMinmaxFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
     float axis[4]; /* vec4<f32>, offset 16 */
@@ -71,7 +71,7 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g0_) == 352, "ScatterMin
 SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g1_) == 368, "ScatterMinmaxFrame.proj_g1_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g2_) == 384, "ScatterMinmaxFrame.proj_g2_ offset");
 
-/* WGSL `Frame` of family prefiltered (scatter::prefiltered), 400 bytes, alignment 16. */
+/* WGSL `Frame` of family prefiltered (scatter::epipolar), 400 bytes, alignment 16. */
 typedef struct ScatterPrefilteredFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
     float axis[4]; /* vec4<f32>, offset 16 */

@@ -8,7 +8,7 @@
 /// Uniform structs of the `minmax` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod minmax {
-    /// WGSL `Frame` (scatter::prefiltered), 400 bytes, alignment 16.
+    /// WGSL `Frame` (scatter::epipolar), 400 bytes, alignment 16.
     #[repr(C)]
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct Frame {
@@ -97,7 +97,7 @@ pub mod minmax {
 /// Uniform structs of the `prefiltered` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod prefiltered {
-    /// WGSL `Frame` (scatter::prefiltered), 400 bytes, alignment 16.
+    /// WGSL `Frame` (scatter::epipolar), 400 bytes, alignment 16.
     #[repr(C)]
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct Frame {

@@ -1,15 +1,16 @@
 //! CPU mirror of `shaderlib/templates/common/prefiltered.wgsl` (`scatter::prefiltered`): the
-//! rectified-space mapping, the Fourier basis and coefficients, reference-ray weights, the
-//! standard shadow-map lookup, and the texture operations (loads, stores in the variant's
-//! format, bilinear sampling) the three kernels use.
+//! Fourier basis and coefficients, reference-ray weights, region bounds and the projective
+//! mapping; plus the texture operations (loads, stores in the variant's format, bilinear
+//! sampling) every mirror uses. The epipolar set-up it builds on is
+//! [`super::common_epipolar`].
 //!
 //! Conventions are documented in `scatter_shaderlib::prefiltered::frame`.
 
+use super::common_epipolar::{DEPTH_MARGIN, row_phi, slice_e};
 use super::common_model::{
     PI, clamp, cone_falloff, exp, max, min, mix, sqrt, transmittance_between,
 };
 pub use super::common_shadow::NO_OCCLUDER;
-use super::common_shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams, Storage};
 
@@ -151,27 +152,6 @@ pub fn xyz(v: [f32; 4]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
 }
 
-/// Unit vector of slice angle `phi` (perpendicular to the axis).
-pub fn slice_e(f: &FrameUniforms, phi: f32) -> Vec3 {
-    xyz(f.e1) * phi.cos() + xyz(f.e2) * phi.sin()
-}
-
-/// Slice angle at the centre of row `row`.
-pub fn row_phi(f: &FrameUniforms, row: u32) -> f32 {
-    f.e1[3] + (row as f32 + 0.5) * f.e2[3]
-}
-
-/// Normalised rectified depth of view angle `theta`, the frame's view angles spanning
-/// [`lo`, `hi`] (`FrameUniforms::theta`).
-pub fn normalised_depth(theta: f32, lo: f32, hi: f32) -> f32 {
-    DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp((theta - lo) / max(hi - lo, 1e-6), 0.0, 1.0)
-}
-
-/// Rectified depths use [`DEPTH_MARGIN`, 1 - `DEPTH_MARGIN`]: the Fourier series of the step
-/// is 2-periodic, so depth differences near +-1 (a ray at the very start of the range
-/// against an empty light ray) would fall on the periodic copy's discontinuity.
-pub const DEPTH_MARGIN: f32 = 0.1;
-
 /// Fourier frequency `c_k = pi (2k - 1)`.
 pub fn freq(k: u32) -> f32 {
     PI * (2 * k - 1) as f32
@@ -250,29 +230,6 @@ pub fn texel_weight(
         w *= cone * exp(-f.medium[0] * r) / (r * r);
     }
     w
-}
-
-/// The frame's standard shadow map ([`super::common_shadow`]).
-pub fn sm_view(f: &FrameUniforms) -> ShadowMapView {
-    ShadowMapView {
-        right: f.sm_right,
-        up: f.sm_up,
-        forward: f.sm_forward,
-        origin: f.sm_origin,
-        proj: f.sm_proj,
-        size: [f.sizes2[0], 0, 0, 0],
-    }
-}
-
-/// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed).
-pub fn sm_visibility(f: &FrameUniforms, sm: &Tex, p: Vec3) -> f32 {
-    shadow_visibility(&sm_view(f), sm, p)
-}
-
-/// Travel distance from `o` along the light ray `o + s l` to its first occluder, or
-/// [`NO_OCCLUDER`].
-pub fn sm_occluder_distance(f: &FrameUniforms, sm: &Tex, o: Vec3, l: Vec3) -> f32 {
-    shadow_occluder_distance(&sm_view(f), sm, o, l)
 }
 
 /// First column of region `r` of `regions` in a row of `width` columns. Directional lights

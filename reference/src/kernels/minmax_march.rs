@@ -9,10 +9,12 @@
 //! [`minmax_brute_main`], the brute-force march over every texel of the same rectified row
 //! (the reference the hierarchy must equal), shares everything but the walk.
 
+use super::common_epipolar::{
+    epipole_march, normalised_depth, pixel_dir, ray_t, row_index, spot_segment,
+};
 use super::common_minmax::{level_offset, tree_levels};
 use super::common_model::{clamp, max, max_u, min, phase_hg, transmittance_between};
-use super::common_prefiltered::{Tex, TexArray, normalised_depth, quantise, sm_visibility, xyz};
-use super::scatter::{frame_spot_integrand, pixel_dir, ray_t, spot_segment};
+use super::common_prefiltered::{Tex, TexArray, quantise, xyz};
 use glam::Vec3;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{FrameUniforms, LightKind, SliceParams, Storage};
@@ -29,39 +31,6 @@ pub struct MarchInputs<'a> {
     pub shadow_map: &'a Tex,
     /// The min-max trees (from `minmax_build`).
     pub tree: &'a TexArray,
-}
-
-/// In-scattering by ray marching `steps` midpoints against the standard shadow map.
-pub fn march(inp: &MarchInputs, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f32 {
-    let f = inp.frame;
-    let steps = f.sizes2[1];
-    let h = s / steps as f32;
-    let mut sum = 0.0;
-    for k in 0..steps {
-        let t = (k as f32 + 0.5) * h;
-        let v = sm_visibility(f, inp.shadow_map, eye + dir * t);
-        if spot {
-            sum += v * h * frame_spot_integrand(f, eye, dir, t);
-        } else {
-            sum += v * transmittance_between(f.medium[0], k as f32 * h, (k + 1) as f32 * h);
-        }
-    }
-    if spot {
-        sum
-    } else {
-        f.medium[1] * phase_hg(f.medium[2], -xyz(f.light_dir).dot(dir)) * sum
-    }
-}
-
-/// Row of the `slices` table for row coordinate `j` (a whole number): wrapped around when
-/// the slices cover the full circle, else clamped.
-pub fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
-    let ji = j as i32;
-    if wrap {
-        (((ji % rows as i32) + rows as i32) % rows as i32) as u32
-    } else {
-        ji.clamp(0, rows as i32 - 1) as u32
-    }
 }
 
 /// Ray distance of column edge `x` of a ray that crosses texels `0 .. n`: the last texel's
@@ -143,7 +112,7 @@ pub fn pixel_ray(id: [u32; 3], spot: bool, inp: &MarchInputs) -> Option<Pixel> {
     let near_anti = f.anti_epipole[2] > 0.5
         && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
     if near_epi || near_anti {
-        let l = march(inp, eye, dir, s, spot) * color;
+        let l = epipole_march(f, inp.shadow_map, eye, dir, s, spot) * color;
         return Some(Pixel::Marched([l.x, l.y, l.z, 1.0]));
     }
 

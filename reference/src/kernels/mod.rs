@@ -3,6 +3,7 @@
 //! GPU result can be compared with its mirror at quantisation-level tolerance. Shared WGSL
 //! modules (`templates/common/<name>.wgsl`) are mirrored by `common_<name>.rs`.
 
+pub mod common_epipolar;
 pub mod common_minmax;
 pub mod common_model;
 pub mod common_prefiltered;

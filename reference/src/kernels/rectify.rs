@@ -5,10 +5,9 @@
 //! light ray's first occluder in the standard shadow map and store its view angle as
 //! normalised rectified depth (see `scatter_shaderlib::prefiltered::frame`).
 
+use super::common_epipolar::{normalised_depth, row_phi, slice_e, sm_occluder_distance};
 use super::common_model::PI;
-use super::common_prefiltered::{
-    NO_OCCLUDER, Tex, normalised_depth, row_phi, slice_e, sm_occluder_distance, xyz,
-};
+use super::common_prefiltered::{NO_OCCLUDER, Tex, xyz};
 use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams};
 
 /// The kernel body for invocation `id` (`spot` is the template's light switch); returns the

@@ -9,13 +9,15 @@
 //! with more, each region's visibility is weighted by the true integrand instead of the
 //! reference ray's. Average visibility: `L = L_unshadowed * sum_j len_j Vbar_j / s`.
 
+use super::common_epipolar::{
+    epipole_march, normalised_depth, pixel_dir, ray_t, row_index, spot_segment,
+};
 use super::common_model::{
-    PI, clamp, max, max_u, min, mix, phase_hg, select, spot_integrand, spot_span,
-    transmittance_between, transmittance_integral,
+    clamp, max, max_u, min, mix, phase_hg, select, transmittance_between, transmittance_integral,
 };
 use super::common_prefiltered::{
-    Tex, TexArray, coeff4, normalised_depth, proj_boundary, proj_column, proj_ray_depth,
-    proj_reach, quantise, region_start, sample_bilinear, sm_visibility, xyz,
+    Tex, TexArray, coeff4, proj_boundary, proj_column, proj_ray_depth, proj_reach, quantise,
+    region_start, sample_bilinear, xyz,
 };
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
@@ -37,53 +39,6 @@ pub struct ScatterInputs<'a> {
     pub shadow_map: &'a Tex,
     /// Filtered bases (from `prefilter`).
     pub filtered: &'a TexArray,
-}
-
-/// Unit view direction through the centre of pixel (x, y).
-pub fn pixel_dir(f: &FrameUniforms, x: u32, y: u32) -> Vec3 {
-    let ndc_x = 2.0 * (x as f32 + 0.5) / f.sizes[0] as f32 - 1.0;
-    let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / f.sizes[1] as f32;
-    let t = f.cam_forward[3];
-    (xyz(f.cam_forward)
-        + xyz(f.cam_right) * (ndc_x * t * f.cam_right[3])
-        + xyz(f.cam_up) * (ndc_y * t))
-        .normalize()
-}
-
-/// The spot integrand at ray parameter `t` with the light and medium of the frame.
-pub fn frame_spot_integrand(f: &FrameUniforms, eye: Vec3, dir: Vec3, t: f32) -> f32 {
-    spot_integrand(
-        eye,
-        dir,
-        t,
-        xyz(f.light_pos),
-        xyz(f.light_dir),
-        f.light_pos[3],
-        f.light_dir[3],
-        f.medium,
-    )
-}
-
-/// In-scattering by ray marching `steps` midpoints against the standard shadow map.
-pub fn march(inp: &ScatterInputs, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f32 {
-    let f = inp.frame;
-    let steps = f.sizes2[1];
-    let h = s / steps as f32;
-    let mut sum = 0.0;
-    for k in 0..steps {
-        let t = (k as f32 + 0.5) * h;
-        let v = sm_visibility(f, inp.shadow_map, eye + dir * t);
-        if spot {
-            sum += v * h * frame_spot_integrand(f, eye, dir, t);
-        } else {
-            sum += v * transmittance_between(f.medium[0], k as f32 * h, (k + 1) as f32 * h);
-        }
-    }
-    if spot {
-        sum
-    } else {
-        f.medium[1] * phase_hg(f.medium[2], -xyz(f.light_dir).dot(dir)) * sum
-    }
 }
 
 /// The kernel body for pixel `id`; returns the rgba16float texel it stores.
@@ -110,7 +65,7 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
     let near_anti = f.anti_epipole[2] > 0.5
         && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
     if near_epi || near_anti {
-        let l = march(inp, eye, dir, s, spot) * color;
+        let l = epipole_march(f, inp.shadow_map, eye, dir, s, spot) * color;
         return Some([l.x, l.y, l.z, 1.0]);
     }
 
@@ -162,16 +117,8 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         let yy = yc - 0.5;
         let j0 = yy.floor();
         let fy = yy - j0;
-        let row_index = |j: f32| -> usize {
-            let j = j as i64;
-            if wrap {
-                j.rem_euclid(i64::from(rows)) as usize
-            } else {
-                j.clamp(0, i64::from(rows) - 1) as usize
-            }
-        };
-        let s0 = inp.slices[row_index(j0)];
-        let s1 = inp.slices[row_index(j0 + 1.0)];
+        let s0 = inp.slices[row_index(j0, rows, wrap) as usize];
+        let s1 = inp.slices[row_index(j0 + 1.0, rows, wrap) as usize];
         delta = mix(s0.delta, s1.delta, fy);
         d = normalised_depth(theta, f.theta[0], f.theta[1]);
         xs = if spot {
@@ -271,37 +218,6 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
     };
     let c = color * l;
     Some([c.x, c.y, c.z, 1.0])
-}
-
-/// Distance along the pixel's own ray (angle `theta` to the axis) of column edge `x`, capped
-/// at the surface distance `s`.
-pub fn ray_t(f: &FrameUniforms, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
-    if spot {
-        let psi = x * delta;
-        let den = (theta + psi).sin();
-        if den <= 1e-6 || theta + psi >= PI {
-            return s;
-        }
-        min(f.axis[3] * psi.sin() / den, s)
-    } else {
-        min(x * delta / max(theta.sin(), 1e-6), s)
-    }
-}
-
-/// Unshadowed spot in-scattering over `[a, b]` of the ray (`common_model::spot_span`).
-pub fn spot_segment(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, panels: u32) -> f32 {
-    spot_span(
-        eye,
-        dir,
-        a,
-        b,
-        panels,
-        xyz(f.light_pos),
-        xyz(f.light_dir),
-        f.light_pos[3],
-        f.light_dir[3],
-        f.medium,
-    )
 }
 
 /// Runs every pixel (rows in parallel); returns the screen-sized output as stored in

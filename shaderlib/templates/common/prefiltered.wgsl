@@ -1,8 +1,8 @@
-// scatter::prefiltered: what the three kernels of the prefiltered family (Klehm et al. 2014)
-// share: the `Frame` uniform block, the per-slice parameters, the rectified-space mapping
-// (Sec. 4.1), the Fourier basis and its coefficients (Sec. 3, Eq. 8), the prefilter's
-// reference-ray weights (Eq. 11/12), region bounds (Table 1) and the frame's standard
-// shadow map (`scatter::shadow`) for `rectify` and the epipole ray march of `scatter` (Sec. 5).
+// scatter::prefiltered: what the kernels of the prefiltered family (Klehm et al. 2014) share
+// beyond the epipolar set-up (`scatter::epipolar`: the `Frame` block, slices, the frame's
+// shadow map, the epipole march): the Fourier basis and its coefficients (Sec. 3, Eq. 8),
+// the prefilter's reference-ray weights (Eq. 11/12), region bounds (Table 1) and the
+// projective rectification's mapping (Sec. 4.2).
 //
 // Composed into kernels by naga_oil (`#import scatter::prefiltered::{...}`); plain WGSL, not
 // an askama template. Conventions: `scatter_shaderlib::prefiltered::frame`. Mirrored line by
@@ -15,108 +15,8 @@
 #define_import_path scatter::prefiltered
 
 #import scatter::model::{PI, cone_falloff, transmittance_between}
-#import scatter::shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility}
+#import scatter::epipolar::{DEPTH_MARGIN, Frame, SliceParams, row_phi, slice_e}
 
-// The uniform block (host: `scatter_shaderlib::prefiltered::FrameUniforms`, field by field;
-// every member is 16 bytes, 25 * 16 = 400 bytes in all). The host's `e1`, `e2`, `sizes2` and
-// `proj_g0..2` are spelled `e1_`, `e2_`, `sizes2_` and `proj_g0_..2_`: naga's back-ends append
-// `_` to identifiers that end in a digit, and naga_oil requires shared modules to use the
-// written-back spelling.
-struct Frame {
-    // Eye position; w unused.
-    eye: vec4<f32>,
-    // Axis A (towards the light); w = eye-light distance D (spot), 0 (directional).
-    axis: vec4<f32>,
-    // Slice basis e1 (perpendicular to A); w = phi0.
-    e1_: vec4<f32>,
-    // Slice basis e2 = A x e1; w = dphi (radians per row).
-    e2_: vec4<f32>,
-    // Camera forward; w = tan(fov_y / 2).
-    cam_forward: vec4<f32>,
-    // Camera right; w = aspect (width / height).
-    cam_right: vec4<f32>,
-    // Camera up; w = near.
-    cam_up: vec4<f32>,
-    // x = theta_lo, y = theta_hi, z = far, w = 1 / (theta_hi - theta_lo).
-    theta: vec4<f32>,
-    // x = sigma_t, y = sigma_s, z = g, w unused.
-    medium: vec4<f32>,
-    // Light colour (E or I); w unused.
-    light_color: vec4<f32>,
-    // Spot position; w = cos(inner angle).
-    light_pos: vec4<f32>,
-    // Direction the light travels (spot axis); w = cos(outer angle).
-    light_dir: vec4<f32>,
-    // Shadow-map right; w = shadow-map near.
-    sm_right: vec4<f32>,
-    // Shadow-map up; w = shadow-map far.
-    sm_up: vec4<f32>,
-    // Shadow-map forward; w = bias in texel footprints.
-    sm_forward: vec4<f32>,
-    // Shadow-map origin; w = 0 orthographic, 1 perspective.
-    sm_origin: vec4<f32>,
-    // Orthographic: x0, x1, y0, y1. Perspective: tan_half, 0, 0, 0.
-    sm_proj: vec4<f32>,
-    // Epipole pixel position x, y; z = 1 if it is on screen; w = march radius (pixels).
-    epipole: vec4<f32>,
-    // Anti-epipole pixel position x, y; z = 1 if on screen; w = 1 if the slices wrap around.
-    anti_epipole: vec4<f32>,
-    // Screen width, height, rectified width, rectified height.
-    sizes: vec4<u32>,
-    // Shadow-map size, march steps, spot quadrature nodes, unused.
-    sizes2_: vec4<u32>,
-    // x = 1 projective frame, 0 epipolar; y = kh (rows span k = qy / qx in [-kh, kh]);
-    // z = m_hi; w = 1 / (m_hi - m_lo) (ray depths m = qz / qx).
-    proj: vec4<f32>,
-    // Projective column invariants G_0..G_3 at the region boundaries.
-    proj_g0_: vec4<f32>,
-    // G_4..G_7.
-    proj_g1_: vec4<f32>,
-    // G_8; yzw unused.
-    proj_g2_: vec4<f32>,
-}
-
-// One rectified row's parameters (host: `SliceParams`), unpacked from the kernels'
-// `slices: array<vec4<f32>>` binding by `slice_params`. In a projective frame the fields hold
-// the row's k (delta), its reference ray's depth m_ref (theta_ref) and its depth range
-// m_lo, m_hi (theta_lo, theta_hi).
-struct SliceParams {
-    // Column spacing: `v` per column (directional) or `psi` per column (spot).
-    delta: f32,
-    // View angle of the slice's reference ray.
-    theta_ref: f32,
-    // Smallest view angle of the slice inside the frustum.
-    theta_lo: f32,
-    // Largest view angle of the slice inside the frustum.
-    theta_hi: f32,
-}
-
-// Unpacks one entry of the `slices` binding (x = delta, y = theta_ref, z = theta_lo,
-// w = theta_hi). No mirror: the CPU reads `SliceParams` directly.
-fn slice_params(v: vec4<f32>) -> SliceParams {
-    return SliceParams(v.x, v.y, v.z, v.w);
-}
-
-// Unit vector of slice angle `phi` (perpendicular to the axis).
-fn slice_e(f: Frame, phi: f32) -> vec3<f32> {
-    return f.e1_.xyz * cos(phi) + f.e2_.xyz * sin(phi);
-}
-
-// Slice angle at the centre of row `row`.
-fn row_phi(f: Frame, row: u32) -> f32 {
-    return f.e1_[3] + (f32(row) + 0.5) * f.e2_[3];
-}
-
-// Normalised rectified depth of view angle `theta`, the frame's view angles spanning
-// [`lo`, `hi`] (`Frame::theta`).
-fn normalised_depth(theta: f32, lo: f32, hi: f32) -> f32 {
-    return DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp((theta - lo) / max(hi - lo, 1e-6), 0.0, 1.0);
-}
-
-// Rectified depths use [DEPTH_MARGIN, 1 - DEPTH_MARGIN]: the Fourier series of the step
-// is 2-periodic, so depth differences near +-1 (a ray at the very start of the range
-// against an empty light ray) would fall on the periodic copy's discontinuity.
-const DEPTH_MARGIN: f32 = 0.1f;
 
 // Smallest cone factor of a spot texel weight: where a region of the reference ray lies
 // outside the cone, its texels still average (nearly uniformly) instead of leaving the
@@ -198,23 +98,6 @@ fn texel_weight(f: Frame, s: SliceParams, row: u32, i: u32, weighted: bool, spot
         w *= cone * exp(-f.medium[0] * r) / (r * r);
     }
     return w;
-}
-
-// The frame's standard shadow map (`scatter::shadow`).
-fn sm_view(f: Frame) -> ShadowMapView {
-    return ShadowMapView(f.sm_right, f.sm_up, f.sm_forward, f.sm_origin, f.sm_proj, vec4<u32>(f.sizes2_[0], 0u, 0u, 0u));
-}
-
-// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed), as the `shadow_map`
-// ground truth tests it. `sm`: the kernel's r32float `shadow_map` binding.
-fn sm_visibility(f: Frame, sm: texture_2d<f32>, p: vec3<f32>) -> f32 {
-    return shadow_visibility(sm_view(f), sm, p);
-}
-
-// Travel distance from `o` along the light ray `o + s l` to its first occluder, or
-// NO_OCCLUDER (`scatter::shadow::shadow_occluder_distance`).
-fn sm_occluder_distance(f: Frame, sm: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
-    return shadow_occluder_distance(sm_view(f), sm, o, l);
 }
 
 // ---- Projective rectification (Sec. 4.2; conventions: `ProjectiveMaps` and

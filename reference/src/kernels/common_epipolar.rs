@@ -1,0 +1,147 @@
+//! CPU mirror of `shaderlib/templates/common/epipolar.wgsl` (`scatter::epipolar`): what
+//! every family built on the epipolar set-up shares and no family owns: slice angles,
+//! rectified depth, the frame's standard shadow-map lookups, the pixel's view ray, the
+//! epipole march, the slice-row index and the spot quadrature of a ray span.
+//!
+//! Conventions are documented in `scatter_frame::frame`.
+
+use super::common_model::{
+    PI, clamp, max, min, phase_hg, spot_integrand, spot_span, transmittance_between,
+};
+use super::common_prefiltered::{Tex, xyz};
+use super::common_shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility};
+use glam::Vec3;
+use scatter_shaderlib::prefiltered::FrameUniforms;
+
+/// Unit vector of slice angle `phi` (perpendicular to the axis).
+pub fn slice_e(f: &FrameUniforms, phi: f32) -> Vec3 {
+    xyz(f.e1) * phi.cos() + xyz(f.e2) * phi.sin()
+}
+
+/// Slice angle at the centre of row `row`.
+pub fn row_phi(f: &FrameUniforms, row: u32) -> f32 {
+    f.e1[3] + (row as f32 + 0.5) * f.e2[3]
+}
+
+/// Normalised rectified depth of view angle `theta`, the frame's view angles spanning
+/// [`lo`, `hi`] (`FrameUniforms::theta`).
+pub fn normalised_depth(theta: f32, lo: f32, hi: f32) -> f32 {
+    DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp((theta - lo) / max(hi - lo, 1e-6), 0.0, 1.0)
+}
+
+/// Rectified depths use [`DEPTH_MARGIN`, 1 - `DEPTH_MARGIN`]: the Fourier series of the step
+/// is 2-periodic, so depth differences near +-1 (a ray at the very start of the range
+/// against an empty light ray) would fall on the periodic copy's discontinuity.
+pub const DEPTH_MARGIN: f32 = 0.1;
+
+/// The frame's standard shadow map ([`super::common_shadow`]).
+pub fn sm_view(f: &FrameUniforms) -> ShadowMapView {
+    ShadowMapView {
+        right: f.sm_right,
+        up: f.sm_up,
+        forward: f.sm_forward,
+        origin: f.sm_origin,
+        proj: f.sm_proj,
+        size: [f.sizes2[0], 0, 0, 0],
+    }
+}
+
+/// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed).
+pub fn sm_visibility(f: &FrameUniforms, sm: &Tex, p: Vec3) -> f32 {
+    shadow_visibility(&sm_view(f), sm, p)
+}
+
+/// Travel distance from `o` along the light ray `o + s l` to its first occluder, or
+/// [`NO_OCCLUDER`].
+pub fn sm_occluder_distance(f: &FrameUniforms, sm: &Tex, o: Vec3, l: Vec3) -> f32 {
+    shadow_occluder_distance(&sm_view(f), sm, o, l)
+}
+
+/// Unit view direction through the centre of pixel (x, y).
+pub fn pixel_dir(f: &FrameUniforms, x: u32, y: u32) -> Vec3 {
+    let ndc_x = 2.0 * (x as f32 + 0.5) / f.sizes[0] as f32 - 1.0;
+    let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / f.sizes[1] as f32;
+    let t = f.cam_forward[3];
+    (xyz(f.cam_forward)
+        + xyz(f.cam_right) * (ndc_x * t * f.cam_right[3])
+        + xyz(f.cam_up) * (ndc_y * t))
+        .normalize()
+}
+
+/// The spot integrand at ray parameter `t` with the light and medium of the frame.
+pub fn frame_spot_integrand(f: &FrameUniforms, eye: Vec3, dir: Vec3, t: f32) -> f32 {
+    spot_integrand(
+        eye,
+        dir,
+        t,
+        xyz(f.light_pos),
+        xyz(f.light_dir),
+        f.light_pos[3],
+        f.light_dir[3],
+        f.medium,
+    )
+}
+
+/// In-scattering along `[0, s]` of the pixel's ray by marching `steps` midpoints against
+/// the standard shadow map `sm`: the epipole and anti-epipole discs of every epipolar family.
+pub fn epipole_march(f: &FrameUniforms, sm: &Tex, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f32 {
+    let steps = f.sizes2[1];
+    let h = s / steps as f32;
+    let mut sum = 0.0;
+    for k in 0..steps {
+        let t = (k as f32 + 0.5) * h;
+        let v = sm_visibility(f, sm, eye + dir * t);
+        if spot {
+            sum += v * h * frame_spot_integrand(f, eye, dir, t);
+        } else {
+            sum += v * transmittance_between(f.medium[0], k as f32 * h, (k + 1) as f32 * h);
+        }
+    }
+    if spot {
+        sum
+    } else {
+        f.medium[1] * phase_hg(f.medium[2], -xyz(f.light_dir).dot(dir)) * sum
+    }
+}
+
+/// Row of the `slices` table for row coordinate `j` (a whole number): wrapped around when
+/// the slices cover the full circle, else clamped.
+pub fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = j as i32;
+    if wrap {
+        (((ji % rows as i32) + rows as i32) % rows as i32) as u32
+    } else {
+        ji.clamp(0, rows as i32 - 1) as u32
+    }
+}
+
+/// Distance along the pixel's own ray (angle `theta` to the axis) of column edge `x`, capped
+/// at the surface distance `s`.
+pub fn ray_t(f: &FrameUniforms, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
+    if spot {
+        let psi = x * delta;
+        let den = (theta + psi).sin();
+        if den <= 1e-6 || theta + psi >= PI {
+            return s;
+        }
+        min(f.axis[3] * psi.sin() / den, s)
+    } else {
+        min(x * delta / max(theta.sin(), 1e-6), s)
+    }
+}
+
+/// Unshadowed spot in-scattering over `[a, b]` of the ray (`common_model::spot_span`).
+pub fn spot_segment(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, panels: u32) -> f32 {
+    spot_span(
+        eye,
+        dir,
+        a,
+        b,
+        panels,
+        xyz(f.light_pos),
+        xyz(f.light_dir),
+        f.light_pos[3],
+        f.light_dir[3],
+        f.medium,
+    )
+}

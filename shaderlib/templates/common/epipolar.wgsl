@@ -1,0 +1,201 @@
+// scatter::epipolar: what every family built on the epipolar set-up shares and no family owns
+// (`prefiltered`, `minmax`, and the coming ones): the `Frame` uniform block, the per-slice
+// parameters, the rectified-space depth, the frame's standard shadow map, the pixel's view
+// ray, the epipole march and the spot quadrature of a ray span.
+//
+// Composed into kernels by naga_oil (`#import scatter::epipolar::{...}`); plain WGSL, not an
+// askama template. Conventions: `scatter_frame::frame`. Mirrored line by line by
+// reference/src/kernels/common_epipolar.rs; functions that read a texture take it as a
+// parameter (a shared module cannot see the kernel's bindings).
+
+#define_import_path scatter::epipolar
+
+#import scatter::model::{PI, phase_hg, spot_integrand, spot_span, transmittance_between}
+#import scatter::shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility}
+
+// The uniform block (host: `scatter_shaderlib::prefiltered::FrameUniforms`, field by field;
+// every member is 16 bytes, 25 * 16 = 400 bytes in all). The host's `e1`, `e2`, `sizes2` and
+// `proj_g0..2` are spelled `e1_`, `e2_`, `sizes2_` and `proj_g0_..2_`: naga's back-ends append
+// `_` to identifiers that end in a digit, and naga_oil requires shared modules to use the
+// written-back spelling.
+struct Frame {
+    // Eye position; w unused.
+    eye: vec4<f32>,
+    // Axis A (towards the light); w = eye-light distance D (spot), 0 (directional).
+    axis: vec4<f32>,
+    // Slice basis e1 (perpendicular to A); w = phi0.
+    e1_: vec4<f32>,
+    // Slice basis e2 = A x e1; w = dphi (radians per row).
+    e2_: vec4<f32>,
+    // Camera forward; w = tan(fov_y / 2).
+    cam_forward: vec4<f32>,
+    // Camera right; w = aspect (width / height).
+    cam_right: vec4<f32>,
+    // Camera up; w = near.
+    cam_up: vec4<f32>,
+    // x = theta_lo, y = theta_hi, z = far, w = 1 / (theta_hi - theta_lo).
+    theta: vec4<f32>,
+    // x = sigma_t, y = sigma_s, z = g, w unused.
+    medium: vec4<f32>,
+    // Light colour (E or I); w unused.
+    light_color: vec4<f32>,
+    // Spot position; w = cos(inner angle).
+    light_pos: vec4<f32>,
+    // Direction the light travels (spot axis); w = cos(outer angle).
+    light_dir: vec4<f32>,
+    // Shadow-map right; w = shadow-map near.
+    sm_right: vec4<f32>,
+    // Shadow-map up; w = shadow-map far.
+    sm_up: vec4<f32>,
+    // Shadow-map forward; w = bias in texel footprints.
+    sm_forward: vec4<f32>,
+    // Shadow-map origin; w = 0 orthographic, 1 perspective.
+    sm_origin: vec4<f32>,
+    // Orthographic: x0, x1, y0, y1. Perspective: tan_half, 0, 0, 0.
+    sm_proj: vec4<f32>,
+    // Epipole pixel position x, y; z = 1 if it is on screen; w = march radius (pixels).
+    epipole: vec4<f32>,
+    // Anti-epipole pixel position x, y; z = 1 if on screen; w = 1 if the slices wrap around.
+    anti_epipole: vec4<f32>,
+    // Screen width, height, rectified width, rectified height.
+    sizes: vec4<u32>,
+    // Shadow-map size, march steps, spot quadrature nodes, unused.
+    sizes2_: vec4<u32>,
+    // x = 1 projective frame, 0 epipolar; y = kh (rows span k = qy / qx in [-kh, kh]);
+    // z = m_hi; w = 1 / (m_hi - m_lo) (ray depths m = qz / qx).
+    proj: vec4<f32>,
+    // Projective column invariants G_0..G_3 at the region boundaries.
+    proj_g0_: vec4<f32>,
+    // G_4..G_7.
+    proj_g1_: vec4<f32>,
+    // G_8; yzw unused.
+    proj_g2_: vec4<f32>,
+}
+
+// One rectified row's parameters (host: `SliceParams`), unpacked from the kernels'
+// `slices: array<vec4<f32>>` binding by `slice_params`. In a projective frame the fields hold
+// the row's k (delta), its reference ray's depth m_ref (theta_ref) and its depth range
+// m_lo, m_hi (theta_lo, theta_hi).
+struct SliceParams {
+    // Column spacing: `v` per column (directional) or `psi` per column (spot).
+    delta: f32,
+    // View angle of the slice's reference ray.
+    theta_ref: f32,
+    // Smallest view angle of the slice inside the frustum.
+    theta_lo: f32,
+    // Largest view angle of the slice inside the frustum.
+    theta_hi: f32,
+}
+
+// Unpacks one entry of the `slices` binding (x = delta, y = theta_ref, z = theta_lo,
+// w = theta_hi). No mirror: the CPU reads `SliceParams` directly.
+fn slice_params(v: vec4<f32>) -> SliceParams {
+    return SliceParams(v.x, v.y, v.z, v.w);
+}
+
+// Unit vector of slice angle `phi` (perpendicular to the axis).
+fn slice_e(f: Frame, phi: f32) -> vec3<f32> {
+    return f.e1_.xyz * cos(phi) + f.e2_.xyz * sin(phi);
+}
+
+// Slice angle at the centre of row `row`.
+fn row_phi(f: Frame, row: u32) -> f32 {
+    return f.e1_[3] + (f32(row) + 0.5) * f.e2_[3];
+}
+
+// Normalised rectified depth of view angle `theta`, the frame's view angles spanning
+// [`lo`, `hi`] (`Frame::theta`).
+fn normalised_depth(theta: f32, lo: f32, hi: f32) -> f32 {
+    return DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp((theta - lo) / max(hi - lo, 1e-6), 0.0, 1.0);
+}
+
+// Rectified depths use [DEPTH_MARGIN, 1 - DEPTH_MARGIN]: the Fourier series of the step
+// is 2-periodic, so depth differences near +-1 (a ray at the very start of the range
+// against an empty light ray) would fall on the periodic copy's discontinuity.
+const DEPTH_MARGIN: f32 = 0.1f;
+
+// The frame's standard shadow map (`scatter::shadow`).
+fn sm_view(f: Frame) -> ShadowMapView {
+    return ShadowMapView(f.sm_right, f.sm_up, f.sm_forward, f.sm_origin, f.sm_proj, vec4<u32>(f.sizes2_[0], 0u, 0u, 0u));
+}
+
+// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed), as the `shadow_map`
+// ground truth tests it. `sm`: the kernel's r32float `shadow_map` binding.
+fn sm_visibility(f: Frame, sm: texture_2d<f32>, p: vec3<f32>) -> f32 {
+    return shadow_visibility(sm_view(f), sm, p);
+}
+
+// Travel distance from `o` along the light ray `o + s l` to its first occluder, or
+// NO_OCCLUDER (`scatter::shadow::shadow_occluder_distance`).
+fn sm_occluder_distance(f: Frame, sm: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
+    return shadow_occluder_distance(sm_view(f), sm, o, l);
+}
+
+
+// Unit view direction through the centre of pixel (x, y).
+fn pixel_dir(f: Frame, x: u32, y: u32) -> vec3<f32> {
+    let ndc_x = 2.0 * (f32(x) + 0.5) / f32(f.sizes[0]) - 1.0;
+    let ndc_y = 1.0 - 2.0 * (f32(y) + 0.5) / f32(f.sizes[1]);
+    let t = f.cam_forward[3];
+    return normalize(f.cam_forward.xyz + f.cam_right.xyz * (ndc_x * t * f.cam_right[3]) + f.cam_up.xyz * (ndc_y * t));
+}
+
+// The spot integrand at ray parameter `t` with the light and medium of the frame.
+fn frame_spot_integrand(f: Frame, eye: vec3<f32>, dir: vec3<f32>, t: f32) -> f32 {
+    return spot_integrand(eye, dir, t, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
+}
+
+// In-scattering along `[0, s]` of the pixel's ray by marching `steps` midpoints against the
+// standard shadow map `sm`: the epipole and anti-epipole discs of every epipolar family,
+// where the rectification degenerates (Klehm Sec. 5). Without `sigma_s p E` for a spot
+// (its integrand carries the lamp), with them for the sun.
+fn epipole_march(f: Frame, sm: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, s: f32, spot: bool) -> f32 {
+    let steps = f.sizes2_[1];
+    let h = s / f32(steps);
+    var sum = 0.0;
+    for (var k = 0u; k < steps; k++) {
+        let t = (f32(k) + 0.5) * h;
+        let v = sm_visibility(f, sm, eye + dir * t);
+        if spot {
+            sum += v * h * frame_spot_integrand(f, eye, dir, t);
+        } else {
+            sum += v * transmittance_between(f.medium[0], f32(k) * h, f32(k + 1u) * h);
+        }
+    }
+    if spot {
+        return sum;
+    } else {
+        return f.medium[1] * phase_hg(f.medium[2], -dot(f.light_dir.xyz, dir)) * sum;
+    }
+}
+
+// Row of the `slices` table for row coordinate `j` (a whole number): wrapped around when
+// the slices cover the full circle, else clamped.
+fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = i32(j);
+    if wrap {
+        return u32(((ji % i32(rows)) + i32(rows)) % i32(rows));
+    } else {
+        return u32(clamp(ji, 0, i32(rows) - 1));
+    }
+}
+
+// Distance along the pixel's own ray (angle `theta` to the axis) of column edge `x`, capped
+// at the surface distance `s`.
+fn ray_t(f: Frame, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
+    if spot {
+        let psi = x * delta;
+        let den = sin(theta + psi);
+        if den <= 1e-6 || theta + psi >= PI {
+            return s;
+        }
+        return min(f.axis[3] * sin(psi) / den, s);
+    } else {
+        return min(x * delta / max(sin(theta), 1e-6), s);
+    }
+}
+
+// Unshadowed spot in-scattering over `[a, b]` of the ray (`scatter::model::spot_span`).
+fn spot_segment(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, panels: u32) -> f32 {
+    return spot_span(eye, dir, a, b, panels, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
+}
