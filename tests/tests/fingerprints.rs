@@ -18,14 +18,11 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use scatter_conformance::gpu;
-use scatter_reference::buffers::{GBuffer, ShadowMap};
-use scatter_reference::bvh::Bvh;
+use scatter_conformance::{Fixture, gpu};
 use scatter_reference::kernels::engine_rectified_map;
-use scatter_reference::scene::Scene;
-use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
+use scatter_reference::suite::{Pose, SceneName};
 use scatter_runtime::{
-    CpuInputs, FrameInput, RaymarchInput, run_minmax_once, run_prefiltered_once, run_raymarch_once,
+    CpuInputs, FrameInput, run_minmax_once, run_prefiltered_once, run_raymarch_once,
 };
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{
@@ -37,51 +34,8 @@ const SCREEN: [u32; 2] = [48, 27];
 const RECTIFIED: [u32; 2] = [64, 32];
 const SHADOW_MAP: u32 = 128;
 
-struct Fixture {
-    scene_name: SceneName,
-    pose: Pose,
-    scene: Scene,
-    bvh: Bvh,
-    gbuf: GBuffer,
-    shadow_map: ShadowMap,
-}
-
-impl Fixture {
-    fn new(scene_name: SceneName, pose: Pose) -> Self {
-        let scene = scene(
-            scene_name,
-            pose,
-            MediumPreset::Default,
-            SCREEN[0],
-            SCREEN[1],
-        );
-        let bvh = Bvh::build(&scene.geometry);
-        let gbuf = GBuffer::cast(&scene, &bvh);
-        let shadow_map = ShadowMap::build(&scene, &bvh, SHADOW_MAP)
-            .unwrap_or_else(|e| panic!("shadow map of {scene_name}/{pose}: {e}"));
-        Self {
-            scene_name,
-            pose,
-            scene,
-            bvh,
-            gbuf,
-            shadow_map,
-        }
-    }
-
-    fn frame_input(&self) -> FrameInput {
-        FrameInput {
-            camera: self.scene.camera_desc(),
-            light: self.scene.light_desc(),
-            medium: self.scene.medium_desc(),
-            shadow_map: self.shadow_map.desc(),
-            settings: FrameSettings::for_screen(SCREEN[0], SCREEN[1]),
-        }
-    }
-
-    fn name(&self) -> String {
-        format!("{}::{}", self.scene_name, self.pose)
-    }
+fn frame_input(f: &Fixture) -> FrameInput {
+    f.frame_input(FrameSettings::for_screen(SCREEN[0], SCREEN[1]))
 }
 
 /// FNV-1a over the bits of every value.
@@ -111,7 +65,9 @@ fn res() -> Resolutions {
 fn fingerprints(ctx: &scatter_runtime::Context) -> String {
     let fixtures: Vec<Fixture> = [SceneName::Columns, SceneName::SpotGrate]
         .into_iter()
-        .flat_map(|s| [Pose::Ordinary, Pose::EpipoleOnScreen].map(|p| Fixture::new(s, p)))
+        .flat_map(|s| {
+            [Pose::Ordinary, Pose::EpipoleOnScreen].map(|p| Fixture::new(s, p, SCREEN, SHADOW_MAP))
+        })
         .collect();
     let for_light = |light: LightKind| {
         let want = if light == LightKind::Spot {
@@ -119,7 +75,7 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
         } else {
             SceneName::Columns
         };
-        fixtures.iter().filter(move |f| f.scene_name == want)
+        fixtures.iter().filter(move |f| f.name == want)
     };
     let mut out = String::new();
     let mut line = |trial: &str, texture: &str, h: u64| {
@@ -129,8 +85,8 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
     let prefiltered: Vec<Variant> = Variant::grid(1..=4).into_iter().step_by(31).collect();
     for v in &prefiltered {
         for f in for_light(v.light) {
-            let trial = format!("prefiltered::{}::{}", v.id(), f.name());
-            let input = f.frame_input();
+            let trial = format!("prefiltered::{}::{}", v.id(), f.trial_tail());
+            let input = frame_input(f);
             let rectified = if v.rectification == Rectification::Projective {
                 let frame = prepare_frame(
                     v,
@@ -167,18 +123,12 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
 
     for v in RaymarchVariant::grid() {
         for f in for_light(v.light).filter(|f| f.pose == Pose::Ordinary) {
-            let trial = format!("raymarch::{}::{}", v.id(), f.name());
-            let input = f.frame_input();
+            let trial = format!("raymarch::{}::{}", v.id(), f.trial_tail());
             let gpu = run_raymarch_once(
                 ctx,
                 &v,
                 SCREEN,
-                &RaymarchInput {
-                    camera: input.camera,
-                    light: input.light,
-                    medium: input.medium,
-                    shadow_map: input.shadow_map,
-                },
+                &f.march_input(),
                 &f.gbuf.view_depth,
                 &f.shadow_map.depth,
             )
@@ -192,12 +142,12 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
 
     for v in MinmaxVariant::grid() {
         for f in for_light(v.light) {
-            let trial = format!("minmax::{}::{}", v.id(), f.name());
+            let trial = format!("minmax::{}::{}", v.id(), f.trial_tail());
             let gpu = run_minmax_once(
                 ctx,
                 &v,
                 res(),
-                &f.frame_input(),
+                &frame_input(f),
                 &f.gbuf.view_depth,
                 &f.shadow_map.depth,
             )
