@@ -328,3 +328,21 @@ pub(crate) fn upload_inputs(
         })
         .collect()
 }
+
+/// Fails with [`RuntimeError::LimitExceeded`] for the first texture side beyond the device's
+/// `max_texture_dimension_2d`; each entry names the kernel to blame and the side.
+pub(crate) fn check_texture_sides(
+    limits: &wgpu::Limits,
+    sides: &[(Kernel, &'static str, u32)],
+) -> Result<(), RuntimeError> {
+    for &(kernel, what, value) in sides {
+        check_limit(
+            kernel,
+            what,
+            value.into(),
+            "max_texture_dimension_2d",
+            limits.max_texture_dimension_2d.into(),
+        )?;
+    }
+    Ok(())
+}

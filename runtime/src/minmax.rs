@@ -17,10 +17,11 @@ use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax, tree_width};
 use scatter_shaderlib::prefiltered::{PrefilteredFrame, Resolutions, Storage};
 use scatter_shaderlib::{Kernel, KernelParams};
 
-use crate::error::{ErrorScopes, check_limit};
+use crate::error::ErrorScopes;
 use crate::executor::Executor;
 use crate::gpu::{
-    DEPTH_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_view, decode_rgba, upload_inputs,
+    DEPTH_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_texture_sides, check_view,
+    decode_rgba, upload_inputs,
 };
 use crate::prefiltered::FrameInput;
 use crate::timer::median_pass_wall_times;
@@ -96,23 +97,17 @@ impl Minmax {
         let tw = tree_width(wr);
         let device = ctx.device();
         let limits = device.limits();
-        let max_2d = u64::from(limits.max_texture_dimension_2d);
-        for (kernel, what, value) in [
-            (MARCH, "screen width", w),
-            (MARCH, "screen height", h),
-            (RECTIFY, "rectified width", wr),
-            (RECTIFY, "rectified height", hr),
-            (RECTIFY, "shadow map size", shadow_map_size),
-            (BUILD, "tree width (all levels of a row)", tw),
-        ] {
-            check_limit(
-                kernel,
-                what,
-                value.into(),
-                "max_texture_dimension_2d",
-                max_2d,
-            )?;
-        }
+        check_texture_sides(
+            &limits,
+            &[
+                (MARCH, "screen width", w),
+                (MARCH, "screen height", h),
+                (RECTIFY, "rectified width", wr),
+                (RECTIFY, "rectified height", hr),
+                (RECTIFY, "shadow map size", shadow_map_size),
+                (BUILD, "tree width (all levels of a row)", tw),
+            ],
+        )?;
         crate::prefiltered::check_frame_buffers(&limits, hr)?;
         let built = KernelParams::minmax(*variant)
             .map(|p| scatter_shaderlib::build(&p))

@@ -28,8 +28,8 @@ use scatter_shaderlib::{Kernel, KernelParams};
 use crate::error::{ErrorScopes, check_limit};
 use crate::executor::Executor;
 use crate::gpu::{
-    DEPTH_NAMES, RECTIFIED_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_view, decode_rgba,
-    upload_inputs,
+    DEPTH_NAMES, RECTIFIED_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_texture_sides,
+    check_view, decode_rgba, upload_inputs,
 };
 use crate::timer::median_pass_wall_times;
 use crate::{Context, RuntimeError};
@@ -176,22 +176,16 @@ impl Prefiltered {
         }
         let device = ctx.device();
         let limits = device.limits();
-        let max_2d = u64::from(limits.max_texture_dimension_2d);
-        for (kernel, what, value) in [
-            (SCATTER, "screen width", w),
-            (SCATTER, "screen height", h),
-            (RECTIFY, "rectified width", wr),
-            (RECTIFY, "rectified height", hr),
-            (RECTIFY, "shadow map size", shadow_map_size),
-        ] {
-            check_limit(
-                kernel,
-                what,
-                value.into(),
-                "max_texture_dimension_2d",
-                max_2d,
-            )?;
-        }
+        check_texture_sides(
+            &limits,
+            &[
+                (SCATTER, "screen width", w),
+                (SCATTER, "screen height", h),
+                (RECTIFY, "rectified width", wr),
+                (RECTIFY, "rectified height", hr),
+                (RECTIFY, "shadow map size", shadow_map_size),
+            ],
+        )?;
         check_limit(
             PREFILTER,
             "filtered-basis layers (bases / 4)",

@@ -18,7 +18,8 @@ use scatter_shaderlib::{Kernel, KernelParams};
 use crate::error::{ErrorScopes, check_limit};
 use crate::executor::Executor;
 use crate::gpu::{
-    DEPTH_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_view, decode_rgba, upload_inputs,
+    DEPTH_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_texture_sides, check_view,
+    decode_rgba, upload_inputs,
 };
 use crate::prefiltered::FrameInput;
 use crate::timer::median_pass_wall_times;
@@ -116,19 +117,14 @@ impl Raymarch {
         ])?;
         let device = ctx.device();
         let limits = device.limits();
-        for (what, value) in [
-            ("screen width", w),
-            ("screen height", h),
-            ("shadow map size", shadow_map_size),
-        ] {
-            check_limit(
-                RAYMARCH,
-                what,
-                value.into(),
-                "max_texture_dimension_2d",
-                limits.max_texture_dimension_2d.into(),
-            )?;
-        }
+        check_texture_sides(
+            &limits,
+            &[
+                (RAYMARCH, "screen width", w),
+                (RAYMARCH, "screen height", h),
+                (RAYMARCH, "shadow map size", shadow_map_size),
+            ],
+        )?;
         check_limit(
             RAYMARCH,
             "uniform block bytes",
