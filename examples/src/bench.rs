@@ -23,8 +23,8 @@ use scatter_reference::scene::Scene;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::prefiltered::{FrameInput, Inputs};
-use scatter_runtime::raymarch::RaymarchInput;
 use scatter_runtime::shaderlib::Kernel;
+use scatter_runtime::shaderlib::family::FamilyVariant;
 use scatter_runtime::shaderlib::minmax::MinmaxVariant;
 use scatter_runtime::shaderlib::prefiltered::{
     FrameSettings, LightKind, Resolutions, Storage, Variant,
@@ -32,7 +32,7 @@ use scatter_runtime::shaderlib::prefiltered::{
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::wgpu::TextureView;
-use scatter_runtime::{Context, Minmax, Prefiltered, Raymarch};
+use scatter_runtime::{Context, FamilyPasses, Prefiltered};
 
 /// A method of one family with its knobs (the light is set per scene).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,6 +62,15 @@ impl Method {
             Self::Prefiltered(v, _) => v.id(),
             Self::Raymarch(v) => v.id(),
             Self::Minmax(v, _) => v.id(),
+        }
+    }
+
+    /// The family's variant (the one enum every tool shares).
+    pub fn variant(&self) -> FamilyVariant {
+        match *self {
+            Self::Prefiltered(v, _) => v.into(),
+            Self::Raymarch(v) => v.into(),
+            Self::Minmax(v, _) => v.into(),
         }
     }
 
@@ -455,100 +464,37 @@ fn run_method(
     rectified: [u32; 2],
     frames: u32,
 ) -> Result<MethodRun, BoxError> {
-    Ok(match method {
-        Method::Prefiltered(v, r) => {
-            let res = Resolutions {
-                screen,
-                rectified: r.unwrap_or(rectified),
-            };
-            let mut pass = Prefiltered::new(ctx, &v, res, sm.size)?;
-            pass.prepare(
-                ctx,
-                &FrameInput {
-                    camera: scene.camera_desc(),
-                    light: scene.light_desc(),
-                    medium: scene.medium_desc(),
-                    shadow_map: sm.desc(),
-                    settings: FrameSettings::for_screen(screen[0], screen[1]),
-                },
-            )?;
-            let inputs = Inputs {
-                depth: dv,
-                shadow_map: Some(sv),
-                rectified: None,
-            };
-            let mut encoder = ctx.device().create_command_encoder(&Default::default());
-            pass.encode(&mut encoder, &inputs)?;
-            ctx.queue().submit([encoder.finish()]);
-            let ts = pass.pass_times(ctx)?.map(|t| t.total());
-            let output = read_rgba16float(ctx, Kernel::Scatter, pass.output_texture())?;
-            let t = pass.measure_pass_wall_times(ctx, &inputs, frames)?;
-            (
-                output,
-                vec![
-                    ("rectify", t.rectify),
-                    ("prefilter", t.prefilter),
-                    ("scatter", t.scatter),
-                ],
-                ts,
-            )
-        }
-        Method::Raymarch(v) => {
-            let mut pass = Raymarch::new(ctx, &v, screen, sm.size)?;
-            pass.prepare(
-                ctx,
-                &RaymarchInput {
-                    camera: scene.camera_desc(),
-                    light: scene.light_desc(),
-                    medium: scene.medium_desc(),
-                    shadow_map: sm.desc(),
-                },
-            )?;
-            let mut encoder = ctx.device().create_command_encoder(&Default::default());
-            pass.encode(ctx, &mut encoder, dv, sv)?;
-            ctx.queue().submit([encoder.finish()]);
-            let ts = pass.pass_times(ctx)?.map(|t| t.total());
-            let output = read_rgba16float(ctx, Kernel::Raymarch, pass.output_texture())?;
-            let t = pass.measure_pass_wall_times(ctx, dv, sv, frames)?;
-            let mut passes = vec![("raymarch", t.raymarch)];
-            if v.interleaved() {
-                passes.push(("interleave_sum", t.interleave_sum));
-            }
-            (output, passes, ts)
-        }
-        Method::Minmax(v, r) => {
-            let res = Resolutions {
-                screen,
-                rectified: r.unwrap_or(rectified),
-            };
-            let mut pass = Minmax::new(ctx, &v, res, sm.size)?;
-            pass.prepare(
-                ctx,
-                &FrameInput {
-                    camera: scene.camera_desc(),
-                    light: scene.light_desc(),
-                    medium: scene.medium_desc(),
-                    shadow_map: sm.desc(),
-                    settings: FrameSettings::for_screen(screen[0], screen[1]),
-                },
-            )?;
-            let mut encoder = ctx.device().create_command_encoder(&Default::default());
-            pass.encode(ctx, &mut encoder, dv, sv)?;
-            ctx.queue().submit([encoder.finish()]);
-            let ts = pass.pass_times(ctx)?.map(|t| t.total());
-            let output = read_rgba16float(ctx, Kernel::MinmaxMarch, pass.output_texture())?;
-            let t = pass.measure_pass_wall_times(ctx, dv, sv, frames)?;
-            (
-                output,
-                vec![
-                    ("rectify", t.rectify),
-                    ("minmax_build", t.build),
-                    ("minmax_march", t.march),
-                ],
-                ts,
-            )
-        }
-    })
+    let res = Resolutions {
+        screen,
+        rectified: method.rectified(rectified).unwrap_or(rectified),
+    };
+    let mut pass = FamilyPasses::new(ctx, &method.variant(), res, sm.size)?;
+    pass.prepare(
+        ctx,
+        &FrameInput {
+            camera: scene.camera_desc(),
+            light: scene.light_desc(),
+            medium: scene.medium_desc(),
+            shadow_map: sm.desc(),
+            settings: FrameSettings::for_screen(screen[0], screen[1]),
+        },
+    )?;
+    let inputs = Inputs {
+        depth: dv,
+        shadow_map: Some(sv),
+        rectified: None,
+    };
+    let mut encoder = ctx.device().create_command_encoder(&Default::default());
+    pass.encode(ctx, &mut encoder, &inputs)?;
+    ctx.queue().submit([encoder.finish()]);
+    let ts = pass.total_pass_time(ctx)?;
+    let output = read_rgba16float(ctx, Kernel::Scatter, pass.output_texture())?;
+    let passes = pass
+        .measure_pass_wall_times(ctx, &inputs, frames)?
+        .into_iter()
+        .map(|(kernel, t)| (kernel.name(), t))
+        .collect();
+    Ok((output, passes, ts))
 }
 
 /// Times `method` (pass wall times) on `name/ordinary` at `screen` (prefiltered: with a

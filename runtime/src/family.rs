@@ -116,8 +116,22 @@ impl FamilyPasses {
         }
     }
 
-    /// Wall time of each pass submitted on its own, the median over `frames` frames, in
-    /// pass order with its kernel.
+    /// GPU time of the last submitted frame's passes added up, or `None` without
+    /// timestamps. Blocks until the GPU is done.
+    ///
+    /// # Errors
+    ///
+    /// As the family's `pass_times`.
+    pub fn total_pass_time(&self, ctx: &Context) -> Result<Option<Duration>, RuntimeError> {
+        Ok(match self {
+            Self::Prefiltered(p) => p.pass_times(ctx)?.map(|t| t.total()),
+            Self::Raymarch(p) => p.pass_times(ctx)?.map(|t| t.total()),
+            Self::Minmax(p) => p.pass_times(ctx)?.map(|t| t.total()),
+        })
+    }
+
+    /// Wall time of each pass the variant has, submitted on its own, the median over
+    /// `frames` frames, in pass order with its kernel.
     ///
     /// # Errors
     ///
@@ -140,10 +154,11 @@ impl FamilyPasses {
             Self::Raymarch(p) => {
                 let t =
                     p.measure_pass_wall_times(ctx, inputs.depth, self.shadow_map(inputs)?, frames)?;
-                vec![
-                    (Kernel::Raymarch, t.raymarch),
-                    (Kernel::InterleaveSum, t.interleave_sum),
-                ]
+                let mut passes = vec![(Kernel::Raymarch, t.raymarch)];
+                if p.variant().interleaved() {
+                    passes.push((Kernel::InterleaveSum, t.interleave_sum));
+                }
+                passes
             }
             Self::Minmax(p) => {
                 let t =
