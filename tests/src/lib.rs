@@ -264,6 +264,7 @@ mod tests {
     }
 
     #[test]
+    /// Runs nested trial sets: their own "FAILED" summaries in the log are on purpose.
     fn expected_failures_are_data() {
         let args = Arguments {
             test_threads: Some(1),
@@ -272,19 +273,19 @@ mod tests {
         };
         let trials = || {
             vec![
-                ("family::passes".to_owned(), check(true)),
-                ("family::fails".to_owned(), check(false)),
+                ("harness_selftest::passes".to_owned(), check(true)),
+                ("harness_selftest::fails_on_purpose".to_owned(), check(false)),
             ]
         };
         // A failing trial fails the run; listed as expected, it passes.
         let plain = run_trials_with(&args, trials(), &[]);
         assert_eq!((plain.num_passed, plain.num_failed), (1, 1));
-        let listed = run_trials_with(&args, trials(), &[("family::fails", "known")]);
+        let listed = run_trials_with(&args, trials(), &[("harness_selftest::fails_on_purpose", "known")]);
         assert_eq!((listed.num_passed, listed.num_failed), (2, 0));
         // A listed trial that passes fails, and so does an entry that names no trial.
-        let fixed = run_trials_with(&args, trials(), &[("family::passes", "was known")]);
+        let fixed = run_trials_with(&args, trials(), &[("harness_selftest::passes", "was known")]);
         assert_eq!((fixed.num_passed, fixed.num_failed), (0, 2));
-        let stale = run_trials_with(&args, vec![], &[("family::gone", "renamed")]);
+        let stale = run_trials_with(&args, vec![], &[("harness_selftest::gone", "renamed")]);
         assert_eq!((stale.num_passed, stale.num_failed), (0, 1));
     }
 
