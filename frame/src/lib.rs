@@ -15,4 +15,5 @@ pub mod family;
 pub mod frame;
 pub mod minmax;
 pub mod raymarch;
+pub mod scene;
 pub mod variant;

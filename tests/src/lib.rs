@@ -274,16 +274,27 @@ mod tests {
         let trials = || {
             vec![
                 ("harness_selftest::passes".to_owned(), check(true)),
-                ("harness_selftest::fails_on_purpose".to_owned(), check(false)),
+                (
+                    "harness_selftest::fails_on_purpose".to_owned(),
+                    check(false),
+                ),
             ]
         };
         // A failing trial fails the run; listed as expected, it passes.
         let plain = run_trials_with(&args, trials(), &[]);
         assert_eq!((plain.num_passed, plain.num_failed), (1, 1));
-        let listed = run_trials_with(&args, trials(), &[("harness_selftest::fails_on_purpose", "known")]);
+        let listed = run_trials_with(
+            &args,
+            trials(),
+            &[("harness_selftest::fails_on_purpose", "known")],
+        );
         assert_eq!((listed.num_passed, listed.num_failed), (2, 0));
         // A listed trial that passes fails, and so does an entry that names no trial.
-        let fixed = run_trials_with(&args, trials(), &[("harness_selftest::passes", "was known")]);
+        let fixed = run_trials_with(
+            &args,
+            trials(),
+            &[("harness_selftest::passes", "was known")],
+        );
         assert_eq!((fixed.num_passed, fixed.num_failed), (0, 2));
         let stale = run_trials_with(&args, vec![], &[("harness_selftest::gone", "renamed")]);
         assert_eq!((stale.num_passed, stale.num_failed), (0, 1));
