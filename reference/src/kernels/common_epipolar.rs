@@ -52,7 +52,7 @@ pub fn sm_visibility(f: &FrameUniforms, sm: &Tex, p: Vec3) -> f32 {
 }
 
 /// Travel distance from `o` along the light ray `o + s l` to its first occluder, or
-/// [`NO_OCCLUDER`].
+/// [`NO_OCCLUDER`](super::common_shadow::NO_OCCLUDER).
 pub fn sm_occluder_distance(f: &FrameUniforms, sm: &Tex, o: Vec3, l: Vec3) -> f32 {
     shadow_occluder_distance(&sm_view(f), sm, o, l)
 }
