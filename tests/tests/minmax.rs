@@ -26,6 +26,7 @@ use scatter_reference::kernels::minmax_march::{MarchInputs, Pixel, pixel_ray};
 use scatter_reference::kernels::{minmax_from_rectified, rectify};
 use scatter_reference::suite::Pose;
 use scatter_runtime::{FrameInput, Minmax, RuntimeError, run_minmax_once};
+use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions};
 
@@ -68,8 +69,8 @@ fn input(f: &Fixture) -> FrameInput {
 
 fn trial_name(light: LightKind, pose: Pose) -> String {
     format!(
-        "minmax::{}::{}::{pose}",
-        MinmaxVariant { light },
+        "{}::{}::{pose}",
+        FamilyVariant::from(MinmaxVariant { light }).trial_name(),
         scene_for(light)
     )
 }

@@ -39,6 +39,7 @@ use scatter_runtime::wgpu::TextureView;
 use scatter_runtime::{
     Context, CpuInputs, FrameInput, Inputs, Prefiltered, RuntimeError, run_prefiltered_once,
 };
+use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, Rectification, Resolutions, Storage, Variant,
 };
@@ -170,7 +171,10 @@ fn f16_ulp(v: f32) -> f32 {
 
 fn trial_name(variant: &Variant) -> String {
     let (name, pose) = case(variant.light, variant.rectification);
-    format!("prefiltered::{}::{name}::{pose}", variant.id())
+    format!(
+        "{}::{name}::{pose}",
+        FamilyVariant::from(*variant).trial_name()
+    )
 }
 
 fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<TrialResult, String> {

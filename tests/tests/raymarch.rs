@@ -19,6 +19,7 @@ use scatter_conformance::{Check, Fixture, gpu, run_trials, scene_for};
 use scatter_reference::kernels::run_raymarch;
 use scatter_reference::suite::Pose;
 use scatter_runtime::{Raymarch, RuntimeError, run_raymarch_once};
+use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::prefiltered::LightKind;
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -39,7 +40,8 @@ fn fixture(light: LightKind) -> &'static Fixture {
 
 fn trial_name(variant: &RaymarchVariant) -> String {
     format!(
-        "raymarch::{variant}::{}::{}",
+        "{}::{}::{}",
+        FamilyVariant::from(*variant).trial_name(),
         scene_for(variant.light),
         Pose::Ordinary
     )
