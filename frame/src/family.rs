@@ -3,9 +3,8 @@
 //! family's variant that the generator, the runtime, the bench, `tune` and the tests share
 //! instead of keeping their own lists.
 //!
-//! Adding a family: its variant type implements [`KnobSet`], and [`Family`] and
-//! [`FamilyVariant`] each get one arm (the compiler then names every `match` that needs one);
-//! see `docs/adding-a-family.md`.
+//! Adding a family: its variant type implements [`KnobSet`] (in the family's own module) and
+//! gets one line in the `families!` table below; see `docs/adding-a-family.md`.
 
 use std::fmt;
 
@@ -16,70 +15,112 @@ use crate::minmax::MinmaxVariant;
 use crate::raymarch::RaymarchVariant;
 use crate::variant::{LightKind, Variant, VariantError};
 
-/// A kernel family: one published method.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Family {
-    /// Chen et al. 2011: `rectify` (the prefiltered family's), `minmax_build`,
-    /// `minmax_march`.
-    Minmax,
-    /// Klehm et al. 2014: `rectify`, `prefilter`, `scatter`.
-    Prefiltered,
-    /// Tóth & Umenhoffer 2009: `raymarch`, `interleave_sum` (interleaved variants).
-    Raymarch,
+/// The one table of every family: `Name(variant type)`, one line each. It defines [`Family`]
+/// (with `ALL`, `name`, `summary`, `default_variant`, `grid`) and [`FamilyVariant`] (with
+/// its `From` impls, `family`, `id`, `light`, `validate`), all from the variant types'
+/// [`KnobSet`] impls.
+macro_rules! families {
+    ($($(#[$doc:meta])* $name:ident($ty:ty)),* $(,)?) => {
+        /// A kernel family: one published method.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+        #[serde(rename_all = "snake_case")]
+        pub enum Family {
+            $($(#[$doc])* $name,)*
+        }
+
+        impl Family {
+            /// Every family, sorted by name.
+            pub const ALL: &'static [Family] = &[$(Family::$name),*];
+
+            /// The family's name (`--family`, config key `family`, manifest, trial names).
+            pub const fn name(self) -> &'static str {
+                match self {
+                    $(Self::$name => <$ty as KnobSet>::FAMILY_NAME,)*
+                }
+            }
+
+            /// One line: the method and its paper.
+            pub const fn summary(self) -> &'static str {
+                match self {
+                    $(Self::$name => <$ty as KnobSet>::SUMMARY,)*
+                }
+            }
+
+            /// The family's variant with every knob at its default (the paper's choice).
+            pub fn default_variant(self) -> FamilyVariant {
+                match self {
+                    $(Self::$name => <$ty>::default().into(),)*
+                }
+            }
+
+            /// The family's conformance grid ([`KnobSet::grid`]).
+            pub fn grid(self) -> Vec<FamilyVariant> {
+                match self {
+                    $(Self::$name => <$ty as KnobSet>::grid().into_iter().map(Into::into).collect(),)*
+                }
+            }
+        }
+
+        /// One variant of some family: the one enum of every family's variant.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum FamilyVariant {
+            $($(#[$doc])* $name($ty),)*
+        }
+
+        $(impl From<$ty> for FamilyVariant {
+            fn from(v: $ty) -> Self {
+                Self::$name(v)
+            }
+        })*
+
+        impl FamilyVariant {
+            /// The family.
+            pub const fn family(&self) -> Family {
+                match self {
+                    $(Self::$name(_) => Family::$name,)*
+                }
+            }
+
+            /// The variant id (`<kernel>.<id>.<ext>` file names, manifest entries).
+            pub fn id(&self) -> String {
+                match self {
+                    $(Self::$name(v) => KnobSet::id(v),)*
+                }
+            }
+
+            /// `family::id`, the head of every trial name.
+            pub fn trial_name(&self) -> String {
+                format!("{}::{}", self.family(), self.id())
+            }
+
+            /// The light type the kernels are compiled for.
+            pub fn light(&self) -> LightKind {
+                match self {
+                    $(Self::$name(v) => KnobSet::light(v),)*
+                }
+            }
+
+            /// Checks every knob.
+            ///
+            /// # Errors
+            ///
+            /// [`VariantError`] naming the knob, the value and the allowed range.
+            pub fn validate(&self) -> Result<(), VariantError> {
+                match self {
+                    $(Self::$name(v) => KnobSet::validate(v),)*
+                }
+            }
+        }
+    };
 }
 
-impl Family {
-    /// Every family, sorted by name.
-    pub const ALL: &'static [Family] = &[Family::Minmax, Family::Prefiltered, Family::Raymarch];
-
-    /// The family's name (`--family`, config key `family`, manifest, trial names).
-    pub const fn name(self) -> &'static str {
-        match self {
-            Self::Minmax => MinmaxVariant::FAMILY_NAME,
-            Self::Prefiltered => Variant::FAMILY_NAME,
-            Self::Raymarch => RaymarchVariant::FAMILY_NAME,
-        }
-    }
-
-    /// One line: the method and its paper.
-    pub const fn summary(self) -> &'static str {
-        match self {
-            Self::Minmax => {
-                "Chen et al. 2011, 1D min-max mipmaps: each pixel marches its rectified row \
-                 through a min-max binary tree, skipping wholly lit or shadowed spans"
-            }
-            Self::Prefiltered => {
-                "Klehm et al. 2014, prefiltered single scattering: Fourier-basis visibility \
-                 prefiltered along epipolar rows of a rectified shadow map"
-            }
-            Self::Raymarch => {
-                "Toth & Umenhoffer 2009, ray marching through the standard shadow map, \
-                 optionally with interleaved sampling and a separable sum filter"
-            }
-        }
-    }
-
-    /// The family's variant with every knob at its default (the paper's choice).
-    pub fn default_variant(self) -> FamilyVariant {
-        match self {
-            Self::Minmax => MinmaxVariant::default().into(),
-            Self::Prefiltered => Variant::default().into(),
-            Self::Raymarch => RaymarchVariant::default().into(),
-        }
-    }
-
-    /// The family's conformance grid ([`KnobSet::grid`]).
-    pub fn grid(self) -> Vec<FamilyVariant> {
-        fn all<V: KnobSet>() -> Vec<FamilyVariant> {
-            V::grid().into_iter().map(Into::into).collect()
-        }
-        match self {
-            Self::Minmax => all::<MinmaxVariant>(),
-            Self::Prefiltered => all::<Variant>(),
-            Self::Raymarch => all::<RaymarchVariant>(),
-        }
-    }
+families! {
+    /// Chen et al. 2011: `rectify` (the prefiltered family's), `minmax_build`, `minmax_march`.
+    Minmax(MinmaxVariant),
+    /// Klehm et al. 2014: `rectify`, `prefilter`, `scatter`.
+    Prefiltered(Variant),
+    /// Tóth & Umenhoffer 2009: `raymarch`, `interleave_sum` (interleaved variants).
+    Raymarch(RaymarchVariant),
 }
 
 impl fmt::Display for Family {
@@ -120,6 +161,8 @@ pub trait KnobSet:
     const FAMILY_NAME: &'static str;
     /// The family.
     const FAMILY: Family;
+    /// One line: the method and its paper.
+    const SUMMARY: &'static str;
 
     /// Checks every knob, naming the first one out of range.
     ///
@@ -136,145 +179,6 @@ pub trait KnobSet:
 
     /// The conformance grid: every variant the GPU-against-mirror trials run.
     fn grid() -> Vec<Self>;
-}
-
-impl KnobSet for Variant {
-    const FAMILY_NAME: &'static str = "prefiltered";
-    const FAMILY: Family = Family::Prefiltered;
-
-    fn validate(&self) -> Result<(), VariantError> {
-        Variant::validate(self)
-    }
-
-    fn id(&self) -> String {
-        Variant::id(self)
-    }
-
-    fn light(&self) -> LightKind {
-        self.light
-    }
-
-    /// Regions 1..=4 (every other knob at every value).
-    fn grid() -> Vec<Self> {
-        Variant::grid(1..=4)
-    }
-}
-
-impl KnobSet for RaymarchVariant {
-    const FAMILY_NAME: &'static str = "raymarch";
-    const FAMILY: Family = Family::Raymarch;
-
-    fn validate(&self) -> Result<(), VariantError> {
-        RaymarchVariant::validate(self)
-    }
-
-    fn id(&self) -> String {
-        RaymarchVariant::id(self)
-    }
-
-    fn light(&self) -> LightKind {
-        self.light
-    }
-
-    fn grid() -> Vec<Self> {
-        RaymarchVariant::grid()
-    }
-}
-
-impl KnobSet for MinmaxVariant {
-    const FAMILY_NAME: &'static str = "minmax";
-    const FAMILY: Family = Family::Minmax;
-
-    fn validate(&self) -> Result<(), VariantError> {
-        MinmaxVariant::validate(self)
-    }
-
-    fn id(&self) -> String {
-        MinmaxVariant::id(self)
-    }
-
-    fn light(&self) -> LightKind {
-        self.light
-    }
-
-    fn grid() -> Vec<Self> {
-        MinmaxVariant::grid()
-    }
-}
-
-/// One validated-or-not variant of some family: the one enum of every family's variant.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum FamilyVariant {
-    /// A minmax-family variant.
-    Minmax(MinmaxVariant),
-    /// A prefiltered-family variant.
-    Prefiltered(Variant),
-    /// A raymarch-family variant.
-    Raymarch(RaymarchVariant),
-}
-
-impl From<MinmaxVariant> for FamilyVariant {
-    fn from(v: MinmaxVariant) -> Self {
-        Self::Minmax(v)
-    }
-}
-
-impl From<Variant> for FamilyVariant {
-    fn from(v: Variant) -> Self {
-        Self::Prefiltered(v)
-    }
-}
-
-impl From<RaymarchVariant> for FamilyVariant {
-    fn from(v: RaymarchVariant) -> Self {
-        Self::Raymarch(v)
-    }
-}
-
-/// Calls `$body` with `$v` bound to the variant inside any arm.
-macro_rules! each {
-    ($self:expr, $v:ident => $body:expr) => {
-        match $self {
-            FamilyVariant::Minmax($v) => $body,
-            FamilyVariant::Prefiltered($v) => $body,
-            FamilyVariant::Raymarch($v) => $body,
-        }
-    };
-}
-
-impl FamilyVariant {
-    /// The family.
-    pub const fn family(&self) -> Family {
-        match self {
-            Self::Minmax(_) => Family::Minmax,
-            Self::Prefiltered(_) => Family::Prefiltered,
-            Self::Raymarch(_) => Family::Raymarch,
-        }
-    }
-
-    /// The variant id (`<kernel>.<id>.<ext>` file names, manifest entries).
-    pub fn id(&self) -> String {
-        each!(self, v => KnobSet::id(v))
-    }
-
-    /// `family::id`, the head of every trial name.
-    pub fn trial_name(&self) -> String {
-        format!("{}::{}", self.family(), self.id())
-    }
-
-    /// The light type the kernels are compiled for.
-    pub fn light(&self) -> LightKind {
-        each!(self, v => KnobSet::light(v))
-    }
-
-    /// Checks every knob.
-    ///
-    /// # Errors
-    ///
-    /// [`VariantError`] naming the knob, the value and the allowed range.
-    pub fn validate(&self) -> Result<(), VariantError> {
-        each!(self, v => KnobSet::validate(v))
-    }
 }
 
 impl fmt::Display for FamilyVariant {

@@ -39,6 +39,7 @@
 //! resolution. Pixels near the epipole or the anti-epipole are ray-marched against the
 //! standard shadow map, as `scatter` does.
 
+use crate::family::{Family, KnobSet};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -158,6 +159,29 @@ pub fn prepare_minmax(
         shadow,
         settings,
     )
+}
+
+impl KnobSet for MinmaxVariant {
+    const FAMILY_NAME: &'static str = "minmax";
+    const FAMILY: Family = Family::Minmax;
+    const SUMMARY: &'static str = "Chen et al. 2011, 1D min-max mipmaps: each pixel marches its rectified row \
+         through a min-max binary tree, skipping wholly lit or shadowed spans";
+
+    fn validate(&self) -> Result<(), VariantError> {
+        MinmaxVariant::validate(self)
+    }
+
+    fn id(&self) -> String {
+        MinmaxVariant::id(self)
+    }
+
+    fn light(&self) -> LightKind {
+        self.light
+    }
+
+    fn grid() -> Vec<Self> {
+        MinmaxVariant::grid()
+    }
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@
 //! the result is exactly the full-N sum; elsewhere it trades noise for blur across depth
 //! edges (the paper's "halos").
 
+use crate::family::{Family, KnobSet};
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -255,4 +256,27 @@ pub fn prepare_march(
         ("sm_proj", u.sm_proj),
     ])?;
     Ok(u)
+}
+
+impl KnobSet for RaymarchVariant {
+    const FAMILY_NAME: &'static str = "raymarch";
+    const FAMILY: Family = Family::Raymarch;
+    const SUMMARY: &'static str = "Toth & Umenhoffer 2009, ray marching through the standard shadow map, \
+         optionally with interleaved sampling and a separable sum filter";
+
+    fn validate(&self) -> Result<(), VariantError> {
+        RaymarchVariant::validate(self)
+    }
+
+    fn id(&self) -> String {
+        RaymarchVariant::id(self)
+    }
+
+    fn light(&self) -> LightKind {
+        self.light
+    }
+
+    fn grid() -> Vec<Self> {
+        RaymarchVariant::grid()
+    }
 }

@@ -1,6 +1,7 @@
 //! [`Variant`]: the knobs of the prefiltered family (DESIGN.md, "Variant space"), validated
 //! with errors that name the knob, the value and the allowed range.
 
+use crate::family::{Family, KnobSet};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -281,5 +282,29 @@ impl Variant {
 impl fmt::Display for Variant {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.id())
+    }
+}
+
+impl KnobSet for Variant {
+    const FAMILY_NAME: &'static str = "prefiltered";
+    const FAMILY: Family = Family::Prefiltered;
+    const SUMMARY: &'static str = "Klehm et al. 2014, prefiltered single scattering: Fourier-basis visibility \
+         prefiltered along epipolar rows of a rectified shadow map";
+
+    fn validate(&self) -> Result<(), VariantError> {
+        Variant::validate(self)
+    }
+
+    fn id(&self) -> String {
+        Variant::id(self)
+    }
+
+    fn light(&self) -> LightKind {
+        self.light
+    }
+
+    /// Regions 1..=4 (every other knob at every value).
+    fn grid() -> Vec<Self> {
+        Variant::grid(1..=4)
     }
 }
