@@ -64,44 +64,53 @@ pub trait FamilyCli: Sized {
     fn variant(self, knobs: &[(String, String)]) -> Result<FamilyVariant, GenError>;
 }
 
-impl FamilyCli for Family {
-    fn knobs(self) -> Vec<KnobInfo> {
-        match self {
-            Self::Minmax => minmax::knobs(),
-            Self::Prefiltered => prefiltered::knobs(),
-            Self::Raymarch => raymarch::knobs(),
-        }
-    }
+/// The generator's one table of families: `Name => module`, one line each (the module has
+/// `knobs()` and `parse()`). It implements [`FamilyCli`] and [`knobs_json`].
+macro_rules! cli_families {
+    ($($name:ident => $module:ident),* $(,)?) => {
+        impl FamilyCli for Family {
+            fn knobs(self) -> Vec<KnobInfo> {
+                match self {
+                    $(Self::$name => $module::knobs(),)*
+                }
+            }
 
-    fn kernels(self) -> Vec<Kernel> {
-        scatter_shaderlib::family::kernels(self)
-    }
+            fn kernels(self) -> Vec<Kernel> {
+                scatter_shaderlib::family::kernels(self)
+            }
 
-    fn variant(self, knobs: &[(String, String)]) -> Result<FamilyVariant, GenError> {
-        let known = self.knobs();
-        for (name, _) in knobs {
-            if !known.iter().any(|k| k.name == name.as_str()) {
-                let names: Vec<_> = known.iter().map(|k| k.name).collect();
-                return Err(GenError::Usage(format!(
-                    "knob `{}` does not apply to family {self} (its knobs: {})",
-                    printable(name),
-                    names.join(", ")
-                )));
+            fn variant(self, knobs: &[(String, String)]) -> Result<FamilyVariant, GenError> {
+                let known = self.knobs();
+                for (name, _) in knobs {
+                    if !known.iter().any(|k| k.name == name.as_str()) {
+                        let names: Vec<_> = known.iter().map(|k| k.name).collect();
+                        return Err(GenError::Usage(format!(
+                            "knob `{}` does not apply to family {self} (its knobs: {})",
+                            printable(name),
+                            names.join(", ")
+                        )));
+                    }
+                }
+                match self {
+                    $(Self::$name => $module::parse(knobs).map(FamilyVariant::$name),)*
+                }
             }
         }
-        match self {
-            Self::Minmax => minmax::parse(knobs).map(FamilyVariant::Minmax),
-            Self::Prefiltered => prefiltered::parse(knobs).map(FamilyVariant::Prefiltered),
-            Self::Raymarch => raymarch::parse(knobs).map(FamilyVariant::Raymarch),
+
+        /// The knobs of a variant as a JSON object (serde names, sorted), as the manifest
+        /// lists them.
+        pub fn knobs_json(v: &FamilyVariant) -> serde_json::Value {
+            match v {
+                $(FamilyVariant::$name(v) => {
+                    serde_json::to_value(v).unwrap_or(serde_json::Value::Null)
+                })*
+            }
         }
-    }
+    };
 }
 
-/// The knobs of a variant as a JSON object (serde names, sorted), as the manifest lists them.
-pub fn knobs_json(v: &FamilyVariant) -> serde_json::Value {
-    match v {
-        FamilyVariant::Minmax(v) => serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
-        FamilyVariant::Prefiltered(v) => serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
-        FamilyVariant::Raymarch(v) => serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
-    }
+cli_families! {
+    Minmax => minmax,
+    Prefiltered => prefiltered,
+    Raymarch => raymarch,
 }
