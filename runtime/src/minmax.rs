@@ -385,3 +385,62 @@ pub fn run_minmax_once(
         wall_time,
     })
 }
+
+impl crate::family::FamilyRuntime for Minmax {
+    type Variant = MinmaxVariant;
+
+    fn create(
+        ctx: &Context,
+        variant: &MinmaxVariant,
+        res: Resolutions,
+        shadow_map_size: u32,
+    ) -> Result<Self, RuntimeError> {
+        Self::new(ctx, variant, res, shadow_map_size)
+    }
+
+    fn knobs(&self) -> MinmaxVariant {
+        self.variant
+    }
+
+    fn prepare_frame(
+        &mut self,
+        ctx: &Context,
+        input: &FrameInput,
+    ) -> Result<Option<scatter_shaderlib::prefiltered::FrameReport>, RuntimeError> {
+        self.prepare(ctx, input)?;
+        Ok(self.frame.as_ref().map(|f| f.report.clone()))
+    }
+
+    fn encode_frame(
+        &self,
+        ctx: &Context,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &crate::prefiltered::Inputs<'_>,
+    ) -> Result<&wgpu::TextureView, RuntimeError> {
+        let shadow_map = crate::family::required_shadow_map(inputs, RECTIFY)?;
+        self.encode(ctx, encoder, inputs.depth, shadow_map)
+    }
+
+    fn output(&self) -> &wgpu::Texture {
+        &self.output
+    }
+
+    fn total_pass_time(&self, ctx: &Context) -> Result<Option<Duration>, RuntimeError> {
+        Ok(self.pass_times(ctx)?.map(|t| t.total()))
+    }
+
+    fn pass_wall_times(
+        &self,
+        ctx: &Context,
+        inputs: &crate::prefiltered::Inputs<'_>,
+        frames: u32,
+    ) -> Result<Vec<(Kernel, Duration)>, RuntimeError> {
+        let shadow_map = crate::family::required_shadow_map(inputs, RECTIFY)?;
+        let t = self.measure_pass_wall_times(ctx, inputs.depth, shadow_map, frames)?;
+        Ok(vec![
+            (RECTIFY, t.rectify),
+            (BUILD, t.build),
+            (MARCH, t.march),
+        ])
+    }
+}

@@ -674,3 +674,59 @@ pub(crate) fn check_frame_buffers(limits: &wgpu::Limits, hr: u32) -> Result<u64,
     )?;
     Ok(slice_bytes)
 }
+
+impl crate::family::FamilyRuntime for Prefiltered {
+    type Variant = Variant;
+
+    fn create(
+        ctx: &Context,
+        variant: &Variant,
+        res: Resolutions,
+        shadow_map_size: u32,
+    ) -> Result<Self, RuntimeError> {
+        Self::new(ctx, variant, res, shadow_map_size)
+    }
+
+    fn knobs(&self) -> Variant {
+        self.variant
+    }
+
+    fn prepare_frame(
+        &mut self,
+        ctx: &Context,
+        input: &FrameInput,
+    ) -> Result<Option<FrameReport>, RuntimeError> {
+        self.prepare(ctx, input).map(Some)
+    }
+
+    fn encode_frame(
+        &self,
+        _ctx: &Context,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &Inputs<'_>,
+    ) -> Result<&wgpu::TextureView, RuntimeError> {
+        self.encode(encoder, inputs)
+    }
+
+    fn output(&self) -> &wgpu::Texture {
+        &self.output
+    }
+
+    fn total_pass_time(&self, ctx: &Context) -> Result<Option<Duration>, RuntimeError> {
+        Ok(self.pass_times(ctx)?.map(|t| t.total()))
+    }
+
+    fn pass_wall_times(
+        &self,
+        ctx: &Context,
+        inputs: &Inputs<'_>,
+        frames: u32,
+    ) -> Result<Vec<(Kernel, Duration)>, RuntimeError> {
+        let t = self.measure_pass_wall_times(ctx, inputs, frames)?;
+        Ok(vec![
+            (RECTIFY, t.rectify),
+            (PREFILTER, t.prefilter),
+            (SCATTER, t.scatter),
+        ])
+    }
+}

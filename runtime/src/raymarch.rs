@@ -401,3 +401,63 @@ pub fn run_raymarch_once(
         wall_time,
     })
 }
+
+impl crate::family::FamilyRuntime for Raymarch {
+    type Variant = RaymarchVariant;
+
+    /// Uses only `res.screen`.
+    fn create(
+        ctx: &Context,
+        variant: &RaymarchVariant,
+        res: scatter_shaderlib::prefiltered::Resolutions,
+        shadow_map_size: u32,
+    ) -> Result<Self, RuntimeError> {
+        Self::new(ctx, variant, res.screen, shadow_map_size)
+    }
+
+    fn knobs(&self) -> RaymarchVariant {
+        self.variant
+    }
+
+    /// Ignores `input.settings`; raymarch has no frame report.
+    fn prepare_frame(
+        &mut self,
+        ctx: &Context,
+        input: &FrameInput,
+    ) -> Result<Option<scatter_shaderlib::prefiltered::FrameReport>, RuntimeError> {
+        self.prepare(ctx, &input.into()).map(|()| None)
+    }
+
+    fn encode_frame(
+        &self,
+        ctx: &Context,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &crate::prefiltered::Inputs<'_>,
+    ) -> Result<&wgpu::TextureView, RuntimeError> {
+        let shadow_map = crate::family::required_shadow_map(inputs, RAYMARCH)?;
+        self.encode(ctx, encoder, inputs.depth, shadow_map)
+    }
+
+    fn output(&self) -> &wgpu::Texture {
+        &self.output
+    }
+
+    fn total_pass_time(&self, ctx: &Context) -> Result<Option<Duration>, RuntimeError> {
+        Ok(self.pass_times(ctx)?.map(|t| t.total()))
+    }
+
+    fn pass_wall_times(
+        &self,
+        ctx: &Context,
+        inputs: &crate::prefiltered::Inputs<'_>,
+        frames: u32,
+    ) -> Result<Vec<(Kernel, Duration)>, RuntimeError> {
+        let shadow_map = crate::family::required_shadow_map(inputs, RAYMARCH)?;
+        let t = self.measure_pass_wall_times(ctx, inputs.depth, shadow_map, frames)?;
+        let mut passes = vec![(RAYMARCH, t.raymarch)];
+        if self.variant.interleaved() {
+            passes.push((INTERLEAVE_SUM, t.interleave_sum));
+        }
+        Ok(passes)
+    }
+}
