@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::Instant;
 
-use scatter_conformance::gpu;
+use scatter_conformance::{Fixture, gpu, scene_for};
 use scatter_foreign_engine::condition::Condition;
 use scatter_foreign_engine::files::{FrameFile, RunArgs, run_dir, write_inputs};
 use scatter_foreign_engine::prefiltered::{Inputs, Sizes, run_frame};
@@ -36,11 +36,8 @@ use scatter_frame::frame::{PrefilteredFrame, prepare_frame};
 use scatter_frame::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_frame::raymarch::{RaymarchVariant, prepare_march};
 use scatter_gen::{FamilyVariant, Request, generate, output};
-use scatter_reference::buffers::{GBuffer, ShadowMap};
-use scatter_reference::bvh::Bvh;
 use scatter_reference::kernels::engine_rectified_map;
-use scatter_reference::scene::Scene;
-use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
+use scatter_reference::suite::Pose;
 use scatter_runtime::{
     Context, CpuInputs, FrameInput, RaymarchInput, run_minmax_once, run_prefiltered_once,
     run_raymarch_once,
@@ -101,50 +98,27 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// A suite scene with its depth buffer and standard shadow map.
-struct Fixture {
-    name: SceneName,
-    pose: Pose,
-    scene: Scene,
-    bvh: Bvh,
-    gbuf: GBuffer,
-    shadow_map: ShadowMap,
+/// The fixture of a light type, at the `ordinary` pose (built once, on first use).
+fn fixture(light: LightKind) -> &'static Fixture {
+    static COLUMNS: OnceLock<Fixture> = OnceLock::new();
+    static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
+    let cell = match light {
+        LightKind::Directional => &COLUMNS,
+        LightKind::Spot => &SPOT_GRATE,
+    };
+    cell.get_or_init(|| Fixture::new(scene_for(light), Pose::Ordinary, SCREEN, SHADOW_MAP))
 }
 
-impl Fixture {
-    fn get(light: LightKind) -> &'static Fixture {
-        static COLUMNS: OnceLock<Fixture> = OnceLock::new();
-        static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
-        let (cell, name) = match light {
-            LightKind::Directional => (&COLUMNS, SceneName::Columns),
-            LightKind::Spot => (&SPOT_GRATE, SceneName::SpotGrate),
-        };
-        cell.get_or_init(|| {
-            let pose = Pose::Ordinary;
-            let scene = scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
-            let bvh = Bvh::build(&scene.geometry);
-            let gbuf = GBuffer::cast(&scene, &bvh);
-            let shadow_map = ShadowMap::build(&scene, &bvh, SHADOW_MAP)
-                .unwrap_or_else(|e| panic!("shadow map of {name}: {e}"));
-            Fixture {
-                name,
-                pose,
-                scene,
-                bvh,
-                gbuf,
-                shadow_map,
-            }
-        })
-    }
+/// What these trials need of a fixture beyond the shared one.
+trait ForeignFixture {
+    fn input(&self) -> FrameInput;
+    fn sizes(&self) -> Sizes;
+    fn frame(&self, variant: &Variant) -> PrefilteredFrame;
+}
 
-    fn frame_input(&self) -> FrameInput {
-        FrameInput {
-            camera: self.scene.camera_desc(),
-            light: self.scene.light_desc(),
-            medium: self.scene.medium_desc(),
-            shadow_map: self.shadow_map.desc(),
-            settings: FrameSettings::default(),
-        }
+impl ForeignFixture for Fixture {
+    fn input(&self) -> FrameInput {
+        self.frame_input(FrameSettings::default())
     }
 
     fn sizes(&self) -> Sizes {
@@ -157,7 +131,7 @@ impl Fixture {
 
     /// The frame set-up, as the foreign engine computes it (scatter-frame only).
     fn frame(&self, variant: &Variant) -> PrefilteredFrame {
-        let f = self.frame_input();
+        let f = self.input();
         prepare_frame(
             variant,
             &Resolutions {
@@ -195,7 +169,7 @@ fn compare(foreign: &[[f32; 4]], runtime: &[[f32; 4]]) -> (f32, f32, usize) {
 }
 
 fn trial(ctx: &Context, variant: &Variant) -> Vec<String> {
-    let fixture = Fixture::get(variant.light);
+    let fixture = fixture(variant.light);
     let name = format!(
         "foreign::{}::{}::{}",
         variant.id(),
@@ -218,7 +192,7 @@ fn trial(ctx: &Context, variant: &Variant) -> Vec<String> {
             rectified: RECTIFIED,
         },
         &CpuInputs {
-            frame: fixture.frame_input(),
+            frame: fixture.input(),
             depth: fixture.gbuf.view_depth.clone(),
             shadow_map: fixture.shadow_map.depth.clone(),
             rectified: rectified.clone(),
@@ -391,14 +365,14 @@ fn foreign_engine_matches_runtime_for_every_family() {
     let dir = other_families_dir();
     let mut lines = Vec::new();
     for v in raymarch_variants() {
-        let fixture = Fixture::get(v.light);
+        let fixture = fixture(v.light);
         let name = format!(
             "foreign::raymarch::{}::{}::{}",
             v.id(),
             fixture.name,
             fixture.pose
         );
-        let f = fixture.frame_input();
+        let f = fixture.input();
         let input = RaymarchInput {
             camera: f.camera,
             light: f.light,
@@ -454,14 +428,14 @@ fn foreign_engine_matches_runtime_for_every_family() {
         }));
     }
     for v in MinmaxVariant::grid() {
-        let fixture = Fixture::get(v.light);
+        let fixture = fixture(v.light);
         let name = format!(
             "foreign::minmax::{}::{}::{}",
             v.id(),
             fixture.name,
             fixture.pose
         );
-        let f = fixture.frame_input();
+        let f = fixture.input();
         let res = Resolutions {
             screen: fixture.sizes().screen,
             rectified: RECTIFIED,
@@ -494,19 +468,9 @@ fn foreign_engine_matches_runtime_for_every_family() {
             &runtime.output,
             &["rectify", "minmax_build", "minmax_march"],
             |target| {
-                let sizes = scatter_foreign_engine::minmax::Sizes {
-                    screen: fixture.sizes().screen,
-                    rectified: RECTIFIED,
-                    shadow_map: SHADOW_MAP,
-                };
-                let mut engine = Engine::load(
-                    ctx.device(),
-                    ctx.queue(),
-                    dir,
-                    &v.id(),
-                    target,
-                    &sizes.params(),
-                )?;
+                let params = scatter_foreign_engine::minmax::params(&fixture.sizes());
+                let mut engine =
+                    Engine::load(ctx.device(), ctx.queue(), dir, &v.id(), target, &params)?;
                 scatter_foreign_engine::minmax::run_frame(
                     &mut engine,
                     &frame,
@@ -536,8 +500,8 @@ fn foreign_engine_files_run_every_family() {
         } else {
             MinmaxVariant::grid()[0].light
         };
-        let fixture = Fixture::get(light);
-        let f = fixture.frame_input();
+        let fixture = fixture(light);
+        let f = fixture.input();
         let file = FrameFile::new(
             fixture.sizes(),
             &f.camera,
@@ -584,7 +548,7 @@ fn foreign_engine_files_run_every_family() {
 fn foreign_engine_comparison_detects_a_wrong_input() {
     let Some(ctx) = gpu() else { return };
     let variant = Variant::default();
-    let fixture = Fixture::get(variant.light);
+    let fixture = fixture(variant.light);
     let frame = fixture.frame(&variant);
     let runtime = run_prefiltered_once(
         ctx,
@@ -594,7 +558,7 @@ fn foreign_engine_comparison_detects_a_wrong_input() {
             rectified: RECTIFIED,
         },
         &CpuInputs {
-            frame: fixture.frame_input(),
+            frame: fixture.input(),
             depth: fixture.gbuf.view_depth.clone(),
             shadow_map: fixture.shadow_map.depth.clone(),
             rectified: None,
@@ -636,11 +600,11 @@ fn foreign_engine_comparison_detects_a_wrong_input() {
 fn foreign_engine_files_round_trip() {
     let Some(ctx) = gpu() else { return };
     let variant = variants()[2];
-    let fixture = Fixture::get(variant.light);
+    let fixture = fixture(variant.light);
     let frame = fixture.frame(&variant);
     let rectified = engine_rectified_map(&fixture.scene, &fixture.bvh, &frame);
     assert!(rectified.is_some(), "expected a projective frame");
-    let f = fixture.frame_input();
+    let f = fixture.input();
     let file = FrameFile::new(
         fixture.sizes(),
         &f.camera,
@@ -842,7 +806,7 @@ fn foreign_engine_reports_bad_directories() {
     assert!(matches!(e, EngineError::Constraint { .. }), "{e}");
 
     // An epipolar frame without the standard shadow map: rectify needs it.
-    let fixture = Fixture::get(variant.light);
+    let fixture = fixture(variant.light);
     let frame = fixture.frame(&variant);
     let mut engine = Engine::load(
         ctx.device(),

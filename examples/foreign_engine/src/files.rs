@@ -668,12 +668,7 @@ pub fn run_dir(
         }
         Knobs::Minmax(variant) => {
             let frame = file.prepare_minmax(variant)?;
-            let sizes = crate::minmax::Sizes {
-                screen: file.screen,
-                rectified: file.rectified,
-                shadow_map: file.shadow_map.size,
-            };
-            let mut engine = load(&sizes.params())?;
+            let mut engine = load(&crate::minmax::params(&file.sizes()))?;
             let out = crate::minmax::run_frame(&mut engine, &frame, &depth, &shadow)?;
             (Some(frame), out)
         }

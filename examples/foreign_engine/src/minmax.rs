@@ -11,32 +11,15 @@ use scatter_frame::frame::PrefilteredFrame;
 use scatter_frame::minmax::tree_width;
 
 use crate::formula::Params;
-use crate::prefiltered::{Inputs, Output};
+use crate::prefiltered::{Inputs, Output, Sizes};
 use crate::{Engine, EngineError};
 
-/// Texture sizes of one configuration: the values of the manifest's parameters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Sizes {
-    /// Screen width and height (depth buffer and output).
-    pub screen: [u32; 2],
-    /// Rectified map width (light rays per slice) and height (slices).
-    pub rectified: [u32; 2],
-    /// Side of the standard shadow map.
-    pub shadow_map: u32,
-}
-
-impl Sizes {
-    /// The manifest parameters: the prefiltered family's plus `tree.width`.
-    pub fn params(&self) -> Params {
-        let mut p = crate::prefiltered::Sizes {
-            screen: self.screen,
-            rectified: self.rectified,
-            shadow_map: self.shadow_map,
-        }
-        .params();
-        p.set("tree.width", tree_width(self.rectified[0]).into());
-        p
-    }
+/// The manifest parameters of a minmax variant: the prefiltered family's (same sizes) plus
+/// `tree.width`.
+pub fn params(sizes: &Sizes) -> Params {
+    let mut p = sizes.params();
+    p.set("tree.width", tree_width(sizes.rectified[0]).into());
+    p
 }
 
 /// Runs one frame of a minmax variant: uploads the frame set-up and the engine's depth
