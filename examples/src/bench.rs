@@ -24,7 +24,7 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::prefiltered::{FrameInput, Inputs};
 use scatter_runtime::shaderlib::Kernel;
-use scatter_runtime::shaderlib::family::FamilyVariant;
+use scatter_runtime::shaderlib::family::{Family, FamilyVariant, KernelFamily};
 use scatter_runtime::shaderlib::minmax::MinmaxVariant;
 use scatter_runtime::shaderlib::prefiltered::{
     FrameSettings, LightKind, Resolutions, Storage, Variant,
@@ -34,93 +34,90 @@ use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::wgpu::TextureView;
 use scatter_runtime::{Context, FamilyPasses, Prefiltered};
 
-/// A method of one family with its knobs (the light is set per scene).
+/// A variant of any family (the light is set per scene) with, for a family that rectifies,
+/// its rectified map when it differs from the run's (`BenchConfig::rectified`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    /// The prefiltered family, with its rectified map when it differs from the run's
-    /// (`BenchConfig::rectified`).
-    Prefiltered(Variant, Option<[u32; 2]>),
-    /// The raymarch family.
-    Raymarch(RaymarchVariant),
-    /// The minmax family, with its rectified map when it differs from the run's.
-    Minmax(MinmaxVariant, Option<[u32; 2]>),
+pub struct Method {
+    /// The variant.
+    pub variant: FamilyVariant,
+    /// Its rectified map, when it differs from the run's.
+    pub rectified: Option<[u32; 2]>,
+}
+
+impl<V: Into<FamilyVariant>> From<V> for Method {
+    fn from(v: V) -> Self {
+        Self::new(v, None)
+    }
 }
 
 impl Method {
+    /// A variant with its own rectified map (`None`: the run's).
+    pub fn new(variant: impl Into<FamilyVariant>, rectified: Option<[u32; 2]>) -> Self {
+        Self {
+            variant: variant.into(),
+            rectified,
+        }
+    }
+
     /// The family's name.
     pub fn family(&self) -> &'static str {
-        match self {
-            Self::Prefiltered(..) => "prefiltered",
-            Self::Raymarch(_) => "raymarch",
-            Self::Minmax(..) => "minmax",
-        }
+        self.variant.family().name()
     }
 
     /// The variant id (light included).
     pub fn id(&self) -> String {
-        match self {
-            Self::Prefiltered(v, _) => v.id(),
-            Self::Raymarch(v) => v.id(),
-            Self::Minmax(v, _) => v.id(),
-        }
+        self.variant.id()
     }
 
     /// The family's variant (the one enum every tool shares).
     pub fn variant(&self) -> FamilyVariant {
-        match *self {
-            Self::Prefiltered(v, _) => v.into(),
-            Self::Raymarch(v) => v.into(),
-            Self::Minmax(v, _) => v.into(),
-        }
+        self.variant
     }
 
     /// The prefiltered default (the paper's variant) at the run's rectified size.
     pub fn prefiltered_default() -> Self {
-        Self::Prefiltered(Variant::default(), None)
+        Family::Prefiltered.default_variant().into()
     }
 
     /// The minmax default at the run's rectified size.
     pub fn minmax_default() -> Self {
-        Self::Minmax(MinmaxVariant::default(), None)
+        Family::Minmax.default_variant().into()
     }
 
-    /// The rectified map this method runs with, given the run's (`None` for raymarch).
+    /// Whether the family has a rectified map (its plan has the `rectified.width`
+    /// parameter).
+    pub fn rectifies(&self) -> bool {
+        self.variant
+            .plan()
+            .parameters
+            .iter()
+            .any(|p| p.name == "rectified.width")
+    }
+
+    /// The rectified map this method runs with, given the run's (`None` for a family
+    /// without one).
     pub fn rectified(&self, run: [u32; 2]) -> Option<[u32; 2]> {
-        match self {
-            Self::Prefiltered(_, r) | Self::Minmax(_, r) => Some(r.unwrap_or(run)),
-            Self::Raymarch(_) => None,
-        }
+        self.rectifies().then(|| self.rectified.unwrap_or(run))
     }
 
-    /// The variant id without the light (the chart's marker).
+    /// The variant's knobs without the light (the chart's marker): its
+    /// [`FamilyVariant::marker`] (the family's name when that is empty), then the
+    /// rectified map when it is not the run's.
     pub fn knobs(&self) -> String {
-        match self {
-            Self::Prefiltered(v, r) => {
-                let mut k = format!("m{}-r{}", v.bases, v.regions);
-                if v.bases_per_thread != Variant::default().bases_per_thread {
-                    k += &format!("-t{}", v.bases_per_thread);
-                }
-                if v.storage != Variant::default().storage {
-                    k += &format!("-{}", v.storage);
-                }
-                if let Some([w, h]) = r {
-                    k += &format!("-{w}x{h}");
-                }
-                k
-            }
-            Self::Raymarch(v) => format!("n{}-i{}", v.samples, v.interleave),
-            Self::Minmax(_, r) => match r {
-                Some([w, h]) => format!("minmax-{w}x{h}"),
-                None => "minmax".to_owned(),
-            },
+        let mut k = self.variant.marker();
+        if k.is_empty() {
+            k = self.family().to_owned();
         }
+        if let Some([w, h]) = self.rectified {
+            k += &format!("-{w}x{h}");
+        }
+        k
     }
 
     fn with_light(self, light: LightKind) -> Self {
-        match self {
-            Self::Prefiltered(v, r) => Self::Prefiltered(Variant { light, ..v }, r),
-            Self::Raymarch(v) => Self::Raymarch(RaymarchVariant { light, ..v }),
-            Self::Minmax(_, r) => Self::Minmax(MinmaxVariant { light }, r),
+        Self {
+            variant: self.variant.with_light(light),
+            ..self
         }
     }
 }
@@ -162,14 +159,11 @@ impl BenchConfig {
         let mut methods: Vec<Method> = [(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)]
             .into_iter()
             .map(|(bases, regions)| {
-                Method::Prefiltered(
-                    Variant {
-                        bases,
-                        regions,
-                        ..Variant::default()
-                    },
-                    None,
-                )
+                Method::from(Variant {
+                    bases,
+                    regions,
+                    ..Variant::default()
+                })
             })
             .collect();
         for (samples, interleave) in [
@@ -181,7 +175,7 @@ impl BenchConfig {
             (64, 4),
             (256, 4),
         ] {
-            methods.push(Method::Raymarch(RaymarchVariant {
+            methods.push(Method::from(RaymarchVariant {
                 samples,
                 interleave,
                 ..RaymarchVariant::default()
@@ -214,11 +208,11 @@ impl BenchConfig {
             ],
             methods: vec![
                 Method::prefiltered_default(),
-                Method::Raymarch(RaymarchVariant {
+                Method::from(RaymarchVariant {
                     samples: 32,
                     ..RaymarchVariant::default()
                 }),
-                Method::Raymarch(RaymarchVariant {
+                Method::from(RaymarchVariant {
                     samples: 64,
                     interleave: 4,
                     ..RaymarchVariant::default()
@@ -554,7 +548,7 @@ fn time_method(
 fn headline_runs(ctx: &Context, frames: u32) -> Result<Vec<HeadlineRow>, BoxError> {
     let mut methods = vec![Method::prefiltered_default(), Method::minmax_default()];
     for (samples, interleave) in [(64, 1), (128, 1), (64, 4)] {
-        methods.push(Method::Raymarch(RaymarchVariant {
+        methods.push(Method::from(RaymarchVariant {
             samples,
             interleave,
             ..RaymarchVariant::default()
@@ -1139,7 +1133,7 @@ pub fn tune_candidates() -> Vec<Method> {
     for rectified in [None, Some([256, 256])] {
         for bases in [16, 32, 64] {
             for regions in [1, 3, 8] {
-                out.push(Method::Prefiltered(
+                out.push(Method::new(
                     Variant {
                         bases,
                         regions,
@@ -1160,14 +1154,14 @@ pub fn tune_candidates() -> Vec<Method> {
         (64, 4),
         (256, 4),
     ] {
-        out.push(Method::Raymarch(RaymarchVariant {
+        out.push(Method::from(RaymarchVariant {
             samples,
             interleave,
             ..RaymarchVariant::default()
         }));
     }
     out.push(Method::minmax_default());
-    out.push(Method::Minmax(MinmaxVariant::default(), Some([256, 256])));
+    out.push(Method::new(MinmaxVariant::default(), Some([256, 256])));
     out
 }
 
@@ -1221,35 +1215,31 @@ pub fn tune_refinements(table: &[TuneEntry], run: [u32; 2]) -> Vec<Method> {
     };
     let rect_knob = |r: [u32; 2]| (r != run).then_some(r);
     for e in front {
-        match e.method {
-            Method::Prefiltered(v, r) => {
-                let rect = r.unwrap_or(run);
-                for bpt in (4..=v.bases).step_by(4) {
-                    if bpt != v.bases_per_thread && v.bases.is_multiple_of(bpt) {
-                        push(Method::Prefiltered(
-                            Variant {
-                                bases_per_thread: bpt,
-                                ..v
-                            },
-                            r,
-                        ));
-                    }
-                }
-                for &storage in Storage::ALL {
-                    if storage != v.storage {
-                        push(Method::Prefiltered(Variant { storage, ..v }, r));
-                    }
-                }
-                for step in rect_steps(rect) {
-                    push(Method::Prefiltered(v, rect_knob(step)));
+        let m = e.method;
+        // The knobs only the prefiltered family has.
+        if let FamilyVariant::Prefiltered(v) = m.variant {
+            for bpt in (4..=v.bases).step_by(4) {
+                if bpt != v.bases_per_thread && v.bases.is_multiple_of(bpt) {
+                    push(Method::new(
+                        Variant {
+                            bases_per_thread: bpt,
+                            ..v
+                        },
+                        m.rectified,
+                    ));
                 }
             }
-            Method::Minmax(v, r) => {
-                for step in rect_steps(r.unwrap_or(run)) {
-                    push(Method::Minmax(v, rect_knob(step)));
+            for &storage in Storage::ALL {
+                if storage != v.storage {
+                    push(Method::new(Variant { storage, ..v }, m.rectified));
                 }
             }
-            Method::Raymarch(_) => {}
+        }
+        // Every family with a rectified map: the next sizes.
+        if let Some(rect) = m.rectified(run) {
+            for step in rect_steps(rect) {
+                push(Method::new(m.variant, rect_knob(step)));
+            }
         }
     }
     out
@@ -1341,28 +1331,16 @@ pub fn scatter_gen_command(method: &Method, run: [u32; 2]) -> String {
         .rectified(run)
         .map(|[w, h]| format!("  # runtime: rectified map {w}x{h}"))
         .unwrap_or_default();
-    match method {
-        Method::Prefiltered(v, _) => format!(
-            "scatter-gen --family prefiltered --bases {} --bases-per-thread {} --regions {} --visibility {} --storage {} --rectification {} --light {} --out shaders/{rect}",
-            v.bases,
-            v.bases_per_thread,
-            v.regions,
-            v.visibility,
-            v.storage,
-            v.rectification,
-            v.light
-        ),
-        Method::Raymarch(v) => format!(
-            "scatter-gen --family raymarch --samples {} --interleave {} --jitter {} --light {} --out shaders/",
-            v.samples, v.interleave, v.jitter, v.light
-        ),
-        Method::Minmax(v, _) => {
-            format!(
-                "scatter-gen --family minmax --light {} --out shaders/{rect}",
-                v.light
-            )
-        }
-    }
+    let knobs: String = method
+        .variant
+        .knob_values()
+        .iter()
+        .map(|(k, v)| format!(" --{} {v}", k.replace('_', "-")))
+        .collect();
+    format!(
+        "scatter-gen --family {}{knobs} --out shaders/{rect}",
+        method.family()
+    )
 }
 
 /// The light of a suite scene.
@@ -1385,7 +1363,7 @@ mod tests {
     }
 
     fn march(samples: u32) -> Method {
-        Method::Raymarch(RaymarchVariant {
+        Method::from(RaymarchVariant {
             samples,
             ..RaymarchVariant::default()
         })
@@ -1393,7 +1371,7 @@ mod tests {
 
     #[test]
     fn tune_picks_the_cheapest_within_budget() {
-        let spot = Method::Prefiltered(
+        let spot = Method::new(
             Variant {
                 light: LightKind::Spot,
                 ..Variant::default()
@@ -1421,18 +1399,37 @@ mod tests {
         assert_eq!(tune_pick(&table, 0.001), None);
         assert_eq!(
             scatter_gen_command(&table[2].method, [512, 512]),
-            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 8 --regions 3 --visibility weighted --storage rgba8unorm --rectification epipolar --light spot --out shaders/  # runtime: rectified map 256x256"
+            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 8 --light spot --rectification epipolar --regions 3 --storage rgba8unorm --visibility weighted --out shaders/  # runtime: rectified map 256x256"
         );
         assert_eq!(
             scatter_gen_command(&table[1].method, [512, 512]),
-            "scatter-gen --family raymarch --samples 64 --interleave 1 --jitter false --light directional --out shaders/"
+            "scatter-gen --family raymarch --interleave 1 --jitter false --light directional --samples 64 --out shaders/"
         );
+        // Every knob of every family's grid: the command's flags parse back to the variant.
+        use scatter_gen::FamilyCli;
+        for &family in Family::ALL {
+            for v in family.grid() {
+                let cmd = scatter_gen_command(&Method::from(v), [512, 512]);
+                let words: Vec<&str> = cmd.split_whitespace().collect();
+                assert_eq!(
+                    words[..3],
+                    ["scatter-gen", "--family", family.name()],
+                    "{cmd}"
+                );
+                let knobs: Vec<(String, String)> = words[3..]
+                    .chunks_exact(2)
+                    .take_while(|kv| kv[0] != "--out")
+                    .map(|kv| (kv[0][2..].replace('-', "_"), kv[1].to_owned()))
+                    .collect();
+                assert_eq!(family.variant(&knobs).ok(), Some(v), "{cmd}");
+            }
+        }
     }
 
     #[test]
     fn refinements_step_the_fixed_knobs_around_the_front() {
         let p = |bases, r| {
-            Method::Prefiltered(
+            Method::new(
                 Variant {
                     bases,
                     ..Variant::default()

@@ -100,6 +100,60 @@ macro_rules! families {
                 }
             }
 
+            /// The knobs as a JSON object (serde names, sorted by name), as the manifest and
+            /// the config file spell them.
+            pub fn knobs_json(&self) -> serde_json::Value {
+                match self {
+                    $(Self::$name(v) => serde_json::to_value(v).unwrap_or(serde_json::Value::Null),)*
+                }
+            }
+
+            /// The knobs as `(name, value)` pairs sorted by name, every knob spelled out
+            /// (the light included): `scatter-gen --family F --<name> <value> ...` with `_`
+            /// as `-` in the flag emits this variant.
+            pub fn knob_values(&self) -> Vec<(String, String)> {
+                match self.knobs_json() {
+                    serde_json::Value::Object(map) => map
+                        .into_iter()
+                        .map(|(k, v)| {
+                            let value = match v {
+                                serde_json::Value::String(s) => s,
+                                other => other.to_string(),
+                            };
+                            (k, value)
+                        })
+                        .collect(),
+                    _ => Vec::new(),
+                }
+            }
+
+            /// The variant with another light, every other knob kept.
+            #[must_use]
+            pub fn with_light(self, light: LightKind) -> Self {
+                match self {
+                    $(Self::$name(v) => Self::$name(KnobSet::with_light(v, light)),)*
+                }
+            }
+
+            /// The knobs without the light, short ([`KnobSet::marker`]); empty for a
+            /// family whose only knob is the light.
+            pub fn marker(&self) -> String {
+                match self {
+                    $(Self::$name(v) => KnobSet::marker(v),)*
+                }
+            }
+
+            /// `family-marker` (or the family's name alone when the marker is empty): a
+            /// short name for tables and charts, light excluded.
+            pub fn label(&self) -> String {
+                let marker = self.marker();
+                if marker.is_empty() {
+                    self.family().name().to_owned()
+                } else {
+                    format!("{}-{marker}", self.family())
+                }
+            }
+
             /// Checks every knob.
             ///
             /// # Errors
@@ -177,6 +231,15 @@ pub trait KnobSet:
     /// The light type the kernels are compiled for.
     fn light(&self) -> LightKind;
 
+    /// The variant with another light, every other knob kept.
+    #[must_use]
+    fn with_light(self, light: LightKind) -> Self;
+
+    /// The knobs without the light, short, for tables and charts (`m32-r3`, `n64-i1`): the
+    /// knobs a sweep usually varies always, every other knob only where it differs from
+    /// its default; empty when the light is the only knob.
+    fn marker(&self) -> String;
+
     /// The conformance grid: every variant the GPU-against-mirror trials run.
     fn grid() -> Vec<Self>;
 }
@@ -205,5 +268,37 @@ mod tests {
             assert!(family.default_variant().validate().is_ok());
         }
         assert_eq!(Family::Prefiltered.grid().len(), 2016);
+    }
+
+    #[test]
+    fn marker_and_light_name_the_variant() {
+        for &family in Family::ALL {
+            let grid = family.grid();
+            let mut seen = std::collections::HashSet::new();
+            for v in &grid {
+                assert!(
+                    seen.insert((v.marker(), v.light())),
+                    "{v}: marker {}",
+                    v.marker()
+                );
+                assert!(v.label().starts_with(family.name()), "{v}");
+                for &light in LightKind::ALL {
+                    let w = v.with_light(light);
+                    assert_eq!(
+                        (w.light(), w.marker(), w.family()),
+                        (light, v.marker(), family)
+                    );
+                }
+            }
+        }
+        assert_eq!(
+            Family::Prefiltered.default_variant().label(),
+            "prefiltered-m32-r3"
+        );
+        assert_eq!(
+            Family::Raymarch.default_variant().label(),
+            "raymarch-n64-i1"
+        );
+        assert_eq!(Family::Minmax.default_variant().label(), "minmax");
     }
 }

@@ -179,6 +179,14 @@ impl KnobSet for MinmaxVariant {
         self.light
     }
 
+    fn with_light(self, light: LightKind) -> Self {
+        Self { light }
+    }
+
+    fn marker(&self) -> String {
+        String::new()
+    }
+
     fn grid() -> Vec<Self> {
         MinmaxVariant::grid()
     }

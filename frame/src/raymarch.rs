@@ -276,6 +276,20 @@ impl KnobSet for RaymarchVariant {
         self.light
     }
 
+    fn with_light(self, light: LightKind) -> Self {
+        Self { light, ..self }
+    }
+
+    /// `n{samples}-i{interleave}`, `-nojitter` / `-jitter` where it differs from the
+    /// default.
+    fn marker(&self) -> String {
+        let mut m = format!("n{}-i{}", self.samples, self.interleave);
+        if self.jitter != Self::default().jitter {
+            m += if self.jitter { "-jitter" } else { "-nojitter" };
+        }
+        m
+    }
+
     fn grid() -> Vec<Self> {
         RaymarchVariant::grid()
     }

@@ -303,6 +303,30 @@ impl KnobSet for Variant {
         self.light
     }
 
+    fn with_light(self, light: LightKind) -> Self {
+        Self { light, ..self }
+    }
+
+    /// `m{bases}-r{regions}`, then `-t{bases_per_thread}`, the visibility, the storage and
+    /// the rectification where they differ from the default.
+    fn marker(&self) -> String {
+        let d = Self::default();
+        let mut m = format!("m{}-r{}", self.bases, self.regions);
+        if self.bases_per_thread != d.bases_per_thread {
+            m += &format!("-t{}", self.bases_per_thread);
+        }
+        if self.visibility != d.visibility {
+            m += &format!("-{}", self.visibility);
+        }
+        if self.storage != d.storage {
+            m += &format!("-{}", self.storage);
+        }
+        if self.rectification != d.rectification {
+            m += &format!("-{}", self.rectification);
+        }
+        m
+    }
+
     /// Regions 1..=4 (every other knob at every value).
     fn grid() -> Vec<Self> {
         Variant::grid(1..=4)

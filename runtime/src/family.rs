@@ -13,7 +13,9 @@ use scatter_shaderlib::Kernel;
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::prefiltered::{FrameReport, Resolutions};
 
-use crate::prefiltered::{FrameInput, Inputs};
+use crate::gpu::upload_inputs;
+use crate::prefiltered::{CpuInputs, FrameInput, Inputs};
+use crate::textures::read_rgba16float;
 use crate::{Context, Minmax, Prefiltered, Raymarch, RuntimeError};
 
 /// What a family's runtime type offers with the inputs every family takes: the frame input
@@ -213,4 +215,74 @@ runtime_families! {
     Prefiltered(Prefiltered),
     /// The raymarch family (it uses only the screen size of the resolutions).
     Raymarch(Raymarch),
+}
+
+/// What [`run_family_once`] reads back: the output and the frame report of any family.
+#[derive(Clone, Debug)]
+pub struct FamilyReadback {
+    /// In-scattered radiance per pixel (rgba16float converted to f32), row-major.
+    pub output: Vec<[f32; 4]>,
+    /// The frame report of the epipolar families (`None` for raymarch).
+    pub report: Option<FrameReport>,
+    /// Median wall time of each pass submitted on its own, in pass order, when
+    /// [`CpuInputs::pass_wall_frames`] is non-zero (empty otherwise).
+    pub pass_wall_times: Vec<(Kernel, Duration)>,
+}
+
+/// Test and tool helper for any family: builds `variant`'s passes, uploads `inputs` (the
+/// depth buffer, the standard shadow map and, for a projective frame, the engine's
+/// rasterised rectified map) as r32float textures, runs one frame and reads the output back.
+///
+/// # Errors
+///
+/// As [`FamilyPasses::new`], `prepare` and `encode`; [`RuntimeError::DataLength`] for an
+/// input whose length does not match its size.
+pub fn run_family_once(
+    ctx: &Context,
+    variant: &FamilyVariant,
+    res: Resolutions,
+    inputs: &CpuInputs,
+) -> Result<FamilyReadback, RuntimeError> {
+    let sm_size = inputs.frame.shadow_map.size;
+    let mut pass = FamilyPasses::new(ctx, variant, res, sm_size)?;
+    let kernels: Vec<Kernel> = scatter_shaderlib::family::KernelFamily::kernel_params(variant)
+        .iter()
+        .map(scatter_shaderlib::KernelParams::kernel)
+        .collect();
+    // The kernels to blame for a bad depth buffer (the last pass reads it) and a bad
+    // shadow map (the first pass of the epipolar families, the only one of raymarch).
+    let first = kernels.first().copied().unwrap_or(Kernel::Scatter);
+    let last = kernels.last().copied().unwrap_or(Kernel::Scatter);
+    let mut cpu = vec![
+        (last, "depth buffer", res.screen, &inputs.depth[..]),
+        (first, "shadow map", [sm_size; 2], &inputs.shadow_map[..]),
+    ];
+    if let Some(data) = &inputs.rectified {
+        cpu.push((first, "rasterised rectified map", res.rectified, &data[..]));
+    }
+    let views = upload_inputs(ctx, &cpu)?;
+    let report = pass.prepare(ctx, &inputs.frame)?;
+    let gpu_inputs = Inputs {
+        depth: &views[0].1,
+        shadow_map: Some(&views[1].1),
+        rectified: views.get(2).map(|(_, v)| v),
+    };
+    let mut encoder = ctx
+        .device()
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("run_family_once"),
+        });
+    pass.encode(ctx, &mut encoder, &gpu_inputs)?;
+    ctx.queue().submit([encoder.finish()]);
+    let output = read_rgba16float(ctx, last, pass.output_texture())?;
+    let pass_wall_times = if inputs.pass_wall_frames > 0 {
+        pass.measure_pass_wall_times(ctx, &gpu_inputs, inputs.pass_wall_frames)?
+    } else {
+        Vec::new()
+    };
+    Ok(FamilyReadback {
+        output,
+        report,
+        pass_wall_times,
+    })
 }

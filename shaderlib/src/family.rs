@@ -11,76 +11,62 @@ use crate::raymarch::RaymarchVariant;
 use crate::{Kernel, KernelParams};
 
 /// A family's variant as kernels: the kernel parameters in pass order and the plan the
-/// generator writes into the manifest and the runtime's executor builds from.
+/// generator writes into the manifest and the runtime's executor builds from. Each family
+/// implements it for its variant type in its own module (`src/<family>/mod.rs`).
 pub trait KernelFamily {
     /// The kernel parameters of every kernel, in pass order.
     fn kernel_params(&self) -> Vec<KernelParams>;
 
     /// The resources, parameters and passes an engine needs to run the variant.
     fn plan(&self) -> Plan;
+
+    /// The family's variant that has the most passes (every kernel of the family), for
+    /// listing its kernels; the default variant unless a knob adds passes.
+    fn with_most_passes() -> Self
+    where
+        Self: Sized;
 }
 
-impl KernelFamily for Variant {
-    fn kernel_params(&self) -> Vec<KernelParams> {
-        KernelParams::prefiltered(*self).to_vec()
-    }
+/// Shaderlib's one table of families: `Name(variant type)`, one line each; the names are
+/// `FamilyVariant`'s. It implements [`KernelFamily`] for [`FamilyVariant`] and [`kernels`].
+macro_rules! kernel_families {
+    ($($name:ident($ty:ty)),* $(,)?) => {
+        impl KernelFamily for FamilyVariant {
+            fn kernel_params(&self) -> Vec<KernelParams> {
+                match self {
+                    $(Self::$name(v) => v.kernel_params(),)*
+                }
+            }
 
-    fn plan(&self) -> Plan {
-        crate::prefiltered::plan::plan(self)
-    }
-}
+            fn plan(&self) -> Plan {
+                match self {
+                    $(Self::$name(v) => v.plan(),)*
+                }
+            }
 
-impl KernelFamily for RaymarchVariant {
-    fn kernel_params(&self) -> Vec<KernelParams> {
-        KernelParams::raymarch(*self)
-    }
-
-    fn plan(&self) -> Plan {
-        crate::raymarch::plan::plan(self)
-    }
-}
-
-impl KernelFamily for MinmaxVariant {
-    fn kernel_params(&self) -> Vec<KernelParams> {
-        KernelParams::minmax(*self).to_vec()
-    }
-
-    fn plan(&self) -> Plan {
-        crate::minmax::plan::plan(self)
-    }
-}
-
-impl KernelFamily for FamilyVariant {
-    fn kernel_params(&self) -> Vec<KernelParams> {
-        match self {
-            Self::Minmax(v) => v.kernel_params(),
-            Self::Prefiltered(v) => v.kernel_params(),
-            Self::Raymarch(v) => v.kernel_params(),
+            /// The default family's variant with the most passes.
+            fn with_most_passes() -> Self {
+                Self::Prefiltered(Variant::with_most_passes())
+            }
         }
-    }
 
-    fn plan(&self) -> Plan {
-        match self {
-            Self::Minmax(v) => v.plan(),
-            Self::Prefiltered(v) => v.plan(),
-            Self::Raymarch(v) => v.plan(),
+        /// The kernels of a family in pass order, for its variant with the most passes (read
+        /// from the kernel parameters, not listed here).
+        pub fn kernels(family: Family) -> Vec<Kernel> {
+            let variant = match family {
+                $(Family::$name => FamilyVariant::$name(<$ty as KernelFamily>::with_most_passes()),)*
+            };
+            variant
+                .kernel_params()
+                .iter()
+                .map(KernelParams::kernel)
+                .collect()
         }
-    }
-}
-
-/// The kernels of a family in pass order, for its variant with the most passes (read from
-/// the kernel parameters, not listed here).
-pub fn kernels(family: Family) -> Vec<Kernel> {
-    let variant = match family {
-        Family::Raymarch => FamilyVariant::Raymarch(RaymarchVariant {
-            interleave: 2,
-            ..RaymarchVariant::default()
-        }),
-        _ => family.default_variant(),
     };
-    variant
-        .kernel_params()
-        .iter()
-        .map(KernelParams::kernel)
-        .collect()
+}
+
+kernel_families! {
+    Minmax(MinmaxVariant),
+    Prefiltered(Variant),
+    Raymarch(RaymarchVariant),
 }

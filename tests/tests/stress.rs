@@ -27,15 +27,13 @@ use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
 use scatter_reference::kernels::common_prefiltered::quantise;
-use scatter_reference::kernels::{engine_rectified_map, run_minmax, run_prefiltered, run_raymarch};
+use scatter_reference::kernels::{CpuFrame, CpuRun, engine_rectified_map, run_family};
 use scatter_reference::metrics;
 use scatter_reference::scene::Light;
 use scatter_reference::stress::{self, StressCase, StressGroup};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
-use scatter_runtime::raymarch::RaymarchInput;
-use scatter_runtime::{
-    Context, CpuInputs, FrameInput, run_minmax_once, run_prefiltered_once, run_raymarch_once,
-};
+use scatter_runtime::{Context, CpuInputs, FrameInput, run_family_once};
+use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{
     FrameReport, FrameSettings, LightKind, ProjectiveFallback, Rectification, Resolutions, Storage,
@@ -69,31 +67,43 @@ const PROJECTIVE_EXCEPTIONS: &[(&str, f64, &str)] = &[(
      within 2 m (the column cut by the near plane) carry 5.5 of the 7.4 %",
 )];
 
-/// The methods run on every case.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Method {
-    Prefiltered(Rectification),
-    Raymarch(u32),
-    Minmax,
+/// The variants run on every case (directional; each case sets the light, and the
+/// prefiltered bases where it stresses them): the prefiltered default, epipolar and
+/// projective, raymarch N = 16, 64 and 256, and minmax.
+fn methods() -> Vec<FamilyVariant> {
+    let raymarch = |samples| {
+        FamilyVariant::Raymarch(RaymarchVariant {
+            samples,
+            ..RaymarchVariant::default()
+        })
+    };
+    vec![
+        Variant::default().into(),
+        Variant {
+            rectification: Rectification::Projective,
+            ..Variant::default()
+        }
+        .into(),
+        raymarch(16),
+        raymarch(64),
+        raymarch(256),
+        MinmaxVariant::default().into(),
+    ]
 }
 
-impl Method {
-    const ALL: [Method; 6] = [
-        Method::Prefiltered(Rectification::Epipolar),
-        Method::Prefiltered(Rectification::Projective),
-        Method::Raymarch(16),
-        Method::Raymarch(64),
-        Method::Raymarch(256),
-        Method::Minmax,
-    ];
+/// The prefiltered default with a projective rectification, or `None`.
+fn rectification(m: &FamilyVariant) -> Option<Rectification> {
+    match m {
+        FamilyVariant::Prefiltered(v) => Some(v.rectification),
+        _ => None,
+    }
+}
 
-    fn label(self) -> String {
-        match self {
-            Method::Prefiltered(Rectification::Epipolar) => "prefiltered".into(),
-            Method::Prefiltered(Rectification::Projective) => "prefiltered-proj".into(),
-            Method::Raymarch(n) => format!("raymarch-n{n}"),
-            Method::Minmax => "minmax".into(),
-        }
+/// Raymarch's sample count, or `None`.
+fn samples(m: &FamilyVariant) -> Option<u32> {
+    match m {
+        FamilyVariant::Raymarch(v) => Some(v.samples),
+        _ => None,
     }
 }
 
@@ -158,52 +168,52 @@ impl Prepared {
         }
     }
 
-    fn prefiltered_variant(&self, rectification: Rectification) -> Variant {
-        let bases = self.case.bases.unwrap_or(32);
-        Variant {
-            bases,
-            bases_per_thread: bases.min(Variant::default().bases_per_thread),
-            light: self.light(),
-            rectification,
-            ..Variant::default()
+    /// `method` as this case runs it: the case's light, and the case's bases for the
+    /// prefiltered family.
+    fn variant(&self, method: &FamilyVariant) -> FamilyVariant {
+        let mut v = method.with_light(self.light());
+        if let (FamilyVariant::Prefiltered(p), Some(bases)) = (&mut v, self.case.bases) {
+            p.bases = bases;
+            p.bases_per_thread = bases.min(p.bases_per_thread);
         }
+        v
     }
 
-    /// Runs `method` on the GPU (or its CPU mirror without one): the output and, for the
+    /// Runs `method` on the GPU (or its CPU mirrors without one): the output and, for the
     /// families with a frame set-up, the frame report.
     fn run(
         &self,
         ctx: Option<&Context>,
-        method: Method,
+        method: &FamilyVariant,
     ) -> Result<(Image, Option<FrameReport>), String> {
         let [w, h] = self.screen();
+        let variant = self.variant(method);
         let depth = self.case.engine_depth(&self.gbuf);
-        let to_image = |out: Vec<[f32; 4]>| {
-            Image::from_pixels(w, h, out.iter().map(|c| [c[0], c[1], c[2]]).collect())
+        let input = self.frame_input();
+        let Some(ctx) = ctx else {
+            let gbuf = GBuffer {
+                view_depth: depth,
+                ..self.gbuf.clone()
+            };
+            let run = run_family(
+                &variant,
+                &CpuFrame {
+                    scene: &self.case.scene,
+                    bvh: &self.bvh,
+                    gbuf: &gbuf,
+                    shadow_map: &self.sm,
+                    rectified: self.resolutions().rectified,
+                    settings: &input.settings,
+                },
+            )
+            .map_err(|e| e.to_string())?;
+            return Ok((run.output().clone(), run.report().cloned()));
         };
-        match method {
-            Method::Prefiltered(rectification) => {
-                let variant = self.prefiltered_variant(rectification);
-                let Some(ctx) = ctx else {
-                    let gbuf = GBuffer {
-                        view_depth: depth,
-                        ..self.gbuf.clone()
-                    };
-                    let run = run_prefiltered(
-                        &variant,
-                        self.resolutions().rectified,
-                        &self.case.scene,
-                        &self.bvh,
-                        &gbuf,
-                        &self.sm,
-                        &self.frame_input().settings,
-                    )
-                    .map_err(|e| e.to_string())?;
-                    return Ok((run.output, Some(run.frame.report)));
-                };
-                let input = self.frame_input();
+        // A projective frame needs the engine's rasterised rectified map.
+        let rectified = match variant {
+            FamilyVariant::Prefiltered(v) => {
                 let frame = prepare_frame(
-                    &variant,
+                    &v,
                     &self.resolutions(),
                     &input.camera,
                     &input.light,
@@ -212,92 +222,35 @@ impl Prepared {
                     &input.settings,
                 )
                 .map_err(|e| e.to_string())?;
-                let rectified = engine_rectified_map(&self.case.scene, &self.bvh, &frame);
-                let out = run_prefiltered_once(
-                    ctx,
-                    &variant,
-                    self.resolutions(),
-                    &CpuInputs {
-                        frame: input,
-                        depth,
-                        shadow_map: self.sm.depth.clone(),
-                        rectified,
-                        pass_wall_frames: 0,
-                    },
-                )
-                .map_err(|e| e.to_string())?;
-                Ok((to_image(out.output), Some(out.frame.report)))
+                engine_rectified_map(&self.case.scene, &self.bvh, &frame)
             }
-            Method::Raymarch(samples) => {
-                let variant = RaymarchVariant {
-                    samples,
-                    light: self.light(),
-                    ..RaymarchVariant::default()
-                };
-                let Some(ctx) = ctx else {
-                    let gbuf = GBuffer {
-                        view_depth: depth,
-                        ..self.gbuf.clone()
-                    };
-                    let run = run_raymarch(&variant, &self.case.scene, &gbuf, &self.sm)
-                        .map_err(|e| e.to_string())?;
-                    return Ok((run.output, None));
-                };
-                let s = &self.case.scene;
-                let out = run_raymarch_once(
-                    ctx,
-                    &variant,
-                    self.screen(),
-                    &RaymarchInput {
-                        camera: s.camera_desc(),
-                        light: s.light_desc(),
-                        medium: s.medium_desc(),
-                        shadow_map: self.sm.desc(),
-                    },
-                    &depth,
-                    &self.sm.depth,
-                )
-                .map_err(|e| e.to_string())?;
-                Ok((to_image(out.output), None))
-            }
-            Method::Minmax => {
-                let variant = MinmaxVariant {
-                    light: self.light(),
-                };
-                let Some(ctx) = ctx else {
-                    let gbuf = GBuffer {
-                        view_depth: depth,
-                        ..self.gbuf.clone()
-                    };
-                    let run = run_minmax(
-                        &variant,
-                        self.resolutions().rectified,
-                        &gbuf,
-                        &self.case.scene,
-                        &self.sm,
-                        &self.frame_input().settings,
-                    )
-                    .map_err(|e| e.to_string())?;
-                    return Ok((run.output, Some(run.frame.report)));
-                };
-                let out = run_minmax_once(
-                    ctx,
-                    &variant,
-                    self.resolutions(),
-                    &self.frame_input(),
-                    &depth,
-                    &self.sm.depth,
-                )
-                .map_err(|e| e.to_string())?;
-                Ok((to_image(out.output), Some(out.frame.report)))
-            }
-        }
+            _ => None,
+        };
+        let out = run_family_once(
+            ctx,
+            &variant,
+            self.resolutions(),
+            &CpuInputs {
+                frame: input,
+                depth,
+                shadow_map: self.sm.depth.clone(),
+                rectified,
+                pass_wall_frames: 0,
+            },
+        )
+        .map_err(|e| e.to_string())?;
+        let image = Image::from_pixels(
+            w,
+            h,
+            out.output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
+        );
+        Ok((image, out.report))
     }
 }
 
 /// One measured cell of the table.
 struct Cell {
-    method: Method,
+    method: FamilyVariant,
     rel_l1: f64,
     non_finite: usize,
     max_abs: f32,
@@ -308,13 +261,15 @@ fn every_family_survives_every_stress_case() {
     let ctx = gpu();
     let backend = if ctx.is_some() { "GPU" } else { "CPU mirror" };
     let mut failures: Vec<String> = Vec::new();
+    let methods = methods();
+    let labels: Vec<String> = methods.iter().map(FamilyVariant::label).collect();
     let mut table = vec![format!(
         "| group | case | truth max | f16 floor | {} | notes |",
-        Method::ALL.map(Method::label).join(" | ")
+        labels.join(" | ")
     )];
     table.push(format!(
         "|---|---|---|---|{}---|",
-        "---|".repeat(Method::ALL.len())
+        "---|".repeat(methods.len())
     ));
     for case in stress::cases(SCREEN[0], SCREEN[1]) {
         let p = Prepared::new(case);
@@ -347,9 +302,9 @@ fn every_family_survives_every_stress_case() {
         let mut cells = Vec::new();
         let mut reports = Vec::new();
         let mut outputs = Vec::new();
-        for method in Method::ALL {
+        for &method in &methods {
             let trial = format!("stress::{}::{name}", method.label());
-            match p.run(ctx, method) {
+            match p.run(ctx, &method) {
                 Ok((image, report)) => {
                     let e = metrics::compare(&image, &p.truth).expect("same size");
                     let max_abs = image
@@ -369,7 +324,13 @@ fn every_family_survives_every_stress_case() {
                 Err(e) => failures.push(format!("{trial}: run failed: {e}")),
             }
         }
-        let cell = |m: Method| cells.iter().find(|c| c.method == m);
+        let cell = |m: FamilyVariant| cells.iter().find(|c| c.method == m);
+        // The methods the checks below single out.
+        let find = |f: &dyn Fn(&FamilyVariant) -> bool| methods.iter().copied().find(|m| f(m));
+        let epipolar = find(&|m| rectification(m) == Some(Rectification::Epipolar));
+        let projective = find(&|m| rectification(m) == Some(Rectification::Projective));
+        let coarse = find(&|m| samples(m) == Some(16));
+        let fine = find(&|m| samples(m) == Some(256));
         for c in &cells {
             let trial = format!("stress::{}::{name}", c.method.label());
             if c.non_finite > 0 {
@@ -382,16 +343,18 @@ fn every_family_survives_every_stress_case() {
                 ));
             }
             let exception = PROJECTIVE_EXCEPTIONS.iter().find(|e| {
-                e.0 == name && c.method == Method::Prefiltered(Rectification::Projective)
+                e.0 == name && rectification(&c.method) == Some(Rectification::Projective)
             });
             let bar = match c.method {
-                Method::Prefiltered(_) if p.case.group == StressGroup::Pose => {
+                FamilyVariant::Prefiltered(_) if p.case.group == StressGroup::Pose => {
                     Some(exception.map_or(PREFILTERED_POSE_BAR, |e| e.1))
                 }
-                Method::Raymarch(256) if pixels >= RAYMARCH_BAR_MIN_PIXELS => {
+                FamilyVariant::Raymarch(v)
+                    if v.samples == 256 && pixels >= RAYMARCH_BAR_MIN_PIXELS =>
+                {
                     Some(RAYMARCH_256_BAR)
                 }
-                Method::Minmax => Some(MINMAX_BAR),
+                FamilyVariant::Minmax(_) => Some(MINMAX_BAR),
                 _ => None,
             };
             if let Some(bar) = bar
@@ -416,7 +379,7 @@ fn every_family_survives_every_stress_case() {
                 ));
             }
         }
-        if let (Some(a), Some(b)) = (cell(Method::Raymarch(16)), cell(Method::Raymarch(256)))
+        if let (Some(a), Some(b)) = (coarse.and_then(cell), fine.and_then(cell))
             && truth_max > 0.0
             && !(b.rel_l1 < a.rel_l1 || b.rel_l1 < 1e-3)
         {
@@ -427,9 +390,14 @@ fn every_family_survives_every_stress_case() {
             ));
         }
         // The safe paths, from the epipolar variant's report.
-        let report = |m: Method| reports.iter().find(|r| r.0 == m).and_then(|r| r.1.clone());
+        let report = |m: Option<FamilyVariant>| {
+            reports
+                .iter()
+                .find(|r| Some(r.0) == m)
+                .and_then(|r| r.1.clone())
+        };
         let mut notes = Vec::new();
-        if let Some(r) = report(Method::Prefiltered(Rectification::Epipolar)) {
+        if let Some(r) = report(epipolar) {
             let on_screen = r.epipole_on_screen || r.anti_epipole_on_screen;
             if on_screen != r.marched_radius_px.is_some() {
                 failures.push(format!(
@@ -441,7 +409,7 @@ fn every_family_survives_every_stress_case() {
                 notes.push(format!("marched r={px:.1}px"));
             }
         }
-        if let Some(r) = report(Method::Prefiltered(Rectification::Projective)) {
+        if let Some(r) = report(projective) {
             match (&r.fallback, r.rectification) {
                 (Some(f), Rectification::Epipolar) => {
                     let expected = if r.epipole_on_screen {
@@ -459,10 +427,10 @@ fn every_family_survives_every_stress_case() {
                         ));
                     }
                     notes.push(format!("proj -> epipolar: {f}"));
-                    let image = |m: Method| outputs.iter().find(|o| o.0 == m).map(|o| &o.1);
-                    if image(Method::Prefiltered(Rectification::Projective))
-                        != image(Method::Prefiltered(Rectification::Epipolar))
-                    {
+                    let image = |m: Option<FamilyVariant>| {
+                        outputs.iter().find(|o| Some(o.0) == m).map(|o| &o.1)
+                    };
+                    if image(projective) != image(epipolar) {
                         failures.push(format!(
                             "stress::prefiltered-proj::{name}: fell back, yet its output differs from the epipolar variant's"
                         ));
@@ -474,7 +442,7 @@ fn every_family_survives_every_stress_case() {
                 )),
             }
         }
-        let row = Method::ALL
+        let row = methods
             .iter()
             .map(|&m| match cell(m) {
                 Some(c) if c.non_finite > 0 => format!("{} NaN", c.non_finite),

@@ -9,6 +9,7 @@ pub mod common_model;
 pub mod common_prefiltered;
 pub mod common_raymarch;
 pub mod common_shadow;
+pub mod family;
 pub mod interleave_sum;
 pub mod minmax_build;
 pub mod minmax_march;
@@ -25,6 +26,7 @@ use crate::image::Image;
 use crate::projective::rasterise_rectified;
 use crate::scene::Scene;
 use common_prefiltered::{Tex, TexArray};
+pub use family::{CpuFamily, CpuFrame, CpuRun, FamilyRun, run_family};
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_shaderlib::prefiltered::{
     FrameError, FrameSettings, LightKind, PrefilteredFrame, Resolutions, Variant, prepare_frame,

@@ -71,3 +71,17 @@ pub(crate) fn render_march(variant: &MinmaxVariant) -> Result<String, ShaderErro
         source,
     })
 }
+
+impl crate::family::KernelFamily for MinmaxVariant {
+    fn kernel_params(&self) -> Vec<crate::KernelParams> {
+        crate::KernelParams::minmax(*self).to_vec()
+    }
+
+    fn plan(&self) -> crate::plan::Plan {
+        plan::plan(self)
+    }
+
+    fn with_most_passes() -> Self {
+        Self::default()
+    }
+}

@@ -17,3 +17,17 @@ pub use kernels::{
     MAX_REGIONS, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE,
 };
 pub use variant::{LightKind, Rectification, Storage, Variant, VariantError, VisibilityMode};
+
+impl crate::family::KernelFamily for Variant {
+    fn kernel_params(&self) -> Vec<crate::KernelParams> {
+        crate::KernelParams::prefiltered(*self).to_vec()
+    }
+
+    fn plan(&self) -> crate::plan::Plan {
+        plan::plan(self)
+    }
+
+    fn with_most_passes() -> Self {
+        Self::default()
+    }
+}

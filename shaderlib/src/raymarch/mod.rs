@@ -82,3 +82,21 @@ pub(crate) fn render_interleave_sum(variant: &RaymarchVariant) -> Result<String,
             source,
         })
 }
+
+impl crate::family::KernelFamily for RaymarchVariant {
+    fn kernel_params(&self) -> Vec<crate::KernelParams> {
+        crate::KernelParams::raymarch(*self)
+    }
+
+    fn plan(&self) -> crate::plan::Plan {
+        plan::plan(self)
+    }
+
+    /// An interleaved variant: `raymarch` and `interleave_sum`.
+    fn with_most_passes() -> Self {
+        Self {
+            interleave: 2,
+            ..Self::default()
+        }
+    }
+}
