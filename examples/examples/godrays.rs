@@ -1,4 +1,4 @@
-//! Renders a suite scene's light shafts to PNG.
+//! Renders a suite scene's light shafts to PNG: a ground truth, or any kernel family.
 //!
 //! ```text
 //! cargo run --release -p scatter-examples --example godrays -- --scene window --truth exact --out window.png
@@ -8,39 +8,125 @@
 //! it `<stem>.inscatter.png` (in-scattered radiance only, tone-mapped) and
 //! `<stem>.inscatter.pfm` (the same as linear float RGB).
 //!
-//! `--method prefiltered` renders with the prefiltered family (Klehm et al. 2014) instead of
-//! a ground truth, through the CPU mirror of its kernels (the same arithmetic as the GPU
-//! kernels; the conformance suite checks that they agree). `--compare` also renders the
-//! `shadow_map` truth from the same shadow map, prints the error and writes
-//! `<stem>.compare.png`: truth | prefiltered | 4x difference.
+//! `--method prefiltered | raymarch | minmax` (every family of `Family::ALL`) renders with
+//! that family instead of a ground truth, through the CPU mirror of its kernels (the same
+//! arithmetic as the GPU kernels; the conformance suite checks that they agree), or with
+//! `--gpu` through the kernels themselves on `scatter-runtime` (lavapipe when there is no
+//! GPU). `--variant` sets the family's knobs, parsed by `scatter-gen`'s knob parser
+//! (`FamilyCli`, the same messages as `scatter-gen --bases ...`); the light follows the
+//! scene. `--compare` also renders the `shadow_map` truth from the same shadow map, prints
+//! the error and writes `<stem>.compare.png`: truth | family | 4x difference.
+//!
+//! Options that do not apply to the chosen method (`--gpu`, `--compare`, `--variant`,
+//! `--rectified` with `--method truth`; `--truth` with a family; `--rectified` with a
+//! family that has no rectified map; `--frames` and `--pass-wall-frames` without `--gpu`)
+//! are refused with one line and exit code 2, never ignored.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
 
 use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
+use scatter_gen::{Family, FamilyCli, FamilyVariant};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
-use scatter_reference::kernels::{engine_rectified_map, run_prefiltered};
+use scatter_reference::kernels::{engine_rectified_map, run_minmax, run_prefiltered, run_raymarch};
 use scatter_reference::metrics;
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
-use scatter_runtime::{Context, CpuInputs, FrameInput, PrefilteredTimes, run_prefiltered_once};
-use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightKind, Resolutions, Variant, VariantError, prepare_frame,
+use scatter_runtime::textures::upload_r32float;
+use scatter_runtime::{
+    Context, CpuInputs, FamilyPasses, FrameInput, Inputs, MinmaxTimes, PrefilteredTimes,
+    RaymarchInput, RaymarchTimes, run_minmax_once, run_prefiltered_once, run_raymarch_once,
 };
-use std::path::PathBuf;
-use std::process::ExitCode;
-use std::time::Instant;
+use scatter_shaderlib::Kernel;
+use scatter_shaderlib::family::KernelFamily;
+use scatter_shaderlib::prefiltered::variant::printable;
+use scatter_shaderlib::prefiltered::{
+    FrameReport, FrameSettings, LightKind, Resolutions, prepare_frame,
+};
 
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
+/// The rectified map size when `--rectified` is not given.
+const DEFAULT_RECTIFIED: [u32; 2] = [1024, 1024];
+/// Frames timed with `--gpu` when `--frames` is not given.
+const DEFAULT_FRAMES: u32 = 5;
+
+/// Any error of a run (printed as one line after `godrays: `).
+type BoxError = Box<dyn std::error::Error>;
+
+/// The families' names, for help and messages (`minmax | prefiltered | raymarch`).
+fn family_names() -> String {
+    Family::ALL
+        .iter()
+        .map(|f| f.name())
+        .collect::<Vec<_>>()
+        .join(" | ")
+}
+
+/// What renders the in-scattering: a ground truth or a kernel family.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Method {
     /// A ground truth (see `--truth`).
     Truth,
-    /// The prefiltered method (Klehm et al. 2014), CPU mirror of the GPU kernels.
-    Prefiltered,
+    /// A kernel family.
+    Family(Family),
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+fn parse_method(text: &str) -> Result<Method, String> {
+    if text == "truth" {
+        return Ok(Method::Truth);
+    }
+    text.parse().map(Method::Family).map_err(|_| {
+        format!(
+            "method must be truth | {}, got {}",
+            family_names(),
+            printable(text)
+        )
+    })
+}
+
+fn method_help() -> String {
+    let families: Vec<String> = Family::ALL
+        .iter()
+        // The summary's head: the paper and the method's name.
+        .map(|f| format!("`{f}` ({})", f.summary().split(':').next().unwrap_or("")))
+        .collect();
+    format!(
+        "What renders the in-scattering: `truth` (see --truth), or a kernel family through the \
+         CPU mirror of its kernels (with --gpu: the GPU kernels): {} [default: truth]",
+        families.join("; ")
+    )
+}
+
+fn variant_help() -> String {
+    let knobs: Vec<String> = Family::ALL
+        .iter()
+        .map(|&f| {
+            let names: Vec<&str> = f
+                .knobs()
+                .iter()
+                .map(|k| k.name)
+                .filter(|&k| k != "light")
+                .collect();
+            if names.is_empty() {
+                format!("{f}: none")
+            } else {
+                format!("{f}: {}", names.join(", "))
+            }
+        })
+        .collect();
+    format!(
+        "The family's knobs as knob=value pairs, e.g. `bases=64,regions=8` (prefiltered) or \
+         `samples=128,interleave=2` (raymarch); knobs not named keep the paper's defaults, the \
+         light follows the scene (`scatter-gen list` shows allowed values). Knobs: {}",
+        knobs.join("; ")
+    )
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 enum Truth {
     /// Visibility by casting a ray to the light.
     Exact,
@@ -48,9 +134,15 @@ enum Truth {
     ShadowMap,
 }
 
-/// Render a scene of the scatter suite (ground truth of the single-scattering model).
+/// The demo's command line (`about` is `--help`'s headline; without it clap would show the
+/// crate's description).
 #[derive(Parser, Debug)]
-#[command(version, about)]
+#[command(
+    name = "godrays",
+    version,
+    about = "Renders a suite scene's light shafts to PNG: a ground truth, or any kernel family \
+             (CPU mirror, or the GPU kernels with --gpu)"
+)]
 struct Args {
     /// Suite scene: sphere, columns, window, foliage, terrain, spot_grate.
     #[arg(long, value_parser = |s: &str| s.parse::<SceneName>())]
@@ -61,51 +153,183 @@ struct Args {
     /// Medium preset: default, thick, thin.
     #[arg(long, default_value = "default", value_parser = |s: &str| s.parse::<MediumPreset>())]
     medium: MediumPreset,
-    /// What renders the in-scattering.
-    #[arg(long, value_enum, default_value = "truth")]
+    #[arg(long, value_name = "METHOD", help = method_help(), default_value = "truth", hide_default_value = true, value_parser = parse_method)]
     method: Method,
-    /// Which ground truth to render (`--method truth`).
-    #[arg(long, value_enum, default_value = "exact")]
-    truth: Truth,
-    /// Prefiltered variant, e.g. `bases=64,regions=8,visibility=average,storage=rgba16float`
-    /// (knobs not named keep the paper's defaults; the light follows the scene).
-    #[arg(long, default_value = "")]
-    variant: String,
-    /// Rectified map size for `--method prefiltered`, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1024x1024")]
-    rectified: String,
-    /// With `--method prefiltered`: also render the `shadow_map` truth, print the error and
-    /// write `<stem>.compare.png` (truth | prefiltered | 4x difference).
+    /// Which ground truth `--method truth` renders [default: exact].
+    #[arg(long, value_enum)]
+    truth: Option<Truth>,
+    #[arg(long, value_name = "KNOBS", help = variant_help())]
+    variant: Option<String>,
+    /// Rectified map size of a family that has one (prefiltered, minmax), WIDTHxHEIGHT
+    /// [default: 1024x1024].
+    #[arg(long, value_name = "WxH")]
+    rectified: Option<String>,
+    /// With a family: also render the `shadow_map` truth from the same shadow map, print the
+    /// error and write `<stem>.compare.png` (truth | family | 4x difference).
     #[arg(long)]
     compare: bool,
-    /// With `--method prefiltered`: run the GPU kernels through `scatter-runtime` (lavapipe
-    /// when there is no GPU) instead of the CPU mirror, and print GPU time per pass (the
-    /// minimum over `--frames` runs).
+    /// With a family: run its GPU kernels through `scatter-runtime` (lavapipe when there is
+    /// no GPU) instead of the CPU mirror, and print the time per pass.
     #[arg(long)]
     gpu: bool,
-    /// Frames timed with `--gpu` (1..=100).
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100))]
-    frames: u32,
-    /// With `--gpu`: also time each pass submitted on its own and waited for (median of this
-    /// many frames after a warm-up; 0 = off). On lavapipe this wall time is the pass's real
-    /// cost, unlike its timestamps.
-    #[arg(long, default_value_t = 0)]
-    pass_wall_frames: u32,
+    /// With --gpu: frames timed (1..=100); the minimum is printed [default: 5].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100))]
+    frames: Option<u32>,
+    /// With --gpu: also time each pass submitted on its own and waited for (median of this
+    /// many frames after a warm-up; 0 = off). This wall time is a pass's real cost on a CPU
+    /// adapter such as lavapipe, whose timestamps are not usable [default: 0 on a GPU,
+    /// --frames on a CPU adapter].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=100))]
+    pass_wall_frames: Option<u32>,
     /// Image width in pixels (1..=8192).
     #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=8192))]
     width: u32,
     /// Image height in pixels (1..=8192).
     #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(1..=8192))]
     height: u32,
-    /// Shadow-map size for `--truth shadow-map` (1..=16384).
+    /// Shadow-map size for `--truth shadow-map` and every family (1..=16384).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=16384))]
     shadow_map_size: u32,
-    /// Quadrature cells per view ray (16..=65536).
+    /// Quadrature cells per view ray of a truth (--method truth, --compare) (16..=65536).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=65536))]
     segments: u32,
     /// Output PNG (composite).
     #[arg(long)]
     out: PathBuf,
+}
+
+/// What to render, from arguments that have been checked against each other.
+#[derive(Debug, PartialEq)]
+enum Plan {
+    /// A ground truth.
+    Truth(Truth),
+    /// A kernel family.
+    Family(FamilyPlan),
+}
+
+#[derive(Debug, PartialEq)]
+struct FamilyPlan {
+    variant: FamilyVariant,
+    /// The rectified map size; `None` for a family without a rectified map.
+    rectified: Option<[u32; 2]>,
+    compare: bool,
+    gpu: Option<GpuPlan>,
+}
+
+#[derive(Debug, PartialEq)]
+struct GpuPlan {
+    frames: u32,
+    /// `None`: not given (the default depends on the adapter).
+    pass_wall_frames: Option<u32>,
+}
+
+/// Checks the options against the method and each other, and parses `--variant` with the
+/// scene's light. Every refusal is one line naming the option.
+fn check(args: &Args, light: LightKind) -> Result<Plan, String> {
+    let family = match args.method {
+        Method::Truth => {
+            let family_only = [
+                ("--gpu", args.gpu),
+                ("--compare", args.compare),
+                ("--variant", args.variant.is_some()),
+                ("--rectified", args.rectified.is_some()),
+                ("--frames", args.frames.is_some()),
+                ("--pass-wall-frames", args.pass_wall_frames.is_some()),
+            ];
+            if let Some((flag, _)) = family_only.iter().find(|(_, given)| *given) {
+                return Err(format!(
+                    "{flag} applies to a kernel family (--method {}), not to --method truth",
+                    family_names()
+                ));
+            }
+            return Ok(Plan::Truth(args.truth.unwrap_or(Truth::Exact)));
+        }
+        Method::Family(f) => f,
+    };
+    if args.truth.is_some() {
+        return Err(format!(
+            "--truth applies to --method truth, not to --method {family} (--compare always uses \
+             the shadow_map truth)"
+        ));
+    }
+    let variant = parse_variant(family, args.variant.as_deref().unwrap_or(""), light)?;
+    let has_rectified_map = variant
+        .kernel_params()
+        .iter()
+        .any(|k| k.kernel() == Kernel::Rectify);
+    let rectified = match (&args.rectified, has_rectified_map) {
+        (Some(text), true) => Some(parse_size(text)?),
+        (None, true) => Some(DEFAULT_RECTIFIED),
+        (Some(_), false) => {
+            return Err(format!(
+                "--rectified does not apply to --method {family}: it has no rectified map"
+            ));
+        }
+        (None, false) => None,
+    };
+    let gpu = if args.gpu {
+        Some(GpuPlan {
+            frames: args.frames.unwrap_or(DEFAULT_FRAMES),
+            pass_wall_frames: args.pass_wall_frames,
+        })
+    } else {
+        if let Some(flag) = [
+            ("--frames", args.frames.is_some()),
+            ("--pass-wall-frames", args.pass_wall_frames.is_some()),
+        ]
+        .iter()
+        .find_map(|(flag, given)| given.then_some(flag))
+        {
+            return Err(format!(
+                "{flag} applies with --gpu only (the CPU mirror is not timed per pass)"
+            ));
+        }
+        None
+    };
+    Ok(Plan::Family(FamilyPlan {
+        variant,
+        rectified,
+        compare: args.compare,
+        gpu,
+    }))
+}
+
+/// Parses `--variant` (`knob=value` pairs separated by commas) with `scatter-gen`'s knob
+/// parser, the light set from the scene.
+fn parse_variant(family: Family, text: &str, light: LightKind) -> Result<FamilyVariant, String> {
+    let mut knobs = Vec::new();
+    for pair in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (k, v) = pair
+            .split_once('=')
+            .ok_or_else(|| format!("--variant: expected knob=value, got '{}'", printable(pair)))?;
+        let k = k.trim();
+        if k == "light" {
+            return Err(format!(
+                "--variant: the light follows the scene ({light} here); leave `light` out"
+            ));
+        }
+        knobs.push((k.to_owned(), v.trim().to_owned()));
+    }
+    knobs.push(("light".to_owned(), light.to_string()));
+    family
+        .variant(&knobs)
+        .map_err(|e| format!("--variant: {e}"))
+}
+
+fn parse_size(text: &str) -> Result<[u32; 2], String> {
+    let err = || {
+        format!(
+            "--rectified must be WIDTHxHEIGHT with both in 1..=16384, got '{}'",
+            printable(text)
+        )
+    };
+    let (w, h) = text.split_once('x').ok_or_else(err)?;
+    let w: u32 = w.parse().map_err(|_| err())?;
+    let h: u32 = h.parse().map_err(|_| err())?;
+    if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+        return Err(err());
+    }
+    Ok([w, h])
 }
 
 fn main() -> ExitCode {
@@ -119,57 +343,17 @@ fn main() -> ExitCode {
     }
 }
 
-/// Parses `--variant` (`knob=value` pairs separated by commas).
-fn parse_variant(text: &str, light: LightKind) -> Result<Variant, String> {
-    let mut v = Variant {
-        light,
-        ..Variant::default()
-    };
-    for pair in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-        let (k, val) = pair
-            .split_once('=')
-            .ok_or_else(|| format!("--variant: expected knob=value, got '{pair}'"))?;
-        let num = || {
-            val.parse::<u32>()
-                .map_err(|_| format!("--variant: {k} must be a number, got '{val}'"))
-        };
-        match k {
-            "bases" => v.bases = num()?,
-            "bases_per_thread" => v.bases_per_thread = num()?,
-            "regions" => v.regions = num()?,
-            "visibility" => v.visibility = val.parse().map_err(|e: VariantError| e.to_string())?,
-            "storage" => v.storage = val.parse().map_err(|e: VariantError| e.to_string())?,
-            "rectification" => {
-                v.rectification = val.parse().map_err(|e: VariantError| e.to_string())?
-            }
-            _ => {
-                return Err(format!(
-                    "--variant: unknown knob '{k}' (bases, bases_per_thread, regions, visibility, storage, rectification)"
-                ));
-            }
-        }
-    }
-    v.validate().map_err(|e| format!("--variant: {e}"))?;
-    Ok(v)
-}
-
-fn parse_size(text: &str) -> Result<[u32; 2], String> {
-    let err = || format!("--rectified must be WIDTHxHEIGHT with both in 1..=16384, got '{text}'");
-    let (w, h) = text.split_once('x').ok_or_else(err)?;
-    let w: u32 = w.parse().map_err(|_| err())?;
-    let h: u32 = h.parse().map_err(|_| err())?;
-    if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
-        return Err(err());
-    }
-    Ok([w, h])
-}
-
-fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+fn run(args: &Args) -> Result<(), BoxError> {
     if args.out.extension().and_then(|e| e.to_str()) != Some("png") {
         return Err(format!("--out must name a .png file, got {}", args.out.display()).into());
     }
     let scene = suite::scene(args.scene, args.pose, args.medium, args.width, args.height);
     scene.validate()?;
+    let light = match scene.light {
+        scatter_reference::scene::Light::Directional { .. } => LightKind::Directional,
+        scatter_reference::scene::Light::Spot { .. } => LightKind::Spot,
+    };
+    let plan = check(args, light)?;
     let t0 = Instant::now();
     let bvh = Bvh::build(&scene.geometry);
     let gbuf = GBuffer::cast(&scene, &bvh);
@@ -182,11 +366,12 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         args.height,
         t0.elapsed()
     );
-    if args.method == Method::Prefiltered {
-        return run_prefiltered_method(args, &scene, &bvh, &gbuf);
-    }
+    let which = match plan {
+        Plan::Family(p) => return run_family(args, &p, &scene, &bvh, &gbuf),
+        Plan::Truth(which) => which,
+    };
     let sm;
-    let vis = match args.truth {
+    let vis = match which {
         Truth::Exact => Visibility::Exact(&bvh),
         Truth::ShadowMap => {
             let t = Instant::now();
@@ -203,7 +388,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, eta {eta}")?
             .progress_chars("=> "),
     );
-    bar.set_message(format!("truth ({:?})", args.truth));
+    bar.set_message(format!("truth ({which:?})"));
     let settings = TruthSettings {
         segments: args.segments as usize,
         ..TruthSettings::default()
@@ -217,11 +402,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     write_outputs(args, &composite, &inscatter)
 }
 
-fn write_outputs(
-    args: &Args,
-    composite: &Image,
-    inscatter: &Image,
-) -> Result<(), Box<dyn std::error::Error>> {
+fn write_outputs(args: &Args, composite: &Image, inscatter: &Image) -> Result<(), BoxError> {
     let stem = args.out.with_extension("");
     let ins_png = stem.with_extension("inscatter.png");
     let ins_pfm = stem.with_extension("inscatter.pfm");
@@ -237,18 +418,24 @@ fn write_outputs(
     Ok(())
 }
 
-fn run_prefiltered_method(
+/// `WxH screen[, WxH rectified]`.
+fn sizes(gbuf: &GBuffer, rectified: Option<[u32; 2]>) -> String {
+    let mut s = format!("{}x{} screen", gbuf.width, gbuf.height);
+    if let Some([w, h]) = rectified {
+        s.push_str(&format!(", {w}x{h} rectified"));
+    }
+    s
+}
+
+fn run_family(
     args: &Args,
+    plan: &FamilyPlan,
     scene: &Scene,
     bvh: &Bvh,
     gbuf: &GBuffer,
-) -> Result<(), Box<dyn std::error::Error>> {
-    let light = match scene.light {
-        scatter_reference::scene::Light::Directional { .. } => LightKind::Directional,
-        scatter_reference::scene::Light::Spot { .. } => LightKind::Spot,
-    };
-    let variant = parse_variant(&args.variant, light)?;
-    let rectified = parse_size(&args.rectified)?;
+) -> Result<(), BoxError> {
+    let variant = plan.variant;
+    let family = variant.family();
     let t = Instant::now();
     let sm = ShadowMap::build(scene, bvh, args.shadow_map_size)?;
     eprintln!(
@@ -258,22 +445,34 @@ fn run_prefiltered_method(
     );
     let t = Instant::now();
     let settings = FrameSettings::for_screen(args.width, args.height);
-    let output = if args.gpu {
-        run_on_gpu(args, &variant, rectified, scene, bvh, gbuf, &sm, settings)?
-    } else {
-        let run = run_prefiltered(&variant, rectified, scene, bvh, gbuf, &sm, &settings)?;
-        eprintln!(
-            "prefiltered {variant} ({}x{} rectified) on the CPU mirror in {:.2?}; {:?}",
-            rectified[0],
-            rectified[1],
-            t.elapsed(),
-            run.frame.report
-        );
-        run.output
+    let rectified = plan.rectified.unwrap_or(DEFAULT_RECTIFIED);
+    let output = match &plan.gpu {
+        Some(gpu) => run_on_gpu(gpu, plan, scene, bvh, gbuf, &sm, settings)?,
+        None => {
+            let (output, report) = match &variant {
+                FamilyVariant::Prefiltered(v) => {
+                    let run = run_prefiltered(v, rectified, scene, bvh, gbuf, &sm, &settings)?;
+                    (run.output, Some(run.frame.report))
+                }
+                FamilyVariant::Raymarch(v) => (run_raymarch(v, scene, gbuf, &sm)?.output, None),
+                FamilyVariant::Minmax(v) => {
+                    let run = run_minmax(v, rectified, gbuf, scene, &sm, &settings)?;
+                    (run.output, Some(run.frame.report))
+                }
+            };
+            eprintln!(
+                "{family} {} ({}) on the CPU mirror in {:.2?}",
+                variant.id(),
+                sizes(gbuf, plan.rectified),
+                t.elapsed()
+            );
+            print_report(report.as_ref());
+            output
+        }
     };
     let composite = truth::surface_radiance(scene, gbuf, bvh).add(&output)?;
     write_outputs(args, &composite, &output)?;
-    if args.compare {
+    if plan.compare {
         let bar = ProgressBar::new(u64::from(args.height)).with_style(
             ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, eta {eta}")?
                 .progress_chars("=> "),
@@ -289,39 +488,162 @@ fn run_prefiltered_method(
         bar.finish_and_clear();
         let report = metrics::compare(&output, &truth)?;
         println!(
-            "{}: prefiltered {variant} vs shadow_map truth: {report}",
-            scene.name
+            "{}: {family} {} vs shadow_map truth: {report}",
+            scene.name,
+            variant.id()
         );
         let diff = output.abs_diff(&truth, 4.0)?;
         let strip = Image::hstack(&[&truth, &output, &diff])?;
         let path = args.out.with_extension("").with_extension("compare.png");
         strip.write_png(&path, Some(truth.auto_exposure()))?;
         eprintln!(
-            "wrote {} (truth | prefiltered | 4x difference)",
+            "wrote {} (truth | {family} | 4x difference)",
             path.display()
         );
     }
     Ok(())
 }
 
-/// Runs the prefiltered kernels on the GPU `--frames` times; prints the adapter and the
-/// fastest GPU time per pass, returns the last output.
+/// Prints the frame report (epipolar families have one), indented under the run's line.
+fn print_report(report: Option<&FrameReport>) {
+    for line in report.map(describe_report).unwrap_or_default() {
+        eprintln!("  {line}");
+    }
+}
+
+/// The frame report of an epipolar family as a few readable lines.
+fn describe_report(r: &FrameReport) -> Vec<String> {
+    let mut lines = Vec::new();
+    lines.push(match (&r.projective, &r.fallback) {
+        (Some(maps), _) => format!(
+            "rectification: projective (the engine rasterises the rectified map with {} \
+             region matrices; rectify does not run)",
+            maps.matrices.len()
+        ),
+        (None, Some(why)) => {
+            format!("rectification: epipolar, the projective variant fell back: {why}")
+        }
+        (None, None) => format!("rectification: {}", r.rectification),
+    });
+    let on_screen = match (r.epipole_on_screen, r.anti_epipole_on_screen) {
+        (true, true) => Some("epipole and anti-epipole on screen"),
+        (true, false) => Some("epipole on screen"),
+        (false, true) => Some("anti-epipole on screen"),
+        (false, false) => None,
+    };
+    lines.push(match (on_screen, r.marched_radius_px) {
+        (Some(what), Some(px)) => {
+            format!("{what}: pixels within {px:.1} px of it are ray-marched")
+        }
+        (Some(what), None) => format!("{what}: no pixel is ray-marched"),
+        (None, _) => "epipole and anti-epipole off screen: no pixel is ray-marched".to_owned(),
+    });
+    lines.push(format!(
+        "epipolar slices: {}, at most {:.2} px apart along the screen border, {} not on screen",
+        if r.full_circle {
+            "the full circle around the epipole"
+        } else {
+            "a fan"
+        },
+        r.max_slice_gap_px,
+        r.empty_slices
+    ));
+    lines
+}
+
+/// Named times, in pass order.
+type PassTimes = Vec<(&'static str, Duration)>;
+
+/// In a projective frame `rectify` does not run and is left out.
+fn prefiltered_times(t: PrefilteredTimes, projective: bool) -> PassTimes {
+    let mut out = vec![
+        (Kernel::Rectify.name(), t.rectify),
+        (Kernel::Prefilter.name(), t.prefilter),
+        (Kernel::Scatter.name(), t.scatter),
+    ];
+    if projective {
+        out.remove(0);
+    }
+    out
+}
+
+fn raymarch_times(t: RaymarchTimes, interleaved: bool) -> PassTimes {
+    let mut out = vec![(Kernel::Raymarch.name(), t.raymarch)];
+    if interleaved {
+        out.push((Kernel::InterleaveSum.name(), t.interleave_sum));
+    }
+    out
+}
+
+fn minmax_times(t: MinmaxTimes) -> PassTimes {
+    vec![
+        (Kernel::Rectify.name(), t.rectify),
+        (Kernel::MinmaxBuild.name(), t.build),
+        (Kernel::MinmaxMarch.name(), t.march),
+    ]
+}
+
+/// The pass-wise minimum of two frames' times.
+fn min_times(a: Option<PassTimes>, b: PassTimes) -> PassTimes {
+    match a {
+        None => b,
+        Some(a) => a
+            .into_iter()
+            .zip(b)
+            .map(|((name, x), (_, y))| (name, x.min(y)))
+            .collect(),
+    }
+}
+
+/// `rectify 0.123 ms, prefilter ..., total ... ms`.
+fn format_times(t: &PassTimes) -> String {
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let mut parts: Vec<String> = t
+        .iter()
+        .map(|(name, d)| format!("{name} {:.3} ms", ms(*d)))
+        .collect();
+    parts.push(format!(
+        "total {:.3} ms",
+        ms(t.iter().map(|(_, d)| *d).sum())
+    ));
+    parts.join(", ")
+}
+
+/// One GPU frame: output, frame report, wall time, GPU timestamps per pass.
+struct GpuFrame {
+    output: Vec<[f32; 4]>,
+    report: Option<FrameReport>,
+    wall_time: Duration,
+    gpu_times: Option<PassTimes>,
+}
+
+/// Runs one GPU frame; `true` for the last one.
+type FrameRunner<'a> = Box<dyn FnMut(bool) -> Result<GpuFrame, BoxError> + 'a>;
+
+/// Runs the family's GPU kernels `frames` times; prints the adapter, the frame wall time,
+/// the frame report, the GPU time per pass (not on a CPU adapter, whose timestamps are not
+/// usable) and the wall time per pass; returns the last output.
 #[allow(clippy::too_many_arguments, reason = "the demo's inputs")]
 fn run_on_gpu(
-    args: &Args,
-    variant: &Variant,
-    rectified: [u32; 2],
+    gpu: &GpuPlan,
+    plan: &FamilyPlan,
     scene: &Scene,
     bvh: &Bvh,
     gbuf: &GBuffer,
     sm: &ShadowMap,
     settings: FrameSettings,
-) -> Result<Image, Box<dyn std::error::Error>> {
+) -> Result<Image, BoxError> {
     let ctx = Context::new()?;
-    eprintln!("GPU adapter: {}", ctx.report());
+    let adapter = ctx.report();
+    eprintln!("GPU adapter: {adapter}");
+    // On a CPU adapter (lavapipe) the per-pass wall time is the only per-pass cost worth
+    // printing: measure it unless told not to.
+    let pass_wall_frames =
+        gpu.pass_wall_frames
+            .unwrap_or(if adapter.is_cpu() { gpu.frames } else { 0 });
     let res = Resolutions {
         screen: [gbuf.width, gbuf.height],
-        rectified,
+        rectified: plan.rectified.unwrap_or(DEFAULT_RECTIFIED),
     };
     let frame = FrameInput {
         camera: scene.camera_desc(),
@@ -330,81 +652,397 @@ fn run_on_gpu(
         shadow_map: sm.desc(),
         settings,
     };
-    // A projective frame needs the engine's rasterised rectified map (ray cast here).
-    let prepared = prepare_frame(
-        variant,
-        &res,
-        &frame.camera,
-        &frame.light,
-        &frame.medium,
-        &frame.shadow_map,
-        &frame.settings,
-    )?;
-    let inputs = CpuInputs {
-        frame,
-        depth: gbuf.view_depth.clone(),
-        shadow_map: sm.depth.clone(),
-        rectified: engine_rectified_map(scene, bvh, &prepared),
-        pass_wall_frames: args.pass_wall_frames,
-    };
-    let mut best: Option<PrefilteredTimes> = None;
-    let mut last = None;
-    let mut best_wall = std::time::Duration::MAX;
-    for _ in 0..args.frames {
-        let rb = run_prefiltered_once(&ctx, variant, res, &inputs)?;
-        best_wall = best_wall.min(rb.wall_time);
-        if let Some(t) = rb.gpu_times {
-            best = Some(match best {
-                None => t,
-                Some(b) => PrefilteredTimes {
-                    rectify: b.rectify.min(t.rectify),
-                    prefilter: b.prefilter.min(t.prefilter),
-                    scatter: b.scatter.min(t.scatter),
-                },
-            });
+    let variant = plan.variant;
+    let mut pass_walls: Option<PassTimes> = None;
+    let mut run_frame: FrameRunner<'_> = match &variant {
+        FamilyVariant::Prefiltered(v) => {
+            // A projective frame needs the engine's rasterised rectified map (ray cast
+            // here).
+            let prepared = prepare_frame(
+                v,
+                &res,
+                &frame.camera,
+                &frame.light,
+                &frame.medium,
+                &frame.shadow_map,
+                &frame.settings,
+            )?;
+            let mut inputs = CpuInputs {
+                frame,
+                depth: gbuf.view_depth.clone(),
+                shadow_map: sm.depth.clone(),
+                rectified: engine_rectified_map(scene, bvh, &prepared),
+                pass_wall_frames: 0,
+            };
+            let ctx = &ctx;
+            let pass_walls = &mut pass_walls;
+            Box::new(move |last| {
+                // Pass wall times once, in the last frame.
+                inputs.pass_wall_frames = if last { pass_wall_frames } else { 0 };
+                let rb = run_prefiltered_once(ctx, v, res, &inputs)?;
+                let projective = rb.frame.report.projective.is_some();
+                if let Some(t) = rb.pass_wall_times {
+                    *pass_walls = Some(prefiltered_times(t, projective));
+                }
+                Ok(GpuFrame {
+                    output: rb.output,
+                    report: Some(rb.frame.report),
+                    wall_time: rb.wall_time,
+                    gpu_times: rb.gpu_times.map(|t| prefiltered_times(t, projective)),
+                })
+            })
         }
-        last = Some(rb);
+        FamilyVariant::Raymarch(v) => {
+            let input = RaymarchInput::from(&frame);
+            let ctx = &ctx;
+            Box::new(move |_| {
+                let rb =
+                    run_raymarch_once(ctx, v, res.screen, &input, &gbuf.view_depth, &sm.depth)?;
+                Ok(GpuFrame {
+                    output: rb.output,
+                    report: None,
+                    wall_time: rb.wall_time,
+                    gpu_times: rb.gpu_times.map(|t| raymarch_times(t, v.interleaved())),
+                })
+            })
+        }
+        FamilyVariant::Minmax(v) => {
+            let ctx = &ctx;
+            Box::new(move |_| {
+                let rb = run_minmax_once(ctx, v, res, &frame, &gbuf.view_depth, &sm.depth)?;
+                Ok(GpuFrame {
+                    output: rb.output,
+                    report: Some(rb.frame.report),
+                    wall_time: rb.wall_time,
+                    gpu_times: rb.gpu_times.map(minmax_times),
+                })
+            })
+        }
+    };
+    let mut last = None;
+    let mut best_wall = Duration::MAX;
+    let mut best_gpu: Option<PassTimes> = None;
+    for i in 0..gpu.frames {
+        let f = run_frame(i + 1 == gpu.frames)?;
+        best_wall = best_wall.min(f.wall_time);
+        if let Some(t) = f.gpu_times {
+            best_gpu = Some(min_times(best_gpu, t));
+        }
+        last = Some((f.output, f.report));
     }
-    let rb = last.ok_or("no frame ran")?;
-    eprintln!("prefiltered {variant} on the GPU; {:?}", rb.frame.report);
+    drop(run_frame);
+    let (output, report) = last.ok_or("no frame ran")?;
+    if pass_wall_frames > 0 && pass_walls.is_none() {
+        pass_walls = Some(measure_pass_walls(
+            &ctx,
+            &variant,
+            res,
+            &frame,
+            gbuf,
+            sm,
+            pass_wall_frames,
+        )?);
+    }
+    let family = variant.family();
+    let sizes = sizes(gbuf, plan.rectified);
+    eprintln!("{family} {} on the GPU ({sizes})", variant.id());
+    print_report(report.as_ref());
     println!(
         "wall time per frame, submission to mapped readback of every texture (min of {} frames): {:.3} ms",
-        args.frames,
+        gpu.frames,
         best_wall.as_secs_f64() * 1e3
     );
-    match best {
+    match best_gpu {
+        Some(_) if adapter.is_cpu() => println!(
+            "GPU time per pass: not shown: {} is a CPU adapter, and its timestamps are not usable \
+             (they are not ordered after the compute work); the GPU is the CPU, so pass wall time \
+             is the real cost{}",
+            adapter.name,
+            if pass_wall_frames == 0 {
+                " (--pass-wall-frames N measures it)"
+            } else {
+                ""
+            }
+        ),
         Some(t) => println!(
-            "GPU time per pass (min of {} frames, {}x{} screen, {}x{} rectified): rectify {:.3} ms, prefilter {:.3} ms, scatter {:.3} ms, total {:.3} ms",
-            args.frames,
-            gbuf.width,
-            gbuf.height,
-            rectified[0],
-            rectified[1],
-            t.rectify.as_secs_f64() * 1e3,
-            t.prefilter.as_secs_f64() * 1e3,
-            t.scatter.as_secs_f64() * 1e3,
-            t.total().as_secs_f64() * 1e3
+            "GPU time per pass (min of {} frames, {sizes}): {}",
+            gpu.frames,
+            format_times(&t)
         ),
         None => println!("the adapter has no timestamp queries: no GPU times"),
     }
-    if let Some(t) = rb.pass_wall_times {
+    if let Some(t) = pass_walls {
+        let rectification = report
+            .as_ref()
+            .map(|r| format!(", {}", r.rectification))
+            .unwrap_or_default();
         println!(
-            "wall time per pass, each submitted alone (median of {} frames, {}x{} screen, {}x{} rectified, {}): rectify {:.3} ms, prefilter {:.3} ms, scatter {:.3} ms, total {:.3} ms",
-            args.pass_wall_frames,
-            gbuf.width,
-            gbuf.height,
-            rectified[0],
-            rectified[1],
-            rb.frame.report.rectification,
-            t.rectify.as_secs_f64() * 1e3,
-            t.prefilter.as_secs_f64() * 1e3,
-            t.scatter.as_secs_f64() * 1e3,
-            t.total().as_secs_f64() * 1e3
+            "wall time per pass, each submitted alone (median of {pass_wall_frames} frames, {sizes}{rectification}): {}",
+            format_times(&t)
         );
     }
-    Ok(Image::from_pixels(
+    let image = Image::from_pixels(
         gbuf.width,
         gbuf.height,
-        rb.output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
-    ))
+        output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
+    );
+    Ok(image)
+}
+
+/// The wall time of each of the variant's passes submitted on its own (median of `frames`),
+/// through [`FamilyPasses`] (any family whose `run_*_once` does not measure it).
+fn measure_pass_walls(
+    ctx: &Context,
+    variant: &FamilyVariant,
+    res: Resolutions,
+    frame: &FrameInput,
+    gbuf: &GBuffer,
+    sm: &ShadowMap,
+    frames: u32,
+) -> Result<PassTimes, BoxError> {
+    let mut pass = FamilyPasses::new(ctx, variant, res, sm.size)?;
+    pass.prepare(ctx, frame)?;
+    let depth = upload_r32float(
+        ctx,
+        Kernel::Scatter,
+        "godrays depth",
+        res.screen,
+        &gbuf.view_depth,
+    )?;
+    let shadow = upload_r32float(
+        ctx,
+        Kernel::Rectify,
+        "godrays shadow map",
+        [sm.size; 2],
+        &sm.depth,
+    )?;
+    let (dv, sv) = (
+        depth.create_view(&Default::default()),
+        shadow.create_view(&Default::default()),
+    );
+    let inputs = Inputs {
+        depth: &dv,
+        shadow_map: Some(&sv),
+        rectified: None,
+    };
+    Ok(pass
+        .measure_pass_wall_times(ctx, &inputs, frames)?
+        .into_iter()
+        .map(|(kernel, t)| (kernel.name(), t))
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    fn args(extra: &[&str]) -> Args {
+        let mut all = vec!["godrays", "--scene", "sphere", "--out", "x.png"];
+        all.extend_from_slice(extra);
+        Args::try_parse_from(all).unwrap_or_else(|e| panic!("{extra:?}: {e}"))
+    }
+
+    fn refused(extra: &[&str]) -> String {
+        match check(&args(extra), LightKind::Directional) {
+            Ok(p) => panic!("{extra:?} accepted: {p:?}"),
+            Err(e) => {
+                assert!(!e.contains('\n'), "{e}");
+                e
+            }
+        }
+    }
+
+    #[test]
+    fn help_describes_the_demo() {
+        let about = Args::command()
+            .get_about()
+            .map(ToString::to_string)
+            .unwrap_or_default();
+        assert!(
+            about.starts_with("Renders a suite scene's light shafts"),
+            "{about}"
+        );
+        let help = Args::command().render_help().to_string();
+        for f in Family::ALL {
+            assert!(help.contains(&format!("`{f}`")), "{f} missing from --help");
+        }
+    }
+
+    #[test]
+    fn every_family_is_a_method() {
+        assert_eq!(parse_method("truth"), Ok(Method::Truth));
+        for &f in Family::ALL {
+            assert_eq!(parse_method(f.name()), Ok(Method::Family(f)));
+            let Ok(Plan::Family(p)) = check(&args(&["--method", f.name()]), LightKind::Spot) else {
+                panic!("{f}");
+            };
+            assert_eq!(p.variant.family(), f);
+            assert_eq!(p.variant.light(), LightKind::Spot);
+            // The family's defaults with the scene's light.
+            let expected = f
+                .variant(&[("light".into(), "spot".into())])
+                .unwrap_or_else(|e| panic!("{f}: {e}"));
+            assert_eq!(p.variant, expected);
+        }
+        let e = parse_method("prefilter").unwrap_err();
+        assert_eq!(
+            e,
+            "method must be truth | minmax | prefiltered | raymarch, got prefilter"
+        );
+        assert!(
+            Args::try_parse_from([
+                "godrays", "--scene", "sphere", "--out", "x.png", "--method", "raytrace"
+            ])
+            .is_err()
+        );
+    }
+
+    #[test]
+    fn truth_refuses_family_options() {
+        let to = "applies to a kernel family (--method minmax | prefiltered | raymarch), not to --method truth";
+        assert_eq!(refused(&["--gpu"]), format!("--gpu {to}"));
+        assert_eq!(refused(&["--compare"]), format!("--compare {to}"));
+        assert_eq!(
+            refused(&["--variant", "bases=64"]),
+            format!("--variant {to}")
+        );
+        assert_eq!(
+            refused(&["--variant", "bases=30"]),
+            format!("--variant {to}")
+        );
+        assert_eq!(
+            refused(&["--rectified", "512x512"]),
+            format!("--rectified {to}")
+        );
+        assert_eq!(refused(&["--frames", "2"]), format!("--frames {to}"));
+        assert_eq!(
+            refused(&["--method", "truth", "--pass-wall-frames", "2"]),
+            format!("--pass-wall-frames {to}")
+        );
+        assert_eq!(
+            check(&args(&["--truth", "shadow-map"]), LightKind::Directional),
+            Ok(Plan::Truth(Truth::ShadowMap))
+        );
+        assert_eq!(
+            check(&args(&[]), LightKind::Directional),
+            Ok(Plan::Truth(Truth::Exact))
+        );
+    }
+
+    #[test]
+    fn families_refuse_what_does_not_apply() {
+        let e = refused(&["--method", "raymarch", "--truth", "exact"]);
+        assert!(e.starts_with("--truth applies to --method truth"), "{e}");
+        assert_eq!(
+            refused(&["--method", "raymarch", "--rectified", "512x512"]),
+            "--rectified does not apply to --method raymarch: it has no rectified map"
+        );
+        assert_eq!(
+            refused(&["--method", "minmax", "--frames", "3"]),
+            "--frames applies with --gpu only (the CPU mirror is not timed per pass)"
+        );
+        assert_eq!(
+            refused(&["--method", "prefiltered", "--rectified", "0x4"]),
+            "--rectified must be WIDTHxHEIGHT with both in 1..=16384, got '0x4'"
+        );
+        let Ok(Plan::Family(p)) = check(
+            &args(&[
+                "--method",
+                "minmax",
+                "--gpu",
+                "--rectified",
+                "256x128",
+                "--compare",
+            ]),
+            LightKind::Directional,
+        ) else {
+            panic!("minmax --gpu");
+        };
+        assert_eq!(p.rectified, Some([256, 128]));
+        assert!(p.compare);
+        assert_eq!(
+            p.gpu,
+            Some(GpuPlan {
+                frames: DEFAULT_FRAMES,
+                pass_wall_frames: None
+            })
+        );
+    }
+
+    #[test]
+    fn invalid_variants_are_refused_for_every_family() {
+        let cases = [
+            (
+                "prefiltered",
+                "bases=30",
+                "--variant: bases must be a multiple of 4 in 4..=128, got 30",
+            ),
+            (
+                "prefiltered",
+                "regions=9",
+                "--variant: regions must be in 1..=8, got 9",
+            ),
+            (
+                "prefiltered",
+                "bases",
+                "--variant: expected knob=value, got 'bases'",
+            ),
+            (
+                "raymarch",
+                "samples=3",
+                "--variant: samples must be in 4..=1024 and a multiple of interleave^2 = 1 (every pixel class gets the same number of samples), got 3",
+            ),
+            (
+                "raymarch",
+                "jitter=maybe",
+                "--variant: jitter must be true | false, got maybe",
+            ),
+            (
+                "minmax",
+                "light=spot",
+                "--variant: the light follows the scene (directional here); leave `light` out",
+            ),
+        ];
+        for (method, variant, message) in cases {
+            assert_eq!(
+                refused(&["--method", method, "--variant", variant]),
+                message
+            );
+        }
+        // A knob of another family names the family's own knobs.
+        let e = refused(&["--method", "minmax", "--variant", "bases=32"]);
+        assert!(
+            e.starts_with("--variant: knob `bases` does not apply to family minmax"),
+            "{e}"
+        );
+        let e = refused(&["--method", "raymarch", "--variant", "regions=3"]);
+        assert!(e.contains("does not apply to family raymarch"), "{e}");
+    }
+
+    #[test]
+    fn the_prefiltered_variant_is_the_one_the_old_parser_made() {
+        let Ok(Plan::Family(p)) = check(
+            &args(&[
+                "--method",
+                "prefiltered",
+                "--variant",
+                "bases=64, regions=8,visibility=average,storage=rgba16float,rectification=projective",
+            ]),
+            LightKind::Spot,
+        ) else {
+            panic!("prefiltered");
+        };
+        let expected = scatter_shaderlib::prefiltered::Variant {
+            bases: 64,
+            regions: 8,
+            visibility: "average".parse().unwrap_or_else(|e| panic!("{e}")),
+            storage: "rgba16float".parse().unwrap_or_else(|e| panic!("{e}")),
+            rectification: "projective".parse().unwrap_or_else(|e| panic!("{e}")),
+            light: LightKind::Spot,
+            ..Default::default()
+        };
+        assert_eq!(p.variant, FamilyVariant::Prefiltered(expected));
+        assert_eq!(p.rectified, Some(DEFAULT_RECTIFIED));
+    }
 }

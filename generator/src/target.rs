@@ -93,11 +93,12 @@ impl Target {
         }
     }
 
-    /// Parses a comma-separated list, deduplicated, in [`Target::ALL`] order.
+    /// Parses a comma-separated list (or several), sorted in [`Target::ALL`] order.
     ///
     /// # Errors
     ///
-    /// [`GenError::Usage`] naming the unknown target and the allowed ones.
+    /// [`GenError::Usage`] naming the unknown target and the allowed ones, or the target
+    /// named twice (`wgsl,wgsl` is a slip, not a request).
     pub fn parse_list<S: AsRef<str>>(names: &[S]) -> Result<Vec<Target>, GenError> {
         let mut out = Vec::new();
         for name in names {
@@ -115,9 +116,12 @@ impl Target {
                             scatter_shaderlib::prefiltered::variant::printable(part)
                         ))
                     })?;
-                if !out.contains(&t) {
-                    out.push(t);
+                if out.contains(&t) {
+                    return Err(GenError::Usage(format!(
+                        "target {t} is named twice: name each target once"
+                    )));
                 }
+                out.push(t);
             }
         }
         out.sort();

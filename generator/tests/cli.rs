@@ -69,6 +69,14 @@ fn bad_knobs_exit_2_with_one_line_and_write_nothing() {
             "target must be wgsl | glsl | spirv | hlsl | msl, got dxil",
         ),
         (
+            &["--target", "wgsl,wgsl"],
+            "target wgsl is named twice: name each target once",
+        ),
+        (
+            &["--target", "spirv", "--target", "glsl,spirv"],
+            "target spirv is named twice: name each target once",
+        ),
+        (
             &["--family", "raytrace"],
             "family must be minmax | prefiltered | raymarch, got raytrace",
         ),
@@ -281,7 +289,7 @@ fn config_emits_exactly_its_variants() {
     fs::write(
         &config,
         "targets = [\"wgsl\", \"spirv\"]\n\n[[variant]]\nlight = \"directional\"\n\n\
-         [[variant]]\nlight = \"spot\"\nbases = 16\nregions = 1\n\n[[variant]]\nlight = \"directional\"\n",
+         [[variant]]\nlight = \"spot\"\nbases = 16\nregions = 1\n",
     )
     .unwrap_or_else(|e| panic!("{e}"));
     let out = dir.join("shaders");
@@ -290,7 +298,7 @@ fn config_emits_exactly_its_variants() {
     let r = scatter_gen(&["--config", c, "--out", o]);
     assert!(r.status.success(), "{:?}", text(&r));
     let names: Vec<_> = files(&out).into_iter().map(|f| f.0).collect();
-    // 2 distinct variants x 3 kernels x 2 targets + manifest + C header + Rust module.
+    // 2 variants x 3 kernels x 2 targets + manifest + C header + Rust module.
     assert_eq!(names.len(), 2 * 3 * 2 + 3, "{names:?}");
     let spot = "m16-t8-r1-weighted-spot-rgba8unorm-epipolar";
     for k in ["rectify", "prefilter", "scatter"] {
@@ -318,6 +326,44 @@ fn config_emits_exactly_its_variants() {
         line.contains("variants.toml: variant 2: regions must be in 1..=8, got 12"),
         "{line}"
     );
+    // Slips refused with one line naming the file and the table or knob: the same variant
+    // twice, a target twice, a number or boolean written as a string.
+    let bad: &[(&str, &str)] = &[
+        (
+            "[[variant]]\nlight = \"spot\"\n[[variant]]\nlight = \"spot\"\nregions = 3\n",
+            "variants.toml: variant 2: same variant as variant 1 \
+             (prefiltered::m32-t8-r3-weighted-spot-rgba8unorm-epipolar): list each variant once",
+        ),
+        (
+            "targets = [\"wgsl\", \"wgsl\"]\n[[variant]]\n",
+            "variants.toml: target wgsl is named twice: name each target once",
+        ),
+        (
+            "[[variant]]\nbases = \"32\"\n",
+            "variants.toml: variant 1: bases must be an integer, got the string \"32\" \
+             (write bases = 32, without quotes)",
+        ),
+        (
+            "[[variant]]\n[[variant]]\nregions = \"3\"\n",
+            "variants.toml: variant 2: regions must be an integer, got the string \"3\" \
+             (write regions = 3, without quotes)",
+        ),
+        (
+            "[[variant]]\nfamily = \"raymarch\"\njitter = \"true\"\n",
+            "variants.toml: variant 1: jitter must be a boolean (true | false), got the string \
+             \"true\" (write jitter = true, without quotes)",
+        ),
+    ];
+    let before = files(&out);
+    for (text, message) in bad {
+        fs::write(&config, text).unwrap_or_else(|e| panic!("{e}"));
+        let line = fails(&["--config", c, "--out", o], 2);
+        assert!(
+            line.starts_with("error: ") && line.ends_with(message),
+            "{line}"
+        );
+        assert!(files(&out) == before, "{text:?} changed {}", out.display());
+    }
     // Knob flags cannot be mixed with --config.
     let line = fails(&["--config", c, "--bases", "16", "--out", o], 2);
     assert!(line.contains("--config"), "{line}");

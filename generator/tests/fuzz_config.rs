@@ -17,7 +17,7 @@ use std::time::Instant;
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
-use scatter_gen::family::FamilyVariant;
+use scatter_gen::family::{FamilyVariant, KnobType};
 use scatter_gen::{Family, FamilyCli, GenError, Request, Target, config, generate, output};
 use scatter_shaderlib::prefiltered::variant::printable;
 use scatter_shaderlib::prefiltered::{LightKind, Rectification, Storage, Variant, VisibilityMode};
@@ -479,6 +479,8 @@ enum Fault {
     WrongType(String, String),
     /// A knob of the table's family set to a bad value.
     BadValue(String, String),
+    /// An integer or boolean knob set to a valid value in quotes (`bases = "32"`).
+    Quoted(String, String),
     /// `family` set to something that is not a family.
     BadFamily(String),
     /// A top-level key that is not `targets` or `variant`.
@@ -501,7 +503,7 @@ fn valid_value(name: &str, pick: usize) -> String {
         "rectification" => &["\"epipolar\"", "\"projective\""],
         "samples" => &["64", "128"],
         "interleave" => &["1", "2", "4"],
-        "jitter" => &["true", "false", "\"on\""],
+        "jitter" => &["true", "false"],
         _ => &["1"],
     };
     options[pick % options.len()].to_owned()
@@ -541,7 +543,7 @@ fn config_with_one_fault() {
                 1..4,
             ),
             any::<prop::sample::Index>(),
-            0..7u32,
+            0..8u32,
             any::<prop::sample::Index>(),
             prop_oneof!["[a-z_]{1,10}", any::<String>()],
             prop::sample::select(vec![
@@ -556,7 +558,8 @@ fn config_with_one_fault() {
             let i = at.index(tables.len());
             let (family, _) = &tables[i];
             let knobs = family.knobs();
-            let knob = knobs[pick.index(knobs.len())].name;
+            let info = &knobs[pick.index(knobs.len())];
+            let knob = info.name;
             // A junk name that is no knob or key of anything.
             let junk = format!("x_{junk}");
             let fault = match kind {
@@ -566,6 +569,9 @@ fn config_with_one_fault() {
                 3 => Fault::BadFamily(junk),
                 4 => Fault::TopLevel(junk),
                 5 => Fault::BadTarget(junk),
+                6 if info.value_type != KnobType::Name => {
+                    Fault::Quoted(knob.to_owned(), format!("\"{}\"", valid_value(knob, 0)))
+                }
                 _ => Fault::None,
             };
             // Minmax's only knob has no bad number form: every bad value is a bad name.
@@ -576,7 +582,10 @@ fn config_with_one_fault() {
             if let Fault::BadTarget(t) = &fault {
                 text.push_str(&format!("targets = [\"wgsl\", {}]\n", toml_string(t)));
             }
+            // Each table's text, to find the variants that repeat an earlier one.
+            let mut table_texts = Vec::new();
             for (j, (family, picks)) in tables.iter().enumerate() {
+                let start = text.len();
                 text.push_str("[[variant]]\n");
                 if j == i
                     && let Fault::BadFamily(f) = &fault
@@ -591,7 +600,7 @@ fn config_with_one_fault() {
                     let k = knobs[p.index(knobs.len())].name;
                     if used.contains(&k)
                         || (j == i
-                            && matches!(&fault, Fault::WrongType(n, _) | Fault::BadValue(n, _) if n == k))
+                            && matches!(&fault, Fault::WrongType(n, _) | Fault::BadValue(n, _) | Fault::Quoted(n, _) if n == k))
                     {
                         continue;
                     }
@@ -604,15 +613,46 @@ fn config_with_one_fault() {
                         Fault::UnknownKnob(k) => {
                             text.push_str(&format!("{} = 1\n", toml_quote(k)));
                         }
-                        Fault::WrongType(k, v) | Fault::BadValue(k, v) => {
+                        Fault::WrongType(k, v) | Fault::BadValue(k, v) | Fault::Quoted(k, v) => {
                             text.push_str(&format!("{k} = {v}\n"));
                         }
                         _ => {}
                     }
                 }
+                table_texts.push(text[start..].to_owned());
             }
+            // Without a fault, a table that resolves to the same variant as an earlier one
+            // is the only thing refused (naming both tables).
+            let repeat = if matches!(fault, Fault::None) {
+                let ids: Vec<String> = table_texts
+                    .iter()
+                    .map(|t| match config::parse(t) {
+                        Ok(c) => c.variants[0].to_string(),
+                        Err(m) => format!("invalid: {m}"),
+                    })
+                    .collect();
+                (1..ids.len())
+                    .find_map(|j| ids[..j].iter().position(|id| *id == ids[j]).map(|i| (i, j)))
+            } else {
+                None
+            };
             let result = config::parse(&text);
             tally(result.is_ok());
+            if let Some((first, again)) = repeat {
+                let m = result.err().unwrap_or_default();
+                prop_assert!(
+                    m.starts_with(&format!(
+                        "variant {}: same variant as variant {}",
+                        again + 1,
+                        first + 1
+                    )),
+                    "tables {} and {} repeat a variant: {m:?}\n{text}",
+                    first + 1,
+                    again + 1
+                );
+                one_line(&m)?;
+                return Ok(());
+            }
             let m = match result {
                 Ok(c) if matches!(fault, Fault::None) => {
                     prop_assert_eq!(c.variants.len(), tables.len());
@@ -652,6 +692,10 @@ fn config_with_one_fault() {
                     vec![format!("variant {}:", i + 1), k]
                 }
                 Fault::BadFamily(_) => vec![format!("variant {}:", i + 1), "family".to_owned()],
+                Fault::Quoted(k, _) => vec![
+                    format!("variant {}: {k} must be", i + 1),
+                    "without quotes".to_owned(),
+                ],
                 Fault::TopLevel(k) => vec![printable(k).into_owned()],
                 Fault::BadTarget(_) => vec!["target".to_owned()],
                 Fault::None => vec![],

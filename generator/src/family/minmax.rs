@@ -5,7 +5,7 @@
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::LightKind;
 
-use super::KnobInfo;
+use super::{KnobInfo, KnobType};
 use crate::GenError;
 
 /// The knobs of [`MinmaxVariant`], defaults from [`MinmaxVariant::default`].
@@ -17,6 +17,7 @@ pub fn knobs() -> Vec<KnobInfo> {
         help: "light type the kernels are compiled for",
         allowed: LightKind::ALLOWED.trim_end().replace(' ', " | "),
         default: d.light.to_string(),
+        value_type: KnobType::Name,
     }]
 }
 

@@ -37,6 +37,32 @@ pub struct KnobInfo {
     pub allowed: String,
     /// The default (the paper's choice).
     pub default: String,
+    /// The TOML type of its value in a config file.
+    pub value_type: KnobType,
+}
+
+/// The TOML type a knob's value must have in a config file (`bases = 32`, `jitter = true`,
+/// `light = "spot"`); on the command line every value is text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KnobType {
+    /// A whole number.
+    Integer,
+    /// `true` or `false`.
+    Boolean,
+    /// A name, as a string.
+    Name,
+}
+
+impl KnobType {
+    /// The type in words, as a config error names it (`an integer`).
+    pub const fn describe(self) -> &'static str {
+        match self {
+            Self::Integer => "an integer",
+            Self::Boolean => "a boolean",
+            Self::Name => "a string",
+        }
+    }
 }
 
 impl KnobInfo {

@@ -6,7 +6,7 @@ use scatter_shaderlib::prefiltered::{
     LightKind, Rectification, Storage, Variant, VariantError, VisibilityMode,
 };
 
-use super::KnobInfo;
+use super::{KnobInfo, KnobType};
 use crate::GenError;
 
 /// Allowed `bases`, in the words of [`Variant::validate`].
@@ -30,6 +30,7 @@ pub fn knobs() -> Vec<KnobInfo> {
             help: "Fourier bases M (M/2 frequencies, sine and cosine)",
             allowed: BASES_ALLOWED.into(),
             default: d.bases.to_string(),
+            value_type: KnobType::Integer,
         },
         KnobInfo {
             name: "bases_per_thread",
@@ -38,6 +39,7 @@ pub fn knobs() -> Vec<KnobInfo> {
                    bases / bases_per_thread)",
             allowed: BASES_PER_THREAD_ALLOWED.into(),
             default: d.bases_per_thread.to_string(),
+            value_type: KnobType::Integer,
         },
         KnobInfo {
             name: "regions",
@@ -45,6 +47,7 @@ pub fn knobs() -> Vec<KnobInfo> {
             help: "independent prefix regions per rectified row (Table 1)",
             allowed: REGIONS_ALLOWED.into(),
             default: d.regions.to_string(),
+            value_type: KnobType::Integer,
         },
         KnobInfo {
             name: "visibility",
@@ -53,6 +56,7 @@ pub fn knobs() -> Vec<KnobInfo> {
                    (Eq. 11/12)",
             allowed: enum_allowed(VisibilityMode::ALLOWED),
             default: d.visibility.to_string(),
+            value_type: KnobType::Name,
         },
         KnobInfo {
             name: "light",
@@ -60,6 +64,7 @@ pub fn knobs() -> Vec<KnobInfo> {
             help: "light type the kernels are compiled for",
             allowed: enum_allowed(LightKind::ALLOWED),
             default: d.light.to_string(),
+            value_type: KnobType::Name,
         },
         KnobInfo {
             name: "storage",
@@ -67,6 +72,7 @@ pub fn knobs() -> Vec<KnobInfo> {
             help: "texture format of the filtered bases (rgba32float needs float32-filterable)",
             allowed: enum_allowed(Storage::ALLOWED),
             default: d.storage.to_string(),
+            value_type: KnobType::Name,
         },
         KnobInfo {
             name: "rectification",
@@ -74,6 +80,7 @@ pub fn knobs() -> Vec<KnobInfo> {
             help: "how the standard shadow map becomes a rectified one (Sec. 4)",
             allowed: enum_allowed(Rectification::ALLOWED),
             default: d.rectification.to_string(),
+            value_type: KnobType::Name,
         },
     ]
 }

@@ -5,7 +5,7 @@
 use scatter_shaderlib::prefiltered::{LightKind, VariantError};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
-use super::KnobInfo;
+use super::{KnobInfo, KnobType};
 use crate::GenError;
 
 /// Allowed `samples`.
@@ -25,6 +25,7 @@ pub fn knobs() -> Vec<KnobInfo> {
             help: "cells per view ray, one shadow-map sample each",
             allowed: SAMPLES_ALLOWED.into(),
             default: d.samples.to_string(),
+            value_type: KnobType::Integer,
         },
         KnobInfo {
             name: "interleave",
@@ -33,6 +34,7 @@ pub fn knobs() -> Vec<KnobInfo> {
                    samples and a separable sum filter adds them (1 = off)",
             allowed: INTERLEAVE_ALLOWED.into(),
             default: d.interleave.to_string(),
+            value_type: KnobType::Integer,
         },
         KnobInfo {
             name: "jitter",
@@ -40,6 +42,7 @@ pub fn knobs() -> Vec<KnobInfo> {
             help: "per-pixel jitter of the sample positions inside their cells",
             allowed: JITTER_ALLOWED.into(),
             default: d.jitter.to_string(),
+            value_type: KnobType::Boolean,
         },
         KnobInfo {
             name: "light",
@@ -47,6 +50,7 @@ pub fn knobs() -> Vec<KnobInfo> {
             help: "light type the kernels are compiled for",
             allowed: LightKind::ALLOWED.trim_end().replace(' ', " | "),
             default: d.light.to_string(),
+            value_type: KnobType::Name,
         },
     ]
 }
