@@ -32,7 +32,7 @@ use scatter_gen::{Family, FamilyCli, FamilyVariant};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
-use scatter_reference::kernels::{engine_rectified_map, run_minmax, run_prefiltered, run_raymarch};
+use scatter_reference::kernels::{CpuFrame, CpuRun, engine_rectified_map};
 use scatter_reference::metrics;
 use scatter_reference::scene::Scene;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
@@ -449,17 +449,18 @@ fn run_family(
     let output = match &plan.gpu {
         Some(gpu) => run_on_gpu(gpu, plan, scene, bvh, gbuf, &sm, settings)?,
         None => {
-            let (output, report) = match &variant {
-                FamilyVariant::Prefiltered(v) => {
-                    let run = run_prefiltered(v, rectified, scene, bvh, gbuf, &sm, &settings)?;
-                    (run.output, Some(run.frame.report))
-                }
-                FamilyVariant::Raymarch(v) => (run_raymarch(v, scene, gbuf, &sm)?.output, None),
-                FamilyVariant::Minmax(v) => {
-                    let run = run_minmax(v, rectified, gbuf, scene, &sm, &settings)?;
-                    (run.output, Some(run.frame.report))
-                }
-            };
+            let run = scatter_reference::kernels::run_family(
+                &variant,
+                &CpuFrame {
+                    scene,
+                    bvh,
+                    gbuf,
+                    shadow_map: &sm,
+                    rectified,
+                    settings: &settings,
+                },
+            )?;
+            let (output, report) = (run.output().clone(), run.report().cloned());
             eprintln!(
                 "{family} {} ({}) on the CPU mirror in {:.2?}",
                 variant.id(),
