@@ -9,8 +9,8 @@
 //! | pass | bindings | dispatch |
 //! |---|---|---|
 //! | `rectify` | 0 uniform `Frame`, 1 slices, 2 shadow map r32float, 3 rectified r32float (storage, write) | `ceil(Wr/8) x ceil(Hr/8) x 1` |
-//! | `prefilter` | 0, 1, 2 rectified r32float, 3 filtered bases (storage array, write, the variant's format) | `ceil(Hr/64) x regions x bases/bases_per_thread` |
-//! | `scatter` | 0, 1, 2 depth r32float, 3 shadow map r32float, 4 filtered bases (sampled array), 5 linear sampler, 6 output rgba16float (storage, write) | `ceil(W/8) x ceil(H/8) x 1` |
+//! | `prefilter` | 0, 1, 2 rectified r32float, 3 filtered bases (storage array, write, the variant's format), 4 bounds rg32float (storage, write) | `ceil(Hr/64) x regions x bases/bases_per_thread` |
+//! | `scatter` | 0, 1, 2 depth r32float, 3 shadow map r32float, 4 filtered bases (sampled array), 5 linear sampler, 6 output rgba16float (storage, write), 7 bounds rg32float | `ceil(W/8) x ceil(H/8) x 1` |
 //!
 //! The sampler clamps along rows (u) and wraps across slices (v) when the slices go round the
 //! full circle (`FrameUniforms::anti_epipole[3] > 0.5`), else clamps: [`Prefiltered`] keeps both
@@ -123,6 +123,7 @@ pub struct Prefiltered {
     filtered: wgpu::Texture,
     /// `D2Array` view (also for one layer).
     filtered_view: wgpu::TextureView,
+    bounds: wgpu::Texture,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
     frame: Option<PrefilteredFrame>,
@@ -229,6 +230,7 @@ impl Prefiltered {
         )?;
         let (rectified, rectified_view) = exec.texture("rectified")?;
         let (filtered, filtered_view) = exec.texture("filtered")?;
+        let (bounds, _) = exec.texture("bounds")?;
         let (output, output_view) = exec.texture("output")?;
         Ok(Self {
             device: device.clone(),
@@ -241,6 +243,7 @@ impl Prefiltered {
             rectified_view: rectified_view.clone(),
             filtered: filtered.clone(),
             filtered_view: filtered_view.clone(),
+            bounds: bounds.clone(),
             output: output.clone(),
             output_view: output_view.clone(),
             exec,
@@ -479,6 +482,12 @@ impl Prefiltered {
         &self.filtered
     }
 
+    /// The region-prefix depth bounds `prefilter` writes beside the filtered bases
+    /// (`Wr x Hr`, rg32float: min, max).
+    pub fn bounds_texture(&self) -> &wgpu::Texture {
+        &self.bounds
+    }
+
     /// A `D2Array` view of [`Self::filtered_texture`].
     pub fn filtered_view(&self) -> &wgpu::TextureView {
         &self.filtered_view
@@ -526,6 +535,8 @@ pub struct PrefilteredReadback {
     /// Filtered bases, `Wr * Hr * bases/4` texels indexed `(layer * Hr + y) * Wr + x`,
     /// converted from the storage format to f32 (values in [0, 1]).
     pub filtered: Vec<[f32; 4]>,
+    /// Region-prefix depth bounds (min, max) per rectified texel, row-major.
+    pub bounds: Vec<[f32; 2]>,
     /// GPU time per pass, when the device has timestamps.
     pub gpu_times: Option<PrefilteredTimes>,
     /// Median wall time per pass submitted on its own, when
@@ -595,6 +606,7 @@ pub fn run_prefiltered_once(
         storage_texel_bytes(variant.storage),
         PREFILTER,
     )?;
+    let bounds = Readback::encode(device, &mut encoder, pass.bounds_texture(), 8, PREFILTER)?;
     let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, SCATTER)?;
     let start = Instant::now();
     ctx.queue().submit([encoder.finish()]);
@@ -609,6 +621,16 @@ pub fn run_prefiltered_once(
         .read(ctx, PREFILTER)?
         .chunks_exact(storage_texel_bytes(variant.storage) as usize)
         .map(|t| decode_rgba(t, variant.storage))
+        .collect();
+    let bounds = bounds
+        .read(ctx, PREFILTER)?
+        .chunks_exact(8)
+        .map(|t| {
+            [
+                f32::from_le_bytes([t[0], t[1], t[2], t[3]]),
+                f32::from_le_bytes([t[4], t[5], t[6], t[7]]),
+            ]
+        })
         .collect();
     let output = output
         .read(ctx, SCATTER)?
@@ -639,6 +661,7 @@ pub fn run_prefiltered_once(
         output,
         rectified,
         filtered,
+        bounds,
         gpu_times,
         pass_wall_times,
         wall_time,

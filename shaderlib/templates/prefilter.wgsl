@@ -6,7 +6,9 @@
 // {{ bases_per_thread }} bases of layers t * {{ layers_per_thread }} .. (t + 1) * {{ layers_per_thread }}, four bases packed per vec4.
 // Each region restarts the running mean. Stored per texel: the normalised weighted mean
 // F_k = sum w_i B_k(d_i) / sum w_i over the region up to the texel, mapped to [0, 1] as
-// F / 2 + 0.5 in {{ storage }}.
+// F / 2 + 0.5 in {{ storage }}. Thread 0 of a row-region also stores the least and the
+// greatest depth over the region up to the texel (`bounds`): where a ray's depth lies outside
+// them, scatter knows the region's visibility exactly and skips the Fourier estimate.
 {%- if projective %}
 //
 // Projective variant: in a projective frame (frame.proj.x = 1) `rectified` is the engine's
@@ -21,8 +23,9 @@
 // | 1       | slices    | var<storage, read> array<vec4<f32>>             | read         |
 // | 2       | rectified | texture_2d<f32> (r32float)                      | textureLoad  |
 // | 3       | filtered  | texture_storage_2d_array<FORMAT, write>         | textureStore |
+// | 4       | bounds    | texture_storage_2d<rg32float, write>            | textureStore |
 // filtered: FORMAT = {{ storage }}; Wr x Hr x {{ layers }} layers (bases / 4), Wr x Hr = the rectified
-// size (frame.sizes.zw).
+// size (frame.sizes.zw). bounds: Wr x Hr, (min, max) of the region's depths up to the texel.
 //
 // Dispatch: (ceil(Hr / 64), {{ regions }}, {{ threads_per_row_region }}) workgroups of (64, 1, 1);
 // invocation id x = row, y = region, z = thread.
@@ -36,6 +39,7 @@
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
 @group(0) @binding(2) var rectified: texture_2d<f32>;
 @group(0) @binding(3) var filtered: texture_storage_2d_array<{{ storage }}, write>;
+@group(0) @binding(4) var bounds: texture_storage_2d<rg32float, write>;
 
 // Independent prefix regions per row.
 const REGIONS: u32 = {{ regions }}u;
@@ -63,6 +67,8 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     let end = region_start(region + 1u, REGIONS, width, spot);
     var acc: array<vec4<f32>, {{ layers_per_thread }}>;
     var wsum = 0.0;
+    var lo = 1e30;
+    var hi = -1e30;
     for (var i = start; i < end; i++) {
 {%- if projective %}
         var d = textureLoad(rectified, vec2<u32>(i, row), 0).x;
@@ -78,6 +84,11 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         let w = texel_weight(frame, slice, row, i, weighted, spot);
 {%- endif %}
         wsum += w;
+        if thread == 0u {
+            lo = min(lo, d);
+            hi = max(hi, d);
+            textureStore(bounds, vec2<u32>(i, row), vec4<f32>(lo, hi, 0.0, 0.0));
+        }
         let blend = select(0.0, w / wsum, wsum > 0.0);
         for (var q = 0u; q < layers_per_thread; q++) {
             let layer = thread * layers_per_thread + q;

@@ -8,6 +8,10 @@
 // pixel's own unshadowed integral over its part of the ray inside region j (closed form
 // for the sun, Gauss-Legendre for a spot) and Vbar_j = clamp(0.5 + a(d) . F_j, 0, 1) the
 // region's prefiltered visibility. Average visibility: L = L_unshadowed * sum_j len_j Vbar_j / s.
+// Where the ray's depth d is at most the least depth of region j's texels that the fetch
+// reads (prefilter's `bounds`), the region is wholly lit and Vbar_j = 1 exactly; above the
+// greatest, wholly shadowed and Vbar_j = 0: the Fourier series rings only where the answer
+// is ambiguous, and no light leaks where no light ray reaches.
 //
 // Bindings (group 0):
 // | binding | name             | type                                     | access             |
@@ -19,6 +23,7 @@
 // | 4       | filtered         | texture_2d_array<f32> (prefilter's)      | textureSampleLevel |
 // | 5       | filtered_sampler | sampler (filtering, linear)              | textureSampleLevel |
 // | 6       | output           | texture_storage_2d<rgba16float, write>   | textureStore       |
+// | 7       | bounds           | texture_2d<f32> (rg32float, prefilter's) | textureLoad        |
 // filtered: Wr x Hr x {{ layers }} layers, Wr x Hr = the rectified size (frame.sizes.zw).
 // filtered_sampler: clamp-to-edge in u; in v repeat when the slices wrap around
 // (frame.anti_epipole.w > 0.5), else clamp-to-edge.
@@ -46,6 +51,7 @@
 @group(0) @binding(4) var filtered: texture_2d_array<f32>;
 @group(0) @binding(5) var filtered_sampler: sampler;
 @group(0) @binding(6) var output: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(7) var bounds: texture_2d<f32>;
 
 // Most regions a variant may have (the size of the per-pixel region arrays).
 const MAX_REGIONS: u32 = 8u;
@@ -140,6 +146,11 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
 
+    // The rectified rows the bilinear fetch blends (the second only with a non-zero weight).
+    let yb = yc - 0.5;
+    let row0 = row_index(floor(yb), rows, wrap);
+    let row1 = select(row0, row_index(floor(yb) + 1.0, rows, wrap), yb > floor(yb));
+
     // Regions: every region before the surface's, whole, and the surface's up to x_s. Each
     // is weighted by this pixel's own unshadowed integral over its part of the ray.
     let last = u32(min(max(xs, 0.0), f32(width) - 1.0));
@@ -196,12 +207,29 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         } else {
             weight = f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_between(f.medium[0], a, b);
         }
+        // The depth bounds of the (up to) four texels the bilinear fetch reads with a non-zero
+        // weight.
+        let xb = pos[r] - 0.5;
+        let x0 = u32(clamp(floor(xb), 0.0, f32(width) - 1.0));
+        let x1 = select(x0, min(x0 + 1u, width - 1u), xb > floor(xb));
+        let b00 = textureLoad(bounds, vec2<u32>(x0, row0), 0);
+        let b01 = textureLoad(bounds, vec2<u32>(x1, row0), 0);
+        let b10 = textureLoad(bounds, vec2<u32>(x0, row1), 0);
+        let b11 = textureLoad(bounds, vec2<u32>(x1, row1), 0);
+        let lo = min(min(b00.x, b01.x), min(b10.x, b11.x));
+        let hi = max(max(b00.y, b01.y), max(b10.y, b11.y));
         var vis = 0.5;
-        for (var layer = 0u; layer < LAYERS; layer++) {
-            let coeff = coeffs[layer];
-            let texel = textureSampleLevel(filtered, filtered_sampler, vec2<f32>(pos[r] / f32(width), yc / f32(rows)), layer, 0.0);
-            for (var k = 0u; k < 4u; k++) {
-                vis += coeff[k] * (texel[k] * 2.0 - 1.0);
+        if d <= lo {
+            vis = 1.0;
+        } else if d > hi {
+            vis = 0.0;
+        } else {
+            for (var layer = 0u; layer < LAYERS; layer++) {
+                let coeff = coeffs[layer];
+                let texel = textureSampleLevel(filtered, filtered_sampler, vec2<f32>(pos[r] / f32(width), yc / f32(rows)), layer, 0.0);
+                for (var k = 0u; k < 4u; k++) {
+                    vis += coeff[k] * (texel[k] * 2.0 - 1.0);
+                }
             }
         }
         total += weight * clamp(vis, 0.0, 1.0);

@@ -142,6 +142,7 @@ impl Worst {
 struct TrialResult {
     rectified: Worst,
     filtered: Worst,
+    bounds: Worst,
     output: Worst,
     line: String,
 }
@@ -212,6 +213,7 @@ fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<Tria
     let lengths = [
         ("rectified", gpu.rectified.len(), cpu.rectified.data.len()),
         ("filtered", gpu.filtered.len(), cpu.filtered.data.len()),
+        ("bounds", gpu.bounds.len(), cpu.bounds.data.len()),
         ("output", gpu.output.len(), cpu.output.data.len()),
     ];
     for (what, g, c) in lengths {
@@ -231,6 +233,13 @@ fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<Tria
     for (i, (g, c)) in gpu.filtered.iter().zip(&cpu.filtered.data).enumerate() {
         for k in 0..4 {
             filtered.update(4 * i + k, g[k], c[k], ftol);
+        }
+    }
+    // The bounds are minima and maxima of rectified depths: as close as the rectified maps.
+    let mut bounds = Worst::default();
+    for (i, (g, c)) in gpu.bounds.iter().zip(&cpu.bounds.data).enumerate() {
+        for k in 0..2 {
+            bounds.update(2 * i + k, g[k], c[k], RECTIFIED_TOL);
         }
     }
     let max_radiance = cpu
@@ -258,9 +267,10 @@ fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<Tria
         },
     );
     let line = format!(
-        "{trial}: rectified max |diff| {:.2e}; filtered {:.2e}; output {:.2e} ({:.2e} of max {:.3e}); {times}; run_prefiltered_once {:.0} ms, total {:.0} ms",
+        "{trial}: rectified max |diff| {:.2e}; filtered {:.2e}; bounds {:.2e}; output {:.2e} ({:.2e} of max {:.3e}); {times}; run_prefiltered_once {:.0} ms, total {:.0} ms",
         rectified.diff,
         filtered.diff,
+        bounds.diff,
         output.diff,
         output.diff / max_radiance.max(f32::MIN_POSITIVE),
         max_radiance,
@@ -270,6 +280,7 @@ fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<Tria
     Ok(TrialResult {
         rectified,
         filtered,
+        bounds,
         output,
         line,
     })
@@ -311,6 +322,17 @@ fn conformance(variant: &Variant) -> Result<(), String> {
                 (texel / wr) % hr,
                 texel / (wr * hr),
                 i % 4
+            )
+        }));
+    }
+    if !r.bounds.ok() {
+        problems.push(describe("prefilter bounds", &r.bounds, |i| {
+            let texel = (i / 2) as u32;
+            format!(
+                "(x {}, row {}) {}",
+                texel % wr,
+                texel / wr,
+                ["min", "max"][i % 2]
             )
         }));
     }

@@ -64,6 +64,8 @@ layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
 layout(binding = 3,rgba16f) writeonly uniform image2DArray _group_0_binding_3_cs;
 
+layout(binding = 4,rg32f) writeonly uniform image2D _group_0_binding_4_cs;
+
 
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
     vec3 q_2 = (p - v.origin.xyz);
@@ -344,84 +346,96 @@ void main() {
     bool local_1 = false;
     vec4 acc[1] = vec4[1](vec4(0.0));
     float wsum = 0.0;
+    float lo = 1e30;
+    float hi = -1e30;
     uint i = 0u;
     uint q = 0u;
     uint row_2 = id.x;
     uint region = id.y;
     uint thread = id.z;
     uint width_1 = _group_0_binding_0_cs.sizes.z;
-    uint _e12 = _group_0_binding_0_cs.sizes.w;
-    if (!((row_2 >= _e12))) {
+    uint _e14 = _group_0_binding_0_cs.sizes.w;
+    if (!((row_2 >= _e14))) {
         local = (region >= REGIONS);
     } else {
         local = true;
     }
-    bool _e20 = local;
-    if (!(_e20)) {
+    bool _e22 = local;
+    if (!(_e22)) {
         local_1 = (thread >= THREADS_PER_ROW_REGION);
     } else {
         local_1 = true;
     }
-    bool _e27 = local_1;
-    if (_e27) {
+    bool _e29 = local_1;
+    if (_e29) {
         return;
     }
-    vec4 _e30 = _group_0_binding_1_cs[row_2];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e31 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e30);
-    uint _e34 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
-    uint _e38 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
-    i = _e34;
+    vec4 _e32 = _group_0_binding_1_cs[row_2];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
+    uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
+    uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
+    i = _e36;
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e98 = i;
-            i = (_e98 + 1u);
+            uint _e116 = i;
+            i = (_e116 + 1u);
         }
         loop_init_2 = false;
-        uint _e40 = i;
-        if ((_e40 < _e38)) {
+        uint _e42 = i;
+        if ((_e42 < _e40)) {
         } else {
             break;
         }
         {
-            uint _e42 = i;
-            int _e46_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-            vec4 _e46 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e42, row_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e46_clamped_lod) - ivec2(1)), _e46_clamped_lod);
-            float d_2 = _e46.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e49 = _group_0_binding_0_cs;
-            uint _e50 = i;
-            float _e52 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e49, _e31, row_2, _e50, false, true);
-            float _e54 = wsum;
-            wsum = (_e54 + _e52);
+            uint _e44 = i;
+            int _e48_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+            vec4 _e48 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e44, row_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e48_clamped_lod) - ivec2(1)), _e48_clamped_lod);
+            float d_2 = _e48.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = _group_0_binding_0_cs;
+            uint _e52 = i;
+            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, false, true);
             float _e56 = wsum;
-            float _e58 = wsum;
-            float blend = ((_e58 > 0.0) ? (_e52 / _e56) : 0.0);
+            wsum = (_e56 + _e54);
+            if ((thread == 0u)) {
+                float _e61 = lo;
+                lo = min(_e61, d_2);
+                float _e64 = hi;
+                hi = max(_e64, d_2);
+                uint _e66 = i;
+                float _e68 = lo;
+                float _e69 = hi;
+                imageStore(_group_0_binding_4_cs, ivec2(uvec2(_e66, row_2)), vec4(_e68, _e69, 0.0, 0.0));
+            }
+            float _e74 = wsum;
+            float _e76 = wsum;
+            float blend = ((_e76 > 0.0) ? (_e54 / _e74) : 0.0);
             q = 0u;
             bool loop_init_3 = true;
             while(true) {
                 if (!loop_init_3) {
-                    uint _e95 = q;
-                    q = (_e95 + 1u);
+                    uint _e113 = q;
+                    q = (_e113 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e66 = q;
-                if ((_e66 < 1u)) {
+                uint _e84 = q;
+                if ((_e84 < 1u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e69 = q;
-                    uint layer_1 = ((thread * 1u) + _e69);
-                    vec4 _e71 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
-                    uint _e73 = q;
-                    vec4 a_2 = acc[_e73];
-                    uint _e76 = q;
-                    acc[_e76] = ((a_2 * (1.0 - blend)) + (_e71 * blend));
-                    uint _e83 = q;
-                    vec4 _e85 = acc[_e83];
-                    vec4 stored = ((_e85 * 0.5) + vec4(0.5));
-                    uint _e91 = i;
-                    imageStore(_group_0_binding_3_cs, ivec3(uvec2(_e91, row_2), layer_1), stored);
+                    uint _e87 = q;
+                    uint layer_1 = ((thread * 1u) + _e87);
+                    vec4 _e89 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
+                    uint _e91 = q;
+                    vec4 a_2 = acc[_e91];
+                    uint _e94 = q;
+                    acc[_e94] = ((a_2 * (1.0 - blend)) + (_e89 * blend));
+                    uint _e101 = q;
+                    vec4 _e103 = acc[_e101];
+                    vec4 stored = ((_e103 * 0.5) + vec4(0.5));
+                    uint _e109 = i;
+                    imageStore(_group_0_binding_3_cs, ivec3(uvec2(_e109, row_2), layer_1), stored);
                 }
             }
         }

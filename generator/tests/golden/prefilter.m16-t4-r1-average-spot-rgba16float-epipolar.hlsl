@@ -64,6 +64,7 @@ cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZA
 ByteAddressBuffer slices : register(t1);
 Texture2D<float4> rectified : register(t2);
 RWTexture2DArray<float4> filtered : register(u3);
+RWTexture2D<float4> bounds : register(u4);
 
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
@@ -394,6 +395,8 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     bool local_1 = (bool)0;
     float4 acc[1] = (float4[1])0;
     float wsum = 0.0;
+    float lo = 1e30;
+    float hi = -1e30;
     uint i = (uint)0;
     uint q = (uint)0;
 
@@ -401,54 +404,64 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     uint region = id.y;
     uint thread = id.z;
     uint width_1 = frame.sizes.z;
-    uint _e12 = frame.sizes.w;
-    if (!((row_2 >= _e12))) {
+    uint _e14 = frame.sizes.w;
+    if (!((row_2 >= _e14))) {
         local = (region >= REGIONS);
     } else {
         local = true;
     }
-    bool _e20 = local;
-    if (!(_e20)) {
+    bool _e22 = local;
+    if (!(_e22)) {
         local_1 = (thread >= THREADS_PER_ROW_REGION);
     } else {
         local_1 = true;
     }
-    bool _e27 = local_1;
-    if (_e27) {
+    bool _e29 = local_1;
+    if (_e29) {
         return;
     }
-    float4 _e30 = asfloat(slices.Load4(row_2*16));
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e31 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e30);
-    const uint _e34 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
-    const uint _e38 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
-    i = _e34;
+    float4 _e32 = asfloat(slices.Load4(row_2*16));
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
+    const uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
+    const uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
+    i = _e36;
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e98 = i;
-            i = (_e98 + 1u);
+            uint _e116 = i;
+            i = (_e116 + 1u);
         }
         loop_init_2 = false;
-        uint _e40 = i;
-        if ((_e40 < _e38)) {
+        uint _e42 = i;
+        if ((_e42 < _e40)) {
         } else {
             break;
         }
         {
-            uint _e42 = i;
-            float4 _e46 = rectified.Load(int3(uint2(_e42, row_2), int(0)));
-            float d_2 = _e46.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e49 = frame;
-            uint _e50 = i;
-            const float _e52 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e49, _e31, row_2, _e50, false, true);
-            float _e54 = wsum;
-            wsum = (_e54 + _e52);
+            uint _e44 = i;
+            float4 _e48 = rectified.Load(int3(uint2(_e44, row_2), int(0)));
+            float d_2 = _e48.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
+            uint _e52 = i;
+            const float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, false, true);
             float _e56 = wsum;
-            float _e58 = wsum;
-            float blend = ((_e58 > 0.0) ? (_e52 / _e56) : 0.0);
+            wsum = (_e56 + _e54);
+            if ((thread == 0u)) {
+                float _e61 = lo;
+                lo = min(_e61, d_2);
+                float _e64 = hi;
+                hi = max(_e64, d_2);
+                uint _e66 = i;
+                float _e68 = lo;
+                float _e69 = hi;
+                bounds[uint2(_e66, row_2)] = float4(_e68, _e69, 0.0, 0.0);
+            }
+            float _e74 = wsum;
+            float _e76 = wsum;
+            float blend = ((_e76 > 0.0) ? (_e54 / _e74) : 0.0);
             q = 0u;
             uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
             bool loop_init_3 = true;
@@ -456,28 +469,28 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e95 = q;
-                    q = (_e95 + 1u);
+                    uint _e113 = q;
+                    q = (_e113 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e66 = q;
-                if ((_e66 < 1u)) {
+                uint _e84 = q;
+                if ((_e84 < 1u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e69 = q;
-                    uint layer_1 = ((thread * 1u) + _e69);
-                    const float4 _e71 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
-                    uint _e73 = q;
-                    float4 a_2 = acc[min(uint(_e73), 0u)];
-                    uint _e76 = q;
-                    acc[min(uint(_e76), 0u)] = ((a_2 * (1.0 - blend)) + (_e71 * blend));
-                    uint _e83 = q;
-                    float4 _e85 = acc[min(uint(_e83), 0u)];
-                    float4 stored = ((_e85 * 0.5) + (0.5).xxxx);
-                    uint _e91 = i;
-                    filtered[int3(uint2(_e91, row_2), layer_1)] = stored;
+                    uint _e87 = q;
+                    uint layer_1 = ((thread * 1u) + _e87);
+                    const float4 _e89 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
+                    uint _e91 = q;
+                    float4 a_2 = acc[min(uint(_e91), 0u)];
+                    uint _e94 = q;
+                    acc[min(uint(_e94), 0u)] = ((a_2 * (1.0 - blend)) + (_e89 * blend));
+                    uint _e101 = q;
+                    float4 _e103 = acc[min(uint(_e101), 0u)];
+                    float4 stored = ((_e103 * 0.5) + (0.5).xxxx);
+                    uint _e109 = i;
+                    filtered[int3(uint2(_e109, row_2), layer_1)] = stored;
                 }
             }
         }

@@ -55,7 +55,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_hi;
 };
 typedef metal::float4 type_10[1];
-struct type_13 {
+struct type_14 {
     metal::float4 inner[2];
 };
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
@@ -449,67 +449,80 @@ kernel void prefilter(
 , device type_10 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(0)]]
 , metal::texture2d_array<float, metal::access::write> filtered [[texture(1)]]
+, metal::texture2d<float, metal::access::write> bounds [[texture(2)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
 ) {
     bool local = {};
     bool local_1 = {};
-    type_13 acc = {};
+    type_14 acc = {};
     float wsum = 0.0;
+    float lo = 1000000000000000000000000000000.0;
+    float hi = -1000000000000000000000000000000.0;
     uint i = {};
     uint q = {};
     uint row_2 = id.x;
     uint region = id.y;
     uint thread_ = id.z;
     uint width_1 = frame.sizes.z;
-    uint _e12 = frame.sizes.w;
-    if (!((row_2 >= _e12))) {
+    uint _e14 = frame.sizes.w;
+    if (!((row_2 >= _e14))) {
         local = region >= REGIONS;
     } else {
         local = true;
     }
-    bool _e20 = local;
-    if (!(_e20)) {
+    bool _e22 = local;
+    if (!(_e22)) {
         local_1 = thread_ >= THREADS_PER_ROW_REGION;
     } else {
         local_1 = true;
     }
-    bool _e27 = local_1;
-    if (_e27) {
+    bool _e29 = local_1;
+    if (_e29) {
         return;
     }
-    metal::float4 _e30 = slices[metal::min(unsigned(row_2), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e31 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e30);
-    uint _e34 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
-    uint _e38 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, false);
-    i = _e34;
+    metal::float4 _e32 = slices[metal::min(unsigned(row_2), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
+    uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
+    uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, false);
+    i = _e36;
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e98 = i;
-            i = _e98 + 1u;
+            uint _e116 = i;
+            i = _e116 + 1u;
         }
         loop_init_2 = false;
-        uint _e40 = i;
-        if (_e40 < _e38) {
+        uint _e42 = i;
+        if (_e42 < _e40) {
         } else {
             break;
         }
         {
-            uint _e42 = i;
-            uint clamped_lod_e46 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e46 = rectified.read(metal::min(metal::uint2(metal::uint2(_e42, row_2)), metal::uint2(rectified.get_width(clamped_lod_e46), rectified.get_height(clamped_lod_e46)) - 1), clamped_lod_e46);
-            float d_2 = _e46.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e49 = frame;
-            uint _e50 = i;
-            float _e52 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e49, _e31, row_2, _e50, true, false);
-            float _e54 = wsum;
-            wsum = _e54 + _e52;
+            uint _e44 = i;
+            uint clamped_lod_e48 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_2)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
+            float d_2 = _e48.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
+            uint _e52 = i;
+            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, true, false);
             float _e56 = wsum;
-            float _e58 = wsum;
-            float blend = (_e58 > 0.0) ? (_e52 / _e56) : 0.0;
+            wsum = _e56 + _e54;
+            if (thread_ == 0u) {
+                float _e61 = lo;
+                lo = metal::min(_e61, d_2);
+                float _e64 = hi;
+                hi = metal::max(_e64, d_2);
+                uint _e66 = i;
+                float _e68 = lo;
+                float _e69 = hi;
+                bounds.write(metal::float4(_e68, _e69, 0.0, 0.0), metal::uint2(metal::uint2(_e66, row_2)));
+            }
+            float _e74 = wsum;
+            float _e76 = wsum;
+            float blend = (_e76 > 0.0) ? (_e54 / _e74) : 0.0;
             q = 0u;
             uint2 loop_bound_3 = uint2(4294967295u);
             bool loop_init_3 = true;
@@ -517,28 +530,28 @@ kernel void prefilter(
                 if (metal::all(loop_bound_3 == uint2(0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e95 = q;
-                    q = _e95 + 1u;
+                    uint _e113 = q;
+                    q = _e113 + 1u;
                 }
                 loop_init_3 = false;
-                uint _e66 = q;
-                if (_e66 < 2u) {
+                uint _e84 = q;
+                if (_e84 < 2u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e69 = q;
-                    uint layer_1 = (thread_ * 2u) + _e69;
-                    metal::float4 _e71 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
-                    uint _e73 = q;
-                    metal::float4 a_2 = acc.inner[metal::min(unsigned(_e73), 1u)];
-                    uint _e76 = q;
-                    acc.inner[metal::min(unsigned(_e76), 1u)] = (a_2 * (1.0 - blend)) + (_e71 * blend);
-                    uint _e83 = q;
-                    metal::float4 _e85 = acc.inner[metal::min(unsigned(_e83), 1u)];
-                    metal::float4 stored = (_e85 * 0.5) + metal::float4(0.5);
-                    uint _e91 = i;
-                    filtered.write(stored, metal::uint2(metal::uint2(_e91, row_2)), layer_1);
+                    uint _e87 = q;
+                    uint layer_1 = (thread_ * 2u) + _e87;
+                    metal::float4 _e89 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
+                    uint _e91 = q;
+                    metal::float4 a_2 = acc.inner[metal::min(unsigned(_e91), 1u)];
+                    uint _e94 = q;
+                    acc.inner[metal::min(unsigned(_e94), 1u)] = (a_2 * (1.0 - blend)) + (_e89 * blend);
+                    uint _e101 = q;
+                    metal::float4 _e103 = acc.inner[metal::min(unsigned(_e101), 1u)];
+                    metal::float4 stored = (_e103 * 0.5) + metal::float4(0.5);
+                    uint _e109 = i;
+                    filtered.write(stored, metal::uint2(metal::uint2(_e109, row_2)), layer_1);
                 }
             }
         }

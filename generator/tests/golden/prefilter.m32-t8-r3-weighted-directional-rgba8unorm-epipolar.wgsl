@@ -62,6 +62,8 @@ var<storage> slices: array<vec4<f32>>;
 var rectified: texture_2d<f32>;
 @group(0) @binding(3) 
 var filtered: texture_storage_2d_array<rgba8unorm,write>;
+@group(0) @binding(4) 
+var bounds: texture_storage_2d<rg32float,write>;
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
     let q_2 = (p - v.origin.xyz);
@@ -343,6 +345,8 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var local_1: bool;
     var acc: array<vec4<f32>, 2>;
     var wsum: f32 = 0f;
+    var lo: f32 = 1000000000000000000000000000000f;
+    var hi: f32 = -1000000000000000000000000000000f;
     var i: u32;
     var q: u32;
 
@@ -350,75 +354,85 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     let region = id.y;
     let thread = id.z;
     let width_1 = frame.sizes.z;
-    let _e12 = frame.sizes.w;
-    if !((row_2 >= _e12)) {
+    let _e14 = frame.sizes.w;
+    if !((row_2 >= _e14)) {
         local = (region >= REGIONS);
     } else {
         local = true;
     }
-    let _e20 = local;
-    if !(_e20) {
+    let _e22 = local;
+    if !(_e22) {
         local_1 = (thread >= THREADS_PER_ROW_REGION);
     } else {
         local_1 = true;
     }
-    let _e27 = local_1;
-    if _e27 {
+    let _e29 = local_1;
+    if _e29 {
         return;
     }
-    let _e30 = slices[row_2];
-    let _e31 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e30);
-    let _e34 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
-    let _e38 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
-    i = _e34;
+    let _e32 = slices[row_2];
+    let _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
+    let _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
+    let _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
+    i = _e36;
     loop {
-        let _e40 = i;
-        if (_e40 < _e38) {
+        let _e42 = i;
+        if (_e42 < _e40) {
         } else {
             break;
         }
         {
-            let _e42 = i;
-            let _e46 = textureLoad(rectified, vec2<u32>(_e42, row_2), 0i);
-            let d_2 = _e46.x;
-            let _e49 = frame;
-            let _e50 = i;
-            let _e52 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e49, _e31, row_2, _e50, true, false);
-            let _e54 = wsum;
-            wsum = (_e54 + _e52);
+            let _e44 = i;
+            let _e48 = textureLoad(rectified, vec2<u32>(_e44, row_2), 0i);
+            let d_2 = _e48.x;
+            let _e51 = frame;
+            let _e52 = i;
+            let _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, true, false);
             let _e56 = wsum;
-            let _e58 = wsum;
-            let blend = select(0f, (_e52 / _e56), (_e58 > 0f));
+            wsum = (_e56 + _e54);
+            if (thread == 0u) {
+                let _e61 = lo;
+                lo = min(_e61, d_2);
+                let _e64 = hi;
+                hi = max(_e64, d_2);
+                let _e66 = i;
+                let _e68 = lo;
+                let _e69 = hi;
+                textureStore(bounds, vec2<u32>(_e66, row_2), vec4<f32>(_e68, _e69, 0f, 0f));
+            }
+            let _e74 = wsum;
+            let _e76 = wsum;
+            let blend = select(0f, (_e54 / _e74), (_e76 > 0f));
             q = 0u;
             loop {
-                let _e66 = q;
-                if (_e66 < 2u) {
+                let _e84 = q;
+                if (_e84 < 2u) {
                 } else {
                     break;
                 }
                 {
-                    let _e69 = q;
-                    let layer_1 = ((thread * 2u) + _e69);
-                    let _e71 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
-                    let _e73 = q;
-                    let a_2 = acc[_e73];
-                    let _e76 = q;
-                    acc[_e76] = ((a_2 * (1f - blend)) + (_e71 * blend));
-                    let _e83 = q;
-                    let _e85 = acc[_e83];
-                    let stored = ((_e85 * 0.5f) + vec4(0.5f));
-                    let _e91 = i;
-                    textureStore(filtered, vec2<u32>(_e91, row_2), layer_1, stored);
+                    let _e87 = q;
+                    let layer_1 = ((thread * 2u) + _e87);
+                    let _e89 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
+                    let _e91 = q;
+                    let a_2 = acc[_e91];
+                    let _e94 = q;
+                    acc[_e94] = ((a_2 * (1f - blend)) + (_e89 * blend));
+                    let _e101 = q;
+                    let _e103 = acc[_e101];
+                    let stored = ((_e103 * 0.5f) + vec4(0.5f));
+                    let _e109 = i;
+                    textureStore(filtered, vec2<u32>(_e109, row_2), layer_1, stored);
                 }
                 continuing {
-                    let _e95 = q;
-                    q = (_e95 + 1u);
+                    let _e113 = q;
+                    q = (_e113 + 1u);
                 }
             }
         }
         continuing {
-            let _e98 = i;
-            i = (_e98 + 1u);
+            let _e116 = i;
+            i = (_e116 + 1u);
         }
     }
     return;

@@ -67,6 +67,8 @@ layout(binding = 4) uniform sampler2DArray _group_0_binding_4_cs;
 
 layout(binding = 6,rgba16f) writeonly uniform image2D _group_0_binding_6_cs;
 
+layout(binding = 7) uniform sampler2D _group_0_binding_7_cs;
+
 
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
     vec3 q_1 = (p - v.origin.xyz);
@@ -512,49 +514,54 @@ void main() {
             xs = ((s_2 * sin(_e187)) / _e190);
         }
     }
-    float _e192 = xs;
-    uint last = uint(min(max(_e192, 0.0), (float(width_1) - 1.0)));
+    float _e192 = yc;
+    float yb = (_e192 - 0.5);
+    uint _e196 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    uint _e200 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e200 : _e196);
+    float _e204 = xs;
+    uint last = uint(min(max(_e204, 0.0), (float(width_1) - 1.0)));
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e255 = r;
-            r = (_e255 + 1u);
+            uint _e267 = r;
+            r = (_e267 + 1u);
         }
         loop_init_3 = false;
-        uint _e202 = r;
-        if ((_e202 < REGIONS)) {
+        uint _e214 = r;
+        if ((_e214 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e204 = r;
-            uint _e205 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e204, REGIONS, width_1, true);
-            float b0_ = float(_e205);
-            uint _e207 = r;
-            uint _e210 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e207 + 1u), REGIONS, width_1, true);
-            float b1_ = float(_e210);
+            uint _e216 = r;
+            uint _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, true);
+            float b0_ = float(_e217);
+            uint _e219 = r;
+            uint _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e219 + 1u), REGIONS, width_1, true);
+            float b1_ = float(_e222);
             if (!((last < uint(b1_)))) {
-                uint _e215 = r;
-                local_4 = ((_e215 + 1u) == REGIONS);
+                uint _e227 = r;
+                local_4 = ((_e227 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             bool is_last = local_4;
-            uint _e224 = r;
-            float _e228 = xs;
-            pos[_e224] = (is_last ? clamp((_e228 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            uint _e238 = r;
-            float _e240 = delta;
-            float _e241 = theta;
-            float _e242 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e240, _e241, s_2, true);
-            t0_[_e238] = _e242;
-            uint _e244 = r;
-            float _e246 = delta;
-            float _e247 = theta;
-            float _e248 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e246, _e247, s_2, true);
-            t1_[_e244] = (is_last ? s_2 : _e248);
+            uint _e236 = r;
+            float _e240 = xs;
+            pos[_e236] = (is_last ? clamp((_e240 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
             uint _e250 = r;
-            count = (_e250 + 1u);
+            float _e252 = delta;
+            float _e253 = theta;
+            float _e254 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e252, _e253, s_2, true);
+            t0_[_e250] = _e254;
+            uint _e256 = r;
+            float _e258 = delta;
+            float _e259 = theta;
+            float _e260 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e258, _e259, s_2, true);
+            t1_[_e256] = (is_last ? s_2 : _e260);
+            uint _e262 = r;
+            count = (_e262 + 1u);
             if (is_last) {
                 break;
             }
@@ -565,127 +572,152 @@ void main() {
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e278 = layer;
-            layer = (_e278 + 1u);
+            uint _e290 = layer;
+            layer = (_e290 + 1u);
         }
         loop_init_4 = false;
-        uint _e268 = layer;
-        if ((_e268 < LAYERS)) {
+        uint _e280 = layer;
+        if ((_e280 < LAYERS)) {
         } else {
             break;
         }
         {
-            uint _e272 = layer;
-            float _e274 = d;
-            uint _e275 = layer;
-            vec4 _e276 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e274, _e275);
-            coeffs[_e272] = _e276;
+            uint _e284 = layer;
+            float _e286 = d;
+            uint _e287 = layer;
+            vec4 _e288 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e286, _e287);
+            coeffs[_e284] = _e288;
         }
     }
     bool loop_init_5 = true;
     while(true) {
         if (!loop_init_5) {
-            uint _e366 = r_1;
-            r_1 = (_e366 + 1u);
+            uint _e434 = r_1;
+            r_1 = (_e434 + 1u);
         }
         loop_init_5 = false;
-        uint _e281 = r_1;
-        uint _e282 = count;
-        if ((_e281 < _e282)) {
+        uint _e293 = r_1;
+        uint _e294 = count;
+        if ((_e293 < _e294)) {
         } else {
             break;
         }
         {
-            uint _e284 = r_1;
-            float a_3 = t0_[_e284];
-            uint _e287 = r_1;
-            float b_3 = t1_[_e287];
+            uint _e296 = r_1;
+            float a_3 = t0_[_e296];
+            uint _e299 = r_1;
+            float b_3 = t1_[_e299];
             weight = 0.0;
             if (!(false)) {
                 weight = (b_3 - a_3);
             } else {
                 if (true) {
-                    float _e295 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, a_3, b_3, panels_2);
-                    weight = _e295;
+                    float _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, a_3, b_3, panels_2);
+                    weight = _e307;
                 } else {
-                    float _e300 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                    float _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3, b_3);
-                    weight = ((f_9.medium.y * _e300) * _e304);
+                    float _e312 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                    float _e316 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3, b_3);
+                    weight = ((f_9.medium.y * _e312) * _e316);
                 }
             }
+            uint _e318 = r_1;
+            float _e320 = pos[_e318];
+            float xb = (_e320 - 0.5);
+            uint x0_ = uint(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
+            uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
+            int _e341_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
+            vec4 b00_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x0_, _e196)), ivec2(0), textureSize(_group_0_binding_7_cs, _e341_clamped_lod) - ivec2(1)), _e341_clamped_lod);
+            int _e345_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
+            vec4 b01_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x1_, _e196)), ivec2(0), textureSize(_group_0_binding_7_cs, _e345_clamped_lod) - ivec2(1)), _e345_clamped_lod);
+            int _e349_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
+            vec4 b10_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x0_, row1_)), ivec2(0), textureSize(_group_0_binding_7_cs, _e349_clamped_lod) - ivec2(1)), _e349_clamped_lod);
+            int _e353_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
+            vec4 b11_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_7_cs, _e353_clamped_lod) - ivec2(1)), _e353_clamped_lod);
+            float lo_1 = min(min(b00_.x, b01_.x), min(b10_.x, b11_.x));
+            float hi_1 = max(max(b00_.y, b01_.y), max(b10_.y, b11_.y));
             vis = 0.5;
-            layer_1 = 0u;
-            bool loop_init_6 = true;
-            while(true) {
-                if (!loop_init_6) {
-                    uint _e350 = layer_1;
-                    layer_1 = (_e350 + 1u);
-                }
-                loop_init_6 = false;
-                uint _e310 = layer_1;
-                if ((_e310 < LAYERS)) {
+            float _e370 = d;
+            if ((_e370 <= lo_1)) {
+                vis = 1.0;
+            } else {
+                float _e373 = d;
+                if ((_e373 > hi_1)) {
+                    vis = 0.0;
                 } else {
-                    break;
-                }
-                {
-                    uint _e313 = layer_1;
-                    vec4 coeff = coeffs[_e313];
-                    uint _e316 = r_1;
-                    float _e318 = pos[_e316];
-                    float _e321 = yc;
-                    uint _e325 = layer_1;
-                    vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e318 / float(width_1)), (_e321 / float(rows_1))), _e325), 0.0);
-                    k = 0u;
-                    bool loop_init_7 = true;
+                    layer_1 = 0u;
+                    bool loop_init_6 = true;
                     while(true) {
-                        if (!loop_init_7) {
-                            uint _e347 = k;
-                            k = (_e347 + 1u);
+                        if (!loop_init_6) {
+                            uint _e418 = layer_1;
+                            layer_1 = (_e418 + 1u);
                         }
-                        loop_init_7 = false;
-                        uint _e332 = k;
-                        if ((_e332 < 4u)) {
+                        loop_init_6 = false;
+                        uint _e378 = layer_1;
+                        if ((_e378 < LAYERS)) {
                         } else {
                             break;
                         }
                         {
-                            float _e335 = vis;
-                            uint _e336 = k;
-                            uint _e338 = k;
-                            vis = (_e335 + (coeff[_e336] * ((texel_1[_e338] * 2.0) - 1.0)));
+                            uint _e381 = layer_1;
+                            vec4 coeff = coeffs[_e381];
+                            uint _e384 = r_1;
+                            float _e386 = pos[_e384];
+                            float _e389 = yc;
+                            uint _e393 = layer_1;
+                            vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e386 / float(width_1)), (_e389 / float(rows_1))), _e393), 0.0);
+                            k = 0u;
+                            bool loop_init_7 = true;
+                            while(true) {
+                                if (!loop_init_7) {
+                                    uint _e415 = k;
+                                    k = (_e415 + 1u);
+                                }
+                                loop_init_7 = false;
+                                uint _e400 = k;
+                                if ((_e400 < 4u)) {
+                                } else {
+                                    break;
+                                }
+                                {
+                                    float _e403 = vis;
+                                    uint _e404 = k;
+                                    uint _e406 = k;
+                                    vis = (_e403 + (coeff[_e404] * ((texel_1[_e406] * 2.0) - 1.0)));
+                                }
+                            }
                         }
                     }
                 }
             }
-            float _e353 = total;
-            float _e354 = weight;
-            float _e355 = vis;
-            total = (_e353 + (_e354 * clamp(_e355, 0.0, 1.0)));
-            float _e362 = norm;
-            float _e363 = weight;
-            norm = (_e362 + _e363);
+            float _e421 = total;
+            float _e422 = weight;
+            float _e423 = vis;
+            total = (_e421 + (_e422 * clamp(_e423, 0.0, 1.0)));
+            float _e430 = norm;
+            float _e431 = weight;
+            norm = (_e430 + _e431);
         }
     }
     if (false) {
-        float _e368 = total;
-        l = _e368;
+        float _e436 = total;
+        l = _e436;
     } else {
         if (true) {
-            float _e377 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, 0.0, s_2, max((f_9.sizes2_.z / 4u), 1u));
-            unshadowed = _e377;
+            float _e445 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, 0.0, s_2, max((f_9.sizes2_.z / 4u), 1u));
+            unshadowed = _e445;
         } else {
-            float _e383 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-            float _e387 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, s_2);
-            unshadowed = ((f_9.medium.y * _e383) * _e387);
+            float _e451 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+            float _e455 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, s_2);
+            unshadowed = ((f_9.medium.y * _e451) * _e455);
         }
-        float _e389 = unshadowed;
-        float _e390 = total;
-        float _e391 = norm;
-        float _e393 = norm;
-        l = (_e389 * ((_e393 > 0.0) ? (_e390 / _e391) : 1.0));
+        float _e457 = unshadowed;
+        float _e458 = total;
+        float _e459 = norm;
+        float _e461 = norm;
+        l = (_e457 * ((_e461 > 0.0) ? (_e458 / _e459) : 1.0));
     }
-    float _e399 = l;
-    vec3 c = (color * _e399);
+    float _e467 = l;
+    vec3 c = (color * _e467);
     imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_6, y_2)), vec4(c.x, c.y, c.z, 1.0));
     return;
 }

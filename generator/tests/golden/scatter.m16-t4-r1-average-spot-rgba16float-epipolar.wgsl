@@ -67,6 +67,8 @@ var filtered: texture_2d_array<f32>;
 var filtered_sampler: sampler;
 @group(0) @binding(6) 
 var output: texture_storage_2d<rgba16float,write>;
+@group(0) @binding(7) 
+var bounds: texture_2d<f32>;
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
     let q_1 = (p - v.origin.xyz);
@@ -511,170 +513,196 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
             xs = ((s_2 * sin(_e187)) / _e190);
         }
     }
-    let _e192 = xs;
-    let last = u32(min(max(_e192, 0f), (f32(width_1) - 1f)));
+    let _e192 = yc;
+    let yb = (_e192 - 0.5f);
+    let _e196 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    let _e200 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
+    let row1_ = select(_e196, _e200, (yb > floor(yb)));
+    let _e204 = xs;
+    let last = u32(min(max(_e204, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e202 = r;
-        if (_e202 < REGIONS) {
+        let _e214 = r;
+        if (_e214 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e204 = r;
-            let _e205 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e204, REGIONS, width_1, true);
-            let b0_ = f32(_e205);
-            let _e207 = r;
-            let _e210 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e207 + 1u), REGIONS, width_1, true);
-            let b1_ = f32(_e210);
+            let _e216 = r;
+            let _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, true);
+            let b0_ = f32(_e217);
+            let _e219 = r;
+            let _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e219 + 1u), REGIONS, width_1, true);
+            let b1_ = f32(_e222);
             if !((last < u32(b1_))) {
-                let _e215 = r;
-                local_4 = ((_e215 + 1u) == REGIONS);
+                let _e227 = r;
+                local_4 = ((_e227 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             let is_last = local_4;
-            let _e224 = r;
-            let _e228 = xs;
-            pos[_e224] = select((b1_ - 0.5f), clamp((_e228 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
-            let _e238 = r;
-            let _e240 = delta;
-            let _e241 = theta;
-            let _e242 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e240, _e241, s_2, true);
-            t0_[_e238] = _e242;
-            let _e244 = r;
-            let _e246 = delta;
-            let _e247 = theta;
-            let _e248 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e246, _e247, s_2, true);
-            t1_[_e244] = select(_e248, s_2, is_last);
+            let _e236 = r;
+            let _e240 = xs;
+            pos[_e236] = select((b1_ - 0.5f), clamp((_e240 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
             let _e250 = r;
-            count = (_e250 + 1u);
+            let _e252 = delta;
+            let _e253 = theta;
+            let _e254 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e252, _e253, s_2, true);
+            t0_[_e250] = _e254;
+            let _e256 = r;
+            let _e258 = delta;
+            let _e259 = theta;
+            let _e260 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e258, _e259, s_2, true);
+            t1_[_e256] = select(_e260, s_2, is_last);
+            let _e262 = r;
+            count = (_e262 + 1u);
             if is_last {
                 break;
             }
         }
         continuing {
-            let _e255 = r;
-            r = (_e255 + 1u);
+            let _e267 = r;
+            r = (_e267 + 1u);
         }
     }
     let cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
     let panels_2 = max((f_9.sizes2_.z / 4u), 1u);
     loop {
-        let _e268 = layer;
-        if (_e268 < LAYERS) {
+        let _e280 = layer;
+        if (_e280 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e272 = layer;
-            let _e274 = d;
-            let _e275 = layer;
-            let _e276 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e274, _e275);
-            coeffs[_e272] = _e276;
+            let _e284 = layer;
+            let _e286 = d;
+            let _e287 = layer;
+            let _e288 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e286, _e287);
+            coeffs[_e284] = _e288;
         }
         continuing {
-            let _e278 = layer;
-            layer = (_e278 + 1u);
+            let _e290 = layer;
+            layer = (_e290 + 1u);
         }
     }
     loop {
-        let _e281 = r_1;
-        let _e282 = count;
-        if (_e281 < _e282) {
+        let _e293 = r_1;
+        let _e294 = count;
+        if (_e293 < _e294) {
         } else {
             break;
         }
         {
-            let _e284 = r_1;
-            let a_3 = t0_[_e284];
-            let _e287 = r_1;
-            let b_3 = t1_[_e287];
+            let _e296 = r_1;
+            let a_3 = t0_[_e296];
+            let _e299 = r_1;
+            let b_3 = t1_[_e299];
             weight = f32();
             if !(false) {
                 weight = (b_3 - a_3);
             } else {
                 if true {
-                    let _e295 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, a_3, b_3, panels_2);
-                    weight = _e295;
+                    let _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, a_3, b_3, panels_2);
+                    weight = _e307;
                 } else {
-                    let _e300 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                    let _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3, b_3);
-                    weight = ((f_9.medium.y * _e300) * _e304);
+                    let _e312 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                    let _e316 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3, b_3);
+                    weight = ((f_9.medium.y * _e312) * _e316);
                 }
             }
+            let _e318 = r_1;
+            let _e320 = pos[_e318];
+            let xb = (_e320 - 0.5f);
+            let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
+            let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
+            let b00_ = textureLoad(bounds, vec2<u32>(x0_, _e196), 0i);
+            let b01_ = textureLoad(bounds, vec2<u32>(x1_, _e196), 0i);
+            let b10_ = textureLoad(bounds, vec2<u32>(x0_, row1_), 0i);
+            let b11_ = textureLoad(bounds, vec2<u32>(x1_, row1_), 0i);
+            let lo_1 = min(min(b00_.x, b01_.x), min(b10_.x, b11_.x));
+            let hi_1 = max(max(b00_.y, b01_.y), max(b10_.y, b11_.y));
             vis = 0.5f;
-            layer_1 = 0u;
-            loop {
-                let _e310 = layer_1;
-                if (_e310 < LAYERS) {
+            let _e370 = d;
+            if (_e370 <= lo_1) {
+                vis = 1f;
+            } else {
+                let _e373 = d;
+                if (_e373 > hi_1) {
+                    vis = 0f;
                 } else {
-                    break;
-                }
-                {
-                    let _e313 = layer_1;
-                    let coeff = coeffs[_e313];
-                    let _e316 = r_1;
-                    let _e318 = pos[_e316];
-                    let _e321 = yc;
-                    let _e325 = layer_1;
-                    let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e318 / f32(width_1)), (_e321 / f32(rows_1))), _e325, 0f);
-                    k = 0u;
+                    layer_1 = 0u;
                     loop {
-                        let _e332 = k;
-                        if (_e332 < 4u) {
+                        let _e378 = layer_1;
+                        if (_e378 < LAYERS) {
                         } else {
                             break;
                         }
                         {
-                            let _e335 = vis;
-                            let _e336 = k;
-                            let _e338 = k;
-                            vis = (_e335 + (coeff[_e336] * ((texel_1[_e338] * 2f) - 1f)));
+                            let _e381 = layer_1;
+                            let coeff = coeffs[_e381];
+                            let _e384 = r_1;
+                            let _e386 = pos[_e384];
+                            let _e389 = yc;
+                            let _e393 = layer_1;
+                            let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e386 / f32(width_1)), (_e389 / f32(rows_1))), _e393, 0f);
+                            k = 0u;
+                            loop {
+                                let _e400 = k;
+                                if (_e400 < 4u) {
+                                } else {
+                                    break;
+                                }
+                                {
+                                    let _e403 = vis;
+                                    let _e404 = k;
+                                    let _e406 = k;
+                                    vis = (_e403 + (coeff[_e404] * ((texel_1[_e406] * 2f) - 1f)));
+                                }
+                                continuing {
+                                    let _e415 = k;
+                                    k = (_e415 + 1u);
+                                }
+                            }
                         }
                         continuing {
-                            let _e347 = k;
-                            k = (_e347 + 1u);
+                            let _e418 = layer_1;
+                            layer_1 = (_e418 + 1u);
                         }
                     }
                 }
-                continuing {
-                    let _e350 = layer_1;
-                    layer_1 = (_e350 + 1u);
-                }
             }
-            let _e353 = total;
-            let _e354 = weight;
-            let _e355 = vis;
-            total = (_e353 + (_e354 * clamp(_e355, 0f, 1f)));
-            let _e362 = norm;
-            let _e363 = weight;
-            norm = (_e362 + _e363);
+            let _e421 = total;
+            let _e422 = weight;
+            let _e423 = vis;
+            total = (_e421 + (_e422 * clamp(_e423, 0f, 1f)));
+            let _e430 = norm;
+            let _e431 = weight;
+            norm = (_e430 + _e431);
         }
         continuing {
-            let _e366 = r_1;
-            r_1 = (_e366 + 1u);
+            let _e434 = r_1;
+            r_1 = (_e434 + 1u);
         }
     }
     if false {
-        let _e368 = total;
-        l = _e368;
+        let _e436 = total;
+        l = _e436;
     } else {
         if true {
-            let _e377 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, 0f, s_2, max((f_9.sizes2_.z / 4u), 1u));
-            unshadowed = _e377;
+            let _e445 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, 0f, s_2, max((f_9.sizes2_.z / 4u), 1u));
+            unshadowed = _e445;
         } else {
-            let _e383 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-            let _e387 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, s_2);
-            unshadowed = ((f_9.medium.y * _e383) * _e387);
+            let _e451 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+            let _e455 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, s_2);
+            unshadowed = ((f_9.medium.y * _e451) * _e455);
         }
-        let _e389 = unshadowed;
-        let _e390 = total;
-        let _e391 = norm;
-        let _e393 = norm;
-        l = (_e389 * select(1f, (_e390 / _e391), (_e393 > 0f)));
+        let _e457 = unshadowed;
+        let _e458 = total;
+        let _e459 = norm;
+        let _e461 = norm;
+        l = (_e457 * select(1f, (_e458 / _e459), (_e461 > 0f)));
     }
-    let _e399 = l;
-    let c = (color * _e399);
+    let _e467 = l;
+    let c = (color * _e467);
     textureStore(output, vec2<u32>(x_6, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

@@ -41,6 +41,8 @@ pub struct PrefilteredRun {
     pub rectified: Tex,
     /// The filtered-basis array.
     pub filtered: TexArray,
+    /// The region-prefix depth bounds `[min, max, 0, 0]` (one layer).
+    pub bounds: TexArray,
     /// In-scattered radiance (as stored in rgba16float).
     pub output: Image,
 }
@@ -90,7 +92,8 @@ pub fn run_prefiltered(
         },
         None => rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot),
     };
-    let filtered = prefilter::prefilter(variant, &frame.uniforms, &frame.slices, &rectified);
+    let prefilter::PrefilterOutput { filtered, bounds } =
+        prefilter::prefilter(variant, &frame.uniforms, &frame.slices, &rectified);
     let out = scatter::scatter(
         variant,
         &scatter::ScatterInputs {
@@ -99,6 +102,7 @@ pub fn run_prefiltered(
             depth: &depth,
             shadow_map: &sm,
             filtered: &filtered,
+            bounds: &bounds,
         },
     );
     let output = Image::from_pixels(
@@ -110,6 +114,7 @@ pub fn run_prefiltered(
         frame,
         rectified,
         filtered,
+        bounds,
         output,
     })
 }

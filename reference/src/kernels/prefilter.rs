@@ -7,14 +7,16 @@
 //! Stored per texel: the normalised weighted mean `F_k = sum w_i B_k(d_i) / sum w_i` over the
 //! region up to the texel, mapped to [0, 1] as `F / 2 + 0.5` in the variant's storage format.
 //! `scatter` weights each region by the pixel's own unshadowed integral over the part of its
-//! ray inside the region, so no weight sums need to be stored.
+//! ray inside the region, so no weight sums need to be stored. Thread 0 of a row-region also
+//! stores the least and the greatest depth over the region up to the texel (`bounds`,
+//! rg32float on the GPU; here a one-layer array of `[min, max, 0, 0]`).
 
 use super::common_model::select;
 use super::common_prefiltered::{
     Tex, TexArray, basis4, proj_stored_depth, proj_texel_weight, region_start, texel_weight,
 };
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, Rectification, SliceParams, Variant, VisibilityMode,
+    FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant, VisibilityMode,
 };
 
 /// The kernel body for invocation `id` = (row, region, thread).
@@ -26,6 +28,7 @@ pub fn prefilter_main(
     slices: &[SliceParams],
     rectified: &Tex,
     filtered: &mut TexArray,
+    bounds: &mut TexArray,
 ) {
     let (row, region, thread) = (id[0], id[1], id[2]);
     let width = frame.sizes[2];
@@ -44,6 +47,8 @@ pub fn prefilter_main(
     let end = region_start(region + 1, variant.regions, width, spot);
     let mut acc = vec![[0.0f32; 4]; layers_per_thread as usize];
     let mut wsum = 0.0f32;
+    let mut lo = 1e30f32;
+    let mut hi = -1e30f32;
     for i in start..end {
         let mut d = rectified.load(i, row);
         let w;
@@ -54,6 +59,11 @@ pub fn prefilter_main(
             w = texel_weight(frame, &slice, row, i, weighted, spot);
         }
         wsum += w;
+        if thread == 0 {
+            lo = lo.min(d);
+            hi = hi.max(d);
+            bounds.store(i, row, 0, [lo, hi, 0.0, 0.0], Storage::Rgba32float);
+        }
         let blend = select(0.0, w / wsum, wsum > 0.0);
         for q in 0..layers_per_thread {
             let layer = thread * layers_per_thread + q;
@@ -73,15 +83,25 @@ pub fn prefilter_main(
     }
 }
 
-/// Runs every invocation; returns the filtered-basis array.
+/// What `prefilter` writes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrefilterOutput {
+    /// The filtered bases.
+    pub filtered: TexArray,
+    /// Per texel `[min, max, 0, 0]` of the region's depths up to the texel (one layer).
+    pub bounds: TexArray,
+}
+
+/// Runs every invocation; returns the filtered-basis array and the region-prefix bounds.
 pub fn prefilter(
     variant: &Variant,
     frame: &FrameUniforms,
     slices: &[SliceParams],
     rectified: &Tex,
-) -> TexArray {
+) -> PrefilterOutput {
     let (w, h) = (frame.sizes[2], frame.sizes[3]);
     let mut filtered = TexArray::new(w, h, variant.layers());
+    let mut bounds = TexArray::new(w, h, 1);
     for row in 0..h {
         for region in 0..variant.regions {
             for thread in 0..variant.threads_per_row_region() {
@@ -92,9 +112,10 @@ pub fn prefilter(
                     slices,
                     rectified,
                     &mut filtered,
+                    &mut bounds,
                 );
             }
         }
     }
-    filtered
+    PrefilterOutput { filtered, bounds }
 }

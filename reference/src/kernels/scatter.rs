@@ -8,6 +8,8 @@
 //! region's prefiltered visibility. With one region this is the paper's `L_unshadowed * Vbar`;
 //! with more, each region's visibility is weighted by the true integrand instead of the
 //! reference ray's. Average visibility: `L = L_unshadowed * sum_j len_j Vbar_j / s`.
+//! Where the ray's depth `d` is at most the least depth of the texels the fetch reads
+//! (`prefilter`'s bounds), `Vbar_j = 1` exactly; above the greatest, `Vbar_j = 0`.
 
 use super::common_epipolar::{
     epipole_march, normalised_depth, pixel_dir, ray_t, row_index, spot_segment,
@@ -39,6 +41,8 @@ pub struct ScatterInputs<'a> {
     pub shadow_map: &'a Tex,
     /// Filtered bases (from `prefilter`).
     pub filtered: &'a TexArray,
+    /// Region-prefix depth bounds `[min, max, 0, 0]` (from `prefilter`, one layer).
+    pub bounds: &'a TexArray,
 }
 
 /// The kernel body for pixel `id`; returns the rgba16float texel it stores.
@@ -129,6 +133,15 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         };
     }
 
+    // The rectified rows the bilinear fetch blends (the second only with a non-zero weight).
+    let yb = yc - 0.5;
+    let row0 = row_index(yb.floor(), rows, wrap);
+    let row1 = if yb > yb.floor() {
+        row_index(yb.floor() + 1.0, rows, wrap)
+    } else {
+        row0
+    };
+
     // Regions: every region before the surface's, whole, and the surface's up to x_s. Each
     // is weighted by this pixel's own unshadowed integral over its part of the ray.
     let last = min(max(xs, 0.0), width as f32 - 1.0) as u32;
@@ -192,12 +205,33 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
                 * phase_hg(f.medium[2], cos_theta_l)
                 * transmittance_between(f.medium[0], a, b)
         };
+        // The depth bounds of the (up to) four texels the bilinear fetch reads with a
+        // non-zero weight.
+        let xb = pos[r as usize] - 0.5;
+        let x0 = clamp(xb.floor(), 0.0, width as f32 - 1.0) as u32;
+        let x1 = if xb > xb.floor() {
+            (x0 + 1).min(width - 1)
+        } else {
+            x0
+        };
+        let b00 = inp.bounds.load(x0, row0, 0);
+        let b01 = inp.bounds.load(x1, row0, 0);
+        let b10 = inp.bounds.load(x0, row1, 0);
+        let b11 = inp.bounds.load(x1, row1, 0);
+        let lo = min(min(b00[0], b01[0]), min(b10[0], b11[0]));
+        let hi = max(max(b00[1], b01[1]), max(b10[1], b11[1]));
         let mut vis = 0.5;
-        for layer in 0..variant.layers() {
-            let coeff = coeffs[layer as usize];
-            let texel = sample_bilinear(inp.filtered, layer, pos[r as usize], yc, wrap);
-            for k in 0..4 {
-                vis += coeff[k] * (texel[k] * 2.0 - 1.0);
+        if d <= lo {
+            vis = 1.0;
+        } else if d > hi {
+            vis = 0.0;
+        } else {
+            for layer in 0..variant.layers() {
+                let coeff = coeffs[layer as usize];
+                let texel = sample_bilinear(inp.filtered, layer, pos[r as usize], yc, wrap);
+                for k in 0..4 {
+                    vis += coeff[k] * (texel[k] * 2.0 - 1.0);
+                }
             }
         }
         total += weight * clamp(vis, 0.0, 1.0);

@@ -21,6 +21,9 @@ pub const PROJECTIVE_WITHOUT_SHADOW_MAP: &str = "the frame is projective and the
 /// The per-frame condition under which the slices go round the full circle and `scatter`
 /// samples the filtered bases with the wrapping sampler.
 pub const WRAPPING_SLICES: &str = "frame.anti_epipole.w > 0.5";
+/// Format of the region-prefix depth bounds written by `prefilter` (r = min, g = max):
+/// 32-bit, so that the bound tests compare the very depths the filter saw.
+pub const BOUNDS_FORMAT: &str = "rg32float";
 /// The engine's rasterised rectified map of projective variants.
 pub const RECTIFIED_RASTER: &str = "rectified_raster";
 
@@ -94,6 +97,16 @@ pub fn plan(v: &Variant) -> Plan {
                  prefilter); view it as a 2d array even with one layer",
             )
         },
+        scatter_texture(
+            "bounds",
+            "per texel, the least and the greatest rectified depth over its region's prefix \
+             up to the texel (min, max), written by prefilter beside the filtered bases: \
+             scatter takes a region as wholly lit (ray depth <= min) or wholly shadowed \
+             (> max) without its Fourier estimate, so no light rings where none can arrive",
+            BOUNDS_FORMAT,
+            "rectified.width",
+            "rectified.height",
+        ),
         scatter_texture(
             "output",
             "in-scattered radiance, rgb, alpha 1 (written by scatter); add it to the \
@@ -206,6 +219,7 @@ pub fn pass(v: &Variant, kernel: Kernel) -> Option<PassPlan> {
                     }),
                 },
                 bind(3, "filtered"),
+                bind(4, "bounds"),
             ],
         }),
         Kernel::Scatter => Some(PassPlan {
@@ -234,6 +248,7 @@ pub fn pass(v: &Variant, kernel: Kernel) -> Option<PassPlan> {
                     }),
                 },
                 bind(6, "output"),
+                bind(7, "bounds"),
             ],
         }),
         _ => None,
