@@ -14,6 +14,8 @@
 //! | pose | `near_cuts_geometry` | a column crosses the near plane (0.6 m) |
 //! | pose | `sky` | most pixels see no geometry: depth at the far plane |
 //! | pose | `sky_infinite` | as `sky`, with the engine writing +inf depth on sky pixels |
+//! | pose | `closed_room` | inside `window` with the sun behind the back wall: no light enters, truth exactly 0 |
+//! | pose | `closed_room_windows` | as `closed_room`, looking at the windows from inside (the lit fog outside is seen through them) |
 //! | pose | `spot_epipole_centre` | the camera looks straight at a spot lamp |
 //! | pose | `spot_in_cone` | the eye stands inside the spot's cone |
 //! | pose | `spot_outside_cone` | the eye stands outside the spot's cone |
@@ -86,6 +88,10 @@ pub enum Premise {
     SkyFraction(f64),
     /// The eye is inside (`true`) or outside (`false`) the spot's outer cone.
     EyeInCone(bool),
+    /// No light reaches any point the camera sees: the truth is exactly 0 at every pixel,
+    /// while the medium scatters. [`StressCase::premise`] checks that the eye is shadowed;
+    /// the stress test, which renders the truth, checks the rest.
+    Dark,
 }
 
 /// One stress configuration.
@@ -168,7 +174,7 @@ impl StressCase {
                     fail(format!("light . forward = {d:e}, not 0"))
                 }
             }
-            Premise::EyeShadowed => {
+            Premise::EyeShadowed | Premise::Dark => {
                 let dir = to_light(cam.position);
                 let reach = match &self.scene.light {
                     Light::Directional { .. } => 1e6,
@@ -413,6 +419,39 @@ pub fn cases(width: u32, height: u32) -> Vec<StressCase> {
         out.push(c);
     }
 
+    // A closed room: inside `window` (room x, z in [-6, 6], y in [0, 5], windows in the wall
+    // at z = -6) with the sun behind the back wall (light travelling towards -z), 35 degrees
+    // up: every light ray into the room is blocked by the roof or the back wall. The
+    // Fourier series of the prefiltered method rang here ("light in closed rooms", issue 12).
+    let room = suite::scene(
+        SceneName::Window,
+        Pose::Ordinary,
+        MediumPreset::Default,
+        width,
+        height,
+    );
+    let (sn, cs) = 35f64.to_radians().sin_cos();
+    let behind = -v(0.3 * cs, sn, 0.95 * cs);
+    let mut s = room.clone();
+    look(&mut s, v(3.0, 1.6, -2.0), v(-0.6, 0.1, 1.0));
+    sun(&mut s, behind);
+    out.push(case(
+        "closed_room",
+        P,
+        "inside the window room, the sun behind its back wall: no light enters",
+        s,
+        Premise::Dark,
+    ));
+    let mut s = room.clone();
+    look(&mut s, v(2.0, 1.8, 3.0), v(-0.2, 0.05, -1.0));
+    sun(&mut s, behind);
+    out.push(case(
+        "closed_room_windows",
+        P,
+        "inside the dark room, looking out through the windows at the lit fog",
+        s,
+        Premise::EyeShadowed,
+    ));
     // Spot light cases on spot_grate.
     let spot = |pose| {
         suite::scene(
