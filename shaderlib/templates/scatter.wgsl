@@ -7,7 +7,12 @@
 // Weighted visibility: L = sum_j U_j Vbar_j over the regions the ray crosses, U_j the
 // pixel's own unshadowed integral over its part of the ray inside region j (closed form
 // for the sun, Gauss-Legendre for a spot) and Vbar_j = clamp(0.5 + a(d) . F_j, 0, 1) the
-// region's prefiltered visibility. Average visibility: L = L_unshadowed * sum_j len_j Vbar_j / s.
+// region's prefiltered visibility. Average visibility combines the regions the same way; it
+// differs in the prefilter, which weights texels by their length along the reference ray
+// instead of its transmittance (with one region: the paper's L_unshadowed * Vbar). Weighting
+// the regions by length instead (L_unshadowed * sum_j len_j Vbar_j / s) was 51 % off on
+// foliage/epipole_on_screen at every region count (issue 12): along a ray towards the sun
+// the shadowed part lies near the eye, where the transmittance is high.
 // Where the ray's depth d is at most the least depth of region j's texels that the fetch
 // reads (prefilter's `bounds`), the region is wholly lit and Vbar_j = 1 exactly; above the
 // greatest, wholly shadowed and Vbar_j = 0: the Fourier series rings only where the answer
@@ -69,7 +74,6 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let spot = {{ spot }};
-    let weighted = {{ weighted }};
     let eye = f.eye.xyz;
     let dir = pixel_dir(f, x, y);
     // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
@@ -196,13 +200,10 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         coeffs[layer] = coeff4(d, layer);
     }
     var total = 0.0;
-    var norm = 0.0;
     for (var r = 0u; r < count; r++) {
         let a = t0[r]; let b = t1[r];
         var weight: f32;
-        if !weighted {
-            weight = b - a;
-        } else if spot {
+        if spot {
             weight = spot_segment(f, eye, dir, a, b, panels);
         } else {
             weight = f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_between(f.medium[0], a, b);
@@ -233,21 +234,8 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
         total += weight * clamp(vis, 0.0, 1.0);
-        norm += weight;
     }
-    var l: f32;
-    if weighted {
-        l = total;
-    } else {
-        // Average visibility times the unshadowed integral of the whole ray.
-        var unshadowed: f32;
-        if spot {
-            unshadowed = spot_segment(f, eye, dir, 0.0, s, max(f.sizes2_[2] / 4u, 1u));
-        } else {
-            unshadowed = f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_integral(f.medium[0], s);
-        }
-        l = unshadowed * select(1.0, total / norm, norm > 0.0);
-    }
+    let l = total;
     let c = color * l;
     textureStore(output, vec2<u32>(x, y), vec4<f32>(c.x, c.y, c.z, 1.0));
 }

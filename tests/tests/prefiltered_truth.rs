@@ -302,6 +302,111 @@ fn weighted_beats_average_in_thick_fog() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// Regions of the average-visibility sweep.
+const AVERAGE_REGIONS: [u32; 4] = [1, 2, 4, 8];
+
+/// Poses where average visibility with 8 regions misses the weighted bars (3 % sun, 5 %
+/// spot): (scene/pose, measured rel L1 in %, asserted bound in %, why).
+const AVERAGE_EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
+    (
+        "window/ordinary",
+        4.01,
+        4.4,
+        "as weighted (3.47 % with 3 regions): reference-ray weighting and ringing",
+    ),
+    (
+        "window/epipole_on_screen",
+        4.71,
+        5.2,
+        "as weighted (5.18 %)",
+    ),
+    ("window/light_behind", 4.10, 4.5, "as weighted (4.30 %)"),
+    ("window/grazing", 5.04, 5.6, "as weighted (8.03 %)"),
+    (
+        "spot_grate/epipole_on_screen",
+        6.43,
+        7.1,
+        "the texel weights are lengths along the reference ray, with no cone or 1/d^2: a \
+         region's visibility is the mean over light rays the lamp barely lights (weighted: \
+         4.05 %)",
+    ),
+];
+
+/// Average visibility (the prefilter weights texels by length along the reference ray; the
+/// regions combine with the pixel's own unshadowed integrals, as weighted visibility's do) on
+/// every suite pose at 1, 2, 4 and 8 regions: with 8 regions it meets the weighted bars
+/// (3 % sun, 5 % spot) except the poses in [`AVERAGE_EXCEPTIONS`], and more regions never
+/// leave it worse than one region (1 region is the paper's `L_unshadowed * Vbar`, whose error
+/// near the epipole is the method's: foliage/epipole_on_screen 51.8 %).
+#[test]
+fn average_visibility_on_every_pose() {
+    let mut failures = Vec::new();
+    let mut table = vec![
+        "| scene/pose | R = 1 | R = 2 | R = 4 | R = 8 | weighted R = 3 |".to_owned(),
+        "|---|---|---|---|---|---|".to_owned(),
+    ];
+    for (name, pose) in all_poses() {
+        let f = fixture(name, pose, MediumPreset::Default);
+        let light = light_of(name);
+        let key = format!("{name}/{pose}");
+        let mut row = format!("| {key} |");
+        let mut errors = Vec::new();
+        for regions in AVERAGE_REGIONS {
+            let variant = Variant {
+                light,
+                regions,
+                visibility: VisibilityMode::Average,
+                ..Variant::default()
+            };
+            let e = 100.0 * error(&f, &variant);
+            row += &format!(" {e:.2} |");
+            println!(
+                "prefiltered::{}::{name}::{pose}: rel L1 {e:.3} %",
+                variant.id()
+            );
+            errors.push(e);
+        }
+        let (one, eight) = (errors[0], errors[errors.len() - 1]);
+        let bar = if light == LightKind::Spot { 5.0 } else { 3.0 };
+        let exception = AVERAGE_EXCEPTIONS.iter().find(|x| x.0 == key);
+        let bound = exception.map_or(bar, |x| x.2);
+        if !(eight <= bound) {
+            failures.push(format!(
+                "{key}: average visibility, 8 regions: rel L1 {eight:.3} % > {bound} %"
+            ));
+        }
+        if let Some(x) = exception
+            && eight <= bar
+        {
+            failures.push(format!(
+                "{key}: average visibility, 8 regions meets the {bar} % bar now ({eight:.3} %): remove it from AVERAGE_EXCEPTIONS ({})",
+                x.3
+            ));
+        }
+        if !(eight <= one) {
+            failures.push(format!(
+                "{key}: average visibility is worse with 8 regions ({eight:.3} %) than with 1 ({one:.3} %)"
+            ));
+        }
+        let weighted = error(
+            &f,
+            &Variant {
+                light,
+                ..Variant::default()
+            },
+        );
+        row += &format!(" {:.2} |", 100.0 * weighted);
+        table.push(row);
+    }
+    println!(
+        "average visibility, rel L1 % against the shadow_map truth (320x180, default medium):"
+    );
+    for line in &table {
+        println!("{line}");
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
 #[test]
 fn projective_rectification_on_every_pose() {
     let mut failures = Vec::new();

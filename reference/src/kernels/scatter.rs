@@ -7,23 +7,25 @@
 //! for the sun, Gauss-Legendre for a spot) and `Vbar_j = clamp(0.5 + a(d) . F_j, 0, 1)` the
 //! region's prefiltered visibility. With one region this is the paper's `L_unshadowed * Vbar`;
 //! with more, each region's visibility is weighted by the true integrand instead of the
-//! reference ray's. Average visibility: `L = L_unshadowed * sum_j len_j Vbar_j / s`.
+//! reference ray's. Average visibility combines the regions the same way and differs in the
+//! prefilter's texel weights (length along the reference ray instead of its transmittance);
+//! with one region it is the paper's `L_unshadowed * Vbar`. Weighting regions by length
+//! (`L_unshadowed * sum_j len_j Vbar_j / s`) was 51 % off on foliage/epipole_on_screen at
+//! every region count: along a ray towards the sun the shadowed part lies near the eye.
 //! Where the ray's depth `d` is at most the least depth of the texels the fetch reads
 //! (`prefilter`'s bounds), `Vbar_j = 1` exactly; above the greatest, `Vbar_j = 0`.
 
 use super::common_epipolar::{
     epipole_march, normalised_depth, pixel_dir, ray_t, row_index, spot_segment,
 };
-use super::common_model::{
-    clamp, max, max_u, min, mix, phase_hg, select, transmittance_between, transmittance_integral,
-};
+use super::common_model::{clamp, max, max_u, min, mix, phase_hg, transmittance_between};
 use super::common_prefiltered::{
     Tex, TexArray, coeff4, proj_boundary, proj_column, proj_ray_depth, proj_reach, quantise,
     region_start, sample_bilinear, xyz,
 };
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant, VisibilityMode,
+    FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant,
 };
 
 /// Most regions a variant may have (the size of the per-pixel region arrays).
@@ -53,7 +55,6 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         return None;
     }
     let spot = variant.light == LightKind::Spot;
-    let weighted = variant.visibility == VisibilityMode::Weighted;
     let eye = xyz(f.eye);
     let dir = pixel_dir(f, x, y);
     // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
@@ -193,12 +194,9 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         .map(|layer| coeff4(d, layer))
         .collect();
     let mut total = 0.0;
-    let mut norm = 0.0;
     for r in 0..count {
         let (a, b) = (t0[r as usize], t1[r as usize]);
-        let weight = if !weighted {
-            b - a
-        } else if spot {
+        let weight = if spot {
             spot_segment(f, eye, dir, a, b, panels)
         } else {
             f.medium[1]
@@ -235,21 +233,8 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
             }
         }
         total += weight * clamp(vis, 0.0, 1.0);
-        norm += weight;
     }
-    let l = if weighted {
-        total
-    } else {
-        // Average visibility times the unshadowed integral of the whole ray.
-        let unshadowed = if spot {
-            spot_segment(f, eye, dir, 0.0, s, max_u(f.sizes2[2] / 4, 1))
-        } else {
-            f.medium[1]
-                * phase_hg(f.medium[2], cos_theta_l)
-                * transmittance_integral(f.medium[0], s)
-        };
-        unshadowed * select(1.0, total / norm, norm > 0.0)
-    };
+    let l = total;
     let c = color * l;
     Some([c.x, c.y, c.z, 1.0])
 }
