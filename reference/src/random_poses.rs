@@ -11,8 +11,9 @@
 //!   from it, turned towards the scene) or **away** from it (within 20 degrees of the
 //!   direction the light travels);
 //! - for the sun: an azimuth, and an elevation from the horizon to the zenith (0.5-90
-//!   degrees) or, one draw in seven, below the horizon (0.5-30 degrees): then there is no
-//!   light at all;
+//!   degrees) or, one draw in seven, below the horizon (0.5-30 degrees): then no light
+//!   reaches anything above the ground ([`RandomPose::dark`]; `terrain` has no ground
+//!   beyond its heightfield, so there the sun lights the fog past its edges from below);
 //! - for the spot lamp (`spot_grate`): its position (over the grate, or low at the side),
 //!   cone (outer 15-50 degrees) and aim (at the grate, or at the eye so that the eye stands
 //!   inside the cone), its intensity scaled with the square of its distance to the aim.
@@ -27,6 +28,9 @@ use std::fmt;
 
 use glam::DVec3;
 
+use crate::buffers::camera_ray;
+use crate::bvh::Bvh;
+use crate::geometry::Ray;
 use crate::scene::{Light, Orientation, Scene, Shape};
 use crate::suite::{self, MediumPreset, Pose, SceneName};
 
@@ -43,10 +47,10 @@ pub enum Category {
     /// The sun is behind the camera: the point the light travels to (the anti-epipole)
     /// projects inside the image.
     SunBehind,
-    /// The sun is below the horizon: no light reaches anything above the ground.
+    /// The sun is below the horizon: no light reaches anything above an infinite ground.
     SunBelowHorizon,
-    /// `window` with the eye in the room and the sun behind the room's back wall: no light
-    /// enters the room, the truth is 0.
+    /// `window` with the eye in the room, the sun behind the room's back wall and no view
+    /// ray leaving through a window: no light enters the room, the truth is 0.
     ClosedRoom,
     /// The spot lamp projects inside the image.
     LampOnScreen,
@@ -81,11 +85,6 @@ impl Category {
             Category::LampInCone => "lamp_in_cone",
             Category::LampOffScreen => "lamp_off_screen",
         }
-    }
-
-    /// Whether no light reaches any view ray: the truth must be (near-)black.
-    pub const fn is_dark(self) -> bool {
-        matches!(self, Category::SunBelowHorizon | Category::ClosedRoom)
     }
 }
 
@@ -134,6 +133,10 @@ pub struct RandomPose {
     pub scene: Scene,
     /// What the pose shows, measured on its geometry.
     pub category: Category,
+    /// No light reaches any view ray (the truth must be black): a closed room, or a sun
+    /// below the horizon of an infinite ground plane (`terrain` has none: a sun below its
+    /// horizon lights the fog beyond the heightfield's edges).
+    pub dark: bool,
     /// The eye lies inside the scene's bounds.
     pub eye_inside: bool,
     /// How the view was drawn relative to the light.
@@ -409,6 +412,40 @@ fn on_screen(scene: &Scene, dir: DVec3) -> bool {
         })
 }
 
+/// `window`: whether every pixel's ray ends on the room's walls, floor or ceiling (none
+/// leaves through a window).
+fn sees_only_the_room(scene: &Scene) -> bool {
+    let bvh = Bvh::build(&scene.geometry);
+    let cam = &scene.camera;
+    let frame = cam.frame();
+    let room = (v(-6.31, -0.01, -6.31), v(6.31, 5.31, 6.31));
+    (0..cam.height).all(|y| {
+        (0..cam.width).all(|x| {
+            let dir = camera_ray(scene, &frame, x, y);
+            bvh.closest(&Ray::new(cam.position, dir), 0.0, f64::INFINITY)
+                .is_some_and(|hit| in_box(cam.position + dir * hit.t, room))
+        })
+    })
+}
+
+/// Whether no light reaches the eye's surroundings: a closed room, or a sun behind an
+/// infinite plane (the ground) the eye stands in front of.
+fn is_dark(scene: &Scene, category: Category) -> bool {
+    match (category, &scene.light) {
+        (Category::ClosedRoom, _) => true,
+        (Category::SunBelowHorizon, Light::Directional { direction, .. }) => {
+            scene.geometry.iter().any(|s| match s {
+                Shape::Plane { point, normal, .. } => {
+                    normal.dot(*direction) > 0.0
+                        && (scene.camera.position - *point).dot(*normal) > 0.0
+                }
+                _ => false,
+            })
+        }
+        _ => false,
+    }
+}
+
 /// The pose's category, measured on its geometry.
 fn classify(name: SceneName, scene: &Scene, b: &Bounds) -> (Category, bool) {
     let eye = scene.camera.position;
@@ -417,8 +454,13 @@ fn classify(name: SceneName, scene: &Scene, b: &Bounds) -> (Category, bool) {
             let to_sun = -direction.normalize();
             let cat = if to_sun.y < 0.0 {
                 Category::SunBelowHorizon
-            } else if name == SceneName::Window && in_box(eye, b.inner) && to_sun.z >= 0.0 {
-                // The windows are in the wall at z = -6: a sun at +z shines on the back wall.
+            } else if name == SceneName::Window
+                && in_box(eye, b.inner)
+                && to_sun.z >= 0.0
+                && sees_only_the_room(scene)
+            {
+                // The windows are in the wall at z = -6: a sun at +z shines on the back wall,
+                // and no view ray leaves the room through a window.
                 Category::ClosedRoom
             } else if on_screen(scene, to_sun) {
                 Category::SunOnScreen
@@ -554,11 +596,13 @@ fn pose_on(base: &Scene, name: SceneName, index: u32, seed: u64) -> RandomPose {
             continue;
         }
         let (category, eye_in_cone) = classify(name, &scene, &bounds(name));
+        let dark = is_dark(&scene, category);
         return RandomPose {
             scene_name: name,
             index,
             scene,
             category,
+            dark,
             eye_inside,
             view,
             eye_in_cone,
