@@ -304,7 +304,10 @@ impl ShadowMap {
                 let u = (ix as f64 + 0.5) / n as f64;
                 let v = (iy as f64 + 0.5) / n as f64;
                 let (ray, z_of_t) = sm.texel_ray(u, v);
-                if backlit.iter().any(|(p, nrm)| (ray.origin - *p).dot(*nrm) > 0.0) {
+                if backlit
+                    .iter()
+                    .any(|(p, nrm)| (ray.origin - *p).dot(*nrm) > 0.0)
+                {
                     return 0.0;
                 }
                 match bvh.closest(&ray, 0.0, f64::INFINITY) {

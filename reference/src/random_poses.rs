@@ -159,7 +159,12 @@ impl RandomPose {
     pub fn describe(&self) -> String {
         let light = match (&self.scene.light, self.sun_elevation_deg) {
             (Light::Directional { .. }, Some(el)) => format!("sun {el:.1} deg"),
-            (Light::Spot { outer_angle_deg, .. }, _) => format!(
+            (
+                Light::Spot {
+                    outer_angle_deg, ..
+                },
+                _,
+            ) => format!(
                 "lamp outer {outer_angle_deg:.0} deg, eye {} the cone",
                 if self.eye_in_cone { "in" } else { "outside" }
             ),
@@ -303,17 +308,13 @@ fn in_box(p: DVec3, (min, max): (DVec3, DVec3)) -> bool {
 fn inside_solid(shapes: &[Shape], p: DVec3, margin: f64) -> bool {
     shapes.iter().any(|s| match s {
         Shape::Plane { point, normal, .. } => (p - *point).dot(normal.normalize()) < margin,
-        Shape::Box { min, max, .. } => {
-            p.cmpgt(*min - margin).all() && p.cmplt(*max + margin).all()
-        }
+        Shape::Box { min, max, .. } => p.cmpgt(*min - margin).all() && p.cmplt(*max + margin).all(),
         Shape::Sphere { center, radius, .. } => (p - *center).length() < radius + margin,
         Shape::Cylinder { a, b, radius, .. } => {
             let axis = *b - *a;
             let len = axis.length();
             let t = (p - *a).dot(axis / len);
-            t > -margin
-                && t < len + margin
-                && (p - *a - axis / len * t).length() < radius + margin
+            t > -margin && t < len + margin && (p - *a - axis / len * t).length() < radius + margin
         }
         Shape::Heightfield {
             origin,
@@ -477,9 +478,7 @@ fn classify(name: SceneName, scene: &Scene, b: &Bounds) -> (Category, bool) {
             outer_angle_deg,
             ..
         } => {
-            let in_cone = (eye - *position)
-                .normalize()
-                .dot(direction.normalize())
+            let in_cone = (eye - *position).normalize().dot(direction.normalize())
                 > outer_angle_deg.to_radians().cos();
             let cat = if on_screen(scene, *position - eye) {
                 Category::LampOnScreen
@@ -639,10 +638,15 @@ mod tests {
         assert_eq!(a.len(), 6 * 12);
         for (p, q) in a.iter().zip(&b) {
             assert_eq!(p.scene, q.scene, "{}", p.name());
-            p.scene.validate().unwrap_or_else(|e| panic!("{}: {e}", p.name()));
+            p.scene
+                .validate()
+                .unwrap_or_else(|e| panic!("{}: {e}", p.name()));
         }
         // A pose does not depend on how many are drawn.
-        assert_eq!(pose(SceneName::Window, 5, DEFAULT_SEED, 48, 27).scene, a[2 * 12 + 5].scene);
+        assert_eq!(
+            pose(SceneName::Window, 5, DEFAULT_SEED, 48, 27).scene,
+            a[2 * 12 + 5].scene
+        );
         assert_ne!(
             pose(SceneName::Window, 5, DEFAULT_SEED ^ 1, 48, 27).scene,
             a[2 * 12 + 5].scene
@@ -666,8 +670,15 @@ mod tests {
             assert!(!inside_solid(&p.scene.geometry, eye, 0.1), "{}", p.name());
             let spot = matches!(p.scene.light, Light::Spot { .. });
             assert_eq!(spot, p.scene_name == SceneName::SpotGrate, "{}", p.name());
-            if let Light::Spot { outer_angle_deg, .. } = p.scene.light {
-                assert!(outer_angle_deg < 80.0, "{}: the shadow map needs < 80", p.name());
+            if let Light::Spot {
+                outer_angle_deg, ..
+            } = p.scene.light
+            {
+                assert!(
+                    outer_angle_deg < 80.0,
+                    "{}: the shadow map needs < 80",
+                    p.name()
+                );
             }
             if p.category == Category::SunBelowHorizon {
                 assert!(p.sun_elevation_deg.is_some_and(|e| e < 0.0), "{}", p.name());
@@ -675,17 +686,32 @@ mod tests {
         }
         // Every category occurs with the suite's seed and count.
         for c in Category::ALL {
-            assert!(count.get(c).copied().unwrap_or(0) > 0, "no {c} pose: {count:?}");
+            assert!(
+                count.get(c).copied().unwrap_or(0) > 0,
+                "no {c} pose: {count:?}"
+            );
         }
     }
 
     #[test]
     fn inside_solid_sees_the_suite_shapes() {
-        let s = suite::scene(SceneName::Sphere, Pose::Ordinary, MediumPreset::Default, 8, 8);
+        let s = suite::scene(
+            SceneName::Sphere,
+            Pose::Ordinary,
+            MediumPreset::Default,
+            8,
+            8,
+        );
         assert!(inside_solid(&s.geometry, v(0.0, 4.0, 0.0), 0.0));
         assert!(inside_solid(&s.geometry, v(0.0, -1.0, 5.0), 0.0));
         assert!(!inside_solid(&s.geometry, v(0.0, 1.0, 5.0), 0.2));
-        let t = suite::scene(SceneName::Terrain, Pose::Ordinary, MediumPreset::Default, 8, 8);
+        let t = suite::scene(
+            SceneName::Terrain,
+            Pose::Ordinary,
+            MediumPreset::Default,
+            8,
+            8,
+        );
         assert!(inside_solid(&t.geometry, v(0.0, 1.0, 0.0), 0.0));
         assert!(!inside_solid(&t.geometry, v(0.0, 60.0, 0.0), 0.0));
     }

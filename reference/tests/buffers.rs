@@ -286,7 +286,12 @@ fn sun_below_the_horizon_shadows_everything_above_the_ground() {
                 "{}: {p} sees a sun below the horizon",
                 s.name
             );
-            assert_eq!(sm.visibility(p), 0.0, "{}: {p} lit in the shadow map", s.name);
+            assert_eq!(
+                sm.visibility(p),
+                0.0,
+                "{}: {p} lit in the shadow map",
+                s.name
+            );
         }
     }
 }

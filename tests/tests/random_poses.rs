@@ -70,20 +70,20 @@ type Bar = (&'static str, f64, f64, f64);
 const BARS: &[Bar] = &[
     // Chen 2011. Provisional: to be set from the fixes of issue 12. Measured: p90 1.38 %,
     // max 6.77 % (spot_grate::6, lamp on screen: the uniform epipole march), near-black
-    // 0.120 (window::2, sun on screen through the window wall: light in a dark frame).
+    // 0.120 (window::11, eye in the room looking towards the sun: light in a dark frame).
     ("minmax", 0.016, 0.075, 0.135),
     // The paper's default, weighted visibility. Provisional: to be set from the fixes of
     // issue 12. Measured: p90 3.73 %, max 27.5 % (window::7, looking out of the room:
-    // Fourier ringing), near-black 0.616 (columns, sun below the horizon: ringing lights a
-    // frame that has no light).
+    // Fourier ringing), near-black 0.616 (columns::22, sun below the horizon: light in a
+    // frame that has none; window::5, a closed room: 0.431).
     ("prefiltered-m32-r3", 0.041, 0.31, 0.68),
     // Average visibility. Provisional: to be set from the fixes of issue 12. Measured: p90
     // 14.4 %, max 110 % (window::7), near-black 0.617 (as weighted).
     ("prefiltered-m32-r3-average", 0.16, 1.21, 0.68),
     // The GPU reference method, N = 64. Provisional: to be set from the fixes of issue 12.
     // Measured: p90 2.98 %, max 17.1 % (spot_grate::12, eye in the cone: the uniform march
-    // misses the 1/d^2 peak), near-black 0.0117 (columns, sun below the horizon: the
-    // march's cells straddle the truth's thin bias-lit layer over the ground).
+    // misses the 1/d^2 peak), near-black 0.0117 (columns::0, sun below the horizon: the
+    // frame's only light is the truth's thin bias-lit layer of fog over the ground).
     ("raymarch-n64-i1", 0.033, 0.19, 0.013),
 ];
 
@@ -476,7 +476,7 @@ fn report(r: &Results, backend: &str) {
     for l in &r.labels {
         let v = r.rel_l1s(l, &all);
         let s = stats(&v);
-        let over = v.iter().filter(|&&x| !(x <= HIGH_ERROR)).count();
+        let over = v.iter().filter(|&&x| !within(x, HIGH_ERROR)).count();
         let nan: usize = r
             .frames
             .iter()
@@ -506,10 +506,7 @@ fn report(r: &Results, backend: &str) {
             .iter()
             .map(|l| cell(stats(&r.rel_l1s(l, &keep))))
             .collect();
-        println!(
-            "| {scene} ({n}, {nb}, {lit:.3e}) | {} |",
-            cells.join(" | ")
-        );
+        println!("| {scene} ({n}, {nb}, {lit:.3e}) | {} |", cells.join(" | "));
     }
     println!("\n### Per pose category (median / p90 / max %, frames not near-black)\n");
     header("category (frames, near-black)");
