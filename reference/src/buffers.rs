@@ -18,11 +18,13 @@
 //! ray, 1.0 where there is none. Lookups are nearest-texel; a point is lit iff its depth is
 //! <= the stored depth + [`ShadowMap::bias_world`] (1.5 texel footprints in world units,
 //! converted to normalised depth): the "documented bias" of the `shadow_map` truth.
-//! Points outside the map's footprint are lit.
+//! Points outside the map's footprint are lit. An infinite plane lit from behind (the ground
+//! with the sun below the horizon) stores depth 0 wherever it lies between the sun and the
+//! map's near plane, as a depth-clamped caster would: everything in front of it is shadowed.
 
 use crate::bvh::Bvh;
 use crate::geometry::{Aabb, Ray};
-use crate::scene::{Frame, Light, Scene};
+use crate::scene::{Frame, Light, Scene, Shape};
 use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 
@@ -205,6 +207,25 @@ impl ShadowMap {
         if size > 16384 {
             return Err(ShadowMapError::TooLarge(size));
         }
+        // Infinite planes the sun shines on from behind (a sun below the ground's horizon):
+        // the near plane stops at the bounded geometry, so such a plane may cross a texel's
+        // line between the sun and the map. Every point in front of it is then in its
+        // shadow, as an engine's depth-clamped ("pancaked") caster would make it: depth 0.
+        let backlit: Vec<(DVec3, DVec3)> = match &scene.light {
+            Light::Directional { direction, .. } => scene
+                .geometry
+                .iter()
+                .filter_map(|s| match s {
+                    Shape::Plane { point, normal, .. }
+                        if normal.normalize().dot(direction.normalize()) > 0.0 =>
+                    {
+                        Some((*point, normal.normalize()))
+                    }
+                    _ => None,
+                })
+                .collect(),
+            Light::Spot { .. } => Vec::new(),
+        };
         let corners = scene.camera.frustum_corners();
         let scene_bounds = bvh.bounds();
         let mut sm = match &scene.light {
@@ -283,6 +304,12 @@ impl ShadowMap {
                 let u = (ix as f64 + 0.5) / n as f64;
                 let v = (iy as f64 + 0.5) / n as f64;
                 let (ray, z_of_t) = sm.texel_ray(u, v);
+                if backlit
+                    .iter()
+                    .any(|(p, nrm)| (ray.origin - *p).dot(*nrm) > 0.0)
+                {
+                    return 0.0;
+                }
                 match bvh.closest(&ray, 0.0, f64::INFINITY) {
                     Some(hit) => sm.normalise(z_of_t(hit.t)).clamp(0.0, 1.0) as f32,
                     None => 1.0,

@@ -4,6 +4,7 @@
 //! - [`suite`]: the named scene suite (`sphere`, `columns`, `window`, `foliage`, `terrain`,
 //!   `spot_grate`), its camera poses and medium presets;
 //! - [`stress`]: the stress configurations where methods break (issue 6);
+//! - [`random_poses`]: seeded random camera and light poses on every suite scene (issue 12);
 //! - [`paths`]: 60-frame camera paths and light rotations for the flicker measurements;
 //! - [`geometry`] and [`bvh`]: primitives and a binned-SAH bounding volume hierarchy;
 //! - [`buffers`]: the inputs every method gets: the camera depth buffer and a standard light
@@ -28,6 +29,7 @@ pub mod metrics;
 pub mod model;
 pub mod paths;
 pub mod projective;
+pub mod random_poses;
 pub mod scene;
 pub mod stress;
 pub mod suite;

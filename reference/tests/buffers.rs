@@ -258,6 +258,44 @@ fn directional_shadow_map_covers_the_eye_and_the_frustum() {
     }
 }
 
+/// A sun below the horizon: the ground plane crosses texel lines between the sun and the
+/// map's near plane (which stops at the bounded geometry), so the map must store it there
+/// (depth 0) for the points above the ground to be shadowed, as exact visibility says.
+#[test]
+fn sun_below_the_horizon_shadows_everything_above_the_ground() {
+    for &name in &[SceneName::Sphere, SceneName::Columns, SceneName::Foliage] {
+        let mut s = small(name, Pose::Ordinary);
+        let to_sun = DVec3::new(0.6, -0.15, -0.8).normalize();
+        s.light = Light::Directional {
+            direction: -to_sun,
+            irradiance: [1.0; 3],
+        };
+        let bvh = Bvh::build(&s.geometry);
+        let sm = ShadowMap::build(&s, &bvh, 256).unwrap();
+        let mut rng = Rng(7);
+        let cam = &s.camera;
+        for _ in 0..2000 {
+            // Points of the view frustum at least 0.5 m above the ground.
+            let d = rng.dir();
+            let p = cam.position + d * (cam.far * rng.f());
+            if p.y < 0.5 || sm.coord(p).is_none() {
+                continue;
+            }
+            assert!(
+                !visibility(&Visibility::Exact(&bvh), &s.light, p),
+                "{}: {p} sees a sun below the horizon",
+                s.name
+            );
+            assert_eq!(
+                sm.visibility(p),
+                0.0,
+                "{}: {p} lit in the shadow map",
+                s.name
+            );
+        }
+    }
+}
+
 /// The shadow map is the discretisation of exact visibility: at 2048 texels they agree on
 /// nearly every point of the view frustum.
 #[test]
