@@ -17,6 +17,9 @@
 //! - raymarch converges: N = 256 beats N = 16 on every case, and is within 2 % on every
 //!   case of at least 1000 pixels;
 //! - minmax within 5 % on every case;
+//! - prefiltered with average visibility (3 regions): finite and exact zeros only (it is
+//!   11-28 % off on `closed_room_windows` and the spot poses; its accuracy bars, at 8
+//!   regions, are in `prefiltered_truth`);
 //! - the safe paths: epipole or anti-epipole on screen -> the neighbourhood is ray-marched
 //!   (`FrameReport::marched_radius_px`) and a projective variant falls back to epipolar with
 //!   the reason, its output then equal to the epipolar variant's.
@@ -39,7 +42,7 @@ use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{
     FrameReport, FrameSettings, LightKind, ProjectiveFallback, Rectification, Resolutions, Storage,
-    Variant, prepare_frame,
+    Variant, VisibilityMode, prepare_frame,
 };
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -82,7 +85,7 @@ const DARK_EXCEPTIONS: &[(&str, Rectification, f64, &str)] = &[(
 
 /// The variants run on every case (directional; each case sets the light, and the
 /// prefiltered bases where it stresses them): the prefiltered default, epipolar and
-/// projective, raymarch N = 16, 64 and 256, and minmax.
+/// projective, and with average visibility; raymarch N = 16, 64 and 256; minmax.
 fn methods() -> Vec<FamilyVariant> {
     let raymarch = |samples| {
         FamilyVariant::Raymarch(RaymarchVariant {
@@ -97,6 +100,11 @@ fn methods() -> Vec<FamilyVariant> {
             ..Variant::default()
         }
         .into(),
+        Variant {
+            visibility: VisibilityMode::Average,
+            ..Variant::default()
+        }
+        .into(),
         raymarch(16),
         raymarch(64),
         raymarch(256),
@@ -104,10 +112,12 @@ fn methods() -> Vec<FamilyVariant> {
     ]
 }
 
-/// The prefiltered default with a projective rectification, or `None`.
+/// The rectification of a weighted prefiltered variant, or `None`.
 fn rectification(m: &FamilyVariant) -> Option<Rectification> {
     match m {
-        FamilyVariant::Prefiltered(v) => Some(v.rectification),
+        FamilyVariant::Prefiltered(v) if v.visibility == VisibilityMode::Weighted => {
+            Some(v.rectification)
+        }
         _ => None,
     }
 }
@@ -379,6 +389,10 @@ fn every_family_survives_every_stress_case() {
                 e.0 == name && rectification(&c.method) == Some(Rectification::Projective)
             });
             let bar = match c.method {
+                // Average visibility: finite and exact zeros only here (with 3 regions it is
+                // 11-28 % off on closed_room_windows and the spot poses); its bars are in
+                // prefiltered_truth (`average_visibility_on_every_pose`, 8 regions).
+                FamilyVariant::Prefiltered(v) if v.visibility == VisibilityMode::Average => None,
                 FamilyVariant::Prefiltered(_) if p.case.group == StressGroup::Pose => {
                     Some(exception.map_or(PREFILTERED_POSE_BAR, |e| e.1))
                 }
