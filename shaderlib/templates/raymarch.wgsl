@@ -3,12 +3,15 @@
 // sampling (Tóth & Umenhoffer 2009).
 //
 // Per pixel: the view ray [0, s] (s from the depth buffer) is cut into N = march.sizes.w
-// cells of length h = s / N; cell j is sampled at (j + u) h, u = 0.5 or the pixel's jitter
-// (march.interleave.z). Directional: each sample adds V times the exact transmittance
-// integral over its cell, scaled once by sigma_s p E; spot: V f(t) h with f the shadow-free
-// integrand (cone, exp(-sigma_t (d + t)) / d^2, phase), times I. With interleaving the pixel
-// of class c = (x mod Mx) + Mx (y mod My) takes only the cells j = c (mod Mx My) and stores
-// its partial sum for `interleave_sum`.
+// cells; cell j is sampled at offset u = 0.5 or the pixel's jitter (march.interleave.z).
+// Directional: cells of length h = s / N in t, sampled at (j + u) h; each sample adds V times
+// the exact transmittance integral over its cell, scaled once by sigma_s p E. Spot: N
+// equiangular strata (`scatter::model::equiangular`: equal angles under which the lamp sees
+// the ray, Kulla & Fajardo 2012), sampled at j + u; each adds V f(t) w with f the shadow-free
+// integrand (cone, exp(-sigma_t (d + t)) / d^2, phase) and w = 1 / (N pdf(t)), which cancels
+// the 1/d^2 peak of a ray passing next to the lamp; times I. With interleaving the pixel of
+// class c = (x mod Mx) + Mx (y mod My) takes only the cells j = c (mod Mx My) (for a spot,
+// its strata of the same equiangular set) and stores its partial sum for `interleave_sum`.
 //
 // Bindings (group 0):
 // | binding | name       | type                                         | access       |
@@ -24,7 +27,7 @@
 //
 // Mirrors reference/src/kernels/raymarch.rs
 
-#import scatter::model::{phase_hg, spot_integrand, transmittance_between}
+#import scatter::model::{equiangular, equiangular_sample, phase_hg, spot_integrand, transmittance_between}
 #import scatter::shadow::shadow_visibility
 #import scatter::raymarch::{March, march_pixel_dir, march_shadow_view, pixel_jitter}
 
@@ -57,12 +60,19 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
         u = pixel_jitter(x, y);
     }
     let view = march_shadow_view(m);
+    let strata = equiangular(eye, dir, m.light_pos.xyz, 0.0, s, n);
     var sum = 0.0;
     for (var j = pixel_class; j < n; j += stride) {
-        let t = (f32(j) + u) * h;
+        var t = (f32(j) + u) * h;
+        var w = h;
+        if spot {
+            let tw = equiangular_sample(strata, f32(j) + u);
+            t = tw.x;
+            w = tw.y;
+        }
         let v = shadow_visibility(view, shadow_map, eye + dir * t);
         if spot {
-            sum += v * h * spot_integrand(eye, dir, t, m.light_pos.xyz, m.light_dir.xyz, m.light_pos[3], m.light_dir[3], m.medium);
+            sum += v * w * spot_integrand(eye, dir, t, m.light_pos.xyz, m.light_dir.xyz, m.light_pos[3], m.light_dir[3], m.medium);
         } else {
             sum += v * transmittance_between(m.medium[0], f32(j) * h, f32(j + 1u) * h);
         }

@@ -7,7 +7,11 @@
 //! `epipole_on_screen` poses; 48x27 pixels, 64x32 rectified map, 128^2 shadow map), the test
 //! hashes every texture the runtime reads back (FNV-1a over the f32 bits) and compares the
 //! hashes with `tests/data/fingerprints.txt`, which was written by this same file run on the
-//! commit before the redesign (45a9458, the hand-wired runtime).
+//! commit before the redesign (45a9458, the hand-wired runtime). Re-blessed once since, for
+//! an intended change of outputs (issue 12, equiangular spot marches): only the 60 spot lines
+//! of the marches moved (the prefiltered and minmax `output` on `spot_grate/epipole_on_screen`,
+//! whose epipole disc is marched, and the raymarch spot `partial` and `output`); every
+//! directional line and every intermediate (`rectified`, `filtered`, `tree`) kept its bits.
 //!
 //! The hashes are those of lavapipe (Mesa 22.3.6, LLVM 15): another driver may round
 //! differently, so on any other adapter the test prints a loud skip and asserts nothing;

@@ -9,6 +9,13 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     uint4 size;
 };
 
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
+};
+
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float4 eye;
     float4 axis;
@@ -73,8 +80,8 @@ float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oi
 {
     if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t_2 = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_2))), (0.5 - ((0.5 * ls.y) / (z_1 * t_2))));
+        float t_3 = v_1.proj.x;
+        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
     } else {
         return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -111,10 +118,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
     if (_e27) {
         return 2.0;
     }
-    uint n_1 = v_2.size.x;
-    uint x_3 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
-    uint y_1 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_3, y_1), int(0)));
+    uint n_2 = v_2.size.x;
+    uint x_4 = min(naga_f2u32((uv.x * float(n_2))), (n_2 - 1u));
+    uint y_1 = min(naga_f2u32((uv.y * float(n_2))), (n_2 - 1u));
+    float4 _e49 = sm.Load(int3(uint2(x_4, y_1), int(0)));
     return _e49.x;
 }
 
@@ -161,18 +168,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        float3 dir_6 = float3(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
-        if ((dir_6.z <= 1e-6)) {
+        float3 dir_7 = float3(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
+        if ((dir_7.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
+        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_7);
         const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_6.z);
+        return ((z_2 + _e35) / dir_7.z);
     } else {
         const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -193,11 +200,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_4 = (sigma_t * len);
-    if ((x_4 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_4)));
+    float x_5 = (sigma_t * len);
+    if ((x_5 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_5)));
     }
-    return ((1.0 - exp(-(x_4))) / sigma_t);
+    return ((1.0 - exp(-(x_5))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -211,14 +218,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
+    float x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_6 * x_6) * (3.0 - (2.0 * x_6)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_6 = (eye + (dir * t));
-    float3 to_x = (x_6 - light_pos);
+    float3 x_7 = (eye + (dir * t));
+    float3 to_x = (x_7 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     float3 travel = (to_x / (d).xxx);
@@ -236,7 +243,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
     float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
     float g0_ = atan(((a_1 - t0_) / h));
-    float w = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
+    float w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
     while(true) {
@@ -254,7 +261,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         }
         {
             uint _e32 = k_1;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w));
+            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
             bool loop_init_1 = true;
@@ -273,7 +280,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
                 }
                 {
                     uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
+                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
                     float _e52 = sum;
                     uint _e54 = q;
                     const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -283,7 +290,31 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w) * h);
+    return (((_e75 * 0.5) * w_1) * h);
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ret = (EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX)0;
+    ret.t_close = arg0;
+    ret.dist = arg1;
+    ret.theta_a = arg2;
+    ret.dtheta = arg3;
+    return ret;
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_2, float3 dir_2, float3 light_pos_2, float a_2, float b_2, uint n)
+{
+    float t0_1 = dot((light_pos_2 - eye_2), dir_2);
+    float h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_1) / h_1));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / float(n)));
+    return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
+}
+
+float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x)
+{
+    float tau = tan((e.theta_a + (x * e.dtheta)));
+    return float2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
 SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float arg0, float arg1, float arg2, float arg3) {
@@ -306,12 +337,12 @@ float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta,
     return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
 }
 
-float3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, uint x, uint y)
+float3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, uint x_1, uint y)
 {
-    float ndc_x = (((2.0 * (float(x) + 0.5)) / float(f.sizes.x)) - 1.0);
+    float ndc_x = (((2.0 * (float(x_1) + 0.5)) / float(f.sizes.x)) - 1.0);
     float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(f.sizes.y)));
-    float t_3 = f.cam_forward.w;
-    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_3) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_3))));
+    float t_4 = f.cam_forward.w;
+    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_4) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_4))));
 }
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(float4 arg0, float4 arg1, float4 arg2, float4 arg3, float4 arg4, uint4 arg5) {
@@ -338,58 +369,71 @@ float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     return _e4;
 }
 
-float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, float3 eye_2, float3 dir_2, float t_1)
+float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, float3 eye_3, float3 dir_3, float t_1)
 {
-    const float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
+    const float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, Texture2D<float4> sm_4, float3 eye_3, float3 dir_3, float s, bool spot)
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, Texture2D<float4> sm_4, float3 eye_4, float3 dir_4, float s, bool spot)
 {
     float sum_1 = 0.0;
     uint k_2 = 0u;
+    float t_2 = (float)0;
+    float w = (float)0;
 
     uint steps = f_4.sizes2_.y;
-    float h_1 = (s / float(steps));
+    float h_2 = (s / float(steps));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0.0, s, steps);
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e44 = k_2;
-            k_2 = (_e44 + 1u);
+            uint _e60 = k_2;
+            k_2 = (_e60 + 1u);
         }
         loop_init_2 = false;
-        uint _e9 = k_2;
-        if ((_e9 < steps)) {
+        uint _e15 = k_2;
+        if ((_e15 < steps)) {
         } else {
             break;
         }
         {
-            uint _e11 = k_2;
-            float t_4 = ((float(_e11) + 0.5) * h_1);
-            const float _e21 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_3 + (dir_3 * t_4)));
+            uint _e17 = k_2;
+            t_2 = ((float(_e17) + 0.5) * h_2);
+            w = h_2;
             if (spot) {
-                float _e24 = sum_1;
-                const float _e26 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_3, dir_3, t_4);
-                sum_1 = (_e24 + ((_e21 * h_1) * _e26));
+                uint _e25 = k_2;
+                const float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e25) + 0.5));
+                t_2 = _e29.x;
+                w = _e29.y;
+            }
+            float _e32 = t_2;
+            const float _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e32)));
+            if (spot) {
+                float _e38 = sum_1;
+                float _e39 = w;
+                float _e41 = t_2;
+                const float _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e41);
+                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
             } else {
-                float _e29 = sum_1;
-                uint _e32 = k_2;
-                uint _e35 = k_2;
-                const float _e40 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (float(_e32) * h_1), (float((_e35 + 1u)) * h_1));
-                sum_1 = (_e29 + (_e21 * _e40));
+                float _e45 = sum_1;
+                uint _e48 = k_2;
+                uint _e51 = k_2;
+                const float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (float(_e48) * h_2), (float((_e51 + 1u)) * h_2));
+                sum_1 = (_e45 + (_e36 * _e56));
             }
         }
     }
     if (spot) {
-        float _e46 = sum_1;
-        return _e46;
+        float _e62 = sum_1;
+        return _e62;
     } else {
-        const float _e55 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_3)));
-        float _e57 = sum_1;
-        return ((f_4.medium.y * _e55) * _e57);
+        const float _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_4)));
+        float _e73 = sum_1;
+        return ((f_4.medium.y * _e71) * _e73);
     }
 }
 
@@ -412,12 +456,12 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, 
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float x_1, float delta, float theta_1, float s_1, bool spot_1)
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float x_2, float delta, float theta_1, float s_1, bool spot_1)
 {
     bool local_11 = (bool)0;
 
     if (spot_1) {
-        float psi = (x_1 * delta);
+        float psi = (x_2 * delta);
         float den = sin((theta_1 + psi));
         if (!((den <= 1e-6))) {
             local_11 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
@@ -430,13 +474,13 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         }
         return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_1 * delta) / max(sin(theta_1), 1e-6)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_1), 1e-6)), s_1);
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 eye_4, float3 dir_4, float a_2, float b_2, uint panels_1)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 eye_5, float3 dir_5, float a_3, float b_3, uint panels_1)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -499,12 +543,12 @@ uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_1, uint wi
     return _e14;
 }
 
-float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, uint x_2, uint n, float delta_1, float theta_2, float s_2, bool spot_2)
+float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, uint x_3, uint n_1, float delta_1, float theta_2, float s_2, bool spot_2)
 {
-    if ((x_2 >= n)) {
+    if ((x_3 >= n_1)) {
         return s_2;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, float(x_2), delta_1, theta_2, s_2, spot_2);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, float(x_3), delta_1, theta_2, s_2, spot_2);
     return _e9;
 }
 
@@ -512,13 +556,13 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_5, float3 dir_5, float a_3, float b_3, bool spot_3)
+float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_6, float3 dir_6, float a_4, float b_4, bool spot_3)
 {
     if (spot_3) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_5, dir_5, a_3, b_3, max(naga_div(f_8.sizes2_.z, 4u), 1u));
+        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_6, dir_6, a_4, b_4, max(naga_div(f_8.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_3, b_3);
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -543,9 +587,9 @@ void minmax_march(uint3 id : SV_DispatchThreadID)
     float l = (float)0;
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
-    uint x_7 = id.x;
+    uint x_8 = id.x;
     uint y_2 = id.y;
-    if (!((x_7 >= f_9.sizes.x))) {
+    if (!((x_8 >= f_9.sizes.x))) {
         local = (y_2 >= f_9.sizes.y);
     } else {
         local = true;
@@ -554,12 +598,12 @@ void minmax_march(uint3 id : SV_DispatchThreadID)
     if (_e18) {
         return;
     }
-    float3 eye_6 = f_9.eye.xyz;
-    const float3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_7, y_2);
-    float4 _e25 = depth.Load(int3(uint2(x_7, y_2), int(0)));
+    float3 eye_7 = f_9.eye.xyz;
+    const float3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_8, y_2);
+    float4 _e25 = depth.Load(int3(uint2(x_8, y_2), int(0)));
     float s_3 = (min(max(_e25.x, 0.0), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 1e-6));
     float3 color = f_9.light_color.xyz;
-    float3 px = float3((float(x_7) + 0.5), (float(y_2) + 0.5), 0.0);
+    float3 px = float3((float(x_8) + 0.5), (float(y_2) + 0.5), 0.0);
     float radius = f_9.epipole.w;
     if ((f_9.epipole.z > 0.5)) {
         local_1 = (length((px - float3(f_9.epipole.x, f_9.epipole.y, 0.0))) < radius);
@@ -581,9 +625,9 @@ void minmax_march(uint3 id : SV_DispatchThreadID)
     bool _e88 = local_3;
     if (_e88) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = frame;
-        const float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_6, _e21, s_3, true);
+        const float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_7, _e21, s_3, true);
         float3 l_2 = (_e93 * color);
-        output[uint2(x_7, y_2)] = float4(l_2.x, l_2.y, l_2.z, 1.0);
+        output[uint2(x_8, y_2)] = float4(l_2.x, l_2.y, l_2.z, 1.0);
         return;
     }
     float3 axis = f_9.axis.xyz;
@@ -608,21 +652,21 @@ void minmax_march(uint3 id : SV_DispatchThreadID)
     float delta_2 = _e148.delta;
     const float _e154 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_3, f_9.theta.x, f_9.theta.y);
     if (true) {
-        float3 q_2 = normalize(((eye_6 + (_e21 * s_3)) - f_9.light_pos.xyz));
+        float3 q_2 = normalize(((eye_7 + (_e21 * s_3)) - f_9.light_pos.xyz));
         xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / delta_2);
     } else {
         xs = ((s_3 * sin(theta_3)) / delta_2);
     }
     float _e172 = xs;
     float _e173 = xs;
-    uint n_2 = naga_f2u32(min(ceil(((_e173 > 0.0) ? _e172 : 0.0)), float(width_3)));
+    uint n_3 = naga_f2u32(min(ceil(((_e173 > 0.0) ? _e172 : 0.0)), float(width_3)));
     const uint _e182 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
     while(true) {
         if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         uint _e184 = i;
-        if ((_e184 < n_2)) {
+        if ((_e184 < n_3)) {
         } else {
             break;
         }
@@ -644,7 +688,7 @@ void minmax_march(uint3 id : SV_DispatchThreadID)
                 if (_e204) {
                     uint _e205 = i;
                     uint _e207 = k;
-                    local_5 = ((_e205 + (2u << _e207)) <= n_2);
+                    local_5 = ((_e205 + (2u << _e207)) <= n_3);
                 } else {
                     local_5 = false;
                 }
@@ -689,14 +733,14 @@ void minmax_march(uint3 id : SV_DispatchThreadID)
             bool _e248 = in_run;
             if ((_e247 != _e248)) {
                 uint _e250 = i;
-                const float _e251 = edge_t(f_9, _e250, n_2, delta_2, theta_3, s_3, true);
+                const float _e251 = edge_t(f_9, _e250, n_3, delta_2, theta_3, s_3, true);
                 bool _e252 = lit_;
                 if (_e252) {
                     run_a = _e251;
                 } else {
                     float _e255 = total;
                     float _e256 = run_a;
-                    const float _e257 = lit_span(f_9, eye_6, _e21, _e256, _e251, true);
+                    const float _e257 = lit_span(f_9, eye_7, _e21, _e256, _e251, true);
                     total = (_e255 + _e257);
                 }
                 bool _e259 = lit_;
@@ -711,7 +755,7 @@ void minmax_march(uint3 id : SV_DispatchThreadID)
     if (_e265) {
         float _e266 = total;
         float _e267 = run_a;
-        const float _e268 = lit_span(f_9, eye_6, _e21, _e267, s_3, true);
+        const float _e268 = lit_span(f_9, eye_7, _e21, _e267, s_3, true);
         total = (_e266 + _e268);
     }
     float _e270 = total;
@@ -723,6 +767,6 @@ void minmax_march(uint3 id : SV_DispatchThreadID)
     }
     float _e285 = l;
     float3 c = (color * _e285);
-    output[uint2(x_7, y_2)] = float4(c.x, c.y, c.z, 1.0);
+    output[uint2(x_8, y_2)] = float4(c.x, c.y, c.z, 1.0);
     return;
 }

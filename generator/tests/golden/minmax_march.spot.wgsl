@@ -9,6 +9,13 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     size: vec4<u32>,
 }
 
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    t_close: f32,
+    dist: f32,
+    theta_a: f32,
+    dtheta: f32,
+}
+
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     eye: vec4<f32>,
     axis: vec4<f32>,
@@ -71,8 +78,8 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
 fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
     if (v_1.origin.w > 0.5f) {
         let z_1 = max(ls.z, 0.000001f);
-        let t_2 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_2))), (0.5f - ((0.5f * ls.y) / (z_1 * t_2))));
+        let t_3 = v_1.proj.x;
+        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
     } else {
         return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -104,10 +111,10 @@ fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_nag
     if _e27 {
         return 2f;
     }
-    let n_1 = v_2.size.x;
-    let x_3 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
-    let y_1 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_3, y_1), 0i);
+    let n_2 = v_2.size.x;
+    let x_4 = min(u32((uv.x * f32(n_2))), (n_2 - 1u));
+    let y_1 = min(u32((uv.y * f32(n_2))), (n_2 - 1u));
+    let _e49 = textureLoad(sm, vec2<u32>(x_4, y_1), 0i);
     return _e49.x;
 }
 
@@ -151,18 +158,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_6 = vec3<f32>(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
-        if (dir_6.z <= 0.000001f) {
+        let dir_7 = vec3<f32>(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
+        if (dir_7.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_7);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_6.z);
+        return ((z_2 + _e35) / dir_7.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -181,11 +188,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_4 = (sigma_t * len);
-    if (x_4 < 0.0001f) {
-        return (len * (1f - (0.5f * x_4)));
+    let x_5 = (sigma_t * len);
+    if (x_5 < 0.0001f) {
+        return (len * (1f - (0.5f * x_5)));
     }
-    return ((1f - exp(-(x_4))) / sigma_t);
+    return ((1f - exp(-(x_5))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -197,13 +204,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_5 * x_5) * (3f - (2f * x_5)));
+    let x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_6 * x_6) * (3f - (2f * x_6)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_6 = (eye + (dir * t));
-    let to_x = (x_6 - light_pos);
+    let x_7 = (eye + (dir * t));
+    let to_x = (x_7 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d = sqrt(d2_);
     let travel = (to_x / vec3(d));
@@ -220,7 +227,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
     let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
     let g0_ = atan(((a_1 - t0_) / h));
-    let w = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
+    let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k_1;
         if (_e30 < panels) {
@@ -229,7 +236,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
         {
             let _e32 = k_1;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w));
+            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
             q = 0u;
             loop {
                 let _e40 = q;
@@ -239,7 +246,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                 }
                 {
                     let _e46 = q;
-                    let u = tan((mid + ((0.5f * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     let _e52 = sum;
                     let _e54 = q;
                     let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -257,7 +264,19 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
     }
     let _e75 = sum;
-    return (((_e75 * 0.5f) * w) * h);
+    return (((_e75 * 0.5f) * w_1) * h);
+}
+
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    let t0_1 = dot((light_pos_2 - eye_2), dir_2);
+    let h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001f * max((b_2 - a_2), 0.000001f)));
+    let theta_a = atan(((a_2 - t0_1) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / f32(n)));
+}
+
+fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x: f32) -> vec2<f32> {
+    let tau = tan((e.theta_a + (x * e.dtheta)));
+    return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
 fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
@@ -268,11 +287,11 @@ fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta: f32, lo:
     return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * clamp(((theta - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
 }
 
-fn pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x: u32, y: u32) -> vec3<f32> {
-    let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(f.sizes.x)) - 1f);
+fn pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: u32, y: u32) -> vec3<f32> {
+    let ndc_x = (((2f * (f32(x_1) + 0.5f)) / f32(f.sizes.x)) - 1f);
     let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(f.sizes.y)));
-    let t_3 = f.cam_forward.w;
-    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_3) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_3))));
+    let t_4 = f.cam_forward.w;
+    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_4) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_4))));
 }
 
 fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
@@ -285,51 +304,64 @@ fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_o
     return _e4;
 }
 
-fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_2: vec3<f32>, dir_2: vec3<f32>, t_1: f32) -> f32 {
-    let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
+fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_3: vec3<f32>, dir_3: vec3<f32>, t_1: f32) -> f32 {
+    let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_3: vec3<f32>, dir_3: vec3<f32>, s: f32, spot: bool) -> f32 {
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, s: f32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_2: u32 = 0u;
+    var t_2: f32;
+    var w: f32;
 
     let steps = f_4.sizes2_.y;
-    let h_1 = (s / f32(steps));
+    let h_2 = (s / f32(steps));
+    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0f, s, steps);
     loop {
-        let _e9 = k_2;
-        if (_e9 < steps) {
+        let _e15 = k_2;
+        if (_e15 < steps) {
         } else {
             break;
         }
         {
-            let _e11 = k_2;
-            let t_4 = ((f32(_e11) + 0.5f) * h_1);
-            let _e21 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_3 + (dir_3 * t_4)));
+            let _e17 = k_2;
+            t_2 = ((f32(_e17) + 0.5f) * h_2);
+            w = h_2;
             if spot {
-                let _e24 = sum_1;
-                let _e26 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_3, dir_3, t_4);
-                sum_1 = (_e24 + ((_e21 * h_1) * _e26));
+                let _e25 = k_2;
+                let _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e25) + 0.5f));
+                t_2 = _e29.x;
+                w = _e29.y;
+            }
+            let _e32 = t_2;
+            let _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e32)));
+            if spot {
+                let _e38 = sum_1;
+                let _e39 = w;
+                let _e41 = t_2;
+                let _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e41);
+                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
             } else {
-                let _e29 = sum_1;
-                let _e32 = k_2;
-                let _e35 = k_2;
-                let _e40 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e32) * h_1), (f32((_e35 + 1u)) * h_1));
-                sum_1 = (_e29 + (_e21 * _e40));
+                let _e45 = sum_1;
+                let _e48 = k_2;
+                let _e51 = k_2;
+                let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e48) * h_2), (f32((_e51 + 1u)) * h_2));
+                sum_1 = (_e45 + (_e36 * _e56));
             }
         }
         continuing {
-            let _e44 = k_2;
-            k_2 = (_e44 + 1u);
+            let _e60 = k_2;
+            k_2 = (_e60 + 1u);
         }
     }
     if spot {
-        let _e46 = sum_1;
-        return _e46;
+        let _e62 = sum_1;
+        return _e62;
     } else {
-        let _e55 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_3)));
-        let _e57 = sum_1;
-        return ((f_4.medium.y * _e55) * _e57);
+        let _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_4)));
+        let _e73 = sum_1;
+        return ((f_4.medium.y * _e71) * _e73);
     }
 }
 
@@ -342,11 +374,11 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
     var local_11: bool;
 
     if spot_1 {
-        let psi = (x_1 * delta);
+        let psi = (x_2 * delta);
         let den = sin((theta_1 + psi));
         if !((den <= 0.000001f)) {
             local_11 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
@@ -359,12 +391,12 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_X
         }
         return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_1 * delta) / max(sin(theta_1), 0.000001f)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_1), 0.000001f)), s_1);
     }
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_4: vec3<f32>, dir_4: vec3<f32>, a_2: f32, b_2: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -416,20 +448,20 @@ fn level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_1: u32, width_2: 
     return _e14;
 }
 
-fn edge_t(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
-    if (x_2 >= n) {
+fn edge_t(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
+    if (x_3 >= n_1) {
         return s_2;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, f32(x_2), delta_1, theta_2, s_2, spot_2);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, f32(x_3), delta_1, theta_2, s_2, spot_2);
     return _e9;
 }
 
-fn lit_span(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, spot_3: bool) -> f32 {
+fn lit_span(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_4: f32, b_4: f32, spot_3: bool) -> f32 {
     if spot_3 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_5, dir_5, a_3, b_3, max((f_8.sizes2_.z / 4u), 1u));
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_6, dir_6, a_4, b_4, max((f_8.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_3, b_3);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -453,9 +485,9 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     var l: f32;
 
     let f_9 = frame;
-    let x_7 = id.x;
+    let x_8 = id.x;
     let y_2 = id.y;
-    if !((x_7 >= f_9.sizes.x)) {
+    if !((x_8 >= f_9.sizes.x)) {
         local = (y_2 >= f_9.sizes.y);
     } else {
         local = true;
@@ -464,12 +496,12 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e18 {
         return;
     }
-    let eye_6 = f_9.eye.xyz;
-    let _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_7, y_2);
-    let _e25 = textureLoad(depth, vec2<u32>(x_7, y_2), 0i);
+    let eye_7 = f_9.eye.xyz;
+    let _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_8, y_2);
+    let _e25 = textureLoad(depth, vec2<u32>(x_8, y_2), 0i);
     let s_3 = (min(max(_e25.x, 0f), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 0.000001f));
     let color = f_9.light_color.xyz;
-    let px = vec3<f32>((f32(x_7) + 0.5f), (f32(y_2) + 0.5f), 0f);
+    let px = vec3<f32>((f32(x_8) + 0.5f), (f32(y_2) + 0.5f), 0f);
     let radius = f_9.epipole.w;
     if (f_9.epipole.z > 0.5f) {
         local_1 = (length((px - vec3<f32>(f_9.epipole.x, f_9.epipole.y, 0f))) < radius);
@@ -491,9 +523,9 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e88 = local_3;
     if _e88 {
         let _e90 = frame;
-        let _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_6, _e21, s_3, true);
+        let _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_7, _e21, s_3, true);
         let l_2 = (_e93 * color);
-        textureStore(output, vec2<u32>(x_7, y_2), vec4<f32>(l_2.x, l_2.y, l_2.z, 1f));
+        textureStore(output, vec2<u32>(x_8, y_2), vec4<f32>(l_2.x, l_2.y, l_2.z, 1f));
         return;
     }
     let axis = f_9.axis.xyz;
@@ -518,18 +550,18 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     let delta_2 = _e148.delta;
     let _e154 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_3, f_9.theta.x, f_9.theta.y);
     if true {
-        let q_2 = normalize(((eye_6 + (_e21 * s_3)) - f_9.light_pos.xyz));
+        let q_2 = normalize(((eye_7 + (_e21 * s_3)) - f_9.light_pos.xyz));
         xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / delta_2);
     } else {
         xs = ((s_3 * sin(theta_3)) / delta_2);
     }
     let _e172 = xs;
     let _e173 = xs;
-    let n_2 = u32(min(ceil(select(0f, _e172, (_e173 > 0f))), f32(width_3)));
+    let n_3 = u32(min(ceil(select(0f, _e172, (_e173 > 0f))), f32(width_3)));
     let _e182 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     loop {
         let _e184 = i;
-        if (_e184 < n_2) {
+        if (_e184 < n_3) {
         } else {
             break;
         }
@@ -548,7 +580,7 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
                 if _e204 {
                     let _e205 = i;
                     let _e207 = k;
-                    local_5 = ((_e205 + (2u << _e207)) <= n_2);
+                    local_5 = ((_e205 + (2u << _e207)) <= n_3);
                 } else {
                     local_5 = false;
                 }
@@ -590,14 +622,14 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
             let _e248 = in_run;
             if (_e247 != _e248) {
                 let _e250 = i;
-                let _e251 = edge_t(f_9, _e250, n_2, delta_2, theta_3, s_3, true);
+                let _e251 = edge_t(f_9, _e250, n_3, delta_2, theta_3, s_3, true);
                 let _e252 = lit;
                 if _e252 {
                     run_a = _e251;
                 } else {
                     let _e255 = total;
                     let _e256 = run_a;
-                    let _e257 = lit_span(f_9, eye_6, _e21, _e256, _e251, true);
+                    let _e257 = lit_span(f_9, eye_7, _e21, _e256, _e251, true);
                     total = (_e255 + _e257);
                 }
                 let _e259 = lit;
@@ -612,7 +644,7 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e265 {
         let _e266 = total;
         let _e267 = run_a;
-        let _e268 = lit_span(f_9, eye_6, _e21, _e267, s_3, true);
+        let _e268 = lit_span(f_9, eye_7, _e21, _e267, s_3, true);
         total = (_e266 + _e268);
     }
     let _e270 = total;
@@ -624,6 +656,6 @@ fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let _e285 = l;
     let c = (color * _e285);
-    textureStore(output, vec2<u32>(x_7, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
+    textureStore(output, vec2<u32>(x_8, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

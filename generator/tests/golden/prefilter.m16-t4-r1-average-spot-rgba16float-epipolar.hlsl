@@ -9,6 +9,13 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     uint4 size;
 };
 
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
+};
+
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float4 eye;
     float4 axis;
@@ -114,10 +121,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
     if (_e27) {
         return 2.0;
     }
-    uint n = v_2.size.x;
-    uint x_1 = min(naga_f2u32((uv.x * float(n))), (n - 1u));
-    uint y = min(naga_f2u32((uv.y * float(n))), (n - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_1, y), int(0)));
+    uint n_1 = v_2.size.x;
+    uint x_2 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint y = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
+    float4 _e49 = sm.Load(int3(uint2(x_2, y), int(0)));
     return _e49.x;
 }
 
@@ -164,18 +171,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        float3 dir_2 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_2.z <= 1e-6)) {
+        float3 dir_3 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_3.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
+        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_3);
         const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_2.z);
+        return ((z_2 + _e35) / dir_3.z);
     } else {
         const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -196,11 +203,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_2 = (sigma_t * len);
-    if ((x_2 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_2)));
+    float x_3 = (sigma_t * len);
+    if ((x_3 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_3)));
     }
-    return ((1.0 - exp(-(x_2))) / sigma_t);
+    return ((1.0 - exp(-(x_3))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -214,14 +221,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_3 * x_3) * (3.0 - (2.0 * x_3)));
+    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_4 = (eye + (dir * t));
-    float3 to_x = (x_4 - light_pos);
+    float3 x_5 = (eye + (dir * t));
+    float3 to_x = (x_5 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_1 = sqrt(d2_);
     float3 travel = (to_x / (d_1).xxx);
@@ -289,6 +296,30 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
     return (((_e75 * 0.5) * w_1) * h);
 }
 
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ret = (EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX)0;
+    ret.t_close = arg0;
+    ret.dist = arg1;
+    ret.theta_a = arg2;
+    ret.dtheta = arg3;
+    return ret;
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_2, float3 dir_2, float3 light_pos_2, float a_2, float b_2, uint n)
+{
+    float t0_1 = dot((light_pos_2 - eye_2), dir_2);
+    float h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_1) / h_1));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / float(n)));
+    return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
+}
+
+float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x)
+{
+    float tau = tan((e.theta_a + (x * e.dtheta)));
+    return float2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
+}
+
 SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float arg0, float arg1, float arg2, float arg3) {
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX ret = (SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX)0;
     ret.delta = arg0;
@@ -338,13 +369,13 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return naga_div(((r * r) * width), (regions * regions));
 }
 
-float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x, bool spot_1)
+float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_1)
 {
     bool local_6 = (bool)0;
 
     float cap = (4.0 * f_2.theta.z);
     if (spot_1) {
-        float psi = (x * s.delta);
+        float psi = (x_1 * s.delta);
         float den = sin((s.theta_ref + psi));
         if (!((den <= 0.0001))) {
             local_6 = ((s.theta_ref + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
@@ -357,7 +388,7 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod
         }
         return min(((f_2.axis.w * sin(psi)) / den), cap);
     } else {
-        return min(((x * s.delta) / max(sin(s.theta_ref), 0.0001)), cap);
+        return min(((x_1 * s.delta) / max(sin(s.theta_ref), 0.0001)), cap);
     }
 }
 
@@ -483,9 +514,9 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                     uint layer_1 = ((thread * 1u) + _e87);
                     const float4 _e89 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
                     uint _e91 = q;
-                    float4 a_2 = acc[min(uint(_e91), 0u)];
+                    float4 a_3 = acc[min(uint(_e91), 0u)];
                     uint _e94 = q;
-                    acc[min(uint(_e94), 0u)] = ((a_2 * (1.0 - blend)) + (_e89 * blend));
+                    acc[min(uint(_e94), 0u)] = ((a_3 * (1.0 - blend)) + (_e89 * blend));
                     uint _e101 = q;
                     float4 _e103 = acc[min(uint(_e101), 0u)];
                     float4 stored = ((_e103 * 0.5) + (0.5).xxxx);

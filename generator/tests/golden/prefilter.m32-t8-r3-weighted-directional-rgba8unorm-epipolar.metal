@@ -21,6 +21,12 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
 struct type_9 {
     float inner[4];
 };
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 eye;
     metal::float4 axis;
@@ -122,11 +128,11 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     if (_e27) {
         return 2.0;
     }
-    uint n = v_2.size.x;
-    uint x_1 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
-    uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
+    uint n_1 = v_2.size.x;
+    uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_1, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -180,18 +186,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir_2 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_2.z <= 0.000001) {
+        metal::float3 dir_3 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_3.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_3);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return (z_2 + _e35) / dir_2.z;
+        return (z_2 + _e35) / dir_3.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -216,11 +222,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_2 = sigma_t * len;
-    if (x_2 < 0.0001) {
-        return len * (1.0 - (0.5 * x_2));
+    float x_3 = sigma_t * len;
+    if (x_3 < 0.0001) {
+        return len * (1.0 - (0.5 * x_3));
     }
-    return (1.0 - metal::exp(-(x_2))) / sigma_t;
+    return (1.0 - metal::exp(-(x_3))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -240,8 +246,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_3 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_3 * x_3) * (3.0 - (2.0 * x_3));
+    float x_4 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_4 * x_4) * (3.0 - (2.0 * x_4));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -254,8 +260,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_4 = eye + (dir * t);
-    metal::float3 to_x = x_4 - light_pos;
+    metal::float3 x_5 = eye + (dir * t);
+    metal::float3 to_x = x_5 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_1 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_1);
@@ -332,6 +338,28 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     return ((_e75 * 0.5) * w_1) * h;
 }
 
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye_2,
+    metal::float3 dir_2,
+    metal::float3 light_pos_2,
+    float a_2,
+    float b_2,
+    uint n
+) {
+    float t0_1 = metal::dot(light_pos_2 - eye_2, dir_2);
+    float h_1 = metal::max(metal::length((eye_2 + (dir_2 * t0_1)) - light_pos_2), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float theta_a = metal::atan((a_2 - t0_1) / h_1);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_1, theta_a, (metal::atan((b_2 - t0_1) / h_1) - theta_a) / static_cast<float>(n)};
+}
+
+metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e,
+    float x
+) {
+    float tau = metal::tan(e.theta_a + (x * e.dtheta));
+    return metal::float2(e.t_close + (e.dist * tau), (e.dtheta * e.dist) * (1.0 + (tau * tau)));
+}
+
 SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float4 v_6
 ) {
@@ -386,13 +414,13 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s,
-    float x,
+    float x_1,
     bool spot_1
 ) {
     bool local_6 = {};
     float cap = 4.0 * f_2.theta.z;
     if (spot_1) {
-        float psi = x * s.delta;
+        float psi = x_1 * s.delta;
         float den = metal::sin(s.theta_ref + psi);
         if (!((den <= 0.0001))) {
             local_6 = (s.theta_ref + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
@@ -405,7 +433,7 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
         }
         return metal::min((f_2.axis.w * metal::sin(psi)) / den, cap);
     } else {
-        return metal::min((x * s.delta) / metal::max(metal::sin(s.theta_ref), 0.0001), cap);
+        return metal::min((x_1 * s.delta) / metal::max(metal::sin(s.theta_ref), 0.0001), cap);
     }
 }
 
@@ -544,9 +572,9 @@ kernel void prefilter(
                     uint layer_1 = (thread_ * 2u) + _e87;
                     metal::float4 _e89 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
                     uint _e91 = q;
-                    metal::float4 a_2 = acc.inner[metal::min(unsigned(_e91), 1u)];
+                    metal::float4 a_3 = acc.inner[metal::min(unsigned(_e91), 1u)];
                     uint _e94 = q;
-                    acc.inner[metal::min(unsigned(_e94), 1u)] = (a_2 * (1.0 - blend)) + (_e89 * blend);
+                    acc.inner[metal::min(unsigned(_e94), 1u)] = (a_3 * (1.0 - blend)) + (_e89 * blend);
                     uint _e101 = q;
                     metal::float4 _e103 = acc.inner[metal::min(unsigned(_e101), 1u)];
                     metal::float4 stored = (_e103 * 0.5) + metal::float4(0.5);

@@ -29,6 +29,12 @@ struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     uvec4 sizes;
     uvec4 interleave;
 };
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
+};
 layout(std140, binding = 0) uniform MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX_block_0Compute { MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX _group_0_binding_0_cs; };
 
 layout(binding = 1) uniform sampler2D _group_0_binding_1_cs;
@@ -45,8 +51,8 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX march_shadow_viewX_naga_o
 vec3 march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_1, uint x, uint y) {
     float ndc_x = (((2.0 * (float(x) + 0.5)) / float(m_1.sizes.x)) - 1.0);
     float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(m_1.sizes.y)));
-    float t_1 = m_1.cam_forward.w;
-    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_1) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_1))));
+    float t_2 = m_1.cam_forward.w;
+    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2))));
 }
 
 float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y_1) {
@@ -65,6 +71,55 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y
     return (float((_e29 >> 8u)) / 16777216.0);
 }
 
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta) {
+    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
+    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
+    float x_3 = (sigma_t * len);
+    if ((x_3 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_3)));
+    }
+    return ((1.0 - exp(-(x_3))) / sigma_t);
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
+    if (((cos_inner - cos_outer) <= 1e-6)) {
+        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
+    }
+    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t_1, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
+    vec3 x_5 = (eye + (dir * t_1));
+    vec3 to_x = (x_5 - light_pos);
+    float d2_ = max(dot(to_x, to_x), 1e-12);
+    float d = sqrt(d2_);
+    vec3 travel = (to_x / vec3(d));
+    float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t_1)))) / d2_);
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, vec3 light_pos_1, float a_1, float b_1, uint n) {
+    float t0_ = dot((light_pos_1 - eye_1), dir_1);
+    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float theta_a = atan(((a_1 - t0_) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_1 - t0_) / h_1)) - theta_a) / float(n)));
+}
+
+vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_2) {
+    float tau = tan((e.theta_a + (x_2 * e.dtheta)));
+    return vec2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
+}
+
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
     vec3 q = (p - v.origin.xyz);
     return vec3(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
@@ -73,8 +128,8 @@ vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
 vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
     if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t_2 = v_1.proj.x;
-        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_2))), (0.5 - ((0.5 * ls.y) / (z_1 * t_2))));
+        float t_3 = v_1.proj.x;
+        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
     } else {
         return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -105,11 +160,11 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
     if (_e27) {
         return 2.0;
     }
-    uint n = v_2.size.x;
-    uint x_2 = min(uint((uv.x * float(n))), (n - 1u));
-    uint y_2 = min(uint((uv.y * float(n))), (n - 1u));
+    uint n_1 = v_2.size.x;
+    uint x_6 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint y_2 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_2, y_2)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_6, y_2)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
     return _e49.x;
 }
 
@@ -146,54 +201,19 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
     return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
 }
 
-float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta) {
-    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
-    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
-}
-
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_3 = (sigma_t * len);
-    if ((x_3 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_3)));
-    }
-    return ((1.0 - exp(-(x_3))) / sigma_t);
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
-    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
-}
-
-float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_5 = (eye + (dir * t));
-    vec3 to_x = (x_5 - light_pos);
-    float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d = sqrt(d2_);
-    vec3 travel = (to_x / vec3(d));
-    float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
-    float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
-}
-
 void main() {
     uvec3 id = gl_GlobalInvocationID;
     bool local = false;
     float u = 0.5;
     float sum = 0.0;
     uint j = 0u;
+    float t = 0.0;
+    float w = 0.0;
     float l = 0.0;
     MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = _group_0_binding_0_cs;
-    uint x_6 = id.x;
+    uint x_7 = id.x;
     uint y_3 = id.y;
-    if (!((x_6 >= m_2.sizes.x))) {
+    if (!((x_7 >= m_2.sizes.x))) {
         local = (y_3 >= m_2.sizes.y);
     } else {
         local = true;
@@ -202,63 +222,75 @@ void main() {
     if (_e17) {
         return;
     }
-    vec3 eye_1 = m_2.eye.xyz;
-    vec3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_6, y_3);
+    vec3 eye_2 = m_2.eye.xyz;
+    vec3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
     int _e24_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
-    vec4 _e24 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_6, y_3)), ivec2(0), textureSize(_group_0_binding_1_cs, _e24_clamped_lod) - ivec2(1)), _e24_clamped_lod);
+    vec4 _e24 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_7, y_3)), ivec2(0), textureSize(_group_0_binding_1_cs, _e24_clamped_lod) - ivec2(1)), _e24_clamped_lod);
     float s = (min(max(_e24.x, 0.0), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 1e-6));
-    uint n_1 = m_2.sizes.w;
-    float h_1 = (s / float(n_1));
+    uint n_2 = m_2.sizes.w;
+    float h_2 = (s / float(n_2));
     uint mx = m_2.interleave.x;
     uint my = m_2.interleave.y;
     uint stride = (mx * my);
-    uint pixel_class = ((x_6 % mx) + (mx * (y_3 % my)));
+    uint pixel_class = ((x_7 % mx) + (mx * (y_3 % my)));
     if ((m_2.interleave.z != 0u)) {
-        float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_6, y_3);
+        float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
         u = _e54;
     }
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0.0, s, n_2);
     j = pixel_class;
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e99 = j;
-            j = (_e99 + stride);
+            uint _e115 = j;
+            j = (_e115 + stride);
         }
         loop_init = false;
-        uint _e58 = j;
-        if ((_e58 < n_1)) {
+        uint _e62 = j;
+        if ((_e62 < n_2)) {
         } else {
             break;
         }
         {
-            uint _e60 = j;
-            float _e62 = u;
-            float t_3 = ((float(_e60) + _e62) * h_1);
-            float _e68 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, _group_0_binding_2_cs, (eye_1 + (_e20 * t_3)));
+            uint _e64 = j;
+            float _e66 = u;
+            t = ((float(_e64) + _e66) * h_2);
+            w = h_2;
             if (false) {
-                float _e71 = sum;
-                float _e82 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, _e20, t_3, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = (_e71 + ((_e68 * h_1) * _e82));
-            } else {
+                uint _e72 = j;
+                float _e74 = u;
+                vec2 _e76 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e60, (float(_e72) + _e74));
+                t = _e76.x;
+                w = _e76.y;
+            }
+            float _e79 = t;
+            float _e83 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, _group_0_binding_2_cs, (eye_2 + (_e20 * _e79)));
+            if (false) {
                 float _e85 = sum;
-                uint _e88 = j;
-                uint _e91 = j;
-                float _e96 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e88) * h_1), (float((_e91 + 1u)) * h_1));
-                sum = (_e85 + (_e68 * _e96));
+                float _e86 = w;
+                float _e88 = t;
+                float _e98 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, _e88, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = (_e85 + ((_e83 * _e86) * _e98));
+            } else {
+                float _e101 = sum;
+                uint _e104 = j;
+                uint _e107 = j;
+                float _e112 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e104) * h_2), (float((_e107 + 1u)) * h_2));
+                sum = (_e101 + (_e83 * _e112));
             }
         }
     }
-    float _e101 = sum;
-    l = _e101;
+    float _e117 = sum;
+    l = _e117;
     if (!(false)) {
-        float _e112 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
-        float _e114 = sum;
-        l = ((m_2.medium.y * _e112) * _e114);
+        float _e128 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
+        float _e130 = sum;
+        l = ((m_2.medium.y * _e128) * _e130);
     }
-    float _e118 = l;
-    vec3 c = (m_2.light_color.xyz * _e118);
-    imageStore(_group_0_binding_3_cs, ivec2(uvec2(x_6, y_3)), vec4(c.x, c.y, c.z, 1.0));
+    float _e134 = l;
+    vec3 c = (m_2.light_color.xyz * _e134);
+    imageStore(_group_0_binding_3_cs, ivec2(uvec2(x_7, y_3)), vec4(c.x, c.y, c.z, 1.0));
     return;
 }
 

@@ -27,6 +27,13 @@ struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     uint4 interleave;
 };
 
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
+};
+
 cbuffer march : register(b0) { MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX march; }
 Texture2D<float4> depth : register(t1);
 Texture2D<float4> shadow_map : register(t2);
@@ -53,8 +60,8 @@ float3 march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(MarchX_naga_
 {
     float ndc_x = (((2.0 * (float(x) + 0.5)) / float(m_1.sizes.x)) - 1.0);
     float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(m_1.sizes.y)));
-    float t_1 = m_1.cam_forward.w;
-    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_1) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_1))));
+    float t_2 = m_1.cam_forward.w;
+    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2))));
 }
 
 float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y_1)
@@ -75,6 +82,72 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y
     return (float((_e29 >> 8u)) / 16777216.0);
 }
 
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
+{
+    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
+    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
+{
+    float x_3 = (sigma_t * len);
+    if ((x_3 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_3)));
+    }
+    return ((1.0 - exp(-(x_3))) / sigma_t);
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
+{
+    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
+{
+    if (((cos_inner - cos_outer) <= 1e-6)) {
+        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
+    }
+    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t_1, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
+{
+    float3 x_5 = (eye + (dir * t_1));
+    float3 to_x = (x_5 - light_pos);
+    float d2_ = max(dot(to_x, to_x), 1e-12);
+    float d = sqrt(d2_);
+    float3 travel = (to_x / (d).xxx);
+    const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t_1)))) / d2_);
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ret = (EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX)0;
+    ret.t_close = arg0;
+    ret.dist = arg1;
+    ret.theta_a = arg2;
+    ret.dtheta = arg3;
+    return ret;
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float3 light_pos_1, float a_1, float b_1, uint n)
+{
+    float t0_ = dot((light_pos_1 - eye_1), dir_1);
+    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float theta_a = atan(((a_1 - t0_) / h_1));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_1 - t0_) / h_1)) - theta_a) / float(n)));
+    return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
+}
+
+float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_2)
+{
+    float tau = tan((e.theta_a + (x_2 * e.dtheta)));
+    return float2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
+}
+
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
     float3 q = (p - v.origin.xyz);
@@ -85,8 +158,8 @@ float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oi
 {
     if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t_2 = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_2))), (0.5 - ((0.5 * ls.y) / (z_1 * t_2))));
+        float t_3 = v_1.proj.x;
+        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
     } else {
         return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -123,10 +196,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
     if (_e27) {
         return 2.0;
     }
-    uint n = v_2.size.x;
-    uint x_2 = min(naga_f2u32((uv.x * float(n))), (n - 1u));
-    uint y_2 = min(naga_f2u32((uv.y * float(n))), (n - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_2, y_2), int(0)));
+    uint n_1 = v_2.size.x;
+    uint x_6 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint y_2 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
+    float4 _e49 = sm.Load(int3(uint2(x_6, y_2), int(0)));
     return _e49.x;
 }
 
@@ -167,48 +240,6 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
     return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
 }
 
-float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
-{
-    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
-    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
-}
-
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
-{
-    float x_3 = (sigma_t * len);
-    if ((x_3 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_3)));
-    }
-    return ((1.0 - exp(-(x_3))) / sigma_t);
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
-{
-    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
-{
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
-    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
-}
-
-float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
-{
-    float3 x_5 = (eye + (dir * t));
-    float3 to_x = (x_5 - light_pos);
-    float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d = sqrt(d2_);
-    float3 travel = (to_x / (d).xxx);
-    const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
-    const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
-}
-
 uint naga_mod(uint lhs, uint rhs) {
     return lhs % (rhs == 0u ? 1u : rhs);
 }
@@ -220,12 +251,14 @@ void raymarch(uint3 id : SV_DispatchThreadID)
     float u = 0.5;
     float sum = 0.0;
     uint j = (uint)0;
+    float t = (float)0;
+    float w = (float)0;
     float l = (float)0;
 
     MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = march;
-    uint x_6 = id.x;
+    uint x_7 = id.x;
     uint y_3 = id.y;
-    if (!((x_6 >= m_2.sizes.x))) {
+    if (!((x_7 >= m_2.sizes.x))) {
         local = (y_3 >= m_2.sizes.y);
     } else {
         local = true;
@@ -234,21 +267,22 @@ void raymarch(uint3 id : SV_DispatchThreadID)
     if (_e17) {
         return;
     }
-    float3 eye_1 = m_2.eye.xyz;
-    const float3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_6, y_3);
-    float4 _e24 = depth.Load(int3(uint2(x_6, y_3), int(0)));
+    float3 eye_2 = m_2.eye.xyz;
+    const float3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
+    float4 _e24 = depth.Load(int3(uint2(x_7, y_3), int(0)));
     float s = (min(max(_e24.x, 0.0), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 1e-6));
-    uint n_1 = m_2.sizes.w;
-    float h_1 = (s / float(n_1));
+    uint n_2 = m_2.sizes.w;
+    float h_2 = (s / float(n_2));
     uint mx = m_2.interleave.x;
     uint my = m_2.interleave.y;
     uint stride = (mx * my);
-    uint pixel_class = (naga_mod(x_6, mx) + (mx * naga_mod(y_3, my)));
+    uint pixel_class = (naga_mod(x_7, mx) + (mx * naga_mod(y_3, my)));
     if ((m_2.interleave.z != 0u)) {
-        const float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_6, y_3);
+        const float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
         u = _e54;
     }
     const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0.0, s, n_2);
     j = pixel_class;
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
@@ -256,42 +290,53 @@ void raymarch(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e99 = j;
-            j = (_e99 + stride);
+            uint _e115 = j;
+            j = (_e115 + stride);
         }
         loop_init = false;
-        uint _e58 = j;
-        if ((_e58 < n_1)) {
+        uint _e62 = j;
+        if ((_e62 < n_2)) {
         } else {
             break;
         }
         {
-            uint _e60 = j;
-            float _e62 = u;
-            float t_3 = ((float(_e60) + _e62) * h_1);
-            const float _e68 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, (eye_1 + (_e20 * t_3)));
+            uint _e64 = j;
+            float _e66 = u;
+            t = ((float(_e64) + _e66) * h_2);
+            w = h_2;
             if (false) {
-                float _e71 = sum;
-                const float _e82 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, _e20, t_3, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = (_e71 + ((_e68 * h_1) * _e82));
-            } else {
+                uint _e72 = j;
+                float _e74 = u;
+                const float2 _e76 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e60, (float(_e72) + _e74));
+                t = _e76.x;
+                w = _e76.y;
+            }
+            float _e79 = t;
+            const float _e83 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, (eye_2 + (_e20 * _e79)));
+            if (false) {
                 float _e85 = sum;
-                uint _e88 = j;
-                uint _e91 = j;
-                const float _e96 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e88) * h_1), (float((_e91 + 1u)) * h_1));
-                sum = (_e85 + (_e68 * _e96));
+                float _e86 = w;
+                float _e88 = t;
+                const float _e98 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, _e88, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = (_e85 + ((_e83 * _e86) * _e98));
+            } else {
+                float _e101 = sum;
+                uint _e104 = j;
+                uint _e107 = j;
+                const float _e112 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e104) * h_2), (float((_e107 + 1u)) * h_2));
+                sum = (_e101 + (_e83 * _e112));
             }
         }
     }
-    float _e101 = sum;
-    l = _e101;
+    float _e117 = sum;
+    l = _e117;
     if (!(false)) {
-        const float _e112 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
-        float _e114 = sum;
-        l = ((m_2.medium.y * _e112) * _e114);
+        const float _e128 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
+        float _e130 = sum;
+        l = ((m_2.medium.y * _e128) * _e130);
     }
-    float _e118 = l;
-    float3 c = (m_2.light_color.xyz * _e118);
-    output[uint2(x_6, y_3)] = float4(c.x, c.y, c.z, 1.0);
+    float _e134 = l;
+    float3 c = (m_2.light_color.xyz * _e134);
+    output[uint2(x_7, y_3)] = float4(c.x, c.y, c.z, 1.0);
     return;
 }

@@ -31,6 +31,12 @@ struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     metal::uint4 sizes;
     metal::uint4 interleave;
 };
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
+};
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
     MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m
@@ -45,8 +51,8 @@ metal::float3 march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
 ) {
     float ndc_x = ((2.0 * (static_cast<float>(x) + 0.5)) / static_cast<float>(m_1.sizes.x)) - 1.0;
     float ndc_y = 1.0 - ((2.0 * (static_cast<float>(y) + 0.5)) / static_cast<float>(m_1.sizes.y));
-    float t_1 = m_1.cam_forward.w;
-    return metal::normalize((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_1) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_1)));
+    float t_2 = m_1.cam_forward.w;
+    return metal::normalize((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2)));
 }
 
 float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
@@ -66,108 +72,6 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
     h = _e24 ^ (_e25 >> 16u);
     uint _e29 = h;
     return static_cast<float>(_e29 >> 8u) / 16777216.0;
-}
-
-metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
-    metal::float3 p
-) {
-    metal::float3 q = p - v.origin.xyz;
-    return metal::float3(metal::dot(q, v.right.xyz), metal::dot(q, v.up.xyz), metal::dot(q, v.forward.xyz));
-}
-
-metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
-    metal::float3 ls
-) {
-    if (v_1.origin.w > 0.5) {
-        float z_1 = metal::max(ls.z, 0.000001);
-        float t_2 = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_2)), 0.5 - ((0.5 * ls.y) / (z_1 * t_2)));
-    } else {
-        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
-    }
-}
-
-uint naga_f2u32(float value) {
-    return static_cast<uint>(metal::clamp(value, 0.0, 4294967000.0));
-}
-
-float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2,
-    metal::texture2d<float, metal::access::sample> sm,
-    metal::float2 uv
-) {
-    bool local_1 = {};
-    bool local_2 = {};
-    bool local_3 = {};
-    if (!((uv.x < 0.0))) {
-        local_1 = uv.x > 1.0;
-    } else {
-        local_1 = true;
-    }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = uv.y < 0.0;
-    } else {
-        local_2 = true;
-    }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = uv.y > 1.0;
-    } else {
-        local_3 = true;
-    }
-    bool _e27 = local_3;
-    if (_e27) {
-        return 2.0;
-    }
-    uint n = v_2.size.x;
-    uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
-    uint y_2 = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
-    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y_2)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
-    return _e49.x;
-}
-
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
-    float z
-) {
-    float texel = {};
-    float size = static_cast<float>(v_3.size.x);
-    if (v_3.origin.w > 0.5) {
-        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
-    } else {
-        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
-    }
-    float _e32 = texel;
-    return v_3.forward.w * _e32;
-}
-
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
-    metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_1
-) {
-    bool local_4 = {};
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if (v_4.origin.w > 0.5) {
-        local_4 = _e2.z <= near;
-    } else {
-        local_4 = false;
-    }
-    bool _e16 = local_4;
-    if (_e16) {
-        return 1.0;
-    }
-    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = (_e2.z - near) / (far - near);
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -213,21 +117,145 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 eye,
     metal::float3 dir,
-    float t,
+    float t_1,
     metal::float3 light_pos,
     metal::float3 light_dir,
     float cos_inner_1,
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_5 = eye + (dir * t);
+    metal::float3 x_5 = eye + (dir * t_1);
     metal::float3 to_x = x_5 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d);
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t))) / d2_;
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t_1))) / d2_;
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye_1,
+    metal::float3 dir_1,
+    metal::float3 light_pos_1,
+    float a_1,
+    float b_1,
+    uint n
+) {
+    float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
+    float h_1 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
+    float theta_a = metal::atan((a_1 - t0_) / h_1);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_, h_1, theta_a, (metal::atan((b_1 - t0_) / h_1) - theta_a) / static_cast<float>(n)};
+}
+
+metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e,
+    float x_2
+) {
+    float tau = metal::tan(e.theta_a + (x_2 * e.dtheta));
+    return metal::float2(e.t_close + (e.dist * tau), (e.dtheta * e.dist) * (1.0 + (tau * tau)));
+}
+
+metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
+    metal::float3 p
+) {
+    metal::float3 q = p - v.origin.xyz;
+    return metal::float3(metal::dot(q, v.right.xyz), metal::dot(q, v.up.xyz), metal::dot(q, v.forward.xyz));
+}
+
+metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
+    metal::float3 ls
+) {
+    if (v_1.origin.w > 0.5) {
+        float z_1 = metal::max(ls.z, 0.000001);
+        float t_3 = v_1.proj.x;
+        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_3)), 0.5 - ((0.5 * ls.y) / (z_1 * t_3)));
+    } else {
+        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
+    }
+}
+
+uint naga_f2u32(float value) {
+    return static_cast<uint>(metal::clamp(value, 0.0, 4294967000.0));
+}
+
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2,
+    metal::texture2d<float, metal::access::sample> sm,
+    metal::float2 uv
+) {
+    bool local_1 = {};
+    bool local_2 = {};
+    bool local_3 = {};
+    if (!((uv.x < 0.0))) {
+        local_1 = uv.x > 1.0;
+    } else {
+        local_1 = true;
+    }
+    bool _e11 = local_1;
+    if (!(_e11)) {
+        local_2 = uv.y < 0.0;
+    } else {
+        local_2 = true;
+    }
+    bool _e19 = local_2;
+    if (!(_e19)) {
+        local_3 = uv.y > 1.0;
+    } else {
+        local_3 = true;
+    }
+    bool _e27 = local_3;
+    if (_e27) {
+        return 2.0;
+    }
+    uint n_1 = v_2.size.x;
+    uint x_6 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint y_2 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
+    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_6, y_2)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    return _e49.x;
+}
+
+float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
+    float z
+) {
+    float texel = {};
+    float size = static_cast<float>(v_3.size.x);
+    if (v_3.origin.w > 0.5) {
+        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
+    } else {
+        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
+    }
+    float _e32 = texel;
+    return v_3.forward.w * _e32;
+}
+
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
+    metal::texture2d<float, metal::access::sample> sm_1,
+    metal::float3 p_1
+) {
+    bool local_4 = {};
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
+    float near = v_4.right.w;
+    float far = v_4.up.w;
+    if (v_4.origin.w > 0.5) {
+        local_4 = _e2.z <= near;
+    } else {
+        local_4 = false;
+    }
+    bool _e16 = local_4;
+    if (_e16) {
+        return 1.0;
+    }
+    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
+    float depth_1 = (_e2.z - near) / (far - near);
+    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
+    return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
 }
 uint naga_mod(uint lhs, uint rhs) {
     return lhs % metal::select(rhs, 1u, rhs == 0u);
@@ -247,11 +275,13 @@ kernel void raymarch(
     float u = 0.5;
     float sum = 0.0;
     uint j = {};
+    float t = {};
+    float w = {};
     float l = {};
     MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = march;
-    uint x_6 = id.x;
+    uint x_7 = id.x;
     uint y_3 = id.y;
-    if (!((x_6 >= m_2.sizes.x))) {
+    if (!((x_7 >= m_2.sizes.x))) {
         local = y_3 >= m_2.sizes.y;
     } else {
         local = true;
@@ -260,22 +290,23 @@ kernel void raymarch(
     if (_e17) {
         return;
     }
-    metal::float3 eye_1 = m_2.eye.xyz;
-    metal::float3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_6, y_3);
+    metal::float3 eye_2 = m_2.eye.xyz;
+    metal::float3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
     uint clamped_lod_e24 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e24 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_3)), metal::uint2(depth.get_width(clamped_lod_e24), depth.get_height(clamped_lod_e24)) - 1), clamped_lod_e24);
+    metal::float4 _e24 = depth.read(metal::min(metal::uint2(metal::uint2(x_7, y_3)), metal::uint2(depth.get_width(clamped_lod_e24), depth.get_height(clamped_lod_e24)) - 1), clamped_lod_e24);
     float s = metal::min(metal::max(_e24.x, 0.0), m_2.eye.w) / metal::max(metal::dot(_e20, m_2.cam_forward.xyz), 0.000001);
-    uint n_1 = m_2.sizes.w;
-    float h_1 = s / static_cast<float>(n_1);
+    uint n_2 = m_2.sizes.w;
+    float h_2 = s / static_cast<float>(n_2);
     uint mx = m_2.interleave.x;
     uint my = m_2.interleave.y;
     uint stride = mx * my;
-    uint pixel_class = naga_mod(x_6, mx) + (mx * naga_mod(y_3, my));
+    uint pixel_class = naga_mod(x_7, mx) + (mx * naga_mod(y_3, my));
     if (m_2.interleave.z != 0u) {
-        float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_6, y_3);
+        float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
         u = _e54;
     }
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0.0, s, n_2);
     j = pixel_class;
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
@@ -283,42 +314,53 @@ kernel void raymarch(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e99 = j;
-            j = _e99 + stride;
+            uint _e115 = j;
+            j = _e115 + stride;
         }
         loop_init = false;
-        uint _e58 = j;
-        if (_e58 < n_1) {
+        uint _e62 = j;
+        if (_e62 < n_2) {
         } else {
             break;
         }
         {
-            uint _e60 = j;
-            float _e62 = u;
-            float t_3 = (static_cast<float>(_e60) + _e62) * h_1;
-            float _e68 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, eye_1 + (_e20 * t_3));
+            uint _e64 = j;
+            float _e66 = u;
+            t = (static_cast<float>(_e64) + _e66) * h_2;
+            w = h_2;
             if (false) {
-                float _e71 = sum;
-                float _e82 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, _e20, t_3, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = _e71 + ((_e68 * h_1) * _e82);
-            } else {
+                uint _e72 = j;
+                float _e74 = u;
+                metal::float2 _e76 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e60, static_cast<float>(_e72) + _e74);
+                t = _e76.x;
+                w = _e76.y;
+            }
+            float _e79 = t;
+            float _e83 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, eye_2 + (_e20 * _e79));
+            if (false) {
                 float _e85 = sum;
-                uint _e88 = j;
-                uint _e91 = j;
-                float _e96 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e88) * h_1, static_cast<float>(_e91 + 1u) * h_1);
-                sum = _e85 + (_e68 * _e96);
+                float _e86 = w;
+                float _e88 = t;
+                float _e98 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, _e88, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = _e85 + ((_e83 * _e86) * _e98);
+            } else {
+                float _e101 = sum;
+                uint _e104 = j;
+                uint _e107 = j;
+                float _e112 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e104) * h_2, static_cast<float>(_e107 + 1u) * h_2);
+                sum = _e101 + (_e83 * _e112);
             }
         }
     }
-    float _e101 = sum;
-    l = _e101;
+    float _e117 = sum;
+    l = _e117;
     if (!(false)) {
-        float _e112 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(metal::dot(m_2.light_dir.xyz, _e20)));
-        float _e114 = sum;
-        l = (m_2.medium.y * _e112) * _e114;
+        float _e128 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(metal::dot(m_2.light_dir.xyz, _e20)));
+        float _e130 = sum;
+        l = (m_2.medium.y * _e128) * _e130;
     }
-    float _e118 = l;
-    metal::float3 c = m_2.light_color.xyz * _e118;
-    output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_6, y_3)));
+    float _e134 = l;
+    metal::float3 c = m_2.light_color.xyz * _e134;
+    output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_7, y_3)));
     return;
 }

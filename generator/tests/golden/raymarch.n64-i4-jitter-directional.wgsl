@@ -27,6 +27,13 @@ struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     interleave: vec4<u32>,
 }
 
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    t_close: f32,
+    dist: f32,
+    theta_a: f32,
+    dtheta: f32,
+}
+
 @group(0) @binding(0) 
 var<uniform> march: MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX;
 @group(0) @binding(1) 
@@ -43,8 +50,8 @@ fn march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m: MarchX_naga
 fn march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_1: MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX, x: u32, y: u32) -> vec3<f32> {
     let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(m_1.sizes.x)) - 1f);
     let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(m_1.sizes.y)));
-    let t_1 = m_1.cam_forward.w;
-    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_1) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_1))));
+    let t_2 = m_1.cam_forward.w;
+    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2))));
 }
 
 fn pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_1: u32, y_1: u32) -> f32 {
@@ -64,6 +71,55 @@ fn pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_1: u32, y_1: u32)
     return (f32((_e29 >> 8u)) / 16777216f);
 }
 
+fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
+    let denom = max(((1f + (g * g)) - ((2f * g) * cos_theta)), 0.00000001f);
+    return ((1f - (g * g)) / ((12.566371f * denom) * sqrt(denom)));
+}
+
+fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
+    let x_3 = (sigma_t * len);
+    if (x_3 < 0.0001f) {
+        return (len * (1f - (0.5f * x_3)));
+    }
+    return ((1f - exp(-(x_3))) / sigma_t);
+}
+
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
+}
+
+fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    if ((cos_inner - cos_outer) <= 0.000001f) {
+        return select(0f, 1f, (cos_angle >= cos_outer));
+    }
+    let x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_4 * x_4) * (3f - (2f * x_4)));
+}
+
+fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t_1: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
+    let x_5 = (eye + (dir * t_1));
+    let to_x = (x_5 - light_pos);
+    let d2_ = max(dot(to_x, to_x), 0.000000000001f);
+    let d = sqrt(d2_);
+    let travel = (to_x / vec3(d));
+    let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t_1)))) / d2_);
+}
+
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, light_pos_1: vec3<f32>, a_1: f32, b_1: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    let t0_ = dot((light_pos_1 - eye_1), dir_1);
+    let h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
+    let theta_a = atan(((a_1 - t0_) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_1 - t0_) / h_1)) - theta_a) / f32(n)));
+}
+
+fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x_2: f32) -> vec2<f32> {
+    let tau = tan((e.theta_a + (x_2 * e.dtheta)));
+    return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
+}
+
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
     let q = (p - v.origin.xyz);
     return vec3<f32>(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
@@ -72,8 +128,8 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
 fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
     if (v_1.origin.w > 0.5f) {
         let z_1 = max(ls.z, 0.000001f);
-        let t_2 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_2))), (0.5f - ((0.5f * ls.y) / (z_1 * t_2))));
+        let t_3 = v_1.proj.x;
+        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
     } else {
         return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -105,10 +161,10 @@ fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_nag
     if _e27 {
         return 2f;
     }
-    let n = v_2.size.x;
-    let x_2 = min(u32((uv.x * f32(n))), (n - 1u));
-    let y_2 = min(u32((uv.y * f32(n))), (n - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_2, y_2), 0i);
+    let n_1 = v_2.size.x;
+    let x_6 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let y_2 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
+    let _e49 = textureLoad(sm, vec2<u32>(x_6, y_2), 0i);
     return _e49.x;
 }
 
@@ -147,55 +203,20 @@ fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapView
     return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
 }
 
-fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
-    let denom = max(((1f + (g * g)) - ((2f * g) * cos_theta)), 0.00000001f);
-    return ((1f - (g * g)) / ((12.566371f * denom) * sqrt(denom)));
-}
-
-fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_3 = (sigma_t * len);
-    if (x_3 < 0.0001f) {
-        return (len * (1f - (0.5f * x_3)));
-    }
-    return ((1f - exp(-(x_3))) / sigma_t);
-}
-
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
-    let x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_4 * x_4) * (3f - (2f * x_4)));
-}
-
-fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_5 = (eye + (dir * t));
-    let to_x = (x_5 - light_pos);
-    let d2_ = max(dot(to_x, to_x), 0.000000000001f);
-    let d = sqrt(d2_);
-    let travel = (to_x / vec3(d));
-    let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
-    let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
-}
-
 @compute @workgroup_size(8, 8, 1) 
 fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
     var local: bool;
     var u: f32 = 0.5f;
     var sum: f32 = 0f;
     var j: u32;
+    var t: f32;
+    var w: f32;
     var l: f32;
 
     let m_2 = march;
-    let x_6 = id.x;
+    let x_7 = id.x;
     let y_3 = id.y;
-    if !((x_6 >= m_2.sizes.x)) {
+    if !((x_7 >= m_2.sizes.x)) {
         local = (y_3 >= m_2.sizes.y);
     } else {
         local = true;
@@ -204,59 +225,71 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e17 {
         return;
     }
-    let eye_1 = m_2.eye.xyz;
-    let _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_6, y_3);
-    let _e24 = textureLoad(depth, vec2<u32>(x_6, y_3), 0i);
+    let eye_2 = m_2.eye.xyz;
+    let _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
+    let _e24 = textureLoad(depth, vec2<u32>(x_7, y_3), 0i);
     let s = (min(max(_e24.x, 0f), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 0.000001f));
-    let n_1 = m_2.sizes.w;
-    let h_1 = (s / f32(n_1));
+    let n_2 = m_2.sizes.w;
+    let h_2 = (s / f32(n_2));
     let mx = m_2.interleave.x;
     let my = m_2.interleave.y;
     let stride = (mx * my);
-    let pixel_class = ((x_6 % mx) + (mx * (y_3 % my)));
+    let pixel_class = ((x_7 % mx) + (mx * (y_3 % my)));
     if (m_2.interleave.z != 0u) {
-        let _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_6, y_3);
+        let _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
         u = _e54;
     }
     let _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    let _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0f, s, n_2);
     j = pixel_class;
     loop {
-        let _e58 = j;
-        if (_e58 < n_1) {
+        let _e62 = j;
+        if (_e62 < n_2) {
         } else {
             break;
         }
         {
-            let _e60 = j;
-            let _e62 = u;
-            let t_3 = ((f32(_e60) + _e62) * h_1);
-            let _e68 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, (eye_1 + (_e20 * t_3)));
+            let _e64 = j;
+            let _e66 = u;
+            t = ((f32(_e64) + _e66) * h_2);
+            w = h_2;
             if false {
-                let _e71 = sum;
-                let _e82 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, _e20, t_3, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = (_e71 + ((_e68 * h_1) * _e82));
-            } else {
+                let _e72 = j;
+                let _e74 = u;
+                let _e76 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e60, (f32(_e72) + _e74));
+                t = _e76.x;
+                w = _e76.y;
+            }
+            let _e79 = t;
+            let _e83 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, (eye_2 + (_e20 * _e79)));
+            if false {
                 let _e85 = sum;
-                let _e88 = j;
-                let _e91 = j;
-                let _e96 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e88) * h_1), (f32((_e91 + 1u)) * h_1));
-                sum = (_e85 + (_e68 * _e96));
+                let _e86 = w;
+                let _e88 = t;
+                let _e98 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, _e88, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = (_e85 + ((_e83 * _e86) * _e98));
+            } else {
+                let _e101 = sum;
+                let _e104 = j;
+                let _e107 = j;
+                let _e112 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e104) * h_2), (f32((_e107 + 1u)) * h_2));
+                sum = (_e101 + (_e83 * _e112));
             }
         }
         continuing {
-            let _e99 = j;
-            j = (_e99 + stride);
+            let _e115 = j;
+            j = (_e115 + stride);
         }
     }
-    let _e101 = sum;
-    l = _e101;
+    let _e117 = sum;
+    l = _e117;
     if !(false) {
-        let _e112 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
-        let _e114 = sum;
-        l = ((m_2.medium.y * _e112) * _e114);
+        let _e128 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
+        let _e130 = sum;
+        l = ((m_2.medium.y * _e128) * _e130);
     }
-    let _e118 = l;
-    let c = (m_2.light_color.xyz * _e118);
-    textureStore(output, vec2<u32>(x_6, y_3), vec4<f32>(c.x, c.y, c.z, 1f));
+    let _e134 = l;
+    let c = (m_2.light_color.xyz * _e134);
+    textureStore(output, vec2<u32>(x_7, y_3), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

@@ -13,6 +13,12 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     vec4 proj;
     uvec4 size;
 };
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 eye;
     vec4 axis;
@@ -101,11 +107,11 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
     if (_e27) {
         return 2.0;
     }
-    uint n = v_2.size.x;
-    uint x = min(uint((uv.x * float(n))), (n - 1u));
-    uint y = min(uint((uv.y * float(n))), (n - 1u));
+    uint n_1 = v_2.size.x;
+    uint x_1 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint y = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x, y)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_1, y)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
     return _e49.x;
 }
 
@@ -147,18 +153,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        vec3 dir_2 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_2.z <= 1e-6)) {
+        vec3 dir_3 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_3.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_3);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_2.z);
+        return ((z_2 + _e35) / dir_3.z);
     } else {
         vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -177,11 +183,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_1 = (sigma_t * len);
-    if ((x_1 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_1)));
+    float x_2 = (sigma_t * len);
+    if ((x_2 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_2)));
     }
-    return ((1.0 - exp(-(x_1))) / sigma_t);
+    return ((1.0 - exp(-(x_2))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -193,13 +199,13 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_2 * x_2) * (3.0 - (2.0 * x_2)));
+    float x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_3 * x_3) * (3.0 - (2.0 * x_3)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_3 = (eye + (dir * t));
-    vec3 to_x = (x_3 - light_pos);
+    vec3 x_4 = (eye + (dir * t));
+    vec3 to_x = (x_4 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     vec3 travel = (to_x / vec3(d));
@@ -259,6 +265,18 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     return (((_e75 * 0.5) * w) * h);
 }
 
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
+    float t0_1 = dot((light_pos_2 - eye_2), dir_2);
+    float h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_1) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / float(n)));
+}
+
+vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x) {
+    float tau = tan((e.theta_a + (x * e.dtheta)));
+    return vec2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
+}
+
 SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec4 v_6) {
     return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
 }
@@ -289,10 +307,10 @@ void main() {
     uvec3 id = gl_GlobalInvocationID;
     bool local = false;
     float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
-    uint x_4 = id.x;
+    uint x_5 = id.x;
     uint y_1 = id.y;
     uint _e7 = _group_0_binding_0_cs.sizes.z;
-    if (!((x_4 >= _e7))) {
+    if (!((x_5 >= _e7))) {
         uint _e13 = _group_0_binding_0_cs.sizes.w;
         local = (y_1 >= _e13);
     } else {
@@ -308,7 +326,7 @@ void main() {
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e26 = _group_0_binding_0_cs;
     float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
     vec3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
-    float col = ((float(x_4) + 0.5) * _e22.delta);
+    float col = ((float(x_5) + 0.5) * _e22.delta);
     vec4 _e36 = _group_0_binding_0_cs.axis;
     vec3 axis = _e36.xyz;
     if (false) {
@@ -333,7 +351,7 @@ void main() {
     float _e85 = _group_0_binding_0_cs.theta.x;
     float _e89 = _group_0_binding_0_cs.theta.y;
     float _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
-    imageStore(_group_0_binding_3_cs, ivec2(uvec2(x_4, y_1)), vec4(_e90, 0.0, 0.0, 0.0));
+    imageStore(_group_0_binding_3_cs, ivec2(uvec2(x_5, y_1)), vec4(_e90, 0.0, 0.0, 0.0));
     return;
 }
 

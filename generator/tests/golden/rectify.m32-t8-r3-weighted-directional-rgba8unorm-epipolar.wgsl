@@ -9,6 +9,13 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     size: vec4<u32>,
 }
 
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    t_close: f32,
+    dist: f32,
+    theta_a: f32,
+    dtheta: f32,
+}
+
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     eye: vec4<f32>,
     axis: vec4<f32>,
@@ -100,10 +107,10 @@ fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_nag
     if _e27 {
         return 2f;
     }
-    let n = v_2.size.x;
-    let x = min(u32((uv.x * f32(n))), (n - 1u));
-    let y = min(u32((uv.y * f32(n))), (n - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x, y), 0i);
+    let n_1 = v_2.size.x;
+    let x_1 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let y = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
+    let _e49 = textureLoad(sm, vec2<u32>(x_1, y), 0i);
     return _e49.x;
 }
 
@@ -147,18 +154,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_2 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_2.z <= 0.000001f) {
+        let dir_3 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_3.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_3);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_2.z);
+        return ((z_2 + _e35) / dir_3.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -177,11 +184,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_1 = (sigma_t * len);
-    if (x_1 < 0.0001f) {
-        return (len * (1f - (0.5f * x_1)));
+    let x_2 = (sigma_t * len);
+    if (x_2 < 0.0001f) {
+        return (len * (1f - (0.5f * x_2)));
     }
-    return ((1f - exp(-(x_1))) / sigma_t);
+    return ((1f - exp(-(x_2))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -193,13 +200,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_2 * x_2) * (3f - (2f * x_2)));
+    let x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_3 * x_3) * (3f - (2f * x_3)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_3 = (eye + (dir * t));
-    let to_x = (x_3 - light_pos);
+    let x_4 = (eye + (dir * t));
+    let to_x = (x_4 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d = sqrt(d2_);
     let travel = (to_x / vec3(d));
@@ -256,6 +263,18 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     return (((_e75 * 0.5f) * w) * h);
 }
 
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    let t0_1 = dot((light_pos_2 - eye_2), dir_2);
+    let h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001f * max((b_2 - a_2), 0.000001f)));
+    let theta_a = atan(((a_2 - t0_1) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / f32(n)));
+}
+
+fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x: f32) -> vec2<f32> {
+    let tau = tan((e.theta_a + (x * e.dtheta)));
+    return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
+}
+
 fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
 }
@@ -287,10 +306,10 @@ fn rectify(@builtin(global_invocation_id) id: vec3<u32>) {
     var local: bool;
     var theta_occ: f32 = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
 
-    let x_4 = id.x;
+    let x_5 = id.x;
     let y_1 = id.y;
     let _e7 = frame.sizes.z;
-    if !((x_4 >= _e7)) {
+    if !((x_5 >= _e7)) {
         let _e13 = frame.sizes.w;
         local = (y_1 >= _e13);
     } else {
@@ -306,7 +325,7 @@ fn rectify(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e26 = frame;
     let _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
     let _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
-    let col = ((f32(x_4) + 0.5f) * _e22.delta);
+    let col = ((f32(x_5) + 0.5f) * _e22.delta);
     let _e36 = frame.axis;
     let axis = _e36.xyz;
     if false {
@@ -331,6 +350,6 @@ fn rectify(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e85 = frame.theta.x;
     let _e89 = frame.theta.y;
     let _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
-    textureStore(rectified, vec2<u32>(x_4, y_1), vec4<f32>(_e90, 0f, 0f, 0f));
+    textureStore(rectified, vec2<u32>(x_5, y_1), vec4<f32>(_e90, 0f, 0f, 0f));
     return;
 }

@@ -21,6 +21,12 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
 struct type_9 {
     float inner[4];
 };
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 eye;
     metal::float4 axis;
@@ -115,11 +121,11 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     if (_e27) {
         return 2.0;
     }
-    uint n = v_2.size.x;
-    uint x = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
-    uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
+    uint n_1 = v_2.size.x;
+    uint x_1 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_1, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -173,18 +179,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir_2 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_2.z <= 0.000001) {
+        metal::float3 dir_3 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_3.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_2);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_3);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return (z_2 + _e35) / dir_2.z;
+        return (z_2 + _e35) / dir_3.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -209,11 +215,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_1 = sigma_t * len;
-    if (x_1 < 0.0001) {
-        return len * (1.0 - (0.5 * x_1));
+    float x_2 = sigma_t * len;
+    if (x_2 < 0.0001) {
+        return len * (1.0 - (0.5 * x_2));
     }
-    return (1.0 - metal::exp(-(x_1))) / sigma_t;
+    return (1.0 - metal::exp(-(x_2))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -233,8 +239,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_2 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_2 * x_2) * (3.0 - (2.0 * x_2));
+    float x_3 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_3 * x_3) * (3.0 - (2.0 * x_3));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -247,8 +253,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_3 = eye + (dir * t);
-    metal::float3 to_x = x_3 - light_pos;
+    metal::float3 x_4 = eye + (dir * t);
+    metal::float3 to_x = x_4 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d);
@@ -325,6 +331,28 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     return ((_e75 * 0.5) * w) * h;
 }
 
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye_2,
+    metal::float3 dir_2,
+    metal::float3 light_pos_2,
+    float a_2,
+    float b_2,
+    uint n
+) {
+    float t0_1 = metal::dot(light_pos_2 - eye_2, dir_2);
+    float h_1 = metal::max(metal::length((eye_2 + (dir_2 * t0_1)) - light_pos_2), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float theta_a = metal::atan((a_2 - t0_1) / h_1);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_1, theta_a, (metal::atan((b_2 - t0_1) / h_1) - theta_a) / static_cast<float>(n)};
+}
+
+metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e,
+    float x
+) {
+    float tau = metal::tan(e.theta_a + (x * e.dtheta));
+    return metal::float2(e.t_close + (e.dist * tau), (e.dtheta * e.dist) * (1.0 + (tau * tau)));
+}
+
 SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float4 v_6
 ) {
@@ -382,10 +410,10 @@ kernel void rectify(
 ) {
     bool local = {};
     float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
-    uint x_4 = id.x;
+    uint x_5 = id.x;
     uint y_1 = id.y;
     uint _e7 = frame.sizes.z;
-    if (!((x_4 >= _e7))) {
+    if (!((x_5 >= _e7))) {
         uint _e13 = frame.sizes.w;
         local = y_1 >= _e13;
     } else {
@@ -401,7 +429,7 @@ kernel void rectify(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e26 = frame;
     float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
     metal::float3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
-    float col = (static_cast<float>(x_4) + 0.5) * _e22.delta;
+    float col = (static_cast<float>(x_5) + 0.5) * _e22.delta;
     metal::float4 _e36 = frame.axis;
     metal::float3 axis = _e36.xyz;
     if (true) {
@@ -426,6 +454,6 @@ kernel void rectify(
     float _e85 = frame.theta.x;
     float _e89 = frame.theta.y;
     float _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
-    rectified.write(metal::float4(_e90, 0.0, 0.0, 0.0), metal::uint2(metal::uint2(x_4, y_1)));
+    rectified.write(metal::float4(_e90, 0.0, 0.0, 0.0), metal::uint2(metal::uint2(x_5, y_1)));
     return;
 }

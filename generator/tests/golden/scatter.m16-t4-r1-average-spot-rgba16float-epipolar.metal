@@ -21,6 +21,12 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
 struct type_9 {
     float inner[4];
 };
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 eye;
     metal::float4 axis;
@@ -84,8 +90,8 @@ metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     if (v_1.origin.w > 0.5) {
         float z_1 = metal::max(ls.z, 0.000001);
-        float t_2 = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_2)), 0.5 - ((0.5 * ls.y) / (z_1 * t_2)));
+        float t_3 = v_1.proj.x;
+        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_3)), 0.5 - ((0.5 * ls.y) / (z_1 * t_3)));
     } else {
         return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
     }
@@ -124,11 +130,11 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     if (_e27) {
         return 2.0;
     }
-    uint n = v_2.size.x;
-    uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n)), n - 1u);
-    uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n)), n - 1u);
+    uint n_1 = v_2.size.x;
+    uint x_3 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_3, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -176,24 +182,24 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5,
     metal::texture2d<float, metal::access::sample> sm_2,
     metal::float3 o,
-    metal::float3 l_1
+    metal::float3 l
 ) {
     metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir_5 = metal::float3(metal::dot(l_1, v_5.right.xyz), metal::dot(l_1, v_5.up.xyz), metal::dot(l_1, v_5.forward.xyz));
-        if (dir_5.z <= 0.000001) {
+        metal::float3 dir_6 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_6.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_5);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return (z_2 + _e35) / dir_5.z;
+        return (z_2 + _e35) / dir_6.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -218,11 +224,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_3 = sigma_t * len;
-    if (x_3 < 0.0001) {
-        return len * (1.0 - (0.5 * x_3));
+    float x_4 = sigma_t * len;
+    if (x_4 < 0.0001) {
+        return len * (1.0 - (0.5 * x_4));
     }
-    return (1.0 - metal::exp(-(x_3))) / sigma_t;
+    return (1.0 - metal::exp(-(x_4))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -242,8 +248,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_4 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_4 * x_4) * (3.0 - (2.0 * x_4));
+    float x_5 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_5 * x_5) * (3.0 - (2.0 * x_5));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -256,8 +262,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_5 = eye + (dir * t);
-    metal::float3 to_x = x_5 - light_pos;
+    metal::float3 x_6 = eye + (dir * t);
+    metal::float3 to_x = x_6 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_2 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_2);
@@ -284,7 +290,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float t0_1 = metal::dot(light_pos_1 - eye_1, dir_1);
     float h = metal::max(metal::length((eye_1 + (dir_1 * t0_1)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
     float g0_ = metal::atan((a_1 - t0_1) / h);
-    float w = (metal::atan((b_1 - t0_1) / h) - g0_) / static_cast<float>(panels);
+    float w_1 = (metal::atan((b_1 - t0_1) / h) - g0_) / static_cast<float>(panels);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
@@ -302,7 +308,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
         {
             uint _e32 = k_1;
-            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w);
+            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
@@ -321,7 +327,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q;
-                    float u = metal::tan(mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_1 + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -331,7 +337,29 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
     }
     float _e75 = sum;
-    return ((_e75 * 0.5) * w) * h;
+    return ((_e75 * 0.5) * w_1) * h;
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye_2,
+    metal::float3 dir_2,
+    metal::float3 light_pos_2,
+    float a_2,
+    float b_2,
+    uint n
+) {
+    float t0_2 = metal::dot(light_pos_2 - eye_2, dir_2);
+    float h_1 = metal::max(metal::length((eye_2 + (dir_2 * t0_2)) - light_pos_2), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float theta_a = metal::atan((a_2 - t0_2) / h_1);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_2, h_1, theta_a, (metal::atan((b_2 - t0_2) / h_1) - theta_a) / static_cast<float>(n)};
+}
+
+metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e,
+    float x
+) {
+    float tau = metal::tan(e.theta_a + (x * e.dtheta));
+    return metal::float2(e.t_close + (e.dist * tau), (e.dtheta * e.dist) * (1.0 + (tau * tau)));
 }
 
 SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -350,13 +378,13 @@ float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 
 metal::float3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f,
-    uint x,
+    uint x_1,
     uint y
 ) {
-    float ndc_x = ((2.0 * (static_cast<float>(x) + 0.5)) / static_cast<float>(f.sizes.x)) - 1.0;
+    float ndc_x = ((2.0 * (static_cast<float>(x_1) + 0.5)) / static_cast<float>(f.sizes.x)) - 1.0;
     float ndc_y = 1.0 - ((2.0 * (static_cast<float>(y) + 0.5)) / static_cast<float>(f.sizes.y));
-    float t_3 = f.cam_forward.w;
-    return metal::normalize((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_3) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_3)));
+    float t_4 = f.cam_forward.w;
+    return metal::normalize((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_4) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_4)));
 }
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -377,65 +405,78 @@ float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 
 float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
-    metal::float3 eye_2,
-    metal::float3 dir_2,
+    metal::float3 eye_3,
+    metal::float3 dir_3,
     float t_1
 ) {
-    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
+    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
     metal::texture2d<float, metal::access::sample> sm_4,
-    metal::float3 eye_3,
-    metal::float3 dir_3,
+    metal::float3 eye_4,
+    metal::float3 dir_4,
     float s,
     bool spot
 ) {
     float sum_1 = 0.0;
     uint k_2 = 0u;
+    float t_2 = {};
+    float w = {};
     uint steps = f_4.sizes2_.y;
-    float h_1 = s / static_cast<float>(steps);
+    float h_2 = s / static_cast<float>(steps);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0.0, s, steps);
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e44 = k_2;
-            k_2 = _e44 + 1u;
+            uint _e60 = k_2;
+            k_2 = _e60 + 1u;
         }
         loop_init_2 = false;
-        uint _e9 = k_2;
-        if (_e9 < steps) {
+        uint _e15 = k_2;
+        if (_e15 < steps) {
         } else {
             break;
         }
         {
-            uint _e11 = k_2;
-            float t_4 = (static_cast<float>(_e11) + 0.5) * h_1;
-            float _e21 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, eye_3 + (dir_3 * t_4));
+            uint _e17 = k_2;
+            t_2 = (static_cast<float>(_e17) + 0.5) * h_2;
+            w = h_2;
             if (spot) {
-                float _e24 = sum_1;
-                float _e26 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_3, dir_3, t_4);
-                sum_1 = _e24 + ((_e21 * h_1) * _e26);
+                uint _e25 = k_2;
+                metal::float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e25) + 0.5);
+                t_2 = _e29.x;
+                w = _e29.y;
+            }
+            float _e32 = t_2;
+            float _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, eye_4 + (dir_4 * _e32));
+            if (spot) {
+                float _e38 = sum_1;
+                float _e39 = w;
+                float _e41 = t_2;
+                float _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e41);
+                sum_1 = _e38 + ((_e36 * _e39) * _e42);
             } else {
-                float _e29 = sum_1;
-                uint _e32 = k_2;
-                uint _e35 = k_2;
-                float _e40 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, static_cast<float>(_e32) * h_1, static_cast<float>(_e35 + 1u) * h_1);
-                sum_1 = _e29 + (_e21 * _e40);
+                float _e45 = sum_1;
+                uint _e48 = k_2;
+                uint _e51 = k_2;
+                float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, static_cast<float>(_e48) * h_2, static_cast<float>(_e51 + 1u) * h_2);
+                sum_1 = _e45 + (_e36 * _e56);
             }
         }
     }
     if (spot) {
-        float _e46 = sum_1;
-        return _e46;
+        float _e62 = sum_1;
+        return _e62;
     } else {
-        float _e55 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(metal::dot(f_4.light_dir.xyz, dir_3)));
-        float _e57 = sum_1;
-        return (f_4.medium.y * _e55) * _e57;
+        float _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(metal::dot(f_4.light_dir.xyz, dir_4)));
+        float _e73 = sum_1;
+        return (f_4.medium.y * _e71) * _e73;
     }
 }
 
@@ -463,7 +504,7 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
-    float x_1,
+    float x_2,
     float delta_1,
     float theta_2,
     float s_1,
@@ -471,7 +512,7 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 ) {
     bool local_9 = {};
     if (spot_1) {
-        float psi = x_1 * delta_1;
+        float psi = x_2 * delta_1;
         float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
             local_9 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
@@ -484,19 +525,19 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         }
         return metal::min((f_5.axis.w * metal::sin(psi)) / den, s_1);
     } else {
-        return metal::min((x_1 * delta_1) / metal::max(metal::sin(theta_2), 0.000001), s_1);
+        return metal::min((x_2 * delta_1) / metal::max(metal::sin(theta_2), 0.000001), s_1);
     }
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
-    metal::float3 eye_4,
-    metal::float3 dir_4,
-    float a_2,
-    float b_2,
+    metal::float3 eye_5,
+    metal::float3 dir_5,
+    float a_3,
+    float b_3,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -577,18 +618,15 @@ kernel void scatter(
     type_16 coeffs = {};
     uint layer = 0u;
     float total = 0.0;
-    float norm = 0.0;
     uint r_1 = 0u;
     float weight = {};
     float vis = {};
     uint layer_1 = {};
     uint k = {};
-    float l = {};
-    float unshadowed = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
-    uint x_6 = id.x;
+    uint x_7 = id.x;
     uint y_2 = id.y;
-    if (!((x_6 >= f_9.sizes.x))) {
+    if (!((x_7 >= f_9.sizes.x))) {
         local = y_2 >= f_9.sizes.y;
     } else {
         local = true;
@@ -597,13 +635,13 @@ kernel void scatter(
     if (_e18) {
         return;
     }
-    metal::float3 eye_5 = f_9.eye.xyz;
-    metal::float3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_6, y_2);
+    metal::float3 eye_6 = f_9.eye.xyz;
+    metal::float3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_7, y_2);
     uint clamped_lod_e25 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e25 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_2)), metal::uint2(depth.get_width(clamped_lod_e25), depth.get_height(clamped_lod_e25)) - 1), clamped_lod_e25);
+    metal::float4 _e25 = depth.read(metal::min(metal::uint2(metal::uint2(x_7, y_2)), metal::uint2(depth.get_width(clamped_lod_e25), depth.get_height(clamped_lod_e25)) - 1), clamped_lod_e25);
     float s_2 = metal::min(metal::max(_e25.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e21, f_9.cam_forward.xyz), 0.000001);
     metal::float3 color = f_9.light_color.xyz;
-    metal::float3 px = metal::float3(static_cast<float>(x_6) + 0.5, static_cast<float>(y_2) + 0.5, 0.0);
+    metal::float3 px = metal::float3(static_cast<float>(x_7) + 0.5, static_cast<float>(y_2) + 0.5, 0.0);
     float radius = f_9.epipole.w;
     if (f_9.epipole.z > 0.5) {
         local_1 = metal::length(px - metal::float3(f_9.epipole.x, f_9.epipole.y, 0.0)) < radius;
@@ -625,9 +663,9 @@ kernel void scatter(
     bool _e88 = local_3;
     if (_e88) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = frame;
-        float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_5, _e21, s_2, true);
-        metal::float3 l_2 = _e93 * color;
-        output.write(metal::float4(l_2.x, l_2.y, l_2.z, 1.0), metal::uint2(metal::uint2(x_6, y_2)));
+        float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_6, _e21, s_2, true);
+        metal::float3 l_1 = _e93 * color;
+        output.write(metal::float4(l_1.x, l_1.y, l_1.z, 1.0), metal::uint2(metal::uint2(x_7, y_2)));
         return;
     }
     metal::float3 axis = f_9.axis.xyz;
@@ -661,7 +699,7 @@ kernel void scatter(
         float _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_9.theta.x, f_9.theta.y);
         d = _e170;
         if (true) {
-            metal::float3 q_2 = metal::normalize((eye_5 + (_e21 * s_2)) - f_9.light_pos.xyz);
+            metal::float3 q_2 = metal::normalize((eye_6 + (_e21 * s_2)) - f_9.light_pos.xyz);
             float _e184 = delta;
             xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / _e184;
         } else {
@@ -757,8 +795,8 @@ kernel void scatter(
         if (metal::all(loop_bound_5 == uint2(0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e434 = r_1;
-            r_1 = _e434 + 1u;
+            uint _e427 = r_1;
+            r_1 = _e427 + 1u;
         }
         loop_init_5 = false;
         uint _e293 = r_1;
@@ -769,44 +807,40 @@ kernel void scatter(
         }
         {
             uint _e296 = r_1;
-            float a_3 = t0_.inner[metal::min(unsigned(_e296), 7u)];
+            float a_4 = t0_.inner[metal::min(unsigned(_e296), 7u)];
             uint _e299 = r_1;
-            float b_3 = t1_.inner[metal::min(unsigned(_e299), 7u)];
+            float b_4 = t1_.inner[metal::min(unsigned(_e299), 7u)];
             weight = float {};
-            if (!(false)) {
-                weight = b_3 - a_3;
+            if (true) {
+                float _e304 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_4, b_4, panels_2);
+                weight = _e304;
             } else {
-                if (true) {
-                    float _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, a_3, b_3, panels_2);
-                    weight = _e307;
-                } else {
-                    float _e312 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                    float _e316 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3, b_3);
-                    weight = (f_9.medium.y * _e312) * _e316;
-                }
+                float _e309 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                float _e313 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+                weight = (f_9.medium.y * _e309) * _e313;
             }
-            uint _e318 = r_1;
-            float _e320 = pos.inner[metal::min(unsigned(_e318), 7u)];
-            float xb = _e320 - 0.5;
+            uint _e315 = r_1;
+            float _e317 = pos.inner[metal::min(unsigned(_e315), 7u)];
+            float xb = _e317 - 0.5;
             uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
             uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
-            uint clamped_lod_e341 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 b00_ = bounds.read(metal::min(metal::uint2(metal::uint2(x0_, _e196)), metal::uint2(bounds.get_width(clamped_lod_e341), bounds.get_height(clamped_lod_e341)) - 1), clamped_lod_e341);
-            uint clamped_lod_e345 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 b01_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e196)), metal::uint2(bounds.get_width(clamped_lod_e345), bounds.get_height(clamped_lod_e345)) - 1), clamped_lod_e345);
-            uint clamped_lod_e349 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 b10_ = bounds.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e349), bounds.get_height(clamped_lod_e349)) - 1), clamped_lod_e349);
-            uint clamped_lod_e353 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 b11_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e353), bounds.get_height(clamped_lod_e353)) - 1), clamped_lod_e353);
+            uint clamped_lod_e338 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 b00_ = bounds.read(metal::min(metal::uint2(metal::uint2(x0_, _e196)), metal::uint2(bounds.get_width(clamped_lod_e338), bounds.get_height(clamped_lod_e338)) - 1), clamped_lod_e338);
+            uint clamped_lod_e342 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 b01_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e196)), metal::uint2(bounds.get_width(clamped_lod_e342), bounds.get_height(clamped_lod_e342)) - 1), clamped_lod_e342);
+            uint clamped_lod_e346 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 b10_ = bounds.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e346), bounds.get_height(clamped_lod_e346)) - 1), clamped_lod_e346);
+            uint clamped_lod_e350 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 b11_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e350), bounds.get_height(clamped_lod_e350)) - 1), clamped_lod_e350);
             float lo_1 = metal::min(metal::min(b00_.x, b01_.x), metal::min(b10_.x, b11_.x));
             float hi_1 = metal::max(metal::max(b00_.y, b01_.y), metal::max(b10_.y, b11_.y));
             vis = 0.5;
-            float _e370 = d;
-            if (_e370 <= lo_1) {
+            float _e367 = d;
+            if (_e367 <= lo_1) {
                 vis = 1.0;
             } else {
-                float _e373 = d;
-                if (_e373 > hi_1) {
+                float _e370 = d;
+                if (_e370 > hi_1) {
                     vis = 0.0;
                 } else {
                     layer_1 = 0u;
@@ -816,23 +850,23 @@ kernel void scatter(
                         if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                         if (!loop_init_6) {
-                            uint _e418 = layer_1;
-                            layer_1 = _e418 + 1u;
+                            uint _e415 = layer_1;
+                            layer_1 = _e415 + 1u;
                         }
                         loop_init_6 = false;
-                        uint _e378 = layer_1;
-                        if (_e378 < LAYERS) {
+                        uint _e375 = layer_1;
+                        if (_e375 < LAYERS) {
                         } else {
                             break;
                         }
                         {
-                            uint _e381 = layer_1;
-                            metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e381), 3u)];
-                            uint _e384 = r_1;
-                            float _e386 = pos.inner[metal::min(unsigned(_e384), 7u)];
-                            float _e389 = yc;
-                            uint _e393 = layer_1;
-                            metal::float4 texel_1 = filtered.sample(filtered_sampler, metal::float2(_e386 / static_cast<float>(width_1), _e389 / static_cast<float>(rows_1)), _e393, metal::level(0.0));
+                            uint _e378 = layer_1;
+                            metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e378), 3u)];
+                            uint _e381 = r_1;
+                            float _e383 = pos.inner[metal::min(unsigned(_e381), 7u)];
+                            float _e386 = yc;
+                            uint _e390 = layer_1;
+                            metal::float4 texel_1 = filtered.sample(filtered_sampler, metal::float2(_e383 / static_cast<float>(width_1), _e386 / static_cast<float>(rows_1)), _e390, metal::level(0.0));
                             k = 0u;
                             uint2 loop_bound_7 = uint2(4294967295u);
                             bool loop_init_7 = true;
@@ -840,55 +874,34 @@ kernel void scatter(
                                 if (metal::all(loop_bound_7 == uint2(0u))) { break; }
                                 loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
                                 if (!loop_init_7) {
-                                    uint _e415 = k;
-                                    k = _e415 + 1u;
+                                    uint _e412 = k;
+                                    k = _e412 + 1u;
                                 }
                                 loop_init_7 = false;
-                                uint _e400 = k;
-                                if (_e400 < 4u) {
+                                uint _e397 = k;
+                                if (_e397 < 4u) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    float _e403 = vis;
-                                    uint _e404 = k;
-                                    uint _e406 = k;
-                                    vis = _e403 + (coeff[metal::min(unsigned(_e404), 3u)] * ((texel_1[metal::min(unsigned(_e406), 3u)] * 2.0) - 1.0));
+                                    float _e400 = vis;
+                                    uint _e401 = k;
+                                    uint _e403 = k;
+                                    vis = _e400 + (coeff[metal::min(unsigned(_e401), 3u)] * ((texel_1[metal::min(unsigned(_e403), 3u)] * 2.0) - 1.0));
                                 }
                             }
                         }
                     }
                 }
             }
-            float _e421 = total;
-            float _e422 = weight;
-            float _e423 = vis;
-            total = _e421 + (_e422 * metal::clamp(_e423, 0.0, 1.0));
-            float _e430 = norm;
-            float _e431 = weight;
-            norm = _e430 + _e431;
+            float _e418 = total;
+            float _e419 = weight;
+            float _e420 = vis;
+            total = _e418 + (_e419 * metal::clamp(_e420, 0.0, 1.0));
         }
     }
-    if (false) {
-        float _e436 = total;
-        l = _e436;
-    } else {
-        if (true) {
-            float _e445 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, 0.0, s_2, metal::max(naga_div(f_9.sizes2_.z, 4u), 1u));
-            unshadowed = _e445;
-        } else {
-            float _e451 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-            float _e455 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, s_2);
-            unshadowed = (f_9.medium.y * _e451) * _e455;
-        }
-        float _e457 = unshadowed;
-        float _e458 = total;
-        float _e459 = norm;
-        float _e461 = norm;
-        l = _e457 * ((_e461 > 0.0) ? (_e458 / _e459) : 1.0);
-    }
-    float _e467 = l;
-    metal::float3 c = color * _e467;
-    output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_6, y_2)));
+    float l_2 = total;
+    metal::float3 c = color * l_2;
+    output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_7, y_2)));
     return;
 }

@@ -9,6 +9,13 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     size: vec4<u32>,
 }
 
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    t_close: f32,
+    dist: f32,
+    theta_a: f32,
+    dtheta: f32,
+}
+
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     eye: vec4<f32>,
     axis: vec4<f32>,
@@ -78,8 +85,8 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
 fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
     if (v_1.origin.w > 0.5f) {
         let z_1 = max(ls.z, 0.000001f);
-        let t_2 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_2))), (0.5f - ((0.5f * ls.y) / (z_1 * t_2))));
+        let t_3 = v_1.proj.x;
+        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
     } else {
         return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -111,10 +118,10 @@ fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_nag
     if _e27 {
         return 2f;
     }
-    let n = v_2.size.x;
-    let x_2 = min(u32((uv.x * f32(n))), (n - 1u));
-    let y_1 = min(u32((uv.y * f32(n))), (n - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_2, y_1), 0i);
+    let n_1 = v_2.size.x;
+    let x_3 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let y_1 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
+    let _e49 = textureLoad(sm, vec2<u32>(x_3, y_1), 0i);
     return _e49.x;
 }
 
@@ -153,23 +160,23 @@ fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapView
     return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
 }
 
-fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, o: vec3<f32>, l_1: vec3<f32>) -> f32 {
+fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
     let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_5 = vec3<f32>(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
-        if (dir_5.z <= 0.000001f) {
+        let dir_6 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_6.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_5);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_5.z);
+        return ((z_2 + _e35) / dir_6.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -188,11 +195,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_3 = (sigma_t * len);
-    if (x_3 < 0.0001f) {
-        return (len * (1f - (0.5f * x_3)));
+    let x_4 = (sigma_t * len);
+    if (x_4 < 0.0001f) {
+        return (len * (1f - (0.5f * x_4)));
     }
-    return ((1f - exp(-(x_3))) / sigma_t);
+    return ((1f - exp(-(x_4))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -204,13 +211,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_4 * x_4) * (3f - (2f * x_4)));
+    let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_5 * x_5) * (3f - (2f * x_5)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_5 = (eye + (dir * t));
-    let to_x = (x_5 - light_pos);
+    let x_6 = (eye + (dir * t));
+    let to_x = (x_6 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d_2 = sqrt(d2_);
     let travel = (to_x / vec3(d_2));
@@ -227,7 +234,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let t0_1 = dot((light_pos_1 - eye_1), dir_1);
     let h = max(length(((eye_1 + (dir_1 * t0_1)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
     let g0_ = atan(((a_1 - t0_1) / h));
-    let w = ((atan(((b_1 - t0_1) / h)) - g0_) / f32(panels));
+    let w_1 = ((atan(((b_1 - t0_1) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k_1;
         if (_e30 < panels) {
@@ -236,7 +243,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
         {
             let _e32 = k_1;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w));
+            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
             q = 0u;
             loop {
                 let _e40 = q;
@@ -246,7 +253,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                 }
                 {
                     let _e46 = q;
-                    let u = tan((mid + ((0.5f * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     let _e52 = sum;
                     let _e54 = q;
                     let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_1 + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -264,7 +271,19 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
     }
     let _e75 = sum;
-    return (((_e75 * 0.5f) * w) * h);
+    return (((_e75 * 0.5f) * w_1) * h);
+}
+
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    let t0_2 = dot((light_pos_2 - eye_2), dir_2);
+    let h_1 = max(length(((eye_2 + (dir_2 * t0_2)) - light_pos_2)), (0.0001f * max((b_2 - a_2), 0.000001f)));
+    let theta_a = atan(((a_2 - t0_2) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_2, h_1, theta_a, ((atan(((b_2 - t0_2) / h_1)) - theta_a) / f32(n)));
+}
+
+fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x: f32) -> vec2<f32> {
+    let tau = tan((e.theta_a + (x * e.dtheta)));
+    return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
 fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
@@ -275,11 +294,11 @@ fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_1: f32, l
     return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * clamp(((theta_1 - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
 }
 
-fn pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x: u32, y: u32) -> vec3<f32> {
-    let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(f.sizes.x)) - 1f);
+fn pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: u32, y: u32) -> vec3<f32> {
+    let ndc_x = (((2f * (f32(x_1) + 0.5f)) / f32(f.sizes.x)) - 1f);
     let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(f.sizes.y)));
-    let t_3 = f.cam_forward.w;
-    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_3) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_3))));
+    let t_4 = f.cam_forward.w;
+    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_4) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_4))));
 }
 
 fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
@@ -292,51 +311,64 @@ fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_o
     return _e4;
 }
 
-fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_2: vec3<f32>, dir_2: vec3<f32>, t_1: f32) -> f32 {
-    let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
+fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_3: vec3<f32>, dir_3: vec3<f32>, t_1: f32) -> f32 {
+    let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_3: vec3<f32>, dir_3: vec3<f32>, s: f32, spot: bool) -> f32 {
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, s: f32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_2: u32 = 0u;
+    var t_2: f32;
+    var w: f32;
 
     let steps = f_4.sizes2_.y;
-    let h_1 = (s / f32(steps));
+    let h_2 = (s / f32(steps));
+    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0f, s, steps);
     loop {
-        let _e9 = k_2;
-        if (_e9 < steps) {
+        let _e15 = k_2;
+        if (_e15 < steps) {
         } else {
             break;
         }
         {
-            let _e11 = k_2;
-            let t_4 = ((f32(_e11) + 0.5f) * h_1);
-            let _e21 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_3 + (dir_3 * t_4)));
+            let _e17 = k_2;
+            t_2 = ((f32(_e17) + 0.5f) * h_2);
+            w = h_2;
             if spot {
-                let _e24 = sum_1;
-                let _e26 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_3, dir_3, t_4);
-                sum_1 = (_e24 + ((_e21 * h_1) * _e26));
+                let _e25 = k_2;
+                let _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e25) + 0.5f));
+                t_2 = _e29.x;
+                w = _e29.y;
+            }
+            let _e32 = t_2;
+            let _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e32)));
+            if spot {
+                let _e38 = sum_1;
+                let _e39 = w;
+                let _e41 = t_2;
+                let _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e41);
+                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
             } else {
-                let _e29 = sum_1;
-                let _e32 = k_2;
-                let _e35 = k_2;
-                let _e40 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e32) * h_1), (f32((_e35 + 1u)) * h_1));
-                sum_1 = (_e29 + (_e21 * _e40));
+                let _e45 = sum_1;
+                let _e48 = k_2;
+                let _e51 = k_2;
+                let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e48) * h_2), (f32((_e51 + 1u)) * h_2));
+                sum_1 = (_e45 + (_e36 * _e56));
             }
         }
         continuing {
-            let _e44 = k_2;
-            k_2 = (_e44 + 1u);
+            let _e60 = k_2;
+            k_2 = (_e60 + 1u);
         }
     }
     if spot {
-        let _e46 = sum_1;
-        return _e46;
+        let _e62 = sum_1;
+        return _e62;
     } else {
-        let _e55 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_3)));
-        let _e57 = sum_1;
-        return ((f_4.medium.y * _e55) * _e57);
+        let _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_4)));
+        let _e73 = sum_1;
+        return ((f_4.medium.y * _e71) * _e73);
     }
 }
 
@@ -349,11 +381,11 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta_1: f32, theta_2: f32, s_1: f32, spot_1: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta_1: f32, theta_2: f32, s_1: f32, spot_1: bool) -> f32 {
     var local_9: bool;
 
     if spot_1 {
-        let psi = (x_1 * delta_1);
+        let psi = (x_2 * delta_1);
         let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
             local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
@@ -366,12 +398,12 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_X
         }
         return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_1 * delta_1) / max(sin(theta_2), 0.000001f)), s_1);
+        return min(((x_2 * delta_1) / max(sin(theta_2), 0.000001f)), s_1);
     }
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_4: vec3<f32>, dir_4: vec3<f32>, a_2: f32, b_2: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -420,19 +452,16 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     var coeffs: array<vec4<f32>, 4>;
     var layer: u32 = 0u;
     var total: f32 = 0f;
-    var norm: f32 = 0f;
     var r_1: u32 = 0u;
     var weight: f32;
     var vis: f32;
     var layer_1: u32;
     var k: u32;
-    var l: f32;
-    var unshadowed: f32;
 
     let f_9 = frame;
-    let x_6 = id.x;
+    let x_7 = id.x;
     let y_2 = id.y;
-    if !((x_6 >= f_9.sizes.x)) {
+    if !((x_7 >= f_9.sizes.x)) {
         local = (y_2 >= f_9.sizes.y);
     } else {
         local = true;
@@ -441,12 +470,12 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e18 {
         return;
     }
-    let eye_5 = f_9.eye.xyz;
-    let _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_6, y_2);
-    let _e25 = textureLoad(depth, vec2<u32>(x_6, y_2), 0i);
+    let eye_6 = f_9.eye.xyz;
+    let _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_7, y_2);
+    let _e25 = textureLoad(depth, vec2<u32>(x_7, y_2), 0i);
     let s_2 = (min(max(_e25.x, 0f), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 0.000001f));
     let color = f_9.light_color.xyz;
-    let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_2) + 0.5f), 0f);
+    let px = vec3<f32>((f32(x_7) + 0.5f), (f32(y_2) + 0.5f), 0f);
     let radius = f_9.epipole.w;
     if (f_9.epipole.z > 0.5f) {
         local_1 = (length((px - vec3<f32>(f_9.epipole.x, f_9.epipole.y, 0f))) < radius);
@@ -468,9 +497,9 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e88 = local_3;
     if _e88 {
         let _e90 = frame;
-        let _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_5, _e21, s_2, true);
-        let l_2 = (_e93 * color);
-        textureStore(output, vec2<u32>(x_6, y_2), vec4<f32>(l_2.x, l_2.y, l_2.z, 1f));
+        let _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_6, _e21, s_2, true);
+        let l_1 = (_e93 * color);
+        textureStore(output, vec2<u32>(x_7, y_2), vec4<f32>(l_1.x, l_1.y, l_1.z, 1f));
         return;
     }
     let axis = f_9.axis.xyz;
@@ -504,7 +533,7 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         let _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_9.theta.x, f_9.theta.y);
         d = _e170;
         if true {
-            let q_2 = normalize(((eye_5 + (_e21 * s_2)) - f_9.light_pos.xyz));
+            let q_2 = normalize(((eye_6 + (_e21 * s_2)) - f_9.light_pos.xyz));
             let _e184 = delta;
             xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / _e184);
         } else {
@@ -593,25 +622,21 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         {
             let _e296 = r_1;
-            let a_3 = t0_[_e296];
+            let a_4 = t0_[_e296];
             let _e299 = r_1;
-            let b_3 = t1_[_e299];
+            let b_4 = t1_[_e299];
             weight = f32();
-            if !(false) {
-                weight = (b_3 - a_3);
+            if true {
+                let _e304 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_4, b_4, panels_2);
+                weight = _e304;
             } else {
-                if true {
-                    let _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, a_3, b_3, panels_2);
-                    weight = _e307;
-                } else {
-                    let _e312 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                    let _e316 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3, b_3);
-                    weight = ((f_9.medium.y * _e312) * _e316);
-                }
+                let _e309 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                let _e313 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+                weight = ((f_9.medium.y * _e309) * _e313);
             }
-            let _e318 = r_1;
-            let _e320 = pos[_e318];
-            let xb = (_e320 - 0.5f);
+            let _e315 = r_1;
+            let _e317 = pos[_e315];
+            let xb = (_e317 - 0.5f);
             let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
             let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
             let b00_ = textureLoad(bounds, vec2<u32>(x0_, _e196), 0i);
@@ -621,88 +646,67 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
             let lo_1 = min(min(b00_.x, b01_.x), min(b10_.x, b11_.x));
             let hi_1 = max(max(b00_.y, b01_.y), max(b10_.y, b11_.y));
             vis = 0.5f;
-            let _e370 = d;
-            if (_e370 <= lo_1) {
+            let _e367 = d;
+            if (_e367 <= lo_1) {
                 vis = 1f;
             } else {
-                let _e373 = d;
-                if (_e373 > hi_1) {
+                let _e370 = d;
+                if (_e370 > hi_1) {
                     vis = 0f;
                 } else {
                     layer_1 = 0u;
                     loop {
-                        let _e378 = layer_1;
-                        if (_e378 < LAYERS) {
+                        let _e375 = layer_1;
+                        if (_e375 < LAYERS) {
                         } else {
                             break;
                         }
                         {
-                            let _e381 = layer_1;
-                            let coeff = coeffs[_e381];
-                            let _e384 = r_1;
-                            let _e386 = pos[_e384];
-                            let _e389 = yc;
-                            let _e393 = layer_1;
-                            let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e386 / f32(width_1)), (_e389 / f32(rows_1))), _e393, 0f);
+                            let _e378 = layer_1;
+                            let coeff = coeffs[_e378];
+                            let _e381 = r_1;
+                            let _e383 = pos[_e381];
+                            let _e386 = yc;
+                            let _e390 = layer_1;
+                            let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e383 / f32(width_1)), (_e386 / f32(rows_1))), _e390, 0f);
                             k = 0u;
                             loop {
-                                let _e400 = k;
-                                if (_e400 < 4u) {
+                                let _e397 = k;
+                                if (_e397 < 4u) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    let _e403 = vis;
-                                    let _e404 = k;
-                                    let _e406 = k;
-                                    vis = (_e403 + (coeff[_e404] * ((texel_1[_e406] * 2f) - 1f)));
+                                    let _e400 = vis;
+                                    let _e401 = k;
+                                    let _e403 = k;
+                                    vis = (_e400 + (coeff[_e401] * ((texel_1[_e403] * 2f) - 1f)));
                                 }
                                 continuing {
-                                    let _e415 = k;
-                                    k = (_e415 + 1u);
+                                    let _e412 = k;
+                                    k = (_e412 + 1u);
                                 }
                             }
                         }
                         continuing {
-                            let _e418 = layer_1;
-                            layer_1 = (_e418 + 1u);
+                            let _e415 = layer_1;
+                            layer_1 = (_e415 + 1u);
                         }
                     }
                 }
             }
-            let _e421 = total;
-            let _e422 = weight;
-            let _e423 = vis;
-            total = (_e421 + (_e422 * clamp(_e423, 0f, 1f)));
-            let _e430 = norm;
-            let _e431 = weight;
-            norm = (_e430 + _e431);
+            let _e418 = total;
+            let _e419 = weight;
+            let _e420 = vis;
+            total = (_e418 + (_e419 * clamp(_e420, 0f, 1f)));
         }
         continuing {
-            let _e434 = r_1;
-            r_1 = (_e434 + 1u);
+            let _e427 = r_1;
+            r_1 = (_e427 + 1u);
         }
     }
-    if false {
-        let _e436 = total;
-        l = _e436;
-    } else {
-        if true {
-            let _e445 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, 0f, s_2, max((f_9.sizes2_.z / 4u), 1u));
-            unshadowed = _e445;
-        } else {
-            let _e451 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-            let _e455 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, s_2);
-            unshadowed = ((f_9.medium.y * _e451) * _e455);
-        }
-        let _e457 = unshadowed;
-        let _e458 = total;
-        let _e459 = norm;
-        let _e461 = norm;
-        l = (_e457 * select(1f, (_e458 / _e459), (_e461 > 0f)));
-    }
-    let _e467 = l;
-    let c = (color * _e467);
-    textureStore(output, vec2<u32>(x_6, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
+    let l_2 = total;
+    let c = (color * l_2);
+    textureStore(output, vec2<u32>(x_7, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
     return;
 }

@@ -13,6 +13,12 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     vec4 proj;
     uvec4 size;
 };
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
+};
 struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 eye;
     vec4 axis;
@@ -78,8 +84,8 @@ vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
 vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
     if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t_2 = v_1.proj.x;
-        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_2))), (0.5 - ((0.5 * ls.y) / (z_1 * t_2))));
+        float t_3 = v_1.proj.x;
+        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
     } else {
         return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -110,11 +116,11 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
     if (_e27) {
         return 2.0;
     }
-    uint n = v_2.size.x;
-    uint x_2 = min(uint((uv.x * float(n))), (n - 1u));
-    uint y_1 = min(uint((uv.y * float(n))), (n - 1u));
+    uint n_1 = v_2.size.x;
+    uint x_3 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint y_1 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_2, y_1)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_3, y_1)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
     return _e49.x;
 }
 
@@ -151,23 +157,23 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
     return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
 }
 
-float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5, sampler2D sm_2, vec3 o, vec3 l_1) {
+float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5, sampler2D sm_2, vec3 o, vec3 l) {
     vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        vec3 dir_5 = vec3(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
-        if ((dir_5.z <= 1e-6)) {
+        vec3 dir_6 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_6.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_5);
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_5.z);
+        return ((z_2 + _e35) / dir_6.z);
     } else {
         vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -186,11 +192,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_3 = (sigma_t * len);
-    if ((x_3 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_3)));
+    float x_4 = (sigma_t * len);
+    if ((x_4 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_4)));
     }
-    return ((1.0 - exp(-(x_3))) / sigma_t);
+    return ((1.0 - exp(-(x_4))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -202,13 +208,13 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
+    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_5 = (eye + (dir * t));
-    vec3 to_x = (x_5 - light_pos);
+    vec3 x_6 = (eye + (dir * t));
+    vec3 to_x = (x_6 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_2 = sqrt(d2_);
     vec3 travel = (to_x / vec3(d_2));
@@ -224,7 +230,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     float t0_1 = dot((light_pos_1 - eye_1), dir_1);
     float h = max(length(((eye_1 + (dir_1 * t0_1)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
     float g0_ = atan(((a_1 - t0_1) / h));
-    float w = ((atan(((b_1 - t0_1) / h)) - g0_) / float(panels));
+    float w_1 = ((atan(((b_1 - t0_1) / h)) - g0_) / float(panels));
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
@@ -239,7 +245,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
         }
         {
             uint _e32 = k_1;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w));
+            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
             q = 0u;
             bool loop_init_1 = true;
             while(true) {
@@ -255,7 +261,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                 }
                 {
                     uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_1 + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -265,7 +271,19 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w) * h);
+    return (((_e75 * 0.5) * w_1) * h);
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
+    float t0_2 = dot((light_pos_2 - eye_2), dir_2);
+    float h_1 = max(length(((eye_2 + (dir_2 * t0_2)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_2) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_2, h_1, theta_a, ((atan(((b_2 - t0_2) / h_1)) - theta_a) / float(n)));
+}
+
+vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x) {
+    float tau = tan((e.theta_a + (x * e.dtheta)));
+    return vec2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
 SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec4 v_6) {
@@ -276,11 +294,11 @@ float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta_
     return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta_1 - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
 }
 
-vec3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, uint x, uint y) {
-    float ndc_x = (((2.0 * (float(x) + 0.5)) / float(f.sizes.x)) - 1.0);
+vec3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, uint x_1, uint y) {
+    float ndc_x = (((2.0 * (float(x_1) + 0.5)) / float(f.sizes.x)) - 1.0);
     float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(f.sizes.y)));
-    float t_3 = f.cam_forward.w;
-    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_3) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_3))));
+    float t_4 = f.cam_forward.w;
+    return normalize(((f.cam_forward.xyz + (f.cam_right.xyz * ((ndc_x * t_4) * f.cam_right.w))) + (f.cam_up.xyz * (ndc_y * t_4))));
 }
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1) {
@@ -293,52 +311,65 @@ float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     return _e4;
 }
 
-float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec3 eye_2, vec3 dir_2, float t_1) {
-    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, dir_2, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
+float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec3 eye_3, vec3 dir_3, float t_1) {
+    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_3.light_pos.xyz, f_3.light_dir.xyz, f_3.light_pos.w, f_3.light_dir.w, f_3.medium);
     return _e13;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, sampler2D sm_4, vec3 eye_3, vec3 dir_3, float s, bool spot) {
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, sampler2D sm_4, vec3 eye_4, vec3 dir_4, float s, bool spot) {
     float sum_1 = 0.0;
     uint k_2 = 0u;
+    float t_2 = 0.0;
+    float w = 0.0;
     uint steps = f_4.sizes2_.y;
-    float h_1 = (s / float(steps));
+    float h_2 = (s / float(steps));
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0.0, s, steps);
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e44 = k_2;
-            k_2 = (_e44 + 1u);
+            uint _e60 = k_2;
+            k_2 = (_e60 + 1u);
         }
         loop_init_2 = false;
-        uint _e9 = k_2;
-        if ((_e9 < steps)) {
+        uint _e15 = k_2;
+        if ((_e15 < steps)) {
         } else {
             break;
         }
         {
-            uint _e11 = k_2;
-            float t_4 = ((float(_e11) + 0.5) * h_1);
-            float _e21 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_3 + (dir_3 * t_4)));
+            uint _e17 = k_2;
+            t_2 = ((float(_e17) + 0.5) * h_2);
+            w = h_2;
             if (spot) {
-                float _e24 = sum_1;
-                float _e26 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_3, dir_3, t_4);
-                sum_1 = (_e24 + ((_e21 * h_1) * _e26));
+                uint _e25 = k_2;
+                vec2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e25) + 0.5));
+                t_2 = _e29.x;
+                w = _e29.y;
+            }
+            float _e32 = t_2;
+            float _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e32)));
+            if (spot) {
+                float _e38 = sum_1;
+                float _e39 = w;
+                float _e41 = t_2;
+                float _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e41);
+                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
             } else {
-                float _e29 = sum_1;
-                uint _e32 = k_2;
-                uint _e35 = k_2;
-                float _e40 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (float(_e32) * h_1), (float((_e35 + 1u)) * h_1));
-                sum_1 = (_e29 + (_e21 * _e40));
+                float _e45 = sum_1;
+                uint _e48 = k_2;
+                uint _e51 = k_2;
+                float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (float(_e48) * h_2), (float((_e51 + 1u)) * h_2));
+                sum_1 = (_e45 + (_e36 * _e56));
             }
         }
     }
     if (spot) {
-        float _e46 = sum_1;
-        return _e46;
+        float _e62 = sum_1;
+        return _e62;
     } else {
-        float _e55 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_3)));
-        float _e57 = sum_1;
-        return ((f_4.medium.y * _e55) * _e57);
+        float _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_4)));
+        float _e73 = sum_1;
+        return ((f_4.medium.y * _e71) * _e73);
     }
 }
 
@@ -351,10 +382,10 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, 
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float x_1, float delta_1, float theta_2, float s_1, bool spot_1) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float x_2, float delta_1, float theta_2, float s_1, bool spot_1) {
     bool local_9 = false;
     if (spot_1) {
-        float psi = (x_1 * delta_1);
+        float psi = (x_2 * delta_1);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
             local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
@@ -367,12 +398,12 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         }
         return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_1 * delta_1) / max(sin(theta_2), 1e-6)), s_1);
+        return min(((x_2 * delta_1) / max(sin(theta_2), 1e-6)), s_1);
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 eye_4, vec3 dir_4, float a_2, float b_2, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, a_2, b_2, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 eye_5, vec3 dir_5, float a_3, float b_3, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -421,18 +452,15 @@ void main() {
     vec4 coeffs[8] = vec4[8](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
     uint layer = 0u;
     float total = 0.0;
-    float norm = 0.0;
     uint r_1 = 0u;
     float weight = 0.0;
     float vis = 0.0;
     uint layer_1 = 0u;
     uint k = 0u;
-    float l = 0.0;
-    float unshadowed = 0.0;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = _group_0_binding_0_cs;
-    uint x_6 = id.x;
+    uint x_7 = id.x;
     uint y_2 = id.y;
-    if (!((x_6 >= f_9.sizes.x))) {
+    if (!((x_7 >= f_9.sizes.x))) {
         local = (y_2 >= f_9.sizes.y);
     } else {
         local = true;
@@ -441,13 +469,13 @@ void main() {
     if (_e18) {
         return;
     }
-    vec3 eye_5 = f_9.eye.xyz;
-    vec3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_6, y_2);
+    vec3 eye_6 = f_9.eye.xyz;
+    vec3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_7, y_2);
     int _e25_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e25 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e25_clamped_lod) - ivec2(1)), _e25_clamped_lod);
+    vec4 _e25 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_7, y_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e25_clamped_lod) - ivec2(1)), _e25_clamped_lod);
     float s_2 = (min(max(_e25.x, 0.0), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 1e-6));
     vec3 color = f_9.light_color.xyz;
-    vec3 px = vec3((float(x_6) + 0.5), (float(y_2) + 0.5), 0.0);
+    vec3 px = vec3((float(x_7) + 0.5), (float(y_2) + 0.5), 0.0);
     float radius = f_9.epipole.w;
     if ((f_9.epipole.z > 0.5)) {
         local_1 = (length((px - vec3(f_9.epipole.x, f_9.epipole.y, 0.0))) < radius);
@@ -469,9 +497,9 @@ void main() {
     bool _e88 = local_3;
     if (_e88) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = _group_0_binding_0_cs;
-        float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, _group_0_binding_3_cs, eye_5, _e21, s_2, false);
-        vec3 l_2 = (_e93 * color);
-        imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_6, y_2)), vec4(l_2.x, l_2.y, l_2.z, 1.0));
+        float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, _group_0_binding_3_cs, eye_6, _e21, s_2, false);
+        vec3 l_1 = (_e93 * color);
+        imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_7, y_2)), vec4(l_1.x, l_1.y, l_1.z, 1.0));
         return;
     }
     vec3 axis = f_9.axis.xyz;
@@ -505,7 +533,7 @@ void main() {
         float _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_9.theta.x, f_9.theta.y);
         d = _e170;
         if (false) {
-            vec3 q_2 = normalize(((eye_5 + (_e21 * s_2)) - f_9.light_pos.xyz));
+            vec3 q_2 = normalize(((eye_6 + (_e21 * s_2)) - f_9.light_pos.xyz));
             float _e184 = delta;
             xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / _e184);
         } else {
@@ -592,8 +620,8 @@ void main() {
     bool loop_init_5 = true;
     while(true) {
         if (!loop_init_5) {
-            uint _e434 = r_1;
-            r_1 = (_e434 + 1u);
+            uint _e427 = r_1;
+            r_1 = (_e427 + 1u);
         }
         loop_init_5 = false;
         uint _e293 = r_1;
@@ -604,121 +632,96 @@ void main() {
         }
         {
             uint _e296 = r_1;
-            float a_3 = t0_[_e296];
+            float a_4 = t0_[_e296];
             uint _e299 = r_1;
-            float b_3 = t1_[_e299];
+            float b_4 = t1_[_e299];
             weight = 0.0;
-            if (!(true)) {
-                weight = (b_3 - a_3);
+            if (false) {
+                float _e304 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_4, b_4, panels_2);
+                weight = _e304;
             } else {
-                if (false) {
-                    float _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, a_3, b_3, panels_2);
-                    weight = _e307;
-                } else {
-                    float _e312 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                    float _e316 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3, b_3);
-                    weight = ((f_9.medium.y * _e312) * _e316);
-                }
+                float _e309 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                float _e313 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+                weight = ((f_9.medium.y * _e309) * _e313);
             }
-            uint _e318 = r_1;
-            float _e320 = pos[_e318];
-            float xb = (_e320 - 0.5);
+            uint _e315 = r_1;
+            float _e317 = pos[_e315];
+            float xb = (_e317 - 0.5);
             uint x0_ = uint(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
             uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
-            int _e341_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
-            vec4 b00_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x0_, _e196)), ivec2(0), textureSize(_group_0_binding_7_cs, _e341_clamped_lod) - ivec2(1)), _e341_clamped_lod);
-            int _e345_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
-            vec4 b01_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x1_, _e196)), ivec2(0), textureSize(_group_0_binding_7_cs, _e345_clamped_lod) - ivec2(1)), _e345_clamped_lod);
-            int _e349_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
-            vec4 b10_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x0_, row1_)), ivec2(0), textureSize(_group_0_binding_7_cs, _e349_clamped_lod) - ivec2(1)), _e349_clamped_lod);
-            int _e353_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
-            vec4 b11_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_7_cs, _e353_clamped_lod) - ivec2(1)), _e353_clamped_lod);
+            int _e338_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
+            vec4 b00_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x0_, _e196)), ivec2(0), textureSize(_group_0_binding_7_cs, _e338_clamped_lod) - ivec2(1)), _e338_clamped_lod);
+            int _e342_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
+            vec4 b01_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x1_, _e196)), ivec2(0), textureSize(_group_0_binding_7_cs, _e342_clamped_lod) - ivec2(1)), _e342_clamped_lod);
+            int _e346_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
+            vec4 b10_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x0_, row1_)), ivec2(0), textureSize(_group_0_binding_7_cs, _e346_clamped_lod) - ivec2(1)), _e346_clamped_lod);
+            int _e350_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
+            vec4 b11_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_7_cs, _e350_clamped_lod) - ivec2(1)), _e350_clamped_lod);
             float lo_1 = min(min(b00_.x, b01_.x), min(b10_.x, b11_.x));
             float hi_1 = max(max(b00_.y, b01_.y), max(b10_.y, b11_.y));
             vis = 0.5;
-            float _e370 = d;
-            if ((_e370 <= lo_1)) {
+            float _e367 = d;
+            if ((_e367 <= lo_1)) {
                 vis = 1.0;
             } else {
-                float _e373 = d;
-                if ((_e373 > hi_1)) {
+                float _e370 = d;
+                if ((_e370 > hi_1)) {
                     vis = 0.0;
                 } else {
                     layer_1 = 0u;
                     bool loop_init_6 = true;
                     while(true) {
                         if (!loop_init_6) {
-                            uint _e418 = layer_1;
-                            layer_1 = (_e418 + 1u);
+                            uint _e415 = layer_1;
+                            layer_1 = (_e415 + 1u);
                         }
                         loop_init_6 = false;
-                        uint _e378 = layer_1;
-                        if ((_e378 < LAYERS)) {
+                        uint _e375 = layer_1;
+                        if ((_e375 < LAYERS)) {
                         } else {
                             break;
                         }
                         {
-                            uint _e381 = layer_1;
-                            vec4 coeff = coeffs[_e381];
-                            uint _e384 = r_1;
-                            float _e386 = pos[_e384];
-                            float _e389 = yc;
-                            uint _e393 = layer_1;
-                            vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e386 / float(width_1)), (_e389 / float(rows_1))), _e393), 0.0);
+                            uint _e378 = layer_1;
+                            vec4 coeff = coeffs[_e378];
+                            uint _e381 = r_1;
+                            float _e383 = pos[_e381];
+                            float _e386 = yc;
+                            uint _e390 = layer_1;
+                            vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e383 / float(width_1)), (_e386 / float(rows_1))), _e390), 0.0);
                             k = 0u;
                             bool loop_init_7 = true;
                             while(true) {
                                 if (!loop_init_7) {
-                                    uint _e415 = k;
-                                    k = (_e415 + 1u);
+                                    uint _e412 = k;
+                                    k = (_e412 + 1u);
                                 }
                                 loop_init_7 = false;
-                                uint _e400 = k;
-                                if ((_e400 < 4u)) {
+                                uint _e397 = k;
+                                if ((_e397 < 4u)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    float _e403 = vis;
-                                    uint _e404 = k;
-                                    uint _e406 = k;
-                                    vis = (_e403 + (coeff[_e404] * ((texel_1[_e406] * 2.0) - 1.0)));
+                                    float _e400 = vis;
+                                    uint _e401 = k;
+                                    uint _e403 = k;
+                                    vis = (_e400 + (coeff[_e401] * ((texel_1[_e403] * 2.0) - 1.0)));
                                 }
                             }
                         }
                     }
                 }
             }
-            float _e421 = total;
-            float _e422 = weight;
-            float _e423 = vis;
-            total = (_e421 + (_e422 * clamp(_e423, 0.0, 1.0)));
-            float _e430 = norm;
-            float _e431 = weight;
-            norm = (_e430 + _e431);
+            float _e418 = total;
+            float _e419 = weight;
+            float _e420 = vis;
+            total = (_e418 + (_e419 * clamp(_e420, 0.0, 1.0)));
         }
     }
-    if (true) {
-        float _e436 = total;
-        l = _e436;
-    } else {
-        if (false) {
-            float _e445 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_5, _e21, 0.0, s_2, max((f_9.sizes2_.z / 4u), 1u));
-            unshadowed = _e445;
-        } else {
-            float _e451 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-            float _e455 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, s_2);
-            unshadowed = ((f_9.medium.y * _e451) * _e455);
-        }
-        float _e457 = unshadowed;
-        float _e458 = total;
-        float _e459 = norm;
-        float _e461 = norm;
-        l = (_e457 * ((_e461 > 0.0) ? (_e458 / _e459) : 1.0));
-    }
-    float _e467 = l;
-    vec3 c = (color * _e467);
-    imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_6, y_2)), vec4(c.x, c.y, c.z, 1.0));
+    float l_2 = total;
+    vec3 c = (color * l_2);
+    imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_7, y_2)), vec4(c.x, c.y, c.z, 1.0));
     return;
 }
 

@@ -1,12 +1,14 @@
 //! CPU mirror of `shaderlib/templates/common/epipolar.wgsl` (`scatter::epipolar`): what
 //! every family built on the epipolar set-up shares and no family owns: slice angles,
 //! rectified depth, the frame's standard shadow-map lookups, the pixel's view ray, the
-//! epipole march, the slice-row index and the spot quadrature of a ray span.
+//! epipole march (equiangular for a spot), the slice-row index and the spot quadrature of a
+//! ray span.
 //!
 //! Conventions are documented in `scatter_frame::frame`.
 
 use super::common_model::{
-    PI, clamp, max, min, phase_hg, spot_integrand, spot_span, transmittance_between,
+    PI, clamp, equiangular, equiangular_sample, max, min, phase_hg, spot_integrand, spot_span,
+    transmittance_between,
 };
 use super::common_prefiltered::{Tex, xyz};
 use super::common_shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility};
@@ -82,17 +84,26 @@ pub fn frame_spot_integrand(f: &FrameUniforms, eye: Vec3, dir: Vec3, t: f32) -> 
     )
 }
 
-/// In-scattering along `[0, s]` of the pixel's ray by marching `steps` midpoints against
-/// the standard shadow map `sm`: the epipole and anti-epipole discs of every epipolar family.
+/// In-scattering along `[0, s]` of the pixel's ray by marching `steps` samples against the
+/// standard shadow map `sm`: the epipole and anti-epipole discs of every epipolar family. The
+/// sun: cell midpoints uniform in `t`; a spot: the midpoints of `steps` equiangular strata
+/// ([`equiangular`]), so the 1/d^2 peak next to the lamp is sampled by its angle.
 pub fn epipole_march(f: &FrameUniforms, sm: &Tex, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f32 {
     let steps = f.sizes2[1];
     let h = s / steps as f32;
+    let strata = equiangular(eye, dir, xyz(f.light_pos), 0.0, s, steps);
     let mut sum = 0.0;
     for k in 0..steps {
-        let t = (k as f32 + 0.5) * h;
+        let mut t = (k as f32 + 0.5) * h;
+        let mut w = h;
+        if spot {
+            let tw = equiangular_sample(&strata, k as f32 + 0.5);
+            t = tw.0;
+            w = tw.1;
+        }
         let v = sm_visibility(f, sm, eye + dir * t);
         if spot {
-            sum += v * h * frame_spot_integrand(f, eye, dir, t);
+            sum += v * w * frame_spot_integrand(f, eye, dir, t);
         } else {
             sum += v * transmittance_between(f.medium[0], k as f32 * h, (k + 1) as f32 * h);
         }

@@ -1,5 +1,6 @@
 //! CPU mirror of `shaderlib/templates/common/model.wgsl` (`scatter::model`): the
-//! single-scattering model's terms in f32, as the kernels evaluate them.
+//! single-scattering model's terms in f32, as the kernels evaluate them (phase, transmittance,
+//! cone, spot integrand, the spot quadrature of a span, equiangular sampling).
 
 use glam::Vec3;
 
@@ -102,6 +103,44 @@ pub fn spot_span(
         }
     }
     sum * 0.5 * w * h
+}
+
+/// Equiangular sampling (Kulla & Fajardo 2012) of `[a, b]` of the view ray `eye + t dir` for a
+/// point light at `light_pos`, cut into `n` strata of equal angle (`t = t0 + h tan(theta)`;
+/// the pdf cancels the 1/d^2 peak of the spot integrand). See the WGSL comment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Equiangular {
+    /// Closest approach `t0` of the ray to the lamp.
+    pub t_close: f32,
+    /// Distance `h` of the lamp from the ray (kept above 1e-4 of the span, as in `spot_span`).
+    pub dist: f32,
+    /// `theta_a = atan((a - t0) / h)`.
+    pub theta_a: f32,
+    /// Angle per stratum, `(theta_b - theta_a) / n`.
+    pub dtheta: f32,
+}
+
+/// The equiangular strata of `[a, b]` (see [`Equiangular`]).
+pub fn equiangular(eye: Vec3, dir: Vec3, light_pos: Vec3, a: f32, b: f32, n: u32) -> Equiangular {
+    let t0 = (light_pos - eye).dot(dir);
+    let h = max(
+        (eye + dir * t0 - light_pos).length(),
+        1e-4 * max(b - a, 1e-6),
+    );
+    let theta_a = ((a - t0) / h).atan();
+    Equiangular {
+        t_close: t0,
+        dist: h,
+        theta_a,
+        dtheta: (((b - t0) / h).atan() - theta_a) / n as f32,
+    }
+}
+
+/// The sample at stratum position `x` (`x = k + u`): (the ray parameter `t`, its weight
+/// `1 / (n pdf(t)) = dtheta h (1 + tan^2 theta)`).
+pub fn equiangular_sample(e: &Equiangular, x: f32) -> (f32, f32) {
+    let tau = (e.theta_a + x * e.dtheta).tan();
+    (e.t_close + e.dist * tau, e.dtheta * e.dist * (1.0 + tau * tau))
 }
 
 /// 4-point Gauss-Legendre abscissae on [-1, 1] (ascending).

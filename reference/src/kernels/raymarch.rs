@@ -1,8 +1,11 @@
 //! CPU mirror of `shaderlib/templates/raymarch.wgsl`: brute-force ray marching through the
 //! standard shadow map, optionally one interleaving class per pixel (Tóth & Umenhoffer
-//! 2009). Conventions: `scatter_frame::raymarch`.
+//! 2009); a spot light's samples are equiangular (Kulla & Fajardo 2012). Conventions:
+//! `scatter_frame::raymarch`.
 
-use super::common_model::{max, min, phase_hg, spot_integrand, transmittance_between};
+use super::common_model::{
+    equiangular, equiangular_sample, max, min, phase_hg, spot_integrand, transmittance_between,
+};
 use super::common_prefiltered::{Tex, TexArray, quantise, xyz};
 use super::common_raymarch::{march_pixel_dir, march_shadow_view, pixel_jitter};
 use super::common_shadow::shadow_visibility;
@@ -38,14 +41,21 @@ pub fn raymarch_main(
         u = pixel_jitter(x, y);
     }
     let view = march_shadow_view(m);
+    let strata = equiangular(eye, dir, xyz(m.light_pos), 0.0, s, n);
     let mut sum = 0.0;
     let mut j = pixel_class;
     while j < n {
-        let t = (j as f32 + u) * h;
+        let mut t = (j as f32 + u) * h;
+        let mut w = h;
+        if spot {
+            let tw = equiangular_sample(&strata, j as f32 + u);
+            t = tw.0;
+            w = tw.1;
+        }
         let v = shadow_visibility(&view, shadow_map, eye + dir * t);
         if spot {
             sum += v
-                * h
+                * w
                 * spot_integrand(
                     eye,
                     dir,

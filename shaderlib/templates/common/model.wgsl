@@ -1,6 +1,7 @@
 // scatter::model: the single-scattering model's terms in f32, as every kernel evaluates them:
 // Henyey-Greenstein phase, transmittance integrals of a homogeneous medium, the spot light's
-// cone falloff and in-scattering integrand, 4-point Gauss-Legendre nodes.
+// cone falloff and in-scattering integrand, 4-point Gauss-Legendre nodes, the spot quadrature
+// of a ray span and equiangular sampling of a ray.
 //
 // Composed into kernels by naga_oil (`#import scatter::model::{...}`); plain WGSL, not an
 // askama template. Mirrored line by line by reference/src/kernels/common_model.rs.
@@ -98,4 +99,39 @@ fn spot_span(
         }
     }
     return sum * 0.5 * w * h;
+}
+
+// Equiangular sampling (Kulla & Fajardo 2012) of `[a, b]` of the view ray `eye + t dir` for a
+// point light at `light_pos`, cut into `n` strata of equal angle. With `t0` the ray's closest
+// approach to the lamp and `h` its distance there, the lamp sees the ray point
+// `t = t0 + h tan(theta)` under the angle `theta` in [`theta_a`, `theta_b`]; samples uniform
+// in `theta` have the pdf `h / ((theta_b - theta_a) (h^2 + (t - t0)^2))`, which cancels the
+// 1/d^2 peak of the spot integrand. A march uniform in `t` cannot follow that peak: with the
+// lamp on screen the pixels next to it overshot the truth 5.6x (issue 12).
+struct Equiangular {
+    // Closest approach `t0` of the ray to the lamp (naga_oil refuses identifiers that end in
+    // a digit).
+    t_close: f32,
+    // Distance `h` of the lamp from the ray (kept above 1e-4 of the span, as in `spot_span`).
+    dist: f32,
+    // `theta_a = atan((a - t0) / h)`.
+    theta_a: f32,
+    // Angle per stratum, `(theta_b - theta_a) / n`.
+    dtheta: f32,
+}
+
+// The equiangular strata of `[a, b]` (see `Equiangular`).
+fn equiangular(eye: vec3<f32>, dir: vec3<f32>, light_pos: vec3<f32>, a: f32, b: f32, n: u32) -> Equiangular {
+    let t0 = dot(light_pos - eye, dir);
+    let h = max(length(eye + dir * t0 - light_pos), 1e-4 * max(b - a, 1e-6));
+    let theta_a = atan((a - t0) / h);
+    return Equiangular(t0, h, theta_a, (atan((b - t0) / h) - theta_a) / f32(n));
+}
+
+// The sample at stratum position `x` (stratum `k` at offset `u` in [0, 1): `x = k + u`): x = the
+// ray parameter `t`, y = its weight `1 / (n pdf(t)) = dtheta h (1 + tan^2 theta)`, so the sum of
+// weight times integrand over the `n` strata estimates the integral over `[a, b]`.
+fn equiangular_sample(e: Equiangular, x: f32) -> vec2<f32> {
+    let tau = tan(e.theta_a + x * e.dtheta);
+    return vec2<f32>(e.t_close + e.dist * tau, e.dtheta * e.dist * (1.0 + tau * tau));
 }
