@@ -322,14 +322,6 @@ const AVERAGE_EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
     ),
     ("window/light_behind", 4.10, 4.5, "as weighted (4.30 %)"),
     ("window/grazing", 5.04, 5.6, "as weighted (8.03 %)"),
-    (
-        "spot_grate/epipole_on_screen",
-        6.43,
-        7.1,
-        "the texel weights are lengths along the reference ray, with no cone or 1/d^2: a \
-         region's visibility is the mean over light rays the lamp barely lights (weighted: \
-         4.05 %)",
-    ),
 ];
 
 /// Average visibility (the prefilter weights texels by length along the reference ray; the
