@@ -320,3 +320,83 @@ mod tests {
         assert!(a.iter().flatten().all(|v| (-1.0..1.0).contains(v)));
     }
 }
+
+/// Runs any family's variant on a scene, as the stress and random-pose suites do: on the GPU
+/// through [`scatter_runtime::run_family_once`] (for a prefiltered variant with the engine's
+/// rasterised rectified map, which a projective frame needs) or, without a context, through
+/// its CPU mirrors ([`scatter_reference::kernels::run_family`]). The depth buffer is
+/// `frame.gbuf.view_depth`. Returns the output (rgb) and, for the epipolar families, the frame
+/// report.
+///
+/// # Errors
+///
+/// The frame set-up's or the runtime's error, as text.
+pub fn run_variant(
+    ctx: Option<&Context>,
+    variant: &scatter_shaderlib::family::FamilyVariant,
+    frame: &scatter_reference::kernels::CpuFrame<'_>,
+) -> Result<
+    (
+        scatter_reference::image::Image,
+        Option<scatter_shaderlib::prefiltered::FrameReport>,
+    ),
+    String,
+> {
+    use scatter_reference::image::Image;
+    use scatter_reference::kernels::{CpuRun, engine_rectified_map, run_family};
+    use scatter_shaderlib::family::FamilyVariant;
+    use scatter_shaderlib::prefiltered::{Resolutions, prepare_frame};
+
+    let Some(ctx) = ctx else {
+        let run = run_family(variant, frame).map_err(|e| e.to_string())?;
+        return Ok((run.output().clone(), run.report().cloned()));
+    };
+    let (scene, gbuf) = (frame.scene, frame.gbuf);
+    let input = FrameInput {
+        camera: scene.camera_desc(),
+        light: scene.light_desc(),
+        medium: scene.medium_desc(),
+        shadow_map: frame.shadow_map.desc(),
+        settings: *frame.settings,
+    };
+    let res = Resolutions {
+        screen: [gbuf.width, gbuf.height],
+        rectified: frame.rectified,
+    };
+    // A projective frame needs the engine's rasterised rectified map.
+    let rectified = match variant {
+        FamilyVariant::Prefiltered(v) => {
+            let prepared = prepare_frame(
+                v,
+                &res,
+                &input.camera,
+                &input.light,
+                &input.medium,
+                &input.shadow_map,
+                &input.settings,
+            )
+            .map_err(|e| e.to_string())?;
+            engine_rectified_map(scene, frame.bvh, &prepared)
+        }
+        _ => None,
+    };
+    let out = scatter_runtime::run_family_once(
+        ctx,
+        variant,
+        res,
+        &scatter_runtime::CpuInputs {
+            frame: input,
+            depth: gbuf.view_depth.clone(),
+            shadow_map: frame.shadow_map.depth.clone(),
+            rectified,
+            pass_wall_frames: 0,
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let image = Image::from_pixels(
+        gbuf.width,
+        gbuf.height,
+        out.output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
+    );
+    Ok((image, out.report))
+}

@@ -29,21 +29,19 @@ use std::process::ExitCode;
 use std::sync::OnceLock;
 use std::time::Instant;
 
-use scatter_conformance::{Check, gpu, run_trials};
+use scatter_conformance::{Check, gpu, run_trials, run_variant};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
-use scatter_reference::kernels::{CpuFrame, CpuRun, engine_rectified_map, run_family};
+use scatter_reference::kernels::CpuFrame;
 use scatter_reference::metrics;
 use scatter_reference::random_poses::{self, Category, RandomPose};
 use scatter_reference::scene::Light;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
-use scatter_runtime::{Context, CpuInputs, FrameInput, run_family_once};
+use scatter_runtime::{Context, FrameInput};
 use scatter_shaderlib::family::{Family, FamilyVariant};
-use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightKind, Resolutions, Variant, VisibilityMode, prepare_frame,
-};
+use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Variant, VisibilityMode};
 
 const SCREEN: [u32; 2] = [96, 54];
 const RECTIFIED: [u32; 2] = [512, 512];
@@ -180,13 +178,6 @@ impl Prepared {
         }
     }
 
-    fn resolutions(&self) -> Resolutions {
-        Resolutions {
-            screen: [self.gbuf.width, self.gbuf.height],
-            rectified: RECTIFIED,
-        }
-    }
-
     fn frame_input(&self) -> FrameInput {
         let s = &self.pose.scene;
         FrameInput {
@@ -200,58 +191,20 @@ impl Prepared {
 
     /// Runs `method` (with the pose's light) on the GPU, or its CPU mirrors without one.
     fn run(&self, ctx: Option<&Context>, method: &FamilyVariant) -> Result<Image, String> {
-        let variant = method.with_light(self.light());
-        let input = self.frame_input();
-        let Some(ctx) = ctx else {
-            let run = run_family(
-                &variant,
-                &CpuFrame {
-                    scene: &self.pose.scene,
-                    bvh: &self.bvh,
-                    gbuf: &self.gbuf,
-                    shadow_map: &self.sm,
-                    rectified: RECTIFIED,
-                    settings: &input.settings,
-                },
-            )
-            .map_err(|e| e.to_string())?;
-            return Ok(run.output().clone());
-        };
-        // A projective frame needs the engine's rasterised rectified map.
-        let rectified = match variant {
-            FamilyVariant::Prefiltered(v) => {
-                let frame = prepare_frame(
-                    &v,
-                    &self.resolutions(),
-                    &input.camera,
-                    &input.light,
-                    &input.medium,
-                    &input.shadow_map,
-                    &input.settings,
-                )
-                .map_err(|e| e.to_string())?;
-                engine_rectified_map(&self.pose.scene, &self.bvh, &frame)
-            }
-            _ => None,
-        };
-        let out = run_family_once(
+        let settings = self.frame_input().settings;
+        run_variant(
             ctx,
-            &variant,
-            self.resolutions(),
-            &CpuInputs {
-                frame: input,
-                depth: self.gbuf.view_depth.clone(),
-                shadow_map: self.sm.depth.clone(),
-                rectified,
-                pass_wall_frames: 0,
+            &method.with_light(self.light()),
+            &CpuFrame {
+                scene: &self.pose.scene,
+                bvh: &self.bvh,
+                gbuf: &self.gbuf,
+                shadow_map: &self.sm,
+                rectified: RECTIFIED,
+                settings: &settings,
             },
         )
-        .map_err(|e| e.to_string())?;
-        Ok(Image::from_pixels(
-            self.gbuf.width,
-            self.gbuf.height,
-            out.output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
-        ))
+        .map(|(image, _)| image)
     }
 }
 

@@ -27,22 +27,22 @@
 //! `cargo test --release -p scatter-conformance --test stress -- --nocapture` prints the
 //! table of the closing note.
 
-use scatter_conformance::gpu;
+use scatter_conformance::{gpu, run_variant};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
+use scatter_reference::kernels::CpuFrame;
 use scatter_reference::kernels::common_prefiltered::quantise;
-use scatter_reference::kernels::{CpuFrame, CpuRun, engine_rectified_map, run_family};
 use scatter_reference::metrics;
 use scatter_reference::scene::Light;
 use scatter_reference::stress::{self, Premise, StressCase, StressGroup};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
-use scatter_runtime::{Context, CpuInputs, FrameInput, run_family_once};
+use scatter_runtime::{Context, FrameInput};
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{
     FrameReport, FrameSettings, LightKind, ProjectiveFallback, Rectification, Resolutions, Storage,
-    Variant, VisibilityMode, prepare_frame,
+    Variant, VisibilityMode,
 };
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -209,65 +209,23 @@ impl Prepared {
         ctx: Option<&Context>,
         method: &FamilyVariant,
     ) -> Result<(Image, Option<FrameReport>), String> {
-        let [w, h] = self.screen();
-        let variant = self.variant(method);
-        let depth = self.case.engine_depth(&self.gbuf);
-        let input = self.frame_input();
-        let Some(ctx) = ctx else {
-            let gbuf = GBuffer {
-                view_depth: depth,
-                ..self.gbuf.clone()
-            };
-            let run = run_family(
-                &variant,
-                &CpuFrame {
-                    scene: &self.case.scene,
-                    bvh: &self.bvh,
-                    gbuf: &gbuf,
-                    shadow_map: &self.sm,
-                    rectified: self.resolutions().rectified,
-                    settings: &input.settings,
-                },
-            )
-            .map_err(|e| e.to_string())?;
-            return Ok((run.output().clone(), run.report().cloned()));
+        let gbuf = GBuffer {
+            view_depth: self.case.engine_depth(&self.gbuf),
+            ..self.gbuf.clone()
         };
-        // A projective frame needs the engine's rasterised rectified map.
-        let rectified = match variant {
-            FamilyVariant::Prefiltered(v) => {
-                let frame = prepare_frame(
-                    &v,
-                    &self.resolutions(),
-                    &input.camera,
-                    &input.light,
-                    &input.medium,
-                    &input.shadow_map,
-                    &input.settings,
-                )
-                .map_err(|e| e.to_string())?;
-                engine_rectified_map(&self.case.scene, &self.bvh, &frame)
-            }
-            _ => None,
-        };
-        let out = run_family_once(
+        let settings = self.frame_input().settings;
+        run_variant(
             ctx,
-            &variant,
-            self.resolutions(),
-            &CpuInputs {
-                frame: input,
-                depth,
-                shadow_map: self.sm.depth.clone(),
-                rectified,
-                pass_wall_frames: 0,
+            &self.variant(method),
+            &CpuFrame {
+                scene: &self.case.scene,
+                bvh: &self.bvh,
+                gbuf: &gbuf,
+                shadow_map: &self.sm,
+                rectified: self.resolutions().rectified,
+                settings: &settings,
             },
         )
-        .map_err(|e| e.to_string())?;
-        let image = Image::from_pixels(
-            w,
-            h,
-            out.output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
-        );
-        Ok((image, out.report))
     }
 }
 
