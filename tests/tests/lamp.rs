@@ -225,11 +225,7 @@ fn lamp_rows(width: u32, height: u32, table: &mut Vec<String>, failures: &mut Ve
 
 #[test]
 fn every_family_follows_the_lamp() {
-    let backend = if gpu().is_some() {
-        "GPU"
-    } else {
-        "CPU mirror"
-    };
+    let backend = if gpu().is_some() { "GPU" } else { "CPU mirror" };
     let labels: Vec<String> = methods().iter().map(FamilyVariant::label).collect();
     let mut table = vec![
         format!(

@@ -140,7 +140,10 @@ pub fn equiangular(eye: Vec3, dir: Vec3, light_pos: Vec3, a: f32, b: f32, n: u32
 /// `1 / (n pdf(t)) = dtheta h (1 + tan^2 theta)`).
 pub fn equiangular_sample(e: &Equiangular, x: f32) -> (f32, f32) {
     let tau = (e.theta_a + x * e.dtheta).tan();
-    (e.t_close + e.dist * tau, e.dtheta * e.dist * (1.0 + tau * tau))
+    (
+        e.t_close + e.dist * tau,
+        e.dtheta * e.dist * (1.0 + tau * tau),
+    )
 }
 
 /// 4-point Gauss-Legendre abscissae on [-1, 1] (ascending).
