@@ -106,6 +106,10 @@ macro_rules! runtime_families {
     ($($(#[$doc:meta])* $name:ident($ty:ty)),* $(,)?) => {
         /// The passes of one variant of any family, sized for one set of resolutions.
         #[derive(Debug)]
+        #[allow(
+            clippy::large_enum_variant,
+            reason = "created once per set of passes and kept; the variants hold wgpu handles"
+        )]
         pub enum FamilyPasses {
             $($(#[$doc])* $name($ty),)*
         }

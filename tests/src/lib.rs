@@ -249,78 +249,6 @@ pub fn ulp_distance(a: f32, b: f32) -> u32 {
     key(a).abs_diff(key(b))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn check(ok: bool) -> Check {
-        Box::new(move || {
-            if ok {
-                Ok(())
-            } else {
-                Err("it failed".to_owned())
-            }
-        })
-    }
-
-    #[test]
-    /// Runs nested trial sets: their own "FAILED" summaries in the log are on purpose.
-    fn expected_failures_are_data() {
-        let args = Arguments {
-            test_threads: Some(1),
-            quiet: true,
-            ..Arguments::default()
-        };
-        let trials = || {
-            vec![
-                ("harness_selftest::passes".to_owned(), check(true)),
-                (
-                    "harness_selftest::fails_on_purpose".to_owned(),
-                    check(false),
-                ),
-            ]
-        };
-        // A failing trial fails the run; listed as expected, it passes.
-        let plain = run_trials_with(&args, trials(), &[]);
-        assert_eq!((plain.num_passed, plain.num_failed), (1, 1));
-        let listed = run_trials_with(
-            &args,
-            trials(),
-            &[("harness_selftest::fails_on_purpose", "known")],
-        );
-        assert_eq!((listed.num_passed, listed.num_failed), (2, 0));
-        // A listed trial that passes fails, and so does an entry that names no trial.
-        let fixed = run_trials_with(
-            &args,
-            trials(),
-            &[("harness_selftest::passes", "was known")],
-        );
-        assert_eq!((fixed.num_passed, fixed.num_failed), (0, 2));
-        let stale = run_trials_with(&args, vec![], &[("harness_selftest::gone", "renamed")]);
-        assert_eq!((stale.num_passed, stale.num_failed), (0, 1));
-    }
-
-    #[test]
-    fn ulp_distance_counts_representable_steps() {
-        assert_eq!(ulp_distance(1.0, 1.0), 0);
-        assert_eq!(ulp_distance(0.0, -0.0), 0);
-        assert_eq!(ulp_distance(1.0, 1.0 + f32::EPSILON), 1);
-        assert_eq!(
-            ulp_distance(-f32::MIN_POSITIVE, f32::MIN_POSITIVE),
-            2 * 0x0080_0000
-        );
-        assert_eq!(ulp_distance(f32::NAN, 1.0), u32::MAX);
-    }
-
-    #[test]
-    fn test_texels_are_deterministic_and_in_range() {
-        let a = test_texels(100, 7);
-        assert_eq!(a, test_texels(100, 7));
-        assert_ne!(a, test_texels(100, 8));
-        assert!(a.iter().flatten().all(|v| (-1.0..1.0).contains(v)));
-    }
-}
-
 /// Runs any family's variant on a scene, as the stress and random-pose suites do: on the GPU
 /// through [`scatter_runtime::run_family_once`] (for a prefiltered variant with the engine's
 /// rasterised rectified map, which a projective frame needs) or, without a context, through
@@ -399,4 +327,76 @@ pub fn run_variant(
         out.output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
     );
     Ok((image, out.report))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(ok: bool) -> Check {
+        Box::new(move || {
+            if ok {
+                Ok(())
+            } else {
+                Err("it failed".to_owned())
+            }
+        })
+    }
+
+    #[test]
+    /// Runs nested trial sets: their own "FAILED" summaries in the log are on purpose.
+    fn expected_failures_are_data() {
+        let args = Arguments {
+            test_threads: Some(1),
+            quiet: true,
+            ..Arguments::default()
+        };
+        let trials = || {
+            vec![
+                ("harness_selftest::passes".to_owned(), check(true)),
+                (
+                    "harness_selftest::fails_on_purpose".to_owned(),
+                    check(false),
+                ),
+            ]
+        };
+        // A failing trial fails the run; listed as expected, it passes.
+        let plain = run_trials_with(&args, trials(), &[]);
+        assert_eq!((plain.num_passed, plain.num_failed), (1, 1));
+        let listed = run_trials_with(
+            &args,
+            trials(),
+            &[("harness_selftest::fails_on_purpose", "known")],
+        );
+        assert_eq!((listed.num_passed, listed.num_failed), (2, 0));
+        // A listed trial that passes fails, and so does an entry that names no trial.
+        let fixed = run_trials_with(
+            &args,
+            trials(),
+            &[("harness_selftest::passes", "was known")],
+        );
+        assert_eq!((fixed.num_passed, fixed.num_failed), (0, 2));
+        let stale = run_trials_with(&args, vec![], &[("harness_selftest::gone", "renamed")]);
+        assert_eq!((stale.num_passed, stale.num_failed), (0, 1));
+    }
+
+    #[test]
+    fn ulp_distance_counts_representable_steps() {
+        assert_eq!(ulp_distance(1.0, 1.0), 0);
+        assert_eq!(ulp_distance(0.0, -0.0), 0);
+        assert_eq!(ulp_distance(1.0, 1.0 + f32::EPSILON), 1);
+        assert_eq!(
+            ulp_distance(-f32::MIN_POSITIVE, f32::MIN_POSITIVE),
+            2 * 0x0080_0000
+        );
+        assert_eq!(ulp_distance(f32::NAN, 1.0), u32::MAX);
+    }
+
+    #[test]
+    fn test_texels_are_deterministic_and_in_range() {
+        let a = test_texels(100, 7);
+        assert_eq!(a, test_texels(100, 7));
+        assert_ne!(a, test_texels(100, 8));
+        assert!(a.iter().flatten().all(|v| (-1.0..1.0).contains(v)));
+    }
 }
