@@ -32,6 +32,7 @@ use crate::buffers::camera_ray;
 use crate::bvh::Bvh;
 use crate::geometry::Ray;
 use crate::scene::{Light, Orientation, Scene, Shape};
+use crate::suite::Rng;
 use crate::suite::{self, MediumPreset, Pose, SceneName};
 
 /// The seed of the random-pose suite (`tests/tests/random_poses.rs`).
@@ -179,29 +180,8 @@ impl RandomPose {
     }
 }
 
-/// SplitMix64: a small deterministic generator, the same on every machine.
-#[derive(Clone, Debug)]
-struct Rng(u64);
-
+/// What the pose draws need beyond the suite's SplitMix64 ([`Rng`]).
 impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    fn f(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in [a, b).
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.f()
-    }
-
     /// True with probability `p`.
     fn chance(&mut self, p: f64) -> bool {
         self.f() < p

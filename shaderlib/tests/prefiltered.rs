@@ -257,6 +257,7 @@ fn bindings_match_the_documented_tables() {
                     b(1, "slices", &slices),
                     b(2, "rectified", &sampled(false)),
                     b(3, "filtered", &storage(format, true)),
+                    b(4, "bounds", &storage(StorageFormat::Rg32Float, false)),
                 ]
             );
             assert_eq!(
@@ -269,6 +270,7 @@ fn bindings_match_the_documented_tables() {
                     b(4, "filtered", &sampled(true)),
                     b(5, "filtered_sampler", &"sampler cmp=false".to_owned()),
                     b(6, "output", &storage(StorageFormat::Rgba16Float, false)),
+                    b(7, "bounds", &sampled(false)),
                 ]
             );
         }
@@ -425,7 +427,9 @@ fn templates_receive_the_variant_s_values() {
     for needle in [
         "const REGIONS: u32 = 5u;",
         "const LAYERS: u32 = 16u;",
-        "let weighted = false;",
+        // Average and weighted visibility share scatter's code (they differ in prefilter's
+        // texel weights); the header names the mode.
+        "5 regions, average visibility",
         "let spot = true;",
         "Mirrors reference/src/kernels/scatter.rs",
     ] {
