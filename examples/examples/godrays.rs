@@ -349,10 +349,7 @@ fn run(args: &Args) -> Result<(), BoxError> {
     }
     let scene = suite::scene(args.scene, args.pose, args.medium, args.width, args.height);
     scene.validate()?;
-    let light = match scene.light {
-        scatter_reference::scene::Light::Directional { .. } => LightKind::Directional,
-        scatter_reference::scene::Light::Spot { .. } => LightKind::Spot,
-    };
+    let light = scene.light.kind();
     let plan = check(args, light)?;
     let t0 = Instant::now();
     let bvh = Bvh::build(&scene.geometry);

@@ -54,6 +54,16 @@ pub enum LightDesc {
     },
 }
 
+impl LightDesc {
+    /// The light type, as variants are compiled for it.
+    pub fn kind(&self) -> LightKind {
+        match self {
+            LightDesc::Directional { .. } => LightKind::Directional,
+            LightDesc::Spot { .. } => LightKind::Spot,
+        }
+    }
+}
+
 /// The homogeneous medium.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MediumDesc {
@@ -263,10 +273,7 @@ pub(crate) fn validate_scene(
     light: &LightDesc,
     medium: &MediumDesc,
 ) -> Result<ScenePart, FrameError> {
-    let got = match light {
-        LightDesc::Directional { .. } => LightKind::Directional,
-        LightDesc::Spot { .. } => LightKind::Spot,
-    };
+    let got = light.kind();
     if got != expected {
         return Err(FrameError::LightMismatch { expected, got });
     }

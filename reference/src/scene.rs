@@ -209,6 +209,15 @@ pub enum Light {
 }
 
 impl Light {
+    /// The light type, as variants are compiled for it.
+    pub fn kind(&self) -> scatter_shaderlib::prefiltered::LightKind {
+        use scatter_shaderlib::prefiltered::LightKind;
+        match self {
+            Light::Directional { .. } => LightKind::Directional,
+            Light::Spot { .. } => LightKind::Spot,
+        }
+    }
+
     /// RGB scale of the light (irradiance or intensity).
     pub fn color(&self) -> [f64; 3] {
         match self {

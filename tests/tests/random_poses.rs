@@ -36,7 +36,6 @@ use scatter_reference::image::Image;
 use scatter_reference::kernels::CpuFrame;
 use scatter_reference::metrics;
 use scatter_reference::random_poses::{self, Category, RandomPose};
-use scatter_reference::scene::Light;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::{Context, FrameInput};
@@ -172,10 +171,7 @@ impl Prepared {
     }
 
     fn light(&self) -> LightKind {
-        match self.pose.scene.light {
-            Light::Directional { .. } => LightKind::Directional,
-            Light::Spot { .. } => LightKind::Spot,
-        }
+        self.pose.scene.light.kind()
     }
 
     fn frame_input(&self) -> FrameInput {

@@ -34,7 +34,6 @@ use scatter_reference::image::Image;
 use scatter_reference::kernels::CpuFrame;
 use scatter_reference::kernels::common_prefiltered::quantise;
 use scatter_reference::metrics;
-use scatter_reference::scene::Light;
 use scatter_reference::stress::{self, Premise, StressCase, StressGroup};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::{Context, FrameInput};
@@ -164,10 +163,7 @@ impl Prepared {
     }
 
     fn light(&self) -> LightKind {
-        match self.case.scene.light {
-            Light::Directional { .. } => LightKind::Directional,
-            Light::Spot { .. } => LightKind::Spot,
-        }
+        self.case.scene.light.kind()
     }
 
     fn screen(&self) -> [u32; 2] {
