@@ -577,7 +577,7 @@ fn minmax_times(t: MinmaxTimes) -> PassTimes {
     vec![
         (Kernel::Rectify.name(), t.rectify),
         (Kernel::MinmaxBuild.name(), t.build),
-        (Kernel::MinmaxMarch.name(), t.march),
+        (Kernel::MinmaxTraverse.name(), t.march),
     ]
 }
 

@@ -169,7 +169,7 @@ macro_rules! families {
 }
 
 families! {
-    /// Chen et al. 2011: `rectify` (the prefiltered family's), `minmax_build`, `minmax_march`.
+    /// Chen et al. 2011: `rectify` (the prefiltered family's), `minmax_build`, `minmax_traverse`.
     Minmax(MinmaxVariant),
     /// Klehm et al. 2014: `rectify`, `prefilter`, `scatter`.
     Prefiltered(Variant),

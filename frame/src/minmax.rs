@@ -22,7 +22,7 @@
 //! single root (`tree_levels(Wr) = ceil(log2 Wr) + 1` levels). The tree is at most
 //! `2 Wr + tree_levels(Wr)` columns wide ([`tree_width`]).
 //!
-//! # The estimate (`minmax_march`)
+//! # The estimate (`minmax_traverse`)
 //!
 //! A pixel maps to its rectified row (the nearest slice: `floor` of the continuous row
 //! coordinate, wrapped or clamped as in `scatter`), its column `x_s` and normalised depth `d`

@@ -1,6 +1,6 @@
 //! The `raymarch` family (Tóth & Umenhoffer 2009): brute-force ray marching through the
 //! standard shadow map, optionally with interleaved sampling. [`RaymarchVariant`] holds its
-//! knobs; [`prepare_march`] fills its uniform block ([`MarchUniforms`], WGSL `struct March`
+//! knobs; [`prepare_raymarch`] fills its uniform block ([`RaymarchUniforms`], WGSL `struct RaymarchFrame`
 //! in `shaderlib/templates/common/raymarch.wgsl`).
 //!
 //! # The estimate
@@ -131,11 +131,11 @@ impl fmt::Display for RaymarchVariant {
     }
 }
 
-/// The uniform block of the `raymarch` and `interleave_sum` kernels (WGSL `struct March`).
+/// The uniform block of the `raymarch` and `interleave_sum` kernels (WGSL `struct RaymarchFrame`).
 /// Every field is a 16-byte vector; the asserts below pin the layout.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct MarchUniforms {
+pub struct RaymarchUniforms {
     /// Eye position; w = camera far (view depths are clamped to it).
     pub eye: [f32; 4],
     /// Camera forward; w = tan(fov_y / 2).
@@ -169,10 +169,10 @@ pub struct MarchUniforms {
 }
 
 const _: () = {
-    assert!(size_of::<MarchUniforms>() == 15 * 16);
-    assert!(std::mem::offset_of!(MarchUniforms, sm_proj) == 12 * 16);
-    assert!(std::mem::offset_of!(MarchUniforms, sizes) == 13 * 16);
-    assert!(std::mem::offset_of!(MarchUniforms, interleave) == 14 * 16);
+    assert!(size_of::<RaymarchUniforms>() == 15 * 16);
+    assert!(std::mem::offset_of!(RaymarchUniforms, sm_proj) == 12 * 16);
+    assert!(std::mem::offset_of!(RaymarchUniforms, sizes) == 13 * 16);
+    assert!(std::mem::offset_of!(RaymarchUniforms, interleave) == 14 * 16);
 };
 
 /// Fills the `raymarch` uniform block for one frame.
@@ -185,14 +185,14 @@ const _: () = {
 /// medium or shadow map, [`FrameError::EyeAtLight`], [`FrameError::NotRepresentable`] if a
 /// uniform still came out non-finite; a variant error for bad knobs is reported as
 /// [`FrameError::Variant`].
-pub fn prepare_march(
+pub fn prepare_raymarch(
     variant: &RaymarchVariant,
     screen: [u32; 2],
     camera: &CameraDesc,
     light: &LightDesc,
     medium: &MediumDesc,
     shadow: &ShadowMapDesc,
-) -> Result<MarchUniforms, FrameError> {
+) -> Result<RaymarchUniforms, FrameError> {
     variant.validate().map_err(FrameError::Variant)?;
     for (what, value, max) in [
         ("screen width", screen[0], 16384),
@@ -208,7 +208,7 @@ pub fn prepare_march(
     let (sm_kind, sm_proj) = shadow_projection(shadow);
     let cam = sc.cam;
     let m = variant.interleave;
-    let u = MarchUniforms {
+    let u = RaymarchUniforms {
         eye: v4(cam.position, cam.far),
         cam_forward: v4(cam.forward, cam.tan_half_fov_y),
         cam_right: v4(cam.right, f64::from(screen[0]) / f64::from(screen[1])),

@@ -1,4 +1,4 @@
-//! Property tests of the per-frame set-up (`prepare_frame`, `prepare_march`,
+//! Property tests of the per-frame set-up (`prepare_frame`, `prepare_raymarch`,
 //! `prepare_minmax`) and the min-max tree layout on hostile numbers: NaN, infinities, zero,
 //! huge and tiny values, negative extinction, `g = ±1`, zero-length or parallel directions,
 //! `near >= far`, a 0 or 180 degree field of view, zero or oversized screens, spot cones
@@ -28,12 +28,12 @@ use scatter_frame::frame::{
     ShadowMapDesc, ShadowProjectionDesc, prepare_frame,
 };
 use scatter_frame::minmax::{MinmaxVariant, level_count, prepare_minmax, tree_levels, tree_width};
-use scatter_frame::raymarch::{MarchUniforms, RaymarchVariant, prepare_march};
+use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_raymarch};
 use scatter_frame::variant::{LightKind, Variant};
 
 /// Cases of `prepare_frame` (prefiltered family, every variant of the grid).
 const PREFILTERED_CASES: u32 = 6000;
-/// Cases of `prepare_march`.
+/// Cases of `prepare_raymarch`.
 const RAYMARCH_CASES: u32 = 3000;
 /// Cases of `prepare_minmax`.
 const MINMAX_CASES: u32 = 3000;
@@ -682,7 +682,7 @@ fn check_prefiltered_frame(case: &Case, frame: &PrefilteredFrame) -> Result<(), 
     Ok(())
 }
 
-fn check_march_uniforms(u: &MarchUniforms) -> Result<(), TestCaseError> {
+fn check_raymarch_uniforms(u: &RaymarchUniforms) -> Result<(), TestCaseError> {
     for (what, v) in [
         ("eye", u.eye),
         ("cam_forward", u.cam_forward),
@@ -725,7 +725,7 @@ fn check_case(case: Case) -> Result<(), TestCaseError> {
             &case.settings,
         )
         .map(|f| check_prefiltered_frame(&case, &f)),
-        FamilyVariant::Raymarch(v) => prepare_march(
+        FamilyVariant::Raymarch(v) => prepare_raymarch(
             &v,
             case.res.screen,
             &case.camera,
@@ -733,7 +733,7 @@ fn check_case(case: Case) -> Result<(), TestCaseError> {
             &case.medium,
             &case.shadow,
         )
-        .map(|u| check_march_uniforms(&u)),
+        .map(|u| check_raymarch_uniforms(&u)),
     };
     tally(result.is_ok());
     if let (FamilyVariant::Prefiltered(v), Ok(_)) = (&case.family, &result) {
@@ -761,9 +761,9 @@ fn prepare_frame_on_mutated_frames() {
 }
 
 #[test]
-fn prepare_march_on_mutated_frames() {
+fn prepare_raymarch_on_mutated_frames() {
     run(
-        "prepare_march",
+        "prepare_raymarch",
         RAYMARCH_CASES,
         0x5ca7_0002,
         case(prop::sample::select(RaymarchVariant::grid()).prop_map(FamilyVariant::Raymarch)),

@@ -5,7 +5,8 @@
 use glam::{DVec3, Vec3};
 use scatter_reference::buffers::ShadowMap;
 use scatter_reference::bvh::Bvh;
-use scatter_reference::kernels::common_prefiltered::{proj_column, xyz};
+use scatter_reference::kernels::common_prefiltered_projective::proj_column;
+use scatter_reference::kernels::texture::xyz;
 use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightDesc, LightKind, Rectification, Resolutions, Variant, prepare_frame,

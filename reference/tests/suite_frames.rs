@@ -1,5 +1,5 @@
 //! Every scene, pose and medium preset of the suite is accepted by the frame set-up of every
-//! family (`prepare_frame`, `prepare_march`, `prepare_minmax`): the set-up's input checks
+//! family (`prepare_frame`, `prepare_raymarch`, `prepare_minmax`): the set-up's input checks
 //! (orthonormal bases, ranges, a valid variant) reject hostile numbers, not the scenes the
 //! conformance suite and the bench run.
 
@@ -10,7 +10,7 @@ use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightDesc, LightKind, Rectification, Resolutions, Variant, prepare_frame,
 };
-use scatter_shaderlib::raymarch::{RaymarchVariant, prepare_march};
+use scatter_shaderlib::raymarch::{RaymarchVariant, prepare_raymarch};
 
 #[test]
 fn every_suite_frame_is_accepted() {
@@ -51,7 +51,7 @@ fn every_suite_frame_is_accepted() {
                     light,
                     ..RaymarchVariant::default()
                 };
-                prepare_march(&r, [w, h], &camera, &light_desc, &medium, &shadow)
+                prepare_raymarch(&r, [w, h], &camera, &light_desc, &medium, &shadow)
                     .unwrap_or_else(|e| panic!("{trial}: raymarch: {e}"));
                 let m = MinmaxVariant { light };
                 prepare_minmax(&m, &res, &camera, &light_desc, &medium, &shadow, &settings)

@@ -11,7 +11,7 @@
 //! [`run_prefiltered_once`] is its test convenience; [`Raymarch`] runs the `raymarch` family
 //! (`raymarch`, then `interleave_sum` when interleaved), [`run_raymarch_once`] its test
 //! convenience; [`Minmax`] runs the `minmax` family (`rectify`, `minmax_build`,
-//! `minmax_march`), [`run_minmax_once`] its test convenience. [`FamilyPasses`] drives any of
+//! `minmax_traverse`), [`run_minmax_once`] its test convenience. [`FamilyPasses`] drives any of
 //! them from the one enum of every family's variant.
 //!
 //! Every family runs on one plan-driven executor (`executor`, crate-private): the family's

@@ -1,6 +1,6 @@
 //! The `minmax` family (Chen et al. 2011) on wgpu: [`Minmax`] owns the `rectify` (the
 //! prefiltered family's kernel, for [`MinmaxVariant::prefiltered`]), `minmax_build` and
-//! `minmax_march` pipelines, the rectified map, the min-max tree and output textures and the
+//! `minmax_traverse` pipelines, the rectified map, the min-max tree and output textures and the
 //! uniform and slice buffers; an engine calls [`Minmax::prepare`] and [`Minmax::encode`]
 //! once per frame with its depth buffer and standard shadow map. [`run_minmax_once`] is the
 //! upload-run-readback convenience the conformance tests use.
@@ -9,7 +9,7 @@
 //! |---|---|---|
 //! | `rectify` | 0 uniform `Frame`, 1 slices, 2 shadow map r32float, 3 rectified r32float (storage, write) | `ceil(Wr/8) x ceil(Hr/8) x 1` |
 //! | `minmax_build` | 0 uniform `Frame`, 1 rectified r32float, 2 tree rg32float (storage, write) | `ceil(tree_width(Wr)/64) x Hr x 1` |
-//! | `minmax_march` | 0 uniform `Frame`, 1 slices, 2 depth r32float, 3 shadow map r32float, 4 tree rg32float, 5 output rgba16float (storage, write) | `ceil(W/8) x ceil(H/8) x 1` |
+//! | `minmax_traverse` | 0 uniform `Frame`, 1 slices, 2 depth r32float, 3 shadow map r32float, 4 tree rg32float, 5 output rgba16float (storage, write) | `ceil(W/8) x ceil(H/8) x 1` |
 
 use std::time::{Duration, Instant};
 
@@ -29,7 +29,7 @@ use crate::{Context, RuntimeError};
 
 const RECTIFY: Kernel = Kernel::Rectify;
 const BUILD: Kernel = Kernel::MinmaxBuild;
-const MARCH: Kernel = Kernel::MinmaxMarch;
+const MARCH: Kernel = Kernel::MinmaxTraverse;
 
 /// Format of the min-max tree (r = min, g = max).
 pub const TREE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
@@ -41,7 +41,7 @@ pub struct MinmaxTimes {
     pub rectify: Duration,
     /// The `minmax_build` pass.
     pub build: Duration,
-    /// The `minmax_march` pass.
+    /// The `minmax_traverse` pass.
     pub march: Duration,
 }
 

@@ -6,13 +6,13 @@
 //!
 //! | pass | bindings | dispatch |
 //! |---|---|---|
-//! | `raymarch` | 0 uniform `March`, 1 depth r32float, 2 shadow map r32float, 3 output (storage, write: rgba16float radiance, or rgba32float partial sums when interleaved) | `ceil(W/8) x ceil(H/8) x 1` |
-//! | `interleave_sum` (interleaved only) | 0 uniform `March`, 1 partial sums rgba32float, 2 output rgba16float (storage, write) | `ceil(W/8) x ceil(H/8) x 1` |
+//! | `raymarch` | 0 uniform `RaymarchFrame`, 1 depth r32float, 2 shadow map r32float, 3 output (storage, write: rgba16float radiance, or rgba32float partial sums when interleaved) | `ceil(W/8) x ceil(H/8) x 1` |
+//! | `interleave_sum` (interleaved only) | 0 uniform `RaymarchFrame`, 1 partial sums rgba32float, 2 output rgba16float (storage, write) | `ceil(W/8) x ceil(H/8) x 1` |
 
 use std::time::{Duration, Instant};
 
 use scatter_shaderlib::prefiltered::{CameraDesc, LightDesc, MediumDesc, ShadowMapDesc};
-use scatter_shaderlib::raymarch::{MarchUniforms, RaymarchVariant, prepare_march};
+use scatter_shaderlib::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_raymarch};
 use scatter_shaderlib::{Kernel, KernelParams};
 
 use crate::error::{ErrorScopes, check_limit};
@@ -86,7 +86,7 @@ pub struct Raymarch {
     partial: Option<wgpu::Texture>,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
-    prepared: Option<MarchUniforms>,
+    prepared: Option<RaymarchUniforms>,
 }
 
 impl Raymarch {
@@ -128,7 +128,7 @@ impl Raymarch {
         check_limit(
             RAYMARCH,
             "uniform block bytes",
-            size_of::<MarchUniforms>() as u64,
+            size_of::<RaymarchUniforms>() as u64,
             "max_uniform_buffer_binding_size",
             limits.max_uniform_buffer_binding_size,
         )?;
@@ -146,7 +146,7 @@ impl Raymarch {
                 ("shadow.size", shadow_map_size.into()),
             ],
         )?;
-        let uniforms = exec.buffer("march")?.clone();
+        let uniforms = exec.buffer("frame")?.clone();
         let partial = if variant.interleaved() {
             Some(exec.texture("partial")?.0.clone())
         } else {
@@ -181,7 +181,7 @@ impl Raymarch {
                 actual: input.shadow_map.size,
             });
         }
-        let u = prepare_march(
+        let u = prepare_raymarch(
             &self.variant,
             self.screen,
             &input.camera,
@@ -305,7 +305,7 @@ impl Raymarch {
     }
 
     /// The uniform block of the last [`Self::prepare`].
-    pub fn uniforms(&self) -> Option<&MarchUniforms> {
+    pub fn uniforms(&self) -> Option<&RaymarchUniforms> {
         self.prepared.as_ref()
     }
 
@@ -324,7 +324,7 @@ impl Raymarch {
 #[derive(Clone, Debug)]
 pub struct RaymarchReadback {
     /// The uploaded uniform block.
-    pub uniforms: MarchUniforms,
+    pub uniforms: RaymarchUniforms,
     /// In-scattered radiance per pixel (rgba16float converted to f32), row-major.
     pub output: Vec<[f32; 4]>,
     /// The partial sums of an interleaved variant, row-major.

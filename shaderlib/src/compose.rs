@@ -35,8 +35,16 @@ const COMMON_MODULES: &[(&str, &str)] = &[
         include_str!("../templates/common/epipolar.wgsl"),
     ),
     (
+        "common/projective.wgsl",
+        include_str!("../templates/common/projective.wgsl"),
+    ),
+    (
         "common/prefiltered.wgsl",
         include_str!("../templates/common/prefiltered.wgsl"),
+    ),
+    (
+        "common/prefiltered_projective.wgsl",
+        include_str!("../templates/common/prefiltered_projective.wgsl"),
     ),
     (
         "common/minmax.wgsl",
@@ -134,7 +142,7 @@ pub(crate) const fn template_path(kernel: Kernel) -> &'static str {
     match kernel {
         Kernel::InterleaveSum => "interleave_sum.wgsl",
         Kernel::MinmaxBuild => "minmax_build.wgsl",
-        Kernel::MinmaxMarch => "minmax_march.wgsl",
+        Kernel::MinmaxTraverse => "minmax_traverse.wgsl",
         Kernel::Prefilter => "prefilter.wgsl",
         Kernel::Raymarch => "raymarch.wgsl",
         Kernel::Rectify => "rectify.wgsl",

@@ -17,7 +17,7 @@ pub enum Kernel {
     MinmaxBuild,
     /// Per pixel: the rectified row marched through its min-max tree, skipping nodes wholly
     /// lit or shadowed; pixels near the epipole ray-marched (Chen et al. 2011).
-    MinmaxMarch,
+    MinmaxTraverse,
     /// Fourier basis transform fused with the weighted running mean along each rectified
     /// row, per region (Klehm et al. 2014, Listings 1-3, Table 1).
     Prefilter,
@@ -40,7 +40,7 @@ impl Kernel {
     pub const ALL: &'static [Self] = &[
         Self::InterleaveSum,
         Self::MinmaxBuild,
-        Self::MinmaxMarch,
+        Self::MinmaxTraverse,
         Self::Prefilter,
         Self::Raymarch,
         Self::Rectify,
@@ -53,7 +53,7 @@ impl Kernel {
         match self {
             Self::InterleaveSum => "interleave_sum",
             Self::MinmaxBuild => "minmax_build",
-            Self::MinmaxMarch => "minmax_march",
+            Self::MinmaxTraverse => "minmax_traverse",
             Self::Prefilter => "prefilter",
             Self::Raymarch => "raymarch",
             Self::Rectify => "rectify",

@@ -11,7 +11,7 @@
 //! [`prefiltered::Variant`] ([`KernelParams::prefiltered`]), and the raymarch family (Tóth &
 //! Umenhoffer 2009) `raymarch`, `interleave_sum` from a [`raymarch::RaymarchVariant`]
 //! ([`KernelParams::raymarch`]), and the minmax family (Chen et al. 2011) `rectify`,
-//! `minmax_build`, `minmax_march` from a [`minmax::MinmaxVariant`] ([`KernelParams::minmax`]).
+//! `minmax_build`, `minmax_traverse` from a [`minmax::MinmaxVariant`] ([`KernelParams::minmax`]).
 //!
 //! ```
 //! use scatter_shaderlib::{build, KernelParams, RowPrefixMode, RowPrefixParams};
@@ -52,8 +52,8 @@ pub enum KernelParams {
     InterleaveSum(RaymarchVariant),
     /// [`Kernel::MinmaxBuild`] of a minmax-family variant (the code does not depend on it).
     MinmaxBuild(MinmaxVariant),
-    /// [`Kernel::MinmaxMarch`] of a minmax-family variant (only `light` changes the code).
-    MinmaxMarch(MinmaxVariant),
+    /// [`Kernel::MinmaxTraverse`] of a minmax-family variant (only `light` changes the code).
+    MinmaxTraverse(MinmaxVariant),
     /// [`Kernel::Prefilter`] of a prefiltered-family variant.
     Prefilter(Variant),
     /// [`Kernel::Raymarch`] of a raymarch-family variant (only `light` and whether it
@@ -74,7 +74,7 @@ impl KernelParams {
         match self {
             Self::InterleaveSum(_) => Kernel::InterleaveSum,
             Self::MinmaxBuild(_) => Kernel::MinmaxBuild,
-            Self::MinmaxMarch(_) => Kernel::MinmaxMarch,
+            Self::MinmaxTraverse(_) => Kernel::MinmaxTraverse,
             Self::Prefilter(_) => Kernel::Prefilter,
             Self::Raymarch(_) => Kernel::Raymarch,
             Self::Rectify(_) => Kernel::Rectify,
@@ -104,12 +104,12 @@ impl KernelParams {
     }
 
     /// The kernels of a minmax-family variant, in pass order: the prefiltered family's
-    /// `rectify` (of [`MinmaxVariant::prefiltered`]), `minmax_build`, `minmax_march`.
+    /// `rectify` (of [`MinmaxVariant::prefiltered`]), `minmax_build`, `minmax_traverse`.
     pub fn minmax(variant: MinmaxVariant) -> [Self; 3] {
         [
             Self::Rectify(variant.prefiltered()),
             Self::MinmaxBuild(variant),
-            Self::MinmaxMarch(variant),
+            Self::MinmaxTraverse(variant),
         ]
     }
 
@@ -200,7 +200,7 @@ pub fn render(params: &KernelParams) -> Result<String, ShaderError> {
     match params {
         KernelParams::InterleaveSum(v) => raymarch::render_interleave_sum(v),
         KernelParams::MinmaxBuild(v) => minmax::render_build(v),
-        KernelParams::MinmaxMarch(v) => minmax::render_march(v),
+        KernelParams::MinmaxTraverse(v) => minmax::render_traverse(v),
         KernelParams::Prefilter(v) => prefiltered::kernels::render_prefilter(v),
         KernelParams::Raymarch(v) => raymarch::render_raymarch(v),
         KernelParams::Rectify(v) => prefiltered::kernels::render_rectify(v),

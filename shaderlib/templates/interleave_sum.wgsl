@@ -10,19 +10,19 @@
 // Bindings (group 0):
 // | binding | name    | type                                        | access       |
 // |---------|---------|---------------------------------------------|--------------|
-// | 0       | march   | var<uniform> March (240 bytes)              | uniform      |
+// | 0       | frame   | var<uniform> RaymarchFrame (240 bytes)              | uniform      |
 // | 1       | partial | texture_2d<f32> (rgba32float, `raymarch`'s) | textureLoad  |
 // | 2       | output  | texture_storage_2d<rgba16float, write>      | textureStore |
 // output: in-scattered radiance, screen-sized (rgb, alpha 1).
 //
 // Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
-// (march.sizes.xy).
+// (frame.sizes.xy).
 //
 // Mirrors reference/src/kernels/interleave_sum.rs
 
-#import scatter::raymarch::{March, window_start}
+#import scatter::raymarch::{RaymarchFrame, window_start}
 
-@group(0) @binding(0) var<uniform> march: March;
+@group(0) @binding(0) var<uniform> frame: RaymarchFrame;
 @group(0) @binding(1) var partial: texture_2d<f32>;
 @group(0) @binding(2) var output: texture_storage_2d<rgba16float, write>;
 
@@ -41,7 +41,7 @@ fn interleave_sum(
     @builtin(workgroup_id) wid: vec3<u32>,
     @builtin(local_invocation_index) lid: u32,
 ) {
-    let m = march;
+    let m = frame;
     let w = m.sizes[0];
     let h = m.sizes[1];
     let mx = m.interleave[0];

@@ -33,7 +33,11 @@
 // Mirrors reference/src/kernels/prefilter.rs
 
 #import scatter::epipolar::{Frame, slice_params}
-#import scatter::prefiltered::{basis4, region_start, texel_weight{% if projective %}, proj_stored_depth, proj_texel_weight{% endif %}}
+#import scatter::prefiltered::{basis4, region_start, texel_weight}
+{%- if projective %}
+#import scatter::projective::proj_stored_depth
+#import scatter::prefiltered_projective::proj_texel_weight
+{%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;

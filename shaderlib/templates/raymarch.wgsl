@@ -2,8 +2,8 @@
 // single-scattering integral through the standard shadow map, optionally with interleaved
 // sampling (Tóth & Umenhoffer 2009).
 //
-// Per pixel: the view ray [0, s] (s from the depth buffer) is cut into N = march.sizes.w
-// cells; cell j is sampled at offset u = 0.5 or the pixel's jitter (march.interleave.z).
+// Per pixel: the view ray [0, s] (s from the depth buffer) is cut into N = frame.sizes.w
+// cells; cell j is sampled at offset u = 0.5 or the pixel's jitter (frame.interleave.z).
 // Directional: cells of length h = s / N in t, sampled at (j + u) h; each sample adds V times
 // the exact transmittance integral over its cell, scaled once by sigma_s p E. Spot: N
 // equiangular strata (`scatter::model::equiangular`: equal angles under which the lamp sees
@@ -16,22 +16,22 @@
 // Bindings (group 0):
 // | binding | name       | type                                         | access       |
 // |---------|------------|----------------------------------------------|--------------|
-// | 0       | march      | var<uniform> March (240 bytes)               | uniform      |
+// | 0       | frame      | var<uniform> RaymarchFrame (240 bytes)               | uniform      |
 // | 1       | depth      | texture_2d<f32> (r32float, view depth)       | textureLoad  |
 // | 2       | shadow_map | texture_2d<f32> (r32float)                   | textureLoad  |
 // | 3       | output     | texture_storage_2d<{{ output_format }}, write>           | textureStore |
 // output: screen-sized; {% if interleaved %}the partial sums `interleave_sum` reads{% else %}in-scattered radiance (rgb, alpha 1){% endif %}.
 //
 // Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
-// (march.sizes.xy); invocation id x = pixel column, y = pixel row.
+// (frame.sizes.xy); invocation id x = pixel column, y = pixel row.
 //
 // Mirrors reference/src/kernels/raymarch.rs
 
 #import scatter::model::{equiangular, equiangular_sample, phase_hg, spot_integrand, transmittance_between}
 #import scatter::shadow::shadow_visibility
-#import scatter::raymarch::{March, march_pixel_dir, march_shadow_view, pixel_jitter}
+#import scatter::raymarch::{RaymarchFrame, raymarch_pixel_dir, raymarch_shadow_view, pixel_jitter}
 
-@group(0) @binding(0) var<uniform> march: March;
+@group(0) @binding(0) var<uniform> frame: RaymarchFrame;
 @group(0) @binding(1) var depth: texture_2d<f32>;
 @group(0) @binding(2) var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) var output: texture_storage_2d<{{ output_format }}, write>;
@@ -39,14 +39,14 @@
 // The kernel body for pixel `id`; stores the pixel's radiance (or partial sum).
 @compute @workgroup_size(8, 8, 1)
 fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
-    let m = march;
+    let m = frame;
     let x = id.x; let y = id.y;
     if x >= m.sizes[0] || y >= m.sizes[1] {
         return;
     }
     let spot = {{ spot }};
     let eye = m.eye.xyz;
-    let dir = march_pixel_dir(m, x, y);
+    let dir = raymarch_pixel_dir(m, x, y);
     // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
     let s = min(max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0), m.eye.w) / max(dot(dir, m.cam_forward.xyz), 1e-6);
     let n = m.sizes[3];
@@ -59,7 +59,7 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
     if m.interleave[2] != 0u {
         u = pixel_jitter(x, y);
     }
-    let view = march_shadow_view(m);
+    let view = raymarch_shadow_view(m);
     let strata = equiangular(eye, dir, m.light_pos.xyz, 0.0, s, n);
     var sum = 0.0;
     for (var j = pixel_class; j < n; j += stride) {

@@ -47,7 +47,11 @@
 
 #import scatter::model::{phase_hg, transmittance_between, transmittance_integral}
 #import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, slice_params, spot_segment}
-#import scatter::prefiltered::{coeff4, region_start{% if projective %}, proj_boundary, proj_column, proj_ray_depth, proj_reach{% endif %}}
+#import scatter::prefiltered::{coeff4, region_start}
+{%- if projective %}
+#import scatter::projective::{proj_boundary, proj_ray_depth, proj_reach}
+#import scatter::prefiltered_projective::proj_column
+{%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;

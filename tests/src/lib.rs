@@ -131,7 +131,7 @@ impl Fixture {
     }
 
     /// The frame input of the raymarch family.
-    pub fn march_input(&self) -> RaymarchInput {
+    pub fn raymarch_input(&self) -> RaymarchInput {
         RaymarchInput {
             camera: self.scene.camera_desc(),
             light: self.scene.light_desc(),

@@ -132,7 +132,7 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
                 ctx,
                 &v,
                 SCREEN,
-                &f.march_input(),
+                &f.raymarch_input(),
                 &f.gbuf.view_depth,
                 &f.shadow_map.depth,
             )

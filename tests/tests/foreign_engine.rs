@@ -34,7 +34,7 @@ use scatter_foreign_engine::prefiltered::{Inputs, Sizes, run_frame};
 use scatter_foreign_engine::{Engine, EngineError, Manifest, Target};
 use scatter_frame::frame::{PrefilteredFrame, prepare_frame};
 use scatter_frame::minmax::{MinmaxVariant, prepare_minmax};
-use scatter_frame::raymarch::{RaymarchVariant, prepare_march};
+use scatter_frame::raymarch::{RaymarchVariant, prepare_raymarch};
 use scatter_gen::{FamilyVariant, Request, generate, output};
 use scatter_reference::kernels::engine_rectified_map;
 use scatter_reference::suite::Pose;
@@ -388,7 +388,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
             &fixture.shadow_map.depth,
         )
         .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
-        let uniforms = prepare_march(
+        let uniforms = prepare_raymarch(
             &v,
             fixture.sizes().screen,
             &f.camera,
@@ -466,7 +466,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
         lines.extend(compare_targets(
             &name,
             &runtime.output,
-            &["rectify", "minmax_build", "minmax_march"],
+            &["rectify", "minmax_build", "minmax_traverse"],
             |target| {
                 let params = scatter_foreign_engine::minmax::params(&fixture.sizes());
                 let mut engine =

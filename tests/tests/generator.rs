@@ -222,12 +222,12 @@ fn manifest_dispatch_matches_the_runtime_grid() {
     }
 }
 
-/// The raymarch family's manifest against `scatter_runtime::raymarch`: formats, the `March`
+/// The raymarch family's manifest against `scatter_runtime::raymarch`: formats, the `RaymarchFrame`
 /// block's size and field offsets, and the dispatch of both passes at odd sizes.
 #[test]
 fn raymarch_manifest_matches_the_runtime() {
     use scatter_runtime::raymarch::PARTIAL_FORMAT;
-    use scatter_shaderlib::raymarch::{MarchUniforms, RaymarchVariant};
+    use scatter_shaderlib::raymarch::{RaymarchUniforms, RaymarchVariant};
     use std::mem::offset_of;
     let v = RaymarchVariant {
         samples: 64,
@@ -249,32 +249,32 @@ fn raymarch_manifest_matches_the_runtime() {
         assert_eq!(str_of(&tex(name), "format"), wgpu_name(DEPTH_FORMAT));
     }
     assert_eq!(
-        str_of(get(resource(variant, "march"), "buffer"), "size_bytes"),
-        size_of::<MarchUniforms>().to_string()
+        str_of(get(resource(variant, "frame"), "buffer"), "size_bytes"),
+        size_of::<RaymarchUniforms>().to_string()
     );
     let march = get(&m, "structs")
         .as_array()
         .and_then(|a| {
             a.iter()
-                .find(|s| s.get("name").and_then(Value::as_str) == Some("March"))
+                .find(|s| s.get("name").and_then(Value::as_str) == Some("RaymarchFrame"))
         })
-        .unwrap_or_else(|| panic!("no struct March"));
+        .unwrap_or_else(|| panic!("no struct RaymarchFrame"));
     let host = [
-        ("eye", offset_of!(MarchUniforms, eye)),
-        ("cam_forward", offset_of!(MarchUniforms, cam_forward)),
-        ("cam_right", offset_of!(MarchUniforms, cam_right)),
-        ("cam_up", offset_of!(MarchUniforms, cam_up)),
-        ("medium", offset_of!(MarchUniforms, medium)),
-        ("light_color", offset_of!(MarchUniforms, light_color)),
-        ("light_pos", offset_of!(MarchUniforms, light_pos)),
-        ("light_dir", offset_of!(MarchUniforms, light_dir)),
-        ("sm_right", offset_of!(MarchUniforms, sm_right)),
-        ("sm_up", offset_of!(MarchUniforms, sm_up)),
-        ("sm_forward", offset_of!(MarchUniforms, sm_forward)),
-        ("sm_origin", offset_of!(MarchUniforms, sm_origin)),
-        ("sm_proj", offset_of!(MarchUniforms, sm_proj)),
-        ("sizes", offset_of!(MarchUniforms, sizes)),
-        ("interleave", offset_of!(MarchUniforms, interleave)),
+        ("eye", offset_of!(RaymarchUniforms, eye)),
+        ("cam_forward", offset_of!(RaymarchUniforms, cam_forward)),
+        ("cam_right", offset_of!(RaymarchUniforms, cam_right)),
+        ("cam_up", offset_of!(RaymarchUniforms, cam_up)),
+        ("medium", offset_of!(RaymarchUniforms, medium)),
+        ("light_color", offset_of!(RaymarchUniforms, light_color)),
+        ("light_pos", offset_of!(RaymarchUniforms, light_pos)),
+        ("light_dir", offset_of!(RaymarchUniforms, light_dir)),
+        ("sm_right", offset_of!(RaymarchUniforms, sm_right)),
+        ("sm_up", offset_of!(RaymarchUniforms, sm_up)),
+        ("sm_forward", offset_of!(RaymarchUniforms, sm_forward)),
+        ("sm_origin", offset_of!(RaymarchUniforms, sm_origin)),
+        ("sm_proj", offset_of!(RaymarchUniforms, sm_proj)),
+        ("sizes", offset_of!(RaymarchUniforms, sizes)),
+        ("interleave", offset_of!(RaymarchUniforms, interleave)),
     ];
     let fields = get(march, "fields").as_array().cloned().unwrap_or_default();
     assert_eq!(fields.len(), host.len(), "{fields:?}");

@@ -267,7 +267,7 @@ fn lowered_device_limits_are_named() {
 
     // A device whose buffers are smaller than its bindings (the slice table, a readback
     // buffer of 8x8 rgba16float, rows padded to 256 bytes: 2048 bytes) and whose uniform
-    // bindings are smaller than the uniform blocks (400 bytes of `Frame`, 240 of `March`).
+    // bindings are smaller than the uniform blocks (400 bytes of `Frame`, 240 of `RaymarchFrame`).
     let ctx = lowered(shared, |l| {
         l.max_buffer_size = 1024;
         l.max_uniform_buffer_binding_size = 128;

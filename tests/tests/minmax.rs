@@ -1,6 +1,6 @@
-//! Conformance of the `minmax` family (`rectify`, `minmax_build`, `minmax_march`): the GPU
+//! Conformance of the `minmax` family (`rectify`, `minmax_build`, `minmax_traverse`): the GPU
 //! (`scatter_runtime::run_minmax_once`) against the CPU mirrors
-//! (`reference/src/kernels/{rectify,minmax_build,minmax_march}.rs`) for both variants of
+//! (`reference/src/kernels/{rectify,minmax_build,minmax_traverse}.rs`) for both variants of
 //! `MinmaxVariant::grid()`, directional on `columns`, spot on `spot_grate`, at the
 //! `ordinary` and `epipole_on_screen` poses (the latter marches pixels near the epipole), at
 //! 67x37 pixels with a 100x60 rectified map (neither a power of two nor a multiple of the
@@ -9,7 +9,7 @@
 //! -- minmax::` runs this family, `-- --list` lists them); `minmax::errors` checks the error
 //! paths.
 //!
-//! The mirror's `minmax_build` and `minmax_march` run on the GPU's rectified map, so that
+//! The mirror's `minmax_build` and `minmax_traverse` run on the GPU's rectified map, so that
 //! each kernel is compared on the same input. Tolerances: the trees bit for bit (min and max
 //! of the same floats); the output `|gpu - cpu| <= 1e-4 * max radiance` plus one f16 step of
 //! the mirror's value, except at *ties* (at most 1 % of the pixels): pixels whose ray depth
@@ -21,8 +21,8 @@ use std::process::ExitCode;
 use std::sync::OnceLock;
 
 use scatter_conformance::{Check, Fixture, gpu, run_trials, scene_for};
-use scatter_reference::kernels::common_prefiltered::Tex;
-use scatter_reference::kernels::minmax_march::{MarchInputs, Pixel, pixel_ray};
+use scatter_reference::kernels::minmax_traverse::{Pixel, TraverseInputs, pixel_ray};
+use scatter_reference::kernels::texture::Tex;
 use scatter_reference::kernels::{minmax_from_rectified, rectify};
 use scatter_reference::suite::Pose;
 use scatter_runtime::{FrameInput, Minmax, RuntimeError, run_minmax_once};
@@ -155,7 +155,7 @@ fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> 
             "{name}: {tree_bad} tree nodes differ from the mirror"
         ));
     }
-    // minmax_march.
+    // minmax_traverse.
     let max = cpu
         .march
         .output
@@ -170,7 +170,7 @@ fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> 
     let mut worst_untied: f32 = 0.0;
     let mut ties = 0;
     let mut over = 0;
-    let inputs = MarchInputs {
+    let inputs = TraverseInputs {
         frame: &cpu.frame.uniforms,
         slices: &cpu.frame.slices,
         depth: &depth,
@@ -226,7 +226,7 @@ fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> 
         || "gpu n/a".to_owned(),
         |t| {
             format!(
-                "gpu rectify {:.2} ms minmax_build {:.2} ms minmax_march {:.2} ms",
+                "gpu rectify {:.2} ms minmax_build {:.2} ms minmax_traverse {:.2} ms",
                 t.rectify.as_secs_f64() * 1e3,
                 t.build.as_secs_f64() * 1e3,
                 t.march.as_secs_f64() * 1e3
@@ -247,7 +247,7 @@ fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> 
 /// may fall into the neighbouring slice). GPU and CPU compute `acos`, `atan2` and the
 /// rectified depths to a few ulps, so such pixels may legitimately differ by one texel's
 /// or one row's worth.
-fn is_tie(inp: &MarchInputs, rectified: &Tex, id: [u32; 3], spot: bool) -> bool {
+fn is_tie(inp: &TraverseInputs, rectified: &Tex, id: [u32; 3], spot: bool) -> bool {
     match pixel_ray(id, spot, inp) {
         Some(Pixel::Row(r)) => {
             let depth_tie = (0..r.n).any(|i| (r.d - rectified.load(i, r.row)).abs() < 1e-4);

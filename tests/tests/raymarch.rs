@@ -65,7 +65,7 @@ fn trial(ctx: &scatter_runtime::Context, variant: &RaymarchVariant) -> Result<St
         ctx,
         variant,
         SCREEN,
-        &f.march_input(),
+        &f.raymarch_input(),
         &f.gbuf.view_depth,
         &f.shadow_map.depth,
     )
@@ -179,11 +179,11 @@ fn bad_input_is_an_error() {
     let mut pass = Raymarch::new(ctx, &RaymarchVariant::default(), SCREEN, SHADOW_MAP / 2)
         .unwrap_or_else(|e| panic!("{e}"));
     let err = pass
-        .prepare(ctx, &f.march_input())
+        .prepare(ctx, &f.raymarch_input())
         .expect_err("shadow map size");
     assert!(matches!(err, RuntimeError::ShadowMapSize { .. }), "{err}");
     eprintln!("ok   raymarch::errors::shadow_map_size: {err}");
-    let mut input = f.march_input();
+    let mut input = f.raymarch_input();
     input.camera.forward.y = f64::NAN;
     let mut pass = Raymarch::new(ctx, &RaymarchVariant::default(), SCREEN, SHADOW_MAP)
         .unwrap_or_else(|e| panic!("{e}"));
@@ -198,7 +198,7 @@ fn bad_input_is_an_error() {
             ..RaymarchVariant::default()
         },
         [1, 1],
-        &f.march_input(),
+        &f.raymarch_input(),
         &[5.0],
         &f.shadow_map.depth,
     )

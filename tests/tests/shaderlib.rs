@@ -31,7 +31,7 @@ fn every_kernel_and_mode_validates() {
             KernelParams::Raymarch(v) | KernelParams::InterleaveSum(v) => {
                 format!("raymarch::{}::{}::validate", params.kernel(), v.id())
             }
-            KernelParams::MinmaxBuild(v) | KernelParams::MinmaxMarch(v) => {
+            KernelParams::MinmaxBuild(v) | KernelParams::MinmaxTraverse(v) => {
                 format!("minmax::{}::{}::validate", params.kernel(), v.id())
             }
         };

@@ -32,7 +32,7 @@ use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
 use scatter_reference::kernels::CpuFrame;
-use scatter_reference::kernels::common_prefiltered::quantise;
+use scatter_reference::kernels::texture::quantise;
 use scatter_reference::metrics;
 use scatter_reference::stress::{self, Premise, StressCase, StressGroup};
 use scatter_reference::truth::{self, TruthSettings, Visibility};

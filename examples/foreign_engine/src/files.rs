@@ -22,7 +22,7 @@ use scatter_frame::frame::{
     ShadowProjectionDesc, prepare_frame,
 };
 use scatter_frame::minmax::{MinmaxVariant, prepare_minmax};
-use scatter_frame::raymarch::{MarchUniforms, RaymarchVariant, prepare_march};
+use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_raymarch};
 use scatter_frame::variant::Variant;
 
 use crate::prefiltered::{Inputs, Sizes, run_frame};
@@ -283,15 +283,18 @@ impl FrameFile {
         )?)
     }
 
-    /// The uniform block of a raymarch variant ([`prepare_march`]; the rectified size and
+    /// The uniform block of a raymarch variant ([`prepare_raymarch`]; the rectified size and
     /// the settings do not apply).
     ///
     /// # Errors
     ///
     /// [`EngineError::Frame`] when the frame set-up rejects the numbers.
-    pub fn prepare_march(&self, variant: &RaymarchVariant) -> Result<MarchUniforms, EngineError> {
+    pub fn prepare_raymarch(
+        &self,
+        variant: &RaymarchVariant,
+    ) -> Result<RaymarchUniforms, EngineError> {
         let d = self.descs();
-        Ok(prepare_march(
+        Ok(prepare_raymarch(
             variant,
             self.screen,
             &d.camera,
@@ -673,7 +676,7 @@ pub fn run_dir(
             (Some(frame), out)
         }
         Knobs::Raymarch(variant) => {
-            let uniforms = file.prepare_march(variant)?;
+            let uniforms = file.prepare_raymarch(variant)?;
             let sizes = crate::raymarch::Sizes {
                 screen: file.screen,
                 shadow_map: file.shadow_map.size,

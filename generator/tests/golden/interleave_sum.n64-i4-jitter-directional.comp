@@ -12,7 +12,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     vec4 proj;
     uvec4 size;
 };
-struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
+struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     vec4 eye;
     vec4 cam_forward;
     vec4 cam_right;
@@ -32,7 +32,7 @@ struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
 const uint TILE = 8u;
 const uint ROWS = 15u;
 
-layout(std140, binding = 0) uniform MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX_block_0Compute { MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX _group_0_binding_0_cs; };
+layout(std140, binding = 0) uniform RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX_block_0Compute { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX _group_0_binding_0_cs; };
 
 layout(binding = 1) uniform sampler2D _group_0_binding_1_cs;
 
@@ -61,7 +61,7 @@ void main() {
     bool local_1 = false;
     vec3 total = vec3(0.0, 0.0, 0.0);
     uint i_1 = 0u;
-    MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m = _group_0_binding_0_cs;
+    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m = _group_0_binding_0_cs;
     uint w = m.sizes.x;
     uint h = m.sizes.y;
     uint mx = m.interleave.x;

@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     uint4 size;
 };
 
-struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
+struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     float4 eye;
     float4 cam_forward;
     float4 cam_right;
@@ -30,7 +30,7 @@ struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
 static const uint TILE = 8u;
 static const uint ROWS = 15u;
 
-cbuffer march : register(b0) { MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX march; }
+cbuffer frame : register(b0) { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX frame; }
 Texture2D<float4> partial : register(t1);
 RWTexture2D<float4> output : register(u2);
 groupshared float3 hsum[15][8];
@@ -63,7 +63,7 @@ void interleave_sum(uint3 gid : SV_DispatchThreadID, uint3 wid : SV_GroupID, uin
     float3 total = float3(0.0, 0.0, 0.0);
     uint i_1 = 0u;
 
-    MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m = march;
+    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m = frame;
     uint w = m.sizes.x;
     uint h = m.sizes.y;
     uint mx = m.interleave.x;

@@ -14,7 +14,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
+struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     metal::float4 eye;
     metal::float4 cam_forward;
     metal::float4 cam_right;
@@ -62,7 +62,7 @@ kernel void interleave_sum(
   metal::uint3 gid [[thread_position_in_grid]]
 , metal::uint3 wid [[threadgroup_position_in_grid]]
 , uint lid [[thread_index_in_threadgroup]]
-, constant MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX& march [[buffer(0)]]
+, constant RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX& frame [[buffer(0)]]
 , metal::texture2d<float, metal::access::sample> partial [[texture(0)]]
 , metal::texture2d<float, metal::access::write> output [[texture(1)]]
 , threadgroup type_7& hsum
@@ -78,7 +78,7 @@ kernel void interleave_sum(
     bool local_1 = {};
     metal::float3 total = metal::float3(0.0, 0.0, 0.0);
     uint i_1 = 0u;
-    MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m = march;
+    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m = frame;
     uint w = m.sizes.x;
     uint h = m.sizes.y;
     uint mx = m.interleave.x;

@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     size: vec4<u32>,
 }
 
-struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
+struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     eye: vec4<f32>,
     cam_forward: vec4<f32>,
     cam_right: vec4<f32>,
@@ -31,7 +31,7 @@ const TILE: u32 = 8u;
 const ROWS: u32 = 15u;
 
 @group(0) @binding(0) 
-var<uniform> march: MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX;
+var<uniform> frame: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX;
 @group(0) @binding(1) 
 var partial: texture_2d<f32>;
 @group(0) @binding(2) 
@@ -52,7 +52,7 @@ fn interleave_sum(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(workgr
     var total: vec3<f32> = vec3<f32>(0f, 0f, 0f);
     var i_1: u32 = 0u;
 
-    let m = march;
+    let m = frame;
     let w = m.sizes.x;
     let h = m.sizes.y;
     let mx = m.interleave.x;

@@ -61,7 +61,6 @@ static const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 static const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 static const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(0.34785485, 0.65214515, 0.65214515, 0.34785485);
-static const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 static const float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
 static const uint REGIONS = 3u;
 static const uint BASES_PER_THREAD = 8u;

@@ -12,7 +12,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     vec4 proj;
     uvec4 size;
 };
-struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
+struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     vec4 eye;
     vec4 cam_forward;
     vec4 cam_right;
@@ -35,7 +35,7 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float theta_a;
     float dtheta;
 };
-layout(std140, binding = 0) uniform MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX_block_0Compute { MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX _group_0_binding_0_cs; };
+layout(std140, binding = 0) uniform RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX_block_0Compute { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX _group_0_binding_0_cs; };
 
 layout(binding = 1) uniform sampler2D _group_0_binding_1_cs;
 
@@ -44,11 +44,11 @@ layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 layout(binding = 3,rgba32f) writeonly uniform image2D _group_0_binding_3_cs;
 
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m) {
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m) {
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(m.sm_right, m.sm_up, m.sm_forward, m.sm_origin, m.sm_proj, uvec4(m.sizes.z, 0u, 0u, 0u));
 }
 
-vec3 march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_1, uint x, uint y) {
+vec3 raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_1, uint x, uint y) {
     float ndc_x = (((2.0 * (float(x) + 0.5)) / float(m_1.sizes.x)) - 1.0);
     float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(m_1.sizes.y)));
     float t_2 = m_1.cam_forward.w;
@@ -210,7 +210,7 @@ void main() {
     float t = 0.0;
     float w = 0.0;
     float l = 0.0;
-    MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = _group_0_binding_0_cs;
+    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = _group_0_binding_0_cs;
     uint x_7 = id.x;
     uint y_3 = id.y;
     if (!((x_7 >= m_2.sizes.x))) {
@@ -223,7 +223,7 @@ void main() {
         return;
     }
     vec3 eye_2 = m_2.eye.xyz;
-    vec3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
+    vec3 _e20 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
     int _e24_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
     vec4 _e24 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_7, y_3)), ivec2(0), textureSize(_group_0_binding_1_cs, _e24_clamped_lod) - ivec2(1)), _e24_clamped_lod);
     float s = (min(max(_e24.x, 0.0), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 1e-6));
@@ -237,7 +237,7 @@ void main() {
         float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
         u = _e54;
     }
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0.0, s, n_2);
     j = pixel_class;
     bool loop_init = true;

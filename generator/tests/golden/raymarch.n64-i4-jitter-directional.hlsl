@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     uint4 size;
 };
 
-struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
+struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     float4 eye;
     float4 cam_forward;
     float4 cam_right;
@@ -34,7 +34,7 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float dtheta;
 };
 
-cbuffer march : register(b0) { MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX march; }
+cbuffer frame : register(b0) { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX frame; }
 Texture2D<float4> depth : register(t1);
 Texture2D<float4> shadow_map : register(t2);
 RWTexture2D<float4> output : register(u3);
@@ -50,13 +50,13 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ConstructShadowMapViewX_n
     return ret;
 }
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m)
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m)
 {
     const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx = ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(m.sm_right, m.sm_up, m.sm_forward, m.sm_origin, m.sm_proj, uint4(m.sizes.z, 0u, 0u, 0u));
     return shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx;
 }
 
-float3 march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_1, uint x, uint y)
+float3 raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_1, uint x, uint y)
 {
     float ndc_x = (((2.0 * (float(x) + 0.5)) / float(m_1.sizes.x)) - 1.0);
     float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(m_1.sizes.y)));
@@ -255,7 +255,7 @@ void raymarch(uint3 id : SV_DispatchThreadID)
     float w = (float)0;
     float l = (float)0;
 
-    MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = march;
+    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
     uint x_7 = id.x;
     uint y_3 = id.y;
     if (!((x_7 >= m_2.sizes.x))) {
@@ -268,7 +268,7 @@ void raymarch(uint3 id : SV_DispatchThreadID)
         return;
     }
     float3 eye_2 = m_2.eye.xyz;
-    const float3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
+    const float3 _e20 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
     float4 _e24 = depth.Load(int3(uint2(x_7, y_3), int(0)));
     float s = (min(max(_e24.x, 0.0), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 1e-6));
     uint n_2 = m_2.sizes.w;
@@ -281,7 +281,7 @@ void raymarch(uint3 id : SV_DispatchThreadID)
         const float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
         u = _e54;
     }
-    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0.0, s, n_2);
     j = pixel_class;
     uint2 loop_bound = uint2(4294967295u, 4294967295u);

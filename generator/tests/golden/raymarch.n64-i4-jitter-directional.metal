@@ -14,7 +14,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
+struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     metal::float4 eye;
     metal::float4 cam_forward;
     metal::float4 cam_right;
@@ -38,14 +38,14 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float dtheta;
 };
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
-    MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
+    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m
 ) {
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {m.sm_right, m.sm_up, m.sm_forward, m.sm_origin, m.sm_proj, metal::uint4(m.sizes.z, 0u, 0u, 0u)};
 }
 
-metal::float3 march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
-    MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_1,
+metal::float3 raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
+    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_1,
     uint x,
     uint y
 ) {
@@ -266,7 +266,7 @@ struct raymarchInput {
 };
 kernel void raymarch(
   metal::uint3 id [[thread_position_in_grid]]
-, constant MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX& march [[buffer(0)]]
+, constant RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX& frame [[buffer(0)]]
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
 , metal::texture2d<float, metal::access::write> output [[texture(2)]]
@@ -278,7 +278,7 @@ kernel void raymarch(
     float t = {};
     float w = {};
     float l = {};
-    MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = march;
+    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
     uint x_7 = id.x;
     uint y_3 = id.y;
     if (!((x_7 >= m_2.sizes.x))) {
@@ -291,7 +291,7 @@ kernel void raymarch(
         return;
     }
     metal::float3 eye_2 = m_2.eye.xyz;
-    metal::float3 _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
+    metal::float3 _e20 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
     uint clamped_lod_e24 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e24 = depth.read(metal::min(metal::uint2(metal::uint2(x_7, y_3)), metal::uint2(depth.get_width(clamped_lod_e24), depth.get_height(clamped_lod_e24)) - 1), clamped_lod_e24);
     float s = metal::min(metal::max(_e24.x, 0.0), m_2.eye.w) / metal::max(metal::dot(_e20, m_2.cam_forward.xyz), 0.000001);
@@ -305,7 +305,7 @@ kernel void raymarch(
         float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
         u = _e54;
     }
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0.0, s, n_2);
     j = pixel_class;
     uint2 loop_bound = uint2(4294967295u);

@@ -9,7 +9,7 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     size: vec4<u32>,
 }
 
-struct MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
+struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     eye: vec4<f32>,
     cam_forward: vec4<f32>,
     cam_right: vec4<f32>,
@@ -35,7 +35,7 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
 }
 
 @group(0) @binding(0) 
-var<uniform> march: MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX;
+var<uniform> frame: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX;
 @group(0) @binding(1) 
 var depth: texture_2d<f32>;
 @group(0) @binding(2) 
@@ -43,11 +43,11 @@ var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) 
 var output: texture_storage_2d<rgba32float,write>;
 
-fn march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m: MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+fn raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(m.sm_right, m.sm_up, m.sm_forward, m.sm_origin, m.sm_proj, vec4<u32>(m.sizes.z, 0u, 0u, 0u));
 }
 
-fn march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_1: MarchX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX, x: u32, y: u32) -> vec3<f32> {
+fn raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_1: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX, x: u32, y: u32) -> vec3<f32> {
     let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(m_1.sizes.x)) - 1f);
     let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(m_1.sizes.y)));
     let t_2 = m_1.cam_forward.w;
@@ -213,7 +213,7 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
     var w: f32;
     var l: f32;
 
-    let m_2 = march;
+    let m_2 = frame;
     let x_7 = id.x;
     let y_3 = id.y;
     if !((x_7 >= m_2.sizes.x)) {
@@ -226,7 +226,7 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let eye_2 = m_2.eye.xyz;
-    let _e20 = march_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
+    let _e20 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
     let _e24 = textureLoad(depth, vec2<u32>(x_7, y_3), 0i);
     let s = (min(max(_e24.x, 0f), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 0.000001f));
     let n_2 = m_2.sizes.w;
@@ -239,7 +239,7 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
         let _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
         u = _e54;
     }
-    let _e56 = march_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    let _e56 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     let _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0f, s, n_2);
     j = pixel_class;
     loop {

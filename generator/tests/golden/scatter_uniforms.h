@@ -126,8 +126,8 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g0_) == 352, "Scatt
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g1_) == 368, "ScatterPrefilteredFrame.proj_g1_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g2_) == 384, "ScatterPrefilteredFrame.proj_g2_ offset");
 
-/* WGSL `March` of family raymarch (scatter::raymarch), 240 bytes, alignment 16. */
-typedef struct ScatterRaymarchMarch {
+/* WGSL `RaymarchFrame` of family raymarch (scatter::raymarch), 240 bytes, alignment 16. */
+typedef struct ScatterRaymarchRaymarchFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
     float cam_forward[4]; /* vec4<f32>, offset 16 */
     float cam_right[4]; /* vec4<f32>, offset 32 */
@@ -143,22 +143,22 @@ typedef struct ScatterRaymarchMarch {
     float sm_proj[4]; /* vec4<f32>, offset 192 */
     uint32_t sizes[4]; /* vec4<u32>, offset 208 */
     uint32_t interleave[4]; /* vec4<u32>, offset 224 */
-} ScatterRaymarchMarch;
-SCATTER_STATIC_ASSERT(sizeof(ScatterRaymarchMarch) == 240, "ScatterRaymarchMarch size");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, eye) == 0, "ScatterRaymarchMarch.eye offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, cam_forward) == 16, "ScatterRaymarchMarch.cam_forward offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, cam_right) == 32, "ScatterRaymarchMarch.cam_right offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, cam_up) == 48, "ScatterRaymarchMarch.cam_up offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, medium) == 64, "ScatterRaymarchMarch.medium offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, light_color) == 80, "ScatterRaymarchMarch.light_color offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, light_pos) == 96, "ScatterRaymarchMarch.light_pos offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, light_dir) == 112, "ScatterRaymarchMarch.light_dir offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sm_right) == 128, "ScatterRaymarchMarch.sm_right offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sm_up) == 144, "ScatterRaymarchMarch.sm_up offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sm_forward) == 160, "ScatterRaymarchMarch.sm_forward offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sm_origin) == 176, "ScatterRaymarchMarch.sm_origin offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sm_proj) == 192, "ScatterRaymarchMarch.sm_proj offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, sizes) == 208, "ScatterRaymarchMarch.sizes offset");
-SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchMarch, interleave) == 224, "ScatterRaymarchMarch.interleave offset");
+} ScatterRaymarchRaymarchFrame;
+SCATTER_STATIC_ASSERT(sizeof(ScatterRaymarchRaymarchFrame) == 240, "ScatterRaymarchRaymarchFrame size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, eye) == 0, "ScatterRaymarchRaymarchFrame.eye offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, cam_forward) == 16, "ScatterRaymarchRaymarchFrame.cam_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, cam_right) == 32, "ScatterRaymarchRaymarchFrame.cam_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, cam_up) == 48, "ScatterRaymarchRaymarchFrame.cam_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, medium) == 64, "ScatterRaymarchRaymarchFrame.medium offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, light_color) == 80, "ScatterRaymarchRaymarchFrame.light_color offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, light_pos) == 96, "ScatterRaymarchRaymarchFrame.light_pos offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, light_dir) == 112, "ScatterRaymarchRaymarchFrame.light_dir offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, sm_right) == 128, "ScatterRaymarchRaymarchFrame.sm_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, sm_up) == 144, "ScatterRaymarchRaymarchFrame.sm_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, sm_forward) == 160, "ScatterRaymarchRaymarchFrame.sm_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, sm_origin) == 176, "ScatterRaymarchRaymarchFrame.sm_origin offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, sm_proj) == 192, "ScatterRaymarchRaymarchFrame.sm_proj offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, sizes) == 208, "ScatterRaymarchRaymarchFrame.sizes offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, interleave) == 224, "ScatterRaymarchRaymarchFrame.interleave offset");
 
 #endif /* SCATTER_UNIFORMS_H */

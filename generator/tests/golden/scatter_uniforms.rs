@@ -186,10 +186,10 @@ pub mod prefiltered {
 /// Uniform structs of the `raymarch` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod raymarch {
-    /// WGSL `March` (scatter::raymarch), 240 bytes, alignment 16.
+    /// WGSL `RaymarchFrame` (scatter::raymarch), 240 bytes, alignment 16.
     #[repr(C)]
     #[derive(Clone, Copy, Debug, PartialEq)]
-    pub struct March {
+    pub struct RaymarchFrame {
         /// `vec4<f32>` at byte 0.
         pub eye: [f32; 4],
         /// `vec4<f32>` at byte 16.
@@ -223,21 +223,21 @@ pub mod raymarch {
     }
 
     const _: () = {
-        assert!(::core::mem::size_of::<March>() == 240);
-        assert!(::core::mem::offset_of!(March, eye) == 0);
-        assert!(::core::mem::offset_of!(March, cam_forward) == 16);
-        assert!(::core::mem::offset_of!(March, cam_right) == 32);
-        assert!(::core::mem::offset_of!(March, cam_up) == 48);
-        assert!(::core::mem::offset_of!(March, medium) == 64);
-        assert!(::core::mem::offset_of!(March, light_color) == 80);
-        assert!(::core::mem::offset_of!(March, light_pos) == 96);
-        assert!(::core::mem::offset_of!(March, light_dir) == 112);
-        assert!(::core::mem::offset_of!(March, sm_right) == 128);
-        assert!(::core::mem::offset_of!(March, sm_up) == 144);
-        assert!(::core::mem::offset_of!(March, sm_forward) == 160);
-        assert!(::core::mem::offset_of!(March, sm_origin) == 176);
-        assert!(::core::mem::offset_of!(March, sm_proj) == 192);
-        assert!(::core::mem::offset_of!(March, sizes) == 208);
-        assert!(::core::mem::offset_of!(March, interleave) == 224);
+        assert!(::core::mem::size_of::<RaymarchFrame>() == 240);
+        assert!(::core::mem::offset_of!(RaymarchFrame, eye) == 0);
+        assert!(::core::mem::offset_of!(RaymarchFrame, cam_forward) == 16);
+        assert!(::core::mem::offset_of!(RaymarchFrame, cam_right) == 32);
+        assert!(::core::mem::offset_of!(RaymarchFrame, cam_up) == 48);
+        assert!(::core::mem::offset_of!(RaymarchFrame, medium) == 64);
+        assert!(::core::mem::offset_of!(RaymarchFrame, light_color) == 80);
+        assert!(::core::mem::offset_of!(RaymarchFrame, light_pos) == 96);
+        assert!(::core::mem::offset_of!(RaymarchFrame, light_dir) == 112);
+        assert!(::core::mem::offset_of!(RaymarchFrame, sm_right) == 128);
+        assert!(::core::mem::offset_of!(RaymarchFrame, sm_up) == 144);
+        assert!(::core::mem::offset_of!(RaymarchFrame, sm_forward) == 160);
+        assert!(::core::mem::offset_of!(RaymarchFrame, sm_origin) == 176);
+        assert!(::core::mem::offset_of!(RaymarchFrame, sm_proj) == 192);
+        assert!(::core::mem::offset_of!(RaymarchFrame, sizes) == 208);
+        assert!(::core::mem::offset_of!(RaymarchFrame, interleave) == 224);
     };
 }

@@ -10,8 +10,8 @@ use super::common_model::{
     PI, clamp, equiangular, equiangular_sample, max, min, phase_hg, spot_integrand, spot_span,
     transmittance_between,
 };
-use super::common_prefiltered::{Tex, xyz};
 use super::common_shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility};
+use super::texture::{Tex, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::FrameUniforms;
 

@@ -1,13 +1,13 @@
 //! CPU mirror of `shaderlib/templates/common/raymarch.wgsl` (`scatter::raymarch`): the
 //! `raymarch` family's shadow-map view, pixel rays, jitter hash and interleaving windows.
 
-use super::common_prefiltered::xyz;
 use super::common_shadow::ShadowMapView;
+use super::texture::xyz;
 use glam::Vec3;
-use scatter_shaderlib::raymarch::MarchUniforms;
+use scatter_shaderlib::raymarch::RaymarchUniforms;
 
 /// The frame's standard shadow map ([`super::common_shadow`]).
-pub fn march_shadow_view(m: &MarchUniforms) -> ShadowMapView {
+pub fn raymarch_shadow_view(m: &RaymarchUniforms) -> ShadowMapView {
     ShadowMapView {
         right: m.sm_right,
         up: m.sm_up,
@@ -19,7 +19,7 @@ pub fn march_shadow_view(m: &MarchUniforms) -> ShadowMapView {
 }
 
 /// Unit view direction through the centre of pixel (x, y).
-pub fn march_pixel_dir(m: &MarchUniforms, x: u32, y: u32) -> Vec3 {
+pub fn raymarch_pixel_dir(m: &RaymarchUniforms, x: u32, y: u32) -> Vec3 {
     let ndc_x = 2.0 * (x as f32 + 0.5) / m.sizes[0] as f32 - 1.0;
     let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / m.sizes[1] as f32;
     let t = m.cam_forward[3];

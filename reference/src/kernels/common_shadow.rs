@@ -4,7 +4,7 @@
 //! first occluder along a light ray).
 
 use super::common_model::{max, select};
-use super::common_prefiltered::{Tex, xyz};
+use super::texture::{Tex, xyz};
 use glam::Vec3;
 
 /// Stand-in for "no occluder": a travel distance far beyond any scene.

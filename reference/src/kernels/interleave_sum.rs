@@ -2,11 +2,11 @@
 //! interleaved sampling, one 8 x 8 workgroup (tile) at a time: phase 1 fills the tile's
 //! horizontal sums (workgroup memory), phase 2 adds `My` of them per pixel.
 
-use super::common_prefiltered::TexArray;
 use super::common_raymarch::window_start;
+use super::texture::TexArray;
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::Storage;
-use scatter_shaderlib::raymarch::MarchUniforms;
+use scatter_shaderlib::raymarch::RaymarchUniforms;
 
 /// Tile side (the workgroup is TILE x TILE).
 pub const TILE: u32 = 8;
@@ -16,7 +16,7 @@ pub const ROWS: u32 = 15;
 /// One workgroup: tile `wid`; stores into `output` (rgba16float).
 pub fn interleave_sum_workgroup(
     wid: [u32; 2],
-    m: &MarchUniforms,
+    m: &RaymarchUniforms,
     partial: &TexArray,
     output: &mut TexArray,
 ) {
@@ -70,7 +70,7 @@ pub fn interleave_sum_workgroup(
 }
 
 /// Runs every workgroup; returns the filtered radiance (rgba16float).
-pub fn interleave_sum(m: &MarchUniforms, partial: &TexArray) -> TexArray {
+pub fn interleave_sum(m: &RaymarchUniforms, partial: &TexArray) -> TexArray {
     let (w, h) = (m.sizes[0], m.sizes[1]);
     let mut out = TexArray::new(w, h, 1);
     for ty in 0..h.div_ceil(TILE) {

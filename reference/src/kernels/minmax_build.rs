@@ -3,7 +3,7 @@
 //! rectified row (layout: `scatter_frame::minmax`).
 
 use super::common_minmax::{level_count, tree_width};
-use super::common_prefiltered::{Tex, TexArray};
+use super::texture::{Tex, TexArray};
 use scatter_shaderlib::prefiltered::FrameUniforms;
 
 /// The kernel body for invocation `id`; returns the node `(min, max, 0, 0)` it stores at

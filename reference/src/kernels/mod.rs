@@ -7,17 +7,20 @@ pub mod common_epipolar;
 pub mod common_minmax;
 pub mod common_model;
 pub mod common_prefiltered;
+pub mod common_prefiltered_projective;
+pub mod common_projective;
 pub mod common_raymarch;
 pub mod common_shadow;
 pub mod family;
 pub mod interleave_sum;
 pub mod minmax_build;
-pub mod minmax_march;
+pub mod minmax_traverse;
 pub mod prefilter;
 pub mod raymarch;
 pub mod rectify;
 pub mod row_prefix;
 pub mod scatter;
+pub mod texture;
 
 use crate::buffers::{GBuffer, ShadowMap};
 use crate::bvh::Bvh;
@@ -25,12 +28,12 @@ use crate::geometry::Aabb;
 use crate::image::Image;
 use crate::projective::rasterise_rectified;
 use crate::scene::Scene;
-use common_prefiltered::{Tex, TexArray};
 pub use family::{CpuFamily, CpuFrame, CpuRun, FamilyRun, run_family};
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_shaderlib::prefiltered::{
     FrameError, FrameSettings, LightKind, PrefilteredFrame, Resolutions, Variant, prepare_frame,
 };
+use texture::{Tex, TexArray};
 
 /// Every intermediate of one CPU run of the prefiltered family.
 #[derive(Clone, Debug)]
@@ -156,7 +159,7 @@ pub fn scene_reach(scene: &Scene, bvh: &Bvh) -> f64 {
 #[derive(Clone, Debug)]
 pub struct RaymarchRun {
     /// The uniform block.
-    pub uniforms: scatter_shaderlib::raymarch::MarchUniforms,
+    pub uniforms: scatter_shaderlib::raymarch::RaymarchUniforms,
     /// The partial sums of an interleaved variant (rgba32float), `None` otherwise.
     pub partial: Option<TexArray>,
     /// In-scattered radiance (as stored in rgba16float).
@@ -171,7 +174,7 @@ pub fn run_raymarch(
     gbuf: &GBuffer,
     shadow_map: &ShadowMap,
 ) -> Result<RaymarchRun, FrameError> {
-    let uniforms = scatter_shaderlib::raymarch::prepare_march(
+    let uniforms = scatter_shaderlib::raymarch::prepare_raymarch(
         variant,
         [gbuf.width, gbuf.height],
         &scene.camera_desc(),
@@ -217,15 +220,15 @@ pub struct MinmaxRun {
     pub rectified: Tex,
     /// The min-max trees (`minmax_build`).
     pub tree: TexArray,
-    /// The hierarchical march (`minmax_march`): radiance, and nodes visited per pixel.
-    pub march: minmax_march::MarchImage,
+    /// The hierarchical march (`minmax_traverse`): radiance, and nodes visited per pixel.
+    pub march: minmax_traverse::TraverseImage,
     /// The brute-force march over every texel of the same rectified rows.
-    pub brute: minmax_march::MarchImage,
+    pub brute: minmax_traverse::TraverseImage,
     /// In-scattered radiance of the hierarchical march (as stored in rgba16float).
     pub output: Image,
 }
 
-/// Runs `rectify`, `minmax_build` and `minmax_march` on the CPU for a scene, its depth
+/// Runs `rectify`, `minmax_build` and `minmax_traverse` on the CPU for a scene, its depth
 /// buffer and its standard shadow map, and the brute-force march over the same rectified
 /// map.
 pub fn run_minmax(
@@ -266,7 +269,7 @@ pub fn run_minmax(
     ))
 }
 
-/// `minmax_build`, `minmax_march` and the brute-force march for a given frame and
+/// `minmax_build`, `minmax_traverse` and the brute-force march for a given frame and
 /// rectified map (the GPU's, in the conformance test).
 pub fn minmax_from_rectified(
     variant: &MinmaxVariant,
@@ -276,15 +279,15 @@ pub fn minmax_from_rectified(
     shadow_map: &Tex,
 ) -> MinmaxRun {
     let tree = minmax_build::minmax_build(&frame.uniforms, &rectified);
-    let inputs = minmax_march::MarchInputs {
+    let inputs = minmax_traverse::TraverseInputs {
         frame: &frame.uniforms,
         slices: &frame.slices,
         depth,
         shadow_map,
         tree: &tree,
     };
-    let march = minmax_march::minmax_march(variant, &inputs);
-    let brute = minmax_march::minmax_brute(variant, &inputs, &rectified);
+    let march = minmax_traverse::minmax_traverse(variant, &inputs);
+    let brute = minmax_traverse::minmax_brute(variant, &inputs, &rectified);
     let output = Image::from_pixels(
         depth.width,
         depth.height,

@@ -12,9 +12,10 @@
 //! rg32float on the GPU; here a one-layer array of `[min, max, 0, 0]`).
 
 use super::common_model::select;
-use super::common_prefiltered::{
-    Tex, TexArray, basis4, proj_stored_depth, proj_texel_weight, region_start, texel_weight,
-};
+use super::common_prefiltered::{basis4, region_start, texel_weight};
+use super::common_prefiltered_projective::proj_texel_weight;
+use super::common_projective::proj_stored_depth;
+use super::texture::{Tex, TexArray};
 use scatter_shaderlib::prefiltered::{
     FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant, VisibilityMode,
 };

@@ -6,18 +6,18 @@
 use super::common_model::{
     equiangular, equiangular_sample, max, min, phase_hg, spot_integrand, transmittance_between,
 };
-use super::common_prefiltered::{Tex, TexArray, quantise, xyz};
-use super::common_raymarch::{march_pixel_dir, march_shadow_view, pixel_jitter};
+use super::common_raymarch::{pixel_jitter, raymarch_pixel_dir, raymarch_shadow_view};
 use super::common_shadow::shadow_visibility;
+use super::texture::{Tex, TexArray, quantise, xyz};
 use scatter_shaderlib::prefiltered::{LightKind, Storage};
-use scatter_shaderlib::raymarch::{MarchUniforms, RaymarchVariant};
+use scatter_shaderlib::raymarch::{RaymarchUniforms, RaymarchVariant};
 
 /// The kernel body for pixel `id`; returns the texel it stores (radiance, or the partial
 /// sum of an interleaved variant), before the storage format's rounding.
 pub fn raymarch_main(
     id: [u32; 3],
     variant: &RaymarchVariant,
-    m: &MarchUniforms,
+    m: &RaymarchUniforms,
     depth: &Tex,
     shadow_map: &Tex,
 ) -> Option<[f32; 4]> {
@@ -27,7 +27,7 @@ pub fn raymarch_main(
     }
     let spot = variant.light == LightKind::Spot;
     let eye = xyz(m.eye);
-    let dir = march_pixel_dir(m, x, y);
+    let dir = raymarch_pixel_dir(m, x, y);
     // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
     let s = min(max(depth.load(x, y), 0.0), m.eye[3]) / max(dir.dot(xyz(m.cam_forward)), 1e-6);
     let n = m.sizes[3];
@@ -40,7 +40,7 @@ pub fn raymarch_main(
     if m.interleave[2] != 0 {
         u = pixel_jitter(x, y);
     }
-    let view = march_shadow_view(m);
+    let view = raymarch_shadow_view(m);
     let strata = equiangular(eye, dir, xyz(m.light_pos), 0.0, s, n);
     let mut sum = 0.0;
     let mut j = pixel_class;
@@ -83,7 +83,7 @@ pub fn raymarch_main(
 /// sums (rgba32float) of an interleaved variant.
 pub fn raymarch(
     variant: &RaymarchVariant,
-    m: &MarchUniforms,
+    m: &RaymarchUniforms,
     depth: &Tex,
     shadow_map: &Tex,
 ) -> TexArray {

@@ -7,7 +7,8 @@
 
 use super::common_epipolar::{normalised_depth, row_phi, slice_e, sm_occluder_distance};
 use super::common_model::PI;
-use super::common_prefiltered::{NO_OCCLUDER, Tex, xyz};
+use super::common_shadow::NO_OCCLUDER;
+use super::texture::{Tex, xyz};
 use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams};
 
 /// The kernel body for invocation `id` (`spot` is the template's light switch); returns the

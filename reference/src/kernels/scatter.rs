@@ -19,10 +19,10 @@ use super::common_epipolar::{
     epipole_march, normalised_depth, pixel_dir, ray_t, row_index, spot_segment,
 };
 use super::common_model::{clamp, max, max_u, min, mix, phase_hg, transmittance_between};
-use super::common_prefiltered::{
-    Tex, TexArray, coeff4, proj_boundary, proj_column, proj_ray_depth, proj_reach, quantise,
-    region_start, sample_bilinear, xyz,
-};
+use super::common_prefiltered::{coeff4, region_start};
+use super::common_prefiltered_projective::proj_column;
+use super::common_projective::{proj_boundary, proj_ray_depth, proj_reach};
+use super::texture::{Tex, TexArray, quantise, sample_bilinear, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
     FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant,

@@ -1,8 +1,8 @@
 //! The `minmax` family (Chen et al. 2011): the askama views of `templates/minmax_build.wgsl`
-//! and `templates/minmax_march.wgsl` and their rendering from a [`MinmaxVariant`]. The
+//! and `templates/minmax_traverse.wgsl` and their rendering from a [`MinmaxVariant`]. The
 //! family's first pass is the prefiltered family's `rectify`
 //! ([`crate::KernelParams::minmax`] lists it with [`MinmaxVariant::prefiltered`]). CPU
-//! mirrors: `reference/src/kernels/{minmax_build,minmax_march}.rs`. Host-side knobs, tree
+//! mirrors: `reference/src/kernels/{minmax_build,minmax_traverse}.rs`. Host-side knobs, tree
 //! layout and frame set-up: [`scatter_frame::minmax`] (re-exported here).
 
 pub mod plan;
@@ -20,7 +20,7 @@ use crate::{Kernel, ShaderError};
 /// Workgroup size of `minmax_build`: one invocation per tree node, 64 along a row.
 pub const BUILD_WORKGROUP_SIZE: [u32; 3] = [64, 1, 1];
 
-/// Workgroup size of `minmax_march`: one invocation per pixel.
+/// Workgroup size of `minmax_traverse`: one invocation per pixel.
 pub const MARCH_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
 
 /// Format of the min-max tree texture (r = min, g = max).
@@ -31,10 +31,10 @@ pub const TREE_FORMAT: &str = "rg32float";
 #[template(path = "minmax_build.wgsl")]
 struct BuildTemplate {}
 
-/// `minmax_march`: the per-pixel hierarchical march.
+/// `minmax_traverse`: the per-pixel hierarchical march.
 #[derive(Template)]
-#[template(path = "minmax_march.wgsl")]
-struct MarchTemplate {
+#[template(path = "minmax_traverse.wgsl")]
+struct TraverseTemplate {
     light_name: &'static str,
     spot: bool,
 }
@@ -57,17 +57,17 @@ pub(crate) fn render_build(variant: &MinmaxVariant) -> Result<String, ShaderErro
         })
 }
 
-/// Renders `templates/minmax_march.wgsl` for `variant` (only the light changes the code).
-pub(crate) fn render_march(variant: &MinmaxVariant) -> Result<String, ShaderError> {
-    validate(Kernel::MinmaxMarch, variant)?;
-    MarchTemplate {
+/// Renders `templates/minmax_traverse.wgsl` for `variant` (only the light changes the code).
+pub(crate) fn render_traverse(variant: &MinmaxVariant) -> Result<String, ShaderError> {
+    validate(Kernel::MinmaxTraverse, variant)?;
+    TraverseTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
     }
     .render()
     .map_err(|source| ShaderError::Render {
-        kernel: Kernel::MinmaxMarch,
-        template: template_path(Kernel::MinmaxMarch),
+        kernel: Kernel::MinmaxTraverse,
+        template: template_path(Kernel::MinmaxTraverse),
         source,
     })
 }

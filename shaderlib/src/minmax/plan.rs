@@ -1,5 +1,5 @@
 //! The plan of a `minmax` variant: its textures and buffers and its passes (`rectify`,
-//! `minmax_build`, `minmax_march`). `scatter-gen` writes it into the manifest;
+//! `minmax_build`, `minmax_traverse`). `scatter-gen` writes it into the manifest;
 //! `scatter-runtime` builds and dispatches from it.
 
 use crate::minmax::{MinmaxVariant, TREE_FORMAT};
@@ -68,7 +68,7 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
         ),
         scatter_texture(
             "output",
-            "in-scattered radiance, rgb, alpha 1 (written by minmax_march); add it to the \
+            "in-scattered radiance, rgb, alpha 1 (written by minmax_traverse); add it to the \
              attenuated scene",
             OUTPUT_FORMAT,
             "screen.width",
@@ -118,7 +118,7 @@ pub fn pass(kernel: Kernel) -> Option<PassPlan> {
             skip_when: None,
             bindings: vec![bind(0, "frame"), bind(1, "rectified"), bind(2, "tree")],
         }),
-        Kernel::MinmaxMarch => Some(PassPlan {
+        Kernel::MinmaxTraverse => Some(PassPlan {
             kernel,
             invocations: [f("screen.width"), f("screen.height"), f("1")],
             skip_when: None,

@@ -7,7 +7,7 @@ pub mod plan;
 
 use askama::Template;
 
-pub use scatter_frame::raymarch::{MarchUniforms, RaymarchVariant, prepare_march};
+pub use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_raymarch};
 
 use crate::compose::template_path;
 use crate::prefiltered::LightKind;

@@ -15,9 +15,9 @@ pub fn plan(v: &RaymarchVariant) -> Plan {
     let [depth, shadow_map] = depth_and_shadow_map();
     let mut resources = vec![
         frame_buffer(
-            "march",
-            "the uniform block of the frame (Rust: scatter_frame::raymarch::MarchUniforms from \
-             prepare_march), written once per frame",
+            "frame",
+            "the uniform block of the frame (Rust: scatter_frame::raymarch::RaymarchUniforms from \
+             prepare_raymarch), written once per frame",
             None,
         ),
         depth,
@@ -50,8 +50,8 @@ pub fn plan(v: &RaymarchVariant) -> Plan {
         passes,
         notes: vec![
             "Run the passes in order with a compute-to-compute memory barrier between them.",
-            "Write `march` once per frame before the first pass; the host code that computes \
-             it is scatter_frame::raymarch::prepare_march (Rust).",
+            "Write `frame` once per frame before the first pass; the host code that computes \
+             it is scatter_frame::raymarch::prepare_raymarch (Rust).",
             "Group 0 holds every binding; bind by group and binding number, not by name.",
         ],
     }
@@ -66,7 +66,7 @@ pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
             invocations: screen(),
             skip_when: None,
             bindings: vec![
-                bind(0, "march"),
+                bind(0, "frame"),
                 bind(1, "depth"),
                 bind(2, "shadow_map"),
                 bind(3, if v.interleaved() { "partial" } else { "output" }),
@@ -76,7 +76,7 @@ pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
             kernel,
             invocations: screen(),
             skip_when: None,
-            bindings: vec![bind(0, "march"), bind(1, "partial"), bind(2, "output")],
+            bindings: vec![bind(0, "frame"), bind(1, "partial"), bind(2, "output")],
         }),
         _ => None,
     }

@@ -1,5 +1,5 @@
 // scatter::minmax: the packed layout of the 1D min-max trees of the `minmax` family (Chen et
-// al. 2011), shared by `minmax_build` and `minmax_march`. Row y of the rg32float tree
+// al. 2011), shared by `minmax_build` and `minmax_traverse`. Row y of the rg32float tree
 // texture holds the tree of rectified row y, levels packed left to right: level k has
 // n_k = ceil(Wr / 2^k) nodes at columns off_k .. off_k + n_k (off_k = n_0 + ... + n_(k-1));
 // node j of level k covers texels [j 2^k, min((j + 1) 2^k, Wr)) and stores (min, max) of

@@ -1,8 +1,9 @@
 // scatter::prefiltered: what the kernels of the prefiltered family (Klehm et al. 2014) share
 // beyond the epipolar set-up (`scatter::epipolar`: the `Frame` block, slices, the frame's
 // shadow map, the epipole march): the Fourier basis and its coefficients (Sec. 3, Eq. 8),
-// the prefilter's reference-ray weights (Eq. 11/12), region bounds (Table 1) and the
-// projective rectification's mapping (Sec. 4.2).
+// the prefilter's reference-ray weights (Eq. 11/12), and region bounds (Table 1).
+// The family's column layout of a projective map is `scatter::prefiltered_projective`, so
+// that epipolar variants compose none of it.
 //
 // Composed into kernels by naga_oil (`#import scatter::prefiltered::{...}`); plain WGSL, not
 // an askama template. Conventions: `scatter_shaderlib::prefiltered::frame`. Mirrored line by
@@ -15,7 +16,7 @@
 #define_import_path scatter::prefiltered
 
 #import scatter::model::{PI, cone_falloff, transmittance_between}
-#import scatter::epipolar::{DEPTH_MARGIN, Frame, SliceParams, row_phi, slice_e}
+#import scatter::epipolar::{Frame, SliceParams, row_phi, slice_e}
 
 
 // Smallest cone factor of a spot texel weight: where a region of the reference ray lies
@@ -96,101 +97,6 @@ fn texel_weight(f: Frame, s: SliceParams, row: u32, i: u32, weighted: bool, spot
         let r = max(f.axis[3] * sin(s.theta_ref) / den, 1e-4);
         let cone = max(cone_falloff(dot(l, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]), CONE_FLOOR);
         w *= cone * exp(-f.medium[0] * r) / (r * r);
-    }
-    return w;
-}
-
-// ---- Projective rectification (Sec. 4.2; conventions: `ProjectiveMaps` and
-// `projective_frame` in scatter_shaderlib::prefiltered::frame). Light space: eye at the
-// origin, x = e1 (the fan's bisectrix), y = e2, z = axis. Row k = qy / qx, ray depth
-// m = qz / qx, column invariant G = 1 / qx (sun) or (D - qz) / qx (spot); region r maps G
-// linearly from G_r to G_(r+1) onto its columns.
-
-// Column invariant G_r of region boundary `r` (0..=8).
-fn proj_boundary(f: Frame, r: u32) -> f32 {
-    var v = f.proj_g2_;
-    if r < 4u {
-        v = f.proj_g0_;
-    } else if r < 8u {
-        v = f.proj_g1_;
-    }
-    return v[r % 4u];
-}
-
-// Column invariant at continuous column `x` of region `r`.
-fn proj_region_g(f: Frame, x: f32, r: u32, regions: u32, width: u32, spot: bool) -> f32 {
-    let b0 = f32(region_start(r, regions, width, spot));
-    let b1 = f32(region_start(r + 1u, regions, width, spot));
-    return mix(proj_boundary(f, r), proj_boundary(f, r + 1u), (x - b0) / (b1 - b0));
-}
-
-// Continuous column of column invariant `g` (outside the map: extrapolated from the first
-// or last region).
-fn proj_column(f: Frame, g: f32, regions: u32, width: u32, spot: bool) -> f32 {
-    var r = 0u;
-    for (; r + 1u < regions; r++) {
-        if g > proj_boundary(f, r + 1u) {
-            break;
-        }
-    }
-    let g0 = proj_boundary(f, r);
-    let g1 = proj_boundary(f, r + 1u);
-    let b0 = f32(region_start(r, regions, width, spot));
-    let b1 = f32(region_start(r + 1u, regions, width, spot));
-    return b0 + (b1 - b0) * (g0 - g) / (g0 - g1);
-}
-
-// qx where a view ray of depth `m` meets the light rays of invariant `g`: 1 / g (sun),
-// D / (g + m) (spot); `cap` when it never does or lies beyond `cap`.
-fn proj_reach(f: Frame, g: f32, m: f32, spot: bool, cap: f32) -> f32 {
-    var num = 1.0;
-    var den = g;
-    if spot {
-        num = f.axis[3];
-        den = g + m;
-    }
-    if den * cap <= num {
-        return cap;
-    }
-    return num / den;
-}
-
-// Normalised rectified depth of a view ray of depth `m` (lit iff it is <= the stored depth).
-fn proj_ray_depth(f: Frame, m: f32) -> f32 {
-    return DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp((f.proj[2] - m) * f.proj[3], 0.0, 1.0);
-}
-
-// Normalised rectified depth of a rasterised texel (clip z / w in [0, 1]).
-fn proj_stored_depth(raw: f32) -> f32 {
-    return DEPTH_MARGIN + (1.0 - 2.0 * DEPTH_MARGIN) * clamp(raw, 0.0, 1.0);
-}
-
-// Projective counterpart of `texel_weight` for column `i` of region `r`: the exact span of
-// the row's reference ray (direction e1 + k e2 + m_ref axis) that the texel covers, from the
-// projective map itself (Klehm's Eq. 12 assumes a constant growth factor per texel; the
-// spans of a perspective map grow hyperbolically, so the exact spans are used instead).
-// Column 0 also covers the ray from the eye to the map's first light ray.
-fn proj_texel_weight(f: Frame, s: SliceParams, i: u32, r: u32, regions: u32, weighted: bool, spot: bool) -> f32 {
-    let width = f.sizes[2];
-    let k = s.delta;
-    let m = s.theta_ref;
-    let len = sqrt(1.0 + k * k + m * m);
-    let cap = 4.0 * f.theta[2];
-    var t0 = 0.0;
-    if i > 0u {
-        t0 = proj_reach(f, proj_region_g(f, f32(i), r, regions, width, spot), m, spot, cap / len) * len;
-    }
-    let t1 = proj_reach(f, proj_region_g(f, f32(i + 1u), r, regions, width, spot), m, spot, cap / len) * len;
-    if !weighted {
-        return t1 - t0;
-    }
-    var w = transmittance_between(f.medium[0], t0, t1);
-    if spot {
-        let dir = (f.e1_.xyz + f.e2_.xyz * k + f.axis.xyz * m) / len;
-        let to = f.eye.xyz + dir * (0.5 * (t0 + t1)) - f.light_pos.xyz;
-        let dl = max(length(to), 1e-4);
-        let cone = max(cone_falloff(dot(to / dl, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]), CONE_FLOOR);
-        w *= cone * exp(-f.medium[0] * dl) / (dl * dl);
     }
     return w;
 }

@@ -1,5 +1,5 @@
 // scatter::raymarch: what the `raymarch` family's kernels (`raymarch`, `interleave_sum`)
-// share: the `March` uniform block, the pixel's view ray, the per-pixel jitter hash and the
+// share: the `RaymarchFrame` uniform block, the pixel's view ray, the per-pixel jitter hash and the
 // interleaving window.
 //
 // Composed into kernels by naga_oil (`#import scatter::raymarch::{...}`); plain WGSL, not an
@@ -10,9 +10,9 @@
 
 #import scatter::shadow::ShadowMapView
 
-// The uniform block (host: `scatter_frame::raymarch::MarchUniforms`, field by field; every
+// The uniform block (host: `scatter_frame::raymarch::RaymarchUniforms`, field by field; every
 // member is 16 bytes, 15 * 16 = 240 bytes in all).
-struct March {
+struct RaymarchFrame {
     // Eye position; w unused.
     eye: vec4<f32>,
     // Camera forward; w = tan(fov_y / 2).
@@ -46,12 +46,12 @@ struct March {
 }
 
 // The frame's standard shadow map (`scatter::shadow`).
-fn march_shadow_view(m: March) -> ShadowMapView {
+fn raymarch_shadow_view(m: RaymarchFrame) -> ShadowMapView {
     return ShadowMapView(m.sm_right, m.sm_up, m.sm_forward, m.sm_origin, m.sm_proj, vec4<u32>(m.sizes[2], 0u, 0u, 0u));
 }
 
 // Unit view direction through the centre of pixel (x, y).
-fn march_pixel_dir(m: March, x: u32, y: u32) -> vec3<f32> {
+fn raymarch_pixel_dir(m: RaymarchFrame, x: u32, y: u32) -> vec3<f32> {
     let ndc_x = 2.0 * (f32(x) + 0.5) / f32(m.sizes[0]) - 1.0;
     let ndc_y = 1.0 - 2.0 * (f32(y) + 0.5) / f32(m.sizes[1]);
     let t = m.cam_forward[3];

@@ -1,4 +1,4 @@
-// minmax_march ({{ light_name }} light): per pixel, in-scattered light by marching the pixel's
+// minmax_traverse ({{ light_name }} light): per pixel, in-scattered light by marching the pixel's
 // rectified row through its 1D min-max tree (Chen et al. 2011, Sec. 4): at each texel the
 // march climbs to the largest aligned node that fits in the rest of the ray, skips it whole
 // when it is wholly lit (d <= min) or wholly shadowed (d > max) for the ray's depth d, and
@@ -22,7 +22,7 @@
 // Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
 // (frame.sizes.xy); invocation id x = pixel column, y = pixel row.
 //
-// Mirrors reference/src/kernels/minmax_march.rs
+// Mirrors reference/src/kernels/minmax_traverse.rs
 
 #import scatter::model::{phase_hg, transmittance_between}
 #import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, slice_params, spot_segment}
@@ -54,7 +54,7 @@ fn lit_span(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, spot: bool
 
 // The kernel body for pixel `id`; stores the pixel's in-scattered radiance.
 @compute @workgroup_size(8, 8, 1)
-fn minmax_march(@builtin(global_invocation_id) id: vec3<u32>) {
+fn minmax_traverse(@builtin(global_invocation_id) id: vec3<u32>) {
     let f = frame;
     let x = id.x; let y = id.y;
     if x >= f.sizes[0] || y >= f.sizes[1] {

@@ -1,4 +1,4 @@
-//! CPU mirror of `shaderlib/templates/minmax_march.wgsl`: per pixel, the rectified row
+//! CPU mirror of `shaderlib/templates/minmax_traverse.wgsl`: per pixel, the rectified row
 //! marched through its 1D min-max tree (Chen et al. 2011), skipping nodes wholly lit or
 //! wholly shadowed for the ray's depth; pixels near the epipole or the anti-epipole
 //! ray-marched against the standard shadow map, as in `scatter`. Conventions and the
@@ -14,13 +14,13 @@ use super::common_epipolar::{
 };
 use super::common_minmax::{level_offset, tree_levels};
 use super::common_model::{clamp, max, max_u, min, phase_hg, transmittance_between};
-use super::common_prefiltered::{Tex, TexArray, quantise, xyz};
+use super::texture::{Tex, TexArray, quantise, xyz};
 use glam::Vec3;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{FrameUniforms, LightKind, SliceParams, Storage};
 
-/// The bindings of `minmax_march`.
-pub struct MarchInputs<'a> {
+/// The bindings of `minmax_traverse`.
+pub struct TraverseInputs<'a> {
     /// Frame uniforms.
     pub frame: &'a FrameUniforms,
     /// Per-slice table.
@@ -91,7 +91,7 @@ pub enum Pixel {
 }
 
 /// The kernel's pixel set-up for pixel `id` (None: out of range).
-pub fn pixel_ray(id: [u32; 3], spot: bool, inp: &MarchInputs) -> Option<Pixel> {
+pub fn pixel_ray(id: [u32; 3], spot: bool, inp: &TraverseInputs) -> Option<Pixel> {
     let f = inp.frame;
     let (x, y) = (id[0], id[1]);
     if x >= f.sizes[0] || y >= f.sizes[1] {
@@ -239,10 +239,10 @@ pub fn radiance(f: &FrameUniforms, r: &RowRay, total: f32, spot: bool) -> [f32; 
 
 /// The kernel body for pixel `id`; returns the rgba16float texel it stores (before
 /// rounding) and the tree nodes visited (0 for a marched pixel).
-pub fn minmax_march_main(
+pub fn minmax_traverse_main(
     id: [u32; 3],
     variant: &MinmaxVariant,
-    inp: &MarchInputs,
+    inp: &TraverseInputs,
 ) -> Option<([f32; 4], u32)> {
     let spot = variant.light == LightKind::Spot;
     Some(match pixel_ray(id, spot, inp)? {
@@ -254,12 +254,12 @@ pub fn minmax_march_main(
     })
 }
 
-/// The brute-force counterpart of [`minmax_march_main`]: the same pixel, its row walked
+/// The brute-force counterpart of [`minmax_traverse_main`]: the same pixel, its row walked
 /// texel by texel over `rectified` (not the tree).
 pub fn minmax_brute_main(
     id: [u32; 3],
     variant: &MinmaxVariant,
-    inp: &MarchInputs,
+    inp: &TraverseInputs,
     rectified: &Tex,
 ) -> Option<([f32; 4], u32)> {
     let spot = variant.light == LightKind::Spot;
@@ -274,7 +274,7 @@ pub fn minmax_brute_main(
 
 /// Per-pixel results of a whole-screen march.
 #[derive(Clone, Debug)]
-pub struct MarchImage {
+pub struct TraverseImage {
     /// Radiance as stored in rgba16float, screen-sized.
     pub output: TexArray,
     /// Radiance before rounding (f32), row-major.
@@ -286,14 +286,14 @@ pub struct MarchImage {
 fn run_pixels(
     f: &FrameUniforms,
     body: &(dyn Fn([u32; 3]) -> Option<([f32; 4], u32)> + Sync),
-) -> MarchImage {
+) -> TraverseImage {
     use rayon::prelude::*;
     let (w, h) = (f.sizes[0], f.sizes[1]);
     let results: Vec<([f32; 4], u32)> = (0..h)
         .into_par_iter()
         .flat_map_iter(|y| (0..w).map(move |x| body([x, y, 0]).unwrap_or(([0.0; 4], 0))))
         .collect();
-    MarchImage {
+    TraverseImage {
         output: TexArray {
             width: w,
             height: h,
@@ -309,12 +309,16 @@ fn run_pixels(
 }
 
 /// Runs every pixel through the tree (rows in parallel).
-pub fn minmax_march(variant: &MinmaxVariant, inp: &MarchInputs) -> MarchImage {
-    run_pixels(inp.frame, &|id| minmax_march_main(id, variant, inp))
+pub fn minmax_traverse(variant: &MinmaxVariant, inp: &TraverseInputs) -> TraverseImage {
+    run_pixels(inp.frame, &|id| minmax_traverse_main(id, variant, inp))
 }
 
 /// Runs every pixel through the brute-force march over `rectified` (rows in parallel).
-pub fn minmax_brute(variant: &MinmaxVariant, inp: &MarchInputs, rectified: &Tex) -> MarchImage {
+pub fn minmax_brute(
+    variant: &MinmaxVariant,
+    inp: &TraverseInputs,
+    rectified: &Tex,
+) -> TraverseImage {
     run_pixels(inp.frame, &|id| {
         minmax_brute_main(id, variant, inp, rectified)
     })
