@@ -117,13 +117,13 @@ fn sources<'p>(pass: &'p PassPlan, binding: u32) -> impl Iterator<Item = &'stati
         .flat_map(|s| std::iter::once(s.resource).chain(s.alternative.as_ref().map(|a| a.resource)))
 }
 
-/// The bind group layout entry of a reflected binding. Samplers are filtering when any
-/// sampler the plan binds there filters linearly.
-fn layout_entry(
+/// The bind group layout entry of a reflected binding. A sampler is filtering when
+/// `filtering(binding)` says so (in a plan: when any sampler the plan binds there filters
+/// linearly).
+pub(crate) fn layout_entry(
     kernel: Kernel,
-    pass: &PassPlan,
-    plan: &Plan,
     b: &Binding,
+    filtering: impl Fn(u32) -> bool,
 ) -> Result<wgpu::BindGroupLayoutEntry, RuntimeError> {
     let dimension = || {
         b.view_dimension.and_then(view_dimension).ok_or_else(|| {
@@ -184,16 +184,11 @@ fn layout_entry(
                 })?,
             view_dimension: dimension()?,
         },
-        BindingKind::Sampler => {
-            let filtering = sources(pass, b.binding)
-                .filter_map(|name| plan.resource(name).and_then(|r| r.sampler.as_ref()))
-                .any(|s| s.mag_filter == "linear" || s.min_filter == "linear");
-            wgpu::BindingType::Sampler(if filtering {
-                wgpu::SamplerBindingType::Filtering
-            } else {
-                wgpu::SamplerBindingType::NonFiltering
-            })
-        }
+        BindingKind::Sampler => wgpu::BindingType::Sampler(if filtering(b.binding) {
+            wgpu::SamplerBindingType::Filtering
+        } else {
+            wgpu::SamplerBindingType::NonFiltering
+        }),
         BindingKind::ComparisonSampler => {
             wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison)
         }
@@ -319,7 +314,13 @@ impl Executor {
         for (pass, (b, bindings, workgroups)) in plan.passes.iter().zip(staged) {
             let entries = bindings
                 .iter()
-                .map(|binding| layout_entry(pass.kernel, pass, &plan, binding))
+                .map(|binding| {
+                    layout_entry(pass.kernel, binding, |at| {
+                        sources(pass, at)
+                            .filter_map(|name| plan.resource(name).and_then(|r| r.sampler.as_ref()))
+                            .any(|s| s.mag_filter == "linear" || s.min_filter == "linear")
+                    })
+                })
                 .collect::<Result<Vec<_>, _>>()?;
             let pipeline = create_pipeline(device, b, &entries)?;
             passes.push(ExecPass {

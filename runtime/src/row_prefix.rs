@@ -1,13 +1,14 @@
 //! The `row_prefix` pass: pipeline, size checks against device limits, encoding, and a
 //! one-call upload-dispatch-readback helper ([`row_prefix`]) for tests and tools.
 
-use std::borrow::Cow;
 use std::fmt;
 use std::time::{Duration, Instant};
 
-use scatter_shaderlib::{Kernel, KernelParams, RowPrefixParams};
+use scatter_shaderlib::{Kernel, KernelParams, RowPrefixParams, reflect};
 
 use crate::error::ErrorScopes;
+use crate::executor::layout_entry;
+use crate::gpu::{Pipeline, create_pipeline};
 use crate::timer::read_buffer;
 use crate::{Context, GpuTimer, RuntimeError};
 
@@ -80,6 +81,10 @@ pub struct RowPrefixPass {
     params: RowPrefixParams,
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
+    /// The reflected binding of `input`.
+    input_binding: u32,
+    /// The reflected binding of `output`.
+    output_binding: u32,
 }
 
 impl RowPrefixPass {
@@ -107,55 +112,40 @@ impl RowPrefixPass {
             limits.max_compute_workgroup_size_x.into(),
         )?;
 
-        let device = ctx.device();
-        let scope = ErrorScopes::push(device);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(KERNEL.name()),
-            source: wgpu::ShaderSource::Naga(Cow::Owned(built.module)),
-        });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("row_prefix bindings"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: FORMAT,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("row_prefix"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("row_prefix"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(built.entry_point),
-            compilation_options: wgpu::PipelineCompilationOptions::default(),
-            cache: None,
-        });
-        scope.pop(KERNEL, "pipeline creation")?;
+        // The bind group layout from the bindings reflected out of the compiled kernel, as
+        // the executor builds every family's (no hand-written layout).
+        let reflection =
+            reflect::reflect(&built.module, &built.info, built.entry_point).map_err(|m| {
+                RuntimeError::Plan {
+                    kernel: KERNEL,
+                    message: format!("reflection failed: {m}"),
+                }
+            })?;
+        let binding_of = |name: &str| {
+            reflection
+                .bindings
+                .iter()
+                .find(|b| b.name == name)
+                .map(|b| b.binding)
+                .ok_or_else(|| RuntimeError::Plan {
+                    kernel: KERNEL,
+                    message: format!("the kernel has no binding named `{name}`"),
+                })
+        };
+        let input_binding = binding_of("input")?;
+        let output_binding = binding_of("output")?;
+        let entries = reflection
+            .bindings
+            .iter()
+            .map(|b| layout_entry(KERNEL, b, |_| false))
+            .collect::<Result<Vec<_>, _>>()?;
+        let Pipeline { layout, pipeline } = create_pipeline(ctx.device(), built, &entries)?;
         Ok(Self {
             params,
             layout,
             pipeline,
+            input_binding,
+            output_binding,
         })
     }
 
@@ -231,11 +221,11 @@ impl RowPrefixPass {
             layout: &self.layout,
             entries: &[
                 wgpu::BindGroupEntry {
-                    binding: 0,
+                    binding: self.input_binding,
                     resource: wgpu::BindingResource::TextureView(input),
                 },
                 wgpu::BindGroupEntry {
-                    binding: 1,
+                    binding: self.output_binding,
                     resource: wgpu::BindingResource::TextureView(output),
                 },
             ],
