@@ -4,6 +4,7 @@
 //! ```sh
 //! cargo run --release -p scatter-examples --example bench -- --out-dir docs/bench
 //! cargo run --release -p scatter-examples --example bench -- --quick --out-dir out/bench
+//! cargo run --release -p scatter-examples --example bench -- --headline-only
 //! ```
 
 use std::path::PathBuf;
@@ -29,6 +30,11 @@ struct Args {
     /// Skip the prefiltered scaling runs (rectified width 512..4096, screen sizes).
     #[arg(long)]
     no_scaling: bool,
+    /// Only the headline runs (1280x720, 1024x1024 rectified map, sphere, foliage and
+    /// terrain): per-pass wall times printed, no accuracy, no files written. For measuring
+    /// a kernel change before and after.
+    #[arg(long, conflicts_with_all = ["quick", "no_scaling"])]
+    headline_only: bool,
 }
 
 fn main() -> ExitCode {
@@ -44,6 +50,11 @@ fn main() -> ExitCode {
     if args.no_scaling {
         config.scaling = false;
     }
+    if args.headline_only {
+        config.cases.clear();
+        config.scaling = false;
+        config.headline = true;
+    }
     let command = std::env::args().collect::<Vec<_>>().join(" ");
     let result = Context::new()
         .map_err(|e| e.to_string())
@@ -52,12 +63,22 @@ fn main() -> ExitCode {
             run(&ctx, &config, true).map_err(|e| e.to_string())
         })
         .and_then(|r| {
+            if args.headline_only {
+                for line in scatter_examples::bench::headline_lines(&r) {
+                    println!("{line}");
+                }
+                return Ok((r, Vec::new()));
+            }
             write_outputs(&r, &args.out_dir, &command)
                 .map(|paths| (r, paths))
                 .map_err(|e| e.to_string())
         });
     match result {
         Ok((r, paths)) => {
+            if args.headline_only {
+                eprintln!("bench done in {:.1} s", r.elapsed.as_secs_f64());
+                return ExitCode::SUCCESS;
+            }
             for line in scatter_examples::bench::ratios(&r) {
                 println!("{line}");
             }

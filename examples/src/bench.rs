@@ -295,6 +295,29 @@ impl HeadlineRow {
     }
 }
 
+/// One line per headline run: family, knobs, scene, total and per-pass wall times (ms).
+pub fn headline_lines(result: &BenchResult) -> Vec<String> {
+    result
+        .headline
+        .iter()
+        .map(|h| {
+            let passes = h
+                .passes
+                .iter()
+                .map(|(name, d)| format!("{name} {:.1}", ms(*d)))
+                .collect::<Vec<_>>()
+                .join(", ");
+            format!(
+                "{} {} {}: {:.1} ms ({passes})",
+                h.family,
+                h.knobs,
+                h.scene,
+                ms(h.total())
+            )
+        })
+        .collect()
+}
+
 /// Everything a bench run measured.
 #[derive(Clone, Debug)]
 pub struct BenchResult {

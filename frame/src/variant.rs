@@ -45,7 +45,7 @@ pub enum Storage {
     Rgba8unorm,
     /// 16-bit float.
     Rgba16float,
-    /// 32-bit float (sampling it needs the FLOAT32_FILTERABLE feature).
+    /// 32-bit float.
     Rgba32float,
 }
 

@@ -174,7 +174,9 @@ impl Context {
     /// among the adapters found, discrete GPUs are preferred to integrated, virtual, other
     /// and finally CPU adapters. `WGPU_ADAPTER_NAME`, when set, keeps only adapters whose
     /// name contains it (case-insensitive). The device gets the adapter's limits and, where
-    /// the adapter has them, `TIMESTAMP_QUERY` (+ inside encoders) and `FLOAT32_FILTERABLE`.
+    /// the adapter has them, `TIMESTAMP_QUERY` (+ inside encoders). No kernel needs an
+    /// optional feature (the prefiltered bases are filtered by hand, so rgba32float needs no
+    /// `FLOAT32_FILTERABLE`).
     ///
     /// # Errors
     ///
@@ -213,10 +215,8 @@ impl Context {
                 },
             });
         };
-        // FLOAT32_FILTERABLE: the prefiltered family samples rgba32float bases with filtering.
-        let wanted_features = wgpu::Features::TIMESTAMP_QUERY
-            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
-            | wgpu::Features::FLOAT32_FILTERABLE;
+        let wanted_features =
+            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let required_features = adapter.features() & wanted_features;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("scatter"),

@@ -96,20 +96,6 @@ pub enum RuntimeError {
         /// The size of this frame's shadow map.
         actual: u32,
     },
-    /// The variant needs a device feature the adapter lacks.
-    #[error(
-        "kernel `{kernel}`: {what} needs the device feature {feature}, which adapter {adapter:?} lacks"
-    )]
-    MissingFeature {
-        /// The kernel.
-        kernel: Kernel,
-        /// What needs it, e.g. `storage = rgba32float`.
-        what: String,
-        /// The `wgpu::Features` flag.
-        feature: &'static str,
-        /// The adapter's name.
-        adapter: String,
-    },
     /// Too few rectified columns for the variant's prefix regions (the sun's regions split a
     /// row quadratically, so the first has `width / regions^2` columns).
     #[error(

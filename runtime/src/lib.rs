@@ -1,8 +1,7 @@
 //! `scatter-runtime`: a thin wgpu driver for the scatter kernels.
 //!
 //! [`Context`] picks an adapter (a real GPU when there is one, otherwise a CPU adapter such
-//! as lavapipe), reports which, and enables GPU timestamps and `FLOAT32_FILTERABLE` (filtered
-//! sampling of rgba32float) where the adapter has them;
+//! as lavapipe), reports which, and enables GPU timestamps where the adapter has them;
 //! [`Context::from_env`] applies the `SCATTER_GPU` policy that tests and tools share. Each
 //! kernel has a pass type that builds its pipeline from `scatter-shaderlib` and encodes it
 //! ([`RowPrefixPass`]), plus a one-call convenience for tests ([`row_prefix()`]). Kernel

@@ -141,7 +141,6 @@ impl Prefiltered {
     /// [`RuntimeError::InvalidVariant`] naming the knob; [`RuntimeError::EmptyInput`] for a
     /// zero size; [`RuntimeError::TooFewColumns`] when `Wr < regions^2`;
     /// [`RuntimeError::LimitExceeded`] naming the device limit;
-    /// [`RuntimeError::MissingFeature`] for `rgba32float` without `FLOAT32_FILTERABLE`;
     /// [`RuntimeError::Shader`] when a kernel does not build; [`RuntimeError::Wgpu`] when wgpu
     /// rejects a pipeline or resource. Nothing is created on the GPU unless every check
     /// passes.
@@ -195,21 +194,6 @@ impl Prefiltered {
             limits.max_texture_array_layers.into(),
         )?;
         check_frame_buffers(&limits, hr)?;
-        if variant.storage == Storage::Rgba32float
-            && !device
-                .features()
-                .contains(wgpu::Features::FLOAT32_FILTERABLE)
-        {
-            return Err(RuntimeError::MissingFeature {
-                kernel: SCATTER,
-                what: format!(
-                    "storage = {} (bilinear sampling of the filtered bases)",
-                    variant.storage
-                ),
-                feature: "FLOAT32_FILTERABLE",
-                adapter: ctx.report().name.clone(),
-            });
-        }
 
         // CPU work only: render, compose and validate the three kernels.
         let built = KernelParams::prefiltered(*variant)
@@ -408,9 +392,6 @@ impl Prefiltered {
             if inputs.shadow_map.is_none() {
                 conditions.push(plan::PROJECTIVE_WITHOUT_SHADOW_MAP);
             }
-        }
-        if frame.uniforms.anti_epipole[3] > 0.5 {
-            conditions.push(plan::WRAPPING_SLICES);
         }
         self.exec
             .encode(&self.device, encoder, &engine, &conditions, only)?;

@@ -25,13 +25,14 @@
 // | 1       | slices           | var<storage, read> array<vec4<f32>>      | read               |
 // | 2       | depth            | texture_2d<f32> (r32float, view depth)   | textureLoad        |
 // | 3       | shadow_map       | texture_2d<f32> (r32float)               | textureLoad        |
-// | 4       | filtered         | texture_2d_array<f32> (prefilter's)      | textureSampleLevel |
-// | 5       | filtered_sampler | sampler (filtering, linear)              | textureSampleLevel |
-// | 6       | output           | texture_storage_2d<rgba16float, write>   | textureStore       |
-// | 7       | bounds           | texture_2d<f32> (rg32float, prefilter's) | textureLoad        |
-// filtered: Wr x Hr x {{ layers }} layers, Wr x Hr = the rectified size (frame.sizes.zw).
-// filtered_sampler: clamp-to-edge in u; in v repeat when the slices wrap around
-// (frame.anti_epipole.w > 0.5), else clamp-to-edge.
+// | 4       | filtered         | texture_2d_array<f32> (prefilter's)      | textureLoad        |
+// | 5       | output           | texture_storage_2d<rgba16float, write>   | textureStore       |
+// | 6       | bounds           | texture_2d<f32> (rg32float, prefilter's) | textureLoad        |
+// filtered: Wr x Hr x {{ layers }} layers, Wr x Hr = the rectified size (frame.sizes.zw),
+// filtered bilinearly by hand (clamp-to-edge in u; in v wrapping round when the slices do,
+// frame.anti_epipole.w > 0.5, else clamp-to-edge): four texel loads per layer measured 1.9x
+// faster for the whole pass than a filtering sampler on lavapipe (1280x720, sphere), the
+// weights are exact floats, and rgba32float bases need no FLOAT32_FILTERABLE.
 //
 // Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
 // (frame.sizes.xy); invocation id x = pixel column, y = pixel row.
@@ -45,9 +46,9 @@
 //
 // Mirrors reference/src/kernels/scatter.rs
 
-#import scatter::model::{phase_hg, transmittance_between, transmittance_integral}
+#import scatter::model::{PI, phase_hg, transmittance_between, transmittance_integral}
 #import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, slice_params, spot_segment}
-#import scatter::prefiltered::{coeff4, region_start}
+#import scatter::prefiltered::{coeff4, fourier_step, region_start, turn}
 {%- if projective %}
 #import scatter::projective::{proj_boundary, proj_ray_depth, proj_reach}
 #import scatter::prefiltered_projective::proj_column
@@ -58,9 +59,8 @@
 @group(0) @binding(2) var depth: texture_2d<f32>;
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) var filtered: texture_2d_array<f32>;
-@group(0) @binding(5) var filtered_sampler: sampler;
-@group(0) @binding(6) var output: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(7) var bounds: texture_2d<f32>;
+@group(0) @binding(5) var output: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(6) var bounds: texture_2d<f32>;
 
 // Most regions a variant may have (the size of the per-pixel region arrays).
 const MAX_REGIONS: u32 = 8u;
@@ -154,8 +154,10 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
 
-    // The rectified rows the bilinear fetch blends (the second only with a non-zero weight).
+    // The rectified rows the bilinear fetch blends (the second only with a non-zero weight)
+    // and the weight of the second.
     let yb = yc - 0.5;
+    let fy = yb - floor(yb);
     let row0 = row_index(floor(yb), rows, wrap);
     let row1 = select(row0, row_index(floor(yb) + 1.0, rows, wrap), yb > floor(yb));
 
@@ -198,10 +200,14 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     // grazing spot, spot_grate/grazing/thick).
     let panels = max(f.sizes2_[2] / 4u, 1u);
     // The ray's Fourier coefficients depend on its depth only: once per pixel, not per
-    // region (they cost four sin/cos per layer).
+    // region, their angles c_k d by angle addition from pi d (two transcendentals per pixel).
     var coeffs: array<vec4<f32>, LAYERS>;
+    var angle = vec2<f32>(sin(PI * d), cos(PI * d));
+    let step = fourier_step(angle);
     for (var layer = 0u; layer < LAYERS; layer++) {
-        coeffs[layer] = coeff4(d, layer);
+        let second = turn(angle, step);
+        coeffs[layer] = coeff4(angle, second, layer);
+        angle = turn(second, step);
     }
     var total = 0.0;
     for (var r = 0u; r < count; r++) {
@@ -212,17 +218,18 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         } else {
             weight = f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_between(f.medium[0], a, b);
         }
-        // The depth bounds of the (up to) four texels the bilinear fetch reads with a non-zero
-        // weight.
+        // The (up to) four texels the bilinear fetch reads with a non-zero weight: columns
+        // x0 <= x1 of the region (pos[r] lies inside it), rows row0 and row1.
         let xb = pos[r] - 0.5;
+        let fx = xb - floor(xb);
         let x0 = u32(clamp(floor(xb), 0.0, f32(width) - 1.0));
         let x1 = select(x0, min(x0 + 1u, width - 1u), xb > floor(xb));
-        let b00 = textureLoad(bounds, vec2<u32>(x0, row0), 0);
-        let b01 = textureLoad(bounds, vec2<u32>(x1, row0), 0);
-        let b10 = textureLoad(bounds, vec2<u32>(x0, row1), 0);
-        let b11 = textureLoad(bounds, vec2<u32>(x1, row1), 0);
-        let lo = min(min(b00.x, b01.x), min(b10.x, b11.x));
-        let hi = max(max(b00.y, b01.y), max(b10.y, b11.y));
+        // Their depth bounds. A region's prefix bounds only widen along the row, so column
+        // x1's cover column x0's: two loads, not four.
+        let bounds0 = textureLoad(bounds, vec2<u32>(x1, row0), 0);
+        let bounds1 = textureLoad(bounds, vec2<u32>(x1, row1), 0);
+        let lo = min(bounds0.x, bounds1.x);
+        let hi = max(bounds0.y, bounds1.y);
         var vis = 0.5;
         if d <= lo {
             vis = 1.0;
@@ -231,7 +238,9 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         } else {
             for (var layer = 0u; layer < LAYERS; layer++) {
                 let coeff = coeffs[layer];
-                let texel = textureSampleLevel(filtered, filtered_sampler, vec2<f32>(pos[r] / f32(width), yc / f32(rows)), layer, 0.0);
+                let top = mix(textureLoad(filtered, vec2<u32>(x0, row0), layer, 0), textureLoad(filtered, vec2<u32>(x1, row0), layer, 0), fx);
+                let bottom = mix(textureLoad(filtered, vec2<u32>(x0, row1), layer, 0), textureLoad(filtered, vec2<u32>(x1, row1), layer, 0), fx);
+                let texel = mix(top, bottom, fy);
                 for (var k = 0u; k < 4u; k++) {
                     vis += coeff[k] * (texel[k] * 2.0 - 1.0);
                 }

@@ -268,9 +268,8 @@ fn bindings_match_the_documented_tables() {
                     b(2, "depth", &sampled(false)),
                     b(3, "shadow_map", &sampled(false)),
                     b(4, "filtered", &sampled(true)),
-                    b(5, "filtered_sampler", &"sampler cmp=false".to_owned()),
-                    b(6, "output", &storage(StorageFormat::Rgba16Float, false)),
-                    b(7, "bounds", &sampled(false)),
+                    b(5, "output", &storage(StorageFormat::Rgba16Float, false)),
+                    b(6, "bounds", &sampled(false)),
                 ]
             );
         }

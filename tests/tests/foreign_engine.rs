@@ -250,14 +250,6 @@ fn trial(ctx: &Context, variant: &Variant) -> Vec<String> {
                 "{name}::{target}"
             );
         }
-        let wraps = frame.uniforms.anti_epipole[3] > 0.5;
-        assert_eq!(
-            out.run
-                .alternatives
-                .contains(&"scatter 5 -> filtered_sampler_wrap".to_owned()),
-            wraps,
-            "{name}::{target}: sampler choice"
-        );
         let (diff, max, at) = compare(&out.radiance, &runtime.output);
         let rel = diff / max.max(f32::MIN_POSITIVE);
         let [w, _] = SCREEN;
@@ -902,7 +894,7 @@ fn manifest_conditions_are_machine_readable() {
             }
         }
     }
-    // Per projective variant: skip rectify, prefilter's map, the sampler; per epipolar
-    // variant: the sampler.
-    assert_eq!(buffer_conditions, 2 * 3 + 2, "buffer conditions");
+    // Per projective variant: skip rectify and prefilter's map; epipolar variants have none
+    // (scatter filters the bases by hand, so no sampler alternative depends on the frame).
+    assert_eq!(buffer_conditions, 2 * 2, "buffer conditions");
 }

@@ -49,11 +49,9 @@ fn device() -> Result<(wgpu::Device, wgpu::Queue, String), EngineError> {
     }))
     .map_err(|e| EngineError::NoDevice(e.to_string()))?;
     let info = adapter.get_info();
-    // rgba32float bases are sampled with filtering.
-    let features = adapter.features() & wgpu::Features::FLOAT32_FILTERABLE;
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         label: Some("scatter-foreign-engine"),
-        required_features: features,
+        required_features: wgpu::Features::empty(),
         required_limits: adapter.limits(),
         experimental_features: wgpu::ExperimentalFeatures::disabled(),
         memory_hints: wgpu::MemoryHints::Performance,

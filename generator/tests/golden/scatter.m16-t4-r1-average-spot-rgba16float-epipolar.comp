@@ -71,9 +71,9 @@ layout(binding = 3) uniform sampler2D _group_0_binding_3_cs;
 
 layout(binding = 4) uniform sampler2DArray _group_0_binding_4_cs;
 
-layout(binding = 6,rgba16f) writeonly uniform image2D _group_0_binding_6_cs;
+layout(binding = 5,rgba16f) writeonly uniform image2D _group_0_binding_5_cs;
 
-layout(binding = 7) uniform sampler2D _group_0_binding_7_cs;
+layout(binding = 6) uniform sampler2D _group_0_binding_6_cs;
 
 
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
@@ -216,11 +216,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir,
     vec3 x_6 = (eye + (dir * t));
     vec3 to_x = (x_6 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d_2 = sqrt(d2_);
-    vec3 travel = (to_x / vec3(d_2));
+    float d_1 = sqrt(d2_);
+    vec3 travel = (to_x / vec3(d_1));
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_1, float b_1, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
@@ -415,14 +415,22 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_X
     return (f_8.e1_.w + ((float(row) + 0.5) * f_8.e2_.w));
 }
 
+vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_4, vec2 b_4) {
+    return vec2(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+}
+
+vec2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 first) {
+    return vec2(((2.0 * first.x) * first.y), (1.0 - ((2.0 * first.x) * first.x)));
+}
+
 float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_3) {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_3) - 1u)));
 }
 
-vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d_1, uint layer_2) {
+vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_5, vec2 b_5, uint layer_2) {
     float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
     float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
-    return vec4(((2.0 / _e5) * cos((_e5 * d_1))), ((-2.0 / _e5) * sin((_e5 * d_1))), ((2.0 / _e10) * cos((_e10 * d_1))), ((-2.0 / _e10) * sin((_e10 * d_1))));
+    return vec4(((2.0 / _e5) * a_5.y), ((-2.0 / _e5) * a_5.x), ((2.0 / _e10) * b_5.y), ((-2.0 / _e10) * b_5.x));
 }
 
 uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_2, uint regions, uint width, bool spot_2) {
@@ -450,6 +458,7 @@ void main() {
     uint r = 0u;
     bool local_4 = false;
     vec4 coeffs[4] = vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
+    vec2 angle = vec2(0.0);
     uint layer = 0u;
     float total = 0.0;
     uint r_1 = 0u;
@@ -499,7 +508,7 @@ void main() {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = _group_0_binding_0_cs;
         float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, _group_0_binding_3_cs, eye_6, _e21, s_2, true);
         vec3 l_1 = (_e93 * color);
-        imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_7, y_2)), vec4(l_1.x, l_1.y, l_1.z, 1.0));
+        imageStore(_group_0_binding_5_cs, ivec2(uvec2(x_7, y_2)), vec4(l_1.x, l_1.y, l_1.z, 1.0));
         return;
     }
     vec3 axis = f_9.axis.xyz;
@@ -544,52 +553,53 @@ void main() {
     }
     float _e192 = yc;
     float yb = (_e192 - 0.5);
-    uint _e196 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    uint _e200 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e200 : _e196);
-    float _e204 = xs;
-    uint last = uint(min(max(_e204, 0.0), (float(width_1) - 1.0)));
+    float fy_1 = (yb - floor(yb));
+    uint _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    uint _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e202 : _e198);
+    float _e206 = xs;
+    uint last = uint(min(max(_e206, 0.0), (float(width_1) - 1.0)));
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e267 = r;
-            r = (_e267 + 1u);
+            uint _e269 = r;
+            r = (_e269 + 1u);
         }
         loop_init_3 = false;
-        uint _e214 = r;
-        if ((_e214 < REGIONS)) {
+        uint _e216 = r;
+        if ((_e216 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e216 = r;
-            uint _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, true);
-            float b0_ = float(_e217);
-            uint _e219 = r;
-            uint _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e219 + 1u), REGIONS, width_1, true);
-            float b1_ = float(_e222);
+            uint _e218 = r;
+            uint _e219 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, REGIONS, width_1, true);
+            float b0_ = float(_e219);
+            uint _e221 = r;
+            uint _e224 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e221 + 1u), REGIONS, width_1, true);
+            float b1_ = float(_e224);
             if (!((last < uint(b1_)))) {
-                uint _e227 = r;
-                local_4 = ((_e227 + 1u) == REGIONS);
+                uint _e229 = r;
+                local_4 = ((_e229 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             bool is_last = local_4;
-            uint _e236 = r;
-            float _e240 = xs;
-            pos[_e236] = (is_last ? clamp((_e240 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            uint _e250 = r;
-            float _e252 = delta;
-            float _e253 = theta;
-            float _e254 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e252, _e253, s_2, true);
-            t0_[_e250] = _e254;
-            uint _e256 = r;
-            float _e258 = delta;
-            float _e259 = theta;
-            float _e260 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e258, _e259, s_2, true);
-            t1_[_e256] = (is_last ? s_2 : _e260);
-            uint _e262 = r;
-            count = (_e262 + 1u);
+            uint _e238 = r;
+            float _e242 = xs;
+            pos[_e238] = (is_last ? clamp((_e242 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            uint _e252 = r;
+            float _e254 = delta;
+            float _e255 = theta;
+            float _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e254, _e255, s_2, true);
+            t0_[_e252] = _e256;
+            uint _e258 = r;
+            float _e260 = delta;
+            float _e261 = theta;
+            float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e260, _e261, s_2, true);
+            t1_[_e258] = (is_last ? s_2 : _e262);
+            uint _e264 = r;
+            count = (_e264 + 1u);
             if (is_last) {
                 break;
             }
@@ -597,131 +607,147 @@ void main() {
     }
     float cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
     uint panels_2 = max((f_9.sizes2_.z / 4u), 1u);
+    float _e282 = d;
+    float _e286 = d;
+    angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e282)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e286)));
+    vec2 _e291 = angle;
+    vec2 _e292 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e291);
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e290 = layer;
-            layer = (_e290 + 1u);
+            uint _e307 = layer;
+            layer = (_e307 + 1u);
         }
         loop_init_4 = false;
-        uint _e280 = layer;
-        if ((_e280 < LAYERS)) {
+        uint _e294 = layer;
+        if ((_e294 < LAYERS)) {
         } else {
             break;
         }
         {
-            uint _e284 = layer;
-            float _e286 = d;
-            uint _e287 = layer;
-            vec4 _e288 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e286, _e287);
-            coeffs[_e284] = _e288;
+            vec2 _e297 = angle;
+            vec2 _e298 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e297, _e292);
+            uint _e300 = layer;
+            vec2 _e302 = angle;
+            uint _e303 = layer;
+            vec4 _e304 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e302, _e298, _e303);
+            coeffs[_e300] = _e304;
+            vec2 _e305 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e298, _e292);
+            angle = _e305;
         }
     }
     bool loop_init_5 = true;
     while(true) {
         if (!loop_init_5) {
-            uint _e427 = r_1;
-            r_1 = (_e427 + 1u);
+            uint _e439 = r_1;
+            r_1 = (_e439 + 1u);
         }
         loop_init_5 = false;
-        uint _e293 = r_1;
-        uint _e294 = count;
-        if ((_e293 < _e294)) {
+        uint _e310 = r_1;
+        uint _e311 = count;
+        if ((_e310 < _e311)) {
         } else {
             break;
         }
         {
-            uint _e296 = r_1;
-            float a_4 = t0_[_e296];
-            uint _e299 = r_1;
-            float b_4 = t1_[_e299];
+            uint _e313 = r_1;
+            float a_6 = t0_[_e313];
+            uint _e316 = r_1;
+            float b_6 = t1_[_e316];
             weight = 0.0;
             if (true) {
-                float _e304 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_4, b_4, panels_2);
-                weight = _e304;
+                float _e321 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_6, b_6, panels_2);
+                weight = _e321;
             } else {
-                float _e309 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                float _e313 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
-                weight = ((f_9.medium.y * _e309) * _e313);
+                float _e326 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                float _e330 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_6);
+                weight = ((f_9.medium.y * _e326) * _e330);
             }
-            uint _e315 = r_1;
-            float _e317 = pos[_e315];
-            float xb = (_e317 - 0.5);
+            uint _e332 = r_1;
+            float _e334 = pos[_e332];
+            float xb = (_e334 - 0.5);
+            float fx = (xb - floor(xb));
             uint x0_ = uint(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
             uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
-            int _e338_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
-            vec4 b00_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x0_, _e196)), ivec2(0), textureSize(_group_0_binding_7_cs, _e338_clamped_lod) - ivec2(1)), _e338_clamped_lod);
-            int _e342_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
-            vec4 b01_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x1_, _e196)), ivec2(0), textureSize(_group_0_binding_7_cs, _e342_clamped_lod) - ivec2(1)), _e342_clamped_lod);
-            int _e346_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
-            vec4 b10_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x0_, row1_)), ivec2(0), textureSize(_group_0_binding_7_cs, _e346_clamped_lod) - ivec2(1)), _e346_clamped_lod);
-            int _e350_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_7_cs) - 1);
-            vec4 b11_ = texelFetch(_group_0_binding_7_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_7_cs, _e350_clamped_lod) - ivec2(1)), _e350_clamped_lod);
-            float lo_1 = min(min(b00_.x, b01_.x), min(b10_.x, b11_.x));
-            float hi_1 = max(max(b00_.y, b01_.y), max(b10_.y, b11_.y));
+            int _e357_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+            vec4 bounds0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, _e198)), ivec2(0), textureSize(_group_0_binding_6_cs, _e357_clamped_lod) - ivec2(1)), _e357_clamped_lod);
+            int _e361_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+            vec4 bounds1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e361_clamped_lod) - ivec2(1)), _e361_clamped_lod);
+            float lo_1 = min(bounds0_.x, bounds1_.x);
+            float hi_1 = max(bounds0_.y, bounds1_.y);
             vis = 0.5;
-            float _e367 = d;
-            if ((_e367 <= lo_1)) {
+            float _e370 = d;
+            if ((_e370 <= lo_1)) {
                 vis = 1.0;
             } else {
-                float _e370 = d;
-                if ((_e370 > hi_1)) {
+                float _e373 = d;
+                if ((_e373 > hi_1)) {
                     vis = 0.0;
                 } else {
                     layer_1 = 0u;
                     bool loop_init_6 = true;
                     while(true) {
                         if (!loop_init_6) {
-                            uint _e415 = layer_1;
-                            layer_1 = (_e415 + 1u);
+                            uint _e427 = layer_1;
+                            layer_1 = (_e427 + 1u);
                         }
                         loop_init_6 = false;
-                        uint _e375 = layer_1;
-                        if ((_e375 < LAYERS)) {
+                        uint _e378 = layer_1;
+                        if ((_e378 < LAYERS)) {
                         } else {
                             break;
                         }
                         {
-                            uint _e378 = layer_1;
-                            vec4 coeff = coeffs[_e378];
-                            uint _e381 = r_1;
-                            float _e383 = pos[_e381];
-                            float _e386 = yc;
+                            uint _e381 = layer_1;
+                            vec4 coeff = coeffs[_e381];
+                            uint _e385 = layer_1;
+                            int _e388_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e388 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, _e198), _e385), ivec3(0), textureSize(_group_0_binding_4_cs, _e388_clamped_lod) - ivec3(1)), _e388_clamped_lod);
                             uint _e390 = layer_1;
-                            vec4 texel_1 = textureLod(_group_0_binding_4_cs, vec3(vec2((_e383 / float(width_1)), (_e386 / float(rows_1))), _e390), 0.0);
+                            int _e393_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e393 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, _e198), _e390), ivec3(0), textureSize(_group_0_binding_4_cs, _e393_clamped_lod) - ivec3(1)), _e393_clamped_lod);
+                            vec4 top = mix(_e388, _e393, fx);
+                            uint _e396 = layer_1;
+                            int _e399_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e399 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row1_), _e396), ivec3(0), textureSize(_group_0_binding_4_cs, _e399_clamped_lod) - ivec3(1)), _e399_clamped_lod);
+                            uint _e401 = layer_1;
+                            int _e404_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e404 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row1_), _e401), ivec3(0), textureSize(_group_0_binding_4_cs, _e404_clamped_lod) - ivec3(1)), _e404_clamped_lod);
+                            vec4 bottom = mix(_e399, _e404, fx);
+                            vec4 texel_1 = mix(top, bottom, fy_1);
                             k = 0u;
                             bool loop_init_7 = true;
                             while(true) {
                                 if (!loop_init_7) {
-                                    uint _e412 = k;
-                                    k = (_e412 + 1u);
+                                    uint _e424 = k;
+                                    k = (_e424 + 1u);
                                 }
                                 loop_init_7 = false;
-                                uint _e397 = k;
-                                if ((_e397 < 4u)) {
+                                uint _e409 = k;
+                                if ((_e409 < 4u)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    float _e400 = vis;
-                                    uint _e401 = k;
-                                    uint _e403 = k;
-                                    vis = (_e400 + (coeff[_e401] * ((texel_1[_e403] * 2.0) - 1.0)));
+                                    float _e412 = vis;
+                                    uint _e413 = k;
+                                    uint _e415 = k;
+                                    vis = (_e412 + (coeff[_e413] * ((texel_1[_e415] * 2.0) - 1.0)));
                                 }
                             }
                         }
                     }
                 }
             }
-            float _e418 = total;
-            float _e419 = weight;
-            float _e420 = vis;
-            total = (_e418 + (_e419 * clamp(_e420, 0.0, 1.0)));
+            float _e430 = total;
+            float _e431 = weight;
+            float _e432 = vis;
+            total = (_e430 + (_e431 * clamp(_e432, 0.0, 1.0)));
         }
     }
     float l_2 = total;
     vec3 c = (color * l_2);
-    imageStore(_group_0_binding_6_cs, ivec2(uvec2(x_7, y_2)), vec4(c.x, c.y, c.z, 1.0));
+    imageStore(_group_0_binding_5_cs, ivec2(uvec2(x_7, y_2)), vec4(c.x, c.y, c.z, 1.0));
     return;
 }
 

@@ -71,12 +71,8 @@ ByteAddressBuffer slices : register(t1);
 Texture2D<float4> depth : register(t2);
 Texture2D<float4> shadow_map : register(t3);
 Texture2DArray<float4> filtered : register(t4);
-SamplerState nagaSamplerHeap[2048]: register(s0, space0);
-SamplerComparisonState nagaComparisonSamplerHeap[2048]: register(s0, space1);
-StructuredBuffer<uint> nagaGroup0SamplerIndexArray : register(t8, space0);
-static const SamplerState filtered_sampler = nagaSamplerHeap[nagaGroup0SamplerIndexArray[0]];
-RWTexture2D<float4> output : register(u6);
-Texture2D<float4> bounds : register(t7);
+RWTexture2D<float4> output : register(u5);
+Texture2D<float4> bounds : register(t6);
 
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
@@ -235,11 +231,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 
     float3 x_6 = (eye + (dir * t));
     float3 to_x = (x_6 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d_2 = sqrt(d2_);
-    float3 travel = (to_x / (d_2).xxx);
+    float d_1 = sqrt(d2_);
+    float3 travel = (to_x / (d_1).xxx);
     const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
@@ -502,16 +498,26 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_X
     return (f_8.e1_.w + ((float(row) + 0.5) * f_8.e2_.w));
 }
 
+float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_4, float2 b_4)
+{
+    return float2(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+}
+
+float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 first)
+{
+    return float2(((2.0 * first.x) * first.y), (1.0 - ((2.0 * first.x) * first.x)));
+}
+
 float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_3)
 {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_3) - 1u)));
 }
 
-float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d_1, uint layer_2)
+float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_5, float2 b_5, uint layer_2)
 {
     const float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
     const float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
-    return float4(((2.0 / _e5) * cos((_e5 * d_1))), ((-2.0 / _e5) * sin((_e5 * d_1))), ((2.0 / _e10) * cos((_e10 * d_1))), ((-2.0 / _e10) * sin((_e10 * d_1))));
+    return float4(((2.0 / _e5) * a_5.y), ((-2.0 / _e5) * a_5.x), ((2.0 / _e10) * b_5.y), ((-2.0 / _e10) * b_5.x));
 }
 
 uint naga_div(uint lhs, uint rhs) {
@@ -549,6 +555,7 @@ void scatter(uint3 id : SV_DispatchThreadID)
     uint r = 0u;
     bool local_4 = (bool)0;
     float4 coeffs[4] = (float4[4])0;
+    float2 angle = (float2)0;
     uint layer = 0u;
     float total = 0.0;
     uint r_1 = 0u;
@@ -643,55 +650,56 @@ void scatter(uint3 id : SV_DispatchThreadID)
     }
     float _e192 = yc;
     float yb = (_e192 - 0.5);
-    const uint _e196 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    const uint _e200 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e200 : _e196);
-    float _e204 = xs;
-    uint last = naga_f2u32(min(max(_e204, 0.0), (float(width_1) - 1.0)));
+    float fy_1 = (yb - floor(yb));
+    const uint _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    const uint _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e202 : _e198);
+    float _e206 = xs;
+    uint last = naga_f2u32(min(max(_e206, 0.0), (float(width_1) - 1.0)));
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e267 = r;
-            r = (_e267 + 1u);
+            uint _e269 = r;
+            r = (_e269 + 1u);
         }
         loop_init_3 = false;
-        uint _e214 = r;
-        if ((_e214 < REGIONS)) {
+        uint _e216 = r;
+        if ((_e216 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e216 = r;
-            const uint _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, true);
-            float b0_ = float(_e217);
-            uint _e219 = r;
-            const uint _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e219 + 1u), REGIONS, width_1, true);
-            float b1_ = float(_e222);
+            uint _e218 = r;
+            const uint _e219 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, REGIONS, width_1, true);
+            float b0_ = float(_e219);
+            uint _e221 = r;
+            const uint _e224 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e221 + 1u), REGIONS, width_1, true);
+            float b1_ = float(_e224);
             if (!((last < naga_f2u32(b1_)))) {
-                uint _e227 = r;
-                local_4 = ((_e227 + 1u) == REGIONS);
+                uint _e229 = r;
+                local_4 = ((_e229 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             bool is_last = local_4;
-            uint _e236 = r;
-            float _e240 = xs;
-            pos[min(uint(_e236), 7u)] = (is_last ? clamp((_e240 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            uint _e250 = r;
-            float _e252 = delta;
-            float _e253 = theta;
-            const float _e254 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e252, _e253, s_2, true);
-            t0_[min(uint(_e250), 7u)] = _e254;
-            uint _e256 = r;
-            float _e258 = delta;
-            float _e259 = theta;
-            const float _e260 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e258, _e259, s_2, true);
-            t1_[min(uint(_e256), 7u)] = (is_last ? s_2 : _e260);
-            uint _e262 = r;
-            count = (_e262 + 1u);
+            uint _e238 = r;
+            float _e242 = xs;
+            pos[min(uint(_e238), 7u)] = (is_last ? clamp((_e242 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            uint _e252 = r;
+            float _e254 = delta;
+            float _e255 = theta;
+            const float _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e254, _e255, s_2, true);
+            t0_[min(uint(_e252), 7u)] = _e256;
+            uint _e258 = r;
+            float _e260 = delta;
+            float _e261 = theta;
+            const float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e260, _e261, s_2, true);
+            t1_[min(uint(_e258), 7u)] = (is_last ? s_2 : _e262);
+            uint _e264 = r;
+            count = (_e264 + 1u);
             if (is_last) {
                 break;
             }
@@ -699,27 +707,36 @@ void scatter(uint3 id : SV_DispatchThreadID)
     }
     float cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
     uint panels_2 = max(naga_div(f_9.sizes2_.z, 4u), 1u);
+    float _e282 = d;
+    float _e286 = d;
+    angle = float2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e282)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e286)));
+    float2 _e291 = angle;
+    const float2 _e292 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e291);
     uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e290 = layer;
-            layer = (_e290 + 1u);
+            uint _e307 = layer;
+            layer = (_e307 + 1u);
         }
         loop_init_4 = false;
-        uint _e280 = layer;
-        if ((_e280 < LAYERS)) {
+        uint _e294 = layer;
+        if ((_e294 < LAYERS)) {
         } else {
             break;
         }
         {
-            uint _e284 = layer;
-            float _e286 = d;
-            uint _e287 = layer;
-            const float4 _e288 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e286, _e287);
-            coeffs[min(uint(_e284), 3u)] = _e288;
+            float2 _e297 = angle;
+            const float2 _e298 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e297, _e292);
+            uint _e300 = layer;
+            float2 _e302 = angle;
+            uint _e303 = layer;
+            const float4 _e304 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e302, _e298, _e303);
+            coeffs[min(uint(_e300), 3u)] = _e304;
+            const float2 _e305 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e298, _e292);
+            angle = _e305;
         }
     }
     uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
@@ -728,48 +745,47 @@ void scatter(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e427 = r_1;
-            r_1 = (_e427 + 1u);
+            uint _e439 = r_1;
+            r_1 = (_e439 + 1u);
         }
         loop_init_5 = false;
-        uint _e293 = r_1;
-        uint _e294 = count;
-        if ((_e293 < _e294)) {
+        uint _e310 = r_1;
+        uint _e311 = count;
+        if ((_e310 < _e311)) {
         } else {
             break;
         }
         {
-            uint _e296 = r_1;
-            float a_4 = t0_[min(uint(_e296), 7u)];
-            uint _e299 = r_1;
-            float b_4 = t1_[min(uint(_e299), 7u)];
+            uint _e313 = r_1;
+            float a_6 = t0_[min(uint(_e313), 7u)];
+            uint _e316 = r_1;
+            float b_6 = t1_[min(uint(_e316), 7u)];
             weight = ZeroValuefloat();
             if (true) {
-                const float _e304 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_4, b_4, panels_2);
-                weight = _e304;
+                const float _e321 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_6, b_6, panels_2);
+                weight = _e321;
             } else {
-                const float _e309 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                const float _e313 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
-                weight = ((f_9.medium.y * _e309) * _e313);
+                const float _e326 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                const float _e330 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_6);
+                weight = ((f_9.medium.y * _e326) * _e330);
             }
-            uint _e315 = r_1;
-            float _e317 = pos[min(uint(_e315), 7u)];
-            float xb = (_e317 - 0.5);
+            uint _e332 = r_1;
+            float _e334 = pos[min(uint(_e332), 7u)];
+            float xb = (_e334 - 0.5);
+            float fx = (xb - floor(xb));
             uint x0_ = naga_f2u32(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
             uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
-            float4 b00_ = bounds.Load(int3(uint2(x0_, _e196), int(0)));
-            float4 b01_ = bounds.Load(int3(uint2(x1_, _e196), int(0)));
-            float4 b10_ = bounds.Load(int3(uint2(x0_, row1_), int(0)));
-            float4 b11_ = bounds.Load(int3(uint2(x1_, row1_), int(0)));
-            float lo_1 = min(min(b00_.x, b01_.x), min(b10_.x, b11_.x));
-            float hi_1 = max(max(b00_.y, b01_.y), max(b10_.y, b11_.y));
+            float4 bounds0_ = bounds.Load(int3(uint2(x1_, _e198), int(0)));
+            float4 bounds1_ = bounds.Load(int3(uint2(x1_, row1_), int(0)));
+            float lo_1 = min(bounds0_.x, bounds1_.x);
+            float hi_1 = max(bounds0_.y, bounds1_.y);
             vis = 0.5;
-            float _e367 = d;
-            if ((_e367 <= lo_1)) {
+            float _e370 = d;
+            if ((_e370 <= lo_1)) {
                 vis = 1.0;
             } else {
-                float _e370 = d;
-                if ((_e370 > hi_1)) {
+                float _e373 = d;
+                if ((_e373 > hi_1)) {
                     vis = 0.0;
                 } else {
                     layer_1 = 0u;
@@ -779,23 +795,29 @@ void scatter(uint3 id : SV_DispatchThreadID)
                         if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
                         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                         if (!loop_init_6) {
-                            uint _e415 = layer_1;
-                            layer_1 = (_e415 + 1u);
+                            uint _e427 = layer_1;
+                            layer_1 = (_e427 + 1u);
                         }
                         loop_init_6 = false;
-                        uint _e375 = layer_1;
-                        if ((_e375 < LAYERS)) {
+                        uint _e378 = layer_1;
+                        if ((_e378 < LAYERS)) {
                         } else {
                             break;
                         }
                         {
-                            uint _e378 = layer_1;
-                            float4 coeff = coeffs[min(uint(_e378), 3u)];
-                            uint _e381 = r_1;
-                            float _e383 = pos[min(uint(_e381), 7u)];
-                            float _e386 = yc;
+                            uint _e381 = layer_1;
+                            float4 coeff = coeffs[min(uint(_e381), 3u)];
+                            uint _e385 = layer_1;
+                            float4 _e388 = filtered.Load(int4(uint2(x0_, _e198), _e385, int(0)));
                             uint _e390 = layer_1;
-                            float4 texel_1 = filtered.SampleLevel(filtered_sampler, float3(float2((_e383 / float(width_1)), (_e386 / float(rows_1))), _e390), 0.0);
+                            float4 _e393 = filtered.Load(int4(uint2(x1_, _e198), _e390, int(0)));
+                            float4 top = lerp(_e388, _e393, fx);
+                            uint _e396 = layer_1;
+                            float4 _e399 = filtered.Load(int4(uint2(x0_, row1_), _e396, int(0)));
+                            uint _e401 = layer_1;
+                            float4 _e404 = filtered.Load(int4(uint2(x1_, row1_), _e401, int(0)));
+                            float4 bottom = lerp(_e399, _e404, fx);
+                            float4 texel_1 = lerp(top, bottom, fy_1);
                             k = 0u;
                             uint2 loop_bound_7 = uint2(4294967295u, 4294967295u);
                             bool loop_init_7 = true;
@@ -803,30 +825,30 @@ void scatter(uint3 id : SV_DispatchThreadID)
                                 if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
                                 loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
                                 if (!loop_init_7) {
-                                    uint _e412 = k;
-                                    k = (_e412 + 1u);
+                                    uint _e424 = k;
+                                    k = (_e424 + 1u);
                                 }
                                 loop_init_7 = false;
-                                uint _e397 = k;
-                                if ((_e397 < 4u)) {
+                                uint _e409 = k;
+                                if ((_e409 < 4u)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    float _e400 = vis;
-                                    uint _e401 = k;
-                                    uint _e403 = k;
-                                    vis = (_e400 + (coeff[min(uint(_e401), 3u)] * ((texel_1[min(uint(_e403), 3u)] * 2.0) - 1.0)));
+                                    float _e412 = vis;
+                                    uint _e413 = k;
+                                    uint _e415 = k;
+                                    vis = (_e412 + (coeff[min(uint(_e413), 3u)] * ((texel_1[min(uint(_e415), 3u)] * 2.0) - 1.0)));
                                 }
                             }
                         }
                     }
                 }
             }
-            float _e418 = total;
-            float _e419 = weight;
-            float _e420 = vis;
-            total = (_e418 + (_e419 * clamp(_e420, 0.0, 1.0)));
+            float _e430 = total;
+            float _e431 = weight;
+            float _e432 = vis;
+            total = (_e430 + (_e431 * clamp(_e432, 0.0, 1.0)));
         }
     }
     float l_2 = total;

@@ -61,10 +61,10 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_hi;
 };
 typedef metal::float4 type_10[1];
-struct type_15 {
+struct type_14 {
     float inner[8];
 };
-struct type_16 {
+struct type_15 {
     metal::float4 inner[8];
 };
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
@@ -265,11 +265,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 x_6 = eye + (dir * t);
     metal::float3 to_x = x_6 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
-    float d_2 = metal::sqrt(d2_);
-    metal::float3 travel = to_x / metal::float3(d_2);
+    float d_1 = metal::sqrt(d2_);
+    metal::float3 travel = to_x / metal::float3(d_1);
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_2 + t))) / d2_;
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_1 + t))) / d2_;
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -555,6 +555,19 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return f_8.e1_.w + ((static_cast<float>(row) + 0.5) * f_8.e2_.w);
 }
 
+metal::float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    metal::float2 a_4,
+    metal::float2 b_4
+) {
+    return metal::float2((a_4.x * b_4.y) + (a_4.y * b_4.x), (a_4.y * b_4.y) - (a_4.x * b_4.x));
+}
+
+metal::float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    metal::float2 first
+) {
+    return metal::float2((2.0 * first.x) * first.y, 1.0 - ((2.0 * first.x) * first.x));
+}
+
 float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     uint k_3
 ) {
@@ -562,12 +575,13 @@ float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 }
 
 metal::float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    float d_1,
+    metal::float2 a_5,
+    metal::float2 b_5,
     uint layer_2
 ) {
     float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_2) + 1u);
     float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_2) + 2u);
-    return metal::float4((2.0 / _e5) * metal::cos(_e5 * d_1), (-2.0 / _e5) * metal::sin(_e5 * d_1), (2.0 / _e10) * metal::cos(_e10 * d_1), (-2.0 / _e10) * metal::sin(_e10 * d_1));
+    return metal::float4((2.0 / _e5) * a_5.y, (-2.0 / _e5) * a_5.x, (2.0 / _e10) * b_5.y, (-2.0 / _e10) * b_5.x);
 }
 
 uint naga_div(uint lhs, uint rhs) {
@@ -595,7 +609,6 @@ kernel void scatter(
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
 , metal::texture2d_array<float, metal::access::sample> filtered [[texture(2)]]
-, metal::sampler filtered_sampler [[sampler(0)]]
 , metal::texture2d<float, metal::access::write> output [[texture(3)]]
 , metal::texture2d<float, metal::access::sample> bounds [[texture(4)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
@@ -609,13 +622,14 @@ kernel void scatter(
     float xs = {};
     float delta = 1.0;
     float theta = 0.0;
-    type_15 pos = {};
-    type_15 t0_ = {};
-    type_15 t1_ = {};
+    type_14 pos = {};
+    type_14 t0_ = {};
+    type_14 t1_ = {};
     uint count = 0u;
     uint r = 0u;
     bool local_4 = {};
-    type_16 coeffs = {};
+    type_15 coeffs = {};
+    metal::float2 angle = {};
     uint layer = 0u;
     float total = 0.0;
     uint r_1 = 0u;
@@ -710,55 +724,56 @@ kernel void scatter(
     }
     float _e192 = yc;
     float yb = _e192 - 0.5;
-    uint _e196 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
-    uint _e200 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
-    uint row1_ = (yb > metal::floor(yb)) ? _e200 : _e196;
-    float _e204 = xs;
-    uint last = naga_f2u32(metal::min(metal::max(_e204, 0.0), static_cast<float>(width_1) - 1.0));
+    float fy_1 = yb - metal::floor(yb);
+    uint _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
+    uint _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
+    uint row1_ = (yb > metal::floor(yb)) ? _e202 : _e198;
+    float _e206 = xs;
+    uint last = naga_f2u32(metal::min(metal::max(_e206, 0.0), static_cast<float>(width_1) - 1.0));
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e267 = r;
-            r = _e267 + 1u;
+            uint _e269 = r;
+            r = _e269 + 1u;
         }
         loop_init_3 = false;
-        uint _e214 = r;
-        if (_e214 < REGIONS) {
+        uint _e216 = r;
+        if (_e216 < REGIONS) {
         } else {
             break;
         }
         {
-            uint _e216 = r;
-            uint _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, false);
-            float b0_ = static_cast<float>(_e217);
-            uint _e219 = r;
-            uint _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e219 + 1u, REGIONS, width_1, false);
-            float b1_ = static_cast<float>(_e222);
+            uint _e218 = r;
+            uint _e219 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, REGIONS, width_1, false);
+            float b0_ = static_cast<float>(_e219);
+            uint _e221 = r;
+            uint _e224 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e221 + 1u, REGIONS, width_1, false);
+            float b1_ = static_cast<float>(_e224);
             if (!((last < naga_f2u32(b1_)))) {
-                uint _e227 = r;
-                local_4 = (_e227 + 1u) == REGIONS;
+                uint _e229 = r;
+                local_4 = (_e229 + 1u) == REGIONS;
             } else {
                 local_4 = true;
             }
             bool is_last = local_4;
-            uint _e236 = r;
-            float _e240 = xs;
-            pos.inner[metal::min(unsigned(_e236), 7u)] = is_last ? metal::clamp(_e240 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-            uint _e250 = r;
-            float _e252 = delta;
-            float _e253 = theta;
-            float _e254 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e252, _e253, s_2, false);
-            t0_.inner[metal::min(unsigned(_e250), 7u)] = _e254;
-            uint _e256 = r;
-            float _e258 = delta;
-            float _e259 = theta;
-            float _e260 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e258, _e259, s_2, false);
-            t1_.inner[metal::min(unsigned(_e256), 7u)] = is_last ? s_2 : _e260;
-            uint _e262 = r;
-            count = _e262 + 1u;
+            uint _e238 = r;
+            float _e242 = xs;
+            pos.inner[metal::min(unsigned(_e238), 7u)] = is_last ? metal::clamp(_e242 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            uint _e252 = r;
+            float _e254 = delta;
+            float _e255 = theta;
+            float _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e254, _e255, s_2, false);
+            t0_.inner[metal::min(unsigned(_e252), 7u)] = _e256;
+            uint _e258 = r;
+            float _e260 = delta;
+            float _e261 = theta;
+            float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e260, _e261, s_2, false);
+            t1_.inner[metal::min(unsigned(_e258), 7u)] = is_last ? s_2 : _e262;
+            uint _e264 = r;
+            count = _e264 + 1u;
             if (is_last) {
                 break;
             }
@@ -766,27 +781,36 @@ kernel void scatter(
     }
     float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e21));
     uint panels_2 = metal::max(naga_div(f_9.sizes2_.z, 4u), 1u);
+    float _e282 = d;
+    float _e286 = d;
+    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e282), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e286));
+    metal::float2 _e291 = angle;
+    metal::float2 _e292 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e291);
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e290 = layer;
-            layer = _e290 + 1u;
+            uint _e307 = layer;
+            layer = _e307 + 1u;
         }
         loop_init_4 = false;
-        uint _e280 = layer;
-        if (_e280 < LAYERS) {
+        uint _e294 = layer;
+        if (_e294 < LAYERS) {
         } else {
             break;
         }
         {
-            uint _e284 = layer;
-            float _e286 = d;
-            uint _e287 = layer;
-            metal::float4 _e288 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e286, _e287);
-            coeffs.inner[metal::min(unsigned(_e284), 7u)] = _e288;
+            metal::float2 _e297 = angle;
+            metal::float2 _e298 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e297, _e292);
+            uint _e300 = layer;
+            metal::float2 _e302 = angle;
+            uint _e303 = layer;
+            metal::float4 _e304 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e302, _e298, _e303);
+            coeffs.inner[metal::min(unsigned(_e300), 7u)] = _e304;
+            metal::float2 _e305 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e298, _e292);
+            angle = _e305;
         }
     }
     uint2 loop_bound_5 = uint2(4294967295u);
@@ -795,52 +819,49 @@ kernel void scatter(
         if (metal::all(loop_bound_5 == uint2(0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e427 = r_1;
-            r_1 = _e427 + 1u;
+            uint _e439 = r_1;
+            r_1 = _e439 + 1u;
         }
         loop_init_5 = false;
-        uint _e293 = r_1;
-        uint _e294 = count;
-        if (_e293 < _e294) {
+        uint _e310 = r_1;
+        uint _e311 = count;
+        if (_e310 < _e311) {
         } else {
             break;
         }
         {
-            uint _e296 = r_1;
-            float a_4 = t0_.inner[metal::min(unsigned(_e296), 7u)];
-            uint _e299 = r_1;
-            float b_4 = t1_.inner[metal::min(unsigned(_e299), 7u)];
+            uint _e313 = r_1;
+            float a_6 = t0_.inner[metal::min(unsigned(_e313), 7u)];
+            uint _e316 = r_1;
+            float b_6 = t1_.inner[metal::min(unsigned(_e316), 7u)];
             weight = float {};
             if (false) {
-                float _e304 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_4, b_4, panels_2);
-                weight = _e304;
+                float _e321 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_6, b_6, panels_2);
+                weight = _e321;
             } else {
-                float _e309 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                float _e313 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
-                weight = (f_9.medium.y * _e309) * _e313;
+                float _e326 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                float _e330 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_6);
+                weight = (f_9.medium.y * _e326) * _e330;
             }
-            uint _e315 = r_1;
-            float _e317 = pos.inner[metal::min(unsigned(_e315), 7u)];
-            float xb = _e317 - 0.5;
+            uint _e332 = r_1;
+            float _e334 = pos.inner[metal::min(unsigned(_e332), 7u)];
+            float xb = _e334 - 0.5;
+            float fx = xb - metal::floor(xb);
             uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
             uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
-            uint clamped_lod_e338 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 b00_ = bounds.read(metal::min(metal::uint2(metal::uint2(x0_, _e196)), metal::uint2(bounds.get_width(clamped_lod_e338), bounds.get_height(clamped_lod_e338)) - 1), clamped_lod_e338);
-            uint clamped_lod_e342 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 b01_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e196)), metal::uint2(bounds.get_width(clamped_lod_e342), bounds.get_height(clamped_lod_e342)) - 1), clamped_lod_e342);
-            uint clamped_lod_e346 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 b10_ = bounds.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e346), bounds.get_height(clamped_lod_e346)) - 1), clamped_lod_e346);
-            uint clamped_lod_e350 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 b11_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e350), bounds.get_height(clamped_lod_e350)) - 1), clamped_lod_e350);
-            float lo_1 = metal::min(metal::min(b00_.x, b01_.x), metal::min(b10_.x, b11_.x));
-            float hi_1 = metal::max(metal::max(b00_.y, b01_.y), metal::max(b10_.y, b11_.y));
+            uint clamped_lod_e357 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 bounds0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(bounds.get_width(clamped_lod_e357), bounds.get_height(clamped_lod_e357)) - 1), clamped_lod_e357);
+            uint clamped_lod_e361 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 bounds1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e361), bounds.get_height(clamped_lod_e361)) - 1), clamped_lod_e361);
+            float lo_1 = metal::min(bounds0_.x, bounds1_.x);
+            float hi_1 = metal::max(bounds0_.y, bounds1_.y);
             vis = 0.5;
-            float _e367 = d;
-            if (_e367 <= lo_1) {
+            float _e370 = d;
+            if (_e370 <= lo_1) {
                 vis = 1.0;
             } else {
-                float _e370 = d;
-                if (_e370 > hi_1) {
+                float _e373 = d;
+                if (_e373 > hi_1) {
                     vis = 0.0;
                 } else {
                     layer_1 = 0u;
@@ -850,23 +871,33 @@ kernel void scatter(
                         if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                         if (!loop_init_6) {
-                            uint _e415 = layer_1;
-                            layer_1 = _e415 + 1u;
+                            uint _e427 = layer_1;
+                            layer_1 = _e427 + 1u;
                         }
                         loop_init_6 = false;
-                        uint _e375 = layer_1;
-                        if (_e375 < LAYERS) {
+                        uint _e378 = layer_1;
+                        if (_e378 < LAYERS) {
                         } else {
                             break;
                         }
                         {
-                            uint _e378 = layer_1;
-                            metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e378), 7u)];
-                            uint _e381 = r_1;
-                            float _e383 = pos.inner[metal::min(unsigned(_e381), 7u)];
-                            float _e386 = yc;
+                            uint _e381 = layer_1;
+                            metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e381), 7u)];
+                            uint _e385 = layer_1;
+                            uint clamped_lod_e388 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e388 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e388), filtered.get_height(clamped_lod_e388)) - 1), metal::min(uint(_e385), filtered.get_array_size() - 1), clamped_lod_e388);
                             uint _e390 = layer_1;
-                            metal::float4 texel_1 = filtered.sample(filtered_sampler, metal::float2(_e383 / static_cast<float>(width_1), _e386 / static_cast<float>(rows_1)), _e390, metal::level(0.0));
+                            uint clamped_lod_e393 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e393 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e393), filtered.get_height(clamped_lod_e393)) - 1), metal::min(uint(_e390), filtered.get_array_size() - 1), clamped_lod_e393);
+                            metal::float4 top = metal::mix(_e388, _e393, fx);
+                            uint _e396 = layer_1;
+                            uint clamped_lod_e399 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e399 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e399), filtered.get_height(clamped_lod_e399)) - 1), metal::min(uint(_e396), filtered.get_array_size() - 1), clamped_lod_e399);
+                            uint _e401 = layer_1;
+                            uint clamped_lod_e404 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e404 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e404), filtered.get_height(clamped_lod_e404)) - 1), metal::min(uint(_e401), filtered.get_array_size() - 1), clamped_lod_e404);
+                            metal::float4 bottom = metal::mix(_e399, _e404, fx);
+                            metal::float4 texel_1 = metal::mix(top, bottom, fy_1);
                             k = 0u;
                             uint2 loop_bound_7 = uint2(4294967295u);
                             bool loop_init_7 = true;
@@ -874,30 +905,30 @@ kernel void scatter(
                                 if (metal::all(loop_bound_7 == uint2(0u))) { break; }
                                 loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
                                 if (!loop_init_7) {
-                                    uint _e412 = k;
-                                    k = _e412 + 1u;
+                                    uint _e424 = k;
+                                    k = _e424 + 1u;
                                 }
                                 loop_init_7 = false;
-                                uint _e397 = k;
-                                if (_e397 < 4u) {
+                                uint _e409 = k;
+                                if (_e409 < 4u) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    float _e400 = vis;
-                                    uint _e401 = k;
-                                    uint _e403 = k;
-                                    vis = _e400 + (coeff[metal::min(unsigned(_e401), 3u)] * ((texel_1[metal::min(unsigned(_e403), 3u)] * 2.0) - 1.0));
+                                    float _e412 = vis;
+                                    uint _e413 = k;
+                                    uint _e415 = k;
+                                    vis = _e412 + (coeff[metal::min(unsigned(_e413), 3u)] * ((texel_1[metal::min(unsigned(_e415), 3u)] * 2.0) - 1.0));
                                 }
                             }
                         }
                     }
                 }
             }
-            float _e418 = total;
-            float _e419 = weight;
-            float _e420 = vis;
-            total = _e418 + (_e419 * metal::clamp(_e420, 0.0, 1.0));
+            float _e430 = total;
+            float _e431 = weight;
+            float _e432 = vis;
+            total = _e430 + (_e431 * metal::clamp(_e432, 0.0, 1.0));
         }
     }
     float l_2 = total;

@@ -71,10 +71,8 @@ var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) 
 var filtered: texture_2d_array<f32>;
 @group(0) @binding(5) 
-var filtered_sampler: sampler;
-@group(0) @binding(6) 
 var output: texture_storage_2d<rgba16float,write>;
-@group(0) @binding(7) 
+@group(0) @binding(6) 
 var bounds: texture_2d<f32>;
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
@@ -219,11 +217,11 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     let x_6 = (eye + (dir * t));
     let to_x = (x_6 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
-    let d_2 = sqrt(d2_);
-    let travel = (to_x / vec3(d_2));
+    let d_1 = sqrt(d2_);
+    let travel = (to_x / vec3(d_1));
     let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
 }
 
 fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
@@ -415,14 +413,22 @@ fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod
     return (f_8.e1_.w + ((f32(row) + 0.5f) * f_8.e2_.w));
 }
 
+fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_4: vec2<f32>, b_4: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+}
+
+fn fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(first: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(((2f * first.x) * first.y), (1f - ((2f * first.x) * first.x)));
+}
+
 fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_3: u32) -> f32 {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_3) - 1u)));
 }
 
-fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_1: f32, layer_2: u32) -> vec4<f32> {
+fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_5: vec2<f32>, layer_2: u32) -> vec4<f32> {
     let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
     let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
-    return vec4<f32>(((2f / _e5) * cos((_e5 * d_1))), ((-2f / _e5) * sin((_e5 * d_1))), ((2f / _e10) * cos((_e10 * d_1))), ((-2f / _e10) * sin((_e10 * d_1))));
+    return vec4<f32>(((2f / _e5) * a_5.y), ((-2f / _e5) * a_5.x), ((2f / _e10) * b_5.y), ((-2f / _e10) * b_5.x));
 }
 
 fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_2: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
@@ -450,6 +456,7 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     var r: u32 = 0u;
     var local_4: bool;
     var coeffs: array<vec4<f32>, 8>;
+    var angle: vec2<f32>;
     var layer: u32 = 0u;
     var total: f32 = 0f;
     var r_1: u32 = 0u;
@@ -544,165 +551,180 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let _e192 = yc;
     let yb = (_e192 - 0.5f);
-    let _e196 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    let _e200 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
-    let row1_ = select(_e196, _e200, (yb > floor(yb)));
-    let _e204 = xs;
-    let last = u32(min(max(_e204, 0f), (f32(width_1) - 1f)));
+    let fy_1 = (yb - floor(yb));
+    let _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    let _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
+    let row1_ = select(_e198, _e202, (yb > floor(yb)));
+    let _e206 = xs;
+    let last = u32(min(max(_e206, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e214 = r;
-        if (_e214 < REGIONS) {
+        let _e216 = r;
+        if (_e216 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e216 = r;
-            let _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, false);
-            let b0_ = f32(_e217);
-            let _e219 = r;
-            let _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e219 + 1u), REGIONS, width_1, false);
-            let b1_ = f32(_e222);
+            let _e218 = r;
+            let _e219 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, REGIONS, width_1, false);
+            let b0_ = f32(_e219);
+            let _e221 = r;
+            let _e224 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e221 + 1u), REGIONS, width_1, false);
+            let b1_ = f32(_e224);
             if !((last < u32(b1_))) {
-                let _e227 = r;
-                local_4 = ((_e227 + 1u) == REGIONS);
+                let _e229 = r;
+                local_4 = ((_e229 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             let is_last = local_4;
-            let _e236 = r;
-            let _e240 = xs;
-            pos[_e236] = select((b1_ - 0.5f), clamp((_e240 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
-            let _e250 = r;
-            let _e252 = delta;
-            let _e253 = theta;
-            let _e254 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e252, _e253, s_2, false);
-            t0_[_e250] = _e254;
-            let _e256 = r;
-            let _e258 = delta;
-            let _e259 = theta;
-            let _e260 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e258, _e259, s_2, false);
-            t1_[_e256] = select(_e260, s_2, is_last);
-            let _e262 = r;
-            count = (_e262 + 1u);
+            let _e238 = r;
+            let _e242 = xs;
+            pos[_e238] = select((b1_ - 0.5f), clamp((_e242 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
+            let _e252 = r;
+            let _e254 = delta;
+            let _e255 = theta;
+            let _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e254, _e255, s_2, false);
+            t0_[_e252] = _e256;
+            let _e258 = r;
+            let _e260 = delta;
+            let _e261 = theta;
+            let _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e260, _e261, s_2, false);
+            t1_[_e258] = select(_e262, s_2, is_last);
+            let _e264 = r;
+            count = (_e264 + 1u);
             if is_last {
                 break;
             }
         }
         continuing {
-            let _e267 = r;
-            r = (_e267 + 1u);
+            let _e269 = r;
+            r = (_e269 + 1u);
         }
     }
     let cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
     let panels_2 = max((f_9.sizes2_.z / 4u), 1u);
+    let _e282 = d;
+    let _e286 = d;
+    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e282)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e286)));
+    let _e291 = angle;
+    let _e292 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e291);
     loop {
-        let _e280 = layer;
-        if (_e280 < LAYERS) {
+        let _e294 = layer;
+        if (_e294 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e284 = layer;
-            let _e286 = d;
-            let _e287 = layer;
-            let _e288 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e286, _e287);
-            coeffs[_e284] = _e288;
+            let _e297 = angle;
+            let _e298 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e297, _e292);
+            let _e300 = layer;
+            let _e302 = angle;
+            let _e303 = layer;
+            let _e304 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e302, _e298, _e303);
+            coeffs[_e300] = _e304;
+            let _e305 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e298, _e292);
+            angle = _e305;
         }
         continuing {
-            let _e290 = layer;
-            layer = (_e290 + 1u);
+            let _e307 = layer;
+            layer = (_e307 + 1u);
         }
     }
     loop {
-        let _e293 = r_1;
-        let _e294 = count;
-        if (_e293 < _e294) {
+        let _e310 = r_1;
+        let _e311 = count;
+        if (_e310 < _e311) {
         } else {
             break;
         }
         {
-            let _e296 = r_1;
-            let a_4 = t0_[_e296];
-            let _e299 = r_1;
-            let b_4 = t1_[_e299];
+            let _e313 = r_1;
+            let a_6 = t0_[_e313];
+            let _e316 = r_1;
+            let b_6 = t1_[_e316];
             weight = f32();
             if false {
-                let _e304 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_4, b_4, panels_2);
-                weight = _e304;
+                let _e321 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_6, b_6, panels_2);
+                weight = _e321;
             } else {
-                let _e309 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                let _e313 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
-                weight = ((f_9.medium.y * _e309) * _e313);
+                let _e326 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+                let _e330 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_6);
+                weight = ((f_9.medium.y * _e326) * _e330);
             }
-            let _e315 = r_1;
-            let _e317 = pos[_e315];
-            let xb = (_e317 - 0.5f);
+            let _e332 = r_1;
+            let _e334 = pos[_e332];
+            let xb = (_e334 - 0.5f);
+            let fx = (xb - floor(xb));
             let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
             let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
-            let b00_ = textureLoad(bounds, vec2<u32>(x0_, _e196), 0i);
-            let b01_ = textureLoad(bounds, vec2<u32>(x1_, _e196), 0i);
-            let b10_ = textureLoad(bounds, vec2<u32>(x0_, row1_), 0i);
-            let b11_ = textureLoad(bounds, vec2<u32>(x1_, row1_), 0i);
-            let lo_1 = min(min(b00_.x, b01_.x), min(b10_.x, b11_.x));
-            let hi_1 = max(max(b00_.y, b01_.y), max(b10_.y, b11_.y));
+            let bounds0_ = textureLoad(bounds, vec2<u32>(x1_, _e198), 0i);
+            let bounds1_ = textureLoad(bounds, vec2<u32>(x1_, row1_), 0i);
+            let lo_1 = min(bounds0_.x, bounds1_.x);
+            let hi_1 = max(bounds0_.y, bounds1_.y);
             vis = 0.5f;
-            let _e367 = d;
-            if (_e367 <= lo_1) {
+            let _e370 = d;
+            if (_e370 <= lo_1) {
                 vis = 1f;
             } else {
-                let _e370 = d;
-                if (_e370 > hi_1) {
+                let _e373 = d;
+                if (_e373 > hi_1) {
                     vis = 0f;
                 } else {
                     layer_1 = 0u;
                     loop {
-                        let _e375 = layer_1;
-                        if (_e375 < LAYERS) {
+                        let _e378 = layer_1;
+                        if (_e378 < LAYERS) {
                         } else {
                             break;
                         }
                         {
-                            let _e378 = layer_1;
-                            let coeff = coeffs[_e378];
-                            let _e381 = r_1;
-                            let _e383 = pos[_e381];
-                            let _e386 = yc;
+                            let _e381 = layer_1;
+                            let coeff = coeffs[_e381];
+                            let _e385 = layer_1;
+                            let _e388 = textureLoad(filtered, vec2<u32>(x0_, _e198), _e385, 0i);
                             let _e390 = layer_1;
-                            let texel_1 = textureSampleLevel(filtered, filtered_sampler, vec2<f32>((_e383 / f32(width_1)), (_e386 / f32(rows_1))), _e390, 0f);
+                            let _e393 = textureLoad(filtered, vec2<u32>(x1_, _e198), _e390, 0i);
+                            let top = mix(_e388, _e393, fx);
+                            let _e396 = layer_1;
+                            let _e399 = textureLoad(filtered, vec2<u32>(x0_, row1_), _e396, 0i);
+                            let _e401 = layer_1;
+                            let _e404 = textureLoad(filtered, vec2<u32>(x1_, row1_), _e401, 0i);
+                            let bottom = mix(_e399, _e404, fx);
+                            let texel_1 = mix(top, bottom, fy_1);
                             k = 0u;
                             loop {
-                                let _e397 = k;
-                                if (_e397 < 4u) {
+                                let _e409 = k;
+                                if (_e409 < 4u) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    let _e400 = vis;
-                                    let _e401 = k;
-                                    let _e403 = k;
-                                    vis = (_e400 + (coeff[_e401] * ((texel_1[_e403] * 2f) - 1f)));
+                                    let _e412 = vis;
+                                    let _e413 = k;
+                                    let _e415 = k;
+                                    vis = (_e412 + (coeff[_e413] * ((texel_1[_e415] * 2f) - 1f)));
                                 }
                                 continuing {
-                                    let _e412 = k;
-                                    k = (_e412 + 1u);
+                                    let _e424 = k;
+                                    k = (_e424 + 1u);
                                 }
                             }
                         }
                         continuing {
-                            let _e415 = layer_1;
-                            layer_1 = (_e415 + 1u);
+                            let _e427 = layer_1;
+                            layer_1 = (_e427 + 1u);
                         }
                     }
                 }
             }
-            let _e418 = total;
-            let _e419 = weight;
-            let _e420 = vis;
-            total = (_e418 + (_e419 * clamp(_e420, 0f, 1f)));
+            let _e430 = total;
+            let _e431 = weight;
+            let _e432 = vis;
+            total = (_e430 + (_e431 * clamp(_e432, 0f, 1f)));
         }
         continuing {
-            let _e427 = r_1;
-            r_1 = (_e427 + 1u);
+            let _e439 = r_1;
+            r_1 = (_e439 + 1u);
         }
     }
     let l_2 = total;

@@ -33,17 +33,28 @@ pub fn basis4(d: f32, layer: u32) -> [f32; 4] {
     ]
 }
 
-/// Coefficients of layer `layer` for a ray of depth `d`:
-/// `(2/c1 cos c1 d, -2/c1 sin c1 d, 2/c2 cos c2 d, -2/c2 sin c2 d)`, so that
+/// `(sin, cos)` of `a + b` from `(sin a, cos a)` and `(sin b, cos b)`.
+pub fn turn(a: [f32; 2], b: [f32; 2]) -> [f32; 2] {
+    [a[0] * b[1] + a[1] * b[0], a[1] * b[1] - a[0] * b[0]]
+}
+
+/// The step of the Fourier recurrence, `(sin, cos)` of `2 pi d = c_(k+1) d - c_k d`, from
+/// `first` = `(sin, cos)` of `c_1 d = pi d` (double angle).
+pub fn fourier_step(first: [f32; 2]) -> [f32; 2] {
+    [2.0 * first[0] * first[1], 1.0 - 2.0 * first[0] * first[0]]
+}
+
+/// Coefficients of layer `layer` from `a` = `(sin, cos)` of `c1 d` and `b` = `(sin, cos)` of
+/// `c2 d`: `(2/c1 cos c1 d, -2/c1 sin c1 d, 2/c2 cos c2 d, -2/c2 sin c2 d)`, so that
 /// `V = 0.5 + sum a . B` approximates the step `H(d_i - d)`.
-pub fn coeff4(d: f32, layer: u32) -> [f32; 4] {
+pub fn coeff4(a: [f32; 2], b: [f32; 2], layer: u32) -> [f32; 4] {
     let c1 = freq(2 * layer + 1);
     let c2 = freq(2 * layer + 2);
     [
-        2.0 / c1 * (c1 * d).cos(),
-        -2.0 / c1 * (c1 * d).sin(),
-        2.0 / c2 * (c2 * d).cos(),
-        -2.0 / c2 * (c2 * d).sin(),
+        2.0 / c1 * a[1],
+        -2.0 / c1 * a[0],
+        2.0 / c2 * b[1],
+        -2.0 / c2 * b[0],
     ]
 }
 

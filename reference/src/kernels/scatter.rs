@@ -18,11 +18,11 @@
 use super::common_epipolar::{
     epipole_march, normalised_depth, pixel_dir, ray_t, row_index, spot_segment,
 };
-use super::common_model::{clamp, max, max_u, min, mix, phase_hg, transmittance_between};
-use super::common_prefiltered::{coeff4, region_start};
+use super::common_model::{PI, clamp, max, max_u, min, mix, phase_hg, transmittance_between};
+use super::common_prefiltered::{coeff4, fourier_step, region_start, turn};
 use super::common_prefiltered_projective::proj_column;
 use super::common_projective::{proj_boundary, proj_ray_depth, proj_reach};
-use super::texture::{Tex, TexArray, quantise, sample_bilinear, xyz};
+use super::texture::{Tex, TexArray, mix4, quantise, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
     FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant,
@@ -134,8 +134,10 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         };
     }
 
-    // The rectified rows the bilinear fetch blends (the second only with a non-zero weight).
+    // The rectified rows the bilinear fetch blends (the second only with a non-zero weight)
+    // and the weight of the second.
     let yb = yc - 0.5;
+    let fy = yb - yb.floor();
     let row0 = row_index(yb.floor(), rows, wrap);
     let row1 = if yb > yb.floor() {
         row_index(yb.floor() + 1.0, rows, wrap)
@@ -189,10 +191,16 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
     let cos_theta_l = -xyz(f.light_dir).dot(dir);
     // Every region gets the full spot quadrature (see the WGSL comment).
     let panels = max_u(f.sizes2[2] / 4, 1);
-    // The ray's Fourier coefficients depend on its depth only: once per pixel.
-    let coeffs: Vec<[f32; 4]> = (0..variant.layers())
-        .map(|layer| coeff4(d, layer))
-        .collect();
+    // The ray's Fourier coefficients depend on its depth only: once per pixel, their angles
+    // by angle addition from pi d.
+    let mut coeffs = Vec::with_capacity(variant.layers() as usize);
+    let mut angle = [(PI * d).sin(), (PI * d).cos()];
+    let step = fourier_step(angle);
+    for layer in 0..variant.layers() {
+        let second = turn(angle, step);
+        coeffs.push(coeff4(angle, second, layer));
+        angle = turn(second, step);
+    }
     let mut total = 0.0;
     for r in 0..count {
         let (a, b) = (t0[r as usize], t1[r as usize]);
@@ -203,21 +211,22 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
                 * phase_hg(f.medium[2], cos_theta_l)
                 * transmittance_between(f.medium[0], a, b)
         };
-        // The depth bounds of the (up to) four texels the bilinear fetch reads with a
-        // non-zero weight.
+        // The (up to) four texels the bilinear fetch reads with a non-zero weight: columns
+        // x0 <= x1 of the region, rows row0 and row1.
         let xb = pos[r as usize] - 0.5;
+        let fx = xb - xb.floor();
         let x0 = clamp(xb.floor(), 0.0, width as f32 - 1.0) as u32;
         let x1 = if xb > xb.floor() {
             (x0 + 1).min(width - 1)
         } else {
             x0
         };
-        let b00 = inp.bounds.load(x0, row0, 0);
-        let b01 = inp.bounds.load(x1, row0, 0);
-        let b10 = inp.bounds.load(x0, row1, 0);
-        let b11 = inp.bounds.load(x1, row1, 0);
-        let lo = min(min(b00[0], b01[0]), min(b10[0], b11[0]));
-        let hi = max(max(b00[1], b01[1]), max(b10[1], b11[1]));
+        // Their depth bounds: a region's prefix bounds only widen along the row, so column
+        // x1's cover column x0's.
+        let bounds0 = inp.bounds.load(x1, row0, 0);
+        let bounds1 = inp.bounds.load(x1, row1, 0);
+        let lo = min(bounds0[0], bounds1[0]);
+        let hi = max(bounds0[1], bounds1[1]);
         let mut vis = 0.5;
         if d <= lo {
             vis = 1.0;
@@ -226,7 +235,10 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
         } else {
             for layer in 0..variant.layers() {
                 let coeff = coeffs[layer as usize];
-                let texel = sample_bilinear(inp.filtered, layer, pos[r as usize], yc, wrap);
+                let load = |x: u32, y: u32| inp.filtered.load(x, y, layer);
+                let top = mix4(load(x0, row0), load(x1, row0), fx);
+                let bottom = mix4(load(x0, row1), load(x1, row1), fx);
+                let texel = mix4(top, bottom, fy);
                 for k in 0..4 {
                     vis += coeff[k] * (texel[k] * 2.0 - 1.0);
                 }

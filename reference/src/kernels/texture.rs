@@ -1,7 +1,7 @@
 //! The texture operations of the CPU mirrors (no WGSL module: in the kernels they are
-//! `textureLoad`, `textureStore` and `textureSampleLevel`): r32float and rgba texture arrays,
-//! what a storage texture of each format keeps of a value, and the bilinear fetch with the
-//! samplers' address modes. Every family's mirrors use them.
+//! `textureLoad` and `textureStore`): r32float and rgba texture arrays, what a storage
+//! texture of each format keeps of a value, and WGSL's `mix` of two texels. Every family's
+//! mirrors use them.
 
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::Storage;
@@ -103,36 +103,9 @@ pub fn round_f16(v: f32) -> f32 {
     }
 }
 
-/// Bilinear sample of layer `layer` at texel-space position (`x`, `y`) (texel `i`'s centre at
-/// `i + 0.5`), clamp-to-edge in x, wrap-around in y when `wrap_y`, else clamp-to-edge.
-pub fn sample_bilinear(t: &TexArray, layer: u32, x: f32, y: f32, wrap_y: bool) -> [f32; 4] {
-    let (x0, fx) = split(x - 0.5);
-    let (y0, fy) = split(y - 0.5);
-    let cx = |i: i64| i.clamp(0, i64::from(t.width) - 1) as u32;
-    let h = i64::from(t.height);
-    let cy = |j: i64| {
-        if wrap_y {
-            j.rem_euclid(h) as u32
-        } else {
-            j.clamp(0, h - 1) as u32
-        }
-    };
-    let a = t.load(cx(x0), cy(y0), layer);
-    let b = t.load(cx(x0 + 1), cy(y0), layer);
-    let c = t.load(cx(x0), cy(y0 + 1), layer);
-    let d = t.load(cx(x0 + 1), cy(y0 + 1), layer);
-    let mut out = [0.0; 4];
-    for k in 0..4 {
-        let top = a[k] * (1.0 - fx) + b[k] * fx;
-        let bottom = c[k] * (1.0 - fx) + d[k] * fx;
-        out[k] = top * (1.0 - fy) + bottom * fy;
-    }
-    out
-}
-
-fn split(x: f32) -> (i64, f32) {
-    let f = x.floor();
-    (f as i64, x - f)
+/// WGSL `mix` of two vec4 with a scalar weight: `a (1 - t) + b t`.
+pub fn mix4(a: [f32; 4], b: [f32; 4], t: f32) -> [f32; 4] {
+    [0, 1, 2, 3].map(|k| a[k] * (1.0 - t) + b[k] * t)
 }
 
 /// `.xyz` of a vec4.

@@ -4,8 +4,8 @@
 
 use crate::plan::{
     Alternative, BindingSource, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
-    SAMPLED, STORAGE_AND_SAMPLED, SamplerDesc, TEXTURE_DIMENSION, bind, depth_and_shadow_map,
-    frame_buffer, scatter_resource, scatter_texture, screen_and_shadow_parameters, texture_2d,
+    SAMPLED, STORAGE_AND_SAMPLED, TEXTURE_DIMENSION, bind, depth_and_shadow_map, frame_buffer,
+    scatter_resource, scatter_texture, screen_and_shadow_parameters, texture_2d,
 };
 use crate::prefiltered::{Rectification, Variant};
 use crate::{Kernel, KernelParams};
@@ -18,25 +18,11 @@ pub const PROJECTIVE_FRAME: &str = "frame.proj.x > 0.5 (a projective frame)";
 pub const PROJECTIVE_WITHOUT_SHADOW_MAP: &str = "the frame is projective and the engine has no \
                                                  standard shadow map (the binding is not read \
                                                  then)";
-/// The per-frame condition under which the slices go round the full circle and `scatter`
-/// samples the filtered bases with the wrapping sampler.
-pub const WRAPPING_SLICES: &str = "frame.anti_epipole.w > 0.5";
 /// Format of the region-prefix depth bounds written by `prefilter` (r = min, g = max):
 /// 32-bit, so that the bound tests compare the very depths the filter saw.
 pub const BOUNDS_FORMAT: &str = "rg32float";
 /// The engine's rasterised rectified map of projective variants.
 pub const RECTIFIED_RASTER: &str = "rectified_raster";
-
-fn linear_sampler(address_mode_v: &'static str) -> SamplerDesc {
-    SamplerDesc {
-        mag_filter: "linear",
-        min_filter: "linear",
-        mipmap_filter: "nearest",
-        address_mode_u: "clamp_to_edge",
-        address_mode_v,
-        address_mode_w: "clamp_to_edge",
-    }
-}
 
 /// The resources and passes of a variant, as `runtime/src/prefiltered.rs` creates them.
 pub fn plan(v: &Variant) -> Plan {
@@ -115,23 +101,6 @@ pub fn plan(v: &Variant) -> Plan {
             "screen.width",
             "screen.height",
         ),
-        Resource {
-            kind: "sampler",
-            sampler: Some(linear_sampler("clamp_to_edge")),
-            ..scatter_resource(
-                "filtered_sampler_clamp",
-                "bilinear sampler of the filtered bases when the slices do not wrap",
-            )
-        },
-        Resource {
-            kind: "sampler",
-            sampler: Some(linear_sampler("repeat")),
-            ..scatter_resource(
-                "filtered_sampler_wrap",
-                "bilinear sampler of the filtered bases when the slices go round the full \
-                 circle (repeat across slices)",
-            )
-        },
     ];
     if v.rectification == Rectification::Projective {
         resources.push(Resource {
@@ -239,16 +208,8 @@ pub fn pass(v: &Variant, kernel: Kernel) -> Option<PassPlan> {
                     }),
                 },
                 bind(4, "filtered"),
-                BindingSource {
-                    binding: 5,
-                    resource: "filtered_sampler_clamp",
-                    alternative: Some(Alternative {
-                        resource: "filtered_sampler_wrap",
-                        when: WRAPPING_SLICES,
-                    }),
-                },
-                bind(6, "output"),
-                bind(7, "bounds"),
+                bind(5, "output"),
+                bind(6, "bounds"),
             ],
         }),
         _ => None,

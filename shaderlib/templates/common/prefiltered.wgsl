@@ -7,11 +7,9 @@
 //
 // Composed into kernels by naga_oil (`#import scatter::prefiltered::{...}`); plain WGSL, not
 // an askama template. Conventions: `scatter_shaderlib::prefiltered::frame`. Mirrored line by
-// line by reference/src/kernels/common_prefiltered.rs; functions that read a texture take it
-// as a parameter (a shared module cannot see the kernel's bindings), the texture operations
-// themselves (`Tex::load`, `TexArray::store`, `sample_bilinear`) are textureLoad,
-// textureStore and textureSampleLevel in the kernels. `region_start` is mirrored by
-// reference/src/kernels/prefilter.rs.
+// line by reference/src/kernels/common_prefiltered.rs; the texture operations
+// (`Tex::load`, `TexArray::store`, `mix4`: reference/src/kernels/texture.rs) are
+// textureLoad, textureStore and mix in the kernels.
 
 #define_import_path scatter::prefiltered
 
@@ -38,18 +36,26 @@ fn basis4(d: f32, layer: u32) -> vec4<f32> {
     return vec4<f32>(sin(c1 * d), cos(c1 * d), sin(c2 * d), cos(c2 * d));
 }
 
-// Coefficients of layer `layer` for a ray of depth `d`:
+// (sin, cos) of a + b from (sin a, cos a) and (sin b, cos b).
+fn turn(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(a.x * b.y + a.y * b.x, a.y * b.y - a.x * b.x);
+}
+
+// The step of the Fourier recurrence, (sin, cos) of 2 pi d = c_(k+1) d - c_k d, from
+// `first` = (sin, cos) of c_1 d = pi d (double angle: no transcendental).
+fn fourier_step(first: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(2.0 * first.x * first.y, 1.0 - 2.0 * first.x * first.x);
+}
+
+// Coefficients of layer `layer` from `a` = (sin, cos) of c1 d and `b` = (sin, cos) of c2 d:
 // `(2/c1 cos c1 d, -2/c1 sin c1 d, 2/c2 cos c2 d, -2/c2 sin c2 d)`, so that
-// `V = 0.5 + sum a . B` approximates the step `H(d_i - d)`.
-fn coeff4(d: f32, layer: u32) -> vec4<f32> {
+// `V = 0.5 + sum a . B` approximates the step `H(d_i - d)`. A ray's angles come by
+// `turn`ing `(sin, cos)(pi d)` by `fourier_step` (two transcendentals per ray, not four per
+// layer).
+fn coeff4(a: vec2<f32>, b: vec2<f32>, layer: u32) -> vec4<f32> {
     let c1 = freq(2u * layer + 1u);
     let c2 = freq(2u * layer + 2u);
-    return vec4<f32>(
-        2.0 / c1 * cos(c1 * d),
-        -2.0 / c1 * sin(c1 * d),
-        2.0 / c2 * cos(c2 * d),
-        -2.0 / c2 * sin(c2 * d),
-    );
+    return vec4<f32>(2.0 / c1 * a.y, -2.0 / c1 * a.x, 2.0 / c2 * b.y, -2.0 / c2 * b.x);
 }
 
 // First column of region `r` of `regions` in a row of `width` columns. Directional lights
