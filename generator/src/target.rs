@@ -420,6 +420,9 @@ fn spirv(input: &Input<'_>) -> Result<Output, String> {
     // retype them, or SPIR-V consumers (naga's own front-end, the Vulkan validation layers)
     // reject the module.
     let (words, _) = crate::spirv_fixup::fix_constant_composite_signedness(&words)?;
+    // naga's SPIR-V front-end reads an arrayed image's size without its layer count: give
+    // the clamp of `texture_2d_array` loads a size it can read (see spirv_fixup).
+    let (words, _) = crate::spirv_fixup::fix_arrayed_load_clamps(&words)?;
     let bytes = words.iter().flat_map(|w| w.to_le_bytes()).collect();
     let bindings = input
         .bindings
