@@ -33,7 +33,8 @@
 // Mirrors reference/src/kernels/prefilter.rs
 
 #import scatter::epipolar::{Frame, slice_params}
-#import scatter::prefiltered::{basis4, region_start, texel_weight}
+#import scatter::model::PI
+#import scatter::prefiltered::{basis4, fourier_step, region_start, texel_weight, turn}
 {%- if projective %}
 #import scatter::projective::proj_stored_depth
 #import scatter::prefiltered_projective::proj_texel_weight
@@ -94,9 +95,19 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             textureStore(bounds, vec2<u32>(i, row), vec4<f32>(lo, hi, 0.0, 0.0));
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);
+        // The basis angles c_k d by angle addition: (sin, cos)(pi d) turned by
+        // (sin, cos)(2 pi d) to this thread's first frequency and on (two transcendentals
+        // per texel, not four per layer).
+        var angle = vec2<f32>(sin(PI * d), cos(PI * d));
+        let step = fourier_step(angle);
+        for (var k = 0u; k < 2u * thread * layers_per_thread; k++) {
+            angle = turn(angle, step);
+        }
         for (var q = 0u; q < layers_per_thread; q++) {
             let layer = thread * layers_per_thread + q;
-            let b = basis4(d, layer);
+            let second = turn(angle, step);
+            let b = basis4(angle, second);
+            angle = turn(second, step);
             let a = acc[q];
             acc[q] = a * (1.0 - blend) + b * blend;
             let stored = acc[q] * 0.5 + 0.5;

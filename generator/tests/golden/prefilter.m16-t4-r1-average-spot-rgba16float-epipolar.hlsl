@@ -229,17 +229,17 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 
     float3 x_5 = (eye + (dir * t));
     float3 to_x = (x_5 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d_1 = sqrt(d2_);
-    float3 travel = (to_x / (d_1).xxx);
+    float d = sqrt(d2_);
+    float3 travel = (to_x / (d).xxx);
     const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
 {
     float sum = 0.0;
-    uint k = 0u;
+    uint k_1 = 0u;
     uint q_1 = (uint)0;
 
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
@@ -252,17 +252,17 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = (_e73 + 1u);
+            uint _e73 = k_1;
+            k_1 = (_e73 + 1u);
         }
         loop_init = false;
-        uint _e30 = k;
+        uint _e30 = k_1;
         if ((_e30 < panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
+            uint _e32 = k_1;
             float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
             q_1 = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
@@ -344,16 +344,19 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_X
     return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
 }
 
-float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_1)
+float4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_3, float2 b_3)
 {
-    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_1) - 1u)));
+    return float4(a_3.x, a_3.y, b_3.x, b_3.y);
 }
 
-float4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d, uint layer)
+float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_4, float2 b_4)
 {
-    const float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 1u));
-    const float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 2u));
-    return float4(sin((_e5 * d)), cos((_e5 * d)), sin((_e10 * d)), cos((_e10 * d)));
+    return float2(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+}
+
+float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 first)
+{
+    return float2(((2.0 * first.x) * first.y), (1.0 - ((2.0 * first.x) * first.x)));
 }
 
 uint naga_div(uint lhs, uint rhs) {
@@ -428,6 +431,8 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     float lo = 1e30;
     float hi = -1e30;
     uint i = (uint)0;
+    float2 angle = (float2)0;
+    uint k = (uint)0;
     uint q = (uint)0;
 
     uint row_2 = id.x;
@@ -461,8 +466,8 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e116 = i;
-            i = (_e116 + 1u);
+            uint _e142 = i;
+            i = (_e142 + 1u);
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -473,7 +478,7 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         {
             uint _e44 = i;
             float4 _e48 = rectified.Load(int3(uint2(_e44, row_2), int(0)));
-            float d_2 = _e48.x;
+            float d_1 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
             uint _e52 = i;
             const float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, false, true);
@@ -481,9 +486,9 @@ void prefilter(uint3 id : SV_DispatchThreadID)
             wsum = (_e56 + _e54);
             if ((thread == 0u)) {
                 float _e61 = lo;
-                lo = min(_e61, d_2);
+                lo = min(_e61, d_1);
                 float _e64 = hi;
-                hi = max(_e64, d_2);
+                hi = max(_e64, d_1);
                 uint _e66 = i;
                 float _e68 = lo;
                 float _e69 = hi;
@@ -492,35 +497,65 @@ void prefilter(uint3 id : SV_DispatchThreadID)
             float _e74 = wsum;
             float _e76 = wsum;
             float blend = ((_e76 > 0.0) ? (_e54 / _e74) : 0.0);
-            q = 0u;
+            angle = float2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
+            float2 _e89 = angle;
+            const float2 _e90 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e89);
+            k = 0u;
             uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
             bool loop_init_3 = true;
             while(true) {
                 if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e113 = q;
-                    q = (_e113 + 1u);
+                    uint _e102 = k;
+                    k = (_e102 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e84 = q;
-                if ((_e84 < 1u)) {
+                uint _e93 = k;
+                if ((_e93 < ((2u * thread) * 1u))) {
                 } else {
                     break;
                 }
                 {
-                    uint _e87 = q;
-                    uint layer_1 = ((thread * 1u) + _e87);
-                    const float4 _e89 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
-                    uint _e91 = q;
-                    float4 a_3 = acc[min(uint(_e91), 0u)];
-                    uint _e94 = q;
-                    acc[min(uint(_e94), 0u)] = ((a_3 * (1.0 - blend)) + (_e89 * blend));
-                    uint _e101 = q;
-                    float4 _e103 = acc[min(uint(_e101), 0u)];
-                    float4 stored = ((_e103 * 0.5) + (0.5).xxxx);
-                    uint _e109 = i;
-                    filtered[int3(uint2(_e109, row_2), layer_1)] = stored;
+                    float2 _e99 = angle;
+                    const float2 _e100 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e99, _e90);
+                    angle = _e100;
+                }
+            }
+            q = 0u;
+            uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
+            bool loop_init_4 = true;
+            while(true) {
+                if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
+                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+                if (!loop_init_4) {
+                    uint _e139 = q;
+                    q = (_e139 + 1u);
+                }
+                loop_init_4 = false;
+                uint _e106 = q;
+                if ((_e106 < 1u)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e109 = q;
+                    uint layer = ((thread * 1u) + _e109);
+                    float2 _e111 = angle;
+                    const float2 _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
+                    float2 _e113 = angle;
+                    const float4 _e114 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e112);
+                    const float2 _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e90);
+                    angle = _e115;
+                    uint _e117 = q;
+                    float4 a_5 = acc[min(uint(_e117), 0u)];
+                    uint _e120 = q;
+                    acc[min(uint(_e120), 0u)] = ((a_5 * (1.0 - blend)) + (_e114 * blend));
+                    uint _e127 = q;
+                    float4 _e129 = acc[min(uint(_e127), 0u)];
+                    float4 stored = ((_e129 * 0.5) + (0.5).xxxx);
+                    uint _e135 = i;
+                    filtered[int3(uint2(_e135, row_2), layer)] = stored;
                 }
             }
         }

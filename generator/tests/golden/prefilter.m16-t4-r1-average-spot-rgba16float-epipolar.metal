@@ -262,11 +262,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 x_5 = eye + (dir * t);
     metal::float3 to_x = x_5 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
-    float d_1 = metal::sqrt(d2_);
-    metal::float3 travel = to_x / metal::float3(d_1);
+    float d = metal::sqrt(d2_);
+    metal::float3 travel = to_x / metal::float3(d);
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_1 + t))) / d2_;
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t))) / d2_;
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -282,7 +282,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float4 medium_1
 ) {
     float sum = 0.0;
-    uint k = 0u;
+    uint k_1 = 0u;
     uint q_1 = {};
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
     float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
@@ -294,17 +294,17 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = _e73 + 1u;
+            uint _e73 = k_1;
+            k_1 = _e73 + 1u;
         }
         loop_init = false;
-        uint _e30 = k;
+        uint _e30 = k_1;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
+            uint _e32 = k_1;
             float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
             q_1 = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
@@ -379,19 +379,24 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
 }
 
-float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    uint k_1
+metal::float4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    metal::float2 a_3,
+    metal::float2 b_3
 ) {
-    return PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * static_cast<float>((2u * k_1) - 1u);
+    return metal::float4(a_3.x, a_3.y, b_3.x, b_3.y);
 }
 
-metal::float4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    float d,
-    uint layer
+metal::float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    metal::float2 a_4,
+    metal::float2 b_4
 ) {
-    float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer) + 1u);
-    float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer) + 2u);
-    return metal::float4(metal::sin(_e5 * d), metal::cos(_e5 * d), metal::sin(_e10 * d), metal::cos(_e10 * d));
+    return metal::float2((a_4.x * b_4.y) + (a_4.y * b_4.x), (a_4.y * b_4.y) - (a_4.x * b_4.x));
+}
+
+metal::float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    metal::float2 first
+) {
+    return metal::float2((2.0 * first.x) * first.y, 1.0 - ((2.0 * first.x) * first.x));
 }
 
 uint naga_div(uint lhs, uint rhs) {
@@ -486,6 +491,8 @@ kernel void prefilter(
     float lo = 1000000000000000000000000000000.0;
     float hi = -1000000000000000000000000000000.0;
     uint i = {};
+    metal::float2 angle = {};
+    uint k = {};
     uint q = {};
     uint row_2 = id.x;
     uint region = id.y;
@@ -518,8 +525,8 @@ kernel void prefilter(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e116 = i;
-            i = _e116 + 1u;
+            uint _e142 = i;
+            i = _e142 + 1u;
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -531,7 +538,7 @@ kernel void prefilter(
             uint _e44 = i;
             uint clamped_lod_e48 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
             metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_2)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
-            float d_2 = _e48.x;
+            float d_1 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
             uint _e52 = i;
             float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, false, true);
@@ -539,9 +546,9 @@ kernel void prefilter(
             wsum = _e56 + _e54;
             if (thread_ == 0u) {
                 float _e61 = lo;
-                lo = metal::min(_e61, d_2);
+                lo = metal::min(_e61, d_1);
                 float _e64 = hi;
-                hi = metal::max(_e64, d_2);
+                hi = metal::max(_e64, d_1);
                 uint _e66 = i;
                 float _e68 = lo;
                 float _e69 = hi;
@@ -550,35 +557,65 @@ kernel void prefilter(
             float _e74 = wsum;
             float _e76 = wsum;
             float blend = (_e76 > 0.0) ? (_e54 / _e74) : 0.0;
-            q = 0u;
+            angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1));
+            metal::float2 _e89 = angle;
+            metal::float2 _e90 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e89);
+            k = 0u;
             uint2 loop_bound_3 = uint2(4294967295u);
             bool loop_init_3 = true;
             while(true) {
                 if (metal::all(loop_bound_3 == uint2(0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e113 = q;
-                    q = _e113 + 1u;
+                    uint _e102 = k;
+                    k = _e102 + 1u;
                 }
                 loop_init_3 = false;
-                uint _e84 = q;
-                if (_e84 < 1u) {
+                uint _e93 = k;
+                if (_e93 < ((2u * thread_) * 1u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e87 = q;
-                    uint layer_1 = (thread_ * 1u) + _e87;
-                    metal::float4 _e89 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
-                    uint _e91 = q;
-                    metal::float4 a_3 = acc.inner[metal::min(unsigned(_e91), 0u)];
-                    uint _e94 = q;
-                    acc.inner[metal::min(unsigned(_e94), 0u)] = (a_3 * (1.0 - blend)) + (_e89 * blend);
-                    uint _e101 = q;
-                    metal::float4 _e103 = acc.inner[metal::min(unsigned(_e101), 0u)];
-                    metal::float4 stored = (_e103 * 0.5) + metal::float4(0.5);
-                    uint _e109 = i;
-                    filtered.write(stored, metal::uint2(metal::uint2(_e109, row_2)), layer_1);
+                    metal::float2 _e99 = angle;
+                    metal::float2 _e100 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e99, _e90);
+                    angle = _e100;
+                }
+            }
+            q = 0u;
+            uint2 loop_bound_4 = uint2(4294967295u);
+            bool loop_init_4 = true;
+            while(true) {
+                if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+                if (!loop_init_4) {
+                    uint _e139 = q;
+                    q = _e139 + 1u;
+                }
+                loop_init_4 = false;
+                uint _e106 = q;
+                if (_e106 < 1u) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e109 = q;
+                    uint layer = (thread_ * 1u) + _e109;
+                    metal::float2 _e111 = angle;
+                    metal::float2 _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
+                    metal::float2 _e113 = angle;
+                    metal::float4 _e114 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e112);
+                    metal::float2 _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e90);
+                    angle = _e115;
+                    uint _e117 = q;
+                    metal::float4 a_5 = acc.inner[metal::min(unsigned(_e117), 0u)];
+                    uint _e120 = q;
+                    acc.inner[metal::min(unsigned(_e120), 0u)] = (a_5 * (1.0 - blend)) + (_e114 * blend);
+                    uint _e127 = q;
+                    metal::float4 _e129 = acc.inner[metal::min(unsigned(_e127), 0u)];
+                    metal::float4 stored = (_e129 * 0.5) + metal::float4(0.5);
+                    uint _e135 = i;
+                    filtered.write(stored, metal::uint2(metal::uint2(_e135, row_2)), layer);
                 }
             }
         }

@@ -213,16 +213,16 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     let x_5 = (eye + (dir * t));
     let to_x = (x_5 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
-    let d_1 = sqrt(d2_);
-    let travel = (to_x / vec3(d_1));
+    let d = sqrt(d2_);
+    let travel = (to_x / vec3(d));
     let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
 }
 
 fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
     var sum: f32 = 0f;
-    var k: u32 = 0u;
+    var k_1: u32 = 0u;
     var q_1: u32;
 
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
@@ -230,13 +230,13 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let g0_ = atan(((a_1 - t0_) / h));
     let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
-        let _e30 = k;
+        let _e30 = k_1;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            let _e32 = k;
+            let _e32 = k_1;
             let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
             q_1 = 0u;
             loop {
@@ -260,8 +260,8 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
             }
         }
         continuing {
-            let _e73 = k;
-            k = (_e73 + 1u);
+            let _e73 = k_1;
+            k_1 = (_e73 + 1u);
         }
     }
     let _e75 = sum;
@@ -292,14 +292,16 @@ fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod
     return (f_1.e1_.w + ((f32(row) + 0.5f) * f_1.e2_.w));
 }
 
-fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_1: u32) -> f32 {
-    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_1) - 1u)));
+fn basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_3: vec2<f32>, b_3: vec2<f32>) -> vec4<f32> {
+    return vec4<f32>(a_3.x, a_3.y, b_3.x, b_3.y);
 }
 
-fn basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d: f32, layer: u32) -> vec4<f32> {
-    let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 1u));
-    let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 2u));
-    return vec4<f32>(sin((_e5 * d)), cos((_e5 * d)), sin((_e10 * d)), cos((_e10 * d)));
+fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_4: vec2<f32>, b_4: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+}
+
+fn fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(first: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(((2f * first.x) * first.y), (1f - ((2f * first.x) * first.x)));
 }
 
 fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
@@ -366,6 +368,8 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var lo: f32 = 1000000000000000000000000000000f;
     var hi: f32 = -1000000000000000000000000000000f;
     var i: u32;
+    var angle: vec2<f32>;
+    var k: u32;
     var q: u32;
 
     let row_2 = id.x;
@@ -402,7 +406,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         {
             let _e44 = i;
             let _e48 = textureLoad(rectified, vec2<u32>(_e44, row_2), 0i);
-            let d_2 = _e48.x;
+            let d_1 = _e48.x;
             let _e51 = frame;
             let _e52 = i;
             let _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, false, true);
@@ -410,9 +414,9 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             wsum = (_e56 + _e54);
             if (thread == 0u) {
                 let _e61 = lo;
-                lo = min(_e61, d_2);
+                lo = min(_e61, d_1);
                 let _e64 = hi;
-                hi = max(_e64, d_2);
+                hi = max(_e64, d_1);
                 let _e66 = i;
                 let _e68 = lo;
                 let _e69 = hi;
@@ -421,36 +425,61 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             let _e74 = wsum;
             let _e76 = wsum;
             let blend = select(0f, (_e54 / _e74), (_e76 > 0f));
-            q = 0u;
+            angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
+            let _e89 = angle;
+            let _e90 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e89);
+            k = 0u;
             loop {
-                let _e84 = q;
-                if (_e84 < 1u) {
+                let _e93 = k;
+                if (_e93 < ((2u * thread) * 1u)) {
                 } else {
                     break;
                 }
                 {
-                    let _e87 = q;
-                    let layer_1 = ((thread * 1u) + _e87);
-                    let _e89 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
-                    let _e91 = q;
-                    let a_3 = acc[_e91];
-                    let _e94 = q;
-                    acc[_e94] = ((a_3 * (1f - blend)) + (_e89 * blend));
-                    let _e101 = q;
-                    let _e103 = acc[_e101];
-                    let stored = ((_e103 * 0.5f) + vec4(0.5f));
-                    let _e109 = i;
-                    textureStore(filtered, vec2<u32>(_e109, row_2), layer_1, stored);
+                    let _e99 = angle;
+                    let _e100 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e99, _e90);
+                    angle = _e100;
                 }
                 continuing {
-                    let _e113 = q;
-                    q = (_e113 + 1u);
+                    let _e102 = k;
+                    k = (_e102 + 1u);
+                }
+            }
+            q = 0u;
+            loop {
+                let _e106 = q;
+                if (_e106 < 1u) {
+                } else {
+                    break;
+                }
+                {
+                    let _e109 = q;
+                    let layer = ((thread * 1u) + _e109);
+                    let _e111 = angle;
+                    let _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
+                    let _e113 = angle;
+                    let _e114 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e112);
+                    let _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e90);
+                    angle = _e115;
+                    let _e117 = q;
+                    let a_5 = acc[_e117];
+                    let _e120 = q;
+                    acc[_e120] = ((a_5 * (1f - blend)) + (_e114 * blend));
+                    let _e127 = q;
+                    let _e129 = acc[_e127];
+                    let stored = ((_e129 * 0.5f) + vec4(0.5f));
+                    let _e135 = i;
+                    textureStore(filtered, vec2<u32>(_e135, row_2), layer, stored);
+                }
+                continuing {
+                    let _e139 = q;
+                    q = (_e139 + 1u);
                 }
             }
         }
         continuing {
-            let _e116 = i;
-            i = (_e116 + 1u);
+            let _e142 = i;
+            i = (_e142 + 1u);
         }
     }
     return;

@@ -212,16 +212,16 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir,
     vec3 x_5 = (eye + (dir * t));
     vec3 to_x = (x_5 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d_1 = sqrt(d2_);
-    vec3 travel = (to_x / vec3(d_1));
+    float d = sqrt(d2_);
+    vec3 travel = (to_x / vec3(d));
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_1, float b_1, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
     float sum = 0.0;
-    uint k = 0u;
+    uint k_1 = 0u;
     uint q_1 = 0u;
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
     float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
@@ -230,17 +230,17 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e73 = k;
-            k = (_e73 + 1u);
+            uint _e73 = k_1;
+            k_1 = (_e73 + 1u);
         }
         loop_init = false;
-        uint _e30 = k;
+        uint _e30 = k_1;
         if ((_e30 < panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
+            uint _e32 = k_1;
             float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
             q_1 = 0u;
             bool loop_init_1 = true;
@@ -294,14 +294,16 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_X
     return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
 }
 
-float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_1) {
-    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_1) - 1u)));
+vec4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_3, vec2 b_3) {
+    return vec4(a_3.x, a_3.y, b_3.x, b_3.y);
 }
 
-vec4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float d, uint layer) {
-    float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 1u));
-    float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 2u));
-    return vec4(sin((_e5 * d)), cos((_e5 * d)), sin((_e10 * d)), cos((_e10 * d)));
+vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_4, vec2 b_4) {
+    return vec2(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+}
+
+vec2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 first) {
+    return vec2(((2.0 * first.x) * first.y), (1.0 - ((2.0 * first.x) * first.x)));
 }
 
 uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot) {
@@ -366,6 +368,8 @@ void main() {
     float lo = 1e30;
     float hi = -1e30;
     uint i = 0u;
+    vec2 angle = vec2(0.0);
+    uint k = 0u;
     uint q = 0u;
     uint row_2 = id.x;
     uint region = id.y;
@@ -395,8 +399,8 @@ void main() {
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e116 = i;
-            i = (_e116 + 1u);
+            uint _e142 = i;
+            i = (_e142 + 1u);
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -408,7 +412,7 @@ void main() {
             uint _e44 = i;
             int _e48_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
             vec4 _e48 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e44, row_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e48_clamped_lod) - ivec2(1)), _e48_clamped_lod);
-            float d_2 = _e48.x;
+            float d_1 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = _group_0_binding_0_cs;
             uint _e52 = i;
             float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, true, false);
@@ -416,9 +420,9 @@ void main() {
             wsum = (_e56 + _e54);
             if ((thread == 0u)) {
                 float _e61 = lo;
-                lo = min(_e61, d_2);
+                lo = min(_e61, d_1);
                 float _e64 = hi;
-                hi = max(_e64, d_2);
+                hi = max(_e64, d_1);
                 uint _e66 = i;
                 float _e68 = lo;
                 float _e69 = hi;
@@ -427,32 +431,59 @@ void main() {
             float _e74 = wsum;
             float _e76 = wsum;
             float blend = ((_e76 > 0.0) ? (_e54 / _e74) : 0.0);
-            q = 0u;
+            angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
+            vec2 _e89 = angle;
+            vec2 _e90 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e89);
+            k = 0u;
             bool loop_init_3 = true;
             while(true) {
                 if (!loop_init_3) {
-                    uint _e113 = q;
-                    q = (_e113 + 1u);
+                    uint _e102 = k;
+                    k = (_e102 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e84 = q;
-                if ((_e84 < 2u)) {
+                uint _e93 = k;
+                if ((_e93 < ((2u * thread) * 2u))) {
                 } else {
                     break;
                 }
                 {
-                    uint _e87 = q;
-                    uint layer_1 = ((thread * 2u) + _e87);
-                    vec4 _e89 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(d_2, layer_1);
-                    uint _e91 = q;
-                    vec4 a_3 = acc[_e91];
-                    uint _e94 = q;
-                    acc[_e94] = ((a_3 * (1.0 - blend)) + (_e89 * blend));
-                    uint _e101 = q;
-                    vec4 _e103 = acc[_e101];
-                    vec4 stored = ((_e103 * 0.5) + vec4(0.5));
-                    uint _e109 = i;
-                    imageStore(_group_0_binding_3_cs, ivec3(uvec2(_e109, row_2), layer_1), stored);
+                    vec2 _e99 = angle;
+                    vec2 _e100 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e99, _e90);
+                    angle = _e100;
+                }
+            }
+            q = 0u;
+            bool loop_init_4 = true;
+            while(true) {
+                if (!loop_init_4) {
+                    uint _e139 = q;
+                    q = (_e139 + 1u);
+                }
+                loop_init_4 = false;
+                uint _e106 = q;
+                if ((_e106 < 2u)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e109 = q;
+                    uint layer = ((thread * 2u) + _e109);
+                    vec2 _e111 = angle;
+                    vec2 _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
+                    vec2 _e113 = angle;
+                    vec4 _e114 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e112);
+                    vec2 _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e90);
+                    angle = _e115;
+                    uint _e117 = q;
+                    vec4 a_5 = acc[_e117];
+                    uint _e120 = q;
+                    acc[_e120] = ((a_5 * (1.0 - blend)) + (_e114 * blend));
+                    uint _e127 = q;
+                    vec4 _e129 = acc[_e127];
+                    vec4 stored = ((_e129 * 0.5) + vec4(0.5));
+                    uint _e135 = i;
+                    imageStore(_group_0_binding_3_cs, ivec3(uvec2(_e135, row_2), layer), stored);
                 }
             }
         }

@@ -20,17 +20,10 @@ pub fn freq(k: u32) -> f32 {
     PI * (2 * k - 1) as f32
 }
 
-/// Basis values of layer `layer` at depth `d`: `(sin c1 d, cos c1 d, sin c2 d, cos c2 d)`
-/// with `k1 = 2 layer + 1`, `k2 = 2 layer + 2` (Klehm Eq. 8: B_{2k-1} = sin, B_{2k} = cos).
-pub fn basis4(d: f32, layer: u32) -> [f32; 4] {
-    let c1 = freq(2 * layer + 1);
-    let c2 = freq(2 * layer + 2);
-    [
-        (c1 * d).sin(),
-        (c1 * d).cos(),
-        (c2 * d).sin(),
-        (c2 * d).cos(),
-    ]
+/// Basis values of a layer from `a` = `(sin, cos)` of `c1 d` and `b` = `(sin, cos)` of
+/// `c2 d`: `(sin c1 d, cos c1 d, sin c2 d, cos c2 d)` (Klehm Eq. 8).
+pub fn basis4(a: [f32; 2], b: [f32; 2]) -> [f32; 4] {
+    [a[0], a[1], b[0], b[1]]
 }
 
 /// `(sin, cos)` of `a + b` from `(sin a, cos a)` and `(sin b, cos b)`.

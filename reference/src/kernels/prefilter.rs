@@ -11,8 +11,9 @@
 //! stores the least and the greatest depth over the region up to the texel (`bounds`,
 //! rg32float on the GPU; here a one-layer array of `[min, max, 0, 0]`).
 
+use super::common_model::PI;
 use super::common_model::select;
-use super::common_prefiltered::{basis4, region_start, texel_weight};
+use super::common_prefiltered::{basis4, fourier_step, region_start, texel_weight, turn};
 use super::common_prefiltered_projective::proj_texel_weight;
 use super::common_projective::proj_stored_depth;
 use super::texture::{Tex, TexArray};
@@ -66,9 +67,17 @@ pub fn prefilter_main(
             bounds.store(i, row, 0, [lo, hi, 0.0, 0.0], Storage::Rgba32float);
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);
+        // The basis angles by angle addition (see the WGSL).
+        let mut angle = [(PI * d).sin(), (PI * d).cos()];
+        let step = fourier_step(angle);
+        for _ in 0..2 * thread * layers_per_thread {
+            angle = turn(angle, step);
+        }
         for q in 0..layers_per_thread {
             let layer = thread * layers_per_thread + q;
-            let b = basis4(d, layer);
+            let second = turn(angle, step);
+            let b = basis4(angle, second);
+            angle = turn(second, step);
             let a = &mut acc[q as usize];
             for c in 0..4 {
                 a[c] = a[c] * (1.0 - blend) + b[c] * blend;

@@ -28,12 +28,12 @@ fn freq(k: u32) -> f32 {
     return PI * f32(2u * k - 1u);
 }
 
-// Basis values of layer `layer` at depth `d`: `(sin c1 d, cos c1 d, sin c2 d, cos c2 d)`
-// with `k1 = 2 layer + 1`, `k2 = 2 layer + 2` (Klehm Eq. 8: B_{2k-1} = sin, B_{2k} = cos).
-fn basis4(d: f32, layer: u32) -> vec4<f32> {
-    let c1 = freq(2u * layer + 1u);
-    let c2 = freq(2u * layer + 2u);
-    return vec4<f32>(sin(c1 * d), cos(c1 * d), sin(c2 * d), cos(c2 * d));
+// Basis values of a layer from `a` = (sin, cos) of c1 d and `b` = (sin, cos) of c2 d,
+// `k1 = 2 layer + 1`, `k2 = 2 layer + 2`: `(sin c1 d, cos c1 d, sin c2 d, cos c2 d)` (Klehm
+// Eq. 8: B_{2k-1} = sin, B_{2k} = cos). The angles come by `turn`ing `(sin, cos)(pi d)` by
+// `fourier_step`.
+fn basis4(a: vec2<f32>, b: vec2<f32>) -> vec4<f32> {
+    return vec4<f32>(a.x, a.y, b.x, b.y);
 }
 
 // (sin, cos) of a + b from (sin a, cos a) and (sin b, cos b).
