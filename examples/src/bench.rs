@@ -4,7 +4,10 @@
 //! with the ratios, and a chart (SVG and PNG) of error against time with the Pareto front.
 //!
 //! Timing. Each pass is submitted on its own and waited for; the median of `frames` frames
-//! after a warm-up is its time ("pass wall time"). On a CPU adapter (lavapipe) that is the
+//! after a warm-up is its time ("pass wall time"). The methods compared on one scene are
+//! timed interleaved, one frame of each in turn, `frames` rounds: this shared machine's speed
+//! drifts by 30 % and more over minutes, and interleaving puts every method of a ratio under
+//! the same drift. On a CPU adapter (lavapipe) that is the
 //! pass's real cost, and GPU timestamps are not usable (they are not ordered after the
 //! compute work: passes read 0.03 ms whatever their size), so the chart uses wall times.
 //! The GPU timestamps are recorded too, for real GPUs. Speed is reported as ratios measured
@@ -153,7 +156,7 @@ impl BenchConfig {
     /// The default sweep: every scene at `ordinary` and `epipole_on_screen`, prefiltered
     /// (M, R) in {(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)} and raymarch N in {16, 32,
     /// 64, 128, 256} plus interleaved (64, 4x4) and (256, 4x4), and minmax, at 320x180 with
-    /// a 512x512 rectified map (prefiltered and minmax) and a 1024^2 shadow map, 3 frames;
+    /// a 512x512 rectified map (prefiltered and minmax) and a 1024^2 shadow map, 5 frames;
     /// plus the scaling and headline runs.
     pub fn default_sweep() -> BenchConfig {
         let mut methods: Vec<Method> = [(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)]
@@ -191,7 +194,7 @@ impl BenchConfig {
             screen: [320, 180],
             rectified: [512, 512],
             shadow_map: 1024,
-            frames: 3,
+            frames: 5,
             truth_segments: TruthSettings::default().segments,
             scaling: true,
             headline: true,
@@ -337,12 +340,8 @@ pub struct BenchResult {
 
 type BoxError = Box<dyn std::error::Error>;
 
-/// A run's output (rgba, row-major), its pass wall times and its GPU timestamps.
-type MethodRun = (
-    Vec<[f32; 4]>,
-    Vec<(&'static str, Duration)>,
-    Option<Duration>,
-);
+/// A run: its passes, its output (rgba, row-major) and its GPU timestamps.
+type MethodRun = (FamilyPasses, Vec<[f32; 4]>, Option<Duration>);
 
 fn light_of(name: SceneName) -> LightKind {
     if name == SceneName::SpotGrate {
@@ -406,10 +405,15 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
         )?;
         let depth_view = depth.create_view(&Default::default());
         let shadow_view = shadow.create_view(&Default::default());
-        for &method in &config.methods {
-            let method = method.with_light(light_of(name));
+        let methods: Vec<Method> = config
+            .methods
+            .iter()
+            .map(|m| m.with_light(light_of(name)))
+            .collect();
+        let mut runs = Vec::with_capacity(methods.len());
+        for &method in &methods {
             bar.set_message(format!("{name}/{pose}: {}", method.id()));
-            let (output, passes, gpu_timestamps) = run_method(
+            runs.push(run_method(
                 ctx,
                 method,
                 &scene,
@@ -418,8 +422,18 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
                 &shadow_view,
                 config.screen,
                 config.rectified,
-                config.frames,
-            )?;
+            )?);
+        }
+        bar.set_message(format!("{name}/{pose}: timing, interleaved"));
+        let inputs = Inputs {
+            depth: &depth_view,
+            shadow_map: Some(&shadow_view),
+            rectified: None,
+        };
+        let times = time_interleaved(ctx, &runs, &inputs, config.frames)?;
+        for ((method, (_, output, gpu_timestamps)), passes) in
+            methods.into_iter().zip(runs).zip(times)
+        {
             let image =
                 Image::from_pixels(w, h, output.iter().map(|c| [c[0], c[1], c[2]]).collect());
             let e = metrics::compare(&image, &exact)?;
@@ -464,8 +478,8 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
 }
 
 /// Runs `method` once on a prepared scene (the engine's depth buffer `dv` and shadow map
-/// `sv` already uploaded): its output, the median wall time of each pass submitted alone
-/// over `frames` frames, and the GPU timestamps of one frame when the adapter has them.
+/// `sv` already uploaded): its passes (for [`time_interleaved`]), its output, and the GPU
+/// timestamps of one frame when the adapter has them.
 #[allow(
     clippy::too_many_arguments,
     reason = "the scene's buffers and the sizes"
@@ -479,7 +493,6 @@ fn run_method(
     sv: &TextureView,
     screen: [u32; 2],
     rectified: [u32; 2],
-    frames: u32,
 ) -> Result<MethodRun, BoxError> {
     let res = Resolutions {
         screen,
@@ -506,24 +519,56 @@ fn run_method(
     ctx.queue().submit([encoder.finish()]);
     let ts = pass.total_pass_time(ctx)?;
     let output = read_rgba16float(ctx, Kernel::Scatter, pass.output_texture())?;
-    let passes = pass
-        .measure_pass_wall_times(ctx, &inputs, frames)?
-        .into_iter()
-        .map(|(kernel, t)| (kernel.name(), t))
-        .collect();
-    Ok((output, passes, ts))
+    Ok((pass, output, ts))
 }
 
-/// Times `method` (pass wall times) on `name/ordinary` at `screen` (prefiltered: with a
-/// `rectified` map).
-fn time_method(
+/// The median wall time of each pass of each run over `frames` rounds; a round times one
+/// frame of every run in turn (after one warm-up frame each), so that the machine's drift
+/// falls on every run alike.
+fn time_interleaved(
     ctx: &Context,
-    method: Method,
+    runs: &[MethodRun],
+    inputs: &Inputs<'_>,
+    frames: u32,
+) -> Result<Vec<Vec<(&'static str, Duration)>>, BoxError> {
+    for (pass, _, _) in runs {
+        pass.measure_pass_wall_times(ctx, inputs, 1)?;
+    }
+    let mut samples: Vec<Vec<(&'static str, Vec<Duration>)>> = vec![Vec::new(); runs.len()];
+    for _ in 0..frames.max(1) {
+        for ((pass, _, _), s) in runs.iter().zip(&mut samples) {
+            let t = pass.measure_pass_wall_times(ctx, inputs, 1)?;
+            if s.is_empty() {
+                *s = t.iter().map(|(k, _)| (k.name(), Vec::new())).collect();
+            }
+            for ((_, v), (_, d)) in s.iter_mut().zip(t) {
+                v.push(d);
+            }
+        }
+    }
+    Ok(samples
+        .into_iter()
+        .map(|s| {
+            s.into_iter()
+                .map(|(name, mut v)| {
+                    v.sort();
+                    (name, v[v.len() / 2])
+                })
+                .collect()
+        })
+        .collect())
+}
+
+/// Times `methods` (pass wall times, interleaved) on `name/ordinary` at `screen`
+/// (prefiltered and minmax: with a `rectified` map).
+fn time_methods(
+    ctx: &Context,
+    methods: &[Method],
     name: SceneName,
     screen: [u32; 2],
     rectified: [u32; 2],
     frames: u32,
-) -> Result<Vec<(&'static str, Duration)>, BoxError> {
+) -> Result<Vec<Vec<(&'static str, Duration)>>, BoxError> {
     let scene = suite::scene(
         name,
         Pose::Ordinary,
@@ -552,18 +597,27 @@ fn time_method(
         depth.create_view(&Default::default()),
         shadow.create_view(&Default::default()),
     );
-    let (_, passes, _) = run_method(
-        ctx,
-        method.with_light(light_of(name)),
-        &scene,
-        &sm,
-        &dv,
-        &sv,
-        screen,
-        rectified,
-        frames,
-    )?;
-    Ok(passes)
+    let runs = methods
+        .iter()
+        .map(|m| {
+            run_method(
+                ctx,
+                m.with_light(light_of(name)),
+                &scene,
+                &sm,
+                &dv,
+                &sv,
+                screen,
+                rectified,
+            )
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let inputs = Inputs {
+        depth: &dv,
+        shadow_map: Some(&sv),
+        rectified: None,
+    };
+    time_interleaved(ctx, &runs, &inputs, frames)
 }
 
 /// The headline configuration: 1280x720, 1024x1024 rectified, on sphere, foliage and
@@ -579,12 +633,13 @@ fn headline_runs(ctx: &Context, frames: u32) -> Result<Vec<HeadlineRow>, BoxErro
     }
     let mut out = Vec::new();
     for name in [SceneName::Sphere, SceneName::Foliage, SceneName::Terrain] {
-        for &m in &methods {
+        let times = time_methods(ctx, &methods, name, [1280, 720], [1024, 1024], frames)?;
+        for (&m, passes) in methods.iter().zip(times) {
             out.push(HeadlineRow {
                 family: m.family(),
                 knobs: m.knobs(),
                 scene: name,
-                passes: time_method(ctx, m, name, [1280, 720], [1024, 1024], frames)?,
+                passes,
             });
         }
     }
