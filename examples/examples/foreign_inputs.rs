@@ -20,7 +20,8 @@ use scatter_reference::bvh::Bvh;
 use scatter_reference::kernels::engine_rectified_map;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightDesc, LightKind, Rectification, Resolutions, Variant, prepare_frame,
+    FrameSettings, LightDesc, LightKind, PrefilteredVariant, Rectification, Resolutions,
+    prepare_frame,
 };
 
 /// Writes frame.json and the PFM inputs of the foreign engine for a suite scene.
@@ -72,13 +73,13 @@ fn run(args: &Args) -> Result<(), String> {
     };
     let settings = FrameSettings::for_screen(gbuf.width, gbuf.height);
     let (camera, light, medium) = (scene.camera_desc(), scene.light_desc(), scene.medium_desc());
-    let variant = Variant {
+    let variant = PrefilteredVariant {
         light: match light {
             LightDesc::Directional { .. } => LightKind::Directional,
             LightDesc::Spot { .. } => LightKind::Spot,
         },
         rectification: args.rectification,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     };
     let frame = prepare_frame(
         &variant,

@@ -1031,7 +1031,7 @@ mod tests {
         ) else {
             panic!("prefiltered");
         };
-        let expected = scatter_shaderlib::prefiltered::Variant {
+        let expected = scatter_shaderlib::prefiltered::PrefilteredVariant {
             bases: 64,
             regions: 8,
             visibility: "average".parse().unwrap_or_else(|e| panic!("{e}")),

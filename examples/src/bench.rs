@@ -30,7 +30,7 @@ use scatter_runtime::shaderlib::Kernel;
 use scatter_runtime::shaderlib::family::{Family, FamilyVariant, KernelFamily};
 use scatter_runtime::shaderlib::minmax::MinmaxVariant;
 use scatter_runtime::shaderlib::prefiltered::{
-    FrameSettings, LightKind, Resolutions, Storage, Variant,
+    FrameSettings, LightKind, PrefilteredVariant, Resolutions, Storage,
 };
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
@@ -162,10 +162,10 @@ impl BenchConfig {
         let mut methods: Vec<Method> = [(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)]
             .into_iter()
             .map(|(bases, regions)| {
-                Method::from(Variant {
+                Method::from(PrefilteredVariant {
                     bases,
                     regions,
-                    ..Variant::default()
+                    ..PrefilteredVariant::default()
                 })
             })
             .collect();
@@ -238,9 +238,9 @@ impl BenchConfig {
 pub struct Row {
     /// Family.
     pub family: &'static str,
-    /// Variant id.
+    /// PrefilteredVariant id.
     pub variant: String,
-    /// Variant knobs without the light.
+    /// PrefilteredVariant knobs without the light.
     pub knobs: String,
     /// The method (light set to the scene's).
     pub method: Method,
@@ -283,7 +283,7 @@ pub struct ScalingRow {
 pub struct HeadlineRow {
     /// Family.
     pub family: &'static str,
-    /// Variant knobs without the light.
+    /// PrefilteredVariant knobs without the light.
     pub knobs: String,
     /// Scene (pose `ordinary`).
     pub scene: SceneName,
@@ -685,7 +685,7 @@ fn scaling_runs(ctx: &Context, frames: u32) -> Result<Vec<ScalingRow>, BoxError>
         );
         let mut pass = Prefiltered::new(
             ctx,
-            &Variant::default(),
+            &PrefilteredVariant::default(),
             Resolutions { screen, rectified },
             sm.size,
         )?;
@@ -1212,10 +1212,10 @@ pub fn tune_candidates() -> Vec<Method> {
         for bases in [16, 32, 64] {
             for regions in [1, 3, 8] {
                 out.push(Method::new(
-                    Variant {
+                    PrefilteredVariant {
                         bases,
                         regions,
-                        ..Variant::default()
+                        ..PrefilteredVariant::default()
                     },
                     rectified,
                 ));
@@ -1299,7 +1299,7 @@ pub fn tune_refinements(table: &[TuneEntry], run: [u32; 2]) -> Vec<Method> {
             for bpt in (4..=v.bases).step_by(4) {
                 if bpt != v.bases_per_thread && v.bases.is_multiple_of(bpt) {
                     push(Method::new(
-                        Variant {
+                        PrefilteredVariant {
                             bases_per_thread: bpt,
                             ..v
                         },
@@ -1309,7 +1309,10 @@ pub fn tune_refinements(table: &[TuneEntry], run: [u32; 2]) -> Vec<Method> {
             }
             for &storage in Storage::ALL {
                 if storage != v.storage {
-                    push(Method::new(Variant { storage, ..v }, m.rectified));
+                    push(Method::new(
+                        PrefilteredVariant { storage, ..v },
+                        m.rectified,
+                    ));
                 }
             }
         }
@@ -1450,9 +1453,9 @@ mod tests {
     #[test]
     fn tune_picks_the_cheapest_within_budget() {
         let spot = Method::new(
-            Variant {
+            PrefilteredVariant {
                 light: LightKind::Spot,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             },
             Some([256, 256]),
         );
@@ -1508,9 +1511,9 @@ mod tests {
     fn refinements_step_the_fixed_knobs_around_the_front() {
         let p = |bases, r| {
             Method::new(
-                Variant {
+                PrefilteredVariant {
                     bases,
-                    ..Variant::default()
+                    ..PrefilteredVariant::default()
                 },
                 r,
             )

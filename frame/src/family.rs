@@ -13,7 +13,7 @@ use serde::de::DeserializeOwned;
 
 use crate::minmax::MinmaxVariant;
 use crate::raymarch::RaymarchVariant;
-use crate::variant::{LightKind, Variant, VariantError};
+use crate::variant::{LightKind, PrefilteredVariant, VariantError};
 
 /// The one table of every family: `Name(variant type)`, one line each. It defines [`Family`]
 /// (with `ALL`, `name`, `summary`, `default_variant`, `grid`) and [`FamilyVariant`] (with
@@ -172,7 +172,7 @@ families! {
     /// Chen et al. 2011: `rectify` (the prefiltered family's), `minmax_build`, `minmax_traverse`.
     Minmax(MinmaxVariant),
     /// Klehm et al. 2014: `rectify`, `prefilter`, `scatter`.
-    Prefiltered(Variant),
+    Prefiltered(PrefilteredVariant),
     /// Tóth & Umenhoffer 2009: `raymarch`, `interleave_sum` (interleaved variants).
     Raymarch(RaymarchVariant),
 }

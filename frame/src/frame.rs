@@ -40,7 +40,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, DVec4};
 use std::f64::consts::PI;
 
-use crate::variant::{LightKind, Rectification, Variant};
+use crate::variant::{LightKind, PrefilteredVariant, Rectification};
 
 pub use crate::scene::{
     BASIS_TOLERANCE, CameraDesc, FrameError, LightDesc, MAX_COLOR, MAX_COORD, MAX_SIGMA_T,
@@ -408,7 +408,7 @@ impl Setup {
 /// value and the accepted range, [`FrameError::EyeAtLight`]; [`FrameError::NotRepresentable`]
 /// if a uniform still came out non-finite.
 pub fn prepare_frame(
-    variant: &Variant,
+    variant: &PrefilteredVariant,
     res: &Resolutions,
     camera: &CameraDesc,
     light: &LightDesc,
@@ -460,7 +460,7 @@ pub fn prepare_frame(
 }
 
 fn prepare_frame_unchecked(
-    variant: &Variant,
+    variant: &PrefilteredVariant,
     res: &Resolutions,
     camera: &CameraDesc,
     light: &LightDesc,
@@ -776,7 +776,7 @@ pub fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
 /// spot_grate/grazing: the last region then spans most of the ray and the per-region
 /// unshadowed quadrature misses the cone).
 fn projective_frame(
-    variant: &Variant,
+    variant: &PrefilteredVariant,
     res: &Resolutions,
     s: &Setup,
     dist: f64,

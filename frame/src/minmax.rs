@@ -47,7 +47,7 @@ use crate::frame::{
     CameraDesc, FrameError, FrameSettings, LightDesc, MediumDesc, PrefilteredFrame, Resolutions,
     ShadowMapDesc, prepare_frame,
 };
-use crate::variant::{LightKind, Rectification, Variant, VariantError};
+use crate::variant::{LightKind, PrefilteredVariant, Rectification, VariantError};
 
 /// The knobs of the `minmax` family.
 #[derive(
@@ -81,12 +81,12 @@ impl MinmaxVariant {
 
     /// The prefiltered-family variant whose frame set-up and `rectify` kernel this family
     /// uses: the light, epipolar rectification, one region (the other knobs do not matter).
-    pub fn prefiltered(&self) -> Variant {
-        Variant {
+    pub fn prefiltered(&self) -> PrefilteredVariant {
+        PrefilteredVariant {
             regions: 1,
             light: self.light,
             rectification: Rectification::Epipolar,
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         }
     }
 }

@@ -1,4 +1,4 @@
-//! [`Variant`]: the knobs of the prefiltered family (DESIGN.md, "Variant space"), validated
+//! [`PrefilteredVariant`]: the knobs of the prefiltered family (DESIGN.md, "PrefilteredVariant space"), validated
 //! with errors that name the knob, the value and the allowed range.
 
 use crate::family::{Family, KnobSet};
@@ -148,7 +148,7 @@ pub struct VariantError {
 /// 32 bases, 8 per thread, 3 regions, weighted visibility, rgba8unorm, epipolar, directional.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-pub struct Variant {
+pub struct PrefilteredVariant {
     /// Fourier bases M (M/2 frequencies, sine and cosine): 4..=128, a multiple of 4.
     pub bases: u32,
     /// Bases filtered by one invocation: a multiple of 4 that divides `bases`.
@@ -165,9 +165,9 @@ pub struct Variant {
     pub rectification: Rectification,
 }
 
-impl Default for Variant {
+impl Default for PrefilteredVariant {
     fn default() -> Self {
-        Variant {
+        PrefilteredVariant {
             bases: 32,
             bases_per_thread: 8,
             regions: 3,
@@ -179,7 +179,7 @@ impl Default for Variant {
     }
 }
 
-impl Variant {
+impl PrefilteredVariant {
     /// Allowed `bases`.
     pub const BASES: std::ops::RangeInclusive<u32> = 4..=128;
     /// Allowed `regions`.
@@ -225,7 +225,7 @@ impl Variant {
     /// Every valid variant with bases in {4, 8, 16, 32, 64, 128} (the powers of two of the
     /// design card), every `bases_per_thread`, the given `regions`, both visibilities, both
     /// lights, every storage format and both rectifications; sorted by those knobs.
-    pub fn grid(regions: std::ops::RangeInclusive<u32>) -> Vec<Variant> {
+    pub fn grid(regions: std::ops::RangeInclusive<u32>) -> Vec<PrefilteredVariant> {
         let mut out = Vec::new();
         for bases in [4, 8, 16, 32, 64, 128] {
             for bases_per_thread in Self::bases_per_thread_options(bases) {
@@ -234,7 +234,7 @@ impl Variant {
                         for &light in LightKind::ALL {
                             for &storage in Storage::ALL {
                                 for &rectification in Rectification::ALL {
-                                    out.push(Variant {
+                                    out.push(PrefilteredVariant {
                                         bases,
                                         bases_per_thread,
                                         regions: r,
@@ -279,24 +279,24 @@ impl Variant {
     }
 }
 
-impl fmt::Display for Variant {
+impl fmt::Display for PrefilteredVariant {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.id())
     }
 }
 
-impl KnobSet for Variant {
+impl KnobSet for PrefilteredVariant {
     const FAMILY_NAME: &'static str = "prefiltered";
     const FAMILY: Family = Family::Prefiltered;
     const SUMMARY: &'static str = "Klehm et al. 2014, prefiltered single scattering: Fourier-basis visibility \
          prefiltered along epipolar rows of a rectified shadow map";
 
     fn validate(&self) -> Result<(), VariantError> {
-        Variant::validate(self)
+        PrefilteredVariant::validate(self)
     }
 
     fn id(&self) -> String {
-        Variant::id(self)
+        PrefilteredVariant::id(self)
     }
 
     fn light(&self) -> LightKind {
@@ -329,6 +329,6 @@ impl KnobSet for Variant {
 
     /// Regions 1..=4 (every other knob at every value).
     fn grid() -> Vec<Self> {
-        Variant::grid(1..=4)
+        PrefilteredVariant::grid(1..=4)
     }
 }

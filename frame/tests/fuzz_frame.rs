@@ -29,7 +29,7 @@ use scatter_frame::frame::{
 };
 use scatter_frame::minmax::{MinmaxVariant, level_count, prepare_minmax, tree_levels, tree_width};
 use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_raymarch};
-use scatter_frame::variant::{LightKind, Variant};
+use scatter_frame::variant::{LightKind, PrefilteredVariant};
 
 /// Cases of `prepare_frame` (prefiltered family, every variant of the grid).
 const PREFILTERED_CASES: u32 = 6000;
@@ -550,7 +550,7 @@ impl Case {
 }
 
 fn family() -> impl Strategy<Value = FamilyVariant> {
-    let grid = Variant::grid(1..=8);
+    let grid = PrefilteredVariant::grid(1..=8);
     prop_oneof![
         prop::sample::select(grid).prop_map(FamilyVariant::Prefiltered),
         prop::sample::select(RaymarchVariant::grid()).prop_map(FamilyVariant::Raymarch),
@@ -750,7 +750,7 @@ fn check_case(case: Case) -> Result<(), TestCaseError> {
 
 #[test]
 fn prepare_frame_on_mutated_frames() {
-    let grid = Variant::grid(1..=8);
+    let grid = PrefilteredVariant::grid(1..=8);
     run(
         "prepare_frame",
         PREFILTERED_CASES,

@@ -78,7 +78,7 @@ pub struct ManifestStruct {
 pub struct ManifestVariant {
     /// Family name.
     pub family: &'static str,
-    /// Variant id (part of every file name).
+    /// PrefilteredVariant id (part of every file name).
     pub id: String,
     /// Knob values.
     pub knobs: Value,

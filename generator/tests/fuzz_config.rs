@@ -1,6 +1,6 @@
 //! Property tests of everything in the generator that reads user input: the knob values of
 //! every family (`Family::variant`, what the CLI flags and the config file go through), the
-//! enum knobs' `FromStr`, `Variant::validate` / `RaymarchVariant::validate`, the family and
+//! enum knobs' `FromStr`, `PrefilteredVariant::validate` / `RaymarchVariant::validate`, the family and
 //! target names, `config::parse` on arbitrary text and on valid `variants.toml` files with
 //! one fault planted, the ownership manifest reader (`output::owned_files`) on arbitrary and
 //! mutated `manifest.json` files, and the `scatter-gen` binary on arbitrary command lines.
@@ -20,7 +20,9 @@ use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
 use scatter_gen::family::{FamilyVariant, KnobType};
 use scatter_gen::{Family, FamilyCli, GenError, Request, Target, config, generate, output};
 use scatter_shaderlib::prefiltered::variant::printable;
-use scatter_shaderlib::prefiltered::{LightKind, Rectification, Storage, Variant, VisibilityMode};
+use scatter_shaderlib::prefiltered::{
+    LightKind, PrefilteredVariant, Rectification, Storage, VisibilityMode,
+};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 use serde_json::Value;
 
@@ -279,11 +281,11 @@ fn validate_on_arbitrary_numbers() {
             any::<bool>(),
         ),
         |(bases, bpt, regions, samples, interleave, jitter)| {
-            let v = Variant {
+            let v = PrefilteredVariant {
                 bases,
                 bases_per_thread: bpt,
                 regions,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             };
             let r = RaymarchVariant {
                 samples,

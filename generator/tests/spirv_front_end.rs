@@ -5,7 +5,7 @@
 //! `src/spirv_fixup.rs`); spirv-val 2023.1 does not notice.
 
 use scatter_gen::{FamilyVariant, Request, Target, generate};
-use scatter_shaderlib::prefiltered::{LightKind, Rectification, Storage, Variant};
+use scatter_shaderlib::prefiltered::{LightKind, PrefilteredVariant, Rectification, Storage};
 
 #[test]
 fn emitted_spirv_passes_naga_spirv_front_end() {
@@ -13,11 +13,11 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
     for &light in LightKind::ALL {
         for &rectification in Rectification::ALL {
             for &storage in Storage::ALL {
-                variants.push(FamilyVariant::Prefiltered(Variant {
+                variants.push(FamilyVariant::Prefiltered(PrefilteredVariant {
                     light,
                     rectification,
                     storage,
-                    ..Variant::default()
+                    ..PrefilteredVariant::default()
                 }));
             }
         }

@@ -1,4 +1,4 @@
-//! The whole default grid (`Variant::grid(1..=4)`: every `bases` power of two with every
+//! The whole default grid (`PrefilteredVariant::grid(1..=4)`: every `bases` power of two with every
 //! `bases_per_thread`, 1-4 regions, both visibilities and lights, every storage format and
 //! every rectification the variant grid lists) plus the raymarch grid
 //! (`RaymarchVariant::grid()`: samples 8/32/128, interleave 1/2/4, jitter, both lights)
@@ -17,14 +17,14 @@ use std::time::Instant;
 use rayon::prelude::*;
 use scatter_gen::{FamilyVariant, KernelFamily, Request, Target, generate, manifest};
 use scatter_shaderlib::minmax::MinmaxVariant;
-use scatter_shaderlib::prefiltered::Variant;
+use scatter_shaderlib::prefiltered::PrefilteredVariant;
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
 use common::{require, scratch};
 
 /// The grid the generator is validated on (documented in the README).
 fn grid() -> Vec<FamilyVariant> {
-    Variant::grid(1..=4)
+    PrefilteredVariant::grid(1..=4)
         .into_iter()
         .map(FamilyVariant::Prefiltered)
         .chain(

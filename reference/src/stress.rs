@@ -47,7 +47,7 @@ pub enum StressGroup {
     Pose,
     /// Medium parameters.
     Medium,
-    /// Variant knobs and sizes.
+    /// PrefilteredVariant knobs and sizes.
     Size,
 }
 

@@ -9,7 +9,8 @@ use scatter_reference::kernels::common_prefiltered_projective::proj_column;
 use scatter_reference::kernels::texture::xyz;
 use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightDesc, LightKind, Rectification, Resolutions, Variant, prepare_frame,
+    FrameSettings, LightDesc, LightKind, PrefilteredVariant, Rectification, Resolutions,
+    prepare_frame,
 };
 
 const RECT: [u32; 2] = [256, 128];
@@ -22,11 +23,11 @@ fn check(name: SceneName, pose: Pose, regions: u32) {
         LightDesc::Directional { .. } => LightKind::Directional,
         LightDesc::Spot { .. } => LightKind::Spot,
     };
-    let variant = Variant {
+    let variant = PrefilteredVariant {
         light,
         regions,
         rectification: Rectification::Projective,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     };
     let res = Resolutions {
         screen: [160, 90],
@@ -165,10 +166,10 @@ fn map_matches_shadow_rays(name: SceneName, pose: Pose) -> f64 {
         LightDesc::Directional { .. } => LightKind::Directional,
         LightDesc::Spot { .. } => LightKind::Spot,
     };
-    let variant = Variant {
+    let variant = PrefilteredVariant {
         light,
         rectification: Rectification::Projective,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     };
     let rect = [1024, 512];
     let res = Resolutions {

@@ -8,7 +8,8 @@ use scatter_reference::bvh::Bvh;
 use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightDesc, LightKind, Rectification, Resolutions, Variant, prepare_frame,
+    FrameSettings, LightDesc, LightKind, PrefilteredVariant, Rectification, Resolutions,
+    prepare_frame,
 };
 use scatter_shaderlib::raymarch::{RaymarchVariant, prepare_raymarch};
 
@@ -39,10 +40,10 @@ fn every_suite_frame_is_accepted() {
                 );
                 let settings = FrameSettings::for_screen(w, h);
                 for rectification in [Rectification::Epipolar, Rectification::Projective] {
-                    let v = Variant {
+                    let v = PrefilteredVariant {
                         light,
                         rectification,
-                        ..Variant::default()
+                        ..PrefilteredVariant::default()
                     };
                     prepare_frame(&v, &res, &camera, &light_desc, &medium, &shadow, &settings)
                         .unwrap_or_else(|e| panic!("{trial}: prefiltered {rectification}: {e}"));

@@ -1,5 +1,5 @@
 //! The `prefiltered` family (Klehm et al. 2014) on wgpu: [`Prefiltered`] owns the three
-//! pipelines (`rectify`, `prefilter`, `scatter`) of one [`Variant`], the intermediate
+//! pipelines (`rectify`, `prefilter`, `scatter`) of one [`PrefilteredVariant`], the intermediate
 //! textures and the per-frame buffers; an engine calls [`Prefiltered::prepare`] and
 //! [`Prefiltered::encode`] once per frame with its depth buffer and standard shadow map.
 //! [`run_prefiltered_once`] is the upload-run-readback convenience the conformance tests use.
@@ -21,7 +21,8 @@ use std::time::{Duration, Instant};
 use scatter_shaderlib::prefiltered::plan;
 use scatter_shaderlib::prefiltered::{
     CameraDesc, FrameReport, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame,
-    Rectification, Resolutions, ShadowMapDesc, SliceParams, Storage, Variant, prepare_frame,
+    PrefilteredVariant, Rectification, Resolutions, ShadowMapDesc, SliceParams, Storage,
+    prepare_frame,
 };
 use scatter_shaderlib::{Kernel, KernelParams};
 
@@ -106,12 +107,12 @@ impl PrefilteredTimes {
     }
 }
 
-/// The `prefiltered` method for one [`Variant`], sized for one set of [`Resolutions`] and one
+/// The `prefiltered` method for one [`PrefilteredVariant`], sized for one set of [`Resolutions`] and one
 /// shadow-map size.
 #[derive(Debug)]
 pub struct Prefiltered {
     device: wgpu::Device,
-    variant: Variant,
+    variant: PrefilteredVariant,
     res: Resolutions,
     shadow_map_size: u32,
     /// The plan of the variant, built.
@@ -146,7 +147,7 @@ impl Prefiltered {
     /// passes.
     pub fn new(
         ctx: &Context,
-        variant: &Variant,
+        variant: &PrefilteredVariant,
         res: Resolutions,
         shadow_map_size: u32,
     ) -> Result<Self, RuntimeError> {
@@ -427,7 +428,7 @@ impl Prefiltered {
     }
 
     /// The variant the pipelines were built for.
-    pub fn variant(&self) -> &Variant {
+    pub fn variant(&self) -> &PrefilteredVariant {
         &self.variant
     }
 
@@ -541,7 +542,7 @@ pub struct PrefilteredReadback {
 /// GPU work or the readback fails.
 pub fn run_prefiltered_once(
     ctx: &Context,
-    variant: &Variant,
+    variant: &PrefilteredVariant,
     res: Resolutions,
     inputs: &CpuInputs,
 ) -> Result<PrefilteredReadback, RuntimeError> {
@@ -680,18 +681,18 @@ pub(crate) fn check_frame_buffers(limits: &wgpu::Limits, hr: u32) -> Result<u64,
 }
 
 impl crate::family::FamilyRuntime for Prefiltered {
-    type Variant = Variant;
+    type Variant = PrefilteredVariant;
 
     fn create(
         ctx: &Context,
-        variant: &Variant,
+        variant: &PrefilteredVariant,
         res: Resolutions,
         shadow_map_size: u32,
     ) -> Result<Self, RuntimeError> {
         Self::new(ctx, variant, res, shadow_map_size)
     }
 
-    fn knobs(&self) -> Variant {
+    fn knobs(&self) -> PrefilteredVariant {
         self.variant
     }
 

@@ -154,7 +154,7 @@ pub(crate) const fn template_path(kernel: Kernel) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::prefiltered::{LightKind, Variant};
+    use crate::prefiltered::{LightKind, PrefilteredVariant};
     use crate::{KernelParams, render};
 
     fn wgsl(module: &naga::Module) -> String {
@@ -167,9 +167,9 @@ mod tests {
     /// composed before, and survives a failed composition.
     #[test]
     fn cached_composer_matches_a_fresh_one() {
-        let spot = Variant {
+        let spot = PrefilteredVariant {
             light: LightKind::Spot,
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         };
         let mut all = KernelParams::all_modes();
         all.extend(KernelParams::prefiltered(spot));

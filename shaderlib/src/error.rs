@@ -18,7 +18,7 @@ pub enum ShaderError {
         /// The allowed range, in words.
         allowed: &'static str,
     },
-    /// A prefiltered-family [`Variant`](crate::prefiltered::Variant) knob is outside its
+    /// A prefiltered-family [`PrefilteredVariant`](crate::prefiltered::PrefilteredVariant) knob is outside its
     /// allowed range (the message names the knob, the value and the range).
     #[error("kernel `{kernel}`: invalid variant: {source}")]
     Variant {

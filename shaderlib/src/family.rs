@@ -6,7 +6,7 @@ pub use scatter_frame::family::{Family, FamilyVariant, KnobSet, UnknownFamily};
 
 use crate::minmax::MinmaxVariant;
 use crate::plan::Plan;
-use crate::prefiltered::Variant;
+use crate::prefiltered::PrefilteredVariant;
 use crate::raymarch::RaymarchVariant;
 use crate::{Kernel, KernelParams};
 
@@ -46,7 +46,7 @@ macro_rules! kernel_families {
 
             /// The default family's variant with the most passes.
             fn with_most_passes() -> Self {
-                Self::Prefiltered(Variant::with_most_passes())
+                Self::Prefiltered(PrefilteredVariant::with_most_passes())
             }
         }
 
@@ -67,6 +67,6 @@ macro_rules! kernel_families {
 
 kernel_families! {
     Minmax(MinmaxVariant),
-    Prefiltered(Variant),
+    Prefiltered(PrefilteredVariant),
     Raymarch(RaymarchVariant),
 }

@@ -8,7 +8,7 @@
 //!
 //! Kernels: `row_prefix` ([`RowPrefixParams`]), the prefiltered family (Klehm et al. 2014)
 //! `rectify`, `prefilter`, `scatter`, all three rendered from one
-//! [`prefiltered::Variant`] ([`KernelParams::prefiltered`]), and the raymarch family (Tóth &
+//! [`prefiltered::PrefilteredVariant`] ([`KernelParams::prefiltered`]), and the raymarch family (Tóth &
 //! Umenhoffer 2009) `raymarch`, `interleave_sum` from a [`raymarch::RaymarchVariant`]
 //! ([`KernelParams::raymarch`]), and the minmax family (Chen et al. 2011) `rectify`,
 //! `minmax_build`, `minmax_traverse` from a [`minmax::MinmaxVariant`] ([`KernelParams::minmax`]).
@@ -39,7 +39,7 @@ pub mod row_prefix;
 pub use error::ShaderError;
 pub use kernel::Kernel;
 use minmax::MinmaxVariant;
-use prefiltered::Variant;
+use prefiltered::PrefilteredVariant;
 use raymarch::RaymarchVariant;
 pub use row_prefix::{RowPrefixMode, RowPrefixParams};
 
@@ -55,17 +55,17 @@ pub enum KernelParams {
     /// [`Kernel::MinmaxTraverse`] of a minmax-family variant (only `light` changes the code).
     MinmaxTraverse(MinmaxVariant),
     /// [`Kernel::Prefilter`] of a prefiltered-family variant.
-    Prefilter(Variant),
+    Prefilter(PrefilteredVariant),
     /// [`Kernel::Raymarch`] of a raymarch-family variant (only `light` and whether it
     /// interleaves change the code).
     Raymarch(RaymarchVariant),
     /// [`Kernel::Rectify`] of a prefiltered-family variant (only `light` changes the code).
-    Rectify(Variant),
+    Rectify(PrefilteredVariant),
     /// [`Kernel::RowPrefix`]: per-row running sum or mean.
     RowPrefix(RowPrefixParams),
     /// [`Kernel::Scatter`] of a prefiltered-family variant (`bases_per_thread` and `storage`
     /// do not change the code).
-    Scatter(Variant),
+    Scatter(PrefilteredVariant),
 }
 
 impl KernelParams {
@@ -85,7 +85,7 @@ impl KernelParams {
 
     /// The three kernels of a prefiltered-family variant, in pass order: `rectify`,
     /// `prefilter`, `scatter`.
-    pub const fn prefiltered(variant: Variant) -> [Self; 3] {
+    pub const fn prefiltered(variant: PrefilteredVariant) -> [Self; 3] {
         [
             Self::Rectify(variant),
             Self::Prefilter(variant),
@@ -115,7 +115,7 @@ impl KernelParams {
 
     /// Every parameter set the conformance suite checks: each kernel in each of its modes,
     /// with default workgroup sizes, then the prefiltered kernels of the default
-    /// [`Variant`].
+    /// [`PrefilteredVariant`].
     pub fn all_modes() -> Vec<Self> {
         RowPrefixMode::ALL
             .iter()
@@ -125,7 +125,7 @@ impl KernelParams {
                     ..RowPrefixParams::default()
                 })
             })
-            .chain(Self::prefiltered(Variant::default()))
+            .chain(Self::prefiltered(PrefilteredVariant::default()))
             .chain(Self::raymarch(RaymarchVariant {
                 interleave: 2,
                 ..RaymarchVariant::default()

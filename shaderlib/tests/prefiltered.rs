@@ -8,15 +8,15 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use scatter_shaderlib::prefiltered::{
-    LightKind, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE, Storage,
-    Variant, VisibilityMode,
+    LightKind, PREFILTER_WORKGROUP_SIZE, PrefilteredVariant, RECTIFY_WORKGROUP_SIZE,
+    SCATTER_WORKGROUP_SIZE, Storage, VisibilityMode,
 };
 use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams, ShaderError, build, render};
 
 /// Every valid variant: bases {4, .., 128} x every bases_per_thread x regions 1..=8 x
 /// visibility x light x storage x rectification.
-fn cross_product() -> Vec<Variant> {
-    Variant::grid(Variant::REGIONS)
+fn cross_product() -> Vec<PrefilteredVariant> {
+    PrefilteredVariant::grid(PrefilteredVariant::REGIONS)
 }
 
 /// Renders every kernel of every variant and validates each distinct rendered source once
@@ -88,31 +88,31 @@ fn full_cross_product_validates() {
 fn bad_variants_are_rejected_naming_the_knob() {
     let cases = [
         (
-            Variant {
+            PrefilteredVariant {
                 bases: 30,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             },
             "bases",
         ),
         (
-            Variant {
+            PrefilteredVariant {
                 bases: 132,
                 bases_per_thread: 4,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             },
             "bases",
         ),
         (
-            Variant {
+            PrefilteredVariant {
                 bases_per_thread: 12,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             },
             "bases_per_thread",
         ),
         (
-            Variant {
+            PrefilteredVariant {
                 regions: 9,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             },
             "regions",
         ),
@@ -132,9 +132,9 @@ fn bad_variants_are_rejected_naming_the_knob() {
             );
         }
     }
-    let text = build(&KernelParams::Prefilter(Variant {
+    let text = build(&KernelParams::Prefilter(PrefilteredVariant {
         bases: 30,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     }))
     .expect_err("rejected")
     .to_string();
@@ -151,15 +151,15 @@ fn built(params: KernelParams) -> BuiltKernel {
 #[test]
 fn workgroup_sizes_read_back_from_the_ir() {
     for variant in [
-        Variant::default(),
-        Variant {
+        PrefilteredVariant::default(),
+        PrefilteredVariant {
             bases: 128,
             bases_per_thread: 128,
             regions: 8,
             light: LightKind::Spot,
             visibility: VisibilityMode::Average,
             storage: Storage::Rgba32float,
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         },
     ] {
         let [rectify, prefilter, scatter] = KernelParams::prefiltered(variant).map(built);
@@ -234,10 +234,10 @@ fn bindings_match_the_documented_tables() {
             StorageFormat::Rgba32Float,
             StorageFormat::Rgba8Unorm,
         ]) {
-            let variant = Variant {
+            let variant = PrefilteredVariant {
                 light,
                 storage: storage_knob,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             };
             let [rectify, prefilter, scatter] = KernelParams::prefiltered(variant).map(built);
             let b = |n: u32, name: &str, ty: &String| (n, name.to_owned(), ty.clone());
@@ -280,7 +280,7 @@ fn bindings_match_the_documented_tables() {
 /// 4 vec4<f32>.
 #[test]
 fn frame_layout_matches_the_host_struct() {
-    let built = built(KernelParams::Scatter(Variant::default()));
+    let built = built(KernelParams::Scatter(PrefilteredVariant::default()));
     let m = &built.module;
     let (_, frame) = m
         .global_variables
@@ -344,22 +344,22 @@ fn frame_layout_matches_the_host_struct() {
 /// The generator's targets: SPIR-V and GLSL 450 accept the extreme variants.
 #[test]
 fn spirv_and_glsl_back_ends_accept_the_modules() {
-    let small = Variant {
+    let small = PrefilteredVariant {
         bases: 4,
         bases_per_thread: 4,
         regions: 1,
         visibility: VisibilityMode::Average,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     };
-    let large = Variant {
+    let large = PrefilteredVariant {
         bases: 128,
         bases_per_thread: 128,
         regions: 8,
         light: LightKind::Spot,
         storage: Storage::Rgba16float,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     };
-    for variant in [small, large, Variant::default()] {
+    for variant in [small, large, PrefilteredVariant::default()] {
         for built in KernelParams::prefiltered(variant).map(built) {
             let stage = naga::ShaderStage::Compute;
             naga::back::spv::write_vec(
@@ -398,14 +398,14 @@ fn spirv_and_glsl_back_ends_accept_the_modules() {
 
 #[test]
 fn templates_receive_the_variant_s_values() {
-    let variant = Variant {
+    let variant = PrefilteredVariant {
         bases: 64,
         bases_per_thread: 16,
         regions: 5,
         visibility: VisibilityMode::Average,
         light: LightKind::Spot,
         storage: Storage::Rgba16float,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     };
     let [rectify, prefilter, scatter] =
         KernelParams::prefiltered(variant).map(|p| render(&p).unwrap_or_else(|e| panic!("{e}")));
@@ -440,10 +440,10 @@ fn templates_receive_the_variant_s_values() {
 
 #[test]
 fn params_round_trip_through_json() {
-    for params in KernelParams::prefiltered(Variant {
+    for params in KernelParams::prefiltered(PrefilteredVariant {
         bases: 16,
         light: LightKind::Spot,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     }) {
         let json = serde_json::to_string(&params).expect("serialises");
         let back: KernelParams = serde_json::from_str(&json).expect("deserialises");
@@ -453,10 +453,10 @@ fn params_round_trip_through_json() {
     let params: KernelParams = serde_json::from_str(json).expect("defaults fill the rest");
     assert_eq!(
         params,
-        KernelParams::Scatter(Variant {
+        KernelParams::Scatter(PrefilteredVariant {
             bases: 8,
             regions: 2,
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         })
     );
     assert!(serde_json::from_str::<KernelParams>(r#"{"kernel":"scatter","base":8}"#).is_err());

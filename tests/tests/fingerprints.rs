@@ -30,7 +30,7 @@ use scatter_runtime::{
 };
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightKind, Rectification, Resolutions, Variant, prepare_frame,
+    FrameSettings, LightKind, PrefilteredVariant, Rectification, Resolutions, prepare_frame,
 };
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -86,7 +86,10 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
         writeln!(out, "{trial} {texture} {h:016x}").unwrap_or_else(|e| panic!("{e}"));
     };
 
-    let prefiltered: Vec<Variant> = Variant::grid(1..=4).into_iter().step_by(31).collect();
+    let prefiltered: Vec<PrefilteredVariant> = PrefilteredVariant::grid(1..=4)
+        .into_iter()
+        .step_by(31)
+        .collect();
     for v in &prefiltered {
         for f in for_light(v.light) {
             let trial = format!("prefiltered::{}::{}", v.id(), f.trial_tail());

@@ -41,7 +41,7 @@ use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::{Context, FamilyPasses, FrameInput};
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
-use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions, Variant};
+use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, PrefilteredVariant, Resolutions};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
 const SCREEN: [u32; 2] = [64, 36];
@@ -77,9 +77,9 @@ const SAMPLES: [u32; 4] = [32, 64, 128, 256];
 /// The variants reported, in column order: the prefiltered default, raymarch at every
 /// `SAMPLES`, minmax.
 fn variants(light: LightKind) -> Vec<FamilyVariant> {
-    let mut v = vec![FamilyVariant::Prefiltered(Variant {
+    let mut v = vec![FamilyVariant::Prefiltered(PrefilteredVariant {
         light,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     })];
     v.extend(SAMPLES.iter().map(|&samples| {
         FamilyVariant::Raymarch(RaymarchVariant {

@@ -43,7 +43,7 @@ use scatter_runtime::{
     run_raymarch_once,
 };
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightKind, Rectification, Resolutions, Storage, Variant,
+    FrameSettings, LightKind, PrefilteredVariant, Rectification, Resolutions, Storage,
 };
 
 const SCREEN: [u32; 2] = [128, 72];
@@ -53,20 +53,20 @@ const SHADOW_MAP: u32 = 256;
 const REL_TOL: f32 = 1e-4;
 
 /// The three trial variants.
-fn variants() -> [Variant; 3] {
+fn variants() -> [PrefilteredVariant; 3] {
     [
-        Variant::default(),
-        Variant {
+        PrefilteredVariant::default(),
+        PrefilteredVariant {
             light: LightKind::Spot,
             storage: Storage::Rgba16float,
             regions: 2,
             bases: 16,
             bases_per_thread: 4,
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         },
-        Variant {
+        PrefilteredVariant {
             rectification: Rectification::Projective,
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         },
     ]
 }
@@ -113,7 +113,7 @@ fn fixture(light: LightKind) -> &'static Fixture {
 trait ForeignFixture {
     fn input(&self) -> FrameInput;
     fn sizes(&self) -> Sizes;
-    fn frame(&self, variant: &Variant) -> PrefilteredFrame;
+    fn frame(&self, variant: &PrefilteredVariant) -> PrefilteredFrame;
 }
 
 impl ForeignFixture for Fixture {
@@ -130,7 +130,7 @@ impl ForeignFixture for Fixture {
     }
 
     /// The frame set-up, as the foreign engine computes it (scatter-frame only).
-    fn frame(&self, variant: &Variant) -> PrefilteredFrame {
+    fn frame(&self, variant: &PrefilteredVariant) -> PrefilteredFrame {
         let f = self.input();
         prepare_frame(
             variant,
@@ -168,7 +168,7 @@ fn compare(foreign: &[[f32; 4]], runtime: &[[f32; 4]]) -> (f32, f32, usize) {
     (worst.0, max, worst.1)
 }
 
-fn trial(ctx: &Context, variant: &Variant) -> Vec<String> {
+fn trial(ctx: &Context, variant: &PrefilteredVariant) -> Vec<String> {
     let fixture = fixture(variant.light);
     let name = format!(
         "foreign::{}::{}::{}",
@@ -539,7 +539,7 @@ fn foreign_engine_files_run_every_family() {
 #[test]
 fn foreign_engine_comparison_detects_a_wrong_input() {
     let Some(ctx) = gpu() else { return };
-    let variant = Variant::default();
+    let variant = PrefilteredVariant::default();
     let fixture = fixture(variant.light);
     let frame = fixture.frame(&variant);
     let runtime = run_prefiltered_once(
@@ -712,7 +712,7 @@ fn copy_dir(from: &Path, name: &str) -> PathBuf {
 #[test]
 fn foreign_engine_reports_bad_directories() {
     let Some(ctx) = gpu() else { return };
-    let variant = Variant::default();
+    let variant = PrefilteredVariant::default();
     let sizes = Sizes {
         screen: SCREEN,
         rectified: RECTIFIED,
@@ -844,15 +844,15 @@ fn foreign_engine_reports_bad_directories() {
 /// engine-side alternatives of engine inputs.
 #[test]
 fn manifest_conditions_are_machine_readable() {
-    let variants: Vec<Variant> = [LightKind::Directional, LightKind::Spot]
+    let variants: Vec<PrefilteredVariant> = [LightKind::Directional, LightKind::Spot]
         .into_iter()
         .flat_map(|light| {
             Rectification::ALL
                 .iter()
-                .map(move |&rectification| Variant {
+                .map(move |&rectification| PrefilteredVariant {
                     light,
                     rectification,
-                    ..Variant::default()
+                    ..PrefilteredVariant::default()
                 })
         })
         .collect();

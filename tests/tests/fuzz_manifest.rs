@@ -26,7 +26,7 @@ use scatter_frame::frame::{
     CameraDesc, FrameSettings, LightDesc, MediumDesc, ShadowMapDesc, ShadowProjectionDesc,
 };
 use scatter_gen::{FamilyVariant, Request, Target, generate};
-use scatter_shaderlib::prefiltered::{LightKind, Rectification, Variant};
+use scatter_shaderlib::prefiltered::{LightKind, PrefilteredVariant, Rectification};
 use serde_json::Value;
 
 /// Cases of `Manifest::parse` on arbitrary bytes.
@@ -382,15 +382,15 @@ fn edited(real: &Value, (list, cut): Edits) -> Vec<u8> {
 /// A real manifest: the default variant and a projective spot variant (skip conditions and
 /// alternatives), WGSL and SPIR-V.
 fn real_manifest() -> Value {
-    let spot = Variant {
+    let spot = PrefilteredVariant {
         light: LightKind::Spot,
         rectification: Rectification::Projective,
         regions: 2,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     };
     let generated = generate(&Request {
         variants: vec![
-            FamilyVariant::Prefiltered(Variant::default()),
+            FamilyVariant::Prefiltered(PrefilteredVariant::default()),
             FamilyVariant::Prefiltered(spot),
         ],
         targets: vec![Target::Wgsl, Target::Spirv],
@@ -721,13 +721,16 @@ fn real_frame_file(light: LightKind) -> Value {
 #[test]
 fn frame_file_on_edited_files() {
     let files = [
-        (real_frame_file(LightKind::Directional), Variant::default()),
+        (
+            real_frame_file(LightKind::Directional),
+            PrefilteredVariant::default(),
+        ),
         (
             real_frame_file(LightKind::Spot),
-            Variant {
+            PrefilteredVariant {
                 light: LightKind::Spot,
                 rectification: Rectification::Projective,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             },
         ),
     ];

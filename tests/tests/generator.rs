@@ -7,13 +7,14 @@
 use scatter_gen::{FamilyVariant, Request, Target, generate};
 use scatter_runtime::prefiltered::{DEPTH_FORMAT, OUTPUT_FORMAT, storage_format};
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant, VisibilityMode,
+    FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
+    VisibilityMode,
 };
 use scatter_shaderlib::{KernelParams, build};
 use serde_json::Value;
 
 /// The manifest of one variant, parsed.
-fn manifest(v: Variant) -> Value {
+fn manifest(v: PrefilteredVariant) -> Value {
     let g = generate(&Request {
         variants: vec![FamilyVariant::Prefiltered(v)],
         targets: vec![Target::Wgsl],
@@ -72,12 +73,12 @@ fn eval(formula: &str, sizes: &[(&str, u32)]) -> u32 {
 fn manifest_resources_match_the_runtime() {
     for (&storage, &rectification) in Storage::ALL.iter().zip(Rectification::ALL.iter().cycle()) {
         for &light in LightKind::ALL {
-            let v = Variant {
+            let v = PrefilteredVariant {
                 storage,
                 light,
                 rectification,
                 bases: 64,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             };
             let m = manifest(v);
             let variant = &get(&m, "variants")[0];
@@ -120,7 +121,7 @@ fn manifest_resources_match_the_runtime() {
 
 #[test]
 fn manifest_frame_layout_matches_the_host_struct() {
-    let m = manifest(Variant::default());
+    let m = manifest(PrefilteredVariant::default());
     let frame = get(&m, "structs")
         .as_array()
         .and_then(|a| {
@@ -187,12 +188,12 @@ fn manifest_dispatch_matches_the_runtime_grid() {
         (128, 4, 8, VisibilityMode::Average),
         (4, 4, 1, VisibilityMode::Weighted),
     ] {
-        let v = Variant {
+        let v = PrefilteredVariant {
             bases,
             bases_per_thread,
             regions,
             visibility,
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         };
         let m = manifest(v);
         let passes = get(&get(&m, "variants")[0], "passes")

@@ -31,7 +31,9 @@ use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::{Context, CpuInputs, FrameInput, run_family_once};
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
-use scatter_shaderlib::prefiltered::{FrameReport, FrameSettings, LightKind, Resolutions, Variant};
+use scatter_shaderlib::prefiltered::{
+    FrameReport, FrameSettings, LightKind, PrefilteredVariant, Resolutions,
+};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
 /// The bars, for every family.
@@ -45,7 +47,7 @@ const RECTIFIED: [u32; 2] = [1024, 512];
 /// with the spot light.
 fn methods() -> Vec<FamilyVariant> {
     vec![
-        Variant::default().into(),
+        PrefilteredVariant::default().into(),
         MinmaxVariant::default().into(),
         FamilyVariant::Raymarch(RaymarchVariant {
             samples: 64,

@@ -16,7 +16,7 @@ use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::{Context, Minmax, Prefiltered, Raymarch, RuntimeError, wgpu};
 use scatter_shaderlib::Kernel;
 use scatter_shaderlib::minmax::MinmaxVariant;
-use scatter_shaderlib::prefiltered::{Resolutions, Variant};
+use scatter_shaderlib::prefiltered::{PrefilteredVariant, Resolutions};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
 /// Checks that `result` is a [`RuntimeError::LimitExceeded`] for `limit` with `value` and
@@ -64,7 +64,7 @@ fn texture_sizes_beyond_the_device_are_refused() {
     let max = ctx.device().limits().max_texture_dimension_2d;
     let (over, m) = (u64::from(max) + 1, u64::from(max));
     let limit = "max_texture_dimension_2d";
-    let v = Variant::default();
+    let v = PrefilteredVariant::default();
     assert_limit(
         "scatter_rectified_width",
         Prefiltered::new(ctx, &v, res([64, 36], [max + 1, 64]), 64),
@@ -154,7 +154,7 @@ fn texture_sizes_beyond_the_device_are_refused() {
 #[test]
 fn zero_sizes_are_refused_with_the_input_named() {
     let Some(ctx) = gpu() else { return };
-    let v = Variant::default();
+    let v = PrefilteredVariant::default();
     assert_empty(
         "scatter_screen",
         Prefiltered::new(ctx, &v, res([0, 36], [64, 64]), 64),
@@ -215,7 +215,7 @@ fn lowered_device_limits_are_named() {
     });
     let ctx = &ctx;
     // 32 bases are 8 rgba layers of filtered bases; 16 bases (4 layers) fit.
-    let v32 = Variant::default();
+    let v32 = PrefilteredVariant::default();
     assert_limit(
         "scatter_layers",
         Prefiltered::new(ctx, &v32, res([64, 36], [64, 16]), 64),
@@ -223,9 +223,9 @@ fn lowered_device_limits_are_named() {
         8,
         4,
     );
-    let v16 = Variant {
+    let v16 = PrefilteredVariant {
         bases: 16,
-        ..Variant::default()
+        ..PrefilteredVariant::default()
     };
     // 65 rows of 16 bytes in the slice table.
     assert_limit(
@@ -335,7 +335,7 @@ fn foreign_engine_names_the_limit() {
     let Some(shared) = gpu() else { return };
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("limits_foreign_engine");
     let _ = std::fs::remove_dir_all(&dir);
-    let variant = Variant::default();
+    let variant = PrefilteredVariant::default();
     let generated = generate(&Request {
         variants: vec![FamilyVariant::Prefiltered(variant)],
         targets: vec![scatter_gen::Target::Wgsl],

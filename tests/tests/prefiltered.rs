@@ -41,7 +41,7 @@ use scatter_runtime::{
 };
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightKind, Rectification, Resolutions, Storage, Variant,
+    FrameSettings, LightKind, PrefilteredVariant, Rectification, Resolutions, Storage,
 };
 
 const SCREEN: [u32; 2] = [64, 36];
@@ -170,7 +170,7 @@ fn f16_ulp(v: f32) -> f32 {
     2f32.powi(a.log2().floor() as i32 - 10)
 }
 
-fn trial_name(variant: &Variant) -> String {
+fn trial_name(variant: &PrefilteredVariant) -> String {
     let (name, pose) = case(variant.light, variant.rectification);
     format!(
         "{}::{name}::{pose}",
@@ -178,7 +178,11 @@ fn trial_name(variant: &Variant) -> String {
     )
 }
 
-fn run_trial(ctx: &Context, variant: &Variant, fixture: &Fixture) -> Result<TrialResult, String> {
+fn run_trial(
+    ctx: &Context,
+    variant: &PrefilteredVariant,
+    fixture: &Fixture,
+) -> Result<TrialResult, String> {
     let trial = trial_name(variant);
     let start = Instant::now();
     let cpu: PrefilteredRun = run_prefiltered(
@@ -301,7 +305,7 @@ fn describe(what: &str, w: &Worst, layout: impl Fn(usize) -> String) -> String {
 
 /// One variant's trial: the GPU against the mirror on its fixture, every output within its
 /// tolerance.
-fn conformance(variant: &Variant) -> Result<(), String> {
+fn conformance(variant: &PrefilteredVariant) -> Result<(), String> {
     let Some(ctx) = gpu() else { return Ok(()) };
     let fixture = fixture(variant.light, variant.rectification);
     let [wr, hr] = RECTIFIED;
@@ -350,7 +354,7 @@ fn conformance(variant: &Variant) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    let mut trials: Vec<(String, Check)> = Variant::grid(1..=4)
+    let mut trials: Vec<(String, Check)> = PrefilteredVariant::grid(1..=4)
         .into_iter()
         .map(|variant| {
             let check: Check = Box::new(move || conformance(&variant));
@@ -376,8 +380,8 @@ fn main() -> ExitCode {
 }
 
 /// The variant the error tests start from.
-fn base_variant() -> Variant {
-    Variant::default()
+fn base_variant() -> PrefilteredVariant {
+    PrefilteredVariant::default()
 }
 
 fn columns_res() -> Resolutions {
@@ -531,7 +535,7 @@ fn invalid_variant_names_the_knob() {
     let Some(ctx) = gpu() else { return };
     let cases = [
         (
-            Variant {
+            PrefilteredVariant {
                 regions: 9,
                 ..base_variant()
             },
@@ -539,7 +543,7 @@ fn invalid_variant_names_the_knob() {
             "9",
         ),
         (
-            Variant {
+            PrefilteredVariant {
                 bases: 6,
                 ..base_variant()
             },
@@ -547,7 +551,7 @@ fn invalid_variant_names_the_knob() {
             "6",
         ),
         (
-            Variant {
+            PrefilteredVariant {
                 bases_per_thread: 12,
                 ..base_variant()
             },

@@ -31,7 +31,7 @@ use scatter_reference::metrics;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightKind, ProjectiveFallback, Rectification, Variant, VisibilityMode,
+    FrameSettings, LightKind, PrefilteredVariant, ProjectiveFallback, Rectification, VisibilityMode,
 };
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -150,12 +150,12 @@ fn light_of(name: SceneName) -> LightKind {
 }
 
 /// rel L1 of the CPU mirror of `variant` against the truth; panics on NaN/Inf.
-fn error(f: &Fixture, variant: &Variant) -> f64 {
+fn error(f: &Fixture, variant: &PrefilteredVariant) -> f64 {
     run(f, variant).1
 }
 
 /// The CPU mirror's run of `variant` and its rel L1 against the truth; panics on NaN/Inf.
-fn run(f: &Fixture, variant: &Variant) -> (PrefilteredRun, f64) {
+fn run(f: &Fixture, variant: &PrefilteredVariant) -> (PrefilteredRun, f64) {
     let run = run_prefiltered(
         variant,
         RECTIFIED,
@@ -190,9 +190,9 @@ fn default_variant_meets_the_bars_or_the_listed_bounds() {
     let mut met = 0;
     for (name, pose) in all_poses() {
         let f = fixture(name, pose, MediumPreset::Default);
-        let variant = Variant {
+        let variant = PrefilteredVariant {
             light: light_of(name),
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         };
         let e = 100.0 * error(&f, &variant);
         let key = format!("{name}/{pose}");
@@ -240,11 +240,11 @@ fn error_falls_as_bases_grow() {
             .map(|bases| {
                 error(
                     &f,
-                    &Variant {
+                    &PrefilteredVariant {
                         bases,
                         bases_per_thread: 4,
                         light: light_of(name),
-                        ..Variant::default()
+                        ..PrefilteredVariant::default()
                     },
                 )
             })
@@ -275,17 +275,17 @@ fn weighted_beats_average_in_thick_fog() {
         let light = light_of(name);
         let weighted = error(
             &f,
-            &Variant {
+            &PrefilteredVariant {
                 light,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             },
         );
         let average = error(
             &f,
-            &Variant {
+            &PrefilteredVariant {
                 light,
                 visibility: VisibilityMode::Average,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             },
         );
         println!(
@@ -344,11 +344,11 @@ fn average_visibility_on_every_pose() {
         let mut row = format!("| {key} |");
         let mut errors = Vec::new();
         for regions in AVERAGE_REGIONS {
-            let variant = Variant {
+            let variant = PrefilteredVariant {
                 light,
                 regions,
                 visibility: VisibilityMode::Average,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             };
             let e = 100.0 * error(&f, &variant);
             row += &format!(" {e:.2} |");
@@ -383,9 +383,9 @@ fn average_visibility_on_every_pose() {
         }
         let weighted = error(
             &f,
-            &Variant {
+            &PrefilteredVariant {
                 light,
-                ..Variant::default()
+                ..PrefilteredVariant::default()
             },
         );
         row += &format!(" {:.2} |", 100.0 * weighted);
@@ -407,10 +407,10 @@ fn projective_rectification_on_every_pose() {
     for (name, pose) in all_poses() {
         let f = fixture(name, pose, MediumPreset::Default);
         let light = light_of(name);
-        let variant = Variant {
+        let variant = PrefilteredVariant {
             light,
             rectification: Rectification::Projective,
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         };
         let (proj, e) = run(&f, &variant);
         let e = 100.0 * e;
@@ -461,9 +461,9 @@ fn projective_rectification_on_every_pose() {
                 // The fallback is exactly the epipolar variant.
                 let (epi, _) = run(
                     &f,
-                    &Variant {
+                    &PrefilteredVariant {
                         light,
-                        ..Variant::default()
+                        ..PrefilteredVariant::default()
                     },
                 );
                 if epi.output.data != proj.output.data {

@@ -40,7 +40,9 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::{Context, FrameInput};
 use scatter_shaderlib::family::{Family, FamilyVariant};
-use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Variant, VisibilityMode};
+use scatter_shaderlib::prefiltered::{
+    FrameSettings, LightKind, PrefilteredVariant, VisibilityMode,
+};
 
 const SCREEN: [u32; 2] = [96, 54];
 const RECTIFIED: [u32; 2] = [512, 512];
@@ -131,7 +133,7 @@ fn variants() -> Vec<FamilyVariant> {
         .flat_map(|f| match f.default_variant() {
             FamilyVariant::Prefiltered(v) => VisibilityMode::ALL
                 .iter()
-                .map(|&visibility| Variant { visibility, ..v }.into())
+                .map(|&visibility| PrefilteredVariant { visibility, ..v }.into())
                 .collect(),
             other => vec![other],
         })

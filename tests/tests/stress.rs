@@ -40,8 +40,8 @@ use scatter_runtime::{Context, FrameInput};
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{
-    FrameReport, FrameSettings, LightKind, ProjectiveFallback, Rectification, Resolutions, Storage,
-    Variant, VisibilityMode,
+    FrameReport, FrameSettings, LightKind, PrefilteredVariant, ProjectiveFallback, Rectification,
+    Resolutions, Storage, VisibilityMode,
 };
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -94,15 +94,15 @@ fn methods() -> Vec<FamilyVariant> {
         })
     };
     vec![
-        Variant::default().into(),
-        Variant {
+        PrefilteredVariant::default().into(),
+        PrefilteredVariant {
             rectification: Rectification::Projective,
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         }
         .into(),
-        Variant {
+        PrefilteredVariant {
             visibility: VisibilityMode::Average,
-            ..Variant::default()
+            ..PrefilteredVariant::default()
         }
         .into(),
         raymarch(16),

@@ -23,7 +23,7 @@ use scatter_frame::frame::{
 };
 use scatter_frame::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_raymarch};
-use scatter_frame::variant::Variant;
+use scatter_frame::variant::PrefilteredVariant;
 
 use crate::prefiltered::{Inputs, Sizes, run_frame};
 use crate::{Engine, EngineError, FrameRun, Target};
@@ -252,7 +252,7 @@ impl FrameFile {
     /// # Errors
     ///
     /// [`EngineError::Frame`] when the frame set-up rejects the numbers.
-    pub fn prepare(&self, variant: &Variant) -> Result<PrefilteredFrame, EngineError> {
+    pub fn prepare(&self, variant: &PrefilteredVariant) -> Result<PrefilteredFrame, EngineError> {
         let d = self.descs();
         Ok(prepare_frame(
             variant,
@@ -704,7 +704,7 @@ pub fn run_dir(
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Knobs {
     /// A `prefiltered` variant.
-    Prefiltered(Variant),
+    Prefiltered(PrefilteredVariant),
     /// A `raymarch` variant.
     Raymarch(RaymarchVariant),
     /// A `minmax` variant.
@@ -754,8 +754,8 @@ pub fn knobs_of(manifest: &crate::Manifest, id: &str) -> Result<Knobs, EngineErr
     match entry.family.as_str() {
         "prefiltered" => parse_knobs(
             entry,
-            |v: &Variant| v.validate().map_err(|e| e.to_string()),
-            Variant::id,
+            |v: &PrefilteredVariant| v.validate().map_err(|e| e.to_string()),
+            PrefilteredVariant::id,
         )
         .map(Knobs::Prefiltered),
         "raymarch" => parse_knobs(

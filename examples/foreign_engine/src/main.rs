@@ -26,7 +26,7 @@ struct Cli {
     /// Directory written by scatter-gen (manifest.json and the shader files).
     #[arg(long, value_name = "DIR")]
     shaders: PathBuf,
-    /// Variant id (from the manifest); may be left out when it has only one.
+    /// PrefilteredVariant id (from the manifest); may be left out when it has only one.
     #[arg(long, value_name = "ID")]
     variant: Option<String>,
     /// Input directory: frame.json, depth.pfm, shadow_map.pfm (rectified.pfm).

@@ -78,7 +78,7 @@ pub struct FileEntry {
 pub struct VariantEntry {
     /// Family (`prefiltered`).
     pub family: String,
-    /// Variant id (part of every file name).
+    /// PrefilteredVariant id (part of every file name).
     pub id: String,
     /// The knob values (family-specific object).
     #[serde(default)]

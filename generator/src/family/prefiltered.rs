@@ -1,15 +1,15 @@
 //! The `prefiltered` family (Klehm et al. 2014) in the registry: its knobs (parsed into a
-//! shaderlib [`Variant`]) and its plan (`scatter_shaderlib::prefiltered::plan`, which the
+//! shaderlib [`PrefilteredVariant`]) and its plan (`scatter_shaderlib::prefiltered::plan`, which the
 //! runtime builds and dispatches from).
 
 use scatter_shaderlib::prefiltered::{
-    LightKind, Rectification, Storage, Variant, VariantError, VisibilityMode,
+    LightKind, PrefilteredVariant, Rectification, Storage, VariantError, VisibilityMode,
 };
 
 use super::{KnobInfo, KnobType};
 use crate::GenError;
 
-/// Allowed `bases`, in the words of [`Variant::validate`].
+/// Allowed `bases`, in the words of [`PrefilteredVariant::validate`].
 const BASES_ALLOWED: &str = "a multiple of 4 in 4..=128";
 /// Allowed `bases_per_thread`.
 const BASES_PER_THREAD_ALLOWED: &str = "a multiple of 4 that divides bases";
@@ -20,9 +20,9 @@ fn enum_allowed(allowed: &str) -> String {
     allowed.trim_end().replace(' ', " | ")
 }
 
-/// The knobs of [`Variant`], defaults from [`Variant::default`] (the paper's choice).
+/// The knobs of [`PrefilteredVariant`], defaults from [`PrefilteredVariant::default`] (the paper's choice).
 pub fn knobs() -> Vec<KnobInfo> {
-    let d = Variant::default();
+    let d = PrefilteredVariant::default();
     vec![
         KnobInfo {
             name: "bases",
@@ -98,8 +98,8 @@ fn number(knob: &'static str, allowed: &str, value: &str) -> Result<u32, Variant
 /// # Errors
 ///
 /// [`GenError::Knob`]: the variant's own message naming the knob, the value and the range.
-pub fn parse(knobs: &[(String, String)]) -> Result<Variant, GenError> {
-    let mut v = Variant::default();
+pub fn parse(knobs: &[(String, String)]) -> Result<PrefilteredVariant, GenError> {
+    let mut v = PrefilteredVariant::default();
     for (name, value) in knobs {
         match name.as_str() {
             "bases" => v.bases = number("bases", BASES_ALLOWED, value)?,

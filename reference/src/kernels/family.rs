@@ -8,7 +8,7 @@
 
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
-use scatter_shaderlib::prefiltered::{FrameError, FrameReport, FrameSettings, Variant};
+use scatter_shaderlib::prefiltered::{FrameError, FrameReport, FrameSettings, PrefilteredVariant};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
 use super::{MinmaxRun, PrefilteredRun, RaymarchRun};
@@ -90,7 +90,7 @@ impl CpuRun for MinmaxRun {
     }
 }
 
-impl CpuFamily for Variant {
+impl CpuFamily for PrefilteredVariant {
     type Run = PrefilteredRun;
 
     fn run_cpu(&self, f: &CpuFrame<'_>) -> Result<PrefilteredRun, FrameError> {
@@ -161,6 +161,6 @@ macro_rules! cpu_families {
 
 cpu_families! {
     Minmax(MinmaxVariant),
-    Prefiltered(Variant),
+    Prefiltered(PrefilteredVariant),
     Raymarch(RaymarchVariant),
 }

@@ -31,7 +31,8 @@ use crate::scene::Scene;
 pub use family::{CpuFamily, CpuFrame, CpuRun, FamilyRun, run_family};
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_shaderlib::prefiltered::{
-    FrameError, FrameSettings, LightKind, PrefilteredFrame, Resolutions, Variant, prepare_frame,
+    FrameError, FrameSettings, LightKind, PrefilteredFrame, PrefilteredVariant, Resolutions,
+    prepare_frame,
 };
 use texture::{Tex, TexArray};
 
@@ -55,7 +56,7 @@ pub struct PrefilteredRun {
 /// it) `rectify` is replaced by the engine's rasterisation of the rectified map
 /// ([`crate::projective::rasterise_rectified`], ray cast in `bvh`).
 pub fn run_prefiltered(
-    variant: &Variant,
+    variant: &PrefilteredVariant,
     rectified_size: [u32; 2],
     scene: &Scene,
     bvh: &Bvh,

@@ -18,14 +18,15 @@ use super::common_prefiltered_projective::proj_texel_weight;
 use super::common_projective::proj_stored_depth;
 use super::texture::{Tex, TexArray};
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant, VisibilityMode,
+    FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
+    VisibilityMode,
 };
 
 /// The kernel body for invocation `id` = (row, region, thread).
 #[allow(clippy::too_many_arguments, reason = "bindings of the kernel")]
 pub fn prefilter_main(
     id: [u32; 3],
-    variant: &Variant,
+    variant: &PrefilteredVariant,
     frame: &FrameUniforms,
     slices: &[SliceParams],
     rectified: &Tex,
@@ -104,7 +105,7 @@ pub struct PrefilterOutput {
 
 /// Runs every invocation; returns the filtered-basis array and the region-prefix bounds.
 pub fn prefilter(
-    variant: &Variant,
+    variant: &PrefilteredVariant,
     frame: &FrameUniforms,
     slices: &[SliceParams],
     rectified: &Tex,

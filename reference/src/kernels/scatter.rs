@@ -25,7 +25,7 @@ use super::common_projective::{proj_boundary, proj_ray_depth, proj_reach};
 use super::texture::{Tex, TexArray, mix4, quantise, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, Rectification, SliceParams, Storage, Variant,
+    FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
 };
 
 /// Most regions a variant may have (the size of the per-pixel region arrays).
@@ -48,7 +48,11 @@ pub struct ScatterInputs<'a> {
 }
 
 /// The kernel body for pixel `id`; returns the rgba16float texel it stores.
-pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Option<[f32; 4]> {
+pub fn scatter_main(
+    id: [u32; 3],
+    variant: &PrefilteredVariant,
+    inp: &ScatterInputs,
+) -> Option<[f32; 4]> {
     let f = inp.frame;
     let (x, y) = (id[0], id[1]);
     if x >= f.sizes[0] || y >= f.sizes[1] {
@@ -253,7 +257,7 @@ pub fn scatter_main(id: [u32; 3], variant: &Variant, inp: &ScatterInputs) -> Opt
 
 /// Runs every pixel (rows in parallel); returns the screen-sized output as stored in
 /// rgba16float.
-pub fn scatter(variant: &Variant, inp: &ScatterInputs) -> TexArray {
+pub fn scatter(variant: &PrefilteredVariant, inp: &ScatterInputs) -> TexArray {
     use rayon::prelude::*;
     let (w, h) = (inp.frame.sizes[0], inp.frame.sizes[1]);
     let data = (0..h)

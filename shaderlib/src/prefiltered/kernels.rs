@@ -1,13 +1,13 @@
 //! The askama views of the prefiltered family's templates (`templates/rectify.wgsl`,
 //! `templates/prefilter.wgsl`, `templates/scatter.wgsl`) and their rendering from a
-//! [`Variant`]. CPU mirrors: `reference/src/kernels/{rectify,prefilter,scatter}.rs`.
+//! [`PrefilteredVariant`]. CPU mirrors: `reference/src/kernels/{rectify,prefilter,scatter}.rs`.
 //!
 //! Every value the templates print is computed here (plain numbers, booleans and names);
 //! the templates do no arithmetic or string building.
 
 use askama::Template;
 
-use super::variant::{LightKind, Rectification, Variant, VisibilityMode};
+use super::variant::{LightKind, PrefilteredVariant, Rectification, VisibilityMode};
 use crate::compose::template_path;
 use crate::{Kernel, ShaderError};
 
@@ -62,7 +62,7 @@ struct ScatterTemplate {
 }
 
 /// Checks `variant` on behalf of `kernel`.
-fn validate(kernel: Kernel, variant: &Variant) -> Result<(), ShaderError> {
+fn validate(kernel: Kernel, variant: &PrefilteredVariant) -> Result<(), ShaderError> {
     variant
         .validate()
         .map_err(|source| ShaderError::Variant { kernel, source })
@@ -77,7 +77,7 @@ fn render_error(kernel: Kernel) -> impl FnOnce(askama::Error) -> ShaderError {
 }
 
 /// Renders `templates/rectify.wgsl` for `variant` (only its light matters).
-pub(crate) fn render_rectify(variant: &Variant) -> Result<String, ShaderError> {
+pub(crate) fn render_rectify(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
     validate(Kernel::Rectify, variant)?;
     RectifyTemplate {
         light_name: variant.light.name(),
@@ -88,7 +88,7 @@ pub(crate) fn render_rectify(variant: &Variant) -> Result<String, ShaderError> {
 }
 
 /// Renders `templates/prefilter.wgsl` for `variant`.
-pub(crate) fn render_prefilter(variant: &Variant) -> Result<String, ShaderError> {
+pub(crate) fn render_prefilter(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
     validate(Kernel::Prefilter, variant)?;
     PrefilterTemplate {
         light_name: variant.light.name(),
@@ -111,7 +111,7 @@ pub(crate) fn render_prefilter(variant: &Variant) -> Result<String, ShaderError>
 
 /// Renders `templates/scatter.wgsl` for `variant` (`bases_per_thread` and `storage` do not
 /// matter).
-pub(crate) fn render_scatter(variant: &Variant) -> Result<String, ShaderError> {
+pub(crate) fn render_scatter(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
     validate(Kernel::Scatter, variant)?;
     ScatterTemplate {
         light_name: variant.light.name(),

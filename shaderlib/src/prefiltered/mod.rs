@@ -16,9 +16,11 @@ pub use frame::{
 pub use kernels::{
     MAX_REGIONS, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE,
 };
-pub use variant::{LightKind, Rectification, Storage, Variant, VariantError, VisibilityMode};
+pub use variant::{
+    LightKind, PrefilteredVariant, Rectification, Storage, VariantError, VisibilityMode,
+};
 
-impl crate::family::KernelFamily for Variant {
+impl crate::family::KernelFamily for PrefilteredVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
         crate::KernelParams::prefiltered(*self).to_vec()
     }

@@ -7,7 +7,7 @@ use crate::plan::{
     SAMPLED, STORAGE_AND_SAMPLED, TEXTURE_DIMENSION, bind, depth_and_shadow_map, frame_buffer,
     scatter_resource, scatter_texture, screen_and_shadow_parameters, texture_2d,
 };
-use crate::prefiltered::{Rectification, Variant};
+use crate::prefiltered::{PrefilteredVariant, Rectification};
 use crate::{Kernel, KernelParams};
 
 /// The per-frame condition of a projective frame (the frame set-up falls back to epipolar
@@ -25,7 +25,7 @@ pub const BOUNDS_FORMAT: &str = "rg32float";
 pub const RECTIFIED_RASTER: &str = "rectified_raster";
 
 /// The resources and passes of a variant, as `runtime/src/prefiltered.rs` creates them.
-pub fn plan(v: &Variant) -> Plan {
+pub fn plan(v: &PrefilteredVariant) -> Plan {
     let mut parameters = screen_and_shadow_parameters();
     parameters.extend([
         Parameter {
@@ -153,7 +153,7 @@ pub fn plan(v: &Variant) -> Plan {
 }
 
 /// The pass of one kernel, or `None` for a kernel that is not in this family.
-pub fn pass(v: &Variant, kernel: Kernel) -> Option<PassPlan> {
+pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
     let f = |s: &str| s.to_owned();
     let projective = v.rectification == Rectification::Projective;
     match kernel {
