@@ -137,18 +137,9 @@ pub(crate) fn validate(kernel: Kernel, module: &naga::Module) -> Result<ModuleIn
         })
 }
 
-/// The template file of a kernel, relative to `shaderlib/templates`.
+/// The template file of a kernel, relative to `shaderlib/templates` (from the kernel table).
 pub(crate) const fn template_path(kernel: Kernel) -> &'static str {
-    match kernel {
-        Kernel::InterleaveSum => "interleave_sum.wgsl",
-        Kernel::MinmaxBuild => "minmax_build.wgsl",
-        Kernel::MinmaxTraverse => "minmax_traverse.wgsl",
-        Kernel::Prefilter => "prefilter.wgsl",
-        Kernel::Raymarch => "raymarch.wgsl",
-        Kernel::Rectify => "rectify.wgsl",
-        Kernel::RowPrefix => "row_prefix.wgsl",
-        Kernel::Scatter => "scatter.wgsl",
-    }
+    kernel.template()
 }
 
 #[cfg(test)]

@@ -50,13 +50,17 @@ macro_rules! kernel_families {
             }
         }
 
+        /// A family's variant with the most passes ([`KernelFamily::with_most_passes`]).
+        pub fn most_passes(family: Family) -> FamilyVariant {
+            match family {
+                $(Family::$name => FamilyVariant::$name(<$ty as KernelFamily>::with_most_passes()),)*
+            }
+        }
+
         /// The kernels of a family in pass order, for its variant with the most passes (read
         /// from the kernel parameters, not listed here).
         pub fn kernels(family: Family) -> Vec<Kernel> {
-            let variant = match family {
-                $(Family::$name => FamilyVariant::$name(<$ty as KernelFamily>::with_most_passes()),)*
-            };
-            variant
+            most_passes(family)
                 .kernel_params()
                 .iter()
                 .map(KernelParams::kernel)

@@ -37,87 +37,46 @@ pub mod reflect;
 pub mod row_prefix;
 
 pub use error::ShaderError;
-pub use kernel::Kernel;
+use family::{Family, KernelFamily};
 use minmax::MinmaxVariant;
 use prefiltered::PrefilteredVariant;
 use raymarch::RaymarchVariant;
 pub use row_prefix::{RowPrefixMode, RowPrefixParams};
 
-/// A kernel together with the template parameters it is rendered with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(tag = "kernel", rename_all = "snake_case")]
-pub enum KernelParams {
-    /// [`Kernel::InterleaveSum`] of an interleaved raymarch-family variant (the code does
-    /// not depend on the variant).
-    InterleaveSum(RaymarchVariant),
-    /// [`Kernel::MinmaxBuild`] of a minmax-family variant (the code does not depend on it).
-    MinmaxBuild(MinmaxVariant),
-    /// [`Kernel::MinmaxTraverse`] of a minmax-family variant (only `light` changes the code).
-    MinmaxTraverse(MinmaxVariant),
-    /// [`Kernel::Prefilter`] of a prefiltered-family variant.
-    Prefilter(PrefilteredVariant),
-    /// [`Kernel::Raymarch`] of a raymarch-family variant (only `light` and whether it
-    /// interleaves change the code).
-    Raymarch(RaymarchVariant),
-    /// [`Kernel::Rectify`] of a prefiltered-family variant (only `light` changes the code).
-    Rectify(PrefilteredVariant),
-    /// [`Kernel::RowPrefix`]: per-row running sum or mean.
-    RowPrefix(RowPrefixParams),
-    /// [`Kernel::Scatter`] of a prefiltered-family variant (`bases_per_thread` and `storage`
-    /// do not change the code).
-    Scatter(PrefilteredVariant),
+// The kernel table: one line per kernel (name, template stem, parameter type, render
+// function), sorted by name. `Kernel`, `KernelParams` and `render` come from it.
+kernel::kernels! {
+    /// Separable sum filter of interleaved sampling over the `raymarch` partial sums (Tóth &
+    /// Umenhoffer 2009).
+    InterleaveSum("interleave_sum", RaymarchVariant, raymarch::render_interleave_sum),
+    /// The 1D min-max tree of every rectified row (Chen et al. 2011).
+    MinmaxBuild("minmax_build", MinmaxVariant, minmax::render_build),
+    /// Per pixel: the rectified row marched through its min-max tree, skipping nodes wholly
+    /// lit or shadowed; pixels near the epipole ray-marched (Chen et al. 2011).
+    MinmaxTraverse("minmax_traverse", MinmaxVariant, minmax::render_traverse),
+    /// Fourier basis transform fused with the weighted running mean along each rectified
+    /// row, per region (Klehm et al. 2014, Listings 1-3, Table 1).
+    Prefilter("prefilter", PrefilteredVariant, prefiltered::kernels::render_prefilter),
+    /// Brute-force ray marching through the standard shadow map, optionally interleaved
+    /// (Tóth & Umenhoffer 2009).
+    Raymarch("raymarch", RaymarchVariant, raymarch::render_raymarch),
+    /// Epipolar resampling of a standard shadow map into the rectified shadow map (Klehm et
+    /// al. 2014, Sec. 4.1, after Baran et al. 2010).
+    Rectify("rectify", PrefilteredVariant, prefiltered::kernels::render_rectify),
+    /// Per-row running prefix (sum or mean) over an rgba texture array; the filtering step
+    /// of the prefiltered method (Klehm et al. 2014, Listing 1).
+    RowPrefix("row_prefix", RowPrefixParams, row_prefix::render),
+    /// Per pixel: prefiltered visibility times the unshadowed integral, one dot product per
+    /// region; pixels near the epipole ray-marched (Klehm et al. 2014, Listing 4, Sec. 5).
+    Scatter("scatter", PrefilteredVariant, prefiltered::kernels::render_scatter),
 }
 
 impl KernelParams {
-    /// The kernel these parameters belong to.
-    pub fn kernel(&self) -> Kernel {
-        match self {
-            Self::InterleaveSum(_) => Kernel::InterleaveSum,
-            Self::MinmaxBuild(_) => Kernel::MinmaxBuild,
-            Self::MinmaxTraverse(_) => Kernel::MinmaxTraverse,
-            Self::Prefilter(_) => Kernel::Prefilter,
-            Self::Raymarch(_) => Kernel::Raymarch,
-            Self::Rectify(_) => Kernel::Rectify,
-            Self::RowPrefix(_) => Kernel::RowPrefix,
-            Self::Scatter(_) => Kernel::Scatter,
-        }
-    }
-
-    /// The three kernels of a prefiltered-family variant, in pass order: `rectify`,
-    /// `prefilter`, `scatter`.
-    pub const fn prefiltered(variant: PrefilteredVariant) -> [Self; 3] {
-        [
-            Self::Rectify(variant),
-            Self::Prefilter(variant),
-            Self::Scatter(variant),
-        ]
-    }
-
-    /// The kernels of a raymarch-family variant, in pass order: `raymarch`, then
-    /// `interleave_sum` when it interleaves.
-    pub fn raymarch(variant: RaymarchVariant) -> Vec<Self> {
-        let mut out = vec![Self::Raymarch(variant)];
-        if variant.interleaved() {
-            out.push(Self::InterleaveSum(variant));
-        }
-        out
-    }
-
-    /// The kernels of a minmax-family variant, in pass order: the prefiltered family's
-    /// `rectify` (of [`MinmaxVariant::prefiltered`]), `minmax_build`, `minmax_traverse`.
-    pub fn minmax(variant: MinmaxVariant) -> [Self; 3] {
-        [
-            Self::Rectify(variant.prefiltered()),
-            Self::MinmaxBuild(variant),
-            Self::MinmaxTraverse(variant),
-        ]
-    }
-
-    /// Every parameter set the conformance suite checks: each kernel in each of its modes,
-    /// with default workgroup sizes, then the prefiltered kernels of the default
-    /// [`PrefilteredVariant`].
+    /// Every parameter set the conformance suite checks: `row_prefix` in each of its
+    /// modes (default workgroup size), then every family's kernels for its variant with the
+    /// most passes, each kernel once (from the family table: a new family needs no line here).
     pub fn all_modes() -> Vec<Self> {
-        RowPrefixMode::ALL
+        let mut out: Vec<Self> = RowPrefixMode::ALL
             .iter()
             .map(|&mode| {
                 Self::RowPrefix(RowPrefixParams {
@@ -125,13 +84,15 @@ impl KernelParams {
                     ..RowPrefixParams::default()
                 })
             })
-            .chain(Self::prefiltered(PrefilteredVariant::default()))
-            .chain(Self::raymarch(RaymarchVariant {
-                interleave: 2,
-                ..RaymarchVariant::default()
-            }))
-            .chain(Self::minmax(MinmaxVariant::default()).into_iter().skip(1))
-            .collect()
+            .collect();
+        for &family in Family::ALL {
+            for params in family::most_passes(family).kernel_params() {
+                if !out.iter().any(|p| p.kernel() == params.kernel()) {
+                    out.push(params);
+                }
+            }
+        }
+        out
     }
 }
 
@@ -187,26 +148,6 @@ pub fn build(params: &KernelParams) -> Result<BuiltKernel, ShaderError> {
         info,
         wgsl,
     })
-}
-
-/// Renders a kernel's askama template to WGSL source that still contains naga_oil
-/// `#import` directives (the input of composition).
-///
-/// # Errors
-///
-/// [`ShaderError::InvalidParameter`] or [`ShaderError::Variant`] for out-of-range
-/// parameters, [`ShaderError::Render`] when askama fails.
-pub fn render(params: &KernelParams) -> Result<String, ShaderError> {
-    match params {
-        KernelParams::InterleaveSum(v) => raymarch::render_interleave_sum(v),
-        KernelParams::MinmaxBuild(v) => minmax::render_build(v),
-        KernelParams::MinmaxTraverse(v) => minmax::render_traverse(v),
-        KernelParams::Prefilter(v) => prefiltered::kernels::render_prefilter(v),
-        KernelParams::Raymarch(v) => raymarch::render_raymarch(v),
-        KernelParams::Rectify(v) => prefiltered::kernels::render_rectify(v),
-        KernelParams::RowPrefix(p) => row_prefix::render(p),
-        KernelParams::Scatter(v) => prefiltered::kernels::render_scatter(v),
-    }
 }
 
 #[cfg(test)]

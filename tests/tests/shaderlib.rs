@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use scatter_shaderlib::family::{Family, kernels};
 use scatter_shaderlib::{Kernel, KernelParams, build};
 
 fn workspace_root() -> &'static Path {
@@ -21,19 +22,16 @@ fn every_kernel_and_mode_validates() {
         );
     }
     for params in &all {
+        // The family whose kernels include this one (from the family table), or `common`.
+        let owner = Family::ALL
+            .iter()
+            .find(|&&f| kernels(f).contains(&params.kernel()))
+            .map_or("common", |f| f.name());
         let trial = match params {
             KernelParams::RowPrefix(p) => {
-                format!("common::{}::{}::validate", params.kernel(), p.mode.name())
+                format!("{owner}::{}::{}::validate", params.kernel(), p.mode.name())
             }
-            KernelParams::Rectify(v) | KernelParams::Prefilter(v) | KernelParams::Scatter(v) => {
-                format!("prefiltered::{}::{}::validate", params.kernel(), v.id())
-            }
-            KernelParams::Raymarch(v) | KernelParams::InterleaveSum(v) => {
-                format!("raymarch::{}::{}::validate", params.kernel(), v.id())
-            }
-            KernelParams::MinmaxBuild(v) | KernelParams::MinmaxTraverse(v) => {
-                format!("minmax::{}::{}::validate", params.kernel(), v.id())
-            }
+            _ => format!("{owner}::{}::validate", params.kernel()),
         };
         let built = build(params).unwrap_or_else(|e| panic!("{trial}: {e}"));
         assert_eq!(built.entry_point, params.kernel().name(), "{trial}");

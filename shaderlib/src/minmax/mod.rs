@@ -72,6 +72,18 @@ pub(crate) fn render_traverse(variant: &MinmaxVariant) -> Result<String, ShaderE
     })
 }
 
+impl crate::KernelParams {
+    /// The kernels of a minmax-family variant, in pass order: the prefiltered family's
+    /// `rectify` (of [`MinmaxVariant::prefiltered`]), `minmax_build`, `minmax_traverse`.
+    pub fn minmax(variant: MinmaxVariant) -> [Self; 3] {
+        [
+            Self::Rectify(variant.prefiltered()),
+            Self::MinmaxBuild(variant),
+            Self::MinmaxTraverse(variant),
+        ]
+    }
+}
+
 impl crate::family::KernelFamily for MinmaxVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
         crate::KernelParams::minmax(*self).to_vec()

@@ -20,6 +20,18 @@ pub use variant::{
     LightKind, PrefilteredVariant, Rectification, Storage, VariantError, VisibilityMode,
 };
 
+impl crate::KernelParams {
+    /// The three kernels of a prefiltered-family variant, in pass order: `rectify`,
+    /// `prefilter`, `scatter`.
+    pub const fn prefiltered(variant: PrefilteredVariant) -> [Self; 3] {
+        [
+            Self::Rectify(variant),
+            Self::Prefilter(variant),
+            Self::Scatter(variant),
+        ]
+    }
+}
+
 impl crate::family::KernelFamily for PrefilteredVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
         crate::KernelParams::prefiltered(*self).to_vec()

@@ -83,6 +83,18 @@ pub(crate) fn render_interleave_sum(variant: &RaymarchVariant) -> Result<String,
         })
 }
 
+impl crate::KernelParams {
+    /// The kernels of a raymarch-family variant, in pass order: `raymarch`, then
+    /// `interleave_sum` when it interleaves.
+    pub fn raymarch(variant: RaymarchVariant) -> Vec<Self> {
+        let mut out = vec![Self::Raymarch(variant)];
+        if variant.interleaved() {
+            out.push(Self::InterleaveSum(variant));
+        }
+        out
+    }
+}
+
 impl crate::family::KernelFamily for RaymarchVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
         crate::KernelParams::raymarch(*self)
