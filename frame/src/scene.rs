@@ -7,8 +7,21 @@
 //! under their old paths.
 
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
 
-use crate::variant::LightKind;
+/// The type of a scene's light, and the light type a variant is compiled for (every family
+/// shares it; its names and parsing are in `crate::variant`).
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum LightKind {
+    /// A distant light (parallel rays).
+    #[default]
+    Directional,
+    /// A spot light (rays from a point, cone falloff, 1/d^2, extinction along the light path).
+    Spot,
+}
 
 /// The camera of one frame (the engine's view).
 #[derive(Clone, Copy, Debug, PartialEq)]

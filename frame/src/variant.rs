@@ -21,18 +21,9 @@ pub enum VisibilityMode {
     Weighted,
 }
 
-/// The light type a variant is compiled for.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
-)]
-#[serde(rename_all = "snake_case")]
-pub enum LightKind {
-    /// A distant light (parallel rays).
-    #[default]
-    Directional,
-    /// A spot light (rays from a point, cone falloff, 1/d^2, extinction along the light path).
-    Spot,
-}
+// The light type is the scene's (`crate::scene::LightKind`, shared by every family); its
+// names (`ALL`, `name`, parsing) are given below with the prefiltered knobs'.
+pub use crate::scene::LightKind;
 
 /// Storage format of the filtered-basis texture array.
 #[derive(
