@@ -559,16 +559,16 @@ fn time_interleaved(
         .collect())
 }
 
-/// Times `methods` (pass wall times, interleaved) on `name/ordinary` at `screen`
-/// (prefiltered and minmax: with a `rectified` map).
-fn time_methods(
-    ctx: &Context,
-    methods: &[Method],
-    name: SceneName,
-    screen: [u32; 2],
-    rectified: [u32; 2],
-    frames: u32,
-) -> Result<Vec<Vec<(&'static str, Duration)>>, BoxError> {
+/// A timing scene: `name/ordinary` at a screen size, its 1024^2 shadow map, and the engine's
+/// depth buffer and shadow map uploaded.
+struct BenchScene {
+    scene: Scene,
+    sm: ShadowMap,
+    dv: TextureView,
+    sv: TextureView,
+}
+
+fn bench_scene(ctx: &Context, name: SceneName, screen: [u32; 2]) -> Result<BenchScene, BoxError> {
     let scene = suite::scene(
         name,
         Pose::Ordinary,
@@ -593,10 +593,25 @@ fn time_methods(
         [sm.size; 2],
         &sm.depth,
     )?;
-    let (dv, sv) = (
-        depth.create_view(&Default::default()),
-        shadow.create_view(&Default::default()),
-    );
+    Ok(BenchScene {
+        dv: depth.create_view(&Default::default()),
+        sv: shadow.create_view(&Default::default()),
+        scene,
+        sm,
+    })
+}
+
+/// Times `methods` (pass wall times, interleaved) on `name/ordinary` at `screen`
+/// (prefiltered and minmax: with a `rectified` map).
+fn time_methods(
+    ctx: &Context,
+    methods: &[Method],
+    name: SceneName,
+    screen: [u32; 2],
+    rectified: [u32; 2],
+    frames: u32,
+) -> Result<Vec<Vec<(&'static str, Duration)>>, BoxError> {
+    let BenchScene { scene, sm, dv, sv } = bench_scene(ctx, name, screen)?;
     let runs = methods
         .iter()
         .map(|m| {
@@ -655,34 +670,7 @@ fn scaling_runs(ctx: &Context, frames: u32) -> Result<Vec<ScalingRow>, BoxError>
         .into_iter()
         .chain([([320, 180], [1024, 1024]), ([640, 360], [1024, 1024])]);
     for (screen, rectified) in configs {
-        let scene = suite::scene(
-            SceneName::Sphere,
-            Pose::Ordinary,
-            MediumPreset::Default,
-            screen[0],
-            screen[1],
-        );
-        let bvh = Bvh::build(&scene.geometry);
-        let gbuf = GBuffer::cast(&scene, &bvh);
-        let sm = ShadowMap::build(&scene, &bvh, 1024)?;
-        let depth = upload_r32float(
-            ctx,
-            Kernel::Scatter,
-            "bench depth",
-            screen,
-            &gbuf.view_depth,
-        )?;
-        let shadow = upload_r32float(
-            ctx,
-            Kernel::Rectify,
-            "bench shadow map",
-            [sm.size; 2],
-            &sm.depth,
-        )?;
-        let (dv, sv) = (
-            depth.create_view(&Default::default()),
-            shadow.create_view(&Default::default()),
-        );
+        let BenchScene { scene, sm, dv, sv } = bench_scene(ctx, SceneName::Sphere, screen)?;
         let mut pass = Prefiltered::new(
             ctx,
             &PrefilteredVariant::default(),
