@@ -76,11 +76,13 @@ const PROJECTIVE_EXCEPTIONS: &[(&str, f64, &str)] = &[(
 const DARK_EXCEPTIONS: &[(&str, Rectification, f64, &str)] = &[(
     "closed_room",
     Rectification::Projective,
-    4.5e-4,
-    "10 of 14400 pixels, on a line 5.8-6.7 m away, reach 4.47e-4 (0.26 % of the window \
-     scene's lit maximum, 0.17): the projective map's texel-centre light rays miss the 0.3 m \
-     wall there. At a 2048x1024 map the output is exactly 0: the rectified map's resolution, \
-     as in the random-pose suite's dark frames. The epipolar frame outputs exactly 0",
+    6.2e-4,
+    "pixels on a line 5.8-6.7 m away reach 6.16e-4 (0.36 % of the window scene's lit maximum, \
+     0.17): the projective map's texel-centre light rays miss the 0.3 m wall there. At a \
+     2048x1024 map the output is exactly 0: the rectified map's resolution, as in the \
+     random-pose suite's dark frames. The epipolar frame outputs exactly 0. (4.47e-4, 10 of \
+     14400 pixels, while scatter blended the bases with lavapipe's sampler weights; exact \
+     float weights since issue 13)",
 )];
 
 /// The variants run on every case (directional; each case sets the light, and the
