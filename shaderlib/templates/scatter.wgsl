@@ -62,8 +62,6 @@
 @group(0) @binding(5) var output: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(6) var bounds: texture_2d<f32>;
 
-// Most regions a variant may have (the size of the per-pixel region arrays).
-const MAX_REGIONS: u32 = 8u;
 // Independent prefix regions per rectified row.
 const REGIONS: u32 = {{ regions }}u;
 // rgba layers of `filtered` (bases / 4).
@@ -161,39 +159,6 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     let row0 = row_index(floor(yb), rows, wrap);
     let row1 = select(row0, row_index(floor(yb) + 1.0, rows, wrap), yb > floor(yb));
 
-    // Regions: every region before the surface's, whole, and the surface's up to x_s. Each
-    // is weighted by this pixel's own unshadowed integral over its part of the ray.
-    let last = u32(min(max(xs, 0.0), f32(width) - 1.0));
-    var pos: array<f32, MAX_REGIONS>;
-    var t0: array<f32, MAX_REGIONS>;
-    var t1: array<f32, MAX_REGIONS>;
-    var count = 0u;
-    for (var r = 0u; r < regions; r++) {
-        let b0 = f32(region_start(r, regions, width, spot));
-        let b1 = f32(region_start(r + 1u, regions, width, spot));
-        let is_last = last < u32(b1) || r + 1u == regions;
-        pos[r] = select(b1 - 0.5, clamp(xs - 0.5, b0 + 0.5, b1 - 0.5), is_last);
-{%- if projective %}
-        if proj {
-            var a = 0.0;
-            if r > 0u {
-                a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
-            }
-            t0[r] = a;
-            t1[r] = select(min(proj_reach(f, proj_boundary(f, r + 1u), m, spot, s * qd) / qd, s), s, is_last);
-        } else {
-            t0[r] = ray_t(f, b0, delta, theta, s, spot);
-            t1[r] = select(ray_t(f, b1, delta, theta, s, spot), s, is_last);
-        }
-{%- else %}
-        t0[r] = ray_t(f, b0, delta, theta, s, spot);
-        t1[r] = select(ray_t(f, b1, delta, theta, s, spot), s, is_last);
-{%- endif %}
-        count = r + 1u;
-        if is_last {
-            break;
-        }
-    }
     let cos_theta_l = -dot(f.light_dir.xyz, dir);
     // Every region gets the full spot quadrature: its weight must be as accurate as the
     // whole ray's (dividing the panels among the regions cost 2.5 % rel L1 on a thick-fog
@@ -209,18 +174,46 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         coeffs[layer] = coeff4(angle, second, layer);
         angle = turn(second, step);
     }
+    // The sun's scattering coefficient times phase, the same for every region.
+    let sun_scatter = f.medium[1] * phase_hg(f.medium[2], cos_theta_l);
+
+    // Regions: every region before the surface's, whole, and the surface's up to x_s. Each
+    // is weighted by this pixel's own unshadowed integral over its part of the ray [a, b].
+    // One loop and no per-region arrays: lavapipe keeps dynamically indexed private arrays
+    // in memory.
+    let last = u32(min(max(xs, 0.0), f32(width) - 1.0));
     var total = 0.0;
-    for (var r = 0u; r < count; r++) {
-        let a = t0[r]; let b = t1[r];
+    for (var r = 0u; r < regions; r++) {
+        let b0 = f32(region_start(r, regions, width, spot));
+        let b1 = f32(region_start(r + 1u, regions, width, spot));
+        let is_last = last < u32(b1) || r + 1u == regions;
+        let pos = select(b1 - 0.5, clamp(xs - 0.5, b0 + 0.5, b1 - 0.5), is_last);
+        var a: f32;
+        var b: f32;
+{%- if projective %}
+        if proj {
+            a = 0.0;
+            if r > 0u {
+                a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
+            }
+            b = select(min(proj_reach(f, proj_boundary(f, r + 1u), m, spot, s * qd) / qd, s), s, is_last);
+        } else {
+            a = ray_t(f, b0, delta, theta, s, spot);
+            b = select(ray_t(f, b1, delta, theta, s, spot), s, is_last);
+        }
+{%- else %}
+        a = ray_t(f, b0, delta, theta, s, spot);
+        b = select(ray_t(f, b1, delta, theta, s, spot), s, is_last);
+{%- endif %}
         var weight: f32;
         if spot {
             weight = spot_segment(f, eye, dir, a, b, panels);
         } else {
-            weight = f.medium[1] * phase_hg(f.medium[2], cos_theta_l) * transmittance_between(f.medium[0], a, b);
+            weight = sun_scatter * transmittance_between(f.medium[0], a, b);
         }
         // The (up to) four texels the bilinear fetch reads with a non-zero weight: columns
-        // x0 <= x1 of the region (pos[r] lies inside it), rows row0 and row1.
-        let xb = pos[r] - 0.5;
+        // x0 <= x1 of the region (pos lies inside it), rows row0 and row1.
+        let xb = pos - 0.5;
         let fx = xb - floor(xb);
         let x0 = u32(clamp(floor(xb), 0.0, f32(width) - 1.0));
         let x1 = select(x0, min(x0 + 1u, width - 1u), xb > floor(xb));
@@ -247,6 +240,9 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
         total += weight * clamp(vis, 0.0, 1.0);
+        if is_last {
+            break;
+        }
     }
     let l = total;
     let c = color * l;

@@ -57,7 +57,6 @@ const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](0.34785485, 0.65214515, 0.65214515, 0.34785485);
 const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
-const uint MAX_REGIONS = 8u;
 const uint REGIONS = 3u;
 const uint LAYERS = 8u;
 
@@ -199,9 +198,9 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma
     return ((1.0 - exp(-(x_4))) / sigma_t);
 }
 
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a_1, float b_1) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
+    return (exp((-(sigma_t_1) * a_1)) * _e7);
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
@@ -223,14 +222,14 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir,
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
 }
 
-float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_1, float b_1, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_2, float b_2, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
     float sum = 0.0;
     uint k_1 = 0u;
     uint q = 0u;
-    float t0_1 = dot((light_pos_1 - eye_1), dir_1);
-    float h = max(length(((eye_1 + (dir_1 * t0_1)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
-    float g0_ = atan(((a_1 - t0_1) / h));
-    float w_1 = ((atan(((b_1 - t0_1) / h)) - g0_) / float(panels));
+    float t0_ = dot((light_pos_1 - eye_1), dir_1);
+    float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float g0_ = atan(((a_2 - t0_) / h));
+    float w_1 = ((atan(((b_2 - t0_) / h)) - g0_) / float(panels));
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
@@ -264,7 +263,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                     float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     float _e52 = sum;
                     uint _e54 = q;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_1 + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
                     sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1.0 + (u * u))));
                 }
             }
@@ -274,11 +273,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     return (((_e75 * 0.5) * w_1) * h);
 }
 
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
-    float t0_2 = dot((light_pos_2 - eye_2), dir_2);
-    float h_1 = max(length(((eye_2 + (dir_2 * t0_2)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
-    float theta_a = atan(((a_2 - t0_2) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_2, h_1, theta_a, ((atan(((b_2 - t0_2) / h_1)) - theta_a) / float(n)));
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_3, float b_3, uint n) {
+    float t0_1 = dot((light_pos_2 - eye_2), dir_2);
+    float h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_3 - a_3), 1e-6)));
+    float theta_a = atan(((a_3 - t0_1) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_3 - t0_1) / h_1)) - theta_a) / float(n)));
 }
 
 vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x) {
@@ -402,8 +401,8 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 eye_5, vec3 dir_5, float a_3, float b_3, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 eye_5, vec3 dir_5, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_4, b_4, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -415,8 +414,8 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_X
     return (f_8.e1_.w + ((float(row) + 0.5) * f_8.e2_.w));
 }
 
-vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_4, vec2 b_4) {
-    return vec2(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_5, vec2 b_5) {
+    return vec2(((a_5.x * b_5.y) + (a_5.y * b_5.x)), ((a_5.y * b_5.y) - (a_5.x * b_5.x)));
 }
 
 vec2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 first) {
@@ -427,17 +426,17 @@ float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_3) {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_3) - 1u)));
 }
 
-vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_5, vec2 b_5, uint layer_2) {
+vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_6, vec2 b_6, uint layer_2) {
     float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
     float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
-    return vec4(((2.0 / _e5) * a_5.y), ((-2.0 / _e5) * a_5.x), ((2.0 / _e10) * b_5.y), ((-2.0 / _e10) * b_5.x));
+    return vec4(((2.0 / _e5) * a_6.y), ((-2.0 / _e5) * a_6.x), ((2.0 / _e10) * b_6.y), ((-2.0 / _e10) * b_6.x));
 }
 
-uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_2, uint regions, uint width, bool spot_2) {
+uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_1, uint regions, uint width, bool spot_2) {
     if (spot_2) {
-        return ((r_2 * width) / regions);
+        return ((r_1 * width) / regions);
     }
-    return (((r_2 * r_2) * width) / (regions * regions));
+    return (((r_1 * r_1) * width) / (regions * regions));
 }
 
 void main() {
@@ -451,17 +450,14 @@ void main() {
     float xs = 0.0;
     float delta = 1.0;
     float theta = 0.0;
-    float pos[8] = float[8](0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    float t0_[8] = float[8](0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    float t1_[8] = float[8](0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    uint count = 0u;
-    uint r = 0u;
-    bool local_4 = false;
     vec4 coeffs[8] = vec4[8](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
     vec2 angle = vec2(0.0);
     uint layer = 0u;
     float total = 0.0;
-    uint r_1 = 0u;
+    uint r = 0u;
+    bool local_4 = false;
+    float a = 0.0;
+    float b = 0.0;
     float weight = 0.0;
     float vis = 0.0;
     uint layer_1 = 0u;
@@ -557,192 +553,172 @@ void main() {
     uint _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
     uint _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
     uint row1_ = ((yb > floor(yb)) ? _e202 : _e198);
-    float _e206 = xs;
-    uint last = uint(min(max(_e206, 0.0), (float(width_1) - 1.0)));
+    float cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
+    uint panels_2 = max((f_9.sizes2_.z / 4u), 1u);
+    float _e217 = d;
+    float _e221 = d;
+    angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e217)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e221)));
+    vec2 _e226 = angle;
+    vec2 _e227 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226);
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e269 = r;
-            r = (_e269 + 1u);
+            uint _e242 = layer;
+            layer = (_e242 + 1u);
         }
         loop_init_3 = false;
-        uint _e216 = r;
-        if ((_e216 < REGIONS)) {
+        uint _e229 = layer;
+        if ((_e229 < LAYERS)) {
         } else {
             break;
         }
         {
-            uint _e218 = r;
-            uint _e219 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, REGIONS, width_1, false);
-            float b0_ = float(_e219);
-            uint _e221 = r;
-            uint _e224 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e221 + 1u), REGIONS, width_1, false);
-            float b1_ = float(_e224);
+            vec2 _e232 = angle;
+            vec2 _e233 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e232, _e227);
+            uint _e235 = layer;
+            vec2 _e237 = angle;
+            uint _e238 = layer;
+            vec4 _e239 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e237, _e233, _e238);
+            coeffs[_e235] = _e239;
+            vec2 _e240 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e233, _e227);
+            angle = _e240;
+        }
+    }
+    float _e248 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    float sun_scatter = (f_9.medium.y * _e248);
+    float _e250 = xs;
+    uint last = uint(min(max(_e250, 0.0), (float(width_1) - 1.0)));
+    bool loop_init_4 = true;
+    while(true) {
+        if (!loop_init_4) {
+            uint _e418 = r;
+            r = (_e418 + 1u);
+        }
+        loop_init_4 = false;
+        uint _e260 = r;
+        if ((_e260 < REGIONS)) {
+        } else {
+            break;
+        }
+        {
+            uint _e262 = r;
+            uint _e263 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e262, REGIONS, width_1, false);
+            float b0_ = float(_e263);
+            uint _e265 = r;
+            uint _e268 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e265 + 1u), REGIONS, width_1, false);
+            float b1_ = float(_e268);
             if (!((last < uint(b1_)))) {
-                uint _e229 = r;
-                local_4 = ((_e229 + 1u) == REGIONS);
+                uint _e273 = r;
+                local_4 = ((_e273 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             bool is_last = local_4;
-            uint _e238 = r;
-            float _e242 = xs;
-            pos[_e238] = (is_last ? clamp((_e242 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            uint _e252 = r;
-            float _e254 = delta;
-            float _e255 = theta;
-            float _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e254, _e255, s_2, false);
-            t0_[_e252] = _e256;
-            uint _e258 = r;
-            float _e260 = delta;
-            float _e261 = theta;
-            float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e260, _e261, s_2, false);
-            t1_[_e258] = (is_last ? s_2 : _e262);
-            uint _e264 = r;
-            count = (_e264 + 1u);
-            if (is_last) {
-                break;
-            }
-        }
-    }
-    float cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
-    uint panels_2 = max((f_9.sizes2_.z / 4u), 1u);
-    float _e282 = d;
-    float _e286 = d;
-    angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e282)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e286)));
-    vec2 _e291 = angle;
-    vec2 _e292 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e291);
-    bool loop_init_4 = true;
-    while(true) {
-        if (!loop_init_4) {
-            uint _e307 = layer;
-            layer = (_e307 + 1u);
-        }
-        loop_init_4 = false;
-        uint _e294 = layer;
-        if ((_e294 < LAYERS)) {
-        } else {
-            break;
-        }
-        {
-            vec2 _e297 = angle;
-            vec2 _e298 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e297, _e292);
-            uint _e300 = layer;
-            vec2 _e302 = angle;
-            uint _e303 = layer;
-            vec4 _e304 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e302, _e298, _e303);
-            coeffs[_e300] = _e304;
-            vec2 _e305 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e298, _e292);
-            angle = _e305;
-        }
-    }
-    bool loop_init_5 = true;
-    while(true) {
-        if (!loop_init_5) {
-            uint _e439 = r_1;
-            r_1 = (_e439 + 1u);
-        }
-        loop_init_5 = false;
-        uint _e310 = r_1;
-        uint _e311 = count;
-        if ((_e310 < _e311)) {
-        } else {
-            break;
-        }
-        {
-            uint _e313 = r_1;
-            float a_6 = t0_[_e313];
-            uint _e316 = r_1;
-            float b_6 = t1_[_e316];
+            float _e283 = xs;
+            float pos = (is_last ? clamp((_e283 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            a = 0.0;
+            b = 0.0;
+            float _e296 = delta;
+            float _e297 = theta;
+            float _e298 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e296, _e297, s_2, false);
+            a = _e298;
+            float _e299 = delta;
+            float _e300 = theta;
+            float _e301 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e299, _e300, s_2, false);
+            b = (is_last ? s_2 : _e301);
             weight = 0.0;
             if (false) {
-                float _e321 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_6, b_6, panels_2);
-                weight = _e321;
+                float _e305 = a;
+                float _e306 = b;
+                float _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, _e305, _e306, panels_2);
+                weight = _e307;
             } else {
-                float _e326 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                float _e330 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_6);
-                weight = ((f_9.medium.y * _e326) * _e330);
+                float _e310 = a;
+                float _e311 = b;
+                float _e312 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e310, _e311);
+                weight = (sun_scatter * _e312);
             }
-            uint _e332 = r_1;
-            float _e334 = pos[_e332];
-            float xb = (_e334 - 0.5);
+            float xb = (pos - 0.5);
             float fx = (xb - floor(xb));
             uint x0_ = uint(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
             uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
-            int _e357_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 bounds0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, _e198)), ivec2(0), textureSize(_group_0_binding_6_cs, _e357_clamped_lod) - ivec2(1)), _e357_clamped_lod);
-            int _e361_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 bounds1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e361_clamped_lod) - ivec2(1)), _e361_clamped_lod);
+            int _e336_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+            vec4 bounds0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, _e198)), ivec2(0), textureSize(_group_0_binding_6_cs, _e336_clamped_lod) - ivec2(1)), _e336_clamped_lod);
+            int _e340_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+            vec4 bounds1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e340_clamped_lod) - ivec2(1)), _e340_clamped_lod);
             float lo_1 = min(bounds0_.x, bounds1_.x);
             float hi_1 = max(bounds0_.y, bounds1_.y);
             vis = 0.5;
-            float _e370 = d;
-            if ((_e370 <= lo_1)) {
+            float _e349 = d;
+            if ((_e349 <= lo_1)) {
                 vis = 1.0;
             } else {
-                float _e373 = d;
-                if ((_e373 > hi_1)) {
+                float _e352 = d;
+                if ((_e352 > hi_1)) {
                     vis = 0.0;
                 } else {
                     layer_1 = 0u;
-                    bool loop_init_6 = true;
+                    bool loop_init_5 = true;
                     while(true) {
-                        if (!loop_init_6) {
-                            uint _e427 = layer_1;
-                            layer_1 = (_e427 + 1u);
+                        if (!loop_init_5) {
+                            uint _e406 = layer_1;
+                            layer_1 = (_e406 + 1u);
                         }
-                        loop_init_6 = false;
-                        uint _e378 = layer_1;
-                        if ((_e378 < LAYERS)) {
+                        loop_init_5 = false;
+                        uint _e357 = layer_1;
+                        if ((_e357 < LAYERS)) {
                         } else {
                             break;
                         }
                         {
-                            uint _e381 = layer_1;
-                            vec4 coeff = coeffs[_e381];
-                            uint _e385 = layer_1;
-                            int _e388_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e388 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, _e198), _e385), ivec3(0), textureSize(_group_0_binding_4_cs, _e388_clamped_lod) - ivec3(1)), _e388_clamped_lod);
-                            uint _e390 = layer_1;
-                            int _e393_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e393 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, _e198), _e390), ivec3(0), textureSize(_group_0_binding_4_cs, _e393_clamped_lod) - ivec3(1)), _e393_clamped_lod);
-                            vec4 top = mix(_e388, _e393, fx);
-                            uint _e396 = layer_1;
-                            int _e399_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e399 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row1_), _e396), ivec3(0), textureSize(_group_0_binding_4_cs, _e399_clamped_lod) - ivec3(1)), _e399_clamped_lod);
-                            uint _e401 = layer_1;
-                            int _e404_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e404 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row1_), _e401), ivec3(0), textureSize(_group_0_binding_4_cs, _e404_clamped_lod) - ivec3(1)), _e404_clamped_lod);
-                            vec4 bottom = mix(_e399, _e404, fx);
+                            uint _e360 = layer_1;
+                            vec4 coeff = coeffs[_e360];
+                            uint _e364 = layer_1;
+                            int _e367_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e367 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, _e198), _e364), ivec3(0), textureSize(_group_0_binding_4_cs, _e367_clamped_lod) - ivec3(1)), _e367_clamped_lod);
+                            uint _e369 = layer_1;
+                            int _e372_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e372 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, _e198), _e369), ivec3(0), textureSize(_group_0_binding_4_cs, _e372_clamped_lod) - ivec3(1)), _e372_clamped_lod);
+                            vec4 top = mix(_e367, _e372, fx);
+                            uint _e375 = layer_1;
+                            int _e378_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e378 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row1_), _e375), ivec3(0), textureSize(_group_0_binding_4_cs, _e378_clamped_lod) - ivec3(1)), _e378_clamped_lod);
+                            uint _e380 = layer_1;
+                            int _e383_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e383 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row1_), _e380), ivec3(0), textureSize(_group_0_binding_4_cs, _e383_clamped_lod) - ivec3(1)), _e383_clamped_lod);
+                            vec4 bottom = mix(_e378, _e383, fx);
                             vec4 texel_1 = mix(top, bottom, fy_1);
                             k = 0u;
-                            bool loop_init_7 = true;
+                            bool loop_init_6 = true;
                             while(true) {
-                                if (!loop_init_7) {
-                                    uint _e424 = k;
-                                    k = (_e424 + 1u);
+                                if (!loop_init_6) {
+                                    uint _e403 = k;
+                                    k = (_e403 + 1u);
                                 }
-                                loop_init_7 = false;
-                                uint _e409 = k;
-                                if ((_e409 < 4u)) {
+                                loop_init_6 = false;
+                                uint _e388 = k;
+                                if ((_e388 < 4u)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    float _e412 = vis;
-                                    uint _e413 = k;
-                                    uint _e415 = k;
-                                    vis = (_e412 + (coeff[_e413] * ((texel_1[_e415] * 2.0) - 1.0)));
+                                    float _e391 = vis;
+                                    uint _e392 = k;
+                                    uint _e394 = k;
+                                    vis = (_e391 + (coeff[_e392] * ((texel_1[_e394] * 2.0) - 1.0)));
                                 }
                             }
                         }
                     }
                 }
             }
-            float _e430 = total;
-            float _e431 = weight;
-            float _e432 = vis;
-            total = (_e430 + (_e431 * clamp(_e432, 0.0, 1.0)));
+            float _e409 = total;
+            float _e410 = weight;
+            float _e411 = vis;
+            total = (_e409 + (_e410 * clamp(_e411, 0.0, 1.0)));
+            if (is_last) {
+                break;
+            }
         }
     }
     float l_2 = total;

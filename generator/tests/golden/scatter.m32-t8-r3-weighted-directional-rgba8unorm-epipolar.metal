@@ -62,9 +62,6 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
 };
 typedef metal::float4 type_10[1];
 struct type_14 {
-    float inner[8];
-};
-struct type_15 {
     metal::float4 inner[8];
 };
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
@@ -72,7 +69,6 @@ constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
 constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
 constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
-constant uint MAX_REGIONS = 8u;
 constant uint REGIONS = 3u;
 constant uint LAYERS = 8u;
 
@@ -233,11 +229,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t_1,
-    float a,
-    float b
+    float a_1,
+    float b_1
 ) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
-    return metal::exp(-(sigma_t_1) * a) * _e7;
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b_1 - a_1);
+    return metal::exp(-(sigma_t_1) * a_1) * _e7;
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -275,8 +271,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 eye_1,
     metal::float3 dir_1,
-    float a_1,
-    float b_1,
+    float a_2,
+    float b_2,
     uint panels,
     metal::float3 light_pos_1,
     metal::float3 light_dir_1,
@@ -287,10 +283,10 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sum = 0.0;
     uint k_1 = 0u;
     uint q = {};
-    float t0_1 = metal::dot(light_pos_1 - eye_1, dir_1);
-    float h = metal::max(metal::length((eye_1 + (dir_1 * t0_1)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
-    float g0_ = metal::atan((a_1 - t0_1) / h);
-    float w_1 = (metal::atan((b_1 - t0_1) / h) - g0_) / static_cast<float>(panels);
+    float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
+    float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float g0_ = metal::atan((a_2 - t0_) / h);
+    float w_1 = (metal::atan((b_2 - t0_) / h) - g0_) / static_cast<float>(panels);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
@@ -330,7 +326,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                     float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_1 + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
                     sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
                 }
             }
@@ -344,14 +340,14 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
     metal::float3 eye_2,
     metal::float3 dir_2,
     metal::float3 light_pos_2,
-    float a_2,
-    float b_2,
+    float a_3,
+    float b_3,
     uint n
 ) {
-    float t0_2 = metal::dot(light_pos_2 - eye_2, dir_2);
-    float h_1 = metal::max(metal::length((eye_2 + (dir_2 * t0_2)) - light_pos_2), 0.0001 * metal::max(b_2 - a_2, 0.000001));
-    float theta_a = metal::atan((a_2 - t0_2) / h_1);
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_2, h_1, theta_a, (metal::atan((b_2 - t0_2) / h_1) - theta_a) / static_cast<float>(n)};
+    float t0_1 = metal::dot(light_pos_2 - eye_2, dir_2);
+    float h_1 = metal::max(metal::length((eye_2 + (dir_2 * t0_1)) - light_pos_2), 0.0001 * metal::max(b_3 - a_3, 0.000001));
+    float theta_a = metal::atan((a_3 - t0_1) / h_1);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_1, theta_a, (metal::atan((b_3 - t0_1) / h_1) - theta_a) / static_cast<float>(n)};
 }
 
 metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -533,11 +529,11 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
     metal::float3 eye_5,
     metal::float3 dir_5,
-    float a_3,
-    float b_3,
+    float a_4,
+    float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_4, b_4, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -556,10 +552,10 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 metal::float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float2 a_4,
-    metal::float2 b_4
+    metal::float2 a_5,
+    metal::float2 b_5
 ) {
-    return metal::float2((a_4.x * b_4.y) + (a_4.y * b_4.x), (a_4.y * b_4.y) - (a_4.x * b_4.x));
+    return metal::float2((a_5.x * b_5.y) + (a_5.y * b_5.x), (a_5.y * b_5.y) - (a_5.x * b_5.x));
 }
 
 metal::float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -575,13 +571,13 @@ float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 }
 
 metal::float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float2 a_5,
-    metal::float2 b_5,
+    metal::float2 a_6,
+    metal::float2 b_6,
     uint layer_2
 ) {
     float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_2) + 1u);
     float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_2) + 2u);
-    return metal::float4((2.0 / _e5) * a_5.y, (-2.0 / _e5) * a_5.x, (2.0 / _e10) * b_5.y, (-2.0 / _e10) * b_5.x);
+    return metal::float4((2.0 / _e5) * a_6.y, (-2.0 / _e5) * a_6.x, (2.0 / _e10) * b_6.y, (-2.0 / _e10) * b_6.x);
 }
 
 uint naga_div(uint lhs, uint rhs) {
@@ -589,15 +585,15 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    uint r_2,
+    uint r_1,
     uint regions,
     uint width,
     bool spot_2
 ) {
     if (spot_2) {
-        return naga_div(r_2 * width, regions);
+        return naga_div(r_1 * width, regions);
     }
-    return naga_div((r_2 * r_2) * width, regions * regions);
+    return naga_div((r_1 * r_1) * width, regions * regions);
 }
 
 struct scatterInput {
@@ -622,17 +618,14 @@ kernel void scatter(
     float xs = {};
     float delta = 1.0;
     float theta = 0.0;
-    type_14 pos = {};
-    type_14 t0_ = {};
-    type_14 t1_ = {};
-    uint count = 0u;
-    uint r = 0u;
-    bool local_4 = {};
-    type_15 coeffs = {};
+    type_14 coeffs = {};
     metal::float2 angle = {};
     uint layer = 0u;
     float total = 0.0;
-    uint r_1 = 0u;
+    uint r = 0u;
+    bool local_4 = {};
+    float a = {};
+    float b = {};
     float weight = {};
     float vis = {};
     uint layer_1 = {};
@@ -728,207 +721,184 @@ kernel void scatter(
     uint _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
     uint _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
     uint row1_ = (yb > metal::floor(yb)) ? _e202 : _e198;
-    float _e206 = xs;
-    uint last = naga_f2u32(metal::min(metal::max(_e206, 0.0), static_cast<float>(width_1) - 1.0));
+    float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e21));
+    uint panels_2 = metal::max(naga_div(f_9.sizes2_.z, 4u), 1u);
+    float _e217 = d;
+    float _e221 = d;
+    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e217), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e221));
+    metal::float2 _e226 = angle;
+    metal::float2 _e227 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226);
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e269 = r;
-            r = _e269 + 1u;
+            uint _e242 = layer;
+            layer = _e242 + 1u;
         }
         loop_init_3 = false;
-        uint _e216 = r;
-        if (_e216 < REGIONS) {
+        uint _e229 = layer;
+        if (_e229 < LAYERS) {
         } else {
             break;
         }
         {
-            uint _e218 = r;
-            uint _e219 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, REGIONS, width_1, false);
-            float b0_ = static_cast<float>(_e219);
-            uint _e221 = r;
-            uint _e224 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e221 + 1u, REGIONS, width_1, false);
-            float b1_ = static_cast<float>(_e224);
-            if (!((last < naga_f2u32(b1_)))) {
-                uint _e229 = r;
-                local_4 = (_e229 + 1u) == REGIONS;
-            } else {
-                local_4 = true;
-            }
-            bool is_last = local_4;
-            uint _e238 = r;
-            float _e242 = xs;
-            pos.inner[metal::min(unsigned(_e238), 7u)] = is_last ? metal::clamp(_e242 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-            uint _e252 = r;
-            float _e254 = delta;
-            float _e255 = theta;
-            float _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e254, _e255, s_2, false);
-            t0_.inner[metal::min(unsigned(_e252), 7u)] = _e256;
-            uint _e258 = r;
-            float _e260 = delta;
-            float _e261 = theta;
-            float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e260, _e261, s_2, false);
-            t1_.inner[metal::min(unsigned(_e258), 7u)] = is_last ? s_2 : _e262;
-            uint _e264 = r;
-            count = _e264 + 1u;
-            if (is_last) {
-                break;
-            }
+            metal::float2 _e232 = angle;
+            metal::float2 _e233 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e232, _e227);
+            uint _e235 = layer;
+            metal::float2 _e237 = angle;
+            uint _e238 = layer;
+            metal::float4 _e239 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e237, _e233, _e238);
+            coeffs.inner[metal::min(unsigned(_e235), 7u)] = _e239;
+            metal::float2 _e240 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e233, _e227);
+            angle = _e240;
         }
     }
-    float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e21));
-    uint panels_2 = metal::max(naga_div(f_9.sizes2_.z, 4u), 1u);
-    float _e282 = d;
-    float _e286 = d;
-    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e282), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e286));
-    metal::float2 _e291 = angle;
-    metal::float2 _e292 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e291);
+    float _e248 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    float sun_scatter = f_9.medium.y * _e248;
+    float _e250 = xs;
+    uint last = naga_f2u32(metal::min(metal::max(_e250, 0.0), static_cast<float>(width_1) - 1.0));
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e307 = layer;
-            layer = _e307 + 1u;
+            uint _e418 = r;
+            r = _e418 + 1u;
         }
         loop_init_4 = false;
-        uint _e294 = layer;
-        if (_e294 < LAYERS) {
+        uint _e260 = r;
+        if (_e260 < REGIONS) {
         } else {
             break;
         }
         {
-            metal::float2 _e297 = angle;
-            metal::float2 _e298 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e297, _e292);
-            uint _e300 = layer;
-            metal::float2 _e302 = angle;
-            uint _e303 = layer;
-            metal::float4 _e304 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e302, _e298, _e303);
-            coeffs.inner[metal::min(unsigned(_e300), 7u)] = _e304;
-            metal::float2 _e305 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e298, _e292);
-            angle = _e305;
-        }
-    }
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
-    while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
-            uint _e439 = r_1;
-            r_1 = _e439 + 1u;
-        }
-        loop_init_5 = false;
-        uint _e310 = r_1;
-        uint _e311 = count;
-        if (_e310 < _e311) {
-        } else {
-            break;
-        }
-        {
-            uint _e313 = r_1;
-            float a_6 = t0_.inner[metal::min(unsigned(_e313), 7u)];
-            uint _e316 = r_1;
-            float b_6 = t1_.inner[metal::min(unsigned(_e316), 7u)];
+            uint _e262 = r;
+            uint _e263 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e262, REGIONS, width_1, false);
+            float b0_ = static_cast<float>(_e263);
+            uint _e265 = r;
+            uint _e268 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e265 + 1u, REGIONS, width_1, false);
+            float b1_ = static_cast<float>(_e268);
+            if (!((last < naga_f2u32(b1_)))) {
+                uint _e273 = r;
+                local_4 = (_e273 + 1u) == REGIONS;
+            } else {
+                local_4 = true;
+            }
+            bool is_last = local_4;
+            float _e283 = xs;
+            float pos = is_last ? metal::clamp(_e283 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            a = float {};
+            b = float {};
+            float _e296 = delta;
+            float _e297 = theta;
+            float _e298 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e296, _e297, s_2, false);
+            a = _e298;
+            float _e299 = delta;
+            float _e300 = theta;
+            float _e301 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e299, _e300, s_2, false);
+            b = is_last ? s_2 : _e301;
             weight = float {};
             if (false) {
-                float _e321 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_6, b_6, panels_2);
-                weight = _e321;
+                float _e305 = a;
+                float _e306 = b;
+                float _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, _e305, _e306, panels_2);
+                weight = _e307;
             } else {
-                float _e326 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                float _e330 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_6);
-                weight = (f_9.medium.y * _e326) * _e330;
+                float _e310 = a;
+                float _e311 = b;
+                float _e312 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e310, _e311);
+                weight = sun_scatter * _e312;
             }
-            uint _e332 = r_1;
-            float _e334 = pos.inner[metal::min(unsigned(_e332), 7u)];
-            float xb = _e334 - 0.5;
+            float xb = pos - 0.5;
             float fx = xb - metal::floor(xb);
             uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
             uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
-            uint clamped_lod_e357 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 bounds0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(bounds.get_width(clamped_lod_e357), bounds.get_height(clamped_lod_e357)) - 1), clamped_lod_e357);
-            uint clamped_lod_e361 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 bounds1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e361), bounds.get_height(clamped_lod_e361)) - 1), clamped_lod_e361);
+            uint clamped_lod_e336 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 bounds0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(bounds.get_width(clamped_lod_e336), bounds.get_height(clamped_lod_e336)) - 1), clamped_lod_e336);
+            uint clamped_lod_e340 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 bounds1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e340), bounds.get_height(clamped_lod_e340)) - 1), clamped_lod_e340);
             float lo_1 = metal::min(bounds0_.x, bounds1_.x);
             float hi_1 = metal::max(bounds0_.y, bounds1_.y);
             vis = 0.5;
-            float _e370 = d;
-            if (_e370 <= lo_1) {
+            float _e349 = d;
+            if (_e349 <= lo_1) {
                 vis = 1.0;
             } else {
-                float _e373 = d;
-                if (_e373 > hi_1) {
+                float _e352 = d;
+                if (_e352 > hi_1) {
                     vis = 0.0;
                 } else {
                     layer_1 = 0u;
-                    uint2 loop_bound_6 = uint2(4294967295u);
-                    bool loop_init_6 = true;
+                    uint2 loop_bound_5 = uint2(4294967295u);
+                    bool loop_init_5 = true;
                     while(true) {
-                        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-                        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                        if (!loop_init_6) {
-                            uint _e427 = layer_1;
-                            layer_1 = _e427 + 1u;
+                        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+                        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+                        if (!loop_init_5) {
+                            uint _e406 = layer_1;
+                            layer_1 = _e406 + 1u;
                         }
-                        loop_init_6 = false;
-                        uint _e378 = layer_1;
-                        if (_e378 < LAYERS) {
+                        loop_init_5 = false;
+                        uint _e357 = layer_1;
+                        if (_e357 < LAYERS) {
                         } else {
                             break;
                         }
                         {
-                            uint _e381 = layer_1;
-                            metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e381), 7u)];
-                            uint _e385 = layer_1;
-                            uint clamped_lod_e388 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e388 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e388), filtered.get_height(clamped_lod_e388)) - 1), metal::min(uint(_e385), filtered.get_array_size() - 1), clamped_lod_e388);
-                            uint _e390 = layer_1;
-                            uint clamped_lod_e393 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e393 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e393), filtered.get_height(clamped_lod_e393)) - 1), metal::min(uint(_e390), filtered.get_array_size() - 1), clamped_lod_e393);
-                            metal::float4 top = metal::mix(_e388, _e393, fx);
-                            uint _e396 = layer_1;
-                            uint clamped_lod_e399 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e399 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e399), filtered.get_height(clamped_lod_e399)) - 1), metal::min(uint(_e396), filtered.get_array_size() - 1), clamped_lod_e399);
-                            uint _e401 = layer_1;
-                            uint clamped_lod_e404 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e404 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e404), filtered.get_height(clamped_lod_e404)) - 1), metal::min(uint(_e401), filtered.get_array_size() - 1), clamped_lod_e404);
-                            metal::float4 bottom = metal::mix(_e399, _e404, fx);
+                            uint _e360 = layer_1;
+                            metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e360), 7u)];
+                            uint _e364 = layer_1;
+                            uint clamped_lod_e367 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e367 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e367), filtered.get_height(clamped_lod_e367)) - 1), metal::min(uint(_e364), filtered.get_array_size() - 1), clamped_lod_e367);
+                            uint _e369 = layer_1;
+                            uint clamped_lod_e372 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e372 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e372), filtered.get_height(clamped_lod_e372)) - 1), metal::min(uint(_e369), filtered.get_array_size() - 1), clamped_lod_e372);
+                            metal::float4 top = metal::mix(_e367, _e372, fx);
+                            uint _e375 = layer_1;
+                            uint clamped_lod_e378 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e378 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e378), filtered.get_height(clamped_lod_e378)) - 1), metal::min(uint(_e375), filtered.get_array_size() - 1), clamped_lod_e378);
+                            uint _e380 = layer_1;
+                            uint clamped_lod_e383 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e383 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e383), filtered.get_height(clamped_lod_e383)) - 1), metal::min(uint(_e380), filtered.get_array_size() - 1), clamped_lod_e383);
+                            metal::float4 bottom = metal::mix(_e378, _e383, fx);
                             metal::float4 texel_1 = metal::mix(top, bottom, fy_1);
                             k = 0u;
-                            uint2 loop_bound_7 = uint2(4294967295u);
-                            bool loop_init_7 = true;
+                            uint2 loop_bound_6 = uint2(4294967295u);
+                            bool loop_init_6 = true;
                             while(true) {
-                                if (metal::all(loop_bound_7 == uint2(0u))) { break; }
-                                loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-                                if (!loop_init_7) {
-                                    uint _e424 = k;
-                                    k = _e424 + 1u;
+                                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+                                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                                if (!loop_init_6) {
+                                    uint _e403 = k;
+                                    k = _e403 + 1u;
                                 }
-                                loop_init_7 = false;
-                                uint _e409 = k;
-                                if (_e409 < 4u) {
+                                loop_init_6 = false;
+                                uint _e388 = k;
+                                if (_e388 < 4u) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    float _e412 = vis;
-                                    uint _e413 = k;
-                                    uint _e415 = k;
-                                    vis = _e412 + (coeff[metal::min(unsigned(_e413), 3u)] * ((texel_1[metal::min(unsigned(_e415), 3u)] * 2.0) - 1.0));
+                                    float _e391 = vis;
+                                    uint _e392 = k;
+                                    uint _e394 = k;
+                                    vis = _e391 + (coeff[metal::min(unsigned(_e392), 3u)] * ((texel_1[metal::min(unsigned(_e394), 3u)] * 2.0) - 1.0));
                                 }
                             }
                         }
                     }
                 }
             }
-            float _e430 = total;
-            float _e431 = weight;
-            float _e432 = vis;
-            total = _e430 + (_e431 * metal::clamp(_e432, 0.0, 1.0));
+            float _e409 = total;
+            float _e410 = weight;
+            float _e411 = vis;
+            total = _e409 + (_e410 * metal::clamp(_e411, 0.0, 1.0));
+            if (is_last) {
+                break;
+            }
         }
     }
     float l_2 = total;

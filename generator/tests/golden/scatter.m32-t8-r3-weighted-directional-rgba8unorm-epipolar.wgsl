@@ -56,7 +56,6 @@ const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
 const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
-const MAX_REGIONS: u32 = 8u;
 const REGIONS: u32 = 3u;
 const LAYERS: u32 = 8u;
 
@@ -200,9 +199,9 @@ fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, 
     return ((1f - exp(-(x_4))) / sigma_t);
 }
 
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a_1: f32, b_1: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
+    return (exp((-(sigma_t_1) * a_1)) * _e7);
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
@@ -224,15 +223,15 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
 }
 
-fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
+fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_2: f32, b_2: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
     var sum: f32 = 0f;
     var k_1: u32 = 0u;
     var q: u32;
 
-    let t0_1 = dot((light_pos_1 - eye_1), dir_1);
-    let h = max(length(((eye_1 + (dir_1 * t0_1)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
-    let g0_ = atan(((a_1 - t0_1) / h));
-    let w_1 = ((atan(((b_1 - t0_1) / h)) - g0_) / f32(panels));
+    let t0_ = dot((light_pos_1 - eye_1), dir_1);
+    let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_2 - a_2), 0.000001f)));
+    let g0_ = atan(((a_2 - t0_) / h));
+    let w_1 = ((atan(((b_2 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k_1;
         if (_e30 < panels) {
@@ -254,7 +253,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                     let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     let _e52 = sum;
                     let _e54 = q;
-                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_1 + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
                     sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u * u))));
                 }
                 continuing {
@@ -272,11 +271,11 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     return (((_e75 * 0.5f) * w_1) * h);
 }
 
-fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
-    let t0_2 = dot((light_pos_2 - eye_2), dir_2);
-    let h_1 = max(length(((eye_2 + (dir_2 * t0_2)) - light_pos_2)), (0.0001f * max((b_2 - a_2), 0.000001f)));
-    let theta_a = atan(((a_2 - t0_2) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_2, h_1, theta_a, ((atan(((b_2 - t0_2) / h_1)) - theta_a) / f32(n)));
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_3: f32, b_3: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    let t0_1 = dot((light_pos_2 - eye_2), dir_2);
+    let h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001f * max((b_3 - a_3), 0.000001f)));
+    let theta_a = atan(((a_3 - t0_1) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_3 - t0_1) / h_1)) - theta_a) / f32(n)));
 }
 
 fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x: f32) -> vec2<f32> {
@@ -400,8 +399,8 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_X
     }
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_4, b_4, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -413,8 +412,8 @@ fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod
     return (f_8.e1_.w + ((f32(row) + 0.5f) * f_8.e2_.w));
 }
 
-fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_4: vec2<f32>, b_4: vec2<f32>) -> vec2<f32> {
-    return vec2<f32>(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_5: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(((a_5.x * b_5.y) + (a_5.y * b_5.x)), ((a_5.y * b_5.y) - (a_5.x * b_5.x)));
 }
 
 fn fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(first: vec2<f32>) -> vec2<f32> {
@@ -425,17 +424,17 @@ fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_3: u32) -> f32 {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_3) - 1u)));
 }
 
-fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_5: vec2<f32>, layer_2: u32) -> vec4<f32> {
+fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_6: vec2<f32>, b_6: vec2<f32>, layer_2: u32) -> vec4<f32> {
     let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
     let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
-    return vec4<f32>(((2f / _e5) * a_5.y), ((-2f / _e5) * a_5.x), ((2f / _e10) * b_5.y), ((-2f / _e10) * b_5.x));
+    return vec4<f32>(((2f / _e5) * a_6.y), ((-2f / _e5) * a_6.x), ((2f / _e10) * b_6.y), ((-2f / _e10) * b_6.x));
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_2: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
     if spot_2 {
-        return ((r_2 * width) / regions);
+        return ((r_1 * width) / regions);
     }
-    return (((r_2 * r_2) * width) / (regions * regions));
+    return (((r_1 * r_1) * width) / (regions * regions));
 }
 
 @compute @workgroup_size(8, 8, 1) 
@@ -449,17 +448,14 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     var xs: f32;
     var delta: f32 = 1f;
     var theta: f32 = 0f;
-    var pos: array<f32, 8>;
-    var t0_: array<f32, 8>;
-    var t1_: array<f32, 8>;
-    var count: u32 = 0u;
-    var r: u32 = 0u;
-    var local_4: bool;
     var coeffs: array<vec4<f32>, 8>;
     var angle: vec2<f32>;
     var layer: u32 = 0u;
     var total: f32 = 0f;
-    var r_1: u32 = 0u;
+    var r: u32 = 0u;
+    var local_4: bool;
+    var a: f32;
+    var b: f32;
     var weight: f32;
     var vis: f32;
     var layer_1: u32;
@@ -555,105 +551,84 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
     let _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
     let row1_ = select(_e198, _e202, (yb > floor(yb)));
-    let _e206 = xs;
-    let last = u32(min(max(_e206, 0f), (f32(width_1) - 1f)));
+    let cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
+    let panels_2 = max((f_9.sizes2_.z / 4u), 1u);
+    let _e217 = d;
+    let _e221 = d;
+    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e217)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e221)));
+    let _e226 = angle;
+    let _e227 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226);
     loop {
-        let _e216 = r;
-        if (_e216 < REGIONS) {
+        let _e229 = layer;
+        if (_e229 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e218 = r;
-            let _e219 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, REGIONS, width_1, false);
-            let b0_ = f32(_e219);
-            let _e221 = r;
-            let _e224 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e221 + 1u), REGIONS, width_1, false);
-            let b1_ = f32(_e224);
+            let _e232 = angle;
+            let _e233 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e232, _e227);
+            let _e235 = layer;
+            let _e237 = angle;
+            let _e238 = layer;
+            let _e239 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e237, _e233, _e238);
+            coeffs[_e235] = _e239;
+            let _e240 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e233, _e227);
+            angle = _e240;
+        }
+        continuing {
+            let _e242 = layer;
+            layer = (_e242 + 1u);
+        }
+    }
+    let _e248 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    let sun_scatter = (f_9.medium.y * _e248);
+    let _e250 = xs;
+    let last = u32(min(max(_e250, 0f), (f32(width_1) - 1f)));
+    loop {
+        let _e260 = r;
+        if (_e260 < REGIONS) {
+        } else {
+            break;
+        }
+        {
+            let _e262 = r;
+            let _e263 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e262, REGIONS, width_1, false);
+            let b0_ = f32(_e263);
+            let _e265 = r;
+            let _e268 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e265 + 1u), REGIONS, width_1, false);
+            let b1_ = f32(_e268);
             if !((last < u32(b1_))) {
-                let _e229 = r;
-                local_4 = ((_e229 + 1u) == REGIONS);
+                let _e273 = r;
+                local_4 = ((_e273 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             let is_last = local_4;
-            let _e238 = r;
-            let _e242 = xs;
-            pos[_e238] = select((b1_ - 0.5f), clamp((_e242 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
-            let _e252 = r;
-            let _e254 = delta;
-            let _e255 = theta;
-            let _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e254, _e255, s_2, false);
-            t0_[_e252] = _e256;
-            let _e258 = r;
-            let _e260 = delta;
-            let _e261 = theta;
-            let _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e260, _e261, s_2, false);
-            t1_[_e258] = select(_e262, s_2, is_last);
-            let _e264 = r;
-            count = (_e264 + 1u);
-            if is_last {
-                break;
-            }
-        }
-        continuing {
-            let _e269 = r;
-            r = (_e269 + 1u);
-        }
-    }
-    let cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
-    let panels_2 = max((f_9.sizes2_.z / 4u), 1u);
-    let _e282 = d;
-    let _e286 = d;
-    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e282)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e286)));
-    let _e291 = angle;
-    let _e292 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e291);
-    loop {
-        let _e294 = layer;
-        if (_e294 < LAYERS) {
-        } else {
-            break;
-        }
-        {
-            let _e297 = angle;
-            let _e298 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e297, _e292);
-            let _e300 = layer;
-            let _e302 = angle;
-            let _e303 = layer;
-            let _e304 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e302, _e298, _e303);
-            coeffs[_e300] = _e304;
-            let _e305 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e298, _e292);
-            angle = _e305;
-        }
-        continuing {
-            let _e307 = layer;
-            layer = (_e307 + 1u);
-        }
-    }
-    loop {
-        let _e310 = r_1;
-        let _e311 = count;
-        if (_e310 < _e311) {
-        } else {
-            break;
-        }
-        {
-            let _e313 = r_1;
-            let a_6 = t0_[_e313];
-            let _e316 = r_1;
-            let b_6 = t1_[_e316];
+            let _e283 = xs;
+            let pos = select((b1_ - 0.5f), clamp((_e283 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
+            a = f32();
+            b = f32();
+            let _e296 = delta;
+            let _e297 = theta;
+            let _e298 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e296, _e297, s_2, false);
+            a = _e298;
+            let _e299 = delta;
+            let _e300 = theta;
+            let _e301 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e299, _e300, s_2, false);
+            b = select(_e301, s_2, is_last);
             weight = f32();
             if false {
-                let _e321 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, a_6, b_6, panels_2);
-                weight = _e321;
+                let _e305 = a;
+                let _e306 = b;
+                let _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, _e305, _e306, panels_2);
+                weight = _e307;
             } else {
-                let _e326 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-                let _e330 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_6);
-                weight = ((f_9.medium.y * _e326) * _e330);
+                let _e310 = a;
+                let _e311 = b;
+                let _e312 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e310, _e311);
+                weight = (sun_scatter * _e312);
             }
-            let _e332 = r_1;
-            let _e334 = pos[_e332];
-            let xb = (_e334 - 0.5f);
+            let xb = (pos - 0.5f);
             let fx = (xb - floor(xb));
             let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
             let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
@@ -662,69 +637,72 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
             let lo_1 = min(bounds0_.x, bounds1_.x);
             let hi_1 = max(bounds0_.y, bounds1_.y);
             vis = 0.5f;
-            let _e370 = d;
-            if (_e370 <= lo_1) {
+            let _e349 = d;
+            if (_e349 <= lo_1) {
                 vis = 1f;
             } else {
-                let _e373 = d;
-                if (_e373 > hi_1) {
+                let _e352 = d;
+                if (_e352 > hi_1) {
                     vis = 0f;
                 } else {
                     layer_1 = 0u;
                     loop {
-                        let _e378 = layer_1;
-                        if (_e378 < LAYERS) {
+                        let _e357 = layer_1;
+                        if (_e357 < LAYERS) {
                         } else {
                             break;
                         }
                         {
-                            let _e381 = layer_1;
-                            let coeff = coeffs[_e381];
-                            let _e385 = layer_1;
-                            let _e388 = textureLoad(filtered, vec2<u32>(x0_, _e198), _e385, 0i);
-                            let _e390 = layer_1;
-                            let _e393 = textureLoad(filtered, vec2<u32>(x1_, _e198), _e390, 0i);
-                            let top = mix(_e388, _e393, fx);
-                            let _e396 = layer_1;
-                            let _e399 = textureLoad(filtered, vec2<u32>(x0_, row1_), _e396, 0i);
-                            let _e401 = layer_1;
-                            let _e404 = textureLoad(filtered, vec2<u32>(x1_, row1_), _e401, 0i);
-                            let bottom = mix(_e399, _e404, fx);
+                            let _e360 = layer_1;
+                            let coeff = coeffs[_e360];
+                            let _e364 = layer_1;
+                            let _e367 = textureLoad(filtered, vec2<u32>(x0_, _e198), _e364, 0i);
+                            let _e369 = layer_1;
+                            let _e372 = textureLoad(filtered, vec2<u32>(x1_, _e198), _e369, 0i);
+                            let top = mix(_e367, _e372, fx);
+                            let _e375 = layer_1;
+                            let _e378 = textureLoad(filtered, vec2<u32>(x0_, row1_), _e375, 0i);
+                            let _e380 = layer_1;
+                            let _e383 = textureLoad(filtered, vec2<u32>(x1_, row1_), _e380, 0i);
+                            let bottom = mix(_e378, _e383, fx);
                             let texel_1 = mix(top, bottom, fy_1);
                             k = 0u;
                             loop {
-                                let _e409 = k;
-                                if (_e409 < 4u) {
+                                let _e388 = k;
+                                if (_e388 < 4u) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    let _e412 = vis;
-                                    let _e413 = k;
-                                    let _e415 = k;
-                                    vis = (_e412 + (coeff[_e413] * ((texel_1[_e415] * 2f) - 1f)));
+                                    let _e391 = vis;
+                                    let _e392 = k;
+                                    let _e394 = k;
+                                    vis = (_e391 + (coeff[_e392] * ((texel_1[_e394] * 2f) - 1f)));
                                 }
                                 continuing {
-                                    let _e424 = k;
-                                    k = (_e424 + 1u);
+                                    let _e403 = k;
+                                    k = (_e403 + 1u);
                                 }
                             }
                         }
                         continuing {
-                            let _e427 = layer_1;
-                            layer_1 = (_e427 + 1u);
+                            let _e406 = layer_1;
+                            layer_1 = (_e406 + 1u);
                         }
                     }
                 }
             }
-            let _e430 = total;
-            let _e431 = weight;
-            let _e432 = vis;
-            total = (_e430 + (_e431 * clamp(_e432, 0f, 1f)));
+            let _e409 = total;
+            let _e410 = weight;
+            let _e411 = vis;
+            total = (_e409 + (_e410 * clamp(_e411, 0f, 1f)));
+            if is_last {
+                break;
+            }
         }
         continuing {
-            let _e439 = r_1;
-            r_1 = (_e439 + 1u);
+            let _e418 = r;
+            r = (_e418 + 1u);
         }
     }
     let l_2 = total;

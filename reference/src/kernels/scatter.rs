@@ -28,9 +28,6 @@ use scatter_shaderlib::prefiltered::{
     FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
 };
 
-/// Most regions a variant may have (the size of the per-pixel region arrays).
-pub const MAX_REGIONS: usize = 8;
-
 /// The bindings of `scatter`.
 pub struct ScatterInputs<'a> {
     /// Frame uniforms.
@@ -149,49 +146,6 @@ pub fn scatter_main(
         row0
     };
 
-    // Regions: every region before the surface's, whole, and the surface's up to x_s. Each
-    // is weighted by this pixel's own unshadowed integral over its part of the ray.
-    let last = min(max(xs, 0.0), width as f32 - 1.0) as u32;
-    let mut pos = [0.0f32; MAX_REGIONS];
-    let mut t0 = [0.0f32; MAX_REGIONS];
-    let mut t1 = [0.0f32; MAX_REGIONS];
-    let mut count = 0u32;
-    for r in 0..regions {
-        let b0 = region_start(r, regions, width, spot) as f32;
-        let b1 = region_start(r + 1, regions, width, spot) as f32;
-        let is_last = last < b1 as u32 || r + 1 == regions;
-        pos[r as usize] = if is_last {
-            clamp(xs - 0.5, b0 + 0.5, b1 - 0.5)
-        } else {
-            b1 - 0.5
-        };
-        if proj {
-            let mut a = 0.0;
-            if r > 0 {
-                a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
-            }
-            t0[r as usize] = a;
-            t1[r as usize] = if is_last {
-                s
-            } else {
-                min(
-                    proj_reach(f, proj_boundary(f, r + 1), m, spot, s * qd) / qd,
-                    s,
-                )
-            };
-        } else {
-            t0[r as usize] = ray_t(f, b0, delta, theta, s, spot);
-            t1[r as usize] = if is_last {
-                s
-            } else {
-                ray_t(f, b1, delta, theta, s, spot)
-            };
-        }
-        count = r + 1;
-        if is_last {
-            break;
-        }
-    }
     let cos_theta_l = -xyz(f.light_dir).dot(dir);
     // Every region gets the full spot quadrature (see the WGSL comment).
     let panels = max_u(f.sizes2[2] / 4, 1);
@@ -205,19 +159,53 @@ pub fn scatter_main(
         coeffs.push(coeff4(angle, second, layer));
         angle = turn(second, step);
     }
+    // The sun's scattering coefficient times phase, the same for every region.
+    let sun_scatter = f.medium[1] * phase_hg(f.medium[2], cos_theta_l);
+
+    // Regions: every region before the surface's, whole, and the surface's up to x_s, each
+    // weighted by this pixel's own unshadowed integral over its part [a, b] of the ray. One
+    // loop, as in the WGSL.
+    let last = min(max(xs, 0.0), width as f32 - 1.0) as u32;
     let mut total = 0.0;
-    for r in 0..count {
-        let (a, b) = (t0[r as usize], t1[r as usize]);
+    for r in 0..regions {
+        let b0 = region_start(r, regions, width, spot) as f32;
+        let b1 = region_start(r + 1, regions, width, spot) as f32;
+        let is_last = last < b1 as u32 || r + 1 == regions;
+        let pos = if is_last {
+            clamp(xs - 0.5, b0 + 0.5, b1 - 0.5)
+        } else {
+            b1 - 0.5
+        };
+        let (a, b) = if proj {
+            let mut a = 0.0;
+            if r > 0 {
+                a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
+            }
+            let b = if is_last {
+                s
+            } else {
+                min(
+                    proj_reach(f, proj_boundary(f, r + 1), m, spot, s * qd) / qd,
+                    s,
+                )
+            };
+            (a, b)
+        } else {
+            let b = if is_last {
+                s
+            } else {
+                ray_t(f, b1, delta, theta, s, spot)
+            };
+            (ray_t(f, b0, delta, theta, s, spot), b)
+        };
         let weight = if spot {
             spot_segment(f, eye, dir, a, b, panels)
         } else {
-            f.medium[1]
-                * phase_hg(f.medium[2], cos_theta_l)
-                * transmittance_between(f.medium[0], a, b)
+            sun_scatter * transmittance_between(f.medium[0], a, b)
         };
         // The (up to) four texels the bilinear fetch reads with a non-zero weight: columns
         // x0 <= x1 of the region, rows row0 and row1.
-        let xb = pos[r as usize] - 0.5;
+        let xb = pos - 0.5;
         let fx = xb - xb.floor();
         let x0 = clamp(xb.floor(), 0.0, width as f32 - 1.0) as u32;
         let x1 = if xb > xb.floor() {
@@ -249,6 +237,9 @@ pub fn scatter_main(
             }
         }
         total += weight * clamp(vis, 0.0, 1.0);
+        if is_last {
+            break;
+        }
     }
     let l = total;
     let c = color * l;

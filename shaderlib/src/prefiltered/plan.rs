@@ -1,4 +1,4 @@
-//! The plan of a `prefiltered` variant: the textures, buffers and samplers and the three
+//! The plan of a `prefiltered` variant: the textures and buffers and the three
 //! passes (`rectify`, `prefilter`, `scatter`). `scatter-gen` writes it into the manifest;
 //! `scatter-runtime` builds and dispatches from it.
 
