@@ -5,6 +5,7 @@
 //! cargo run --release -p scatter-examples --example bench -- --out-dir docs/bench
 //! cargo run --release -p scatter-examples --example bench -- --quick --out-dir out/bench
 //! cargo run --release -p scatter-examples --example bench -- --headline-only
+//! cargo run --release -p scatter-examples --example bench -- --roofline
 //! ```
 
 use std::path::PathBuf;
@@ -35,6 +36,12 @@ struct Args {
     /// a kernel change before and after.
     #[arg(long, conflicts_with_all = ["quick", "no_scaling"])]
     headline_only: bool,
+    /// Only the machine's bounds (probe kernels: copy bandwidth, texel loads, filtered
+    /// fetches, transcendentals, FMAs) and every kernel's cost model against them at the
+    /// headline configuration (`scatter_examples::roofline`): two markdown tables printed,
+    /// no files written.
+    #[arg(long, conflicts_with_all = ["quick", "no_scaling", "headline_only"])]
+    roofline: bool,
 }
 
 fn main() -> ExitCode {
@@ -54,6 +61,10 @@ fn main() -> ExitCode {
         config.cases.clear();
         config.scaling = false;
         config.headline = true;
+        config.headline_error = false;
+    }
+    if args.roofline {
+        return roofline(args.frames.unwrap_or(5));
     }
     let command = std::env::args().collect::<Vec<_>>().join(" ");
     let result = Context::new()
@@ -86,6 +97,28 @@ fn main() -> ExitCode {
                 eprintln!("wrote {}", p.display());
             }
             eprintln!("bench done in {:.1} s", r.elapsed.as_secs_f64());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// `--roofline`: the bounds and the cost-model table, printed as markdown.
+fn roofline(frames: u32) -> ExitCode {
+    use scatter_examples::roofline;
+    let result = Context::new().map_err(|e| e.to_string()).and_then(|ctx| {
+        eprintln!("GPU adapter: {}", ctx.report());
+        let bounds = roofline::measure_bounds(&ctx, frames).map_err(|e| e.to_string())?;
+        let rows = roofline::roofline(&ctx, &bounds, frames).map_err(|e| e.to_string())?;
+        Ok((bounds, rows))
+    });
+    match result {
+        Ok((bounds, rows)) => {
+            println!("{}", roofline::bounds_markdown(&bounds));
+            println!("{}", roofline::roofline_markdown(&rows));
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -552,15 +552,18 @@ fn describe_report(r: &FrameReport) -> Vec<String> {
 /// Named times, in pass order.
 type PassTimes = Vec<(&'static str, Duration)>;
 
-/// In a projective frame `rectify` does not run and is left out.
+/// In a projective frame `depth_columns`, `slice_fit` and `rectify` do not run and are left
+/// out.
 fn prefiltered_times(t: PrefilteredTimes, projective: bool) -> PassTimes {
     let mut out = vec![
+        (Kernel::DepthColumns.name(), t.depth_columns),
+        (Kernel::SliceFit.name(), t.slice_fit),
         (Kernel::Rectify.name(), t.rectify),
         (Kernel::Prefilter.name(), t.prefilter),
         (Kernel::Scatter.name(), t.scatter),
     ];
     if projective {
-        out.remove(0);
+        out.drain(..3);
     }
     out
 }
@@ -575,6 +578,8 @@ fn raymarch_times(t: RaymarchTimes, interleaved: bool) -> PassTimes {
 
 fn minmax_times(t: MinmaxTimes) -> PassTimes {
     vec![
+        (Kernel::DepthColumns.name(), t.depth_columns),
+        (Kernel::SliceFit.name(), t.slice_fit),
         (Kernel::Rectify.name(), t.rectify),
         (Kernel::MinmaxBuild.name(), t.build),
         (Kernel::MinmaxTraverse.name(), t.march),

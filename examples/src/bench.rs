@@ -147,9 +147,12 @@ pub struct BenchConfig {
     pub scaling: bool,
     /// Also time the headline configuration (1280x720 screen, 1024x1024 rectified map) for
     /// the prefiltered default, minmax and raymarch N = 64, 128 and (64, 4x4) on
-    /// `sphere/ordinary`, `foliage/ordinary` and `terrain/ordinary` (no accuracy: ground truths at 1280x720 cost
-    /// minutes per pose on two cores).
+    /// `sphere/ordinary`, `foliage/ordinary` and `terrain/ordinary`.
     pub headline: bool,
+    /// With `headline`: also measure each headline run's rel L1 against the `shadow_map`
+    /// truth at 1280x720 (the truth costs about a minute per scene on two cores; off for
+    /// `bench --headline-only`, which times a kernel change).
+    pub headline_error: bool,
 }
 
 impl BenchConfig {
@@ -198,6 +201,7 @@ impl BenchConfig {
             truth_segments: TruthSettings::default().segments,
             scaling: true,
             headline: true,
+            headline_error: true,
         }
     }
 
@@ -229,6 +233,7 @@ impl BenchConfig {
             truth_segments: 256,
             scaling: false,
             headline: false,
+            headline_error: false,
         }
     }
 }
@@ -274,11 +279,11 @@ pub struct ScalingRow {
     pub screen: [u32; 2],
     /// Rectified size.
     pub rectified: [u32; 2],
-    /// Pass wall times: rectify, prefilter, scatter.
-    pub passes: [Duration; 3],
+    /// Pass wall times: depth_columns, slice_fit, rectify, prefilter, scatter.
+    pub passes: [Duration; 5],
 }
 
-/// A timing-only run at the headline configuration.
+/// A run at the headline configuration.
 #[derive(Clone, Debug)]
 pub struct HeadlineRow {
     /// Family.
@@ -289,6 +294,9 @@ pub struct HeadlineRow {
     pub scene: SceneName,
     /// Pass wall times.
     pub passes: Vec<(&'static str, Duration)>,
+    /// rel L1 against the `shadow_map` truth at the headline size, when measured
+    /// ([`BenchConfig::headline_error`]).
+    pub rel_l1_shadow_map: Option<f64>,
 }
 
 impl HeadlineRow {
@@ -310,8 +318,11 @@ pub fn headline_lines(result: &BenchResult) -> Vec<String> {
                 .map(|(name, d)| format!("{name} {:.1}", ms(*d)))
                 .collect::<Vec<_>>()
                 .join(", ");
+            let error = h
+                .rel_l1_shadow_map
+                .map_or(String::new(), |e| format!(", rel L1 {:.2} %", 100.0 * e));
             format!(
-                "{} {} {}: {:.1} ms ({passes})",
+                "{} {} {}: {:.1} ms ({passes}){error}",
                 h.family,
                 h.knobs,
                 h.scene,
@@ -338,7 +349,8 @@ pub struct BenchResult {
     pub elapsed: Duration,
 }
 
-type BoxError = Box<dyn std::error::Error>;
+/// Any error of a bench run.
+pub type BoxError = Box<dyn std::error::Error>;
 
 /// A run: its passes, its output (rgba, row-major) and its GPU timestamps.
 type MethodRun = (FamilyPasses, Vec<[f32; 4]>, Option<Duration>);
@@ -462,7 +474,7 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
     };
     let headline = if config.headline {
         bar.set_message("headline 1280x720");
-        headline_runs(ctx, config.frames)?
+        headline_runs(ctx, config.frames, config.headline_error)?
     } else {
         Vec::new()
     };
@@ -559,10 +571,11 @@ fn time_interleaved(
         .collect())
 }
 
-/// A timing scene: `name/ordinary` at a screen size, its 1024^2 shadow map, and the engine's
-/// depth buffer and shadow map uploaded.
+/// A timing scene: `name/ordinary` at a screen size, its depth buffer and 1024^2 shadow map,
+/// and the engine's depth buffer and shadow map uploaded.
 struct BenchScene {
     scene: Scene,
+    gbuf: GBuffer,
     sm: ShadowMap,
     dv: TextureView,
     sv: TextureView,
@@ -597,13 +610,14 @@ fn bench_scene(ctx: &Context, name: SceneName, screen: [u32; 2]) -> Result<Bench
         dv: depth.create_view(&Default::default()),
         sv: shadow.create_view(&Default::default()),
         scene,
+        gbuf,
         sm,
     })
 }
 
 /// Times `methods` (pass wall times, interleaved) on `name/ordinary` at `screen`
 /// (prefiltered and minmax: with a `rectified` map).
-fn time_methods(
+pub(crate) fn time_methods(
     ctx: &Context,
     methods: &[Method],
     name: SceneName,
@@ -611,33 +625,62 @@ fn time_methods(
     rectified: [u32; 2],
     frames: u32,
 ) -> Result<Vec<Vec<(&'static str, Duration)>>, BoxError> {
-    let BenchScene { scene, sm, dv, sv } = bench_scene(ctx, name, screen)?;
+    let bench = bench_scene(ctx, name, screen)?;
+    Ok(
+        time_methods_on(ctx, methods, name, &bench, screen, rectified, frames)?
+            .into_iter()
+            .map(|(times, _)| times)
+            .collect(),
+    )
+}
+
+/// One method's pass wall times and its output (rgba, row-major).
+type TimedOutput = (Vec<(&'static str, Duration)>, Vec<[f32; 4]>);
+
+/// [`time_methods`] on a prepared scene, with each method's output (read back once).
+fn time_methods_on(
+    ctx: &Context,
+    methods: &[Method],
+    name: SceneName,
+    bench: &BenchScene,
+    screen: [u32; 2],
+    rectified: [u32; 2],
+    frames: u32,
+) -> Result<Vec<TimedOutput>, BoxError> {
+    let BenchScene {
+        scene, sm, dv, sv, ..
+    } = bench;
     let runs = methods
         .iter()
         .map(|m| {
             run_method(
                 ctx,
                 m.with_light(light_of(name)),
-                &scene,
-                &sm,
-                &dv,
-                &sv,
+                scene,
+                sm,
+                dv,
+                sv,
                 screen,
                 rectified,
             )
         })
         .collect::<Result<Vec<_>, _>>()?;
     let inputs = Inputs {
-        depth: &dv,
-        shadow_map: Some(&sv),
+        depth: dv,
+        shadow_map: Some(sv),
         rectified: None,
     };
-    time_interleaved(ctx, &runs, &inputs, frames)
+    let times = time_interleaved(ctx, &runs, &inputs, frames)?;
+    Ok(times
+        .into_iter()
+        .zip(runs)
+        .map(|(t, (_, output, _))| (t, output))
+        .collect())
 }
 
 /// The headline configuration: 1280x720, 1024x1024 rectified, on sphere, foliage and
-/// terrain.
-fn headline_runs(ctx: &Context, frames: u32) -> Result<Vec<HeadlineRow>, BoxError> {
+/// terrain; with `errors`, each run's rel L1 against the `shadow_map` truth at that size.
+fn headline_runs(ctx: &Context, frames: u32, errors: bool) -> Result<Vec<HeadlineRow>, BoxError> {
     let mut methods = vec![Method::prefiltered_default(), Method::minmax_default()];
     for (samples, interleave) in [(64, 1), (128, 1), (64, 4)] {
         methods.push(Method::from(RaymarchVariant {
@@ -646,15 +689,38 @@ fn headline_runs(ctx: &Context, frames: u32) -> Result<Vec<HeadlineRow>, BoxErro
             ..RaymarchVariant::default()
         }));
     }
+    let screen = [1280, 720];
     let mut out = Vec::new();
     for name in [SceneName::Sphere, SceneName::Foliage, SceneName::Terrain] {
-        let times = time_methods(ctx, &methods, name, [1280, 720], [1024, 1024], frames)?;
-        for (&m, passes) in methods.iter().zip(times) {
+        let bench = bench_scene(ctx, name, screen)?;
+        let runs = time_methods_on(ctx, &methods, name, &bench, screen, [1024, 1024], frames)?;
+        let truth = errors.then(|| {
+            truth::render(
+                &bench.scene,
+                &bench.gbuf,
+                &Visibility::ShadowMap(&bench.sm),
+                &TruthSettings::default(),
+                &|| (),
+            )
+        });
+        for (&m, (passes, output)) in methods.iter().zip(runs) {
+            let rel_l1_shadow_map = match &truth {
+                Some(t) => {
+                    let image = Image::from_pixels(
+                        screen[0],
+                        screen[1],
+                        output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
+                    );
+                    Some(metrics::compare(&image, t)?.rel_l1)
+                }
+                None => None,
+            };
             out.push(HeadlineRow {
                 family: m.family(),
                 knobs: m.knobs(),
                 scene: name,
                 passes,
+                rel_l1_shadow_map,
             });
         }
     }
@@ -670,7 +736,9 @@ fn scaling_runs(ctx: &Context, frames: u32) -> Result<Vec<ScalingRow>, BoxError>
         .into_iter()
         .chain([([320, 180], [1024, 1024]), ([640, 360], [1024, 1024])]);
     for (screen, rectified) in configs {
-        let BenchScene { scene, sm, dv, sv } = bench_scene(ctx, SceneName::Sphere, screen)?;
+        let BenchScene {
+            scene, sm, dv, sv, ..
+        } = bench_scene(ctx, SceneName::Sphere, screen)?;
         let mut pass = Prefiltered::new(
             ctx,
             &PrefilteredVariant::default(),
@@ -699,7 +767,13 @@ fn scaling_runs(ctx: &Context, frames: u32) -> Result<Vec<ScalingRow>, BoxError>
         out.push(ScalingRow {
             screen,
             rectified,
-            passes: [t.rectify, t.prefilter, t.scatter],
+            passes: [
+                t.depth_columns,
+                t.slice_fit,
+                t.rectify,
+                t.prefilter,
+                t.scatter,
+            ],
         });
     }
     Ok(out)
@@ -792,8 +866,8 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             }
         }
     }
-    // The same comparison at the headline configuration (times only; errors from the
-    // sweep above).
+    // The same comparison at the headline configuration (times; the tag takes the errors
+    // from the sweep above).
     let matching = reference.and_then(|p| {
         variants
             .iter()
@@ -822,6 +896,41 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                         r / p
                     ));
                 }
+            }
+        }
+    }
+    // Time and error read from the same runs at the headline size: per method, the means
+    // over the headline scenes, each against the prefiltered default.
+    let headline_mean = |family: &str, knobs: &str| {
+        let rows: Vec<&HeadlineRow> = result
+            .headline
+            .iter()
+            .filter(|r| r.family == family && r.knobs == knobs)
+            .collect();
+        let errors: Option<Vec<f64>> = rows.iter().map(|r| r.rel_l1_shadow_map).collect();
+        match errors {
+            Some(e) if !rows.is_empty() => Some((
+                rows.iter().map(|r| ms(r.total())).sum::<f64>() / rows.len() as f64,
+                e.iter().sum::<f64>() / e.len() as f64,
+            )),
+            _ => None,
+        }
+    };
+    if let Some((pt, pe)) = headline_mean("prefiltered", "m32-r3") {
+        for (family, knobs) in [
+            ("raymarch", "n64-i1"),
+            ("raymarch", "n128-i1"),
+            ("raymarch", "n64-i4"),
+            ("minmax", "minmax"),
+        ] {
+            if let Some((t, e)) = headline_mean(family, knobs) {
+                out.push(format!(
+                    "headline 1280x720, means over sphere, foliage and terrain (ordinary): {family} {knobs} {t:.1} ms at rel L1 {:.3} % / prefiltered m32-r3 {pt:.1} ms at {:.3} %: {:.2}x the time, {} error",
+                    100.0 * e,
+                    100.0 * pe,
+                    t / pt,
+                    if e <= pe { "equal or lower" } else { "higher" }
+                ));
             }
         }
     }
@@ -918,7 +1027,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
         for r in &result.scaling {
             let t: f64 = r.passes.iter().copied().map(ms).sum();
             out.push(format!(
-                "prefiltered m32-r3 scaling, {}x{} screen, {}x{} rectified: {:.1} ms (rectify {:.1}, prefilter {:.1}, scatter {:.1}) = {:.2}x the 1280x720 / 512x1024 time",
+                "prefiltered m32-r3 scaling, {}x{} screen, {}x{} rectified: {:.1} ms (depth_columns {:.1}, slice_fit {:.1}, rectify {:.1}, prefilter {:.1}, scatter {:.1}) = {:.2}x the 1280x720 / 512x1024 time",
                 r.screen[0],
                 r.screen[1],
                 r.rectified[0],
@@ -927,6 +1036,8 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 ms(r.passes[0]),
                 ms(r.passes[1]),
                 ms(r.passes[2]),
+                ms(r.passes[3]),
+                ms(r.passes[4]),
                 t / b
             ));
         }
@@ -989,19 +1100,25 @@ pub fn markdown(result: &BenchResult, command: &str) -> String {
     if !result.headline.is_empty() {
         let _ = writeln!(
             s,
-            "\n## Headline configuration (1280x720, 1024x1024 rectified; times only)\n"
+            "\n## Headline configuration (1280x720, 1024x1024 rectified)\n"
         );
-        let _ = writeln!(s, "| family | variant | scene | time (ms) | passes (ms) |");
-        let _ = writeln!(s, "|---|---|---|---|---|");
+        let _ = writeln!(
+            s,
+            "| family | variant | scene | time (ms) | rel L1 vs shadow_map truth | passes (ms) |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|---|---|");
         for r in &result.headline {
             let passes: Vec<String> = r
                 .passes
                 .iter()
                 .map(|(n, d)| format!("{n} {:.1}", ms(*d)))
                 .collect();
+            let error = r
+                .rel_l1_shadow_map
+                .map_or("-".to_owned(), |e| format!("{:.2} %", 100.0 * e));
             let _ = writeln!(
                 s,
-                "| {} | {} | {} | {:.1} | {} |",
+                "| {} | {} | {} | {:.1} | {error} | {} |",
                 r.family,
                 r.knobs,
                 r.scene,

@@ -1,3 +1,4 @@
 //! Shared helpers of the scatter examples (see `examples/`).
 
 pub mod bench;
+pub mod roofline;

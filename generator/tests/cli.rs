@@ -148,7 +148,7 @@ fn same_input_same_bytes_and_nothing_rewritten() {
     let (fa, fb) = (files(&a), files(&b));
     assert_eq!(
         fa.len(),
-        3 * 5 + 3,
+        5 * 5 + 3,
         "{:?}",
         fa.iter().map(|f| &f.0).collect::<Vec<_>>()
     );
@@ -164,7 +164,7 @@ fn same_input_same_bytes_and_nothing_rewritten() {
     ]);
     let (stdout, _) = text(&out);
     assert!(
-        stdout.contains(": 0 written, 18 unchanged, 0 removed"),
+        stdout.contains(": 0 written, 28 unchanged, 0 removed"),
         "{stdout}"
     );
     assert!(files(&a) == fb);
@@ -185,7 +185,7 @@ fn check_names_stale_files() {
     let r = scatter_gen(&["--out", o, "--check"]);
     assert_eq!(r.status.code(), Some(0), "{:?}", text(&r));
     assert!(
-        text(&r).0.contains("up to date (12 files)"),
+        text(&r).0.contains("up to date (18 files)"),
         "{:?}",
         text(&r)
     );
@@ -219,10 +219,10 @@ fn check_names_stale_files() {
     assert!(stdout.contains("manifest.json (differs)"), "{stdout}");
     assert_eq!(
         stdout.matches("(no longer generated)").count(),
-        9,
+        15,
         "{stdout}"
     );
-    assert_eq!(stdout.matches("(missing)").count(), 9, "{stdout}");
+    assert_eq!(stdout.matches("(missing)").count(), 15, "{stdout}");
 }
 
 #[test]
@@ -247,7 +247,7 @@ fn never_overwrites_or_deletes_foreign_files_without_force() {
 
     // --force takes it over; the unrelated file stays.
     assert!(scatter_gen(&["--out", o, "--force"]).status.success());
-    assert_eq!(files(&out).len(), 13);
+    assert_eq!(files(&out).len(), 19);
 
     // A foreign file with a kernel's name next to our manifest: refused.
     let stray = out.join("prefilter.m16-t8-r3-weighted-directional-rgba8unorm-epipolar.wgsl");
@@ -263,7 +263,7 @@ fn never_overwrites_or_deletes_foreign_files_without_force() {
     // Our own files of an earlier variant are replaced; notes.txt survives.
     let r = scatter_gen(&["--out", o, "--bases", "16"]);
     assert!(r.status.success(), "{:?}", text(&r));
-    assert!(text(&r).0.contains("9 removed"), "{:?}", text(&r));
+    assert!(text(&r).0.contains("15 removed"), "{:?}", text(&r));
     let names: Vec<_> = files(&out).into_iter().map(|f| f.0).collect();
     assert!(names.contains(&"notes.txt".to_owned()));
     assert!(!names.iter().any(|n| n.contains(DEFAULT_ID)), "{names:?}");
@@ -298,10 +298,16 @@ fn config_emits_exactly_its_variants() {
     let r = scatter_gen(&["--config", c, "--out", o]);
     assert!(r.status.success(), "{:?}", text(&r));
     let names: Vec<_> = files(&out).into_iter().map(|f| f.0).collect();
-    // 2 variants x 3 kernels x 2 targets + manifest + C header + Rust module.
-    assert_eq!(names.len(), 2 * 3 * 2 + 3, "{names:?}");
+    // 2 variants x 5 kernels x 2 targets + manifest + C header + Rust module.
+    assert_eq!(names.len(), 2 * 5 * 2 + 3, "{names:?}");
     let spot = "m16-t8-r1-weighted-spot-rgba8unorm-epipolar";
-    for k in ["rectify", "prefilter", "scatter"] {
+    for k in [
+        "depth_columns",
+        "slice_fit",
+        "rectify",
+        "prefilter",
+        "scatter",
+    ] {
         for id in [DEFAULT_ID, spot] {
             for ext in ["wgsl", "spv"] {
                 let name = format!("{k}.{id}.{ext}");
@@ -386,7 +392,9 @@ fn list_and_help_document_every_knob() {
     let (list, _) = text(&r);
     assert!(list.contains("family prefiltered"), "{list}");
     assert!(
-        list.contains("kernels (pass order): rectify, prefilter, scatter"),
+        list.contains(
+            "kernels (pass order): depth_columns, slice_fit, rectify, prefilter, scatter"
+        ),
         "{list}"
     );
     let r = scatter_gen(&["--help"]);

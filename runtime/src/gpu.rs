@@ -283,6 +283,34 @@ impl Readback {
     }
 }
 
+/// Records the copy of the whole of `buffer` (which needs `COPY_SRC`) into a new mappable
+/// buffer; read it with [`crate::timer::read_buffer`] after submitting.
+pub(crate) fn encode_buffer_readback(
+    device: &wgpu::Device,
+    encoder: &mut wgpu::CommandEncoder,
+    buffer: &wgpu::Buffer,
+) -> wgpu::Buffer {
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("buffer readback"),
+        size: buffer.size(),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    staging
+}
+
+/// The slice table read back after `slice_fit` (16 bytes per row).
+pub(crate) fn read_slices(
+    ctx: &Context,
+    kernel: Kernel,
+    staging: &wgpu::Buffer,
+) -> Result<Vec<scatter_shaderlib::prefiltered::SliceParams>, RuntimeError> {
+    Ok(bytemuck::pod_collect_to_vec(&read_buffer(
+        ctx, kernel, staging,
+    )?))
+}
+
 /// Fails with [`RuntimeError::EmptyInput`] for the first size with a zero dimension; each
 /// entry names the kernel to blame and what the size is (`screen`, `shadow map`, ...).
 pub(crate) fn check_nonempty(sizes: &[(Kernel, &str, [u32; 2])]) -> Result<(), RuntimeError> {

@@ -6,11 +6,12 @@
 //! kernel has a pass type that builds its pipeline from `scatter-shaderlib` and encodes it
 //! ([`RowPrefixPass`]), plus a one-call convenience for tests ([`row_prefix()`]). Kernel
 //! families with several passes have one type for the whole family: [`Prefiltered`] runs the
-//! `prefiltered` method (`rectify`, `prefilter`, `scatter`) once per frame,
+//! `prefiltered` method (`depth_columns`, `slice_fit`, `rectify`, `prefilter`, `scatter`) once
+//! per frame,
 //! [`run_prefiltered_once`] is its test convenience; [`Raymarch`] runs the `raymarch` family
 //! (`raymarch`, then `interleave_sum` when interleaved), [`run_raymarch_once`] its test
-//! convenience; [`Minmax`] runs the `minmax` family (`rectify`, `minmax_build`,
-//! `minmax_traverse`), [`run_minmax_once`] its test convenience. [`FamilyPasses`] drives any of
+//! convenience; [`Minmax`] runs the `minmax` family (`depth_columns`, `slice_fit`, `rectify`,
+//! `minmax_build`, `minmax_traverse`), [`run_minmax_once`] its test convenience. [`FamilyPasses`] drives any of
 //! them from the one enum of every family's variant.
 //!
 //! Every family runs on one plan-driven executor (`executor`, crate-private): the family's

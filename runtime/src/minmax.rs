@@ -1,5 +1,5 @@
-//! The `minmax` family (Chen et al. 2011) on wgpu: [`Minmax`] owns the `rectify` (the
-//! prefiltered family's kernel, for [`MinmaxVariant::prefiltered`]), `minmax_build` and
+//! The `minmax` family (Chen et al. 2011) on wgpu: [`Minmax`] owns the `depth_columns`,
+//! `slice_fit` and `rectify` (the prefiltered family's kernels, for [`MinmaxVariant::prefiltered`]), `minmax_build` and
 //! `minmax_traverse` pipelines, the rectified map, the min-max tree and output textures and the
 //! uniform and slice buffers; an engine calls [`Minmax::prepare`] and [`Minmax::encode`]
 //! once per frame with its depth buffer and standard shadow map. [`run_minmax_once`] is the
@@ -7,6 +7,8 @@
 //!
 //! | pass | bindings | dispatch |
 //! |---|---|---|
+//! | `depth_columns` | 0 uniform `Frame`, 1 depth r32float, 2 column_depth (storage, one f32 per screen column) | `ceil(W/64) x 1 x 1` |
+//! | `slice_fit` | 0 uniform `Frame`, 1 slices (read_write), 2 column_depth | `1 x 1 x 1` (one workgroup of 256) |
 //! | `rectify` | 0 uniform `Frame`, 1 slices, 2 shadow map r32float, 3 rectified r32float (storage, write) | `ceil(Wr/8) x ceil(Hr/8) x 1` |
 //! | `minmax_build` | 0 uniform `Frame`, 1 rectified r32float, 2 tree rg32float (storage, write) | `ceil(tree_width(Wr)/64) x Hr x 1` |
 //! | `minmax_traverse` | 0 uniform `Frame`, 1 slices, 2 depth r32float, 3 shadow map r32float, 4 tree rg32float, 5 output rgba16float (storage, write) | `ceil(W/8) x ceil(H/8) x 1` |
@@ -14,19 +16,21 @@
 use std::time::{Duration, Instant};
 
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax, tree_width};
-use scatter_shaderlib::prefiltered::{PrefilteredFrame, Resolutions, Storage};
+use scatter_shaderlib::prefiltered::{PrefilteredFrame, Resolutions, SliceParams, Storage};
 use scatter_shaderlib::{Kernel, KernelParams};
 
 use crate::error::ErrorScopes;
 use crate::executor::Executor;
 use crate::gpu::{
     DEPTH_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_texture_sides, check_view,
-    decode_rgba, upload_inputs,
+    decode_rgba, encode_buffer_readback, read_slices, upload_inputs,
 };
 use crate::prefiltered::FrameInput;
 use crate::timer::median_pass_wall_times;
 use crate::{Context, RuntimeError};
 
+const DEPTH_COLUMNS: Kernel = Kernel::DepthColumns;
+const SLICE_FIT: Kernel = Kernel::SliceFit;
 const RECTIFY: Kernel = Kernel::Rectify;
 const BUILD: Kernel = Kernel::MinmaxBuild;
 const MARCH: Kernel = Kernel::MinmaxTraverse;
@@ -37,6 +41,10 @@ pub const TREE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
 /// GPU time of each pass of one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct MinmaxTimes {
+    /// The `depth_columns` pass.
+    pub depth_columns: Duration,
+    /// The `slice_fit` pass.
+    pub slice_fit: Duration,
     /// The `rectify` pass.
     pub rectify: Duration,
     /// The `minmax_build` pass.
@@ -48,7 +56,7 @@ pub struct MinmaxTimes {
 impl MinmaxTimes {
     /// Sum of the passes.
     pub fn total(&self) -> Duration {
-        self.rectify + self.build + self.march
+        self.depth_columns + self.slice_fit + self.rectify + self.build + self.march
     }
 }
 
@@ -183,7 +191,7 @@ impl Minmax {
         Ok(())
     }
 
-    /// Records the three passes (with GPU timestamps when the device has them) and returns
+    /// Records the five passes (with GPU timestamps when the device has them) and returns
     /// the output view: in-scattered radiance, rgba16float, screen-sized. `depth` is linear
     /// view depth (r32float, screen-sized), `shadow_map` the standard shadow map (r32float).
     ///
@@ -216,12 +224,18 @@ impl Minmax {
         shadow_map: &wgpu::TextureView,
         frames: u32,
     ) -> Result<MinmaxTimes, RuntimeError> {
-        let [rectify, build, march] =
-            median_pass_wall_times(ctx, [RECTIFY, BUILD, MARCH], frames, |encoder, kernel| {
+        let [depth_columns, slice_fit, rectify, build, march] = median_pass_wall_times(
+            ctx,
+            [DEPTH_COLUMNS, SLICE_FIT, RECTIFY, BUILD, MARCH],
+            frames,
+            |encoder, kernel| {
                 self.encode_selected(ctx, encoder, depth, shadow_map, Some(kernel))
                     .map(|_| ())
-            })?;
+            },
+        )?;
         Ok(MinmaxTimes {
+            depth_columns,
+            slice_fit,
             rectify,
             build,
             march,
@@ -269,9 +283,11 @@ impl Minmax {
         let t = timer.read_all(ctx, MARCH)?;
         let at = |i: usize| t.get(i).copied().unwrap_or_default();
         Ok(Some(MinmaxTimes {
-            rectify: at(0),
-            build: at(1),
-            march: at(2),
+            depth_columns: at(0),
+            slice_fit: at(1),
+            rectify: at(2),
+            build: at(3),
+            march: at(4),
         }))
     }
 
@@ -306,6 +322,8 @@ impl Minmax {
 pub struct MinmaxReadback {
     /// The frame set-up that was uploaded.
     pub frame: PrefilteredFrame,
+    /// The slice table after `slice_fit` (read back).
+    pub slices: Vec<SliceParams>,
     /// The rectified map, row-major.
     pub rectified: Vec<f32>,
     /// The min-max trees (min, max), row-major over `tree_width(Wr) x Hr`.
@@ -352,6 +370,7 @@ pub fn run_minmax_once(
     let rectified = Readback::encode(device, &mut encoder, pass.rectified_texture(), 4, RECTIFY)?;
     let tree = Readback::encode(device, &mut encoder, pass.tree_texture(), 8, BUILD)?;
     let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, MARCH)?;
+    let slices = encode_buffer_readback(device, &mut encoder, &pass.slices);
     let start = Instant::now();
     ctx.queue().submit([encoder.finish()]);
     scope.pop(MARCH, "dispatch")?;
@@ -361,6 +380,7 @@ pub fn run_minmax_once(
             .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
             .collect()
     };
+    let slices = read_slices(ctx, SLICE_FIT, &slices)?;
     let rectified = f32s(rectified.read(ctx, RECTIFY)?);
     let tree = f32s(tree.read(ctx, BUILD)?)
         .chunks_exact(2)
@@ -378,6 +398,7 @@ pub fn run_minmax_once(
         .ok_or(RuntimeError::NotPrepared { kernel: MARCH })?;
     Ok(MinmaxReadback {
         frame,
+        slices,
         rectified,
         tree,
         output,
@@ -438,6 +459,8 @@ impl crate::family::FamilyRuntime for Minmax {
         let shadow_map = crate::family::required_shadow_map(inputs, RECTIFY)?;
         let t = self.measure_pass_wall_times(ctx, inputs.depth, shadow_map, frames)?;
         Ok(vec![
+            (DEPTH_COLUMNS, t.depth_columns),
+            (SLICE_FIT, t.slice_fit),
             (RECTIFY, t.rectify),
             (BUILD, t.build),
             (MARCH, t.march),

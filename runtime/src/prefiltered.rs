@@ -1,20 +1,21 @@
-//! The `prefiltered` family (Klehm et al. 2014) on wgpu: [`Prefiltered`] owns the three
-//! pipelines (`rectify`, `prefilter`, `scatter`) of one [`PrefilteredVariant`], the intermediate
-//! textures and the per-frame buffers; an engine calls [`Prefiltered::prepare`] and
-//! [`Prefiltered::encode`] once per frame with its depth buffer and standard shadow map.
-//! [`run_prefiltered_once`] is the upload-run-readback convenience the conformance tests use.
+//! The `prefiltered` family (Klehm et al. 2014) on wgpu: [`Prefiltered`] owns the five
+//! pipelines (`depth_columns`, `slice_fit`, `rectify`, `prefilter`, `scatter`) of one [`PrefilteredVariant`],
+//! the intermediate textures and the per-frame buffers; an engine calls
+//! [`Prefiltered::prepare`] and [`Prefiltered::encode`] once per frame with its depth buffer
+//! and standard shadow map. [`run_prefiltered_once`] is the upload-run-readback convenience
+//! the conformance tests use.
 //!
-//! Pass order and bindings (group 0 of every kernel):
+//! Pass order and bindings (group 0 of every kernel; built from the variant's plan):
 //!
 //! | pass | bindings | dispatch |
 //! |---|---|---|
+//! | `depth_columns` | 0 uniform `Frame`, 1 depth r32float, 2 column_depth (storage, one f32 per screen column) | `ceil(W/64) x 1 x 1` |
+//! | `slice_fit` | 0 uniform `Frame`, 1 slices (read_write), 2 column_depth | `1 x 1 x 1` (one workgroup of 256) |
 //! | `rectify` | 0 uniform `Frame`, 1 slices, 2 shadow map r32float, 3 rectified r32float (storage, write) | `ceil(Wr/8) x ceil(Hr/8) x 1` |
 //! | `prefilter` | 0, 1, 2 rectified r32float, 3 filtered bases (storage array, write, the variant's format), 4 bounds rg32float (storage, write) | `ceil(Hr/64) x regions x bases/bases_per_thread` |
-//! | `scatter` | 0, 1, 2 depth r32float, 3 shadow map r32float, 4 filtered bases (sampled array), 5 linear sampler, 6 output rgba16float (storage, write), 7 bounds rg32float | `ceil(W/8) x ceil(H/8) x 1` |
+//! | `scatter` | 0, 1, 2 depth r32float, 3 shadow map r32float, 4 filtered bases (loaded array), 5 output rgba16float (storage, write), 6 bounds rg32float | `ceil(W/8) x ceil(H/8) x 1` |
 //!
-//! The sampler clamps along rows (u) and wraps across slices (v) when the slices go round the
-//! full circle (`FrameUniforms::anti_epipole[3] > 0.5`), else clamps: [`Prefiltered`] keeps both
-//! samplers and picks one per frame.
+//! Projective frames skip `depth_columns`, `slice_fit` and `rectify`.
 
 use std::time::{Duration, Instant};
 
@@ -30,11 +31,13 @@ use crate::error::{ErrorScopes, check_limit};
 use crate::executor::Executor;
 use crate::gpu::{
     DEPTH_NAMES, RECTIFIED_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_texture_sides,
-    check_view, decode_rgba, upload_inputs,
+    check_view, decode_rgba, encode_buffer_readback, read_slices, upload_inputs,
 };
 use crate::timer::median_pass_wall_times;
 use crate::{Context, RuntimeError};
 
+const DEPTH_COLUMNS: Kernel = Kernel::DepthColumns;
+const SLICE_FIT: Kernel = Kernel::SliceFit;
 const RECTIFY: Kernel = Kernel::Rectify;
 const PREFILTER: Kernel = Kernel::Prefilter;
 const SCATTER: Kernel = Kernel::Scatter;
@@ -92,6 +95,10 @@ pub struct Inputs<'a> {
 /// GPU time of each pass of one frame (from timestamps at the start and end of each pass).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PrefilteredTimes {
+    /// The `depth_columns` pass (zero in a projective frame, where it does not run).
+    pub depth_columns: Duration,
+    /// The `slice_fit` pass (zero in a projective frame, where it does not run).
+    pub slice_fit: Duration,
     /// The `rectify` pass (zero in a projective frame, where it does not run).
     pub rectify: Duration,
     /// The `prefilter` pass.
@@ -101,9 +108,9 @@ pub struct PrefilteredTimes {
 }
 
 impl PrefilteredTimes {
-    /// Sum of the three passes.
+    /// Sum of the five passes.
     pub fn total(&self) -> Duration {
-        self.rectify + self.prefilter + self.scatter
+        self.depth_columns + self.slice_fit + self.rectify + self.prefilter + self.scatter
     }
 }
 
@@ -286,10 +293,10 @@ impl Prefiltered {
     /// them with [`Self::pass_times`] after submitting) and returns the output view:
     /// in-scattered radiance, rgba16float, screen-sized.
     ///
-    /// Epipolar frames run `rectify`, `prefilter` and `scatter` and need
-    /// `inputs.shadow_map`; projective frames ([`FrameReport::rectification`] is
-    /// `projective`) skip `rectify` and need `inputs.rectified`, the map the engine
-    /// rasterised with the frame's matrices.
+    /// Epipolar frames run `depth_columns`, `slice_fit`, `rectify`, `prefilter` and
+    /// `scatter` and need `inputs.shadow_map`; projective frames
+    /// ([`FrameReport::rectification`] is `projective`) skip the first three and need
+    /// `inputs.rectified`, the map the engine rasterised with the frame's matrices.
     ///
     /// # Errors
     ///
@@ -305,10 +312,10 @@ impl Prefiltered {
         self.encode_selected(encoder, inputs, None)
     }
 
-    /// Records one pass of the frame (`rectify`, `prefilter` or `scatter`) without
-    /// timestamps, for timing passes one submission at a time
-    /// ([`Self::measure_pass_wall_times`]). A projective frame records nothing for
-    /// `rectify`. Errors as [`Self::encode`].
+    /// Records one pass of the frame (`depth_columns`, `slice_fit`, `rectify`, `prefilter`
+    /// or `scatter`) without timestamps, for timing passes one submission at a time
+    /// ([`Self::measure_pass_wall_times`]). A projective frame records nothing for the first
+    /// three. Errors as [`Self::encode`].
     ///
     /// # Errors
     ///
@@ -338,13 +345,15 @@ impl Prefiltered {
         inputs: &Inputs<'_>,
         frames: u32,
     ) -> Result<PrefilteredTimes, RuntimeError> {
-        let [rectify, prefilter, scatter] = median_pass_wall_times(
+        let [depth_columns, slice_fit, rectify, prefilter, scatter] = median_pass_wall_times(
             ctx,
-            [RECTIFY, PREFILTER, SCATTER],
+            [DEPTH_COLUMNS, SLICE_FIT, RECTIFY, PREFILTER, SCATTER],
             frames,
             |encoder, kernel| self.encode_pass(encoder, inputs, kernel),
         )?;
         Ok(PrefilteredTimes {
+            depth_columns,
+            slice_fit,
             rectify,
             prefilter,
             scatter,
@@ -415,14 +424,24 @@ impl Prefiltered {
             .as_ref()
             .is_some_and(|f| f.report.rectification == Rectification::Projective);
         match times[..] {
-            [rectify, prefilter, scatter] => Ok(Some(PrefilteredTimes {
+            [depth_columns, slice_fit, rectify, prefilter, scatter] => Ok(Some(PrefilteredTimes {
+                depth_columns: if projective {
+                    Duration::ZERO
+                } else {
+                    depth_columns
+                },
+                slice_fit: if projective {
+                    Duration::ZERO
+                } else {
+                    slice_fit
+                },
                 rectify: if projective { Duration::ZERO } else { rectify },
                 prefilter,
                 scatter,
             })),
             _ => Err(RuntimeError::Readback {
                 kernel: SCATTER,
-                message: format!("expected 3 pass times, got {}", times.len()),
+                message: format!("expected 5 pass times, got {}", times.len()),
             }),
         }
     }
@@ -510,6 +529,9 @@ pub struct CpuInputs {
 pub struct PrefilteredReadback {
     /// The frame set-up that was uploaded.
     pub frame: PrefilteredFrame,
+    /// The slice table after `slice_fit` (read back; the uploaded one in a projective
+    /// frame).
+    pub slices: Vec<SliceParams>,
     /// In-scattered radiance per pixel (rgba16float converted to f32), row-major.
     pub output: Vec<[f32; 4]>,
     /// Rectified map, `Wr * Hr` values, row-major.
@@ -590,10 +612,12 @@ pub fn run_prefiltered_once(
     )?;
     let bounds = Readback::encode(device, &mut encoder, pass.bounds_texture(), 8, PREFILTER)?;
     let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, SCATTER)?;
+    let slices = encode_buffer_readback(device, &mut encoder, &pass.slices);
     let start = Instant::now();
     ctx.queue().submit([encoder.finish()]);
     scope.pop(SCATTER, "dispatch")?;
 
+    let slices = read_slices(ctx, SLICE_FIT, &slices)?;
     let rectified = rectified
         .read(ctx, RECTIFY)?
         .chunks_exact(4)
@@ -640,6 +664,7 @@ pub fn run_prefiltered_once(
         .ok_or(RuntimeError::NotPrepared { kernel: RECTIFY })?;
     Ok(PrefilteredReadback {
         frame,
+        slices,
         output,
         rectified,
         filtered,
@@ -729,6 +754,8 @@ impl crate::family::FamilyRuntime for Prefiltered {
     ) -> Result<Vec<(Kernel, Duration)>, RuntimeError> {
         let t = self.measure_pass_wall_times(ctx, inputs, frames)?;
         Ok(vec![
+            (DEPTH_COLUMNS, t.depth_columns),
+            (SLICE_FIT, t.slice_fit),
             (RECTIFY, t.rectify),
             (PREFILTER, t.prefilter),
             (SCATTER, t.scatter),

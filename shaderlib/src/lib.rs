@@ -7,10 +7,10 @@
 //! with naga and returns the [`naga::Module`], its [`naga::valid::ModuleInfo`] and WGSL text.
 //!
 //! Kernels: `row_prefix` ([`RowPrefixParams`]), the prefiltered family (Klehm et al. 2014)
-//! `rectify`, `prefilter`, `scatter`, all three rendered from one
+//! `depth_columns`, `slice_fit`, `rectify`, `prefilter`, `scatter`, all five rendered from one
 //! [`prefiltered::PrefilteredVariant`] ([`KernelParams::prefiltered`]), and the raymarch family (Tóth &
 //! Umenhoffer 2009) `raymarch`, `interleave_sum` from a [`raymarch::RaymarchVariant`]
-//! ([`KernelParams::raymarch`]), and the minmax family (Chen et al. 2011) `rectify`,
+//! ([`KernelParams::raymarch`]), and the minmax family (Chen et al. 2011) `depth_columns`, `slice_fit`, `rectify`,
 //! `minmax_build`, `minmax_traverse` from a [`minmax::MinmaxVariant`] ([`KernelParams::minmax`]).
 //!
 //! ```
@@ -46,6 +46,9 @@ pub use row_prefix::{RowPrefixMode, RowPrefixParams};
 // The kernel table: one line per kernel (name, template stem, parameter type, render
 // function), sorted by name. `Kernel`, `KernelParams` and `render` come from it.
 kernel::kernels! {
+    /// The deepest pixel of every depth-buffer row (the epipolar families' first pass, for
+    /// `slice_fit`).
+    DepthColumns("depth_columns", PrefilteredVariant, prefiltered::kernels::render_depth_columns),
     /// Separable sum filter of interleaved sampling over the `raymarch` partial sums (Tóth &
     /// Umenhoffer 2009).
     InterleaveSum("interleave_sum", RaymarchVariant, raymarch::render_interleave_sum),
@@ -69,6 +72,9 @@ kernel::kernels! {
     /// Per pixel: prefiltered visibility times the unshadowed integral, one dot product per
     /// region; pixels near the epipole ray-marched (Klehm et al. 2014, Listing 4, Sec. 5).
     Scatter("scatter", PrefilteredVariant, prefiltered::kernels::render_scatter),
+    /// Every rectified row's column spacing fitted to the deepest pixel of the depth buffer
+    /// (after `depth_columns`; the host spans rows to the far plane).
+    SliceFit("slice_fit", PrefilteredVariant, prefiltered::kernels::render_slice_fit),
 }
 
 impl KernelParams {

@@ -16,6 +16,28 @@ pub const OUTPUT_FORMAT: &str = "rgba16float";
 pub const SAMPLED: &[&str] = &["texture_binding"];
 /// Usages of a texture one pass writes and a later one reads.
 pub const STORAGE_AND_SAMPLED: &[&str] = &["storage_binding", "texture_binding"];
+/// What the engine must know of `slice_fit`, the epipolar families' second pass.
+pub const SLICE_FIT_NOTE: &str = "`slice_fit` (after `depth_columns`, one workgroup) rewrites \
+                                  the column spacing (x) of every `slices` entry from the \
+                                  depth buffer's deepest pixel: upload `slices` anew every \
+                                  frame before it, as the frame set-up returns it.";
+
+/// The epipolar families' `column_depth` buffer: one f32 per screen column, written by
+/// `depth_columns` and read by `slice_fit`.
+pub fn column_depth_buffer() -> Resource {
+    Resource {
+        kind: "storage_buffer",
+        buffer: Some(BufferDesc {
+            elements: Some("screen.width".to_owned()),
+            usage: vec!["storage"],
+        }),
+        ..scatter_resource(
+            "column_depth",
+            "the deepest pixel (view depth clamped to the far plane) of every screen column, \
+             written by depth_columns and read by slice_fit",
+        )
+    }
+}
 /// The constraint of a parameter that sizes a 2D texture.
 pub const TEXTURE_DIMENSION: &str = "1..=max_texture_dimension_2d";
 
@@ -90,7 +112,8 @@ pub fn frame_buffer(
 ) -> Resource {
     let (kind, usage) = match elements {
         None => ("uniform_buffer", vec!["uniform", "copy_dst"]),
-        Some(_) => ("storage_buffer", vec!["storage", "copy_dst"]),
+        // copy_src: a pass may rewrite it (`slice_fit`), and tests read it back.
+        Some(_) => ("storage_buffer", vec!["storage", "copy_dst", "copy_src"]),
     };
     Resource {
         kind,

@@ -4,7 +4,8 @@
 //
 // One invocation per rectified texel (column x = light ray, row y = epipolar slice): find the
 // light ray's first occluder in the standard shadow map and store its view angle as
-// normalised rectified depth (conventions: `scatter_shaderlib::prefiltered::frame`).
+// normalised rectified depth (conventions: `scatter_shaderlib::prefiltered::frame`), in
+// [0, 1] where view rays use [0.1, 0.9] (`occluder_depth`).
 //
 // Bindings (group 0):
 // | binding | name       | type                                     | access       |
@@ -21,7 +22,7 @@
 // Mirrors reference/src/kernels/rectify.rs
 
 #import scatter::model::PI
-#import scatter::epipolar::{Frame, normalised_depth, row_phi, slice_e, slice_params, sm_occluder_distance}
+#import scatter::epipolar::{Frame, occluder_depth, row_phi, slice_e, slice_params, sm_occluder_distance}
 #import scatter::shadow::NO_OCCLUDER
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -59,6 +60,6 @@ fn rectify(@builtin(global_invocation_id) id: vec3<u32>) {
             theta_occ = atan2(col, -s);
         }
     }
-    let d = normalised_depth(theta_occ, frame.theta[0], frame.theta[1]);
+    let d = occluder_depth(theta_occ, frame.theta[0], frame.theta[1]);
     textureStore(rectified, vec2<u32>(x, y), vec4<f32>(d, 0.0, 0.0, 0.0));
 }

@@ -8,8 +8,9 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use scatter_shaderlib::prefiltered::{
-    LightKind, PREFILTER_WORKGROUP_SIZE, PrefilteredVariant, RECTIFY_WORKGROUP_SIZE,
-    SCATTER_WORKGROUP_SIZE, Storage, VisibilityMode,
+    DEPTH_COLUMNS_WORKGROUP_SIZE, LightKind, PREFILTER_WORKGROUP_SIZE, PrefilteredVariant,
+    RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE, SLICE_FIT_WORKGROUP_SIZE, Storage,
+    VisibilityMode,
 };
 use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams, ShaderError, build, render};
 
@@ -162,7 +163,12 @@ fn workgroup_sizes_read_back_from_the_ir() {
             ..PrefilteredVariant::default()
         },
     ] {
-        let [rectify, prefilter, scatter] = KernelParams::prefiltered(variant).map(built);
+        let [depth_columns, slice_fit, rectify, prefilter, scatter] =
+            KernelParams::prefiltered(variant).map(built);
+        assert_eq!(depth_columns.workgroup_size, DEPTH_COLUMNS_WORKGROUP_SIZE);
+        assert_eq!(depth_columns.workgroup_size, [64, 1, 1]);
+        assert_eq!(slice_fit.workgroup_size, SLICE_FIT_WORKGROUP_SIZE);
+        assert_eq!(slice_fit.workgroup_size, [256, 1, 1]);
         assert_eq!(rectify.workgroup_size, RECTIFY_WORKGROUP_SIZE);
         assert_eq!(rectify.workgroup_size, [8, 8, 1]);
         assert_eq!(prefilter.workgroup_size, PREFILTER_WORKGROUP_SIZE);
@@ -208,6 +214,15 @@ fn bindings_match_the_documented_tables() {
     let slices = "Storage { access: StorageAccess(LOAD) } array<Vector { size: Quad, scalar: \
                   Scalar { kind: Float, width: 4 } }>"
         .to_owned();
+    let slices_rw = "Storage { access: StorageAccess(LOAD | STORE) } array<Vector { size: Quad, \
+                     scalar: Scalar { kind: Float, width: 4 } }>"
+        .to_owned();
+    let column_depth_rw = "Storage { access: StorageAccess(LOAD | STORE) } array<Scalar(Scalar { \
+                        kind: Float, width: 4 })>"
+        .to_owned();
+    let column_depth_read = "Storage { access: StorageAccess(LOAD) } array<Scalar(Scalar { kind: \
+                          Float, width: 4 })>"
+        .to_owned();
     let sampled = |arrayed: bool| {
         format!(
             "{:?} arrayed={arrayed} {:?}",
@@ -239,8 +254,25 @@ fn bindings_match_the_documented_tables() {
                 storage: storage_knob,
                 ..PrefilteredVariant::default()
             };
-            let [rectify, prefilter, scatter] = KernelParams::prefiltered(variant).map(built);
+            let [depth_columns, slice_fit, rectify, prefilter, scatter] =
+                KernelParams::prefiltered(variant).map(built);
             let b = |n: u32, name: &str, ty: &String| (n, name.to_owned(), ty.clone());
+            assert_eq!(
+                bindings(&depth_columns),
+                vec![
+                    b(0, "frame", &uniform),
+                    b(1, "depth", &sampled(false)),
+                    b(2, "column_depth", &column_depth_rw),
+                ]
+            );
+            assert_eq!(
+                bindings(&slice_fit),
+                vec![
+                    b(0, "frame", &uniform),
+                    b(1, "slices", &slices_rw),
+                    b(2, "column_depth", &column_depth_read),
+                ]
+            );
             assert_eq!(
                 bindings(&rectify),
                 vec![
@@ -407,8 +439,11 @@ fn templates_receive_the_variant_s_values() {
         storage: Storage::Rgba16float,
         ..PrefilteredVariant::default()
     };
-    let [rectify, prefilter, scatter] =
+    let [depth_columns, slice_fit, rectify, prefilter, scatter] =
         KernelParams::prefiltered(variant).map(|p| render(&p).unwrap_or_else(|e| panic!("{e}")));
+    assert!(depth_columns.contains("Mirrors reference/src/kernels/depth_columns.rs"));
+    assert!(slice_fit.contains("let spot = true;"), "{slice_fit}");
+    assert!(slice_fit.contains("Mirrors reference/src/kernels/slice_fit.rs"));
     assert!(rectify.contains("let spot = true;"), "{rectify}");
     assert!(rectify.contains("Mirrors reference/src/kernels/rectify.rs"));
     for needle in [

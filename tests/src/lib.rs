@@ -114,6 +114,27 @@ impl Fixture {
         }
     }
 
+    /// The same fixture with every depth-buffer value times `k` (and the ray lengths with
+    /// them): a frame whose deepest pixel lies closer than the far plane, where `slice_fit`
+    /// rewrites the slice table (almost every suite pose sees the sky, where it does not).
+    pub fn with_depth_scaled(&self, k: f32) -> Self {
+        let mut gbuf = self.gbuf.clone();
+        for z in &mut gbuf.view_depth {
+            *z *= k;
+        }
+        for s in &mut gbuf.ray_length {
+            *s *= f64::from(k);
+        }
+        Self {
+            name: self.name,
+            pose: self.pose,
+            scene: self.scene.clone(),
+            bvh: Bvh::build(&self.scene.geometry),
+            gbuf,
+            shadow_map: self.shadow_map.clone(),
+        }
+    }
+
     /// `scene::pose`, the tail of trial names.
     pub fn trial_tail(&self) -> String {
         format!("{}::{}", self.name, self.pose)
@@ -327,6 +348,35 @@ pub fn run_variant(
         out.output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
     );
     Ok((image, out.report))
+}
+
+/// Relative tolerance of `slice_fit`'s column spacing, GPU against its mirror: exact for the
+/// sun (one product and one quotient), a few ulp of the driver's `atan2` for a spot.
+pub const SLICE_DELTA_REL_TOL: f32 = 1e-5;
+
+/// The slice table `slice_fit` left on the GPU against the mirror's: the view angles equal,
+/// the column spacings within [`SLICE_DELTA_REL_TOL`]. `Err` names the first row that is not.
+pub fn compare_slices(
+    gpu: &[scatter_shaderlib::prefiltered::SliceParams],
+    cpu: &[scatter_shaderlib::prefiltered::SliceParams],
+) -> Result<(), String> {
+    if gpu.len() != cpu.len() {
+        return Err(format!(
+            "slice table: {} rows on the GPU, {} in the mirror",
+            gpu.len(),
+            cpu.len()
+        ));
+    }
+    for (row, (g, c)) in gpu.iter().zip(cpu).enumerate() {
+        let angles = [g.theta_ref, g.theta_lo, g.theta_hi] == [c.theta_ref, c.theta_lo, c.theta_hi];
+        let close = (g.delta - c.delta).abs() <= SLICE_DELTA_REL_TOL * c.delta.abs();
+        if !angles || !close {
+            return Err(format!(
+                "slice table row {row}: gpu {g:?}, mirror {c:?} (slice_fit)"
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -233,7 +233,11 @@ fn trial(ctx: &Context, variant: &PrefilteredVariant) -> Vec<String> {
         // What the manifest made the engine do this frame.
         let dispatched: Vec<&str> = out.run.dispatched.iter().map(|(k, _)| k.as_str()).collect();
         if frame.report.projective.is_some() {
-            assert_eq!(out.run.skipped, ["rectify"], "{name}::{target}");
+            assert_eq!(
+                out.run.skipped,
+                ["depth_columns", "slice_fit", "rectify"],
+                "{name}::{target}"
+            );
             assert_eq!(dispatched, ["prefilter", "scatter"], "{name}::{target}");
             assert!(
                 out.run
@@ -246,7 +250,13 @@ fn trial(ctx: &Context, variant: &PrefilteredVariant) -> Vec<String> {
             assert!(out.run.skipped.is_empty(), "{name}::{target}");
             assert_eq!(
                 dispatched,
-                ["rectify", "prefilter", "scatter"],
+                [
+                    "depth_columns",
+                    "slice_fit",
+                    "rectify",
+                    "prefilter",
+                    "scatter"
+                ],
                 "{name}::{target}"
             );
         }
@@ -458,7 +468,13 @@ fn foreign_engine_matches_runtime_for_every_family() {
         lines.extend(compare_targets(
             &name,
             &runtime.output,
-            &["rectify", "minmax_build", "minmax_traverse"],
+            &[
+                "depth_columns",
+                "slice_fit",
+                "rectify",
+                "minmax_build",
+                "minmax_traverse",
+            ],
             |target| {
                 let params = scatter_foreign_engine::minmax::params(&fixture.sizes());
                 let mut engine =
@@ -894,7 +910,8 @@ fn manifest_conditions_are_machine_readable() {
             }
         }
     }
-    // Per projective variant: skip rectify and prefilter's map; epipolar variants have none
-    // (scatter filters the bases by hand, so no sampler alternative depends on the frame).
-    assert_eq!(buffer_conditions, 2 * 2, "buffer conditions");
+    // Per projective variant: skip depth_columns, slice_fit and rectify, and prefilter's map; epipolar
+    // variants have none (scatter filters the bases by hand, so no sampler alternative
+    // depends on the frame).
+    assert_eq!(buffer_conditions, 2 * 4, "buffer conditions");
 }

@@ -202,6 +202,8 @@ fn manifest_dispatch_matches_the_runtime_grid() {
             .unwrap_or_default();
         // Prefiltered::encode's invocation grids, in pass order.
         let grids = [
+            [w, 1, 1],
+            [256, 1, 1],
             [wr, hr, 1],
             [hr, v.regions, v.threads_per_row_region()],
             [w, h, 1],
@@ -358,10 +360,11 @@ fn minmax_manifest_matches_the_runtime() {
         .unwrap_or_default();
     let params = KernelParams::minmax(v);
     assert_eq!(passes.len(), params.len());
-    for ((pass, p), grid) in passes
-        .iter()
-        .zip(params)
-        .zip([[wr, hr, 1], [tw, hr, 1], [w, h, 1]])
+    for ((pass, p), grid) in
+        passes
+            .iter()
+            .zip(params)
+            .zip([[w, 1, 1], [256, 1, 1], [wr, hr, 1], [tw, hr, 1], [w, h, 1]])
     {
         let built = build(&p).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(str_of(pass, "kernel"), built.kernel.name());

@@ -1,4 +1,5 @@
-//! Conformance of the `minmax` family (`rectify`, `minmax_build`, `minmax_traverse`): the GPU
+//! Conformance of the `minmax` family (`depth_columns`, `slice_fit`, `rectify`, `minmax_build`,
+//! `minmax_traverse`): the GPU
 //! (`scatter_runtime::run_minmax_once`) against the CPU mirrors
 //! (`reference/src/kernels/{rectify,minmax_build,minmax_traverse}.rs`) for both variants of
 //! `MinmaxVariant::grid()`, directional on `columns`, spot on `spot_grate`, at the
@@ -20,10 +21,10 @@
 use std::process::ExitCode;
 use std::sync::OnceLock;
 
-use scatter_conformance::{Check, Fixture, gpu, run_trials, scene_for};
+use scatter_conformance::{Check, Fixture, compare_slices, gpu, run_trials, scene_for};
 use scatter_reference::kernels::minmax_traverse::{Pixel, TraverseInputs, pixel_ray};
 use scatter_reference::kernels::texture::Tex;
-use scatter_reference::kernels::{minmax_from_rectified, rectify};
+use scatter_reference::kernels::{depth_columns, minmax_from_rectified, rectify, slice_fit};
 use scatter_reference::suite::Pose;
 use scatter_runtime::{FrameInput, Minmax, RuntimeError, run_minmax_once};
 use scatter_shaderlib::family::FamilyVariant;
@@ -35,13 +36,16 @@ const RECTIFIED: [u32; 2] = [100, 60];
 const SHADOW_MAP: u32 = 128;
 const REL_TOL: f32 = 1e-4;
 
-/// The (light, scene, pose) of every trial: both lights (the grid), at the `ordinary` and
-/// `epipole_on_screen` poses.
-const CASES: [(LightKind, Pose); 4] = [
-    (LightKind::Directional, Pose::Ordinary),
-    (LightKind::Directional, Pose::EpipoleOnScreen),
-    (LightKind::Spot, Pose::Ordinary),
-    (LightKind::Spot, Pose::EpipoleOnScreen),
+/// The (light, pose, depth scale) of every trial: both lights (the grid), at the `ordinary`
+/// and `epipole_on_screen` poses, and at the `ordinary` pose with the depth buffer at 0.3x,
+/// where `slice_fit` narrows the rows (every suite pose here sees the sky, where it does not).
+const CASES: [(LightKind, Pose, f32); 6] = [
+    (LightKind::Directional, Pose::Ordinary, 1.0),
+    (LightKind::Directional, Pose::EpipoleOnScreen, 1.0),
+    (LightKind::Spot, Pose::Ordinary, 1.0),
+    (LightKind::Spot, Pose::EpipoleOnScreen, 1.0),
+    (LightKind::Directional, Pose::Ordinary, 0.3),
+    (LightKind::Spot, Pose::Ordinary, 0.3),
 ];
 
 /// The fixture of case `i` of [`CASES`] (all built once, on first use).
@@ -50,7 +54,14 @@ fn fixture(i: usize) -> &'static Fixture {
     &ALL.get_or_init(|| {
         CASES
             .iter()
-            .map(|&(light, pose)| Fixture::new(scene_for(light), pose, SCREEN, SHADOW_MAP))
+            .map(|&(light, pose, scale)| {
+                let f = Fixture::new(scene_for(light), pose, SCREEN, SHADOW_MAP);
+                if scale == 1.0 {
+                    f
+                } else {
+                    f.with_depth_scaled(scale)
+                }
+            })
             .collect()
     })[i]
 }
@@ -67,9 +78,14 @@ fn input(f: &Fixture) -> FrameInput {
     f.frame_input(FrameSettings::for_screen(SCREEN[0], SCREEN[1]))
 }
 
-fn trial_name(light: LightKind, pose: Pose) -> String {
+fn trial_name(light: LightKind, pose: Pose, depth_scale: f32) -> String {
+    let tail = if depth_scale == 1.0 {
+        String::new()
+    } else {
+        format!("::depth_x{depth_scale}")
+    };
     format!(
-        "{}::{}::{pose}",
+        "{}::{}::{pose}{tail}",
         FamilyVariant::from(MinmaxVariant { light }).trial_name(),
         scene_for(light)
     )
@@ -93,7 +109,7 @@ fn f16_ulp(v: f32) -> f32 {
 
 fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> {
     let variant = MinmaxVariant { light: light_of(f) };
-    let name = trial_name(variant.light, f.pose);
+    let name = format!("{}::{}", variant.light, f.pose);
     let gpu = run_minmax_once(
         ctx,
         &variant,
@@ -114,10 +130,21 @@ fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> 
         height: SCREEN[1],
         data: f.gbuf.view_depth.clone(),
     };
+    // depth_columns and slice_fit: the mirrors on the uploaded table against the GPU's.
+    let mut fitted = gpu.frame.slices.clone();
+    slice_fit::slice_fit(
+        &gpu.frame.uniforms,
+        &mut fitted,
+        &depth_columns::depth_columns(&gpu.frame.uniforms, &depth),
+        variant.light == LightKind::Spot,
+    );
+    compare_slices(&gpu.slices, &fitted).map_err(|e| format!("{name}: {e}"))?;
+    let mut frame = gpu.frame.clone();
+    frame.slices = gpu.slices.clone();
     // rectify: reported only (its own conformance lives with the prefiltered family).
     let cpu_rect = rectify::rectify(
-        &gpu.frame.uniforms,
-        &gpu.frame.slices,
+        &frame.uniforms,
+        &frame.slices,
         &sm,
         variant.light == LightKind::Spot,
     );
@@ -138,7 +165,7 @@ fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> 
         height: hr,
         data: gpu.rectified.clone(),
     };
-    let cpu = minmax_from_rectified(&variant, gpu.frame.clone(), gpu_rect, &depth, &sm);
+    let cpu = minmax_from_rectified(&variant, frame, gpu_rect, &depth, &sm);
     // minmax_build: bit for bit.
     if cpu.tree.data.len() != gpu.tree.len() {
         return Err(format!("{name}: tree sizes differ"));
@@ -263,12 +290,12 @@ fn main() -> ExitCode {
     let mut trials: Vec<(String, Check)> = CASES
         .iter()
         .enumerate()
-        .map(|(i, &(light, pose))| {
+        .map(|(i, &(light, pose, scale))| {
             let check: Check = Box::new(move || {
                 let Some(ctx) = gpu() else { return Ok(()) };
                 trial(ctx, fixture(i)).map(drop)
             });
-            (trial_name(light, pose), check)
+            (trial_name(light, pose, scale), check)
         })
         .collect();
     trials.push((

@@ -32,7 +32,7 @@ use std::process::ExitCode;
 use std::sync::OnceLock;
 use std::time::Instant;
 
-use scatter_conformance::{Check, Fixture, gpu, run_trials};
+use scatter_conformance::{Check, Fixture, compare_slices, gpu, run_trials};
 use scatter_reference::kernels::{PrefilteredRun, run_prefiltered};
 use scatter_reference::suite::{Pose, SceneName};
 use scatter_runtime::wgpu::TextureView;
@@ -178,14 +178,9 @@ fn trial_name(variant: &PrefilteredVariant) -> String {
     )
 }
 
-fn run_trial(
-    ctx: &Context,
-    variant: &PrefilteredVariant,
-    fixture: &Fixture,
-) -> Result<TrialResult, String> {
-    let trial = trial_name(variant);
-    let start = Instant::now();
-    let cpu: PrefilteredRun = run_prefiltered(
+/// The CPU mirrors' run of `variant` on `fixture` (default frame settings).
+fn cpu_run(variant: &PrefilteredVariant, fixture: &Fixture) -> Result<PrefilteredRun, String> {
+    run_prefiltered(
         variant,
         RECTIFIED,
         &fixture.scene,
@@ -194,7 +189,17 @@ fn run_trial(
         &fixture.shadow_map,
         &FrameSettings::default(),
     )
-    .map_err(|e| format!("{trial}: CPU mirror failed: {e}"))?;
+    .map_err(|e| format!("CPU mirror failed: {e}"))
+}
+
+fn run_trial(
+    ctx: &Context,
+    variant: &PrefilteredVariant,
+    fixture: &Fixture,
+) -> Result<TrialResult, String> {
+    let trial = trial_name(variant);
+    let start = Instant::now();
+    let cpu = cpu_run(variant, fixture).map_err(|e| format!("{trial}: {e}"))?;
     if cpu.frame.report.rectification != variant.rectification {
         return Err(format!(
             "{trial}: expected a {} frame, got {} ({:?})",
@@ -209,11 +214,12 @@ fn run_trial(
     let gpu = run_prefiltered_once(ctx, variant, resolutions(fixture), &inputs)
         .map_err(|e| format!("{trial}: GPU run failed: {e}"))?;
     let gpu_wall = gpu_start.elapsed();
-    if gpu.frame != cpu.frame {
+    if gpu.frame.uniforms != cpu.frame.uniforms || gpu.frame.report != cpu.frame.report {
         return Err(format!(
             "{trial}: the runtime uploaded a different frame set-up than the mirror used"
         ));
     }
+    compare_slices(&gpu.slices, &cpu.frame.slices).map_err(|e| format!("{trial}: {e}"))?;
     let lengths = [
         ("rectified", gpu.rectified.len(), cpu.rectified.data.len()),
         ("filtered", gpu.filtered.len(), cpu.filtered.data.len()),
@@ -307,7 +313,60 @@ fn describe(what: &str, w: &Worst, layout: impl Fn(usize) -> String) -> String {
 /// tolerance.
 fn conformance(variant: &PrefilteredVariant) -> Result<(), String> {
     let Some(ctx) = gpu() else { return Ok(()) };
-    let fixture = fixture(variant.light, variant.rectification);
+    compare(ctx, variant, fixture(variant.light, variant.rectification))
+}
+
+/// `slice_fit` where it changes the slice table: the light's fixture with its depth buffer
+/// at 0.3x (the deepest pixel at 0.3 of the far plane), the default variant of the light.
+/// Besides the whole comparison, the mirror's fitted table must be narrower than the
+/// uploaded one on every row, by exactly the depth's factor for the sun.
+fn slice_fit_conformance(light: LightKind) -> Result<(), String> {
+    let Some(ctx) = gpu() else { return Ok(()) };
+    let fixture = for_light(light).with_depth_scaled(0.3);
+    let variant = PrefilteredVariant {
+        light,
+        ..base_variant()
+    };
+    let cpu = cpu_run(&variant, &fixture)?;
+    let uploaded = scatter_shaderlib::prefiltered::prepare_frame(
+        &variant,
+        &resolutions(&fixture),
+        &fixture.scene.camera_desc(),
+        &fixture.scene.light_desc(),
+        &fixture.scene.medium_desc(),
+        &fixture.shadow_map.desc(),
+        &FrameSettings::default(),
+    )
+    .map_err(|e| e.to_string())?;
+    // The sun's extent is linear in the far distance: every row at exactly 0.3x. A spot's
+    // is an angle at the light, which shrinks less (0.76-0.89x here): every row narrower.
+    let wrong: Vec<(usize, f32)> = cpu
+        .frame
+        .slices
+        .iter()
+        .zip(&uploaded.slices)
+        .map(|(c, u)| c.delta / u.delta)
+        .enumerate()
+        .filter(|&(_, ratio)| match light {
+            LightKind::Directional => (ratio - 0.3).abs() > 1e-6,
+            LightKind::Spot => ratio >= 0.95,
+        })
+        .collect();
+    if !wrong.is_empty() {
+        return Err(format!(
+            "slice_fit at 0.3x depth: {} of {} rows have an unexpected spacing ratio, first \
+             (row, ratio) {:?}",
+            wrong.len(),
+            uploaded.slices.len(),
+            wrong[0]
+        ));
+    }
+    compare(ctx, &variant, &fixture)
+}
+
+/// Runs one variant on one fixture, GPU against the mirror; `Err` lists every pass that
+/// missed its tolerance.
+fn compare(ctx: &Context, variant: &PrefilteredVariant, fixture: &Fixture) -> Result<(), String> {
     let [wr, hr] = RECTIFIED;
     let [w, _] = SCREEN;
     let r = run_trial(ctx, variant, fixture)?;
@@ -361,6 +420,12 @@ fn main() -> ExitCode {
             (trial_name(&variant), check)
         })
         .collect();
+    for light in LightKind::ALL.iter().copied() {
+        trials.push((
+            format!("prefiltered::slice_fit::{light}"),
+            Box::new(move || slice_fit_conformance(light)),
+        ));
+    }
     let errors: [(&str, fn()); 4] = [
         ("wrong_shadow_map_size", wrong_shadow_map_size_is_an_error),
         ("zero_resolution", zero_resolution_is_an_error),

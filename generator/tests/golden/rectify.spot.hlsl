@@ -340,9 +340,9 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_X
     return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
 }
 
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi)
+float occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi)
 {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
+    return clamp((DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * ((theta - lo) / max((hi - lo), 1e-6)))), 0.0, 1.0);
 }
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(float4 arg0, float4 arg1, float4 arg2, float4 arg3, float4 arg4, uint4 arg5) {
@@ -418,7 +418,7 @@ void rectify(uint3 id : SV_DispatchThreadID)
     float _e81 = theta_occ;
     float _e85 = frame.theta.x;
     float _e89 = frame.theta.y;
-    const float _e90 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
+    const float _e90 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
     rectified[uint2(x_5, y_1)] = float4(_e90, 0.0, 0.0, 0.0);
     return;
 }

@@ -11,6 +11,7 @@ pub mod common_prefiltered_projective;
 pub mod common_projective;
 pub mod common_raymarch;
 pub mod common_shadow;
+pub mod depth_columns;
 pub mod family;
 pub mod interleave_sum;
 pub mod minmax_build;
@@ -20,6 +21,7 @@ pub mod raymarch;
 pub mod rectify;
 pub mod row_prefix;
 pub mod scatter;
+pub mod slice_fit;
 pub mod texture;
 
 use crate::buffers::{GBuffer, ShadowMap};
@@ -51,7 +53,7 @@ pub struct PrefilteredRun {
     pub output: Image,
 }
 
-/// Runs `rectify`, `prefilter` and `scatter` on the CPU for a scene, its depth buffer and
+/// Runs `depth_columns`, `slice_fit`, `rectify`, `prefilter` and `scatter` on the CPU for a scene, its depth buffer and
 /// its standard shadow map. In a projective frame (a `projective` variant whose frame allows
 /// it) `rectify` is replaced by the engine's rasterisation of the rectified map
 /// ([`crate::projective::rasterise_rectified`], ray cast in `bvh`).
@@ -68,7 +70,7 @@ pub fn run_prefiltered(
         screen: [gbuf.width, gbuf.height],
         rectified: rectified_size,
     };
-    let frame = prepare_frame(
+    let mut frame = prepare_frame(
         variant,
         &res,
         &scene.camera_desc(),
@@ -88,6 +90,8 @@ pub fn run_prefiltered(
         height: gbuf.height,
         data: gbuf.view_depth.clone(),
     };
+    let column_depth = depth_columns::depth_columns(&frame.uniforms, &depth);
+    slice_fit::slice_fit(&frame.uniforms, &mut frame.slices, &column_depth, spot);
     let rectified = match engine_rectified_map(scene, bvh, &frame) {
         Some(data) => Tex {
             width: rectified_size[0],
@@ -229,7 +233,7 @@ pub struct MinmaxRun {
     pub output: Image,
 }
 
-/// Runs `rectify`, `minmax_build` and `minmax_traverse` on the CPU for a scene, its depth
+/// Runs `depth_columns`, `slice_fit`, `rectify`, `minmax_build` and `minmax_traverse` on the CPU for a scene, its depth
 /// buffer and its standard shadow map, and the brute-force march over the same rectified
 /// map.
 pub fn run_minmax(
@@ -244,7 +248,7 @@ pub fn run_minmax(
         screen: [gbuf.width, gbuf.height],
         rectified: rectified_size,
     };
-    let frame = prepare_minmax(
+    let mut frame = prepare_minmax(
         variant,
         &res,
         &scene.camera_desc(),
@@ -259,12 +263,14 @@ pub fn run_minmax(
         data: shadow_map.depth.clone(),
     };
     let spot = variant.light == LightKind::Spot;
-    let rectified = rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot);
     let depth = Tex {
         width: gbuf.width,
         height: gbuf.height,
         data: gbuf.view_depth.clone(),
     };
+    let column_depth = depth_columns::depth_columns(&frame.uniforms, &depth);
+    slice_fit::slice_fit(&frame.uniforms, &mut frame.slices, &column_depth, spot);
+    let rectified = rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot);
     Ok(minmax_from_rectified(
         variant, frame, rectified, &depth, &sm,
     ))

@@ -5,7 +5,7 @@
 //! light ray's first occluder in the standard shadow map and store its view angle as
 //! normalised rectified depth (see `scatter_shaderlib::prefiltered::frame`).
 
-use super::common_epipolar::{normalised_depth, row_phi, slice_e, sm_occluder_distance};
+use super::common_epipolar::{occluder_depth, row_phi, slice_e, sm_occluder_distance};
 use super::common_model::PI;
 use super::common_shadow::NO_OCCLUDER;
 use super::texture::{Tex, xyz};
@@ -45,7 +45,7 @@ pub fn rectify_main(
             theta_occ = col.atan2(-s);
         }
     }
-    let d = normalised_depth(theta_occ, frame.theta[0], frame.theta[1]);
+    let d = occluder_depth(theta_occ, frame.theta[0], frame.theta[1]);
     Some(d)
 }
 

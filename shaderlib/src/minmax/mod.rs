@@ -74,9 +74,12 @@ pub(crate) fn render_traverse(variant: &MinmaxVariant) -> Result<String, ShaderE
 
 impl crate::KernelParams {
     /// The kernels of a minmax-family variant, in pass order: the prefiltered family's
-    /// `rectify` (of [`MinmaxVariant::prefiltered`]), `minmax_build`, `minmax_traverse`.
-    pub fn minmax(variant: MinmaxVariant) -> [Self; 3] {
+    /// `depth_columns`, `slice_fit` and `rectify` (of [`MinmaxVariant::prefiltered`]),
+    /// `minmax_build`, `minmax_traverse`.
+    pub fn minmax(variant: MinmaxVariant) -> [Self; 5] {
         [
+            Self::DepthColumns(variant.prefiltered()),
+            Self::SliceFit(variant.prefiltered()),
             Self::Rectify(variant.prefiltered()),
             Self::MinmaxBuild(variant),
             Self::MinmaxTraverse(variant),

@@ -1,11 +1,12 @@
-//! The plan of a `minmax` variant: its textures and buffers and its passes (`rectify`,
-//! `minmax_build`, `minmax_traverse`). `scatter-gen` writes it into the manifest;
+//! The plan of a `minmax` variant: its textures and buffers and its passes (`depth_columns`,
+//! `slice_fit`, `rectify`, `minmax_build`, `minmax_traverse`). `scatter-gen` writes it into the manifest;
 //! `scatter-runtime` builds and dispatches from it.
 
 use crate::minmax::{MinmaxVariant, TREE_FORMAT};
 use crate::plan::{
-    DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, TEXTURE_DIMENSION, bind,
-    depth_and_shadow_map, frame_buffer, scatter_texture, screen_and_shadow_parameters,
+    DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, SLICE_FIT_NOTE, TEXTURE_DIMENSION,
+    bind, column_depth_buffer, depth_and_shadow_map, frame_buffer, scatter_texture,
+    screen_and_shadow_parameters,
 };
 use crate::{Kernel, KernelParams};
 
@@ -50,6 +51,7 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
         ),
         depth,
         shadow_map,
+        column_depth_buffer(),
         scatter_texture(
             "rectified",
             "rectified shadow map: normalised view angle of the first occluder per light ray \
@@ -90,7 +92,8 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
             "Write `frame` and `slices` once per frame before the first pass; the host code \
              that computes them is scatter_frame::minmax::prepare_minmax (Rust): the \
              prefiltered family's prepare_frame with an epipolar one-region variant of the \
-             same light. `rectify` is the prefiltered family's kernel.",
+             same light. `depth_columns`, `slice_fit` and `rectify` are the prefiltered family's kernels.",
+            SLICE_FIT_NOTE,
             "Group 0 holds every binding; bind by group and binding number, not by name: \
              emitted names may be mangled (naga_oil) or carry a trailing `_` (naga).",
         ],
@@ -101,6 +104,18 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
 pub fn pass(kernel: Kernel) -> Option<PassPlan> {
     let f = |s: &str| s.to_owned();
     match kernel {
+        Kernel::DepthColumns => Some(PassPlan {
+            kernel,
+            invocations: [f("screen.width"), f("1"), f("1")],
+            skip_when: None,
+            bindings: vec![bind(0, "frame"), bind(1, "depth"), bind(2, "column_depth")],
+        }),
+        Kernel::SliceFit => Some(PassPlan {
+            kernel,
+            invocations: [f("256"), f("1"), f("1")],
+            skip_when: None,
+            bindings: vec![bind(0, "frame"), bind(1, "slices"), bind(2, "column_depth")],
+        }),
         Kernel::Rectify => Some(PassPlan {
             kernel,
             invocations: [f("rectified.width"), f("rectified.height"), f("1")],

@@ -1,6 +1,8 @@
-//! The askama views of the prefiltered family's templates (`templates/rectify.wgsl`,
-//! `templates/prefilter.wgsl`, `templates/scatter.wgsl`) and their rendering from a
-//! [`PrefilteredVariant`]. CPU mirrors: `reference/src/kernels/{rectify,prefilter,scatter}.rs`.
+//! The askama views of the prefiltered family's templates (`templates/depth_columns.wgsl`,
+//! `templates/slice_fit.wgsl`,
+//! `templates/rectify.wgsl`, `templates/prefilter.wgsl`, `templates/scatter.wgsl`) and their
+//! rendering from a [`PrefilteredVariant`]. CPU mirrors:
+//! `reference/src/kernels/{depth_columns,slice_fit,rectify,prefilter,scatter}.rs`.
 //!
 //! Every value the templates print is computed here (plain numbers, booleans and names);
 //! the templates do no arithmetic or string building.
@@ -11,6 +13,10 @@ use super::variant::{LightKind, PrefilteredVariant, Rectification, VisibilityMod
 use crate::compose::template_path;
 use crate::{Kernel, ShaderError};
 
+/// Workgroup size of `depth_columns`: one workgroup per screen row.
+pub const DEPTH_COLUMNS_WORKGROUP_SIZE: [u32; 3] = [64, 1, 1];
+/// Workgroup size of `slice_fit`: its one workgroup (the dispatch is `(1, 1, 1)`).
+pub const SLICE_FIT_WORKGROUP_SIZE: [u32; 3] = [256, 1, 1];
 /// Workgroup size of `rectify`: one invocation per rectified texel.
 pub const RECTIFY_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
 /// Workgroup size of `prefilter`: one invocation per (row, region, thread).
@@ -20,6 +26,19 @@ pub const SCATTER_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
 /// Largest `regions` a variant may have (`PrefilteredVariant::REGIONS`): the projective
 /// frame holds the column invariants of at most 9 region boundaries (`proj_g0..2`).
 pub const MAX_REGIONS: u32 = 8;
+
+/// `depth_columns`: the deepest pixel of every screen row.
+#[derive(Template)]
+#[template(path = "depth_columns.wgsl")]
+struct DepthColumnsTemplate {}
+
+/// `slice_fit`: every row's column spacing fitted to the deepest pixel.
+#[derive(Template)]
+#[template(path = "slice_fit.wgsl")]
+struct SliceFitTemplate {
+    light_name: &'static str,
+    spot: bool,
+}
 
 /// `rectify`: epipolar resampling of the standard shadow map.
 #[derive(Template)]
@@ -75,6 +94,25 @@ fn render_error(kernel: Kernel) -> impl FnOnce(askama::Error) -> ShaderError {
         template: template_path(kernel),
         source,
     }
+}
+
+/// Renders `templates/depth_columns.wgsl` (the same for every variant).
+pub(crate) fn render_depth_columns(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
+    validate(Kernel::DepthColumns, variant)?;
+    DepthColumnsTemplate {}
+        .render()
+        .map_err(render_error(Kernel::DepthColumns))
+}
+
+/// Renders `templates/slice_fit.wgsl` for `variant` (only its light matters).
+pub(crate) fn render_slice_fit(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
+    validate(Kernel::SliceFit, variant)?;
+    SliceFitTemplate {
+        light_name: variant.light.name(),
+        spot: variant.light == LightKind::Spot,
+    }
+    .render()
+    .map_err(render_error(Kernel::SliceFit))
 }
 
 /// Renders `templates/rectify.wgsl` for `variant` (only its light matters).

@@ -1,7 +1,7 @@
 //! The `prefiltered` family (Klehm et al. 2014): variant knobs, per-frame parameters and the
-//! three kernels `rectify`, `prefilter` and `scatter`.
+//! five kernels `depth_columns`, `slice_fit`, `rectify`, `prefilter` and `scatter`.
 //!
-//! CPU mirrors: `reference/src/kernels/{common_model,common_prefiltered,rectify,prefilter,scatter}.rs`.
+//! CPU mirrors: `reference/src/kernels/{common_model,common_prefiltered,depth_columns,slice_fit,rectify,prefilter,scatter}.rs`.
 
 pub mod kernels;
 pub mod plan;
@@ -14,17 +14,20 @@ pub use frame::{
     ShadowProjectionDesc, SliceParams, prepare_frame, region_start,
 };
 pub use kernels::{
-    MAX_REGIONS, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE,
+    DEPTH_COLUMNS_WORKGROUP_SIZE, MAX_REGIONS, PREFILTER_WORKGROUP_SIZE, RECTIFY_WORKGROUP_SIZE,
+    SCATTER_WORKGROUP_SIZE, SLICE_FIT_WORKGROUP_SIZE,
 };
 pub use variant::{
     LightKind, PrefilteredVariant, Rectification, Storage, VariantError, VisibilityMode,
 };
 
 impl crate::KernelParams {
-    /// The three kernels of a prefiltered-family variant, in pass order: `rectify`,
-    /// `prefilter`, `scatter`.
-    pub const fn prefiltered(variant: PrefilteredVariant) -> [Self; 3] {
+    /// The five kernels of a prefiltered-family variant, in pass order: `depth_columns`,
+    /// `slice_fit`, `rectify`, `prefilter`, `scatter`.
+    pub const fn prefiltered(variant: PrefilteredVariant) -> [Self; 5] {
         [
+            Self::DepthColumns(variant),
+            Self::SliceFit(variant),
             Self::Rectify(variant),
             Self::Prefilter(variant),
             Self::Scatter(variant),

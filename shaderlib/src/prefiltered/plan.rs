@@ -1,11 +1,12 @@
-//! The plan of a `prefiltered` variant: the textures and buffers and the three
-//! passes (`rectify`, `prefilter`, `scatter`). `scatter-gen` writes it into the manifest;
+//! The plan of a `prefiltered` variant: the textures and buffers and the five
+//! passes (`depth_columns`, `slice_fit`, `rectify`, `prefilter`, `scatter`). `scatter-gen` writes it into the manifest;
 //! `scatter-runtime` builds and dispatches from it.
 
 use crate::plan::{
     Alternative, BindingSource, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
-    SAMPLED, STORAGE_AND_SAMPLED, TEXTURE_DIMENSION, bind, depth_and_shadow_map, frame_buffer,
-    scatter_resource, scatter_texture, screen_and_shadow_parameters, texture_2d,
+    SAMPLED, SLICE_FIT_NOTE, STORAGE_AND_SAMPLED, TEXTURE_DIMENSION, bind, column_depth_buffer,
+    depth_and_shadow_map, frame_buffer, scatter_resource, scatter_texture,
+    screen_and_shadow_parameters, texture_2d,
 };
 use crate::prefiltered::{PrefilteredVariant, Rectification};
 use crate::{Kernel, KernelParams};
@@ -61,6 +62,7 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
         ),
         depth,
         shadow_map,
+        column_depth_buffer(),
         scatter_texture(
             "rectified",
             "rectified shadow map: normalised view angle of the first occluder per light ray \
@@ -132,6 +134,7 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
              from storage to sampled) between them.",
         "Write `frame` and `slices` once per frame before the first pass; the host code \
              that computes them is scatter_shaderlib::prefiltered::prepare_frame (Rust).",
+        SLICE_FIT_NOTE,
         "Group 0 holds every binding; bind by group and binding number, not by name: \
              emitted names may be mangled (naga_oil) or carry a trailing `_` (naga).",
     ];
@@ -140,7 +143,8 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
             "Projective variant: the frame set-up decides per frame (FrameReport::rectification) \
              whether the frame is projective or falls back to epipolar (FrameReport::fallback \
              says why: epipole or anti-epipole on screen, slices fanning out too wide). In a \
-             projective frame skip `rectify`, rasterise `rectified_raster` with the frame's \
+             projective frame skip `depth_columns`, `slice_fit` and `rectify`, rasterise \
+             `rectified_raster` with the frame's \
              matrices and bind it where the passes say; epipolar frames run as usual.",
         );
     }
@@ -157,6 +161,18 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
     let f = |s: &str| s.to_owned();
     let projective = v.rectification == Rectification::Projective;
     match kernel {
+        Kernel::DepthColumns => Some(PassPlan {
+            kernel,
+            invocations: [f("screen.width"), f("1"), f("1")],
+            skip_when: projective.then_some(PROJECTIVE_FRAME),
+            bindings: vec![bind(0, "frame"), bind(1, "depth"), bind(2, "column_depth")],
+        }),
+        Kernel::SliceFit => Some(PassPlan {
+            kernel,
+            invocations: [f("256"), f("1"), f("1")],
+            skip_when: projective.then_some(PROJECTIVE_FRAME),
+            bindings: vec![bind(0, "frame"), bind(1, "slices"), bind(2, "column_depth")],
+        }),
         Kernel::Rectify => Some(PassPlan {
             kernel,
             invocations: [f("rectified.width"), f("rectified.height"), f("1")],
