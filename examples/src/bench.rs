@@ -187,6 +187,9 @@ impl BenchConfig {
                 ..RaymarchVariant::default()
             }));
         }
+        for moments in PrefilteredVariant::MOMENTS {
+            methods.push(Method::from(PrefilteredVariant::with_moments(moments)));
+        }
         methods.push(Method::minmax_default());
         BenchConfig {
             cases: SceneName::ALL
@@ -682,7 +685,10 @@ fn time_methods_on(
 /// terrain; with `errors`, each run's rel L1 against the `shadow_map` truth at that size.
 fn headline_runs(ctx: &Context, frames: u32, errors: bool) -> Result<Vec<HeadlineRow>, BoxError> {
     let mut methods = vec![Method::prefiltered_default(), Method::minmax_default()];
-    for (samples, interleave) in [(64, 1), (128, 1), (64, 4)] {
+    for moments in PrefilteredVariant::MOMENTS {
+        methods.push(Method::from(PrefilteredVariant::with_moments(moments)));
+    }
+    for (samples, interleave) in [(64, 1), (128, 1), (256, 1), (64, 4)] {
         methods.push(Method::from(RaymarchVariant {
             samples,
             interleave,
@@ -918,8 +924,11 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
     };
     if let Some((pt, pe)) = headline_mean("prefiltered", "m32-r3") {
         for (family, knobs) in [
+            ("prefiltered", "moments4-r3"),
+            ("prefiltered", "moments6-r3"),
             ("raymarch", "n64-i1"),
             ("raymarch", "n128-i1"),
+            ("raymarch", "n256-i1"),
             ("raymarch", "n64-i4"),
             ("minmax", "minmax"),
         ] {
@@ -930,6 +939,28 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                     100.0 * pe,
                     t / pt,
                     if e <= pe { "equal or lower" } else { "higher" }
+                ));
+            }
+        }
+    }
+    // Issue 13's targets, per prefiltered basis: the brute-force march at about the same
+    // error, how much longer it takes, and whether the prefiltered error is at or below it.
+    for prefiltered in ["m32-r3", "moments4-r3", "moments6-r3"] {
+        let Some((pt, pe)) = headline_mean("prefiltered", prefiltered) else {
+            continue;
+        };
+        for (family, knobs) in [
+            ("raymarch", "n64-i1"),
+            ("raymarch", "n256-i1"),
+            ("minmax", "minmax"),
+        ] {
+            if let Some((t, e)) = headline_mean(family, knobs) {
+                out.push(format!(
+                    "target check, headline means: {family} {knobs} takes {:.2}x the time of prefiltered {prefiltered} ({t:.1} / {pt:.1} ms); prefiltered error {:.3} % is {} {family} {knobs}'s {:.3} %",
+                    t / pt,
+                    100.0 * pe,
+                    if pe <= e { "at or below" } else { "above" },
+                    100.0 * e
                 ));
             }
         }

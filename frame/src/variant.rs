@@ -40,6 +40,21 @@ pub enum Storage {
     Rgba32float,
 }
 
+/// What the prefilter stores of each rectified texel's depth, and what `scatter` reconstructs
+/// a region's visibility from.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Basis {
+    /// `bases` Fourier bases of the step function (Klehm et al. 2014, Eq. 8): the paper.
+    #[default]
+    Fourier,
+    /// `moments` power moments of the depth (Peters et al. 2016): per pixel the lit fraction
+    /// of each region from the moment problem's bounds (4: Hamburger 4MSM, 6: a cubic).
+    Moments,
+}
+
 /// How the standard shadow map becomes a rectified one.
 #[derive(
     Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
@@ -94,6 +109,8 @@ fn stringify_knob<T: 'static>() -> &'static str {
         "light"
     } else if t.ends_with("Storage") {
         "storage"
+    } else if t.ends_with("Basis") {
+        "basis"
     } else {
         "rectification"
     }
@@ -103,6 +120,7 @@ names!(VisibilityMode, [Average => "average", Weighted => "weighted"]);
 names!(LightKind, [Directional => "directional", Spot => "spot"]);
 names!(Storage, [Rgba16float => "rgba16float", Rgba32float => "rgba32float", Rgba8unorm => "rgba8unorm"]);
 names!(Rectification, [Epipolar => "epipolar", Projective => "projective"]);
+names!(Basis, [Fourier => "fourier", Moments => "moments"]);
 
 /// `text` with its control characters (newlines, tabs, escape codes) written as Rust
 /// escapes (`\n`, `\u{1b}`): user text quoted in an error message keeps the message on
@@ -136,14 +154,23 @@ pub struct VariantError {
 }
 
 /// One compiled configuration of the prefiltered family. `Default` is the paper's choice:
-/// 32 bases, 8 per thread, 3 regions, weighted visibility, rgba8unorm, epipolar, directional.
+/// the Fourier basis, 32 bases, 8 per thread, 3 regions, weighted visibility, rgba8unorm,
+/// epipolar, directional. [`PrefilteredVariant::with_moments`] is the moment basis.
+///
+/// Knobs of one basis only: `bases` and `bases_per_thread` belong to the Fourier basis,
+/// `moments` to the moment basis; the other basis's knobs must stay at their defaults, so
+/// that one configuration has one id.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PrefilteredVariant {
+    /// What the prefilter stores: Fourier bases or power moments of the rectified depth.
+    pub basis: Basis,
     /// Fourier bases M (M/2 frequencies, sine and cosine): 4..=128, a multiple of 4.
     pub bases: u32,
     /// Bases filtered by one invocation: a multiple of 4 that divides `bases`.
     pub bases_per_thread: u32,
+    /// Power moments of the moment basis: 4 or 6.
+    pub moments: u32,
     /// Independent prefix regions per rectified row: 1..=8.
     pub regions: u32,
     /// Visibility weighting.
@@ -159,8 +186,10 @@ pub struct PrefilteredVariant {
 impl Default for PrefilteredVariant {
     fn default() -> Self {
         PrefilteredVariant {
+            basis: Basis::Fourier,
             bases: 32,
             bases_per_thread: 8,
+            moments: Self::DEFAULT_MOMENTS,
             regions: 3,
             visibility: VisibilityMode::Weighted,
             light: LightKind::Directional,
@@ -175,9 +204,72 @@ impl PrefilteredVariant {
     pub const BASES: std::ops::RangeInclusive<u32> = 4..=128;
     /// Allowed `regions`.
     pub const REGIONS: std::ops::RangeInclusive<u32> = 1..=8;
+    /// Allowed `moments`.
+    pub const MOMENTS: [u32; 2] = [4, 6];
+    /// `moments` of [`PrefilteredVariant::with_moments`]'s callers that do not choose.
+    pub const DEFAULT_MOMENTS: u32 = 4;
+
+    /// The default variant with the moment basis of `moments` power moments (4 or 6) and
+    /// its storage, rgba32float (the only one it allows: the moment problem is
+    /// ill-conditioned, and 16 bits would need Peters et al.'s quantisation transform).
+    pub fn with_moments(moments: u32) -> Self {
+        Self {
+            basis: Basis::Moments,
+            moments,
+            storage: Storage::Rgba32float,
+            ..Self::default()
+        }
+    }
 
     /// Checks every knob; the error names the first offending one.
     pub fn validate(&self) -> Result<(), VariantError> {
+        let d = Self::default();
+        if self.basis == Basis::Moments {
+            if !Self::MOMENTS.contains(&self.moments) {
+                return Err(VariantError {
+                    knob: "moments",
+                    value: self.moments.to_string(),
+                    allowed: "4 or 6".into(),
+                });
+            }
+            if self.storage != Storage::Rgba32float {
+                return Err(VariantError {
+                    knob: "storage",
+                    value: self.storage.to_string(),
+                    allowed: "rgba32float with basis = moments (power moments need 32-bit floats)"
+                        .into(),
+                });
+            }
+            if self.bases != d.bases {
+                return Err(VariantError {
+                    knob: "bases",
+                    value: self.bases.to_string(),
+                    allowed: format!(
+                        "{} (a Fourier knob; with basis = moments set `moments`)",
+                        d.bases
+                    ),
+                });
+            }
+            if self.bases_per_thread != d.bases_per_thread {
+                return Err(VariantError {
+                    knob: "bases_per_thread",
+                    value: self.bases_per_thread.to_string(),
+                    allowed: format!(
+                        "{} (a Fourier knob; basis = moments filters every moment in one thread)",
+                        d.bases_per_thread
+                    ),
+                });
+            }
+        } else if self.moments != d.moments {
+            return Err(VariantError {
+                knob: "moments",
+                value: self.moments.to_string(),
+                allowed: format!(
+                    "{} (a moment-basis knob; with basis = fourier set `bases`)",
+                    d.moments
+                ),
+            });
+        }
         if !Self::BASES.contains(&self.bases) || !self.bases.is_multiple_of(4) {
             return Err(VariantError {
                 knob: "bases",
@@ -233,6 +325,7 @@ impl PrefilteredVariant {
                                         light,
                                         storage,
                                         rectification,
+                                        ..Self::default()
                                     });
                                 }
                             }
@@ -241,26 +334,68 @@ impl PrefilteredVariant {
                 }
             }
         }
+        for moments in Self::MOMENTS {
+            for r in regions.clone() {
+                for &visibility in VisibilityMode::ALL {
+                    for &light in LightKind::ALL {
+                        for &rectification in Rectification::ALL {
+                            out.push(PrefilteredVariant {
+                                regions: r,
+                                visibility,
+                                light,
+                                rectification,
+                                ..Self::with_moments(moments)
+                            });
+                        }
+                    }
+                }
+            }
+        }
         out
     }
 
-    /// rgba layers of the filtered-basis texture array: `bases / 4`.
+    /// rgba layers of the filtered-basis texture array: `bases / 4` (Fourier), or
+    /// `ceil(moments / 4)` (moments: `(z, z^2, z^3, z^4)` then `(z^5, z^6, 0, 0)`).
     pub fn layers(&self) -> u32 {
-        self.bases / 4
+        match self.basis {
+            Basis::Fourier => self.bases / 4,
+            Basis::Moments => self.moments.div_ceil(4),
+        }
     }
 
-    /// Invocations per (row, region): `bases / bases_per_thread`.
+    /// Invocations per (row, region): `bases / bases_per_thread` (Fourier), 1 (moments).
     pub fn threads_per_row_region(&self) -> u32 {
-        self.bases / self.bases_per_thread
+        match self.basis {
+            Basis::Fourier => self.bases / self.bases_per_thread,
+            Basis::Moments => 1,
+        }
+    }
+
+    /// Bases one prefilter invocation filters: `bases_per_thread` (Fourier), every moment
+    /// (moments).
+    pub fn per_thread(&self) -> u32 {
+        match self.basis {
+            Basis::Fourier => self.bases_per_thread,
+            Basis::Moments => self.moments,
+        }
+    }
+
+    /// The basis in a variant id: `m{bases}-t{bases_per_thread}` (Fourier) or
+    /// `moments{moments}`.
+    fn basis_id(&self) -> String {
+        match self.basis {
+            Basis::Fourier => format!("m{}-t{}", self.bases, self.bases_per_thread),
+            Basis::Moments => format!("moments{}", self.moments),
+        }
     }
 
     /// A short stable id, used in file names and trial names:
-    /// `m32-t8-r3-weighted-directional-rgba8unorm-epipolar`.
+    /// `m32-t8-r3-weighted-directional-rgba8unorm-epipolar`, or
+    /// `moments4-r3-weighted-directional-rgba32float-epipolar`.
     pub fn id(&self) -> String {
         format!(
-            "m{}-t{}-r{}-{}-{}-{}-{}",
-            self.bases,
-            self.bases_per_thread,
+            "{}-r{}-{}-{}-{}-{}",
+            self.basis_id(),
             self.regions,
             self.visibility,
             self.light,
@@ -298,11 +433,18 @@ impl KnobSet for PrefilteredVariant {
         Self { light, ..self }
     }
 
-    /// `m{bases}-r{regions}`, then `-t{bases_per_thread}`, the visibility, the storage and
-    /// the rectification where they differ from the default.
+    /// `m{bases}-r{regions}` (or `moments{moments}-r{regions}`), then
+    /// `-t{bases_per_thread}`, the visibility, the storage and the rectification where they
+    /// differ from the basis's default.
     fn marker(&self) -> String {
-        let d = Self::default();
-        let mut m = format!("m{}-r{}", self.bases, self.regions);
+        let d = match self.basis {
+            Basis::Fourier => Self::default(),
+            Basis::Moments => Self::with_moments(self.moments),
+        };
+        let mut m = match self.basis {
+            Basis::Fourier => format!("m{}-r{}", self.bases, self.regions),
+            Basis::Moments => format!("moments{}-r{}", self.moments, self.regions),
+        };
         if self.bases_per_thread != d.bases_per_thread {
             m += &format!("-t{}", self.bases_per_thread);
         }

@@ -196,7 +196,7 @@ impl Prefiltered {
         )?;
         check_limit(
             PREFILTER,
-            "filtered-basis layers (bases / 4)",
+            "filtered-basis layers (bases / 4, or 1-2 for moments)",
             variant.layers().into(),
             "max_texture_array_layers",
             limits.max_texture_array_layers.into(),

@@ -43,6 +43,10 @@ const COMMON_MODULES: &[(&str, &str)] = &[
         include_str!("../templates/common/prefiltered.wgsl"),
     ),
     (
+        "common/moments.wgsl",
+        include_str!("../templates/common/moments.wgsl"),
+    ),
+    (
         "common/prefiltered_projective.wgsl",
         include_str!("../templates/common/prefiltered_projective.wgsl"),
     ),

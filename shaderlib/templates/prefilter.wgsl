@@ -1,3 +1,16 @@
+{%- if moments %}
+// prefilter ({{ moment_count }} power moments, {{ regions }} regions, {{ visibility_name }} visibility, {{ light_name }} light, {{ storage }}, {{ rectification_name }}):
+// the moment basis (Peters et al. 2016) fused with the weighted running mean along each
+// rectified row (Klehm et al. 2014, Sec. 3.3 and 5, Listings 1-3, Table 1's regions).
+//
+// One invocation per (row, region) (thread is always 0): it filters the {{ moment_count }} power moments
+// of z = 2 d - 1, (z, z^2, z^3, z^4){% if layers > 1 %} and (z^5, z^6, 0, 0){% endif %}, in {{ layers }} layer{% if layers > 1 %}s{% endif %}.
+// Each region restarts the running mean. Stored per texel: the normalised weighted mean
+// b_k = sum w_i z_i^k / sum w_i over the region up to the texel, as it is ({{ storage }}).
+// The invocation also stores the least and the greatest depth over the region up to the
+// texel (`bounds`): where a ray's depth lies outside them, scatter knows the region's
+// visibility exactly and skips the moment reconstruction.
+{%- else %}
 // prefilter ({{ bases }} bases, {{ bases_per_thread }} per thread, {{ regions }} regions, {{ visibility_name }} visibility, {{ light_name }} light, {{ storage }}, {{ rectification_name }}):
 // the Fourier basis transform fused with the weighted running mean along each rectified row
 // (Klehm et al. 2014, Sec. 3.3 and 5, Listings 1-3, Table 1's regions and bases per thread).
@@ -9,6 +22,7 @@
 // F / 2 + 0.5 in {{ storage }}. Thread 0 of a row-region also stores the least and the
 // greatest depth over the region up to the texel (`bounds`): where a ray's depth lies outside
 // them, scatter knows the region's visibility exactly and skips the Fourier estimate.
+{%- endif %}
 {%- if projective %}
 //
 // Projective variant: in a projective frame (frame.proj.x = 1) `rectified` is the engine's
@@ -24,7 +38,7 @@
 // | 2       | rectified | texture_2d<f32> (r32float)                      | textureLoad  |
 // | 3       | filtered  | texture_storage_2d_array<FORMAT, write>         | textureStore |
 // | 4       | bounds    | texture_storage_2d<rg32float, write>            | textureStore |
-// filtered: FORMAT = {{ storage }}; Wr x Hr x {{ layers }} layers (bases / 4), Wr x Hr = the rectified
+// filtered: FORMAT = {{ storage }}; Wr x Hr x {{ layers }} layers{% if !moments %} (bases / 4){% endif %}, Wr x Hr = the rectified
 // size (frame.sizes.zw). bounds: Wr x Hr, (min, max) of the region's depths up to the texel.
 //
 // Dispatch: (ceil(Hr / 64), {{ regions }}, {{ threads_per_row_region }}) workgroups of (64, 1, 1);
@@ -33,8 +47,13 @@
 // Mirrors reference/src/kernels/prefilter.rs
 
 #import scatter::epipolar::{Frame, slice_params}
+{%- if moments %}
+#import scatter::prefiltered::{region_start, texel_weight}
+#import scatter::moments::{moment_layer, moment_z}
+{%- else %}
 #import scatter::model::PI
 #import scatter::prefiltered::{basis4, fourier_step, region_start, texel_weight, turn}
+{%- endif %}
 {%- if projective %}
 #import scatter::projective::proj_stored_depth
 #import scatter::prefiltered_projective::proj_texel_weight
@@ -66,7 +85,11 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
 {%- if projective %}
     let proj = frame.proj[0] > 0.5;
 {%- endif %}
+{%- if moments %}
+    let layers_per_thread = {{ layers_per_thread }}u;
+{%- else %}
     let layers_per_thread = BASES_PER_THREAD / 4u;
+{%- endif %}
     let slice = slice_params(slices[row]);
     let start = region_start(region, REGIONS, width, spot);
     let end = region_start(region + 1u, REGIONS, width, spot);
@@ -95,6 +118,14 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             textureStore(bounds, vec2<u32>(i, row), vec4<f32>(lo, hi, 0.0, 0.0));
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);
+{%- if moments %}
+        // The power moments of z, stored as they are.
+        let z = moment_z(d);
+        for (var q = 0u; q < layers_per_thread; q++) {
+            acc[q] = acc[q] * (1.0 - blend) + moment_layer(z, q) * blend;
+            textureStore(filtered, vec2<u32>(i, row), q, acc[q]);
+        }
+{%- else %}
         // The basis angles c_k d by angle addition: (sin, cos)(pi d) turned by
         // (sin, cos)(2 pi d) to this thread's first frequency and on (two transcendentals
         // per texel, not four per layer).
@@ -113,5 +144,6 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             let stored = acc[q] * 0.5 + 0.5;
             textureStore(filtered, vec2<u32>(i, row), layer, stored);
         }
+{%- endif %}
     }
 }

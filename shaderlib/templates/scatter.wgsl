@@ -1,13 +1,22 @@
+{%- if moments %}
+// scatter ({{ layers }} layer{% if layers > 1 %}s{% endif %} = {{ moment_count }} power moments, {{ regions }} regions, {{ visibility_name }} visibility, {{ light_name }} light, {{ rectification_name }}): per pixel, the
+// prefiltered estimate of in-scattered light (Klehm et al. 2014, Sec. 3, with the moment
+// basis of Peters et al. 2016: per region the lit fraction at the pixel's depth reconstructed
+// from the filtered moments, `scatter::moments`) and a ray march against the standard shadow
+// map for pixels near the epipole or the anti-epipole, where the rectification degenerates
+// (Sec. 5, Fig. 8).
+{%- else %}
 // scatter ({{ layers }} layers = {{ bases }} bases, {{ regions }} regions, {{ visibility_name }} visibility, {{ light_name }} light, {{ rectification_name }}): per pixel, the
 // prefiltered estimate of in-scattered light (Klehm et al. 2014, Sec. 3, Listing 4: one dot
 // product of the pixel's Fourier coefficients with the filtered bases per region) and a ray
 // march against the standard shadow map for pixels near the epipole or the anti-epipole,
 // where the rectification degenerates (Sec. 5, Fig. 8).
+{%- endif %}
 //
 // Weighted visibility: L = sum_j U_j Vbar_j over the regions the ray crosses, U_j the
 // pixel's own unshadowed integral over its part of the ray inside region j (closed form
-// for the sun, Gauss-Legendre for a spot) and Vbar_j = clamp(0.5 + a(d) . F_j, 0, 1) the
-// region's prefiltered visibility. Average visibility combines the regions the same way; it
+// for the sun, Gauss-Legendre for a spot) and Vbar_j the region's prefiltered visibility
+// ({% if moments %}from its moments at z = 2 d - 1{% else %}clamp(0.5 + a(d) . F_j, 0, 1){% endif %}). Average visibility combines the regions the same way; it
 // differs in the prefilter, which weights texels by their length along the reference ray
 // instead of its transmittance (with one region: the paper's L_unshadowed * Vbar). Weighting
 // the regions by length instead (L_unshadowed * sum_j len_j Vbar_j / s) was 51 % off on
@@ -16,7 +25,9 @@
 // Where the ray's depth d is at most the least depth of region j's texels that the fetch
 // reads (prefilter's `bounds`), the region is wholly lit and Vbar_j = 1 exactly; above the
 // greatest, wholly shadowed and Vbar_j = 0: the Fourier series rings only where the answer
-// is ambiguous, and no light leaks where no light ray reaches.
+// is ambiguous, and no light leaks where no light ray reaches.{% if moments %} (The moment reconstruction
+// is also exact outside the depths' range up to the moment bias; the bounds make it exact
+// and skip the solve.){% endif %}
 //
 // Bindings (group 0):
 // | binding | name             | type                                     | access             |
@@ -46,9 +57,14 @@
 //
 // Mirrors reference/src/kernels/scatter.rs
 
-#import scatter::model::{PI, phase_hg, transmittance_between, transmittance_integral}
+#import scatter::model::{ {%- if !moments %}PI, {% endif %}phase_hg, transmittance_between, transmittance_integral}
 #import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, slice_params, spot_segment}
+{%- if moments %}
+#import scatter::prefiltered::region_start
+#import scatter::moments::{lit_moments{{ moment_count }}, moment_z}
+{%- else %}
 #import scatter::prefiltered::{coeff4, fourier_step, region_start, turn}
+{%- endif %}
 {%- if projective %}
 #import scatter::projective::{proj_boundary, proj_ray_depth, proj_reach}
 #import scatter::prefiltered_projective::proj_column
@@ -64,8 +80,10 @@
 
 // Independent prefix regions per rectified row.
 const REGIONS: u32 = {{ regions }}u;
+{%- if !moments %}
 // rgba layers of `filtered` (bases / 4).
 const LAYERS: u32 = {{ layers }}u;
+{%- endif %}
 
 // The kernel body for pixel `id`; stores the pixel's in-scattered radiance.
 @compute @workgroup_size(8, 8, 1)
@@ -164,6 +182,10 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     // whole ray's (dividing the panels among the regions cost 2.5 % rel L1 on a thick-fog
     // grazing spot, spot_grate/grazing/thick).
     let panels = max(f.sizes2_[2] / 4u, 1u);
+{%- if moments %}
+    // The ray's depth in the moments' coordinate.
+    let zf = moment_z(d);
+{%- else %}
     // The ray's Fourier coefficients depend on its depth only: once per pixel, not per
     // region, their angles c_k d by angle addition from pi d (two transcendentals per pixel).
     var coeffs: array<vec4<f32>, LAYERS>;
@@ -174,6 +196,7 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         coeffs[layer] = coeff4(angle, second, layer);
         angle = turn(second, step);
     }
+{%- endif %}
     // The sun's scattering coefficient times phase, the same for every region.
     let sun_scatter = f.medium[1] * phase_hg(f.medium[2], cos_theta_l);
 
@@ -229,6 +252,21 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         } else if d > hi {
             vis = 0.0;
         } else {
+{%- if moments %}
+            // The region's moments, filtered bilinearly (a mix of moments is the moments of
+            // the mixed depths: still a valid moment vector).
+            let top0 = mix(textureLoad(filtered, vec2<u32>(x0, row0), 0, 0), textureLoad(filtered, vec2<u32>(x1, row0), 0, 0), fx);
+            let bottom0 = mix(textureLoad(filtered, vec2<u32>(x0, row1), 0, 0), textureLoad(filtered, vec2<u32>(x1, row1), 0, 0), fx);
+            let m0 = mix(top0, bottom0, fy);
+{%- if moment_count == 6 %}
+            let top1 = mix(textureLoad(filtered, vec2<u32>(x0, row0), 1, 0), textureLoad(filtered, vec2<u32>(x1, row0), 1, 0), fx);
+            let bottom1 = mix(textureLoad(filtered, vec2<u32>(x0, row1), 1, 0), textureLoad(filtered, vec2<u32>(x1, row1), 1, 0), fx);
+            let m1 = mix(top1, bottom1, fy);
+            vis = lit_moments6(m0, m1.xy, zf);
+{%- else %}
+            vis = lit_moments4(m0, zf);
+{%- endif %}
+{%- else %}
             for (var layer = 0u; layer < LAYERS; layer++) {
                 let coeff = coeffs[layer];
                 let top = mix(textureLoad(filtered, vec2<u32>(x0, row0), layer, 0), textureLoad(filtered, vec2<u32>(x1, row0), layer, 0), fx);
@@ -238,6 +276,7 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
                     vis += coeff[k] * (texel[k] * 2.0 - 1.0);
                 }
             }
+{%- endif %}
         }
         total += weight * clamp(vis, 0.0, 1.0);
         if is_last {

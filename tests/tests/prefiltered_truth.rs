@@ -484,3 +484,103 @@ fn projective_rectification_on_every_pose() {
     println!("{projective_frames} projective frames of 24 poses");
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// Poses where the moment basis with 6 moments and 8 regions misses the issue's bar
+/// (3 % sun, 5 % spot): (scene/pose, measured rel L1 in %, asserted bound in %, source).
+const MOMENT_EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
+    (
+        "window/ordinary",
+        8.05,
+        8.9,
+        "the reconstruction: 6 moments resolve the room's depths too coarsely where a ray's \
+         depth lies inside a region's depth range (Fourier m32-r8: 2.47 %); the bounds' \
+         midpoint is the best split measured (lower bound 20.9 %, upper 24.3 %)",
+    ),
+    (
+        "window/epipole_on_screen",
+        6.20,
+        6.9,
+        "the reconstruction, as window/ordinary (Fourier m32-r8: 2.51 %)",
+    ),
+    (
+        "window/grazing",
+        4.21,
+        4.7,
+        "the reconstruction, as window/ordinary",
+    ),
+];
+
+/// The moment basis (Peters et al. 2016, `basis = moments`, rgba32float, weighted) on every
+/// suite pose: 4 and 6 moments with 3 and 8 regions, printed beside the default Fourier
+/// variant. Asserted: 6 moments with 8 regions meet the issue's bars (3 % sun, 5 % spot)
+/// except on the poses in [`MOMENT_EXCEPTIONS`]; 6 moments beat 4 on the mean over the poses
+/// at both region counts; no NaN/Inf (in [`run`]).
+#[test]
+fn moment_basis_on_every_pose() {
+    let configs = [(4, 3), (6, 3), (4, 8), (6, 8)];
+    let mut sums = [0.0f64; 4];
+    let mut failures = Vec::new();
+    let mut met = 0;
+    for (name, pose) in all_poses() {
+        let f = fixture(name, pose, MediumPreset::Default);
+        let light = light_of(name);
+        let bar = if light == LightKind::Spot { 5.0 } else { 3.0 };
+        let fourier = 100.0
+            * error(
+                &f,
+                &PrefilteredVariant {
+                    light,
+                    ..PrefilteredVariant::default()
+                },
+            );
+        let mut line = format!("{name}/{pose}: fourier m32-r3 {fourier:.3} %");
+        let mut last = 0.0;
+        for (i, (moments, regions)) in configs.into_iter().enumerate() {
+            let variant = PrefilteredVariant {
+                light,
+                regions,
+                ..PrefilteredVariant::with_moments(moments)
+            };
+            let e = 100.0 * error(&f, &variant);
+            sums[i] += e;
+            line += &format!(", moments{moments}-r{regions} {e:.3} %");
+            last = e;
+        }
+        let key = format!("{name}/{pose}");
+        match MOMENT_EXCEPTIONS.iter().find(|x| x.0 == key) {
+            Some(&(_, measured, bound, source)) => {
+                line += &format!(
+                    " (bar {bar} % missed: {source}; measured {measured} %, bound {bound} %)"
+                );
+                assert!(
+                    last > bar,
+                    "{key} now meets the {bar} % bar with moments6-r8 ({last:.3} %): remove it from MOMENT_EXCEPTIONS"
+                );
+                if last > bound {
+                    failures.push(format!("moments6-r8 {key}: {last:.3} % > {bound} %"));
+                }
+            }
+            None => {
+                met += 1;
+                if last > bar {
+                    failures.push(format!("moments6-r8 {key}: {last:.3} % > {bar} %"));
+                }
+            }
+        }
+        println!("{line}");
+    }
+    let means = sums.map(|s| s / 24.0);
+    println!(
+        "means over the 24 poses: moments4-r3 {:.3} %, moments6-r3 {:.3} %, moments4-r8 {:.3} %, moments6-r8 {:.3} %; moments6-r8 meets the bar on {met} of 24 poses",
+        means[0], means[1], means[2], means[3]
+    );
+    assert!(
+        means[1] < means[0],
+        "6 moments not better than 4 at 3 regions: {means:?}"
+    );
+    assert!(
+        means[3] < means[2],
+        "6 moments not better than 4 at 8 regions: {means:?}"
+    );
+    assert!(failures.is_empty(), "{failures:#?}");
+}

@@ -3,7 +3,7 @@
 //! runtime builds and dispatches from).
 
 use scatter_shaderlib::prefiltered::{
-    LightKind, PrefilteredVariant, Rectification, Storage, VariantError, VisibilityMode,
+    Basis, LightKind, PrefilteredVariant, Rectification, Storage, VariantError, VisibilityMode,
 };
 
 use super::{KnobInfo, KnobType};
@@ -15,6 +15,8 @@ const BASES_ALLOWED: &str = "a multiple of 4 in 4..=128";
 const BASES_PER_THREAD_ALLOWED: &str = "a multiple of 4 that divides bases";
 /// Allowed `regions`.
 const REGIONS_ALLOWED: &str = "in 1..=8";
+/// Allowed `moments`.
+const MOMENTS_ALLOWED: &str = "4 or 6";
 
 fn enum_allowed(allowed: &str) -> String {
     allowed.trim_end().replace(' ', " | ")
@@ -25,9 +27,18 @@ pub fn knobs() -> Vec<KnobInfo> {
     let d = PrefilteredVariant::default();
     vec![
         KnobInfo {
+            name: "basis",
+            value_name: "BASIS",
+            help: "what the prefilter stores of the rectified depth: Fourier bases (the paper) \
+                   or power moments (Peters et al. 2016; storage defaults to rgba32float)",
+            allowed: enum_allowed(Basis::ALLOWED),
+            default: d.basis.to_string(),
+            value_type: KnobType::Name,
+        },
+        KnobInfo {
             name: "bases",
             value_name: "N",
-            help: "Fourier bases M (M/2 frequencies, sine and cosine)",
+            help: "Fourier bases M (M/2 frequencies, sine and cosine); basis = fourier only",
             allowed: BASES_ALLOWED.into(),
             default: d.bases.to_string(),
             value_type: KnobType::Integer,
@@ -39,6 +50,15 @@ pub fn knobs() -> Vec<KnobInfo> {
                    bases / bases_per_thread)",
             allowed: BASES_PER_THREAD_ALLOWED.into(),
             default: d.bases_per_thread.to_string(),
+            value_type: KnobType::Integer,
+        },
+        KnobInfo {
+            name: "moments",
+            value_name: "N",
+            help: "power moments of the moment basis (4: Hamburger 4MSM, 6: a cubic); \
+                   basis = moments only",
+            allowed: MOMENTS_ALLOWED.into(),
+            default: d.moments.to_string(),
             value_type: KnobType::Integer,
         },
         KnobInfo {
@@ -93,15 +113,20 @@ fn number(knob: &'static str, allowed: &str, value: &str) -> Result<u32, Variant
     })
 }
 
-/// Parses `(knob, value)` pairs over the default variant and validates the result.
+/// Parses `(knob, value)` pairs over the default variant and validates the result. With
+/// `basis = moments` and no `storage` given, the storage is rgba32float (the only one the
+/// moment basis allows).
 ///
 /// # Errors
 ///
 /// [`GenError::Knob`]: the variant's own message naming the knob, the value and the range.
 pub fn parse(knobs: &[(String, String)]) -> Result<PrefilteredVariant, GenError> {
     let mut v = PrefilteredVariant::default();
+    let mut storage_given = false;
     for (name, value) in knobs {
         match name.as_str() {
+            "basis" => v.basis = value.parse()?,
+            "moments" => v.moments = number("moments", MOMENTS_ALLOWED, value)?,
             "bases" => v.bases = number("bases", BASES_ALLOWED, value)?,
             "bases_per_thread" => {
                 v.bases_per_thread = number("bases_per_thread", BASES_PER_THREAD_ALLOWED, value)?;
@@ -109,7 +134,10 @@ pub fn parse(knobs: &[(String, String)]) -> Result<PrefilteredVariant, GenError>
             "regions" => v.regions = number("regions", REGIONS_ALLOWED, value)?,
             "visibility" => v.visibility = value.parse()?,
             "light" => v.light = value.parse()?,
-            "storage" => v.storage = value.parse()?,
+            "storage" => {
+                v.storage = value.parse()?;
+                storage_given = true;
+            }
             "rectification" => v.rectification = value.parse()?,
             other => {
                 return Err(GenError::Usage(format!(
@@ -118,6 +146,9 @@ pub fn parse(knobs: &[(String, String)]) -> Result<PrefilteredVariant, GenError>
                 )));
             }
         }
+    }
+    if v.basis == Basis::Moments && !storage_given {
+        v.storage = Storage::Rgba32float;
     }
     v.validate()?;
     Ok(v)

@@ -6,6 +6,7 @@
 pub mod common_epipolar;
 pub mod common_minmax;
 pub mod common_model;
+pub mod common_moments;
 pub mod common_prefiltered;
 pub mod common_prefiltered_projective;
 pub mod common_projective;

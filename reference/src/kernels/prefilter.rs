@@ -1,6 +1,7 @@
-//! CPU mirror of `shaderlib/templates/prefilter.wgsl`: the Fourier basis transform fused with
-//! the weighted running mean along each rectified row (Klehm et al. 2014 Listings 1-3,
-//! Table 1's regions and bases per thread).
+//! CPU mirror of `shaderlib/templates/prefilter.wgsl`: the Fourier basis transform (or the
+//! power moments of the depth, `basis = moments`: one thread per row-region, stored as they
+//! are) fused with the weighted running mean along each rectified row (Klehm et al. 2014
+//! Listings 1-3, Table 1's regions and bases per thread).
 //!
 //! One invocation per (row, region, thread): thread `t` of a row-region filters the
 //! `bases_per_thread` bases of layers `t * bpt / 4 ..`. Each region restarts the running mean.
@@ -13,12 +14,13 @@
 
 use super::common_model::PI;
 use super::common_model::select;
+use super::common_moments::{moment_layer, moment_z};
 use super::common_prefiltered::{basis4, fourier_step, region_start, texel_weight, turn};
 use super::common_prefiltered_projective::proj_texel_weight;
 use super::common_projective::proj_stored_depth;
 use super::texture::{Tex, TexArray};
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
+    Basis, FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
     VisibilityMode,
 };
 
@@ -44,7 +46,8 @@ pub fn prefilter_main(
     let weighted = variant.visibility == VisibilityMode::Weighted;
     let spot = variant.light == LightKind::Spot;
     let proj = variant.rectification == Rectification::Projective && frame.proj[0] > 0.5;
-    let layers_per_thread = variant.bases_per_thread / 4;
+    let moments = variant.basis == Basis::Moments;
+    let layers_per_thread = variant.per_thread().div_ceil(4);
     let slice = slices[row as usize];
     let start = region_start(region, variant.regions, width, spot);
     let end = region_start(region + 1, variant.regions, width, spot);
@@ -68,6 +71,19 @@ pub fn prefilter_main(
             bounds.store(i, row, 0, [lo, hi, 0.0, 0.0], Storage::Rgba32float);
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);
+        if moments {
+            // The power moments of z, stored as they are.
+            let z = moment_z(d);
+            for q in 0..layers_per_thread {
+                let b = moment_layer(z, q);
+                let a = &mut acc[q as usize];
+                for c in 0..4 {
+                    a[c] = a[c] * (1.0 - blend) + b[c] * blend;
+                }
+                filtered.store(i, row, q, *a, variant.storage);
+            }
+            continue;
+        }
         // The basis angles by angle addition (see the WGSL).
         let mut angle = [(PI * d).sin(), (PI * d).cos()];
         let step = fourier_step(angle);

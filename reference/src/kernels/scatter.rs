@@ -19,13 +19,14 @@ use super::common_epipolar::{
     epipole_march, normalised_depth, pixel_dir, ray_t, row_index, spot_segment,
 };
 use super::common_model::{PI, clamp, max, max_u, min, mix, phase_hg, transmittance_between};
+use super::common_moments::{lit_moments4, lit_moments6, moment_z};
 use super::common_prefiltered::{coeff4, fourier_step, region_start, turn};
 use super::common_prefiltered_projective::proj_column;
 use super::common_projective::{proj_boundary, proj_ray_depth, proj_reach};
 use super::texture::{Tex, TexArray, mix4, quantise, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
+    Basis, FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
 };
 
 /// The bindings of `scatter`.
@@ -151,13 +152,18 @@ pub fn scatter_main(
     let panels = max_u(f.sizes2[2] / 4, 1);
     // The ray's Fourier coefficients depend on its depth only: once per pixel, their angles
     // by angle addition from pi d.
+    // (The moment basis: the ray's depth in the moments' coordinate instead.)
+    let moments = variant.basis == Basis::Moments;
+    let zf = moment_z(d);
     let mut coeffs = Vec::with_capacity(variant.layers() as usize);
-    let mut angle = [(PI * d).sin(), (PI * d).cos()];
-    let step = fourier_step(angle);
-    for layer in 0..variant.layers() {
-        let second = turn(angle, step);
-        coeffs.push(coeff4(angle, second, layer));
-        angle = turn(second, step);
+    if !moments {
+        let mut angle = [(PI * d).sin(), (PI * d).cos()];
+        let step = fourier_step(angle);
+        for layer in 0..variant.layers() {
+            let second = turn(angle, step);
+            coeffs.push(coeff4(angle, second, layer));
+            angle = turn(second, step);
+        }
     }
     // The sun's scattering coefficient times phase, the same for every region.
     let sun_scatter = f.medium[1] * phase_hg(f.medium[2], cos_theta_l);
@@ -224,6 +230,21 @@ pub fn scatter_main(
             vis = 1.0;
         } else if d > hi {
             vis = 0.0;
+        } else if moments {
+            // The region's moments, filtered bilinearly.
+            let fetch = |layer: u32| {
+                let load = |x: u32, y: u32| inp.filtered.load(x, y, layer);
+                let top = mix4(load(x0, row0), load(x1, row0), fx);
+                let bottom = mix4(load(x0, row1), load(x1, row1), fx);
+                mix4(top, bottom, fy)
+            };
+            let m0 = fetch(0);
+            if variant.moments == 6 {
+                let m1 = fetch(1);
+                vis = lit_moments6(m0, [m1[0], m1[1]], zf);
+            } else {
+                vis = lit_moments4(m0, zf);
+            }
         } else {
             for layer in 0..variant.layers() {
                 let coeff = coeffs[layer as usize];

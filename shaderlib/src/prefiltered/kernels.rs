@@ -9,7 +9,7 @@
 
 use askama::Template;
 
-use super::variant::{LightKind, PrefilteredVariant, Rectification, VisibilityMode};
+use super::variant::{Basis, LightKind, PrefilteredVariant, Rectification, VisibilityMode};
 use crate::compose::template_path;
 use crate::{Kernel, ShaderError};
 
@@ -48,7 +48,8 @@ struct RectifyTemplate {
     spot: bool,
 }
 
-/// `prefilter`: Fourier basis transform and weighted running mean per row and region.
+/// `prefilter`: basis transform (Fourier or power moments) and weighted running mean per row
+/// and region.
 #[derive(Template)]
 #[template(path = "prefilter.wgsl")]
 struct PrefilterTemplate {
@@ -65,6 +66,8 @@ struct PrefilterTemplate {
     regions: u32,
     rectification_name: &'static str,
     projective: bool,
+    moments: bool,
+    moment_count: u32,
 }
 
 /// `scatter`: per-pixel prefiltered estimate plus the epipole ray march.
@@ -79,6 +82,8 @@ struct ScatterTemplate {
     regions: u32,
     rectification_name: &'static str,
     projective: bool,
+    moments: bool,
+    moment_count: u32,
 }
 
 /// Checks `variant` on behalf of `kernel`.
@@ -137,12 +142,14 @@ pub(crate) fn render_prefilter(variant: &PrefilteredVariant) -> Result<String, S
         weighted: variant.visibility == VisibilityMode::Weighted,
         bases: variant.bases,
         layers: variant.layers(),
-        bases_per_thread: variant.bases_per_thread,
-        layers_per_thread: variant.bases_per_thread / 4,
+        bases_per_thread: variant.per_thread(),
+        layers_per_thread: variant.per_thread().div_ceil(4),
         threads_per_row_region: variant.threads_per_row_region(),
         regions: variant.regions,
         rectification_name: variant.rectification.name(),
         projective: variant.rectification == Rectification::Projective,
+        moments: variant.basis == Basis::Moments,
+        moment_count: variant.moments,
     }
     .render()
     .map_err(render_error(Kernel::Prefilter))
@@ -161,6 +168,8 @@ pub(crate) fn render_scatter(variant: &PrefilteredVariant) -> Result<String, Sha
         regions: variant.regions,
         rectification_name: variant.rectification.name(),
         projective: variant.rectification == Rectification::Projective,
+        moments: variant.basis == Basis::Moments,
+        moment_count: variant.moments,
     }
     .render()
     .map_err(render_error(Kernel::Scatter))

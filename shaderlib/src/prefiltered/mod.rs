@@ -18,7 +18,7 @@ pub use kernels::{
     SCATTER_WORKGROUP_SIZE, SLICE_FIT_WORKGROUP_SIZE,
 };
 pub use variant::{
-    LightKind, PrefilteredVariant, Rectification, Storage, VariantError, VisibilityMode,
+    Basis, LightKind, PrefilteredVariant, Rectification, Storage, VariantError, VisibilityMode,
 };
 
 impl crate::KernelParams {

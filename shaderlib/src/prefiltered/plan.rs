@@ -8,7 +8,7 @@ use crate::plan::{
     depth_and_shadow_map, frame_buffer, scatter_resource, scatter_texture,
     screen_and_shadow_parameters, texture_2d,
 };
-use crate::prefiltered::{PrefilteredVariant, Rectification};
+use crate::prefiltered::{Basis, PrefilteredVariant, Rectification};
 use crate::{Kernel, KernelParams};
 
 /// The per-frame condition of a projective frame (the frame set-up falls back to epipolar
@@ -79,11 +79,7 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
                 &v.layers().to_string(),
                 STORAGE_AND_SAMPLED,
             )),
-            ..scatter_resource(
-                "filtered",
-                "filtered Fourier bases, four per layer, stored as F / 2 + 0.5 (written by \
-                 prefilter); view it as a 2d array even with one layer",
-            )
+            ..scatter_resource("filtered", filtered_description(v))
         },
         scatter_texture(
             "bounds",
@@ -153,6 +149,24 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
         resources,
         passes,
         notes,
+    }
+}
+
+/// What the `filtered` texture holds for the variant's basis.
+fn filtered_description(v: &PrefilteredVariant) -> &'static str {
+    match (v.basis, v.moments) {
+        (Basis::Fourier, _) => {
+            "filtered Fourier bases, four per layer, stored as F / 2 + 0.5 (written by \
+             prefilter); view it as a 2d array even with one layer"
+        }
+        (Basis::Moments, 6) => {
+            "filtered power moments of z = 2 d - 1, (z, z^2, z^3, z^4) in layer 0 and \
+             (z^5, z^6, 0, 0) in layer 1, stored as they are (written by prefilter)"
+        }
+        (Basis::Moments, _) => {
+            "filtered power moments of z = 2 d - 1, (z, z^2, z^3, z^4), stored as they are \
+             (written by prefilter); view it as a 2d array even with one layer"
+        }
     }
 }
 
