@@ -30,7 +30,7 @@ use scatter_runtime::shaderlib::Kernel;
 use scatter_runtime::shaderlib::family::{Family, FamilyVariant, KernelFamily};
 use scatter_runtime::shaderlib::minmax::MinmaxVariant;
 use scatter_runtime::shaderlib::prefiltered::{
-    FrameSettings, LightKind, PrefilteredVariant, Resolutions, Storage,
+    Basis, FrameSettings, LightKind, PrefilteredVariant, Resolutions, Storage,
 };
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
@@ -1338,8 +1338,9 @@ pub fn write_outputs(
     Ok(written)
 }
 
-/// The `tune` first-stage grid: prefiltered (M, R) over {16, 32, 64} x {1, 3, 8} with a
-/// 512x512 and a 256x256 rectified map (the paper's 8 bases per thread, rgba8unorm),
+/// The `tune` first-stage grid: prefiltered (M, R) over {16, 32, 64} x {1, 3, 8} (the
+/// paper's 8 bases per thread, rgba8unorm) and the moment basis with 4 or 6 moments and 3 or
+/// 8 regions, each with a 512x512 and a 256x256 rectified map,
 /// raymarch N over {16, 32, 64, 128, 256, 512} plus interleaved (64, 4x4) and (256, 4x4),
 /// minmax with both maps. Run it with `BenchConfig::rectified` = 512x512.
 pub fn tune_candidates() -> Vec<Method> {
@@ -1352,6 +1353,17 @@ pub fn tune_candidates() -> Vec<Method> {
                         bases,
                         regions,
                         ..PrefilteredVariant::default()
+                    },
+                    rectified,
+                ));
+            }
+        }
+        for moments in PrefilteredVariant::MOMENTS {
+            for regions in [3, 8] {
+                out.push(Method::new(
+                    PrefilteredVariant {
+                        regions,
+                        ..PrefilteredVariant::with_moments(moments)
                     },
                     rectified,
                 ));
@@ -1431,7 +1443,9 @@ pub fn tune_refinements(table: &[TuneEntry], run: [u32; 2]) -> Vec<Method> {
     for e in front {
         let m = e.method;
         // The knobs only the prefiltered family has.
-        if let FamilyVariant::Prefiltered(v) = m.variant {
+        if let FamilyVariant::Prefiltered(v) = m.variant
+            && v.basis == Basis::Fourier
+        {
             for bpt in (4..=v.bases).step_by(4) {
                 if bpt != v.bases_per_thread && v.bases.is_multiple_of(bpt) {
                     push(Method::new(
@@ -1616,7 +1630,7 @@ mod tests {
         assert_eq!(tune_pick(&table, 0.001), None);
         assert_eq!(
             scatter_gen_command(&table[2].method, [512, 512]),
-            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 8 --light spot --rectification epipolar --regions 3 --storage rgba8unorm --visibility weighted --out shaders/  # runtime: rectified map 256x256"
+            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 8 --basis fourier --light spot --moments 4 --rectification epipolar --regions 3 --storage rgba8unorm --visibility weighted --out shaders/  # runtime: rectified map 256x256"
         );
         assert_eq!(
             scatter_gen_command(&table[1].method, [512, 512]),

@@ -267,7 +267,8 @@ mod tests {
             assert_eq!(family.default_variant().family(), family);
             assert!(family.default_variant().validate().is_ok());
         }
-        assert_eq!(Family::Prefiltered.grid().len(), 2016);
+        // 2016 Fourier variants and 64 of the moment basis.
+        assert_eq!(Family::Prefiltered.grid().len(), 2016 + 64);
     }
 
     #[test]

@@ -196,8 +196,18 @@ mod tests {
             "variant 2: bases must be a multiple of 4 in 4..=128, got 30"
         );
         let e = parse("[[variant]]\nbasis = 32\n").unwrap_err();
+        assert_eq!(
+            e,
+            "variant 1: basis must be a string (fourier | moments), got 32"
+        );
+        let e = parse("[[variant]]\nbasse = 32\n").unwrap_err();
         assert!(
-            e.starts_with("variant 1: knob `basis` does not apply"),
+            e.starts_with("variant 1: knob `basse` does not apply"),
+            "{e}"
+        );
+        let e = parse("[[variant]]\nbasis = \"moments\"\nbases = 16\n").unwrap_err();
+        assert!(
+            e.starts_with("variant 1: bases must be 32 (a Fourier knob"),
             "{e}"
         );
         let e = parse("[[variant]]\nbases = [32]\n").unwrap_err();

@@ -496,6 +496,8 @@ enum Fault {
 /// A valid knob value for `family`'s knob `name`, as TOML source.
 fn valid_value(name: &str, pick: usize) -> String {
     let options: &[&str] = match name {
+        "basis" => &["\"fourier\""],
+        "moments" => &["4"],
         "bases" => &["32"],
         "bases_per_thread" => &["4", "8"],
         "regions" => &["1", "2", "3", "8"],
@@ -514,6 +516,8 @@ fn valid_value(name: &str, pick: usize) -> String {
 /// A bad value for knob `name`, as TOML source.
 fn bad_value(name: &str, pick: usize) -> String {
     let options: &[&str] = match name {
+        "basis" => &["\"moment\"", "\"Fourier\"", "1"],
+        "moments" => &["5", "0", "8", "\"six\""],
         "bases" => &["30", "132", "0", "-4", "\"abc\"", "4294967296", "\"\""],
         "bases_per_thread" => &["3", "0", "12", "256", "\"x\""],
         "regions" => &["0", "9", "-1", "\"three\"", "1.5"],

@@ -1,6 +1,7 @@
-//! Golden files: the complete output for three canonical variants (the paper's default, a
-//! small spot-light variant with average visibility and rgba16float, an interleaved
-//! raymarch variant and the spot-light minmax variant) in every target, kept
+//! Golden files: the complete output for the canonical variants (the paper's default, a
+//! small spot-light variant with average visibility and rgba16float, the moment basis with
+//! 6 moments, an interleaved raymarch variant and the spot-light minmax variant) in every
+//! target, kept
 //! as reviewable text in `tests/golden/` (SPIR-V as `spirv-dis` text; its exact bytes are
 //! pinned by the sha256 in the golden `manifest.json`). Any change to a template, to naga or
 //! to the generator shows up here as a diff.
@@ -30,6 +31,12 @@ fn canonical() -> Generated {
             ("storage".into(), "rgba16float".into()),
         ])
         .unwrap_or_else(|e| panic!("{e}"));
+    let moments = Family::Prefiltered
+        .variant(&[
+            ("basis".into(), "moments".into()),
+            ("moments".into(), "6".into()),
+        ])
+        .unwrap_or_else(|e| panic!("{e}"));
     let march = Family::Raymarch
         .variant(&[
             ("samples".into(), "64".into()),
@@ -41,7 +48,13 @@ fn canonical() -> Generated {
         .variant(&[("light".into(), "spot".into())])
         .unwrap_or_else(|e| panic!("{e}"));
     generate(&Request {
-        variants: vec![Family::Prefiltered.default_variant(), spot, march, minmax],
+        variants: vec![
+            Family::Prefiltered.default_variant(),
+            spot,
+            moments,
+            march,
+            minmax,
+        ],
         targets: Target::ALL.to_vec(),
     })
     .unwrap_or_else(|e| panic!("{e}"))

@@ -17,6 +17,13 @@
 //! - raymarch converges: N = 256 beats N = 16 on every case, and is within 2 % on every
 //!   case of at least 1000 pixels;
 //! - minmax within 5 % on every case;
+//! - the moment basis (4 moments with 3 regions, 6 with 8; issue 13) within the same 5 % on
+//!   every stress pose, 4 moments excepted on two poses (`MOMENTS4_EXCEPTIONS`). The cases
+//!   where moments are known to fail (Peters et al.): light leaking where a region's depths
+//!   span a large range (`closed_room`: exactly 0 through the depth bounds;
+//!   `closed_room_windows`: walls, ceiling and lit floor in one region; `sky`,
+//!   `sky_infinite`: depths at the far plane) and precision loss (`rectified_4096`: the
+//!   longest f32 running mean; `sigma_t_1e-6`: radiance among f16's subnormals);
 //! - prefiltered with average visibility (3 regions): finite and exact zeros only (it is
 //!   11-28 % off on `closed_room_windows` and the spot poses; its accuracy bars, at 8
 //!   regions, are in `prefiltered_truth`);
@@ -40,8 +47,8 @@ use scatter_runtime::{Context, FrameInput};
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::prefiltered::{
-    FrameReport, FrameSettings, LightKind, PrefilteredVariant, ProjectiveFallback, Rectification,
-    Resolutions, Storage, VisibilityMode,
+    Basis, FrameReport, FrameSettings, LightKind, PrefilteredVariant, ProjectiveFallback,
+    Rectification, Resolutions, Storage, VisibilityMode,
 };
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -71,6 +78,26 @@ const PROJECTIVE_EXCEPTIONS: &[(&str, f64, &str)] = &[(
      within 2 m (the column cut by the near plane) carry 5.5 of the 7.4 %",
 )];
 
+/// Stress poses where the moment basis with 4 moments and 3 regions misses the prefiltered
+/// bar: (case, measured rel L1 plus about 10 %, why). 6 moments with 8 regions meet the bar
+/// on every case (0.80 % on closed_room_windows, 2.12 % on epipole_corner).
+const MOMENTS4_EXCEPTIONS: &[(&str, f64, &str)] = &[
+    (
+        "closed_room_windows",
+        0.158,
+        "14.3 %: a region's texels hold the room's walls, ceiling and the lit floor behind the \
+         windows, and a ray's depth falls inside that range; 4 moments put an atom of up to a \
+         third of the weight at the ray's depth, half of it counted wrong (6 moments, 8 \
+         regions: 0.80 %; the Fourier default 2.64 %)",
+    ),
+    (
+        "epipole_corner",
+        0.075,
+        "6.75 %: the epipole in a corner stretches the slices over the whole screen, so the \
+         3 regions span most of the scene's depths (6 moments, 8 regions: 2.12 %)",
+    ),
+];
+
 /// Dark cases (the truth exactly 0) where a variant's output is not exactly 0: (case, the
 /// prefiltered rectification, the greatest output asserted instead, why).
 const DARK_EXCEPTIONS: &[(&str, Rectification, f64, &str)] = &[(
@@ -86,8 +113,9 @@ const DARK_EXCEPTIONS: &[(&str, Rectification, f64, &str)] = &[(
 )];
 
 /// The variants run on every case (directional; each case sets the light, and the
-/// prefiltered bases where it stresses them): the prefiltered default, epipolar and
-/// projective, and with average visibility; raymarch N = 16, 64 and 256; minmax.
+/// prefiltered Fourier bases where it stresses them): the prefiltered default, epipolar and
+/// projective, and with average visibility; the moment basis with 4 moments (3 regions) and
+/// 6 (8 regions); raymarch N = 16, 64 and 256; minmax.
 fn methods() -> Vec<FamilyVariant> {
     let raymarch = |samples| {
         FamilyVariant::Raymarch(RaymarchVariant {
@@ -105,6 +133,12 @@ fn methods() -> Vec<FamilyVariant> {
         PrefilteredVariant {
             visibility: VisibilityMode::Average,
             ..PrefilteredVariant::default()
+        }
+        .into(),
+        PrefilteredVariant::with_moments(4).into(),
+        PrefilteredVariant {
+            regions: 8,
+            ..PrefilteredVariant::with_moments(6)
         }
         .into(),
         raymarch(16),
@@ -194,7 +228,9 @@ impl Prepared {
     /// prefiltered family.
     fn variant(&self, method: &FamilyVariant) -> FamilyVariant {
         let mut v = method.with_light(self.light());
-        if let (FamilyVariant::Prefiltered(p), Some(bases)) = (&mut v, self.case.bases) {
+        if let (FamilyVariant::Prefiltered(p), Some(bases)) = (&mut v, self.case.bases)
+            && p.basis == Basis::Fourier
+        {
             p.bases = bases;
             p.bases_per_thread = bases.min(p.bases_per_thread);
         }
@@ -345,13 +381,17 @@ fn every_family_survives_every_stress_case() {
             let exception = PROJECTIVE_EXCEPTIONS.iter().find(|e| {
                 e.0 == name && rectification(&c.method) == Some(Rectification::Projective)
             });
+            let moments4 = MOMENTS4_EXCEPTIONS.iter().find(|e| {
+                e.0 == name
+                    && matches!(c.method, FamilyVariant::Prefiltered(v) if v.basis == Basis::Moments && v.moments == 4)
+            });
             let bar = match c.method {
                 // Average visibility: finite and exact zeros only here (with 3 regions it is
                 // 11-28 % off on closed_room_windows and the spot poses); its bars are in
                 // prefiltered_truth (`average_visibility_on_every_pose`, 8 regions).
                 FamilyVariant::Prefiltered(v) if v.visibility == VisibilityMode::Average => None,
                 FamilyVariant::Prefiltered(_) if p.case.group == StressGroup::Pose => {
-                    Some(exception.map_or(PREFILTERED_POSE_BAR, |e| e.1))
+                    Some(exception.or(moments4).map_or(PREFILTERED_POSE_BAR, |e| e.1))
                 }
                 FamilyVariant::Raymarch(v)
                     if v.samples == 256 && pixels >= RAYMARCH_BAR_MIN_PIXELS =>
@@ -379,6 +419,16 @@ fn every_family_survives_every_stress_case() {
             {
                 failures.push(format!(
                     "{trial}: meets the {:.0} % bar now ({:.3} %): remove it from PROJECTIVE_EXCEPTIONS ({})",
+                    100.0 * PREFILTERED_POSE_BAR,
+                    100.0 * c.rel_l1,
+                    e.2
+                ));
+            }
+            if let Some(e) = moments4
+                && c.rel_l1 <= PREFILTERED_POSE_BAR
+            {
+                failures.push(format!(
+                    "{trial}: meets the {:.0} % bar now ({:.3} %): remove it from MOMENTS4_EXCEPTIONS ({})",
                     100.0 * PREFILTERED_POSE_BAR,
                     100.0 * c.rel_l1,
                     e.2

