@@ -8,6 +8,8 @@
 //! rectified map, a 256^2 shadow map:
 //! - the default variant on `columns/ordinary` (directional, epipolar);
 //! - a spot variant (rgba16float bases, 2 regions) on `spot_grate/ordinary`;
+//! - the moment basis (6 moments: two rgba32float layers) with a spot light on
+//!   `spot_grate/ordinary`;
 //! - a projective variant on `columns/ordinary`, a projective frame: `rectify` is skipped
 //!   (`skip_when`) and `prefilter` binds the engine's rasterised map (`alternative`), the
 //!   reference's stand-in for the rasteriser (`engine_rectified_map`), on both sides.
@@ -52,8 +54,8 @@ const SHADOW_MAP: u32 = 256;
 /// The bound: `max |foreign - runtime| <= REL_TOL * max radiance`.
 const REL_TOL: f32 = 1e-4;
 
-/// The three trial variants.
-fn variants() -> [PrefilteredVariant; 3] {
+/// The four trial variants.
+fn variants() -> [PrefilteredVariant; 4] {
     [
         PrefilteredVariant::default(),
         PrefilteredVariant {
@@ -67,6 +69,10 @@ fn variants() -> [PrefilteredVariant; 3] {
         PrefilteredVariant {
             rectification: Rectification::Projective,
             ..PrefilteredVariant::default()
+        },
+        PrefilteredVariant {
+            light: LightKind::Spot,
+            ..PrefilteredVariant::with_moments(6)
         },
     ]
 }
