@@ -24,6 +24,7 @@ use std::time::{Duration, Instant};
 use scatter_reference::suite::SceneName;
 use scatter_runtime::Context;
 use scatter_runtime::shaderlib::minmax::tree_width;
+use scatter_runtime::shaderlib::prefiltered::PrefilteredVariant;
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::wgpu;
 
@@ -454,6 +455,48 @@ pub fn kernel_costs() -> Vec<KernelCost> {
             trips: "regions x layers where ambiguous (none .. all)",
         },
         KernelCost {
+            method: "prefiltered moments4-r3",
+            kernel: "prefilter",
+            invocations: hr * regions,
+            // One thread per row and region. Per texel of its region: one load; sin(theta_ref)
+            // twice and two exp (the weight, as the Fourier prefilter); z and its powers and
+            // the blend of one rgba32float layer (about 12 FMAs) and the weight's arithmetic
+            // (10); stores of one rgba32float texel (16 bytes) and the bounds (8 bytes).
+            counts: [
+                region_texels * 24.0,
+                region_texels,
+                0.0,
+                region_texels * 4.0,
+                region_texels * 22.0,
+            ],
+            low: None,
+            trips: "Wr/regions texels x 1 layer",
+        },
+        KernelCost {
+            method: "prefiltered moments4-r3",
+            kernel: "scatter",
+            invocations: pixels,
+            // Scatter's set-up without the Fourier coefficients (acos, atan2, sin(theta) for
+            // x_s); per region 2 bounds loads, two ray_t and two exp; per ambiguous region 4
+            // loads of one layer, 3 rgba mixes, and the 4MSM solve: about 60 FMAs, a sqrt and
+            // 6 divisions (counted as 7 transcendentals).
+            counts: [
+                8.0,
+                1.0 + regions as f64 * (2.0 + 4.0),
+                0.0,
+                3.0 + regions as f64 * (4.0 + 7.0),
+                40.0 + regions as f64 * (30.0 + 12.0 + 60.0),
+            ],
+            low: Some([
+                8.0,
+                1.0 + regions as f64 * 2.0,
+                0.0,
+                3.0 + regions as f64 * 4.0,
+                40.0 + regions as f64 * 30.0,
+            ]),
+            trips: "regions, the solve where ambiguous (none .. all)",
+        },
+        KernelCost {
             method: "minmax",
             kernel: "minmax_build",
             invocations: u64::from(tree_width(RECTIFIED[0])) * hr,
@@ -558,18 +601,21 @@ pub fn roofline(
             interleave: 4,
             ..RaymarchVariant::default()
         }),
+        Method::from(PrefilteredVariant::with_moments(4)),
     ];
     let times = time_methods(ctx, &methods, SceneName::Sphere, SCREEN, RECTIFIED, frames)?;
     // (kernel, time): raymarch from the plain run, interleave_sum from the interleaved one.
-    let mut measured: Vec<(&'static str, Duration)> = Vec::new();
+    // The moment basis's prefilter and scatter (method 4) go to its own cost lines, keyed
+    // by the method; its shared first passes are the default's.
+    let mut measured: Vec<(bool, &'static str, Duration)> = Vec::new();
     for (i, passes) in times.into_iter().enumerate() {
         for (name, t) in passes {
             let keep = !matches!(
                 (i, name),
-                (3, "raymarch") | (1, "depth_columns" | "slice_fit" | "rectify")
+                (3, "raymarch") | (1 | 4, "depth_columns" | "slice_fit" | "rectify")
             );
             if keep {
-                measured.push((name, t));
+                measured.push((i == 4, name, t));
             }
         }
     }
@@ -586,10 +632,11 @@ pub fn roofline(
                 |counts: [f64; 5]| std::array::from_fn(|i| counts[i] * cost_of(OpKind::ALL[i]));
             let bound_ns = per_kind(cost.counts);
             let low_bound_ns = cost.low.map(per_kind);
+            let moments = cost.method.contains("moments");
             let measured_ns = measured
                 .iter()
-                .find(|(n, _)| *n == cost.kernel)
-                .map(|(_, t)| t.as_secs_f64() * 1e9 / cost.invocations as f64);
+                .find(|(m, n, _)| *m == moments && *n == cost.kernel)
+                .map(|(_, _, t)| t.as_secs_f64() * 1e9 / cost.invocations as f64);
             RooflineRow {
                 cost,
                 bound_ns,
