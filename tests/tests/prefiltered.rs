@@ -3,7 +3,10 @@
 //! (`reference/src/kernels/{rectify,prefilter,scatter}.rs`, driven by
 //! `scatter_reference::kernels::run_prefiltered`) for every variant of the design card:
 //! bases {4, 8, 16, 32, 64, 128} x every valid bases_per_thread x regions {1, 2, 3, 4} x
-//! visibility x light x storage x rectification. Directional variants run on
+//! visibility x light x storage x rectification, and the moment basis (4 or 6 moments,
+//! rgba32float) x regions x visibility x light x rectification (the moments are stored raw,
+//! within the float formats' `1e-3`; the output within `1e-3 * max radiance`, as the Fourier
+//! float variants, although the reconstruction is a solve). Directional variants run on
 //! `columns/ordinary`, spot variants on `spot_grate/ordinary`, 64x36 pixels, a 128^2 shadow
 //! map and a 64x64 rectified map. Trials are named
 //! `prefiltered::<variant id>::<scene>::<pose>`. Both poses are projective frames for the
@@ -25,7 +28,7 @@
 //!   `max |diff| / max radiance` without that allowance.
 //!
 //! Each variant is one libtest trial (`cargo test -p scatter-conformance --test prefiltered
-//! -- m32-t8-r3` runs those whose name contains the filter, `-- --list` lists the 2016);
+//! -- m32-t8-r3` runs those whose name contains the filter, `-- --list` lists the 2080);
 //! `prefiltered::errors::*` check the error paths.
 
 use std::process::ExitCode;
