@@ -499,6 +499,11 @@ float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float d_1)
     return ((2.0 * d_1) - 1.0);
 }
 
+float4 biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float4 raw, float a_5)
+{
+    return float4((raw.x * (1.0 - a_5)), ((raw.y * (1.0 - a_5)) + (a_5 / 3.0)), (raw.z * (1.0 - a_5)), ((raw.w * (1.0 - a_5)) + (a_5 / 5.0)));
+}
+
 float sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float x_3, float s_2)
 {
     return ((s_2 >= 0.0) ? x_3 : -(x_3));
@@ -530,11 +535,11 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
         const CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubicrootsx_naga_oil_mod_xonrwc5dumvzduotnn5wwk3tuomx = ConstructCubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float3((c1_ / _e24), (_e24 / c3_), 0.0), true);
         return cubicrootsx_naga_oil_mod_xonrwc5dumvzduotnn5wwk3tuomx;
     }
-    float a_5 = (c3_ / c4_);
+    float a_6 = (c3_ / c4_);
     float b_5 = (c2_ / c4_);
     float c = (c1_ / c4_);
-    float p_3 = min((b_5 - ((a_5 * a_5) / 3.0)), -1e-12);
-    float qq = ((((((2.0 * a_5) * a_5) * a_5) / 27.0) - ((a_5 * b_5) / 3.0)) + c);
+    float p_3 = min((b_5 - ((a_6 * a_6) / 3.0)), -1e-12);
+    float qq = ((((((2.0 * a_6) * a_6) * a_6) / 27.0) - ((a_6 * b_5) / 3.0)) + c);
     float m = (2.0 * sqrt((-(p_3) / 3.0)));
     float theta_3 = (acos(clamp(((3.0 * qq) / (p_3 * m)), -1.0, 1.0)) / 3.0);
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
@@ -554,7 +559,7 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
         }
         {
             uint _e72 = k_2;
-            z_1 = ((m * cos((theta_3 - ((6.2831855 * float(_e72)) / 3.0)))) - (a_5 / 3.0));
+            z_1 = ((m * cos((theta_3 - ((6.2831855 * float(_e72)) / 3.0)))) - (a_6 / 3.0));
             i = 0u;
             uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
             bool loop_init_4 = true;
@@ -629,10 +634,11 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float4 raw0_, floa
     float shadow = 0.0;
     bool local_10 = (bool)0;
 
-    float b1_1 = (raw0_.x * (1.0 - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
-    float b2_1 = ((raw0_.y * (1.0 - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX)) + (MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX / 3.0));
-    float b3_1 = (raw0_.z * (1.0 - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
-    float b4_ = ((raw0_.w * (1.0 - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX)) + (MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX / 5.0));
+    const float4 _e3 = biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_, MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX);
+    float b1_1 = _e3.x;
+    float b2_1 = _e3.y;
+    float b3_1 = _e3.z;
+    float b4_ = _e3.w;
     float b5_ = (raw1_.x * (1.0 - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
     float b6_ = ((raw1_.y * (1.0 - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX)) + (MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX / 7.0));
     float d2_1 = (b2_1 - (b1_1 * b1_1));
@@ -649,34 +655,34 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float4 raw0_, floa
     float c3_1 = ((y3_ / d3_) - (l43_ * c4_1));
     float c2_1 = (((y2_ / d2_1) - (l32_ * c3_1)) - (l42_ * c4_1));
     float c1_1 = (((1.0 - (b1_1 * c2_1)) - (b2_1 * c3_1)) - (b3_1 * c4_1));
-    const CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX _e105 = cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_1, c2_1, c3_1, c4_1);
-    float3 r_3 = _e105.r;
-    bool at_infinity_1 = _e105.at_infinity;
+    const CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX _e88 = cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_1, c2_1, c3_1, c4_1);
+    float3 r_3 = _e88.r;
+    bool at_infinity_1 = _e88.at_infinity;
     if ((r_3.x < zf)) {
-        float _e111 = shadow;
-        const float _e116 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.x, r_3.z, at_infinity_1);
-        const float _e117 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.x, zf, r_3.y, _e116);
-        shadow = (_e111 + _e117);
+        float _e94 = shadow;
+        const float _e99 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.x, r_3.z, at_infinity_1);
+        const float _e100 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.x, zf, r_3.y, _e99);
+        shadow = (_e94 + _e100);
     }
     if ((r_3.y < zf)) {
-        float _e121 = shadow;
-        const float _e126 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.y, r_3.z, at_infinity_1);
-        const float _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.y, zf, r_3.x, _e126);
-        shadow = (_e121 + _e127);
+        float _e104 = shadow;
+        const float _e109 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.y, r_3.z, at_infinity_1);
+        const float _e110 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.y, zf, r_3.x, _e109);
+        shadow = (_e104 + _e110);
     }
     if (!(at_infinity_1)) {
         local_10 = (r_3.z < zf);
     } else {
         local_10 = false;
     }
-    bool _e135 = local_10;
-    if (_e135) {
-        float _e136 = shadow;
-        const float _e144 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.z, zf, r_3.x, (1.0 / (r_3.z - r_3.y)));
-        shadow = (_e136 + _e144);
+    bool _e118 = local_10;
+    if (_e118) {
+        float _e119 = shadow;
+        const float _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.z, zf, r_3.x, (1.0 / (r_3.z - r_3.y)));
+        shadow = (_e119 + _e127);
     }
-    float _e146 = shadow;
-    return clamp(((1.0 - _e146) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0.0, 1.0);
+    float _e129 = shadow;
+    return clamp(((1.0 - _e129) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0.0, 1.0);
 }
 
 float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float phi)

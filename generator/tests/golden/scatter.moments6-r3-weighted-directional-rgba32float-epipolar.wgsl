@@ -415,6 +415,10 @@ fn moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_1: f32) -> f32 {
     return ((2f * d_1) - 1f);
 }
 
+fn biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw: vec4<f32>, a_5: f32) -> vec4<f32> {
+    return vec4<f32>((raw.x * (1f - a_5)), ((raw.y * (1f - a_5)) + (a_5 / 3f)), (raw.z * (1f - a_5)), ((raw.w * (1f - a_5)) + (a_5 / 5f)));
+}
+
 fn sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(x_3: f32, s_2: f32) -> f32 {
     return select(-(x_3), x_3, (s_2 >= 0f));
 }
@@ -435,11 +439,11 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
         let _e24 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX((-0.5f * (c2_ + _e20)));
         return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec3<f32>((c1_ / _e24), (_e24 / c3_), 0f), true);
     }
-    let a_5 = (c3_ / c4_);
+    let a_6 = (c3_ / c4_);
     let b_5 = (c2_ / c4_);
     let c = (c1_ / c4_);
-    let p_3 = min((b_5 - ((a_5 * a_5) / 3f)), -0.000000000001f);
-    let qq = ((((((2f * a_5) * a_5) * a_5) / 27f) - ((a_5 * b_5) / 3f)) + c);
+    let p_3 = min((b_5 - ((a_6 * a_6) / 3f)), -0.000000000001f);
+    let qq = ((((((2f * a_6) * a_6) * a_6) / 27f) - ((a_6 * b_5) / 3f)) + c);
     let m = (2f * sqrt((-(p_3) / 3f)));
     let theta_3 = (acos(clamp(((3f * qq) / (p_3 * m)), -1f, 1f)) / 3f);
     loop {
@@ -450,7 +454,7 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
         }
         {
             let _e72 = k_2;
-            z_1 = ((m * cos((theta_3 - ((6.2831855f * f32(_e72)) / 3f)))) - (a_5 / 3f));
+            z_1 = ((m * cos((theta_3 - ((6.2831855f * f32(_e72)) / 3f)))) - (a_6 / 3f));
             i = 0u;
             loop {
                 let _e86 = i;
@@ -520,10 +524,11 @@ fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw
     var shadow: f32 = 0f;
     var local_10: bool;
 
-    let b1_1 = (raw0_.x * (1f - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
-    let b2_1 = ((raw0_.y * (1f - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX)) + (MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX / 3f));
-    let b3_1 = (raw0_.z * (1f - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
-    let b4_ = ((raw0_.w * (1f - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX)) + (MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX / 5f));
+    let _e3 = biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_, MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX);
+    let b1_1 = _e3.x;
+    let b2_1 = _e3.y;
+    let b3_1 = _e3.z;
+    let b4_ = _e3.w;
     let b5_ = (raw1_.x * (1f - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
     let b6_ = ((raw1_.y * (1f - MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX)) + (MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX / 7f));
     let d2_1 = (b2_1 - (b1_1 * b1_1));
@@ -540,34 +545,34 @@ fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw
     let c3_1 = ((y3_ / d3_) - (l43_ * c4_1));
     let c2_1 = (((y2_ / d2_1) - (l32_ * c3_1)) - (l42_ * c4_1));
     let c1_1 = (((1f - (b1_1 * c2_1)) - (b2_1 * c3_1)) - (b3_1 * c4_1));
-    let _e105 = cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_1, c2_1, c3_1, c4_1);
-    let r_3 = _e105.r;
-    let at_infinity_1 = _e105.at_infinity;
+    let _e88 = cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_1, c2_1, c3_1, c4_1);
+    let r_3 = _e88.r;
+    let at_infinity_1 = _e88.at_infinity;
     if (r_3.x < zf) {
-        let _e111 = shadow;
-        let _e116 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.x, r_3.z, at_infinity_1);
-        let _e117 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.x, zf, r_3.y, _e116);
-        shadow = (_e111 + _e117);
+        let _e94 = shadow;
+        let _e99 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.x, r_3.z, at_infinity_1);
+        let _e100 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.x, zf, r_3.y, _e99);
+        shadow = (_e94 + _e100);
     }
     if (r_3.y < zf) {
-        let _e121 = shadow;
-        let _e126 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.y, r_3.z, at_infinity_1);
-        let _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.y, zf, r_3.x, _e126);
-        shadow = (_e121 + _e127);
+        let _e104 = shadow;
+        let _e109 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.y, r_3.z, at_infinity_1);
+        let _e110 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.y, zf, r_3.x, _e109);
+        shadow = (_e104 + _e110);
     }
     if !(at_infinity_1) {
         local_10 = (r_3.z < zf);
     } else {
         local_10 = false;
     }
-    let _e135 = local_10;
-    if _e135 {
-        let _e136 = shadow;
-        let _e144 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.z, zf, r_3.x, (1f / (r_3.z - r_3.y)));
-        shadow = (_e136 + _e144);
+    let _e118 = local_10;
+    if _e118 {
+        let _e119 = shadow;
+        let _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.z, zf, r_3.x, (1f / (r_3.z - r_3.y)));
+        shadow = (_e119 + _e127);
     }
-    let _e146 = shadow;
-    return clamp(((1f - _e146) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0f, 1f);
+    let _e129 = shadow;
+    return clamp(((1f - _e129) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0f, 1f);
 }
 
 fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {

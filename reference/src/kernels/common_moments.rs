@@ -52,6 +52,17 @@ pub fn moment_layer(z: f32, layer: u32) -> [f32; 4] {
     [z4 * z, z4 * z2, 0.0, 0.0]
 }
 
+/// The first four moments mixed with a share `a` of the uniform distribution on `[-1, 1]`'s
+/// `(0, 1/3, 0, 1/5)`.
+pub fn biased4(raw: [f32; 4], a: f32) -> [f32; 4] {
+    [
+        raw[0] * (1.0 - a),
+        raw[1] * (1.0 - a) + a / 3.0,
+        raw[2] * (1.0 - a),
+        raw[3] * (1.0 - a) + a / 5.0,
+    ]
+}
+
 /// Weight of atom `x` of a discrete distribution with atoms `{x, u, far}` and moments
 /// `(1, b1, b2)`: `E[(z - u)(z - far)] / ((x - u)(x - far))`, written as
 /// `(E[z - u] + E[(z - u)(z - x)] k) / (x - u)` with `k = 1 / (x - far)` (0 for an atom at
@@ -101,11 +112,7 @@ pub fn far_k(x: f32, far: f32, at_infinity: bool) -> f32 {
 /// The lit fraction at depth `zf` of a region with 4 moments `raw` (Hamburger 4MSM, Peters
 /// & Klein 2015, with the estimate between the bounds described in the module docs).
 pub fn lit_moments4(raw: [f32; 4], zf: f32) -> f32 {
-    let a = MOMENT_BIAS_4;
-    let b1 = raw[0] * (1.0 - a);
-    let b2 = raw[1] * (1.0 - a) + a / 3.0;
-    let b3 = raw[2] * (1.0 - a);
-    let b4 = raw[3] * (1.0 - a) + a / 5.0;
+    let [b1, b2, b3, b4] = biased4(raw, MOMENT_BIAS_4);
     // LDL^T of the Hankel matrix [[1, b1, b2], [b1, b2, b3], [b2, b3, b4]].
     let d2 = b2 - b1 * b1;
     let l32 = (b3 - b1 * b2) / d2;
@@ -179,10 +186,7 @@ pub fn cubic_roots(c1: f32, c2: f32, c3: f32, c4: f32) -> ([f32; 3], bool) {
 /// `raw1 = (b5, b6)` (the canonical representation with four atoms; see the module docs).
 pub fn lit_moments6(raw0: [f32; 4], raw1: [f32; 2], zf: f32) -> f32 {
     let a = MOMENT_BIAS_6;
-    let b1 = raw0[0] * (1.0 - a);
-    let b2 = raw0[1] * (1.0 - a) + a / 3.0;
-    let b3 = raw0[2] * (1.0 - a);
-    let b4 = raw0[3] * (1.0 - a) + a / 5.0;
+    let [b1, b2, b3, b4] = biased4(raw0, a);
     let b5 = raw1[0] * (1.0 - a);
     let b6 = raw1[1] * (1.0 - a) + a / 7.0;
     // LDL^T of the 4x4 Hankel matrix of (1, b1, .., b6).

@@ -52,6 +52,12 @@ fn moment_layer(z: f32, layer: u32) -> vec4<f32> {
     return vec4<f32>(z4 * z, z4 * z2, 0.0, 0.0);
 }
 
+// The first four moments mixed with a share `a` of the uniform distribution on [-1, 1]'s
+// (0, 1/3, 0, 1/5).
+fn biased4(raw: vec4<f32>, a: f32) -> vec4<f32> {
+    return vec4<f32>(raw.x * (1.0 - a), raw.y * (1.0 - a) + a / 3.0, raw.z * (1.0 - a), raw.w * (1.0 - a) + a / 5.0);
+}
+
 // Weight of atom x of a distribution with atoms {x, u, far} and moments (1, b1, b2):
 // (E[z - u] + E[(z - u)(z - x)] k) / (x - u), k = 1 / (x - far) (0 for an atom at infinity).
 fn atom_weight2(b1: f32, b2: f32, x: f32, u: f32, k: f32) -> f32 {
@@ -90,11 +96,11 @@ fn far_k(x: f32, far: f32, at_infinity: bool) -> f32 {
 
 // The lit fraction at depth zf of a region with 4 moments `raw` (Hamburger 4MSM).
 fn lit_moments4(raw: vec4<f32>, zf: f32) -> f32 {
-    let a = MOMENT_BIAS_4;
-    let b1 = raw.x * (1.0 - a);
-    let b2 = raw.y * (1.0 - a) + a / 3.0;
-    let b3 = raw.z * (1.0 - a);
-    let b4 = raw.w * (1.0 - a) + a / 5.0;
+    let b = biased4(raw, MOMENT_BIAS_4);
+    let b1 = b.x;
+    let b2 = b.y;
+    let b3 = b.z;
+    let b4 = b.w;
     // LDL^T of the Hankel matrix [[1, b1, b2], [b1, b2, b3], [b2, b3, b4]].
     let d2 = b2 - b1 * b1;
     let l32 = (b3 - b1 * b2) / d2;
@@ -174,10 +180,11 @@ fn cubic_roots(c1: f32, c2: f32, c3: f32, c4: f32) -> CubicRoots {
 // raw1 = (b5, b6) (the canonical representation with four atoms).
 fn lit_moments6(raw0: vec4<f32>, raw1: vec2<f32>, zf: f32) -> f32 {
     let a = MOMENT_BIAS_6;
-    let b1 = raw0.x * (1.0 - a);
-    let b2 = raw0.y * (1.0 - a) + a / 3.0;
-    let b3 = raw0.z * (1.0 - a);
-    let b4 = raw0.w * (1.0 - a) + a / 5.0;
+    let b = biased4(raw0, a);
+    let b1 = b.x;
+    let b2 = b.y;
+    let b3 = b.z;
+    let b4 = b.w;
     let b5 = raw1.x * (1.0 - a);
     let b6 = raw1.y * (1.0 - a) + a / 7.0;
     // LDL^T of the 4x4 Hankel matrix of (1, b1, .., b6).
