@@ -13,6 +13,7 @@ use serde::de::DeserializeOwned;
 
 use crate::minmax::MinmaxVariant;
 use crate::raymarch::RaymarchVariant;
+use crate::sampling::SamplingKnobs;
 use crate::variant::{LightKind, PrefilteredVariant, VariantError};
 
 /// The one table of every family: `Name(variant type)`, one line each. It defines [`Family`]
@@ -135,6 +136,21 @@ macro_rules! families {
                 }
             }
 
+            /// Where the family evaluates its per-pixel integral.
+            pub fn sampling(&self) -> SamplingKnobs {
+                match self {
+                    $(Self::$name(v) => KnobSet::sampling(v),)*
+                }
+            }
+
+            /// The variant with other sampling knobs, every other knob kept.
+            #[must_use]
+            pub fn with_sampling(self, sampling: SamplingKnobs) -> Self {
+                match self {
+                    $(Self::$name(v) => Self::$name(KnobSet::with_sampling(v, sampling)),)*
+                }
+            }
+
             /// The knobs without the light, short ([`KnobSet::marker`]); empty for a
             /// family whose only knob is the light.
             pub fn marker(&self) -> String {
@@ -242,6 +258,14 @@ pub trait KnobSet:
 
     /// The conformance grid: every variant the GPU-against-mirror trials run.
     fn grid() -> Vec<Self>;
+
+    /// Where the family evaluates its per-pixel integral ([`crate::sampling`]).
+    fn sampling(&self) -> SamplingKnobs;
+
+    /// The variant with other sampling knobs, every other knob kept (not validated: a
+    /// raymarch variant that interleaves rejects sampled evaluation in `validate`).
+    #[must_use]
+    fn with_sampling(self, sampling: SamplingKnobs) -> Self;
 }
 
 impl fmt::Display for FamilyVariant {

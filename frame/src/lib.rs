@@ -15,5 +15,6 @@ pub mod family;
 pub mod frame;
 pub mod minmax;
 pub mod raymarch;
+pub mod sampling;
 pub mod scene;
 pub mod variant;

@@ -40,6 +40,7 @@
 //! standard shadow map, as `scatter` does.
 
 use crate::family::{Family, KnobSet};
+use crate::sampling::{Sampling, SamplingKnobs};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -50,32 +51,60 @@ use crate::frame::{
 use crate::variant::{LightKind, PrefilteredVariant, Rectification, VariantError};
 
 /// The knobs of the `minmax` family.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MinmaxVariant {
     /// Light type.
     pub light: LightKind,
+    /// Where `minmax_traverse` runs: every pixel, or a low-resolution grid
+    /// ([`crate::sampling`]).
+    pub sampling: Sampling,
+    /// `sampling = lowres`: the block side, 2 or 4.
+    pub scale: u32,
+    /// `sampling = lowres`: the depth break in percent of the nearer depth.
+    pub depth_break: u32,
+}
+
+impl Default for MinmaxVariant {
+    /// Directional light, every pixel.
+    fn default() -> Self {
+        Self {
+            light: LightKind::Directional,
+            sampling: Sampling::Pixels,
+            scale: SamplingKnobs::DEFAULT_SCALE,
+            depth_break: SamplingKnobs::DEFAULT_DEPTH_BREAK,
+        }
+    }
 }
 
 impl MinmaxVariant {
-    /// Checks every knob (every value of the only knob is valid; kept for symmetry with the
-    /// other families).
+    /// Checks every knob; the error names the first offending one.
     pub fn validate(&self) -> Result<(), VariantError> {
-        Ok(())
+        self.sampling_knobs().validate()
     }
 
-    /// A short stable id: `directional`, `spot`.
+    /// The sampling knobs.
+    pub fn sampling_knobs(&self) -> SamplingKnobs {
+        SamplingKnobs {
+            sampling: self.sampling,
+            scale: self.scale,
+            depth_break: self.depth_break,
+        }
+    }
+
+    /// A short stable id: `directional`, `spot`, `spot-lowres2-b5`.
     pub fn id(&self) -> String {
-        self.light.name().to_owned()
+        format!("{}{}", self.light.name(), self.sampling_knobs().id_suffix())
     }
 
-    /// The conformance grid: both lights.
+    /// The conformance grid: both lights, every pixel.
     pub fn grid() -> Vec<MinmaxVariant> {
         LightKind::ALL
             .iter()
-            .map(|&light| MinmaxVariant { light })
+            .map(|&light| MinmaxVariant {
+                light,
+                ..MinmaxVariant::default()
+            })
             .collect()
     }
 
@@ -180,11 +209,28 @@ impl KnobSet for MinmaxVariant {
     }
 
     fn with_light(self, light: LightKind) -> Self {
-        Self { light }
+        Self { light, ..self }
     }
 
+    /// Empty (the light is not in markers), or the sampling's (`lr2`).
     fn marker(&self) -> String {
-        String::new()
+        self.sampling_knobs()
+            .marker_suffix()
+            .trim_start_matches('-')
+            .to_owned()
+    }
+
+    fn sampling(&self) -> SamplingKnobs {
+        self.sampling_knobs()
+    }
+
+    fn with_sampling(self, s: SamplingKnobs) -> Self {
+        Self {
+            sampling: s.sampling,
+            scale: s.scale,
+            depth_break: s.depth_break,
+            ..self
+        }
     }
 
     fn grid() -> Vec<Self> {

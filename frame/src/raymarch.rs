@@ -20,6 +20,7 @@
 //! edges (the paper's "halos").
 
 use crate::family::{Family, KnobSet};
+use crate::sampling::{Sampling, SamplingKnobs};
 use bytemuck::{Pod, Zeroable};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -42,6 +43,12 @@ pub struct RaymarchVariant {
     pub jitter: bool,
     /// Light type.
     pub light: LightKind,
+    /// Where `raymarch` runs: every pixel, or a low-resolution grid ([`crate::sampling`]).
+    pub sampling: Sampling,
+    /// `sampling = lowres`: the block side, 2 or 4.
+    pub scale: u32,
+    /// `sampling = lowres`: the depth break in percent of the nearer depth.
+    pub depth_break: u32,
 }
 
 impl Default for RaymarchVariant {
@@ -52,6 +59,9 @@ impl Default for RaymarchVariant {
             interleave: 1,
             jitter: false,
             light: LightKind::Directional,
+            sampling: Sampling::Pixels,
+            scale: SamplingKnobs::DEFAULT_SCALE,
+            depth_break: SamplingKnobs::DEFAULT_DEPTH_BREAK,
         }
     }
 }
@@ -81,7 +91,28 @@ impl RaymarchVariant {
                 ),
             });
         }
+        self.sampling_knobs().validate()?;
+        if self.interleaved() && self.sampling_knobs().is_sampled() {
+            return Err(VariantError {
+                knob: "interleave",
+                value: self.interleave.to_string(),
+                allowed: format!(
+                    "1 with sampling = {} (interleaving spreads a pixel's samples over its \
+                     neighbours, which a sampled variant does not evaluate)",
+                    self.sampling
+                ),
+            });
+        }
         Ok(())
+    }
+
+    /// The sampling knobs.
+    pub fn sampling_knobs(&self) -> SamplingKnobs {
+        SamplingKnobs {
+            sampling: self.sampling,
+            scale: self.scale,
+            depth_break: self.depth_break,
+        }
     }
 
     /// Whether the variant has the `interleave_sum` passes.
@@ -92,11 +123,12 @@ impl RaymarchVariant {
     /// A short stable id: `n64-i4-jitter-directional`, `n128-i1-nojitter-spot`.
     pub fn id(&self) -> String {
         format!(
-            "n{}-i{}-{}-{}",
+            "n{}-i{}-{}-{}{}",
             self.samples,
             self.interleave,
             if self.jitter { "jitter" } else { "nojitter" },
-            self.light
+            self.light,
+            self.sampling_knobs().id_suffix()
         )
     }
 
@@ -113,6 +145,7 @@ impl RaymarchVariant {
                             interleave,
                             jitter,
                             light,
+                            ..RaymarchVariant::default()
                         };
                         if v.validate().is_ok() {
                             out.push(v);
@@ -287,7 +320,20 @@ impl KnobSet for RaymarchVariant {
         if self.jitter != Self::default().jitter {
             m += if self.jitter { "-jitter" } else { "-nojitter" };
         }
-        m
+        m + &self.sampling_knobs().marker_suffix()
+    }
+
+    fn sampling(&self) -> SamplingKnobs {
+        self.sampling_knobs()
+    }
+
+    fn with_sampling(self, s: SamplingKnobs) -> Self {
+        Self {
+            sampling: s.sampling,
+            scale: s.scale,
+            depth_break: s.depth_break,
+            ..self
+        }
     }
 
     fn grid() -> Vec<Self> {

@@ -2,6 +2,7 @@
 //! with errors that name the knob, the value and the allowed range.
 
 use crate::family::{Family, KnobSet};
+use crate::sampling::{Sampling, SamplingKnobs};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -181,6 +182,12 @@ pub struct PrefilteredVariant {
     pub storage: Storage,
     /// Rectification scheme.
     pub rectification: Rectification,
+    /// Where `scatter` runs: every pixel, or a low-resolution grid ([`crate::sampling`]).
+    pub sampling: Sampling,
+    /// `sampling = lowres`: the block side, 2 or 4.
+    pub scale: u32,
+    /// `sampling = lowres`: the depth break in percent of the nearer depth.
+    pub depth_break: u32,
 }
 
 impl Default for PrefilteredVariant {
@@ -195,6 +202,9 @@ impl Default for PrefilteredVariant {
             light: LightKind::Directional,
             storage: Storage::Rgba8unorm,
             rectification: Rectification::Epipolar,
+            sampling: Sampling::Pixels,
+            scale: SamplingKnobs::DEFAULT_SCALE,
+            depth_break: SamplingKnobs::DEFAULT_DEPTH_BREAK,
         }
     }
 }
@@ -294,7 +304,16 @@ impl PrefilteredVariant {
                 allowed: "in 1..=8".into(),
             });
         }
-        Ok(())
+        self.sampling_knobs().validate()
+    }
+
+    /// The sampling knobs.
+    pub fn sampling_knobs(&self) -> SamplingKnobs {
+        SamplingKnobs {
+            sampling: self.sampling,
+            scale: self.scale,
+            depth_break: self.depth_break,
+        }
     }
 
     /// Every valid `bases_per_thread` for `bases`.
@@ -394,13 +413,14 @@ impl PrefilteredVariant {
     /// `moments4-r3-weighted-directional-rgba32float-epipolar`.
     pub fn id(&self) -> String {
         format!(
-            "{}-r{}-{}-{}-{}-{}",
+            "{}-r{}-{}-{}-{}-{}{}",
             self.basis_id(),
             self.regions,
             self.visibility,
             self.light,
             self.storage,
-            self.rectification
+            self.rectification,
+            self.sampling_knobs().id_suffix()
         )
     }
 }
@@ -457,7 +477,20 @@ impl KnobSet for PrefilteredVariant {
         if self.rectification != d.rectification {
             m += &format!("-{}", self.rectification);
         }
-        m
+        m + &self.sampling_knobs().marker_suffix()
+    }
+
+    fn sampling(&self) -> SamplingKnobs {
+        self.sampling_knobs()
+    }
+
+    fn with_sampling(self, s: SamplingKnobs) -> Self {
+        Self {
+            sampling: s.sampling,
+            scale: s.scale,
+            depth_break: s.depth_break,
+            ..self
+        }
     }
 
     /// Regions 1..=4 (every other knob at every value).

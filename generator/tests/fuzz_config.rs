@@ -292,6 +292,7 @@ fn validate_on_arbitrary_numbers() {
                 interleave,
                 jitter,
                 light: LightKind::Spot,
+                ..RaymarchVariant::default()
             };
             let (vr, rr) = (v.validate(), r.validate());
             tally(vr.is_ok() || rr.is_ok());

@@ -17,7 +17,8 @@ use std::time::{Duration, Instant};
 
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax, tree_width};
 use scatter_shaderlib::prefiltered::{PrefilteredFrame, Resolutions, SliceParams, Storage};
-use scatter_shaderlib::{Kernel, KernelParams};
+use scatter_shaderlib::Kernel;
+use scatter_shaderlib::family::KernelFamily;
 
 use crate::error::ErrorScopes;
 use crate::executor::Executor;
@@ -117,9 +118,10 @@ impl Minmax {
             ],
         )?;
         crate::prefiltered::check_frame_buffers(&limits, hr)?;
-        let built = KernelParams::minmax(*variant)
-            .map(|p| scatter_shaderlib::build(&p))
-            .into_iter()
+        let built = variant
+            .kernel_params()
+            .iter()
+            .map(scatter_shaderlib::build)
             .collect::<Result<Vec<_>, _>>()?;
         let exec = Executor::new(
             ctx,

@@ -25,7 +25,8 @@ use scatter_shaderlib::prefiltered::{
     PrefilteredVariant, Rectification, Resolutions, ShadowMapDesc, SliceParams, Storage,
     prepare_frame,
 };
-use scatter_shaderlib::{Kernel, KernelParams};
+use scatter_shaderlib::Kernel;
+use scatter_shaderlib::family::KernelFamily;
 
 use crate::error::{ErrorScopes, check_limit};
 use crate::executor::Executor;
@@ -204,7 +205,8 @@ impl Prefiltered {
         check_frame_buffers(&limits, hr)?;
 
         // CPU work only: render, compose and validate the three kernels.
-        let built = KernelParams::prefiltered(*variant)
+        let built = variant
+            .kernel_params()
             .iter()
             .map(scatter_shaderlib::build)
             .collect::<Result<Vec<_>, _>>()?;

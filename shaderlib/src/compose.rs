@@ -54,6 +54,10 @@ const COMMON_MODULES: &[(&str, &str)] = &[
         "common/minmax.wgsl",
         include_str!("../templates/common/minmax.wgsl"),
     ),
+    (
+        "common/sampling.wgsl",
+        include_str!("../templates/common/sampling.wgsl"),
+    ),
 ];
 
 thread_local! {

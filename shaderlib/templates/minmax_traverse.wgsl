@@ -27,6 +27,9 @@
 #import scatter::model::{phase_hg, transmittance_between}
 #import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, slice_params, spot_segment}
 #import scatter::minmax::{level_offset, tree_levels}
+{%- if sampling.lowres %}
+#import scatter::sampling::{lowres_covered, lowres_grid, lowres_pixel, lowres_taps}
+{%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
@@ -34,6 +37,7 @@
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) var tree: texture_2d<f32>;
 @group(0) @binding(5) var output: texture_storage_2d<rgba16float, write>;
+{% include "include/sampled_bindings.wgsl" %}
 
 // Ray distance of column edge `x` of a ray that crosses texels 0 .. n: the last texel's
 // span ends at the surface `s`.
@@ -52,14 +56,9 @@ fn lit_span(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, spot: bool
     return transmittance_between(f.medium[0], a, b);
 }
 
-// The kernel body for pixel `id`; stores the pixel's in-scattered radiance.
-@compute @workgroup_size(8, 8, 1)
-fn minmax_traverse(@builtin(global_invocation_id) id: vec3<u32>) {
+// The in-scattered radiance of pixel (x, y) (the sampling entry point below calls it).
+fn minmax_traverse_pixel(x: u32, y: u32) -> vec3<f32> {
     let f = frame;
-    let x = id.x; let y = id.y;
-    if x >= f.sizes[0] || y >= f.sizes[1] {
-        return;
-    }
     let spot = {{ spot }};
     let eye = f.eye.xyz;
     let dir = pixel_dir(f, x, y);
@@ -75,8 +74,7 @@ fn minmax_traverse(@builtin(global_invocation_id) id: vec3<u32>) {
         f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
     if near_epi || near_anti {
         let l = epipole_march(frame, shadow_map, eye, dir, s, spot) * color;
-        textureStore(output, vec2<u32>(x, y), vec4<f32>(l.x, l.y, l.z, 1.0));
-        return;
+        return l;
     }
 
     // Rectified coordinates of the surface point: the nearest row, its column x_s, depth d.
@@ -148,5 +146,6 @@ fn minmax_traverse(@builtin(global_invocation_id) id: vec3<u32>) {
         l = f.medium[1] * phase_hg(f.medium[2], -dot(f.light_dir.xyz, dir)) * total;
     }
     let c = color * l;
-    textureStore(output, vec2<u32>(x, y), vec4<f32>(c.x, c.y, c.z, 1.0));
+    return c;
 }
+{% include "include/sampled_entry.wgsl" %}

@@ -30,20 +30,19 @@
 #import scatter::model::{equiangular, equiangular_sample, phase_hg, spot_integrand, transmittance_between}
 #import scatter::shadow::shadow_visibility
 #import scatter::raymarch::{RaymarchFrame, raymarch_pixel_dir, raymarch_shadow_view, pixel_jitter}
+{%- if sampling.lowres %}
+#import scatter::sampling::{lowres_covered, lowres_grid, lowres_pixel, lowres_taps}
+{%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: RaymarchFrame;
 @group(0) @binding(1) var depth: texture_2d<f32>;
 @group(0) @binding(2) var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) var output: texture_storage_2d<{{ output_format }}, write>;
+{% include "include/sampled_bindings.wgsl" %}
 
-// The kernel body for pixel `id`; stores the pixel's radiance (or partial sum).
-@compute @workgroup_size(8, 8, 1)
-fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
+// The in-scattered radiance of pixel (x, y) (the sampling entry point below calls it).
+fn raymarch_pixel(x: u32, y: u32) -> vec3<f32> {
     let m = frame;
-    let x = id.x; let y = id.y;
-    if x >= m.sizes[0] || y >= m.sizes[1] {
-        return;
-    }
     let spot = {{ spot }};
     let eye = m.eye.xyz;
     let dir = raymarch_pixel_dir(m, x, y);
@@ -82,5 +81,6 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
         l = m.medium[1] * phase_hg(m.medium[2], -dot(m.light_dir.xyz, dir)) * sum;
     }
     let c = m.light_color.xyz * l;
-    textureStore(output, vec2<u32>(x, y), vec4<f32>(c.x, c.y, c.z, 1.0));
+    return c;
 }
+{% include "include/sampled_entry.wgsl" %}

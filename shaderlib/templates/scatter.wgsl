@@ -69,6 +69,9 @@
 #import scatter::projective::{proj_boundary, proj_ray_depth, proj_reach}
 #import scatter::prefiltered_projective::proj_column
 {%- endif %}
+{%- if sampling.lowres %}
+#import scatter::sampling::{lowres_covered, lowres_grid, lowres_pixel, lowres_taps}
+{%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
@@ -77,6 +80,7 @@
 @group(0) @binding(4) var filtered: texture_2d_array<f32>;
 @group(0) @binding(5) var output: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(6) var bounds: texture_2d<f32>;
+{% include "include/sampled_bindings.wgsl" %}
 
 // Independent prefix regions per rectified row.
 const REGIONS: u32 = {{ regions }}u;
@@ -85,14 +89,9 @@ const REGIONS: u32 = {{ regions }}u;
 const LAYERS: u32 = {{ layers }}u;
 {%- endif %}
 
-// The kernel body for pixel `id`; stores the pixel's in-scattered radiance.
-@compute @workgroup_size(8, 8, 1)
-fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
+// The in-scattered radiance of pixel (x, y) (the sampling entry point below calls it).
+fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     let f = frame;
-    let x = id.x; let y = id.y;
-    if x >= f.sizes[0] || y >= f.sizes[1] {
-        return;
-    }
     let spot = {{ spot }};
     let eye = f.eye.xyz;
     let dir = pixel_dir(f, x, y);
@@ -108,8 +107,7 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
     if near_epi || near_anti {
         let l = epipole_march(frame, shadow_map, eye, dir, s, spot) * color;
-        textureStore(output, vec2<u32>(x, y), vec4<f32>(l.x, l.y, l.z, 1.0));
-        return;
+        return l;
     }
 
     // Rectified coordinates of the surface point.
@@ -285,5 +283,6 @@ fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let l = total;
     let c = color * l;
-    textureStore(output, vec2<u32>(x, y), vec4<f32>(c.x, c.y, c.z, 1.0));
+    return c;
 }
+{% include "include/sampled_entry.wgsl" %}

@@ -96,7 +96,7 @@ fn variants(light: LightKind) -> Vec<FamilyVariant> {
             ..RaymarchVariant::default()
         })
     }));
-    v.push(FamilyVariant::Minmax(MinmaxVariant { light }));
+    v.push(FamilyVariant::Minmax(MinmaxVariant { light, ..MinmaxVariant::default() }));
     v
 }
 

@@ -329,6 +329,7 @@ fn raymarch_variants() -> [RaymarchVariant; 2] {
             interleave: 2,
             jitter: true,
             light: LightKind::Spot,
+            ..RaymarchVariant::default()
         },
     ]
 }

@@ -237,6 +237,7 @@ fn raymarch_manifest_matches_the_runtime() {
         interleave: 4,
         jitter: true,
         light: LightKind::Spot,
+        ..RaymarchVariant::default()
     };
     let g = generate(&Request {
         variants: vec![FamilyVariant::Raymarch(v)],
@@ -326,6 +327,7 @@ fn minmax_manifest_matches_the_runtime() {
     use scatter_shaderlib::prefiltered::FrameUniforms;
     let v = MinmaxVariant {
         light: LightKind::Spot,
+        ..MinmaxVariant::default()
     };
     let g = generate(&Request {
         variants: vec![FamilyVariant::Minmax(v)],

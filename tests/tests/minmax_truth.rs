@@ -41,6 +41,7 @@ fn hierarchy_equals_brute_force_and_skips_on_every_scene() {
             let sm = ShadowMap::build(&scene, &bvh, SHADOW_MAP).expect("shadow map");
             let variant = MinmaxVariant {
                 light: light_of(name),
+                ..MinmaxVariant::default()
             };
             let settings = FrameSettings::for_screen(SCREEN.0, SCREEN.1);
             let run = run_minmax(&variant, RECTIFIED, &gbuf, &scene, &sm, &settings)

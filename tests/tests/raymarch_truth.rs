@@ -106,6 +106,7 @@ fn interleaving_a_constant_integrand_gives_the_full_sum() {
                 interleave: 1,
                 jitter,
                 light: LightKind::Directional,
+                ..RaymarchVariant::default()
             },
             &scene,
             &gbuf,
@@ -125,6 +126,7 @@ fn interleaving_a_constant_integrand_gives_the_full_sum() {
                 interleave,
                 jitter,
                 light: LightKind::Directional,
+                ..RaymarchVariant::default()
             };
             let run = run_raymarch(&variant, &scene, &gbuf, &sm).expect("frame");
             // Each pixel's own partial sum holds 1 / interleave^2 of the cells (up to the

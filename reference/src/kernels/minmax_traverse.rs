@@ -14,6 +14,7 @@ use super::common_epipolar::{
 };
 use super::common_minmax::{level_offset, tree_levels};
 use super::common_model::{clamp, max, max_u, min, phase_hg, transmittance_between};
+use super::common_sampling::run_sampled;
 use super::texture::{Tex, TexArray, quantise, xyz};
 use glam::Vec3;
 use scatter_shaderlib::minmax::MinmaxVariant;
@@ -308,9 +309,28 @@ fn run_pixels(
     }
 }
 
-/// Runs every pixel through the tree (rows in parallel).
+/// Runs every pixel through the tree (rows in parallel). A sampled variant runs through
+/// [`run_sampled`] instead: `output` is then the upsampled image, `exact` its values and
+/// `visits` empty.
 pub fn minmax_traverse(variant: &MinmaxVariant, inp: &TraverseInputs) -> TraverseImage {
-    run_pixels(inp.frame, &|id| minmax_traverse_main(id, variant, inp))
+    let knobs = variant.sampling_knobs();
+    if !knobs.is_sampled() {
+        return run_pixels(inp.frame, &|id| minmax_traverse_main(id, variant, inp));
+    }
+    let sampled = run_sampled(
+        &knobs,
+        [inp.frame.sizes[0], inp.frame.sizes[1]],
+        inp.depth,
+        &|x, y| {
+            let c = minmax_traverse_main([x, y, 0], variant, inp).map_or([0.0; 4], |(c, _)| c);
+            [c[0], c[1], c[2]]
+        },
+    );
+    TraverseImage {
+        exact: sampled.output.data.clone(),
+        output: sampled.output,
+        visits: Vec::new(),
+    }
 }
 
 /// Runs every pixel through the brute-force march over `rectified` (rows in parallel).

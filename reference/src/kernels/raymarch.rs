@@ -7,6 +7,7 @@ use super::common_model::{
     equiangular, equiangular_sample, max, min, phase_hg, spot_integrand, transmittance_between,
 };
 use super::common_raymarch::{pixel_jitter, raymarch_pixel_dir, raymarch_shadow_view};
+use super::common_sampling::{SampledOutput, run_sampled};
 use super::common_shadow::shadow_visibility;
 use super::texture::{Tex, TexArray, quantise, xyz};
 use scatter_shaderlib::prefiltered::{LightKind, Storage};
@@ -80,7 +81,8 @@ pub fn raymarch_main(
 }
 
 /// Runs every pixel (rows in parallel): radiance as stored in rgba16float, or the partial
-/// sums (rgba32float) of an interleaved variant.
+/// sums (rgba32float) of an interleaved variant; a sampled variant through
+/// [`raymarch_sampled`].
 pub fn raymarch(
     variant: &RaymarchVariant,
     m: &RaymarchUniforms,
@@ -88,19 +90,17 @@ pub fn raymarch(
     shadow_map: &Tex,
 ) -> TexArray {
     use rayon::prelude::*;
+    if !variant.interleaved() {
+        return raymarch_sampled(variant, m, depth, shadow_map).output;
+    }
     let (w, h) = (m.sizes[0], m.sizes[1]);
-    let storage = if variant.interleaved() {
-        Storage::Rgba32float
-    } else {
-        Storage::Rgba16float
-    };
     let data = (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
             (0..w).map(move |x| {
                 raymarch_main([x, y, 0], variant, m, depth, shadow_map)
                     .unwrap_or([0.0; 4])
-                    .map(|c| quantise(c, storage))
+                    .map(|c| quantise(c, Storage::Rgba32float))
             })
         })
         .collect();
@@ -110,4 +110,23 @@ pub fn raymarch(
         layers: 1,
         data,
     }
+}
+
+/// A variant without interleaving through its sampling (every pixel, or `lowres` with its
+/// upsample): [`run_sampled`] with [`raymarch_main`] as the pixel body.
+pub fn raymarch_sampled(
+    variant: &RaymarchVariant,
+    m: &RaymarchUniforms,
+    depth: &Tex,
+    shadow_map: &Tex,
+) -> SampledOutput {
+    run_sampled(
+        &variant.sampling_knobs(),
+        [m.sizes[0], m.sizes[1]],
+        depth,
+        &|x, y| {
+            let c = raymarch_main([x, y, 0], variant, m, depth, shadow_map).unwrap_or([0.0; 4]);
+            [c[0], c[1], c[2]]
+        },
+    )
 }

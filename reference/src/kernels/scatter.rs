@@ -23,10 +23,11 @@ use super::common_moments::{lit_moments4, lit_moments6, moment_z};
 use super::common_prefiltered::{coeff4, fourier_step, region_start, turn};
 use super::common_prefiltered_projective::proj_column;
 use super::common_projective::{proj_boundary, proj_ray_depth, proj_reach};
-use super::texture::{Tex, TexArray, mix4, quantise, xyz};
+use super::common_sampling::{SampledOutput, run_sampled};
+use super::texture::{Tex, TexArray, mix4, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
-    Basis, FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
+    Basis, FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams,
 };
 
 /// The bindings of `scatter`.
@@ -267,25 +268,21 @@ pub fn scatter_main(
     Some([c.x, c.y, c.z, 1.0])
 }
 
-/// Runs every pixel (rows in parallel); returns the screen-sized output as stored in
-/// rgba16float.
+/// Runs every pixel (rows in parallel), or the samples and the upsample of a sampled
+/// variant; returns the screen-sized output as stored in rgba16float.
 pub fn scatter(variant: &PrefilteredVariant, inp: &ScatterInputs) -> TexArray {
-    use rayon::prelude::*;
-    let (w, h) = (inp.frame.sizes[0], inp.frame.sizes[1]);
-    let data = (0..h)
-        .into_par_iter()
-        .flat_map_iter(|y| {
-            (0..w).map(move |x| {
-                scatter_main([x, y, 0], variant, inp)
-                    .unwrap_or([0.0; 4])
-                    .map(|c| quantise(c, Storage::Rgba16float))
-            })
-        })
-        .collect();
-    TexArray {
-        width: w,
-        height: h,
-        layers: 1,
-        data,
-    }
+    scatter_sampled(variant, inp).output
+}
+
+/// [`run_sampled`] with [`scatter_main`] as the pixel body.
+pub fn scatter_sampled(variant: &PrefilteredVariant, inp: &ScatterInputs) -> SampledOutput {
+    run_sampled(
+        &variant.sampling_knobs(),
+        [inp.frame.sizes[0], inp.frame.sizes[1]],
+        inp.depth,
+        &|x, y| {
+            let c = scatter_main([x, y, 0], variant, inp).unwrap_or([0.0; 4]);
+            [c[0], c[1], c[2]]
+        },
+    )
 }

@@ -9,6 +9,8 @@ pub mod plan;
 
 use askama::Template;
 
+use crate::sampling::SamplingView;
+
 pub use scatter_frame::minmax::{
     MinmaxVariant, level_count, level_offset, prepare_minmax, tree_levels, tree_width,
 };
@@ -37,6 +39,7 @@ struct BuildTemplate {}
 struct TraverseTemplate {
     light_name: &'static str,
     spot: bool,
+    sampling: SamplingView,
 }
 
 fn validate(kernel: Kernel, variant: &MinmaxVariant) -> Result<(), ShaderError> {
@@ -63,6 +66,7 @@ pub(crate) fn render_traverse(variant: &MinmaxVariant) -> Result<String, ShaderE
     TraverseTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
+        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::MinmaxTraverse, 6),
     }
     .render()
     .map_err(|source| ShaderError::Render {
@@ -89,7 +93,9 @@ impl crate::KernelParams {
 
 impl crate::family::KernelFamily for MinmaxVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
-        crate::KernelParams::minmax(*self).to_vec()
+        let mut out = crate::KernelParams::minmax(*self).to_vec();
+        out.extend(crate::sampling::sampling_kernels(&self.sampling_knobs()));
+        out
     }
 
     fn plan(&self) -> crate::plan::Plan {

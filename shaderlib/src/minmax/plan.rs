@@ -8,7 +8,11 @@ use crate::plan::{
     bind, column_depth_buffer, depth_and_shadow_map, frame_buffer, scatter_texture,
     screen_and_shadow_parameters,
 };
-use crate::{Kernel, KernelParams};
+use crate::Kernel;
+use crate::family::KernelFamily;
+use crate::sampling::{
+    sampling_bindings, sampling_invocations, sampling_resources, upsample_pass,
+};
 
 /// The resources and passes of a variant, as `runtime/src/minmax.rs` creates them.
 pub fn plan(v: &MinmaxVariant) -> Plan {
@@ -36,7 +40,7 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
         },
     ]);
     let [depth, shadow_map] = depth_and_shadow_map();
-    let resources = vec![
+    let mut resources = vec![
         frame_buffer(
             "frame",
             "the uniform block of the frame (Rust: scatter_frame::frame::FrameUniforms from \
@@ -77,9 +81,11 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
             "screen.height",
         ),
     ];
-    let passes = KernelParams::minmax(*v)
+    resources.extend(sampling_resources(&v.sampling_knobs()));
+    let passes = v
+        .kernel_params()
         .iter()
-        .filter_map(|p| pass(p.kernel()))
+        .filter_map(|p| pass(v, p.kernel()))
         .collect();
     Plan {
         parameters,
@@ -101,7 +107,7 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
 }
 
 /// The pass of one kernel, or `None` for a kernel that is not in this family.
-pub fn pass(kernel: Kernel) -> Option<PassPlan> {
+pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
     let f = |s: &str| s.to_owned();
     match kernel {
         Kernel::DepthColumns => Some(PassPlan {
@@ -135,7 +141,7 @@ pub fn pass(kernel: Kernel) -> Option<PassPlan> {
         }),
         Kernel::MinmaxTraverse => Some(PassPlan {
             kernel,
-            invocations: [f("screen.width"), f("screen.height"), f("1")],
+            invocations: sampling_invocations(&v.sampling_knobs()),
             skip_when: None,
             bindings: vec![
                 bind(0, "frame"),
@@ -144,8 +150,12 @@ pub fn pass(kernel: Kernel) -> Option<PassPlan> {
                 bind(3, "shadow_map"),
                 bind(4, "tree"),
                 bind(5, "output"),
-            ],
+            ]
+            .into_iter()
+            .chain(sampling_bindings(&v.sampling_knobs(), 6))
+            .collect(),
         }),
+        Kernel::LowresUpsample => upsample_pass(&v.sampling_knobs()),
         _ => None,
     }
 }

@@ -9,6 +9,8 @@
 
 use askama::Template;
 
+use crate::sampling::SamplingView;
+
 use super::variant::{Basis, LightKind, PrefilteredVariant, Rectification, VisibilityMode};
 use crate::compose::template_path;
 use crate::{Kernel, ShaderError};
@@ -84,6 +86,7 @@ struct ScatterTemplate {
     projective: bool,
     moments: bool,
     moment_count: u32,
+    sampling: SamplingView,
 }
 
 /// Checks `variant` on behalf of `kernel`.
@@ -170,6 +173,7 @@ pub(crate) fn render_scatter(variant: &PrefilteredVariant) -> Result<String, Sha
         projective: variant.rectification == Rectification::Projective,
         moments: variant.basis == Basis::Moments,
         moment_count: variant.moments,
+        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::Scatter, 7),
     }
     .render()
     .map_err(render_error(Kernel::Scatter))

@@ -37,7 +37,9 @@ impl crate::KernelParams {
 
 impl crate::family::KernelFamily for PrefilteredVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
-        crate::KernelParams::prefiltered(*self).to_vec()
+        let mut out = crate::KernelParams::prefiltered(*self).to_vec();
+        out.extend(crate::sampling::sampling_kernels(&self.sampling_knobs()));
+        out
     }
 
     fn plan(&self) -> crate::plan::Plan {

@@ -9,7 +9,11 @@ use crate::plan::{
     screen_and_shadow_parameters, texture_2d,
 };
 use crate::prefiltered::{Basis, PrefilteredVariant, Rectification};
-use crate::{Kernel, KernelParams};
+use crate::family::KernelFamily;
+use crate::sampling::{
+    sampling_bindings, sampling_invocations, sampling_resources, upsample_pass,
+};
+use crate::Kernel;
 
 /// The per-frame condition of a projective frame (the frame set-up falls back to epipolar
 /// when the epipole is on screen).
@@ -120,7 +124,9 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
     }
     // One pass per kernel shaderlib lists for the variant, in its order; a kernel this
     // module does not know gets no pass, and generation names it.
-    let passes = KernelParams::prefiltered(*v)
+    resources.extend(sampling_resources(&v.sampling_knobs()));
+    let passes = v
+        .kernel_params()
         .iter()
         .filter_map(|p| pass(v, p.kernel()))
         .collect();
@@ -223,7 +229,7 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
         }),
         Kernel::Scatter => Some(PassPlan {
             kernel,
-            invocations: [f("screen.width"), f("screen.height"), f("1")],
+            invocations: sampling_invocations(&v.sampling_knobs()),
             skip_when: None,
             bindings: vec![
                 bind(0, "frame"),
@@ -240,8 +246,12 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                 bind(4, "filtered"),
                 bind(5, "output"),
                 bind(6, "bounds"),
-            ],
+            ]
+            .into_iter()
+            .chain(sampling_bindings(&v.sampling_knobs(), 7))
+            .collect(),
         }),
+        Kernel::LowresUpsample => upsample_pass(&v.sampling_knobs()),
         _ => None,
     }
 }

@@ -10,6 +10,7 @@ use askama::Template;
 pub use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_raymarch};
 
 use crate::compose::template_path;
+use crate::sampling::SamplingView;
 use crate::prefiltered::LightKind;
 use crate::{Kernel, ShaderError};
 
@@ -27,6 +28,7 @@ struct RaymarchTemplate {
     spot: bool,
     interleaved: bool,
     output_format: &'static str,
+    sampling: SamplingView,
 }
 
 /// `interleave_sum`: the separable window sum.
@@ -53,6 +55,7 @@ pub(crate) fn render_raymarch(variant: &RaymarchVariant) -> Result<String, Shade
         } else {
             "rgba16float"
         },
+        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::Raymarch, 4),
     }
     .render()
     .map_err(|source| ShaderError::Render {
@@ -91,6 +94,7 @@ impl crate::KernelParams {
         if variant.interleaved() {
             out.push(Self::InterleaveSum(variant));
         }
+        out.extend(crate::sampling::sampling_kernels(&variant.sampling_knobs()));
         out
     }
 }

@@ -7,6 +7,9 @@ use crate::plan::{
     screen_and_shadow_parameters,
 };
 use crate::raymarch::{PARTIAL_FORMAT, RaymarchVariant};
+use crate::sampling::{
+    sampling_bindings, sampling_invocations, sampling_resources, upsample_pass,
+};
 use crate::{Kernel, KernelParams};
 
 /// The resources and passes of a variant, as `runtime/src/raymarch.rs` creates them.
@@ -40,6 +43,7 @@ pub fn plan(v: &RaymarchVariant) -> Plan {
             "screen.height",
         ));
     }
+    resources.extend(sampling_resources(&v.sampling_knobs()));
     let passes = KernelParams::raymarch(*v)
         .iter()
         .filter_map(|p| pass(v, p.kernel()))
@@ -63,15 +67,19 @@ pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
     match kernel {
         Kernel::Raymarch => Some(PassPlan {
             kernel,
-            invocations: screen(),
+            invocations: sampling_invocations(&v.sampling_knobs()),
             skip_when: None,
             bindings: vec![
                 bind(0, "frame"),
                 bind(1, "depth"),
                 bind(2, "shadow_map"),
                 bind(3, if v.interleaved() { "partial" } else { "output" }),
-            ],
+            ]
+            .into_iter()
+            .chain(sampling_bindings(&v.sampling_knobs(), 4))
+            .collect(),
         }),
+        Kernel::LowresUpsample => upsample_pass(&v.sampling_knobs()),
         Kernel::InterleaveSum => Some(PassPlan {
             kernel,
             invocations: screen(),

@@ -1,0 +1,243 @@
+//! The sampling stage every family can use (DESIGN.md, "Sampling"): where a family evaluates
+//! its per-pixel integral. `pixels` evaluates it at every screen pixel; `lowres` at one pixel
+//! of every `scale x scale` block (a fixed pixel, so that samples do not jump between frames)
+//! and fills the screen with a depth-aware upsample (`lowres_upsample`).
+//!
+//! # The upsample
+//!
+//! Sample `(i, j)` stands on pixel `(min(i S + S / 2, W - 1), min(j S + S / 2, H - 1))`, `S`
+//! the scale. A screen pixel takes the bilinear blend of its four nearest samples, each kept
+//! only when its pixel's view depth is within `depth_break` percent of the pixel's own
+//! (`|a - b| <= depth_break / 100 * min(a, b)`, equal depths always): a joint bilateral
+//! filter with a box range kernel. The box, not a Gaussian, because a sample across a depth
+//! break must get no weight at all (no halo), while samples on the same surface keep their
+//! bilinear weights (no blur beyond the sample spacing). A pixel none of whose four samples
+//! is close in depth (a thin occluder, a silhouette between samples) is evaluated per pixel:
+//! the family's sampling pass evaluates such pixels of its block after its sample, so no
+//! extra pass or list is needed, and the upsample leaves them alone. The classification uses
+//! the depth buffer only, so both passes make it identically.
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+use crate::variant::VariantError;
+
+/// Where a family evaluates its per-pixel integral.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum Sampling {
+    /// Every screen pixel (the methods as published).
+    #[default]
+    Pixels,
+    /// One pixel of every `scale x scale` block, then a depth-aware upsample; pixels no
+    /// sample stands for in depth are evaluated per pixel.
+    Lowres,
+}
+
+impl Sampling {
+    /// Every value, sorted by name.
+    pub const ALL: &'static [Sampling] = &[Sampling::Lowres, Sampling::Pixels];
+    /// The allowed names, for error messages.
+    pub const ALLOWED: &'static str = "lowres | pixels";
+
+    /// The value's name (serde, CLI, variant ids).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Sampling::Pixels => "pixels",
+            Sampling::Lowres => "lowres",
+        }
+    }
+}
+
+impl fmt::Display for Sampling {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Sampling {
+    type Err = VariantError;
+    fn from_str(s: &str) -> Result<Self, VariantError> {
+        match s {
+            "pixels" => Ok(Sampling::Pixels),
+            "lowres" => Ok(Sampling::Lowres),
+            _ => Err(VariantError {
+                knob: "sampling",
+                value: s.to_owned(),
+                allowed: Self::ALLOWED.into(),
+            }),
+        }
+    }
+}
+
+/// The sampling knobs every family's variant carries (as the fields `sampling`, `scale`,
+/// `depth_break`; the parameters of the `lowres_upsample` kernel).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SamplingKnobs {
+    /// Where the family evaluates its integral.
+    pub sampling: Sampling,
+    /// `lowres`: the block side S, 2 or 4 (1/2 or 1/4 of the screen per axis).
+    pub scale: u32,
+    /// `lowres`: the depth difference, in percent of the nearer depth, beyond which a
+    /// sample does not stand for a pixel (1..=50).
+    pub depth_break: u32,
+}
+
+impl Default for SamplingKnobs {
+    /// `pixels` (every pixel), with the lowres knobs at their defaults.
+    fn default() -> Self {
+        Self {
+            sampling: Sampling::Pixels,
+            scale: Self::DEFAULT_SCALE,
+            depth_break: Self::DEFAULT_DEPTH_BREAK,
+        }
+    }
+}
+
+impl SamplingKnobs {
+    /// Allowed `scale`.
+    pub const SCALES: [u32; 2] = [2, 4];
+    /// `scale` when not chosen.
+    pub const DEFAULT_SCALE: u32 = 2;
+    /// Allowed `depth_break` (percent).
+    pub const DEPTH_BREAK: std::ops::RangeInclusive<u32> = 1..=50;
+    /// `depth_break` when not chosen (percent; measured in the bench's sweep).
+    pub const DEFAULT_DEPTH_BREAK: u32 = 5;
+
+    /// `lowres` at `scale`, the depth break at its default.
+    pub fn lowres(scale: u32) -> Self {
+        Self {
+            sampling: Sampling::Lowres,
+            scale,
+            ..Self::default()
+        }
+    }
+
+    /// Whether the family evaluates fewer samples than pixels (and has the upsample pass).
+    pub fn is_sampled(&self) -> bool {
+        self.sampling != Sampling::Pixels
+    }
+
+    /// Checks the knobs; the error names the first offending one. The lowres knobs must stay
+    /// at their defaults with `sampling = pixels`, so that one configuration has one id.
+    pub fn validate(&self) -> Result<(), VariantError> {
+        let d = Self::default();
+        match self.sampling {
+            Sampling::Pixels => {
+                if self.scale != d.scale {
+                    return Err(VariantError {
+                        knob: "scale",
+                        value: self.scale.to_string(),
+                        allowed: format!("{} (a lowres knob; set sampling = lowres)", d.scale),
+                    });
+                }
+                if self.depth_break != d.depth_break {
+                    return Err(VariantError {
+                        knob: "depth_break",
+                        value: self.depth_break.to_string(),
+                        allowed: format!(
+                            "{} (a lowres knob; set sampling = lowres)",
+                            d.depth_break
+                        ),
+                    });
+                }
+            }
+            Sampling::Lowres => {
+                if !Self::SCALES.contains(&self.scale) {
+                    return Err(VariantError {
+                        knob: "scale",
+                        value: self.scale.to_string(),
+                        allowed: "2 or 4 (samples per axis: 1/2 or 1/4 of the screen)".into(),
+                    });
+                }
+                if !Self::DEPTH_BREAK.contains(&self.depth_break) {
+                    return Err(VariantError {
+                        knob: "depth_break",
+                        value: self.depth_break.to_string(),
+                        allowed: "in 1..=50 (percent of the nearer depth)".into(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The tail of a variant id: empty for `pixels` (ids of per-pixel variants are those of
+    /// before the knob), `-lowres{scale}-b{depth_break}` otherwise.
+    pub fn id_suffix(&self) -> String {
+        match self.sampling {
+            Sampling::Pixels => String::new(),
+            Sampling::Lowres => format!("-lowres{}-b{}", self.scale, self.depth_break),
+        }
+    }
+
+    /// The tail of a marker: empty for `pixels`, `-lr{scale}` (and `-b{depth_break}` where
+    /// it differs from the default) otherwise.
+    pub fn marker_suffix(&self) -> String {
+        match self.sampling {
+            Sampling::Pixels => String::new(),
+            Sampling::Lowres => {
+                let mut m = format!("-lr{}", self.scale);
+                if self.depth_break != Self::DEFAULT_DEPTH_BREAK {
+                    m += &format!("-b{}", self.depth_break);
+                }
+                m
+            }
+        }
+    }
+
+    /// The sample grid for a `screen` (width, height): the screen itself for `pixels`,
+    /// `ceil(screen / scale)` for `lowres`.
+    pub fn grid_size(&self, screen: [u32; 2]) -> [u32; 2] {
+        match self.sampling {
+            Sampling::Pixels => screen,
+            Sampling::Lowres => [
+                screen[0].div_ceil(self.scale),
+                screen[1].div_ceil(self.scale),
+            ],
+        }
+    }
+
+    /// The depth break as a fraction (`depth_break / 100`), as the kernels compile it in.
+    pub fn depth_break_fraction(&self) -> f32 {
+        self.depth_break as f32 / 100.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn knobs_validate_and_name_the_knob() {
+        assert!(SamplingKnobs::default().validate().is_ok());
+        assert!(SamplingKnobs::lowres(2).validate().is_ok());
+        assert!(SamplingKnobs::lowres(4).validate().is_ok());
+        assert_eq!(SamplingKnobs::lowres(3).validate().unwrap_err().knob, "scale");
+        let pixels_scale = SamplingKnobs {
+            scale: 4,
+            ..SamplingKnobs::default()
+        };
+        assert_eq!(pixels_scale.validate().unwrap_err().knob, "scale");
+        let bad_break = SamplingKnobs {
+            depth_break: 0,
+            ..SamplingKnobs::lowres(2)
+        };
+        assert_eq!(bad_break.validate().unwrap_err().knob, "depth_break");
+        assert_eq!("lowres".parse::<Sampling>(), Ok(Sampling::Lowres));
+        assert_eq!("epi".parse::<Sampling>().unwrap_err().knob, "sampling");
+    }
+
+    #[test]
+    fn ids_and_grids() {
+        assert_eq!(SamplingKnobs::default().id_suffix(), "");
+        assert_eq!(SamplingKnobs::lowres(4).id_suffix(), "-lowres4-b5");
+        assert_eq!(SamplingKnobs::lowres(2).marker_suffix(), "-lr2");
+        assert_eq!(SamplingKnobs::lowres(2).grid_size([67, 37]), [34, 19]);
+        assert_eq!(SamplingKnobs::lowres(4).grid_size([67, 37]), [17, 10]);
+        assert_eq!(SamplingKnobs::default().grid_size([67, 37]), [67, 37]);
+    }
+}
