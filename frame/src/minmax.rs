@@ -63,6 +63,8 @@ pub struct MinmaxVariant {
     pub scale: u32,
     /// `sampling = lowres`: the depth break in percent of the nearer depth.
     pub depth_break: u32,
+    /// `sampling = lowres`: the light break in percent of the brightest sample.
+    pub light_break: u32,
 }
 
 impl Default for MinmaxVariant {
@@ -73,6 +75,7 @@ impl Default for MinmaxVariant {
             sampling: Sampling::Pixels,
             scale: SamplingKnobs::DEFAULT_SCALE,
             depth_break: SamplingKnobs::DEFAULT_DEPTH_BREAK,
+            light_break: SamplingKnobs::DEFAULT_LIGHT_BREAK,
         }
     }
 }
@@ -89,6 +92,7 @@ impl MinmaxVariant {
             sampling: self.sampling,
             scale: self.scale,
             depth_break: self.depth_break,
+            light_break: self.light_break,
         }
     }
 
@@ -229,6 +233,7 @@ impl KnobSet for MinmaxVariant {
             sampling: s.sampling,
             scale: s.scale,
             depth_break: s.depth_break,
+            light_break: s.light_break,
             ..self
         }
     }

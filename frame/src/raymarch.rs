@@ -49,6 +49,8 @@ pub struct RaymarchVariant {
     pub scale: u32,
     /// `sampling = lowres`: the depth break in percent of the nearer depth.
     pub depth_break: u32,
+    /// `sampling = lowres`: the light break in percent of the brightest sample.
+    pub light_break: u32,
 }
 
 impl Default for RaymarchVariant {
@@ -62,6 +64,7 @@ impl Default for RaymarchVariant {
             sampling: Sampling::Pixels,
             scale: SamplingKnobs::DEFAULT_SCALE,
             depth_break: SamplingKnobs::DEFAULT_DEPTH_BREAK,
+            light_break: SamplingKnobs::DEFAULT_LIGHT_BREAK,
         }
     }
 }
@@ -112,6 +115,7 @@ impl RaymarchVariant {
             sampling: self.sampling,
             scale: self.scale,
             depth_break: self.depth_break,
+            light_break: self.light_break,
         }
     }
 
@@ -332,6 +336,7 @@ impl KnobSet for RaymarchVariant {
             sampling: s.sampling,
             scale: s.scale,
             depth_break: s.depth_break,
+            light_break: s.light_break,
             ..self
         }
     }

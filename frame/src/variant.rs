@@ -188,6 +188,8 @@ pub struct PrefilteredVariant {
     pub scale: u32,
     /// `sampling = lowres`: the depth break in percent of the nearer depth.
     pub depth_break: u32,
+    /// `sampling = lowres`: the light break in percent of the brightest sample.
+    pub light_break: u32,
 }
 
 impl Default for PrefilteredVariant {
@@ -205,6 +207,7 @@ impl Default for PrefilteredVariant {
             sampling: Sampling::Pixels,
             scale: SamplingKnobs::DEFAULT_SCALE,
             depth_break: SamplingKnobs::DEFAULT_DEPTH_BREAK,
+            light_break: SamplingKnobs::DEFAULT_LIGHT_BREAK,
         }
     }
 }
@@ -313,6 +316,7 @@ impl PrefilteredVariant {
             sampling: self.sampling,
             scale: self.scale,
             depth_break: self.depth_break,
+            light_break: self.light_break,
         }
     }
 
@@ -489,6 +493,7 @@ impl KnobSet for PrefilteredVariant {
             sampling: s.sampling,
             scale: s.scale,
             depth_break: s.depth_break,
+            light_break: s.light_break,
             ..self
         }
     }

@@ -42,7 +42,6 @@ use family::{Family, KernelFamily};
 use minmax::MinmaxVariant;
 use prefiltered::PrefilteredVariant;
 use raymarch::RaymarchVariant;
-use sampling::SamplingKnobs;
 pub use row_prefix::{RowPrefixMode, RowPrefixParams};
 
 // The kernel table: one line per kernel (name, template stem, parameter type, render
@@ -54,9 +53,6 @@ kernel::kernels! {
     /// Separable sum filter of interleaved sampling over the `raymarch` partial sums (Tóth &
     /// Umenhoffer 2009).
     InterleaveSum("interleave_sum", RaymarchVariant, raymarch::render_interleave_sum),
-    /// The depth-aware upsample of `sampling = lowres`, shared by every family: each pixel
-    /// blends its four nearest samples that are close to it in depth.
-    LowresUpsample("lowres_upsample", SamplingKnobs, sampling::render_lowres_upsample),
     /// The 1D min-max tree of every rectified row (Chen et al. 2011).
     MinmaxBuild("minmax_build", MinmaxVariant, minmax::render_build),
     /// Per pixel: the rectified row marched through its min-max tree, skipping nodes wholly

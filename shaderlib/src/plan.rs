@@ -319,28 +319,47 @@ impl BindingSource {
     }
 }
 
-/// Evaluates a plan formula (an integer, a parameter name, or a product of those, e.g.
-/// `16 * rectified.height`) with the parameters' values.
+/// Evaluates a plan formula (an integer, a parameter name, `ceil(a / b)` of two of those, or
+/// a product of those, e.g. `16 * rectified.height`, `ceil(screen.width / 2)`) with the
+/// parameters' values.
 ///
 /// # Errors
 ///
 /// A message naming the formula and the unknown symbol, the malformed term or the overflow.
 pub fn eval(formula: &str, params: &[(&str, u64)]) -> Result<u64, String> {
+    let atom = |term: &str| -> Result<u64, String> {
+        if let Ok(n) = term.parse::<u64>() {
+            Ok(n)
+        } else if let Some(&(_, v)) = params.iter().find(|(name, _)| *name == term) {
+            Ok(v)
+        } else if term.is_empty() {
+            Err(format!("formula `{formula}` has an empty term"))
+        } else {
+            let names: Vec<_> = params.iter().map(|(n, _)| *n).collect();
+            Err(format!(
+                "formula `{formula}` names `{term}`, which is not a parameter (known: {})",
+                names.join(", ")
+            ))
+        }
+    };
     let mut value: u64 = 1;
     for term in formula.split('*') {
         let term = term.trim();
-        let factor = if let Ok(n) = term.parse::<u64>() {
-            n
-        } else if let Some(&(_, v)) = params.iter().find(|(name, _)| *name == term) {
-            v
-        } else if term.is_empty() {
-            return Err(format!("formula `{formula}` has an empty term"));
+        // `ceil(a / b)`: integer division rounding up (a sample grid of the screen).
+        let factor = if let Some(inner) = term
+            .strip_prefix("ceil(")
+            .and_then(|t| t.strip_suffix(')'))
+        {
+            let (a, b) = inner
+                .split_once('/')
+                .ok_or_else(|| format!("formula `{formula}`: `ceil(` takes `a / b`"))?;
+            let (a, b) = (atom(a.trim())?, atom(b.trim())?);
+            if b == 0 {
+                return Err(format!("formula `{formula}` divides by zero"));
+            }
+            a.div_ceil(b)
         } else {
-            let names: Vec<_> = params.iter().map(|(n, _)| *n).collect();
-            return Err(format!(
-                "formula `{formula}` names `{term}`, which is not a parameter (known: {})",
-                names.join(", ")
-            ));
+            atom(term)?
         };
         value = value
             .checked_mul(factor)
@@ -363,5 +382,9 @@ mod tests {
         assert!(eval("tree.width", &p).unwrap_err().contains("tree.width"));
         assert!(eval("2 * ", &p).unwrap_err().contains("empty term"));
         assert!(eval("4294967296 * 4294967296", &p).is_err());
+        assert_eq!(eval("ceil(screen.width / 3)", &p), Ok(427));
+        assert_eq!(eval("2 * ceil(7 / 2)", &p), Ok(8));
+        assert!(eval("ceil(7 / 0)", &p).unwrap_err().contains("zero"));
+        assert!(eval("ceil(7)", &p).unwrap_err().contains("a / b"));
     }
 }

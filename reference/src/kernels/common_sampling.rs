@@ -1,10 +1,10 @@
 //! CPU mirror of `shaderlib/templates/common/sampling.wgsl` (`scatter::sampling`): where the
-//! samples of `sampling = lowres` stand and which of them stand for a pixel; and of the
-//! families' sampling entry point (`shaderlib/templates/include/sampled_entry.wgsl`),
-//! [`run_sampled`], which every family's per-pixel mirror calls with its pixel body.
+//! samples of `sampling = lowres` stand, which of them stand for a pixel and when a pixel is
+//! evaluated itself; and of the families' sampling entry point
+//! (`shaderlib/templates/include/sampled_entry.wgsl`), [`run_sampled`], which every family's
+//! per-pixel mirror calls with its pixel body.
 //! Conventions: `scatter_frame::sampling`.
 
-use super::lowres_upsample::lowres_upsample;
 use super::texture::{Tex, TexArray, quantise};
 use scatter_shaderlib::prefiltered::Storage;
 use scatter_shaderlib::sampling::{Sampling, SamplingKnobs};
@@ -33,25 +33,20 @@ pub fn depth_close(a: f32, b: f32, depth_break: f32) -> bool {
     a == b || (a - b).abs() <= depth_break * a.min(b)
 }
 
-/// The four samples nearest to a pixel and their weights.
+/// The four samples nearest to a pixel and their bilinear weights.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LowresTaps {
-    /// Columns (x0, x1) of the samples (x0, y0), (x1, y0), (x0, y1), (x1, y1).
+    /// Columns (x0, x1) of the samples (x0, y0), (x1, y0), (x0, y1), (x1, y1), clamped
+    /// inside the sample grid.
     pub cols: [u32; 2],
     /// Rows (y0, y1).
     pub rows: [u32; 2],
-    /// Their weights in that order: bilinear, times 0 for a sample not close in depth.
+    /// Their bilinear weights in that order: multiples of 1 / scale^2, exact in f32.
     pub w: [f32; 4],
 }
 
-/// The taps of pixel `p` (bilinear fractions are multiples of 1 / scale, exact in f32).
-pub fn lowres_taps(
-    depth: &Tex,
-    p: [u32; 2],
-    screen: [u32; 2],
-    scale: u32,
-    depth_break: f32,
-) -> LowresTaps {
+/// The taps of pixel `p`: sample i sits at pixel i S + S / 2.
+pub fn lowres_taps(p: [u32; 2], screen: [u32; 2], scale: u32) -> LowresTaps {
     let grid = lowres_grid(screen, scale).map(|g| g as i32);
     let f = [0, 1].map(|a| (p[a] as f32 - (scale / 2) as f32) / scale as f32);
     let fl = f.map(f32::floor);
@@ -59,51 +54,73 @@ pub fn lowres_taps(
     let i0 = fl.map(|v| v as i32);
     let lo = [0, 1].map(|a| i0[a].clamp(0, grid[a] - 1) as u32);
     let hi = [0, 1].map(|a| (i0[a] + 1).clamp(0, grid[a] - 1) as u32);
-    let d = depth.load(p[0], p[1]);
-    let mut t = LowresTaps {
+    LowresTaps {
         cols: [lo[0], hi[0]],
         rows: [lo[1], hi[1]],
-        w: [0.0; 4],
-    };
-    let bx = [1.0 - fr[0], fr[0]];
-    let by = [1.0 - fr[1], fr[1]];
-    for k in 0..4 {
-        let cx = k % 2;
-        let cy = k / 2;
-        let q = lowres_pixel([t.cols[cx], t.rows[cy]], screen, scale);
-        let mut w = 0.0;
-        if depth_close(depth.load(q[0], q[1]), d, depth_break) {
-            w = bx[cx] * by[cy];
-        }
-        t.w[k] = w;
+        w: [
+            (1.0 - fr[0]) * (1.0 - fr[1]),
+            fr[0] * (1.0 - fr[1]),
+            (1.0 - fr[0]) * fr[1],
+            fr[0] * fr[1],
+        ],
     }
-    t
 }
 
-/// Whether some sample stands for the pixel (a positive weight); if not, the family's
-/// sampling pass evaluates the pixel itself.
-pub fn lowres_covered(t: &LowresTaps) -> bool {
-    t.w.iter().any(|&w| w > 0.0)
+/// The pixel's radiance from its taps (`w` bilinear weights, `depths` of the taps' pixels,
+/// `light` their radiance, `d` the pixel's depth): the bilinear blend of the taps with a
+/// positive weight that lie within `depth_break` of `d`; `None` where the pixel needs its
+/// own evaluation (no such tap, or their spread over `light_break` of the brightest).
+pub fn lowres_blend(
+    w: [f32; 4],
+    depths: [f32; 4],
+    light: [[f32; 3]; 4],
+    d: f32,
+    depth_break: f32,
+    light_break: f32,
+) -> Option<[f32; 3]> {
+    let mut sum = [0.0f32; 3];
+    let mut total = 0.0f32;
+    let mut lo = [3.4e38f32; 3];
+    let mut hi = [0.0f32; 3];
+    for k in 0..4 {
+        if w[k] > 0.0 && depth_close(depths[k], d, depth_break) {
+            for c in 0..3 {
+                sum[c] += w[k] * light[k][c];
+                lo[c] = lo[c].min(light[k][c]);
+                hi[c] = hi[c].max(light[k][c]);
+            }
+            total += w[k];
+        }
+    }
+    if total <= 0.0 {
+        return None;
+    }
+    let spread = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+    if spread[0].max(spread[1].max(spread[2])) > light_break * hi[0].max(hi[1].max(hi[2])) {
+        return None;
+    }
+    Some(sum.map(|v| v / total))
 }
 
-/// The outputs of a family's per-pixel kernel and, for `lowres`, the upsample.
+/// The outputs of a family's per-pixel kernel.
 #[derive(Clone, Debug)]
 pub struct SampledOutput {
-    /// `lowres`: the samples as stored (rgba16float); `None` for `pixels`.
-    pub samples: Option<TexArray>,
     /// The screen-sized output as stored (rgba16float).
     pub output: TexArray,
-    /// Pixels the sampling pass evaluated itself (every pixel for `pixels`; for `lowres`
-    /// the samples plus the pixels no sample stands for).
+    /// Pixel evaluations (every pixel for `pixels`; for `lowres` the samples, without the
+    /// ring a workgroup evaluates again, plus the pixels evaluated themselves).
     pub evaluated: u64,
-    /// `lowres`: the pixels no sample stands for in depth (evaluated per pixel).
-    pub fallback: u64,
+    /// `lowres`: the pixels evaluated themselves because no sample is close in depth.
+    pub depth_refined: u64,
+    /// `lowres`: the pixels evaluated themselves because their samples' light differs.
+    pub light_refined: u64,
 }
 
-/// The family's sampling entry point and, for `lowres`, `lowres_upsample`: `pixel(x, y)` is
-/// the family's per-pixel body (radiance before rounding), `screen` the screen size.
-/// `pixels`: every pixel (rows in parallel). `lowres`: every sample, then per block the
-/// pixels no sample stands for, then the upsample of the rest.
+/// The family's sampling entry point (`include/sampled_entry.wgsl`): `pixel(x, y)` is the
+/// family's per-pixel body (radiance before rounding), `screen` the screen size.
+/// `pixels`: every pixel (rows in parallel). `lowres`: every sample, then every pixel the
+/// blend of its taps or its own evaluation. (The GPU evaluates the samples of a workgroup's
+/// ring again; the same pixel gives the same value, so the mirror evaluates each once.)
 pub fn run_sampled(
     knobs: &SamplingKnobs,
     screen: [u32; 2],
@@ -113,72 +130,78 @@ pub fn run_sampled(
     use rayon::prelude::*;
     let [w, h] = screen;
     let store = |c: [f32; 3]| [c[0], c[1], c[2], 1.0].map(|v| quantise(v, Storage::Rgba16float));
-    match knobs.sampling {
-        Sampling::Pixels => {
-            let data = (0..h)
-                .into_par_iter()
-                .flat_map_iter(|y| (0..w).map(move |x| store(pixel(x, y))))
-                .collect();
-            SampledOutput {
-                samples: None,
-                output: TexArray {
-                    width: w,
-                    height: h,
-                    layers: 1,
-                    data,
-                },
-                evaluated: u64::from(w) * u64::from(h),
-                fallback: 0,
-            }
-        }
-        Sampling::Lowres => {
-            let scale = knobs.scale;
-            let depth_break = knobs.depth_break_fraction();
-            let grid = lowres_grid(screen, scale);
-            // Per sample: its value, then the block's pixels no sample stands for.
-            type Block = ([f32; 4], Vec<([u32; 2], [f32; 4])>);
-            let blocks: Vec<Block> = (0..grid[1])
-                .into_par_iter()
-                .flat_map_iter(|j| {
-                    (0..grid[0]).map(move |i| {
-                        let p = lowres_pixel([i, j], screen, scale);
-                        let c = store(pixel(p[0], p[1]));
-                        let mut own = Vec::new();
-                        for k in 0..scale * scale {
-                            let q = [i * scale + k % scale, j * scale + k / scale];
-                            if q[0] < w
-                                && q[1] < h
-                                && !lowres_covered(&lowres_taps(depth, q, screen, scale, depth_break))
-                            {
-                                own.push((q, store(pixel(q[0], q[1]))));
-                            }
-                        }
-                        (c, own)
-                    })
-                })
-                .collect();
-            let mut output = TexArray::new(w, h, 1);
-            let mut fallback = 0;
-            for (_, own) in &blocks {
-                for &(q, c) in own {
-                    output.data[(q[1] * w + q[0]) as usize] = c;
-                    fallback += 1;
-                }
-            }
-            let samples = TexArray {
-                width: grid[0],
-                height: grid[1],
+    if knobs.sampling == Sampling::Pixels {
+        let data = (0..h)
+            .into_par_iter()
+            .flat_map_iter(|y| (0..w).map(move |x| store(pixel(x, y))))
+            .collect();
+        return SampledOutput {
+            output: TexArray {
+                width: w,
+                height: h,
                 layers: 1,
-                data: blocks.iter().map(|(c, _)| *c).collect(),
-            };
-            lowres_upsample(knobs, depth, &samples, &mut output);
-            SampledOutput {
-                samples: Some(samples),
-                output,
-                evaluated: u64::from(grid[0]) * u64::from(grid[1]) + fallback,
-                fallback,
-            }
-        }
+                data,
+            },
+            evaluated: u64::from(w) * u64::from(h),
+            depth_refined: 0,
+            light_refined: 0,
+        };
+    }
+    let scale = knobs.scale;
+    let (depth_break, light_break) = (knobs.depth_break_fraction(), knobs.light_break_fraction());
+    let grid = lowres_grid(screen, scale);
+    // Phase 1: every sample's radiance and its pixel's depth.
+    let samples: Vec<([f32; 3], f32)> = (0..grid[1])
+        .into_par_iter()
+        .flat_map_iter(|j| {
+            (0..grid[0]).map(move |i| {
+                let p = lowres_pixel([i, j], screen, scale);
+                (pixel(p[0], p[1]), depth.load(p[0], p[1]))
+            })
+        })
+        .collect();
+    // Phase 2: every pixel, blended or evaluated (0 = blended, 1 = no sample close in
+    // depth, 2 = the samples' light differs).
+    let pixels: Vec<([f32; 4], u8)> = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let samples = &samples;
+            (0..w).map(move |x| {
+                let t = lowres_taps([x, y], screen, scale);
+                let mut depths = [0.0f32; 4];
+                let mut light = [[0.0f32; 3]; 4];
+                for j in 0..4 {
+                    let (c, d) = samples[(t.rows[j / 2] * grid[0] + t.cols[j % 2]) as usize];
+                    depths[j] = d;
+                    light[j] = c;
+                }
+                let d = depth.load(x, y);
+                match lowres_blend(t.w, depths, light, d, depth_break, light_break) {
+                    Some(c) => (store(c), 0),
+                    None => {
+                        let why = if lowres_blend(t.w, depths, light, d, depth_break, 1.0).is_none() {
+                            1
+                        } else {
+                            2
+                        };
+                        (store(pixel(x, y)), why)
+                    }
+                }
+            })
+        })
+        .collect();
+    let depth_refined = pixels.iter().filter(|p| p.1 == 1).count() as u64;
+    let light_refined = pixels.iter().filter(|p| p.1 == 2).count() as u64;
+    SampledOutput {
+        output: TexArray {
+            width: w,
+            height: h,
+            layers: 1,
+            data: pixels.into_iter().map(|p| p.0).collect(),
+        },
+        evaluated: u64::from(grid[0]) * u64::from(grid[1]) + depth_refined + light_refined,
+        depth_refined,
+        light_refined,
     }
 }
 
@@ -195,23 +218,27 @@ mod tests {
     }
 
     #[test]
-    fn taps_follow_depth() {
-        let mut depth = Tex::new(8, 8);
-        depth.data.iter_mut().for_each(|d| *d = 10.0);
+    fn taps_and_blends() {
         // A sample pixel is its own tap with weight 1.
-        let t = lowres_taps(&depth, [3, 3], [8, 8], 2, 0.05);
+        let t = lowres_taps([3, 3], [8, 8], 2);
         assert_eq!(t.w, [1.0, 0.0, 0.0, 0.0]);
         assert_eq!((t.cols, t.rows), ([1, 2], [1, 2]));
         // Between four samples: a quarter each.
-        let t = lowres_taps(&depth, [4, 4], [8, 8], 2, 0.05);
+        let t = lowres_taps([4, 4], [8, 8], 2);
         assert_eq!(t.w, [0.25; 4]);
-        // A near occluder on one pixel (no sample stands on column 4): none of the samples stands for it.
-        depth.store(4, 4, 2.0);
-        let t = lowres_taps(&depth, [4, 4], [8, 8], 2, 0.05);
-        assert!(!lowres_covered(&t));
-        // Infinite depths are equal.
-        depth.data.iter_mut().for_each(|d| *d = f32::INFINITY);
-        assert!(lowres_covered(&lowres_taps(&depth, [4, 4], [8, 8], 2, 0.05)));
+        let light = [[1.0, 1.0, 1.0], [1.1, 1.1, 1.1], [0.9, 0.9, 0.9], [1.0, 1.0, 1.0]];
+        let c = lowres_blend(t.w, [10.0; 4], light, 10.0, 0.05, 0.25).expect("blends");
+        assert!((c[0] - 1.0).abs() < 1e-6);
+        // A near occluder: no tap is close in depth.
+        assert_eq!(lowres_blend(t.w, [10.0; 4], light, 2.0, 0.05, 0.25), None);
+        // A shadow edge between the taps: their spread is over the light break.
+        assert_eq!(lowres_blend(t.w, [10.0; 4], light, 10.0, 0.05, 0.1), None);
+        // Only the taps close in depth count, for the blend and for the spread.
+        let c = lowres_blend(t.w, [10.0, 10.0, 2.0, 2.0], [[1.0; 3], [1.0; 3], [9.0; 3], [9.0; 3]], 10.0, 0.05, 0.1);
+        assert_eq!(c, Some([1.0; 3]));
+        // Infinite depths are equal; a light break of 1 never refines.
+        let inf = f32::INFINITY;
+        assert!(lowres_blend(t.w, [inf; 4], [[0.0; 3], [5.0; 3], [0.0; 3], [0.0; 3]], inf, 0.05, 1.0).is_some());
     }
 
     #[test]
@@ -227,7 +254,7 @@ mod tests {
         let px = run_sampled(&SamplingKnobs::default(), screen, &depth, &body);
         for scale in [2, 4] {
             let lr = run_sampled(&SamplingKnobs::lowres(scale), screen, &depth, &body);
-            assert!(lr.fallback > 0, "the one-pixel column is evaluated per pixel");
+            assert!(lr.depth_refined > 0, "the one-pixel column is evaluated per pixel");
             for (a, b) in px.output.data.iter().zip(&lr.output.data) {
                 for c in 0..3 {
                     assert!((a[c] - b[c]).abs() <= 0.1 * scale as f32, "{a:?} {b:?}");

@@ -16,7 +16,6 @@ pub mod common_shadow;
 pub mod depth_columns;
 pub mod family;
 pub mod interleave_sum;
-pub mod lowres_upsample;
 pub mod minmax_build;
 pub mod minmax_traverse;
 pub mod prefilter;

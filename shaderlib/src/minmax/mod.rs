@@ -66,7 +66,7 @@ pub(crate) fn render_traverse(variant: &MinmaxVariant) -> Result<String, ShaderE
     TraverseTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
-        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::MinmaxTraverse, 6),
+        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::MinmaxTraverse),
     }
     .render()
     .map_err(|source| ShaderError::Render {
@@ -93,9 +93,7 @@ impl crate::KernelParams {
 
 impl crate::family::KernelFamily for MinmaxVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
-        let mut out = crate::KernelParams::minmax(*self).to_vec();
-        out.extend(crate::sampling::sampling_kernels(&self.sampling_knobs()));
-        out
+        crate::KernelParams::minmax(*self).to_vec()
     }
 
     fn plan(&self) -> crate::plan::Plan {

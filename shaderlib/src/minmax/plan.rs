@@ -10,9 +10,7 @@ use crate::plan::{
 };
 use crate::Kernel;
 use crate::family::KernelFamily;
-use crate::sampling::{
-    sampling_bindings, sampling_invocations, sampling_resources, upsample_pass,
-};
+use crate::sampling::sampling_invocations;
 
 /// The resources and passes of a variant, as `runtime/src/minmax.rs` creates them.
 pub fn plan(v: &MinmaxVariant) -> Plan {
@@ -40,7 +38,7 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
         },
     ]);
     let [depth, shadow_map] = depth_and_shadow_map();
-    let mut resources = vec![
+    let resources = vec![
         frame_buffer(
             "frame",
             "the uniform block of the frame (Rust: scatter_frame::frame::FrameUniforms from \
@@ -81,7 +79,6 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
             "screen.height",
         ),
     ];
-    resources.extend(sampling_resources(&v.sampling_knobs()));
     let passes = v
         .kernel_params()
         .iter()
@@ -150,12 +147,8 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
                 bind(3, "shadow_map"),
                 bind(4, "tree"),
                 bind(5, "output"),
-            ]
-            .into_iter()
-            .chain(sampling_bindings(&v.sampling_knobs(), 6))
-            .collect(),
+            ],
         }),
-        Kernel::LowresUpsample => upsample_pass(&v.sampling_knobs()),
         _ => None,
     }
 }

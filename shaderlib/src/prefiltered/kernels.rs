@@ -173,7 +173,7 @@ pub(crate) fn render_scatter(variant: &PrefilteredVariant) -> Result<String, Sha
         projective: variant.rectification == Rectification::Projective,
         moments: variant.basis == Basis::Moments,
         moment_count: variant.moments,
-        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::Scatter, 7),
+        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::Scatter),
     }
     .render()
     .map_err(render_error(Kernel::Scatter))

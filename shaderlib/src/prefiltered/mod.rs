@@ -37,9 +37,7 @@ impl crate::KernelParams {
 
 impl crate::family::KernelFamily for PrefilteredVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
-        let mut out = crate::KernelParams::prefiltered(*self).to_vec();
-        out.extend(crate::sampling::sampling_kernels(&self.sampling_knobs()));
-        out
+        crate::KernelParams::prefiltered(*self).to_vec()
     }
 
     fn plan(&self) -> crate::plan::Plan {

@@ -10,9 +10,7 @@ use crate::plan::{
 };
 use crate::prefiltered::{Basis, PrefilteredVariant, Rectification};
 use crate::family::KernelFamily;
-use crate::sampling::{
-    sampling_bindings, sampling_invocations, sampling_resources, upsample_pass,
-};
+use crate::sampling::sampling_invocations;
 use crate::Kernel;
 
 /// The per-frame condition of a projective frame (the frame set-up falls back to epipolar
@@ -124,7 +122,6 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
     }
     // One pass per kernel shaderlib lists for the variant, in its order; a kernel this
     // module does not know gets no pass, and generation names it.
-    resources.extend(sampling_resources(&v.sampling_knobs()));
     let passes = v
         .kernel_params()
         .iter()
@@ -246,12 +243,8 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                 bind(4, "filtered"),
                 bind(5, "output"),
                 bind(6, "bounds"),
-            ]
-            .into_iter()
-            .chain(sampling_bindings(&v.sampling_knobs(), 7))
-            .collect(),
+            ],
         }),
-        Kernel::LowresUpsample => upsample_pass(&v.sampling_knobs()),
         _ => None,
     }
 }

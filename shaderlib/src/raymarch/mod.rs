@@ -55,7 +55,7 @@ pub(crate) fn render_raymarch(variant: &RaymarchVariant) -> Result<String, Shade
         } else {
             "rgba16float"
         },
-        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::Raymarch, 4),
+        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::Raymarch),
     }
     .render()
     .map_err(|source| ShaderError::Render {
@@ -94,7 +94,6 @@ impl crate::KernelParams {
         if variant.interleaved() {
             out.push(Self::InterleaveSum(variant));
         }
-        out.extend(crate::sampling::sampling_kernels(&variant.sampling_knobs()));
         out
     }
 }

@@ -7,9 +7,7 @@ use crate::plan::{
     screen_and_shadow_parameters,
 };
 use crate::raymarch::{PARTIAL_FORMAT, RaymarchVariant};
-use crate::sampling::{
-    sampling_bindings, sampling_invocations, sampling_resources, upsample_pass,
-};
+use crate::sampling::sampling_invocations;
 use crate::{Kernel, KernelParams};
 
 /// The resources and passes of a variant, as `runtime/src/raymarch.rs` creates them.
@@ -43,7 +41,6 @@ pub fn plan(v: &RaymarchVariant) -> Plan {
             "screen.height",
         ));
     }
-    resources.extend(sampling_resources(&v.sampling_knobs()));
     let passes = KernelParams::raymarch(*v)
         .iter()
         .filter_map(|p| pass(v, p.kernel()))
@@ -74,12 +71,8 @@ pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
                 bind(1, "depth"),
                 bind(2, "shadow_map"),
                 bind(3, if v.interleaved() { "partial" } else { "output" }),
-            ]
-            .into_iter()
-            .chain(sampling_bindings(&v.sampling_knobs(), 4))
-            .collect(),
+            ],
         }),
-        Kernel::LowresUpsample => upsample_pass(&v.sampling_knobs()),
         Kernel::InterleaveSum => Some(PassPlan {
             kernel,
             invocations: screen(),

@@ -1,7 +1,7 @@
 // scatter::sampling: the low-resolution sampling stage every family can use (`sampling =
-// lowres`): where sample (i, j) stands, and which samples stand for a screen pixel (the
-// four nearest, each only when close to the pixel in view depth). Host side and the
-// reasoning: scatter_frame::sampling.
+// lowres`): where sample (i, j) stands, which samples stand for a screen pixel, and when a
+// pixel needs its own evaluation instead. Host side and the reasoning:
+// scatter_frame::sampling.
 //
 // Mirrors reference/src/kernels/common_sampling.rs
 
@@ -25,21 +25,18 @@ fn depth_close(a: f32, b: f32, depth_break: f32) -> bool {
     return a == b || abs(a - b) <= depth_break * min(a, b);
 }
 
-// The four samples nearest to a pixel and their weights.
+// The four samples nearest to a pixel and their bilinear weights.
 struct LowresTaps {
     // Columns (x0, x1) and rows (y0, y1) of the samples (x0, y0), (x1, y0), (x0, y1),
     // (x1, y1), clamped inside the sample grid.
     cols: vec2<u32>,
     rows: vec2<u32>,
-    // Their weights in that order: bilinear, times 0 for a sample not close in depth.
+    // Their bilinear weights in that order: multiples of 1 / scale^2, exact in f32.
     w: vec4<f32>,
 }
 
-// The taps of pixel `p`. The bilinear fractions are multiples of 1 / scale, exact in f32, so
-// a weight is exactly 0 only where the pixel lies on a sample's row or column, in every
-// module that calls this: `lowres_covered` decides the same for the sampling pass and the
-// upsample.
-fn lowres_taps(depth: texture_2d<f32>, p: vec2<u32>, screen: vec2<u32>, scale: u32, depth_break: f32) -> LowresTaps {
+// The taps of pixel `p`: sample i sits at pixel i S + S / 2.
+fn lowres_taps(p: vec2<u32>, screen: vec2<u32>, scale: u32) -> LowresTaps {
     let grid = vec2<i32>(lowres_grid(screen, scale));
     let f = (vec2<f32>(p) - vec2<f32>(f32(scale / 2u))) / f32(scale);
     let fl = floor(f);
@@ -47,27 +44,39 @@ fn lowres_taps(depth: texture_2d<f32>, p: vec2<u32>, screen: vec2<u32>, scale: u
     let i0 = vec2<i32>(fl);
     let lo = vec2<u32>(clamp(i0, vec2<i32>(0), grid - vec2<i32>(1)));
     let hi = vec2<u32>(clamp(i0 + vec2<i32>(1), vec2<i32>(0), grid - vec2<i32>(1)));
-    let d = textureLoad(depth, p, 0).x;
     var t: LowresTaps;
     t.cols = vec2<u32>(lo.x, hi.x);
     t.rows = vec2<u32>(lo.y, hi.y);
-    let bx = vec2<f32>(1.0 - fr.x, fr.x);
-    let by = vec2<f32>(1.0 - fr.y, fr.y);
-    for (var k = 0u; k < 4u; k++) {
-        let cx = k % 2u;
-        let cy = k / 2u;
-        let q = lowres_pixel(vec2<u32>(t.cols[cx], t.rows[cy]), screen, scale);
-        var w = 0.0;
-        if depth_close(textureLoad(depth, q, 0).x, d, depth_break) {
-            w = bx[cx] * by[cy];
-        }
-        t.w[k] = w;
-    }
+    t.w = vec4<f32>((1.0 - fr.x) * (1.0 - fr.y), fr.x * (1.0 - fr.y), (1.0 - fr.x) * fr.y, fr.x * fr.y);
     return t;
 }
 
-// Whether some sample stands for pixel `p` (a positive weight); if not, the family's
-// sampling pass evaluates the pixel itself.
-fn lowres_covered(t: LowresTaps) -> bool {
-    return t.w.x > 0.0 || t.w.y > 0.0 || t.w.z > 0.0 || t.w.w > 0.0;
+// The pixel's radiance from its taps (`w` bilinear weights, `depths` of the taps' pixels,
+// `light` their radiance, `d` the pixel's depth): the bilinear blend of the taps with a
+// positive weight that lie within `depth_break` of `d`, in (rgb, 1); or alpha 0 where the
+// pixel needs its own evaluation: no such tap (a depth break: a thin occluder, a
+// silhouette), or the taps differ by more than `light_break` of the brightest channel of
+// the brightest one (a shadow edge, the lamp; Yusov 2013's second criterion).
+fn lowres_blend(w: vec4<f32>, depths: vec4<f32>, light: array<vec3<f32>, 4>, d: f32, depth_break: f32, light_break: f32) -> vec4<f32> {
+    var sum = vec3<f32>(0.0, 0.0, 0.0);
+    var total = 0.0;
+    var lo = vec3<f32>(3.4e38, 3.4e38, 3.4e38);
+    var hi = vec3<f32>(0.0, 0.0, 0.0);
+    for (var k = 0u; k < 4u; k++) {
+        if w[k] > 0.0 && depth_close(depths[k], d, depth_break) {
+            sum += w[k] * light[k];
+            total += w[k];
+            lo = min(lo, light[k]);
+            hi = max(hi, light[k]);
+        }
+    }
+    if total <= 0.0 {
+        return vec4<f32>(0.0, 0.0, 0.0, 0.0);
+    }
+    let spread = hi - lo;
+    if max(spread.x, max(spread.y, spread.z)) > light_break * max(hi.x, max(hi.y, hi.z)) {
+        return vec4<f32>(0.0, 0.0, 0.0, 0.0);
+    }
+    let c = sum / total;
+    return vec4<f32>(c.x, c.y, c.z, 1.0);
 }

@@ -1,7 +1,7 @@
 {%- if sampling.lowres %}
-@group(0) @binding({{ sampling.samples_binding }}) var samples: texture_storage_2d<rgba16float, write>;
 
-// The low-resolution grid's block side S and depth break (a fraction of the nearer depth).
+// The low-resolution grid's block side S, and its depth and light breaks (fractions).
 const SCALE: u32 = {{ sampling.scale }}u;
 const DEPTH_BREAK: f32 = {{ sampling.depth_break }};
+const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 {%- endif %}

@@ -1,0 +1,473 @@
+//! The sampling stage (`sampling = lowres`, `scatter_frame::sampling`) of every family.
+//!
+//! GPU against the mirror, `sampling::<family>::<variant id>::<scene>::<pose>`: the sampled
+//! variant on the GPU (the family's lowres pass) against the CPU mirror of the sampling
+//! stage (`scatter_reference::kernels::common_sampling`: `lowres_taps`, `lowres_blend`) fed
+//! with the same family's per-pixel output from the GPU, so that the trial checks the stage
+//! alone (the families' own trials check their pixel bodies).
+//! Every family x both lights (directional on `columns`, spot on `spot_grate`) x scale {2, 4},
+//! at the `ordinary` and `epipole_on_screen` poses, at 67x37 pixels (not a multiple of
+//! either block side, nor of the 8x8 workgroups). Tolerance: `1e-4 * max radiance` plus one
+//! f16 step of the expected value (both round to rgba16float), plus for a blend one f16 step
+//! of the largest tap (the GPU blends its f32 samples, the mirror here their stored f16
+//! values); where the light criterion is within two f16 steps of flipping, either outcome.
+//!
+//! Accuracy, `sampling::accuracy::<family label>`: the sampled variant against the same
+//! family per pixel (the interpolation error alone) and against the `shadow_map` truth on
+//! every suite scene and pose at 320x180 (GPU, or the CPU mirrors with `SCATTER_GPU=off`).
+//! Bars: over the 24 poses, the suite-mean rel L1 against the truth at most
+//! [`MEAN_ADDED`] above the per-pixel variant's, and no pose more than [`POSE_ADDED`]
+//! above; 0 NaN/Inf. The error within 2 pixels of a depth break (a neighbour more than 5 %
+//! apart in depth) is reported apart from the rest, with the share of pixels evaluated per
+//! pixel (the samples plus the pixels no sample stands for).
+//!
+//! `cargo test -p scatter-conformance --test sampling -- --nocapture` prints the tables.
+
+use std::process::ExitCode;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use scatter_conformance::{Check, Fixture, gpu, run_trials, run_variant, scene_for};
+use scatter_reference::buffers::{GBuffer, ShadowMap};
+use scatter_reference::bvh::Bvh;
+use scatter_reference::image::Image;
+use scatter_reference::kernels::CpuFrame;
+use scatter_reference::kernels::common_sampling::{
+    depth_close, lowres_blend, lowres_pixel, lowres_taps,
+};
+use scatter_reference::kernels::texture::Tex;
+use scatter_reference::metrics;
+use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
+use scatter_reference::truth::{self, TruthSettings, Visibility};
+use scatter_shaderlib::family::{Family, FamilyVariant};
+use scatter_shaderlib::prefiltered::{FrameSettings, LightKind};
+use scatter_shaderlib::sampling::SamplingKnobs;
+
+/// Screen of the GPU-against-mirror trials.
+const SCREEN: [u32; 2] = [67, 37];
+/// Shadow map of the GPU-against-mirror trials.
+const SHADOW_MAP: u32 = 128;
+/// Rectified map of the GPU-against-mirror trials.
+const RECTIFIED: [u32; 2] = [64, 64];
+/// Relative tolerance of the GPU against the mirror.
+const REL_TOL: f32 = 1e-4;
+
+/// Screen of the accuracy trials (as `prefiltered_truth`).
+const TRUTH_SCREEN: [u32; 2] = [320, 180];
+/// Shadow map of the accuracy trials.
+const TRUTH_SHADOW_MAP: u32 = 1024;
+/// Rectified map of the accuracy trials.
+const TRUTH_RECTIFIED: [u32; 2] = [512, 512];
+/// The most the suite-mean rel L1 against the truth may grow, sampled against per pixel
+/// (the bar: half a point).
+const MEAN_ADDED: f64 = 0.005;
+/// The most any one pose's rel L1 may grow (the bar: one point).
+const POSE_ADDED: f64 = 0.01;
+/// A depth break for the report's edge mask: neighbours more than 5 % apart in depth.
+const EDGE_BREAK: f32 = 0.05;
+/// The edge mask's reach: pixels within 2 pixels of a depth break.
+const EDGE_REACH: i32 = 2;
+
+/// Spacing of f16 values at `v`.
+fn f16_ulp(v: f32) -> f32 {
+    let a = v.abs();
+    if !a.is_finite() || a < 2f32.powi(-14) {
+        return 2f32.powi(-24);
+    }
+    2f32.powi(a.log2().floor() as i32 - 10)
+}
+
+/// The families' default variants with `light`, per pixel.
+fn bases(light: LightKind) -> Vec<FamilyVariant> {
+    Family::ALL
+        .iter()
+        .map(|f| f.default_variant().with_light(light))
+        .collect()
+}
+
+/// The sampled configurations the trials run.
+fn knobs() -> [SamplingKnobs; 2] {
+    [SamplingKnobs::lowres(2), SamplingKnobs::lowres(4)]
+}
+
+fn fixture(light: LightKind, pose: Pose) -> Arc<Fixture> {
+    type Cache = Mutex<Vec<((LightKind, Pose), Arc<OnceLock<Arc<Fixture>>>)>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let cell = {
+        let mut cache = CACHE.get_or_init(Default::default).lock().expect("cache");
+        if let Some((_, c)) = cache.iter().find(|(k, _)| *k == (light, pose)) {
+            c.clone()
+        } else {
+            let c: Arc<OnceLock<Arc<Fixture>>> = Arc::default();
+            cache.push(((light, pose), c.clone()));
+            c
+        }
+    };
+    cell.get_or_init(|| Arc::new(Fixture::new(scene_for(light), pose, SCREEN, SHADOW_MAP)))
+        .clone()
+}
+
+fn depth_tex(gbuf: &GBuffer) -> Tex {
+    Tex {
+        width: gbuf.width,
+        height: gbuf.height,
+        data: gbuf.view_depth.clone(),
+    }
+}
+
+/// One GPU-against-mirror trial: every pixel of the GPU's sampled output against the
+/// mirror's `lowres_blend` of the GPU's per-pixel output at the taps' sample pixels, or
+/// against the per-pixel output where the mirror evaluates the pixel itself.
+fn stage_trial(
+    ctx: &'static scatter_runtime::Context,
+    base: FamilyVariant,
+    knobs: SamplingKnobs,
+    pose: Pose,
+) -> Result<(), String> {
+    let f = fixture(base.light(), pose);
+    let sampled = base.with_sampling(knobs);
+    let settings = FrameSettings::for_screen(SCREEN[0], SCREEN[1]);
+    let frame = CpuFrame {
+        scene: &f.scene,
+        bvh: &f.bvh,
+        gbuf: &f.gbuf,
+        shadow_map: &f.shadow_map,
+        rectified: RECTIFIED,
+        settings: &settings,
+    };
+    let (pixels, _) = run_variant(Some(ctx), &base, &frame)?;
+    let (gpu, _) = run_variant(Some(ctx), &sampled, &frame)?;
+    let depth = depth_tex(&f.gbuf);
+    let [w, _] = SCREEN;
+    let at = |p: [u32; 2]| pixels.data[(p[1] * w + p[0]) as usize];
+    let max = pixels
+        .data
+        .iter()
+        .flat_map(|c| c.iter().copied())
+        .fold(0.0f32, f32::max);
+    if max.is_nan() || max <= 0.0 {
+        return Err("the per-pixel image is black".into());
+    }
+    let (depth_break, light_break) = (knobs.depth_break_fraction(), knobs.light_break_fraction());
+    let (mut blended, mut refined, mut ties, mut over) = (0, 0, 0, 0);
+    let mut worst = 0.0f32;
+    let mut first = None;
+    for (i, g) in gpu.data.iter().enumerate() {
+        let q = [i as u32 % w, i as u32 / w];
+        let t = lowres_taps(q, SCREEN, knobs.scale);
+        let mut depths = [0.0f32; 4];
+        let mut light = [[0.0f32; 3]; 4];
+        let mut tap_max = 0.0f32;
+        for j in 0..4 {
+            let p = lowres_pixel([t.cols[j % 2], t.rows[j / 2]], SCREEN, knobs.scale);
+            depths[j] = depth.load(p[0], p[1]);
+            light[j] = at(p);
+            tap_max = light[j].iter().copied().fold(tap_max, f32::max);
+        }
+        let d = depth.load(q[0], q[1]);
+        let blend = lowres_blend(t.w, depths, light, d, depth_break, light_break);
+        // The light criterion within two f16 steps of the taps' largest value of flipping:
+        // the GPU decides on f32 samples, the mirror here on the stored (f16) ones.
+        let margin = 2.0 * f16_ulp(tap_max);
+        let lower = lowres_blend(t.w, depths, light, d, depth_break, (light_break - margin / tap_max.max(1e-30)).max(0.0));
+        let upper = lowres_blend(t.w, depths, light, d, depth_break, light_break + margin / tap_max.max(1e-30));
+        let tie = lower.is_some() != upper.is_some();
+        let mut candidates = Vec::new();
+        match blend {
+            Some(c) => {
+                blended += 1;
+                candidates.push((c, f16_ulp(tap_max)));
+            }
+            None => {
+                refined += 1;
+                candidates.push((at(q), 0.0));
+            }
+        }
+        if tie {
+            ties += 1;
+            candidates.push((at(q), 0.0));
+            if let Some(c) = upper {
+                candidates.push((c, f16_ulp(tap_max)));
+            }
+        }
+        let ok = candidates.iter().any(|(c, extra)| {
+            (0..3).all(|k| {
+                let diff = (g[k] - c[k]).abs();
+                diff <= REL_TOL * max + f16_ulp(c[k]) + extra
+            })
+        });
+        let (c, _) = candidates[0];
+        let diff = (0..3).map(|k| (g[k] - c[k]).abs()).fold(0.0f32, |m, v| if v.is_nan() { f32::INFINITY } else { m.max(v) });
+        worst = worst.max(diff);
+        if !ok {
+            over += 1;
+            first.get_or_insert((q, *g, c));
+        }
+    }
+    if over > 0 {
+        return Err(format!(
+            "{over} pixels over tolerance, first at {first:?}; worst |diff| {worst:e} (max {max:e})"
+        ));
+    }
+    println!(
+        "sampling::{}::{}::{pose}: {blended} pixels blended, {refined} evaluated themselves, {ties} light-criterion ties; max |diff| {:.2e} of max",
+        sampled.trial_name(),
+        scene_for(base.light()),
+        worst / max
+    );
+    Ok(())
+}
+
+/// Scene, buffers and `shadow_map` truth of one suite pose at [`TRUTH_SCREEN`].
+struct TruthFixture {
+    scene: scatter_reference::scene::Scene,
+    bvh: Bvh,
+    gbuf: GBuffer,
+    shadow_map: ShadowMap,
+    truth: Image,
+}
+
+fn truth_fixture(name: SceneName, pose: Pose) -> Arc<TruthFixture> {
+    type Cache = Mutex<Vec<((SceneName, Pose), Arc<OnceLock<Arc<TruthFixture>>>)>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let cell = {
+        let mut cache = CACHE.get_or_init(Default::default).lock().expect("cache");
+        if let Some((_, c)) = cache.iter().find(|(k, _)| *k == (name, pose)) {
+            c.clone()
+        } else {
+            let c: Arc<OnceLock<Arc<TruthFixture>>> = Arc::default();
+            cache.push(((name, pose), c.clone()));
+            c
+        }
+    };
+    cell.get_or_init(|| {
+        let scene = suite::scene(
+            name,
+            pose,
+            MediumPreset::Default,
+            TRUTH_SCREEN[0],
+            TRUTH_SCREEN[1],
+        );
+        let bvh = Bvh::build(&scene.geometry);
+        let gbuf = GBuffer::cast(&scene, &bvh);
+        let shadow_map =
+            ShadowMap::build(&scene, &bvh, TRUTH_SHADOW_MAP).expect("suite shadow map");
+        let truth = truth::render(
+            &scene,
+            &gbuf,
+            &Visibility::ShadowMap(&shadow_map),
+            &TruthSettings::default(),
+            &|| (),
+        );
+        Arc::new(TruthFixture {
+            scene,
+            bvh,
+            gbuf,
+            shadow_map,
+            truth,
+        })
+    })
+    .clone()
+}
+
+/// Pixels within [`EDGE_REACH`] of a depth break.
+fn edge_mask(gbuf: &GBuffer) -> Vec<bool> {
+    let (w, h) = (gbuf.width as i32, gbuf.height as i32);
+    let d = |x: i32, y: i32| gbuf.view_depth[(y * w + x) as usize];
+    let mut brk = vec![false; (w * h) as usize];
+    for y in 0..h {
+        for x in 0..w {
+            let here = d(x, y);
+            let broken = [(1, 0), (0, 1)].iter().any(|&(dx, dy)| {
+                let (nx, ny) = (x + dx, y + dy);
+                nx < w && ny < h && !depth_close(here, d(nx, ny), EDGE_BREAK)
+            });
+            if broken {
+                brk[(y * w + x) as usize] = true;
+                if x + 1 < w {
+                    brk[(y * w + x + 1) as usize] |= here != d(x + 1, y);
+                }
+                if y + 1 < h {
+                    brk[((y + 1) * w + x) as usize] |= here != d(x, y + 1);
+                }
+            }
+        }
+    }
+    let mut mask = vec![false; (w * h) as usize];
+    for y in 0..h {
+        for x in 0..w {
+            if !brk[(y * w + x) as usize] {
+                continue;
+            }
+            for yy in (y - EDGE_REACH).max(0)..=(y + EDGE_REACH).min(h - 1) {
+                for xx in (x - EDGE_REACH).max(0)..=(x + EDGE_REACH).min(w - 1) {
+                    mask[(yy * w + xx) as usize] = true;
+                }
+            }
+        }
+    }
+    mask
+}
+
+/// rel L1 of `img` against `reference` over the pixels where `mask == keep`.
+fn masked_rel_l1(img: &Image, reference: &Image, mask: &[bool], keep: bool) -> f64 {
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for ((a, r), &m) in img.data.iter().zip(&reference.data).zip(mask) {
+        if m != keep {
+            continue;
+        }
+        for c in 0..3 {
+            num += (f64::from(a[c]) - f64::from(r[c])).abs();
+            den += f64::from(r[c]).abs();
+        }
+    }
+    if den > 0.0 { num / den } else { 0.0 }
+}
+
+/// One pose's measurements of a sampled variant.
+struct PoseRow {
+    pose: String,
+    pixels: f64,
+    sampled: f64,
+    interpolation: f64,
+    edge: f64,
+    rest: f64,
+    edge_share: f64,
+}
+
+/// The accuracy trial of one family and one sampling.
+fn accuracy_trial(base: FamilyVariant, knobs: SamplingKnobs) -> Result<(), String> {
+    let ctx = gpu();
+    let mut rows = Vec::new();
+    for &name in SceneName::ALL {
+        let light = if name == SceneName::SpotGrate {
+            LightKind::Spot
+        } else {
+            LightKind::Directional
+        };
+        let per_pixel = base.with_light(light);
+        let sampled = per_pixel.with_sampling(knobs);
+        for &pose in Pose::ALL {
+            let f = truth_fixture(name, pose);
+            let settings = FrameSettings::default();
+            let frame = CpuFrame {
+                scene: &f.scene,
+                bvh: &f.bvh,
+                gbuf: &f.gbuf,
+                shadow_map: &f.shadow_map,
+                rectified: TRUTH_RECTIFIED,
+                settings: &settings,
+            };
+            let (px, _) = run_variant(ctx, &per_pixel, &frame)?;
+            let (lr, _) = run_variant(ctx, &sampled, &frame)?;
+            let report = metrics::compare(&lr, &f.truth).map_err(|e| e.to_string())?;
+            if report.non_finite > 0 {
+                return Err(format!(
+                    "{name}/{pose}: {} NaN/Inf pixels",
+                    report.non_finite
+                ));
+            }
+            let pixels = metrics::rel_l1(&px, &f.truth).map_err(|e| e.to_string())?;
+            let interpolation = metrics::rel_l1(&lr, &px).map_err(|e| e.to_string())?;
+            let mask = edge_mask(&f.gbuf);
+            rows.push(PoseRow {
+                pose: format!("{name}/{pose}"),
+                pixels,
+                sampled: report.rel_l1,
+                interpolation,
+                edge: masked_rel_l1(&lr, &f.truth, &mask, true),
+                rest: masked_rel_l1(&lr, &f.truth, &mask, false),
+                edge_share: mask.iter().filter(|&&m| m).count() as f64 / mask.len() as f64,
+            });
+        }
+    }
+    let n = rows.len() as f64;
+    let mean = |g: &dyn Fn(&PoseRow) -> f64| rows.iter().map(g).sum::<f64>() / n;
+    let label = base.with_sampling(knobs).label();
+    let mut table = format!(
+        "\n{label} against the shadow_map truth ({}x{}):\n| pose | per pixel | sampled | sampled vs per pixel | edge (share) | rest |\n|---|---|---|---|---|---|\n",
+        TRUTH_SCREEN[0], TRUTH_SCREEN[1]
+    );
+    for r in &rows {
+        table += &format!(
+            "| {} | {:.2} % | {:.2} % | {:.2} % | {:.2} % ({:.0} %) | {:.2} % |\n",
+            r.pose,
+            100.0 * r.pixels,
+            100.0 * r.sampled,
+            100.0 * r.interpolation,
+            100.0 * r.edge,
+            100.0 * r.edge_share,
+            100.0 * r.rest
+        );
+    }
+    let (m_px, m_lr) = (mean(&|r| r.pixels), mean(&|r| r.sampled));
+    table += &format!(
+        "| mean | {:.2} % | {:.2} % | {:.2} % | {:.2} % | {:.2} % |\n",
+        100.0 * m_px,
+        100.0 * m_lr,
+        100.0 * mean(&|r| r.interpolation),
+        100.0 * mean(&|r| r.edge),
+        100.0 * mean(&|r| r.rest)
+    );
+    println!("{table}");
+    let mut failures = Vec::new();
+    if m_lr - m_px > MEAN_ADDED {
+        failures.push(format!(
+            "suite mean {:.2} % against {:.2} % per pixel (+{:.2} points > {:.1})",
+            100.0 * m_lr,
+            100.0 * m_px,
+            100.0 * (m_lr - m_px),
+            100.0 * MEAN_ADDED
+        ));
+    }
+    for r in &rows {
+        if r.sampled - r.pixels > POSE_ADDED {
+            failures.push(format!(
+                "{}: {:.2} % against {:.2} % per pixel (+{:.2} points > {:.1})",
+                r.pose,
+                100.0 * r.sampled,
+                100.0 * r.pixels,
+                100.0 * (r.sampled - r.pixels),
+                100.0 * POSE_ADDED
+            ));
+        }
+    }
+    if failures.is_empty() {
+        Ok(())
+    } else {
+        Err(failures.join("; "))
+    }
+}
+
+fn main() -> ExitCode {
+    let mut trials: Vec<(String, Check)> = Vec::new();
+    if let Some(ctx) = gpu() {
+        for light in [LightKind::Directional, LightKind::Spot] {
+            for base in bases(light) {
+                for knobs in knobs() {
+                    for pose in [Pose::Ordinary, Pose::EpipoleOnScreen] {
+                        let name = format!(
+                            "sampling::{}::{}::{pose}",
+                            base.with_sampling(knobs).trial_name(),
+                            scene_for(light)
+                        );
+                        trials.push((
+                            name,
+                            Box::new(move || stage_trial(ctx, base, knobs, pose)),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    for &family in Family::ALL {
+        for knobs in knobs() {
+            let base = family.default_variant();
+            let name = format!(
+                "sampling::accuracy::{}",
+                base.with_sampling(knobs).label()
+            );
+            trials.push((name, Box::new(move || accuracy_trial(base, knobs))));
+        }
+    }
+    run_trials(trials, &[])
+}
