@@ -33,6 +33,7 @@ use scatter_runtime::shaderlib::prefiltered::{
     Basis, FrameSettings, LightKind, PrefilteredVariant, Resolutions, Storage,
 };
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
+use scatter_runtime::shaderlib::sampling::SamplingKnobs;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::wgpu::TextureView;
 use scatter_runtime::{Context, FamilyPasses, Prefiltered};
@@ -681,6 +682,14 @@ fn time_methods_on(
         .collect())
 }
 
+/// The per-pixel variants the headline also runs sampled (`sampling = lowres`): every
+/// family's default and the moment basis with 4 moments.
+fn sampled_bases() -> Vec<FamilyVariant> {
+    let mut out: Vec<FamilyVariant> = Family::ALL.iter().map(|f| f.default_variant()).collect();
+    out.push(PrefilteredVariant::with_moments(4).into());
+    out
+}
+
 /// The headline configuration: 1280x720, 1024x1024 rectified, on sphere, foliage and
 /// terrain; with `errors`, each run's rel L1 against the `shadow_map` truth at that size.
 fn headline_runs(ctx: &Context, frames: u32, errors: bool) -> Result<Vec<HeadlineRow>, BoxError> {
@@ -699,6 +708,13 @@ fn headline_runs(ctx: &Context, frames: u32, errors: bool) -> Result<Vec<Headlin
             interleave,
             ..RaymarchVariant::default()
         }));
+    }
+    // The sampling stage (issue 14): each family's default, and the moment basis's
+    // cheapest, at 1/2 and 1/4 of the screen per axis.
+    for base in sampled_bases() {
+        for scale in SamplingKnobs::SCALES {
+            methods.push(Method::from(base.with_sampling(SamplingKnobs::lowres(scale))));
+        }
     }
     let screen = [1280, 720];
     let mut out = Vec::new();
@@ -969,6 +985,60 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                     100.0 * e
                 ));
             }
+        }
+    }
+    // Issue 14: each family sampled against itself per pixel, and the best sampled
+    // configuration against brute-force raymarch n256 at equal or lower error.
+    let mut best: Option<(String, f64, f64)> = None;
+    for base in sampled_bases() {
+        let px = Method::from(base);
+        let Some((pt, pe)) = headline_mean(px.family(), &px.knobs()) else {
+            continue;
+        };
+        for scale in SamplingKnobs::SCALES {
+            let m = Method::from(base.with_sampling(SamplingKnobs::lowres(scale)));
+            if let Some((t, e)) = headline_mean(m.family(), &m.knobs()) {
+                out.push(format!(
+                    "sampled vs per pixel, headline means: {} {} {t:.1} ms at rel L1 {:.3} % / {} {pt:.1} ms at {:.3} %: {:.2}x faster, {:+.3} points",
+                    m.family(),
+                    m.knobs(),
+                    100.0 * e,
+                    px.knobs(),
+                    100.0 * pe,
+                    pt / t,
+                    100.0 * (e - pe)
+                ));
+                if best.as_ref().is_none_or(|b| t < b.1) {
+                    best = Some((format!("{} {}", m.family(), m.knobs()), t, e));
+                }
+            }
+        }
+    }
+    if let (Some((name, _, _)), Some((rt, re))) = (&best, headline_mean("raymarch", "n256-i1")) {
+        // The fastest sampled configuration whose error is at or below raymarch n256's.
+        let mut at_error: Option<(String, f64, f64)> = None;
+        for base in sampled_bases() {
+            for scale in SamplingKnobs::SCALES {
+                let m = Method::from(base.with_sampling(SamplingKnobs::lowres(scale)));
+                if let Some((t, e)) = headline_mean(m.family(), &m.knobs())
+                    && e <= re
+                    && at_error.as_ref().is_none_or(|b| t < b.1)
+                {
+                    at_error = Some((format!("{} {}", m.family(), m.knobs()), t, e));
+                }
+            }
+        }
+        match at_error {
+            Some((n, t, e)) => out.push(format!(
+                "best sampled configuration vs brute-force raymarch n256 at equal or lower error, headline means: {n} {t:.1} ms at rel L1 {:.3} % / raymarch n256-i1 {rt:.1} ms at {:.3} %: {:.1}x faster (Yusov 2013: 33x)",
+                100.0 * e,
+                100.0 * re,
+                rt / t
+            )),
+            None => out.push(format!(
+                "best sampled configuration vs brute-force raymarch n256: no sampled configuration reaches its rel L1 {:.3} % (the fastest sampled: {name})",
+                100.0 * re
+            )),
         }
     }
     for family_knobs in [

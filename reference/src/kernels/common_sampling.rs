@@ -9,22 +9,15 @@ use super::texture::{Tex, TexArray, quantise};
 use scatter_shaderlib::prefiltered::Storage;
 use scatter_shaderlib::sampling::{Sampling, SamplingKnobs};
 
-/// The sample grid of a screen at block side `scale`: ceil(screen / scale).
+/// The sample grid of a screen at block side `scale`: samples at every S-th pixel from the
+/// first, and one on the last: ceil((screen - 1) / scale) + 1.
 pub fn lowres_grid(screen: [u32; 2], scale: u32) -> [u32; 2] {
-    [
-        (screen[0] + scale - 1) / scale,
-        (screen[1] + scale - 1) / scale,
-    ]
+    screen.map(|s| (s - 1 + scale - 1) / scale + 1)
 }
 
-/// The pixel sample `i` stands on: the pixel S / 2 into its block (the block's centre, or
-/// the last pixel of the screen where the block is cut off).
+/// The pixel sample `i` stands on: the first pixel of block i, or the screen's last pixel.
 pub fn lowres_pixel(i: [u32; 2], screen: [u32; 2], scale: u32) -> [u32; 2] {
-    let h = scale / 2;
-    [
-        (i[0] * scale + h).min(screen[0] - 1),
-        (i[1] * scale + h).min(screen[1] - 1),
-    ]
+    [(i[0] * scale).min(screen[0] - 1), (i[1] * scale).min(screen[1] - 1)]
 }
 
 /// Whether two view depths lie on one surface: equal (sky pixels at +inf included), or
@@ -41,19 +34,20 @@ pub struct LowresTaps {
     pub cols: [u32; 2],
     /// Rows (y0, y1).
     pub rows: [u32; 2],
-    /// Their bilinear weights in that order: multiples of 1 / scale^2, exact in f32.
+    /// Their bilinear weights in that order (a weight is exactly 0 where the pixel lies on
+    /// the other sample's column or row).
     pub w: [f32; 4],
 }
 
-/// The taps of pixel `p`: sample i sits at pixel i S + S / 2.
+/// The taps of pixel `p` in block p / S: samples p / S and p / S + 1 per axis (the block's
+/// first pixel and the next block's), weighted by the pixel's place between their pixels.
 pub fn lowres_taps(p: [u32; 2], screen: [u32; 2], scale: u32) -> LowresTaps {
-    let grid = lowres_grid(screen, scale).map(|g| g as i32);
-    let f = [0, 1].map(|a| (p[a] as f32 - (scale / 2) as f32) / scale as f32);
-    let fl = f.map(f32::floor);
-    let fr = [0, 1].map(|a| (f[a] - fl[a]).clamp(0.0, 1.0));
-    let i0 = fl.map(|v| v as i32);
-    let lo = [0, 1].map(|a| i0[a].clamp(0, grid[a] - 1) as u32);
-    let hi = [0, 1].map(|a| (i0[a] + 1).clamp(0, grid[a] - 1) as u32);
+    let grid = lowres_grid(screen, scale);
+    let lo = p.map(|v| v / scale);
+    let hi = [0, 1].map(|a| (lo[a] + 1).min(grid[a] - 1));
+    let p0 = lowres_pixel(lo, screen, scale);
+    let p1 = lowres_pixel(hi, screen, scale);
+    let fr = [0, 1].map(|a| (p[a] - p0[a]) as f32 / (p1[a] - p0[a]).max(1) as f32);
     LowresTaps {
         cols: [lo[0], hi[0]],
         rows: [lo[1], hi[1]],
@@ -211,21 +205,25 @@ mod tests {
 
     #[test]
     fn samples_stand_in_their_blocks() {
-        assert_eq!(lowres_grid([67, 37], 4), [17, 10]);
-        assert_eq!(lowres_pixel([0, 0], [67, 37], 4), [2, 2]);
-        assert_eq!(lowres_pixel([16, 9], [67, 37], 4), [66, 36]);
-        assert_eq!(lowres_pixel([1, 1], [67, 37], 2), [3, 3]);
+        assert_eq!(lowres_grid([67, 37], 4), [18, 10]);
+        assert_eq!(lowres_grid([65, 37], 4), [17, 10]);
+        assert_eq!(lowres_pixel([0, 0], [67, 37], 4), [0, 0]);
+        assert_eq!(lowres_pixel([17, 9], [67, 37], 4), [66, 36]);
+        assert_eq!(lowres_pixel([1, 1], [67, 37], 2), [2, 2]);
     }
 
     #[test]
     fn taps_and_blends() {
         // A sample pixel is its own tap with weight 1.
-        let t = lowres_taps([3, 3], [8, 8], 2);
+        let t = lowres_taps([2, 2], [8, 8], 2);
         assert_eq!(t.w, [1.0, 0.0, 0.0, 0.0]);
         assert_eq!((t.cols, t.rows), ([1, 2], [1, 2]));
         // Between four samples: a quarter each.
-        let t = lowres_taps([4, 4], [8, 8], 2);
+        let t = lowres_taps([3, 3], [8, 8], 2);
         assert_eq!(t.w, [0.25; 4]);
+        // The last column: between the sample on column 6 and the one on the last pixel.
+        let edge = lowres_taps([7, 3], [8, 8], 2);
+        assert_eq!((edge.cols, edge.w), ([3, 4], [0.0, 0.5, 0.0, 0.5]));
         let light = [[1.0, 1.0, 1.0], [1.1, 1.1, 1.1], [0.9, 0.9, 0.9], [1.0, 1.0, 1.0]];
         let c = lowres_blend(t.w, [10.0; 4], light, 10.0, 0.05, 0.25).expect("blends");
         assert!((c[0] - 1.0).abs() < 1e-6);
@@ -247,7 +245,7 @@ mod tests {
         let mut depth = Tex::new(13, 9);
         for y in 0..9 {
             for x in 0..13 {
-                depth.store(x, y, if x == 4 { 1.0 } else { 10.0 });
+                depth.store(x, y, if x == 5 { 1.0 } else { 10.0 });
             }
         }
         let body = |x: u32, y: u32| [x as f32 * 0.1, y as f32 * 0.1, 1.0];
@@ -262,8 +260,8 @@ mod tests {
             }
             for y in 0..9 {
                 assert_eq!(
-                    lr.output.load(4, y, 0),
-                    px.output.load(4, y, 0),
+                    lr.output.load(5, y, 0),
+                    px.output.load(5, y, 0),
                     "the occluder column is exact"
                 );
             }

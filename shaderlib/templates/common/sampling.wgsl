@@ -7,16 +7,15 @@
 
 #define_import_path scatter::sampling
 
-// The sample grid of a screen at block side `scale`: ceil(screen / scale).
+// The sample grid of a screen at block side `scale`: samples at every S-th pixel from the
+// first, and one on the last: ceil((screen - 1) / scale) + 1.
 fn lowres_grid(screen: vec2<u32>, scale: u32) -> vec2<u32> {
-    return (screen + vec2<u32>(scale - 1u, scale - 1u)) / scale;
+    return (screen - vec2<u32>(1u, 1u) + vec2<u32>(scale - 1u, scale - 1u)) / scale + vec2<u32>(1u, 1u);
 }
 
-// The pixel sample `i` stands on: the pixel S / 2 into its block (the block's centre, or the
-// last pixel of the screen where the block is cut off).
+// The pixel sample `i` stands on: the first pixel of block i, or the screen's last pixel.
 fn lowres_pixel(i: vec2<u32>, screen: vec2<u32>, scale: u32) -> vec2<u32> {
-    let h = scale / 2u;
-    return min(i * scale + vec2<u32>(h, h), screen - vec2<u32>(1u, 1u));
+    return min(i * scale, screen - vec2<u32>(1u, 1u));
 }
 
 // Whether two view depths lie on one surface: equal (sky pixels at +inf included), or
@@ -31,19 +30,20 @@ struct LowresTaps {
     // (x1, y1), clamped inside the sample grid.
     cols: vec2<u32>,
     rows: vec2<u32>,
-    // Their bilinear weights in that order: multiples of 1 / scale^2, exact in f32.
+    // Their bilinear weights in that order (a weight is exactly 0 where the pixel lies on
+    // the other sample's column or row).
     w: vec4<f32>,
 }
 
-// The taps of pixel `p`: sample i sits at pixel i S + S / 2.
+// The taps of pixel `p` in block p / S: samples p / S and p / S + 1 per axis (the block's
+// first pixel and the next block's), weighted by the pixel's place between their pixels.
 fn lowres_taps(p: vec2<u32>, screen: vec2<u32>, scale: u32) -> LowresTaps {
-    let grid = vec2<i32>(lowres_grid(screen, scale));
-    let f = (vec2<f32>(p) - vec2<f32>(f32(scale / 2u))) / f32(scale);
-    let fl = floor(f);
-    let fr = clamp(f - fl, vec2<f32>(0.0), vec2<f32>(1.0));
-    let i0 = vec2<i32>(fl);
-    let lo = vec2<u32>(clamp(i0, vec2<i32>(0), grid - vec2<i32>(1)));
-    let hi = vec2<u32>(clamp(i0 + vec2<i32>(1), vec2<i32>(0), grid - vec2<i32>(1)));
+    let grid = lowres_grid(screen, scale);
+    let lo = p / scale;
+    let hi = min(lo + vec2<u32>(1u, 1u), grid - vec2<u32>(1u, 1u));
+    let p0 = lowres_pixel(lo, screen, scale);
+    let p1 = lowres_pixel(hi, screen, scale);
+    let fr = vec2<f32>(p - p0) / vec2<f32>(max(p1 - p0, vec2<u32>(1u, 1u)));
     var t: LowresTaps;
     t.cols = vec2<u32>(lo.x, hi.x);
     t.rows = vec2<u32>(lo.y, hi.y);
