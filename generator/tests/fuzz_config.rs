@@ -509,6 +509,12 @@ fn valid_value(name: &str, pick: usize) -> String {
         "samples" => &["64", "128"],
         "interleave" => &["1", "2", "4"],
         "jitter" => &["true", "false"],
+        // The lowres knobs only at their defaults: set with `sampling = pixels` (and
+        // `lowres` with an interleaving raymarch) they are rejected.
+        "sampling" => &["\"pixels\""],
+        "scale" => &["2"],
+        "depth_break" => &["5"],
+        "light_break" => &["20"],
         _ => &["1"],
     };
     options[pick % options.len()].to_owned()
@@ -529,6 +535,10 @@ fn bad_value(name: &str, pick: usize) -> String {
         "samples" => &["3", "1025", "0", "\"many\""],
         "interleave" => &["0", "9", "\"two\""],
         "jitter" => &["\"maybe\"", "2", "\"yes\""],
+        "sampling" => &["\"epipolar\"", "\"lowres2\"", "2"],
+        "scale" => &["3", "0", "8", "\"two\""],
+        "depth_break" => &["0", "51", "\"x\""],
+        "light_break" => &["0", "101", "-5"],
         _ => &["\"?\""],
     };
     options[pick % options.len()].to_owned()

@@ -13,7 +13,9 @@ pub mod prefiltered;
 pub mod raymarch;
 
 use scatter_shaderlib::Kernel;
+use scatter_shaderlib::prefiltered::VariantError;
 use scatter_shaderlib::prefiltered::variant::printable;
+use scatter_shaderlib::sampling::{Sampling, SamplingKnobs};
 use serde::Serialize;
 
 pub use scatter_shaderlib::family::{Family, FamilyVariant, KernelFamily, KnobSet};
@@ -96,9 +98,11 @@ macro_rules! cli_families {
     ($($name:ident => $module:ident),* $(,)?) => {
         impl FamilyCli for Family {
             fn knobs(self) -> Vec<KnobInfo> {
-                match self {
+                let mut out = match self {
                     $(Self::$name => $module::knobs(),)*
-                }
+                };
+                out.extend(sampling_knobs());
+                out
             }
 
             fn kernels(self) -> Vec<Kernel> {
@@ -117,12 +121,98 @@ macro_rules! cli_families {
                         )));
                     }
                 }
-                match self {
-                    $(Self::$name => $module::parse(knobs).map(FamilyVariant::$name),)*
-                }
+                let own: Vec<(String, String)> = knobs
+                    .iter()
+                    .filter(|(name, _)| !SAMPLING_KNOBS.contains(&name.as_str()))
+                    .cloned()
+                    .collect();
+                let variant = match self {
+                    $(Self::$name => $module::parse(&own).map(FamilyVariant::$name)?,)*
+                };
+                apply_sampling(variant, knobs)
             }
         }
     };
+}
+
+/// The names of the sampling knobs every family has.
+const SAMPLING_KNOBS: [&str; 4] = ["sampling", "scale", "depth_break", "light_break"];
+
+/// The sampling knobs every family has (`scatter_frame::sampling`), after the family's own.
+pub fn sampling_knobs() -> Vec<KnobInfo> {
+    let d = SamplingKnobs::default();
+    vec![
+        KnobInfo {
+            name: "sampling",
+            value_name: "MODE",
+            help: "where the per-pixel integral is evaluated: every pixel, or one pixel per \
+                   scale x scale block with a depth- and light-aware upsample (pixels no \
+                   sample can stand for are evaluated themselves)",
+            allowed: Sampling::ALLOWED.into(),
+            default: d.sampling.to_string(),
+            value_type: KnobType::Name,
+        },
+        KnobInfo {
+            name: "scale",
+            value_name: "S",
+            help: "sampling = lowres: block side (samples per axis: 1/S of the screen)",
+            allowed: SCALE_ALLOWED.into(),
+            default: d.scale.to_string(),
+            value_type: KnobType::Integer,
+        },
+        KnobInfo {
+            name: "depth_break",
+            value_name: "PERCENT",
+            help: "sampling = lowres: a sample stands for a pixel only within this depth \
+                   difference, in percent of the nearer depth",
+            allowed: DEPTH_BREAK_ALLOWED.into(),
+            default: d.depth_break.to_string(),
+            value_type: KnobType::Integer,
+        },
+        KnobInfo {
+            name: "light_break",
+            value_name: "PERCENT",
+            help: "sampling = lowres: a pixel whose samples differ by more than this, in \
+                   percent of the brightest, is evaluated itself (100: never)",
+            allowed: LIGHT_BREAK_ALLOWED.into(),
+            default: d.light_break.to_string(),
+            value_type: KnobType::Integer,
+        },
+    ]
+}
+
+/// Allowed `scale`.
+const SCALE_ALLOWED: &str = "2 | 4";
+/// Allowed `depth_break`.
+const DEPTH_BREAK_ALLOWED: &str = "in 1..=50";
+/// Allowed `light_break`.
+const LIGHT_BREAK_ALLOWED: &str = "in 1..=100";
+
+/// `variant` with the sampling knobs among `knobs` applied, validated.
+fn apply_sampling(
+    variant: FamilyVariant,
+    knobs: &[(String, String)],
+) -> Result<FamilyVariant, GenError> {
+    let number = |knob: &'static str, allowed: &str, value: &str| {
+        value.trim().parse::<u32>().map_err(|_| VariantError {
+            knob,
+            value: value.to_owned(),
+            allowed: allowed.to_owned(),
+        })
+    };
+    let mut s = variant.sampling();
+    for (name, value) in knobs {
+        match name.as_str() {
+            "sampling" => s.sampling = value.trim().parse()?,
+            "scale" => s.scale = number("scale", SCALE_ALLOWED, value)?,
+            "depth_break" => s.depth_break = number("depth_break", DEPTH_BREAK_ALLOWED, value)?,
+            "light_break" => s.light_break = number("light_break", LIGHT_BREAK_ALLOWED, value)?,
+            _ => {}
+        }
+    }
+    let variant = variant.with_sampling(s);
+    variant.validate()?;
+    Ok(variant)
 }
 
 /// The knobs of a variant as a JSON object (serde names, sorted), as the manifest lists

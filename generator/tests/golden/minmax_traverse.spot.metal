@@ -97,35 +97,35 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_7 = {};
-    bool local_8 = {};
-    bool local_9 = {};
+    bool local_1 = {};
+    bool local_2 = {};
+    bool local_3 = {};
     if (!((uv.x < 0.0))) {
-        local_7 = uv.x > 1.0;
+        local_1 = uv.x > 1.0;
     } else {
-        local_7 = true;
+        local_1 = true;
     }
-    bool _e11 = local_7;
+    bool _e11 = local_1;
     if (!(_e11)) {
-        local_8 = uv.y < 0.0;
+        local_2 = uv.y < 0.0;
     } else {
-        local_8 = true;
+        local_2 = true;
     }
-    bool _e19 = local_8;
+    bool _e19 = local_2;
     if (!(_e19)) {
-        local_9 = uv.y > 1.0;
+        local_3 = uv.y > 1.0;
     } else {
-        local_9 = true;
+        local_3 = true;
     }
-    bool _e27 = local_9;
+    bool _e27 = local_3;
     if (_e27) {
         return 2.0;
     }
     uint n_2 = v_2.size.x;
-    uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_2)), n_2 - 1u);
-    uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_2)), n_2 - 1u);
+    uint x_5 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_2)), n_2 - 1u);
+    uint y_2 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_2)), n_2 - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_5, y_2)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -149,16 +149,16 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm_1,
     metal::float3 p_1
 ) {
-    bool local_10 = {};
+    bool local_4 = {};
     metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     float near = v_4.right.w;
     float far = v_4.up.w;
     if (v_4.origin.w > 0.5) {
-        local_10 = _e2.z <= near;
+        local_4 = _e2.z <= near;
     } else {
-        local_10 = false;
+        local_4 = false;
     }
-    bool _e16 = local_10;
+    bool _e16 = local_4;
     if (_e16) {
         return 1.0;
     }
@@ -173,13 +173,13 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5,
     metal::texture2d<float, metal::access::sample> sm_2,
     metal::float3 o,
-    metal::float3 l_1
+    metal::float3 l
 ) {
     metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir_7 = metal::float3(metal::dot(l_1, v_5.right.xyz), metal::dot(l_1, v_5.up.xyz), metal::dot(l_1, v_5.forward.xyz));
+        metal::float3 dir_7 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
         if (dir_7.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
@@ -215,11 +215,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_5 = sigma_t * len;
-    if (x_5 < 0.0001) {
-        return len * (1.0 - (0.5 * x_5));
+    float x_6 = sigma_t * len;
+    if (x_6 < 0.0001) {
+        return len * (1.0 - (0.5 * x_6));
     }
-    return (1.0 - metal::exp(-(x_5))) / sigma_t;
+    return (1.0 - metal::exp(-(x_6))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -239,8 +239,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_6 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_6 * x_6) * (3.0 - (2.0 * x_6));
+    float x_7 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_7 * x_7) * (3.0 - (2.0 * x_7));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -253,8 +253,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_7 = eye + (dir * t);
-    metal::float3 to_x = x_7 - light_pos;
+    metal::float3 x_8 = eye + (dir * t);
+    metal::float3 to_x = x_8 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d);
@@ -276,7 +276,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float4 medium_1
 ) {
     float sum = 0.0;
-    uint k_1 = 0u;
+    uint k = 0u;
     uint q = {};
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
     float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
@@ -288,17 +288,17 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k_1;
-            k_1 = _e73 + 1u;
+            uint _e73 = k;
+            k = _e73 + 1u;
         }
         loop_init = false;
-        uint _e30 = k_1;
+        uint _e30 = k;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            uint _e32 = k_1;
+            uint _e32 = k;
             float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
@@ -413,7 +413,7 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot
 ) {
     float sum_1 = 0.0;
-    uint k_2 = 0u;
+    uint k_1 = 0u;
     float t_2 = {};
     float w = {};
     uint steps = f_4.sizes2_.y;
@@ -425,21 +425,21 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e60 = k_2;
-            k_2 = _e60 + 1u;
+            uint _e60 = k_1;
+            k_1 = _e60 + 1u;
         }
         loop_init_2 = false;
-        uint _e15 = k_2;
+        uint _e15 = k_1;
         if (_e15 < steps) {
         } else {
             break;
         }
         {
-            uint _e17 = k_2;
+            uint _e17 = k_1;
             t_2 = (static_cast<float>(_e17) + 0.5) * h_2;
             w = h_2;
             if (spot) {
-                uint _e25 = k_2;
+                uint _e25 = k_1;
                 metal::float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e25) + 0.5);
                 t_2 = _e29.x;
                 w = _e29.y;
@@ -454,8 +454,8 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
                 sum_1 = _e38 + ((_e36 * _e39) * _e42);
             } else {
                 float _e45 = sum_1;
-                uint _e48 = k_2;
-                uint _e51 = k_2;
+                uint _e48 = k_1;
+                uint _e51 = k_1;
                 float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, static_cast<float>(_e48) * h_2, static_cast<float>(_e51 + 1u) * h_2);
                 sum_1 = _e45 + (_e36 * _e56);
             }
@@ -501,16 +501,16 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float s_1,
     bool spot_1
 ) {
-    bool local_11 = {};
+    bool local_5 = {};
     if (spot_1) {
         float psi = x_2 * delta;
         float den = metal::sin(theta_1 + psi);
         if (!((den <= 0.000001))) {
-            local_11 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_5 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local_11 = true;
+            local_5 = true;
         }
-        bool _e16 = local_11;
+        bool _e16 = local_5;
         if (_e16) {
             return s_1;
         }
@@ -542,23 +542,23 @@ uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
 uint tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
     uint width_1
 ) {
-    uint k_3 = 0u;
+    uint k_2 = 0u;
     uint2 loop_bound_3 = uint2(4294967295u);
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        uint _e2 = k_3;
+        uint _e2 = k_2;
         uint _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
         if (_e4 > 1u) {
         } else {
             break;
         }
         {
-            uint _e8 = k_3;
-            k_3 = _e8 + 1u;
+            uint _e8 = k_2;
+            k_2 = _e8 + 1u;
         }
     }
-    uint _e10 = k_3;
+    uint _e10 = k_2;
     return _e10 + 1u;
 }
 
@@ -567,25 +567,25 @@ uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
     uint width_2
 ) {
     uint off = 0u;
-    uint k_4 = 0u;
+    uint k_3 = 0u;
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e12 = k_4;
-            k_4 = _e12 + 1u;
+            uint _e12 = k_3;
+            k_3 = _e12 + 1u;
         }
         loop_init_3 = false;
-        uint _e3 = k_4;
+        uint _e3 = k_3;
         if (_e3 < level_1) {
         } else {
             break;
         }
         {
             uint _e6 = off;
-            uint _e7 = k_4;
+            uint _e7 = k_3;
             uint _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
             off = _e6 + _e9;
         }
@@ -630,6 +630,205 @@ float lit_span(
     return _e15;
 }
 
+metal::float3 minmax_traverse_pixel(
+    uint x_4,
+    uint y_1,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
+    device type_10 const& slices,
+    metal::texture2d<float, metal::access::sample> depth,
+    metal::texture2d<float, metal::access::sample> shadow_map,
+    metal::texture2d<float, metal::access::sample> tree,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    bool local_6 = {};
+    bool local_7 = {};
+    bool local_8 = {};
+    float yc = {};
+    float xs = {};
+    float total = 0.0;
+    bool in_run = false;
+    float run_a = 0.0;
+    uint i = 0u;
+    uint k_4 = {};
+    bool local_9 = {};
+    bool local_10 = {};
+    bool lit = {};
+    bool local_11 = {};
+    float l_1 = {};
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
+    metal::float3 eye_7 = f_9.eye.xyz;
+    metal::float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_4, y_1);
+    uint clamped_lod_e13 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e13 = depth.read(metal::min(metal::uint2(metal::uint2(x_4, y_1)), metal::uint2(depth.get_width(clamped_lod_e13), depth.get_height(clamped_lod_e13)) - 1), clamped_lod_e13);
+    float s_3 = metal::min(metal::max(_e13.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e9, f_9.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_9.light_color.xyz;
+    metal::float3 px = metal::float3(static_cast<float>(x_4) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
+    float radius = f_9.epipole.w;
+    if (f_9.epipole.z > 0.5) {
+        local_6 = metal::length(px - metal::float3(f_9.epipole.x, f_9.epipole.y, 0.0)) < radius;
+    } else {
+        local_6 = false;
+    }
+    bool near_epi = local_6;
+    if (f_9.anti_epipole.z > 0.5) {
+        local_7 = metal::length(px - metal::float3(f_9.anti_epipole.x, f_9.anti_epipole.y, 0.0)) < radius;
+    } else {
+        local_7 = false;
+    }
+    bool near_anti = local_7;
+    if (!(near_epi)) {
+        local_8 = near_anti;
+    } else {
+        local_8 = true;
+    }
+    bool _e76 = local_8;
+    if (_e76) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = frame;
+        float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_7, _e9, s_3, true);
+        metal::float3 l_2 = _e81 * color;
+        return l_2;
+    }
+    metal::float3 axis = f_9.axis.xyz;
+    uint rows_1 = f_9.sizes.w;
+    uint width_3 = f_9.sizes.z;
+    bool wrap_1 = f_9.anti_epipole.w > 0.5;
+    float theta_3 = metal::atan2(metal::length(metal::cross(_e9, axis)), metal::dot(_e9, axis));
+    float phi = metal::atan2(metal::dot(_e9, f_9.e2_.xyz), metal::dot(_e9, f_9.e1_.xyz));
+    yc = (phi - f_9.e1_.w) / f_9.e2_.w;
+    if (wrap_1) {
+        float _e111 = yc;
+        float _e112 = yc;
+        yc = _e111 - (metal::floor(_e112 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+    } else {
+        float _e119 = yc;
+        yc = metal::clamp(_e119, 0.0, static_cast<float>(rows_1));
+    }
+    float _e123 = yc;
+    uint _e125 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e123), rows_1, wrap_1);
+    metal::float4 _e128 = slices[metal::min(unsigned(_e125), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e129 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e128);
+    float delta_2 = _e129.delta;
+    float _e135 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_3, f_9.theta.x, f_9.theta.y);
+    if (true) {
+        metal::float3 q_2 = metal::normalize((eye_7 + (_e9 * s_3)) - f_9.light_pos.xyz);
+        xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / delta_2;
+    } else {
+        xs = (s_3 * metal::sin(theta_3)) / delta_2;
+    }
+    float _e153 = xs;
+    float _e154 = xs;
+    uint n_3 = naga_f2u32(metal::min(metal::ceil((_e154 > 0.0) ? _e153 : 0.0), static_cast<float>(width_3)));
+    uint _e163 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
+    uint2 loop_bound_5 = uint2(4294967295u);
+    while(true) {
+        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        uint _e165 = i;
+        if (_e165 < n_3) {
+        } else {
+            break;
+        }
+        {
+            k_4 = 0u;
+            uint2 loop_bound_6 = uint2(4294967295u);
+            while(true) {
+                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                uint _e169 = k_4;
+                if ((_e169 + 1u) < _e163) {
+                    uint _e173 = i;
+                    uint _e175 = k_4;
+                    local_9 = (_e173 & ((2u << _e175) - 1u)) == 0u;
+                } else {
+                    local_9 = false;
+                }
+                bool _e185 = local_9;
+                if (_e185) {
+                    uint _e186 = i;
+                    uint _e188 = k_4;
+                    local_10 = (_e186 + (2u << _e188)) <= n_3;
+                } else {
+                    local_10 = false;
+                }
+                bool _e195 = local_10;
+                if (_e195) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e197 = k_4;
+                    k_4 = _e197 + 1u;
+                }
+            }
+            lit = false;
+            uint2 loop_bound_7 = uint2(4294967295u);
+            while(true) {
+                if (metal::all(loop_bound_7 == uint2(0u))) { break; }
+                loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+                uint _e201 = k_4;
+                uint _e202 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e201, width_3);
+                uint _e203 = i;
+                uint _e204 = k_4;
+                uint clamped_lod_e210 = metal::min(uint(0), tree.get_num_mip_levels() - 1);
+                metal::float4 node = tree.read(metal::min(metal::uint2(metal::uint2(_e202 + (_e203 >> _e204), _e125)), metal::uint2(tree.get_width(clamped_lod_e210), tree.get_height(clamped_lod_e210)) - 1), clamped_lod_e210);
+                if (_e135 <= node.x) {
+                    lit = true;
+                    break;
+                }
+                if (!((_e135 > node.y))) {
+                    uint _e217 = k_4;
+                    local_11 = _e217 == 0u;
+                } else {
+                    local_11 = true;
+                }
+                bool _e223 = local_11;
+                if (_e223) {
+                    break;
+                }
+                uint _e225 = k_4;
+                k_4 = _e225 - 1u;
+            }
+            bool _e228 = lit;
+            bool _e229 = in_run;
+            if (_e228 != _e229) {
+                uint _e231 = i;
+                float _e232 = edge_t(f_9, _e231, n_3, delta_2, theta_3, s_3, true);
+                bool _e233 = lit;
+                if (_e233) {
+                    run_a = _e232;
+                } else {
+                    float _e236 = total;
+                    float _e237 = run_a;
+                    float _e238 = lit_span(f_9, eye_7, _e9, _e237, _e232, true);
+                    total = _e236 + _e238;
+                }
+                bool _e240 = lit;
+                in_run = _e240;
+            }
+            uint _e241 = i;
+            uint _e243 = k_4;
+            i = _e241 + (1u << _e243);
+        }
+    }
+    bool _e246 = in_run;
+    if (_e246) {
+        float _e247 = total;
+        float _e248 = run_a;
+        float _e249 = lit_span(f_9, eye_7, _e9, _e248, s_3, true);
+        total = _e247 + _e249;
+    }
+    float _e251 = total;
+    l_1 = _e251;
+    if (!(true)) {
+        float _e262 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(metal::dot(f_9.light_dir.xyz, _e9)));
+        float _e264 = total;
+        l_1 = (f_9.medium.y * _e262) * _e264;
+    }
+    float _e266 = l_1;
+    metal::float3 c = color * _e266;
+    return c;
+}
+
 struct minmax_traverseInput {
 };
 kernel void minmax_traverse(
@@ -643,204 +842,18 @@ kernel void minmax_traverse(
 , constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
 ) {
     bool local = {};
-    bool local_1 = {};
-    bool local_2 = {};
-    bool local_3 = {};
-    float yc = {};
-    float xs = {};
-    float total = 0.0;
-    bool in_run = false;
-    float run_a = 0.0;
-    uint i = 0u;
-    uint k = {};
-    bool local_4 = {};
-    bool local_5 = {};
-    bool lit = {};
-    bool local_6 = {};
-    float l = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
-    uint x_8 = id.x;
-    uint y_2 = id.y;
-    if (!((x_8 >= f_9.sizes.x))) {
-        local = y_2 >= f_9.sizes.y;
+    uint _e5 = frame.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = frame.sizes.y;
+        local = id.y >= _e12;
     } else {
         local = true;
     }
-    bool _e18 = local;
-    if (_e18) {
+    bool _e17 = local;
+    if (_e17) {
         return;
     }
-    metal::float3 eye_7 = f_9.eye.xyz;
-    metal::float3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_8, y_2);
-    uint clamped_lod_e25 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e25 = depth.read(metal::min(metal::uint2(metal::uint2(x_8, y_2)), metal::uint2(depth.get_width(clamped_lod_e25), depth.get_height(clamped_lod_e25)) - 1), clamped_lod_e25);
-    float s_3 = metal::min(metal::max(_e25.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e21, f_9.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_9.light_color.xyz;
-    metal::float3 px = metal::float3(static_cast<float>(x_8) + 0.5, static_cast<float>(y_2) + 0.5, 0.0);
-    float radius = f_9.epipole.w;
-    if (f_9.epipole.z > 0.5) {
-        local_1 = metal::length(px - metal::float3(f_9.epipole.x, f_9.epipole.y, 0.0)) < radius;
-    } else {
-        local_1 = false;
-    }
-    bool near_epi = local_1;
-    if (f_9.anti_epipole.z > 0.5) {
-        local_2 = metal::length(px - metal::float3(f_9.anti_epipole.x, f_9.anti_epipole.y, 0.0)) < radius;
-    } else {
-        local_2 = false;
-    }
-    bool near_anti = local_2;
-    if (!(near_epi)) {
-        local_3 = near_anti;
-    } else {
-        local_3 = true;
-    }
-    bool _e88 = local_3;
-    if (_e88) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = frame;
-        float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_7, _e21, s_3, true);
-        metal::float3 l_2 = _e93 * color;
-        output.write(metal::float4(l_2.x, l_2.y, l_2.z, 1.0), metal::uint2(metal::uint2(x_8, y_2)));
-        return;
-    }
-    metal::float3 axis = f_9.axis.xyz;
-    uint rows_1 = f_9.sizes.w;
-    uint width_3 = f_9.sizes.z;
-    bool wrap_1 = f_9.anti_epipole.w > 0.5;
-    float theta_3 = metal::atan2(metal::length(metal::cross(_e21, axis)), metal::dot(_e21, axis));
-    float phi = metal::atan2(metal::dot(_e21, f_9.e2_.xyz), metal::dot(_e21, f_9.e1_.xyz));
-    yc = (phi - f_9.e1_.w) / f_9.e2_.w;
-    if (wrap_1) {
-        float _e130 = yc;
-        float _e131 = yc;
-        yc = _e130 - (metal::floor(_e131 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
-    } else {
-        float _e138 = yc;
-        yc = metal::clamp(_e138, 0.0, static_cast<float>(rows_1));
-    }
-    float _e142 = yc;
-    uint _e144 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e142), rows_1, wrap_1);
-    metal::float4 _e147 = slices[metal::min(unsigned(_e144), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e148 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e147);
-    float delta_2 = _e148.delta;
-    float _e154 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_3, f_9.theta.x, f_9.theta.y);
-    if (true) {
-        metal::float3 q_2 = metal::normalize((eye_7 + (_e21 * s_3)) - f_9.light_pos.xyz);
-        xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / delta_2;
-    } else {
-        xs = (s_3 * metal::sin(theta_3)) / delta_2;
-    }
-    float _e172 = xs;
-    float _e173 = xs;
-    uint n_3 = naga_f2u32(metal::min(metal::ceil((_e173 > 0.0) ? _e172 : 0.0), static_cast<float>(width_3)));
-    uint _e182 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
-    uint2 loop_bound_5 = uint2(4294967295u);
-    while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        uint _e184 = i;
-        if (_e184 < n_3) {
-        } else {
-            break;
-        }
-        {
-            k = 0u;
-            uint2 loop_bound_6 = uint2(4294967295u);
-            while(true) {
-                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                uint _e188 = k;
-                if ((_e188 + 1u) < _e182) {
-                    uint _e192 = i;
-                    uint _e194 = k;
-                    local_4 = (_e192 & ((2u << _e194) - 1u)) == 0u;
-                } else {
-                    local_4 = false;
-                }
-                bool _e204 = local_4;
-                if (_e204) {
-                    uint _e205 = i;
-                    uint _e207 = k;
-                    local_5 = (_e205 + (2u << _e207)) <= n_3;
-                } else {
-                    local_5 = false;
-                }
-                bool _e214 = local_5;
-                if (_e214) {
-                } else {
-                    break;
-                }
-                {
-                    uint _e216 = k;
-                    k = _e216 + 1u;
-                }
-            }
-            lit = false;
-            uint2 loop_bound_7 = uint2(4294967295u);
-            while(true) {
-                if (metal::all(loop_bound_7 == uint2(0u))) { break; }
-                loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-                uint _e220 = k;
-                uint _e221 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e220, width_3);
-                uint _e222 = i;
-                uint _e223 = k;
-                uint clamped_lod_e229 = metal::min(uint(0), tree.get_num_mip_levels() - 1);
-                metal::float4 node = tree.read(metal::min(metal::uint2(metal::uint2(_e221 + (_e222 >> _e223), _e144)), metal::uint2(tree.get_width(clamped_lod_e229), tree.get_height(clamped_lod_e229)) - 1), clamped_lod_e229);
-                if (_e154 <= node.x) {
-                    lit = true;
-                    break;
-                }
-                if (!((_e154 > node.y))) {
-                    uint _e236 = k;
-                    local_6 = _e236 == 0u;
-                } else {
-                    local_6 = true;
-                }
-                bool _e242 = local_6;
-                if (_e242) {
-                    break;
-                }
-                uint _e244 = k;
-                k = _e244 - 1u;
-            }
-            bool _e247 = lit;
-            bool _e248 = in_run;
-            if (_e247 != _e248) {
-                uint _e250 = i;
-                float _e251 = edge_t(f_9, _e250, n_3, delta_2, theta_3, s_3, true);
-                bool _e252 = lit;
-                if (_e252) {
-                    run_a = _e251;
-                } else {
-                    float _e255 = total;
-                    float _e256 = run_a;
-                    float _e257 = lit_span(f_9, eye_7, _e21, _e256, _e251, true);
-                    total = _e255 + _e257;
-                }
-                bool _e259 = lit;
-                in_run = _e259;
-            }
-            uint _e260 = i;
-            uint _e262 = k;
-            i = _e260 + (1u << _e262);
-        }
-    }
-    bool _e265 = in_run;
-    if (_e265) {
-        float _e266 = total;
-        float _e267 = run_a;
-        float _e268 = lit_span(f_9, eye_7, _e21, _e267, s_3, true);
-        total = _e266 + _e268;
-    }
-    float _e270 = total;
-    l = _e270;
-    if (!(true)) {
-        float _e281 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(metal::dot(f_9.light_dir.xyz, _e21)));
-        float _e283 = total;
-        l = (f_9.medium.y * _e281) * _e283;
-    }
-    float _e285 = l;
-    metal::float3 c = color * _e285;
-    output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_8, y_2)));
+    metal::float3 _e20 = minmax_traverse_pixel(id.x, id.y, frame, slices, depth, shadow_map, tree, _buffer_sizes);
+    output.write(metal::float4(_e20.x, _e20.y, _e20.z, 1.0), metal::uint2(id.xy));
     return;
 }

@@ -86,35 +86,35 @@ fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_o
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_7: bool;
-    var local_8: bool;
-    var local_9: bool;
+    var local_1: bool;
+    var local_2: bool;
+    var local_3: bool;
 
     if !((uv.x < 0f)) {
-        local_7 = (uv.x > 1f);
+        local_1 = (uv.x > 1f);
     } else {
-        local_7 = true;
+        local_1 = true;
     }
-    let _e11 = local_7;
+    let _e11 = local_1;
     if !(_e11) {
-        local_8 = (uv.y < 0f);
+        local_2 = (uv.y < 0f);
     } else {
-        local_8 = true;
+        local_2 = true;
     }
-    let _e19 = local_8;
+    let _e19 = local_2;
     if !(_e19) {
-        local_9 = (uv.y > 1f);
+        local_3 = (uv.y > 1f);
     } else {
-        local_9 = true;
+        local_3 = true;
     }
-    let _e27 = local_9;
+    let _e27 = local_3;
     if _e27 {
         return 2f;
     }
     let n_2 = v_2.size.x;
-    let x_4 = min(u32((uv.x * f32(n_2))), (n_2 - 1u));
-    let y_1 = min(u32((uv.y * f32(n_2))), (n_2 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_4, y_1), 0i);
+    let x_5 = min(u32((uv.x * f32(n_2))), (n_2 - 1u));
+    let y_2 = min(u32((uv.y * f32(n_2))), (n_2 - 1u));
+    let _e49 = textureLoad(sm, vec2<u32>(x_5, y_2), 0i);
     return _e49.x;
 }
 
@@ -132,17 +132,17 @@ fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga
 }
 
 fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_10: bool;
+    var local_4: bool;
 
     let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     let near = v_4.right.w;
     let far = v_4.up.w;
     if (v_4.origin.w > 0.5f) {
-        local_10 = (_e2.z <= near);
+        local_4 = (_e2.z <= near);
     } else {
-        local_10 = false;
+        local_4 = false;
     }
-    let _e16 = local_10;
+    let _e16 = local_4;
     if _e16 {
         return 1f;
     }
@@ -153,12 +153,12 @@ fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapView
     return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
 }
 
-fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, o: vec3<f32>, l_1: vec3<f32>) -> f32 {
+fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
     let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_7 = vec3<f32>(dot(l_1, v_5.right.xyz), dot(l_1, v_5.up.xyz), dot(l_1, v_5.forward.xyz));
+        let dir_7 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
         if (dir_7.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
@@ -188,11 +188,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_5 = (sigma_t * len);
-    if (x_5 < 0.0001f) {
-        return (len * (1f - (0.5f * x_5)));
+    let x_6 = (sigma_t * len);
+    if (x_6 < 0.0001f) {
+        return (len * (1f - (0.5f * x_6)));
     }
-    return ((1f - exp(-(x_5))) / sigma_t);
+    return ((1f - exp(-(x_6))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -204,13 +204,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_6 * x_6) * (3f - (2f * x_6)));
+    let x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_7 * x_7) * (3f - (2f * x_7)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_7 = (eye + (dir * t));
-    let to_x = (x_7 - light_pos);
+    let x_8 = (eye + (dir * t));
+    let to_x = (x_8 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d = sqrt(d2_);
     let travel = (to_x / vec3(d));
@@ -221,7 +221,7 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
 
 fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
     var sum: f32 = 0f;
-    var k_1: u32 = 0u;
+    var k: u32 = 0u;
     var q: u32;
 
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
@@ -229,13 +229,13 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let g0_ = atan(((a_1 - t0_) / h));
     let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
-        let _e30 = k_1;
+        let _e30 = k;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            let _e32 = k_1;
+            let _e32 = k;
             let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
             q = 0u;
             loop {
@@ -259,8 +259,8 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
             }
         }
         continuing {
-            let _e73 = k_1;
-            k_1 = (_e73 + 1u);
+            let _e73 = k;
+            k = (_e73 + 1u);
         }
     }
     let _e75 = sum;
@@ -311,7 +311,7 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX
 
 fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, s: f32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
-    var k_2: u32 = 0u;
+    var k_1: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
@@ -319,17 +319,17 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_o
     let h_2 = (s / f32(steps));
     let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0f, s, steps);
     loop {
-        let _e15 = k_2;
+        let _e15 = k_1;
         if (_e15 < steps) {
         } else {
             break;
         }
         {
-            let _e17 = k_2;
+            let _e17 = k_1;
             t_2 = ((f32(_e17) + 0.5f) * h_2);
             w = h_2;
             if spot {
-                let _e25 = k_2;
+                let _e25 = k_1;
                 let _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e25) + 0.5f));
                 t_2 = _e29.x;
                 w = _e29.y;
@@ -344,15 +344,15 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_o
                 sum_1 = (_e38 + ((_e36 * _e39) * _e42));
             } else {
                 let _e45 = sum_1;
-                let _e48 = k_2;
-                let _e51 = k_2;
+                let _e48 = k_1;
+                let _e51 = k_1;
                 let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e48) * h_2), (f32((_e51 + 1u)) * h_2));
                 sum_1 = (_e45 + (_e36 * _e56));
             }
         }
         continuing {
-            let _e60 = k_2;
-            k_2 = (_e60 + 1u);
+            let _e60 = k_1;
+            k_1 = (_e60 + 1u);
         }
     }
     if spot {
@@ -375,17 +375,17 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
 }
 
 fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
-    var local_11: bool;
+    var local_5: bool;
 
     if spot_1 {
         let psi = (x_2 * delta);
         let den = sin((theta_1 + psi));
         if !((den <= 0.000001f)) {
-            local_11 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_5 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_11 = true;
+            local_5 = true;
         }
-        let _e16 = local_11;
+        let _e16 = local_5;
         if _e16 {
             return s_1;
         }
@@ -405,43 +405,43 @@ fn level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level: u32, width: u32) 
 }
 
 fn tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_1: u32) -> u32 {
-    var k_3: u32 = 0u;
+    var k_2: u32 = 0u;
 
     loop {
-        let _e2 = k_3;
+        let _e2 = k_2;
         let _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
         if (_e4 > 1u) {
         } else {
             break;
         }
         {
-            let _e8 = k_3;
-            k_3 = (_e8 + 1u);
+            let _e8 = k_2;
+            k_2 = (_e8 + 1u);
         }
     }
-    let _e10 = k_3;
+    let _e10 = k_2;
     return (_e10 + 1u);
 }
 
 fn level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_1: u32, width_2: u32) -> u32 {
     var off: u32 = 0u;
-    var k_4: u32 = 0u;
+    var k_3: u32 = 0u;
 
     loop {
-        let _e3 = k_4;
+        let _e3 = k_3;
         if (_e3 < level_1) {
         } else {
             break;
         }
         {
             let _e6 = off;
-            let _e7 = k_4;
+            let _e7 = k_3;
             let _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
             off = (_e6 + _e9);
         }
         continuing {
-            let _e12 = k_4;
-            k_4 = (_e12 + 1u);
+            let _e12 = k_3;
+            k_3 = (_e12 + 1u);
         }
     }
     let _e14 = off;
@@ -465,197 +465,202 @@ fn lit_span(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3
     return _e15;
 }
 
-@compute @workgroup_size(8, 8, 1) 
-fn minmax_traverse(@builtin(global_invocation_id) id: vec3<u32>) {
-    var local: bool;
-    var local_1: bool;
-    var local_2: bool;
-    var local_3: bool;
+fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
+    var local_6: bool;
+    var local_7: bool;
+    var local_8: bool;
     var yc: f32;
     var xs: f32;
     var total: f32 = 0f;
     var in_run: bool = false;
     var run_a: f32 = 0f;
     var i: u32 = 0u;
-    var k: u32;
-    var local_4: bool;
-    var local_5: bool;
+    var k_4: u32;
+    var local_9: bool;
+    var local_10: bool;
     var lit: bool;
-    var local_6: bool;
-    var l: f32;
+    var local_11: bool;
+    var l_1: f32;
 
     let f_9 = frame;
-    let x_8 = id.x;
-    let y_2 = id.y;
-    if !((x_8 >= f_9.sizes.x)) {
-        local = (y_2 >= f_9.sizes.y);
-    } else {
-        local = true;
-    }
-    let _e18 = local;
-    if _e18 {
-        return;
-    }
     let eye_7 = f_9.eye.xyz;
-    let _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_8, y_2);
-    let _e25 = textureLoad(depth, vec2<u32>(x_8, y_2), 0i);
-    let s_3 = (min(max(_e25.x, 0f), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 0.000001f));
+    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_4, y_1);
+    let _e13 = textureLoad(depth, vec2<u32>(x_4, y_1), 0i);
+    let s_3 = (min(max(_e13.x, 0f), f_9.theta.z) / max(dot(_e9, f_9.cam_forward.xyz), 0.000001f));
     let color = f_9.light_color.xyz;
-    let px = vec3<f32>((f32(x_8) + 0.5f), (f32(y_2) + 0.5f), 0f);
+    let px = vec3<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_9.epipole.w;
     if (f_9.epipole.z > 0.5f) {
-        local_1 = (length((px - vec3<f32>(f_9.epipole.x, f_9.epipole.y, 0f))) < radius);
+        local_6 = (length((px - vec3<f32>(f_9.epipole.x, f_9.epipole.y, 0f))) < radius);
     } else {
-        local_1 = false;
+        local_6 = false;
     }
-    let near_epi = local_1;
+    let near_epi = local_6;
     if (f_9.anti_epipole.z > 0.5f) {
-        local_2 = (length((px - vec3<f32>(f_9.anti_epipole.x, f_9.anti_epipole.y, 0f))) < radius);
+        local_7 = (length((px - vec3<f32>(f_9.anti_epipole.x, f_9.anti_epipole.y, 0f))) < radius);
     } else {
-        local_2 = false;
+        local_7 = false;
     }
-    let near_anti = local_2;
+    let near_anti = local_7;
     if !(near_epi) {
-        local_3 = near_anti;
+        local_8 = near_anti;
     } else {
-        local_3 = true;
+        local_8 = true;
     }
-    let _e88 = local_3;
-    if _e88 {
-        let _e90 = frame;
-        let _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_7, _e21, s_3, true);
-        let l_2 = (_e93 * color);
-        textureStore(output, vec2<u32>(x_8, y_2), vec4<f32>(l_2.x, l_2.y, l_2.z, 1f));
-        return;
+    let _e76 = local_8;
+    if _e76 {
+        let _e78 = frame;
+        let _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_7, _e9, s_3, true);
+        let l_2 = (_e81 * color);
+        return l_2;
     }
     let axis = f_9.axis.xyz;
     let rows_1 = f_9.sizes.w;
     let width_3 = f_9.sizes.z;
     let wrap_1 = (f_9.anti_epipole.w > 0.5f);
-    let theta_3 = atan2(length(cross(_e21, axis)), dot(_e21, axis));
-    let phi = atan2(dot(_e21, f_9.e2_.xyz), dot(_e21, f_9.e1_.xyz));
+    let theta_3 = atan2(length(cross(_e9, axis)), dot(_e9, axis));
+    let phi = atan2(dot(_e9, f_9.e2_.xyz), dot(_e9, f_9.e1_.xyz));
     yc = ((phi - f_9.e1_.w) / f_9.e2_.w);
     if wrap_1 {
-        let _e130 = yc;
-        let _e131 = yc;
-        yc = (_e130 - (floor((_e131 / f32(rows_1))) * f32(rows_1)));
+        let _e111 = yc;
+        let _e112 = yc;
+        yc = (_e111 - (floor((_e112 / f32(rows_1))) * f32(rows_1)));
     } else {
-        let _e138 = yc;
-        yc = clamp(_e138, 0f, f32(rows_1));
+        let _e119 = yc;
+        yc = clamp(_e119, 0f, f32(rows_1));
     }
-    let _e142 = yc;
-    let _e144 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e142), rows_1, wrap_1);
-    let _e147 = slices[_e144];
-    let _e148 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e147);
-    let delta_2 = _e148.delta;
-    let _e154 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_3, f_9.theta.x, f_9.theta.y);
+    let _e123 = yc;
+    let _e125 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e123), rows_1, wrap_1);
+    let _e128 = slices[_e125];
+    let _e129 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e128);
+    let delta_2 = _e129.delta;
+    let _e135 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_3, f_9.theta.x, f_9.theta.y);
     if true {
-        let q_2 = normalize(((eye_7 + (_e21 * s_3)) - f_9.light_pos.xyz));
+        let q_2 = normalize(((eye_7 + (_e9 * s_3)) - f_9.light_pos.xyz));
         xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / delta_2);
     } else {
         xs = ((s_3 * sin(theta_3)) / delta_2);
     }
-    let _e172 = xs;
-    let _e173 = xs;
-    let n_3 = u32(min(ceil(select(0f, _e172, (_e173 > 0f))), f32(width_3)));
-    let _e182 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
+    let _e153 = xs;
+    let _e154 = xs;
+    let n_3 = u32(min(ceil(select(0f, _e153, (_e154 > 0f))), f32(width_3)));
+    let _e163 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     loop {
-        let _e184 = i;
-        if (_e184 < n_3) {
+        let _e165 = i;
+        if (_e165 < n_3) {
         } else {
             break;
         }
         {
-            k = 0u;
+            k_4 = 0u;
             loop {
-                let _e188 = k;
-                if ((_e188 + 1u) < _e182) {
-                    let _e192 = i;
-                    let _e194 = k;
-                    local_4 = ((_e192 & ((2u << _e194) - 1u)) == 0u);
+                let _e169 = k_4;
+                if ((_e169 + 1u) < _e163) {
+                    let _e173 = i;
+                    let _e175 = k_4;
+                    local_9 = ((_e173 & ((2u << _e175) - 1u)) == 0u);
                 } else {
-                    local_4 = false;
+                    local_9 = false;
                 }
-                let _e204 = local_4;
-                if _e204 {
-                    let _e205 = i;
-                    let _e207 = k;
-                    local_5 = ((_e205 + (2u << _e207)) <= n_3);
+                let _e185 = local_9;
+                if _e185 {
+                    let _e186 = i;
+                    let _e188 = k_4;
+                    local_10 = ((_e186 + (2u << _e188)) <= n_3);
                 } else {
-                    local_5 = false;
+                    local_10 = false;
                 }
-                let _e214 = local_5;
-                if _e214 {
+                let _e195 = local_10;
+                if _e195 {
                 } else {
                     break;
                 }
                 {
-                    let _e216 = k;
-                    k = (_e216 + 1u);
+                    let _e197 = k_4;
+                    k_4 = (_e197 + 1u);
                 }
             }
             lit = false;
             loop {
-                let _e220 = k;
-                let _e221 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e220, width_3);
-                let _e222 = i;
-                let _e223 = k;
-                let node = textureLoad(tree, vec2<u32>((_e221 + (_e222 >> _e223)), _e144), 0i);
-                if (_e154 <= node.x) {
+                let _e201 = k_4;
+                let _e202 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e201, width_3);
+                let _e203 = i;
+                let _e204 = k_4;
+                let node = textureLoad(tree, vec2<u32>((_e202 + (_e203 >> _e204)), _e125), 0i);
+                if (_e135 <= node.x) {
                     lit = true;
                     break;
                 }
-                if !((_e154 > node.y)) {
-                    let _e236 = k;
-                    local_6 = (_e236 == 0u);
+                if !((_e135 > node.y)) {
+                    let _e217 = k_4;
+                    local_11 = (_e217 == 0u);
                 } else {
-                    local_6 = true;
+                    local_11 = true;
                 }
-                let _e242 = local_6;
-                if _e242 {
+                let _e223 = local_11;
+                if _e223 {
                     break;
                 }
-                let _e244 = k;
-                k = (_e244 - 1u);
+                let _e225 = k_4;
+                k_4 = (_e225 - 1u);
             }
-            let _e247 = lit;
-            let _e248 = in_run;
-            if (_e247 != _e248) {
-                let _e250 = i;
-                let _e251 = edge_t(f_9, _e250, n_3, delta_2, theta_3, s_3, true);
-                let _e252 = lit;
-                if _e252 {
-                    run_a = _e251;
+            let _e228 = lit;
+            let _e229 = in_run;
+            if (_e228 != _e229) {
+                let _e231 = i;
+                let _e232 = edge_t(f_9, _e231, n_3, delta_2, theta_3, s_3, true);
+                let _e233 = lit;
+                if _e233 {
+                    run_a = _e232;
                 } else {
-                    let _e255 = total;
-                    let _e256 = run_a;
-                    let _e257 = lit_span(f_9, eye_7, _e21, _e256, _e251, true);
-                    total = (_e255 + _e257);
+                    let _e236 = total;
+                    let _e237 = run_a;
+                    let _e238 = lit_span(f_9, eye_7, _e9, _e237, _e232, true);
+                    total = (_e236 + _e238);
                 }
-                let _e259 = lit;
-                in_run = _e259;
+                let _e240 = lit;
+                in_run = _e240;
             }
-            let _e260 = i;
-            let _e262 = k;
-            i = (_e260 + (1u << _e262));
+            let _e241 = i;
+            let _e243 = k_4;
+            i = (_e241 + (1u << _e243));
         }
     }
-    let _e265 = in_run;
-    if _e265 {
-        let _e266 = total;
-        let _e267 = run_a;
-        let _e268 = lit_span(f_9, eye_7, _e21, _e267, s_3, true);
-        total = (_e266 + _e268);
+    let _e246 = in_run;
+    if _e246 {
+        let _e247 = total;
+        let _e248 = run_a;
+        let _e249 = lit_span(f_9, eye_7, _e9, _e248, s_3, true);
+        total = (_e247 + _e249);
     }
-    let _e270 = total;
-    l = _e270;
+    let _e251 = total;
+    l_1 = _e251;
     if !(true) {
-        let _e281 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(dot(f_9.light_dir.xyz, _e21)));
-        let _e283 = total;
-        l = ((f_9.medium.y * _e281) * _e283);
+        let _e262 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(dot(f_9.light_dir.xyz, _e9)));
+        let _e264 = total;
+        l_1 = ((f_9.medium.y * _e262) * _e264);
     }
-    let _e285 = l;
-    let c = (color * _e285);
-    textureStore(output, vec2<u32>(x_8, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
+    let _e266 = l_1;
+    let c = (color * _e266);
+    return c;
+}
+
+@compute @workgroup_size(8, 8, 1) 
+fn minmax_traverse(@builtin(global_invocation_id) id: vec3<u32>) {
+    var local: bool;
+
+    let _e5 = frame.sizes.x;
+    if !((id.x >= _e5)) {
+        let _e12 = frame.sizes.y;
+        local = (id.y >= _e12);
+    } else {
+        local = true;
+    }
+    let _e17 = local;
+    if _e17 {
+        return;
+    }
+    let _e20 = minmax_traverse_pixel(id.x, id.y);
+    textureStore(output, id.xy, vec4<f32>(_e20.x, _e20.y, _e20.z, 1f));
     return;
 }

@@ -77,11 +77,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_3 = (sigma_t * len);
-    if ((x_3 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_3)));
+    float x_4 = (sigma_t * len);
+    if ((x_4 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_4)));
     }
-    return ((1.0 - exp(-(x_3))) / sigma_t);
+    return ((1.0 - exp(-(x_4))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -93,19 +93,19 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
+    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
 }
 
-float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t_1, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_5 = (eye + (dir * t_1));
-    vec3 to_x = (x_5 - light_pos);
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
+    vec3 x_6 = (eye + (dir * t));
+    vec3 to_x = (x_6 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     vec3 travel = (to_x / vec3(d));
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t_1)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, vec3 light_pos_1, float a_1, float b_1, uint n) {
@@ -161,10 +161,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_6 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
-    uint y_2 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
+    uint x_7 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint y_3 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_6, y_2)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_7, y_3)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
     return _e49.x;
 }
 
@@ -201,20 +201,92 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
     return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
 }
 
-void main() {
-    uvec3 id = gl_GlobalInvocationID;
-    bool local = false;
+vec3 raymarch_pixel(uint x_3, uint y_2) {
     float u = 0.5;
     float sum = 0.0;
     uint j = 0u;
-    float t = 0.0;
+    float t_1 = 0.0;
     float w = 0.0;
     float l = 0.0;
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = _group_0_binding_0_cs;
-    uint x_7 = id.x;
-    uint y_3 = id.y;
-    if (!((x_7 >= m_2.sizes.x))) {
-        local = (y_3 >= m_2.sizes.y);
+    vec3 eye_2 = m_2.eye.xyz;
+    vec3 _e8 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
+    int _e12_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+    vec4 _e12 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_3, y_2)), ivec2(0), textureSize(_group_0_binding_1_cs, _e12_clamped_lod) - ivec2(1)), _e12_clamped_lod);
+    float s = (min(max(_e12.x, 0.0), m_2.eye.w) / max(dot(_e8, m_2.cam_forward.xyz), 1e-6));
+    uint n_2 = m_2.sizes.w;
+    float h_2 = (s / float(n_2));
+    uint mx = m_2.interleave.x;
+    uint my = m_2.interleave.y;
+    uint stride = (mx * my);
+    uint pixel_class = ((x_3 % mx) + (mx * (y_2 % my)));
+    if ((m_2.interleave.z != 0u)) {
+        float _e42 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
+        u = _e42;
+    }
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0.0, s, n_2);
+    j = pixel_class;
+    bool loop_init = true;
+    while(true) {
+        if (!loop_init) {
+            uint _e103 = j;
+            j = (_e103 + stride);
+        }
+        loop_init = false;
+        uint _e50 = j;
+        if ((_e50 < n_2)) {
+        } else {
+            break;
+        }
+        {
+            uint _e52 = j;
+            float _e54 = u;
+            t_1 = ((float(_e52) + _e54) * h_2);
+            w = h_2;
+            if (false) {
+                uint _e60 = j;
+                float _e62 = u;
+                vec2 _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (float(_e60) + _e62));
+                t_1 = _e64.x;
+                w = _e64.y;
+            }
+            float _e67 = t_1;
+            float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, _group_0_binding_2_cs, (eye_2 + (_e8 * _e67)));
+            if (false) {
+                float _e73 = sum;
+                float _e74 = w;
+                float _e76 = t_1;
+                float _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = (_e73 + ((_e71 * _e74) * _e86));
+            } else {
+                float _e89 = sum;
+                uint _e92 = j;
+                uint _e95 = j;
+                float _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e92) * h_2), (float((_e95 + 1u)) * h_2));
+                sum = (_e89 + (_e71 * _e100));
+            }
+        }
+    }
+    float _e105 = sum;
+    l = _e105;
+    if (!(false)) {
+        float _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e8)));
+        float _e118 = sum;
+        l = ((m_2.medium.y * _e116) * _e118);
+    }
+    float _e122 = l;
+    vec3 c = (m_2.light_color.xyz * _e122);
+    return c;
+}
+
+void main() {
+    uvec3 id = gl_GlobalInvocationID;
+    bool local = false;
+    uint _e5 = _group_0_binding_0_cs.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = _group_0_binding_0_cs.sizes.y;
+        local = (id.y >= _e12);
     } else {
         local = true;
     }
@@ -222,75 +294,8 @@ void main() {
     if (_e17) {
         return;
     }
-    vec3 eye_2 = m_2.eye.xyz;
-    vec3 _e20 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
-    int _e24_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
-    vec4 _e24 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_7, y_3)), ivec2(0), textureSize(_group_0_binding_1_cs, _e24_clamped_lod) - ivec2(1)), _e24_clamped_lod);
-    float s = (min(max(_e24.x, 0.0), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 1e-6));
-    uint n_2 = m_2.sizes.w;
-    float h_2 = (s / float(n_2));
-    uint mx = m_2.interleave.x;
-    uint my = m_2.interleave.y;
-    uint stride = (mx * my);
-    uint pixel_class = ((x_7 % mx) + (mx * (y_3 % my)));
-    if ((m_2.interleave.z != 0u)) {
-        float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
-        u = _e54;
-    }
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0.0, s, n_2);
-    j = pixel_class;
-    bool loop_init = true;
-    while(true) {
-        if (!loop_init) {
-            uint _e115 = j;
-            j = (_e115 + stride);
-        }
-        loop_init = false;
-        uint _e62 = j;
-        if ((_e62 < n_2)) {
-        } else {
-            break;
-        }
-        {
-            uint _e64 = j;
-            float _e66 = u;
-            t = ((float(_e64) + _e66) * h_2);
-            w = h_2;
-            if (false) {
-                uint _e72 = j;
-                float _e74 = u;
-                vec2 _e76 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e60, (float(_e72) + _e74));
-                t = _e76.x;
-                w = _e76.y;
-            }
-            float _e79 = t;
-            float _e83 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, _group_0_binding_2_cs, (eye_2 + (_e20 * _e79)));
-            if (false) {
-                float _e85 = sum;
-                float _e86 = w;
-                float _e88 = t;
-                float _e98 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, _e88, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = (_e85 + ((_e83 * _e86) * _e98));
-            } else {
-                float _e101 = sum;
-                uint _e104 = j;
-                uint _e107 = j;
-                float _e112 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e104) * h_2), (float((_e107 + 1u)) * h_2));
-                sum = (_e101 + (_e83 * _e112));
-            }
-        }
-    }
-    float _e117 = sum;
-    l = _e117;
-    if (!(false)) {
-        float _e128 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
-        float _e130 = sum;
-        l = ((m_2.medium.y * _e128) * _e130);
-    }
-    float _e134 = l;
-    vec3 c = (m_2.light_color.xyz * _e134);
-    imageStore(_group_0_binding_3_cs, ivec2(uvec2(x_7, y_3)), vec4(c.x, c.y, c.z, 1.0));
+    vec3 _e20 = raymarch_pixel(id.x, id.y);
+    imageStore(_group_0_binding_3_cs, ivec2(id.xy), vec4(_e20.x, _e20.y, _e20.z, 1.0));
     return;
 }
 

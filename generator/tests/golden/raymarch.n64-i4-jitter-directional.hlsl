@@ -90,11 +90,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_3 = (sigma_t * len);
-    if ((x_3 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_3)));
+    float x_4 = (sigma_t * len);
+    if ((x_4 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_4)));
     }
-    return ((1.0 - exp(-(x_3))) / sigma_t);
+    return ((1.0 - exp(-(x_4))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -108,20 +108,20 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
+    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
 }
 
-float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t_1, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_5 = (eye + (dir * t_1));
-    float3 to_x = (x_5 - light_pos);
+    float3 x_6 = (eye + (dir * t));
+    float3 to_x = (x_6 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     float3 travel = (to_x / (d).xxx);
     const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t_1)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
@@ -197,9 +197,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_6 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
-    uint y_2 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_6, y_2), int(0)));
+    uint x_7 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint y_3 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
+    float4 _e49 = sm.Load(int3(uint2(x_7, y_3), int(0)));
     return _e49.x;
 }
 
@@ -244,45 +244,32 @@ uint naga_mod(uint lhs, uint rhs) {
     return lhs % (rhs == 0u ? 1u : rhs);
 }
 
-[numthreads(8, 8, 1)]
-void raymarch(uint3 id : SV_DispatchThreadID)
+float3 raymarch_pixel(uint x_3, uint y_2)
 {
-    bool local = (bool)0;
     float u = 0.5;
     float sum = 0.0;
     uint j = (uint)0;
-    float t = (float)0;
+    float t_1 = (float)0;
     float w = (float)0;
     float l = (float)0;
 
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
-    uint x_7 = id.x;
-    uint y_3 = id.y;
-    if (!((x_7 >= m_2.sizes.x))) {
-        local = (y_3 >= m_2.sizes.y);
-    } else {
-        local = true;
-    }
-    bool _e17 = local;
-    if (_e17) {
-        return;
-    }
     float3 eye_2 = m_2.eye.xyz;
-    const float3 _e20 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
-    float4 _e24 = depth.Load(int3(uint2(x_7, y_3), int(0)));
-    float s = (min(max(_e24.x, 0.0), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 1e-6));
+    const float3 _e8 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
+    float4 _e12 = depth.Load(int3(uint2(x_3, y_2), int(0)));
+    float s = (min(max(_e12.x, 0.0), m_2.eye.w) / max(dot(_e8, m_2.cam_forward.xyz), 1e-6));
     uint n_2 = m_2.sizes.w;
     float h_2 = (s / float(n_2));
     uint mx = m_2.interleave.x;
     uint my = m_2.interleave.y;
     uint stride = (mx * my);
-    uint pixel_class = (naga_mod(x_7, mx) + (mx * naga_mod(y_3, my)));
+    uint pixel_class = (naga_mod(x_3, mx) + (mx * naga_mod(y_2, my)));
     if ((m_2.interleave.z != 0u)) {
-        const float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
-        u = _e54;
+        const float _e42 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
+        u = _e42;
     }
-    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0.0, s, n_2);
+    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0.0, s, n_2);
     j = pixel_class;
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
@@ -290,53 +277,73 @@ void raymarch(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e115 = j;
-            j = (_e115 + stride);
+            uint _e103 = j;
+            j = (_e103 + stride);
         }
         loop_init = false;
-        uint _e62 = j;
-        if ((_e62 < n_2)) {
+        uint _e50 = j;
+        if ((_e50 < n_2)) {
         } else {
             break;
         }
         {
-            uint _e64 = j;
-            float _e66 = u;
-            t = ((float(_e64) + _e66) * h_2);
+            uint _e52 = j;
+            float _e54 = u;
+            t_1 = ((float(_e52) + _e54) * h_2);
             w = h_2;
             if (false) {
-                uint _e72 = j;
-                float _e74 = u;
-                const float2 _e76 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e60, (float(_e72) + _e74));
-                t = _e76.x;
-                w = _e76.y;
+                uint _e60 = j;
+                float _e62 = u;
+                const float2 _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (float(_e60) + _e62));
+                t_1 = _e64.x;
+                w = _e64.y;
             }
-            float _e79 = t;
-            const float _e83 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, (eye_2 + (_e20 * _e79)));
+            float _e67 = t_1;
+            const float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)));
             if (false) {
-                float _e85 = sum;
-                float _e86 = w;
-                float _e88 = t;
-                const float _e98 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, _e88, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = (_e85 + ((_e83 * _e86) * _e98));
+                float _e73 = sum;
+                float _e74 = w;
+                float _e76 = t_1;
+                const float _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = (_e73 + ((_e71 * _e74) * _e86));
             } else {
-                float _e101 = sum;
-                uint _e104 = j;
-                uint _e107 = j;
-                const float _e112 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e104) * h_2), (float((_e107 + 1u)) * h_2));
-                sum = (_e101 + (_e83 * _e112));
+                float _e89 = sum;
+                uint _e92 = j;
+                uint _e95 = j;
+                const float _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e92) * h_2), (float((_e95 + 1u)) * h_2));
+                sum = (_e89 + (_e71 * _e100));
             }
         }
     }
-    float _e117 = sum;
-    l = _e117;
+    float _e105 = sum;
+    l = _e105;
     if (!(false)) {
-        const float _e128 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
-        float _e130 = sum;
-        l = ((m_2.medium.y * _e128) * _e130);
+        const float _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e8)));
+        float _e118 = sum;
+        l = ((m_2.medium.y * _e116) * _e118);
     }
-    float _e134 = l;
-    float3 c = (m_2.light_color.xyz * _e134);
-    output[uint2(x_7, y_3)] = float4(c.x, c.y, c.z, 1.0);
+    float _e122 = l;
+    float3 c = (m_2.light_color.xyz * _e122);
+    return c;
+}
+
+[numthreads(8, 8, 1)]
+void raymarch(uint3 id : SV_DispatchThreadID)
+{
+    bool local = (bool)0;
+
+    uint _e5 = frame.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = frame.sizes.y;
+        local = (id.y >= _e12);
+    } else {
+        local = true;
+    }
+    bool _e17 = local;
+    if (_e17) {
+        return;
+    }
+    const float3 _e20 = raymarch_pixel(id.x, id.y);
+    output[id.xy] = float4(_e20.x, _e20.y, _e20.z, 1.0);
     return;
 }

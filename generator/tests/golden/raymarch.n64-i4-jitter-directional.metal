@@ -86,11 +86,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_3 = sigma_t * len;
-    if (x_3 < 0.0001) {
-        return len * (1.0 - (0.5 * x_3));
+    float x_4 = sigma_t * len;
+    if (x_4 < 0.0001) {
+        return len * (1.0 - (0.5 * x_4));
     }
-    return (1.0 - metal::exp(-(x_3))) / sigma_t;
+    return (1.0 - metal::exp(-(x_4))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -110,28 +110,28 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_4 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_4 * x_4) * (3.0 - (2.0 * x_4));
+    float x_5 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_5 * x_5) * (3.0 - (2.0 * x_5));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 eye,
     metal::float3 dir,
-    float t_1,
+    float t,
     metal::float3 light_pos,
     metal::float3 light_dir,
     float cos_inner_1,
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_5 = eye + (dir * t_1);
-    metal::float3 to_x = x_5 - light_pos;
+    metal::float3 x_6 = eye + (dir * t);
+    metal::float3 to_x = x_6 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d);
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t_1))) / d2_;
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t))) / d2_;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -211,10 +211,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_6 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
-    uint y_2 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_7 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint y_3 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_6, y_2)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_7, y_3)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -257,10 +257,98 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
     return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
 }
+
 uint naga_mod(uint lhs, uint rhs) {
     return lhs % metal::select(rhs, 1u, rhs == 0u);
 }
 
+metal::float3 raymarch_pixel(
+    uint x_3,
+    uint y_2,
+    constant RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX& frame,
+    metal::texture2d<float, metal::access::sample> depth,
+    metal::texture2d<float, metal::access::sample> shadow_map
+) {
+    float u = 0.5;
+    float sum = 0.0;
+    uint j = {};
+    float t_1 = {};
+    float w = {};
+    float l = {};
+    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
+    metal::float3 eye_2 = m_2.eye.xyz;
+    metal::float3 _e8 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
+    uint clamped_lod_e12 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e12 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_2)), metal::uint2(depth.get_width(clamped_lod_e12), depth.get_height(clamped_lod_e12)) - 1), clamped_lod_e12);
+    float s = metal::min(metal::max(_e12.x, 0.0), m_2.eye.w) / metal::max(metal::dot(_e8, m_2.cam_forward.xyz), 0.000001);
+    uint n_2 = m_2.sizes.w;
+    float h_2 = s / static_cast<float>(n_2);
+    uint mx = m_2.interleave.x;
+    uint my = m_2.interleave.y;
+    uint stride = mx * my;
+    uint pixel_class = naga_mod(x_3, mx) + (mx * naga_mod(y_2, my));
+    if (m_2.interleave.z != 0u) {
+        float _e42 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
+        u = _e42;
+    }
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0.0, s, n_2);
+    j = pixel_class;
+    uint2 loop_bound = uint2(4294967295u);
+    bool loop_init = true;
+    while(true) {
+        if (metal::all(loop_bound == uint2(0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e103 = j;
+            j = _e103 + stride;
+        }
+        loop_init = false;
+        uint _e50 = j;
+        if (_e50 < n_2) {
+        } else {
+            break;
+        }
+        {
+            uint _e52 = j;
+            float _e54 = u;
+            t_1 = (static_cast<float>(_e52) + _e54) * h_2;
+            w = h_2;
+            if (false) {
+                uint _e60 = j;
+                float _e62 = u;
+                metal::float2 _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, static_cast<float>(_e60) + _e62);
+                t_1 = _e64.x;
+                w = _e64.y;
+            }
+            float _e67 = t_1;
+            float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, eye_2 + (_e8 * _e67));
+            if (false) {
+                float _e73 = sum;
+                float _e74 = w;
+                float _e76 = t_1;
+                float _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = _e73 + ((_e71 * _e74) * _e86);
+            } else {
+                float _e89 = sum;
+                uint _e92 = j;
+                uint _e95 = j;
+                float _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e92) * h_2, static_cast<float>(_e95 + 1u) * h_2);
+                sum = _e89 + (_e71 * _e100);
+            }
+        }
+    }
+    float _e105 = sum;
+    l = _e105;
+    if (!(false)) {
+        float _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(metal::dot(m_2.light_dir.xyz, _e8)));
+        float _e118 = sum;
+        l = (m_2.medium.y * _e116) * _e118;
+    }
+    float _e122 = l;
+    metal::float3 c = m_2.light_color.xyz * _e122;
+    return c;
+}
 
 struct raymarchInput {
 };
@@ -272,17 +360,10 @@ kernel void raymarch(
 , metal::texture2d<float, metal::access::write> output [[texture(2)]]
 ) {
     bool local = {};
-    float u = 0.5;
-    float sum = 0.0;
-    uint j = {};
-    float t = {};
-    float w = {};
-    float l = {};
-    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
-    uint x_7 = id.x;
-    uint y_3 = id.y;
-    if (!((x_7 >= m_2.sizes.x))) {
-        local = y_3 >= m_2.sizes.y;
+    uint _e5 = frame.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = frame.sizes.y;
+        local = id.y >= _e12;
     } else {
         local = true;
     }
@@ -290,77 +371,7 @@ kernel void raymarch(
     if (_e17) {
         return;
     }
-    metal::float3 eye_2 = m_2.eye.xyz;
-    metal::float3 _e20 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
-    uint clamped_lod_e24 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e24 = depth.read(metal::min(metal::uint2(metal::uint2(x_7, y_3)), metal::uint2(depth.get_width(clamped_lod_e24), depth.get_height(clamped_lod_e24)) - 1), clamped_lod_e24);
-    float s = metal::min(metal::max(_e24.x, 0.0), m_2.eye.w) / metal::max(metal::dot(_e20, m_2.cam_forward.xyz), 0.000001);
-    uint n_2 = m_2.sizes.w;
-    float h_2 = s / static_cast<float>(n_2);
-    uint mx = m_2.interleave.x;
-    uint my = m_2.interleave.y;
-    uint stride = mx * my;
-    uint pixel_class = naga_mod(x_7, mx) + (mx * naga_mod(y_3, my));
-    if (m_2.interleave.z != 0u) {
-        float _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
-        u = _e54;
-    }
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e56 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0.0, s, n_2);
-    j = pixel_class;
-    uint2 loop_bound = uint2(4294967295u);
-    bool loop_init = true;
-    while(true) {
-        if (metal::all(loop_bound == uint2(0u))) { break; }
-        loop_bound -= uint2(loop_bound.y == 0u, 1u);
-        if (!loop_init) {
-            uint _e115 = j;
-            j = _e115 + stride;
-        }
-        loop_init = false;
-        uint _e62 = j;
-        if (_e62 < n_2) {
-        } else {
-            break;
-        }
-        {
-            uint _e64 = j;
-            float _e66 = u;
-            t = (static_cast<float>(_e64) + _e66) * h_2;
-            w = h_2;
-            if (false) {
-                uint _e72 = j;
-                float _e74 = u;
-                metal::float2 _e76 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e60, static_cast<float>(_e72) + _e74);
-                t = _e76.x;
-                w = _e76.y;
-            }
-            float _e79 = t;
-            float _e83 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, eye_2 + (_e20 * _e79));
-            if (false) {
-                float _e85 = sum;
-                float _e86 = w;
-                float _e88 = t;
-                float _e98 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, _e88, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = _e85 + ((_e83 * _e86) * _e98);
-            } else {
-                float _e101 = sum;
-                uint _e104 = j;
-                uint _e107 = j;
-                float _e112 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e104) * h_2, static_cast<float>(_e107 + 1u) * h_2);
-                sum = _e101 + (_e83 * _e112);
-            }
-        }
-    }
-    float _e117 = sum;
-    l = _e117;
-    if (!(false)) {
-        float _e128 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(metal::dot(m_2.light_dir.xyz, _e20)));
-        float _e130 = sum;
-        l = (m_2.medium.y * _e128) * _e130;
-    }
-    float _e134 = l;
-    metal::float3 c = m_2.light_color.xyz * _e134;
-    output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_7, y_3)));
+    metal::float3 _e20 = raymarch_pixel(id.x, id.y, frame, depth, shadow_map);
+    output.write(metal::float4(_e20.x, _e20.y, _e20.z, 1.0), metal::uint2(id.xy));
     return;
 }

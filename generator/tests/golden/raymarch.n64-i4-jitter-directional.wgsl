@@ -77,11 +77,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_3 = (sigma_t * len);
-    if (x_3 < 0.0001f) {
-        return (len * (1f - (0.5f * x_3)));
+    let x_4 = (sigma_t * len);
+    if (x_4 < 0.0001f) {
+        return (len * (1f - (0.5f * x_4)));
     }
-    return ((1f - exp(-(x_3))) / sigma_t);
+    return ((1f - exp(-(x_4))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -93,19 +93,19 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_4 * x_4) * (3f - (2f * x_4)));
+    let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_5 * x_5) * (3f - (2f * x_5)));
 }
 
-fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t_1: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_5 = (eye + (dir * t_1));
-    let to_x = (x_5 - light_pos);
+fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
+    let x_6 = (eye + (dir * t));
+    let to_x = (x_6 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d = sqrt(d2_);
     let travel = (to_x / vec3(d));
     let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t_1)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, light_pos_1: vec3<f32>, a_1: f32, b_1: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -162,9 +162,9 @@ fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_nag
         return 2f;
     }
     let n_1 = v_2.size.x;
-    let x_6 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
-    let y_2 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_6, y_2), 0i);
+    let x_7 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let y_3 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
+    let _e49 = textureLoad(sm, vec2<u32>(x_7, y_3), 0i);
     return _e49.x;
 }
 
@@ -203,21 +203,91 @@ fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapView
     return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
 }
 
-@compute @workgroup_size(8, 8, 1) 
-fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
-    var local: bool;
+fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     var u: f32 = 0.5f;
     var sum: f32 = 0f;
     var j: u32;
-    var t: f32;
+    var t_1: f32;
     var w: f32;
     var l: f32;
 
     let m_2 = frame;
-    let x_7 = id.x;
-    let y_3 = id.y;
-    if !((x_7 >= m_2.sizes.x)) {
-        local = (y_3 >= m_2.sizes.y);
+    let eye_2 = m_2.eye.xyz;
+    let _e8 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
+    let _e12 = textureLoad(depth, vec2<u32>(x_3, y_2), 0i);
+    let s = (min(max(_e12.x, 0f), m_2.eye.w) / max(dot(_e8, m_2.cam_forward.xyz), 0.000001f));
+    let n_2 = m_2.sizes.w;
+    let h_2 = (s / f32(n_2));
+    let mx = m_2.interleave.x;
+    let my = m_2.interleave.y;
+    let stride = (mx * my);
+    let pixel_class = ((x_3 % mx) + (mx * (y_2 % my)));
+    if (m_2.interleave.z != 0u) {
+        let _e42 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
+        u = _e42;
+    }
+    let _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
+    let _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0f, s, n_2);
+    j = pixel_class;
+    loop {
+        let _e50 = j;
+        if (_e50 < n_2) {
+        } else {
+            break;
+        }
+        {
+            let _e52 = j;
+            let _e54 = u;
+            t_1 = ((f32(_e52) + _e54) * h_2);
+            w = h_2;
+            if false {
+                let _e60 = j;
+                let _e62 = u;
+                let _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (f32(_e60) + _e62));
+                t_1 = _e64.x;
+                w = _e64.y;
+            }
+            let _e67 = t_1;
+            let _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)));
+            if false {
+                let _e73 = sum;
+                let _e74 = w;
+                let _e76 = t_1;
+                let _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = (_e73 + ((_e71 * _e74) * _e86));
+            } else {
+                let _e89 = sum;
+                let _e92 = j;
+                let _e95 = j;
+                let _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e92) * h_2), (f32((_e95 + 1u)) * h_2));
+                sum = (_e89 + (_e71 * _e100));
+            }
+        }
+        continuing {
+            let _e103 = j;
+            j = (_e103 + stride);
+        }
+    }
+    let _e105 = sum;
+    l = _e105;
+    if !(false) {
+        let _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e8)));
+        let _e118 = sum;
+        l = ((m_2.medium.y * _e116) * _e118);
+    }
+    let _e122 = l;
+    let c = (m_2.light_color.xyz * _e122);
+    return c;
+}
+
+@compute @workgroup_size(8, 8, 1) 
+fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
+    var local: bool;
+
+    let _e5 = frame.sizes.x;
+    if !((id.x >= _e5)) {
+        let _e12 = frame.sizes.y;
+        local = (id.y >= _e12);
     } else {
         local = true;
     }
@@ -225,71 +295,7 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e17 {
         return;
     }
-    let eye_2 = m_2.eye.xyz;
-    let _e20 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_7, y_3);
-    let _e24 = textureLoad(depth, vec2<u32>(x_7, y_3), 0i);
-    let s = (min(max(_e24.x, 0f), m_2.eye.w) / max(dot(_e20, m_2.cam_forward.xyz), 0.000001f));
-    let n_2 = m_2.sizes.w;
-    let h_2 = (s / f32(n_2));
-    let mx = m_2.interleave.x;
-    let my = m_2.interleave.y;
-    let stride = (mx * my);
-    let pixel_class = ((x_7 % mx) + (mx * (y_3 % my)));
-    if (m_2.interleave.z != 0u) {
-        let _e54 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_7, y_3);
-        u = _e54;
-    }
-    let _e56 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    let _e60 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, m_2.light_pos.xyz, 0f, s, n_2);
-    j = pixel_class;
-    loop {
-        let _e62 = j;
-        if (_e62 < n_2) {
-        } else {
-            break;
-        }
-        {
-            let _e64 = j;
-            let _e66 = u;
-            t = ((f32(_e64) + _e66) * h_2);
-            w = h_2;
-            if false {
-                let _e72 = j;
-                let _e74 = u;
-                let _e76 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e60, (f32(_e72) + _e74));
-                t = _e76.x;
-                w = _e76.y;
-            }
-            let _e79 = t;
-            let _e83 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e56, shadow_map, (eye_2 + (_e20 * _e79)));
-            if false {
-                let _e85 = sum;
-                let _e86 = w;
-                let _e88 = t;
-                let _e98 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e20, _e88, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = (_e85 + ((_e83 * _e86) * _e98));
-            } else {
-                let _e101 = sum;
-                let _e104 = j;
-                let _e107 = j;
-                let _e112 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e104) * h_2), (f32((_e107 + 1u)) * h_2));
-                sum = (_e101 + (_e83 * _e112));
-            }
-        }
-        continuing {
-            let _e115 = j;
-            j = (_e115 + stride);
-        }
-    }
-    let _e117 = sum;
-    l = _e117;
-    if !(false) {
-        let _e128 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e20)));
-        let _e130 = sum;
-        l = ((m_2.medium.y * _e128) * _e130);
-    }
-    let _e134 = l;
-    let c = (m_2.light_color.xyz * _e134);
-    textureStore(output, vec2<u32>(x_7, y_3), vec4<f32>(c.x, c.y, c.z, 1f));
+    let _e20 = raymarch_pixel(id.x, id.y);
+    textureStore(output, id.xy, vec4<f32>(_e20.x, _e20.y, _e20.z, 1f));
     return;
 }

@@ -96,35 +96,35 @@ uint naga_f2u32(float value) {
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
 {
-    bool local_5 = (bool)0;
-    bool local_6 = (bool)0;
-    bool local_7 = (bool)0;
+    bool local_1 = (bool)0;
+    bool local_2 = (bool)0;
+    bool local_3 = (bool)0;
 
     if (!((uv.x < 0.0))) {
-        local_5 = (uv.x > 1.0);
+        local_1 = (uv.x > 1.0);
     } else {
-        local_5 = true;
+        local_1 = true;
     }
-    bool _e11 = local_5;
+    bool _e11 = local_1;
     if (!(_e11)) {
-        local_6 = (uv.y < 0.0);
+        local_2 = (uv.y < 0.0);
     } else {
-        local_6 = true;
+        local_2 = true;
     }
-    bool _e19 = local_6;
+    bool _e19 = local_2;
     if (!(_e19)) {
-        local_7 = (uv.y > 1.0);
+        local_3 = (uv.y > 1.0);
     } else {
-        local_7 = true;
+        local_3 = true;
     }
-    bool _e27 = local_7;
+    bool _e27 = local_3;
     if (_e27) {
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_3 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
-    uint y_1 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_3, y_1), int(0)));
+    uint x_4 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint y_2 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
+    float4 _e49 = sm.Load(int3(uint2(x_4, y_2), int(0)));
     return _e49.x;
 }
 
@@ -144,17 +144,17 @@ float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_o
 
 float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, Texture2D<float4> sm_1, float3 p_1)
 {
-    bool local_8 = (bool)0;
+    bool local_4 = (bool)0;
 
     const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     float near = v_4.right.w;
     float far = v_4.up.w;
     if ((v_4.origin.w > 0.5)) {
-        local_8 = (_e2.z <= near);
+        local_4 = (_e2.z <= near);
     } else {
-        local_8 = false;
+        local_4 = false;
     }
-    bool _e16 = local_8;
+    bool _e16 = local_4;
     if (_e16) {
         return 1.0;
     }
@@ -203,17 +203,17 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_4 = (sigma_t * len);
-    if ((x_4 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_4)));
+    float x_5 = (sigma_t * len);
+    if ((x_5 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_5)));
     }
-    return ((1.0 - exp(-(x_4))) / sigma_t);
+    return ((1.0 - exp(-(x_5))) / sigma_t);
 }
 
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a_1, float b_1)
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
 {
-    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
-    return (exp((-(sigma_t_1) * a_1)) * _e7);
+    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
@@ -221,14 +221,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
+    float x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_6 * x_6) * (3.0 - (2.0 * x_6)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_6 = (eye + (dir * t));
-    float3 to_x = (x_6 - light_pos);
+    float3 x_7 = (eye + (dir * t));
+    float3 to_x = (x_7 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_1 = sqrt(d2_);
     float3 travel = (to_x / (d_1).xxx);
@@ -237,33 +237,33 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
 }
 
-float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_2, float b_2, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
 {
     float sum = 0.0;
-    uint k_1 = 0u;
+    uint k = 0u;
     uint q = (uint)0;
 
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
-    float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_2 - a_2), 1e-6)));
-    float g0_ = atan(((a_2 - t0_) / h));
-    float w_1 = ((atan(((b_2 - t0_) / h)) - g0_) / float(panels));
+    float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float g0_ = atan(((a_1 - t0_) / h));
+    float w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
     while(true) {
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k_1;
-            k_1 = (_e73 + 1u);
+            uint _e73 = k;
+            k = (_e73 + 1u);
         }
         loop_init = false;
-        uint _e30 = k_1;
+        uint _e30 = k;
         if ((_e30 < panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k_1;
+            uint _e32 = k;
             float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
@@ -305,12 +305,12 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_o
     return ret;
 }
 
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_2, float3 dir_2, float3 light_pos_2, float a_3, float b_3, uint n)
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_2, float3 dir_2, float3 light_pos_2, float a_2, float b_2, uint n)
 {
     float t0_1 = dot((light_pos_2 - eye_2), dir_2);
-    float h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_3 - a_3), 1e-6)));
-    float theta_a = atan(((a_3 - t0_1) / h_1));
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_3 - t0_1) / h_1)) - theta_a) / float(n)));
+    float h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_1) / h_1));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / float(n)));
     return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
 }
 
@@ -335,9 +335,9 @@ SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_
     return sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax;
 }
 
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta_1, float lo, float hi)
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi)
 {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta_1 - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
 }
 
 float3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, uint x_1, uint y)
@@ -381,7 +381,7 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, Texture2D<float4> sm_4, float3 eye_4, float3 dir_4, float s, bool spot)
 {
     float sum_1 = 0.0;
-    uint k_2 = 0u;
+    uint k_1 = 0u;
     float t_2 = (float)0;
     float w = (float)0;
 
@@ -394,21 +394,21 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e60 = k_2;
-            k_2 = (_e60 + 1u);
+            uint _e60 = k_1;
+            k_1 = (_e60 + 1u);
         }
         loop_init_2 = false;
-        uint _e15 = k_2;
+        uint _e15 = k_1;
         if ((_e15 < steps)) {
         } else {
             break;
         }
         {
-            uint _e17 = k_2;
+            uint _e17 = k_1;
             t_2 = ((float(_e17) + 0.5) * h_2);
             w = h_2;
             if (spot) {
-                uint _e25 = k_2;
+                uint _e25 = k_1;
                 const float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e25) + 0.5));
                 t_2 = _e29.x;
                 w = _e29.y;
@@ -423,8 +423,8 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
                 sum_1 = (_e38 + ((_e36 * _e39) * _e42));
             } else {
                 float _e45 = sum_1;
-                uint _e48 = k_2;
-                uint _e51 = k_2;
+                uint _e48 = k_1;
+                uint _e51 = k_1;
                 const float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (float(_e48) * h_2), (float((_e51 + 1u)) * h_2));
                 sum_1 = (_e45 + (_e36 * _e56));
             }
@@ -459,31 +459,31 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, 
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float x_2, float delta_1, float theta_2, float s_1, bool spot_1)
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float x_2, float delta, float theta_1, float s_1, bool spot_1)
 {
-    bool local_9 = (bool)0;
+    bool local_5 = (bool)0;
 
     if (spot_1) {
-        float psi = (x_2 * delta_1);
-        float den = sin((theta_2 + psi));
+        float psi = (x_2 * delta);
+        float den = sin((theta_1 + psi));
         if (!((den <= 1e-6))) {
-            local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_5 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_9 = true;
+            local_5 = true;
         }
-        bool _e16 = local_9;
+        bool _e16 = local_5;
         if (_e16) {
             return s_1;
         }
         return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_2 * delta_1) / max(sin(theta_2), 1e-6)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_1), 1e-6)), s_1);
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 eye_5, float3 dir_5, float a_4, float b_4, uint panels_1)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 eye_5, float3 dir_5, float a_3, float b_3, uint panels_1)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_4, b_4, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -497,9 +497,9 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_X
     return (f_8.e1_.w + ((float(row) + 0.5) * f_8.e2_.w));
 }
 
-float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_5, float2 b_5)
+float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_4, float2 b_4)
 {
-    return float2(((a_5.x * b_5.y) + (a_5.y * b_5.x)), ((a_5.y * b_5.y) - (a_5.x * b_5.x)));
+    return float2(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
 }
 
 float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 first)
@@ -507,318 +507,304 @@ float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 firs
     return float2(((2.0 * first.x) * first.y), (1.0 - ((2.0 * first.x) * first.x)));
 }
 
-float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_3)
+float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_2)
 {
-    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_3) - 1u)));
+    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_2) - 1u)));
 }
 
-float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_6, float2 b_6, uint layer_2)
+float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_5, float2 b_5, uint layer)
 {
-    const float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
-    const float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
-    return float4(((2.0 / _e5) * a_6.y), ((-2.0 / _e5) * a_6.x), ((2.0 / _e10) * b_6.y), ((-2.0 / _e10) * b_6.x));
+    const float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 1u));
+    const float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 2u));
+    return float4(((2.0 / _e5) * a_5.y), ((-2.0 / _e5) * a_5.x), ((2.0 / _e10) * b_5.y), ((-2.0 / _e10) * b_5.x));
 }
 
 uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_1, uint regions, uint width, bool spot_2)
+uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_2)
 {
     if (spot_2) {
-        return naga_div((r_1 * width), regions);
+        return naga_div((r * width), regions);
     }
-    return naga_div(((r_1 * r_1) * width), (regions * regions));
+    return naga_div(((r * r) * width), (regions * regions));
 }
 
 float ZeroValuefloat() {
     return (float)0;
 }
 
-[numthreads(8, 8, 1)]
-void scatter(uint3 id : SV_DispatchThreadID)
+float3 scatter_pixel(uint x_3, uint y_1)
 {
-    bool local = (bool)0;
-    bool local_1 = (bool)0;
-    bool local_2 = (bool)0;
-    bool local_3 = (bool)0;
+    bool local_6 = (bool)0;
+    bool local_7 = (bool)0;
+    bool local_8 = (bool)0;
     float yc = (float)0;
     float d = (float)0;
     float xs = (float)0;
-    float delta = 1.0;
-    float theta = 0.0;
+    float delta_1 = 1.0;
+    float theta_2 = 0.0;
     float4 coeffs[4] = (float4[4])0;
     float2 angle = (float2)0;
-    uint layer = 0u;
+    uint layer_1 = 0u;
     float total = 0.0;
-    uint r = 0u;
-    bool local_4 = (bool)0;
-    float a = (float)0;
-    float b = (float)0;
+    uint r_1 = 0u;
+    bool local_9 = (bool)0;
+    float a_6 = (float)0;
+    float b_6 = (float)0;
     float weight = (float)0;
     float vis = (float)0;
-    uint layer_1 = (uint)0;
-    uint k = (uint)0;
+    uint layer_2 = (uint)0;
+    uint k_3 = (uint)0;
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
-    uint x_7 = id.x;
-    uint y_2 = id.y;
-    if (!((x_7 >= f_9.sizes.x))) {
-        local = (y_2 >= f_9.sizes.y);
-    } else {
-        local = true;
-    }
-    bool _e18 = local;
-    if (_e18) {
-        return;
-    }
     float3 eye_6 = f_9.eye.xyz;
-    const float3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_7, y_2);
-    float4 _e25 = depth.Load(int3(uint2(x_7, y_2), int(0)));
-    float s_2 = (min(max(_e25.x, 0.0), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 1e-6));
+    const float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    float4 _e13 = depth.Load(int3(uint2(x_3, y_1), int(0)));
+    float s_2 = (min(max(_e13.x, 0.0), f_9.theta.z) / max(dot(_e9, f_9.cam_forward.xyz), 1e-6));
     float3 color = f_9.light_color.xyz;
-    float3 px = float3((float(x_7) + 0.5), (float(y_2) + 0.5), 0.0);
+    float3 px = float3((float(x_3) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_9.epipole.w;
     if ((f_9.epipole.z > 0.5)) {
-        local_1 = (length((px - float3(f_9.epipole.x, f_9.epipole.y, 0.0))) < radius);
+        local_6 = (length((px - float3(f_9.epipole.x, f_9.epipole.y, 0.0))) < radius);
     } else {
-        local_1 = false;
+        local_6 = false;
     }
-    bool near_epi = local_1;
+    bool near_epi = local_6;
     if ((f_9.anti_epipole.z > 0.5)) {
-        local_2 = (length((px - float3(f_9.anti_epipole.x, f_9.anti_epipole.y, 0.0))) < radius);
+        local_7 = (length((px - float3(f_9.anti_epipole.x, f_9.anti_epipole.y, 0.0))) < radius);
     } else {
-        local_2 = false;
+        local_7 = false;
     }
-    bool near_anti = local_2;
+    bool near_anti = local_7;
     if (!(near_epi)) {
-        local_3 = near_anti;
+        local_8 = near_anti;
     } else {
-        local_3 = true;
+        local_8 = true;
     }
-    bool _e88 = local_3;
-    if (_e88) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = frame;
-        const float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_6, _e21, s_2, true);
-        float3 l_1 = (_e93 * color);
-        output[uint2(x_7, y_2)] = float4(l_1.x, l_1.y, l_1.z, 1.0);
-        return;
+    bool _e76 = local_8;
+    if (_e76) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = frame;
+        const float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_6, _e9, s_2, true);
+        float3 l_1 = (_e81 * color);
+        return l_1;
     }
     float3 axis = f_9.axis.xyz;
     uint rows_1 = f_9.sizes.w;
     uint width_1 = f_9.sizes.z;
     bool wrap_1 = (f_9.anti_epipole.w > 0.5);
     {
-        theta = acos(clamp(dot(_e21, axis), -1.0, 1.0));
-        float phi_1 = atan2(dot(_e21, f_9.e2_.xyz), dot(_e21, f_9.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e9, axis), -1.0, 1.0));
+        float phi_1 = atan2(dot(_e9, f_9.e2_.xyz), dot(_e9, f_9.e1_.xyz));
         yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
         if (wrap_1) {
-            float _e132 = yc;
-            float _e133 = yc;
-            yc = (_e132 - (floor((_e133 / float(rows_1))) * float(rows_1)));
+            float _e113 = yc;
+            float _e114 = yc;
+            yc = (_e113 - (floor((_e114 / float(rows_1))) * float(rows_1)));
         } else {
-            float _e140 = yc;
-            yc = clamp(_e140, 0.0, float(rows_1));
+            float _e121 = yc;
+            yc = clamp(_e121, 0.0, float(rows_1));
         }
-        float _e144 = yc;
-        float yy = (_e144 - 0.5);
+        float _e125 = yc;
+        float yy = (_e125 - 0.5);
         float j0_ = floor(yy);
         float fy = (yy - j0_);
-        const uint _e149 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        float4 _e152 = asfloat(slices.Load4(_e149*16));
-        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e153 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e152);
-        const uint _e156 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1.0), rows_1, wrap_1);
-        float4 _e159 = asfloat(slices.Load4(_e156*16));
-        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e160 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e159);
-        delta = lerp(_e153.delta, _e160.delta, fy);
-        float _e165 = theta;
-        const float _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_9.theta.x, f_9.theta.y);
-        d = _e170;
+        const uint _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
+        float4 _e133 = asfloat(slices.Load4(_e130*16));
+        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
+        const uint _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1.0), rows_1, wrap_1);
+        float4 _e140 = asfloat(slices.Load4(_e137*16));
+        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
+        delta_1 = lerp(_e134.delta, _e141.delta, fy);
+        float _e146 = theta_2;
+        const float _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_9.theta.x, f_9.theta.y);
+        d = _e151;
         if (true) {
-            float3 q_2 = normalize(((eye_6 + (_e21 * s_2)) - f_9.light_pos.xyz));
-            float _e184 = delta;
-            xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / _e184);
+            float3 q_2 = normalize(((eye_6 + (_e9 * s_2)) - f_9.light_pos.xyz));
+            float _e165 = delta_1;
+            xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / _e165);
         } else {
-            float _e187 = theta;
-            float _e190 = delta;
-            xs = ((s_2 * sin(_e187)) / _e190);
+            float _e168 = theta_2;
+            float _e171 = delta_1;
+            xs = ((s_2 * sin(_e168)) / _e171);
         }
     }
-    float _e192 = yc;
-    float yb = (_e192 - 0.5);
+    float _e173 = yc;
+    float yb = (_e173 - 0.5);
     float fy_1 = (yb - floor(yb));
-    const uint _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    const uint _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e202 : _e198);
-    float cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
+    const uint _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    const uint _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e183 : _e179);
+    float cos_theta_l = -(dot(f_9.light_dir.xyz, _e9));
     uint panels_2 = max(naga_div(f_9.sizes2_.z, 4u), 1u);
-    float _e217 = d;
-    float _e221 = d;
-    angle = float2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e217)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e221)));
-    float2 _e226 = angle;
-    const float2 _e227 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226);
+    float _e198 = d;
+    float _e202 = d;
+    angle = float2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e198)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e202)));
+    float2 _e207 = angle;
+    const float2 _e208 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e207);
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e242 = layer;
-            layer = (_e242 + 1u);
+            uint _e223 = layer_1;
+            layer_1 = (_e223 + 1u);
         }
         loop_init_3 = false;
-        uint _e229 = layer;
-        if ((_e229 < LAYERS)) {
+        uint _e210 = layer_1;
+        if ((_e210 < LAYERS)) {
         } else {
             break;
         }
         {
-            float2 _e232 = angle;
-            const float2 _e233 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e232, _e227);
-            uint _e235 = layer;
-            float2 _e237 = angle;
-            uint _e238 = layer;
-            const float4 _e239 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e237, _e233, _e238);
-            coeffs[min(uint(_e235), 3u)] = _e239;
-            const float2 _e240 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e233, _e227);
-            angle = _e240;
+            float2 _e213 = angle;
+            const float2 _e214 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e213, _e208);
+            uint _e216 = layer_1;
+            float2 _e218 = angle;
+            uint _e219 = layer_1;
+            const float4 _e220 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, _e214, _e219);
+            coeffs[min(uint(_e216), 3u)] = _e220;
+            const float2 _e221 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e214, _e208);
+            angle = _e221;
         }
     }
-    const float _e248 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    float sun_scatter = (f_9.medium.y * _e248);
-    float _e250 = xs;
-    uint last = naga_f2u32(min(max(_e250, 0.0), (float(width_1) - 1.0)));
+    const float _e229 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    float sun_scatter = (f_9.medium.y * _e229);
+    float _e231 = xs;
+    uint last = naga_f2u32(min(max(_e231, 0.0), (float(width_1) - 1.0)));
     uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e418 = r;
-            r = (_e418 + 1u);
+            uint _e399 = r_1;
+            r_1 = (_e399 + 1u);
         }
         loop_init_4 = false;
-        uint _e260 = r;
-        if ((_e260 < REGIONS)) {
+        uint _e241 = r_1;
+        if ((_e241 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e262 = r;
-            const uint _e263 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e262, REGIONS, width_1, true);
-            float b0_ = float(_e263);
-            uint _e265 = r;
-            const uint _e268 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e265 + 1u), REGIONS, width_1, true);
-            float b1_ = float(_e268);
+            uint _e243 = r_1;
+            const uint _e244 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e243, REGIONS, width_1, true);
+            float b0_ = float(_e244);
+            uint _e246 = r_1;
+            const uint _e249 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e246 + 1u), REGIONS, width_1, true);
+            float b1_ = float(_e249);
             if (!((last < naga_f2u32(b1_)))) {
-                uint _e273 = r;
-                local_4 = ((_e273 + 1u) == REGIONS);
+                uint _e254 = r_1;
+                local_9 = ((_e254 + 1u) == REGIONS);
             } else {
-                local_4 = true;
+                local_9 = true;
             }
-            bool is_last = local_4;
-            float _e283 = xs;
-            float pos = (is_last ? clamp((_e283 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            a = ZeroValuefloat();
-            b = ZeroValuefloat();
-            float _e296 = delta;
-            float _e297 = theta;
-            const float _e298 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e296, _e297, s_2, true);
-            a = _e298;
-            float _e299 = delta;
-            float _e300 = theta;
-            const float _e301 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e299, _e300, s_2, true);
-            b = (is_last ? s_2 : _e301);
+            bool is_last = local_9;
+            float _e264 = xs;
+            float pos = (is_last ? clamp((_e264 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            a_6 = ZeroValuefloat();
+            b_6 = ZeroValuefloat();
+            float _e277 = delta_1;
+            float _e278 = theta_2;
+            const float _e279 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e277, _e278, s_2, true);
+            a_6 = _e279;
+            float _e280 = delta_1;
+            float _e281 = theta_2;
+            const float _e282 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e280, _e281, s_2, true);
+            b_6 = (is_last ? s_2 : _e282);
             weight = ZeroValuefloat();
             if (true) {
-                float _e305 = a;
-                float _e306 = b;
-                const float _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, _e305, _e306, panels_2);
-                weight = _e307;
+                float _e286 = a_6;
+                float _e287 = b_6;
+                const float _e288 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e9, _e286, _e287, panels_2);
+                weight = _e288;
             } else {
-                float _e310 = a;
-                float _e311 = b;
-                const float _e312 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e310, _e311);
-                weight = (sun_scatter * _e312);
+                float _e291 = a_6;
+                float _e292 = b_6;
+                const float _e293 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e291, _e292);
+                weight = (sun_scatter * _e293);
             }
             float xb = (pos - 0.5);
             float fx = (xb - floor(xb));
             uint x0_ = naga_f2u32(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
             uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
-            float4 bounds0_ = bounds.Load(int3(uint2(x1_, _e198), int(0)));
+            float4 bounds0_ = bounds.Load(int3(uint2(x1_, _e179), int(0)));
             float4 bounds1_ = bounds.Load(int3(uint2(x1_, row1_), int(0)));
             float lo_1 = min(bounds0_.x, bounds1_.x);
             float hi_1 = max(bounds0_.y, bounds1_.y);
             vis = 0.5;
-            float _e349 = d;
-            if ((_e349 <= lo_1)) {
+            float _e330 = d;
+            if ((_e330 <= lo_1)) {
                 vis = 1.0;
             } else {
-                float _e352 = d;
-                if ((_e352 > hi_1)) {
+                float _e333 = d;
+                if ((_e333 > hi_1)) {
                     vis = 0.0;
                 } else {
-                    layer_1 = 0u;
+                    layer_2 = 0u;
                     uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
                     bool loop_init_5 = true;
                     while(true) {
                         if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
                         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                         if (!loop_init_5) {
-                            uint _e406 = layer_1;
-                            layer_1 = (_e406 + 1u);
+                            uint _e387 = layer_2;
+                            layer_2 = (_e387 + 1u);
                         }
                         loop_init_5 = false;
-                        uint _e357 = layer_1;
-                        if ((_e357 < LAYERS)) {
+                        uint _e338 = layer_2;
+                        if ((_e338 < LAYERS)) {
                         } else {
                             break;
                         }
                         {
-                            uint _e360 = layer_1;
-                            float4 coeff = coeffs[min(uint(_e360), 3u)];
-                            uint _e364 = layer_1;
-                            float4 _e367 = filtered.Load(int4(uint2(x0_, _e198), _e364, int(0)));
-                            uint _e369 = layer_1;
-                            float4 _e372 = filtered.Load(int4(uint2(x1_, _e198), _e369, int(0)));
-                            float4 top = lerp(_e367, _e372, fx);
-                            uint _e375 = layer_1;
-                            float4 _e378 = filtered.Load(int4(uint2(x0_, row1_), _e375, int(0)));
-                            uint _e380 = layer_1;
-                            float4 _e383 = filtered.Load(int4(uint2(x1_, row1_), _e380, int(0)));
-                            float4 bottom = lerp(_e378, _e383, fx);
+                            uint _e341 = layer_2;
+                            float4 coeff = coeffs[min(uint(_e341), 3u)];
+                            uint _e345 = layer_2;
+                            float4 _e348 = filtered.Load(int4(uint2(x0_, _e179), _e345, int(0)));
+                            uint _e350 = layer_2;
+                            float4 _e353 = filtered.Load(int4(uint2(x1_, _e179), _e350, int(0)));
+                            float4 top = lerp(_e348, _e353, fx);
+                            uint _e356 = layer_2;
+                            float4 _e359 = filtered.Load(int4(uint2(x0_, row1_), _e356, int(0)));
+                            uint _e361 = layer_2;
+                            float4 _e364 = filtered.Load(int4(uint2(x1_, row1_), _e361, int(0)));
+                            float4 bottom = lerp(_e359, _e364, fx);
                             float4 texel_1 = lerp(top, bottom, fy_1);
-                            k = 0u;
+                            k_3 = 0u;
                             uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
                             bool loop_init_6 = true;
                             while(true) {
                                 if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
                                 loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                                 if (!loop_init_6) {
-                                    uint _e403 = k;
-                                    k = (_e403 + 1u);
+                                    uint _e384 = k_3;
+                                    k_3 = (_e384 + 1u);
                                 }
                                 loop_init_6 = false;
-                                uint _e388 = k;
-                                if ((_e388 < 4u)) {
+                                uint _e369 = k_3;
+                                if ((_e369 < 4u)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    float _e391 = vis;
-                                    uint _e392 = k;
-                                    uint _e394 = k;
-                                    vis = (_e391 + (coeff[min(uint(_e392), 3u)] * ((texel_1[min(uint(_e394), 3u)] * 2.0) - 1.0)));
+                                    float _e372 = vis;
+                                    uint _e373 = k_3;
+                                    uint _e375 = k_3;
+                                    vis = (_e372 + (coeff[min(uint(_e373), 3u)] * ((texel_1[min(uint(_e375), 3u)] * 2.0) - 1.0)));
                                 }
                             }
                         }
                     }
                 }
             }
-            float _e409 = total;
-            float _e410 = weight;
-            float _e411 = vis;
-            total = (_e409 + (_e410 * clamp(_e411, 0.0, 1.0)));
+            float _e390 = total;
+            float _e391 = weight;
+            float _e392 = vis;
+            total = (_e390 + (_e391 * clamp(_e392, 0.0, 1.0)));
             if (is_last) {
                 break;
             }
@@ -826,6 +812,26 @@ void scatter(uint3 id : SV_DispatchThreadID)
     }
     float l_2 = total;
     float3 c = (color * l_2);
-    output[uint2(x_7, y_2)] = float4(c.x, c.y, c.z, 1.0);
+    return c;
+}
+
+[numthreads(8, 8, 1)]
+void scatter(uint3 id : SV_DispatchThreadID)
+{
+    bool local = (bool)0;
+
+    uint _e5 = frame.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = frame.sizes.y;
+        local = (id.y >= _e12);
+    } else {
+        local = true;
+    }
+    bool _e17 = local;
+    if (_e17) {
+        return;
+    }
+    const float3 _e20 = scatter_pixel(id.x, id.y);
+    output[id.xy] = float4(_e20.x, _e20.y, _e20.z, 1.0);
     return;
 }

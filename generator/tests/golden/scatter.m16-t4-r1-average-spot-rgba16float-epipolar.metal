@@ -61,7 +61,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_hi;
 };
 typedef metal::float4 type_10[1];
-struct type_14 {
+struct type_13 {
     metal::float4 inner[4];
 };
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
@@ -102,35 +102,35 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_5 = {};
-    bool local_6 = {};
-    bool local_7 = {};
+    bool local_1 = {};
+    bool local_2 = {};
+    bool local_3 = {};
     if (!((uv.x < 0.0))) {
-        local_5 = uv.x > 1.0;
+        local_1 = uv.x > 1.0;
     } else {
-        local_5 = true;
+        local_1 = true;
     }
-    bool _e11 = local_5;
+    bool _e11 = local_1;
     if (!(_e11)) {
-        local_6 = uv.y < 0.0;
+        local_2 = uv.y < 0.0;
     } else {
-        local_6 = true;
+        local_2 = true;
     }
-    bool _e19 = local_6;
+    bool _e19 = local_2;
     if (!(_e19)) {
-        local_7 = uv.y > 1.0;
+        local_3 = uv.y > 1.0;
     } else {
-        local_7 = true;
+        local_3 = true;
     }
-    bool _e27 = local_7;
+    bool _e27 = local_3;
     if (_e27) {
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_3 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
-    uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint y_2 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_3, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y_2)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -154,16 +154,16 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm_1,
     metal::float3 p_1
 ) {
-    bool local_8 = {};
+    bool local_4 = {};
     metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     float near = v_4.right.w;
     float far = v_4.up.w;
     if (v_4.origin.w > 0.5) {
-        local_8 = _e2.z <= near;
+        local_4 = _e2.z <= near;
     } else {
-        local_8 = false;
+        local_4 = false;
     }
-    bool _e16 = local_8;
+    bool _e16 = local_4;
     if (_e16) {
         return 1.0;
     }
@@ -220,20 +220,20 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_4 = sigma_t * len;
-    if (x_4 < 0.0001) {
-        return len * (1.0 - (0.5 * x_4));
+    float x_5 = sigma_t * len;
+    if (x_5 < 0.0001) {
+        return len * (1.0 - (0.5 * x_5));
     }
-    return (1.0 - metal::exp(-(x_4))) / sigma_t;
+    return (1.0 - metal::exp(-(x_5))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t_1,
-    float a_1,
-    float b_1
+    float a,
+    float b
 ) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b_1 - a_1);
-    return metal::exp(-(sigma_t_1) * a_1) * _e7;
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
+    return metal::exp(-(sigma_t_1) * a) * _e7;
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -244,8 +244,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_5 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_5 * x_5) * (3.0 - (2.0 * x_5));
+    float x_6 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_6 * x_6) * (3.0 - (2.0 * x_6));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -258,8 +258,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_6 = eye + (dir * t);
-    metal::float3 to_x = x_6 - light_pos;
+    metal::float3 x_7 = eye + (dir * t);
+    metal::float3 to_x = x_7 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_1 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_1);
@@ -271,8 +271,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 eye_1,
     metal::float3 dir_1,
-    float a_2,
-    float b_2,
+    float a_1,
+    float b_1,
     uint panels,
     metal::float3 light_pos_1,
     metal::float3 light_dir_1,
@@ -281,29 +281,29 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float4 medium_1
 ) {
     float sum = 0.0;
-    uint k_1 = 0u;
+    uint k = 0u;
     uint q = {};
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
-    float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_2 - a_2, 0.000001));
-    float g0_ = metal::atan((a_2 - t0_) / h);
-    float w_1 = (metal::atan((b_2 - t0_) / h) - g0_) / static_cast<float>(panels);
+    float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
+    float g0_ = metal::atan((a_1 - t0_) / h);
+    float w_1 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k_1;
-            k_1 = _e73 + 1u;
+            uint _e73 = k;
+            k = _e73 + 1u;
         }
         loop_init = false;
-        uint _e30 = k_1;
+        uint _e30 = k;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            uint _e32 = k_1;
+            uint _e32 = k;
             float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
@@ -340,14 +340,14 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
     metal::float3 eye_2,
     metal::float3 dir_2,
     metal::float3 light_pos_2,
-    float a_3,
-    float b_3,
+    float a_2,
+    float b_2,
     uint n
 ) {
     float t0_1 = metal::dot(light_pos_2 - eye_2, dir_2);
-    float h_1 = metal::max(metal::length((eye_2 + (dir_2 * t0_1)) - light_pos_2), 0.0001 * metal::max(b_3 - a_3, 0.000001));
-    float theta_a = metal::atan((a_3 - t0_1) / h_1);
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_1, theta_a, (metal::atan((b_3 - t0_1) / h_1) - theta_a) / static_cast<float>(n)};
+    float h_1 = metal::max(metal::length((eye_2 + (dir_2 * t0_1)) - light_pos_2), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float theta_a = metal::atan((a_2 - t0_1) / h_1);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_1, theta_a, (metal::atan((b_2 - t0_1) / h_1) - theta_a) / static_cast<float>(n)};
 }
 
 metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -365,11 +365,11 @@ SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_
 }
 
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    float theta_1,
+    float theta,
     float lo,
     float hi
 ) {
-    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * metal::clamp((theta_1 - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
+    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * metal::clamp((theta - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
 }
 
 metal::float3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -418,7 +418,7 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot
 ) {
     float sum_1 = 0.0;
-    uint k_2 = 0u;
+    uint k_1 = 0u;
     float t_2 = {};
     float w = {};
     uint steps = f_4.sizes2_.y;
@@ -430,21 +430,21 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e60 = k_2;
-            k_2 = _e60 + 1u;
+            uint _e60 = k_1;
+            k_1 = _e60 + 1u;
         }
         loop_init_2 = false;
-        uint _e15 = k_2;
+        uint _e15 = k_1;
         if (_e15 < steps) {
         } else {
             break;
         }
         {
-            uint _e17 = k_2;
+            uint _e17 = k_1;
             t_2 = (static_cast<float>(_e17) + 0.5) * h_2;
             w = h_2;
             if (spot) {
-                uint _e25 = k_2;
+                uint _e25 = k_1;
                 metal::float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e25) + 0.5);
                 t_2 = _e29.x;
                 w = _e29.y;
@@ -459,8 +459,8 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
                 sum_1 = _e38 + ((_e36 * _e39) * _e42);
             } else {
                 float _e45 = sum_1;
-                uint _e48 = k_2;
-                uint _e51 = k_2;
+                uint _e48 = k_1;
+                uint _e51 = k_1;
                 float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, static_cast<float>(_e48) * h_2, static_cast<float>(_e51 + 1u) * h_2);
                 sum_1 = _e45 + (_e36 * _e56);
             }
@@ -501,27 +501,27 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
     float x_2,
-    float delta_1,
-    float theta_2,
+    float delta,
+    float theta_1,
     float s_1,
     bool spot_1
 ) {
-    bool local_9 = {};
+    bool local_5 = {};
     if (spot_1) {
-        float psi = x_2 * delta_1;
-        float den = metal::sin(theta_2 + psi);
+        float psi = x_2 * delta;
+        float den = metal::sin(theta_1 + psi);
         if (!((den <= 0.000001))) {
-            local_9 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_5 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local_9 = true;
+            local_5 = true;
         }
-        bool _e16 = local_9;
+        bool _e16 = local_5;
         if (_e16) {
             return s_1;
         }
         return metal::min((f_5.axis.w * metal::sin(psi)) / den, s_1);
     } else {
-        return metal::min((x_2 * delta_1) / metal::max(metal::sin(theta_2), 0.000001), s_1);
+        return metal::min((x_2 * delta) / metal::max(metal::sin(theta_1), 0.000001), s_1);
     }
 }
 
@@ -529,11 +529,11 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
     metal::float3 eye_5,
     metal::float3 dir_5,
-    float a_4,
-    float b_4,
+    float a_3,
+    float b_3,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_4, b_4, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -552,10 +552,10 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 metal::float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float2 a_5,
-    metal::float2 b_5
+    metal::float2 a_4,
+    metal::float2 b_4
 ) {
-    return metal::float2((a_5.x * b_5.y) + (a_5.y * b_5.x), (a_5.y * b_5.y) - (a_5.x * b_5.x));
+    return metal::float2((a_4.x * b_4.y) + (a_4.y * b_4.x), (a_4.y * b_4.y) - (a_4.x * b_4.x));
 }
 
 metal::float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -565,19 +565,19 @@ metal::float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 }
 
 float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    uint k_3
+    uint k_2
 ) {
-    return PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * static_cast<float>((2u * k_3) - 1u);
+    return PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * static_cast<float>((2u * k_2) - 1u);
 }
 
 metal::float4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float2 a_6,
-    metal::float2 b_6,
-    uint layer_2
+    metal::float2 a_5,
+    metal::float2 b_5,
+    uint layer
 ) {
-    float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_2) + 1u);
-    float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer_2) + 2u);
-    return metal::float4((2.0 / _e5) * a_6.y, (-2.0 / _e5) * a_6.x, (2.0 / _e10) * b_6.y, (-2.0 / _e10) * b_6.x);
+    float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer) + 1u);
+    float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((2u * layer) + 2u);
+    return metal::float4((2.0 / _e5) * a_5.y, (-2.0 / _e5) * a_5.x, (2.0 / _e10) * b_5.y, (-2.0 / _e10) * b_5.x);
 }
 
 uint naga_div(uint lhs, uint rhs) {
@@ -585,15 +585,310 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    uint r_1,
+    uint r,
     uint regions,
     uint width,
     bool spot_2
 ) {
     if (spot_2) {
-        return naga_div(r_1 * width, regions);
+        return naga_div(r * width, regions);
     }
-    return naga_div((r_1 * r_1) * width, regions * regions);
+    return naga_div((r * r) * width, regions * regions);
+}
+
+metal::float3 scatter_pixel(
+    uint x_3,
+    uint y_1,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
+    device type_10 const& slices,
+    metal::texture2d<float, metal::access::sample> depth,
+    metal::texture2d<float, metal::access::sample> shadow_map,
+    metal::texture2d_array<float, metal::access::sample> filtered,
+    metal::texture2d<float, metal::access::sample> bounds,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    bool local_6 = {};
+    bool local_7 = {};
+    bool local_8 = {};
+    float yc = {};
+    float d = {};
+    float xs = {};
+    float delta_1 = 1.0;
+    float theta_2 = 0.0;
+    type_13 coeffs = {};
+    metal::float2 angle = {};
+    uint layer_1 = 0u;
+    float total = 0.0;
+    uint r_1 = 0u;
+    bool local_9 = {};
+    float a_6 = {};
+    float b_6 = {};
+    float weight = {};
+    float vis = {};
+    uint layer_2 = {};
+    uint k_3 = {};
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
+    metal::float3 eye_6 = f_9.eye.xyz;
+    metal::float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    uint clamped_lod_e13 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e13 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_1)), metal::uint2(depth.get_width(clamped_lod_e13), depth.get_height(clamped_lod_e13)) - 1), clamped_lod_e13);
+    float s_2 = metal::min(metal::max(_e13.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e9, f_9.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_9.light_color.xyz;
+    metal::float3 px = metal::float3(static_cast<float>(x_3) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
+    float radius = f_9.epipole.w;
+    if (f_9.epipole.z > 0.5) {
+        local_6 = metal::length(px - metal::float3(f_9.epipole.x, f_9.epipole.y, 0.0)) < radius;
+    } else {
+        local_6 = false;
+    }
+    bool near_epi = local_6;
+    if (f_9.anti_epipole.z > 0.5) {
+        local_7 = metal::length(px - metal::float3(f_9.anti_epipole.x, f_9.anti_epipole.y, 0.0)) < radius;
+    } else {
+        local_7 = false;
+    }
+    bool near_anti = local_7;
+    if (!(near_epi)) {
+        local_8 = near_anti;
+    } else {
+        local_8 = true;
+    }
+    bool _e76 = local_8;
+    if (_e76) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = frame;
+        float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_6, _e9, s_2, true);
+        metal::float3 l_1 = _e81 * color;
+        return l_1;
+    }
+    metal::float3 axis = f_9.axis.xyz;
+    uint rows_1 = f_9.sizes.w;
+    uint width_1 = f_9.sizes.z;
+    bool wrap_1 = f_9.anti_epipole.w > 0.5;
+    {
+        theta_2 = metal::acos(metal::clamp(metal::dot(_e9, axis), -1.0, 1.0));
+        float phi_1 = metal::atan2(metal::dot(_e9, f_9.e2_.xyz), metal::dot(_e9, f_9.e1_.xyz));
+        yc = (phi_1 - f_9.e1_.w) / f_9.e2_.w;
+        if (wrap_1) {
+            float _e113 = yc;
+            float _e114 = yc;
+            yc = _e113 - (metal::floor(_e114 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+        } else {
+            float _e121 = yc;
+            yc = metal::clamp(_e121, 0.0, static_cast<float>(rows_1));
+        }
+        float _e125 = yc;
+        float yy = _e125 - 0.5;
+        float j0_ = metal::floor(yy);
+        float fy = yy - j0_;
+        uint _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
+        metal::float4 _e133 = slices[metal::min(unsigned(_e130), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
+        uint _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_ + 1.0, rows_1, wrap_1);
+        metal::float4 _e140 = slices[metal::min(unsigned(_e137), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
+        delta_1 = metal::mix(_e134.delta, _e141.delta, fy);
+        float _e146 = theta_2;
+        float _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_9.theta.x, f_9.theta.y);
+        d = _e151;
+        if (true) {
+            metal::float3 q_2 = metal::normalize((eye_6 + (_e9 * s_2)) - f_9.light_pos.xyz);
+            float _e165 = delta_1;
+            xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / _e165;
+        } else {
+            float _e168 = theta_2;
+            float _e171 = delta_1;
+            xs = (s_2 * metal::sin(_e168)) / _e171;
+        }
+    }
+    float _e173 = yc;
+    float yb = _e173 - 0.5;
+    float fy_1 = yb - metal::floor(yb);
+    uint _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
+    uint _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
+    uint row1_ = (yb > metal::floor(yb)) ? _e183 : _e179;
+    float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e9));
+    uint panels_2 = metal::max(naga_div(f_9.sizes2_.z, 4u), 1u);
+    float _e198 = d;
+    float _e202 = d;
+    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e198), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e202));
+    metal::float2 _e207 = angle;
+    metal::float2 _e208 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e207);
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
+    while(true) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e223 = layer_1;
+            layer_1 = _e223 + 1u;
+        }
+        loop_init_3 = false;
+        uint _e210 = layer_1;
+        if (_e210 < LAYERS) {
+        } else {
+            break;
+        }
+        {
+            metal::float2 _e213 = angle;
+            metal::float2 _e214 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e213, _e208);
+            uint _e216 = layer_1;
+            metal::float2 _e218 = angle;
+            uint _e219 = layer_1;
+            metal::float4 _e220 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, _e214, _e219);
+            coeffs.inner[metal::min(unsigned(_e216), 3u)] = _e220;
+            metal::float2 _e221 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e214, _e208);
+            angle = _e221;
+        }
+    }
+    float _e229 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    float sun_scatter = f_9.medium.y * _e229;
+    float _e231 = xs;
+    uint last = naga_f2u32(metal::min(metal::max(_e231, 0.0), static_cast<float>(width_1) - 1.0));
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_4 = true;
+    while(true) {
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
+            uint _e399 = r_1;
+            r_1 = _e399 + 1u;
+        }
+        loop_init_4 = false;
+        uint _e241 = r_1;
+        if (_e241 < REGIONS) {
+        } else {
+            break;
+        }
+        {
+            uint _e243 = r_1;
+            uint _e244 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e243, REGIONS, width_1, true);
+            float b0_ = static_cast<float>(_e244);
+            uint _e246 = r_1;
+            uint _e249 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e246 + 1u, REGIONS, width_1, true);
+            float b1_ = static_cast<float>(_e249);
+            if (!((last < naga_f2u32(b1_)))) {
+                uint _e254 = r_1;
+                local_9 = (_e254 + 1u) == REGIONS;
+            } else {
+                local_9 = true;
+            }
+            bool is_last = local_9;
+            float _e264 = xs;
+            float pos = is_last ? metal::clamp(_e264 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            a_6 = float {};
+            b_6 = float {};
+            float _e277 = delta_1;
+            float _e278 = theta_2;
+            float _e279 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e277, _e278, s_2, true);
+            a_6 = _e279;
+            float _e280 = delta_1;
+            float _e281 = theta_2;
+            float _e282 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e280, _e281, s_2, true);
+            b_6 = is_last ? s_2 : _e282;
+            weight = float {};
+            if (true) {
+                float _e286 = a_6;
+                float _e287 = b_6;
+                float _e288 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e9, _e286, _e287, panels_2);
+                weight = _e288;
+            } else {
+                float _e291 = a_6;
+                float _e292 = b_6;
+                float _e293 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e291, _e292);
+                weight = sun_scatter * _e293;
+            }
+            float xb = pos - 0.5;
+            float fx = xb - metal::floor(xb);
+            uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
+            uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
+            uint clamped_lod_e317 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 bounds0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e179)), metal::uint2(bounds.get_width(clamped_lod_e317), bounds.get_height(clamped_lod_e317)) - 1), clamped_lod_e317);
+            uint clamped_lod_e321 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 bounds1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e321), bounds.get_height(clamped_lod_e321)) - 1), clamped_lod_e321);
+            float lo_1 = metal::min(bounds0_.x, bounds1_.x);
+            float hi_1 = metal::max(bounds0_.y, bounds1_.y);
+            vis = 0.5;
+            float _e330 = d;
+            if (_e330 <= lo_1) {
+                vis = 1.0;
+            } else {
+                float _e333 = d;
+                if (_e333 > hi_1) {
+                    vis = 0.0;
+                } else {
+                    layer_2 = 0u;
+                    uint2 loop_bound_5 = uint2(4294967295u);
+                    bool loop_init_5 = true;
+                    while(true) {
+                        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+                        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+                        if (!loop_init_5) {
+                            uint _e387 = layer_2;
+                            layer_2 = _e387 + 1u;
+                        }
+                        loop_init_5 = false;
+                        uint _e338 = layer_2;
+                        if (_e338 < LAYERS) {
+                        } else {
+                            break;
+                        }
+                        {
+                            uint _e341 = layer_2;
+                            metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e341), 3u)];
+                            uint _e345 = layer_2;
+                            uint clamped_lod_e348 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e348 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e348), filtered.get_height(clamped_lod_e348)) - 1), metal::min(uint(_e345), filtered.get_array_size() - 1), clamped_lod_e348);
+                            uint _e350 = layer_2;
+                            uint clamped_lod_e353 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e353 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e353), filtered.get_height(clamped_lod_e353)) - 1), metal::min(uint(_e350), filtered.get_array_size() - 1), clamped_lod_e353);
+                            metal::float4 top = metal::mix(_e348, _e353, fx);
+                            uint _e356 = layer_2;
+                            uint clamped_lod_e359 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e359 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e359), filtered.get_height(clamped_lod_e359)) - 1), metal::min(uint(_e356), filtered.get_array_size() - 1), clamped_lod_e359);
+                            uint _e361 = layer_2;
+                            uint clamped_lod_e364 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e364 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e364), filtered.get_height(clamped_lod_e364)) - 1), metal::min(uint(_e361), filtered.get_array_size() - 1), clamped_lod_e364);
+                            metal::float4 bottom = metal::mix(_e359, _e364, fx);
+                            metal::float4 texel_1 = metal::mix(top, bottom, fy_1);
+                            k_3 = 0u;
+                            uint2 loop_bound_6 = uint2(4294967295u);
+                            bool loop_init_6 = true;
+                            while(true) {
+                                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+                                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                                if (!loop_init_6) {
+                                    uint _e384 = k_3;
+                                    k_3 = _e384 + 1u;
+                                }
+                                loop_init_6 = false;
+                                uint _e369 = k_3;
+                                if (_e369 < 4u) {
+                                } else {
+                                    break;
+                                }
+                                {
+                                    float _e372 = vis;
+                                    uint _e373 = k_3;
+                                    uint _e375 = k_3;
+                                    vis = _e372 + (coeff[metal::min(unsigned(_e373), 3u)] * ((texel_1[metal::min(unsigned(_e375), 3u)] * 2.0) - 1.0));
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            float _e390 = total;
+            float _e391 = weight;
+            float _e392 = vis;
+            total = _e390 + (_e391 * metal::clamp(_e392, 0.0, 1.0));
+            if (is_last) {
+                break;
+            }
+        }
+    }
+    float l_2 = total;
+    metal::float3 c = color * l_2;
+    return c;
 }
 
 struct scatterInput {
@@ -610,299 +905,18 @@ kernel void scatter(
 , constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
 ) {
     bool local = {};
-    bool local_1 = {};
-    bool local_2 = {};
-    bool local_3 = {};
-    float yc = {};
-    float d = {};
-    float xs = {};
-    float delta = 1.0;
-    float theta = 0.0;
-    type_14 coeffs = {};
-    metal::float2 angle = {};
-    uint layer = 0u;
-    float total = 0.0;
-    uint r = 0u;
-    bool local_4 = {};
-    float a = {};
-    float b = {};
-    float weight = {};
-    float vis = {};
-    uint layer_1 = {};
-    uint k = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
-    uint x_7 = id.x;
-    uint y_2 = id.y;
-    if (!((x_7 >= f_9.sizes.x))) {
-        local = y_2 >= f_9.sizes.y;
+    uint _e5 = frame.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = frame.sizes.y;
+        local = id.y >= _e12;
     } else {
         local = true;
     }
-    bool _e18 = local;
-    if (_e18) {
+    bool _e17 = local;
+    if (_e17) {
         return;
     }
-    metal::float3 eye_6 = f_9.eye.xyz;
-    metal::float3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_7, y_2);
-    uint clamped_lod_e25 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e25 = depth.read(metal::min(metal::uint2(metal::uint2(x_7, y_2)), metal::uint2(depth.get_width(clamped_lod_e25), depth.get_height(clamped_lod_e25)) - 1), clamped_lod_e25);
-    float s_2 = metal::min(metal::max(_e25.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e21, f_9.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_9.light_color.xyz;
-    metal::float3 px = metal::float3(static_cast<float>(x_7) + 0.5, static_cast<float>(y_2) + 0.5, 0.0);
-    float radius = f_9.epipole.w;
-    if (f_9.epipole.z > 0.5) {
-        local_1 = metal::length(px - metal::float3(f_9.epipole.x, f_9.epipole.y, 0.0)) < radius;
-    } else {
-        local_1 = false;
-    }
-    bool near_epi = local_1;
-    if (f_9.anti_epipole.z > 0.5) {
-        local_2 = metal::length(px - metal::float3(f_9.anti_epipole.x, f_9.anti_epipole.y, 0.0)) < radius;
-    } else {
-        local_2 = false;
-    }
-    bool near_anti = local_2;
-    if (!(near_epi)) {
-        local_3 = near_anti;
-    } else {
-        local_3 = true;
-    }
-    bool _e88 = local_3;
-    if (_e88) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = frame;
-        float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_6, _e21, s_2, true);
-        metal::float3 l_1 = _e93 * color;
-        output.write(metal::float4(l_1.x, l_1.y, l_1.z, 1.0), metal::uint2(metal::uint2(x_7, y_2)));
-        return;
-    }
-    metal::float3 axis = f_9.axis.xyz;
-    uint rows_1 = f_9.sizes.w;
-    uint width_1 = f_9.sizes.z;
-    bool wrap_1 = f_9.anti_epipole.w > 0.5;
-    {
-        theta = metal::acos(metal::clamp(metal::dot(_e21, axis), -1.0, 1.0));
-        float phi_1 = metal::atan2(metal::dot(_e21, f_9.e2_.xyz), metal::dot(_e21, f_9.e1_.xyz));
-        yc = (phi_1 - f_9.e1_.w) / f_9.e2_.w;
-        if (wrap_1) {
-            float _e132 = yc;
-            float _e133 = yc;
-            yc = _e132 - (metal::floor(_e133 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
-        } else {
-            float _e140 = yc;
-            yc = metal::clamp(_e140, 0.0, static_cast<float>(rows_1));
-        }
-        float _e144 = yc;
-        float yy = _e144 - 0.5;
-        float j0_ = metal::floor(yy);
-        float fy = yy - j0_;
-        uint _e149 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        metal::float4 _e152 = slices[metal::min(unsigned(_e149), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e153 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e152);
-        uint _e156 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_ + 1.0, rows_1, wrap_1);
-        metal::float4 _e159 = slices[metal::min(unsigned(_e156), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e160 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e159);
-        delta = metal::mix(_e153.delta, _e160.delta, fy);
-        float _e165 = theta;
-        float _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_9.theta.x, f_9.theta.y);
-        d = _e170;
-        if (true) {
-            metal::float3 q_2 = metal::normalize((eye_6 + (_e21 * s_2)) - f_9.light_pos.xyz);
-            float _e184 = delta;
-            xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / _e184;
-        } else {
-            float _e187 = theta;
-            float _e190 = delta;
-            xs = (s_2 * metal::sin(_e187)) / _e190;
-        }
-    }
-    float _e192 = yc;
-    float yb = _e192 - 0.5;
-    float fy_1 = yb - metal::floor(yb);
-    uint _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
-    uint _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
-    uint row1_ = (yb > metal::floor(yb)) ? _e202 : _e198;
-    float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e21));
-    uint panels_2 = metal::max(naga_div(f_9.sizes2_.z, 4u), 1u);
-    float _e217 = d;
-    float _e221 = d;
-    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e217), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e221));
-    metal::float2 _e226 = angle;
-    metal::float2 _e227 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226);
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
-    while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
-            uint _e242 = layer;
-            layer = _e242 + 1u;
-        }
-        loop_init_3 = false;
-        uint _e229 = layer;
-        if (_e229 < LAYERS) {
-        } else {
-            break;
-        }
-        {
-            metal::float2 _e232 = angle;
-            metal::float2 _e233 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e232, _e227);
-            uint _e235 = layer;
-            metal::float2 _e237 = angle;
-            uint _e238 = layer;
-            metal::float4 _e239 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e237, _e233, _e238);
-            coeffs.inner[metal::min(unsigned(_e235), 3u)] = _e239;
-            metal::float2 _e240 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e233, _e227);
-            angle = _e240;
-        }
-    }
-    float _e248 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    float sun_scatter = f_9.medium.y * _e248;
-    float _e250 = xs;
-    uint last = naga_f2u32(metal::min(metal::max(_e250, 0.0), static_cast<float>(width_1) - 1.0));
-    uint2 loop_bound_4 = uint2(4294967295u);
-    bool loop_init_4 = true;
-    while(true) {
-        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
-            uint _e418 = r;
-            r = _e418 + 1u;
-        }
-        loop_init_4 = false;
-        uint _e260 = r;
-        if (_e260 < REGIONS) {
-        } else {
-            break;
-        }
-        {
-            uint _e262 = r;
-            uint _e263 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e262, REGIONS, width_1, true);
-            float b0_ = static_cast<float>(_e263);
-            uint _e265 = r;
-            uint _e268 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e265 + 1u, REGIONS, width_1, true);
-            float b1_ = static_cast<float>(_e268);
-            if (!((last < naga_f2u32(b1_)))) {
-                uint _e273 = r;
-                local_4 = (_e273 + 1u) == REGIONS;
-            } else {
-                local_4 = true;
-            }
-            bool is_last = local_4;
-            float _e283 = xs;
-            float pos = is_last ? metal::clamp(_e283 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-            a = float {};
-            b = float {};
-            float _e296 = delta;
-            float _e297 = theta;
-            float _e298 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e296, _e297, s_2, true);
-            a = _e298;
-            float _e299 = delta;
-            float _e300 = theta;
-            float _e301 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e299, _e300, s_2, true);
-            b = is_last ? s_2 : _e301;
-            weight = float {};
-            if (true) {
-                float _e305 = a;
-                float _e306 = b;
-                float _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, _e305, _e306, panels_2);
-                weight = _e307;
-            } else {
-                float _e310 = a;
-                float _e311 = b;
-                float _e312 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e310, _e311);
-                weight = sun_scatter * _e312;
-            }
-            float xb = pos - 0.5;
-            float fx = xb - metal::floor(xb);
-            uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
-            uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
-            uint clamped_lod_e336 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 bounds0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(bounds.get_width(clamped_lod_e336), bounds.get_height(clamped_lod_e336)) - 1), clamped_lod_e336);
-            uint clamped_lod_e340 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 bounds1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e340), bounds.get_height(clamped_lod_e340)) - 1), clamped_lod_e340);
-            float lo_1 = metal::min(bounds0_.x, bounds1_.x);
-            float hi_1 = metal::max(bounds0_.y, bounds1_.y);
-            vis = 0.5;
-            float _e349 = d;
-            if (_e349 <= lo_1) {
-                vis = 1.0;
-            } else {
-                float _e352 = d;
-                if (_e352 > hi_1) {
-                    vis = 0.0;
-                } else {
-                    layer_1 = 0u;
-                    uint2 loop_bound_5 = uint2(4294967295u);
-                    bool loop_init_5 = true;
-                    while(true) {
-                        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-                        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-                        if (!loop_init_5) {
-                            uint _e406 = layer_1;
-                            layer_1 = _e406 + 1u;
-                        }
-                        loop_init_5 = false;
-                        uint _e357 = layer_1;
-                        if (_e357 < LAYERS) {
-                        } else {
-                            break;
-                        }
-                        {
-                            uint _e360 = layer_1;
-                            metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e360), 3u)];
-                            uint _e364 = layer_1;
-                            uint clamped_lod_e367 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e367 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e367), filtered.get_height(clamped_lod_e367)) - 1), metal::min(uint(_e364), filtered.get_array_size() - 1), clamped_lod_e367);
-                            uint _e369 = layer_1;
-                            uint clamped_lod_e372 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e372 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e372), filtered.get_height(clamped_lod_e372)) - 1), metal::min(uint(_e369), filtered.get_array_size() - 1), clamped_lod_e372);
-                            metal::float4 top = metal::mix(_e367, _e372, fx);
-                            uint _e375 = layer_1;
-                            uint clamped_lod_e378 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e378 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e378), filtered.get_height(clamped_lod_e378)) - 1), metal::min(uint(_e375), filtered.get_array_size() - 1), clamped_lod_e378);
-                            uint _e380 = layer_1;
-                            uint clamped_lod_e383 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e383 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e383), filtered.get_height(clamped_lod_e383)) - 1), metal::min(uint(_e380), filtered.get_array_size() - 1), clamped_lod_e383);
-                            metal::float4 bottom = metal::mix(_e378, _e383, fx);
-                            metal::float4 texel_1 = metal::mix(top, bottom, fy_1);
-                            k = 0u;
-                            uint2 loop_bound_6 = uint2(4294967295u);
-                            bool loop_init_6 = true;
-                            while(true) {
-                                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-                                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                                if (!loop_init_6) {
-                                    uint _e403 = k;
-                                    k = _e403 + 1u;
-                                }
-                                loop_init_6 = false;
-                                uint _e388 = k;
-                                if (_e388 < 4u) {
-                                } else {
-                                    break;
-                                }
-                                {
-                                    float _e391 = vis;
-                                    uint _e392 = k;
-                                    uint _e394 = k;
-                                    vis = _e391 + (coeff[metal::min(unsigned(_e392), 3u)] * ((texel_1[metal::min(unsigned(_e394), 3u)] * 2.0) - 1.0));
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-            float _e409 = total;
-            float _e410 = weight;
-            float _e411 = vis;
-            total = _e409 + (_e410 * metal::clamp(_e411, 0.0, 1.0));
-            if (is_last) {
-                break;
-            }
-        }
-    }
-    float l_2 = total;
-    metal::float3 c = color * l_2;
-    output.write(metal::float4(c.x, c.y, c.z, 1.0), metal::uint2(metal::uint2(x_7, y_2)));
+    metal::float3 _e20 = scatter_pixel(id.x, id.y, frame, slices, depth, shadow_map, filtered, bounds, _buffer_sizes);
+    output.write(metal::float4(_e20.x, _e20.y, _e20.z, 1.0), metal::uint2(id.xy));
     return;
 }

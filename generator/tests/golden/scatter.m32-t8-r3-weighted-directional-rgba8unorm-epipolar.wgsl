@@ -90,35 +90,35 @@ fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_o
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_5: bool;
-    var local_6: bool;
-    var local_7: bool;
+    var local_1: bool;
+    var local_2: bool;
+    var local_3: bool;
 
     if !((uv.x < 0f)) {
-        local_5 = (uv.x > 1f);
+        local_1 = (uv.x > 1f);
     } else {
-        local_5 = true;
+        local_1 = true;
     }
-    let _e11 = local_5;
+    let _e11 = local_1;
     if !(_e11) {
-        local_6 = (uv.y < 0f);
+        local_2 = (uv.y < 0f);
     } else {
-        local_6 = true;
+        local_2 = true;
     }
-    let _e19 = local_6;
+    let _e19 = local_2;
     if !(_e19) {
-        local_7 = (uv.y > 1f);
+        local_3 = (uv.y > 1f);
     } else {
-        local_7 = true;
+        local_3 = true;
     }
-    let _e27 = local_7;
+    let _e27 = local_3;
     if _e27 {
         return 2f;
     }
     let n_1 = v_2.size.x;
-    let x_3 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
-    let y_1 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_3, y_1), 0i);
+    let x_4 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let y_2 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
+    let _e49 = textureLoad(sm, vec2<u32>(x_4, y_2), 0i);
     return _e49.x;
 }
 
@@ -136,17 +136,17 @@ fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga
 }
 
 fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_8: bool;
+    var local_4: bool;
 
     let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     let near = v_4.right.w;
     let far = v_4.up.w;
     if (v_4.origin.w > 0.5f) {
-        local_8 = (_e2.z <= near);
+        local_4 = (_e2.z <= near);
     } else {
-        local_8 = false;
+        local_4 = false;
     }
-    let _e16 = local_8;
+    let _e16 = local_4;
     if _e16 {
         return 1f;
     }
@@ -192,29 +192,29 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_4 = (sigma_t * len);
-    if (x_4 < 0.0001f) {
-        return (len * (1f - (0.5f * x_4)));
+    let x_5 = (sigma_t * len);
+    if (x_5 < 0.0001f) {
+        return (len * (1f - (0.5f * x_5)));
     }
-    return ((1f - exp(-(x_4))) / sigma_t);
+    return ((1f - exp(-(x_5))) / sigma_t);
 }
 
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a_1: f32, b_1: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
-    return (exp((-(sigma_t_1) * a_1)) * _e7);
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_5 * x_5) * (3f - (2f * x_5)));
+    let x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_6 * x_6) * (3f - (2f * x_6)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_6 = (eye + (dir * t));
-    let to_x = (x_6 - light_pos);
+    let x_7 = (eye + (dir * t));
+    let to_x = (x_7 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d_1 = sqrt(d2_);
     let travel = (to_x / vec3(d_1));
@@ -223,23 +223,23 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
 }
 
-fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_2: f32, b_2: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
+fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
     var sum: f32 = 0f;
-    var k_1: u32 = 0u;
+    var k: u32 = 0u;
     var q: u32;
 
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
-    let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_2 - a_2), 0.000001f)));
-    let g0_ = atan(((a_2 - t0_) / h));
-    let w_1 = ((atan(((b_2 - t0_) / h)) - g0_) / f32(panels));
+    let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
+    let g0_ = atan(((a_1 - t0_) / h));
+    let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
-        let _e30 = k_1;
+        let _e30 = k;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            let _e32 = k_1;
+            let _e32 = k;
             let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
             q = 0u;
             loop {
@@ -263,19 +263,19 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
             }
         }
         continuing {
-            let _e73 = k_1;
-            k_1 = (_e73 + 1u);
+            let _e73 = k;
+            k = (_e73 + 1u);
         }
     }
     let _e75 = sum;
     return (((_e75 * 0.5f) * w_1) * h);
 }
 
-fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_3: f32, b_3: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     let t0_1 = dot((light_pos_2 - eye_2), dir_2);
-    let h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001f * max((b_3 - a_3), 0.000001f)));
-    let theta_a = atan(((a_3 - t0_1) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_3 - t0_1) / h_1)) - theta_a) / f32(n)));
+    let h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001f * max((b_2 - a_2), 0.000001f)));
+    let theta_a = atan(((a_2 - t0_1) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / f32(n)));
 }
 
 fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x: f32) -> vec2<f32> {
@@ -287,8 +287,8 @@ fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> 
     return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
 }
 
-fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_1: f32, lo: f32, hi: f32) -> f32 {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * clamp(((theta_1 - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
+fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta: f32, lo: f32, hi: f32) -> f32 {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * clamp(((theta - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
 }
 
 fn pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: u32, y: u32) -> vec3<f32> {
@@ -315,7 +315,7 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX
 
 fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, s: f32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
-    var k_2: u32 = 0u;
+    var k_1: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
@@ -323,17 +323,17 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_o
     let h_2 = (s / f32(steps));
     let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0f, s, steps);
     loop {
-        let _e15 = k_2;
+        let _e15 = k_1;
         if (_e15 < steps) {
         } else {
             break;
         }
         {
-            let _e17 = k_2;
+            let _e17 = k_1;
             t_2 = ((f32(_e17) + 0.5f) * h_2);
             w = h_2;
             if spot {
-                let _e25 = k_2;
+                let _e25 = k_1;
                 let _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e25) + 0.5f));
                 t_2 = _e29.x;
                 w = _e29.y;
@@ -348,15 +348,15 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_o
                 sum_1 = (_e38 + ((_e36 * _e39) * _e42));
             } else {
                 let _e45 = sum_1;
-                let _e48 = k_2;
-                let _e51 = k_2;
+                let _e48 = k_1;
+                let _e51 = k_1;
                 let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e48) * h_2), (f32((_e51 + 1u)) * h_2));
                 sum_1 = (_e45 + (_e36 * _e56));
             }
         }
         continuing {
-            let _e60 = k_2;
-            k_2 = (_e60 + 1u);
+            let _e60 = k_1;
+            k_1 = (_e60 + 1u);
         }
     }
     if spot {
@@ -378,29 +378,29 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta_1: f32, theta_2: f32, s_1: f32, spot_1: bool) -> f32 {
-    var local_9: bool;
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
+    var local_5: bool;
 
     if spot_1 {
-        let psi = (x_2 * delta_1);
-        let den = sin((theta_2 + psi));
+        let psi = (x_2 * delta);
+        let den = sin((theta_1 + psi));
         if !((den <= 0.000001f)) {
-            local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_5 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_9 = true;
+            local_5 = true;
         }
-        let _e16 = local_9;
+        let _e16 = local_5;
         if _e16 {
             return s_1;
         }
         return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_2 * delta_1) / max(sin(theta_2), 0.000001f)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_1), 0.000001f)), s_1);
     }
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_4, b_4, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
@@ -412,301 +412,306 @@ fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod
     return (f_8.e1_.w + ((f32(row) + 0.5f) * f_8.e2_.w));
 }
 
-fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_5: vec2<f32>) -> vec2<f32> {
-    return vec2<f32>(((a_5.x * b_5.y) + (a_5.y * b_5.x)), ((a_5.y * b_5.y) - (a_5.x * b_5.x)));
+fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_4: vec2<f32>, b_4: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
 }
 
 fn fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(first: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(((2f * first.x) * first.y), (1f - ((2f * first.x) * first.x)));
 }
 
-fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_3: u32) -> f32 {
-    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_3) - 1u)));
+fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_2: u32) -> f32 {
+    return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_2) - 1u)));
 }
 
-fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_6: vec2<f32>, b_6: vec2<f32>, layer_2: u32) -> vec4<f32> {
-    let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 1u));
-    let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer_2) + 2u));
-    return vec4<f32>(((2f / _e5) * a_6.y), ((-2f / _e5) * a_6.x), ((2f / _e10) * b_6.y), ((-2f / _e10) * b_6.x));
+fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_5: vec2<f32>, layer: u32) -> vec4<f32> {
+    let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 1u));
+    let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 2u));
+    return vec4<f32>(((2f / _e5) * a_5.y), ((-2f / _e5) * a_5.x), ((2f / _e10) * b_5.y), ((-2f / _e10) * b_5.x));
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
     if spot_2 {
-        return ((r_1 * width) / regions);
+        return ((r * width) / regions);
     }
-    return (((r_1 * r_1) * width) / (regions * regions));
+    return (((r * r) * width) / (regions * regions));
 }
 
-@compute @workgroup_size(8, 8, 1) 
-fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
-    var local: bool;
-    var local_1: bool;
-    var local_2: bool;
-    var local_3: bool;
+fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
+    var local_6: bool;
+    var local_7: bool;
+    var local_8: bool;
     var yc: f32;
     var d: f32;
     var xs: f32;
-    var delta: f32 = 1f;
-    var theta: f32 = 0f;
+    var delta_1: f32 = 1f;
+    var theta_2: f32 = 0f;
     var coeffs: array<vec4<f32>, 8>;
     var angle: vec2<f32>;
-    var layer: u32 = 0u;
+    var layer_1: u32 = 0u;
     var total: f32 = 0f;
-    var r: u32 = 0u;
-    var local_4: bool;
-    var a: f32;
-    var b: f32;
+    var r_1: u32 = 0u;
+    var local_9: bool;
+    var a_6: f32;
+    var b_6: f32;
     var weight: f32;
     var vis: f32;
-    var layer_1: u32;
-    var k: u32;
+    var layer_2: u32;
+    var k_3: u32;
 
     let f_9 = frame;
-    let x_7 = id.x;
-    let y_2 = id.y;
-    if !((x_7 >= f_9.sizes.x)) {
-        local = (y_2 >= f_9.sizes.y);
-    } else {
-        local = true;
-    }
-    let _e18 = local;
-    if _e18 {
-        return;
-    }
     let eye_6 = f_9.eye.xyz;
-    let _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_7, y_2);
-    let _e25 = textureLoad(depth, vec2<u32>(x_7, y_2), 0i);
-    let s_2 = (min(max(_e25.x, 0f), f_9.theta.z) / max(dot(_e21, f_9.cam_forward.xyz), 0.000001f));
+    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    let _e13 = textureLoad(depth, vec2<u32>(x_3, y_1), 0i);
+    let s_2 = (min(max(_e13.x, 0f), f_9.theta.z) / max(dot(_e9, f_9.cam_forward.xyz), 0.000001f));
     let color = f_9.light_color.xyz;
-    let px = vec3<f32>((f32(x_7) + 0.5f), (f32(y_2) + 0.5f), 0f);
+    let px = vec3<f32>((f32(x_3) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_9.epipole.w;
     if (f_9.epipole.z > 0.5f) {
-        local_1 = (length((px - vec3<f32>(f_9.epipole.x, f_9.epipole.y, 0f))) < radius);
+        local_6 = (length((px - vec3<f32>(f_9.epipole.x, f_9.epipole.y, 0f))) < radius);
     } else {
-        local_1 = false;
+        local_6 = false;
     }
-    let near_epi = local_1;
+    let near_epi = local_6;
     if (f_9.anti_epipole.z > 0.5f) {
-        local_2 = (length((px - vec3<f32>(f_9.anti_epipole.x, f_9.anti_epipole.y, 0f))) < radius);
+        local_7 = (length((px - vec3<f32>(f_9.anti_epipole.x, f_9.anti_epipole.y, 0f))) < radius);
     } else {
-        local_2 = false;
+        local_7 = false;
     }
-    let near_anti = local_2;
+    let near_anti = local_7;
     if !(near_epi) {
-        local_3 = near_anti;
+        local_8 = near_anti;
     } else {
-        local_3 = true;
+        local_8 = true;
     }
-    let _e88 = local_3;
-    if _e88 {
-        let _e90 = frame;
-        let _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_6, _e21, s_2, false);
-        let l_1 = (_e93 * color);
-        textureStore(output, vec2<u32>(x_7, y_2), vec4<f32>(l_1.x, l_1.y, l_1.z, 1f));
-        return;
+    let _e76 = local_8;
+    if _e76 {
+        let _e78 = frame;
+        let _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_6, _e9, s_2, false);
+        let l_1 = (_e81 * color);
+        return l_1;
     }
     let axis = f_9.axis.xyz;
     let rows_1 = f_9.sizes.w;
     let width_1 = f_9.sizes.z;
     let wrap_1 = (f_9.anti_epipole.w > 0.5f);
     {
-        theta = acos(clamp(dot(_e21, axis), -1f, 1f));
-        let phi_1 = atan2(dot(_e21, f_9.e2_.xyz), dot(_e21, f_9.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e9, axis), -1f, 1f));
+        let phi_1 = atan2(dot(_e9, f_9.e2_.xyz), dot(_e9, f_9.e1_.xyz));
         yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
         if wrap_1 {
-            let _e132 = yc;
-            let _e133 = yc;
-            yc = (_e132 - (floor((_e133 / f32(rows_1))) * f32(rows_1)));
+            let _e113 = yc;
+            let _e114 = yc;
+            yc = (_e113 - (floor((_e114 / f32(rows_1))) * f32(rows_1)));
         } else {
-            let _e140 = yc;
-            yc = clamp(_e140, 0f, f32(rows_1));
+            let _e121 = yc;
+            yc = clamp(_e121, 0f, f32(rows_1));
         }
-        let _e144 = yc;
-        let yy = (_e144 - 0.5f);
+        let _e125 = yc;
+        let yy = (_e125 - 0.5f);
         let j0_ = floor(yy);
         let fy = (yy - j0_);
-        let _e149 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        let _e152 = slices[_e149];
-        let _e153 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e152);
-        let _e156 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1f), rows_1, wrap_1);
-        let _e159 = slices[_e156];
-        let _e160 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e159);
-        delta = mix(_e153.delta, _e160.delta, fy);
-        let _e165 = theta;
-        let _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_9.theta.x, f_9.theta.y);
-        d = _e170;
+        let _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
+        let _e133 = slices[_e130];
+        let _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
+        let _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1f), rows_1, wrap_1);
+        let _e140 = slices[_e137];
+        let _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
+        delta_1 = mix(_e134.delta, _e141.delta, fy);
+        let _e146 = theta_2;
+        let _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_9.theta.x, f_9.theta.y);
+        d = _e151;
         if false {
-            let q_2 = normalize(((eye_6 + (_e21 * s_2)) - f_9.light_pos.xyz));
-            let _e184 = delta;
-            xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / _e184);
+            let q_2 = normalize(((eye_6 + (_e9 * s_2)) - f_9.light_pos.xyz));
+            let _e165 = delta_1;
+            xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / _e165);
         } else {
-            let _e187 = theta;
-            let _e190 = delta;
-            xs = ((s_2 * sin(_e187)) / _e190);
+            let _e168 = theta_2;
+            let _e171 = delta_1;
+            xs = ((s_2 * sin(_e168)) / _e171);
         }
     }
-    let _e192 = yc;
-    let yb = (_e192 - 0.5f);
+    let _e173 = yc;
+    let yb = (_e173 - 0.5f);
     let fy_1 = (yb - floor(yb));
-    let _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    let _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
-    let row1_ = select(_e198, _e202, (yb > floor(yb)));
-    let cos_theta_l = -(dot(f_9.light_dir.xyz, _e21));
+    let _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    let _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
+    let row1_ = select(_e179, _e183, (yb > floor(yb)));
+    let cos_theta_l = -(dot(f_9.light_dir.xyz, _e9));
     let panels_2 = max((f_9.sizes2_.z / 4u), 1u);
-    let _e217 = d;
-    let _e221 = d;
-    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e217)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e221)));
-    let _e226 = angle;
-    let _e227 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226);
+    let _e198 = d;
+    let _e202 = d;
+    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e198)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e202)));
+    let _e207 = angle;
+    let _e208 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e207);
     loop {
-        let _e229 = layer;
-        if (_e229 < LAYERS) {
+        let _e210 = layer_1;
+        if (_e210 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e232 = angle;
-            let _e233 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e232, _e227);
-            let _e235 = layer;
-            let _e237 = angle;
-            let _e238 = layer;
-            let _e239 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e237, _e233, _e238);
-            coeffs[_e235] = _e239;
-            let _e240 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e233, _e227);
-            angle = _e240;
+            let _e213 = angle;
+            let _e214 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e213, _e208);
+            let _e216 = layer_1;
+            let _e218 = angle;
+            let _e219 = layer_1;
+            let _e220 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, _e214, _e219);
+            coeffs[_e216] = _e220;
+            let _e221 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e214, _e208);
+            angle = _e221;
         }
         continuing {
-            let _e242 = layer;
-            layer = (_e242 + 1u);
+            let _e223 = layer_1;
+            layer_1 = (_e223 + 1u);
         }
     }
-    let _e248 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    let sun_scatter = (f_9.medium.y * _e248);
-    let _e250 = xs;
-    let last = u32(min(max(_e250, 0f), (f32(width_1) - 1f)));
+    let _e229 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    let sun_scatter = (f_9.medium.y * _e229);
+    let _e231 = xs;
+    let last = u32(min(max(_e231, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e260 = r;
-        if (_e260 < REGIONS) {
+        let _e241 = r_1;
+        if (_e241 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e262 = r;
-            let _e263 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e262, REGIONS, width_1, false);
-            let b0_ = f32(_e263);
-            let _e265 = r;
-            let _e268 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e265 + 1u), REGIONS, width_1, false);
-            let b1_ = f32(_e268);
+            let _e243 = r_1;
+            let _e244 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e243, REGIONS, width_1, false);
+            let b0_ = f32(_e244);
+            let _e246 = r_1;
+            let _e249 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e246 + 1u), REGIONS, width_1, false);
+            let b1_ = f32(_e249);
             if !((last < u32(b1_))) {
-                let _e273 = r;
-                local_4 = ((_e273 + 1u) == REGIONS);
+                let _e254 = r_1;
+                local_9 = ((_e254 + 1u) == REGIONS);
             } else {
-                local_4 = true;
+                local_9 = true;
             }
-            let is_last = local_4;
-            let _e283 = xs;
-            let pos = select((b1_ - 0.5f), clamp((_e283 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
-            a = f32();
-            b = f32();
-            let _e296 = delta;
-            let _e297 = theta;
-            let _e298 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e296, _e297, s_2, false);
-            a = _e298;
-            let _e299 = delta;
-            let _e300 = theta;
-            let _e301 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e299, _e300, s_2, false);
-            b = select(_e301, s_2, is_last);
+            let is_last = local_9;
+            let _e264 = xs;
+            let pos = select((b1_ - 0.5f), clamp((_e264 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
+            a_6 = f32();
+            b_6 = f32();
+            let _e277 = delta_1;
+            let _e278 = theta_2;
+            let _e279 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e277, _e278, s_2, false);
+            a_6 = _e279;
+            let _e280 = delta_1;
+            let _e281 = theta_2;
+            let _e282 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e280, _e281, s_2, false);
+            b_6 = select(_e282, s_2, is_last);
             weight = f32();
             if false {
-                let _e305 = a;
-                let _e306 = b;
-                let _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e21, _e305, _e306, panels_2);
-                weight = _e307;
+                let _e286 = a_6;
+                let _e287 = b_6;
+                let _e288 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e9, _e286, _e287, panels_2);
+                weight = _e288;
             } else {
-                let _e310 = a;
-                let _e311 = b;
-                let _e312 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e310, _e311);
-                weight = (sun_scatter * _e312);
+                let _e291 = a_6;
+                let _e292 = b_6;
+                let _e293 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e291, _e292);
+                weight = (sun_scatter * _e293);
             }
             let xb = (pos - 0.5f);
             let fx = (xb - floor(xb));
             let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
             let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
-            let bounds0_ = textureLoad(bounds, vec2<u32>(x1_, _e198), 0i);
+            let bounds0_ = textureLoad(bounds, vec2<u32>(x1_, _e179), 0i);
             let bounds1_ = textureLoad(bounds, vec2<u32>(x1_, row1_), 0i);
             let lo_1 = min(bounds0_.x, bounds1_.x);
             let hi_1 = max(bounds0_.y, bounds1_.y);
             vis = 0.5f;
-            let _e349 = d;
-            if (_e349 <= lo_1) {
+            let _e330 = d;
+            if (_e330 <= lo_1) {
                 vis = 1f;
             } else {
-                let _e352 = d;
-                if (_e352 > hi_1) {
+                let _e333 = d;
+                if (_e333 > hi_1) {
                     vis = 0f;
                 } else {
-                    layer_1 = 0u;
+                    layer_2 = 0u;
                     loop {
-                        let _e357 = layer_1;
-                        if (_e357 < LAYERS) {
+                        let _e338 = layer_2;
+                        if (_e338 < LAYERS) {
                         } else {
                             break;
                         }
                         {
-                            let _e360 = layer_1;
-                            let coeff = coeffs[_e360];
-                            let _e364 = layer_1;
-                            let _e367 = textureLoad(filtered, vec2<u32>(x0_, _e198), _e364, 0i);
-                            let _e369 = layer_1;
-                            let _e372 = textureLoad(filtered, vec2<u32>(x1_, _e198), _e369, 0i);
-                            let top = mix(_e367, _e372, fx);
-                            let _e375 = layer_1;
-                            let _e378 = textureLoad(filtered, vec2<u32>(x0_, row1_), _e375, 0i);
-                            let _e380 = layer_1;
-                            let _e383 = textureLoad(filtered, vec2<u32>(x1_, row1_), _e380, 0i);
-                            let bottom = mix(_e378, _e383, fx);
+                            let _e341 = layer_2;
+                            let coeff = coeffs[_e341];
+                            let _e345 = layer_2;
+                            let _e348 = textureLoad(filtered, vec2<u32>(x0_, _e179), _e345, 0i);
+                            let _e350 = layer_2;
+                            let _e353 = textureLoad(filtered, vec2<u32>(x1_, _e179), _e350, 0i);
+                            let top = mix(_e348, _e353, fx);
+                            let _e356 = layer_2;
+                            let _e359 = textureLoad(filtered, vec2<u32>(x0_, row1_), _e356, 0i);
+                            let _e361 = layer_2;
+                            let _e364 = textureLoad(filtered, vec2<u32>(x1_, row1_), _e361, 0i);
+                            let bottom = mix(_e359, _e364, fx);
                             let texel_1 = mix(top, bottom, fy_1);
-                            k = 0u;
+                            k_3 = 0u;
                             loop {
-                                let _e388 = k;
-                                if (_e388 < 4u) {
+                                let _e369 = k_3;
+                                if (_e369 < 4u) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    let _e391 = vis;
-                                    let _e392 = k;
-                                    let _e394 = k;
-                                    vis = (_e391 + (coeff[_e392] * ((texel_1[_e394] * 2f) - 1f)));
+                                    let _e372 = vis;
+                                    let _e373 = k_3;
+                                    let _e375 = k_3;
+                                    vis = (_e372 + (coeff[_e373] * ((texel_1[_e375] * 2f) - 1f)));
                                 }
                                 continuing {
-                                    let _e403 = k;
-                                    k = (_e403 + 1u);
+                                    let _e384 = k_3;
+                                    k_3 = (_e384 + 1u);
                                 }
                             }
                         }
                         continuing {
-                            let _e406 = layer_1;
-                            layer_1 = (_e406 + 1u);
+                            let _e387 = layer_2;
+                            layer_2 = (_e387 + 1u);
                         }
                     }
                 }
             }
-            let _e409 = total;
-            let _e410 = weight;
-            let _e411 = vis;
-            total = (_e409 + (_e410 * clamp(_e411, 0f, 1f)));
+            let _e390 = total;
+            let _e391 = weight;
+            let _e392 = vis;
+            total = (_e390 + (_e391 * clamp(_e392, 0f, 1f)));
             if is_last {
                 break;
             }
         }
         continuing {
-            let _e418 = r;
-            r = (_e418 + 1u);
+            let _e399 = r_1;
+            r_1 = (_e399 + 1u);
         }
     }
     let l_2 = total;
     let c = (color * l_2);
-    textureStore(output, vec2<u32>(x_7, y_2), vec4<f32>(c.x, c.y, c.z, 1f));
+    return c;
+}
+
+@compute @workgroup_size(8, 8, 1) 
+fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
+    var local: bool;
+
+    let _e5 = frame.sizes.x;
+    if !((id.x >= _e5)) {
+        let _e12 = frame.sizes.y;
+        local = (id.y >= _e12);
+    } else {
+        local = true;
+    }
+    let _e17 = local;
+    if _e17 {
+        return;
+    }
+    let _e20 = scatter_pixel(id.x, id.y);
+    textureStore(output, id.xy, vec4<f32>(_e20.x, _e20.y, _e20.z, 1f));
     return;
 }

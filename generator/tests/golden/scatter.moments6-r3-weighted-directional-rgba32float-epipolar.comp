@@ -97,35 +97,35 @@ vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_
 }
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
-    bool local_5 = false;
-    bool local_6 = false;
-    bool local_7 = false;
+    bool local_1 = false;
+    bool local_2 = false;
+    bool local_3 = false;
     if (!((uv.x < 0.0))) {
-        local_5 = (uv.x > 1.0);
+        local_1 = (uv.x > 1.0);
     } else {
-        local_5 = true;
+        local_1 = true;
     }
-    bool _e11 = local_5;
+    bool _e11 = local_1;
     if (!(_e11)) {
-        local_6 = (uv.y < 0.0);
+        local_2 = (uv.y < 0.0);
     } else {
-        local_6 = true;
+        local_2 = true;
     }
-    bool _e19 = local_6;
+    bool _e19 = local_2;
     if (!(_e19)) {
-        local_7 = (uv.y > 1.0);
+        local_3 = (uv.y > 1.0);
     } else {
-        local_7 = true;
+        local_3 = true;
     }
-    bool _e27 = local_7;
+    bool _e27 = local_3;
     if (_e27) {
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_6 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
-    uint y_1 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
+    uint x_7 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint y_2 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_7, y_2)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
     return _e49.x;
 }
 
@@ -142,16 +142,16 @@ float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_o
 }
 
 float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_1) {
-    bool local_8 = false;
+    bool local_4 = false;
     vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     float near = v_4.right.w;
     float far_1 = v_4.up.w;
     if ((v_4.origin.w > 0.5)) {
-        local_8 = (_e2.z <= near);
+        local_4 = (_e2.z <= near);
     } else {
-        local_8 = false;
+        local_4 = false;
     }
-    bool _e16 = local_8;
+    bool _e16 = local_4;
     if (_e16) {
         return 1.0;
     }
@@ -197,29 +197,29 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_7 = (sigma_t * len);
-    if ((x_7 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_7)));
+    float x_8 = (sigma_t * len);
+    if ((x_8 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_8)));
     }
-    return ((1.0 - exp(-(x_7))) / sigma_t);
+    return ((1.0 - exp(-(x_8))) / sigma_t);
 }
 
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a_1, float b_1) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
-    return (exp((-(sigma_t_1) * a_1)) * _e7);
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_8 * x_8) * (3.0 - (2.0 * x_8)));
+    float x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_9 * x_9) * (3.0 - (2.0 * x_9)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_9 = (eye + (dir * t));
-    vec3 to_x = (x_9 - light_pos);
+    vec3 x_10 = (eye + (dir * t));
+    vec3 to_x = (x_10 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_2 = sqrt(d2_);
     vec3 travel = (to_x / vec3(d_2));
@@ -228,14 +228,14 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir,
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
-float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_2, float b_2, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
+float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_1, float b_1, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
     float sum = 0.0;
     uint k = 0u;
     uint q = 0u;
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
-    float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_2 - a_2), 1e-6)));
-    float g0_ = atan(((a_2 - t0_) / h));
-    float w_1 = ((atan(((b_2 - t0_) / h)) - g0_) / float(panels));
+    float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float g0_ = atan(((a_1 - t0_) / h));
+    float w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
@@ -279,11 +279,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     return (((_e75 * 0.5) * w_1) * h);
 }
 
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_3, float b_3, uint n) {
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
     float t0_1 = dot((light_pos_2 - eye_2), dir_2);
-    float h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_3 - a_3), 1e-6)));
-    float theta_a = atan(((a_3 - t0_1) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_3 - t0_1) / h_1)) - theta_a) / float(n)));
+    float h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_1) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / float(n)));
 }
 
 vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x) {
@@ -295,8 +295,8 @@ SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_
     return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
 }
 
-float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta_1, float lo, float hi) {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta_1 - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
+float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi) {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
 }
 
 vec3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, uint x_1, uint y) {
@@ -387,37 +387,37 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, 
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float x_2, float delta_1, float theta_2, float s_1, bool spot_1) {
-    bool local_9 = false;
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float x_2, float delta, float theta_1, float s_1, bool spot_1) {
+    bool local_5 = false;
     if (spot_1) {
-        float psi = (x_2 * delta_1);
-        float den = sin((theta_2 + psi));
+        float psi = (x_2 * delta);
+        float den = sin((theta_1 + psi));
         if (!((den <= 1e-6))) {
-            local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_5 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_9 = true;
+            local_5 = true;
         }
-        bool _e16 = local_9;
+        bool _e16 = local_5;
         if (_e16) {
             return s_1;
         }
         return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_2 * delta_1) / max(sin(theta_2), 1e-6)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_1), 1e-6)), s_1);
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 eye_5, vec3 dir_5, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_4, b_4, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 eye_5, vec3 dir_5, float a_3, float b_3, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
-float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float d_1) {
-    return ((2.0 * d_1) - 1.0);
+float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float d) {
+    return ((2.0 * d) - 1.0);
 }
 
-vec4 biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw, float a_5) {
-    return vec4((raw.x * (1.0 - a_5)), ((raw.y * (1.0 - a_5)) + (a_5 / 3.0)), (raw.z * (1.0 - a_5)), ((raw.w * (1.0 - a_5)) + (a_5 / 5.0)));
+vec4 biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw, float a_4) {
+    return vec4((raw.x * (1.0 - a_4)), ((raw.y * (1.0 - a_4)) + (a_4 / 3.0)), (raw.z * (1.0 - a_4)), ((raw.w * (1.0 - a_4)) + (a_4 / 5.0)));
 }
 
 float sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float x_3, float s_2) {
@@ -429,7 +429,7 @@ float nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float q_1) {
 }
 
 CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float c1_, float c2_, float c3_, float c4_) {
-    vec3 r_1 = vec3(0.0);
+    vec3 r = vec3(0.0);
     uint k_2 = 0u;
     float z_1 = 0.0;
     uint i = 0u;
@@ -490,22 +490,22 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
             }
             uint _e117 = k_2;
             float _e119 = z_1;
-            r_1[_e117] = _e119;
+            r[_e117] = _e119;
         }
     }
-    float _e124 = r_1.x;
-    float _e127 = r_1.z;
+    float _e124 = r.x;
+    float _e127 = r.z;
     if ((abs(_e124) > abs(_e127))) {
-        vec3 _e130 = r_1;
-        r_1 = _e130.zyx;
+        vec3 _e130 = r;
+        r = _e130.zyx;
     }
-    float _e133 = r_1.y;
-    float _e136 = r_1.z;
+    float _e133 = r.y;
+    float _e136 = r.z;
     if ((abs(_e133) > abs(_e136))) {
-        vec3 _e139 = r_1;
-        r_1 = _e139.xzy;
+        vec3 _e139 = r;
+        r = _e139.xzy;
     }
-    vec3 _e141 = r_1;
+    vec3 _e141 = r;
     return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e141, false);
 }
 
@@ -526,7 +526,7 @@ float atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float b1_, float b
 
 float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw0_, vec2 raw1_, float zf) {
     float shadow = 0.0;
-    bool local_10 = false;
+    bool local_6 = false;
     vec4 _e3 = biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_, MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX);
     float b1_1 = _e3.x;
     float b2_1 = _e3.y;
@@ -564,11 +564,11 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw0_, vec2 r
         shadow = (_e104 + _e110);
     }
     if (!(at_infinity_1)) {
-        local_10 = (r_3.z < zf);
+        local_6 = (r_3.z < zf);
     } else {
-        local_10 = false;
+        local_6 = false;
     }
-    bool _e118 = local_10;
+    bool _e118 = local_6;
     if (_e118) {
         float _e119 = shadow;
         float _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.z, zf, r_3.x, (1.0 / (r_3.z - r_3.y)));
@@ -586,229 +586,215 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_X
     return (f_8.e1_.w + ((float(row) + 0.5) * f_8.e2_.w));
 }
 
-uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_2, uint regions, uint width, bool spot_2) {
+uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_1, uint regions, uint width, bool spot_2) {
     if (spot_2) {
-        return ((r_2 * width) / regions);
+        return ((r_1 * width) / regions);
     }
-    return (((r_2 * r_2) * width) / (regions * regions));
+    return (((r_1 * r_1) * width) / (regions * regions));
 }
 
-void main() {
-    uvec3 id = gl_GlobalInvocationID;
-    bool local = false;
-    bool local_1 = false;
-    bool local_2 = false;
-    bool local_3 = false;
+vec3 scatter_pixel(uint x_6, uint y_1) {
+    bool local_7 = false;
+    bool local_8 = false;
+    bool local_9 = false;
     float yc = 0.0;
-    float d = 0.0;
+    float d_1 = 0.0;
     float xs = 0.0;
-    float delta = 1.0;
-    float theta = 0.0;
+    float delta_1 = 1.0;
+    float theta_2 = 0.0;
     float total = 0.0;
-    uint r = 0u;
-    bool local_4 = false;
-    float a = 0.0;
-    float b = 0.0;
+    uint r_2 = 0u;
+    bool local_10 = false;
+    float a_5 = 0.0;
+    float b_4 = 0.0;
     float weight = 0.0;
     float vis = 0.0;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10 = _group_0_binding_0_cs;
-    uint x_10 = id.x;
-    uint y_2 = id.y;
-    if (!((x_10 >= f_10.sizes.x))) {
-        local = (y_2 >= f_10.sizes.y);
-    } else {
-        local = true;
-    }
-    bool _e18 = local;
-    if (_e18) {
-        return;
-    }
     vec3 eye_6 = f_10.eye.xyz;
-    vec3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_10, y_2);
-    int _e25_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e25 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_10, y_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e25_clamped_lod) - ivec2(1)), _e25_clamped_lod);
-    float s_4 = (min(max(_e25.x, 0.0), f_10.theta.z) / max(dot(_e21, f_10.cam_forward.xyz), 1e-6));
+    vec3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    int _e13_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+    vec4 _e13 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e13_clamped_lod) - ivec2(1)), _e13_clamped_lod);
+    float s_4 = (min(max(_e13.x, 0.0), f_10.theta.z) / max(dot(_e9, f_10.cam_forward.xyz), 1e-6));
     vec3 color = f_10.light_color.xyz;
-    vec3 px = vec3((float(x_10) + 0.5), (float(y_2) + 0.5), 0.0);
+    vec3 px = vec3((float(x_6) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_10.epipole.w;
     if ((f_10.epipole.z > 0.5)) {
-        local_1 = (length((px - vec3(f_10.epipole.x, f_10.epipole.y, 0.0))) < radius);
+        local_7 = (length((px - vec3(f_10.epipole.x, f_10.epipole.y, 0.0))) < radius);
     } else {
-        local_1 = false;
+        local_7 = false;
     }
-    bool near_epi = local_1;
+    bool near_epi = local_7;
     if ((f_10.anti_epipole.z > 0.5)) {
-        local_2 = (length((px - vec3(f_10.anti_epipole.x, f_10.anti_epipole.y, 0.0))) < radius);
+        local_8 = (length((px - vec3(f_10.anti_epipole.x, f_10.anti_epipole.y, 0.0))) < radius);
     } else {
-        local_2 = false;
+        local_8 = false;
     }
-    bool near_anti = local_2;
+    bool near_anti = local_8;
     if (!(near_epi)) {
-        local_3 = near_anti;
+        local_9 = near_anti;
     } else {
-        local_3 = true;
+        local_9 = true;
     }
-    bool _e88 = local_3;
-    if (_e88) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = _group_0_binding_0_cs;
-        float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, _group_0_binding_3_cs, eye_6, _e21, s_4, false);
-        vec3 l_1 = (_e93 * color);
-        imageStore(_group_0_binding_5_cs, ivec2(uvec2(x_10, y_2)), vec4(l_1.x, l_1.y, l_1.z, 1.0));
-        return;
+    bool _e76 = local_9;
+    if (_e76) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = _group_0_binding_0_cs;
+        float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, _group_0_binding_3_cs, eye_6, _e9, s_4, false);
+        vec3 l_1 = (_e81 * color);
+        return l_1;
     }
     vec3 axis = f_10.axis.xyz;
     uint rows_1 = f_10.sizes.w;
     uint width_1 = f_10.sizes.z;
     bool wrap_1 = (f_10.anti_epipole.w > 0.5);
     {
-        theta = acos(clamp(dot(_e21, axis), -1.0, 1.0));
-        float phi_1 = atan(dot(_e21, f_10.e2_.xyz), dot(_e21, f_10.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e9, axis), -1.0, 1.0));
+        float phi_1 = atan(dot(_e9, f_10.e2_.xyz), dot(_e9, f_10.e1_.xyz));
         yc = ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
         if (wrap_1) {
-            float _e132 = yc;
-            float _e133 = yc;
-            yc = (_e132 - (floor((_e133 / float(rows_1))) * float(rows_1)));
+            float _e113 = yc;
+            float _e114 = yc;
+            yc = (_e113 - (floor((_e114 / float(rows_1))) * float(rows_1)));
         } else {
-            float _e140 = yc;
-            yc = clamp(_e140, 0.0, float(rows_1));
+            float _e121 = yc;
+            yc = clamp(_e121, 0.0, float(rows_1));
         }
-        float _e144 = yc;
-        float yy = (_e144 - 0.5);
+        float _e125 = yc;
+        float yy = (_e125 - 0.5);
         float j0_ = floor(yy);
         float fy = (yy - j0_);
-        uint _e149 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        vec4 _e152 = _group_0_binding_1_cs[_e149];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e153 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e152);
-        uint _e156 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1.0), rows_1, wrap_1);
-        vec4 _e159 = _group_0_binding_1_cs[_e156];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e160 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e159);
-        delta = mix(_e153.delta, _e160.delta, fy);
-        float _e165 = theta;
-        float _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_10.theta.x, f_10.theta.y);
-        d = _e170;
+        uint _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
+        vec4 _e133 = _group_0_binding_1_cs[_e130];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
+        uint _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1.0), rows_1, wrap_1);
+        vec4 _e140 = _group_0_binding_1_cs[_e137];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
+        delta_1 = mix(_e134.delta, _e141.delta, fy);
+        float _e146 = theta_2;
+        float _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_10.theta.x, f_10.theta.y);
+        d_1 = _e151;
         if (false) {
-            vec3 q_3 = normalize(((eye_6 + (_e21 * s_4)) - f_10.light_pos.xyz));
-            float _e184 = delta;
-            xs = (acos(clamp(dot(q_3, -(axis)), -1.0, 1.0)) / _e184);
+            vec3 q_3 = normalize(((eye_6 + (_e9 * s_4)) - f_10.light_pos.xyz));
+            float _e165 = delta_1;
+            xs = (acos(clamp(dot(q_3, -(axis)), -1.0, 1.0)) / _e165);
         } else {
-            float _e187 = theta;
-            float _e190 = delta;
-            xs = ((s_4 * sin(_e187)) / _e190);
+            float _e168 = theta_2;
+            float _e171 = delta_1;
+            xs = ((s_4 * sin(_e168)) / _e171);
         }
     }
-    float _e192 = yc;
-    float yb = (_e192 - 0.5);
+    float _e173 = yc;
+    float yb = (_e173 - 0.5);
     float fy_1 = (yb - floor(yb));
-    uint _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    uint _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e202 : _e198);
-    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e21));
+    uint _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    uint _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e183 : _e179);
+    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e9));
     uint panels_2 = max((f_10.sizes2_.z / 4u), 1u);
-    float _e216 = d;
-    float _e217 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e216);
-    float _e222 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    float sun_scatter = (f_10.medium.y * _e222);
-    float _e224 = xs;
-    uint last = uint(min(max(_e224, 0.0), (float(width_1) - 1.0)));
+    float _e197 = d_1;
+    float _e198 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e197);
+    float _e203 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+    float sun_scatter = (f_10.medium.y * _e203);
+    float _e205 = xs;
+    uint last = uint(min(max(_e205, 0.0), (float(width_1) - 1.0)));
     bool loop_init_5 = true;
     while(true) {
         if (!loop_init_5) {
-            uint _e387 = r;
-            r = (_e387 + 1u);
+            uint _e368 = r_2;
+            r_2 = (_e368 + 1u);
         }
         loop_init_5 = false;
-        uint _e234 = r;
-        if ((_e234 < REGIONS)) {
+        uint _e215 = r_2;
+        if ((_e215 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e236 = r;
-            uint _e237 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e236, REGIONS, width_1, false);
-            float b0_ = float(_e237);
-            uint _e239 = r;
-            uint _e242 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e239 + 1u), REGIONS, width_1, false);
-            float b1_2 = float(_e242);
+            uint _e217 = r_2;
+            uint _e218 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e217, REGIONS, width_1, false);
+            float b0_ = float(_e218);
+            uint _e220 = r_2;
+            uint _e223 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e220 + 1u), REGIONS, width_1, false);
+            float b1_2 = float(_e223);
             if (!((last < uint(b1_2)))) {
-                uint _e247 = r;
-                local_4 = ((_e247 + 1u) == REGIONS);
+                uint _e228 = r_2;
+                local_10 = ((_e228 + 1u) == REGIONS);
             } else {
-                local_4 = true;
+                local_10 = true;
             }
-            bool is_last = local_4;
-            float _e257 = xs;
-            float pos = (is_last ? clamp((_e257 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
-            a = 0.0;
-            b = 0.0;
-            float _e270 = delta;
-            float _e271 = theta;
-            float _e272 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e270, _e271, s_4, false);
-            a = _e272;
-            float _e273 = delta;
-            float _e274 = theta;
-            float _e275 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e273, _e274, s_4, false);
-            b = (is_last ? s_4 : _e275);
+            bool is_last = local_10;
+            float _e238 = xs;
+            float pos = (is_last ? clamp((_e238 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            a_5 = 0.0;
+            b_4 = 0.0;
+            float _e251 = delta_1;
+            float _e252 = theta_2;
+            float _e253 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e251, _e252, s_4, false);
+            a_5 = _e253;
+            float _e254 = delta_1;
+            float _e255 = theta_2;
+            float _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e254, _e255, s_4, false);
+            b_4 = (is_last ? s_4 : _e256);
             weight = 0.0;
             if (false) {
-                float _e279 = a;
-                float _e280 = b;
-                float _e281 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e21, _e279, _e280, panels_2);
-                weight = _e281;
+                float _e260 = a_5;
+                float _e261 = b_4;
+                float _e262 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e9, _e260, _e261, panels_2);
+                weight = _e262;
             } else {
-                float _e284 = a;
-                float _e285 = b;
-                float _e286 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e284, _e285);
-                weight = (sun_scatter * _e286);
+                float _e265 = a_5;
+                float _e266 = b_4;
+                float _e267 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e265, _e266);
+                weight = (sun_scatter * _e267);
             }
             float xb = (pos - 0.5);
             float fx = (xb - floor(xb));
             uint x0_ = uint(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
             uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
-            int _e310_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 bounds0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, _e198)), ivec2(0), textureSize(_group_0_binding_6_cs, _e310_clamped_lod) - ivec2(1)), _e310_clamped_lod);
-            int _e314_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 bounds1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e314_clamped_lod) - ivec2(1)), _e314_clamped_lod);
+            int _e291_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+            vec4 bounds0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, _e179)), ivec2(0), textureSize(_group_0_binding_6_cs, _e291_clamped_lod) - ivec2(1)), _e291_clamped_lod);
+            int _e295_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+            vec4 bounds1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e295_clamped_lod) - ivec2(1)), _e295_clamped_lod);
             float lo_1 = min(bounds0_.x, bounds1_.x);
             float hi_1 = max(bounds0_.y, bounds1_.y);
             vis = 0.5;
-            float _e323 = d;
-            if ((_e323 <= lo_1)) {
+            float _e304 = d_1;
+            if ((_e304 <= lo_1)) {
                 vis = 1.0;
             } else {
-                float _e326 = d;
-                if ((_e326 > hi_1)) {
+                float _e307 = d_1;
+                if ((_e307 > hi_1)) {
                     vis = 0.0;
                 } else {
-                    int _e333_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e333 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, _e198), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e333_clamped_lod) - ivec3(1)), _e333_clamped_lod);
-                    int _e338_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e338 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, _e198), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e338_clamped_lod) - ivec3(1)), _e338_clamped_lod);
-                    vec4 top0_ = mix(_e333, _e338, fx);
-                    int _e344_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e344 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e344_clamped_lod) - ivec3(1)), _e344_clamped_lod);
-                    int _e349_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e349 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e349_clamped_lod) - ivec3(1)), _e349_clamped_lod);
-                    vec4 bottom0_ = mix(_e344, _e349, fx);
+                    int _e314_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                    vec4 _e314 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, _e179), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e314_clamped_lod) - ivec3(1)), _e314_clamped_lod);
+                    int _e319_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                    vec4 _e319 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, _e179), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e319_clamped_lod) - ivec3(1)), _e319_clamped_lod);
+                    vec4 top0_ = mix(_e314, _e319, fx);
+                    int _e325_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                    vec4 _e325 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e325_clamped_lod) - ivec3(1)), _e325_clamped_lod);
+                    int _e330_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                    vec4 _e330 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e330_clamped_lod) - ivec3(1)), _e330_clamped_lod);
+                    vec4 bottom0_ = mix(_e325, _e330, fx);
                     vec4 m0_ = mix(top0_, bottom0_, fy_1);
-                    int _e356_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e356 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, _e198), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e356_clamped_lod) - ivec3(1)), _e356_clamped_lod);
-                    int _e361_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e361 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, _e198), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e361_clamped_lod) - ivec3(1)), _e361_clamped_lod);
-                    vec4 top1_ = mix(_e356, _e361, fx);
-                    int _e367_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e367 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e367_clamped_lod) - ivec3(1)), _e367_clamped_lod);
-                    int _e372_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e372 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e372_clamped_lod) - ivec3(1)), _e372_clamped_lod);
-                    vec4 bottom1_ = mix(_e367, _e372, fx);
+                    int _e337_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                    vec4 _e337 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, _e179), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e337_clamped_lod) - ivec3(1)), _e337_clamped_lod);
+                    int _e342_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                    vec4 _e342 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, _e179), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e342_clamped_lod) - ivec3(1)), _e342_clamped_lod);
+                    vec4 top1_ = mix(_e337, _e342, fx);
+                    int _e348_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                    vec4 _e348 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e348_clamped_lod) - ivec3(1)), _e348_clamped_lod);
+                    int _e353_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                    vec4 _e353 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e353_clamped_lod) - ivec3(1)), _e353_clamped_lod);
+                    vec4 bottom1_ = mix(_e348, _e353, fx);
                     vec4 m1_ = mix(top1_, bottom1_, fy_1);
-                    float _e376 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e217);
-                    vis = _e376;
+                    float _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e198);
+                    vis = _e357;
                 }
             }
-            float _e378 = total;
-            float _e379 = weight;
-            float _e380 = vis;
-            total = (_e378 + (_e379 * clamp(_e380, 0.0, 1.0)));
+            float _e359 = total;
+            float _e360 = weight;
+            float _e361 = vis;
+            total = (_e359 + (_e360 * clamp(_e361, 0.0, 1.0)));
             if (is_last) {
                 break;
             }
@@ -816,7 +802,25 @@ void main() {
     }
     float l_2 = total;
     vec3 c_1 = (color * l_2);
-    imageStore(_group_0_binding_5_cs, ivec2(uvec2(x_10, y_2)), vec4(c_1.x, c_1.y, c_1.z, 1.0));
+    return c_1;
+}
+
+void main() {
+    uvec3 id = gl_GlobalInvocationID;
+    bool local = false;
+    uint _e5 = _group_0_binding_0_cs.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = _group_0_binding_0_cs.sizes.y;
+        local = (id.y >= _e12);
+    } else {
+        local = true;
+    }
+    bool _e17 = local;
+    if (_e17) {
+        return;
+    }
+    vec3 _e20 = scatter_pixel(id.x, id.y);
+    imageStore(_group_0_binding_5_cs, ivec2(id.xy), vec4(_e20.x, _e20.y, _e20.z, 1.0));
     return;
 }
 

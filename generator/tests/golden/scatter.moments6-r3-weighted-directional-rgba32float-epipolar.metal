@@ -106,35 +106,35 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_5 = {};
-    bool local_6 = {};
-    bool local_7 = {};
+    bool local_1 = {};
+    bool local_2 = {};
+    bool local_3 = {};
     if (!((uv.x < 0.0))) {
-        local_5 = uv.x > 1.0;
+        local_1 = uv.x > 1.0;
     } else {
-        local_5 = true;
+        local_1 = true;
     }
-    bool _e11 = local_5;
+    bool _e11 = local_1;
     if (!(_e11)) {
-        local_6 = uv.y < 0.0;
+        local_2 = uv.y < 0.0;
     } else {
-        local_6 = true;
+        local_2 = true;
     }
-    bool _e19 = local_6;
+    bool _e19 = local_2;
     if (!(_e19)) {
-        local_7 = uv.y > 1.0;
+        local_3 = uv.y > 1.0;
     } else {
-        local_7 = true;
+        local_3 = true;
     }
-    bool _e27 = local_7;
+    bool _e27 = local_3;
     if (_e27) {
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_6 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
-    uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_7 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint y_2 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_7, y_2)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -158,16 +158,16 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm_1,
     metal::float3 p_1
 ) {
-    bool local_8 = {};
+    bool local_4 = {};
     metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     float near = v_4.right.w;
     float far_1 = v_4.up.w;
     if (v_4.origin.w > 0.5) {
-        local_8 = _e2.z <= near;
+        local_4 = _e2.z <= near;
     } else {
-        local_8 = false;
+        local_4 = false;
     }
-    bool _e16 = local_8;
+    bool _e16 = local_4;
     if (_e16) {
         return 1.0;
     }
@@ -224,20 +224,20 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_7 = sigma_t * len;
-    if (x_7 < 0.0001) {
-        return len * (1.0 - (0.5 * x_7));
+    float x_8 = sigma_t * len;
+    if (x_8 < 0.0001) {
+        return len * (1.0 - (0.5 * x_8));
     }
-    return (1.0 - metal::exp(-(x_7))) / sigma_t;
+    return (1.0 - metal::exp(-(x_8))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t_1,
-    float a_1,
-    float b_1
+    float a,
+    float b
 ) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b_1 - a_1);
-    return metal::exp(-(sigma_t_1) * a_1) * _e7;
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
+    return metal::exp(-(sigma_t_1) * a) * _e7;
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -248,8 +248,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_8 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_8 * x_8) * (3.0 - (2.0 * x_8));
+    float x_9 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_9 * x_9) * (3.0 - (2.0 * x_9));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -262,8 +262,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_9 = eye + (dir * t);
-    metal::float3 to_x = x_9 - light_pos;
+    metal::float3 x_10 = eye + (dir * t);
+    metal::float3 to_x = x_10 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_2 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_2);
@@ -275,8 +275,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 eye_1,
     metal::float3 dir_1,
-    float a_2,
-    float b_2,
+    float a_1,
+    float b_1,
     uint panels,
     metal::float3 light_pos_1,
     metal::float3 light_dir_1,
@@ -288,9 +288,9 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     uint k = 0u;
     uint q = {};
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
-    float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_2 - a_2, 0.000001));
-    float g0_ = metal::atan((a_2 - t0_) / h);
-    float w_1 = (metal::atan((b_2 - t0_) / h) - g0_) / static_cast<float>(panels);
+    float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
+    float g0_ = metal::atan((a_1 - t0_) / h);
+    float w_1 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
@@ -344,14 +344,14 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
     metal::float3 eye_2,
     metal::float3 dir_2,
     metal::float3 light_pos_2,
-    float a_3,
-    float b_3,
+    float a_2,
+    float b_2,
     uint n
 ) {
     float t0_1 = metal::dot(light_pos_2 - eye_2, dir_2);
-    float h_1 = metal::max(metal::length((eye_2 + (dir_2 * t0_1)) - light_pos_2), 0.0001 * metal::max(b_3 - a_3, 0.000001));
-    float theta_a = metal::atan((a_3 - t0_1) / h_1);
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_1, theta_a, (metal::atan((b_3 - t0_1) / h_1) - theta_a) / static_cast<float>(n)};
+    float h_1 = metal::max(metal::length((eye_2 + (dir_2 * t0_1)) - light_pos_2), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float theta_a = metal::atan((a_2 - t0_1) / h_1);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_1, theta_a, (metal::atan((b_2 - t0_1) / h_1) - theta_a) / static_cast<float>(n)};
 }
 
 metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -369,11 +369,11 @@ SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_
 }
 
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    float theta_1,
+    float theta,
     float lo,
     float hi
 ) {
-    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * metal::clamp((theta_1 - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
+    return DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * metal::clamp((theta - lo) / metal::max(hi - lo, 0.000001), 0.0, 1.0));
 }
 
 metal::float3 pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -505,27 +505,27 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
     float x_2,
-    float delta_1,
-    float theta_2,
+    float delta,
+    float theta_1,
     float s_1,
     bool spot_1
 ) {
-    bool local_9 = {};
+    bool local_5 = {};
     if (spot_1) {
-        float psi = x_2 * delta_1;
-        float den = metal::sin(theta_2 + psi);
+        float psi = x_2 * delta;
+        float den = metal::sin(theta_1 + psi);
         if (!((den <= 0.000001))) {
-            local_9 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_5 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local_9 = true;
+            local_5 = true;
         }
-        bool _e16 = local_9;
+        bool _e16 = local_5;
         if (_e16) {
             return s_1;
         }
         return metal::min((f_5.axis.w * metal::sin(psi)) / den, s_1);
     } else {
-        return metal::min((x_2 * delta_1) / metal::max(metal::sin(theta_2), 0.000001), s_1);
+        return metal::min((x_2 * delta) / metal::max(metal::sin(theta_1), 0.000001), s_1);
     }
 }
 
@@ -533,25 +533,25 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
     metal::float3 eye_5,
     metal::float3 dir_5,
-    float a_4,
-    float b_4,
+    float a_3,
+    float b_3,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_4, b_4, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
 float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
-    float d_1
+    float d
 ) {
-    return (2.0 * d_1) - 1.0;
+    return (2.0 * d) - 1.0;
 }
 
 metal::float4 biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
     metal::float4 raw,
-    float a_5
+    float a_4
 ) {
-    return metal::float4(raw.x * (1.0 - a_5), (raw.y * (1.0 - a_5)) + (a_5 / 3.0), raw.z * (1.0 - a_5), (raw.w * (1.0 - a_5)) + (a_5 / 5.0));
+    return metal::float4(raw.x * (1.0 - a_4), (raw.y * (1.0 - a_4)) + (a_4 / 3.0), raw.z * (1.0 - a_4), (raw.w * (1.0 - a_4)) + (a_4 / 5.0));
 }
 
 float sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
@@ -573,7 +573,7 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
     float c3_,
     float c4_
 ) {
-    metal::float3 r_1 = metal::float3(0.0);
+    metal::float3 r = metal::float3(0.0);
     uint k_2 = 0u;
     float z_1 = {};
     uint i = {};
@@ -640,22 +640,22 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
             }
             uint _e117 = k_2;
             float _e119 = z_1;
-            r_1[metal::min(unsigned(_e117), 2u)] = _e119;
+            r[metal::min(unsigned(_e117), 2u)] = _e119;
         }
     }
-    float _e124 = r_1.x;
-    float _e127 = r_1.z;
+    float _e124 = r.x;
+    float _e127 = r.z;
     if (metal::abs(_e124) > metal::abs(_e127)) {
-        metal::float3 _e130 = r_1;
-        r_1 = _e130.zyx;
+        metal::float3 _e130 = r;
+        r = _e130.zyx;
     }
-    float _e133 = r_1.y;
-    float _e136 = r_1.z;
+    float _e133 = r.y;
+    float _e136 = r.z;
     if (metal::abs(_e133) > metal::abs(_e136)) {
-        metal::float3 _e139 = r_1;
-        r_1 = _e139.xzy;
+        metal::float3 _e139 = r;
+        r = _e139.xzy;
     }
-    metal::float3 _e141 = r_1;
+    metal::float3 _e141 = r;
     return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX {_e141, false};
 }
 
@@ -692,7 +692,7 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
     float zf
 ) {
     float shadow = 0.0;
-    bool local_10 = {};
+    bool local_6 = {};
     metal::float4 _e3 = biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_, MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX);
     float b1_1 = _e3.x;
     float b2_1 = _e3.y;
@@ -730,11 +730,11 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
         shadow = _e104 + _e110;
     }
     if (!(at_infinity_1)) {
-        local_10 = _e88.r[2] < zf;
+        local_6 = _e88.r[2] < zf;
     } else {
-        local_10 = false;
+        local_6 = false;
     }
-    bool _e118 = local_10;
+    bool _e118 = local_6;
     if (_e118) {
         float _e119 = shadow;
         float _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, _e88.r[2], zf, _e88.r[0], 1.0 / (_e88.r[2] - _e88.r[1]));
@@ -763,15 +763,240 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    uint r_2,
+    uint r_1,
     uint regions,
     uint width,
     bool spot_2
 ) {
     if (spot_2) {
-        return naga_div(r_2 * width, regions);
+        return naga_div(r_1 * width, regions);
     }
-    return naga_div((r_2 * r_2) * width, regions * regions);
+    return naga_div((r_1 * r_1) * width, regions * regions);
+}
+
+metal::float3 scatter_pixel(
+    uint x_6,
+    uint y_1,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
+    device type_10 const& slices,
+    metal::texture2d<float, metal::access::sample> depth,
+    metal::texture2d<float, metal::access::sample> shadow_map,
+    metal::texture2d_array<float, metal::access::sample> filtered,
+    metal::texture2d<float, metal::access::sample> bounds,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    bool local_7 = {};
+    bool local_8 = {};
+    bool local_9 = {};
+    float yc = {};
+    float d_1 = {};
+    float xs = {};
+    float delta_1 = 1.0;
+    float theta_2 = 0.0;
+    float total = 0.0;
+    uint r_2 = 0u;
+    bool local_10 = {};
+    float a_5 = {};
+    float b_4 = {};
+    float weight = {};
+    float vis = {};
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10 = frame;
+    metal::float3 eye_6 = f_10.eye.xyz;
+    metal::float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    uint clamped_lod_e13 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e13 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(depth.get_width(clamped_lod_e13), depth.get_height(clamped_lod_e13)) - 1), clamped_lod_e13);
+    float s_4 = metal::min(metal::max(_e13.x, 0.0), f_10.theta.z) / metal::max(metal::dot(_e9, f_10.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_10.light_color.xyz;
+    metal::float3 px = metal::float3(static_cast<float>(x_6) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
+    float radius = f_10.epipole.w;
+    if (f_10.epipole.z > 0.5) {
+        local_7 = metal::length(px - metal::float3(f_10.epipole.x, f_10.epipole.y, 0.0)) < radius;
+    } else {
+        local_7 = false;
+    }
+    bool near_epi = local_7;
+    if (f_10.anti_epipole.z > 0.5) {
+        local_8 = metal::length(px - metal::float3(f_10.anti_epipole.x, f_10.anti_epipole.y, 0.0)) < radius;
+    } else {
+        local_8 = false;
+    }
+    bool near_anti = local_8;
+    if (!(near_epi)) {
+        local_9 = near_anti;
+    } else {
+        local_9 = true;
+    }
+    bool _e76 = local_9;
+    if (_e76) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = frame;
+        float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_6, _e9, s_4, false);
+        metal::float3 l_1 = _e81 * color;
+        return l_1;
+    }
+    metal::float3 axis = f_10.axis.xyz;
+    uint rows_1 = f_10.sizes.w;
+    uint width_1 = f_10.sizes.z;
+    bool wrap_1 = f_10.anti_epipole.w > 0.5;
+    {
+        theta_2 = metal::acos(metal::clamp(metal::dot(_e9, axis), -1.0, 1.0));
+        float phi_1 = metal::atan2(metal::dot(_e9, f_10.e2_.xyz), metal::dot(_e9, f_10.e1_.xyz));
+        yc = (phi_1 - f_10.e1_.w) / f_10.e2_.w;
+        if (wrap_1) {
+            float _e113 = yc;
+            float _e114 = yc;
+            yc = _e113 - (metal::floor(_e114 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+        } else {
+            float _e121 = yc;
+            yc = metal::clamp(_e121, 0.0, static_cast<float>(rows_1));
+        }
+        float _e125 = yc;
+        float yy = _e125 - 0.5;
+        float j0_ = metal::floor(yy);
+        float fy = yy - j0_;
+        uint _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
+        metal::float4 _e133 = slices[metal::min(unsigned(_e130), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
+        uint _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_ + 1.0, rows_1, wrap_1);
+        metal::float4 _e140 = slices[metal::min(unsigned(_e137), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
+        delta_1 = metal::mix(_e134.delta, _e141.delta, fy);
+        float _e146 = theta_2;
+        float _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_10.theta.x, f_10.theta.y);
+        d_1 = _e151;
+        if (false) {
+            metal::float3 q_3 = metal::normalize((eye_6 + (_e9 * s_4)) - f_10.light_pos.xyz);
+            float _e165 = delta_1;
+            xs = metal::acos(metal::clamp(metal::dot(q_3, -(axis)), -1.0, 1.0)) / _e165;
+        } else {
+            float _e168 = theta_2;
+            float _e171 = delta_1;
+            xs = (s_4 * metal::sin(_e168)) / _e171;
+        }
+    }
+    float _e173 = yc;
+    float yb = _e173 - 0.5;
+    float fy_1 = yb - metal::floor(yb);
+    uint _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
+    uint _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
+    uint row1_ = (yb > metal::floor(yb)) ? _e183 : _e179;
+    float cos_theta_l = -(metal::dot(f_10.light_dir.xyz, _e9));
+    uint panels_2 = metal::max(naga_div(f_10.sizes2_.z, 4u), 1u);
+    float _e197 = d_1;
+    float _e198 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e197);
+    float _e203 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+    float sun_scatter = f_10.medium.y * _e203;
+    float _e205 = xs;
+    uint last = naga_f2u32(metal::min(metal::max(_e205, 0.0), static_cast<float>(width_1) - 1.0));
+    uint2 loop_bound_5 = uint2(4294967295u);
+    bool loop_init_5 = true;
+    while(true) {
+        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
+            uint _e368 = r_2;
+            r_2 = _e368 + 1u;
+        }
+        loop_init_5 = false;
+        uint _e215 = r_2;
+        if (_e215 < REGIONS) {
+        } else {
+            break;
+        }
+        {
+            uint _e217 = r_2;
+            uint _e218 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e217, REGIONS, width_1, false);
+            float b0_ = static_cast<float>(_e218);
+            uint _e220 = r_2;
+            uint _e223 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e220 + 1u, REGIONS, width_1, false);
+            float b1_2 = static_cast<float>(_e223);
+            if (!((last < naga_f2u32(b1_2)))) {
+                uint _e228 = r_2;
+                local_10 = (_e228 + 1u) == REGIONS;
+            } else {
+                local_10 = true;
+            }
+            bool is_last = local_10;
+            float _e238 = xs;
+            float pos = is_last ? metal::clamp(_e238 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
+            a_5 = float {};
+            b_4 = float {};
+            float _e251 = delta_1;
+            float _e252 = theta_2;
+            float _e253 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e251, _e252, s_4, false);
+            a_5 = _e253;
+            float _e254 = delta_1;
+            float _e255 = theta_2;
+            float _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e254, _e255, s_4, false);
+            b_4 = is_last ? s_4 : _e256;
+            weight = float {};
+            if (false) {
+                float _e260 = a_5;
+                float _e261 = b_4;
+                float _e262 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e9, _e260, _e261, panels_2);
+                weight = _e262;
+            } else {
+                float _e265 = a_5;
+                float _e266 = b_4;
+                float _e267 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e265, _e266);
+                weight = sun_scatter * _e267;
+            }
+            float xb = pos - 0.5;
+            float fx = xb - metal::floor(xb);
+            uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
+            uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
+            uint clamped_lod_e291 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 bounds0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e179)), metal::uint2(bounds.get_width(clamped_lod_e291), bounds.get_height(clamped_lod_e291)) - 1), clamped_lod_e291);
+            uint clamped_lod_e295 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 bounds1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e295), bounds.get_height(clamped_lod_e295)) - 1), clamped_lod_e295);
+            float lo_1 = metal::min(bounds0_.x, bounds1_.x);
+            float hi_1 = metal::max(bounds0_.y, bounds1_.y);
+            vis = 0.5;
+            float _e304 = d_1;
+            if (_e304 <= lo_1) {
+                vis = 1.0;
+            } else {
+                float _e307 = d_1;
+                if (_e307 > hi_1) {
+                    vis = 0.0;
+                } else {
+                    uint clamped_lod_e314 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                    metal::float4 _e314 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e314), filtered.get_height(clamped_lod_e314)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e314);
+                    uint clamped_lod_e319 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                    metal::float4 _e319 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e319), filtered.get_height(clamped_lod_e319)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e319);
+                    metal::float4 top0_ = metal::mix(_e314, _e319, fx);
+                    uint clamped_lod_e325 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                    metal::float4 _e325 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e325), filtered.get_height(clamped_lod_e325)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e325);
+                    uint clamped_lod_e330 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                    metal::float4 _e330 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e330), filtered.get_height(clamped_lod_e330)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e330);
+                    metal::float4 bottom0_ = metal::mix(_e325, _e330, fx);
+                    metal::float4 m0_ = metal::mix(top0_, bottom0_, fy_1);
+                    uint clamped_lod_e337 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                    metal::float4 _e337 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e337), filtered.get_height(clamped_lod_e337)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e337);
+                    uint clamped_lod_e342 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                    metal::float4 _e342 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e342), filtered.get_height(clamped_lod_e342)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e342);
+                    metal::float4 top1_ = metal::mix(_e337, _e342, fx);
+                    uint clamped_lod_e348 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                    metal::float4 _e348 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e348), filtered.get_height(clamped_lod_e348)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e348);
+                    uint clamped_lod_e353 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                    metal::float4 _e353 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e353), filtered.get_height(clamped_lod_e353)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e353);
+                    metal::float4 bottom1_ = metal::mix(_e348, _e353, fx);
+                    metal::float4 m1_ = metal::mix(top1_, bottom1_, fy_1);
+                    float _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e198);
+                    vis = _e357;
+                }
+            }
+            float _e359 = total;
+            float _e360 = weight;
+            float _e361 = vis;
+            total = _e359 + (_e360 * metal::clamp(_e361, 0.0, 1.0));
+            if (is_last) {
+                break;
+            }
+        }
+    }
+    float l_2 = total;
+    metal::float3 c_1 = color * l_2;
+    return c_1;
 }
 
 struct scatterInput {
@@ -788,229 +1013,18 @@ kernel void scatter(
 , constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
 ) {
     bool local = {};
-    bool local_1 = {};
-    bool local_2 = {};
-    bool local_3 = {};
-    float yc = {};
-    float d = {};
-    float xs = {};
-    float delta = 1.0;
-    float theta = 0.0;
-    float total = 0.0;
-    uint r = 0u;
-    bool local_4 = {};
-    float a = {};
-    float b = {};
-    float weight = {};
-    float vis = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10 = frame;
-    uint x_10 = id.x;
-    uint y_2 = id.y;
-    if (!((x_10 >= f_10.sizes.x))) {
-        local = y_2 >= f_10.sizes.y;
+    uint _e5 = frame.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = frame.sizes.y;
+        local = id.y >= _e12;
     } else {
         local = true;
     }
-    bool _e18 = local;
-    if (_e18) {
+    bool _e17 = local;
+    if (_e17) {
         return;
     }
-    metal::float3 eye_6 = f_10.eye.xyz;
-    metal::float3 _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_10, y_2);
-    uint clamped_lod_e25 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e25 = depth.read(metal::min(metal::uint2(metal::uint2(x_10, y_2)), metal::uint2(depth.get_width(clamped_lod_e25), depth.get_height(clamped_lod_e25)) - 1), clamped_lod_e25);
-    float s_4 = metal::min(metal::max(_e25.x, 0.0), f_10.theta.z) / metal::max(metal::dot(_e21, f_10.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_10.light_color.xyz;
-    metal::float3 px = metal::float3(static_cast<float>(x_10) + 0.5, static_cast<float>(y_2) + 0.5, 0.0);
-    float radius = f_10.epipole.w;
-    if (f_10.epipole.z > 0.5) {
-        local_1 = metal::length(px - metal::float3(f_10.epipole.x, f_10.epipole.y, 0.0)) < radius;
-    } else {
-        local_1 = false;
-    }
-    bool near_epi = local_1;
-    if (f_10.anti_epipole.z > 0.5) {
-        local_2 = metal::length(px - metal::float3(f_10.anti_epipole.x, f_10.anti_epipole.y, 0.0)) < radius;
-    } else {
-        local_2 = false;
-    }
-    bool near_anti = local_2;
-    if (!(near_epi)) {
-        local_3 = near_anti;
-    } else {
-        local_3 = true;
-    }
-    bool _e88 = local_3;
-    if (_e88) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e90 = frame;
-        float _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_6, _e21, s_4, false);
-        metal::float3 l_1 = _e93 * color;
-        output.write(metal::float4(l_1.x, l_1.y, l_1.z, 1.0), metal::uint2(metal::uint2(x_10, y_2)));
-        return;
-    }
-    metal::float3 axis = f_10.axis.xyz;
-    uint rows_1 = f_10.sizes.w;
-    uint width_1 = f_10.sizes.z;
-    bool wrap_1 = f_10.anti_epipole.w > 0.5;
-    {
-        theta = metal::acos(metal::clamp(metal::dot(_e21, axis), -1.0, 1.0));
-        float phi_1 = metal::atan2(metal::dot(_e21, f_10.e2_.xyz), metal::dot(_e21, f_10.e1_.xyz));
-        yc = (phi_1 - f_10.e1_.w) / f_10.e2_.w;
-        if (wrap_1) {
-            float _e132 = yc;
-            float _e133 = yc;
-            yc = _e132 - (metal::floor(_e133 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
-        } else {
-            float _e140 = yc;
-            yc = metal::clamp(_e140, 0.0, static_cast<float>(rows_1));
-        }
-        float _e144 = yc;
-        float yy = _e144 - 0.5;
-        float j0_ = metal::floor(yy);
-        float fy = yy - j0_;
-        uint _e149 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        metal::float4 _e152 = slices[metal::min(unsigned(_e149), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e153 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e152);
-        uint _e156 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_ + 1.0, rows_1, wrap_1);
-        metal::float4 _e159 = slices[metal::min(unsigned(_e156), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e160 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e159);
-        delta = metal::mix(_e153.delta, _e160.delta, fy);
-        float _e165 = theta;
-        float _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_10.theta.x, f_10.theta.y);
-        d = _e170;
-        if (false) {
-            metal::float3 q_3 = metal::normalize((eye_6 + (_e21 * s_4)) - f_10.light_pos.xyz);
-            float _e184 = delta;
-            xs = metal::acos(metal::clamp(metal::dot(q_3, -(axis)), -1.0, 1.0)) / _e184;
-        } else {
-            float _e187 = theta;
-            float _e190 = delta;
-            xs = (s_4 * metal::sin(_e187)) / _e190;
-        }
-    }
-    float _e192 = yc;
-    float yb = _e192 - 0.5;
-    float fy_1 = yb - metal::floor(yb);
-    uint _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
-    uint _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
-    uint row1_ = (yb > metal::floor(yb)) ? _e202 : _e198;
-    float cos_theta_l = -(metal::dot(f_10.light_dir.xyz, _e21));
-    uint panels_2 = metal::max(naga_div(f_10.sizes2_.z, 4u), 1u);
-    float _e216 = d;
-    float _e217 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e216);
-    float _e222 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    float sun_scatter = f_10.medium.y * _e222;
-    float _e224 = xs;
-    uint last = naga_f2u32(metal::min(metal::max(_e224, 0.0), static_cast<float>(width_1) - 1.0));
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
-    while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
-            uint _e387 = r;
-            r = _e387 + 1u;
-        }
-        loop_init_5 = false;
-        uint _e234 = r;
-        if (_e234 < REGIONS) {
-        } else {
-            break;
-        }
-        {
-            uint _e236 = r;
-            uint _e237 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e236, REGIONS, width_1, false);
-            float b0_ = static_cast<float>(_e237);
-            uint _e239 = r;
-            uint _e242 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e239 + 1u, REGIONS, width_1, false);
-            float b1_2 = static_cast<float>(_e242);
-            if (!((last < naga_f2u32(b1_2)))) {
-                uint _e247 = r;
-                local_4 = (_e247 + 1u) == REGIONS;
-            } else {
-                local_4 = true;
-            }
-            bool is_last = local_4;
-            float _e257 = xs;
-            float pos = is_last ? metal::clamp(_e257 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
-            a = float {};
-            b = float {};
-            float _e270 = delta;
-            float _e271 = theta;
-            float _e272 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e270, _e271, s_4, false);
-            a = _e272;
-            float _e273 = delta;
-            float _e274 = theta;
-            float _e275 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e273, _e274, s_4, false);
-            b = is_last ? s_4 : _e275;
-            weight = float {};
-            if (false) {
-                float _e279 = a;
-                float _e280 = b;
-                float _e281 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e21, _e279, _e280, panels_2);
-                weight = _e281;
-            } else {
-                float _e284 = a;
-                float _e285 = b;
-                float _e286 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e284, _e285);
-                weight = sun_scatter * _e286;
-            }
-            float xb = pos - 0.5;
-            float fx = xb - metal::floor(xb);
-            uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
-            uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
-            uint clamped_lod_e310 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 bounds0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(bounds.get_width(clamped_lod_e310), bounds.get_height(clamped_lod_e310)) - 1), clamped_lod_e310);
-            uint clamped_lod_e314 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 bounds1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e314), bounds.get_height(clamped_lod_e314)) - 1), clamped_lod_e314);
-            float lo_1 = metal::min(bounds0_.x, bounds1_.x);
-            float hi_1 = metal::max(bounds0_.y, bounds1_.y);
-            vis = 0.5;
-            float _e323 = d;
-            if (_e323 <= lo_1) {
-                vis = 1.0;
-            } else {
-                float _e326 = d;
-                if (_e326 > hi_1) {
-                    vis = 0.0;
-                } else {
-                    uint clamped_lod_e333 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e333 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e333), filtered.get_height(clamped_lod_e333)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e333);
-                    uint clamped_lod_e338 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e338 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e338), filtered.get_height(clamped_lod_e338)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e338);
-                    metal::float4 top0_ = metal::mix(_e333, _e338, fx);
-                    uint clamped_lod_e344 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e344 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e344), filtered.get_height(clamped_lod_e344)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e344);
-                    uint clamped_lod_e349 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e349 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e349), filtered.get_height(clamped_lod_e349)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e349);
-                    metal::float4 bottom0_ = metal::mix(_e344, _e349, fx);
-                    metal::float4 m0_ = metal::mix(top0_, bottom0_, fy_1);
-                    uint clamped_lod_e356 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e356 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e356), filtered.get_height(clamped_lod_e356)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e356);
-                    uint clamped_lod_e361 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e361 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e198)), metal::uint2(filtered.get_width(clamped_lod_e361), filtered.get_height(clamped_lod_e361)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e361);
-                    metal::float4 top1_ = metal::mix(_e356, _e361, fx);
-                    uint clamped_lod_e367 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e367 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e367), filtered.get_height(clamped_lod_e367)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e367);
-                    uint clamped_lod_e372 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e372 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e372), filtered.get_height(clamped_lod_e372)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e372);
-                    metal::float4 bottom1_ = metal::mix(_e367, _e372, fx);
-                    metal::float4 m1_ = metal::mix(top1_, bottom1_, fy_1);
-                    float _e376 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e217);
-                    vis = _e376;
-                }
-            }
-            float _e378 = total;
-            float _e379 = weight;
-            float _e380 = vis;
-            total = _e378 + (_e379 * metal::clamp(_e380, 0.0, 1.0));
-            if (is_last) {
-                break;
-            }
-        }
-    }
-    float l_2 = total;
-    metal::float3 c_1 = color * l_2;
-    output.write(metal::float4(c_1.x, c_1.y, c_1.z, 1.0), metal::uint2(metal::uint2(x_10, y_2)));
+    metal::float3 _e20 = scatter_pixel(id.x, id.y, frame, slices, depth, shadow_map, filtered, bounds, _buffer_sizes);
+    output.write(metal::float4(_e20.x, _e20.y, _e20.z, 1.0), metal::uint2(id.xy));
     return;
 }

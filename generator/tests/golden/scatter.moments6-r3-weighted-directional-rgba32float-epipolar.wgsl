@@ -97,35 +97,35 @@ fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_o
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_5: bool;
-    var local_6: bool;
-    var local_7: bool;
+    var local_1: bool;
+    var local_2: bool;
+    var local_3: bool;
 
     if !((uv.x < 0f)) {
-        local_5 = (uv.x > 1f);
+        local_1 = (uv.x > 1f);
     } else {
-        local_5 = true;
+        local_1 = true;
     }
-    let _e11 = local_5;
+    let _e11 = local_1;
     if !(_e11) {
-        local_6 = (uv.y < 0f);
+        local_2 = (uv.y < 0f);
     } else {
-        local_6 = true;
+        local_2 = true;
     }
-    let _e19 = local_6;
+    let _e19 = local_2;
     if !(_e19) {
-        local_7 = (uv.y > 1f);
+        local_3 = (uv.y > 1f);
     } else {
-        local_7 = true;
+        local_3 = true;
     }
-    let _e27 = local_7;
+    let _e27 = local_3;
     if _e27 {
         return 2f;
     }
     let n_1 = v_2.size.x;
-    let x_6 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
-    let y_1 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_6, y_1), 0i);
+    let x_7 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let y_2 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
+    let _e49 = textureLoad(sm, vec2<u32>(x_7, y_2), 0i);
     return _e49.x;
 }
 
@@ -143,17 +143,17 @@ fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga
 }
 
 fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_8: bool;
+    var local_4: bool;
 
     let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     let near = v_4.right.w;
     let far_1 = v_4.up.w;
     if (v_4.origin.w > 0.5f) {
-        local_8 = (_e2.z <= near);
+        local_4 = (_e2.z <= near);
     } else {
-        local_8 = false;
+        local_4 = false;
     }
-    let _e16 = local_8;
+    let _e16 = local_4;
     if _e16 {
         return 1f;
     }
@@ -199,29 +199,29 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_7 = (sigma_t * len);
-    if (x_7 < 0.0001f) {
-        return (len * (1f - (0.5f * x_7)));
+    let x_8 = (sigma_t * len);
+    if (x_8 < 0.0001f) {
+        return (len * (1f - (0.5f * x_8)));
     }
-    return ((1f - exp(-(x_7))) / sigma_t);
+    return ((1f - exp(-(x_8))) / sigma_t);
 }
 
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a_1: f32, b_1: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
-    return (exp((-(sigma_t_1) * a_1)) * _e7);
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
+    return (exp((-(sigma_t_1) * a)) * _e7);
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_8 * x_8) * (3f - (2f * x_8)));
+    let x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_9 * x_9) * (3f - (2f * x_9)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_9 = (eye + (dir * t));
-    let to_x = (x_9 - light_pos);
+    let x_10 = (eye + (dir * t));
+    let to_x = (x_10 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d_2 = sqrt(d2_);
     let travel = (to_x / vec3(d_2));
@@ -230,15 +230,15 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
-fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_2: f32, b_2: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
+fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
     var sum: f32 = 0f;
     var k: u32 = 0u;
     var q: u32;
 
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
-    let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_2 - a_2), 0.000001f)));
-    let g0_ = atan(((a_2 - t0_) / h));
-    let w_1 = ((atan(((b_2 - t0_) / h)) - g0_) / f32(panels));
+    let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
+    let g0_ = atan(((a_1 - t0_) / h));
+    let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k;
         if (_e30 < panels) {
@@ -278,11 +278,11 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     return (((_e75 * 0.5f) * w_1) * h);
 }
 
-fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_3: f32, b_3: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     let t0_1 = dot((light_pos_2 - eye_2), dir_2);
-    let h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001f * max((b_3 - a_3), 0.000001f)));
-    let theta_a = atan(((a_3 - t0_1) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_3 - t0_1) / h_1)) - theta_a) / f32(n)));
+    let h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001f * max((b_2 - a_2), 0.000001f)));
+    let theta_a = atan(((a_2 - t0_1) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / f32(n)));
 }
 
 fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x: f32) -> vec2<f32> {
@@ -294,8 +294,8 @@ fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> 
     return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
 }
 
-fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_1: f32, lo: f32, hi: f32) -> f32 {
-    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * clamp(((theta_1 - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
+fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta: f32, lo: f32, hi: f32) -> f32 {
+    return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * clamp(((theta - lo) / max((hi - lo), 0.000001f)), 0f, 1f)));
 }
 
 fn pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: u32, y: u32) -> vec3<f32> {
@@ -385,38 +385,38 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta_1: f32, theta_2: f32, s_1: f32, spot_1: bool) -> f32 {
-    var local_9: bool;
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
+    var local_5: bool;
 
     if spot_1 {
-        let psi = (x_2 * delta_1);
-        let den = sin((theta_2 + psi));
+        let psi = (x_2 * delta);
+        let den = sin((theta_1 + psi));
         if !((den <= 0.000001f)) {
-            local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_5 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_9 = true;
+            local_5 = true;
         }
-        let _e16 = local_9;
+        let _e16 = local_5;
         if _e16 {
             return s_1;
         }
         return min(((f_5.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_2 * delta_1) / max(sin(theta_2), 0.000001f)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_1), 0.000001f)), s_1);
     }
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_4, b_4, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
     return _e15;
 }
 
-fn moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_1: f32) -> f32 {
-    return ((2f * d_1) - 1f);
+fn moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d: f32) -> f32 {
+    return ((2f * d) - 1f);
 }
 
-fn biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw: vec4<f32>, a_5: f32) -> vec4<f32> {
-    return vec4<f32>((raw.x * (1f - a_5)), ((raw.y * (1f - a_5)) + (a_5 / 3f)), (raw.z * (1f - a_5)), ((raw.w * (1f - a_5)) + (a_5 / 5f)));
+fn biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw: vec4<f32>, a_4: f32) -> vec4<f32> {
+    return vec4<f32>((raw.x * (1f - a_4)), ((raw.y * (1f - a_4)) + (a_4 / 3f)), (raw.z * (1f - a_4)), ((raw.w * (1f - a_4)) + (a_4 / 5f)));
 }
 
 fn sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(x_3: f32, s_2: f32) -> f32 {
@@ -428,7 +428,7 @@ fn nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(q_1: f32) -> f32 {
 }
 
 fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3_: f32, c4_: f32) -> CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX {
-    var r_1: vec3<f32> = vec3(0f);
+    var r: vec3<f32> = vec3(0f);
     var k_2: u32 = 0u;
     var z_1: f32;
     var i: u32;
@@ -482,26 +482,26 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
             }
             let _e117 = k_2;
             let _e119 = z_1;
-            r_1[_e117] = _e119;
+            r[_e117] = _e119;
         }
         continuing {
             let _e121 = k_2;
             k_2 = (_e121 + 1u);
         }
     }
-    let _e124 = r_1.x;
-    let _e127 = r_1.z;
+    let _e124 = r.x;
+    let _e127 = r.z;
     if (abs(_e124) > abs(_e127)) {
-        let _e130 = r_1;
-        r_1 = _e130.zyx;
+        let _e130 = r;
+        r = _e130.zyx;
     }
-    let _e133 = r_1.y;
-    let _e136 = r_1.z;
+    let _e133 = r.y;
+    let _e136 = r.z;
     if (abs(_e133) > abs(_e136)) {
-        let _e139 = r_1;
-        r_1 = _e139.xzy;
+        let _e139 = r;
+        r = _e139.xzy;
     }
-    let _e141 = r_1;
+    let _e141 = r;
     return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e141, false);
 }
 
@@ -522,7 +522,7 @@ fn atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_: f32, b2_: f32, b
 
 fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw1_: vec2<f32>, zf: f32) -> f32 {
     var shadow: f32 = 0f;
-    var local_10: bool;
+    var local_6: bool;
 
     let _e3 = biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_, MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX);
     let b1_1 = _e3.x;
@@ -561,11 +561,11 @@ fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw
         shadow = (_e104 + _e110);
     }
     if !(at_infinity_1) {
-        local_10 = (r_3.z < zf);
+        local_6 = (r_3.z < zf);
     } else {
-        local_10 = false;
+        local_6 = false;
     }
-    let _e118 = local_10;
+    let _e118 = local_6;
     if _e118 {
         let _e119 = shadow;
         let _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.z, zf, r_3.x, (1f / (r_3.z - r_3.y)));
@@ -583,224 +583,229 @@ fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod
     return (f_8.e1_.w + ((f32(row) + 0.5f) * f_8.e2_.w));
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_2: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
     if spot_2 {
-        return ((r_2 * width) / regions);
+        return ((r_1 * width) / regions);
     }
-    return (((r_2 * r_2) * width) / (regions * regions));
+    return (((r_1 * r_1) * width) / (regions * regions));
 }
 
-@compute @workgroup_size(8, 8, 1) 
-fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
-    var local: bool;
-    var local_1: bool;
-    var local_2: bool;
-    var local_3: bool;
+fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
+    var local_7: bool;
+    var local_8: bool;
+    var local_9: bool;
     var yc: f32;
-    var d: f32;
+    var d_1: f32;
     var xs: f32;
-    var delta: f32 = 1f;
-    var theta: f32 = 0f;
+    var delta_1: f32 = 1f;
+    var theta_2: f32 = 0f;
     var total: f32 = 0f;
-    var r: u32 = 0u;
-    var local_4: bool;
-    var a: f32;
-    var b: f32;
+    var r_2: u32 = 0u;
+    var local_10: bool;
+    var a_5: f32;
+    var b_4: f32;
     var weight: f32;
     var vis: f32;
 
     let f_10 = frame;
-    let x_10 = id.x;
-    let y_2 = id.y;
-    if !((x_10 >= f_10.sizes.x)) {
-        local = (y_2 >= f_10.sizes.y);
-    } else {
-        local = true;
-    }
-    let _e18 = local;
-    if _e18 {
-        return;
-    }
     let eye_6 = f_10.eye.xyz;
-    let _e21 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_10, y_2);
-    let _e25 = textureLoad(depth, vec2<u32>(x_10, y_2), 0i);
-    let s_4 = (min(max(_e25.x, 0f), f_10.theta.z) / max(dot(_e21, f_10.cam_forward.xyz), 0.000001f));
+    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    let _e13 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
+    let s_4 = (min(max(_e13.x, 0f), f_10.theta.z) / max(dot(_e9, f_10.cam_forward.xyz), 0.000001f));
     let color = f_10.light_color.xyz;
-    let px = vec3<f32>((f32(x_10) + 0.5f), (f32(y_2) + 0.5f), 0f);
+    let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_10.epipole.w;
     if (f_10.epipole.z > 0.5f) {
-        local_1 = (length((px - vec3<f32>(f_10.epipole.x, f_10.epipole.y, 0f))) < radius);
+        local_7 = (length((px - vec3<f32>(f_10.epipole.x, f_10.epipole.y, 0f))) < radius);
     } else {
-        local_1 = false;
+        local_7 = false;
     }
-    let near_epi = local_1;
+    let near_epi = local_7;
     if (f_10.anti_epipole.z > 0.5f) {
-        local_2 = (length((px - vec3<f32>(f_10.anti_epipole.x, f_10.anti_epipole.y, 0f))) < radius);
+        local_8 = (length((px - vec3<f32>(f_10.anti_epipole.x, f_10.anti_epipole.y, 0f))) < radius);
     } else {
-        local_2 = false;
+        local_8 = false;
     }
-    let near_anti = local_2;
+    let near_anti = local_8;
     if !(near_epi) {
-        local_3 = near_anti;
+        local_9 = near_anti;
     } else {
-        local_3 = true;
+        local_9 = true;
     }
-    let _e88 = local_3;
-    if _e88 {
-        let _e90 = frame;
-        let _e93 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e90, shadow_map, eye_6, _e21, s_4, false);
-        let l_1 = (_e93 * color);
-        textureStore(output, vec2<u32>(x_10, y_2), vec4<f32>(l_1.x, l_1.y, l_1.z, 1f));
-        return;
+    let _e76 = local_9;
+    if _e76 {
+        let _e78 = frame;
+        let _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_6, _e9, s_4, false);
+        let l_1 = (_e81 * color);
+        return l_1;
     }
     let axis = f_10.axis.xyz;
     let rows_1 = f_10.sizes.w;
     let width_1 = f_10.sizes.z;
     let wrap_1 = (f_10.anti_epipole.w > 0.5f);
     {
-        theta = acos(clamp(dot(_e21, axis), -1f, 1f));
-        let phi_1 = atan2(dot(_e21, f_10.e2_.xyz), dot(_e21, f_10.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e9, axis), -1f, 1f));
+        let phi_1 = atan2(dot(_e9, f_10.e2_.xyz), dot(_e9, f_10.e1_.xyz));
         yc = ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
         if wrap_1 {
-            let _e132 = yc;
-            let _e133 = yc;
-            yc = (_e132 - (floor((_e133 / f32(rows_1))) * f32(rows_1)));
+            let _e113 = yc;
+            let _e114 = yc;
+            yc = (_e113 - (floor((_e114 / f32(rows_1))) * f32(rows_1)));
         } else {
-            let _e140 = yc;
-            yc = clamp(_e140, 0f, f32(rows_1));
+            let _e121 = yc;
+            yc = clamp(_e121, 0f, f32(rows_1));
         }
-        let _e144 = yc;
-        let yy = (_e144 - 0.5f);
+        let _e125 = yc;
+        let yy = (_e125 - 0.5f);
         let j0_ = floor(yy);
         let fy = (yy - j0_);
-        let _e149 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        let _e152 = slices[_e149];
-        let _e153 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e152);
-        let _e156 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1f), rows_1, wrap_1);
-        let _e159 = slices[_e156];
-        let _e160 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e159);
-        delta = mix(_e153.delta, _e160.delta, fy);
-        let _e165 = theta;
-        let _e170 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e165, f_10.theta.x, f_10.theta.y);
-        d = _e170;
+        let _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
+        let _e133 = slices[_e130];
+        let _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
+        let _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1f), rows_1, wrap_1);
+        let _e140 = slices[_e137];
+        let _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
+        delta_1 = mix(_e134.delta, _e141.delta, fy);
+        let _e146 = theta_2;
+        let _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_10.theta.x, f_10.theta.y);
+        d_1 = _e151;
         if false {
-            let q_3 = normalize(((eye_6 + (_e21 * s_4)) - f_10.light_pos.xyz));
-            let _e184 = delta;
-            xs = (acos(clamp(dot(q_3, -(axis)), -1f, 1f)) / _e184);
+            let q_3 = normalize(((eye_6 + (_e9 * s_4)) - f_10.light_pos.xyz));
+            let _e165 = delta_1;
+            xs = (acos(clamp(dot(q_3, -(axis)), -1f, 1f)) / _e165);
         } else {
-            let _e187 = theta;
-            let _e190 = delta;
-            xs = ((s_4 * sin(_e187)) / _e190);
+            let _e168 = theta_2;
+            let _e171 = delta_1;
+            xs = ((s_4 * sin(_e168)) / _e171);
         }
     }
-    let _e192 = yc;
-    let yb = (_e192 - 0.5f);
+    let _e173 = yc;
+    let yb = (_e173 - 0.5f);
     let fy_1 = (yb - floor(yb));
-    let _e198 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    let _e202 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
-    let row1_ = select(_e198, _e202, (yb > floor(yb)));
-    let cos_theta_l = -(dot(f_10.light_dir.xyz, _e21));
+    let _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    let _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
+    let row1_ = select(_e179, _e183, (yb > floor(yb)));
+    let cos_theta_l = -(dot(f_10.light_dir.xyz, _e9));
     let panels_2 = max((f_10.sizes2_.z / 4u), 1u);
-    let _e216 = d;
-    let _e217 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e216);
-    let _e222 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    let sun_scatter = (f_10.medium.y * _e222);
-    let _e224 = xs;
-    let last = u32(min(max(_e224, 0f), (f32(width_1) - 1f)));
+    let _e197 = d_1;
+    let _e198 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e197);
+    let _e203 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+    let sun_scatter = (f_10.medium.y * _e203);
+    let _e205 = xs;
+    let last = u32(min(max(_e205, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e234 = r;
-        if (_e234 < REGIONS) {
+        let _e215 = r_2;
+        if (_e215 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e236 = r;
-            let _e237 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e236, REGIONS, width_1, false);
-            let b0_ = f32(_e237);
-            let _e239 = r;
-            let _e242 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e239 + 1u), REGIONS, width_1, false);
-            let b1_2 = f32(_e242);
+            let _e217 = r_2;
+            let _e218 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e217, REGIONS, width_1, false);
+            let b0_ = f32(_e218);
+            let _e220 = r_2;
+            let _e223 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e220 + 1u), REGIONS, width_1, false);
+            let b1_2 = f32(_e223);
             if !((last < u32(b1_2))) {
-                let _e247 = r;
-                local_4 = ((_e247 + 1u) == REGIONS);
+                let _e228 = r_2;
+                local_10 = ((_e228 + 1u) == REGIONS);
             } else {
-                local_4 = true;
+                local_10 = true;
             }
-            let is_last = local_4;
-            let _e257 = xs;
-            let pos = select((b1_2 - 0.5f), clamp((_e257 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last);
-            a = f32();
-            b = f32();
-            let _e270 = delta;
-            let _e271 = theta;
-            let _e272 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e270, _e271, s_4, false);
-            a = _e272;
-            let _e273 = delta;
-            let _e274 = theta;
-            let _e275 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e273, _e274, s_4, false);
-            b = select(_e275, s_4, is_last);
+            let is_last = local_10;
+            let _e238 = xs;
+            let pos = select((b1_2 - 0.5f), clamp((_e238 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last);
+            a_5 = f32();
+            b_4 = f32();
+            let _e251 = delta_1;
+            let _e252 = theta_2;
+            let _e253 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e251, _e252, s_4, false);
+            a_5 = _e253;
+            let _e254 = delta_1;
+            let _e255 = theta_2;
+            let _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e254, _e255, s_4, false);
+            b_4 = select(_e256, s_4, is_last);
             weight = f32();
             if false {
-                let _e279 = a;
-                let _e280 = b;
-                let _e281 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e21, _e279, _e280, panels_2);
-                weight = _e281;
+                let _e260 = a_5;
+                let _e261 = b_4;
+                let _e262 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e9, _e260, _e261, panels_2);
+                weight = _e262;
             } else {
-                let _e284 = a;
-                let _e285 = b;
-                let _e286 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e284, _e285);
-                weight = (sun_scatter * _e286);
+                let _e265 = a_5;
+                let _e266 = b_4;
+                let _e267 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e265, _e266);
+                weight = (sun_scatter * _e267);
             }
             let xb = (pos - 0.5f);
             let fx = (xb - floor(xb));
             let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
             let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
-            let bounds0_ = textureLoad(bounds, vec2<u32>(x1_, _e198), 0i);
+            let bounds0_ = textureLoad(bounds, vec2<u32>(x1_, _e179), 0i);
             let bounds1_ = textureLoad(bounds, vec2<u32>(x1_, row1_), 0i);
             let lo_1 = min(bounds0_.x, bounds1_.x);
             let hi_1 = max(bounds0_.y, bounds1_.y);
             vis = 0.5f;
-            let _e323 = d;
-            if (_e323 <= lo_1) {
+            let _e304 = d_1;
+            if (_e304 <= lo_1) {
                 vis = 1f;
             } else {
-                let _e326 = d;
-                if (_e326 > hi_1) {
+                let _e307 = d_1;
+                if (_e307 > hi_1) {
                     vis = 0f;
                 } else {
-                    let _e333 = textureLoad(filtered, vec2<u32>(x0_, _e198), 0i, 0i);
-                    let _e338 = textureLoad(filtered, vec2<u32>(x1_, _e198), 0i, 0i);
-                    let top0_ = mix(_e333, _e338, fx);
-                    let _e344 = textureLoad(filtered, vec2<u32>(x0_, row1_), 0i, 0i);
-                    let _e349 = textureLoad(filtered, vec2<u32>(x1_, row1_), 0i, 0i);
-                    let bottom0_ = mix(_e344, _e349, fx);
+                    let _e314 = textureLoad(filtered, vec2<u32>(x0_, _e179), 0i, 0i);
+                    let _e319 = textureLoad(filtered, vec2<u32>(x1_, _e179), 0i, 0i);
+                    let top0_ = mix(_e314, _e319, fx);
+                    let _e325 = textureLoad(filtered, vec2<u32>(x0_, row1_), 0i, 0i);
+                    let _e330 = textureLoad(filtered, vec2<u32>(x1_, row1_), 0i, 0i);
+                    let bottom0_ = mix(_e325, _e330, fx);
                     let m0_ = mix(top0_, bottom0_, fy_1);
-                    let _e356 = textureLoad(filtered, vec2<u32>(x0_, _e198), 1i, 0i);
-                    let _e361 = textureLoad(filtered, vec2<u32>(x1_, _e198), 1i, 0i);
-                    let top1_ = mix(_e356, _e361, fx);
-                    let _e367 = textureLoad(filtered, vec2<u32>(x0_, row1_), 1i, 0i);
-                    let _e372 = textureLoad(filtered, vec2<u32>(x1_, row1_), 1i, 0i);
-                    let bottom1_ = mix(_e367, _e372, fx);
+                    let _e337 = textureLoad(filtered, vec2<u32>(x0_, _e179), 1i, 0i);
+                    let _e342 = textureLoad(filtered, vec2<u32>(x1_, _e179), 1i, 0i);
+                    let top1_ = mix(_e337, _e342, fx);
+                    let _e348 = textureLoad(filtered, vec2<u32>(x0_, row1_), 1i, 0i);
+                    let _e353 = textureLoad(filtered, vec2<u32>(x1_, row1_), 1i, 0i);
+                    let bottom1_ = mix(_e348, _e353, fx);
                     let m1_ = mix(top1_, bottom1_, fy_1);
-                    let _e376 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e217);
-                    vis = _e376;
+                    let _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e198);
+                    vis = _e357;
                 }
             }
-            let _e378 = total;
-            let _e379 = weight;
-            let _e380 = vis;
-            total = (_e378 + (_e379 * clamp(_e380, 0f, 1f)));
+            let _e359 = total;
+            let _e360 = weight;
+            let _e361 = vis;
+            total = (_e359 + (_e360 * clamp(_e361, 0f, 1f)));
             if is_last {
                 break;
             }
         }
         continuing {
-            let _e387 = r;
-            r = (_e387 + 1u);
+            let _e368 = r_2;
+            r_2 = (_e368 + 1u);
         }
     }
     let l_2 = total;
     let c_1 = (color * l_2);
-    textureStore(output, vec2<u32>(x_10, y_2), vec4<f32>(c_1.x, c_1.y, c_1.z, 1f));
+    return c_1;
+}
+
+@compute @workgroup_size(8, 8, 1) 
+fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
+    var local: bool;
+
+    let _e5 = frame.sizes.x;
+    if !((id.x >= _e5)) {
+        let _e12 = frame.sizes.y;
+        local = (id.y >= _e12);
+    } else {
+        local = true;
+    }
+    let _e17 = local;
+    if _e17 {
+        return;
+    }
+    let _e20 = scatter_pixel(id.x, id.y);
+    textureStore(output, id.xy, vec4<f32>(_e20.x, _e20.y, _e20.z, 1f));
     return;
 }
