@@ -320,8 +320,9 @@ fn other_families_dir() -> &'static Path {
     })
 }
 
-/// The raymarch trial variants: plain directional, interleaved and jittered spot.
-fn raymarch_variants() -> [RaymarchVariant; 2] {
+/// The raymarch trial variants: plain directional, interleaved and jittered spot, and
+/// `sampling = lowres` (scale 2) spot: the sampled dispatch and workgroup memory.
+fn raymarch_variants() -> [RaymarchVariant; 3] {
     [
         RaymarchVariant::default(),
         RaymarchVariant {
@@ -329,6 +330,11 @@ fn raymarch_variants() -> [RaymarchVariant; 2] {
             interleave: 2,
             jitter: true,
             light: LightKind::Spot,
+            ..RaymarchVariant::default()
+        },
+        RaymarchVariant {
+            light: LightKind::Spot,
+            sampling: scatter_frame::sampling::Sampling::Lowres,
             ..RaymarchVariant::default()
         },
     ]
