@@ -1464,6 +1464,23 @@ pub fn tune_candidates() -> Vec<Method> {
     }
     out.push(Method::minmax_default());
     out.push(Method::new(MinmaxVariant::default(), Some([256, 256])));
+    // Issue 14: fewer samples than pixels, for every family.
+    let sampled: Vec<FamilyVariant> = vec![
+        PrefilteredVariant::default().into(),
+        PrefilteredVariant::with_moments(4).into(),
+        RaymarchVariant::default().into(),
+        RaymarchVariant {
+            samples: 128,
+            ..RaymarchVariant::default()
+        }
+        .into(),
+        MinmaxVariant::default().into(),
+    ];
+    for base in sampled {
+        for scale in SamplingKnobs::SCALES {
+            out.push(Method::from(base.with_sampling(SamplingKnobs::lowres(scale))));
+        }
+    }
     out
 }
 
