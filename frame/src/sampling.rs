@@ -122,11 +122,16 @@ impl SamplingKnobs {
     pub const DEFAULT_SCALE: u32 = 2;
     /// Allowed `depth_break` (percent).
     pub const DEPTH_BREAK: std::ops::RangeInclusive<u32> = 1..=50;
-    /// `depth_break` when not chosen (percent; measured in the bench's sweep).
-    pub const DEFAULT_DEPTH_BREAK: u32 = 5;
+    /// `depth_break` when not chosen (percent). Measured (raymarch N = 64 at scale 4, the 24
+    /// suite poses at 320x180, light break 20): 2 / 5 / 10 % gave a mean rel L1 of 1.17 /
+    /// 1.19 / 1.18 % with 19.5 / 5.5 / 1.8 % of the pixels evaluated for depth: 10 % is as
+    /// accurate for the fewest evaluations.
+    pub const DEFAULT_DEPTH_BREAK: u32 = 10;
     /// Allowed `light_break` (percent).
     pub const LIGHT_BREAK: std::ops::RangeInclusive<u32> = 1..=100;
-    /// `light_break` when not chosen (percent; measured in the bench's sweep).
+    /// `light_break` when not chosen (percent). Measured as `depth_break` (depth break 5):
+    /// 10 / 20 / 40 / 100 % gave 1.18 / 1.19 / 1.24 / 1.78 % with 7.7 / 4.2 / 2.2 / 0 % of
+    /// the pixels evaluated for light; per pixel 1.04 %.
     pub const DEFAULT_LIGHT_BREAK: u32 = 20;
 
     /// `lowres` at `scale`, the depth break at its default.
@@ -283,7 +288,7 @@ mod tests {
     #[test]
     fn ids_and_grids() {
         assert_eq!(SamplingKnobs::default().id_suffix(), "");
-        assert_eq!(SamplingKnobs::lowres(4).id_suffix(), "-lowres4-b5-l20");
+        assert_eq!(SamplingKnobs::lowres(4).id_suffix(), "-lowres4-b10-l20");
         assert_eq!(SamplingKnobs::lowres(2).marker_suffix(), "-lr2");
         assert_eq!(SamplingKnobs::lowres(2).grid_size([67, 37]), [34, 19]);
         assert_eq!(SamplingKnobs::lowres(4).grid_size([67, 37]), [18, 10]);

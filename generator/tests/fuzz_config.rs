@@ -513,7 +513,7 @@ fn valid_value(name: &str, pick: usize) -> String {
         // `lowres` with an interleaving raymarch) they are rejected.
         "sampling" => &["\"pixels\""],
         "scale" => &["2"],
-        "depth_break" => &["5"],
+        "depth_break" => &["10"],
         "light_break" => &["20"],
         _ => &["1"],
     };
