@@ -28,7 +28,7 @@
 #import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, slice_params, spot_segment}
 #import scatter::minmax::{level_offset, tree_levels}
 {%- if sampling.lowres %}
-#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps}
+#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}
 {%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: Frame;

@@ -31,7 +31,7 @@
 #import scatter::shadow::shadow_visibility
 #import scatter::raymarch::{RaymarchFrame, raymarch_pixel_dir, raymarch_shadow_view, pixel_jitter}
 {%- if sampling.lowres %}
-#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps}
+#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}
 {%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: RaymarchFrame;

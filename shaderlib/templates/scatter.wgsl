@@ -70,7 +70,7 @@
 #import scatter::prefiltered_projective::proj_column
 {%- endif %}
 {%- if sampling.lowres %}
-#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps}
+#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}
 {%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: Frame;

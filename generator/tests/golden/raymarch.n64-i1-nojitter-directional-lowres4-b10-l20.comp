@@ -226,6 +226,14 @@ uvec2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2 i, uvec2 s
     return min((i * scale_1), (screen_1 - uvec2(1u, 1u)));
 }
 
+vec3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec3 v_5) {
+    vec3 a_3 = min(abs(v_5), vec3(65504.0));
+    uvec3 u_1 = floatBitsToUint(a_3);
+    vec3 normal = uintBitsToFloat((((u_1 + uvec3(4095u)) + ((u_1 >> uvec3(13u)) & uvec3(1u))) & uvec3(4294959104u)));
+    vec3 subnormal = (roundEven((a_3 * 16777216.0)) / vec3(16777216.0));
+    return (sign(v_5) * mix(normal, subnormal, lessThan(a_3, vec3(6.1035156e-5))));
+}
+
 LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2 p_2, uvec2 screen_2, uint scale_2) {
     LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
     uvec2 _e2 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, scale_2);
@@ -423,8 +431,8 @@ void main() {
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e49 = k;
-            k = (_e49 + 64u);
+            uint _e50 = k;
+            k = (_e50 + 64u);
         }
         loop_init_2 = false;
         uint _e18 = k;
@@ -439,11 +447,12 @@ void main() {
             uvec2 _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i_1, screen_3, SCALE);
             uint _e37 = k;
             vec3 _e41 = raymarch_pixel(_e35.x, _e35.y);
-            tile_light[_e37] = _e41;
-            uint _e43 = k;
-            int _e47_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
-            vec4 _e47 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(_e35), ivec2(0), textureSize(_group_0_binding_1_cs, _e47_clamped_lod) - ivec2(1)), _e47_clamped_lod);
-            tile_depth[_e43] = _e47.x;
+            vec3 _e42 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e41);
+            tile_light[_e37] = _e42;
+            uint _e44 = k;
+            int _e48_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+            vec4 _e48 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(_e35), ivec2(0), textureSize(_group_0_binding_1_cs, _e48_clamped_lod) - ivec2(1)), _e48_clamped_lod);
+            tile_depth[_e44] = _e48.x;
         }
     }
     memoryBarrierShared();
@@ -451,65 +460,65 @@ void main() {
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e148 = k_1;
-            k_1 = (_e148 + 1u);
+            uint _e149 = k_1;
+            k_1 = (_e149 + 1u);
         }
         loop_init_3 = false;
-        uint _e53 = k_1;
-        if ((_e53 < 16u)) {
+        uint _e54 = k_1;
+        if ((_e54 < 16u)) {
         } else {
             break;
         }
         {
-            uint _e57 = k_1;
-            uint e_2 = (li + (64u * _e57));
+            uint _e58 = k_1;
+            uint e_2 = (li + (64u * _e58));
             uvec2 q_1 = ((origin * SCALE) + uvec2((e_2 % 32u), (e_2 / 32u)));
             if ((q_1.x < screen_3.x)) {
                 local = (q_1.y < screen_3.y);
             } else {
                 local = false;
             }
-            bool _e77 = local;
-            if (_e77) {
-                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e79 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
+            bool _e78 = local;
+            if (_e78) {
+                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e80 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
                 depths = vec4(0.0, 0.0, 0.0, 0.0);
                 light = vec3[4](vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0));
                 j = 0u;
                 bool loop_init_4 = true;
                 while(true) {
                     if (!loop_init_4) {
-                        uint _e121 = j;
-                        j = (_e121 + 1u);
+                        uint _e122 = j;
+                        j = (_e122 + 1u);
                     }
                     loop_init_4 = false;
-                    uint _e90 = j;
-                    if ((_e90 < 4u)) {
+                    uint _e91 = j;
+                    if ((_e91 < 4u)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e94 = j;
-                        uint _e99 = j;
-                        uvec2 s_1 = (uvec2(_e79.cols[(_e94 % 2u)], _e79.rows[(_e99 / 2u)]) - origin);
+                        uint _e95 = j;
+                        uint _e100 = j;
+                        uvec2 s_1 = (uvec2(_e80.cols[(_e95 % 2u)], _e80.rows[(_e100 / 2u)]) - origin);
                         uint at = ((s_1.y * 9u) + s_1.x);
-                        uint _e110 = j;
-                        float _e114 = tile_depth[at];
-                        depths[_e110] = _e114;
-                        uint _e115 = j;
-                        vec3 _e119 = tile_light[at];
-                        light[_e115] = _e119;
+                        uint _e111 = j;
+                        float _e115 = tile_depth[at];
+                        depths[_e111] = _e115;
+                        uint _e116 = j;
+                        vec3 _e120 = tile_light[at];
+                        light[_e116] = _e120;
                     }
                 }
-                vec4 _e124 = depths;
-                vec3 _e125[4] = light;
-                int _e128_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
-                vec4 _e128 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q_1), ivec2(0), textureSize(_group_0_binding_1_cs, _e128_clamped_lod) - ivec2(1)), _e128_clamped_lod);
-                vec4 _e132 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e79.w, _e124, _e125, _e128.x, DEPTH_BREAK, LIGHT_BREAK);
-                if ((_e132.w == 0.0)) {
-                    uint _e138 = atomicAdd(refine_count, 1u);
-                    refine[_e138] = (q_1.x | (q_1.y << 16u));
+                vec4 _e125 = depths;
+                vec3 _e126[4] = light;
+                int _e129_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+                vec4 _e129 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q_1), ivec2(0), textureSize(_group_0_binding_1_cs, _e129_clamped_lod) - ivec2(1)), _e129_clamped_lod);
+                vec4 _e133 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e80.w, _e125, _e126, _e129.x, DEPTH_BREAK, LIGHT_BREAK);
+                if ((_e133.w == 0.0)) {
+                    uint _e139 = atomicAdd(refine_count, 1u);
+                    refine[_e139] = (q_1.x | (q_1.y << 16u));
                 } else {
-                    imageStore(_group_0_binding_3_cs, ivec2(q_1), _e132);
+                    imageStore(_group_0_binding_3_cs, ivec2(q_1), _e133);
                 }
             }
         }
@@ -521,23 +530,23 @@ void main() {
     bool loop_init_5 = true;
     while(true) {
         if (!loop_init_5) {
-            uint _e177 = e;
-            e = (_e177 + 64u);
+            uint _e178 = e;
+            e = (_e178 + 64u);
         }
         loop_init_5 = false;
-        uint _e153 = e;
-        if ((_e153 < n_3)) {
+        uint _e154 = e;
+        if ((_e154 < n_3)) {
         } else {
             break;
         }
         {
-            uint _e156 = e;
-            uint _e158 = refine[_e156];
-            uint _e162 = e;
-            uint _e164 = refine[_e162];
-            uvec2 q_2 = uvec2((_e158 & 65535u), (_e164 >> 16u));
-            vec3 _e170 = raymarch_pixel(q_2.x, q_2.y);
-            imageStore(_group_0_binding_3_cs, ivec2(q_2), vec4(_e170.x, _e170.y, _e170.z, 1.0));
+            uint _e157 = e;
+            uint _e159 = refine[_e157];
+            uint _e163 = e;
+            uint _e165 = refine[_e163];
+            uvec2 q_2 = uvec2((_e159 & 65535u), (_e165 >> 16u));
+            vec3 _e171 = raymarch_pixel(q_2.x, q_2.y);
+            imageStore(_group_0_binding_3_cs, ivec2(q_2), vec4(_e171.x, _e171.y, _e171.z, 1.0));
         }
     }
     return;

@@ -268,6 +268,15 @@ uint2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uint2 i, uint2 s
     return min((i * scale_1), (screen_1 - uint2(1u, 1u)));
 }
 
+float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 v_5)
+{
+    float3 a_3 = min(abs(v_5), (65504.0).xxx);
+    uint3 u_1 = asuint(a_3);
+    float3 normal = asfloat((((u_1 + (4095u).xxx) + ((u_1 >> (13u).xxx) & (1u).xxx)) & (4294959104u).xxx));
+    float3 subnormal = (round((a_3 * 16777216.0)) / (16777216.0).xxx);
+    return (sign(v_5) * ((a_3 < (6.1035156e-5).xxx) ? subnormal : normal));
+}
+
 LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uint2 p_2, uint2 screen_2, uint scale_2)
 {
     LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = (LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
@@ -495,8 +504,8 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e49 = k;
-            k = (_e49 + 64u);
+            uint _e50 = k;
+            k = (_e50 + 64u);
         }
         loop_init_2 = false;
         uint _e18 = k;
@@ -511,10 +520,11 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             const uint2 _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i_1, screen_3, SCALE);
             uint _e37 = k;
             const float3 _e41 = raymarch_pixel(_e35.x, _e35.y);
-            tile_light[min(uint(_e37), 80u)] = _e41;
-            uint _e43 = k;
-            float4 _e47 = depth.Load(int3(_e35, int(0)));
-            tile_depth[min(uint(_e43), 80u)] = _e47.x;
+            const float3 _e42 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e41);
+            tile_light[min(uint(_e37), 80u)] = _e42;
+            uint _e44 = k;
+            float4 _e48 = depth.Load(int3(_e35, int(0)));
+            tile_depth[min(uint(_e44), 80u)] = _e48.x;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -524,27 +534,27 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e148 = k_1;
-            k_1 = (_e148 + 1u);
+            uint _e149 = k_1;
+            k_1 = (_e149 + 1u);
         }
         loop_init_3 = false;
-        uint _e53 = k_1;
-        if ((_e53 < 16u)) {
+        uint _e54 = k_1;
+        if ((_e54 < 16u)) {
         } else {
             break;
         }
         {
-            uint _e57 = k_1;
-            uint e_2 = (li + (64u * _e57));
+            uint _e58 = k_1;
+            uint e_2 = (li + (64u * _e58));
             uint2 q_1 = ((origin * SCALE) + uint2(naga_mod(e_2, 32u), naga_div(e_2, 32u)));
             if ((q_1.x < screen_3.x)) {
                 local = (q_1.y < screen_3.y);
             } else {
                 local = false;
             }
-            bool _e77 = local;
-            if (_e77) {
-                const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e79 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
+            bool _e78 = local;
+            if (_e78) {
+                const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e80 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
                 depths = float4(0.0, 0.0, 0.0, 0.0);
                 light = ZeroValuearray4_float3_();
                 j = 0u;
@@ -554,37 +564,37 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
                     loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
                     if (!loop_init_4) {
-                        uint _e121 = j;
-                        j = (_e121 + 1u);
+                        uint _e122 = j;
+                        j = (_e122 + 1u);
                     }
                     loop_init_4 = false;
-                    uint _e90 = j;
-                    if ((_e90 < 4u)) {
+                    uint _e91 = j;
+                    if ((_e91 < 4u)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e94 = j;
-                        uint _e99 = j;
-                        uint2 s_1 = (uint2(_e79.cols[min(uint(naga_mod(_e94, 2u)), 1u)], _e79.rows[min(uint(naga_div(_e99, 2u)), 1u)]) - origin);
+                        uint _e95 = j;
+                        uint _e100 = j;
+                        uint2 s_1 = (uint2(_e80.cols[min(uint(naga_mod(_e95, 2u)), 1u)], _e80.rows[min(uint(naga_div(_e100, 2u)), 1u)]) - origin);
                         uint at = ((s_1.y * 9u) + s_1.x);
-                        uint _e110 = j;
-                        float _e114 = tile_depth[min(uint(at), 80u)];
-                        depths[min(uint(_e110), 3u)] = _e114;
-                        uint _e115 = j;
-                        float3 _e119 = tile_light[min(uint(at), 80u)];
-                        light[min(uint(_e115), 3u)] = _e119;
+                        uint _e111 = j;
+                        float _e115 = tile_depth[min(uint(at), 80u)];
+                        depths[min(uint(_e111), 3u)] = _e115;
+                        uint _e116 = j;
+                        float3 _e120 = tile_light[min(uint(at), 80u)];
+                        light[min(uint(_e116), 3u)] = _e120;
                     }
                 }
-                float4 _e124 = depths;
-                float3 _e125[4] = light;
-                float4 _e128 = depth.Load(int3(q_1, int(0)));
-                const float4 _e132 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e79.w, _e124, _e125, _e128.x, DEPTH_BREAK, LIGHT_BREAK);
-                if ((_e132.w == 0.0)) {
-                    uint _e138; InterlockedAdd(refine_count, 1u, _e138);
-                    refine[min(uint(_e138), 1023u)] = (q_1.x | (q_1.y << 16u));
+                float4 _e125 = depths;
+                float3 _e126[4] = light;
+                float4 _e129 = depth.Load(int3(q_1, int(0)));
+                const float4 _e133 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e80.w, _e125, _e126, _e129.x, DEPTH_BREAK, LIGHT_BREAK);
+                if ((_e133.w == 0.0)) {
+                    uint _e139; InterlockedAdd(refine_count, 1u, _e139);
+                    refine[min(uint(_e139), 1023u)] = (q_1.x | (q_1.y << 16u));
                 } else {
-                    output[q_1] = _e132;
+                    output[q_1] = _e133;
                 }
             }
         }
@@ -598,23 +608,23 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e177 = e;
-            e = (_e177 + 64u);
+            uint _e178 = e;
+            e = (_e178 + 64u);
         }
         loop_init_5 = false;
-        uint _e153 = e;
-        if ((_e153 < n_3)) {
+        uint _e154 = e;
+        if ((_e154 < n_3)) {
         } else {
             break;
         }
         {
-            uint _e156 = e;
-            uint _e158 = refine[min(uint(_e156), 1023u)];
-            uint _e162 = e;
-            uint _e164 = refine[min(uint(_e162), 1023u)];
-            uint2 q_2 = uint2((_e158 & 65535u), (_e164 >> 16u));
-            const float3 _e170 = raymarch_pixel(q_2.x, q_2.y);
-            output[q_2] = float4(_e170.x, _e170.y, _e170.z, 1.0);
+            uint _e157 = e;
+            uint _e159 = refine[min(uint(_e157), 1023u)];
+            uint _e163 = e;
+            uint _e165 = refine[min(uint(_e163), 1023u)];
+            uint2 q_2 = uint2((_e159 & 65535u), (_e165 >> 16u));
+            const float3 _e171 = raymarch_pixel(q_2.x, q_2.y);
+            output[q_2] = float4(_e171.x, _e171.y, _e171.z, 1.0);
         }
     }
     return;

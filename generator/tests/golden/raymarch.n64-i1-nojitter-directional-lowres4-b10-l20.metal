@@ -297,6 +297,16 @@ metal::uint2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     return metal::min(i * scale_1, screen_1 - metal::uint2(1u, 1u));
 }
 
+metal::float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+    metal::float3 v_5
+) {
+    metal::float3 a_3 = metal::min(metal::abs(v_5), metal::float3(65504.0));
+    metal::uint3 u_1 = as_type<metal::uint3>(a_3);
+    metal::float3 normal = as_type<metal::float3>(((u_1 + metal::uint3(4095u)) + ((u_1 >> metal::uint3(13u)) & metal::uint3(1u))) & metal::uint3(4294959104u));
+    metal::float3 subnormal = metal::rint(a_3 * 16777216.0) / metal::float3(16777216.0);
+    return metal::sign(v_5) * metal::select(normal, subnormal, a_3 < metal::float3(0.000061035156));
+}
+
 LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::uint2 p_2,
     metal::uint2 screen_2,
@@ -542,8 +552,8 @@ kernel void raymarch(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e49 = k;
-            k = _e49 + 64u;
+            uint _e50 = k;
+            k = _e50 + 64u;
         }
         loop_init_2 = false;
         uint _e18 = k;
@@ -558,11 +568,12 @@ kernel void raymarch(
             metal::uint2 _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i_1, screen_3, SCALE);
             uint _e37 = k;
             metal::float3 _e41 = raymarch_pixel(_e35.x, _e35.y, frame, depth, shadow_map);
-            tile_light.inner[metal::min(unsigned(_e37), 80u)] = _e41;
-            uint _e43 = k;
-            uint clamped_lod_e47 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-            metal::float4 _e47 = depth.read(metal::min(metal::uint2(_e35), metal::uint2(depth.get_width(clamped_lod_e47), depth.get_height(clamped_lod_e47)) - 1), clamped_lod_e47);
-            tile_depth.inner[metal::min(unsigned(_e43), 80u)] = _e47.x;
+            metal::float3 _e42 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e41);
+            tile_light.inner[metal::min(unsigned(_e37), 80u)] = _e42;
+            uint _e44 = k;
+            uint clamped_lod_e48 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+            metal::float4 _e48 = depth.read(metal::min(metal::uint2(_e35), metal::uint2(depth.get_width(clamped_lod_e48), depth.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
+            tile_depth.inner[metal::min(unsigned(_e44), 80u)] = _e48.x;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
@@ -572,27 +583,27 @@ kernel void raymarch(
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e148 = k_1;
-            k_1 = _e148 + 1u;
+            uint _e149 = k_1;
+            k_1 = _e149 + 1u;
         }
         loop_init_3 = false;
-        uint _e53 = k_1;
-        if (_e53 < 16u) {
+        uint _e54 = k_1;
+        if (_e54 < 16u) {
         } else {
             break;
         }
         {
-            uint _e57 = k_1;
-            uint e_2 = li + (64u * _e57);
+            uint _e58 = k_1;
+            uint e_2 = li + (64u * _e58);
             metal::uint2 q_1 = (origin * SCALE) + metal::uint2(naga_mod(e_2, 32u), naga_div(e_2, 32u));
             if (q_1.x < screen_3.x) {
                 local = q_1.y < screen_3.y;
             } else {
                 local = false;
             }
-            bool _e77 = local;
-            if (_e77) {
-                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e79 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
+            bool _e78 = local;
+            if (_e78) {
+                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e80 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
                 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
                 light = type_9 {};
                 j = 0u;
@@ -602,38 +613,38 @@ kernel void raymarch(
                     if (metal::all(loop_bound_4 == uint2(0u))) { break; }
                     loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
                     if (!loop_init_4) {
-                        uint _e121 = j;
-                        j = _e121 + 1u;
+                        uint _e122 = j;
+                        j = _e122 + 1u;
                     }
                     loop_init_4 = false;
-                    uint _e90 = j;
-                    if (_e90 < 4u) {
+                    uint _e91 = j;
+                    if (_e91 < 4u) {
                     } else {
                         break;
                     }
                     {
-                        uint _e94 = j;
-                        uint _e99 = j;
-                        metal::uint2 s_1 = metal::uint2(_e79.cols[metal::min(unsigned(naga_mod(_e94, 2u)), 1u)], _e79.rows[metal::min(unsigned(naga_div(_e99, 2u)), 1u)]) - origin;
+                        uint _e95 = j;
+                        uint _e100 = j;
+                        metal::uint2 s_1 = metal::uint2(_e80.cols[metal::min(unsigned(naga_mod(_e95, 2u)), 1u)], _e80.rows[metal::min(unsigned(naga_div(_e100, 2u)), 1u)]) - origin;
                         uint at = (s_1.y * 9u) + s_1.x;
-                        uint _e110 = j;
-                        float _e114 = tile_depth.inner[metal::min(unsigned(at), 80u)];
-                        depths[metal::min(unsigned(_e110), 3u)] = _e114;
-                        uint _e115 = j;
-                        metal::float3 _e119 = tile_light.inner[metal::min(unsigned(at), 80u)];
-                        light.inner[metal::min(unsigned(_e115), 3u)] = _e119;
+                        uint _e111 = j;
+                        float _e115 = tile_depth.inner[metal::min(unsigned(at), 80u)];
+                        depths[metal::min(unsigned(_e111), 3u)] = _e115;
+                        uint _e116 = j;
+                        metal::float3 _e120 = tile_light.inner[metal::min(unsigned(at), 80u)];
+                        light.inner[metal::min(unsigned(_e116), 3u)] = _e120;
                     }
                 }
-                metal::float4 _e124 = depths;
-                type_9 _e125 = light;
-                uint clamped_lod_e128 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-                metal::float4 _e128 = depth.read(metal::min(metal::uint2(q_1), metal::uint2(depth.get_width(clamped_lod_e128), depth.get_height(clamped_lod_e128)) - 1), clamped_lod_e128);
-                metal::float4 _e132 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e79.w, _e124, _e125, _e128.x, DEPTH_BREAK, LIGHT_BREAK);
-                if (_e132.w == 0.0) {
-                    uint _e138 = metal::atomic_fetch_add_explicit(&refine_count, 1u, metal::memory_order_relaxed);
-                    refine.inner[metal::min(unsigned(_e138), 1023u)] = q_1.x | (q_1.y << 16u);
+                metal::float4 _e125 = depths;
+                type_9 _e126 = light;
+                uint clamped_lod_e129 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+                metal::float4 _e129 = depth.read(metal::min(metal::uint2(q_1), metal::uint2(depth.get_width(clamped_lod_e129), depth.get_height(clamped_lod_e129)) - 1), clamped_lod_e129);
+                metal::float4 _e133 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e80.w, _e125, _e126, _e129.x, DEPTH_BREAK, LIGHT_BREAK);
+                if (_e133.w == 0.0) {
+                    uint _e139 = metal::atomic_fetch_add_explicit(&refine_count, 1u, metal::memory_order_relaxed);
+                    refine.inner[metal::min(unsigned(_e139), 1023u)] = q_1.x | (q_1.y << 16u);
                 } else {
-                    output.write(_e132, metal::uint2(q_1));
+                    output.write(_e133, metal::uint2(q_1));
                 }
             }
         }
@@ -647,23 +658,23 @@ kernel void raymarch(
         if (metal::all(loop_bound_5 == uint2(0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e177 = e;
-            e = _e177 + 64u;
+            uint _e178 = e;
+            e = _e178 + 64u;
         }
         loop_init_5 = false;
-        uint _e153 = e;
-        if (_e153 < n_3) {
+        uint _e154 = e;
+        if (_e154 < n_3) {
         } else {
             break;
         }
         {
-            uint _e156 = e;
-            uint _e158 = refine.inner[metal::min(unsigned(_e156), 1023u)];
-            uint _e162 = e;
-            uint _e164 = refine.inner[metal::min(unsigned(_e162), 1023u)];
-            metal::uint2 q_2 = metal::uint2(_e158 & 65535u, _e164 >> 16u);
-            metal::float3 _e170 = raymarch_pixel(q_2.x, q_2.y, frame, depth, shadow_map);
-            output.write(metal::float4(_e170.x, _e170.y, _e170.z, 1.0), metal::uint2(q_2));
+            uint _e157 = e;
+            uint _e159 = refine.inner[metal::min(unsigned(_e157), 1023u)];
+            uint _e163 = e;
+            uint _e165 = refine.inner[metal::min(unsigned(_e163), 1023u)];
+            metal::uint2 q_2 = metal::uint2(_e159 & 65535u, _e165 >> 16u);
+            metal::float3 _e171 = raymarch_pixel(q_2.x, q_2.y, frame, depth, shadow_map);
+            output.write(metal::float4(_e171.x, _e171.y, _e171.z, 1.0), metal::uint2(q_2));
         }
     }
     return;

@@ -225,6 +225,14 @@ fn lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i: vec2<u32>, scree
     return min((i * scale_1), (screen_1 - vec2<u32>(1u, 1u)));
 }
 
+fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_5: vec3<f32>) -> vec3<f32> {
+    let a_3 = min(abs(v_5), vec3(65504f));
+    let u_1 = bitcast<vec3<u32>>(a_3);
+    let normal = bitcast<vec3<f32>>((((u_1 + vec3(4095u)) + ((u_1 >> vec3(13u)) & vec3(1u))) & vec3(4294959104u)));
+    let subnormal = (round((a_3 * 16777216f)) / vec3(16777216f));
+    return (sign(v_5) * select(normal, subnormal, (a_3 < vec3(0.000061035156f))));
+}
+
 fn lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(p_2: vec2<u32>, screen_2: vec2<u32>, scale_2: u32) -> LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     var t_1: LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
 
@@ -423,99 +431,100 @@ fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_ind
             let _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i_1, screen_3, SCALE);
             let _e37 = k;
             let _e41 = raymarch_pixel(_e35.x, _e35.y);
-            tile_light[_e37] = _e41;
-            let _e43 = k;
-            let _e47 = textureLoad(depth, _e35, 0i);
-            tile_depth[_e43] = _e47.x;
+            let _e42 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e41);
+            tile_light[_e37] = _e42;
+            let _e44 = k;
+            let _e48 = textureLoad(depth, _e35, 0i);
+            tile_depth[_e44] = _e48.x;
         }
         continuing {
-            let _e49 = k;
-            k = (_e49 + 64u);
+            let _e50 = k;
+            k = (_e50 + 64u);
         }
     }
     workgroupBarrier();
     loop {
-        let _e53 = k_1;
-        if (_e53 < 16u) {
+        let _e54 = k_1;
+        if (_e54 < 16u) {
         } else {
             break;
         }
         {
-            let _e57 = k_1;
-            let e_2 = (li + (64u * _e57));
+            let _e58 = k_1;
+            let e_2 = (li + (64u * _e58));
             let q_1 = ((origin * SCALE) + vec2<u32>((e_2 % 32u), (e_2 / 32u)));
             if (q_1.x < screen_3.x) {
                 local = (q_1.y < screen_3.y);
             } else {
                 local = false;
             }
-            let _e77 = local;
-            if _e77 {
-                let _e79 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
+            let _e78 = local;
+            if _e78 {
+                let _e80 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
                 depths = vec4<f32>(0f, 0f, 0f, 0f);
                 light = array<vec3<f32>, 4>();
                 j = 0u;
                 loop {
-                    let _e90 = j;
-                    if (_e90 < 4u) {
+                    let _e91 = j;
+                    if (_e91 < 4u) {
                     } else {
                         break;
                     }
                     {
-                        let _e94 = j;
-                        let _e99 = j;
-                        let s_1 = (vec2<u32>(_e79.cols[(_e94 % 2u)], _e79.rows[(_e99 / 2u)]) - origin);
+                        let _e95 = j;
+                        let _e100 = j;
+                        let s_1 = (vec2<u32>(_e80.cols[(_e95 % 2u)], _e80.rows[(_e100 / 2u)]) - origin);
                         let at = ((s_1.y * 9u) + s_1.x);
-                        let _e110 = j;
-                        let _e114 = tile_depth[at];
-                        depths[_e110] = _e114;
-                        let _e115 = j;
-                        let _e119 = tile_light[at];
-                        light[_e115] = _e119;
+                        let _e111 = j;
+                        let _e115 = tile_depth[at];
+                        depths[_e111] = _e115;
+                        let _e116 = j;
+                        let _e120 = tile_light[at];
+                        light[_e116] = _e120;
                     }
                     continuing {
-                        let _e121 = j;
-                        j = (_e121 + 1u);
+                        let _e122 = j;
+                        j = (_e122 + 1u);
                     }
                 }
-                let _e124 = depths;
-                let _e125 = light;
-                let _e128 = textureLoad(depth, q_1, 0i);
-                let _e132 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e79.w, _e124, _e125, _e128.x, DEPTH_BREAK, LIGHT_BREAK);
-                if (_e132.w == 0f) {
-                    let _e138 = atomicAdd((&refine_count), 1u);
-                    refine[_e138] = (q_1.x | (q_1.y << 16u));
+                let _e125 = depths;
+                let _e126 = light;
+                let _e129 = textureLoad(depth, q_1, 0i);
+                let _e133 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e80.w, _e125, _e126, _e129.x, DEPTH_BREAK, LIGHT_BREAK);
+                if (_e133.w == 0f) {
+                    let _e139 = atomicAdd((&refine_count), 1u);
+                    refine[_e139] = (q_1.x | (q_1.y << 16u));
                 } else {
-                    textureStore(output, q_1, _e132);
+                    textureStore(output, q_1, _e133);
                 }
             }
         }
         continuing {
-            let _e148 = k_1;
-            k_1 = (_e148 + 1u);
+            let _e149 = k_1;
+            k_1 = (_e149 + 1u);
         }
     }
     workgroupBarrier();
     let n_3 = atomicLoad((&refine_count));
     e = li;
     loop {
-        let _e153 = e;
-        if (_e153 < n_3) {
+        let _e154 = e;
+        if (_e154 < n_3) {
         } else {
             break;
         }
         {
-            let _e156 = e;
-            let _e158 = refine[_e156];
-            let _e162 = e;
-            let _e164 = refine[_e162];
-            let q_2 = vec2<u32>((_e158 & 65535u), (_e164 >> 16u));
-            let _e170 = raymarch_pixel(q_2.x, q_2.y);
-            textureStore(output, q_2, vec4<f32>(_e170.x, _e170.y, _e170.z, 1f));
+            let _e157 = e;
+            let _e159 = refine[_e157];
+            let _e163 = e;
+            let _e165 = refine[_e163];
+            let q_2 = vec2<u32>((_e159 & 65535u), (_e165 >> 16u));
+            let _e171 = raymarch_pixel(q_2.x, q_2.y);
+            textureStore(output, q_2, vec4<f32>(_e171.x, _e171.y, _e171.z, 1f));
         }
         continuing {
-            let _e177 = e;
-            e = (_e177 + 64u);
+            let _e178 = e;
+            e = (_e178 + 64u);
         }
     }
     return;

@@ -5,7 +5,7 @@
 //! per-pixel mirror calls with its pixel body.
 //! Conventions: `scatter_frame::sampling`.
 
-use super::texture::{Tex, TexArray, quantise};
+use super::texture::{Tex, TexArray, quantise, round_f16};
 use scatter_shaderlib::prefiltered::Storage;
 use scatter_shaderlib::sampling::{Sampling, SamplingKnobs};
 
@@ -24,6 +24,12 @@ pub fn lowres_pixel(i: [u32; 2], screen: [u32; 2], scale: u32) -> [u32; 2] {
 /// within `depth_break` (a fraction) of the nearer one.
 pub fn depth_close(a: f32, b: f32, depth_break: f32) -> bool {
     a == b || (a - b).abs() <= depth_break * a.min(b)
+}
+
+/// `v` rounded to f16 (to nearest, ties to even) as rgba16float stores it, clamped to f16's
+/// largest finite value (WGSL `round_f16`, which does it by bits).
+pub fn round_f16_rgb(v: [f32; 3]) -> [f32; 3] {
+    v.map(|c| round_f16(c.clamp(-65504.0, 65504.0)))
 }
 
 /// The four samples nearest to a pixel and their bilinear weights.
@@ -144,13 +150,13 @@ pub fn run_sampled(
     let scale = knobs.scale;
     let (depth_break, light_break) = (knobs.depth_break_fraction(), knobs.light_break_fraction());
     let grid = lowres_grid(screen, scale);
-    // Phase 1: every sample's radiance and its pixel's depth.
+    // Phase 1: every sample's radiance (rounded to f16) and its pixel's depth.
     let samples: Vec<([f32; 3], f32)> = (0..grid[1])
         .into_par_iter()
         .flat_map_iter(|j| {
             (0..grid[0]).map(move |i| {
                 let p = lowres_pixel([i, j], screen, scale);
-                (pixel(p[0], p[1]), depth.load(p[0], p[1]))
+                (round_f16_rgb(pixel(p[0], p[1])), depth.load(p[0], p[1]))
             })
         })
         .collect();
@@ -210,6 +216,26 @@ mod tests {
         assert_eq!(lowres_pixel([0, 0], [67, 37], 4), [0, 0]);
         assert_eq!(lowres_pixel([17, 9], [67, 37], 4), [66, 36]);
         assert_eq!(lowres_pixel([1, 1], [67, 37], 2), [2, 2]);
+    }
+
+    #[test]
+    fn f16_rounding_by_bits_matches() {
+        // The WGSL rounds by bits; check that scheme against `round_f16` here.
+        let by_bits = |v: f32| {
+            let a = v.abs().min(65504.0);
+            let u = a.to_bits();
+            let normal = f32::from_bits((u + 0xfff + ((u >> 13) & 1)) & 0xffff_e000);
+            let sub = (a * 16_777_216.0).round_ties_even() / 16_777_216.0;
+            v.signum() * if a < 6.103_515_6e-5 { sub } else { normal }
+        };
+        let mut x = 1.0e-9f32;
+        while x < 7.0e4 {
+            for v in [x, x * 1.000_03, x * 0.999_97, -x] {
+                assert_eq!(by_bits(v), round_f16_rgb([v; 3])[0], "{v:e}");
+            }
+            x *= 1.013;
+        }
+        assert_eq!(round_f16_rgb([1e6, 0.0, -1e6]), [65504.0, 0.0, -65504.0]);
     }
 
     #[test]

@@ -24,6 +24,20 @@ fn depth_close(a: f32, b: f32, depth_break: f32) -> bool {
     return a == b || abs(a - b) <= depth_break * min(a, b);
 }
 
+// `v` rounded to f16 (to nearest, ties to even), as rgba16float stores it, clamped to f16's
+// largest finite value. The samples are kept this way, so that a blend and the light
+// criterion see a sample as a per-pixel pass would store it. (By bits, not with
+// pack2x16float, which naga admits only with the SHADER_FLOAT16_IN_FLOAT32 capability.)
+fn round_f16(v: vec3<f32>) -> vec3<f32> {
+    let a = min(abs(v), vec3<f32>(65504.0));
+    // Normal f16 range: keep 10 of the 23 mantissa bits, rounding to nearest even.
+    let u = bitcast<vec3<u32>>(a);
+    let normal = bitcast<vec3<f32>>((u + vec3<u32>(0xfffu) + ((u >> vec3<u32>(13u)) & vec3<u32>(1u))) & vec3<u32>(0xffffe000u));
+    // Below 2^-14 f16 is subnormal: multiples of 2^-24 (`round` ties to even).
+    let subnormal = round(a * 16777216.0) / 16777216.0;
+    return sign(v) * select(normal, subnormal, a < vec3<f32>(6.103515625e-5));
+}
+
 // The four samples nearest to a pixel and their bilinear weights.
 struct LowresTaps {
     // Columns (x0, x1) and rows (y0, y1) of the samples (x0, y0), (x1, y0), (x0, y1),

@@ -12,7 +12,8 @@ var<workgroup> refine_count: atomic<u32>;
 
 // Sampling pass (`sampling = lowres`, scatter::sampling): workgroup `wid` owns the 8 x 8
 // blocks from block 8 wid. Phase 1: its invocations evaluate the 9 x 9 samples of those
-// blocks and the next ones (sample = the block's first pixel) into workgroup memory.
+// blocks and the next ones (sample = the block's first pixel) into workgroup memory,
+// rounded to f16 as a per-pixel pass would store them.
 // Phase 2: the invocations take the workgroup's 8 S x 8 S pixels, 64 neighbouring ones at a
 // time: each gets the blend of its taps (`lowres_blend`), or goes on the workgroup's list
 // where the taps cannot stand for it.
@@ -27,7 +28,7 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
     for (var k = li; k < 81u; k += 64u) {
         let i = min(origin + vec2<u32>(k % 9u, k / 9u), grid - vec2<u32>(1u, 1u));
         let p = lowres_pixel(i, screen, SCALE);
-        tile_light[k] = {{ sampling.entry }}_pixel(p.x, p.y);
+        tile_light[k] = round_f16({{ sampling.entry }}_pixel(p.x, p.y));
         tile_depth[k] = textureLoad(depth, p, 0).x;
     }
     workgroupBarrier();
