@@ -713,7 +713,9 @@ fn headline_runs(ctx: &Context, frames: u32, errors: bool) -> Result<Vec<Headlin
     // cheapest, at 1/2 and 1/4 of the screen per axis.
     for base in sampled_bases() {
         for scale in SamplingKnobs::SCALES {
-            methods.push(Method::from(base.with_sampling(SamplingKnobs::lowres(scale))));
+            methods.push(Method::from(
+                base.with_sampling(SamplingKnobs::lowres(scale)),
+            ));
         }
     }
     let screen = [1280, 720];
@@ -1478,7 +1480,9 @@ pub fn tune_candidates() -> Vec<Method> {
     ];
     for base in sampled {
         for scale in SamplingKnobs::SCALES {
-            out.push(Method::from(base.with_sampling(SamplingKnobs::lowres(scale))));
+            out.push(Method::from(
+                base.with_sampling(SamplingKnobs::lowres(scale)),
+            ));
         }
     }
     out

@@ -270,7 +270,10 @@ mod tests {
         assert!(SamplingKnobs::default().validate().is_ok());
         assert!(SamplingKnobs::lowres(2).validate().is_ok());
         assert!(SamplingKnobs::lowres(4).validate().is_ok());
-        assert_eq!(SamplingKnobs::lowres(3).validate().unwrap_err().knob, "scale");
+        assert_eq!(
+            SamplingKnobs::lowres(3).validate().unwrap_err().knob,
+            "scale"
+        );
         let pixels_scale = SamplingKnobs {
             scale: 4,
             ..SamplingKnobs::default()

@@ -54,7 +54,10 @@ fn every_suite_frame_is_accepted() {
                 };
                 prepare_raymarch(&r, [w, h], &camera, &light_desc, &medium, &shadow)
                     .unwrap_or_else(|e| panic!("{trial}: raymarch: {e}"));
-                let m = MinmaxVariant { light, ..MinmaxVariant::default() };
+                let m = MinmaxVariant {
+                    light,
+                    ..MinmaxVariant::default()
+                };
                 prepare_minmax(&m, &res, &camera, &light_desc, &medium, &shadow, &settings)
                     .unwrap_or_else(|e| panic!("{trial}: minmax: {e}"));
                 frames += 1;

@@ -15,10 +15,10 @@
 
 use std::time::{Duration, Instant};
 
-use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax, tree_width};
-use scatter_shaderlib::prefiltered::{PrefilteredFrame, Resolutions, SliceParams, Storage};
 use scatter_shaderlib::Kernel;
 use scatter_shaderlib::family::KernelFamily;
+use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax, tree_width};
+use scatter_shaderlib::prefiltered::{PrefilteredFrame, Resolutions, SliceParams, Storage};
 
 use crate::error::ErrorScopes;
 use crate::executor::Executor;

@@ -19,14 +19,14 @@
 
 use std::time::{Duration, Instant};
 
+use scatter_shaderlib::Kernel;
+use scatter_shaderlib::family::KernelFamily;
 use scatter_shaderlib::prefiltered::plan;
 use scatter_shaderlib::prefiltered::{
     CameraDesc, FrameReport, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame,
     PrefilteredVariant, Rectification, Resolutions, ShadowMapDesc, SliceParams, Storage,
     prepare_frame,
 };
-use scatter_shaderlib::Kernel;
-use scatter_shaderlib::family::KernelFamily;
 
 use crate::error::{ErrorScopes, check_limit};
 use crate::executor::Executor;

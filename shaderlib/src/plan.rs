@@ -346,21 +346,19 @@ pub fn eval(formula: &str, params: &[(&str, u64)]) -> Result<u64, String> {
     for term in formula.split('*') {
         let term = term.trim();
         // `ceil(a / b)`: integer division rounding up (a sample grid of the screen).
-        let factor = if let Some(inner) = term
-            .strip_prefix("ceil(")
-            .and_then(|t| t.strip_suffix(')'))
-        {
-            let (a, b) = inner
-                .split_once('/')
-                .ok_or_else(|| format!("formula `{formula}`: `ceil(` takes `a / b`"))?;
-            let (a, b) = (atom(a.trim())?, atom(b.trim())?);
-            if b == 0 {
-                return Err(format!("formula `{formula}` divides by zero"));
-            }
-            a.div_ceil(b)
-        } else {
-            atom(term)?
-        };
+        let factor =
+            if let Some(inner) = term.strip_prefix("ceil(").and_then(|t| t.strip_suffix(')')) {
+                let (a, b) = inner
+                    .split_once('/')
+                    .ok_or_else(|| format!("formula `{formula}`: `ceil(` takes `a / b`"))?;
+                let (a, b) = (atom(a.trim())?, atom(b.trim())?);
+                if b == 0 {
+                    return Err(format!("formula `{formula}` divides by zero"));
+                }
+                a.div_ceil(b)
+            } else {
+                atom(term)?
+            };
         value = value
             .checked_mul(factor)
             .ok_or_else(|| format!("formula `{formula}` overflows 64 bits"))?;

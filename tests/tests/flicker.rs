@@ -105,7 +105,10 @@ fn variants(light: LightKind) -> Vec<FamilyVariant> {
             ..RaymarchVariant::default()
         })
     }));
-    v.push(FamilyVariant::Minmax(MinmaxVariant { light, ..MinmaxVariant::default() }));
+    v.push(FamilyVariant::Minmax(MinmaxVariant {
+        light,
+        ..MinmaxVariant::default()
+    }));
     // Issue 14: each family's default at a quarter of the screen per axis (reported, NaN
     // checked): samples stay on fixed pixels, so the flicker of the upsample shows here.
     let sampled: Vec<FamilyVariant> = [v[0], v[3], v[v.len() - 1]]

@@ -86,7 +86,11 @@ fn trial_name(light: LightKind, pose: Pose, depth_scale: f32) -> String {
     };
     format!(
         "{}::{}::{pose}{tail}",
-        FamilyVariant::from(MinmaxVariant { light, ..MinmaxVariant::default() }).trial_name(),
+        FamilyVariant::from(MinmaxVariant {
+            light,
+            ..MinmaxVariant::default()
+        })
+        .trial_name(),
         scene_for(light)
     )
 }
@@ -108,7 +112,10 @@ fn f16_ulp(v: f32) -> f32 {
 }
 
 fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> {
-    let variant = MinmaxVariant { light: light_of(f), ..MinmaxVariant::default() };
+    let variant = MinmaxVariant {
+        light: light_of(f),
+        ..MinmaxVariant::default()
+    };
     let name = format!("{}::{}", variant.light, f.pose);
     let gpu = run_minmax_once(
         ctx,

@@ -177,9 +177,9 @@ fn stage_trial(
                 (at(q), 0.0)
             }
         };
-        let diff = (0..3)
-            .map(|k| (g[k] - c[k]).abs())
-            .fold(0.0f32, |m, v| if v.is_nan() { f32::INFINITY } else { m.max(v) });
+        let diff = (0..3).map(|k| (g[k] - c[k]).abs()).fold(0.0f32, |m, v| {
+            if v.is_nan() { f32::INFINITY } else { m.max(v) }
+        });
         worst = worst.max(diff);
         let ok = (0..3).all(|k| (g[k] - c[k]).abs() <= REL_TOL * max + f16_ulp(c[k]) + extra);
         if !ok {
@@ -439,10 +439,7 @@ fn main() -> ExitCode {
                             base.with_sampling(knobs).trial_name(),
                             scene_for(light)
                         );
-                        trials.push((
-                            name,
-                            Box::new(move || stage_trial(ctx, base, knobs, pose)),
-                        ));
+                        trials.push((name, Box::new(move || stage_trial(ctx, base, knobs, pose))));
                     }
                 }
             }
@@ -451,10 +448,7 @@ fn main() -> ExitCode {
     for &family in Family::ALL {
         for knobs in knobs() {
             let base = family.default_variant();
-            let name = format!(
-                "sampling::accuracy::{}",
-                base.with_sampling(knobs).label()
-            );
+            let name = format!("sampling::accuracy::{}", base.with_sampling(knobs).label());
             trials.push((name, Box::new(move || accuracy_trial(base, knobs))));
         }
     }

@@ -12,12 +12,15 @@ use scatter_shaderlib::sampling::{Sampling, SamplingKnobs};
 /// The sample grid of a screen at block side `scale`: samples at every S-th pixel from the
 /// first, and one on the last: ceil((screen - 1) / scale) + 1.
 pub fn lowres_grid(screen: [u32; 2], scale: u32) -> [u32; 2] {
-    screen.map(|s| (s - 1 + scale - 1) / scale + 1)
+    screen.map(|s| (s - 1).div_ceil(scale) + 1)
 }
 
 /// The pixel sample `i` stands on: the first pixel of block i, or the screen's last pixel.
 pub fn lowres_pixel(i: [u32; 2], screen: [u32; 2], scale: u32) -> [u32; 2] {
-    [(i[0] * scale).min(screen[0] - 1), (i[1] * scale).min(screen[1] - 1)]
+    [
+        (i[0] * scale).min(screen[0] - 1),
+        (i[1] * scale).min(screen[1] - 1),
+    ]
 }
 
 /// Whether two view depths lie on one surface: equal (sky pixels at +inf included), or
@@ -179,7 +182,8 @@ pub fn run_sampled(
                 match lowres_blend(t.w, depths, light, d, depth_break, light_break) {
                     Some(c) => (store(c), 0),
                     None => {
-                        let why = if lowres_blend(t.w, depths, light, d, depth_break, 1.0).is_none() {
+                        let why = if lowres_blend(t.w, depths, light, d, depth_break, 1.0).is_none()
+                        {
                             1
                         } else {
                             2
@@ -250,7 +254,12 @@ mod tests {
         // The last column: between the sample on column 6 and the one on the last pixel.
         let edge = lowres_taps([7, 3], [8, 8], 2);
         assert_eq!((edge.cols, edge.w), ([3, 4], [0.0, 0.5, 0.0, 0.5]));
-        let light = [[1.0, 1.0, 1.0], [1.1, 1.1, 1.1], [0.9, 0.9, 0.9], [1.0, 1.0, 1.0]];
+        let light = [
+            [1.0, 1.0, 1.0],
+            [1.1, 1.1, 1.1],
+            [0.9, 0.9, 0.9],
+            [1.0, 1.0, 1.0],
+        ];
         let c = lowres_blend(t.w, [10.0; 4], light, 10.0, 0.05, 0.25).expect("blends");
         assert!((c[0] - 1.0).abs() < 1e-6);
         // A near occluder: no tap is close in depth.
@@ -258,11 +267,28 @@ mod tests {
         // A shadow edge between the taps: their spread is over the light break.
         assert_eq!(lowres_blend(t.w, [10.0; 4], light, 10.0, 0.05, 0.1), None);
         // Only the taps close in depth count, for the blend and for the spread.
-        let c = lowres_blend(t.w, [10.0, 10.0, 2.0, 2.0], [[1.0; 3], [1.0; 3], [9.0; 3], [9.0; 3]], 10.0, 0.05, 0.1);
+        let c = lowres_blend(
+            t.w,
+            [10.0, 10.0, 2.0, 2.0],
+            [[1.0; 3], [1.0; 3], [9.0; 3], [9.0; 3]],
+            10.0,
+            0.05,
+            0.1,
+        );
         assert_eq!(c, Some([1.0; 3]));
         // Infinite depths are equal; a light break of 1 never refines.
         let inf = f32::INFINITY;
-        assert!(lowres_blend(t.w, [inf; 4], [[0.0; 3], [5.0; 3], [0.0; 3], [0.0; 3]], inf, 0.05, 1.0).is_some());
+        assert!(
+            lowres_blend(
+                t.w,
+                [inf; 4],
+                [[0.0; 3], [5.0; 3], [0.0; 3], [0.0; 3]],
+                inf,
+                0.05,
+                1.0
+            )
+            .is_some()
+        );
     }
 
     #[test]
@@ -278,7 +304,10 @@ mod tests {
         let px = run_sampled(&SamplingKnobs::default(), screen, &depth, &body);
         for scale in [2, 4] {
             let lr = run_sampled(&SamplingKnobs::lowres(scale), screen, &depth, &body);
-            assert!(lr.depth_refined > 0, "the one-pixel column is evaluated per pixel");
+            assert!(
+                lr.depth_refined > 0,
+                "the one-pixel column is evaluated per pixel"
+            );
             for (a, b) in px.output.data.iter().zip(&lr.output.data) {
                 for c in 0..3 {
                     assert!((a[c] - b[c]).abs() <= 0.1 * scale as f32, "{a:?} {b:?}");

@@ -2,14 +2,14 @@
 //! `slice_fit`, `rectify`, `minmax_build`, `minmax_traverse`). `scatter-gen` writes it into the manifest;
 //! `scatter-runtime` builds and dispatches from it.
 
+use crate::Kernel;
+use crate::family::KernelFamily;
 use crate::minmax::{MinmaxVariant, TREE_FORMAT};
 use crate::plan::{
     DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, SLICE_FIT_NOTE, TEXTURE_DIMENSION,
     bind, column_depth_buffer, depth_and_shadow_map, frame_buffer, scatter_texture,
     screen_and_shadow_parameters,
 };
-use crate::Kernel;
-use crate::family::KernelFamily;
 use crate::sampling::sampling_invocations;
 
 /// The resources and passes of a variant, as `runtime/src/minmax.rs` creates them.

@@ -2,6 +2,8 @@
 //! passes (`depth_columns`, `slice_fit`, `rectify`, `prefilter`, `scatter`). `scatter-gen` writes it into the manifest;
 //! `scatter-runtime` builds and dispatches from it.
 
+use crate::Kernel;
+use crate::family::KernelFamily;
 use crate::plan::{
     Alternative, BindingSource, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
     SAMPLED, SLICE_FIT_NOTE, STORAGE_AND_SAMPLED, TEXTURE_DIMENSION, bind, column_depth_buffer,
@@ -9,9 +11,7 @@ use crate::plan::{
     screen_and_shadow_parameters, texture_2d,
 };
 use crate::prefiltered::{Basis, PrefilteredVariant, Rectification};
-use crate::family::KernelFamily;
 use crate::sampling::sampling_invocations;
-use crate::Kernel;
 
 /// The per-frame condition of a projective frame (the frame set-up falls back to epipolar
 /// when the epipole is on screen).

@@ -10,8 +10,8 @@ use askama::Template;
 pub use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_raymarch};
 
 use crate::compose::template_path;
-use crate::sampling::SamplingView;
 use crate::prefiltered::LightKind;
+use crate::sampling::SamplingView;
 use crate::{Kernel, ShaderError};
 
 /// Workgroup size of `raymarch` and `interleave_sum`: one invocation per pixel.
