@@ -86,16 +86,6 @@ impl MinmaxVariant {
         self.sampling_knobs().validate()
     }
 
-    /// The sampling knobs.
-    pub fn sampling_knobs(&self) -> SamplingKnobs {
-        SamplingKnobs {
-            sampling: self.sampling,
-            scale: self.scale,
-            depth_break: self.depth_break,
-            light_break: self.light_break,
-        }
-    }
-
     /// A short stable id: `directional`, `spot`, `spot-lowres2-b5`.
     pub fn id(&self) -> String {
         format!("{}{}", self.light.name(), self.sampling_knobs().id_suffix())
@@ -123,6 +113,8 @@ impl MinmaxVariant {
         }
     }
 }
+
+crate::sampling::sampling_fields!(MinmaxVariant);
 
 impl fmt::Display for MinmaxVariant {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -229,13 +221,7 @@ impl KnobSet for MinmaxVariant {
     }
 
     fn with_sampling(self, s: SamplingKnobs) -> Self {
-        Self {
-            sampling: s.sampling,
-            scale: s.scale,
-            depth_break: s.depth_break,
-            light_break: s.light_break,
-            ..self
-        }
+        self.with_sampling_knobs(s)
     }
 
     fn grid() -> Vec<Self> {

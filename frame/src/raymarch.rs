@@ -109,16 +109,6 @@ impl RaymarchVariant {
         Ok(())
     }
 
-    /// The sampling knobs.
-    pub fn sampling_knobs(&self) -> SamplingKnobs {
-        SamplingKnobs {
-            sampling: self.sampling,
-            scale: self.scale,
-            depth_break: self.depth_break,
-            light_break: self.light_break,
-        }
-    }
-
     /// Whether the variant has the `interleave_sum` passes.
     pub fn interleaved(&self) -> bool {
         self.interleave > 1
@@ -161,6 +151,8 @@ impl RaymarchVariant {
         out
     }
 }
+
+crate::sampling::sampling_fields!(RaymarchVariant);
 
 impl fmt::Display for RaymarchVariant {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -332,13 +324,7 @@ impl KnobSet for RaymarchVariant {
     }
 
     fn with_sampling(self, s: SamplingKnobs) -> Self {
-        Self {
-            sampling: s.sampling,
-            scale: s.scale,
-            depth_break: s.depth_break,
-            light_break: s.light_break,
-            ..self
-        }
+        self.with_sampling_knobs(s)
     }
 
     fn grid() -> Vec<Self> {

@@ -261,6 +261,39 @@ impl SamplingKnobs {
     }
 }
 
+/// Implements, for a variant type with the fields `sampling`, `scale`, `depth_break` and
+/// `light_break`, `sampling_knobs` (those fields as [`SamplingKnobs`]) and
+/// `with_sampling_knobs`.
+macro_rules! sampling_fields {
+    ($t:ty) => {
+        impl $t {
+            /// The sampling knobs.
+            pub fn sampling_knobs(&self) -> $crate::sampling::SamplingKnobs {
+                $crate::sampling::SamplingKnobs {
+                    sampling: self.sampling,
+                    scale: self.scale,
+                    depth_break: self.depth_break,
+                    light_break: self.light_break,
+                }
+            }
+
+            /// The variant with other sampling knobs, every other knob kept (not
+            /// validated).
+            #[must_use]
+            pub fn with_sampling_knobs(self, s: $crate::sampling::SamplingKnobs) -> Self {
+                Self {
+                    sampling: s.sampling,
+                    scale: s.scale,
+                    depth_break: s.depth_break,
+                    light_break: s.light_break,
+                    ..self
+                }
+            }
+        }
+    };
+}
+pub(crate) use sampling_fields;
+
 #[cfg(test)]
 mod tests {
     use super::*;

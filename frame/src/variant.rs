@@ -310,16 +310,6 @@ impl PrefilteredVariant {
         self.sampling_knobs().validate()
     }
 
-    /// The sampling knobs.
-    pub fn sampling_knobs(&self) -> SamplingKnobs {
-        SamplingKnobs {
-            sampling: self.sampling,
-            scale: self.scale,
-            depth_break: self.depth_break,
-            light_break: self.light_break,
-        }
-    }
-
     /// Every valid `bases_per_thread` for `bases`.
     pub fn bases_per_thread_options(bases: u32) -> Vec<u32> {
         (4..=bases)
@@ -429,6 +419,8 @@ impl PrefilteredVariant {
     }
 }
 
+crate::sampling::sampling_fields!(PrefilteredVariant);
+
 impl fmt::Display for PrefilteredVariant {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.id())
@@ -489,13 +481,7 @@ impl KnobSet for PrefilteredVariant {
     }
 
     fn with_sampling(self, s: SamplingKnobs) -> Self {
-        Self {
-            sampling: s.sampling,
-            scale: s.scale,
-            depth_break: s.depth_break,
-            light_break: s.light_break,
-            ..self
-        }
+        self.with_sampling_knobs(s)
     }
 
     /// Regions 1..=4 (every other knob at every value).
