@@ -61,10 +61,16 @@ pub struct MinmaxVariant {
     pub sampling: Sampling,
     /// `sampling = lowres`: the block side, 2 or 4.
     pub scale: u32,
-    /// `sampling = lowres`: the depth break in percent of the nearer depth.
+    /// `sampling = lowres | epipolar`: the depth break in percent of the nearer depth.
     pub depth_break: u32,
-    /// `sampling = lowres`: the light break in percent of the brightest sample.
+    /// `sampling = lowres | epipolar`: the light break in percent of the brightest sample.
     pub light_break: u32,
+    /// `sampling = epipolar`: epipolar slices.
+    pub slices: u32,
+    /// `sampling = epipolar`: samples per slice.
+    pub slice_samples: u32,
+    /// `sampling = epipolar`: the initial step between evaluated samples of a slice.
+    pub step: u32,
 }
 
 impl Default for MinmaxVariant {
@@ -76,6 +82,9 @@ impl Default for MinmaxVariant {
             scale: SamplingKnobs::DEFAULT_SCALE,
             depth_break: SamplingKnobs::DEFAULT_DEPTH_BREAK,
             light_break: SamplingKnobs::DEFAULT_LIGHT_BREAK,
+            slices: SamplingKnobs::DEFAULT_SLICES,
+            slice_samples: SamplingKnobs::DEFAULT_SLICE_SAMPLES,
+            step: SamplingKnobs::DEFAULT_STEP,
         }
     }
 }

@@ -58,12 +58,18 @@ kernel::kernels! {
     /// Per pixel: the rectified row marched through its min-max tree, skipping nodes wholly
     /// lit or shadowed; pixels near the epipole ray-marched (Chen et al. 2011).
     MinmaxTraverse("minmax_traverse", MinmaxVariant, minmax::render_traverse),
+    /// `sampling = epipolar`: every pixel gathered from the `minmax_traverse` samples of
+    /// the two slices around it, or traversed itself where none stands for it.
+    MinmaxTraverseUnwarp("minmax_traverse_unwarp", MinmaxVariant, minmax::render_traverse_unwarp),
     /// Fourier basis transform fused with the weighted running mean along each rectified
     /// row, per region (Klehm et al. 2014, Listings 1-3, Table 1).
     Prefilter("prefilter", PrefilteredVariant, prefiltered::kernels::render_prefilter),
     /// Brute-force ray marching through the standard shadow map, optionally interleaved
     /// (Tóth & Umenhoffer 2009).
     Raymarch("raymarch", RaymarchVariant, raymarch::render_raymarch),
+    /// `sampling = epipolar`: every pixel gathered from the `raymarch` samples of the two
+    /// slices around it, or marched itself where none stands for it.
+    RaymarchUnwarp("raymarch_unwarp", RaymarchVariant, raymarch::render_raymarch_unwarp),
     /// Epipolar resampling of a standard shadow map into the rectified shadow map (Klehm et
     /// al. 2014, Sec. 4.1, after Baran et al. 2010).
     Rectify("rectify", PrefilteredVariant, prefiltered::kernels::render_rectify),
@@ -73,6 +79,9 @@ kernel::kernels! {
     /// Per pixel: prefiltered visibility times the unshadowed integral, one dot product per
     /// region; pixels near the epipole ray-marched (Klehm et al. 2014, Listing 4, Sec. 5).
     Scatter("scatter", PrefilteredVariant, prefiltered::kernels::render_scatter),
+    /// `sampling = epipolar`: every pixel gathered from the `scatter` samples of the two
+    /// slices around it, or evaluated itself where none stands for it.
+    ScatterUnwarp("scatter_unwarp", PrefilteredVariant, prefiltered::kernels::render_scatter_unwarp),
     /// Every rectified row's column spacing fitted to the deepest pixel of the depth buffer
     /// (after `depth_columns`; the host spans rows to the far plane).
     SliceFit("slice_fit", PrefilteredVariant, prefiltered::kernels::render_slice_fit),

@@ -13,27 +13,94 @@ use crate::Kernel;
 pub(crate) struct SamplingView {
     /// Whether the kernel is the lowres pass (`sampling = lowres`).
     pub lowres: bool,
+    /// Whether the kernel is one of the epipolar passes (`sampling = epipolar`).
+    pub epipolar: bool,
+    /// Whether the kernel is the epipolar unwarp (`<kernel>_unwarp`).
+    pub unwarp: bool,
     /// Block side S.
     pub scale: u32,
     /// The depth break as a WGSL f32 literal (a fraction of the nearer depth).
     pub depth_break: String,
     /// The light break as a WGSL f32 literal (a fraction of the brightest sample).
     pub light_break: String,
-    /// The kernel's entry point; its per-pixel function is `<entry>_pixel`.
+    /// Epipolar slices, samples per slice, initial step.
+    pub slices: u32,
+    pub slice_samples: u32,
+    pub step: u32,
+    /// The kernel's entry point.
     pub entry: &'static str,
+    /// The family kernel's entry point (`entry` without `_unwarp`).
+    pub family_entry: &'static str,
+    /// The family's per-pixel function, `<family kernel>_pixel`.
+    pub pixel: String,
+    /// A WGSL expression of type `scatter::sampling::EpipolarCamera` from the kernel's
+    /// uniform block.
+    pub camera: String,
+    /// The binding of `epipolar_samples` in the unwarp pass (the family's first free one).
+    pub binding: u32,
+    /// The `#import scatter::sampling::{..}` line the kernel needs (empty for `pixels`).
+    pub imports: &'static str,
+    /// The format of `output`: rgba32float for the epipolar samples, else rgba16float.
+    pub output_format: &'static str,
 }
 
 impl SamplingView {
-    /// The view of `knobs` for kernel `kernel`.
-    pub(crate) fn new(knobs: &SamplingKnobs, kernel: Kernel) -> Self {
+    /// The view of `knobs` for kernel `kernel`, whose per-pixel body is the one of
+    /// `family_kernel` (the same kernel, or the family kernel of an `_unwarp` pass), whose
+    /// uniform block gives `camera` and whose first free binding is `binding`.
+    pub(crate) fn new(
+        knobs: &SamplingKnobs,
+        kernel: Kernel,
+        family_kernel: Kernel,
+        camera: String,
+        binding: u32,
+    ) -> Self {
+        let unwarp = kernel != family_kernel;
+        let imports = match knobs.sampling {
+            Sampling::Pixels => "",
+            Sampling::Lowres => {
+                "#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}"
+            }
+            Sampling::Epipolar if unwarp => {
+                "#import scatter::sampling::{EpipolarCamera, epipolar_layout, epipolar_taps, lowres_blend}"
+            }
+            Sampling::Epipolar => {
+                "#import scatter::sampling::{EpipolarCamera, depth_close, epipolar_layout, round_f16, slice_direction, slice_sample_pixel, slice_span}"
+            }
+        };
         Self {
             lowres: knobs.sampling == Sampling::Lowres,
+            epipolar: knobs.sampling == Sampling::Epipolar,
+            unwarp,
             scale: knobs.scale,
             depth_break: wgsl_f32(knobs.depth_break_fraction()),
             light_break: wgsl_f32(knobs.light_break_fraction()),
+            slices: knobs.slices,
+            slice_samples: knobs.slice_samples,
+            step: knobs.step,
             entry: kernel.name(),
+            family_entry: family_kernel.name(),
+            pixel: format!("{}_pixel", family_kernel.name()),
+            camera,
+            binding,
+            imports,
+            output_format: if knobs.sampling == Sampling::Epipolar && !unwarp {
+                EPIPOLAR_SAMPLES_FORMAT
+            } else {
+                "rgba16float"
+            },
         }
     }
+}
+
+/// The `EpipolarCamera` of a uniform block named `frame` whose fields `cam_forward` (w =
+/// tan(fov_y / 2)), `cam_right` (w = aspect) and `cam_up` are the camera's, with `toward`
+/// the direction towards the light.
+pub(crate) fn camera_expr(toward: &str) -> String {
+    format!(
+        "EpipolarCamera(frame.cam_forward.xyz, frame.cam_right.xyz, frame.cam_up.xyz, \
+         frame.cam_forward.w, frame.cam_right.w, {toward})"
+    )
 }
 
 /// An f32 as a WGSL literal that parses back to the same value.
@@ -48,7 +115,8 @@ fn wgsl_f32(v: f32) -> String {
 
 /// The invocations of a family's per-pixel pass: the screen for `pixels`; for `lowres`,
 /// one workgroup of 8 x 8 invocations per 8 x 8 blocks of S x S pixels:
-/// `8 * ceil(screen.width / (8 S))` by `8 * ceil(screen.height / (8 S))`.
+/// `8 * ceil(screen.width / (8 S))` by `8 * ceil(screen.height / (8 S))`; for `epipolar`,
+/// one workgroup of 64 invocations per slice: `64 * slices` by 1.
 pub fn sampling_invocations(knobs: &SamplingKnobs) -> [String; 3] {
     match knobs.sampling {
         Sampling::Pixels => ["screen.width".into(), "screen.height".into(), "1".into()],
@@ -57,8 +125,75 @@ pub fn sampling_invocations(knobs: &SamplingKnobs) -> [String; 3] {
             format!("8 * ceil(screen.height / {})", 8 * knobs.scale),
             "1".into(),
         ],
+        Sampling::Epipolar => [(64 * knobs.slices).to_string(), "1".into(), "1".into()],
     }
 }
+
+/// The `epipolar_samples` texture of an `epipolar` plan (`slice_samples x slices`,
+/// rgba32float), or `None` for the other modes.
+pub fn epipolar_samples_texture(knobs: &SamplingKnobs) -> Option<crate::plan::Resource> {
+    (knobs.sampling == Sampling::Epipolar).then(|| {
+        crate::plan::scatter_texture(
+            "epipolar_samples",
+            "sampling = epipolar: the samples of every slice (x = sample, y = slice): radiance \
+             rgb, the view depth of the sample's pixel in alpha (written by the family's \
+             per-pixel kernel, read by its _unwarp pass)",
+            EPIPOLAR_SAMPLES_FORMAT,
+            &knobs.slice_samples.to_string(),
+            &knobs.slices.to_string(),
+        )
+    })
+}
+
+/// An error for the `_unwarp` pass `kernel` of a variant whose sampling is not `epipolar`.
+pub(crate) fn unwarp_only(kernel: Kernel, sampling: Sampling) -> Result<(), crate::ShaderError> {
+    if sampling == Sampling::Epipolar {
+        Ok(())
+    } else {
+        Err(crate::ShaderError::InvalidParameter {
+            kernel,
+            knob: "sampling",
+            value: sampling.to_string(),
+            allowed: "epipolar (only epipolar sampling has an unwarp pass)",
+        })
+    }
+}
+
+/// The resource a family's per-pixel kernel writes: `output`, or `epipolar_samples` with
+/// epipolar sampling (its `_unwarp` pass writes `output`).
+pub fn sampled_output(knobs: &SamplingKnobs) -> &'static str {
+    if knobs.sampling == Sampling::Epipolar {
+        "epipolar_samples"
+    } else {
+        "output"
+    }
+}
+
+/// The `_unwarp` pass `kernel` of a family kernel's epipolar pass `family`: the same
+/// bindings with `output` where `family` writes `epipolar_samples`, and `epipolar_samples`
+/// read at `binding`; one invocation per screen pixel.
+pub fn unwarp_pass(family: crate::plan::PassPlan, kernel: Kernel, binding: u32) -> crate::plan::PassPlan {
+    let mut bindings: Vec<_> = family
+        .bindings
+        .into_iter()
+        .map(|mut b| {
+            if b.resource == "epipolar_samples" {
+                b.resource = "output";
+            }
+            b
+        })
+        .collect();
+    bindings.push(crate::plan::bind(binding, "epipolar_samples"));
+    crate::plan::PassPlan {
+        kernel,
+        invocations: ["screen.width".into(), "screen.height".into(), "1".into()],
+        skip_when: family.skip_when,
+        bindings,
+    }
+}
+
+/// Format of `epipolar_samples`.
+pub const EPIPOLAR_SAMPLES_FORMAT: &str = "rgba32float";
 
 #[cfg(test)]
 mod tests {
@@ -72,9 +207,19 @@ mod tests {
     }
 
     #[test]
-    fn every_family_builds_lowres() {
+    fn every_family_builds_lowres_and_epipolar() {
         use crate::family::KernelFamily;
-        for k in [SamplingKnobs::lowres(2), SamplingKnobs::lowres(4)] {
+        let long = SamplingKnobs {
+            slice_samples: 512,
+            step: 1,
+            ..SamplingKnobs::epipolar(1024)
+        };
+        for k in [
+            SamplingKnobs::lowres(2),
+            SamplingKnobs::lowres(4),
+            SamplingKnobs::epipolar(64),
+            long,
+        ] {
             for light in [
                 crate::prefiltered::LightKind::Directional,
                 crate::prefiltered::LightKind::Spot,

@@ -27,8 +27,8 @@
 #import scatter::model::{phase_hg, transmittance_between}
 #import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, slice_params, spot_segment}
 #import scatter::minmax::{level_offset, tree_levels}
-{%- if sampling.lowres %}
-#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}
+{%- if !sampling.imports.is_empty() %}
+{{ sampling.imports }}
 {%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -36,7 +36,7 @@
 @group(0) @binding(2) var depth: texture_2d<f32>;
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) var tree: texture_2d<f32>;
-@group(0) @binding(5) var output: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(5) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
 {% include "include/sampled_bindings.wgsl" %}
 
 // Ray distance of column edge `x` of a ray that crosses texels 0 .. n: the last texel's

@@ -30,8 +30,8 @@
 #import scatter::model::{equiangular, equiangular_sample, phase_hg, spot_integrand, transmittance_between}
 #import scatter::shadow::shadow_visibility
 #import scatter::raymarch::{RaymarchFrame, raymarch_pixel_dir, raymarch_shadow_view, pixel_jitter}
-{%- if sampling.lowres %}
-#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}
+{%- if !sampling.imports.is_empty() %}
+{{ sampling.imports }}
 {%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: RaymarchFrame;

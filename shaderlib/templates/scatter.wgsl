@@ -69,8 +69,8 @@
 #import scatter::projective::{proj_boundary, proj_ray_depth, proj_reach}
 #import scatter::prefiltered_projective::proj_column
 {%- endif %}
-{%- if sampling.lowres %}
-#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}
+{%- if !sampling.imports.is_empty() %}
+{{ sampling.imports }}
 {%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -78,7 +78,7 @@
 @group(0) @binding(2) var depth: texture_2d<f32>;
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) var filtered: texture_2d_array<f32>;
-@group(0) @binding(5) var output: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(5) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
 @group(0) @binding(6) var bounds: texture_2d<f32>;
 {% include "include/sampled_bindings.wgsl" %}
 

@@ -9,7 +9,7 @@ pub mod plan;
 
 use askama::Template;
 
-use crate::sampling::SamplingView;
+use crate::sampling::{SamplingView, camera_expr, unwarp_only};
 
 pub use scatter_frame::minmax::{
     MinmaxVariant, level_count, level_offset, prepare_minmax, tree_levels, tree_width,
@@ -42,6 +42,26 @@ struct TraverseTemplate {
     sampling: SamplingView,
 }
 
+/// `minmax_traverse_unwarp`: `minmax_traverse.wgsl` rendered as the epipolar unwarp.
+#[derive(Template)]
+#[template(path = "minmax_traverse_unwarp.wgsl")]
+struct TraverseUnwarpTemplate {
+    light_name: &'static str,
+    spot: bool,
+    sampling: SamplingView,
+}
+
+/// The sampling view of `kernel` (`minmax_traverse` or its `_unwarp`) for `variant`.
+fn sampling_view(variant: &MinmaxVariant, kernel: Kernel) -> SamplingView {
+    SamplingView::new(
+        &variant.sampling_knobs(),
+        kernel,
+        Kernel::MinmaxTraverse,
+        camera_expr("frame.axis.xyz"),
+        6,
+    )
+}
+
 fn validate(kernel: Kernel, variant: &MinmaxVariant) -> Result<(), ShaderError> {
     variant
         .validate()
@@ -66,12 +86,30 @@ pub(crate) fn render_traverse(variant: &MinmaxVariant) -> Result<String, ShaderE
     TraverseTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
-        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::MinmaxTraverse),
+        sampling: sampling_view(variant, Kernel::MinmaxTraverse),
     }
     .render()
     .map_err(|source| ShaderError::Render {
         kernel: Kernel::MinmaxTraverse,
         template: template_path(Kernel::MinmaxTraverse),
+        source,
+    })
+}
+
+/// Renders `templates/minmax_traverse_unwarp.wgsl` for an `epipolar` variant (an error for
+/// the others, which have no such pass).
+pub(crate) fn render_traverse_unwarp(variant: &MinmaxVariant) -> Result<String, ShaderError> {
+    validate(Kernel::MinmaxTraverseUnwarp, variant)?;
+    unwarp_only(Kernel::MinmaxTraverseUnwarp, variant.sampling)?;
+    TraverseUnwarpTemplate {
+        light_name: variant.light.name(),
+        spot: variant.light == LightKind::Spot,
+        sampling: sampling_view(variant, Kernel::MinmaxTraverseUnwarp),
+    }
+    .render()
+    .map_err(|source| ShaderError::Render {
+        kernel: Kernel::MinmaxTraverseUnwarp,
+        template: template_path(Kernel::MinmaxTraverseUnwarp),
         source,
     })
 }
@@ -93,7 +131,11 @@ impl crate::KernelParams {
 
 impl crate::family::KernelFamily for MinmaxVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
-        crate::KernelParams::minmax(*self).to_vec()
+        let mut out = crate::KernelParams::minmax(*self).to_vec();
+        if self.sampling == crate::sampling::Sampling::Epipolar {
+            out.push(crate::KernelParams::MinmaxTraverseUnwarp(*self));
+        }
+        out
     }
 
     fn plan(&self) -> crate::plan::Plan {

@@ -10,7 +10,9 @@ use crate::plan::{
     bind, column_depth_buffer, depth_and_shadow_map, frame_buffer, scatter_texture,
     screen_and_shadow_parameters,
 };
-use crate::sampling::sampling_invocations;
+use crate::sampling::{
+    epipolar_samples_texture, sampled_output, sampling_invocations, unwarp_pass,
+};
 
 /// The resources and passes of a variant, as `runtime/src/minmax.rs` creates them.
 pub fn plan(v: &MinmaxVariant) -> Plan {
@@ -38,7 +40,7 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
         },
     ]);
     let [depth, shadow_map] = depth_and_shadow_map();
-    let resources = vec![
+    let mut resources = vec![
         frame_buffer(
             "frame",
             "the uniform block of the frame (Rust: scatter_frame::frame::FrameUniforms from \
@@ -79,6 +81,7 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
             "screen.height",
         ),
     ];
+    resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
     let passes = v
         .kernel_params()
         .iter()
@@ -146,9 +149,12 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
                 bind(2, "depth"),
                 bind(3, "shadow_map"),
                 bind(4, "tree"),
-                bind(5, "output"),
+                bind(5, sampled_output(&v.sampling_knobs())),
             ],
         }),
+        Kernel::MinmaxTraverseUnwarp => {
+            pass(v, Kernel::MinmaxTraverse).map(|p| unwarp_pass(p, kernel, 6))
+        }
         _ => None,
     }
 }

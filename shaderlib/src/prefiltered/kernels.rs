@@ -9,7 +9,7 @@
 
 use askama::Template;
 
-use crate::sampling::SamplingView;
+use crate::sampling::{SamplingView, camera_expr, unwarp_only};
 
 use super::variant::{Basis, LightKind, PrefilteredVariant, Rectification, VisibilityMode};
 use crate::compose::template_path;
@@ -76,6 +76,23 @@ struct PrefilterTemplate {
 #[derive(Template)]
 #[template(path = "scatter.wgsl")]
 struct ScatterTemplate {
+    light_name: &'static str,
+    visibility_name: &'static str,
+    spot: bool,
+    bases: u32,
+    layers: u32,
+    regions: u32,
+    rectification_name: &'static str,
+    projective: bool,
+    moments: bool,
+    moment_count: u32,
+    sampling: SamplingView,
+}
+
+/// `scatter_unwarp`: `scatter.wgsl` rendered as the epipolar unwarp.
+#[derive(Template)]
+#[template(path = "scatter_unwarp.wgsl")]
+struct ScatterUnwarpTemplate {
     light_name: &'static str,
     visibility_name: &'static str,
     spot: bool,
@@ -173,8 +190,41 @@ pub(crate) fn render_scatter(variant: &PrefilteredVariant) -> Result<String, Sha
         projective: variant.rectification == Rectification::Projective,
         moments: variant.basis == Basis::Moments,
         moment_count: variant.moments,
-        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::Scatter),
+        sampling: scatter_sampling_view(variant, Kernel::Scatter),
     }
     .render()
     .map_err(render_error(Kernel::Scatter))
+}
+
+/// The sampling view of `kernel` (`scatter` or `scatter_unwarp`) for `variant`.
+fn scatter_sampling_view(variant: &PrefilteredVariant, kernel: Kernel) -> SamplingView {
+    SamplingView::new(
+        &variant.sampling_knobs(),
+        kernel,
+        Kernel::Scatter,
+        camera_expr("frame.axis.xyz"),
+        7,
+    )
+}
+
+/// Renders `templates/scatter_unwarp.wgsl` for an `epipolar` variant (an error for the
+/// others, which have no such pass).
+pub(crate) fn render_scatter_unwarp(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
+    validate(Kernel::ScatterUnwarp, variant)?;
+    unwarp_only(Kernel::ScatterUnwarp, variant.sampling)?;
+    ScatterUnwarpTemplate {
+        light_name: variant.light.name(),
+        visibility_name: variant.visibility.name(),
+        spot: variant.light == LightKind::Spot,
+        bases: variant.bases,
+        layers: variant.layers(),
+        regions: variant.regions,
+        rectification_name: variant.rectification.name(),
+        projective: variant.rectification == Rectification::Projective,
+        moments: variant.basis == Basis::Moments,
+        moment_count: variant.moments,
+        sampling: scatter_sampling_view(variant, Kernel::ScatterUnwarp),
+    }
+    .render()
+    .map_err(render_error(Kernel::ScatterUnwarp))
 }

@@ -37,7 +37,11 @@ impl crate::KernelParams {
 
 impl crate::family::KernelFamily for PrefilteredVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
-        crate::KernelParams::prefiltered(*self).to_vec()
+        let mut out = crate::KernelParams::prefiltered(*self).to_vec();
+        if self.sampling == crate::sampling::Sampling::Epipolar {
+            out.push(crate::KernelParams::ScatterUnwarp(*self));
+        }
+        out
     }
 
     fn plan(&self) -> crate::plan::Plan {

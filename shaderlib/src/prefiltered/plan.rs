@@ -11,7 +11,9 @@ use crate::plan::{
     screen_and_shadow_parameters, texture_2d,
 };
 use crate::prefiltered::{Basis, PrefilteredVariant, Rectification};
-use crate::sampling::sampling_invocations;
+use crate::sampling::{
+    epipolar_samples_texture, sampled_output, sampling_invocations, unwarp_pass,
+};
 
 /// The per-frame condition of a projective frame (the frame set-up falls back to epipolar
 /// when the epipole is on screen).
@@ -120,6 +122,7 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
             )
         });
     }
+    resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
     // One pass per kernel shaderlib lists for the variant, in its order; a kernel this
     // module does not know gets no pass, and generation names it.
     let passes = v
@@ -241,10 +244,11 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                     }),
                 },
                 bind(4, "filtered"),
-                bind(5, "output"),
+                bind(5, sampled_output(&v.sampling_knobs())),
                 bind(6, "bounds"),
             ],
         }),
+        Kernel::ScatterUnwarp => pass(v, Kernel::Scatter).map(|p| unwarp_pass(p, kernel, 7)),
         _ => None,
     }
 }

@@ -11,7 +11,9 @@ pub use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_ray
 
 use crate::compose::template_path;
 use crate::prefiltered::LightKind;
-use crate::sampling::SamplingView;
+use crate::sampling::{
+    EPIPOLAR_SAMPLES_FORMAT, Sampling, SamplingView, camera_expr, unwarp_only,
+};
 use crate::{Kernel, ShaderError};
 
 /// Workgroup size of `raymarch` and `interleave_sum`: one invocation per pixel.
@@ -31,6 +33,17 @@ struct RaymarchTemplate {
     sampling: SamplingView,
 }
 
+/// `raymarch_unwarp`: `raymarch.wgsl` rendered as the epipolar unwarp.
+#[derive(Template)]
+#[template(path = "raymarch_unwarp.wgsl")]
+struct RaymarchUnwarpTemplate {
+    light_name: &'static str,
+    spot: bool,
+    interleaved: bool,
+    output_format: &'static str,
+    sampling: SamplingView,
+}
+
 /// `interleave_sum`: the separable window sum.
 #[derive(Template)]
 #[template(path = "interleave_sum.wgsl")]
@@ -40,6 +53,21 @@ fn validate(kernel: Kernel, variant: &RaymarchVariant) -> Result<(), ShaderError
     variant
         .validate()
         .map_err(|source| ShaderError::Variant { kernel, source })
+}
+
+/// The sampling view of `kernel` (`raymarch` or `raymarch_unwarp`) for `variant`.
+fn sampling_view(variant: &RaymarchVariant, kernel: Kernel) -> SamplingView {
+    let toward = match variant.light {
+        LightKind::Directional => "-frame.light_dir.xyz",
+        LightKind::Spot => "frame.light_pos.xyz - frame.eye.xyz",
+    };
+    SamplingView::new(
+        &variant.sampling_knobs(),
+        kernel,
+        Kernel::Raymarch,
+        camera_expr(toward),
+        4,
+    )
 }
 
 /// Renders `templates/raymarch.wgsl` for `variant` (`samples` is a uniform, not compiled
@@ -52,15 +80,37 @@ pub(crate) fn render_raymarch(variant: &RaymarchVariant) -> Result<String, Shade
         interleaved: variant.interleaved(),
         output_format: if variant.interleaved() {
             PARTIAL_FORMAT
+        } else if variant.sampling == Sampling::Epipolar {
+            EPIPOLAR_SAMPLES_FORMAT
         } else {
             "rgba16float"
         },
-        sampling: SamplingView::new(&variant.sampling_knobs(), Kernel::Raymarch),
+        sampling: sampling_view(variant, Kernel::Raymarch),
     }
     .render()
     .map_err(|source| ShaderError::Render {
         kernel: Kernel::Raymarch,
         template: template_path(Kernel::Raymarch),
+        source,
+    })
+}
+
+/// Renders `templates/raymarch_unwarp.wgsl` for an `epipolar` variant (an error for the
+/// others, which have no such pass).
+pub(crate) fn render_raymarch_unwarp(variant: &RaymarchVariant) -> Result<String, ShaderError> {
+    validate(Kernel::RaymarchUnwarp, variant)?;
+    unwarp_only(Kernel::RaymarchUnwarp, variant.sampling)?;
+    RaymarchUnwarpTemplate {
+        light_name: variant.light.name(),
+        spot: variant.light == LightKind::Spot,
+        interleaved: false,
+        output_format: "rgba16float",
+        sampling: sampling_view(variant, Kernel::RaymarchUnwarp),
+    }
+    .render()
+    .map_err(|source| ShaderError::Render {
+        kernel: Kernel::RaymarchUnwarp,
+        template: template_path(Kernel::RaymarchUnwarp),
         source,
     })
 }
@@ -88,11 +138,14 @@ pub(crate) fn render_interleave_sum(variant: &RaymarchVariant) -> Result<String,
 
 impl crate::KernelParams {
     /// The kernels of a raymarch-family variant, in pass order: `raymarch`, then
-    /// `interleave_sum` when it interleaves.
+    /// `interleave_sum` when it interleaves, or `raymarch_unwarp` with epipolar sampling.
     pub fn raymarch(variant: RaymarchVariant) -> Vec<Self> {
         let mut out = vec![Self::Raymarch(variant)];
         if variant.interleaved() {
             out.push(Self::InterleaveSum(variant));
+        }
+        if variant.sampling == Sampling::Epipolar {
+            out.push(Self::RaymarchUnwarp(variant));
         }
         out
     }

@@ -7,7 +7,9 @@ use crate::plan::{
     screen_and_shadow_parameters,
 };
 use crate::raymarch::{PARTIAL_FORMAT, RaymarchVariant};
-use crate::sampling::sampling_invocations;
+use crate::sampling::{
+    epipolar_samples_texture, sampled_output, sampling_invocations, unwarp_pass,
+};
 use crate::{Kernel, KernelParams};
 
 /// The resources and passes of a variant, as `runtime/src/raymarch.rs` creates them.
@@ -31,6 +33,7 @@ pub fn plan(v: &RaymarchVariant) -> Plan {
             "screen.height",
         ),
     ];
+    resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
     if v.interleaved() {
         resources.push(scatter_texture(
             "partial",
@@ -70,9 +73,17 @@ pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
                 bind(0, "frame"),
                 bind(1, "depth"),
                 bind(2, "shadow_map"),
-                bind(3, if v.interleaved() { "partial" } else { "output" }),
+                bind(
+                    3,
+                    if v.interleaved() {
+                        "partial"
+                    } else {
+                        sampled_output(&v.sampling_knobs())
+                    },
+                ),
             ],
         }),
+        Kernel::RaymarchUnwarp => pass(v, Kernel::Raymarch).map(|p| unwarp_pass(p, kernel, 4)),
         Kernel::InterleaveSum => Some(PassPlan {
             kernel,
             invocations: screen(),

@@ -94,3 +94,176 @@ fn lowres_blend(w: vec4<f32>, depths: vec4<f32>, light: array<vec3<f32>, 4>, d: 
     let c = sum / total;
     return vec4<f32>(c.x, c.y, c.z, 1.0);
 }
+
+// ---- sampling = epipolar (scatter_frame::sampling, "The epipolar passes") ----
+
+// What an epipolar layout is built from: the camera and the direction towards the light.
+struct EpipolarCamera {
+    forward: vec3<f32>,
+    right: vec3<f32>,
+    up: vec3<f32>,
+    // tan(fov_y / 2) and width / height.
+    tan_half: f32,
+    aspect: f32,
+    // From the eye towards the light (any length).
+    toward: vec3<f32>,
+}
+
+// A frame's slices: the epipole `origin` (pixel coordinates, pixel centres at + 0.5), the
+// unit direction `axis` from it to the screen centre (angle 0), slice 0's first angle `phi_start`
+// and the angle per slice `dphi` (radians, counter-clockwise from `axis` towards
+// (-axis.y, axis.x)), and whether the origin is on screen (the slices go around it).
+struct EpipolarLayout {
+    origin: vec2<f32>,
+    axis: vec2<f32>,
+    phi_start: f32,
+    dphi: f32,
+    wrap: u32,
+}
+
+// The farthest the layout's origin lies from the screen centre, in screens (max(W, H)):
+// lines from farther away are parallel to within a pixel's width, and f32 angles stay exact
+// to a hundredth of a slice.
+const EPIPOLE_FAR: f32 = 100.0;
+
+// Angle of `d` from `axis` (counter-clockwise towards (-axis.y, axis.x)).
+fn epipolar_angle(axis: vec2<f32>, d: vec2<f32>) -> f32 {
+    return atan2(axis.x * d.y - axis.y * d.x, axis.x * d.x + axis.y * d.y);
+}
+
+// The layout of `slices` slices for a camera and a screen.
+fn epipolar_layout(cam: EpipolarCamera, screen: vec2<u32>, slices: u32) -> EpipolarLayout {
+    let size = vec2<f32>(screen);
+    let centre = 0.5 * size;
+    // The light direction in camera space; its screen point is centre + q / z.
+    let z = dot(cam.toward, cam.forward);
+    let q = vec2<f32>(dot(cam.toward, cam.right) * centre.x / (cam.tan_half * cam.aspect), -dot(cam.toward, cam.up) * centre.y / cam.tan_half);
+    let far = EPIPOLE_FAR * max(size.x, size.y);
+    let lq = length(q);
+    var origin = centre;
+    if lq >= far * abs(z) {
+        // At or near infinity: the direction only (z's sign flips the side, not the lines).
+        origin = centre + q * (far / max(lq, 1e-30)) * select(1.0, -1.0, z < 0.0);
+    } else if lq > 0.0 {
+        origin = centre + q / z;
+    }
+    var l: EpipolarLayout;
+    l.origin = origin;
+    let to_centre = centre - origin;
+    let lc = length(to_centre);
+    l.axis = select(vec2<f32>(1.0, 0.0), to_centre / max(lc, 1e-30), lc > 0.0);
+    let lo = vec2<f32>(0.5, 0.5);
+    let hi = size - vec2<f32>(0.5, 0.5);
+    let inside = origin.x >= lo.x && origin.x <= hi.x && origin.y >= lo.y && origin.y <= hi.y;
+    if inside {
+        l.wrap = 1u;
+        l.phi_start = -PI_SAMPLING;
+        l.dphi = 2.0 * PI_SAMPLING / f32(slices);
+    } else {
+        l.wrap = 0u;
+        var a = 0.0;
+        var b = 0.0;
+        for (var k = 0u; k < 4u; k++) {
+            let corner = vec2<f32>(select(lo.x, hi.x, (k & 1u) != 0u), select(lo.y, hi.y, (k & 2u) != 0u));
+            let phi = epipolar_angle(l.axis, corner - origin);
+            if k == 0u {
+                a = phi;
+                b = phi;
+            } else {
+                a = min(a, phi);
+                b = max(b, phi);
+            }
+        }
+        l.phi_start = a;
+        l.dphi = (b - a) / f32(slices);
+    }
+    return l;
+}
+
+const PI_SAMPLING: f32 = 3.14159265358979;
+
+// Unit direction of slice `s`.
+fn slice_direction(l: EpipolarLayout, s: u32) -> vec2<f32> {
+    let phi = l.phi_start + (f32(s) + 0.5) * l.dphi;
+    let c = cos(phi);
+    let sn = sin(phi);
+    return vec2<f32>(l.axis.x * c - l.axis.y * sn, l.axis.y * c + l.axis.x * sn);
+}
+
+// Where slice `s` runs inside the rectangle of pixel centres: (first distance from the
+// origin, distance between samples); distances along `slice_direction`.
+fn slice_span(l: EpipolarLayout, s: u32, screen: vec2<u32>, samples: u32) -> vec2<f32> {
+    let u = slice_direction(l, s);
+    let lo = vec2<f32>(0.5, 0.5);
+    let hi = vec2<f32>(screen) - vec2<f32>(0.5, 0.5);
+    var t_in = 0.0;
+    var t_out = 3.4e38;
+    for (var a = 0u; a < 2u; a++) {
+        if abs(u[a]) > 1e-12 {
+            let ta = (lo[a] - l.origin[a]) / u[a];
+            let tb = (hi[a] - l.origin[a]) / u[a];
+            t_in = max(t_in, min(ta, tb));
+            t_out = min(t_out, max(ta, tb));
+        }
+    }
+    // A slice that misses the rectangle (rounding at the outermost angles) keeps its samples
+    // at its nearest point.
+    t_out = max(t_out, t_in);
+    return vec2<f32>(t_in, (t_out - t_in) / f32(samples - 1u));
+}
+
+// The pixel sample `k` of a slice (direction `u`, span `span`) stands on.
+fn slice_sample_pixel(l: EpipolarLayout, u: vec2<f32>, span: vec2<f32>, k: u32, screen: vec2<u32>) -> vec2<u32> {
+    let p = l.origin + u * (span.x + f32(k) * span.y);
+    let last = vec2<f32>(screen) - vec2<f32>(1.0, 1.0);
+    return vec2<u32>(clamp(floor(p), vec2<f32>(0.0, 0.0), last));
+}
+
+// The four samples a pixel is gathered from: slices `slices.x` and `slices.y`, samples
+// (k.x, k.x + 1) on the first and (k.y, k.y + 1) on the second, and their bilinear weights
+// in that order (0 for a slice the pixel lies beyond the ends of).
+struct EpipolarTaps {
+    slices: vec2<u32>,
+    k: vec2<u32>,
+    w: vec4<f32>,
+}
+
+// The taps of pixel `p`: the slices on either side of its angle, and on each the samples on
+// either side of its distance along the slice.
+fn epipolar_taps(l: EpipolarLayout, p: vec2<u32>, screen: vec2<u32>, slices: u32, samples: u32) -> EpipolarTaps {
+    let d = vec2<f32>(p) + vec2<f32>(0.5, 0.5) - l.origin;
+    let f = (epipolar_angle(l.axis, d) - l.phi_start) / l.dphi - 0.5;
+    var s_lo = 0u;
+    var fs = 0.0;
+    if l.wrap != 0u {
+        let fl = floor(f);
+        fs = f - fl;
+        s_lo = u32(i32(fl) + i32(slices)) % slices;
+    } else {
+        let fc = clamp(f, 0.0, f32(slices - 1u));
+        s_lo = min(u32(fc), slices - 2u);
+        fs = fc - f32(s_lo);
+    }
+    var t: EpipolarTaps;
+    t.slices = vec2<u32>(s_lo, (s_lo + 1u) % slices);
+    let ws = vec2<f32>(1.0 - fs, fs);
+    for (var j = 0u; j < 2u; j++) {
+        let s = t.slices[j];
+        let span = slice_span(l, s, screen, samples);
+        let g = (dot(d, slice_direction(l, s)) - span.x) / max(span.y, 1e-20);
+        let last = f32(samples - 1u);
+        if g < -1.0 || g > last + 1.0 {
+            t.k[j] = 0u;
+            t.w[2u * j] = 0.0;
+            t.w[2u * j + 1u] = 0.0;
+        } else {
+            let gc = clamp(g, 0.0, last);
+            let k_lo = min(u32(gc), samples - 2u);
+            let fk = gc - f32(k_lo);
+            t.k[j] = k_lo;
+            t.w[2u * j] = ws[j] * (1.0 - fk);
+            t.w[2u * j + 1u] = ws[j] * fk;
+        }
+    }
+    return t;
+}

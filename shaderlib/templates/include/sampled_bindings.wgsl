@@ -5,3 +5,18 @@ const SCALE: u32 = {{ sampling.scale }}u;
 const DEPTH_BREAK: f32 = {{ sampling.depth_break }};
 const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 {%- endif %}
+{%- if sampling.epipolar %}
+
+// Epipolar slices, samples per slice, the initial step between evaluated samples, and the
+// depth and light breaks (fractions).
+const SLICES: u32 = {{ sampling.slices }}u;
+const SLICE_SAMPLES: u32 = {{ sampling.slice_samples }}u;
+const STEP: u32 = {{ sampling.step }}u;
+const DEPTH_BREAK: f32 = {{ sampling.depth_break }};
+const LIGHT_BREAK: f32 = {{ sampling.light_break }};
+{%- endif %}
+{%- if sampling.unwarp %}
+// The samples of every slice (written by `{{ sampling.family_entry }}`): radiance, and the view depth
+// of the sample's pixel in w.
+@group(0) @binding({{ sampling.binding }}) var epipolar_samples: texture_2d<f32>;
+{%- endif %}

@@ -28,7 +28,7 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
     for (var k = li; k < 81u; k += 64u) {
         let i = min(origin + vec2<u32>(k % 9u, k / 9u), grid - vec2<u32>(1u, 1u));
         let p = lowres_pixel(i, screen, SCALE);
-        tile_light[k] = round_f16({{ sampling.entry }}_pixel(p.x, p.y));
+        tile_light[k] = round_f16({{ sampling.pixel }}(p.x, p.y));
         tile_depth[k] = textureLoad(depth, p, 0).x;
     }
     workgroupBarrier();
@@ -59,8 +59,148 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
     let n = atomicLoad(&refine_count);
     for (var e = li; e < n; e += 64u) {
         let q = vec2<u32>(refine[e] & 0xffffu, refine[e] >> 16u);
-        let c = {{ sampling.entry }}_pixel(q.x, q.y);
+        let c = {{ sampling.pixel }}(q.x, q.y);
         textureStore(output, q, vec4<f32>(c.x, c.y, c.z, 1.0));
+    }
+}
+{%- else if sampling.epipolar && !sampling.unwarp %}
+
+// One slice's samples: their depths, which are evaluated (1) or interpolated (0), their
+// radiance, and lists of samples to evaluate with their counts (workgroup memory starts
+// zeroed).
+var<workgroup> line_depth: array<f32, {{ sampling.slice_samples }}>;
+var<workgroup> line_flag: array<u32, {{ sampling.slice_samples }}>;
+var<workgroup> line_light: array<vec3<f32>, {{ sampling.slice_samples }}>;
+var<workgroup> line_list: array<u32, {{ sampling.slice_samples }}>;
+var<workgroup> line_count: array<atomic<u32>, 2>;
+
+// The evaluated samples around sample k (k itself when it is one): every STEP-th sample and
+// the last are, so both exist.
+fn line_bracket(k: u32) -> vec2<u32> {
+    var a = k;
+    while line_flag[a] == 0u {
+        a -= 1u;
+    }
+    var b = k;
+    while line_flag[b] == 0u {
+        b += 1u;
+    }
+    return vec2<u32>(a, b);
+}
+
+// Whether evaluated samples a and b differ by more than LIGHT_BREAK of the brighter (then
+// the samples between them are evaluated too).
+fn line_spread_over(ab: vec2<u32>) -> bool {
+    let la = line_light[ab.x];
+    let lb = line_light[ab.y];
+    let hi = max(la, lb);
+    let spread = abs(la - lb);
+    return max(spread.x, max(spread.y, spread.z)) > LIGHT_BREAK * max(hi.x, max(hi.y, hi.z));
+}
+
+// Sampling pass 1 (`sampling = epipolar`, scatter::sampling): workgroup `wid.x` takes slice
+// wid.x. Its invocations find the slice's samples and their pixels' depths; mark every
+// STEP-th sample, the last, and both samples on either side of a depth break; evaluate the
+// marked ones (rounded to f16 as a per-pixel pass stores them); then evaluate every sample
+// between two marked ones that differ by more than LIGHT_BREAK; and interpolate the rest
+// between the marked samples around them. Writes `output` (SLICE_SAMPLES x SLICES,
+// rgba32float: radiance, the sample pixel's depth in w). Dispatch: (SLICES, 1, 1)
+// workgroups of (64, 1, 1).
+@compute @workgroup_size(64, 1, 1)
+fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
+    let lines = epipolar_layout({{ sampling.camera }}, screen, SLICES);
+    let s = wid.x;
+    let u = slice_direction(lines, s);
+    let span = slice_span(lines, s, screen, SLICE_SAMPLES);
+    for (var k = li; k < SLICE_SAMPLES; k += 64u) {
+        let p = slice_sample_pixel(lines, u, span, k, screen);
+        line_depth[k] = textureLoad(depth, p, 0).x;
+    }
+    workgroupBarrier();
+    for (var k = li; k < SLICE_SAMPLES; k += 64u) {
+        var marked = k % STEP == 0u || k == SLICE_SAMPLES - 1u;
+        if k > 0u && !depth_close(line_depth[k - 1u], line_depth[k], DEPTH_BREAK) {
+            marked = true;
+        }
+        if k + 1u < SLICE_SAMPLES && !depth_close(line_depth[k], line_depth[k + 1u], DEPTH_BREAK) {
+            marked = true;
+        }
+        line_flag[k] = select(0u, 1u, marked);
+        if marked {
+            line_list[atomicAdd(&line_count[0], 1u)] = k;
+        }
+    }
+    workgroupBarrier();
+    let n = atomicLoad(&line_count[0]);
+    for (var e = li; e < n; e += 64u) {
+        let k = line_list[e];
+        let p = slice_sample_pixel(lines, u, span, k, screen);
+        line_light[k] = round_f16({{ sampling.pixel }}(p.x, p.y));
+    }
+    workgroupBarrier();
+    for (var k = li; k < SLICE_SAMPLES; k += 64u) {
+        if line_flag[k] == 0u && line_spread_over(line_bracket(k)) {
+            line_list[atomicAdd(&line_count[1], 1u)] = k;
+        }
+    }
+    workgroupBarrier();
+    let n2 = atomicLoad(&line_count[1]);
+    for (var e = li; e < n2; e += 64u) {
+        let k = line_list[e];
+        let p = slice_sample_pixel(lines, u, span, k, screen);
+        line_light[k] = round_f16({{ sampling.pixel }}(p.x, p.y));
+    }
+    workgroupBarrier();
+    for (var k = li; k < SLICE_SAMPLES; k += 64u) {
+        var c = line_light[k];
+        if line_flag[k] == 0u {
+            let ab = line_bracket(k);
+            if !line_spread_over(ab) {
+                c = mix(line_light[ab.x], line_light[ab.y], f32(k - ab.x) / f32(ab.y - ab.x));
+            }
+        }
+        textureStore(output, vec2<u32>(k, s), vec4<f32>(c.x, c.y, c.z, line_depth[k]));
+    }
+}
+{%- else if sampling.unwarp %}
+
+// The workgroup's pixels to evaluate themselves, packed x | y << 16, and their count.
+var<workgroup> refine: array<u32, 64>;
+var<workgroup> refine_count: atomic<u32>;
+
+// Sampling pass 2 (`sampling = epipolar`, scatter::sampling): invocation `id` gathers pixel
+// `id` from the four samples around it (`epipolar_taps`: two slices, two samples on each)
+// kept by depth and light spread (`lowres_blend`), or puts it on the workgroup's list; then
+// the workgroup's invocations evaluate the list. Dispatch: (ceil(W / 8), ceil(H / 8), 1)
+// workgroups of (8, 8, 1).
+@compute @workgroup_size(8, 8, 1)
+fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
+    let q = id.xy;
+    if q.x < screen.x && q.y < screen.y {
+        let lines = epipolar_layout({{ sampling.camera }}, screen, SLICES);
+        let t = epipolar_taps(lines, q, screen, SLICES, SLICE_SAMPLES);
+        var depths = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        var light: array<vec3<f32>, 4>;
+        for (var j = 0u; j < 4u; j++) {
+            let v = textureLoad(epipolar_samples, vec2<u32>(t.k[j / 2u] + j % 2u, t.slices[j / 2u]), 0);
+            depths[j] = v.w;
+            light[j] = v.xyz;
+        }
+        let c = lowres_blend(t.w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
+        if c.w == 0.0 {
+            refine[atomicAdd(&refine_count, 1u)] = q.x | (q.y << 16u);
+        } else {
+            textureStore(output, q, c);
+        }
+    }
+    workgroupBarrier();
+    let n = atomicLoad(&refine_count);
+    for (var e = li; e < n; e += 64u) {
+        let p = vec2<u32>(refine[e] & 0xffffu, refine[e] >> 16u);
+        let c = {{ sampling.pixel }}(p.x, p.y);
+        textureStore(output, p, vec4<f32>(c.x, c.y, c.z, 1.0));
     }
 }
 {%- else %}
@@ -71,7 +211,7 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= frame.sizes[0] || id.y >= frame.sizes[1] {
         return;
     }
-    let c = {{ sampling.entry }}_pixel(id.x, id.y);
+    let c = {{ sampling.pixel }}(id.x, id.y);
     textureStore(output, id.xy, vec4<f32>(c.x, c.y, c.z, 1.0));
 }
 {%- endif %}
