@@ -34,15 +34,16 @@ use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
 use scatter_reference::kernels::CpuFrame;
 use scatter_reference::kernels::common_sampling::{
-    depth_close, lowres_blend, lowres_pixel, lowres_taps,
+    EpipolarCamera, depth_close, lowres_blend, lowres_pixel, lowres_taps, run_sampled,
 };
 use scatter_reference::kernels::texture::Tex;
 use scatter_reference::metrics;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_shaderlib::family::{Family, FamilyVariant};
-use scatter_shaderlib::prefiltered::{FrameSettings, LightKind};
-use scatter_shaderlib::sampling::SamplingKnobs;
+use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions, prepare_frame};
+use scatter_shaderlib::raymarch::prepare_raymarch;
+use scatter_shaderlib::sampling::{Sampling, SamplingKnobs};
 
 /// Screen of the GPU-against-mirror trials.
 const SCREEN: [u32; 2] = [67, 37];
@@ -86,9 +87,146 @@ fn bases(light: LightKind) -> Vec<FamilyVariant> {
         .collect()
 }
 
-/// The sampled configurations the trials run.
-fn knobs() -> [SamplingKnobs; 2] {
-    [SamplingKnobs::lowres(2), SamplingKnobs::lowres(4)]
+/// The sampled configurations the trials run: lowres at both scales, epipolar at its
+/// defaults (512 slices x 256 samples, step 16) and a coarse layout (64 x 64, step 8: at
+/// [`SCREEN`] its samples are sparser than the pixels, so the unwarp's interpolation and
+/// refinement are exercised).
+fn knobs() -> [SamplingKnobs; 4] {
+    [
+        SamplingKnobs::lowres(2),
+        SamplingKnobs::lowres(4),
+        SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES),
+        coarse_epipolar(),
+    ]
+}
+
+/// 64 slices x 64 samples, step 8.
+fn coarse_epipolar() -> SamplingKnobs {
+    SamplingKnobs {
+        slice_samples: 64,
+        step: 8,
+        ..SamplingKnobs::epipolar(64)
+    }
+}
+
+/// The most pixels of an epipolar GPU-against-mirror trial that may differ beyond the
+/// tolerance: the layout's sample pixels and slice coordinates come from f32 `atan2`, `sin`
+/// and `cos`, whose last bits differ between lavapipe and Rust's libm, so a sample lying
+/// within ~1e-4 pixel of a pixel border may stand on the neighbouring pixel on one side
+/// (and a pixel on a slice's centre line may take the other neighbouring slice).
+const EPIPOLAR_MISMATCH_SHARE: f64 = 0.005;
+
+/// What the epipolar layout of `variant`'s frame is built from, as its uniforms give it.
+fn epipolar_camera(variant: &FamilyVariant, f: &Fixture) -> Result<EpipolarCamera, String> {
+    let settings = FrameSettings::for_screen(SCREEN[0], SCREEN[1]);
+    let res = Resolutions {
+        screen: SCREEN,
+        rectified: RECTIFIED,
+    };
+    let frame = |v: &scatter_shaderlib::prefiltered::PrefilteredVariant| {
+        prepare_frame(
+            v,
+            &res,
+            &f.scene.camera_desc(),
+            &f.scene.light_desc(),
+            &f.scene.medium_desc(),
+            &f.shadow_map.desc(),
+            &settings,
+        )
+        .map(|p| EpipolarCamera::of_frame(&p.uniforms))
+        .map_err(|e| e.to_string())
+    };
+    match variant {
+        FamilyVariant::Prefiltered(v) => frame(v),
+        FamilyVariant::Minmax(v) => frame(&v.prefiltered()),
+        FamilyVariant::Raymarch(v) => prepare_raymarch(
+            v,
+            SCREEN,
+            &f.scene.camera_desc(),
+            &f.scene.light_desc(),
+            &f.scene.medium_desc(),
+            &f.shadow_map.desc(),
+        )
+        .map(|m| EpipolarCamera::of_raymarch(&m, v.light))
+        .map_err(|e| e.to_string()),
+    }
+}
+
+/// One epipolar GPU-against-mirror trial: the GPU's epipolar output (both passes) against
+/// the mirror of both passes (`common_sampling::run_sampled`) with the GPU's per-pixel
+/// output as the body, so that the trial checks the stage alone.
+fn epipolar_stage_trial(
+    ctx: &'static scatter_runtime::Context,
+    base: FamilyVariant,
+    knobs: SamplingKnobs,
+    pose: Pose,
+) -> Result<(), String> {
+    let f = fixture(base.light(), pose);
+    let sampled = base.with_sampling(knobs);
+    let settings = FrameSettings::for_screen(SCREEN[0], SCREEN[1]);
+    let frame = CpuFrame {
+        scene: &f.scene,
+        bvh: &f.bvh,
+        gbuf: &f.gbuf,
+        shadow_map: &f.shadow_map,
+        rectified: RECTIFIED,
+        settings: &settings,
+    };
+    let (pixels, _) = run_variant(Some(ctx), &base, &frame)?;
+    let (gpu, _) = run_variant(Some(ctx), &sampled, &frame)?;
+    let depth = depth_tex(&f.gbuf);
+    let [w, _] = SCREEN;
+    let max = pixels
+        .data
+        .iter()
+        .flat_map(|c| c.iter().copied())
+        .fold(0.0f32, f32::max);
+    if max.is_nan() || max <= 0.0 {
+        return Err("the per-pixel image is black".into());
+    }
+    let camera = epipolar_camera(&sampled, &f)?;
+    let body = |x: u32, y: u32| pixels.data[(y * w + x) as usize];
+    let cpu = run_sampled(&knobs, SCREEN, &depth, &camera, &body);
+    let (mut over, mut worst) = (0usize, 0.0f32);
+    let mut first = None;
+    for (i, g) in gpu.data.iter().enumerate() {
+        let c = cpu.output.data[i];
+        let diff = (0..3).map(|k| (g[k] - c[k]).abs()).fold(0.0f32, |m, v| {
+            if v.is_nan() { f32::INFINITY } else { m.max(v) }
+        });
+        // One f16 step of the expected value and of the brightest value (a blend of
+        // f16-rounded samples lands within a step of the mirror's either way).
+        let tol = |k: usize| REL_TOL * max + f16_ulp(c[k]) + f16_ulp(max);
+        if (0..3).any(|k| (g[k] - c[k]).abs() > tol(k)) {
+            over += 1;
+            first.get_or_insert(format!(
+                "pixel ({}, {}): gpu {g:?}, mirror {c:?}",
+                i as u32 % w,
+                i as u32 / w
+            ));
+        } else {
+            worst = worst.max(diff);
+        }
+    }
+    let share = over as f64 / gpu.data.len() as f64;
+    if share > EPIPOLAR_MISMATCH_SHARE {
+        return Err(format!(
+            "{over} pixels ({:.2} %) over tolerance, first at {}",
+            100.0 * share,
+            first.unwrap_or_default()
+        ));
+    }
+    println!(
+        "sampling::{}::{}::{pose}: {} samples and pixels evaluated ({} for depth, {} for light) of {} pixels; {over} pixels over tolerance (layout ulps); max |diff| elsewhere {:.2e} of max",
+        sampled.trial_name(),
+        scene_for(base.light()),
+        cpu.evaluated,
+        cpu.depth_refined,
+        cpu.light_refined,
+        gpu.data.len(),
+        worst / max
+    );
+    Ok(())
 }
 
 fn fixture(light: LightKind, pose: Pose) -> Arc<Fixture> {
@@ -439,14 +577,27 @@ fn main() -> ExitCode {
                             base.with_sampling(knobs).trial_name(),
                             scene_for(light)
                         );
-                        trials.push((name, Box::new(move || stage_trial(ctx, base, knobs, pose))));
+                        trials.push((
+                            name,
+                            Box::new(move || {
+                                if knobs.sampling == Sampling::Epipolar {
+                                    epipolar_stage_trial(ctx, base, knobs, pose)
+                                } else {
+                                    stage_trial(ctx, base, knobs, pose)
+                                }
+                            }),
+                        ));
                     }
                 }
             }
         }
     }
     for &family in Family::ALL {
-        for knobs in knobs() {
+        for knobs in [
+            SamplingKnobs::lowres(2),
+            SamplingKnobs::lowres(4),
+            SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES),
+        ] {
             let base = family.default_variant();
             let name = format!("sampling::accuracy::{}", base.with_sampling(knobs).label());
             trials.push((name, Box::new(move || accuracy_trial(base, knobs))));

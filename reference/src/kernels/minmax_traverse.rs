@@ -14,7 +14,7 @@ use super::common_epipolar::{
 };
 use super::common_minmax::{level_offset, tree_levels};
 use super::common_model::{clamp, max, max_u, min, phase_hg, transmittance_between};
-use super::common_sampling::run_sampled;
+use super::common_sampling::{EpipolarCamera, EpipolarSamples, epipolar_samples, run_sampled};
 use super::texture::{Tex, TexArray, quantise, xyz};
 use glam::Vec3;
 use scatter_shaderlib::minmax::MinmaxVariant;
@@ -321,6 +321,7 @@ pub fn minmax_traverse(variant: &MinmaxVariant, inp: &TraverseInputs) -> Travers
         &knobs,
         [inp.frame.sizes[0], inp.frame.sizes[1]],
         inp.depth,
+        &EpipolarCamera::of_frame(inp.frame),
         &|x, y| {
             let c = minmax_traverse_main([x, y, 0], variant, inp).map_or([0.0; 4], |(c, _)| c);
             [c[0], c[1], c[2]]
@@ -342,4 +343,21 @@ pub fn minmax_brute(
     run_pixels(inp.frame, &|id| {
         minmax_brute_main(id, variant, inp, rectified)
     })
+}
+
+/// `minmax_traverse` of an `epipolar` variant: the samples of every slice (sampling pass 1).
+pub fn minmax_traverse_epipolar_samples(
+    variant: &MinmaxVariant,
+    inp: &TraverseInputs,
+) -> EpipolarSamples {
+    epipolar_samples(
+        &variant.sampling_knobs(),
+        [inp.frame.sizes[0], inp.frame.sizes[1]],
+        inp.depth,
+        &EpipolarCamera::of_frame(inp.frame),
+        &|x, y| {
+            let c = minmax_traverse_main([x, y, 0], variant, inp).map_or([0.0; 4], |(c, _)| c);
+            [c[0], c[1], c[2]]
+        },
+    )
 }

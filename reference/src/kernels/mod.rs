@@ -18,11 +18,14 @@ pub mod family;
 pub mod interleave_sum;
 pub mod minmax_build;
 pub mod minmax_traverse;
+pub mod minmax_traverse_unwarp;
 pub mod prefilter;
 pub mod raymarch;
+pub mod raymarch_unwarp;
 pub mod rectify;
 pub mod row_prefix;
 pub mod scatter;
+pub mod scatter_unwarp;
 pub mod slice_fit;
 pub mod texture;
 

@@ -7,7 +7,9 @@ use super::common_model::{
     equiangular, equiangular_sample, max, min, phase_hg, spot_integrand, transmittance_between,
 };
 use super::common_raymarch::{pixel_jitter, raymarch_pixel_dir, raymarch_shadow_view};
-use super::common_sampling::{SampledOutput, run_sampled};
+use super::common_sampling::{
+    EpipolarCamera, EpipolarSamples, SampledOutput, epipolar_samples, run_sampled,
+};
 use super::common_shadow::shadow_visibility;
 use super::texture::{Tex, TexArray, quantise, xyz};
 use scatter_shaderlib::prefiltered::{LightKind, Storage};
@@ -124,6 +126,26 @@ pub fn raymarch_sampled(
         &variant.sampling_knobs(),
         [m.sizes[0], m.sizes[1]],
         depth,
+        &EpipolarCamera::of_raymarch(m, variant.light),
+        &|x, y| {
+            let c = raymarch_main([x, y, 0], variant, m, depth, shadow_map).unwrap_or([0.0; 4]);
+            [c[0], c[1], c[2]]
+        },
+    )
+}
+
+/// `raymarch` of an `epipolar` variant: the samples of every slice (sampling pass 1).
+pub fn raymarch_epipolar_samples(
+    variant: &RaymarchVariant,
+    m: &RaymarchUniforms,
+    depth: &Tex,
+    shadow_map: &Tex,
+) -> EpipolarSamples {
+    epipolar_samples(
+        &variant.sampling_knobs(),
+        [m.sizes[0], m.sizes[1]],
+        depth,
+        &EpipolarCamera::of_raymarch(m, variant.light),
         &|x, y| {
             let c = raymarch_main([x, y, 0], variant, m, depth, shadow_map).unwrap_or([0.0; 4]);
             [c[0], c[1], c[2]]

@@ -23,7 +23,9 @@ use super::common_moments::{lit_moments4, lit_moments6, moment_z};
 use super::common_prefiltered::{coeff4, fourier_step, region_start, turn};
 use super::common_prefiltered_projective::proj_column;
 use super::common_projective::{proj_boundary, proj_ray_depth, proj_reach};
-use super::common_sampling::{SampledOutput, run_sampled};
+use super::common_sampling::{
+    EpipolarCamera, EpipolarSamples, SampledOutput, epipolar_samples, run_sampled,
+};
 use super::texture::{Tex, TexArray, mix4, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
@@ -280,6 +282,21 @@ pub fn scatter_sampled(variant: &PrefilteredVariant, inp: &ScatterInputs) -> Sam
         &variant.sampling_knobs(),
         [inp.frame.sizes[0], inp.frame.sizes[1]],
         inp.depth,
+        &EpipolarCamera::of_frame(inp.frame),
+        &|x, y| {
+            let c = scatter_main([x, y, 0], variant, inp).unwrap_or([0.0; 4]);
+            [c[0], c[1], c[2]]
+        },
+    )
+}
+
+/// `scatter` of an `epipolar` variant: the samples of every slice (sampling pass 1).
+pub fn scatter_epipolar_samples(variant: &PrefilteredVariant, inp: &ScatterInputs) -> EpipolarSamples {
+    epipolar_samples(
+        &variant.sampling_knobs(),
+        [inp.frame.sizes[0], inp.frame.sizes[1]],
+        inp.depth,
+        &EpipolarCamera::of_frame(inp.frame),
         &|x, y| {
             let c = scatter_main([x, y, 0], variant, inp).unwrap_or([0.0; 4]);
             [c[0], c[1], c[2]]

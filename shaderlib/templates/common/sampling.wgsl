@@ -221,7 +221,7 @@ fn slice_sample_pixel(l: EpipolarLayout, u: vec2<f32>, span: vec2<f32>, k: u32, 
 
 // The four samples a pixel is gathered from: slices `slices.x` and `slices.y`, samples
 // (k.x, k.x + 1) on the first and (k.y, k.y + 1) on the second, and their bilinear weights
-// in that order (0 for a slice the pixel lies beyond the ends of).
+// in that order (a pixel beyond a slice's end takes its end sample: the depth test decides).
 struct EpipolarTaps {
     slices: vec2<u32>,
     k: vec2<u32>,
@@ -251,19 +251,12 @@ fn epipolar_taps(l: EpipolarLayout, p: vec2<u32>, screen: vec2<u32>, slices: u32
         let s = t.slices[j];
         let span = slice_span(l, s, screen, samples);
         let g = (dot(d, slice_direction(l, s)) - span.x) / max(span.y, 1e-20);
-        let last = f32(samples - 1u);
-        if g < -1.0 || g > last + 1.0 {
-            t.k[j] = 0u;
-            t.w[2u * j] = 0.0;
-            t.w[2u * j + 1u] = 0.0;
-        } else {
-            let gc = clamp(g, 0.0, last);
-            let k_lo = min(u32(gc), samples - 2u);
-            let fk = gc - f32(k_lo);
-            t.k[j] = k_lo;
-            t.w[2u * j] = ws[j] * (1.0 - fk);
-            t.w[2u * j + 1u] = ws[j] * fk;
-        }
+        let gc = clamp(g, 0.0, f32(samples - 1u));
+        let k_lo = min(u32(gc), samples - 2u);
+        let fk = gc - f32(k_lo);
+        t.k[j] = k_lo;
+        t.w[2u * j] = ws[j] * (1.0 - fk);
+        t.w[2u * j + 1u] = ws[j] * fk;
     }
     return t;
 }

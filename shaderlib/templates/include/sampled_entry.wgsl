@@ -157,7 +157,8 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
         if line_flag[k] == 0u {
             let ab = line_bracket(k);
             if !line_spread_over(ab) {
-                c = mix(line_light[ab.x], line_light[ab.y], f32(k - ab.x) / f32(ab.y - ab.x));
+                let t = f32(k - ab.x) / f32(ab.y - ab.x);
+                c = line_light[ab.x] * (1.0 - t) + line_light[ab.y] * t;
             }
         }
         textureStore(output, vec2<u32>(k, s), vec4<f32>(c.x, c.y, c.z, line_depth[k]));
