@@ -562,6 +562,9 @@ fn prefiltered_times(t: PrefilteredTimes, projective: bool) -> PassTimes {
         (Kernel::Prefilter.name(), t.prefilter),
         (Kernel::Scatter.name(), t.scatter),
     ];
+    if t.unwarp > Duration::ZERO {
+        out.push((Kernel::ScatterUnwarp.name(), t.unwarp));
+    }
     if projective {
         out.drain(..3);
     }
@@ -573,17 +576,24 @@ fn raymarch_times(t: RaymarchTimes, interleaved: bool) -> PassTimes {
     if interleaved {
         out.push((Kernel::InterleaveSum.name(), t.interleave_sum));
     }
+    if t.unwarp > Duration::ZERO {
+        out.push((Kernel::RaymarchUnwarp.name(), t.unwarp));
+    }
     out
 }
 
 fn minmax_times(t: MinmaxTimes) -> PassTimes {
-    vec![
+    let mut out = vec![
         (Kernel::DepthColumns.name(), t.depth_columns),
         (Kernel::SliceFit.name(), t.slice_fit),
         (Kernel::Rectify.name(), t.rectify),
         (Kernel::MinmaxBuild.name(), t.build),
         (Kernel::MinmaxTraverse.name(), t.march),
-    ]
+    ];
+    if t.unwarp > Duration::ZERO {
+        out.push((Kernel::MinmaxTraverseUnwarp.name(), t.unwarp));
+    }
+    out
 }
 
 /// The pass-wise minimum of two frames' times.

@@ -682,11 +682,44 @@ fn time_methods_on(
         .collect())
 }
 
-/// The per-pixel variants the headline also runs sampled (`sampling = lowres`): every
-/// family's default and the moment basis with 4 moments.
+/// The per-pixel variants the headline also runs sampled: every family's default and the
+/// moment basis with 4 moments.
 fn sampled_bases() -> Vec<FamilyVariant> {
     let mut out: Vec<FamilyVariant> = Family::ALL.iter().map(|f| f.default_variant()).collect();
     out.push(PrefilteredVariant::with_moments(4).into());
+    out
+}
+
+/// The sampling configurations the headline runs every sampled base with: lowres at 1/2
+/// and 1/4 of the screen per axis, and epipolar at its defaults (512 slices x 256 samples,
+/// step 16).
+fn sampled_configs() -> Vec<SamplingKnobs> {
+    let mut out: Vec<SamplingKnobs> = SamplingKnobs::SCALES
+        .iter()
+        .map(|&s| SamplingKnobs::lowres(s))
+        .collect();
+    out.push(SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES));
+    out
+}
+
+/// Every sampled variant of the headline: each base in each configuration, and raymarch
+/// n256 epipolar (the brute-force anchor sampled: its evaluations are the fewest).
+fn sampled_variants() -> Vec<(FamilyVariant, FamilyVariant)> {
+    let mut out = Vec::new();
+    for base in sampled_bases() {
+        for knobs in sampled_configs() {
+            out.push((base, base.with_sampling(knobs)));
+        }
+    }
+    let n256: FamilyVariant = RaymarchVariant {
+        samples: 256,
+        ..RaymarchVariant::default()
+    }
+    .into();
+    out.push((
+        n256,
+        n256.with_sampling(SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES)),
+    ));
     out
 }
 
@@ -710,13 +743,9 @@ fn headline_runs(ctx: &Context, frames: u32, errors: bool) -> Result<Vec<Headlin
         }));
     }
     // The sampling stage (issue 14): each family's default, and the moment basis's
-    // cheapest, at 1/2 and 1/4 of the screen per axis.
-    for base in sampled_bases() {
-        for scale in SamplingKnobs::SCALES {
-            methods.push(Method::from(
-                base.with_sampling(SamplingKnobs::lowres(scale)),
-            ));
-        }
+    // cheapest, at 1/2 and 1/4 of the screen per axis and epipolar.
+    for (_, sampled) in sampled_variants() {
+        methods.push(Method::from(sampled));
     }
     let screen = [1280, 720];
     let mut out = Vec::new();
@@ -992,13 +1021,13 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
     // Issue 14: each family sampled against itself per pixel, and the best sampled
     // configuration against brute-force raymarch n256 at equal or lower error.
     let mut best: Option<(String, f64, f64)> = None;
-    for base in sampled_bases() {
+    for (base, sampled) in sampled_variants() {
         let px = Method::from(base);
         let Some((pt, pe)) = headline_mean(px.family(), &px.knobs()) else {
             continue;
         };
-        for scale in SamplingKnobs::SCALES {
-            let m = Method::from(base.with_sampling(SamplingKnobs::lowres(scale)));
+        {
+            let m = Method::from(sampled);
             if let Some((t, e)) = headline_mean(m.family(), &m.knobs()) {
                 out.push(format!(
                     "sampled vs per pixel, headline means: {} {} {t:.1} ms at rel L1 {:.3} % / {} {pt:.1} ms at {:.3} %: {:.2}x faster, {:+.3} points",
@@ -1019,15 +1048,13 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
     if let (Some((name, _, _)), Some((rt, re))) = (&best, headline_mean("raymarch", "n256-i1")) {
         // The fastest sampled configuration whose error is at or below raymarch n256's.
         let mut at_error: Option<(String, f64, f64)> = None;
-        for base in sampled_bases() {
-            for scale in SamplingKnobs::SCALES {
-                let m = Method::from(base.with_sampling(SamplingKnobs::lowres(scale)));
-                if let Some((t, e)) = headline_mean(m.family(), &m.knobs())
-                    && e <= re
-                    && at_error.as_ref().is_none_or(|b| t < b.1)
-                {
-                    at_error = Some((format!("{} {}", m.family(), m.knobs()), t, e));
-                }
+        for (_, sampled) in sampled_variants() {
+            let m = Method::from(sampled);
+            if let Some((t, e)) = headline_mean(m.family(), &m.knobs())
+                && e <= re
+                && at_error.as_ref().is_none_or(|b| t < b.1)
+            {
+                at_error = Some((format!("{} {}", m.family(), m.knobs()), t, e));
             }
         }
         match at_error {
@@ -1479,10 +1506,8 @@ pub fn tune_candidates() -> Vec<Method> {
         MinmaxVariant::default().into(),
     ];
     for base in sampled {
-        for scale in SamplingKnobs::SCALES {
-            out.push(Method::from(
-                base.with_sampling(SamplingKnobs::lowres(scale)),
-            ));
+        for knobs in sampled_configs() {
+            out.push(Method::from(base.with_sampling(knobs)));
         }
     }
     out

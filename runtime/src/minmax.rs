@@ -35,6 +35,7 @@ const SLICE_FIT: Kernel = Kernel::SliceFit;
 const RECTIFY: Kernel = Kernel::Rectify;
 const BUILD: Kernel = Kernel::MinmaxBuild;
 const MARCH: Kernel = Kernel::MinmaxTraverse;
+const UNWARP: Kernel = Kernel::MinmaxTraverseUnwarp;
 
 /// Format of the min-max tree (r = min, g = max).
 pub const TREE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
@@ -52,12 +53,14 @@ pub struct MinmaxTimes {
     pub build: Duration,
     /// The `minmax_traverse` pass.
     pub march: Duration,
+    /// The `minmax_traverse_unwarp` pass (zero without epipolar sampling).
+    pub unwarp: Duration,
 }
 
 impl MinmaxTimes {
     /// Sum of the passes.
     pub fn total(&self) -> Duration {
-        self.depth_columns + self.slice_fit + self.rectify + self.build + self.march
+        self.depth_columns + self.slice_fit + self.rectify + self.build + self.march + self.unwarp
     }
 }
 
@@ -226,9 +229,10 @@ impl Minmax {
         shadow_map: &wgpu::TextureView,
         frames: u32,
     ) -> Result<MinmaxTimes, RuntimeError> {
-        let [depth_columns, slice_fit, rectify, build, march] = median_pass_wall_times(
+        // Without epipolar sampling there is no unwarp pass: its slot records nothing.
+        let [depth_columns, slice_fit, rectify, build, march, unwarp] = median_pass_wall_times(
             ctx,
-            [DEPTH_COLUMNS, SLICE_FIT, RECTIFY, BUILD, MARCH],
+            [DEPTH_COLUMNS, SLICE_FIT, RECTIFY, BUILD, MARCH, UNWARP],
             frames,
             |encoder, kernel| {
                 self.encode_selected(ctx, encoder, depth, shadow_map, Some(kernel))
@@ -241,7 +245,17 @@ impl Minmax {
             rectify,
             build,
             march,
+            unwarp: if self.epipolar() {
+                unwarp
+            } else {
+                Duration::ZERO
+            },
         })
+    }
+
+    /// Whether the variant samples epipolar lines (and has the unwarp pass).
+    fn epipolar(&self) -> bool {
+        self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
     }
 
     fn encode_selected(
@@ -290,6 +304,7 @@ impl Minmax {
             rectify: at(2),
             build: at(3),
             march: at(4),
+            unwarp: at(5),
         }))
     }
 
@@ -460,12 +475,16 @@ impl crate::family::FamilyRuntime for Minmax {
     ) -> Result<Vec<(Kernel, Duration)>, RuntimeError> {
         let shadow_map = crate::family::required_shadow_map(inputs, RECTIFY)?;
         let t = self.measure_pass_wall_times(ctx, inputs.depth, shadow_map, frames)?;
-        Ok(vec![
+        let mut passes = vec![
             (DEPTH_COLUMNS, t.depth_columns),
             (SLICE_FIT, t.slice_fit),
             (RECTIFY, t.rectify),
             (BUILD, t.build),
             (MARCH, t.march),
-        ])
+        ];
+        if self.epipolar() {
+            passes.push((UNWARP, t.unwarp));
+        }
+        Ok(passes)
     }
 }

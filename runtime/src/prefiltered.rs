@@ -42,6 +42,7 @@ const SLICE_FIT: Kernel = Kernel::SliceFit;
 const RECTIFY: Kernel = Kernel::Rectify;
 const PREFILTER: Kernel = Kernel::Prefilter;
 const SCATTER: Kernel = Kernel::Scatter;
+const SCATTER_UNWARP: Kernel = Kernel::ScatterUnwarp;
 
 pub use crate::gpu::{DEPTH_FORMAT, OUTPUT_FORMAT};
 
@@ -106,12 +107,19 @@ pub struct PrefilteredTimes {
     pub prefilter: Duration,
     /// The `scatter` pass.
     pub scatter: Duration,
+    /// The `scatter_unwarp` pass (zero without epipolar sampling).
+    pub unwarp: Duration,
 }
 
 impl PrefilteredTimes {
-    /// Sum of the five passes.
+    /// Sum of the passes.
     pub fn total(&self) -> Duration {
-        self.depth_columns + self.slice_fit + self.rectify + self.prefilter + self.scatter
+        self.depth_columns
+            + self.slice_fit
+            + self.rectify
+            + self.prefilter
+            + self.scatter
+            + self.unwarp
     }
 }
 
@@ -347,18 +355,26 @@ impl Prefiltered {
         inputs: &Inputs<'_>,
         frames: u32,
     ) -> Result<PrefilteredTimes, RuntimeError> {
-        let [depth_columns, slice_fit, rectify, prefilter, scatter] = median_pass_wall_times(
-            ctx,
-            [DEPTH_COLUMNS, SLICE_FIT, RECTIFY, PREFILTER, SCATTER],
-            frames,
-            |encoder, kernel| self.encode_pass(encoder, inputs, kernel),
-        )?;
+        // Without epipolar sampling there is no `scatter_unwarp` pass: its slot records
+        // nothing.
+        let [depth_columns, slice_fit, rectify, prefilter, scatter, unwarp] =
+            median_pass_wall_times(
+                ctx,
+                [DEPTH_COLUMNS, SLICE_FIT, RECTIFY, PREFILTER, SCATTER, SCATTER_UNWARP],
+                frames,
+                |encoder, kernel| self.encode_pass(encoder, inputs, kernel),
+            )?;
         Ok(PrefilteredTimes {
             depth_columns,
             slice_fit,
             rectify,
             prefilter,
             scatter,
+            unwarp: if self.epipolar() {
+                unwarp
+            } else {
+                Duration::ZERO
+            },
         })
     }
 
@@ -425,7 +441,11 @@ impl Prefiltered {
             .frame
             .as_ref()
             .is_some_and(|f| f.report.rectification == Rectification::Projective);
-        match times[..] {
+        let (times, unwarp) = match times[..] {
+            [ref head @ .., unwarp] if self.epipolar() && times.len() == 6 => (head, unwarp),
+            _ => (&times[..], Duration::ZERO),
+        };
+        match *times {
             [depth_columns, slice_fit, rectify, prefilter, scatter] => Ok(Some(PrefilteredTimes {
                 depth_columns: if projective {
                     Duration::ZERO
@@ -440,12 +460,22 @@ impl Prefiltered {
                 rectify: if projective { Duration::ZERO } else { rectify },
                 prefilter,
                 scatter,
+                unwarp,
             })),
             _ => Err(RuntimeError::Readback {
                 kernel: SCATTER,
-                message: format!("expected 5 pass times, got {}", times.len()),
+                message: format!(
+                    "expected {} pass times, got {}",
+                    if self.epipolar() { 6 } else { 5 },
+                    times.len() + usize::from(self.epipolar())
+                ),
             }),
         }
+    }
+
+    /// Whether the variant samples epipolar lines (and has the `scatter_unwarp` pass).
+    fn epipolar(&self) -> bool {
+        self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
     }
 
     /// The variant the pipelines were built for.
@@ -755,12 +785,16 @@ impl crate::family::FamilyRuntime for Prefiltered {
         frames: u32,
     ) -> Result<Vec<(Kernel, Duration)>, RuntimeError> {
         let t = self.measure_pass_wall_times(ctx, inputs, frames)?;
-        Ok(vec![
+        let mut passes = vec![
             (DEPTH_COLUMNS, t.depth_columns),
             (SLICE_FIT, t.slice_fit),
             (RECTIFY, t.rectify),
             (PREFILTER, t.prefilter),
             (SCATTER, t.scatter),
-        ])
+        ];
+        if self.epipolar() {
+            passes.push((SCATTER_UNWARP, t.unwarp));
+        }
+        Ok(passes)
     }
 }

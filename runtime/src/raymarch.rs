@@ -27,6 +27,7 @@ use crate::{Context, RuntimeError};
 
 const RAYMARCH: Kernel = Kernel::Raymarch;
 const INTERLEAVE_SUM: Kernel = Kernel::InterleaveSum;
+const UNWARP: Kernel = Kernel::RaymarchUnwarp;
 
 /// Format of the partial sums of an interleaved variant
 /// (`scatter_shaderlib::raymarch::PARTIAL_FORMAT`).
@@ -64,12 +65,14 @@ pub struct RaymarchTimes {
     pub raymarch: Duration,
     /// The `interleave_sum` pass (zero without interleaving).
     pub interleave_sum: Duration,
+    /// The `raymarch_unwarp` pass (zero without epipolar sampling).
+    pub unwarp: Duration,
 }
 
 impl RaymarchTimes {
     /// Sum of the passes.
     pub fn total(&self) -> Duration {
-        self.raymarch + self.interleave_sum
+        self.raymarch + self.interleave_sum + self.unwarp
     }
 }
 
@@ -231,9 +234,9 @@ impl Raymarch {
         frames: u32,
     ) -> Result<RaymarchTimes, RuntimeError> {
         // Without interleaving there is no `interleave_sum` pass: its slot records nothing.
-        let [raymarch, interleave_sum] = median_pass_wall_times(
+        let [raymarch, interleave_sum, unwarp] = median_pass_wall_times(
             ctx,
-            [RAYMARCH, INTERLEAVE_SUM],
+            [RAYMARCH, INTERLEAVE_SUM, UNWARP],
             frames,
             |encoder, kernel| {
                 self.encode_selected(ctx, encoder, depth, shadow_map, Some(kernel))
@@ -247,7 +250,17 @@ impl Raymarch {
             } else {
                 Duration::ZERO
             },
+            unwarp: if self.epipolar() {
+                unwarp
+            } else {
+                Duration::ZERO
+            },
         })
+    }
+
+    /// Whether the variant samples epipolar lines (and has the `raymarch_unwarp` pass).
+    fn epipolar(&self) -> bool {
+        self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
     }
 
     fn encode_selected(
@@ -292,6 +305,11 @@ impl Raymarch {
         Ok(Some(RaymarchTimes {
             raymarch: times.first().copied().unwrap_or_default(),
             interleave_sum: if self.partial.is_some() {
+                times.get(1).copied().unwrap_or_default()
+            } else {
+                Duration::ZERO
+            },
+            unwarp: if self.epipolar() {
                 times.get(1).copied().unwrap_or_default()
             } else {
                 Duration::ZERO
@@ -457,6 +475,9 @@ impl crate::family::FamilyRuntime for Raymarch {
         let mut passes = vec![(RAYMARCH, t.raymarch)];
         if self.variant.interleaved() {
             passes.push((INTERLEAVE_SUM, t.interleave_sum));
+        }
+        if self.epipolar() {
+            passes.push((UNWARP, t.unwarp));
         }
         Ok(passes)
     }

@@ -62,7 +62,7 @@ impl SamplingView {
                 "#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}"
             }
             Sampling::Epipolar if unwarp => {
-                "#import scatter::sampling::{EpipolarCamera, epipolar_layout, epipolar_taps, lowres_blend}"
+                "#import scatter::sampling::{EpipolarCamera, EpipolarLayout, epipolar_layout, epipolar_slices, epipolar_taps, lowres_blend}"
             }
             Sampling::Epipolar => {
                 "#import scatter::sampling::{EpipolarCamera, depth_close, epipolar_layout, round_f16, slice_direction, slice_sample_pixel, slice_span}"
@@ -129,17 +129,18 @@ pub fn sampling_invocations(knobs: &SamplingKnobs) -> [String; 3] {
     }
 }
 
-/// The `epipolar_samples` texture of an `epipolar` plan (`slice_samples x slices`,
-/// rgba32float), or `None` for the other modes.
+/// The `epipolar_samples` texture of an `epipolar` plan (`(slice_samples + 1) x slices`,
+/// rgba32float: the last column holds each slice's line), or `None` for the other modes.
 pub fn epipolar_samples_texture(knobs: &SamplingKnobs) -> Option<crate::plan::Resource> {
     (knobs.sampling == Sampling::Epipolar).then(|| {
         crate::plan::scatter_texture(
             "epipolar_samples",
             "sampling = epipolar: the samples of every slice (x = sample, y = slice): radiance \
-             rgb, the view depth of the sample's pixel in alpha (written by the family's \
-             per-pixel kernel, read by its _unwarp pass)",
+             rgb, the view depth of the sample's pixel in alpha; the last column holds the \
+             slice's line (direction xy, first distance, distance between samples) (written \
+             by the family's per-pixel kernel, read by its _unwarp pass)",
             EPIPOLAR_SAMPLES_FORMAT,
-            &knobs.slice_samples.to_string(),
+            &(knobs.slice_samples + 1).to_string(),
             &knobs.slices.to_string(),
         )
     })

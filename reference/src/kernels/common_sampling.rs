@@ -433,15 +433,9 @@ pub struct EpipolarTaps {
     pub w: [f32; 4],
 }
 
-/// The taps of pixel `p`: the slices on either side of its angle, and on each the samples on
-/// either side of its distance along the slice.
-pub fn epipolar_taps(
-    l: &EpipolarLayout,
-    p: [u32; 2],
-    screen: [u32; 2],
-    slices: u32,
-    samples: u32,
-) -> EpipolarTaps {
+/// The slices on either side of pixel `p`'s angle (`t.slices`), the second one's weight in
+/// `t.w[1]` (the rest is filled by [`epipolar_taps`]).
+pub fn epipolar_slices(l: &EpipolarLayout, p: [u32; 2], slices: u32) -> EpipolarTaps {
     let d = [
         p[0] as f32 + 0.5 - l.origin[0],
         p[1] as f32 + 0.5 - l.origin[1],
@@ -455,17 +449,30 @@ pub fn epipolar_taps(
         let s_lo = (fc as u32).min(slices - 2);
         (s_lo, fc - s_lo as f32)
     };
-    let mut t = EpipolarTaps {
+    EpipolarTaps {
         slices: [s_lo, (s_lo + 1) % slices],
         k: [0; 2],
-        w: [0.0; 4],
-    };
-    let ws = [1.0 - fs, fs];
-    for j in 0..2 {
-        let s = t.slices[j];
-        let span = slice_span(l, s, screen, samples);
-        let u = slice_direction(l, s);
-        let g = (d[0] * u[0] + d[1] * u[1] - span[0]) / span[1].max(1e-20);
+        w: [1.0 - fs, fs, 0.0, 0.0],
+    }
+}
+
+/// The taps of pixel `p` from its slices `pair` ([`epipolar_slices`]) and their lines
+/// (direction, first distance, distance between samples: the samples' last column).
+pub fn epipolar_taps(
+    l: &EpipolarLayout,
+    p: [u32; 2],
+    pair: EpipolarTaps,
+    lines: [[f32; 4]; 2],
+    samples: u32,
+) -> EpipolarTaps {
+    let d = [
+        p[0] as f32 + 0.5 - l.origin[0],
+        p[1] as f32 + 0.5 - l.origin[1],
+    ];
+    let mut t = pair;
+    let ws = [pair.w[0], pair.w[1]];
+    for (j, line) in lines.iter().enumerate() {
+        let g = (d[0] * line[0] + d[1] * line[1] - line[2]) / line[3].max(1e-20);
         let gc = g.clamp(0.0, (samples - 1) as f32);
         let k_lo = (gc as u32).min(samples - 2);
         let fk = gc - k_lo as f32;
@@ -476,10 +483,29 @@ pub fn epipolar_taps(
     t
 }
 
+/// The taps of pixel `p`, its slices' lines computed here (as the samples pass stores them).
+pub fn epipolar_taps_direct(
+    l: &EpipolarLayout,
+    p: [u32; 2],
+    screen: [u32; 2],
+    slices: u32,
+    samples: u32,
+) -> EpipolarTaps {
+    let pair = epipolar_slices(l, p, slices);
+    let lines = pair.slices.map(|s| {
+        let u = slice_direction(l, s);
+        let span = slice_span(l, s, screen, samples);
+        [u[0], u[1], span[0], span[1]]
+    });
+    epipolar_taps(l, p, pair, lines, samples)
+}
+
 /// What the epipolar samples pass produced.
 #[derive(Clone, Debug)]
 pub struct EpipolarSamples {
-    /// `slice_samples x slices`, rgba32float: radiance, the sample pixel's depth in w.
+    /// `(slice_samples + 1) x slices`, rgba32float: radiance, the sample pixel's depth in
+    /// w; the last column holds each slice's line (direction, first distance, distance
+    /// between samples).
     pub samples: TexArray,
     /// Samples evaluated (every slice's marked ones and those the light criterion added).
     pub evaluated: u64,
@@ -567,6 +593,7 @@ pub fn epipolar_samples(
                     }
                     [c[0], c[1], c[2], d[k]]
                 })
+                .chain(std::iter::once([u[0], u[1], span[0], span[1]]))
                 .collect();
             let marked = flag.iter().filter(|&&f| f).count() as u64;
             (
@@ -580,7 +607,7 @@ pub fn epipolar_samples(
         })
         .collect();
     let mut counts = [0u64; 3];
-    let mut data = Vec::with_capacity((n * m) as usize);
+    let mut data = Vec::with_capacity((n * (m + 1)) as usize);
     for (line, c) in lines {
         data.extend(line);
         for i in 0..3 {
@@ -589,7 +616,7 @@ pub fn epipolar_samples(
     }
     EpipolarSamples {
         samples: TexArray {
-            width: m,
+            width: m + 1,
             height: n,
             layers: 1,
             data,
@@ -622,7 +649,9 @@ pub fn epipolar_unwarp(
         .flat_map_iter(|y| {
             let layout = &layout;
             (0..w).map(move |x| {
-                let t = epipolar_taps(layout, [x, y], screen, knobs.slices, knobs.slice_samples);
+                let pair = epipolar_slices(layout, [x, y], knobs.slices);
+                let lines = pair.slices.map(|s| samples.load(knobs.slice_samples, s, 0));
+                let t = epipolar_taps(layout, [x, y], pair, lines, knobs.slice_samples);
                 let mut depths = [0.0f32; 4];
                 let mut light = [[0.0f32; 3]; 4];
                 for j in 0..4 {
@@ -811,7 +840,7 @@ mod tests {
             // Every pixel lies between two slices and two samples with weights summing to 1.
             for y in 0..37 {
                 for x in 0..67 {
-                    let t = epipolar_taps(&l, [x, y], screen, 64, 64);
+                    let t = epipolar_taps_direct(&l, [x, y], screen, 64, 64);
                     let sum: f32 = t.w.iter().sum();
                     assert!(t.w.iter().all(|&w| w >= 0.0), "{toward:?} ({x}, {y}): {t:?}");
                     assert!((sum - 1.0).abs() <= 1e-5, "{toward:?} ({x}, {y}): {t:?}");

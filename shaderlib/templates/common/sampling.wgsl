@@ -228,9 +228,9 @@ struct EpipolarTaps {
     w: vec4<f32>,
 }
 
-// The taps of pixel `p`: the slices on either side of its angle, and on each the samples on
-// either side of its distance along the slice.
-fn epipolar_taps(l: EpipolarLayout, p: vec2<u32>, screen: vec2<u32>, slices: u32, samples: u32) -> EpipolarTaps {
+// The slices on either side of pixel `p`'s angle (`t.slices`), the second one's weight in
+// `t.w.y` (the rest of `t` is filled by `epipolar_taps`).
+fn epipolar_slices(l: EpipolarLayout, p: vec2<u32>, slices: u32) -> EpipolarTaps {
     let d = vec2<f32>(p) + vec2<f32>(0.5, 0.5) - l.origin;
     let f = (epipolar_angle(l.axis, d) - l.phi_start) / l.dphi - 0.5;
     var s_lo = 0u;
@@ -246,11 +246,21 @@ fn epipolar_taps(l: EpipolarLayout, p: vec2<u32>, screen: vec2<u32>, slices: u32
     }
     var t: EpipolarTaps;
     t.slices = vec2<u32>(s_lo, (s_lo + 1u) % slices);
-    let ws = vec2<f32>(1.0 - fs, fs);
+    t.w = vec4<f32>(1.0 - fs, fs, 0.0, 0.0);
+    return t;
+}
+
+// The taps of pixel `p` from its slices `pair` (`epipolar_slices`) and their lines
+// `line_lo`, `line_hi` (direction xy, first distance z, distance between samples w; the last
+// column of `epipolar_samples`): on each slice the samples on either side of the pixel's
+// distance along it.
+fn epipolar_taps(l: EpipolarLayout, p: vec2<u32>, pair: EpipolarTaps, line_lo: vec4<f32>, line_hi: vec4<f32>, samples: u32) -> EpipolarTaps {
+    let d = vec2<f32>(p) + vec2<f32>(0.5, 0.5) - l.origin;
+    var t = pair;
+    let ws = pair.w.xy;
     for (var j = 0u; j < 2u; j++) {
-        let s = t.slices[j];
-        let span = slice_span(l, s, screen, samples);
-        let g = (dot(d, slice_direction(l, s)) - span.x) / max(span.y, 1e-20);
+        let line = select(line_lo, line_hi, j == 1u);
+        let g = (dot(d, line.xy) - line.z) / max(line.w, 1e-20);
         let gc = clamp(g, 0.0, f32(samples - 1u));
         let k_lo = min(u32(gc), samples - 2u);
         let fk = gc - f32(k_lo);

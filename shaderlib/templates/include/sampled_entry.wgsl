@@ -103,8 +103,9 @@ fn line_spread_over(ab: vec2<u32>) -> bool {
 // STEP-th sample, the last, and both samples on either side of a depth break; evaluate the
 // marked ones (rounded to f16 as a per-pixel pass stores them); then evaluate every sample
 // between two marked ones that differ by more than LIGHT_BREAK; and interpolate the rest
-// between the marked samples around them. Writes `output` (SLICE_SAMPLES x SLICES,
-// rgba32float: radiance, the sample pixel's depth in w). Dispatch: (SLICES, 1, 1)
+// between the marked samples around them. Writes `output` ((SLICE_SAMPLES + 1) x SLICES,
+// rgba32float: radiance and the sample pixel's depth in w; the last column holds the
+// slice's line: direction xy, first distance z, distance between samples w). Dispatch: (SLICES, 1, 1)
 // workgroups of (64, 1, 1).
 @compute @workgroup_size(64, 1, 1)
 fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
@@ -113,6 +114,10 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
     let s = wid.x;
     let u = slice_direction(lines, s);
     let span = slice_span(lines, s, screen, SLICE_SAMPLES);
+    if li == 0u {
+        // The slice's line, for the unwarp.
+        textureStore(output, vec2<u32>(SLICE_SAMPLES, s), vec4<f32>(u.x, u.y, span.x, span.y));
+    }
     for (var k = li; k < SLICE_SAMPLES; k += 64u) {
         let p = slice_sample_pixel(lines, u, span, k, screen);
         line_depth[k] = textureLoad(depth, p, 0).x;
@@ -169,19 +174,29 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
 // The workgroup's pixels to evaluate themselves, packed x | y << 16, and their count.
 var<workgroup> refine: array<u32, 64>;
 var<workgroup> refine_count: atomic<u32>;
+// The frame's slices (one invocation computes them).
+var<workgroup> wg_lines: EpipolarLayout;
 
 // Sampling pass 2 (`sampling = epipolar`, scatter::sampling): invocation `id` gathers pixel
-// `id` from the four samples around it (`epipolar_taps`: two slices, two samples on each)
+// `id` from the four samples around it (`epipolar_slices`, then `epipolar_taps` with the two
+// slices' lines from the samples' last column: two slices, two samples on each)
 // kept by depth and light spread (`lowres_blend`), or puts it on the workgroup's list; then
 // the workgroup's invocations evaluate the list. Dispatch: (ceil(W / 8), ceil(H / 8), 1)
 // workgroups of (8, 8, 1).
 @compute @workgroup_size(8, 8, 1)
 fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
+    if li == 0u {
+        wg_lines = epipolar_layout({{ sampling.camera }}, screen, SLICES);
+    }
+    workgroupBarrier();
     let q = id.xy;
     if q.x < screen.x && q.y < screen.y {
-        let lines = epipolar_layout({{ sampling.camera }}, screen, SLICES);
-        let t = epipolar_taps(lines, q, screen, SLICES, SLICE_SAMPLES);
+        let lines = wg_lines;
+        let pair = epipolar_slices(lines, q, SLICES);
+        let line_lo = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, pair.slices.x), 0);
+        let line_hi = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, pair.slices.y), 0);
+        let t = epipolar_taps(lines, q, pair, line_lo, line_hi, SLICE_SAMPLES);
         var depths = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         var light: array<vec3<f32>, 4>;
         for (var j = 0u; j < 4u; j++) {
