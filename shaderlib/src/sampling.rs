@@ -62,7 +62,7 @@ impl SamplingView {
                 "#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}"
             }
             Sampling::Epipolar if unwarp => {
-                "#import scatter::sampling::{EpipolarCamera, EpipolarLayout, epipolar_layout, epipolar_slices, epipolar_taps, lowres_blend}"
+                "#import scatter::sampling::{EpipolarCamera, epipolar_layout, epipolar_slices, epipolar_taps, lowres_blend}"
             }
             Sampling::Epipolar => {
                 "#import scatter::sampling::{EpipolarCamera, depth_close, epipolar_layout, round_f16, slice_direction, slice_sample_pixel, slice_span}"

@@ -171,53 +171,40 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
 }
 {%- else if sampling.unwarp %}
 
-// The workgroup's pixels to evaluate themselves, packed x | y << 16, and their count.
-var<workgroup> refine: array<u32, 64>;
-var<workgroup> refine_count: atomic<u32>;
-// The frame's slices (one invocation computes them).
-var<workgroup> wg_lines: EpipolarLayout;
-
 // Sampling pass 2 (`sampling = epipolar`, scatter::sampling): invocation `id` gathers pixel
 // `id` from the four samples around it (`epipolar_slices`, then `epipolar_taps` with the two
-// slices' lines from the samples' last column: two slices, two samples on each)
-// kept by depth and light spread (`lowres_blend`), or puts it on the workgroup's list; then
-// the workgroup's invocations evaluate the list. Dispatch: (ceil(W / 8), ceil(H / 8), 1)
-// workgroups of (8, 8, 1).
+// slices' lines from the samples' last column: two slices, two samples on each) kept by
+// depth and light spread (`lowres_blend`), or evaluates it itself where they cannot stand
+// for it. No workgroup list and no barrier, unlike `lowres`: on lavapipe a barrier splits
+// the kernel into resumable parts that keep the per-pixel body's state, which cost more
+// than the lanes an 8-wide batch leaves idle around a lone refined pixel (measured: the
+// list form's unwarp took 20-60 ms more at 1280x720 with almost no pixel refined).
+// Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1).
 @compute @workgroup_size(8, 8, 1)
-fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
-    if li == 0u {
-        wg_lines = epipolar_layout({{ sampling.camera }}, screen, SLICES);
-    }
-    workgroupBarrier();
     let q = id.xy;
-    if q.x < screen.x && q.y < screen.y {
-        let lines = wg_lines;
-        let pair = epipolar_slices(lines, q, SLICES);
-        let line_lo = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, pair.slices.x), 0);
-        let line_hi = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, pair.slices.y), 0);
-        let t = epipolar_taps(lines, q, pair, line_lo, line_hi, SLICE_SAMPLES);
-        var depths = vec4<f32>(0.0, 0.0, 0.0, 0.0);
-        var light: array<vec3<f32>, 4>;
-        for (var j = 0u; j < 4u; j++) {
-            let v = textureLoad(epipolar_samples, vec2<u32>(t.k[j / 2u] + j % 2u, t.slices[j / 2u]), 0);
-            depths[j] = v.w;
-            light[j] = v.xyz;
-        }
-        let c = lowres_blend(t.w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
-        if c.w == 0.0 {
-            refine[atomicAdd(&refine_count, 1u)] = q.x | (q.y << 16u);
-        } else {
-            textureStore(output, q, c);
-        }
+    if q.x >= screen.x || q.y >= screen.y {
+        return;
     }
-    workgroupBarrier();
-    let n = atomicLoad(&refine_count);
-    for (var e = li; e < n; e += 64u) {
-        let p = vec2<u32>(refine[e] & 0xffffu, refine[e] >> 16u);
-        let c = {{ sampling.pixel }}(p.x, p.y);
-        textureStore(output, p, vec4<f32>(c.x, c.y, c.z, 1.0));
+    let lines = epipolar_layout({{ sampling.camera }}, screen, SLICES);
+    let pair = epipolar_slices(lines, q, SLICES);
+    let line_lo = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, pair.slices.x), 0);
+    let line_hi = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, pair.slices.y), 0);
+    let t = epipolar_taps(lines, q, pair, line_lo, line_hi, SLICE_SAMPLES);
+    var depths = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+    var light: array<vec3<f32>, 4>;
+    for (var j = 0u; j < 4u; j++) {
+        let v = textureLoad(epipolar_samples, vec2<u32>(t.k[j / 2u] + j % 2u, t.slices[j / 2u]), 0);
+        depths[j] = v.w;
+        light[j] = v.xyz;
     }
+    var c = lowres_blend(t.w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
+    if c.w == 0.0 {
+        let own = {{ sampling.pixel }}(q.x, q.y);
+        c = vec4<f32>(own.x, own.y, own.z, 1.0);
+    }
+    textureStore(output, q, c);
 }
 {%- else %}
 
