@@ -509,12 +509,15 @@ fn valid_value(name: &str, pick: usize) -> String {
         "samples" => &["64", "128"],
         "interleave" => &["1", "2", "4"],
         "jitter" => &["true", "false"],
-        // The lowres knobs only at their defaults: set with `sampling = pixels` (and
-        // `lowres` with an interleaving raymarch) they are rejected.
+        // The sampling knobs only at their defaults: set with `sampling = pixels` (and
+        // a sampled mode with an interleaving raymarch) they are rejected.
         "sampling" => &["\"pixels\""],
         "scale" => &["2"],
         "depth_break" => &["10"],
         "light_break" => &["20"],
+        "slices" => &["512"],
+        "slice_samples" => &["256"],
+        "step" => &["16"],
         _ => &["1"],
     };
     options[pick % options.len()].to_owned()
@@ -535,10 +538,13 @@ fn bad_value(name: &str, pick: usize) -> String {
         "samples" => &["3", "1025", "0", "\"many\""],
         "interleave" => &["0", "9", "\"two\""],
         "jitter" => &["\"maybe\"", "2", "\"yes\""],
-        "sampling" => &["\"epipolar\"", "\"lowres2\"", "2"],
+        "sampling" => &["\"epipole\"", "\"lowres2\"", "2"],
         "scale" => &["3", "0", "8", "\"two\""],
         "depth_break" => &["0", "51", "\"x\""],
         "light_break" => &["0", "101", "-5"],
+        "slices" => &["300", "0", "2048", "\"many\""],
+        "slice_samples" => &["100", "1024", "-1"],
+        "step" => &["3", "0", "64", "\"x\""],
         _ => &["\"?\""],
     };
     options[pick % options.len()].to_owned()

@@ -1,7 +1,8 @@
 //! Golden files: the complete output for the canonical variants (the paper's default, a
 //! small spot-light variant with average visibility and rgba16float, the moment basis with
-//! 6 moments, an interleaved raymarch variant, the spot-light minmax variant and raymarch
-//! with `sampling = lowres`, scale 4) in every target, kept
+//! 6 moments, an interleaved raymarch variant, the spot-light minmax variant, raymarch
+//! with `sampling = lowres`, scale 4, and raymarch with `sampling = epipolar`, 256 slices)
+//! in every target, kept
 //! as reviewable text in `tests/golden/` (SPIR-V as `spirv-dis` text; its exact bytes are
 //! pinned by the sha256 in the golden `manifest.json`). Any change to a template, to naga or
 //! to the generator shows up here as a diff.
@@ -53,6 +54,12 @@ fn canonical() -> Generated {
             ("scale".into(), "4".into()),
         ])
         .unwrap_or_else(|e| panic!("{e}"));
+    let epipolar = Family::Raymarch
+        .variant(&[
+            ("sampling".into(), "epipolar".into()),
+            ("slices".into(), "256".into()),
+        ])
+        .unwrap_or_else(|e| panic!("{e}"));
     generate(&Request {
         variants: vec![
             Family::Prefiltered.default_variant(),
@@ -61,6 +68,7 @@ fn canonical() -> Generated {
             march,
             minmax,
             lowres,
+            epipolar,
         ],
         targets: Target::ALL.to_vec(),
     })

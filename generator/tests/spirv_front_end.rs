@@ -27,6 +27,18 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
             .into_iter()
             .map(FamilyVariant::Raymarch),
     );
+    // Every family sampled (lowres and epipolar: workgroup memory, atomics, the unwarp
+    // passes), both lights.
+    for &light in LightKind::ALL {
+        for family in scatter_shaderlib::family::Family::ALL {
+            for knobs in [
+                scatter_shaderlib::sampling::SamplingKnobs::lowres(4),
+                scatter_shaderlib::sampling::SamplingKnobs::epipolar(64),
+            ] {
+                variants.push(family.default_variant().with_light(light).with_sampling(knobs));
+            }
+        }
+    }
     let generated = generate(&Request {
         variants,
         targets: vec![Target::Spirv],
@@ -42,7 +54,18 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
             naga::valid::Capabilities::all(),
         )
         .validate(&module)
-        .unwrap_or_else(|e| panic!("{}: naga validation after spv-in: {e:?}", file.path));
+        .unwrap_or_else(|e| {
+            let f = e.as_inner();
+            panic!(
+                "{}: naga validation after spv-in: {e:?}\nfunctions: {:?}",
+                file.path,
+                module
+                    .functions
+                    .iter()
+                    .map(|(h, f)| (h.index(), f.name.clone()))
+                    .collect::<Vec<_>>()
+            )
+        });
         checked += 1;
     }
     assert!(checked >= 3 * 2 * 2 * 3 - 12, "only {checked} SPIR-V files");

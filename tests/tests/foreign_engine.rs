@@ -320,9 +320,11 @@ fn other_families_dir() -> &'static Path {
     })
 }
 
-/// The raymarch trial variants: plain directional, interleaved and jittered spot, and
-/// `sampling = lowres` (scale 2) spot: the sampled dispatch and workgroup memory.
-fn raymarch_variants() -> [RaymarchVariant; 3] {
+/// The raymarch trial variants: plain directional, interleaved and jittered spot,
+/// `sampling = lowres` (scale 2) spot: the sampled dispatch and workgroup memory, and
+/// `sampling = epipolar` (64 slices x 64 samples) spot: the `epipolar_samples` texture the
+/// engine allocates from the manifest and the `raymarch_unwarp` pass.
+fn raymarch_variants() -> [RaymarchVariant; 4] {
     [
         RaymarchVariant::default(),
         RaymarchVariant {
@@ -337,6 +339,15 @@ fn raymarch_variants() -> [RaymarchVariant; 3] {
             sampling: scatter_frame::sampling::Sampling::Lowres,
             ..RaymarchVariant::default()
         },
+        RaymarchVariant {
+            light: LightKind::Spot,
+            ..RaymarchVariant::default()
+        }
+        .with_sampling_knobs(scatter_frame::sampling::SamplingKnobs {
+            slice_samples: 64,
+            step: 8,
+            ..scatter_frame::sampling::SamplingKnobs::epipolar(64)
+        }),
     ]
 }
 
@@ -418,6 +429,8 @@ fn foreign_engine_matches_runtime_for_every_family() {
         );
         let expect: &[&str] = if v.interleaved() {
             &["raymarch", "interleave_sum"]
+        } else if v.sampling == scatter_frame::sampling::Sampling::Epipolar {
+            &["raymarch", "raymarch_unwarp"]
         } else {
             &["raymarch"]
         };

@@ -136,7 +136,15 @@ macro_rules! cli_families {
 }
 
 /// The names of the sampling knobs every family has.
-const SAMPLING_KNOBS: [&str; 4] = ["sampling", "scale", "depth_break", "light_break"];
+const SAMPLING_KNOBS: [&str; 7] = [
+    "sampling",
+    "scale",
+    "depth_break",
+    "light_break",
+    "slices",
+    "slice_samples",
+    "step",
+];
 
 /// The sampling knobs every family has (`scatter_frame::sampling`), after the family's own.
 pub fn sampling_knobs() -> Vec<KnobInfo> {
@@ -145,9 +153,10 @@ pub fn sampling_knobs() -> Vec<KnobInfo> {
         KnobInfo {
             name: "sampling",
             value_name: "MODE",
-            help: "where the per-pixel integral is evaluated: every pixel, or one pixel per \
-                   scale x scale block with a depth- and light-aware upsample (pixels no \
-                   sample can stand for are evaluated themselves)",
+            help: "where the per-pixel integral is evaluated: every pixel; one pixel per \
+                   scale x scale block with a depth- and light-aware upsample (lowres); or \
+                   samples along epipolar lines with an unwarp pass (epipolar); pixels no \
+                   sample can stand for are evaluated themselves",
             allowed: Sampling::ALLOWED.into(),
             default: d.sampling.to_string(),
             value_type: KnobType::Name,
@@ -163,8 +172,9 @@ pub fn sampling_knobs() -> Vec<KnobInfo> {
         KnobInfo {
             name: "depth_break",
             value_name: "PERCENT",
-            help: "sampling = lowres: a sample stands for a pixel only within this depth \
-                   difference, in percent of the nearer depth",
+            help: "sampling = lowres | epipolar: a sample stands for a pixel only within \
+                   this depth difference, in percent of the nearer depth (epipolar: also \
+                   where neighbouring samples of a slice are both evaluated)",
             allowed: DEPTH_BREAK_ALLOWED.into(),
             default: d.depth_break.to_string(),
             value_type: KnobType::Integer,
@@ -172,10 +182,36 @@ pub fn sampling_knobs() -> Vec<KnobInfo> {
         KnobInfo {
             name: "light_break",
             value_name: "PERCENT",
-            help: "sampling = lowres: a pixel whose samples differ by more than this, in \
-                   percent of the brightest, is evaluated itself (100: never)",
+            help: "sampling = lowres | epipolar: a pixel whose samples differ by more than \
+                   this, in percent of the brightest, is evaluated itself (100: never; \
+                   epipolar: also the samples between two evaluated ones that differ so)",
             allowed: LIGHT_BREAK_ALLOWED.into(),
             default: d.light_break.to_string(),
+            value_type: KnobType::Integer,
+        },
+        KnobInfo {
+            name: "slices",
+            value_name: "N",
+            help: "sampling = epipolar: epipolar slices (lines from the epipole)",
+            allowed: SLICES_ALLOWED.into(),
+            default: d.slices.to_string(),
+            value_type: KnobType::Integer,
+        },
+        KnobInfo {
+            name: "slice_samples",
+            value_name: "M",
+            help: "sampling = epipolar: samples per slice, across the screen",
+            allowed: SLICE_SAMPLES_ALLOWED.into(),
+            default: d.slice_samples.to_string(),
+            value_type: KnobType::Integer,
+        },
+        KnobInfo {
+            name: "step",
+            value_name: "K",
+            help: "sampling = epipolar: every K-th sample of a slice is evaluated (and both \
+                   sides of a depth break); the rest are interpolated (1: every sample)",
+            allowed: STEP_ALLOWED.into(),
+            default: d.step.to_string(),
             value_type: KnobType::Integer,
         },
     ]
@@ -187,6 +223,12 @@ const SCALE_ALLOWED: &str = "2 | 4";
 const DEPTH_BREAK_ALLOWED: &str = "in 1..=50";
 /// Allowed `light_break`.
 const LIGHT_BREAK_ALLOWED: &str = "in 1..=100";
+/// Allowed `slices`.
+const SLICES_ALLOWED: &str = "64 | 128 | 256 | 512 | 1024";
+/// Allowed `slice_samples`.
+const SLICE_SAMPLES_ALLOWED: &str = "64 | 128 | 256 | 512";
+/// Allowed `step`.
+const STEP_ALLOWED: &str = "1 | 2 | 4 | 8 | 16 | 32 (less than slice_samples)";
 
 /// `variant` with the sampling knobs among `knobs` applied, validated.
 fn apply_sampling(
@@ -207,6 +249,11 @@ fn apply_sampling(
             "scale" => s.scale = number("scale", SCALE_ALLOWED, value)?,
             "depth_break" => s.depth_break = number("depth_break", DEPTH_BREAK_ALLOWED, value)?,
             "light_break" => s.light_break = number("light_break", LIGHT_BREAK_ALLOWED, value)?,
+            "slices" => s.slices = number("slices", SLICES_ALLOWED, value)?,
+            "slice_samples" => {
+                s.slice_samples = number("slice_samples", SLICE_SAMPLES_ALLOWED, value)?;
+            }
+            "step" => s.step = number("step", STEP_ALLOWED, value)?,
             _ => {}
         }
     }

@@ -72,7 +72,10 @@ var<workgroup> line_depth: array<f32, {{ sampling.slice_samples }}>;
 var<workgroup> line_flag: array<u32, {{ sampling.slice_samples }}>;
 var<workgroup> line_light: array<vec3<f32>, {{ sampling.slice_samples }}>;
 var<workgroup> line_list: array<u32, {{ sampling.slice_samples }}>;
-var<workgroup> line_count: array<atomic<u32>, 2>;
+// (Two scalars, not an array of atomics: naga's SPIR-V front-end reads the zero
+// initialisation of an atomic array as a plain store, which its validator rejects.)
+var<workgroup> line_count: atomic<u32>;
+var<workgroup> line_count_light: atomic<u32>;
 
 // The evaluated samples around sample k (k itself when it is one): every STEP-th sample and
 // the last are, so both exist.
@@ -133,11 +136,11 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
         }
         line_flag[k] = select(0u, 1u, marked);
         if marked {
-            line_list[atomicAdd(&line_count[0], 1u)] = k;
+            line_list[atomicAdd(&line_count, 1u)] = k;
         }
     }
     workgroupBarrier();
-    let n = atomicLoad(&line_count[0]);
+    let n = atomicLoad(&line_count);
     for (var e = li; e < n; e += 64u) {
         let k = line_list[e];
         let p = slice_sample_pixel(lines, u, span, k, screen);
@@ -146,11 +149,11 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
     workgroupBarrier();
     for (var k = li; k < SLICE_SAMPLES; k += 64u) {
         if line_flag[k] == 0u && line_spread_over(line_bracket(k)) {
-            line_list[atomicAdd(&line_count[1], 1u)] = k;
+            line_list[atomicAdd(&line_count_light, 1u)] = k;
         }
     }
     workgroupBarrier();
-    let n2 = atomicLoad(&line_count[1]);
+    let n2 = atomicLoad(&line_count_light);
     for (var e = li; e < n2; e += 64u) {
         let k = line_list[e];
         let p = slice_sample_pixel(lines, u, span, k, screen);
