@@ -21,9 +21,10 @@
 //! reason. Against N = 128 it flickers less on `foliage`'s camera path (0.19 against 0.20 %)
 //! and on `spot_grate` (0.48 against 0.70 %).
 //!
-//! A sampled variant (issue 14, `sampling = lowres` at scale 4, raymarch N = 64) is reported
-//! and NaN-checked; its samples stand on fixed pixels, so what moves is the scene under
-//! them.
+//! Two sampled variants (issue 14, raymarch N = 64) are reported and NaN-checked:
+//! `sampling = lowres` at scale 4, whose samples stand on fixed pixels, so that what moves
+//! is the scene under them, and `sampling = epipolar` (64 x 64, step 8), whose samples move
+//! with the epipole.
 //!
 //! 64x36 pixels, 256x256 rectified map, 512^2 shadow map, truth with 512 cells per ray:
 //! small enough for CI (75 s here in the test profile with a warm Mesa cache).
@@ -115,7 +116,20 @@ fn variants(light: LightKind) -> Vec<FamilyVariant> {
     // measured 1.07-1.96x their per-pixel flicker, issue 14's note).
     let sampled = v[3].with_sampling(SamplingKnobs::lowres(SAMPLED_SCALE));
     v.push(sampled);
+    // And epipolar (64 slices x 64 samples, step 8, at this screen): its samples move with
+    // the epipole, so a camera or light that moves moves them (Yusov 2013's flicker).
+    v.push(v[3].with_sampling(epipolar_knobs()));
     v
+}
+
+/// The epipolar configuration reported: 64 slices x 64 samples, step 8 (at 64x36 pixels
+/// the defaults would place more samples than pixels).
+fn epipolar_knobs() -> SamplingKnobs {
+    SamplingKnobs {
+        slice_samples: 64,
+        step: 8,
+        ..SamplingKnobs::epipolar(64)
+    }
 }
 
 fn labels() -> Vec<String> {
@@ -126,6 +140,7 @@ fn labels() -> Vec<String> {
     l.extend(SAMPLES.iter().map(|n| format!("raymarch n{n}")));
     l.push("minmax".into());
     l.push(format!("raymarch n64-lr{SAMPLED_SCALE}"));
+    l.push("raymarch n64-ep64x64-s8".into());
     l
 }
 

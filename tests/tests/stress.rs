@@ -27,9 +27,10 @@
 //! - prefiltered with average visibility (3 regions): finite and exact zeros only (it is
 //!   11-28 % off on `closed_room_windows` and the spot poses; its accuracy bars, at 8
 //!   regions, are in `prefiltered_truth`);
-//! - sampled (`sampling = lowres`, scale 4: every family's default): finite and exact zeros
-//!   as above, and the prefiltered and minmax bars above (the sampled raymarch N = 64 has no
-//!   bar of its own, as N = 64 per pixel);
+//! - sampled (`sampling = lowres`, scale 4, and `sampling = epipolar` at its defaults:
+//!   every family's default): finite and exact zeros as above, and the prefiltered and
+//!   minmax bars above (the sampled raymarch N = 64 has no bar of its own, as N = 64 per
+//!   pixel);
 //! - the safe paths: epipole or anti-epipole on screen -> the neighbourhood is ray-marched
 //!   (`FrameReport::marched_radius_px`) and a projective variant falls back to epipolar with
 //!   the reason, its output then equal to the epipolar variant's.
@@ -153,7 +154,16 @@ fn methods() -> Vec<FamilyVariant> {
         FamilyVariant::from(PrefilteredVariant::default()).with_sampling(SamplingKnobs::lowres(4)),
         raymarch(64).with_sampling(SamplingKnobs::lowres(4)),
         FamilyVariant::from(MinmaxVariant::default()).with_sampling(SamplingKnobs::lowres(4)),
+        // And epipolar at its defaults.
+        FamilyVariant::from(PrefilteredVariant::default()).with_sampling(epipolar()),
+        raymarch(64).with_sampling(epipolar()),
+        FamilyVariant::from(MinmaxVariant::default()).with_sampling(epipolar()),
     ]
+}
+
+/// `sampling = epipolar` at its defaults.
+fn epipolar() -> SamplingKnobs {
+    SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES)
 }
 
 /// The rectification of a weighted prefiltered variant, or `None`.
