@@ -17,7 +17,10 @@
 //!   horizon) has a near-black truth, and every pose's buffers build;
 //! - `random::<variant>::finite`: every run succeeds, 0 NaN/Inf pixels;
 //! - `random::<variant>::{p90,max,near_black}_bar`: within the variant's row of [`BARS`];
-//! - `random::<variant>::p90_vs_raymarch`: p90 no worse than raymarch n64's.
+//! - `random::<variant>::p90_vs_raymarch`: p90 no worse than raymarch n64's (per-pixel
+//!   variants); `random::<variant>::p90_vs_per_pixel`: a sampled variant's (issue 14's
+//!   epipolar sampling, 64 x 64 samples, step 8, every family) p90 at most half a point
+//!   above its family's per-pixel variant's.
 //!
 //! Expected failures are data ([`EXPECTED_FAILURES`]): such a trial must fail, and the run
 //! fails when it starts passing.
@@ -82,14 +85,39 @@ const BARS: &[Bar] = &[
     ("prefiltered-m32-r3-average", 0.03, 0.07, NEAR_BLACK),
     ("prefiltered-moments6-r8", 0.03, 0.07, NEAR_BLACK),
     ("raymarch-n64-i1", 0.03, 0.07, NEAR_BLACK),
+    ("minmax-ep64x64-s8", 0.03, 0.07, NEAR_BLACK),
+    ("prefiltered-m32-r3-ep64x64-s8", 0.03, 0.07, NEAR_BLACK),
+    ("raymarch-n64-i1-ep64x64-s8", 0.03, 0.07, NEAR_BLACK),
 ];
 
-/// The variant every other's p90 is compared with.
+/// The most a sampled variant's p90 may exceed its per-pixel variant's (issue 14's bar for
+/// the suite mean: half a point); sampled variants are compared with their own family per
+/// pixel, not with raymarch n64.
+const SAMPLED_ADDED: f64 = 0.005;
+
+/// The variant every other per-pixel variant's p90 is compared with.
 const REFERENCE: &str = "raymarch-n64-i1";
 
 /// Trials expected to fail today, with the reason: `(trial name, why)`. The run fails when
 /// one of them starts passing: remove it then.
 const EXPECTED_FAILURES: &[(&str, &str)] = &[
+    (
+        "random::minmax-ep64x64-s8::p90_vs_per_pixel",
+        "p90 1.72 % against minmax per pixel 1.08 % (+0.64 points; raymarch n64 +0.39, \
+         prefiltered +0.31): minmax's exact hard shadows (foliage, the grate) are what an \
+         interpolation between slices 3-5 pixels apart at the screen's edge blurs most; its \
+         suite mean at 320x180 with the defaults is +0.10 points (sampling::accuracy)",
+    ),
+    (
+        "random::prefiltered-m32-r3-ep64x64-s8::near_black_bar",
+        "the per-pixel prefiltered-m32-r3's near-black failure (random::columns::0, the same \
+         ground tie), which epipolar sampling carries over: 5.9e-2 of the lit maximum",
+    ),
+    (
+        "random::prefiltered-m32-r3-ep64x64-s8::closed_room_bar",
+        "the per-pixel prefiltered-m32-r3's closed-room failure (the bilinear blend of two \
+         rectified rows), which epipolar sampling carries over",
+    ),
     (
         "random::prefiltered-m32-r3::near_black_bar",
         "5.9e-2 of the lit maximum on random::columns::0 (the sun 13.9 deg below the horizon, \
@@ -166,7 +194,18 @@ fn variants() -> Vec<FamilyVariant> {
                 .collect(),
             other => vec![other],
         })
+        .chain(Family::ALL.iter().map(|f| f.default_variant().with_sampling(epipolar())))
         .collect()
+}
+
+/// Issue 14's epipolar sampling at this screen size: 64 slices x 64 samples, step 8 (the
+/// defaults would place more samples than the 96x54 pixels).
+fn epipolar() -> scatter_shaderlib::sampling::SamplingKnobs {
+    scatter_shaderlib::sampling::SamplingKnobs {
+        slice_samples: 64,
+        step: 8,
+        ..scatter_shaderlib::sampling::SamplingKnobs::epipolar(64)
+    }
 }
 
 /// A pose prepared once: buffers and truth.
@@ -628,6 +667,15 @@ fn within(value: f64, bound: f64) -> bool {
 
 fn main() -> ExitCode {
     let labels: Vec<String> = variants().iter().map(FamilyVariant::label).collect();
+    // Each sampled variant's per-pixel variant (issue 14's bars are against it).
+    let per_pixel: Vec<Option<String>> = variants()
+        .iter()
+        .map(|v| {
+            v.sampling()
+                .is_sampled()
+                .then(|| v.with_sampling(Default::default()).label())
+        })
+        .collect();
     let mut trials: Vec<(String, Check)> = Vec::new();
     trials.push((
         "random::premises".into(),
@@ -671,7 +719,7 @@ fn main() -> ExitCode {
             }
         }),
     ));
-    for label in labels {
+    for (index, label) in labels.iter().enumerate() {
         let l = label.clone();
         trials.push((
             format!("random::{label}::finite"),
@@ -744,7 +792,29 @@ fn main() -> ExitCode {
                 }
             }),
         ));
-        if label != REFERENCE {
+        if let Some(base) = per_pixel[index].clone()
+        {
+            let l = label.clone();
+            trials.push((
+                format!("random::{label}::p90_vs_per_pixel"),
+                check(move || {
+                    let r = results();
+                    let all = |_: &Frame| true;
+                    let p90 = |l: &str| stats(&r.rel_l1s(l, &all)).map_or(f64::NAN, |s| s.p90);
+                    let (mine, theirs) = (p90(&l), p90(&base));
+                    if within(mine, theirs + SAMPLED_ADDED) {
+                        Ok(())
+                    } else {
+                        Err(format!(
+                            "random::{l}: p90 rel L1 {} % is more than {} points above {base}'s {} %",
+                            pct(mine),
+                            pct(SAMPLED_ADDED),
+                            pct(theirs)
+                        ))
+                    }
+                }),
+            ));
+        } else if label != REFERENCE {
             let l = label.clone();
             trials.push((
                 format!("random::{label}::p90_vs_raymarch"),
