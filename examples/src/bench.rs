@@ -692,7 +692,7 @@ fn sampled_bases() -> Vec<FamilyVariant> {
 
 /// The sampling configurations the headline runs every sampled base with: lowres at 1/2
 /// and 1/4 of the screen per axis, and epipolar at its defaults (512 slices x 256 samples,
-/// step 16).
+/// step 8).
 fn sampled_configs() -> Vec<SamplingKnobs> {
     let mut out: Vec<SamplingKnobs> = SamplingKnobs::SCALES
         .iter()

@@ -88,7 +88,7 @@ fn bases(light: LightKind) -> Vec<FamilyVariant> {
 }
 
 /// The sampled configurations the trials run: lowres at both scales, epipolar at its
-/// defaults (512 slices x 256 samples, step 16) and a coarse layout (64 x 64, step 8: at
+/// defaults (512 slices x 256 samples, step 8) and a coarse layout (64 x 64, step 8: at
 /// [`SCREEN`] its samples are sparser than the pixels, so the unwarp's interpolation and
 /// refinement are exercised).
 fn knobs() -> [SamplingKnobs; 4] {
