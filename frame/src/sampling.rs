@@ -250,12 +250,27 @@ impl SamplingKnobs {
         }
         if self.sampling != Sampling::Epipolar {
             unused("slices", self.slices, d.slices, "epipolar")?;
-            unused("slice_samples", self.slice_samples, d.slice_samples, "epipolar")?;
+            unused(
+                "slice_samples",
+                self.slice_samples,
+                d.slice_samples,
+                "epipolar",
+            )?;
             unused("step", self.step, d.step, "epipolar")?;
         }
         if self.sampling == Sampling::Pixels {
-            unused("depth_break", self.depth_break, d.depth_break, "lowres | epipolar")?;
-            unused("light_break", self.light_break, d.light_break, "lowres | epipolar")?;
+            unused(
+                "depth_break",
+                self.depth_break,
+                d.depth_break,
+                "lowres | epipolar",
+            )?;
+            unused(
+                "light_break",
+                self.light_break,
+                d.light_break,
+                "lowres | epipolar",
+            )?;
             return Ok(());
         }
         if self.sampling == Sampling::Lowres && !Self::SCALES.contains(&self.scale) {

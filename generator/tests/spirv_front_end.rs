@@ -35,7 +35,12 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
                 scatter_shaderlib::sampling::SamplingKnobs::lowres(4),
                 scatter_shaderlib::sampling::SamplingKnobs::epipolar(64),
             ] {
-                variants.push(family.default_variant().with_light(light).with_sampling(knobs));
+                variants.push(
+                    family
+                        .default_variant()
+                        .with_light(light)
+                        .with_sampling(knobs),
+                );
             }
         }
     }
@@ -55,7 +60,6 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
         )
         .validate(&module)
         .unwrap_or_else(|e| {
-            let f = e.as_inner();
             panic!(
                 "{}: naga validation after spv-in: {e:?}\nfunctions: {:?}",
                 file.path,

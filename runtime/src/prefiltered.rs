@@ -357,13 +357,26 @@ impl Prefiltered {
     ) -> Result<PrefilteredTimes, RuntimeError> {
         // Without epipolar sampling there is no `scatter_unwarp` pass: its slot records
         // nothing.
-        let [depth_columns, slice_fit, rectify, prefilter, scatter, unwarp] =
-            median_pass_wall_times(
-                ctx,
-                [DEPTH_COLUMNS, SLICE_FIT, RECTIFY, PREFILTER, SCATTER, SCATTER_UNWARP],
-                frames,
-                |encoder, kernel| self.encode_pass(encoder, inputs, kernel),
-            )?;
+        let [
+            depth_columns,
+            slice_fit,
+            rectify,
+            prefilter,
+            scatter,
+            unwarp,
+        ] = median_pass_wall_times(
+            ctx,
+            [
+                DEPTH_COLUMNS,
+                SLICE_FIT,
+                RECTIFY,
+                PREFILTER,
+                SCATTER,
+                SCATTER_UNWARP,
+            ],
+            frames,
+            |encoder, kernel| self.encode_pass(encoder, inputs, kernel),
+        )?;
         Ok(PrefilteredTimes {
             depth_columns,
             slice_fit,

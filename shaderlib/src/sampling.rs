@@ -173,7 +173,11 @@ pub fn sampled_output(knobs: &SamplingKnobs) -> &'static str {
 /// The `_unwarp` pass `kernel` of a family kernel's epipolar pass `family`: the same
 /// bindings with `output` where `family` writes `epipolar_samples`, and `epipolar_samples`
 /// read at `binding`; one invocation per screen pixel.
-pub fn unwarp_pass(family: crate::plan::PassPlan, kernel: Kernel, binding: u32) -> crate::plan::PassPlan {
+pub fn unwarp_pass(
+    family: crate::plan::PassPlan,
+    kernel: Kernel,
+    binding: u32,
+) -> crate::plan::PassPlan {
     let mut bindings: Vec<_> = family
         .bindings
         .into_iter()

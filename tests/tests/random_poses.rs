@@ -810,8 +810,7 @@ fn main() -> ExitCode {
                 }
             }),
         ));
-        if let Some(base) = per_pixel[index].clone()
-        {
+        if let Some(base) = per_pixel[index].clone() {
             let l = label.clone();
             trials.push((
                 format!("random::{label}::p90_vs_per_pixel"),
@@ -859,9 +858,10 @@ fn main() -> ExitCode {
         .iter()
         .copied()
         .filter(|(name, _)| {
-            labels
-                .iter()
-                .any(|l| name.strip_prefix("random::").is_some_and(|n| n.starts_with(&format!("{l}::"))))
+            labels.iter().any(|l| {
+                name.strip_prefix("random::")
+                    .is_some_and(|n| n.starts_with(&format!("{l}::")))
+            })
         })
         .collect();
     run_trials(trials, &expected)

@@ -244,7 +244,12 @@ pub struct EpipolarCamera {
 impl EpipolarCamera {
     /// The camera of the epipolar families' `Frame` (`frame.axis` points towards the light).
     pub fn of_frame(f: &scatter_shaderlib::prefiltered::FrameUniforms) -> Self {
-        Self::new(f.cam_forward, f.cam_right, f.cam_up, [f.axis[0], f.axis[1], f.axis[2]])
+        Self::new(
+            f.cam_forward,
+            f.cam_right,
+            f.cam_up,
+            [f.axis[0], f.axis[1], f.axis[2]],
+        )
     }
 
     /// The camera of `RaymarchFrame`: towards the light is `-light_dir` (directional) or
@@ -303,7 +308,8 @@ pub struct EpipolarLayout {
 
 /// The farthest the layout's origin lies from the screen centre, in screens.
 pub const EPIPOLE_FAR: f32 = 100.0;
-const PI_SAMPLING: f32 = 3.141_592_7;
+/// WGSL `PI_SAMPLING` (3.14159265358979, which rounds to this f32).
+const PI_SAMPLING: f32 = std::f32::consts::PI;
 
 fn dot3(a: [f32; 3], b: [f32; 3]) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -345,7 +351,8 @@ pub fn epipolar_layout(cam: &EpipolarCamera, screen: [u32; 2], slices: u32) -> E
     };
     let lo = [0.5f32, 0.5];
     let hi = [size[0] - 0.5, size[1] - 0.5];
-    let inside = origin[0] >= lo[0] && origin[0] <= hi[0] && origin[1] >= lo[1] && origin[1] <= hi[1];
+    let inside =
+        origin[0] >= lo[0] && origin[0] <= hi[0] && origin[1] >= lo[1] && origin[1] <= hi[1];
     let (phi_start, dphi) = if inside {
         (-PI_SAMPLING, 2.0 * PI_SAMPLING / slices as f32)
     } else {
@@ -542,7 +549,7 @@ pub fn epipolar_samples(
             let mut depth_marked = 0u64;
             let flag: Vec<bool> = (0..m as usize)
                 .map(|k| {
-                    let on_step = k as u32 % step == 0 || k as u32 == m - 1;
+                    let on_step = (k as u32).is_multiple_of(step) || k as u32 == m - 1;
                     let brk = (k > 0 && !depth_close(d[k - 1], d[k], depth_break))
                         || (k + 1 < m as usize && !depth_close(d[k], d[k + 1], depth_break));
                     if brk && !on_step {
@@ -782,9 +789,21 @@ mod tests {
             }
         }
         let body = |x: u32, y: u32| [x as f32 * 0.1, y as f32 * 0.1, 1.0];
-        let px = run_sampled(&SamplingKnobs::default(), screen, &depth, &camera([0.0; 3]), &body);
+        let px = run_sampled(
+            &SamplingKnobs::default(),
+            screen,
+            &depth,
+            &camera([0.0; 3]),
+            &body,
+        );
         for scale in [2, 4] {
-            let lr = run_sampled(&SamplingKnobs::lowres(scale), screen, &depth, &camera([0.0; 3]), &body);
+            let lr = run_sampled(
+                &SamplingKnobs::lowres(scale),
+                screen,
+                &depth,
+                &camera([0.0; 3]),
+                &body,
+            );
             assert!(
                 lr.depth_refined > 0,
                 "the one-pixel column is evaluated per pixel"
@@ -842,11 +861,17 @@ mod tests {
                 for x in 0..67 {
                     let t = epipolar_taps_direct(&l, [x, y], screen, 64, 64);
                     let sum: f32 = t.w.iter().sum();
-                    assert!(t.w.iter().all(|&w| w >= 0.0), "{toward:?} ({x}, {y}): {t:?}");
+                    assert!(
+                        t.w.iter().all(|&w| w >= 0.0),
+                        "{toward:?} ({x}, {y}): {t:?}"
+                    );
                     assert!((sum - 1.0).abs() <= 1e-5, "{toward:?} ({x}, {y}): {t:?}");
                 }
             }
-            assert_eq!(l.wrap, toward == [0.2, 0.1, -1.0] || toward == [0.3, -0.2, 1.0]);
+            assert_eq!(
+                l.wrap,
+                toward == [0.2, 0.1, -1.0] || toward == [0.3, -0.2, 1.0]
+            );
         }
     }
 
@@ -864,7 +889,13 @@ mod tests {
             let b = if x == 20 { 5.0 } else { 1.0 };
             [x as f32 * 0.01 + b, y as f32 * 0.01 + b, b]
         };
-        let px = run_sampled(&SamplingKnobs::default(), screen, &depth, &camera([0.0; 3]), &body);
+        let px = run_sampled(
+            &SamplingKnobs::default(),
+            screen,
+            &depth,
+            &camera([0.0; 3]),
+            &body,
+        );
         for toward in [[0.2, 0.1, -1.0], [3.0, 0.5, -1.0]] {
             let knobs = SamplingKnobs {
                 slice_samples: 64,
@@ -872,7 +903,11 @@ mod tests {
                 ..SamplingKnobs::epipolar(64)
             };
             let e = run_sampled(&knobs, screen, &depth, &camera(toward), &body);
-            assert!(e.evaluated < 67 * 37, "fewer evaluations than pixels: {}", e.evaluated);
+            assert!(
+                e.evaluated < 67 * 37,
+                "fewer evaluations than pixels: {}",
+                e.evaluated
+            );
             let mut worst = 0.0f32;
             for (a, b) in px.output.data.iter().zip(&e.output.data) {
                 for c in 0..3 {
@@ -882,7 +917,10 @@ mod tests {
             // The body changes by 0.01 per pixel; samples stand within a few pixels; no
             // pixel takes light across the depth break (a halo would be off by 4).
             assert!(worst < 0.05, "{toward:?}: worst {worst}");
-            assert!(e.depth_refined > 0, "the occluder column's breaks are refined");
+            assert!(
+                e.depth_refined > 0,
+                "the occluder column's breaks are refined"
+            );
         }
     }
 }

@@ -291,7 +291,10 @@ pub fn scatter_sampled(variant: &PrefilteredVariant, inp: &ScatterInputs) -> Sam
 }
 
 /// `scatter` of an `epipolar` variant: the samples of every slice (sampling pass 1).
-pub fn scatter_epipolar_samples(variant: &PrefilteredVariant, inp: &ScatterInputs) -> EpipolarSamples {
+pub fn scatter_epipolar_samples(
+    variant: &PrefilteredVariant,
+    inp: &ScatterInputs,
+) -> EpipolarSamples {
     epipolar_samples(
         &variant.sampling_knobs(),
         [inp.frame.sizes[0], inp.frame.sizes[1]],

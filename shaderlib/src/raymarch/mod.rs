@@ -11,9 +11,7 @@ pub use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_ray
 
 use crate::compose::template_path;
 use crate::prefiltered::LightKind;
-use crate::sampling::{
-    EPIPOLAR_SAMPLES_FORMAT, Sampling, SamplingView, camera_expr, unwarp_only,
-};
+use crate::sampling::{EPIPOLAR_SAMPLES_FORMAT, Sampling, SamplingView, camera_expr, unwarp_only};
 use crate::{Kernel, ShaderError};
 
 /// Workgroup size of `raymarch` and `interleave_sum`: one invocation per pixel.
