@@ -140,7 +140,7 @@ fn labels() -> Vec<String> {
     l.extend(SAMPLES.iter().map(|n| format!("raymarch n{n}")));
     l.push("minmax".into());
     l.push(format!("raymarch n64-lr{SAMPLED_SCALE}"));
-    l.push("raymarch n64-ep64x64-s8".into());
+    l.push("raymarch n64-ep64x64".into());
     l
 }
 

@@ -85,9 +85,9 @@ const BARS: &[Bar] = &[
     ("prefiltered-m32-r3-average", 0.03, 0.07, NEAR_BLACK),
     ("prefiltered-moments6-r8", 0.03, 0.07, NEAR_BLACK),
     ("raymarch-n64-i1", 0.03, 0.07, NEAR_BLACK),
-    ("minmax-ep64x64-s8", 0.03, 0.07, NEAR_BLACK),
-    ("prefiltered-m32-r3-ep64x64-s8", 0.03, 0.07, NEAR_BLACK),
-    ("raymarch-n64-i1-ep64x64-s8", 0.03, 0.07, NEAR_BLACK),
+    ("minmax-ep64x64", 0.03, 0.07, NEAR_BLACK),
+    ("prefiltered-m32-r3-ep64x64", 0.03, 0.07, NEAR_BLACK),
+    ("raymarch-n64-i1-ep64x64", 0.03, 0.07, NEAR_BLACK),
 ];
 
 /// The most a sampled variant's p90 may exceed its per-pixel variant's (issue 14's bar for
@@ -102,19 +102,19 @@ const REFERENCE: &str = "raymarch-n64-i1";
 /// one of them starts passing: remove it then.
 const EXPECTED_FAILURES: &[(&str, &str)] = &[
     (
-        "random::minmax-ep64x64-s8::p90_vs_per_pixel",
+        "random::minmax-ep64x64::p90_vs_per_pixel",
         "p90 1.72 % against minmax per pixel 1.08 % (+0.64 points; raymarch n64 +0.39, \
          prefiltered +0.31): minmax's exact hard shadows (foliage, the grate) are what an \
          interpolation between slices 3-5 pixels apart at the screen's edge blurs most; its \
          suite mean at 320x180 with the defaults is +0.10 points (sampling::accuracy)",
     ),
     (
-        "random::prefiltered-m32-r3-ep64x64-s8::near_black_bar",
+        "random::prefiltered-m32-r3-ep64x64::near_black_bar",
         "the per-pixel prefiltered-m32-r3's near-black failure (random::columns::0, the same \
          ground tie), which epipolar sampling carries over: 5.9e-2 of the lit maximum",
     ),
     (
-        "random::prefiltered-m32-r3-ep64x64-s8::closed_room_bar",
+        "random::prefiltered-m32-r3-ep64x64::closed_room_bar",
         "the per-pixel prefiltered-m32-r3's closed-room failure (the bilinear blend of two \
          rectified rows), which epipolar sampling carries over",
     ),
