@@ -1752,11 +1752,11 @@ mod tests {
         assert_eq!(tune_pick(&table, 0.001), None);
         assert_eq!(
             scatter_gen_command(&table[2].method, [512, 512]),
-            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 8 --basis fourier --depth-break 10 --light spot --light-break 20 --moments 4 --rectification epipolar --regions 3 --sampling pixels --scale 2 --storage rgba8unorm --visibility weighted --out shaders/  # runtime: rectified map 256x256"
+            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 8 --basis fourier --depth-break 10 --light spot --light-break 20 --moments 4 --rectification epipolar --regions 3 --sampling pixels --scale 2 --slice-samples 256 --slices 512 --step 8 --storage rgba8unorm --visibility weighted --out shaders/  # runtime: rectified map 256x256"
         );
         assert_eq!(
             scatter_gen_command(&table[1].method, [512, 512]),
-            "scatter-gen --family raymarch --depth-break 10 --interleave 1 --jitter false --light directional --light-break 20 --samples 64 --sampling pixels --scale 2 --out shaders/"
+            "scatter-gen --family raymarch --depth-break 10 --interleave 1 --jitter false --light directional --light-break 20 --samples 64 --sampling pixels --scale 2 --slice-samples 256 --slices 512 --step 8 --out shaders/"
         );
         // Every knob of every family's grid: the command's flags parse back to the variant.
         use scatter_gen::FamilyCli;

@@ -517,7 +517,7 @@ fn valid_value(name: &str, pick: usize) -> String {
         "light_break" => &["20"],
         "slices" => &["512"],
         "slice_samples" => &["256"],
-        "step" => &["16"],
+        "step" => &["8"],
         _ => &["1"],
     };
     options[pick % options.len()].to_owned()

@@ -90,7 +90,7 @@ kernel::kernels! {
 impl KernelParams {
     /// Every parameter set the conformance suite checks: `row_prefix` in each of its
     /// modes (default workgroup size), then every family's kernels for its variant with the
-    /// most passes, each kernel once (from the family table: a new family needs no line here).
+    /// most passes and its default with epipolar sampling, each kernel once (from the family table: a new family needs no line here).
     pub fn all_modes() -> Vec<Self> {
         let mut out: Vec<Self> = RowPrefixMode::ALL
             .iter()
@@ -102,7 +102,19 @@ impl KernelParams {
             })
             .collect();
         for &family in Family::ALL {
-            for params in family::most_passes(family).kernel_params() {
+            // The variant with the most passes, then the default with epipolar sampling
+            // (its `_unwarp` kernel).
+            let epipolar =
+                family
+                    .default_variant()
+                    .with_sampling(sampling::SamplingKnobs::epipolar(
+                        sampling::SamplingKnobs::DEFAULT_SLICES,
+                    ));
+            for params in family::most_passes(family)
+                .kernel_params()
+                .into_iter()
+                .chain(epipolar.kernel_params())
+            {
                 if !out.iter().any(|p| p.kernel() == params.kernel()) {
                     out.push(params);
                 }

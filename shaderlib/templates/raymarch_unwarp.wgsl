@@ -2,5 +2,5 @@
 scatter_frame::sampling, "The epipolar passes"): raymarch.wgsl rendered with its second
 sampling entry point, which gathers every pixel from the samples `raymarch` wrote to
 `epipolar_samples` (one more binding) and evaluates with raymarch's per-pixel body the pixels no
-sample stands for. CPU mirror: reference/src/kernels/raymarch_unwarp.rs. -#}
+sample stands for. Mirrors reference/src/kernels/raymarch_unwarp.rs -#}
 {% include "raymarch.wgsl" %}

@@ -2,5 +2,5 @@
 scatter_frame::sampling, "The epipolar passes"): scatter.wgsl rendered with its second
 sampling entry point, which gathers every pixel from the samples `scatter` wrote to
 `epipolar_samples` (one more binding) and evaluates with scatter's per-pixel body the pixels no
-sample stands for. CPU mirror: reference/src/kernels/scatter_unwarp.rs. -#}
+sample stands for. Mirrors reference/src/kernels/scatter_unwarp.rs -#}
 {% include "scatter.wgsl" %}
