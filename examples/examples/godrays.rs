@@ -564,6 +564,7 @@ fn prefiltered_times(t: PrefilteredTimes, projective: bool) -> PassTimes {
     ];
     if t.unwarp > Duration::ZERO {
         out.push((Kernel::ScatterUnwarp.name(), t.unwarp));
+        out.push((Kernel::ScatterFallback.name(), t.fallback));
     }
     if projective {
         out.drain(..3);
@@ -578,6 +579,7 @@ fn raymarch_times(t: RaymarchTimes, interleaved: bool) -> PassTimes {
     }
     if t.unwarp > Duration::ZERO {
         out.push((Kernel::RaymarchUnwarp.name(), t.unwarp));
+        out.push((Kernel::RaymarchFallback.name(), t.fallback));
     }
     out
 }
@@ -592,6 +594,7 @@ fn minmax_times(t: MinmaxTimes) -> PassTimes {
     ];
     if t.unwarp > Duration::ZERO {
         out.push((Kernel::MinmaxTraverseUnwarp.name(), t.unwarp));
+        out.push((Kernel::MinmaxTraverseFallback.name(), t.fallback));
     }
     out
 }

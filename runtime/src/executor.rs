@@ -508,6 +508,14 @@ impl Executor {
         self.owned.iter().find(|(n, _)| *n == name).map(|(_, o)| o)
     }
 
+    /// An allocated buffer, or `None` when the plan allocates none of that name.
+    pub(crate) fn buffer_if_any(&self, name: &str) -> Option<&wgpu::Buffer> {
+        match self.owned(name) {
+            Some(Owned::Buffer(b)) => Some(b),
+            _ => None,
+        }
+    }
+
     /// An allocated buffer.
     ///
     /// # Errors

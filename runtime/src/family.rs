@@ -87,6 +87,42 @@ pub trait FamilyRuntime: Sized {
         inputs: &Inputs<'_>,
         frames: u32,
     ) -> Result<Vec<(Kernel, Duration)>, RuntimeError>;
+
+    /// How many pixels the last submitted frame's `_unwarp` pass listed for its `_fallback`
+    /// pass, or `None` without epipolar sampling. Blocks until the GPU is done.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
+    fn fallback_pixels(&self, ctx: &Context) -> Result<Option<u32>, RuntimeError>;
+}
+
+/// The `fallback_count` buffer of `exec`'s plan read back (`None` when the plan has none:
+/// no epipolar sampling); `kernel` is blamed for a failed readback.
+pub(crate) fn read_fallback_count(
+    ctx: &Context,
+    exec: &crate::executor::Executor,
+    kernel: Kernel,
+) -> Result<Option<u32>, RuntimeError> {
+    let Some(buffer) = exec.buffer_if_any(scatter_shaderlib::sampling::FALLBACK_COUNT) else {
+        return Ok(None);
+    };
+    let mut encoder = ctx
+        .device()
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("fallback_count readback"),
+        });
+    let staging = crate::gpu::encode_buffer_readback(ctx.device(), &mut encoder, buffer);
+    ctx.queue().submit([encoder.finish()]);
+    let bytes = crate::timer::read_buffer(ctx, kernel, &staging)?;
+    let count: [u8; 4] = bytes
+        .get(..4)
+        .and_then(|b| b.try_into().ok())
+        .ok_or_else(|| RuntimeError::Readback {
+            kernel,
+            message: format!("fallback_count holds {} bytes, not 4", bytes.len()),
+        })?;
+    Ok(Some(u32::from_le_bytes(count)))
 }
 
 /// The standard shadow map of `inputs`, which `kernel`'s family needs in every frame.
@@ -192,6 +228,19 @@ macro_rules! runtime_families {
                 }
             }
 
+            /// How many pixels the last submitted frame's `_unwarp` pass listed for its
+            /// `_fallback` pass, or `None` without epipolar sampling. Blocks until the GPU is
+            /// done.
+            ///
+            /// # Errors
+            ///
+            /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
+            pub fn fallback_pixels(&self, ctx: &Context) -> Result<Option<u32>, RuntimeError> {
+                match self {
+                    $(Self::$name(p) => p.fallback_pixels(ctx),)*
+                }
+            }
+
             /// Wall time of each pass the variant has, submitted on its own, the median over
             /// `frames` frames, in pass order with its kernel.
             ///
@@ -231,6 +280,9 @@ pub struct FamilyReadback {
     /// Median wall time of each pass submitted on its own, in pass order, when
     /// [`CpuInputs::pass_wall_frames`] is non-zero (empty otherwise).
     pub pass_wall_times: Vec<(Kernel, Duration)>,
+    /// With epipolar sampling, the pixels the `_unwarp` pass listed for the `_fallback`
+    /// pass (no sample stands for them); `None` otherwise.
+    pub fallback_pixels: Option<u32>,
 }
 
 /// Test and tool helper for any family: builds `variant`'s passes, uploads `inputs` (the
@@ -279,6 +331,7 @@ pub fn run_family_once(
     pass.encode(ctx, &mut encoder, &gpu_inputs)?;
     ctx.queue().submit([encoder.finish()]);
     let output = read_rgba16float(ctx, last, pass.output_texture())?;
+    let fallback_pixels = pass.fallback_pixels(ctx)?;
     let pass_wall_times = if inputs.pass_wall_frames > 0 {
         pass.measure_pass_wall_times(ctx, &gpu_inputs, inputs.pass_wall_frames)?
     } else {
@@ -288,5 +341,6 @@ pub fn run_family_once(
         output,
         report,
         pass_wall_times,
+        fallback_pixels,
     })
 }

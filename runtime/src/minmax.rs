@@ -36,6 +36,7 @@ const RECTIFY: Kernel = Kernel::Rectify;
 const BUILD: Kernel = Kernel::MinmaxBuild;
 const MARCH: Kernel = Kernel::MinmaxTraverse;
 const UNWARP: Kernel = Kernel::MinmaxTraverseUnwarp;
+const FALLBACK: Kernel = Kernel::MinmaxTraverseFallback;
 
 /// Format of the min-max tree (r = min, g = max).
 pub const TREE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
@@ -55,12 +56,20 @@ pub struct MinmaxTimes {
     pub march: Duration,
     /// The `minmax_traverse_unwarp` pass (zero without epipolar sampling).
     pub unwarp: Duration,
+    /// The `minmax_traverse_fallback` pass (zero without epipolar sampling).
+    pub fallback: Duration,
 }
 
 impl MinmaxTimes {
     /// Sum of the passes.
     pub fn total(&self) -> Duration {
-        self.depth_columns + self.slice_fit + self.rectify + self.build + self.march + self.unwarp
+        self.depth_columns
+            + self.slice_fit
+            + self.rectify
+            + self.build
+            + self.march
+            + self.unwarp
+            + self.fallback
     }
 }
 
@@ -229,10 +238,27 @@ impl Minmax {
         shadow_map: &wgpu::TextureView,
         frames: u32,
     ) -> Result<MinmaxTimes, RuntimeError> {
-        // Without epipolar sampling there is no unwarp pass: its slot records nothing.
-        let [depth_columns, slice_fit, rectify, build, march, unwarp] = median_pass_wall_times(
+        // Without epipolar sampling there are no unwarp and fallback passes: their slots
+        // record nothing.
+        let [
+            depth_columns,
+            slice_fit,
+            rectify,
+            build,
+            march,
+            unwarp,
+            fallback,
+        ] = median_pass_wall_times(
             ctx,
-            [DEPTH_COLUMNS, SLICE_FIT, RECTIFY, BUILD, MARCH, UNWARP],
+            [
+                DEPTH_COLUMNS,
+                SLICE_FIT,
+                RECTIFY,
+                BUILD,
+                MARCH,
+                UNWARP,
+                FALLBACK,
+            ],
             frames,
             |encoder, kernel| {
                 self.encode_selected(ctx, encoder, depth, shadow_map, Some(kernel))
@@ -250,10 +276,15 @@ impl Minmax {
             } else {
                 Duration::ZERO
             },
+            fallback: if self.epipolar() {
+                fallback
+            } else {
+                Duration::ZERO
+            },
         })
     }
 
-    /// Whether the variant samples epipolar lines (and has the unwarp pass).
+    /// Whether the variant samples epipolar lines (and has the unwarp and fallback passes).
     fn epipolar(&self) -> bool {
         self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
     }
@@ -305,6 +336,7 @@ impl Minmax {
             build: at(3),
             march: at(4),
             unwarp: at(5),
+            fallback: at(6),
         }))
     }
 
@@ -467,6 +499,10 @@ impl crate::family::FamilyRuntime for Minmax {
         Ok(self.pass_times(ctx)?.map(|t| t.total()))
     }
 
+    fn fallback_pixels(&self, ctx: &Context) -> Result<Option<u32>, RuntimeError> {
+        crate::family::read_fallback_count(ctx, &self.exec, UNWARP)
+    }
+
     fn pass_wall_times(
         &self,
         ctx: &Context,
@@ -484,6 +520,7 @@ impl crate::family::FamilyRuntime for Minmax {
         ];
         if self.epipolar() {
             passes.push((UNWARP, t.unwarp));
+            passes.push((FALLBACK, t.fallback));
         }
         Ok(passes)
     }

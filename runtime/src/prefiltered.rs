@@ -43,6 +43,7 @@ const RECTIFY: Kernel = Kernel::Rectify;
 const PREFILTER: Kernel = Kernel::Prefilter;
 const SCATTER: Kernel = Kernel::Scatter;
 const SCATTER_UNWARP: Kernel = Kernel::ScatterUnwarp;
+const SCATTER_FALLBACK: Kernel = Kernel::ScatterFallback;
 
 pub use crate::gpu::{DEPTH_FORMAT, OUTPUT_FORMAT};
 
@@ -109,6 +110,8 @@ pub struct PrefilteredTimes {
     pub scatter: Duration,
     /// The `scatter_unwarp` pass (zero without epipolar sampling).
     pub unwarp: Duration,
+    /// The `scatter_fallback` pass (zero without epipolar sampling).
+    pub fallback: Duration,
 }
 
 impl PrefilteredTimes {
@@ -120,6 +123,7 @@ impl PrefilteredTimes {
             + self.prefilter
             + self.scatter
             + self.unwarp
+            + self.fallback
     }
 }
 
@@ -355,8 +359,8 @@ impl Prefiltered {
         inputs: &Inputs<'_>,
         frames: u32,
     ) -> Result<PrefilteredTimes, RuntimeError> {
-        // Without epipolar sampling there is no `scatter_unwarp` pass: its slot records
-        // nothing.
+        // Without epipolar sampling there are no `scatter_unwarp` and `scatter_fallback`
+        // passes: their slots record nothing.
         let [
             depth_columns,
             slice_fit,
@@ -364,6 +368,7 @@ impl Prefiltered {
             prefilter,
             scatter,
             unwarp,
+            fallback,
         ] = median_pass_wall_times(
             ctx,
             [
@@ -373,6 +378,7 @@ impl Prefiltered {
                 PREFILTER,
                 SCATTER,
                 SCATTER_UNWARP,
+                SCATTER_FALLBACK,
             ],
             frames,
             |encoder, kernel| self.encode_pass(encoder, inputs, kernel),
@@ -385,6 +391,11 @@ impl Prefiltered {
             scatter,
             unwarp: if self.epipolar() {
                 unwarp
+            } else {
+                Duration::ZERO
+            },
+            fallback: if self.epipolar() {
+                fallback
             } else {
                 Duration::ZERO
             },
@@ -454,9 +465,11 @@ impl Prefiltered {
             .frame
             .as_ref()
             .is_some_and(|f| f.report.rectification == Rectification::Projective);
-        let (times, unwarp) = match times[..] {
-            [ref head @ .., unwarp] if self.epipolar() && times.len() == 6 => (head, unwarp),
-            _ => (&times[..], Duration::ZERO),
+        let (times, unwarp, fallback) = match times[..] {
+            [ref head @ .., unwarp, fallback] if self.epipolar() && times.len() == 7 => {
+                (head, unwarp, fallback)
+            }
+            _ => (&times[..], Duration::ZERO, Duration::ZERO),
         };
         match *times {
             [depth_columns, slice_fit, rectify, prefilter, scatter] => Ok(Some(PrefilteredTimes {
@@ -474,19 +487,21 @@ impl Prefiltered {
                 prefilter,
                 scatter,
                 unwarp,
+                fallback,
             })),
             _ => Err(RuntimeError::Readback {
                 kernel: SCATTER,
                 message: format!(
                     "expected {} pass times, got {}",
-                    if self.epipolar() { 6 } else { 5 },
-                    times.len() + usize::from(self.epipolar())
+                    if self.epipolar() { 7 } else { 5 },
+                    times.len() + 2 * usize::from(self.epipolar())
                 ),
             }),
         }
     }
 
-    /// Whether the variant samples epipolar lines (and has the `scatter_unwarp` pass).
+    /// Whether the variant samples epipolar lines (and has the `scatter_unwarp` and
+    /// `scatter_fallback` passes).
     fn epipolar(&self) -> bool {
         self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
     }
@@ -791,6 +806,10 @@ impl crate::family::FamilyRuntime for Prefiltered {
         Ok(self.pass_times(ctx)?.map(|t| t.total()))
     }
 
+    fn fallback_pixels(&self, ctx: &Context) -> Result<Option<u32>, RuntimeError> {
+        crate::family::read_fallback_count(ctx, &self.exec, SCATTER_UNWARP)
+    }
+
     fn pass_wall_times(
         &self,
         ctx: &Context,
@@ -807,6 +826,7 @@ impl crate::family::FamilyRuntime for Prefiltered {
         ];
         if self.epipolar() {
             passes.push((SCATTER_UNWARP, t.unwarp));
+            passes.push((SCATTER_FALLBACK, t.fallback));
         }
         Ok(passes)
     }

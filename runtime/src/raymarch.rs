@@ -28,6 +28,7 @@ use crate::{Context, RuntimeError};
 const RAYMARCH: Kernel = Kernel::Raymarch;
 const INTERLEAVE_SUM: Kernel = Kernel::InterleaveSum;
 const UNWARP: Kernel = Kernel::RaymarchUnwarp;
+const FALLBACK: Kernel = Kernel::RaymarchFallback;
 
 /// Format of the partial sums of an interleaved variant
 /// (`scatter_shaderlib::raymarch::PARTIAL_FORMAT`).
@@ -67,12 +68,14 @@ pub struct RaymarchTimes {
     pub interleave_sum: Duration,
     /// The `raymarch_unwarp` pass (zero without epipolar sampling).
     pub unwarp: Duration,
+    /// The `raymarch_fallback` pass (zero without epipolar sampling).
+    pub fallback: Duration,
 }
 
 impl RaymarchTimes {
     /// Sum of the passes.
     pub fn total(&self) -> Duration {
-        self.raymarch + self.interleave_sum + self.unwarp
+        self.raymarch + self.interleave_sum + self.unwarp + self.fallback
     }
 }
 
@@ -234,9 +237,9 @@ impl Raymarch {
         frames: u32,
     ) -> Result<RaymarchTimes, RuntimeError> {
         // Without interleaving there is no `interleave_sum` pass: its slot records nothing.
-        let [raymarch, interleave_sum, unwarp] = median_pass_wall_times(
+        let [raymarch, interleave_sum, unwarp, fallback] = median_pass_wall_times(
             ctx,
-            [RAYMARCH, INTERLEAVE_SUM, UNWARP],
+            [RAYMARCH, INTERLEAVE_SUM, UNWARP, FALLBACK],
             frames,
             |encoder, kernel| {
                 self.encode_selected(ctx, encoder, depth, shadow_map, Some(kernel))
@@ -255,10 +258,16 @@ impl Raymarch {
             } else {
                 Duration::ZERO
             },
+            fallback: if self.epipolar() {
+                fallback
+            } else {
+                Duration::ZERO
+            },
         })
     }
 
-    /// Whether the variant samples epipolar lines (and has the `raymarch_unwarp` pass).
+    /// Whether the variant samples epipolar lines (and has the `raymarch_unwarp` and
+    /// `raymarch_fallback` passes).
     fn epipolar(&self) -> bool {
         self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
     }
@@ -311,6 +320,11 @@ impl Raymarch {
             },
             unwarp: if self.epipolar() {
                 times.get(1).copied().unwrap_or_default()
+            } else {
+                Duration::ZERO
+            },
+            fallback: if self.epipolar() {
+                times.get(2).copied().unwrap_or_default()
             } else {
                 Duration::ZERO
             },
@@ -464,6 +478,10 @@ impl crate::family::FamilyRuntime for Raymarch {
         Ok(self.pass_times(ctx)?.map(|t| t.total()))
     }
 
+    fn fallback_pixels(&self, ctx: &Context) -> Result<Option<u32>, RuntimeError> {
+        crate::family::read_fallback_count(ctx, &self.exec, UNWARP)
+    }
+
     fn pass_wall_times(
         &self,
         ctx: &Context,
@@ -478,6 +496,7 @@ impl crate::family::FamilyRuntime for Raymarch {
         }
         if self.epipolar() {
             passes.push((UNWARP, t.unwarp));
+            passes.push((FALLBACK, t.fallback));
         }
         Ok(passes)
     }

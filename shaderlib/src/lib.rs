@@ -58,8 +58,12 @@ kernel::kernels! {
     /// Per pixel: the rectified row marched through its min-max tree, skipping nodes wholly
     /// lit or shadowed; pixels near the epipole ray-marched (Chen et al. 2011).
     MinmaxTraverse("minmax_traverse", MinmaxVariant, minmax::render_traverse),
+    /// `sampling = epipolar`: the pixels `minmax_traverse_unwarp` listed (no sample stands
+    /// for them), traversed themselves.
+    MinmaxTraverseFallback("minmax_traverse_fallback", MinmaxVariant, minmax::render_traverse_fallback),
     /// `sampling = epipolar`: every pixel gathered from the `minmax_traverse` samples of
-    /// the two slices around it, or traversed itself where none stands for it.
+    /// the two slices around it, or listed for `minmax_traverse_fallback` where none stands
+    /// for it.
     MinmaxTraverseUnwarp("minmax_traverse_unwarp", MinmaxVariant, minmax::render_traverse_unwarp),
     /// Fourier basis transform fused with the weighted running mean along each rectified
     /// row, per region (Klehm et al. 2014, Listings 1-3, Table 1).
@@ -67,8 +71,11 @@ kernel::kernels! {
     /// Brute-force ray marching through the standard shadow map, optionally interleaved
     /// (Tóth & Umenhoffer 2009).
     Raymarch("raymarch", RaymarchVariant, raymarch::render_raymarch),
+    /// `sampling = epipolar`: the pixels `raymarch_unwarp` listed (no sample stands for
+    /// them), marched themselves.
+    RaymarchFallback("raymarch_fallback", RaymarchVariant, raymarch::render_raymarch_fallback),
     /// `sampling = epipolar`: every pixel gathered from the `raymarch` samples of the two
-    /// slices around it, or marched itself where none stands for it.
+    /// slices around it, or listed for `raymarch_fallback` where none stands for it.
     RaymarchUnwarp("raymarch_unwarp", RaymarchVariant, raymarch::render_raymarch_unwarp),
     /// Epipolar resampling of a standard shadow map into the rectified shadow map (Klehm et
     /// al. 2014, Sec. 4.1, after Baran et al. 2010).
@@ -79,8 +86,11 @@ kernel::kernels! {
     /// Per pixel: prefiltered visibility times the unshadowed integral, one dot product per
     /// region; pixels near the epipole ray-marched (Klehm et al. 2014, Listing 4, Sec. 5).
     Scatter("scatter", PrefilteredVariant, prefiltered::kernels::render_scatter),
+    /// `sampling = epipolar`: the pixels `scatter_unwarp` listed (no sample stands for
+    /// them), evaluated themselves.
+    ScatterFallback("scatter_fallback", PrefilteredVariant, prefiltered::kernels::render_scatter_fallback),
     /// `sampling = epipolar`: every pixel gathered from the `scatter` samples of the two
-    /// slices around it, or evaluated itself where none stands for it.
+    /// slices around it, or listed for `scatter_fallback` where none stands for it.
     ScatterUnwarp("scatter_unwarp", PrefilteredVariant, prefiltered::kernels::render_scatter_unwarp),
     /// Every rectified row's column spacing fitted to the deepest pixel of the depth buffer
     /// (after `depth_columns`; the host spans rows to the far plane).
@@ -103,7 +113,7 @@ impl KernelParams {
             .collect();
         for &family in Family::ALL {
             // The variant with the most passes, then the default with epipolar sampling
-            // (its `_unwarp` kernel).
+            // (its `_unwarp` and `_fallback` kernels).
             let epipolar =
                 family
                     .default_variant()

@@ -17,6 +17,8 @@ pub(crate) struct SamplingView {
     pub epipolar: bool,
     /// Whether the kernel is the epipolar unwarp (`<kernel>_unwarp`).
     pub unwarp: bool,
+    /// Whether the kernel is the epipolar fallback (`<kernel>_fallback`).
+    pub fallback: bool,
     /// Block side S.
     pub scale: u32,
     /// The depth break as a WGSL f32 literal (a fraction of the nearer depth).
@@ -29,14 +31,15 @@ pub(crate) struct SamplingView {
     pub step: u32,
     /// The kernel's entry point.
     pub entry: &'static str,
-    /// The family kernel's entry point (`entry` without `_unwarp`).
+    /// The family kernel's entry point (`entry` without `_unwarp` or `_fallback`).
     pub family_entry: &'static str,
     /// The family's per-pixel function, `<family kernel>_pixel`.
     pub pixel: String,
     /// A WGSL expression of type `scatter::sampling::EpipolarCamera` from the kernel's
     /// uniform block.
     pub camera: String,
-    /// The binding of `epipolar_samples` in the unwarp pass (the family's first free one).
+    /// The family's first free binding B: `epipolar_samples` in the unwarp pass; B + 1 is
+    /// `fallback_count` and B + 2 `fallback_pixels` in the passes that bind them.
     pub binding: u32,
     /// The `#import scatter::sampling::{..}` line the kernel needs (empty for `pixels`).
     pub imports: &'static str,
@@ -46,8 +49,9 @@ pub(crate) struct SamplingView {
 
 impl SamplingView {
     /// The view of `knobs` for kernel `kernel`, whose per-pixel body is the one of
-    /// `family_kernel` (the same kernel, or the family kernel of an `_unwarp` pass), whose
-    /// uniform block gives `camera` and whose first free binding is `binding`.
+    /// `family_kernel` (the same kernel, or the family kernel of an `_unwarp` or
+    /// `_fallback` pass), whose uniform block gives `camera` and whose first free binding is
+    /// `binding`.
     pub(crate) fn new(
         knobs: &SamplingKnobs,
         kernel: Kernel,
@@ -55,12 +59,14 @@ impl SamplingView {
         camera: String,
         binding: u32,
     ) -> Self {
-        let unwarp = kernel != family_kernel;
+        let fallback = kernel != family_kernel && kernel.name().ends_with("_fallback");
+        let unwarp = kernel != family_kernel && !fallback;
         let imports = match knobs.sampling {
             Sampling::Pixels => "",
             Sampling::Lowres => {
                 "#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}"
             }
+            Sampling::Epipolar if fallback => "",
             Sampling::Epipolar if unwarp => {
                 "#import scatter::sampling::{EpipolarCamera, epipolar_layout, epipolar_slices, epipolar_taps, lowres_blend}"
             }
@@ -72,6 +78,7 @@ impl SamplingView {
             lowres: knobs.sampling == Sampling::Lowres,
             epipolar: knobs.sampling == Sampling::Epipolar,
             unwarp,
+            fallback,
             scale: knobs.scale,
             depth_break: wgsl_f32(knobs.depth_break_fraction()),
             light_break: wgsl_f32(knobs.light_break_fraction()),
@@ -84,7 +91,7 @@ impl SamplingView {
             camera,
             binding,
             imports,
-            output_format: if knobs.sampling == Sampling::Epipolar && !unwarp {
+            output_format: if knobs.sampling == Sampling::Epipolar && !unwarp && !fallback {
                 EPIPOLAR_SAMPLES_FORMAT
             } else {
                 "rgba16float"
@@ -146,7 +153,8 @@ pub fn epipolar_samples_texture(knobs: &SamplingKnobs) -> Option<crate::plan::Re
     })
 }
 
-/// An error for the `_unwarp` pass `kernel` of a variant whose sampling is not `epipolar`.
+/// An error for the `_unwarp` or `_fallback` pass `kernel` of a variant whose sampling is
+/// not `epipolar`.
 pub(crate) fn unwarp_only(kernel: Kernel, sampling: Sampling) -> Result<(), crate::ShaderError> {
     if sampling == Sampling::Epipolar {
         Ok(())
@@ -155,7 +163,7 @@ pub(crate) fn unwarp_only(kernel: Kernel, sampling: Sampling) -> Result<(), crat
             kernel,
             knob: "sampling",
             value: sampling.to_string(),
-            allowed: "epipolar (only epipolar sampling has an unwarp pass)",
+            allowed: "epipolar (only epipolar sampling has unwarp and fallback passes)",
         })
     }
 }
@@ -170,25 +178,57 @@ pub fn sampled_output(knobs: &SamplingKnobs) -> &'static str {
     }
 }
 
-/// The `_unwarp` pass `kernel` of a family kernel's epipolar pass `family`: the same
-/// bindings with `output` where `family` writes `epipolar_samples`, and `epipolar_samples`
-/// read at `binding`; one invocation per screen pixel.
-pub fn unwarp_pass(
-    family: crate::plan::PassPlan,
-    kernel: Kernel,
+/// The family kernel's pass `family` as `knobs` sample it: with `epipolar`,
+/// `fallback_count` bound at `binding + 1` (the samples pass zeroes it for the unwarp);
+/// unchanged otherwise.
+pub fn sampled_pass(
+    knobs: &SamplingKnobs,
+    mut family: crate::plan::PassPlan,
     binding: u32,
 ) -> crate::plan::PassPlan {
-    let mut bindings: Vec<_> = family
+    if knobs.sampling == Sampling::Epipolar {
+        family
+            .bindings
+            .push(crate::plan::bind(binding + 1, FALLBACK_COUNT));
+    }
+    family
+}
+
+/// The bindings of the family kernel's pass `family` as its `_unwarp` and `_fallback`
+/// passes take them: `output` where `family` writes `epipolar_samples`, without what
+/// [`sampled_pass`] added.
+fn family_bindings(family: &crate::plan::PassPlan) -> Vec<crate::plan::BindingSource> {
+    family
         .bindings
-        .into_iter()
+        .iter()
+        .filter(|b| b.resource != FALLBACK_COUNT)
+        .cloned()
         .map(|mut b| {
             if b.resource == "epipolar_samples" {
                 b.resource = "output";
             }
             b
         })
+        .collect()
+}
+
+/// The `_unwarp` pass `kernel` of a family kernel's epipolar pass `family`: its `frame` and
+/// `depth` bindings, `output` where `family` writes `epipolar_samples`, `epipolar_samples`
+/// read at `binding`, `fallback_count` and `fallback_pixels` at `binding + 1` and `+ 2`; one
+/// invocation per screen pixel.
+pub fn unwarp_pass(
+    family: crate::plan::PassPlan,
+    kernel: Kernel,
+    binding: u32,
+) -> crate::plan::PassPlan {
+    // The gather reads only the uniform block, the depth buffer and the samples.
+    let mut bindings: Vec<_> = family_bindings(&family)
+        .into_iter()
+        .filter(|b| ["frame", "depth", "output"].contains(&b.resource))
         .collect();
     bindings.push(crate::plan::bind(binding, "epipolar_samples"));
+    bindings.push(crate::plan::bind(binding + 1, FALLBACK_COUNT));
+    bindings.push(crate::plan::bind(binding + 2, FALLBACK_PIXELS));
     crate::plan::PassPlan {
         kernel,
         invocations: ["screen.width".into(), "screen.height".into(), "1".into()],
@@ -196,6 +236,68 @@ pub fn unwarp_pass(
         bindings,
     }
 }
+
+/// The `_fallback` pass `kernel` of a family kernel's epipolar pass `family`: the same
+/// bindings with `output` where `family` writes `epipolar_samples`, and `fallback_count`
+/// and `fallback_pixels` read at `binding + 1` and `+ 2`; one invocation per 8 x 8 pixels,
+/// each evaluating every `invocations`-th listed pixel.
+pub fn fallback_pass(
+    family: crate::plan::PassPlan,
+    kernel: Kernel,
+    binding: u32,
+) -> crate::plan::PassPlan {
+    let mut bindings = family_bindings(&family);
+    bindings.push(crate::plan::bind(binding + 1, FALLBACK_COUNT));
+    bindings.push(crate::plan::bind(binding + 2, FALLBACK_PIXELS));
+    crate::plan::PassPlan {
+        kernel,
+        invocations: [
+            format!("ceil(screen.width / {FALLBACK_TILE})"),
+            format!("ceil(screen.height / {FALLBACK_TILE})"),
+            "1".into(),
+        ],
+        skip_when: family.skip_when,
+        bindings,
+    }
+}
+
+/// The buffers of an `epipolar` plan's fallback list (`fallback_count`, `fallback_pixels`),
+/// or none for the other modes.
+pub fn fallback_buffers(knobs: &SamplingKnobs) -> Vec<crate::plan::Resource> {
+    if knobs.sampling != Sampling::Epipolar {
+        return Vec::new();
+    }
+    let buffer = |name, contents, elements: Option<&str>, usage| crate::plan::Resource {
+        kind: "storage_buffer",
+        buffer: Some(crate::plan::BufferDesc {
+            elements: elements.map(str::to_owned),
+            usage,
+        }),
+        ..crate::plan::scatter_resource(name, contents)
+    };
+    vec![
+        buffer(
+            FALLBACK_COUNT,
+            "sampling = epipolar: how many pixels the _unwarp pass listed in fallback_pixels              (zeroed by the family's samples pass, incremented by the _unwarp pass, read by              the _fallback pass; no host upload or clear; copy it back to report how many \
+             pixels fell back)",
+            None,
+            vec!["storage", "copy_src"],
+        ),
+        buffer(
+            FALLBACK_PIXELS,
+            "sampling = epipolar: the pixels no sample stands for, packed x | y << 16, in no              particular order (written by the _unwarp pass, evaluated by the _fallback pass)",
+            Some("screen.width * screen.height"),
+            vec!["storage"],
+        ),
+    ]
+}
+
+/// The fallback list's count.
+pub const FALLBACK_COUNT: &str = "fallback_count";
+/// The fallback list's pixels.
+pub const FALLBACK_PIXELS: &str = "fallback_pixels";
+/// The `_fallback` pass runs one invocation per `FALLBACK_TILE` x `FALLBACK_TILE` pixels.
+pub const FALLBACK_TILE: u32 = 8;
 
 /// Format of `epipolar_samples`.
 pub const EPIPOLAR_SAMPLES_FORMAT: &str = "rgba32float";

@@ -291,6 +291,31 @@ pub fn run_variant(
     ),
     String,
 > {
+    run_variant_counted(ctx, variant, frame).map(|(image, report, _)| (image, report))
+}
+
+/// [`run_variant`], with the pixels the GPU's epipolar `_unwarp` pass listed for its
+/// `_fallback` pass (`None` without epipolar sampling or on the CPU).
+///
+/// # Errors
+///
+/// As [`run_variant`].
+#[allow(
+    clippy::type_complexity,
+    reason = "the tuple of run_variant plus one count; a struct would name it once"
+)]
+pub fn run_variant_counted(
+    ctx: Option<&Context>,
+    variant: &scatter_shaderlib::family::FamilyVariant,
+    frame: &scatter_reference::kernels::CpuFrame<'_>,
+) -> Result<
+    (
+        scatter_reference::image::Image,
+        Option<scatter_shaderlib::prefiltered::FrameReport>,
+        Option<u32>,
+    ),
+    String,
+> {
     use scatter_reference::image::Image;
     use scatter_reference::kernels::{CpuRun, engine_rectified_map, run_family};
     use scatter_shaderlib::family::FamilyVariant;
@@ -298,7 +323,7 @@ pub fn run_variant(
 
     let Some(ctx) = ctx else {
         let run = run_family(variant, frame).map_err(|e| e.to_string())?;
-        return Ok((run.output().clone(), run.report().cloned()));
+        return Ok((run.output().clone(), run.report().cloned(), None));
     };
     let (scene, gbuf) = (frame.scene, frame.gbuf);
     let input = FrameInput {
@@ -347,7 +372,7 @@ pub fn run_variant(
         gbuf.height,
         out.output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
     );
-    Ok((image, out.report))
+    Ok((image, out.report, out.fallback_pixels))
 }
 
 /// Relative tolerance of `slice_fit`'s column spacing, GPU against its mirror: exact for the

@@ -323,7 +323,8 @@ fn other_families_dir() -> &'static Path {
 /// The raymarch trial variants: plain directional, interleaved and jittered spot,
 /// `sampling = lowres` (scale 2) spot: the sampled dispatch and workgroup memory, and
 /// `sampling = epipolar` (64 slices x 64 samples) spot: the `epipolar_samples` texture the
-/// engine allocates from the manifest and the `raymarch_unwarp` pass.
+/// engine allocates from the manifest, the `raymarch_unwarp` pass, the fallback list
+/// (`fallback_count`, `fallback_pixels`) and the `raymarch_fallback` pass.
 fn raymarch_variants() -> [RaymarchVariant; 4] {
     [
         RaymarchVariant::default(),
@@ -430,7 +431,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
         let expect: &[&str] = if v.interleaved() {
             &["raymarch", "interleave_sum"]
         } else if v.sampling == scatter_frame::sampling::Sampling::Epipolar {
-            &["raymarch", "raymarch_unwarp"]
+            &["raymarch", "raymarch_unwarp", "raymarch_fallback"]
         } else {
             &["raymarch"]
         };

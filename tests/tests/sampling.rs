@@ -28,13 +28,16 @@
 use std::process::ExitCode;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use scatter_conformance::{Check, Fixture, gpu, run_trials, run_variant, scene_for};
+use scatter_conformance::{
+    Check, Fixture, gpu, run_trials, run_variant, run_variant_counted, scene_for,
+};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
 use scatter_reference::kernels::CpuFrame;
 use scatter_reference::kernels::common_sampling::{
-    EpipolarCamera, depth_close, lowres_blend, lowres_pixel, lowres_taps, run_sampled,
+    EpipolarCamera, depth_close, epipolar_samples, epipolar_unwarp, lowres_blend, lowres_pixel,
+    lowres_taps, run_sampled,
 };
 use scatter_reference::kernels::texture::Tex;
 use scatter_reference::metrics;
@@ -173,7 +176,7 @@ fn epipolar_stage_trial(
         settings: &settings,
     };
     let (pixels, _) = run_variant(Some(ctx), &base, &frame)?;
-    let (gpu, _) = run_variant(Some(ctx), &sampled, &frame)?;
+    let (gpu, _, listed) = run_variant_counted(Some(ctx), &sampled, &frame)?;
     let depth = depth_tex(&f.gbuf);
     let [w, _] = SCREEN;
     let max = pixels
@@ -209,6 +212,23 @@ fn epipolar_stage_trial(
         }
     }
     let share = over as f64 / gpu.data.len() as f64;
+    // The unwarp's list: as long as the mirror's, give or take the pixels whose layout
+    // differs in the last bits (the body does not decide which pixels fall back).
+    let listed = listed.ok_or("the GPU run reports no fallback count")?;
+    let unwarped = epipolar_unwarp(
+        &knobs,
+        SCREEN,
+        &depth,
+        &camera,
+        &epipolar_samples(&knobs, SCREEN, &depth, &camera, &body).samples,
+    );
+    let expected = unwarped.fallback.len() as u64;
+    let slack = (EPIPOLAR_MISMATCH_SHARE * gpu.data.len() as f64).ceil() as u64;
+    if u64::from(listed).abs_diff(expected) > slack {
+        return Err(format!(
+            "the unwarp listed {listed} pixels for the fallback pass, the mirror {expected}"
+        ));
+    }
     if share > EPIPOLAR_MISMATCH_SHARE {
         return Err(format!(
             "{over} pixels ({:.2} %) over tolerance, first at {}",
@@ -217,7 +237,7 @@ fn epipolar_stage_trial(
         ));
     }
     println!(
-        "sampling::{}::{}::{pose}: {} samples and pixels evaluated ({} for depth, {} for light) of {} pixels; {over} pixels over tolerance (layout ulps); max |diff| elsewhere {:.2e} of max",
+        "sampling::{}::{}::{pose}: {} samples and pixels evaluated ({} for depth, {} for light) of {} pixels, {listed} listed for the fallback pass (mirror {expected}); {over} pixels over tolerance (layout ulps); max |diff| elsewhere {:.2e} of max",
         sampled.trial_name(),
         scene_for(base.light()),
         cpu.evaluated,

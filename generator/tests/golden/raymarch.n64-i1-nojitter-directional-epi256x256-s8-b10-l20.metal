@@ -54,13 +54,13 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uint wrap;
     char _pad5[4];
 };
-struct type_10 {
+struct type_11 {
     float inner[256];
 };
-struct type_11 {
+struct type_12 {
     uint inner[256];
 };
-struct type_12 {
+struct type_13 {
     metal::float3 inner[256];
 };
 constant float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
@@ -603,7 +603,7 @@ metal::float3 raymarch_pixel(
 
 metal::uint2 line_bracket(
     uint k_6,
-    threadgroup type_11& line_flag
+    threadgroup type_12& line_flag
 ) {
     uint a_5 = {};
     uint b_4 = {};
@@ -646,7 +646,7 @@ metal::uint2 line_bracket(
 
 bool line_spread_over(
     metal::uint2 ab,
-    threadgroup type_12& line_light
+    threadgroup type_13& line_light
 ) {
     metal::float3 la = line_light.inner[metal::min(unsigned(ab.x), 255u)];
     metal::float3 lb = line_light.inner[metal::min(unsigned(ab.y), 255u)];
@@ -664,10 +664,11 @@ kernel void raymarch(
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
 , metal::texture2d<float, metal::access::write> output [[texture(2)]]
-, threadgroup type_10& line_depth
-, threadgroup type_11& line_flag
-, threadgroup type_12& line_light
-, threadgroup type_11& line_list
+, device metal::atomic_uint& fallback_count [[buffer(1)]]
+, threadgroup type_11& line_depth
+, threadgroup type_12& line_flag
+, threadgroup type_13& line_light
+, threadgroup type_12& line_list
 , threadgroup metal::atomic_uint& line_count
 , threadgroup metal::atomic_uint& line_count_light
 ) {
@@ -707,6 +708,9 @@ kernel void raymarch(
     metal::float2 _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_3, screen_3, SLICE_SAMPLES);
     if (li == 0u) {
         output.write(metal::float4(_e39.x, _e39.y, _e41.x, _e41.y), metal::uint2(metal::uint2(SLICE_SAMPLES, s_3)));
+        if (s_3 == 0u) {
+            metal::atomic_store_explicit(&fallback_count, 0u, metal::memory_order_relaxed);
+        }
     }
     k = li;
     uint2 loop_bound_5 = uint2(4294967295u);
@@ -715,22 +719,22 @@ kernel void raymarch(
         if (metal::all(loop_bound_5 == uint2(0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e66 = k;
-            k = _e66 + 64u;
+            uint _e70 = k;
+            k = _e70 + 64u;
         }
         loop_init_3 = false;
-        uint _e54 = k;
-        if (_e54 < SLICE_SAMPLES) {
+        uint _e58 = k;
+        if (_e58 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e57 = k;
-            metal::uint2 _e58 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e57, screen_3);
-            uint _e60 = k;
-            uint clamped_lod_e64 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-            metal::float4 _e64 = depth.read(metal::min(metal::uint2(_e58), metal::uint2(depth.get_width(clamped_lod_e64), depth.get_height(clamped_lod_e64)) - 1), clamped_lod_e64);
-            line_depth.inner[metal::min(unsigned(_e60), 255u)] = _e64.x;
+            uint _e61 = k;
+            metal::uint2 _e62 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e61, screen_3);
+            uint _e64 = k;
+            uint clamped_lod_e68 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+            metal::float4 _e68 = depth.read(metal::min(metal::uint2(_e62), metal::uint2(depth.get_width(clamped_lod_e68), depth.get_height(clamped_lod_e68)) - 1), clamped_lod_e68);
+            line_depth.inner[metal::min(unsigned(_e64), 255u)] = _e68.x;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
@@ -741,63 +745,63 @@ kernel void raymarch(
         if (metal::all(loop_bound_6 == uint2(0u))) { break; }
         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e145 = k_1;
-            k_1 = _e145 + 64u;
+            uint _e149 = k_1;
+            k_1 = _e149 + 64u;
         }
         loop_init_4 = false;
-        uint _e70 = k_1;
-        if (_e70 < SLICE_SAMPLES) {
+        uint _e74 = k_1;
+        if (_e74 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e73 = k_1;
-            if (!((naga_mod(_e73, STEP) == 0u))) {
-                uint _e79 = k_1;
-                local = _e79 == 255u;
+            uint _e77 = k_1;
+            if (!((naga_mod(_e77, STEP) == 0u))) {
+                uint _e83 = k_1;
+                local = _e83 == 255u;
             } else {
                 local = true;
             }
-            bool _e85 = local;
-            marked = _e85;
-            uint _e87 = k_1;
-            if (_e87 > 0u) {
-                uint _e90 = k_1;
-                float _e95 = line_depth.inner[metal::min(unsigned(_e90 - 1u), 255u)];
-                uint _e97 = k_1;
-                float _e99 = line_depth.inner[metal::min(unsigned(_e97), 255u)];
-                bool _e101 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e95, _e99, DEPTH_BREAK);
-                local_1 = !(_e101);
+            bool _e89 = local;
+            marked = _e89;
+            uint _e91 = k_1;
+            if (_e91 > 0u) {
+                uint _e94 = k_1;
+                float _e99 = line_depth.inner[metal::min(unsigned(_e94 - 1u), 255u)];
+                uint _e101 = k_1;
+                float _e103 = line_depth.inner[metal::min(unsigned(_e101), 255u)];
+                bool _e105 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e99, _e103, DEPTH_BREAK);
+                local_1 = !(_e105);
             } else {
                 local_1 = false;
             }
-            bool _e106 = local_1;
-            if (_e106) {
+            bool _e110 = local_1;
+            if (_e110) {
                 marked = true;
             }
-            uint _e108 = k_1;
-            if ((_e108 + 1u) < SLICE_SAMPLES) {
-                uint _e114 = k_1;
-                float _e116 = line_depth.inner[metal::min(unsigned(_e114), 255u)];
-                uint _e117 = k_1;
-                float _e122 = line_depth.inner[metal::min(unsigned(_e117 + 1u), 255u)];
-                bool _e124 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e116, _e122, DEPTH_BREAK);
-                local_2 = !(_e124);
+            uint _e112 = k_1;
+            if ((_e112 + 1u) < SLICE_SAMPLES) {
+                uint _e118 = k_1;
+                float _e120 = line_depth.inner[metal::min(unsigned(_e118), 255u)];
+                uint _e121 = k_1;
+                float _e126 = line_depth.inner[metal::min(unsigned(_e121 + 1u), 255u)];
+                bool _e128 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e120, _e126, DEPTH_BREAK);
+                local_2 = !(_e128);
             } else {
                 local_2 = false;
             }
-            bool _e129 = local_2;
-            if (_e129) {
+            bool _e133 = local_2;
+            if (_e133) {
                 marked = true;
             }
-            uint _e132 = k_1;
-            bool _e136 = marked;
-            line_flag.inner[metal::min(unsigned(_e132), 255u)] = _e136 ? 1u : 0u;
-            bool _e138 = marked;
-            if (_e138) {
-                uint _e141 = metal::atomic_fetch_add_explicit(&line_count, 1u, metal::memory_order_relaxed);
-                uint _e144 = k_1;
-                line_list.inner[metal::min(unsigned(_e141), 255u)] = _e144;
+            uint _e136 = k_1;
+            bool _e140 = marked;
+            line_flag.inner[metal::min(unsigned(_e136), 255u)] = _e140 ? 1u : 0u;
+            bool _e142 = marked;
+            if (_e142) {
+                uint _e145 = metal::atomic_fetch_add_explicit(&line_count, 1u, metal::memory_order_relaxed);
+                uint _e148 = k_1;
+                line_list.inner[metal::min(unsigned(_e145), 255u)] = _e148;
             }
         }
     }
@@ -810,22 +814,22 @@ kernel void raymarch(
         if (metal::all(loop_bound_7 == uint2(0u))) { break; }
         loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e164 = e;
-            e = _e164 + 64u;
+            uint _e168 = e;
+            e = _e168 + 64u;
         }
         loop_init_5 = false;
-        uint _e151 = e;
-        if (_e151 < n_3) {
+        uint _e155 = e;
+        if (_e155 < n_3) {
         } else {
             break;
         }
         {
-            uint _e154 = e;
-            uint k_7 = line_list.inner[metal::min(unsigned(_e154), 255u)];
-            metal::uint2 _e157 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
-            metal::float3 _e162 = raymarch_pixel(_e157.x, _e157.y, frame, depth, shadow_map);
-            metal::float3 _e163 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e162);
-            line_light.inner[metal::min(unsigned(k_7), 255u)] = _e163;
+            uint _e158 = e;
+            uint k_7 = line_list.inner[metal::min(unsigned(_e158), 255u)];
+            metal::uint2 _e161 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
+            metal::float3 _e166 = raymarch_pixel(_e161.x, _e161.y, frame, depth, shadow_map);
+            metal::float3 _e167 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e166);
+            line_light.inner[metal::min(unsigned(k_7), 255u)] = _e167;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
@@ -836,31 +840,31 @@ kernel void raymarch(
         if (metal::all(loop_bound_8 == uint2(0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
         if (!loop_init_6) {
-            uint _e190 = k_2;
-            k_2 = _e190 + 64u;
+            uint _e194 = k_2;
+            k_2 = _e194 + 64u;
         }
         loop_init_6 = false;
-        uint _e168 = k_2;
-        if (_e168 < SLICE_SAMPLES) {
+        uint _e172 = k_2;
+        if (_e172 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e172 = k_2;
-            uint _e174 = line_flag.inner[metal::min(unsigned(_e172), 255u)];
-            if (_e174 == 0u) {
-                uint _e177 = k_2;
-                metal::uint2 _e178 = line_bracket(_e177, line_flag);
-                bool _e179 = line_spread_over(_e178, line_light);
-                local_3 = _e179;
+            uint _e176 = k_2;
+            uint _e178 = line_flag.inner[metal::min(unsigned(_e176), 255u)];
+            if (_e178 == 0u) {
+                uint _e181 = k_2;
+                metal::uint2 _e182 = line_bracket(_e181, line_flag);
+                bool _e183 = line_spread_over(_e182, line_light);
+                local_3 = _e183;
             } else {
                 local_3 = false;
             }
-            bool _e183 = local_3;
-            if (_e183) {
-                uint _e186 = metal::atomic_fetch_add_explicit(&line_count_light, 1u, metal::memory_order_relaxed);
-                uint _e189 = k_2;
-                line_list.inner[metal::min(unsigned(_e186), 255u)] = _e189;
+            bool _e187 = local_3;
+            if (_e187) {
+                uint _e190 = metal::atomic_fetch_add_explicit(&line_count_light, 1u, metal::memory_order_relaxed);
+                uint _e193 = k_2;
+                line_list.inner[metal::min(unsigned(_e190), 255u)] = _e193;
             }
         }
     }
@@ -873,22 +877,22 @@ kernel void raymarch(
         if (metal::all(loop_bound_9 == uint2(0u))) { break; }
         loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
         if (!loop_init_7) {
-            uint _e209 = e_1;
-            e_1 = _e209 + 64u;
+            uint _e213 = e_1;
+            e_1 = _e213 + 64u;
         }
         loop_init_7 = false;
-        uint _e196 = e_1;
-        if (_e196 < n2_) {
+        uint _e200 = e_1;
+        if (_e200 < n2_) {
         } else {
             break;
         }
         {
-            uint _e199 = e_1;
-            uint k_8 = line_list.inner[metal::min(unsigned(_e199), 255u)];
-            metal::uint2 _e202 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-            metal::float3 _e207 = raymarch_pixel(_e202.x, _e202.y, frame, depth, shadow_map);
-            metal::float3 _e208 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e207);
-            line_light.inner[metal::min(unsigned(k_8), 255u)] = _e208;
+            uint _e203 = e_1;
+            uint k_8 = line_list.inner[metal::min(unsigned(_e203), 255u)];
+            metal::uint2 _e206 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
+            metal::float3 _e211 = raymarch_pixel(_e206.x, _e206.y, frame, depth, shadow_map);
+            metal::float3 _e212 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e211);
+            line_light.inner[metal::min(unsigned(k_8), 255u)] = _e212;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
@@ -899,40 +903,40 @@ kernel void raymarch(
         if (metal::all(loop_bound_10 == uint2(0u))) { break; }
         loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
         if (!loop_init_8) {
-            uint _e267 = k_3;
-            k_3 = _e267 + 64u;
+            uint _e271 = k_3;
+            k_3 = _e271 + 64u;
         }
         loop_init_8 = false;
-        uint _e213 = k_3;
-        if (_e213 < SLICE_SAMPLES) {
+        uint _e217 = k_3;
+        if (_e217 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e217 = k_3;
-            metal::float3 _e219 = line_light.inner[metal::min(unsigned(_e217), 255u)];
-            c = _e219;
-            uint _e222 = k_3;
-            uint _e224 = line_flag.inner[metal::min(unsigned(_e222), 255u)];
-            if (_e224 == 0u) {
-                uint _e227 = k_3;
-                metal::uint2 _e228 = line_bracket(_e227, line_flag);
-                bool _e229 = line_spread_over(_e228, line_light);
-                if (!(_e229)) {
-                    uint _e231 = k_3;
-                    float t_4 = static_cast<float>(_e231 - _e228.x) / static_cast<float>(_e228.y - _e228.x);
-                    metal::float3 _e243 = line_light.inner[metal::min(unsigned(_e228.x), 255u)];
-                    metal::float3 _e250 = line_light.inner[metal::min(unsigned(_e228.y), 255u)];
-                    c = (_e243 * (1.0 - t_4)) + (_e250 * t_4);
+            uint _e221 = k_3;
+            metal::float3 _e223 = line_light.inner[metal::min(unsigned(_e221), 255u)];
+            c = _e223;
+            uint _e226 = k_3;
+            uint _e228 = line_flag.inner[metal::min(unsigned(_e226), 255u)];
+            if (_e228 == 0u) {
+                uint _e231 = k_3;
+                metal::uint2 _e232 = line_bracket(_e231, line_flag);
+                bool _e233 = line_spread_over(_e232, line_light);
+                if (!(_e233)) {
+                    uint _e235 = k_3;
+                    float t_4 = static_cast<float>(_e235 - _e232.x) / static_cast<float>(_e232.y - _e232.x);
+                    metal::float3 _e247 = line_light.inner[metal::min(unsigned(_e232.x), 255u)];
+                    metal::float3 _e254 = line_light.inner[metal::min(unsigned(_e232.y), 255u)];
+                    c = (_e247 * (1.0 - t_4)) + (_e254 * t_4);
                 }
             }
-            uint _e253 = k_3;
-            float _e256 = c.x;
-            float _e258 = c.y;
-            float _e260 = c.z;
-            uint _e262 = k_3;
-            float _e264 = line_depth.inner[metal::min(unsigned(_e262), 255u)];
-            output.write(metal::float4(_e256, _e258, _e260, _e264), metal::uint2(metal::uint2(_e253, s_3)));
+            uint _e257 = k_3;
+            float _e260 = c.x;
+            float _e262 = c.y;
+            float _e264 = c.z;
+            uint _e266 = k_3;
+            float _e268 = line_depth.inner[metal::min(unsigned(_e266), 255u)];
+            output.write(metal::float4(_e260, _e262, _e264, _e268), metal::uint2(metal::uint2(_e257, s_3)));
         }
     }
     return;

@@ -66,6 +66,8 @@ var depth: texture_2d<f32>;
 var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) 
 var output: texture_storage_2d<rgba32float,write>;
+@group(0) @binding(5) 
+var<storage, read_write> fallback_count: atomic<u32>;
 var<workgroup> line_depth: array<f32, 256>;
 var<workgroup> line_flag: array<u32, 256>;
 var<workgroup> line_light: array<vec3<f32>, 256>;
@@ -564,201 +566,204 @@ fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_ind
     let _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_3, screen_3, SLICE_SAMPLES);
     if (li == 0u) {
         textureStore(output, vec2<u32>(SLICE_SAMPLES, s_3), vec4<f32>(_e39.x, _e39.y, _e41.x, _e41.y));
+        if (s_3 == 0u) {
+            atomicStore((&fallback_count), 0u);
+        }
     }
     k = li;
     loop {
-        let _e54 = k;
-        if (_e54 < SLICE_SAMPLES) {
+        let _e58 = k;
+        if (_e58 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e57 = k;
-            let _e58 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e57, screen_3);
-            let _e60 = k;
-            let _e64 = textureLoad(depth, _e58, 0i);
-            line_depth[_e60] = _e64.x;
+            let _e61 = k;
+            let _e62 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e61, screen_3);
+            let _e64 = k;
+            let _e68 = textureLoad(depth, _e62, 0i);
+            line_depth[_e64] = _e68.x;
         }
         continuing {
-            let _e66 = k;
-            k = (_e66 + 64u);
+            let _e70 = k;
+            k = (_e70 + 64u);
         }
     }
     workgroupBarrier();
     k_1 = li;
     loop {
-        let _e70 = k_1;
-        if (_e70 < SLICE_SAMPLES) {
+        let _e74 = k_1;
+        if (_e74 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e73 = k_1;
-            if !(((_e73 % STEP) == 0u)) {
-                let _e79 = k_1;
-                local = (_e79 == 255u);
+            let _e77 = k_1;
+            if !(((_e77 % STEP) == 0u)) {
+                let _e83 = k_1;
+                local = (_e83 == 255u);
             } else {
                 local = true;
             }
-            let _e85 = local;
-            marked = _e85;
-            let _e87 = k_1;
-            if (_e87 > 0u) {
-                let _e90 = k_1;
-                let _e95 = line_depth[(_e90 - 1u)];
-                let _e97 = k_1;
-                let _e99 = line_depth[_e97];
-                let _e101 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e95, _e99, DEPTH_BREAK);
-                local_1 = !(_e101);
+            let _e89 = local;
+            marked = _e89;
+            let _e91 = k_1;
+            if (_e91 > 0u) {
+                let _e94 = k_1;
+                let _e99 = line_depth[(_e94 - 1u)];
+                let _e101 = k_1;
+                let _e103 = line_depth[_e101];
+                let _e105 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e99, _e103, DEPTH_BREAK);
+                local_1 = !(_e105);
             } else {
                 local_1 = false;
             }
-            let _e106 = local_1;
-            if _e106 {
+            let _e110 = local_1;
+            if _e110 {
                 marked = true;
             }
-            let _e108 = k_1;
-            if ((_e108 + 1u) < SLICE_SAMPLES) {
-                let _e114 = k_1;
-                let _e116 = line_depth[_e114];
-                let _e117 = k_1;
-                let _e122 = line_depth[(_e117 + 1u)];
-                let _e124 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e116, _e122, DEPTH_BREAK);
-                local_2 = !(_e124);
+            let _e112 = k_1;
+            if ((_e112 + 1u) < SLICE_SAMPLES) {
+                let _e118 = k_1;
+                let _e120 = line_depth[_e118];
+                let _e121 = k_1;
+                let _e126 = line_depth[(_e121 + 1u)];
+                let _e128 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e120, _e126, DEPTH_BREAK);
+                local_2 = !(_e128);
             } else {
                 local_2 = false;
             }
-            let _e129 = local_2;
-            if _e129 {
+            let _e133 = local_2;
+            if _e133 {
                 marked = true;
             }
-            let _e132 = k_1;
-            let _e136 = marked;
-            line_flag[_e132] = select(0u, 1u, _e136);
-            let _e138 = marked;
-            if _e138 {
-                let _e141 = atomicAdd((&line_count), 1u);
-                let _e144 = k_1;
-                line_list[_e141] = _e144;
+            let _e136 = k_1;
+            let _e140 = marked;
+            line_flag[_e136] = select(0u, 1u, _e140);
+            let _e142 = marked;
+            if _e142 {
+                let _e145 = atomicAdd((&line_count), 1u);
+                let _e148 = k_1;
+                line_list[_e145] = _e148;
             }
         }
         continuing {
-            let _e145 = k_1;
-            k_1 = (_e145 + 64u);
+            let _e149 = k_1;
+            k_1 = (_e149 + 64u);
         }
     }
     workgroupBarrier();
     let n_3 = atomicLoad((&line_count));
     e = li;
     loop {
-        let _e151 = e;
-        if (_e151 < n_3) {
+        let _e155 = e;
+        if (_e155 < n_3) {
         } else {
             break;
         }
         {
-            let _e154 = e;
-            let k_7 = line_list[_e154];
-            let _e157 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
-            let _e162 = raymarch_pixel(_e157.x, _e157.y);
-            let _e163 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e162);
-            line_light[k_7] = _e163;
+            let _e158 = e;
+            let k_7 = line_list[_e158];
+            let _e161 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
+            let _e166 = raymarch_pixel(_e161.x, _e161.y);
+            let _e167 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e166);
+            line_light[k_7] = _e167;
         }
         continuing {
-            let _e164 = e;
-            e = (_e164 + 64u);
+            let _e168 = e;
+            e = (_e168 + 64u);
         }
     }
     workgroupBarrier();
     k_2 = li;
     loop {
-        let _e168 = k_2;
-        if (_e168 < SLICE_SAMPLES) {
+        let _e172 = k_2;
+        if (_e172 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e172 = k_2;
-            let _e174 = line_flag[_e172];
-            if (_e174 == 0u) {
-                let _e177 = k_2;
-                let _e178 = line_bracket(_e177);
-                let _e179 = line_spread_over(_e178);
-                local_3 = _e179;
+            let _e176 = k_2;
+            let _e178 = line_flag[_e176];
+            if (_e178 == 0u) {
+                let _e181 = k_2;
+                let _e182 = line_bracket(_e181);
+                let _e183 = line_spread_over(_e182);
+                local_3 = _e183;
             } else {
                 local_3 = false;
             }
-            let _e183 = local_3;
-            if _e183 {
-                let _e186 = atomicAdd((&line_count_light), 1u);
-                let _e189 = k_2;
-                line_list[_e186] = _e189;
+            let _e187 = local_3;
+            if _e187 {
+                let _e190 = atomicAdd((&line_count_light), 1u);
+                let _e193 = k_2;
+                line_list[_e190] = _e193;
             }
         }
         continuing {
-            let _e190 = k_2;
-            k_2 = (_e190 + 64u);
+            let _e194 = k_2;
+            k_2 = (_e194 + 64u);
         }
     }
     workgroupBarrier();
     let n2_ = atomicLoad((&line_count_light));
     e_1 = li;
     loop {
-        let _e196 = e_1;
-        if (_e196 < n2_) {
+        let _e200 = e_1;
+        if (_e200 < n2_) {
         } else {
             break;
         }
         {
-            let _e199 = e_1;
-            let k_8 = line_list[_e199];
-            let _e202 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-            let _e207 = raymarch_pixel(_e202.x, _e202.y);
-            let _e208 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e207);
-            line_light[k_8] = _e208;
+            let _e203 = e_1;
+            let k_8 = line_list[_e203];
+            let _e206 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
+            let _e211 = raymarch_pixel(_e206.x, _e206.y);
+            let _e212 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e211);
+            line_light[k_8] = _e212;
         }
         continuing {
-            let _e209 = e_1;
-            e_1 = (_e209 + 64u);
+            let _e213 = e_1;
+            e_1 = (_e213 + 64u);
         }
     }
     workgroupBarrier();
     k_3 = li;
     loop {
-        let _e213 = k_3;
-        if (_e213 < SLICE_SAMPLES) {
+        let _e217 = k_3;
+        if (_e217 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e217 = k_3;
-            let _e219 = line_light[_e217];
-            c = _e219;
-            let _e222 = k_3;
-            let _e224 = line_flag[_e222];
-            if (_e224 == 0u) {
-                let _e227 = k_3;
-                let _e228 = line_bracket(_e227);
-                let _e229 = line_spread_over(_e228);
-                if !(_e229) {
-                    let _e231 = k_3;
-                    let t_4 = (f32((_e231 - _e228.x)) / f32((_e228.y - _e228.x)));
-                    let _e243 = line_light[_e228.x];
-                    let _e250 = line_light[_e228.y];
-                    c = ((_e243 * (1f - t_4)) + (_e250 * t_4));
+            let _e221 = k_3;
+            let _e223 = line_light[_e221];
+            c = _e223;
+            let _e226 = k_3;
+            let _e228 = line_flag[_e226];
+            if (_e228 == 0u) {
+                let _e231 = k_3;
+                let _e232 = line_bracket(_e231);
+                let _e233 = line_spread_over(_e232);
+                if !(_e233) {
+                    let _e235 = k_3;
+                    let t_4 = (f32((_e235 - _e232.x)) / f32((_e232.y - _e232.x)));
+                    let _e247 = line_light[_e232.x];
+                    let _e254 = line_light[_e232.y];
+                    c = ((_e247 * (1f - t_4)) + (_e254 * t_4));
                 }
             }
-            let _e253 = k_3;
-            let _e256 = c.x;
-            let _e258 = c.y;
-            let _e260 = c.z;
-            let _e262 = k_3;
-            let _e264 = line_depth[_e262];
-            textureStore(output, vec2<u32>(_e253, s_3), vec4<f32>(_e256, _e258, _e260, _e264));
+            let _e257 = k_3;
+            let _e260 = c.x;
+            let _e262 = c.y;
+            let _e264 = c.z;
+            let _e266 = k_3;
+            let _e268 = line_depth[_e266];
+            textureStore(output, vec2<u32>(_e257, s_3), vec4<f32>(_e260, _e262, _e264, _e268));
         }
         continuing {
-            let _e267 = k_3;
-            k_3 = (_e267 + 64u);
+            let _e271 = k_3;
+            k_3 = (_e271 + 64u);
         }
     }
     return;

@@ -73,9 +73,10 @@ static const float LIGHT_BREAK = 0.2;
 
 cbuffer frame : register(b0) { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX frame; }
 Texture2D<float4> depth : register(t1);
-Texture2D<float4> shadow_map : register(t2);
 RWTexture2D<float4> output : register(u3);
 Texture2D<float4> epipolar_samples : register(t4);
+RWByteAddressBuffer fallback_count : register(u5);
+RWByteAddressBuffer fallback_pixels : register(u6);
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(float4 arg0, float4 arg1, float4 arg2, float4 arg3, float4 arg4, uint4 arg5) {
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ret = (ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)0;
@@ -357,8 +358,8 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
     }
     float3 _e83 = sum;
     float _e84 = total;
-    float3 c_1 = (_e83 / (_e84).xxx);
-    return float4(c_1.x, c_1.y, c_1.z, 1.0);
+    float3 c = (_e83 / (_e84).xxx);
+    return float4(c.x, c.y, c.z, 1.0);
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float2 axis, float2 d_1)
@@ -555,89 +556,6 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
     return epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1;
 }
 
-float3 raymarch_pixel(uint x_3, uint y_2)
-{
-    float u = 0.5;
-    float sum_1 = 0.0;
-    uint j_2 = (uint)0;
-    float t_3 = (float)0;
-    float w_1 = (float)0;
-    float l_3 = (float)0;
-
-    RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
-    float3 eye_2 = m_2.eye.xyz;
-    const float3 _e8 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
-    float4 _e12 = depth.Load(int3(uint2(x_3, y_2), int(0)));
-    float s = (min(max(_e12.x, 0.0), m_2.eye.w) / max(dot(_e8, m_2.cam_forward.xyz), 1e-6));
-    uint n_2 = m_2.sizes.w;
-    float h_2 = (s / float(n_2));
-    uint mx = m_2.interleave.x;
-    uint my = m_2.interleave.y;
-    uint stride = (mx * my);
-    uint pixel_class = (naga_mod(x_3, mx) + (mx * naga_mod(y_2, my)));
-    if ((m_2.interleave.z != 0u)) {
-        const float _e42 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
-        u = _e42;
-    }
-    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0.0, s, n_2);
-    j_2 = pixel_class;
-    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
-    bool loop_init_3 = true;
-    while(true) {
-        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
-            uint _e103 = j_2;
-            j_2 = (_e103 + stride);
-        }
-        loop_init_3 = false;
-        uint _e50 = j_2;
-        if ((_e50 < n_2)) {
-        } else {
-            break;
-        }
-        {
-            uint _e52 = j_2;
-            float _e54 = u;
-            t_3 = ((float(_e52) + _e54) * h_2);
-            w_1 = h_2;
-            if (false) {
-                uint _e60 = j_2;
-                float _e62 = u;
-                const float2 _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (float(_e60) + _e62));
-                t_3 = _e64.x;
-                w_1 = _e64.y;
-            }
-            float _e67 = t_3;
-            const float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)));
-            if (false) {
-                float _e73 = sum_1;
-                float _e74 = w_1;
-                float _e76 = t_3;
-                const float _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum_1 = (_e73 + ((_e71 * _e74) * _e86));
-            } else {
-                float _e89 = sum_1;
-                uint _e92 = j_2;
-                uint _e95 = j_2;
-                const float _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e92) * h_2), (float((_e95 + 1u)) * h_2));
-                sum_1 = (_e89 + (_e71 * _e100));
-            }
-        }
-    }
-    float _e105 = sum_1;
-    l_3 = _e105;
-    if (!(false)) {
-        const float _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e8)));
-        float _e118 = sum_1;
-        l_3 = ((m_2.medium.y * _e116) * _e118);
-    }
-    float _e122 = l_3;
-    float3 c_2 = (m_2.light_color.xyz * _e122);
-    return c_2;
-}
-
 uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
@@ -660,7 +578,6 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     float4 depths = float4(0.0, 0.0, 0.0, 0.0);
     float3 light[4] = (float3[4])0;
     uint j = 0u;
-    float4 c = (float4)0;
 
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
@@ -686,16 +603,16 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e54.slices.x), int(0)));
     float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e54.slices.y), int(0)));
     const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e52, q_2, _e54, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
-    bool loop_init_4 = true;
+    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
+        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e102 = j;
             j = (_e102 + 1u);
         }
-        loop_init_4 = false;
+        loop_init_3 = false;
         uint _e72 = j;
         if ((_e72 < 4u)) {
         } else {
@@ -716,13 +633,12 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     float3 _e106[4] = light;
     float4 _e109 = depth.Load(int3(q_2, int(0)));
     const float4 _e113 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e70.w, _e105, _e106, _e109.x, DEPTH_BREAK, LIGHT_BREAK);
-    c = _e113;
-    float _e116 = c.w;
-    if ((_e116 == 0.0)) {
-        const float3 _e121 = raymarch_pixel(q_2.x, q_2.y);
-        c = float4(_e121.x, _e121.y, _e121.z, 1.0);
+    if ((_e113.w == 0.0)) {
+        uint _e119; fallback_count.InterlockedAdd(0, 1u, _e119);
+        fallback_pixels.Store(_e119*4, asuint((q_2.x | (q_2.y << 16u))));
+        return;
+    } else {
+        output[q_2] = _e113;
+        return;
     }
-    float4 _e127 = c;
-    output[q_2] = _e127;
-    return;
 }

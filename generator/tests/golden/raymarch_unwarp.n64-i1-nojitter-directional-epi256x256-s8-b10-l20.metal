@@ -6,6 +6,10 @@
 
 using metal::uint;
 
+struct _mslBufferSizes {
+    uint size6;
+};
+
 struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 right;
     metal::float4 up;
@@ -62,6 +66,7 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     metal::uint2 k;
     metal::float4 w;
 };
+typedef uint type_12[1];
 constant float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 constant uint SLICES = 256u;
 constant uint SLICE_SAMPLES = 256u;
@@ -375,8 +380,8 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     }
     metal::float3 _e83 = sum;
     float _e84 = total;
-    metal::float3 c_1 = _e83 / metal::float3(_e84);
-    return metal::float4(c_1.x, c_1.y, c_1.z, 1.0);
+    metal::float3 c = _e83 / metal::float3(_e84);
+    return metal::float4(c.x, c.y, c.z, 1.0);
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
@@ -665,8 +670,8 @@ metal::float3 raymarch_pixel(
         l_3 = (m_2.medium.y * _e116) * _e118;
     }
     float _e122 = l_3;
-    metal::float3 c_2 = m_2.light_color.xyz * _e122;
-    return c_2;
+    metal::float3 c_1 = m_2.light_color.xyz * _e122;
+    return c_1;
 }
 uint naga_div(uint lhs, uint rhs) {
     return lhs / metal::select(rhs, 1u, rhs == 0u);
@@ -679,15 +684,16 @@ kernel void raymarch_unwarp(
   metal::uint3 id [[thread_position_in_grid]]
 , constant RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX& frame [[buffer(0)]]
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
-, metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
-, metal::texture2d<float, metal::access::write> output [[texture(2)]]
-, metal::texture2d<float, metal::access::sample> epipolar_samples [[texture(3)]]
+, metal::texture2d<float, metal::access::write> output [[texture(1)]]
+, metal::texture2d<float, metal::access::sample> epipolar_samples [[texture(2)]]
+, device metal::atomic_uint& fallback_count [[buffer(1)]]
+, device type_12& fallback_pixels [[buffer(2)]]
+, constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {
     bool local = {};
     metal::float4 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
     type_9 light = {};
     uint j = 0u;
-    metal::float4 c = {};
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     metal::uint2 screen_1 = metal::uint2(_e6, _e10);
@@ -746,13 +752,12 @@ kernel void raymarch_unwarp(
     uint clamped_lod_e109 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e109 = depth.read(metal::min(metal::uint2(q_2), metal::uint2(depth.get_width(clamped_lod_e109), depth.get_height(clamped_lod_e109)) - 1), clamped_lod_e109);
     metal::float4 _e113 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e70.w, _e105, _e106, _e109.x, DEPTH_BREAK, LIGHT_BREAK);
-    c = _e113;
-    float _e116 = c.w;
-    if (_e116 == 0.0) {
-        metal::float3 _e121 = raymarch_pixel(q_2.x, q_2.y, frame, depth, shadow_map);
-        c = metal::float4(_e121.x, _e121.y, _e121.z, 1.0);
+    if (_e113.w == 0.0) {
+        uint _e119 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
+        fallback_pixels[metal::min(unsigned(_e119), (_buffer_sizes.size6 - 0 - 4) / 4)] = q_2.x | (q_2.y << 16u);
+        return;
+    } else {
+        output.write(_e113, metal::uint2(q_2));
+        return;
     }
-    metal::float4 _e127 = c;
-    output.write(_e127, metal::uint2(q_2));
-    return;
 }

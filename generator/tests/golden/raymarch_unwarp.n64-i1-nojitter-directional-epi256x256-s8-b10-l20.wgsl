@@ -74,6 +74,10 @@ var shadow_map: texture_2d<f32>;
 var output: texture_storage_2d<rgba16float,write>;
 @group(0) @binding(4) 
 var epipolar_samples: texture_2d<f32>;
+@group(0) @binding(5) 
+var<storage, read_write> fallback_count: atomic<u32>;
+@group(0) @binding(6) 
+var<storage, read_write> fallback_pixels: array<u32>;
 
 fn raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(m.sm_right, m.sm_up, m.sm_forward, m.sm_origin, m.sm_proj, vec4<u32>(m.sizes.z, 0u, 0u, 0u));
@@ -307,8 +311,8 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
     }
     let _e83 = sum;
     let _e84 = total;
-    let c_1 = (_e83 / vec3(_e84));
-    return vec4<f32>(c_1.x, c_1.y, c_1.z, 1f);
+    let c = (_e83 / vec3(_e84));
+    return vec4<f32>(c.x, c.y, c.z, 1f);
 }
 
 fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, d_1: vec2<f32>) -> f32 {
@@ -553,8 +557,8 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
         l_3 = ((m_2.medium.y * _e116) * _e118);
     }
     let _e122 = l_3;
-    let c_2 = (m_2.light_color.xyz * _e122);
-    return c_2;
+    let c_1 = (m_2.light_color.xyz * _e122);
+    return c_1;
 }
 
 @compute @workgroup_size(8, 8, 1) 
@@ -563,7 +567,6 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     var depths: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var light: array<vec3<f32>, 4>;
     var j: u32 = 0u;
-    var c: vec4<f32>;
 
     let _e6 = frame.sizes.x;
     let _e10 = frame.sizes.y;
@@ -614,13 +617,12 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e106 = light;
     let _e109 = textureLoad(depth, q_2, 0i);
     let _e113 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e70.w, _e105, _e106, _e109.x, DEPTH_BREAK, LIGHT_BREAK);
-    c = _e113;
-    let _e116 = c.w;
-    if (_e116 == 0f) {
-        let _e121 = raymarch_pixel(q_2.x, q_2.y);
-        c = vec4<f32>(_e121.x, _e121.y, _e121.z, 1f);
+    if (_e113.w == 0f) {
+        let _e119 = atomicAdd((&fallback_count), 1u);
+        fallback_pixels[_e119] = (q_2.x | (q_2.y << 16u));
+        return;
+    } else {
+        textureStore(output, q_2, _e113);
+        return;
     }
-    let _e127 = c;
-    textureStore(output, q_2, _e127);
-    return;
 }

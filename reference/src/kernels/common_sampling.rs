@@ -123,8 +123,8 @@ pub struct SampledOutput {
 /// family's per-pixel body (radiance before rounding), `screen` the screen size, `camera`
 /// what the epipolar layout is built from (read only by `epipolar`).
 /// `pixels`: every pixel (rows in parallel). `lowres`: every sample, then every pixel the
-/// blend of its taps or its own evaluation. `epipolar`: both passes
-/// ([`epipolar_samples`], [`epipolar_unwarp`]). (The GPU evaluates the samples of a workgroup's
+/// blend of its taps or its own evaluation. `epipolar`: its three passes
+/// ([`epipolar_samples`], [`epipolar_unwarp`], [`epipolar_fallback`]). (The GPU evaluates the samples of a workgroup's
 /// ring again; the same pixel gives the same value, so the mirror evaluates each once.)
 pub fn run_sampled(
     knobs: &SamplingKnobs,
@@ -137,7 +137,10 @@ pub fn run_sampled(
     let [w, h] = screen;
     if knobs.sampling == Sampling::Epipolar {
         let s = epipolar_samples(knobs, screen, depth, camera, pixel);
-        let out = epipolar_unwarp(knobs, screen, depth, camera, &s.samples, pixel);
+        let out = epipolar_fallback(
+            epipolar_unwarp(knobs, screen, depth, camera, &s.samples),
+            pixel,
+        );
         return SampledOutput {
             output: out.output,
             evaluated: s.evaluated + out.evaluated,
@@ -634,18 +637,31 @@ pub fn epipolar_samples(
     }
 }
 
+/// What the epipolar unwarp (`<kernel>_unwarp`) produced.
+#[derive(Clone, Debug)]
+pub struct EpipolarUnwarp {
+    /// The screen-sized output as stored (rgba16float); the listed pixels are left 0 (the
+    /// GPU pass does not write them).
+    pub output: TexArray,
+    /// The pixels no sample stands for (`fallback_pixels`), in row-major order (the GPU
+    /// lists them in no particular order).
+    pub fallback: Vec<[u32; 2]>,
+    /// Of those, the ones no sample is close to in depth.
+    pub depth_refined: u64,
+    /// Of those, the ones whose samples' light differs.
+    pub light_refined: u64,
+}
+
 /// Sampling pass 2 of `sampling = epipolar`, `<kernel>_unwarp`: every pixel gathered from
-/// its four samples (`epipolar_taps`, kept as `lowres_blend` keeps taps) or evaluated with
-/// `pixel`. `evaluated` counts the pixels evaluated themselves; `depth_refined` and
-/// `light_refined` why.
+/// its four samples (`epipolar_taps`, kept as `lowres_blend` keeps taps), or listed for the
+/// fallback pass (with why: `depth_refined`, `light_refined`).
 pub fn epipolar_unwarp(
     knobs: &SamplingKnobs,
     screen: [u32; 2],
     depth: &Tex,
     camera: &EpipolarCamera,
     samples: &TexArray,
-    pixel: &(dyn Fn(u32, u32) -> [f32; 3] + Sync),
-) -> SampledOutput {
+) -> EpipolarUnwarp {
     use rayon::prelude::*;
     let [w, h] = screen;
     let (depth_break, light_break) = (knobs.depth_break_fraction(), knobs.light_break_fraction());
@@ -676,22 +692,57 @@ pub fn epipolar_unwarp(
                         } else {
                             2
                         };
-                        (store(pixel(x, y)), why)
+                        ([0.0; 4], why)
                     }
                 }
             })
         })
         .collect();
+    let fallback: Vec<[u32; 2]> = pixels
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.1 != 0)
+        .map(|(i, _)| [i as u32 % w, i as u32 / w])
+        .collect();
     let depth_refined = pixels.iter().filter(|p| p.1 == 1).count() as u64;
-    let light_refined = pixels.iter().filter(|p| p.1 == 2).count() as u64;
-    SampledOutput {
+    EpipolarUnwarp {
         output: TexArray {
             width: w,
             height: h,
             layers: 1,
             data: pixels.into_iter().map(|p| p.0).collect(),
         },
-        evaluated: depth_refined + light_refined,
+        light_refined: fallback.len() as u64 - depth_refined,
+        fallback,
+        depth_refined,
+    }
+}
+
+/// Sampling pass 3 of `sampling = epipolar`, `<kernel>_fallback`: the pixels the unwarp
+/// listed, evaluated with `pixel` into its output. `evaluated` counts them.
+pub fn epipolar_fallback(
+    unwarped: EpipolarUnwarp,
+    pixel: &(dyn Fn(u32, u32) -> [f32; 3] + Sync),
+) -> SampledOutput {
+    use rayon::prelude::*;
+    let store = |c: [f32; 3]| [c[0], c[1], c[2], 1.0].map(|v| quantise(v, Storage::Rgba16float));
+    let EpipolarUnwarp {
+        mut output,
+        fallback,
+        depth_refined,
+        light_refined,
+    } = unwarped;
+    let values: Vec<[f32; 4]> = fallback
+        .par_iter()
+        .map(|p| store(pixel(p[0], p[1])))
+        .collect();
+    let w = output.width;
+    for (p, v) in fallback.iter().zip(values) {
+        output.data[(p[1] * w + p[0]) as usize] = v;
+    }
+    SampledOutput {
+        output,
+        evaluated: fallback.len() as u64,
         depth_refined,
         light_refined,
     }

@@ -1,28 +1,24 @@
-//! CPU mirror of `shaderlib/templates/minmax_traverse_unwarp.wgsl`: the epipolar unwarp of
-//! the minmax family (`scatter_reference::kernels::common_sampling::epipolar_unwarp` with
-//! [`minmax_traverse_main`] as the body of the pixels no sample stands for).
+//! CPU mirror of `shaderlib/templates/minmax_traverse_unwarp.wgsl`: the epipolar unwarp of the
+//! minmax_traverse family (`scatter_reference::kernels::common_sampling::epipolar_unwarp`): every pixel
+//! gathered from the samples, or listed for `minmax_traverse_fallback`.
 
-use super::common_sampling::{EpipolarCamera, SampledOutput, epipolar_unwarp};
-use super::minmax_traverse::{TraverseInputs, minmax_traverse_main};
+use super::common_sampling::{EpipolarCamera, EpipolarUnwarp, epipolar_unwarp};
+use super::minmax_traverse::TraverseInputs;
 use super::texture::TexArray;
 use scatter_shaderlib::minmax::MinmaxVariant;
 
-/// Every pixel of an `epipolar` variant gathered from `samples` (what `minmax_traverse`
-/// wrote to `epipolar_samples`), or traversed itself.
+/// Every pixel of an `epipolar` variant gathered from `samples` (what `minmax_traverse` wrote to
+/// `epipolar_samples`), or listed for `minmax_traverse_fallback` where no sample stands for it.
 pub fn minmax_traverse_unwarp(
     variant: &MinmaxVariant,
     inp: &TraverseInputs,
     samples: &TexArray,
-) -> SampledOutput {
+) -> EpipolarUnwarp {
     epipolar_unwarp(
         &variant.sampling_knobs(),
         [inp.frame.sizes[0], inp.frame.sizes[1]],
         inp.depth,
         &EpipolarCamera::of_frame(inp.frame),
         samples,
-        &|x, y| {
-            let c = minmax_traverse_main([x, y, 0], variant, inp).map_or([0.0; 4], |(c, _)| c);
-            [c[0], c[1], c[2]]
-        },
     )
 }

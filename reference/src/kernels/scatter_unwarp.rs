@@ -1,28 +1,24 @@
 //! CPU mirror of `shaderlib/templates/scatter_unwarp.wgsl`: the epipolar unwarp of the
-//! prefiltered family (`scatter_reference::kernels::common_sampling::epipolar_unwarp` with
-//! [`scatter_main`] as the body of the pixels no sample stands for).
+//! scatter family (`scatter_reference::kernels::common_sampling::epipolar_unwarp`): every pixel
+//! gathered from the samples, or listed for `scatter_fallback`.
 
-use super::common_sampling::{EpipolarCamera, SampledOutput, epipolar_unwarp};
-use super::scatter::{ScatterInputs, scatter_main};
+use super::common_sampling::{EpipolarCamera, EpipolarUnwarp, epipolar_unwarp};
+use super::scatter::ScatterInputs;
 use super::texture::TexArray;
 use scatter_shaderlib::prefiltered::PrefilteredVariant;
 
 /// Every pixel of an `epipolar` variant gathered from `samples` (what `scatter` wrote to
-/// `epipolar_samples`), or evaluated itself.
+/// `epipolar_samples`), or listed for `scatter_fallback` where no sample stands for it.
 pub fn scatter_unwarp(
     variant: &PrefilteredVariant,
     inp: &ScatterInputs,
     samples: &TexArray,
-) -> SampledOutput {
+) -> EpipolarUnwarp {
     epipolar_unwarp(
         &variant.sampling_knobs(),
         [inp.frame.sizes[0], inp.frame.sizes[1]],
         inp.depth,
         &EpipolarCamera::of_frame(inp.frame),
         samples,
-        &|x, y| {
-            let c = scatter_main([x, y, 0], variant, inp).unwrap_or([0.0; 4]);
-            [c[0], c[1], c[2]]
-        },
     )
 }

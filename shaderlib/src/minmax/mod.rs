@@ -51,7 +51,17 @@ struct TraverseUnwarpTemplate {
     sampling: SamplingView,
 }
 
-/// The sampling view of `kernel` (`minmax_traverse` or its `_unwarp`) for `variant`.
+/// `minmax_traverse_fallback`: `minmax_traverse.wgsl` rendered as the epipolar fallback.
+#[derive(Template)]
+#[template(path = "minmax_traverse_fallback.wgsl")]
+struct TraverseFallbackTemplate {
+    light_name: &'static str,
+    spot: bool,
+    sampling: SamplingView,
+}
+
+/// The sampling view of `kernel` (`minmax_traverse`, its `_unwarp` or its `_fallback`) for
+/// `variant`.
 fn sampling_view(variant: &MinmaxVariant, kernel: Kernel) -> SamplingView {
     SamplingView::new(
         &variant.sampling_knobs(),
@@ -114,6 +124,24 @@ pub(crate) fn render_traverse_unwarp(variant: &MinmaxVariant) -> Result<String, 
     })
 }
 
+/// Renders `templates/minmax_traverse_fallback.wgsl` for an `epipolar` variant (an error
+/// for the others, which have no such pass).
+pub(crate) fn render_traverse_fallback(variant: &MinmaxVariant) -> Result<String, ShaderError> {
+    validate(Kernel::MinmaxTraverseFallback, variant)?;
+    unwarp_only(Kernel::MinmaxTraverseFallback, variant.sampling)?;
+    TraverseFallbackTemplate {
+        light_name: variant.light.name(),
+        spot: variant.light == LightKind::Spot,
+        sampling: sampling_view(variant, Kernel::MinmaxTraverseFallback),
+    }
+    .render()
+    .map_err(|source| ShaderError::Render {
+        kernel: Kernel::MinmaxTraverseFallback,
+        template: template_path(Kernel::MinmaxTraverseFallback),
+        source,
+    })
+}
+
 impl crate::KernelParams {
     /// The kernels of a minmax-family variant, in pass order: the prefiltered family's
     /// `depth_columns`, `slice_fit` and `rectify` (of [`MinmaxVariant::prefiltered`]),
@@ -134,6 +162,7 @@ impl crate::family::KernelFamily for MinmaxVariant {
         let mut out = crate::KernelParams::minmax(*self).to_vec();
         if self.sampling == crate::sampling::Sampling::Epipolar {
             out.push(crate::KernelParams::MinmaxTraverseUnwarp(*self));
+            out.push(crate::KernelParams::MinmaxTraverseFallback(*self));
         }
         out
     }

@@ -11,7 +11,8 @@ use crate::plan::{
     screen_and_shadow_parameters,
 };
 use crate::sampling::{
-    epipolar_samples_texture, sampled_output, sampling_invocations, unwarp_pass,
+    epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
+    sampling_invocations, unwarp_pass,
 };
 
 /// The resources and passes of a variant, as `runtime/src/minmax.rs` creates them.
@@ -82,6 +83,7 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
         ),
     ];
     resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
+    resources.extend(fallback_buffers(&v.sampling_knobs()));
     let passes = v
         .kernel_params()
         .iter()
@@ -139,21 +141,28 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
             skip_when: None,
             bindings: vec![bind(0, "frame"), bind(1, "rectified"), bind(2, "tree")],
         }),
-        Kernel::MinmaxTraverse => Some(PassPlan {
-            kernel,
-            invocations: sampling_invocations(&v.sampling_knobs()),
-            skip_when: None,
-            bindings: vec![
-                bind(0, "frame"),
-                bind(1, "slices"),
-                bind(2, "depth"),
-                bind(3, "shadow_map"),
-                bind(4, "tree"),
-                bind(5, sampled_output(&v.sampling_knobs())),
-            ],
-        }),
+        Kernel::MinmaxTraverse => Some(sampled_pass(
+            &v.sampling_knobs(),
+            PassPlan {
+                kernel,
+                invocations: sampling_invocations(&v.sampling_knobs()),
+                skip_when: None,
+                bindings: vec![
+                    bind(0, "frame"),
+                    bind(1, "slices"),
+                    bind(2, "depth"),
+                    bind(3, "shadow_map"),
+                    bind(4, "tree"),
+                    bind(5, sampled_output(&v.sampling_knobs())),
+                ],
+            },
+            6,
+        )),
         Kernel::MinmaxTraverseUnwarp => {
             pass(v, Kernel::MinmaxTraverse).map(|p| unwarp_pass(p, kernel, 6))
+        }
+        Kernel::MinmaxTraverseFallback => {
+            pass(v, Kernel::MinmaxTraverse).map(|p| fallback_pass(p, kernel, 6))
         }
         _ => None,
     }

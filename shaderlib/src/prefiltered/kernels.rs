@@ -106,6 +106,23 @@ struct ScatterUnwarpTemplate {
     sampling: SamplingView,
 }
 
+/// `scatter_fallback`: `scatter.wgsl` rendered as the epipolar fallback.
+#[derive(Template)]
+#[template(path = "scatter_fallback.wgsl")]
+struct ScatterFallbackTemplate {
+    light_name: &'static str,
+    visibility_name: &'static str,
+    spot: bool,
+    bases: u32,
+    layers: u32,
+    regions: u32,
+    rectification_name: &'static str,
+    projective: bool,
+    moments: bool,
+    moment_count: u32,
+    sampling: SamplingView,
+}
+
 /// Checks `variant` on behalf of `kernel`.
 fn validate(kernel: Kernel, variant: &PrefilteredVariant) -> Result<(), ShaderError> {
     variant
@@ -196,7 +213,8 @@ pub(crate) fn render_scatter(variant: &PrefilteredVariant) -> Result<String, Sha
     .map_err(render_error(Kernel::Scatter))
 }
 
-/// The sampling view of `kernel` (`scatter` or `scatter_unwarp`) for `variant`.
+/// The sampling view of `kernel` (`scatter`, `scatter_unwarp` or `scatter_fallback`) for
+/// `variant`.
 fn scatter_sampling_view(variant: &PrefilteredVariant, kernel: Kernel) -> SamplingView {
     SamplingView::new(
         &variant.sampling_knobs(),
@@ -227,4 +245,26 @@ pub(crate) fn render_scatter_unwarp(variant: &PrefilteredVariant) -> Result<Stri
     }
     .render()
     .map_err(render_error(Kernel::ScatterUnwarp))
+}
+
+/// Renders `templates/scatter_fallback.wgsl` for an `epipolar` variant (an error for the
+/// others, which have no such pass).
+pub(crate) fn render_scatter_fallback(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
+    validate(Kernel::ScatterFallback, variant)?;
+    unwarp_only(Kernel::ScatterFallback, variant.sampling)?;
+    ScatterFallbackTemplate {
+        light_name: variant.light.name(),
+        visibility_name: variant.visibility.name(),
+        spot: variant.light == LightKind::Spot,
+        bases: variant.bases,
+        layers: variant.layers(),
+        regions: variant.regions,
+        rectification_name: variant.rectification.name(),
+        projective: variant.rectification == Rectification::Projective,
+        moments: variant.basis == Basis::Moments,
+        moment_count: variant.moments,
+        sampling: scatter_sampling_view(variant, Kernel::ScatterFallback),
+    }
+    .render()
+    .map_err(render_error(Kernel::ScatterFallback))
 }

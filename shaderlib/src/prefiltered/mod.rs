@@ -40,6 +40,7 @@ impl crate::family::KernelFamily for PrefilteredVariant {
         let mut out = crate::KernelParams::prefiltered(*self).to_vec();
         if self.sampling == crate::sampling::Sampling::Epipolar {
             out.push(crate::KernelParams::ScatterUnwarp(*self));
+            out.push(crate::KernelParams::ScatterFallback(*self));
         }
         out
     }

@@ -12,7 +12,8 @@ use crate::plan::{
 };
 use crate::prefiltered::{Basis, PrefilteredVariant, Rectification};
 use crate::sampling::{
-    epipolar_samples_texture, sampled_output, sampling_invocations, unwarp_pass,
+    epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
+    sampling_invocations, unwarp_pass,
 };
 
 /// The per-frame condition of a projective frame (the frame set-up falls back to epipolar
@@ -123,6 +124,7 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
         });
     }
     resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
+    resources.extend(fallback_buffers(&v.sampling_knobs()));
     // One pass per kernel shaderlib lists for the variant, in its order; a kernel this
     // module does not know gets no pass, and generation names it.
     let passes = v
@@ -227,28 +229,33 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                 bind(4, "bounds"),
             ],
         }),
-        Kernel::Scatter => Some(PassPlan {
-            kernel,
-            invocations: sampling_invocations(&v.sampling_knobs()),
-            skip_when: None,
-            bindings: vec![
-                bind(0, "frame"),
-                bind(1, "slices"),
-                bind(2, "depth"),
-                BindingSource {
-                    binding: 3,
-                    resource: "shadow_map",
-                    alternative: projective.then_some(Alternative {
-                        resource: RECTIFIED_RASTER,
-                        when: PROJECTIVE_WITHOUT_SHADOW_MAP,
-                    }),
-                },
-                bind(4, "filtered"),
-                bind(5, sampled_output(&v.sampling_knobs())),
-                bind(6, "bounds"),
-            ],
-        }),
+        Kernel::Scatter => Some(sampled_pass(
+            &v.sampling_knobs(),
+            PassPlan {
+                kernel,
+                invocations: sampling_invocations(&v.sampling_knobs()),
+                skip_when: None,
+                bindings: vec![
+                    bind(0, "frame"),
+                    bind(1, "slices"),
+                    bind(2, "depth"),
+                    BindingSource {
+                        binding: 3,
+                        resource: "shadow_map",
+                        alternative: projective.then_some(Alternative {
+                            resource: RECTIFIED_RASTER,
+                            when: PROJECTIVE_WITHOUT_SHADOW_MAP,
+                        }),
+                    },
+                    bind(4, "filtered"),
+                    bind(5, sampled_output(&v.sampling_knobs())),
+                    bind(6, "bounds"),
+                ],
+            },
+            7,
+        )),
         Kernel::ScatterUnwarp => pass(v, Kernel::Scatter).map(|p| unwarp_pass(p, kernel, 7)),
+        Kernel::ScatterFallback => pass(v, Kernel::Scatter).map(|p| fallback_pass(p, kernel, 7)),
         _ => None,
     }
 }

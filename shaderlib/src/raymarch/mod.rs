@@ -42,6 +42,17 @@ struct RaymarchUnwarpTemplate {
     sampling: SamplingView,
 }
 
+/// `raymarch_fallback`: `raymarch.wgsl` rendered as the epipolar fallback.
+#[derive(Template)]
+#[template(path = "raymarch_fallback.wgsl")]
+struct RaymarchFallbackTemplate {
+    light_name: &'static str,
+    spot: bool,
+    interleaved: bool,
+    output_format: &'static str,
+    sampling: SamplingView,
+}
+
 /// `interleave_sum`: the separable window sum.
 #[derive(Template)]
 #[template(path = "interleave_sum.wgsl")]
@@ -53,7 +64,8 @@ fn validate(kernel: Kernel, variant: &RaymarchVariant) -> Result<(), ShaderError
         .map_err(|source| ShaderError::Variant { kernel, source })
 }
 
-/// The sampling view of `kernel` (`raymarch` or `raymarch_unwarp`) for `variant`.
+/// The sampling view of `kernel` (`raymarch`, `raymarch_unwarp` or `raymarch_fallback`)
+/// for `variant`.
 fn sampling_view(variant: &RaymarchVariant, kernel: Kernel) -> SamplingView {
     let toward = match variant.light {
         LightKind::Directional => "-frame.light_dir.xyz",
@@ -113,6 +125,26 @@ pub(crate) fn render_raymarch_unwarp(variant: &RaymarchVariant) -> Result<String
     })
 }
 
+/// Renders `templates/raymarch_fallback.wgsl` for an `epipolar` variant (an error for the
+/// others, which have no such pass).
+pub(crate) fn render_raymarch_fallback(variant: &RaymarchVariant) -> Result<String, ShaderError> {
+    validate(Kernel::RaymarchFallback, variant)?;
+    unwarp_only(Kernel::RaymarchFallback, variant.sampling)?;
+    RaymarchFallbackTemplate {
+        light_name: variant.light.name(),
+        spot: variant.light == LightKind::Spot,
+        interleaved: false,
+        output_format: "rgba16float",
+        sampling: sampling_view(variant, Kernel::RaymarchFallback),
+    }
+    .render()
+    .map_err(|source| ShaderError::Render {
+        kernel: Kernel::RaymarchFallback,
+        template: template_path(Kernel::RaymarchFallback),
+        source,
+    })
+}
+
 /// Renders `templates/interleave_sum.wgsl` (the same code for every interleaved variant;
 /// an error for a variant without interleaving, which has no such pass).
 pub(crate) fn render_interleave_sum(variant: &RaymarchVariant) -> Result<String, ShaderError> {
@@ -136,7 +168,8 @@ pub(crate) fn render_interleave_sum(variant: &RaymarchVariant) -> Result<String,
 
 impl crate::KernelParams {
     /// The kernels of a raymarch-family variant, in pass order: `raymarch`, then
-    /// `interleave_sum` when it interleaves, or `raymarch_unwarp` with epipolar sampling.
+    /// `interleave_sum` when it interleaves, or `raymarch_unwarp` and `raymarch_fallback`
+    /// with epipolar sampling.
     pub fn raymarch(variant: RaymarchVariant) -> Vec<Self> {
         let mut out = vec![Self::Raymarch(variant)];
         if variant.interleaved() {
@@ -144,6 +177,7 @@ impl crate::KernelParams {
         }
         if variant.sampling == Sampling::Epipolar {
             out.push(Self::RaymarchUnwarp(variant));
+            out.push(Self::RaymarchFallback(variant));
         }
         out
     }

@@ -8,7 +8,8 @@ use crate::plan::{
 };
 use crate::raymarch::{PARTIAL_FORMAT, RaymarchVariant};
 use crate::sampling::{
-    epipolar_samples_texture, sampled_output, sampling_invocations, unwarp_pass,
+    epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
+    sampling_invocations, unwarp_pass,
 };
 use crate::{Kernel, KernelParams};
 
@@ -34,6 +35,7 @@ pub fn plan(v: &RaymarchVariant) -> Plan {
         ),
     ];
     resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
+    resources.extend(fallback_buffers(&v.sampling_knobs()));
     if v.interleaved() {
         resources.push(scatter_texture(
             "partial",
@@ -65,25 +67,30 @@ pub fn plan(v: &RaymarchVariant) -> Plan {
 pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
     let screen = || ["screen.width".into(), "screen.height".into(), "1".into()];
     match kernel {
-        Kernel::Raymarch => Some(PassPlan {
-            kernel,
-            invocations: sampling_invocations(&v.sampling_knobs()),
-            skip_when: None,
-            bindings: vec![
-                bind(0, "frame"),
-                bind(1, "depth"),
-                bind(2, "shadow_map"),
-                bind(
-                    3,
-                    if v.interleaved() {
-                        "partial"
-                    } else {
-                        sampled_output(&v.sampling_knobs())
-                    },
-                ),
-            ],
-        }),
+        Kernel::Raymarch => Some(sampled_pass(
+            &v.sampling_knobs(),
+            PassPlan {
+                kernel,
+                invocations: sampling_invocations(&v.sampling_knobs()),
+                skip_when: None,
+                bindings: vec![
+                    bind(0, "frame"),
+                    bind(1, "depth"),
+                    bind(2, "shadow_map"),
+                    bind(
+                        3,
+                        if v.interleaved() {
+                            "partial"
+                        } else {
+                            sampled_output(&v.sampling_knobs())
+                        },
+                    ),
+                ],
+            },
+            4,
+        )),
         Kernel::RaymarchUnwarp => pass(v, Kernel::Raymarch).map(|p| unwarp_pass(p, kernel, 4)),
+        Kernel::RaymarchFallback => pass(v, Kernel::Raymarch).map(|p| fallback_pass(p, kernel, 4)),
         Kernel::InterleaveSum => Some(PassPlan {
             kernel,
             invocations: screen(),

@@ -20,3 +20,16 @@ const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 // of the sample's pixel in w.
 @group(0) @binding({{ sampling.binding }}) var epipolar_samples: texture_2d<f32>;
 {%- endif %}
+{%- if sampling.fallback %}
+// The pixels no sample stands for (listed by `{{ sampling.family_entry }}_unwarp`, packed
+// x | y << 16) and their count.
+@group(0) @binding({{ sampling.binding + 1 }}) var<storage, read> fallback_count: u32;
+@group(0) @binding({{ sampling.binding + 2 }}) var<storage, read> fallback_pixels: array<u32>;
+{%- else if sampling.epipolar %}
+// How many pixels `{{ sampling.family_entry }}_unwarp` listed for `{{ sampling.family_entry }}_fallback` (zeroed by `{{ sampling.family_entry }}`).
+@group(0) @binding({{ sampling.binding + 1 }}) var<storage, read_write> fallback_count: atomic<u32>;
+{%- endif %}
+{%- if sampling.unwarp %}
+// The pixels no sample stands for, packed x | y << 16, for `{{ sampling.family_entry }}_fallback`.
+@group(0) @binding({{ sampling.binding + 2 }}) var<storage, read_write> fallback_pixels: array<u32>;
+{%- endif %}

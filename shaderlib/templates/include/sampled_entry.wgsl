@@ -63,7 +63,7 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
         textureStore(output, q, vec4<f32>(c.x, c.y, c.z, 1.0));
     }
 }
-{%- else if sampling.epipolar && !sampling.unwarp %}
+{%- else if sampling.epipolar && !sampling.unwarp && !sampling.fallback %}
 
 // One slice's samples: their depths, which are evaluated (1) or interpolated (0), their
 // radiance, and lists of samples to evaluate with their counts (workgroup memory starts
@@ -108,8 +108,8 @@ fn line_spread_over(ab: vec2<u32>) -> bool {
 // between two marked ones that differ by more than LIGHT_BREAK; and interpolate the rest
 // between the marked samples around them. Writes `output` ((SLICE_SAMPLES + 1) x SLICES,
 // rgba32float: radiance and the sample pixel's depth in w; the last column holds the
-// slice's line: direction xy, first distance z, distance between samples w). Dispatch: (SLICES, 1, 1)
-// workgroups of (64, 1, 1).
+// slice's line: direction xy, first distance z, distance between samples w), and zeroes
+// `fallback_count` for the unwarp. Dispatch: (SLICES, 1, 1) workgroups of (64, 1, 1).
 @compute @workgroup_size(64, 1, 1)
 fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
@@ -120,6 +120,10 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
     if li == 0u {
         // The slice's line, for the unwarp.
         textureStore(output, vec2<u32>(SLICE_SAMPLES, s), vec4<f32>(u.x, u.y, span.x, span.y));
+        if s == 0u {
+            // An empty fallback list for the unwarp (no host clear).
+            atomicStore(&fallback_count, 0u);
+        }
     }
     for (var k = li; k < SLICE_SAMPLES; k += 64u) {
         let p = slice_sample_pixel(lines, u, span, k, screen);
@@ -177,12 +181,13 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
 // Sampling pass 2 (`sampling = epipolar`, scatter::sampling): invocation `id` gathers pixel
 // `id` from the four samples around it (`epipolar_slices`, then `epipolar_taps` with the two
 // slices' lines from the samples' last column: two slices, two samples on each) kept by
-// depth and light spread (`lowres_blend`), or evaluates it itself where they cannot stand
-// for it. No workgroup list and no barrier, unlike `lowres`: on lavapipe a barrier splits
-// the kernel into resumable parts that keep the per-pixel body's state, which cost more
-// than the lanes an 8-wide batch leaves idle around a lone refined pixel (measured: the
-// list form's unwarp took 20-60 ms more at 1280x720 with almost no pixel refined).
-// Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1).
+// depth and light spread (`lowres_blend`), or, where they cannot stand for it, lists it in
+// `fallback_pixels` for pass 3 and writes nothing. Not evaluated here: llvmpipe runs an
+// `if` body under a mask for every lane whether or not one takes it, so an inlined
+// per-pixel body cost every pixel its set-up (unwarp 32-87 ms at 1280x720 against 25-37 ms
+// without it); and not in a workgroup list either: a barrier splits the kernel into
+// resumable parts, which cost 20-60 ms more. Dispatch: (ceil(W / 8), ceil(H / 8), 1)
+// workgroups of (8, 8, 1).
 @compute @workgroup_size(8, 8, 1)
 fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
@@ -202,12 +207,31 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
         depths[j] = v.w;
         light[j] = v.xyz;
     }
-    var c = lowres_blend(t.w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
+    let c = lowres_blend(t.w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
     if c.w == 0.0 {
-        let own = {{ sampling.pixel }}(q.x, q.y);
-        c = vec4<f32>(own.x, own.y, own.z, 1.0);
+        fallback_pixels[atomicAdd(&fallback_count, 1u)] = q.x | (q.y << 16u);
+    } else {
+        textureStore(output, q, c);
     }
-    textureStore(output, q, c);
+}
+{%- else if sampling.fallback %}
+
+// Sampling pass 3 (`sampling = epipolar`, scatter::sampling): the pixels the unwarp listed
+// in `fallback_pixels`, evaluated with the family's per-pixel body: invocation i of the N
+// takes entries i, i + N, ... (one invocation per 8 x 8 pixels: a fixed dispatch, no
+// indirect one; where nothing is listed each 8-lane batch runs the body once under an
+// empty mask). Dispatch: (ceil(ceil(W / 8) / 8), ceil(ceil(H / 8) / 8), 1) workgroups of
+// (8, 8, 1).
+@compute @workgroup_size(8, 8, 1)
+fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
+    let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
+    let lanes = 8u * ((screen + 63u) / 64u);
+    let n = min(fallback_count, screen.x * screen.y);
+    for (var e = id.y * lanes.x + id.x; e < n; e += lanes.x * lanes.y) {
+        let q = vec2<u32>(fallback_pixels[e] & 0xffffu, fallback_pixels[e] >> 16u);
+        let c = {{ sampling.pixel }}(q.x, q.y);
+        textureStore(output, q, vec4<f32>(c.x, c.y, c.z, 1.0));
+    }
 }
 {%- else %}
 

@@ -1,0 +1,6 @@
+{#- raymarch_fallback: the epipolar fallback of the family of `raymarch` (`sampling = epipolar`;
+scatter_frame::sampling, "The epipolar passes"): raymarch.wgsl rendered with its third
+sampling entry point, which evaluates with raymarch's per-pixel body the pixels
+`raymarch_unwarp` listed in `fallback_pixels` (no sample stands for them) and writes them to
+`output`. Mirrors reference/src/kernels/raymarch_fallback.rs -#}
+{% include "raymarch.wgsl" %}
