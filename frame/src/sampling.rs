@@ -54,13 +54,15 @@
 //! sample between two evaluated ones whose values differ by more than `light_break` of the
 //! brighter (Yusov 2013's second criterion); and interpolates the rest linearly between the
 //! evaluated samples around it (which lie on the same surface: no break between them). It
-//! writes `epipolar_samples` (`slice_samples x slices`, rgba32float: radiance rounded to f16
-//! as a per-pixel pass stores it, and the view depth of the sample's pixel).
+//! writes `epipolar_samples` (`(slice_samples + 1) x (slices + 1)`, rgba32float: radiance
+//! rounded to f16 as a per-pixel pass stores it, and the view depth of the sample's pixel;
+//! each slice's line in the last column, the layout in the last row).
 //!
 //! Pass 2, `<kernel>_unwarp`, gathers every screen pixel from the two slices around its
 //! angle and the two samples around its distance from `o` on each (bilinear weights), kept
 //! by depth and checked for light spread exactly as `lowres` keeps its taps; a pixel no
-//! sample stands for is evaluated itself (a workgroup list, as in `lowres`).
+//! sample stands for is listed in `fallback_pixels`. Pass 3, `<kernel>_fallback`, evaluates
+//! the listed pixels with the family's per-pixel body.
 
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -81,8 +83,8 @@ pub enum Sampling {
     Lowres,
     /// Samples along epipolar lines (Engelhardt & Dachsbacher 2010, Yusov 2013), evaluated
     /// every `step` samples and on both sides of every depth break, interpolated along the
-    /// slice elsewhere; then an unwarp pass gathers every pixel from its two nearest slices,
-    /// evaluating the pixels no sample can stand for.
+    /// slice elsewhere; then an unwarp pass gathers every pixel from its two nearest slices
+    /// and lists the pixels no sample can stand for, which a fallback pass evaluates.
     Epipolar,
 }
 

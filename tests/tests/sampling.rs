@@ -219,7 +219,6 @@ fn epipolar_stage_trial(
         &knobs,
         SCREEN,
         &depth,
-        &camera,
         &epipolar_samples(&knobs, SCREEN, &depth, &camera, &body).samples,
     );
     let expected = unwarped.fallback.len() as u64;

@@ -3,7 +3,7 @@
 // Do not edit: edit shaderlib/templates/raymarch.wgsl and run scatter-gen again. Bindings, resources and dispatch: manifest.json.
 #extension GL_ARB_compute_shader : require
 #extension GL_ARB_shader_storage_buffer_object : require
-layout(local_size_x = 64, local_size_y = 1, local_size_z = 1) in;
+layout(local_size_x = 32, local_size_y = 1, local_size_z = 1) in;
 
 struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     vec4 right;
@@ -54,6 +54,7 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
 const float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 const uint SLICES = 256u;
 const uint SLICE_SAMPLES = 256u;
+const uint SLICE_LANES = 32u;
 const uint STEP = 8u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
@@ -583,28 +584,30 @@ void main() {
         imageStore(_group_0_binding_3_cs, ivec2(uvec2(SLICE_SAMPLES, s_3)), vec4(_e39.x, _e39.y, _e41.x, _e41.y));
         if ((s_3 == 0u)) {
             atomicExchange(_group_0_binding_5_cs, 0u);
+            imageStore(_group_0_binding_3_cs, ivec2(uvec2(0u, 256u)), vec4(_e36.origin, _e36.axis));
+            imageStore(_group_0_binding_3_cs, ivec2(uvec2(1u, 256u)), vec4(_e36.phi_start, _e36.dphi, float(_e36.wrap), 0.0));
         }
     }
     k = li;
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e70 = k;
-            k = (_e70 + 64u);
+            uint _e87 = k;
+            k = (_e87 + SLICE_LANES);
         }
         loop_init_3 = false;
-        uint _e58 = k;
-        if ((_e58 < SLICE_SAMPLES)) {
+        uint _e75 = k;
+        if ((_e75 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e61 = k;
-            uvec2 _e62 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e61, screen_3);
-            uint _e64 = k;
-            int _e68_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
-            vec4 _e68 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(_e62), ivec2(0), textureSize(_group_0_binding_1_cs, _e68_clamped_lod) - ivec2(1)), _e68_clamped_lod);
-            line_depth[_e64] = _e68.x;
+            uint _e78 = k;
+            uvec2 _e79 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e78, screen_3);
+            uint _e81 = k;
+            int _e85_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+            vec4 _e85 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(_e79), ivec2(0), textureSize(_group_0_binding_1_cs, _e85_clamped_lod) - ivec2(1)), _e85_clamped_lod);
+            line_depth[_e81] = _e85.x;
         }
     }
     memoryBarrierShared();
@@ -613,63 +616,63 @@ void main() {
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e149 = k_1;
-            k_1 = (_e149 + 64u);
+            uint _e166 = k_1;
+            k_1 = (_e166 + SLICE_LANES);
         }
         loop_init_4 = false;
-        uint _e74 = k_1;
-        if ((_e74 < SLICE_SAMPLES)) {
+        uint _e91 = k_1;
+        if ((_e91 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e77 = k_1;
-            if (!(((_e77 % STEP) == 0u))) {
-                uint _e83 = k_1;
-                local = (_e83 == 255u);
+            uint _e94 = k_1;
+            if (!(((_e94 % STEP) == 0u))) {
+                uint _e100 = k_1;
+                local = (_e100 == 255u);
             } else {
                 local = true;
             }
-            bool _e89 = local;
-            marked = _e89;
-            uint _e91 = k_1;
-            if ((_e91 > 0u)) {
-                uint _e94 = k_1;
-                float _e99 = line_depth[(_e94 - 1u)];
-                uint _e101 = k_1;
-                float _e103 = line_depth[_e101];
-                bool _e105 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e99, _e103, DEPTH_BREAK);
-                local_1 = !(_e105);
+            bool _e106 = local;
+            marked = _e106;
+            uint _e108 = k_1;
+            if ((_e108 > 0u)) {
+                uint _e111 = k_1;
+                float _e116 = line_depth[(_e111 - 1u)];
+                uint _e118 = k_1;
+                float _e120 = line_depth[_e118];
+                bool _e122 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e116, _e120, DEPTH_BREAK);
+                local_1 = !(_e122);
             } else {
                 local_1 = false;
             }
-            bool _e110 = local_1;
-            if (_e110) {
+            bool _e127 = local_1;
+            if (_e127) {
                 marked = true;
             }
-            uint _e112 = k_1;
-            if (((_e112 + 1u) < SLICE_SAMPLES)) {
-                uint _e118 = k_1;
-                float _e120 = line_depth[_e118];
-                uint _e121 = k_1;
-                float _e126 = line_depth[(_e121 + 1u)];
-                bool _e128 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e120, _e126, DEPTH_BREAK);
-                local_2 = !(_e128);
+            uint _e129 = k_1;
+            if (((_e129 + 1u) < SLICE_SAMPLES)) {
+                uint _e135 = k_1;
+                float _e137 = line_depth[_e135];
+                uint _e138 = k_1;
+                float _e143 = line_depth[(_e138 + 1u)];
+                bool _e145 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e137, _e143, DEPTH_BREAK);
+                local_2 = !(_e145);
             } else {
                 local_2 = false;
             }
-            bool _e133 = local_2;
-            if (_e133) {
+            bool _e150 = local_2;
+            if (_e150) {
                 marked = true;
             }
-            uint _e136 = k_1;
-            bool _e140 = marked;
-            line_flag[_e136] = (_e140 ? 1u : 0u);
-            bool _e142 = marked;
-            if (_e142) {
-                uint _e145 = atomicAdd(line_count, 1u);
-                uint _e148 = k_1;
-                line_list[_e145] = _e148;
+            uint _e153 = k_1;
+            bool _e157 = marked;
+            line_flag[_e153] = (_e157 ? 1u : 0u);
+            bool _e159 = marked;
+            if (_e159) {
+                uint _e162 = atomicAdd(line_count, 1u);
+                uint _e165 = k_1;
+                line_list[_e162] = _e165;
             }
         }
     }
@@ -680,22 +683,22 @@ void main() {
     bool loop_init_5 = true;
     while(true) {
         if (!loop_init_5) {
-            uint _e168 = e;
-            e = (_e168 + 64u);
+            uint _e185 = e;
+            e = (_e185 + SLICE_LANES);
         }
         loop_init_5 = false;
-        uint _e155 = e;
-        if ((_e155 < n_3)) {
+        uint _e172 = e;
+        if ((_e172 < n_3)) {
         } else {
             break;
         }
         {
-            uint _e158 = e;
-            uint k_7 = line_list[_e158];
-            uvec2 _e161 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
-            vec3 _e166 = raymarch_pixel(_e161.x, _e161.y);
-            vec3 _e167 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e166);
-            line_light[k_7] = _e167;
+            uint _e175 = e;
+            uint k_7 = line_list[_e175];
+            uvec2 _e178 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
+            vec3 _e183 = raymarch_pixel(_e178.x, _e178.y);
+            vec3 _e184 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e183);
+            line_light[k_7] = _e184;
         }
     }
     memoryBarrierShared();
@@ -704,31 +707,31 @@ void main() {
     bool loop_init_6 = true;
     while(true) {
         if (!loop_init_6) {
-            uint _e194 = k_2;
-            k_2 = (_e194 + 64u);
+            uint _e211 = k_2;
+            k_2 = (_e211 + SLICE_LANES);
         }
         loop_init_6 = false;
-        uint _e172 = k_2;
-        if ((_e172 < SLICE_SAMPLES)) {
+        uint _e189 = k_2;
+        if ((_e189 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e176 = k_2;
-            uint _e178 = line_flag[_e176];
-            if ((_e178 == 0u)) {
-                uint _e181 = k_2;
-                uvec2 _e182 = line_bracket(_e181);
-                bool _e183 = line_spread_over(_e182);
-                local_3 = _e183;
+            uint _e193 = k_2;
+            uint _e195 = line_flag[_e193];
+            if ((_e195 == 0u)) {
+                uint _e198 = k_2;
+                uvec2 _e199 = line_bracket(_e198);
+                bool _e200 = line_spread_over(_e199);
+                local_3 = _e200;
             } else {
                 local_3 = false;
             }
-            bool _e187 = local_3;
-            if (_e187) {
-                uint _e190 = atomicAdd(line_count_light, 1u);
-                uint _e193 = k_2;
-                line_list[_e190] = _e193;
+            bool _e204 = local_3;
+            if (_e204) {
+                uint _e207 = atomicAdd(line_count_light, 1u);
+                uint _e210 = k_2;
+                line_list[_e207] = _e210;
             }
         }
     }
@@ -739,22 +742,22 @@ void main() {
     bool loop_init_7 = true;
     while(true) {
         if (!loop_init_7) {
-            uint _e213 = e_1;
-            e_1 = (_e213 + 64u);
+            uint _e230 = e_1;
+            e_1 = (_e230 + SLICE_LANES);
         }
         loop_init_7 = false;
-        uint _e200 = e_1;
-        if ((_e200 < n2_)) {
+        uint _e217 = e_1;
+        if ((_e217 < n2_)) {
         } else {
             break;
         }
         {
-            uint _e203 = e_1;
-            uint k_8 = line_list[_e203];
-            uvec2 _e206 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-            vec3 _e211 = raymarch_pixel(_e206.x, _e206.y);
-            vec3 _e212 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e211);
-            line_light[k_8] = _e212;
+            uint _e220 = e_1;
+            uint k_8 = line_list[_e220];
+            uvec2 _e223 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
+            vec3 _e228 = raymarch_pixel(_e223.x, _e223.y);
+            vec3 _e229 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e228);
+            line_light[k_8] = _e229;
         }
     }
     memoryBarrierShared();
@@ -763,40 +766,40 @@ void main() {
     bool loop_init_8 = true;
     while(true) {
         if (!loop_init_8) {
-            uint _e271 = k_3;
-            k_3 = (_e271 + 64u);
+            uint _e288 = k_3;
+            k_3 = (_e288 + SLICE_LANES);
         }
         loop_init_8 = false;
-        uint _e217 = k_3;
-        if ((_e217 < SLICE_SAMPLES)) {
+        uint _e234 = k_3;
+        if ((_e234 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e221 = k_3;
-            vec3 _e223 = line_light[_e221];
-            c = _e223;
-            uint _e226 = k_3;
-            uint _e228 = line_flag[_e226];
-            if ((_e228 == 0u)) {
-                uint _e231 = k_3;
-                uvec2 _e232 = line_bracket(_e231);
-                bool _e233 = line_spread_over(_e232);
-                if (!(_e233)) {
-                    uint _e235 = k_3;
-                    float t_4 = (float((_e235 - _e232.x)) / float((_e232.y - _e232.x)));
-                    vec3 _e247 = line_light[_e232.x];
-                    vec3 _e254 = line_light[_e232.y];
-                    c = ((_e247 * (1.0 - t_4)) + (_e254 * t_4));
+            uint _e238 = k_3;
+            vec3 _e240 = line_light[_e238];
+            c = _e240;
+            uint _e243 = k_3;
+            uint _e245 = line_flag[_e243];
+            if ((_e245 == 0u)) {
+                uint _e248 = k_3;
+                uvec2 _e249 = line_bracket(_e248);
+                bool _e250 = line_spread_over(_e249);
+                if (!(_e250)) {
+                    uint _e252 = k_3;
+                    float t_4 = (float((_e252 - _e249.x)) / float((_e249.y - _e249.x)));
+                    vec3 _e264 = line_light[_e249.x];
+                    vec3 _e271 = line_light[_e249.y];
+                    c = ((_e264 * (1.0 - t_4)) + (_e271 * t_4));
                 }
             }
-            uint _e257 = k_3;
-            float _e260 = c.x;
-            float _e262 = c.y;
-            float _e264 = c.z;
-            uint _e266 = k_3;
-            float _e268 = line_depth[_e266];
-            imageStore(_group_0_binding_3_cs, ivec2(uvec2(_e257, s_3)), vec4(_e260, _e262, _e264, _e268));
+            uint _e274 = k_3;
+            float _e277 = c.x;
+            float _e279 = c.y;
+            float _e281 = c.z;
+            uint _e283 = k_3;
+            float _e285 = line_depth[_e283];
+            imageStore(_group_0_binding_3_cs, ivec2(uvec2(_e274, s_3)), vec4(_e277, _e279, _e281, _e285));
         }
     }
     return;

@@ -61,6 +61,7 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
 static const float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 static const uint SLICES = 256u;
 static const uint SLICE_SAMPLES = 256u;
+static const uint SLICE_LANES = 32u;
 static const uint STEP = 8u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
@@ -630,7 +631,7 @@ EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX ConstructEpipolarCam
     return ret;
 }
 
-[numthreads(64, 1, 1)]
+[numthreads(32, 1, 1)]
 void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
 {
     if (li == 0) {
@@ -672,6 +673,8 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         output[uint2(SLICE_SAMPLES, s_3)] = float4(_e39.x, _e39.y, _e41.x, _e41.y);
         if ((s_3 == 0u)) {
             { uint dummy = 0; fallback_count.InterlockedExchange(0, 0u, dummy); }
+            output[uint2(0u, 256u)] = float4(_e36.origin, _e36.axis);
+            output[uint2(1u, 256u)] = float4(_e36.phi_start, _e36.dphi, float(_e36.wrap), 0.0);
         }
     }
     k = li;
@@ -681,21 +684,21 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e70 = k;
-            k = (_e70 + 64u);
+            uint _e87 = k;
+            k = (_e87 + SLICE_LANES);
         }
         loop_init_3 = false;
-        uint _e58 = k;
-        if ((_e58 < SLICE_SAMPLES)) {
+        uint _e75 = k;
+        if ((_e75 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e61 = k;
-            const uint2 _e62 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e61, screen_3);
-            uint _e64 = k;
-            float4 _e68 = depth.Load(int3(_e62, int(0)));
-            line_depth[min(uint(_e64), 255u)] = _e68.x;
+            uint _e78 = k;
+            const uint2 _e79 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e78, screen_3);
+            uint _e81 = k;
+            float4 _e85 = depth.Load(int3(_e79, int(0)));
+            line_depth[min(uint(_e81), 255u)] = _e85.x;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -706,63 +709,63 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e149 = k_1;
-            k_1 = (_e149 + 64u);
+            uint _e166 = k_1;
+            k_1 = (_e166 + SLICE_LANES);
         }
         loop_init_4 = false;
-        uint _e74 = k_1;
-        if ((_e74 < SLICE_SAMPLES)) {
+        uint _e91 = k_1;
+        if ((_e91 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e77 = k_1;
-            if (!((naga_mod(_e77, STEP) == 0u))) {
-                uint _e83 = k_1;
-                local = (_e83 == 255u);
+            uint _e94 = k_1;
+            if (!((naga_mod(_e94, STEP) == 0u))) {
+                uint _e100 = k_1;
+                local = (_e100 == 255u);
             } else {
                 local = true;
             }
-            bool _e89 = local;
-            marked = _e89;
-            uint _e91 = k_1;
-            if ((_e91 > 0u)) {
-                uint _e94 = k_1;
-                float _e99 = line_depth[min(uint((_e94 - 1u)), 255u)];
-                uint _e101 = k_1;
-                float _e103 = line_depth[min(uint(_e101), 255u)];
-                const bool _e105 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e99, _e103, DEPTH_BREAK);
-                local_1 = !(_e105);
+            bool _e106 = local;
+            marked = _e106;
+            uint _e108 = k_1;
+            if ((_e108 > 0u)) {
+                uint _e111 = k_1;
+                float _e116 = line_depth[min(uint((_e111 - 1u)), 255u)];
+                uint _e118 = k_1;
+                float _e120 = line_depth[min(uint(_e118), 255u)];
+                const bool _e122 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e116, _e120, DEPTH_BREAK);
+                local_1 = !(_e122);
             } else {
                 local_1 = false;
             }
-            bool _e110 = local_1;
-            if (_e110) {
+            bool _e127 = local_1;
+            if (_e127) {
                 marked = true;
             }
-            uint _e112 = k_1;
-            if (((_e112 + 1u) < SLICE_SAMPLES)) {
-                uint _e118 = k_1;
-                float _e120 = line_depth[min(uint(_e118), 255u)];
-                uint _e121 = k_1;
-                float _e126 = line_depth[min(uint((_e121 + 1u)), 255u)];
-                const bool _e128 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e120, _e126, DEPTH_BREAK);
-                local_2 = !(_e128);
+            uint _e129 = k_1;
+            if (((_e129 + 1u) < SLICE_SAMPLES)) {
+                uint _e135 = k_1;
+                float _e137 = line_depth[min(uint(_e135), 255u)];
+                uint _e138 = k_1;
+                float _e143 = line_depth[min(uint((_e138 + 1u)), 255u)];
+                const bool _e145 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e137, _e143, DEPTH_BREAK);
+                local_2 = !(_e145);
             } else {
                 local_2 = false;
             }
-            bool _e133 = local_2;
-            if (_e133) {
+            bool _e150 = local_2;
+            if (_e150) {
                 marked = true;
             }
-            uint _e136 = k_1;
-            bool _e140 = marked;
-            line_flag[min(uint(_e136), 255u)] = (_e140 ? 1u : 0u);
-            bool _e142 = marked;
-            if (_e142) {
-                uint _e145; InterlockedAdd(line_count, 1u, _e145);
-                uint _e148 = k_1;
-                line_list[min(uint(_e145), 255u)] = _e148;
+            uint _e153 = k_1;
+            bool _e157 = marked;
+            line_flag[min(uint(_e153), 255u)] = (_e157 ? 1u : 0u);
+            bool _e159 = marked;
+            if (_e159) {
+                uint _e162; InterlockedAdd(line_count, 1u, _e162);
+                uint _e165 = k_1;
+                line_list[min(uint(_e162), 255u)] = _e165;
             }
         }
     }
@@ -775,22 +778,22 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
         loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e168 = e;
-            e = (_e168 + 64u);
+            uint _e185 = e;
+            e = (_e185 + SLICE_LANES);
         }
         loop_init_5 = false;
-        uint _e155 = e;
-        if ((_e155 < n_3)) {
+        uint _e172 = e;
+        if ((_e172 < n_3)) {
         } else {
             break;
         }
         {
-            uint _e158 = e;
-            uint k_7 = line_list[min(uint(_e158), 255u)];
-            const uint2 _e161 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
-            const float3 _e166 = raymarch_pixel(_e161.x, _e161.y);
-            const float3 _e167 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e166);
-            line_light[min(uint(k_7), 255u)] = _e167;
+            uint _e175 = e;
+            uint k_7 = line_list[min(uint(_e175), 255u)];
+            const uint2 _e178 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
+            const float3 _e183 = raymarch_pixel(_e178.x, _e178.y);
+            const float3 _e184 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e183);
+            line_light[min(uint(k_7), 255u)] = _e184;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -801,31 +804,31 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_8 == uint2(0u, 0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
         if (!loop_init_6) {
-            uint _e194 = k_2;
-            k_2 = (_e194 + 64u);
+            uint _e211 = k_2;
+            k_2 = (_e211 + SLICE_LANES);
         }
         loop_init_6 = false;
-        uint _e172 = k_2;
-        if ((_e172 < SLICE_SAMPLES)) {
+        uint _e189 = k_2;
+        if ((_e189 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e176 = k_2;
-            uint _e178 = line_flag[min(uint(_e176), 255u)];
-            if ((_e178 == 0u)) {
-                uint _e181 = k_2;
-                const uint2 _e182 = line_bracket(_e181);
-                const bool _e183 = line_spread_over(_e182);
-                local_3 = _e183;
+            uint _e193 = k_2;
+            uint _e195 = line_flag[min(uint(_e193), 255u)];
+            if ((_e195 == 0u)) {
+                uint _e198 = k_2;
+                const uint2 _e199 = line_bracket(_e198);
+                const bool _e200 = line_spread_over(_e199);
+                local_3 = _e200;
             } else {
                 local_3 = false;
             }
-            bool _e187 = local_3;
-            if (_e187) {
-                uint _e190; InterlockedAdd(line_count_light, 1u, _e190);
-                uint _e193 = k_2;
-                line_list[min(uint(_e190), 255u)] = _e193;
+            bool _e204 = local_3;
+            if (_e204) {
+                uint _e207; InterlockedAdd(line_count_light, 1u, _e207);
+                uint _e210 = k_2;
+                line_list[min(uint(_e207), 255u)] = _e210;
             }
         }
     }
@@ -838,22 +841,22 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_9 == uint2(0u, 0u))) { break; }
         loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
         if (!loop_init_7) {
-            uint _e213 = e_1;
-            e_1 = (_e213 + 64u);
+            uint _e230 = e_1;
+            e_1 = (_e230 + SLICE_LANES);
         }
         loop_init_7 = false;
-        uint _e200 = e_1;
-        if ((_e200 < n2_)) {
+        uint _e217 = e_1;
+        if ((_e217 < n2_)) {
         } else {
             break;
         }
         {
-            uint _e203 = e_1;
-            uint k_8 = line_list[min(uint(_e203), 255u)];
-            const uint2 _e206 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-            const float3 _e211 = raymarch_pixel(_e206.x, _e206.y);
-            const float3 _e212 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e211);
-            line_light[min(uint(k_8), 255u)] = _e212;
+            uint _e220 = e_1;
+            uint k_8 = line_list[min(uint(_e220), 255u)];
+            const uint2 _e223 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
+            const float3 _e228 = raymarch_pixel(_e223.x, _e223.y);
+            const float3 _e229 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e228);
+            line_light[min(uint(k_8), 255u)] = _e229;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -864,40 +867,40 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_10 == uint2(0u, 0u))) { break; }
         loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
         if (!loop_init_8) {
-            uint _e271 = k_3;
-            k_3 = (_e271 + 64u);
+            uint _e288 = k_3;
+            k_3 = (_e288 + SLICE_LANES);
         }
         loop_init_8 = false;
-        uint _e217 = k_3;
-        if ((_e217 < SLICE_SAMPLES)) {
+        uint _e234 = k_3;
+        if ((_e234 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e221 = k_3;
-            float3 _e223 = line_light[min(uint(_e221), 255u)];
-            c = _e223;
-            uint _e226 = k_3;
-            uint _e228 = line_flag[min(uint(_e226), 255u)];
-            if ((_e228 == 0u)) {
-                uint _e231 = k_3;
-                const uint2 _e232 = line_bracket(_e231);
-                const bool _e233 = line_spread_over(_e232);
-                if (!(_e233)) {
-                    uint _e235 = k_3;
-                    float t_4 = (float((_e235 - _e232.x)) / float((_e232.y - _e232.x)));
-                    float3 _e247 = line_light[min(uint(_e232.x), 255u)];
-                    float3 _e254 = line_light[min(uint(_e232.y), 255u)];
-                    c = ((_e247 * (1.0 - t_4)) + (_e254 * t_4));
+            uint _e238 = k_3;
+            float3 _e240 = line_light[min(uint(_e238), 255u)];
+            c = _e240;
+            uint _e243 = k_3;
+            uint _e245 = line_flag[min(uint(_e243), 255u)];
+            if ((_e245 == 0u)) {
+                uint _e248 = k_3;
+                const uint2 _e249 = line_bracket(_e248);
+                const bool _e250 = line_spread_over(_e249);
+                if (!(_e250)) {
+                    uint _e252 = k_3;
+                    float t_4 = (float((_e252 - _e249.x)) / float((_e249.y - _e249.x)));
+                    float3 _e264 = line_light[min(uint(_e249.x), 255u)];
+                    float3 _e271 = line_light[min(uint(_e249.y), 255u)];
+                    c = ((_e264 * (1.0 - t_4)) + (_e271 * t_4));
                 }
             }
-            uint _e257 = k_3;
-            float _e260 = c.x;
-            float _e262 = c.y;
-            float _e264 = c.z;
-            uint _e266 = k_3;
-            float _e268 = line_depth[min(uint(_e266), 255u)];
-            output[uint2(_e257, s_3)] = float4(_e260, _e262, _e264, _e268);
+            uint _e274 = k_3;
+            float _e277 = c.x;
+            float _e279 = c.y;
+            float _e281 = c.z;
+            uint _e283 = k_3;
+            float _e285 = line_depth[min(uint(_e283), 255u)];
+            output[uint2(_e274, s_3)] = float4(_e277, _e279, _e281, _e285);
         }
     }
     return;

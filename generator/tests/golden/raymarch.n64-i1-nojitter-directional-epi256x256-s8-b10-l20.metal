@@ -66,6 +66,7 @@ struct type_13 {
 constant float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 constant uint SLICES = 256u;
 constant uint SLICE_SAMPLES = 256u;
+constant uint SLICE_LANES = 32u;
 constant uint STEP = 8u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
@@ -710,6 +711,8 @@ kernel void raymarch(
         output.write(metal::float4(_e39.x, _e39.y, _e41.x, _e41.y), metal::uint2(metal::uint2(SLICE_SAMPLES, s_3)));
         if (s_3 == 0u) {
             metal::atomic_store_explicit(&fallback_count, 0u, metal::memory_order_relaxed);
+            output.write(metal::float4(_e36.origin, _e36.axis), metal::uint2(metal::uint2(0u, 256u)));
+            output.write(metal::float4(_e36.phi_start, _e36.dphi, static_cast<float>(_e36.wrap), 0.0), metal::uint2(metal::uint2(1u, 256u)));
         }
     }
     k = li;
@@ -719,22 +722,22 @@ kernel void raymarch(
         if (metal::all(loop_bound_5 == uint2(0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e70 = k;
-            k = _e70 + 64u;
+            uint _e87 = k;
+            k = _e87 + SLICE_LANES;
         }
         loop_init_3 = false;
-        uint _e58 = k;
-        if (_e58 < SLICE_SAMPLES) {
+        uint _e75 = k;
+        if (_e75 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e61 = k;
-            metal::uint2 _e62 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e61, screen_3);
-            uint _e64 = k;
-            uint clamped_lod_e68 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-            metal::float4 _e68 = depth.read(metal::min(metal::uint2(_e62), metal::uint2(depth.get_width(clamped_lod_e68), depth.get_height(clamped_lod_e68)) - 1), clamped_lod_e68);
-            line_depth.inner[metal::min(unsigned(_e64), 255u)] = _e68.x;
+            uint _e78 = k;
+            metal::uint2 _e79 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e78, screen_3);
+            uint _e81 = k;
+            uint clamped_lod_e85 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+            metal::float4 _e85 = depth.read(metal::min(metal::uint2(_e79), metal::uint2(depth.get_width(clamped_lod_e85), depth.get_height(clamped_lod_e85)) - 1), clamped_lod_e85);
+            line_depth.inner[metal::min(unsigned(_e81), 255u)] = _e85.x;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
@@ -745,63 +748,63 @@ kernel void raymarch(
         if (metal::all(loop_bound_6 == uint2(0u))) { break; }
         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e149 = k_1;
-            k_1 = _e149 + 64u;
+            uint _e166 = k_1;
+            k_1 = _e166 + SLICE_LANES;
         }
         loop_init_4 = false;
-        uint _e74 = k_1;
-        if (_e74 < SLICE_SAMPLES) {
+        uint _e91 = k_1;
+        if (_e91 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e77 = k_1;
-            if (!((naga_mod(_e77, STEP) == 0u))) {
-                uint _e83 = k_1;
-                local = _e83 == 255u;
+            uint _e94 = k_1;
+            if (!((naga_mod(_e94, STEP) == 0u))) {
+                uint _e100 = k_1;
+                local = _e100 == 255u;
             } else {
                 local = true;
             }
-            bool _e89 = local;
-            marked = _e89;
-            uint _e91 = k_1;
-            if (_e91 > 0u) {
-                uint _e94 = k_1;
-                float _e99 = line_depth.inner[metal::min(unsigned(_e94 - 1u), 255u)];
-                uint _e101 = k_1;
-                float _e103 = line_depth.inner[metal::min(unsigned(_e101), 255u)];
-                bool _e105 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e99, _e103, DEPTH_BREAK);
-                local_1 = !(_e105);
+            bool _e106 = local;
+            marked = _e106;
+            uint _e108 = k_1;
+            if (_e108 > 0u) {
+                uint _e111 = k_1;
+                float _e116 = line_depth.inner[metal::min(unsigned(_e111 - 1u), 255u)];
+                uint _e118 = k_1;
+                float _e120 = line_depth.inner[metal::min(unsigned(_e118), 255u)];
+                bool _e122 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e116, _e120, DEPTH_BREAK);
+                local_1 = !(_e122);
             } else {
                 local_1 = false;
             }
-            bool _e110 = local_1;
-            if (_e110) {
+            bool _e127 = local_1;
+            if (_e127) {
                 marked = true;
             }
-            uint _e112 = k_1;
-            if ((_e112 + 1u) < SLICE_SAMPLES) {
-                uint _e118 = k_1;
-                float _e120 = line_depth.inner[metal::min(unsigned(_e118), 255u)];
-                uint _e121 = k_1;
-                float _e126 = line_depth.inner[metal::min(unsigned(_e121 + 1u), 255u)];
-                bool _e128 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e120, _e126, DEPTH_BREAK);
-                local_2 = !(_e128);
+            uint _e129 = k_1;
+            if ((_e129 + 1u) < SLICE_SAMPLES) {
+                uint _e135 = k_1;
+                float _e137 = line_depth.inner[metal::min(unsigned(_e135), 255u)];
+                uint _e138 = k_1;
+                float _e143 = line_depth.inner[metal::min(unsigned(_e138 + 1u), 255u)];
+                bool _e145 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e137, _e143, DEPTH_BREAK);
+                local_2 = !(_e145);
             } else {
                 local_2 = false;
             }
-            bool _e133 = local_2;
-            if (_e133) {
+            bool _e150 = local_2;
+            if (_e150) {
                 marked = true;
             }
-            uint _e136 = k_1;
-            bool _e140 = marked;
-            line_flag.inner[metal::min(unsigned(_e136), 255u)] = _e140 ? 1u : 0u;
-            bool _e142 = marked;
-            if (_e142) {
-                uint _e145 = metal::atomic_fetch_add_explicit(&line_count, 1u, metal::memory_order_relaxed);
-                uint _e148 = k_1;
-                line_list.inner[metal::min(unsigned(_e145), 255u)] = _e148;
+            uint _e153 = k_1;
+            bool _e157 = marked;
+            line_flag.inner[metal::min(unsigned(_e153), 255u)] = _e157 ? 1u : 0u;
+            bool _e159 = marked;
+            if (_e159) {
+                uint _e162 = metal::atomic_fetch_add_explicit(&line_count, 1u, metal::memory_order_relaxed);
+                uint _e165 = k_1;
+                line_list.inner[metal::min(unsigned(_e162), 255u)] = _e165;
             }
         }
     }
@@ -814,22 +817,22 @@ kernel void raymarch(
         if (metal::all(loop_bound_7 == uint2(0u))) { break; }
         loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e168 = e;
-            e = _e168 + 64u;
+            uint _e185 = e;
+            e = _e185 + SLICE_LANES;
         }
         loop_init_5 = false;
-        uint _e155 = e;
-        if (_e155 < n_3) {
+        uint _e172 = e;
+        if (_e172 < n_3) {
         } else {
             break;
         }
         {
-            uint _e158 = e;
-            uint k_7 = line_list.inner[metal::min(unsigned(_e158), 255u)];
-            metal::uint2 _e161 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
-            metal::float3 _e166 = raymarch_pixel(_e161.x, _e161.y, frame, depth, shadow_map);
-            metal::float3 _e167 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e166);
-            line_light.inner[metal::min(unsigned(k_7), 255u)] = _e167;
+            uint _e175 = e;
+            uint k_7 = line_list.inner[metal::min(unsigned(_e175), 255u)];
+            metal::uint2 _e178 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
+            metal::float3 _e183 = raymarch_pixel(_e178.x, _e178.y, frame, depth, shadow_map);
+            metal::float3 _e184 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e183);
+            line_light.inner[metal::min(unsigned(k_7), 255u)] = _e184;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
@@ -840,31 +843,31 @@ kernel void raymarch(
         if (metal::all(loop_bound_8 == uint2(0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
         if (!loop_init_6) {
-            uint _e194 = k_2;
-            k_2 = _e194 + 64u;
+            uint _e211 = k_2;
+            k_2 = _e211 + SLICE_LANES;
         }
         loop_init_6 = false;
-        uint _e172 = k_2;
-        if (_e172 < SLICE_SAMPLES) {
+        uint _e189 = k_2;
+        if (_e189 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e176 = k_2;
-            uint _e178 = line_flag.inner[metal::min(unsigned(_e176), 255u)];
-            if (_e178 == 0u) {
-                uint _e181 = k_2;
-                metal::uint2 _e182 = line_bracket(_e181, line_flag);
-                bool _e183 = line_spread_over(_e182, line_light);
-                local_3 = _e183;
+            uint _e193 = k_2;
+            uint _e195 = line_flag.inner[metal::min(unsigned(_e193), 255u)];
+            if (_e195 == 0u) {
+                uint _e198 = k_2;
+                metal::uint2 _e199 = line_bracket(_e198, line_flag);
+                bool _e200 = line_spread_over(_e199, line_light);
+                local_3 = _e200;
             } else {
                 local_3 = false;
             }
-            bool _e187 = local_3;
-            if (_e187) {
-                uint _e190 = metal::atomic_fetch_add_explicit(&line_count_light, 1u, metal::memory_order_relaxed);
-                uint _e193 = k_2;
-                line_list.inner[metal::min(unsigned(_e190), 255u)] = _e193;
+            bool _e204 = local_3;
+            if (_e204) {
+                uint _e207 = metal::atomic_fetch_add_explicit(&line_count_light, 1u, metal::memory_order_relaxed);
+                uint _e210 = k_2;
+                line_list.inner[metal::min(unsigned(_e207), 255u)] = _e210;
             }
         }
     }
@@ -877,22 +880,22 @@ kernel void raymarch(
         if (metal::all(loop_bound_9 == uint2(0u))) { break; }
         loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
         if (!loop_init_7) {
-            uint _e213 = e_1;
-            e_1 = _e213 + 64u;
+            uint _e230 = e_1;
+            e_1 = _e230 + SLICE_LANES;
         }
         loop_init_7 = false;
-        uint _e200 = e_1;
-        if (_e200 < n2_) {
+        uint _e217 = e_1;
+        if (_e217 < n2_) {
         } else {
             break;
         }
         {
-            uint _e203 = e_1;
-            uint k_8 = line_list.inner[metal::min(unsigned(_e203), 255u)];
-            metal::uint2 _e206 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-            metal::float3 _e211 = raymarch_pixel(_e206.x, _e206.y, frame, depth, shadow_map);
-            metal::float3 _e212 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e211);
-            line_light.inner[metal::min(unsigned(k_8), 255u)] = _e212;
+            uint _e220 = e_1;
+            uint k_8 = line_list.inner[metal::min(unsigned(_e220), 255u)];
+            metal::uint2 _e223 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
+            metal::float3 _e228 = raymarch_pixel(_e223.x, _e223.y, frame, depth, shadow_map);
+            metal::float3 _e229 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e228);
+            line_light.inner[metal::min(unsigned(k_8), 255u)] = _e229;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
@@ -903,40 +906,40 @@ kernel void raymarch(
         if (metal::all(loop_bound_10 == uint2(0u))) { break; }
         loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
         if (!loop_init_8) {
-            uint _e271 = k_3;
-            k_3 = _e271 + 64u;
+            uint _e288 = k_3;
+            k_3 = _e288 + SLICE_LANES;
         }
         loop_init_8 = false;
-        uint _e217 = k_3;
-        if (_e217 < SLICE_SAMPLES) {
+        uint _e234 = k_3;
+        if (_e234 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e221 = k_3;
-            metal::float3 _e223 = line_light.inner[metal::min(unsigned(_e221), 255u)];
-            c = _e223;
-            uint _e226 = k_3;
-            uint _e228 = line_flag.inner[metal::min(unsigned(_e226), 255u)];
-            if (_e228 == 0u) {
-                uint _e231 = k_3;
-                metal::uint2 _e232 = line_bracket(_e231, line_flag);
-                bool _e233 = line_spread_over(_e232, line_light);
-                if (!(_e233)) {
-                    uint _e235 = k_3;
-                    float t_4 = static_cast<float>(_e235 - _e232.x) / static_cast<float>(_e232.y - _e232.x);
-                    metal::float3 _e247 = line_light.inner[metal::min(unsigned(_e232.x), 255u)];
-                    metal::float3 _e254 = line_light.inner[metal::min(unsigned(_e232.y), 255u)];
-                    c = (_e247 * (1.0 - t_4)) + (_e254 * t_4);
+            uint _e238 = k_3;
+            metal::float3 _e240 = line_light.inner[metal::min(unsigned(_e238), 255u)];
+            c = _e240;
+            uint _e243 = k_3;
+            uint _e245 = line_flag.inner[metal::min(unsigned(_e243), 255u)];
+            if (_e245 == 0u) {
+                uint _e248 = k_3;
+                metal::uint2 _e249 = line_bracket(_e248, line_flag);
+                bool _e250 = line_spread_over(_e249, line_light);
+                if (!(_e250)) {
+                    uint _e252 = k_3;
+                    float t_4 = static_cast<float>(_e252 - _e249.x) / static_cast<float>(_e249.y - _e249.x);
+                    metal::float3 _e264 = line_light.inner[metal::min(unsigned(_e249.x), 255u)];
+                    metal::float3 _e271 = line_light.inner[metal::min(unsigned(_e249.y), 255u)];
+                    c = (_e264 * (1.0 - t_4)) + (_e271 * t_4);
                 }
             }
-            uint _e257 = k_3;
-            float _e260 = c.x;
-            float _e262 = c.y;
-            float _e264 = c.z;
-            uint _e266 = k_3;
-            float _e268 = line_depth.inner[metal::min(unsigned(_e266), 255u)];
-            output.write(metal::float4(_e260, _e262, _e264, _e268), metal::uint2(metal::uint2(_e257, s_3)));
+            uint _e274 = k_3;
+            float _e277 = c.x;
+            float _e279 = c.y;
+            float _e281 = c.z;
+            uint _e283 = k_3;
+            float _e285 = line_depth.inner[metal::min(unsigned(_e283), 255u)];
+            output.write(metal::float4(_e277, _e279, _e281, _e285), metal::uint2(metal::uint2(_e274, s_3)));
         }
     }
     return;

@@ -54,6 +54,7 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
 const EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX: f32 = 100f;
 const SLICES: u32 = 256u;
 const SLICE_SAMPLES: u32 = 256u;
+const SLICE_LANES: u32 = 32u;
 const STEP: u32 = 8u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
@@ -536,7 +537,7 @@ fn line_spread_over(ab: vec2<u32>) -> bool {
     return (max(spread.x, max(spread.y, spread.z)) > (LIGHT_BREAK * max(hi_2.x, max(hi_2.y, hi_2.z))));
 }
 
-@compute @workgroup_size(64, 1, 1) 
+@compute @workgroup_size(32, 1, 1) 
 fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     var k: u32;
     var k_1: u32;
@@ -568,202 +569,204 @@ fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_ind
         textureStore(output, vec2<u32>(SLICE_SAMPLES, s_3), vec4<f32>(_e39.x, _e39.y, _e41.x, _e41.y));
         if (s_3 == 0u) {
             atomicStore((&fallback_count), 0u);
+            textureStore(output, vec2<u32>(0u, 256u), vec4<f32>(_e36.origin, _e36.axis));
+            textureStore(output, vec2<u32>(1u, 256u), vec4<f32>(_e36.phi_start, _e36.dphi, f32(_e36.wrap), 0f));
         }
     }
     k = li;
     loop {
-        let _e58 = k;
-        if (_e58 < SLICE_SAMPLES) {
+        let _e75 = k;
+        if (_e75 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e61 = k;
-            let _e62 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e61, screen_3);
-            let _e64 = k;
-            let _e68 = textureLoad(depth, _e62, 0i);
-            line_depth[_e64] = _e68.x;
+            let _e78 = k;
+            let _e79 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e78, screen_3);
+            let _e81 = k;
+            let _e85 = textureLoad(depth, _e79, 0i);
+            line_depth[_e81] = _e85.x;
         }
         continuing {
-            let _e70 = k;
-            k = (_e70 + 64u);
+            let _e87 = k;
+            k = (_e87 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     k_1 = li;
     loop {
-        let _e74 = k_1;
-        if (_e74 < SLICE_SAMPLES) {
+        let _e91 = k_1;
+        if (_e91 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e77 = k_1;
-            if !(((_e77 % STEP) == 0u)) {
-                let _e83 = k_1;
-                local = (_e83 == 255u);
+            let _e94 = k_1;
+            if !(((_e94 % STEP) == 0u)) {
+                let _e100 = k_1;
+                local = (_e100 == 255u);
             } else {
                 local = true;
             }
-            let _e89 = local;
-            marked = _e89;
-            let _e91 = k_1;
-            if (_e91 > 0u) {
-                let _e94 = k_1;
-                let _e99 = line_depth[(_e94 - 1u)];
-                let _e101 = k_1;
-                let _e103 = line_depth[_e101];
-                let _e105 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e99, _e103, DEPTH_BREAK);
-                local_1 = !(_e105);
+            let _e106 = local;
+            marked = _e106;
+            let _e108 = k_1;
+            if (_e108 > 0u) {
+                let _e111 = k_1;
+                let _e116 = line_depth[(_e111 - 1u)];
+                let _e118 = k_1;
+                let _e120 = line_depth[_e118];
+                let _e122 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e116, _e120, DEPTH_BREAK);
+                local_1 = !(_e122);
             } else {
                 local_1 = false;
             }
-            let _e110 = local_1;
-            if _e110 {
+            let _e127 = local_1;
+            if _e127 {
                 marked = true;
             }
-            let _e112 = k_1;
-            if ((_e112 + 1u) < SLICE_SAMPLES) {
-                let _e118 = k_1;
-                let _e120 = line_depth[_e118];
-                let _e121 = k_1;
-                let _e126 = line_depth[(_e121 + 1u)];
-                let _e128 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e120, _e126, DEPTH_BREAK);
-                local_2 = !(_e128);
+            let _e129 = k_1;
+            if ((_e129 + 1u) < SLICE_SAMPLES) {
+                let _e135 = k_1;
+                let _e137 = line_depth[_e135];
+                let _e138 = k_1;
+                let _e143 = line_depth[(_e138 + 1u)];
+                let _e145 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e137, _e143, DEPTH_BREAK);
+                local_2 = !(_e145);
             } else {
                 local_2 = false;
             }
-            let _e133 = local_2;
-            if _e133 {
+            let _e150 = local_2;
+            if _e150 {
                 marked = true;
             }
-            let _e136 = k_1;
-            let _e140 = marked;
-            line_flag[_e136] = select(0u, 1u, _e140);
-            let _e142 = marked;
-            if _e142 {
-                let _e145 = atomicAdd((&line_count), 1u);
-                let _e148 = k_1;
-                line_list[_e145] = _e148;
+            let _e153 = k_1;
+            let _e157 = marked;
+            line_flag[_e153] = select(0u, 1u, _e157);
+            let _e159 = marked;
+            if _e159 {
+                let _e162 = atomicAdd((&line_count), 1u);
+                let _e165 = k_1;
+                line_list[_e162] = _e165;
             }
         }
         continuing {
-            let _e149 = k_1;
-            k_1 = (_e149 + 64u);
+            let _e166 = k_1;
+            k_1 = (_e166 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let n_3 = atomicLoad((&line_count));
     e = li;
     loop {
-        let _e155 = e;
-        if (_e155 < n_3) {
+        let _e172 = e;
+        if (_e172 < n_3) {
         } else {
             break;
         }
         {
-            let _e158 = e;
-            let k_7 = line_list[_e158];
-            let _e161 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
-            let _e166 = raymarch_pixel(_e161.x, _e161.y);
-            let _e167 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e166);
-            line_light[k_7] = _e167;
+            let _e175 = e;
+            let k_7 = line_list[_e175];
+            let _e178 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
+            let _e183 = raymarch_pixel(_e178.x, _e178.y);
+            let _e184 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e183);
+            line_light[k_7] = _e184;
         }
         continuing {
-            let _e168 = e;
-            e = (_e168 + 64u);
+            let _e185 = e;
+            e = (_e185 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     k_2 = li;
     loop {
-        let _e172 = k_2;
-        if (_e172 < SLICE_SAMPLES) {
+        let _e189 = k_2;
+        if (_e189 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e176 = k_2;
-            let _e178 = line_flag[_e176];
-            if (_e178 == 0u) {
-                let _e181 = k_2;
-                let _e182 = line_bracket(_e181);
-                let _e183 = line_spread_over(_e182);
-                local_3 = _e183;
+            let _e193 = k_2;
+            let _e195 = line_flag[_e193];
+            if (_e195 == 0u) {
+                let _e198 = k_2;
+                let _e199 = line_bracket(_e198);
+                let _e200 = line_spread_over(_e199);
+                local_3 = _e200;
             } else {
                 local_3 = false;
             }
-            let _e187 = local_3;
-            if _e187 {
-                let _e190 = atomicAdd((&line_count_light), 1u);
-                let _e193 = k_2;
-                line_list[_e190] = _e193;
+            let _e204 = local_3;
+            if _e204 {
+                let _e207 = atomicAdd((&line_count_light), 1u);
+                let _e210 = k_2;
+                line_list[_e207] = _e210;
             }
         }
         continuing {
-            let _e194 = k_2;
-            k_2 = (_e194 + 64u);
+            let _e211 = k_2;
+            k_2 = (_e211 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let n2_ = atomicLoad((&line_count_light));
     e_1 = li;
     loop {
-        let _e200 = e_1;
-        if (_e200 < n2_) {
+        let _e217 = e_1;
+        if (_e217 < n2_) {
         } else {
             break;
         }
         {
-            let _e203 = e_1;
-            let k_8 = line_list[_e203];
-            let _e206 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-            let _e211 = raymarch_pixel(_e206.x, _e206.y);
-            let _e212 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e211);
-            line_light[k_8] = _e212;
+            let _e220 = e_1;
+            let k_8 = line_list[_e220];
+            let _e223 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
+            let _e228 = raymarch_pixel(_e223.x, _e223.y);
+            let _e229 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e228);
+            line_light[k_8] = _e229;
         }
         continuing {
-            let _e213 = e_1;
-            e_1 = (_e213 + 64u);
+            let _e230 = e_1;
+            e_1 = (_e230 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     k_3 = li;
     loop {
-        let _e217 = k_3;
-        if (_e217 < SLICE_SAMPLES) {
+        let _e234 = k_3;
+        if (_e234 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e221 = k_3;
-            let _e223 = line_light[_e221];
-            c = _e223;
-            let _e226 = k_3;
-            let _e228 = line_flag[_e226];
-            if (_e228 == 0u) {
-                let _e231 = k_3;
-                let _e232 = line_bracket(_e231);
-                let _e233 = line_spread_over(_e232);
-                if !(_e233) {
-                    let _e235 = k_3;
-                    let t_4 = (f32((_e235 - _e232.x)) / f32((_e232.y - _e232.x)));
-                    let _e247 = line_light[_e232.x];
-                    let _e254 = line_light[_e232.y];
-                    c = ((_e247 * (1f - t_4)) + (_e254 * t_4));
+            let _e238 = k_3;
+            let _e240 = line_light[_e238];
+            c = _e240;
+            let _e243 = k_3;
+            let _e245 = line_flag[_e243];
+            if (_e245 == 0u) {
+                let _e248 = k_3;
+                let _e249 = line_bracket(_e248);
+                let _e250 = line_spread_over(_e249);
+                if !(_e250) {
+                    let _e252 = k_3;
+                    let t_4 = (f32((_e252 - _e249.x)) / f32((_e249.y - _e249.x)));
+                    let _e264 = line_light[_e249.x];
+                    let _e271 = line_light[_e249.y];
+                    c = ((_e264 * (1f - t_4)) + (_e271 * t_4));
                 }
             }
-            let _e257 = k_3;
-            let _e260 = c.x;
-            let _e262 = c.y;
-            let _e264 = c.z;
-            let _e266 = k_3;
-            let _e268 = line_depth[_e266];
-            textureStore(output, vec2<u32>(_e257, s_3), vec4<f32>(_e260, _e262, _e264, _e268));
+            let _e274 = k_3;
+            let _e277 = c.x;
+            let _e279 = c.y;
+            let _e281 = c.z;
+            let _e283 = k_3;
+            let _e285 = line_depth[_e283];
+            textureStore(output, vec2<u32>(_e274, s_3), vec4<f32>(_e277, _e279, _e281, _e285));
         }
         continuing {
-            let _e271 = k_3;
-            k_3 = (_e271 + 64u);
+            let _e288 = k_3;
+            k_3 = (_e288 + SLICE_LANES);
         }
     }
     return;

@@ -36,14 +36,6 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float theta_a;
     float dtheta;
 };
-struct EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    vec3 forward;
-    vec3 right;
-    vec3 up;
-    float tan_half;
-    float aspect;
-    vec3 toward;
-};
 struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     vec2 origin;
     vec2 axis;
@@ -56,9 +48,9 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uvec2 k;
     vec4 w;
 };
-const float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 const uint SLICES = 256u;
 const uint SLICE_SAMPLES = 256u;
+const uint SLICE_LANES = 32u;
 const uint STEP = 8u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
@@ -313,126 +305,26 @@ float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec
     return atan(((axis.x * d_1.y) - (axis.y * d_1.x)), ((axis.x * d_1.x) + (axis.y * d_1.y)));
 }
 
-EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX cam, uvec2 screen, uint slices) {
-    vec2 origin = vec2(0.0);
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2(0.0), vec2(0.0), 0.0, 0.0, 0u);
-    bool local_7 = false;
-    bool local_8 = false;
-    bool local_9 = false;
-    float a_3 = 0.0;
-    float b_3 = 0.0;
-    uint k_1 = 0u;
-    vec2 size_1 = vec2(screen);
-    vec2 centre = (0.5 * size_1);
-    float z_2 = dot(cam.toward, cam.forward);
-    vec2 q_1 = vec2(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
-    float far_1 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
-    float lq = length(q_1);
-    origin = centre;
-    if ((lq >= (far_1 * abs(z_2)))) {
-        origin = (centre + ((q_1 * (far_1 / max(lq, 1e-30))) * ((z_2 < 0.0) ? -1.0 : 1.0)));
-    } else {
-        if ((lq > 0.0)) {
-            origin = (centre + (q_1 / vec2(z_2)));
-        }
-    }
-    vec2 _e56 = origin;
-    l.origin = _e56;
-    vec2 _e57 = origin;
-    vec2 to_centre = (centre - _e57);
-    float lc = length(to_centre);
-    l.axis = ((lc > 0.0) ? (to_centre / vec2(max(lc, 1e-30))) : vec2(1.0, 0.0));
-    vec2 lo_1 = vec2(0.5, 0.5);
-    vec2 hi_1 = (size_1 - vec2(0.5, 0.5));
-    float _e79 = origin.x;
-    if ((_e79 >= lo_1.x)) {
-        float _e83 = origin.x;
-        local_7 = (_e83 <= hi_1.x);
-    } else {
-        local_7 = false;
-    }
-    bool _e89 = local_7;
-    if (_e89) {
-        float _e91 = origin.y;
-        local_8 = (_e91 >= lo_1.y);
-    } else {
-        local_8 = false;
-    }
-    bool _e97 = local_8;
-    if (_e97) {
-        float _e99 = origin.y;
-        local_9 = (_e99 <= hi_1.y);
-    } else {
-        local_9 = false;
-    }
-    bool inside = local_9;
-    if (inside) {
-        l.wrap = 1u;
-        l.phi_start = -3.1415927;
-        l.dphi = (6.2831855 / float(slices));
-    } else {
-        l.wrap = 0u;
-        bool loop_init_1 = true;
-        while(true) {
-            if (!loop_init_1) {
-                uint _e153 = k_1;
-                k_1 = (_e153 + 1u);
-            }
-            loop_init_1 = false;
-            uint _e118 = k_1;
-            if ((_e118 < 4u)) {
-            } else {
-                break;
-            }
-            {
-                uint _e123 = k_1;
-                uint _e131 = k_1;
-                vec2 corner = vec2((((_e123 & 1u) != 0u) ? hi_1.x : lo_1.x), (((_e131 & 2u) != 0u) ? hi_1.y : lo_1.y));
-                vec2 _e139 = l.axis;
-                vec2 _e140 = origin;
-                float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
-                uint _e143 = k_1;
-                if ((_e143 == 0u)) {
-                    a_3 = _e142;
-                    b_3 = _e142;
-                } else {
-                    float _e148 = a_3;
-                    a_3 = min(_e148, _e142);
-                    float _e150 = b_3;
-                    b_3 = max(_e150, _e142);
-                }
-            }
-        }
-        float _e156 = a_3;
-        l.phi_start = _e156;
-        float _e158 = b_3;
-        float _e159 = a_3;
-        l.dphi = ((_e158 - _e159) / float(slices));
-    }
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l;
-    return _e163;
-}
-
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uvec2 p_2, uint slices_1) {
+EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l, uvec2 p_2, uint slices) {
     uint s_lo = 0u;
     float fs = 0.0;
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
-    vec2 d_3 = ((vec2(p_2) + vec2(0.5, 0.5)) - l_1.origin);
-    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_3);
-    float f = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
-    if ((l_1.wrap != 0u)) {
+    vec2 d_3 = ((vec2(p_2) + vec2(0.5, 0.5)) - l.origin);
+    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_3);
+    float f = (((_e12 - l.phi_start) / l.dphi) - 0.5);
+    if ((l.wrap != 0u)) {
         float fl = floor(f);
         fs = (f - fl);
-        s_lo = (uint((int(fl) + int(slices_1))) % slices_1);
+        s_lo = (uint((int(fl) + int(slices))) % slices);
     } else {
-        float fc = clamp(f, 0.0, float((slices_1 - 1u)));
-        s_lo = min(uint(fc), (slices_1 - 2u));
+        float fc = clamp(f, 0.0, float((slices - 1u)));
+        s_lo = min(uint(fc), (slices - 2u));
         uint _e41 = s_lo;
         fs = (fc - float(_e41));
     }
     uint _e46 = s_lo;
     uint _e47 = s_lo;
-    t_1.slices = uvec2(_e46, ((_e47 + 1u) % slices_1));
+    t_1.slices = uvec2(_e46, ((_e47 + 1u) % slices));
     float _e53 = fs;
     float _e56 = fs;
     t_1.w = vec4((1.0 - _e53), _e56, 0.0, 0.0);
@@ -440,19 +332,19 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     return _e60;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2, uvec2 p_3, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, vec4 line_lo, vec4 line_hi, uint samples) {
+EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uvec2 p_3, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, vec4 line_lo, vec4 line_hi, uint samples) {
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_2 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
     uint j_1 = 0u;
-    vec2 d_4 = ((vec2(p_3) + vec2(0.5, 0.5)) - l_2.origin);
+    vec2 d_4 = ((vec2(p_3) + vec2(0.5, 0.5)) - l_1.origin);
     t_2 = pair;
     vec2 ws = pair.w.xy;
-    bool loop_init_2 = true;
+    bool loop_init_1 = true;
     while(true) {
-        if (!loop_init_2) {
+        if (!loop_init_1) {
             uint _e68 = j_1;
             j_1 = (_e68 + 1u);
         }
-        loop_init_2 = false;
+        loop_init_1 = false;
         uint _e15 = j_1;
         if ((_e15 < 2u)) {
         } else {
@@ -487,10 +379,10 @@ void main() {
     uint j = 0u;
     uint _e6 = _group_0_binding_0_cs.sizes.x;
     uint _e10 = _group_0_binding_0_cs.sizes.y;
-    uvec2 screen_1 = uvec2(_e6, _e10);
-    uvec2 q_2 = id.xy;
-    if (!((q_2.x >= screen_1.x))) {
-        local = (q_2.y >= screen_1.y);
+    uvec2 screen = uvec2(_e6, _e10);
+    uvec2 q_1 = id.xy;
+    if (!((q_1.x >= screen.x))) {
+        local = (q_1.y >= screen.y);
     } else {
         local = true;
     }
@@ -498,54 +390,52 @@ void main() {
     if (_e24) {
         return;
     }
-    vec4 _e27 = _group_0_binding_0_cs.cam_forward;
-    vec4 _e31 = _group_0_binding_0_cs.cam_right;
-    vec4 _e35 = _group_0_binding_0_cs.cam_up;
-    float _e40 = _group_0_binding_0_cs.cam_forward.w;
-    float _e44 = _group_0_binding_0_cs.cam_right.w;
-    vec4 _e47 = _group_0_binding_0_cs.light_dir;
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e52 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e27.xyz, _e31.xyz, _e35.xyz, _e40, _e44, -(_e47.xyz)), screen_1, SLICES);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e54 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e52, q_2, SLICES);
-    int _e61_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-    vec4 line_lo_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e54.slices.x)), ivec2(0), textureSize(_group_0_binding_4_cs, _e61_clamped_lod) - ivec2(1)), _e61_clamped_lod);
-    int _e68_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-    vec4 line_hi_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e54.slices.y)), ivec2(0), textureSize(_group_0_binding_4_cs, _e68_clamped_lod) - ivec2(1)), _e68_clamped_lod);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e52, q_2, _e54, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    bool loop_init_3 = true;
+    int _e30_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+    vec4 head = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(0u, 256u)), ivec2(0), textureSize(_group_0_binding_4_cs, _e30_clamped_lod) - ivec2(1)), _e30_clamped_lod);
+    int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+    vec4 angles = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(1u, 256u)), ivec2(0), textureSize(_group_0_binding_4_cs, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, uint(angles.z));
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, SLICES);
+    int _e52_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+    vec4 line_lo_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.x)), ivec2(0), textureSize(_group_0_binding_4_cs, _e52_clamped_lod) - ivec2(1)), _e52_clamped_lod);
+    int _e59_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+    vec4 line_hi_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.y)), ivec2(0), textureSize(_group_0_binding_4_cs, _e59_clamped_lod) - ivec2(1)), _e59_clamped_lod);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    bool loop_init_2 = true;
     while(true) {
-        if (!loop_init_3) {
-            uint _e102 = j;
-            j = (_e102 + 1u);
+        if (!loop_init_2) {
+            uint _e93 = j;
+            j = (_e93 + 1u);
         }
-        loop_init_3 = false;
-        uint _e72 = j;
-        if ((_e72 < 4u)) {
+        loop_init_2 = false;
+        uint _e63 = j;
+        if ((_e63 < 4u)) {
         } else {
             break;
         }
         {
+            uint _e67 = j;
+            uint _e71 = j;
             uint _e76 = j;
-            uint _e80 = j;
+            int _e83_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+            vec4 v_5 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((_e61.k[(_e67 / 2u)] + (_e71 % 2u)), _e61.slices[(_e76 / 2u)])), ivec2(0), textureSize(_group_0_binding_4_cs, _e83_clamped_lod) - ivec2(1)), _e83_clamped_lod);
             uint _e85 = j;
-            int _e92_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-            vec4 v_5 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((_e70.k[(_e76 / 2u)] + (_e80 % 2u)), _e70.slices[(_e85 / 2u)])), ivec2(0), textureSize(_group_0_binding_4_cs, _e92_clamped_lod) - ivec2(1)), _e92_clamped_lod);
-            uint _e94 = j;
-            depths[_e94] = v_5.w;
-            uint _e98 = j;
-            light[_e98] = v_5.xyz;
+            depths[_e85] = v_5.w;
+            uint _e89 = j;
+            light[_e89] = v_5.xyz;
         }
     }
-    vec4 _e105 = depths;
-    vec3 _e106[4] = light;
-    int _e109_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
-    vec4 _e109 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q_2), ivec2(0), textureSize(_group_0_binding_1_cs, _e109_clamped_lod) - ivec2(1)), _e109_clamped_lod);
-    vec4 _e113 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e70.w, _e105, _e106, _e109.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e113.w == 0.0)) {
-        uint _e119 = atomicAdd(_group_0_binding_5_cs, 1u);
-        _group_0_binding_6_cs[_e119] = (q_2.x | (q_2.y << 16u));
+    vec4 _e96 = depths;
+    vec3 _e97[4] = light;
+    int _e100_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+    vec4 _e100 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q_1), ivec2(0), textureSize(_group_0_binding_1_cs, _e100_clamped_lod) - ivec2(1)), _e100_clamped_lod);
+    vec4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e104.w == 0.0)) {
+        uint _e110 = atomicAdd(_group_0_binding_5_cs, 1u);
+        _group_0_binding_6_cs[_e110] = (q_1.x | (q_1.y << 16u));
         return;
     } else {
-        imageStore(_group_0_binding_3_cs, ivec2(q_2), _e113);
+        imageStore(_group_0_binding_3_cs, ivec2(q_1), _e104);
         return;
     }
 }

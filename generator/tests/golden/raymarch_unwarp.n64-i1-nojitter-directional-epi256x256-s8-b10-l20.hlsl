@@ -34,21 +34,6 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float dtheta;
 };
 
-struct EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    float3 forward;
-    int _pad1_0;
-    float3 right;
-    int _pad2_0;
-    float3 up;
-    float tan_half;
-    float aspect;
-    int _pad5_0;
-    int _pad5_1;
-    int _pad5_2;
-    float3 toward;
-    int _end_pad_0;
-};
-
 struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     float2 origin;
     float2 axis;
@@ -64,9 +49,9 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     float4 w;
 };
 
-static const float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 static const uint SLICES = 256u;
 static const uint SLICE_SAMPLES = 256u;
+static const uint SLICE_LANES = 32u;
 static const uint STEP = 8u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
@@ -367,112 +352,6 @@ float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float2 axis, f
     return atan2(((axis.x * d_1.y) - (axis.y * d_1.x)), ((axis.x * d_1.x) + (axis.y * d_1.y)));
 }
 
-EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX cam, uint2 screen, uint slices)
-{
-    float2 origin = (float2)0;
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l = (EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
-    bool local_7 = (bool)0;
-    bool local_8 = (bool)0;
-    bool local_9 = (bool)0;
-    float a_3 = 0.0;
-    float b_3 = 0.0;
-    uint k_1 = 0u;
-
-    float2 size_1 = float2(screen);
-    float2 centre = (0.5 * size_1);
-    float z_2 = dot(cam.toward, cam.forward);
-    float2 q_1 = float2(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
-    float far_1 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
-    float lq = length(q_1);
-    origin = centre;
-    if ((lq >= (far_1 * abs(z_2)))) {
-        origin = (centre + ((q_1 * (far_1 / max(lq, 1e-30))) * ((z_2 < 0.0) ? -1.0 : 1.0)));
-    } else {
-        if ((lq > 0.0)) {
-            origin = (centre + (q_1 / (z_2).xx));
-        }
-    }
-    float2 _e56 = origin;
-    l.origin = _e56;
-    float2 _e57 = origin;
-    float2 to_centre = (centre - _e57);
-    float lc = length(to_centre);
-    l.axis = ((lc > 0.0) ? (to_centre / (max(lc, 1e-30)).xx) : float2(1.0, 0.0));
-    float2 lo_1 = float2(0.5, 0.5);
-    float2 hi_1 = (size_1 - float2(0.5, 0.5));
-    float _e79 = origin.x;
-    if ((_e79 >= lo_1.x)) {
-        float _e83 = origin.x;
-        local_7 = (_e83 <= hi_1.x);
-    } else {
-        local_7 = false;
-    }
-    bool _e89 = local_7;
-    if (_e89) {
-        float _e91 = origin.y;
-        local_8 = (_e91 >= lo_1.y);
-    } else {
-        local_8 = false;
-    }
-    bool _e97 = local_8;
-    if (_e97) {
-        float _e99 = origin.y;
-        local_9 = (_e99 <= hi_1.y);
-    } else {
-        local_9 = false;
-    }
-    bool inside = local_9;
-    if (inside) {
-        l.wrap = 1u;
-        l.phi_start = -3.1415927;
-        l.dphi = (6.2831855 / float(slices));
-    } else {
-        l.wrap = 0u;
-        uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
-        bool loop_init_1 = true;
-        while(true) {
-            if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
-            loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-            if (!loop_init_1) {
-                uint _e153 = k_1;
-                k_1 = (_e153 + 1u);
-            }
-            loop_init_1 = false;
-            uint _e118 = k_1;
-            if ((_e118 < 4u)) {
-            } else {
-                break;
-            }
-            {
-                uint _e123 = k_1;
-                uint _e131 = k_1;
-                float2 corner = float2((((_e123 & 1u) != 0u) ? hi_1.x : lo_1.x), (((_e131 & 2u) != 0u) ? hi_1.y : lo_1.y));
-                float2 _e139 = l.axis;
-                float2 _e140 = origin;
-                const float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
-                uint _e143 = k_1;
-                if ((_e143 == 0u)) {
-                    a_3 = _e142;
-                    b_3 = _e142;
-                } else {
-                    float _e148 = a_3;
-                    a_3 = min(_e148, _e142);
-                    float _e150 = b_3;
-                    b_3 = max(_e150, _e142);
-                }
-            }
-        }
-        float _e156 = a_3;
-        l.phi_start = _e156;
-        float _e158 = b_3;
-        float _e159 = a_3;
-        l.dphi = ((_e158 - _e159) / float(slices));
-    }
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l;
-    const EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolarlayoutx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx = _e163;
-    return epipolarlayoutx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx;
-}
-
 uint naga_mod(uint lhs, uint rhs) {
     return lhs % (rhs == 0u ? 1u : rhs);
 }
@@ -481,28 +360,28 @@ int naga_f2i32(float value) {
     return int(clamp(value, -2147483600.0, 2147483500.0));
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uint2 p_2, uint slices_1)
+EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l, uint2 p_2, uint slices)
 {
     uint s_lo = 0u;
     float fs = 0.0;
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = (EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
 
-    float2 d_3 = ((float2(p_2) + float2(0.5, 0.5)) - l_1.origin);
-    const float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_3);
-    float f = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
-    if ((l_1.wrap != 0u)) {
+    float2 d_3 = ((float2(p_2) + float2(0.5, 0.5)) - l.origin);
+    const float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_3);
+    float f = (((_e12 - l.phi_start) / l.dphi) - 0.5);
+    if ((l.wrap != 0u)) {
         float fl = floor(f);
         fs = (f - fl);
-        s_lo = naga_mod(uint(asint(asuint(naga_f2i32(fl)) + asuint(int(slices_1)))), slices_1);
+        s_lo = naga_mod(uint(asint(asuint(naga_f2i32(fl)) + asuint(int(slices)))), slices);
     } else {
-        float fc = clamp(f, 0.0, float((slices_1 - 1u)));
-        s_lo = min(naga_f2u32(fc), (slices_1 - 2u));
+        float fc = clamp(f, 0.0, float((slices - 1u)));
+        s_lo = min(naga_f2u32(fc), (slices - 2u));
         uint _e41 = s_lo;
         fs = (fc - float(_e41));
     }
     uint _e46 = s_lo;
     uint _e47 = s_lo;
-    t_1.slices = uint2(_e46, naga_mod((_e47 + 1u), slices_1));
+    t_1.slices = uint2(_e46, naga_mod((_e47 + 1u), slices));
     float _e53 = fs;
     float _e56 = fs;
     t_1.w = float4((1.0 - _e53), _e56, 0.0, 0.0);
@@ -511,24 +390,24 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     return epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2, uint2 p_3, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, float4 line_lo, float4 line_hi, uint samples)
+EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uint2 p_3, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, float4 line_lo, float4 line_hi, uint samples)
 {
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_2 = (EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
     uint j_1 = 0u;
 
-    float2 d_4 = ((float2(p_3) + float2(0.5, 0.5)) - l_2.origin);
+    float2 d_4 = ((float2(p_3) + float2(0.5, 0.5)) - l_1.origin);
     t_2 = pair;
     float2 ws = pair.w.xy;
-    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
-    bool loop_init_2 = true;
+    uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
+    bool loop_init_1 = true;
     while(true) {
-        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
+        if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
+        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+        if (!loop_init_1) {
             uint _e68 = j_1;
             j_1 = (_e68 + 1u);
         }
-        loop_init_2 = false;
+        loop_init_1 = false;
         uint _e15 = j_1;
         if ((_e15 < 2u)) {
         } else {
@@ -560,14 +439,13 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX ConstructEpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 arg0, float3 arg1, float3 arg2, float arg3, float arg4, float3 arg5) {
-    EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX ret = (EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
-    ret.forward = arg0;
-    ret.right = arg1;
-    ret.up = arg2;
-    ret.tan_half = arg3;
-    ret.aspect = arg4;
-    ret.toward = arg5;
+EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX ConstructEpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float2 arg0, float2 arg1, float arg2, float arg3, uint arg4) {
+    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX ret = (EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
+    ret.origin = arg0;
+    ret.axis = arg1;
+    ret.phi_start = arg2;
+    ret.dphi = arg3;
+    ret.wrap = arg4;
     return ret;
 }
 
@@ -581,10 +459,10 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
 
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
-    uint2 screen_1 = uint2(_e6, _e10);
-    uint2 q_2 = id.xy;
-    if (!((q_2.x >= screen_1.x))) {
-        local = (q_2.y >= screen_1.y);
+    uint2 screen = uint2(_e6, _e10);
+    uint2 q_1 = id.xy;
+    if (!((q_1.x >= screen.x))) {
+        local = (q_1.y >= screen.y);
     } else {
         local = true;
     }
@@ -592,53 +470,49 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     if (_e24) {
         return;
     }
-    float4 _e27 = frame.cam_forward;
-    float4 _e31 = frame.cam_right;
-    float4 _e35 = frame.cam_up;
-    float _e40 = frame.cam_forward.w;
-    float _e44 = frame.cam_right.w;
-    float4 _e47 = frame.light_dir;
-    const EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e52 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(ConstructEpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e27.xyz, _e31.xyz, _e35.xyz, _e40, _e44, -(_e47.xyz)), screen_1, SLICES);
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e54 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e52, q_2, SLICES);
-    float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e54.slices.x), int(0)));
-    float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e54.slices.y), int(0)));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e52, q_2, _e54, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
-    bool loop_init_3 = true;
+    float4 head = epipolar_samples.Load(int3(uint2(0u, 256u), int(0)));
+    float4 angles = epipolar_samples.Load(int3(uint2(1u, 256u), int(0)));
+    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = ConstructEpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z));
+    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, SLICES);
+    float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.x), int(0)));
+    float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.y), int(0)));
+    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
-            uint _e102 = j;
-            j = (_e102 + 1u);
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e93 = j;
+            j = (_e93 + 1u);
         }
-        loop_init_3 = false;
-        uint _e72 = j;
-        if ((_e72 < 4u)) {
+        loop_init_2 = false;
+        uint _e63 = j;
+        if ((_e63 < 4u)) {
         } else {
             break;
         }
         {
+            uint _e67 = j;
+            uint _e71 = j;
             uint _e76 = j;
-            uint _e80 = j;
+            float4 v_5 = epipolar_samples.Load(int3(uint2((_e61.k[min(uint(naga_div(_e67, 2u)), 1u)] + naga_mod(_e71, 2u)), _e61.slices[min(uint(naga_div(_e76, 2u)), 1u)]), int(0)));
             uint _e85 = j;
-            float4 v_5 = epipolar_samples.Load(int3(uint2((_e70.k[min(uint(naga_div(_e76, 2u)), 1u)] + naga_mod(_e80, 2u)), _e70.slices[min(uint(naga_div(_e85, 2u)), 1u)]), int(0)));
-            uint _e94 = j;
-            depths[min(uint(_e94), 3u)] = v_5.w;
-            uint _e98 = j;
-            light[min(uint(_e98), 3u)] = v_5.xyz;
+            depths[min(uint(_e85), 3u)] = v_5.w;
+            uint _e89 = j;
+            light[min(uint(_e89), 3u)] = v_5.xyz;
         }
     }
-    float4 _e105 = depths;
-    float3 _e106[4] = light;
-    float4 _e109 = depth.Load(int3(q_2, int(0)));
-    const float4 _e113 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e70.w, _e105, _e106, _e109.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e113.w == 0.0)) {
-        uint _e119; fallback_count.InterlockedAdd(0, 1u, _e119);
-        fallback_pixels.Store(_e119*4, asuint((q_2.x | (q_2.y << 16u))));
+    float4 _e96 = depths;
+    float3 _e97[4] = light;
+    float4 _e100 = depth.Load(int3(q_1, int(0)));
+    const float4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e104.w == 0.0)) {
+        uint _e110; fallback_count.InterlockedAdd(0, 1u, _e110);
+        fallback_pixels.Store(_e110*4, asuint((q_1.x | (q_1.y << 16u))));
         return;
     } else {
-        output[q_2] = _e113;
+        output[q_1] = _e104;
         return;
     }
 }

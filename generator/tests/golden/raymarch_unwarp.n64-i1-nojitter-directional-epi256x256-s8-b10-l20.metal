@@ -41,18 +41,6 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float theta_a;
     float dtheta;
 };
-struct EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    metal::float3 forward;
-    metal::float3 right;
-    metal::packed_float3 up;
-    float tan_half;
-    float aspect;
-    char _pad5[12];
-    metal::float3 toward;
-};
-struct type_9 {
-    metal::float3 inner[4];
-};
 struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     metal::float2 origin;
     metal::float2 axis;
@@ -61,15 +49,18 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uint wrap;
     char _pad5[4];
 };
+struct type_9 {
+    metal::float3 inner[4];
+};
 struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     metal::uint2 slices;
     metal::uint2 k;
     metal::float4 w;
 };
 typedef uint type_12[1];
-constant float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 constant uint SLICES = 256u;
 constant uint SLICE_SAMPLES = 256u;
+constant uint SLICE_LANES = 32u;
 constant uint STEP = 8u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
@@ -391,113 +382,6 @@ float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     return metal::atan2((axis.x * d_1.y) - (axis.y * d_1.x), (axis.x * d_1.x) + (axis.y * d_1.y));
 }
 
-EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX cam,
-    metal::uint2 screen,
-    uint slices
-) {
-    metal::float2 origin = {};
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l = {};
-    bool local_7 = {};
-    bool local_8 = {};
-    bool local_9 = {};
-    float a_3 = 0.0;
-    float b_3 = 0.0;
-    uint k_1 = 0u;
-    metal::float2 size_1 = static_cast<metal::float2>(screen);
-    metal::float2 centre = 0.5 * size_1;
-    float z_2 = metal::dot(cam.toward, cam.forward);
-    metal::float2 q_1 = metal::float2((metal::dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect), (-(metal::dot(cam.toward, cam.up)) * centre.y) / cam.tan_half);
-    float far_1 = EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * metal::max(size_1.x, size_1.y);
-    float lq = metal::length(q_1);
-    origin = centre;
-    if (lq >= (far_1 * metal::abs(z_2))) {
-        origin = centre + ((q_1 * (far_1 / metal::max(lq, 0.000000000000000000000000000001))) * ((z_2 < 0.0) ? -1.0 : 1.0));
-    } else {
-        if (lq > 0.0) {
-            origin = centre + (q_1 / metal::float2(z_2));
-        }
-    }
-    metal::float2 _e56 = origin;
-    l.origin = _e56;
-    metal::float2 _e57 = origin;
-    metal::float2 to_centre = centre - _e57;
-    float lc = metal::length(to_centre);
-    l.axis = (lc > 0.0) ? (to_centre / metal::float2(metal::max(lc, 0.000000000000000000000000000001))) : metal::float2(1.0, 0.0);
-    metal::float2 lo_1 = metal::float2(0.5, 0.5);
-    metal::float2 hi_1 = size_1 - metal::float2(0.5, 0.5);
-    float _e79 = origin.x;
-    if (_e79 >= lo_1.x) {
-        float _e83 = origin.x;
-        local_7 = _e83 <= hi_1.x;
-    } else {
-        local_7 = false;
-    }
-    bool _e89 = local_7;
-    if (_e89) {
-        float _e91 = origin.y;
-        local_8 = _e91 >= lo_1.y;
-    } else {
-        local_8 = false;
-    }
-    bool _e97 = local_8;
-    if (_e97) {
-        float _e99 = origin.y;
-        local_9 = _e99 <= hi_1.y;
-    } else {
-        local_9 = false;
-    }
-    bool inside = local_9;
-    if (inside) {
-        l.wrap = 1u;
-        l.phi_start = -3.1415927;
-        l.dphi = 6.2831855 / static_cast<float>(slices);
-    } else {
-        l.wrap = 0u;
-        uint2 loop_bound_1 = uint2(4294967295u);
-        bool loop_init_1 = true;
-        while(true) {
-            if (metal::all(loop_bound_1 == uint2(0u))) { break; }
-            loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-            if (!loop_init_1) {
-                uint _e153 = k_1;
-                k_1 = _e153 + 1u;
-            }
-            loop_init_1 = false;
-            uint _e118 = k_1;
-            if (_e118 < 4u) {
-            } else {
-                break;
-            }
-            {
-                uint _e123 = k_1;
-                uint _e131 = k_1;
-                metal::float2 corner = metal::float2(((_e123 & 1u) != 0u) ? hi_1.x : lo_1.x, ((_e131 & 2u) != 0u) ? hi_1.y : lo_1.y);
-                metal::float2 _e139 = l.axis;
-                metal::float2 _e140 = origin;
-                float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, corner - _e140);
-                uint _e143 = k_1;
-                if (_e143 == 0u) {
-                    a_3 = _e142;
-                    b_3 = _e142;
-                } else {
-                    float _e148 = a_3;
-                    a_3 = metal::min(_e148, _e142);
-                    float _e150 = b_3;
-                    b_3 = metal::max(_e150, _e142);
-                }
-            }
-        }
-        float _e156 = a_3;
-        l.phi_start = _e156;
-        float _e158 = b_3;
-        float _e159 = a_3;
-        l.dphi = (_e158 - _e159) / static_cast<float>(slices);
-    }
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l;
-    return _e163;
-}
-
 int naga_f2i32(float value) {
     return static_cast<int>(metal::clamp(value, -2147483600.0, 2147483500.0));
 }
@@ -507,29 +391,29 @@ uint naga_mod(uint lhs, uint rhs) {
 }
 
 EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1,
+    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l,
     metal::uint2 p_2,
-    uint slices_1
+    uint slices
 ) {
     uint s_lo = 0u;
     float fs = 0.0;
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = {};
-    metal::float2 d_3 = (static_cast<metal::float2>(p_2) + metal::float2(0.5, 0.5)) - l_1.origin;
-    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_3);
-    float f = ((_e12 - l_1.phi_start) / l_1.dphi) - 0.5;
-    if (l_1.wrap != 0u) {
+    metal::float2 d_3 = (static_cast<metal::float2>(p_2) + metal::float2(0.5, 0.5)) - l.origin;
+    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_3);
+    float f = ((_e12 - l.phi_start) / l.dphi) - 0.5;
+    if (l.wrap != 0u) {
         float fl = metal::floor(f);
         fs = f - fl;
-        s_lo = naga_mod(static_cast<uint>(as_type<int>(as_type<uint>(naga_f2i32(fl)) + as_type<uint>(static_cast<int>(slices_1)))), slices_1);
+        s_lo = naga_mod(static_cast<uint>(as_type<int>(as_type<uint>(naga_f2i32(fl)) + as_type<uint>(static_cast<int>(slices)))), slices);
     } else {
-        float fc = metal::clamp(f, 0.0, static_cast<float>(slices_1 - 1u));
-        s_lo = metal::min(naga_f2u32(fc), slices_1 - 2u);
+        float fc = metal::clamp(f, 0.0, static_cast<float>(slices - 1u));
+        s_lo = metal::min(naga_f2u32(fc), slices - 2u);
         uint _e41 = s_lo;
         fs = fc - static_cast<float>(_e41);
     }
     uint _e46 = s_lo;
     uint _e47 = s_lo;
-    t_1.slices = metal::uint2(_e46, naga_mod(_e47 + 1u, slices_1));
+    t_1.slices = metal::uint2(_e46, naga_mod(_e47 + 1u, slices));
     float _e53 = fs;
     float _e56 = fs;
     t_1.w = metal::float4(1.0 - _e53, _e56, 0.0, 0.0);
@@ -538,7 +422,7 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
 }
 
 EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2,
+    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1,
     metal::uint2 p_3,
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair,
     metal::float4 line_lo,
@@ -547,19 +431,19 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
 ) {
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_2 = {};
     uint j_1 = 0u;
-    metal::float2 d_4 = (static_cast<metal::float2>(p_3) + metal::float2(0.5, 0.5)) - l_2.origin;
+    metal::float2 d_4 = (static_cast<metal::float2>(p_3) + metal::float2(0.5, 0.5)) - l_1.origin;
     t_2 = pair;
     metal::float2 ws = pair.w.xy;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
+    uint2 loop_bound_1 = uint2(4294967295u);
+    bool loop_init_1 = true;
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
+        if (metal::all(loop_bound_1 == uint2(0u))) { break; }
+        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+        if (!loop_init_1) {
             uint _e68 = j_1;
             j_1 = _e68 + 1u;
         }
-        loop_init_2 = false;
+        loop_init_1 = false;
         uint _e15 = j_1;
         if (_e15 < 2u) {
         } else {
@@ -598,7 +482,7 @@ metal::float3 raymarch_pixel(
     uint j_2 = {};
     float t_3 = {};
     float w_1 = {};
-    float l_3 = {};
+    float l_2 = {};
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
     metal::float3 eye_2 = m_2.eye.xyz;
     metal::float3 _e8 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
@@ -618,16 +502,16 @@ metal::float3 raymarch_pixel(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0.0, s, n_2);
     j_2 = pixel_class;
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e103 = j_2;
             j_2 = _e103 + stride;
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e50 = j_2;
         if (_e50 < n_2) {
         } else {
@@ -663,13 +547,13 @@ metal::float3 raymarch_pixel(
         }
     }
     float _e105 = sum_1;
-    l_3 = _e105;
+    l_2 = _e105;
     if (!(false)) {
         float _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(metal::dot(m_2.light_dir.xyz, _e8)));
         float _e118 = sum_1;
-        l_3 = (m_2.medium.y * _e116) * _e118;
+        l_2 = (m_2.medium.y * _e116) * _e118;
     }
-    float _e122 = l_3;
+    float _e122 = l_2;
     metal::float3 c_1 = m_2.light_color.xyz * _e122;
     return c_1;
 }
@@ -696,10 +580,10 @@ kernel void raymarch_unwarp(
     uint j = 0u;
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
-    metal::uint2 screen_1 = metal::uint2(_e6, _e10);
-    metal::uint2 q_2 = id.xy;
-    if (!((q_2.x >= screen_1.x))) {
-        local = q_2.y >= screen_1.y;
+    metal::uint2 screen = metal::uint2(_e6, _e10);
+    metal::uint2 q_1 = id.xy;
+    if (!((q_1.x >= screen.x))) {
+        local = q_1.y >= screen.y;
     } else {
         local = true;
     }
@@ -707,57 +591,55 @@ kernel void raymarch_unwarp(
     if (_e24) {
         return;
     }
-    metal::float4 _e27 = frame.cam_forward;
-    metal::float4 _e31 = frame.cam_right;
-    metal::float4 _e35 = frame.cam_up;
-    float _e40 = frame.cam_forward.w;
-    float _e44 = frame.cam_right.w;
-    metal::float4 _e47 = frame.light_dir;
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e52 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {_e27.xyz, _e31.xyz, _e35.xyz, _e40, _e44, {}, -(_e47.xyz)}, screen_1, SLICES);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e54 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e52, q_2, SLICES);
-    uint clamped_lod_e61 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-    metal::float4 line_lo_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e54.slices.x)), metal::uint2(epipolar_samples.get_width(clamped_lod_e61), epipolar_samples.get_height(clamped_lod_e61)) - 1), clamped_lod_e61);
-    uint clamped_lod_e68 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-    metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e54.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e68), epipolar_samples.get_height(clamped_lod_e68)) - 1), clamped_lod_e68);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e52, q_2, _e54, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    uint2 loop_bound_4 = uint2(4294967295u);
-    bool loop_init_4 = true;
+    uint clamped_lod_e30 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 head = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(0u, 256u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e30), epipolar_samples.get_height(clamped_lod_e30)) - 1), clamped_lod_e30);
+    uint clamped_lod_e36 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 angles = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(1u, 256u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e36), epipolar_samples.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z)};
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, SLICES);
+    uint clamped_lod_e52 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 line_lo_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.x)), metal::uint2(epipolar_samples.get_width(clamped_lod_e52), epipolar_samples.get_height(clamped_lod_e52)) - 1), clamped_lod_e52);
+    uint clamped_lod_e59 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e59), epipolar_samples.get_height(clamped_lod_e59)) - 1), clamped_lod_e59);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
-            uint _e102 = j;
-            j = _e102 + 1u;
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e93 = j;
+            j = _e93 + 1u;
         }
-        loop_init_4 = false;
-        uint _e72 = j;
-        if (_e72 < 4u) {
+        loop_init_3 = false;
+        uint _e63 = j;
+        if (_e63 < 4u) {
         } else {
             break;
         }
         {
+            uint _e67 = j;
+            uint _e71 = j;
             uint _e76 = j;
-            uint _e80 = j;
+            uint clamped_lod_e83 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+            metal::float4 v_5 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(_e61.k[metal::min(unsigned(naga_div(_e67, 2u)), 1u)] + naga_mod(_e71, 2u), _e61.slices[metal::min(unsigned(naga_div(_e76, 2u)), 1u)])), metal::uint2(epipolar_samples.get_width(clamped_lod_e83), epipolar_samples.get_height(clamped_lod_e83)) - 1), clamped_lod_e83);
             uint _e85 = j;
-            uint clamped_lod_e92 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-            metal::float4 v_5 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(_e70.k[metal::min(unsigned(naga_div(_e76, 2u)), 1u)] + naga_mod(_e80, 2u), _e70.slices[metal::min(unsigned(naga_div(_e85, 2u)), 1u)])), metal::uint2(epipolar_samples.get_width(clamped_lod_e92), epipolar_samples.get_height(clamped_lod_e92)) - 1), clamped_lod_e92);
-            uint _e94 = j;
-            depths[metal::min(unsigned(_e94), 3u)] = v_5.w;
-            uint _e98 = j;
-            light.inner[metal::min(unsigned(_e98), 3u)] = v_5.xyz;
+            depths[metal::min(unsigned(_e85), 3u)] = v_5.w;
+            uint _e89 = j;
+            light.inner[metal::min(unsigned(_e89), 3u)] = v_5.xyz;
         }
     }
-    metal::float4 _e105 = depths;
-    type_9 _e106 = light;
-    uint clamped_lod_e109 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e109 = depth.read(metal::min(metal::uint2(q_2), metal::uint2(depth.get_width(clamped_lod_e109), depth.get_height(clamped_lod_e109)) - 1), clamped_lod_e109);
-    metal::float4 _e113 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e70.w, _e105, _e106, _e109.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e113.w == 0.0) {
-        uint _e119 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e119), (_buffer_sizes.size6 - 0 - 4) / 4)] = q_2.x | (q_2.y << 16u);
+    metal::float4 _e96 = depths;
+    type_9 _e97 = light;
+    uint clamped_lod_e100 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e100 = depth.read(metal::min(metal::uint2(q_1), metal::uint2(depth.get_width(clamped_lod_e100), depth.get_height(clamped_lod_e100)) - 1), clamped_lod_e100);
+    metal::float4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e104.w == 0.0) {
+        uint _e110 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
+        fallback_pixels[metal::min(unsigned(_e110), (_buffer_sizes.size6 - 0 - 4) / 4)] = q_1.x | (q_1.y << 16u);
         return;
     } else {
-        output.write(_e113, metal::uint2(q_2));
+        output.write(_e104, metal::uint2(q_1));
         return;
     }
 }

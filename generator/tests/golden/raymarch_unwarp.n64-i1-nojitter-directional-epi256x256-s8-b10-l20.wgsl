@@ -34,15 +34,6 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     dtheta: f32,
 }
 
-struct EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    forward: vec3<f32>,
-    right: vec3<f32>,
-    up: vec3<f32>,
-    tan_half: f32,
-    aspect: f32,
-    toward: vec3<f32>,
-}
-
 struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     origin: vec2<f32>,
     axis: vec2<f32>,
@@ -57,9 +48,9 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     w: vec4<f32>,
 }
 
-const EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX: f32 = 100f;
 const SLICES: u32 = 256u;
 const SLICE_SAMPLES: u32 = 256u;
+const SLICE_LANES: u32 = 32u;
 const STEP: u32 = 8u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
@@ -319,126 +310,27 @@ fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, 
     return atan2(((axis.x * d_1.y) - (axis.y * d_1.x)), ((axis.x * d_1.x) + (axis.y * d_1.y)));
 }
 
-fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, screen: vec2<u32>, slices: u32) -> EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    var origin: vec2<f32>;
-    var l: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
-    var local_7: bool;
-    var local_8: bool;
-    var local_9: bool;
-    var a_3: f32 = 0f;
-    var b_3: f32 = 0f;
-    var k_1: u32 = 0u;
-
-    let size_1 = vec2<f32>(screen);
-    let centre = (0.5f * size_1);
-    let z_2 = dot(cam.toward, cam.forward);
-    let q_1 = vec2<f32>(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
-    let far_1 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
-    let lq = length(q_1);
-    origin = centre;
-    if (lq >= (far_1 * abs(z_2))) {
-        origin = (centre + ((q_1 * (far_1 / max(lq, 0.000000000000000000000000000001f))) * select(1f, -1f, (z_2 < 0f))));
-    } else {
-        if (lq > 0f) {
-            origin = (centre + (q_1 / vec2(z_2)));
-        }
-    }
-    let _e56 = origin;
-    l.origin = _e56;
-    let _e57 = origin;
-    let to_centre = (centre - _e57);
-    let lc = length(to_centre);
-    l.axis = select(vec2<f32>(1f, 0f), (to_centre / vec2(max(lc, 0.000000000000000000000000000001f))), (lc > 0f));
-    let lo_1 = vec2<f32>(0.5f, 0.5f);
-    let hi_1 = (size_1 - vec2<f32>(0.5f, 0.5f));
-    let _e79 = origin.x;
-    if (_e79 >= lo_1.x) {
-        let _e83 = origin.x;
-        local_7 = (_e83 <= hi_1.x);
-    } else {
-        local_7 = false;
-    }
-    let _e89 = local_7;
-    if _e89 {
-        let _e91 = origin.y;
-        local_8 = (_e91 >= lo_1.y);
-    } else {
-        local_8 = false;
-    }
-    let _e97 = local_8;
-    if _e97 {
-        let _e99 = origin.y;
-        local_9 = (_e99 <= hi_1.y);
-    } else {
-        local_9 = false;
-    }
-    let inside = local_9;
-    if inside {
-        l.wrap = 1u;
-        l.phi_start = -3.1415927f;
-        l.dphi = (6.2831855f / f32(slices));
-    } else {
-        l.wrap = 0u;
-        loop {
-            let _e118 = k_1;
-            if (_e118 < 4u) {
-            } else {
-                break;
-            }
-            {
-                let _e123 = k_1;
-                let _e131 = k_1;
-                let corner = vec2<f32>(select(lo_1.x, hi_1.x, ((_e123 & 1u) != 0u)), select(lo_1.y, hi_1.y, ((_e131 & 2u) != 0u)));
-                let _e139 = l.axis;
-                let _e140 = origin;
-                let _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
-                let _e143 = k_1;
-                if (_e143 == 0u) {
-                    a_3 = _e142;
-                    b_3 = _e142;
-                } else {
-                    let _e148 = a_3;
-                    a_3 = min(_e148, _e142);
-                    let _e150 = b_3;
-                    b_3 = max(_e150, _e142);
-                }
-            }
-            continuing {
-                let _e153 = k_1;
-                k_1 = (_e153 + 1u);
-            }
-        }
-        let _e156 = a_3;
-        l.phi_start = _e156;
-        let _e158 = b_3;
-        let _e159 = a_3;
-        l.dphi = ((_e158 - _e159) / f32(slices));
-    }
-    let _e163 = l;
-    return _e163;
-}
-
-fn epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p_2: vec2<u32>, slices_1: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+fn epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p_2: vec2<u32>, slices: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     var s_lo: u32 = 0u;
     var fs: f32 = 0f;
     var t_1: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
 
-    let d_3 = ((vec2<f32>(p_2) + vec2<f32>(0.5f, 0.5f)) - l_1.origin);
-    let _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_3);
-    let f = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5f);
-    if (l_1.wrap != 0u) {
+    let d_3 = ((vec2<f32>(p_2) + vec2<f32>(0.5f, 0.5f)) - l.origin);
+    let _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_3);
+    let f = (((_e12 - l.phi_start) / l.dphi) - 0.5f);
+    if (l.wrap != 0u) {
         let fl = floor(f);
         fs = (f - fl);
-        s_lo = (u32((i32(fl) + i32(slices_1))) % slices_1);
+        s_lo = (u32((i32(fl) + i32(slices))) % slices);
     } else {
-        let fc = clamp(f, 0f, f32((slices_1 - 1u)));
-        s_lo = min(u32(fc), (slices_1 - 2u));
+        let fc = clamp(f, 0f, f32((slices - 1u)));
+        s_lo = min(u32(fc), (slices - 2u));
         let _e41 = s_lo;
         fs = (fc - f32(_e41));
     }
     let _e46 = s_lo;
     let _e47 = s_lo;
-    t_1.slices = vec2<u32>(_e46, ((_e47 + 1u) % slices_1));
+    t_1.slices = vec2<u32>(_e46, ((_e47 + 1u) % slices));
     let _e53 = fs;
     let _e56 = fs;
     t_1.w = vec4<f32>((1f - _e53), _e56, 0f, 0f);
@@ -446,11 +338,11 @@ fn epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLay
     return _e60;
 }
 
-fn epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p_3: vec2<u32>, pair: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, line_lo: vec4<f32>, line_hi: vec4<f32>, samples: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+fn epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p_3: vec2<u32>, pair: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, line_lo: vec4<f32>, line_hi: vec4<f32>, samples: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     var t_2: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
     var j_1: u32 = 0u;
 
-    let d_4 = ((vec2<f32>(p_3) + vec2<f32>(0.5f, 0.5f)) - l_2.origin);
+    let d_4 = ((vec2<f32>(p_3) + vec2<f32>(0.5f, 0.5f)) - l_1.origin);
     t_2 = pair;
     let ws = pair.w.xy;
     loop {
@@ -490,7 +382,7 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     var j_2: u32;
     var t_3: f32;
     var w_1: f32;
-    var l_3: f32;
+    var l_2: f32;
 
     let m_2 = frame;
     let eye_2 = m_2.eye.xyz;
@@ -550,13 +442,13 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
         }
     }
     let _e105 = sum_1;
-    l_3 = _e105;
+    l_2 = _e105;
     if !(false) {
         let _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e8)));
         let _e118 = sum_1;
-        l_3 = ((m_2.medium.y * _e116) * _e118);
+        l_2 = ((m_2.medium.y * _e116) * _e118);
     }
-    let _e122 = l_3;
+    let _e122 = l_2;
     let c_1 = (m_2.light_color.xyz * _e122);
     return c_1;
 }
@@ -570,10 +462,10 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
 
     let _e6 = frame.sizes.x;
     let _e10 = frame.sizes.y;
-    let screen_1 = vec2<u32>(_e6, _e10);
-    let q_2 = id.xy;
-    if !((q_2.x >= screen_1.x)) {
-        local = (q_2.y >= screen_1.y);
+    let screen = vec2<u32>(_e6, _e10);
+    let q_1 = id.xy;
+    if !((q_1.x >= screen.x)) {
+        local = (q_1.y >= screen.y);
     } else {
         local = true;
     }
@@ -581,48 +473,44 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e24 {
         return;
     }
-    let _e27 = frame.cam_forward;
-    let _e31 = frame.cam_right;
-    let _e35 = frame.cam_up;
-    let _e40 = frame.cam_forward.w;
-    let _e44 = frame.cam_right.w;
-    let _e47 = frame.light_dir;
-    let _e52 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e27.xyz, _e31.xyz, _e35.xyz, _e40, _e44, -(_e47.xyz)), screen_1, SLICES);
-    let _e54 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e52, q_2, SLICES);
-    let line_lo_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e54.slices.x), 0i);
-    let line_hi_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e54.slices.y), 0i);
-    let _e70 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e52, q_2, _e54, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    let head = textureLoad(epipolar_samples, vec2<u32>(0u, 256u), 0i);
+    let angles = textureLoad(epipolar_samples, vec2<u32>(1u, 256u), 0i);
+    let lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, u32(angles.z));
+    let _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, SLICES);
+    let line_lo_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e45.slices.x), 0i);
+    let line_hi_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e45.slices.y), 0i);
+    let _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     loop {
-        let _e72 = j;
-        if (_e72 < 4u) {
+        let _e63 = j;
+        if (_e63 < 4u) {
         } else {
             break;
         }
         {
+            let _e67 = j;
+            let _e71 = j;
             let _e76 = j;
-            let _e80 = j;
+            let v_5 = textureLoad(epipolar_samples, vec2<u32>((_e61.k[(_e67 / 2u)] + (_e71 % 2u)), _e61.slices[(_e76 / 2u)]), 0i);
             let _e85 = j;
-            let v_5 = textureLoad(epipolar_samples, vec2<u32>((_e70.k[(_e76 / 2u)] + (_e80 % 2u)), _e70.slices[(_e85 / 2u)]), 0i);
-            let _e94 = j;
-            depths[_e94] = v_5.w;
-            let _e98 = j;
-            light[_e98] = v_5.xyz;
+            depths[_e85] = v_5.w;
+            let _e89 = j;
+            light[_e89] = v_5.xyz;
         }
         continuing {
-            let _e102 = j;
-            j = (_e102 + 1u);
+            let _e93 = j;
+            j = (_e93 + 1u);
         }
     }
-    let _e105 = depths;
-    let _e106 = light;
-    let _e109 = textureLoad(depth, q_2, 0i);
-    let _e113 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e70.w, _e105, _e106, _e109.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e113.w == 0f) {
-        let _e119 = atomicAdd((&fallback_count), 1u);
-        fallback_pixels[_e119] = (q_2.x | (q_2.y << 16u));
+    let _e96 = depths;
+    let _e97 = light;
+    let _e100 = textureLoad(depth, q_1, 0i);
+    let _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e104.w == 0f) {
+        let _e110 = atomicAdd((&fallback_count), 1u);
+        fallback_pixels[_e110] = (q_1.x | (q_1.y << 16u));
         return;
     } else {
-        textureStore(output, q_2, _e113);
+        textureStore(output, q_1, _e104);
         return;
     }
 }

@@ -137,10 +137,7 @@ pub fn run_sampled(
     let [w, h] = screen;
     if knobs.sampling == Sampling::Epipolar {
         let s = epipolar_samples(knobs, screen, depth, camera, pixel);
-        let out = epipolar_fallback(
-            epipolar_unwarp(knobs, screen, depth, camera, &s.samples),
-            pixel,
-        );
+        let out = epipolar_fallback(epipolar_unwarp(knobs, screen, depth, &s.samples), pixel);
         return SampledOutput {
             output: out.output,
             evaluated: s.evaluated + out.evaluated,
@@ -513,9 +510,9 @@ pub fn epipolar_taps_direct(
 /// What the epipolar samples pass produced.
 #[derive(Clone, Debug)]
 pub struct EpipolarSamples {
-    /// `(slice_samples + 1) x slices`, rgba32float: radiance, the sample pixel's depth in
-    /// w; the last column holds each slice's line (direction, first distance, distance
-    /// between samples).
+    /// `(slice_samples + 1) x (slices + 1)`, rgba32float: radiance, the sample pixel's
+    /// depth in w; the last column holds each slice's line (direction, first distance,
+    /// distance between samples), the last row's first two texels the layout ([`layout_of`]).
     pub samples: TexArray,
     /// Samples evaluated (every slice's marked ones and those the light criterion added).
     pub evaluated: u64,
@@ -617,23 +614,50 @@ pub fn epipolar_samples(
         })
         .collect();
     let mut counts = [0u64; 3];
-    let mut data = Vec::with_capacity((n * (m + 1)) as usize);
+    let mut data = Vec::with_capacity(((n + 1) * (m + 1)) as usize);
     for (line, c) in lines {
         data.extend(line);
         for i in 0..3 {
             counts[i] += c[i];
         }
     }
+    // The last row: the layout, for the unwarp.
+    data.push([
+        layout.origin[0],
+        layout.origin[1],
+        layout.axis[0],
+        layout.axis[1],
+    ]);
+    data.push([
+        layout.phi_start,
+        layout.dphi,
+        if layout.wrap { 1.0 } else { 0.0 },
+        0.0,
+    ]);
+    data.resize(((n + 1) * (m + 1)) as usize, [0.0; 4]);
     EpipolarSamples {
         samples: TexArray {
             width: m + 1,
-            height: n,
+            height: n + 1,
             layers: 1,
             data,
         },
         evaluated: counts[0],
         depth_refined: counts[1],
         light_refined: counts[2],
+    }
+}
+
+/// The layout the samples pass stored in the last row of `samples` (`slices` slices).
+pub fn layout_of(samples: &TexArray, slices: u32) -> EpipolarLayout {
+    let head = samples.load(0, slices, 0);
+    let angles = samples.load(1, slices, 0);
+    EpipolarLayout {
+        origin: [head[0], head[1]],
+        axis: [head[2], head[3]],
+        phi_start: angles[0],
+        dphi: angles[1],
+        wrap: angles[2] != 0.0,
     }
 }
 
@@ -659,13 +683,12 @@ pub fn epipolar_unwarp(
     knobs: &SamplingKnobs,
     screen: [u32; 2],
     depth: &Tex,
-    camera: &EpipolarCamera,
     samples: &TexArray,
 ) -> EpipolarUnwarp {
     use rayon::prelude::*;
     let [w, h] = screen;
     let (depth_break, light_break) = (knobs.depth_break_fraction(), knobs.light_break_fraction());
-    let layout = epipolar_layout(camera, screen, knobs.slices);
+    let layout = layout_of(samples, knobs.slices);
     let store = |c: [f32; 3]| [c[0], c[1], c[2], 1.0].map(|v| quantise(v, Storage::Rgba16float));
     let pixels: Vec<([f32; 4], u8)> = (0..h)
         .into_par_iter()

@@ -2,7 +2,7 @@
 //! minmax_traverse family (`scatter_reference::kernels::common_sampling::epipolar_unwarp`): every pixel
 //! gathered from the samples, or listed for `minmax_traverse_fallback`.
 
-use super::common_sampling::{EpipolarCamera, EpipolarUnwarp, epipolar_unwarp};
+use super::common_sampling::{EpipolarUnwarp, epipolar_unwarp};
 use super::minmax_traverse::TraverseInputs;
 use super::texture::TexArray;
 use scatter_shaderlib::minmax::MinmaxVariant;
@@ -18,7 +18,6 @@ pub fn minmax_traverse_unwarp(
         &variant.sampling_knobs(),
         [inp.frame.sizes[0], inp.frame.sizes[1]],
         inp.depth,
-        &EpipolarCamera::of_frame(inp.frame),
         samples,
     )
 }

@@ -2,7 +2,7 @@
 //! raymarch family (`scatter_reference::kernels::common_sampling::epipolar_unwarp`): every pixel
 //! gathered from the samples, or listed for `raymarch_fallback`.
 
-use super::common_sampling::{EpipolarCamera, EpipolarUnwarp, epipolar_unwarp};
+use super::common_sampling::{EpipolarUnwarp, epipolar_unwarp};
 use super::texture::{Tex, TexArray};
 use scatter_shaderlib::raymarch::{RaymarchUniforms, RaymarchVariant};
 
@@ -18,7 +18,6 @@ pub fn raymarch_unwarp(
         &variant.sampling_knobs(),
         [m.sizes[0], m.sizes[1]],
         depth,
-        &EpipolarCamera::of_raymarch(m, variant.light),
         samples,
     )
 }

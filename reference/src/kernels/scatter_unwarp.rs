@@ -2,7 +2,7 @@
 //! scatter family (`scatter_reference::kernels::common_sampling::epipolar_unwarp`): every pixel
 //! gathered from the samples, or listed for `scatter_fallback`.
 
-use super::common_sampling::{EpipolarCamera, EpipolarUnwarp, epipolar_unwarp};
+use super::common_sampling::{EpipolarUnwarp, epipolar_unwarp};
 use super::scatter::ScatterInputs;
 use super::texture::TexArray;
 use scatter_shaderlib::prefiltered::PrefilteredVariant;
@@ -18,7 +18,6 @@ pub fn scatter_unwarp(
         &variant.sampling_knobs(),
         [inp.frame.sizes[0], inp.frame.sizes[1]],
         inp.depth,
-        &EpipolarCamera::of_frame(inp.frame),
         samples,
     )
 }

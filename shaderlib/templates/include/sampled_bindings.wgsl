@@ -11,6 +11,7 @@ const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 // depth and light breaks (fractions).
 const SLICES: u32 = {{ sampling.slices }}u;
 const SLICE_SAMPLES: u32 = {{ sampling.slice_samples }}u;
+const SLICE_LANES: u32 = {{ sampling.slice_lanes }}u;
 const STEP: u32 = {{ sampling.step }}u;
 const DEPTH_BREAK: f32 = {{ sampling.depth_break }};
 const LIGHT_BREAK: f32 = {{ sampling.light_break }};

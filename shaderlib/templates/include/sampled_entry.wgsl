@@ -106,11 +106,15 @@ fn line_spread_over(ab: vec2<u32>) -> bool {
 // STEP-th sample, the last, and both samples on either side of a depth break; evaluate the
 // marked ones (rounded to f16 as a per-pixel pass stores them); then evaluate every sample
 // between two marked ones that differ by more than LIGHT_BREAK; and interpolate the rest
-// between the marked samples around them. Writes `output` ((SLICE_SAMPLES + 1) x SLICES,
+// between the marked samples around them. Writes `output` ((SLICE_SAMPLES + 1) x (SLICES + 1),
 // rgba32float: radiance and the sample pixel's depth in w; the last column holds the
-// slice's line: direction xy, first distance z, distance between samples w), and zeroes
-// `fallback_count` for the unwarp. Dispatch: (SLICES, 1, 1) workgroups of (64, 1, 1).
-@compute @workgroup_size(64, 1, 1)
+// slice's line: direction xy, first distance z, distance between samples w; the last row's
+// first two texels the layout: origin, axis; first angle, angle per slice, wrap), and
+// zeroes `fallback_count` for the unwarp. Dispatch: (SLICES, 1, 1) workgroups of (SLICE_LANES, 1,
+// 1): 32, not 64, because llvmpipe runs a loop's body at least once for every 8-lane batch
+// (under an empty mask when the list is shorter than the batch), and a slice lists 32-40
+// samples to evaluate at the default step.
+@compute @workgroup_size({{ sampling.slice_lanes }}, 1, 1)
 fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
     let lines = epipolar_layout({{ sampling.camera }}, screen, SLICES);
@@ -121,16 +125,19 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
         // The slice's line, for the unwarp.
         textureStore(output, vec2<u32>(SLICE_SAMPLES, s), vec4<f32>(u.x, u.y, span.x, span.y));
         if s == 0u {
-            // An empty fallback list for the unwarp (no host clear).
+            // An empty fallback list for the unwarp (no host clear), and the layout in the
+            // last row, so that the unwarp loads it instead of computing it per pixel.
             atomicStore(&fallback_count, 0u);
+            textureStore(output, vec2<u32>(0u, SLICES), vec4<f32>(lines.origin, lines.axis));
+            textureStore(output, vec2<u32>(1u, SLICES), vec4<f32>(lines.phi_start, lines.dphi, f32(lines.wrap), 0.0));
         }
     }
-    for (var k = li; k < SLICE_SAMPLES; k += 64u) {
+    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
         let p = slice_sample_pixel(lines, u, span, k, screen);
         line_depth[k] = textureLoad(depth, p, 0).x;
     }
     workgroupBarrier();
-    for (var k = li; k < SLICE_SAMPLES; k += 64u) {
+    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
         var marked = k % STEP == 0u || k == SLICE_SAMPLES - 1u;
         if k > 0u && !depth_close(line_depth[k - 1u], line_depth[k], DEPTH_BREAK) {
             marked = true;
@@ -145,26 +152,26 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
     }
     workgroupBarrier();
     let n = atomicLoad(&line_count);
-    for (var e = li; e < n; e += 64u) {
+    for (var e = li; e < n; e += SLICE_LANES) {
         let k = line_list[e];
         let p = slice_sample_pixel(lines, u, span, k, screen);
         line_light[k] = round_f16({{ sampling.pixel }}(p.x, p.y));
     }
     workgroupBarrier();
-    for (var k = li; k < SLICE_SAMPLES; k += 64u) {
+    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
         if line_flag[k] == 0u && line_spread_over(line_bracket(k)) {
             line_list[atomicAdd(&line_count_light, 1u)] = k;
         }
     }
     workgroupBarrier();
     let n2 = atomicLoad(&line_count_light);
-    for (var e = li; e < n2; e += 64u) {
+    for (var e = li; e < n2; e += SLICE_LANES) {
         let k = line_list[e];
         let p = slice_sample_pixel(lines, u, span, k, screen);
         line_light[k] = round_f16({{ sampling.pixel }}(p.x, p.y));
     }
     workgroupBarrier();
-    for (var k = li; k < SLICE_SAMPLES; k += 64u) {
+    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
         var c = line_light[k];
         if line_flag[k] == 0u {
             let ab = line_bracket(k);
@@ -195,7 +202,10 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
     if q.x >= screen.x || q.y >= screen.y {
         return;
     }
-    let lines = epipolar_layout({{ sampling.camera }}, screen, SLICES);
+    // The layout the samples pass computed (the last row of `epipolar_samples`).
+    let head = textureLoad(epipolar_samples, vec2<u32>(0u, SLICES), 0);
+    let angles = textureLoad(epipolar_samples, vec2<u32>(1u, SLICES), 0);
+    let lines = EpipolarLayout(head.xy, head.zw, angles.x, angles.y, u32(angles.z));
     let pair = epipolar_slices(lines, q, SLICES);
     let line_lo = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, pair.slices.x), 0);
     let line_hi = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, pair.slices.y), 0);
