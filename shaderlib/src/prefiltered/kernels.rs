@@ -72,55 +72,56 @@ struct PrefilterTemplate {
     moment_count: u32,
 }
 
-/// `scatter`: per-pixel prefiltered estimate plus the epipole ray march.
-#[derive(Template)]
-#[template(path = "scatter.wgsl")]
-struct ScatterTemplate {
-    light_name: &'static str,
-    visibility_name: &'static str,
-    spot: bool,
-    bases: u32,
-    layers: u32,
-    regions: u32,
-    rectification_name: &'static str,
-    projective: bool,
-    moments: bool,
-    moment_count: u32,
-    sampling: SamplingView,
+/// The askama views of `scatter.wgsl` and of the two epipolar passes that render it with
+/// another sampling entry point (`scatter_unwarp.wgsl`, `scatter_fallback.wgsl`): the same
+/// fields, one struct per template path.
+macro_rules! scatter_templates {
+    ($($(#[$doc:meta])* $name:ident($path:literal);)*) => {$(
+        $(#[$doc])*
+        #[derive(Template)]
+        #[template(path = $path)]
+        struct $name {
+            light_name: &'static str,
+            visibility_name: &'static str,
+            spot: bool,
+            bases: u32,
+            layers: u32,
+            regions: u32,
+            rectification_name: &'static str,
+            projective: bool,
+            moments: bool,
+            moment_count: u32,
+            sampling: SamplingView,
+        }
+
+        impl $name {
+            /// The view of `variant` for `kernel` (`scatter` or one of its epipolar passes).
+            fn of(variant: &PrefilteredVariant, kernel: Kernel) -> Self {
+                Self {
+                    light_name: variant.light.name(),
+                    visibility_name: variant.visibility.name(),
+                    spot: variant.light == LightKind::Spot,
+                    bases: variant.bases,
+                    layers: variant.layers(),
+                    regions: variant.regions,
+                    rectification_name: variant.rectification.name(),
+                    projective: variant.rectification == Rectification::Projective,
+                    moments: variant.basis == Basis::Moments,
+                    moment_count: variant.moments,
+                    sampling: scatter_sampling_view(variant, kernel),
+                }
+            }
+        }
+    )*};
 }
 
-/// `scatter_unwarp`: `scatter.wgsl` rendered as the epipolar unwarp.
-#[derive(Template)]
-#[template(path = "scatter_unwarp.wgsl")]
-struct ScatterUnwarpTemplate {
-    light_name: &'static str,
-    visibility_name: &'static str,
-    spot: bool,
-    bases: u32,
-    layers: u32,
-    regions: u32,
-    rectification_name: &'static str,
-    projective: bool,
-    moments: bool,
-    moment_count: u32,
-    sampling: SamplingView,
-}
-
-/// `scatter_fallback`: `scatter.wgsl` rendered as the epipolar fallback.
-#[derive(Template)]
-#[template(path = "scatter_fallback.wgsl")]
-struct ScatterFallbackTemplate {
-    light_name: &'static str,
-    visibility_name: &'static str,
-    spot: bool,
-    bases: u32,
-    layers: u32,
-    regions: u32,
-    rectification_name: &'static str,
-    projective: bool,
-    moments: bool,
-    moment_count: u32,
-    sampling: SamplingView,
+scatter_templates! {
+    /// `scatter`: per-pixel prefiltered estimate plus the epipole ray march.
+    ScatterTemplate("scatter.wgsl");
+    /// `scatter_unwarp`: `scatter.wgsl` rendered as the epipolar unwarp.
+    ScatterUnwarpTemplate("scatter_unwarp.wgsl");
+    /// `scatter_fallback`: `scatter.wgsl` rendered as the epipolar fallback.
+    ScatterFallbackTemplate("scatter_fallback.wgsl");
 }
 
 /// Checks `variant` on behalf of `kernel`.
@@ -196,21 +197,9 @@ pub(crate) fn render_prefilter(variant: &PrefilteredVariant) -> Result<String, S
 /// matter).
 pub(crate) fn render_scatter(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
     validate(Kernel::Scatter, variant)?;
-    ScatterTemplate {
-        light_name: variant.light.name(),
-        visibility_name: variant.visibility.name(),
-        spot: variant.light == LightKind::Spot,
-        bases: variant.bases,
-        layers: variant.layers(),
-        regions: variant.regions,
-        rectification_name: variant.rectification.name(),
-        projective: variant.rectification == Rectification::Projective,
-        moments: variant.basis == Basis::Moments,
-        moment_count: variant.moments,
-        sampling: scatter_sampling_view(variant, Kernel::Scatter),
-    }
-    .render()
-    .map_err(render_error(Kernel::Scatter))
+    ScatterTemplate::of(variant, Kernel::Scatter)
+        .render()
+        .map_err(render_error(Kernel::Scatter))
 }
 
 /// The sampling view of `kernel` (`scatter`, `scatter_unwarp` or `scatter_fallback`) for
@@ -230,21 +219,9 @@ fn scatter_sampling_view(variant: &PrefilteredVariant, kernel: Kernel) -> Sampli
 pub(crate) fn render_scatter_unwarp(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
     validate(Kernel::ScatterUnwarp, variant)?;
     unwarp_only(Kernel::ScatterUnwarp, variant.sampling)?;
-    ScatterUnwarpTemplate {
-        light_name: variant.light.name(),
-        visibility_name: variant.visibility.name(),
-        spot: variant.light == LightKind::Spot,
-        bases: variant.bases,
-        layers: variant.layers(),
-        regions: variant.regions,
-        rectification_name: variant.rectification.name(),
-        projective: variant.rectification == Rectification::Projective,
-        moments: variant.basis == Basis::Moments,
-        moment_count: variant.moments,
-        sampling: scatter_sampling_view(variant, Kernel::ScatterUnwarp),
-    }
-    .render()
-    .map_err(render_error(Kernel::ScatterUnwarp))
+    ScatterUnwarpTemplate::of(variant, Kernel::ScatterUnwarp)
+        .render()
+        .map_err(render_error(Kernel::ScatterUnwarp))
 }
 
 /// Renders `templates/scatter_fallback.wgsl` for an `epipolar` variant (an error for the
@@ -252,19 +229,7 @@ pub(crate) fn render_scatter_unwarp(variant: &PrefilteredVariant) -> Result<Stri
 pub(crate) fn render_scatter_fallback(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
     validate(Kernel::ScatterFallback, variant)?;
     unwarp_only(Kernel::ScatterFallback, variant.sampling)?;
-    ScatterFallbackTemplate {
-        light_name: variant.light.name(),
-        visibility_name: variant.visibility.name(),
-        spot: variant.light == LightKind::Spot,
-        bases: variant.bases,
-        layers: variant.layers(),
-        regions: variant.regions,
-        rectification_name: variant.rectification.name(),
-        projective: variant.rectification == Rectification::Projective,
-        moments: variant.basis == Basis::Moments,
-        moment_count: variant.moments,
-        sampling: scatter_sampling_view(variant, Kernel::ScatterFallback),
-    }
-    .render()
-    .map_err(render_error(Kernel::ScatterFallback))
+    ScatterFallbackTemplate::of(variant, Kernel::ScatterFallback)
+        .render()
+        .map_err(render_error(Kernel::ScatterFallback))
 }
