@@ -271,16 +271,8 @@ impl Minmax {
             rectify,
             build,
             march,
-            unwarp: if self.epipolar() {
-                unwarp
-            } else {
-                Duration::ZERO
-            },
-            fallback: if self.epipolar() {
-                fallback
-            } else {
-                Duration::ZERO
-            },
+            unwarp: crate::timer::when(self.epipolar(), unwarp),
+            fallback: crate::timer::when(self.epipolar(), fallback),
         })
     }
 

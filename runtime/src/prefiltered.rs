@@ -389,16 +389,8 @@ impl Prefiltered {
             rectify,
             prefilter,
             scatter,
-            unwarp: if self.epipolar() {
-                unwarp
-            } else {
-                Duration::ZERO
-            },
-            fallback: if self.epipolar() {
-                fallback
-            } else {
-                Duration::ZERO
-            },
+            unwarp: crate::timer::when(self.epipolar(), unwarp),
+            fallback: crate::timer::when(self.epipolar(), fallback),
         })
     }
 

@@ -253,16 +253,8 @@ impl Raymarch {
             } else {
                 Duration::ZERO
             },
-            unwarp: if self.epipolar() {
-                unwarp
-            } else {
-                Duration::ZERO
-            },
-            fallback: if self.epipolar() {
-                fallback
-            } else {
-                Duration::ZERO
-            },
+            unwarp: crate::timer::when(self.epipolar(), unwarp),
+            fallback: crate::timer::when(self.epipolar(), fallback),
         })
     }
 
@@ -318,16 +310,11 @@ impl Raymarch {
             } else {
                 Duration::ZERO
             },
-            unwarp: if self.epipolar() {
-                times.get(1).copied().unwrap_or_default()
-            } else {
-                Duration::ZERO
-            },
-            fallback: if self.epipolar() {
-                times.get(2).copied().unwrap_or_default()
-            } else {
-                Duration::ZERO
-            },
+            unwarp: crate::timer::when(self.epipolar(), times.get(1).copied().unwrap_or_default()),
+            fallback: crate::timer::when(
+                self.epipolar(),
+                times.get(2).copied().unwrap_or_default(),
+            ),
         }))
     }
 

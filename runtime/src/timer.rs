@@ -206,3 +206,9 @@ pub(crate) fn median_pass_wall_times<const N: usize>(
         v.get(v.len() / 2).copied().unwrap_or_default()
     }))
 }
+
+/// `d` when `cond` holds (the pass ran), else zero: the time of a pass only some variants
+/// have (the epipolar `_unwarp` and `_fallback` passes).
+pub(crate) fn when(cond: bool, d: Duration) -> Duration {
+    if cond { d } else { Duration::ZERO }
+}
