@@ -443,14 +443,17 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     var local_8: bool;
     var yc: f32;
     var d: f32;
-    var xs: f32;
-    var delta_1: f32 = 1f;
+    var xs: f32 = 0f;
+    var reach: f32 = 0f;
     var theta_2: f32 = 0f;
     var coeffs: array<vec4<f32>, 4>;
     var angle: vec2<f32>;
     var layer_1: u32 = 0u;
     var total: f32 = 0f;
-    var r_1: u32 = 0u;
+    var side: u32 = 0u;
+    var delta_1: f32;
+    var row_total: f32;
+    var r_1: u32;
     var local_9: bool;
     var a_6: f32;
     var b_6: f32;
@@ -461,9 +464,9 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
 
     let f_9 = frame;
     let eye_6 = f_9.eye.xyz;
-    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
-    let _e13 = textureLoad(depth, vec2<u32>(x_3, y_1), 0i);
-    let s_2 = (min(max(_e13.x, 0f), f_9.theta.z) / max(dot(_e9, f_9.cam_forward.xyz), 0.000001f));
+    let _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    let _e12 = textureLoad(depth, vec2<u32>(x_3, y_1), 0i);
+    let s_2 = (min(max(_e12.x, 0f), f_9.theta.z) / max(dot(_e8, f_9.cam_forward.xyz), 0.000001f));
     let color = f_9.light_color.xyz;
     let px = vec3<f32>((f32(x_3) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_9.epipole.w;
@@ -484,11 +487,11 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     } else {
         local_8 = true;
     }
-    let _e76 = local_8;
-    if _e76 {
-        let _e78 = frame;
-        let _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_6, _e9, s_2, true);
-        let l_1 = (_e81 * color);
+    let _e75 = local_8;
+    if _e75 {
+        let _e77 = frame;
+        let _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, shadow_map, eye_6, _e8, s_2, true);
+        let l_1 = (_e80 * color);
         return l_1;
     }
     let axis = f_9.axis.xyz;
@@ -496,199 +499,211 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     let width_1 = f_9.sizes.z;
     let wrap_1 = (f_9.anti_epipole.w > 0.5f);
     {
-        theta_2 = acos(clamp(dot(_e9, axis), -1f, 1f));
-        let phi_1 = atan2(dot(_e9, f_9.e2_.xyz), dot(_e9, f_9.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e8, axis), -1f, 1f));
+        let phi_1 = atan2(dot(_e8, f_9.e2_.xyz), dot(_e8, f_9.e1_.xyz));
         yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
         if wrap_1 {
+            let _e112 = yc;
             let _e113 = yc;
-            let _e114 = yc;
-            yc = (_e113 - (floor((_e114 / f32(rows_1))) * f32(rows_1)));
+            yc = (_e112 - (floor((_e113 / f32(rows_1))) * f32(rows_1)));
         } else {
-            let _e121 = yc;
-            yc = clamp(_e121, 0f, f32(rows_1));
+            let _e120 = yc;
+            yc = clamp(_e120, 0f, f32(rows_1));
         }
-        let _e125 = yc;
-        let yy = (_e125 - 0.5f);
-        let j0_ = floor(yy);
-        let fy = (yy - j0_);
-        let _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        let _e133 = slices[_e130];
-        let _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
-        let _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1f), rows_1, wrap_1);
-        let _e140 = slices[_e137];
-        let _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
-        delta_1 = mix(_e134.delta, _e141.delta, fy);
-        let _e146 = theta_2;
-        let _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_9.theta.x, f_9.theta.y);
-        d = _e151;
+        let _e124 = theta_2;
+        let _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_9.theta.x, f_9.theta.y);
+        d = _e129;
         if true {
-            let q_2 = normalize(((eye_6 + (_e9 * s_2)) - f_9.light_pos.xyz));
-            let _e165 = delta_1;
-            xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / _e165);
+            let q_2 = normalize(((eye_6 + (_e8 * s_2)) - f_9.light_pos.xyz));
+            reach = acos(clamp(dot(q_2, -(axis)), -1f, 1f));
         } else {
-            let _e168 = theta_2;
-            let _e171 = delta_1;
-            xs = ((s_2 * sin(_e168)) / _e171);
+            let _e144 = theta_2;
+            reach = (s_2 * sin(_e144));
         }
     }
-    let _e173 = yc;
-    let yb = (_e173 - 0.5f);
-    let fy_1 = (yb - floor(yb));
-    let _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    let _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
-    let row1_ = select(_e179, _e183, (yb > floor(yb)));
-    let cos_theta_l = -(dot(f_9.light_dir.xyz, _e9));
+    let _e147 = yc;
+    let yb = (_e147 - 0.5f);
+    let fy = (yb - floor(yb));
+    let _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    let _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
+    let row1_ = select(_e153, _e157, (yb > floor(yb)));
+    let row_count = select(1u, 2u, (row1_ != _e153));
+    let cos_theta_l = -(dot(f_9.light_dir.xyz, _e8));
     let panels_2 = max((f_9.sizes2_.z / 4u), 1u);
-    let _e198 = d;
-    let _e202 = d;
-    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e198)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e202)));
-    let _e207 = angle;
-    let _e208 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e207);
+    let _e176 = d;
+    let _e180 = d;
+    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e176)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e180)));
+    let _e185 = angle;
+    let _e186 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e185);
     loop {
-        let _e210 = layer_1;
-        if (_e210 < LAYERS) {
+        let _e188 = layer_1;
+        if (_e188 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e213 = angle;
-            let _e214 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e213, _e208);
-            let _e216 = layer_1;
-            let _e218 = angle;
-            let _e219 = layer_1;
-            let _e220 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, _e214, _e219);
-            coeffs[_e216] = _e220;
-            let _e221 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e214, _e208);
-            angle = _e221;
+            let _e191 = angle;
+            let _e192 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e191, _e186);
+            let _e194 = layer_1;
+            let _e196 = angle;
+            let _e197 = layer_1;
+            let _e198 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e196, _e192, _e197);
+            coeffs[_e194] = _e198;
+            let _e199 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e192, _e186);
+            angle = _e199;
         }
         continuing {
-            let _e223 = layer_1;
-            layer_1 = (_e223 + 1u);
+            let _e201 = layer_1;
+            layer_1 = (_e201 + 1u);
         }
     }
-    let _e229 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    let sun_scatter = (f_9.medium.y * _e229);
-    let _e231 = xs;
-    let last = u32(min(max(_e231, 0f), (f32(width_1) - 1f)));
+    let _e207 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    let sun_scatter = (f_9.medium.y * _e207);
     loop {
-        let _e241 = r_1;
-        if (_e241 < REGIONS) {
+        let _e210 = side;
+        if (_e210 < row_count) {
         } else {
             break;
         }
         {
-            let _e243 = r_1;
-            let _e244 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e243, REGIONS, width_1, true);
-            let b0_ = f32(_e244);
-            let _e246 = r_1;
-            let _e249 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e246 + 1u), REGIONS, width_1, true);
-            let b1_ = f32(_e249);
-            if !((last < u32(b1_))) {
-                let _e254 = r_1;
-                local_9 = ((_e254 + 1u) == REGIONS);
-            } else {
-                local_9 = true;
+            let _e212 = side;
+            let row_1 = select(_e153, row1_, (_e212 == 1u));
+            let _e222 = side;
+            let row_weight = select(select((1f - fy), 1f, (row_count == 1u)), fy, (_e222 == 1u));
+            delta_1 = 1f;
+            {
+                let _e230 = slices[row_1];
+                let _e231 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e230);
+                delta_1 = _e231.delta;
+                let _e233 = reach;
+                let _e234 = delta_1;
+                xs = (_e233 / _e234);
             }
-            let is_last = local_9;
-            let _e264 = xs;
-            let pos = select((b1_ - 0.5f), clamp((_e264 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
-            a_6 = f32();
-            b_6 = f32();
-            let _e277 = delta_1;
-            let _e278 = theta_2;
-            let _e279 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e277, _e278, s_2, true);
-            a_6 = _e279;
-            let _e280 = delta_1;
-            let _e281 = theta_2;
-            let _e282 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e280, _e281, s_2, true);
-            b_6 = select(_e282, s_2, is_last);
-            weight = f32();
-            if true {
-                let _e286 = a_6;
-                let _e287 = b_6;
-                let _e288 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e9, _e286, _e287, panels_2);
-                weight = _e288;
-            } else {
-                let _e291 = a_6;
-                let _e292 = b_6;
-                let _e293 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e291, _e292);
-                weight = (sun_scatter * _e293);
-            }
-            let xb = (pos - 0.5f);
-            let fx = (xb - floor(xb));
-            let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
-            let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
-            let bounds0_ = textureLoad(bounds, vec2<u32>(x1_, _e179), 0i);
-            let bounds1_ = textureLoad(bounds, vec2<u32>(x1_, row1_), 0i);
-            let lo_1 = min(bounds0_.x, bounds1_.x);
-            let hi_1 = max(bounds0_.y, bounds1_.y);
-            vis = 0.5f;
-            let _e330 = d;
-            if (_e330 <= lo_1) {
-                vis = 1f;
-            } else {
-                let _e333 = d;
-                if (_e333 > hi_1) {
-                    vis = 0f;
+            let _e237 = xs;
+            let last = u32(min(max(_e237, 0f), (f32(width_1) - 1f)));
+            row_total = 0f;
+            r_1 = 0u;
+            loop {
+                let _e250 = r_1;
+                if (_e250 < REGIONS) {
                 } else {
-                    layer_2 = 0u;
-                    loop {
-                        let _e338 = layer_2;
-                        if (_e338 < LAYERS) {
+                    break;
+                }
+                {
+                    let _e252 = r_1;
+                    let _e253 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e252, REGIONS, width_1, true);
+                    let b0_ = f32(_e253);
+                    let _e255 = r_1;
+                    let _e258 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e255 + 1u), REGIONS, width_1, true);
+                    let b1_ = f32(_e258);
+                    if !((last < u32(b1_))) {
+                        let _e263 = r_1;
+                        local_9 = ((_e263 + 1u) == REGIONS);
+                    } else {
+                        local_9 = true;
+                    }
+                    let is_last = local_9;
+                    let _e273 = xs;
+                    let pos = select((b1_ - 0.5f), clamp((_e273 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
+                    a_6 = f32();
+                    b_6 = f32();
+                    let _e286 = delta_1;
+                    let _e287 = theta_2;
+                    let _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e286, _e287, s_2, true);
+                    a_6 = _e288;
+                    let _e289 = delta_1;
+                    let _e290 = theta_2;
+                    let _e291 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e289, _e290, s_2, true);
+                    b_6 = select(_e291, s_2, is_last);
+                    weight = f32();
+                    if true {
+                        let _e295 = a_6;
+                        let _e296 = b_6;
+                        let _e297 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e8, _e295, _e296, panels_2);
+                        weight = _e297;
+                    } else {
+                        let _e300 = a_6;
+                        let _e301 = b_6;
+                        let _e302 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e300, _e301);
+                        weight = (sun_scatter * _e302);
+                    }
+                    let xb = (pos - 0.5f);
+                    let fx = (xb - floor(xb));
+                    let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
+                    let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
+                    let lohi = textureLoad(bounds, vec2<u32>(x1_, row_1), 0i);
+                    let lo_1 = lohi.x;
+                    let hi_1 = lohi.y;
+                    vis = 0.5f;
+                    let _e331 = d;
+                    if (_e331 <= lo_1) {
+                        vis = 1f;
+                    } else {
+                        let _e334 = d;
+                        if (_e334 > hi_1) {
+                            vis = 0f;
                         } else {
-                            break;
-                        }
-                        {
-                            let _e341 = layer_2;
-                            let coeff = coeffs[_e341];
-                            let _e345 = layer_2;
-                            let _e348 = textureLoad(filtered, vec2<u32>(x0_, _e179), _e345, 0i);
-                            let _e350 = layer_2;
-                            let _e353 = textureLoad(filtered, vec2<u32>(x1_, _e179), _e350, 0i);
-                            let top = mix(_e348, _e353, fx);
-                            let _e356 = layer_2;
-                            let _e359 = textureLoad(filtered, vec2<u32>(x0_, row1_), _e356, 0i);
-                            let _e361 = layer_2;
-                            let _e364 = textureLoad(filtered, vec2<u32>(x1_, row1_), _e361, 0i);
-                            let bottom = mix(_e359, _e364, fx);
-                            let texel_1 = mix(top, bottom, fy_1);
-                            k_3 = 0u;
+                            layer_2 = 0u;
                             loop {
-                                let _e369 = k_3;
-                                if (_e369 < 4u) {
+                                let _e339 = layer_2;
+                                if (_e339 < LAYERS) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    let _e372 = vis;
-                                    let _e373 = k_3;
-                                    let _e375 = k_3;
-                                    vis = (_e372 + (coeff[_e373] * ((texel_1[_e375] * 2f) - 1f)));
+                                    let _e342 = layer_2;
+                                    let coeff = coeffs[_e342];
+                                    let _e346 = layer_2;
+                                    let _e349 = textureLoad(filtered, vec2<u32>(x0_, row_1), _e346, 0i);
+                                    let _e351 = layer_2;
+                                    let _e354 = textureLoad(filtered, vec2<u32>(x1_, row_1), _e351, 0i);
+                                    let texel_1 = mix(_e349, _e354, fx);
+                                    k_3 = 0u;
+                                    loop {
+                                        let _e358 = k_3;
+                                        if (_e358 < 4u) {
+                                        } else {
+                                            break;
+                                        }
+                                        {
+                                            let _e361 = vis;
+                                            let _e362 = k_3;
+                                            let _e364 = k_3;
+                                            vis = (_e361 + (coeff[_e362] * ((texel_1[_e364] * 2f) - 1f)));
+                                        }
+                                        continuing {
+                                            let _e373 = k_3;
+                                            k_3 = (_e373 + 1u);
+                                        }
+                                    }
                                 }
                                 continuing {
-                                    let _e384 = k_3;
-                                    k_3 = (_e384 + 1u);
+                                    let _e376 = layer_2;
+                                    layer_2 = (_e376 + 1u);
                                 }
                             }
                         }
-                        continuing {
-                            let _e387 = layer_2;
-                            layer_2 = (_e387 + 1u);
-                        }
                     }
+                    let _e378 = row_total;
+                    let _e379 = weight;
+                    let _e380 = vis;
+                    row_total = (_e378 + (_e379 * clamp(_e380, 0f, 1f)));
+                    if is_last {
+                        break;
+                    }
+                }
+                continuing {
+                    let _e387 = r_1;
+                    r_1 = (_e387 + 1u);
                 }
             }
             let _e390 = total;
-            let _e391 = weight;
-            let _e392 = vis;
-            total = (_e390 + (_e391 * clamp(_e392, 0f, 1f)));
-            if is_last {
-                break;
-            }
+            let _e391 = row_total;
+            total = (_e390 + (row_weight * _e391));
         }
         continuing {
-            let _e399 = r_1;
-            r_1 = (_e399 + 1u);
+            let _e395 = side;
+            side = (_e395 + 1u);
         }
     }
     let l_2 = total;

@@ -446,12 +446,15 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     float yc = 0.0;
     float d = 0.0;
     float xs = 0.0;
-    float delta_1 = 1.0;
+    float reach = 0.0;
     float theta_2 = 0.0;
     vec4 coeffs[8] = vec4[8](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
     vec2 angle = vec2(0.0);
     uint layer_1 = 0u;
     float total = 0.0;
+    uint side = 0u;
+    float delta_1 = 0.0;
+    float row_total = 0.0;
     uint r_1 = 0u;
     bool local_9 = false;
     float a_6 = 0.0;
@@ -462,10 +465,10 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     uint k_3 = 0u;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = _group_0_binding_0_cs;
     vec3 eye_6 = f_9.eye.xyz;
-    vec3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
-    int _e13_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e13 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_3, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e13_clamped_lod) - ivec2(1)), _e13_clamped_lod);
-    float s_2 = (min(max(_e13.x, 0.0), f_9.theta.z) / max(dot(_e9, f_9.cam_forward.xyz), 1e-6));
+    vec3 _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    int _e12_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+    vec4 _e12 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_3, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e12_clamped_lod) - ivec2(1)), _e12_clamped_lod);
+    float s_2 = (min(max(_e12.x, 0.0), f_9.theta.z) / max(dot(_e8, f_9.cam_forward.xyz), 1e-6));
     vec3 color = f_9.light_color.xyz;
     vec3 px = vec3((float(x_3) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_9.epipole.w;
@@ -486,11 +489,11 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     } else {
         local_8 = true;
     }
-    bool _e76 = local_8;
-    if (_e76) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = _group_0_binding_0_cs;
-        float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, _group_0_binding_3_cs, eye_6, _e9, s_2, false);
-        vec3 l_1 = (_e81 * color);
+    bool _e75 = local_8;
+    if (_e75) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e77 = _group_0_binding_0_cs;
+        float _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, _group_0_binding_3_cs, eye_6, _e8, s_2, false);
+        vec3 l_1 = (_e80 * color);
         return l_1;
     }
     vec3 axis = f_9.axis.xyz;
@@ -498,213 +501,224 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     uint width_1 = f_9.sizes.z;
     bool wrap_1 = (f_9.anti_epipole.w > 0.5);
     {
-        theta_2 = acos(clamp(dot(_e9, axis), -1.0, 1.0));
-        float phi_1 = atan(dot(_e9, f_9.e2_.xyz), dot(_e9, f_9.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e8, axis), -1.0, 1.0));
+        float phi_1 = atan(dot(_e8, f_9.e2_.xyz), dot(_e8, f_9.e1_.xyz));
         yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
         if (wrap_1) {
+            float _e112 = yc;
             float _e113 = yc;
-            float _e114 = yc;
-            yc = (_e113 - (floor((_e114 / float(rows_1))) * float(rows_1)));
+            yc = (_e112 - (floor((_e113 / float(rows_1))) * float(rows_1)));
         } else {
-            float _e121 = yc;
-            yc = clamp(_e121, 0.0, float(rows_1));
+            float _e120 = yc;
+            yc = clamp(_e120, 0.0, float(rows_1));
         }
-        float _e125 = yc;
-        float yy = (_e125 - 0.5);
-        float j0_ = floor(yy);
-        float fy = (yy - j0_);
-        uint _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        vec4 _e133 = _group_0_binding_1_cs[_e130];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
-        uint _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1.0), rows_1, wrap_1);
-        vec4 _e140 = _group_0_binding_1_cs[_e137];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
-        delta_1 = mix(_e134.delta, _e141.delta, fy);
-        float _e146 = theta_2;
-        float _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_9.theta.x, f_9.theta.y);
-        d = _e151;
+        float _e124 = theta_2;
+        float _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_9.theta.x, f_9.theta.y);
+        d = _e129;
         if (false) {
-            vec3 q_2 = normalize(((eye_6 + (_e9 * s_2)) - f_9.light_pos.xyz));
-            float _e165 = delta_1;
-            xs = (acos(clamp(dot(q_2, -(axis)), -1.0, 1.0)) / _e165);
+            vec3 q_2 = normalize(((eye_6 + (_e8 * s_2)) - f_9.light_pos.xyz));
+            reach = acos(clamp(dot(q_2, -(axis)), -1.0, 1.0));
         } else {
-            float _e168 = theta_2;
-            float _e171 = delta_1;
-            xs = ((s_2 * sin(_e168)) / _e171);
+            float _e144 = theta_2;
+            reach = (s_2 * sin(_e144));
         }
     }
-    float _e173 = yc;
-    float yb = (_e173 - 0.5);
-    float fy_1 = (yb - floor(yb));
-    uint _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    uint _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e183 : _e179);
-    float cos_theta_l = -(dot(f_9.light_dir.xyz, _e9));
+    float _e147 = yc;
+    float yb = (_e147 - 0.5);
+    float fy = (yb - floor(yb));
+    uint _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    uint _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e157 : _e153);
+    uint row_count = ((row1_ != _e153) ? 2u : 1u);
+    float cos_theta_l = -(dot(f_9.light_dir.xyz, _e8));
     uint panels_2 = max((f_9.sizes2_.z / 4u), 1u);
-    float _e198 = d;
-    float _e202 = d;
-    angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e198)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e202)));
-    vec2 _e207 = angle;
-    vec2 _e208 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e207);
+    float _e176 = d;
+    float _e180 = d;
+    angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e176)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e180)));
+    vec2 _e185 = angle;
+    vec2 _e186 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e185);
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e223 = layer_1;
-            layer_1 = (_e223 + 1u);
+            uint _e201 = layer_1;
+            layer_1 = (_e201 + 1u);
         }
         loop_init_3 = false;
-        uint _e210 = layer_1;
-        if ((_e210 < LAYERS)) {
+        uint _e188 = layer_1;
+        if ((_e188 < LAYERS)) {
         } else {
             break;
         }
         {
-            vec2 _e213 = angle;
-            vec2 _e214 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e213, _e208);
-            uint _e216 = layer_1;
-            vec2 _e218 = angle;
-            uint _e219 = layer_1;
-            vec4 _e220 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, _e214, _e219);
-            coeffs[_e216] = _e220;
-            vec2 _e221 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e214, _e208);
-            angle = _e221;
+            vec2 _e191 = angle;
+            vec2 _e192 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e191, _e186);
+            uint _e194 = layer_1;
+            vec2 _e196 = angle;
+            uint _e197 = layer_1;
+            vec4 _e198 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e196, _e192, _e197);
+            coeffs[_e194] = _e198;
+            vec2 _e199 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e192, _e186);
+            angle = _e199;
         }
     }
-    float _e229 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    float sun_scatter = (f_9.medium.y * _e229);
-    float _e231 = xs;
-    uint last = uint(min(max(_e231, 0.0), (float(width_1) - 1.0)));
+    float _e207 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    float sun_scatter = (f_9.medium.y * _e207);
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e399 = r_1;
-            r_1 = (_e399 + 1u);
+            uint _e395 = side;
+            side = (_e395 + 1u);
         }
         loop_init_4 = false;
-        uint _e241 = r_1;
-        if ((_e241 < REGIONS)) {
+        uint _e210 = side;
+        if ((_e210 < row_count)) {
         } else {
             break;
         }
         {
-            uint _e243 = r_1;
-            uint _e244 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e243, REGIONS, width_1, false);
-            float b0_ = float(_e244);
-            uint _e246 = r_1;
-            uint _e249 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e246 + 1u), REGIONS, width_1, false);
-            float b1_ = float(_e249);
-            if (!((last < uint(b1_)))) {
-                uint _e254 = r_1;
-                local_9 = ((_e254 + 1u) == REGIONS);
-            } else {
-                local_9 = true;
+            uint _e212 = side;
+            uint row_1 = ((_e212 == 1u) ? row1_ : _e153);
+            uint _e222 = side;
+            float row_weight = ((_e222 == 1u) ? fy : ((row_count == 1u) ? 1.0 : (1.0 - fy)));
+            delta_1 = 1.0;
+            {
+                vec4 _e230 = _group_0_binding_1_cs[row_1];
+                SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e231 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e230);
+                delta_1 = _e231.delta;
+                float _e233 = reach;
+                float _e234 = delta_1;
+                xs = (_e233 / _e234);
             }
-            bool is_last = local_9;
-            float _e264 = xs;
-            float pos = (is_last ? clamp((_e264 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            a_6 = 0.0;
-            b_6 = 0.0;
-            float _e277 = delta_1;
-            float _e278 = theta_2;
-            float _e279 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e277, _e278, s_2, false);
-            a_6 = _e279;
-            float _e280 = delta_1;
-            float _e281 = theta_2;
-            float _e282 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e280, _e281, s_2, false);
-            b_6 = (is_last ? s_2 : _e282);
-            weight = 0.0;
-            if (false) {
-                float _e286 = a_6;
-                float _e287 = b_6;
-                float _e288 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e9, _e286, _e287, panels_2);
-                weight = _e288;
-            } else {
-                float _e291 = a_6;
-                float _e292 = b_6;
-                float _e293 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e291, _e292);
-                weight = (sun_scatter * _e293);
-            }
-            float xb = (pos - 0.5);
-            float fx = (xb - floor(xb));
-            uint x0_ = uint(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
-            uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
-            int _e317_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 bounds0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, _e179)), ivec2(0), textureSize(_group_0_binding_6_cs, _e317_clamped_lod) - ivec2(1)), _e317_clamped_lod);
-            int _e321_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 bounds1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e321_clamped_lod) - ivec2(1)), _e321_clamped_lod);
-            float lo_1 = min(bounds0_.x, bounds1_.x);
-            float hi_1 = max(bounds0_.y, bounds1_.y);
-            vis = 0.5;
-            float _e330 = d;
-            if ((_e330 <= lo_1)) {
-                vis = 1.0;
-            } else {
-                float _e333 = d;
-                if ((_e333 > hi_1)) {
-                    vis = 0.0;
+            float _e237 = xs;
+            uint last = uint(min(max(_e237, 0.0), (float(width_1) - 1.0)));
+            row_total = 0.0;
+            r_1 = 0u;
+            bool loop_init_5 = true;
+            while(true) {
+                if (!loop_init_5) {
+                    uint _e387 = r_1;
+                    r_1 = (_e387 + 1u);
+                }
+                loop_init_5 = false;
+                uint _e250 = r_1;
+                if ((_e250 < REGIONS)) {
                 } else {
-                    layer_2 = 0u;
-                    bool loop_init_5 = true;
-                    while(true) {
-                        if (!loop_init_5) {
-                            uint _e387 = layer_2;
-                            layer_2 = (_e387 + 1u);
-                        }
-                        loop_init_5 = false;
-                        uint _e338 = layer_2;
-                        if ((_e338 < LAYERS)) {
+                    break;
+                }
+                {
+                    uint _e252 = r_1;
+                    uint _e253 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e252, REGIONS, width_1, false);
+                    float b0_ = float(_e253);
+                    uint _e255 = r_1;
+                    uint _e258 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e255 + 1u), REGIONS, width_1, false);
+                    float b1_ = float(_e258);
+                    if (!((last < uint(b1_)))) {
+                        uint _e263 = r_1;
+                        local_9 = ((_e263 + 1u) == REGIONS);
+                    } else {
+                        local_9 = true;
+                    }
+                    bool is_last = local_9;
+                    float _e273 = xs;
+                    float pos = (is_last ? clamp((_e273 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+                    a_6 = 0.0;
+                    b_6 = 0.0;
+                    float _e286 = delta_1;
+                    float _e287 = theta_2;
+                    float _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e286, _e287, s_2, false);
+                    a_6 = _e288;
+                    float _e289 = delta_1;
+                    float _e290 = theta_2;
+                    float _e291 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e289, _e290, s_2, false);
+                    b_6 = (is_last ? s_2 : _e291);
+                    weight = 0.0;
+                    if (false) {
+                        float _e295 = a_6;
+                        float _e296 = b_6;
+                        float _e297 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e8, _e295, _e296, panels_2);
+                        weight = _e297;
+                    } else {
+                        float _e300 = a_6;
+                        float _e301 = b_6;
+                        float _e302 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e300, _e301);
+                        weight = (sun_scatter * _e302);
+                    }
+                    float xb = (pos - 0.5);
+                    float fx = (xb - floor(xb));
+                    uint x0_ = uint(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
+                    uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
+                    int _e326_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+                    vec4 lohi = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, row_1)), ivec2(0), textureSize(_group_0_binding_6_cs, _e326_clamped_lod) - ivec2(1)), _e326_clamped_lod);
+                    float lo_1 = lohi.x;
+                    float hi_1 = lohi.y;
+                    vis = 0.5;
+                    float _e331 = d;
+                    if ((_e331 <= lo_1)) {
+                        vis = 1.0;
+                    } else {
+                        float _e334 = d;
+                        if ((_e334 > hi_1)) {
+                            vis = 0.0;
                         } else {
-                            break;
-                        }
-                        {
-                            uint _e341 = layer_2;
-                            vec4 coeff = coeffs[_e341];
-                            uint _e345 = layer_2;
-                            int _e348_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e348 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, _e179), _e345), ivec3(0), textureSize(_group_0_binding_4_cs, _e348_clamped_lod) - ivec3(1)), _e348_clamped_lod);
-                            uint _e350 = layer_2;
-                            int _e353_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e353 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, _e179), _e350), ivec3(0), textureSize(_group_0_binding_4_cs, _e353_clamped_lod) - ivec3(1)), _e353_clamped_lod);
-                            vec4 top = mix(_e348, _e353, fx);
-                            uint _e356 = layer_2;
-                            int _e359_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e359 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row1_), _e356), ivec3(0), textureSize(_group_0_binding_4_cs, _e359_clamped_lod) - ivec3(1)), _e359_clamped_lod);
-                            uint _e361 = layer_2;
-                            int _e364_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e364 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row1_), _e361), ivec3(0), textureSize(_group_0_binding_4_cs, _e364_clamped_lod) - ivec3(1)), _e364_clamped_lod);
-                            vec4 bottom = mix(_e359, _e364, fx);
-                            vec4 texel_1 = mix(top, bottom, fy_1);
-                            k_3 = 0u;
+                            layer_2 = 0u;
                             bool loop_init_6 = true;
                             while(true) {
                                 if (!loop_init_6) {
-                                    uint _e384 = k_3;
-                                    k_3 = (_e384 + 1u);
+                                    uint _e376 = layer_2;
+                                    layer_2 = (_e376 + 1u);
                                 }
                                 loop_init_6 = false;
-                                uint _e369 = k_3;
-                                if ((_e369 < 4u)) {
+                                uint _e339 = layer_2;
+                                if ((_e339 < LAYERS)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    float _e372 = vis;
-                                    uint _e373 = k_3;
-                                    uint _e375 = k_3;
-                                    vis = (_e372 + (coeff[_e373] * ((texel_1[_e375] * 2.0) - 1.0)));
+                                    uint _e342 = layer_2;
+                                    vec4 coeff = coeffs[_e342];
+                                    uint _e346 = layer_2;
+                                    int _e349_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                                    vec4 _e349 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row_1), _e346), ivec3(0), textureSize(_group_0_binding_4_cs, _e349_clamped_lod) - ivec3(1)), _e349_clamped_lod);
+                                    uint _e351 = layer_2;
+                                    int _e354_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                                    vec4 _e354 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row_1), _e351), ivec3(0), textureSize(_group_0_binding_4_cs, _e354_clamped_lod) - ivec3(1)), _e354_clamped_lod);
+                                    vec4 texel_1 = mix(_e349, _e354, fx);
+                                    k_3 = 0u;
+                                    bool loop_init_7 = true;
+                                    while(true) {
+                                        if (!loop_init_7) {
+                                            uint _e373 = k_3;
+                                            k_3 = (_e373 + 1u);
+                                        }
+                                        loop_init_7 = false;
+                                        uint _e358 = k_3;
+                                        if ((_e358 < 4u)) {
+                                        } else {
+                                            break;
+                                        }
+                                        {
+                                            float _e361 = vis;
+                                            uint _e362 = k_3;
+                                            uint _e364 = k_3;
+                                            vis = (_e361 + (coeff[_e362] * ((texel_1[_e364] * 2.0) - 1.0)));
+                                        }
+                                    }
                                 }
                             }
                         }
                     }
+                    float _e378 = row_total;
+                    float _e379 = weight;
+                    float _e380 = vis;
+                    row_total = (_e378 + (_e379 * clamp(_e380, 0.0, 1.0)));
+                    if (is_last) {
+                        break;
+                    }
                 }
             }
             float _e390 = total;
-            float _e391 = weight;
-            float _e392 = vis;
-            total = (_e390 + (_e391 * clamp(_e392, 0.0, 1.0)));
-            if (is_last) {
-                break;
-            }
+            float _e391 = row_total;
+            total = (_e390 + (row_weight * _e391));
         }
     }
     float l_2 = total;

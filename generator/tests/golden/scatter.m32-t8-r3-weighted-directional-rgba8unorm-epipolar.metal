@@ -612,14 +612,17 @@ metal::float3 scatter_pixel(
     bool local_8 = {};
     float yc = {};
     float d = {};
-    float xs = {};
-    float delta_1 = 1.0;
+    float xs = 0.0;
+    float reach = 0.0;
     float theta_2 = 0.0;
     type_13 coeffs = {};
     metal::float2 angle = {};
     uint layer_1 = 0u;
     float total = 0.0;
-    uint r_1 = 0u;
+    uint side = 0u;
+    float delta_1 = {};
+    float row_total = {};
+    uint r_1 = {};
     bool local_9 = {};
     float a_6 = {};
     float b_6 = {};
@@ -629,10 +632,10 @@ metal::float3 scatter_pixel(
     uint k_3 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
     metal::float3 eye_6 = f_9.eye.xyz;
-    metal::float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
-    uint clamped_lod_e13 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e13 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_1)), metal::uint2(depth.get_width(clamped_lod_e13), depth.get_height(clamped_lod_e13)) - 1), clamped_lod_e13);
-    float s_2 = metal::min(metal::max(_e13.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e9, f_9.cam_forward.xyz), 0.000001);
+    metal::float3 _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    uint clamped_lod_e12 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e12 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_1)), metal::uint2(depth.get_width(clamped_lod_e12), depth.get_height(clamped_lod_e12)) - 1), clamped_lod_e12);
+    float s_2 = metal::min(metal::max(_e12.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e8, f_9.cam_forward.xyz), 0.000001);
     metal::float3 color = f_9.light_color.xyz;
     metal::float3 px = metal::float3(static_cast<float>(x_3) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
     float radius = f_9.epipole.w;
@@ -653,11 +656,11 @@ metal::float3 scatter_pixel(
     } else {
         local_8 = true;
     }
-    bool _e76 = local_8;
-    if (_e76) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = frame;
-        float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_6, _e9, s_2, false);
-        metal::float3 l_1 = _e81 * color;
+    bool _e75 = local_8;
+    if (_e75) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e77 = frame;
+        float _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, shadow_map, eye_6, _e8, s_2, false);
+        metal::float3 l_1 = _e80 * color;
         return l_1;
     }
     metal::float3 axis = f_9.axis.xyz;
@@ -665,225 +668,239 @@ metal::float3 scatter_pixel(
     uint width_1 = f_9.sizes.z;
     bool wrap_1 = f_9.anti_epipole.w > 0.5;
     {
-        theta_2 = metal::acos(metal::clamp(metal::dot(_e9, axis), -1.0, 1.0));
-        float phi_1 = metal::atan2(metal::dot(_e9, f_9.e2_.xyz), metal::dot(_e9, f_9.e1_.xyz));
+        theta_2 = metal::acos(metal::clamp(metal::dot(_e8, axis), -1.0, 1.0));
+        float phi_1 = metal::atan2(metal::dot(_e8, f_9.e2_.xyz), metal::dot(_e8, f_9.e1_.xyz));
         yc = (phi_1 - f_9.e1_.w) / f_9.e2_.w;
         if (wrap_1) {
+            float _e112 = yc;
             float _e113 = yc;
-            float _e114 = yc;
-            yc = _e113 - (metal::floor(_e114 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+            yc = _e112 - (metal::floor(_e113 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
         } else {
-            float _e121 = yc;
-            yc = metal::clamp(_e121, 0.0, static_cast<float>(rows_1));
+            float _e120 = yc;
+            yc = metal::clamp(_e120, 0.0, static_cast<float>(rows_1));
         }
-        float _e125 = yc;
-        float yy = _e125 - 0.5;
-        float j0_ = metal::floor(yy);
-        float fy = yy - j0_;
-        uint _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        metal::float4 _e133 = slices[metal::min(unsigned(_e130), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
-        uint _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_ + 1.0, rows_1, wrap_1);
-        metal::float4 _e140 = slices[metal::min(unsigned(_e137), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
-        delta_1 = metal::mix(_e134.delta, _e141.delta, fy);
-        float _e146 = theta_2;
-        float _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_9.theta.x, f_9.theta.y);
-        d = _e151;
+        float _e124 = theta_2;
+        float _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_9.theta.x, f_9.theta.y);
+        d = _e129;
         if (false) {
-            metal::float3 q_2 = metal::normalize((eye_6 + (_e9 * s_2)) - f_9.light_pos.xyz);
-            float _e165 = delta_1;
-            xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / _e165;
+            metal::float3 q_2 = metal::normalize((eye_6 + (_e8 * s_2)) - f_9.light_pos.xyz);
+            reach = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0));
         } else {
-            float _e168 = theta_2;
-            float _e171 = delta_1;
-            xs = (s_2 * metal::sin(_e168)) / _e171;
+            float _e144 = theta_2;
+            reach = s_2 * metal::sin(_e144);
         }
     }
-    float _e173 = yc;
-    float yb = _e173 - 0.5;
-    float fy_1 = yb - metal::floor(yb);
-    uint _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
-    uint _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
-    uint row1_ = (yb > metal::floor(yb)) ? _e183 : _e179;
-    float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e9));
+    float _e147 = yc;
+    float yb = _e147 - 0.5;
+    float fy = yb - metal::floor(yb);
+    uint _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
+    uint _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
+    uint row1_ = (yb > metal::floor(yb)) ? _e157 : _e153;
+    uint row_count = (row1_ != _e153) ? 2u : 1u;
+    float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e8));
     uint panels_2 = metal::max(naga_div(f_9.sizes2_.z, 4u), 1u);
-    float _e198 = d;
-    float _e202 = d;
-    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e198), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e202));
-    metal::float2 _e207 = angle;
-    metal::float2 _e208 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e207);
+    float _e176 = d;
+    float _e180 = d;
+    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e176), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e180));
+    metal::float2 _e185 = angle;
+    metal::float2 _e186 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e185);
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e223 = layer_1;
-            layer_1 = _e223 + 1u;
+            uint _e201 = layer_1;
+            layer_1 = _e201 + 1u;
         }
         loop_init_3 = false;
-        uint _e210 = layer_1;
-        if (_e210 < LAYERS) {
+        uint _e188 = layer_1;
+        if (_e188 < LAYERS) {
         } else {
             break;
         }
         {
-            metal::float2 _e213 = angle;
-            metal::float2 _e214 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e213, _e208);
-            uint _e216 = layer_1;
-            metal::float2 _e218 = angle;
-            uint _e219 = layer_1;
-            metal::float4 _e220 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e218, _e214, _e219);
-            coeffs.inner[metal::min(unsigned(_e216), 7u)] = _e220;
-            metal::float2 _e221 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e214, _e208);
-            angle = _e221;
+            metal::float2 _e191 = angle;
+            metal::float2 _e192 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e191, _e186);
+            uint _e194 = layer_1;
+            metal::float2 _e196 = angle;
+            uint _e197 = layer_1;
+            metal::float4 _e198 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e196, _e192, _e197);
+            coeffs.inner[metal::min(unsigned(_e194), 7u)] = _e198;
+            metal::float2 _e199 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e192, _e186);
+            angle = _e199;
         }
     }
-    float _e229 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    float sun_scatter = f_9.medium.y * _e229;
-    float _e231 = xs;
-    uint last = naga_f2u32(metal::min(metal::max(_e231, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e207 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    float sun_scatter = f_9.medium.y * _e207;
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e399 = r_1;
-            r_1 = _e399 + 1u;
+            uint _e395 = side;
+            side = _e395 + 1u;
         }
         loop_init_4 = false;
-        uint _e241 = r_1;
-        if (_e241 < REGIONS) {
+        uint _e210 = side;
+        if (_e210 < row_count) {
         } else {
             break;
         }
         {
-            uint _e243 = r_1;
-            uint _e244 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e243, REGIONS, width_1, false);
-            float b0_ = static_cast<float>(_e244);
-            uint _e246 = r_1;
-            uint _e249 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e246 + 1u, REGIONS, width_1, false);
-            float b1_ = static_cast<float>(_e249);
-            if (!((last < naga_f2u32(b1_)))) {
-                uint _e254 = r_1;
-                local_9 = (_e254 + 1u) == REGIONS;
-            } else {
-                local_9 = true;
+            uint _e212 = side;
+            uint row_1 = (_e212 == 1u) ? row1_ : _e153;
+            uint _e222 = side;
+            float row_weight = (_e222 == 1u) ? fy : ((row_count == 1u) ? 1.0 : (1.0 - fy));
+            delta_1 = 1.0;
+            {
+                metal::float4 _e230 = slices[metal::min(unsigned(row_1), (_buffer_sizes.size1 - 0 - 16) / 16)];
+                SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e231 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e230);
+                delta_1 = _e231.delta;
+                float _e233 = reach;
+                float _e234 = delta_1;
+                xs = _e233 / _e234;
             }
-            bool is_last = local_9;
-            float _e264 = xs;
-            float pos = is_last ? metal::clamp(_e264 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-            a_6 = float {};
-            b_6 = float {};
-            float _e277 = delta_1;
-            float _e278 = theta_2;
-            float _e279 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e277, _e278, s_2, false);
-            a_6 = _e279;
-            float _e280 = delta_1;
-            float _e281 = theta_2;
-            float _e282 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e280, _e281, s_2, false);
-            b_6 = is_last ? s_2 : _e282;
-            weight = float {};
-            if (false) {
-                float _e286 = a_6;
-                float _e287 = b_6;
-                float _e288 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e9, _e286, _e287, panels_2);
-                weight = _e288;
-            } else {
-                float _e291 = a_6;
-                float _e292 = b_6;
-                float _e293 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e291, _e292);
-                weight = sun_scatter * _e293;
-            }
-            float xb = pos - 0.5;
-            float fx = xb - metal::floor(xb);
-            uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
-            uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
-            uint clamped_lod_e317 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 bounds0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e179)), metal::uint2(bounds.get_width(clamped_lod_e317), bounds.get_height(clamped_lod_e317)) - 1), clamped_lod_e317);
-            uint clamped_lod_e321 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 bounds1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e321), bounds.get_height(clamped_lod_e321)) - 1), clamped_lod_e321);
-            float lo_1 = metal::min(bounds0_.x, bounds1_.x);
-            float hi_1 = metal::max(bounds0_.y, bounds1_.y);
-            vis = 0.5;
-            float _e330 = d;
-            if (_e330 <= lo_1) {
-                vis = 1.0;
-            } else {
-                float _e333 = d;
-                if (_e333 > hi_1) {
-                    vis = 0.0;
+            float _e237 = xs;
+            uint last = naga_f2u32(metal::min(metal::max(_e237, 0.0), static_cast<float>(width_1) - 1.0));
+            row_total = 0.0;
+            r_1 = 0u;
+            uint2 loop_bound_5 = uint2(4294967295u);
+            bool loop_init_5 = true;
+            while(true) {
+                if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+                if (!loop_init_5) {
+                    uint _e387 = r_1;
+                    r_1 = _e387 + 1u;
+                }
+                loop_init_5 = false;
+                uint _e250 = r_1;
+                if (_e250 < REGIONS) {
                 } else {
-                    layer_2 = 0u;
-                    uint2 loop_bound_5 = uint2(4294967295u);
-                    bool loop_init_5 = true;
-                    while(true) {
-                        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-                        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-                        if (!loop_init_5) {
-                            uint _e387 = layer_2;
-                            layer_2 = _e387 + 1u;
-                        }
-                        loop_init_5 = false;
-                        uint _e338 = layer_2;
-                        if (_e338 < LAYERS) {
+                    break;
+                }
+                {
+                    uint _e252 = r_1;
+                    uint _e253 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e252, REGIONS, width_1, false);
+                    float b0_ = static_cast<float>(_e253);
+                    uint _e255 = r_1;
+                    uint _e258 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e255 + 1u, REGIONS, width_1, false);
+                    float b1_ = static_cast<float>(_e258);
+                    if (!((last < naga_f2u32(b1_)))) {
+                        uint _e263 = r_1;
+                        local_9 = (_e263 + 1u) == REGIONS;
+                    } else {
+                        local_9 = true;
+                    }
+                    bool is_last = local_9;
+                    float _e273 = xs;
+                    float pos = is_last ? metal::clamp(_e273 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+                    a_6 = float {};
+                    b_6 = float {};
+                    float _e286 = delta_1;
+                    float _e287 = theta_2;
+                    float _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e286, _e287, s_2, false);
+                    a_6 = _e288;
+                    float _e289 = delta_1;
+                    float _e290 = theta_2;
+                    float _e291 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e289, _e290, s_2, false);
+                    b_6 = is_last ? s_2 : _e291;
+                    weight = float {};
+                    if (false) {
+                        float _e295 = a_6;
+                        float _e296 = b_6;
+                        float _e297 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e8, _e295, _e296, panels_2);
+                        weight = _e297;
+                    } else {
+                        float _e300 = a_6;
+                        float _e301 = b_6;
+                        float _e302 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e300, _e301);
+                        weight = sun_scatter * _e302;
+                    }
+                    float xb = pos - 0.5;
+                    float fx = xb - metal::floor(xb);
+                    uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
+                    uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
+                    uint clamped_lod_e326 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+                    metal::float4 lohi = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row_1)), metal::uint2(bounds.get_width(clamped_lod_e326), bounds.get_height(clamped_lod_e326)) - 1), clamped_lod_e326);
+                    float lo_1 = lohi.x;
+                    float hi_1 = lohi.y;
+                    vis = 0.5;
+                    float _e331 = d;
+                    if (_e331 <= lo_1) {
+                        vis = 1.0;
+                    } else {
+                        float _e334 = d;
+                        if (_e334 > hi_1) {
+                            vis = 0.0;
                         } else {
-                            break;
-                        }
-                        {
-                            uint _e341 = layer_2;
-                            metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e341), 7u)];
-                            uint _e345 = layer_2;
-                            uint clamped_lod_e348 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e348 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e348), filtered.get_height(clamped_lod_e348)) - 1), metal::min(uint(_e345), filtered.get_array_size() - 1), clamped_lod_e348);
-                            uint _e350 = layer_2;
-                            uint clamped_lod_e353 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e353 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e353), filtered.get_height(clamped_lod_e353)) - 1), metal::min(uint(_e350), filtered.get_array_size() - 1), clamped_lod_e353);
-                            metal::float4 top = metal::mix(_e348, _e353, fx);
-                            uint _e356 = layer_2;
-                            uint clamped_lod_e359 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e359 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e359), filtered.get_height(clamped_lod_e359)) - 1), metal::min(uint(_e356), filtered.get_array_size() - 1), clamped_lod_e359);
-                            uint _e361 = layer_2;
-                            uint clamped_lod_e364 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                            metal::float4 _e364 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e364), filtered.get_height(clamped_lod_e364)) - 1), metal::min(uint(_e361), filtered.get_array_size() - 1), clamped_lod_e364);
-                            metal::float4 bottom = metal::mix(_e359, _e364, fx);
-                            metal::float4 texel_1 = metal::mix(top, bottom, fy_1);
-                            k_3 = 0u;
+                            layer_2 = 0u;
                             uint2 loop_bound_6 = uint2(4294967295u);
                             bool loop_init_6 = true;
                             while(true) {
                                 if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                                 loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                                 if (!loop_init_6) {
-                                    uint _e384 = k_3;
-                                    k_3 = _e384 + 1u;
+                                    uint _e376 = layer_2;
+                                    layer_2 = _e376 + 1u;
                                 }
                                 loop_init_6 = false;
-                                uint _e369 = k_3;
-                                if (_e369 < 4u) {
+                                uint _e339 = layer_2;
+                                if (_e339 < LAYERS) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    float _e372 = vis;
-                                    uint _e373 = k_3;
-                                    uint _e375 = k_3;
-                                    vis = _e372 + (coeff[metal::min(unsigned(_e373), 3u)] * ((texel_1[metal::min(unsigned(_e375), 3u)] * 2.0) - 1.0));
+                                    uint _e342 = layer_2;
+                                    metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e342), 7u)];
+                                    uint _e346 = layer_2;
+                                    uint clamped_lod_e349 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                                    metal::float4 _e349 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row_1)), metal::uint2(filtered.get_width(clamped_lod_e349), filtered.get_height(clamped_lod_e349)) - 1), metal::min(uint(_e346), filtered.get_array_size() - 1), clamped_lod_e349);
+                                    uint _e351 = layer_2;
+                                    uint clamped_lod_e354 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                                    metal::float4 _e354 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row_1)), metal::uint2(filtered.get_width(clamped_lod_e354), filtered.get_height(clamped_lod_e354)) - 1), metal::min(uint(_e351), filtered.get_array_size() - 1), clamped_lod_e354);
+                                    metal::float4 texel_1 = metal::mix(_e349, _e354, fx);
+                                    k_3 = 0u;
+                                    uint2 loop_bound_7 = uint2(4294967295u);
+                                    bool loop_init_7 = true;
+                                    while(true) {
+                                        if (metal::all(loop_bound_7 == uint2(0u))) { break; }
+                                        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+                                        if (!loop_init_7) {
+                                            uint _e373 = k_3;
+                                            k_3 = _e373 + 1u;
+                                        }
+                                        loop_init_7 = false;
+                                        uint _e358 = k_3;
+                                        if (_e358 < 4u) {
+                                        } else {
+                                            break;
+                                        }
+                                        {
+                                            float _e361 = vis;
+                                            uint _e362 = k_3;
+                                            uint _e364 = k_3;
+                                            vis = _e361 + (coeff[metal::min(unsigned(_e362), 3u)] * ((texel_1[metal::min(unsigned(_e364), 3u)] * 2.0) - 1.0));
+                                        }
+                                    }
                                 }
                             }
                         }
                     }
+                    float _e378 = row_total;
+                    float _e379 = weight;
+                    float _e380 = vis;
+                    row_total = _e378 + (_e379 * metal::clamp(_e380, 0.0, 1.0));
+                    if (is_last) {
+                        break;
+                    }
                 }
             }
             float _e390 = total;
-            float _e391 = weight;
-            float _e392 = vis;
-            total = _e390 + (_e391 * metal::clamp(_e392, 0.0, 1.0));
-            if (is_last) {
-                break;
-            }
+            float _e391 = row_total;
+            total = _e390 + (row_weight * _e391);
         }
     }
     float l_2 = total;

@@ -429,15 +429,13 @@ float nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float q_1) {
 }
 
 CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float c1_, float c2_, float c3_, float c4_) {
-    vec3 r = vec3(0.0);
-    uint k_2 = 0u;
     float z_1 = 0.0;
     uint i = 0u;
     if (((abs(c4_) * FAR_ROOTX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX) <= abs(c3_))) {
         float disc = max(((c2_ * c2_) - ((4.0 * c1_) * c3_)), 0.0);
-        float _e20 = sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(sqrt(disc), c2_);
-        float _e24 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX((-0.5 * (c2_ + _e20)));
-        return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec3((c1_ / _e24), (_e24 / c3_), 0.0), true);
+        float _e18 = sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(sqrt(disc), c2_);
+        float _e22 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX((-0.5 * (c2_ + _e18)));
+        return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec3((c1_ / _e22), (_e22 / c3_), 0.0), true);
     }
     float a_6 = (c3_ / c4_);
     float b_5 = (c2_ / c4_);
@@ -446,67 +444,45 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
     float qq = ((((((2.0 * a_6) * a_6) * a_6) / 27.0) - ((a_6 * b_5) / 3.0)) + c);
     float m = (2.0 * sqrt((-(p_3) / 3.0)));
     float theta_3 = (acos(clamp(((3.0 * qq) / (p_3 * m)), -1.0, 1.0)) / 3.0);
+    float greatest = ((m * cos(theta_3)) - (a_6 / 3.0));
+    float least = ((m * cos((theta_3 - 4.1887903))) - (a_6 / 3.0));
+    z_1 = ((abs(greatest) >= abs(least)) ? greatest : least);
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e121 = k_2;
-            k_2 = (_e121 + 1u);
+            uint _e111 = i;
+            i = (_e111 + 1u);
         }
         loop_init_3 = false;
-        uint _e68 = k_2;
-        if ((_e68 < 3u)) {
+        uint _e83 = i;
+        if ((_e83 < 2u)) {
         } else {
             break;
         }
         {
-            uint _e72 = k_2;
-            z_1 = ((m * cos((theta_3 - ((6.2831855 * float(_e72)) / 3.0)))) - (a_6 / 3.0));
-            i = 0u;
-            bool loop_init_4 = true;
-            while(true) {
-                if (!loop_init_4) {
-                    uint _e114 = i;
-                    i = (_e114 + 1u);
-                }
-                loop_init_4 = false;
-                uint _e86 = i;
-                if ((_e86 < 2u)) {
-                } else {
-                    break;
-                }
-                {
-                    float _e89 = z_1;
-                    float _e90 = z_1;
-                    float _e91 = z_1;
-                    float f_9 = (c1_ + (_e89 * (c2_ + (_e90 * (c3_ + (_e91 * c4_))))));
-                    float _e98 = z_1;
-                    float _e101 = z_1;
-                    float df = (c2_ + (_e98 * ((2.0 * c3_) + ((3.0 * _e101) * c4_))));
-                    if ((df != 0.0)) {
-                        float _e110 = z_1;
-                        z_1 = (_e110 - (f_9 / df));
-                    }
-                }
+            float _e86 = z_1;
+            float _e87 = z_1;
+            float _e88 = z_1;
+            float f_9 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
+            float _e95 = z_1;
+            float _e98 = z_1;
+            float df = (c2_ + (_e95 * ((2.0 * c3_) + ((3.0 * _e98) * c4_))));
+            if ((df != 0.0)) {
+                float _e107 = z_1;
+                z_1 = (_e107 - (f_9 / df));
             }
-            uint _e117 = k_2;
-            float _e119 = z_1;
-            r[_e117] = _e119;
         }
     }
-    float _e124 = r.x;
-    float _e127 = r.z;
-    if ((abs(_e124) > abs(_e127))) {
-        vec3 _e130 = r;
-        r = _e130.zyx;
-    }
-    float _e133 = r.y;
-    float _e136 = r.z;
-    if ((abs(_e133) > abs(_e136))) {
-        vec3 _e139 = r;
-        r = _e139.xzy;
-    }
-    vec3 _e141 = r;
-    return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e141, false);
+    float _e113 = z_1;
+    float _e114 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e113);
+    float q0_ = (-(c1_) / _e114);
+    float q1_ = ((q0_ - c2_) / _e114);
+    float q2_ = ((q1_ - c3_) / _e114);
+    float disc_1 = max(((q1_ * q1_) - ((4.0 * q0_) * q2_)), 0.0);
+    float _e129 = sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(sqrt(disc_1), q1_);
+    float _e133 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX((-0.5 * (q1_ + _e129)));
+    float _e135 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(q2_);
+    return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec3((q0_ / _e133), (_e133 / _e135), _e114), false);
 }
 
 float far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float x_4, float far, bool at_infinity) {
@@ -516,12 +492,12 @@ float far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float x_4, float far, boo
     return (1.0 / (x_4 - far));
 }
 
-float atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float b1_, float b2_, float b3_, float x_5, float u, float v_7, float k_3) {
+float atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float b1_, float b2_, float b3_, float x_5, float u, float v_7, float k_2) {
     float s_3 = (u + v_7);
     float p_4 = (u * v_7);
     float e2_ = ((b2_ - (b1_ * s_3)) + p_4);
     float e3_ = (((b3_ - (b2_ * (s_3 + x_5))) + (b1_ * (p_4 + (s_3 * x_5)))) - (p_4 * x_5));
-    return ((e2_ + (e3_ * k_3)) / ((x_5 - u) * (x_5 - v_7)));
+    return ((e2_ + (e3_ * k_2)) / ((x_5 - u) * (x_5 - v_7)));
 }
 
 float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw0_, vec2 raw1_, float zf) {
@@ -549,29 +525,29 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw0_, vec2 r
     float c2_1 = (((y2_ / d2_1) - (l32_ * c3_1)) - (l42_ * c4_1));
     float c1_1 = (((1.0 - (b1_1 * c2_1)) - (b2_1 * c3_1)) - (b3_1 * c4_1));
     CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX _e88 = cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_1, c2_1, c3_1, c4_1);
-    vec3 r_3 = _e88.r;
+    vec3 r_2 = _e88.r;
     bool at_infinity_1 = _e88.at_infinity;
-    if ((r_3.x < zf)) {
+    if ((r_2.x < zf)) {
         float _e94 = shadow;
-        float _e99 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.x, r_3.z, at_infinity_1);
-        float _e100 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.x, zf, r_3.y, _e99);
+        float _e99 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_2.x, r_2.z, at_infinity_1);
+        float _e100 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_2.x, zf, r_2.y, _e99);
         shadow = (_e94 + _e100);
     }
-    if ((r_3.y < zf)) {
+    if ((r_2.y < zf)) {
         float _e104 = shadow;
-        float _e109 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.y, r_3.z, at_infinity_1);
-        float _e110 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.y, zf, r_3.x, _e109);
+        float _e109 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_2.y, r_2.z, at_infinity_1);
+        float _e110 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_2.y, zf, r_2.x, _e109);
         shadow = (_e104 + _e110);
     }
     if (!(at_infinity_1)) {
-        local_6 = (r_3.z < zf);
+        local_6 = (r_2.z < zf);
     } else {
         local_6 = false;
     }
     bool _e118 = local_6;
     if (_e118) {
         float _e119 = shadow;
-        float _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.z, zf, r_3.x, (1.0 / (r_3.z - r_3.y)));
+        float _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_2.z, zf, r_2.x, (1.0 / (r_2.z - r_2.y)));
         shadow = (_e119 + _e127);
     }
     float _e129 = shadow;
@@ -586,11 +562,11 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_X
     return (f_8.e1_.w + ((float(row) + 0.5) * f_8.e2_.w));
 }
 
-uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_1, uint regions, uint width, bool spot_2) {
+uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_2) {
     if (spot_2) {
-        return ((r_1 * width) / regions);
+        return ((r * width) / regions);
     }
-    return (((r_1 * r_1) * width) / (regions * regions));
+    return (((r * r) * width) / (regions * regions));
 }
 
 vec3 scatter_pixel(uint x_6, uint y_1) {
@@ -600,10 +576,13 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     float yc = 0.0;
     float d_1 = 0.0;
     float xs = 0.0;
-    float delta_1 = 1.0;
+    float reach = 0.0;
     float theta_2 = 0.0;
     float total = 0.0;
-    uint r_2 = 0u;
+    uint side = 0u;
+    float delta_1 = 0.0;
+    float row_total = 0.0;
+    uint r_1 = 0u;
     bool local_10 = false;
     float a_5 = 0.0;
     float b_4 = 0.0;
@@ -611,10 +590,10 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     float vis = 0.0;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10 = _group_0_binding_0_cs;
     vec3 eye_6 = f_10.eye.xyz;
-    vec3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
-    int _e13_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e13 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e13_clamped_lod) - ivec2(1)), _e13_clamped_lod);
-    float s_4 = (min(max(_e13.x, 0.0), f_10.theta.z) / max(dot(_e9, f_10.cam_forward.xyz), 1e-6));
+    vec3 _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    int _e12_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+    vec4 _e12 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e12_clamped_lod) - ivec2(1)), _e12_clamped_lod);
+    float s_4 = (min(max(_e12.x, 0.0), f_10.theta.z) / max(dot(_e8, f_10.cam_forward.xyz), 1e-6));
     vec3 color = f_10.light_color.xyz;
     vec3 px = vec3((float(x_6) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_10.epipole.w;
@@ -635,11 +614,11 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     } else {
         local_9 = true;
     }
-    bool _e76 = local_9;
-    if (_e76) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = _group_0_binding_0_cs;
-        float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, _group_0_binding_3_cs, eye_6, _e9, s_4, false);
-        vec3 l_1 = (_e81 * color);
+    bool _e75 = local_9;
+    if (_e75) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e77 = _group_0_binding_0_cs;
+        float _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, _group_0_binding_3_cs, eye_6, _e8, s_4, false);
+        vec3 l_1 = (_e80 * color);
         return l_1;
     }
     vec3 axis = f_10.axis.xyz;
@@ -647,157 +626,164 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     uint width_1 = f_10.sizes.z;
     bool wrap_1 = (f_10.anti_epipole.w > 0.5);
     {
-        theta_2 = acos(clamp(dot(_e9, axis), -1.0, 1.0));
-        float phi_1 = atan(dot(_e9, f_10.e2_.xyz), dot(_e9, f_10.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e8, axis), -1.0, 1.0));
+        float phi_1 = atan(dot(_e8, f_10.e2_.xyz), dot(_e8, f_10.e1_.xyz));
         yc = ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
         if (wrap_1) {
+            float _e112 = yc;
             float _e113 = yc;
-            float _e114 = yc;
-            yc = (_e113 - (floor((_e114 / float(rows_1))) * float(rows_1)));
+            yc = (_e112 - (floor((_e113 / float(rows_1))) * float(rows_1)));
         } else {
-            float _e121 = yc;
-            yc = clamp(_e121, 0.0, float(rows_1));
+            float _e120 = yc;
+            yc = clamp(_e120, 0.0, float(rows_1));
         }
-        float _e125 = yc;
-        float yy = (_e125 - 0.5);
-        float j0_ = floor(yy);
-        float fy = (yy - j0_);
-        uint _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        vec4 _e133 = _group_0_binding_1_cs[_e130];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
-        uint _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1.0), rows_1, wrap_1);
-        vec4 _e140 = _group_0_binding_1_cs[_e137];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
-        delta_1 = mix(_e134.delta, _e141.delta, fy);
-        float _e146 = theta_2;
-        float _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_10.theta.x, f_10.theta.y);
-        d_1 = _e151;
+        float _e124 = theta_2;
+        float _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_10.theta.x, f_10.theta.y);
+        d_1 = _e129;
         if (false) {
-            vec3 q_3 = normalize(((eye_6 + (_e9 * s_4)) - f_10.light_pos.xyz));
-            float _e165 = delta_1;
-            xs = (acos(clamp(dot(q_3, -(axis)), -1.0, 1.0)) / _e165);
+            vec3 q_3 = normalize(((eye_6 + (_e8 * s_4)) - f_10.light_pos.xyz));
+            reach = acos(clamp(dot(q_3, -(axis)), -1.0, 1.0));
         } else {
-            float _e168 = theta_2;
-            float _e171 = delta_1;
-            xs = ((s_4 * sin(_e168)) / _e171);
+            float _e144 = theta_2;
+            reach = (s_4 * sin(_e144));
         }
     }
-    float _e173 = yc;
-    float yb = (_e173 - 0.5);
-    float fy_1 = (yb - floor(yb));
-    uint _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    uint _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e183 : _e179);
-    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e9));
+    float _e147 = yc;
+    float yb = (_e147 - 0.5);
+    float fy = (yb - floor(yb));
+    uint _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    uint _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e157 : _e153);
+    uint row_count = ((row1_ != _e153) ? 2u : 1u);
+    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e8));
     uint panels_2 = max((f_10.sizes2_.z / 4u), 1u);
-    float _e197 = d_1;
-    float _e198 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e197);
-    float _e203 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    float sun_scatter = (f_10.medium.y * _e203);
-    float _e205 = xs;
-    uint last = uint(min(max(_e205, 0.0), (float(width_1) - 1.0)));
-    bool loop_init_5 = true;
+    float _e175 = d_1;
+    float _e176 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e175);
+    float _e181 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+    float sun_scatter = (f_10.medium.y * _e181);
+    bool loop_init_4 = true;
     while(true) {
-        if (!loop_init_5) {
-            uint _e368 = r_2;
-            r_2 = (_e368 + 1u);
+        if (!loop_init_4) {
+            uint _e352 = side;
+            side = (_e352 + 1u);
         }
-        loop_init_5 = false;
-        uint _e215 = r_2;
-        if ((_e215 < REGIONS)) {
+        loop_init_4 = false;
+        uint _e184 = side;
+        if ((_e184 < row_count)) {
         } else {
             break;
         }
         {
-            uint _e217 = r_2;
-            uint _e218 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e217, REGIONS, width_1, false);
-            float b0_ = float(_e218);
-            uint _e220 = r_2;
-            uint _e223 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e220 + 1u), REGIONS, width_1, false);
-            float b1_2 = float(_e223);
-            if (!((last < uint(b1_2)))) {
-                uint _e228 = r_2;
-                local_10 = ((_e228 + 1u) == REGIONS);
-            } else {
-                local_10 = true;
+            uint _e186 = side;
+            uint row_1 = ((_e186 == 1u) ? row1_ : _e153);
+            uint _e196 = side;
+            float row_weight = ((_e196 == 1u) ? fy : ((row_count == 1u) ? 1.0 : (1.0 - fy)));
+            delta_1 = 1.0;
+            {
+                vec4 _e204 = _group_0_binding_1_cs[row_1];
+                SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e205 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e204);
+                delta_1 = _e205.delta;
+                float _e207 = reach;
+                float _e208 = delta_1;
+                xs = (_e207 / _e208);
             }
-            bool is_last = local_10;
-            float _e238 = xs;
-            float pos = (is_last ? clamp((_e238 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
-            a_5 = 0.0;
-            b_4 = 0.0;
-            float _e251 = delta_1;
-            float _e252 = theta_2;
-            float _e253 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e251, _e252, s_4, false);
-            a_5 = _e253;
-            float _e254 = delta_1;
-            float _e255 = theta_2;
-            float _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e254, _e255, s_4, false);
-            b_4 = (is_last ? s_4 : _e256);
-            weight = 0.0;
-            if (false) {
-                float _e260 = a_5;
-                float _e261 = b_4;
-                float _e262 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e9, _e260, _e261, panels_2);
-                weight = _e262;
-            } else {
-                float _e265 = a_5;
-                float _e266 = b_4;
-                float _e267 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e265, _e266);
-                weight = (sun_scatter * _e267);
-            }
-            float xb = (pos - 0.5);
-            float fx = (xb - floor(xb));
-            uint x0_ = uint(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
-            uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
-            int _e291_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 bounds0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, _e179)), ivec2(0), textureSize(_group_0_binding_6_cs, _e291_clamped_lod) - ivec2(1)), _e291_clamped_lod);
-            int _e295_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 bounds1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e295_clamped_lod) - ivec2(1)), _e295_clamped_lod);
-            float lo_1 = min(bounds0_.x, bounds1_.x);
-            float hi_1 = max(bounds0_.y, bounds1_.y);
-            vis = 0.5;
-            float _e304 = d_1;
-            if ((_e304 <= lo_1)) {
-                vis = 1.0;
-            } else {
-                float _e307 = d_1;
-                if ((_e307 > hi_1)) {
-                    vis = 0.0;
+            float _e211 = xs;
+            uint last = uint(min(max(_e211, 0.0), (float(width_1) - 1.0)));
+            row_total = 0.0;
+            r_1 = 0u;
+            bool loop_init_5 = true;
+            while(true) {
+                if (!loop_init_5) {
+                    uint _e344 = r_1;
+                    r_1 = (_e344 + 1u);
+                }
+                loop_init_5 = false;
+                uint _e224 = r_1;
+                if ((_e224 < REGIONS)) {
                 } else {
-                    int _e314_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e314 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, _e179), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e314_clamped_lod) - ivec3(1)), _e314_clamped_lod);
-                    int _e319_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e319 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, _e179), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e319_clamped_lod) - ivec3(1)), _e319_clamped_lod);
-                    vec4 top0_ = mix(_e314, _e319, fx);
-                    int _e325_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e325 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e325_clamped_lod) - ivec3(1)), _e325_clamped_lod);
-                    int _e330_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e330 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e330_clamped_lod) - ivec3(1)), _e330_clamped_lod);
-                    vec4 bottom0_ = mix(_e325, _e330, fx);
-                    vec4 m0_ = mix(top0_, bottom0_, fy_1);
-                    int _e337_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e337 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, _e179), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e337_clamped_lod) - ivec3(1)), _e337_clamped_lod);
-                    int _e342_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e342 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, _e179), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e342_clamped_lod) - ivec3(1)), _e342_clamped_lod);
-                    vec4 top1_ = mix(_e337, _e342, fx);
-                    int _e348_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e348 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e348_clamped_lod) - ivec3(1)), _e348_clamped_lod);
-                    int _e353_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e353 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e353_clamped_lod) - ivec3(1)), _e353_clamped_lod);
-                    vec4 bottom1_ = mix(_e348, _e353, fx);
-                    vec4 m1_ = mix(top1_, bottom1_, fy_1);
-                    float _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e198);
-                    vis = _e357;
+                    break;
+                }
+                {
+                    uint _e226 = r_1;
+                    uint _e227 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226, REGIONS, width_1, false);
+                    float b0_ = float(_e227);
+                    uint _e229 = r_1;
+                    uint _e232 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e229 + 1u), REGIONS, width_1, false);
+                    float b1_2 = float(_e232);
+                    if (!((last < uint(b1_2)))) {
+                        uint _e237 = r_1;
+                        local_10 = ((_e237 + 1u) == REGIONS);
+                    } else {
+                        local_10 = true;
+                    }
+                    bool is_last = local_10;
+                    float _e247 = xs;
+                    float pos = (is_last ? clamp((_e247 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+                    a_5 = 0.0;
+                    b_4 = 0.0;
+                    float _e260 = delta_1;
+                    float _e261 = theta_2;
+                    float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e260, _e261, s_4, false);
+                    a_5 = _e262;
+                    float _e263 = delta_1;
+                    float _e264 = theta_2;
+                    float _e265 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e263, _e264, s_4, false);
+                    b_4 = (is_last ? s_4 : _e265);
+                    weight = 0.0;
+                    if (false) {
+                        float _e269 = a_5;
+                        float _e270 = b_4;
+                        float _e271 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e8, _e269, _e270, panels_2);
+                        weight = _e271;
+                    } else {
+                        float _e274 = a_5;
+                        float _e275 = b_4;
+                        float _e276 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e274, _e275);
+                        weight = (sun_scatter * _e276);
+                    }
+                    float xb = (pos - 0.5);
+                    float fx = (xb - floor(xb));
+                    uint x0_ = uint(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
+                    uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
+                    int _e300_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+                    vec4 lohi = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, row_1)), ivec2(0), textureSize(_group_0_binding_6_cs, _e300_clamped_lod) - ivec2(1)), _e300_clamped_lod);
+                    float lo_1 = lohi.x;
+                    float hi_1 = lohi.y;
+                    vis = 0.5;
+                    float _e305 = d_1;
+                    if ((_e305 <= lo_1)) {
+                        vis = 1.0;
+                    } else {
+                        float _e308 = d_1;
+                        if ((_e308 > hi_1)) {
+                            vis = 0.0;
+                        } else {
+                            int _e315_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e315 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row_1), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e315_clamped_lod) - ivec3(1)), _e315_clamped_lod);
+                            int _e320_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e320 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row_1), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e320_clamped_lod) - ivec3(1)), _e320_clamped_lod);
+                            vec4 m0_ = mix(_e315, _e320, fx);
+                            int _e326_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e326 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row_1), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e326_clamped_lod) - ivec3(1)), _e326_clamped_lod);
+                            int _e331_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                            vec4 _e331 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row_1), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e331_clamped_lod) - ivec3(1)), _e331_clamped_lod);
+                            vec4 m1_ = mix(_e326, _e331, fx);
+                            float _e334 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e176);
+                            vis = _e334;
+                        }
+                    }
+                    float _e335 = row_total;
+                    float _e336 = weight;
+                    float _e337 = vis;
+                    row_total = (_e335 + (_e336 * clamp(_e337, 0.0, 1.0)));
+                    if (is_last) {
+                        break;
+                    }
                 }
             }
-            float _e359 = total;
-            float _e360 = weight;
-            float _e361 = vis;
-            total = (_e359 + (_e360 * clamp(_e361, 0.0, 1.0)));
-            if (is_last) {
-                break;
-            }
+            float _e347 = total;
+            float _e348 = row_total;
+            total = (_e347 + (row_weight * _e348));
         }
     }
     float l_2 = total;

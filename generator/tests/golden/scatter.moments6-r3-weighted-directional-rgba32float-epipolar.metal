@@ -573,15 +573,13 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
     float c3_,
     float c4_
 ) {
-    metal::float3 r = metal::float3(0.0);
-    uint k_2 = 0u;
     float z_1 = {};
-    uint i = {};
+    uint i = 0u;
     if ((metal::abs(c4_) * FAR_ROOTX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX) <= metal::abs(c3_)) {
         float disc = metal::max((c2_ * c2_) - ((4.0 * c1_) * c3_), 0.0);
-        float _e20 = sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(metal::sqrt(disc), c2_);
-        float _e24 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(-0.5 * (c2_ + _e20));
-        return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX {metal::float3(c1_ / _e24, _e24 / c3_, 0.0), true};
+        float _e18 = sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(metal::sqrt(disc), c2_);
+        float _e22 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(-0.5 * (c2_ + _e18));
+        return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX {metal::float3(c1_ / _e22, _e22 / c3_, 0.0), true};
     }
     float a_6 = c3_ / c4_;
     float b_5 = c2_ / c4_;
@@ -590,73 +588,48 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
     float qq = (((((2.0 * a_6) * a_6) * a_6) / 27.0) - ((a_6 * b_5) / 3.0)) + c;
     float m = 2.0 * metal::sqrt(-(p_3) / 3.0);
     float theta_3 = metal::acos(metal::clamp((3.0 * qq) / (p_3 * m), -1.0, 1.0)) / 3.0;
+    float greatest = (m * metal::cos(theta_3)) - (a_6 / 3.0);
+    float least = (m * metal::cos(theta_3 - 4.1887903)) - (a_6 / 3.0);
+    z_1 = (metal::abs(greatest) >= metal::abs(least)) ? greatest : least;
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e121 = k_2;
-            k_2 = _e121 + 1u;
+            uint _e111 = i;
+            i = _e111 + 1u;
         }
         loop_init_3 = false;
-        uint _e68 = k_2;
-        if (_e68 < 3u) {
+        uint _e83 = i;
+        if (_e83 < 2u) {
         } else {
             break;
         }
         {
-            uint _e72 = k_2;
-            z_1 = (m * metal::cos(theta_3 - ((6.2831855 * static_cast<float>(_e72)) / 3.0))) - (a_6 / 3.0);
-            i = 0u;
-            uint2 loop_bound_4 = uint2(4294967295u);
-            bool loop_init_4 = true;
-            while(true) {
-                if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-                if (!loop_init_4) {
-                    uint _e114 = i;
-                    i = _e114 + 1u;
-                }
-                loop_init_4 = false;
-                uint _e86 = i;
-                if (_e86 < 2u) {
-                } else {
-                    break;
-                }
-                {
-                    float _e89 = z_1;
-                    float _e90 = z_1;
-                    float _e91 = z_1;
-                    float f_9 = c1_ + (_e89 * (c2_ + (_e90 * (c3_ + (_e91 * c4_)))));
-                    float _e98 = z_1;
-                    float _e101 = z_1;
-                    float df = c2_ + (_e98 * ((2.0 * c3_) + ((3.0 * _e101) * c4_)));
-                    if (df != 0.0) {
-                        float _e110 = z_1;
-                        z_1 = _e110 - (f_9 / df);
-                    }
-                }
+            float _e86 = z_1;
+            float _e87 = z_1;
+            float _e88 = z_1;
+            float f_9 = c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_)))));
+            float _e95 = z_1;
+            float _e98 = z_1;
+            float df = c2_ + (_e95 * ((2.0 * c3_) + ((3.0 * _e98) * c4_)));
+            if (df != 0.0) {
+                float _e107 = z_1;
+                z_1 = _e107 - (f_9 / df);
             }
-            uint _e117 = k_2;
-            float _e119 = z_1;
-            r[metal::min(unsigned(_e117), 2u)] = _e119;
         }
     }
-    float _e124 = r.x;
-    float _e127 = r.z;
-    if (metal::abs(_e124) > metal::abs(_e127)) {
-        metal::float3 _e130 = r;
-        r = _e130.zyx;
-    }
-    float _e133 = r.y;
-    float _e136 = r.z;
-    if (metal::abs(_e133) > metal::abs(_e136)) {
-        metal::float3 _e139 = r;
-        r = _e139.xzy;
-    }
-    metal::float3 _e141 = r;
-    return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX {_e141, false};
+    float _e113 = z_1;
+    float _e114 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e113);
+    float q0_ = -(c1_) / _e114;
+    float q1_ = (q0_ - c2_) / _e114;
+    float q2_ = (q1_ - c3_) / _e114;
+    float disc_1 = metal::max((q1_ * q1_) - ((4.0 * q0_) * q2_), 0.0);
+    float _e129 = sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(metal::sqrt(disc_1), q1_);
+    float _e133 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(-0.5 * (q1_ + _e129));
+    float _e135 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(q2_);
+    return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX {metal::float3(q0_ / _e133, _e133 / _e135, _e114), false};
 }
 
 float far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
@@ -677,13 +650,13 @@ float atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
     float x_5,
     float u,
     float v_7,
-    float k_3
+    float k_2
 ) {
     float s_3 = u + v_7;
     float p_4 = u * v_7;
     float e2_ = (b2_ - (b1_ * s_3)) + p_4;
     float e3_ = ((b3_ - (b2_ * (s_3 + x_5))) + (b1_ * (p_4 + (s_3 * x_5)))) - (p_4 * x_5);
-    return (e2_ + (e3_ * k_3)) / ((x_5 - u) * (x_5 - v_7));
+    return (e2_ + (e3_ * k_2)) / ((x_5 - u) * (x_5 - v_7));
 }
 
 float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
@@ -715,7 +688,7 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
     float c2_1 = ((y2_ / d2_1) - (l32_ * c3_1)) - (l42_ * c4_1);
     float c1_1 = ((1.0 - (b1_1 * c2_1)) - (b2_1 * c3_1)) - (b3_1 * c4_1);
     CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX _e88 = cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_1, c2_1, c3_1, c4_1);
-    metal::float3 r_3 = _e88.r;
+    metal::float3 r_2 = _e88.r;
     bool at_infinity_1 = _e88.at_infinity;
     if (_e88.r[0] < zf) {
         float _e94 = shadow;
@@ -763,15 +736,15 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    uint r_1,
+    uint r,
     uint regions,
     uint width,
     bool spot_2
 ) {
     if (spot_2) {
-        return naga_div(r_1 * width, regions);
+        return naga_div(r * width, regions);
     }
-    return naga_div((r_1 * r_1) * width, regions * regions);
+    return naga_div((r * r) * width, regions * regions);
 }
 
 metal::float3 scatter_pixel(
@@ -790,11 +763,14 @@ metal::float3 scatter_pixel(
     bool local_9 = {};
     float yc = {};
     float d_1 = {};
-    float xs = {};
-    float delta_1 = 1.0;
+    float xs = 0.0;
+    float reach = 0.0;
     float theta_2 = 0.0;
     float total = 0.0;
-    uint r_2 = 0u;
+    uint side = 0u;
+    float delta_1 = {};
+    float row_total = {};
+    uint r_1 = {};
     bool local_10 = {};
     float a_5 = {};
     float b_4 = {};
@@ -802,10 +778,10 @@ metal::float3 scatter_pixel(
     float vis = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10 = frame;
     metal::float3 eye_6 = f_10.eye.xyz;
-    metal::float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
-    uint clamped_lod_e13 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e13 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(depth.get_width(clamped_lod_e13), depth.get_height(clamped_lod_e13)) - 1), clamped_lod_e13);
-    float s_4 = metal::min(metal::max(_e13.x, 0.0), f_10.theta.z) / metal::max(metal::dot(_e9, f_10.cam_forward.xyz), 0.000001);
+    metal::float3 _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    uint clamped_lod_e12 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e12 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(depth.get_width(clamped_lod_e12), depth.get_height(clamped_lod_e12)) - 1), clamped_lod_e12);
+    float s_4 = metal::min(metal::max(_e12.x, 0.0), f_10.theta.z) / metal::max(metal::dot(_e8, f_10.cam_forward.xyz), 0.000001);
     metal::float3 color = f_10.light_color.xyz;
     metal::float3 px = metal::float3(static_cast<float>(x_6) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
     float radius = f_10.epipole.w;
@@ -826,11 +802,11 @@ metal::float3 scatter_pixel(
     } else {
         local_9 = true;
     }
-    bool _e76 = local_9;
-    if (_e76) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = frame;
-        float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_6, _e9, s_4, false);
-        metal::float3 l_1 = _e81 * color;
+    bool _e75 = local_9;
+    if (_e75) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e77 = frame;
+        float _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, shadow_map, eye_6, _e8, s_4, false);
+        metal::float3 l_1 = _e80 * color;
         return l_1;
     }
     metal::float3 axis = f_10.axis.xyz;
@@ -838,160 +814,170 @@ metal::float3 scatter_pixel(
     uint width_1 = f_10.sizes.z;
     bool wrap_1 = f_10.anti_epipole.w > 0.5;
     {
-        theta_2 = metal::acos(metal::clamp(metal::dot(_e9, axis), -1.0, 1.0));
-        float phi_1 = metal::atan2(metal::dot(_e9, f_10.e2_.xyz), metal::dot(_e9, f_10.e1_.xyz));
+        theta_2 = metal::acos(metal::clamp(metal::dot(_e8, axis), -1.0, 1.0));
+        float phi_1 = metal::atan2(metal::dot(_e8, f_10.e2_.xyz), metal::dot(_e8, f_10.e1_.xyz));
         yc = (phi_1 - f_10.e1_.w) / f_10.e2_.w;
         if (wrap_1) {
+            float _e112 = yc;
             float _e113 = yc;
-            float _e114 = yc;
-            yc = _e113 - (metal::floor(_e114 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+            yc = _e112 - (metal::floor(_e113 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
         } else {
-            float _e121 = yc;
-            yc = metal::clamp(_e121, 0.0, static_cast<float>(rows_1));
+            float _e120 = yc;
+            yc = metal::clamp(_e120, 0.0, static_cast<float>(rows_1));
         }
-        float _e125 = yc;
-        float yy = _e125 - 0.5;
-        float j0_ = metal::floor(yy);
-        float fy = yy - j0_;
-        uint _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        metal::float4 _e133 = slices[metal::min(unsigned(_e130), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
-        uint _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_ + 1.0, rows_1, wrap_1);
-        metal::float4 _e140 = slices[metal::min(unsigned(_e137), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
-        delta_1 = metal::mix(_e134.delta, _e141.delta, fy);
-        float _e146 = theta_2;
-        float _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_10.theta.x, f_10.theta.y);
-        d_1 = _e151;
+        float _e124 = theta_2;
+        float _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_10.theta.x, f_10.theta.y);
+        d_1 = _e129;
         if (false) {
-            metal::float3 q_3 = metal::normalize((eye_6 + (_e9 * s_4)) - f_10.light_pos.xyz);
-            float _e165 = delta_1;
-            xs = metal::acos(metal::clamp(metal::dot(q_3, -(axis)), -1.0, 1.0)) / _e165;
+            metal::float3 q_3 = metal::normalize((eye_6 + (_e8 * s_4)) - f_10.light_pos.xyz);
+            reach = metal::acos(metal::clamp(metal::dot(q_3, -(axis)), -1.0, 1.0));
         } else {
-            float _e168 = theta_2;
-            float _e171 = delta_1;
-            xs = (s_4 * metal::sin(_e168)) / _e171;
+            float _e144 = theta_2;
+            reach = s_4 * metal::sin(_e144);
         }
     }
-    float _e173 = yc;
-    float yb = _e173 - 0.5;
-    float fy_1 = yb - metal::floor(yb);
-    uint _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
-    uint _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
-    uint row1_ = (yb > metal::floor(yb)) ? _e183 : _e179;
-    float cos_theta_l = -(metal::dot(f_10.light_dir.xyz, _e9));
+    float _e147 = yc;
+    float yb = _e147 - 0.5;
+    float fy = yb - metal::floor(yb);
+    uint _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
+    uint _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
+    uint row1_ = (yb > metal::floor(yb)) ? _e157 : _e153;
+    uint row_count = (row1_ != _e153) ? 2u : 1u;
+    float cos_theta_l = -(metal::dot(f_10.light_dir.xyz, _e8));
     uint panels_2 = metal::max(naga_div(f_10.sizes2_.z, 4u), 1u);
-    float _e197 = d_1;
-    float _e198 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e197);
-    float _e203 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    float sun_scatter = f_10.medium.y * _e203;
-    float _e205 = xs;
-    uint last = naga_f2u32(metal::min(metal::max(_e205, 0.0), static_cast<float>(width_1) - 1.0));
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
+    float _e175 = d_1;
+    float _e176 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e175);
+    float _e181 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+    float sun_scatter = f_10.medium.y * _e181;
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
-            uint _e368 = r_2;
-            r_2 = _e368 + 1u;
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
+            uint _e352 = side;
+            side = _e352 + 1u;
         }
-        loop_init_5 = false;
-        uint _e215 = r_2;
-        if (_e215 < REGIONS) {
+        loop_init_4 = false;
+        uint _e184 = side;
+        if (_e184 < row_count) {
         } else {
             break;
         }
         {
-            uint _e217 = r_2;
-            uint _e218 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e217, REGIONS, width_1, false);
-            float b0_ = static_cast<float>(_e218);
-            uint _e220 = r_2;
-            uint _e223 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e220 + 1u, REGIONS, width_1, false);
-            float b1_2 = static_cast<float>(_e223);
-            if (!((last < naga_f2u32(b1_2)))) {
-                uint _e228 = r_2;
-                local_10 = (_e228 + 1u) == REGIONS;
-            } else {
-                local_10 = true;
+            uint _e186 = side;
+            uint row_1 = (_e186 == 1u) ? row1_ : _e153;
+            uint _e196 = side;
+            float row_weight = (_e196 == 1u) ? fy : ((row_count == 1u) ? 1.0 : (1.0 - fy));
+            delta_1 = 1.0;
+            {
+                metal::float4 _e204 = slices[metal::min(unsigned(row_1), (_buffer_sizes.size1 - 0 - 16) / 16)];
+                SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e205 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e204);
+                delta_1 = _e205.delta;
+                float _e207 = reach;
+                float _e208 = delta_1;
+                xs = _e207 / _e208;
             }
-            bool is_last = local_10;
-            float _e238 = xs;
-            float pos = is_last ? metal::clamp(_e238 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
-            a_5 = float {};
-            b_4 = float {};
-            float _e251 = delta_1;
-            float _e252 = theta_2;
-            float _e253 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e251, _e252, s_4, false);
-            a_5 = _e253;
-            float _e254 = delta_1;
-            float _e255 = theta_2;
-            float _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e254, _e255, s_4, false);
-            b_4 = is_last ? s_4 : _e256;
-            weight = float {};
-            if (false) {
-                float _e260 = a_5;
-                float _e261 = b_4;
-                float _e262 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e9, _e260, _e261, panels_2);
-                weight = _e262;
-            } else {
-                float _e265 = a_5;
-                float _e266 = b_4;
-                float _e267 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e265, _e266);
-                weight = sun_scatter * _e267;
-            }
-            float xb = pos - 0.5;
-            float fx = xb - metal::floor(xb);
-            uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
-            uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
-            uint clamped_lod_e291 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 bounds0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, _e179)), metal::uint2(bounds.get_width(clamped_lod_e291), bounds.get_height(clamped_lod_e291)) - 1), clamped_lod_e291);
-            uint clamped_lod_e295 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 bounds1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e295), bounds.get_height(clamped_lod_e295)) - 1), clamped_lod_e295);
-            float lo_1 = metal::min(bounds0_.x, bounds1_.x);
-            float hi_1 = metal::max(bounds0_.y, bounds1_.y);
-            vis = 0.5;
-            float _e304 = d_1;
-            if (_e304 <= lo_1) {
-                vis = 1.0;
-            } else {
-                float _e307 = d_1;
-                if (_e307 > hi_1) {
-                    vis = 0.0;
+            float _e211 = xs;
+            uint last = naga_f2u32(metal::min(metal::max(_e211, 0.0), static_cast<float>(width_1) - 1.0));
+            row_total = 0.0;
+            r_1 = 0u;
+            uint2 loop_bound_5 = uint2(4294967295u);
+            bool loop_init_5 = true;
+            while(true) {
+                if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+                if (!loop_init_5) {
+                    uint _e344 = r_1;
+                    r_1 = _e344 + 1u;
+                }
+                loop_init_5 = false;
+                uint _e224 = r_1;
+                if (_e224 < REGIONS) {
                 } else {
-                    uint clamped_lod_e314 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e314 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e314), filtered.get_height(clamped_lod_e314)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e314);
-                    uint clamped_lod_e319 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e319 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e319), filtered.get_height(clamped_lod_e319)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e319);
-                    metal::float4 top0_ = metal::mix(_e314, _e319, fx);
-                    uint clamped_lod_e325 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e325 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e325), filtered.get_height(clamped_lod_e325)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e325);
-                    uint clamped_lod_e330 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e330 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e330), filtered.get_height(clamped_lod_e330)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e330);
-                    metal::float4 bottom0_ = metal::mix(_e325, _e330, fx);
-                    metal::float4 m0_ = metal::mix(top0_, bottom0_, fy_1);
-                    uint clamped_lod_e337 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e337 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e337), filtered.get_height(clamped_lod_e337)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e337);
-                    uint clamped_lod_e342 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e342 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, _e179)), metal::uint2(filtered.get_width(clamped_lod_e342), filtered.get_height(clamped_lod_e342)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e342);
-                    metal::float4 top1_ = metal::mix(_e337, _e342, fx);
-                    uint clamped_lod_e348 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e348 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e348), filtered.get_height(clamped_lod_e348)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e348);
-                    uint clamped_lod_e353 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                    metal::float4 _e353 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e353), filtered.get_height(clamped_lod_e353)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e353);
-                    metal::float4 bottom1_ = metal::mix(_e348, _e353, fx);
-                    metal::float4 m1_ = metal::mix(top1_, bottom1_, fy_1);
-                    float _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e198);
-                    vis = _e357;
+                    break;
+                }
+                {
+                    uint _e226 = r_1;
+                    uint _e227 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226, REGIONS, width_1, false);
+                    float b0_ = static_cast<float>(_e227);
+                    uint _e229 = r_1;
+                    uint _e232 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e229 + 1u, REGIONS, width_1, false);
+                    float b1_2 = static_cast<float>(_e232);
+                    if (!((last < naga_f2u32(b1_2)))) {
+                        uint _e237 = r_1;
+                        local_10 = (_e237 + 1u) == REGIONS;
+                    } else {
+                        local_10 = true;
+                    }
+                    bool is_last = local_10;
+                    float _e247 = xs;
+                    float pos = is_last ? metal::clamp(_e247 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
+                    a_5 = float {};
+                    b_4 = float {};
+                    float _e260 = delta_1;
+                    float _e261 = theta_2;
+                    float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e260, _e261, s_4, false);
+                    a_5 = _e262;
+                    float _e263 = delta_1;
+                    float _e264 = theta_2;
+                    float _e265 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e263, _e264, s_4, false);
+                    b_4 = is_last ? s_4 : _e265;
+                    weight = float {};
+                    if (false) {
+                        float _e269 = a_5;
+                        float _e270 = b_4;
+                        float _e271 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e8, _e269, _e270, panels_2);
+                        weight = _e271;
+                    } else {
+                        float _e274 = a_5;
+                        float _e275 = b_4;
+                        float _e276 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e274, _e275);
+                        weight = sun_scatter * _e276;
+                    }
+                    float xb = pos - 0.5;
+                    float fx = xb - metal::floor(xb);
+                    uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
+                    uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
+                    uint clamped_lod_e300 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+                    metal::float4 lohi = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row_1)), metal::uint2(bounds.get_width(clamped_lod_e300), bounds.get_height(clamped_lod_e300)) - 1), clamped_lod_e300);
+                    float lo_1 = lohi.x;
+                    float hi_1 = lohi.y;
+                    vis = 0.5;
+                    float _e305 = d_1;
+                    if (_e305 <= lo_1) {
+                        vis = 1.0;
+                    } else {
+                        float _e308 = d_1;
+                        if (_e308 > hi_1) {
+                            vis = 0.0;
+                        } else {
+                            uint clamped_lod_e315 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e315 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row_1)), metal::uint2(filtered.get_width(clamped_lod_e315), filtered.get_height(clamped_lod_e315)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e315);
+                            uint clamped_lod_e320 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e320 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row_1)), metal::uint2(filtered.get_width(clamped_lod_e320), filtered.get_height(clamped_lod_e320)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e320);
+                            metal::float4 m0_ = metal::mix(_e315, _e320, fx);
+                            uint clamped_lod_e326 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e326 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row_1)), metal::uint2(filtered.get_width(clamped_lod_e326), filtered.get_height(clamped_lod_e326)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e326);
+                            uint clamped_lod_e331 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                            metal::float4 _e331 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row_1)), metal::uint2(filtered.get_width(clamped_lod_e331), filtered.get_height(clamped_lod_e331)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e331);
+                            metal::float4 m1_ = metal::mix(_e326, _e331, fx);
+                            float _e334 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e176);
+                            vis = _e334;
+                        }
+                    }
+                    float _e335 = row_total;
+                    float _e336 = weight;
+                    float _e337 = vis;
+                    row_total = _e335 + (_e336 * metal::clamp(_e337, 0.0, 1.0));
+                    if (is_last) {
+                        break;
+                    }
                 }
             }
-            float _e359 = total;
-            float _e360 = weight;
-            float _e361 = vis;
-            total = _e359 + (_e360 * metal::clamp(_e361, 0.0, 1.0));
-            if (is_last) {
-                break;
-            }
+            float _e347 = total;
+            float _e348 = row_total;
+            total = _e347 + (row_weight * _e348);
         }
     }
     float l_2 = total;

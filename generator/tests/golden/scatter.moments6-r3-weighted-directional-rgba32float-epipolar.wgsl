@@ -428,16 +428,14 @@ fn nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(q_1: f32) -> f32 {
 }
 
 fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3_: f32, c4_: f32) -> CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX {
-    var r: vec3<f32> = vec3(0f);
-    var k_2: u32 = 0u;
     var z_1: f32;
-    var i: u32;
+    var i: u32 = 0u;
 
     if ((abs(c4_) * FAR_ROOTX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX) <= abs(c3_)) {
         let disc = max(((c2_ * c2_) - ((4f * c1_) * c3_)), 0f);
-        let _e20 = sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(sqrt(disc), c2_);
-        let _e24 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX((-0.5f * (c2_ + _e20)));
-        return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec3<f32>((c1_ / _e24), (_e24 / c3_), 0f), true);
+        let _e18 = sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(sqrt(disc), c2_);
+        let _e22 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX((-0.5f * (c2_ + _e18)));
+        return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec3<f32>((c1_ / _e22), (_e22 / c3_), 0f), true);
     }
     let a_6 = (c3_ / c4_);
     let b_5 = (c2_ / c4_);
@@ -446,63 +444,43 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
     let qq = ((((((2f * a_6) * a_6) * a_6) / 27f) - ((a_6 * b_5) / 3f)) + c);
     let m = (2f * sqrt((-(p_3) / 3f)));
     let theta_3 = (acos(clamp(((3f * qq) / (p_3 * m)), -1f, 1f)) / 3f);
+    let greatest = ((m * cos(theta_3)) - (a_6 / 3f));
+    let least = ((m * cos((theta_3 - 4.1887903f))) - (a_6 / 3f));
+    z_1 = select(least, greatest, (abs(greatest) >= abs(least)));
     loop {
-        let _e68 = k_2;
-        if (_e68 < 3u) {
+        let _e83 = i;
+        if (_e83 < 2u) {
         } else {
             break;
         }
         {
-            let _e72 = k_2;
-            z_1 = ((m * cos((theta_3 - ((6.2831855f * f32(_e72)) / 3f)))) - (a_6 / 3f));
-            i = 0u;
-            loop {
-                let _e86 = i;
-                if (_e86 < 2u) {
-                } else {
-                    break;
-                }
-                {
-                    let _e89 = z_1;
-                    let _e90 = z_1;
-                    let _e91 = z_1;
-                    let f_9 = (c1_ + (_e89 * (c2_ + (_e90 * (c3_ + (_e91 * c4_))))));
-                    let _e98 = z_1;
-                    let _e101 = z_1;
-                    let df = (c2_ + (_e98 * ((2f * c3_) + ((3f * _e101) * c4_))));
-                    if (df != 0f) {
-                        let _e110 = z_1;
-                        z_1 = (_e110 - (f_9 / df));
-                    }
-                }
-                continuing {
-                    let _e114 = i;
-                    i = (_e114 + 1u);
-                }
+            let _e86 = z_1;
+            let _e87 = z_1;
+            let _e88 = z_1;
+            let f_9 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
+            let _e95 = z_1;
+            let _e98 = z_1;
+            let df = (c2_ + (_e95 * ((2f * c3_) + ((3f * _e98) * c4_))));
+            if (df != 0f) {
+                let _e107 = z_1;
+                z_1 = (_e107 - (f_9 / df));
             }
-            let _e117 = k_2;
-            let _e119 = z_1;
-            r[_e117] = _e119;
         }
         continuing {
-            let _e121 = k_2;
-            k_2 = (_e121 + 1u);
+            let _e111 = i;
+            i = (_e111 + 1u);
         }
     }
-    let _e124 = r.x;
-    let _e127 = r.z;
-    if (abs(_e124) > abs(_e127)) {
-        let _e130 = r;
-        r = _e130.zyx;
-    }
-    let _e133 = r.y;
-    let _e136 = r.z;
-    if (abs(_e133) > abs(_e136)) {
-        let _e139 = r;
-        r = _e139.xzy;
-    }
-    let _e141 = r;
-    return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e141, false);
+    let _e113 = z_1;
+    let _e114 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e113);
+    let q0_ = (-(c1_) / _e114);
+    let q1_ = ((q0_ - c2_) / _e114);
+    let q2_ = ((q1_ - c3_) / _e114);
+    let disc_1 = max(((q1_ * q1_) - ((4f * q0_) * q2_)), 0f);
+    let _e129 = sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(sqrt(disc_1), q1_);
+    let _e133 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX((-0.5f * (q1_ + _e129)));
+    let _e135 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(q2_);
+    return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec3<f32>((q0_ / _e133), (_e133 / _e135), _e114), false);
 }
 
 fn far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(x_4: f32, far: f32, at_infinity: bool) -> f32 {
@@ -512,12 +490,12 @@ fn far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(x_4: f32, far: f32, at_infin
     return (1f / (x_4 - far));
 }
 
-fn atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_: f32, b2_: f32, b3_: f32, x_5: f32, u: f32, v_7: f32, k_3: f32) -> f32 {
+fn atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_: f32, b2_: f32, b3_: f32, x_5: f32, u: f32, v_7: f32, k_2: f32) -> f32 {
     let s_3 = (u + v_7);
     let p_4 = (u * v_7);
     let e2_ = ((b2_ - (b1_ * s_3)) + p_4);
     let e3_ = (((b3_ - (b2_ * (s_3 + x_5))) + (b1_ * (p_4 + (s_3 * x_5)))) - (p_4 * x_5));
-    return ((e2_ + (e3_ * k_3)) / ((x_5 - u) * (x_5 - v_7)));
+    return ((e2_ + (e3_ * k_2)) / ((x_5 - u) * (x_5 - v_7)));
 }
 
 fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw1_: vec2<f32>, zf: f32) -> f32 {
@@ -546,29 +524,29 @@ fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw
     let c2_1 = (((y2_ / d2_1) - (l32_ * c3_1)) - (l42_ * c4_1));
     let c1_1 = (((1f - (b1_1 * c2_1)) - (b2_1 * c3_1)) - (b3_1 * c4_1));
     let _e88 = cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_1, c2_1, c3_1, c4_1);
-    let r_3 = _e88.r;
+    let r_2 = _e88.r;
     let at_infinity_1 = _e88.at_infinity;
-    if (r_3.x < zf) {
+    if (r_2.x < zf) {
         let _e94 = shadow;
-        let _e99 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.x, r_3.z, at_infinity_1);
-        let _e100 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.x, zf, r_3.y, _e99);
+        let _e99 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_2.x, r_2.z, at_infinity_1);
+        let _e100 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_2.x, zf, r_2.y, _e99);
         shadow = (_e94 + _e100);
     }
-    if (r_3.y < zf) {
+    if (r_2.y < zf) {
         let _e104 = shadow;
-        let _e109 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_3.y, r_3.z, at_infinity_1);
-        let _e110 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.y, zf, r_3.x, _e109);
+        let _e109 = far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(r_2.y, r_2.z, at_infinity_1);
+        let _e110 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_2.y, zf, r_2.x, _e109);
         shadow = (_e104 + _e110);
     }
     if !(at_infinity_1) {
-        local_6 = (r_3.z < zf);
+        local_6 = (r_2.z < zf);
     } else {
         local_6 = false;
     }
     let _e118 = local_6;
     if _e118 {
         let _e119 = shadow;
-        let _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_3.z, zf, r_3.x, (1f / (r_3.z - r_3.y)));
+        let _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_2.z, zf, r_2.x, (1f / (r_2.z - r_2.y)));
         shadow = (_e119 + _e127);
     }
     let _e129 = shadow;
@@ -583,11 +561,11 @@ fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod
     return (f_8.e1_.w + ((f32(row) + 0.5f) * f_8.e2_.w));
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
     if spot_2 {
-        return ((r_1 * width) / regions);
+        return ((r * width) / regions);
     }
-    return (((r_1 * r_1) * width) / (regions * regions));
+    return (((r * r) * width) / (regions * regions));
 }
 
 fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
@@ -596,11 +574,14 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var local_9: bool;
     var yc: f32;
     var d_1: f32;
-    var xs: f32;
-    var delta_1: f32 = 1f;
+    var xs: f32 = 0f;
+    var reach: f32 = 0f;
     var theta_2: f32 = 0f;
     var total: f32 = 0f;
-    var r_2: u32 = 0u;
+    var side: u32 = 0u;
+    var delta_1: f32;
+    var row_total: f32;
+    var r_1: u32;
     var local_10: bool;
     var a_5: f32;
     var b_4: f32;
@@ -609,9 +590,9 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
 
     let f_10 = frame;
     let eye_6 = f_10.eye.xyz;
-    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
-    let _e13 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
-    let s_4 = (min(max(_e13.x, 0f), f_10.theta.z) / max(dot(_e9, f_10.cam_forward.xyz), 0.000001f));
+    let _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    let _e12 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
+    let s_4 = (min(max(_e12.x, 0f), f_10.theta.z) / max(dot(_e8, f_10.cam_forward.xyz), 0.000001f));
     let color = f_10.light_color.xyz;
     let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_10.epipole.w;
@@ -632,11 +613,11 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     } else {
         local_9 = true;
     }
-    let _e76 = local_9;
-    if _e76 {
-        let _e78 = frame;
-        let _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_6, _e9, s_4, false);
-        let l_1 = (_e81 * color);
+    let _e75 = local_9;
+    if _e75 {
+        let _e77 = frame;
+        let _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, shadow_map, eye_6, _e8, s_4, false);
+        let l_1 = (_e80 * color);
         return l_1;
     }
     let axis = f_10.axis.xyz;
@@ -644,145 +625,155 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     let width_1 = f_10.sizes.z;
     let wrap_1 = (f_10.anti_epipole.w > 0.5f);
     {
-        theta_2 = acos(clamp(dot(_e9, axis), -1f, 1f));
-        let phi_1 = atan2(dot(_e9, f_10.e2_.xyz), dot(_e9, f_10.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e8, axis), -1f, 1f));
+        let phi_1 = atan2(dot(_e8, f_10.e2_.xyz), dot(_e8, f_10.e1_.xyz));
         yc = ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
         if wrap_1 {
+            let _e112 = yc;
             let _e113 = yc;
-            let _e114 = yc;
-            yc = (_e113 - (floor((_e114 / f32(rows_1))) * f32(rows_1)));
+            yc = (_e112 - (floor((_e113 / f32(rows_1))) * f32(rows_1)));
         } else {
-            let _e121 = yc;
-            yc = clamp(_e121, 0f, f32(rows_1));
+            let _e120 = yc;
+            yc = clamp(_e120, 0f, f32(rows_1));
         }
-        let _e125 = yc;
-        let yy = (_e125 - 0.5f);
-        let j0_ = floor(yy);
-        let fy = (yy - j0_);
-        let _e130 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j0_, rows_1, wrap_1);
-        let _e133 = slices[_e130];
-        let _e134 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e133);
-        let _e137 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j0_ + 1f), rows_1, wrap_1);
-        let _e140 = slices[_e137];
-        let _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
-        delta_1 = mix(_e134.delta, _e141.delta, fy);
-        let _e146 = theta_2;
-        let _e151 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e146, f_10.theta.x, f_10.theta.y);
-        d_1 = _e151;
+        let _e124 = theta_2;
+        let _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_10.theta.x, f_10.theta.y);
+        d_1 = _e129;
         if false {
-            let q_3 = normalize(((eye_6 + (_e9 * s_4)) - f_10.light_pos.xyz));
-            let _e165 = delta_1;
-            xs = (acos(clamp(dot(q_3, -(axis)), -1f, 1f)) / _e165);
+            let q_3 = normalize(((eye_6 + (_e8 * s_4)) - f_10.light_pos.xyz));
+            reach = acos(clamp(dot(q_3, -(axis)), -1f, 1f));
         } else {
-            let _e168 = theta_2;
-            let _e171 = delta_1;
-            xs = ((s_4 * sin(_e168)) / _e171);
+            let _e144 = theta_2;
+            reach = (s_4 * sin(_e144));
         }
     }
-    let _e173 = yc;
-    let yb = (_e173 - 0.5f);
-    let fy_1 = (yb - floor(yb));
-    let _e179 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    let _e183 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
-    let row1_ = select(_e179, _e183, (yb > floor(yb)));
-    let cos_theta_l = -(dot(f_10.light_dir.xyz, _e9));
+    let _e147 = yc;
+    let yb = (_e147 - 0.5f);
+    let fy = (yb - floor(yb));
+    let _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    let _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
+    let row1_ = select(_e153, _e157, (yb > floor(yb)));
+    let row_count = select(1u, 2u, (row1_ != _e153));
+    let cos_theta_l = -(dot(f_10.light_dir.xyz, _e8));
     let panels_2 = max((f_10.sizes2_.z / 4u), 1u);
-    let _e197 = d_1;
-    let _e198 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e197);
-    let _e203 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    let sun_scatter = (f_10.medium.y * _e203);
-    let _e205 = xs;
-    let last = u32(min(max(_e205, 0f), (f32(width_1) - 1f)));
+    let _e175 = d_1;
+    let _e176 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e175);
+    let _e181 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+    let sun_scatter = (f_10.medium.y * _e181);
     loop {
-        let _e215 = r_2;
-        if (_e215 < REGIONS) {
+        let _e184 = side;
+        if (_e184 < row_count) {
         } else {
             break;
         }
         {
-            let _e217 = r_2;
-            let _e218 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e217, REGIONS, width_1, false);
-            let b0_ = f32(_e218);
-            let _e220 = r_2;
-            let _e223 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e220 + 1u), REGIONS, width_1, false);
-            let b1_2 = f32(_e223);
-            if !((last < u32(b1_2))) {
-                let _e228 = r_2;
-                local_10 = ((_e228 + 1u) == REGIONS);
-            } else {
-                local_10 = true;
+            let _e186 = side;
+            let row_1 = select(_e153, row1_, (_e186 == 1u));
+            let _e196 = side;
+            let row_weight = select(select((1f - fy), 1f, (row_count == 1u)), fy, (_e196 == 1u));
+            delta_1 = 1f;
+            {
+                let _e204 = slices[row_1];
+                let _e205 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e204);
+                delta_1 = _e205.delta;
+                let _e207 = reach;
+                let _e208 = delta_1;
+                xs = (_e207 / _e208);
             }
-            let is_last = local_10;
-            let _e238 = xs;
-            let pos = select((b1_2 - 0.5f), clamp((_e238 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last);
-            a_5 = f32();
-            b_4 = f32();
-            let _e251 = delta_1;
-            let _e252 = theta_2;
-            let _e253 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e251, _e252, s_4, false);
-            a_5 = _e253;
-            let _e254 = delta_1;
-            let _e255 = theta_2;
-            let _e256 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e254, _e255, s_4, false);
-            b_4 = select(_e256, s_4, is_last);
-            weight = f32();
-            if false {
-                let _e260 = a_5;
-                let _e261 = b_4;
-                let _e262 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e9, _e260, _e261, panels_2);
-                weight = _e262;
-            } else {
-                let _e265 = a_5;
-                let _e266 = b_4;
-                let _e267 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e265, _e266);
-                weight = (sun_scatter * _e267);
-            }
-            let xb = (pos - 0.5f);
-            let fx = (xb - floor(xb));
-            let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
-            let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
-            let bounds0_ = textureLoad(bounds, vec2<u32>(x1_, _e179), 0i);
-            let bounds1_ = textureLoad(bounds, vec2<u32>(x1_, row1_), 0i);
-            let lo_1 = min(bounds0_.x, bounds1_.x);
-            let hi_1 = max(bounds0_.y, bounds1_.y);
-            vis = 0.5f;
-            let _e304 = d_1;
-            if (_e304 <= lo_1) {
-                vis = 1f;
-            } else {
-                let _e307 = d_1;
-                if (_e307 > hi_1) {
-                    vis = 0f;
+            let _e211 = xs;
+            let last = u32(min(max(_e211, 0f), (f32(width_1) - 1f)));
+            row_total = 0f;
+            r_1 = 0u;
+            loop {
+                let _e224 = r_1;
+                if (_e224 < REGIONS) {
                 } else {
-                    let _e314 = textureLoad(filtered, vec2<u32>(x0_, _e179), 0i, 0i);
-                    let _e319 = textureLoad(filtered, vec2<u32>(x1_, _e179), 0i, 0i);
-                    let top0_ = mix(_e314, _e319, fx);
-                    let _e325 = textureLoad(filtered, vec2<u32>(x0_, row1_), 0i, 0i);
-                    let _e330 = textureLoad(filtered, vec2<u32>(x1_, row1_), 0i, 0i);
-                    let bottom0_ = mix(_e325, _e330, fx);
-                    let m0_ = mix(top0_, bottom0_, fy_1);
-                    let _e337 = textureLoad(filtered, vec2<u32>(x0_, _e179), 1i, 0i);
-                    let _e342 = textureLoad(filtered, vec2<u32>(x1_, _e179), 1i, 0i);
-                    let top1_ = mix(_e337, _e342, fx);
-                    let _e348 = textureLoad(filtered, vec2<u32>(x0_, row1_), 1i, 0i);
-                    let _e353 = textureLoad(filtered, vec2<u32>(x1_, row1_), 1i, 0i);
-                    let bottom1_ = mix(_e348, _e353, fx);
-                    let m1_ = mix(top1_, bottom1_, fy_1);
-                    let _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e198);
-                    vis = _e357;
+                    break;
+                }
+                {
+                    let _e226 = r_1;
+                    let _e227 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226, REGIONS, width_1, false);
+                    let b0_ = f32(_e227);
+                    let _e229 = r_1;
+                    let _e232 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e229 + 1u), REGIONS, width_1, false);
+                    let b1_2 = f32(_e232);
+                    if !((last < u32(b1_2))) {
+                        let _e237 = r_1;
+                        local_10 = ((_e237 + 1u) == REGIONS);
+                    } else {
+                        local_10 = true;
+                    }
+                    let is_last = local_10;
+                    let _e247 = xs;
+                    let pos = select((b1_2 - 0.5f), clamp((_e247 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last);
+                    a_5 = f32();
+                    b_4 = f32();
+                    let _e260 = delta_1;
+                    let _e261 = theta_2;
+                    let _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e260, _e261, s_4, false);
+                    a_5 = _e262;
+                    let _e263 = delta_1;
+                    let _e264 = theta_2;
+                    let _e265 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e263, _e264, s_4, false);
+                    b_4 = select(_e265, s_4, is_last);
+                    weight = f32();
+                    if false {
+                        let _e269 = a_5;
+                        let _e270 = b_4;
+                        let _e271 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e8, _e269, _e270, panels_2);
+                        weight = _e271;
+                    } else {
+                        let _e274 = a_5;
+                        let _e275 = b_4;
+                        let _e276 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e274, _e275);
+                        weight = (sun_scatter * _e276);
+                    }
+                    let xb = (pos - 0.5f);
+                    let fx = (xb - floor(xb));
+                    let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
+                    let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
+                    let lohi = textureLoad(bounds, vec2<u32>(x1_, row_1), 0i);
+                    let lo_1 = lohi.x;
+                    let hi_1 = lohi.y;
+                    vis = 0.5f;
+                    let _e305 = d_1;
+                    if (_e305 <= lo_1) {
+                        vis = 1f;
+                    } else {
+                        let _e308 = d_1;
+                        if (_e308 > hi_1) {
+                            vis = 0f;
+                        } else {
+                            let _e315 = textureLoad(filtered, vec2<u32>(x0_, row_1), 0i, 0i);
+                            let _e320 = textureLoad(filtered, vec2<u32>(x1_, row_1), 0i, 0i);
+                            let m0_ = mix(_e315, _e320, fx);
+                            let _e326 = textureLoad(filtered, vec2<u32>(x0_, row_1), 1i, 0i);
+                            let _e331 = textureLoad(filtered, vec2<u32>(x1_, row_1), 1i, 0i);
+                            let m1_ = mix(_e326, _e331, fx);
+                            let _e334 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e176);
+                            vis = _e334;
+                        }
+                    }
+                    let _e335 = row_total;
+                    let _e336 = weight;
+                    let _e337 = vis;
+                    row_total = (_e335 + (_e336 * clamp(_e337, 0f, 1f)));
+                    if is_last {
+                        break;
+                    }
+                }
+                continuing {
+                    let _e344 = r_1;
+                    r_1 = (_e344 + 1u);
                 }
             }
-            let _e359 = total;
-            let _e360 = weight;
-            let _e361 = vis;
-            total = (_e359 + (_e360 * clamp(_e361, 0f, 1f)));
-            if is_last {
-                break;
-            }
+            let _e347 = total;
+            let _e348 = row_total;
+            total = (_e347 + (row_weight * _e348));
         }
         continuing {
-            let _e368 = r_2;
-            r_2 = (_e368 + 1u);
+            let _e352 = side;
+            side = (_e352 + 1u);
         }
     }
     let l_2 = total;

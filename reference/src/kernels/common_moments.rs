@@ -145,8 +145,9 @@ pub fn lit_moments4(raw: [f32; 4], zf: f32) -> f32 {
 /// The real roots of `c1 + c2 z + c3 z^2 + c4 z^3` (three, as the kernel polynomial of a
 /// positive definite Hankel matrix has): `(r0, r1, r2, at_infinity)` with `r2` the root of
 /// largest magnitude, at infinity when `|c4|` is negligible (then `r0`, `r1` are the roots of
-/// the quadratic). Trigonometric solution of the monic cubic, each root polished by two
-/// Newton steps on the unscaled polynomial.
+/// the quadratic). The root of largest magnitude from the trigonometric solution of the monic
+/// cubic, polished by two Newton steps on the unscaled polynomial; the other two from the
+/// deflated quadratic.
 pub fn cubic_roots(c1: f32, c2: f32, c3: f32, c4: f32) -> ([f32; 3], bool) {
     if c4.abs() * FAR_ROOT <= c3.abs() {
         let disc = (c2 * c2 - 4.0 * c1 * c3).max(0.0);
@@ -160,26 +161,34 @@ pub fn cubic_roots(c1: f32, c2: f32, c3: f32, c4: f32) -> ([f32; 3], bool) {
     let qq = 2.0 * a * a * a / 27.0 - a * b / 3.0 + c;
     let m = 2.0 * (-p / 3.0).sqrt();
     let theta = clamp(3.0 * qq / (p * m), -1.0, 1.0).acos() / 3.0;
-    let mut r = [0.0f32; 3];
-    for (k, root) in r.iter_mut().enumerate() {
-        let mut z = m * (theta - 2.0 * PI * k as f32 / 3.0).cos() - a / 3.0;
-        for _ in 0..2 {
-            let f = c1 + z * (c2 + z * (c3 + z * c4));
-            let df = c2 + z * (2.0 * c3 + 3.0 * z * c4);
-            if df != 0.0 {
-                z -= f / df;
-            }
+    // The root of largest magnitude: the greatest or the least of the trigonometric
+    // solution (theta in [0, pi / 3]: k = 0 and k = 2), polished by Newton's method.
+    let greatest = m * theta.cos() - a / 3.0;
+    let least = m * (theta - 4.0 * PI / 3.0).cos() - a / 3.0;
+    let mut z = if greatest.abs() >= least.abs() {
+        greatest
+    } else {
+        least
+    };
+    for _ in 0..2 {
+        let f = c1 + z * (c2 + z * (c3 + z * c4));
+        let df = c2 + z * (2.0 * c3 + 3.0 * z * c4);
+        if df != 0.0 {
+            z -= f / df;
         }
-        *root = z;
     }
-    // The root of largest magnitude last.
-    if r[0].abs() > r[2].abs() {
-        r.swap(0, 2);
-    }
-    if r[1].abs() > r[2].abs() {
-        r.swap(1, 2);
-    }
-    (r, false)
+    // The other two: the polynomial divided by (z - big) from the constant term up (stable
+    // for the root of largest magnitude), then the stable quadratic formula. Taken from the
+    // trigonometric solution instead, roots near zero are differences of terms of the big
+    // root's size: with a far root (604 on a conformance fixture) lavapipe's cos and acos
+    // put one of them elsewhere and the GPU and the CPU were 7 % apart at a pixel.
+    let big = nonzero(z);
+    let q0 = -c1 / big;
+    let q1 = (q0 - c2) / big;
+    let q2 = (q1 - c3) / big;
+    let disc = (q1 * q1 - 4.0 * q0 * q2).max(0.0);
+    let q = nonzero(-0.5 * (q1 + sign_of(disc.sqrt(), q1)));
+    ([q0 / q, q / nonzero(q2), big], false)
 }
 
 /// The lit fraction at depth `zf` of a region with 6 moments `raw0 = (b1, b2, b3, b4)`,

@@ -18,7 +18,7 @@
 use super::common_epipolar::{
     epipole_march, normalised_depth, pixel_dir, ray_t, row_index, spot_segment,
 };
-use super::common_model::{PI, clamp, max, max_u, min, mix, phase_hg, transmittance_between};
+use super::common_model::{PI, clamp, max, max_u, min, phase_hg, transmittance_between};
 use super::common_moments::{lit_moments4, lit_moments6, moment_z};
 use super::common_prefiltered::{coeff4, fourier_step, region_start, turn};
 use super::common_prefiltered_projective::proj_column;
@@ -87,9 +87,11 @@ pub fn scatter_main(
     let wrap = f.anti_epipole[3] > 0.5;
     let yc: f32;
     let d: f32;
-    let xs: f32;
-    // Epipolar: the slice's column spacing and the ray's view angle.
-    let mut delta = 1.0;
+    // Projective: the ray's end column, the same in every row.
+    let mut xs = 0.0;
+    // Epipolar: the ray's end in column units times the row's column spacing (a row's end
+    // column is reach / delta), and its view angle.
+    let mut reach = 0.0;
     let mut theta = 0.0;
     // Projective: the ray's e1 component and depth m.
     let mut qd = 1.0;
@@ -122,25 +124,18 @@ pub fn scatter_main(
             y = clamp(y, 0.0, rows as f32);
         }
         yc = y;
-        // Slice parameters, interpolated between the two nearest slices like the bilinear
-        // fetch.
-        let yy = yc - 0.5;
-        let j0 = yy.floor();
-        let fy = yy - j0;
-        let s0 = inp.slices[row_index(j0, rows, wrap) as usize];
-        let s1 = inp.slices[row_index(j0 + 1.0, rows, wrap) as usize];
-        delta = mix(s0.delta, s1.delta, fy);
         d = normalised_depth(theta, f.theta[0], f.theta[1]);
-        xs = if spot {
+        reach = if spot {
             let q = (eye + dir * s - xyz(f.light_pos)).normalize();
-            clamp(q.dot(-axis), -1.0, 1.0).acos() / delta
+            clamp(q.dot(-axis), -1.0, 1.0).acos()
         } else {
-            s * theta.sin() / delta
+            s * theta.sin()
         };
     }
 
-    // The rectified rows the bilinear fetch blends (the second only with a non-zero weight)
-    // and the weight of the second.
+    // The two rectified rows the pixel lies between (the second only with a non-zero weight)
+    // and the weight of the second; each row is read at its own column for the ray's points
+    // (see the WGSL comment).
     let yb = yc - 0.5;
     let fy = yb - yb.floor();
     let row0 = row_index(yb.floor(), rows, wrap);
@@ -149,6 +144,7 @@ pub fn scatter_main(
     } else {
         row0
     };
+    let row_count = if row1 != row0 { 2 } else { 1 };
 
     let cos_theta_l = -xyz(f.light_dir).dot(dir);
     // Every region gets the full spot quadrature (see the WGSL comment).
@@ -171,99 +167,111 @@ pub fn scatter_main(
     // The sun's scattering coefficient times phase, the same for every region.
     let sun_scatter = f.medium[1] * phase_hg(f.medium[2], cos_theta_l);
 
-    // Regions: every region before the surface's, whole, and the surface's up to x_s, each
-    // weighted by this pixel's own unshadowed integral over its part [a, b] of the ray. One
-    // loop, as in the WGSL.
-    let last = min(max(xs, 0.0), width as f32 - 1.0) as u32;
+    // Per row, regions: every region before the surface's, whole, and the surface's up to
+    // x_s, each weighted by this pixel's own unshadowed integral over its part [a, b] of the
+    // ray (the row's own spacing places a and b). One loop per row, as in the WGSL.
     let mut total = 0.0;
-    for r in 0..regions {
-        let b0 = region_start(r, regions, width, spot) as f32;
-        let b1 = region_start(r + 1, regions, width, spot) as f32;
-        let is_last = last < b1 as u32 || r + 1 == regions;
-        let pos = if is_last {
-            clamp(xs - 0.5, b0 + 0.5, b1 - 0.5)
+    for side in 0..row_count {
+        let row = if side == 1 { row1 } else { row0 };
+        let row_weight = if side == 1 {
+            fy
+        } else if row_count == 1 {
+            1.0
         } else {
-            b1 - 0.5
+            1.0 - fy
         };
-        let (a, b) = if proj {
-            let mut a = 0.0;
-            if r > 0 {
-                a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
-            }
-            let b = if is_last {
-                s
+        let mut delta = 1.0;
+        if !proj {
+            delta = inp.slices[row as usize].delta;
+            xs = reach / delta;
+        }
+        let last = min(max(xs, 0.0), width as f32 - 1.0) as u32;
+        let mut row_total = 0.0;
+        for r in 0..regions {
+            let b0 = region_start(r, regions, width, spot) as f32;
+            let b1 = region_start(r + 1, regions, width, spot) as f32;
+            let is_last = last < b1 as u32 || r + 1 == regions;
+            let pos = if is_last {
+                clamp(xs - 0.5, b0 + 0.5, b1 - 0.5)
             } else {
-                min(
-                    proj_reach(f, proj_boundary(f, r + 1), m, spot, s * qd) / qd,
-                    s,
-                )
+                b1 - 0.5
             };
-            (a, b)
-        } else {
-            let b = if is_last {
-                s
+            let (a, b) = if proj {
+                let mut a = 0.0;
+                if r > 0 {
+                    a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
+                }
+                let b = if is_last {
+                    s
+                } else {
+                    min(
+                        proj_reach(f, proj_boundary(f, r + 1), m, spot, s * qd) / qd,
+                        s,
+                    )
+                };
+                (a, b)
             } else {
-                ray_t(f, b1, delta, theta, s, spot)
+                let b = if is_last {
+                    s
+                } else {
+                    ray_t(f, b1, delta, theta, s, spot)
+                };
+                (ray_t(f, b0, delta, theta, s, spot), b)
             };
-            (ray_t(f, b0, delta, theta, s, spot), b)
-        };
-        let weight = if spot {
-            spot_segment(f, eye, dir, a, b, panels)
-        } else {
-            sun_scatter * transmittance_between(f.medium[0], a, b)
-        };
-        // The (up to) four texels the bilinear fetch reads with a non-zero weight: columns
-        // x0 <= x1 of the region, rows row0 and row1.
-        let xb = pos - 0.5;
-        let fx = xb - xb.floor();
-        let x0 = clamp(xb.floor(), 0.0, width as f32 - 1.0) as u32;
-        let x1 = if xb > xb.floor() {
-            (x0 + 1).min(width - 1)
-        } else {
-            x0
-        };
-        // Their depth bounds: a region's prefix bounds only widen along the row, so column
-        // x1's cover column x0's.
-        let bounds0 = inp.bounds.load(x1, row0, 0);
-        let bounds1 = inp.bounds.load(x1, row1, 0);
-        let lo = min(bounds0[0], bounds1[0]);
-        let hi = max(bounds0[1], bounds1[1]);
-        let mut vis = 0.5;
-        if d <= lo {
-            vis = 1.0;
-        } else if d > hi {
-            vis = 0.0;
-        } else if moments {
-            // The region's moments, filtered bilinearly.
-            let fetch = |layer: u32| {
-                let load = |x: u32, y: u32| inp.filtered.load(x, y, layer);
-                let top = mix4(load(x0, row0), load(x1, row0), fx);
-                let bottom = mix4(load(x0, row1), load(x1, row1), fx);
-                mix4(top, bottom, fy)
-            };
-            let m0 = fetch(0);
-            if variant.moments == 6 {
-                let m1 = fetch(1);
-                vis = lit_moments6(m0, [m1[0], m1[1]], zf);
+            let weight = if spot {
+                spot_segment(f, eye, dir, a, b, panels)
             } else {
-                vis = lit_moments4(m0, zf);
-            }
-        } else {
-            for layer in 0..variant.layers() {
-                let coeff = coeffs[layer as usize];
-                let load = |x: u32, y: u32| inp.filtered.load(x, y, layer);
-                let top = mix4(load(x0, row0), load(x1, row0), fx);
-                let bottom = mix4(load(x0, row1), load(x1, row1), fx);
-                let texel = mix4(top, bottom, fy);
-                for k in 0..4 {
-                    vis += coeff[k] * (texel[k] * 2.0 - 1.0);
+                sun_scatter * transmittance_between(f.medium[0], a, b)
+            };
+            // The (up to) two texels of the row the linear fetch reads with a non-zero weight:
+            // columns x0 <= x1 of the region.
+            let xb = pos - 0.5;
+            let fx = xb - xb.floor();
+            let x0 = clamp(xb.floor(), 0.0, width as f32 - 1.0) as u32;
+            let x1 = if xb > xb.floor() {
+                (x0 + 1).min(width - 1)
+            } else {
+                x0
+            };
+            // Their depth bounds: a region's prefix bounds only widen along the row, so column
+            // x1's cover column x0's.
+            let lohi = inp.bounds.load(x1, row, 0);
+            let lo = lohi[0];
+            let hi = lohi[1];
+            let mut vis = 0.5;
+            if d <= lo {
+                vis = 1.0;
+            } else if d > hi {
+                vis = 0.0;
+            } else if moments {
+                // The region's moments, filtered linearly along the row.
+                let fetch = |layer: u32| {
+                    let load = |x: u32| inp.filtered.load(x, row, layer);
+                    mix4(load(x0), load(x1), fx)
+                };
+                let m0 = fetch(0);
+                if variant.moments == 6 {
+                    let m1 = fetch(1);
+                    vis = lit_moments6(m0, [m1[0], m1[1]], zf);
+                } else {
+                    vis = lit_moments4(m0, zf);
+                }
+            } else {
+                for layer in 0..variant.layers() {
+                    let coeff = coeffs[layer as usize];
+                    let load = |x: u32| inp.filtered.load(x, row, layer);
+                    let texel = mix4(load(x0), load(x1), fx);
+                    for k in 0..4 {
+                        vis += coeff[k] * (texel[k] * 2.0 - 1.0);
+                    }
                 }
             }
+            row_total += weight * clamp(vis, 0.0, 1.0);
+            if is_last {
+                break;
+            }
         }
-        total += weight * clamp(vis, 0.0, 1.0);
-        if is_last {
-            break;
-        }
+        total += row_weight * row_total;
     }
     let l = total;
     let c = color * l;

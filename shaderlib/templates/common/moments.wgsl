@@ -135,7 +135,8 @@ fn lit_moments4(raw: vec4<f32>, zf: f32) -> f32 {
 
 // The real roots of c1 + c2 z + c3 z^2 + c4 z^3, the largest in magnitude last (.z), and
 // whether it is at infinity (|c4| negligible: then .x, .y are the quadratic's roots).
-// Trigonometric solution of the monic cubic, each root polished by two Newton steps.
+// The root of largest magnitude from the trigonometric solution of the monic cubic, polished
+// by two Newton steps; the other two from the deflated quadratic.
 struct CubicRoots {
     r: vec3<f32>,
     at_infinity: bool,
@@ -154,26 +155,30 @@ fn cubic_roots(c1: f32, c2: f32, c3: f32, c4: f32) -> CubicRoots {
     let qq = 2.0 * a * a * a / 27.0 - a * b / 3.0 + c;
     let m = 2.0 * sqrt(-p / 3.0);
     let theta = acos(clamp(3.0 * qq / (p * m), -1.0, 1.0)) / 3.0;
-    var r = vec3<f32>(0.0);
-    for (var k = 0u; k < 3u; k++) {
-        var z = m * cos(theta - 2.0 * PI * f32(k) / 3.0) - a / 3.0;
-        for (var i = 0u; i < 2u; i++) {
-            let f = c1 + z * (c2 + z * (c3 + z * c4));
-            let df = c2 + z * (2.0 * c3 + 3.0 * z * c4);
-            if df != 0.0 {
-                z -= f / df;
-            }
+    // The root of largest magnitude: the greatest or the least of the trigonometric
+    // solution (theta in [0, pi / 3]: k = 0 and k = 2), polished by Newton's method.
+    let greatest = m * cos(theta) - a / 3.0;
+    let least = m * cos(theta - 4.0 * PI / 3.0) - a / 3.0;
+    var z = select(least, greatest, abs(greatest) >= abs(least));
+    for (var i = 0u; i < 2u; i++) {
+        let f = c1 + z * (c2 + z * (c3 + z * c4));
+        let df = c2 + z * (2.0 * c3 + 3.0 * z * c4);
+        if df != 0.0 {
+            z -= f / df;
         }
-        r[k] = z;
     }
-    // The root of largest magnitude last.
-    if abs(r.x) > abs(r.z) {
-        r = r.zyx;
-    }
-    if abs(r.y) > abs(r.z) {
-        r = r.xzy;
-    }
-    return CubicRoots(r, false);
+    // The other two: the polynomial divided by (z - big) from the constant term up (stable
+    // for the root of largest magnitude), then the stable quadratic formula. Taken from the
+    // trigonometric solution instead, roots near zero are differences of terms of the big
+    // root's size: with a far root (604 on a conformance fixture) lavapipe's cos and acos
+    // put one of them elsewhere and the GPU and the CPU were 7 % apart at a pixel.
+    let big = nonzero(z);
+    let q0 = -c1 / big;
+    let q1 = (q0 - c2) / big;
+    let q2 = (q1 - c3) / big;
+    let disc = max(q1 * q1 - 4.0 * q0 * q2, 0.0);
+    let q = nonzero(-0.5 * (q1 + sign_of(sqrt(disc), q1)));
+    return CubicRoots(vec3<f32>(q0 / q, q / nonzero(q2), big), false);
 }
 
 // The lit fraction at depth zf of a region with 6 moments raw0 = (b1, b2, b3, b4),
