@@ -13,7 +13,9 @@
 //! - [`truth`]: the two ground truths, `exact` and `shadow_map`, accumulated in f64;
 //! - [`metrics`]: error metrics between images and over image sequences;
 //! - [`image`]: float images, PFM and PNG output, tone mapping and composites;
-//! - [`kernels`]: a line-comparable CPU mirror of every GPU kernel.
+//! - [`kernels`]: a line-comparable CPU mirror of every GPU kernel;
+//! - [`partial_sum_tree`]: the partial-sum-tree method (Baran et al. 2010) on the CPU, the
+//!   reference its kernels will mirror (issue 15; no kernel yet).
 //!
 //! Conventions (used everywhere in the workspace): right-handed world, `+y` up, lengths in
 //! metres, `sigma_t` in 1/m. A directional light's `direction` is the direction the light
@@ -27,6 +29,7 @@ pub mod image;
 pub mod kernels;
 pub mod metrics;
 pub mod model;
+pub mod partial_sum_tree;
 pub mod paths;
 pub mod projective;
 pub mod random_poses;

@@ -1,0 +1,209 @@
+//! The partial-sum-tree method's CPU reference (`scatter_reference::partial_sum_tree`, issue
+//! 15) on every directional suite pose: against the brute-force walk over the same rectified
+//! rows (`minmax`'s reference: the same sum with exact per-texel weights, so the difference
+//! is the rank-r integrand alone) and against the `shadow_map` truth. CPU only.
+//!
+//! `cargo test -p scatter-conformance --test partial_sum_tree -- --nocapture` prints the table.
+
+use scatter_reference::buffers::{GBuffer, ShadowMap};
+use scatter_reference::bvh::Bvh;
+use scatter_reference::image::Image;
+use scatter_reference::kernels::minmax_traverse::TraverseInputs;
+use scatter_reference::kernels::run_minmax;
+use scatter_reference::kernels::texture::Tex;
+use scatter_reference::metrics;
+use scatter_reference::partial_sum_tree::{Separable, partial_sum_tree};
+use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
+use scatter_reference::truth::{self, TruthSettings, Visibility};
+use scatter_shaderlib::minmax::MinmaxVariant;
+use scatter_shaderlib::prefiltered::FrameSettings;
+
+const SCREEN: (u32, u32) = (96, 54);
+const RECTIFIED: [u32; 2] = [1024, 512];
+const SHADOW_MAP: u32 = 512;
+/// The paper's rank.
+const RANK: usize = 4;
+/// The issue's bar against the `shadow_map` truth, away from the marched epipole ring (sun).
+/// Met at 1024 columns x 512 slices; at 256 x 256 window and foliage/epipole_on_screen miss
+/// it (2.3-5.3 %) exactly as the brute-force walk (minmax) does: the map's resolution.
+const SUN_BAR: f64 = 0.02;
+/// Most the rank-4 sum may differ from the brute-force walk over the same rows (rel L1 of
+/// the image): the paper's 1-2 % reconstruction error of the integrand, at its lower end.
+const RANK_BAR: f64 = 0.01;
+
+/// Rel L1 of `a` against `b` over the pixels `keep` selects (first three channels).
+fn rel_l1(a: &[[f32; 4]], b: &[[f32; 4]], keep: &dyn Fn(usize) -> bool) -> f64 {
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for (i, (x, y)) in a.iter().zip(b).enumerate() {
+        if !keep(i) {
+            continue;
+        }
+        for k in 0..3 {
+            num += f64::from((x[k] - y[k]).abs());
+            den += f64::from(y[k].abs());
+        }
+    }
+    if den > 0.0 { num / den } else { num }
+}
+
+#[test]
+fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_sun_pose() {
+    let mut failures = Vec::new();
+    let start = std::time::Instant::now();
+    println!(
+        "| scene/pose | kernel rank-{RANK} max error | vs brute-force walk | vs truth (ring excluded) | vs truth | minmax vs truth | updates / queries |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for &name in SceneName::ALL {
+        if name == SceneName::SpotGrate {
+            continue;
+        }
+        for &pose in Pose::ALL {
+            let scene = suite::scene(name, pose, MediumPreset::Default, SCREEN.0, SCREEN.1);
+            let bvh = Bvh::build(&scene.geometry);
+            let gbuf = GBuffer::cast(&scene, &bvh);
+            let sm = ShadowMap::build(&scene, &bvh, SHADOW_MAP).expect("shadow map");
+            let settings = FrameSettings::for_screen(SCREEN.0, SCREEN.1);
+            let variant = MinmaxVariant::default();
+            let run = run_minmax(&variant, RECTIFIED, &gbuf, &scene, &sm, &settings)
+                .unwrap_or_else(|e| panic!("{name}/{pose}: {e}"));
+            let depth = Tex {
+                width: gbuf.width,
+                height: gbuf.height,
+                data: gbuf.view_depth.clone(),
+            };
+            let smt = Tex {
+                width: sm.size,
+                height: sm.size,
+                data: sm.depth.clone(),
+            };
+            let inputs = TraverseInputs {
+                frame: &run.frame.uniforms,
+                slices: &run.frame.slices,
+                depth: &depth,
+                shadow_map: &smt,
+                tree: &run.tree,
+            };
+            let pst = partial_sum_tree(&inputs, &run.rectified, false, RANK)
+                .unwrap_or_else(|e| panic!("{name}/{pose}: {e}"));
+            // The integrand's own error: the rank-4 kernel against exp(-sigma v / sin theta)
+            // on a grid finer than the SVD's, off its nodes.
+            let kernel_err = kernel_error(&pst.separable, run.frame.uniforms.medium[0]);
+            let marched: Vec<bool> = run.brute.visits.iter().map(|&v| v == 0).collect();
+            let all = |_: usize| true;
+            let away = |i: usize| !marched[i];
+            let vs_brute = rel_l1(&pst.exact, &run.brute.exact, &away);
+            let truth = truth::render(
+                &scene,
+                &gbuf,
+                &Visibility::ShadowMap(&sm),
+                &TruthSettings::default(),
+                &|| (),
+            );
+            let t4: Vec<[f32; 4]> = truth.data.iter().map(|c| [c[0], c[1], c[2], 1.0]).collect();
+            let vs_truth_away = rel_l1(&pst.exact, &t4, &away);
+            let vs_truth = rel_l1(&pst.exact, &t4, &all);
+            let image = Image::from_pixels(
+                gbuf.width,
+                gbuf.height,
+                pst.exact.iter().map(|c| [c[0], c[1], c[2]]).collect(),
+            );
+            let report = metrics::compare(&image, &truth).expect("same size");
+            let minmax = metrics::compare(&run.output, &truth).expect("same size");
+            println!(
+                "| {name}/{pose} | {:.2e} | {:.3} % | {:.3} % | {:.3} % | {:.3} % | {} / {} |",
+                kernel_err,
+                100.0 * vs_brute,
+                100.0 * vs_truth_away,
+                100.0 * vs_truth,
+                100.0 * minmax.rel_l1,
+                pst.updates,
+                pst.queries
+            );
+            if report.non_finite > 0 {
+                failures.push(format!(
+                    "{name}/{pose}: {} non-finite pixels",
+                    report.non_finite
+                ));
+            }
+            if vs_brute.is_nan() || vs_brute > RANK_BAR {
+                failures.push(format!(
+                    "{name}/{pose}: rank-{RANK} sweep {:.3} % from the brute-force walk (bar {:.1} %)",
+                    100.0 * vs_brute,
+                    100.0 * RANK_BAR
+                ));
+            }
+            if vs_truth_away.is_nan() || vs_truth_away > SUN_BAR {
+                failures.push(format!(
+                    "{name}/{pose}: {:.3} % from the shadow_map truth away from the ring (bar {:.1} %)",
+                    100.0 * vs_truth_away,
+                    100.0 * SUN_BAR
+                ));
+            }
+        }
+    }
+    println!("partial_sum_tree: {:.1} s", start.elapsed().as_secs_f64());
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Largest absolute error of the separable kernel against `exp(-sigma v / sin theta)` (whose
+/// values lie in (0, 1]) at 4x the SVD grid's resolution per axis.
+fn kernel_error(sep: &Separable, sigma: f32) -> f64 {
+    let n = 4 * scatter_reference::partial_sum_tree::GRID;
+    let mut worst = 0.0f64;
+    for i in 0..n {
+        let v = sep.v_max * i as f32 / (n - 1) as f32;
+        for j in 0..n {
+            let t = sep.theta_lo + (sep.theta_hi - sep.theta_lo) * j as f32 / (n - 1) as f32;
+            let exact = (-f64::from(sigma) * f64::from(v) / f64::from(t).sin()).exp();
+            worst = worst.max((f64::from(sep.eval(v, t)) - exact).abs());
+        }
+    }
+    worst
+}
+
+#[test]
+fn spot_lights_are_refused_with_a_reason() {
+    let scene = suite::scene(
+        SceneName::SpotGrate,
+        Pose::Ordinary,
+        MediumPreset::Default,
+        16,
+        9,
+    );
+    let bvh = Bvh::build(&scene.geometry);
+    let gbuf = GBuffer::cast(&scene, &bvh);
+    let sm = ShadowMap::build(&scene, &bvh, 64).expect("shadow map");
+    let variant = MinmaxVariant {
+        light: scatter_shaderlib::prefiltered::LightKind::Spot,
+        ..MinmaxVariant::default()
+    };
+    let run = run_minmax(
+        &variant,
+        [64, 64],
+        &gbuf,
+        &scene,
+        &sm,
+        &FrameSettings::for_screen(16, 9),
+    )
+    .expect("minmax");
+    let depth = Tex {
+        width: gbuf.width,
+        height: gbuf.height,
+        data: gbuf.view_depth.clone(),
+    };
+    let smt = Tex {
+        width: sm.size,
+        height: sm.size,
+        data: sm.depth.clone(),
+    };
+    let inputs = TraverseInputs {
+        frame: &run.frame.uniforms,
+        slices: &run.frame.slices,
+        depth: &depth,
+        shadow_map: &smt,
+        tree: &run.tree,
+    };
+    let err = partial_sum_tree(&inputs, &run.rectified, true, RANK).unwrap_err();
+    assert!(err.to_string().contains("directional lights only"), "{err}");
+}
