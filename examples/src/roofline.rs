@@ -24,7 +24,7 @@ use std::time::{Duration, Instant};
 use scatter_reference::suite::SceneName;
 use scatter_runtime::Context;
 use scatter_runtime::shaderlib::minmax::tree_width;
-use scatter_runtime::shaderlib::prefiltered::PrefilteredVariant;
+use scatter_runtime::shaderlib::prefiltered::{PrefilteredVariant, RECTIFY_TEXELS};
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::wgpu;
 
@@ -367,7 +367,6 @@ pub fn kernel_costs() -> Vec<KernelCost> {
     let [w, h] = SCREEN.map(u64::from);
     let [wr, hr] = RECTIFIED.map(u64::from);
     let pixels = w * h;
-    let texels = wr * hr;
     // Default prefiltered variant: 32 bases (8 layers), 8 per thread (2 layers, 4 threads per
     // row and region), 3 regions, rgba8unorm.
     let (layers, lpt, threads, regions) = (8.0, 2.0, 4u64, 3u64);
@@ -402,11 +401,19 @@ pub fn kernel_costs() -> Vec<KernelCost> {
         KernelCost {
             method: "prefiltered, minmax",
             kernel: "rectify",
-            invocations: texels,
-            // One shadow-map load; cos and sin of the slice angle, atan2 of the occluder.
-            counts: [4.0, 1.0, 0.0, 3.0, 30.0],
+            invocations: wr.div_ceil(u64::from(RECTIFY_TEXELS)) * hr,
+            // Per column (RECTIFY_TEXELS of a row per invocation): one shadow-map load, an
+            // atan2 of the occluder, a 4-byte store; once per invocation cos and sin of the
+            // slice angle.
+            counts: [
+                4.0 * RECTIFY_TEXELS as f64,
+                RECTIFY_TEXELS as f64,
+                0.0,
+                2.0 + RECTIFY_TEXELS as f64,
+                30.0 * RECTIFY_TEXELS as f64,
+            ],
             low: None,
-            trips: "none",
+            trips: "RECTIFY_TEXELS columns",
         },
         KernelCost {
             method: "prefiltered m32-t8-r3",

@@ -66,6 +66,7 @@ constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
 constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
 constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
+constant uint TEXELS = 8u;
 
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
@@ -122,10 +123,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_1 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_3 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_1, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_3, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -215,11 +216,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_2 = sigma_t * len;
-    if (x_2 < 0.0001) {
-        return len * (1.0 - (0.5 * x_2));
+    float x_4 = sigma_t * len;
+    if (x_4 < 0.0001) {
+        return len * (1.0 - (0.5 * x_4));
     }
-    return (1.0 - metal::exp(-(x_2))) / sigma_t;
+    return (1.0 - metal::exp(-(x_4))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -239,8 +240,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_3 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_3 * x_3) * (3.0 - (2.0 * x_3));
+    float x_5 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_5 * x_5) * (3.0 - (2.0 * x_5));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -253,8 +254,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_4 = eye + (dir * t);
-    metal::float3 to_x = x_4 - light_pos;
+    metal::float3 x_6 = eye + (dir * t);
+    metal::float3 to_x = x_6 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d);
@@ -347,9 +348,9 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
 
 metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e,
-    float x
+    float x_1
 ) {
-    float tau = metal::tan(e.theta_a + (x * e.dtheta));
+    float tau = metal::tan(e.theta_a + (x_1 * e.dtheta));
     return metal::float2(e.t_close + (e.dist * tau), (e.dtheta * e.dist) * (1.0 + (tau * tau)));
 }
 
@@ -398,6 +399,43 @@ float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return _e5;
 }
 
+float rectify_texel(
+    uint x_2,
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice,
+    metal::float3 e_1,
+    bool spot,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
+    metal::texture2d<float, metal::access::sample> shadow_map
+) {
+    float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+    float col = (static_cast<float>(x_2) + 0.5) * slice.delta;
+    metal::float4 _e10 = frame.axis;
+    metal::float3 axis = _e10.xyz;
+    if (spot) {
+        metal::float3 l_2 = (-(axis) * metal::cos(col)) + (e_1 * metal::sin(col));
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e21 = frame;
+        metal::float4 _e24 = frame.light_pos;
+        float _e27 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21, shadow_map, _e24.xyz, l_2);
+        if (_e27 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
+            float dist = frame.axis.w;
+            theta_occ = metal::atan2(_e27 * metal::sin(col), dist - (_e27 * metal::cos(col)));
+        }
+    } else {
+        metal::float4 _e43 = frame.eye;
+        metal::float3 o_2 = _e43.xyz + (e_1 * col);
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e48 = frame;
+        float _e51 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e48, shadow_map, o_2, -(axis));
+        if (_e51 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
+            theta_occ = metal::atan2(col, -(_e51));
+        }
+    }
+    float _e56 = theta_occ;
+    float _e60 = frame.theta.x;
+    float _e64 = frame.theta.y;
+    float _e65 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56, _e60, _e64);
+    return _e65;
+}
+
 struct rectifyInput {
 };
 kernel void rectify(
@@ -409,51 +447,50 @@ kernel void rectify(
 , constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
 ) {
     bool local = {};
-    float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
-    uint x_5 = id.x;
+    uint x = {};
+    uint first = id.x * TEXELS;
     uint y_1 = id.y;
-    uint _e7 = frame.sizes.z;
-    if (!((x_5 >= _e7))) {
-        uint _e13 = frame.sizes.w;
-        local = y_1 >= _e13;
+    uint _e8 = frame.sizes.z;
+    if (!((first >= _e8))) {
+        uint _e14 = frame.sizes.w;
+        local = y_1 >= _e14;
     } else {
         local = true;
     }
-    bool _e18 = local;
-    if (_e18) {
+    bool _e19 = local;
+    if (_e19) {
         return;
     }
-    metal::float4 _e21 = slices[metal::min(unsigned(y_1), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e24 = frame;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e26 = frame;
-    float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
-    metal::float3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
-    float col = (static_cast<float>(x_5) + 0.5) * _e22.delta;
-    metal::float4 _e36 = frame.axis;
-    metal::float3 axis = _e36.xyz;
-    if (true) {
-        metal::float3 l_2 = (-(axis) * metal::cos(col)) + (_e28 * metal::sin(col));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e46 = frame;
-        metal::float4 _e49 = frame.light_pos;
-        float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, shadow_map, _e49.xyz, l_2);
-        if (_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
-            float dist = frame.axis.w;
-            theta_occ = metal::atan2(_e52 * metal::sin(col), dist - (_e52 * metal::cos(col)));
+    metal::float4 _e22 = slices[metal::min(unsigned(y_1), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e23 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e22);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e25 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e27 = frame;
+    float _e28 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e27, y_1);
+    metal::float3 _e29 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e25, _e28);
+    uint _e35 = frame.sizes.z;
+    uint end = metal::min(first + TEXELS, _e35);
+    x = first;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e51 = x;
+            x = _e51 + 1u;
         }
-    } else {
-        metal::float4 _e68 = frame.eye;
-        metal::float3 o_2 = _e68.xyz + (_e28 * col);
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e73 = frame;
-        float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e73, shadow_map, o_2, -(axis));
-        if (_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
-            theta_occ = metal::atan2(col, -(_e76));
+        loop_init_2 = false;
+        uint _e38 = x;
+        if (_e38 < end) {
+        } else {
+            break;
+        }
+        {
+            uint _e40 = x;
+            uint _e42 = x;
+            float _e44 = rectify_texel(_e42, _e23, _e29, true, frame, shadow_map);
+            rectified.write(metal::float4(_e44, 0.0, 0.0, 0.0), metal::uint2(metal::uint2(_e40, y_1)));
         }
     }
-    float _e81 = theta_occ;
-    float _e85 = frame.theta.x;
-    float _e89 = frame.theta.y;
-    float _e90 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
-    rectified.write(metal::float4(_e90, 0.0, 0.0, 0.0), metal::uint2(metal::uint2(x_5, y_1)));
     return;
 }

@@ -56,6 +56,7 @@ const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: array<f32, 4> = array<f32, 4>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
 const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
+const TEXELS: u32 = 8u;
 
 @group(0) @binding(0) 
 var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX;
@@ -108,9 +109,9 @@ fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_nag
         return 2f;
     }
     let n_1 = v_2.size.x;
-    let x_1 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let x_3 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_1, y), 0i);
+    let _e49 = textureLoad(sm, vec2<u32>(x_3, y), 0i);
     return _e49.x;
 }
 
@@ -184,11 +185,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_2 = (sigma_t * len);
-    if (x_2 < 0.0001f) {
-        return (len * (1f - (0.5f * x_2)));
+    let x_4 = (sigma_t * len);
+    if (x_4 < 0.0001f) {
+        return (len * (1f - (0.5f * x_4)));
     }
-    return ((1f - exp(-(x_2))) / sigma_t);
+    return ((1f - exp(-(x_4))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -200,13 +201,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_3 * x_3) * (3f - (2f * x_3)));
+    let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_5 * x_5) * (3f - (2f * x_5)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_4 = (eye + (dir * t));
-    let to_x = (x_4 - light_pos);
+    let x_6 = (eye + (dir * t));
+    let to_x = (x_6 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d = sqrt(d2_);
     let travel = (to_x / vec3(d));
@@ -270,8 +271,8 @@ fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: 
     return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / f32(n)));
 }
 
-fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x: f32) -> vec2<f32> {
-    let tau = tan((e.theta_a + (x * e.dtheta)));
+fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x_1: f32) -> vec2<f32> {
+    let tau = tan((e.theta_a + (x_1 * e.dtheta)));
     return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
@@ -301,55 +302,80 @@ fn sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX
     return _e5;
 }
 
+fn rectify_texel(x_2: u32, slice: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, spot: bool) -> f32 {
+    var theta_occ: f32 = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+
+    let col = ((f32(x_2) + 0.5f) * slice.delta);
+    let _e10 = frame.axis;
+    let axis = _e10.xyz;
+    if spot {
+        let l_2 = ((-(axis) * cos(col)) + (e_1 * sin(col)));
+        let _e21 = frame;
+        let _e24 = frame.light_pos;
+        let _e27 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21, shadow_map, _e24.xyz, l_2);
+        if (_e27 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
+            let dist = frame.axis.w;
+            theta_occ = atan2((_e27 * sin(col)), (dist - (_e27 * cos(col))));
+        }
+    } else {
+        let _e43 = frame.eye;
+        let o_2 = (_e43.xyz + (e_1 * col));
+        let _e48 = frame;
+        let _e51 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e48, shadow_map, o_2, -(axis));
+        if (_e51 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
+            theta_occ = atan2(col, -(_e51));
+        }
+    }
+    let _e56 = theta_occ;
+    let _e60 = frame.theta.x;
+    let _e64 = frame.theta.y;
+    let _e65 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56, _e60, _e64);
+    return _e65;
+}
+
 @compute @workgroup_size(8, 8, 1) 
 fn rectify(@builtin(global_invocation_id) id: vec3<u32>) {
     var local: bool;
-    var theta_occ: f32 = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+    var x: u32;
 
-    let x_5 = id.x;
+    let first = (id.x * TEXELS);
     let y_1 = id.y;
-    let _e7 = frame.sizes.z;
-    if !((x_5 >= _e7)) {
-        let _e13 = frame.sizes.w;
-        local = (y_1 >= _e13);
+    let _e8 = frame.sizes.z;
+    if !((first >= _e8)) {
+        let _e14 = frame.sizes.w;
+        local = (y_1 >= _e14);
     } else {
         local = true;
     }
-    let _e18 = local;
-    if _e18 {
+    let _e19 = local;
+    if _e19 {
         return;
     }
-    let _e21 = slices[y_1];
-    let _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21);
-    let _e24 = frame;
-    let _e26 = frame;
-    let _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
-    let _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
-    let col = ((f32(x_5) + 0.5f) * _e22.delta);
-    let _e36 = frame.axis;
-    let axis = _e36.xyz;
-    if false {
-        let l_2 = ((-(axis) * cos(col)) + (_e28 * sin(col)));
-        let _e46 = frame;
-        let _e49 = frame.light_pos;
-        let _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, shadow_map, _e49.xyz, l_2);
-        if (_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
-            let dist = frame.axis.w;
-            theta_occ = atan2((_e52 * sin(col)), (dist - (_e52 * cos(col))));
+    let _e22 = slices[y_1];
+    let _e23 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e22);
+    let _e25 = frame;
+    let _e27 = frame;
+    let _e28 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e27, y_1);
+    let _e29 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e25, _e28);
+    let _e35 = frame.sizes.z;
+    let end = min((first + TEXELS), _e35);
+    x = first;
+    loop {
+        let _e38 = x;
+        if (_e38 < end) {
+        } else {
+            break;
         }
-    } else {
-        let _e68 = frame.eye;
-        let o_2 = (_e68.xyz + (_e28 * col));
-        let _e73 = frame;
-        let _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e73, shadow_map, o_2, -(axis));
-        if (_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
-            theta_occ = atan2(col, -(_e76));
+        {
+            let _e40 = x;
+            let _e42 = x;
+            let _e44 = rectify_texel(_e42, _e23, _e29, false);
+            textureStore(rectified, vec2<u32>(_e40, y_1), vec4<f32>(_e44, 0f, 0f, 0f));
+        }
+        continuing {
+            let _e51 = x;
+            x = (_e51 + 1u);
         }
     }
-    let _e81 = theta_occ;
-    let _e85 = frame.theta.x;
-    let _e89 = frame.theta.y;
-    let _e90 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
-    textureStore(rectified, vec2<u32>(x_5, y_1), vec4<f32>(_e90, 0f, 0f, 0f));
     return;
 }

@@ -57,6 +57,7 @@ const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](0.34785485, 0.65214515, 0.65214515, 0.34785485);
 const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
+const uint TEXELS = 8u;
 
 layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _group_0_binding_0_cs; };
 
@@ -108,10 +109,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_1 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_3 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
     uint y = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_1, y)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_3, y)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
     return _e49.x;
 }
 
@@ -183,11 +184,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_2 = (sigma_t * len);
-    if ((x_2 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_2)));
+    float x_4 = (sigma_t * len);
+    if ((x_4 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_4)));
     }
-    return ((1.0 - exp(-(x_2))) / sigma_t);
+    return ((1.0 - exp(-(x_4))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -199,13 +200,13 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_3 * x_3) * (3.0 - (2.0 * x_3)));
+    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_4 = (eye + (dir * t));
-    vec3 to_x = (x_4 - light_pos);
+    vec3 x_6 = (eye + (dir * t));
+    vec3 to_x = (x_6 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     vec3 travel = (to_x / vec3(d));
@@ -272,8 +273,8 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
     return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / float(n)));
 }
 
-vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x) {
-    float tau = tan((e.theta_a + (x * e.dtheta)));
+vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_1) {
+    float tau = tan((e.theta_a + (x_1 * e.dtheta)));
     return vec2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
@@ -303,55 +304,81 @@ float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e5;
 }
 
+float rectify_texel(uint x_2, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice, vec3 e_1, bool spot) {
+    float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+    float col = ((float(x_2) + 0.5) * slice.delta);
+    vec4 _e10 = _group_0_binding_0_cs.axis;
+    vec3 axis = _e10.xyz;
+    if (spot) {
+        vec3 l_2 = ((-(axis) * cos(col)) + (e_1 * sin(col)));
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e21 = _group_0_binding_0_cs;
+        vec4 _e24 = _group_0_binding_0_cs.light_pos;
+        float _e27 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21, _group_0_binding_2_cs, _e24.xyz, l_2);
+        if ((_e27 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
+            float dist = _group_0_binding_0_cs.axis.w;
+            theta_occ = atan((_e27 * sin(col)), (dist - (_e27 * cos(col))));
+        }
+    } else {
+        vec4 _e43 = _group_0_binding_0_cs.eye;
+        vec3 o_2 = (_e43.xyz + (e_1 * col));
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e48 = _group_0_binding_0_cs;
+        float _e51 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e48, _group_0_binding_2_cs, o_2, -(axis));
+        if ((_e51 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
+            theta_occ = atan(col, -(_e51));
+        }
+    }
+    float _e56 = theta_occ;
+    float _e60 = _group_0_binding_0_cs.theta.x;
+    float _e64 = _group_0_binding_0_cs.theta.y;
+    float _e65 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56, _e60, _e64);
+    return _e65;
+}
+
 void main() {
     uvec3 id = gl_GlobalInvocationID;
     bool local = false;
-    float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
-    uint x_5 = id.x;
+    uint x = 0u;
+    uint first = (id.x * TEXELS);
     uint y_1 = id.y;
-    uint _e7 = _group_0_binding_0_cs.sizes.z;
-    if (!((x_5 >= _e7))) {
-        uint _e13 = _group_0_binding_0_cs.sizes.w;
-        local = (y_1 >= _e13);
+    uint _e8 = _group_0_binding_0_cs.sizes.z;
+    if (!((first >= _e8))) {
+        uint _e14 = _group_0_binding_0_cs.sizes.w;
+        local = (y_1 >= _e14);
     } else {
         local = true;
     }
-    bool _e18 = local;
-    if (_e18) {
+    bool _e19 = local;
+    if (_e19) {
         return;
     }
-    vec4 _e21 = _group_0_binding_1_cs[y_1];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e24 = _group_0_binding_0_cs;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e26 = _group_0_binding_0_cs;
-    float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
-    vec3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
-    float col = ((float(x_5) + 0.5) * _e22.delta);
-    vec4 _e36 = _group_0_binding_0_cs.axis;
-    vec3 axis = _e36.xyz;
-    if (true) {
-        vec3 l_2 = ((-(axis) * cos(col)) + (_e28 * sin(col)));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e46 = _group_0_binding_0_cs;
-        vec4 _e49 = _group_0_binding_0_cs.light_pos;
-        float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, _group_0_binding_2_cs, _e49.xyz, l_2);
-        if ((_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
-            float dist = _group_0_binding_0_cs.axis.w;
-            theta_occ = atan((_e52 * sin(col)), (dist - (_e52 * cos(col))));
+    vec4 _e22 = _group_0_binding_1_cs[y_1];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e23 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e22);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e25 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e27 = _group_0_binding_0_cs;
+    float _e28 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e27, y_1);
+    vec3 _e29 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e25, _e28);
+    uint _e35 = _group_0_binding_0_cs.sizes.z;
+    uint end = min((first + TEXELS), _e35);
+    x = first;
+    bool loop_init_2 = true;
+    while(true) {
+        if (!loop_init_2) {
+            uint _e51 = x;
+            x = (_e51 + 1u);
         }
-    } else {
-        vec4 _e68 = _group_0_binding_0_cs.eye;
-        vec3 o_2 = (_e68.xyz + (_e28 * col));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e73 = _group_0_binding_0_cs;
-        float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e73, _group_0_binding_2_cs, o_2, -(axis));
-        if ((_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
-            theta_occ = atan(col, -(_e76));
+        loop_init_2 = false;
+        uint _e38 = x;
+        if ((_e38 < end)) {
+        } else {
+            break;
+        }
+        {
+            uint _e40 = x;
+            uint _e42 = x;
+            float _e44 = rectify_texel(_e42, _e23, _e29, true);
+            imageStore(_group_0_binding_3_cs, ivec2(uvec2(_e40, y_1)), vec4(_e44, 0.0, 0.0, 0.0));
         }
     }
-    float _e81 = theta_occ;
-    float _e85 = _group_0_binding_0_cs.theta.x;
-    float _e89 = _group_0_binding_0_cs.theta.y;
-    float _e90 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
-    imageStore(_group_0_binding_3_cs, ivec2(uvec2(x_5, y_1)), vec4(_e90, 0.0, 0.0, 0.0));
     return;
 }
 

@@ -62,6 +62,7 @@ static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 static const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 static const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 static const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
+static const uint TEXELS = 8u;
 
 cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX frame; }
 ByteAddressBuffer slices : register(t1);
@@ -117,9 +118,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
         return 2.0;
     }
     uint n_1 = v_2.size.x;
-    uint x_1 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_3 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
     uint y = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_1, y), int(0)));
+    float4 _e49 = sm.Load(int3(uint2(x_3, y), int(0)));
     return _e49.x;
 }
 
@@ -198,11 +199,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_2 = (sigma_t * len);
-    if ((x_2 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_2)));
+    float x_4 = (sigma_t * len);
+    if ((x_4 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_4)));
     }
-    return ((1.0 - exp(-(x_2))) / sigma_t);
+    return ((1.0 - exp(-(x_4))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -216,14 +217,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_3 * x_3) * (3.0 - (2.0 * x_3)));
+    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_4 = (eye + (dir * t));
-    float3 to_x = (x_4 - light_pos);
+    float3 x_6 = (eye + (dir * t));
+    float3 to_x = (x_6 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     float3 travel = (to_x / (d).xxx);
@@ -309,9 +310,9 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
     return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
 }
 
-float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x)
+float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_1)
 {
-    float tau = tan((e.theta_a + (x * e.dtheta)));
+    float tau = tan((e.theta_a + (x_1 * e.dtheta)));
     return float2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
@@ -369,56 +370,87 @@ float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e5;
 }
 
+float rectify_texel(uint x_2, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice, float3 e_1, bool spot)
+{
+    float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+
+    float col = ((float(x_2) + 0.5) * slice.delta);
+    float4 _e10 = frame.axis;
+    float3 axis = _e10.xyz;
+    if (spot) {
+        float3 l_2 = ((-(axis) * cos(col)) + (e_1 * sin(col)));
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e21 = frame;
+        float4 _e24 = frame.light_pos;
+        const float _e27 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21, shadow_map, _e24.xyz, l_2);
+        if ((_e27 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
+            float dist = frame.axis.w;
+            theta_occ = atan2((_e27 * sin(col)), (dist - (_e27 * cos(col))));
+        }
+    } else {
+        float4 _e43 = frame.eye;
+        float3 o_2 = (_e43.xyz + (e_1 * col));
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e48 = frame;
+        const float _e51 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e48, shadow_map, o_2, -(axis));
+        if ((_e51 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
+            theta_occ = atan2(col, -(_e51));
+        }
+    }
+    float _e56 = theta_occ;
+    float _e60 = frame.theta.x;
+    float _e64 = frame.theta.y;
+    const float _e65 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56, _e60, _e64);
+    return _e65;
+}
+
 [numthreads(8, 8, 1)]
 void rectify(uint3 id : SV_DispatchThreadID)
 {
     bool local = (bool)0;
-    float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+    uint x = (uint)0;
 
-    uint x_5 = id.x;
+    uint first = (id.x * TEXELS);
     uint y_1 = id.y;
-    uint _e7 = frame.sizes.z;
-    if (!((x_5 >= _e7))) {
-        uint _e13 = frame.sizes.w;
-        local = (y_1 >= _e13);
+    uint _e8 = frame.sizes.z;
+    if (!((first >= _e8))) {
+        uint _e14 = frame.sizes.w;
+        local = (y_1 >= _e14);
     } else {
         local = true;
     }
-    bool _e18 = local;
-    if (_e18) {
+    bool _e19 = local;
+    if (_e19) {
         return;
     }
-    float4 _e21 = asfloat(slices.Load4(y_1*16));
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e22 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e24 = frame;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e26 = frame;
-    const float _e27 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e26, y_1);
-    const float3 _e28 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24, _e27);
-    float col = ((float(x_5) + 0.5) * _e22.delta);
-    float4 _e36 = frame.axis;
-    float3 axis = _e36.xyz;
-    if (true) {
-        float3 l_2 = ((-(axis) * cos(col)) + (_e28 * sin(col)));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e46 = frame;
-        float4 _e49 = frame.light_pos;
-        const float _e52 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, shadow_map, _e49.xyz, l_2);
-        if ((_e52 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
-            float dist = frame.axis.w;
-            theta_occ = atan2((_e52 * sin(col)), (dist - (_e52 * cos(col))));
+    float4 _e22 = asfloat(slices.Load4(y_1*16));
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e23 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e22);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e25 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e27 = frame;
+    const float _e28 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e27, y_1);
+    const float3 _e29 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e25, _e28);
+    uint _e35 = frame.sizes.z;
+    uint end = min((first + TEXELS), _e35);
+    x = first;
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e51 = x;
+            x = (_e51 + 1u);
         }
-    } else {
-        float4 _e68 = frame.eye;
-        float3 o_2 = (_e68.xyz + (_e28 * col));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e73 = frame;
-        const float _e76 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e73, shadow_map, o_2, -(axis));
-        if ((_e76 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
-            theta_occ = atan2(col, -(_e76));
+        loop_init_2 = false;
+        uint _e38 = x;
+        if ((_e38 < end)) {
+        } else {
+            break;
+        }
+        {
+            uint _e40 = x;
+            uint _e42 = x;
+            const float _e44 = rectify_texel(_e42, _e23, _e29, true);
+            rectified[uint2(_e40, y_1)] = float4(_e44, 0.0, 0.0, 0.0);
         }
     }
-    float _e81 = theta_occ;
-    float _e85 = frame.theta.x;
-    float _e89 = frame.theta.y;
-    const float _e90 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e81, _e85, _e89);
-    rectified[uint2(x_5, y_1)] = float4(_e90, 0.0, 0.0, 0.0);
     return;
 }

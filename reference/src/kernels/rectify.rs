@@ -1,31 +1,28 @@
 //! CPU mirror of `shaderlib/templates/rectify.wgsl`: epipolar resampling of the standard
 //! shadow map into the rectified map (Klehm et al. 2014 Sec. 4.1, Baran et al. 2010).
 //!
-//! One invocation per rectified texel (column `x` = light ray, row `y` = slice): find the
-//! light ray's first occluder in the standard shadow map and store its view angle as
-//! normalised rectified depth (see `scatter_shaderlib::prefiltered::frame`).
+//! Per rectified texel (column `x` = light ray, row `y` = slice): find the light ray's first
+//! occluder in the standard shadow map and store its view angle as normalised rectified depth
+//! (see `scatter_shaderlib::prefiltered::frame`). Each invocation takes `RECTIFY_TEXELS`
+//! consecutive columns of a row, its row's constants once.
 
 use super::common_epipolar::{occluder_depth, row_phi, slice_e, sm_occluder_distance};
 use super::common_model::PI;
 use super::common_shadow::NO_OCCLUDER;
 use super::texture::{Tex, xyz};
-use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams};
+use glam::Vec3;
+use scatter_shaderlib::prefiltered::{FrameUniforms, RECTIFY_TEXELS, SliceParams};
 
-/// The kernel body for invocation `id` (`spot` is the template's light switch); returns the
-/// value it stores at texel `id.xy` (None: out of range, no store).
-pub fn rectify_main(
-    id: [u32; 3],
+/// The value `rectify_texel` stores at texel `x` of a row (`slice` its parameters, `e` its
+/// slice direction; `spot` is the template's light switch).
+pub fn rectify_texel(
+    x: u32,
     frame: &FrameUniforms,
-    slices: &[SliceParams],
+    slice: SliceParams,
+    e: Vec3,
     shadow_map: &Tex,
     spot: bool,
-) -> Option<f32> {
-    let (x, y) = (id[0], id[1]);
-    if x >= frame.sizes[2] || y >= frame.sizes[3] {
-        return None;
-    }
-    let slice = slices[y as usize];
-    let e = slice_e(frame, row_phi(frame, y));
+) -> f32 {
     let col = (x as f32 + 0.5) * slice.delta;
     let axis = xyz(frame.axis);
     let mut theta_occ = PI;
@@ -45,8 +42,31 @@ pub fn rectify_main(
             theta_occ = col.atan2(-s);
         }
     }
-    let d = occluder_depth(theta_occ, frame.theta[0], frame.theta[1]);
-    Some(d)
+    occluder_depth(theta_occ, frame.theta[0], frame.theta[1])
+}
+
+/// The kernel body for invocation `id`: the values it stores at texels `(RECTIFY_TEXELS
+/// id.x .., id.y)`, those inside the map (None: out of range, no store).
+pub fn rectify_main(
+    id: [u32; 3],
+    frame: &FrameUniforms,
+    slices: &[SliceParams],
+    shadow_map: &Tex,
+    spot: bool,
+) -> Option<Vec<f32>> {
+    let first = id[0] * RECTIFY_TEXELS;
+    let y = id[1];
+    if first >= frame.sizes[2] || y >= frame.sizes[3] {
+        return None;
+    }
+    let slice = slices[y as usize];
+    let e = slice_e(frame, row_phi(frame, y));
+    let end = (first + RECTIFY_TEXELS).min(frame.sizes[2]);
+    Some(
+        (first..end)
+            .map(|x| rectify_texel(x, frame, slice, e, shadow_map, spot))
+            .collect(),
+    )
 }
 
 /// Runs every invocation (rows in parallel).
@@ -56,8 +76,8 @@ pub fn rectify(frame: &FrameUniforms, slices: &[SliceParams], shadow_map: &Tex, 
     let data = (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
-            (0..w).map(move |x| {
-                rectify_main([x, y, 0], frame, slices, shadow_map, spot).unwrap_or(0.0)
+            (0..w.div_ceil(RECTIFY_TEXELS)).flat_map(move |i| {
+                rectify_main([i, y, 0], frame, slices, shadow_map, spot).unwrap_or_default()
             })
         })
         .collect();

@@ -126,7 +126,11 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
         }),
         Kernel::Rectify => Some(PassPlan {
             kernel,
-            invocations: [f("rectified.width"), f("rectified.height"), f("1")],
+            invocations: [
+                crate::prefiltered::plan::rectify_columns(),
+                f("rectified.height"),
+                f("1"),
+            ],
             skip_when: None,
             bindings: vec![
                 bind(0, "frame"),

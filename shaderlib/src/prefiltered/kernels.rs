@@ -42,12 +42,18 @@ struct SliceFitTemplate {
     spot: bool,
 }
 
+/// Rectified columns each `rectify` invocation stores (the plans' invocation count is
+/// `ceil(rectified.width / RECTIFY_TEXELS)`): its row's constants once, and lavapipe's
+/// per-invocation cost shared.
+pub const RECTIFY_TEXELS: u32 = 8;
+
 /// `rectify`: epipolar resampling of the standard shadow map.
 #[derive(Template)]
 #[template(path = "rectify.wgsl")]
 struct RectifyTemplate {
     light_name: &'static str,
     spot: bool,
+    texels: u32,
 }
 
 /// `prefilter`: basis transform (Fourier or power moments) and weighted running mean per row
@@ -164,6 +170,7 @@ pub(crate) fn render_rectify(variant: &PrefilteredVariant) -> Result<String, Sha
     RectifyTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
+        texels: RECTIFY_TEXELS,
     }
     .render()
     .map_err(render_error(Kernel::Rectify))

@@ -5,9 +5,9 @@
 use crate::Kernel;
 use crate::family::KernelFamily;
 use crate::plan::{
-    Alternative, BindingSource, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
-    SAMPLED, SLICE_FIT_NOTE, STORAGE_AND_SAMPLED, TEXTURE_DIMENSION, bind, column_depth_buffer,
-    depth_and_shadow_map, frame_buffer, scatter_resource, scatter_texture,
+    Alternative, BindingSource, DEPTH_FORMAT, Formula, OUTPUT_FORMAT, Parameter, PassPlan, Plan,
+    Resource, SAMPLED, SLICE_FIT_NOTE, STORAGE_AND_SAMPLED, TEXTURE_DIMENSION, bind,
+    column_depth_buffer, depth_and_shadow_map, frame_buffer, scatter_resource, scatter_texture,
     screen_and_shadow_parameters, texture_2d,
 };
 use crate::prefiltered::{Basis, PrefilteredVariant, Rectification};
@@ -197,7 +197,7 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
         }),
         Kernel::Rectify => Some(PassPlan {
             kernel,
-            invocations: [f("rectified.width"), f("rectified.height"), f("1")],
+            invocations: [rectify_columns(), f("rectified.height"), f("1")],
             skip_when: projective.then_some(PROJECTIVE_FRAME),
             bindings: vec![
                 bind(0, "frame"),
@@ -258,4 +258,10 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
         Kernel::ScatterFallback => pass(v, Kernel::Scatter).map(|p| fallback_pass(p, kernel, 7)),
         _ => None,
     }
+}
+
+/// The `rectify` pass's invocations along x: each stores
+/// [`RECTIFY_TEXELS`](super::kernels::RECTIFY_TEXELS) columns of a row.
+pub fn rectify_columns() -> Formula {
+    format!("ceil(rectified.width / {})", super::kernels::RECTIFY_TEXELS)
 }
