@@ -175,7 +175,7 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     let fy = yb - floor(yb);
     let row0 = row_index(floor(yb), rows, wrap);
     let row1 = select(row0, row_index(floor(yb) + 1.0, rows, wrap), yb > floor(yb));
-    let row_count = select(1u, 2u, row1 != row0);
+    let w1 = select(0.0, fy, row1 != row0);
 
     let cos_theta_l = -dot(f.light_dir.xyz, dir);
     // Every region gets the full spot quadrature: its weight must be as accurate as the
@@ -200,97 +200,139 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     // The sun's scattering coefficient times phase, the same for every region.
     let sun_scatter = f.medium[1] * phase_hg(f.medium[2], cos_theta_l);
 
-    // Per row, regions: every region before the surface's, whole, and the surface's up to
-    // x_s. Each is weighted by this pixel's own unshadowed integral over its part of the ray
-    // [a, b] (the row's own spacing places a and b). One loop per row and no per-region
-    // arrays: lavapipe keeps dynamically indexed private arrays in memory.
-    var total = 0.0;
-    for (var side = 0u; side < row_count; side++) {
-        let row = select(row0, row1, side == 1u);
-        let row_weight = select(select(1.0 - fy, 1.0, row_count == 1u), fy, side == 1u);
-        var delta = 1.0;
+    // Regions: every region before the surface's, whole, and the surface's up to x_s. Each
+    // is weighted by this pixel's own unshadowed integral over its part of the ray [a, b];
+    // each row places a and b with its own spacing, so the two rows' regions are summed
+    // apart (total0, total1) in one loop, each row's ending at its own last region. One
+    // loop and no per-region arrays: lavapipe keeps dynamically indexed private arrays in
+    // memory (a loop per row measured 1.2-1.7x the whole pass).
+    var delta0 = 1.0;
+    var delta1 = 1.0;
+    var xs0 = xs;
+    var xs1 = xs;
 {%- if projective %}
-        if !proj {
+    if !proj {
 {%- else %}
-        {
+    {
 {%- endif %}
-            delta = slice_params(slices[row]).delta;
-            xs = reach / delta;
-        }
-        let last = u32(min(max(xs, 0.0), f32(width) - 1.0));
-        var row_total = 0.0;
-        for (var r = 0u; r < regions; r++) {
-            let b0 = f32(region_start(r, regions, width, spot));
-            let b1 = f32(region_start(r + 1u, regions, width, spot));
-            let is_last = last < u32(b1) || r + 1u == regions;
-            let pos = select(b1 - 0.5, clamp(xs - 0.5, b0 + 0.5, b1 - 0.5), is_last);
-            var a: f32;
-            var b: f32;
-{%- if projective %}
-            if proj {
-                a = 0.0;
-                if r > 0u {
-                    a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
-                }
-                b = select(min(proj_reach(f, proj_boundary(f, r + 1u), m, spot, s * qd) / qd, s), s, is_last);
-            } else {
-                a = ray_t(f, b0, delta, theta, s, spot);
-                b = select(ray_t(f, b1, delta, theta, s, spot), s, is_last);
-            }
-{%- else %}
-            a = ray_t(f, b0, delta, theta, s, spot);
-            b = select(ray_t(f, b1, delta, theta, s, spot), s, is_last);
-{%- endif %}
-            var weight: f32;
-            if spot {
-                weight = spot_segment(f, eye, dir, a, b, panels);
-            } else {
-                weight = sun_scatter * transmittance_between(f.medium[0], a, b);
-            }
-            // The (up to) two texels of the row the linear fetch reads with a non-zero weight:
-            // columns x0 <= x1 of the region (pos lies inside it).
-            let xb = pos - 0.5;
-            let fx = xb - floor(xb);
-            let x0 = u32(clamp(floor(xb), 0.0, f32(width) - 1.0));
-            let x1 = select(x0, min(x0 + 1u, width - 1u), xb > floor(xb));
-            // Their depth bounds. A region's prefix bounds only widen along the row, so column
-            // x1's cover column x0's: one load, not two.
-            let lohi = textureLoad(bounds, vec2<u32>(x1, row), 0);
-            let lo = lohi.x;
-            let hi = lohi.y;
-            var vis = 0.5;
-            if d <= lo {
-                vis = 1.0;
-            } else if d > hi {
-                vis = 0.0;
-            } else {
-{%- if moments %}
-                // The region's moments, filtered linearly along the row (a mix of moments is the
-                // moments of the mixed depths: still a valid moment vector).
-                let m0 = mix(textureLoad(filtered, vec2<u32>(x0, row), 0, 0), textureLoad(filtered, vec2<u32>(x1, row), 0, 0), fx);
-{%- if moment_count == 6 %}
-                let m1 = mix(textureLoad(filtered, vec2<u32>(x0, row), 1, 0), textureLoad(filtered, vec2<u32>(x1, row), 1, 0), fx);
-                vis = lit_moments6(m0, m1.xy, zf);
-{%- else %}
-                vis = lit_moments4(m0, zf);
-{%- endif %}
-{%- else %}
-                for (var layer = 0u; layer < LAYERS; layer++) {
-                    let coeff = coeffs[layer];
-                    let texel = mix(textureLoad(filtered, vec2<u32>(x0, row), layer, 0), textureLoad(filtered, vec2<u32>(x1, row), layer, 0), fx);
-                    for (var k = 0u; k < 4u; k++) {
-                        vis += coeff[k] * (texel[k] * 2.0 - 1.0);
-                    }
-                }
-{%- endif %}
-            }
-            row_total += weight * clamp(vis, 0.0, 1.0);
-            if is_last {
-                break;
-            }
-        }
-        total += row_weight * row_total;
+        delta0 = slice_params(slices[row0]).delta;
+        delta1 = slice_params(slices[row1]).delta;
+        xs0 = reach / delta0;
+        xs1 = reach / delta1;
     }
+    let last0 = u32(min(max(xs0, 0.0), f32(width) - 1.0));
+    let last1 = u32(min(max(xs1, 0.0), f32(width) - 1.0));
+    var total0 = 0.0;
+    var total1 = 0.0;
+    var done0 = false;
+    var done1 = false;
+    for (var r = 0u; r < regions; r++) {
+        let b0 = f32(region_start(r, regions, width, spot));
+        let b1 = f32(region_start(r + 1u, regions, width, spot));
+        let is_last0 = last0 < u32(b1) || r + 1u == regions;
+        let is_last1 = last1 < u32(b1) || r + 1u == regions;
+        let pos0 = select(b1 - 0.5, clamp(xs0 - 0.5, b0 + 0.5, b1 - 0.5), is_last0);
+        let pos1 = select(b1 - 0.5, clamp(xs1 - 0.5, b0 + 0.5, b1 - 0.5), is_last1);
+        var a0: f32;
+        var e0: f32;
+        var a1: f32;
+        var e1: f32;
+{%- if projective %}
+        if proj {
+            a0 = 0.0;
+            if r > 0u {
+                a0 = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
+            }
+            e0 = select(min(proj_reach(f, proj_boundary(f, r + 1u), m, spot, s * qd) / qd, s), s, is_last0);
+            a1 = a0;
+            e1 = e0;
+        } else {
+            a0 = ray_t(f, b0, delta0, theta, s, spot);
+            e0 = select(ray_t(f, b1, delta0, theta, s, spot), s, is_last0);
+            a1 = ray_t(f, b0, delta1, theta, s, spot);
+            e1 = select(ray_t(f, b1, delta1, theta, s, spot), s, is_last1);
+        }
+{%- else %}
+        a0 = ray_t(f, b0, delta0, theta, s, spot);
+        e0 = select(ray_t(f, b1, delta0, theta, s, spot), s, is_last0);
+        a1 = ray_t(f, b0, delta1, theta, s, spot);
+        e1 = select(ray_t(f, b1, delta1, theta, s, spot), s, is_last1);
+{%- endif %}
+        var weight0: f32;
+        var weight1: f32;
+        if spot {
+            weight0 = spot_segment(f, eye, dir, a0, e0, panels);
+            weight1 = spot_segment(f, eye, dir, a1, e1, panels);
+        } else {
+            weight0 = sun_scatter * transmittance_between(f.medium[0], a0, e0);
+            weight1 = sun_scatter * transmittance_between(f.medium[0], a1, e1);
+        }
+        // Per row, the (up to) two texels the linear fetch reads with a non-zero weight:
+        // columns x0 <= x1 of the region (pos lies inside it).
+        let xb0 = pos0 - 0.5;
+        let fx0 = xb0 - floor(xb0);
+        let x00 = u32(clamp(floor(xb0), 0.0, f32(width) - 1.0));
+        let x01 = select(x00, min(x00 + 1u, width - 1u), xb0 > floor(xb0));
+        let xb1 = pos1 - 0.5;
+        let fx1 = xb1 - floor(xb1);
+        let x10 = u32(clamp(floor(xb1), 0.0, f32(width) - 1.0));
+        let x11 = select(x10, min(x10 + 1u, width - 1u), xb1 > floor(xb1));
+        // Their depth bounds. A region's prefix bounds only widen along the row, so column
+        // x1's cover column x0's: one load per row.
+        let lohi0 = textureLoad(bounds, vec2<u32>(x01, row0), 0);
+        let lohi1 = textureLoad(bounds, vec2<u32>(x11, row1), 0);
+        var vis0 = 0.5;
+        var vis1 = 0.5;
+{%- if moments %}
+        // The region's moments, filtered linearly along each row (a mix of moments is the
+        // moments of the mixed depths: still a valid moment vector).
+        if d > lohi0.x && d <= lohi0.y {
+            let m0 = mix(textureLoad(filtered, vec2<u32>(x00, row0), 0, 0), textureLoad(filtered, vec2<u32>(x01, row0), 0, 0), fx0);
+{%- if moment_count == 6 %}
+            let m1 = mix(textureLoad(filtered, vec2<u32>(x00, row0), 1, 0), textureLoad(filtered, vec2<u32>(x01, row0), 1, 0), fx0);
+            vis0 = lit_moments6(m0, m1.xy, zf);
+{%- else %}
+            vis0 = lit_moments4(m0, zf);
+{%- endif %}
+        }
+        if d > lohi1.x && d <= lohi1.y {
+            let m0 = mix(textureLoad(filtered, vec2<u32>(x10, row1), 0, 0), textureLoad(filtered, vec2<u32>(x11, row1), 0, 0), fx1);
+{%- if moment_count == 6 %}
+            let m1 = mix(textureLoad(filtered, vec2<u32>(x10, row1), 1, 0), textureLoad(filtered, vec2<u32>(x11, row1), 1, 0), fx1);
+            vis1 = lit_moments6(m0, m1.xy, zf);
+{%- else %}
+            vis1 = lit_moments4(m0, zf);
+{%- endif %}
+        }
+{%- else %}
+        if (d > lohi0.x && d <= lohi0.y) || (d > lohi1.x && d <= lohi1.y) {
+            for (var layer = 0u; layer < LAYERS; layer++) {
+                let coeff = coeffs[layer];
+                let texel0 = mix(textureLoad(filtered, vec2<u32>(x00, row0), layer, 0), textureLoad(filtered, vec2<u32>(x01, row0), layer, 0), fx0);
+                let texel1 = mix(textureLoad(filtered, vec2<u32>(x10, row1), layer, 0), textureLoad(filtered, vec2<u32>(x11, row1), layer, 0), fx1);
+                for (var k = 0u; k < 4u; k++) {
+                    vis0 += coeff[k] * (texel0[k] * 2.0 - 1.0);
+                    vis1 += coeff[k] * (texel1[k] * 2.0 - 1.0);
+                }
+            }
+        }
+{%- endif %}
+        // Outside the row's depth range the region is exactly lit or shadowed.
+        vis0 = select(select(vis0, 0.0, d > lohi0.y), 1.0, d <= lohi0.x);
+        vis1 = select(select(vis1, 0.0, d > lohi1.y), 1.0, d <= lohi1.x);
+        if !done0 {
+            total0 += weight0 * clamp(vis0, 0.0, 1.0);
+        }
+        if !done1 {
+            total1 += weight1 * clamp(vis1, 0.0, 1.0);
+        }
+        done0 = done0 || is_last0;
+        done1 = done1 || is_last1;
+        if done0 && done1 {
+            break;
+        }
+    }
+    let total = (1.0 - w1) * total0 + w1 * total1;
     let l = total;
     let c = color * l;
     return c;

@@ -618,24 +618,39 @@ metal::float3 scatter_pixel(
     type_13 coeffs = {};
     metal::float2 angle = {};
     uint layer_1 = 0u;
-    float total = 0.0;
-    uint side = 0u;
-    float delta_1 = {};
-    float row_total = {};
-    uint r_1 = {};
+    float delta0_ = 1.0;
+    float delta1_ = 1.0;
+    float xs0_ = {};
+    float xs1_ = {};
+    float total0_ = 0.0;
+    float total1_ = 0.0;
+    bool done0_ = false;
+    bool done1_ = false;
+    uint r_1 = 0u;
     bool local_9 = {};
-    float a_6 = {};
-    float b_6 = {};
-    float weight = {};
-    float vis = {};
+    bool local_10 = {};
+    float a0_ = {};
+    float e0_ = {};
+    float a1_ = {};
+    float e1_ = {};
+    float weight0_ = {};
+    float weight1_ = {};
+    float vis0_ = {};
+    float vis1_ = {};
+    bool local_11 = {};
+    bool local_12 = {};
+    bool local_13 = {};
     uint layer_2 = {};
     uint k_3 = {};
+    bool local_14 = {};
+    bool local_15 = {};
+    bool local_16 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
     metal::float3 eye_6 = f_9.eye.xyz;
-    metal::float3 _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
-    uint clamped_lod_e12 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e12 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_1)), metal::uint2(depth.get_width(clamped_lod_e12), depth.get_height(clamped_lod_e12)) - 1), clamped_lod_e12);
-    float s_2 = metal::min(metal::max(_e12.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e8, f_9.cam_forward.xyz), 0.000001);
+    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    uint clamped_lod_e14 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
+    float s_2 = metal::min(metal::max(_e14.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e10, f_9.cam_forward.xyz), 0.000001);
     metal::float3 color = f_9.light_color.xyz;
     metal::float3 px = metal::float3(static_cast<float>(x_3) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
     float radius = f_9.epipole.w;
@@ -656,11 +671,11 @@ metal::float3 scatter_pixel(
     } else {
         local_8 = true;
     }
-    bool _e75 = local_8;
-    if (_e75) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e77 = frame;
-        float _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, shadow_map, eye_6, _e8, s_2, true);
-        metal::float3 l_1 = _e80 * color;
+    bool _e77 = local_8;
+    if (_e77) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = frame;
+        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_6, _e10, s_2, true);
+        metal::float3 l_1 = _e82 * color;
         return l_1;
     }
     metal::float3 axis = f_9.axis.xyz;
@@ -668,242 +683,328 @@ metal::float3 scatter_pixel(
     uint width_1 = f_9.sizes.z;
     bool wrap_1 = f_9.anti_epipole.w > 0.5;
     {
-        theta_2 = metal::acos(metal::clamp(metal::dot(_e8, axis), -1.0, 1.0));
-        float phi_1 = metal::atan2(metal::dot(_e8, f_9.e2_.xyz), metal::dot(_e8, f_9.e1_.xyz));
+        theta_2 = metal::acos(metal::clamp(metal::dot(_e10, axis), -1.0, 1.0));
+        float phi_1 = metal::atan2(metal::dot(_e10, f_9.e2_.xyz), metal::dot(_e10, f_9.e1_.xyz));
         yc = (phi_1 - f_9.e1_.w) / f_9.e2_.w;
         if (wrap_1) {
-            float _e112 = yc;
-            float _e113 = yc;
-            yc = _e112 - (metal::floor(_e113 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+            float _e114 = yc;
+            float _e115 = yc;
+            yc = _e114 - (metal::floor(_e115 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
         } else {
-            float _e120 = yc;
-            yc = metal::clamp(_e120, 0.0, static_cast<float>(rows_1));
+            float _e122 = yc;
+            yc = metal::clamp(_e122, 0.0, static_cast<float>(rows_1));
         }
-        float _e124 = theta_2;
-        float _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_9.theta.x, f_9.theta.y);
-        d = _e129;
+        float _e126 = theta_2;
+        float _e131 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e126, f_9.theta.x, f_9.theta.y);
+        d = _e131;
         if (true) {
-            metal::float3 q_2 = metal::normalize((eye_6 + (_e8 * s_2)) - f_9.light_pos.xyz);
+            metal::float3 q_2 = metal::normalize((eye_6 + (_e10 * s_2)) - f_9.light_pos.xyz);
             reach = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0));
         } else {
-            float _e144 = theta_2;
-            reach = s_2 * metal::sin(_e144);
+            float _e146 = theta_2;
+            reach = s_2 * metal::sin(_e146);
         }
     }
-    float _e147 = yc;
-    float yb = _e147 - 0.5;
+    float _e149 = yc;
+    float yb = _e149 - 0.5;
     float fy = yb - metal::floor(yb);
-    uint _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
-    uint _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
-    uint row1_ = (yb > metal::floor(yb)) ? _e157 : _e153;
-    uint row_count = (row1_ != _e153) ? 2u : 1u;
-    float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e8));
+    uint _e155 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
+    uint _e159 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
+    uint row1_ = (yb > metal::floor(yb)) ? _e159 : _e155;
+    float w1_ = (row1_ != _e155) ? fy : 0.0;
+    float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e10));
     uint panels_2 = metal::max(naga_div(f_9.sizes2_.z, 4u), 1u);
-    float _e176 = d;
-    float _e180 = d;
-    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e176), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e180));
-    metal::float2 _e185 = angle;
-    metal::float2 _e186 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e185);
+    float _e177 = d;
+    float _e181 = d;
+    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e177), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e181));
+    metal::float2 _e186 = angle;
+    metal::float2 _e187 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e186);
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e201 = layer_1;
-            layer_1 = _e201 + 1u;
+            uint _e202 = layer_1;
+            layer_1 = _e202 + 1u;
         }
         loop_init_3 = false;
-        uint _e188 = layer_1;
-        if (_e188 < LAYERS) {
+        uint _e189 = layer_1;
+        if (_e189 < LAYERS) {
         } else {
             break;
         }
         {
-            metal::float2 _e191 = angle;
-            metal::float2 _e192 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e191, _e186);
-            uint _e194 = layer_1;
-            metal::float2 _e196 = angle;
-            uint _e197 = layer_1;
-            metal::float4 _e198 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e196, _e192, _e197);
-            coeffs.inner[metal::min(unsigned(_e194), 3u)] = _e198;
-            metal::float2 _e199 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e192, _e186);
-            angle = _e199;
+            metal::float2 _e192 = angle;
+            metal::float2 _e193 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e192, _e187);
+            uint _e195 = layer_1;
+            metal::float2 _e197 = angle;
+            uint _e198 = layer_1;
+            metal::float4 _e199 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e197, _e193, _e198);
+            coeffs.inner[metal::min(unsigned(_e195), 3u)] = _e199;
+            metal::float2 _e200 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e193, _e187);
+            angle = _e200;
         }
     }
-    float _e207 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    float sun_scatter = f_9.medium.y * _e207;
+    float _e208 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    float sun_scatter = f_9.medium.y * _e208;
+    float _e211 = xs;
+    xs0_ = _e211;
+    float _e213 = xs;
+    xs1_ = _e213;
+    {
+        metal::float4 _e217 = slices[metal::min(unsigned(_e155), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e218 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e217);
+        delta0_ = _e218.delta;
+        metal::float4 _e223 = slices[metal::min(unsigned(row1_), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e224 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e223);
+        delta1_ = _e224.delta;
+        float _e227 = reach;
+        float _e228 = delta0_;
+        xs0_ = _e227 / _e228;
+        float _e230 = reach;
+        float _e231 = delta1_;
+        xs1_ = _e230 / _e231;
+    }
+    float _e233 = xs0_;
+    uint last0_ = naga_f2u32(metal::min(metal::max(_e233, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e241 = xs1_;
+    uint last1_ = naga_f2u32(metal::min(metal::max(_e241, 0.0), static_cast<float>(width_1) - 1.0));
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e395 = side;
-            side = _e395 + 1u;
+            uint _e552 = r_1;
+            r_1 = _e552 + 1u;
         }
         loop_init_4 = false;
-        uint _e210 = side;
-        if (_e210 < row_count) {
+        uint _e251 = r_1;
+        if (_e251 < REGIONS) {
         } else {
             break;
         }
         {
-            uint _e212 = side;
-            uint row_1 = (_e212 == 1u) ? row1_ : _e153;
-            uint _e222 = side;
-            float row_weight = (_e222 == 1u) ? fy : ((row_count == 1u) ? 1.0 : (1.0 - fy));
-            delta_1 = 1.0;
-            {
-                metal::float4 _e230 = slices[metal::min(unsigned(row_1), (_buffer_sizes.size1 - 0 - 16) / 16)];
-                SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e231 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e230);
-                delta_1 = _e231.delta;
-                float _e233 = reach;
-                float _e234 = delta_1;
-                xs = _e233 / _e234;
+            uint _e253 = r_1;
+            uint _e254 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e253, REGIONS, width_1, true);
+            float b0_ = static_cast<float>(_e254);
+            uint _e256 = r_1;
+            uint _e259 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e256 + 1u, REGIONS, width_1, true);
+            float b1_ = static_cast<float>(_e259);
+            if (!((last0_ < naga_f2u32(b1_)))) {
+                uint _e264 = r_1;
+                local_9 = (_e264 + 1u) == REGIONS;
+            } else {
+                local_9 = true;
             }
-            float _e237 = xs;
-            uint last = naga_f2u32(metal::min(metal::max(_e237, 0.0), static_cast<float>(width_1) - 1.0));
-            row_total = 0.0;
-            r_1 = 0u;
-            uint2 loop_bound_5 = uint2(4294967295u);
-            bool loop_init_5 = true;
-            while(true) {
-                if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-                if (!loop_init_5) {
-                    uint _e387 = r_1;
-                    r_1 = _e387 + 1u;
-                }
-                loop_init_5 = false;
-                uint _e250 = r_1;
-                if (_e250 < REGIONS) {
+            bool is_last0_ = local_9;
+            if (!((last1_ < naga_f2u32(b1_)))) {
+                uint _e275 = r_1;
+                local_10 = (_e275 + 1u) == REGIONS;
+            } else {
+                local_10 = true;
+            }
+            bool is_last1_ = local_10;
+            float _e285 = xs0_;
+            float pos0_ = is_last0_ ? metal::clamp(_e285 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            float _e296 = xs1_;
+            float pos1_ = is_last1_ ? metal::clamp(_e296 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            a0_ = float {};
+            e0_ = float {};
+            a1_ = float {};
+            e1_ = float {};
+            float _e313 = delta0_;
+            float _e314 = theta_2;
+            float _e315 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e313, _e314, s_2, true);
+            a0_ = _e315;
+            float _e316 = delta0_;
+            float _e317 = theta_2;
+            float _e318 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e316, _e317, s_2, true);
+            e0_ = is_last0_ ? s_2 : _e318;
+            float _e320 = delta1_;
+            float _e321 = theta_2;
+            float _e322 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e320, _e321, s_2, true);
+            a1_ = _e322;
+            float _e323 = delta1_;
+            float _e324 = theta_2;
+            float _e325 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e323, _e324, s_2, true);
+            e1_ = is_last1_ ? s_2 : _e325;
+            weight0_ = float {};
+            weight1_ = float {};
+            if (true) {
+                float _e331 = a0_;
+                float _e332 = e0_;
+                float _e333 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e10, _e331, _e332, panels_2);
+                weight0_ = _e333;
+                float _e334 = a1_;
+                float _e335 = e1_;
+                float _e336 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e10, _e334, _e335, panels_2);
+                weight1_ = _e336;
+            } else {
+                float _e339 = a0_;
+                float _e340 = e0_;
+                float _e341 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e339, _e340);
+                weight0_ = sun_scatter * _e341;
+                float _e345 = a1_;
+                float _e346 = e1_;
+                float _e347 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e345, _e346);
+                weight1_ = sun_scatter * _e347;
+            }
+            float xb0_ = pos0_ - 0.5;
+            float fx0_ = xb0_ - metal::floor(xb0_);
+            uint x00_ = naga_f2u32(metal::clamp(metal::floor(xb0_), 0.0, static_cast<float>(width_1) - 1.0));
+            uint x01_ = (xb0_ > metal::floor(xb0_)) ? metal::min(x00_ + 1u, width_1 - 1u) : x00_;
+            float xb1_ = pos1_ - 0.5;
+            float fx1_ = xb1_ - metal::floor(xb1_);
+            uint x10_ = naga_f2u32(metal::clamp(metal::floor(xb1_), 0.0, static_cast<float>(width_1) - 1.0));
+            uint x11_ = (xb1_ > metal::floor(xb1_)) ? metal::min(x10_ + 1u, width_1 - 1u) : x10_;
+            uint clamped_lod_e390 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 lohi0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x01_, _e155)), metal::uint2(bounds.get_width(clamped_lod_e390), bounds.get_height(clamped_lod_e390)) - 1), clamped_lod_e390);
+            uint clamped_lod_e394 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 lohi1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x11_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e394), bounds.get_height(clamped_lod_e394)) - 1), clamped_lod_e394);
+            vis0_ = 0.5;
+            vis1_ = 0.5;
+            float _e399 = d;
+            if (_e399 > lohi0_.x) {
+                float _e402 = d;
+                local_11 = _e402 <= lohi0_.y;
+            } else {
+                local_11 = false;
+            }
+            bool _e408 = local_11;
+            if (!(_e408)) {
+                float _e410 = d;
+                if (_e410 > lohi1_.x) {
+                    float _e413 = d;
+                    local_13 = _e413 <= lohi1_.y;
                 } else {
-                    break;
+                    local_13 = false;
                 }
-                {
-                    uint _e252 = r_1;
-                    uint _e253 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e252, REGIONS, width_1, true);
-                    float b0_ = static_cast<float>(_e253);
-                    uint _e255 = r_1;
-                    uint _e258 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e255 + 1u, REGIONS, width_1, true);
-                    float b1_ = static_cast<float>(_e258);
-                    if (!((last < naga_f2u32(b1_)))) {
-                        uint _e263 = r_1;
-                        local_9 = (_e263 + 1u) == REGIONS;
-                    } else {
-                        local_9 = true;
+                bool _e419 = local_13;
+                local_12 = _e419;
+            } else {
+                local_12 = true;
+            }
+            bool _e423 = local_12;
+            if (_e423) {
+                layer_2 = 0u;
+                uint2 loop_bound_5 = uint2(4294967295u);
+                bool loop_init_5 = true;
+                while(true) {
+                    if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+                    loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+                    if (!loop_init_5) {
+                        uint _e485 = layer_2;
+                        layer_2 = _e485 + 1u;
                     }
-                    bool is_last = local_9;
-                    float _e273 = xs;
-                    float pos = is_last ? metal::clamp(_e273 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-                    a_6 = float {};
-                    b_6 = float {};
-                    float _e286 = delta_1;
-                    float _e287 = theta_2;
-                    float _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e286, _e287, s_2, true);
-                    a_6 = _e288;
-                    float _e289 = delta_1;
-                    float _e290 = theta_2;
-                    float _e291 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e289, _e290, s_2, true);
-                    b_6 = is_last ? s_2 : _e291;
-                    weight = float {};
-                    if (true) {
-                        float _e295 = a_6;
-                        float _e296 = b_6;
-                        float _e297 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e8, _e295, _e296, panels_2);
-                        weight = _e297;
+                    loop_init_5 = false;
+                    uint _e426 = layer_2;
+                    if (_e426 < LAYERS) {
                     } else {
-                        float _e300 = a_6;
-                        float _e301 = b_6;
-                        float _e302 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e300, _e301);
-                        weight = sun_scatter * _e302;
+                        break;
                     }
-                    float xb = pos - 0.5;
-                    float fx = xb - metal::floor(xb);
-                    uint x0_ = naga_f2u32(metal::clamp(metal::floor(xb), 0.0, static_cast<float>(width_1) - 1.0));
-                    uint x1_ = (xb > metal::floor(xb)) ? metal::min(x0_ + 1u, width_1 - 1u) : x0_;
-                    uint clamped_lod_e326 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-                    metal::float4 lohi = bounds.read(metal::min(metal::uint2(metal::uint2(x1_, row_1)), metal::uint2(bounds.get_width(clamped_lod_e326), bounds.get_height(clamped_lod_e326)) - 1), clamped_lod_e326);
-                    float lo_1 = lohi.x;
-                    float hi_1 = lohi.y;
-                    vis = 0.5;
-                    float _e331 = d;
-                    if (_e331 <= lo_1) {
-                        vis = 1.0;
-                    } else {
-                        float _e334 = d;
-                        if (_e334 > hi_1) {
-                            vis = 0.0;
-                        } else {
-                            layer_2 = 0u;
-                            uint2 loop_bound_6 = uint2(4294967295u);
-                            bool loop_init_6 = true;
-                            while(true) {
-                                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-                                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                                if (!loop_init_6) {
-                                    uint _e376 = layer_2;
-                                    layer_2 = _e376 + 1u;
-                                }
-                                loop_init_6 = false;
-                                uint _e339 = layer_2;
-                                if (_e339 < LAYERS) {
-                                } else {
-                                    break;
-                                }
-                                {
-                                    uint _e342 = layer_2;
-                                    metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e342), 3u)];
-                                    uint _e346 = layer_2;
-                                    uint clamped_lod_e349 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                                    metal::float4 _e349 = filtered.read(metal::min(metal::uint2(metal::uint2(x0_, row_1)), metal::uint2(filtered.get_width(clamped_lod_e349), filtered.get_height(clamped_lod_e349)) - 1), metal::min(uint(_e346), filtered.get_array_size() - 1), clamped_lod_e349);
-                                    uint _e351 = layer_2;
-                                    uint clamped_lod_e354 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                                    metal::float4 _e354 = filtered.read(metal::min(metal::uint2(metal::uint2(x1_, row_1)), metal::uint2(filtered.get_width(clamped_lod_e354), filtered.get_height(clamped_lod_e354)) - 1), metal::min(uint(_e351), filtered.get_array_size() - 1), clamped_lod_e354);
-                                    metal::float4 texel_1 = metal::mix(_e349, _e354, fx);
-                                    k_3 = 0u;
-                                    uint2 loop_bound_7 = uint2(4294967295u);
-                                    bool loop_init_7 = true;
-                                    while(true) {
-                                        if (metal::all(loop_bound_7 == uint2(0u))) { break; }
-                                        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-                                        if (!loop_init_7) {
-                                            uint _e373 = k_3;
-                                            k_3 = _e373 + 1u;
-                                        }
-                                        loop_init_7 = false;
-                                        uint _e358 = k_3;
-                                        if (_e358 < 4u) {
-                                        } else {
-                                            break;
-                                        }
-                                        {
-                                            float _e361 = vis;
-                                            uint _e362 = k_3;
-                                            uint _e364 = k_3;
-                                            vis = _e361 + (coeff[metal::min(unsigned(_e362), 3u)] * ((texel_1[metal::min(unsigned(_e364), 3u)] * 2.0) - 1.0));
-                                        }
-                                    }
-                                }
+                    {
+                        uint _e429 = layer_2;
+                        metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e429), 3u)];
+                        uint _e433 = layer_2;
+                        uint clamped_lod_e436 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                        metal::float4 _e436 = filtered.read(metal::min(metal::uint2(metal::uint2(x00_, _e155)), metal::uint2(filtered.get_width(clamped_lod_e436), filtered.get_height(clamped_lod_e436)) - 1), metal::min(uint(_e433), filtered.get_array_size() - 1), clamped_lod_e436);
+                        uint _e438 = layer_2;
+                        uint clamped_lod_e441 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                        metal::float4 _e441 = filtered.read(metal::min(metal::uint2(metal::uint2(x01_, _e155)), metal::uint2(filtered.get_width(clamped_lod_e441), filtered.get_height(clamped_lod_e441)) - 1), metal::min(uint(_e438), filtered.get_array_size() - 1), clamped_lod_e441);
+                        metal::float4 texel0_ = metal::mix(_e436, _e441, fx0_);
+                        uint _e444 = layer_2;
+                        uint clamped_lod_e447 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                        metal::float4 _e447 = filtered.read(metal::min(metal::uint2(metal::uint2(x10_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e447), filtered.get_height(clamped_lod_e447)) - 1), metal::min(uint(_e444), filtered.get_array_size() - 1), clamped_lod_e447);
+                        uint _e449 = layer_2;
+                        uint clamped_lod_e452 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                        metal::float4 _e452 = filtered.read(metal::min(metal::uint2(metal::uint2(x11_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e452), filtered.get_height(clamped_lod_e452)) - 1), metal::min(uint(_e449), filtered.get_array_size() - 1), clamped_lod_e452);
+                        metal::float4 texel1_ = metal::mix(_e447, _e452, fx1_);
+                        k_3 = 0u;
+                        uint2 loop_bound_6 = uint2(4294967295u);
+                        bool loop_init_6 = true;
+                        while(true) {
+                            if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+                            loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                            if (!loop_init_6) {
+                                uint _e482 = k_3;
+                                k_3 = _e482 + 1u;
+                            }
+                            loop_init_6 = false;
+                            uint _e456 = k_3;
+                            if (_e456 < 4u) {
+                            } else {
+                                break;
+                            }
+                            {
+                                float _e459 = vis0_;
+                                uint _e460 = k_3;
+                                uint _e462 = k_3;
+                                vis0_ = _e459 + (coeff[metal::min(unsigned(_e460), 3u)] * ((texel0_[metal::min(unsigned(_e462), 3u)] * 2.0) - 1.0));
+                                float _e470 = vis1_;
+                                uint _e471 = k_3;
+                                uint _e473 = k_3;
+                                vis1_ = _e470 + (coeff[metal::min(unsigned(_e471), 3u)] * ((texel1_[metal::min(unsigned(_e473), 3u)] * 2.0) - 1.0));
                             }
                         }
                     }
-                    float _e378 = row_total;
-                    float _e379 = weight;
-                    float _e380 = vis;
-                    row_total = _e378 + (_e379 * metal::clamp(_e380, 0.0, 1.0));
-                    if (is_last) {
-                        break;
-                    }
                 }
             }
-            float _e390 = total;
-            float _e391 = row_total;
-            total = _e390 + (row_weight * _e391);
+            float _e487 = vis0_;
+            float _e488 = d;
+            float _e493 = d;
+            vis0_ = (_e493 <= lohi0_.x) ? 1.0 : ((_e488 > lohi0_.y) ? 0.0 : _e487);
+            float _e498 = vis1_;
+            float _e499 = d;
+            float _e504 = d;
+            vis1_ = (_e504 <= lohi1_.x) ? 1.0 : ((_e499 > lohi1_.y) ? 0.0 : _e498);
+            bool _e510 = done0_;
+            if (!(_e510)) {
+                float _e513 = total0_;
+                float _e514 = weight0_;
+                float _e515 = vis0_;
+                total0_ = _e513 + (_e514 * metal::clamp(_e515, 0.0, 1.0));
+            }
+            bool _e522 = done1_;
+            if (!(_e522)) {
+                float _e525 = total1_;
+                float _e526 = weight1_;
+                float _e527 = vis1_;
+                total1_ = _e525 + (_e526 * metal::clamp(_e527, 0.0, 1.0));
+            }
+            bool _e533 = done0_;
+            if (!(_e533)) {
+                local_14 = is_last0_;
+            } else {
+                local_14 = true;
+            }
+            bool _e538 = local_14;
+            done0_ = _e538;
+            bool _e539 = done1_;
+            if (!(_e539)) {
+                local_15 = is_last1_;
+            } else {
+                local_15 = true;
+            }
+            bool _e544 = local_15;
+            done1_ = _e544;
+            bool _e545 = done0_;
+            if (_e545) {
+                bool _e546 = done1_;
+                local_16 = _e546;
+            } else {
+                local_16 = false;
+            }
+            bool _e550 = local_16;
+            if (_e550) {
+                break;
+            }
         }
     }
-    float l_2 = total;
+    float _e556 = total0_;
+    float _e558 = total1_;
+    float l_2 = ((1.0 - w1_) * _e556) + (w1_ * _e558);
     metal::float3 c = color * l_2;
     return c;
 }

@@ -449,24 +449,39 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     var coeffs: array<vec4<f32>, 4>;
     var angle: vec2<f32>;
     var layer_1: u32 = 0u;
-    var total: f32 = 0f;
-    var side: u32 = 0u;
-    var delta_1: f32;
-    var row_total: f32;
-    var r_1: u32;
+    var delta0_: f32 = 1f;
+    var delta1_: f32 = 1f;
+    var xs0_: f32;
+    var xs1_: f32;
+    var total0_: f32 = 0f;
+    var total1_: f32 = 0f;
+    var done0_: bool = false;
+    var done1_: bool = false;
+    var r_1: u32 = 0u;
     var local_9: bool;
-    var a_6: f32;
-    var b_6: f32;
-    var weight: f32;
-    var vis: f32;
+    var local_10: bool;
+    var a0_: f32;
+    var e0_: f32;
+    var a1_: f32;
+    var e1_: f32;
+    var weight0_: f32;
+    var weight1_: f32;
+    var vis0_: f32;
+    var vis1_: f32;
+    var local_11: bool;
+    var local_12: bool;
+    var local_13: bool;
     var layer_2: u32;
     var k_3: u32;
+    var local_14: bool;
+    var local_15: bool;
+    var local_16: bool;
 
     let f_9 = frame;
     let eye_6 = f_9.eye.xyz;
-    let _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
-    let _e12 = textureLoad(depth, vec2<u32>(x_3, y_1), 0i);
-    let s_2 = (min(max(_e12.x, 0f), f_9.theta.z) / max(dot(_e8, f_9.cam_forward.xyz), 0.000001f));
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    let _e14 = textureLoad(depth, vec2<u32>(x_3, y_1), 0i);
+    let s_2 = (min(max(_e14.x, 0f), f_9.theta.z) / max(dot(_e10, f_9.cam_forward.xyz), 0.000001f));
     let color = f_9.light_color.xyz;
     let px = vec3<f32>((f32(x_3) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_9.epipole.w;
@@ -487,11 +502,11 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     } else {
         local_8 = true;
     }
-    let _e75 = local_8;
-    if _e75 {
-        let _e77 = frame;
-        let _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, shadow_map, eye_6, _e8, s_2, true);
-        let l_1 = (_e80 * color);
+    let _e77 = local_8;
+    if _e77 {
+        let _e79 = frame;
+        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_6, _e10, s_2, true);
+        let l_1 = (_e82 * color);
         return l_1;
     }
     let axis = f_9.axis.xyz;
@@ -499,214 +514,302 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     let width_1 = f_9.sizes.z;
     let wrap_1 = (f_9.anti_epipole.w > 0.5f);
     {
-        theta_2 = acos(clamp(dot(_e8, axis), -1f, 1f));
-        let phi_1 = atan2(dot(_e8, f_9.e2_.xyz), dot(_e8, f_9.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e10, axis), -1f, 1f));
+        let phi_1 = atan2(dot(_e10, f_9.e2_.xyz), dot(_e10, f_9.e1_.xyz));
         yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
         if wrap_1 {
-            let _e112 = yc;
-            let _e113 = yc;
-            yc = (_e112 - (floor((_e113 / f32(rows_1))) * f32(rows_1)));
+            let _e114 = yc;
+            let _e115 = yc;
+            yc = (_e114 - (floor((_e115 / f32(rows_1))) * f32(rows_1)));
         } else {
-            let _e120 = yc;
-            yc = clamp(_e120, 0f, f32(rows_1));
+            let _e122 = yc;
+            yc = clamp(_e122, 0f, f32(rows_1));
         }
-        let _e124 = theta_2;
-        let _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_9.theta.x, f_9.theta.y);
-        d = _e129;
+        let _e126 = theta_2;
+        let _e131 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e126, f_9.theta.x, f_9.theta.y);
+        d = _e131;
         if true {
-            let q_2 = normalize(((eye_6 + (_e8 * s_2)) - f_9.light_pos.xyz));
+            let q_2 = normalize(((eye_6 + (_e10 * s_2)) - f_9.light_pos.xyz));
             reach = acos(clamp(dot(q_2, -(axis)), -1f, 1f));
         } else {
-            let _e144 = theta_2;
-            reach = (s_2 * sin(_e144));
+            let _e146 = theta_2;
+            reach = (s_2 * sin(_e146));
         }
     }
-    let _e147 = yc;
-    let yb = (_e147 - 0.5f);
+    let _e149 = yc;
+    let yb = (_e149 - 0.5f);
     let fy = (yb - floor(yb));
-    let _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    let _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
-    let row1_ = select(_e153, _e157, (yb > floor(yb)));
-    let row_count = select(1u, 2u, (row1_ != _e153));
-    let cos_theta_l = -(dot(f_9.light_dir.xyz, _e8));
+    let _e155 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    let _e159 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
+    let row1_ = select(_e155, _e159, (yb > floor(yb)));
+    let w1_ = select(0f, fy, (row1_ != _e155));
+    let cos_theta_l = -(dot(f_9.light_dir.xyz, _e10));
     let panels_2 = max((f_9.sizes2_.z / 4u), 1u);
-    let _e176 = d;
-    let _e180 = d;
-    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e176)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e180)));
-    let _e185 = angle;
-    let _e186 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e185);
+    let _e177 = d;
+    let _e181 = d;
+    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e177)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e181)));
+    let _e186 = angle;
+    let _e187 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e186);
     loop {
-        let _e188 = layer_1;
-        if (_e188 < LAYERS) {
+        let _e189 = layer_1;
+        if (_e189 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e191 = angle;
-            let _e192 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e191, _e186);
-            let _e194 = layer_1;
-            let _e196 = angle;
-            let _e197 = layer_1;
-            let _e198 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e196, _e192, _e197);
-            coeffs[_e194] = _e198;
-            let _e199 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e192, _e186);
-            angle = _e199;
+            let _e192 = angle;
+            let _e193 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e192, _e187);
+            let _e195 = layer_1;
+            let _e197 = angle;
+            let _e198 = layer_1;
+            let _e199 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e197, _e193, _e198);
+            coeffs[_e195] = _e199;
+            let _e200 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e193, _e187);
+            angle = _e200;
         }
         continuing {
-            let _e201 = layer_1;
-            layer_1 = (_e201 + 1u);
+            let _e202 = layer_1;
+            layer_1 = (_e202 + 1u);
         }
     }
-    let _e207 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    let sun_scatter = (f_9.medium.y * _e207);
+    let _e208 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
+    let sun_scatter = (f_9.medium.y * _e208);
+    let _e211 = xs;
+    xs0_ = _e211;
+    let _e213 = xs;
+    xs1_ = _e213;
+    {
+        let _e217 = slices[_e155];
+        let _e218 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e217);
+        delta0_ = _e218.delta;
+        let _e223 = slices[row1_];
+        let _e224 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e223);
+        delta1_ = _e224.delta;
+        let _e227 = reach;
+        let _e228 = delta0_;
+        xs0_ = (_e227 / _e228);
+        let _e230 = reach;
+        let _e231 = delta1_;
+        xs1_ = (_e230 / _e231);
+    }
+    let _e233 = xs0_;
+    let last0_ = u32(min(max(_e233, 0f), (f32(width_1) - 1f)));
+    let _e241 = xs1_;
+    let last1_ = u32(min(max(_e241, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e210 = side;
-        if (_e210 < row_count) {
+        let _e251 = r_1;
+        if (_e251 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e212 = side;
-            let row_1 = select(_e153, row1_, (_e212 == 1u));
-            let _e222 = side;
-            let row_weight = select(select((1f - fy), 1f, (row_count == 1u)), fy, (_e222 == 1u));
-            delta_1 = 1f;
-            {
-                let _e230 = slices[row_1];
-                let _e231 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e230);
-                delta_1 = _e231.delta;
-                let _e233 = reach;
-                let _e234 = delta_1;
-                xs = (_e233 / _e234);
+            let _e253 = r_1;
+            let _e254 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e253, REGIONS, width_1, true);
+            let b0_ = f32(_e254);
+            let _e256 = r_1;
+            let _e259 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e256 + 1u), REGIONS, width_1, true);
+            let b1_ = f32(_e259);
+            if !((last0_ < u32(b1_))) {
+                let _e264 = r_1;
+                local_9 = ((_e264 + 1u) == REGIONS);
+            } else {
+                local_9 = true;
             }
-            let _e237 = xs;
-            let last = u32(min(max(_e237, 0f), (f32(width_1) - 1f)));
-            row_total = 0f;
-            r_1 = 0u;
-            loop {
-                let _e250 = r_1;
-                if (_e250 < REGIONS) {
+            let is_last0_ = local_9;
+            if !((last1_ < u32(b1_))) {
+                let _e275 = r_1;
+                local_10 = ((_e275 + 1u) == REGIONS);
+            } else {
+                local_10 = true;
+            }
+            let is_last1_ = local_10;
+            let _e285 = xs0_;
+            let pos0_ = select((b1_ - 0.5f), clamp((_e285 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
+            let _e296 = xs1_;
+            let pos1_ = select((b1_ - 0.5f), clamp((_e296 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
+            a0_ = f32();
+            e0_ = f32();
+            a1_ = f32();
+            e1_ = f32();
+            let _e313 = delta0_;
+            let _e314 = theta_2;
+            let _e315 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e313, _e314, s_2, true);
+            a0_ = _e315;
+            let _e316 = delta0_;
+            let _e317 = theta_2;
+            let _e318 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e316, _e317, s_2, true);
+            e0_ = select(_e318, s_2, is_last0_);
+            let _e320 = delta1_;
+            let _e321 = theta_2;
+            let _e322 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e320, _e321, s_2, true);
+            a1_ = _e322;
+            let _e323 = delta1_;
+            let _e324 = theta_2;
+            let _e325 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e323, _e324, s_2, true);
+            e1_ = select(_e325, s_2, is_last1_);
+            weight0_ = f32();
+            weight1_ = f32();
+            if true {
+                let _e331 = a0_;
+                let _e332 = e0_;
+                let _e333 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e10, _e331, _e332, panels_2);
+                weight0_ = _e333;
+                let _e334 = a1_;
+                let _e335 = e1_;
+                let _e336 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e10, _e334, _e335, panels_2);
+                weight1_ = _e336;
+            } else {
+                let _e339 = a0_;
+                let _e340 = e0_;
+                let _e341 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e339, _e340);
+                weight0_ = (sun_scatter * _e341);
+                let _e345 = a1_;
+                let _e346 = e1_;
+                let _e347 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e345, _e346);
+                weight1_ = (sun_scatter * _e347);
+            }
+            let xb0_ = (pos0_ - 0.5f);
+            let fx0_ = (xb0_ - floor(xb0_));
+            let x00_ = u32(clamp(floor(xb0_), 0f, (f32(width_1) - 1f)));
+            let x01_ = select(x00_, min((x00_ + 1u), (width_1 - 1u)), (xb0_ > floor(xb0_)));
+            let xb1_ = (pos1_ - 0.5f);
+            let fx1_ = (xb1_ - floor(xb1_));
+            let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
+            let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
+            let lohi0_ = textureLoad(bounds, vec2<u32>(x01_, _e155), 0i);
+            let lohi1_ = textureLoad(bounds, vec2<u32>(x11_, row1_), 0i);
+            vis0_ = 0.5f;
+            vis1_ = 0.5f;
+            let _e399 = d;
+            if (_e399 > lohi0_.x) {
+                let _e402 = d;
+                local_11 = (_e402 <= lohi0_.y);
+            } else {
+                local_11 = false;
+            }
+            let _e408 = local_11;
+            if !(_e408) {
+                let _e410 = d;
+                if (_e410 > lohi1_.x) {
+                    let _e413 = d;
+                    local_13 = (_e413 <= lohi1_.y);
                 } else {
-                    break;
+                    local_13 = false;
                 }
-                {
-                    let _e252 = r_1;
-                    let _e253 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e252, REGIONS, width_1, true);
-                    let b0_ = f32(_e253);
-                    let _e255 = r_1;
-                    let _e258 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e255 + 1u), REGIONS, width_1, true);
-                    let b1_ = f32(_e258);
-                    if !((last < u32(b1_))) {
-                        let _e263 = r_1;
-                        local_9 = ((_e263 + 1u) == REGIONS);
+                let _e419 = local_13;
+                local_12 = _e419;
+            } else {
+                local_12 = true;
+            }
+            let _e423 = local_12;
+            if _e423 {
+                layer_2 = 0u;
+                loop {
+                    let _e426 = layer_2;
+                    if (_e426 < LAYERS) {
                     } else {
-                        local_9 = true;
+                        break;
                     }
-                    let is_last = local_9;
-                    let _e273 = xs;
-                    let pos = select((b1_ - 0.5f), clamp((_e273 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last);
-                    a_6 = f32();
-                    b_6 = f32();
-                    let _e286 = delta_1;
-                    let _e287 = theta_2;
-                    let _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e286, _e287, s_2, true);
-                    a_6 = _e288;
-                    let _e289 = delta_1;
-                    let _e290 = theta_2;
-                    let _e291 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e289, _e290, s_2, true);
-                    b_6 = select(_e291, s_2, is_last);
-                    weight = f32();
-                    if true {
-                        let _e295 = a_6;
-                        let _e296 = b_6;
-                        let _e297 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e8, _e295, _e296, panels_2);
-                        weight = _e297;
-                    } else {
-                        let _e300 = a_6;
-                        let _e301 = b_6;
-                        let _e302 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e300, _e301);
-                        weight = (sun_scatter * _e302);
-                    }
-                    let xb = (pos - 0.5f);
-                    let fx = (xb - floor(xb));
-                    let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
-                    let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
-                    let lohi = textureLoad(bounds, vec2<u32>(x1_, row_1), 0i);
-                    let lo_1 = lohi.x;
-                    let hi_1 = lohi.y;
-                    vis = 0.5f;
-                    let _e331 = d;
-                    if (_e331 <= lo_1) {
-                        vis = 1f;
-                    } else {
-                        let _e334 = d;
-                        if (_e334 > hi_1) {
-                            vis = 0f;
-                        } else {
-                            layer_2 = 0u;
-                            loop {
-                                let _e339 = layer_2;
-                                if (_e339 < LAYERS) {
-                                } else {
-                                    break;
-                                }
-                                {
-                                    let _e342 = layer_2;
-                                    let coeff = coeffs[_e342];
-                                    let _e346 = layer_2;
-                                    let _e349 = textureLoad(filtered, vec2<u32>(x0_, row_1), _e346, 0i);
-                                    let _e351 = layer_2;
-                                    let _e354 = textureLoad(filtered, vec2<u32>(x1_, row_1), _e351, 0i);
-                                    let texel_1 = mix(_e349, _e354, fx);
-                                    k_3 = 0u;
-                                    loop {
-                                        let _e358 = k_3;
-                                        if (_e358 < 4u) {
-                                        } else {
-                                            break;
-                                        }
-                                        {
-                                            let _e361 = vis;
-                                            let _e362 = k_3;
-                                            let _e364 = k_3;
-                                            vis = (_e361 + (coeff[_e362] * ((texel_1[_e364] * 2f) - 1f)));
-                                        }
-                                        continuing {
-                                            let _e373 = k_3;
-                                            k_3 = (_e373 + 1u);
-                                        }
-                                    }
-                                }
-                                continuing {
-                                    let _e376 = layer_2;
-                                    layer_2 = (_e376 + 1u);
-                                }
+                    {
+                        let _e429 = layer_2;
+                        let coeff = coeffs[_e429];
+                        let _e433 = layer_2;
+                        let _e436 = textureLoad(filtered, vec2<u32>(x00_, _e155), _e433, 0i);
+                        let _e438 = layer_2;
+                        let _e441 = textureLoad(filtered, vec2<u32>(x01_, _e155), _e438, 0i);
+                        let texel0_ = mix(_e436, _e441, fx0_);
+                        let _e444 = layer_2;
+                        let _e447 = textureLoad(filtered, vec2<u32>(x10_, row1_), _e444, 0i);
+                        let _e449 = layer_2;
+                        let _e452 = textureLoad(filtered, vec2<u32>(x11_, row1_), _e449, 0i);
+                        let texel1_ = mix(_e447, _e452, fx1_);
+                        k_3 = 0u;
+                        loop {
+                            let _e456 = k_3;
+                            if (_e456 < 4u) {
+                            } else {
+                                break;
+                            }
+                            {
+                                let _e459 = vis0_;
+                                let _e460 = k_3;
+                                let _e462 = k_3;
+                                vis0_ = (_e459 + (coeff[_e460] * ((texel0_[_e462] * 2f) - 1f)));
+                                let _e470 = vis1_;
+                                let _e471 = k_3;
+                                let _e473 = k_3;
+                                vis1_ = (_e470 + (coeff[_e471] * ((texel1_[_e473] * 2f) - 1f)));
+                            }
+                            continuing {
+                                let _e482 = k_3;
+                                k_3 = (_e482 + 1u);
                             }
                         }
                     }
-                    let _e378 = row_total;
-                    let _e379 = weight;
-                    let _e380 = vis;
-                    row_total = (_e378 + (_e379 * clamp(_e380, 0f, 1f)));
-                    if is_last {
-                        break;
+                    continuing {
+                        let _e485 = layer_2;
+                        layer_2 = (_e485 + 1u);
                     }
                 }
-                continuing {
-                    let _e387 = r_1;
-                    r_1 = (_e387 + 1u);
-                }
             }
-            let _e390 = total;
-            let _e391 = row_total;
-            total = (_e390 + (row_weight * _e391));
+            let _e487 = vis0_;
+            let _e488 = d;
+            let _e493 = d;
+            vis0_ = select(select(_e487, 0f, (_e488 > lohi0_.y)), 1f, (_e493 <= lohi0_.x));
+            let _e498 = vis1_;
+            let _e499 = d;
+            let _e504 = d;
+            vis1_ = select(select(_e498, 0f, (_e499 > lohi1_.y)), 1f, (_e504 <= lohi1_.x));
+            let _e510 = done0_;
+            if !(_e510) {
+                let _e513 = total0_;
+                let _e514 = weight0_;
+                let _e515 = vis0_;
+                total0_ = (_e513 + (_e514 * clamp(_e515, 0f, 1f)));
+            }
+            let _e522 = done1_;
+            if !(_e522) {
+                let _e525 = total1_;
+                let _e526 = weight1_;
+                let _e527 = vis1_;
+                total1_ = (_e525 + (_e526 * clamp(_e527, 0f, 1f)));
+            }
+            let _e533 = done0_;
+            if !(_e533) {
+                local_14 = is_last0_;
+            } else {
+                local_14 = true;
+            }
+            let _e538 = local_14;
+            done0_ = _e538;
+            let _e539 = done1_;
+            if !(_e539) {
+                local_15 = is_last1_;
+            } else {
+                local_15 = true;
+            }
+            let _e544 = local_15;
+            done1_ = _e544;
+            let _e545 = done0_;
+            if _e545 {
+                let _e546 = done1_;
+                local_16 = _e546;
+            } else {
+                local_16 = false;
+            }
+            let _e550 = local_16;
+            if _e550 {
+                break;
+            }
         }
         continuing {
-            let _e395 = side;
-            side = (_e395 + 1u);
+            let _e552 = r_1;
+            r_1 = (_e552 + 1u);
         }
     }
-    let l_2 = total;
+    let _e556 = total0_;
+    let _e558 = total1_;
+    let l_2 = (((1f - w1_) * _e556) + (w1_ * _e558));
     let c = (color * l_2);
     return c;
 }

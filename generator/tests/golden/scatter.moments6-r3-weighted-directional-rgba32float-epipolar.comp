@@ -437,15 +437,15 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
         float _e22 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX((-0.5 * (c2_ + _e18)));
         return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec3((c1_ / _e22), (_e22 / c3_), 0.0), true);
     }
-    float a_6 = (c3_ / c4_);
-    float b_5 = (c2_ / c4_);
+    float a_5 = (c3_ / c4_);
+    float b_4 = (c2_ / c4_);
     float c = (c1_ / c4_);
-    float p_3 = min((b_5 - ((a_6 * a_6) / 3.0)), -1e-12);
-    float qq = ((((((2.0 * a_6) * a_6) * a_6) / 27.0) - ((a_6 * b_5) / 3.0)) + c);
+    float p_3 = min((b_4 - ((a_5 * a_5) / 3.0)), -1e-12);
+    float qq = ((((((2.0 * a_5) * a_5) * a_5) / 27.0) - ((a_5 * b_4) / 3.0)) + c);
     float m = (2.0 * sqrt((-(p_3) / 3.0)));
     float theta_3 = (acos(clamp(((3.0 * qq) / (p_3 * m)), -1.0, 1.0)) / 3.0);
-    float greatest = ((m * cos(theta_3)) - (a_6 / 3.0));
-    float least = ((m * cos((theta_3 - 4.1887903))) - (a_6 / 3.0));
+    float greatest = ((m * cos(theta_3)) - (a_5 / 3.0));
+    float least = ((m * cos((theta_3 - 4.1887903))) - (a_5 / 3.0));
     z_1 = ((abs(greatest) >= abs(least)) ? greatest : least);
     bool loop_init_3 = true;
     while(true) {
@@ -578,22 +578,36 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     float xs = 0.0;
     float reach = 0.0;
     float theta_2 = 0.0;
-    float total = 0.0;
-    uint side = 0u;
-    float delta_1 = 0.0;
-    float row_total = 0.0;
+    float delta0_ = 1.0;
+    float delta1_ = 1.0;
+    float xs0_ = 0.0;
+    float xs1_ = 0.0;
+    float total0_ = 0.0;
+    float total1_ = 0.0;
+    bool done0_ = false;
+    bool done1_ = false;
     uint r_1 = 0u;
     bool local_10 = false;
-    float a_5 = 0.0;
-    float b_4 = 0.0;
-    float weight = 0.0;
-    float vis = 0.0;
+    bool local_11 = false;
+    float a0_ = 0.0;
+    float e0_ = 0.0;
+    float a1_ = 0.0;
+    float e1_ = 0.0;
+    float weight0_ = 0.0;
+    float weight1_ = 0.0;
+    float vis0_ = 0.0;
+    float vis1_ = 0.0;
+    bool local_12 = false;
+    bool local_13 = false;
+    bool local_14 = false;
+    bool local_15 = false;
+    bool local_16 = false;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10 = _group_0_binding_0_cs;
     vec3 eye_6 = f_10.eye.xyz;
-    vec3 _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
-    int _e12_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e12 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e12_clamped_lod) - ivec2(1)), _e12_clamped_lod);
-    float s_4 = (min(max(_e12.x, 0.0), f_10.theta.z) / max(dot(_e8, f_10.cam_forward.xyz), 1e-6));
+    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    int _e14_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+    vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
+    float s_4 = (min(max(_e14.x, 0.0), f_10.theta.z) / max(dot(_e10, f_10.cam_forward.xyz), 1e-6));
     vec3 color = f_10.light_color.xyz;
     vec3 px = vec3((float(x_6) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_10.epipole.w;
@@ -614,11 +628,11 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     } else {
         local_9 = true;
     }
-    bool _e75 = local_9;
-    if (_e75) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e77 = _group_0_binding_0_cs;
-        float _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, _group_0_binding_3_cs, eye_6, _e8, s_4, false);
-        vec3 l_1 = (_e80 * color);
+    bool _e77 = local_9;
+    if (_e77) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = _group_0_binding_0_cs;
+        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, _group_0_binding_3_cs, eye_6, _e10, s_4, false);
+        vec3 l_1 = (_e82 * color);
         return l_1;
     }
     vec3 axis = f_10.axis.xyz;
@@ -626,167 +640,253 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     uint width_1 = f_10.sizes.z;
     bool wrap_1 = (f_10.anti_epipole.w > 0.5);
     {
-        theta_2 = acos(clamp(dot(_e8, axis), -1.0, 1.0));
-        float phi_1 = atan(dot(_e8, f_10.e2_.xyz), dot(_e8, f_10.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
+        float phi_1 = atan(dot(_e10, f_10.e2_.xyz), dot(_e10, f_10.e1_.xyz));
         yc = ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
         if (wrap_1) {
-            float _e112 = yc;
-            float _e113 = yc;
-            yc = (_e112 - (floor((_e113 / float(rows_1))) * float(rows_1)));
+            float _e114 = yc;
+            float _e115 = yc;
+            yc = (_e114 - (floor((_e115 / float(rows_1))) * float(rows_1)));
         } else {
-            float _e120 = yc;
-            yc = clamp(_e120, 0.0, float(rows_1));
+            float _e122 = yc;
+            yc = clamp(_e122, 0.0, float(rows_1));
         }
-        float _e124 = theta_2;
-        float _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_10.theta.x, f_10.theta.y);
-        d_1 = _e129;
+        float _e126 = theta_2;
+        float _e131 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e126, f_10.theta.x, f_10.theta.y);
+        d_1 = _e131;
         if (false) {
-            vec3 q_3 = normalize(((eye_6 + (_e8 * s_4)) - f_10.light_pos.xyz));
+            vec3 q_3 = normalize(((eye_6 + (_e10 * s_4)) - f_10.light_pos.xyz));
             reach = acos(clamp(dot(q_3, -(axis)), -1.0, 1.0));
         } else {
-            float _e144 = theta_2;
-            reach = (s_4 * sin(_e144));
+            float _e146 = theta_2;
+            reach = (s_4 * sin(_e146));
         }
     }
-    float _e147 = yc;
-    float yb = (_e147 - 0.5);
+    float _e149 = yc;
+    float yb = (_e149 - 0.5);
     float fy = (yb - floor(yb));
-    uint _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    uint _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e157 : _e153);
-    uint row_count = ((row1_ != _e153) ? 2u : 1u);
-    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e8));
+    uint _e155 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    uint _e159 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e159 : _e155);
+    float w1_ = ((row1_ != _e155) ? fy : 0.0);
+    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e10));
     uint panels_2 = max((f_10.sizes2_.z / 4u), 1u);
-    float _e175 = d_1;
-    float _e176 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e175);
-    float _e181 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    float sun_scatter = (f_10.medium.y * _e181);
+    float _e176 = d_1;
+    float _e177 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e176);
+    float _e182 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+    float sun_scatter = (f_10.medium.y * _e182);
+    float _e185 = xs;
+    xs0_ = _e185;
+    float _e187 = xs;
+    xs1_ = _e187;
+    {
+        vec4 _e191 = _group_0_binding_1_cs[_e155];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e192 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e191);
+        delta0_ = _e192.delta;
+        vec4 _e197 = _group_0_binding_1_cs[row1_];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e198 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e197);
+        delta1_ = _e198.delta;
+        float _e201 = reach;
+        float _e202 = delta0_;
+        xs0_ = (_e201 / _e202);
+        float _e204 = reach;
+        float _e205 = delta1_;
+        xs1_ = (_e204 / _e205);
+    }
+    float _e207 = xs0_;
+    uint last0_ = uint(min(max(_e207, 0.0), (float(width_1) - 1.0)));
+    float _e215 = xs1_;
+    uint last1_ = uint(min(max(_e215, 0.0), (float(width_1) - 1.0)));
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e352 = side;
-            side = (_e352 + 1u);
+            uint _e506 = r_1;
+            r_1 = (_e506 + 1u);
         }
         loop_init_4 = false;
-        uint _e184 = side;
-        if ((_e184 < row_count)) {
+        uint _e225 = r_1;
+        if ((_e225 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e186 = side;
-            uint row_1 = ((_e186 == 1u) ? row1_ : _e153);
-            uint _e196 = side;
-            float row_weight = ((_e196 == 1u) ? fy : ((row_count == 1u) ? 1.0 : (1.0 - fy)));
-            delta_1 = 1.0;
-            {
-                vec4 _e204 = _group_0_binding_1_cs[row_1];
-                SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e205 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e204);
-                delta_1 = _e205.delta;
-                float _e207 = reach;
-                float _e208 = delta_1;
-                xs = (_e207 / _e208);
+            uint _e227 = r_1;
+            uint _e228 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e227, REGIONS, width_1, false);
+            float b0_ = float(_e228);
+            uint _e230 = r_1;
+            uint _e233 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e230 + 1u), REGIONS, width_1, false);
+            float b1_2 = float(_e233);
+            if (!((last0_ < uint(b1_2)))) {
+                uint _e238 = r_1;
+                local_10 = ((_e238 + 1u) == REGIONS);
+            } else {
+                local_10 = true;
             }
-            float _e211 = xs;
-            uint last = uint(min(max(_e211, 0.0), (float(width_1) - 1.0)));
-            row_total = 0.0;
-            r_1 = 0u;
-            bool loop_init_5 = true;
-            while(true) {
-                if (!loop_init_5) {
-                    uint _e344 = r_1;
-                    r_1 = (_e344 + 1u);
-                }
-                loop_init_5 = false;
-                uint _e224 = r_1;
-                if ((_e224 < REGIONS)) {
-                } else {
-                    break;
-                }
-                {
-                    uint _e226 = r_1;
-                    uint _e227 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226, REGIONS, width_1, false);
-                    float b0_ = float(_e227);
-                    uint _e229 = r_1;
-                    uint _e232 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e229 + 1u), REGIONS, width_1, false);
-                    float b1_2 = float(_e232);
-                    if (!((last < uint(b1_2)))) {
-                        uint _e237 = r_1;
-                        local_10 = ((_e237 + 1u) == REGIONS);
-                    } else {
-                        local_10 = true;
-                    }
-                    bool is_last = local_10;
-                    float _e247 = xs;
-                    float pos = (is_last ? clamp((_e247 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
-                    a_5 = 0.0;
-                    b_4 = 0.0;
-                    float _e260 = delta_1;
-                    float _e261 = theta_2;
-                    float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e260, _e261, s_4, false);
-                    a_5 = _e262;
-                    float _e263 = delta_1;
-                    float _e264 = theta_2;
-                    float _e265 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e263, _e264, s_4, false);
-                    b_4 = (is_last ? s_4 : _e265);
-                    weight = 0.0;
-                    if (false) {
-                        float _e269 = a_5;
-                        float _e270 = b_4;
-                        float _e271 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e8, _e269, _e270, panels_2);
-                        weight = _e271;
-                    } else {
-                        float _e274 = a_5;
-                        float _e275 = b_4;
-                        float _e276 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e274, _e275);
-                        weight = (sun_scatter * _e276);
-                    }
-                    float xb = (pos - 0.5);
-                    float fx = (xb - floor(xb));
-                    uint x0_ = uint(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
-                    uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
-                    int _e300_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-                    vec4 lohi = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x1_, row_1)), ivec2(0), textureSize(_group_0_binding_6_cs, _e300_clamped_lod) - ivec2(1)), _e300_clamped_lod);
-                    float lo_1 = lohi.x;
-                    float hi_1 = lohi.y;
-                    vis = 0.5;
-                    float _e305 = d_1;
-                    if ((_e305 <= lo_1)) {
-                        vis = 1.0;
-                    } else {
-                        float _e308 = d_1;
-                        if ((_e308 > hi_1)) {
-                            vis = 0.0;
-                        } else {
-                            int _e315_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e315 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row_1), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e315_clamped_lod) - ivec3(1)), _e315_clamped_lod);
-                            int _e320_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e320 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row_1), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e320_clamped_lod) - ivec3(1)), _e320_clamped_lod);
-                            vec4 m0_ = mix(_e315, _e320, fx);
-                            int _e326_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e326 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x0_, row_1), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e326_clamped_lod) - ivec3(1)), _e326_clamped_lod);
-                            int _e331_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                            vec4 _e331 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x1_, row_1), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e331_clamped_lod) - ivec3(1)), _e331_clamped_lod);
-                            vec4 m1_ = mix(_e326, _e331, fx);
-                            float _e334 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e176);
-                            vis = _e334;
-                        }
-                    }
-                    float _e335 = row_total;
-                    float _e336 = weight;
-                    float _e337 = vis;
-                    row_total = (_e335 + (_e336 * clamp(_e337, 0.0, 1.0)));
-                    if (is_last) {
-                        break;
-                    }
-                }
+            bool is_last0_ = local_10;
+            if (!((last1_ < uint(b1_2)))) {
+                uint _e249 = r_1;
+                local_11 = ((_e249 + 1u) == REGIONS);
+            } else {
+                local_11 = true;
             }
-            float _e347 = total;
-            float _e348 = row_total;
-            total = (_e347 + (row_weight * _e348));
+            bool is_last1_ = local_11;
+            float _e259 = xs0_;
+            float pos0_ = (is_last0_ ? clamp((_e259 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            float _e270 = xs1_;
+            float pos1_ = (is_last1_ ? clamp((_e270 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            a0_ = 0.0;
+            e0_ = 0.0;
+            a1_ = 0.0;
+            e1_ = 0.0;
+            float _e287 = delta0_;
+            float _e288 = theta_2;
+            float _e289 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e287, _e288, s_4, false);
+            a0_ = _e289;
+            float _e290 = delta0_;
+            float _e291 = theta_2;
+            float _e292 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e290, _e291, s_4, false);
+            e0_ = (is_last0_ ? s_4 : _e292);
+            float _e294 = delta1_;
+            float _e295 = theta_2;
+            float _e296 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e294, _e295, s_4, false);
+            a1_ = _e296;
+            float _e297 = delta1_;
+            float _e298 = theta_2;
+            float _e299 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e297, _e298, s_4, false);
+            e1_ = (is_last1_ ? s_4 : _e299);
+            weight0_ = 0.0;
+            weight1_ = 0.0;
+            if (false) {
+                float _e305 = a0_;
+                float _e306 = e0_;
+                float _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e10, _e305, _e306, panels_2);
+                weight0_ = _e307;
+                float _e308 = a1_;
+                float _e309 = e1_;
+                float _e310 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e10, _e308, _e309, panels_2);
+                weight1_ = _e310;
+            } else {
+                float _e313 = a0_;
+                float _e314 = e0_;
+                float _e315 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e313, _e314);
+                weight0_ = (sun_scatter * _e315);
+                float _e319 = a1_;
+                float _e320 = e1_;
+                float _e321 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e319, _e320);
+                weight1_ = (sun_scatter * _e321);
+            }
+            float xb0_ = (pos0_ - 0.5);
+            float fx0_ = (xb0_ - floor(xb0_));
+            uint x00_ = uint(clamp(floor(xb0_), 0.0, (float(width_1) - 1.0)));
+            uint x01_ = ((xb0_ > floor(xb0_)) ? min((x00_ + 1u), (width_1 - 1u)) : x00_);
+            float xb1_ = (pos1_ - 0.5);
+            float fx1_ = (xb1_ - floor(xb1_));
+            uint x10_ = uint(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
+            uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
+            int _e364_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+            vec4 lohi0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x01_, _e155)), ivec2(0), textureSize(_group_0_binding_6_cs, _e364_clamped_lod) - ivec2(1)), _e364_clamped_lod);
+            int _e368_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+            vec4 lohi1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x11_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e368_clamped_lod) - ivec2(1)), _e368_clamped_lod);
+            vis0_ = 0.5;
+            vis1_ = 0.5;
+            float _e373 = d_1;
+            if ((_e373 > lohi0_.x)) {
+                float _e376 = d_1;
+                local_12 = (_e376 <= lohi0_.y);
+            } else {
+                local_12 = false;
+            }
+            bool _e382 = local_12;
+            if (_e382) {
+                int _e387_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e387 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x00_, _e155), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e387_clamped_lod) - ivec3(1)), _e387_clamped_lod);
+                int _e392_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e392 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x01_, _e155), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e392_clamped_lod) - ivec3(1)), _e392_clamped_lod);
+                vec4 m0_ = mix(_e387, _e392, fx0_);
+                int _e398_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e398 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x00_, _e155), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e398_clamped_lod) - ivec3(1)), _e398_clamped_lod);
+                int _e403_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e403 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x01_, _e155), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e403_clamped_lod) - ivec3(1)), _e403_clamped_lod);
+                vec4 m1_ = mix(_e398, _e403, fx0_);
+                float _e406 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e177);
+                vis0_ = _e406;
+            }
+            float _e407 = d_1;
+            if ((_e407 > lohi1_.x)) {
+                float _e410 = d_1;
+                local_13 = (_e410 <= lohi1_.y);
+            } else {
+                local_13 = false;
+            }
+            bool _e416 = local_13;
+            if (_e416) {
+                int _e421_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e421 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x10_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e421_clamped_lod) - ivec3(1)), _e421_clamped_lod);
+                int _e426_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e426 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x11_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e426_clamped_lod) - ivec3(1)), _e426_clamped_lod);
+                vec4 m0_1 = mix(_e421, _e426, fx1_);
+                int _e432_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e432 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x10_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e432_clamped_lod) - ivec3(1)), _e432_clamped_lod);
+                int _e437_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e437 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x11_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e437_clamped_lod) - ivec3(1)), _e437_clamped_lod);
+                vec4 m1_1 = mix(_e432, _e437, fx1_);
+                float _e440 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e177);
+                vis1_ = _e440;
+            }
+            float _e441 = vis0_;
+            float _e442 = d_1;
+            float _e447 = d_1;
+            vis0_ = ((_e447 <= lohi0_.x) ? 1.0 : ((_e442 > lohi0_.y) ? 0.0 : _e441));
+            float _e452 = vis1_;
+            float _e453 = d_1;
+            float _e458 = d_1;
+            vis1_ = ((_e458 <= lohi1_.x) ? 1.0 : ((_e453 > lohi1_.y) ? 0.0 : _e452));
+            bool _e464 = done0_;
+            if (!(_e464)) {
+                float _e467 = total0_;
+                float _e468 = weight0_;
+                float _e469 = vis0_;
+                total0_ = (_e467 + (_e468 * clamp(_e469, 0.0, 1.0)));
+            }
+            bool _e476 = done1_;
+            if (!(_e476)) {
+                float _e479 = total1_;
+                float _e480 = weight1_;
+                float _e481 = vis1_;
+                total1_ = (_e479 + (_e480 * clamp(_e481, 0.0, 1.0)));
+            }
+            bool _e487 = done0_;
+            if (!(_e487)) {
+                local_14 = is_last0_;
+            } else {
+                local_14 = true;
+            }
+            bool _e492 = local_14;
+            done0_ = _e492;
+            bool _e493 = done1_;
+            if (!(_e493)) {
+                local_15 = is_last1_;
+            } else {
+                local_15 = true;
+            }
+            bool _e498 = local_15;
+            done1_ = _e498;
+            bool _e499 = done0_;
+            if (_e499) {
+                bool _e500 = done1_;
+                local_16 = _e500;
+            } else {
+                local_16 = false;
+            }
+            bool _e504 = local_16;
+            if (_e504) {
+                break;
+            }
         }
     }
-    float l_2 = total;
+    float _e510 = total0_;
+    float _e512 = total1_;
+    float l_2 = (((1.0 - w1_) * _e510) + (w1_ * _e512));
     vec3 c_1 = (color * l_2);
     return c_1;
 }

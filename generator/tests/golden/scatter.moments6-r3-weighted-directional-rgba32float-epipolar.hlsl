@@ -533,15 +533,15 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
         const CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubicrootsx_naga_oil_mod_xonrwc5dumvzduotnn5wwk3tuomx = ConstructCubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float3((c1_ / _e22), (_e22 / c3_), 0.0), true);
         return cubicrootsx_naga_oil_mod_xonrwc5dumvzduotnn5wwk3tuomx;
     }
-    float a_6 = (c3_ / c4_);
-    float b_5 = (c2_ / c4_);
+    float a_5 = (c3_ / c4_);
+    float b_4 = (c2_ / c4_);
     float c = (c1_ / c4_);
-    float p_3 = min((b_5 - ((a_6 * a_6) / 3.0)), -1e-12);
-    float qq = ((((((2.0 * a_6) * a_6) * a_6) / 27.0) - ((a_6 * b_5) / 3.0)) + c);
+    float p_3 = min((b_4 - ((a_5 * a_5) / 3.0)), -1e-12);
+    float qq = ((((((2.0 * a_5) * a_5) * a_5) / 27.0) - ((a_5 * b_4) / 3.0)) + c);
     float m = (2.0 * sqrt((-(p_3) / 3.0)));
     float theta_3 = (acos(clamp(((3.0 * qq) / (p_3 * m)), -1.0, 1.0)) / 3.0);
-    float greatest = ((m * cos(theta_3)) - (a_6 / 3.0));
-    float least = ((m * cos((theta_3 - 4.1887903))) - (a_6 / 3.0));
+    float greatest = ((m * cos(theta_3)) - (a_5 / 3.0));
+    float least = ((m * cos((theta_3 - 4.1887903))) - (a_5 / 3.0));
     z_1 = ((abs(greatest) >= abs(least)) ? greatest : least);
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
@@ -694,22 +694,36 @@ float3 scatter_pixel(uint x_6, uint y_1)
     float xs = 0.0;
     float reach = 0.0;
     float theta_2 = 0.0;
-    float total = 0.0;
-    uint side = 0u;
-    float delta_1 = (float)0;
-    float row_total = (float)0;
-    uint r_1 = (uint)0;
+    float delta0_ = 1.0;
+    float delta1_ = 1.0;
+    float xs0_ = (float)0;
+    float xs1_ = (float)0;
+    float total0_ = 0.0;
+    float total1_ = 0.0;
+    bool done0_ = false;
+    bool done1_ = false;
+    uint r_1 = 0u;
     bool local_10 = (bool)0;
-    float a_5 = (float)0;
-    float b_4 = (float)0;
-    float weight = (float)0;
-    float vis = (float)0;
+    bool local_11 = (bool)0;
+    float a0_ = (float)0;
+    float e0_ = (float)0;
+    float a1_ = (float)0;
+    float e1_ = (float)0;
+    float weight0_ = (float)0;
+    float weight1_ = (float)0;
+    float vis0_ = (float)0;
+    float vis1_ = (float)0;
+    bool local_12 = (bool)0;
+    bool local_13 = (bool)0;
+    bool local_14 = (bool)0;
+    bool local_15 = (bool)0;
+    bool local_16 = (bool)0;
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10 = frame;
     float3 eye_6 = f_10.eye.xyz;
-    const float3 _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
-    float4 _e12 = depth.Load(int3(uint2(x_6, y_1), int(0)));
-    float s_4 = (min(max(_e12.x, 0.0), f_10.theta.z) / max(dot(_e8, f_10.cam_forward.xyz), 1e-6));
+    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    float4 _e14 = depth.Load(int3(uint2(x_6, y_1), int(0)));
+    float s_4 = (min(max(_e14.x, 0.0), f_10.theta.z) / max(dot(_e10, f_10.cam_forward.xyz), 1e-6));
     float3 color = f_10.light_color.xyz;
     float3 px = float3((float(x_6) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_10.epipole.w;
@@ -730,11 +744,11 @@ float3 scatter_pixel(uint x_6, uint y_1)
     } else {
         local_9 = true;
     }
-    bool _e75 = local_9;
-    if (_e75) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e77 = frame;
-        const float _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, shadow_map, eye_6, _e8, s_4, false);
-        float3 l_1 = (_e80 * color);
+    bool _e77 = local_9;
+    if (_e77) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = frame;
+        const float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_6, _e10, s_4, false);
+        float3 l_1 = (_e82 * color);
         return l_1;
     }
     float3 axis = f_10.axis.xyz;
@@ -742,168 +756,246 @@ float3 scatter_pixel(uint x_6, uint y_1)
     uint width_1 = f_10.sizes.z;
     bool wrap_1 = (f_10.anti_epipole.w > 0.5);
     {
-        theta_2 = acos(clamp(dot(_e8, axis), -1.0, 1.0));
-        float phi_1 = atan2(dot(_e8, f_10.e2_.xyz), dot(_e8, f_10.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
+        float phi_1 = atan2(dot(_e10, f_10.e2_.xyz), dot(_e10, f_10.e1_.xyz));
         yc = ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
         if (wrap_1) {
-            float _e112 = yc;
-            float _e113 = yc;
-            yc = (_e112 - (floor((_e113 / float(rows_1))) * float(rows_1)));
+            float _e114 = yc;
+            float _e115 = yc;
+            yc = (_e114 - (floor((_e115 / float(rows_1))) * float(rows_1)));
         } else {
-            float _e120 = yc;
-            yc = clamp(_e120, 0.0, float(rows_1));
+            float _e122 = yc;
+            yc = clamp(_e122, 0.0, float(rows_1));
         }
-        float _e124 = theta_2;
-        const float _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_10.theta.x, f_10.theta.y);
-        d_1 = _e129;
+        float _e126 = theta_2;
+        const float _e131 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e126, f_10.theta.x, f_10.theta.y);
+        d_1 = _e131;
         if (false) {
-            float3 q_3 = normalize(((eye_6 + (_e8 * s_4)) - f_10.light_pos.xyz));
+            float3 q_3 = normalize(((eye_6 + (_e10 * s_4)) - f_10.light_pos.xyz));
             reach = acos(clamp(dot(q_3, -(axis)), -1.0, 1.0));
         } else {
-            float _e144 = theta_2;
-            reach = (s_4 * sin(_e144));
+            float _e146 = theta_2;
+            reach = (s_4 * sin(_e146));
         }
     }
-    float _e147 = yc;
-    float yb = (_e147 - 0.5);
+    float _e149 = yc;
+    float yb = (_e149 - 0.5);
     float fy = (yb - floor(yb));
-    const uint _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    const uint _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e157 : _e153);
-    uint row_count = ((row1_ != _e153) ? 2u : 1u);
-    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e8));
+    const uint _e155 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    const uint _e159 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e159 : _e155);
+    float w1_ = ((row1_ != _e155) ? fy : 0.0);
+    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e10));
     uint panels_2 = max(naga_div(f_10.sizes2_.z, 4u), 1u);
-    float _e175 = d_1;
-    const float _e176 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e175);
-    const float _e181 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    float sun_scatter = (f_10.medium.y * _e181);
+    float _e176 = d_1;
+    const float _e177 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e176);
+    const float _e182 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+    float sun_scatter = (f_10.medium.y * _e182);
+    float _e185 = xs;
+    xs0_ = _e185;
+    float _e187 = xs;
+    xs1_ = _e187;
+    {
+        float4 _e191 = asfloat(slices.Load4(_e155*16));
+        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e192 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e191);
+        delta0_ = _e192.delta;
+        float4 _e197 = asfloat(slices.Load4(row1_*16));
+        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e198 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e197);
+        delta1_ = _e198.delta;
+        float _e201 = reach;
+        float _e202 = delta0_;
+        xs0_ = (_e201 / _e202);
+        float _e204 = reach;
+        float _e205 = delta1_;
+        xs1_ = (_e204 / _e205);
+    }
+    float _e207 = xs0_;
+    uint last0_ = naga_f2u32(min(max(_e207, 0.0), (float(width_1) - 1.0)));
+    float _e215 = xs1_;
+    uint last1_ = naga_f2u32(min(max(_e215, 0.0), (float(width_1) - 1.0)));
     uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e352 = side;
-            side = (_e352 + 1u);
+            uint _e506 = r_1;
+            r_1 = (_e506 + 1u);
         }
         loop_init_4 = false;
-        uint _e184 = side;
-        if ((_e184 < row_count)) {
+        uint _e225 = r_1;
+        if ((_e225 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e186 = side;
-            uint row_1 = ((_e186 == 1u) ? row1_ : _e153);
-            uint _e196 = side;
-            float row_weight = ((_e196 == 1u) ? fy : ((row_count == 1u) ? 1.0 : (1.0 - fy)));
-            delta_1 = 1.0;
-            {
-                float4 _e204 = asfloat(slices.Load4(row_1*16));
-                const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e205 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e204);
-                delta_1 = _e205.delta;
-                float _e207 = reach;
-                float _e208 = delta_1;
-                xs = (_e207 / _e208);
+            uint _e227 = r_1;
+            const uint _e228 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e227, REGIONS, width_1, false);
+            float b0_ = float(_e228);
+            uint _e230 = r_1;
+            const uint _e233 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e230 + 1u), REGIONS, width_1, false);
+            float b1_2 = float(_e233);
+            if (!((last0_ < naga_f2u32(b1_2)))) {
+                uint _e238 = r_1;
+                local_10 = ((_e238 + 1u) == REGIONS);
+            } else {
+                local_10 = true;
             }
-            float _e211 = xs;
-            uint last = naga_f2u32(min(max(_e211, 0.0), (float(width_1) - 1.0)));
-            row_total = 0.0;
-            r_1 = 0u;
-            uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
-            bool loop_init_5 = true;
-            while(true) {
-                if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
-                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-                if (!loop_init_5) {
-                    uint _e344 = r_1;
-                    r_1 = (_e344 + 1u);
-                }
-                loop_init_5 = false;
-                uint _e224 = r_1;
-                if ((_e224 < REGIONS)) {
-                } else {
-                    break;
-                }
-                {
-                    uint _e226 = r_1;
-                    const uint _e227 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226, REGIONS, width_1, false);
-                    float b0_ = float(_e227);
-                    uint _e229 = r_1;
-                    const uint _e232 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e229 + 1u), REGIONS, width_1, false);
-                    float b1_2 = float(_e232);
-                    if (!((last < naga_f2u32(b1_2)))) {
-                        uint _e237 = r_1;
-                        local_10 = ((_e237 + 1u) == REGIONS);
-                    } else {
-                        local_10 = true;
-                    }
-                    bool is_last = local_10;
-                    float _e247 = xs;
-                    float pos = (is_last ? clamp((_e247 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
-                    a_5 = ZeroValuefloat();
-                    b_4 = ZeroValuefloat();
-                    float _e260 = delta_1;
-                    float _e261 = theta_2;
-                    const float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e260, _e261, s_4, false);
-                    a_5 = _e262;
-                    float _e263 = delta_1;
-                    float _e264 = theta_2;
-                    const float _e265 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e263, _e264, s_4, false);
-                    b_4 = (is_last ? s_4 : _e265);
-                    weight = ZeroValuefloat();
-                    if (false) {
-                        float _e269 = a_5;
-                        float _e270 = b_4;
-                        const float _e271 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e8, _e269, _e270, panels_2);
-                        weight = _e271;
-                    } else {
-                        float _e274 = a_5;
-                        float _e275 = b_4;
-                        const float _e276 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e274, _e275);
-                        weight = (sun_scatter * _e276);
-                    }
-                    float xb = (pos - 0.5);
-                    float fx = (xb - floor(xb));
-                    uint x0_ = naga_f2u32(clamp(floor(xb), 0.0, (float(width_1) - 1.0)));
-                    uint x1_ = ((xb > floor(xb)) ? min((x0_ + 1u), (width_1 - 1u)) : x0_);
-                    float4 lohi = bounds.Load(int3(uint2(x1_, row_1), int(0)));
-                    float lo_1 = lohi.x;
-                    float hi_1 = lohi.y;
-                    vis = 0.5;
-                    float _e305 = d_1;
-                    if ((_e305 <= lo_1)) {
-                        vis = 1.0;
-                    } else {
-                        float _e308 = d_1;
-                        if ((_e308 > hi_1)) {
-                            vis = 0.0;
-                        } else {
-                            float4 _e315 = filtered.Load(int4(uint2(x0_, row_1), int(0), int(0)));
-                            float4 _e320 = filtered.Load(int4(uint2(x1_, row_1), int(0), int(0)));
-                            float4 m0_ = lerp(_e315, _e320, fx);
-                            float4 _e326 = filtered.Load(int4(uint2(x0_, row_1), int(1), int(0)));
-                            float4 _e331 = filtered.Load(int4(uint2(x1_, row_1), int(1), int(0)));
-                            float4 m1_ = lerp(_e326, _e331, fx);
-                            const float _e334 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e176);
-                            vis = _e334;
-                        }
-                    }
-                    float _e335 = row_total;
-                    float _e336 = weight;
-                    float _e337 = vis;
-                    row_total = (_e335 + (_e336 * clamp(_e337, 0.0, 1.0)));
-                    if (is_last) {
-                        break;
-                    }
-                }
+            bool is_last0_ = local_10;
+            if (!((last1_ < naga_f2u32(b1_2)))) {
+                uint _e249 = r_1;
+                local_11 = ((_e249 + 1u) == REGIONS);
+            } else {
+                local_11 = true;
             }
-            float _e347 = total;
-            float _e348 = row_total;
-            total = (_e347 + (row_weight * _e348));
+            bool is_last1_ = local_11;
+            float _e259 = xs0_;
+            float pos0_ = (is_last0_ ? clamp((_e259 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            float _e270 = xs1_;
+            float pos1_ = (is_last1_ ? clamp((_e270 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            a0_ = ZeroValuefloat();
+            e0_ = ZeroValuefloat();
+            a1_ = ZeroValuefloat();
+            e1_ = ZeroValuefloat();
+            float _e287 = delta0_;
+            float _e288 = theta_2;
+            const float _e289 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e287, _e288, s_4, false);
+            a0_ = _e289;
+            float _e290 = delta0_;
+            float _e291 = theta_2;
+            const float _e292 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e290, _e291, s_4, false);
+            e0_ = (is_last0_ ? s_4 : _e292);
+            float _e294 = delta1_;
+            float _e295 = theta_2;
+            const float _e296 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e294, _e295, s_4, false);
+            a1_ = _e296;
+            float _e297 = delta1_;
+            float _e298 = theta_2;
+            const float _e299 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e297, _e298, s_4, false);
+            e1_ = (is_last1_ ? s_4 : _e299);
+            weight0_ = ZeroValuefloat();
+            weight1_ = ZeroValuefloat();
+            if (false) {
+                float _e305 = a0_;
+                float _e306 = e0_;
+                const float _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e10, _e305, _e306, panels_2);
+                weight0_ = _e307;
+                float _e308 = a1_;
+                float _e309 = e1_;
+                const float _e310 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e10, _e308, _e309, panels_2);
+                weight1_ = _e310;
+            } else {
+                float _e313 = a0_;
+                float _e314 = e0_;
+                const float _e315 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e313, _e314);
+                weight0_ = (sun_scatter * _e315);
+                float _e319 = a1_;
+                float _e320 = e1_;
+                const float _e321 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e319, _e320);
+                weight1_ = (sun_scatter * _e321);
+            }
+            float xb0_ = (pos0_ - 0.5);
+            float fx0_ = (xb0_ - floor(xb0_));
+            uint x00_ = naga_f2u32(clamp(floor(xb0_), 0.0, (float(width_1) - 1.0)));
+            uint x01_ = ((xb0_ > floor(xb0_)) ? min((x00_ + 1u), (width_1 - 1u)) : x00_);
+            float xb1_ = (pos1_ - 0.5);
+            float fx1_ = (xb1_ - floor(xb1_));
+            uint x10_ = naga_f2u32(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
+            uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
+            float4 lohi0_ = bounds.Load(int3(uint2(x01_, _e155), int(0)));
+            float4 lohi1_ = bounds.Load(int3(uint2(x11_, row1_), int(0)));
+            vis0_ = 0.5;
+            vis1_ = 0.5;
+            float _e373 = d_1;
+            if ((_e373 > lohi0_.x)) {
+                float _e376 = d_1;
+                local_12 = (_e376 <= lohi0_.y);
+            } else {
+                local_12 = false;
+            }
+            bool _e382 = local_12;
+            if (_e382) {
+                float4 _e387 = filtered.Load(int4(uint2(x00_, _e155), int(0), int(0)));
+                float4 _e392 = filtered.Load(int4(uint2(x01_, _e155), int(0), int(0)));
+                float4 m0_ = lerp(_e387, _e392, fx0_);
+                float4 _e398 = filtered.Load(int4(uint2(x00_, _e155), int(1), int(0)));
+                float4 _e403 = filtered.Load(int4(uint2(x01_, _e155), int(1), int(0)));
+                float4 m1_ = lerp(_e398, _e403, fx0_);
+                const float _e406 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e177);
+                vis0_ = _e406;
+            }
+            float _e407 = d_1;
+            if ((_e407 > lohi1_.x)) {
+                float _e410 = d_1;
+                local_13 = (_e410 <= lohi1_.y);
+            } else {
+                local_13 = false;
+            }
+            bool _e416 = local_13;
+            if (_e416) {
+                float4 _e421 = filtered.Load(int4(uint2(x10_, row1_), int(0), int(0)));
+                float4 _e426 = filtered.Load(int4(uint2(x11_, row1_), int(0), int(0)));
+                float4 m0_1 = lerp(_e421, _e426, fx1_);
+                float4 _e432 = filtered.Load(int4(uint2(x10_, row1_), int(1), int(0)));
+                float4 _e437 = filtered.Load(int4(uint2(x11_, row1_), int(1), int(0)));
+                float4 m1_1 = lerp(_e432, _e437, fx1_);
+                const float _e440 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e177);
+                vis1_ = _e440;
+            }
+            float _e441 = vis0_;
+            float _e442 = d_1;
+            float _e447 = d_1;
+            vis0_ = ((_e447 <= lohi0_.x) ? 1.0 : ((_e442 > lohi0_.y) ? 0.0 : _e441));
+            float _e452 = vis1_;
+            float _e453 = d_1;
+            float _e458 = d_1;
+            vis1_ = ((_e458 <= lohi1_.x) ? 1.0 : ((_e453 > lohi1_.y) ? 0.0 : _e452));
+            bool _e464 = done0_;
+            if (!(_e464)) {
+                float _e467 = total0_;
+                float _e468 = weight0_;
+                float _e469 = vis0_;
+                total0_ = (_e467 + (_e468 * clamp(_e469, 0.0, 1.0)));
+            }
+            bool _e476 = done1_;
+            if (!(_e476)) {
+                float _e479 = total1_;
+                float _e480 = weight1_;
+                float _e481 = vis1_;
+                total1_ = (_e479 + (_e480 * clamp(_e481, 0.0, 1.0)));
+            }
+            bool _e487 = done0_;
+            if (!(_e487)) {
+                local_14 = is_last0_;
+            } else {
+                local_14 = true;
+            }
+            bool _e492 = local_14;
+            done0_ = _e492;
+            bool _e493 = done1_;
+            if (!(_e493)) {
+                local_15 = is_last1_;
+            } else {
+                local_15 = true;
+            }
+            bool _e498 = local_15;
+            done1_ = _e498;
+            bool _e499 = done0_;
+            if (_e499) {
+                bool _e500 = done1_;
+                local_16 = _e500;
+            } else {
+                local_16 = false;
+            }
+            bool _e504 = local_16;
+            if (_e504) {
+                break;
+            }
         }
     }
-    float l_2 = total;
+    float _e510 = total0_;
+    float _e512 = total1_;
+    float l_2 = (((1.0 - w1_) * _e510) + (w1_ * _e512));
     float3 c_1 = (color * l_2);
     return c_1;
 }

@@ -437,15 +437,15 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
         let _e22 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX((-0.5f * (c2_ + _e18)));
         return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec3<f32>((c1_ / _e22), (_e22 / c3_), 0f), true);
     }
-    let a_6 = (c3_ / c4_);
-    let b_5 = (c2_ / c4_);
+    let a_5 = (c3_ / c4_);
+    let b_4 = (c2_ / c4_);
     let c = (c1_ / c4_);
-    let p_3 = min((b_5 - ((a_6 * a_6) / 3f)), -0.000000000001f);
-    let qq = ((((((2f * a_6) * a_6) * a_6) / 27f) - ((a_6 * b_5) / 3f)) + c);
+    let p_3 = min((b_4 - ((a_5 * a_5) / 3f)), -0.000000000001f);
+    let qq = ((((((2f * a_5) * a_5) * a_5) / 27f) - ((a_5 * b_4) / 3f)) + c);
     let m = (2f * sqrt((-(p_3) / 3f)));
     let theta_3 = (acos(clamp(((3f * qq) / (p_3 * m)), -1f, 1f)) / 3f);
-    let greatest = ((m * cos(theta_3)) - (a_6 / 3f));
-    let least = ((m * cos((theta_3 - 4.1887903f))) - (a_6 / 3f));
+    let greatest = ((m * cos(theta_3)) - (a_5 / 3f));
+    let least = ((m * cos((theta_3 - 4.1887903f))) - (a_5 / 3f));
     z_1 = select(least, greatest, (abs(greatest) >= abs(least)));
     loop {
         let _e83 = i;
@@ -577,22 +577,36 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var xs: f32 = 0f;
     var reach: f32 = 0f;
     var theta_2: f32 = 0f;
-    var total: f32 = 0f;
-    var side: u32 = 0u;
-    var delta_1: f32;
-    var row_total: f32;
-    var r_1: u32;
+    var delta0_: f32 = 1f;
+    var delta1_: f32 = 1f;
+    var xs0_: f32;
+    var xs1_: f32;
+    var total0_: f32 = 0f;
+    var total1_: f32 = 0f;
+    var done0_: bool = false;
+    var done1_: bool = false;
+    var r_1: u32 = 0u;
     var local_10: bool;
-    var a_5: f32;
-    var b_4: f32;
-    var weight: f32;
-    var vis: f32;
+    var local_11: bool;
+    var a0_: f32;
+    var e0_: f32;
+    var a1_: f32;
+    var e1_: f32;
+    var weight0_: f32;
+    var weight1_: f32;
+    var vis0_: f32;
+    var vis1_: f32;
+    var local_12: bool;
+    var local_13: bool;
+    var local_14: bool;
+    var local_15: bool;
+    var local_16: bool;
 
     let f_10 = frame;
     let eye_6 = f_10.eye.xyz;
-    let _e8 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
-    let _e12 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
-    let s_4 = (min(max(_e12.x, 0f), f_10.theta.z) / max(dot(_e8, f_10.cam_forward.xyz), 0.000001f));
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    let _e14 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
+    let s_4 = (min(max(_e14.x, 0f), f_10.theta.z) / max(dot(_e10, f_10.cam_forward.xyz), 0.000001f));
     let color = f_10.light_color.xyz;
     let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_10.epipole.w;
@@ -613,11 +627,11 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     } else {
         local_9 = true;
     }
-    let _e75 = local_9;
-    if _e75 {
-        let _e77 = frame;
-        let _e80 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e77, shadow_map, eye_6, _e8, s_4, false);
-        let l_1 = (_e80 * color);
+    let _e77 = local_9;
+    if _e77 {
+        let _e79 = frame;
+        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_6, _e10, s_4, false);
+        let l_1 = (_e82 * color);
         return l_1;
     }
     let axis = f_10.axis.xyz;
@@ -625,158 +639,241 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     let width_1 = f_10.sizes.z;
     let wrap_1 = (f_10.anti_epipole.w > 0.5f);
     {
-        theta_2 = acos(clamp(dot(_e8, axis), -1f, 1f));
-        let phi_1 = atan2(dot(_e8, f_10.e2_.xyz), dot(_e8, f_10.e1_.xyz));
+        theta_2 = acos(clamp(dot(_e10, axis), -1f, 1f));
+        let phi_1 = atan2(dot(_e10, f_10.e2_.xyz), dot(_e10, f_10.e1_.xyz));
         yc = ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
         if wrap_1 {
-            let _e112 = yc;
-            let _e113 = yc;
-            yc = (_e112 - (floor((_e113 / f32(rows_1))) * f32(rows_1)));
+            let _e114 = yc;
+            let _e115 = yc;
+            yc = (_e114 - (floor((_e115 / f32(rows_1))) * f32(rows_1)));
         } else {
-            let _e120 = yc;
-            yc = clamp(_e120, 0f, f32(rows_1));
+            let _e122 = yc;
+            yc = clamp(_e122, 0f, f32(rows_1));
         }
-        let _e124 = theta_2;
-        let _e129 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e124, f_10.theta.x, f_10.theta.y);
-        d_1 = _e129;
+        let _e126 = theta_2;
+        let _e131 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e126, f_10.theta.x, f_10.theta.y);
+        d_1 = _e131;
         if false {
-            let q_3 = normalize(((eye_6 + (_e8 * s_4)) - f_10.light_pos.xyz));
+            let q_3 = normalize(((eye_6 + (_e10 * s_4)) - f_10.light_pos.xyz));
             reach = acos(clamp(dot(q_3, -(axis)), -1f, 1f));
         } else {
-            let _e144 = theta_2;
-            reach = (s_4 * sin(_e144));
+            let _e146 = theta_2;
+            reach = (s_4 * sin(_e146));
         }
     }
-    let _e147 = yc;
-    let yb = (_e147 - 0.5f);
+    let _e149 = yc;
+    let yb = (_e149 - 0.5f);
     let fy = (yb - floor(yb));
-    let _e153 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    let _e157 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
-    let row1_ = select(_e153, _e157, (yb > floor(yb)));
-    let row_count = select(1u, 2u, (row1_ != _e153));
-    let cos_theta_l = -(dot(f_10.light_dir.xyz, _e8));
+    let _e155 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
+    let _e159 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
+    let row1_ = select(_e155, _e159, (yb > floor(yb)));
+    let w1_ = select(0f, fy, (row1_ != _e155));
+    let cos_theta_l = -(dot(f_10.light_dir.xyz, _e10));
     let panels_2 = max((f_10.sizes2_.z / 4u), 1u);
-    let _e175 = d_1;
-    let _e176 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e175);
-    let _e181 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    let sun_scatter = (f_10.medium.y * _e181);
+    let _e176 = d_1;
+    let _e177 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e176);
+    let _e182 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
+    let sun_scatter = (f_10.medium.y * _e182);
+    let _e185 = xs;
+    xs0_ = _e185;
+    let _e187 = xs;
+    xs1_ = _e187;
+    {
+        let _e191 = slices[_e155];
+        let _e192 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e191);
+        delta0_ = _e192.delta;
+        let _e197 = slices[row1_];
+        let _e198 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e197);
+        delta1_ = _e198.delta;
+        let _e201 = reach;
+        let _e202 = delta0_;
+        xs0_ = (_e201 / _e202);
+        let _e204 = reach;
+        let _e205 = delta1_;
+        xs1_ = (_e204 / _e205);
+    }
+    let _e207 = xs0_;
+    let last0_ = u32(min(max(_e207, 0f), (f32(width_1) - 1f)));
+    let _e215 = xs1_;
+    let last1_ = u32(min(max(_e215, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e184 = side;
-        if (_e184 < row_count) {
+        let _e225 = r_1;
+        if (_e225 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e186 = side;
-            let row_1 = select(_e153, row1_, (_e186 == 1u));
-            let _e196 = side;
-            let row_weight = select(select((1f - fy), 1f, (row_count == 1u)), fy, (_e196 == 1u));
-            delta_1 = 1f;
-            {
-                let _e204 = slices[row_1];
-                let _e205 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e204);
-                delta_1 = _e205.delta;
-                let _e207 = reach;
-                let _e208 = delta_1;
-                xs = (_e207 / _e208);
+            let _e227 = r_1;
+            let _e228 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e227, REGIONS, width_1, false);
+            let b0_ = f32(_e228);
+            let _e230 = r_1;
+            let _e233 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e230 + 1u), REGIONS, width_1, false);
+            let b1_2 = f32(_e233);
+            if !((last0_ < u32(b1_2))) {
+                let _e238 = r_1;
+                local_10 = ((_e238 + 1u) == REGIONS);
+            } else {
+                local_10 = true;
             }
-            let _e211 = xs;
-            let last = u32(min(max(_e211, 0f), (f32(width_1) - 1f)));
-            row_total = 0f;
-            r_1 = 0u;
-            loop {
-                let _e224 = r_1;
-                if (_e224 < REGIONS) {
-                } else {
-                    break;
-                }
-                {
-                    let _e226 = r_1;
-                    let _e227 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e226, REGIONS, width_1, false);
-                    let b0_ = f32(_e227);
-                    let _e229 = r_1;
-                    let _e232 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e229 + 1u), REGIONS, width_1, false);
-                    let b1_2 = f32(_e232);
-                    if !((last < u32(b1_2))) {
-                        let _e237 = r_1;
-                        local_10 = ((_e237 + 1u) == REGIONS);
-                    } else {
-                        local_10 = true;
-                    }
-                    let is_last = local_10;
-                    let _e247 = xs;
-                    let pos = select((b1_2 - 0.5f), clamp((_e247 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last);
-                    a_5 = f32();
-                    b_4 = f32();
-                    let _e260 = delta_1;
-                    let _e261 = theta_2;
-                    let _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e260, _e261, s_4, false);
-                    a_5 = _e262;
-                    let _e263 = delta_1;
-                    let _e264 = theta_2;
-                    let _e265 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e263, _e264, s_4, false);
-                    b_4 = select(_e265, s_4, is_last);
-                    weight = f32();
-                    if false {
-                        let _e269 = a_5;
-                        let _e270 = b_4;
-                        let _e271 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e8, _e269, _e270, panels_2);
-                        weight = _e271;
-                    } else {
-                        let _e274 = a_5;
-                        let _e275 = b_4;
-                        let _e276 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e274, _e275);
-                        weight = (sun_scatter * _e276);
-                    }
-                    let xb = (pos - 0.5f);
-                    let fx = (xb - floor(xb));
-                    let x0_ = u32(clamp(floor(xb), 0f, (f32(width_1) - 1f)));
-                    let x1_ = select(x0_, min((x0_ + 1u), (width_1 - 1u)), (xb > floor(xb)));
-                    let lohi = textureLoad(bounds, vec2<u32>(x1_, row_1), 0i);
-                    let lo_1 = lohi.x;
-                    let hi_1 = lohi.y;
-                    vis = 0.5f;
-                    let _e305 = d_1;
-                    if (_e305 <= lo_1) {
-                        vis = 1f;
-                    } else {
-                        let _e308 = d_1;
-                        if (_e308 > hi_1) {
-                            vis = 0f;
-                        } else {
-                            let _e315 = textureLoad(filtered, vec2<u32>(x0_, row_1), 0i, 0i);
-                            let _e320 = textureLoad(filtered, vec2<u32>(x1_, row_1), 0i, 0i);
-                            let m0_ = mix(_e315, _e320, fx);
-                            let _e326 = textureLoad(filtered, vec2<u32>(x0_, row_1), 1i, 0i);
-                            let _e331 = textureLoad(filtered, vec2<u32>(x1_, row_1), 1i, 0i);
-                            let m1_ = mix(_e326, _e331, fx);
-                            let _e334 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e176);
-                            vis = _e334;
-                        }
-                    }
-                    let _e335 = row_total;
-                    let _e336 = weight;
-                    let _e337 = vis;
-                    row_total = (_e335 + (_e336 * clamp(_e337, 0f, 1f)));
-                    if is_last {
-                        break;
-                    }
-                }
-                continuing {
-                    let _e344 = r_1;
-                    r_1 = (_e344 + 1u);
-                }
+            let is_last0_ = local_10;
+            if !((last1_ < u32(b1_2))) {
+                let _e249 = r_1;
+                local_11 = ((_e249 + 1u) == REGIONS);
+            } else {
+                local_11 = true;
             }
-            let _e347 = total;
-            let _e348 = row_total;
-            total = (_e347 + (row_weight * _e348));
+            let is_last1_ = local_11;
+            let _e259 = xs0_;
+            let pos0_ = select((b1_2 - 0.5f), clamp((_e259 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
+            let _e270 = xs1_;
+            let pos1_ = select((b1_2 - 0.5f), clamp((_e270 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
+            a0_ = f32();
+            e0_ = f32();
+            a1_ = f32();
+            e1_ = f32();
+            let _e287 = delta0_;
+            let _e288 = theta_2;
+            let _e289 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e287, _e288, s_4, false);
+            a0_ = _e289;
+            let _e290 = delta0_;
+            let _e291 = theta_2;
+            let _e292 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e290, _e291, s_4, false);
+            e0_ = select(_e292, s_4, is_last0_);
+            let _e294 = delta1_;
+            let _e295 = theta_2;
+            let _e296 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e294, _e295, s_4, false);
+            a1_ = _e296;
+            let _e297 = delta1_;
+            let _e298 = theta_2;
+            let _e299 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e297, _e298, s_4, false);
+            e1_ = select(_e299, s_4, is_last1_);
+            weight0_ = f32();
+            weight1_ = f32();
+            if false {
+                let _e305 = a0_;
+                let _e306 = e0_;
+                let _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e10, _e305, _e306, panels_2);
+                weight0_ = _e307;
+                let _e308 = a1_;
+                let _e309 = e1_;
+                let _e310 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e10, _e308, _e309, panels_2);
+                weight1_ = _e310;
+            } else {
+                let _e313 = a0_;
+                let _e314 = e0_;
+                let _e315 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e313, _e314);
+                weight0_ = (sun_scatter * _e315);
+                let _e319 = a1_;
+                let _e320 = e1_;
+                let _e321 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e319, _e320);
+                weight1_ = (sun_scatter * _e321);
+            }
+            let xb0_ = (pos0_ - 0.5f);
+            let fx0_ = (xb0_ - floor(xb0_));
+            let x00_ = u32(clamp(floor(xb0_), 0f, (f32(width_1) - 1f)));
+            let x01_ = select(x00_, min((x00_ + 1u), (width_1 - 1u)), (xb0_ > floor(xb0_)));
+            let xb1_ = (pos1_ - 0.5f);
+            let fx1_ = (xb1_ - floor(xb1_));
+            let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
+            let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
+            let lohi0_ = textureLoad(bounds, vec2<u32>(x01_, _e155), 0i);
+            let lohi1_ = textureLoad(bounds, vec2<u32>(x11_, row1_), 0i);
+            vis0_ = 0.5f;
+            vis1_ = 0.5f;
+            let _e373 = d_1;
+            if (_e373 > lohi0_.x) {
+                let _e376 = d_1;
+                local_12 = (_e376 <= lohi0_.y);
+            } else {
+                local_12 = false;
+            }
+            let _e382 = local_12;
+            if _e382 {
+                let _e387 = textureLoad(filtered, vec2<u32>(x00_, _e155), 0i, 0i);
+                let _e392 = textureLoad(filtered, vec2<u32>(x01_, _e155), 0i, 0i);
+                let m0_ = mix(_e387, _e392, fx0_);
+                let _e398 = textureLoad(filtered, vec2<u32>(x00_, _e155), 1i, 0i);
+                let _e403 = textureLoad(filtered, vec2<u32>(x01_, _e155), 1i, 0i);
+                let m1_ = mix(_e398, _e403, fx0_);
+                let _e406 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e177);
+                vis0_ = _e406;
+            }
+            let _e407 = d_1;
+            if (_e407 > lohi1_.x) {
+                let _e410 = d_1;
+                local_13 = (_e410 <= lohi1_.y);
+            } else {
+                local_13 = false;
+            }
+            let _e416 = local_13;
+            if _e416 {
+                let _e421 = textureLoad(filtered, vec2<u32>(x10_, row1_), 0i, 0i);
+                let _e426 = textureLoad(filtered, vec2<u32>(x11_, row1_), 0i, 0i);
+                let m0_1 = mix(_e421, _e426, fx1_);
+                let _e432 = textureLoad(filtered, vec2<u32>(x10_, row1_), 1i, 0i);
+                let _e437 = textureLoad(filtered, vec2<u32>(x11_, row1_), 1i, 0i);
+                let m1_1 = mix(_e432, _e437, fx1_);
+                let _e440 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e177);
+                vis1_ = _e440;
+            }
+            let _e441 = vis0_;
+            let _e442 = d_1;
+            let _e447 = d_1;
+            vis0_ = select(select(_e441, 0f, (_e442 > lohi0_.y)), 1f, (_e447 <= lohi0_.x));
+            let _e452 = vis1_;
+            let _e453 = d_1;
+            let _e458 = d_1;
+            vis1_ = select(select(_e452, 0f, (_e453 > lohi1_.y)), 1f, (_e458 <= lohi1_.x));
+            let _e464 = done0_;
+            if !(_e464) {
+                let _e467 = total0_;
+                let _e468 = weight0_;
+                let _e469 = vis0_;
+                total0_ = (_e467 + (_e468 * clamp(_e469, 0f, 1f)));
+            }
+            let _e476 = done1_;
+            if !(_e476) {
+                let _e479 = total1_;
+                let _e480 = weight1_;
+                let _e481 = vis1_;
+                total1_ = (_e479 + (_e480 * clamp(_e481, 0f, 1f)));
+            }
+            let _e487 = done0_;
+            if !(_e487) {
+                local_14 = is_last0_;
+            } else {
+                local_14 = true;
+            }
+            let _e492 = local_14;
+            done0_ = _e492;
+            let _e493 = done1_;
+            if !(_e493) {
+                local_15 = is_last1_;
+            } else {
+                local_15 = true;
+            }
+            let _e498 = local_15;
+            done1_ = _e498;
+            let _e499 = done0_;
+            if _e499 {
+                let _e500 = done1_;
+                local_16 = _e500;
+            } else {
+                local_16 = false;
+            }
+            let _e504 = local_16;
+            if _e504 {
+                break;
+            }
         }
         continuing {
-            let _e352 = side;
-            side = (_e352 + 1u);
+            let _e506 = r_1;
+            r_1 = (_e506 + 1u);
         }
     }
-    let l_2 = total;
+    let _e510 = total0_;
+    let _e512 = total1_;
+    let l_2 = (((1f - w1_) * _e510) + (w1_ * _e512));
     let c_1 = (color * l_2);
     return c_1;
 }

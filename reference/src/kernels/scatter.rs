@@ -144,7 +144,7 @@ pub fn scatter_main(
     } else {
         row0
     };
-    let row_count = if row1 != row0 { 2 } else { 1 };
+    let w1 = if row1 != row0 { fy } else { 0.0 };
 
     let cos_theta_l = -xyz(f.light_dir).dot(dir);
     // Every region gets the full spot quadrature (see the WGSL comment).
@@ -167,64 +167,71 @@ pub fn scatter_main(
     // The sun's scattering coefficient times phase, the same for every region.
     let sun_scatter = f.medium[1] * phase_hg(f.medium[2], cos_theta_l);
 
-    // Per row, regions: every region before the surface's, whole, and the surface's up to
-    // x_s, each weighted by this pixel's own unshadowed integral over its part [a, b] of the
-    // ray (the row's own spacing places a and b). One loop per row, as in the WGSL.
-    let mut total = 0.0;
-    for side in 0..row_count {
-        let row = if side == 1 { row1 } else { row0 };
-        let row_weight = if side == 1 {
-            fy
-        } else if row_count == 1 {
-            1.0
-        } else {
-            1.0 - fy
-        };
-        let mut delta = 1.0;
-        if !proj {
-            delta = inp.slices[row as usize].delta;
-            xs = reach / delta;
-        }
-        let last = min(max(xs, 0.0), width as f32 - 1.0) as u32;
-        let mut row_total = 0.0;
-        for r in 0..regions {
-            let b0 = region_start(r, regions, width, spot) as f32;
-            let b1 = region_start(r + 1, regions, width, spot) as f32;
-            let is_last = last < b1 as u32 || r + 1 == regions;
-            let pos = if is_last {
+    // Regions: every region before the surface's, whole, and the surface's up to x_s, each
+    // weighted by this pixel's own unshadowed integral over its part [a, b] of the ray; each
+    // row places a and b with its own spacing, so the two rows' regions are summed apart in
+    // one loop, each row's ending at its own last region (see the WGSL comment).
+    let (mut delta0, mut delta1) = (1.0, 1.0);
+    let (mut xs0, mut xs1) = (xs, xs);
+    if !proj {
+        delta0 = inp.slices[row0 as usize].delta;
+        delta1 = inp.slices[row1 as usize].delta;
+        xs0 = reach / delta0;
+        xs1 = reach / delta1;
+    }
+    let last0 = min(max(xs0, 0.0), width as f32 - 1.0) as u32;
+    let last1 = min(max(xs1, 0.0), width as f32 - 1.0) as u32;
+    let (mut total0, mut total1) = (0.0, 0.0);
+    let (mut done0, mut done1) = (false, false);
+    for r in 0..regions {
+        let b0 = region_start(r, regions, width, spot) as f32;
+        let b1 = region_start(r + 1, regions, width, spot) as f32;
+        let is_last0 = last0 < b1 as u32 || r + 1 == regions;
+        let is_last1 = last1 < b1 as u32 || r + 1 == regions;
+        let pos_of = |xs: f32, is_last: bool| {
+            if is_last {
                 clamp(xs - 0.5, b0 + 0.5, b1 - 0.5)
             } else {
                 b1 - 0.5
-            };
-            let (a, b) = if proj {
-                let mut a = 0.0;
-                if r > 0 {
-                    a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
-                }
-                let b = if is_last {
-                    s
-                } else {
-                    min(
-                        proj_reach(f, proj_boundary(f, r + 1), m, spot, s * qd) / qd,
-                        s,
-                    )
-                };
-                (a, b)
+            }
+        };
+        let (pos0, pos1) = (pos_of(xs0, is_last0), pos_of(xs1, is_last1));
+        let ((a0, e0), (a1, e1)) = if proj {
+            let mut a = 0.0;
+            if r > 0 {
+                a = min(proj_reach(f, proj_boundary(f, r), m, spot, s * qd) / qd, s);
+            }
+            let e = if is_last0 {
+                s
             } else {
-                let b = if is_last {
+                min(
+                    proj_reach(f, proj_boundary(f, r + 1), m, spot, s * qd) / qd,
+                    s,
+                )
+            };
+            ((a, e), (a, e))
+        } else {
+            let span = |delta: f32, is_last: bool| {
+                let e = if is_last {
                     s
                 } else {
                     ray_t(f, b1, delta, theta, s, spot)
                 };
-                (ray_t(f, b0, delta, theta, s, spot), b)
+                (ray_t(f, b0, delta, theta, s, spot), e)
             };
-            let weight = if spot {
-                spot_segment(f, eye, dir, a, b, panels)
+            (span(delta0, is_last0), span(delta1, is_last1))
+        };
+        let weight_of = |a: f32, e: f32| {
+            if spot {
+                spot_segment(f, eye, dir, a, e, panels)
             } else {
-                sun_scatter * transmittance_between(f.medium[0], a, b)
-            };
-            // The (up to) two texels of the row the linear fetch reads with a non-zero weight:
-            // columns x0 <= x1 of the region.
+                sun_scatter * transmittance_between(f.medium[0], a, e)
+            }
+        };
+        let (weight0, weight1) = (weight_of(a0, e0), weight_of(a1, e1));
+        // Per row, the (up to) two texels the linear fetch reads with a non-zero weight:
+        // columns x0 <= x1 of the region.
+        let texels = |pos: f32| {
             let xb = pos - 0.5;
             let fx = xb - xb.floor();
             let x0 = clamp(xb.floor(), 0.0, width as f32 - 1.0) as u32;
@@ -233,18 +240,19 @@ pub fn scatter_main(
             } else {
                 x0
             };
-            // Their depth bounds: a region's prefix bounds only widen along the row, so column
-            // x1's cover column x0's.
-            let lohi = inp.bounds.load(x1, row, 0);
-            let lo = lohi[0];
-            let hi = lohi[1];
-            let mut vis = 0.5;
-            if d <= lo {
-                vis = 1.0;
-            } else if d > hi {
-                vis = 0.0;
-            } else if moments {
-                // The region's moments, filtered linearly along the row.
+            (x0, x1, fx)
+        };
+        let (x00, x01, fx0) = texels(pos0);
+        let (x10, x11, fx1) = texels(pos1);
+        // Their depth bounds: a region's prefix bounds only widen along the row, so column
+        // x1's cover column x0's.
+        let lohi0 = inp.bounds.load(x01, row0, 0);
+        let lohi1 = inp.bounds.load(x11, row1, 0);
+        let ambiguous = |lohi: [f32; 4]| d > lohi[0] && d <= lohi[1];
+        let (mut vis0, mut vis1) = (0.5, 0.5);
+        if moments {
+            // The region's moments, filtered linearly along each row.
+            let lit = |x0: u32, x1: u32, fx: f32, row: u32| {
                 let fetch = |layer: u32| {
                     let load = |x: u32| inp.filtered.load(x, row, layer);
                     mix4(load(x0), load(x1), fx)
@@ -252,27 +260,54 @@ pub fn scatter_main(
                 let m0 = fetch(0);
                 if variant.moments == 6 {
                     let m1 = fetch(1);
-                    vis = lit_moments6(m0, [m1[0], m1[1]], zf);
+                    lit_moments6(m0, [m1[0], m1[1]], zf)
                 } else {
-                    vis = lit_moments4(m0, zf);
+                    lit_moments4(m0, zf)
                 }
-            } else {
-                for layer in 0..variant.layers() {
-                    let coeff = coeffs[layer as usize];
-                    let load = |x: u32| inp.filtered.load(x, row, layer);
-                    let texel = mix4(load(x0), load(x1), fx);
-                    for k in 0..4 {
-                        vis += coeff[k] * (texel[k] * 2.0 - 1.0);
-                    }
-                }
+            };
+            if ambiguous(lohi0) {
+                vis0 = lit(x00, x01, fx0, row0);
             }
-            row_total += weight * clamp(vis, 0.0, 1.0);
-            if is_last {
-                break;
+            if ambiguous(lohi1) {
+                vis1 = lit(x10, x11, fx1, row1);
+            }
+        } else if ambiguous(lohi0) || ambiguous(lohi1) {
+            for layer in 0..variant.layers() {
+                let coeff = coeffs[layer as usize];
+                let load = |x: u32, row: u32| inp.filtered.load(x, row, layer);
+                let texel0 = mix4(load(x00, row0), load(x01, row0), fx0);
+                let texel1 = mix4(load(x10, row1), load(x11, row1), fx1);
+                for k in 0..4 {
+                    vis0 += coeff[k] * (texel0[k] * 2.0 - 1.0);
+                    vis1 += coeff[k] * (texel1[k] * 2.0 - 1.0);
+                }
             }
         }
-        total += row_weight * row_total;
+        // Outside the row's depth range the region is exactly lit or shadowed.
+        let exact = |vis: f32, lohi: [f32; 4]| {
+            if d <= lohi[0] {
+                1.0
+            } else if d > lohi[1] {
+                0.0
+            } else {
+                vis
+            }
+        };
+        vis0 = exact(vis0, lohi0);
+        vis1 = exact(vis1, lohi1);
+        if !done0 {
+            total0 += weight0 * clamp(vis0, 0.0, 1.0);
+        }
+        if !done1 {
+            total1 += weight1 * clamp(vis1, 0.0, 1.0);
+        }
+        done0 = done0 || is_last0;
+        done1 = done1 || is_last1;
+        if done0 && done1 {
+            break;
+        }
     }
+    let total = (1.0 - w1) * total0 + w1 * total1;
     let l = total;
     let c = color * l;
     Some([c.x, c.y, c.z, 1.0])
