@@ -17,7 +17,8 @@
 //!   and `g(u) = integral_0^u T`, exact per query. The kernel `K(v, theta) =
 //!   exp(-sigma_t v / sin theta)` is not separable; its rank-r truncated SVD on a grid over
 //!   the frame's `v` and `theta` ranges, `K ~ sum_k Gamma_k(v) B_k(theta)`, is ([`Separable`],
-//!   the paper's rank-4 SVD; factors interpolated linearly between grid nodes);
+//!   the paper's rank-4 SVD; factors interpolated linearly between grid nodes; a spot
+//!   light's kernel below);
 //! - **a Fenwick tree per slice.** Queries sorted by `d`; before a query every column whose
 //!   occluder lies before it (`S_i < d`) is removed (its `Gamma(v_i)` subtracted), then the
 //!   prefix over columns `0 .. n - 1` gives `P_k`, and the ray's sum is
@@ -26,14 +27,19 @@
 //!   `O(W Q)` for the walk.
 //!
 //! Pixels near the epipole and the anti-epipole are marched as every epipolar family marches
-//! them. Spot lights are refused ([`PstError::SpotNotSupported`]): in the light-ray angle
-//! `psi` the lamp's `1/r^2` cancels against `dt/dpsi`, leaving `p(theta + psi) exp(-sigma_t D
-//! (sin psi + sin theta) / sin(theta + psi)) / (D sin theta)` (`D` the eye-lamp distance)
-//! times the cone factor of the light ray, which belongs in the leaves; not built yet.
+//! them. A spot light's columns are light-ray angles `psi` from the lamp-eye line: there the
+//! lamp's `1/r^2` cancels against `dt/dpsi`, and the weight of column `i` is
+//! `sigma_s / (D sin theta)` times the integral over the column of `K(psi, theta) cone(psi)`
+//! with `K = p(cos(theta + psi)) exp(-sigma_t D (sin psi + sin theta) / sin(theta + psi))`
+//! (`D` the eye-lamp distance, `p` Henyey-Greenstein): `K` is separated as the sun's kernel
+//! is, the cone factor (a function of the light ray alone) goes into the leaves.
 
-use crate::kernels::common_model::transmittance_between;
-use crate::kernels::minmax_traverse::{Pixel, RowRay, TraverseInputs, pixel_ray, radiance};
-use crate::kernels::texture::Tex;
+use crate::kernels::common_epipolar::{row_phi, slice_e};
+use crate::kernels::common_model::{cone_falloff, transmittance_between};
+use crate::kernels::minmax_traverse::{
+    Pixel, RowRay, TraverseInputs, edge_t, lit_span, pixel_ray, radiance,
+};
+use crate::kernels::texture::{Tex, xyz};
 use scatter_shaderlib::prefiltered::FrameUniforms;
 use std::fmt;
 
@@ -108,9 +114,10 @@ impl Fenwick {
 pub enum PstError {
     /// The rank must lie in `1..=MAX_RANK`.
     Rank(usize),
-    /// Spot lights: the separable integrand in the light-ray angle is not built yet.
-    SpotNotSupported,
 }
+
+/// The 2-point Gauss-Legendre node on [-1, 1].
+const GL2: f32 = 0.577_350_26;
 
 /// The largest rank [`Separable::sun`] accepts.
 pub const MAX_RANK: usize = 8;
@@ -118,9 +125,9 @@ pub const MAX_RANK: usize = 8;
 impl fmt::Display for PstError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            PstError::Rank(r) => write!(f, "partial-sum-tree rank must be in 1..={MAX_RANK}, got {r}"),
-            PstError::SpotNotSupported => f.write_str(
-                "the partial-sum-tree method handles directional lights only so far (spot lights: issue 15)",
+            PstError::Rank(r) => write!(
+                f,
+                "partial-sum-tree rank must be in 1..={MAX_RANK}, got {r}"
             ),
         }
     }
@@ -163,6 +170,48 @@ impl Separable {
         theta_hi: f32,
         rank: usize,
     ) -> Result<Separable, PstError> {
+        let sigma = f64::from(sigma_t);
+        Separable::from_kernel(
+            &|v, theta| (-sigma * v / theta.sin()).exp(),
+            v_max,
+            theta_lo,
+            theta_hi,
+            rank,
+        )
+    }
+
+    /// The rank-`rank` approximation of a spot light's kernel in the light-ray angle `psi`
+    /// (the `v` axis) and the view angle `theta`: `p(cos(theta + psi)) exp(-sigma_t D (sin psi
+    /// + sin theta) / sin(theta + psi))`, `D` the eye-lamp distance and `p` Henyey-Greenstein
+    /// with `g`; 0 where `theta + psi >= pi` (a light ray the view ray never meets).
+    pub fn spot(
+        sigma_t: f32,
+        g: f32,
+        eye_lamp: f32,
+        psi_max: f32,
+        theta_lo: f32,
+        theta_hi: f32,
+        rank: usize,
+    ) -> Result<Separable, PstError> {
+        let (sigma, g, dist) = (f64::from(sigma_t), f64::from(g), f64::from(eye_lamp));
+        Separable::from_kernel(
+            &|psi, theta| spot_kernel(sigma, g, dist, psi, theta),
+            psi_max,
+            theta_lo,
+            theta_hi,
+            rank,
+        )
+    }
+
+    /// The rank-`rank` truncated SVD of `kernel(v, theta)` sampled on a [`GRID`] x [`GRID`]
+    /// grid over `[0, v_max]` x `[theta_lo, theta_hi]` (clamped to `[1e-3, pi - 1e-3]`).
+    pub fn from_kernel(
+        kernel: &dyn Fn(f64, f64) -> f64,
+        v_max: f32,
+        theta_lo: f32,
+        theta_hi: f32,
+        rank: usize,
+    ) -> Result<Separable, PstError> {
         if rank == 0 || rank > MAX_RANK {
             return Err(PstError::Rank(rank));
         }
@@ -175,7 +224,7 @@ impl Separable {
         let mut a = vec![0.0f64; m * n];
         for i in 0..m {
             for j in 0..n {
-                a[i * n + j] = (-f64::from(sigma_t) * v_at(i) / t_at(j).sin()).exp();
+                a[i * n + j] = kernel(v_at(i), t_at(j));
             }
         }
         let (u, s, v) = svd_jacobi(&a, m, n);
@@ -219,6 +268,18 @@ impl Separable {
         self.beta_at(theta, &mut b);
         (0..self.rank).map(|k| g[k] * b[k]).sum()
     }
+}
+
+/// The spot light's kernel (see [`Separable::spot`]) in f64.
+pub fn spot_kernel(sigma: f64, g: f64, dist: f64, psi: f64, theta: f64) -> f64 {
+    let sum = theta + psi;
+    if sum >= std::f64::consts::PI - 1e-6 {
+        return 0.0;
+    }
+    let c = sum.cos();
+    let denom = (1.0 + g * g - 2.0 * g * c).max(1e-8);
+    let phase = (1.0 - g * g) / (4.0 * std::f64::consts::PI * denom * denom.sqrt());
+    phase * (-sigma * dist * (psi.sin() + theta.sin()) / sum.sin()).exp()
 }
 
 /// Linear interpolation of a node-major table of `nodes` x `rank` at `x` in `[0, 1]`.
@@ -316,6 +377,7 @@ pub fn frame_separable(
     slices: &[scatter_shaderlib::prefiltered::SliceParams],
     theta_lo: f32,
     theta_hi: f32,
+    spot: bool,
     rank: usize,
 ) -> Result<Separable, PstError> {
     let width = f.sizes[2] as f32;
@@ -323,6 +385,17 @@ pub fn frame_separable(
         .iter()
         .map(|s| s.delta * width)
         .fold(0.0f32, f32::max);
+    if spot {
+        return Separable::spot(
+            f.medium[0],
+            f.medium[2],
+            f.axis[3],
+            v_max,
+            theta_lo,
+            theta_hi,
+            rank,
+        );
+    }
     Separable::sun(f.medium[0], v_max, theta_lo, theta_hi, rank)
 }
 
@@ -348,9 +421,6 @@ pub fn partial_sum_tree(
     spot: bool,
     rank: usize,
 ) -> Result<PstImage, PstError> {
-    if spot {
-        return Err(PstError::SpotNotSupported);
-    }
     if rank == 0 || rank > MAX_RANK {
         return Err(PstError::Rank(rank));
     }
@@ -364,7 +434,7 @@ pub fn partial_sum_tree(
     for y in 0..h {
         for x in 0..w {
             let i = (y * w + x) as usize;
-            match pixel_ray([x, y, 0], false, inp) {
+            match pixel_ray([x, y, 0], spot, inp) {
                 Some(Pixel::Marched(c)) => exact[i] = c,
                 Some(Pixel::Row(r)) => per_row[r.row as usize].push((i, r)),
                 None => {}
@@ -378,9 +448,9 @@ pub fn partial_sum_tree(
             (lo.min(r.theta), hi.max(r.theta))
         });
     let sep = if lo <= hi {
-        frame_separable(f, inp.slices, lo, hi, rank)?
+        frame_separable(f, inp.slices, lo, hi, spot, rank)?
     } else {
-        frame_separable(f, inp.slices, f.theta[0], f.theta[1], rank)?
+        frame_separable(f, inp.slices, f.theta[0], f.theta[1], spot, rank)?
     };
     let (mut updates, mut queries) = (0u64, 0u64);
     let mut leaves = vec![0.0f32; width * rank];
@@ -393,9 +463,29 @@ pub fn partial_sum_tree(
             continue;
         }
         let delta = inp.slices[row].delta;
-        for i in 0..width {
-            sep.gamma_at((i as f32) * delta, &mut g);
-            leaves[i * rank..(i + 1) * rank].copy_from_slice(&g[..rank]);
+        if spot {
+            // A spot's leaf: gamma times the light ray's cone factor, integrated over the
+            // column's angles (2-point Gauss-Legendre).
+            let e = slice_e(f, row_phi(f, row as u32));
+            let axis = xyz(f.axis);
+            for i in 0..width {
+                leaves[i * rank..(i + 1) * rank].fill(0.0);
+                for q in [-GL2, GL2] {
+                    let psi = (i as f32 + 0.5 + 0.5 * q) * delta;
+                    let l = -axis * psi.cos() + e * psi.sin();
+                    let cone =
+                        cone_falloff(l.dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]);
+                    sep.gamma_at(psi, &mut g);
+                    for k in 0..rank {
+                        leaves[i * rank + k] += 0.5 * delta * cone * g[k];
+                    }
+                }
+            }
+        } else {
+            for i in 0..width {
+                sep.gamma_at((i as f32) * delta, &mut g);
+                leaves[i * rank..(i + 1) * rank].copy_from_slice(&g[..rank]);
+            }
         }
         let mut tree = Fenwick::from_leaves(&leaves, rank);
         // Columns in order of their occluder depth; rays in order of theirs.
@@ -416,8 +506,8 @@ pub fn partial_sum_tree(
                 next += 1;
             }
             queries += 1;
-            let total = ray_sum(f, &sep, &tree, rectified, row, r, &mut b, &mut p);
-            exact[*pixel] = radiance(f, r, total, false);
+            let total = ray_sum(f, &sep, &tree, rectified, row, r, spot, &mut b, &mut p);
+            exact[*pixel] = radiance(f, r, total, spot);
         }
     }
     Ok(PstImage {
@@ -429,7 +519,8 @@ pub fn partial_sum_tree(
 }
 
 /// One ray's sum: the tree's prefix over its whole columns `0 .. n - 1` times the separable
-/// weights, plus its last, partial column exactly.
+/// weights, plus its last, partial column exactly (`lit_span`). The sun's sum is without
+/// `sigma_s p E` (as `walk_texels`); a spot's carries `sigma_s / (D sin theta)` here.
 #[allow(
     clippy::too_many_arguments,
     reason = "the sweep's state and two scratch arrays, as a kernel would pass them"
@@ -441,6 +532,7 @@ fn ray_sum(
     rectified: &Tex,
     row: usize,
     r: &RowRay,
+    spot: bool,
     b: &mut [f32],
     p: &mut [f32],
 ) -> f32 {
@@ -450,16 +542,19 @@ fn ray_sum(
     let rank = sep.rank;
     let sigma = f.medium[0];
     let sin_theta = r.theta.sin().max(1e-6);
-    let u = r.delta / sin_theta;
     tree.prefix((r.n - 1) as usize, p);
     sep.beta_at(r.theta, b);
-    let whole: f32 =
-        (0..rank).map(|k| b[k] * p[k]).sum::<f32>() * transmittance_between(sigma, 0.0, u);
+    let dot: f32 = (0..rank).map(|k| b[k] * p[k]).sum();
+    let whole = if spot {
+        f.medium[1] * dot / (f.axis[3] * sin_theta)
+    } else {
+        dot * transmittance_between(sigma, 0.0, r.delta / sin_theta)
+    };
     let last = r.n - 1;
     let mut tail = 0.0;
     if r.d <= rectified.load(last, row as u32) {
-        let a = (last as f32 * u).min(r.s);
-        tail = transmittance_between(sigma, a, r.s.max(a));
+        let a = edge_t(f, last, r.n, r.delta, r.theta, r.s, spot);
+        tail = lit_span(f, r.eye, r.dir, a, r.s, spot);
     }
     whole.max(0.0) + tail
 }

@@ -1,5 +1,5 @@
 //! The partial-sum-tree method's CPU reference (`scatter_reference::partial_sum_tree`, issue
-//! 15) on every directional suite pose: against the brute-force walk over the same rectified
+//! 15) on every suite pose, sun and spot: against the brute-force walk over the same rectified
 //! rows (`minmax`'s reference: the same sum with exact per-texel weights, so the difference
 //! is the rank-r integrand alone) and against the `shadow_map` truth. CPU only.
 //!
@@ -12,7 +12,7 @@ use scatter_reference::kernels::minmax_traverse::TraverseInputs;
 use scatter_reference::kernels::run_minmax;
 use scatter_reference::kernels::texture::Tex;
 use scatter_reference::metrics;
-use scatter_reference::partial_sum_tree::{Separable, partial_sum_tree};
+use scatter_reference::partial_sum_tree::{Separable, partial_sum_tree, spot_kernel};
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_shaderlib::minmax::MinmaxVariant;
@@ -23,10 +23,12 @@ const RECTIFIED: [u32; 2] = [1024, 512];
 const SHADOW_MAP: u32 = 512;
 /// The paper's rank.
 const RANK: usize = 4;
-/// The issue's bar against the `shadow_map` truth, away from the marched epipole ring (sun).
+/// The issue's bars against the `shadow_map` truth, away from the marched epipole ring (sun;
+/// spot below).
 /// Met at 1024 columns x 512 slices; at 256 x 256 window and foliage/epipole_on_screen miss
 /// it (2.3-5.3 %) exactly as the brute-force walk (minmax) does: the map's resolution.
 const SUN_BAR: f64 = 0.02;
+const SPOT_BAR: f64 = 0.03;
 /// Most the rank-4 sum may differ from the brute-force walk over the same rows (rel L1 of
 /// the image): the paper's 1-2 % reconstruction error of the integrand, at its lower end.
 const RANK_BAR: f64 = 0.01;
@@ -47,7 +49,7 @@ fn rel_l1(a: &[[f32; 4]], b: &[[f32; 4]], keep: &dyn Fn(usize) -> bool) -> f64 {
 }
 
 #[test]
-fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_sun_pose() {
+fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_pose() {
     let mut failures = Vec::new();
     let start = std::time::Instant::now();
     println!(
@@ -55,16 +57,22 @@ fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_sun_pose() {
     );
     println!("|---|---|---|---|---|---|---|");
     for &name in SceneName::ALL {
-        if name == SceneName::SpotGrate {
-            continue;
-        }
+        let spot = name == SceneName::SpotGrate;
+        let bar = if spot { SPOT_BAR } else { SUN_BAR };
         for &pose in Pose::ALL {
             let scene = suite::scene(name, pose, MediumPreset::Default, SCREEN.0, SCREEN.1);
             let bvh = Bvh::build(&scene.geometry);
             let gbuf = GBuffer::cast(&scene, &bvh);
             let sm = ShadowMap::build(&scene, &bvh, SHADOW_MAP).expect("shadow map");
             let settings = FrameSettings::for_screen(SCREEN.0, SCREEN.1);
-            let variant = MinmaxVariant::default();
+            let variant = MinmaxVariant {
+                light: if spot {
+                    scatter_shaderlib::prefiltered::LightKind::Spot
+                } else {
+                    scatter_shaderlib::prefiltered::LightKind::Directional
+                },
+                ..MinmaxVariant::default()
+            };
             let run = run_minmax(&variant, RECTIFIED, &gbuf, &scene, &sm, &settings)
                 .unwrap_or_else(|e| panic!("{name}/{pose}: {e}"));
             let depth = Tex {
@@ -84,11 +92,11 @@ fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_sun_pose() {
                 shadow_map: &smt,
                 tree: &run.tree,
             };
-            let pst = partial_sum_tree(&inputs, &run.rectified, false, RANK)
+            let pst = partial_sum_tree(&inputs, &run.rectified, spot, RANK)
                 .unwrap_or_else(|e| panic!("{name}/{pose}: {e}"));
             // The integrand's own error: the rank-4 kernel against exp(-sigma v / sin theta)
             // on a grid finer than the SVD's, off its nodes.
-            let kernel_err = kernel_error(&pst.separable, run.frame.uniforms.medium[0]);
+            let kernel_err = kernel_error(&pst.separable, &run.frame.uniforms, spot);
             let marched: Vec<bool> = run.brute.visits.iter().map(|&v| v == 0).collect();
             let all = |_: usize| true;
             let away = |i: usize| !marched[i];
@@ -133,11 +141,11 @@ fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_sun_pose() {
                     100.0 * RANK_BAR
                 ));
             }
-            if vs_truth_away.is_nan() || vs_truth_away > SUN_BAR {
+            if vs_truth_away.is_nan() || vs_truth_away > bar {
                 failures.push(format!(
                     "{name}/{pose}: {:.3} % from the shadow_map truth away from the ring (bar {:.1} %)",
                     100.0 * vs_truth_away,
-                    100.0 * SUN_BAR
+                    100.0 * bar
                 ));
             }
         }
@@ -146,26 +154,42 @@ fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_sun_pose() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// Largest absolute error of the separable kernel against `exp(-sigma v / sin theta)` (whose
-/// values lie in (0, 1]) at 4x the SVD grid's resolution per axis.
-fn kernel_error(sep: &Separable, sigma: f32) -> f64 {
+/// Largest error of the separable kernel against the exact one at 4x the SVD grid's
+/// resolution per axis, relative to the kernel's largest value there (the sun's lies in
+/// (0, 1]; a spot's carries the phase function).
+fn kernel_error(
+    sep: &Separable,
+    f: &scatter_shaderlib::prefiltered::FrameUniforms,
+    spot: bool,
+) -> f64 {
     let n = 4 * scatter_reference::partial_sum_tree::GRID;
-    let mut worst = 0.0f64;
+    let (mut worst, mut top) = (0.0f64, 0.0f64);
     for i in 0..n {
         let v = sep.v_max * i as f32 / (n - 1) as f32;
         for j in 0..n {
             let t = sep.theta_lo + (sep.theta_hi - sep.theta_lo) * j as f32 / (n - 1) as f32;
-            let exact = (-f64::from(sigma) * f64::from(v) / f64::from(t).sin()).exp();
+            let exact = if spot {
+                spot_kernel(
+                    f64::from(f.medium[0]),
+                    f64::from(f.medium[2]),
+                    f64::from(f.axis[3]),
+                    f64::from(v),
+                    f64::from(t),
+                )
+            } else {
+                (-f64::from(f.medium[0]) * f64::from(v) / f64::from(t).sin()).exp()
+            };
+            top = top.max(exact.abs());
             worst = worst.max((f64::from(sep.eval(v, t)) - exact).abs());
         }
     }
-    worst
+    worst / top.max(1e-300)
 }
 
 #[test]
-fn spot_lights_are_refused_with_a_reason() {
+fn ranks_outside_the_range_are_refused_with_a_reason() {
     let scene = suite::scene(
-        SceneName::SpotGrate,
+        SceneName::Sphere,
         Pose::Ordinary,
         MediumPreset::Default,
         16,
@@ -174,10 +198,7 @@ fn spot_lights_are_refused_with_a_reason() {
     let bvh = Bvh::build(&scene.geometry);
     let gbuf = GBuffer::cast(&scene, &bvh);
     let sm = ShadowMap::build(&scene, &bvh, 64).expect("shadow map");
-    let variant = MinmaxVariant {
-        light: scatter_shaderlib::prefiltered::LightKind::Spot,
-        ..MinmaxVariant::default()
-    };
+    let variant = MinmaxVariant::default();
     let run = run_minmax(
         &variant,
         [64, 64],
@@ -204,6 +225,8 @@ fn spot_lights_are_refused_with_a_reason() {
         shadow_map: &smt,
         tree: &run.tree,
     };
-    let err = partial_sum_tree(&inputs, &run.rectified, true, RANK).unwrap_err();
-    assert!(err.to_string().contains("directional lights only"), "{err}");
+    for rank in [0, scatter_reference::partial_sum_tree::MAX_RANK + 1] {
+        let err = partial_sum_tree(&inputs, &run.rectified, false, rank).unwrap_err();
+        assert!(err.to_string().contains("rank must be in 1..="), "{err}");
+    }
 }
