@@ -53,9 +53,9 @@ fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_pose() {
     let mut failures = Vec::new();
     let start = std::time::Instant::now();
     println!(
-        "| scene/pose | kernel rank-{RANK} max error | vs brute-force walk | vs truth (ring excluded) | vs truth | minmax vs truth | updates / queries |"
+        "| scene/pose | kernel rank-{RANK} max error | vs brute-force walk | ranks 1 / 2 / 8 vs brute-force walk | vs truth (ring excluded) | vs truth | minmax vs truth | updates / queries |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     for &name in SceneName::ALL {
         let spot = name == SceneName::SpotGrate;
         let bar = if spot { SPOT_BAR } else { SUN_BAR };
@@ -101,6 +101,17 @@ fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_pose() {
             let all = |_: usize| true;
             let away = |i: usize| !marched[i];
             let vs_brute = rel_l1(&pst.exact, &run.brute.exact, &away);
+            let other_ranks: Vec<String> = [1, 2, 8]
+                .iter()
+                .map(|&rank| {
+                    let other = partial_sum_tree(&inputs, &run.rectified, spot, rank)
+                        .unwrap_or_else(|e| panic!("{name}/{pose}: {e}"));
+                    format!(
+                        "{:.3}",
+                        100.0 * rel_l1(&other.exact, &run.brute.exact, &away)
+                    )
+                })
+                .collect();
             let truth = truth::render(
                 &scene,
                 &gbuf,
@@ -119,9 +130,10 @@ fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_pose() {
             let report = metrics::compare(&image, &truth).expect("same size");
             let minmax = metrics::compare(&run.output, &truth).expect("same size");
             println!(
-                "| {name}/{pose} | {:.2e} | {:.3} % | {:.3} % | {:.3} % | {:.3} % | {} / {} |",
+                "| {name}/{pose} | {:.2e} | {:.3} % | {} % | {:.3} % | {:.3} % | {:.3} % | {} / {} |",
                 kernel_err,
                 100.0 * vs_brute,
+                other_ranks.join(" / "),
                 100.0 * vs_truth_away,
                 100.0 * vs_truth,
                 100.0 * minmax.rel_l1,
