@@ -150,11 +150,50 @@ pub fn emit_kernel(
     })
 }
 
+/// The workgroup count of `invocations` in workgroups of `size`, as a manifest formula. An
+/// invocation count that is itself `ceil(a / n)` (n an integer: `rectify`'s columns, a lowres
+/// grid) gives `ceil(a / (n size))`, the same integer for positive sizes, so that no formula
+/// nests `ceil` (MANIFEST.md's grammar).
 fn workgroups(invocations: &str, size: u32) -> String {
+    let size = size.max(1);
+    if let Some((a, n)) = invocations
+        .strip_prefix("ceil(")
+        .and_then(|t| t.strip_suffix(')'))
+        .and_then(|t| t.split_once(" / "))
+        .and_then(|(a, n)| Some((a, n.parse::<u32>().ok()?)))
+        .filter(|(a, _)| !a.contains('('))
+    {
+        return format!("ceil({a} / {})", n * size);
+    }
     match invocations.parse::<u32>() {
-        Ok(n) => n.div_ceil(size.max(1)).to_string(),
+        Ok(n) => n.div_ceil(size).to_string(),
         Err(_) if size == 1 => invocations.to_owned(),
         Err(_) => format!("ceil({invocations} / {size})"),
+    }
+}
+
+#[cfg(test)]
+mod workgroup_tests {
+    use super::workgroups;
+
+    #[test]
+    fn nested_ceilings_fold_into_one() {
+        assert_eq!(
+            workgroups("ceil(rectified.width / 8)", 8),
+            "ceil(rectified.width / 64)"
+        );
+        assert_eq!(
+            workgroups("ceil(screen.width / 2)", 1),
+            "ceil(screen.width / 2)"
+        );
+        assert_eq!(workgroups("screen.width", 8), "ceil(screen.width / 8)");
+        assert_eq!(workgroups("256", 64), "4");
+        // ceil(ceil(a / m) / n) == ceil(a / (m n)) for positive integers.
+        for a in 1u32..300 {
+            for (m, n) in [(8u32, 8u32), (2, 8), (4, 16), (3, 5)] {
+                assert_eq!(a.div_ceil(m).div_ceil(n), a.div_ceil(m * n));
+            }
+        }
     }
 }
 

@@ -7,8 +7,8 @@
 use scatter_gen::{FamilyVariant, Request, Target, generate};
 use scatter_runtime::prefiltered::{DEPTH_FORMAT, OUTPUT_FORMAT, storage_format};
 use scatter_shaderlib::prefiltered::{
-    FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
-    VisibilityMode,
+    FrameUniforms, LightKind, PrefilteredVariant, RECTIFY_TEXELS, Rectification, SliceParams,
+    Storage, VisibilityMode,
 };
 use scatter_shaderlib::{KernelParams, build};
 use serde_json::Value;
@@ -204,7 +204,7 @@ fn manifest_dispatch_matches_the_runtime_grid() {
         let grids = [
             [w, 1, 1],
             [256, 1, 1],
-            [wr, hr, 1],
+            [wr.div_ceil(RECTIFY_TEXELS), hr, 1],
             [hr, v.regions, v.threads_per_row_region()],
             [w, h, 1],
         ];
@@ -362,12 +362,13 @@ fn minmax_manifest_matches_the_runtime() {
         .unwrap_or_default();
     let params = KernelParams::minmax(v);
     assert_eq!(passes.len(), params.len());
-    for ((pass, p), grid) in
-        passes
-            .iter()
-            .zip(params)
-            .zip([[w, 1, 1], [256, 1, 1], [wr, hr, 1], [tw, hr, 1], [w, h, 1]])
-    {
+    for ((pass, p), grid) in passes.iter().zip(params).zip([
+        [w, 1, 1],
+        [256, 1, 1],
+        [wr.div_ceil(RECTIFY_TEXELS), hr, 1],
+        [tw, hr, 1],
+        [w, h, 1],
+    ]) {
         let built = build(&p).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(str_of(pass, "kernel"), built.kernel.name());
         let dispatch = get(pass, "dispatch")
