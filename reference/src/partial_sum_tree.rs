@@ -1,7 +1,8 @@
 //! The partial-sum-tree method of Baran et al. 2010 ("A hierarchical volumetric shadow
 //! algorithm for single scattering"), on the CPU: the method's reference, before any kernel
 //! (issue 15). Not a family yet: no template, plan, runtime or generator support exists; this
-//! module fixes the method's math against brute force so that the kernels can mirror it.
+//! module fixes the method's math against brute force so that the kernels can mirror it
+//! (derivation, measurements and the plan for the kernels: `docs/partial-sum-tree.md`).
 //!
 //! It works on the shared epipolar layer (the frame set-up, `slice_fit` and `rectify` every
 //! rectified family runs): row `y` of the rectified map is a slice, column `i` a light ray, and
