@@ -9,8 +9,8 @@ use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
 use scatter_reference::kernels::minmax_traverse::TraverseInputs;
-use scatter_reference::kernels::run_minmax;
 use scatter_reference::kernels::texture::Tex;
+use scatter_reference::kernels::{MinmaxRun, run_minmax};
 use scatter_reference::metrics;
 use scatter_reference::partial_sum_tree::{Separable, partial_sum_tree, spot_kernel};
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
@@ -32,6 +32,32 @@ const SPOT_BAR: f64 = 0.03;
 /// Most the rank-4 sum may differ from the brute-force walk over the same rows (rel L1 of
 /// the image): the paper's 1-2 % reconstruction error of the integrand, at its lower end.
 const RANK_BAR: f64 = 0.01;
+
+/// The depth buffer and the shadow map as the mirrors read them.
+fn textures(gbuf: &GBuffer, sm: &ShadowMap) -> (Tex, Tex) {
+    let depth = Tex {
+        width: gbuf.width,
+        height: gbuf.height,
+        data: gbuf.view_depth.clone(),
+    };
+    let smt = Tex {
+        width: sm.size,
+        height: sm.size,
+        data: sm.depth.clone(),
+    };
+    (depth, smt)
+}
+
+/// `minmax_traverse`'s inputs of a CPU minmax run (the frame and rows the method shares).
+fn inputs<'a>(run: &'a MinmaxRun, depth: &'a Tex, sm: &'a Tex) -> TraverseInputs<'a> {
+    TraverseInputs {
+        frame: &run.frame.uniforms,
+        slices: &run.frame.slices,
+        depth,
+        shadow_map: sm,
+        tree: &run.tree,
+    }
+}
 
 /// Rel L1 of `a` against `b` over the pixels `keep` selects (first three channels).
 fn rel_l1(a: &[[f32; 4]], b: &[[f32; 4]], keep: &dyn Fn(usize) -> bool) -> f64 {
@@ -75,23 +101,8 @@ fn rank4_sweep_matches_the_brute_force_walk_and_the_truth_on_every_pose() {
             };
             let run = run_minmax(&variant, RECTIFIED, &gbuf, &scene, &sm, &settings)
                 .unwrap_or_else(|e| panic!("{name}/{pose}: {e}"));
-            let depth = Tex {
-                width: gbuf.width,
-                height: gbuf.height,
-                data: gbuf.view_depth.clone(),
-            };
-            let smt = Tex {
-                width: sm.size,
-                height: sm.size,
-                data: sm.depth.clone(),
-            };
-            let inputs = TraverseInputs {
-                frame: &run.frame.uniforms,
-                slices: &run.frame.slices,
-                depth: &depth,
-                shadow_map: &smt,
-                tree: &run.tree,
-            };
+            let (depth, smt) = textures(&gbuf, &sm);
+            let inputs = inputs(&run, &depth, &smt);
             let pst = partial_sum_tree(&inputs, &run.rectified, spot, RANK)
                 .unwrap_or_else(|e| panic!("{name}/{pose}: {e}"));
             // The integrand's own error: the rank-4 kernel against exp(-sigma v / sin theta)
@@ -220,23 +231,8 @@ fn ranks_outside_the_range_are_refused_with_a_reason() {
         &FrameSettings::for_screen(16, 9),
     )
     .expect("minmax");
-    let depth = Tex {
-        width: gbuf.width,
-        height: gbuf.height,
-        data: gbuf.view_depth.clone(),
-    };
-    let smt = Tex {
-        width: sm.size,
-        height: sm.size,
-        data: sm.depth.clone(),
-    };
-    let inputs = TraverseInputs {
-        frame: &run.frame.uniforms,
-        slices: &run.frame.slices,
-        depth: &depth,
-        shadow_map: &smt,
-        tree: &run.tree,
-    };
+    let (depth, smt) = textures(&gbuf, &sm);
+    let inputs = inputs(&run, &depth, &smt);
     for rank in [0, scatter_reference::partial_sum_tree::MAX_RANK + 1] {
         let err = partial_sum_tree(&inputs, &run.rectified, false, rank).unwrap_err();
         assert!(err.to_string().contains("rank must be in 1..="), "{err}");
