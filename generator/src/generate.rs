@@ -172,31 +172,6 @@ fn workgroups(invocations: &str, size: u32) -> String {
     }
 }
 
-#[cfg(test)]
-mod workgroup_tests {
-    use super::workgroups;
-
-    #[test]
-    fn nested_ceilings_fold_into_one() {
-        assert_eq!(
-            workgroups("ceil(rectified.width / 8)", 8),
-            "ceil(rectified.width / 64)"
-        );
-        assert_eq!(
-            workgroups("ceil(screen.width / 2)", 1),
-            "ceil(screen.width / 2)"
-        );
-        assert_eq!(workgroups("screen.width", 8), "ceil(screen.width / 8)");
-        assert_eq!(workgroups("256", 64), "4");
-        // ceil(ceil(a / m) / n) == ceil(a / (m n)) for positive integers.
-        for a in 1u32..300 {
-            for (m, n) in [(8u32, 8u32), (2, 8), (4, 16), (3, 5)] {
-                assert_eq!(a.div_ceil(m).div_ceil(n), a.div_ceil(m * n));
-            }
-        }
-    }
-}
-
 fn plan_error(variant: &FamilyVariant, kernel: Kernel, message: String) -> GenError {
     GenError::Plan {
         variant: variant.id(),
@@ -582,4 +557,29 @@ pub fn generate(request: &Request) -> Result<Generated, GenError> {
         files,
         manifest: json.into_bytes(),
     })
+}
+
+#[cfg(test)]
+mod workgroup_tests {
+    use super::workgroups;
+
+    #[test]
+    fn nested_ceilings_fold_into_one() {
+        assert_eq!(
+            workgroups("ceil(rectified.width / 8)", 8),
+            "ceil(rectified.width / 64)"
+        );
+        assert_eq!(
+            workgroups("ceil(screen.width / 2)", 1),
+            "ceil(screen.width / 2)"
+        );
+        assert_eq!(workgroups("screen.width", 8), "ceil(screen.width / 8)");
+        assert_eq!(workgroups("256", 64), "4");
+        // ceil(ceil(a / m) / n) == ceil(a / (m n)) for positive integers.
+        for a in 1u32..300 {
+            for (m, n) in [(8u32, 8u32), (2, 8), (4, 16), (3, 5)] {
+                assert_eq!(a.div_ceil(m).div_ceil(n), a.div_ceil(m * n));
+            }
+        }
+    }
 }
