@@ -12,6 +12,7 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 use crate::minmax::MinmaxVariant;
+use crate::partial_sum_tree::PartialSumTreeVariant;
 use crate::raymarch::RaymarchVariant;
 use crate::sampling::SamplingKnobs;
 use crate::variant::{LightKind, PrefilteredVariant, VariantError};
@@ -187,6 +188,9 @@ macro_rules! families {
 families! {
     /// Chen et al. 2011: `rectify` (the prefiltered family's), `minmax_build`, `minmax_traverse`.
     Minmax(MinmaxVariant),
+    /// Baran et al. 2010: `rectify` (the prefiltered family's), `pst_sweep` (epipolar samples
+    /// only), its unwarp and fallback.
+    PartialSumTree(PartialSumTreeVariant),
     /// Klehm et al. 2014: `rectify`, `prefilter`, `scatter`.
     Prefiltered(PrefilteredVariant),
     /// Tóth & Umenhoffer 2009: `raymarch`, `interleave_sum` (interleaved variants).

@@ -14,6 +14,7 @@
 pub mod family;
 pub mod frame;
 pub mod minmax;
+pub mod partial_sum_tree;
 pub mod raymarch;
 pub mod sampling;
 pub mod scene;

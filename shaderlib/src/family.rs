@@ -5,6 +5,7 @@
 pub use scatter_frame::family::{Family, FamilyVariant, KnobSet, UnknownFamily};
 
 use crate::minmax::MinmaxVariant;
+use crate::partial_sum_tree::PartialSumTreeVariant;
 use crate::plan::Plan;
 use crate::prefiltered::PrefilteredVariant;
 use crate::raymarch::RaymarchVariant;
@@ -71,6 +72,7 @@ macro_rules! kernel_families {
 
 kernel_families! {
     Minmax(MinmaxVariant),
+    PartialSumTree(PartialSumTreeVariant),
     Prefiltered(PrefilteredVariant),
     Raymarch(RaymarchVariant),
 }

@@ -30,6 +30,7 @@ mod error;
 pub mod family;
 mod kernel;
 pub mod minmax;
+pub mod partial_sum_tree;
 pub mod plan;
 pub mod prefiltered;
 pub mod raymarch;
@@ -40,6 +41,7 @@ pub mod sampling;
 pub use error::ShaderError;
 use family::{Family, KernelFamily};
 use minmax::MinmaxVariant;
+use partial_sum_tree::PartialSumTreeVariant;
 use prefiltered::PrefilteredVariant;
 use raymarch::RaymarchVariant;
 pub use row_prefix::{RowPrefixMode, RowPrefixParams};
@@ -68,6 +70,16 @@ kernel::kernels! {
     /// Fourier basis transform fused with the weighted running mean along each rectified
     /// row, per region (Klehm et al. 2014, Listings 1-3, Table 1).
     Prefilter("prefilter", PrefilteredVariant, prefiltered::kernels::render_prefilter),
+    /// Per epipolar slice: every sample answered by one sweep through a partial-sum
+    /// (Fenwick) tree of a rank-r separable integrand over the slice's rectified row;
+    /// samples near the epipole ray-marched (Baran et al. 2010).
+    PstSweep("pst_sweep", PartialSumTreeVariant, partial_sum_tree::render_sweep),
+    /// The pixels `pst_sweep_unwarp` listed (no sample stands for them), each summed over
+    /// its own row's lit columns without the tree.
+    PstSweepFallback("pst_sweep_fallback", PartialSumTreeVariant, partial_sum_tree::render_sweep_fallback),
+    /// Every pixel gathered from the `pst_sweep` samples of the two slices around it, or
+    /// listed for `pst_sweep_fallback` where none stands for it.
+    PstSweepUnwarp("pst_sweep_unwarp", PartialSumTreeVariant, partial_sum_tree::render_sweep_unwarp),
     /// Brute-force ray marching through the standard shadow map, optionally interleaved
     /// (Tóth & Umenhoffer 2009).
     Raymarch("raymarch", RaymarchVariant, raymarch::render_raymarch),

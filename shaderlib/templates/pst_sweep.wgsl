@@ -1,0 +1,400 @@
+// pst_sweep ({{ light_name }} light, rank {{ rank }}): the partial-sum-tree method of Baran et al.
+// 2010 on the epipolar samples (`sampling = epipolar`): workgroup s takes epipolar sample
+// slice s, whose samples are the queries of one sweep through a Fenwick tree over the
+// rectified row the slice lies in (the row of its last sample's pixel). Each query is a view
+// ray of the row: normalised view angle d, whole columns 0 .. n - 1 (its last, partial column
+// n - 1 is added exactly, as `minmax_traverse` adds it), lit where d <= S_i. The column
+// weights are separable, `w_i(theta) ~ a(theta) sum_k leaf_k(i) beta_k(theta)` (the frame's
+// rank-r SVD, `pst_factors`; scatter_frame::partial_sum_tree), so a query's sum over its lit
+// whole columns is `a(theta) beta(theta) . P` with `P` the sum of the leaves of the lit
+// columns before n - 1.
+//
+// The sweep: the V queries are ranked by d (rank j); column i is lit for the b_i queries of
+// lowest rank (b_i = how many d <= S_i). Inserting column i's leaf at tree position V - b_i
+// and answering a query, in order of n, after the columns 0 .. n - 2 are in, by the prefix
+// over positions below V - j sums exactly its lit whole columns: nothing is removed, no sum
+// cancels. O((W + V) log V) on one invocation; its 32 invocations first set up the samples,
+// rank them, and compute every column's b_i and leaf in parallel. Samples near the epipole
+// and the anti-epipole are ray-marched, as every epipolar family marches them.
+//
+// Bindings (group 0):
+// | binding | name        | type                                    | access       |
+// |---------|-------------|-----------------------------------------|--------------|
+// | 0       | frame       | var<uniform> Frame (400 bytes)          | uniform      |
+// | 1       | slices      | var<storage, read> array<vec4<f32>>     | read         |
+// | 2       | depth       | texture_2d<f32> (r32float, view depth)  | textureLoad  |
+// | 3       | shadow_map  | texture_2d<f32> (r32float)              | textureLoad  |
+// | 4       | rectified   | texture_2d<f32> (r32float, rectify's)   | textureLoad  |
+// | 5       | pst_factors | var<storage, read> array<vec4<f32>>     | read         |
+// | 6       | pst_leaves  | var<storage, read_write> array<vec4<f32>> (SLICES x Wr x {{ rank_vecs }}) | read_write |
+// | 7       | pst_tree    | var<storage, read_write> array<vec4<f32>> (SLICES x SLICE_SAMPLES x {{ rank_vecs }}) | read_write |
+// | 8       | pst_columns | var<storage, read_write> array<u32> (SLICES x Wr) | read_write |
+// | 9       | output      | texture_storage_2d<rgba32float, write> (epipolar_samples) | textureStore |
+// | 11      | fallback_count | var<storage, read_write> atomic<u32> | read_write   |
+// The unwarp and fallback passes (`pst_sweep_unwarp`, `pst_sweep_fallback`) bind 6-8 not.
+//
+// Dispatch: (SLICES, 1, 1) workgroups of (32, 1, 1).
+//
+// Mirrors reference/src/kernels/pst_sweep.rs
+
+#import scatter::model::{cone_falloff, phase_hg, transmittance_between}
+#import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, row_phi, slice_e, slice_params, spot_segment}
+{%- if !sampling.imports.is_empty() %}
+{{ sampling.imports }}
+{%- endif %}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
+@group(0) @binding(2) var depth: texture_2d<f32>;
+@group(0) @binding(3) var shadow_map: texture_2d<f32>;
+@group(0) @binding(4) var rectified: texture_2d<f32>;
+@group(0) @binding(5) var<storage, read> pst_factors: array<vec4<f32>>;
+{%- if !sampling.unwarp && !sampling.fallback %}
+@group(0) @binding(6) var<storage, read_write> pst_leaves: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read_write> pst_tree: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read_write> pst_columns: array<u32>;
+{%- endif %}
+@group(0) @binding(9) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
+{% include "include/sampled_bindings.wgsl" %}
+
+// vec4s per leaf (ceil(rank / 4)), grid nodes of the factors, the 2-point Gauss-Legendre node.
+const RANK_VECS: u32 = {{ rank_vecs }}u;
+const GRID: u32 = {{ grid }}u;
+const GL2: f32 = 0.57735026f;
+
+// Ray distance of column edge `x` of a ray that crosses texels 0 .. n: the last texel's
+// span ends at the surface `s` (as in `minmax_traverse`).
+fn edge_t(f: Frame, x: u32, n: u32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
+    if x >= n {
+        return s;
+    }
+    return ray_t(f, f32(x), delta, theta, s, spot);
+}
+
+// Unshadowed in-scattering over `[a, b]` of the ray, without `sigma_s p E` for the sun.
+fn lit_span(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, spot: bool) -> f32 {
+    if spot {
+        return spot_segment(f, eye, dir, a, b, max(f.sizes2_[2] / 4u, 1u));
+    }
+    return transmittance_between(f.medium[0], a, b);
+}
+
+// Factor table `base` (1: gamma over v, 1 + 2 GRID: beta over theta) at `x` in [0, 1], bases
+// 4h .. 4h + 3, linear between nodes.
+fn factor_at(base: u32, x: f32, h: u32) -> vec4<f32> {
+    let p = min(clamp(x, 0.0, 1.0) * f32(GRID - 1u), f32(GRID - 1u));
+    let j = min(u32(floor(p)), GRID - 2u);
+    let t = p - f32(j);
+    return pst_factors[base + 2u * j + h] * (1.0 - t) + pst_factors[base + 2u * (j + 1u) + h] * t;
+}
+
+// gamma_(4h ..)(v).
+fn gamma_at(v: f32, h: u32) -> vec4<f32> {
+    return factor_at(1u, v / pst_factors[0].x, h);
+}
+
+// beta_(4h ..)(theta).
+fn beta_at(theta: f32, h: u32) -> vec4<f32> {
+    let head = pst_factors[0];
+    return factor_at(1u + 2u * GRID, (theta - head.y) / max(head.z - head.y, 1e-12), h);
+}
+
+// Leaf of column i of `row` (spacing `delta`), bases 4h ..: the sun's gamma(i delta); a spot's
+// integral over the column's light-ray angles of gamma(psi) cone(psi) (2-point Gauss-Legendre).
+fn pst_leaf(f: Frame, i: u32, row: u32, delta: f32, h: u32) -> vec4<f32> {
+    if !{{ spot }} {
+        return gamma_at(f32(i) * delta, h);
+    }
+    let e = slice_e(f, row_phi(f, row));
+    let axis = f.axis.xyz;
+    var leaf = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+    for (var g = 0u; g < 2u; g++) {
+        let q = select(GL2, -GL2, g == 0u);
+        let psi = (f32(i) + 0.5 + 0.5 * q) * delta;
+        let l = -axis * cos(psi) + e * sin(psi);
+        let cone = cone_falloff(dot(l, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]);
+        leaf += (0.5 * delta * cone) * gamma_at(psi, h);
+    }
+    return leaf;
+}
+
+// A pixel's ray in rectified space (`minmax_traverse`'s set-up): marched (near the epipoles:
+// `color` holds the radiance), or its nearest row, view angle, depth d and the numerator of
+// its column x_s (x_s = xs_num / delta of the row it is read in).
+struct PstRay {
+    marched: bool,
+    color: vec3<f32>,
+    eye: vec3<f32>,
+    dir: vec3<f32>,
+    s: f32,
+    row: u32,
+    theta: f32,
+    d: f32,
+    xs_num: f32,
+}
+
+fn pst_ray(x: u32, y: u32) -> PstRay {
+    let f = frame;
+    let spot = {{ spot }};
+    let eye = f.eye.xyz;
+    let dir = pixel_dir(f, x, y);
+    // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
+    let s = min(max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0), f.theta.z) / max(dot(dir, f.cam_forward.xyz), 1e-6);
+    var r = PstRay(false, vec3<f32>(0.0, 0.0, 0.0), eye, dir, s, 0u, 0.0, 0.0, 0.0);
+
+    // Near the epipole and the anti-epipole the rectification degenerates: march instead.
+    let px = vec3<f32>(f32(x) + 0.5, f32(y) + 0.5, 0.0);
+    let radius = f.epipole[3];
+    let near_epi = f.epipole[2] > 0.5 && length(px - vec3<f32>(f.epipole[0], f.epipole[1], 0.0)) < radius;
+    let near_anti =
+        f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
+    if near_epi || near_anti {
+        r.marched = true;
+        r.color = epipole_march(frame, shadow_map, eye, dir, s, spot) * f.light_color.xyz;
+    }
+
+    let axis = f.axis.xyz;
+    let rows = f.sizes[3];
+    let wrap = f.anti_epipole[3] > 0.5;
+    // atan2 rather than scatter's acos: accurate near the axis, where acos loses digits.
+    r.theta = atan2(length(cross(dir, axis)), dot(dir, axis));
+    let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
+    var yc = (phi - f.e1_[3]) / f.e2_[3];
+    if wrap {
+        yc -= floor(yc / f32(rows)) * f32(rows);
+    } else {
+        yc = clamp(yc, 0.0, f32(rows));
+    }
+    r.row = row_index(floor(yc), rows, wrap);
+    r.d = normalised_depth(r.theta, f.theta[0], f.theta[1]);
+    if spot {
+        let q = normalize(eye + dir * s - f.light_pos.xyz);
+        r.xs_num = acos(clamp(dot(q, -axis), -1.0, 1.0));
+    } else {
+        r.xs_num = s * sin(r.theta);
+    }
+    return r;
+}
+
+// Texels the ray crosses in a row of spacing `delta` (NaN or negative x_s: none).
+fn pst_columns_crossed(r: PstRay, delta: f32) -> u32 {
+    let xs = r.xs_num / delta;
+    return u32(min(ceil(select(0.0, xs, xs > 0.0)), f32(frame.sizes[2])));
+}
+
+// A query's factor and term: radiance = color (max(a dot, 0) + b), `dot` the tree's
+// prefix dotted with beta(theta). x: a, y: b. The sun's a = sigma_s p T(delta / sin theta)
+// and b = sigma_s p tail; a spot's a = sigma_s / (D sin theta), b = tail (the last column
+// exactly).
+fn pst_terms(r: PstRay, row: u32, delta: f32, n: u32) -> vec2<f32> {
+    let f = frame;
+    let spot = {{ spot }};
+    let sin_theta = max(sin(r.theta), 1e-6);
+    var tail = 0.0;
+    if r.d <= textureLoad(rectified, vec2<u32>(n - 1u, row), 0).x {
+        let a = edge_t(f, n - 1u, n, delta, r.theta, r.s, spot);
+        tail = lit_span(f, r.eye, r.dir, a, r.s, spot);
+    }
+    if spot {
+        return vec2<f32>(f.medium[1] / (f.axis[3] * sin_theta), tail);
+    }
+    let sp = f.medium[1] * phase_hg(f.medium[2], -dot(f.light_dir.xyz, r.dir));
+    return vec2<f32>(sp * transmittance_between(f.medium[0], 0.0, delta / sin_theta), sp * tail);
+}
+
+// The in-scattered radiance of pixel (x, y) without the tree (the fallback's body): its own
+// nearest row, the lit whole columns' leaves summed in column order.
+fn pst_sweep_pixel(x: u32, y: u32) -> vec3<f32> {
+    let f = frame;
+    let r = pst_ray(x, y);
+    if r.marched {
+        return r.color;
+    }
+    let delta = slice_params(slices[r.row]).delta;
+    let n = pst_columns_crossed(r, delta);
+    if n == 0u {
+        return vec3<f32>(0.0, 0.0, 0.0);
+    }
+    var sum = 0.0;
+    for (var h = 0u; h < RANK_VECS; h++) {
+        var p = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        for (var i = 0u; i + 1u < n; i++) {
+            if r.d <= textureLoad(rectified, vec2<u32>(i, r.row), 0).x {
+                p += pst_leaf(f, i, r.row, delta, h);
+            }
+        }
+        sum += dot(p, beta_at(r.theta, h));
+    }
+    let ab = pst_terms(r, r.row, delta, n);
+    return f.light_color.xyz * (max(ab.x * sum, 0.0) + ab.y);
+}
+{%- if !sampling.unwarp && !sampling.fallback %}
+
+// The slice's queries: prefix end (whole columns n - 1; NONE where the sample is done:
+// marched or no column), rank by d, d (then the sorted d), view angle, the terms a and b,
+// and the queries in order of their prefix end.
+const NONE: u32 = 0xffffffffu;
+var<workgroup> q_end: array<u32, {{ sampling.slice_samples }}>;
+var<workgroup> q_rank: array<u32, {{ sampling.slice_samples }}>;
+var<workgroup> q_d: array<f32, {{ sampling.slice_samples }}>;
+var<workgroup> q_theta: array<f32, {{ sampling.slice_samples }}>;
+var<workgroup> q_a: array<f32, {{ sampling.slice_samples }}>;
+var<workgroup> q_b: array<f32, {{ sampling.slice_samples }}>;
+var<workgroup> by_end: array<u32, {{ sampling.slice_samples }}>;
+// How many queries are not done (V).
+var<workgroup> live: atomic<u32>;
+
+// The slice's samples pass (`sampling = epipolar`, scatter::sampling): the layout, the
+// slice's line and the zeroed fallback list as every family's samples pass writes them,
+// then every sample answered by the sweep. Writes `output` ((SLICE_SAMPLES + 1) x (SLICES
+// + 1), rgba32float: radiance and the sample pixel's depth in w; the last column the
+// slice's line, the last row the layout).
+@compute @workgroup_size({{ sampling.slice_lanes }}, 1, 1)
+fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let f = frame;
+    let screen = vec2<u32>(f.sizes[0], f.sizes[1]);
+    let width = f.sizes[2];
+    let lines = epipolar_layout({{ sampling.camera }}, screen, SLICES);
+    let s = wid.x;
+    let u = slice_direction(lines, s);
+    let span = slice_span(lines, s, screen, SLICE_SAMPLES);
+    if li == 0u {
+        // The slice's line, for the unwarp.
+        textureStore(output, vec2<u32>(SLICE_SAMPLES, s), vec4<f32>(u.x, u.y, span.x, span.y));
+        if s == 0u {
+            // An empty fallback list for the unwarp (no host clear), and the layout in the
+            // last row, so that the unwarp loads it instead of computing it per pixel.
+            atomicStore(&fallback_count, 0u);
+            textureStore(output, vec2<u32>(0u, SLICES), vec4<f32>(lines.origin, lines.axis));
+            textureStore(output, vec2<u32>(1u, SLICES), vec4<f32>(lines.phi_start, lines.dphi, f32(lines.wrap), 0.0));
+        }
+    }
+    // The slice's row: the one its farthest sample's pixel lies in.
+    let last = slice_sample_pixel(lines, u, span, SLICE_SAMPLES - 1u, screen);
+    let row = pst_ray(last.x, last.y).row;
+    let delta = slice_params(slices[row]).delta;
+
+    // 1. The samples: marched ones and rays without a column are written now.
+    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
+        let p = slice_sample_pixel(lines, u, span, k, screen);
+        let r = pst_ray(p.x, p.y);
+        let n = pst_columns_crossed(r, delta);
+        q_end[k] = NONE;
+        if r.marched || n == 0u {
+            let z = textureLoad(depth, p, 0).x;
+            let c = round_f16(r.color);
+            textureStore(output, vec2<u32>(k, s), vec4<f32>(c.x, c.y, c.z, z));
+        } else {
+            let ab = pst_terms(r, row, delta, n);
+            q_end[k] = n - 1u;
+            q_d[k] = r.d;
+            q_theta[k] = r.theta;
+            q_a[k] = ab.x;
+            q_b[k] = ab.y;
+            atomicAdd(&live, 1u);
+        }
+    }
+    workgroupBarrier();
+    let v = atomicLoad(&live);
+
+    // 2. Ranks by d and by prefix end (ties by sample index).
+    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
+        if q_end[k] != NONE {
+            var by_d = 0u;
+            var by_e = 0u;
+            for (var q = 0u; q < SLICE_SAMPLES; q++) {
+                if q_end[q] != NONE {
+                    by_d += select(0u, 1u, q_d[q] < q_d[k] || (q_d[q] == q_d[k] && q < k));
+                    by_e += select(0u, 1u, q_end[q] < q_end[k] || (q_end[q] == q_end[k] && q < k));
+                }
+            }
+            q_rank[k] = by_d;
+            by_end[by_e] = k;
+        }
+    }
+    workgroupBarrier();
+    // The d of the queries in rank order (through registers: every lane reads before any
+    // writes).
+    var mine: array<f32, {{ per_lane }}>;
+    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
+        mine[k / SLICE_LANES] = q_d[k];
+    }
+    workgroupBarrier();
+    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
+        if q_end[k] != NONE {
+            q_d[q_rank[k]] = mine[k / SLICE_LANES];
+        }
+    }
+    workgroupBarrier();
+
+    // 3. Every column: b = how many queries see it lit (d <= S_i, a prefix of the sorted d),
+    // and its leaf where some query does.
+    let base = s * width;
+    for (var i = li; i < width; i += SLICE_LANES) {
+        let occluder = textureLoad(rectified, vec2<u32>(i, row), 0).x;
+        var lo = 0u;
+        var hi = v;
+        while lo < hi {
+            let mid = (lo + hi) / 2u;
+            if q_d[mid] <= occluder {
+                lo = mid + 1u;
+            } else {
+                hi = mid;
+            }
+        }
+        pst_columns[base + i] = lo;
+        if lo > 0u {
+            for (var h = 0u; h < RANK_VECS; h++) {
+                pst_leaves[(base + i) * RANK_VECS + h] = pst_leaf(f, i, row, delta, h);
+            }
+        }
+    }
+    storageBarrier();
+    workgroupBarrier();
+
+    // 4. The sweep, on one invocation: columns in index order, each query answered once the
+    // columns before its last are in.
+    if li == 0u {
+        let tree = s * SLICE_SAMPLES * RANK_VECS;
+        for (var j = 0u; j < v * RANK_VECS; j++) {
+            pst_tree[tree + j] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        }
+        var next = 0u;
+        for (var i = 0u; i <= width; i++) {
+            while next < v && q_end[by_end[next]] == i {
+                let k = by_end[next];
+                next++;
+                var dotp = 0.0;
+                for (var h = 0u; h < RANK_VECS; h++) {
+                    var p = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+                    var j = v - q_rank[k];
+                    while j > 0u {
+                        p += pst_tree[tree + (j - 1u) * RANK_VECS + h];
+                        j -= j & (~j + 1u);
+                    }
+                    dotp += dot(p, beta_at(q_theta[k], h));
+                }
+                let c = round_f16(f.light_color.xyz * (max(q_a[k] * dotp, 0.0) + q_b[k]));
+                let z = textureLoad(depth, slice_sample_pixel(lines, u, span, k, screen), 0).x;
+                textureStore(output, vec2<u32>(k, s), vec4<f32>(c.x, c.y, c.z, z));
+            }
+            if i == width {
+                break;
+            }
+            let b = pst_columns[base + i];
+            if b > 0u {
+                for (var h = 0u; h < RANK_VECS; h++) {
+                    let leaf = pst_leaves[(base + i) * RANK_VECS + h];
+                    var j = v - b + 1u;
+                    while j <= v {
+                        pst_tree[tree + (j - 1u) * RANK_VECS + h] += leaf;
+                        j += j & (~j + 1u);
+                    }
+                }
+            }
+        }
+    }
+}
+{%- else %}
+{% include "include/sampled_entry.wgsl" %}
+{%- endif %}
