@@ -39,8 +39,8 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::textures::upload_r32float;
 use scatter_runtime::{
-    Context, CpuInputs, FamilyPasses, FrameInput, Inputs, MinmaxTimes, PrefilteredTimes,
-    RaymarchInput, RaymarchTimes, run_minmax_once, run_prefiltered_once, run_raymarch_once,
+    Context, CpuInputs, FamilyPasses, FrameInput, Inputs, MinmaxTimes, PartialSumTreeTimes, PrefilteredTimes,
+    RaymarchInput, RaymarchTimes, run_minmax_once, run_partial_sum_tree_once, run_prefiltered_once, run_raymarch_once,
 };
 use scatter_shaderlib::Kernel;
 use scatter_shaderlib::family::KernelFamily;
@@ -599,6 +599,17 @@ fn minmax_times(t: MinmaxTimes) -> PassTimes {
     out
 }
 
+fn partial_sum_tree_times(t: PartialSumTreeTimes) -> PassTimes {
+    vec![
+        (Kernel::DepthColumns.name(), t.depth_columns),
+        (Kernel::SliceFit.name(), t.slice_fit),
+        (Kernel::Rectify.name(), t.rectify),
+        (Kernel::PstSweep.name(), t.sweep),
+        (Kernel::PstSweepUnwarp.name(), t.unwarp),
+        (Kernel::PstSweepFallback.name(), t.fallback),
+    ]
+}
+
 /// The pass-wise minimum of two frames' times.
 fn min_times(a: Option<PassTimes>, b: PassTimes) -> PassTimes {
     match a {
@@ -731,6 +742,25 @@ fn run_on_gpu(
                     report: Some(rb.frame.report),
                     wall_time: rb.wall_time,
                     gpu_times: rb.gpu_times.map(minmax_times),
+                })
+            })
+        }
+        FamilyVariant::PartialSumTree(v) => {
+            let ctx = &ctx;
+            Box::new(move |_| {
+                let rb = run_partial_sum_tree_once(
+                    ctx,
+                    v,
+                    res,
+                    &frame,
+                    &gbuf.view_depth,
+                    &sm.depth,
+                )?;
+                Ok(GpuFrame {
+                    output: rb.output,
+                    report: Some(rb.frame.frame.report),
+                    wall_time: rb.wall_time,
+                    gpu_times: rb.gpu_times.map(partial_sum_tree_times),
                 })
             })
         }

@@ -28,6 +28,9 @@ use scatter_frame::frame::{
     ShadowMapDesc, ShadowProjectionDesc, prepare_frame,
 };
 use scatter_frame::minmax::{MinmaxVariant, level_count, prepare_minmax, tree_levels, tree_width};
+use scatter_frame::partial_sum_tree::{
+    FACTOR_VECS, PartialSumTreeFrame, PartialSumTreeVariant, prepare_partial_sum_tree,
+};
 use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_raymarch};
 use scatter_frame::variant::{LightKind, PrefilteredVariant};
 
@@ -37,6 +40,8 @@ const PREFILTERED_CASES: u32 = 6000;
 const RAYMARCH_CASES: u32 = 3000;
 /// Cases of `prepare_minmax`.
 const MINMAX_CASES: u32 = 3000;
+/// Cases of `prepare_partial_sum_tree` (each runs a 96 x 96 SVD).
+const PST_CASES: u32 = 400;
 /// Cases of `prepare_frame` on fully arbitrary numbers (no valid starting point).
 const ARBITRARY_CASES: u32 = 2000;
 /// Cases of the tree layout functions on arbitrary widths.
@@ -555,6 +560,7 @@ fn family() -> impl Strategy<Value = FamilyVariant> {
         prop::sample::select(grid).prop_map(FamilyVariant::Prefiltered),
         prop::sample::select(RaymarchVariant::grid()).prop_map(FamilyVariant::Raymarch),
         prop::sample::select(MinmaxVariant::grid()).prop_map(FamilyVariant::Minmax),
+        prop::sample::select(PartialSumTreeVariant::grid()).prop_map(FamilyVariant::PartialSumTree),
     ]
 }
 
@@ -682,6 +688,26 @@ fn check_prefiltered_frame(case: &Case, frame: &PrefilteredFrame) -> Result<(), 
     Ok(())
 }
 
+fn check_partial_sum_tree_frame(
+    case: &Case,
+    frame: &PartialSumTreeFrame,
+) -> Result<(), TestCaseError> {
+    check_prefiltered_frame(case, &frame.frame)?;
+    prop_assert_eq!(frame.factors.len(), FACTOR_VECS as usize);
+    for (j, v) in frame.factors.iter().enumerate() {
+        finite4(&format!("pst_factors[{j}]"), *v)?;
+    }
+    let sep = &frame.separable;
+    prop_assert!(
+        sep.theta_lo <= sep.theta_hi && sep.v_max > 0.0,
+        "separable grid {} {} {}",
+        sep.v_max,
+        sep.theta_lo,
+        sep.theta_hi
+    );
+    Ok(())
+}
+
 fn check_raymarch_uniforms(u: &RaymarchUniforms) -> Result<(), TestCaseError> {
     for (what, v) in [
         ("eye", u.eye),
@@ -725,6 +751,16 @@ fn check_case(case: Case) -> Result<(), TestCaseError> {
             &case.settings,
         )
         .map(|f| check_prefiltered_frame(&case, &f)),
+        FamilyVariant::PartialSumTree(v) => prepare_partial_sum_tree(
+            &v,
+            &case.res,
+            &case.camera,
+            &case.light,
+            &case.medium,
+            &case.shadow,
+            &case.settings,
+        )
+        .map(|f| check_partial_sum_tree_frame(&case, &f)),
         FamilyVariant::Raymarch(v) => prepare_raymarch(
             &v,
             case.res.screen,
@@ -778,6 +814,20 @@ fn prepare_minmax_on_mutated_frames() {
         MINMAX_CASES,
         0x5ca7_0003,
         case(prop::sample::select(MinmaxVariant::grid()).prop_map(FamilyVariant::Minmax)),
+        check_case,
+    );
+}
+
+#[test]
+fn prepare_partial_sum_tree_on_mutated_frames() {
+    run(
+        "prepare_partial_sum_tree",
+        PST_CASES,
+        0x5ca7_0006,
+        case(
+            prop::sample::select(PartialSumTreeVariant::grid())
+                .prop_map(FamilyVariant::PartialSumTree),
+        ),
         check_case,
     );
 }

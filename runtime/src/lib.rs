@@ -26,6 +26,7 @@ mod executor;
 pub mod family;
 pub mod gpu;
 pub mod minmax;
+pub mod partial_sum_tree;
 pub mod prefiltered;
 pub mod raymarch;
 pub mod row_prefix;
@@ -40,6 +41,9 @@ pub use family::{FamilyPasses, FamilyReadback, FamilyRuntime, run_family_once};
 #[deprecated(note = "renamed `Prefiltered`: `Scatter` is also the crate and a kernel")]
 pub type Scatter = Prefiltered;
 pub use minmax::{Minmax, MinmaxReadback, MinmaxTimes, run_minmax_once};
+pub use partial_sum_tree::{
+    PartialSumTree, PartialSumTreeReadback, PartialSumTreeTimes, run_partial_sum_tree_once,
+};
 pub use prefiltered::{
     CpuInputs, FrameInput, Inputs, Prefiltered, PrefilteredReadback, PrefilteredTimes,
     run_prefiltered_once,

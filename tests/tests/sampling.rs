@@ -88,11 +88,14 @@ fn f16_ulp(v: f32) -> f32 {
     2f32.powi(a.log2().floor() as i32 - 10)
 }
 
-/// The families' default variants with `light`, per pixel.
+/// The families' default variants with `light`, per pixel: the families that have a
+/// per-pixel body the stage samples (not `partial_sum_tree`, whose sweep answers epipolar
+/// samples only and is checked against its mirror in `tests/tests/partial_sum_tree_gpu.rs`).
 fn bases(light: LightKind) -> Vec<FamilyVariant> {
     Family::ALL
         .iter()
         .map(|f| f.default_variant().with_light(light))
+        .filter(|v| v.sampling().sampling == Sampling::Pixels)
         .collect()
 }
 
@@ -148,6 +151,7 @@ fn epipolar_camera(variant: &FamilyVariant, f: &Fixture) -> Result<EpipolarCamer
     match variant {
         FamilyVariant::Prefiltered(v) => frame(v),
         FamilyVariant::Minmax(v) => frame(&v.prefiltered()),
+        FamilyVariant::PartialSumTree(v) => frame(&v.prefiltered()),
         FamilyVariant::Raymarch(v) => prepare_raymarch(
             v,
             SCREEN,
@@ -642,13 +646,13 @@ fn main() -> ExitCode {
             }
         }
     }
-    for &family in Family::ALL {
+    for base in bases(LightKind::Directional) {
         for knobs in [
             SamplingKnobs::lowres(2),
             SamplingKnobs::lowres(4),
             SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES),
         ] {
-            let base = family.default_variant();
+            let base = base.family().default_variant();
             let name = format!("sampling::accuracy::{}", base.with_sampling(knobs).label());
             trials.push((name, Box::new(move || accuracy_trial(base, knobs))));
         }

@@ -9,6 +9,7 @@
 //! `docs/adding-a-family.md`.
 
 pub mod minmax;
+pub mod partial_sum_tree;
 pub mod prefiltered;
 pub mod raymarch;
 
@@ -101,7 +102,7 @@ macro_rules! cli_families {
                 let mut out = match self {
                     $(Self::$name => $module::knobs(),)*
                 };
-                out.extend(sampling_knobs());
+                out.extend(sampling_knobs(self.default_variant().sampling()));
                 out
             }
 
@@ -146,9 +147,9 @@ const SAMPLING_KNOBS: [&str; 7] = [
     "step",
 ];
 
-/// The sampling knobs every family has (`scatter_frame::sampling`), after the family's own.
-pub fn sampling_knobs() -> Vec<KnobInfo> {
-    let d = SamplingKnobs::default();
+/// The sampling knobs every family has (`scatter_frame::sampling`), after the family's own,
+/// with the family's defaults `d` (`partial_sum_tree` samples epipolar lines by default).
+pub fn sampling_knobs(d: SamplingKnobs) -> Vec<KnobInfo> {
     vec![
         KnobInfo {
             name: "sampling",
@@ -270,6 +271,7 @@ pub fn knobs_json(v: &FamilyVariant) -> serde_json::Value {
 
 cli_families! {
     Minmax => minmax,
+    PartialSumTree => partial_sum_tree,
     Prefiltered => prefiltered,
     Raymarch => raymarch,
 }

@@ -8,10 +8,11 @@
 
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
+use scatter_shaderlib::partial_sum_tree::PartialSumTreeVariant;
 use scatter_shaderlib::prefiltered::{FrameError, FrameReport, FrameSettings, PrefilteredVariant};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
-use super::{MinmaxRun, PrefilteredRun, RaymarchRun};
+use super::{MinmaxRun, PartialSumTreeRun, PrefilteredRun, RaymarchRun};
 use crate::buffers::{GBuffer, ShadowMap};
 use crate::bvh::Bvh;
 use crate::image::Image;
@@ -90,6 +91,24 @@ impl CpuRun for MinmaxRun {
     }
 }
 
+impl CpuRun for PartialSumTreeRun {
+    fn output(&self) -> &Image {
+        &self.output
+    }
+
+    fn report(&self) -> Option<&FrameReport> {
+        Some(&self.frame.frame.report)
+    }
+}
+
+impl CpuFamily for PartialSumTreeVariant {
+    type Run = PartialSumTreeRun;
+
+    fn run_cpu(&self, f: &CpuFrame<'_>) -> Result<PartialSumTreeRun, FrameError> {
+        super::run_partial_sum_tree(self, f.rectified, f.gbuf, f.scene, f.shadow_map, f.settings)
+    }
+}
+
 impl CpuFamily for PrefilteredVariant {
     type Run = PrefilteredRun;
 
@@ -161,6 +180,7 @@ macro_rules! cpu_families {
 
 cpu_families! {
     Minmax(MinmaxVariant),
+    PartialSumTree(PartialSumTreeVariant),
     Prefiltered(PrefilteredVariant),
     Raymarch(RaymarchVariant),
 }

@@ -21,6 +21,9 @@ pub mod minmax_traverse;
 pub mod minmax_traverse_fallback;
 pub mod minmax_traverse_unwarp;
 pub mod prefilter;
+pub mod pst_sweep;
+pub mod pst_sweep_fallback;
+pub mod pst_sweep_unwarp;
 pub mod raymarch;
 pub mod raymarch_fallback;
 pub mod raymarch_unwarp;
@@ -40,6 +43,9 @@ use crate::projective::rasterise_rectified;
 use crate::scene::Scene;
 pub use family::{CpuFamily, CpuFrame, CpuRun, FamilyRun, run_family};
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
+use scatter_shaderlib::partial_sum_tree::{
+    PartialSumTreeFrame, PartialSumTreeVariant, prepare_partial_sum_tree,
+};
 use scatter_shaderlib::prefiltered::{
     FrameError, FrameSettings, LightKind, PrefilteredFrame, PrefilteredVariant, Resolutions,
     prepare_frame,
@@ -319,6 +325,112 @@ pub fn minmax_from_rectified(
         tree,
         march,
         brute,
+        output,
+    }
+}
+
+/// Every intermediate of one CPU run of the `partial_sum_tree` family.
+#[derive(Clone, Debug)]
+pub struct PartialSumTreeRun {
+    /// The frame set-up (the shared epipolar frame after `slice_fit`, and the separable
+    /// integrand with its factors buffer).
+    pub frame: PartialSumTreeFrame,
+    /// The rectified shadow map (`rectify`).
+    pub rectified: Tex,
+    /// What `pst_sweep` wrote to `epipolar_samples`.
+    pub samples: common_sampling::EpipolarSamples,
+    /// The sweep's counts.
+    pub counts: pst_sweep::SweepCounts,
+    /// The unwarp and fallback (`output`, the fallback's pixel count).
+    pub sampled: common_sampling::SampledOutput,
+    /// In-scattered radiance (as stored in rgba16float).
+    pub output: Image,
+}
+
+/// Runs `depth_columns`, `slice_fit`, `rectify`, `pst_sweep`, `pst_sweep_unwarp` and
+/// `pst_sweep_fallback` on the CPU for a scene, its depth buffer and its standard shadow
+/// map.
+///
+/// # Errors
+///
+/// [`FrameError`] when the frame cannot be set up.
+pub fn run_partial_sum_tree(
+    variant: &PartialSumTreeVariant,
+    rectified_size: [u32; 2],
+    gbuf: &GBuffer,
+    scene: &Scene,
+    shadow_map: &ShadowMap,
+    settings: &FrameSettings,
+) -> Result<PartialSumTreeRun, FrameError> {
+    let res = Resolutions {
+        screen: [gbuf.width, gbuf.height],
+        rectified: rectified_size,
+    };
+    let mut frame = prepare_partial_sum_tree(
+        variant,
+        &res,
+        &scene.camera_desc(),
+        &scene.light_desc(),
+        &scene.medium_desc(),
+        &shadow_map.desc(),
+        settings,
+    )?;
+    let sm = Tex {
+        width: shadow_map.size,
+        height: shadow_map.size,
+        data: shadow_map.depth.clone(),
+    };
+    let spot = variant.light == LightKind::Spot;
+    let depth = Tex {
+        width: gbuf.width,
+        height: gbuf.height,
+        data: gbuf.view_depth.clone(),
+    };
+    let f = &mut frame.frame;
+    let column_depth = depth_columns::depth_columns(&f.uniforms, &depth);
+    slice_fit::slice_fit(&f.uniforms, &mut f.slices, &column_depth, spot);
+    let rectified = rectify::rectify(&f.uniforms, &f.slices, &sm, spot);
+    Ok(partial_sum_tree_from_rectified(
+        variant, frame, rectified, &depth, &sm,
+    ))
+}
+
+/// `pst_sweep`, its unwarp and its fallback for a given frame (after `slice_fit`) and
+/// rectified map (the GPU's, in the conformance test).
+pub fn partial_sum_tree_from_rectified(
+    variant: &PartialSumTreeVariant,
+    frame: PartialSumTreeFrame,
+    rectified: Tex,
+    depth: &Tex,
+    shadow_map: &Tex,
+) -> PartialSumTreeRun {
+    let inputs = pst_sweep::PstInputs {
+        frame: &frame.frame.uniforms,
+        slices: &frame.frame.slices,
+        depth,
+        shadow_map,
+        rectified: &rectified,
+        factors: &frame.factors,
+    };
+    let (samples, counts) = pst_sweep::pst_sweep(variant, &inputs);
+    let unwarped = pst_sweep_unwarp::pst_sweep_unwarp(variant, &inputs, &samples.samples);
+    let sampled = pst_sweep_fallback::pst_sweep_fallback(variant, &inputs, unwarped);
+    let output = Image::from_pixels(
+        depth.width,
+        depth.height,
+        sampled
+            .output
+            .data
+            .iter()
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+    );
+    PartialSumTreeRun {
+        frame,
+        rectified,
+        samples,
+        counts,
+        sampled,
         output,
     }
 }

@@ -1,0 +1,402 @@
+//! CPU mirror of `shaderlib/templates/pst_sweep.wgsl`: the partial-sum-tree method of Baran et
+//! al. 2010 on the epipolar samples. Per sample slice, its samples are the queries of one
+//! sweep through a Fenwick tree over the rectified row the slice lies in (the row of its last
+//! sample's pixel): queries ranked by `d`, every column's count `b` of queries that see it lit,
+//! its leaf inserted at tree position `V - b` in column order, each query answered (in order
+//! of its prefix end) by the prefix below `V - rank`. Conventions and the derivation:
+//! `scatter_frame::partial_sum_tree`. The WGSL's four phases run one after the other here;
+//! every value is computed by the same expression in the same order.
+
+use super::common_epipolar::{
+    epipole_march, normalised_depth, pixel_dir, ray_t, row_index, row_phi, slice_e, spot_segment,
+};
+use super::common_model::{
+    clamp, cone_falloff, max, max_u, min, phase_hg, select, transmittance_between,
+};
+use super::common_sampling::{
+    EpipolarCamera, EpipolarSamples, epipolar_layout, round_f16_rgb, slice_direction,
+    slice_sample_pixel, slice_span,
+};
+use super::texture::{Tex, TexArray, xyz};
+use glam::{Vec3, Vec4};
+use scatter_shaderlib::partial_sum_tree::{GL2, GRID, PartialSumTreeVariant};
+use scatter_shaderlib::prefiltered::{FrameUniforms, LightKind, SliceParams};
+
+/// The bindings of `pst_sweep` (and of its fallback, which reads the same but the scratch).
+pub struct PstInputs<'a> {
+    /// Frame uniforms.
+    pub frame: &'a FrameUniforms,
+    /// Per-row table (after `slice_fit`).
+    pub slices: &'a [SliceParams],
+    /// Linear view depth, screen-sized.
+    pub depth: &'a Tex,
+    /// The standard shadow map.
+    pub shadow_map: &'a Tex,
+    /// The rectified map (`rectify`).
+    pub rectified: &'a Tex,
+    /// The factors buffer (`PartialSumTreeFrame::factors`).
+    pub factors: &'a [[f32; 4]],
+}
+
+/// What the sweep of every slice did (not written by the kernel: counts for reports).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SweepCounts {
+    /// Queries answered through the trees.
+    pub queries: u64,
+    /// Columns inserted (some query sees them lit).
+    pub inserted: u64,
+    /// Samples marched (near the epipoles) or without a column.
+    pub direct: u64,
+}
+
+fn v4(a: [f32; 4]) -> Vec4 {
+    Vec4::from_array(a)
+}
+
+/// Factor table `base` at `x` in [0, 1], bases `4h ..`, linear between nodes.
+fn factor_at(inp: &PstInputs, base: u32, x: f32, h: u32) -> Vec4 {
+    let grid = GRID as u32;
+    let p = min(clamp(x, 0.0, 1.0) * (grid - 1) as f32, (grid - 1) as f32);
+    let j = (p.floor() as u32).min(grid - 2);
+    let t = p - j as f32;
+    v4(inp.factors[(base + 2 * j + h) as usize]) * (1.0 - t)
+        + v4(inp.factors[(base + 2 * (j + 1) + h) as usize]) * t
+}
+
+/// `gamma_(4h ..)(v)`.
+fn gamma_at(inp: &PstInputs, v: f32, h: u32) -> Vec4 {
+    factor_at(inp, 1, v / inp.factors[0][0], h)
+}
+
+/// `beta_(4h ..)(theta)`.
+fn beta_at(inp: &PstInputs, theta: f32, h: u32) -> Vec4 {
+    let head = inp.factors[0];
+    factor_at(
+        inp,
+        1 + 2 * GRID as u32,
+        (theta - head[1]) / max(head[2] - head[1], 1e-12),
+        h,
+    )
+}
+
+/// Leaf of column `i` of `row` (spacing `delta`), bases `4h ..`.
+pub fn pst_leaf(inp: &PstInputs, spot: bool, i: u32, row: u32, delta: f32, h: u32) -> Vec4 {
+    let f = inp.frame;
+    if !spot {
+        return gamma_at(inp, i as f32 * delta, h);
+    }
+    let e = slice_e(f, row_phi(f, row));
+    let axis = xyz(f.axis);
+    let mut leaf = Vec4::ZERO;
+    for g in 0..2u32 {
+        let q = if g == 0 { -GL2 } else { GL2 };
+        let psi = (i as f32 + 0.5 + 0.5 * q) * delta;
+        let l = -axis * psi.cos() + e * psi.sin();
+        let cone = cone_falloff(l.dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]);
+        leaf += (0.5 * delta * cone) * gamma_at(inp, psi, h);
+    }
+    leaf
+}
+
+/// A pixel's ray in rectified space (WGSL `PstRay`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PstRay {
+    /// Near the epipoles: `color` holds the marched radiance.
+    pub marched: bool,
+    /// The marched radiance.
+    pub color: Vec3,
+    /// Eye position.
+    pub eye: Vec3,
+    /// Unit view direction.
+    pub dir: Vec3,
+    /// Distance to the surface.
+    pub s: f32,
+    /// The pixel's nearest row.
+    pub row: u32,
+    /// View angle to the axis.
+    pub theta: f32,
+    /// Normalised rectified depth.
+    pub d: f32,
+    /// `x_s` times the row's spacing.
+    pub xs_num: f32,
+}
+
+/// The pixel set-up (WGSL `pst_ray`).
+pub fn pst_ray(inp: &PstInputs, spot: bool, x: u32, y: u32) -> PstRay {
+    let f = inp.frame;
+    let eye = xyz(f.eye);
+    let dir = pixel_dir(f, x, y);
+    // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
+    let s = min(max(inp.depth.load(x, y), 0.0), f.theta[2]) / max(dir.dot(xyz(f.cam_forward)), 1e-6);
+    let mut r = PstRay {
+        marched: false,
+        color: Vec3::ZERO,
+        eye,
+        dir,
+        s,
+        row: 0,
+        theta: 0.0,
+        d: 0.0,
+        xs_num: 0.0,
+    };
+    let px = Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 0.0);
+    let radius = f.epipole[3];
+    let near_epi =
+        f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
+    let near_anti = f.anti_epipole[2] > 0.5
+        && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
+    if near_epi || near_anti {
+        r.marched = true;
+        r.color = epipole_march(f, inp.shadow_map, eye, dir, s, spot) * xyz(f.light_color);
+    }
+    let axis = xyz(f.axis);
+    let rows = f.sizes[3];
+    let wrap = f.anti_epipole[3] > 0.5;
+    r.theta = dir.cross(axis).length().atan2(dir.dot(axis));
+    let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
+    let mut yc = (phi - f.e1[3]) / f.e2[3];
+    if wrap {
+        yc -= (yc / rows as f32).floor() * rows as f32;
+    } else {
+        yc = clamp(yc, 0.0, rows as f32);
+    }
+    r.row = row_index(yc.floor(), rows, wrap);
+    r.d = normalised_depth(r.theta, f.theta[0], f.theta[1]);
+    r.xs_num = if spot {
+        let q = (eye + dir * s - xyz(f.light_pos)).normalize();
+        clamp(q.dot(-axis), -1.0, 1.0).acos()
+    } else {
+        s * r.theta.sin()
+    };
+    r
+}
+
+/// Texels the ray crosses in a row of spacing `delta` (WGSL `pst_columns_crossed`).
+pub fn pst_columns_crossed(f: &FrameUniforms, r: &PstRay, delta: f32) -> u32 {
+    let xs = r.xs_num / delta;
+    min(select(0.0, xs, xs > 0.0).ceil(), f.sizes[2] as f32) as u32
+}
+
+/// A query's factor and term (WGSL `pst_terms`): `(a, b)`.
+pub fn pst_terms(inp: &PstInputs, spot: bool, r: &PstRay, row: u32, delta: f32, n: u32) -> [f32; 2] {
+    let f = inp.frame;
+    let sin_theta = max(r.theta.sin(), 1e-6);
+    let mut tail = 0.0;
+    if r.d <= inp.rectified.load(n - 1, row) {
+        // (`edge_t` of column n - 1 < n: the ray distance of its edge.)
+        let a = ray_t(f, (n - 1) as f32, delta, r.theta, r.s, spot);
+        tail = if spot {
+            spot_segment(f, r.eye, r.dir, a, r.s, max_u(f.sizes2[2] / 4, 1))
+        } else {
+            transmittance_between(f.medium[0], a, r.s)
+        };
+    }
+    if spot {
+        return [f.medium[1] / (f.axis[3] * sin_theta), tail];
+    }
+    let sp = f.medium[1] * phase_hg(f.medium[2], -xyz(f.light_dir).dot(r.dir));
+    [
+        sp * transmittance_between(f.medium[0], 0.0, delta / sin_theta),
+        sp * tail,
+    ]
+}
+
+/// The fallback's per-pixel body (WGSL `pst_sweep_pixel`): the pixel's own nearest row, its
+/// lit whole columns' leaves summed in column order.
+pub fn pst_sweep_pixel(inp: &PstInputs, variant: &PartialSumTreeVariant, x: u32, y: u32) -> [f32; 3] {
+    let f = inp.frame;
+    let spot = variant.light == LightKind::Spot;
+    let r = pst_ray(inp, spot, x, y);
+    if r.marched {
+        return r.color.to_array();
+    }
+    let delta = inp.slices[r.row as usize].delta;
+    let n = pst_columns_crossed(f, &r, delta);
+    if n == 0 {
+        return [0.0; 3];
+    }
+    let mut sum = 0.0;
+    for h in 0..variant.rank_vecs() {
+        let mut p = Vec4::ZERO;
+        for i in 0..n - 1 {
+            if r.d <= inp.rectified.load(i, r.row) {
+                p += pst_leaf(inp, spot, i, r.row, delta, h);
+            }
+        }
+        sum += p.dot(beta_at(inp, r.theta, h));
+    }
+    let ab = pst_terms(inp, spot, &r, r.row, delta, n);
+    (xyz(f.light_color) * (max(ab[0] * sum, 0.0) + ab[1])).to_array()
+}
+
+/// The samples pass: every slice swept (slices in parallel). Returns the
+/// `epipolar_samples` texture (layout: `common_sampling::EpipolarSamples`; `evaluated`
+/// counts every sample, `depth_refined` and `light_refined` 0: nothing is interpolated) and
+/// the sweep's counts.
+pub fn pst_sweep(
+    variant: &PartialSumTreeVariant,
+    inp: &PstInputs,
+) -> (EpipolarSamples, SweepCounts) {
+    use rayon::prelude::*;
+    let f = inp.frame;
+    let spot = variant.light == LightKind::Spot;
+    let knobs = variant.sampling_knobs();
+    let (n_slices, m) = (knobs.slices, knobs.slice_samples);
+    let screen = [f.sizes[0], f.sizes[1]];
+    let width = f.sizes[2];
+    let rv = variant.rank_vecs();
+    let layout = epipolar_layout(&EpipolarCamera::of_frame(f), screen, n_slices);
+    let lines: Vec<(Vec<[f32; 4]>, SweepCounts)> = (0..n_slices)
+        .into_par_iter()
+        .map(|s| {
+            let u = slice_direction(&layout, s);
+            let span = slice_span(&layout, s, screen, m);
+            let mut out = vec![[0.0f32; 4]; m as usize + 1];
+            out[m as usize] = [u[0], u[1], span[0], span[1]];
+            let last = slice_sample_pixel(&layout, u, span, m - 1, screen);
+            let row = pst_ray(inp, spot, last[0], last[1]).row;
+            let delta = inp.slices[row as usize].delta;
+            let mut counts = SweepCounts::default();
+
+            // 1. The samples.
+            const NONE: u32 = u32::MAX;
+            let mut q_end = vec![NONE; m as usize];
+            let mut q_d = vec![0.0f32; m as usize];
+            let mut q_theta = vec![0.0f32; m as usize];
+            let mut q_ab = vec![[0.0f32; 2]; m as usize];
+            let mut v = 0u32;
+            for k in 0..m {
+                let p = slice_sample_pixel(&layout, u, span, k, screen);
+                let r = pst_ray(inp, spot, p[0], p[1]);
+                let n = pst_columns_crossed(f, &r, delta);
+                let ku = k as usize;
+                if r.marched || n == 0 {
+                    let c = round_f16_rgb(r.color.to_array());
+                    out[ku] = [c[0], c[1], c[2], inp.depth.load(p[0], p[1])];
+                    counts.direct += 1;
+                } else {
+                    q_ab[ku] = pst_terms(inp, spot, &r, row, delta, n);
+                    q_end[ku] = n - 1;
+                    q_d[ku] = r.d;
+                    q_theta[ku] = r.theta;
+                    v += 1;
+                }
+            }
+
+            // 2. Ranks by d and by prefix end (ties by sample index), then the sorted d.
+            let mut q_rank = vec![0u32; m as usize];
+            let mut by_end = vec![0u32; m as usize];
+            for k in 0..m as usize {
+                if q_end[k] == NONE {
+                    continue;
+                }
+                let (mut by_d, mut by_e) = (0u32, 0u32);
+                for q in 0..m as usize {
+                    if q_end[q] != NONE {
+                        by_d += u32::from(q_d[q] < q_d[k] || (q_d[q] == q_d[k] && q < k));
+                        by_e +=
+                            u32::from(q_end[q] < q_end[k] || (q_end[q] == q_end[k] && q < k));
+                    }
+                }
+                q_rank[k] = by_d;
+                by_end[by_e as usize] = k as u32;
+            }
+            let mut sorted = vec![0.0f32; v as usize];
+            for k in 0..m as usize {
+                if q_end[k] != NONE {
+                    sorted[q_rank[k] as usize] = q_d[k];
+                }
+            }
+
+            // 3. Every column's count of queries that see it lit, and its leaf.
+            let mut columns = vec![0u32; width as usize];
+            let mut leaves = vec![Vec4::ZERO; (width * rv) as usize];
+            for i in 0..width {
+                let occluder = inp.rectified.load(i, row);
+                let b = sorted.partition_point(|&d| d <= occluder) as u32;
+                columns[i as usize] = b;
+                if b > 0 {
+                    for h in 0..rv {
+                        leaves[(i * rv + h) as usize] = pst_leaf(inp, spot, i, row, delta, h);
+                    }
+                }
+            }
+
+            // 4. The sweep.
+            let mut tree = vec![Vec4::ZERO; (v * rv) as usize];
+            let mut next = 0u32;
+            for i in 0..=width {
+                while next < v && q_end[by_end[next as usize] as usize] == i {
+                    let k = by_end[next as usize] as usize;
+                    next += 1;
+                    let mut dotp = 0.0;
+                    for h in 0..rv {
+                        let mut p = Vec4::ZERO;
+                        let mut j = v - q_rank[k];
+                        while j > 0 {
+                            p += tree[((j - 1) * rv + h) as usize];
+                            j -= j & j.wrapping_neg();
+                        }
+                        dotp += p.dot(beta_at(inp, q_theta[k], h));
+                    }
+                    let c = xyz(f.light_color) * (max(q_ab[k][0] * dotp, 0.0) + q_ab[k][1]);
+                    let c = round_f16_rgb(c.to_array());
+                    let p = slice_sample_pixel(&layout, u, span, k as u32, screen);
+                    out[k] = [c[0], c[1], c[2], inp.depth.load(p[0], p[1])];
+                    counts.queries += 1;
+                }
+                if i == width {
+                    break;
+                }
+                let b = columns[i as usize];
+                if b > 0 {
+                    counts.inserted += 1;
+                    for h in 0..rv {
+                        let leaf = leaves[(i * rv + h) as usize];
+                        let mut j = v - b + 1;
+                        while j <= v {
+                            tree[((j - 1) * rv + h) as usize] += leaf;
+                            j += j & j.wrapping_neg();
+                        }
+                    }
+                }
+            }
+            (out, counts)
+        })
+        .collect();
+    let mut counts = SweepCounts::default();
+    let mut data = Vec::with_capacity(((n_slices + 1) * (m + 1)) as usize);
+    for (line, c) in lines {
+        data.extend(line);
+        counts.queries += c.queries;
+        counts.inserted += c.inserted;
+        counts.direct += c.direct;
+    }
+    data.push([
+        layout.origin[0],
+        layout.origin[1],
+        layout.axis[0],
+        layout.axis[1],
+    ]);
+    data.push([
+        layout.phi_start,
+        layout.dphi,
+        if layout.wrap { 1.0 } else { 0.0 },
+        0.0,
+    ]);
+    data.resize(((n_slices + 1) * (m + 1)) as usize, [0.0; 4]);
+    (
+        EpipolarSamples {
+            samples: TexArray {
+                width: m + 1,
+                height: n_slices + 1,
+                layers: 1,
+                data,
+            },
+            evaluated: u64::from(n_slices) * u64::from(m),
+            depth_refined: 0,
+            light_refined: 0,
+        },
+        counts,
+    )
+}
