@@ -181,8 +181,11 @@ fn trial(
     for s in 0..slices {
         let u = slice_direction(&layout, s);
         let span = slice_span(&layout, s, SCREEN, m);
-        let last = slice_sample_pixel(&layout, u, span, m - 1, SCREEN);
-        let lr = pst_ray(&inp, spot, last[0], last[1]);
+        let at = |k: u32| {
+            let t = span[0] + k as f32 * span[1];
+            [layout.origin[0] + u[0] * t, layout.origin[1] + u[1] * t]
+        };
+        let lr = pst_ray(&inp, spot, at(m - 1), 0.0);
         let row = lr.row;
         let rows = f.sizes[3] as f32;
         let phi = lr.dir.dot(glam::Vec3::from_slice(&f.e2[..3]))
@@ -201,7 +204,7 @@ fn trial(
                 continue;
             }
             let p = slice_sample_pixel(&layout, u, span, k, SCREEN);
-            let r = pst_ray(&inp, spot, p[0], p[1]);
+            let r = pst_ray(&inp, spot, at(k), depth.load(p[0], p[1]));
             let n = pst_columns_crossed(f, &r, delta);
             let xs = r.xs_num / delta;
             let tie = r.marched

@@ -8,7 +8,7 @@
 //! every value is computed by the same expression in the same order.
 
 use super::common_epipolar::{
-    epipole_march, normalised_depth, pixel_dir, ray_t, row_index, row_phi, slice_e, spot_segment,
+    epipole_march, normalised_depth, ray_t, row_index, row_phi, slice_e, spot_segment,
 };
 use super::common_model::{
     clamp, cone_falloff, max, max_u, min, phase_hg, select, transmittance_between,
@@ -121,13 +121,22 @@ pub struct PstRay {
     pub xs_num: f32,
 }
 
-/// The pixel set-up (WGSL `pst_ray`).
-pub fn pst_ray(inp: &PstInputs, spot: bool, x: u32, y: u32) -> PstRay {
+/// The ray through the continuous pixel position `pc` ending at view depth `z` (WGSL
+/// `pst_ray`).
+pub fn pst_ray(inp: &PstInputs, spot: bool, pc: [f32; 2], z: f32) -> PstRay {
     let f = inp.frame;
     let eye = xyz(f.eye);
-    let dir = pixel_dir(f, x, y);
+    let ndc = [
+        2.0 * pc[0] / f.sizes[0] as f32 - 1.0,
+        1.0 - 2.0 * pc[1] / f.sizes[1] as f32,
+    ];
+    let t = f.cam_forward[3];
+    let dir = (xyz(f.cam_forward)
+        + xyz(f.cam_right) * (ndc[0] * t * f.cam_right[3])
+        + xyz(f.cam_up) * (ndc[1] * t))
+        .normalize();
     // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
-    let s = min(max(inp.depth.load(x, y), 0.0), f.theta[2]) / max(dir.dot(xyz(f.cam_forward)), 1e-6);
+    let s = min(max(z, 0.0), f.theta[2]) / max(dir.dot(xyz(f.cam_forward)), 1e-6);
     let mut r = PstRay {
         marched: false,
         color: Vec3::ZERO,
@@ -139,7 +148,7 @@ pub fn pst_ray(inp: &PstInputs, spot: bool, x: u32, y: u32) -> PstRay {
         d: 0.0,
         xs_num: 0.0,
     };
-    let px = Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 0.0);
+    let px = Vec3::new(pc[0], pc[1], 0.0);
     let radius = f.epipole[3];
     let near_epi =
         f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
@@ -206,7 +215,12 @@ pub fn pst_terms(inp: &PstInputs, spot: bool, r: &PstRay, row: u32, delta: f32, 
 pub fn pst_sweep_pixel(inp: &PstInputs, variant: &PartialSumTreeVariant, x: u32, y: u32) -> [f32; 3] {
     let f = inp.frame;
     let spot = variant.light == LightKind::Spot;
-    let r = pst_ray(inp, spot, x, y);
+    let r = pst_ray(
+        inp,
+        spot,
+        [x as f32 + 0.5, y as f32 + 0.5],
+        inp.depth.load(x, y),
+    );
     if r.marched {
         return r.color.to_array();
     }
@@ -253,8 +267,12 @@ pub fn pst_sweep(
             let span = slice_span(&layout, s, screen, m);
             let mut out = vec![[0.0f32; 4]; m as usize + 1];
             out[m as usize] = [u[0], u[1], span[0], span[1]];
-            let last = slice_sample_pixel(&layout, u, span, m - 1, screen);
-            let row = pst_ray(inp, spot, last[0], last[1]).row;
+            // Samples on the slice's line (see the WGSL): one row per slice.
+            let at = |k: u32| {
+                let t = span[0] + k as f32 * span[1];
+                [layout.origin[0] + u[0] * t, layout.origin[1] + u[1] * t]
+            };
+            let row = pst_ray(inp, spot, at(m - 1), 0.0).row;
             let delta = inp.slices[row as usize].delta;
             let mut counts = SweepCounts::default();
 
@@ -267,12 +285,13 @@ pub fn pst_sweep(
             let mut v = 0u32;
             for k in 0..m {
                 let p = slice_sample_pixel(&layout, u, span, k, screen);
-                let r = pst_ray(inp, spot, p[0], p[1]);
+                let z = inp.depth.load(p[0], p[1]);
+                let r = pst_ray(inp, spot, at(k), z);
                 let n = pst_columns_crossed(f, &r, delta);
                 let ku = k as usize;
                 if r.marched || n == 0 {
                     let c = round_f16_rgb(r.color.to_array());
-                    out[ku] = [c[0], c[1], c[2], inp.depth.load(p[0], p[1])];
+                    out[ku] = [c[0], c[1], c[2], z];
                     counts.direct += 1;
                 } else {
                     q_ab[ku] = pst_terms(inp, spot, &r, row, delta, n);
