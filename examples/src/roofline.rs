@@ -547,6 +547,53 @@ pub fn kernel_costs() -> Vec<KernelCost> {
         low: None,
         trips: "2 x 4 taps",
     });
+    // partial_sum_tree, rank 4, 512 slices x 256 samples: one workgroup of 32 lanes per
+    // slice; counts per invocation averaged over the slice's lanes (the sweep runs on one
+    // of them). Per slice: Q = 256 sample set-ups (depth and tail loads, two atan2, sin,
+    // acos, two exp: about 10 transcendentals), Q^2 = 65536 rank comparisons (two per pair),
+    // Wr = 1024 columns (a load, an 8-step binary search, the leaf: two factor loads and
+    // a lerp, 16 + 4 bytes), then (Wr + Q) log2 Q = 10240 tree steps of one vec4 load and
+    // add (inserts also store 16 bytes) and Q answers (beta: two loads).
+    let q = 256.0;
+    let slices = 512u64;
+    let per_lane = |per_slice: f64| per_slice / 32.0;
+    out.push(KernelCost {
+        method: "partial_sum_tree r4",
+        kernel: "pst_sweep",
+        invocations: slices * 32,
+        counts: [
+            per_lane(q * 16.0 + wr as f64 * 20.0 + wr as f64 * 8.0 * 16.0),
+            per_lane(3.0 * q + wr as f64 + (wr as f64 + q) * 8.0 + 2.0 * wr as f64),
+            0.0,
+            per_lane(10.0 * q),
+            per_lane(2.0 * q * q + wr as f64 * (24.0 + 8.0) + (wr as f64 + q) * 8.0 * 4.0),
+        ],
+        low: None,
+        trips: "per slice: Q set-ups, Q^2 rank comparisons, Wr columns, (Wr + Q) log2 Q tree steps on one lane",
+    });
+    out.push(KernelCost {
+        method: "partial_sum_tree r4",
+        kernel: "pst_sweep_unwarp",
+        invocations: pixels,
+        // The layout (two loads), the two slices' lines, four sample loads and the pixel's
+        // depth; two atan2 (the pixel's angle and slice), the bilinear weights and the
+        // depth- and light-aware blend (about 60 FMAs); the rgba16float store.
+        counts: [8.0, 9.0, 0.0, 2.0, 60.0],
+        low: None,
+        trips: "4 taps",
+    });
+    out.push(KernelCost {
+        method: "partial_sum_tree r4",
+        kernel: "pst_sweep_fallback",
+        invocations: pixels.div_ceil(64),
+        // One invocation per 8 x 8 pixels walks the list: per listed pixel the ray set-up
+        // and every column of its row summed without the tree (Wr rectified loads, the
+        // leaves' two factor loads each). Counted for no listed pixel (the common case):
+        // the count load.
+        counts: [0.0, 1.0, 0.0, 0.0, 4.0],
+        low: None,
+        trips: "listed pixels, data-dependent (none .. a few per cent of the screen)",
+    });
     out
 }
 

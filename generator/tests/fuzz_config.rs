@@ -496,7 +496,20 @@ enum Fault {
 }
 
 /// A valid knob value for `family`'s knob `name`, as TOML source.
-fn valid_value(name: &str, pick: usize) -> String {
+fn valid_value(family: Family, name: &str, pick: usize) -> String {
+    // The sampling knobs only at the family's defaults (`partial_sum_tree` samples epipolar
+    // lines with step 1; the others every pixel): set apart from their mode they are
+    // rejected.
+    if let Some(k) = family
+        .knobs()
+        .into_iter()
+        .find(|k| k.name == name && SAMPLING_KNOB_NAMES.contains(&name))
+    {
+        return match k.value_type {
+            KnobType::Name => format!("\"{}\"", k.default),
+            _ => k.default,
+        };
+    }
     let options: &[&str] = match name {
         "basis" => &["\"fourier\""],
         "moments" => &["4"],
@@ -510,19 +523,21 @@ fn valid_value(name: &str, pick: usize) -> String {
         "samples" => &["64", "128"],
         "interleave" => &["1", "2", "4"],
         "jitter" => &["true", "false"],
-        // The sampling knobs only at their defaults: set with `sampling = pixels` (and
-        // a sampled mode with an interleaving raymarch) they are rejected.
-        "sampling" => &["\"pixels\""],
-        "scale" => &["2"],
-        "depth_break" => &["10"],
-        "light_break" => &["20"],
-        "slices" => &["512"],
-        "slice_samples" => &["256"],
-        "step" => &["8"],
         _ => &["1"],
     };
     options[pick % options.len()].to_owned()
 }
+
+/// The sampling knobs every family has.
+const SAMPLING_KNOB_NAMES: [&str; 7] = [
+    "sampling",
+    "scale",
+    "depth_break",
+    "light_break",
+    "slices",
+    "slice_samples",
+    "step",
+];
 
 /// A bad value for knob `name`, as TOML source.
 fn bad_value(name: &str, pick: usize) -> String {
@@ -546,6 +561,7 @@ fn bad_value(name: &str, pick: usize) -> String {
         "slices" => &["300", "0", "2048", "\"many\""],
         "slice_samples" => &["100", "1024", "-1"],
         "step" => &["3", "0", "64", "\"x\""],
+        "rank" => &["0", "9", "\"four\"", "-1"],
         _ => &["\"?\""],
     };
     options[pick % options.len()].to_owned()
@@ -594,7 +610,7 @@ fn config_with_one_fault() {
                 4 => Fault::TopLevel(junk),
                 5 => Fault::BadTarget(junk),
                 6 if info.value_type != KnobType::Name => {
-                    Fault::Quoted(knob.to_owned(), format!("\"{}\"", valid_value(knob, 0)))
+                    Fault::Quoted(knob.to_owned(), format!("\"{}\"", valid_value(*family, knob, 0)))
                 }
                 _ => Fault::None,
             };
@@ -630,7 +646,7 @@ fn config_with_one_fault() {
                     }
                     used.push(k);
                     // bases and bases_per_thread depend on each other: keep both valid.
-                    text.push_str(&format!("{k} = {}\n", valid_value(k, p.index(12))));
+                    text.push_str(&format!("{k} = {}\n", valid_value(*family, k, p.index(12))));
                 }
                 if j == i {
                     match &fault {

@@ -6,6 +6,7 @@
 
 use scatter_gen::{FamilyVariant, Request, Target, generate};
 use scatter_shaderlib::prefiltered::{LightKind, PrefilteredVariant, Rectification, Storage};
+use scatter_shaderlib::sampling::Sampling;
 
 #[test]
 fn emitted_spirv_passes_naga_spirv_front_end() {
@@ -27,10 +28,19 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
             .into_iter()
             .map(FamilyVariant::Raymarch),
     );
-    // Every family sampled (lowres and epipolar: workgroup memory, atomics, the unwarp
-    // passes), both lights.
+    // Every family with a per-pixel mode sampled (lowres and epipolar: workgroup memory,
+    // atomics, the unwarp passes), both lights; `partial_sum_tree` (epipolar only) over its
+    // grid (ranks 1, 4, 8: one and two vec4 per leaf).
+    variants.extend(
+        scatter_shaderlib::partial_sum_tree::PartialSumTreeVariant::grid()
+            .into_iter()
+            .map(FamilyVariant::PartialSumTree),
+    );
     for &light in LightKind::ALL {
-        for family in scatter_shaderlib::family::Family::ALL {
+        for family in scatter_shaderlib::family::Family::ALL
+            .iter()
+            .filter(|f| f.default_variant().sampling().sampling == Sampling::Pixels)
+        {
             for knobs in [
                 scatter_shaderlib::sampling::SamplingKnobs::lowres(4),
                 scatter_shaderlib::sampling::SamplingKnobs::epipolar(64),

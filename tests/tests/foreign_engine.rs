@@ -36,12 +36,13 @@ use scatter_foreign_engine::prefiltered::{Inputs, Sizes, run_frame};
 use scatter_foreign_engine::{Engine, EngineError, Manifest, Target};
 use scatter_frame::frame::{PrefilteredFrame, prepare_frame};
 use scatter_frame::minmax::{MinmaxVariant, prepare_minmax};
+use scatter_frame::partial_sum_tree::{PartialSumTreeVariant, prepare_partial_sum_tree};
 use scatter_frame::raymarch::{RaymarchVariant, prepare_raymarch};
 use scatter_gen::{FamilyVariant, Request, generate, output};
 use scatter_reference::kernels::engine_rectified_map;
 use scatter_reference::suite::Pose;
 use scatter_runtime::{
-    Context, CpuInputs, FrameInput, RaymarchInput, run_minmax_once, run_prefiltered_once,
+    Context, CpuInputs, FrameInput, RaymarchInput, run_minmax_once, run_partial_sum_tree_once, run_prefiltered_once,
     run_raymarch_once,
 };
 use scatter_shaderlib::prefiltered::{
@@ -309,6 +310,7 @@ fn other_families_dir() -> &'static Path {
             .map(FamilyVariant::Raymarch)
             .into_iter()
             .chain(MinmaxVariant::grid().into_iter().map(FamilyVariant::Minmax))
+            .chain(pst_variants().into_iter().map(FamilyVariant::PartialSumTree))
             .collect();
         let generated = generate(&Request {
             variants,
@@ -318,6 +320,14 @@ fn other_families_dir() -> &'static Path {
         output::write(&dir, &generated, false).unwrap_or_else(|e| panic!("scatter-gen: {e}"));
         dir
     })
+}
+
+/// The partial-sum-tree trial variants: rank 4 directional and rank 8 spot (two vec4 per
+/// leaf), 64 slices x 64 samples: the `pst_factors` buffer the engine uploads, the sweep's
+/// scratch buffers it allocates from the manifest, and the unwarp and fallback passes.
+fn pst_variants() -> [PartialSumTreeVariant; 2] {
+    let g = PartialSumTreeVariant::grid();
+    [g[1], g[4]]
 }
 
 /// The raymarch trial variants: plain directional, interleaved and jittered spot,
@@ -515,9 +525,70 @@ fn foreign_engine_matches_runtime_for_every_family() {
             },
         ));
     }
+    for v in pst_variants() {
+        let fixture = fixture(v.light);
+        let name = format!(
+            "foreign::partial_sum_tree::{}::{}::{}",
+            v.id(),
+            fixture.name,
+            fixture.pose
+        );
+        let f = fixture.input();
+        let res = Resolutions {
+            screen: fixture.sizes().screen,
+            rectified: RECTIFIED,
+        };
+        let runtime = run_partial_sum_tree_once(
+            ctx,
+            &v,
+            res,
+            &f,
+            &fixture.gbuf.view_depth,
+            &fixture.shadow_map.depth,
+        )
+        .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
+        let frame = prepare_partial_sum_tree(
+            &v,
+            &res,
+            &f.camera,
+            &f.light,
+            &f.medium,
+            &f.shadow_map,
+            &f.settings,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(
+            (&runtime.frame.frame, &runtime.frame.factors),
+            (&frame.frame, &frame.factors),
+            "{name}: the runtime set up another frame"
+        );
+        lines.extend(compare_targets(
+            &name,
+            &runtime.output,
+            &[
+                "depth_columns",
+                "slice_fit",
+                "rectify",
+                "pst_sweep",
+                "pst_sweep_unwarp",
+                "pst_sweep_fallback",
+            ],
+            |target| {
+                let params = fixture.sizes().params();
+                let mut engine =
+                    Engine::load(ctx.device(), ctx.queue(), dir, &v.id(), target, &params)?;
+                scatter_foreign_engine::partial_sum_tree::run_frame(
+                    &mut engine,
+                    &frame,
+                    &fixture.gbuf.view_depth,
+                    &fixture.shadow_map.depth,
+                )
+            },
+        ));
+    }
     assert_eq!(
         lines.len(),
-        2 * (raymarch_variants().len() + MinmaxVariant::grid().len())
+        2 * (raymarch_variants().len() + MinmaxVariant::grid().len() + pst_variants().len())
     );
 }
 
@@ -529,11 +600,12 @@ fn foreign_engine_files_run_every_family() {
     for (id, family) in [
         (raymarch_variants()[1].id(), "raymarch"),
         (MinmaxVariant::grid()[0].id(), "minmax"),
+        (pst_variants()[1].id(), "partial_sum_tree"),
     ] {
-        let light = if family == "raymarch" {
-            raymarch_variants()[1].light
-        } else {
-            MinmaxVariant::grid()[0].light
+        let light = match family {
+            "raymarch" => raymarch_variants()[1].light,
+            "minmax" => MinmaxVariant::grid()[0].light,
+            _ => pst_variants()[1].light,
         };
         let fixture = fixture(light);
         let f = fixture.input();
@@ -567,7 +639,7 @@ fn foreign_engine_files_run_every_family() {
         )
         .unwrap_or_else(|e| panic!("run_dir {family}: {e}"));
         assert_eq!(summary.family, family);
-        assert_eq!(summary.frame.is_some(), family == "minmax");
+        assert_eq!(summary.frame.is_some(), family != "raymarch");
         let max = summary
             .radiance
             .iter()

@@ -18,7 +18,8 @@
 //! - `random::<variant>::finite`: every run succeeds, 0 NaN/Inf pixels;
 //! - `random::<variant>::{p90,max,near_black}_bar`: within the variant's row of [`BARS`];
 //! - `random::<variant>::p90_vs_raymarch`: p90 no worse than raymarch n64's (per-pixel
-//!   variants); `random::<variant>::p90_vs_per_pixel`: a sampled variant's (issue 14's
+//!   variants, and `partial_sum_tree` at 64 x 64 samples, step 1: it has no per-pixel
+//!   variant); `random::<variant>::p90_vs_per_pixel`: a sampled variant's (issue 14's
 //!   epipolar sampling, 64 x 64 samples, step 8: raymarch; every family with
 //!   `SCATTER_FULL=1`) p90 at most half a point above its family's per-pixel variant's.
 //!
@@ -43,6 +44,7 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::{Context, FrameInput};
 use scatter_shaderlib::family::{Family, FamilyVariant};
+use scatter_shaderlib::sampling::Sampling;
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, PrefilteredVariant, VisibilityMode,
 };
@@ -89,6 +91,7 @@ const BARS: &[Bar] = &[
     ("minmax-ep64x64", 0.03, 0.07, NEAR_BLACK),
     ("prefiltered-m32-r3-ep64x64", 0.03, 0.07, NEAR_BLACK),
     ("raymarch-n64-i1-ep64x64", 0.03, 0.07, NEAR_BLACK),
+    ("partial_sum_tree-r4-ep64x64-s1", 0.03, 0.07, NEAR_BLACK),
 ];
 
 /// The most a sampled variant's p90 may exceed its per-pixel variant's (issue 14's bar for
@@ -173,11 +176,20 @@ fn variants() -> Vec<FamilyVariant> {
                     .into(),
                 ))
                 .collect(),
+            // Epipolar samples only: at this screen's layout (the sweep answers every sample).
+            FamilyVariant::PartialSumTree(v) => vec![
+                v.with_sampling_knobs(scatter_shaderlib::sampling::SamplingKnobs {
+                    step: 1,
+                    ..epipolar()
+                })
+                .into(),
+            ],
             other => vec![other],
         })
         .chain(
             Family::ALL
                 .iter()
+                .filter(|f| f.default_variant().sampling().sampling == Sampling::Pixels)
                 .map(|f| f.default_variant().with_sampling(epipolar()))
                 .filter(|v| full() || matches!(v, FamilyVariant::Raymarch(_))),
         )
@@ -662,12 +674,13 @@ fn within(value: f64, bound: f64) -> bool {
 fn main() -> ExitCode {
     let labels: Vec<String> = variants().iter().map(FamilyVariant::label).collect();
     // Each sampled variant's per-pixel variant (issue 14's bars are against it).
+    // A sampled variant's per-pixel variant, where its family has one (not
+    // `partial_sum_tree`, which is compared with raymarch n64 instead).
     let per_pixel: Vec<Option<String>> = variants()
         .iter()
         .map(|v| {
-            v.sampling()
-                .is_sampled()
-                .then(|| v.with_sampling(Default::default()).label())
+            let pixels = v.with_sampling(Default::default());
+            (v.sampling().is_sampled() && pixels.validate().is_ok()).then(|| pixels.label())
         })
         .collect();
     let mut trials: Vec<(String, Check)> = Vec::new();

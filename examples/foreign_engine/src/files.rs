@@ -22,6 +22,9 @@ use scatter_frame::frame::{
     ShadowProjectionDesc, prepare_frame,
 };
 use scatter_frame::minmax::{MinmaxVariant, prepare_minmax};
+use scatter_frame::partial_sum_tree::{
+    PartialSumTreeFrame, PartialSumTreeVariant, prepare_partial_sum_tree,
+};
 use scatter_frame::raymarch::{RaymarchUniforms, RaymarchVariant, prepare_raymarch};
 use scatter_frame::variant::PrefilteredVariant;
 
@@ -273,6 +276,28 @@ impl FrameFile {
     pub fn prepare_minmax(&self, variant: &MinmaxVariant) -> Result<PrefilteredFrame, EngineError> {
         let d = self.descs();
         Ok(prepare_minmax(
+            variant,
+            &self.resolutions(),
+            &d.camera,
+            &d.light,
+            &d.medium,
+            &d.shadow_map,
+            &d.settings,
+        )?)
+    }
+
+    /// Sets up the frame of a partial-sum-tree variant ([`prepare_partial_sum_tree`]: the
+    /// epipolar frame and the separable integrand's factors).
+    ///
+    /// # Errors
+    ///
+    /// [`EngineError::Frame`] when the frame set-up rejects the numbers.
+    pub fn prepare_partial_sum_tree(
+        &self,
+        variant: &PartialSumTreeVariant,
+    ) -> Result<PartialSumTreeFrame, EngineError> {
+        let d = self.descs();
+        Ok(prepare_partial_sum_tree(
             variant,
             &self.resolutions(),
             &d.camera,
@@ -571,9 +596,10 @@ pub struct RunArgs {
 pub struct RunSummary {
     /// The variant id.
     pub variant: String,
-    /// The variant's family (`prefiltered`, `raymarch`, `minmax`).
+    /// The variant's family (`prefiltered`, `raymarch`, `minmax`, `partial_sum_tree`).
     pub family: String,
-    /// The epipolar frame set-up (prefiltered and minmax; `None` for raymarch).
+    /// The epipolar frame set-up (prefiltered, minmax and partial_sum_tree; `None` for
+    /// raymarch).
     pub frame: Option<PrefilteredFrame>,
     /// Passes run and skipped.
     pub run: FrameRun,
@@ -675,6 +701,12 @@ pub fn run_dir(
             let out = crate::minmax::run_frame(&mut engine, &frame, &depth, &shadow)?;
             (Some(frame), out)
         }
+        Knobs::PartialSumTree(variant) => {
+            let frame = file.prepare_partial_sum_tree(variant)?;
+            let mut engine = load(&file.sizes().params())?;
+            let out = crate::partial_sum_tree::run_frame(&mut engine, &frame, &depth, &shadow)?;
+            (Some(frame.frame), out)
+        }
         Knobs::Raymarch(variant) => {
             let uniforms = file.prepare_raymarch(variant)?;
             let sizes = crate::raymarch::Sizes {
@@ -709,6 +741,8 @@ pub enum Knobs {
     Raymarch(RaymarchVariant),
     /// A `minmax` variant.
     Minmax(MinmaxVariant),
+    /// A `partial_sum_tree` variant.
+    PartialSumTree(PartialSumTreeVariant),
 }
 
 impl Knobs {
@@ -718,6 +752,7 @@ impl Knobs {
             Self::Prefiltered(_) => "prefiltered",
             Self::Raymarch(_) => "raymarch",
             Self::Minmax(_) => "minmax",
+            Self::PartialSumTree(_) => "partial_sum_tree",
         }
     }
 }
@@ -770,6 +805,12 @@ pub fn knobs_of(manifest: &crate::Manifest, id: &str) -> Result<Knobs, EngineErr
             MinmaxVariant::id,
         )
         .map(Knobs::Minmax),
+        "partial_sum_tree" => parse_knobs(
+            entry,
+            |v: &PartialSumTreeVariant| v.validate().map_err(|e| e.to_string()),
+            PartialSumTreeVariant::id,
+        )
+        .map(Knobs::PartialSumTree),
         _ => Err(EngineError::Unsupported {
             context: format!("variant {id}"),
             what: "family",

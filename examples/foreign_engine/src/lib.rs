@@ -12,7 +12,8 @@
 //! - [`formula`]: size and dispatch formulas, parameter constraints;
 //! - [`condition`]: per-frame conditions (`skip_when`, `alternative.when`);
 //! - [`engine`]: [`Engine`], family-agnostic;
-//! - [`prefiltered`], [`raymarch`], [`minmax`]: what each family's resources hold, one
+//! - [`prefiltered`], [`raymarch`], [`minmax`], [`partial_sum_tree`]: what each family's
+//!   resources hold, one
 //!   frame end to end (the only family-specific code: which host struct goes into which
 //!   buffer, which engine texture into which resource, the family's size parameters);
 //! - [`files`]: the binary's `frame.json` and PFM files.
@@ -39,6 +40,7 @@ pub mod files;
 pub mod formula;
 pub mod manifest;
 pub mod minmax;
+pub mod partial_sum_tree;
 pub mod prefiltered;
 pub mod raymarch;
 
