@@ -1,8 +1,8 @@
 //! Golden files: the complete output for the canonical variants (the paper's default, a
 //! small spot-light variant with average visibility and rgba16float, the moment basis with
 //! 6 moments, an interleaved raymarch variant, the spot-light minmax variant, raymarch
-//! with `sampling = lowres`, scale 4, and raymarch with `sampling = epipolar`, 256 slices)
-//! in every target, kept
+//! with `sampling = lowres`, scale 4, raymarch with `sampling = epipolar`, 256 slices, and
+//! the spot-light partial-sum-tree variant at rank 8) in every target, kept
 //! as reviewable text in `tests/golden/` (SPIR-V as `spirv-dis` text; its exact bytes are
 //! pinned by the sha256 in the golden `manifest.json`). Any change to a template, to naga or
 //! to the generator shows up here as a diff.
@@ -60,6 +60,12 @@ fn canonical() -> Generated {
             ("slices".into(), "256".into()),
         ])
         .unwrap_or_else(|e| panic!("{e}"));
+    let pst = Family::PartialSumTree
+        .variant(&[
+            ("light".into(), "spot".into()),
+            ("rank".into(), "8".into()),
+        ])
+        .unwrap_or_else(|e| panic!("{e}"));
     generate(&Request {
         variants: vec![
             Family::Prefiltered.default_variant(),
@@ -69,6 +75,7 @@ fn canonical() -> Generated {
             minmax,
             lowres,
             epipolar,
+            pst,
         ],
         targets: Target::ALL.to_vec(),
     })

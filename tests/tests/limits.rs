@@ -7,15 +7,20 @@
 //! adapter with lowered limits (`Context::from_device`), which reaches the limits a
 //! software adapter is too generous to reach otherwise: `max_texture_array_layers` (the
 //! filtered bases), `max_storage_buffer_binding_size` and `max_buffer_size` (the slice
-//! table, a readback buffer), `max_uniform_buffer_binding_size` (the uniform blocks),
+//! table, a readback buffer, the partial-sum-tree sweep's leaves),
+//! `max_compute_workgroup_storage_size` (the sweep's per-sample arrays),
+//! `max_uniform_buffer_binding_size` (the uniform blocks),
 //! `max_compute_workgroups_per_dimension` (the scatter, raymarch and minmax dispatches).
 //! Skips without a GPU, like every GPU test.
 
 use scatter_conformance::gpu;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
-use scatter_runtime::{Context, Minmax, Prefiltered, Raymarch, RuntimeError, wgpu};
+use scatter_runtime::{
+    Context, Minmax, PartialSumTree, Prefiltered, Raymarch, RuntimeError, wgpu,
+};
 use scatter_shaderlib::Kernel;
 use scatter_shaderlib::minmax::MinmaxVariant;
+use scatter_shaderlib::partial_sum_tree::PartialSumTreeVariant;
 use scatter_shaderlib::prefiltered::{PrefilteredVariant, Resolutions};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -242,6 +247,19 @@ fn lowered_device_limits_are_named() {
         65 * 16,
         1024,
     );
+    // The sweep's leaves: 512 slices x 64 columns x 16 bytes.
+    assert_limit(
+        "partial_sum_tree_leaves",
+        PartialSumTree::new(
+            ctx,
+            &PartialSumTreeVariant::default(),
+            res([64, 36], [64, 16]),
+            64,
+        ),
+        "max_storage_buffer_binding_size",
+        512 * 64 * 16,
+        1024,
+    );
     // 256 pixels wide in 8x8 workgroups: 32 workgroups along x.
     assert_limit(
         "scatter_workgroups",
@@ -263,6 +281,25 @@ fn lowered_device_limits_are_named() {
         "max_compute_workgroups_per_dimension",
         32,
         16,
+    );
+
+    // The sweep keeps seven 4-byte values per sample of a slice in workgroup memory: 512
+    // samples need 14340 bytes.
+    let small = lowered(shared, |l| l.max_compute_workgroup_storage_size = 8192);
+    assert_limit(
+        "partial_sum_tree_workgroup_memory",
+        PartialSumTree::new(
+            &small,
+            &PartialSumTreeVariant {
+                slice_samples: 512,
+                ..PartialSumTreeVariant::default()
+            },
+            res([64, 36], [64, 16]),
+            64,
+        ),
+        "max_compute_workgroup_storage_size",
+        28 * 512 + 4,
+        8192,
     );
 
     // A device whose buffers are smaller than its bindings (the slice table, a readback

@@ -71,6 +71,61 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g0_) == 352, "ScatterMin
 SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g1_) == 368, "ScatterMinmaxFrame.proj_g1_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g2_) == 384, "ScatterMinmaxFrame.proj_g2_ offset");
 
+/* WGSL `Frame` of family partial_sum_tree (scatter::epipolar), 400 bytes, alignment 16. */
+typedef struct ScatterPartialSumTreeFrame {
+    float eye[4]; /* vec4<f32>, offset 0 */
+    float axis[4]; /* vec4<f32>, offset 16 */
+    float e1_[4]; /* vec4<f32>, offset 32 */
+    float e2_[4]; /* vec4<f32>, offset 48 */
+    float cam_forward[4]; /* vec4<f32>, offset 64 */
+    float cam_right[4]; /* vec4<f32>, offset 80 */
+    float cam_up[4]; /* vec4<f32>, offset 96 */
+    float theta[4]; /* vec4<f32>, offset 112 */
+    float medium[4]; /* vec4<f32>, offset 128 */
+    float light_color[4]; /* vec4<f32>, offset 144 */
+    float light_pos[4]; /* vec4<f32>, offset 160 */
+    float light_dir[4]; /* vec4<f32>, offset 176 */
+    float sm_right[4]; /* vec4<f32>, offset 192 */
+    float sm_up[4]; /* vec4<f32>, offset 208 */
+    float sm_forward[4]; /* vec4<f32>, offset 224 */
+    float sm_origin[4]; /* vec4<f32>, offset 240 */
+    float sm_proj[4]; /* vec4<f32>, offset 256 */
+    float epipole[4]; /* vec4<f32>, offset 272 */
+    float anti_epipole[4]; /* vec4<f32>, offset 288 */
+    uint32_t sizes[4]; /* vec4<u32>, offset 304 */
+    uint32_t sizes2_[4]; /* vec4<u32>, offset 320 */
+    float proj[4]; /* vec4<f32>, offset 336 */
+    float proj_g0_[4]; /* vec4<f32>, offset 352 */
+    float proj_g1_[4]; /* vec4<f32>, offset 368 */
+    float proj_g2_[4]; /* vec4<f32>, offset 384 */
+} ScatterPartialSumTreeFrame;
+SCATTER_STATIC_ASSERT(sizeof(ScatterPartialSumTreeFrame) == 400, "ScatterPartialSumTreeFrame size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, eye) == 0, "ScatterPartialSumTreeFrame.eye offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, axis) == 16, "ScatterPartialSumTreeFrame.axis offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, e1_) == 32, "ScatterPartialSumTreeFrame.e1_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, e2_) == 48, "ScatterPartialSumTreeFrame.e2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, cam_forward) == 64, "ScatterPartialSumTreeFrame.cam_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, cam_right) == 80, "ScatterPartialSumTreeFrame.cam_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, cam_up) == 96, "ScatterPartialSumTreeFrame.cam_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, theta) == 112, "ScatterPartialSumTreeFrame.theta offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, medium) == 128, "ScatterPartialSumTreeFrame.medium offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, light_color) == 144, "ScatterPartialSumTreeFrame.light_color offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, light_pos) == 160, "ScatterPartialSumTreeFrame.light_pos offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, light_dir) == 176, "ScatterPartialSumTreeFrame.light_dir offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, sm_right) == 192, "ScatterPartialSumTreeFrame.sm_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, sm_up) == 208, "ScatterPartialSumTreeFrame.sm_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, sm_forward) == 224, "ScatterPartialSumTreeFrame.sm_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, sm_origin) == 240, "ScatterPartialSumTreeFrame.sm_origin offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, sm_proj) == 256, "ScatterPartialSumTreeFrame.sm_proj offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, epipole) == 272, "ScatterPartialSumTreeFrame.epipole offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, anti_epipole) == 288, "ScatterPartialSumTreeFrame.anti_epipole offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, sizes) == 304, "ScatterPartialSumTreeFrame.sizes offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, sizes2_) == 320, "ScatterPartialSumTreeFrame.sizes2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, proj) == 336, "ScatterPartialSumTreeFrame.proj offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, proj_g0_) == 352, "ScatterPartialSumTreeFrame.proj_g0_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, proj_g1_) == 368, "ScatterPartialSumTreeFrame.proj_g1_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, proj_g2_) == 384, "ScatterPartialSumTreeFrame.proj_g2_ offset");
+
 /* WGSL `Frame` of family prefiltered (scatter::epipolar), 400 bytes, alignment 16. */
 typedef struct ScatterPrefilteredFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
