@@ -29,6 +29,7 @@ use scatter_runtime::prefiltered::{FrameInput, Inputs};
 use scatter_runtime::shaderlib::Kernel;
 use scatter_runtime::shaderlib::family::{Family, FamilyVariant, KernelFamily};
 use scatter_runtime::shaderlib::minmax::MinmaxVariant;
+use scatter_runtime::shaderlib::partial_sum_tree::PartialSumTreeVariant;
 use scatter_runtime::shaderlib::prefiltered::{
     Basis, FrameSettings, LightKind, PrefilteredVariant, Resolutions, Storage,
 };
@@ -86,6 +87,12 @@ impl Method {
     /// The minmax default at the run's rectified size.
     pub fn minmax_default() -> Self {
         Family::Minmax.default_variant().into()
+    }
+
+    /// The partial-sum-tree default (rank 4, 512 slices x 256 samples) at the run's
+    /// rectified size.
+    pub fn partial_sum_tree_default() -> Self {
+        Family::PartialSumTree.default_variant().into()
     }
 
     /// Whether the family has a rectified map (its plan has the `rectified.width`
@@ -192,6 +199,7 @@ impl BenchConfig {
             methods.push(Method::from(PrefilteredVariant::with_moments(moments)));
         }
         methods.push(Method::minmax_default());
+        methods.push(Method::partial_sum_tree_default());
         BenchConfig {
             cases: SceneName::ALL
                 .iter()
@@ -229,6 +237,7 @@ impl BenchConfig {
                     ..RaymarchVariant::default()
                 }),
                 Method::minmax_default(),
+                Method::partial_sum_tree_default(),
             ],
             screen: [160, 90],
             rectified: [256, 256],
@@ -685,7 +694,13 @@ fn time_methods_on(
 /// The per-pixel variants the headline also runs sampled: every family's default and the
 /// moment basis with 4 moments.
 fn sampled_bases() -> Vec<FamilyVariant> {
-    let mut out: Vec<FamilyVariant> = Family::ALL.iter().map(|f| f.default_variant()).collect();
+    // The families with a per-pixel mode (not partial_sum_tree, which samples epipolar
+    // lines only and is timed on its own).
+    let mut out: Vec<FamilyVariant> = Family::ALL
+        .iter()
+        .map(|f| f.default_variant())
+        .filter(|v| !v.sampling().is_sampled())
+        .collect();
     out.push(PrefilteredVariant::with_moments(4).into());
     out
 }
@@ -726,7 +741,15 @@ fn sampled_variants() -> Vec<(FamilyVariant, FamilyVariant)> {
 /// The headline configuration: 1280x720, 1024x1024 rectified, on sphere, foliage and
 /// terrain; with `errors`, each run's rel L1 against the `shadow_map` truth at that size.
 fn headline_runs(ctx: &Context, frames: u32, errors: bool) -> Result<Vec<HeadlineRow>, BoxError> {
-    let mut methods = vec![Method::prefiltered_default(), Method::minmax_default()];
+    let mut methods = vec![
+        Method::prefiltered_default(),
+        Method::minmax_default(),
+        Method::partial_sum_tree_default(),
+        Method::new(
+            Family::PartialSumTree.default_variant(),
+            Some([512, 512]),
+        ),
+    ];
     for moments in PrefilteredVariant::MOMENTS {
         methods.push(Method::from(PrefilteredVariant::with_moments(moments)));
     }
@@ -994,6 +1017,8 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             ("raymarch", "n256-i1"),
             ("raymarch", "n64-i4"),
             ("minmax", "minmax"),
+            ("partial_sum_tree", "r4-ep512"),
+            ("partial_sum_tree", "r4-ep512-512x512"),
         ] {
             if let Some((t, e)) = headline_mean(family, knobs) {
                 out.push(format!(
@@ -1016,6 +1041,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             ("raymarch", "n64-i1"),
             ("raymarch", "n256-i1"),
             ("minmax", "minmax"),
+            ("partial_sum_tree", "r4-ep512"),
         ] {
             if let Some((t, e)) = headline_mean(family, knobs) {
                 out.push(format!(
@@ -1372,7 +1398,12 @@ where
         .draw_series(LineSeries::new(front.clone(), BLACK.stroke_width(1)))?
         .label("Pareto front")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK));
-    for (family, colour) in [("prefiltered", RED), ("raymarch", BLUE), ("minmax", GREEN)] {
+    for (family, colour) in [
+        ("prefiltered", RED),
+        ("raymarch", BLUE),
+        ("minmax", GREEN),
+        ("partial_sum_tree", MAGENTA),
+    ] {
         let sel: Vec<_> = v.iter().zip(&pts).filter(|(p, _)| p.0 == family).collect();
         if sel.is_empty() {
             continue;
@@ -1520,6 +1551,21 @@ pub fn tune_candidates() -> Vec<Method> {
             out.push(Method::from(base.with_sampling(knobs)));
         }
     }
+    // Issue 15: partial-sum trees (epipolar samples only): the rank, and the layout.
+    for rank in [2, 4, 8] {
+        for (slices, slice_samples) in [(256, 256), (512, 256), (1024, 512)] {
+            out.push(Method::from(PartialSumTreeVariant {
+                rank,
+                slices,
+                slice_samples,
+                ..PartialSumTreeVariant::default()
+            }));
+        }
+    }
+    out.push(Method::new(
+        PartialSumTreeVariant::default(),
+        Some([512, 512]),
+    ));
     out
 }
 

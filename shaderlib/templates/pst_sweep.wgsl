@@ -248,6 +248,32 @@ var<workgroup> by_end: array<u32, {{ sampling.slice_samples }}>;
 // How many queries are not done (V).
 var<workgroup> live: atomic<u32>;
 
+// View depth at the continuous pixel position `pc` from the 2 x 2 pixels around it, 1 / z
+// interpolated bilinearly (exact on a plane); -1 where they are not all within DEPTH_BREAK of
+// each other (a depth break).
+fn pst_footprint_depth(pc: vec2<f32>, screen: vec2<u32>) -> f32 {
+    let last = vec2<f32>(screen) - vec2<f32>(1.0, 1.0);
+    let q = clamp(pc - vec2<f32>(0.5, 0.5), vec2<f32>(0.0, 0.0), last);
+    let i0 = vec2<u32>(floor(q));
+    let i1 = min(i0 + vec2<u32>(1u, 1u), screen - vec2<u32>(1u, 1u));
+    let t = q - floor(q);
+    let z00 = textureLoad(depth, i0, 0).x;
+    let z10 = textureLoad(depth, vec2<u32>(i1.x, i0.y), 0).x;
+    let z01 = textureLoad(depth, vec2<u32>(i0.x, i1.y), 0).x;
+    let z11 = textureLoad(depth, i1, 0).x;
+    let lo = min(min(z00, z10), min(z01, z11));
+    let hi = max(max(z00, z10), max(z01, z11));
+    if !depth_close(lo, hi, DEPTH_BREAK) {
+        return -1.0;
+    }
+    if lo == hi {
+        return lo;
+    }
+    let w0 = (1.0 / z00) * (1.0 - t.x) + (1.0 / z10) * t.x;
+    let w1 = (1.0 / z01) * (1.0 - t.x) + (1.0 / z11) * t.x;
+    return 1.0 / (w0 * (1.0 - t.y) + w1 * t.y);
+}
+
 // The slice's samples pass (`sampling = epipolar`, scatter::sampling): the layout, the
 // slice's line and the zeroed fallback list as every family's samples pass writes them,
 // then every sample answered by the sweep. Writes `output` ((SLICE_SAMPLES + 1) x (SLICES
@@ -283,11 +309,22 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     let row = pst_ray(far_end, 0.0).row;
     let delta = slice_params(slices[row]).delta;
 
-    // 1. The samples: marched ones and rays without a column are written now.
+    // 1. The samples: marched ones and rays without a column are written now. A sample's ray
+    // runs through its point on the line to the depth the 2 x 2 pixels around the point give
+    // there (1 / z interpolated bilinearly: exact on a plane), not to its pixel's depth, which
+    // a ray half a pixel off the pixel's centre overshoots on a slanted wall (it lit closed
+    // rooms through their walls); where those pixels differ by more than DEPTH_BREAK (a
+    // silhouette) the sample is its pixel's ray, through the pixel's centre to its depth.
     for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
         let p = slice_sample_pixel(lines, u, span, k, screen);
         let z = textureLoad(depth, p, 0).x;
-        let r = pst_ray(lines.origin + u * (span.x + f32(k) * span.y), z);
+        let footprint = pst_footprint_depth(lines.origin + u * (span.x + f32(k) * span.y), screen);
+        var r: PstRay;
+        if footprint < 0.0 {
+            r = pst_ray(vec2<f32>(f32(p.x) + 0.5, f32(p.y) + 0.5), z);
+        } else {
+            r = pst_ray(lines.origin + u * (span.x + f32(k) * span.y), footprint);
+        }
         let n = pst_columns_crossed(r, delta);
         q_end[k] = NONE;
         if r.marched || n == 0u {

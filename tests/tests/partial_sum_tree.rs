@@ -15,7 +15,9 @@
 //! *ties*: samples whose ray depth lies within 1e-4 of a stored depth of the slice's row
 //! before its last column, whose column count `x_s` lies within 1e-3 of a whole number,
 //! whose slice's row coordinate lies within 1e-3 of a row boundary, or that are marched (a
-//! shadow-map texel test); at most 2 % of the samples may be ties. The sample depths (w)
+//! shadow-map texel test), or whose 2 x 2 depth footprint lies within 0.1 % of the depth
+//! break (the sample is then its pixel's ray on one side); at most 2 % of the samples may be
+//! ties. The sample depths (w)
 //! and the slices' lines bit for bit up to the layout's f32 ulps. The screen output (the
 //! unwarp's gather and the fallback's pixels) within the same tolerance on all but
 //! [`OUTPUT_MISMATCH_SHARE`] of the pixels (a tie sample moves its taps, and the layout's
@@ -28,7 +30,9 @@ use scatter_conformance::{Check, Fixture, compare_slices, gpu, run_trials, scene
 use scatter_reference::kernels::common_sampling::{
     EpipolarCamera, epipolar_layout, slice_direction, slice_sample_pixel, slice_span,
 };
-use scatter_reference::kernels::pst_sweep::{PstInputs, pst_columns_crossed, pst_ray};
+use scatter_reference::kernels::pst_sweep::{
+    PstInputs, pst_columns_crossed, pst_footprint_depth, pst_ray,
+};
 use scatter_reference::kernels::texture::Tex;
 use scatter_reference::kernels::{
     depth_columns, partial_sum_tree_from_rectified, rectify, slice_fit,
@@ -204,18 +208,34 @@ fn trial(
                 continue;
             }
             let p = slice_sample_pixel(&layout, u, span, k, SCREEN);
-            let r = pst_ray(&inp, spot, at(k), depth.load(p[0], p[1]));
+            let footprint = pst_footprint_depth(&inp, at(k), SCREEN, knobs.depth_break_fraction());
+            // A sample at a depth break is its pixel's ray.
+            let r = if footprint < 0.0 {
+                pst_ray(
+                    &inp,
+                    spot,
+                    [p[0] as f32 + 0.5, p[1] as f32 + 0.5],
+                    depth.load(p[0], p[1]),
+                )
+            } else {
+                pst_ray(&inp, spot, at(k), footprint)
+            };
             let n = pst_columns_crossed(f, &r, delta);
             let xs = r.xs_num / delta;
+            // The depth-break decision within 0.1 % of the break either way.
+            let db = knobs.depth_break_fraction();
+            let break_tie = (pst_footprint_depth(&inp, at(k), SCREEN, db * 0.999) < 0.0)
+                != (pst_footprint_depth(&inp, at(k), SCREEN, db * 1.001) < 0.0);
             let tie = r.marched
                 || row_tie
+                || break_tie
                 || (xs - xs.round()).abs() < 1e-3
                 || (0..n).any(|i| (r.d - rectified.load(i, row)).abs() < 1e-4);
             if tie {
                 ties += 1;
             } else {
                 bad.push(format!(
-                    "slice {s} sample {k} pixel {p:?}: gpu {g:?} cpu {c:?} (n {n}, row {row})"
+                    "slice {s} sample {k} pixel {p:?}: gpu {g:?} cpu {c:?} (n {n}, row {row}, footprint depth {footprint})"
                 ));
             }
         }

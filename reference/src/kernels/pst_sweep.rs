@@ -14,7 +14,7 @@ use super::common_model::{
     clamp, cone_falloff, max, max_u, min, phase_hg, select, transmittance_between,
 };
 use super::common_sampling::{
-    EpipolarCamera, EpipolarSamples, epipolar_layout, round_f16_rgb, slice_direction,
+    EpipolarCamera, EpipolarSamples, depth_close, epipolar_layout, round_f16_rgb, slice_direction,
     slice_sample_pixel, slice_span,
 };
 use super::texture::{Tex, TexArray, xyz};
@@ -47,6 +47,8 @@ pub struct SweepCounts {
     pub inserted: u64,
     /// Samples marched (near the epipoles) or without a column.
     pub direct: u64,
+    /// Samples at a depth break: their pixel's ray (through its centre, to its depth).
+    pub edges: u64,
 }
 
 fn v4(a: [f32; 4]) -> Vec4 {
@@ -210,6 +212,31 @@ pub fn pst_terms(inp: &PstInputs, spot: bool, r: &PstRay, row: u32, delta: f32, 
     ]
 }
 
+/// View depth at the continuous pixel position `pc` from the 2 x 2 pixels around it, `1 / z`
+/// interpolated bilinearly; -1 at a depth break (WGSL `pst_footprint_depth`).
+pub fn pst_footprint_depth(inp: &PstInputs, pc: [f32; 2], screen: [u32; 2], depth_break: f32) -> f32 {
+    let last = [screen[0] as f32 - 1.0, screen[1] as f32 - 1.0];
+    let q = [clamp(pc[0] - 0.5, 0.0, last[0]), clamp(pc[1] - 0.5, 0.0, last[1])];
+    let i0 = [q[0].floor() as u32, q[1].floor() as u32];
+    let i1 = [(i0[0] + 1).min(screen[0] - 1), (i0[1] + 1).min(screen[1] - 1)];
+    let t = [q[0] - q[0].floor(), q[1] - q[1].floor()];
+    let z00 = inp.depth.load(i0[0], i0[1]);
+    let z10 = inp.depth.load(i1[0], i0[1]);
+    let z01 = inp.depth.load(i0[0], i1[1]);
+    let z11 = inp.depth.load(i1[0], i1[1]);
+    let lo = min(min(z00, z10), min(z01, z11));
+    let hi = max(max(z00, z10), max(z01, z11));
+    if !depth_close(lo, hi, depth_break) {
+        return -1.0;
+    }
+    if lo == hi {
+        return lo;
+    }
+    let w0 = (1.0 / z00) * (1.0 - t[0]) + (1.0 / z10) * t[0];
+    let w1 = (1.0 / z01) * (1.0 - t[0]) + (1.0 / z11) * t[0];
+    1.0 / (w0 * (1.0 - t[1]) + w1 * t[1])
+}
+
 /// The fallback's per-pixel body (WGSL `pst_sweep_pixel`): the pixel's own nearest row, its
 /// lit whole columns' leaves summed in column order.
 pub fn pst_sweep_pixel(inp: &PstInputs, variant: &PartialSumTreeVariant, x: u32, y: u32) -> [f32; 3] {
@@ -260,6 +287,7 @@ pub fn pst_sweep(
     let width = f.sizes[2];
     let rv = variant.rank_vecs();
     let layout = epipolar_layout(&EpipolarCamera::of_frame(f), screen, n_slices);
+    let depth_break = knobs.depth_break_fraction();
     let lines: Vec<(Vec<[f32; 4]>, SweepCounts)> = (0..n_slices)
         .into_par_iter()
         .map(|s| {
@@ -286,7 +314,13 @@ pub fn pst_sweep(
             for k in 0..m {
                 let p = slice_sample_pixel(&layout, u, span, k, screen);
                 let z = inp.depth.load(p[0], p[1]);
-                let r = pst_ray(inp, spot, at(k), z);
+                let footprint = pst_footprint_depth(inp, at(k), screen, depth_break);
+                let r = if footprint < 0.0 {
+                    counts.edges += 1;
+                    pst_ray(inp, spot, [p[0] as f32 + 0.5, p[1] as f32 + 0.5], z)
+                } else {
+                    pst_ray(inp, spot, at(k), footprint)
+                };
                 let n = pst_columns_crossed(f, &r, delta);
                 let ku = k as usize;
                 if r.marched || n == 0 {
@@ -390,6 +424,7 @@ pub fn pst_sweep(
         counts.queries += c.queries;
         counts.inserted += c.inserted;
         counts.direct += c.direct;
+        counts.edges += c.edges;
     }
     data.push([
         layout.origin[0],
