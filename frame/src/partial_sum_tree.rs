@@ -42,8 +42,11 @@
 //! `b_i`), a column's leaf is inserted at tree position `Q - b_i`, and a query's whole
 //! columns are `i < n_q - 1` with `b_i > j_q`: the sweep inserts the columns in index order
 //! and answers each query, in order of `n_q`, by the prefix over positions below `Q - j_q`.
-//! Nothing is removed or subtracted, so no sum cancels; the tree has `Q + 1` positions
-//! (Q = samples per slice) and each step costs `log2(Q + 1)`.
+//! Nothing is removed or subtracted, so no sum cancels; the tree has `Q` positions (Q =
+//! samples per slice) and each step costs `log2 Q`. The columns are split over [`TREES`]
+//! trees filled at once (each answers the part of a query that lies in its columns); the
+//! trees are then summed into exclusive prefixes (a Fenwick tree is linear in its leaves),
+//! and each query adds the complete trees before its own.
 
 use crate::family::{Family, KnobSet};
 use crate::frame::{
@@ -67,6 +70,10 @@ pub const GRID: usize = 96;
 /// Entries (`vec4<f32>`) of the factors buffer: the header and two vec4 per node of each
 /// factor.
 pub const FACTOR_VECS: u32 = 1 + 4 * GRID as u32;
+
+/// Fenwick trees per slice that the sweep fills at once (`pst_sweep`'s step 4: each owns
+/// `ceil(Wr / TREES)` consecutive columns).
+pub const TREES: u32 = 8;
 
 /// The 2-point Gauss-Legendre node on [-1, 1] (a spot's leaves).
 pub const GL2: f32 = 0.577_350_26;

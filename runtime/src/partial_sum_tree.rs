@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 use scatter_shaderlib::Kernel;
 use scatter_shaderlib::family::KernelFamily;
 use scatter_shaderlib::partial_sum_tree::{
-    PartialSumTreeFrame, PartialSumTreeVariant, prepare_partial_sum_tree,
+    PartialSumTreeFrame, PartialSumTreeVariant, TREES, prepare_partial_sum_tree,
 };
 use scatter_shaderlib::prefiltered::{Resolutions, SliceParams, Storage};
 
@@ -131,6 +131,11 @@ impl PartialSumTree {
             * u64::from(wr)
             * u64::from(variant.rank_vecs())
             * 16;
+        let trees = u64::from(variant.slices)
+            * u64::from(TREES + 1)
+            * u64::from(variant.slice_samples)
+            * u64::from(variant.rank_vecs())
+            * 16;
         for (name, limit) in [
             (
                 "max_storage_buffer_binding_size",
@@ -142,6 +147,13 @@ impl PartialSumTree {
                 SWEEP,
                 "sweep leaves bytes (slices x rectified width x 16 per 4 ranks)",
                 leaves,
+                name,
+                limit,
+            )?;
+            check_limit(
+                SWEEP,
+                "sweep trees bytes (slices x 9 x slice samples x 16 per 4 ranks)",
+                trees,
                 name,
                 limit,
             )?;

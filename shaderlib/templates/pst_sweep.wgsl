@@ -13,8 +13,8 @@
 // lowest rank (b_i = how many d <= S_i). Inserting column i's leaf at tree position V - b_i
 // and answering a query, in order of n, after the columns 0 .. n - 2 are in, by the prefix
 // over positions below V - j sums exactly its lit whole columns: nothing is removed, no sum
-// cancels. O((W + V) log V) on one invocation; its 32 invocations first set up the samples,
-// rank them, and compute every column's b_i and leaf in parallel. Samples near the epipole
+// cancels. The columns are split over TREES trees swept at once (step 4); the slice's 32
+// invocations first set up the samples, rank them, and compute every column's b_i and leaf. Samples near the epipole
 // and the anti-epipole are ray-marched, as every epipolar family marches them.
 //
 // Bindings (group 0):
@@ -27,7 +27,7 @@
 // | 4       | rectified   | texture_2d<f32> (r32float, rectify's)   | textureLoad  |
 // | 5       | pst_factors | var<storage, read> array<vec4<f32>>     | read         |
 // | 6       | pst_leaves  | var<storage, read_write> array<vec4<f32>> (SLICES x Wr x {{ rank_vecs }}) | read_write |
-// | 7       | pst_tree    | var<storage, read_write> array<vec4<f32>> (SLICES x SLICE_SAMPLES x {{ rank_vecs }}) | read_write |
+// | 7       | pst_tree    | var<storage, read_write> array<vec4<f32>> (SLICES x (TREES + 1) x SLICE_SAMPLES x {{ rank_vecs }}) | read_write |
 // | 8       | pst_columns | var<storage, read_write> array<u32> (SLICES x Wr) | read_write |
 // | 9       | output      | texture_storage_2d<rgba32float, write> (epipolar_samples) | textureStore |
 // | 11      | fallback_count | var<storage, read_write> atomic<u32> | read_write   |
@@ -57,8 +57,10 @@
 @group(0) @binding(9) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
 {% include "include/sampled_bindings.wgsl" %}
 
-// vec4s per leaf (ceil(rank / 4)), grid nodes of the factors, the 2-point Gauss-Legendre node.
+// vec4s per leaf (ceil(rank / 4)), grid nodes of the factors, the 2-point Gauss-Legendre node,
+// and the sweep's trees per slice.
 const RANK_VECS: u32 = {{ rank_vecs }}u;
+const TREES: u32 = {{ trees }}u;
 const GRID: u32 = {{ grid }}u;
 const GL2: f32 = 0.57735026f;
 
@@ -398,19 +400,38 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     storageBarrier();
     workgroupBarrier();
 
-    // 4. The sweep, on one invocation: columns in index order, each query answered once the
-    // columns before its last are in.
-    if li == 0u {
-        let tree = s * SLICE_SAMPLES * RANK_VECS;
+    // 4. The sweep, split over TREES trees (invocation c < TREES owns the columns
+    // [c CW, (c + 1) CW), CW = ceil(Wr / TREES)): each inserts its columns in index order
+    // and answers the part of every query ending in its range that lies in its own columns
+    // (a query's whole columns end at n - 1; the query belongs to the tree of that column),
+    // then the trees are summed into exclusive prefixes over c (a Fenwick tree is linear in
+    // its leaves) and every query adds the complete trees before its own: one step per
+    // column on TREES invocations at once instead of all columns on one.
+    let cw = (width + TREES - 1u) / TREES;
+    let trees = s * (TREES + 1u) * SLICE_SAMPLES * RANK_VECS;
+    let partials = trees + TREES * SLICE_SAMPLES * RANK_VECS;
+    if li < TREES {
+        let tree = trees + li * SLICE_SAMPLES * RANK_VECS;
         for (var j = 0u; j < v * RANK_VECS; j++) {
             pst_tree[tree + j] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         }
+        let lo = li * cw;
+        let hi = select(min(lo + cw, width), width, li + 1u == TREES);
+        // The first query (in order of its end) ending at or after `lo`.
         var next = 0u;
-        for (var i = 0u; i <= width; i++) {
-            while next < v && q_end[by_end[next]] == i {
+        var top = v;
+        while next < top {
+            let mid = (next + top) / 2u;
+            if q_end[by_end[mid]] < lo {
+                next = mid + 1u;
+            } else {
+                top = mid;
+            }
+        }
+        for (var i = lo; i <= hi; i++) {
+            while next < v && q_end[by_end[next]] == i && (i < hi || li + 1u == TREES) {
                 let k = by_end[next];
                 next++;
-                var dotp = 0.0;
                 for (var h = 0u; h < RANK_VECS; h++) {
                     var p = vec4<f32>(0.0, 0.0, 0.0, 0.0);
                     var j = v - q_rank[k];
@@ -418,13 +439,10 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                         p += pst_tree[tree + (j - 1u) * RANK_VECS + h];
                         j -= j & (~j + 1u);
                     }
-                    dotp += dot(p, beta_at(q_theta[k], h));
+                    pst_tree[partials + k * RANK_VECS + h] = p;
                 }
-                let c = round_f16(f.light_color.xyz * (max(q_a[k] * dotp, 0.0) + q_b[k]));
-                let z = textureLoad(depth, slice_sample_pixel(lines, u, span, k, screen), 0).x;
-                textureStore(output, vec2<u32>(k, s), vec4<f32>(c.x, c.y, c.z, z));
             }
-            if i == width {
+            if i == hi {
                 break;
             }
             let b = pst_columns[base + i];
@@ -438,6 +456,39 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                     }
                 }
             }
+        }
+    }
+    storageBarrier();
+    workgroupBarrier();
+    // Exclusive prefix sums over the trees, entry by entry.
+    for (var x = li; x < v * RANK_VECS; x += SLICE_LANES) {
+        var running = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        for (var c = 0u; c < TREES; c++) {
+            let at = trees + c * SLICE_SAMPLES * RANK_VECS + x;
+            let own = pst_tree[at];
+            pst_tree[at] = running;
+            running += own;
+        }
+    }
+    storageBarrier();
+    workgroupBarrier();
+    // Every query: its partial sum plus the complete trees before its own.
+    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
+        if q_end[k] != NONE {
+            let tree = trees + min(q_end[k] / cw, TREES - 1u) * SLICE_SAMPLES * RANK_VECS;
+            var dotp = 0.0;
+            for (var h = 0u; h < RANK_VECS; h++) {
+                var p = pst_tree[partials + k * RANK_VECS + h];
+                var j = v - q_rank[k];
+                while j > 0u {
+                    p += pst_tree[tree + (j - 1u) * RANK_VECS + h];
+                    j -= j & (~j + 1u);
+                }
+                dotp += dot(p, beta_at(q_theta[k], h));
+            }
+            let c = round_f16(f.light_color.xyz * (max(q_a[k] * dotp, 0.0) + q_b[k]));
+            let z = textureLoad(depth, slice_sample_pixel(lines, u, span, k, screen), 0).x;
+            textureStore(output, vec2<u32>(k, s), vec4<f32>(c.x, c.y, c.z, z));
         }
     }
 }

@@ -18,7 +18,7 @@
 //! - `random::<variant>::finite`: every run succeeds, 0 NaN/Inf pixels;
 //! - `random::<variant>::{p90,max,near_black}_bar`: within the variant's row of [`BARS`];
 //! - `random::<variant>::p90_vs_raymarch`: p90 no worse than raymarch n64's (per-pixel
-//!   variants, and `partial_sum_tree` at 64 x 64 samples, step 1: it has no per-pixel
+//!   variants, and `partial_sum_tree` at 128 x 128 samples, step 1: it has no per-pixel
 //!   variant); `random::<variant>::p90_vs_per_pixel`: a sampled variant's (issue 14's
 //!   epipolar sampling, 64 x 64 samples, step 8: raymarch; every family with
 //!   `SCATTER_FULL=1`) p90 at most half a point above its family's per-pixel variant's.
@@ -91,7 +91,7 @@ const BARS: &[Bar] = &[
     ("minmax-ep64x64", 0.03, 0.07, NEAR_BLACK),
     ("prefiltered-m32-r3-ep64x64", 0.03, 0.07, NEAR_BLACK),
     ("raymarch-n64-i1-ep64x64", 0.03, 0.07, NEAR_BLACK),
-    ("partial_sum_tree-r4-ep64x64-s1", 0.03, 0.07, NEAR_BLACK),
+    ("partial_sum_tree-r4-ep128x128-s1", 0.03, 0.07, NEAR_BLACK),
 ];
 
 /// The most a sampled variant's p90 may exceed its per-pixel variant's (issue 14's bar for
@@ -105,6 +105,16 @@ const REFERENCE: &str = "raymarch-n64-i1";
 /// Trials expected to fail today, with the reason: `(trial name, why)`. The run fails when
 /// one of them starts passing: remove it then.
 const EXPECTED_FAILURES: &[(&str, &str)] = &[
+    (
+        "random::partial_sum_tree-r4-ep128x128-s1::near_black_bar",
+        "4.5e-2 of the lit maximum on random::columns::0 (the sun 13.9 deg below the horizon, \
+         looking towards it), minmax's ground tie (2.2e-2 per pixel): view rays ending on the \
+         ground, whose own light ray is blocked at the ray's end. The sweep's samples lie on \
+         the slice's line, between pixel centres, and end on the ground at the depth their \
+         2x2 pixels give; there the tie resolves lit about twice as often as at the pixels' \
+         centres (largest sample 6.0e-3, the same pixels' own rays 2.8e-3); 64 x 64 samples \
+         give 4.3e-2",
+    ),
     (
         "random::minmax-ep64x64::p90_vs_per_pixel",
         "p90 1.72 % against minmax per pixel 1.08 % (+0.64 points; raymarch n64 +0.39, \
@@ -176,9 +186,14 @@ fn variants() -> Vec<FamilyVariant> {
                     .into(),
                 ))
                 .collect(),
-            // Epipolar samples only: at this screen's layout (the sweep answers every sample).
+            // Epipolar samples only: 128 slices x 128 samples, every sample answered (the
+            // sweep's cost is per slice and column; at 64 x 64 the slices lie 5 pixels apart
+            // at the screen's edge and the unwarp spreads the ground tie of
+            // random::columns::0 to 4.3e-2 of the lit maximum, against 2.2e-2 per pixel).
             FamilyVariant::PartialSumTree(v) => vec![
                 v.with_sampling_knobs(scatter_shaderlib::sampling::SamplingKnobs {
+                    slices: 128,
+                    slice_samples: 128,
                     step: 1,
                     ..epipolar()
                 })

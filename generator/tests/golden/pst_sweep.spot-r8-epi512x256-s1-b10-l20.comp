@@ -91,6 +91,7 @@ const uint STEP = 1u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
 const uint RANK_VECS = 2u;
+const uint TREES = 8u;
 const uint GRID = 96u;
 const float GL2_ = 0.57735026;
 const uint NONE = 4294967295u;
@@ -134,8 +135,8 @@ shared uint by_end[256];
 shared uint live;
 
 
-vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p_1) {
-    vec3 q_2 = (p_1 - v.origin.xyz);
+vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p_2) {
+    vec3 q_2 = (p_2 - v.origin.xyz);
     return vec3(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
 }
 
@@ -150,35 +151,35 @@ vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_
 }
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
-    bool local_6 = false;
-    bool local_7 = false;
     bool local_8 = false;
+    bool local_9 = false;
+    bool local_10 = false;
     if (!((uv.x < 0.0))) {
-        local_6 = (uv.x > 1.0);
-    } else {
-        local_6 = true;
-    }
-    bool _e11 = local_6;
-    if (!(_e11)) {
-        local_7 = (uv.y < 0.0);
-    } else {
-        local_7 = true;
-    }
-    bool _e19 = local_7;
-    if (!(_e19)) {
-        local_8 = (uv.y > 1.0);
+        local_8 = (uv.x > 1.0);
     } else {
         local_8 = true;
     }
-    bool _e27 = local_8;
+    bool _e11 = local_8;
+    if (!(_e11)) {
+        local_9 = (uv.y < 0.0);
+    } else {
+        local_9 = true;
+    }
+    bool _e19 = local_9;
+    if (!(_e19)) {
+        local_10 = (uv.y > 1.0);
+    } else {
+        local_10 = true;
+    }
+    bool _e27 = local_10;
     if (_e27) {
         return 2.0;
     }
     uint n_3 = v_2.size.x;
-    uint x_5 = min(uint((uv.x * float(n_3))), (n_3 - 1u));
+    uint x_6 = min(uint((uv.x * float(n_3))), (n_3 - 1u));
     uint y_1 = min(uint((uv.y * float(n_3))), (n_3 - 1u));
     int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_5, y_1)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
     return _e49.x;
 }
 
@@ -194,17 +195,17 @@ float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_o
     return (v_3.forward.w * _e32);
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_2) {
-    bool local_9 = false;
-    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_2);
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_3) {
+    bool local_11 = false;
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
     float near = v_4.right.w;
     float far = v_4.up.w;
     if ((v_4.origin.w > 0.5)) {
-        local_9 = (_e2.z <= near);
+        local_11 = (_e2.z <= near);
     } else {
-        local_9 = false;
+        local_11 = false;
     }
-    bool _e16 = local_9;
+    bool _e16 = local_11;
     if (_e16) {
         return 1.0;
     }
@@ -250,11 +251,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_6 = (sigma_t * len);
-    if ((x_6 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_6)));
+    float x_7 = (sigma_t * len);
+    if ((x_7 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_7)));
     }
-    return ((1.0 - exp(-(x_6))) / sigma_t);
+    return ((1.0 - exp(-(x_7))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -266,13 +267,13 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
+    float x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_8 * x_8) * (3.0 - (2.0 * x_8)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_8 = (eye + (dir * t));
-    vec3 to_x = (x_8 - light_pos);
+    vec3 x_9 = (eye + (dir * t));
+    vec3 to_x = (x_9 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_1 = sqrt(d2_);
     vec3 travel = (to_x / vec3(d_1));
@@ -283,26 +284,26 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir,
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_1, float b_1, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
     float sum = 0.0;
-    uint k_4 = 0u;
+    uint k_5 = 0u;
     uint q_1 = 0u;
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
-    float h_8 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
-    float g0_ = atan(((a_1 - t0_) / h_8));
-    float w_1 = ((atan(((b_1 - t0_) / h_8)) - g0_) / float(panels));
+    float h_9 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float g0_ = atan(((a_1 - t0_) / h_9));
+    float w_1 = ((atan(((b_1 - t0_) / h_9)) - g0_) / float(panels));
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e73 = k_4;
-            k_4 = (_e73 + 1u);
+            uint _e73 = k_5;
+            k_5 = (_e73 + 1u);
         }
         loop_init = false;
-        uint _e30 = k_4;
+        uint _e30 = k_5;
         if ((_e30 < panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k_4;
+            uint _e32 = k_5;
             float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
             q_1 = 0u;
             bool loop_init_1 = true;
@@ -322,25 +323,25 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                     float u_1 = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     float _e52 = sum;
                     uint _e54 = q_1;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_8 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_9 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
                     sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1.0 + (u_1 * u_1))));
                 }
             }
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w_1) * h_8);
+    return (((_e75 * 0.5) * w_1) * h_9);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
     float t0_1 = dot((light_pos_2 - eye_2), dir_2);
-    float h_9 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
-    float theta_a = atan(((a_2 - t0_1) / h_9));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_9, theta_a, ((atan(((b_2 - t0_1) / h_9)) - theta_a) / float(n)));
+    float h_10 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_1) / h_10));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_10, theta_a, ((atan(((b_2 - t0_1) / h_10)) - theta_a) / float(n)));
 }
 
-vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x) {
-    float tau = tan((e.theta_a + (x * e.dtheta)));
+vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_1) {
+    float tau = tan((e.theta_a + (x_1 * e.dtheta)));
     return vec2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
@@ -364,9 +365,9 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XON
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, uvec4(f_2.sizes2_.x, 0u, 0u, 0u));
 }
 
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, sampler2D sm_3, vec3 p_3) {
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, sampler2D sm_3, vec3 p_4) {
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_3);
+    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_4);
     return _e4;
 }
 
@@ -377,30 +378,30 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_4, vec3 eye_4, vec3 dir_4, float s, bool spot) {
     float sum_1 = 0.0;
-    uint k_5 = 0u;
+    uint k_6 = 0u;
     float t_2 = 0.0;
     float w = 0.0;
     uint steps = f_5.sizes2_.y;
-    float h_10 = (s / float(steps));
+    float h_11 = (s / float(steps));
     EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, 0.0, s, steps);
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e60 = k_5;
-            k_5 = (_e60 + 1u);
+            uint _e60 = k_6;
+            k_6 = (_e60 + 1u);
         }
         loop_init_2 = false;
-        uint _e15 = k_5;
+        uint _e15 = k_6;
         if ((_e15 < steps)) {
         } else {
             break;
         }
         {
-            uint _e17 = k_5;
-            t_2 = ((float(_e17) + 0.5) * h_10);
-            w = h_10;
+            uint _e17 = k_6;
+            t_2 = ((float(_e17) + 0.5) * h_11);
+            w = h_11;
             if (spot) {
-                uint _e25 = k_5;
+                uint _e25 = k_6;
                 vec2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e25) + 0.5));
                 t_2 = _e29.x;
                 w = _e29.y;
@@ -415,9 +416,9 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
                 sum_1 = (_e38 + ((_e36 * _e39) * _e42));
             } else {
                 float _e45 = sum_1;
-                uint _e48 = k_5;
-                uint _e51 = k_5;
-                float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (float(_e48) * h_10), (float((_e51 + 1u)) * h_10));
+                uint _e48 = k_6;
+                uint _e51 = k_6;
+                float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (float(_e48) * h_11), (float((_e51 + 1u)) * h_11));
                 sum_1 = (_e45 + (_e36 * _e56));
             }
         }
@@ -432,8 +433,8 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     }
 }
 
-uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_3, uint rows, bool wrap) {
-    int ji = int(j_3);
+uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_4, uint rows, bool wrap) {
+    int ji = int(j_4);
     if (wrap) {
         return uint((((ji % int(rows)) + int(rows)) % int(rows)));
     } else {
@@ -441,23 +442,23 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_3, uint rows
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float x_1, float delta, float theta_1, float s_1, bool spot_1) {
-    bool local_10 = false;
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float x_2, float delta, float theta_1, float s_1, bool spot_1) {
+    bool local_12 = false;
     if (spot_1) {
-        float psi = (x_1 * delta);
+        float psi = (x_2 * delta);
         float den = sin((theta_1 + psi));
         if (!((den <= 1e-6))) {
-            local_10 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_12 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_10 = true;
+            local_12 = true;
         }
-        bool _e16 = local_10;
+        bool _e16 = local_12;
         if (_e16) {
             return s_1;
         }
         return min(((f_6.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_1 * delta) / max(sin(theta_1), 1e-6)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_1), 1e-6)), s_1);
     }
 }
 
@@ -466,12 +467,23 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_
     return _e15;
 }
 
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_4, float b_4, float depth_break) {
+    bool local_13 = false;
+    if (!((a_4 == b_4))) {
+        local_13 = (abs((a_4 - b_4)) <= (depth_break * min(a_4, b_4)));
+    } else {
+        local_13 = true;
+    }
+    bool _e13 = local_13;
+    return _e13;
+}
+
 vec3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec3 v_7) {
-    vec3 a_7 = min(abs(v_7), vec3(65504.0));
-    uvec3 u_2 = floatBitsToUint(a_7);
+    vec3 a_8 = min(abs(v_7), vec3(65504.0));
+    uvec3 u_2 = floatBitsToUint(a_8);
     vec3 normal = uintBitsToFloat((((u_2 + uvec3(4095u)) + ((u_2 >> uvec3(13u)) & uvec3(1u))) & uvec3(4294959104u)));
-    vec3 subnormal = (roundEven((a_7 * 16777216.0)) / vec3(16777216.0));
-    return (sign(v_7) * mix(normal, subnormal, lessThan(a_7, vec3(6.1035156e-5))));
+    vec3 subnormal = (roundEven((a_8 * 16777216.0)) / vec3(16777216.0));
+    return (sign(v_7) * mix(normal, subnormal, lessThan(a_8, vec3(6.1035156e-5))));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec2 d) {
@@ -481,12 +493,12 @@ float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec
 EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX cam, uvec2 screen, uint slices) {
     vec2 origin = vec2(0.0);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1 = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2(0.0), vec2(0.0), 0.0, 0.0, 0u);
-    bool local_11 = false;
-    bool local_12 = false;
-    bool local_13 = false;
-    float a_4 = 0.0;
-    float b_4 = 0.0;
-    uint k_6 = 0u;
+    bool local_14 = false;
+    bool local_15 = false;
+    bool local_16 = false;
+    float a_5 = 0.0;
+    float b_5 = 0.0;
+    uint k_7 = 0u;
     vec2 size_1 = vec2(screen);
     vec2 centre = (0.5 * size_1);
     float z_5 = dot(cam.toward, cam.forward);
@@ -512,25 +524,25 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     float _e79 = origin.x;
     if ((_e79 >= lo_2.x)) {
         float _e83 = origin.x;
-        local_11 = (_e83 <= hi_2.x);
+        local_14 = (_e83 <= hi_2.x);
     } else {
-        local_11 = false;
+        local_14 = false;
     }
-    bool _e89 = local_11;
+    bool _e89 = local_14;
     if (_e89) {
         float _e91 = origin.y;
-        local_12 = (_e91 >= lo_2.y);
+        local_15 = (_e91 >= lo_2.y);
     } else {
-        local_12 = false;
+        local_15 = false;
     }
-    bool _e97 = local_12;
+    bool _e97 = local_15;
     if (_e97) {
         float _e99 = origin.y;
-        local_13 = (_e99 <= hi_2.y);
+        local_16 = (_e99 <= hi_2.y);
     } else {
-        local_13 = false;
+        local_16 = false;
     }
-    bool inside = local_13;
+    bool inside = local_16;
     if (inside) {
         l_1.wrap = 1u;
         l_1.phi_start = -3.1415927;
@@ -540,38 +552,38 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
         bool loop_init_3 = true;
         while(true) {
             if (!loop_init_3) {
-                uint _e153 = k_6;
-                k_6 = (_e153 + 1u);
+                uint _e153 = k_7;
+                k_7 = (_e153 + 1u);
             }
             loop_init_3 = false;
-            uint _e118 = k_6;
+            uint _e118 = k_7;
             if ((_e118 < 4u)) {
             } else {
                 break;
             }
             {
-                uint _e123 = k_6;
-                uint _e131 = k_6;
+                uint _e123 = k_7;
+                uint _e131 = k_7;
                 vec2 corner = vec2((((_e123 & 1u) != 0u) ? hi_2.x : lo_2.x), (((_e131 & 2u) != 0u) ? hi_2.y : lo_2.y));
                 vec2 _e139 = l_1.axis;
                 vec2 _e140 = origin;
                 float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
-                uint _e143 = k_6;
+                uint _e143 = k_7;
                 if ((_e143 == 0u)) {
-                    a_4 = _e142;
-                    b_4 = _e142;
+                    a_5 = _e142;
+                    b_5 = _e142;
                 } else {
-                    float _e148 = a_4;
-                    a_4 = min(_e148, _e142);
-                    float _e150 = b_4;
-                    b_4 = max(_e150, _e142);
+                    float _e148 = a_5;
+                    a_5 = min(_e148, _e142);
+                    float _e150 = b_5;
+                    b_5 = max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_4;
+        float _e156 = a_5;
         l_1.phi_start = _e156;
-        float _e158 = b_4;
-        float _e159 = a_4;
+        float _e158 = b_5;
+        float _e159 = a_5;
         l_1.dphi = ((_e158 - _e159) / float(slices));
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l_1;
@@ -580,40 +592,40 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
 
 vec2 slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2, uint s_2) {
     float phi_1 = (l_2.phi_start + ((float(s_2) + 0.5) * l_2.dphi));
-    float c = cos(phi_1);
+    float c_1 = cos(phi_1);
     float sn = sin(phi_1);
-    return vec2(((l_2.axis.x * c) - (l_2.axis.y * sn)), ((l_2.axis.y * c) + (l_2.axis.x * sn)));
+    return vec2(((l_2.axis.x * c_1) - (l_2.axis.y * sn)), ((l_2.axis.y * c_1) + (l_2.axis.x * sn)));
 }
 
 vec2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_3, uint s_3, uvec2 screen_1, uint samples) {
     float t_in = 0.0;
     float t_out = 3.4e38;
-    uint a_5 = 0u;
+    uint a_6 = 0u;
     vec2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_3);
     vec2 lo_3 = vec2(0.5, 0.5);
     vec2 hi_3 = (vec2(screen_1) - vec2(0.5, 0.5));
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e51 = a_5;
-            a_5 = (_e51 + 1u);
+            uint _e51 = a_6;
+            a_6 = (_e51 + 1u);
         }
         loop_init_4 = false;
-        uint _e16 = a_5;
+        uint _e16 = a_6;
         if ((_e16 < 2u)) {
         } else {
             break;
         }
         {
-            uint _e19 = a_5;
+            uint _e19 = a_6;
             if ((abs(_e5[_e19]) > 1e-12)) {
-                uint _e24 = a_5;
-                uint _e27 = a_5;
-                uint _e30 = a_5;
+                uint _e24 = a_6;
+                uint _e27 = a_6;
+                uint _e30 = a_6;
                 float ta = ((lo_3[_e24] - l_3.origin[_e27]) / _e5[_e30]);
-                uint _e33 = a_5;
-                uint _e36 = a_5;
-                uint _e39 = a_5;
+                uint _e33 = a_6;
+                uint _e36 = a_6;
+                uint _e39 = a_6;
                 float tb = ((hi_3[_e33] - l_3.origin[_e36]) / _e5[_e39]);
                 float _e43 = t_in;
                 t_in = max(_e43, min(ta, tb));
@@ -631,55 +643,55 @@ vec2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_nag
     return vec2(_e56, ((_e57 - _e58) / float((samples - 1u))));
 }
 
-uvec2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_4, vec2 u, vec2 span, uint k_7, uvec2 screen_2) {
-    vec2 p_5 = (l_4.origin + (u * (span.x + (float(k_7) * span.y))));
+uvec2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_4, vec2 u, vec2 span, uint k_8, uvec2 screen_2) {
+    vec2 p_6 = (l_4.origin + (u * (span.x + (float(k_8) * span.y))));
     vec2 last = (vec2(screen_2) - vec2(1.0, 1.0));
-    return uvec2(clamp(floor(p_5), vec2(0.0, 0.0), last));
+    return uvec2(clamp(floor(p_6), vec2(0.0, 0.0), last));
 }
 
-float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, uint x_2, uint n_1, float delta_1, float theta_2, float s_4, bool spot_2) {
-    if ((x_2 >= n_1)) {
+float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, uint x_3, uint n_1, float delta_1, float theta_2, float s_4, bool spot_2) {
+    if ((x_3 >= n_1)) {
         return s_4;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, float(x_2), delta_1, theta_2, s_4, spot_2);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, float(x_3), delta_1, theta_2, s_4, spot_2);
     return _e9;
 }
 
-float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_6, float a_6, float b_5, bool spot_3) {
+float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_6, float a_7, float b_6, bool spot_3) {
     if (spot_3) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_6, b_5, max((f_9.sizes2_.z / 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_7, b_6, max((f_9.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_7, b_6);
     return _e15;
 }
 
-vec4 factor_at(uint base, float x_3, uint h_3) {
-    float p_6 = min((clamp(x_3, 0.0, 1.0) * 95.0), 95.0);
-    uint j_4 = min(uint(floor(p_6)), 94u);
-    float t_4 = (p_6 - float(j_4));
-    vec4 _e22 = _group_0_binding_5_cs[((base + (2u * j_4)) + h_3)];
-    vec4 _e34 = _group_0_binding_5_cs[((base + (2u * (j_4 + 1u))) + h_3)];
+vec4 factor_at(uint base, float x_4, uint h_4) {
+    float p_7 = min((clamp(x_4, 0.0, 1.0) * 95.0), 95.0);
+    uint j_5 = min(uint(floor(p_7)), 94u);
+    float t_4 = (p_7 - float(j_5));
+    vec4 _e22 = _group_0_binding_5_cs[((base + (2u * j_5)) + h_4)];
+    vec4 _e34 = _group_0_binding_5_cs[((base + (2u * (j_5 + 1u))) + h_4)];
     return ((_e22 * (1.0 - t_4)) + (_e34 * t_4));
 }
 
-vec4 gamma_at(float v_8, uint h_4) {
+vec4 gamma_at(float v_8, uint h_5) {
     float _e4 = _group_0_binding_5_cs[0].x;
-    vec4 _e8 = factor_at(1u, (v_8 / _e4), h_4);
+    vec4 _e8 = factor_at(1u, (v_8 / _e4), h_5);
     return _e8;
 }
 
-vec4 beta_at(float theta_3, uint h_5) {
+vec4 beta_at(float theta_3, uint h_6) {
     vec4 head = _group_0_binding_5_cs[0];
-    vec4 _e14 = factor_at(193u, ((theta_3 - head.y) / max((head.z - head.y), 1e-12)), h_5);
+    vec4 _e14 = factor_at(193u, ((theta_3 - head.y) / max((head.z - head.y), 1e-12)), h_6);
     return _e14;
 }
 
-vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint i_2, uint row_1, float delta_2, uint h_6) {
+vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint i_2, uint row_1, float delta_2, uint h_7) {
     vec4 leaf = vec4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
     if (false) {
-        vec4 _e9 = gamma_at((float(i_2) * delta_2), h_6);
+        vec4 _e9 = gamma_at((float(i_2) * delta_2), h_7);
         return _e9;
     }
     float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, row_1);
@@ -704,7 +716,7 @@ vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint i_2,
             vec3 l_5 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
             float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_10.light_dir.xyz), f_10.light_pos.w, f_10.light_dir.w);
             vec4 _e48 = leaf;
-            vec4 _e52 = gamma_at(psi_1, h_6);
+            vec4 _e52 = gamma_at(psi_1, h_7);
             leaf = (_e48 + (((0.5 * delta_2) * _e46) * _e52));
         }
     }
@@ -713,10 +725,10 @@ vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint i_2,
 }
 
 PstRay pst_ray(vec2 pc, float z_1) {
-    PstRay r = PstRay(false, vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0u, 0.0, 0.0, 0.0);
-    bool local_14 = false;
-    bool local_15 = false;
-    bool local_16 = false;
+    PstRay r_1 = PstRay(false, vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0u, 0.0, 0.0, 0.0);
+    bool local_17 = false;
+    bool local_18 = false;
+    bool local_19 = false;
     float yc = 0.0;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11 = _group_0_binding_0_cs;
     vec3 eye_7 = f_11.eye.xyz;
@@ -724,37 +736,37 @@ PstRay pst_ray(vec2 pc, float z_1) {
     float t_5 = f_11.cam_forward.w;
     vec3 dir_8 = normalize(((f_11.cam_forward.xyz + (f_11.cam_right.xyz * ((ndc.x * t_5) * f_11.cam_right.w))) + (f_11.cam_up.xyz * (ndc.y * t_5))));
     float s_5 = (min(max(z_1, 0.0), f_11.theta.z) / max(dot(dir_8, f_11.cam_forward.xyz), 1e-6));
-    r = PstRay(false, vec3(0.0, 0.0, 0.0), eye_7, dir_8, s_5, 0u, 0.0, 0.0, 0.0);
+    r_1 = PstRay(false, vec3(0.0, 0.0, 0.0), eye_7, dir_8, s_5, 0u, 0.0, 0.0, 0.0);
     vec3 px = vec3(pc, 0.0);
     float radius = f_11.epipole.w;
     if ((f_11.epipole.z > 0.5)) {
-        local_14 = (length((px - vec3(f_11.epipole.x, f_11.epipole.y, 0.0))) < radius);
+        local_17 = (length((px - vec3(f_11.epipole.x, f_11.epipole.y, 0.0))) < radius);
     } else {
-        local_14 = false;
+        local_17 = false;
     }
-    bool near_epi = local_14;
+    bool near_epi = local_17;
     if ((f_11.anti_epipole.z > 0.5)) {
-        local_15 = (length((px - vec3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0))) < radius);
+        local_18 = (length((px - vec3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0))) < radius);
     } else {
-        local_15 = false;
+        local_18 = false;
     }
-    bool near_anti = local_15;
+    bool near_anti = local_18;
     if (!(near_epi)) {
-        local_16 = near_anti;
+        local_19 = near_anti;
     } else {
-        local_16 = true;
+        local_19 = true;
     }
-    bool _e109 = local_16;
+    bool _e109 = local_19;
     if (_e109) {
-        r.marched = true;
+        r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = _group_0_binding_0_cs;
         float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, _group_0_binding_3_cs, eye_7, dir_8, s_5, true);
-        r.color = (_e117 * f_11.light_color.xyz);
+        r_1.color = (_e117 * f_11.light_color.xyz);
     }
     vec3 axis_2 = f_11.axis.xyz;
     uint rows_1 = f_11.sizes.w;
     bool wrap_1 = (f_11.anti_epipole.w > 0.5);
-    r.theta = atan(length(cross(dir_8, axis_2)), dot(dir_8, axis_2));
+    r_1.theta = atan(length(cross(dir_8, axis_2)), dot(dir_8, axis_2));
     float phi_2 = atan(dot(dir_8, f_11.e2_.xyz), dot(dir_8, f_11.e1_.xyz));
     yc = ((phi_2 - f_11.e1_.w) / f_11.e2_.w);
     if (wrap_1) {
@@ -767,58 +779,58 @@ PstRay pst_ray(vec2 pc, float z_1) {
     }
     float _e161 = yc;
     uint _e163 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e161), rows_1, wrap_1);
-    r.row = _e163;
-    float _e166 = r.theta;
+    r_1.row = _e163;
+    float _e166 = r_1.theta;
     float _e171 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e166, f_11.theta.x, f_11.theta.y);
-    r.d = _e171;
+    r_1.d = _e171;
     if (true) {
         vec3 q_5 = normalize(((eye_7 + (dir_8 * s_5)) - f_11.light_pos.xyz));
-        r.xs_num = acos(clamp(dot(q_5, -(axis_2)), -1.0, 1.0));
+        r_1.xs_num = acos(clamp(dot(q_5, -(axis_2)), -1.0, 1.0));
     } else {
-        float _e187 = r.theta;
-        r.xs_num = (s_5 * sin(_e187));
+        float _e187 = r_1.theta;
+        r_1.xs_num = (s_5 * sin(_e187));
     }
-    PstRay _e190 = r;
+    PstRay _e190 = r_1;
     return _e190;
 }
 
-uint pst_columns_crossed(PstRay r_1, float delta_3) {
-    float xs = (r_1.xs_num / delta_3);
+uint pst_columns_crossed(PstRay r_2, float delta_3) {
+    float xs = (r_2.xs_num / delta_3);
     uint _e12 = _group_0_binding_0_cs.sizes.z;
     return uint(min(ceil(((xs > 0.0) ? xs : 0.0)), float(_e12)));
 }
 
-vec2 pst_terms(PstRay r_2, uint row_2, float delta_4, uint n_2) {
+vec2 pst_terms(PstRay r_3, uint row_2, float delta_4, uint n_2) {
     float tail = 0.0;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = _group_0_binding_0_cs;
-    float sin_theta = max(sin(r_2.theta), 1e-6);
+    float sin_theta = max(sin(r_3.theta), 1e-6);
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 _e16 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((n_2 - 1u), row_2)), ivec2(0), textureSize(_group_0_binding_4_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
-    if ((r_2.d <= _e16.x)) {
-        float _e25 = edge_t(f_12, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        float _e29 = lit_span(f_12, r_2.eye, r_2.dir, _e25, r_2.s, true);
+    if ((r_3.d <= _e16.x)) {
+        float _e25 = edge_t(f_12, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
+        float _e29 = lit_span(f_12, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
         return vec2((f_12.medium.y / (f_12.axis.w * sin_theta)), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, r_2.dir)));
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, r_3.dir)));
     float sp = (f_12.medium.y * _e48);
     float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, 0.0, (delta_4 / sin_theta));
     float _e56 = tail;
     return vec2((sp * _e54), (sp * _e56));
 }
 
-vec3 pst_sweep_pixel(uint x_4, uint y) {
+vec3 pst_sweep_pixel(uint x_5, uint y) {
     float sum_2 = 0.0;
-    uint h_7 = 0u;
-    vec4 p_4 = vec4(0.0);
+    uint h_8 = 0u;
+    vec4 p_5 = vec4(0.0);
     uint i_3 = 0u;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = _group_0_binding_0_cs;
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e16 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_4, y)), ivec2(0), textureSize(_group_0_binding_2_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
-    PstRay _e18 = pst_ray(vec2((float(x_4) + 0.5), (float(y) + 0.5)), _e16.x);
+    vec4 _e16 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_5, y)), ivec2(0), textureSize(_group_0_binding_2_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
+    PstRay _e18 = pst_ray(vec2((float(x_5) + 0.5), (float(y) + 0.5)), _e16.x);
     if (_e18.marched) {
         return _e18.color;
     }
@@ -832,17 +844,17 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
     bool loop_init_6 = true;
     while(true) {
         if (!loop_init_6) {
-            uint _e77 = h_7;
-            h_7 = (_e77 + 1u);
+            uint _e77 = h_8;
+            h_8 = (_e77 + 1u);
         }
         loop_init_6 = false;
-        uint _e35 = h_7;
+        uint _e35 = h_8;
         if ((_e35 < RANK_VECS)) {
         } else {
             break;
         }
         {
-            p_4 = vec4(0.0, 0.0, 0.0, 0.0);
+            p_5 = vec4(0.0, 0.0, 0.0, 0.0);
             i_3 = 0u;
             bool loop_init_7 = true;
             while(true) {
@@ -861,17 +873,17 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
                     int _e56_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
                     vec4 _e56 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e51, _e18.row)), ivec2(0), textureSize(_group_0_binding_4_cs, _e56_clamped_lod) - ivec2(1)), _e56_clamped_lod);
                     if ((_e18.d <= _e56.x)) {
-                        vec4 _e59 = p_4;
+                        vec4 _e59 = p_5;
                         uint _e60 = i_3;
-                        uint _e62 = h_7;
+                        uint _e62 = h_8;
                         vec4 _e63 = pst_leaf(f_13, _e60, _e18.row, delta_5, _e62);
-                        p_4 = (_e59 + _e63);
+                        p_5 = (_e59 + _e63);
                     }
                 }
             }
             float _e69 = sum_2;
-            vec4 _e70 = p_4;
-            uint _e72 = h_7;
+            vec4 _e70 = p_5;
+            uint _e72 = h_8;
             vec4 _e73 = beta_at(_e18.theta, _e72);
             sum_2 = (_e69 + dot(_e70, _e73));
         }
@@ -879,6 +891,38 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
     vec2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     float _e84 = sum_2;
     return (f_13.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
+}
+
+float pst_footprint_depth(vec2 pc_1, uvec2 screen_3) {
+    vec2 last_1 = (vec2(screen_3) - vec2(1.0, 1.0));
+    vec2 q_6 = clamp((pc_1 - vec2(0.5, 0.5)), vec2(0.0, 0.0), last_1);
+    uvec2 i0_ = uvec2(floor(q_6));
+    uvec2 i1_ = min((i0_ + uvec2(1u, 1u)), (screen_3 - uvec2(1u, 1u)));
+    vec2 t_6 = (q_6 - floor(q_6));
+    int _e30_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+    vec4 _e30 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(i0_), ivec2(0), textureSize(_group_0_binding_2_cs, _e30_clamped_lod) - ivec2(1)), _e30_clamped_lod);
+    float z00_ = _e30.x;
+    int _e37_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+    vec4 _e37 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(i1_.x, i0_.y)), ivec2(0), textureSize(_group_0_binding_2_cs, _e37_clamped_lod) - ivec2(1)), _e37_clamped_lod);
+    float z10_ = _e37.x;
+    int _e44_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+    vec4 _e44 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(i0_.x, i1_.y)), ivec2(0), textureSize(_group_0_binding_2_cs, _e44_clamped_lod) - ivec2(1)), _e44_clamped_lod);
+    float z01_ = _e44.x;
+    int _e48_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+    vec4 _e48 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(i1_), ivec2(0), textureSize(_group_0_binding_2_cs, _e48_clamped_lod) - ivec2(1)), _e48_clamped_lod);
+    float z11_ = _e48.x;
+    float lo_4 = min(min(z00_, z10_), min(z01_, z11_));
+    float hi_4 = max(max(z00_, z10_), max(z01_, z11_));
+    bool _e57 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lo_4, hi_4, DEPTH_BREAK);
+    if (!(_e57)) {
+        return -1.0;
+    }
+    if ((lo_4 == hi_4)) {
+        return lo_4;
+    }
+    float w0_ = (((1.0 / z00_) * (1.0 - t_6.x)) + ((1.0 / z10_) * t_6.x));
+    float w1_ = (((1.0 / z01_) * (1.0 - t_6.x)) + ((1.0 / z11_) * t_6.x));
+    return (1.0 / ((w0_ * (1.0 - t_6.y)) + (w1_ * t_6.y)));
 }
 
 void main() {
@@ -897,6 +941,7 @@ void main() {
     uvec3 wid = gl_WorkGroupID;
     uint li = gl_LocalInvocationIndex;
     uint k = 0u;
+    PstRay r = PstRay(false, vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0u, 0.0, 0.0, 0.0);
     bool local = false;
     uint k_1 = 0u;
     uint by_d = 0u;
@@ -915,16 +960,26 @@ void main() {
     uint h = 0u;
     uint j = 0u;
     uint next = 0u;
+    uint top = 0u;
     uint i_1 = 0u;
     bool local_5 = false;
-    float dotp = 0.0;
+    bool local_6 = false;
+    bool local_7 = false;
     uint h_1 = 0u;
     vec4 p = vec4(0.0);
     uint j_1 = 0u;
     uint h_2 = 0u;
     uint j_2 = 0u;
+    uint x = 0u;
+    vec4 running = vec4(0.0);
+    uint c = 0u;
+    uint k_4 = 0u;
+    float dotp = 0.0;
+    uint h_3 = 0u;
+    vec4 p_1 = vec4(0.0);
+    uint j_3 = 0u;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = _group_0_binding_0_cs;
-    uvec2 screen_3 = uvec2(f_14.sizes.x, f_14.sizes.y);
+    uvec2 screen_4 = uvec2(f_14.sizes.x, f_14.sizes.y);
     uint width = f_14.sizes.z;
     vec4 _e12 = _group_0_binding_0_cs.cam_forward;
     vec4 _e16 = _group_0_binding_0_cs.cam_right;
@@ -932,10 +987,10 @@ void main() {
     float _e25 = _group_0_binding_0_cs.cam_forward.w;
     float _e29 = _group_0_binding_0_cs.cam_right.w;
     vec4 _e32 = _group_0_binding_0_cs.axis;
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e36 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e12.xyz, _e16.xyz, _e20.xyz, _e25, _e29, _e32.xyz), screen_3, SLICES);
+    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e36 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e12.xyz, _e16.xyz, _e20.xyz, _e25, _e29, _e32.xyz), screen_4, SLICES);
     uint s_6 = wid.x;
     vec2 _e39 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6);
-    vec2 _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6, screen_3, SLICE_SAMPLES);
+    vec2 _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6, screen_4, SLICE_SAMPLES);
     if ((li == 0u)) {
         imageStore(_group_0_binding_9_cs, ivec2(uvec2(SLICE_SAMPLES, s_6)), vec4(_e39.x, _e39.y, _e41.x, _e41.y));
         if ((s_6 == 0u)) {
@@ -954,8 +1009,8 @@ void main() {
     bool loop_init_8 = true;
     while(true) {
         if (!loop_init_8) {
-            uint _e157 = k;
-            k = (_e157 + SLICE_LANES);
+            uint _e187 = k;
+            k = (_e187 + SLICE_LANES);
         }
         loop_init_8 = false;
         uint _e91 = k;
@@ -965,38 +1020,53 @@ void main() {
         }
         {
             uint _e94 = k;
-            uvec2 _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e94, screen_3);
+            uvec2 _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e94, screen_4);
             int _e98_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
             vec4 _e98 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e95), ivec2(0), textureSize(_group_0_binding_2_cs, _e98_clamped_lod) - ivec2(1)), _e98_clamped_lod);
             float z_6 = _e98.x;
             uint _e102 = k;
-            PstRay _e109 = pst_ray((_e36.origin + (_e39 * (_e41.x + (float(_e102) * _e41.y)))), z_6);
-            uint _e110 = pst_columns_crossed(_e109, delta_6);
-            uint _e112 = k;
-            q_end[_e112] = NONE;
-            if (!(_e109.marched)) {
-                local = (_e110 == 0u);
+            float _e109 = pst_footprint_depth((_e36.origin + (_e39 * (_e41.x + (float(_e102) * _e41.y)))), screen_4);
+            r = PstRay(false, vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0u, 0.0, 0.0, 0.0);
+            if ((_e109 < 0.0)) {
+                PstRay _e123 = pst_ray(vec2((float(_e95.x) + 0.5), (float(_e95.y) + 0.5)), z_6);
+                r = _e123;
+            } else {
+                uint _e126 = k;
+                PstRay _e133 = pst_ray((_e36.origin + (_e39 * (_e41.x + (float(_e126) * _e41.y)))), _e109);
+                r = _e133;
+            }
+            PstRay _e134 = r;
+            uint _e135 = pst_columns_crossed(_e134, delta_6);
+            uint _e137 = k;
+            q_end[_e137] = NONE;
+            bool _e141 = r.marched;
+            if (!(_e141)) {
+                local = (_e135 == 0u);
             } else {
                 local = true;
             }
-            bool _e122 = local;
-            if (_e122) {
-                vec3 _e124 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e109.color);
-                uint _e125 = k;
-                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e125, s_6)), vec4(_e124.x, _e124.y, _e124.z, z_6));
+            bool _e148 = local;
+            if (_e148) {
+                vec3 _e150 = r.color;
+                vec3 _e151 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e150);
+                uint _e152 = k;
+                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e152, s_6)), vec4(_e151.x, _e151.y, _e151.z, z_6));
             } else {
-                vec2 _e132 = pst_terms(_e109, row_3, delta_6, _e110);
-                uint _e134 = k;
-                q_end[_e134] = (_e110 - 1u);
-                uint _e139 = k;
-                q_d[_e139] = _e109.d;
-                uint _e143 = k;
-                q_theta[_e143] = _e109.theta;
-                uint _e147 = k;
-                q_a[_e147] = _e132.x;
-                uint _e151 = k;
-                q_b[_e151] = _e132.y;
-                uint _e156 = atomicAdd(live, 1u);
+                PstRay _e159 = r;
+                vec2 _e160 = pst_terms(_e159, row_3, delta_6, _e135);
+                uint _e162 = k;
+                q_end[_e162] = (_e135 - 1u);
+                uint _e167 = k;
+                float _e170 = r.d;
+                q_d[_e167] = _e170;
+                uint _e172 = k;
+                float _e175 = r.theta;
+                q_theta[_e172] = _e175;
+                uint _e177 = k;
+                q_a[_e177] = _e160.x;
+                uint _e181 = k;
+                q_b[_e181] = _e160.y;
+                uint _e186 = atomicAdd(live, 1u);
             }
         }
     }
@@ -1007,95 +1077,95 @@ void main() {
     bool loop_init_9 = true;
     while(true) {
         if (!loop_init_9) {
-            uint _e268 = k_1;
-            k_1 = (_e268 + SLICE_LANES);
+            uint _e298 = k_1;
+            k_1 = (_e298 + SLICE_LANES);
         }
         loop_init_9 = false;
-        uint _e163 = k_1;
-        if ((_e163 < SLICE_SAMPLES)) {
+        uint _e193 = k_1;
+        if ((_e193 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e167 = k_1;
-            uint _e169 = q_end[_e167];
-            if ((_e169 != NONE)) {
+            uint _e197 = k_1;
+            uint _e199 = q_end[_e197];
+            if ((_e199 != NONE)) {
                 by_d = 0u;
                 by_e = 0u;
                 q = 0u;
                 bool loop_init_10 = true;
                 while(true) {
                     if (!loop_init_10) {
-                        uint _e258 = q;
-                        q = (_e258 + 1u);
+                        uint _e288 = q;
+                        q = (_e288 + 1u);
                     }
                     loop_init_10 = false;
-                    uint _e178 = q;
-                    if ((_e178 < SLICE_SAMPLES)) {
+                    uint _e208 = q;
+                    if ((_e208 < SLICE_SAMPLES)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e182 = q;
-                        uint _e184 = q_end[_e182];
-                        if ((_e184 != NONE)) {
-                            uint _e187 = by_d;
-                            uint _e189 = q;
-                            float _e191 = q_d[_e189];
-                            uint _e193 = k_1;
-                            float _e195 = q_d[_e193];
-                            if (!((_e191 < _e195))) {
-                                uint _e199 = q;
-                                float _e201 = q_d[_e199];
-                                uint _e203 = k_1;
-                                float _e205 = q_d[_e203];
-                                if ((_e201 == _e205)) {
-                                    uint _e207 = q;
-                                    uint _e208 = k_1;
-                                    local_2 = (_e207 < _e208);
+                        uint _e212 = q;
+                        uint _e214 = q_end[_e212];
+                        if ((_e214 != NONE)) {
+                            uint _e217 = by_d;
+                            uint _e219 = q;
+                            float _e221 = q_d[_e219];
+                            uint _e223 = k_1;
+                            float _e225 = q_d[_e223];
+                            if (!((_e221 < _e225))) {
+                                uint _e229 = q;
+                                float _e231 = q_d[_e229];
+                                uint _e233 = k_1;
+                                float _e235 = q_d[_e233];
+                                if ((_e231 == _e235)) {
+                                    uint _e237 = q;
+                                    uint _e238 = k_1;
+                                    local_2 = (_e237 < _e238);
                                 } else {
                                     local_2 = false;
                                 }
-                                bool _e213 = local_2;
-                                local_1 = _e213;
+                                bool _e243 = local_2;
+                                local_1 = _e243;
                             } else {
                                 local_1 = true;
                             }
-                            bool _e219 = local_1;
-                            by_d = (_e187 + (_e219 ? 1u : 0u));
-                            uint _e222 = by_e;
-                            uint _e224 = q;
-                            uint _e226 = q_end[_e224];
-                            uint _e228 = k_1;
-                            uint _e230 = q_end[_e228];
-                            if (!((_e226 < _e230))) {
-                                uint _e234 = q;
-                                uint _e236 = q_end[_e234];
-                                uint _e238 = k_1;
-                                uint _e240 = q_end[_e238];
-                                if ((_e236 == _e240)) {
-                                    uint _e242 = q;
-                                    uint _e243 = k_1;
-                                    local_4 = (_e242 < _e243);
+                            bool _e249 = local_1;
+                            by_d = (_e217 + (_e249 ? 1u : 0u));
+                            uint _e252 = by_e;
+                            uint _e254 = q;
+                            uint _e256 = q_end[_e254];
+                            uint _e258 = k_1;
+                            uint _e260 = q_end[_e258];
+                            if (!((_e256 < _e260))) {
+                                uint _e264 = q;
+                                uint _e266 = q_end[_e264];
+                                uint _e268 = k_1;
+                                uint _e270 = q_end[_e268];
+                                if ((_e266 == _e270)) {
+                                    uint _e272 = q;
+                                    uint _e273 = k_1;
+                                    local_4 = (_e272 < _e273);
                                 } else {
                                     local_4 = false;
                                 }
-                                bool _e248 = local_4;
-                                local_3 = _e248;
+                                bool _e278 = local_4;
+                                local_3 = _e278;
                             } else {
                                 local_3 = true;
                             }
-                            bool _e254 = local_3;
-                            by_e = (_e222 + (_e254 ? 1u : 0u));
+                            bool _e284 = local_3;
+                            by_e = (_e252 + (_e284 ? 1u : 0u));
                         }
                     }
                 }
-                uint _e261 = k_1;
-                uint _e263 = by_d;
-                q_rank[_e261] = _e263;
-                uint _e265 = by_e;
-                uint _e267 = k_1;
-                by_end[_e265] = _e267;
+                uint _e291 = k_1;
+                uint _e293 = by_d;
+                q_rank[_e291] = _e293;
+                uint _e295 = by_e;
+                uint _e297 = k_1;
+                by_end[_e295] = _e297;
             }
         }
     }
@@ -1105,20 +1175,20 @@ void main() {
     bool loop_init_11 = true;
     while(true) {
         if (!loop_init_11) {
-            uint _e284 = k_2;
-            k_2 = (_e284 + SLICE_LANES);
+            uint _e314 = k_2;
+            k_2 = (_e314 + SLICE_LANES);
         }
         loop_init_11 = false;
-        uint _e272 = k_2;
-        if ((_e272 < SLICE_SAMPLES)) {
+        uint _e302 = k_2;
+        if ((_e302 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e275 = k_2;
-            uint _e281 = k_2;
-            float _e283 = q_d[_e281];
-            mine[(_e275 / SLICE_LANES)] = _e283;
+            uint _e305 = k_2;
+            uint _e311 = k_2;
+            float _e313 = q_d[_e311];
+            mine[(_e305 / SLICE_LANES)] = _e313;
         }
     }
     memoryBarrierShared();
@@ -1127,24 +1197,24 @@ void main() {
     bool loop_init_12 = true;
     while(true) {
         if (!loop_init_12) {
-            uint _e308 = k_3;
-            k_3 = (_e308 + SLICE_LANES);
+            uint _e338 = k_3;
+            k_3 = (_e338 + SLICE_LANES);
         }
         loop_init_12 = false;
-        uint _e288 = k_3;
-        if ((_e288 < SLICE_SAMPLES)) {
+        uint _e318 = k_3;
+        if ((_e318 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e292 = k_3;
-            uint _e294 = q_end[_e292];
-            if ((_e294 != NONE)) {
-                uint _e299 = k_3;
-                uint _e301 = q_rank[_e299];
-                uint _e303 = k_3;
-                float _e307 = mine[(_e303 / SLICE_LANES)];
-                q_d[_e301] = _e307;
+            uint _e322 = k_3;
+            uint _e324 = q_end[_e322];
+            if ((_e324 != NONE)) {
+                uint _e329 = k_3;
+                uint _e331 = q_rank[_e329];
+                uint _e333 = k_3;
+                float _e337 = mine[(_e333 / SLICE_LANES)];
+                q_d[_e331] = _e337;
             }
         }
     }
@@ -1155,66 +1225,66 @@ void main() {
     bool loop_init_13 = true;
     while(true) {
         if (!loop_init_13) {
-            uint _e365 = i;
-            i = (_e365 + SLICE_LANES);
+            uint _e395 = i;
+            i = (_e395 + SLICE_LANES);
         }
         loop_init_13 = false;
-        uint _e313 = i;
-        if ((_e313 < width)) {
+        uint _e343 = i;
+        if ((_e343 < width)) {
         } else {
             break;
         }
         {
-            uint _e315 = i;
-            int _e319_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-            vec4 _e319 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e315, row_3)), ivec2(0), textureSize(_group_0_binding_4_cs, _e319_clamped_lod) - ivec2(1)), _e319_clamped_lod);
-            float occluder = _e319.x;
+            uint _e345 = i;
+            int _e349_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+            vec4 _e349 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e345, row_3)), ivec2(0), textureSize(_group_0_binding_4_cs, _e349_clamped_lod) - ivec2(1)), _e349_clamped_lod);
+            float occluder = _e349.x;
             lo = 0u;
             hi = v_9;
             while(true) {
-                uint _e324 = lo;
-                uint _e325 = hi;
-                if ((_e324 < _e325)) {
+                uint _e354 = lo;
+                uint _e355 = hi;
+                if ((_e354 < _e355)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e327 = lo;
-                    uint _e328 = hi;
-                    uint mid_1 = ((_e327 + _e328) / 2u);
-                    float _e334 = q_d[mid_1];
-                    if ((_e334 <= occluder)) {
+                    uint _e357 = lo;
+                    uint _e358 = hi;
+                    uint mid_1 = ((_e357 + _e358) / 2u);
+                    float _e364 = q_d[mid_1];
+                    if ((_e364 <= occluder)) {
                         lo = (mid_1 + 1u);
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            uint _e339 = i;
-            uint _e342 = lo;
-            _group_0_binding_8_cs[(base_1 + _e339)] = _e342;
-            uint _e343 = lo;
-            if ((_e343 > 0u)) {
+            uint _e369 = i;
+            uint _e372 = lo;
+            _group_0_binding_8_cs[(base_1 + _e369)] = _e372;
+            uint _e373 = lo;
+            if ((_e373 > 0u)) {
                 h = 0u;
                 bool loop_init_14 = true;
                 while(true) {
                     if (!loop_init_14) {
-                        uint _e363 = h;
-                        h = (_e363 + 1u);
+                        uint _e393 = h;
+                        h = (_e393 + 1u);
                     }
                     loop_init_14 = false;
-                    uint _e348 = h;
-                    if ((_e348 < RANK_VECS)) {
+                    uint _e378 = h;
+                    if ((_e378 < RANK_VECS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e351 = i;
-                        uint _e356 = h;
-                        uint _e359 = i;
-                        uint _e360 = h;
-                        vec4 _e361 = pst_leaf(f_14, _e359, row_3, delta_6, _e360);
-                        _group_0_binding_6_cs[(((base_1 + _e351) * RANK_VECS) + _e356)] = _e361;
+                        uint _e381 = i;
+                        uint _e386 = h;
+                        uint _e389 = i;
+                        uint _e390 = h;
+                        vec4 _e391 = pst_leaf(f_14, _e389, row_3, delta_6, _e390);
+                        _group_0_binding_6_cs[(((base_1 + _e381) * RANK_VECS) + _e386)] = _e391;
                     }
                 }
             }
@@ -1224,154 +1294,181 @@ void main() {
     barrier();
     memoryBarrierShared();
     barrier();
-    if ((li == 0u)) {
-        uint tree = ((s_6 * SLICE_SAMPLES) * RANK_VECS);
+    uint cw = (((width + TREES) - 1u) / TREES);
+    uint trees = (((s_6 * 9u) * SLICE_SAMPLES) * RANK_VECS);
+    uint partials = (trees + 4096u);
+    if ((li < TREES)) {
+        uint tree = (trees + ((li * SLICE_SAMPLES) * RANK_VECS));
         bool loop_init_15 = true;
         while(true) {
             if (!loop_init_15) {
-                uint _e389 = j;
-                j = (_e389 + 1u);
+                uint _e434 = j;
+                j = (_e434 + 1u);
             }
             loop_init_15 = false;
-            uint _e375 = j;
-            if ((_e375 < (v_9 * RANK_VECS))) {
+            uint _e420 = j;
+            if ((_e420 < (v_9 * RANK_VECS))) {
             } else {
                 break;
             }
             {
-                uint _e380 = j;
-                _group_0_binding_7_cs[(tree + _e380)] = vec4(0.0, 0.0, 0.0, 0.0);
+                uint _e425 = j;
+                _group_0_binding_7_cs[(tree + _e425)] = vec4(0.0, 0.0, 0.0, 0.0);
             }
         }
+        uint lo_5 = (li * cw);
+        uint hi_5 = (((li + 1u) == TREES) ? width : min((lo_5 + cw), width));
+        top = v_9;
+        while(true) {
+            uint _e446 = next;
+            uint _e447 = top;
+            if ((_e446 < _e447)) {
+            } else {
+                break;
+            }
+            {
+                uint _e449 = next;
+                uint _e450 = top;
+                uint mid_2 = ((_e449 + _e450) / 2u);
+                uint _e457 = by_end[mid_2];
+                uint _e459 = q_end[_e457];
+                if ((_e459 < lo_5)) {
+                    next = (mid_2 + 1u);
+                } else {
+                    top = mid_2;
+                }
+            }
+        }
+        i_1 = lo_5;
         bool loop_init_16 = true;
         while(true) {
             if (!loop_init_16) {
-                uint _e550 = i_1;
-                i_1 = (_e550 + 1u);
+                uint _e607 = i_1;
+                i_1 = (_e607 + 1u);
             }
             loop_init_16 = false;
-            uint _e392 = i_1;
-            if ((_e392 <= width)) {
+            uint _e464 = i_1;
+            if ((_e464 <= hi_5)) {
             } else {
                 break;
             }
             {
                 while(true) {
-                    uint _e395 = next;
-                    if ((_e395 < v_9)) {
-                        uint _e399 = next;
-                        uint _e401 = by_end[_e399];
-                        uint _e403 = q_end[_e401];
-                        uint _e404 = i_1;
-                        local_5 = (_e403 == _e404);
+                    uint _e466 = next;
+                    if ((_e466 < v_9)) {
+                        uint _e470 = next;
+                        uint _e472 = by_end[_e470];
+                        uint _e474 = q_end[_e472];
+                        uint _e475 = i_1;
+                        local_5 = (_e474 == _e475);
                     } else {
                         local_5 = false;
                     }
-                    bool _e409 = local_5;
-                    if (_e409) {
+                    bool _e480 = local_5;
+                    if (_e480) {
+                        uint _e481 = i_1;
+                        if (!((_e481 < hi_5))) {
+                            local_7 = ((li + 1u) == TREES);
+                        } else {
+                            local_7 = true;
+                        }
+                        bool _e491 = local_7;
+                        local_6 = _e491;
+                    } else {
+                        local_6 = false;
+                    }
+                    bool _e495 = local_6;
+                    if (_e495) {
                     } else {
                         break;
                     }
                     {
-                        uint _e411 = next;
-                        uint k_8 = by_end[_e411];
-                        uint _e415 = next;
-                        next = (_e415 + 1u);
-                        dotp = 0.0;
+                        uint _e497 = next;
+                        uint k_9 = by_end[_e497];
+                        uint _e501 = next;
+                        next = (_e501 + 1u);
                         h_1 = 0u;
                         bool loop_init_17 = true;
                         while(true) {
                             if (!loop_init_17) {
-                                uint _e469 = h_1;
-                                h_1 = (_e469 + 1u);
+                                uint _e552 = h_1;
+                                h_1 = (_e552 + 1u);
                             }
                             loop_init_17 = false;
-                            uint _e421 = h_1;
-                            if ((_e421 < RANK_VECS)) {
+                            uint _e505 = h_1;
+                            if ((_e505 < RANK_VECS)) {
                             } else {
                                 break;
                             }
                             {
                                 p = vec4(0.0, 0.0, 0.0, 0.0);
-                                uint _e432 = q_rank[k_8];
-                                j_1 = (v_9 - _e432);
+                                uint _e516 = q_rank[k_9];
+                                j_1 = (v_9 - _e516);
                                 while(true) {
-                                    uint _e435 = j_1;
-                                    if ((_e435 > 0u)) {
+                                    uint _e519 = j_1;
+                                    if ((_e519 > 0u)) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        vec4 _e438 = p;
-                                        uint _e439 = j_1;
-                                        uint _e446 = h_1;
-                                        vec4 _e449 = _group_0_binding_7_cs[((tree + ((_e439 - 1u) * RANK_VECS)) + _e446)];
-                                        p = (_e438 + _e449);
-                                        uint _e451 = j_1;
-                                        uint _e452 = j_1;
-                                        uint _e453 = j_1;
-                                        j_1 = (_e451 - (_e452 & (~(_e453) + 1u)));
+                                        vec4 _e522 = p;
+                                        uint _e523 = j_1;
+                                        uint _e530 = h_1;
+                                        vec4 _e533 = _group_0_binding_7_cs[((tree + ((_e523 - 1u) * RANK_VECS)) + _e530)];
+                                        p = (_e522 + _e533);
+                                        uint _e535 = j_1;
+                                        uint _e536 = j_1;
+                                        uint _e537 = j_1;
+                                        j_1 = (_e535 - (_e536 & (~(_e537) + 1u)));
                                     }
                                 }
-                                float _e459 = dotp;
-                                vec4 _e460 = p;
-                                float _e463 = q_theta[k_8];
-                                uint _e464 = h_1;
-                                vec4 _e465 = beta_at(_e463, _e464);
-                                dotp = (_e459 + dot(_e460, _e465));
+                                uint _e547 = h_1;
+                                vec4 _e550 = p;
+                                _group_0_binding_7_cs[((partials + (k_9 * RANK_VECS)) + _e547)] = _e550;
                             }
                         }
-                        float _e475 = q_a[k_8];
-                        float _e476 = dotp;
-                        float _e482 = q_b[k_8];
-                        vec3 _e485 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_14.light_color.xyz * (max((_e475 * _e476), 0.0) + _e482)));
-                        uvec2 _e486 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-                        int _e489_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-                        vec4 _e489 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e486), ivec2(0), textureSize(_group_0_binding_2_cs, _e489_clamped_lod) - ivec2(1)), _e489_clamped_lod);
-                        float z_7 = _e489.x;
-                        imageStore(_group_0_binding_9_cs, ivec2(uvec2(k_8, s_6)), vec4(_e485.x, _e485.y, _e485.z, z_7));
                     }
                 }
-                uint _e497 = i_1;
-                if ((_e497 == width)) {
+                uint _e554 = i_1;
+                if ((_e554 == hi_5)) {
                     break;
                 }
-                uint _e500 = i_1;
-                uint b_6 = _group_0_binding_8_cs[(base_1 + _e500)];
-                if ((b_6 > 0u)) {
+                uint _e557 = i_1;
+                uint b_7 = _group_0_binding_8_cs[(base_1 + _e557)];
+                if ((b_7 > 0u)) {
                     h_2 = 0u;
                     bool loop_init_18 = true;
                     while(true) {
                         if (!loop_init_18) {
-                            uint _e547 = h_2;
-                            h_2 = (_e547 + 1u);
+                            uint _e604 = h_2;
+                            h_2 = (_e604 + 1u);
                         }
                         loop_init_18 = false;
-                        uint _e508 = h_2;
-                        if ((_e508 < RANK_VECS)) {
+                        uint _e565 = h_2;
+                        if ((_e565 < RANK_VECS)) {
                         } else {
                             break;
                         }
                         {
-                            uint _e511 = i_1;
-                            uint _e516 = h_2;
-                            vec4 leaf_1 = _group_0_binding_6_cs[(((base_1 + _e511) * RANK_VECS) + _e516)];
-                            j_2 = ((v_9 - b_6) + 1u);
+                            uint _e568 = i_1;
+                            uint _e573 = h_2;
+                            vec4 leaf_1 = _group_0_binding_6_cs[(((base_1 + _e568) * RANK_VECS) + _e573)];
+                            j_2 = ((v_9 - b_7) + 1u);
                             while(true) {
-                                uint _e524 = j_2;
-                                if ((_e524 <= v_9)) {
+                                uint _e581 = j_2;
+                                if ((_e581 <= v_9)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    uint _e526 = j_2;
-                                    uint _e533 = h_2;
-                                    vec4 _e536 = _group_0_binding_7_cs[((tree + ((_e526 - 1u) * RANK_VECS)) + _e533)];
-                                    _group_0_binding_7_cs[((tree + ((_e526 - 1u) * RANK_VECS)) + _e533)] = (_e536 + leaf_1);
-                                    uint _e538 = j_2;
-                                    uint _e539 = j_2;
-                                    uint _e540 = j_2;
-                                    j_2 = (_e538 + (_e539 & (~(_e540) + 1u)));
+                                    uint _e583 = j_2;
+                                    uint _e590 = h_2;
+                                    vec4 _e593 = _group_0_binding_7_cs[((tree + ((_e583 - 1u) * RANK_VECS)) + _e590)];
+                                    _group_0_binding_7_cs[((tree + ((_e583 - 1u) * RANK_VECS)) + _e590)] = (_e593 + leaf_1);
+                                    uint _e595 = j_2;
+                                    uint _e596 = j_2;
+                                    uint _e597 = j_2;
+                                    j_2 = (_e595 + (_e596 & (~(_e597) + 1u)));
                                 }
                             }
                         }
@@ -1379,9 +1476,141 @@ void main() {
                 }
             }
         }
-        return;
-    } else {
-        return;
     }
+    memoryBarrierBuffer();
+    barrier();
+    memoryBarrierShared();
+    barrier();
+    x = li;
+    bool loop_init_19 = true;
+    while(true) {
+        if (!loop_init_19) {
+            uint _e644 = x;
+            x = (_e644 + SLICE_LANES);
+        }
+        loop_init_19 = false;
+        uint _e610 = x;
+        if ((_e610 < (v_9 * RANK_VECS))) {
+        } else {
+            break;
+        }
+        {
+            running = vec4(0.0, 0.0, 0.0, 0.0);
+            c = 0u;
+            bool loop_init_20 = true;
+            while(true) {
+                if (!loop_init_20) {
+                    uint _e642 = c;
+                    c = (_e642 + 1u);
+                }
+                loop_init_20 = false;
+                uint _e622 = c;
+                if ((_e622 < TREES)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e625 = c;
+                    uint _e631 = x;
+                    uint at = ((trees + ((_e625 * SLICE_SAMPLES) * RANK_VECS)) + _e631);
+                    vec4 own = _group_0_binding_7_cs[at];
+                    vec4 _e638 = running;
+                    _group_0_binding_7_cs[at] = _e638;
+                    vec4 _e639 = running;
+                    running = (_e639 + own);
+                }
+            }
+        }
+    }
+    memoryBarrierBuffer();
+    barrier();
+    memoryBarrierShared();
+    barrier();
+    k_4 = li;
+    bool loop_init_21 = true;
+    while(true) {
+        if (!loop_init_21) {
+            uint _e759 = k_4;
+            k_4 = (_e759 + SLICE_LANES);
+        }
+        loop_init_21 = false;
+        uint _e648 = k_4;
+        if ((_e648 < SLICE_SAMPLES)) {
+        } else {
+            break;
+        }
+        {
+            uint _e652 = k_4;
+            uint _e654 = q_end[_e652];
+            if ((_e654 != NONE)) {
+                uint _e658 = k_4;
+                uint _e660 = q_end[_e658];
+                uint tree_1 = (trees + ((min((_e660 / cw), 7u) * SLICE_SAMPLES) * RANK_VECS));
+                dotp = 0.0;
+                h_3 = 0u;
+                bool loop_init_22 = true;
+                while(true) {
+                    if (!loop_init_22) {
+                        uint _e727 = h_3;
+                        h_3 = (_e727 + 1u);
+                    }
+                    loop_init_22 = false;
+                    uint _e673 = h_3;
+                    if ((_e673 < RANK_VECS)) {
+                    } else {
+                        break;
+                    }
+                    {
+                        uint _e676 = k_4;
+                        uint _e681 = h_3;
+                        vec4 _e684 = _group_0_binding_7_cs[((partials + (_e676 * RANK_VECS)) + _e681)];
+                        p_1 = _e684;
+                        uint _e687 = k_4;
+                        uint _e689 = q_rank[_e687];
+                        j_3 = (v_9 - _e689);
+                        while(true) {
+                            uint _e692 = j_3;
+                            if ((_e692 > 0u)) {
+                            } else {
+                                break;
+                            }
+                            {
+                                vec4 _e695 = p_1;
+                                uint _e696 = j_3;
+                                uint _e703 = h_3;
+                                vec4 _e706 = _group_0_binding_7_cs[((tree_1 + ((_e696 - 1u) * RANK_VECS)) + _e703)];
+                                p_1 = (_e695 + _e706);
+                                uint _e708 = j_3;
+                                uint _e709 = j_3;
+                                uint _e710 = j_3;
+                                j_3 = (_e708 - (_e709 & (~(_e710) + 1u)));
+                            }
+                        }
+                        float _e716 = dotp;
+                        vec4 _e717 = p_1;
+                        uint _e719 = k_4;
+                        float _e721 = q_theta[_e719];
+                        uint _e722 = h_3;
+                        vec4 _e723 = beta_at(_e721, _e722);
+                        dotp = (_e716 + dot(_e717, _e723));
+                    }
+                }
+                uint _e732 = k_4;
+                float _e734 = q_a[_e732];
+                float _e735 = dotp;
+                uint _e740 = k_4;
+                float _e742 = q_b[_e740];
+                vec3 _e745 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_14.light_color.xyz * (max((_e734 * _e735), 0.0) + _e742)));
+                uint _e746 = k_4;
+                uvec2 _e747 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e746, screen_4);
+                int _e750_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+                vec4 _e750 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e747), ivec2(0), textureSize(_group_0_binding_2_cs, _e750_clamped_lod) - ivec2(1)), _e750_clamped_lod);
+                float z_7 = _e750.x;
+                uint _e752 = k_4;
+                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e752, s_6)), vec4(_e745.x, _e745.y, _e745.z, z_7));
+            }
+        }
+    }
+    return;
 }
 

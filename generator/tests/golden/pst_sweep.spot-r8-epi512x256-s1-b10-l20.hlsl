@@ -111,6 +111,7 @@ static const uint STEP = 1u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
 static const uint RANK_VECS = 2u;
+static const uint TREES = 8u;
 static const uint GRID = 96u;
 static const float GL2_ = 0.57735026;
 static const uint NONE = 4294967295u;
@@ -135,9 +136,9 @@ groupshared float q_b[256];
 groupshared uint by_end[256];
 groupshared uint live;
 
-float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p_1)
+float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p_2)
 {
-    float3 q_2 = (p_1 - v.origin.xyz);
+    float3 q_2 = (p_2 - v.origin.xyz);
     return float3(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
 }
 
@@ -158,35 +159,35 @@ uint naga_f2u32(float value) {
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
 {
-    bool local_6 = (bool)0;
-    bool local_7 = (bool)0;
     bool local_8 = (bool)0;
+    bool local_9 = (bool)0;
+    bool local_10 = (bool)0;
 
     if (!((uv.x < 0.0))) {
-        local_6 = (uv.x > 1.0);
-    } else {
-        local_6 = true;
-    }
-    bool _e11 = local_6;
-    if (!(_e11)) {
-        local_7 = (uv.y < 0.0);
-    } else {
-        local_7 = true;
-    }
-    bool _e19 = local_7;
-    if (!(_e19)) {
-        local_8 = (uv.y > 1.0);
+        local_8 = (uv.x > 1.0);
     } else {
         local_8 = true;
     }
-    bool _e27 = local_8;
+    bool _e11 = local_8;
+    if (!(_e11)) {
+        local_9 = (uv.y < 0.0);
+    } else {
+        local_9 = true;
+    }
+    bool _e19 = local_9;
+    if (!(_e19)) {
+        local_10 = (uv.y > 1.0);
+    } else {
+        local_10 = true;
+    }
+    bool _e27 = local_10;
     if (_e27) {
         return 2.0;
     }
     uint n_3 = v_2.size.x;
-    uint x_5 = min(naga_f2u32((uv.x * float(n_3))), (n_3 - 1u));
+    uint x_6 = min(naga_f2u32((uv.x * float(n_3))), (n_3 - 1u));
     uint y_1 = min(naga_f2u32((uv.y * float(n_3))), (n_3 - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_5, y_1), int(0)));
+    float4 _e49 = sm.Load(int3(uint2(x_6, y_1), int(0)));
     return _e49.x;
 }
 
@@ -204,19 +205,19 @@ float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_o
     return (v_3.forward.w * _e32);
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, Texture2D<float4> sm_1, float3 p_2)
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, Texture2D<float4> sm_1, float3 p_3)
 {
-    bool local_9 = (bool)0;
+    bool local_11 = (bool)0;
 
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_2);
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
     float near = v_4.right.w;
     float far = v_4.up.w;
     if ((v_4.origin.w > 0.5)) {
-        local_9 = (_e2.z <= near);
+        local_11 = (_e2.z <= near);
     } else {
-        local_9 = false;
+        local_11 = false;
     }
-    bool _e16 = local_9;
+    bool _e16 = local_11;
     if (_e16) {
         return 1.0;
     }
@@ -265,11 +266,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_6 = (sigma_t * len);
-    if ((x_6 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_6)));
+    float x_7 = (sigma_t * len);
+    if ((x_7 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_7)));
     }
-    return ((1.0 - exp(-(x_6))) / sigma_t);
+    return ((1.0 - exp(-(x_7))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -283,14 +284,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
+    float x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_8 * x_8) * (3.0 - (2.0 * x_8)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_8 = (eye + (dir * t));
-    float3 to_x = (x_8 - light_pos);
+    float3 x_9 = (eye + (dir * t));
+    float3 to_x = (x_9 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_1 = sqrt(d2_);
     float3 travel = (to_x / (d_1).xxx);
@@ -302,30 +303,30 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
 {
     float sum = 0.0;
-    uint k_4 = 0u;
+    uint k_5 = 0u;
     uint q_1 = (uint)0;
 
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
-    float h_8 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
-    float g0_ = atan(((a_1 - t0_) / h_8));
-    float w_1 = ((atan(((b_1 - t0_) / h_8)) - g0_) / float(panels));
+    float h_9 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
+    float g0_ = atan(((a_1 - t0_) / h_9));
+    float w_1 = ((atan(((b_1 - t0_) / h_9)) - g0_) / float(panels));
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
     while(true) {
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k_4;
-            k_4 = (_e73 + 1u);
+            uint _e73 = k_5;
+            k_5 = (_e73 + 1u);
         }
         loop_init = false;
-        uint _e30 = k_4;
+        uint _e30 = k_5;
         if ((_e30 < panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k_4;
+            uint _e32 = k_5;
             float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
             q_1 = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
@@ -348,14 +349,14 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
                     float u_1 = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
                     float _e52 = sum;
                     uint _e54 = q_1;
-                    const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_8 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_9 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
                     sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e54), 3u)] * _e62) * (1.0 + (u_1 * u_1))));
                 }
             }
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w_1) * h_8);
+    return (((_e75 * 0.5) * w_1) * h_9);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
@@ -370,15 +371,15 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_o
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_2, float3 dir_2, float3 light_pos_2, float a_2, float b_2, uint n)
 {
     float t0_1 = dot((light_pos_2 - eye_2), dir_2);
-    float h_9 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
-    float theta_a = atan(((a_2 - t0_1) / h_9));
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_9, theta_a, ((atan(((b_2 - t0_1) / h_9)) - theta_a) / float(n)));
+    float h_10 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_1) / h_10));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_10, theta_a, ((atan(((b_2 - t0_1) / h_10)) - theta_a) / float(n)));
     return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
 }
 
-float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x)
+float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_1)
 {
-    float tau = tan((e.theta_a + (x * e.dtheta)));
+    float tau = tan((e.theta_a + (x_1 * e.dtheta)));
     return float2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
@@ -429,10 +430,10 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XON
     return shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx;
 }
 
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, Texture2D<float4> sm_3, float3 p_3)
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, Texture2D<float4> sm_3, float3 p_4)
 {
     const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    const float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_3);
+    const float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_4);
     return _e4;
 }
 
@@ -445,12 +446,12 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, Texture2D<float4> sm_4, float3 eye_4, float3 dir_4, float s, bool spot)
 {
     float sum_1 = 0.0;
-    uint k_5 = 0u;
+    uint k_6 = 0u;
     float t_2 = (float)0;
     float w = (float)0;
 
     uint steps = f_5.sizes2_.y;
-    float h_10 = (s / float(steps));
+    float h_11 = (s / float(steps));
     const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, 0.0, s, steps);
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
@@ -458,21 +459,21 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e60 = k_5;
-            k_5 = (_e60 + 1u);
+            uint _e60 = k_6;
+            k_6 = (_e60 + 1u);
         }
         loop_init_2 = false;
-        uint _e15 = k_5;
+        uint _e15 = k_6;
         if ((_e15 < steps)) {
         } else {
             break;
         }
         {
-            uint _e17 = k_5;
-            t_2 = ((float(_e17) + 0.5) * h_10);
-            w = h_10;
+            uint _e17 = k_6;
+            t_2 = ((float(_e17) + 0.5) * h_11);
+            w = h_11;
             if (spot) {
-                uint _e25 = k_5;
+                uint _e25 = k_6;
                 const float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e25) + 0.5));
                 t_2 = _e29.x;
                 w = _e29.y;
@@ -487,9 +488,9 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
                 sum_1 = (_e38 + ((_e36 * _e39) * _e42));
             } else {
                 float _e45 = sum_1;
-                uint _e48 = k_5;
-                uint _e51 = k_5;
-                const float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (float(_e48) * h_10), (float((_e51 + 1u)) * h_10));
+                uint _e48 = k_6;
+                uint _e51 = k_6;
+                const float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (float(_e48) * h_11), (float((_e51 + 1u)) * h_11));
                 sum_1 = (_e45 + (_e36 * _e56));
             }
         }
@@ -513,9 +514,9 @@ int naga_f2i32(float value) {
     return int(clamp(value, -2147483600.0, 2147483500.0));
 }
 
-uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_3, uint rows, bool wrap)
+uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_4, uint rows, bool wrap)
 {
-    int ji = naga_f2i32(j_3);
+    int ji = naga_f2i32(j_4);
     if (wrap) {
         return uint(naga_mod(asint(asuint(naga_mod(ji, int(rows))) + asuint(int(rows))), int(rows)));
     } else {
@@ -523,25 +524,25 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_3, uint rows
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float x_1, float delta, float theta_1, float s_1, bool spot_1)
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float x_2, float delta, float theta_1, float s_1, bool spot_1)
 {
-    bool local_10 = (bool)0;
+    bool local_12 = (bool)0;
 
     if (spot_1) {
-        float psi = (x_1 * delta);
+        float psi = (x_2 * delta);
         float den = sin((theta_1 + psi));
         if (!((den <= 1e-6))) {
-            local_10 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_12 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_10 = true;
+            local_12 = true;
         }
-        bool _e16 = local_10;
+        bool _e16 = local_12;
         if (_e16) {
             return s_1;
         }
         return min(((f_6.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_1 * delta) / max(sin(theta_1), 1e-6)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_1), 1e-6)), s_1);
     }
 }
 
@@ -551,13 +552,26 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_
     return _e15;
 }
 
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_4, float b_4, float depth_break)
+{
+    bool local_13 = (bool)0;
+
+    if (!((a_4 == b_4))) {
+        local_13 = (abs((a_4 - b_4)) <= (depth_break * min(a_4, b_4)));
+    } else {
+        local_13 = true;
+    }
+    bool _e13 = local_13;
+    return _e13;
+}
+
 float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 v_7)
 {
-    float3 a_7 = min(abs(v_7), (65504.0).xxx);
-    uint3 u_2 = asuint(a_7);
+    float3 a_8 = min(abs(v_7), (65504.0).xxx);
+    uint3 u_2 = asuint(a_8);
     float3 normal = asfloat((((u_2 + (4095u).xxx) + ((u_2 >> (13u).xxx) & (1u).xxx)) & (4294959104u).xxx));
-    float3 subnormal = (round((a_7 * 16777216.0)) / (16777216.0).xxx);
-    return (sign(v_7) * ((a_7 < (6.1035156e-5).xxx) ? subnormal : normal));
+    float3 subnormal = (round((a_8 * 16777216.0)) / (16777216.0).xxx);
+    return (sign(v_7) * ((a_8 < (6.1035156e-5).xxx) ? subnormal : normal));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float2 axis, float2 d)
@@ -569,12 +583,12 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
 {
     float2 origin = (float2)0;
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1 = (EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
-    bool local_11 = (bool)0;
-    bool local_12 = (bool)0;
-    bool local_13 = (bool)0;
-    float a_4 = 0.0;
-    float b_4 = 0.0;
-    uint k_6 = 0u;
+    bool local_14 = (bool)0;
+    bool local_15 = (bool)0;
+    bool local_16 = (bool)0;
+    float a_5 = 0.0;
+    float b_5 = 0.0;
+    uint k_7 = 0u;
 
     float2 size_1 = float2(screen);
     float2 centre = (0.5 * size_1);
@@ -601,25 +615,25 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     float _e79 = origin.x;
     if ((_e79 >= lo_2.x)) {
         float _e83 = origin.x;
-        local_11 = (_e83 <= hi_2.x);
+        local_14 = (_e83 <= hi_2.x);
     } else {
-        local_11 = false;
+        local_14 = false;
     }
-    bool _e89 = local_11;
+    bool _e89 = local_14;
     if (_e89) {
         float _e91 = origin.y;
-        local_12 = (_e91 >= lo_2.y);
+        local_15 = (_e91 >= lo_2.y);
     } else {
-        local_12 = false;
+        local_15 = false;
     }
-    bool _e97 = local_12;
+    bool _e97 = local_15;
     if (_e97) {
         float _e99 = origin.y;
-        local_13 = (_e99 <= hi_2.y);
+        local_16 = (_e99 <= hi_2.y);
     } else {
-        local_13 = false;
+        local_16 = false;
     }
-    bool inside = local_13;
+    bool inside = local_16;
     if (inside) {
         l_1.wrap = 1u;
         l_1.phi_start = -3.1415927;
@@ -632,38 +646,38 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
             if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
             loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
             if (!loop_init_3) {
-                uint _e153 = k_6;
-                k_6 = (_e153 + 1u);
+                uint _e153 = k_7;
+                k_7 = (_e153 + 1u);
             }
             loop_init_3 = false;
-            uint _e118 = k_6;
+            uint _e118 = k_7;
             if ((_e118 < 4u)) {
             } else {
                 break;
             }
             {
-                uint _e123 = k_6;
-                uint _e131 = k_6;
+                uint _e123 = k_7;
+                uint _e131 = k_7;
                 float2 corner = float2((((_e123 & 1u) != 0u) ? hi_2.x : lo_2.x), (((_e131 & 2u) != 0u) ? hi_2.y : lo_2.y));
                 float2 _e139 = l_1.axis;
                 float2 _e140 = origin;
                 const float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
-                uint _e143 = k_6;
+                uint _e143 = k_7;
                 if ((_e143 == 0u)) {
-                    a_4 = _e142;
-                    b_4 = _e142;
+                    a_5 = _e142;
+                    b_5 = _e142;
                 } else {
-                    float _e148 = a_4;
-                    a_4 = min(_e148, _e142);
-                    float _e150 = b_4;
-                    b_4 = max(_e150, _e142);
+                    float _e148 = a_5;
+                    a_5 = min(_e148, _e142);
+                    float _e150 = b_5;
+                    b_5 = max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_4;
+        float _e156 = a_5;
         l_1.phi_start = _e156;
-        float _e158 = b_4;
-        float _e159 = a_4;
+        float _e158 = b_5;
+        float _e159 = a_5;
         l_1.dphi = ((_e158 - _e159) / float(slices));
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l_1;
@@ -674,16 +688,16 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
 float2 slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2, uint s_2)
 {
     float phi_1 = (l_2.phi_start + ((float(s_2) + 0.5) * l_2.dphi));
-    float c = cos(phi_1);
+    float c_1 = cos(phi_1);
     float sn = sin(phi_1);
-    return float2(((l_2.axis.x * c) - (l_2.axis.y * sn)), ((l_2.axis.y * c) + (l_2.axis.x * sn)));
+    return float2(((l_2.axis.x * c_1) - (l_2.axis.y * sn)), ((l_2.axis.y * c_1) + (l_2.axis.x * sn)));
 }
 
 float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_3, uint s_3, uint2 screen_1, uint samples)
 {
     float t_in = 0.0;
     float t_out = 3.4e38;
-    uint a_5 = 0u;
+    uint a_6 = 0u;
 
     const float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_3);
     float2 lo_3 = float2(0.5, 0.5);
@@ -694,25 +708,25 @@ float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_n
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e51 = a_5;
-            a_5 = (_e51 + 1u);
+            uint _e51 = a_6;
+            a_6 = (_e51 + 1u);
         }
         loop_init_4 = false;
-        uint _e16 = a_5;
+        uint _e16 = a_6;
         if ((_e16 < 2u)) {
         } else {
             break;
         }
         {
-            uint _e19 = a_5;
+            uint _e19 = a_6;
             if ((abs(_e5[min(uint(_e19), 1u)]) > 1e-12)) {
-                uint _e24 = a_5;
-                uint _e27 = a_5;
-                uint _e30 = a_5;
+                uint _e24 = a_6;
+                uint _e27 = a_6;
+                uint _e30 = a_6;
                 float ta = ((lo_3[min(uint(_e24), 1u)] - l_3.origin[min(uint(_e27), 1u)]) / _e5[min(uint(_e30), 1u)]);
-                uint _e33 = a_5;
-                uint _e36 = a_5;
-                uint _e39 = a_5;
+                uint _e33 = a_6;
+                uint _e36 = a_6;
+                uint _e39 = a_6;
                 float tb = ((hi_3[min(uint(_e33), 1u)] - l_3.origin[min(uint(_e36), 1u)]) / _e5[min(uint(_e39), 1u)]);
                 float _e43 = t_in;
                 t_in = max(_e43, min(ta, tb));
@@ -734,19 +748,19 @@ uint2 naga_f2u32(float2 value) {
     return uint2(clamp(value, 0.0, 4294967000.0));
 }
 
-uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_4, float2 u, float2 span, uint k_7, uint2 screen_2)
+uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_4, float2 u, float2 span, uint k_8, uint2 screen_2)
 {
-    float2 p_5 = (l_4.origin + (u * (span.x + (float(k_7) * span.y))));
+    float2 p_6 = (l_4.origin + (u * (span.x + (float(k_8) * span.y))));
     float2 last = (float2(screen_2) - float2(1.0, 1.0));
-    return naga_f2u32(clamp(floor(p_5), float2(0.0, 0.0), last));
+    return naga_f2u32(clamp(floor(p_6), float2(0.0, 0.0), last));
 }
 
-float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, uint x_2, uint n_1, float delta_1, float theta_2, float s_4, bool spot_2)
+float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, uint x_3, uint n_1, float delta_1, float theta_2, float s_4, bool spot_2)
 {
-    if ((x_2 >= n_1)) {
+    if ((x_3 >= n_1)) {
         return s_4;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, float(x_2), delta_1, theta_2, s_4, spot_2);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, float(x_3), delta_1, theta_2, s_4, spot_2);
     return _e9;
 }
 
@@ -754,47 +768,47 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_6, float a_6, float b_5, bool spot_3)
+float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_6, float a_7, float b_6, bool spot_3)
 {
     if (spot_3) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_6, b_5, max(naga_div(f_9.sizes2_.z, 4u), 1u));
+        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_7, b_6, max(naga_div(f_9.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_5);
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_7, b_6);
     return _e15;
 }
 
-float4 factor_at(uint base, float x_3, uint h_3)
+float4 factor_at(uint base, float x_4, uint h_4)
 {
-    float p_6 = min((clamp(x_3, 0.0, 1.0) * 95.0), 95.0);
-    uint j_4 = min(naga_f2u32(floor(p_6)), 94u);
-    float t_4 = (p_6 - float(j_4));
-    float4 _e22 = asfloat(pst_factors.Load4(((base + (2u * j_4)) + h_3)*16));
-    float4 _e34 = asfloat(pst_factors.Load4(((base + (2u * (j_4 + 1u))) + h_3)*16));
+    float p_7 = min((clamp(x_4, 0.0, 1.0) * 95.0), 95.0);
+    uint j_5 = min(naga_f2u32(floor(p_7)), 94u);
+    float t_4 = (p_7 - float(j_5));
+    float4 _e22 = asfloat(pst_factors.Load4(((base + (2u * j_5)) + h_4)*16));
+    float4 _e34 = asfloat(pst_factors.Load4(((base + (2u * (j_5 + 1u))) + h_4)*16));
     return ((_e22 * (1.0 - t_4)) + (_e34 * t_4));
 }
 
-float4 gamma_at(float v_8, uint h_4)
+float4 gamma_at(float v_8, uint h_5)
 {
     float _e4 = asfloat(pst_factors.Load(0+0));
-    const float4 _e8 = factor_at(1u, (v_8 / _e4), h_4);
+    const float4 _e8 = factor_at(1u, (v_8 / _e4), h_5);
     return _e8;
 }
 
-float4 beta_at(float theta_3, uint h_5)
+float4 beta_at(float theta_3, uint h_6)
 {
     float4 head = asfloat(pst_factors.Load4(0));
-    const float4 _e14 = factor_at(193u, ((theta_3 - head.y) / max((head.z - head.y), 1e-12)), h_5);
+    const float4 _e14 = factor_at(193u, ((theta_3 - head.y) / max((head.z - head.y), 1e-12)), h_6);
     return _e14;
 }
 
-float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint i_2, uint row_1, float delta_2, uint h_6)
+float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint i_2, uint row_1, float delta_2, uint h_7)
 {
     float4 leaf = float4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
 
     if (false) {
-        const float4 _e9 = gamma_at((float(i_2) * delta_2), h_6);
+        const float4 _e9 = gamma_at((float(i_2) * delta_2), h_7);
         return _e9;
     }
     const float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, row_1);
@@ -822,7 +836,7 @@ float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint i_
             float3 l_5 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
             const float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_10.light_dir.xyz), f_10.light_pos.w, f_10.light_dir.w);
             float4 _e48 = leaf;
-            const float4 _e52 = gamma_at(psi_1, h_6);
+            const float4 _e52 = gamma_at(psi_1, h_7);
             leaf = (_e48 + (((0.5 * delta_2) * _e46) * _e52));
         }
     }
@@ -846,10 +860,10 @@ PstRay ConstructPstRay(bool arg0, float3 arg1, float3 arg2, float3 arg3, float a
 
 PstRay pst_ray(float2 pc, float z_1)
 {
-    PstRay r = (PstRay)0;
-    bool local_14 = (bool)0;
-    bool local_15 = (bool)0;
-    bool local_16 = (bool)0;
+    PstRay r_1 = (PstRay)0;
+    bool local_17 = (bool)0;
+    bool local_18 = (bool)0;
+    bool local_19 = (bool)0;
     float yc = (float)0;
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11 = frame;
@@ -858,37 +872,37 @@ PstRay pst_ray(float2 pc, float z_1)
     float t_5 = f_11.cam_forward.w;
     float3 dir_8 = normalize(((f_11.cam_forward.xyz + (f_11.cam_right.xyz * ((ndc.x * t_5) * f_11.cam_right.w))) + (f_11.cam_up.xyz * (ndc.y * t_5))));
     float s_5 = (min(max(z_1, 0.0), f_11.theta.z) / max(dot(dir_8, f_11.cam_forward.xyz), 1e-6));
-    r = ConstructPstRay(false, float3(0.0, 0.0, 0.0), eye_7, dir_8, s_5, 0u, 0.0, 0.0, 0.0);
+    r_1 = ConstructPstRay(false, float3(0.0, 0.0, 0.0), eye_7, dir_8, s_5, 0u, 0.0, 0.0, 0.0);
     float3 px = float3(pc, 0.0);
     float radius = f_11.epipole.w;
     if ((f_11.epipole.z > 0.5)) {
-        local_14 = (length((px - float3(f_11.epipole.x, f_11.epipole.y, 0.0))) < radius);
+        local_17 = (length((px - float3(f_11.epipole.x, f_11.epipole.y, 0.0))) < radius);
     } else {
-        local_14 = false;
+        local_17 = false;
     }
-    bool near_epi = local_14;
+    bool near_epi = local_17;
     if ((f_11.anti_epipole.z > 0.5)) {
-        local_15 = (length((px - float3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0))) < radius);
+        local_18 = (length((px - float3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0))) < radius);
     } else {
-        local_15 = false;
+        local_18 = false;
     }
-    bool near_anti = local_15;
+    bool near_anti = local_18;
     if (!(near_epi)) {
-        local_16 = near_anti;
+        local_19 = near_anti;
     } else {
-        local_16 = true;
+        local_19 = true;
     }
-    bool _e109 = local_16;
+    bool _e109 = local_19;
     if (_e109) {
-        r.marched = true;
+        r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
         const float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_7, dir_8, s_5, true);
-        r.color = (_e117 * f_11.light_color.xyz);
+        r_1.color = (_e117 * f_11.light_color.xyz);
     }
     float3 axis_2 = f_11.axis.xyz;
     uint rows_1 = f_11.sizes.w;
     bool wrap_1 = (f_11.anti_epipole.w > 0.5);
-    r.theta = atan2(length(cross(dir_8, axis_2)), dot(dir_8, axis_2));
+    r_1.theta = atan2(length(cross(dir_8, axis_2)), dot(dir_8, axis_2));
     float phi_2 = atan2(dot(dir_8, f_11.e2_.xyz), dot(dir_8, f_11.e1_.xyz));
     yc = ((phi_2 - f_11.e1_.w) / f_11.e2_.w);
     if (wrap_1) {
@@ -901,62 +915,62 @@ PstRay pst_ray(float2 pc, float z_1)
     }
     float _e161 = yc;
     const uint _e163 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e161), rows_1, wrap_1);
-    r.row = _e163;
-    float _e166 = r.theta;
+    r_1.row = _e163;
+    float _e166 = r_1.theta;
     const float _e171 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e166, f_11.theta.x, f_11.theta.y);
-    r.d = _e171;
+    r_1.d = _e171;
     if (true) {
         float3 q_5 = normalize(((eye_7 + (dir_8 * s_5)) - f_11.light_pos.xyz));
-        r.xs_num = acos(clamp(dot(q_5, -(axis_2)), -1.0, 1.0));
+        r_1.xs_num = acos(clamp(dot(q_5, -(axis_2)), -1.0, 1.0));
     } else {
-        float _e187 = r.theta;
-        r.xs_num = (s_5 * sin(_e187));
+        float _e187 = r_1.theta;
+        r_1.xs_num = (s_5 * sin(_e187));
     }
-    PstRay _e190 = r;
+    PstRay _e190 = r_1;
     const PstRay pstray = _e190;
     return pstray;
 }
 
-uint pst_columns_crossed(PstRay r_1, float delta_3)
+uint pst_columns_crossed(PstRay r_2, float delta_3)
 {
-    float xs = (r_1.xs_num / delta_3);
+    float xs = (r_2.xs_num / delta_3);
     uint _e12 = frame.sizes.z;
     return naga_f2u32(min(ceil(((xs > 0.0) ? xs : 0.0)), float(_e12)));
 }
 
-float2 pst_terms(PstRay r_2, uint row_2, float delta_4, uint n_2)
+float2 pst_terms(PstRay r_3, uint row_2, float delta_4, uint n_2)
 {
     float tail = 0.0;
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
-    float sin_theta = max(sin(r_2.theta), 1e-6);
+    float sin_theta = max(sin(r_3.theta), 1e-6);
     float4 _e16 = rectified.Load(int3(uint2((n_2 - 1u), row_2), int(0)));
-    if ((r_2.d <= _e16.x)) {
-        const float _e25 = edge_t(f_12, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        const float _e29 = lit_span(f_12, r_2.eye, r_2.dir, _e25, r_2.s, true);
+    if ((r_3.d <= _e16.x)) {
+        const float _e25 = edge_t(f_12, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
+        const float _e29 = lit_span(f_12, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
         return float2((f_12.medium.y / (f_12.axis.w * sin_theta)), _e37);
     }
-    const float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, r_2.dir)));
+    const float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, r_3.dir)));
     float sp = (f_12.medium.y * _e48);
     const float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, 0.0, (delta_4 / sin_theta));
     float _e56 = tail;
     return float2((sp * _e54), (sp * _e56));
 }
 
-float3 pst_sweep_pixel(uint x_4, uint y)
+float3 pst_sweep_pixel(uint x_5, uint y)
 {
     float sum_2 = 0.0;
-    uint h_7 = 0u;
-    float4 p_4 = (float4)0;
+    uint h_8 = 0u;
+    float4 p_5 = (float4)0;
     uint i_3 = (uint)0;
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
-    float4 _e16 = depth.Load(int3(uint2(x_4, y), int(0)));
-    const PstRay _e18 = pst_ray(float2((float(x_4) + 0.5), (float(y) + 0.5)), _e16.x);
+    float4 _e16 = depth.Load(int3(uint2(x_5, y), int(0)));
+    const PstRay _e18 = pst_ray(float2((float(x_5) + 0.5), (float(y) + 0.5)), _e16.x);
     if (_e18.marched) {
         return _e18.color;
     }
@@ -973,17 +987,17 @@ float3 pst_sweep_pixel(uint x_4, uint y)
         if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
         if (!loop_init_6) {
-            uint _e77 = h_7;
-            h_7 = (_e77 + 1u);
+            uint _e77 = h_8;
+            h_8 = (_e77 + 1u);
         }
         loop_init_6 = false;
-        uint _e35 = h_7;
+        uint _e35 = h_8;
         if ((_e35 < RANK_VECS)) {
         } else {
             break;
         }
         {
-            p_4 = float4(0.0, 0.0, 0.0, 0.0);
+            p_5 = float4(0.0, 0.0, 0.0, 0.0);
             i_3 = 0u;
             uint2 loop_bound_7 = uint2(4294967295u, 4294967295u);
             bool loop_init_7 = true;
@@ -1004,17 +1018,17 @@ float3 pst_sweep_pixel(uint x_4, uint y)
                     uint _e51 = i_3;
                     float4 _e56 = rectified.Load(int3(uint2(_e51, _e18.row), int(0)));
                     if ((_e18.d <= _e56.x)) {
-                        float4 _e59 = p_4;
+                        float4 _e59 = p_5;
                         uint _e60 = i_3;
-                        uint _e62 = h_7;
+                        uint _e62 = h_8;
                         const float4 _e63 = pst_leaf(f_13, _e60, _e18.row, delta_5, _e62);
-                        p_4 = (_e59 + _e63);
+                        p_5 = (_e59 + _e63);
                     }
                 }
             }
             float _e69 = sum_2;
-            float4 _e70 = p_4;
-            uint _e72 = h_7;
+            float4 _e70 = p_5;
+            uint _e72 = h_8;
             const float4 _e73 = beta_at(_e18.theta, _e72);
             sum_2 = (_e69 + dot(_e70, _e73));
         }
@@ -1022,6 +1036,35 @@ float3 pst_sweep_pixel(uint x_4, uint y)
     const float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     float _e84 = sum_2;
     return (f_13.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
+}
+
+float pst_footprint_depth(float2 pc_1, uint2 screen_3)
+{
+    float2 last_1 = (float2(screen_3) - float2(1.0, 1.0));
+    float2 q_6 = clamp((pc_1 - float2(0.5, 0.5)), float2(0.0, 0.0), last_1);
+    uint2 i0_ = naga_f2u32(floor(q_6));
+    uint2 i1_ = min((i0_ + uint2(1u, 1u)), (screen_3 - uint2(1u, 1u)));
+    float2 t_6 = (q_6 - floor(q_6));
+    float4 _e30 = depth.Load(int3(i0_, int(0)));
+    float z00_ = _e30.x;
+    float4 _e37 = depth.Load(int3(uint2(i1_.x, i0_.y), int(0)));
+    float z10_ = _e37.x;
+    float4 _e44 = depth.Load(int3(uint2(i0_.x, i1_.y), int(0)));
+    float z01_ = _e44.x;
+    float4 _e48 = depth.Load(int3(i1_, int(0)));
+    float z11_ = _e48.x;
+    float lo_4 = min(min(z00_, z10_), min(z01_, z11_));
+    float hi_4 = max(max(z00_, z10_), max(z01_, z11_));
+    const bool _e57 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lo_4, hi_4, DEPTH_BREAK);
+    if (!(_e57)) {
+        return -1.0;
+    }
+    if ((lo_4 == hi_4)) {
+        return lo_4;
+    }
+    float w0_ = (((1.0 / z00_) * (1.0 - t_6.x)) + ((1.0 / z10_) * t_6.x));
+    float w1_ = (((1.0 / z01_) * (1.0 - t_6.x)) + ((1.0 / z11_) * t_6.x));
+    return (1.0 / ((w0_ * (1.0 - t_6.y)) + (w1_ * t_6.y)));
 }
 
 EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX ConstructEpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 arg0, float3 arg1, float3 arg2, float arg3, float arg4, float3 arg5) {
@@ -1033,6 +1076,10 @@ EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX ConstructEpipolarCam
     ret.aspect = arg4;
     ret.toward = arg5;
     return ret;
+}
+
+PstRay ZeroValuePstRay() {
+    return (PstRay)0;
 }
 
 [numthreads(32, 1, 1)]
@@ -1050,6 +1097,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     }
     GroupMemoryBarrierWithGroupSync();
     uint k = (uint)0;
+    PstRay r = (PstRay)0;
     bool local = (bool)0;
     uint k_1 = (uint)0;
     uint by_d = (uint)0;
@@ -1068,17 +1116,27 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     uint h = (uint)0;
     uint j = 0u;
     uint next = 0u;
-    uint i_1 = 0u;
+    uint top = (uint)0;
+    uint i_1 = (uint)0;
     bool local_5 = (bool)0;
-    float dotp = (float)0;
+    bool local_6 = (bool)0;
+    bool local_7 = (bool)0;
     uint h_1 = (uint)0;
     float4 p = (float4)0;
     uint j_1 = (uint)0;
     uint h_2 = (uint)0;
     uint j_2 = (uint)0;
+    uint x = (uint)0;
+    float4 running = (float4)0;
+    uint c = (uint)0;
+    uint k_4 = (uint)0;
+    float dotp = (float)0;
+    uint h_3 = (uint)0;
+    float4 p_1 = (float4)0;
+    uint j_3 = (uint)0;
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = frame;
-    uint2 screen_3 = uint2(f_14.sizes.x, f_14.sizes.y);
+    uint2 screen_4 = uint2(f_14.sizes.x, f_14.sizes.y);
     uint width = f_14.sizes.z;
     float4 _e12 = frame.cam_forward;
     float4 _e16 = frame.cam_right;
@@ -1086,10 +1144,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     float _e25 = frame.cam_forward.w;
     float _e29 = frame.cam_right.w;
     float4 _e32 = frame.axis;
-    const EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e36 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(ConstructEpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e12.xyz, _e16.xyz, _e20.xyz, _e25, _e29, _e32.xyz), screen_3, SLICES);
+    const EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e36 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(ConstructEpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e12.xyz, _e16.xyz, _e20.xyz, _e25, _e29, _e32.xyz), screen_4, SLICES);
     uint s_6 = wid.x;
     const float2 _e39 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6);
-    const float2 _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6, screen_3, SLICE_SAMPLES);
+    const float2 _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6, screen_4, SLICE_SAMPLES);
     if ((li == 0u)) {
         output[uint2(SLICE_SAMPLES, s_6)] = float4(_e39.x, _e39.y, _e41.x, _e41.y);
         if ((s_6 == 0u)) {
@@ -1111,8 +1169,8 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_8 == uint2(0u, 0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
         if (!loop_init_8) {
-            uint _e157 = k;
-            k = (_e157 + SLICE_LANES);
+            uint _e187 = k;
+            k = (_e187 + SLICE_LANES);
         }
         loop_init_8 = false;
         uint _e91 = k;
@@ -1122,37 +1180,52 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
         {
             uint _e94 = k;
-            const uint2 _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e94, screen_3);
+            const uint2 _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e94, screen_4);
             float4 _e98 = depth.Load(int3(_e95, int(0)));
             float z_6 = _e98.x;
             uint _e102 = k;
-            const PstRay _e109 = pst_ray((_e36.origin + (_e39 * (_e41.x + (float(_e102) * _e41.y)))), z_6);
-            const uint _e110 = pst_columns_crossed(_e109, delta_6);
-            uint _e112 = k;
-            q_end[min(uint(_e112), 255u)] = NONE;
-            if (!(_e109.marched)) {
-                local = (_e110 == 0u);
+            const float _e109 = pst_footprint_depth((_e36.origin + (_e39 * (_e41.x + (float(_e102) * _e41.y)))), screen_4);
+            r = ZeroValuePstRay();
+            if ((_e109 < 0.0)) {
+                const PstRay _e123 = pst_ray(float2((float(_e95.x) + 0.5), (float(_e95.y) + 0.5)), z_6);
+                r = _e123;
+            } else {
+                uint _e126 = k;
+                const PstRay _e133 = pst_ray((_e36.origin + (_e39 * (_e41.x + (float(_e126) * _e41.y)))), _e109);
+                r = _e133;
+            }
+            PstRay _e134 = r;
+            const uint _e135 = pst_columns_crossed(_e134, delta_6);
+            uint _e137 = k;
+            q_end[min(uint(_e137), 255u)] = NONE;
+            bool _e141 = r.marched;
+            if (!(_e141)) {
+                local = (_e135 == 0u);
             } else {
                 local = true;
             }
-            bool _e122 = local;
-            if (_e122) {
-                const float3 _e124 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e109.color);
-                uint _e125 = k;
-                output[uint2(_e125, s_6)] = float4(_e124.x, _e124.y, _e124.z, z_6);
+            bool _e148 = local;
+            if (_e148) {
+                float3 _e150 = r.color;
+                const float3 _e151 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e150);
+                uint _e152 = k;
+                output[uint2(_e152, s_6)] = float4(_e151.x, _e151.y, _e151.z, z_6);
             } else {
-                const float2 _e132 = pst_terms(_e109, row_3, delta_6, _e110);
-                uint _e134 = k;
-                q_end[min(uint(_e134), 255u)] = (_e110 - 1u);
-                uint _e139 = k;
-                q_d[min(uint(_e139), 255u)] = _e109.d;
-                uint _e143 = k;
-                q_theta[min(uint(_e143), 255u)] = _e109.theta;
-                uint _e147 = k;
-                q_a[min(uint(_e147), 255u)] = _e132.x;
-                uint _e151 = k;
-                q_b[min(uint(_e151), 255u)] = _e132.y;
-                uint _e156; InterlockedAdd(live, 1u, _e156);
+                PstRay _e159 = r;
+                const float2 _e160 = pst_terms(_e159, row_3, delta_6, _e135);
+                uint _e162 = k;
+                q_end[min(uint(_e162), 255u)] = (_e135 - 1u);
+                uint _e167 = k;
+                float _e170 = r.d;
+                q_d[min(uint(_e167), 255u)] = _e170;
+                uint _e172 = k;
+                float _e175 = r.theta;
+                q_theta[min(uint(_e172), 255u)] = _e175;
+                uint _e177 = k;
+                q_a[min(uint(_e177), 255u)] = _e160.x;
+                uint _e181 = k;
+                q_b[min(uint(_e181), 255u)] = _e160.y;
+                uint _e186; InterlockedAdd(live, 1u, _e186);
             }
         }
     }
@@ -1165,19 +1238,19 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_9 == uint2(0u, 0u))) { break; }
         loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
         if (!loop_init_9) {
-            uint _e268 = k_1;
-            k_1 = (_e268 + SLICE_LANES);
+            uint _e298 = k_1;
+            k_1 = (_e298 + SLICE_LANES);
         }
         loop_init_9 = false;
-        uint _e163 = k_1;
-        if ((_e163 < SLICE_SAMPLES)) {
+        uint _e193 = k_1;
+        if ((_e193 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e167 = k_1;
-            uint _e169 = q_end[min(uint(_e167), 255u)];
-            if ((_e169 != NONE)) {
+            uint _e197 = k_1;
+            uint _e199 = q_end[min(uint(_e197), 255u)];
+            if ((_e199 != NONE)) {
                 by_d = 0u;
                 by_e = 0u;
                 q = 0u;
@@ -1187,76 +1260,76 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     if (all(loop_bound_10 == uint2(0u, 0u))) { break; }
                     loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
                     if (!loop_init_10) {
-                        uint _e258 = q;
-                        q = (_e258 + 1u);
+                        uint _e288 = q;
+                        q = (_e288 + 1u);
                     }
                     loop_init_10 = false;
-                    uint _e178 = q;
-                    if ((_e178 < SLICE_SAMPLES)) {
+                    uint _e208 = q;
+                    if ((_e208 < SLICE_SAMPLES)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e182 = q;
-                        uint _e184 = q_end[min(uint(_e182), 255u)];
-                        if ((_e184 != NONE)) {
-                            uint _e187 = by_d;
-                            uint _e189 = q;
-                            float _e191 = q_d[min(uint(_e189), 255u)];
-                            uint _e193 = k_1;
-                            float _e195 = q_d[min(uint(_e193), 255u)];
-                            if (!((_e191 < _e195))) {
-                                uint _e199 = q;
-                                float _e201 = q_d[min(uint(_e199), 255u)];
-                                uint _e203 = k_1;
-                                float _e205 = q_d[min(uint(_e203), 255u)];
-                                if ((_e201 == _e205)) {
-                                    uint _e207 = q;
-                                    uint _e208 = k_1;
-                                    local_2 = (_e207 < _e208);
+                        uint _e212 = q;
+                        uint _e214 = q_end[min(uint(_e212), 255u)];
+                        if ((_e214 != NONE)) {
+                            uint _e217 = by_d;
+                            uint _e219 = q;
+                            float _e221 = q_d[min(uint(_e219), 255u)];
+                            uint _e223 = k_1;
+                            float _e225 = q_d[min(uint(_e223), 255u)];
+                            if (!((_e221 < _e225))) {
+                                uint _e229 = q;
+                                float _e231 = q_d[min(uint(_e229), 255u)];
+                                uint _e233 = k_1;
+                                float _e235 = q_d[min(uint(_e233), 255u)];
+                                if ((_e231 == _e235)) {
+                                    uint _e237 = q;
+                                    uint _e238 = k_1;
+                                    local_2 = (_e237 < _e238);
                                 } else {
                                     local_2 = false;
                                 }
-                                bool _e213 = local_2;
-                                local_1 = _e213;
+                                bool _e243 = local_2;
+                                local_1 = _e243;
                             } else {
                                 local_1 = true;
                             }
-                            bool _e219 = local_1;
-                            by_d = (_e187 + (_e219 ? 1u : 0u));
-                            uint _e222 = by_e;
-                            uint _e224 = q;
-                            uint _e226 = q_end[min(uint(_e224), 255u)];
-                            uint _e228 = k_1;
-                            uint _e230 = q_end[min(uint(_e228), 255u)];
-                            if (!((_e226 < _e230))) {
-                                uint _e234 = q;
-                                uint _e236 = q_end[min(uint(_e234), 255u)];
-                                uint _e238 = k_1;
-                                uint _e240 = q_end[min(uint(_e238), 255u)];
-                                if ((_e236 == _e240)) {
-                                    uint _e242 = q;
-                                    uint _e243 = k_1;
-                                    local_4 = (_e242 < _e243);
+                            bool _e249 = local_1;
+                            by_d = (_e217 + (_e249 ? 1u : 0u));
+                            uint _e252 = by_e;
+                            uint _e254 = q;
+                            uint _e256 = q_end[min(uint(_e254), 255u)];
+                            uint _e258 = k_1;
+                            uint _e260 = q_end[min(uint(_e258), 255u)];
+                            if (!((_e256 < _e260))) {
+                                uint _e264 = q;
+                                uint _e266 = q_end[min(uint(_e264), 255u)];
+                                uint _e268 = k_1;
+                                uint _e270 = q_end[min(uint(_e268), 255u)];
+                                if ((_e266 == _e270)) {
+                                    uint _e272 = q;
+                                    uint _e273 = k_1;
+                                    local_4 = (_e272 < _e273);
                                 } else {
                                     local_4 = false;
                                 }
-                                bool _e248 = local_4;
-                                local_3 = _e248;
+                                bool _e278 = local_4;
+                                local_3 = _e278;
                             } else {
                                 local_3 = true;
                             }
-                            bool _e254 = local_3;
-                            by_e = (_e222 + (_e254 ? 1u : 0u));
+                            bool _e284 = local_3;
+                            by_e = (_e252 + (_e284 ? 1u : 0u));
                         }
                     }
                 }
-                uint _e261 = k_1;
-                uint _e263 = by_d;
-                q_rank[min(uint(_e261), 255u)] = _e263;
-                uint _e265 = by_e;
-                uint _e267 = k_1;
-                by_end[min(uint(_e265), 255u)] = _e267;
+                uint _e291 = k_1;
+                uint _e293 = by_d;
+                q_rank[min(uint(_e291), 255u)] = _e293;
+                uint _e295 = by_e;
+                uint _e297 = k_1;
+                by_end[min(uint(_e295), 255u)] = _e297;
             }
         }
     }
@@ -1268,20 +1341,20 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_11 == uint2(0u, 0u))) { break; }
         loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
         if (!loop_init_11) {
-            uint _e284 = k_2;
-            k_2 = (_e284 + SLICE_LANES);
+            uint _e314 = k_2;
+            k_2 = (_e314 + SLICE_LANES);
         }
         loop_init_11 = false;
-        uint _e272 = k_2;
-        if ((_e272 < SLICE_SAMPLES)) {
+        uint _e302 = k_2;
+        if ((_e302 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e275 = k_2;
-            uint _e281 = k_2;
-            float _e283 = q_d[min(uint(_e281), 255u)];
-            mine[min(uint(naga_div(_e275, SLICE_LANES)), 7u)] = _e283;
+            uint _e305 = k_2;
+            uint _e311 = k_2;
+            float _e313 = q_d[min(uint(_e311), 255u)];
+            mine[min(uint(naga_div(_e305, SLICE_LANES)), 7u)] = _e313;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -1292,24 +1365,24 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_12 == uint2(0u, 0u))) { break; }
         loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
         if (!loop_init_12) {
-            uint _e308 = k_3;
-            k_3 = (_e308 + SLICE_LANES);
+            uint _e338 = k_3;
+            k_3 = (_e338 + SLICE_LANES);
         }
         loop_init_12 = false;
-        uint _e288 = k_3;
-        if ((_e288 < SLICE_SAMPLES)) {
+        uint _e318 = k_3;
+        if ((_e318 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e292 = k_3;
-            uint _e294 = q_end[min(uint(_e292), 255u)];
-            if ((_e294 != NONE)) {
-                uint _e299 = k_3;
-                uint _e301 = q_rank[min(uint(_e299), 255u)];
-                uint _e303 = k_3;
-                float _e307 = mine[min(uint(naga_div(_e303, SLICE_LANES)), 7u)];
-                q_d[min(uint(_e301), 255u)] = _e307;
+            uint _e322 = k_3;
+            uint _e324 = q_end[min(uint(_e322), 255u)];
+            if ((_e324 != NONE)) {
+                uint _e329 = k_3;
+                uint _e331 = q_rank[min(uint(_e329), 255u)];
+                uint _e333 = k_3;
+                float _e337 = mine[min(uint(naga_div(_e333, SLICE_LANES)), 7u)];
+                q_d[min(uint(_e331), 255u)] = _e337;
             }
         }
     }
@@ -1322,48 +1395,48 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_13 == uint2(0u, 0u))) { break; }
         loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
         if (!loop_init_13) {
-            uint _e365 = i;
-            i = (_e365 + SLICE_LANES);
+            uint _e395 = i;
+            i = (_e395 + SLICE_LANES);
         }
         loop_init_13 = false;
-        uint _e313 = i;
-        if ((_e313 < width)) {
+        uint _e343 = i;
+        if ((_e343 < width)) {
         } else {
             break;
         }
         {
-            uint _e315 = i;
-            float4 _e319 = rectified.Load(int3(uint2(_e315, row_3), int(0)));
-            float occluder = _e319.x;
+            uint _e345 = i;
+            float4 _e349 = rectified.Load(int3(uint2(_e345, row_3), int(0)));
+            float occluder = _e349.x;
             lo = 0u;
             hi = v_9;
             uint2 loop_bound_14 = uint2(4294967295u, 4294967295u);
             while(true) {
                 if (all(loop_bound_14 == uint2(0u, 0u))) { break; }
                 loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
-                uint _e324 = lo;
-                uint _e325 = hi;
-                if ((_e324 < _e325)) {
+                uint _e354 = lo;
+                uint _e355 = hi;
+                if ((_e354 < _e355)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e327 = lo;
-                    uint _e328 = hi;
-                    uint mid_1 = naga_div((_e327 + _e328), 2u);
-                    float _e334 = q_d[min(uint(mid_1), 255u)];
-                    if ((_e334 <= occluder)) {
+                    uint _e357 = lo;
+                    uint _e358 = hi;
+                    uint mid_1 = naga_div((_e357 + _e358), 2u);
+                    float _e364 = q_d[min(uint(mid_1), 255u)];
+                    if ((_e364 <= occluder)) {
                         lo = (mid_1 + 1u);
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            uint _e339 = i;
-            uint _e342 = lo;
-            pst_columns.Store((base_1 + _e339)*4, asuint(_e342));
-            uint _e343 = lo;
-            if ((_e343 > 0u)) {
+            uint _e369 = i;
+            uint _e372 = lo;
+            pst_columns.Store((base_1 + _e369)*4, asuint(_e372));
+            uint _e373 = lo;
+            if ((_e373 > 0u)) {
                 h = 0u;
                 uint2 loop_bound_15 = uint2(4294967295u, 4294967295u);
                 bool loop_init_14 = true;
@@ -1371,22 +1444,22 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     if (all(loop_bound_15 == uint2(0u, 0u))) { break; }
                     loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
                     if (!loop_init_14) {
-                        uint _e363 = h;
-                        h = (_e363 + 1u);
+                        uint _e393 = h;
+                        h = (_e393 + 1u);
                     }
                     loop_init_14 = false;
-                    uint _e348 = h;
-                    if ((_e348 < RANK_VECS)) {
+                    uint _e378 = h;
+                    if ((_e378 < RANK_VECS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e351 = i;
-                        uint _e356 = h;
-                        uint _e359 = i;
-                        uint _e360 = h;
-                        const float4 _e361 = pst_leaf(f_14, _e359, row_3, delta_6, _e360);
-                        pst_leaves.Store4((((base_1 + _e351) * RANK_VECS) + _e356)*16, asuint(_e361));
+                        uint _e381 = i;
+                        uint _e386 = h;
+                        uint _e389 = i;
+                        uint _e390 = h;
+                        const float4 _e391 = pst_leaf(f_14, _e389, row_3, delta_6, _e390);
+                        pst_leaves.Store4((((base_1 + _e381) * RANK_VECS) + _e386)*16, asuint(_e391));
                     }
                 }
             }
@@ -1394,174 +1467,205 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     }
     DeviceMemoryBarrierWithGroupSync();
     GroupMemoryBarrierWithGroupSync();
-    if ((li == 0u)) {
-        uint tree = ((s_6 * SLICE_SAMPLES) * RANK_VECS);
+    uint cw = naga_div(((width + TREES) - 1u), TREES);
+    uint trees = (((s_6 * 9u) * SLICE_SAMPLES) * RANK_VECS);
+    uint partials = (trees + 4096u);
+    if ((li < TREES)) {
+        uint tree = (trees + ((li * SLICE_SAMPLES) * RANK_VECS));
         uint2 loop_bound_16 = uint2(4294967295u, 4294967295u);
         bool loop_init_15 = true;
         while(true) {
             if (all(loop_bound_16 == uint2(0u, 0u))) { break; }
             loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
             if (!loop_init_15) {
-                uint _e389 = j;
-                j = (_e389 + 1u);
+                uint _e434 = j;
+                j = (_e434 + 1u);
             }
             loop_init_15 = false;
-            uint _e375 = j;
-            if ((_e375 < (v_9 * RANK_VECS))) {
+            uint _e420 = j;
+            if ((_e420 < (v_9 * RANK_VECS))) {
             } else {
                 break;
             }
             {
-                uint _e380 = j;
-                pst_tree.Store4((tree + _e380)*16, asuint(float4(0.0, 0.0, 0.0, 0.0)));
+                uint _e425 = j;
+                pst_tree.Store4((tree + _e425)*16, asuint(float4(0.0, 0.0, 0.0, 0.0)));
             }
         }
+        uint lo_5 = (li * cw);
+        uint hi_5 = (((li + 1u) == TREES) ? width : min((lo_5 + cw), width));
+        top = v_9;
         uint2 loop_bound_17 = uint2(4294967295u, 4294967295u);
-        bool loop_init_16 = true;
         while(true) {
             if (all(loop_bound_17 == uint2(0u, 0u))) { break; }
             loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
-            if (!loop_init_16) {
-                uint _e550 = i_1;
-                i_1 = (_e550 + 1u);
-            }
-            loop_init_16 = false;
-            uint _e392 = i_1;
-            if ((_e392 <= width)) {
+            uint _e446 = next;
+            uint _e447 = top;
+            if ((_e446 < _e447)) {
             } else {
                 break;
             }
             {
-                uint2 loop_bound_18 = uint2(4294967295u, 4294967295u);
+                uint _e449 = next;
+                uint _e450 = top;
+                uint mid_2 = naga_div((_e449 + _e450), 2u);
+                uint _e457 = by_end[min(uint(mid_2), 255u)];
+                uint _e459 = q_end[min(uint(_e457), 255u)];
+                if ((_e459 < lo_5)) {
+                    next = (mid_2 + 1u);
+                } else {
+                    top = mid_2;
+                }
+            }
+        }
+        i_1 = lo_5;
+        uint2 loop_bound_18 = uint2(4294967295u, 4294967295u);
+        bool loop_init_16 = true;
+        while(true) {
+            if (all(loop_bound_18 == uint2(0u, 0u))) { break; }
+            loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
+            if (!loop_init_16) {
+                uint _e607 = i_1;
+                i_1 = (_e607 + 1u);
+            }
+            loop_init_16 = false;
+            uint _e464 = i_1;
+            if ((_e464 <= hi_5)) {
+            } else {
+                break;
+            }
+            {
+                uint2 loop_bound_19 = uint2(4294967295u, 4294967295u);
                 while(true) {
-                    if (all(loop_bound_18 == uint2(0u, 0u))) { break; }
-                    loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
-                    uint _e395 = next;
-                    if ((_e395 < v_9)) {
-                        uint _e399 = next;
-                        uint _e401 = by_end[min(uint(_e399), 255u)];
-                        uint _e403 = q_end[min(uint(_e401), 255u)];
-                        uint _e404 = i_1;
-                        local_5 = (_e403 == _e404);
+                    if (all(loop_bound_19 == uint2(0u, 0u))) { break; }
+                    loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
+                    uint _e466 = next;
+                    if ((_e466 < v_9)) {
+                        uint _e470 = next;
+                        uint _e472 = by_end[min(uint(_e470), 255u)];
+                        uint _e474 = q_end[min(uint(_e472), 255u)];
+                        uint _e475 = i_1;
+                        local_5 = (_e474 == _e475);
                     } else {
                         local_5 = false;
                     }
-                    bool _e409 = local_5;
-                    if (_e409) {
+                    bool _e480 = local_5;
+                    if (_e480) {
+                        uint _e481 = i_1;
+                        if (!((_e481 < hi_5))) {
+                            local_7 = ((li + 1u) == TREES);
+                        } else {
+                            local_7 = true;
+                        }
+                        bool _e491 = local_7;
+                        local_6 = _e491;
+                    } else {
+                        local_6 = false;
+                    }
+                    bool _e495 = local_6;
+                    if (_e495) {
                     } else {
                         break;
                     }
                     {
-                        uint _e411 = next;
-                        uint k_8 = by_end[min(uint(_e411), 255u)];
-                        uint _e415 = next;
-                        next = (_e415 + 1u);
-                        dotp = 0.0;
+                        uint _e497 = next;
+                        uint k_9 = by_end[min(uint(_e497), 255u)];
+                        uint _e501 = next;
+                        next = (_e501 + 1u);
                         h_1 = 0u;
-                        uint2 loop_bound_19 = uint2(4294967295u, 4294967295u);
+                        uint2 loop_bound_20 = uint2(4294967295u, 4294967295u);
                         bool loop_init_17 = true;
                         while(true) {
-                            if (all(loop_bound_19 == uint2(0u, 0u))) { break; }
-                            loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
+                            if (all(loop_bound_20 == uint2(0u, 0u))) { break; }
+                            loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
                             if (!loop_init_17) {
-                                uint _e469 = h_1;
-                                h_1 = (_e469 + 1u);
+                                uint _e552 = h_1;
+                                h_1 = (_e552 + 1u);
                             }
                             loop_init_17 = false;
-                            uint _e421 = h_1;
-                            if ((_e421 < RANK_VECS)) {
+                            uint _e505 = h_1;
+                            if ((_e505 < RANK_VECS)) {
                             } else {
                                 break;
                             }
                             {
                                 p = float4(0.0, 0.0, 0.0, 0.0);
-                                uint _e432 = q_rank[min(uint(k_8), 255u)];
-                                j_1 = (v_9 - _e432);
-                                uint2 loop_bound_20 = uint2(4294967295u, 4294967295u);
+                                uint _e516 = q_rank[min(uint(k_9), 255u)];
+                                j_1 = (v_9 - _e516);
+                                uint2 loop_bound_21 = uint2(4294967295u, 4294967295u);
                                 while(true) {
-                                    if (all(loop_bound_20 == uint2(0u, 0u))) { break; }
-                                    loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
-                                    uint _e435 = j_1;
-                                    if ((_e435 > 0u)) {
+                                    if (all(loop_bound_21 == uint2(0u, 0u))) { break; }
+                                    loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
+                                    uint _e519 = j_1;
+                                    if ((_e519 > 0u)) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        float4 _e438 = p;
-                                        uint _e439 = j_1;
-                                        uint _e446 = h_1;
-                                        float4 _e449 = asfloat(pst_tree.Load4(((tree + ((_e439 - 1u) * RANK_VECS)) + _e446)*16));
-                                        p = (_e438 + _e449);
-                                        uint _e451 = j_1;
-                                        uint _e452 = j_1;
-                                        uint _e453 = j_1;
-                                        j_1 = (_e451 - (_e452 & (~(_e453) + 1u)));
+                                        float4 _e522 = p;
+                                        uint _e523 = j_1;
+                                        uint _e530 = h_1;
+                                        float4 _e533 = asfloat(pst_tree.Load4(((tree + ((_e523 - 1u) * RANK_VECS)) + _e530)*16));
+                                        p = (_e522 + _e533);
+                                        uint _e535 = j_1;
+                                        uint _e536 = j_1;
+                                        uint _e537 = j_1;
+                                        j_1 = (_e535 - (_e536 & (~(_e537) + 1u)));
                                     }
                                 }
-                                float _e459 = dotp;
-                                float4 _e460 = p;
-                                float _e463 = q_theta[min(uint(k_8), 255u)];
-                                uint _e464 = h_1;
-                                const float4 _e465 = beta_at(_e463, _e464);
-                                dotp = (_e459 + dot(_e460, _e465));
+                                uint _e547 = h_1;
+                                float4 _e550 = p;
+                                pst_tree.Store4(((partials + (k_9 * RANK_VECS)) + _e547)*16, asuint(_e550));
                             }
                         }
-                        float _e475 = q_a[min(uint(k_8), 255u)];
-                        float _e476 = dotp;
-                        float _e482 = q_b[min(uint(k_8), 255u)];
-                        const float3 _e485 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_14.light_color.xyz * (max((_e475 * _e476), 0.0) + _e482)));
-                        const uint2 _e486 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-                        float4 _e489 = depth.Load(int3(_e486, int(0)));
-                        float z_7 = _e489.x;
-                        output[uint2(k_8, s_6)] = float4(_e485.x, _e485.y, _e485.z, z_7);
                     }
                 }
-                uint _e497 = i_1;
-                if ((_e497 == width)) {
+                uint _e554 = i_1;
+                if ((_e554 == hi_5)) {
                     break;
                 }
-                uint _e500 = i_1;
-                uint b_6 = asuint(pst_columns.Load((base_1 + _e500)*4));
-                if ((b_6 > 0u)) {
+                uint _e557 = i_1;
+                uint b_7 = asuint(pst_columns.Load((base_1 + _e557)*4));
+                if ((b_7 > 0u)) {
                     h_2 = 0u;
-                    uint2 loop_bound_21 = uint2(4294967295u, 4294967295u);
+                    uint2 loop_bound_22 = uint2(4294967295u, 4294967295u);
                     bool loop_init_18 = true;
                     while(true) {
-                        if (all(loop_bound_21 == uint2(0u, 0u))) { break; }
-                        loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
+                        if (all(loop_bound_22 == uint2(0u, 0u))) { break; }
+                        loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
                         if (!loop_init_18) {
-                            uint _e547 = h_2;
-                            h_2 = (_e547 + 1u);
+                            uint _e604 = h_2;
+                            h_2 = (_e604 + 1u);
                         }
                         loop_init_18 = false;
-                        uint _e508 = h_2;
-                        if ((_e508 < RANK_VECS)) {
+                        uint _e565 = h_2;
+                        if ((_e565 < RANK_VECS)) {
                         } else {
                             break;
                         }
                         {
-                            uint _e511 = i_1;
-                            uint _e516 = h_2;
-                            float4 leaf_1 = asfloat(pst_leaves.Load4((((base_1 + _e511) * RANK_VECS) + _e516)*16));
-                            j_2 = ((v_9 - b_6) + 1u);
-                            uint2 loop_bound_22 = uint2(4294967295u, 4294967295u);
+                            uint _e568 = i_1;
+                            uint _e573 = h_2;
+                            float4 leaf_1 = asfloat(pst_leaves.Load4((((base_1 + _e568) * RANK_VECS) + _e573)*16));
+                            j_2 = ((v_9 - b_7) + 1u);
+                            uint2 loop_bound_23 = uint2(4294967295u, 4294967295u);
                             while(true) {
-                                if (all(loop_bound_22 == uint2(0u, 0u))) { break; }
-                                loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
-                                uint _e524 = j_2;
-                                if ((_e524 <= v_9)) {
+                                if (all(loop_bound_23 == uint2(0u, 0u))) { break; }
+                                loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
+                                uint _e581 = j_2;
+                                if ((_e581 <= v_9)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    uint _e526 = j_2;
-                                    uint _e533 = h_2;
-                                    float4 _e536 = asfloat(pst_tree.Load4(((tree + ((_e526 - 1u) * RANK_VECS)) + _e533)*16));
-                                    pst_tree.Store4(((tree + ((_e526 - 1u) * RANK_VECS)) + _e533)*16, asuint((_e536 + leaf_1)));
-                                    uint _e538 = j_2;
-                                    uint _e539 = j_2;
-                                    uint _e540 = j_2;
-                                    j_2 = (_e538 + (_e539 & (~(_e540) + 1u)));
+                                    uint _e583 = j_2;
+                                    uint _e590 = h_2;
+                                    float4 _e593 = asfloat(pst_tree.Load4(((tree + ((_e583 - 1u) * RANK_VECS)) + _e590)*16));
+                                    pst_tree.Store4(((tree + ((_e583 - 1u) * RANK_VECS)) + _e590)*16, asuint((_e593 + leaf_1)));
+                                    uint _e595 = j_2;
+                                    uint _e596 = j_2;
+                                    uint _e597 = j_2;
+                                    j_2 = (_e595 + (_e596 & (~(_e597) + 1u)));
                                 }
                             }
                         }
@@ -1569,8 +1673,150 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 }
             }
         }
-        return;
-    } else {
-        return;
     }
+    DeviceMemoryBarrierWithGroupSync();
+    GroupMemoryBarrierWithGroupSync();
+    x = li;
+    uint2 loop_bound_24 = uint2(4294967295u, 4294967295u);
+    bool loop_init_19 = true;
+    while(true) {
+        if (all(loop_bound_24 == uint2(0u, 0u))) { break; }
+        loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
+        if (!loop_init_19) {
+            uint _e644 = x;
+            x = (_e644 + SLICE_LANES);
+        }
+        loop_init_19 = false;
+        uint _e610 = x;
+        if ((_e610 < (v_9 * RANK_VECS))) {
+        } else {
+            break;
+        }
+        {
+            running = float4(0.0, 0.0, 0.0, 0.0);
+            c = 0u;
+            uint2 loop_bound_25 = uint2(4294967295u, 4294967295u);
+            bool loop_init_20 = true;
+            while(true) {
+                if (all(loop_bound_25 == uint2(0u, 0u))) { break; }
+                loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
+                if (!loop_init_20) {
+                    uint _e642 = c;
+                    c = (_e642 + 1u);
+                }
+                loop_init_20 = false;
+                uint _e622 = c;
+                if ((_e622 < TREES)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e625 = c;
+                    uint _e631 = x;
+                    uint at = ((trees + ((_e625 * SLICE_SAMPLES) * RANK_VECS)) + _e631);
+                    float4 own = asfloat(pst_tree.Load4(at*16));
+                    float4 _e638 = running;
+                    pst_tree.Store4(at*16, asuint(_e638));
+                    float4 _e639 = running;
+                    running = (_e639 + own);
+                }
+            }
+        }
+    }
+    DeviceMemoryBarrierWithGroupSync();
+    GroupMemoryBarrierWithGroupSync();
+    k_4 = li;
+    uint2 loop_bound_26 = uint2(4294967295u, 4294967295u);
+    bool loop_init_21 = true;
+    while(true) {
+        if (all(loop_bound_26 == uint2(0u, 0u))) { break; }
+        loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
+        if (!loop_init_21) {
+            uint _e759 = k_4;
+            k_4 = (_e759 + SLICE_LANES);
+        }
+        loop_init_21 = false;
+        uint _e648 = k_4;
+        if ((_e648 < SLICE_SAMPLES)) {
+        } else {
+            break;
+        }
+        {
+            uint _e652 = k_4;
+            uint _e654 = q_end[min(uint(_e652), 255u)];
+            if ((_e654 != NONE)) {
+                uint _e658 = k_4;
+                uint _e660 = q_end[min(uint(_e658), 255u)];
+                uint tree_1 = (trees + ((min(naga_div(_e660, cw), 7u) * SLICE_SAMPLES) * RANK_VECS));
+                dotp = 0.0;
+                h_3 = 0u;
+                uint2 loop_bound_27 = uint2(4294967295u, 4294967295u);
+                bool loop_init_22 = true;
+                while(true) {
+                    if (all(loop_bound_27 == uint2(0u, 0u))) { break; }
+                    loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
+                    if (!loop_init_22) {
+                        uint _e727 = h_3;
+                        h_3 = (_e727 + 1u);
+                    }
+                    loop_init_22 = false;
+                    uint _e673 = h_3;
+                    if ((_e673 < RANK_VECS)) {
+                    } else {
+                        break;
+                    }
+                    {
+                        uint _e676 = k_4;
+                        uint _e681 = h_3;
+                        float4 _e684 = asfloat(pst_tree.Load4(((partials + (_e676 * RANK_VECS)) + _e681)*16));
+                        p_1 = _e684;
+                        uint _e687 = k_4;
+                        uint _e689 = q_rank[min(uint(_e687), 255u)];
+                        j_3 = (v_9 - _e689);
+                        uint2 loop_bound_28 = uint2(4294967295u, 4294967295u);
+                        while(true) {
+                            if (all(loop_bound_28 == uint2(0u, 0u))) { break; }
+                            loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
+                            uint _e692 = j_3;
+                            if ((_e692 > 0u)) {
+                            } else {
+                                break;
+                            }
+                            {
+                                float4 _e695 = p_1;
+                                uint _e696 = j_3;
+                                uint _e703 = h_3;
+                                float4 _e706 = asfloat(pst_tree.Load4(((tree_1 + ((_e696 - 1u) * RANK_VECS)) + _e703)*16));
+                                p_1 = (_e695 + _e706);
+                                uint _e708 = j_3;
+                                uint _e709 = j_3;
+                                uint _e710 = j_3;
+                                j_3 = (_e708 - (_e709 & (~(_e710) + 1u)));
+                            }
+                        }
+                        float _e716 = dotp;
+                        float4 _e717 = p_1;
+                        uint _e719 = k_4;
+                        float _e721 = q_theta[min(uint(_e719), 255u)];
+                        uint _e722 = h_3;
+                        const float4 _e723 = beta_at(_e721, _e722);
+                        dotp = (_e716 + dot(_e717, _e723));
+                    }
+                }
+                uint _e732 = k_4;
+                float _e734 = q_a[min(uint(_e732), 255u)];
+                float _e735 = dotp;
+                uint _e740 = k_4;
+                float _e742 = q_b[min(uint(_e740), 255u)];
+                const float3 _e745 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_14.light_color.xyz * (max((_e734 * _e735), 0.0) + _e742)));
+                uint _e746 = k_4;
+                const uint2 _e747 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e746, screen_4);
+                float4 _e750 = depth.Load(int3(_e747, int(0)));
+                float z_7 = _e750.x;
+                uint _e752 = k_4;
+                output[uint2(_e752, s_6)] = float4(_e745.x, _e745.y, _e745.z, z_7);
+            }
+        }
+    }
+    return;
 }

@@ -117,15 +117,16 @@ constant uint STEP = 1u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
 constant uint RANK_VECS = 2u;
+constant uint TREES = 8u;
 constant uint GRID = 96u;
 constant float GL2_ = 0.57735026;
 constant uint NONE = 4294967295u;
 
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
-    metal::float3 p_1
+    metal::float3 p_2
 ) {
-    metal::float3 q_2 = p_1 - v.origin.xyz;
+    metal::float3 q_2 = p_2 - v.origin.xyz;
     return metal::float3(metal::dot(q_2, v.right.xyz), metal::dot(q_2, v.up.xyz), metal::dot(q_2, v.forward.xyz));
 }
 
@@ -151,35 +152,35 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_6 = {};
-    bool local_7 = {};
     bool local_8 = {};
+    bool local_9 = {};
+    bool local_10 = {};
     if (!((uv.x < 0.0))) {
-        local_6 = uv.x > 1.0;
-    } else {
-        local_6 = true;
-    }
-    bool _e11 = local_6;
-    if (!(_e11)) {
-        local_7 = uv.y < 0.0;
-    } else {
-        local_7 = true;
-    }
-    bool _e19 = local_7;
-    if (!(_e19)) {
-        local_8 = uv.y > 1.0;
+        local_8 = uv.x > 1.0;
     } else {
         local_8 = true;
     }
-    bool _e27 = local_8;
+    bool _e11 = local_8;
+    if (!(_e11)) {
+        local_9 = uv.y < 0.0;
+    } else {
+        local_9 = true;
+    }
+    bool _e19 = local_9;
+    if (!(_e19)) {
+        local_10 = uv.y > 1.0;
+    } else {
+        local_10 = true;
+    }
+    bool _e27 = local_10;
     if (_e27) {
         return 2.0;
     }
     uint n_3 = v_2.size.x;
-    uint x_5 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_3)), n_3 - 1u);
+    uint x_6 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_3)), n_3 - 1u);
     uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_3)), n_3 - 1u);
     uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_5, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
     return _e49.x;
 }
 
@@ -201,18 +202,18 @@ float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
     metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_2
+    metal::float3 p_3
 ) {
-    bool local_9 = {};
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_2);
+    bool local_11 = {};
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
     float near = v_4.right.w;
     float far = v_4.up.w;
     if (v_4.origin.w > 0.5) {
-        local_9 = _e2.z <= near;
+        local_11 = _e2.z <= near;
     } else {
-        local_9 = false;
+        local_11 = false;
     }
-    bool _e16 = local_9;
+    bool _e16 = local_11;
     if (_e16) {
         return 1.0;
     }
@@ -269,11 +270,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_6 = sigma_t * len;
-    if (x_6 < 0.0001) {
-        return len * (1.0 - (0.5 * x_6));
+    float x_7 = sigma_t * len;
+    if (x_7 < 0.0001) {
+        return len * (1.0 - (0.5 * x_7));
     }
-    return (1.0 - metal::exp(-(x_6))) / sigma_t;
+    return (1.0 - metal::exp(-(x_7))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -293,8 +294,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_7 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_7 * x_7) * (3.0 - (2.0 * x_7));
+    float x_8 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_8 * x_8) * (3.0 - (2.0 * x_8));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -307,8 +308,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_8 = eye + (dir * t);
-    metal::float3 to_x = x_8 - light_pos;
+    metal::float3 x_9 = eye + (dir * t);
+    metal::float3 to_x = x_9 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_1 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_1);
@@ -330,29 +331,29 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float4 medium_1
 ) {
     float sum = 0.0;
-    uint k_4 = 0u;
+    uint k_5 = 0u;
     uint q_1 = {};
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
-    float h_8 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
-    float g0_ = metal::atan((a_1 - t0_) / h_8);
-    float w_1 = (metal::atan((b_1 - t0_) / h_8) - g0_) / static_cast<float>(panels);
+    float h_9 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
+    float g0_ = metal::atan((a_1 - t0_) / h_9);
+    float w_1 = (metal::atan((b_1 - t0_) / h_9) - g0_) / static_cast<float>(panels);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k_4;
-            k_4 = _e73 + 1u;
+            uint _e73 = k_5;
+            k_5 = _e73 + 1u;
         }
         loop_init = false;
-        uint _e30 = k_4;
+        uint _e30 = k_5;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            uint _e32 = k_4;
+            uint _e32 = k_5;
             float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
             q_1 = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
@@ -375,14 +376,14 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                     float u_1 = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q_1;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_8 * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_9 * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
                     sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u_1 * u_1)));
                 }
             }
         }
     }
     float _e75 = sum;
-    return ((_e75 * 0.5) * w_1) * h_8;
+    return ((_e75 * 0.5) * w_1) * h_9;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -394,16 +395,16 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
     uint n
 ) {
     float t0_1 = metal::dot(light_pos_2 - eye_2, dir_2);
-    float h_9 = metal::max(metal::length((eye_2 + (dir_2 * t0_1)) - light_pos_2), 0.0001 * metal::max(b_2 - a_2, 0.000001));
-    float theta_a = metal::atan((a_2 - t0_1) / h_9);
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_9, theta_a, (metal::atan((b_2 - t0_1) / h_9) - theta_a) / static_cast<float>(n)};
+    float h_10 = metal::max(metal::length((eye_2 + (dir_2 * t0_1)) - light_pos_2), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float theta_a = metal::atan((a_2 - t0_1) / h_10);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_10, theta_a, (metal::atan((b_2 - t0_1) / h_10) - theta_a) / static_cast<float>(n)};
 }
 
 metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e,
-    float x
+    float x_1
 ) {
-    float tau = metal::tan(e.theta_a + (x * e.dtheta));
+    float tau = metal::tan(e.theta_a + (x_1 * e.dtheta));
     return metal::float2(e.t_close + (e.dist * tau), (e.dtheta * e.dist) * (1.0 + (tau * tau)));
 }
 
@@ -444,10 +445,10 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XON
 float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
     metal::texture2d<float, metal::access::sample> sm_3,
-    metal::float3 p_3
+    metal::float3 p_4
 ) {
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_3);
+    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_4);
     return _e4;
 }
 
@@ -470,11 +471,11 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot
 ) {
     float sum_1 = 0.0;
-    uint k_5 = 0u;
+    uint k_6 = 0u;
     float t_2 = {};
     float w = {};
     uint steps = f_5.sizes2_.y;
-    float h_10 = s / static_cast<float>(steps);
+    float h_11 = s / static_cast<float>(steps);
     EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, 0.0, s, steps);
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
@@ -482,21 +483,21 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e60 = k_5;
-            k_5 = _e60 + 1u;
+            uint _e60 = k_6;
+            k_6 = _e60 + 1u;
         }
         loop_init_2 = false;
-        uint _e15 = k_5;
+        uint _e15 = k_6;
         if (_e15 < steps) {
         } else {
             break;
         }
         {
-            uint _e17 = k_5;
-            t_2 = (static_cast<float>(_e17) + 0.5) * h_10;
-            w = h_10;
+            uint _e17 = k_6;
+            t_2 = (static_cast<float>(_e17) + 0.5) * h_11;
+            w = h_11;
             if (spot) {
-                uint _e25 = k_5;
+                uint _e25 = k_6;
                 metal::float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e25) + 0.5);
                 t_2 = _e29.x;
                 w = _e29.y;
@@ -511,9 +512,9 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
                 sum_1 = _e38 + ((_e36 * _e39) * _e42);
             } else {
                 float _e45 = sum_1;
-                uint _e48 = k_5;
-                uint _e51 = k_5;
-                float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, static_cast<float>(_e48) * h_10, static_cast<float>(_e51 + 1u) * h_10);
+                uint _e48 = k_6;
+                uint _e51 = k_6;
+                float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, static_cast<float>(_e48) * h_11, static_cast<float>(_e51 + 1u) * h_11);
                 sum_1 = _e45 + (_e36 * _e56);
             }
         }
@@ -538,11 +539,11 @@ int naga_mod(int lhs, int rhs) {
 }
 
 uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    float j_3,
+    float j_4,
     uint rows,
     bool wrap
 ) {
-    int ji = naga_f2i32(j_3);
+    int ji = naga_f2i32(j_4);
     if (wrap) {
         return static_cast<uint>(naga_mod(as_type<int>(as_type<uint>(naga_mod(ji, static_cast<int>(rows))) + as_type<uint>(static_cast<int>(rows))), static_cast<int>(rows)));
     } else {
@@ -552,28 +553,28 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
-    float x_1,
+    float x_2,
     float delta,
     float theta_1,
     float s_1,
     bool spot_1
 ) {
-    bool local_10 = {};
+    bool local_12 = {};
     if (spot_1) {
-        float psi = x_1 * delta;
+        float psi = x_2 * delta;
         float den = metal::sin(theta_1 + psi);
         if (!((den <= 0.000001))) {
-            local_10 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_12 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local_10 = true;
+            local_12 = true;
         }
-        bool _e16 = local_10;
+        bool _e16 = local_12;
         if (_e16) {
             return s_1;
         }
         return metal::min((f_6.axis.w * metal::sin(psi)) / den, s_1);
     } else {
-        return metal::min((x_1 * delta) / metal::max(metal::sin(theta_1), 0.000001), s_1);
+        return metal::min((x_2 * delta) / metal::max(metal::sin(theta_1), 0.000001), s_1);
     }
 }
 
@@ -589,14 +590,29 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return _e15;
 }
 
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+    float a_4,
+    float b_4,
+    float depth_break
+) {
+    bool local_13 = {};
+    if (!((a_4 == b_4))) {
+        local_13 = metal::abs(a_4 - b_4) <= (depth_break * metal::min(a_4, b_4));
+    } else {
+        local_13 = true;
+    }
+    bool _e13 = local_13;
+    return _e13;
+}
+
 metal::float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float3 v_7
 ) {
-    metal::float3 a_7 = metal::min(metal::abs(v_7), metal::float3(65504.0));
-    metal::uint3 u_2 = as_type<metal::uint3>(a_7);
+    metal::float3 a_8 = metal::min(metal::abs(v_7), metal::float3(65504.0));
+    metal::uint3 u_2 = as_type<metal::uint3>(a_8);
     metal::float3 normal = as_type<metal::float3>(((u_2 + metal::uint3(4095u)) + ((u_2 >> metal::uint3(13u)) & metal::uint3(1u))) & metal::uint3(4294959104u));
-    metal::float3 subnormal = metal::rint(a_7 * 16777216.0) / metal::float3(16777216.0);
-    return metal::sign(v_7) * metal::select(normal, subnormal, a_7 < metal::float3(0.000061035156));
+    metal::float3 subnormal = metal::rint(a_8 * 16777216.0) / metal::float3(16777216.0);
+    return metal::sign(v_7) * metal::select(normal, subnormal, a_8 < metal::float3(0.000061035156));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
@@ -613,12 +629,12 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
 ) {
     metal::float2 origin = {};
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1 = {};
-    bool local_11 = {};
-    bool local_12 = {};
-    bool local_13 = {};
-    float a_4 = 0.0;
-    float b_4 = 0.0;
-    uint k_6 = 0u;
+    bool local_14 = {};
+    bool local_15 = {};
+    bool local_16 = {};
+    float a_5 = 0.0;
+    float b_5 = 0.0;
+    uint k_7 = 0u;
     metal::float2 size_1 = static_cast<metal::float2>(screen);
     metal::float2 centre = 0.5 * size_1;
     float z_5 = metal::dot(cam.toward, cam.forward);
@@ -644,25 +660,25 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     float _e79 = origin.x;
     if (_e79 >= lo_2.x) {
         float _e83 = origin.x;
-        local_11 = _e83 <= hi_2.x;
+        local_14 = _e83 <= hi_2.x;
     } else {
-        local_11 = false;
+        local_14 = false;
     }
-    bool _e89 = local_11;
+    bool _e89 = local_14;
     if (_e89) {
         float _e91 = origin.y;
-        local_12 = _e91 >= lo_2.y;
+        local_15 = _e91 >= lo_2.y;
     } else {
-        local_12 = false;
+        local_15 = false;
     }
-    bool _e97 = local_12;
+    bool _e97 = local_15;
     if (_e97) {
         float _e99 = origin.y;
-        local_13 = _e99 <= hi_2.y;
+        local_16 = _e99 <= hi_2.y;
     } else {
-        local_13 = false;
+        local_16 = false;
     }
-    bool inside = local_13;
+    bool inside = local_16;
     if (inside) {
         l_1.wrap = 1u;
         l_1.phi_start = -3.1415927;
@@ -675,38 +691,38 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
             if (metal::all(loop_bound_3 == uint2(0u))) { break; }
             loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
             if (!loop_init_3) {
-                uint _e153 = k_6;
-                k_6 = _e153 + 1u;
+                uint _e153 = k_7;
+                k_7 = _e153 + 1u;
             }
             loop_init_3 = false;
-            uint _e118 = k_6;
+            uint _e118 = k_7;
             if (_e118 < 4u) {
             } else {
                 break;
             }
             {
-                uint _e123 = k_6;
-                uint _e131 = k_6;
+                uint _e123 = k_7;
+                uint _e131 = k_7;
                 metal::float2 corner = metal::float2(((_e123 & 1u) != 0u) ? hi_2.x : lo_2.x, ((_e131 & 2u) != 0u) ? hi_2.y : lo_2.y);
                 metal::float2 _e139 = l_1.axis;
                 metal::float2 _e140 = origin;
                 float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, corner - _e140);
-                uint _e143 = k_6;
+                uint _e143 = k_7;
                 if (_e143 == 0u) {
-                    a_4 = _e142;
-                    b_4 = _e142;
+                    a_5 = _e142;
+                    b_5 = _e142;
                 } else {
-                    float _e148 = a_4;
-                    a_4 = metal::min(_e148, _e142);
-                    float _e150 = b_4;
-                    b_4 = metal::max(_e150, _e142);
+                    float _e148 = a_5;
+                    a_5 = metal::min(_e148, _e142);
+                    float _e150 = b_5;
+                    b_5 = metal::max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_4;
+        float _e156 = a_5;
         l_1.phi_start = _e156;
-        float _e158 = b_4;
-        float _e159 = a_4;
+        float _e158 = b_5;
+        float _e159 = a_5;
         l_1.dphi = (_e158 - _e159) / static_cast<float>(slices);
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l_1;
@@ -718,9 +734,9 @@ metal::float2 slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     uint s_2
 ) {
     float phi_1 = l_2.phi_start + ((static_cast<float>(s_2) + 0.5) * l_2.dphi);
-    float c = metal::cos(phi_1);
+    float c_1 = metal::cos(phi_1);
     float sn = metal::sin(phi_1);
-    return metal::float2((l_2.axis.x * c) - (l_2.axis.y * sn), (l_2.axis.y * c) + (l_2.axis.x * sn));
+    return metal::float2((l_2.axis.x * c_1) - (l_2.axis.y * sn), (l_2.axis.y * c_1) + (l_2.axis.x * sn));
 }
 
 metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
@@ -731,7 +747,7 @@ metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 ) {
     float t_in = 0.0;
     float t_out = 340000000000000000000000000000000000000.0;
-    uint a_5 = 0u;
+    uint a_6 = 0u;
     metal::float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_3);
     metal::float2 lo_3 = metal::float2(0.5, 0.5);
     metal::float2 hi_3 = static_cast<metal::float2>(screen_1) - metal::float2(0.5, 0.5);
@@ -741,25 +757,25 @@ metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e51 = a_5;
-            a_5 = _e51 + 1u;
+            uint _e51 = a_6;
+            a_6 = _e51 + 1u;
         }
         loop_init_4 = false;
-        uint _e16 = a_5;
+        uint _e16 = a_6;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            uint _e19 = a_5;
+            uint _e19 = a_6;
             if (metal::abs(_e5[metal::min(unsigned(_e19), 1u)]) > 0.000000000001) {
-                uint _e24 = a_5;
-                uint _e27 = a_5;
-                uint _e30 = a_5;
+                uint _e24 = a_6;
+                uint _e27 = a_6;
+                uint _e30 = a_6;
                 float ta = (lo_3[metal::min(unsigned(_e24), 1u)] - l_3.origin[metal::min(unsigned(_e27), 1u)]) / _e5[metal::min(unsigned(_e30), 1u)];
-                uint _e33 = a_5;
-                uint _e36 = a_5;
-                uint _e39 = a_5;
+                uint _e33 = a_6;
+                uint _e36 = a_6;
+                uint _e39 = a_6;
                 float tb = (hi_3[metal::min(unsigned(_e33), 1u)] - l_3.origin[metal::min(unsigned(_e36), 1u)]) / _e5[metal::min(unsigned(_e39), 1u)];
                 float _e43 = t_in;
                 t_in = metal::max(_e43, metal::min(ta, tb));
@@ -785,27 +801,27 @@ metal::uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_4,
     metal::float2 u,
     metal::float2 span,
-    uint k_7,
+    uint k_8,
     metal::uint2 screen_2
 ) {
-    metal::float2 p_5 = l_4.origin + (u * (span.x + (static_cast<float>(k_7) * span.y)));
+    metal::float2 p_6 = l_4.origin + (u * (span.x + (static_cast<float>(k_8) * span.y)));
     metal::float2 last = static_cast<metal::float2>(screen_2) - metal::float2(1.0, 1.0);
-    return naga_f2u32(metal::clamp(metal::floor(p_5), metal::float2(0.0, 0.0), last));
+    return naga_f2u32(metal::clamp(metal::floor(p_6), metal::float2(0.0, 0.0), last));
 }
 
 float edge_t(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
-    uint x_2,
+    uint x_3,
     uint n_1,
     float delta_1,
     float theta_2,
     float s_4,
     bool spot_2
 ) {
-    if (x_2 >= n_1) {
+    if (x_3 >= n_1) {
         return s_4;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, static_cast<float>(x_2), delta_1, theta_2, s_4, spot_2);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, static_cast<float>(x_3), delta_1, theta_2, s_4, spot_2);
     return _e9;
 }
 
@@ -817,52 +833,52 @@ float lit_span(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     metal::float3 eye_6,
     metal::float3 dir_6,
-    float a_6,
-    float b_5,
+    float a_7,
+    float b_6,
     bool spot_3
 ) {
     if (spot_3) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_6, b_5, metal::max(naga_div(f_9.sizes2_.z, 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_7, b_6, metal::max(naga_div(f_9.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_7, b_6);
     return _e15;
 }
 
 metal::float4 factor_at(
     uint base,
-    float x_3,
-    uint h_3,
+    float x_4,
+    uint h_4,
     device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    float p_6 = metal::min(metal::clamp(x_3, 0.0, 1.0) * 95.0, 95.0);
-    uint j_4 = metal::min(naga_f2u32(metal::floor(p_6)), 94u);
-    float t_4 = p_6 - static_cast<float>(j_4);
-    metal::float4 _e22 = pst_factors[metal::min(unsigned((base + (2u * j_4)) + h_3), (_buffer_sizes.size5 - 0 - 16) / 16)];
-    metal::float4 _e34 = pst_factors[metal::min(unsigned((base + (2u * (j_4 + 1u))) + h_3), (_buffer_sizes.size5 - 0 - 16) / 16)];
+    float p_7 = metal::min(metal::clamp(x_4, 0.0, 1.0) * 95.0, 95.0);
+    uint j_5 = metal::min(naga_f2u32(metal::floor(p_7)), 94u);
+    float t_4 = p_7 - static_cast<float>(j_5);
+    metal::float4 _e22 = pst_factors[metal::min(unsigned((base + (2u * j_5)) + h_4), (_buffer_sizes.size5 - 0 - 16) / 16)];
+    metal::float4 _e34 = pst_factors[metal::min(unsigned((base + (2u * (j_5 + 1u))) + h_4), (_buffer_sizes.size5 - 0 - 16) / 16)];
     return (_e22 * (1.0 - t_4)) + (_e34 * t_4);
 }
 
 metal::float4 gamma_at(
     float v_8,
-    uint h_4,
+    uint h_5,
     device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float _e4 = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)].x;
-    metal::float4 _e8 = factor_at(1u, v_8 / _e4, h_4, pst_factors, _buffer_sizes);
+    metal::float4 _e8 = factor_at(1u, v_8 / _e4, h_5, pst_factors, _buffer_sizes);
     return _e8;
 }
 
 metal::float4 beta_at(
     float theta_3,
-    uint h_5,
+    uint h_6,
     device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 head = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)];
-    metal::float4 _e14 = factor_at(193u, (theta_3 - head.y) / metal::max(head.z - head.y, 0.000000000001), h_5, pst_factors, _buffer_sizes);
+    metal::float4 _e14 = factor_at(193u, (theta_3 - head.y) / metal::max(head.z - head.y, 0.000000000001), h_6, pst_factors, _buffer_sizes);
     return _e14;
 }
 
@@ -871,14 +887,14 @@ metal::float4 pst_leaf(
     uint i_2,
     uint row_1,
     float delta_2,
-    uint h_6,
+    uint h_7,
     device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 leaf = metal::float4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
     if (false) {
-        metal::float4 _e9 = gamma_at(static_cast<float>(i_2) * delta_2, h_6, pst_factors, _buffer_sizes);
+        metal::float4 _e9 = gamma_at(static_cast<float>(i_2) * delta_2, h_7, pst_factors, _buffer_sizes);
         return _e9;
     }
     float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, row_1);
@@ -906,7 +922,7 @@ metal::float4 pst_leaf(
             metal::float3 l_5 = (-(axis_1) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
             float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_5, f_10.light_dir.xyz), f_10.light_pos.w, f_10.light_dir.w);
             metal::float4 _e48 = leaf;
-            metal::float4 _e52 = gamma_at(psi_1, h_6, pst_factors, _buffer_sizes);
+            metal::float4 _e52 = gamma_at(psi_1, h_7, pst_factors, _buffer_sizes);
             leaf = _e48 + (((0.5 * delta_2) * _e46) * _e52);
         }
     }
@@ -920,10 +936,10 @@ PstRay pst_ray(
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
-    PstRay r = {};
-    bool local_14 = {};
-    bool local_15 = {};
-    bool local_16 = {};
+    PstRay r_1 = {};
+    bool local_17 = {};
+    bool local_18 = {};
+    bool local_19 = {};
     float yc = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11 = frame;
     metal::float3 eye_7 = f_11.eye.xyz;
@@ -931,37 +947,37 @@ PstRay pst_ray(
     float t_5 = f_11.cam_forward.w;
     metal::float3 dir_8 = metal::normalize((f_11.cam_forward.xyz + (f_11.cam_right.xyz * ((ndc.x * t_5) * f_11.cam_right.w))) + (f_11.cam_up.xyz * (ndc.y * t_5)));
     float s_5 = metal::min(metal::max(z_1, 0.0), f_11.theta.z) / metal::max(metal::dot(dir_8, f_11.cam_forward.xyz), 0.000001);
-    r = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_7, dir_8, s_5, 0u, 0.0, 0.0, 0.0};
+    r_1 = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_7, dir_8, s_5, 0u, 0.0, 0.0, 0.0};
     metal::float3 px = metal::float3(pc, 0.0);
     float radius = f_11.epipole.w;
     if (f_11.epipole.z > 0.5) {
-        local_14 = metal::length(px - metal::float3(f_11.epipole.x, f_11.epipole.y, 0.0)) < radius;
+        local_17 = metal::length(px - metal::float3(f_11.epipole.x, f_11.epipole.y, 0.0)) < radius;
     } else {
-        local_14 = false;
+        local_17 = false;
     }
-    bool near_epi = local_14;
+    bool near_epi = local_17;
     if (f_11.anti_epipole.z > 0.5) {
-        local_15 = metal::length(px - metal::float3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0)) < radius;
+        local_18 = metal::length(px - metal::float3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0)) < radius;
     } else {
-        local_15 = false;
+        local_18 = false;
     }
-    bool near_anti = local_15;
+    bool near_anti = local_18;
     if (!(near_epi)) {
-        local_16 = near_anti;
+        local_19 = near_anti;
     } else {
-        local_16 = true;
+        local_19 = true;
     }
-    bool _e109 = local_16;
+    bool _e109 = local_19;
     if (_e109) {
-        r.marched = true;
+        r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
         float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_7, dir_8, s_5, true);
-        r.color = _e117 * f_11.light_color.xyz;
+        r_1.color = _e117 * f_11.light_color.xyz;
     }
     metal::float3 axis_2 = f_11.axis.xyz;
     uint rows_1 = f_11.sizes.w;
     bool wrap_1 = f_11.anti_epipole.w > 0.5;
-    r.theta = metal::atan2(metal::length(metal::cross(dir_8, axis_2)), metal::dot(dir_8, axis_2));
+    r_1.theta = metal::atan2(metal::length(metal::cross(dir_8, axis_2)), metal::dot(dir_8, axis_2));
     float phi_2 = metal::atan2(metal::dot(dir_8, f_11.e2_.xyz), metal::dot(dir_8, f_11.e1_.xyz));
     yc = (phi_2 - f_11.e1_.w) / f_11.e2_.w;
     if (wrap_1) {
@@ -974,33 +990,33 @@ PstRay pst_ray(
     }
     float _e161 = yc;
     uint _e163 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e161), rows_1, wrap_1);
-    r.row = _e163;
-    float _e166 = r.theta;
+    r_1.row = _e163;
+    float _e166 = r_1.theta;
     float _e171 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e166, f_11.theta.x, f_11.theta.y);
-    r.d = _e171;
+    r_1.d = _e171;
     if (true) {
         metal::float3 q_5 = metal::normalize((eye_7 + (dir_8 * s_5)) - f_11.light_pos.xyz);
-        r.xs_num = metal::acos(metal::clamp(metal::dot(q_5, -(axis_2)), -1.0, 1.0));
+        r_1.xs_num = metal::acos(metal::clamp(metal::dot(q_5, -(axis_2)), -1.0, 1.0));
     } else {
-        float _e187 = r.theta;
-        r.xs_num = s_5 * metal::sin(_e187);
+        float _e187 = r_1.theta;
+        r_1.xs_num = s_5 * metal::sin(_e187);
     }
-    PstRay _e190 = r;
+    PstRay _e190 = r_1;
     return _e190;
 }
 
 uint pst_columns_crossed(
-    PstRay r_1,
+    PstRay r_2,
     float delta_3,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
-    float xs = r_1.xs_num / delta_3;
+    float xs = r_2.xs_num / delta_3;
     uint _e12 = frame.sizes.z;
     return naga_f2u32(metal::min(metal::ceil((xs > 0.0) ? xs : 0.0), static_cast<float>(_e12)));
 }
 
 metal::float2 pst_terms(
-    PstRay r_2,
+    PstRay r_3,
     uint row_2,
     float delta_4,
     uint n_2,
@@ -1009,19 +1025,19 @@ metal::float2 pst_terms(
 ) {
     float tail = 0.0;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
-    float sin_theta = metal::max(metal::sin(r_2.theta), 0.000001);
+    float sin_theta = metal::max(metal::sin(r_3.theta), 0.000001);
     uint clamped_lod_e16 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
     metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_2)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
-    if (r_2.d <= _e16.x) {
-        float _e25 = edge_t(f_12, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
-        float _e29 = lit_span(f_12, r_2.eye, r_2.dir, _e25, r_2.s, true);
+    if (r_3.d <= _e16.x) {
+        float _e25 = edge_t(f_12, n_2 - 1u, n_2, delta_4, r_3.theta, r_3.s, true);
+        float _e29 = lit_span(f_12, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
         return metal::float2(f_12.medium.y / (f_12.axis.w * sin_theta), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(metal::dot(f_12.light_dir.xyz, r_2.dir)));
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(metal::dot(f_12.light_dir.xyz, r_3.dir)));
     float sp = f_12.medium.y * _e48;
     float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, 0.0, delta_4 / sin_theta);
     float _e56 = tail;
@@ -1029,7 +1045,7 @@ metal::float2 pst_terms(
 }
 
 metal::float3 pst_sweep_pixel(
-    uint x_4,
+    uint x_5,
     uint y,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_10 const& slices_1,
@@ -1040,13 +1056,13 @@ metal::float3 pst_sweep_pixel(
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float sum_2 = 0.0;
-    uint h_7 = 0u;
-    metal::float4 p_4 = {};
+    uint h_8 = 0u;
+    metal::float4 p_5 = {};
     uint i_3 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
     uint clamped_lod_e16 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_4, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
-    PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_4) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
+    metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
+    PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_5) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
     if (_e18.marched) {
         return _e18.color;
     }
@@ -1063,17 +1079,17 @@ metal::float3 pst_sweep_pixel(
         if (metal::all(loop_bound_6 == uint2(0u))) { break; }
         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
         if (!loop_init_6) {
-            uint _e77 = h_7;
-            h_7 = _e77 + 1u;
+            uint _e77 = h_8;
+            h_8 = _e77 + 1u;
         }
         loop_init_6 = false;
-        uint _e35 = h_7;
+        uint _e35 = h_8;
         if (_e35 < RANK_VECS) {
         } else {
             break;
         }
         {
-            p_4 = metal::float4(0.0, 0.0, 0.0, 0.0);
+            p_5 = metal::float4(0.0, 0.0, 0.0, 0.0);
             i_3 = 0u;
             uint2 loop_bound_7 = uint2(4294967295u);
             bool loop_init_7 = true;
@@ -1095,17 +1111,17 @@ metal::float3 pst_sweep_pixel(
                     uint clamped_lod_e56 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
                     metal::float4 _e56 = rectified.read(metal::min(metal::uint2(metal::uint2(_e51, _e18.row)), metal::uint2(rectified.get_width(clamped_lod_e56), rectified.get_height(clamped_lod_e56)) - 1), clamped_lod_e56);
                     if (_e18.d <= _e56.x) {
-                        metal::float4 _e59 = p_4;
+                        metal::float4 _e59 = p_5;
                         uint _e60 = i_3;
-                        uint _e62 = h_7;
+                        uint _e62 = h_8;
                         metal::float4 _e63 = pst_leaf(f_13, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
-                        p_4 = _e59 + _e63;
+                        p_5 = _e59 + _e63;
                     }
                 }
             }
             float _e69 = sum_2;
-            metal::float4 _e70 = p_4;
-            uint _e72 = h_7;
+            metal::float4 _e70 = p_5;
+            uint _e72 = h_8;
             metal::float4 _e73 = beta_at(_e18.theta, _e72, pst_factors, _buffer_sizes);
             sum_2 = _e69 + metal::dot(_e70, _e73);
         }
@@ -1113,6 +1129,42 @@ metal::float3 pst_sweep_pixel(
     metal::float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27, frame, rectified);
     float _e84 = sum_2;
     return f_13.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
+}
+
+float pst_footprint_depth(
+    metal::float2 pc_1,
+    metal::uint2 screen_3,
+    metal::texture2d<float, metal::access::sample> depth
+) {
+    metal::float2 last_1 = static_cast<metal::float2>(screen_3) - metal::float2(1.0, 1.0);
+    metal::float2 q_6 = metal::clamp(pc_1 - metal::float2(0.5, 0.5), metal::float2(0.0, 0.0), last_1);
+    metal::uint2 i0_ = naga_f2u32(metal::floor(q_6));
+    metal::uint2 i1_ = metal::min(i0_ + metal::uint2(1u, 1u), screen_3 - metal::uint2(1u, 1u));
+    metal::float2 t_6 = q_6 - metal::floor(q_6);
+    uint clamped_lod_e30 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e30 = depth.read(metal::min(metal::uint2(i0_), metal::uint2(depth.get_width(clamped_lod_e30), depth.get_height(clamped_lod_e30)) - 1), clamped_lod_e30);
+    float z00_ = _e30.x;
+    uint clamped_lod_e37 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e37 = depth.read(metal::min(metal::uint2(metal::uint2(i1_.x, i0_.y)), metal::uint2(depth.get_width(clamped_lod_e37), depth.get_height(clamped_lod_e37)) - 1), clamped_lod_e37);
+    float z10_ = _e37.x;
+    uint clamped_lod_e44 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e44 = depth.read(metal::min(metal::uint2(metal::uint2(i0_.x, i1_.y)), metal::uint2(depth.get_width(clamped_lod_e44), depth.get_height(clamped_lod_e44)) - 1), clamped_lod_e44);
+    float z01_ = _e44.x;
+    uint clamped_lod_e48 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e48 = depth.read(metal::min(metal::uint2(i1_), metal::uint2(depth.get_width(clamped_lod_e48), depth.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
+    float z11_ = _e48.x;
+    float lo_4 = metal::min(metal::min(z00_, z10_), metal::min(z01_, z11_));
+    float hi_4 = metal::max(metal::max(z00_, z10_), metal::max(z01_, z11_));
+    bool _e57 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lo_4, hi_4, DEPTH_BREAK);
+    if (!(_e57)) {
+        return -1.0;
+    }
+    if (lo_4 == hi_4) {
+        return lo_4;
+    }
+    float w0_ = ((1.0 / z00_) * (1.0 - t_6.x)) + ((1.0 / z10_) * t_6.x);
+    float w1_ = ((1.0 / z01_) * (1.0 - t_6.x)) + ((1.0 / z11_) * t_6.x);
+    return 1.0 / ((w0_ * (1.0 - t_6.y)) + (w1_ * t_6.y));
 }
 
 struct pst_sweepInput {
@@ -1153,6 +1205,7 @@ kernel void pst_sweep(
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     uint k = {};
+    PstRay r = {};
     bool local = {};
     uint k_1 = {};
     uint by_d = {};
@@ -1171,16 +1224,26 @@ kernel void pst_sweep(
     uint h = {};
     uint j = 0u;
     uint next = 0u;
-    uint i_1 = 0u;
+    uint top = {};
+    uint i_1 = {};
     bool local_5 = {};
-    float dotp = {};
+    bool local_6 = {};
+    bool local_7 = {};
     uint h_1 = {};
     metal::float4 p = {};
     uint j_1 = {};
     uint h_2 = {};
     uint j_2 = {};
+    uint x = {};
+    metal::float4 running = {};
+    uint c = {};
+    uint k_4 = {};
+    float dotp = {};
+    uint h_3 = {};
+    metal::float4 p_1 = {};
+    uint j_3 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = frame;
-    metal::uint2 screen_3 = metal::uint2(f_14.sizes.x, f_14.sizes.y);
+    metal::uint2 screen_4 = metal::uint2(f_14.sizes.x, f_14.sizes.y);
     uint width = f_14.sizes.z;
     metal::float4 _e12 = frame.cam_forward;
     metal::float4 _e16 = frame.cam_right;
@@ -1188,10 +1251,10 @@ kernel void pst_sweep(
     float _e25 = frame.cam_forward.w;
     float _e29 = frame.cam_right.w;
     metal::float4 _e32 = frame.axis;
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e36 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {_e12.xyz, _e16.xyz, _e20.xyz, _e25, _e29, {}, _e32.xyz}, screen_3, SLICES);
+    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e36 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {_e12.xyz, _e16.xyz, _e20.xyz, _e25, _e29, {}, _e32.xyz}, screen_4, SLICES);
     uint s_6 = wid.x;
     metal::float2 _e39 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6);
-    metal::float2 _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6, screen_3, SLICE_SAMPLES);
+    metal::float2 _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6, screen_4, SLICE_SAMPLES);
     if (li == 0u) {
         output.write(metal::float4(_e39.x, _e39.y, _e41.x, _e41.y), metal::uint2(metal::uint2(SLICE_SAMPLES, s_6)));
         if (s_6 == 0u) {
@@ -1213,8 +1276,8 @@ kernel void pst_sweep(
         if (metal::all(loop_bound_8 == uint2(0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
         if (!loop_init_8) {
-            uint _e157 = k;
-            k = _e157 + SLICE_LANES;
+            uint _e187 = k;
+            k = _e187 + SLICE_LANES;
         }
         loop_init_8 = false;
         uint _e91 = k;
@@ -1224,38 +1287,53 @@ kernel void pst_sweep(
         }
         {
             uint _e94 = k;
-            metal::uint2 _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e94, screen_3);
+            metal::uint2 _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e94, screen_4);
             uint clamped_lod_e98 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
             metal::float4 _e98 = depth.read(metal::min(metal::uint2(_e95), metal::uint2(depth.get_width(clamped_lod_e98), depth.get_height(clamped_lod_e98)) - 1), clamped_lod_e98);
             float z_6 = _e98.x;
             uint _e102 = k;
-            PstRay _e109 = pst_ray(_e36.origin + (_e39 * (_e41.x + (static_cast<float>(_e102) * _e41.y))), z_6, frame, shadow_map);
-            uint _e110 = pst_columns_crossed(_e109, delta_6, frame);
-            uint _e112 = k;
-            q_end.inner[metal::min(unsigned(_e112), 255u)] = NONE;
-            if (!(_e109.marched)) {
-                local = _e110 == 0u;
+            float _e109 = pst_footprint_depth(_e36.origin + (_e39 * (_e41.x + (static_cast<float>(_e102) * _e41.y))), screen_4, depth);
+            r = PstRay {};
+            if (_e109 < 0.0) {
+                PstRay _e123 = pst_ray(metal::float2(static_cast<float>(_e95.x) + 0.5, static_cast<float>(_e95.y) + 0.5), z_6, frame, shadow_map);
+                r = _e123;
+            } else {
+                uint _e126 = k;
+                PstRay _e133 = pst_ray(_e36.origin + (_e39 * (_e41.x + (static_cast<float>(_e126) * _e41.y))), _e109, frame, shadow_map);
+                r = _e133;
+            }
+            PstRay _e134 = r;
+            uint _e135 = pst_columns_crossed(_e134, delta_6, frame);
+            uint _e137 = k;
+            q_end.inner[metal::min(unsigned(_e137), 255u)] = NONE;
+            bool _e141 = r.marched;
+            if (!(_e141)) {
+                local = _e135 == 0u;
             } else {
                 local = true;
             }
-            bool _e122 = local;
-            if (_e122) {
-                metal::float3 _e124 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e109.color);
-                uint _e125 = k;
-                output.write(metal::float4(_e124.x, _e124.y, _e124.z, z_6), metal::uint2(metal::uint2(_e125, s_6)));
+            bool _e148 = local;
+            if (_e148) {
+                metal::float3 _e150 = r.color;
+                metal::float3 _e151 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e150);
+                uint _e152 = k;
+                output.write(metal::float4(_e151.x, _e151.y, _e151.z, z_6), metal::uint2(metal::uint2(_e152, s_6)));
             } else {
-                metal::float2 _e132 = pst_terms(_e109, row_3, delta_6, _e110, frame, rectified);
-                uint _e134 = k;
-                q_end.inner[metal::min(unsigned(_e134), 255u)] = _e110 - 1u;
-                uint _e139 = k;
-                q_d.inner[metal::min(unsigned(_e139), 255u)] = _e109.d;
-                uint _e143 = k;
-                q_theta.inner[metal::min(unsigned(_e143), 255u)] = _e109.theta;
-                uint _e147 = k;
-                q_a.inner[metal::min(unsigned(_e147), 255u)] = _e132.x;
-                uint _e151 = k;
-                q_b.inner[metal::min(unsigned(_e151), 255u)] = _e132.y;
-                uint _e156 = metal::atomic_fetch_add_explicit(&live, 1u, metal::memory_order_relaxed);
+                PstRay _e159 = r;
+                metal::float2 _e160 = pst_terms(_e159, row_3, delta_6, _e135, frame, rectified);
+                uint _e162 = k;
+                q_end.inner[metal::min(unsigned(_e162), 255u)] = _e135 - 1u;
+                uint _e167 = k;
+                float _e170 = r.d;
+                q_d.inner[metal::min(unsigned(_e167), 255u)] = _e170;
+                uint _e172 = k;
+                float _e175 = r.theta;
+                q_theta.inner[metal::min(unsigned(_e172), 255u)] = _e175;
+                uint _e177 = k;
+                q_a.inner[metal::min(unsigned(_e177), 255u)] = _e160.x;
+                uint _e181 = k;
+                q_b.inner[metal::min(unsigned(_e181), 255u)] = _e160.y;
+                uint _e186 = metal::atomic_fetch_add_explicit(&live, 1u, metal::memory_order_relaxed);
             }
         }
     }
@@ -1268,19 +1346,19 @@ kernel void pst_sweep(
         if (metal::all(loop_bound_9 == uint2(0u))) { break; }
         loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
         if (!loop_init_9) {
-            uint _e268 = k_1;
-            k_1 = _e268 + SLICE_LANES;
+            uint _e298 = k_1;
+            k_1 = _e298 + SLICE_LANES;
         }
         loop_init_9 = false;
-        uint _e163 = k_1;
-        if (_e163 < SLICE_SAMPLES) {
+        uint _e193 = k_1;
+        if (_e193 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e167 = k_1;
-            uint _e169 = q_end.inner[metal::min(unsigned(_e167), 255u)];
-            if (_e169 != NONE) {
+            uint _e197 = k_1;
+            uint _e199 = q_end.inner[metal::min(unsigned(_e197), 255u)];
+            if (_e199 != NONE) {
                 by_d = 0u;
                 by_e = 0u;
                 q = 0u;
@@ -1290,76 +1368,76 @@ kernel void pst_sweep(
                     if (metal::all(loop_bound_10 == uint2(0u))) { break; }
                     loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
                     if (!loop_init_10) {
-                        uint _e258 = q;
-                        q = _e258 + 1u;
+                        uint _e288 = q;
+                        q = _e288 + 1u;
                     }
                     loop_init_10 = false;
-                    uint _e178 = q;
-                    if (_e178 < SLICE_SAMPLES) {
+                    uint _e208 = q;
+                    if (_e208 < SLICE_SAMPLES) {
                     } else {
                         break;
                     }
                     {
-                        uint _e182 = q;
-                        uint _e184 = q_end.inner[metal::min(unsigned(_e182), 255u)];
-                        if (_e184 != NONE) {
-                            uint _e187 = by_d;
-                            uint _e189 = q;
-                            float _e191 = q_d.inner[metal::min(unsigned(_e189), 255u)];
-                            uint _e193 = k_1;
-                            float _e195 = q_d.inner[metal::min(unsigned(_e193), 255u)];
-                            if (!((_e191 < _e195))) {
-                                uint _e199 = q;
-                                float _e201 = q_d.inner[metal::min(unsigned(_e199), 255u)];
-                                uint _e203 = k_1;
-                                float _e205 = q_d.inner[metal::min(unsigned(_e203), 255u)];
-                                if (_e201 == _e205) {
-                                    uint _e207 = q;
-                                    uint _e208 = k_1;
-                                    local_2 = _e207 < _e208;
+                        uint _e212 = q;
+                        uint _e214 = q_end.inner[metal::min(unsigned(_e212), 255u)];
+                        if (_e214 != NONE) {
+                            uint _e217 = by_d;
+                            uint _e219 = q;
+                            float _e221 = q_d.inner[metal::min(unsigned(_e219), 255u)];
+                            uint _e223 = k_1;
+                            float _e225 = q_d.inner[metal::min(unsigned(_e223), 255u)];
+                            if (!((_e221 < _e225))) {
+                                uint _e229 = q;
+                                float _e231 = q_d.inner[metal::min(unsigned(_e229), 255u)];
+                                uint _e233 = k_1;
+                                float _e235 = q_d.inner[metal::min(unsigned(_e233), 255u)];
+                                if (_e231 == _e235) {
+                                    uint _e237 = q;
+                                    uint _e238 = k_1;
+                                    local_2 = _e237 < _e238;
                                 } else {
                                     local_2 = false;
                                 }
-                                bool _e213 = local_2;
-                                local_1 = _e213;
+                                bool _e243 = local_2;
+                                local_1 = _e243;
                             } else {
                                 local_1 = true;
                             }
-                            bool _e219 = local_1;
-                            by_d = _e187 + (_e219 ? 1u : 0u);
-                            uint _e222 = by_e;
-                            uint _e224 = q;
-                            uint _e226 = q_end.inner[metal::min(unsigned(_e224), 255u)];
-                            uint _e228 = k_1;
-                            uint _e230 = q_end.inner[metal::min(unsigned(_e228), 255u)];
-                            if (!((_e226 < _e230))) {
-                                uint _e234 = q;
-                                uint _e236 = q_end.inner[metal::min(unsigned(_e234), 255u)];
-                                uint _e238 = k_1;
-                                uint _e240 = q_end.inner[metal::min(unsigned(_e238), 255u)];
-                                if (_e236 == _e240) {
-                                    uint _e242 = q;
-                                    uint _e243 = k_1;
-                                    local_4 = _e242 < _e243;
+                            bool _e249 = local_1;
+                            by_d = _e217 + (_e249 ? 1u : 0u);
+                            uint _e252 = by_e;
+                            uint _e254 = q;
+                            uint _e256 = q_end.inner[metal::min(unsigned(_e254), 255u)];
+                            uint _e258 = k_1;
+                            uint _e260 = q_end.inner[metal::min(unsigned(_e258), 255u)];
+                            if (!((_e256 < _e260))) {
+                                uint _e264 = q;
+                                uint _e266 = q_end.inner[metal::min(unsigned(_e264), 255u)];
+                                uint _e268 = k_1;
+                                uint _e270 = q_end.inner[metal::min(unsigned(_e268), 255u)];
+                                if (_e266 == _e270) {
+                                    uint _e272 = q;
+                                    uint _e273 = k_1;
+                                    local_4 = _e272 < _e273;
                                 } else {
                                     local_4 = false;
                                 }
-                                bool _e248 = local_4;
-                                local_3 = _e248;
+                                bool _e278 = local_4;
+                                local_3 = _e278;
                             } else {
                                 local_3 = true;
                             }
-                            bool _e254 = local_3;
-                            by_e = _e222 + (_e254 ? 1u : 0u);
+                            bool _e284 = local_3;
+                            by_e = _e252 + (_e284 ? 1u : 0u);
                         }
                     }
                 }
-                uint _e261 = k_1;
-                uint _e263 = by_d;
-                q_rank.inner[metal::min(unsigned(_e261), 255u)] = _e263;
-                uint _e265 = by_e;
-                uint _e267 = k_1;
-                by_end.inner[metal::min(unsigned(_e265), 255u)] = _e267;
+                uint _e291 = k_1;
+                uint _e293 = by_d;
+                q_rank.inner[metal::min(unsigned(_e291), 255u)] = _e293;
+                uint _e295 = by_e;
+                uint _e297 = k_1;
+                by_end.inner[metal::min(unsigned(_e295), 255u)] = _e297;
             }
         }
     }
@@ -1371,20 +1449,20 @@ kernel void pst_sweep(
         if (metal::all(loop_bound_11 == uint2(0u))) { break; }
         loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
         if (!loop_init_11) {
-            uint _e284 = k_2;
-            k_2 = _e284 + SLICE_LANES;
+            uint _e314 = k_2;
+            k_2 = _e314 + SLICE_LANES;
         }
         loop_init_11 = false;
-        uint _e272 = k_2;
-        if (_e272 < SLICE_SAMPLES) {
+        uint _e302 = k_2;
+        if (_e302 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e275 = k_2;
-            uint _e281 = k_2;
-            float _e283 = q_d.inner[metal::min(unsigned(_e281), 255u)];
-            mine.inner[metal::min(unsigned(naga_div(_e275, SLICE_LANES)), 7u)] = _e283;
+            uint _e305 = k_2;
+            uint _e311 = k_2;
+            float _e313 = q_d.inner[metal::min(unsigned(_e311), 255u)];
+            mine.inner[metal::min(unsigned(naga_div(_e305, SLICE_LANES)), 7u)] = _e313;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
@@ -1395,24 +1473,24 @@ kernel void pst_sweep(
         if (metal::all(loop_bound_12 == uint2(0u))) { break; }
         loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
         if (!loop_init_12) {
-            uint _e308 = k_3;
-            k_3 = _e308 + SLICE_LANES;
+            uint _e338 = k_3;
+            k_3 = _e338 + SLICE_LANES;
         }
         loop_init_12 = false;
-        uint _e288 = k_3;
-        if (_e288 < SLICE_SAMPLES) {
+        uint _e318 = k_3;
+        if (_e318 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e292 = k_3;
-            uint _e294 = q_end.inner[metal::min(unsigned(_e292), 255u)];
-            if (_e294 != NONE) {
-                uint _e299 = k_3;
-                uint _e301 = q_rank.inner[metal::min(unsigned(_e299), 255u)];
-                uint _e303 = k_3;
-                float _e307 = mine.inner[metal::min(unsigned(naga_div(_e303, SLICE_LANES)), 7u)];
-                q_d.inner[metal::min(unsigned(_e301), 255u)] = _e307;
+            uint _e322 = k_3;
+            uint _e324 = q_end.inner[metal::min(unsigned(_e322), 255u)];
+            if (_e324 != NONE) {
+                uint _e329 = k_3;
+                uint _e331 = q_rank.inner[metal::min(unsigned(_e329), 255u)];
+                uint _e333 = k_3;
+                float _e337 = mine.inner[metal::min(unsigned(naga_div(_e333, SLICE_LANES)), 7u)];
+                q_d.inner[metal::min(unsigned(_e331), 255u)] = _e337;
             }
         }
     }
@@ -1425,49 +1503,49 @@ kernel void pst_sweep(
         if (metal::all(loop_bound_13 == uint2(0u))) { break; }
         loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
         if (!loop_init_13) {
-            uint _e365 = i;
-            i = _e365 + SLICE_LANES;
+            uint _e395 = i;
+            i = _e395 + SLICE_LANES;
         }
         loop_init_13 = false;
-        uint _e313 = i;
-        if (_e313 < width) {
+        uint _e343 = i;
+        if (_e343 < width) {
         } else {
             break;
         }
         {
-            uint _e315 = i;
-            uint clamped_lod_e319 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e319 = rectified.read(metal::min(metal::uint2(metal::uint2(_e315, row_3)), metal::uint2(rectified.get_width(clamped_lod_e319), rectified.get_height(clamped_lod_e319)) - 1), clamped_lod_e319);
-            float occluder = _e319.x;
+            uint _e345 = i;
+            uint clamped_lod_e349 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+            metal::float4 _e349 = rectified.read(metal::min(metal::uint2(metal::uint2(_e345, row_3)), metal::uint2(rectified.get_width(clamped_lod_e349), rectified.get_height(clamped_lod_e349)) - 1), clamped_lod_e349);
+            float occluder = _e349.x;
             lo = 0u;
             hi = v_9;
             uint2 loop_bound_14 = uint2(4294967295u);
             while(true) {
                 if (metal::all(loop_bound_14 == uint2(0u))) { break; }
                 loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
-                uint _e324 = lo;
-                uint _e325 = hi;
-                if (_e324 < _e325) {
+                uint _e354 = lo;
+                uint _e355 = hi;
+                if (_e354 < _e355) {
                 } else {
                     break;
                 }
                 {
-                    uint _e327 = lo;
-                    uint _e328 = hi;
-                    uint mid_1 = naga_div(_e327 + _e328, 2u);
-                    float _e334 = q_d.inner[metal::min(unsigned(mid_1), 255u)];
-                    if (_e334 <= occluder) {
+                    uint _e357 = lo;
+                    uint _e358 = hi;
+                    uint mid_1 = naga_div(_e357 + _e358, 2u);
+                    float _e364 = q_d.inner[metal::min(unsigned(mid_1), 255u)];
+                    if (_e364 <= occluder) {
                         lo = mid_1 + 1u;
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            uint _e339 = i;
-            uint _e342 = lo;
-            pst_columns[metal::min(unsigned(base_1 + _e339), (_buffer_sizes.size8 - 0 - 4) / 4)] = _e342;
-            uint _e343 = lo;
-            if (_e343 > 0u) {
+            uint _e369 = i;
+            uint _e372 = lo;
+            pst_columns[metal::min(unsigned(base_1 + _e369), (_buffer_sizes.size8 - 0 - 4) / 4)] = _e372;
+            uint _e373 = lo;
+            if (_e373 > 0u) {
                 h = 0u;
                 uint2 loop_bound_15 = uint2(4294967295u);
                 bool loop_init_14 = true;
@@ -1475,22 +1553,22 @@ kernel void pst_sweep(
                     if (metal::all(loop_bound_15 == uint2(0u))) { break; }
                     loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
                     if (!loop_init_14) {
-                        uint _e363 = h;
-                        h = _e363 + 1u;
+                        uint _e393 = h;
+                        h = _e393 + 1u;
                     }
                     loop_init_14 = false;
-                    uint _e348 = h;
-                    if (_e348 < RANK_VECS) {
+                    uint _e378 = h;
+                    if (_e378 < RANK_VECS) {
                     } else {
                         break;
                     }
                     {
-                        uint _e351 = i;
-                        uint _e356 = h;
-                        uint _e359 = i;
-                        uint _e360 = h;
-                        metal::float4 _e361 = pst_leaf(f_14, _e359, row_3, delta_6, _e360, pst_factors, _buffer_sizes);
-                        pst_leaves[metal::min(unsigned(((base_1 + _e351) * RANK_VECS) + _e356), (_buffer_sizes.size6 - 0 - 16) / 16)] = _e361;
+                        uint _e381 = i;
+                        uint _e386 = h;
+                        uint _e389 = i;
+                        uint _e390 = h;
+                        metal::float4 _e391 = pst_leaf(f_14, _e389, row_3, delta_6, _e390, pst_factors, _buffer_sizes);
+                        pst_leaves[metal::min(unsigned(((base_1 + _e381) * RANK_VECS) + _e386), (_buffer_sizes.size6 - 0 - 16) / 16)] = _e391;
                     }
                 }
             }
@@ -1498,175 +1576,205 @@ kernel void pst_sweep(
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_device);
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    if (li == 0u) {
-        uint tree = (s_6 * SLICE_SAMPLES) * RANK_VECS;
+    uint cw = naga_div((width + TREES) - 1u, TREES);
+    uint trees = ((s_6 * 9u) * SLICE_SAMPLES) * RANK_VECS;
+    uint partials = trees + 4096u;
+    if (li < TREES) {
+        uint tree = trees + ((li * SLICE_SAMPLES) * RANK_VECS);
         uint2 loop_bound_16 = uint2(4294967295u);
         bool loop_init_15 = true;
         while(true) {
             if (metal::all(loop_bound_16 == uint2(0u))) { break; }
             loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
             if (!loop_init_15) {
-                uint _e389 = j;
-                j = _e389 + 1u;
+                uint _e434 = j;
+                j = _e434 + 1u;
             }
             loop_init_15 = false;
-            uint _e375 = j;
-            if (_e375 < (v_9 * RANK_VECS)) {
+            uint _e420 = j;
+            if (_e420 < (v_9 * RANK_VECS)) {
             } else {
                 break;
             }
             {
-                uint _e380 = j;
-                pst_tree[metal::min(unsigned(tree + _e380), (_buffer_sizes.size7 - 0 - 16) / 16)] = metal::float4(0.0, 0.0, 0.0, 0.0);
+                uint _e425 = j;
+                pst_tree[metal::min(unsigned(tree + _e425), (_buffer_sizes.size7 - 0 - 16) / 16)] = metal::float4(0.0, 0.0, 0.0, 0.0);
             }
         }
+        uint lo_5 = li * cw;
+        uint hi_5 = ((li + 1u) == TREES) ? width : metal::min(lo_5 + cw, width);
+        top = v_9;
         uint2 loop_bound_17 = uint2(4294967295u);
-        bool loop_init_16 = true;
         while(true) {
             if (metal::all(loop_bound_17 == uint2(0u))) { break; }
             loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
-            if (!loop_init_16) {
-                uint _e550 = i_1;
-                i_1 = _e550 + 1u;
-            }
-            loop_init_16 = false;
-            uint _e392 = i_1;
-            if (_e392 <= width) {
+            uint _e446 = next;
+            uint _e447 = top;
+            if (_e446 < _e447) {
             } else {
                 break;
             }
             {
-                uint2 loop_bound_18 = uint2(4294967295u);
+                uint _e449 = next;
+                uint _e450 = top;
+                uint mid_2 = naga_div(_e449 + _e450, 2u);
+                uint _e457 = by_end.inner[metal::min(unsigned(mid_2), 255u)];
+                uint _e459 = q_end.inner[metal::min(unsigned(_e457), 255u)];
+                if (_e459 < lo_5) {
+                    next = mid_2 + 1u;
+                } else {
+                    top = mid_2;
+                }
+            }
+        }
+        i_1 = lo_5;
+        uint2 loop_bound_18 = uint2(4294967295u);
+        bool loop_init_16 = true;
+        while(true) {
+            if (metal::all(loop_bound_18 == uint2(0u))) { break; }
+            loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
+            if (!loop_init_16) {
+                uint _e607 = i_1;
+                i_1 = _e607 + 1u;
+            }
+            loop_init_16 = false;
+            uint _e464 = i_1;
+            if (_e464 <= hi_5) {
+            } else {
+                break;
+            }
+            {
+                uint2 loop_bound_19 = uint2(4294967295u);
                 while(true) {
-                    if (metal::all(loop_bound_18 == uint2(0u))) { break; }
-                    loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
-                    uint _e395 = next;
-                    if (_e395 < v_9) {
-                        uint _e399 = next;
-                        uint _e401 = by_end.inner[metal::min(unsigned(_e399), 255u)];
-                        uint _e403 = q_end.inner[metal::min(unsigned(_e401), 255u)];
-                        uint _e404 = i_1;
-                        local_5 = _e403 == _e404;
+                    if (metal::all(loop_bound_19 == uint2(0u))) { break; }
+                    loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
+                    uint _e466 = next;
+                    if (_e466 < v_9) {
+                        uint _e470 = next;
+                        uint _e472 = by_end.inner[metal::min(unsigned(_e470), 255u)];
+                        uint _e474 = q_end.inner[metal::min(unsigned(_e472), 255u)];
+                        uint _e475 = i_1;
+                        local_5 = _e474 == _e475;
                     } else {
                         local_5 = false;
                     }
-                    bool _e409 = local_5;
-                    if (_e409) {
+                    bool _e480 = local_5;
+                    if (_e480) {
+                        uint _e481 = i_1;
+                        if (!((_e481 < hi_5))) {
+                            local_7 = (li + 1u) == TREES;
+                        } else {
+                            local_7 = true;
+                        }
+                        bool _e491 = local_7;
+                        local_6 = _e491;
+                    } else {
+                        local_6 = false;
+                    }
+                    bool _e495 = local_6;
+                    if (_e495) {
                     } else {
                         break;
                     }
                     {
-                        uint _e411 = next;
-                        uint k_8 = by_end.inner[metal::min(unsigned(_e411), 255u)];
-                        uint _e415 = next;
-                        next = _e415 + 1u;
-                        dotp = 0.0;
+                        uint _e497 = next;
+                        uint k_9 = by_end.inner[metal::min(unsigned(_e497), 255u)];
+                        uint _e501 = next;
+                        next = _e501 + 1u;
                         h_1 = 0u;
-                        uint2 loop_bound_19 = uint2(4294967295u);
+                        uint2 loop_bound_20 = uint2(4294967295u);
                         bool loop_init_17 = true;
                         while(true) {
-                            if (metal::all(loop_bound_19 == uint2(0u))) { break; }
-                            loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
+                            if (metal::all(loop_bound_20 == uint2(0u))) { break; }
+                            loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
                             if (!loop_init_17) {
-                                uint _e469 = h_1;
-                                h_1 = _e469 + 1u;
+                                uint _e552 = h_1;
+                                h_1 = _e552 + 1u;
                             }
                             loop_init_17 = false;
-                            uint _e421 = h_1;
-                            if (_e421 < RANK_VECS) {
+                            uint _e505 = h_1;
+                            if (_e505 < RANK_VECS) {
                             } else {
                                 break;
                             }
                             {
                                 p = metal::float4(0.0, 0.0, 0.0, 0.0);
-                                uint _e432 = q_rank.inner[metal::min(unsigned(k_8), 255u)];
-                                j_1 = v_9 - _e432;
-                                uint2 loop_bound_20 = uint2(4294967295u);
+                                uint _e516 = q_rank.inner[metal::min(unsigned(k_9), 255u)];
+                                j_1 = v_9 - _e516;
+                                uint2 loop_bound_21 = uint2(4294967295u);
                                 while(true) {
-                                    if (metal::all(loop_bound_20 == uint2(0u))) { break; }
-                                    loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
-                                    uint _e435 = j_1;
-                                    if (_e435 > 0u) {
+                                    if (metal::all(loop_bound_21 == uint2(0u))) { break; }
+                                    loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
+                                    uint _e519 = j_1;
+                                    if (_e519 > 0u) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        metal::float4 _e438 = p;
-                                        uint _e439 = j_1;
-                                        uint _e446 = h_1;
-                                        metal::float4 _e449 = pst_tree[metal::min(unsigned((tree + ((_e439 - 1u) * RANK_VECS)) + _e446), (_buffer_sizes.size7 - 0 - 16) / 16)];
-                                        p = _e438 + _e449;
-                                        uint _e451 = j_1;
-                                        uint _e452 = j_1;
-                                        uint _e453 = j_1;
-                                        j_1 = _e451 - (_e452 & (~(_e453) + 1u));
+                                        metal::float4 _e522 = p;
+                                        uint _e523 = j_1;
+                                        uint _e530 = h_1;
+                                        metal::float4 _e533 = pst_tree[metal::min(unsigned((tree + ((_e523 - 1u) * RANK_VECS)) + _e530), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                                        p = _e522 + _e533;
+                                        uint _e535 = j_1;
+                                        uint _e536 = j_1;
+                                        uint _e537 = j_1;
+                                        j_1 = _e535 - (_e536 & (~(_e537) + 1u));
                                     }
                                 }
-                                float _e459 = dotp;
-                                metal::float4 _e460 = p;
-                                float _e463 = q_theta.inner[metal::min(unsigned(k_8), 255u)];
-                                uint _e464 = h_1;
-                                metal::float4 _e465 = beta_at(_e463, _e464, pst_factors, _buffer_sizes);
-                                dotp = _e459 + metal::dot(_e460, _e465);
+                                uint _e547 = h_1;
+                                metal::float4 _e550 = p;
+                                pst_tree[metal::min(unsigned((partials + (k_9 * RANK_VECS)) + _e547), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e550;
                             }
                         }
-                        float _e475 = q_a.inner[metal::min(unsigned(k_8), 255u)];
-                        float _e476 = dotp;
-                        float _e482 = q_b.inner[metal::min(unsigned(k_8), 255u)];
-                        metal::float3 _e485 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(f_14.light_color.xyz * (metal::max(_e475 * _e476, 0.0) + _e482));
-                        metal::uint2 _e486 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-                        uint clamped_lod_e489 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-                        metal::float4 _e489 = depth.read(metal::min(metal::uint2(_e486), metal::uint2(depth.get_width(clamped_lod_e489), depth.get_height(clamped_lod_e489)) - 1), clamped_lod_e489);
-                        float z_7 = _e489.x;
-                        output.write(metal::float4(_e485.x, _e485.y, _e485.z, z_7), metal::uint2(metal::uint2(k_8, s_6)));
                     }
                 }
-                uint _e497 = i_1;
-                if (_e497 == width) {
+                uint _e554 = i_1;
+                if (_e554 == hi_5) {
                     break;
                 }
-                uint _e500 = i_1;
-                uint b_6 = pst_columns[metal::min(unsigned(base_1 + _e500), (_buffer_sizes.size8 - 0 - 4) / 4)];
-                if (b_6 > 0u) {
+                uint _e557 = i_1;
+                uint b_7 = pst_columns[metal::min(unsigned(base_1 + _e557), (_buffer_sizes.size8 - 0 - 4) / 4)];
+                if (b_7 > 0u) {
                     h_2 = 0u;
-                    uint2 loop_bound_21 = uint2(4294967295u);
+                    uint2 loop_bound_22 = uint2(4294967295u);
                     bool loop_init_18 = true;
                     while(true) {
-                        if (metal::all(loop_bound_21 == uint2(0u))) { break; }
-                        loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
+                        if (metal::all(loop_bound_22 == uint2(0u))) { break; }
+                        loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
                         if (!loop_init_18) {
-                            uint _e547 = h_2;
-                            h_2 = _e547 + 1u;
+                            uint _e604 = h_2;
+                            h_2 = _e604 + 1u;
                         }
                         loop_init_18 = false;
-                        uint _e508 = h_2;
-                        if (_e508 < RANK_VECS) {
+                        uint _e565 = h_2;
+                        if (_e565 < RANK_VECS) {
                         } else {
                             break;
                         }
                         {
-                            uint _e511 = i_1;
-                            uint _e516 = h_2;
-                            metal::float4 leaf_1 = pst_leaves[metal::min(unsigned(((base_1 + _e511) * RANK_VECS) + _e516), (_buffer_sizes.size6 - 0 - 16) / 16)];
-                            j_2 = (v_9 - b_6) + 1u;
-                            uint2 loop_bound_22 = uint2(4294967295u);
+                            uint _e568 = i_1;
+                            uint _e573 = h_2;
+                            metal::float4 leaf_1 = pst_leaves[metal::min(unsigned(((base_1 + _e568) * RANK_VECS) + _e573), (_buffer_sizes.size6 - 0 - 16) / 16)];
+                            j_2 = (v_9 - b_7) + 1u;
+                            uint2 loop_bound_23 = uint2(4294967295u);
                             while(true) {
-                                if (metal::all(loop_bound_22 == uint2(0u))) { break; }
-                                loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
-                                uint _e524 = j_2;
-                                if (_e524 <= v_9) {
+                                if (metal::all(loop_bound_23 == uint2(0u))) { break; }
+                                loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
+                                uint _e581 = j_2;
+                                if (_e581 <= v_9) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    uint _e526 = j_2;
-                                    uint _e533 = h_2;
-                                    metal::float4 _e536 = pst_tree[metal::min(unsigned((tree + ((_e526 - 1u) * RANK_VECS)) + _e533), (_buffer_sizes.size7 - 0 - 16) / 16)];
-                                    pst_tree[metal::min(unsigned((tree + ((_e526 - 1u) * RANK_VECS)) + _e533), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e536 + leaf_1;
-                                    uint _e538 = j_2;
-                                    uint _e539 = j_2;
-                                    uint _e540 = j_2;
-                                    j_2 = _e538 + (_e539 & (~(_e540) + 1u));
+                                    uint _e583 = j_2;
+                                    uint _e590 = h_2;
+                                    metal::float4 _e593 = pst_tree[metal::min(unsigned((tree + ((_e583 - 1u) * RANK_VECS)) + _e590), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                                    pst_tree[metal::min(unsigned((tree + ((_e583 - 1u) * RANK_VECS)) + _e590), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e593 + leaf_1;
+                                    uint _e595 = j_2;
+                                    uint _e596 = j_2;
+                                    uint _e597 = j_2;
+                                    j_2 = _e595 + (_e596 & (~(_e597) + 1u));
                                 }
                             }
                         }
@@ -1674,8 +1782,151 @@ kernel void pst_sweep(
                 }
             }
         }
-        return;
-    } else {
-        return;
     }
+    metal::threadgroup_barrier(metal::mem_flags::mem_device);
+    metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
+    x = li;
+    uint2 loop_bound_24 = uint2(4294967295u);
+    bool loop_init_19 = true;
+    while(true) {
+        if (metal::all(loop_bound_24 == uint2(0u))) { break; }
+        loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
+        if (!loop_init_19) {
+            uint _e644 = x;
+            x = _e644 + SLICE_LANES;
+        }
+        loop_init_19 = false;
+        uint _e610 = x;
+        if (_e610 < (v_9 * RANK_VECS)) {
+        } else {
+            break;
+        }
+        {
+            running = metal::float4(0.0, 0.0, 0.0, 0.0);
+            c = 0u;
+            uint2 loop_bound_25 = uint2(4294967295u);
+            bool loop_init_20 = true;
+            while(true) {
+                if (metal::all(loop_bound_25 == uint2(0u))) { break; }
+                loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
+                if (!loop_init_20) {
+                    uint _e642 = c;
+                    c = _e642 + 1u;
+                }
+                loop_init_20 = false;
+                uint _e622 = c;
+                if (_e622 < TREES) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e625 = c;
+                    uint _e631 = x;
+                    uint at = (trees + ((_e625 * SLICE_SAMPLES) * RANK_VECS)) + _e631;
+                    metal::float4 own = pst_tree[metal::min(unsigned(at), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                    metal::float4 _e638 = running;
+                    pst_tree[metal::min(unsigned(at), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e638;
+                    metal::float4 _e639 = running;
+                    running = _e639 + own;
+                }
+            }
+        }
+    }
+    metal::threadgroup_barrier(metal::mem_flags::mem_device);
+    metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
+    k_4 = li;
+    uint2 loop_bound_26 = uint2(4294967295u);
+    bool loop_init_21 = true;
+    while(true) {
+        if (metal::all(loop_bound_26 == uint2(0u))) { break; }
+        loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
+        if (!loop_init_21) {
+            uint _e759 = k_4;
+            k_4 = _e759 + SLICE_LANES;
+        }
+        loop_init_21 = false;
+        uint _e648 = k_4;
+        if (_e648 < SLICE_SAMPLES) {
+        } else {
+            break;
+        }
+        {
+            uint _e652 = k_4;
+            uint _e654 = q_end.inner[metal::min(unsigned(_e652), 255u)];
+            if (_e654 != NONE) {
+                uint _e658 = k_4;
+                uint _e660 = q_end.inner[metal::min(unsigned(_e658), 255u)];
+                uint tree_1 = trees + ((metal::min(naga_div(_e660, cw), 7u) * SLICE_SAMPLES) * RANK_VECS);
+                dotp = 0.0;
+                h_3 = 0u;
+                uint2 loop_bound_27 = uint2(4294967295u);
+                bool loop_init_22 = true;
+                while(true) {
+                    if (metal::all(loop_bound_27 == uint2(0u))) { break; }
+                    loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
+                    if (!loop_init_22) {
+                        uint _e727 = h_3;
+                        h_3 = _e727 + 1u;
+                    }
+                    loop_init_22 = false;
+                    uint _e673 = h_3;
+                    if (_e673 < RANK_VECS) {
+                    } else {
+                        break;
+                    }
+                    {
+                        uint _e676 = k_4;
+                        uint _e681 = h_3;
+                        metal::float4 _e684 = pst_tree[metal::min(unsigned((partials + (_e676 * RANK_VECS)) + _e681), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                        p_1 = _e684;
+                        uint _e687 = k_4;
+                        uint _e689 = q_rank.inner[metal::min(unsigned(_e687), 255u)];
+                        j_3 = v_9 - _e689;
+                        uint2 loop_bound_28 = uint2(4294967295u);
+                        while(true) {
+                            if (metal::all(loop_bound_28 == uint2(0u))) { break; }
+                            loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
+                            uint _e692 = j_3;
+                            if (_e692 > 0u) {
+                            } else {
+                                break;
+                            }
+                            {
+                                metal::float4 _e695 = p_1;
+                                uint _e696 = j_3;
+                                uint _e703 = h_3;
+                                metal::float4 _e706 = pst_tree[metal::min(unsigned((tree_1 + ((_e696 - 1u) * RANK_VECS)) + _e703), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                                p_1 = _e695 + _e706;
+                                uint _e708 = j_3;
+                                uint _e709 = j_3;
+                                uint _e710 = j_3;
+                                j_3 = _e708 - (_e709 & (~(_e710) + 1u));
+                            }
+                        }
+                        float _e716 = dotp;
+                        metal::float4 _e717 = p_1;
+                        uint _e719 = k_4;
+                        float _e721 = q_theta.inner[metal::min(unsigned(_e719), 255u)];
+                        uint _e722 = h_3;
+                        metal::float4 _e723 = beta_at(_e721, _e722, pst_factors, _buffer_sizes);
+                        dotp = _e716 + metal::dot(_e717, _e723);
+                    }
+                }
+                uint _e732 = k_4;
+                float _e734 = q_a.inner[metal::min(unsigned(_e732), 255u)];
+                float _e735 = dotp;
+                uint _e740 = k_4;
+                float _e742 = q_b.inner[metal::min(unsigned(_e740), 255u)];
+                metal::float3 _e745 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(f_14.light_color.xyz * (metal::max(_e734 * _e735, 0.0) + _e742));
+                uint _e746 = k_4;
+                metal::uint2 _e747 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e746, screen_4);
+                uint clamped_lod_e750 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+                metal::float4 _e750 = depth.read(metal::min(metal::uint2(_e747), metal::uint2(depth.get_width(clamped_lod_e750), depth.get_height(clamped_lod_e750)) - 1), clamped_lod_e750);
+                float z_7 = _e750.x;
+                uint _e752 = k_4;
+                output.write(metal::float4(_e745.x, _e745.y, _e745.z, z_7), metal::uint2(metal::uint2(_e752, s_6)));
+            }
+        }
+    }
+    return;
 }

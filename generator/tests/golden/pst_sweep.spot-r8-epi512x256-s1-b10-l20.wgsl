@@ -93,6 +93,7 @@ const STEP: u32 = 1u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
 const RANK_VECS: u32 = 2u;
+const TREES: u32 = 8u;
 const GRID: u32 = 96u;
 const GL2_: f32 = 0.57735026f;
 const NONE: u32 = 4294967295u;
@@ -128,8 +129,8 @@ var<workgroup> q_b: array<f32, 256>;
 var<workgroup> by_end: array<u32, 256>;
 var<workgroup> live: atomic<u32>;
 
-fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p_1: vec3<f32>) -> vec3<f32> {
-    let q_2 = (p_1 - v.origin.xyz);
+fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p_2: vec3<f32>) -> vec3<f32> {
+    let q_2 = (p_2 - v.origin.xyz);
     return vec3<f32>(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
 }
 
@@ -144,35 +145,35 @@ fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_o
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_6: bool;
-    var local_7: bool;
     var local_8: bool;
+    var local_9: bool;
+    var local_10: bool;
 
     if !((uv.x < 0f)) {
-        local_6 = (uv.x > 1f);
-    } else {
-        local_6 = true;
-    }
-    let _e11 = local_6;
-    if !(_e11) {
-        local_7 = (uv.y < 0f);
-    } else {
-        local_7 = true;
-    }
-    let _e19 = local_7;
-    if !(_e19) {
-        local_8 = (uv.y > 1f);
+        local_8 = (uv.x > 1f);
     } else {
         local_8 = true;
     }
-    let _e27 = local_8;
+    let _e11 = local_8;
+    if !(_e11) {
+        local_9 = (uv.y < 0f);
+    } else {
+        local_9 = true;
+    }
+    let _e19 = local_9;
+    if !(_e19) {
+        local_10 = (uv.y > 1f);
+    } else {
+        local_10 = true;
+    }
+    let _e27 = local_10;
     if _e27 {
         return 2f;
     }
     let n_3 = v_2.size.x;
-    let x_5 = min(u32((uv.x * f32(n_3))), (n_3 - 1u));
+    let x_6 = min(u32((uv.x * f32(n_3))), (n_3 - 1u));
     let y_1 = min(u32((uv.y * f32(n_3))), (n_3 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_5, y_1), 0i);
+    let _e49 = textureLoad(sm, vec2<u32>(x_6, y_1), 0i);
     return _e49.x;
 }
 
@@ -189,18 +190,18 @@ fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga
     return (v_3.forward.w * _e32);
 }
 
-fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_2: vec3<f32>) -> f32 {
-    var local_9: bool;
+fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_3: vec3<f32>) -> f32 {
+    var local_11: bool;
 
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_2);
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
     let near = v_4.right.w;
     let far = v_4.up.w;
     if (v_4.origin.w > 0.5f) {
-        local_9 = (_e2.z <= near);
+        local_11 = (_e2.z <= near);
     } else {
-        local_9 = false;
+        local_11 = false;
     }
-    let _e16 = local_9;
+    let _e16 = local_11;
     if _e16 {
         return 1f;
     }
@@ -246,11 +247,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_6 = (sigma_t * len);
-    if (x_6 < 0.0001f) {
-        return (len * (1f - (0.5f * x_6)));
+    let x_7 = (sigma_t * len);
+    if (x_7 < 0.0001f) {
+        return (len * (1f - (0.5f * x_7)));
     }
-    return ((1f - exp(-(x_6))) / sigma_t);
+    return ((1f - exp(-(x_7))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -262,13 +263,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_7 * x_7) * (3f - (2f * x_7)));
+    let x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_8 * x_8) * (3f - (2f * x_8)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_8 = (eye + (dir * t));
-    let to_x = (x_8 - light_pos);
+    let x_9 = (eye + (dir * t));
+    let to_x = (x_9 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d_1 = sqrt(d2_);
     let travel = (to_x / vec3(d_1));
@@ -279,21 +280,21 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
 
 fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
     var sum: f32 = 0f;
-    var k_4: u32 = 0u;
+    var k_5: u32 = 0u;
     var q_1: u32;
 
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
-    let h_8 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
-    let g0_ = atan(((a_1 - t0_) / h_8));
-    let w_1 = ((atan(((b_1 - t0_) / h_8)) - g0_) / f32(panels));
+    let h_9 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
+    let g0_ = atan(((a_1 - t0_) / h_9));
+    let w_1 = ((atan(((b_1 - t0_) / h_9)) - g0_) / f32(panels));
     loop {
-        let _e30 = k_4;
+        let _e30 = k_5;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            let _e32 = k_4;
+            let _e32 = k_5;
             let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
             q_1 = 0u;
             loop {
@@ -307,7 +308,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                     let u_1 = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     let _e52 = sum;
                     let _e54 = q_1;
-                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_8 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_9 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
                     sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u_1 * u_1))));
                 }
                 continuing {
@@ -317,23 +318,23 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
             }
         }
         continuing {
-            let _e73 = k_4;
-            k_4 = (_e73 + 1u);
+            let _e73 = k_5;
+            k_5 = (_e73 + 1u);
         }
     }
     let _e75 = sum;
-    return (((_e75 * 0.5f) * w_1) * h_8);
+    return (((_e75 * 0.5f) * w_1) * h_9);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     let t0_1 = dot((light_pos_2 - eye_2), dir_2);
-    let h_9 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001f * max((b_2 - a_2), 0.000001f)));
-    let theta_a = atan(((a_2 - t0_1) / h_9));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_9, theta_a, ((atan(((b_2 - t0_1) / h_9)) - theta_a) / f32(n)));
+    let h_10 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001f * max((b_2 - a_2), 0.000001f)));
+    let theta_a = atan(((a_2 - t0_1) / h_10));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_10, theta_a, ((atan(((b_2 - t0_1) / h_10)) - theta_a) / f32(n)));
 }
 
-fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x: f32) -> vec2<f32> {
-    let tau = tan((e.theta_a + (x * e.dtheta)));
+fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x_1: f32) -> vec2<f32> {
+    let tau = tan((e.theta_a + (x_1 * e.dtheta)));
     return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
@@ -357,9 +358,9 @@ fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, vec4<u32>(f_2.sizes2_.x, 0u, 0u, 0u));
 }
 
-fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_3: texture_2d<f32>, p_3: vec3<f32>) -> f32 {
+fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_3: texture_2d<f32>, p_4: vec3<f32>) -> f32 {
     let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    let _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_3);
+    let _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_4);
     return _e4;
 }
 
@@ -370,25 +371,25 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX
 
 fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, s: f32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
-    var k_5: u32 = 0u;
+    var k_6: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
     let steps = f_5.sizes2_.y;
-    let h_10 = (s / f32(steps));
+    let h_11 = (s / f32(steps));
     let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, 0f, s, steps);
     loop {
-        let _e15 = k_5;
+        let _e15 = k_6;
         if (_e15 < steps) {
         } else {
             break;
         }
         {
-            let _e17 = k_5;
-            t_2 = ((f32(_e17) + 0.5f) * h_10);
-            w = h_10;
+            let _e17 = k_6;
+            t_2 = ((f32(_e17) + 0.5f) * h_11);
+            w = h_11;
             if spot {
-                let _e25 = k_5;
+                let _e25 = k_6;
                 let _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e25) + 0.5f));
                 t_2 = _e29.x;
                 w = _e29.y;
@@ -403,15 +404,15 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_o
                 sum_1 = (_e38 + ((_e36 * _e39) * _e42));
             } else {
                 let _e45 = sum_1;
-                let _e48 = k_5;
-                let _e51 = k_5;
-                let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (f32(_e48) * h_10), (f32((_e51 + 1u)) * h_10));
+                let _e48 = k_6;
+                let _e51 = k_6;
+                let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (f32(_e48) * h_11), (f32((_e51 + 1u)) * h_11));
                 sum_1 = (_e45 + (_e36 * _e56));
             }
         }
         continuing {
-            let _e60 = k_5;
-            k_5 = (_e60 + 1u);
+            let _e60 = k_6;
+            k_6 = (_e60 + 1u);
         }
     }
     if spot {
@@ -424,8 +425,8 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_o
     }
 }
 
-fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_3: f32, rows: u32, wrap: bool) -> u32 {
-    let ji = i32(j_3);
+fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_4: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = i32(j_4);
     if wrap {
         return u32((((ji % i32(rows)) + i32(rows)) % i32(rows)));
     } else {
@@ -433,24 +434,24 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_3: f32, rows: u32, w
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
-    var local_10: bool;
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
+    var local_12: bool;
 
     if spot_1 {
-        let psi = (x_1 * delta);
+        let psi = (x_2 * delta);
         let den = sin((theta_1 + psi));
         if !((den <= 0.000001f)) {
-            local_10 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_12 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_10 = true;
+            local_12 = true;
         }
-        let _e16 = local_10;
+        let _e16 = local_12;
         if _e16 {
             return s_1;
         }
         return min(((f_6.axis.w * sin(psi)) / den), s_1);
     } else {
-        return min(((x_1 * delta) / max(sin(theta_1), 0.000001f)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_1), 0.000001f)), s_1);
     }
 }
 
@@ -459,12 +460,24 @@ fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oi
     return _e15;
 }
 
+fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_4: f32, b_4: f32, depth_break: f32) -> bool {
+    var local_13: bool;
+
+    if !((a_4 == b_4)) {
+        local_13 = (abs((a_4 - b_4)) <= (depth_break * min(a_4, b_4)));
+    } else {
+        local_13 = true;
+    }
+    let _e13 = local_13;
+    return _e13;
+}
+
 fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_7: vec3<f32>) -> vec3<f32> {
-    let a_7 = min(abs(v_7), vec3(65504f));
-    let u_2 = bitcast<vec3<u32>>(a_7);
+    let a_8 = min(abs(v_7), vec3(65504f));
+    let u_2 = bitcast<vec3<u32>>(a_8);
     let normal = bitcast<vec3<f32>>((((u_2 + vec3(4095u)) + ((u_2 >> vec3(13u)) & vec3(1u))) & vec3(4294959104u)));
-    let subnormal = (round((a_7 * 16777216f)) / vec3(16777216f));
-    return (sign(v_7) * select(normal, subnormal, (a_7 < vec3(0.000061035156f))));
+    let subnormal = (round((a_8 * 16777216f)) / vec3(16777216f));
+    return (sign(v_7) * select(normal, subnormal, (a_8 < vec3(0.000061035156f))));
 }
 
 fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, d: vec2<f32>) -> f32 {
@@ -474,12 +487,12 @@ fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, 
 fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, screen: vec2<u32>, slices: u32) -> EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     var origin: vec2<f32>;
     var l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
-    var local_11: bool;
-    var local_12: bool;
-    var local_13: bool;
-    var a_4: f32 = 0f;
-    var b_4: f32 = 0f;
-    var k_6: u32 = 0u;
+    var local_14: bool;
+    var local_15: bool;
+    var local_16: bool;
+    var a_5: f32 = 0f;
+    var b_5: f32 = 0f;
+    var k_7: u32 = 0u;
 
     let size_1 = vec2<f32>(screen);
     let centre = (0.5f * size_1);
@@ -506,25 +519,25 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     let _e79 = origin.x;
     if (_e79 >= lo_2.x) {
         let _e83 = origin.x;
-        local_11 = (_e83 <= hi_2.x);
+        local_14 = (_e83 <= hi_2.x);
     } else {
-        local_11 = false;
+        local_14 = false;
     }
-    let _e89 = local_11;
+    let _e89 = local_14;
     if _e89 {
         let _e91 = origin.y;
-        local_12 = (_e91 >= lo_2.y);
+        local_15 = (_e91 >= lo_2.y);
     } else {
-        local_12 = false;
+        local_15 = false;
     }
-    let _e97 = local_12;
+    let _e97 = local_15;
     if _e97 {
         let _e99 = origin.y;
-        local_13 = (_e99 <= hi_2.y);
+        local_16 = (_e99 <= hi_2.y);
     } else {
-        local_13 = false;
+        local_16 = false;
     }
-    let inside = local_13;
+    let inside = local_16;
     if inside {
         l_1.wrap = 1u;
         l_1.phi_start = -3.1415927f;
@@ -532,38 +545,38 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     } else {
         l_1.wrap = 0u;
         loop {
-            let _e118 = k_6;
+            let _e118 = k_7;
             if (_e118 < 4u) {
             } else {
                 break;
             }
             {
-                let _e123 = k_6;
-                let _e131 = k_6;
+                let _e123 = k_7;
+                let _e131 = k_7;
                 let corner = vec2<f32>(select(lo_2.x, hi_2.x, ((_e123 & 1u) != 0u)), select(lo_2.y, hi_2.y, ((_e131 & 2u) != 0u)));
                 let _e139 = l_1.axis;
                 let _e140 = origin;
                 let _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
-                let _e143 = k_6;
+                let _e143 = k_7;
                 if (_e143 == 0u) {
-                    a_4 = _e142;
-                    b_4 = _e142;
+                    a_5 = _e142;
+                    b_5 = _e142;
                 } else {
-                    let _e148 = a_4;
-                    a_4 = min(_e148, _e142);
-                    let _e150 = b_4;
-                    b_4 = max(_e150, _e142);
+                    let _e148 = a_5;
+                    a_5 = min(_e148, _e142);
+                    let _e150 = b_5;
+                    b_5 = max(_e150, _e142);
                 }
             }
             continuing {
-                let _e153 = k_6;
-                k_6 = (_e153 + 1u);
+                let _e153 = k_7;
+                k_7 = (_e153 + 1u);
             }
         }
-        let _e156 = a_4;
+        let _e156 = a_5;
         l_1.phi_start = _e156;
-        let _e158 = b_4;
-        let _e159 = a_4;
+        let _e158 = b_5;
+        let _e159 = a_5;
         l_1.dphi = ((_e158 - _e159) / f32(slices));
     }
     let _e163 = l_1;
@@ -572,35 +585,35 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
 
 fn slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_2: u32) -> vec2<f32> {
     let phi_1 = (l_2.phi_start + ((f32(s_2) + 0.5f) * l_2.dphi));
-    let c = cos(phi_1);
+    let c_1 = cos(phi_1);
     let sn = sin(phi_1);
-    return vec2<f32>(((l_2.axis.x * c) - (l_2.axis.y * sn)), ((l_2.axis.y * c) + (l_2.axis.x * sn)));
+    return vec2<f32>(((l_2.axis.x * c_1) - (l_2.axis.y * sn)), ((l_2.axis.y * c_1) + (l_2.axis.x * sn)));
 }
 
 fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_3: u32, screen_1: vec2<u32>, samples: u32) -> vec2<f32> {
     var t_in: f32 = 0f;
     var t_out: f32 = 340000000000000000000000000000000000000f;
-    var a_5: u32 = 0u;
+    var a_6: u32 = 0u;
 
     let _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_3);
     let lo_3 = vec2<f32>(0.5f, 0.5f);
     let hi_3 = (vec2<f32>(screen_1) - vec2<f32>(0.5f, 0.5f));
     loop {
-        let _e16 = a_5;
+        let _e16 = a_6;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            let _e19 = a_5;
+            let _e19 = a_6;
             if (abs(_e5[_e19]) > 0.000000000001f) {
-                let _e24 = a_5;
-                let _e27 = a_5;
-                let _e30 = a_5;
+                let _e24 = a_6;
+                let _e27 = a_6;
+                let _e30 = a_6;
                 let ta = ((lo_3[_e24] - l_3.origin[_e27]) / _e5[_e30]);
-                let _e33 = a_5;
-                let _e36 = a_5;
-                let _e39 = a_5;
+                let _e33 = a_6;
+                let _e36 = a_6;
+                let _e39 = a_6;
                 let tb = ((hi_3[_e33] - l_3.origin[_e36]) / _e5[_e39]);
                 let _e43 = t_in;
                 t_in = max(_e43, min(ta, tb));
@@ -609,8 +622,8 @@ fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_
             }
         }
         continuing {
-            let _e51 = a_5;
-            a_5 = (_e51 + 1u);
+            let _e51 = a_6;
+            a_6 = (_e51 + 1u);
         }
     }
     let _e53 = t_out;
@@ -622,56 +635,56 @@ fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_
     return vec2<f32>(_e56, ((_e57 - _e58) / f32((samples - 1u))));
 }
 
-fn slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_4: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, u: vec2<f32>, span: vec2<f32>, k_7: u32, screen_2: vec2<u32>) -> vec2<u32> {
-    let p_5 = (l_4.origin + (u * (span.x + (f32(k_7) * span.y))));
+fn slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_4: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, u: vec2<f32>, span: vec2<f32>, k_8: u32, screen_2: vec2<u32>) -> vec2<u32> {
+    let p_6 = (l_4.origin + (u * (span.x + (f32(k_8) * span.y))));
     let last = (vec2<f32>(screen_2) - vec2<f32>(1f, 1f));
-    return vec2<u32>(clamp(floor(p_5), vec2<f32>(0f, 0f), last));
+    return vec2<u32>(clamp(floor(p_6), vec2<f32>(0f, 0f), last));
 }
 
-fn edge_t(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n_1: u32, delta_1: f32, theta_2: f32, s_4: f32, spot_2: bool) -> f32 {
-    if (x_2 >= n_1) {
+fn edge_t(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_2: f32, s_4: f32, spot_2: bool) -> f32 {
+    if (x_3 >= n_1) {
         return s_4;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, f32(x_2), delta_1, theta_2, s_4, spot_2);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, f32(x_3), delta_1, theta_2, s_4, spot_2);
     return _e9;
 }
 
-fn lit_span(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_6: f32, b_5: f32, spot_3: bool) -> f32 {
+fn lit_span(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_7: f32, b_6: f32, spot_3: bool) -> f32 {
     if spot_3 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_6, b_5, max((f_9.sizes2_.z / 4u), 1u));
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_7, b_6, max((f_9.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_6, b_5);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_7, b_6);
     return _e15;
 }
 
-fn factor_at(base: u32, x_3: f32, h_3: u32) -> vec4<f32> {
-    let p_6 = min((clamp(x_3, 0f, 1f) * 95f), 95f);
-    let j_4 = min(u32(floor(p_6)), 94u);
-    let t_4 = (p_6 - f32(j_4));
-    let _e22 = pst_factors[((base + (2u * j_4)) + h_3)];
-    let _e34 = pst_factors[((base + (2u * (j_4 + 1u))) + h_3)];
+fn factor_at(base: u32, x_4: f32, h_4: u32) -> vec4<f32> {
+    let p_7 = min((clamp(x_4, 0f, 1f) * 95f), 95f);
+    let j_5 = min(u32(floor(p_7)), 94u);
+    let t_4 = (p_7 - f32(j_5));
+    let _e22 = pst_factors[((base + (2u * j_5)) + h_4)];
+    let _e34 = pst_factors[((base + (2u * (j_5 + 1u))) + h_4)];
     return ((_e22 * (1f - t_4)) + (_e34 * t_4));
 }
 
-fn gamma_at(v_8: f32, h_4: u32) -> vec4<f32> {
+fn gamma_at(v_8: f32, h_5: u32) -> vec4<f32> {
     let _e4 = pst_factors[0].x;
-    let _e8 = factor_at(1u, (v_8 / _e4), h_4);
+    let _e8 = factor_at(1u, (v_8 / _e4), h_5);
     return _e8;
 }
 
-fn beta_at(theta_3: f32, h_5: u32) -> vec4<f32> {
+fn beta_at(theta_3: f32, h_6: u32) -> vec4<f32> {
     let head = pst_factors[0];
-    let _e14 = factor_at(193u, ((theta_3 - head.y) / max((head.z - head.y), 0.000000000001f)), h_5);
+    let _e14 = factor_at(193u, ((theta_3 - head.y) / max((head.z - head.y), 0.000000000001f)), h_6);
     return _e14;
 }
 
-fn pst_leaf(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, row_1: u32, delta_2: f32, h_6: u32) -> vec4<f32> {
+fn pst_leaf(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, row_1: u32, delta_2: f32, h_7: u32) -> vec4<f32> {
     var leaf: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var g_1: u32 = 0u;
 
     if false {
-        let _e9 = gamma_at((f32(i_2) * delta_2), h_6);
+        let _e9 = gamma_at((f32(i_2) * delta_2), h_7);
         return _e9;
     }
     let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, row_1);
@@ -690,7 +703,7 @@ fn pst_leaf(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
             let l_5 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
             let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_10.light_dir.xyz), f_10.light_pos.w, f_10.light_dir.w);
             let _e48 = leaf;
-            let _e52 = gamma_at(psi_1, h_6);
+            let _e52 = gamma_at(psi_1, h_7);
             leaf = (_e48 + (((0.5f * delta_2) * _e46) * _e52));
         }
         continuing {
@@ -703,10 +716,10 @@ fn pst_leaf(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
 }
 
 fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
-    var r: PstRay;
-    var local_14: bool;
-    var local_15: bool;
-    var local_16: bool;
+    var r_1: PstRay;
+    var local_17: bool;
+    var local_18: bool;
+    var local_19: bool;
     var yc: f32;
 
     let f_11 = frame;
@@ -715,37 +728,37 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     let t_5 = f_11.cam_forward.w;
     let dir_8 = normalize(((f_11.cam_forward.xyz + (f_11.cam_right.xyz * ((ndc.x * t_5) * f_11.cam_right.w))) + (f_11.cam_up.xyz * (ndc.y * t_5))));
     let s_5 = (min(max(z_1, 0f), f_11.theta.z) / max(dot(dir_8, f_11.cam_forward.xyz), 0.000001f));
-    r = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_7, dir_8, s_5, 0u, 0f, 0f, 0f);
+    r_1 = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_7, dir_8, s_5, 0u, 0f, 0f, 0f);
     let px = vec3<f32>(pc, 0f);
     let radius = f_11.epipole.w;
     if (f_11.epipole.z > 0.5f) {
-        local_14 = (length((px - vec3<f32>(f_11.epipole.x, f_11.epipole.y, 0f))) < radius);
+        local_17 = (length((px - vec3<f32>(f_11.epipole.x, f_11.epipole.y, 0f))) < radius);
     } else {
-        local_14 = false;
+        local_17 = false;
     }
-    let near_epi = local_14;
+    let near_epi = local_17;
     if (f_11.anti_epipole.z > 0.5f) {
-        local_15 = (length((px - vec3<f32>(f_11.anti_epipole.x, f_11.anti_epipole.y, 0f))) < radius);
+        local_18 = (length((px - vec3<f32>(f_11.anti_epipole.x, f_11.anti_epipole.y, 0f))) < radius);
     } else {
-        local_15 = false;
+        local_18 = false;
     }
-    let near_anti = local_15;
+    let near_anti = local_18;
     if !(near_epi) {
-        local_16 = near_anti;
+        local_19 = near_anti;
     } else {
-        local_16 = true;
+        local_19 = true;
     }
-    let _e109 = local_16;
+    let _e109 = local_19;
     if _e109 {
-        r.marched = true;
+        r_1.marched = true;
         let _e114 = frame;
         let _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_7, dir_8, s_5, true);
-        r.color = (_e117 * f_11.light_color.xyz);
+        r_1.color = (_e117 * f_11.light_color.xyz);
     }
     let axis_2 = f_11.axis.xyz;
     let rows_1 = f_11.sizes.w;
     let wrap_1 = (f_11.anti_epipole.w > 0.5f);
-    r.theta = atan2(length(cross(dir_8, axis_2)), dot(dir_8, axis_2));
+    r_1.theta = atan2(length(cross(dir_8, axis_2)), dot(dir_8, axis_2));
     let phi_2 = atan2(dot(dir_8, f_11.e2_.xyz), dot(dir_8, f_11.e1_.xyz));
     yc = ((phi_2 - f_11.e1_.w) / f_11.e2_.w);
     if wrap_1 {
@@ -758,58 +771,58 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     }
     let _e161 = yc;
     let _e163 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e161), rows_1, wrap_1);
-    r.row = _e163;
-    let _e166 = r.theta;
+    r_1.row = _e163;
+    let _e166 = r_1.theta;
     let _e171 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e166, f_11.theta.x, f_11.theta.y);
-    r.d = _e171;
+    r_1.d = _e171;
     if true {
         let q_5 = normalize(((eye_7 + (dir_8 * s_5)) - f_11.light_pos.xyz));
-        r.xs_num = acos(clamp(dot(q_5, -(axis_2)), -1f, 1f));
+        r_1.xs_num = acos(clamp(dot(q_5, -(axis_2)), -1f, 1f));
     } else {
-        let _e187 = r.theta;
-        r.xs_num = (s_5 * sin(_e187));
+        let _e187 = r_1.theta;
+        r_1.xs_num = (s_5 * sin(_e187));
     }
-    let _e190 = r;
+    let _e190 = r_1;
     return _e190;
 }
 
-fn pst_columns_crossed(r_1: PstRay, delta_3: f32) -> u32 {
-    let xs = (r_1.xs_num / delta_3);
+fn pst_columns_crossed(r_2: PstRay, delta_3: f32) -> u32 {
+    let xs = (r_2.xs_num / delta_3);
     let _e12 = frame.sizes.z;
     return u32(min(ceil(select(0f, xs, (xs > 0f))), f32(_e12)));
 }
 
-fn pst_terms(r_2: PstRay, row_2: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
+fn pst_terms(r_3: PstRay, row_2: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     var tail: f32 = 0f;
 
     let f_12 = frame;
-    let sin_theta = max(sin(r_2.theta), 0.000001f);
+    let sin_theta = max(sin(r_3.theta), 0.000001f);
     let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_2), 0i);
-    if (r_2.d <= _e16.x) {
-        let _e25 = edge_t(f_12, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        let _e29 = lit_span(f_12, r_2.eye, r_2.dir, _e25, r_2.s, true);
+    if (r_3.d <= _e16.x) {
+        let _e25 = edge_t(f_12, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
+        let _e29 = lit_span(f_12, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if true {
         let _e37 = tail;
         return vec2<f32>((f_12.medium.y / (f_12.axis.w * sin_theta)), _e37);
     }
-    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, r_2.dir)));
+    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, r_3.dir)));
     let sp = (f_12.medium.y * _e48);
     let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, 0f, (delta_4 / sin_theta));
     let _e56 = tail;
     return vec2<f32>((sp * _e54), (sp * _e56));
 }
 
-fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
+fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
     var sum_2: f32 = 0f;
-    var h_7: u32 = 0u;
-    var p_4: vec4<f32>;
+    var h_8: u32 = 0u;
+    var p_5: vec4<f32>;
     var i_3: u32;
 
     let f_13 = frame;
-    let _e16 = textureLoad(depth, vec2<u32>(x_4, y), 0i);
-    let _e18 = pst_ray(vec2<f32>((f32(x_4) + 0.5f), (f32(y) + 0.5f)), _e16.x);
+    let _e16 = textureLoad(depth, vec2<u32>(x_5, y), 0i);
+    let _e18 = pst_ray(vec2<f32>((f32(x_5) + 0.5f), (f32(y) + 0.5f)), _e16.x);
     if _e18.marched {
         return _e18.color;
     }
@@ -821,13 +834,13 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
         return vec3<f32>(0f, 0f, 0f);
     }
     loop {
-        let _e35 = h_7;
+        let _e35 = h_8;
         if (_e35 < RANK_VECS) {
         } else {
             break;
         }
         {
-            p_4 = vec4<f32>(0f, 0f, 0f, 0f);
+            p_5 = vec4<f32>(0f, 0f, 0f, 0f);
             i_3 = 0u;
             loop {
                 let _e46 = i_3;
@@ -839,11 +852,11 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
                     let _e51 = i_3;
                     let _e56 = textureLoad(rectified, vec2<u32>(_e51, _e18.row), 0i);
                     if (_e18.d <= _e56.x) {
-                        let _e59 = p_4;
+                        let _e59 = p_5;
                         let _e60 = i_3;
-                        let _e62 = h_7;
+                        let _e62 = h_8;
                         let _e63 = pst_leaf(f_13, _e60, _e18.row, delta_5, _e62);
-                        p_4 = (_e59 + _e63);
+                        p_5 = (_e59 + _e63);
                     }
                 }
                 continuing {
@@ -852,14 +865,14 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
                 }
             }
             let _e69 = sum_2;
-            let _e70 = p_4;
-            let _e72 = h_7;
+            let _e70 = p_5;
+            let _e72 = h_8;
             let _e73 = beta_at(_e18.theta, _e72);
             sum_2 = (_e69 + dot(_e70, _e73));
         }
         continuing {
-            let _e77 = h_7;
-            h_7 = (_e77 + 1u);
+            let _e77 = h_8;
+            h_8 = (_e77 + 1u);
         }
     }
     let _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
@@ -867,9 +880,38 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
     return (f_13.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
 }
 
+fn pst_footprint_depth(pc_1: vec2<f32>, screen_3: vec2<u32>) -> f32 {
+    let last_1 = (vec2<f32>(screen_3) - vec2<f32>(1f, 1f));
+    let q_6 = clamp((pc_1 - vec2<f32>(0.5f, 0.5f)), vec2<f32>(0f, 0f), last_1);
+    let i0_ = vec2<u32>(floor(q_6));
+    let i1_ = min((i0_ + vec2<u32>(1u, 1u)), (screen_3 - vec2<u32>(1u, 1u)));
+    let t_6 = (q_6 - floor(q_6));
+    let _e30 = textureLoad(depth, i0_, 0i);
+    let z00_ = _e30.x;
+    let _e37 = textureLoad(depth, vec2<u32>(i1_.x, i0_.y), 0i);
+    let z10_ = _e37.x;
+    let _e44 = textureLoad(depth, vec2<u32>(i0_.x, i1_.y), 0i);
+    let z01_ = _e44.x;
+    let _e48 = textureLoad(depth, i1_, 0i);
+    let z11_ = _e48.x;
+    let lo_4 = min(min(z00_, z10_), min(z01_, z11_));
+    let hi_4 = max(max(z00_, z10_), max(z01_, z11_));
+    let _e57 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lo_4, hi_4, DEPTH_BREAK);
+    if !(_e57) {
+        return -1f;
+    }
+    if (lo_4 == hi_4) {
+        return lo_4;
+    }
+    let w0_ = (((1f / z00_) * (1f - t_6.x)) + ((1f / z10_) * t_6.x));
+    let w1_ = (((1f / z01_) * (1f - t_6.x)) + ((1f / z11_) * t_6.x));
+    return (1f / ((w0_ * (1f - t_6.y)) + (w1_ * t_6.y)));
+}
+
 @compute @workgroup_size(32, 1, 1) 
 fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     var k: u32;
+    var r: PstRay;
     var local: bool;
     var k_1: u32;
     var by_d: u32;
@@ -888,17 +930,27 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     var h: u32;
     var j: u32 = 0u;
     var next: u32 = 0u;
-    var i_1: u32 = 0u;
+    var top: u32;
+    var i_1: u32;
     var local_5: bool;
-    var dotp: f32;
+    var local_6: bool;
+    var local_7: bool;
     var h_1: u32;
     var p: vec4<f32>;
     var j_1: u32;
     var h_2: u32;
     var j_2: u32;
+    var x: u32;
+    var running: vec4<f32>;
+    var c: u32;
+    var k_4: u32;
+    var dotp: f32;
+    var h_3: u32;
+    var p_1: vec4<f32>;
+    var j_3: u32;
 
     let f_14 = frame;
-    let screen_3 = vec2<u32>(f_14.sizes.x, f_14.sizes.y);
+    let screen_4 = vec2<u32>(f_14.sizes.x, f_14.sizes.y);
     let width = f_14.sizes.z;
     let _e12 = frame.cam_forward;
     let _e16 = frame.cam_right;
@@ -906,10 +958,10 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     let _e25 = frame.cam_forward.w;
     let _e29 = frame.cam_right.w;
     let _e32 = frame.axis;
-    let _e36 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e12.xyz, _e16.xyz, _e20.xyz, _e25, _e29, _e32.xyz), screen_3, SLICES);
+    let _e36 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e12.xyz, _e16.xyz, _e20.xyz, _e25, _e29, _e32.xyz), screen_4, SLICES);
     let s_6 = wid.x;
     let _e39 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6);
-    let _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6, screen_3, SLICE_SAMPLES);
+    let _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6, screen_4, SLICE_SAMPLES);
     if (li == 0u) {
         textureStore(output, vec2<u32>(SLICE_SAMPLES, s_6), vec4<f32>(_e39.x, _e39.y, _e41.x, _e41.y));
         if (s_6 == 0u) {
@@ -933,397 +985,559 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         }
         {
             let _e94 = k;
-            let _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e94, screen_3);
+            let _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e94, screen_4);
             let _e98 = textureLoad(depth, _e95, 0i);
             let z_6 = _e98.x;
             let _e102 = k;
-            let _e109 = pst_ray((_e36.origin + (_e39 * (_e41.x + (f32(_e102) * _e41.y)))), z_6);
-            let _e110 = pst_columns_crossed(_e109, delta_6);
-            let _e112 = k;
-            q_end[_e112] = NONE;
-            if !(_e109.marched) {
-                local = (_e110 == 0u);
+            let _e109 = pst_footprint_depth((_e36.origin + (_e39 * (_e41.x + (f32(_e102) * _e41.y)))), screen_4);
+            r = PstRay();
+            if (_e109 < 0f) {
+                let _e123 = pst_ray(vec2<f32>((f32(_e95.x) + 0.5f), (f32(_e95.y) + 0.5f)), z_6);
+                r = _e123;
+            } else {
+                let _e126 = k;
+                let _e133 = pst_ray((_e36.origin + (_e39 * (_e41.x + (f32(_e126) * _e41.y)))), _e109);
+                r = _e133;
+            }
+            let _e134 = r;
+            let _e135 = pst_columns_crossed(_e134, delta_6);
+            let _e137 = k;
+            q_end[_e137] = NONE;
+            let _e141 = r.marched;
+            if !(_e141) {
+                local = (_e135 == 0u);
             } else {
                 local = true;
             }
-            let _e122 = local;
-            if _e122 {
-                let _e124 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e109.color);
-                let _e125 = k;
-                textureStore(output, vec2<u32>(_e125, s_6), vec4<f32>(_e124.x, _e124.y, _e124.z, z_6));
+            let _e148 = local;
+            if _e148 {
+                let _e150 = r.color;
+                let _e151 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e150);
+                let _e152 = k;
+                textureStore(output, vec2<u32>(_e152, s_6), vec4<f32>(_e151.x, _e151.y, _e151.z, z_6));
             } else {
-                let _e132 = pst_terms(_e109, row_3, delta_6, _e110);
-                let _e134 = k;
-                q_end[_e134] = (_e110 - 1u);
-                let _e139 = k;
-                q_d[_e139] = _e109.d;
-                let _e143 = k;
-                q_theta[_e143] = _e109.theta;
-                let _e147 = k;
-                q_a[_e147] = _e132.x;
-                let _e151 = k;
-                q_b[_e151] = _e132.y;
-                let _e156 = atomicAdd((&live), 1u);
+                let _e159 = r;
+                let _e160 = pst_terms(_e159, row_3, delta_6, _e135);
+                let _e162 = k;
+                q_end[_e162] = (_e135 - 1u);
+                let _e167 = k;
+                let _e170 = r.d;
+                q_d[_e167] = _e170;
+                let _e172 = k;
+                let _e175 = r.theta;
+                q_theta[_e172] = _e175;
+                let _e177 = k;
+                q_a[_e177] = _e160.x;
+                let _e181 = k;
+                q_b[_e181] = _e160.y;
+                let _e186 = atomicAdd((&live), 1u);
             }
         }
         continuing {
-            let _e157 = k;
-            k = (_e157 + SLICE_LANES);
+            let _e187 = k;
+            k = (_e187 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let v_9 = atomicLoad((&live));
     k_1 = li;
     loop {
-        let _e163 = k_1;
-        if (_e163 < SLICE_SAMPLES) {
+        let _e193 = k_1;
+        if (_e193 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e167 = k_1;
-            let _e169 = q_end[_e167];
-            if (_e169 != NONE) {
+            let _e197 = k_1;
+            let _e199 = q_end[_e197];
+            if (_e199 != NONE) {
                 by_d = 0u;
                 by_e = 0u;
                 q = 0u;
                 loop {
-                    let _e178 = q;
-                    if (_e178 < SLICE_SAMPLES) {
+                    let _e208 = q;
+                    if (_e208 < SLICE_SAMPLES) {
                     } else {
                         break;
                     }
                     {
-                        let _e182 = q;
-                        let _e184 = q_end[_e182];
-                        if (_e184 != NONE) {
-                            let _e187 = by_d;
-                            let _e189 = q;
-                            let _e191 = q_d[_e189];
-                            let _e193 = k_1;
-                            let _e195 = q_d[_e193];
-                            if !((_e191 < _e195)) {
-                                let _e199 = q;
-                                let _e201 = q_d[_e199];
-                                let _e203 = k_1;
-                                let _e205 = q_d[_e203];
-                                if (_e201 == _e205) {
-                                    let _e207 = q;
-                                    let _e208 = k_1;
-                                    local_2 = (_e207 < _e208);
+                        let _e212 = q;
+                        let _e214 = q_end[_e212];
+                        if (_e214 != NONE) {
+                            let _e217 = by_d;
+                            let _e219 = q;
+                            let _e221 = q_d[_e219];
+                            let _e223 = k_1;
+                            let _e225 = q_d[_e223];
+                            if !((_e221 < _e225)) {
+                                let _e229 = q;
+                                let _e231 = q_d[_e229];
+                                let _e233 = k_1;
+                                let _e235 = q_d[_e233];
+                                if (_e231 == _e235) {
+                                    let _e237 = q;
+                                    let _e238 = k_1;
+                                    local_2 = (_e237 < _e238);
                                 } else {
                                     local_2 = false;
                                 }
-                                let _e213 = local_2;
-                                local_1 = _e213;
+                                let _e243 = local_2;
+                                local_1 = _e243;
                             } else {
                                 local_1 = true;
                             }
-                            let _e219 = local_1;
-                            by_d = (_e187 + select(0u, 1u, _e219));
-                            let _e222 = by_e;
-                            let _e224 = q;
-                            let _e226 = q_end[_e224];
-                            let _e228 = k_1;
-                            let _e230 = q_end[_e228];
-                            if !((_e226 < _e230)) {
-                                let _e234 = q;
-                                let _e236 = q_end[_e234];
-                                let _e238 = k_1;
-                                let _e240 = q_end[_e238];
-                                if (_e236 == _e240) {
-                                    let _e242 = q;
-                                    let _e243 = k_1;
-                                    local_4 = (_e242 < _e243);
+                            let _e249 = local_1;
+                            by_d = (_e217 + select(0u, 1u, _e249));
+                            let _e252 = by_e;
+                            let _e254 = q;
+                            let _e256 = q_end[_e254];
+                            let _e258 = k_1;
+                            let _e260 = q_end[_e258];
+                            if !((_e256 < _e260)) {
+                                let _e264 = q;
+                                let _e266 = q_end[_e264];
+                                let _e268 = k_1;
+                                let _e270 = q_end[_e268];
+                                if (_e266 == _e270) {
+                                    let _e272 = q;
+                                    let _e273 = k_1;
+                                    local_4 = (_e272 < _e273);
                                 } else {
                                     local_4 = false;
                                 }
-                                let _e248 = local_4;
-                                local_3 = _e248;
+                                let _e278 = local_4;
+                                local_3 = _e278;
                             } else {
                                 local_3 = true;
                             }
-                            let _e254 = local_3;
-                            by_e = (_e222 + select(0u, 1u, _e254));
+                            let _e284 = local_3;
+                            by_e = (_e252 + select(0u, 1u, _e284));
                         }
                     }
                     continuing {
-                        let _e258 = q;
-                        q = (_e258 + 1u);
+                        let _e288 = q;
+                        q = (_e288 + 1u);
                     }
                 }
-                let _e261 = k_1;
-                let _e263 = by_d;
-                q_rank[_e261] = _e263;
-                let _e265 = by_e;
-                let _e267 = k_1;
-                by_end[_e265] = _e267;
+                let _e291 = k_1;
+                let _e293 = by_d;
+                q_rank[_e291] = _e293;
+                let _e295 = by_e;
+                let _e297 = k_1;
+                by_end[_e295] = _e297;
             }
         }
         continuing {
-            let _e268 = k_1;
-            k_1 = (_e268 + SLICE_LANES);
+            let _e298 = k_1;
+            k_1 = (_e298 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     k_2 = li;
     loop {
-        let _e272 = k_2;
-        if (_e272 < SLICE_SAMPLES) {
+        let _e302 = k_2;
+        if (_e302 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e275 = k_2;
-            let _e281 = k_2;
-            let _e283 = q_d[_e281];
-            mine[(_e275 / SLICE_LANES)] = _e283;
+            let _e305 = k_2;
+            let _e311 = k_2;
+            let _e313 = q_d[_e311];
+            mine[(_e305 / SLICE_LANES)] = _e313;
         }
         continuing {
-            let _e284 = k_2;
-            k_2 = (_e284 + SLICE_LANES);
+            let _e314 = k_2;
+            k_2 = (_e314 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     k_3 = li;
     loop {
-        let _e288 = k_3;
-        if (_e288 < SLICE_SAMPLES) {
+        let _e318 = k_3;
+        if (_e318 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e292 = k_3;
-            let _e294 = q_end[_e292];
-            if (_e294 != NONE) {
-                let _e299 = k_3;
-                let _e301 = q_rank[_e299];
-                let _e303 = k_3;
-                let _e307 = mine[(_e303 / SLICE_LANES)];
-                q_d[_e301] = _e307;
+            let _e322 = k_3;
+            let _e324 = q_end[_e322];
+            if (_e324 != NONE) {
+                let _e329 = k_3;
+                let _e331 = q_rank[_e329];
+                let _e333 = k_3;
+                let _e337 = mine[(_e333 / SLICE_LANES)];
+                q_d[_e331] = _e337;
             }
         }
         continuing {
-            let _e308 = k_3;
-            k_3 = (_e308 + SLICE_LANES);
+            let _e338 = k_3;
+            k_3 = (_e338 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let base_1 = (s_6 * width);
     i = li;
     loop {
-        let _e313 = i;
-        if (_e313 < width) {
+        let _e343 = i;
+        if (_e343 < width) {
         } else {
             break;
         }
         {
-            let _e315 = i;
-            let _e319 = textureLoad(rectified, vec2<u32>(_e315, row_3), 0i);
-            let occluder = _e319.x;
+            let _e345 = i;
+            let _e349 = textureLoad(rectified, vec2<u32>(_e345, row_3), 0i);
+            let occluder = _e349.x;
             lo = 0u;
             hi = v_9;
             loop {
-                let _e324 = lo;
-                let _e325 = hi;
-                if (_e324 < _e325) {
+                let _e354 = lo;
+                let _e355 = hi;
+                if (_e354 < _e355) {
                 } else {
                     break;
                 }
                 {
-                    let _e327 = lo;
-                    let _e328 = hi;
-                    let mid_1 = ((_e327 + _e328) / 2u);
-                    let _e334 = q_d[mid_1];
-                    if (_e334 <= occluder) {
+                    let _e357 = lo;
+                    let _e358 = hi;
+                    let mid_1 = ((_e357 + _e358) / 2u);
+                    let _e364 = q_d[mid_1];
+                    if (_e364 <= occluder) {
                         lo = (mid_1 + 1u);
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            let _e339 = i;
-            let _e342 = lo;
-            pst_columns[(base_1 + _e339)] = _e342;
-            let _e343 = lo;
-            if (_e343 > 0u) {
+            let _e369 = i;
+            let _e372 = lo;
+            pst_columns[(base_1 + _e369)] = _e372;
+            let _e373 = lo;
+            if (_e373 > 0u) {
                 h = 0u;
                 loop {
-                    let _e348 = h;
-                    if (_e348 < RANK_VECS) {
+                    let _e378 = h;
+                    if (_e378 < RANK_VECS) {
                     } else {
                         break;
                     }
                     {
-                        let _e351 = i;
-                        let _e356 = h;
-                        let _e359 = i;
-                        let _e360 = h;
-                        let _e361 = pst_leaf(f_14, _e359, row_3, delta_6, _e360);
-                        pst_leaves[(((base_1 + _e351) * RANK_VECS) + _e356)] = _e361;
+                        let _e381 = i;
+                        let _e386 = h;
+                        let _e389 = i;
+                        let _e390 = h;
+                        let _e391 = pst_leaf(f_14, _e389, row_3, delta_6, _e390);
+                        pst_leaves[(((base_1 + _e381) * RANK_VECS) + _e386)] = _e391;
                     }
                     continuing {
-                        let _e363 = h;
-                        h = (_e363 + 1u);
+                        let _e393 = h;
+                        h = (_e393 + 1u);
                     }
                 }
             }
         }
         continuing {
-            let _e365 = i;
-            i = (_e365 + SLICE_LANES);
+            let _e395 = i;
+            i = (_e395 + SLICE_LANES);
         }
     }
     storageBarrier();
     workgroupBarrier();
-    if (li == 0u) {
-        let tree = ((s_6 * SLICE_SAMPLES) * RANK_VECS);
+    let cw = (((width + TREES) - 1u) / TREES);
+    let trees = (((s_6 * 9u) * SLICE_SAMPLES) * RANK_VECS);
+    let partials = (trees + 4096u);
+    if (li < TREES) {
+        let tree = (trees + ((li * SLICE_SAMPLES) * RANK_VECS));
         loop {
-            let _e375 = j;
-            if (_e375 < (v_9 * RANK_VECS)) {
+            let _e420 = j;
+            if (_e420 < (v_9 * RANK_VECS)) {
             } else {
                 break;
             }
             {
-                let _e380 = j;
-                pst_tree[(tree + _e380)] = vec4<f32>(0f, 0f, 0f, 0f);
+                let _e425 = j;
+                pst_tree[(tree + _e425)] = vec4<f32>(0f, 0f, 0f, 0f);
             }
             continuing {
-                let _e389 = j;
-                j = (_e389 + 1u);
+                let _e434 = j;
+                j = (_e434 + 1u);
             }
         }
+        let lo_5 = (li * cw);
+        let hi_5 = select(min((lo_5 + cw), width), width, ((li + 1u) == TREES));
+        top = v_9;
         loop {
-            let _e392 = i_1;
-            if (_e392 <= width) {
+            let _e446 = next;
+            let _e447 = top;
+            if (_e446 < _e447) {
+            } else {
+                break;
+            }
+            {
+                let _e449 = next;
+                let _e450 = top;
+                let mid_2 = ((_e449 + _e450) / 2u);
+                let _e457 = by_end[mid_2];
+                let _e459 = q_end[_e457];
+                if (_e459 < lo_5) {
+                    next = (mid_2 + 1u);
+                } else {
+                    top = mid_2;
+                }
+            }
+        }
+        i_1 = lo_5;
+        loop {
+            let _e464 = i_1;
+            if (_e464 <= hi_5) {
             } else {
                 break;
             }
             {
                 loop {
-                    let _e395 = next;
-                    if (_e395 < v_9) {
-                        let _e399 = next;
-                        let _e401 = by_end[_e399];
-                        let _e403 = q_end[_e401];
-                        let _e404 = i_1;
-                        local_5 = (_e403 == _e404);
+                    let _e466 = next;
+                    if (_e466 < v_9) {
+                        let _e470 = next;
+                        let _e472 = by_end[_e470];
+                        let _e474 = q_end[_e472];
+                        let _e475 = i_1;
+                        local_5 = (_e474 == _e475);
                     } else {
                         local_5 = false;
                     }
-                    let _e409 = local_5;
-                    if _e409 {
+                    let _e480 = local_5;
+                    if _e480 {
+                        let _e481 = i_1;
+                        if !((_e481 < hi_5)) {
+                            local_7 = ((li + 1u) == TREES);
+                        } else {
+                            local_7 = true;
+                        }
+                        let _e491 = local_7;
+                        local_6 = _e491;
+                    } else {
+                        local_6 = false;
+                    }
+                    let _e495 = local_6;
+                    if _e495 {
                     } else {
                         break;
                     }
                     {
-                        let _e411 = next;
-                        let k_8 = by_end[_e411];
-                        let _e415 = next;
-                        next = (_e415 + 1u);
-                        dotp = 0f;
+                        let _e497 = next;
+                        let k_9 = by_end[_e497];
+                        let _e501 = next;
+                        next = (_e501 + 1u);
                         h_1 = 0u;
                         loop {
-                            let _e421 = h_1;
-                            if (_e421 < RANK_VECS) {
+                            let _e505 = h_1;
+                            if (_e505 < RANK_VECS) {
                             } else {
                                 break;
                             }
                             {
                                 p = vec4<f32>(0f, 0f, 0f, 0f);
-                                let _e432 = q_rank[k_8];
-                                j_1 = (v_9 - _e432);
+                                let _e516 = q_rank[k_9];
+                                j_1 = (v_9 - _e516);
                                 loop {
-                                    let _e435 = j_1;
-                                    if (_e435 > 0u) {
+                                    let _e519 = j_1;
+                                    if (_e519 > 0u) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        let _e438 = p;
-                                        let _e439 = j_1;
-                                        let _e446 = h_1;
-                                        let _e449 = pst_tree[((tree + ((_e439 - 1u) * RANK_VECS)) + _e446)];
-                                        p = (_e438 + _e449);
-                                        let _e451 = j_1;
-                                        let _e452 = j_1;
-                                        let _e453 = j_1;
-                                        j_1 = (_e451 - (_e452 & (~(_e453) + 1u)));
+                                        let _e522 = p;
+                                        let _e523 = j_1;
+                                        let _e530 = h_1;
+                                        let _e533 = pst_tree[((tree + ((_e523 - 1u) * RANK_VECS)) + _e530)];
+                                        p = (_e522 + _e533);
+                                        let _e535 = j_1;
+                                        let _e536 = j_1;
+                                        let _e537 = j_1;
+                                        j_1 = (_e535 - (_e536 & (~(_e537) + 1u)));
                                     }
                                 }
-                                let _e459 = dotp;
-                                let _e460 = p;
-                                let _e463 = q_theta[k_8];
-                                let _e464 = h_1;
-                                let _e465 = beta_at(_e463, _e464);
-                                dotp = (_e459 + dot(_e460, _e465));
+                                let _e547 = h_1;
+                                let _e550 = p;
+                                pst_tree[((partials + (k_9 * RANK_VECS)) + _e547)] = _e550;
                             }
                             continuing {
-                                let _e469 = h_1;
-                                h_1 = (_e469 + 1u);
+                                let _e552 = h_1;
+                                h_1 = (_e552 + 1u);
                             }
                         }
-                        let _e475 = q_a[k_8];
-                        let _e476 = dotp;
-                        let _e482 = q_b[k_8];
-                        let _e485 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_14.light_color.xyz * (max((_e475 * _e476), 0f) + _e482)));
-                        let _e486 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-                        let _e489 = textureLoad(depth, _e486, 0i);
-                        let z_7 = _e489.x;
-                        textureStore(output, vec2<u32>(k_8, s_6), vec4<f32>(_e485.x, _e485.y, _e485.z, z_7));
                     }
                 }
-                let _e497 = i_1;
-                if (_e497 == width) {
+                let _e554 = i_1;
+                if (_e554 == hi_5) {
                     break;
                 }
-                let _e500 = i_1;
-                let b_6 = pst_columns[(base_1 + _e500)];
-                if (b_6 > 0u) {
+                let _e557 = i_1;
+                let b_7 = pst_columns[(base_1 + _e557)];
+                if (b_7 > 0u) {
                     h_2 = 0u;
                     loop {
-                        let _e508 = h_2;
-                        if (_e508 < RANK_VECS) {
+                        let _e565 = h_2;
+                        if (_e565 < RANK_VECS) {
                         } else {
                             break;
                         }
                         {
-                            let _e511 = i_1;
-                            let _e516 = h_2;
-                            let leaf_1 = pst_leaves[(((base_1 + _e511) * RANK_VECS) + _e516)];
-                            j_2 = ((v_9 - b_6) + 1u);
+                            let _e568 = i_1;
+                            let _e573 = h_2;
+                            let leaf_1 = pst_leaves[(((base_1 + _e568) * RANK_VECS) + _e573)];
+                            j_2 = ((v_9 - b_7) + 1u);
                             loop {
-                                let _e524 = j_2;
-                                if (_e524 <= v_9) {
+                                let _e581 = j_2;
+                                if (_e581 <= v_9) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    let _e526 = j_2;
-                                    let _e533 = h_2;
-                                    let _e536 = pst_tree[((tree + ((_e526 - 1u) * RANK_VECS)) + _e533)];
-                                    pst_tree[((tree + ((_e526 - 1u) * RANK_VECS)) + _e533)] = (_e536 + leaf_1);
-                                    let _e538 = j_2;
-                                    let _e539 = j_2;
-                                    let _e540 = j_2;
-                                    j_2 = (_e538 + (_e539 & (~(_e540) + 1u)));
+                                    let _e583 = j_2;
+                                    let _e590 = h_2;
+                                    let _e593 = pst_tree[((tree + ((_e583 - 1u) * RANK_VECS)) + _e590)];
+                                    pst_tree[((tree + ((_e583 - 1u) * RANK_VECS)) + _e590)] = (_e593 + leaf_1);
+                                    let _e595 = j_2;
+                                    let _e596 = j_2;
+                                    let _e597 = j_2;
+                                    j_2 = (_e595 + (_e596 & (~(_e597) + 1u)));
                                 }
                             }
                         }
                         continuing {
-                            let _e547 = h_2;
-                            h_2 = (_e547 + 1u);
+                            let _e604 = h_2;
+                            h_2 = (_e604 + 1u);
                         }
                     }
                 }
             }
             continuing {
-                let _e550 = i_1;
-                i_1 = (_e550 + 1u);
+                let _e607 = i_1;
+                i_1 = (_e607 + 1u);
             }
         }
-        return;
-    } else {
-        return;
     }
+    storageBarrier();
+    workgroupBarrier();
+    x = li;
+    loop {
+        let _e610 = x;
+        if (_e610 < (v_9 * RANK_VECS)) {
+        } else {
+            break;
+        }
+        {
+            running = vec4<f32>(0f, 0f, 0f, 0f);
+            c = 0u;
+            loop {
+                let _e622 = c;
+                if (_e622 < TREES) {
+                } else {
+                    break;
+                }
+                {
+                    let _e625 = c;
+                    let _e631 = x;
+                    let at = ((trees + ((_e625 * SLICE_SAMPLES) * RANK_VECS)) + _e631);
+                    let own = pst_tree[at];
+                    let _e638 = running;
+                    pst_tree[at] = _e638;
+                    let _e639 = running;
+                    running = (_e639 + own);
+                }
+                continuing {
+                    let _e642 = c;
+                    c = (_e642 + 1u);
+                }
+            }
+        }
+        continuing {
+            let _e644 = x;
+            x = (_e644 + SLICE_LANES);
+        }
+    }
+    storageBarrier();
+    workgroupBarrier();
+    k_4 = li;
+    loop {
+        let _e648 = k_4;
+        if (_e648 < SLICE_SAMPLES) {
+        } else {
+            break;
+        }
+        {
+            let _e652 = k_4;
+            let _e654 = q_end[_e652];
+            if (_e654 != NONE) {
+                let _e658 = k_4;
+                let _e660 = q_end[_e658];
+                let tree_1 = (trees + ((min((_e660 / cw), 7u) * SLICE_SAMPLES) * RANK_VECS));
+                dotp = 0f;
+                h_3 = 0u;
+                loop {
+                    let _e673 = h_3;
+                    if (_e673 < RANK_VECS) {
+                    } else {
+                        break;
+                    }
+                    {
+                        let _e676 = k_4;
+                        let _e681 = h_3;
+                        let _e684 = pst_tree[((partials + (_e676 * RANK_VECS)) + _e681)];
+                        p_1 = _e684;
+                        let _e687 = k_4;
+                        let _e689 = q_rank[_e687];
+                        j_3 = (v_9 - _e689);
+                        loop {
+                            let _e692 = j_3;
+                            if (_e692 > 0u) {
+                            } else {
+                                break;
+                            }
+                            {
+                                let _e695 = p_1;
+                                let _e696 = j_3;
+                                let _e703 = h_3;
+                                let _e706 = pst_tree[((tree_1 + ((_e696 - 1u) * RANK_VECS)) + _e703)];
+                                p_1 = (_e695 + _e706);
+                                let _e708 = j_3;
+                                let _e709 = j_3;
+                                let _e710 = j_3;
+                                j_3 = (_e708 - (_e709 & (~(_e710) + 1u)));
+                            }
+                        }
+                        let _e716 = dotp;
+                        let _e717 = p_1;
+                        let _e719 = k_4;
+                        let _e721 = q_theta[_e719];
+                        let _e722 = h_3;
+                        let _e723 = beta_at(_e721, _e722);
+                        dotp = (_e716 + dot(_e717, _e723));
+                    }
+                    continuing {
+                        let _e727 = h_3;
+                        h_3 = (_e727 + 1u);
+                    }
+                }
+                let _e732 = k_4;
+                let _e734 = q_a[_e732];
+                let _e735 = dotp;
+                let _e740 = k_4;
+                let _e742 = q_b[_e740];
+                let _e745 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_14.light_color.xyz * (max((_e734 * _e735), 0f) + _e742)));
+                let _e746 = k_4;
+                let _e747 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e746, screen_4);
+                let _e750 = textureLoad(depth, _e747, 0i);
+                let z_7 = _e750.x;
+                let _e752 = k_4;
+                textureStore(output, vec2<u32>(_e752, s_6), vec4<f32>(_e745.x, _e745.y, _e745.z, z_7));
+            }
+        }
+        continuing {
+            let _e759 = k_4;
+            k_4 = (_e759 + SLICE_LANES);
+        }
+    }
+    return;
 }

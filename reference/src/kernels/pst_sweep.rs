@@ -3,7 +3,8 @@
 //! sweep through a Fenwick tree over the rectified row the slice lies in (the row of its last
 //! sample's pixel): queries ranked by `d`, every column's count `b` of queries that see it lit,
 //! its leaf inserted at tree position `V - b` in column order, each query answered (in order
-//! of its prefix end) by the prefix below `V - rank`. Conventions and the derivation:
+//! of its prefix end) by the prefix below `V - rank`; the columns split over `TREES` trees
+//! swept at once, then summed into exclusive prefixes over the trees. Conventions and the derivation:
 //! `scatter_frame::partial_sum_tree`. The WGSL's four phases run one after the other here;
 //! every value is computed by the same expression in the same order.
 
@@ -19,7 +20,7 @@ use super::common_sampling::{
 };
 use super::texture::{Tex, TexArray, xyz};
 use glam::{Vec3, Vec4};
-use scatter_shaderlib::partial_sum_tree::{GL2, GRID, PartialSumTreeVariant};
+use scatter_shaderlib::partial_sum_tree::{GL2, GRID, PartialSumTreeVariant, TREES};
 use scatter_shaderlib::prefiltered::{FrameUniforms, LightKind, SliceParams};
 
 /// The bindings of `pst_sweep` (and of its fallback, which reads the same but the scratch).
@@ -375,44 +376,81 @@ pub fn pst_sweep(
                 }
             }
 
-            // 4. The sweep.
-            let mut tree = vec![Vec4::ZERO; (v * rv) as usize];
-            let mut next = 0u32;
-            for i in 0..=width {
-                while next < v && q_end[by_end[next as usize] as usize] == i {
-                    let k = by_end[next as usize] as usize;
-                    next += 1;
-                    let mut dotp = 0.0;
-                    for h in 0..rv {
-                        let mut p = Vec4::ZERO;
-                        let mut j = v - q_rank[k];
-                        while j > 0 {
-                            p += tree[((j - 1) * rv + h) as usize];
-                            j -= j & j.wrapping_neg();
-                        }
-                        dotp += p.dot(beta_at(inp, q_theta[k], h));
-                    }
-                    let c = xyz(f.light_color) * (max(q_ab[k][0] * dotp, 0.0) + q_ab[k][1]);
-                    let c = round_f16_rgb(c.to_array());
-                    let p = slice_sample_pixel(&layout, u, span, k as u32, screen);
-                    out[k] = [c[0], c[1], c[2], inp.depth.load(p[0], p[1])];
-                    counts.queries += 1;
-                }
-                if i == width {
-                    break;
-                }
-                let b = columns[i as usize];
-                if b > 0 {
-                    counts.inserted += 1;
-                    for h in 0..rv {
-                        let leaf = leaves[(i * rv + h) as usize];
-                        let mut j = v - b + 1;
-                        while j <= v {
-                            tree[((j - 1) * rv + h) as usize] += leaf;
-                            j += j & j.wrapping_neg();
+            // 4. The sweep over TREES trees of CW columns each, then the exclusive prefixes
+            // of the trees, then every query.
+            let trees_n = TREES as usize;
+            let cw = width.div_ceil(TREES);
+            let stride = (m * rv) as usize;
+            let mut trees = vec![Vec4::ZERO; trees_n * stride];
+            let mut partials = vec![Vec4::ZERO; stride];
+            for c in 0..TREES {
+                let tree = c as usize * stride;
+                let lo = c * cw;
+                let hi = if c + 1 == TREES { width } else { (lo + cw).min(width) };
+                let mut next = by_end[..v as usize]
+                    .partition_point(|&k| q_end[k as usize] < lo) as u32;
+                for i in lo..=hi {
+                    while next < v
+                        && q_end[by_end[next as usize] as usize] == i
+                        && (i < hi || c + 1 == TREES)
+                    {
+                        let k = by_end[next as usize] as usize;
+                        next += 1;
+                        for h in 0..rv {
+                            let mut p = Vec4::ZERO;
+                            let mut j = v - q_rank[k];
+                            while j > 0 {
+                                p += trees[tree + ((j - 1) * rv + h) as usize];
+                                j -= j & j.wrapping_neg();
+                            }
+                            partials[k * rv as usize + h as usize] = p;
                         }
                     }
+                    if i == hi {
+                        break;
+                    }
+                    let b = columns[i as usize];
+                    if b > 0 {
+                        counts.inserted += 1;
+                        for h in 0..rv {
+                            let leaf = leaves[(i * rv + h) as usize];
+                            let mut j = v - b + 1;
+                            while j <= v {
+                                trees[tree + ((j - 1) * rv + h) as usize] += leaf;
+                                j += j & j.wrapping_neg();
+                            }
+                        }
+                    }
                 }
+            }
+            for x in 0..(v * rv) as usize {
+                let mut running = Vec4::ZERO;
+                for c in 0..trees_n {
+                    let own = trees[c * stride + x];
+                    trees[c * stride + x] = running;
+                    running += own;
+                }
+            }
+            for k in 0..m as usize {
+                if q_end[k] == NONE {
+                    continue;
+                }
+                let tree = (q_end[k] / cw).min(TREES - 1) as usize * stride;
+                let mut dotp = 0.0;
+                for h in 0..rv {
+                    let mut p = partials[k * rv as usize + h as usize];
+                    let mut j = v - q_rank[k];
+                    while j > 0 {
+                        p += trees[tree + ((j - 1) * rv + h) as usize];
+                        j -= j & j.wrapping_neg();
+                    }
+                    dotp += p.dot(beta_at(inp, q_theta[k], h));
+                }
+                let c = xyz(f.light_color) * (max(q_ab[k][0] * dotp, 0.0) + q_ab[k][1]);
+                let c = round_f16_rgb(c.to_array());
+                let p = slice_sample_pixel(&layout, u, span, k as u32, screen);
+                out[k] = [c[0], c[1], c[2], inp.depth.load(p[0], p[1])];
+                counts.queries += 1;
             }
             (out, counts)
         })

@@ -15,7 +15,7 @@ use crate::sampling::{SLICE_LANES, SamplingView, camera_expr};
 
 pub use scatter_frame::partial_sum_tree::{
     DEFAULT_RANK, FACTOR_VECS, GL2, GRID, MAX_RANK, PartialSumTreeFrame, PartialSumTreeVariant,
-    PstError, Separable, frame_separable, prepare_partial_sum_tree, query_theta_range,
+    PstError, Separable, TREES, frame_separable, prepare_partial_sum_tree, query_theta_range,
     spot_kernel, svd_jacobi,
 };
 
@@ -42,6 +42,7 @@ macro_rules! sweep_template {
             rank_vecs: u32,
             grid: usize,
             per_lane: u32,
+            trees: u32,
             sampling: SamplingView,
         }
     };
@@ -80,6 +81,7 @@ fn render(kernel: Kernel, variant: &PartialSumTreeVariant) -> Result<String, Sha
             rank_vecs,
             grid,
             per_lane,
+            trees: TREES,
             sampling,
         }
         .render(),
@@ -90,6 +92,7 @@ fn render(kernel: Kernel, variant: &PartialSumTreeVariant) -> Result<String, Sha
             rank_vecs,
             grid,
             per_lane,
+            trees: TREES,
             sampling,
         }
         .render(),
@@ -100,6 +103,7 @@ fn render(kernel: Kernel, variant: &PartialSumTreeVariant) -> Result<String, Sha
             rank_vecs,
             grid,
             per_lane,
+            trees: TREES,
             sampling,
         }
         .render(),

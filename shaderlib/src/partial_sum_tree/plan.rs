@@ -5,7 +5,7 @@
 
 use crate::Kernel;
 use crate::family::KernelFamily;
-use crate::partial_sum_tree::{FACTOR_VECS, PartialSumTreeVariant, SAMPLED_BINDING};
+use crate::partial_sum_tree::{FACTOR_VECS, PartialSumTreeVariant, SAMPLED_BINDING, TREES};
 use crate::plan::{
     BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
     SLICE_FIT_NOTE, TEXTURE_DIMENSION, bind, column_depth_buffer, depth_and_shadow_map,
@@ -90,9 +90,9 @@ pub fn plan(v: &PartialSumTreeVariant) -> Plan {
         ),
         scratch(
             "pst_tree",
-            "the sweep's scratch: every slice's Fenwick tree over its queries (written and \
-             read by pst_sweep)",
-            (v.slices * v.slice_samples * rv).to_string(),
+            "the sweep's scratch: every slice's 8 Fenwick trees over its queries and the \
+             queries' partial sums (written and read by pst_sweep)",
+            (v.slices * (TREES + 1) * v.slice_samples * rv).to_string(),
         ),
         scratch(
             "pst_columns",
