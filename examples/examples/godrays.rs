@@ -39,8 +39,9 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::textures::upload_r32float;
 use scatter_runtime::{
-    Context, CpuInputs, FamilyPasses, FrameInput, Inputs, MinmaxTimes, PartialSumTreeTimes, PrefilteredTimes,
-    RaymarchInput, RaymarchTimes, run_minmax_once, run_partial_sum_tree_once, run_prefiltered_once, run_raymarch_once,
+    Context, CpuInputs, FamilyPasses, FrameInput, Inputs, MinmaxTimes, PartialSumTreeTimes,
+    PrefilteredTimes, RaymarchInput, RaymarchTimes, run_minmax_once, run_partial_sum_tree_once,
+    run_prefiltered_once, run_raymarch_once,
 };
 use scatter_shaderlib::Kernel;
 use scatter_shaderlib::family::KernelFamily;
@@ -748,14 +749,8 @@ fn run_on_gpu(
         FamilyVariant::PartialSumTree(v) => {
             let ctx = &ctx;
             Box::new(move |_| {
-                let rb = run_partial_sum_tree_once(
-                    ctx,
-                    v,
-                    res,
-                    &frame,
-                    &gbuf.view_depth,
-                    &sm.depth,
-                )?;
+                let rb =
+                    run_partial_sum_tree_once(ctx, v, res, &frame, &gbuf.view_depth, &sm.depth)?;
                 Ok(GpuFrame {
                     output: rb.output,
                     report: Some(rb.frame.frame.report),

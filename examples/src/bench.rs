@@ -745,10 +745,7 @@ fn headline_runs(ctx: &Context, frames: u32, errors: bool) -> Result<Vec<Headlin
         Method::prefiltered_default(),
         Method::minmax_default(),
         Method::partial_sum_tree_default(),
-        Method::new(
-            Family::PartialSumTree.default_variant(),
-            Some([512, 512]),
-        ),
+        Method::new(Family::PartialSumTree.default_variant(), Some([512, 512])),
     ];
     for moments in PrefilteredVariant::MOMENTS {
         methods.push(Method::from(PrefilteredVariant::with_moments(moments)));

@@ -50,8 +50,8 @@
 
 use crate::family::{Family, KnobSet};
 use crate::frame::{
-    CameraDesc, FrameError, FrameSettings, FrameUniforms, LightDesc, MediumDesc,
-    PrefilteredFrame, Resolutions, ShadowMapDesc, SliceParams, prepare_frame,
+    CameraDesc, FrameError, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame,
+    Resolutions, ShadowMapDesc, SliceParams, prepare_frame,
 };
 use crate::sampling::{Sampling, SamplingKnobs};
 use crate::variant::{LightKind, PrefilteredVariant, Rectification, VariantError};

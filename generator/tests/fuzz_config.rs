@@ -609,9 +609,10 @@ fn config_with_one_fault() {
                 3 => Fault::BadFamily(junk),
                 4 => Fault::TopLevel(junk),
                 5 => Fault::BadTarget(junk),
-                6 if info.value_type != KnobType::Name => {
-                    Fault::Quoted(knob.to_owned(), format!("\"{}\"", valid_value(*family, knob, 0)))
-                }
+                6 if info.value_type != KnobType::Name => Fault::Quoted(
+                    knob.to_owned(),
+                    format!("\"{}\"", valid_value(*family, knob, 0)),
+                ),
                 _ => Fault::None,
             };
             // Minmax's only knob has no bad number form: every bad value is a bad name.

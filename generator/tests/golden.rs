@@ -61,10 +61,7 @@ fn canonical() -> Generated {
         ])
         .unwrap_or_else(|e| panic!("{e}"));
     let pst = Family::PartialSumTree
-        .variant(&[
-            ("light".into(), "spot".into()),
-            ("rank".into(), "8".into()),
-        ])
+        .variant(&[("light".into(), "spot".into()), ("rank".into(), "8".into())])
         .unwrap_or_else(|e| panic!("{e}"));
     generate(&Request {
         variants: vec![

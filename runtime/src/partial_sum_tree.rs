@@ -127,10 +127,8 @@ impl PartialSumTree {
             ],
         )?;
         crate::prefiltered::check_frame_buffers(&limits, hr)?;
-        let leaves = u64::from(variant.slices)
-            * u64::from(wr)
-            * u64::from(variant.rank_vecs())
-            * 16;
+        let leaves =
+            u64::from(variant.slices) * u64::from(wr) * u64::from(variant.rank_vecs()) * 16;
         let trees = u64::from(variant.slices)
             * u64::from(TREES + 1)
             * u64::from(variant.slice_samples)
@@ -240,7 +238,11 @@ impl PartialSumTree {
             0,
             bytemuck::bytes_of(&prepared.frame.uniforms),
         );
-        queue.write_buffer(&self.slices, 0, bytemuck::cast_slice(&prepared.frame.slices));
+        queue.write_buffer(
+            &self.slices,
+            0,
+            bytemuck::cast_slice(&prepared.frame.slices),
+        );
         queue.write_buffer(&self.factors, 0, bytemuck::cast_slice(&prepared.factors));
         scope.pop(SWEEP, "uploading frame parameters")?;
         self.frame = Some(prepared);
@@ -279,16 +281,15 @@ impl PartialSumTree {
         shadow_map: &wgpu::TextureView,
         frames: u32,
     ) -> Result<PartialSumTreeTimes, RuntimeError> {
-        let [depth_columns, slice_fit, rectify, sweep, unwarp, fallback] =
-            median_pass_wall_times(
-                ctx,
-                [DEPTH_COLUMNS, SLICE_FIT, RECTIFY, SWEEP, UNWARP, FALLBACK],
-                frames,
-                |encoder, kernel| {
-                    self.encode_selected(ctx, encoder, depth, shadow_map, Some(kernel))
-                        .map(|_| ())
-                },
-            )?;
+        let [depth_columns, slice_fit, rectify, sweep, unwarp, fallback] = median_pass_wall_times(
+            ctx,
+            [DEPTH_COLUMNS, SLICE_FIT, RECTIFY, SWEEP, UNWARP, FALLBACK],
+            frames,
+            |encoder, kernel| {
+                self.encode_selected(ctx, encoder, depth, shadow_map, Some(kernel))
+                    .map(|_| ())
+            },
+        )?;
         Ok(PartialSumTreeTimes {
             depth_columns,
             slice_fit,

@@ -247,8 +247,9 @@ var<workgroup> q_theta: array<f32, {{ sampling.slice_samples }}>;
 var<workgroup> q_a: array<f32, {{ sampling.slice_samples }}>;
 var<workgroup> q_b: array<f32, {{ sampling.slice_samples }}>;
 var<workgroup> by_end: array<u32, {{ sampling.slice_samples }}>;
-// How many queries are not done (V).
+// How many queries are not done (V), and how many end in each tree's columns.
 var<workgroup> live: atomic<u32>;
+var<workgroup> bucket: array<u32, {{ trees }}>;
 
 // View depth at the continuous pixel position `pc` from the 2 x 2 pixels around it, 1 / z
 // interpolated bilinearly (exact on a plane); -1 where they are not all within DEPTH_BREAK of
@@ -345,33 +346,85 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     workgroupBarrier();
     let v = atomicLoad(&live);
 
-    // 2. Ranks by d and by prefix end (ties by sample index).
-    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
-        if q_end[k] != NONE {
-            var by_d = 0u;
-            var by_e = 0u;
-            for (var q = 0u; q < SLICE_SAMPLES; q++) {
-                if q_end[q] != NONE {
-                    by_d += select(0u, 1u, q_d[q] < q_d[k] || (q_d[q] == q_d[k] && q < k));
-                    by_e += select(0u, 1u, q_end[q] < q_end[k] || (q_end[q] == q_end[k] && q < k));
-                }
+    // 2. The queries in order of their prefix end and of d. Invocation c < TREES collects the
+    // queries ending in tree c's columns into its part of `by_end` (after the parts of the
+    // trees before it), by insertion in order of the end; invocation TREES sorts d in place
+    // by insertion: along the slice d runs monotonically (up from the epipole, down from the
+    // anti-epipole) but for silhouette samples, so in the direction it runs each insertion
+    // shifts little, and the slots it writes lie below the samples it has still to read.
+    let cw = (width + TREES - 1u) / TREES;
+    if li < TREES {
+        var count = 0u;
+        for (var k = 0u; k < SLICE_SAMPLES; k++) {
+            if q_end[k] != NONE && min(q_end[k] / cw, TREES - 1u) == li {
+                count++;
             }
-            q_rank[k] = by_d;
-            by_end[by_e] = k;
+        }
+        bucket[li] = count;
+    } else if li == TREES && v > 0u {
+        var first = 0u;
+        while q_end[first] == NONE {
+            first++;
+        }
+        var last = SLICE_SAMPLES - 1u;
+        while q_end[last] == NONE {
+            last--;
+        }
+        let up = q_d[first] <= q_d[last];
+        var m = 0u;
+        for (var k = 0u; k < SLICE_SAMPLES; k++) {
+            if q_end[k] != NONE {
+                let d = q_d[k];
+                var j = m;
+                while j > 0u && select(q_d[j - 1u] < d, q_d[j - 1u] > d, up) {
+                    q_d[j] = q_d[j - 1u];
+                    q_rank[j] = q_rank[j - 1u];
+                    j--;
+                }
+                q_d[j] = d;
+                q_rank[j] = k;
+                m++;
+            }
+        }
+        if !up {
+            for (var j = 0u; j < v / 2u; j++) {
+                let d = q_d[j];
+                q_d[j] = q_d[v - 1u - j];
+                q_d[v - 1u - j] = d;
+                let k = q_rank[j];
+                q_rank[j] = q_rank[v - 1u - j];
+                q_rank[v - 1u - j] = k;
+            }
         }
     }
     workgroupBarrier();
-    // The d of the queries in rank order (through registers: every lane reads before any
-    // writes).
-    var mine: array<f32, {{ per_lane }}>;
-    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
-        mine[k / SLICE_LANES] = q_d[k];
+    if li < TREES {
+        var start = 0u;
+        for (var c = 0u; c < li; c++) {
+            start += bucket[c];
+        }
+        var m = 0u;
+        for (var k = 0u; k < SLICE_SAMPLES; k++) {
+            if q_end[k] != NONE && min(q_end[k] / cw, TREES - 1u) == li {
+                var j = m;
+                while j > 0u && q_end[by_end[start + j - 1u]] > q_end[k] {
+                    by_end[start + j] = by_end[start + j - 1u];
+                    j--;
+                }
+                by_end[start + j] = k;
+                m++;
+            }
+        }
+    }
+    // The rank of every query from the sorted list (through registers: every invocation
+    // reads before any writes).
+    var mine: array<u32, {{ per_lane }}>;
+    for (var j = li; j < v; j += SLICE_LANES) {
+        mine[j / SLICE_LANES] = q_rank[j];
     }
     workgroupBarrier();
-    for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
-        if q_end[k] != NONE {
-            q_d[q_rank[k]] = mine[k / SLICE_LANES];
-        }
+    for (var j = li; j < v; j += SLICE_LANES) {
+        q_rank[mine[j / SLICE_LANES]] = j;
     }
     workgroupBarrier();
 
@@ -407,7 +460,6 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     // then the trees are summed into exclusive prefixes over c (a Fenwick tree is linear in
     // its leaves) and every query adds the complete trees before its own: one step per
     // column on TREES invocations at once instead of all columns on one.
-    let cw = (width + TREES - 1u) / TREES;
     let trees = s * (TREES + 1u) * SLICE_SAMPLES * RANK_VECS;
     let partials = trees + TREES * SLICE_SAMPLES * RANK_VECS;
     if li < TREES {

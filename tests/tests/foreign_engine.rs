@@ -42,8 +42,8 @@ use scatter_gen::{FamilyVariant, Request, generate, output};
 use scatter_reference::kernels::engine_rectified_map;
 use scatter_reference::suite::Pose;
 use scatter_runtime::{
-    Context, CpuInputs, FrameInput, RaymarchInput, run_minmax_once, run_partial_sum_tree_once, run_prefiltered_once,
-    run_raymarch_once,
+    Context, CpuInputs, FrameInput, RaymarchInput, run_minmax_once, run_partial_sum_tree_once,
+    run_prefiltered_once, run_raymarch_once,
 };
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, PrefilteredVariant, Rectification, Resolutions, Storage,
@@ -310,7 +310,11 @@ fn other_families_dir() -> &'static Path {
             .map(FamilyVariant::Raymarch)
             .into_iter()
             .chain(MinmaxVariant::grid().into_iter().map(FamilyVariant::Minmax))
-            .chain(pst_variants().into_iter().map(FamilyVariant::PartialSumTree))
+            .chain(
+                pst_variants()
+                    .into_iter()
+                    .map(FamilyVariant::PartialSumTree),
+            )
             .collect();
         let generated = generate(&Request {
             variants,

@@ -15,9 +15,7 @@
 
 use scatter_conformance::gpu;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
-use scatter_runtime::{
-    Context, Minmax, PartialSumTree, Prefiltered, Raymarch, RuntimeError, wgpu,
-};
+use scatter_runtime::{Context, Minmax, PartialSumTree, Prefiltered, Raymarch, RuntimeError, wgpu};
 use scatter_shaderlib::Kernel;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::partial_sum_tree::PartialSumTreeVariant;

@@ -192,7 +192,9 @@ fn trial(
         let lr = pst_ray(&inp, spot, at(m - 1), 0.0);
         let row = lr.row;
         let rows = f.sizes[3] as f32;
-        let phi = lr.dir.dot(glam::Vec3::from_slice(&f.e2[..3]))
+        let phi = lr
+            .dir
+            .dot(glam::Vec3::from_slice(&f.e2[..3]))
             .atan2(lr.dir.dot(glam::Vec3::from_slice(&f.e1[..3])));
         let yc = (phi - f.e1[3]) / f.e2[3];
         let row_tie = (yc - yc.round()).abs() < 1e-3 || (yc.rem_euclid(rows) - 0.0).abs() < 1e-3;
@@ -338,11 +340,8 @@ fn bad_input_is_an_error() {
     assert!(matches!(err, RuntimeError::EmptyInput { .. }), "{err}");
     eprintln!("ok   partial_sum_tree::errors::zero_size: {err}");
     let limits = ctx.device().limits();
-    let wide = u64::from(limits.max_storage_buffer_binding_size) / 16 / 1024 + 1;
-    let big = PartialSumTreeVariant {
-        slices: 1024,
-        ..v
-    };
+    let wide = limits.max_storage_buffer_binding_size / 16 / 1024 + 1;
+    let big = PartialSumTreeVariant { slices: 1024, ..v };
     if let Ok(wide) = u32::try_from(wide)
         && wide <= limits.max_texture_dimension_2d
     {
@@ -383,7 +382,8 @@ fn bad_input_is_an_error() {
     eprintln!("ok   partial_sum_tree::errors::light_mismatch: {err}");
     let mut input = input(f);
     input.camera.forward.y = f64::NAN;
-    let mut pass = PartialSumTree::new(ctx, &v, res(), SHADOW_MAP).unwrap_or_else(|e| panic!("{e}"));
+    let mut pass =
+        PartialSumTree::new(ctx, &v, res(), SHADOW_MAP).unwrap_or_else(|e| panic!("{e}"));
     let err = pass.prepare(ctx, &input).expect_err("NaN camera");
     assert!(err.to_string().contains("camera"), "{err}");
     eprintln!("ok   partial_sum_tree::errors::nan_camera: {err}");

@@ -44,10 +44,10 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::{Context, FrameInput};
 use scatter_shaderlib::family::{Family, FamilyVariant};
-use scatter_shaderlib::sampling::Sampling;
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, PrefilteredVariant, VisibilityMode,
 };
+use scatter_shaderlib::sampling::Sampling;
 
 const SCREEN: [u32; 2] = [96, 54];
 const RECTIFIED: [u32; 2] = [512, 512];

@@ -8,7 +8,9 @@
 
 use scatter_frame::partial_sum_tree::PartialSumTreeFrame;
 
-use crate::prefiltered::{DEPTH, FRAME, Output, SHADOW_MAP, SLICES, check_frame_layout, read_output};
+use crate::prefiltered::{
+    DEPTH, FRAME, Output, SHADOW_MAP, SLICES, check_frame_layout, read_output,
+};
 use crate::{Engine, EngineError, FrameData};
 
 /// Resource of the separable integrand's factors.

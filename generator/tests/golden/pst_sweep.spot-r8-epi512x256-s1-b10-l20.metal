@@ -101,8 +101,8 @@ struct type_14 {
 struct type_15 {
     float inner[256];
 };
-struct type_17 {
-    float inner[8];
+struct type_16 {
+    uint inner[8];
 };
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
@@ -126,8 +126,8 @@ metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
     metal::float3 p_2
 ) {
-    metal::float3 q_2 = p_2 - v.origin.xyz;
-    return metal::float3(metal::dot(q_2, v.right.xyz), metal::dot(q_2, v.up.xyz), metal::dot(q_2, v.forward.xyz));
+    metal::float3 q_1 = p_2 - v.origin.xyz;
+    return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
 }
 
 metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
@@ -152,27 +152,27 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_8 = {};
     bool local_9 = {};
     bool local_10 = {};
+    bool local_11 = {};
     if (!((uv.x < 0.0))) {
-        local_8 = uv.x > 1.0;
-    } else {
-        local_8 = true;
-    }
-    bool _e11 = local_8;
-    if (!(_e11)) {
-        local_9 = uv.y < 0.0;
+        local_9 = uv.x > 1.0;
     } else {
         local_9 = true;
     }
-    bool _e19 = local_9;
-    if (!(_e19)) {
-        local_10 = uv.y > 1.0;
+    bool _e11 = local_9;
+    if (!(_e11)) {
+        local_10 = uv.y < 0.0;
     } else {
         local_10 = true;
     }
-    bool _e27 = local_10;
+    bool _e19 = local_10;
+    if (!(_e19)) {
+        local_11 = uv.y > 1.0;
+    } else {
+        local_11 = true;
+    }
+    bool _e27 = local_11;
     if (_e27) {
         return 2.0;
     }
@@ -204,16 +204,16 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm_1,
     metal::float3 p_3
 ) {
-    bool local_11 = {};
+    bool local_12 = {};
     metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
     float near = v_4.right.w;
     float far = v_4.up.w;
     if (v_4.origin.w > 0.5) {
-        local_11 = _e2.z <= near;
+        local_12 = _e2.z <= near;
     } else {
-        local_11 = false;
+        local_12 = false;
     }
-    bool _e16 = local_11;
+    bool _e16 = local_12;
     if (_e16) {
         return 1.0;
     }
@@ -332,7 +332,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 ) {
     float sum = 0.0;
     uint k_5 = 0u;
-    uint q_1 = {};
+    uint q = {};
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
     float h_9 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
     float g0_ = metal::atan((a_1 - t0_) / h_9);
@@ -355,27 +355,27 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         {
             uint _e32 = k_5;
             float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
-            q_1 = 0u;
+            q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
             while(true) {
                 if (metal::all(loop_bound_1 == uint2(0u))) { break; }
                 loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
                 if (!loop_init_1) {
-                    uint _e70 = q_1;
-                    q_1 = _e70 + 1u;
+                    uint _e70 = q;
+                    q = _e70 + 1u;
                 }
                 loop_init_1 = false;
-                uint _e40 = q_1;
+                uint _e40 = q;
                 if (_e40 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q_1;
+                    uint _e46 = q;
                     float u_1 = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
-                    uint _e54 = q_1;
+                    uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_9 * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
                     sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u_1 * u_1)));
                 }
@@ -539,11 +539,11 @@ int naga_mod(int lhs, int rhs) {
 }
 
 uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    float j_4,
+    float j_9,
     uint rows,
     bool wrap
 ) {
-    int ji = naga_f2i32(j_4);
+    int ji = naga_f2i32(j_9);
     if (wrap) {
         return static_cast<uint>(naga_mod(as_type<int>(as_type<uint>(naga_mod(ji, static_cast<int>(rows))) + as_type<uint>(static_cast<int>(rows))), static_cast<int>(rows)));
     } else {
@@ -559,16 +559,16 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float s_1,
     bool spot_1
 ) {
-    bool local_12 = {};
+    bool local_13 = {};
     if (spot_1) {
         float psi = x_2 * delta;
         float den = metal::sin(theta_1 + psi);
         if (!((den <= 0.000001))) {
-            local_12 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_13 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local_12 = true;
+            local_13 = true;
         }
-        bool _e16 = local_12;
+        bool _e16 = local_13;
         if (_e16) {
             return s_1;
         }
@@ -595,13 +595,13 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     float b_4,
     float depth_break
 ) {
-    bool local_13 = {};
+    bool local_14 = {};
     if (!((a_4 == b_4))) {
-        local_13 = metal::abs(a_4 - b_4) <= (depth_break * metal::min(a_4, b_4));
+        local_14 = metal::abs(a_4 - b_4) <= (depth_break * metal::min(a_4, b_4));
     } else {
-        local_13 = true;
+        local_14 = true;
     }
-    bool _e13 = local_13;
+    bool _e13 = local_14;
     return _e13;
 }
 
@@ -629,24 +629,24 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
 ) {
     metal::float2 origin = {};
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1 = {};
-    bool local_14 = {};
     bool local_15 = {};
     bool local_16 = {};
+    bool local_17 = {};
     float a_5 = 0.0;
     float b_5 = 0.0;
     uint k_7 = 0u;
     metal::float2 size_1 = static_cast<metal::float2>(screen);
     metal::float2 centre = 0.5 * size_1;
     float z_5 = metal::dot(cam.toward, cam.forward);
-    metal::float2 q_3 = metal::float2((metal::dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect), (-(metal::dot(cam.toward, cam.up)) * centre.y) / cam.tan_half);
+    metal::float2 q_2 = metal::float2((metal::dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect), (-(metal::dot(cam.toward, cam.up)) * centre.y) / cam.tan_half);
     float far_2 = EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * metal::max(size_1.x, size_1.y);
-    float lq = metal::length(q_3);
+    float lq = metal::length(q_2);
     origin = centre;
     if (lq >= (far_2 * metal::abs(z_5))) {
-        origin = centre + ((q_3 * (far_2 / metal::max(lq, 0.000000000000000000000000000001))) * ((z_5 < 0.0) ? -1.0 : 1.0));
+        origin = centre + ((q_2 * (far_2 / metal::max(lq, 0.000000000000000000000000000001))) * ((z_5 < 0.0) ? -1.0 : 1.0));
     } else {
         if (lq > 0.0) {
-            origin = centre + (q_3 / metal::float2(z_5));
+            origin = centre + (q_2 / metal::float2(z_5));
         }
     }
     metal::float2 _e56 = origin;
@@ -660,25 +660,25 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     float _e79 = origin.x;
     if (_e79 >= lo_2.x) {
         float _e83 = origin.x;
-        local_14 = _e83 <= hi_2.x;
-    } else {
-        local_14 = false;
-    }
-    bool _e89 = local_14;
-    if (_e89) {
-        float _e91 = origin.y;
-        local_15 = _e91 >= lo_2.y;
+        local_15 = _e83 <= hi_2.x;
     } else {
         local_15 = false;
     }
-    bool _e97 = local_15;
-    if (_e97) {
-        float _e99 = origin.y;
-        local_16 = _e99 <= hi_2.y;
+    bool _e89 = local_15;
+    if (_e89) {
+        float _e91 = origin.y;
+        local_16 = _e91 >= lo_2.y;
     } else {
         local_16 = false;
     }
-    bool inside = local_16;
+    bool _e97 = local_16;
+    if (_e97) {
+        float _e99 = origin.y;
+        local_17 = _e99 <= hi_2.y;
+    } else {
+        local_17 = false;
+    }
+    bool inside = local_17;
     if (inside) {
         l_1.wrap = 1u;
         l_1.phi_start = -3.1415927;
@@ -734,9 +734,9 @@ metal::float2 slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     uint s_2
 ) {
     float phi_1 = l_2.phi_start + ((static_cast<float>(s_2) + 0.5) * l_2.dphi);
-    float c_1 = metal::cos(phi_1);
+    float c_2 = metal::cos(phi_1);
     float sn = metal::sin(phi_1);
-    return metal::float2((l_2.axis.x * c_1) - (l_2.axis.y * sn), (l_2.axis.y * c_1) + (l_2.axis.x * sn));
+    return metal::float2((l_2.axis.x * c_2) - (l_2.axis.y * sn), (l_2.axis.y * c_2) + (l_2.axis.x * sn));
 }
 
 metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
@@ -805,8 +805,8 @@ metal::uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::uint2 screen_2
 ) {
     metal::float2 p_6 = l_4.origin + (u * (span.x + (static_cast<float>(k_8) * span.y)));
-    metal::float2 last = static_cast<metal::float2>(screen_2) - metal::float2(1.0, 1.0);
-    return naga_f2u32(metal::clamp(metal::floor(p_6), metal::float2(0.0, 0.0), last));
+    metal::float2 last_1 = static_cast<metal::float2>(screen_2) - metal::float2(1.0, 1.0);
+    return naga_f2u32(metal::clamp(metal::floor(p_6), metal::float2(0.0, 0.0), last_1));
 }
 
 float edge_t(
@@ -853,10 +853,10 @@ metal::float4 factor_at(
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float p_7 = metal::min(metal::clamp(x_4, 0.0, 1.0) * 95.0, 95.0);
-    uint j_5 = metal::min(naga_f2u32(metal::floor(p_7)), 94u);
-    float t_4 = p_7 - static_cast<float>(j_5);
-    metal::float4 _e22 = pst_factors[metal::min(unsigned((base + (2u * j_5)) + h_4), (_buffer_sizes.size5 - 0 - 16) / 16)];
-    metal::float4 _e34 = pst_factors[metal::min(unsigned((base + (2u * (j_5 + 1u))) + h_4), (_buffer_sizes.size5 - 0 - 16) / 16)];
+    uint j_10 = metal::min(naga_f2u32(metal::floor(p_7)), 94u);
+    float t_4 = p_7 - static_cast<float>(j_10);
+    metal::float4 _e22 = pst_factors[metal::min(unsigned((base + (2u * j_10)) + h_4), (_buffer_sizes.size5 - 0 - 16) / 16)];
+    metal::float4 _e34 = pst_factors[metal::min(unsigned((base + (2u * (j_10 + 1u))) + h_4), (_buffer_sizes.size5 - 0 - 16) / 16)];
     return (_e22 * (1.0 - t_4)) + (_e34 * t_4);
 }
 
@@ -917,8 +917,8 @@ metal::float4 pst_leaf(
         }
         {
             uint _e20 = g_1;
-            float q_4 = (_e20 == 0u) ? -0.57735026 : GL2_;
-            float psi_1 = ((static_cast<float>(i_2) + 0.5) + (0.5 * q_4)) * delta_2;
+            float q_3 = (_e20 == 0u) ? -0.57735026 : GL2_;
+            float psi_1 = ((static_cast<float>(i_2) + 0.5) + (0.5 * q_3)) * delta_2;
             metal::float3 l_5 = (-(axis_1) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
             float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_5, f_10.light_dir.xyz), f_10.light_pos.w, f_10.light_dir.w);
             metal::float4 _e48 = leaf;
@@ -937,9 +937,9 @@ PstRay pst_ray(
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     PstRay r_1 = {};
-    bool local_17 = {};
     bool local_18 = {};
     bool local_19 = {};
+    bool local_20 = {};
     float yc = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11 = frame;
     metal::float3 eye_7 = f_11.eye.xyz;
@@ -951,23 +951,23 @@ PstRay pst_ray(
     metal::float3 px = metal::float3(pc, 0.0);
     float radius = f_11.epipole.w;
     if (f_11.epipole.z > 0.5) {
-        local_17 = metal::length(px - metal::float3(f_11.epipole.x, f_11.epipole.y, 0.0)) < radius;
-    } else {
-        local_17 = false;
-    }
-    bool near_epi = local_17;
-    if (f_11.anti_epipole.z > 0.5) {
-        local_18 = metal::length(px - metal::float3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0)) < radius;
+        local_18 = metal::length(px - metal::float3(f_11.epipole.x, f_11.epipole.y, 0.0)) < radius;
     } else {
         local_18 = false;
     }
-    bool near_anti = local_18;
-    if (!(near_epi)) {
-        local_19 = near_anti;
+    bool near_epi = local_18;
+    if (f_11.anti_epipole.z > 0.5) {
+        local_19 = metal::length(px - metal::float3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0)) < radius;
     } else {
-        local_19 = true;
+        local_19 = false;
     }
-    bool _e109 = local_19;
+    bool near_anti = local_19;
+    if (!(near_epi)) {
+        local_20 = near_anti;
+    } else {
+        local_20 = true;
+    }
+    bool _e109 = local_20;
     if (_e109) {
         r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
@@ -995,8 +995,8 @@ PstRay pst_ray(
     float _e171 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e166, f_11.theta.x, f_11.theta.y);
     r_1.d = _e171;
     if (true) {
-        metal::float3 q_5 = metal::normalize((eye_7 + (dir_8 * s_5)) - f_11.light_pos.xyz);
-        r_1.xs_num = metal::acos(metal::clamp(metal::dot(q_5, -(axis_2)), -1.0, 1.0));
+        metal::float3 q_4 = metal::normalize((eye_7 + (dir_8 * s_5)) - f_11.light_pos.xyz);
+        r_1.xs_num = metal::acos(metal::clamp(metal::dot(q_4, -(axis_2)), -1.0, 1.0));
     } else {
         float _e187 = r_1.theta;
         r_1.xs_num = s_5 * metal::sin(_e187);
@@ -1136,11 +1136,11 @@ float pst_footprint_depth(
     metal::uint2 screen_3,
     metal::texture2d<float, metal::access::sample> depth
 ) {
-    metal::float2 last_1 = static_cast<metal::float2>(screen_3) - metal::float2(1.0, 1.0);
-    metal::float2 q_6 = metal::clamp(pc_1 - metal::float2(0.5, 0.5), metal::float2(0.0, 0.0), last_1);
-    metal::uint2 i0_ = naga_f2u32(metal::floor(q_6));
+    metal::float2 last_2 = static_cast<metal::float2>(screen_3) - metal::float2(1.0, 1.0);
+    metal::float2 q_5 = metal::clamp(pc_1 - metal::float2(0.5, 0.5), metal::float2(0.0, 0.0), last_2);
+    metal::uint2 i0_ = naga_f2u32(metal::floor(q_5));
     metal::uint2 i1_ = metal::min(i0_ + metal::uint2(1u, 1u), screen_3 - metal::uint2(1u, 1u));
-    metal::float2 t_6 = q_6 - metal::floor(q_6);
+    metal::float2 t_6 = q_5 - metal::floor(q_5);
     uint clamped_lod_e30 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e30 = depth.read(metal::min(metal::uint2(i0_), metal::uint2(depth.get_width(clamped_lod_e30), depth.get_height(clamped_lod_e30)) - 1), clamped_lod_e30);
     float z00_ = _e30.x;
@@ -1191,6 +1191,7 @@ kernel void pst_sweep(
 , threadgroup type_15& q_b
 , threadgroup type_14& by_end
 , threadgroup metal::atomic_uint& live
+, threadgroup type_16& bucket
 , constant _mslBufferSizes& _buffer_sizes [[buffer(7)]]
 ) {
     if (li == 0u) {
@@ -1202,73 +1203,84 @@ kernel void pst_sweep(
         q_b = {};
         by_end = {};
         metal::atomic_store_explicit(&live, 0, metal::memory_order_relaxed);
+        bucket = {};
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     uint k = {};
     PstRay r = {};
     bool local = {};
-    uint k_1 = {};
-    uint by_d = {};
-    uint by_e = {};
-    uint q = {};
+    uint count = 0u;
+    uint k_1 = 0u;
     bool local_1 = {};
     bool local_2 = {};
+    uint first = 0u;
+    uint last = 255u;
+    uint m = 0u;
+    uint k_2 = 0u;
+    uint j = {};
     bool local_3 = {};
+    uint j_1 = 0u;
+    uint start = 0u;
+    uint c = 0u;
+    uint m_1 = 0u;
+    uint k_3 = 0u;
     bool local_4 = {};
-    type_17 mine = {};
-    uint k_2 = {};
-    uint k_3 = {};
+    uint j_2 = {};
+    bool local_5 = {};
+    type_16 mine = {};
+    uint j_3 = {};
+    uint j_4 = {};
     uint i = {};
     uint lo = {};
     uint hi = {};
     uint h = {};
-    uint j = 0u;
+    uint j_5 = 0u;
     uint next = 0u;
     uint top = {};
     uint i_1 = {};
-    bool local_5 = {};
     bool local_6 = {};
     bool local_7 = {};
+    bool local_8 = {};
     uint h_1 = {};
     metal::float4 p = {};
-    uint j_1 = {};
+    uint j_6 = {};
     uint h_2 = {};
-    uint j_2 = {};
+    uint j_7 = {};
     uint x = {};
     metal::float4 running = {};
-    uint c = {};
+    uint c_1 = {};
     uint k_4 = {};
     float dotp = {};
     uint h_3 = {};
     metal::float4 p_1 = {};
-    uint j_3 = {};
+    uint j_8 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = frame;
     metal::uint2 screen_4 = metal::uint2(f_14.sizes.x, f_14.sizes.y);
     uint width = f_14.sizes.z;
-    metal::float4 _e12 = frame.cam_forward;
-    metal::float4 _e16 = frame.cam_right;
-    metal::float4 _e20 = frame.cam_up;
-    float _e25 = frame.cam_forward.w;
-    float _e29 = frame.cam_right.w;
-    metal::float4 _e32 = frame.axis;
-    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e36 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {_e12.xyz, _e16.xyz, _e20.xyz, _e25, _e29, {}, _e32.xyz}, screen_4, SLICES);
+    metal::float4 _e13 = frame.cam_forward;
+    metal::float4 _e17 = frame.cam_right;
+    metal::float4 _e21 = frame.cam_up;
+    float _e26 = frame.cam_forward.w;
+    float _e30 = frame.cam_right.w;
+    metal::float4 _e33 = frame.axis;
+    EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e37 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {_e13.xyz, _e17.xyz, _e21.xyz, _e26, _e30, {}, _e33.xyz}, screen_4, SLICES);
     uint s_6 = wid.x;
-    metal::float2 _e39 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6);
-    metal::float2 _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6, screen_4, SLICE_SAMPLES);
+    metal::float2 _e40 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_6);
+    metal::float2 _e42 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_6, screen_4, SLICE_SAMPLES);
     if (li == 0u) {
-        output.write(metal::float4(_e39.x, _e39.y, _e41.x, _e41.y), metal::uint2(metal::uint2(SLICE_SAMPLES, s_6)));
+        output.write(metal::float4(_e40.x, _e40.y, _e42.x, _e42.y), metal::uint2(metal::uint2(SLICE_SAMPLES, s_6)));
         if (s_6 == 0u) {
             metal::atomic_store_explicit(&fallback_count, 0u, metal::memory_order_relaxed);
-            output.write(metal::float4(_e36.origin, _e36.axis), metal::uint2(metal::uint2(0u, 512u)));
-            output.write(metal::float4(_e36.phi_start, _e36.dphi, static_cast<float>(_e36.wrap), 0.0), metal::uint2(metal::uint2(1u, 512u)));
+            output.write(metal::float4(_e37.origin, _e37.axis), metal::uint2(metal::uint2(0u, 512u)));
+            output.write(metal::float4(_e37.phi_start, _e37.dphi, static_cast<float>(_e37.wrap), 0.0), metal::uint2(metal::uint2(1u, 512u)));
         }
     }
-    metal::float2 far_end = _e36.origin + (_e39 * (_e41.x + (255.0 * _e41.y)));
-    PstRay _e83 = pst_ray(far_end, 0.0, frame, shadow_map);
-    uint row_3 = _e83.row;
-    metal::float4 _e87 = slices_1[metal::min(unsigned(row_3), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e88 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e87);
-    float delta_6 = _e88.delta;
+    metal::float2 far_end = _e37.origin + (_e40 * (_e42.x + (255.0 * _e42.y)));
+    PstRay _e84 = pst_ray(far_end, 0.0, frame, shadow_map);
+    uint row_3 = _e84.row;
+    metal::float4 _e88 = slices_1[metal::min(unsigned(row_3), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
+    float delta_6 = _e89.delta;
     k = li;
     uint2 loop_bound_8 = uint2(4294967295u);
     bool loop_init_8 = true;
@@ -1276,299 +1288,468 @@ kernel void pst_sweep(
         if (metal::all(loop_bound_8 == uint2(0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
         if (!loop_init_8) {
-            uint _e187 = k;
-            k = _e187 + SLICE_LANES;
+            uint _e188 = k;
+            k = _e188 + SLICE_LANES;
         }
         loop_init_8 = false;
-        uint _e91 = k;
-        if (_e91 < SLICE_SAMPLES) {
+        uint _e92 = k;
+        if (_e92 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e94 = k;
-            metal::uint2 _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e94, screen_4);
-            uint clamped_lod_e98 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-            metal::float4 _e98 = depth.read(metal::min(metal::uint2(_e95), metal::uint2(depth.get_width(clamped_lod_e98), depth.get_height(clamped_lod_e98)) - 1), clamped_lod_e98);
-            float z_6 = _e98.x;
-            uint _e102 = k;
-            float _e109 = pst_footprint_depth(_e36.origin + (_e39 * (_e41.x + (static_cast<float>(_e102) * _e41.y))), screen_4, depth);
+            uint _e95 = k;
+            metal::uint2 _e96 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e95, screen_4);
+            uint clamped_lod_e99 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+            metal::float4 _e99 = depth.read(metal::min(metal::uint2(_e96), metal::uint2(depth.get_width(clamped_lod_e99), depth.get_height(clamped_lod_e99)) - 1), clamped_lod_e99);
+            float z_6 = _e99.x;
+            uint _e103 = k;
+            float _e110 = pst_footprint_depth(_e37.origin + (_e40 * (_e42.x + (static_cast<float>(_e103) * _e42.y))), screen_4, depth);
             r = PstRay {};
-            if (_e109 < 0.0) {
-                PstRay _e123 = pst_ray(metal::float2(static_cast<float>(_e95.x) + 0.5, static_cast<float>(_e95.y) + 0.5), z_6, frame, shadow_map);
-                r = _e123;
+            if (_e110 < 0.0) {
+                PstRay _e124 = pst_ray(metal::float2(static_cast<float>(_e96.x) + 0.5, static_cast<float>(_e96.y) + 0.5), z_6, frame, shadow_map);
+                r = _e124;
             } else {
-                uint _e126 = k;
-                PstRay _e133 = pst_ray(_e36.origin + (_e39 * (_e41.x + (static_cast<float>(_e126) * _e41.y))), _e109, frame, shadow_map);
-                r = _e133;
+                uint _e127 = k;
+                PstRay _e134 = pst_ray(_e37.origin + (_e40 * (_e42.x + (static_cast<float>(_e127) * _e42.y))), _e110, frame, shadow_map);
+                r = _e134;
             }
-            PstRay _e134 = r;
-            uint _e135 = pst_columns_crossed(_e134, delta_6, frame);
-            uint _e137 = k;
-            q_end.inner[metal::min(unsigned(_e137), 255u)] = NONE;
-            bool _e141 = r.marched;
-            if (!(_e141)) {
-                local = _e135 == 0u;
+            PstRay _e135 = r;
+            uint _e136 = pst_columns_crossed(_e135, delta_6, frame);
+            uint _e138 = k;
+            q_end.inner[metal::min(unsigned(_e138), 255u)] = NONE;
+            bool _e142 = r.marched;
+            if (!(_e142)) {
+                local = _e136 == 0u;
             } else {
                 local = true;
             }
-            bool _e148 = local;
-            if (_e148) {
-                metal::float3 _e150 = r.color;
-                metal::float3 _e151 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e150);
-                uint _e152 = k;
-                output.write(metal::float4(_e151.x, _e151.y, _e151.z, z_6), metal::uint2(metal::uint2(_e152, s_6)));
+            bool _e149 = local;
+            if (_e149) {
+                metal::float3 _e151 = r.color;
+                metal::float3 _e152 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e151);
+                uint _e153 = k;
+                output.write(metal::float4(_e152.x, _e152.y, _e152.z, z_6), metal::uint2(metal::uint2(_e153, s_6)));
             } else {
-                PstRay _e159 = r;
-                metal::float2 _e160 = pst_terms(_e159, row_3, delta_6, _e135, frame, rectified);
-                uint _e162 = k;
-                q_end.inner[metal::min(unsigned(_e162), 255u)] = _e135 - 1u;
-                uint _e167 = k;
-                float _e170 = r.d;
-                q_d.inner[metal::min(unsigned(_e167), 255u)] = _e170;
-                uint _e172 = k;
-                float _e175 = r.theta;
-                q_theta.inner[metal::min(unsigned(_e172), 255u)] = _e175;
-                uint _e177 = k;
-                q_a.inner[metal::min(unsigned(_e177), 255u)] = _e160.x;
-                uint _e181 = k;
-                q_b.inner[metal::min(unsigned(_e181), 255u)] = _e160.y;
-                uint _e186 = metal::atomic_fetch_add_explicit(&live, 1u, metal::memory_order_relaxed);
+                PstRay _e160 = r;
+                metal::float2 _e161 = pst_terms(_e160, row_3, delta_6, _e136, frame, rectified);
+                uint _e163 = k;
+                q_end.inner[metal::min(unsigned(_e163), 255u)] = _e136 - 1u;
+                uint _e168 = k;
+                float _e171 = r.d;
+                q_d.inner[metal::min(unsigned(_e168), 255u)] = _e171;
+                uint _e173 = k;
+                float _e176 = r.theta;
+                q_theta.inner[metal::min(unsigned(_e173), 255u)] = _e176;
+                uint _e178 = k;
+                q_a.inner[metal::min(unsigned(_e178), 255u)] = _e161.x;
+                uint _e182 = k;
+                q_b.inner[metal::min(unsigned(_e182), 255u)] = _e161.y;
+                uint _e187 = metal::atomic_fetch_add_explicit(&live, 1u, metal::memory_order_relaxed);
             }
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     uint v_9 = metal::atomic_load_explicit(&live, metal::memory_order_relaxed);
-    k_1 = li;
-    uint2 loop_bound_9 = uint2(4294967295u);
-    bool loop_init_9 = true;
-    while(true) {
-        if (metal::all(loop_bound_9 == uint2(0u))) { break; }
-        loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
-        if (!loop_init_9) {
-            uint _e298 = k_1;
-            k_1 = _e298 + SLICE_LANES;
+    uint cw = naga_div((width + TREES) - 1u, TREES);
+    if (li < TREES) {
+        uint2 loop_bound_9 = uint2(4294967295u);
+        bool loop_init_9 = true;
+        while(true) {
+            if (metal::all(loop_bound_9 == uint2(0u))) { break; }
+            loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
+            if (!loop_init_9) {
+                uint _e228 = k_1;
+                k_1 = _e228 + 1u;
+            }
+            loop_init_9 = false;
+            uint _e202 = k_1;
+            if (_e202 < SLICE_SAMPLES) {
+            } else {
+                break;
+            }
+            {
+                uint _e206 = k_1;
+                uint _e208 = q_end.inner[metal::min(unsigned(_e206), 255u)];
+                if (_e208 != NONE) {
+                    uint _e212 = k_1;
+                    uint _e214 = q_end.inner[metal::min(unsigned(_e212), 255u)];
+                    local_1 = metal::min(naga_div(_e214, cw), 7u) == li;
+                } else {
+                    local_1 = false;
+                }
+                bool _e222 = local_1;
+                if (_e222) {
+                    uint _e225 = count;
+                    count = _e225 + 1u;
+                }
+            }
         }
-        loop_init_9 = false;
-        uint _e193 = k_1;
-        if (_e193 < SLICE_SAMPLES) {
+        uint _e232 = count;
+        bucket.inner[metal::min(unsigned(li), 7u)] = _e232;
+    } else {
+        if (li == TREES) {
+            local_2 = v_9 > 0u;
         } else {
-            break;
+            local_2 = false;
         }
-        {
-            uint _e197 = k_1;
-            uint _e199 = q_end.inner[metal::min(unsigned(_e197), 255u)];
-            if (_e199 != NONE) {
-                by_d = 0u;
-                by_e = 0u;
-                q = 0u;
-                uint2 loop_bound_10 = uint2(4294967295u);
-                bool loop_init_10 = true;
-                while(true) {
-                    if (metal::all(loop_bound_10 == uint2(0u))) { break; }
-                    loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
-                    if (!loop_init_10) {
-                        uint _e288 = q;
-                        q = _e288 + 1u;
+        bool _e240 = local_2;
+        if (_e240) {
+            uint2 loop_bound_10 = uint2(4294967295u);
+            while(true) {
+                if (metal::all(loop_bound_10 == uint2(0u))) { break; }
+                loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
+                uint _e243 = first;
+                uint _e245 = q_end.inner[metal::min(unsigned(_e243), 255u)];
+                if (_e245 == NONE) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e249 = first;
+                    first = _e249 + 1u;
+                }
+            }
+            uint2 loop_bound_11 = uint2(4294967295u);
+            while(true) {
+                if (metal::all(loop_bound_11 == uint2(0u))) { break; }
+                loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
+                uint _e253 = last;
+                uint _e255 = q_end.inner[metal::min(unsigned(_e253), 255u)];
+                if (_e255 == NONE) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e259 = last;
+                    last = _e259 - 1u;
+                }
+            }
+            uint _e262 = first;
+            float _e264 = q_d.inner[metal::min(unsigned(_e262), 255u)];
+            uint _e266 = last;
+            float _e268 = q_d.inner[metal::min(unsigned(_e266), 255u)];
+            bool up = _e264 <= _e268;
+            uint2 loop_bound_12 = uint2(4294967295u);
+            bool loop_init_10 = true;
+            while(true) {
+                if (metal::all(loop_bound_12 == uint2(0u))) { break; }
+                loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
+                if (!loop_init_10) {
+                    uint _e341 = k_2;
+                    k_2 = _e341 + 1u;
+                }
+                loop_init_10 = false;
+                uint _e271 = k_2;
+                if (_e271 < SLICE_SAMPLES) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e275 = k_2;
+                    uint _e277 = q_end.inner[metal::min(unsigned(_e275), 255u)];
+                    if (_e277 != NONE) {
+                        uint _e281 = k_2;
+                        float d_2 = q_d.inner[metal::min(unsigned(_e281), 255u)];
+                        uint _e285 = m;
+                        j = _e285;
+                        uint2 loop_bound_13 = uint2(4294967295u);
+                        while(true) {
+                            if (metal::all(loop_bound_13 == uint2(0u))) { break; }
+                            loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
+                            uint _e287 = j;
+                            if (_e287 > 0u) {
+                                uint _e290 = j;
+                                float _e295 = q_d.inner[metal::min(unsigned(_e290 - 1u), 255u)];
+                                uint _e297 = j;
+                                float _e302 = q_d.inner[metal::min(unsigned(_e297 - 1u), 255u)];
+                                local_3 = up ? (_e302 > d_2) : (_e295 < d_2);
+                            } else {
+                                local_3 = false;
+                            }
+                            bool _e308 = local_3;
+                            if (_e308) {
+                            } else {
+                                break;
+                            }
+                            {
+                                uint _e310 = j;
+                                uint _e312 = j;
+                                float _e317 = q_d.inner[metal::min(unsigned(_e312 - 1u), 255u)];
+                                q_d.inner[metal::min(unsigned(_e310), 255u)] = _e317;
+                                uint _e319 = j;
+                                uint _e321 = j;
+                                uint _e326 = q_rank.inner[metal::min(unsigned(_e321 - 1u), 255u)];
+                                q_rank.inner[metal::min(unsigned(_e319), 255u)] = _e326;
+                                uint _e328 = j;
+                                j = _e328 - 1u;
+                            }
+                        }
+                        uint _e331 = j;
+                        q_d.inner[metal::min(unsigned(_e331), 255u)] = d_2;
+                        uint _e334 = j;
+                        uint _e336 = k_2;
+                        q_rank.inner[metal::min(unsigned(_e334), 255u)] = _e336;
+                        uint _e338 = m;
+                        m = _e338 + 1u;
                     }
-                    loop_init_10 = false;
-                    uint _e208 = q;
-                    if (_e208 < SLICE_SAMPLES) {
+                }
+            }
+            if (!(up)) {
+                uint2 loop_bound_14 = uint2(4294967295u);
+                bool loop_init_11 = true;
+                while(true) {
+                    if (metal::all(loop_bound_14 == uint2(0u))) { break; }
+                    loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
+                    if (!loop_init_11) {
+                        uint _e390 = j_1;
+                        j_1 = _e390 + 1u;
+                    }
+                    loop_init_11 = false;
+                    uint _e345 = j_1;
+                    if (_e345 < naga_div(v_9, 2u)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e212 = q;
-                        uint _e214 = q_end.inner[metal::min(unsigned(_e212), 255u)];
-                        if (_e214 != NONE) {
-                            uint _e217 = by_d;
-                            uint _e219 = q;
-                            float _e221 = q_d.inner[metal::min(unsigned(_e219), 255u)];
-                            uint _e223 = k_1;
-                            float _e225 = q_d.inner[metal::min(unsigned(_e223), 255u)];
-                            if (!((_e221 < _e225))) {
-                                uint _e229 = q;
-                                float _e231 = q_d.inner[metal::min(unsigned(_e229), 255u)];
-                                uint _e233 = k_1;
-                                float _e235 = q_d.inner[metal::min(unsigned(_e233), 255u)];
-                                if (_e231 == _e235) {
-                                    uint _e237 = q;
-                                    uint _e238 = k_1;
-                                    local_2 = _e237 < _e238;
-                                } else {
-                                    local_2 = false;
-                                }
-                                bool _e243 = local_2;
-                                local_1 = _e243;
-                            } else {
-                                local_1 = true;
-                            }
-                            bool _e249 = local_1;
-                            by_d = _e217 + (_e249 ? 1u : 0u);
-                            uint _e252 = by_e;
-                            uint _e254 = q;
-                            uint _e256 = q_end.inner[metal::min(unsigned(_e254), 255u)];
-                            uint _e258 = k_1;
-                            uint _e260 = q_end.inner[metal::min(unsigned(_e258), 255u)];
-                            if (!((_e256 < _e260))) {
-                                uint _e264 = q;
-                                uint _e266 = q_end.inner[metal::min(unsigned(_e264), 255u)];
-                                uint _e268 = k_1;
-                                uint _e270 = q_end.inner[metal::min(unsigned(_e268), 255u)];
-                                if (_e266 == _e270) {
-                                    uint _e272 = q;
-                                    uint _e273 = k_1;
-                                    local_4 = _e272 < _e273;
-                                } else {
-                                    local_4 = false;
-                                }
-                                bool _e278 = local_4;
-                                local_3 = _e278;
-                            } else {
-                                local_3 = true;
-                            }
-                            bool _e284 = local_3;
-                            by_e = _e252 + (_e284 ? 1u : 0u);
-                        }
+                        uint _e350 = j_1;
+                        float d_3 = q_d.inner[metal::min(unsigned(_e350), 255u)];
+                        uint _e354 = j_1;
+                        uint _e359 = j_1;
+                        float _e362 = q_d.inner[metal::min(unsigned((v_9 - 1u) - _e359), 255u)];
+                        q_d.inner[metal::min(unsigned(_e354), 255u)] = _e362;
+                        uint _e366 = j_1;
+                        q_d.inner[metal::min(unsigned((v_9 - 1u) - _e366), 255u)] = d_3;
+                        uint _e370 = j_1;
+                        uint k_9 = q_rank.inner[metal::min(unsigned(_e370), 255u)];
+                        uint _e374 = j_1;
+                        uint _e379 = j_1;
+                        uint _e382 = q_rank.inner[metal::min(unsigned((v_9 - 1u) - _e379), 255u)];
+                        q_rank.inner[metal::min(unsigned(_e374), 255u)] = _e382;
+                        uint _e386 = j_1;
+                        q_rank.inner[metal::min(unsigned((v_9 - 1u) - _e386), 255u)] = k_9;
                     }
                 }
-                uint _e291 = k_1;
-                uint _e293 = by_d;
-                q_rank.inner[metal::min(unsigned(_e291), 255u)] = _e293;
-                uint _e295 = by_e;
-                uint _e297 = k_1;
-                by_end.inner[metal::min(unsigned(_e295), 255u)] = _e297;
             }
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    k_2 = li;
-    uint2 loop_bound_11 = uint2(4294967295u);
-    bool loop_init_11 = true;
-    while(true) {
-        if (metal::all(loop_bound_11 == uint2(0u))) { break; }
-        loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
-        if (!loop_init_11) {
-            uint _e314 = k_2;
-            k_2 = _e314 + SLICE_LANES;
+    if (li < TREES) {
+        uint2 loop_bound_15 = uint2(4294967295u);
+        bool loop_init_12 = true;
+        while(true) {
+            if (metal::all(loop_bound_15 == uint2(0u))) { break; }
+            loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
+            if (!loop_init_12) {
+                uint _e405 = c;
+                c = _e405 + 1u;
+            }
+            loop_init_12 = false;
+            uint _e395 = c;
+            if (_e395 < li) {
+            } else {
+                break;
+            }
+            {
+                uint _e398 = start;
+                uint _e400 = c;
+                uint _e402 = bucket.inner[metal::min(unsigned(_e400), 7u)];
+                start = _e398 + _e402;
+            }
         }
-        loop_init_11 = false;
-        uint _e302 = k_2;
-        if (_e302 < SLICE_SAMPLES) {
+        uint2 loop_bound_16 = uint2(4294967295u);
+        bool loop_init_13 = true;
+        while(true) {
+            if (metal::all(loop_bound_16 == uint2(0u))) { break; }
+            loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
+            if (!loop_init_13) {
+                uint _e481 = k_3;
+                k_3 = _e481 + 1u;
+            }
+            loop_init_13 = false;
+            uint _e408 = k_3;
+            if (_e408 < SLICE_SAMPLES) {
+            } else {
+                break;
+            }
+            {
+                uint _e412 = k_3;
+                uint _e414 = q_end.inner[metal::min(unsigned(_e412), 255u)];
+                if (_e414 != NONE) {
+                    uint _e418 = k_3;
+                    uint _e420 = q_end.inner[metal::min(unsigned(_e418), 255u)];
+                    local_4 = metal::min(naga_div(_e420, cw), 7u) == li;
+                } else {
+                    local_4 = false;
+                }
+                bool _e428 = local_4;
+                if (_e428) {
+                    uint _e430 = m_1;
+                    j_2 = _e430;
+                    uint2 loop_bound_17 = uint2(4294967295u);
+                    while(true) {
+                        if (metal::all(loop_bound_17 == uint2(0u))) { break; }
+                        loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
+                        uint _e432 = j_2;
+                        if (_e432 > 0u) {
+                            uint _e435 = start;
+                            uint _e436 = j_2;
+                            uint _e443 = by_end.inner[metal::min(unsigned((_e435 + _e436) - 1u), 255u)];
+                            uint _e445 = q_end.inner[metal::min(unsigned(_e443), 255u)];
+                            uint _e447 = k_3;
+                            uint _e449 = q_end.inner[metal::min(unsigned(_e447), 255u)];
+                            local_5 = _e445 > _e449;
+                        } else {
+                            local_5 = false;
+                        }
+                        bool _e454 = local_5;
+                        if (_e454) {
+                        } else {
+                            break;
+                        }
+                        {
+                            uint _e456 = start;
+                            uint _e457 = j_2;
+                            uint _e460 = start;
+                            uint _e461 = j_2;
+                            uint _e467 = by_end.inner[metal::min(unsigned((_e460 + _e461) - 1u), 255u)];
+                            by_end.inner[metal::min(unsigned(_e456 + _e457), 255u)] = _e467;
+                            uint _e469 = j_2;
+                            j_2 = _e469 - 1u;
+                        }
+                    }
+                    uint _e472 = start;
+                    uint _e473 = j_2;
+                    uint _e476 = k_3;
+                    by_end.inner[metal::min(unsigned(_e472 + _e473), 255u)] = _e476;
+                    uint _e478 = m_1;
+                    m_1 = _e478 + 1u;
+                }
+            }
+        }
+    }
+    j_3 = li;
+    uint2 loop_bound_18 = uint2(4294967295u);
+    bool loop_init_14 = true;
+    while(true) {
+        if (metal::all(loop_bound_18 == uint2(0u))) { break; }
+        loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
+        if (!loop_init_14) {
+            uint _e495 = j_3;
+            j_3 = _e495 + SLICE_LANES;
+        }
+        loop_init_14 = false;
+        uint _e484 = j_3;
+        if (_e484 < v_9) {
         } else {
             break;
         }
         {
-            uint _e305 = k_2;
-            uint _e311 = k_2;
-            float _e313 = q_d.inner[metal::min(unsigned(_e311), 255u)];
-            mine.inner[metal::min(unsigned(naga_div(_e305, SLICE_LANES)), 7u)] = _e313;
+            uint _e486 = j_3;
+            uint _e492 = j_3;
+            uint _e494 = q_rank.inner[metal::min(unsigned(_e492), 255u)];
+            mine.inner[metal::min(unsigned(naga_div(_e486, SLICE_LANES)), 7u)] = _e494;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    k_3 = li;
-    uint2 loop_bound_12 = uint2(4294967295u);
-    bool loop_init_12 = true;
+    j_4 = li;
+    uint2 loop_bound_19 = uint2(4294967295u);
+    bool loop_init_15 = true;
     while(true) {
-        if (metal::all(loop_bound_12 == uint2(0u))) { break; }
-        loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
-        if (!loop_init_12) {
-            uint _e338 = k_3;
-            k_3 = _e338 + SLICE_LANES;
+        if (metal::all(loop_bound_19 == uint2(0u))) { break; }
+        loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
+        if (!loop_init_15) {
+            uint _e509 = j_4;
+            j_4 = _e509 + SLICE_LANES;
         }
-        loop_init_12 = false;
-        uint _e318 = k_3;
-        if (_e318 < SLICE_SAMPLES) {
+        loop_init_15 = false;
+        uint _e499 = j_4;
+        if (_e499 < v_9) {
         } else {
             break;
         }
         {
-            uint _e322 = k_3;
-            uint _e324 = q_end.inner[metal::min(unsigned(_e322), 255u)];
-            if (_e324 != NONE) {
-                uint _e329 = k_3;
-                uint _e331 = q_rank.inner[metal::min(unsigned(_e329), 255u)];
-                uint _e333 = k_3;
-                float _e337 = mine.inner[metal::min(unsigned(naga_div(_e333, SLICE_LANES)), 7u)];
-                q_d.inner[metal::min(unsigned(_e331), 255u)] = _e337;
-            }
+            uint _e501 = j_4;
+            uint _e506 = mine.inner[metal::min(unsigned(naga_div(_e501, SLICE_LANES)), 7u)];
+            uint _e508 = j_4;
+            q_rank.inner[metal::min(unsigned(_e506), 255u)] = _e508;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     uint base_1 = s_6 * width;
     i = li;
-    uint2 loop_bound_13 = uint2(4294967295u);
-    bool loop_init_13 = true;
+    uint2 loop_bound_20 = uint2(4294967295u);
+    bool loop_init_16 = true;
     while(true) {
-        if (metal::all(loop_bound_13 == uint2(0u))) { break; }
-        loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
-        if (!loop_init_13) {
-            uint _e395 = i;
-            i = _e395 + SLICE_LANES;
+        if (metal::all(loop_bound_20 == uint2(0u))) { break; }
+        loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
+        if (!loop_init_16) {
+            uint _e566 = i;
+            i = _e566 + SLICE_LANES;
         }
-        loop_init_13 = false;
-        uint _e343 = i;
-        if (_e343 < width) {
+        loop_init_16 = false;
+        uint _e514 = i;
+        if (_e514 < width) {
         } else {
             break;
         }
         {
-            uint _e345 = i;
-            uint clamped_lod_e349 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e349 = rectified.read(metal::min(metal::uint2(metal::uint2(_e345, row_3)), metal::uint2(rectified.get_width(clamped_lod_e349), rectified.get_height(clamped_lod_e349)) - 1), clamped_lod_e349);
-            float occluder = _e349.x;
+            uint _e516 = i;
+            uint clamped_lod_e520 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+            metal::float4 _e520 = rectified.read(metal::min(metal::uint2(metal::uint2(_e516, row_3)), metal::uint2(rectified.get_width(clamped_lod_e520), rectified.get_height(clamped_lod_e520)) - 1), clamped_lod_e520);
+            float occluder = _e520.x;
             lo = 0u;
             hi = v_9;
-            uint2 loop_bound_14 = uint2(4294967295u);
+            uint2 loop_bound_21 = uint2(4294967295u);
             while(true) {
-                if (metal::all(loop_bound_14 == uint2(0u))) { break; }
-                loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
-                uint _e354 = lo;
-                uint _e355 = hi;
-                if (_e354 < _e355) {
+                if (metal::all(loop_bound_21 == uint2(0u))) { break; }
+                loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
+                uint _e525 = lo;
+                uint _e526 = hi;
+                if (_e525 < _e526) {
                 } else {
                     break;
                 }
                 {
-                    uint _e357 = lo;
-                    uint _e358 = hi;
-                    uint mid_1 = naga_div(_e357 + _e358, 2u);
-                    float _e364 = q_d.inner[metal::min(unsigned(mid_1), 255u)];
-                    if (_e364 <= occluder) {
+                    uint _e528 = lo;
+                    uint _e529 = hi;
+                    uint mid_1 = naga_div(_e528 + _e529, 2u);
+                    float _e535 = q_d.inner[metal::min(unsigned(mid_1), 255u)];
+                    if (_e535 <= occluder) {
                         lo = mid_1 + 1u;
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            uint _e369 = i;
-            uint _e372 = lo;
-            pst_columns[metal::min(unsigned(base_1 + _e369), (_buffer_sizes.size8 - 0 - 4) / 4)] = _e372;
-            uint _e373 = lo;
-            if (_e373 > 0u) {
+            uint _e540 = i;
+            uint _e543 = lo;
+            pst_columns[metal::min(unsigned(base_1 + _e540), (_buffer_sizes.size8 - 0 - 4) / 4)] = _e543;
+            uint _e544 = lo;
+            if (_e544 > 0u) {
                 h = 0u;
-                uint2 loop_bound_15 = uint2(4294967295u);
-                bool loop_init_14 = true;
+                uint2 loop_bound_22 = uint2(4294967295u);
+                bool loop_init_17 = true;
                 while(true) {
-                    if (metal::all(loop_bound_15 == uint2(0u))) { break; }
-                    loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
-                    if (!loop_init_14) {
-                        uint _e393 = h;
-                        h = _e393 + 1u;
+                    if (metal::all(loop_bound_22 == uint2(0u))) { break; }
+                    loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
+                    if (!loop_init_17) {
+                        uint _e564 = h;
+                        h = _e564 + 1u;
                     }
-                    loop_init_14 = false;
-                    uint _e378 = h;
-                    if (_e378 < RANK_VECS) {
+                    loop_init_17 = false;
+                    uint _e549 = h;
+                    if (_e549 < RANK_VECS) {
                     } else {
                         break;
                     }
                     {
-                        uint _e381 = i;
-                        uint _e386 = h;
-                        uint _e389 = i;
-                        uint _e390 = h;
-                        metal::float4 _e391 = pst_leaf(f_14, _e389, row_3, delta_6, _e390, pst_factors, _buffer_sizes);
-                        pst_leaves[metal::min(unsigned(((base_1 + _e381) * RANK_VECS) + _e386), (_buffer_sizes.size6 - 0 - 16) / 16)] = _e391;
+                        uint _e552 = i;
+                        uint _e557 = h;
+                        uint _e560 = i;
+                        uint _e561 = h;
+                        metal::float4 _e562 = pst_leaf(f_14, _e560, row_3, delta_6, _e561, pst_factors, _buffer_sizes);
+                        pst_leaves[metal::min(unsigned(((base_1 + _e552) * RANK_VECS) + _e557), (_buffer_sizes.size6 - 0 - 16) / 16)] = _e562;
                     }
                 }
             }
@@ -1576,51 +1757,50 @@ kernel void pst_sweep(
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_device);
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    uint cw = naga_div((width + TREES) - 1u, TREES);
     uint trees = ((s_6 * 9u) * SLICE_SAMPLES) * RANK_VECS;
     uint partials = trees + 4096u;
     if (li < TREES) {
         uint tree = trees + ((li * SLICE_SAMPLES) * RANK_VECS);
-        uint2 loop_bound_16 = uint2(4294967295u);
-        bool loop_init_15 = true;
+        uint2 loop_bound_23 = uint2(4294967295u);
+        bool loop_init_18 = true;
         while(true) {
-            if (metal::all(loop_bound_16 == uint2(0u))) { break; }
-            loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
-            if (!loop_init_15) {
-                uint _e434 = j;
-                j = _e434 + 1u;
+            if (metal::all(loop_bound_23 == uint2(0u))) { break; }
+            loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
+            if (!loop_init_18) {
+                uint _e599 = j_5;
+                j_5 = _e599 + 1u;
             }
-            loop_init_15 = false;
-            uint _e420 = j;
-            if (_e420 < (v_9 * RANK_VECS)) {
+            loop_init_18 = false;
+            uint _e585 = j_5;
+            if (_e585 < (v_9 * RANK_VECS)) {
             } else {
                 break;
             }
             {
-                uint _e425 = j;
-                pst_tree[metal::min(unsigned(tree + _e425), (_buffer_sizes.size7 - 0 - 16) / 16)] = metal::float4(0.0, 0.0, 0.0, 0.0);
+                uint _e590 = j_5;
+                pst_tree[metal::min(unsigned(tree + _e590), (_buffer_sizes.size7 - 0 - 16) / 16)] = metal::float4(0.0, 0.0, 0.0, 0.0);
             }
         }
         uint lo_5 = li * cw;
         uint hi_5 = ((li + 1u) == TREES) ? width : metal::min(lo_5 + cw, width);
         top = v_9;
-        uint2 loop_bound_17 = uint2(4294967295u);
+        uint2 loop_bound_24 = uint2(4294967295u);
         while(true) {
-            if (metal::all(loop_bound_17 == uint2(0u))) { break; }
-            loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
-            uint _e446 = next;
-            uint _e447 = top;
-            if (_e446 < _e447) {
+            if (metal::all(loop_bound_24 == uint2(0u))) { break; }
+            loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
+            uint _e611 = next;
+            uint _e612 = top;
+            if (_e611 < _e612) {
             } else {
                 break;
             }
             {
-                uint _e449 = next;
-                uint _e450 = top;
-                uint mid_2 = naga_div(_e449 + _e450, 2u);
-                uint _e457 = by_end.inner[metal::min(unsigned(mid_2), 255u)];
-                uint _e459 = q_end.inner[metal::min(unsigned(_e457), 255u)];
-                if (_e459 < lo_5) {
+                uint _e614 = next;
+                uint _e615 = top;
+                uint mid_2 = naga_div(_e614 + _e615, 2u);
+                uint _e622 = by_end.inner[metal::min(unsigned(mid_2), 255u)];
+                uint _e624 = q_end.inner[metal::min(unsigned(_e622), 255u)];
+                if (_e624 < lo_5) {
                     next = mid_2 + 1u;
                 } else {
                     top = mid_2;
@@ -1628,153 +1808,153 @@ kernel void pst_sweep(
             }
         }
         i_1 = lo_5;
-        uint2 loop_bound_18 = uint2(4294967295u);
-        bool loop_init_16 = true;
+        uint2 loop_bound_25 = uint2(4294967295u);
+        bool loop_init_19 = true;
         while(true) {
-            if (metal::all(loop_bound_18 == uint2(0u))) { break; }
-            loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
-            if (!loop_init_16) {
-                uint _e607 = i_1;
-                i_1 = _e607 + 1u;
+            if (metal::all(loop_bound_25 == uint2(0u))) { break; }
+            loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
+            if (!loop_init_19) {
+                uint _e772 = i_1;
+                i_1 = _e772 + 1u;
             }
-            loop_init_16 = false;
-            uint _e464 = i_1;
-            if (_e464 <= hi_5) {
+            loop_init_19 = false;
+            uint _e629 = i_1;
+            if (_e629 <= hi_5) {
             } else {
                 break;
             }
             {
-                uint2 loop_bound_19 = uint2(4294967295u);
+                uint2 loop_bound_26 = uint2(4294967295u);
                 while(true) {
-                    if (metal::all(loop_bound_19 == uint2(0u))) { break; }
-                    loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
-                    uint _e466 = next;
-                    if (_e466 < v_9) {
-                        uint _e470 = next;
-                        uint _e472 = by_end.inner[metal::min(unsigned(_e470), 255u)];
-                        uint _e474 = q_end.inner[metal::min(unsigned(_e472), 255u)];
-                        uint _e475 = i_1;
-                        local_5 = _e474 == _e475;
-                    } else {
-                        local_5 = false;
-                    }
-                    bool _e480 = local_5;
-                    if (_e480) {
-                        uint _e481 = i_1;
-                        if (!((_e481 < hi_5))) {
-                            local_7 = (li + 1u) == TREES;
-                        } else {
-                            local_7 = true;
-                        }
-                        bool _e491 = local_7;
-                        local_6 = _e491;
+                    if (metal::all(loop_bound_26 == uint2(0u))) { break; }
+                    loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
+                    uint _e631 = next;
+                    if (_e631 < v_9) {
+                        uint _e635 = next;
+                        uint _e637 = by_end.inner[metal::min(unsigned(_e635), 255u)];
+                        uint _e639 = q_end.inner[metal::min(unsigned(_e637), 255u)];
+                        uint _e640 = i_1;
+                        local_6 = _e639 == _e640;
                     } else {
                         local_6 = false;
                     }
-                    bool _e495 = local_6;
-                    if (_e495) {
+                    bool _e645 = local_6;
+                    if (_e645) {
+                        uint _e646 = i_1;
+                        if (!((_e646 < hi_5))) {
+                            local_8 = (li + 1u) == TREES;
+                        } else {
+                            local_8 = true;
+                        }
+                        bool _e656 = local_8;
+                        local_7 = _e656;
+                    } else {
+                        local_7 = false;
+                    }
+                    bool _e660 = local_7;
+                    if (_e660) {
                     } else {
                         break;
                     }
                     {
-                        uint _e497 = next;
-                        uint k_9 = by_end.inner[metal::min(unsigned(_e497), 255u)];
-                        uint _e501 = next;
-                        next = _e501 + 1u;
+                        uint _e662 = next;
+                        uint k_10 = by_end.inner[metal::min(unsigned(_e662), 255u)];
+                        uint _e666 = next;
+                        next = _e666 + 1u;
                         h_1 = 0u;
-                        uint2 loop_bound_20 = uint2(4294967295u);
-                        bool loop_init_17 = true;
+                        uint2 loop_bound_27 = uint2(4294967295u);
+                        bool loop_init_20 = true;
                         while(true) {
-                            if (metal::all(loop_bound_20 == uint2(0u))) { break; }
-                            loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
-                            if (!loop_init_17) {
-                                uint _e552 = h_1;
-                                h_1 = _e552 + 1u;
+                            if (metal::all(loop_bound_27 == uint2(0u))) { break; }
+                            loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
+                            if (!loop_init_20) {
+                                uint _e717 = h_1;
+                                h_1 = _e717 + 1u;
                             }
-                            loop_init_17 = false;
-                            uint _e505 = h_1;
-                            if (_e505 < RANK_VECS) {
+                            loop_init_20 = false;
+                            uint _e670 = h_1;
+                            if (_e670 < RANK_VECS) {
                             } else {
                                 break;
                             }
                             {
                                 p = metal::float4(0.0, 0.0, 0.0, 0.0);
-                                uint _e516 = q_rank.inner[metal::min(unsigned(k_9), 255u)];
-                                j_1 = v_9 - _e516;
-                                uint2 loop_bound_21 = uint2(4294967295u);
+                                uint _e681 = q_rank.inner[metal::min(unsigned(k_10), 255u)];
+                                j_6 = v_9 - _e681;
+                                uint2 loop_bound_28 = uint2(4294967295u);
                                 while(true) {
-                                    if (metal::all(loop_bound_21 == uint2(0u))) { break; }
-                                    loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
-                                    uint _e519 = j_1;
-                                    if (_e519 > 0u) {
+                                    if (metal::all(loop_bound_28 == uint2(0u))) { break; }
+                                    loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
+                                    uint _e684 = j_6;
+                                    if (_e684 > 0u) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        metal::float4 _e522 = p;
-                                        uint _e523 = j_1;
-                                        uint _e530 = h_1;
-                                        metal::float4 _e533 = pst_tree[metal::min(unsigned((tree + ((_e523 - 1u) * RANK_VECS)) + _e530), (_buffer_sizes.size7 - 0 - 16) / 16)];
-                                        p = _e522 + _e533;
-                                        uint _e535 = j_1;
-                                        uint _e536 = j_1;
-                                        uint _e537 = j_1;
-                                        j_1 = _e535 - (_e536 & (~(_e537) + 1u));
+                                        metal::float4 _e687 = p;
+                                        uint _e688 = j_6;
+                                        uint _e695 = h_1;
+                                        metal::float4 _e698 = pst_tree[metal::min(unsigned((tree + ((_e688 - 1u) * RANK_VECS)) + _e695), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                                        p = _e687 + _e698;
+                                        uint _e700 = j_6;
+                                        uint _e701 = j_6;
+                                        uint _e702 = j_6;
+                                        j_6 = _e700 - (_e701 & (~(_e702) + 1u));
                                     }
                                 }
-                                uint _e547 = h_1;
-                                metal::float4 _e550 = p;
-                                pst_tree[metal::min(unsigned((partials + (k_9 * RANK_VECS)) + _e547), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e550;
+                                uint _e712 = h_1;
+                                metal::float4 _e715 = p;
+                                pst_tree[metal::min(unsigned((partials + (k_10 * RANK_VECS)) + _e712), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e715;
                             }
                         }
                     }
                 }
-                uint _e554 = i_1;
-                if (_e554 == hi_5) {
+                uint _e719 = i_1;
+                if (_e719 == hi_5) {
                     break;
                 }
-                uint _e557 = i_1;
-                uint b_7 = pst_columns[metal::min(unsigned(base_1 + _e557), (_buffer_sizes.size8 - 0 - 4) / 4)];
+                uint _e722 = i_1;
+                uint b_7 = pst_columns[metal::min(unsigned(base_1 + _e722), (_buffer_sizes.size8 - 0 - 4) / 4)];
                 if (b_7 > 0u) {
                     h_2 = 0u;
-                    uint2 loop_bound_22 = uint2(4294967295u);
-                    bool loop_init_18 = true;
+                    uint2 loop_bound_29 = uint2(4294967295u);
+                    bool loop_init_21 = true;
                     while(true) {
-                        if (metal::all(loop_bound_22 == uint2(0u))) { break; }
-                        loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
-                        if (!loop_init_18) {
-                            uint _e604 = h_2;
-                            h_2 = _e604 + 1u;
+                        if (metal::all(loop_bound_29 == uint2(0u))) { break; }
+                        loop_bound_29 -= uint2(loop_bound_29.y == 0u, 1u);
+                        if (!loop_init_21) {
+                            uint _e769 = h_2;
+                            h_2 = _e769 + 1u;
                         }
-                        loop_init_18 = false;
-                        uint _e565 = h_2;
-                        if (_e565 < RANK_VECS) {
+                        loop_init_21 = false;
+                        uint _e730 = h_2;
+                        if (_e730 < RANK_VECS) {
                         } else {
                             break;
                         }
                         {
-                            uint _e568 = i_1;
-                            uint _e573 = h_2;
-                            metal::float4 leaf_1 = pst_leaves[metal::min(unsigned(((base_1 + _e568) * RANK_VECS) + _e573), (_buffer_sizes.size6 - 0 - 16) / 16)];
-                            j_2 = (v_9 - b_7) + 1u;
-                            uint2 loop_bound_23 = uint2(4294967295u);
+                            uint _e733 = i_1;
+                            uint _e738 = h_2;
+                            metal::float4 leaf_1 = pst_leaves[metal::min(unsigned(((base_1 + _e733) * RANK_VECS) + _e738), (_buffer_sizes.size6 - 0 - 16) / 16)];
+                            j_7 = (v_9 - b_7) + 1u;
+                            uint2 loop_bound_30 = uint2(4294967295u);
                             while(true) {
-                                if (metal::all(loop_bound_23 == uint2(0u))) { break; }
-                                loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
-                                uint _e581 = j_2;
-                                if (_e581 <= v_9) {
+                                if (metal::all(loop_bound_30 == uint2(0u))) { break; }
+                                loop_bound_30 -= uint2(loop_bound_30.y == 0u, 1u);
+                                uint _e746 = j_7;
+                                if (_e746 <= v_9) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    uint _e583 = j_2;
-                                    uint _e590 = h_2;
-                                    metal::float4 _e593 = pst_tree[metal::min(unsigned((tree + ((_e583 - 1u) * RANK_VECS)) + _e590), (_buffer_sizes.size7 - 0 - 16) / 16)];
-                                    pst_tree[metal::min(unsigned((tree + ((_e583 - 1u) * RANK_VECS)) + _e590), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e593 + leaf_1;
-                                    uint _e595 = j_2;
-                                    uint _e596 = j_2;
-                                    uint _e597 = j_2;
-                                    j_2 = _e595 + (_e596 & (~(_e597) + 1u));
+                                    uint _e748 = j_7;
+                                    uint _e755 = h_2;
+                                    metal::float4 _e758 = pst_tree[metal::min(unsigned((tree + ((_e748 - 1u) * RANK_VECS)) + _e755), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                                    pst_tree[metal::min(unsigned((tree + ((_e748 - 1u) * RANK_VECS)) + _e755), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e758 + leaf_1;
+                                    uint _e760 = j_7;
+                                    uint _e761 = j_7;
+                                    uint _e762 = j_7;
+                                    j_7 = _e760 + (_e761 & (~(_e762) + 1u));
                                 }
                             }
                         }
@@ -1786,48 +1966,48 @@ kernel void pst_sweep(
     metal::threadgroup_barrier(metal::mem_flags::mem_device);
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     x = li;
-    uint2 loop_bound_24 = uint2(4294967295u);
-    bool loop_init_19 = true;
+    uint2 loop_bound_31 = uint2(4294967295u);
+    bool loop_init_22 = true;
     while(true) {
-        if (metal::all(loop_bound_24 == uint2(0u))) { break; }
-        loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
-        if (!loop_init_19) {
-            uint _e644 = x;
-            x = _e644 + SLICE_LANES;
+        if (metal::all(loop_bound_31 == uint2(0u))) { break; }
+        loop_bound_31 -= uint2(loop_bound_31.y == 0u, 1u);
+        if (!loop_init_22) {
+            uint _e809 = x;
+            x = _e809 + SLICE_LANES;
         }
-        loop_init_19 = false;
-        uint _e610 = x;
-        if (_e610 < (v_9 * RANK_VECS)) {
+        loop_init_22 = false;
+        uint _e775 = x;
+        if (_e775 < (v_9 * RANK_VECS)) {
         } else {
             break;
         }
         {
             running = metal::float4(0.0, 0.0, 0.0, 0.0);
-            c = 0u;
-            uint2 loop_bound_25 = uint2(4294967295u);
-            bool loop_init_20 = true;
+            c_1 = 0u;
+            uint2 loop_bound_32 = uint2(4294967295u);
+            bool loop_init_23 = true;
             while(true) {
-                if (metal::all(loop_bound_25 == uint2(0u))) { break; }
-                loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
-                if (!loop_init_20) {
-                    uint _e642 = c;
-                    c = _e642 + 1u;
+                if (metal::all(loop_bound_32 == uint2(0u))) { break; }
+                loop_bound_32 -= uint2(loop_bound_32.y == 0u, 1u);
+                if (!loop_init_23) {
+                    uint _e807 = c_1;
+                    c_1 = _e807 + 1u;
                 }
-                loop_init_20 = false;
-                uint _e622 = c;
-                if (_e622 < TREES) {
+                loop_init_23 = false;
+                uint _e787 = c_1;
+                if (_e787 < TREES) {
                 } else {
                     break;
                 }
                 {
-                    uint _e625 = c;
-                    uint _e631 = x;
-                    uint at = (trees + ((_e625 * SLICE_SAMPLES) * RANK_VECS)) + _e631;
+                    uint _e790 = c_1;
+                    uint _e796 = x;
+                    uint at = (trees + ((_e790 * SLICE_SAMPLES) * RANK_VECS)) + _e796;
                     metal::float4 own = pst_tree[metal::min(unsigned(at), (_buffer_sizes.size7 - 0 - 16) / 16)];
-                    metal::float4 _e638 = running;
-                    pst_tree[metal::min(unsigned(at), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e638;
-                    metal::float4 _e639 = running;
-                    running = _e639 + own;
+                    metal::float4 _e803 = running;
+                    pst_tree[metal::min(unsigned(at), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e803;
+                    metal::float4 _e804 = running;
+                    running = _e804 + own;
                 }
             }
         }
@@ -1835,96 +2015,96 @@ kernel void pst_sweep(
     metal::threadgroup_barrier(metal::mem_flags::mem_device);
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     k_4 = li;
-    uint2 loop_bound_26 = uint2(4294967295u);
-    bool loop_init_21 = true;
+    uint2 loop_bound_33 = uint2(4294967295u);
+    bool loop_init_24 = true;
     while(true) {
-        if (metal::all(loop_bound_26 == uint2(0u))) { break; }
-        loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
-        if (!loop_init_21) {
-            uint _e759 = k_4;
-            k_4 = _e759 + SLICE_LANES;
+        if (metal::all(loop_bound_33 == uint2(0u))) { break; }
+        loop_bound_33 -= uint2(loop_bound_33.y == 0u, 1u);
+        if (!loop_init_24) {
+            uint _e924 = k_4;
+            k_4 = _e924 + SLICE_LANES;
         }
-        loop_init_21 = false;
-        uint _e648 = k_4;
-        if (_e648 < SLICE_SAMPLES) {
+        loop_init_24 = false;
+        uint _e813 = k_4;
+        if (_e813 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e652 = k_4;
-            uint _e654 = q_end.inner[metal::min(unsigned(_e652), 255u)];
-            if (_e654 != NONE) {
-                uint _e658 = k_4;
-                uint _e660 = q_end.inner[metal::min(unsigned(_e658), 255u)];
-                uint tree_1 = trees + ((metal::min(naga_div(_e660, cw), 7u) * SLICE_SAMPLES) * RANK_VECS);
+            uint _e817 = k_4;
+            uint _e819 = q_end.inner[metal::min(unsigned(_e817), 255u)];
+            if (_e819 != NONE) {
+                uint _e823 = k_4;
+                uint _e825 = q_end.inner[metal::min(unsigned(_e823), 255u)];
+                uint tree_1 = trees + ((metal::min(naga_div(_e825, cw), 7u) * SLICE_SAMPLES) * RANK_VECS);
                 dotp = 0.0;
                 h_3 = 0u;
-                uint2 loop_bound_27 = uint2(4294967295u);
-                bool loop_init_22 = true;
+                uint2 loop_bound_34 = uint2(4294967295u);
+                bool loop_init_25 = true;
                 while(true) {
-                    if (metal::all(loop_bound_27 == uint2(0u))) { break; }
-                    loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
-                    if (!loop_init_22) {
-                        uint _e727 = h_3;
-                        h_3 = _e727 + 1u;
+                    if (metal::all(loop_bound_34 == uint2(0u))) { break; }
+                    loop_bound_34 -= uint2(loop_bound_34.y == 0u, 1u);
+                    if (!loop_init_25) {
+                        uint _e892 = h_3;
+                        h_3 = _e892 + 1u;
                     }
-                    loop_init_22 = false;
-                    uint _e673 = h_3;
-                    if (_e673 < RANK_VECS) {
+                    loop_init_25 = false;
+                    uint _e838 = h_3;
+                    if (_e838 < RANK_VECS) {
                     } else {
                         break;
                     }
                     {
-                        uint _e676 = k_4;
-                        uint _e681 = h_3;
-                        metal::float4 _e684 = pst_tree[metal::min(unsigned((partials + (_e676 * RANK_VECS)) + _e681), (_buffer_sizes.size7 - 0 - 16) / 16)];
-                        p_1 = _e684;
-                        uint _e687 = k_4;
-                        uint _e689 = q_rank.inner[metal::min(unsigned(_e687), 255u)];
-                        j_3 = v_9 - _e689;
-                        uint2 loop_bound_28 = uint2(4294967295u);
+                        uint _e841 = k_4;
+                        uint _e846 = h_3;
+                        metal::float4 _e849 = pst_tree[metal::min(unsigned((partials + (_e841 * RANK_VECS)) + _e846), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                        p_1 = _e849;
+                        uint _e852 = k_4;
+                        uint _e854 = q_rank.inner[metal::min(unsigned(_e852), 255u)];
+                        j_8 = v_9 - _e854;
+                        uint2 loop_bound_35 = uint2(4294967295u);
                         while(true) {
-                            if (metal::all(loop_bound_28 == uint2(0u))) { break; }
-                            loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
-                            uint _e692 = j_3;
-                            if (_e692 > 0u) {
+                            if (metal::all(loop_bound_35 == uint2(0u))) { break; }
+                            loop_bound_35 -= uint2(loop_bound_35.y == 0u, 1u);
+                            uint _e857 = j_8;
+                            if (_e857 > 0u) {
                             } else {
                                 break;
                             }
                             {
-                                metal::float4 _e695 = p_1;
-                                uint _e696 = j_3;
-                                uint _e703 = h_3;
-                                metal::float4 _e706 = pst_tree[metal::min(unsigned((tree_1 + ((_e696 - 1u) * RANK_VECS)) + _e703), (_buffer_sizes.size7 - 0 - 16) / 16)];
-                                p_1 = _e695 + _e706;
-                                uint _e708 = j_3;
-                                uint _e709 = j_3;
-                                uint _e710 = j_3;
-                                j_3 = _e708 - (_e709 & (~(_e710) + 1u));
+                                metal::float4 _e860 = p_1;
+                                uint _e861 = j_8;
+                                uint _e868 = h_3;
+                                metal::float4 _e871 = pst_tree[metal::min(unsigned((tree_1 + ((_e861 - 1u) * RANK_VECS)) + _e868), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                                p_1 = _e860 + _e871;
+                                uint _e873 = j_8;
+                                uint _e874 = j_8;
+                                uint _e875 = j_8;
+                                j_8 = _e873 - (_e874 & (~(_e875) + 1u));
                             }
                         }
-                        float _e716 = dotp;
-                        metal::float4 _e717 = p_1;
-                        uint _e719 = k_4;
-                        float _e721 = q_theta.inner[metal::min(unsigned(_e719), 255u)];
-                        uint _e722 = h_3;
-                        metal::float4 _e723 = beta_at(_e721, _e722, pst_factors, _buffer_sizes);
-                        dotp = _e716 + metal::dot(_e717, _e723);
+                        float _e881 = dotp;
+                        metal::float4 _e882 = p_1;
+                        uint _e884 = k_4;
+                        float _e886 = q_theta.inner[metal::min(unsigned(_e884), 255u)];
+                        uint _e887 = h_3;
+                        metal::float4 _e888 = beta_at(_e886, _e887, pst_factors, _buffer_sizes);
+                        dotp = _e881 + metal::dot(_e882, _e888);
                     }
                 }
-                uint _e732 = k_4;
-                float _e734 = q_a.inner[metal::min(unsigned(_e732), 255u)];
-                float _e735 = dotp;
-                uint _e740 = k_4;
-                float _e742 = q_b.inner[metal::min(unsigned(_e740), 255u)];
-                metal::float3 _e745 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(f_14.light_color.xyz * (metal::max(_e734 * _e735, 0.0) + _e742));
-                uint _e746 = k_4;
-                metal::uint2 _e747 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e746, screen_4);
-                uint clamped_lod_e750 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-                metal::float4 _e750 = depth.read(metal::min(metal::uint2(_e747), metal::uint2(depth.get_width(clamped_lod_e750), depth.get_height(clamped_lod_e750)) - 1), clamped_lod_e750);
-                float z_7 = _e750.x;
-                uint _e752 = k_4;
-                output.write(metal::float4(_e745.x, _e745.y, _e745.z, z_7), metal::uint2(metal::uint2(_e752, s_6)));
+                uint _e897 = k_4;
+                float _e899 = q_a.inner[metal::min(unsigned(_e897), 255u)];
+                float _e900 = dotp;
+                uint _e905 = k_4;
+                float _e907 = q_b.inner[metal::min(unsigned(_e905), 255u)];
+                metal::float3 _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(f_14.light_color.xyz * (metal::max(_e899 * _e900, 0.0) + _e907));
+                uint _e911 = k_4;
+                metal::uint2 _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
+                uint clamped_lod_e915 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+                metal::float4 _e915 = depth.read(metal::min(metal::uint2(_e912), metal::uint2(depth.get_width(clamped_lod_e915), depth.get_height(clamped_lod_e915)) - 1), clamped_lod_e915);
+                float z_7 = _e915.x;
+                uint _e917 = k_4;
+                output.write(metal::float4(_e910.x, _e910.y, _e910.z, z_7), metal::uint2(metal::uint2(_e917, s_6)));
             }
         }
     }

@@ -128,10 +128,11 @@ var<workgroup> q_a: array<f32, 256>;
 var<workgroup> q_b: array<f32, 256>;
 var<workgroup> by_end: array<u32, 256>;
 var<workgroup> live: atomic<u32>;
+var<workgroup> bucket: array<u32, 8>;
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p_2: vec3<f32>) -> vec3<f32> {
-    let q_2 = (p_2 - v.origin.xyz);
-    return vec3<f32>(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
+    let q_1 = (p_2 - v.origin.xyz);
+    return vec3<f32>(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
 fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
@@ -145,28 +146,28 @@ fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_o
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_8: bool;
     var local_9: bool;
     var local_10: bool;
+    var local_11: bool;
 
     if !((uv.x < 0f)) {
-        local_8 = (uv.x > 1f);
-    } else {
-        local_8 = true;
-    }
-    let _e11 = local_8;
-    if !(_e11) {
-        local_9 = (uv.y < 0f);
+        local_9 = (uv.x > 1f);
     } else {
         local_9 = true;
     }
-    let _e19 = local_9;
-    if !(_e19) {
-        local_10 = (uv.y > 1f);
+    let _e11 = local_9;
+    if !(_e11) {
+        local_10 = (uv.y < 0f);
     } else {
         local_10 = true;
     }
-    let _e27 = local_10;
+    let _e19 = local_10;
+    if !(_e19) {
+        local_11 = (uv.y > 1f);
+    } else {
+        local_11 = true;
+    }
+    let _e27 = local_11;
     if _e27 {
         return 2f;
     }
@@ -191,17 +192,17 @@ fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga
 }
 
 fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_3: vec3<f32>) -> f32 {
-    var local_11: bool;
+    var local_12: bool;
 
     let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
     let near = v_4.right.w;
     let far = v_4.up.w;
     if (v_4.origin.w > 0.5f) {
-        local_11 = (_e2.z <= near);
+        local_12 = (_e2.z <= near);
     } else {
-        local_11 = false;
+        local_12 = false;
     }
-    let _e16 = local_11;
+    let _e16 = local_12;
     if _e16 {
         return 1f;
     }
@@ -281,7 +282,7 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
 fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
     var sum: f32 = 0f;
     var k_5: u32 = 0u;
-    var q_1: u32;
+    var q: u32;
 
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
     let h_9 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
@@ -296,24 +297,24 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         {
             let _e32 = k_5;
             let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
-            q_1 = 0u;
+            q = 0u;
             loop {
-                let _e40 = q_1;
+                let _e40 = q;
                 if (_e40 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    let _e46 = q_1;
+                    let _e46 = q;
                     let u_1 = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     let _e52 = sum;
-                    let _e54 = q_1;
+                    let _e54 = q;
                     let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_9 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
                     sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u_1 * u_1))));
                 }
                 continuing {
-                    let _e70 = q_1;
-                    q_1 = (_e70 + 1u);
+                    let _e70 = q;
+                    q = (_e70 + 1u);
                 }
             }
         }
@@ -425,8 +426,8 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_o
     }
 }
 
-fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_4: f32, rows: u32, wrap: bool) -> u32 {
-    let ji = i32(j_4);
+fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_9: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = i32(j_9);
     if wrap {
         return u32((((ji % i32(rows)) + i32(rows)) % i32(rows)));
     } else {
@@ -435,17 +436,17 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_4: f32, rows: u32, w
 }
 
 fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
-    var local_12: bool;
+    var local_13: bool;
 
     if spot_1 {
         let psi = (x_2 * delta);
         let den = sin((theta_1 + psi));
         if !((den <= 0.000001f)) {
-            local_12 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_13 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_12 = true;
+            local_13 = true;
         }
-        let _e16 = local_12;
+        let _e16 = local_13;
         if _e16 {
             return s_1;
         }
@@ -461,14 +462,14 @@ fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oi
 }
 
 fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_4: f32, b_4: f32, depth_break: f32) -> bool {
-    var local_13: bool;
+    var local_14: bool;
 
     if !((a_4 == b_4)) {
-        local_13 = (abs((a_4 - b_4)) <= (depth_break * min(a_4, b_4)));
+        local_14 = (abs((a_4 - b_4)) <= (depth_break * min(a_4, b_4)));
     } else {
-        local_13 = true;
+        local_14 = true;
     }
-    let _e13 = local_13;
+    let _e13 = local_14;
     return _e13;
 }
 
@@ -487,9 +488,9 @@ fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, 
 fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, screen: vec2<u32>, slices: u32) -> EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     var origin: vec2<f32>;
     var l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
-    var local_14: bool;
     var local_15: bool;
     var local_16: bool;
+    var local_17: bool;
     var a_5: f32 = 0f;
     var b_5: f32 = 0f;
     var k_7: u32 = 0u;
@@ -497,15 +498,15 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     let size_1 = vec2<f32>(screen);
     let centre = (0.5f * size_1);
     let z_5 = dot(cam.toward, cam.forward);
-    let q_3 = vec2<f32>(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
+    let q_2 = vec2<f32>(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
     let far_2 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
-    let lq = length(q_3);
+    let lq = length(q_2);
     origin = centre;
     if (lq >= (far_2 * abs(z_5))) {
-        origin = (centre + ((q_3 * (far_2 / max(lq, 0.000000000000000000000000000001f))) * select(1f, -1f, (z_5 < 0f))));
+        origin = (centre + ((q_2 * (far_2 / max(lq, 0.000000000000000000000000000001f))) * select(1f, -1f, (z_5 < 0f))));
     } else {
         if (lq > 0f) {
-            origin = (centre + (q_3 / vec2(z_5)));
+            origin = (centre + (q_2 / vec2(z_5)));
         }
     }
     let _e56 = origin;
@@ -519,25 +520,25 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     let _e79 = origin.x;
     if (_e79 >= lo_2.x) {
         let _e83 = origin.x;
-        local_14 = (_e83 <= hi_2.x);
-    } else {
-        local_14 = false;
-    }
-    let _e89 = local_14;
-    if _e89 {
-        let _e91 = origin.y;
-        local_15 = (_e91 >= lo_2.y);
+        local_15 = (_e83 <= hi_2.x);
     } else {
         local_15 = false;
     }
-    let _e97 = local_15;
-    if _e97 {
-        let _e99 = origin.y;
-        local_16 = (_e99 <= hi_2.y);
+    let _e89 = local_15;
+    if _e89 {
+        let _e91 = origin.y;
+        local_16 = (_e91 >= lo_2.y);
     } else {
         local_16 = false;
     }
-    let inside = local_16;
+    let _e97 = local_16;
+    if _e97 {
+        let _e99 = origin.y;
+        local_17 = (_e99 <= hi_2.y);
+    } else {
+        local_17 = false;
+    }
+    let inside = local_17;
     if inside {
         l_1.wrap = 1u;
         l_1.phi_start = -3.1415927f;
@@ -585,9 +586,9 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
 
 fn slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_2: u32) -> vec2<f32> {
     let phi_1 = (l_2.phi_start + ((f32(s_2) + 0.5f) * l_2.dphi));
-    let c_1 = cos(phi_1);
+    let c_2 = cos(phi_1);
     let sn = sin(phi_1);
-    return vec2<f32>(((l_2.axis.x * c_1) - (l_2.axis.y * sn)), ((l_2.axis.y * c_1) + (l_2.axis.x * sn)));
+    return vec2<f32>(((l_2.axis.x * c_2) - (l_2.axis.y * sn)), ((l_2.axis.y * c_2) + (l_2.axis.x * sn)));
 }
 
 fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_3: u32, screen_1: vec2<u32>, samples: u32) -> vec2<f32> {
@@ -637,8 +638,8 @@ fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_
 
 fn slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_4: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, u: vec2<f32>, span: vec2<f32>, k_8: u32, screen_2: vec2<u32>) -> vec2<u32> {
     let p_6 = (l_4.origin + (u * (span.x + (f32(k_8) * span.y))));
-    let last = (vec2<f32>(screen_2) - vec2<f32>(1f, 1f));
-    return vec2<u32>(clamp(floor(p_6), vec2<f32>(0f, 0f), last));
+    let last_1 = (vec2<f32>(screen_2) - vec2<f32>(1f, 1f));
+    return vec2<u32>(clamp(floor(p_6), vec2<f32>(0f, 0f), last_1));
 }
 
 fn edge_t(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_2: f32, s_4: f32, spot_2: bool) -> f32 {
@@ -660,10 +661,10 @@ fn lit_span(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3
 
 fn factor_at(base: u32, x_4: f32, h_4: u32) -> vec4<f32> {
     let p_7 = min((clamp(x_4, 0f, 1f) * 95f), 95f);
-    let j_5 = min(u32(floor(p_7)), 94u);
-    let t_4 = (p_7 - f32(j_5));
-    let _e22 = pst_factors[((base + (2u * j_5)) + h_4)];
-    let _e34 = pst_factors[((base + (2u * (j_5 + 1u))) + h_4)];
+    let j_10 = min(u32(floor(p_7)), 94u);
+    let t_4 = (p_7 - f32(j_10));
+    let _e22 = pst_factors[((base + (2u * j_10)) + h_4)];
+    let _e34 = pst_factors[((base + (2u * (j_10 + 1u))) + h_4)];
     return ((_e22 * (1f - t_4)) + (_e34 * t_4));
 }
 
@@ -698,8 +699,8 @@ fn pst_leaf(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
         }
         {
             let _e20 = g_1;
-            let q_4 = select(GL2_, -0.57735026f, (_e20 == 0u));
-            let psi_1 = (((f32(i_2) + 0.5f) + (0.5f * q_4)) * delta_2);
+            let q_3 = select(GL2_, -0.57735026f, (_e20 == 0u));
+            let psi_1 = (((f32(i_2) + 0.5f) + (0.5f * q_3)) * delta_2);
             let l_5 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
             let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_10.light_dir.xyz), f_10.light_pos.w, f_10.light_dir.w);
             let _e48 = leaf;
@@ -717,9 +718,9 @@ fn pst_leaf(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
 
 fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     var r_1: PstRay;
-    var local_17: bool;
     var local_18: bool;
     var local_19: bool;
+    var local_20: bool;
     var yc: f32;
 
     let f_11 = frame;
@@ -732,23 +733,23 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     let px = vec3<f32>(pc, 0f);
     let radius = f_11.epipole.w;
     if (f_11.epipole.z > 0.5f) {
-        local_17 = (length((px - vec3<f32>(f_11.epipole.x, f_11.epipole.y, 0f))) < radius);
-    } else {
-        local_17 = false;
-    }
-    let near_epi = local_17;
-    if (f_11.anti_epipole.z > 0.5f) {
-        local_18 = (length((px - vec3<f32>(f_11.anti_epipole.x, f_11.anti_epipole.y, 0f))) < radius);
+        local_18 = (length((px - vec3<f32>(f_11.epipole.x, f_11.epipole.y, 0f))) < radius);
     } else {
         local_18 = false;
     }
-    let near_anti = local_18;
-    if !(near_epi) {
-        local_19 = near_anti;
+    let near_epi = local_18;
+    if (f_11.anti_epipole.z > 0.5f) {
+        local_19 = (length((px - vec3<f32>(f_11.anti_epipole.x, f_11.anti_epipole.y, 0f))) < radius);
     } else {
-        local_19 = true;
+        local_19 = false;
     }
-    let _e109 = local_19;
+    let near_anti = local_19;
+    if !(near_epi) {
+        local_20 = near_anti;
+    } else {
+        local_20 = true;
+    }
+    let _e109 = local_20;
     if _e109 {
         r_1.marched = true;
         let _e114 = frame;
@@ -776,8 +777,8 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     let _e171 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e166, f_11.theta.x, f_11.theta.y);
     r_1.d = _e171;
     if true {
-        let q_5 = normalize(((eye_7 + (dir_8 * s_5)) - f_11.light_pos.xyz));
-        r_1.xs_num = acos(clamp(dot(q_5, -(axis_2)), -1f, 1f));
+        let q_4 = normalize(((eye_7 + (dir_8 * s_5)) - f_11.light_pos.xyz));
+        r_1.xs_num = acos(clamp(dot(q_4, -(axis_2)), -1f, 1f));
     } else {
         let _e187 = r_1.theta;
         r_1.xs_num = (s_5 * sin(_e187));
@@ -881,11 +882,11 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
 }
 
 fn pst_footprint_depth(pc_1: vec2<f32>, screen_3: vec2<u32>) -> f32 {
-    let last_1 = (vec2<f32>(screen_3) - vec2<f32>(1f, 1f));
-    let q_6 = clamp((pc_1 - vec2<f32>(0.5f, 0.5f)), vec2<f32>(0f, 0f), last_1);
-    let i0_ = vec2<u32>(floor(q_6));
+    let last_2 = (vec2<f32>(screen_3) - vec2<f32>(1f, 1f));
+    let q_5 = clamp((pc_1 - vec2<f32>(0.5f, 0.5f)), vec2<f32>(0f, 0f), last_2);
+    let i0_ = vec2<u32>(floor(q_5));
     let i1_ = min((i0_ + vec2<u32>(1u, 1u)), (screen_3 - vec2<u32>(1u, 1u)));
-    let t_6 = (q_6 - floor(q_6));
+    let t_6 = (q_5 - floor(q_5));
     let _e30 = textureLoad(depth, i0_, 0i);
     let z00_ = _e30.x;
     let _e37 = textureLoad(depth, vec2<u32>(i1_.x, i0_.y), 0i);
@@ -913,373 +914,524 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     var k: u32;
     var r: PstRay;
     var local: bool;
-    var k_1: u32;
-    var by_d: u32;
-    var by_e: u32;
-    var q: u32;
+    var count: u32 = 0u;
+    var k_1: u32 = 0u;
     var local_1: bool;
     var local_2: bool;
+    var first: u32 = 0u;
+    var last: u32 = 255u;
+    var m: u32 = 0u;
+    var k_2: u32 = 0u;
+    var j: u32;
     var local_3: bool;
+    var j_1: u32 = 0u;
+    var start: u32 = 0u;
+    var c: u32 = 0u;
+    var m_1: u32 = 0u;
+    var k_3: u32 = 0u;
     var local_4: bool;
-    var mine: array<f32, 8>;
-    var k_2: u32;
-    var k_3: u32;
+    var j_2: u32;
+    var local_5: bool;
+    var mine: array<u32, 8>;
+    var j_3: u32;
+    var j_4: u32;
     var i: u32;
     var lo: u32;
     var hi: u32;
     var h: u32;
-    var j: u32 = 0u;
+    var j_5: u32 = 0u;
     var next: u32 = 0u;
     var top: u32;
     var i_1: u32;
-    var local_5: bool;
     var local_6: bool;
     var local_7: bool;
+    var local_8: bool;
     var h_1: u32;
     var p: vec4<f32>;
-    var j_1: u32;
+    var j_6: u32;
     var h_2: u32;
-    var j_2: u32;
+    var j_7: u32;
     var x: u32;
     var running: vec4<f32>;
-    var c: u32;
+    var c_1: u32;
     var k_4: u32;
     var dotp: f32;
     var h_3: u32;
     var p_1: vec4<f32>;
-    var j_3: u32;
+    var j_8: u32;
 
     let f_14 = frame;
     let screen_4 = vec2<u32>(f_14.sizes.x, f_14.sizes.y);
     let width = f_14.sizes.z;
-    let _e12 = frame.cam_forward;
-    let _e16 = frame.cam_right;
-    let _e20 = frame.cam_up;
-    let _e25 = frame.cam_forward.w;
-    let _e29 = frame.cam_right.w;
-    let _e32 = frame.axis;
-    let _e36 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e12.xyz, _e16.xyz, _e20.xyz, _e25, _e29, _e32.xyz), screen_4, SLICES);
+    let _e13 = frame.cam_forward;
+    let _e17 = frame.cam_right;
+    let _e21 = frame.cam_up;
+    let _e26 = frame.cam_forward.w;
+    let _e30 = frame.cam_right.w;
+    let _e33 = frame.axis;
+    let _e37 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e13.xyz, _e17.xyz, _e21.xyz, _e26, _e30, _e33.xyz), screen_4, SLICES);
     let s_6 = wid.x;
-    let _e39 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6);
-    let _e41 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, s_6, screen_4, SLICE_SAMPLES);
+    let _e40 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_6);
+    let _e42 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_6, screen_4, SLICE_SAMPLES);
     if (li == 0u) {
-        textureStore(output, vec2<u32>(SLICE_SAMPLES, s_6), vec4<f32>(_e39.x, _e39.y, _e41.x, _e41.y));
+        textureStore(output, vec2<u32>(SLICE_SAMPLES, s_6), vec4<f32>(_e40.x, _e40.y, _e42.x, _e42.y));
         if (s_6 == 0u) {
             atomicStore((&fallback_count), 0u);
-            textureStore(output, vec2<u32>(0u, 512u), vec4<f32>(_e36.origin, _e36.axis));
-            textureStore(output, vec2<u32>(1u, 512u), vec4<f32>(_e36.phi_start, _e36.dphi, f32(_e36.wrap), 0f));
+            textureStore(output, vec2<u32>(0u, 512u), vec4<f32>(_e37.origin, _e37.axis));
+            textureStore(output, vec2<u32>(1u, 512u), vec4<f32>(_e37.phi_start, _e37.dphi, f32(_e37.wrap), 0f));
         }
     }
-    let far_end = (_e36.origin + (_e39 * (_e41.x + (255f * _e41.y))));
-    let _e83 = pst_ray(far_end, 0f);
-    let row_3 = _e83.row;
-    let _e87 = slices_1[row_3];
-    let _e88 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e87);
-    let delta_6 = _e88.delta;
+    let far_end = (_e37.origin + (_e40 * (_e42.x + (255f * _e42.y))));
+    let _e84 = pst_ray(far_end, 0f);
+    let row_3 = _e84.row;
+    let _e88 = slices_1[row_3];
+    let _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
+    let delta_6 = _e89.delta;
     k = li;
     loop {
-        let _e91 = k;
-        if (_e91 < SLICE_SAMPLES) {
+        let _e92 = k;
+        if (_e92 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e94 = k;
-            let _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e94, screen_4);
-            let _e98 = textureLoad(depth, _e95, 0i);
-            let z_6 = _e98.x;
-            let _e102 = k;
-            let _e109 = pst_footprint_depth((_e36.origin + (_e39 * (_e41.x + (f32(_e102) * _e41.y)))), screen_4);
+            let _e95 = k;
+            let _e96 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e95, screen_4);
+            let _e99 = textureLoad(depth, _e96, 0i);
+            let z_6 = _e99.x;
+            let _e103 = k;
+            let _e110 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (f32(_e103) * _e42.y)))), screen_4);
             r = PstRay();
-            if (_e109 < 0f) {
-                let _e123 = pst_ray(vec2<f32>((f32(_e95.x) + 0.5f), (f32(_e95.y) + 0.5f)), z_6);
-                r = _e123;
+            if (_e110 < 0f) {
+                let _e124 = pst_ray(vec2<f32>((f32(_e96.x) + 0.5f), (f32(_e96.y) + 0.5f)), z_6);
+                r = _e124;
             } else {
-                let _e126 = k;
-                let _e133 = pst_ray((_e36.origin + (_e39 * (_e41.x + (f32(_e126) * _e41.y)))), _e109);
-                r = _e133;
+                let _e127 = k;
+                let _e134 = pst_ray((_e37.origin + (_e40 * (_e42.x + (f32(_e127) * _e42.y)))), _e110);
+                r = _e134;
             }
-            let _e134 = r;
-            let _e135 = pst_columns_crossed(_e134, delta_6);
-            let _e137 = k;
-            q_end[_e137] = NONE;
-            let _e141 = r.marched;
-            if !(_e141) {
-                local = (_e135 == 0u);
+            let _e135 = r;
+            let _e136 = pst_columns_crossed(_e135, delta_6);
+            let _e138 = k;
+            q_end[_e138] = NONE;
+            let _e142 = r.marched;
+            if !(_e142) {
+                local = (_e136 == 0u);
             } else {
                 local = true;
             }
-            let _e148 = local;
-            if _e148 {
-                let _e150 = r.color;
-                let _e151 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e150);
-                let _e152 = k;
-                textureStore(output, vec2<u32>(_e152, s_6), vec4<f32>(_e151.x, _e151.y, _e151.z, z_6));
+            let _e149 = local;
+            if _e149 {
+                let _e151 = r.color;
+                let _e152 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e151);
+                let _e153 = k;
+                textureStore(output, vec2<u32>(_e153, s_6), vec4<f32>(_e152.x, _e152.y, _e152.z, z_6));
             } else {
-                let _e159 = r;
-                let _e160 = pst_terms(_e159, row_3, delta_6, _e135);
-                let _e162 = k;
-                q_end[_e162] = (_e135 - 1u);
-                let _e167 = k;
-                let _e170 = r.d;
-                q_d[_e167] = _e170;
-                let _e172 = k;
-                let _e175 = r.theta;
-                q_theta[_e172] = _e175;
-                let _e177 = k;
-                q_a[_e177] = _e160.x;
-                let _e181 = k;
-                q_b[_e181] = _e160.y;
-                let _e186 = atomicAdd((&live), 1u);
+                let _e160 = r;
+                let _e161 = pst_terms(_e160, row_3, delta_6, _e136);
+                let _e163 = k;
+                q_end[_e163] = (_e136 - 1u);
+                let _e168 = k;
+                let _e171 = r.d;
+                q_d[_e168] = _e171;
+                let _e173 = k;
+                let _e176 = r.theta;
+                q_theta[_e173] = _e176;
+                let _e178 = k;
+                q_a[_e178] = _e161.x;
+                let _e182 = k;
+                q_b[_e182] = _e161.y;
+                let _e187 = atomicAdd((&live), 1u);
             }
         }
         continuing {
-            let _e187 = k;
-            k = (_e187 + SLICE_LANES);
+            let _e188 = k;
+            k = (_e188 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let v_9 = atomicLoad((&live));
-    k_1 = li;
-    loop {
-        let _e193 = k_1;
-        if (_e193 < SLICE_SAMPLES) {
-        } else {
-            break;
+    let cw = (((width + TREES) - 1u) / TREES);
+    if (li < TREES) {
+        loop {
+            let _e202 = k_1;
+            if (_e202 < SLICE_SAMPLES) {
+            } else {
+                break;
+            }
+            {
+                let _e206 = k_1;
+                let _e208 = q_end[_e206];
+                if (_e208 != NONE) {
+                    let _e212 = k_1;
+                    let _e214 = q_end[_e212];
+                    local_1 = (min((_e214 / cw), 7u) == li);
+                } else {
+                    local_1 = false;
+                }
+                let _e222 = local_1;
+                if _e222 {
+                    let _e225 = count;
+                    count = (_e225 + 1u);
+                }
+            }
+            continuing {
+                let _e228 = k_1;
+                k_1 = (_e228 + 1u);
+            }
         }
-        {
-            let _e197 = k_1;
-            let _e199 = q_end[_e197];
-            if (_e199 != NONE) {
-                by_d = 0u;
-                by_e = 0u;
-                q = 0u;
+        let _e232 = count;
+        bucket[li] = _e232;
+    } else {
+        if (li == TREES) {
+            local_2 = (v_9 > 0u);
+        } else {
+            local_2 = false;
+        }
+        let _e240 = local_2;
+        if _e240 {
+            loop {
+                let _e243 = first;
+                let _e245 = q_end[_e243];
+                if (_e245 == NONE) {
+                } else {
+                    break;
+                }
+                {
+                    let _e249 = first;
+                    first = (_e249 + 1u);
+                }
+            }
+            loop {
+                let _e253 = last;
+                let _e255 = q_end[_e253];
+                if (_e255 == NONE) {
+                } else {
+                    break;
+                }
+                {
+                    let _e259 = last;
+                    last = (_e259 - 1u);
+                }
+            }
+            let _e262 = first;
+            let _e264 = q_d[_e262];
+            let _e266 = last;
+            let _e268 = q_d[_e266];
+            let up = (_e264 <= _e268);
+            loop {
+                let _e271 = k_2;
+                if (_e271 < SLICE_SAMPLES) {
+                } else {
+                    break;
+                }
+                {
+                    let _e275 = k_2;
+                    let _e277 = q_end[_e275];
+                    if (_e277 != NONE) {
+                        let _e281 = k_2;
+                        let d_2 = q_d[_e281];
+                        let _e285 = m;
+                        j = _e285;
+                        loop {
+                            let _e287 = j;
+                            if (_e287 > 0u) {
+                                let _e290 = j;
+                                let _e295 = q_d[(_e290 - 1u)];
+                                let _e297 = j;
+                                let _e302 = q_d[(_e297 - 1u)];
+                                local_3 = select((_e295 < d_2), (_e302 > d_2), up);
+                            } else {
+                                local_3 = false;
+                            }
+                            let _e308 = local_3;
+                            if _e308 {
+                            } else {
+                                break;
+                            }
+                            {
+                                let _e310 = j;
+                                let _e312 = j;
+                                let _e317 = q_d[(_e312 - 1u)];
+                                q_d[_e310] = _e317;
+                                let _e319 = j;
+                                let _e321 = j;
+                                let _e326 = q_rank[(_e321 - 1u)];
+                                q_rank[_e319] = _e326;
+                                let _e328 = j;
+                                j = (_e328 - 1u);
+                            }
+                        }
+                        let _e331 = j;
+                        q_d[_e331] = d_2;
+                        let _e334 = j;
+                        let _e336 = k_2;
+                        q_rank[_e334] = _e336;
+                        let _e338 = m;
+                        m = (_e338 + 1u);
+                    }
+                }
+                continuing {
+                    let _e341 = k_2;
+                    k_2 = (_e341 + 1u);
+                }
+            }
+            if !(up) {
                 loop {
-                    let _e208 = q;
-                    if (_e208 < SLICE_SAMPLES) {
+                    let _e345 = j_1;
+                    if (_e345 < (v_9 / 2u)) {
                     } else {
                         break;
                     }
                     {
-                        let _e212 = q;
-                        let _e214 = q_end[_e212];
-                        if (_e214 != NONE) {
-                            let _e217 = by_d;
-                            let _e219 = q;
-                            let _e221 = q_d[_e219];
-                            let _e223 = k_1;
-                            let _e225 = q_d[_e223];
-                            if !((_e221 < _e225)) {
-                                let _e229 = q;
-                                let _e231 = q_d[_e229];
-                                let _e233 = k_1;
-                                let _e235 = q_d[_e233];
-                                if (_e231 == _e235) {
-                                    let _e237 = q;
-                                    let _e238 = k_1;
-                                    local_2 = (_e237 < _e238);
-                                } else {
-                                    local_2 = false;
-                                }
-                                let _e243 = local_2;
-                                local_1 = _e243;
-                            } else {
-                                local_1 = true;
-                            }
-                            let _e249 = local_1;
-                            by_d = (_e217 + select(0u, 1u, _e249));
-                            let _e252 = by_e;
-                            let _e254 = q;
-                            let _e256 = q_end[_e254];
-                            let _e258 = k_1;
-                            let _e260 = q_end[_e258];
-                            if !((_e256 < _e260)) {
-                                let _e264 = q;
-                                let _e266 = q_end[_e264];
-                                let _e268 = k_1;
-                                let _e270 = q_end[_e268];
-                                if (_e266 == _e270) {
-                                    let _e272 = q;
-                                    let _e273 = k_1;
-                                    local_4 = (_e272 < _e273);
-                                } else {
-                                    local_4 = false;
-                                }
-                                let _e278 = local_4;
-                                local_3 = _e278;
-                            } else {
-                                local_3 = true;
-                            }
-                            let _e284 = local_3;
-                            by_e = (_e252 + select(0u, 1u, _e284));
-                        }
+                        let _e350 = j_1;
+                        let d_3 = q_d[_e350];
+                        let _e354 = j_1;
+                        let _e359 = j_1;
+                        let _e362 = q_d[((v_9 - 1u) - _e359)];
+                        q_d[_e354] = _e362;
+                        let _e366 = j_1;
+                        q_d[((v_9 - 1u) - _e366)] = d_3;
+                        let _e370 = j_1;
+                        let k_9 = q_rank[_e370];
+                        let _e374 = j_1;
+                        let _e379 = j_1;
+                        let _e382 = q_rank[((v_9 - 1u) - _e379)];
+                        q_rank[_e374] = _e382;
+                        let _e386 = j_1;
+                        q_rank[((v_9 - 1u) - _e386)] = k_9;
                     }
                     continuing {
-                        let _e288 = q;
-                        q = (_e288 + 1u);
+                        let _e390 = j_1;
+                        j_1 = (_e390 + 1u);
                     }
                 }
-                let _e291 = k_1;
-                let _e293 = by_d;
-                q_rank[_e291] = _e293;
-                let _e295 = by_e;
-                let _e297 = k_1;
-                by_end[_e295] = _e297;
             }
-        }
-        continuing {
-            let _e298 = k_1;
-            k_1 = (_e298 + SLICE_LANES);
         }
     }
     workgroupBarrier();
-    k_2 = li;
+    if (li < TREES) {
+        loop {
+            let _e395 = c;
+            if (_e395 < li) {
+            } else {
+                break;
+            }
+            {
+                let _e398 = start;
+                let _e400 = c;
+                let _e402 = bucket[_e400];
+                start = (_e398 + _e402);
+            }
+            continuing {
+                let _e405 = c;
+                c = (_e405 + 1u);
+            }
+        }
+        loop {
+            let _e408 = k_3;
+            if (_e408 < SLICE_SAMPLES) {
+            } else {
+                break;
+            }
+            {
+                let _e412 = k_3;
+                let _e414 = q_end[_e412];
+                if (_e414 != NONE) {
+                    let _e418 = k_3;
+                    let _e420 = q_end[_e418];
+                    local_4 = (min((_e420 / cw), 7u) == li);
+                } else {
+                    local_4 = false;
+                }
+                let _e428 = local_4;
+                if _e428 {
+                    let _e430 = m_1;
+                    j_2 = _e430;
+                    loop {
+                        let _e432 = j_2;
+                        if (_e432 > 0u) {
+                            let _e435 = start;
+                            let _e436 = j_2;
+                            let _e443 = by_end[((_e435 + _e436) - 1u)];
+                            let _e445 = q_end[_e443];
+                            let _e447 = k_3;
+                            let _e449 = q_end[_e447];
+                            local_5 = (_e445 > _e449);
+                        } else {
+                            local_5 = false;
+                        }
+                        let _e454 = local_5;
+                        if _e454 {
+                        } else {
+                            break;
+                        }
+                        {
+                            let _e456 = start;
+                            let _e457 = j_2;
+                            let _e460 = start;
+                            let _e461 = j_2;
+                            let _e467 = by_end[((_e460 + _e461) - 1u)];
+                            by_end[(_e456 + _e457)] = _e467;
+                            let _e469 = j_2;
+                            j_2 = (_e469 - 1u);
+                        }
+                    }
+                    let _e472 = start;
+                    let _e473 = j_2;
+                    let _e476 = k_3;
+                    by_end[(_e472 + _e473)] = _e476;
+                    let _e478 = m_1;
+                    m_1 = (_e478 + 1u);
+                }
+            }
+            continuing {
+                let _e481 = k_3;
+                k_3 = (_e481 + 1u);
+            }
+        }
+    }
+    j_3 = li;
     loop {
-        let _e302 = k_2;
-        if (_e302 < SLICE_SAMPLES) {
+        let _e484 = j_3;
+        if (_e484 < v_9) {
         } else {
             break;
         }
         {
-            let _e305 = k_2;
-            let _e311 = k_2;
-            let _e313 = q_d[_e311];
-            mine[(_e305 / SLICE_LANES)] = _e313;
+            let _e486 = j_3;
+            let _e492 = j_3;
+            let _e494 = q_rank[_e492];
+            mine[(_e486 / SLICE_LANES)] = _e494;
         }
         continuing {
-            let _e314 = k_2;
-            k_2 = (_e314 + SLICE_LANES);
+            let _e495 = j_3;
+            j_3 = (_e495 + SLICE_LANES);
         }
     }
     workgroupBarrier();
-    k_3 = li;
+    j_4 = li;
     loop {
-        let _e318 = k_3;
-        if (_e318 < SLICE_SAMPLES) {
+        let _e499 = j_4;
+        if (_e499 < v_9) {
         } else {
             break;
         }
         {
-            let _e322 = k_3;
-            let _e324 = q_end[_e322];
-            if (_e324 != NONE) {
-                let _e329 = k_3;
-                let _e331 = q_rank[_e329];
-                let _e333 = k_3;
-                let _e337 = mine[(_e333 / SLICE_LANES)];
-                q_d[_e331] = _e337;
-            }
+            let _e501 = j_4;
+            let _e506 = mine[(_e501 / SLICE_LANES)];
+            let _e508 = j_4;
+            q_rank[_e506] = _e508;
         }
         continuing {
-            let _e338 = k_3;
-            k_3 = (_e338 + SLICE_LANES);
+            let _e509 = j_4;
+            j_4 = (_e509 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let base_1 = (s_6 * width);
     i = li;
     loop {
-        let _e343 = i;
-        if (_e343 < width) {
+        let _e514 = i;
+        if (_e514 < width) {
         } else {
             break;
         }
         {
-            let _e345 = i;
-            let _e349 = textureLoad(rectified, vec2<u32>(_e345, row_3), 0i);
-            let occluder = _e349.x;
+            let _e516 = i;
+            let _e520 = textureLoad(rectified, vec2<u32>(_e516, row_3), 0i);
+            let occluder = _e520.x;
             lo = 0u;
             hi = v_9;
             loop {
-                let _e354 = lo;
-                let _e355 = hi;
-                if (_e354 < _e355) {
+                let _e525 = lo;
+                let _e526 = hi;
+                if (_e525 < _e526) {
                 } else {
                     break;
                 }
                 {
-                    let _e357 = lo;
-                    let _e358 = hi;
-                    let mid_1 = ((_e357 + _e358) / 2u);
-                    let _e364 = q_d[mid_1];
-                    if (_e364 <= occluder) {
+                    let _e528 = lo;
+                    let _e529 = hi;
+                    let mid_1 = ((_e528 + _e529) / 2u);
+                    let _e535 = q_d[mid_1];
+                    if (_e535 <= occluder) {
                         lo = (mid_1 + 1u);
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            let _e369 = i;
-            let _e372 = lo;
-            pst_columns[(base_1 + _e369)] = _e372;
-            let _e373 = lo;
-            if (_e373 > 0u) {
+            let _e540 = i;
+            let _e543 = lo;
+            pst_columns[(base_1 + _e540)] = _e543;
+            let _e544 = lo;
+            if (_e544 > 0u) {
                 h = 0u;
                 loop {
-                    let _e378 = h;
-                    if (_e378 < RANK_VECS) {
+                    let _e549 = h;
+                    if (_e549 < RANK_VECS) {
                     } else {
                         break;
                     }
                     {
-                        let _e381 = i;
-                        let _e386 = h;
-                        let _e389 = i;
-                        let _e390 = h;
-                        let _e391 = pst_leaf(f_14, _e389, row_3, delta_6, _e390);
-                        pst_leaves[(((base_1 + _e381) * RANK_VECS) + _e386)] = _e391;
+                        let _e552 = i;
+                        let _e557 = h;
+                        let _e560 = i;
+                        let _e561 = h;
+                        let _e562 = pst_leaf(f_14, _e560, row_3, delta_6, _e561);
+                        pst_leaves[(((base_1 + _e552) * RANK_VECS) + _e557)] = _e562;
                     }
                     continuing {
-                        let _e393 = h;
-                        h = (_e393 + 1u);
+                        let _e564 = h;
+                        h = (_e564 + 1u);
                     }
                 }
             }
         }
         continuing {
-            let _e395 = i;
-            i = (_e395 + SLICE_LANES);
+            let _e566 = i;
+            i = (_e566 + SLICE_LANES);
         }
     }
     storageBarrier();
     workgroupBarrier();
-    let cw = (((width + TREES) - 1u) / TREES);
     let trees = (((s_6 * 9u) * SLICE_SAMPLES) * RANK_VECS);
     let partials = (trees + 4096u);
     if (li < TREES) {
         let tree = (trees + ((li * SLICE_SAMPLES) * RANK_VECS));
         loop {
-            let _e420 = j;
-            if (_e420 < (v_9 * RANK_VECS)) {
+            let _e585 = j_5;
+            if (_e585 < (v_9 * RANK_VECS)) {
             } else {
                 break;
             }
             {
-                let _e425 = j;
-                pst_tree[(tree + _e425)] = vec4<f32>(0f, 0f, 0f, 0f);
+                let _e590 = j_5;
+                pst_tree[(tree + _e590)] = vec4<f32>(0f, 0f, 0f, 0f);
             }
             continuing {
-                let _e434 = j;
-                j = (_e434 + 1u);
+                let _e599 = j_5;
+                j_5 = (_e599 + 1u);
             }
         }
         let lo_5 = (li * cw);
         let hi_5 = select(min((lo_5 + cw), width), width, ((li + 1u) == TREES));
         top = v_9;
         loop {
-            let _e446 = next;
-            let _e447 = top;
-            if (_e446 < _e447) {
+            let _e611 = next;
+            let _e612 = top;
+            if (_e611 < _e612) {
             } else {
                 break;
             }
             {
-                let _e449 = next;
-                let _e450 = top;
-                let mid_2 = ((_e449 + _e450) / 2u);
-                let _e457 = by_end[mid_2];
-                let _e459 = q_end[_e457];
-                if (_e459 < lo_5) {
+                let _e614 = next;
+                let _e615 = top;
+                let mid_2 = ((_e614 + _e615) / 2u);
+                let _e622 = by_end[mid_2];
+                let _e624 = q_end[_e622];
+                if (_e624 < lo_5) {
                     next = (mid_2 + 1u);
                 } else {
                     top = mid_2;
@@ -1288,133 +1440,133 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         }
         i_1 = lo_5;
         loop {
-            let _e464 = i_1;
-            if (_e464 <= hi_5) {
+            let _e629 = i_1;
+            if (_e629 <= hi_5) {
             } else {
                 break;
             }
             {
                 loop {
-                    let _e466 = next;
-                    if (_e466 < v_9) {
-                        let _e470 = next;
-                        let _e472 = by_end[_e470];
-                        let _e474 = q_end[_e472];
-                        let _e475 = i_1;
-                        local_5 = (_e474 == _e475);
-                    } else {
-                        local_5 = false;
-                    }
-                    let _e480 = local_5;
-                    if _e480 {
-                        let _e481 = i_1;
-                        if !((_e481 < hi_5)) {
-                            local_7 = ((li + 1u) == TREES);
-                        } else {
-                            local_7 = true;
-                        }
-                        let _e491 = local_7;
-                        local_6 = _e491;
+                    let _e631 = next;
+                    if (_e631 < v_9) {
+                        let _e635 = next;
+                        let _e637 = by_end[_e635];
+                        let _e639 = q_end[_e637];
+                        let _e640 = i_1;
+                        local_6 = (_e639 == _e640);
                     } else {
                         local_6 = false;
                     }
-                    let _e495 = local_6;
-                    if _e495 {
+                    let _e645 = local_6;
+                    if _e645 {
+                        let _e646 = i_1;
+                        if !((_e646 < hi_5)) {
+                            local_8 = ((li + 1u) == TREES);
+                        } else {
+                            local_8 = true;
+                        }
+                        let _e656 = local_8;
+                        local_7 = _e656;
+                    } else {
+                        local_7 = false;
+                    }
+                    let _e660 = local_7;
+                    if _e660 {
                     } else {
                         break;
                     }
                     {
-                        let _e497 = next;
-                        let k_9 = by_end[_e497];
-                        let _e501 = next;
-                        next = (_e501 + 1u);
+                        let _e662 = next;
+                        let k_10 = by_end[_e662];
+                        let _e666 = next;
+                        next = (_e666 + 1u);
                         h_1 = 0u;
                         loop {
-                            let _e505 = h_1;
-                            if (_e505 < RANK_VECS) {
+                            let _e670 = h_1;
+                            if (_e670 < RANK_VECS) {
                             } else {
                                 break;
                             }
                             {
                                 p = vec4<f32>(0f, 0f, 0f, 0f);
-                                let _e516 = q_rank[k_9];
-                                j_1 = (v_9 - _e516);
+                                let _e681 = q_rank[k_10];
+                                j_6 = (v_9 - _e681);
                                 loop {
-                                    let _e519 = j_1;
-                                    if (_e519 > 0u) {
+                                    let _e684 = j_6;
+                                    if (_e684 > 0u) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        let _e522 = p;
-                                        let _e523 = j_1;
-                                        let _e530 = h_1;
-                                        let _e533 = pst_tree[((tree + ((_e523 - 1u) * RANK_VECS)) + _e530)];
-                                        p = (_e522 + _e533);
-                                        let _e535 = j_1;
-                                        let _e536 = j_1;
-                                        let _e537 = j_1;
-                                        j_1 = (_e535 - (_e536 & (~(_e537) + 1u)));
+                                        let _e687 = p;
+                                        let _e688 = j_6;
+                                        let _e695 = h_1;
+                                        let _e698 = pst_tree[((tree + ((_e688 - 1u) * RANK_VECS)) + _e695)];
+                                        p = (_e687 + _e698);
+                                        let _e700 = j_6;
+                                        let _e701 = j_6;
+                                        let _e702 = j_6;
+                                        j_6 = (_e700 - (_e701 & (~(_e702) + 1u)));
                                     }
                                 }
-                                let _e547 = h_1;
-                                let _e550 = p;
-                                pst_tree[((partials + (k_9 * RANK_VECS)) + _e547)] = _e550;
+                                let _e712 = h_1;
+                                let _e715 = p;
+                                pst_tree[((partials + (k_10 * RANK_VECS)) + _e712)] = _e715;
                             }
                             continuing {
-                                let _e552 = h_1;
-                                h_1 = (_e552 + 1u);
+                                let _e717 = h_1;
+                                h_1 = (_e717 + 1u);
                             }
                         }
                     }
                 }
-                let _e554 = i_1;
-                if (_e554 == hi_5) {
+                let _e719 = i_1;
+                if (_e719 == hi_5) {
                     break;
                 }
-                let _e557 = i_1;
-                let b_7 = pst_columns[(base_1 + _e557)];
+                let _e722 = i_1;
+                let b_7 = pst_columns[(base_1 + _e722)];
                 if (b_7 > 0u) {
                     h_2 = 0u;
                     loop {
-                        let _e565 = h_2;
-                        if (_e565 < RANK_VECS) {
+                        let _e730 = h_2;
+                        if (_e730 < RANK_VECS) {
                         } else {
                             break;
                         }
                         {
-                            let _e568 = i_1;
-                            let _e573 = h_2;
-                            let leaf_1 = pst_leaves[(((base_1 + _e568) * RANK_VECS) + _e573)];
-                            j_2 = ((v_9 - b_7) + 1u);
+                            let _e733 = i_1;
+                            let _e738 = h_2;
+                            let leaf_1 = pst_leaves[(((base_1 + _e733) * RANK_VECS) + _e738)];
+                            j_7 = ((v_9 - b_7) + 1u);
                             loop {
-                                let _e581 = j_2;
-                                if (_e581 <= v_9) {
+                                let _e746 = j_7;
+                                if (_e746 <= v_9) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    let _e583 = j_2;
-                                    let _e590 = h_2;
-                                    let _e593 = pst_tree[((tree + ((_e583 - 1u) * RANK_VECS)) + _e590)];
-                                    pst_tree[((tree + ((_e583 - 1u) * RANK_VECS)) + _e590)] = (_e593 + leaf_1);
-                                    let _e595 = j_2;
-                                    let _e596 = j_2;
-                                    let _e597 = j_2;
-                                    j_2 = (_e595 + (_e596 & (~(_e597) + 1u)));
+                                    let _e748 = j_7;
+                                    let _e755 = h_2;
+                                    let _e758 = pst_tree[((tree + ((_e748 - 1u) * RANK_VECS)) + _e755)];
+                                    pst_tree[((tree + ((_e748 - 1u) * RANK_VECS)) + _e755)] = (_e758 + leaf_1);
+                                    let _e760 = j_7;
+                                    let _e761 = j_7;
+                                    let _e762 = j_7;
+                                    j_7 = (_e760 + (_e761 & (~(_e762) + 1u)));
                                 }
                             }
                         }
                         continuing {
-                            let _e604 = h_2;
-                            h_2 = (_e604 + 1u);
+                            let _e769 = h_2;
+                            h_2 = (_e769 + 1u);
                         }
                     }
                 }
             }
             continuing {
-                let _e607 = i_1;
-                i_1 = (_e607 + 1u);
+                let _e772 = i_1;
+                i_1 = (_e772 + 1u);
             }
         }
     }
@@ -1422,121 +1574,121 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     workgroupBarrier();
     x = li;
     loop {
-        let _e610 = x;
-        if (_e610 < (v_9 * RANK_VECS)) {
+        let _e775 = x;
+        if (_e775 < (v_9 * RANK_VECS)) {
         } else {
             break;
         }
         {
             running = vec4<f32>(0f, 0f, 0f, 0f);
-            c = 0u;
+            c_1 = 0u;
             loop {
-                let _e622 = c;
-                if (_e622 < TREES) {
+                let _e787 = c_1;
+                if (_e787 < TREES) {
                 } else {
                     break;
                 }
                 {
-                    let _e625 = c;
-                    let _e631 = x;
-                    let at = ((trees + ((_e625 * SLICE_SAMPLES) * RANK_VECS)) + _e631);
+                    let _e790 = c_1;
+                    let _e796 = x;
+                    let at = ((trees + ((_e790 * SLICE_SAMPLES) * RANK_VECS)) + _e796);
                     let own = pst_tree[at];
-                    let _e638 = running;
-                    pst_tree[at] = _e638;
-                    let _e639 = running;
-                    running = (_e639 + own);
+                    let _e803 = running;
+                    pst_tree[at] = _e803;
+                    let _e804 = running;
+                    running = (_e804 + own);
                 }
                 continuing {
-                    let _e642 = c;
-                    c = (_e642 + 1u);
+                    let _e807 = c_1;
+                    c_1 = (_e807 + 1u);
                 }
             }
         }
         continuing {
-            let _e644 = x;
-            x = (_e644 + SLICE_LANES);
+            let _e809 = x;
+            x = (_e809 + SLICE_LANES);
         }
     }
     storageBarrier();
     workgroupBarrier();
     k_4 = li;
     loop {
-        let _e648 = k_4;
-        if (_e648 < SLICE_SAMPLES) {
+        let _e813 = k_4;
+        if (_e813 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e652 = k_4;
-            let _e654 = q_end[_e652];
-            if (_e654 != NONE) {
-                let _e658 = k_4;
-                let _e660 = q_end[_e658];
-                let tree_1 = (trees + ((min((_e660 / cw), 7u) * SLICE_SAMPLES) * RANK_VECS));
+            let _e817 = k_4;
+            let _e819 = q_end[_e817];
+            if (_e819 != NONE) {
+                let _e823 = k_4;
+                let _e825 = q_end[_e823];
+                let tree_1 = (trees + ((min((_e825 / cw), 7u) * SLICE_SAMPLES) * RANK_VECS));
                 dotp = 0f;
                 h_3 = 0u;
                 loop {
-                    let _e673 = h_3;
-                    if (_e673 < RANK_VECS) {
+                    let _e838 = h_3;
+                    if (_e838 < RANK_VECS) {
                     } else {
                         break;
                     }
                     {
-                        let _e676 = k_4;
-                        let _e681 = h_3;
-                        let _e684 = pst_tree[((partials + (_e676 * RANK_VECS)) + _e681)];
-                        p_1 = _e684;
-                        let _e687 = k_4;
-                        let _e689 = q_rank[_e687];
-                        j_3 = (v_9 - _e689);
+                        let _e841 = k_4;
+                        let _e846 = h_3;
+                        let _e849 = pst_tree[((partials + (_e841 * RANK_VECS)) + _e846)];
+                        p_1 = _e849;
+                        let _e852 = k_4;
+                        let _e854 = q_rank[_e852];
+                        j_8 = (v_9 - _e854);
                         loop {
-                            let _e692 = j_3;
-                            if (_e692 > 0u) {
+                            let _e857 = j_8;
+                            if (_e857 > 0u) {
                             } else {
                                 break;
                             }
                             {
-                                let _e695 = p_1;
-                                let _e696 = j_3;
-                                let _e703 = h_3;
-                                let _e706 = pst_tree[((tree_1 + ((_e696 - 1u) * RANK_VECS)) + _e703)];
-                                p_1 = (_e695 + _e706);
-                                let _e708 = j_3;
-                                let _e709 = j_3;
-                                let _e710 = j_3;
-                                j_3 = (_e708 - (_e709 & (~(_e710) + 1u)));
+                                let _e860 = p_1;
+                                let _e861 = j_8;
+                                let _e868 = h_3;
+                                let _e871 = pst_tree[((tree_1 + ((_e861 - 1u) * RANK_VECS)) + _e868)];
+                                p_1 = (_e860 + _e871);
+                                let _e873 = j_8;
+                                let _e874 = j_8;
+                                let _e875 = j_8;
+                                j_8 = (_e873 - (_e874 & (~(_e875) + 1u)));
                             }
                         }
-                        let _e716 = dotp;
-                        let _e717 = p_1;
-                        let _e719 = k_4;
-                        let _e721 = q_theta[_e719];
-                        let _e722 = h_3;
-                        let _e723 = beta_at(_e721, _e722);
-                        dotp = (_e716 + dot(_e717, _e723));
+                        let _e881 = dotp;
+                        let _e882 = p_1;
+                        let _e884 = k_4;
+                        let _e886 = q_theta[_e884];
+                        let _e887 = h_3;
+                        let _e888 = beta_at(_e886, _e887);
+                        dotp = (_e881 + dot(_e882, _e888));
                     }
                     continuing {
-                        let _e727 = h_3;
-                        h_3 = (_e727 + 1u);
+                        let _e892 = h_3;
+                        h_3 = (_e892 + 1u);
                     }
                 }
-                let _e732 = k_4;
-                let _e734 = q_a[_e732];
-                let _e735 = dotp;
-                let _e740 = k_4;
-                let _e742 = q_b[_e740];
-                let _e745 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_14.light_color.xyz * (max((_e734 * _e735), 0f) + _e742)));
-                let _e746 = k_4;
-                let _e747 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e746, screen_4);
-                let _e750 = textureLoad(depth, _e747, 0i);
-                let z_7 = _e750.x;
-                let _e752 = k_4;
-                textureStore(output, vec2<u32>(_e752, s_6), vec4<f32>(_e745.x, _e745.y, _e745.z, z_7));
+                let _e897 = k_4;
+                let _e899 = q_a[_e897];
+                let _e900 = dotp;
+                let _e905 = k_4;
+                let _e907 = q_b[_e905];
+                let _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_14.light_color.xyz * (max((_e899 * _e900), 0f) + _e907)));
+                let _e911 = k_4;
+                let _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
+                let _e915 = textureLoad(depth, _e912, 0i);
+                let z_7 = _e915.x;
+                let _e917 = k_4;
+                textureStore(output, vec2<u32>(_e917, s_6), vec4<f32>(_e910.x, _e910.y, _e910.z, z_7));
             }
         }
         continuing {
-            let _e759 = k_4;
-            k_4 = (_e759 + SLICE_LANES);
+            let _e924 = k_4;
+            k_4 = (_e924 + SLICE_LANES);
         }
     }
     return;

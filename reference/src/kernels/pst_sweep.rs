@@ -190,7 +190,14 @@ pub fn pst_columns_crossed(f: &FrameUniforms, r: &PstRay, delta: f32) -> u32 {
 }
 
 /// A query's factor and term (WGSL `pst_terms`): `(a, b)`.
-pub fn pst_terms(inp: &PstInputs, spot: bool, r: &PstRay, row: u32, delta: f32, n: u32) -> [f32; 2] {
+pub fn pst_terms(
+    inp: &PstInputs,
+    spot: bool,
+    r: &PstRay,
+    row: u32,
+    delta: f32,
+    n: u32,
+) -> [f32; 2] {
     let f = inp.frame;
     let sin_theta = max(r.theta.sin(), 1e-6);
     let mut tail = 0.0;
@@ -215,11 +222,22 @@ pub fn pst_terms(inp: &PstInputs, spot: bool, r: &PstRay, row: u32, delta: f32, 
 
 /// View depth at the continuous pixel position `pc` from the 2 x 2 pixels around it, `1 / z`
 /// interpolated bilinearly; -1 at a depth break (WGSL `pst_footprint_depth`).
-pub fn pst_footprint_depth(inp: &PstInputs, pc: [f32; 2], screen: [u32; 2], depth_break: f32) -> f32 {
+pub fn pst_footprint_depth(
+    inp: &PstInputs,
+    pc: [f32; 2],
+    screen: [u32; 2],
+    depth_break: f32,
+) -> f32 {
     let last = [screen[0] as f32 - 1.0, screen[1] as f32 - 1.0];
-    let q = [clamp(pc[0] - 0.5, 0.0, last[0]), clamp(pc[1] - 0.5, 0.0, last[1])];
+    let q = [
+        clamp(pc[0] - 0.5, 0.0, last[0]),
+        clamp(pc[1] - 0.5, 0.0, last[1]),
+    ];
     let i0 = [q[0].floor() as u32, q[1].floor() as u32];
-    let i1 = [(i0[0] + 1).min(screen[0] - 1), (i0[1] + 1).min(screen[1] - 1)];
+    let i1 = [
+        (i0[0] + 1).min(screen[0] - 1),
+        (i0[1] + 1).min(screen[1] - 1),
+    ];
     let t = [q[0] - q[0].floor(), q[1] - q[1].floor()];
     let z00 = inp.depth.load(i0[0], i0[1]);
     let z10 = inp.depth.load(i1[0], i0[1]);
@@ -240,7 +258,12 @@ pub fn pst_footprint_depth(inp: &PstInputs, pc: [f32; 2], screen: [u32; 2], dept
 
 /// The fallback's per-pixel body (WGSL `pst_sweep_pixel`): the pixel's own nearest row, its
 /// lit whole columns' leaves summed in column order.
-pub fn pst_sweep_pixel(inp: &PstInputs, variant: &PartialSumTreeVariant, x: u32, y: u32) -> [f32; 3] {
+pub fn pst_sweep_pixel(
+    inp: &PstInputs,
+    variant: &PartialSumTreeVariant,
+    x: u32,
+    y: u32,
+) -> [f32; 3] {
     let f = inp.frame;
     let spot = variant.light == LightKind::Spot;
     let r = pst_ray(
@@ -337,29 +360,39 @@ pub fn pst_sweep(
                 }
             }
 
-            // 2. Ranks by d and by prefix end (ties by sample index), then the sorted d.
-            let mut q_rank = vec![0u32; m as usize];
-            let mut by_end = vec![0u32; m as usize];
-            for k in 0..m as usize {
-                if q_end[k] == NONE {
-                    continue;
-                }
-                let (mut by_d, mut by_e) = (0u32, 0u32);
-                for q in 0..m as usize {
-                    if q_end[q] != NONE {
-                        by_d += u32::from(q_d[q] < q_d[k] || (q_d[q] == q_d[k] && q < k));
-                        by_e +=
-                            u32::from(q_end[q] < q_end[k] || (q_end[q] == q_end[k] && q < k));
+            // 2. The queries in order of their prefix end (ties by sample index: the WGSL's
+            // insertion per tree, trees in order), and d sorted by insertion in the direction
+            // it runs along the slice (ties: by sample index up, reversed down).
+            let mut by_end: Vec<u32> = (0..m).filter(|&k| q_end[k as usize] != NONE).collect();
+            by_end.sort_by_key(|&k| q_end[k as usize]);
+            let live: Vec<usize> = (0..m as usize).filter(|&k| q_end[k] != NONE).collect();
+            let mut sorted: Vec<f32> = Vec::with_capacity(live.len());
+            let mut order: Vec<u32> = Vec::with_capacity(live.len());
+            if let (Some(&first), Some(&last)) = (live.first(), live.last()) {
+                let up = q_d[first] <= q_d[last];
+                for &k in &live {
+                    let d = q_d[k];
+                    let mut j = sorted.len();
+                    while j > 0
+                        && if up {
+                            sorted[j - 1] > d
+                        } else {
+                            sorted[j - 1] < d
+                        }
+                    {
+                        j -= 1;
                     }
+                    sorted.insert(j, d);
+                    order.insert(j, k as u32);
                 }
-                q_rank[k] = by_d;
-                by_end[by_e as usize] = k as u32;
+                if !up {
+                    sorted.reverse();
+                    order.reverse();
+                }
             }
-            let mut sorted = vec![0.0f32; v as usize];
-            for k in 0..m as usize {
-                if q_end[k] != NONE {
-                    sorted[q_rank[k] as usize] = q_d[k];
-                }
+            let mut q_rank = vec![0u32; m as usize];
+            for (j, &k) in order.iter().enumerate() {
+                q_rank[k as usize] = j as u32;
             }
 
             // 3. Every column's count of queries that see it lit, and its leaf.
@@ -386,9 +419,13 @@ pub fn pst_sweep(
             for c in 0..TREES {
                 let tree = c as usize * stride;
                 let lo = c * cw;
-                let hi = if c + 1 == TREES { width } else { (lo + cw).min(width) };
-                let mut next = by_end[..v as usize]
-                    .partition_point(|&k| q_end[k as usize] < lo) as u32;
+                let hi = if c + 1 == TREES {
+                    width
+                } else {
+                    (lo + cw).min(width)
+                };
+                let mut next =
+                    by_end[..v as usize].partition_point(|&k| q_end[k as usize] < lo) as u32;
                 for i in lo..=hi {
                     while next < v
                         && q_end[by_end[next as usize] as usize] == i

@@ -7,9 +7,9 @@ use crate::Kernel;
 use crate::family::KernelFamily;
 use crate::partial_sum_tree::{FACTOR_VECS, PartialSumTreeVariant, SAMPLED_BINDING, TREES};
 use crate::plan::{
-    BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
-    SLICE_FIT_NOTE, TEXTURE_DIMENSION, bind, column_depth_buffer, depth_and_shadow_map,
-    frame_buffer, scatter_resource, scatter_texture, screen_and_shadow_parameters,
+    BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource, SLICE_FIT_NOTE,
+    TEXTURE_DIMENSION, bind, column_depth_buffer, depth_and_shadow_map, frame_buffer,
+    scatter_resource, scatter_texture, screen_and_shadow_parameters,
 };
 use crate::sampling::{
     epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
