@@ -1,8 +1,9 @@
 //! The partial-sum-tree method of Baran et al. 2010 ("A hierarchical volumetric shadow
-//! algorithm for single scattering"), on the CPU: the method's reference, before any kernel
-//! (issue 15). Not a family yet: no template, plan, runtime or generator support exists; this
-//! module fixes the method's math against brute force so that the kernels can mirror it
-//! (derivation, measurements and the plan for the kernels: `docs/partial-sum-tree.md`).
+//! algorithm for single scattering"), on the CPU: the method's independent reference (issue
+//! 15), a removal sweep over every pixel of the screen, beside the `partial_sum_tree` family's
+//! kernels (`pst_sweep` and its mirror `kernels::pst_sweep`, which sweep epipolar samples by
+//! insertion). It checks the method's math against brute force (derivation and measurements:
+//! `docs/partial-sum-tree.md`).
 //!
 //! It works on the shared epipolar layer (the frame set-up, `slice_fit` and `rectify` every
 //! rectified family runs): row `y` of the rectified map is a slice, column `i` a light ray, and

@@ -24,7 +24,8 @@
 //! Two sampled variants (issue 14, raymarch N = 64) are reported and NaN-checked:
 //! `sampling = lowres` at scale 4, whose samples stand on fixed pixels, so that what moves
 //! is the scene under them, and `sampling = epipolar` (64 x 64, step 8), whose samples move
-//! with the epipole.
+//! with the epipole. The partial-sum-tree family (issue 15; epipolar samples only, 64 x 64,
+//! every sample answered) is reported and NaN-checked too.
 //!
 //! 64x36 pixels, 256x256 rectified map, 512^2 shadow map, truth with 512 cells per ray:
 //! small enough for CI (75 s here in the test profile with a warm Mesa cache).
@@ -46,6 +47,7 @@ use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::{Context, FamilyPasses, FrameInput};
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
+use scatter_shaderlib::partial_sum_tree::PartialSumTreeVariant;
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, PrefilteredVariant, Resolutions};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 use scatter_shaderlib::sampling::SamplingKnobs;
@@ -119,6 +121,18 @@ fn variants(light: LightKind) -> Vec<FamilyVariant> {
     // And epipolar (64 slices x 64 samples, step 8, at this screen): its samples move with
     // the epipole, so a camera or light that moves moves them (Yusov 2013's flicker).
     v.push(v[3].with_sampling(epipolar_knobs()));
+    // Issue 15: the partial-sum-tree family (epipolar samples only) at the same layout,
+    // every sample answered (reported, NaN checked).
+    v.push(FamilyVariant::PartialSumTree(
+        PartialSumTreeVariant {
+            light,
+            ..PartialSumTreeVariant::default()
+        }
+        .with_sampling_knobs(SamplingKnobs {
+            step: 1,
+            ..epipolar_knobs()
+        }),
+    ));
     v
 }
 
@@ -141,6 +155,7 @@ fn labels() -> Vec<String> {
     l.push("minmax".into());
     l.push(format!("raymarch n64-lr{SAMPLED_SCALE}"));
     l.push("raymarch n64-ep64x64".into());
+    l.push("partial_sum_tree r4-ep64x64".into());
     l
 }
 
