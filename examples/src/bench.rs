@@ -1014,8 +1014,8 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             ("raymarch", "n256-i1"),
             ("raymarch", "n64-i4"),
             ("minmax", "minmax"),
-            ("partial_sum_tree", "r4-ep512"),
-            ("partial_sum_tree", "r4-ep512-512x512"),
+            ("partial_sum_tree", "r4-ep512-s1"),
+            ("partial_sum_tree", "r4-ep512-s1-512x512"),
         ] {
             if let Some((t, e)) = headline_mean(family, knobs) {
                 out.push(format!(
@@ -1038,7 +1038,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             ("raymarch", "n64-i1"),
             ("raymarch", "n256-i1"),
             ("minmax", "minmax"),
-            ("partial_sum_tree", "r4-ep512"),
+            ("partial_sum_tree", "r4-ep512-s1"),
         ] {
             if let Some((t, e)) = headline_mean(family, knobs) {
                 out.push(format!(
