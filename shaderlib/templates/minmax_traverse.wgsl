@@ -24,8 +24,8 @@
 //
 // Mirrors reference/src/kernels/minmax_traverse.rs
 
-#import scatter::model::{phase_hg, transmittance_between}
-#import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, slice_params, spot_segment}
+#import scatter::model::{phase_hg}
+#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, pixel_dir, row_index, slice_params}
 #import scatter::minmax::{level_offset, tree_levels}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
@@ -38,23 +38,6 @@
 @group(0) @binding(4) var tree: texture_2d<f32>;
 @group(0) @binding(5) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
 {% include "include/sampled_bindings.wgsl" %}
-
-// Ray distance of column edge `x` of a ray that crosses texels 0 .. n: the last texel's
-// span ends at the surface `s`.
-fn edge_t(f: Frame, x: u32, n: u32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
-    if x >= n {
-        return s;
-    }
-    return ray_t(f, f32(x), delta, theta, s, spot);
-}
-
-// Unshadowed in-scattering over `[a, b]` of the ray, without `sigma_s p E` for the sun.
-fn lit_span(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, spot: bool) -> f32 {
-    if spot {
-        return spot_segment(f, eye, dir, a, b, max(f.sizes2_[2] / 4u, 1u));
-    }
-    return transmittance_between(f.medium[0], a, b);
-}
 
 // The in-scattered radiance of pixel (x, y) (the sampling entry point below calls it).
 fn minmax_traverse_pixel(x: u32, y: u32) -> vec3<f32> {

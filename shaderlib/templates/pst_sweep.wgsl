@@ -38,7 +38,7 @@
 // Mirrors reference/src/kernels/pst_sweep.rs
 
 #import scatter::model::{cone_falloff, phase_hg, transmittance_between}
-#import scatter::epipolar::{Frame, epipole_march, normalised_depth, ray_t, row_index, row_phi, slice_e, slice_params, spot_segment}
+#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, row_index, row_phi, slice_e, slice_params}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
 {%- endif %}
@@ -63,23 +63,6 @@ const RANK_VECS: u32 = {{ rank_vecs }}u;
 const TREES: u32 = {{ trees }}u;
 const GRID: u32 = {{ grid }}u;
 const GL2: f32 = 0.57735026f;
-
-// Ray distance of column edge `x` of a ray that crosses texels 0 .. n: the last texel's
-// span ends at the surface `s` (as in `minmax_traverse`).
-fn edge_t(f: Frame, x: u32, n: u32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
-    if x >= n {
-        return s;
-    }
-    return ray_t(f, f32(x), delta, theta, s, spot);
-}
-
-// Unshadowed in-scattering over `[a, b]` of the ray, without `sigma_s p E` for the sun.
-fn lit_span(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, spot: bool) -> f32 {
-    if spot {
-        return spot_segment(f, eye, dir, a, b, max(f.sizes2_[2] / 4u, 1u));
-    }
-    return transmittance_between(f.medium[0], a, b);
-}
 
 // Factor table `base` (1: gamma over v, 1 + 2 GRID: beta over theta) at `x` in [0, 1], bases
 // 4h .. 4h + 3, linear between nodes.

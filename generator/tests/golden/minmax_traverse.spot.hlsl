@@ -478,9 +478,32 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 eye_5, float3 dir_5, float a_3, float b_3, uint panels_1)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, uint x_3, uint n_1, float delta_1, float theta_2, float s_2, bool spot_2)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+    if ((x_3 >= n_1)) {
+        return s_2;
+    }
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, float(x_3), delta_1, theta_2, s_2, spot_2);
+    return _e9;
+}
+
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 eye_5, float3 dir_5, float a_3, float b_3, uint panels_1)
+{
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_7.light_pos.xyz, f_7.light_dir.xyz, f_7.light_pos.w, f_7.light_dir.w, f_7.medium);
+    return _e15;
+}
+
+uint naga_div(uint lhs, uint rhs) {
+    return lhs / (rhs == 0u ? 1u : rhs);
+}
+
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_6, float3 dir_6, float a_4, float b_4, bool spot_3)
+{
+    if (spot_3) {
+        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_6, dir_6, a_4, b_4, max(naga_div(f_8.sizes2_.z, 4u), 1u));
+        return _e12;
+    }
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -541,29 +564,6 @@ uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_1, uint wi
     }
     uint _e14 = off;
     return _e14;
-}
-
-float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, uint x_3, uint n_1, float delta_1, float theta_2, float s_2, bool spot_2)
-{
-    if ((x_3 >= n_1)) {
-        return s_2;
-    }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, float(x_3), delta_1, theta_2, s_2, spot_2);
-    return _e9;
-}
-
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / (rhs == 0u ? 1u : rhs);
-}
-
-float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_6, float3 dir_6, float a_4, float b_4, bool spot_3)
-{
-    if (spot_3) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_6, dir_6, a_4, b_4, max(naga_div(f_8.sizes2_.z, 4u), 1u));
-        return _e12;
-    }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_4, b_4);
-    return _e15;
 }
 
 float3 minmax_traverse_pixel(uint x_4, uint y_1)
@@ -719,14 +719,14 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
             bool _e229 = in_run;
             if ((_e228 != _e229)) {
                 uint _e231 = i;
-                const float _e232 = edge_t(f_9, _e231, n_3, delta_2, theta_3, s_3, true);
+                const float _e232 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, _e231, n_3, delta_2, theta_3, s_3, true);
                 bool _e233 = lit_;
                 if (_e233) {
                     run_a = _e232;
                 } else {
                     float _e236 = total;
                     float _e237 = run_a;
-                    const float _e238 = lit_span(f_9, eye_7, _e9, _e237, _e232, true);
+                    const float _e238 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_7, _e9, _e237, _e232, true);
                     total = (_e236 + _e238);
                 }
                 bool _e240 = lit_;
@@ -741,7 +741,7 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
     if (_e246) {
         float _e247 = total;
         float _e248 = run_a;
-        const float _e249 = lit_span(f_9, eye_7, _e9, _e248, s_3, true);
+        const float _e249 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_7, _e9, _e248, s_3, true);
         total = (_e247 + _e249);
     }
     float _e251 = total;

@@ -395,8 +395,25 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_X
     }
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
+    if (x_3 >= n_1) {
+        return s_2;
+    }
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, f32(x_3), delta_1, theta_2, s_2, spot_2);
+    return _e9;
+}
+
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_7.light_pos.xyz, f_7.light_dir.xyz, f_7.light_pos.w, f_7.light_dir.w, f_7.medium);
+    return _e15;
+}
+
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_4: f32, b_4: f32, spot_3: bool) -> f32 {
+    if spot_3 {
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_6, dir_6, a_4, b_4, max((f_8.sizes2_.z / 4u), 1u));
+        return _e12;
+    }
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -446,23 +463,6 @@ fn level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_1: u32, width_2: 
     }
     let _e14 = off;
     return _e14;
-}
-
-fn edge_t(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
-    if (x_3 >= n_1) {
-        return s_2;
-    }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, f32(x_3), delta_1, theta_2, s_2, spot_2);
-    return _e9;
-}
-
-fn lit_span(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_4: f32, b_4: f32, spot_3: bool) -> f32 {
-    if spot_3 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_6, dir_6, a_4, b_4, max((f_8.sizes2_.z / 4u), 1u));
-        return _e12;
-    }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_4, b_4);
-    return _e15;
 }
 
 fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
@@ -608,14 +608,14 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
             let _e229 = in_run;
             if (_e228 != _e229) {
                 let _e231 = i;
-                let _e232 = edge_t(f_9, _e231, n_3, delta_2, theta_3, s_3, true);
+                let _e232 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, _e231, n_3, delta_2, theta_3, s_3, true);
                 let _e233 = lit;
                 if _e233 {
                     run_a = _e232;
                 } else {
                     let _e236 = total;
                     let _e237 = run_a;
-                    let _e238 = lit_span(f_9, eye_7, _e9, _e237, _e232, true);
+                    let _e238 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_7, _e9, _e237, _e232, true);
                     total = (_e236 + _e238);
                 }
                 let _e240 = lit;
@@ -630,7 +630,7 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     if _e246 {
         let _e247 = total;
         let _e248 = run_a;
-        let _e249 = lit_span(f_9, eye_7, _e9, _e248, s_3, true);
+        let _e249 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_7, _e9, _e248, s_3, true);
         total = (_e247 + _e249);
     }
     let _e251 = total;

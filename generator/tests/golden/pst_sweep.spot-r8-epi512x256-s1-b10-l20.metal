@@ -578,26 +578,62 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    uint x_3,
+    uint n_1,
+    float delta_1,
+    float theta_2,
+    float s_2,
+    bool spot_2
+) {
+    if (x_3 >= n_1) {
+        return s_2;
+    }
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, static_cast<float>(x_3), delta_1, theta_2, s_2, spot_2);
+    return _e9;
+}
+
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
     metal::float3 eye_5,
     metal::float3 dir_5,
     float a_3,
     float b_3,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_7.light_pos.xyz, f_7.light_dir.xyz, f_7.light_pos.w, f_7.light_dir.w, f_7.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+    return _e15;
+}
+
+uint naga_div(uint lhs, uint rhs) {
+    return lhs / metal::select(rhs, 1u, rhs == 0u);
+}
+
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    metal::float3 eye_6,
+    metal::float3 dir_6,
+    float a_4,
+    float b_4,
+    bool spot_3
+) {
+    if (spot_3) {
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, metal::max(naga_div(f_9.sizes2_.z, 4u), 1u));
+        return _e12;
+    }
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
     return _e15;
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_4,
-    float b_4,
+    float a_5,
+    float b_5,
     float depth_break
 ) {
     bool local_14 = {};
-    if (!((a_4 == b_4))) {
-        local_14 = metal::abs(a_4 - b_4) <= (depth_break * metal::min(a_4, b_4));
+    if (!((a_5 == b_5))) {
+        local_14 = metal::abs(a_5 - b_5) <= (depth_break * metal::min(a_5, b_5));
     } else {
         local_14 = true;
     }
@@ -632,8 +668,8 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     bool local_15 = {};
     bool local_16 = {};
     bool local_17 = {};
-    float a_5 = 0.0;
-    float b_5 = 0.0;
+    float a_6 = 0.0;
+    float b_6 = 0.0;
     uint k_7 = 0u;
     metal::float2 size_1 = static_cast<metal::float2>(screen);
     metal::float2 centre = 0.5 * size_1;
@@ -709,20 +745,20 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
                 float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, corner - _e140);
                 uint _e143 = k_7;
                 if (_e143 == 0u) {
-                    a_5 = _e142;
-                    b_5 = _e142;
+                    a_6 = _e142;
+                    b_6 = _e142;
                 } else {
-                    float _e148 = a_5;
-                    a_5 = metal::min(_e148, _e142);
-                    float _e150 = b_5;
-                    b_5 = metal::max(_e150, _e142);
+                    float _e148 = a_6;
+                    a_6 = metal::min(_e148, _e142);
+                    float _e150 = b_6;
+                    b_6 = metal::max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_5;
+        float _e156 = a_6;
         l_1.phi_start = _e156;
-        float _e158 = b_5;
-        float _e159 = a_5;
+        float _e158 = b_6;
+        float _e159 = a_6;
         l_1.dphi = (_e158 - _e159) / static_cast<float>(slices);
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l_1;
@@ -731,9 +767,9 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
 
 metal::float2 slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2,
-    uint s_2
+    uint s_3
 ) {
-    float phi_1 = l_2.phi_start + ((static_cast<float>(s_2) + 0.5) * l_2.dphi);
+    float phi_1 = l_2.phi_start + ((static_cast<float>(s_3) + 0.5) * l_2.dphi);
     float c_2 = metal::cos(phi_1);
     float sn = metal::sin(phi_1);
     return metal::float2((l_2.axis.x * c_2) - (l_2.axis.y * sn), (l_2.axis.y * c_2) + (l_2.axis.x * sn));
@@ -741,14 +777,14 @@ metal::float2 slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 
 metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_3,
-    uint s_3,
+    uint s_4,
     metal::uint2 screen_1,
     uint samples
 ) {
     float t_in = 0.0;
     float t_out = 340000000000000000000000000000000000000.0;
-    uint a_6 = 0u;
-    metal::float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_3);
+    uint a_7 = 0u;
+    metal::float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_4);
     metal::float2 lo_3 = metal::float2(0.5, 0.5);
     metal::float2 hi_3 = static_cast<metal::float2>(screen_1) - metal::float2(0.5, 0.5);
     uint2 loop_bound_4 = uint2(4294967295u);
@@ -757,25 +793,25 @@ metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e51 = a_6;
-            a_6 = _e51 + 1u;
+            uint _e51 = a_7;
+            a_7 = _e51 + 1u;
         }
         loop_init_4 = false;
-        uint _e16 = a_6;
+        uint _e16 = a_7;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            uint _e19 = a_6;
+            uint _e19 = a_7;
             if (metal::abs(_e5[metal::min(unsigned(_e19), 1u)]) > 0.000000000001) {
-                uint _e24 = a_6;
-                uint _e27 = a_6;
-                uint _e30 = a_6;
+                uint _e24 = a_7;
+                uint _e27 = a_7;
+                uint _e30 = a_7;
                 float ta = (lo_3[metal::min(unsigned(_e24), 1u)] - l_3.origin[metal::min(unsigned(_e27), 1u)]) / _e5[metal::min(unsigned(_e30), 1u)];
-                uint _e33 = a_6;
-                uint _e36 = a_6;
-                uint _e39 = a_6;
+                uint _e33 = a_7;
+                uint _e36 = a_7;
+                uint _e39 = a_7;
                 float tb = (hi_3[metal::min(unsigned(_e33), 1u)] - l_3.origin[metal::min(unsigned(_e36), 1u)]) / _e5[metal::min(unsigned(_e39), 1u)];
                 float _e43 = t_in;
                 t_in = metal::max(_e43, metal::min(ta, tb));
@@ -807,42 +843,6 @@ metal::uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float2 p_6 = l_4.origin + (u * (span.x + (static_cast<float>(k_8) * span.y)));
     metal::float2 last_1 = static_cast<metal::float2>(screen_2) - metal::float2(1.0, 1.0);
     return naga_f2u32(metal::clamp(metal::floor(p_6), metal::float2(0.0, 0.0), last_1));
-}
-
-float edge_t(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
-    uint x_3,
-    uint n_1,
-    float delta_1,
-    float theta_2,
-    float s_4,
-    bool spot_2
-) {
-    if (x_3 >= n_1) {
-        return s_4;
-    }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, static_cast<float>(x_3), delta_1, theta_2, s_4, spot_2);
-    return _e9;
-}
-
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / metal::select(rhs, 1u, rhs == 0u);
-}
-
-float lit_span(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
-    metal::float3 eye_6,
-    metal::float3 dir_6,
-    float a_7,
-    float b_6,
-    bool spot_3
-) {
-    if (spot_3) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_7, b_6, metal::max(naga_div(f_9.sizes2_.z, 4u), 1u));
-        return _e12;
-    }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_7, b_6);
-    return _e15;
 }
 
 metal::float4 factor_at(
@@ -1029,8 +1029,8 @@ metal::float2 pst_terms(
     uint clamped_lod_e16 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
     metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_2)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     if (r_3.d <= _e16.x) {
-        float _e25 = edge_t(f_12, n_2 - 1u, n_2, delta_4, r_3.theta, r_3.s, true);
-        float _e29 = lit_span(f_12, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, n_2 - 1u, n_2, delta_4, r_3.theta, r_3.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if (true) {

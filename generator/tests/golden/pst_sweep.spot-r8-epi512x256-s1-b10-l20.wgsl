@@ -456,16 +456,33 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_X
     }
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_7.light_pos.xyz, f_7.light_dir.xyz, f_7.light_pos.w, f_7.light_dir.w, f_7.medium);
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
+    if (x_3 >= n_1) {
+        return s_2;
+    }
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, f32(x_3), delta_1, theta_2, s_2, spot_2);
+    return _e9;
+}
+
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e15;
 }
 
-fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_4: f32, b_4: f32, depth_break: f32) -> bool {
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_4: f32, b_4: f32, spot_3: bool) -> f32 {
+    if spot_3 {
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, max((f_9.sizes2_.z / 4u), 1u));
+        return _e12;
+    }
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+    return _e15;
+}
+
+fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_5: f32, b_5: f32, depth_break: f32) -> bool {
     var local_14: bool;
 
-    if !((a_4 == b_4)) {
-        local_14 = (abs((a_4 - b_4)) <= (depth_break * min(a_4, b_4)));
+    if !((a_5 == b_5)) {
+        local_14 = (abs((a_5 - b_5)) <= (depth_break * min(a_5, b_5)));
     } else {
         local_14 = true;
     }
@@ -491,8 +508,8 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     var local_15: bool;
     var local_16: bool;
     var local_17: bool;
-    var a_5: f32 = 0f;
-    var b_5: f32 = 0f;
+    var a_6: f32 = 0f;
+    var b_6: f32 = 0f;
     var k_7: u32 = 0u;
 
     let size_1 = vec2<f32>(screen);
@@ -560,13 +577,13 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
                 let _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
                 let _e143 = k_7;
                 if (_e143 == 0u) {
-                    a_5 = _e142;
-                    b_5 = _e142;
+                    a_6 = _e142;
+                    b_6 = _e142;
                 } else {
-                    let _e148 = a_5;
-                    a_5 = min(_e148, _e142);
-                    let _e150 = b_5;
-                    b_5 = max(_e150, _e142);
+                    let _e148 = a_6;
+                    a_6 = min(_e148, _e142);
+                    let _e150 = b_6;
+                    b_6 = max(_e150, _e142);
                 }
             }
             continuing {
@@ -574,47 +591,47 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
                 k_7 = (_e153 + 1u);
             }
         }
-        let _e156 = a_5;
+        let _e156 = a_6;
         l_1.phi_start = _e156;
-        let _e158 = b_5;
-        let _e159 = a_5;
+        let _e158 = b_6;
+        let _e159 = a_6;
         l_1.dphi = ((_e158 - _e159) / f32(slices));
     }
     let _e163 = l_1;
     return _e163;
 }
 
-fn slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_2: u32) -> vec2<f32> {
-    let phi_1 = (l_2.phi_start + ((f32(s_2) + 0.5f) * l_2.dphi));
+fn slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_3: u32) -> vec2<f32> {
+    let phi_1 = (l_2.phi_start + ((f32(s_3) + 0.5f) * l_2.dphi));
     let c_2 = cos(phi_1);
     let sn = sin(phi_1);
     return vec2<f32>(((l_2.axis.x * c_2) - (l_2.axis.y * sn)), ((l_2.axis.y * c_2) + (l_2.axis.x * sn)));
 }
 
-fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_3: u32, screen_1: vec2<u32>, samples: u32) -> vec2<f32> {
+fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_4: u32, screen_1: vec2<u32>, samples: u32) -> vec2<f32> {
     var t_in: f32 = 0f;
     var t_out: f32 = 340000000000000000000000000000000000000f;
-    var a_6: u32 = 0u;
+    var a_7: u32 = 0u;
 
-    let _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_3);
+    let _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_4);
     let lo_3 = vec2<f32>(0.5f, 0.5f);
     let hi_3 = (vec2<f32>(screen_1) - vec2<f32>(0.5f, 0.5f));
     loop {
-        let _e16 = a_6;
+        let _e16 = a_7;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            let _e19 = a_6;
+            let _e19 = a_7;
             if (abs(_e5[_e19]) > 0.000000000001f) {
-                let _e24 = a_6;
-                let _e27 = a_6;
-                let _e30 = a_6;
+                let _e24 = a_7;
+                let _e27 = a_7;
+                let _e30 = a_7;
                 let ta = ((lo_3[_e24] - l_3.origin[_e27]) / _e5[_e30]);
-                let _e33 = a_6;
-                let _e36 = a_6;
-                let _e39 = a_6;
+                let _e33 = a_7;
+                let _e36 = a_7;
+                let _e39 = a_7;
                 let tb = ((hi_3[_e33] - l_3.origin[_e36]) / _e5[_e39]);
                 let _e43 = t_in;
                 t_in = max(_e43, min(ta, tb));
@@ -623,8 +640,8 @@ fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_
             }
         }
         continuing {
-            let _e51 = a_6;
-            a_6 = (_e51 + 1u);
+            let _e51 = a_7;
+            a_7 = (_e51 + 1u);
         }
     }
     let _e53 = t_out;
@@ -640,23 +657,6 @@ fn slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_4: Epipolar
     let p_6 = (l_4.origin + (u * (span.x + (f32(k_8) * span.y))));
     let last_1 = (vec2<f32>(screen_2) - vec2<f32>(1f, 1f));
     return vec2<u32>(clamp(floor(p_6), vec2<f32>(0f, 0f), last_1));
-}
-
-fn edge_t(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_2: f32, s_4: f32, spot_2: bool) -> f32 {
-    if (x_3 >= n_1) {
-        return s_4;
-    }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, f32(x_3), delta_1, theta_2, s_4, spot_2);
-    return _e9;
-}
-
-fn lit_span(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_7: f32, b_6: f32, spot_3: bool) -> f32 {
-    if spot_3 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_7, b_6, max((f_9.sizes2_.z / 4u), 1u));
-        return _e12;
-    }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_7, b_6);
-    return _e15;
 }
 
 fn factor_at(base: u32, x_4: f32, h_4: u32) -> vec4<f32> {
@@ -800,8 +800,8 @@ fn pst_terms(r_3: PstRay, row_2: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     let sin_theta = max(sin(r_3.theta), 0.000001f);
     let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_2), 0i);
     if (r_3.d <= _e16.x) {
-        let _e25 = edge_t(f_12, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
-        let _e29 = lit_span(f_12, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
+        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if true {

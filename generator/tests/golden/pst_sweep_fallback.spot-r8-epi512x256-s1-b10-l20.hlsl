@@ -510,26 +510,26 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 eye_5, float3 dir_5, float a_3, float b_3, uint panels_1)
-{
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_7.light_pos.xyz, f_7.light_dir.xyz, f_7.light_pos.w, f_7.light_dir.w, f_7.medium);
-    return _e15;
-}
-
-float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, uint x_2, uint n_1, float delta_1, float theta_2, float s_2, bool spot_2)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, uint x_2, uint n_1, float delta_1, float theta_2, float s_2, bool spot_2)
 {
     if ((x_2 >= n_1)) {
         return s_2;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, float(x_2), delta_1, theta_2, s_2, spot_2);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, float(x_2), delta_1, theta_2, s_2, spot_2);
     return _e9;
+}
+
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_5, float3 dir_5, float a_3, float b_3, uint panels_1)
+{
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+    return _e15;
 }
 
 uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_6, float a_4, float b_4, bool spot_3)
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_6, float a_4, float b_4, bool spot_3)
 {
     if (spot_3) {
         const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, max(naga_div(f_9.sizes2_.z, 4u), 1u));
@@ -707,8 +707,8 @@ float2 pst_terms(PstRay r_2, uint row_2, float delta_4, uint n_2)
     float sin_theta = max(sin(r_2.theta), 1e-6);
     float4 _e16 = rectified.Load(int3(uint2((n_2 - 1u), row_2), int(0)));
     if ((r_2.d <= _e16.x)) {
-        const float _e25 = edge_t(f_12, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        const float _e29 = lit_span(f_12, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        const float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        const float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {

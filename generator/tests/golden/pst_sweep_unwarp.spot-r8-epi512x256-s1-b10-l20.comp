@@ -431,15 +431,32 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 eye_5, vec3 dir_5, float a_3, float b_3, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_7.light_pos.xyz, f_7.light_dir.xyz, f_7.light_pos.w, f_7.light_dir.w, f_7.medium);
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, uint x_2, uint n_1, float delta_1, float theta_2, float s_2, bool spot_2) {
+    if ((x_2 >= n_1)) {
+        return s_2;
+    }
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, float(x_2), delta_1, theta_2, s_2, spot_2);
+    return _e9;
+}
+
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_5, vec3 dir_5, float a_3, float b_3, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e15;
 }
 
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_4, float b_4, float depth_break) {
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_6, float a_4, float b_4, bool spot_3) {
+    if (spot_3) {
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, max((f_9.sizes2_.z / 4u), 1u));
+        return _e12;
+    }
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+    return _e15;
+}
+
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_5, float b_5, float depth_break) {
     bool local_6 = false;
-    if (!((a_4 == b_4))) {
-        local_6 = (abs((a_4 - b_4)) <= (depth_break * min(a_4, b_4)));
+    if (!((a_5 == b_5))) {
+        local_6 = (abs((a_5 - b_5)) <= (depth_break * min(a_5, b_5)));
     } else {
         local_6 = true;
     }
@@ -580,23 +597,6 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
     }
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_4;
     return _e70;
-}
-
-float edge_t(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, uint x_2, uint n_1, float delta_1, float theta_2, float s_2, bool spot_2) {
-    if ((x_2 >= n_1)) {
-        return s_2;
-    }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, float(x_2), delta_1, theta_2, s_2, spot_2);
-    return _e9;
-}
-
-float lit_span(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_6, float a_5, float b_5, bool spot_3) {
-    if (spot_3) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_5, b_5, max((f_9.sizes2_.z / 4u), 1u));
-        return _e12;
-    }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_5, b_5);
-    return _e15;
 }
 
 uint pst_columns_crossed(PstRay r_1, float delta_3) {

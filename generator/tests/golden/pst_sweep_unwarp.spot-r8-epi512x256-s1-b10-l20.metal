@@ -564,26 +564,62 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    uint x_2,
+    uint n_1,
+    float delta_1,
+    float theta_2,
+    float s_2,
+    bool spot_2
+) {
+    if (x_2 >= n_1) {
+        return s_2;
+    }
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, static_cast<float>(x_2), delta_1, theta_2, s_2, spot_2);
+    return _e9;
+}
+
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
     metal::float3 eye_5,
     metal::float3 dir_5,
     float a_3,
     float b_3,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_7.light_pos.xyz, f_7.light_dir.xyz, f_7.light_pos.w, f_7.light_dir.w, f_7.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+    return _e15;
+}
+
+uint naga_div(uint lhs, uint rhs) {
+    return lhs / metal::select(rhs, 1u, rhs == 0u);
+}
+
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    metal::float3 eye_6,
+    metal::float3 dir_6,
+    float a_4,
+    float b_4,
+    bool spot_3
+) {
+    if (spot_3) {
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, metal::max(naga_div(f_9.sizes2_.z, 4u), 1u));
+        return _e12;
+    }
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
     return _e15;
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_4,
-    float b_4,
+    float a_5,
+    float b_5,
     float depth_break
 ) {
     bool local_6 = {};
-    if (!((a_4 == b_4))) {
-        local_6 = metal::abs(a_4 - b_4) <= (depth_break * metal::min(a_4, b_4));
+    if (!((a_5 == b_5))) {
+        local_6 = metal::abs(a_5 - b_5) <= (depth_break * metal::min(a_5, b_5));
     } else {
         local_6 = true;
     }
@@ -755,42 +791,6 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
     }
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_4;
     return _e70;
-}
-
-float edge_t(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
-    uint x_2,
-    uint n_1,
-    float delta_1,
-    float theta_2,
-    float s_2,
-    bool spot_2
-) {
-    if (x_2 >= n_1) {
-        return s_2;
-    }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, static_cast<float>(x_2), delta_1, theta_2, s_2, spot_2);
-    return _e9;
-}
-
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / metal::select(rhs, 1u, rhs == 0u);
-}
-
-float lit_span(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
-    metal::float3 eye_6,
-    metal::float3 dir_6,
-    float a_5,
-    float b_5,
-    bool spot_3
-) {
-    if (spot_3) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_5, b_5, metal::max(naga_div(f_9.sizes2_.z, 4u), 1u));
-        return _e12;
-    }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_5, b_5);
-    return _e15;
 }
 
 metal::float4 factor_at(
@@ -977,8 +977,8 @@ metal::float2 pst_terms(
     uint clamped_lod_e16 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
     metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_2)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     if (r_2.d <= _e16.x) {
-        float _e25 = edge_t(f_13, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
-        float _e29 = lit_span(f_13, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {

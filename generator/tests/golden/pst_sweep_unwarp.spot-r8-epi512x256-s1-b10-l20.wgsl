@@ -440,16 +440,33 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_X
     }
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_7.light_pos.xyz, f_7.light_dir.xyz, f_7.light_pos.w, f_7.light_dir.w, f_7.medium);
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n_1: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
+    if (x_2 >= n_1) {
+        return s_2;
+    }
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, f32(x_2), delta_1, theta_2, s_2, spot_2);
+    return _e9;
+}
+
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e15;
 }
 
-fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_4: f32, b_4: f32, depth_break: f32) -> bool {
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_4: f32, b_4: f32, spot_3: bool) -> f32 {
+    if spot_3 {
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, max((f_9.sizes2_.z / 4u), 1u));
+        return _e12;
+    }
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+    return _e15;
+}
+
+fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_5: f32, b_5: f32, depth_break: f32) -> bool {
     var local_6: bool;
 
-    if !((a_4 == b_4)) {
-        local_6 = (abs((a_4 - b_4)) <= (depth_break * min(a_4, b_4)));
+    if !((a_5 == b_5)) {
+        local_6 = (abs((a_5 - b_5)) <= (depth_break * min(a_5, b_5)));
     } else {
         local_6 = true;
     }
@@ -589,23 +606,6 @@ fn epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayou
     }
     let _e70 = t_4;
     return _e70;
-}
-
-fn edge_t(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n_1: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
-    if (x_2 >= n_1) {
-        return s_2;
-    }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, f32(x_2), delta_1, theta_2, s_2, spot_2);
-    return _e9;
-}
-
-fn lit_span(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_5: f32, b_5: f32, spot_3: bool) -> f32 {
-    if spot_3 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_5, b_5, max((f_9.sizes2_.z / 4u), 1u));
-        return _e12;
-    }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_5, b_5);
-    return _e15;
 }
 
 fn factor_at(base: u32, x_3: f32, h: u32) -> vec4<f32> {
@@ -749,8 +749,8 @@ fn pst_terms(r_2: PstRay, row_2: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     let sin_theta = max(sin(r_2.theta), 0.000001f);
     let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_2), 0i);
     if (r_2.d <= _e16.x) {
-        let _e25 = edge_t(f_13, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        let _e29 = lit_span(f_13, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if true {

@@ -7,8 +7,8 @@
 //! Conventions are documented in `scatter_frame::frame`.
 
 use super::common_model::{
-    PI, clamp, equiangular, equiangular_sample, max, min, phase_hg, spot_integrand, spot_span,
-    transmittance_between,
+    PI, clamp, equiangular, equiangular_sample, max, max_u, min, phase_hg, spot_integrand,
+    spot_span, transmittance_between,
 };
 use super::common_shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility};
 use super::texture::{Tex, xyz};
@@ -169,4 +169,29 @@ pub fn spot_segment(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, pan
         f.light_dir[3],
         f.medium,
     )
+}
+
+/// Ray distance of column edge `x` of a ray that crosses texels `0 .. n`: the last texel's
+/// span ends at the surface `s` (the texel walks of `minmax_traverse` and `pst_sweep`).
+pub fn edge_t(
+    f: &FrameUniforms,
+    x: u32,
+    n: u32,
+    delta: f32,
+    theta: f32,
+    s: f32,
+    spot: bool,
+) -> f32 {
+    if x >= n {
+        return s;
+    }
+    ray_t(f, x as f32, delta, theta, s, spot)
+}
+
+/// Unshadowed in-scattering over `[a, b]` of the ray, without `sigma_s p E` for the sun.
+pub fn lit_span(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, spot: bool) -> f32 {
+    if spot {
+        return spot_segment(f, eye, dir, a, b, max_u(f.sizes2[2] / 4, 1));
+    }
+    transmittance_between(f.medium[0], a, b)
 }

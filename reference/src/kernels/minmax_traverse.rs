@@ -9,11 +9,9 @@
 //! [`minmax_brute_main`], the brute-force march over every texel of the same rectified row
 //! (the reference the hierarchy must equal), shares everything but the walk.
 
-use super::common_epipolar::{
-    epipole_march, normalised_depth, pixel_dir, ray_t, row_index, spot_segment,
-};
+use super::common_epipolar::{epipole_march, normalised_depth, pixel_dir, row_index};
 use super::common_minmax::{level_offset, tree_levels};
-use super::common_model::{clamp, max, max_u, min, phase_hg, transmittance_between};
+use super::common_model::{clamp, max, min, phase_hg};
 use super::common_sampling::{EpipolarCamera, EpipolarSamples, epipolar_samples, run_sampled};
 use super::texture::{Tex, TexArray, quantise, xyz};
 use glam::Vec3;
@@ -34,30 +32,7 @@ pub struct TraverseInputs<'a> {
     pub tree: &'a TexArray,
 }
 
-/// Ray distance of column edge `x` of a ray that crosses texels `0 .. n`: the last texel's
-/// span ends at the surface `s`.
-pub fn edge_t(
-    f: &FrameUniforms,
-    x: u32,
-    n: u32,
-    delta: f32,
-    theta: f32,
-    s: f32,
-    spot: bool,
-) -> f32 {
-    if x >= n {
-        return s;
-    }
-    ray_t(f, x as f32, delta, theta, s, spot)
-}
-
-/// Unshadowed in-scattering over `[a, b]` of the ray, without `sigma_s p E` for the sun.
-pub fn lit_span(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, spot: bool) -> f32 {
-    if spot {
-        return spot_segment(f, eye, dir, a, b, max_u(f.sizes2[2] / 4, 1));
-    }
-    transmittance_between(f.medium[0], a, b)
-}
+pub use super::common_epipolar::{edge_t, lit_span};
 
 /// A pixel's ray in rectified space.
 #[derive(Clone, Copy, Debug, PartialEq)]

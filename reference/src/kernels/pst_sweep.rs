@@ -9,11 +9,9 @@
 //! every value is computed by the same expression in the same order.
 
 use super::common_epipolar::{
-    epipole_march, normalised_depth, ray_t, row_index, row_phi, slice_e, spot_segment,
+    edge_t, epipole_march, lit_span, normalised_depth, row_index, row_phi, slice_e,
 };
-use super::common_model::{
-    clamp, cone_falloff, max, max_u, min, phase_hg, select, transmittance_between,
-};
+use super::common_model::{clamp, cone_falloff, max, min, phase_hg, select, transmittance_between};
 use super::common_sampling::{
     EpipolarCamera, EpipolarSamples, depth_close, epipolar_layout, round_f16_rgb, slice_direction,
     slice_sample_pixel, slice_span,
@@ -202,13 +200,8 @@ pub fn pst_terms(
     let sin_theta = max(r.theta.sin(), 1e-6);
     let mut tail = 0.0;
     if r.d <= inp.rectified.load(n - 1, row) {
-        // (`edge_t` of column n - 1 < n: the ray distance of its edge.)
-        let a = ray_t(f, (n - 1) as f32, delta, r.theta, r.s, spot);
-        tail = if spot {
-            spot_segment(f, r.eye, r.dir, a, r.s, max_u(f.sizes2[2] / 4, 1))
-        } else {
-            transmittance_between(f.medium[0], a, r.s)
-        };
+        let a = edge_t(f, n - 1, n, delta, r.theta, r.s, spot);
+        tail = lit_span(f, r.eye, r.dir, a, r.s, spot);
     }
     if spot {
         return [f.medium[1] / (f.axis[3] * sin_theta), tail];

@@ -220,3 +220,20 @@ fn ray_t(f: Frame, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
 fn spot_segment(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, panels: u32) -> f32 {
     return spot_span(eye, dir, a, b, panels, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
 }
+
+// Ray distance of column edge `x` of a ray that crosses texels 0 .. n: the last texel's
+// span ends at the surface `s` (the texel walks of `minmax_traverse` and `pst_sweep`).
+fn edge_t(f: Frame, x: u32, n: u32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
+    if x >= n {
+        return s;
+    }
+    return ray_t(f, f32(x), delta, theta, s, spot);
+}
+
+// Unshadowed in-scattering over `[a, b]` of the ray, without `sigma_s p E` for the sun.
+fn lit_span(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, spot: bool) -> f32 {
+    if spot {
+        return spot_segment(f, eye, dir, a, b, max(f.sizes2_[2] / 4u, 1u));
+    }
+    return transmittance_between(f.medium[0], a, b);
+}
