@@ -40,7 +40,7 @@ const PREFILTERED_CASES: u32 = 6000;
 const RAYMARCH_CASES: u32 = 3000;
 /// Cases of `prepare_minmax`.
 const MINMAX_CASES: u32 = 3000;
-/// Cases of `prepare_partial_sum_tree` (each runs a 96 x 96 SVD).
+/// Cases of `prepare_partial_sum_tree` (each factorises a 96 x 96 kernel grid).
 const PST_CASES: u32 = 400;
 /// Cases of `prepare_frame` on fully arbitrary numbers (no valid starting point).
 const ARBITRARY_CASES: u32 = 2000;
