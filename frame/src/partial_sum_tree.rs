@@ -826,10 +826,13 @@ mod tests {
             .sum()
     }
 
+    /// A named kernel `K(v, theta)` for the SVD tests.
+    type NamedKernel = (&'static str, Box<dyn Fn(f64, f64) -> f64>);
+
     #[test]
     fn truncated_svd_matches_the_full_one_on_the_kernels() {
         let n = GRID;
-        let kernels: Vec<(&str, Box<dyn Fn(f64, f64) -> f64>)> = vec![
+        let kernels: Vec<NamedKernel> = vec![
             (
                 "sun thin",
                 Box::new(|v: f64, t: f64| (-0.02 * v / t.sin()).exp()),
