@@ -25,7 +25,7 @@
 // Mirrors reference/src/kernels/minmax_traverse.rs
 
 #import scatter::model::{phase_hg}
-#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, pixel_dir, row_index, slice_params}
+#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index, slice_params}
 #import scatter::minmax::{level_offset, tree_levels}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
@@ -61,29 +61,15 @@ fn minmax_traverse_pixel(x: u32, y: u32) -> vec3<f32> {
     }
 
     // Rectified coordinates of the surface point: the nearest row, its column x_s, depth d.
-    let axis = f.axis.xyz;
     let rows = f.sizes[3];
     let width = f.sizes[2];
     let wrap = f.anti_epipole[3] > 0.5;
-    // atan2 rather than scatter's acos: accurate near the axis, where acos loses digits.
-    let theta = atan2(length(cross(dir, axis)), dot(dir, axis));
-    let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
-    var yc = (phi - f.e1_[3]) / f.e2_[3];
-    if wrap {
-        yc -= floor(yc / f32(rows)) * f32(rows);
-    } else {
-        yc = clamp(yc, 0.0, f32(rows));
-    }
+    let theta = ray_theta(f, dir);
+    let yc = ray_row_coord(f, dir);
     let row = row_index(floor(yc), rows, wrap);
     let delta = slice_params(slices[row]).delta;
     let d = normalised_depth(theta, f.theta[0], f.theta[1]);
-    var xs: f32;
-    if spot {
-        let q = normalize(eye + dir * s - f.light_pos.xyz);
-        xs = acos(clamp(dot(q, -axis), -1.0, 1.0)) / delta;
-    } else {
-        xs = s * sin(theta) / delta;
-    }
+    let xs = ray_column(f, eye, dir, s, theta, spot) / delta;
     // Texels the ray crosses (NaN or negative x_s: none).
     let n = u32(min(ceil(select(0.0, xs, xs > 0.0)), f32(width)));
 

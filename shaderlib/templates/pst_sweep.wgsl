@@ -38,7 +38,7 @@
 // Mirrors reference/src/kernels/pst_sweep.rs
 
 #import scatter::model::{cone_falloff, phase_hg, transmittance_between}
-#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, row_index, row_phi, slice_e, slice_params}
+#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta, row_index, row_phi, slice_e, slice_params}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
 {%- endif %}
@@ -142,26 +142,10 @@ fn pst_ray(pc: vec2<f32>, z: f32) -> PstRay {
         r.color = epipole_march(frame, shadow_map, eye, dir, s, spot) * f.light_color.xyz;
     }
 
-    let axis = f.axis.xyz;
-    let rows = f.sizes[3];
-    let wrap = f.anti_epipole[3] > 0.5;
-    // atan2 rather than scatter's acos: accurate near the axis, where acos loses digits.
-    r.theta = atan2(length(cross(dir, axis)), dot(dir, axis));
-    let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
-    var yc = (phi - f.e1_[3]) / f.e2_[3];
-    if wrap {
-        yc -= floor(yc / f32(rows)) * f32(rows);
-    } else {
-        yc = clamp(yc, 0.0, f32(rows));
-    }
-    r.row = row_index(floor(yc), rows, wrap);
+    r.theta = ray_theta(f, dir);
+    r.row = row_index(floor(ray_row_coord(f, dir)), f.sizes[3], f.anti_epipole[3] > 0.5);
     r.d = normalised_depth(r.theta, f.theta[0], f.theta[1]);
-    if spot {
-        let q = normalize(eye + dir * s - f.light_pos.xyz);
-        r.xs_num = acos(clamp(dot(q, -axis), -1.0, 1.0));
-    } else {
-        r.xs_num = s * sin(r.theta);
-    }
+    r.xs_num = ray_column(f, eye, dir, s, r.theta, spot);
     return r;
 }
 

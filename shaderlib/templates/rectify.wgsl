@@ -23,7 +23,7 @@
 // Mirrors reference/src/kernels/rectify.rs
 
 #import scatter::model::PI
-#import scatter::epipolar::{Frame, SliceParams, occluder_depth, row_phi, slice_e, slice_params, sm_occluder_distance}
+#import scatter::epipolar::{Frame, SliceParams, light_point_theta, occluder_depth, row_phi, slice_e, slice_params, sm_occluder_distance}
 #import scatter::shadow::NO_OCCLUDER
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -47,15 +47,14 @@ fn rectify_texel(x: u32, slice: SliceParams, e: vec3<f32>, spot: bool) -> f32 {
         let l = -axis * cos(col) + e * sin(col);
         let s = sm_occluder_distance(frame, shadow_map, frame.light_pos.xyz, l);
         if s < NO_OCCLUDER {
-            let dist = frame.axis[3];
-            theta_occ = atan2(s * sin(col), dist - s * cos(col));
+            theta_occ = light_point_theta(frame, col, s, true);
         }
     } else {
         // The light ray at distance v = col from the axis, travelling along -axis.
         let o = frame.eye.xyz + e * col;
         let s = sm_occluder_distance(frame, shadow_map, o, -axis);
         if s < NO_OCCLUDER {
-            theta_occ = atan2(col, -s);
+            theta_occ = light_point_theta(frame, col, s, false);
         }
     }
     return occluder_depth(theta_occ, frame.theta[0], frame.theta[1]);

@@ -60,7 +60,7 @@
 // Mirrors reference/src/kernels/scatter.rs
 
 #import scatter::model::{ {%- if !moments %}PI, {% endif %}phase_hg, transmittance_between, transmittance_integral}
-#import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_t, row_index, slice_params, spot_segment}
+#import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_t, row_index, slice_params, spot_segment}
 {%- if moments %}
 #import scatter::prefiltered::region_start
 #import scatter::moments::{lit_moments{{ moment_count }}, moment_z}
@@ -149,20 +149,9 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     {
 {%- endif %}
         theta = acos(clamp(dot(dir, axis), -1.0, 1.0));
-        let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
-        yc = (phi - f.e1_[3]) / f.e2_[3];
-        if wrap {
-            yc -= floor(yc / f32(rows)) * f32(rows);
-        } else {
-            yc = clamp(yc, 0.0, f32(rows));
-        }
+        yc = ray_row_coord(f, dir);
         d = normalised_depth(theta, f.theta[0], f.theta[1]);
-        if spot {
-            let q = normalize(eye + dir * s - f.light_pos.xyz);
-            reach = acos(clamp(dot(q, -axis), -1.0, 1.0));
-        } else {
-            reach = s * sin(theta);
-        }
+        reach = ray_column(f, eye, dir, s, theta, spot);
     }
 
     // The two rectified rows the pixel lies between (the second only with a non-zero weight)

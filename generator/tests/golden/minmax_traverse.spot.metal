@@ -179,18 +179,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir_7 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_7.z <= 0.000001) {
+        metal::float3 dir_10 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_10.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_7);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return (z_2 + _e35) / dir_7.z;
+        return (z_2 + _e35) / dir_10.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -493,58 +493,102 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
-    float x_2,
-    float delta,
-    float theta_1,
+    metal::float3 dir_5
+) {
+    metal::float3 axis = f_5.axis.xyz;
+    return metal::atan2(metal::length(metal::cross(dir_5, axis)), metal::dot(dir_5, axis));
+}
+
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    metal::float3 dir_6
+) {
+    float yc = {};
+    uint rows_1 = f_6.sizes.w;
+    float phi = metal::atan2(metal::dot(dir_6, f_6.e2_.xyz), metal::dot(dir_6, f_6.e1_.xyz));
+    yc = (phi - f_6.e1_.w) / f_6.e2_.w;
+    if (f_6.anti_epipole.w > 0.5) {
+        float _e22 = yc;
+        float _e23 = yc;
+        yc = _e22 - (metal::floor(_e23 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+    } else {
+        float _e30 = yc;
+        yc = metal::clamp(_e30, 0.0, static_cast<float>(rows_1));
+    }
+    float _e34 = yc;
+    return _e34;
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    metal::float3 eye_5,
+    metal::float3 dir_7,
     float s_1,
+    float theta_1,
     bool spot_1
 ) {
-    bool local_5 = {};
     if (spot_1) {
+        metal::float3 q_2 = (eye_5 + (dir_7 * s_1)) - f_7.light_pos.xyz;
+        metal::float3 to_eye = -(f_7.axis.xyz);
+        return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
+    }
+    return s_1 * metal::sin(theta_1);
+}
+
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    float x_2,
+    float delta,
+    float theta_2,
+    float s_2,
+    bool spot_2
+) {
+    bool local_5 = {};
+    if (spot_2) {
         float psi = x_2 * delta;
-        float den = metal::sin(theta_1 + psi);
+        float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
-            local_5 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_5 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
             local_5 = true;
         }
         bool _e16 = local_5;
         if (_e16) {
-            return s_1;
+            return s_2;
         }
-        return metal::min((f_5.axis.w * metal::sin(psi)) / den, s_1);
+        return metal::min((f_8.axis.w * metal::sin(psi)) / den, s_2);
     } else {
-        return metal::min((x_2 * delta) / metal::max(metal::sin(theta_1), 0.000001), s_1);
+        return metal::min((x_2 * delta) / metal::max(metal::sin(theta_2), 0.000001), s_2);
     }
 }
 
 float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     uint x_3,
     uint n_1,
     float delta_1,
-    float theta_2,
-    float s_2,
-    bool spot_2
+    float theta_3,
+    float s_3,
+    bool spot_3
 ) {
     if (x_3 >= n_1) {
-        return s_2;
+        return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, static_cast<float>(x_3), delta_1, theta_2, s_2, spot_2);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_3);
     return _e9;
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
-    metal::float3 eye_5,
-    metal::float3 dir_5,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    metal::float3 eye_6,
+    metal::float3 dir_8,
     float a_3,
     float b_3,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_7.light_pos.xyz, f_7.light_dir.xyz, f_7.light_pos.w, f_7.light_dir.w, f_7.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
     return _e15;
 }
 
@@ -553,18 +597,18 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
-    metal::float3 eye_6,
-    metal::float3 dir_6,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
+    metal::float3 eye_7,
+    metal::float3 dir_9,
     float a_4,
     float b_4,
-    bool spot_3
+    bool spot_4
 ) {
-    if (spot_3) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_6, dir_6, a_4, b_4, metal::max(naga_div(f_8.sizes2_.z, 4u), 1u));
+    if (spot_4) {
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, dir_9, a_4, b_4, metal::max(naga_div(f_11.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_4, b_4);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -643,8 +687,6 @@ metal::float3 minmax_traverse_pixel(
     bool local_6 = {};
     bool local_7 = {};
     bool local_8 = {};
-    float yc = {};
-    float xs = {};
     float total = 0.0;
     bool in_run = false;
     float run_a = 0.0;
@@ -655,23 +697,23 @@ metal::float3 minmax_traverse_pixel(
     bool lit = {};
     bool local_11 = {};
     float l_1 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
-    metal::float3 eye_7 = f_9.eye.xyz;
-    metal::float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_4, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
+    metal::float3 eye_8 = f_12.eye.xyz;
+    metal::float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_4, y_1);
     uint clamped_lod_e13 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e13 = depth.read(metal::min(metal::uint2(metal::uint2(x_4, y_1)), metal::uint2(depth.get_width(clamped_lod_e13), depth.get_height(clamped_lod_e13)) - 1), clamped_lod_e13);
-    float s_3 = metal::min(metal::max(_e13.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e9, f_9.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_9.light_color.xyz;
+    float s_4 = metal::min(metal::max(_e13.x, 0.0), f_12.theta.z) / metal::max(metal::dot(_e9, f_12.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_12.light_color.xyz;
     metal::float3 px = metal::float3(static_cast<float>(x_4) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
-    float radius = f_9.epipole.w;
-    if (f_9.epipole.z > 0.5) {
-        local_6 = metal::length(px - metal::float3(f_9.epipole.x, f_9.epipole.y, 0.0)) < radius;
+    float radius = f_12.epipole.w;
+    if (f_12.epipole.z > 0.5) {
+        local_6 = metal::length(px - metal::float3(f_12.epipole.x, f_12.epipole.y, 0.0)) < radius;
     } else {
         local_6 = false;
     }
     bool near_epi = local_6;
-    if (f_9.anti_epipole.z > 0.5) {
-        local_7 = metal::length(px - metal::float3(f_9.anti_epipole.x, f_9.anti_epipole.y, 0.0)) < radius;
+    if (f_12.anti_epipole.z > 0.5) {
+        local_7 = metal::length(px - metal::float3(f_12.anti_epipole.x, f_12.anti_epipole.y, 0.0)) < radius;
     } else {
         local_7 = false;
     }
@@ -684,47 +726,30 @@ metal::float3 minmax_traverse_pixel(
     bool _e76 = local_8;
     if (_e76) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = frame;
-        float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_7, _e9, s_3, true);
+        float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_8, _e9, s_4, true);
         metal::float3 l_2 = _e81 * color;
         return l_2;
     }
-    metal::float3 axis = f_9.axis.xyz;
-    uint rows_1 = f_9.sizes.w;
-    uint width_3 = f_9.sizes.z;
-    bool wrap_1 = f_9.anti_epipole.w > 0.5;
-    float theta_3 = metal::atan2(metal::length(metal::cross(_e9, axis)), metal::dot(_e9, axis));
-    float phi = metal::atan2(metal::dot(_e9, f_9.e2_.xyz), metal::dot(_e9, f_9.e1_.xyz));
-    yc = (phi - f_9.e1_.w) / f_9.e2_.w;
-    if (wrap_1) {
-        float _e111 = yc;
-        float _e112 = yc;
-        yc = _e111 - (metal::floor(_e112 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
-    } else {
-        float _e119 = yc;
-        yc = metal::clamp(_e119, 0.0, static_cast<float>(rows_1));
-    }
-    float _e123 = yc;
-    uint _e125 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e123), rows_1, wrap_1);
-    metal::float4 _e128 = slices[metal::min(unsigned(_e125), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e129 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e128);
-    float delta_2 = _e129.delta;
-    float _e135 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_3, f_9.theta.x, f_9.theta.y);
-    if (true) {
-        metal::float3 q_2 = metal::normalize((eye_7 + (_e9 * s_3)) - f_9.light_pos.xyz);
-        xs = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0)) / delta_2;
-    } else {
-        xs = (s_3 * metal::sin(theta_3)) / delta_2;
-    }
-    float _e153 = xs;
-    float _e154 = xs;
-    uint n_3 = naga_f2u32(metal::min(metal::ceil((_e154 > 0.0) ? _e153 : 0.0), static_cast<float>(width_3)));
-    uint _e163 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
+    uint rows_2 = f_12.sizes.w;
+    uint width_3 = f_12.sizes.z;
+    bool wrap_1 = f_12.anti_epipole.w > 0.5;
+    float _e91 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e9);
+    float _e92 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e9);
+    uint _e94 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e92), rows_2, wrap_1);
+    metal::float4 _e97 = slices[metal::min(unsigned(_e94), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e98 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e97);
+    float delta_2 = _e98.delta;
+    float _e104 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e91, f_12.theta.x, f_12.theta.y);
+    float _e105 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, s_4, _e91, true);
+    float xs = _e105 / delta_2;
+    uint n_3 = naga_f2u32(metal::min(metal::ceil((xs > 0.0) ? xs : 0.0), static_cast<float>(width_3)));
+    uint _e115 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     uint2 loop_bound_5 = uint2(4294967295u);
     while(true) {
         if (metal::all(loop_bound_5 == uint2(0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        uint _e165 = i;
-        if (_e165 < n_3) {
+        uint _e117 = i;
+        if (_e117 < n_3) {
         } else {
             break;
         }
@@ -734,30 +759,30 @@ metal::float3 minmax_traverse_pixel(
             while(true) {
                 if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                 loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                uint _e169 = k_4;
-                if ((_e169 + 1u) < _e163) {
-                    uint _e173 = i;
-                    uint _e175 = k_4;
-                    local_9 = (_e173 & ((2u << _e175) - 1u)) == 0u;
+                uint _e121 = k_4;
+                if ((_e121 + 1u) < _e115) {
+                    uint _e125 = i;
+                    uint _e127 = k_4;
+                    local_9 = (_e125 & ((2u << _e127) - 1u)) == 0u;
                 } else {
                     local_9 = false;
                 }
-                bool _e185 = local_9;
-                if (_e185) {
-                    uint _e186 = i;
-                    uint _e188 = k_4;
-                    local_10 = (_e186 + (2u << _e188)) <= n_3;
+                bool _e137 = local_9;
+                if (_e137) {
+                    uint _e138 = i;
+                    uint _e140 = k_4;
+                    local_10 = (_e138 + (2u << _e140)) <= n_3;
                 } else {
                     local_10 = false;
                 }
-                bool _e195 = local_10;
-                if (_e195) {
+                bool _e147 = local_10;
+                if (_e147) {
                 } else {
                     break;
                 }
                 {
-                    uint _e197 = k_4;
-                    k_4 = _e197 + 1u;
+                    uint _e149 = k_4;
+                    k_4 = _e149 + 1u;
                 }
             }
             lit = false;
@@ -765,67 +790,67 @@ metal::float3 minmax_traverse_pixel(
             while(true) {
                 if (metal::all(loop_bound_7 == uint2(0u))) { break; }
                 loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-                uint _e201 = k_4;
-                uint _e202 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e201, width_3);
-                uint _e203 = i;
-                uint _e204 = k_4;
-                uint clamped_lod_e210 = metal::min(uint(0), tree.get_num_mip_levels() - 1);
-                metal::float4 node = tree.read(metal::min(metal::uint2(metal::uint2(_e202 + (_e203 >> _e204), _e125)), metal::uint2(tree.get_width(clamped_lod_e210), tree.get_height(clamped_lod_e210)) - 1), clamped_lod_e210);
-                if (_e135 <= node.x) {
+                uint _e153 = k_4;
+                uint _e154 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e153, width_3);
+                uint _e155 = i;
+                uint _e156 = k_4;
+                uint clamped_lod_e162 = metal::min(uint(0), tree.get_num_mip_levels() - 1);
+                metal::float4 node = tree.read(metal::min(metal::uint2(metal::uint2(_e154 + (_e155 >> _e156), _e94)), metal::uint2(tree.get_width(clamped_lod_e162), tree.get_height(clamped_lod_e162)) - 1), clamped_lod_e162);
+                if (_e104 <= node.x) {
                     lit = true;
                     break;
                 }
-                if (!((_e135 > node.y))) {
-                    uint _e217 = k_4;
-                    local_11 = _e217 == 0u;
+                if (!((_e104 > node.y))) {
+                    uint _e169 = k_4;
+                    local_11 = _e169 == 0u;
                 } else {
                     local_11 = true;
                 }
-                bool _e223 = local_11;
-                if (_e223) {
+                bool _e175 = local_11;
+                if (_e175) {
                     break;
                 }
-                uint _e225 = k_4;
-                k_4 = _e225 - 1u;
+                uint _e177 = k_4;
+                k_4 = _e177 - 1u;
             }
-            bool _e228 = lit;
-            bool _e229 = in_run;
-            if (_e228 != _e229) {
-                uint _e231 = i;
-                float _e232 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, _e231, n_3, delta_2, theta_3, s_3, true);
-                bool _e233 = lit;
-                if (_e233) {
-                    run_a = _e232;
+            bool _e180 = lit;
+            bool _e181 = in_run;
+            if (_e180 != _e181) {
+                uint _e183 = i;
+                float _e184 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e183, n_3, delta_2, _e91, s_4, true);
+                bool _e185 = lit;
+                if (_e185) {
+                    run_a = _e184;
                 } else {
-                    float _e236 = total;
-                    float _e237 = run_a;
-                    float _e238 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_7, _e9, _e237, _e232, true);
-                    total = _e236 + _e238;
+                    float _e188 = total;
+                    float _e189 = run_a;
+                    float _e190 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, _e189, _e184, true);
+                    total = _e188 + _e190;
                 }
-                bool _e240 = lit;
-                in_run = _e240;
+                bool _e192 = lit;
+                in_run = _e192;
             }
-            uint _e241 = i;
-            uint _e243 = k_4;
-            i = _e241 + (1u << _e243);
+            uint _e193 = i;
+            uint _e195 = k_4;
+            i = _e193 + (1u << _e195);
         }
     }
-    bool _e246 = in_run;
-    if (_e246) {
-        float _e247 = total;
-        float _e248 = run_a;
-        float _e249 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_7, _e9, _e248, s_3, true);
-        total = _e247 + _e249;
+    bool _e198 = in_run;
+    if (_e198) {
+        float _e199 = total;
+        float _e200 = run_a;
+        float _e201 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, _e200, s_4, true);
+        total = _e199 + _e201;
     }
-    float _e251 = total;
-    l_1 = _e251;
+    float _e203 = total;
+    l_1 = _e203;
     if (!(true)) {
-        float _e262 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(metal::dot(f_9.light_dir.xyz, _e9)));
-        float _e264 = total;
-        l_1 = (f_9.medium.y * _e262) * _e264;
+        float _e214 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(metal::dot(f_12.light_dir.xyz, _e9)));
+        float _e216 = total;
+        l_1 = (f_12.medium.y * _e214) * _e216;
     }
-    float _e266 = l_1;
-    metal::float3 c = color * _e266;
+    float _e218 = l_1;
+    metal::float3 c = color * _e218;
     return c;
 }
 

@@ -158,18 +158,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_7 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_7.z <= 0.000001f) {
+        let dir_10 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_10.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_7);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_7.z);
+        return ((z_2 + _e35) / dir_10.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -374,46 +374,78 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
+fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_5: vec3<f32>) -> f32 {
+    let axis = f_5.axis.xyz;
+    return atan2(length(cross(dir_5, axis)), dot(dir_5, axis));
+}
+
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    var yc: f32;
+
+    let rows_1 = f_6.sizes.w;
+    let phi = atan2(dot(dir_6, f_6.e2_.xyz), dot(dir_6, f_6.e1_.xyz));
+    yc = ((phi - f_6.e1_.w) / f_6.e2_.w);
+    if (f_6.anti_epipole.w > 0.5f) {
+        let _e22 = yc;
+        let _e23 = yc;
+        yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
+    } else {
+        let _e30 = yc;
+        yc = clamp(_e30, 0f, f32(rows_1));
+    }
+    let _e34 = yc;
+    return _e34;
+}
+
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_7: vec3<f32>, s_1: f32, theta_1: f32, spot_1: bool) -> f32 {
+    if spot_1 {
+        let q_2 = ((eye_5 + (dir_7 * s_1)) - f_7.light_pos.xyz);
+        let to_eye = -(f_7.axis.xyz);
+        return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
+    }
+    return (s_1 * sin(theta_1));
+}
+
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
     var local_5: bool;
 
-    if spot_1 {
+    if spot_2 {
         let psi = (x_2 * delta);
-        let den = sin((theta_1 + psi));
+        let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
-            local_5 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_5 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
             local_5 = true;
         }
         let _e16 = local_5;
         if _e16 {
-            return s_1;
+            return s_2;
         }
-        return min(((f_5.axis.w * sin(psi)) / den), s_1);
+        return min(((f_8.axis.w * sin(psi)) / den), s_2);
     } else {
-        return min(((x_2 * delta) / max(sin(theta_1), 0.000001f)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_3: bool) -> f32 {
     if (x_3 >= n_1) {
-        return s_2;
+        return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, f32(x_3), delta_1, theta_2, s_2, spot_2);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, f32(x_3), delta_1, theta_3, s_3, spot_3);
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_7.light_pos.xyz, f_7.light_dir.xyz, f_7.light_pos.w, f_7.light_dir.w, f_7.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_4: f32, b_4: f32, spot_3: bool) -> f32 {
-    if spot_3 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8, eye_6, dir_6, a_4, b_4, max((f_8.sizes2_.z / 4u), 1u));
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, spot_4: bool) -> f32 {
+    if spot_4 {
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, dir_9, a_4, b_4, max((f_11.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_8.medium.x, a_4, b_4);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -469,8 +501,6 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     var local_6: bool;
     var local_7: bool;
     var local_8: bool;
-    var yc: f32;
-    var xs: f32;
     var total: f32 = 0f;
     var in_run: bool = false;
     var run_a: f32 = 0f;
@@ -482,22 +512,22 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     var local_11: bool;
     var l_1: f32;
 
-    let f_9 = frame;
-    let eye_7 = f_9.eye.xyz;
-    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_4, y_1);
+    let f_12 = frame;
+    let eye_8 = f_12.eye.xyz;
+    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_4, y_1);
     let _e13 = textureLoad(depth, vec2<u32>(x_4, y_1), 0i);
-    let s_3 = (min(max(_e13.x, 0f), f_9.theta.z) / max(dot(_e9, f_9.cam_forward.xyz), 0.000001f));
-    let color = f_9.light_color.xyz;
+    let s_4 = (min(max(_e13.x, 0f), f_12.theta.z) / max(dot(_e9, f_12.cam_forward.xyz), 0.000001f));
+    let color = f_12.light_color.xyz;
     let px = vec3<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f), 0f);
-    let radius = f_9.epipole.w;
-    if (f_9.epipole.z > 0.5f) {
-        local_6 = (length((px - vec3<f32>(f_9.epipole.x, f_9.epipole.y, 0f))) < radius);
+    let radius = f_12.epipole.w;
+    if (f_12.epipole.z > 0.5f) {
+        local_6 = (length((px - vec3<f32>(f_12.epipole.x, f_12.epipole.y, 0f))) < radius);
     } else {
         local_6 = false;
     }
     let near_epi = local_6;
-    if (f_9.anti_epipole.z > 0.5f) {
-        local_7 = (length((px - vec3<f32>(f_9.anti_epipole.x, f_9.anti_epipole.y, 0f))) < radius);
+    if (f_12.anti_epipole.z > 0.5f) {
+        local_7 = (length((px - vec3<f32>(f_12.anti_epipole.x, f_12.anti_epipole.y, 0f))) < radius);
     } else {
         local_7 = false;
     }
@@ -510,138 +540,121 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     let _e76 = local_8;
     if _e76 {
         let _e78 = frame;
-        let _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_7, _e9, s_3, true);
+        let _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_8, _e9, s_4, true);
         let l_2 = (_e81 * color);
         return l_2;
     }
-    let axis = f_9.axis.xyz;
-    let rows_1 = f_9.sizes.w;
-    let width_3 = f_9.sizes.z;
-    let wrap_1 = (f_9.anti_epipole.w > 0.5f);
-    let theta_3 = atan2(length(cross(_e9, axis)), dot(_e9, axis));
-    let phi = atan2(dot(_e9, f_9.e2_.xyz), dot(_e9, f_9.e1_.xyz));
-    yc = ((phi - f_9.e1_.w) / f_9.e2_.w);
-    if wrap_1 {
-        let _e111 = yc;
-        let _e112 = yc;
-        yc = (_e111 - (floor((_e112 / f32(rows_1))) * f32(rows_1)));
-    } else {
-        let _e119 = yc;
-        yc = clamp(_e119, 0f, f32(rows_1));
-    }
-    let _e123 = yc;
-    let _e125 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e123), rows_1, wrap_1);
-    let _e128 = slices[_e125];
-    let _e129 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e128);
-    let delta_2 = _e129.delta;
-    let _e135 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta_3, f_9.theta.x, f_9.theta.y);
-    if true {
-        let q_2 = normalize(((eye_7 + (_e9 * s_3)) - f_9.light_pos.xyz));
-        xs = (acos(clamp(dot(q_2, -(axis)), -1f, 1f)) / delta_2);
-    } else {
-        xs = ((s_3 * sin(theta_3)) / delta_2);
-    }
-    let _e153 = xs;
-    let _e154 = xs;
-    let n_3 = u32(min(ceil(select(0f, _e153, (_e154 > 0f))), f32(width_3)));
-    let _e163 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
+    let rows_2 = f_12.sizes.w;
+    let width_3 = f_12.sizes.z;
+    let wrap_1 = (f_12.anti_epipole.w > 0.5f);
+    let _e91 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e9);
+    let _e92 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e9);
+    let _e94 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e92), rows_2, wrap_1);
+    let _e97 = slices[_e94];
+    let _e98 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e97);
+    let delta_2 = _e98.delta;
+    let _e104 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e91, f_12.theta.x, f_12.theta.y);
+    let _e105 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, s_4, _e91, true);
+    let xs = (_e105 / delta_2);
+    let n_3 = u32(min(ceil(select(0f, xs, (xs > 0f))), f32(width_3)));
+    let _e115 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     loop {
-        let _e165 = i;
-        if (_e165 < n_3) {
+        let _e117 = i;
+        if (_e117 < n_3) {
         } else {
             break;
         }
         {
             k_4 = 0u;
             loop {
-                let _e169 = k_4;
-                if ((_e169 + 1u) < _e163) {
-                    let _e173 = i;
-                    let _e175 = k_4;
-                    local_9 = ((_e173 & ((2u << _e175) - 1u)) == 0u);
+                let _e121 = k_4;
+                if ((_e121 + 1u) < _e115) {
+                    let _e125 = i;
+                    let _e127 = k_4;
+                    local_9 = ((_e125 & ((2u << _e127) - 1u)) == 0u);
                 } else {
                     local_9 = false;
                 }
-                let _e185 = local_9;
-                if _e185 {
-                    let _e186 = i;
-                    let _e188 = k_4;
-                    local_10 = ((_e186 + (2u << _e188)) <= n_3);
+                let _e137 = local_9;
+                if _e137 {
+                    let _e138 = i;
+                    let _e140 = k_4;
+                    local_10 = ((_e138 + (2u << _e140)) <= n_3);
                 } else {
                     local_10 = false;
                 }
-                let _e195 = local_10;
-                if _e195 {
+                let _e147 = local_10;
+                if _e147 {
                 } else {
                     break;
                 }
                 {
-                    let _e197 = k_4;
-                    k_4 = (_e197 + 1u);
+                    let _e149 = k_4;
+                    k_4 = (_e149 + 1u);
                 }
             }
             lit = false;
             loop {
-                let _e201 = k_4;
-                let _e202 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e201, width_3);
-                let _e203 = i;
-                let _e204 = k_4;
-                let node = textureLoad(tree, vec2<u32>((_e202 + (_e203 >> _e204)), _e125), 0i);
-                if (_e135 <= node.x) {
+                let _e153 = k_4;
+                let _e154 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e153, width_3);
+                let _e155 = i;
+                let _e156 = k_4;
+                let node = textureLoad(tree, vec2<u32>((_e154 + (_e155 >> _e156)), _e94), 0i);
+                if (_e104 <= node.x) {
                     lit = true;
                     break;
                 }
-                if !((_e135 > node.y)) {
-                    let _e217 = k_4;
-                    local_11 = (_e217 == 0u);
+                if !((_e104 > node.y)) {
+                    let _e169 = k_4;
+                    local_11 = (_e169 == 0u);
                 } else {
                     local_11 = true;
                 }
-                let _e223 = local_11;
-                if _e223 {
+                let _e175 = local_11;
+                if _e175 {
                     break;
                 }
-                let _e225 = k_4;
-                k_4 = (_e225 - 1u);
+                let _e177 = k_4;
+                k_4 = (_e177 - 1u);
             }
-            let _e228 = lit;
-            let _e229 = in_run;
-            if (_e228 != _e229) {
-                let _e231 = i;
-                let _e232 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, _e231, n_3, delta_2, theta_3, s_3, true);
-                let _e233 = lit;
-                if _e233 {
-                    run_a = _e232;
+            let _e180 = lit;
+            let _e181 = in_run;
+            if (_e180 != _e181) {
+                let _e183 = i;
+                let _e184 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e183, n_3, delta_2, _e91, s_4, true);
+                let _e185 = lit;
+                if _e185 {
+                    run_a = _e184;
                 } else {
-                    let _e236 = total;
-                    let _e237 = run_a;
-                    let _e238 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_7, _e9, _e237, _e232, true);
-                    total = (_e236 + _e238);
+                    let _e188 = total;
+                    let _e189 = run_a;
+                    let _e190 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, _e189, _e184, true);
+                    total = (_e188 + _e190);
                 }
-                let _e240 = lit;
-                in_run = _e240;
+                let _e192 = lit;
+                in_run = _e192;
             }
-            let _e241 = i;
-            let _e243 = k_4;
-            i = (_e241 + (1u << _e243));
+            let _e193 = i;
+            let _e195 = k_4;
+            i = (_e193 + (1u << _e195));
         }
     }
-    let _e246 = in_run;
-    if _e246 {
-        let _e247 = total;
-        let _e248 = run_a;
-        let _e249 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_7, _e9, _e248, s_3, true);
-        total = (_e247 + _e249);
+    let _e198 = in_run;
+    if _e198 {
+        let _e199 = total;
+        let _e200 = run_a;
+        let _e201 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, _e200, s_4, true);
+        total = (_e199 + _e201);
     }
-    let _e251 = total;
-    l_1 = _e251;
+    let _e203 = total;
+    l_1 = _e203;
     if !(true) {
-        let _e262 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, -(dot(f_9.light_dir.xyz, _e9)));
-        let _e264 = total;
-        l_1 = ((f_9.medium.y * _e262) * _e264);
+        let _e214 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, _e9)));
+        let _e216 = total;
+        l_1 = ((f_12.medium.y * _e214) * _e216);
     }
-    let _e266 = l_1;
-    let c = (color * _e266);
+    let _e218 = l_1;
+    let c = (color * _e218);
     return c;
 }
 

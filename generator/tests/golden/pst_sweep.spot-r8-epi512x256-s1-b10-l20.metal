@@ -234,18 +234,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir_7 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_7.z <= 0.000001) {
+        metal::float3 dir_10 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_10.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_7);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_3 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return (z_3 + _e35) / dir_7.z;
+        return (z_3 + _e35) / dir_10.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -551,58 +551,102 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
-    float x_2,
-    float delta,
-    float theta_1,
+    metal::float3 dir_5
+) {
+    metal::float3 axis_1 = f_6.axis.xyz;
+    return metal::atan2(metal::length(metal::cross(dir_5, axis_1)), metal::dot(dir_5, axis_1));
+}
+
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    metal::float3 dir_6
+) {
+    float yc = {};
+    uint rows_1 = f_7.sizes.w;
+    float phi_1 = metal::atan2(metal::dot(dir_6, f_7.e2_.xyz), metal::dot(dir_6, f_7.e1_.xyz));
+    yc = (phi_1 - f_7.e1_.w) / f_7.e2_.w;
+    if (f_7.anti_epipole.w > 0.5) {
+        float _e22 = yc;
+        float _e23 = yc;
+        yc = _e22 - (metal::floor(_e23 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+    } else {
+        float _e30 = yc;
+        yc = metal::clamp(_e30, 0.0, static_cast<float>(rows_1));
+    }
+    float _e34 = yc;
+    return _e34;
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    metal::float3 eye_5,
+    metal::float3 dir_7,
     float s_1,
+    float theta_1,
     bool spot_1
 ) {
-    bool local_13 = {};
     if (spot_1) {
+        metal::float3 q_2 = (eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz;
+        metal::float3 to_eye = -(f_8.axis.xyz);
+        return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
+    }
+    return s_1 * metal::sin(theta_1);
+}
+
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    float x_2,
+    float delta,
+    float theta_2,
+    float s_2,
+    bool spot_2
+) {
+    bool local_13 = {};
+    if (spot_2) {
         float psi = x_2 * delta;
-        float den = metal::sin(theta_1 + psi);
+        float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
-            local_13 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_13 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
             local_13 = true;
         }
         bool _e16 = local_13;
         if (_e16) {
-            return s_1;
+            return s_2;
         }
-        return metal::min((f_6.axis.w * metal::sin(psi)) / den, s_1);
+        return metal::min((f_9.axis.w * metal::sin(psi)) / den, s_2);
     } else {
-        return metal::min((x_2 * delta) / metal::max(metal::sin(theta_1), 0.000001), s_1);
+        return metal::min((x_2 * delta) / metal::max(metal::sin(theta_2), 0.000001), s_2);
     }
 }
 
 float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     uint x_3,
     uint n_1,
     float delta_1,
-    float theta_2,
-    float s_2,
-    bool spot_2
+    float theta_3,
+    float s_3,
+    bool spot_3
 ) {
     if (x_3 >= n_1) {
-        return s_2;
+        return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, static_cast<float>(x_3), delta_1, theta_2, s_2, spot_2);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_3);
     return _e9;
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
-    metal::float3 eye_5,
-    metal::float3 dir_5,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
+    metal::float3 eye_6,
+    metal::float3 dir_8,
     float a_3,
     float b_3,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
@@ -611,18 +655,18 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
-    metal::float3 eye_6,
-    metal::float3 dir_6,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
+    metal::float3 eye_7,
+    metal::float3 dir_9,
     float a_4,
     float b_4,
-    bool spot_3
+    bool spot_4
 ) {
-    if (spot_3) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, metal::max(naga_div(f_9.sizes2_.z, 4u), 1u));
+    if (spot_4) {
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, metal::max(naga_div(f_12.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -674,15 +718,15 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     metal::float2 size_1 = static_cast<metal::float2>(screen);
     metal::float2 centre = 0.5 * size_1;
     float z_5 = metal::dot(cam.toward, cam.forward);
-    metal::float2 q_2 = metal::float2((metal::dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect), (-(metal::dot(cam.toward, cam.up)) * centre.y) / cam.tan_half);
+    metal::float2 q_3 = metal::float2((metal::dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect), (-(metal::dot(cam.toward, cam.up)) * centre.y) / cam.tan_half);
     float far_2 = EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * metal::max(size_1.x, size_1.y);
-    float lq = metal::length(q_2);
+    float lq = metal::length(q_3);
     origin = centre;
     if (lq >= (far_2 * metal::abs(z_5))) {
-        origin = centre + ((q_2 * (far_2 / metal::max(lq, 0.000000000000000000000000000001))) * ((z_5 < 0.0) ? -1.0 : 1.0));
+        origin = centre + ((q_3 * (far_2 / metal::max(lq, 0.000000000000000000000000000001))) * ((z_5 < 0.0) ? -1.0 : 1.0));
     } else {
         if (lq > 0.0) {
-            origin = centre + (q_2 / metal::float2(z_5));
+            origin = centre + (q_3 / metal::float2(z_5));
         }
     }
     metal::float2 _e56 = origin;
@@ -767,24 +811,24 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
 
 metal::float2 slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2,
-    uint s_3
+    uint s_4
 ) {
-    float phi_1 = l_2.phi_start + ((static_cast<float>(s_3) + 0.5) * l_2.dphi);
-    float c_2 = metal::cos(phi_1);
-    float sn = metal::sin(phi_1);
+    float phi_2 = l_2.phi_start + ((static_cast<float>(s_4) + 0.5) * l_2.dphi);
+    float c_2 = metal::cos(phi_2);
+    float sn = metal::sin(phi_2);
     return metal::float2((l_2.axis.x * c_2) - (l_2.axis.y * sn), (l_2.axis.y * c_2) + (l_2.axis.x * sn));
 }
 
 metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_3,
-    uint s_4,
+    uint s_5,
     metal::uint2 screen_1,
     uint samples
 ) {
     float t_in = 0.0;
     float t_out = 340000000000000000000000000000000000000.0;
     uint a_7 = 0u;
-    metal::float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_4);
+    metal::float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     metal::float2 lo_3 = metal::float2(0.5, 0.5);
     metal::float2 hi_3 = static_cast<metal::float2>(screen_1) - metal::float2(0.5, 0.5);
     uint2 loop_bound_4 = uint2(4294967295u);
@@ -872,18 +916,18 @@ metal::float4 gamma_at(
 }
 
 metal::float4 beta_at(
-    float theta_3,
+    float theta_4,
     uint h_6,
     device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 head = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)];
-    metal::float4 _e14 = factor_at(193u, (theta_3 - head.y) / metal::max(head.z - head.y, 0.000000000001), h_6, pst_factors, _buffer_sizes);
+    metal::float4 _e14 = factor_at(193u, (theta_4 - head.y) / metal::max(head.z - head.y, 0.000000000001), h_6, pst_factors, _buffer_sizes);
     return _e14;
 }
 
 metal::float4 pst_leaf(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
     uint i_2,
     uint row_1,
     float delta_2,
@@ -897,9 +941,9 @@ metal::float4 pst_leaf(
         metal::float4 _e9 = gamma_at(static_cast<float>(i_2) * delta_2, h_7, pst_factors, _buffer_sizes);
         return _e9;
     }
-    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, row_1);
-    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, _e12);
-    metal::float3 axis_1 = f_10.axis.xyz;
+    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, row_1);
+    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e12);
+    metal::float3 axis_2 = f_13.axis.xyz;
     uint2 loop_bound_5 = uint2(4294967295u);
     bool loop_init_5 = true;
     while(true) {
@@ -917,10 +961,10 @@ metal::float4 pst_leaf(
         }
         {
             uint _e20 = g_1;
-            float q_3 = (_e20 == 0u) ? -0.57735026 : GL2_;
-            float psi_1 = ((static_cast<float>(i_2) + 0.5) + (0.5 * q_3)) * delta_2;
-            metal::float3 l_5 = (-(axis_1) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_5, f_10.light_dir.xyz), f_10.light_pos.w, f_10.light_dir.w);
+            float q_4 = (_e20 == 0u) ? -0.57735026 : GL2_;
+            float psi_1 = ((static_cast<float>(i_2) + 0.5) + (0.5 * q_4)) * delta_2;
+            metal::float3 l_5 = (-(axis_2) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
+            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_5, f_13.light_dir.xyz), f_13.light_pos.w, f_13.light_dir.w);
             metal::float4 _e48 = leaf;
             metal::float4 _e52 = gamma_at(psi_1, h_7, pst_factors, _buffer_sizes);
             leaf = _e48 + (((0.5 * delta_2) * _e46) * _e52);
@@ -940,24 +984,23 @@ PstRay pst_ray(
     bool local_18 = {};
     bool local_19 = {};
     bool local_20 = {};
-    float yc = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11 = frame;
-    metal::float3 eye_7 = f_11.eye.xyz;
-    metal::float2 ndc = metal::float2(((2.0 * pc.x) / static_cast<float>(f_11.sizes.x)) - 1.0, 1.0 - ((2.0 * pc.y) / static_cast<float>(f_11.sizes.y)));
-    float t_5 = f_11.cam_forward.w;
-    metal::float3 dir_8 = metal::normalize((f_11.cam_forward.xyz + (f_11.cam_right.xyz * ((ndc.x * t_5) * f_11.cam_right.w))) + (f_11.cam_up.xyz * (ndc.y * t_5)));
-    float s_5 = metal::min(metal::max(z_1, 0.0), f_11.theta.z) / metal::max(metal::dot(dir_8, f_11.cam_forward.xyz), 0.000001);
-    r_1 = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_7, dir_8, s_5, 0u, 0.0, 0.0, 0.0};
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = frame;
+    metal::float3 eye_8 = f_14.eye.xyz;
+    metal::float2 ndc = metal::float2(((2.0 * pc.x) / static_cast<float>(f_14.sizes.x)) - 1.0, 1.0 - ((2.0 * pc.y) / static_cast<float>(f_14.sizes.y)));
+    float t_5 = f_14.cam_forward.w;
+    metal::float3 dir_11 = metal::normalize((f_14.cam_forward.xyz + (f_14.cam_right.xyz * ((ndc.x * t_5) * f_14.cam_right.w))) + (f_14.cam_up.xyz * (ndc.y * t_5)));
+    float s_6 = metal::min(metal::max(z_1, 0.0), f_14.theta.z) / metal::max(metal::dot(dir_11, f_14.cam_forward.xyz), 0.000001);
+    r_1 = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_8, dir_11, s_6, 0u, 0.0, 0.0, 0.0};
     metal::float3 px = metal::float3(pc, 0.0);
-    float radius = f_11.epipole.w;
-    if (f_11.epipole.z > 0.5) {
-        local_18 = metal::length(px - metal::float3(f_11.epipole.x, f_11.epipole.y, 0.0)) < radius;
+    float radius = f_14.epipole.w;
+    if (f_14.epipole.z > 0.5) {
+        local_18 = metal::length(px - metal::float3(f_14.epipole.x, f_14.epipole.y, 0.0)) < radius;
     } else {
         local_18 = false;
     }
     bool near_epi = local_18;
-    if (f_11.anti_epipole.z > 0.5) {
-        local_19 = metal::length(px - metal::float3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0)) < radius;
+    if (f_14.anti_epipole.z > 0.5) {
+        local_19 = metal::length(px - metal::float3(f_14.anti_epipole.x, f_14.anti_epipole.y, 0.0)) < radius;
     } else {
         local_19 = false;
     }
@@ -971,38 +1014,22 @@ PstRay pst_ray(
     if (_e109) {
         r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
-        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_7, dir_8, s_5, true);
-        r_1.color = _e117 * f_11.light_color.xyz;
+        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_8, dir_11, s_6, true);
+        r_1.color = _e117 * f_14.light_color.xyz;
     }
-    metal::float3 axis_2 = f_11.axis.xyz;
-    uint rows_1 = f_11.sizes.w;
-    bool wrap_1 = f_11.anti_epipole.w > 0.5;
-    r_1.theta = metal::atan2(metal::length(metal::cross(dir_8, axis_2)), metal::dot(dir_8, axis_2));
-    float phi_2 = metal::atan2(metal::dot(dir_8, f_11.e2_.xyz), metal::dot(dir_8, f_11.e1_.xyz));
-    yc = (phi_2 - f_11.e1_.w) / f_11.e2_.w;
-    if (wrap_1) {
-        float _e148 = yc;
-        float _e149 = yc;
-        yc = _e148 - (metal::floor(_e149 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
-    } else {
-        float _e156 = yc;
-        yc = metal::clamp(_e156, 0.0, static_cast<float>(rows_1));
-    }
-    float _e161 = yc;
-    uint _e163 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e161), rows_1, wrap_1);
-    r_1.row = _e163;
-    float _e166 = r_1.theta;
-    float _e171 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e166, f_11.theta.x, f_11.theta.y);
-    r_1.d = _e171;
-    if (true) {
-        metal::float3 q_4 = metal::normalize((eye_7 + (dir_8 * s_5)) - f_11.light_pos.xyz);
-        r_1.xs_num = metal::acos(metal::clamp(metal::dot(q_4, -(axis_2)), -1.0, 1.0));
-    } else {
-        float _e187 = r_1.theta;
-        r_1.xs_num = s_5 * metal::sin(_e187);
-    }
-    PstRay _e190 = r_1;
-    return _e190;
+    float _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
+    r_1.theta = _e122;
+    float _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
+    uint _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e124), f_14.sizes.w, f_14.anti_epipole.w > 0.5);
+    r_1.row = _e132;
+    float _e135 = r_1.theta;
+    float _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_14.theta.x, f_14.theta.y);
+    r_1.d = _e140;
+    float _e143 = r_1.theta;
+    float _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_11, s_6, _e143, true);
+    r_1.xs_num = _e144;
+    PstRay _e145 = r_1;
+    return _e145;
 }
 
 uint pst_columns_crossed(
@@ -1024,22 +1051,22 @@ metal::float2 pst_terms(
     metal::texture2d<float, metal::access::sample> rectified
 ) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
     float sin_theta = metal::max(metal::sin(r_3.theta), 0.000001);
     uint clamped_lod_e16 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
     metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_2)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     if (r_3.d <= _e16.x) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, n_2 - 1u, n_2, delta_4, r_3.theta, r_3.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, n_2 - 1u, n_2, delta_4, r_3.theta, r_3.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return metal::float2(f_12.medium.y / (f_12.axis.w * sin_theta), _e37);
+        return metal::float2(f_15.medium.y / (f_15.axis.w * sin_theta), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(metal::dot(f_12.light_dir.xyz, r_3.dir)));
-    float sp = f_12.medium.y * _e48;
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, 0.0, delta_4 / sin_theta);
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(metal::dot(f_15.light_dir.xyz, r_3.dir)));
+    float sp = f_15.medium.y * _e48;
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, 0.0, delta_4 / sin_theta);
     float _e56 = tail;
     return metal::float2(sp * _e54, sp * _e56);
 }
@@ -1059,7 +1086,7 @@ metal::float3 pst_sweep_pixel(
     uint h_8 = 0u;
     metal::float4 p_5 = {};
     uint i_3 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
     uint clamped_lod_e16 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_5) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
@@ -1114,7 +1141,7 @@ metal::float3 pst_sweep_pixel(
                         metal::float4 _e59 = p_5;
                         uint _e60 = i_3;
                         uint _e62 = h_8;
-                        metal::float4 _e63 = pst_leaf(f_13, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
+                        metal::float4 _e63 = pst_leaf(f_16, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
                         p_5 = _e59 + _e63;
                     }
                 }
@@ -1128,7 +1155,7 @@ metal::float3 pst_sweep_pixel(
     }
     metal::float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27, frame, rectified);
     float _e84 = sum_2;
-    return f_13.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
+    return f_16.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
 }
 
 float pst_footprint_depth(
@@ -1254,9 +1281,9 @@ kernel void pst_sweep(
     uint h_3 = {};
     metal::float4 p_1 = {};
     uint j_8 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = frame;
-    metal::uint2 screen_4 = metal::uint2(f_14.sizes.x, f_14.sizes.y);
-    uint width = f_14.sizes.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
+    metal::uint2 screen_4 = metal::uint2(f_17.sizes.x, f_17.sizes.y);
+    uint width = f_17.sizes.z;
     metal::float4 _e13 = frame.cam_forward;
     metal::float4 _e17 = frame.cam_right;
     metal::float4 _e21 = frame.cam_up;
@@ -1264,12 +1291,12 @@ kernel void pst_sweep(
     float _e30 = frame.cam_right.w;
     metal::float4 _e33 = frame.axis;
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e37 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {_e13.xyz, _e17.xyz, _e21.xyz, _e26, _e30, {}, _e33.xyz}, screen_4, SLICES);
-    uint s_6 = wid.x;
-    metal::float2 _e40 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_6);
-    metal::float2 _e42 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_6, screen_4, SLICE_SAMPLES);
+    uint s_7 = wid.x;
+    metal::float2 _e40 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_7);
+    metal::float2 _e42 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_7, screen_4, SLICE_SAMPLES);
     if (li == 0u) {
-        output.write(metal::float4(_e40.x, _e40.y, _e42.x, _e42.y), metal::uint2(metal::uint2(SLICE_SAMPLES, s_6)));
-        if (s_6 == 0u) {
+        output.write(metal::float4(_e40.x, _e40.y, _e42.x, _e42.y), metal::uint2(metal::uint2(SLICE_SAMPLES, s_7)));
+        if (s_7 == 0u) {
             metal::atomic_store_explicit(&fallback_count, 0u, metal::memory_order_relaxed);
             output.write(metal::float4(_e37.origin, _e37.axis), metal::uint2(metal::uint2(0u, 512u)));
             output.write(metal::float4(_e37.phi_start, _e37.dphi, static_cast<float>(_e37.wrap), 0.0), metal::uint2(metal::uint2(1u, 512u)));
@@ -1329,7 +1356,7 @@ kernel void pst_sweep(
                 metal::float3 _e151 = r.color;
                 metal::float3 _e152 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e151);
                 uint _e153 = k;
-                output.write(metal::float4(_e152.x, _e152.y, _e152.z, z_6), metal::uint2(metal::uint2(_e153, s_6)));
+                output.write(metal::float4(_e152.x, _e152.y, _e152.z, z_6), metal::uint2(metal::uint2(_e153, s_7)));
             } else {
                 PstRay _e160 = r;
                 metal::float2 _e161 = pst_terms(_e160, row_3, delta_6, _e136, frame, rectified);
@@ -1676,7 +1703,7 @@ kernel void pst_sweep(
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    uint base_1 = s_6 * width;
+    uint base_1 = s_7 * width;
     i = li;
     uint2 loop_bound_20 = uint2(4294967295u);
     bool loop_init_16 = true;
@@ -1748,7 +1775,7 @@ kernel void pst_sweep(
                         uint _e557 = h;
                         uint _e560 = i;
                         uint _e561 = h;
-                        metal::float4 _e562 = pst_leaf(f_14, _e560, row_3, delta_6, _e561, pst_factors, _buffer_sizes);
+                        metal::float4 _e562 = pst_leaf(f_17, _e560, row_3, delta_6, _e561, pst_factors, _buffer_sizes);
                         pst_leaves[metal::min(unsigned(((base_1 + _e552) * RANK_VECS) + _e557), (_buffer_sizes.size6 - 0 - 16) / 16)] = _e562;
                     }
                 }
@@ -1757,7 +1784,7 @@ kernel void pst_sweep(
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_device);
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    uint trees = ((s_6 * 9u) * SLICE_SAMPLES) * RANK_VECS;
+    uint trees = ((s_7 * 9u) * SLICE_SAMPLES) * RANK_VECS;
     uint partials = trees + 4096u;
     if (li < TREES) {
         uint tree = trees + ((li * SLICE_SAMPLES) * RANK_VECS);
@@ -2097,14 +2124,14 @@ kernel void pst_sweep(
                 float _e900 = dotp;
                 uint _e905 = k_4;
                 float _e907 = q_b.inner[metal::min(unsigned(_e905), 255u)];
-                metal::float3 _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(f_14.light_color.xyz * (metal::max(_e899 * _e900, 0.0) + _e907));
+                metal::float3 _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(f_17.light_color.xyz * (metal::max(_e899 * _e900, 0.0) + _e907));
                 uint _e911 = k_4;
                 metal::uint2 _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
                 uint clamped_lod_e915 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
                 metal::float4 _e915 = depth.read(metal::min(metal::uint2(_e912), metal::uint2(depth.get_width(clamped_lod_e915), depth.get_height(clamped_lod_e915)) - 1), clamped_lod_e915);
                 float z_7 = _e915.x;
                 uint _e917 = k_4;
-                output.write(metal::float4(_e910.x, _e910.y, _e910.z, z_7), metal::uint2(metal::uint2(_e917, s_6)));
+                output.write(metal::float4(_e910.x, _e910.y, _e910.z, z_7), metal::uint2(metal::uint2(_e917, s_7)));
             }
         }
     }

@@ -218,18 +218,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_7 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_7.z <= 0.000001f) {
+        let dir_10 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_10.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_7);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_3 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_7.z);
+        return ((z_3 + _e35) / dir_10.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -435,46 +435,78 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_9: f32, rows: u32, w
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
+fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_5: vec3<f32>) -> f32 {
+    let axis_1 = f_6.axis.xyz;
+    return atan2(length(cross(dir_5, axis_1)), dot(dir_5, axis_1));
+}
+
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    var yc: f32;
+
+    let rows_1 = f_7.sizes.w;
+    let phi_1 = atan2(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
+    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
+    if (f_7.anti_epipole.w > 0.5f) {
+        let _e22 = yc;
+        let _e23 = yc;
+        yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
+    } else {
+        let _e30 = yc;
+        yc = clamp(_e30, 0f, f32(rows_1));
+    }
+    let _e34 = yc;
+    return _e34;
+}
+
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_7: vec3<f32>, s_1: f32, theta_1: f32, spot_1: bool) -> f32 {
+    if spot_1 {
+        let q_2 = ((eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz);
+        let to_eye = -(f_8.axis.xyz);
+        return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
+    }
+    return (s_1 * sin(theta_1));
+}
+
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
     var local_13: bool;
 
-    if spot_1 {
+    if spot_2 {
         let psi = (x_2 * delta);
-        let den = sin((theta_1 + psi));
+        let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
-            local_13 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_13 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
             local_13 = true;
         }
         let _e16 = local_13;
         if _e16 {
-            return s_1;
+            return s_2;
         }
-        return min(((f_6.axis.w * sin(psi)) / den), s_1);
+        return min(((f_9.axis.w * sin(psi)) / den), s_2);
     } else {
-        return min(((x_2 * delta) / max(sin(theta_1), 0.000001f)), s_1);
+        return min(((x_2 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_3: bool) -> f32 {
     if (x_3 >= n_1) {
-        return s_2;
+        return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, f32(x_3), delta_1, theta_2, s_2, spot_2);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, f32(x_3), delta_1, theta_3, s_3, spot_3);
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_6: vec3<f32>, a_4: f32, b_4: f32, spot_3: bool) -> f32 {
-    if spot_3 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, max((f_9.sizes2_.z / 4u), 1u));
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, spot_4: bool) -> f32 {
+    if spot_4 {
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, max((f_12.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -515,15 +547,15 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     let size_1 = vec2<f32>(screen);
     let centre = (0.5f * size_1);
     let z_5 = dot(cam.toward, cam.forward);
-    let q_2 = vec2<f32>(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
+    let q_3 = vec2<f32>(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
     let far_2 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
-    let lq = length(q_2);
+    let lq = length(q_3);
     origin = centre;
     if (lq >= (far_2 * abs(z_5))) {
-        origin = (centre + ((q_2 * (far_2 / max(lq, 0.000000000000000000000000000001f))) * select(1f, -1f, (z_5 < 0f))));
+        origin = (centre + ((q_3 * (far_2 / max(lq, 0.000000000000000000000000000001f))) * select(1f, -1f, (z_5 < 0f))));
     } else {
         if (lq > 0f) {
-            origin = (centre + (q_2 / vec2(z_5)));
+            origin = (centre + (q_3 / vec2(z_5)));
         }
     }
     let _e56 = origin;
@@ -601,19 +633,19 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     return _e163;
 }
 
-fn slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_3: u32) -> vec2<f32> {
-    let phi_1 = (l_2.phi_start + ((f32(s_3) + 0.5f) * l_2.dphi));
-    let c_2 = cos(phi_1);
-    let sn = sin(phi_1);
+fn slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_4: u32) -> vec2<f32> {
+    let phi_2 = (l_2.phi_start + ((f32(s_4) + 0.5f) * l_2.dphi));
+    let c_2 = cos(phi_2);
+    let sn = sin(phi_2);
     return vec2<f32>(((l_2.axis.x * c_2) - (l_2.axis.y * sn)), ((l_2.axis.y * c_2) + (l_2.axis.x * sn)));
 }
 
-fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_4: u32, screen_1: vec2<u32>, samples: u32) -> vec2<f32> {
+fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_5: u32, screen_1: vec2<u32>, samples: u32) -> vec2<f32> {
     var t_in: f32 = 0f;
     var t_out: f32 = 340000000000000000000000000000000000000f;
     var a_7: u32 = 0u;
 
-    let _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_4);
+    let _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     let lo_3 = vec2<f32>(0.5f, 0.5f);
     let hi_3 = (vec2<f32>(screen_1) - vec2<f32>(0.5f, 0.5f));
     loop {
@@ -674,13 +706,13 @@ fn gamma_at(v_8: f32, h_5: u32) -> vec4<f32> {
     return _e8;
 }
 
-fn beta_at(theta_3: f32, h_6: u32) -> vec4<f32> {
+fn beta_at(theta_4: f32, h_6: u32) -> vec4<f32> {
     let head = pst_factors[0];
-    let _e14 = factor_at(193u, ((theta_3 - head.y) / max((head.z - head.y), 0.000000000001f)), h_6);
+    let _e14 = factor_at(193u, ((theta_4 - head.y) / max((head.z - head.y), 0.000000000001f)), h_6);
     return _e14;
 }
 
-fn pst_leaf(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, row_1: u32, delta_2: f32, h_7: u32) -> vec4<f32> {
+fn pst_leaf(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, row_1: u32, delta_2: f32, h_7: u32) -> vec4<f32> {
     var leaf: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var g_1: u32 = 0u;
 
@@ -688,9 +720,9 @@ fn pst_leaf(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
         let _e9 = gamma_at((f32(i_2) * delta_2), h_7);
         return _e9;
     }
-    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, row_1);
-    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, _e12);
-    let axis_1 = f_10.axis.xyz;
+    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, row_1);
+    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e12);
+    let axis_2 = f_13.axis.xyz;
     loop {
         let _e17 = g_1;
         if (_e17 < 2u) {
@@ -699,10 +731,10 @@ fn pst_leaf(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
         }
         {
             let _e20 = g_1;
-            let q_3 = select(GL2_, -0.57735026f, (_e20 == 0u));
-            let psi_1 = (((f32(i_2) + 0.5f) + (0.5f * q_3)) * delta_2);
-            let l_5 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_10.light_dir.xyz), f_10.light_pos.w, f_10.light_dir.w);
+            let q_4 = select(GL2_, -0.57735026f, (_e20 == 0u));
+            let psi_1 = (((f32(i_2) + 0.5f) + (0.5f * q_4)) * delta_2);
+            let l_5 = ((-(axis_2) * cos(psi_1)) + (_e13 * sin(psi_1)));
+            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_13.light_dir.xyz), f_13.light_pos.w, f_13.light_dir.w);
             let _e48 = leaf;
             let _e52 = gamma_at(psi_1, h_7);
             leaf = (_e48 + (((0.5f * delta_2) * _e46) * _e52));
@@ -721,25 +753,24 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     var local_18: bool;
     var local_19: bool;
     var local_20: bool;
-    var yc: f32;
 
-    let f_11 = frame;
-    let eye_7 = f_11.eye.xyz;
-    let ndc = vec2<f32>((((2f * pc.x) / f32(f_11.sizes.x)) - 1f), (1f - ((2f * pc.y) / f32(f_11.sizes.y))));
-    let t_5 = f_11.cam_forward.w;
-    let dir_8 = normalize(((f_11.cam_forward.xyz + (f_11.cam_right.xyz * ((ndc.x * t_5) * f_11.cam_right.w))) + (f_11.cam_up.xyz * (ndc.y * t_5))));
-    let s_5 = (min(max(z_1, 0f), f_11.theta.z) / max(dot(dir_8, f_11.cam_forward.xyz), 0.000001f));
-    r_1 = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_7, dir_8, s_5, 0u, 0f, 0f, 0f);
+    let f_14 = frame;
+    let eye_8 = f_14.eye.xyz;
+    let ndc = vec2<f32>((((2f * pc.x) / f32(f_14.sizes.x)) - 1f), (1f - ((2f * pc.y) / f32(f_14.sizes.y))));
+    let t_5 = f_14.cam_forward.w;
+    let dir_11 = normalize(((f_14.cam_forward.xyz + (f_14.cam_right.xyz * ((ndc.x * t_5) * f_14.cam_right.w))) + (f_14.cam_up.xyz * (ndc.y * t_5))));
+    let s_6 = (min(max(z_1, 0f), f_14.theta.z) / max(dot(dir_11, f_14.cam_forward.xyz), 0.000001f));
+    r_1 = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_8, dir_11, s_6, 0u, 0f, 0f, 0f);
     let px = vec3<f32>(pc, 0f);
-    let radius = f_11.epipole.w;
-    if (f_11.epipole.z > 0.5f) {
-        local_18 = (length((px - vec3<f32>(f_11.epipole.x, f_11.epipole.y, 0f))) < radius);
+    let radius = f_14.epipole.w;
+    if (f_14.epipole.z > 0.5f) {
+        local_18 = (length((px - vec3<f32>(f_14.epipole.x, f_14.epipole.y, 0f))) < radius);
     } else {
         local_18 = false;
     }
     let near_epi = local_18;
-    if (f_11.anti_epipole.z > 0.5f) {
-        local_19 = (length((px - vec3<f32>(f_11.anti_epipole.x, f_11.anti_epipole.y, 0f))) < radius);
+    if (f_14.anti_epipole.z > 0.5f) {
+        local_19 = (length((px - vec3<f32>(f_14.anti_epipole.x, f_14.anti_epipole.y, 0f))) < radius);
     } else {
         local_19 = false;
     }
@@ -753,38 +784,22 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     if _e109 {
         r_1.marched = true;
         let _e114 = frame;
-        let _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_7, dir_8, s_5, true);
-        r_1.color = (_e117 * f_11.light_color.xyz);
+        let _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_8, dir_11, s_6, true);
+        r_1.color = (_e117 * f_14.light_color.xyz);
     }
-    let axis_2 = f_11.axis.xyz;
-    let rows_1 = f_11.sizes.w;
-    let wrap_1 = (f_11.anti_epipole.w > 0.5f);
-    r_1.theta = atan2(length(cross(dir_8, axis_2)), dot(dir_8, axis_2));
-    let phi_2 = atan2(dot(dir_8, f_11.e2_.xyz), dot(dir_8, f_11.e1_.xyz));
-    yc = ((phi_2 - f_11.e1_.w) / f_11.e2_.w);
-    if wrap_1 {
-        let _e148 = yc;
-        let _e149 = yc;
-        yc = (_e148 - (floor((_e149 / f32(rows_1))) * f32(rows_1)));
-    } else {
-        let _e156 = yc;
-        yc = clamp(_e156, 0f, f32(rows_1));
-    }
-    let _e161 = yc;
-    let _e163 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e161), rows_1, wrap_1);
-    r_1.row = _e163;
-    let _e166 = r_1.theta;
-    let _e171 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e166, f_11.theta.x, f_11.theta.y);
-    r_1.d = _e171;
-    if true {
-        let q_4 = normalize(((eye_7 + (dir_8 * s_5)) - f_11.light_pos.xyz));
-        r_1.xs_num = acos(clamp(dot(q_4, -(axis_2)), -1f, 1f));
-    } else {
-        let _e187 = r_1.theta;
-        r_1.xs_num = (s_5 * sin(_e187));
-    }
-    let _e190 = r_1;
-    return _e190;
+    let _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
+    r_1.theta = _e122;
+    let _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
+    let _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e124), f_14.sizes.w, (f_14.anti_epipole.w > 0.5f));
+    r_1.row = _e132;
+    let _e135 = r_1.theta;
+    let _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_14.theta.x, f_14.theta.y);
+    r_1.d = _e140;
+    let _e143 = r_1.theta;
+    let _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_11, s_6, _e143, true);
+    r_1.xs_num = _e144;
+    let _e145 = r_1;
+    return _e145;
 }
 
 fn pst_columns_crossed(r_2: PstRay, delta_3: f32) -> u32 {
@@ -796,21 +811,21 @@ fn pst_columns_crossed(r_2: PstRay, delta_3: f32) -> u32 {
 fn pst_terms(r_3: PstRay, row_2: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     var tail: f32 = 0f;
 
-    let f_12 = frame;
+    let f_15 = frame;
     let sin_theta = max(sin(r_3.theta), 0.000001f);
     let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_2), 0i);
     if (r_3.d <= _e16.x) {
-        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
-        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
+        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if true {
         let _e37 = tail;
-        return vec2<f32>((f_12.medium.y / (f_12.axis.w * sin_theta)), _e37);
+        return vec2<f32>((f_15.medium.y / (f_15.axis.w * sin_theta)), _e37);
     }
-    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, r_3.dir)));
-    let sp = (f_12.medium.y * _e48);
-    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, 0f, (delta_4 / sin_theta));
+    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(dot(f_15.light_dir.xyz, r_3.dir)));
+    let sp = (f_15.medium.y * _e48);
+    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, 0f, (delta_4 / sin_theta));
     let _e56 = tail;
     return vec2<f32>((sp * _e54), (sp * _e56));
 }
@@ -821,7 +836,7 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
     var p_5: vec4<f32>;
     var i_3: u32;
 
-    let f_13 = frame;
+    let f_16 = frame;
     let _e16 = textureLoad(depth, vec2<u32>(x_5, y), 0i);
     let _e18 = pst_ray(vec2<f32>((f32(x_5) + 0.5f), (f32(y) + 0.5f)), _e16.x);
     if _e18.marched {
@@ -856,7 +871,7 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
                         let _e59 = p_5;
                         let _e60 = i_3;
                         let _e62 = h_8;
-                        let _e63 = pst_leaf(f_13, _e60, _e18.row, delta_5, _e62);
+                        let _e63 = pst_leaf(f_16, _e60, _e18.row, delta_5, _e62);
                         p_5 = (_e59 + _e63);
                     }
                 }
@@ -878,7 +893,7 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
     }
     let _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     let _e84 = sum_2;
-    return (f_13.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
+    return (f_16.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
 }
 
 fn pst_footprint_depth(pc_1: vec2<f32>, screen_3: vec2<u32>) -> f32 {
@@ -960,9 +975,9 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     var p_1: vec4<f32>;
     var j_8: u32;
 
-    let f_14 = frame;
-    let screen_4 = vec2<u32>(f_14.sizes.x, f_14.sizes.y);
-    let width = f_14.sizes.z;
+    let f_17 = frame;
+    let screen_4 = vec2<u32>(f_17.sizes.x, f_17.sizes.y);
+    let width = f_17.sizes.z;
     let _e13 = frame.cam_forward;
     let _e17 = frame.cam_right;
     let _e21 = frame.cam_up;
@@ -970,12 +985,12 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     let _e30 = frame.cam_right.w;
     let _e33 = frame.axis;
     let _e37 = epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e13.xyz, _e17.xyz, _e21.xyz, _e26, _e30, _e33.xyz), screen_4, SLICES);
-    let s_6 = wid.x;
-    let _e40 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_6);
-    let _e42 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_6, screen_4, SLICE_SAMPLES);
+    let s_7 = wid.x;
+    let _e40 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_7);
+    let _e42 = slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, s_7, screen_4, SLICE_SAMPLES);
     if (li == 0u) {
-        textureStore(output, vec2<u32>(SLICE_SAMPLES, s_6), vec4<f32>(_e40.x, _e40.y, _e42.x, _e42.y));
-        if (s_6 == 0u) {
+        textureStore(output, vec2<u32>(SLICE_SAMPLES, s_7), vec4<f32>(_e40.x, _e40.y, _e42.x, _e42.y));
+        if (s_7 == 0u) {
             atomicStore((&fallback_count), 0u);
             textureStore(output, vec2<u32>(0u, 512u), vec4<f32>(_e37.origin, _e37.axis));
             textureStore(output, vec2<u32>(1u, 512u), vec4<f32>(_e37.phi_start, _e37.dphi, f32(_e37.wrap), 0f));
@@ -1025,7 +1040,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                 let _e151 = r.color;
                 let _e152 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e151);
                 let _e153 = k;
-                textureStore(output, vec2<u32>(_e153, s_6), vec4<f32>(_e152.x, _e152.y, _e152.z, z_6));
+                textureStore(output, vec2<u32>(_e153, s_7), vec4<f32>(_e152.x, _e152.y, _e152.z, z_6));
             } else {
                 let _e160 = r;
                 let _e161 = pst_terms(_e160, row_3, delta_6, _e136);
@@ -1329,7 +1344,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         }
     }
     workgroupBarrier();
-    let base_1 = (s_6 * width);
+    let base_1 = (s_7 * width);
     i = li;
     loop {
         let _e514 = i;
@@ -1379,7 +1394,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                         let _e557 = h;
                         let _e560 = i;
                         let _e561 = h;
-                        let _e562 = pst_leaf(f_14, _e560, row_3, delta_6, _e561);
+                        let _e562 = pst_leaf(f_17, _e560, row_3, delta_6, _e561);
                         pst_leaves[(((base_1 + _e552) * RANK_VECS) + _e557)] = _e562;
                     }
                     continuing {
@@ -1396,7 +1411,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     }
     storageBarrier();
     workgroupBarrier();
-    let trees = (((s_6 * 9u) * SLICE_SAMPLES) * RANK_VECS);
+    let trees = (((s_7 * 9u) * SLICE_SAMPLES) * RANK_VECS);
     let partials = (trees + 4096u);
     if (li < TREES) {
         let tree = (trees + ((li * SLICE_SAMPLES) * RANK_VECS));
@@ -1677,13 +1692,13 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                 let _e900 = dotp;
                 let _e905 = k_4;
                 let _e907 = q_b[_e905];
-                let _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_14.light_color.xyz * (max((_e899 * _e900), 0f) + _e907)));
+                let _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_17.light_color.xyz * (max((_e899 * _e900), 0f) + _e907)));
                 let _e911 = k_4;
                 let _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
                 let _e915 = textureLoad(depth, _e912, 0i);
                 let z_7 = _e915.x;
                 let _e917 = k_4;
-                textureStore(output, vec2<u32>(_e917, s_6), vec4<f32>(_e910.x, _e910.y, _e910.z, z_7));
+                textureStore(output, vec2<u32>(_e917, s_7), vec4<f32>(_e910.x, _e910.y, _e910.z, z_7));
             }
         }
         continuing {

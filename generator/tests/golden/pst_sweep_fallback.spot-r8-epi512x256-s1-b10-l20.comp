@@ -184,18 +184,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        vec3 dir_7 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_7.z <= 1e-6)) {
+        vec3 dir_10 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_10.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_7);
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_3 = (near_1 + (_e28 * (far_1 - near_1)));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_7.z);
+        return ((z_3 + _e35) / dir_10.z);
     } else {
         vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -405,45 +405,76 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, 
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float x_1, float delta, float theta_1, float s_1, bool spot_1) {
-    bool local_4 = false;
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 dir_5) {
+    vec3 axis = f_6.axis.xyz;
+    return atan(length(cross(dir_5, axis)), dot(dir_5, axis));
+}
+
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 dir_6) {
+    float yc = 0.0;
+    uint rows_1 = f_7.sizes.w;
+    float phi_1 = atan(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
+    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
+    if ((f_7.anti_epipole.w > 0.5)) {
+        float _e22 = yc;
+        float _e23 = yc;
+        yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
+    } else {
+        float _e30 = yc;
+        yc = clamp(_e30, 0.0, float(rows_1));
+    }
+    float _e34 = yc;
+    return _e34;
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_5, vec3 dir_7, float s_1, float theta_1, bool spot_1) {
     if (spot_1) {
+        vec3 q_2 = ((eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz);
+        vec3 to_eye = -(f_8.axis.xyz);
+        return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
+    }
+    return (s_1 * sin(theta_1));
+}
+
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_1, float delta, float theta_2, float s_2, bool spot_2) {
+    bool local_4 = false;
+    if (spot_2) {
         float psi = (x_1 * delta);
-        float den = sin((theta_1 + psi));
+        float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local_4 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_4 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
             local_4 = true;
         }
         bool _e16 = local_4;
         if (_e16) {
-            return s_1;
+            return s_2;
         }
-        return min(((f_6.axis.w * sin(psi)) / den), s_1);
+        return min(((f_9.axis.w * sin(psi)) / den), s_2);
     } else {
-        return min(((x_1 * delta) / max(sin(theta_1), 1e-6)), s_1);
+        return min(((x_1 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, uint x_2, uint n_1, float delta_1, float theta_2, float s_2, bool spot_2) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_3) {
     if ((x_2 >= n_1)) {
-        return s_2;
+        return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, float(x_2), delta_1, theta_2, s_2, spot_2);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_2), delta_1, theta_3, s_3, spot_3);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_5, vec3 dir_5, float a_3, float b_3, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec3 eye_6, vec3 dir_8, float a_3, float b_3, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_6, float a_4, float b_4, bool spot_3) {
-    if (spot_3) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, max((f_9.sizes2_.z / 4u), 1u));
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_7, vec3 dir_9, float a_4, float b_4, bool spot_4) {
+    if (spot_4) {
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, max((f_12.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -462,22 +493,22 @@ vec4 gamma_at(float v_7, uint h_1) {
     return _e8;
 }
 
-vec4 beta_at(float theta_3, uint h_2) {
+vec4 beta_at(float theta_4, uint h_2) {
     vec4 head = _group_0_binding_5_cs[0];
-    vec4 _e14 = factor_at(193u, ((theta_3 - head.y) / max((head.z - head.y), 1e-12)), h_2);
+    vec4 _e14 = factor_at(193u, ((theta_4 - head.y) / max((head.z - head.y), 1e-12)), h_2);
     return _e14;
 }
 
-vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint i, uint row_1, float delta_2, uint h_3) {
+vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, uint i, uint row_1, float delta_2, uint h_3) {
     vec4 leaf = vec4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
     if (false) {
         vec4 _e9 = gamma_at((float(i) * delta_2), h_3);
         return _e9;
     }
-    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, row_1);
-    vec3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, _e12);
-    vec3 axis = f_10.axis.xyz;
+    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, row_1);
+    vec3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e12);
+    vec3 axis_1 = f_13.axis.xyz;
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
@@ -492,10 +523,10 @@ vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint i, u
         }
         {
             uint _e20 = g_1;
-            float q_2 = ((_e20 == 0u) ? -0.57735026 : GL2_);
-            float psi_1 = (((float(i) + 0.5) + (0.5 * q_2)) * delta_2);
-            vec3 l_1 = ((-(axis) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_10.light_dir.xyz), f_10.light_pos.w, f_10.light_dir.w);
+            float q_3 = ((_e20 == 0u) ? -0.57735026 : GL2_);
+            float psi_1 = (((float(i) + 0.5) + (0.5 * q_3)) * delta_2);
+            vec3 l_1 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
+            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_13.light_dir.xyz), f_13.light_pos.w, f_13.light_dir.w);
             vec4 _e48 = leaf;
             vec4 _e52 = gamma_at(psi_1, h_3);
             leaf = (_e48 + (((0.5 * delta_2) * _e46) * _e52));
@@ -510,24 +541,23 @@ PstRay pst_ray(vec2 pc, float z_1) {
     bool local_5 = false;
     bool local_6 = false;
     bool local_7 = false;
-    float yc = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11 = _group_0_binding_0_cs;
-    vec3 eye_7 = f_11.eye.xyz;
-    vec2 ndc = vec2((((2.0 * pc.x) / float(f_11.sizes.x)) - 1.0), (1.0 - ((2.0 * pc.y) / float(f_11.sizes.y))));
-    float t_5 = f_11.cam_forward.w;
-    vec3 dir_8 = normalize(((f_11.cam_forward.xyz + (f_11.cam_right.xyz * ((ndc.x * t_5) * f_11.cam_right.w))) + (f_11.cam_up.xyz * (ndc.y * t_5))));
-    float s_3 = (min(max(z_1, 0.0), f_11.theta.z) / max(dot(dir_8, f_11.cam_forward.xyz), 1e-6));
-    r = PstRay(false, vec3(0.0, 0.0, 0.0), eye_7, dir_8, s_3, 0u, 0.0, 0.0, 0.0);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = _group_0_binding_0_cs;
+    vec3 eye_8 = f_14.eye.xyz;
+    vec2 ndc = vec2((((2.0 * pc.x) / float(f_14.sizes.x)) - 1.0), (1.0 - ((2.0 * pc.y) / float(f_14.sizes.y))));
+    float t_5 = f_14.cam_forward.w;
+    vec3 dir_11 = normalize(((f_14.cam_forward.xyz + (f_14.cam_right.xyz * ((ndc.x * t_5) * f_14.cam_right.w))) + (f_14.cam_up.xyz * (ndc.y * t_5))));
+    float s_4 = (min(max(z_1, 0.0), f_14.theta.z) / max(dot(dir_11, f_14.cam_forward.xyz), 1e-6));
+    r = PstRay(false, vec3(0.0, 0.0, 0.0), eye_8, dir_11, s_4, 0u, 0.0, 0.0, 0.0);
     vec3 px = vec3(pc, 0.0);
-    float radius = f_11.epipole.w;
-    if ((f_11.epipole.z > 0.5)) {
-        local_5 = (length((px - vec3(f_11.epipole.x, f_11.epipole.y, 0.0))) < radius);
+    float radius = f_14.epipole.w;
+    if ((f_14.epipole.z > 0.5)) {
+        local_5 = (length((px - vec3(f_14.epipole.x, f_14.epipole.y, 0.0))) < radius);
     } else {
         local_5 = false;
     }
     bool near_epi = local_5;
-    if ((f_11.anti_epipole.z > 0.5)) {
-        local_6 = (length((px - vec3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0))) < radius);
+    if ((f_14.anti_epipole.z > 0.5)) {
+        local_6 = (length((px - vec3(f_14.anti_epipole.x, f_14.anti_epipole.y, 0.0))) < radius);
     } else {
         local_6 = false;
     }
@@ -541,38 +571,22 @@ PstRay pst_ray(vec2 pc, float z_1) {
     if (_e109) {
         r.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = _group_0_binding_0_cs;
-        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, _group_0_binding_3_cs, eye_7, dir_8, s_3, true);
-        r.color = (_e117 * f_11.light_color.xyz);
+        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, _group_0_binding_3_cs, eye_8, dir_11, s_4, true);
+        r.color = (_e117 * f_14.light_color.xyz);
     }
-    vec3 axis_1 = f_11.axis.xyz;
-    uint rows_1 = f_11.sizes.w;
-    bool wrap_1 = (f_11.anti_epipole.w > 0.5);
-    r.theta = atan(length(cross(dir_8, axis_1)), dot(dir_8, axis_1));
-    float phi_1 = atan(dot(dir_8, f_11.e2_.xyz), dot(dir_8, f_11.e1_.xyz));
-    yc = ((phi_1 - f_11.e1_.w) / f_11.e2_.w);
-    if (wrap_1) {
-        float _e148 = yc;
-        float _e149 = yc;
-        yc = (_e148 - (floor((_e149 / float(rows_1))) * float(rows_1)));
-    } else {
-        float _e156 = yc;
-        yc = clamp(_e156, 0.0, float(rows_1));
-    }
-    float _e161 = yc;
-    uint _e163 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e161), rows_1, wrap_1);
-    r.row = _e163;
-    float _e166 = r.theta;
-    float _e171 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e166, f_11.theta.x, f_11.theta.y);
-    r.d = _e171;
-    if (true) {
-        vec3 q_3 = normalize(((eye_7 + (dir_8 * s_3)) - f_11.light_pos.xyz));
-        r.xs_num = acos(clamp(dot(q_3, -(axis_1)), -1.0, 1.0));
-    } else {
-        float _e187 = r.theta;
-        r.xs_num = (s_3 * sin(_e187));
-    }
-    PstRay _e190 = r;
-    return _e190;
+    float _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
+    r.theta = _e122;
+    float _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
+    uint _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e124), f_14.sizes.w, (f_14.anti_epipole.w > 0.5));
+    r.row = _e132;
+    float _e135 = r.theta;
+    float _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_14.theta.x, f_14.theta.y);
+    r.d = _e140;
+    float _e143 = r.theta;
+    float _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_11, s_4, _e143, true);
+    r.xs_num = _e144;
+    PstRay _e145 = r;
+    return _e145;
 }
 
 uint pst_columns_crossed(PstRay r_1, float delta_3) {
@@ -583,22 +597,22 @@ uint pst_columns_crossed(PstRay r_1, float delta_3) {
 
 vec2 pst_terms(PstRay r_2, uint row_2, float delta_4, uint n_2) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = _group_0_binding_0_cs;
     float sin_theta = max(sin(r_2.theta), 1e-6);
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 _e16 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((n_2 - 1u), row_2)), ivec2(0), textureSize(_group_0_binding_4_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
     if ((r_2.d <= _e16.x)) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return vec2((f_12.medium.y / (f_12.axis.w * sin_theta)), _e37);
+        return vec2((f_15.medium.y / (f_15.axis.w * sin_theta)), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, r_2.dir)));
-    float sp = (f_12.medium.y * _e48);
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, 0.0, (delta_4 / sin_theta));
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(dot(f_15.light_dir.xyz, r_2.dir)));
+    float sp = (f_15.medium.y * _e48);
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, 0.0, (delta_4 / sin_theta));
     float _e56 = tail;
     return vec2((sp * _e54), (sp * _e56));
 }
@@ -608,7 +622,7 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
     uint h_4 = 0u;
     vec4 p_3 = vec4(0.0);
     uint i_1 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = _group_0_binding_0_cs;
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e16 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_4, y)), ivec2(0), textureSize(_group_0_binding_2_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
     PstRay _e18 = pst_ray(vec2((float(x_4) + 0.5), (float(y) + 0.5)), _e16.x);
@@ -657,7 +671,7 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
                         vec4 _e59 = p_3;
                         uint _e60 = i_1;
                         uint _e62 = h_4;
-                        vec4 _e63 = pst_leaf(f_13, _e60, _e18.row, delta_5, _e62);
+                        vec4 _e63 = pst_leaf(f_16, _e60, _e18.row, delta_5, _e62);
                         p_3 = (_e59 + _e63);
                     }
                 }
@@ -671,7 +685,7 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
     }
     vec2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     float _e84 = sum_2;
-    return (f_13.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
+    return (f_16.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
 }
 
 void main() {

@@ -190,18 +190,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        vec3 dir_7 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_7.z <= 1e-6)) {
+        vec3 dir_10 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_10.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_7);
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_3 = (near_1 + (_e28 * (far_1 - near_1)));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_7.z);
+        return ((z_3 + _e35) / dir_10.z);
     } else {
         vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -411,45 +411,76 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_1, uint rows
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float x_1, float delta, float theta_1, float s_1, bool spot_1) {
-    bool local_5 = false;
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 dir_5) {
+    vec3 axis_1 = f_6.axis.xyz;
+    return atan(length(cross(dir_5, axis_1)), dot(dir_5, axis_1));
+}
+
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 dir_6) {
+    float yc = 0.0;
+    uint rows_1 = f_7.sizes.w;
+    float phi_1 = atan(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
+    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
+    if ((f_7.anti_epipole.w > 0.5)) {
+        float _e22 = yc;
+        float _e23 = yc;
+        yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
+    } else {
+        float _e30 = yc;
+        yc = clamp(_e30, 0.0, float(rows_1));
+    }
+    float _e34 = yc;
+    return _e34;
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_5, vec3 dir_7, float s_1, float theta_1, bool spot_1) {
     if (spot_1) {
+        vec3 q_2 = ((eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz);
+        vec3 to_eye = -(f_8.axis.xyz);
+        return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
+    }
+    return (s_1 * sin(theta_1));
+}
+
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_1, float delta, float theta_2, float s_2, bool spot_2) {
+    bool local_5 = false;
+    if (spot_2) {
         float psi = (x_1 * delta);
-        float den = sin((theta_1 + psi));
+        float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local_5 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_5 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
             local_5 = true;
         }
         bool _e16 = local_5;
         if (_e16) {
-            return s_1;
+            return s_2;
         }
-        return min(((f_6.axis.w * sin(psi)) / den), s_1);
+        return min(((f_9.axis.w * sin(psi)) / den), s_2);
     } else {
-        return min(((x_1 * delta) / max(sin(theta_1), 1e-6)), s_1);
+        return min(((x_1 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, uint x_2, uint n_1, float delta_1, float theta_2, float s_2, bool spot_2) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_3) {
     if ((x_2 >= n_1)) {
-        return s_2;
+        return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, float(x_2), delta_1, theta_2, s_2, spot_2);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_2), delta_1, theta_3, s_3, spot_3);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_5, vec3 dir_5, float a_3, float b_3, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec3 eye_6, vec3 dir_8, float a_3, float b_3, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_6, float a_4, float b_4, bool spot_3) {
-    if (spot_3) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, max((f_9.sizes2_.z / 4u), 1u));
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_7, vec3 dir_9, float a_4, float b_4, bool spot_4) {
+    if (spot_4) {
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, max((f_12.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -539,13 +570,13 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_3 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
     vec2 d_3 = ((vec2(p_3) + vec2(0.5, 0.5)) - l_1.origin);
     float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_3);
-    float f_11 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
+    float f_14 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
     if ((l_1.wrap != 0u)) {
-        float fl = floor(f_11);
-        fs = (f_11 - fl);
+        float fl = floor(f_14);
+        fs = (f_14 - fl);
         s_lo = (uint((int(fl) + int(slices))) % slices);
     } else {
-        float fc = clamp(f_11, 0.0, float((slices - 1u)));
+        float fc = clamp(f_14, 0.0, float((slices - 1u)));
         s_lo = min(uint(fc), (slices - 2u));
         uint _e41 = s_lo;
         fs = (fc - float(_e41));
@@ -614,9 +645,9 @@ void main() {
     uint _e6 = _group_0_binding_0_cs.sizes.x;
     uint _e10 = _group_0_binding_0_cs.sizes.y;
     uvec2 screen = uvec2(_e6, _e10);
-    uvec2 q_2 = id.xy;
-    if (!((q_2.x >= screen.x))) {
-        local = (q_2.y >= screen.y);
+    uvec2 q_3 = id.xy;
+    if (!((q_3.x >= screen.x))) {
+        local = (q_3.y >= screen.y);
     } else {
         local = true;
     }
@@ -629,12 +660,12 @@ void main() {
     int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
     vec4 angles = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(1u, 512u)), ivec2(0), textureSize(_group_0_binding_10_cs, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, uint(angles.z));
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, SLICES);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_3, SLICES);
     int _e52_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
     vec4 line_lo_1 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.x)), ivec2(0), textureSize(_group_0_binding_10_cs, _e52_clamped_lod) - ivec2(1)), _e52_clamped_lod);
     int _e59_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
     vec4 line_hi_1 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.y)), ivec2(0), textureSize(_group_0_binding_10_cs, _e59_clamped_lod) - ivec2(1)), _e59_clamped_lod);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_3, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     bool loop_init_5 = true;
     while(true) {
         if (!loop_init_5) {
@@ -662,14 +693,14 @@ void main() {
     vec4 _e96 = depths;
     vec3 _e97[4] = light;
     int _e100_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e100 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(q_2), ivec2(0), textureSize(_group_0_binding_2_cs, _e100_clamped_lod) - ivec2(1)), _e100_clamped_lod);
+    vec4 _e100 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(q_3), ivec2(0), textureSize(_group_0_binding_2_cs, _e100_clamped_lod) - ivec2(1)), _e100_clamped_lod);
     vec4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
     if ((_e104.w == 0.0)) {
         uint _e110 = atomicAdd(_group_0_binding_11_cs, 1u);
-        _group_0_binding_12_cs[_e110] = (q_2.x | (q_2.y << 16u));
+        _group_0_binding_12_cs[_e110] = (q_3.x | (q_3.y << 16u));
         return;
     } else {
-        imageStore(_group_0_binding_9_cs, ivec2(q_2), _e104);
+        imageStore(_group_0_binding_9_cs, ivec2(q_3), _e104);
         return;
     }
 }

@@ -210,18 +210,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        float3 dir_7 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_7.z <= 1e-6)) {
+        float3 dir_10 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_10.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_7);
+        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
         const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_3 = (near_1 + (_e28 * (far_1 - near_1)));
         const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_7.z);
+        return ((z_3 + _e35) / dir_10.z);
     } else {
         const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -500,40 +500,75 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_1, uint rows
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float x_1, float delta, float theta_1, float s_1, bool spot_1)
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 dir_5)
+{
+    float3 axis_1 = f_6.axis.xyz;
+    return atan2(length(cross(dir_5, axis_1)), dot(dir_5, axis_1));
+}
+
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 dir_6)
+{
+    float yc = (float)0;
+
+    uint rows_1 = f_7.sizes.w;
+    float phi_1 = atan2(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
+    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
+    if ((f_7.anti_epipole.w > 0.5)) {
+        float _e22 = yc;
+        float _e23 = yc;
+        yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
+    } else {
+        float _e30 = yc;
+        yc = clamp(_e30, 0.0, float(rows_1));
+    }
+    float _e34 = yc;
+    return _e34;
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_5, float3 dir_7, float s_1, float theta_1, bool spot_1)
+{
+    if (spot_1) {
+        float3 q_2 = ((eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz);
+        float3 to_eye = -(f_8.axis.xyz);
+        return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
+    }
+    return (s_1 * sin(theta_1));
+}
+
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_1, float delta, float theta_2, float s_2, bool spot_2)
 {
     bool local_5 = (bool)0;
 
-    if (spot_1) {
+    if (spot_2) {
         float psi = (x_1 * delta);
-        float den = sin((theta_1 + psi));
+        float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local_5 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_5 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
             local_5 = true;
         }
         bool _e16 = local_5;
         if (_e16) {
-            return s_1;
+            return s_2;
         }
-        return min(((f_6.axis.w * sin(psi)) / den), s_1);
+        return min(((f_9.axis.w * sin(psi)) / den), s_2);
     } else {
-        return min(((x_1 * delta) / max(sin(theta_1), 1e-6)), s_1);
+        return min(((x_1 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, uint x_2, uint n_1, float delta_1, float theta_2, float s_2, bool spot_2)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_3)
 {
     if ((x_2 >= n_1)) {
-        return s_2;
+        return s_3;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, float(x_2), delta_1, theta_2, s_2, spot_2);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_2), delta_1, theta_3, s_3, spot_3);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_5, float3 dir_5, float a_3, float b_3, uint panels_1)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float3 eye_6, float3 dir_8, float a_3, float b_3, uint panels_1)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
@@ -541,13 +576,13 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_6, float a_4, float b_4, bool spot_3)
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_7, float3 dir_9, float a_4, float b_4, bool spot_4)
 {
-    if (spot_3) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, dir_6, a_4, b_4, max(naga_div(f_9.sizes2_.z, 4u), 1u));
+    if (spot_4) {
+        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, max(naga_div(f_12.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4, b_4);
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
     return _e15;
 }
 
@@ -651,13 +686,13 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
 
     float2 d_3 = ((float2(p_3) + float2(0.5, 0.5)) - l_1.origin);
     const float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_3);
-    float f_11 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
+    float f_14 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
     if ((l_1.wrap != 0u)) {
-        float fl = floor(f_11);
-        fs = (f_11 - fl);
+        float fl = floor(f_14);
+        fs = (f_14 - fl);
         s_lo = naga_mod(uint(asint(asuint(naga_f2i32(fl)) + asuint(int(slices)))), slices);
     } else {
-        float fc = clamp(f_11, 0.0, float((slices - 1u)));
+        float fc = clamp(f_14, 0.0, float((slices - 1u)));
         s_lo = min(naga_f2u32(fc), (slices - 2u));
         uint _e41 = s_lo;
         fs = (fc - float(_e41));
@@ -746,9 +781,9 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     uint2 screen = uint2(_e6, _e10);
-    uint2 q_2 = id.xy;
-    if (!((q_2.x >= screen.x))) {
-        local = (q_2.y >= screen.y);
+    uint2 q_3 = id.xy;
+    if (!((q_3.x >= screen.x))) {
+        local = (q_3.y >= screen.y);
     } else {
         local = true;
     }
@@ -759,10 +794,10 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
     float4 head = epipolar_samples.Load(int3(uint2(0u, 512u), int(0)));
     float4 angles = epipolar_samples.Load(int3(uint2(1u, 512u), int(0)));
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = ConstructEpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, SLICES);
+    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_3, SLICES);
     float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.x), int(0)));
     float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.y), int(0)));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_3, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
     bool loop_init_5 = true;
     while(true) {
@@ -791,14 +826,14 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
     }
     float4 _e96 = depths;
     float3 _e97[4] = light;
-    float4 _e100 = depth.Load(int3(q_2, int(0)));
+    float4 _e100 = depth.Load(int3(q_3, int(0)));
     const float4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
     if ((_e104.w == 0.0)) {
         uint _e110; fallback_count.InterlockedAdd(0, 1u, _e110);
-        fallback_pixels.Store(_e110*4, asuint((q_2.x | (q_2.y << 16u))));
+        fallback_pixels.Store(_e110*4, asuint((q_3.x | (q_3.y << 16u))));
         return;
     } else {
-        output[q_2] = _e104;
+        output[q_3] = _e104;
         return;
     }
 }

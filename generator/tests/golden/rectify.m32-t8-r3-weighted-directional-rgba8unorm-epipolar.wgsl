@@ -302,35 +302,46 @@ fn sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX
     return _e5;
 }
 
-fn rectify_texel(x_2: u32, slice: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, spot: bool) -> f32 {
+fn light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, col: f32, s: f32, spot: bool) -> f32 {
+    if spot {
+        return atan2((s * sin(col)), (f_4.axis.w - (s * cos(col))));
+    } else {
+        return atan2(col, -(s));
+    }
+}
+
+fn rectify_texel(x_2: u32, slice: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, spot_1: bool) -> f32 {
     var theta_occ: f32 = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
 
-    let col = ((f32(x_2) + 0.5f) * slice.delta);
+    let col_1 = ((f32(x_2) + 0.5f) * slice.delta);
     let _e10 = frame.axis;
     let axis = _e10.xyz;
-    if spot {
-        let l_2 = ((-(axis) * cos(col)) + (e_1 * sin(col)));
+    if spot_1 {
+        let l_2 = ((-(axis) * cos(col_1)) + (e_1 * sin(col_1)));
         let _e21 = frame;
         let _e24 = frame.light_pos;
         let _e27 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21, shadow_map, _e24.xyz, l_2);
         if (_e27 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
-            let dist = frame.axis.w;
-            theta_occ = atan2((_e27 * sin(col)), (dist - (_e27 * cos(col))));
+            let _e31 = frame;
+            let _e33 = light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e31, col_1, _e27, true);
+            theta_occ = _e33;
         }
     } else {
-        let _e43 = frame.eye;
-        let o_2 = (_e43.xyz + (e_1 * col));
-        let _e48 = frame;
-        let _e51 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e48, shadow_map, o_2, -(axis));
-        if (_e51 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
-            theta_occ = atan2(col, -(_e51));
+        let _e37 = frame.eye;
+        let o_2 = (_e37.xyz + (e_1 * col_1));
+        let _e42 = frame;
+        let _e45 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e42, shadow_map, o_2, -(axis));
+        if (_e45 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) {
+            let _e49 = frame;
+            let _e51 = light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e49, col_1, _e45, false);
+            theta_occ = _e51;
         }
     }
-    let _e56 = theta_occ;
-    let _e60 = frame.theta.x;
-    let _e64 = frame.theta.y;
-    let _e65 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56, _e60, _e64);
-    return _e65;
+    let _e52 = theta_occ;
+    let _e56 = frame.theta.x;
+    let _e60 = frame.theta.y;
+    let _e61 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e52, _e56, _e60);
+    return _e61;
 }
 
 @compute @workgroup_size(8, 8, 1) 

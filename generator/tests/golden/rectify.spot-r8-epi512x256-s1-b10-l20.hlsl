@@ -370,36 +370,48 @@ float sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e5;
 }
 
-float rectify_texel(uint x_2, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice, float3 e_1, bool spot)
+float light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, float col, float s, bool spot)
+{
+    if (spot) {
+        return atan2((s * sin(col)), (f_4.axis.w - (s * cos(col))));
+    } else {
+        return atan2(col, -(s));
+    }
+}
+
+float rectify_texel(uint x_2, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice, float3 e_1, bool spot_1)
 {
     float theta_occ = PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
 
-    float col = ((float(x_2) + 0.5) * slice.delta);
+    float col_1 = ((float(x_2) + 0.5) * slice.delta);
     float4 _e10 = frame.axis;
     float3 axis = _e10.xyz;
-    if (spot) {
-        float3 l_2 = ((-(axis) * cos(col)) + (e_1 * sin(col)));
+    if (spot_1) {
+        float3 l_2 = ((-(axis) * cos(col_1)) + (e_1 * sin(col_1)));
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e21 = frame;
         float4 _e24 = frame.light_pos;
         const float _e27 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e21, shadow_map, _e24.xyz, l_2);
         if ((_e27 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
-            float dist = frame.axis.w;
-            theta_occ = atan2((_e27 * sin(col)), (dist - (_e27 * cos(col))));
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e31 = frame;
+            const float _e33 = light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e31, col_1, _e27, true);
+            theta_occ = _e33;
         }
     } else {
-        float4 _e43 = frame.eye;
-        float3 o_2 = (_e43.xyz + (e_1 * col));
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e48 = frame;
-        const float _e51 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e48, shadow_map, o_2, -(axis));
-        if ((_e51 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
-            theta_occ = atan2(col, -(_e51));
+        float4 _e37 = frame.eye;
+        float3 o_2 = (_e37.xyz + (e_1 * col_1));
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e42 = frame;
+        const float _e45 = sm_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e42, shadow_map, o_2, -(axis));
+        if ((_e45 < NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)) {
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e49 = frame;
+            const float _e51 = light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e49, col_1, _e45, false);
+            theta_occ = _e51;
         }
     }
-    float _e56 = theta_occ;
-    float _e60 = frame.theta.x;
-    float _e64 = frame.theta.y;
-    const float _e65 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56, _e60, _e64);
-    return _e65;
+    float _e52 = theta_occ;
+    float _e56 = frame.theta.x;
+    float _e60 = frame.theta.y;
+    const float _e61 = occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e52, _e56, _e60);
+    return _e61;
 }
 
 [numthreads(8, 8, 1)]

@@ -171,18 +171,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        float3 dir_6 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_6.z <= 1e-6)) {
+        float3 dir_8 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_8.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
+        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_8);
         const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_6.z);
+        return ((z_2 + _e35) / dir_8.z);
     } else {
         const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -481,20 +481,49 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 eye_5, float3 dir_5, float a_3, float b_3, uint panels_1)
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 dir_5)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+    float yc = (float)0;
+
+    uint rows_1 = f_6.sizes.w;
+    float phi_1 = atan2(dot(dir_5, f_6.e2_.xyz), dot(dir_5, f_6.e1_.xyz));
+    yc = ((phi_1 - f_6.e1_.w) / f_6.e2_.w);
+    if ((f_6.anti_epipole.w > 0.5)) {
+        float _e22 = yc;
+        float _e23 = yc;
+        yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
+    } else {
+        float _e30 = yc;
+        yc = clamp(_e30, 0.0, float(rows_1));
+    }
+    float _e34 = yc;
+    return _e34;
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 eye_5, float3 dir_6, float s_2, float theta_2, bool spot_2)
+{
+    if (spot_2) {
+        float3 q_2 = ((eye_5 + (dir_6 * s_2)) - f_7.light_pos.xyz);
+        float3 to_eye = -(f_7.axis.xyz);
+        return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
+    }
+    return (s_2 * sin(theta_2));
+}
+
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_6, float3 dir_7, float a_3, float b_3, uint panels_1)
+{
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_7, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e15;
 }
 
-float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float phi)
+float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float phi)
 {
-    return ((f_7.e1_.xyz * cos(phi)) + (f_7.e2_.xyz * sin(phi)));
+    return ((f_9.e1_.xyz * cos(phi)) + (f_9.e2_.xyz * sin(phi)));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, uint row)
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint row)
 {
-    return (f_8.e1_.w + ((float(row) + 0.5) * f_8.e2_.w));
+    return (f_10.e1_.w + ((float(row) + 0.5) * f_10.e2_.w));
 }
 
 float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_4, float2 b_4)
@@ -523,9 +552,9 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_2)
+uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_3)
 {
-    if (spot_2) {
+    if (spot_3) {
         return naga_div((r * width), regions);
     }
     return naga_div(((r * r) * width), (regions * regions));
@@ -540,11 +569,11 @@ float3 scatter_pixel(uint x_3, uint y_1)
     bool local_6 = (bool)0;
     bool local_7 = (bool)0;
     bool local_8 = (bool)0;
-    float yc = (float)0;
+    float yc_1 = (float)0;
     float d = (float)0;
     float xs = 0.0;
     float reach = 0.0;
-    float theta_2 = 0.0;
+    float theta_3 = 0.0;
     float4 coeffs[8] = (float4[8])0;
     float2 angle = (float2)0;
     uint layer_1 = 0u;
@@ -576,22 +605,22 @@ float3 scatter_pixel(uint x_3, uint y_1)
     bool local_15 = (bool)0;
     bool local_16 = (bool)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
-    float3 eye_6 = f_9.eye.xyz;
-    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11 = frame;
+    float3 eye_7 = f_11.eye.xyz;
+    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, x_3, y_1);
     float4 _e14 = depth.Load(int3(uint2(x_3, y_1), int(0)));
-    float s_2 = (min(max(_e14.x, 0.0), f_9.theta.z) / max(dot(_e10, f_9.cam_forward.xyz), 1e-6));
-    float3 color = f_9.light_color.xyz;
+    float s_3 = (min(max(_e14.x, 0.0), f_11.theta.z) / max(dot(_e10, f_11.cam_forward.xyz), 1e-6));
+    float3 color = f_11.light_color.xyz;
     float3 px = float3((float(x_3) + 0.5), (float(y_1) + 0.5), 0.0);
-    float radius = f_9.epipole.w;
-    if ((f_9.epipole.z > 0.5)) {
-        local_6 = (length((px - float3(f_9.epipole.x, f_9.epipole.y, 0.0))) < radius);
+    float radius = f_11.epipole.w;
+    if ((f_11.epipole.z > 0.5)) {
+        local_6 = (length((px - float3(f_11.epipole.x, f_11.epipole.y, 0.0))) < radius);
     } else {
         local_6 = false;
     }
     bool near_epi = local_6;
-    if ((f_9.anti_epipole.z > 0.5)) {
-        local_7 = (length((px - float3(f_9.anti_epipole.x, f_9.anti_epipole.y, 0.0))) < radius);
+    if ((f_11.anti_epipole.z > 0.5)) {
+        local_7 = (length((px - float3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0))) < radius);
     } else {
         local_7 = false;
     }
@@ -604,182 +633,170 @@ float3 scatter_pixel(uint x_3, uint y_1)
     bool _e77 = local_8;
     if (_e77) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = frame;
-        const float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_6, _e10, s_2, false);
+        const float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_7, _e10, s_3, false);
         float3 l_1 = (_e82 * color);
         return l_1;
     }
-    float3 axis = f_9.axis.xyz;
-    uint rows_1 = f_9.sizes.w;
-    uint width_1 = f_9.sizes.z;
-    bool wrap_1 = (f_9.anti_epipole.w > 0.5);
+    float3 axis = f_11.axis.xyz;
+    uint rows_2 = f_11.sizes.w;
+    uint width_1 = f_11.sizes.z;
+    bool wrap_1 = (f_11.anti_epipole.w > 0.5);
     {
-        theta_2 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
-        float phi_1 = atan2(dot(_e10, f_9.e2_.xyz), dot(_e10, f_9.e1_.xyz));
-        yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
-        if (wrap_1) {
-            float _e114 = yc;
-            float _e115 = yc;
-            yc = (_e114 - (floor((_e115 / float(rows_1))) * float(rows_1)));
-        } else {
-            float _e122 = yc;
-            yc = clamp(_e122, 0.0, float(rows_1));
-        }
-        float _e126 = theta_2;
-        const float _e131 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e126, f_9.theta.x, f_9.theta.y);
-        d = _e131;
-        if (false) {
-            float3 q_2 = normalize(((eye_6 + (_e10 * s_2)) - f_9.light_pos.xyz));
-            reach = acos(clamp(dot(q_2, -(axis)), -1.0, 1.0));
-        } else {
-            float _e146 = theta_2;
-            reach = (s_2 * sin(_e146));
-        }
+        theta_3 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
+        const float _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, _e10);
+        yc_1 = _e100;
+        float _e102 = theta_3;
+        const float _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_11.theta.x, f_11.theta.y);
+        d = _e107;
+        float _e109 = theta_3;
+        const float _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, s_3, _e109, false);
+        reach = _e110;
     }
-    float _e149 = yc;
-    float yb = (_e149 - 0.5);
+    float _e112 = yc_1;
+    float yb = (_e112 - 0.5);
     float fy = (yb - floor(yb));
-    const uint _e155 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    const uint _e159 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e159 : _e155);
-    float w1_ = ((row1_ != _e155) ? fy : 0.0);
-    float cos_theta_l = -(dot(f_9.light_dir.xyz, _e10));
-    uint panels_2 = max(naga_div(f_9.sizes2_.z, 4u), 1u);
-    float _e177 = d;
-    float _e181 = d;
-    angle = float2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e177)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e181)));
-    float2 _e186 = angle;
-    const float2 _e187 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e186);
+    const uint _e118 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    const uint _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e122 : _e118);
+    float w1_ = ((row1_ != _e118) ? fy : 0.0);
+    float cos_theta_l = -(dot(f_11.light_dir.xyz, _e10));
+    uint panels_2 = max(naga_div(f_11.sizes2_.z, 4u), 1u);
+    float _e140 = d;
+    float _e144 = d;
+    angle = float2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e140)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e144)));
+    float2 _e149 = angle;
+    const float2 _e150 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e202 = layer_1;
-            layer_1 = (_e202 + 1u);
+            uint _e165 = layer_1;
+            layer_1 = (_e165 + 1u);
         }
         loop_init_3 = false;
-        uint _e189 = layer_1;
-        if ((_e189 < LAYERS)) {
+        uint _e152 = layer_1;
+        if ((_e152 < LAYERS)) {
         } else {
             break;
         }
         {
-            float2 _e192 = angle;
-            const float2 _e193 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e192, _e187);
-            uint _e195 = layer_1;
-            float2 _e197 = angle;
-            uint _e198 = layer_1;
-            const float4 _e199 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e197, _e193, _e198);
-            coeffs[min(uint(_e195), 7u)] = _e199;
-            const float2 _e200 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e193, _e187);
-            angle = _e200;
+            float2 _e155 = angle;
+            const float2 _e156 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, _e150);
+            uint _e158 = layer_1;
+            float2 _e160 = angle;
+            uint _e161 = layer_1;
+            const float4 _e162 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e160, _e156, _e161);
+            coeffs[min(uint(_e158), 7u)] = _e162;
+            const float2 _e163 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156, _e150);
+            angle = _e163;
         }
     }
-    const float _e208 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    float sun_scatter = (f_9.medium.y * _e208);
-    float _e211 = xs;
-    xs0_ = _e211;
-    float _e213 = xs;
-    xs1_ = _e213;
+    const float _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.z, cos_theta_l);
+    float sun_scatter = (f_11.medium.y * _e171);
+    float _e174 = xs;
+    xs0_ = _e174;
+    float _e176 = xs;
+    xs1_ = _e176;
     {
-        float4 _e217 = asfloat(slices.Load4(_e155*16));
-        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e218 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e217);
-        delta0_ = _e218.delta;
-        float4 _e223 = asfloat(slices.Load4(row1_*16));
-        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e224 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e223);
-        delta1_ = _e224.delta;
-        float _e227 = reach;
-        float _e228 = delta0_;
-        xs0_ = (_e227 / _e228);
-        float _e230 = reach;
-        float _e231 = delta1_;
-        xs1_ = (_e230 / _e231);
+        float4 _e180 = asfloat(slices.Load4(_e118*16));
+        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e181 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e180);
+        delta0_ = _e181.delta;
+        float4 _e186 = asfloat(slices.Load4(row1_*16));
+        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e187 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e186);
+        delta1_ = _e187.delta;
+        float _e190 = reach;
+        float _e191 = delta0_;
+        xs0_ = (_e190 / _e191);
+        float _e193 = reach;
+        float _e194 = delta1_;
+        xs1_ = (_e193 / _e194);
     }
-    float _e233 = xs0_;
-    uint last0_ = naga_f2u32(min(max(_e233, 0.0), (float(width_1) - 1.0)));
-    float _e241 = xs1_;
-    uint last1_ = naga_f2u32(min(max(_e241, 0.0), (float(width_1) - 1.0)));
+    float _e196 = xs0_;
+    uint last0_ = naga_f2u32(min(max(_e196, 0.0), (float(width_1) - 1.0)));
+    float _e204 = xs1_;
+    uint last1_ = naga_f2u32(min(max(_e204, 0.0), (float(width_1) - 1.0)));
     uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e552 = r_1;
-            r_1 = (_e552 + 1u);
+            uint _e515 = r_1;
+            r_1 = (_e515 + 1u);
         }
         loop_init_4 = false;
-        uint _e251 = r_1;
-        if ((_e251 < REGIONS)) {
+        uint _e214 = r_1;
+        if ((_e214 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e253 = r_1;
-            const uint _e254 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e253, REGIONS, width_1, false);
-            float b0_ = float(_e254);
-            uint _e256 = r_1;
-            const uint _e259 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e256 + 1u), REGIONS, width_1, false);
-            float b1_ = float(_e259);
+            uint _e216 = r_1;
+            const uint _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, false);
+            float b0_ = float(_e217);
+            uint _e219 = r_1;
+            const uint _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e219 + 1u), REGIONS, width_1, false);
+            float b1_ = float(_e222);
             if (!((last0_ < naga_f2u32(b1_)))) {
-                uint _e264 = r_1;
-                local_9 = ((_e264 + 1u) == REGIONS);
+                uint _e227 = r_1;
+                local_9 = ((_e227 + 1u) == REGIONS);
             } else {
                 local_9 = true;
             }
             bool is_last0_ = local_9;
             if (!((last1_ < naga_f2u32(b1_)))) {
-                uint _e275 = r_1;
-                local_10 = ((_e275 + 1u) == REGIONS);
+                uint _e238 = r_1;
+                local_10 = ((_e238 + 1u) == REGIONS);
             } else {
                 local_10 = true;
             }
             bool is_last1_ = local_10;
-            float _e285 = xs0_;
-            float pos0_ = (is_last0_ ? clamp((_e285 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            float _e296 = xs1_;
-            float pos1_ = (is_last1_ ? clamp((_e296 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            float _e248 = xs0_;
+            float pos0_ = (is_last0_ ? clamp((_e248 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            float _e259 = xs1_;
+            float pos1_ = (is_last1_ ? clamp((_e259 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
             a0_ = ZeroValuefloat();
             e0_ = ZeroValuefloat();
             a1_ = ZeroValuefloat();
             e1_ = ZeroValuefloat();
-            float _e313 = delta0_;
-            float _e314 = theta_2;
-            const float _e315 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e313, _e314, s_2, false);
-            a0_ = _e315;
-            float _e316 = delta0_;
-            float _e317 = theta_2;
-            const float _e318 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e316, _e317, s_2, false);
-            e0_ = (is_last0_ ? s_2 : _e318);
-            float _e320 = delta1_;
-            float _e321 = theta_2;
-            const float _e322 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e320, _e321, s_2, false);
-            a1_ = _e322;
-            float _e323 = delta1_;
-            float _e324 = theta_2;
-            const float _e325 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e323, _e324, s_2, false);
-            e1_ = (is_last1_ ? s_2 : _e325);
+            float _e276 = delta0_;
+            float _e277 = theta_3;
+            const float _e278 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b0_, _e276, _e277, s_3, false);
+            a0_ = _e278;
+            float _e279 = delta0_;
+            float _e280 = theta_3;
+            const float _e281 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b1_, _e279, _e280, s_3, false);
+            e0_ = (is_last0_ ? s_3 : _e281);
+            float _e283 = delta1_;
+            float _e284 = theta_3;
+            const float _e285 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b0_, _e283, _e284, s_3, false);
+            a1_ = _e285;
+            float _e286 = delta1_;
+            float _e287 = theta_3;
+            const float _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b1_, _e286, _e287, s_3, false);
+            e1_ = (is_last1_ ? s_3 : _e288);
             weight0_ = ZeroValuefloat();
             weight1_ = ZeroValuefloat();
             if (false) {
-                float _e331 = a0_;
-                float _e332 = e0_;
-                const float _e333 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e10, _e331, _e332, panels_2);
-                weight0_ = _e333;
-                float _e334 = a1_;
-                float _e335 = e1_;
-                const float _e336 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e10, _e334, _e335, panels_2);
-                weight1_ = _e336;
+                float _e294 = a0_;
+                float _e295 = e0_;
+                const float _e296 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, _e294, _e295, panels_2);
+                weight0_ = _e296;
+                float _e297 = a1_;
+                float _e298 = e1_;
+                const float _e299 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, _e297, _e298, panels_2);
+                weight1_ = _e299;
             } else {
-                float _e339 = a0_;
-                float _e340 = e0_;
-                const float _e341 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e339, _e340);
-                weight0_ = (sun_scatter * _e341);
-                float _e345 = a1_;
-                float _e346 = e1_;
-                const float _e347 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e345, _e346);
-                weight1_ = (sun_scatter * _e347);
+                float _e302 = a0_;
+                float _e303 = e0_;
+                const float _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, _e302, _e303);
+                weight0_ = (sun_scatter * _e304);
+                float _e308 = a1_;
+                float _e309 = e1_;
+                const float _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, _e308, _e309);
+                weight1_ = (sun_scatter * _e310);
             }
             float xb0_ = (pos0_ - 0.5);
             float fx0_ = (xb0_ - floor(xb0_));
@@ -789,33 +806,33 @@ float3 scatter_pixel(uint x_3, uint y_1)
             float fx1_ = (xb1_ - floor(xb1_));
             uint x10_ = naga_f2u32(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
-            float4 lohi0_ = bounds.Load(int3(uint2(x01_, _e155), int(0)));
+            float4 lohi0_ = bounds.Load(int3(uint2(x01_, _e118), int(0)));
             float4 lohi1_ = bounds.Load(int3(uint2(x11_, row1_), int(0)));
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e399 = d;
-            if ((_e399 > lohi0_.x)) {
-                float _e402 = d;
-                local_11 = (_e402 <= lohi0_.y);
+            float _e362 = d;
+            if ((_e362 > lohi0_.x)) {
+                float _e365 = d;
+                local_11 = (_e365 <= lohi0_.y);
             } else {
                 local_11 = false;
             }
-            bool _e408 = local_11;
-            if (!(_e408)) {
-                float _e410 = d;
-                if ((_e410 > lohi1_.x)) {
-                    float _e413 = d;
-                    local_13 = (_e413 <= lohi1_.y);
+            bool _e371 = local_11;
+            if (!(_e371)) {
+                float _e373 = d;
+                if ((_e373 > lohi1_.x)) {
+                    float _e376 = d;
+                    local_13 = (_e376 <= lohi1_.y);
                 } else {
                     local_13 = false;
                 }
-                bool _e419 = local_13;
-                local_12 = _e419;
+                bool _e382 = local_13;
+                local_12 = _e382;
             } else {
                 local_12 = true;
             }
-            bool _e423 = local_12;
-            if (_e423) {
+            bool _e386 = local_12;
+            if (_e386) {
                 layer_2 = 0u;
                 uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
                 bool loop_init_5 = true;
@@ -823,28 +840,28 @@ float3 scatter_pixel(uint x_3, uint y_1)
                     if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
                     loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                     if (!loop_init_5) {
-                        uint _e485 = layer_2;
-                        layer_2 = (_e485 + 1u);
+                        uint _e448 = layer_2;
+                        layer_2 = (_e448 + 1u);
                     }
                     loop_init_5 = false;
-                    uint _e426 = layer_2;
-                    if ((_e426 < LAYERS)) {
+                    uint _e389 = layer_2;
+                    if ((_e389 < LAYERS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e429 = layer_2;
-                        float4 coeff = coeffs[min(uint(_e429), 7u)];
-                        uint _e433 = layer_2;
-                        float4 _e436 = filtered.Load(int4(uint2(x00_, _e155), _e433, int(0)));
-                        uint _e438 = layer_2;
-                        float4 _e441 = filtered.Load(int4(uint2(x01_, _e155), _e438, int(0)));
-                        float4 texel0_ = lerp(_e436, _e441, fx0_);
-                        uint _e444 = layer_2;
-                        float4 _e447 = filtered.Load(int4(uint2(x10_, row1_), _e444, int(0)));
-                        uint _e449 = layer_2;
-                        float4 _e452 = filtered.Load(int4(uint2(x11_, row1_), _e449, int(0)));
-                        float4 texel1_ = lerp(_e447, _e452, fx1_);
+                        uint _e392 = layer_2;
+                        float4 coeff = coeffs[min(uint(_e392), 7u)];
+                        uint _e396 = layer_2;
+                        float4 _e399 = filtered.Load(int4(uint2(x00_, _e118), _e396, int(0)));
+                        uint _e401 = layer_2;
+                        float4 _e404 = filtered.Load(int4(uint2(x01_, _e118), _e401, int(0)));
+                        float4 texel0_ = lerp(_e399, _e404, fx0_);
+                        uint _e407 = layer_2;
+                        float4 _e410 = filtered.Load(int4(uint2(x10_, row1_), _e407, int(0)));
+                        uint _e412 = layer_2;
+                        float4 _e415 = filtered.Load(int4(uint2(x11_, row1_), _e412, int(0)));
+                        float4 texel1_ = lerp(_e410, _e415, fx1_);
                         k_3 = 0u;
                         uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
                         bool loop_init_6 = true;
@@ -852,83 +869,83 @@ float3 scatter_pixel(uint x_3, uint y_1)
                             if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
                             loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                             if (!loop_init_6) {
-                                uint _e482 = k_3;
-                                k_3 = (_e482 + 1u);
+                                uint _e445 = k_3;
+                                k_3 = (_e445 + 1u);
                             }
                             loop_init_6 = false;
-                            uint _e456 = k_3;
-                            if ((_e456 < 4u)) {
+                            uint _e419 = k_3;
+                            if ((_e419 < 4u)) {
                             } else {
                                 break;
                             }
                             {
-                                float _e459 = vis0_;
-                                uint _e460 = k_3;
-                                uint _e462 = k_3;
-                                vis0_ = (_e459 + (coeff[min(uint(_e460), 3u)] * ((texel0_[min(uint(_e462), 3u)] * 2.0) - 1.0)));
-                                float _e470 = vis1_;
-                                uint _e471 = k_3;
-                                uint _e473 = k_3;
-                                vis1_ = (_e470 + (coeff[min(uint(_e471), 3u)] * ((texel1_[min(uint(_e473), 3u)] * 2.0) - 1.0)));
+                                float _e422 = vis0_;
+                                uint _e423 = k_3;
+                                uint _e425 = k_3;
+                                vis0_ = (_e422 + (coeff[min(uint(_e423), 3u)] * ((texel0_[min(uint(_e425), 3u)] * 2.0) - 1.0)));
+                                float _e433 = vis1_;
+                                uint _e434 = k_3;
+                                uint _e436 = k_3;
+                                vis1_ = (_e433 + (coeff[min(uint(_e434), 3u)] * ((texel1_[min(uint(_e436), 3u)] * 2.0) - 1.0)));
                             }
                         }
                     }
                 }
             }
-            float _e487 = vis0_;
-            float _e488 = d;
-            float _e493 = d;
-            vis0_ = ((_e493 <= lohi0_.x) ? 1.0 : ((_e488 > lohi0_.y) ? 0.0 : _e487));
-            float _e498 = vis1_;
-            float _e499 = d;
-            float _e504 = d;
-            vis1_ = ((_e504 <= lohi1_.x) ? 1.0 : ((_e499 > lohi1_.y) ? 0.0 : _e498));
-            bool _e510 = done0_;
-            if (!(_e510)) {
-                float _e513 = total0_;
-                float _e514 = weight0_;
-                float _e515 = vis0_;
-                total0_ = (_e513 + (_e514 * clamp(_e515, 0.0, 1.0)));
+            float _e450 = vis0_;
+            float _e451 = d;
+            float _e456 = d;
+            vis0_ = ((_e456 <= lohi0_.x) ? 1.0 : ((_e451 > lohi0_.y) ? 0.0 : _e450));
+            float _e461 = vis1_;
+            float _e462 = d;
+            float _e467 = d;
+            vis1_ = ((_e467 <= lohi1_.x) ? 1.0 : ((_e462 > lohi1_.y) ? 0.0 : _e461));
+            bool _e473 = done0_;
+            if (!(_e473)) {
+                float _e476 = total0_;
+                float _e477 = weight0_;
+                float _e478 = vis0_;
+                total0_ = (_e476 + (_e477 * clamp(_e478, 0.0, 1.0)));
             }
-            bool _e522 = done1_;
-            if (!(_e522)) {
-                float _e525 = total1_;
-                float _e526 = weight1_;
-                float _e527 = vis1_;
-                total1_ = (_e525 + (_e526 * clamp(_e527, 0.0, 1.0)));
+            bool _e485 = done1_;
+            if (!(_e485)) {
+                float _e488 = total1_;
+                float _e489 = weight1_;
+                float _e490 = vis1_;
+                total1_ = (_e488 + (_e489 * clamp(_e490, 0.0, 1.0)));
             }
-            bool _e533 = done0_;
-            if (!(_e533)) {
+            bool _e496 = done0_;
+            if (!(_e496)) {
                 local_14 = is_last0_;
             } else {
                 local_14 = true;
             }
-            bool _e538 = local_14;
-            done0_ = _e538;
-            bool _e539 = done1_;
-            if (!(_e539)) {
+            bool _e501 = local_14;
+            done0_ = _e501;
+            bool _e502 = done1_;
+            if (!(_e502)) {
                 local_15 = is_last1_;
             } else {
                 local_15 = true;
             }
-            bool _e544 = local_15;
-            done1_ = _e544;
-            bool _e545 = done0_;
-            if (_e545) {
-                bool _e546 = done1_;
-                local_16 = _e546;
+            bool _e507 = local_15;
+            done1_ = _e507;
+            bool _e508 = done0_;
+            if (_e508) {
+                bool _e509 = done1_;
+                local_16 = _e509;
             } else {
                 local_16 = false;
             }
-            bool _e550 = local_16;
-            if (_e550) {
+            bool _e513 = local_16;
+            if (_e513) {
                 break;
             }
         }
     }
-    float _e556 = total0_;
-    float _e558 = total1_;
-    float l_2 = (((1.0 - w1_) * _e556) + (w1_ * _e558));
+    float _e519 = total0_;
+    float _e521 = total1_;
+    float l_2 = (((1.0 - w1_) * _e519) + (w1_ * _e521));
     float3 c = (color * l_2);
     return c;
 }

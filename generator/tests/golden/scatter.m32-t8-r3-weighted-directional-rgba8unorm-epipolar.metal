@@ -184,18 +184,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir_6 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_6.z <= 0.000001) {
+        metal::float3 dir_8 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_8.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_8);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return (z_2 + _e35) / dir_6.z;
+        return (z_2 + _e35) / dir_8.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -525,30 +525,66 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    metal::float3 dir_5
+) {
+    float yc = {};
+    uint rows_1 = f_6.sizes.w;
+    float phi_1 = metal::atan2(metal::dot(dir_5, f_6.e2_.xyz), metal::dot(dir_5, f_6.e1_.xyz));
+    yc = (phi_1 - f_6.e1_.w) / f_6.e2_.w;
+    if (f_6.anti_epipole.w > 0.5) {
+        float _e22 = yc;
+        float _e23 = yc;
+        yc = _e22 - (metal::floor(_e23 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
+    } else {
+        float _e30 = yc;
+        yc = metal::clamp(_e30, 0.0, static_cast<float>(rows_1));
+    }
+    float _e34 = yc;
+    return _e34;
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
     metal::float3 eye_5,
-    metal::float3 dir_5,
+    metal::float3 dir_6,
+    float s_2,
+    float theta_2,
+    bool spot_2
+) {
+    if (spot_2) {
+        metal::float3 q_2 = (eye_5 + (dir_6 * s_2)) - f_7.light_pos.xyz;
+        metal::float3 to_eye = -(f_7.axis.xyz);
+        return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
+    }
+    return s_2 * metal::sin(theta_2);
+}
+
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    metal::float3 eye_6,
+    metal::float3 dir_7,
     float a_3,
     float b_3,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_7, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e15;
 }
 
 metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     float phi
 ) {
-    return (f_7.e1_.xyz * metal::cos(phi)) + (f_7.e2_.xyz * metal::sin(phi));
+    return (f_9.e1_.xyz * metal::cos(phi)) + (f_9.e2_.xyz * metal::sin(phi));
 }
 
 float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     uint row
 ) {
-    return f_8.e1_.w + ((static_cast<float>(row) + 0.5) * f_8.e2_.w);
+    return f_10.e1_.w + ((static_cast<float>(row) + 0.5) * f_10.e2_.w);
 }
 
 metal::float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -588,9 +624,9 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     uint r,
     uint regions,
     uint width,
-    bool spot_2
+    bool spot_3
 ) {
-    if (spot_2) {
+    if (spot_3) {
         return naga_div(r * width, regions);
     }
     return naga_div((r * r) * width, regions * regions);
@@ -610,11 +646,11 @@ metal::float3 scatter_pixel(
     bool local_6 = {};
     bool local_7 = {};
     bool local_8 = {};
-    float yc = {};
+    float yc_1 = {};
     float d = {};
     float xs = 0.0;
     float reach = 0.0;
-    float theta_2 = 0.0;
+    float theta_3 = 0.0;
     type_13 coeffs = {};
     metal::float2 angle = {};
     uint layer_1 = 0u;
@@ -645,23 +681,23 @@ metal::float3 scatter_pixel(
     bool local_14 = {};
     bool local_15 = {};
     bool local_16 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9 = frame;
-    metal::float3 eye_6 = f_9.eye.xyz;
-    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11 = frame;
+    metal::float3 eye_7 = f_11.eye.xyz;
+    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, x_3, y_1);
     uint clamped_lod_e14 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
-    float s_2 = metal::min(metal::max(_e14.x, 0.0), f_9.theta.z) / metal::max(metal::dot(_e10, f_9.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_9.light_color.xyz;
+    float s_3 = metal::min(metal::max(_e14.x, 0.0), f_11.theta.z) / metal::max(metal::dot(_e10, f_11.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_11.light_color.xyz;
     metal::float3 px = metal::float3(static_cast<float>(x_3) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
-    float radius = f_9.epipole.w;
-    if (f_9.epipole.z > 0.5) {
-        local_6 = metal::length(px - metal::float3(f_9.epipole.x, f_9.epipole.y, 0.0)) < radius;
+    float radius = f_11.epipole.w;
+    if (f_11.epipole.z > 0.5) {
+        local_6 = metal::length(px - metal::float3(f_11.epipole.x, f_11.epipole.y, 0.0)) < radius;
     } else {
         local_6 = false;
     }
     bool near_epi = local_6;
-    if (f_9.anti_epipole.z > 0.5) {
-        local_7 = metal::length(px - metal::float3(f_9.anti_epipole.x, f_9.anti_epipole.y, 0.0)) < radius;
+    if (f_11.anti_epipole.z > 0.5) {
+        local_7 = metal::length(px - metal::float3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0)) < radius;
     } else {
         local_7 = false;
     }
@@ -674,182 +710,170 @@ metal::float3 scatter_pixel(
     bool _e77 = local_8;
     if (_e77) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = frame;
-        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_6, _e10, s_2, false);
+        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_7, _e10, s_3, false);
         metal::float3 l_1 = _e82 * color;
         return l_1;
     }
-    metal::float3 axis = f_9.axis.xyz;
-    uint rows_1 = f_9.sizes.w;
-    uint width_1 = f_9.sizes.z;
-    bool wrap_1 = f_9.anti_epipole.w > 0.5;
+    metal::float3 axis = f_11.axis.xyz;
+    uint rows_2 = f_11.sizes.w;
+    uint width_1 = f_11.sizes.z;
+    bool wrap_1 = f_11.anti_epipole.w > 0.5;
     {
-        theta_2 = metal::acos(metal::clamp(metal::dot(_e10, axis), -1.0, 1.0));
-        float phi_1 = metal::atan2(metal::dot(_e10, f_9.e2_.xyz), metal::dot(_e10, f_9.e1_.xyz));
-        yc = (phi_1 - f_9.e1_.w) / f_9.e2_.w;
-        if (wrap_1) {
-            float _e114 = yc;
-            float _e115 = yc;
-            yc = _e114 - (metal::floor(_e115 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
-        } else {
-            float _e122 = yc;
-            yc = metal::clamp(_e122, 0.0, static_cast<float>(rows_1));
-        }
-        float _e126 = theta_2;
-        float _e131 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e126, f_9.theta.x, f_9.theta.y);
-        d = _e131;
-        if (false) {
-            metal::float3 q_2 = metal::normalize((eye_6 + (_e10 * s_2)) - f_9.light_pos.xyz);
-            reach = metal::acos(metal::clamp(metal::dot(q_2, -(axis)), -1.0, 1.0));
-        } else {
-            float _e146 = theta_2;
-            reach = s_2 * metal::sin(_e146);
-        }
+        theta_3 = metal::acos(metal::clamp(metal::dot(_e10, axis), -1.0, 1.0));
+        float _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, _e10);
+        yc_1 = _e100;
+        float _e102 = theta_3;
+        float _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_11.theta.x, f_11.theta.y);
+        d = _e107;
+        float _e109 = theta_3;
+        float _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, s_3, _e109, false);
+        reach = _e110;
     }
-    float _e149 = yc;
-    float yb = _e149 - 0.5;
+    float _e112 = yc_1;
+    float yb = _e112 - 0.5;
     float fy = yb - metal::floor(yb);
-    uint _e155 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_1, wrap_1);
-    uint _e159 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_1, wrap_1);
-    uint row1_ = (yb > metal::floor(yb)) ? _e159 : _e155;
-    float w1_ = (row1_ != _e155) ? fy : 0.0;
-    float cos_theta_l = -(metal::dot(f_9.light_dir.xyz, _e10));
-    uint panels_2 = metal::max(naga_div(f_9.sizes2_.z, 4u), 1u);
-    float _e177 = d;
-    float _e181 = d;
-    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e177), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e181));
-    metal::float2 _e186 = angle;
-    metal::float2 _e187 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e186);
+    uint _e118 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_2, wrap_1);
+    uint _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_2, wrap_1);
+    uint row1_ = (yb > metal::floor(yb)) ? _e122 : _e118;
+    float w1_ = (row1_ != _e118) ? fy : 0.0;
+    float cos_theta_l = -(metal::dot(f_11.light_dir.xyz, _e10));
+    uint panels_2 = metal::max(naga_div(f_11.sizes2_.z, 4u), 1u);
+    float _e140 = d;
+    float _e144 = d;
+    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e140), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e144));
+    metal::float2 _e149 = angle;
+    metal::float2 _e150 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e202 = layer_1;
-            layer_1 = _e202 + 1u;
+            uint _e165 = layer_1;
+            layer_1 = _e165 + 1u;
         }
         loop_init_3 = false;
-        uint _e189 = layer_1;
-        if (_e189 < LAYERS) {
+        uint _e152 = layer_1;
+        if (_e152 < LAYERS) {
         } else {
             break;
         }
         {
-            metal::float2 _e192 = angle;
-            metal::float2 _e193 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e192, _e187);
-            uint _e195 = layer_1;
-            metal::float2 _e197 = angle;
-            uint _e198 = layer_1;
-            metal::float4 _e199 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e197, _e193, _e198);
-            coeffs.inner[metal::min(unsigned(_e195), 7u)] = _e199;
-            metal::float2 _e200 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e193, _e187);
-            angle = _e200;
+            metal::float2 _e155 = angle;
+            metal::float2 _e156 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, _e150);
+            uint _e158 = layer_1;
+            metal::float2 _e160 = angle;
+            uint _e161 = layer_1;
+            metal::float4 _e162 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e160, _e156, _e161);
+            coeffs.inner[metal::min(unsigned(_e158), 7u)] = _e162;
+            metal::float2 _e163 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156, _e150);
+            angle = _e163;
         }
     }
-    float _e208 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    float sun_scatter = f_9.medium.y * _e208;
-    float _e211 = xs;
-    xs0_ = _e211;
-    float _e213 = xs;
-    xs1_ = _e213;
+    float _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.z, cos_theta_l);
+    float sun_scatter = f_11.medium.y * _e171;
+    float _e174 = xs;
+    xs0_ = _e174;
+    float _e176 = xs;
+    xs1_ = _e176;
     {
-        metal::float4 _e217 = slices[metal::min(unsigned(_e155), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e218 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e217);
-        delta0_ = _e218.delta;
-        metal::float4 _e223 = slices[metal::min(unsigned(row1_), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e224 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e223);
-        delta1_ = _e224.delta;
-        float _e227 = reach;
-        float _e228 = delta0_;
-        xs0_ = _e227 / _e228;
-        float _e230 = reach;
-        float _e231 = delta1_;
-        xs1_ = _e230 / _e231;
+        metal::float4 _e180 = slices[metal::min(unsigned(_e118), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e181 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e180);
+        delta0_ = _e181.delta;
+        metal::float4 _e186 = slices[metal::min(unsigned(row1_), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e187 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e186);
+        delta1_ = _e187.delta;
+        float _e190 = reach;
+        float _e191 = delta0_;
+        xs0_ = _e190 / _e191;
+        float _e193 = reach;
+        float _e194 = delta1_;
+        xs1_ = _e193 / _e194;
     }
-    float _e233 = xs0_;
-    uint last0_ = naga_f2u32(metal::min(metal::max(_e233, 0.0), static_cast<float>(width_1) - 1.0));
-    float _e241 = xs1_;
-    uint last1_ = naga_f2u32(metal::min(metal::max(_e241, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e196 = xs0_;
+    uint last0_ = naga_f2u32(metal::min(metal::max(_e196, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e204 = xs1_;
+    uint last1_ = naga_f2u32(metal::min(metal::max(_e204, 0.0), static_cast<float>(width_1) - 1.0));
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e552 = r_1;
-            r_1 = _e552 + 1u;
+            uint _e515 = r_1;
+            r_1 = _e515 + 1u;
         }
         loop_init_4 = false;
-        uint _e251 = r_1;
-        if (_e251 < REGIONS) {
+        uint _e214 = r_1;
+        if (_e214 < REGIONS) {
         } else {
             break;
         }
         {
-            uint _e253 = r_1;
-            uint _e254 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e253, REGIONS, width_1, false);
-            float b0_ = static_cast<float>(_e254);
-            uint _e256 = r_1;
-            uint _e259 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e256 + 1u, REGIONS, width_1, false);
-            float b1_ = static_cast<float>(_e259);
+            uint _e216 = r_1;
+            uint _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, false);
+            float b0_ = static_cast<float>(_e217);
+            uint _e219 = r_1;
+            uint _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e219 + 1u, REGIONS, width_1, false);
+            float b1_ = static_cast<float>(_e222);
             if (!((last0_ < naga_f2u32(b1_)))) {
-                uint _e264 = r_1;
-                local_9 = (_e264 + 1u) == REGIONS;
+                uint _e227 = r_1;
+                local_9 = (_e227 + 1u) == REGIONS;
             } else {
                 local_9 = true;
             }
             bool is_last0_ = local_9;
             if (!((last1_ < naga_f2u32(b1_)))) {
-                uint _e275 = r_1;
-                local_10 = (_e275 + 1u) == REGIONS;
+                uint _e238 = r_1;
+                local_10 = (_e238 + 1u) == REGIONS;
             } else {
                 local_10 = true;
             }
             bool is_last1_ = local_10;
-            float _e285 = xs0_;
-            float pos0_ = is_last0_ ? metal::clamp(_e285 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-            float _e296 = xs1_;
-            float pos1_ = is_last1_ ? metal::clamp(_e296 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            float _e248 = xs0_;
+            float pos0_ = is_last0_ ? metal::clamp(_e248 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            float _e259 = xs1_;
+            float pos1_ = is_last1_ ? metal::clamp(_e259 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
             a0_ = float {};
             e0_ = float {};
             a1_ = float {};
             e1_ = float {};
-            float _e313 = delta0_;
-            float _e314 = theta_2;
-            float _e315 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e313, _e314, s_2, false);
-            a0_ = _e315;
-            float _e316 = delta0_;
-            float _e317 = theta_2;
-            float _e318 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e316, _e317, s_2, false);
-            e0_ = is_last0_ ? s_2 : _e318;
-            float _e320 = delta1_;
-            float _e321 = theta_2;
-            float _e322 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e320, _e321, s_2, false);
-            a1_ = _e322;
-            float _e323 = delta1_;
-            float _e324 = theta_2;
-            float _e325 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e323, _e324, s_2, false);
-            e1_ = is_last1_ ? s_2 : _e325;
+            float _e276 = delta0_;
+            float _e277 = theta_3;
+            float _e278 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b0_, _e276, _e277, s_3, false);
+            a0_ = _e278;
+            float _e279 = delta0_;
+            float _e280 = theta_3;
+            float _e281 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b1_, _e279, _e280, s_3, false);
+            e0_ = is_last0_ ? s_3 : _e281;
+            float _e283 = delta1_;
+            float _e284 = theta_3;
+            float _e285 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b0_, _e283, _e284, s_3, false);
+            a1_ = _e285;
+            float _e286 = delta1_;
+            float _e287 = theta_3;
+            float _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b1_, _e286, _e287, s_3, false);
+            e1_ = is_last1_ ? s_3 : _e288;
             weight0_ = float {};
             weight1_ = float {};
             if (false) {
-                float _e331 = a0_;
-                float _e332 = e0_;
-                float _e333 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e10, _e331, _e332, panels_2);
-                weight0_ = _e333;
-                float _e334 = a1_;
-                float _e335 = e1_;
-                float _e336 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e10, _e334, _e335, panels_2);
-                weight1_ = _e336;
+                float _e294 = a0_;
+                float _e295 = e0_;
+                float _e296 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, _e294, _e295, panels_2);
+                weight0_ = _e296;
+                float _e297 = a1_;
+                float _e298 = e1_;
+                float _e299 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, _e297, _e298, panels_2);
+                weight1_ = _e299;
             } else {
-                float _e339 = a0_;
-                float _e340 = e0_;
-                float _e341 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e339, _e340);
-                weight0_ = sun_scatter * _e341;
-                float _e345 = a1_;
-                float _e346 = e1_;
-                float _e347 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e345, _e346);
-                weight1_ = sun_scatter * _e347;
+                float _e302 = a0_;
+                float _e303 = e0_;
+                float _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, _e302, _e303);
+                weight0_ = sun_scatter * _e304;
+                float _e308 = a1_;
+                float _e309 = e1_;
+                float _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, _e308, _e309);
+                weight1_ = sun_scatter * _e310;
             }
             float xb0_ = pos0_ - 0.5;
             float fx0_ = xb0_ - metal::floor(xb0_);
@@ -859,35 +883,35 @@ metal::float3 scatter_pixel(
             float fx1_ = xb1_ - metal::floor(xb1_);
             uint x10_ = naga_f2u32(metal::clamp(metal::floor(xb1_), 0.0, static_cast<float>(width_1) - 1.0));
             uint x11_ = (xb1_ > metal::floor(xb1_)) ? metal::min(x10_ + 1u, width_1 - 1u) : x10_;
-            uint clamped_lod_e390 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 lohi0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x01_, _e155)), metal::uint2(bounds.get_width(clamped_lod_e390), bounds.get_height(clamped_lod_e390)) - 1), clamped_lod_e390);
-            uint clamped_lod_e394 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 lohi1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x11_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e394), bounds.get_height(clamped_lod_e394)) - 1), clamped_lod_e394);
+            uint clamped_lod_e353 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 lohi0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x01_, _e118)), metal::uint2(bounds.get_width(clamped_lod_e353), bounds.get_height(clamped_lod_e353)) - 1), clamped_lod_e353);
+            uint clamped_lod_e357 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
+            metal::float4 lohi1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x11_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e357), bounds.get_height(clamped_lod_e357)) - 1), clamped_lod_e357);
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e399 = d;
-            if (_e399 > lohi0_.x) {
-                float _e402 = d;
-                local_11 = _e402 <= lohi0_.y;
+            float _e362 = d;
+            if (_e362 > lohi0_.x) {
+                float _e365 = d;
+                local_11 = _e365 <= lohi0_.y;
             } else {
                 local_11 = false;
             }
-            bool _e408 = local_11;
-            if (!(_e408)) {
-                float _e410 = d;
-                if (_e410 > lohi1_.x) {
-                    float _e413 = d;
-                    local_13 = _e413 <= lohi1_.y;
+            bool _e371 = local_11;
+            if (!(_e371)) {
+                float _e373 = d;
+                if (_e373 > lohi1_.x) {
+                    float _e376 = d;
+                    local_13 = _e376 <= lohi1_.y;
                 } else {
                     local_13 = false;
                 }
-                bool _e419 = local_13;
-                local_12 = _e419;
+                bool _e382 = local_13;
+                local_12 = _e382;
             } else {
                 local_12 = true;
             }
-            bool _e423 = local_12;
-            if (_e423) {
+            bool _e386 = local_12;
+            if (_e386) {
                 layer_2 = 0u;
                 uint2 loop_bound_5 = uint2(4294967295u);
                 bool loop_init_5 = true;
@@ -895,32 +919,32 @@ metal::float3 scatter_pixel(
                     if (metal::all(loop_bound_5 == uint2(0u))) { break; }
                     loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                     if (!loop_init_5) {
-                        uint _e485 = layer_2;
-                        layer_2 = _e485 + 1u;
+                        uint _e448 = layer_2;
+                        layer_2 = _e448 + 1u;
                     }
                     loop_init_5 = false;
-                    uint _e426 = layer_2;
-                    if (_e426 < LAYERS) {
+                    uint _e389 = layer_2;
+                    if (_e389 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        uint _e429 = layer_2;
-                        metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e429), 7u)];
-                        uint _e433 = layer_2;
-                        uint clamped_lod_e436 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                        metal::float4 _e436 = filtered.read(metal::min(metal::uint2(metal::uint2(x00_, _e155)), metal::uint2(filtered.get_width(clamped_lod_e436), filtered.get_height(clamped_lod_e436)) - 1), metal::min(uint(_e433), filtered.get_array_size() - 1), clamped_lod_e436);
-                        uint _e438 = layer_2;
-                        uint clamped_lod_e441 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                        metal::float4 _e441 = filtered.read(metal::min(metal::uint2(metal::uint2(x01_, _e155)), metal::uint2(filtered.get_width(clamped_lod_e441), filtered.get_height(clamped_lod_e441)) - 1), metal::min(uint(_e438), filtered.get_array_size() - 1), clamped_lod_e441);
-                        metal::float4 texel0_ = metal::mix(_e436, _e441, fx0_);
-                        uint _e444 = layer_2;
-                        uint clamped_lod_e447 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                        metal::float4 _e447 = filtered.read(metal::min(metal::uint2(metal::uint2(x10_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e447), filtered.get_height(clamped_lod_e447)) - 1), metal::min(uint(_e444), filtered.get_array_size() - 1), clamped_lod_e447);
-                        uint _e449 = layer_2;
-                        uint clamped_lod_e452 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                        metal::float4 _e452 = filtered.read(metal::min(metal::uint2(metal::uint2(x11_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e452), filtered.get_height(clamped_lod_e452)) - 1), metal::min(uint(_e449), filtered.get_array_size() - 1), clamped_lod_e452);
-                        metal::float4 texel1_ = metal::mix(_e447, _e452, fx1_);
+                        uint _e392 = layer_2;
+                        metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e392), 7u)];
+                        uint _e396 = layer_2;
+                        uint clamped_lod_e399 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                        metal::float4 _e399 = filtered.read(metal::min(metal::uint2(metal::uint2(x00_, _e118)), metal::uint2(filtered.get_width(clamped_lod_e399), filtered.get_height(clamped_lod_e399)) - 1), metal::min(uint(_e396), filtered.get_array_size() - 1), clamped_lod_e399);
+                        uint _e401 = layer_2;
+                        uint clamped_lod_e404 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                        metal::float4 _e404 = filtered.read(metal::min(metal::uint2(metal::uint2(x01_, _e118)), metal::uint2(filtered.get_width(clamped_lod_e404), filtered.get_height(clamped_lod_e404)) - 1), metal::min(uint(_e401), filtered.get_array_size() - 1), clamped_lod_e404);
+                        metal::float4 texel0_ = metal::mix(_e399, _e404, fx0_);
+                        uint _e407 = layer_2;
+                        uint clamped_lod_e410 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                        metal::float4 _e410 = filtered.read(metal::min(metal::uint2(metal::uint2(x10_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e410), filtered.get_height(clamped_lod_e410)) - 1), metal::min(uint(_e407), filtered.get_array_size() - 1), clamped_lod_e410);
+                        uint _e412 = layer_2;
+                        uint clamped_lod_e415 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
+                        metal::float4 _e415 = filtered.read(metal::min(metal::uint2(metal::uint2(x11_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e415), filtered.get_height(clamped_lod_e415)) - 1), metal::min(uint(_e412), filtered.get_array_size() - 1), clamped_lod_e415);
+                        metal::float4 texel1_ = metal::mix(_e410, _e415, fx1_);
                         k_3 = 0u;
                         uint2 loop_bound_6 = uint2(4294967295u);
                         bool loop_init_6 = true;
@@ -928,83 +952,83 @@ metal::float3 scatter_pixel(
                             if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                             loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                             if (!loop_init_6) {
-                                uint _e482 = k_3;
-                                k_3 = _e482 + 1u;
+                                uint _e445 = k_3;
+                                k_3 = _e445 + 1u;
                             }
                             loop_init_6 = false;
-                            uint _e456 = k_3;
-                            if (_e456 < 4u) {
+                            uint _e419 = k_3;
+                            if (_e419 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                float _e459 = vis0_;
-                                uint _e460 = k_3;
-                                uint _e462 = k_3;
-                                vis0_ = _e459 + (coeff[metal::min(unsigned(_e460), 3u)] * ((texel0_[metal::min(unsigned(_e462), 3u)] * 2.0) - 1.0));
-                                float _e470 = vis1_;
-                                uint _e471 = k_3;
-                                uint _e473 = k_3;
-                                vis1_ = _e470 + (coeff[metal::min(unsigned(_e471), 3u)] * ((texel1_[metal::min(unsigned(_e473), 3u)] * 2.0) - 1.0));
+                                float _e422 = vis0_;
+                                uint _e423 = k_3;
+                                uint _e425 = k_3;
+                                vis0_ = _e422 + (coeff[metal::min(unsigned(_e423), 3u)] * ((texel0_[metal::min(unsigned(_e425), 3u)] * 2.0) - 1.0));
+                                float _e433 = vis1_;
+                                uint _e434 = k_3;
+                                uint _e436 = k_3;
+                                vis1_ = _e433 + (coeff[metal::min(unsigned(_e434), 3u)] * ((texel1_[metal::min(unsigned(_e436), 3u)] * 2.0) - 1.0));
                             }
                         }
                     }
                 }
             }
-            float _e487 = vis0_;
-            float _e488 = d;
-            float _e493 = d;
-            vis0_ = (_e493 <= lohi0_.x) ? 1.0 : ((_e488 > lohi0_.y) ? 0.0 : _e487);
-            float _e498 = vis1_;
-            float _e499 = d;
-            float _e504 = d;
-            vis1_ = (_e504 <= lohi1_.x) ? 1.0 : ((_e499 > lohi1_.y) ? 0.0 : _e498);
-            bool _e510 = done0_;
-            if (!(_e510)) {
-                float _e513 = total0_;
-                float _e514 = weight0_;
-                float _e515 = vis0_;
-                total0_ = _e513 + (_e514 * metal::clamp(_e515, 0.0, 1.0));
+            float _e450 = vis0_;
+            float _e451 = d;
+            float _e456 = d;
+            vis0_ = (_e456 <= lohi0_.x) ? 1.0 : ((_e451 > lohi0_.y) ? 0.0 : _e450);
+            float _e461 = vis1_;
+            float _e462 = d;
+            float _e467 = d;
+            vis1_ = (_e467 <= lohi1_.x) ? 1.0 : ((_e462 > lohi1_.y) ? 0.0 : _e461);
+            bool _e473 = done0_;
+            if (!(_e473)) {
+                float _e476 = total0_;
+                float _e477 = weight0_;
+                float _e478 = vis0_;
+                total0_ = _e476 + (_e477 * metal::clamp(_e478, 0.0, 1.0));
             }
-            bool _e522 = done1_;
-            if (!(_e522)) {
-                float _e525 = total1_;
-                float _e526 = weight1_;
-                float _e527 = vis1_;
-                total1_ = _e525 + (_e526 * metal::clamp(_e527, 0.0, 1.0));
+            bool _e485 = done1_;
+            if (!(_e485)) {
+                float _e488 = total1_;
+                float _e489 = weight1_;
+                float _e490 = vis1_;
+                total1_ = _e488 + (_e489 * metal::clamp(_e490, 0.0, 1.0));
             }
-            bool _e533 = done0_;
-            if (!(_e533)) {
+            bool _e496 = done0_;
+            if (!(_e496)) {
                 local_14 = is_last0_;
             } else {
                 local_14 = true;
             }
-            bool _e538 = local_14;
-            done0_ = _e538;
-            bool _e539 = done1_;
-            if (!(_e539)) {
+            bool _e501 = local_14;
+            done0_ = _e501;
+            bool _e502 = done1_;
+            if (!(_e502)) {
                 local_15 = is_last1_;
             } else {
                 local_15 = true;
             }
-            bool _e544 = local_15;
-            done1_ = _e544;
-            bool _e545 = done0_;
-            if (_e545) {
-                bool _e546 = done1_;
-                local_16 = _e546;
+            bool _e507 = local_15;
+            done1_ = _e507;
+            bool _e508 = done0_;
+            if (_e508) {
+                bool _e509 = done1_;
+                local_16 = _e509;
             } else {
                 local_16 = false;
             }
-            bool _e550 = local_16;
-            if (_e550) {
+            bool _e513 = local_16;
+            if (_e513) {
                 break;
             }
         }
     }
-    float _e556 = total0_;
-    float _e558 = total1_;
-    float l_2 = ((1.0 - w1_) * _e556) + (w1_ * _e558);
+    float _e519 = total0_;
+    float _e521 = total1_;
+    float l_2 = ((1.0 - w1_) * _e519) + (w1_ * _e521);
     metal::float3 c = color * l_2;
     return c;
 }

@@ -162,18 +162,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_6 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_6.z <= 0.000001f) {
+        let dir_8 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_8.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_8);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_6.z);
+        return ((z_2 + _e35) / dir_8.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -399,17 +399,44 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_X
     }
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_5: vec3<f32>) -> f32 {
+    var yc: f32;
+
+    let rows_1 = f_6.sizes.w;
+    let phi_1 = atan2(dot(dir_5, f_6.e2_.xyz), dot(dir_5, f_6.e1_.xyz));
+    yc = ((phi_1 - f_6.e1_.w) / f_6.e2_.w);
+    if (f_6.anti_epipole.w > 0.5f) {
+        let _e22 = yc;
+        let _e23 = yc;
+        yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
+    } else {
+        let _e30 = yc;
+        yc = clamp(_e30, 0f, f32(rows_1));
+    }
+    let _e34 = yc;
+    return _e34;
+}
+
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_6: vec3<f32>, s_2: f32, theta_2: f32, spot_2: bool) -> f32 {
+    if spot_2 {
+        let q_2 = ((eye_5 + (dir_6 * s_2)) - f_7.light_pos.xyz);
+        let to_eye = -(f_7.axis.xyz);
+        return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
+    }
+    return (s_2 * sin(theta_2));
+}
+
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_7, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e15;
 }
 
-fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
-    return ((f_7.e1_.xyz * cos(phi)) + (f_7.e2_.xyz * sin(phi)));
+fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
+    return ((f_9.e1_.xyz * cos(phi)) + (f_9.e2_.xyz * sin(phi)));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    return (f_8.e1_.w + ((f32(row) + 0.5f) * f_8.e2_.w));
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    return (f_10.e1_.w + ((f32(row) + 0.5f) * f_10.e2_.w));
 }
 
 fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_4: vec2<f32>, b_4: vec2<f32>) -> vec2<f32> {
@@ -430,8 +457,8 @@ fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_5: 
     return vec4<f32>(((2f / _e5) * a_5.y), ((-2f / _e5) * a_5.x), ((2f / _e10) * b_5.y), ((-2f / _e10) * b_5.x));
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
-    if spot_2 {
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_3: bool) -> u32 {
+    if spot_3 {
         return ((r * width) / regions);
     }
     return (((r * r) * width) / (regions * regions));
@@ -441,11 +468,11 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     var local_6: bool;
     var local_7: bool;
     var local_8: bool;
-    var yc: f32;
+    var yc_1: f32;
     var d: f32;
     var xs: f32 = 0f;
     var reach: f32 = 0f;
-    var theta_2: f32 = 0f;
+    var theta_3: f32 = 0f;
     var coeffs: array<vec4<f32>, 8>;
     var angle: vec2<f32>;
     var layer_1: u32 = 0u;
@@ -477,22 +504,22 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     var local_15: bool;
     var local_16: bool;
 
-    let f_9 = frame;
-    let eye_6 = f_9.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, x_3, y_1);
+    let f_11 = frame;
+    let eye_7 = f_11.eye.xyz;
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, x_3, y_1);
     let _e14 = textureLoad(depth, vec2<u32>(x_3, y_1), 0i);
-    let s_2 = (min(max(_e14.x, 0f), f_9.theta.z) / max(dot(_e10, f_9.cam_forward.xyz), 0.000001f));
-    let color = f_9.light_color.xyz;
+    let s_3 = (min(max(_e14.x, 0f), f_11.theta.z) / max(dot(_e10, f_11.cam_forward.xyz), 0.000001f));
+    let color = f_11.light_color.xyz;
     let px = vec3<f32>((f32(x_3) + 0.5f), (f32(y_1) + 0.5f), 0f);
-    let radius = f_9.epipole.w;
-    if (f_9.epipole.z > 0.5f) {
-        local_6 = (length((px - vec3<f32>(f_9.epipole.x, f_9.epipole.y, 0f))) < radius);
+    let radius = f_11.epipole.w;
+    if (f_11.epipole.z > 0.5f) {
+        local_6 = (length((px - vec3<f32>(f_11.epipole.x, f_11.epipole.y, 0f))) < radius);
     } else {
         local_6 = false;
     }
     let near_epi = local_6;
-    if (f_9.anti_epipole.z > 0.5f) {
-        local_7 = (length((px - vec3<f32>(f_9.anti_epipole.x, f_9.anti_epipole.y, 0f))) < radius);
+    if (f_11.anti_epipole.z > 0.5f) {
+        local_7 = (length((px - vec3<f32>(f_11.anti_epipole.x, f_11.anti_epipole.y, 0f))) < radius);
     } else {
         local_7 = false;
     }
@@ -505,168 +532,156 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     let _e77 = local_8;
     if _e77 {
         let _e79 = frame;
-        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_6, _e10, s_2, false);
+        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_7, _e10, s_3, false);
         let l_1 = (_e82 * color);
         return l_1;
     }
-    let axis = f_9.axis.xyz;
-    let rows_1 = f_9.sizes.w;
-    let width_1 = f_9.sizes.z;
-    let wrap_1 = (f_9.anti_epipole.w > 0.5f);
+    let axis = f_11.axis.xyz;
+    let rows_2 = f_11.sizes.w;
+    let width_1 = f_11.sizes.z;
+    let wrap_1 = (f_11.anti_epipole.w > 0.5f);
     {
-        theta_2 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let phi_1 = atan2(dot(_e10, f_9.e2_.xyz), dot(_e10, f_9.e1_.xyz));
-        yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
-        if wrap_1 {
-            let _e114 = yc;
-            let _e115 = yc;
-            yc = (_e114 - (floor((_e115 / f32(rows_1))) * f32(rows_1)));
-        } else {
-            let _e122 = yc;
-            yc = clamp(_e122, 0f, f32(rows_1));
-        }
-        let _e126 = theta_2;
-        let _e131 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e126, f_9.theta.x, f_9.theta.y);
-        d = _e131;
-        if false {
-            let q_2 = normalize(((eye_6 + (_e10 * s_2)) - f_9.light_pos.xyz));
-            reach = acos(clamp(dot(q_2, -(axis)), -1f, 1f));
-        } else {
-            let _e146 = theta_2;
-            reach = (s_2 * sin(_e146));
-        }
+        theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
+        let _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, _e10);
+        yc_1 = _e100;
+        let _e102 = theta_3;
+        let _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_11.theta.x, f_11.theta.y);
+        d = _e107;
+        let _e109 = theta_3;
+        let _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, s_3, _e109, false);
+        reach = _e110;
     }
-    let _e149 = yc;
-    let yb = (_e149 - 0.5f);
+    let _e112 = yc_1;
+    let yb = (_e112 - 0.5f);
     let fy = (yb - floor(yb));
-    let _e155 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    let _e159 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
-    let row1_ = select(_e155, _e159, (yb > floor(yb)));
-    let w1_ = select(0f, fy, (row1_ != _e155));
-    let cos_theta_l = -(dot(f_9.light_dir.xyz, _e10));
-    let panels_2 = max((f_9.sizes2_.z / 4u), 1u);
-    let _e177 = d;
-    let _e181 = d;
-    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e177)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e181)));
-    let _e186 = angle;
-    let _e187 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e186);
+    let _e118 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    let _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
+    let row1_ = select(_e118, _e122, (yb > floor(yb)));
+    let w1_ = select(0f, fy, (row1_ != _e118));
+    let cos_theta_l = -(dot(f_11.light_dir.xyz, _e10));
+    let panels_2 = max((f_11.sizes2_.z / 4u), 1u);
+    let _e140 = d;
+    let _e144 = d;
+    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e140)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e144)));
+    let _e149 = angle;
+    let _e150 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
     loop {
-        let _e189 = layer_1;
-        if (_e189 < LAYERS) {
+        let _e152 = layer_1;
+        if (_e152 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e192 = angle;
-            let _e193 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e192, _e187);
-            let _e195 = layer_1;
-            let _e197 = angle;
-            let _e198 = layer_1;
-            let _e199 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e197, _e193, _e198);
-            coeffs[_e195] = _e199;
-            let _e200 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e193, _e187);
-            angle = _e200;
+            let _e155 = angle;
+            let _e156 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, _e150);
+            let _e158 = layer_1;
+            let _e160 = angle;
+            let _e161 = layer_1;
+            let _e162 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e160, _e156, _e161);
+            coeffs[_e158] = _e162;
+            let _e163 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156, _e150);
+            angle = _e163;
         }
         continuing {
-            let _e202 = layer_1;
-            layer_1 = (_e202 + 1u);
+            let _e165 = layer_1;
+            layer_1 = (_e165 + 1u);
         }
     }
-    let _e208 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.z, cos_theta_l);
-    let sun_scatter = (f_9.medium.y * _e208);
-    let _e211 = xs;
-    xs0_ = _e211;
-    let _e213 = xs;
-    xs1_ = _e213;
+    let _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.z, cos_theta_l);
+    let sun_scatter = (f_11.medium.y * _e171);
+    let _e174 = xs;
+    xs0_ = _e174;
+    let _e176 = xs;
+    xs1_ = _e176;
     {
-        let _e217 = slices[_e155];
-        let _e218 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e217);
-        delta0_ = _e218.delta;
-        let _e223 = slices[row1_];
-        let _e224 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e223);
-        delta1_ = _e224.delta;
-        let _e227 = reach;
-        let _e228 = delta0_;
-        xs0_ = (_e227 / _e228);
-        let _e230 = reach;
-        let _e231 = delta1_;
-        xs1_ = (_e230 / _e231);
+        let _e180 = slices[_e118];
+        let _e181 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e180);
+        delta0_ = _e181.delta;
+        let _e186 = slices[row1_];
+        let _e187 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e186);
+        delta1_ = _e187.delta;
+        let _e190 = reach;
+        let _e191 = delta0_;
+        xs0_ = (_e190 / _e191);
+        let _e193 = reach;
+        let _e194 = delta1_;
+        xs1_ = (_e193 / _e194);
     }
-    let _e233 = xs0_;
-    let last0_ = u32(min(max(_e233, 0f), (f32(width_1) - 1f)));
-    let _e241 = xs1_;
-    let last1_ = u32(min(max(_e241, 0f), (f32(width_1) - 1f)));
+    let _e196 = xs0_;
+    let last0_ = u32(min(max(_e196, 0f), (f32(width_1) - 1f)));
+    let _e204 = xs1_;
+    let last1_ = u32(min(max(_e204, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e251 = r_1;
-        if (_e251 < REGIONS) {
+        let _e214 = r_1;
+        if (_e214 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e253 = r_1;
-            let _e254 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e253, REGIONS, width_1, false);
-            let b0_ = f32(_e254);
-            let _e256 = r_1;
-            let _e259 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e256 + 1u), REGIONS, width_1, false);
-            let b1_ = f32(_e259);
+            let _e216 = r_1;
+            let _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, false);
+            let b0_ = f32(_e217);
+            let _e219 = r_1;
+            let _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e219 + 1u), REGIONS, width_1, false);
+            let b1_ = f32(_e222);
             if !((last0_ < u32(b1_))) {
-                let _e264 = r_1;
-                local_9 = ((_e264 + 1u) == REGIONS);
+                let _e227 = r_1;
+                local_9 = ((_e227 + 1u) == REGIONS);
             } else {
                 local_9 = true;
             }
             let is_last0_ = local_9;
             if !((last1_ < u32(b1_))) {
-                let _e275 = r_1;
-                local_10 = ((_e275 + 1u) == REGIONS);
+                let _e238 = r_1;
+                local_10 = ((_e238 + 1u) == REGIONS);
             } else {
                 local_10 = true;
             }
             let is_last1_ = local_10;
-            let _e285 = xs0_;
-            let pos0_ = select((b1_ - 0.5f), clamp((_e285 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
-            let _e296 = xs1_;
-            let pos1_ = select((b1_ - 0.5f), clamp((_e296 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
+            let _e248 = xs0_;
+            let pos0_ = select((b1_ - 0.5f), clamp((_e248 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
+            let _e259 = xs1_;
+            let pos1_ = select((b1_ - 0.5f), clamp((_e259 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
             a0_ = f32();
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e313 = delta0_;
-            let _e314 = theta_2;
-            let _e315 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e313, _e314, s_2, false);
-            a0_ = _e315;
-            let _e316 = delta0_;
-            let _e317 = theta_2;
-            let _e318 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e316, _e317, s_2, false);
-            e0_ = select(_e318, s_2, is_last0_);
-            let _e320 = delta1_;
-            let _e321 = theta_2;
-            let _e322 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b0_, _e320, _e321, s_2, false);
-            a1_ = _e322;
-            let _e323 = delta1_;
-            let _e324 = theta_2;
-            let _e325 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, b1_, _e323, _e324, s_2, false);
-            e1_ = select(_e325, s_2, is_last1_);
+            let _e276 = delta0_;
+            let _e277 = theta_3;
+            let _e278 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b0_, _e276, _e277, s_3, false);
+            a0_ = _e278;
+            let _e279 = delta0_;
+            let _e280 = theta_3;
+            let _e281 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b1_, _e279, _e280, s_3, false);
+            e0_ = select(_e281, s_3, is_last0_);
+            let _e283 = delta1_;
+            let _e284 = theta_3;
+            let _e285 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b0_, _e283, _e284, s_3, false);
+            a1_ = _e285;
+            let _e286 = delta1_;
+            let _e287 = theta_3;
+            let _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b1_, _e286, _e287, s_3, false);
+            e1_ = select(_e288, s_3, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
-                let _e331 = a0_;
-                let _e332 = e0_;
-                let _e333 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e10, _e331, _e332, panels_2);
-                weight0_ = _e333;
-                let _e334 = a1_;
-                let _e335 = e1_;
-                let _e336 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_6, _e10, _e334, _e335, panels_2);
-                weight1_ = _e336;
+                let _e294 = a0_;
+                let _e295 = e0_;
+                let _e296 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, _e294, _e295, panels_2);
+                weight0_ = _e296;
+                let _e297 = a1_;
+                let _e298 = e1_;
+                let _e299 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, _e297, _e298, panels_2);
+                weight1_ = _e299;
             } else {
-                let _e339 = a0_;
-                let _e340 = e0_;
-                let _e341 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e339, _e340);
-                weight0_ = (sun_scatter * _e341);
-                let _e345 = a1_;
-                let _e346 = e1_;
-                let _e347 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, _e345, _e346);
-                weight1_ = (sun_scatter * _e347);
+                let _e302 = a0_;
+                let _e303 = e0_;
+                let _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, _e302, _e303);
+                weight0_ = (sun_scatter * _e304);
+                let _e308 = a1_;
+                let _e309 = e1_;
+                let _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, _e308, _e309);
+                weight1_ = (sun_scatter * _e310);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -676,140 +691,140 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let lohi0_ = textureLoad(bounds, vec2<u32>(x01_, _e155), 0i);
+            let lohi0_ = textureLoad(bounds, vec2<u32>(x01_, _e118), 0i);
             let lohi1_ = textureLoad(bounds, vec2<u32>(x11_, row1_), 0i);
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e399 = d;
-            if (_e399 > lohi0_.x) {
-                let _e402 = d;
-                local_11 = (_e402 <= lohi0_.y);
+            let _e362 = d;
+            if (_e362 > lohi0_.x) {
+                let _e365 = d;
+                local_11 = (_e365 <= lohi0_.y);
             } else {
                 local_11 = false;
             }
-            let _e408 = local_11;
-            if !(_e408) {
-                let _e410 = d;
-                if (_e410 > lohi1_.x) {
-                    let _e413 = d;
-                    local_13 = (_e413 <= lohi1_.y);
+            let _e371 = local_11;
+            if !(_e371) {
+                let _e373 = d;
+                if (_e373 > lohi1_.x) {
+                    let _e376 = d;
+                    local_13 = (_e376 <= lohi1_.y);
                 } else {
                     local_13 = false;
                 }
-                let _e419 = local_13;
-                local_12 = _e419;
+                let _e382 = local_13;
+                local_12 = _e382;
             } else {
                 local_12 = true;
             }
-            let _e423 = local_12;
-            if _e423 {
+            let _e386 = local_12;
+            if _e386 {
                 layer_2 = 0u;
                 loop {
-                    let _e426 = layer_2;
-                    if (_e426 < LAYERS) {
+                    let _e389 = layer_2;
+                    if (_e389 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        let _e429 = layer_2;
-                        let coeff = coeffs[_e429];
-                        let _e433 = layer_2;
-                        let _e436 = textureLoad(filtered, vec2<u32>(x00_, _e155), _e433, 0i);
-                        let _e438 = layer_2;
-                        let _e441 = textureLoad(filtered, vec2<u32>(x01_, _e155), _e438, 0i);
-                        let texel0_ = mix(_e436, _e441, fx0_);
-                        let _e444 = layer_2;
-                        let _e447 = textureLoad(filtered, vec2<u32>(x10_, row1_), _e444, 0i);
-                        let _e449 = layer_2;
-                        let _e452 = textureLoad(filtered, vec2<u32>(x11_, row1_), _e449, 0i);
-                        let texel1_ = mix(_e447, _e452, fx1_);
+                        let _e392 = layer_2;
+                        let coeff = coeffs[_e392];
+                        let _e396 = layer_2;
+                        let _e399 = textureLoad(filtered, vec2<u32>(x00_, _e118), _e396, 0i);
+                        let _e401 = layer_2;
+                        let _e404 = textureLoad(filtered, vec2<u32>(x01_, _e118), _e401, 0i);
+                        let texel0_ = mix(_e399, _e404, fx0_);
+                        let _e407 = layer_2;
+                        let _e410 = textureLoad(filtered, vec2<u32>(x10_, row1_), _e407, 0i);
+                        let _e412 = layer_2;
+                        let _e415 = textureLoad(filtered, vec2<u32>(x11_, row1_), _e412, 0i);
+                        let texel1_ = mix(_e410, _e415, fx1_);
                         k_3 = 0u;
                         loop {
-                            let _e456 = k_3;
-                            if (_e456 < 4u) {
+                            let _e419 = k_3;
+                            if (_e419 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                let _e459 = vis0_;
-                                let _e460 = k_3;
-                                let _e462 = k_3;
-                                vis0_ = (_e459 + (coeff[_e460] * ((texel0_[_e462] * 2f) - 1f)));
-                                let _e470 = vis1_;
-                                let _e471 = k_3;
-                                let _e473 = k_3;
-                                vis1_ = (_e470 + (coeff[_e471] * ((texel1_[_e473] * 2f) - 1f)));
+                                let _e422 = vis0_;
+                                let _e423 = k_3;
+                                let _e425 = k_3;
+                                vis0_ = (_e422 + (coeff[_e423] * ((texel0_[_e425] * 2f) - 1f)));
+                                let _e433 = vis1_;
+                                let _e434 = k_3;
+                                let _e436 = k_3;
+                                vis1_ = (_e433 + (coeff[_e434] * ((texel1_[_e436] * 2f) - 1f)));
                             }
                             continuing {
-                                let _e482 = k_3;
-                                k_3 = (_e482 + 1u);
+                                let _e445 = k_3;
+                                k_3 = (_e445 + 1u);
                             }
                         }
                     }
                     continuing {
-                        let _e485 = layer_2;
-                        layer_2 = (_e485 + 1u);
+                        let _e448 = layer_2;
+                        layer_2 = (_e448 + 1u);
                     }
                 }
             }
-            let _e487 = vis0_;
-            let _e488 = d;
-            let _e493 = d;
-            vis0_ = select(select(_e487, 0f, (_e488 > lohi0_.y)), 1f, (_e493 <= lohi0_.x));
-            let _e498 = vis1_;
-            let _e499 = d;
-            let _e504 = d;
-            vis1_ = select(select(_e498, 0f, (_e499 > lohi1_.y)), 1f, (_e504 <= lohi1_.x));
-            let _e510 = done0_;
-            if !(_e510) {
-                let _e513 = total0_;
-                let _e514 = weight0_;
-                let _e515 = vis0_;
-                total0_ = (_e513 + (_e514 * clamp(_e515, 0f, 1f)));
+            let _e450 = vis0_;
+            let _e451 = d;
+            let _e456 = d;
+            vis0_ = select(select(_e450, 0f, (_e451 > lohi0_.y)), 1f, (_e456 <= lohi0_.x));
+            let _e461 = vis1_;
+            let _e462 = d;
+            let _e467 = d;
+            vis1_ = select(select(_e461, 0f, (_e462 > lohi1_.y)), 1f, (_e467 <= lohi1_.x));
+            let _e473 = done0_;
+            if !(_e473) {
+                let _e476 = total0_;
+                let _e477 = weight0_;
+                let _e478 = vis0_;
+                total0_ = (_e476 + (_e477 * clamp(_e478, 0f, 1f)));
             }
-            let _e522 = done1_;
-            if !(_e522) {
-                let _e525 = total1_;
-                let _e526 = weight1_;
-                let _e527 = vis1_;
-                total1_ = (_e525 + (_e526 * clamp(_e527, 0f, 1f)));
+            let _e485 = done1_;
+            if !(_e485) {
+                let _e488 = total1_;
+                let _e489 = weight1_;
+                let _e490 = vis1_;
+                total1_ = (_e488 + (_e489 * clamp(_e490, 0f, 1f)));
             }
-            let _e533 = done0_;
-            if !(_e533) {
+            let _e496 = done0_;
+            if !(_e496) {
                 local_14 = is_last0_;
             } else {
                 local_14 = true;
             }
-            let _e538 = local_14;
-            done0_ = _e538;
-            let _e539 = done1_;
-            if !(_e539) {
+            let _e501 = local_14;
+            done0_ = _e501;
+            let _e502 = done1_;
+            if !(_e502) {
                 local_15 = is_last1_;
             } else {
                 local_15 = true;
             }
-            let _e544 = local_15;
-            done1_ = _e544;
-            let _e545 = done0_;
-            if _e545 {
-                let _e546 = done1_;
-                local_16 = _e546;
+            let _e507 = local_15;
+            done1_ = _e507;
+            let _e508 = done0_;
+            if _e508 {
+                let _e509 = done1_;
+                local_16 = _e509;
             } else {
                 local_16 = false;
             }
-            let _e550 = local_16;
-            if _e550 {
+            let _e513 = local_16;
+            if _e513 {
                 break;
             }
         }
         continuing {
-            let _e552 = r_1;
-            r_1 = (_e552 + 1u);
+            let _e515 = r_1;
+            r_1 = (_e515 + 1u);
         }
     }
-    let _e556 = total0_;
-    let _e558 = total1_;
-    let l_2 = (((1f - w1_) * _e556) + (w1_ * _e558));
+    let _e519 = total0_;
+    let _e521 = total1_;
+    let l_2 = (((1f - w1_) * _e519) + (w1_ * _e521));
     let c = (color * l_2);
     return c;
 }

@@ -167,18 +167,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_2 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        vec3 dir_6 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_6.z <= 1e-6)) {
+        vec3 dir_8 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_8.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_8);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_3 = (near_1 + (_e28 * (far_2 - near_1)));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_6.z);
+        return ((z_3 + _e35) / dir_8.z);
     } else {
         vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -407,8 +407,34 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 eye_5, vec3 dir_5, float a_3, float b_3, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 dir_5) {
+    float yc = 0.0;
+    uint rows_1 = f_6.sizes.w;
+    float phi_1 = atan(dot(dir_5, f_6.e2_.xyz), dot(dir_5, f_6.e1_.xyz));
+    yc = ((phi_1 - f_6.e1_.w) / f_6.e2_.w);
+    if ((f_6.anti_epipole.w > 0.5)) {
+        float _e22 = yc;
+        float _e23 = yc;
+        yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
+    } else {
+        float _e30 = yc;
+        yc = clamp(_e30, 0.0, float(rows_1));
+    }
+    float _e34 = yc;
+    return _e34;
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 eye_5, vec3 dir_6, float s_2, float theta_2, bool spot_2) {
+    if (spot_2) {
+        vec3 q_3 = ((eye_5 + (dir_6 * s_2)) - f_7.light_pos.xyz);
+        vec3 to_eye = -(f_7.axis.xyz);
+        return atan(length(cross(q_3, to_eye)), dot(q_3, to_eye));
+    }
+    return (s_2 * sin(theta_2));
+}
+
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_6, vec3 dir_7, float a_3, float b_3, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_7, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e15;
 }
 
@@ -420,8 +446,8 @@ vec4 biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw, float a_4) {
     return vec4((raw.x * (1.0 - a_4)), ((raw.y * (1.0 - a_4)) + (a_4 / 3.0)), (raw.z * (1.0 - a_4)), ((raw.w * (1.0 - a_4)) + (a_4 / 5.0)));
 }
 
-float sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float x_3, float s_2) {
-    return ((s_2 >= 0.0) ? x_3 : -(x_3));
+float sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float x_3, float s_3) {
+    return ((s_3 >= 0.0) ? x_3 : -(x_3));
 }
 
 float nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float q_1) {
@@ -443,9 +469,9 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
     float p_3 = min((b_4 - ((a_5 * a_5) / 3.0)), -1e-12);
     float qq = ((((((2.0 * a_5) * a_5) * a_5) / 27.0) - ((a_5 * b_4) / 3.0)) + c);
     float m = (2.0 * sqrt((-(p_3) / 3.0)));
-    float theta_3 = (acos(clamp(((3.0 * qq) / (p_3 * m)), -1.0, 1.0)) / 3.0);
-    float greatest = ((m * cos(theta_3)) - (a_5 / 3.0));
-    float least = ((m * cos((theta_3 - 4.1887903))) - (a_5 / 3.0));
+    float theta_4 = (acos(clamp(((3.0 * qq) / (p_3 * m)), -1.0, 1.0)) / 3.0);
+    float greatest = ((m * cos(theta_4)) - (a_5 / 3.0));
+    float least = ((m * cos((theta_4 - 4.1887903))) - (a_5 / 3.0));
     z_1 = ((abs(greatest) >= abs(least)) ? greatest : least);
     bool loop_init_3 = true;
     while(true) {
@@ -463,13 +489,13 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
             float _e86 = z_1;
             float _e87 = z_1;
             float _e88 = z_1;
-            float f_9 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
+            float f_11 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
             float _e95 = z_1;
             float _e98 = z_1;
             float df = (c2_ + (_e95 * ((2.0 * c3_) + ((3.0 * _e98) * c4_))));
             if ((df != 0.0)) {
                 float _e107 = z_1;
-                z_1 = (_e107 - (f_9 / df));
+                z_1 = (_e107 - (f_11 / df));
             }
         }
     }
@@ -493,10 +519,10 @@ float far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float x_4, float far, boo
 }
 
 float atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float b1_, float b2_, float b3_, float x_5, float u, float v_7, float k_2) {
-    float s_3 = (u + v_7);
+    float s_4 = (u + v_7);
     float p_4 = (u * v_7);
-    float e2_ = ((b2_ - (b1_ * s_3)) + p_4);
-    float e3_ = (((b3_ - (b2_ * (s_3 + x_5))) + (b1_ * (p_4 + (s_3 * x_5)))) - (p_4 * x_5));
+    float e2_ = ((b2_ - (b1_ * s_4)) + p_4);
+    float e3_ = (((b3_ - (b2_ * (s_4 + x_5))) + (b1_ * (p_4 + (s_4 * x_5)))) - (p_4 * x_5));
     return ((e2_ + (e3_ * k_2)) / ((x_5 - u) * (x_5 - v_7)));
 }
 
@@ -554,16 +580,16 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw0_, vec2 r
     return clamp(((1.0 - _e129) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0.0, 1.0);
 }
 
-vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float phi) {
-    return ((f_7.e1_.xyz * cos(phi)) + (f_7.e2_.xyz * sin(phi)));
+vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float phi) {
+    return ((f_9.e1_.xyz * cos(phi)) + (f_9.e2_.xyz * sin(phi)));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, uint row) {
-    return (f_8.e1_.w + ((float(row) + 0.5) * f_8.e2_.w));
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint row) {
+    return (f_10.e1_.w + ((float(row) + 0.5) * f_10.e2_.w));
 }
 
-uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_2) {
-    if (spot_2) {
+uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_3) {
+    if (spot_3) {
         return ((r * width) / regions);
     }
     return (((r * r) * width) / (regions * regions));
@@ -573,11 +599,11 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     bool local_7 = false;
     bool local_8 = false;
     bool local_9 = false;
-    float yc = 0.0;
+    float yc_1 = 0.0;
     float d_1 = 0.0;
     float xs = 0.0;
     float reach = 0.0;
-    float theta_2 = 0.0;
+    float theta_3 = 0.0;
     float delta0_ = 1.0;
     float delta1_ = 1.0;
     float xs0_ = 0.0;
@@ -602,23 +628,23 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     bool local_14 = false;
     bool local_15 = false;
     bool local_16 = false;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10 = _group_0_binding_0_cs;
-    vec3 eye_6 = f_10.eye.xyz;
-    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = _group_0_binding_0_cs;
+    vec3 eye_7 = f_12.eye.xyz;
+    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
     int _e14_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
-    float s_4 = (min(max(_e14.x, 0.0), f_10.theta.z) / max(dot(_e10, f_10.cam_forward.xyz), 1e-6));
-    vec3 color = f_10.light_color.xyz;
+    float s_5 = (min(max(_e14.x, 0.0), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 1e-6));
+    vec3 color = f_12.light_color.xyz;
     vec3 px = vec3((float(x_6) + 0.5), (float(y_1) + 0.5), 0.0);
-    float radius = f_10.epipole.w;
-    if ((f_10.epipole.z > 0.5)) {
-        local_7 = (length((px - vec3(f_10.epipole.x, f_10.epipole.y, 0.0))) < radius);
+    float radius = f_12.epipole.w;
+    if ((f_12.epipole.z > 0.5)) {
+        local_7 = (length((px - vec3(f_12.epipole.x, f_12.epipole.y, 0.0))) < radius);
     } else {
         local_7 = false;
     }
     bool near_epi = local_7;
-    if ((f_10.anti_epipole.z > 0.5)) {
-        local_8 = (length((px - vec3(f_10.anti_epipole.x, f_10.anti_epipole.y, 0.0))) < radius);
+    if ((f_12.anti_epipole.z > 0.5)) {
+        local_8 = (length((px - vec3(f_12.anti_epipole.x, f_12.anti_epipole.y, 0.0))) < radius);
     } else {
         local_8 = false;
     }
@@ -631,149 +657,137 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     bool _e77 = local_9;
     if (_e77) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = _group_0_binding_0_cs;
-        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, _group_0_binding_3_cs, eye_6, _e10, s_4, false);
+        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, _group_0_binding_3_cs, eye_7, _e10, s_5, false);
         vec3 l_1 = (_e82 * color);
         return l_1;
     }
-    vec3 axis = f_10.axis.xyz;
-    uint rows_1 = f_10.sizes.w;
-    uint width_1 = f_10.sizes.z;
-    bool wrap_1 = (f_10.anti_epipole.w > 0.5);
+    vec3 axis = f_12.axis.xyz;
+    uint rows_2 = f_12.sizes.w;
+    uint width_1 = f_12.sizes.z;
+    bool wrap_1 = (f_12.anti_epipole.w > 0.5);
     {
-        theta_2 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
-        float phi_1 = atan(dot(_e10, f_10.e2_.xyz), dot(_e10, f_10.e1_.xyz));
-        yc = ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
-        if (wrap_1) {
-            float _e114 = yc;
-            float _e115 = yc;
-            yc = (_e114 - (floor((_e115 / float(rows_1))) * float(rows_1)));
-        } else {
-            float _e122 = yc;
-            yc = clamp(_e122, 0.0, float(rows_1));
-        }
-        float _e126 = theta_2;
-        float _e131 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e126, f_10.theta.x, f_10.theta.y);
-        d_1 = _e131;
-        if (false) {
-            vec3 q_3 = normalize(((eye_6 + (_e10 * s_4)) - f_10.light_pos.xyz));
-            reach = acos(clamp(dot(q_3, -(axis)), -1.0, 1.0));
-        } else {
-            float _e146 = theta_2;
-            reach = (s_4 * sin(_e146));
-        }
+        theta_3 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
+        float _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
+        yc_1 = _e100;
+        float _e102 = theta_3;
+        float _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_12.theta.x, f_12.theta.y);
+        d_1 = _e107;
+        float _e109 = theta_3;
+        float _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, _e10, s_5, _e109, false);
+        reach = _e110;
     }
-    float _e149 = yc;
-    float yb = (_e149 - 0.5);
+    float _e112 = yc_1;
+    float yb = (_e112 - 0.5);
     float fy = (yb - floor(yb));
-    uint _e155 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    uint _e159 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_1, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e159 : _e155);
-    float w1_ = ((row1_ != _e155) ? fy : 0.0);
-    float cos_theta_l = -(dot(f_10.light_dir.xyz, _e10));
-    uint panels_2 = max((f_10.sizes2_.z / 4u), 1u);
-    float _e176 = d_1;
-    float _e177 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e176);
-    float _e182 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    float sun_scatter = (f_10.medium.y * _e182);
-    float _e185 = xs;
-    xs0_ = _e185;
-    float _e187 = xs;
-    xs1_ = _e187;
+    uint _e118 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    uint _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e122 : _e118);
+    float w1_ = ((row1_ != _e118) ? fy : 0.0);
+    float cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
+    uint panels_2 = max((f_12.sizes2_.z / 4u), 1u);
+    float _e139 = d_1;
+    float _e140 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e139);
+    float _e145 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    float sun_scatter = (f_12.medium.y * _e145);
+    float _e148 = xs;
+    xs0_ = _e148;
+    float _e150 = xs;
+    xs1_ = _e150;
     {
-        vec4 _e191 = _group_0_binding_1_cs[_e155];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e192 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e191);
-        delta0_ = _e192.delta;
-        vec4 _e197 = _group_0_binding_1_cs[row1_];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e198 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e197);
-        delta1_ = _e198.delta;
-        float _e201 = reach;
-        float _e202 = delta0_;
-        xs0_ = (_e201 / _e202);
-        float _e204 = reach;
-        float _e205 = delta1_;
-        xs1_ = (_e204 / _e205);
+        vec4 _e154 = _group_0_binding_1_cs[_e118];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e155 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e154);
+        delta0_ = _e155.delta;
+        vec4 _e160 = _group_0_binding_1_cs[row1_];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e161 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e160);
+        delta1_ = _e161.delta;
+        float _e164 = reach;
+        float _e165 = delta0_;
+        xs0_ = (_e164 / _e165);
+        float _e167 = reach;
+        float _e168 = delta1_;
+        xs1_ = (_e167 / _e168);
     }
-    float _e207 = xs0_;
-    uint last0_ = uint(min(max(_e207, 0.0), (float(width_1) - 1.0)));
-    float _e215 = xs1_;
-    uint last1_ = uint(min(max(_e215, 0.0), (float(width_1) - 1.0)));
+    float _e170 = xs0_;
+    uint last0_ = uint(min(max(_e170, 0.0), (float(width_1) - 1.0)));
+    float _e178 = xs1_;
+    uint last1_ = uint(min(max(_e178, 0.0), (float(width_1) - 1.0)));
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e506 = r_1;
-            r_1 = (_e506 + 1u);
+            uint _e469 = r_1;
+            r_1 = (_e469 + 1u);
         }
         loop_init_4 = false;
-        uint _e225 = r_1;
-        if ((_e225 < REGIONS)) {
+        uint _e188 = r_1;
+        if ((_e188 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e227 = r_1;
-            uint _e228 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e227, REGIONS, width_1, false);
-            float b0_ = float(_e228);
-            uint _e230 = r_1;
-            uint _e233 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e230 + 1u), REGIONS, width_1, false);
-            float b1_2 = float(_e233);
+            uint _e190 = r_1;
+            uint _e191 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e190, REGIONS, width_1, false);
+            float b0_ = float(_e191);
+            uint _e193 = r_1;
+            uint _e196 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e193 + 1u), REGIONS, width_1, false);
+            float b1_2 = float(_e196);
             if (!((last0_ < uint(b1_2)))) {
-                uint _e238 = r_1;
-                local_10 = ((_e238 + 1u) == REGIONS);
+                uint _e201 = r_1;
+                local_10 = ((_e201 + 1u) == REGIONS);
             } else {
                 local_10 = true;
             }
             bool is_last0_ = local_10;
             if (!((last1_ < uint(b1_2)))) {
-                uint _e249 = r_1;
-                local_11 = ((_e249 + 1u) == REGIONS);
+                uint _e212 = r_1;
+                local_11 = ((_e212 + 1u) == REGIONS);
             } else {
                 local_11 = true;
             }
             bool is_last1_ = local_11;
-            float _e259 = xs0_;
-            float pos0_ = (is_last0_ ? clamp((_e259 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
-            float _e270 = xs1_;
-            float pos1_ = (is_last1_ ? clamp((_e270 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            float _e222 = xs0_;
+            float pos0_ = (is_last0_ ? clamp((_e222 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            float _e233 = xs1_;
+            float pos1_ = (is_last1_ ? clamp((_e233 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
             a0_ = 0.0;
             e0_ = 0.0;
             a1_ = 0.0;
             e1_ = 0.0;
-            float _e287 = delta0_;
-            float _e288 = theta_2;
-            float _e289 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e287, _e288, s_4, false);
-            a0_ = _e289;
-            float _e290 = delta0_;
-            float _e291 = theta_2;
-            float _e292 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e290, _e291, s_4, false);
-            e0_ = (is_last0_ ? s_4 : _e292);
-            float _e294 = delta1_;
-            float _e295 = theta_2;
-            float _e296 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e294, _e295, s_4, false);
-            a1_ = _e296;
-            float _e297 = delta1_;
-            float _e298 = theta_2;
-            float _e299 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e297, _e298, s_4, false);
-            e1_ = (is_last1_ ? s_4 : _e299);
+            float _e250 = delta0_;
+            float _e251 = theta_3;
+            float _e252 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e250, _e251, s_5, false);
+            a0_ = _e252;
+            float _e253 = delta0_;
+            float _e254 = theta_3;
+            float _e255 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_2, _e253, _e254, s_5, false);
+            e0_ = (is_last0_ ? s_5 : _e255);
+            float _e257 = delta1_;
+            float _e258 = theta_3;
+            float _e259 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e257, _e258, s_5, false);
+            a1_ = _e259;
+            float _e260 = delta1_;
+            float _e261 = theta_3;
+            float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_2, _e260, _e261, s_5, false);
+            e1_ = (is_last1_ ? s_5 : _e262);
             weight0_ = 0.0;
             weight1_ = 0.0;
             if (false) {
-                float _e305 = a0_;
-                float _e306 = e0_;
-                float _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e10, _e305, _e306, panels_2);
-                weight0_ = _e307;
-                float _e308 = a1_;
-                float _e309 = e1_;
-                float _e310 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e10, _e308, _e309, panels_2);
-                weight1_ = _e310;
+                float _e268 = a0_;
+                float _e269 = e0_;
+                float _e270 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, _e10, _e268, _e269, panels_2);
+                weight0_ = _e270;
+                float _e271 = a1_;
+                float _e272 = e1_;
+                float _e273 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, _e10, _e271, _e272, panels_2);
+                weight1_ = _e273;
             } else {
-                float _e313 = a0_;
-                float _e314 = e0_;
-                float _e315 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e313, _e314);
-                weight0_ = (sun_scatter * _e315);
-                float _e319 = a1_;
-                float _e320 = e1_;
-                float _e321 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e319, _e320);
-                weight1_ = (sun_scatter * _e321);
+                float _e276 = a0_;
+                float _e277 = e0_;
+                float _e278 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e276, _e277);
+                weight0_ = (sun_scatter * _e278);
+                float _e282 = a1_;
+                float _e283 = e1_;
+                float _e284 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e282, _e283);
+                weight1_ = (sun_scatter * _e284);
             }
             float xb0_ = (pos0_ - 0.5);
             float fx0_ = (xb0_ - floor(xb0_));
@@ -783,110 +797,110 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
             float fx1_ = (xb1_ - floor(xb1_));
             uint x10_ = uint(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
-            int _e364_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 lohi0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x01_, _e155)), ivec2(0), textureSize(_group_0_binding_6_cs, _e364_clamped_lod) - ivec2(1)), _e364_clamped_lod);
-            int _e368_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 lohi1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x11_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e368_clamped_lod) - ivec2(1)), _e368_clamped_lod);
+            int _e327_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+            vec4 lohi0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x01_, _e118)), ivec2(0), textureSize(_group_0_binding_6_cs, _e327_clamped_lod) - ivec2(1)), _e327_clamped_lod);
+            int _e331_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
+            vec4 lohi1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x11_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e331_clamped_lod) - ivec2(1)), _e331_clamped_lod);
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e373 = d_1;
-            if ((_e373 > lohi0_.x)) {
-                float _e376 = d_1;
-                local_12 = (_e376 <= lohi0_.y);
+            float _e336 = d_1;
+            if ((_e336 > lohi0_.x)) {
+                float _e339 = d_1;
+                local_12 = (_e339 <= lohi0_.y);
             } else {
                 local_12 = false;
             }
-            bool _e382 = local_12;
-            if (_e382) {
-                int _e387_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e387 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x00_, _e155), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e387_clamped_lod) - ivec3(1)), _e387_clamped_lod);
-                int _e392_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e392 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x01_, _e155), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e392_clamped_lod) - ivec3(1)), _e392_clamped_lod);
-                vec4 m0_ = mix(_e387, _e392, fx0_);
-                int _e398_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e398 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x00_, _e155), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e398_clamped_lod) - ivec3(1)), _e398_clamped_lod);
-                int _e403_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e403 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x01_, _e155), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e403_clamped_lod) - ivec3(1)), _e403_clamped_lod);
-                vec4 m1_ = mix(_e398, _e403, fx0_);
-                float _e406 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e177);
-                vis0_ = _e406;
+            bool _e345 = local_12;
+            if (_e345) {
+                int _e350_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e350 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x00_, _e118), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e350_clamped_lod) - ivec3(1)), _e350_clamped_lod);
+                int _e355_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e355 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x01_, _e118), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e355_clamped_lod) - ivec3(1)), _e355_clamped_lod);
+                vec4 m0_ = mix(_e350, _e355, fx0_);
+                int _e361_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e361 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x00_, _e118), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e361_clamped_lod) - ivec3(1)), _e361_clamped_lod);
+                int _e366_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e366 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x01_, _e118), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e366_clamped_lod) - ivec3(1)), _e366_clamped_lod);
+                vec4 m1_ = mix(_e361, _e366, fx0_);
+                float _e369 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e140);
+                vis0_ = _e369;
             }
-            float _e407 = d_1;
-            if ((_e407 > lohi1_.x)) {
-                float _e410 = d_1;
-                local_13 = (_e410 <= lohi1_.y);
+            float _e370 = d_1;
+            if ((_e370 > lohi1_.x)) {
+                float _e373 = d_1;
+                local_13 = (_e373 <= lohi1_.y);
             } else {
                 local_13 = false;
             }
-            bool _e416 = local_13;
-            if (_e416) {
-                int _e421_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e421 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x10_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e421_clamped_lod) - ivec3(1)), _e421_clamped_lod);
-                int _e426_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e426 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x11_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e426_clamped_lod) - ivec3(1)), _e426_clamped_lod);
-                vec4 m0_1 = mix(_e421, _e426, fx1_);
-                int _e432_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e432 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x10_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e432_clamped_lod) - ivec3(1)), _e432_clamped_lod);
-                int _e437_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e437 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x11_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e437_clamped_lod) - ivec3(1)), _e437_clamped_lod);
-                vec4 m1_1 = mix(_e432, _e437, fx1_);
-                float _e440 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e177);
-                vis1_ = _e440;
+            bool _e379 = local_13;
+            if (_e379) {
+                int _e384_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e384 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x10_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e384_clamped_lod) - ivec3(1)), _e384_clamped_lod);
+                int _e389_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e389 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x11_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e389_clamped_lod) - ivec3(1)), _e389_clamped_lod);
+                vec4 m0_1 = mix(_e384, _e389, fx1_);
+                int _e395_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e395 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x10_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e395_clamped_lod) - ivec3(1)), _e395_clamped_lod);
+                int _e400_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                vec4 _e400 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x11_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e400_clamped_lod) - ivec3(1)), _e400_clamped_lod);
+                vec4 m1_1 = mix(_e395, _e400, fx1_);
+                float _e403 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e140);
+                vis1_ = _e403;
             }
-            float _e441 = vis0_;
-            float _e442 = d_1;
-            float _e447 = d_1;
-            vis0_ = ((_e447 <= lohi0_.x) ? 1.0 : ((_e442 > lohi0_.y) ? 0.0 : _e441));
-            float _e452 = vis1_;
-            float _e453 = d_1;
-            float _e458 = d_1;
-            vis1_ = ((_e458 <= lohi1_.x) ? 1.0 : ((_e453 > lohi1_.y) ? 0.0 : _e452));
-            bool _e464 = done0_;
-            if (!(_e464)) {
-                float _e467 = total0_;
-                float _e468 = weight0_;
-                float _e469 = vis0_;
-                total0_ = (_e467 + (_e468 * clamp(_e469, 0.0, 1.0)));
+            float _e404 = vis0_;
+            float _e405 = d_1;
+            float _e410 = d_1;
+            vis0_ = ((_e410 <= lohi0_.x) ? 1.0 : ((_e405 > lohi0_.y) ? 0.0 : _e404));
+            float _e415 = vis1_;
+            float _e416 = d_1;
+            float _e421 = d_1;
+            vis1_ = ((_e421 <= lohi1_.x) ? 1.0 : ((_e416 > lohi1_.y) ? 0.0 : _e415));
+            bool _e427 = done0_;
+            if (!(_e427)) {
+                float _e430 = total0_;
+                float _e431 = weight0_;
+                float _e432 = vis0_;
+                total0_ = (_e430 + (_e431 * clamp(_e432, 0.0, 1.0)));
             }
-            bool _e476 = done1_;
-            if (!(_e476)) {
-                float _e479 = total1_;
-                float _e480 = weight1_;
-                float _e481 = vis1_;
-                total1_ = (_e479 + (_e480 * clamp(_e481, 0.0, 1.0)));
+            bool _e439 = done1_;
+            if (!(_e439)) {
+                float _e442 = total1_;
+                float _e443 = weight1_;
+                float _e444 = vis1_;
+                total1_ = (_e442 + (_e443 * clamp(_e444, 0.0, 1.0)));
             }
-            bool _e487 = done0_;
-            if (!(_e487)) {
+            bool _e450 = done0_;
+            if (!(_e450)) {
                 local_14 = is_last0_;
             } else {
                 local_14 = true;
             }
-            bool _e492 = local_14;
-            done0_ = _e492;
-            bool _e493 = done1_;
-            if (!(_e493)) {
+            bool _e455 = local_14;
+            done0_ = _e455;
+            bool _e456 = done1_;
+            if (!(_e456)) {
                 local_15 = is_last1_;
             } else {
                 local_15 = true;
             }
-            bool _e498 = local_15;
-            done1_ = _e498;
-            bool _e499 = done0_;
-            if (_e499) {
-                bool _e500 = done1_;
-                local_16 = _e500;
+            bool _e461 = local_15;
+            done1_ = _e461;
+            bool _e462 = done0_;
+            if (_e462) {
+                bool _e463 = done1_;
+                local_16 = _e463;
             } else {
                 local_16 = false;
             }
-            bool _e504 = local_16;
-            if (_e504) {
+            bool _e467 = local_16;
+            if (_e467) {
                 break;
             }
         }
     }
-    float _e510 = total0_;
-    float _e512 = total1_;
-    float l_2 = (((1.0 - w1_) * _e510) + (w1_ * _e512));
+    float _e473 = total0_;
+    float _e475 = total1_;
+    float l_2 = (((1.0 - w1_) * _e473) + (w1_ * _e475));
     vec3 c_1 = (color * l_2);
     return c_1;
 }

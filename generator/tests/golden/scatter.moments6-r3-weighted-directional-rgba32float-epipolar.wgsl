@@ -169,18 +169,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_2 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_6 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_6.z <= 0.000001f) {
+        let dir_8 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_8.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_6);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_8);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_3 = (near_1 + (_e28 * (far_2 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_6.z);
+        return ((z_3 + _e35) / dir_8.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -406,8 +406,35 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_X
     }
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_5: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_5, dir_5, a_3, b_3, panels_1, f_6.light_pos.xyz, f_6.light_dir.xyz, f_6.light_pos.w, f_6.light_dir.w, f_6.medium);
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_5: vec3<f32>) -> f32 {
+    var yc: f32;
+
+    let rows_1 = f_6.sizes.w;
+    let phi_1 = atan2(dot(dir_5, f_6.e2_.xyz), dot(dir_5, f_6.e1_.xyz));
+    yc = ((phi_1 - f_6.e1_.w) / f_6.e2_.w);
+    if (f_6.anti_epipole.w > 0.5f) {
+        let _e22 = yc;
+        let _e23 = yc;
+        yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
+    } else {
+        let _e30 = yc;
+        yc = clamp(_e30, 0f, f32(rows_1));
+    }
+    let _e34 = yc;
+    return _e34;
+}
+
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_6: vec3<f32>, s_2: f32, theta_2: f32, spot_2: bool) -> f32 {
+    if spot_2 {
+        let q_3 = ((eye_5 + (dir_6 * s_2)) - f_7.light_pos.xyz);
+        let to_eye = -(f_7.axis.xyz);
+        return atan2(length(cross(q_3, to_eye)), dot(q_3, to_eye));
+    }
+    return (s_2 * sin(theta_2));
+}
+
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_7, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e15;
 }
 
@@ -419,8 +446,8 @@ fn biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw: vec4<f32>, a_4: f32) 
     return vec4<f32>((raw.x * (1f - a_4)), ((raw.y * (1f - a_4)) + (a_4 / 3f)), (raw.z * (1f - a_4)), ((raw.w * (1f - a_4)) + (a_4 / 5f)));
 }
 
-fn sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(x_3: f32, s_2: f32) -> f32 {
-    return select(-(x_3), x_3, (s_2 >= 0f));
+fn sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(x_3: f32, s_3: f32) -> f32 {
+    return select(-(x_3), x_3, (s_3 >= 0f));
 }
 
 fn nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(q_1: f32) -> f32 {
@@ -443,9 +470,9 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
     let p_3 = min((b_4 - ((a_5 * a_5) / 3f)), -0.000000000001f);
     let qq = ((((((2f * a_5) * a_5) * a_5) / 27f) - ((a_5 * b_4) / 3f)) + c);
     let m = (2f * sqrt((-(p_3) / 3f)));
-    let theta_3 = (acos(clamp(((3f * qq) / (p_3 * m)), -1f, 1f)) / 3f);
-    let greatest = ((m * cos(theta_3)) - (a_5 / 3f));
-    let least = ((m * cos((theta_3 - 4.1887903f))) - (a_5 / 3f));
+    let theta_4 = (acos(clamp(((3f * qq) / (p_3 * m)), -1f, 1f)) / 3f);
+    let greatest = ((m * cos(theta_4)) - (a_5 / 3f));
+    let least = ((m * cos((theta_4 - 4.1887903f))) - (a_5 / 3f));
     z_1 = select(least, greatest, (abs(greatest) >= abs(least)));
     loop {
         let _e83 = i;
@@ -457,13 +484,13 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
             let _e86 = z_1;
             let _e87 = z_1;
             let _e88 = z_1;
-            let f_9 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
+            let f_11 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
             let _e95 = z_1;
             let _e98 = z_1;
             let df = (c2_ + (_e95 * ((2f * c3_) + ((3f * _e98) * c4_))));
             if (df != 0f) {
                 let _e107 = z_1;
-                z_1 = (_e107 - (f_9 / df));
+                z_1 = (_e107 - (f_11 / df));
             }
         }
         continuing {
@@ -491,10 +518,10 @@ fn far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(x_4: f32, far: f32, at_infin
 }
 
 fn atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_: f32, b2_: f32, b3_: f32, x_5: f32, u: f32, v_7: f32, k_2: f32) -> f32 {
-    let s_3 = (u + v_7);
+    let s_4 = (u + v_7);
     let p_4 = (u * v_7);
-    let e2_ = ((b2_ - (b1_ * s_3)) + p_4);
-    let e3_ = (((b3_ - (b2_ * (s_3 + x_5))) + (b1_ * (p_4 + (s_3 * x_5)))) - (p_4 * x_5));
+    let e2_ = ((b2_ - (b1_ * s_4)) + p_4);
+    let e3_ = (((b3_ - (b2_ * (s_4 + x_5))) + (b1_ * (p_4 + (s_4 * x_5)))) - (p_4 * x_5));
     return ((e2_ + (e3_ * k_2)) / ((x_5 - u) * (x_5 - v_7)));
 }
 
@@ -553,16 +580,16 @@ fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw
     return clamp(((1f - _e129) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0f, 1f);
 }
 
-fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
-    return ((f_7.e1_.xyz * cos(phi)) + (f_7.e2_.xyz * sin(phi)));
+fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
+    return ((f_9.e1_.xyz * cos(phi)) + (f_9.e2_.xyz * sin(phi)));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    return (f_8.e1_.w + ((f32(row) + 0.5f) * f_8.e2_.w));
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    return (f_10.e1_.w + ((f32(row) + 0.5f) * f_10.e2_.w));
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_2: bool) -> u32 {
-    if spot_2 {
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_3: bool) -> u32 {
+    if spot_3 {
         return ((r * width) / regions);
     }
     return (((r * r) * width) / (regions * regions));
@@ -572,11 +599,11 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var local_7: bool;
     var local_8: bool;
     var local_9: bool;
-    var yc: f32;
+    var yc_1: f32;
     var d_1: f32;
     var xs: f32 = 0f;
     var reach: f32 = 0f;
-    var theta_2: f32 = 0f;
+    var theta_3: f32 = 0f;
     var delta0_: f32 = 1f;
     var delta1_: f32 = 1f;
     var xs0_: f32;
@@ -602,22 +629,22 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var local_15: bool;
     var local_16: bool;
 
-    let f_10 = frame;
-    let eye_6 = f_10.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, x_6, y_1);
+    let f_12 = frame;
+    let eye_7 = f_12.eye.xyz;
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
     let _e14 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
-    let s_4 = (min(max(_e14.x, 0f), f_10.theta.z) / max(dot(_e10, f_10.cam_forward.xyz), 0.000001f));
-    let color = f_10.light_color.xyz;
+    let s_5 = (min(max(_e14.x, 0f), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 0.000001f));
+    let color = f_12.light_color.xyz;
     let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f), 0f);
-    let radius = f_10.epipole.w;
-    if (f_10.epipole.z > 0.5f) {
-        local_7 = (length((px - vec3<f32>(f_10.epipole.x, f_10.epipole.y, 0f))) < radius);
+    let radius = f_12.epipole.w;
+    if (f_12.epipole.z > 0.5f) {
+        local_7 = (length((px - vec3<f32>(f_12.epipole.x, f_12.epipole.y, 0f))) < radius);
     } else {
         local_7 = false;
     }
     let near_epi = local_7;
-    if (f_10.anti_epipole.z > 0.5f) {
-        local_8 = (length((px - vec3<f32>(f_10.anti_epipole.x, f_10.anti_epipole.y, 0f))) < radius);
+    if (f_12.anti_epipole.z > 0.5f) {
+        local_8 = (length((px - vec3<f32>(f_12.anti_epipole.x, f_12.anti_epipole.y, 0f))) < radius);
     } else {
         local_8 = false;
     }
@@ -630,143 +657,131 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     let _e77 = local_9;
     if _e77 {
         let _e79 = frame;
-        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_6, _e10, s_4, false);
+        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_7, _e10, s_5, false);
         let l_1 = (_e82 * color);
         return l_1;
     }
-    let axis = f_10.axis.xyz;
-    let rows_1 = f_10.sizes.w;
-    let width_1 = f_10.sizes.z;
-    let wrap_1 = (f_10.anti_epipole.w > 0.5f);
+    let axis = f_12.axis.xyz;
+    let rows_2 = f_12.sizes.w;
+    let width_1 = f_12.sizes.z;
+    let wrap_1 = (f_12.anti_epipole.w > 0.5f);
     {
-        theta_2 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let phi_1 = atan2(dot(_e10, f_10.e2_.xyz), dot(_e10, f_10.e1_.xyz));
-        yc = ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
-        if wrap_1 {
-            let _e114 = yc;
-            let _e115 = yc;
-            yc = (_e114 - (floor((_e115 / f32(rows_1))) * f32(rows_1)));
-        } else {
-            let _e122 = yc;
-            yc = clamp(_e122, 0f, f32(rows_1));
-        }
-        let _e126 = theta_2;
-        let _e131 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e126, f_10.theta.x, f_10.theta.y);
-        d_1 = _e131;
-        if false {
-            let q_3 = normalize(((eye_6 + (_e10 * s_4)) - f_10.light_pos.xyz));
-            reach = acos(clamp(dot(q_3, -(axis)), -1f, 1f));
-        } else {
-            let _e146 = theta_2;
-            reach = (s_4 * sin(_e146));
-        }
+        theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
+        let _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
+        yc_1 = _e100;
+        let _e102 = theta_3;
+        let _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_12.theta.x, f_12.theta.y);
+        d_1 = _e107;
+        let _e109 = theta_3;
+        let _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, _e10, s_5, _e109, false);
+        reach = _e110;
     }
-    let _e149 = yc;
-    let yb = (_e149 - 0.5f);
+    let _e112 = yc_1;
+    let yb = (_e112 - 0.5f);
     let fy = (yb - floor(yb));
-    let _e155 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_1, wrap_1);
-    let _e159 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_1, wrap_1);
-    let row1_ = select(_e155, _e159, (yb > floor(yb)));
-    let w1_ = select(0f, fy, (row1_ != _e155));
-    let cos_theta_l = -(dot(f_10.light_dir.xyz, _e10));
-    let panels_2 = max((f_10.sizes2_.z / 4u), 1u);
-    let _e176 = d_1;
-    let _e177 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e176);
-    let _e182 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, cos_theta_l);
-    let sun_scatter = (f_10.medium.y * _e182);
-    let _e185 = xs;
-    xs0_ = _e185;
-    let _e187 = xs;
-    xs1_ = _e187;
+    let _e118 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    let _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
+    let row1_ = select(_e118, _e122, (yb > floor(yb)));
+    let w1_ = select(0f, fy, (row1_ != _e118));
+    let cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
+    let panels_2 = max((f_12.sizes2_.z / 4u), 1u);
+    let _e139 = d_1;
+    let _e140 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e139);
+    let _e145 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    let sun_scatter = (f_12.medium.y * _e145);
+    let _e148 = xs;
+    xs0_ = _e148;
+    let _e150 = xs;
+    xs1_ = _e150;
     {
-        let _e191 = slices[_e155];
-        let _e192 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e191);
-        delta0_ = _e192.delta;
-        let _e197 = slices[row1_];
-        let _e198 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e197);
-        delta1_ = _e198.delta;
-        let _e201 = reach;
-        let _e202 = delta0_;
-        xs0_ = (_e201 / _e202);
-        let _e204 = reach;
-        let _e205 = delta1_;
-        xs1_ = (_e204 / _e205);
+        let _e154 = slices[_e118];
+        let _e155 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e154);
+        delta0_ = _e155.delta;
+        let _e160 = slices[row1_];
+        let _e161 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e160);
+        delta1_ = _e161.delta;
+        let _e164 = reach;
+        let _e165 = delta0_;
+        xs0_ = (_e164 / _e165);
+        let _e167 = reach;
+        let _e168 = delta1_;
+        xs1_ = (_e167 / _e168);
     }
-    let _e207 = xs0_;
-    let last0_ = u32(min(max(_e207, 0f), (f32(width_1) - 1f)));
-    let _e215 = xs1_;
-    let last1_ = u32(min(max(_e215, 0f), (f32(width_1) - 1f)));
+    let _e170 = xs0_;
+    let last0_ = u32(min(max(_e170, 0f), (f32(width_1) - 1f)));
+    let _e178 = xs1_;
+    let last1_ = u32(min(max(_e178, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e225 = r_1;
-        if (_e225 < REGIONS) {
+        let _e188 = r_1;
+        if (_e188 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e227 = r_1;
-            let _e228 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e227, REGIONS, width_1, false);
-            let b0_ = f32(_e228);
-            let _e230 = r_1;
-            let _e233 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e230 + 1u), REGIONS, width_1, false);
-            let b1_2 = f32(_e233);
+            let _e190 = r_1;
+            let _e191 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e190, REGIONS, width_1, false);
+            let b0_ = f32(_e191);
+            let _e193 = r_1;
+            let _e196 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e193 + 1u), REGIONS, width_1, false);
+            let b1_2 = f32(_e196);
             if !((last0_ < u32(b1_2))) {
-                let _e238 = r_1;
-                local_10 = ((_e238 + 1u) == REGIONS);
+                let _e201 = r_1;
+                local_10 = ((_e201 + 1u) == REGIONS);
             } else {
                 local_10 = true;
             }
             let is_last0_ = local_10;
             if !((last1_ < u32(b1_2))) {
-                let _e249 = r_1;
-                local_11 = ((_e249 + 1u) == REGIONS);
+                let _e212 = r_1;
+                local_11 = ((_e212 + 1u) == REGIONS);
             } else {
                 local_11 = true;
             }
             let is_last1_ = local_11;
-            let _e259 = xs0_;
-            let pos0_ = select((b1_2 - 0.5f), clamp((_e259 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
-            let _e270 = xs1_;
-            let pos1_ = select((b1_2 - 0.5f), clamp((_e270 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
+            let _e222 = xs0_;
+            let pos0_ = select((b1_2 - 0.5f), clamp((_e222 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
+            let _e233 = xs1_;
+            let pos1_ = select((b1_2 - 0.5f), clamp((_e233 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
             a0_ = f32();
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e287 = delta0_;
-            let _e288 = theta_2;
-            let _e289 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e287, _e288, s_4, false);
-            a0_ = _e289;
-            let _e290 = delta0_;
-            let _e291 = theta_2;
-            let _e292 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e290, _e291, s_4, false);
-            e0_ = select(_e292, s_4, is_last0_);
-            let _e294 = delta1_;
-            let _e295 = theta_2;
-            let _e296 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b0_, _e294, _e295, s_4, false);
-            a1_ = _e296;
-            let _e297 = delta1_;
-            let _e298 = theta_2;
-            let _e299 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, b1_2, _e297, _e298, s_4, false);
-            e1_ = select(_e299, s_4, is_last1_);
+            let _e250 = delta0_;
+            let _e251 = theta_3;
+            let _e252 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e250, _e251, s_5, false);
+            a0_ = _e252;
+            let _e253 = delta0_;
+            let _e254 = theta_3;
+            let _e255 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_2, _e253, _e254, s_5, false);
+            e0_ = select(_e255, s_5, is_last0_);
+            let _e257 = delta1_;
+            let _e258 = theta_3;
+            let _e259 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e257, _e258, s_5, false);
+            a1_ = _e259;
+            let _e260 = delta1_;
+            let _e261 = theta_3;
+            let _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_2, _e260, _e261, s_5, false);
+            e1_ = select(_e262, s_5, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
-                let _e305 = a0_;
-                let _e306 = e0_;
-                let _e307 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e10, _e305, _e306, panels_2);
-                weight0_ = _e307;
-                let _e308 = a1_;
-                let _e309 = e1_;
-                let _e310 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, eye_6, _e10, _e308, _e309, panels_2);
-                weight1_ = _e310;
+                let _e268 = a0_;
+                let _e269 = e0_;
+                let _e270 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, _e10, _e268, _e269, panels_2);
+                weight0_ = _e270;
+                let _e271 = a1_;
+                let _e272 = e1_;
+                let _e273 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, _e10, _e271, _e272, panels_2);
+                weight1_ = _e273;
             } else {
-                let _e313 = a0_;
-                let _e314 = e0_;
-                let _e315 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e313, _e314);
-                weight0_ = (sun_scatter * _e315);
-                let _e319 = a1_;
-                let _e320 = e1_;
-                let _e321 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.x, _e319, _e320);
-                weight1_ = (sun_scatter * _e321);
+                let _e276 = a0_;
+                let _e277 = e0_;
+                let _e278 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e276, _e277);
+                weight0_ = (sun_scatter * _e278);
+                let _e282 = a1_;
+                let _e283 = e1_;
+                let _e284 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e282, _e283);
+                weight1_ = (sun_scatter * _e284);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -776,104 +791,104 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let lohi0_ = textureLoad(bounds, vec2<u32>(x01_, _e155), 0i);
+            let lohi0_ = textureLoad(bounds, vec2<u32>(x01_, _e118), 0i);
             let lohi1_ = textureLoad(bounds, vec2<u32>(x11_, row1_), 0i);
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e373 = d_1;
-            if (_e373 > lohi0_.x) {
-                let _e376 = d_1;
-                local_12 = (_e376 <= lohi0_.y);
+            let _e336 = d_1;
+            if (_e336 > lohi0_.x) {
+                let _e339 = d_1;
+                local_12 = (_e339 <= lohi0_.y);
             } else {
                 local_12 = false;
             }
-            let _e382 = local_12;
-            if _e382 {
-                let _e387 = textureLoad(filtered, vec2<u32>(x00_, _e155), 0i, 0i);
-                let _e392 = textureLoad(filtered, vec2<u32>(x01_, _e155), 0i, 0i);
-                let m0_ = mix(_e387, _e392, fx0_);
-                let _e398 = textureLoad(filtered, vec2<u32>(x00_, _e155), 1i, 0i);
-                let _e403 = textureLoad(filtered, vec2<u32>(x01_, _e155), 1i, 0i);
-                let m1_ = mix(_e398, _e403, fx0_);
-                let _e406 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e177);
-                vis0_ = _e406;
+            let _e345 = local_12;
+            if _e345 {
+                let _e350 = textureLoad(filtered, vec2<u32>(x00_, _e118), 0i, 0i);
+                let _e355 = textureLoad(filtered, vec2<u32>(x01_, _e118), 0i, 0i);
+                let m0_ = mix(_e350, _e355, fx0_);
+                let _e361 = textureLoad(filtered, vec2<u32>(x00_, _e118), 1i, 0i);
+                let _e366 = textureLoad(filtered, vec2<u32>(x01_, _e118), 1i, 0i);
+                let m1_ = mix(_e361, _e366, fx0_);
+                let _e369 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e140);
+                vis0_ = _e369;
             }
-            let _e407 = d_1;
-            if (_e407 > lohi1_.x) {
-                let _e410 = d_1;
-                local_13 = (_e410 <= lohi1_.y);
+            let _e370 = d_1;
+            if (_e370 > lohi1_.x) {
+                let _e373 = d_1;
+                local_13 = (_e373 <= lohi1_.y);
             } else {
                 local_13 = false;
             }
-            let _e416 = local_13;
-            if _e416 {
-                let _e421 = textureLoad(filtered, vec2<u32>(x10_, row1_), 0i, 0i);
-                let _e426 = textureLoad(filtered, vec2<u32>(x11_, row1_), 0i, 0i);
-                let m0_1 = mix(_e421, _e426, fx1_);
-                let _e432 = textureLoad(filtered, vec2<u32>(x10_, row1_), 1i, 0i);
-                let _e437 = textureLoad(filtered, vec2<u32>(x11_, row1_), 1i, 0i);
-                let m1_1 = mix(_e432, _e437, fx1_);
-                let _e440 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e177);
-                vis1_ = _e440;
+            let _e379 = local_13;
+            if _e379 {
+                let _e384 = textureLoad(filtered, vec2<u32>(x10_, row1_), 0i, 0i);
+                let _e389 = textureLoad(filtered, vec2<u32>(x11_, row1_), 0i, 0i);
+                let m0_1 = mix(_e384, _e389, fx1_);
+                let _e395 = textureLoad(filtered, vec2<u32>(x10_, row1_), 1i, 0i);
+                let _e400 = textureLoad(filtered, vec2<u32>(x11_, row1_), 1i, 0i);
+                let m1_1 = mix(_e395, _e400, fx1_);
+                let _e403 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e140);
+                vis1_ = _e403;
             }
-            let _e441 = vis0_;
-            let _e442 = d_1;
-            let _e447 = d_1;
-            vis0_ = select(select(_e441, 0f, (_e442 > lohi0_.y)), 1f, (_e447 <= lohi0_.x));
-            let _e452 = vis1_;
-            let _e453 = d_1;
-            let _e458 = d_1;
-            vis1_ = select(select(_e452, 0f, (_e453 > lohi1_.y)), 1f, (_e458 <= lohi1_.x));
-            let _e464 = done0_;
-            if !(_e464) {
-                let _e467 = total0_;
-                let _e468 = weight0_;
-                let _e469 = vis0_;
-                total0_ = (_e467 + (_e468 * clamp(_e469, 0f, 1f)));
+            let _e404 = vis0_;
+            let _e405 = d_1;
+            let _e410 = d_1;
+            vis0_ = select(select(_e404, 0f, (_e405 > lohi0_.y)), 1f, (_e410 <= lohi0_.x));
+            let _e415 = vis1_;
+            let _e416 = d_1;
+            let _e421 = d_1;
+            vis1_ = select(select(_e415, 0f, (_e416 > lohi1_.y)), 1f, (_e421 <= lohi1_.x));
+            let _e427 = done0_;
+            if !(_e427) {
+                let _e430 = total0_;
+                let _e431 = weight0_;
+                let _e432 = vis0_;
+                total0_ = (_e430 + (_e431 * clamp(_e432, 0f, 1f)));
             }
-            let _e476 = done1_;
-            if !(_e476) {
-                let _e479 = total1_;
-                let _e480 = weight1_;
-                let _e481 = vis1_;
-                total1_ = (_e479 + (_e480 * clamp(_e481, 0f, 1f)));
+            let _e439 = done1_;
+            if !(_e439) {
+                let _e442 = total1_;
+                let _e443 = weight1_;
+                let _e444 = vis1_;
+                total1_ = (_e442 + (_e443 * clamp(_e444, 0f, 1f)));
             }
-            let _e487 = done0_;
-            if !(_e487) {
+            let _e450 = done0_;
+            if !(_e450) {
                 local_14 = is_last0_;
             } else {
                 local_14 = true;
             }
-            let _e492 = local_14;
-            done0_ = _e492;
-            let _e493 = done1_;
-            if !(_e493) {
+            let _e455 = local_14;
+            done0_ = _e455;
+            let _e456 = done1_;
+            if !(_e456) {
                 local_15 = is_last1_;
             } else {
                 local_15 = true;
             }
-            let _e498 = local_15;
-            done1_ = _e498;
-            let _e499 = done0_;
-            if _e499 {
-                let _e500 = done1_;
-                local_16 = _e500;
+            let _e461 = local_15;
+            done1_ = _e461;
+            let _e462 = done0_;
+            if _e462 {
+                let _e463 = done1_;
+                local_16 = _e463;
             } else {
                 local_16 = false;
             }
-            let _e504 = local_16;
-            if _e504 {
+            let _e467 = local_16;
+            if _e467 {
                 break;
             }
         }
         continuing {
-            let _e506 = r_1;
-            r_1 = (_e506 + 1u);
+            let _e469 = r_1;
+            r_1 = (_e469 + 1u);
         }
     }
-    let _e510 = total0_;
-    let _e512 = total1_;
-    let l_2 = (((1f - w1_) * _e510) + (w1_ * _e512));
+    let _e473 = total0_;
+    let _e475 = total1_;
+    let l_2 = (((1f - w1_) * _e473) + (w1_ * _e475));
     let c_1 = (color * l_2);
     return c_1;
 }

@@ -155,6 +155,54 @@ pub fn ray_t(f: &FrameUniforms, x: f32, delta: f32, theta: f32, s: f32, spot: bo
     }
 }
 
+/// View angle of direction `dir` to the axis (atan2: accurate near the axis, where acos
+/// loses digits).
+pub fn ray_theta(f: &FrameUniforms, dir: Vec3) -> f32 {
+    let axis = xyz(f.axis);
+    dir.cross(axis).length().atan2(dir.dot(axis))
+}
+
+/// Continuous row coordinate of the slice holding direction `dir`: its slice angle in rows
+/// from the first row's start, wrapped into `[0, rows)` when the slices cover the full
+/// circle, else clamped to `[0, rows]`. Row `floor(yc)` is the nearest ([`row_index`]).
+pub fn ray_row_coord(f: &FrameUniforms, dir: Vec3) -> f32 {
+    let rows = f.sizes[3];
+    let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
+    let mut yc = (phi - f.e1[3]) / f.e2[3];
+    if f.anti_epipole[3] > 0.5 {
+        yc -= (yc / rows as f32).floor() * rows as f32;
+    } else {
+        yc = clamp(yc, 0.0, rows as f32);
+    }
+    yc
+}
+
+/// Column coordinate, before division by a row's spacing, of the point at distance `s`
+/// along the view ray `dir` (view angle `theta`): the sun's distance from the axis, the
+/// spot's angle at the lamp from the direction towards the eye (atan2, not acos of the
+/// normalised cosine: acos loses digits near 0, where a point near the eye-lamp line lies,
+/// off by up to 5 % of its distance in the round-trip test). The inverse of [`ray_t`].
+pub fn ray_column(f: &FrameUniforms, eye: Vec3, dir: Vec3, s: f32, theta: f32, spot: bool) -> f32 {
+    if spot {
+        let q = eye + dir * s - xyz(f.light_pos);
+        let to_eye = -xyz(f.axis);
+        return q.cross(to_eye).length().atan2(q.dot(to_eye));
+    }
+    s * theta.sin()
+}
+
+/// View angle (to the axis) of the point at distance `s` along the light ray of column
+/// coordinate `col` in its slice: the sun's ray at distance `v = col` from the axis, leaving
+/// `eye + e v` along -axis; the spot's ray leaving the lamp at angle `psi = col` from the
+/// direction towards the eye. [`ray_t`] maps it back to a distance along the view ray.
+pub fn light_point_theta(f: &FrameUniforms, col: f32, s: f32, spot: bool) -> f32 {
+    if spot {
+        (s * col.sin()).atan2(f.axis[3] - s * col.cos())
+    } else {
+        col.atan2(-s)
+    }
+}
+
 /// Unshadowed spot in-scattering over `[a, b]` of the ray (`common_model::spot_span`).
 pub fn spot_segment(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, panels: u32) -> f32 {
     spot_span(

@@ -9,9 +9,11 @@
 //! [`minmax_brute_main`], the brute-force march over every texel of the same rectified row
 //! (the reference the hierarchy must equal), shares everything but the walk.
 
-use super::common_epipolar::{epipole_march, normalised_depth, pixel_dir, row_index};
+use super::common_epipolar::{
+    epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index,
+};
 use super::common_minmax::{level_offset, tree_levels};
-use super::common_model::{clamp, max, min, phase_hg};
+use super::common_model::{max, min, phase_hg};
 use super::common_sampling::{EpipolarCamera, EpipolarSamples, epipolar_samples, run_sampled};
 use super::texture::{Tex, TexArray, quantise, xyz};
 use glam::Vec3;
@@ -93,28 +95,15 @@ pub fn pixel_ray(id: [u32; 3], spot: bool, inp: &TraverseInputs) -> Option<Pixel
     }
 
     // Rectified coordinates of the surface point: the nearest row, its column x_s, depth d.
-    let axis = xyz(f.axis);
     let rows = f.sizes[3];
     let width = f.sizes[2];
     let wrap = f.anti_epipole[3] > 0.5;
-    // atan2 rather than scatter's acos: accurate near the axis, where acos loses digits.
-    let theta = dir.cross(axis).length().atan2(dir.dot(axis));
-    let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
-    let mut yc = (phi - f.e1[3]) / f.e2[3];
-    if wrap {
-        yc -= (yc / rows as f32).floor() * rows as f32;
-    } else {
-        yc = clamp(yc, 0.0, rows as f32);
-    }
+    let theta = ray_theta(f, dir);
+    let yc = ray_row_coord(f, dir);
     let row = row_index(yc.floor(), rows, wrap);
     let delta = inp.slices[row as usize].delta;
     let d = normalised_depth(theta, f.theta[0], f.theta[1]);
-    let xs = if spot {
-        let q = (eye + dir * s - xyz(f.light_pos)).normalize();
-        clamp(q.dot(-axis), -1.0, 1.0).acos() / delta
-    } else {
-        s * theta.sin() / delta
-    };
+    let xs = ray_column(f, eye, dir, s, theta, spot) / delta;
     // Texels the ray crosses (NaN or negative x_s: none).
     let n = min((if xs > 0.0 { xs } else { 0.0 }).ceil(), width as f32) as u32;
     Some(Pixel::Row(RowRay {

@@ -9,7 +9,8 @@
 //! every value is computed by the same expression in the same order.
 
 use super::common_epipolar::{
-    edge_t, epipole_march, lit_span, normalised_depth, row_index, row_phi, slice_e,
+    edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta,
+    row_index, row_phi, slice_e,
 };
 use super::common_model::{clamp, cone_falloff, max, min, phase_hg, select, transmittance_between};
 use super::common_sampling::{
@@ -159,25 +160,14 @@ pub fn pst_ray(inp: &PstInputs, spot: bool, pc: [f32; 2], z: f32) -> PstRay {
         r.marched = true;
         r.color = epipole_march(f, inp.shadow_map, eye, dir, s, spot) * xyz(f.light_color);
     }
-    let axis = xyz(f.axis);
-    let rows = f.sizes[3];
-    let wrap = f.anti_epipole[3] > 0.5;
-    r.theta = dir.cross(axis).length().atan2(dir.dot(axis));
-    let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
-    let mut yc = (phi - f.e1[3]) / f.e2[3];
-    if wrap {
-        yc -= (yc / rows as f32).floor() * rows as f32;
-    } else {
-        yc = clamp(yc, 0.0, rows as f32);
-    }
-    r.row = row_index(yc.floor(), rows, wrap);
+    r.theta = ray_theta(f, dir);
+    r.row = row_index(
+        ray_row_coord(f, dir).floor(),
+        f.sizes[3],
+        f.anti_epipole[3] > 0.5,
+    );
     r.d = normalised_depth(r.theta, f.theta[0], f.theta[1]);
-    r.xs_num = if spot {
-        let q = (eye + dir * s - xyz(f.light_pos)).normalize();
-        clamp(q.dot(-axis), -1.0, 1.0).acos()
-    } else {
-        s * r.theta.sin()
-    };
+    r.xs_num = ray_column(f, eye, dir, s, r.theta, spot);
     r
 }
 

@@ -6,7 +6,9 @@
 //! (see `scatter_shaderlib::prefiltered::frame`). Each invocation takes `RECTIFY_TEXELS`
 //! consecutive columns of a row, its row's constants once.
 
-use super::common_epipolar::{occluder_depth, row_phi, slice_e, sm_occluder_distance};
+use super::common_epipolar::{
+    light_point_theta, occluder_depth, row_phi, slice_e, sm_occluder_distance,
+};
 use super::common_model::PI;
 use super::common_shadow::NO_OCCLUDER;
 use super::texture::{Tex, xyz};
@@ -31,15 +33,14 @@ pub fn rectify_texel(
         let l = -axis * col.cos() + e * col.sin();
         let s = sm_occluder_distance(frame, shadow_map, xyz(frame.light_pos), l);
         if s < NO_OCCLUDER {
-            let dist = frame.axis[3];
-            theta_occ = (s * col.sin()).atan2(dist - s * col.cos());
+            theta_occ = light_point_theta(frame, col, s, true);
         }
     } else {
         // The light ray at distance v = col from the axis, travelling along -axis.
         let o = xyz(frame.eye) + e * col;
         let s = sm_occluder_distance(frame, shadow_map, o, -axis);
         if s < NO_OCCLUDER {
-            theta_occ = col.atan2(-s);
+            theta_occ = light_point_theta(frame, col, s, false);
         }
     }
     occluder_depth(theta_occ, frame.theta[0], frame.theta[1])

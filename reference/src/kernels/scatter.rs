@@ -16,7 +16,8 @@
 //! (`prefilter`'s bounds), `Vbar_j = 1` exactly; above the greatest, `Vbar_j = 0`.
 
 use super::common_epipolar::{
-    epipole_march, normalised_depth, pixel_dir, ray_t, row_index, spot_segment,
+    epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_t, row_index,
+    spot_segment,
 };
 use super::common_model::{PI, clamp, max, max_u, min, phase_hg, transmittance_between};
 use super::common_moments::{lit_moments4, lit_moments6, moment_z};
@@ -116,21 +117,9 @@ pub fn scatter_main(
         xs = proj_column(f, g, regions, width, spot);
     } else {
         theta = clamp(dir.dot(axis), -1.0, 1.0).acos();
-        let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
-        let mut y = (phi - f.e1[3]) / f.e2[3];
-        if wrap {
-            y -= (y / rows as f32).floor() * rows as f32;
-        } else {
-            y = clamp(y, 0.0, rows as f32);
-        }
-        yc = y;
+        yc = ray_row_coord(f, dir);
         d = normalised_depth(theta, f.theta[0], f.theta[1]);
-        reach = if spot {
-            let q = (eye + dir * s - xyz(f.light_pos)).normalize();
-            clamp(q.dot(-axis), -1.0, 1.0).acos()
-        } else {
-            s * theta.sin()
-        };
+        reach = ray_column(f, eye, dir, s, theta, spot);
     }
 
     // The two rectified rows the pixel lies between (the second only with a non-zero weight)

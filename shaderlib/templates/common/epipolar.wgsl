@@ -216,6 +216,54 @@ fn ray_t(f: Frame, x: f32, delta: f32, theta: f32, s: f32, spot: bool) -> f32 {
     }
 }
 
+// View angle of direction `dir` to the axis (atan2: accurate near the axis, where acos loses
+// digits).
+fn ray_theta(f: Frame, dir: vec3<f32>) -> f32 {
+    let axis = f.axis.xyz;
+    return atan2(length(cross(dir, axis)), dot(dir, axis));
+}
+
+// Continuous row coordinate of the slice holding direction `dir`: its slice angle in rows
+// from the first row's start, wrapped into [0, rows) when the slices cover the full circle,
+// else clamped to [0, rows]. Row `floor(yc)` is the nearest (`row_index`).
+fn ray_row_coord(f: Frame, dir: vec3<f32>) -> f32 {
+    let rows = f.sizes[3];
+    let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
+    var yc = (phi - f.e1_[3]) / f.e2_[3];
+    if f.anti_epipole[3] > 0.5 {
+        yc -= floor(yc / f32(rows)) * f32(rows);
+    } else {
+        yc = clamp(yc, 0.0, f32(rows));
+    }
+    return yc;
+}
+
+// Column coordinate, before division by a row's spacing, of the point at distance `s` along
+// the view ray `dir` (view angle `theta`): the sun's distance from the axis, the spot's angle
+// at the lamp from the direction towards the eye (atan2, not acos of the normalised cosine:
+// acos loses digits near 0, where a point near the eye-lamp line lies, off by up to 5 % of
+// its distance in the round-trip test). The inverse of `ray_t`.
+fn ray_column(f: Frame, eye: vec3<f32>, dir: vec3<f32>, s: f32, theta: f32, spot: bool) -> f32 {
+    if spot {
+        let q = eye + dir * s - f.light_pos.xyz;
+        let to_eye = -f.axis.xyz;
+        return atan2(length(cross(q, to_eye)), dot(q, to_eye));
+    }
+    return s * sin(theta);
+}
+
+// View angle (to the axis) of the point at distance `s` along the light ray of column
+// coordinate `col` in its slice: the sun's ray at distance `v = col` from the axis, leaving
+// `eye + e v` along -axis; the spot's ray leaving the lamp at angle `psi = col` from the
+// direction towards the eye. `ray_t` maps it back to a distance along the view ray.
+fn light_point_theta(f: Frame, col: f32, s: f32, spot: bool) -> f32 {
+    if spot {
+        return atan2(s * sin(col), f.axis[3] - s * cos(col));
+    } else {
+        return atan2(col, -s);
+    }
+}
+
 // Unshadowed spot in-scattering over `[a, b]` of the ray (`scatter::model::spot_span`).
 fn spot_segment(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, panels: u32) -> f32 {
     return spot_span(eye, dir, a, b, panels, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
