@@ -11,7 +11,8 @@
 //! configuration (1280x720, 1024^2 rectified map) raymarch N = 64 took 0.68-0.93x the
 //! prefiltered default's time and N = 128 1.36-1.94x over two runs on this machine's
 //! lavapipe (docs/bench/bench.md), so the equal-time N lies between them. The test compares
-//! with N = 64, the cheaper side, and reports N = 32, 128 and 256 and minmax too.
+//! with N = 64, the cheaper side, and reports minmax too (and N = 32, 128 and 256 with
+//! `SCATTER_FULL=1`: each column costs a minute of shader compilation with a cold Mesa cache).
 //!
 //! Prefiltered flickers less than raymarch N = 64 on `sphere`, `columns`, `foliage`,
 //! `spot_grate` (spot: 0.48 against 0.90 %; 2.59 % before raymarch's spot samples became
@@ -82,12 +83,25 @@ const SMOOTH: &str = "terrain: one clean shadow volume, where a 64-sample march 
 /// The block side of the sampled variants reported (`sampling = lowres`).
 const SAMPLED_SCALE: u32 = 4;
 
-/// Raymarch sample counts reported.
+/// Raymarch sample counts reported with `SCATTER_FULL=1`; CI runs the equal-time one
+/// only ([`samples`]).
 const SAMPLES: [u32; 4] = [32, 64, 128, 256];
+
+/// The raymarch sample counts this run reports: [`EQUAL_TIME_SAMPLES`] (the one asserted
+/// against), and with `SCATTER_FULL=1` every [`SAMPLES`]. With a cold Mesa shader cache each
+/// column costs about a minute of shader compilation (the whole file took 694 s cold against
+/// 75 s warm, 2026-12-03), and the other three are context only.
+fn samples() -> Vec<u32> {
+    if std::env::var("SCATTER_FULL").is_ok_and(|v| v == "1") {
+        SAMPLES.to_vec()
+    } else {
+        vec![EQUAL_TIME_SAMPLES]
+    }
+}
 
 /// The variants reported, in column order: the prefiltered default, the moment basis (6
 /// moments, 8 regions; reported, its frames checked for NaN/Inf), raymarch at every
-/// `SAMPLES`, minmax, then raymarch N = 64 with `sampling = lowres` at [`SAMPLED_SCALE`].
+/// [`samples`], minmax, then raymarch N = 64 with `sampling = lowres` at [`SAMPLED_SCALE`].
 fn variants(light: LightKind) -> Vec<FamilyVariant> {
     let mut v = vec![
         FamilyVariant::Prefiltered(PrefilteredVariant {
@@ -100,7 +114,7 @@ fn variants(light: LightKind) -> Vec<FamilyVariant> {
             ..PrefilteredVariant::with_moments(6)
         }),
     ];
-    v.extend(SAMPLES.iter().map(|&samples| {
+    v.extend(samples().into_iter().map(|samples| {
         FamilyVariant::Raymarch(RaymarchVariant {
             samples,
             light,
@@ -116,11 +130,15 @@ fn variants(light: LightKind) -> Vec<FamilyVariant> {
     // only: the sampling stage is the same code in every family, and each column costs this
     // test a minute of shader compilation with a cold Mesa cache (the three families
     // measured 1.07-1.96x their per-pixel flicker, issue 14's note).
-    let sampled = v[3].with_sampling(SamplingKnobs::lowres(SAMPLED_SCALE));
-    v.push(sampled);
+    let n64 = FamilyVariant::Raymarch(RaymarchVariant {
+        samples: EQUAL_TIME_SAMPLES,
+        light,
+        ..RaymarchVariant::default()
+    });
+    v.push(n64.with_sampling(SamplingKnobs::lowres(SAMPLED_SCALE)));
     // And epipolar (64 slices x 64 samples, step 8, at this screen): its samples move with
     // the epipole, so a camera or light that moves moves them (Yusov 2013's flicker).
-    v.push(v[3].with_sampling(epipolar_knobs()));
+    v.push(n64.with_sampling(epipolar_knobs()));
     // Issue 15: the partial-sum-tree family (epipolar samples only) at the same layout,
     // every sample answered (reported, NaN checked).
     v.push(FamilyVariant::PartialSumTree(
@@ -151,7 +169,7 @@ fn labels() -> Vec<String> {
         "prefiltered m32-r3".to_owned(),
         "prefiltered moments6-r8".to_owned(),
     ];
-    l.extend(SAMPLES.iter().map(|n| format!("raymarch n{n}")));
+    l.extend(samples().iter().map(|n| format!("raymarch n{n}")));
     l.push("minmax".into());
     l.push(format!("raymarch n64-lr{SAMPLED_SCALE}"));
     l.push("raymarch n64-ep64x64".into());
@@ -159,7 +177,8 @@ fn labels() -> Vec<String> {
     l
 }
 
-/// The passes of every reported variant, created once per scene (as an engine keeps them).
+/// The passes of every reported variant for one light kind (created once, as an engine keeps
+/// them).
 fn passes(ctx: &Context, light: LightKind) -> Vec<FamilyPasses> {
     let res = Resolutions {
         screen: SCREEN,
@@ -249,6 +268,11 @@ fn frames_are_finite_and_prefiltered_flicker_is_within_raymarch_or_its_listed_ce
     ];
     let mut errors_table = table.clone();
     let only = std::env::var("SCATTER_FLICKER_SCENE").ok();
+    // One set of passes per light kind for every scene, as an engine keeps them. With a cold
+    // Mesa cache, passes created anew per scene cost this file 713 s against 480 s now (about
+    // 60 s warm; same outputs, 2026-12-03): llvmpipe compiled kernels again for new passes.
+    let mut sun_passes: Option<Vec<FamilyPasses>> = None;
+    let mut spot_passes: Option<Vec<FamilyPasses>> = None;
     for &name in SceneName::ALL
         .iter()
         .filter(|n| only.as_deref().is_none_or(|o| o == n.name()))
@@ -258,7 +282,12 @@ fn frames_are_finite_and_prefiltered_flicker_is_within_raymarch_or_its_listed_ce
         } else {
             LightKind::Directional
         };
-        let mut passes = passes(ctx, light);
+        let slot = if light == LightKind::Spot {
+            &mut spot_passes
+        } else {
+            &mut sun_passes
+        };
+        let passes = slot.get_or_insert_with(|| passes(ctx, light));
         for path in Path::ALL {
             let mut outputs: Vec<Vec<Image>> = vec![Vec::new(); labels.len()];
             let mut truths = Vec::new();
@@ -277,7 +306,7 @@ fn frames_are_finite_and_prefiltered_flicker_is_within_raymarch_or_its_listed_ce
                     },
                     &|| (),
                 ));
-                for (i, image) in render(ctx, &mut passes, &scene, &gbuf, &sm)
+                for (i, image) in render(ctx, passes, &scene, &gbuf, &sm)
                     .into_iter()
                     .enumerate()
                 {
