@@ -11,8 +11,8 @@
 //! configuration (1280x720, 1024^2 rectified map) raymarch N = 64 took 0.68-0.93x the
 //! prefiltered default's time and N = 128 1.36-1.94x over two runs on this machine's
 //! lavapipe (docs/bench/bench.md), so the equal-time N lies between them. The test compares
-//! with N = 64, the cheaper side, and reports minmax too (and N = 32, 128 and 256 with
-//! `SCATTER_FULL=1`: each column costs a minute of shader compilation with a cold Mesa cache).
+//! with N = 64, the cheaper side, and reports minmax too (and N = 32, 128 and 256, context
+//! only, with `SCATTER_FULL=1`).
 //!
 //! Prefiltered flickers less than raymarch N = 64 on `sphere`, `columns`, `foliage`,
 //! `spot_grate` (spot: 0.48 against 0.90 %; 2.59 % before raymarch's spot samples became
@@ -88,9 +88,9 @@ const SAMPLED_SCALE: u32 = 4;
 const SAMPLES: [u32; 4] = [32, 64, 128, 256];
 
 /// The raymarch sample counts this run reports: [`EQUAL_TIME_SAMPLES`] (the one asserted
-/// against), and with `SCATTER_FULL=1` every [`SAMPLES`]. With a cold Mesa shader cache each
-/// column costs about a minute of shader compilation (the whole file took 694 s cold against
-/// 75 s warm, 2026-12-03), and the other three are context only.
+/// against), and with `SCATTER_FULL=1` every [`SAMPLES`]: the other three are context for
+/// the table, not asserted (leaving them out saved no measurable time with a cold Mesa cache,
+/// 694 s against 713 s for the file; the passes created per scene were that cost, below).
 fn samples() -> Vec<u32> {
     if std::env::var("SCATTER_FULL").is_ok_and(|v| v == "1") {
         SAMPLES.to_vec()
