@@ -301,8 +301,26 @@ pub fn run_family_once(
     res: Resolutions,
     inputs: &CpuInputs,
 ) -> Result<FamilyReadback, RuntimeError> {
+    let mut pass = FamilyPasses::new(ctx, variant, res, inputs.frame.shadow_map.size)?;
+    run_family_on(ctx, &mut pass, res, inputs)
+}
+
+/// [`run_family_once`] on passes already built, for many frames of one variant (as an engine
+/// keeps its passes; on lavapipe with a cold Mesa cache, passes built anew per frame compile
+/// their kernels again). `res` and `inputs.frame.shadow_map.size` must be the ones `pass`
+/// was built with.
+///
+/// # Errors
+///
+/// As [`run_family_once`] but for building the passes.
+pub fn run_family_on(
+    ctx: &Context,
+    pass: &mut FamilyPasses,
+    res: Resolutions,
+    inputs: &CpuInputs,
+) -> Result<FamilyReadback, RuntimeError> {
+    let variant = &pass.variant();
     let sm_size = inputs.frame.shadow_map.size;
-    let mut pass = FamilyPasses::new(ctx, variant, res, sm_size)?;
     let kernels: Vec<Kernel> = scatter_shaderlib::family::KernelFamily::kernel_params(variant)
         .iter()
         .map(scatter_shaderlib::KernelParams::kernel)

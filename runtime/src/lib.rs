@@ -35,7 +35,7 @@ mod timer;
 
 pub use context::{AdapterReport, Context, ContextError, GpuPolicy};
 pub use error::RuntimeError;
-pub use family::{FamilyPasses, FamilyReadback, FamilyRuntime, run_family_once};
+pub use family::{FamilyPasses, FamilyReadback, FamilyRuntime, run_family_on, run_family_once};
 
 /// The prefiltered family's passes under their name before the redesign.
 #[deprecated(note = "renamed `Prefiltered`: `Scatter` is also the crate and a kernel")]

@@ -316,6 +316,49 @@ pub fn run_variant_counted(
     ),
     String,
 > {
+    run_variant_in(ctx, None, variant, frame)
+}
+
+/// Passes kept across the frames of a test, per variant and sizes (as an engine keeps them):
+/// on lavapipe with a cold Mesa cache, passes built anew per frame compile their kernels
+/// again (the flicker test: 713 s with passes per scene, 480 s kept).
+#[derive(Default)]
+pub struct PassCache(std::collections::HashMap<String, scatter_runtime::FamilyPasses>);
+
+/// [`run_variant`] on the GPU through `cache`'s passes for the variant (built on first use).
+///
+/// # Errors
+///
+/// As [`run_variant`].
+pub fn run_variant_cached(
+    ctx: Option<&Context>,
+    cache: &mut PassCache,
+    variant: &scatter_shaderlib::family::FamilyVariant,
+    frame: &scatter_reference::kernels::CpuFrame<'_>,
+) -> Result<
+    (
+        scatter_reference::image::Image,
+        Option<scatter_shaderlib::prefiltered::FrameReport>,
+    ),
+    String,
+> {
+    run_variant_in(ctx, Some(cache), variant, frame).map(|(image, report, _)| (image, report))
+}
+
+#[allow(clippy::type_complexity, reason = "run_variant_counted's tuple")]
+fn run_variant_in(
+    ctx: Option<&Context>,
+    cache: Option<&mut PassCache>,
+    variant: &scatter_shaderlib::family::FamilyVariant,
+    frame: &scatter_reference::kernels::CpuFrame<'_>,
+) -> Result<
+    (
+        scatter_reference::image::Image,
+        Option<scatter_shaderlib::prefiltered::FrameReport>,
+        Option<u32>,
+    ),
+    String,
+> {
     use scatter_reference::image::Image;
     use scatter_reference::kernels::{CpuRun, engine_rectified_map, run_family};
     use scatter_shaderlib::family::FamilyVariant;
@@ -354,18 +397,28 @@ pub fn run_variant_counted(
         }
         _ => None,
     };
-    let out = scatter_runtime::run_family_once(
-        ctx,
-        variant,
-        res,
-        &scatter_runtime::CpuInputs {
-            frame: input,
-            depth: gbuf.view_depth.clone(),
-            shadow_map: frame.shadow_map.depth.clone(),
-            rectified,
-            pass_wall_frames: 0,
-        },
-    )
+    let cpu = scatter_runtime::CpuInputs {
+        frame: input,
+        depth: gbuf.view_depth.clone(),
+        shadow_map: frame.shadow_map.depth.clone(),
+        rectified,
+        pass_wall_frames: 0,
+    };
+    let out = match cache {
+        None => scatter_runtime::run_family_once(ctx, variant, res, &cpu),
+        Some(cache) => {
+            let sm_size = cpu.frame.shadow_map.size;
+            let key = format!("{variant:?} {res:?} {sm_size}");
+            let pass = match cache.0.entry(key) {
+                std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+                std::collections::hash_map::Entry::Vacant(e) => e.insert(
+                    scatter_runtime::FamilyPasses::new(ctx, variant, res, sm_size)
+                        .map_err(|e| e.to_string())?,
+                ),
+            };
+            scatter_runtime::run_family_on(ctx, pass, res, &cpu)
+        }
+    }
     .map_err(|e| e.to_string())?;
     let image = Image::from_pixels(
         gbuf.width,

@@ -33,7 +33,7 @@ use std::process::ExitCode;
 use std::sync::OnceLock;
 use std::time::Instant;
 
-use scatter_conformance::{Check, gpu, run_trials, run_variant};
+use scatter_conformance::{Check, PassCache, gpu, run_trials, run_variant_cached};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
@@ -277,10 +277,16 @@ impl Prepared {
     }
 
     /// Runs `method` (with the pose's light) on the GPU, or its CPU mirrors without one.
-    fn run(&self, ctx: Option<&Context>, method: &FamilyVariant) -> Result<Image, String> {
+    fn run(
+        &self,
+        ctx: Option<&Context>,
+        cache: &mut PassCache,
+        method: &FamilyVariant,
+    ) -> Result<Image, String> {
         let settings = self.frame_input().settings;
-        run_variant(
+        run_variant_cached(
             ctx,
+            cache,
             &method.with_light(self.light()),
             &CpuFrame {
                 scene: &self.pose.scene,
@@ -435,6 +441,8 @@ fn measure() -> Results {
         .collect();
     let mut t_setup = t.elapsed().as_secs_f64();
     let mut t_run = vec![0.0; methods.len()];
+    // Every variant's passes built once for all poses (see `PassCache`).
+    let mut cache = PassCache::default();
     for pose in poses {
         let t = Instant::now();
         let name = pose.name();
@@ -455,7 +463,7 @@ fn measure() -> Results {
         let mut scores = BTreeMap::new();
         for (i, (method, label)) in methods.iter().zip(&labels).enumerate() {
             let t = Instant::now();
-            let score = p.run(ctx, method).and_then(|image| {
+            let score = p.run(ctx, &mut cache, method).and_then(|image| {
                 let e = metrics::compare(&image, &p.truth).map_err(|e| e.to_string())?;
                 let max_abs_err = image
                     .data
