@@ -98,17 +98,29 @@ pub fn frame_spot_integrand(f: &FrameUniforms, eye: Vec3, dir: Vec3, t: f32) -> 
     )
 }
 
-/// In-scattering along `[0, s]` of the pixel's ray by marching `steps` samples against the
-/// standard shadow map `sm`: the epipole and anti-epipole discs of every epipolar family. The
-/// sun: cell midpoints uniform in `t`; a spot: the midpoints of `steps` equiangular strata
-/// ([`equiangular`]), so the 1/d^2 peak next to the lamp is sampled by its angle.
-pub fn epipole_march(f: &FrameUniforms, sm: &Tex, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f32 {
-    let steps = f.sizes2[1];
-    let h = s / steps as f32;
-    let strata = equiangular(eye, dir, xyz(f.light_pos), 0.0, s, steps);
+/// In-scattering along `[a, b]` of the pixel's ray by marching `steps` samples against the
+/// standard shadow map `sm`, without `sigma_s p E` for the sun (as [`lit_span`]). The sun:
+/// cell midpoints uniform in `t`; a spot: the midpoints of `steps` equiangular strata of
+/// `[a, b]` ([`equiangular`]), so the 1/d^2 peak next to the lamp is sampled by its angle.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "line for line with the WGSL function's parameters"
+)]
+pub fn span_march(
+    f: &FrameUniforms,
+    sm: &Tex,
+    eye: Vec3,
+    dir: Vec3,
+    a: f32,
+    b: f32,
+    steps: u32,
+    spot: bool,
+) -> f32 {
+    let h = (b - a) / steps as f32;
+    let strata = equiangular(eye, dir, xyz(f.light_pos), a, b, steps);
     let mut sum = 0.0;
     for k in 0..steps {
-        let mut t = (k as f32 + 0.5) * h;
+        let mut t = a + (k as f32 + 0.5) * h;
         let mut w = h;
         if spot {
             let tw = equiangular_sample(&strata, k as f32 + 0.5);
@@ -119,9 +131,17 @@ pub fn epipole_march(f: &FrameUniforms, sm: &Tex, eye: Vec3, dir: Vec3, s: f32, 
         if spot {
             sum += v * w * frame_spot_integrand(f, eye, dir, t);
         } else {
-            sum += v * transmittance_between(f.medium[0], k as f32 * h, (k + 1) as f32 * h);
+            sum += v * transmittance_between(f.medium[0], a + k as f32 * h, a + (k + 1) as f32 * h);
         }
     }
+    sum
+}
+
+/// In-scattering along `[0, s]` of the pixel's ray by marching `f.sizes2[1]` samples
+/// ([`span_march`]): the epipole and anti-epipole discs of every epipolar family; without
+/// the light colour.
+pub fn epipole_march(f: &FrameUniforms, sm: &Tex, eye: Vec3, dir: Vec3, s: f32, spot: bool) -> f32 {
+    let sum = span_march(f, sm, eye, dir, 0.0, s, f.sizes2[1], spot);
     if spot {
         sum
     } else {

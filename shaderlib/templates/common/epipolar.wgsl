@@ -155,21 +155,20 @@ fn frame_spot_integrand(f: Frame, eye: vec3<f32>, dir: vec3<f32>, t: f32) -> f32
     return spot_integrand(eye, dir, t, f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium);
 }
 
-// In-scattering along `[0, s]` of the pixel's ray by marching `steps` samples against the
-// standard shadow map `sm`: the epipole and anti-epipole discs of every epipolar family,
-// where the rectification degenerates (Klehm Sec. 5). The sun: cell midpoints uniform in `t`,
-// each with the exact transmittance integral of its cell, scaled once by `sigma_s p E`. A spot:
-// the midpoints of `steps` equiangular strata (`scatter::model::equiangular`), each weighted
-// by `1 / (steps pdf)`, so the 1/d^2 peak of a ray passing next to the lamp is sampled by its
-// angle (uniform midpoints in `t` overshot the truth 5.6x next to a lamp on screen); without
-// the light colour (its integrand carries `sigma_s p`).
-fn epipole_march(f: Frame, sm: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, s: f32, spot: bool) -> f32 {
-    let steps = f.sizes2_[1];
-    let h = s / f32(steps);
-    let strata = equiangular(eye, dir, f.light_pos.xyz, 0.0, s, steps);
+// In-scattering along `[a, b]` of the pixel's ray by marching `steps` samples against the
+// standard shadow map `sm`, without `sigma_s p E` for the sun (as `lit_span`). The sun: cell
+// midpoints uniform in `t`, each with the exact transmittance integral of its cell. A spot:
+// the midpoints of `steps` equiangular strata of `[a, b]` (`scatter::model::equiangular`),
+// each weighted by `1 / (steps pdf)`, so the 1/d^2 peak of a ray passing next to the lamp is
+// sampled by its angle (uniform midpoints in `t` overshot the truth 5.6x next to a lamp on
+// screen); its integrand carries `sigma_s p`. The epipole discs march `[0, s]`
+// (`epipole_march`); `volume_march` marches the span its shadow-volume bounds leave open.
+fn span_march(f: Frame, sm: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, steps: u32, spot: bool) -> f32 {
+    let h = (b - a) / f32(steps);
+    let strata = equiangular(eye, dir, f.light_pos.xyz, a, b, steps);
     var sum = 0.0;
     for (var k = 0u; k < steps; k++) {
-        var t = (f32(k) + 0.5) * h;
+        var t = a + (f32(k) + 0.5) * h;
         var w = h;
         if spot {
             let tw = equiangular_sample(strata, f32(k) + 0.5);
@@ -180,9 +179,18 @@ fn epipole_march(f: Frame, sm: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, 
         if spot {
             sum += v * w * frame_spot_integrand(f, eye, dir, t);
         } else {
-            sum += v * transmittance_between(f.medium[0], f32(k) * h, f32(k + 1u) * h);
+            sum += v * transmittance_between(f.medium[0], a + f32(k) * h, a + f32(k + 1u) * h);
         }
     }
+    return sum;
+}
+
+// In-scattering along `[0, s]` of the pixel's ray by marching `f.sizes2_[1]` samples against
+// the standard shadow map (`span_march`): the epipole and anti-epipole discs of every
+// epipolar family, where the rectification degenerates (Klehm Sec. 5); without the light
+// colour.
+fn epipole_march(f: Frame, sm: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, s: f32, spot: bool) -> f32 {
+    let sum = span_march(f, sm, eye, dir, 0.0, s, f.sizes2_[1], spot);
     if spot {
         return sum;
     } else {
