@@ -39,9 +39,9 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::textures::upload_r32float;
 use scatter_runtime::{
-    Context, CpuInputs, FamilyPasses, FrameInput, Inputs, MinmaxTimes, PartialSumTreeTimes,
-    PrefilteredTimes, RaymarchInput, RaymarchTimes, run_minmax_once, run_partial_sum_tree_once,
-    run_prefiltered_once, run_raymarch_once,
+    Context, CpuInputs, FamilyPasses, FrameInput, HybridVolumeTimes, Inputs, MinmaxTimes,
+    PartialSumTreeTimes, PrefilteredTimes, RaymarchInput, RaymarchTimes, run_hybrid_volume_once,
+    run_minmax_once, run_partial_sum_tree_once, run_prefiltered_once, run_raymarch_once,
 };
 use scatter_shaderlib::Kernel;
 use scatter_shaderlib::family::KernelFamily;
@@ -600,6 +600,21 @@ fn minmax_times(t: MinmaxTimes) -> PassTimes {
     out
 }
 
+fn hybrid_volume_times(t: HybridVolumeTimes) -> PassTimes {
+    let mut out = vec![
+        (Kernel::DepthColumns.name(), t.depth_columns),
+        (Kernel::SliceFit.name(), t.slice_fit),
+        (Kernel::Rectify.name(), t.rectify),
+        (Kernel::VolumeBounds.name(), t.bounds),
+        (Kernel::VolumeMarch.name(), t.march),
+    ];
+    if t.unwarp > Duration::ZERO {
+        out.push((Kernel::VolumeMarchUnwarp.name(), t.unwarp));
+        out.push((Kernel::VolumeMarchFallback.name(), t.fallback));
+    }
+    out
+}
+
 fn partial_sum_tree_times(t: PartialSumTreeTimes) -> PassTimes {
     vec![
         (Kernel::DepthColumns.name(), t.depth_columns),
@@ -743,6 +758,18 @@ fn run_on_gpu(
                     report: Some(rb.frame.report),
                     wall_time: rb.wall_time,
                     gpu_times: rb.gpu_times.map(minmax_times),
+                })
+            })
+        }
+        FamilyVariant::HybridVolume(v) => {
+            let ctx = &ctx;
+            Box::new(move |_| {
+                let rb = run_hybrid_volume_once(ctx, v, res, &frame, &gbuf.view_depth, &sm.depth)?;
+                Ok(GpuFrame {
+                    output: rb.output,
+                    report: Some(rb.frame.report),
+                    wall_time: rb.wall_time,
+                    gpu_times: rb.gpu_times.map(hybrid_volume_times),
                 })
             })
         }

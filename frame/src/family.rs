@@ -11,6 +11,7 @@ use std::fmt;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
+use crate::hybrid_volume::HybridVolumeVariant;
 use crate::minmax::MinmaxVariant;
 use crate::partial_sum_tree::PartialSumTreeVariant;
 use crate::raymarch::RaymarchVariant;
@@ -186,6 +187,9 @@ macro_rules! families {
 }
 
 families! {
+    /// Wyman & Ramsey 2008: `rectify` (the prefiltered family's), `volume_bounds`,
+    /// `volume_march`.
+    HybridVolume(HybridVolumeVariant),
     /// Chen et al. 2011: `rectify` (the prefiltered family's), `minmax_build`, `minmax_traverse`.
     Minmax(MinmaxVariant),
     /// Baran et al. 2010: `rectify` (the prefiltered family's), `pst_sweep` (epipolar samples

@@ -13,6 +13,7 @@
 
 pub mod family;
 pub mod frame;
+pub mod hybrid_volume;
 pub mod minmax;
 pub mod partial_sum_tree;
 pub mod raymarch;

@@ -25,7 +25,6 @@ pub mod buffers;
 pub mod bvh;
 pub mod desc;
 pub mod geometry;
-pub mod hybrid_volume;
 pub mod image;
 pub mod kernels;
 pub mod metrics;

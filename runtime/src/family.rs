@@ -16,7 +16,7 @@ use scatter_shaderlib::prefiltered::{FrameReport, Resolutions};
 use crate::gpu::upload_inputs;
 use crate::prefiltered::{CpuInputs, FrameInput, Inputs};
 use crate::textures::read_rgba16float;
-use crate::{Context, Minmax, PartialSumTree, Prefiltered, Raymarch, RuntimeError};
+use crate::{Context, HybridVolume, Minmax, PartialSumTree, Prefiltered, Raymarch, RuntimeError};
 
 /// What a family's runtime type offers with the inputs every family takes: the frame input
 /// of the epipolar families (a family ignores what it does not use) and the engine's
@@ -262,6 +262,8 @@ macro_rules! runtime_families {
 }
 
 runtime_families! {
+    /// The hybrid shadow-volume family.
+    HybridVolume(HybridVolume),
     /// The minmax family.
     Minmax(Minmax),
     /// The partial-sum-tree family.

@@ -25,6 +25,7 @@ mod error;
 mod executor;
 pub mod family;
 pub mod gpu;
+pub mod hybrid_volume;
 pub mod minmax;
 pub mod partial_sum_tree;
 pub mod prefiltered;
@@ -40,6 +41,9 @@ pub use family::{FamilyPasses, FamilyReadback, FamilyRuntime, run_family_on, run
 /// The prefiltered family's passes under their name before the redesign.
 #[deprecated(note = "renamed `Prefiltered`: `Scatter` is also the crate and a kernel")]
 pub type Scatter = Prefiltered;
+pub use hybrid_volume::{
+    HybridVolume, HybridVolumeReadback, HybridVolumeTimes, run_hybrid_volume_once,
+};
 pub use minmax::{Minmax, MinmaxReadback, MinmaxTimes, run_minmax_once};
 pub use partial_sum_tree::{
     PartialSumTree, PartialSumTreeReadback, PartialSumTreeTimes, run_partial_sum_tree_once,

@@ -4,6 +4,7 @@
 
 pub use scatter_frame::family::{Family, FamilyVariant, KnobSet, UnknownFamily};
 
+use crate::hybrid_volume::HybridVolumeVariant;
 use crate::minmax::MinmaxVariant;
 use crate::partial_sum_tree::PartialSumTreeVariant;
 use crate::plan::Plan;
@@ -71,6 +72,7 @@ macro_rules! kernel_families {
 }
 
 kernel_families! {
+    HybridVolume(HybridVolumeVariant),
     Minmax(MinmaxVariant),
     PartialSumTree(PartialSumTreeVariant),
     Prefiltered(PrefilteredVariant),

@@ -28,6 +28,7 @@
 mod compose;
 mod error;
 pub mod family;
+pub mod hybrid_volume;
 mod kernel;
 pub mod minmax;
 pub mod partial_sum_tree;
@@ -40,6 +41,7 @@ pub mod sampling;
 
 pub use error::ShaderError;
 use family::{Family, KernelFamily};
+use hybrid_volume::HybridVolumeVariant;
 use minmax::MinmaxVariant;
 use partial_sum_tree::PartialSumTreeVariant;
 use prefiltered::PrefilteredVariant;
@@ -107,6 +109,19 @@ kernel::kernels! {
     /// Every rectified row's column spacing fitted to the deepest pixel of the depth buffer
     /// (after `depth_columns`; the host spans rows to the far plane).
     SliceFit("slice_fit", PrefilteredVariant, prefiltered::kernels::render_slice_fit),
+    /// The shadow volume's boundary crossings of every rectified row, binned by ray depth:
+    /// first and last column edge per bin (Wyman & Ramsey 2008, rasterised per slice).
+    VolumeBounds("volume_bounds", HybridVolumeVariant, hybrid_volume::render_bounds),
+    /// Per pixel: only the interval between the first and last shadow-volume crossing
+    /// ray-marched, head and tail in closed form; pixels near the epipole marched whole
+    /// (Wyman & Ramsey 2008).
+    VolumeMarch("volume_march", HybridVolumeVariant, hybrid_volume::render_march),
+    /// `sampling = epipolar`: the pixels `volume_march_unwarp` listed (no sample stands for
+    /// them), marched themselves.
+    VolumeMarchFallback("volume_march_fallback", HybridVolumeVariant, hybrid_volume::render_march_fallback),
+    /// `sampling = epipolar`: every pixel gathered from the `volume_march` samples of the
+    /// two slices around it, or listed for `volume_march_fallback` where none stands for it.
+    VolumeMarchUnwarp("volume_march_unwarp", HybridVolumeVariant, hybrid_volume::render_march_unwarp),
 }
 
 impl KernelParams {

@@ -151,6 +151,7 @@ fn epipolar_camera(variant: &FamilyVariant, f: &Fixture) -> Result<EpipolarCamer
     match variant {
         FamilyVariant::Prefiltered(v) => frame(v),
         FamilyVariant::Minmax(v) => frame(&v.prefiltered()),
+        FamilyVariant::HybridVolume(v) => frame(&v.prefiltered()),
         FamilyVariant::PartialSumTree(v) => frame(&v.prefiltered()),
         FamilyVariant::Raymarch(v) => prepare_raymarch(
             v,

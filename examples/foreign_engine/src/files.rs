@@ -21,6 +21,7 @@ use scatter_frame::frame::{
     CameraDesc, FrameSettings, LightDesc, MediumDesc, PrefilteredFrame, Resolutions, ShadowMapDesc,
     ShadowProjectionDesc, prepare_frame,
 };
+use scatter_frame::hybrid_volume::{HybridVolumeVariant, prepare_hybrid_volume};
 use scatter_frame::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_frame::partial_sum_tree::{
     PartialSumTreeFrame, PartialSumTreeVariant, prepare_partial_sum_tree,
@@ -276,6 +277,27 @@ impl FrameFile {
     pub fn prepare_minmax(&self, variant: &MinmaxVariant) -> Result<PrefilteredFrame, EngineError> {
         let d = self.descs();
         Ok(prepare_minmax(
+            variant,
+            &self.resolutions(),
+            &d.camera,
+            &d.light,
+            &d.medium,
+            &d.shadow_map,
+            &d.settings,
+        )?)
+    }
+
+    /// Sets up the frame of a hybrid_volume variant ([`prepare_hybrid_volume`]).
+    ///
+    /// # Errors
+    ///
+    /// [`EngineError::Frame`] when the frame set-up rejects the numbers.
+    pub fn prepare_hybrid_volume(
+        &self,
+        variant: &HybridVolumeVariant,
+    ) -> Result<PrefilteredFrame, EngineError> {
+        let d = self.descs();
+        Ok(prepare_hybrid_volume(
             variant,
             &self.resolutions(),
             &d.camera,
@@ -596,9 +618,10 @@ pub struct RunArgs {
 pub struct RunSummary {
     /// The variant id.
     pub variant: String,
-    /// The variant's family (`prefiltered`, `raymarch`, `minmax`, `partial_sum_tree`).
+    /// The variant's family (`prefiltered`, `raymarch`, `minmax`, `partial_sum_tree`,
+    /// `hybrid_volume`).
     pub family: String,
-    /// The epipolar frame set-up (prefiltered, minmax and partial_sum_tree; `None` for
+    /// The epipolar frame set-up (prefiltered, minmax, partial_sum_tree and hybrid_volume; `None` for
     /// raymarch).
     pub frame: Option<PrefilteredFrame>,
     /// Passes run and skipped.
@@ -695,6 +718,12 @@ pub fn run_dir(
             )?;
             (Some(frame), out)
         }
+        Knobs::HybridVolume(variant) => {
+            let frame = file.prepare_hybrid_volume(variant)?;
+            let mut engine = load(&crate::hybrid_volume::params(&file.sizes()))?;
+            let out = crate::hybrid_volume::run_frame(&mut engine, &frame, &depth, &shadow)?;
+            (Some(frame), out)
+        }
         Knobs::Minmax(variant) => {
             let frame = file.prepare_minmax(variant)?;
             let mut engine = load(&crate::minmax::params(&file.sizes()))?;
@@ -741,6 +770,8 @@ pub enum Knobs {
     Raymarch(RaymarchVariant),
     /// A `minmax` variant.
     Minmax(MinmaxVariant),
+    /// A `hybrid_volume` variant.
+    HybridVolume(HybridVolumeVariant),
     /// A `partial_sum_tree` variant.
     PartialSumTree(PartialSumTreeVariant),
 }
@@ -752,6 +783,7 @@ impl Knobs {
             Self::Prefiltered(_) => "prefiltered",
             Self::Raymarch(_) => "raymarch",
             Self::Minmax(_) => "minmax",
+            Self::HybridVolume(_) => "hybrid_volume",
             Self::PartialSumTree(_) => "partial_sum_tree",
         }
     }
@@ -805,6 +837,12 @@ pub fn knobs_of(manifest: &crate::Manifest, id: &str) -> Result<Knobs, EngineErr
             MinmaxVariant::id,
         )
         .map(Knobs::Minmax),
+        "hybrid_volume" => parse_knobs(
+            entry,
+            |v: &HybridVolumeVariant| v.validate().map_err(|e| e.to_string()),
+            HybridVolumeVariant::id,
+        )
+        .map(Knobs::HybridVolume),
         "partial_sum_tree" => parse_knobs(
             entry,
             |v: &PartialSumTreeVariant| v.validate().map_err(|e| e.to_string()),

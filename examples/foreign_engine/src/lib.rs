@@ -38,6 +38,7 @@ pub mod engine;
 mod error;
 pub mod files;
 pub mod formula;
+pub mod hybrid_volume;
 pub mod manifest;
 pub mod minmax;
 pub mod partial_sum_tree;

@@ -7,12 +7,13 @@
 //! in [`super`]); [`FamilyRun`] and [`run_family`] come from one table, one line per family.
 
 use scatter_shaderlib::family::FamilyVariant;
+use scatter_shaderlib::hybrid_volume::HybridVolumeVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::partial_sum_tree::PartialSumTreeVariant;
 use scatter_shaderlib::prefiltered::{FrameError, FrameReport, FrameSettings, PrefilteredVariant};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
-use super::{MinmaxRun, PartialSumTreeRun, PrefilteredRun, RaymarchRun};
+use super::{HybridVolumeRun, MinmaxRun, PartialSumTreeRun, PrefilteredRun, RaymarchRun};
 use crate::buffers::{GBuffer, ShadowMap};
 use crate::bvh::Bvh;
 use crate::image::Image;
@@ -78,6 +79,24 @@ impl CpuRun for RaymarchRun {
 
     fn report(&self) -> Option<&FrameReport> {
         None
+    }
+}
+
+impl CpuRun for HybridVolumeRun {
+    fn output(&self) -> &Image {
+        &self.output
+    }
+
+    fn report(&self) -> Option<&FrameReport> {
+        Some(&self.frame.report)
+    }
+}
+
+impl CpuFamily for HybridVolumeVariant {
+    type Run = HybridVolumeRun;
+
+    fn run_cpu(&self, f: &CpuFrame<'_>) -> Result<HybridVolumeRun, FrameError> {
+        super::run_hybrid_volume(self, f.rectified, f.gbuf, f.scene, f.shadow_map, f.settings)
     }
 }
 
@@ -179,6 +198,7 @@ macro_rules! cpu_families {
 }
 
 cpu_families! {
+    HybridVolume(HybridVolumeVariant),
     Minmax(MinmaxVariant),
     PartialSumTree(PartialSumTreeVariant),
     Prefiltered(PrefilteredVariant),

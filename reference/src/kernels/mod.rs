@@ -34,6 +34,10 @@ pub mod scatter_fallback;
 pub mod scatter_unwarp;
 pub mod slice_fit;
 pub mod texture;
+pub mod volume_bounds;
+pub mod volume_march;
+pub mod volume_march_fallback;
+pub mod volume_march_unwarp;
 
 use crate::buffers::{GBuffer, ShadowMap};
 use crate::bvh::Bvh;
@@ -42,6 +46,7 @@ use crate::image::Image;
 use crate::projective::rasterise_rectified;
 use crate::scene::Scene;
 pub use family::{CpuFamily, CpuFrame, CpuRun, FamilyRun, run_family};
+use scatter_shaderlib::hybrid_volume::{HybridVolumeVariant, prepare_hybrid_volume};
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_shaderlib::partial_sum_tree::{
     PartialSumTreeFrame, PartialSumTreeVariant, prepare_partial_sum_tree,
@@ -325,6 +330,114 @@ pub fn minmax_from_rectified(
         tree,
         march,
         brute,
+        output,
+    }
+}
+
+/// Every intermediate of one CPU run of the `hybrid_volume` family.
+#[derive(Clone, Debug)]
+pub struct HybridVolumeRun {
+    /// The frame set-up (the prefiltered family's, for [`HybridVolumeVariant::prefiltered`]).
+    pub frame: PrefilteredFrame,
+    /// The rectified shadow map (`rectify`).
+    pub rectified: Tex,
+    /// The binned boundary crossings (`volume_bounds`).
+    pub crossings: volume_bounds::VolumeBounds,
+    /// Each pixel's interval (`None`: an epipole disc, marched whole), row-major; empty for
+    /// a sampled variant (diagnostics, not a pass).
+    pub spans: Vec<Option<volume_march::PixelSpan>>,
+    /// `volume_march` through its sampling stage.
+    pub march: common_sampling::SampledOutput,
+    /// In-scattered radiance (as stored in rgba16float).
+    pub output: Image,
+}
+
+/// Runs `depth_columns`, `slice_fit`, `rectify`, `volume_bounds` and `volume_march` on the
+/// CPU for a scene, its depth buffer and its standard shadow map.
+///
+/// # Errors
+///
+/// As the frame set-up ([`prepare_hybrid_volume`]).
+pub fn run_hybrid_volume(
+    variant: &HybridVolumeVariant,
+    rectified_size: [u32; 2],
+    gbuf: &GBuffer,
+    scene: &Scene,
+    shadow_map: &ShadowMap,
+    settings: &FrameSettings,
+) -> Result<HybridVolumeRun, FrameError> {
+    let res = Resolutions {
+        screen: [gbuf.width, gbuf.height],
+        rectified: rectified_size,
+    };
+    let mut frame = prepare_hybrid_volume(
+        variant,
+        &res,
+        &scene.camera_desc(),
+        &scene.light_desc(),
+        &scene.medium_desc(),
+        &shadow_map.desc(),
+        settings,
+    )?;
+    let sm = Tex {
+        width: shadow_map.size,
+        height: shadow_map.size,
+        data: shadow_map.depth.clone(),
+    };
+    let spot = variant.light == LightKind::Spot;
+    let depth = Tex {
+        width: gbuf.width,
+        height: gbuf.height,
+        data: gbuf.view_depth.clone(),
+    };
+    let column_depth = depth_columns::depth_columns(&frame.uniforms, &depth);
+    slice_fit::slice_fit(&frame.uniforms, &mut frame.slices, &column_depth, spot);
+    let rectified = rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot);
+    Ok(hybrid_volume_from_rectified(
+        variant, frame, rectified, &depth, &sm,
+    ))
+}
+
+/// `volume_bounds` and `volume_march` for a given frame (after `slice_fit`) and rectified
+/// map (the GPU's, in the conformance test).
+pub fn hybrid_volume_from_rectified(
+    variant: &HybridVolumeVariant,
+    frame: PrefilteredFrame,
+    rectified: Tex,
+    depth: &Tex,
+    shadow_map: &Tex,
+) -> HybridVolumeRun {
+    let crossings = volume_bounds::volume_bounds(&frame.uniforms, &rectified, variant.bins);
+    let inputs = volume_march::MarchInputs {
+        frame: &frame.uniforms,
+        slices: &frame.slices,
+        depth,
+        shadow_map,
+        rectified: &rectified,
+        crossings: &crossings,
+    };
+    let march = volume_march::volume_march(variant, &inputs);
+    let spans = if variant.sampling_knobs().is_sampled() {
+        Vec::new()
+    } else {
+        volume_march::pixel_spans(variant, &inputs)
+    };
+    let output = Image::from_pixels(
+        depth.width,
+        depth.height,
+        march
+            .output
+            .data
+            .iter()
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+    );
+    HybridVolumeRun {
+        frame,
+        rectified,
+        crossings,
+        spans,
+        march,
         output,
     }
 }
