@@ -524,6 +524,38 @@ pub fn kernel_costs() -> Vec<KernelCost> {
             low: Some([8.0, 2.0, 0.0, 6.0, 60.0]),
             trips: "tree steps, data-dependent (one transition: 20 .. none)",
         },
+        KernelCost {
+            method: "hybrid_volume n32",
+            kernel: "volume_bounds",
+            invocations: 64 * hr,
+            // 64 invocations per row, Wr / 64 edges each: two texel loads, the two bins
+            // (multiply, floor, clamp) and per covered bin an atomicMin and an atomicMax
+            // (counted as two FMAs); then B / 64 bins of 8 bytes stored each. Counted for
+            // walls that cover one bin; a wall covers up to B.
+            counts: [
+                8.0 * 256.0 / 64.0,
+                2.0 * wr as f64 / 64.0,
+                0.0,
+                0.0,
+                (wr as f64 / 64.0) * 8.0,
+            ],
+            low: None,
+            trips: "Wr / 64 edges, each over the bins its wall covers (1 .. B)",
+        },
+        KernelCost {
+            method: "hybrid_volume n32",
+            kernel: "volume_march",
+            invocations: pixels,
+            // The ray set-up (two atan2, the depth's normalisation), per row of the two: two
+            // rectified loads, one crossings load and two sin (edge_t); head and tail in
+            // closed form (two exp each); then N = 32 samples, each a shadow-map load, the
+            // sample's light-space transform and test (about 25 FMAs) and its cell's
+            // transmittance (two exp). Counted with every sample marched; none marched: the
+            // set-up, head and tail.
+            counts: [8.0, 6.0 + 32.0, 0.0, 10.0 + 64.0, 80.0 + 32.0 * 25.0],
+            low: Some([8.0, 6.0, 0.0, 10.0, 80.0]),
+            trips: "samples marched, data-dependent (32 .. none: the interval is empty)",
+        },
     ];
     let n = 64.0;
     out.push(KernelCost {

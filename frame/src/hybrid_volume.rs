@@ -21,7 +21,8 @@
 //! The walls of each row rasterised into [`HybridVolumeVariant::bins`] bins of the ray depth
 //! `d` (bin `k`: `d` in `[k / B, (k + 1) / B)`): edge `c` with depth range `(lo, hi]` reaches
 //! bins `floor(lo B) ..= floor(hi B)`, and each bin keeps its first and last edge
-//! (`atomicMin` / `atomicMax` in workgroup memory; [`NO_EDGE`] when none). This is the
+//! (`atomicMax` in zero-initialised workgroup memory, the first edge as `NO_EDGE - c`;
+//! [`NO_EDGE`] when none). This is the
 //! paper's rasterisation of shadow-volume faces restricted to one slice, where every view ray
 //! of the slice is one point of a 1D "screen" (its `d`): the front-most and back-most boundary
 //! crossings for every ray of the slice at once, with no render pipeline. Output: the storage

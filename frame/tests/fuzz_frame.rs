@@ -27,6 +27,7 @@ use scatter_frame::frame::{
     CameraDesc, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame, Resolutions,
     ShadowMapDesc, ShadowProjectionDesc, prepare_frame,
 };
+use scatter_frame::hybrid_volume::{HybridVolumeVariant, prepare_hybrid_volume};
 use scatter_frame::minmax::{MinmaxVariant, level_count, prepare_minmax, tree_levels, tree_width};
 use scatter_frame::partial_sum_tree::{
     FACTOR_VECS, PartialSumTreeFrame, PartialSumTreeVariant, prepare_partial_sum_tree,
@@ -40,6 +41,8 @@ const PREFILTERED_CASES: u32 = 6000;
 const RAYMARCH_CASES: u32 = 3000;
 /// Cases of `prepare_minmax`.
 const MINMAX_CASES: u32 = 3000;
+/// Cases of `prepare_hybrid_volume`.
+const HYBRID_VOLUME_CASES: u32 = 1000;
 /// Cases of `prepare_partial_sum_tree` (each factorises a 96 x 96 kernel grid).
 const PST_CASES: u32 = 400;
 /// Cases of `prepare_frame` on fully arbitrary numbers (no valid starting point).
@@ -560,6 +563,7 @@ fn family() -> impl Strategy<Value = FamilyVariant> {
         prop::sample::select(grid).prop_map(FamilyVariant::Prefiltered),
         prop::sample::select(RaymarchVariant::grid()).prop_map(FamilyVariant::Raymarch),
         prop::sample::select(MinmaxVariant::grid()).prop_map(FamilyVariant::Minmax),
+        prop::sample::select(HybridVolumeVariant::grid()).prop_map(FamilyVariant::HybridVolume),
         prop::sample::select(PartialSumTreeVariant::grid()).prop_map(FamilyVariant::PartialSumTree),
     ]
 }
@@ -751,6 +755,16 @@ fn check_case(case: Case) -> Result<(), TestCaseError> {
             &case.settings,
         )
         .map(|f| check_prefiltered_frame(&case, &f)),
+        FamilyVariant::HybridVolume(v) => prepare_hybrid_volume(
+            &v,
+            &case.res,
+            &case.camera,
+            &case.light,
+            &case.medium,
+            &case.shadow,
+            &case.settings,
+        )
+        .map(|f| check_prefiltered_frame(&case, &f)),
         FamilyVariant::PartialSumTree(v) => prepare_partial_sum_tree(
             &v,
             &case.res,
@@ -814,6 +828,19 @@ fn prepare_minmax_on_mutated_frames() {
         MINMAX_CASES,
         0x5ca7_0003,
         case(prop::sample::select(MinmaxVariant::grid()).prop_map(FamilyVariant::Minmax)),
+        check_case,
+    );
+}
+
+#[test]
+fn prepare_hybrid_volume_on_mutated_frames() {
+    run(
+        "prepare_hybrid_volume",
+        HYBRID_VOLUME_CASES,
+        0x5ca7_0007,
+        case(
+            prop::sample::select(HybridVolumeVariant::grid()).prop_map(FamilyVariant::HybridVolume),
+        ),
         check_case,
     );
 }

@@ -78,7 +78,7 @@ fn bad_knobs_exit_2_with_one_line_and_write_nothing() {
         ),
         (
             &["--family", "raytrace"],
-            "family must be minmax | partial_sum_tree | prefiltered | raymarch, got raytrace",
+            "family must be hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch, got raytrace",
         ),
     ];
     for (args, message) in cases {

@@ -142,6 +142,7 @@ fn knob_value() -> impl Strategy<Value = String> {
 
 fn validates(v: &FamilyVariant) -> bool {
     match v {
+        FamilyVariant::HybridVolume(v) => v.validate().is_ok(),
         FamilyVariant::Minmax(v) => v.validate().is_ok(),
         FamilyVariant::PartialSumTree(v) => v.validate().is_ok(),
         FamilyVariant::Prefiltered(v) => v.validate().is_ok(),
@@ -551,7 +552,10 @@ fn bad_value(name: &str, pick: usize) -> String {
         "light" => &["\"area\"", "\" spot\"", "\"spot\\n\"", "1"],
         "storage" => &["\"rgba8\"", "\"r32float\""],
         "rectification" => &["\"projection\"", "\"\""],
-        "samples" => &["3", "1025", "0", "\"many\""],
+        // Bad for raymarch (a power of two in 1..=1024) and hybrid_volume (1..=1024) alike.
+        "samples" => &["1025", "0", "\"many\""],
+        "bins" => &["0", "1025", "\"many\""],
+        "pad" => &["9", "-1", "\"x\""],
         "interleave" => &["0", "9", "\"two\""],
         "jitter" => &["\"maybe\"", "2", "\"yes\""],
         "sampling" => &["\"epipole\"", "\"lowres2\"", "2"],

@@ -8,18 +8,21 @@
 // first and last edge: for any depth of the bin, every crossing lies in [first, last].
 // B = {{ bins }} bins (conventions: `scatter_frame::hybrid_volume`).
 //
-// One workgroup per rectified row: its 64 invocations take every 64th edge and combine with
-// atomicMin / atomicMax in workgroup memory (order-free, so the result is exact and
-// deterministic), then write the row's bins.
-//
+// One workgroup per rectified row: its 64 invocations set the row's bins to "no edge", then
+// take every 64th edge and combine with atomicMin / atomicMax on the row's bins in the
+// output buffer (order-free, so the result is exact and deterministic). The bins live in the
+// storage buffer, not in workgroup memory: naga zero-initialises workgroup memory with a
+// store that its own SPIR-V front-end (wgpu's `ShaderSource::SpirV`) rejects for an array of
+// atomics.
+
 // Bindings (group 0):
 // | binding | name      | type                                        | access      |
 // |---------|-----------|---------------------------------------------|-------------|
 // | 0       | frame     | var<uniform> Frame (400 bytes)              | uniform     |
 // | 1       | rectified | texture_2d<f32> (r32float, `rectify`'s)     | textureLoad |
-// | 2       | crossings | var<storage, read_write> array<vec2<u32>>   | write       |
-// crossings: B x Hr entries, index row * B + bin: (first edge, last edge), first =
-// 0xffffffff (and last = 0) where no edge reaches the bin.
+// | 2       | crossings | var<storage, read_write> array<atomic<u32>> | atomics     |
+// crossings: 2 B Hr u32, bin (row, k) at 2 (row * B + k): the first edge, then the last; first
+// = 0xffffffff (and last = 0) where no edge reaches the bin.
 //
 // Dispatch: (1, Hr, 1) workgroups of (64, 1, 1), Hr = rectified rows (frame.sizes.w);
 // workgroup id y = row.
@@ -33,10 +36,7 @@ const NO_EDGE: u32 = 0xffffffffu;
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var rectified: texture_2d<f32>;
-@group(0) @binding(2) var<storage, read_write> crossings: array<vec2<u32>>;
-
-var<workgroup> first_edge: array<atomic<u32>, BINS>;
-var<workgroup> last_edge: array<atomic<u32>, BINS>;
+@group(0) @binding(2) var<storage, read_write> crossings: array<atomic<u32>>;
 
 // The bin of ray depth `d` (clamped to the bins before the conversion, which is undefined
 // out of range).
@@ -49,11 +49,13 @@ fn volume_bounds(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
     let width = frame.sizes[2];
     let row = wid.y;
     let in_range = row < frame.sizes[3];
-    for (var k = li; k < BINS; k += 64u) {
-        atomicStore(&first_edge[k], NO_EDGE);
-        atomicStore(&last_edge[k], 0u);
+    if in_range {
+        for (var k = li; k < BINS; k += 64u) {
+            atomicStore(&crossings[2u * (row * BINS + k)], NO_EDGE);
+            atomicStore(&crossings[2u * (row * BINS + k) + 1u], 0u);
+        }
     }
-    workgroupBarrier();
+    storageBarrier();
     if in_range {
         for (var c = li + 1u; c < width; c += 64u) {
             let a = textureLoad(rectified, vec2<u32>(c - 1u, row), 0).x;
@@ -63,16 +65,10 @@ fn volume_bounds(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
             if lo < hi {
                 let k1 = depth_bin(hi);
                 for (var k = depth_bin(lo); k <= k1; k++) {
-                    atomicMin(&first_edge[k], c);
-                    atomicMax(&last_edge[k], c);
+                    atomicMin(&crossings[2u * (row * BINS + k)], c);
+                    atomicMax(&crossings[2u * (row * BINS + k) + 1u], c);
                 }
             }
-        }
-    }
-    workgroupBarrier();
-    if in_range {
-        for (var k = li; k < BINS; k += 64u) {
-            crossings[row * BINS + k] = vec2<u32>(atomicLoad(&first_edge[k]), atomicLoad(&last_edge[k]));
         }
     }
 }

@@ -17,7 +17,7 @@
 // | 2       | depth      | texture_2d<f32> (r32float, view depth) | textureLoad  |
 // | 3       | shadow_map | texture_2d<f32> (r32float)             | textureLoad  |
 // | 4       | rectified  | texture_2d<f32> (r32float, `rectify`'s) | textureLoad |
-// | 5       | crossings  | var<storage, read> array<vec2<u32>> (`volume_bounds`'s) | read |
+// | 5       | crossings  | var<storage, read> array<u32> (`volume_bounds`'s: first, last per bin) | read |
 // | 6       | output     | texture_storage_2d<rgba16float, write> | textureStore |
 // slices: one vec4 per rectified row (x = delta, y = theta_ref, z = theta_lo, w = theta_hi).
 //
@@ -42,7 +42,7 @@ const NO_EDGE: u32 = 0xffffffffu;
 @group(0) @binding(2) var depth: texture_2d<f32>;
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) var rectified: texture_2d<f32>;
-@group(0) @binding(5) var<storage, read> crossings: array<vec2<u32>>;
+@group(0) @binding(5) var<storage, read> crossings: array<u32>;
 @group(0) @binding(6) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
 {% include "include/sampled_bindings.wgsl" %}
 
@@ -74,13 +74,13 @@ fn row_span(row: u32, col: f32, d: f32, bin: u32, theta: f32, s: f32, spot: bool
         return RowSpan(0.0, s, true, true);
     }
     let head = d <= textureLoad(rectified, vec2<u32>(0u, row), 0).x;
-    let e = crossings[row * BINS + bin];
-    if e.x == NO_EDGE || e.x >= n {
+    let first_edge = crossings[2u * (row * BINS + bin)];
+    if first_edge == NO_EDGE || first_edge >= n {
         return RowSpan(s, 0.0, head, head);
     }
-    let last = min(e.y, n - 1u);
+    let last = min(crossings[2u * (row * BINS + bin) + 1u], n - 1u);
     let tail = d <= textureLoad(rectified, vec2<u32>(last, row), 0).x;
-    let first = select(e.x - PAD, 0u, e.x < PAD);
+    let first = select(first_edge - PAD, 0u, first_edge < PAD);
     return RowSpan(
         edge_t(f, first, n, delta, theta, s, spot),
         edge_t(f, last + PAD, n, delta, theta, s, spot),

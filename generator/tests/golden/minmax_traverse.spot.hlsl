@@ -168,18 +168,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        float3 dir_10 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_10.z <= 1e-6)) {
+        float3 dir_11 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_11.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
+        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
         const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_10.z);
+        return ((z_2 + _e35) / dir_11.z);
     } else {
         const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -375,24 +375,23 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, Texture2D<float4> sm_4, float3 eye_4, float3 dir_4, float s, bool spot)
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, Texture2D<float4> sm_4, float3 eye_4, float3 dir_4, float a_3, float b_3, uint steps, bool spot)
 {
     float sum_1 = 0.0;
     uint k_1 = 0u;
     float t_2 = (float)0;
     float w = (float)0;
 
-    uint steps = f_4.sizes2_.y;
-    float h_2 = (s / float(steps));
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0.0, s, steps);
+    float h_2 = ((b_3 - a_3) / float(steps));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, a_3, b_3, steps);
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e60 = k_1;
-            k_1 = (_e60 + 1u);
+            uint _e63 = k_1;
+            k_1 = (_e63 + 1u);
         }
         loop_init_2 = false;
         uint _e15 = k_1;
@@ -402,38 +401,43 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
         }
         {
             uint _e17 = k_1;
-            t_2 = ((float(_e17) + 0.5) * h_2);
+            t_2 = (a_3 + ((float(_e17) + 0.5) * h_2));
             w = h_2;
             if (spot) {
-                uint _e25 = k_1;
-                const float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e25) + 0.5));
-                t_2 = _e29.x;
-                w = _e29.y;
+                uint _e26 = k_1;
+                const float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            float _e32 = t_2;
-            const float _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e32)));
+            float _e33 = t_2;
+            const float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e33)));
             if (spot) {
-                float _e38 = sum_1;
-                float _e39 = w;
-                float _e41 = t_2;
-                const float _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e41);
-                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
+                float _e39 = sum_1;
+                float _e40 = w;
+                float _e42 = t_2;
+                const float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
+                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
             } else {
-                float _e45 = sum_1;
-                uint _e48 = k_1;
-                uint _e51 = k_1;
-                const float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (float(_e48) * h_2), (float((_e51 + 1u)) * h_2));
-                sum_1 = (_e45 + (_e36 * _e56));
+                float _e46 = sum_1;
+                uint _e49 = k_1;
+                uint _e53 = k_1;
+                const float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (float(_e49) * h_2)), (a_3 + (float((_e53 + 1u)) * h_2)));
+                sum_1 = (_e46 + (_e37 * _e59));
             }
         }
     }
-    if (spot) {
-        float _e62 = sum_1;
-        return _e62;
+    float _e65 = sum_1;
+    return _e65;
+}
+
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, Texture2D<float4> sm_5, float3 eye_5, float3 dir_5, float s, bool spot_1)
+{
+    const float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_5, dir_5, 0.0, s, f_5.sizes2_.y, spot_1);
+    if (spot_1) {
+        return _e9;
     } else {
-        const float _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_4)));
-        float _e73 = sum_1;
-        return ((f_4.medium.y * _e71) * _e73);
+        const float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_5)));
+        return ((f_5.medium.y * _e18) * _e9);
     }
 }
 
@@ -456,20 +460,20 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, 
     }
 }
 
-float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float3 dir_5)
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 dir_6)
 {
-    float3 axis = f_5.axis.xyz;
-    return atan2(length(cross(dir_5, axis)), dot(dir_5, axis));
+    float3 axis = f_6.axis.xyz;
+    return atan2(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 dir_6)
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 dir_7)
 {
     float yc = (float)0;
 
-    uint rows_1 = f_6.sizes.w;
-    float phi = atan2(dot(dir_6, f_6.e2_.xyz), dot(dir_6, f_6.e1_.xyz));
-    yc = ((phi - f_6.e1_.w) / f_6.e2_.w);
-    if ((f_6.anti_epipole.w > 0.5)) {
+    uint rows_1 = f_7.sizes.w;
+    float phi = atan2(dot(dir_7, f_7.e2_.xyz), dot(dir_7, f_7.e1_.xyz));
+    yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
+    if ((f_7.anti_epipole.w > 0.5)) {
         float _e22 = yc;
         float _e23 = yc;
         yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
@@ -481,21 +485,21 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     return _e34;
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 eye_5, float3 dir_7, float s_1, float theta_1, bool spot_1)
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_2)
 {
-    if (spot_1) {
-        float3 q_2 = ((eye_5 + (dir_7 * s_1)) - f_7.light_pos.xyz);
-        float3 to_eye = -(f_7.axis.xyz);
+    if (spot_2) {
+        float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_8.light_pos.xyz);
+        float3 to_eye = -(f_8.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float x_2, float delta, float theta_2, float s_2, bool spot_2)
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_2, float delta, float theta_2, float s_2, bool spot_3)
 {
     bool local_5 = (bool)0;
 
-    if (spot_2) {
+    if (spot_3) {
         float psi = (x_2 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
@@ -507,24 +511,24 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_8.axis.w * sin(psi)) / den), s_2);
+        return min(((f_9.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_3)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4)
 {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, float(x_3), delta_1, theta_3, s_3, spot_3);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_3), delta_1, theta_3, s_3, spot_4);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float3 eye_6, float3 dir_8, float a_3, float b_3, uint panels_1)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float3 eye_7, float3 dir_9, float a_4, float b_4, uint panels_1)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
@@ -532,13 +536,13 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float3 eye_7, float3 dir_9, float a_4, float b_4, bool spot_4)
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_5)
 {
-    if (spot_4) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, dir_9, a_4, b_4, max(naga_div(f_11.sizes2_.z, 4u), 1u));
+    if (spot_5) {
+        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max(naga_div(f_12.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, a_4, b_4);
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -617,22 +621,22 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
     bool local_11 = (bool)0;
     float l_1 = (float)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
-    float3 eye_8 = f_12.eye.xyz;
-    const float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_4, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
+    float3 eye_9 = f_13.eye.xyz;
+    const float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_4, y_1);
     float4 _e13 = depth.Load(int3(uint2(x_4, y_1), int(0)));
-    float s_4 = (min(max(_e13.x, 0.0), f_12.theta.z) / max(dot(_e9, f_12.cam_forward.xyz), 1e-6));
-    float3 color = f_12.light_color.xyz;
+    float s_4 = (min(max(_e13.x, 0.0), f_13.theta.z) / max(dot(_e9, f_13.cam_forward.xyz), 1e-6));
+    float3 color = f_13.light_color.xyz;
     float3 px = float3((float(x_4) + 0.5), (float(y_1) + 0.5), 0.0);
-    float radius = f_12.epipole.w;
-    if ((f_12.epipole.z > 0.5)) {
-        local_6 = (length((px - float3(f_12.epipole.x, f_12.epipole.y, 0.0))) < radius);
+    float radius = f_13.epipole.w;
+    if ((f_13.epipole.z > 0.5)) {
+        local_6 = (length((px - float3(f_13.epipole.x, f_13.epipole.y, 0.0))) < radius);
     } else {
         local_6 = false;
     }
     bool near_epi = local_6;
-    if ((f_12.anti_epipole.z > 0.5)) {
-        local_7 = (length((px - float3(f_12.anti_epipole.x, f_12.anti_epipole.y, 0.0))) < radius);
+    if ((f_13.anti_epipole.z > 0.5)) {
+        local_7 = (length((px - float3(f_13.anti_epipole.x, f_13.anti_epipole.y, 0.0))) < radius);
     } else {
         local_7 = false;
     }
@@ -645,21 +649,21 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
     bool _e76 = local_8;
     if (_e76) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = frame;
-        const float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_8, _e9, s_4, true);
+        const float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_9, _e9, s_4, true);
         float3 l_2 = (_e81 * color);
         return l_2;
     }
-    uint rows_2 = f_12.sizes.w;
-    uint width_3 = f_12.sizes.z;
-    bool wrap_1 = (f_12.anti_epipole.w > 0.5);
-    const float _e91 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e9);
-    const float _e92 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e9);
+    uint rows_2 = f_13.sizes.w;
+    uint width_3 = f_13.sizes.z;
+    bool wrap_1 = (f_13.anti_epipole.w > 0.5);
+    const float _e91 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e9);
+    const float _e92 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e9);
     const uint _e94 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e92), rows_2, wrap_1);
     float4 _e97 = asfloat(slices.Load4(_e94*16));
     const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e98 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e97);
     float delta_2 = _e98.delta;
-    const float _e104 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e91, f_12.theta.x, f_12.theta.y);
-    const float _e105 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, s_4, _e91, true);
+    const float _e104 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e91, f_13.theta.x, f_13.theta.y);
+    const float _e105 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, s_4, _e91, true);
     float xs = (_e105 / delta_2);
     uint n_3 = naga_f2u32(min(ceil(((xs > 0.0) ? xs : 0.0)), float(width_3)));
     const uint _e115 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
@@ -735,14 +739,14 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
             bool _e181 = in_run;
             if ((_e180 != _e181)) {
                 uint _e183 = i;
-                const float _e184 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e183, n_3, delta_2, _e91, s_4, true);
+                const float _e184 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e183, n_3, delta_2, _e91, s_4, true);
                 bool _e185 = lit_;
                 if (_e185) {
                     run_a = _e184;
                 } else {
                     float _e188 = total;
                     float _e189 = run_a;
-                    const float _e190 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, _e189, _e184, true);
+                    const float _e190 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, _e189, _e184, true);
                     total = (_e188 + _e190);
                 }
                 bool _e192 = lit_;
@@ -757,15 +761,15 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
     if (_e198) {
         float _e199 = total;
         float _e200 = run_a;
-        const float _e201 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, _e200, s_4, true);
+        const float _e201 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, _e200, s_4, true);
         total = (_e199 + _e201);
     }
     float _e203 = total;
     l_1 = _e203;
     if (!(true)) {
-        const float _e214 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, _e9)));
+        const float _e214 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, -(dot(f_13.light_dir.xyz, _e9)));
         float _e216 = total;
-        l_1 = ((f_12.medium.y * _e214) * _e216);
+        l_1 = ((f_13.medium.y * _e214) * _e216);
     }
     float _e218 = l_1;
     float3 c = (color * _e218);

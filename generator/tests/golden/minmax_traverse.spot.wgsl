@@ -158,18 +158,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_10 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_10.z <= 0.000001f) {
+        let dir_11 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_11.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_10.z);
+        return ((z_2 + _e35) / dir_11.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -309,15 +309,14 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX
     return _e13;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, s: f32, spot: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_1: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
-    let steps = f_4.sizes2_.y;
-    let h_2 = (s / f32(steps));
-    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0f, s, steps);
+    let h_2 = ((b_3 - a_3) / f32(steps));
+    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_1;
         if (_e15 < steps) {
@@ -326,42 +325,46 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_o
         }
         {
             let _e17 = k_1;
-            t_2 = ((f32(_e17) + 0.5f) * h_2);
+            t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_2));
             w = h_2;
             if spot {
-                let _e25 = k_1;
-                let _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e25) + 0.5f));
-                t_2 = _e29.x;
-                w = _e29.y;
+                let _e26 = k_1;
+                let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            let _e32 = t_2;
-            let _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e32)));
+            let _e33 = t_2;
+            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e33)));
             if spot {
-                let _e38 = sum_1;
-                let _e39 = w;
-                let _e41 = t_2;
-                let _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e41);
-                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
+                let _e39 = sum_1;
+                let _e40 = w;
+                let _e42 = t_2;
+                let _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
+                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
             } else {
-                let _e45 = sum_1;
-                let _e48 = k_1;
-                let _e51 = k_1;
-                let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e48) * h_2), (f32((_e51 + 1u)) * h_2));
-                sum_1 = (_e45 + (_e36 * _e56));
+                let _e46 = sum_1;
+                let _e49 = k_1;
+                let _e53 = k_1;
+                let _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e49) * h_2)), (a_3 + (f32((_e53 + 1u)) * h_2)));
+                sum_1 = (_e46 + (_e37 * _e59));
             }
         }
         continuing {
-            let _e60 = k_1;
-            k_1 = (_e60 + 1u);
+            let _e63 = k_1;
+            k_1 = (_e63 + 1u);
         }
     }
-    if spot {
-        let _e62 = sum_1;
-        return _e62;
+    let _e65 = sum_1;
+    return _e65;
+}
+
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_1: bool) -> f32 {
+    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_5, dir_5, 0f, s, f_5.sizes2_.y, spot_1);
+    if spot_1 {
+        return _e9;
     } else {
-        let _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_4)));
-        let _e73 = sum_1;
-        return ((f_4.medium.y * _e71) * _e73);
+        let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_5)));
+        return ((f_5.medium.y * _e18) * _e9);
     }
 }
 
@@ -374,18 +377,18 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
     }
 }
 
-fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_5: vec3<f32>) -> f32 {
-    let axis = f_5.axis.xyz;
-    return atan2(length(cross(dir_5, axis)), dot(dir_5, axis));
+fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let axis = f_6.axis.xyz;
+    return atan2(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
     var yc: f32;
 
-    let rows_1 = f_6.sizes.w;
-    let phi = atan2(dot(dir_6, f_6.e2_.xyz), dot(dir_6, f_6.e1_.xyz));
-    yc = ((phi - f_6.e1_.w) / f_6.e2_.w);
-    if (f_6.anti_epipole.w > 0.5f) {
+    let rows_1 = f_7.sizes.w;
+    let phi = atan2(dot(dir_7, f_7.e2_.xyz), dot(dir_7, f_7.e1_.xyz));
+    yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
+    if (f_7.anti_epipole.w > 0.5f) {
         let _e22 = yc;
         let _e23 = yc;
         yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
@@ -397,19 +400,19 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_o
     return _e34;
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_7: vec3<f32>, s_1: f32, theta_1: f32, spot_1: bool) -> f32 {
-    if spot_1 {
-        let q_2 = ((eye_5 + (dir_7 * s_1)) - f_7.light_pos.xyz);
-        let to_eye = -(f_7.axis.xyz);
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_2: bool) -> f32 {
+    if spot_2 {
+        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_8.light_pos.xyz);
+        let to_eye = -(f_8.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_3: bool) -> f32 {
     var local_5: bool;
 
-    if spot_2 {
+    if spot_3 {
         let psi = (x_2 * delta);
         let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
@@ -421,31 +424,31 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_X
         if _e16 {
             return s_2;
         }
-        return min(((f_8.axis.w * sin(psi)) / den), s_2);
+        return min(((f_9.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_3: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_4: bool) -> f32 {
     if (x_3 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, f32(x_3), delta_1, theta_3, s_3, spot_3);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, f32(x_3), delta_1, theta_3, s_3, spot_4);
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, spot_4: bool) -> f32 {
-    if spot_4 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, dir_9, a_4, b_4, max((f_11.sizes2_.z / 4u), 1u));
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_5: bool) -> f32 {
+    if spot_5 {
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max((f_12.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, a_4, b_4);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -512,22 +515,22 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     var local_11: bool;
     var l_1: f32;
 
-    let f_12 = frame;
-    let eye_8 = f_12.eye.xyz;
-    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_4, y_1);
+    let f_13 = frame;
+    let eye_9 = f_13.eye.xyz;
+    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_4, y_1);
     let _e13 = textureLoad(depth, vec2<u32>(x_4, y_1), 0i);
-    let s_4 = (min(max(_e13.x, 0f), f_12.theta.z) / max(dot(_e9, f_12.cam_forward.xyz), 0.000001f));
-    let color = f_12.light_color.xyz;
+    let s_4 = (min(max(_e13.x, 0f), f_13.theta.z) / max(dot(_e9, f_13.cam_forward.xyz), 0.000001f));
+    let color = f_13.light_color.xyz;
     let px = vec3<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f), 0f);
-    let radius = f_12.epipole.w;
-    if (f_12.epipole.z > 0.5f) {
-        local_6 = (length((px - vec3<f32>(f_12.epipole.x, f_12.epipole.y, 0f))) < radius);
+    let radius = f_13.epipole.w;
+    if (f_13.epipole.z > 0.5f) {
+        local_6 = (length((px - vec3<f32>(f_13.epipole.x, f_13.epipole.y, 0f))) < radius);
     } else {
         local_6 = false;
     }
     let near_epi = local_6;
-    if (f_12.anti_epipole.z > 0.5f) {
-        local_7 = (length((px - vec3<f32>(f_12.anti_epipole.x, f_12.anti_epipole.y, 0f))) < radius);
+    if (f_13.anti_epipole.z > 0.5f) {
+        local_7 = (length((px - vec3<f32>(f_13.anti_epipole.x, f_13.anti_epipole.y, 0f))) < radius);
     } else {
         local_7 = false;
     }
@@ -540,21 +543,21 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     let _e76 = local_8;
     if _e76 {
         let _e78 = frame;
-        let _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_8, _e9, s_4, true);
+        let _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_9, _e9, s_4, true);
         let l_2 = (_e81 * color);
         return l_2;
     }
-    let rows_2 = f_12.sizes.w;
-    let width_3 = f_12.sizes.z;
-    let wrap_1 = (f_12.anti_epipole.w > 0.5f);
-    let _e91 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e9);
-    let _e92 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e9);
+    let rows_2 = f_13.sizes.w;
+    let width_3 = f_13.sizes.z;
+    let wrap_1 = (f_13.anti_epipole.w > 0.5f);
+    let _e91 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e9);
+    let _e92 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e9);
     let _e94 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e92), rows_2, wrap_1);
     let _e97 = slices[_e94];
     let _e98 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e97);
     let delta_2 = _e98.delta;
-    let _e104 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e91, f_12.theta.x, f_12.theta.y);
-    let _e105 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, s_4, _e91, true);
+    let _e104 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e91, f_13.theta.x, f_13.theta.y);
+    let _e105 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, s_4, _e91, true);
     let xs = (_e105 / delta_2);
     let n_3 = u32(min(ceil(select(0f, xs, (xs > 0f))), f32(width_3)));
     let _e115 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
@@ -621,14 +624,14 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
             let _e181 = in_run;
             if (_e180 != _e181) {
                 let _e183 = i;
-                let _e184 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e183, n_3, delta_2, _e91, s_4, true);
+                let _e184 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e183, n_3, delta_2, _e91, s_4, true);
                 let _e185 = lit;
                 if _e185 {
                     run_a = _e184;
                 } else {
                     let _e188 = total;
                     let _e189 = run_a;
-                    let _e190 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, _e189, _e184, true);
+                    let _e190 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, _e189, _e184, true);
                     total = (_e188 + _e190);
                 }
                 let _e192 = lit;
@@ -643,15 +646,15 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     if _e198 {
         let _e199 = total;
         let _e200 = run_a;
-        let _e201 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e9, _e200, s_4, true);
+        let _e201 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, _e200, s_4, true);
         total = (_e199 + _e201);
     }
     let _e203 = total;
     l_1 = _e203;
     if !(true) {
-        let _e214 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, -(dot(f_12.light_dir.xyz, _e9)));
+        let _e214 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, -(dot(f_13.light_dir.xyz, _e9)));
         let _e216 = total;
-        l_1 = ((f_12.medium.y * _e214) * _e216);
+        l_1 = ((f_13.medium.y * _e214) * _e216);
     }
     let _e218 = l_1;
     let c = (color * _e218);

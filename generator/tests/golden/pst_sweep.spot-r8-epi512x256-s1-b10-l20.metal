@@ -234,18 +234,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir_10 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_10.z <= 0.000001) {
+        metal::float3 dir_11 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_11.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_3 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return (z_3 + _e35) / dir_10.z;
+        return (z_3 + _e35) / dir_11.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -462,29 +462,30 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return _e13;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
     metal::texture2d<float, metal::access::sample> sm_4,
     metal::float3 eye_4,
     metal::float3 dir_4,
-    float s,
+    float a_3,
+    float b_3,
+    uint steps,
     bool spot
 ) {
     float sum_1 = 0.0;
     uint k_6 = 0u;
     float t_2 = {};
     float w = {};
-    uint steps = f_5.sizes2_.y;
-    float h_11 = s / static_cast<float>(steps);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, 0.0, s, steps);
+    float h_11 = (b_3 - a_3) / static_cast<float>(steps);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e60 = k_6;
-            k_6 = _e60 + 1u;
+            uint _e63 = k_6;
+            k_6 = _e63 + 1u;
         }
         loop_init_2 = false;
         uint _e15 = k_6;
@@ -494,38 +495,49 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         }
         {
             uint _e17 = k_6;
-            t_2 = (static_cast<float>(_e17) + 0.5) * h_11;
+            t_2 = a_3 + ((static_cast<float>(_e17) + 0.5) * h_11);
             w = h_11;
             if (spot) {
-                uint _e25 = k_6;
-                metal::float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e25) + 0.5);
-                t_2 = _e29.x;
-                w = _e29.y;
+                uint _e26 = k_6;
+                metal::float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e26) + 0.5);
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            float _e32 = t_2;
-            float _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, eye_4 + (dir_4 * _e32));
+            float _e33 = t_2;
+            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, eye_4 + (dir_4 * _e33));
             if (spot) {
-                float _e38 = sum_1;
-                float _e39 = w;
-                float _e41 = t_2;
-                float _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e41);
-                sum_1 = _e38 + ((_e36 * _e39) * _e42);
+                float _e39 = sum_1;
+                float _e40 = w;
+                float _e42 = t_2;
+                float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e42);
+                sum_1 = _e39 + ((_e37 * _e40) * _e43);
             } else {
-                float _e45 = sum_1;
-                uint _e48 = k_6;
-                uint _e51 = k_6;
-                float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, static_cast<float>(_e48) * h_11, static_cast<float>(_e51 + 1u) * h_11);
-                sum_1 = _e45 + (_e36 * _e56);
+                float _e46 = sum_1;
+                uint _e49 = k_6;
+                uint _e53 = k_6;
+                float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, a_3 + (static_cast<float>(_e49) * h_11), a_3 + (static_cast<float>(_e53 + 1u) * h_11));
+                sum_1 = _e46 + (_e37 * _e59);
             }
         }
     }
-    if (spot) {
-        float _e62 = sum_1;
-        return _e62;
+    float _e65 = sum_1;
+    return _e65;
+}
+
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    metal::texture2d<float, metal::access::sample> sm_5,
+    metal::float3 eye_5,
+    metal::float3 dir_5,
+    float s,
+    bool spot_1
+) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_1);
+    if (spot_1) {
+        return _e9;
     } else {
-        float _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(metal::dot(f_5.light_dir.xyz, dir_4)));
-        float _e73 = sum_1;
-        return (f_5.medium.y * _e71) * _e73;
+        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(metal::dot(f_6.light_dir.xyz, dir_5)));
+        return (f_6.medium.y * _e18) * _e9;
     }
 }
 
@@ -552,22 +564,22 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
-    metal::float3 dir_5
-) {
-    metal::float3 axis_1 = f_6.axis.xyz;
-    return metal::atan2(metal::length(metal::cross(dir_5, axis_1)), metal::dot(dir_5, axis_1));
-}
-
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
     metal::float3 dir_6
 ) {
+    metal::float3 axis_1 = f_7.axis.xyz;
+    return metal::atan2(metal::length(metal::cross(dir_6, axis_1)), metal::dot(dir_6, axis_1));
+}
+
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    metal::float3 dir_7
+) {
     float yc = {};
-    uint rows_1 = f_7.sizes.w;
-    float phi_1 = metal::atan2(metal::dot(dir_6, f_7.e2_.xyz), metal::dot(dir_6, f_7.e1_.xyz));
-    yc = (phi_1 - f_7.e1_.w) / f_7.e2_.w;
-    if (f_7.anti_epipole.w > 0.5) {
+    uint rows_1 = f_8.sizes.w;
+    float phi_1 = metal::atan2(metal::dot(dir_7, f_8.e2_.xyz), metal::dot(dir_7, f_8.e1_.xyz));
+    yc = (phi_1 - f_8.e1_.w) / f_8.e2_.w;
+    if (f_8.anti_epipole.w > 0.5) {
         float _e22 = yc;
         float _e23 = yc;
         yc = _e22 - (metal::floor(_e23 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
@@ -580,31 +592,31 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
-    metal::float3 eye_5,
-    metal::float3 dir_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    metal::float3 eye_6,
+    metal::float3 dir_8,
     float s_1,
     float theta_1,
-    bool spot_1
+    bool spot_2
 ) {
-    if (spot_1) {
-        metal::float3 q_2 = (eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz;
-        metal::float3 to_eye = -(f_8.axis.xyz);
+    if (spot_2) {
+        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz;
+        metal::float3 to_eye = -(f_9.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
     }
     return s_1 * metal::sin(theta_1);
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     float x_2,
     float delta,
     float theta_2,
     float s_2,
-    bool spot_2
+    bool spot_3
 ) {
     bool local_13 = {};
-    if (spot_2) {
+    if (spot_3) {
         float psi = x_2 * delta;
         float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
@@ -616,37 +628,37 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (_e16) {
             return s_2;
         }
-        return metal::min((f_9.axis.w * metal::sin(psi)) / den, s_2);
+        return metal::min((f_10.axis.w * metal::sin(psi)) / den, s_2);
     } else {
         return metal::min((x_2 * delta) / metal::max(metal::sin(theta_2), 0.000001), s_2);
     }
 }
 
 float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     uint x_3,
     uint n_1,
     float delta_1,
     float theta_3,
     float s_3,
-    bool spot_3
+    bool spot_4
 ) {
     if (x_3 >= n_1) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_3);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_4);
     return _e9;
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
-    metal::float3 eye_6,
-    metal::float3 dir_8,
-    float a_3,
-    float b_3,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
+    metal::float3 eye_7,
+    metal::float3 dir_9,
+    float a_4,
+    float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
     return _e15;
 }
 
@@ -655,29 +667,29 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
-    metal::float3 eye_7,
-    metal::float3 dir_9,
-    float a_4,
-    float b_4,
-    bool spot_4
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
+    metal::float3 eye_8,
+    metal::float3 dir_10,
+    float a_5,
+    float b_5,
+    bool spot_5
 ) {
-    if (spot_4) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, metal::max(naga_div(f_12.sizes2_.z, 4u), 1u));
+    if (spot_5) {
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_13.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
     return _e15;
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_5,
-    float b_5,
+    float a_6,
+    float b_6,
     float depth_break
 ) {
     bool local_14 = {};
-    if (!((a_5 == b_5))) {
-        local_14 = metal::abs(a_5 - b_5) <= (depth_break * metal::min(a_5, b_5));
+    if (!((a_6 == b_6))) {
+        local_14 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
     } else {
         local_14 = true;
     }
@@ -688,11 +700,11 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 metal::float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float3 v_7
 ) {
-    metal::float3 a_8 = metal::min(metal::abs(v_7), metal::float3(65504.0));
-    metal::uint3 u_2 = as_type<metal::uint3>(a_8);
+    metal::float3 a_9 = metal::min(metal::abs(v_7), metal::float3(65504.0));
+    metal::uint3 u_2 = as_type<metal::uint3>(a_9);
     metal::float3 normal = as_type<metal::float3>(((u_2 + metal::uint3(4095u)) + ((u_2 >> metal::uint3(13u)) & metal::uint3(1u))) & metal::uint3(4294959104u));
-    metal::float3 subnormal = metal::rint(a_8 * 16777216.0) / metal::float3(16777216.0);
-    return metal::sign(v_7) * metal::select(normal, subnormal, a_8 < metal::float3(0.000061035156));
+    metal::float3 subnormal = metal::rint(a_9 * 16777216.0) / metal::float3(16777216.0);
+    return metal::sign(v_7) * metal::select(normal, subnormal, a_9 < metal::float3(0.000061035156));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
@@ -712,8 +724,8 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     bool local_15 = {};
     bool local_16 = {};
     bool local_17 = {};
-    float a_6 = 0.0;
-    float b_6 = 0.0;
+    float a_7 = 0.0;
+    float b_7 = 0.0;
     uint k_7 = 0u;
     metal::float2 size_1 = static_cast<metal::float2>(screen);
     metal::float2 centre = 0.5 * size_1;
@@ -789,20 +801,20 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
                 float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, corner - _e140);
                 uint _e143 = k_7;
                 if (_e143 == 0u) {
-                    a_6 = _e142;
-                    b_6 = _e142;
+                    a_7 = _e142;
+                    b_7 = _e142;
                 } else {
-                    float _e148 = a_6;
-                    a_6 = metal::min(_e148, _e142);
-                    float _e150 = b_6;
-                    b_6 = metal::max(_e150, _e142);
+                    float _e148 = a_7;
+                    a_7 = metal::min(_e148, _e142);
+                    float _e150 = b_7;
+                    b_7 = metal::max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_6;
+        float _e156 = a_7;
         l_1.phi_start = _e156;
-        float _e158 = b_6;
-        float _e159 = a_6;
+        float _e158 = b_7;
+        float _e159 = a_7;
         l_1.dphi = (_e158 - _e159) / static_cast<float>(slices);
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l_1;
@@ -827,7 +839,7 @@ metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 ) {
     float t_in = 0.0;
     float t_out = 340000000000000000000000000000000000000.0;
-    uint a_7 = 0u;
+    uint a_8 = 0u;
     metal::float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     metal::float2 lo_3 = metal::float2(0.5, 0.5);
     metal::float2 hi_3 = static_cast<metal::float2>(screen_1) - metal::float2(0.5, 0.5);
@@ -837,25 +849,25 @@ metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e51 = a_7;
-            a_7 = _e51 + 1u;
+            uint _e51 = a_8;
+            a_8 = _e51 + 1u;
         }
         loop_init_4 = false;
-        uint _e16 = a_7;
+        uint _e16 = a_8;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            uint _e19 = a_7;
+            uint _e19 = a_8;
             if (metal::abs(_e5[metal::min(unsigned(_e19), 1u)]) > 0.000000000001) {
-                uint _e24 = a_7;
-                uint _e27 = a_7;
-                uint _e30 = a_7;
+                uint _e24 = a_8;
+                uint _e27 = a_8;
+                uint _e30 = a_8;
                 float ta = (lo_3[metal::min(unsigned(_e24), 1u)] - l_3.origin[metal::min(unsigned(_e27), 1u)]) / _e5[metal::min(unsigned(_e30), 1u)];
-                uint _e33 = a_7;
-                uint _e36 = a_7;
-                uint _e39 = a_7;
+                uint _e33 = a_8;
+                uint _e36 = a_8;
+                uint _e39 = a_8;
                 float tb = (hi_3[metal::min(unsigned(_e33), 1u)] - l_3.origin[metal::min(unsigned(_e36), 1u)]) / _e5[metal::min(unsigned(_e39), 1u)];
                 float _e43 = t_in;
                 t_in = metal::max(_e43, metal::min(ta, tb));
@@ -927,7 +939,7 @@ metal::float4 beta_at(
 }
 
 metal::float4 pst_leaf(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14,
     uint i_2,
     uint row_1,
     float delta_2,
@@ -941,9 +953,9 @@ metal::float4 pst_leaf(
         metal::float4 _e9 = gamma_at(static_cast<float>(i_2) * delta_2, h_7, pst_factors, _buffer_sizes);
         return _e9;
     }
-    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, row_1);
-    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e12);
-    metal::float3 axis_2 = f_13.axis.xyz;
+    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, row_1);
+    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e12);
+    metal::float3 axis_2 = f_14.axis.xyz;
     uint2 loop_bound_5 = uint2(4294967295u);
     bool loop_init_5 = true;
     while(true) {
@@ -964,7 +976,7 @@ metal::float4 pst_leaf(
             float q_4 = (_e20 == 0u) ? -0.57735026 : GL2_;
             float psi_1 = ((static_cast<float>(i_2) + 0.5) + (0.5 * q_4)) * delta_2;
             metal::float3 l_5 = (-(axis_2) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_5, f_13.light_dir.xyz), f_13.light_pos.w, f_13.light_dir.w);
+            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_5, f_14.light_dir.xyz), f_14.light_pos.w, f_14.light_dir.w);
             metal::float4 _e48 = leaf;
             metal::float4 _e52 = gamma_at(psi_1, h_7, pst_factors, _buffer_sizes);
             leaf = _e48 + (((0.5 * delta_2) * _e46) * _e52);
@@ -984,23 +996,23 @@ PstRay pst_ray(
     bool local_18 = {};
     bool local_19 = {};
     bool local_20 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = frame;
-    metal::float3 eye_8 = f_14.eye.xyz;
-    metal::float2 ndc = metal::float2(((2.0 * pc.x) / static_cast<float>(f_14.sizes.x)) - 1.0, 1.0 - ((2.0 * pc.y) / static_cast<float>(f_14.sizes.y)));
-    float t_5 = f_14.cam_forward.w;
-    metal::float3 dir_11 = metal::normalize((f_14.cam_forward.xyz + (f_14.cam_right.xyz * ((ndc.x * t_5) * f_14.cam_right.w))) + (f_14.cam_up.xyz * (ndc.y * t_5)));
-    float s_6 = metal::min(metal::max(z_1, 0.0), f_14.theta.z) / metal::max(metal::dot(dir_11, f_14.cam_forward.xyz), 0.000001);
-    r_1 = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_8, dir_11, s_6, 0u, 0.0, 0.0, 0.0};
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
+    metal::float3 eye_9 = f_15.eye.xyz;
+    metal::float2 ndc = metal::float2(((2.0 * pc.x) / static_cast<float>(f_15.sizes.x)) - 1.0, 1.0 - ((2.0 * pc.y) / static_cast<float>(f_15.sizes.y)));
+    float t_5 = f_15.cam_forward.w;
+    metal::float3 dir_12 = metal::normalize((f_15.cam_forward.xyz + (f_15.cam_right.xyz * ((ndc.x * t_5) * f_15.cam_right.w))) + (f_15.cam_up.xyz * (ndc.y * t_5)));
+    float s_6 = metal::min(metal::max(z_1, 0.0), f_15.theta.z) / metal::max(metal::dot(dir_12, f_15.cam_forward.xyz), 0.000001);
+    r_1 = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_9, dir_12, s_6, 0u, 0.0, 0.0, 0.0};
     metal::float3 px = metal::float3(pc, 0.0);
-    float radius = f_14.epipole.w;
-    if (f_14.epipole.z > 0.5) {
-        local_18 = metal::length(px - metal::float3(f_14.epipole.x, f_14.epipole.y, 0.0)) < radius;
+    float radius = f_15.epipole.w;
+    if (f_15.epipole.z > 0.5) {
+        local_18 = metal::length(px - metal::float3(f_15.epipole.x, f_15.epipole.y, 0.0)) < radius;
     } else {
         local_18 = false;
     }
     bool near_epi = local_18;
-    if (f_14.anti_epipole.z > 0.5) {
-        local_19 = metal::length(px - metal::float3(f_14.anti_epipole.x, f_14.anti_epipole.y, 0.0)) < radius;
+    if (f_15.anti_epipole.z > 0.5) {
+        local_19 = metal::length(px - metal::float3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0)) < radius;
     } else {
         local_19 = false;
     }
@@ -1014,19 +1026,19 @@ PstRay pst_ray(
     if (_e109) {
         r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
-        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_8, dir_11, s_6, true);
-        r_1.color = _e117 * f_14.light_color.xyz;
+        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_9, dir_12, s_6, true);
+        r_1.color = _e117 * f_15.light_color.xyz;
     }
-    float _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
+    float _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
     r_1.theta = _e122;
-    float _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
-    uint _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e124), f_14.sizes.w, f_14.anti_epipole.w > 0.5);
+    float _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
+    uint _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e124), f_15.sizes.w, f_15.anti_epipole.w > 0.5);
     r_1.row = _e132;
     float _e135 = r_1.theta;
-    float _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_14.theta.x, f_14.theta.y);
+    float _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_15.theta.x, f_15.theta.y);
     r_1.d = _e140;
     float _e143 = r_1.theta;
-    float _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_11, s_6, _e143, true);
+    float _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, dir_12, s_6, _e143, true);
     r_1.xs_num = _e144;
     PstRay _e145 = r_1;
     return _e145;
@@ -1051,22 +1063,22 @@ metal::float2 pst_terms(
     metal::texture2d<float, metal::access::sample> rectified
 ) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
     float sin_theta = metal::max(metal::sin(r_3.theta), 0.000001);
     uint clamped_lod_e16 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
     metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_2)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     if (r_3.d <= _e16.x) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, n_2 - 1u, n_2, delta_4, r_3.theta, r_3.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, n_2 - 1u, n_2, delta_4, r_3.theta, r_3.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return metal::float2(f_15.medium.y / (f_15.axis.w * sin_theta), _e37);
+        return metal::float2(f_16.medium.y / (f_16.axis.w * sin_theta), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(metal::dot(f_15.light_dir.xyz, r_3.dir)));
-    float sp = f_15.medium.y * _e48;
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, 0.0, delta_4 / sin_theta);
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(metal::dot(f_16.light_dir.xyz, r_3.dir)));
+    float sp = f_16.medium.y * _e48;
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.x, 0.0, delta_4 / sin_theta);
     float _e56 = tail;
     return metal::float2(sp * _e54, sp * _e56);
 }
@@ -1086,7 +1098,7 @@ metal::float3 pst_sweep_pixel(
     uint h_8 = 0u;
     metal::float4 p_5 = {};
     uint i_3 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
     uint clamped_lod_e16 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_5) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
@@ -1141,7 +1153,7 @@ metal::float3 pst_sweep_pixel(
                         metal::float4 _e59 = p_5;
                         uint _e60 = i_3;
                         uint _e62 = h_8;
-                        metal::float4 _e63 = pst_leaf(f_16, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
+                        metal::float4 _e63 = pst_leaf(f_17, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
                         p_5 = _e59 + _e63;
                     }
                 }
@@ -1155,7 +1167,7 @@ metal::float3 pst_sweep_pixel(
     }
     metal::float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27, frame, rectified);
     float _e84 = sum_2;
-    return f_16.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
+    return f_17.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
 }
 
 float pst_footprint_depth(
@@ -1281,9 +1293,9 @@ kernel void pst_sweep(
     uint h_3 = {};
     metal::float4 p_1 = {};
     uint j_8 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
-    metal::uint2 screen_4 = metal::uint2(f_17.sizes.x, f_17.sizes.y);
-    uint width = f_17.sizes.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18 = frame;
+    metal::uint2 screen_4 = metal::uint2(f_18.sizes.x, f_18.sizes.y);
+    uint width = f_18.sizes.z;
     metal::float4 _e13 = frame.cam_forward;
     metal::float4 _e17 = frame.cam_right;
     metal::float4 _e21 = frame.cam_up;
@@ -1775,7 +1787,7 @@ kernel void pst_sweep(
                         uint _e557 = h;
                         uint _e560 = i;
                         uint _e561 = h;
-                        metal::float4 _e562 = pst_leaf(f_17, _e560, row_3, delta_6, _e561, pst_factors, _buffer_sizes);
+                        metal::float4 _e562 = pst_leaf(f_18, _e560, row_3, delta_6, _e561, pst_factors, _buffer_sizes);
                         pst_leaves[metal::min(unsigned(((base_1 + _e552) * RANK_VECS) + _e557), (_buffer_sizes.size6 - 0 - 16) / 16)] = _e562;
                     }
                 }
@@ -1941,8 +1953,8 @@ kernel void pst_sweep(
                     break;
                 }
                 uint _e722 = i_1;
-                uint b_7 = pst_columns[metal::min(unsigned(base_1 + _e722), (_buffer_sizes.size8 - 0 - 4) / 4)];
-                if (b_7 > 0u) {
+                uint b_8 = pst_columns[metal::min(unsigned(base_1 + _e722), (_buffer_sizes.size8 - 0 - 4) / 4)];
+                if (b_8 > 0u) {
                     h_2 = 0u;
                     uint2 loop_bound_29 = uint2(4294967295u);
                     bool loop_init_21 = true;
@@ -1963,7 +1975,7 @@ kernel void pst_sweep(
                             uint _e733 = i_1;
                             uint _e738 = h_2;
                             metal::float4 leaf_1 = pst_leaves[metal::min(unsigned(((base_1 + _e733) * RANK_VECS) + _e738), (_buffer_sizes.size6 - 0 - 16) / 16)];
-                            j_7 = (v_9 - b_7) + 1u;
+                            j_7 = (v_9 - b_8) + 1u;
                             uint2 loop_bound_30 = uint2(4294967295u);
                             while(true) {
                                 if (metal::all(loop_bound_30 == uint2(0u))) { break; }
@@ -2124,7 +2136,7 @@ kernel void pst_sweep(
                 float _e900 = dotp;
                 uint _e905 = k_4;
                 float _e907 = q_b.inner[metal::min(unsigned(_e905), 255u)];
-                metal::float3 _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(f_17.light_color.xyz * (metal::max(_e899 * _e900, 0.0) + _e907));
+                metal::float3 _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(f_18.light_color.xyz * (metal::max(_e899 * _e900, 0.0) + _e907));
                 uint _e911 = k_4;
                 metal::uint2 _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
                 uint clamped_lod_e915 = metal::min(uint(0), depth.get_num_mip_levels() - 1);

@@ -218,18 +218,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_10 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_10.z <= 0.000001f) {
+        let dir_11 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_11.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_3 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_10.z);
+        return ((z_3 + _e35) / dir_11.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -370,15 +370,14 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX
     return _e13;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, s: f32, spot: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_6: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
-    let steps = f_5.sizes2_.y;
-    let h_11 = (s / f32(steps));
-    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, 0f, s, steps);
+    let h_11 = ((b_3 - a_3) / f32(steps));
+    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_6;
         if (_e15 < steps) {
@@ -387,42 +386,46 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_o
         }
         {
             let _e17 = k_6;
-            t_2 = ((f32(_e17) + 0.5f) * h_11);
+            t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_11));
             w = h_11;
             if spot {
-                let _e25 = k_6;
-                let _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e25) + 0.5f));
-                t_2 = _e29.x;
-                w = _e29.y;
+                let _e26 = k_6;
+                let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            let _e32 = t_2;
-            let _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e32)));
+            let _e33 = t_2;
+            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e33)));
             if spot {
-                let _e38 = sum_1;
-                let _e39 = w;
-                let _e41 = t_2;
-                let _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e41);
-                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
+                let _e39 = sum_1;
+                let _e40 = w;
+                let _e42 = t_2;
+                let _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e42);
+                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
             } else {
-                let _e45 = sum_1;
-                let _e48 = k_6;
-                let _e51 = k_6;
-                let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (f32(_e48) * h_11), (f32((_e51 + 1u)) * h_11));
-                sum_1 = (_e45 + (_e36 * _e56));
+                let _e46 = sum_1;
+                let _e49 = k_6;
+                let _e53 = k_6;
+                let _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (f32(_e49) * h_11)), (a_3 + (f32((_e53 + 1u)) * h_11)));
+                sum_1 = (_e46 + (_e37 * _e59));
             }
         }
         continuing {
-            let _e60 = k_6;
-            k_6 = (_e60 + 1u);
+            let _e63 = k_6;
+            k_6 = (_e63 + 1u);
         }
     }
-    if spot {
-        let _e62 = sum_1;
-        return _e62;
+    let _e65 = sum_1;
+    return _e65;
+}
+
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_1: bool) -> f32 {
+    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0f, s, f_6.sizes2_.y, spot_1);
+    if spot_1 {
+        return _e9;
     } else {
-        let _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_4)));
-        let _e73 = sum_1;
-        return ((f_5.medium.y * _e71) * _e73);
+        let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
+        return ((f_6.medium.y * _e18) * _e9);
     }
 }
 
@@ -435,18 +438,18 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_9: f32, rows: u32, w
     }
 }
 
-fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_5: vec3<f32>) -> f32 {
-    let axis_1 = f_6.axis.xyz;
-    return atan2(length(cross(dir_5, axis_1)), dot(dir_5, axis_1));
+fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let axis_1 = f_7.axis.xyz;
+    return atan2(length(cross(dir_6, axis_1)), dot(dir_6, axis_1));
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
     var yc: f32;
 
-    let rows_1 = f_7.sizes.w;
-    let phi_1 = atan2(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
-    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
-    if (f_7.anti_epipole.w > 0.5f) {
+    let rows_1 = f_8.sizes.w;
+    let phi_1 = atan2(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
+    yc = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
+    if (f_8.anti_epipole.w > 0.5f) {
         let _e22 = yc;
         let _e23 = yc;
         yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
@@ -458,19 +461,19 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_o
     return _e34;
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_7: vec3<f32>, s_1: f32, theta_1: f32, spot_1: bool) -> f32 {
-    if spot_1 {
-        let q_2 = ((eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz);
-        let to_eye = -(f_8.axis.xyz);
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_2: bool) -> f32 {
+    if spot_2 {
+        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        let to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_3: bool) -> f32 {
     var local_13: bool;
 
-    if spot_2 {
+    if spot_3 {
         let psi = (x_2 * delta);
         let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
@@ -482,39 +485,39 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_X
         if _e16 {
             return s_2;
         }
-        return min(((f_9.axis.w * sin(psi)) / den), s_2);
+        return min(((f_10.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_3: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_4: bool) -> f32 {
     if (x_3 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, f32(x_3), delta_1, theta_3, s_3, spot_3);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_3), delta_1, theta_3, s_3, spot_4);
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, spot_4: bool) -> f32 {
-    if spot_4 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, max((f_12.sizes2_.z / 4u), 1u));
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_5: bool) -> f32 {
+    if spot_5 {
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
     return _e15;
 }
 
-fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_5: f32, b_5: f32, depth_break: f32) -> bool {
+fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_6: f32, b_6: f32, depth_break: f32) -> bool {
     var local_14: bool;
 
-    if !((a_5 == b_5)) {
-        local_14 = (abs((a_5 - b_5)) <= (depth_break * min(a_5, b_5)));
+    if !((a_6 == b_6)) {
+        local_14 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
         local_14 = true;
     }
@@ -523,11 +526,11 @@ fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_5: f32, b_5: f32, 
 }
 
 fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_7: vec3<f32>) -> vec3<f32> {
-    let a_8 = min(abs(v_7), vec3(65504f));
-    let u_2 = bitcast<vec3<u32>>(a_8);
+    let a_9 = min(abs(v_7), vec3(65504f));
+    let u_2 = bitcast<vec3<u32>>(a_9);
     let normal = bitcast<vec3<f32>>((((u_2 + vec3(4095u)) + ((u_2 >> vec3(13u)) & vec3(1u))) & vec3(4294959104u)));
-    let subnormal = (round((a_8 * 16777216f)) / vec3(16777216f));
-    return (sign(v_7) * select(normal, subnormal, (a_8 < vec3(0.000061035156f))));
+    let subnormal = (round((a_9 * 16777216f)) / vec3(16777216f));
+    return (sign(v_7) * select(normal, subnormal, (a_9 < vec3(0.000061035156f))));
 }
 
 fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, d: vec2<f32>) -> f32 {
@@ -540,8 +543,8 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     var local_15: bool;
     var local_16: bool;
     var local_17: bool;
-    var a_6: f32 = 0f;
-    var b_6: f32 = 0f;
+    var a_7: f32 = 0f;
+    var b_7: f32 = 0f;
     var k_7: u32 = 0u;
 
     let size_1 = vec2<f32>(screen);
@@ -609,13 +612,13 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
                 let _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
                 let _e143 = k_7;
                 if (_e143 == 0u) {
-                    a_6 = _e142;
-                    b_6 = _e142;
+                    a_7 = _e142;
+                    b_7 = _e142;
                 } else {
-                    let _e148 = a_6;
-                    a_6 = min(_e148, _e142);
-                    let _e150 = b_6;
-                    b_6 = max(_e150, _e142);
+                    let _e148 = a_7;
+                    a_7 = min(_e148, _e142);
+                    let _e150 = b_7;
+                    b_7 = max(_e150, _e142);
                 }
             }
             continuing {
@@ -623,10 +626,10 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
                 k_7 = (_e153 + 1u);
             }
         }
-        let _e156 = a_6;
+        let _e156 = a_7;
         l_1.phi_start = _e156;
-        let _e158 = b_6;
-        let _e159 = a_6;
+        let _e158 = b_7;
+        let _e159 = a_7;
         l_1.dphi = ((_e158 - _e159) / f32(slices));
     }
     let _e163 = l_1;
@@ -643,27 +646,27 @@ fn slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLay
 fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_5: u32, screen_1: vec2<u32>, samples: u32) -> vec2<f32> {
     var t_in: f32 = 0f;
     var t_out: f32 = 340000000000000000000000000000000000000f;
-    var a_7: u32 = 0u;
+    var a_8: u32 = 0u;
 
     let _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     let lo_3 = vec2<f32>(0.5f, 0.5f);
     let hi_3 = (vec2<f32>(screen_1) - vec2<f32>(0.5f, 0.5f));
     loop {
-        let _e16 = a_7;
+        let _e16 = a_8;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            let _e19 = a_7;
+            let _e19 = a_8;
             if (abs(_e5[_e19]) > 0.000000000001f) {
-                let _e24 = a_7;
-                let _e27 = a_7;
-                let _e30 = a_7;
+                let _e24 = a_8;
+                let _e27 = a_8;
+                let _e30 = a_8;
                 let ta = ((lo_3[_e24] - l_3.origin[_e27]) / _e5[_e30]);
-                let _e33 = a_7;
-                let _e36 = a_7;
-                let _e39 = a_7;
+                let _e33 = a_8;
+                let _e36 = a_8;
+                let _e39 = a_8;
                 let tb = ((hi_3[_e33] - l_3.origin[_e36]) / _e5[_e39]);
                 let _e43 = t_in;
                 t_in = max(_e43, min(ta, tb));
@@ -672,8 +675,8 @@ fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_
             }
         }
         continuing {
-            let _e51 = a_7;
-            a_7 = (_e51 + 1u);
+            let _e51 = a_8;
+            a_8 = (_e51 + 1u);
         }
     }
     let _e53 = t_out;
@@ -712,7 +715,7 @@ fn beta_at(theta_4: f32, h_6: u32) -> vec4<f32> {
     return _e14;
 }
 
-fn pst_leaf(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, row_1: u32, delta_2: f32, h_7: u32) -> vec4<f32> {
+fn pst_leaf(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, row_1: u32, delta_2: f32, h_7: u32) -> vec4<f32> {
     var leaf: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var g_1: u32 = 0u;
 
@@ -720,9 +723,9 @@ fn pst_leaf(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
         let _e9 = gamma_at((f32(i_2) * delta_2), h_7);
         return _e9;
     }
-    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, row_1);
-    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e12);
-    let axis_2 = f_13.axis.xyz;
+    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, row_1);
+    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e12);
+    let axis_2 = f_14.axis.xyz;
     loop {
         let _e17 = g_1;
         if (_e17 < 2u) {
@@ -734,7 +737,7 @@ fn pst_leaf(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
             let q_4 = select(GL2_, -0.57735026f, (_e20 == 0u));
             let psi_1 = (((f32(i_2) + 0.5f) + (0.5f * q_4)) * delta_2);
             let l_5 = ((-(axis_2) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_13.light_dir.xyz), f_13.light_pos.w, f_13.light_dir.w);
+            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_14.light_dir.xyz), f_14.light_pos.w, f_14.light_dir.w);
             let _e48 = leaf;
             let _e52 = gamma_at(psi_1, h_7);
             leaf = (_e48 + (((0.5f * delta_2) * _e46) * _e52));
@@ -754,23 +757,23 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     var local_19: bool;
     var local_20: bool;
 
-    let f_14 = frame;
-    let eye_8 = f_14.eye.xyz;
-    let ndc = vec2<f32>((((2f * pc.x) / f32(f_14.sizes.x)) - 1f), (1f - ((2f * pc.y) / f32(f_14.sizes.y))));
-    let t_5 = f_14.cam_forward.w;
-    let dir_11 = normalize(((f_14.cam_forward.xyz + (f_14.cam_right.xyz * ((ndc.x * t_5) * f_14.cam_right.w))) + (f_14.cam_up.xyz * (ndc.y * t_5))));
-    let s_6 = (min(max(z_1, 0f), f_14.theta.z) / max(dot(dir_11, f_14.cam_forward.xyz), 0.000001f));
-    r_1 = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_8, dir_11, s_6, 0u, 0f, 0f, 0f);
+    let f_15 = frame;
+    let eye_9 = f_15.eye.xyz;
+    let ndc = vec2<f32>((((2f * pc.x) / f32(f_15.sizes.x)) - 1f), (1f - ((2f * pc.y) / f32(f_15.sizes.y))));
+    let t_5 = f_15.cam_forward.w;
+    let dir_12 = normalize(((f_15.cam_forward.xyz + (f_15.cam_right.xyz * ((ndc.x * t_5) * f_15.cam_right.w))) + (f_15.cam_up.xyz * (ndc.y * t_5))));
+    let s_6 = (min(max(z_1, 0f), f_15.theta.z) / max(dot(dir_12, f_15.cam_forward.xyz), 0.000001f));
+    r_1 = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_9, dir_12, s_6, 0u, 0f, 0f, 0f);
     let px = vec3<f32>(pc, 0f);
-    let radius = f_14.epipole.w;
-    if (f_14.epipole.z > 0.5f) {
-        local_18 = (length((px - vec3<f32>(f_14.epipole.x, f_14.epipole.y, 0f))) < radius);
+    let radius = f_15.epipole.w;
+    if (f_15.epipole.z > 0.5f) {
+        local_18 = (length((px - vec3<f32>(f_15.epipole.x, f_15.epipole.y, 0f))) < radius);
     } else {
         local_18 = false;
     }
     let near_epi = local_18;
-    if (f_14.anti_epipole.z > 0.5f) {
-        local_19 = (length((px - vec3<f32>(f_14.anti_epipole.x, f_14.anti_epipole.y, 0f))) < radius);
+    if (f_15.anti_epipole.z > 0.5f) {
+        local_19 = (length((px - vec3<f32>(f_15.anti_epipole.x, f_15.anti_epipole.y, 0f))) < radius);
     } else {
         local_19 = false;
     }
@@ -784,19 +787,19 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     if _e109 {
         r_1.marched = true;
         let _e114 = frame;
-        let _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_8, dir_11, s_6, true);
-        r_1.color = (_e117 * f_14.light_color.xyz);
+        let _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_9, dir_12, s_6, true);
+        r_1.color = (_e117 * f_15.light_color.xyz);
     }
-    let _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
+    let _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
     r_1.theta = _e122;
-    let _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
-    let _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e124), f_14.sizes.w, (f_14.anti_epipole.w > 0.5f));
+    let _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
+    let _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e124), f_15.sizes.w, (f_15.anti_epipole.w > 0.5f));
     r_1.row = _e132;
     let _e135 = r_1.theta;
-    let _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_14.theta.x, f_14.theta.y);
+    let _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_15.theta.x, f_15.theta.y);
     r_1.d = _e140;
     let _e143 = r_1.theta;
-    let _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_11, s_6, _e143, true);
+    let _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, dir_12, s_6, _e143, true);
     r_1.xs_num = _e144;
     let _e145 = r_1;
     return _e145;
@@ -811,21 +814,21 @@ fn pst_columns_crossed(r_2: PstRay, delta_3: f32) -> u32 {
 fn pst_terms(r_3: PstRay, row_2: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     var tail: f32 = 0f;
 
-    let f_15 = frame;
+    let f_16 = frame;
     let sin_theta = max(sin(r_3.theta), 0.000001f);
     let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_2), 0i);
     if (r_3.d <= _e16.x) {
-        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
-        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
+        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if true {
         let _e37 = tail;
-        return vec2<f32>((f_15.medium.y / (f_15.axis.w * sin_theta)), _e37);
+        return vec2<f32>((f_16.medium.y / (f_16.axis.w * sin_theta)), _e37);
     }
-    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(dot(f_15.light_dir.xyz, r_3.dir)));
-    let sp = (f_15.medium.y * _e48);
-    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, 0f, (delta_4 / sin_theta));
+    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(dot(f_16.light_dir.xyz, r_3.dir)));
+    let sp = (f_16.medium.y * _e48);
+    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.x, 0f, (delta_4 / sin_theta));
     let _e56 = tail;
     return vec2<f32>((sp * _e54), (sp * _e56));
 }
@@ -836,7 +839,7 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
     var p_5: vec4<f32>;
     var i_3: u32;
 
-    let f_16 = frame;
+    let f_17 = frame;
     let _e16 = textureLoad(depth, vec2<u32>(x_5, y), 0i);
     let _e18 = pst_ray(vec2<f32>((f32(x_5) + 0.5f), (f32(y) + 0.5f)), _e16.x);
     if _e18.marched {
@@ -871,7 +874,7 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
                         let _e59 = p_5;
                         let _e60 = i_3;
                         let _e62 = h_8;
-                        let _e63 = pst_leaf(f_16, _e60, _e18.row, delta_5, _e62);
+                        let _e63 = pst_leaf(f_17, _e60, _e18.row, delta_5, _e62);
                         p_5 = (_e59 + _e63);
                     }
                 }
@@ -893,7 +896,7 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
     }
     let _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     let _e84 = sum_2;
-    return (f_16.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
+    return (f_17.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
 }
 
 fn pst_footprint_depth(pc_1: vec2<f32>, screen_3: vec2<u32>) -> f32 {
@@ -975,9 +978,9 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     var p_1: vec4<f32>;
     var j_8: u32;
 
-    let f_17 = frame;
-    let screen_4 = vec2<u32>(f_17.sizes.x, f_17.sizes.y);
-    let width = f_17.sizes.z;
+    let f_18 = frame;
+    let screen_4 = vec2<u32>(f_18.sizes.x, f_18.sizes.y);
+    let width = f_18.sizes.z;
     let _e13 = frame.cam_forward;
     let _e17 = frame.cam_right;
     let _e21 = frame.cam_up;
@@ -1394,7 +1397,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                         let _e557 = h;
                         let _e560 = i;
                         let _e561 = h;
-                        let _e562 = pst_leaf(f_17, _e560, row_3, delta_6, _e561);
+                        let _e562 = pst_leaf(f_18, _e560, row_3, delta_6, _e561);
                         pst_leaves[(((base_1 + _e552) * RANK_VECS) + _e557)] = _e562;
                     }
                     continuing {
@@ -1540,8 +1543,8 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                     break;
                 }
                 let _e722 = i_1;
-                let b_7 = pst_columns[(base_1 + _e722)];
-                if (b_7 > 0u) {
+                let b_8 = pst_columns[(base_1 + _e722)];
+                if (b_8 > 0u) {
                     h_2 = 0u;
                     loop {
                         let _e730 = h_2;
@@ -1553,7 +1556,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                             let _e733 = i_1;
                             let _e738 = h_2;
                             let leaf_1 = pst_leaves[(((base_1 + _e733) * RANK_VECS) + _e738)];
-                            j_7 = ((v_9 - b_7) + 1u);
+                            j_7 = ((v_9 - b_8) + 1u);
                             loop {
                                 let _e746 = j_7;
                                 if (_e746 <= v_9) {
@@ -1692,7 +1695,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                 let _e900 = dotp;
                 let _e905 = k_4;
                 let _e907 = q_b[_e905];
-                let _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_17.light_color.xyz * (max((_e899 * _e900), 0f) + _e907)));
+                let _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_18.light_color.xyz * (max((_e899 * _e900), 0f) + _e907)));
                 let _e911 = k_4;
                 let _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
                 let _e915 = textureLoad(depth, _e912, 0i);

@@ -184,18 +184,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        vec3 dir_10 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_10.z <= 1e-6)) {
+        vec3 dir_11 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_11.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_3 = (near_1 + (_e28 * (far_1 - near_1)));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_10.z);
+        return ((z_3 + _e35) / dir_11.z);
     } else {
         vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -339,19 +339,18 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_4, vec3 eye_4, vec3 dir_4, float s, bool spot) {
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_4, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot) {
     float sum_1 = 0.0;
     uint k_1 = 0u;
     float t_2 = 0.0;
     float w = 0.0;
-    uint steps = f_5.sizes2_.y;
-    float h_7 = (s / float(steps));
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, 0.0, s, steps);
+    float h_7 = ((b_3 - a_3) / float(steps));
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e60 = k_1;
-            k_1 = (_e60 + 1u);
+            uint _e63 = k_1;
+            k_1 = (_e63 + 1u);
         }
         loop_init_2 = false;
         uint _e15 = k_1;
@@ -361,38 +360,42 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
         }
         {
             uint _e17 = k_1;
-            t_2 = ((float(_e17) + 0.5) * h_7);
+            t_2 = (a_3 + ((float(_e17) + 0.5) * h_7));
             w = h_7;
             if (spot) {
-                uint _e25 = k_1;
-                vec2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e25) + 0.5));
-                t_2 = _e29.x;
-                w = _e29.y;
+                uint _e26 = k_1;
+                vec2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            float _e32 = t_2;
-            float _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e32)));
+            float _e33 = t_2;
+            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e33)));
             if (spot) {
-                float _e38 = sum_1;
-                float _e39 = w;
-                float _e41 = t_2;
-                float _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e41);
-                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
+                float _e39 = sum_1;
+                float _e40 = w;
+                float _e42 = t_2;
+                float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e42);
+                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
             } else {
-                float _e45 = sum_1;
-                uint _e48 = k_1;
-                uint _e51 = k_1;
-                float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (float(_e48) * h_7), (float((_e51 + 1u)) * h_7));
-                sum_1 = (_e45 + (_e36 * _e56));
+                float _e46 = sum_1;
+                uint _e49 = k_1;
+                uint _e53 = k_1;
+                float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (float(_e49) * h_7)), (a_3 + (float((_e53 + 1u)) * h_7)));
+                sum_1 = (_e46 + (_e37 * _e59));
             }
         }
     }
-    if (spot) {
-        float _e62 = sum_1;
-        return _e62;
+    float _e65 = sum_1;
+    return _e65;
+}
+
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, sampler2D sm_5, vec3 eye_5, vec3 dir_5, float s, bool spot_1) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_1);
+    if (spot_1) {
+        return _e9;
     } else {
-        float _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_4)));
-        float _e73 = sum_1;
-        return ((f_5.medium.y * _e71) * _e73);
+        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
+        return ((f_6.medium.y * _e18) * _e9);
     }
 }
 
@@ -405,17 +408,17 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, 
     }
 }
 
-float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 dir_5) {
-    vec3 axis = f_6.axis.xyz;
-    return atan(length(cross(dir_5, axis)), dot(dir_5, axis));
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 dir_6) {
+    vec3 axis = f_7.axis.xyz;
+    return atan(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 dir_6) {
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_7) {
     float yc = 0.0;
-    uint rows_1 = f_7.sizes.w;
-    float phi_1 = atan(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
-    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
-    if ((f_7.anti_epipole.w > 0.5)) {
+    uint rows_1 = f_8.sizes.w;
+    float phi_1 = atan(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
+    yc = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
+    if ((f_8.anti_epipole.w > 0.5)) {
         float _e22 = yc;
         float _e23 = yc;
         yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
@@ -427,18 +430,18 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     return _e34;
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_5, vec3 dir_7, float s_1, float theta_1, bool spot_1) {
-    if (spot_1) {
-        vec3 q_2 = ((eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz);
-        vec3 to_eye = -(f_8.axis.xyz);
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_2) {
+    if (spot_2) {
+        vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        vec3 to_eye = -(f_9.axis.xyz);
         return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_1, float delta, float theta_2, float s_2, bool spot_2) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_1, float delta, float theta_2, float s_2, bool spot_3) {
     bool local_4 = false;
-    if (spot_2) {
+    if (spot_3) {
         float psi = (x_1 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
@@ -450,31 +453,31 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_9.axis.w * sin(psi)) / den), s_2);
+        return min(((f_10.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_1 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_3) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4) {
     if ((x_2 >= n_1)) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_2), delta_1, theta_3, s_3, spot_3);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_2), delta_1, theta_3, s_3, spot_4);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec3 eye_6, vec3 dir_8, float a_3, float b_3, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_7, vec3 dir_9, float a_4, float b_4, bool spot_4) {
-    if (spot_4) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, max((f_12.sizes2_.z / 4u), 1u));
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_5) {
+    if (spot_5) {
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -499,16 +502,16 @@ vec4 beta_at(float theta_4, uint h_2) {
     return _e14;
 }
 
-vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, uint i, uint row_1, float delta_2, uint h_3) {
+vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, uint i, uint row_1, float delta_2, uint h_3) {
     vec4 leaf = vec4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
     if (false) {
         vec4 _e9 = gamma_at((float(i) * delta_2), h_3);
         return _e9;
     }
-    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, row_1);
-    vec3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e12);
-    vec3 axis_1 = f_13.axis.xyz;
+    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, row_1);
+    vec3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e12);
+    vec3 axis_1 = f_14.axis.xyz;
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
@@ -526,7 +529,7 @@ vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, uint i, u
             float q_3 = ((_e20 == 0u) ? -0.57735026 : GL2_);
             float psi_1 = (((float(i) + 0.5) + (0.5 * q_3)) * delta_2);
             vec3 l_1 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_13.light_dir.xyz), f_13.light_pos.w, f_13.light_dir.w);
+            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_14.light_dir.xyz), f_14.light_pos.w, f_14.light_dir.w);
             vec4 _e48 = leaf;
             vec4 _e52 = gamma_at(psi_1, h_3);
             leaf = (_e48 + (((0.5 * delta_2) * _e46) * _e52));
@@ -541,23 +544,23 @@ PstRay pst_ray(vec2 pc, float z_1) {
     bool local_5 = false;
     bool local_6 = false;
     bool local_7 = false;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = _group_0_binding_0_cs;
-    vec3 eye_8 = f_14.eye.xyz;
-    vec2 ndc = vec2((((2.0 * pc.x) / float(f_14.sizes.x)) - 1.0), (1.0 - ((2.0 * pc.y) / float(f_14.sizes.y))));
-    float t_5 = f_14.cam_forward.w;
-    vec3 dir_11 = normalize(((f_14.cam_forward.xyz + (f_14.cam_right.xyz * ((ndc.x * t_5) * f_14.cam_right.w))) + (f_14.cam_up.xyz * (ndc.y * t_5))));
-    float s_4 = (min(max(z_1, 0.0), f_14.theta.z) / max(dot(dir_11, f_14.cam_forward.xyz), 1e-6));
-    r = PstRay(false, vec3(0.0, 0.0, 0.0), eye_8, dir_11, s_4, 0u, 0.0, 0.0, 0.0);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = _group_0_binding_0_cs;
+    vec3 eye_9 = f_15.eye.xyz;
+    vec2 ndc = vec2((((2.0 * pc.x) / float(f_15.sizes.x)) - 1.0), (1.0 - ((2.0 * pc.y) / float(f_15.sizes.y))));
+    float t_5 = f_15.cam_forward.w;
+    vec3 dir_12 = normalize(((f_15.cam_forward.xyz + (f_15.cam_right.xyz * ((ndc.x * t_5) * f_15.cam_right.w))) + (f_15.cam_up.xyz * (ndc.y * t_5))));
+    float s_4 = (min(max(z_1, 0.0), f_15.theta.z) / max(dot(dir_12, f_15.cam_forward.xyz), 1e-6));
+    r = PstRay(false, vec3(0.0, 0.0, 0.0), eye_9, dir_12, s_4, 0u, 0.0, 0.0, 0.0);
     vec3 px = vec3(pc, 0.0);
-    float radius = f_14.epipole.w;
-    if ((f_14.epipole.z > 0.5)) {
-        local_5 = (length((px - vec3(f_14.epipole.x, f_14.epipole.y, 0.0))) < radius);
+    float radius = f_15.epipole.w;
+    if ((f_15.epipole.z > 0.5)) {
+        local_5 = (length((px - vec3(f_15.epipole.x, f_15.epipole.y, 0.0))) < radius);
     } else {
         local_5 = false;
     }
     bool near_epi = local_5;
-    if ((f_14.anti_epipole.z > 0.5)) {
-        local_6 = (length((px - vec3(f_14.anti_epipole.x, f_14.anti_epipole.y, 0.0))) < radius);
+    if ((f_15.anti_epipole.z > 0.5)) {
+        local_6 = (length((px - vec3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0))) < radius);
     } else {
         local_6 = false;
     }
@@ -571,19 +574,19 @@ PstRay pst_ray(vec2 pc, float z_1) {
     if (_e109) {
         r.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = _group_0_binding_0_cs;
-        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, _group_0_binding_3_cs, eye_8, dir_11, s_4, true);
-        r.color = (_e117 * f_14.light_color.xyz);
+        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, _group_0_binding_3_cs, eye_9, dir_12, s_4, true);
+        r.color = (_e117 * f_15.light_color.xyz);
     }
-    float _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
+    float _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
     r.theta = _e122;
-    float _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, dir_11);
-    uint _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e124), f_14.sizes.w, (f_14.anti_epipole.w > 0.5));
+    float _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
+    uint _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e124), f_15.sizes.w, (f_15.anti_epipole.w > 0.5));
     r.row = _e132;
     float _e135 = r.theta;
-    float _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_14.theta.x, f_14.theta.y);
+    float _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_15.theta.x, f_15.theta.y);
     r.d = _e140;
     float _e143 = r.theta;
-    float _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_11, s_4, _e143, true);
+    float _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, dir_12, s_4, _e143, true);
     r.xs_num = _e144;
     PstRay _e145 = r;
     return _e145;
@@ -597,22 +600,22 @@ uint pst_columns_crossed(PstRay r_1, float delta_3) {
 
 vec2 pst_terms(PstRay r_2, uint row_2, float delta_4, uint n_2) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = _group_0_binding_0_cs;
     float sin_theta = max(sin(r_2.theta), 1e-6);
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 _e16 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((n_2 - 1u), row_2)), ivec2(0), textureSize(_group_0_binding_4_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
     if ((r_2.d <= _e16.x)) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return vec2((f_15.medium.y / (f_15.axis.w * sin_theta)), _e37);
+        return vec2((f_16.medium.y / (f_16.axis.w * sin_theta)), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(dot(f_15.light_dir.xyz, r_2.dir)));
-    float sp = (f_15.medium.y * _e48);
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, 0.0, (delta_4 / sin_theta));
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(dot(f_16.light_dir.xyz, r_2.dir)));
+    float sp = (f_16.medium.y * _e48);
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.x, 0.0, (delta_4 / sin_theta));
     float _e56 = tail;
     return vec2((sp * _e54), (sp * _e56));
 }
@@ -622,7 +625,7 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
     uint h_4 = 0u;
     vec4 p_3 = vec4(0.0);
     uint i_1 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = _group_0_binding_0_cs;
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e16 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_4, y)), ivec2(0), textureSize(_group_0_binding_2_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
     PstRay _e18 = pst_ray(vec2((float(x_4) + 0.5), (float(y) + 0.5)), _e16.x);
@@ -671,7 +674,7 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
                         vec4 _e59 = p_3;
                         uint _e60 = i_1;
                         uint _e62 = h_4;
-                        vec4 _e63 = pst_leaf(f_16, _e60, _e18.row, delta_5, _e62);
+                        vec4 _e63 = pst_leaf(f_17, _e60, _e18.row, delta_5, _e62);
                         p_3 = (_e59 + _e63);
                     }
                 }
@@ -685,7 +688,7 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
     }
     vec2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     float _e84 = sum_2;
-    return (f_16.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
+    return (f_17.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
 }
 
 void main() {

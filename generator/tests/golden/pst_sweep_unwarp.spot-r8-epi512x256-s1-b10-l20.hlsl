@@ -210,18 +210,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        float3 dir_10 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_10.z <= 1e-6)) {
+        float3 dir_11 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_11.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
+        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
         const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_3 = (near_1 + (_e28 * (far_1 - near_1)));
         const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_10.z);
+        return ((z_3 + _e35) / dir_11.z);
     } else {
         const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -419,24 +419,23 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, Texture2D<float4> sm_4, float3 eye_4, float3 dir_4, float s, bool spot)
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, Texture2D<float4> sm_4, float3 eye_4, float3 dir_4, float a_3, float b_3, uint steps, bool spot)
 {
     float sum_1 = 0.0;
     uint k_1 = 0u;
     float t_2 = (float)0;
     float w = (float)0;
 
-    uint steps = f_5.sizes2_.y;
-    float h_7 = (s / float(steps));
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, 0.0, s, steps);
+    float h_7 = ((b_3 - a_3) / float(steps));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e60 = k_1;
-            k_1 = (_e60 + 1u);
+            uint _e63 = k_1;
+            k_1 = (_e63 + 1u);
         }
         loop_init_2 = false;
         uint _e15 = k_1;
@@ -446,38 +445,43 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
         }
         {
             uint _e17 = k_1;
-            t_2 = ((float(_e17) + 0.5) * h_7);
+            t_2 = (a_3 + ((float(_e17) + 0.5) * h_7));
             w = h_7;
             if (spot) {
-                uint _e25 = k_1;
-                const float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e25) + 0.5));
-                t_2 = _e29.x;
-                w = _e29.y;
+                uint _e26 = k_1;
+                const float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            float _e32 = t_2;
-            const float _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e32)));
+            float _e33 = t_2;
+            const float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e33)));
             if (spot) {
-                float _e38 = sum_1;
-                float _e39 = w;
-                float _e41 = t_2;
-                const float _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e41);
-                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
+                float _e39 = sum_1;
+                float _e40 = w;
+                float _e42 = t_2;
+                const float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e42);
+                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
             } else {
-                float _e45 = sum_1;
-                uint _e48 = k_1;
-                uint _e51 = k_1;
-                const float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (float(_e48) * h_7), (float((_e51 + 1u)) * h_7));
-                sum_1 = (_e45 + (_e36 * _e56));
+                float _e46 = sum_1;
+                uint _e49 = k_1;
+                uint _e53 = k_1;
+                const float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (float(_e49) * h_7)), (a_3 + (float((_e53 + 1u)) * h_7)));
+                sum_1 = (_e46 + (_e37 * _e59));
             }
         }
     }
-    if (spot) {
-        float _e62 = sum_1;
-        return _e62;
+    float _e65 = sum_1;
+    return _e65;
+}
+
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, Texture2D<float4> sm_5, float3 eye_5, float3 dir_5, float s, bool spot_1)
+{
+    const float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_1);
+    if (spot_1) {
+        return _e9;
     } else {
-        const float _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_4)));
-        float _e73 = sum_1;
-        return ((f_5.medium.y * _e71) * _e73);
+        const float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
+        return ((f_6.medium.y * _e18) * _e9);
     }
 }
 
@@ -500,20 +504,20 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_1, uint rows
     }
 }
 
-float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 dir_5)
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 dir_6)
 {
-    float3 axis_1 = f_6.axis.xyz;
-    return atan2(length(cross(dir_5, axis_1)), dot(dir_5, axis_1));
+    float3 axis_1 = f_7.axis.xyz;
+    return atan2(length(cross(dir_6, axis_1)), dot(dir_6, axis_1));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 dir_6)
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 dir_7)
 {
     float yc = (float)0;
 
-    uint rows_1 = f_7.sizes.w;
-    float phi_1 = atan2(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
-    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
-    if ((f_7.anti_epipole.w > 0.5)) {
+    uint rows_1 = f_8.sizes.w;
+    float phi_1 = atan2(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
+    yc = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
+    if ((f_8.anti_epipole.w > 0.5)) {
         float _e22 = yc;
         float _e23 = yc;
         yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
@@ -525,21 +529,21 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     return _e34;
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_5, float3 dir_7, float s_1, float theta_1, bool spot_1)
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_2)
 {
-    if (spot_1) {
-        float3 q_2 = ((eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz);
-        float3 to_eye = -(f_8.axis.xyz);
+    if (spot_2) {
+        float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        float3 to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_1, float delta, float theta_2, float s_2, bool spot_2)
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_1, float delta, float theta_2, float s_2, bool spot_3)
 {
     bool local_5 = (bool)0;
 
-    if (spot_2) {
+    if (spot_3) {
         float psi = (x_1 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
@@ -551,24 +555,24 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_9.axis.w * sin(psi)) / den), s_2);
+        return min(((f_10.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_1 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_3)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4)
 {
     if ((x_2 >= n_1)) {
         return s_3;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_2), delta_1, theta_3, s_3, spot_3);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_2), delta_1, theta_3, s_3, spot_4);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float3 eye_6, float3 dir_8, float a_3, float b_3, uint panels_1)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_7, float3 dir_9, float a_4, float b_4, uint panels_1)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
     return _e15;
 }
 
@@ -576,22 +580,22 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_7, float3 dir_9, float a_4, float b_4, bool spot_4)
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_5)
 {
-    if (spot_4) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, max(naga_div(f_12.sizes2_.z, 4u), 1u));
+    if (spot_5) {
+        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max(naga_div(f_13.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
     return _e15;
 }
 
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_5, float b_5, float depth_break)
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b_6, float depth_break)
 {
     bool local_6 = (bool)0;
 
-    if (!((a_5 == b_5))) {
-        local_6 = (abs((a_5 - b_5)) <= (depth_break * min(a_5, b_5)));
+    if (!((a_6 == b_6))) {
+        local_6 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
         local_6 = true;
     }
@@ -686,13 +690,13 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
 
     float2 d_3 = ((float2(p_3) + float2(0.5, 0.5)) - l_1.origin);
     const float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_3);
-    float f_14 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
+    float f_15 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
     if ((l_1.wrap != 0u)) {
-        float fl = floor(f_14);
-        fs = (f_14 - fl);
+        float fl = floor(f_15);
+        fs = (f_15 - fl);
         s_lo = naga_mod(uint(asint(asuint(naga_f2i32(fl)) + asuint(int(slices)))), slices);
     } else {
-        float fc = clamp(f_14, 0.0, float((slices - 1u)));
+        float fc = clamp(f_15, 0.0, float((slices - 1u)));
         s_lo = min(naga_f2u32(fc), (slices - 2u));
         uint _e41 = s_lo;
         fs = (fc - float(_e41));

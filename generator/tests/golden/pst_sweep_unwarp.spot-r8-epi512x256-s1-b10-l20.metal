@@ -220,18 +220,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5) {
-        metal::float3 dir_10 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_10.z <= 0.000001) {
+        metal::float3 dir_11 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
+        if (dir_11.z <= 0.000001) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
+        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1.0) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_3 = near_1 + (_e28 * (far_1 - near_1));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return (z_3 + _e35) / dir_10.z;
+        return (z_3 + _e35) / dir_11.z;
     } else {
         metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -448,29 +448,30 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return _e13;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
     metal::texture2d<float, metal::access::sample> sm_4,
     metal::float3 eye_4,
     metal::float3 dir_4,
-    float s,
+    float a_3,
+    float b_3,
+    uint steps,
     bool spot
 ) {
     float sum_1 = 0.0;
     uint k_1 = 0u;
     float t_2 = {};
     float w = {};
-    uint steps = f_5.sizes2_.y;
-    float h_7 = s / static_cast<float>(steps);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, 0.0, s, steps);
+    float h_7 = (b_3 - a_3) / static_cast<float>(steps);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e60 = k_1;
-            k_1 = _e60 + 1u;
+            uint _e63 = k_1;
+            k_1 = _e63 + 1u;
         }
         loop_init_2 = false;
         uint _e15 = k_1;
@@ -480,38 +481,49 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         }
         {
             uint _e17 = k_1;
-            t_2 = (static_cast<float>(_e17) + 0.5) * h_7;
+            t_2 = a_3 + ((static_cast<float>(_e17) + 0.5) * h_7);
             w = h_7;
             if (spot) {
-                uint _e25 = k_1;
-                metal::float2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e25) + 0.5);
-                t_2 = _e29.x;
-                w = _e29.y;
+                uint _e26 = k_1;
+                metal::float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e26) + 0.5);
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            float _e32 = t_2;
-            float _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, eye_4 + (dir_4 * _e32));
+            float _e33 = t_2;
+            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, eye_4 + (dir_4 * _e33));
             if (spot) {
-                float _e38 = sum_1;
-                float _e39 = w;
-                float _e41 = t_2;
-                float _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e41);
-                sum_1 = _e38 + ((_e36 * _e39) * _e42);
+                float _e39 = sum_1;
+                float _e40 = w;
+                float _e42 = t_2;
+                float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e42);
+                sum_1 = _e39 + ((_e37 * _e40) * _e43);
             } else {
-                float _e45 = sum_1;
-                uint _e48 = k_1;
-                uint _e51 = k_1;
-                float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, static_cast<float>(_e48) * h_7, static_cast<float>(_e51 + 1u) * h_7);
-                sum_1 = _e45 + (_e36 * _e56);
+                float _e46 = sum_1;
+                uint _e49 = k_1;
+                uint _e53 = k_1;
+                float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, a_3 + (static_cast<float>(_e49) * h_7), a_3 + (static_cast<float>(_e53 + 1u) * h_7));
+                sum_1 = _e46 + (_e37 * _e59);
             }
         }
     }
-    if (spot) {
-        float _e62 = sum_1;
-        return _e62;
+    float _e65 = sum_1;
+    return _e65;
+}
+
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    metal::texture2d<float, metal::access::sample> sm_5,
+    metal::float3 eye_5,
+    metal::float3 dir_5,
+    float s,
+    bool spot_1
+) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_1);
+    if (spot_1) {
+        return _e9;
     } else {
-        float _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(metal::dot(f_5.light_dir.xyz, dir_4)));
-        float _e73 = sum_1;
-        return (f_5.medium.y * _e71) * _e73;
+        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(metal::dot(f_6.light_dir.xyz, dir_5)));
+        return (f_6.medium.y * _e18) * _e9;
     }
 }
 
@@ -538,22 +550,22 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
-    metal::float3 dir_5
-) {
-    metal::float3 axis_1 = f_6.axis.xyz;
-    return metal::atan2(metal::length(metal::cross(dir_5, axis_1)), metal::dot(dir_5, axis_1));
-}
-
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
     metal::float3 dir_6
 ) {
+    metal::float3 axis_1 = f_7.axis.xyz;
+    return metal::atan2(metal::length(metal::cross(dir_6, axis_1)), metal::dot(dir_6, axis_1));
+}
+
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    metal::float3 dir_7
+) {
     float yc = {};
-    uint rows_1 = f_7.sizes.w;
-    float phi_1 = metal::atan2(metal::dot(dir_6, f_7.e2_.xyz), metal::dot(dir_6, f_7.e1_.xyz));
-    yc = (phi_1 - f_7.e1_.w) / f_7.e2_.w;
-    if (f_7.anti_epipole.w > 0.5) {
+    uint rows_1 = f_8.sizes.w;
+    float phi_1 = metal::atan2(metal::dot(dir_7, f_8.e2_.xyz), metal::dot(dir_7, f_8.e1_.xyz));
+    yc = (phi_1 - f_8.e1_.w) / f_8.e2_.w;
+    if (f_8.anti_epipole.w > 0.5) {
         float _e22 = yc;
         float _e23 = yc;
         yc = _e22 - (metal::floor(_e23 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
@@ -566,31 +578,31 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
-    metal::float3 eye_5,
-    metal::float3 dir_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    metal::float3 eye_6,
+    metal::float3 dir_8,
     float s_1,
     float theta_1,
-    bool spot_1
+    bool spot_2
 ) {
-    if (spot_1) {
-        metal::float3 q_2 = (eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz;
-        metal::float3 to_eye = -(f_8.axis.xyz);
+    if (spot_2) {
+        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz;
+        metal::float3 to_eye = -(f_9.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
     }
     return s_1 * metal::sin(theta_1);
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     float x_1,
     float delta,
     float theta_2,
     float s_2,
-    bool spot_2
+    bool spot_3
 ) {
     bool local_5 = {};
-    if (spot_2) {
+    if (spot_3) {
         float psi = x_1 * delta;
         float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
@@ -602,37 +614,37 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (_e16) {
             return s_2;
         }
-        return metal::min((f_9.axis.w * metal::sin(psi)) / den, s_2);
+        return metal::min((f_10.axis.w * metal::sin(psi)) / den, s_2);
     } else {
         return metal::min((x_1 * delta) / metal::max(metal::sin(theta_2), 0.000001), s_2);
     }
 }
 
 float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     uint x_2,
     uint n_1,
     float delta_1,
     float theta_3,
     float s_3,
-    bool spot_3
+    bool spot_4
 ) {
     if (x_2 >= n_1) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, static_cast<float>(x_2), delta_1, theta_3, s_3, spot_3);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, static_cast<float>(x_2), delta_1, theta_3, s_3, spot_4);
     return _e9;
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
-    metal::float3 eye_6,
-    metal::float3 dir_8,
-    float a_3,
-    float b_3,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
+    metal::float3 eye_7,
+    metal::float3 dir_9,
+    float a_4,
+    float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
     return _e15;
 }
 
@@ -641,29 +653,29 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
-    metal::float3 eye_7,
-    metal::float3 dir_9,
-    float a_4,
-    float b_4,
-    bool spot_4
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
+    metal::float3 eye_8,
+    metal::float3 dir_10,
+    float a_5,
+    float b_5,
+    bool spot_5
 ) {
-    if (spot_4) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, metal::max(naga_div(f_12.sizes2_.z, 4u), 1u));
+    if (spot_5) {
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_13.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
     return _e15;
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_5,
-    float b_5,
+    float a_6,
+    float b_6,
     float depth_break
 ) {
     bool local_6 = {};
-    if (!((a_5 == b_5))) {
-        local_6 = metal::abs(a_5 - b_5) <= (depth_break * metal::min(a_5, b_5));
+    if (!((a_6 == b_6))) {
+        local_6 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
     } else {
         local_6 = true;
     }
@@ -767,13 +779,13 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_3 = {};
     metal::float2 d_3 = (static_cast<metal::float2>(p_3) + metal::float2(0.5, 0.5)) - l_1.origin;
     float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_3);
-    float f_14 = ((_e12 - l_1.phi_start) / l_1.dphi) - 0.5;
+    float f_15 = ((_e12 - l_1.phi_start) / l_1.dphi) - 0.5;
     if (l_1.wrap != 0u) {
-        float fl = metal::floor(f_14);
-        fs = f_14 - fl;
+        float fl = metal::floor(f_15);
+        fs = f_15 - fl;
         s_lo = naga_mod(static_cast<uint>(as_type<int>(as_type<uint>(naga_f2i32(fl)) + as_type<uint>(static_cast<int>(slices)))), slices);
     } else {
-        float fc = metal::clamp(f_14, 0.0, static_cast<float>(slices - 1u));
+        float fc = metal::clamp(f_15, 0.0, static_cast<float>(slices - 1u));
         s_lo = metal::min(naga_f2u32(fc), slices - 2u);
         uint _e41 = s_lo;
         fs = fc - static_cast<float>(_e41);
@@ -875,7 +887,7 @@ metal::float4 beta_at(
 }
 
 metal::float4 pst_leaf(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14,
     uint i,
     uint row_1,
     float delta_2,
@@ -889,9 +901,9 @@ metal::float4 pst_leaf(
         metal::float4 _e9 = gamma_at(static_cast<float>(i) * delta_2, h_3, pst_factors, _buffer_sizes);
         return _e9;
     }
-    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, row_1);
-    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e12);
-    metal::float3 axis_2 = f_13.axis.xyz;
+    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, row_1);
+    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e12);
+    metal::float3 axis_2 = f_14.axis.xyz;
     uint2 loop_bound_5 = uint2(4294967295u);
     bool loop_init_5 = true;
     while(true) {
@@ -912,7 +924,7 @@ metal::float4 pst_leaf(
             float q_3 = (_e20 == 0u) ? -0.57735026 : GL2_;
             float psi_1 = ((static_cast<float>(i) + 0.5) + (0.5 * q_3)) * delta_2;
             metal::float3 l_3 = (-(axis_2) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_3, f_13.light_dir.xyz), f_13.light_pos.w, f_13.light_dir.w);
+            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_3, f_14.light_dir.xyz), f_14.light_pos.w, f_14.light_dir.w);
             metal::float4 _e48 = leaf;
             metal::float4 _e52 = gamma_at(psi_1, h_3, pst_factors, _buffer_sizes);
             leaf = _e48 + (((0.5 * delta_2) * _e46) * _e52);
@@ -932,23 +944,23 @@ PstRay pst_ray(
     bool local_8 = {};
     bool local_9 = {};
     bool local_10 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
-    metal::float3 eye_8 = f_15.eye.xyz;
-    metal::float2 ndc = metal::float2(((2.0 * pc.x) / static_cast<float>(f_15.sizes.x)) - 1.0, 1.0 - ((2.0 * pc.y) / static_cast<float>(f_15.sizes.y)));
-    float t_7 = f_15.cam_forward.w;
-    metal::float3 dir_11 = metal::normalize((f_15.cam_forward.xyz + (f_15.cam_right.xyz * ((ndc.x * t_7) * f_15.cam_right.w))) + (f_15.cam_up.xyz * (ndc.y * t_7)));
-    float s_4 = metal::min(metal::max(z_1, 0.0), f_15.theta.z) / metal::max(metal::dot(dir_11, f_15.cam_forward.xyz), 0.000001);
-    r = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_8, dir_11, s_4, 0u, 0.0, 0.0, 0.0};
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
+    metal::float3 eye_9 = f_16.eye.xyz;
+    metal::float2 ndc = metal::float2(((2.0 * pc.x) / static_cast<float>(f_16.sizes.x)) - 1.0, 1.0 - ((2.0 * pc.y) / static_cast<float>(f_16.sizes.y)));
+    float t_7 = f_16.cam_forward.w;
+    metal::float3 dir_12 = metal::normalize((f_16.cam_forward.xyz + (f_16.cam_right.xyz * ((ndc.x * t_7) * f_16.cam_right.w))) + (f_16.cam_up.xyz * (ndc.y * t_7)));
+    float s_4 = metal::min(metal::max(z_1, 0.0), f_16.theta.z) / metal::max(metal::dot(dir_12, f_16.cam_forward.xyz), 0.000001);
+    r = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_9, dir_12, s_4, 0u, 0.0, 0.0, 0.0};
     metal::float3 px = metal::float3(pc, 0.0);
-    float radius = f_15.epipole.w;
-    if (f_15.epipole.z > 0.5) {
-        local_8 = metal::length(px - metal::float3(f_15.epipole.x, f_15.epipole.y, 0.0)) < radius;
+    float radius = f_16.epipole.w;
+    if (f_16.epipole.z > 0.5) {
+        local_8 = metal::length(px - metal::float3(f_16.epipole.x, f_16.epipole.y, 0.0)) < radius;
     } else {
         local_8 = false;
     }
     bool near_epi = local_8;
-    if (f_15.anti_epipole.z > 0.5) {
-        local_9 = metal::length(px - metal::float3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0)) < radius;
+    if (f_16.anti_epipole.z > 0.5) {
+        local_9 = metal::length(px - metal::float3(f_16.anti_epipole.x, f_16.anti_epipole.y, 0.0)) < radius;
     } else {
         local_9 = false;
     }
@@ -962,19 +974,19 @@ PstRay pst_ray(
     if (_e109) {
         r.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
-        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_8, dir_11, s_4, true);
-        r.color = _e117 * f_15.light_color.xyz;
+        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_9, dir_12, s_4, true);
+        r.color = _e117 * f_16.light_color.xyz;
     }
-    float _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_11);
+    float _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, dir_12);
     r.theta = _e122;
-    float _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_11);
-    uint _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e124), f_15.sizes.w, f_15.anti_epipole.w > 0.5);
+    float _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, dir_12);
+    uint _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e124), f_16.sizes.w, f_16.anti_epipole.w > 0.5);
     r.row = _e132;
     float _e135 = r.theta;
-    float _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_15.theta.x, f_15.theta.y);
+    float _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_16.theta.x, f_16.theta.y);
     r.d = _e140;
     float _e143 = r.theta;
-    float _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_8, dir_11, s_4, _e143, true);
+    float _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, eye_9, dir_12, s_4, _e143, true);
     r.xs_num = _e144;
     PstRay _e145 = r;
     return _e145;
@@ -999,22 +1011,22 @@ metal::float2 pst_terms(
     metal::texture2d<float, metal::access::sample> rectified
 ) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
     float sin_theta = metal::max(metal::sin(r_2.theta), 0.000001);
     uint clamped_lod_e16 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
     metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_2)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     if (r_2.d <= _e16.x) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return metal::float2(f_16.medium.y / (f_16.axis.w * sin_theta), _e37);
+        return metal::float2(f_17.medium.y / (f_17.axis.w * sin_theta), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(metal::dot(f_16.light_dir.xyz, r_2.dir)));
-    float sp = f_16.medium.y * _e48;
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.x, 0.0, delta_4 / sin_theta);
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_17.medium.z, -(metal::dot(f_17.light_dir.xyz, r_2.dir)));
+    float sp = f_17.medium.y * _e48;
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_17.medium.x, 0.0, delta_4 / sin_theta);
     float _e56 = tail;
     return metal::float2(sp * _e54, sp * _e56);
 }
@@ -1034,7 +1046,7 @@ metal::float3 pst_sweep_pixel(
     uint h_4 = 0u;
     metal::float4 p_5 = {};
     uint i_1 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18 = frame;
     uint clamped_lod_e16 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_4, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_4) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
@@ -1089,7 +1101,7 @@ metal::float3 pst_sweep_pixel(
                         metal::float4 _e59 = p_5;
                         uint _e60 = i_1;
                         uint _e62 = h_4;
-                        metal::float4 _e63 = pst_leaf(f_17, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
+                        metal::float4 _e63 = pst_leaf(f_18, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
                         p_5 = _e59 + _e63;
                     }
                 }
@@ -1103,7 +1115,7 @@ metal::float3 pst_sweep_pixel(
     }
     metal::float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27, frame, rectified);
     float _e84 = sum_3;
-    return f_17.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
+    return f_18.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
 }
 
 struct pst_sweep_unwarpInput {

@@ -202,18 +202,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_10 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_10.z <= 0.000001f) {
+        let dir_11 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_11.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_10);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_3 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_10.z);
+        return ((z_3 + _e35) / dir_11.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -354,15 +354,14 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX
     return _e13;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, s: f32, spot: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_1: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
-    let steps = f_5.sizes2_.y;
-    let h_7 = (s / f32(steps));
-    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, 0f, s, steps);
+    let h_7 = ((b_3 - a_3) / f32(steps));
+    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_1;
         if (_e15 < steps) {
@@ -371,42 +370,46 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_o
         }
         {
             let _e17 = k_1;
-            t_2 = ((f32(_e17) + 0.5f) * h_7);
+            t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_7));
             w = h_7;
             if spot {
-                let _e25 = k_1;
-                let _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e25) + 0.5f));
-                t_2 = _e29.x;
-                w = _e29.y;
+                let _e26 = k_1;
+                let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            let _e32 = t_2;
-            let _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e32)));
+            let _e33 = t_2;
+            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e33)));
             if spot {
-                let _e38 = sum_1;
-                let _e39 = w;
-                let _e41 = t_2;
-                let _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e41);
-                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
+                let _e39 = sum_1;
+                let _e40 = w;
+                let _e42 = t_2;
+                let _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e42);
+                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
             } else {
-                let _e45 = sum_1;
-                let _e48 = k_1;
-                let _e51 = k_1;
-                let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (f32(_e48) * h_7), (f32((_e51 + 1u)) * h_7));
-                sum_1 = (_e45 + (_e36 * _e56));
+                let _e46 = sum_1;
+                let _e49 = k_1;
+                let _e53 = k_1;
+                let _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (f32(_e49) * h_7)), (a_3 + (f32((_e53 + 1u)) * h_7)));
+                sum_1 = (_e46 + (_e37 * _e59));
             }
         }
         continuing {
-            let _e60 = k_1;
-            k_1 = (_e60 + 1u);
+            let _e63 = k_1;
+            k_1 = (_e63 + 1u);
         }
     }
-    if spot {
-        let _e62 = sum_1;
-        return _e62;
+    let _e65 = sum_1;
+    return _e65;
+}
+
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_1: bool) -> f32 {
+    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0f, s, f_6.sizes2_.y, spot_1);
+    if spot_1 {
+        return _e9;
     } else {
-        let _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_4)));
-        let _e73 = sum_1;
-        return ((f_5.medium.y * _e71) * _e73);
+        let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
+        return ((f_6.medium.y * _e18) * _e9);
     }
 }
 
@@ -419,18 +422,18 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_1: f32, rows: u32, w
     }
 }
 
-fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_5: vec3<f32>) -> f32 {
-    let axis_1 = f_6.axis.xyz;
-    return atan2(length(cross(dir_5, axis_1)), dot(dir_5, axis_1));
+fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let axis_1 = f_7.axis.xyz;
+    return atan2(length(cross(dir_6, axis_1)), dot(dir_6, axis_1));
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
     var yc: f32;
 
-    let rows_1 = f_7.sizes.w;
-    let phi_1 = atan2(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
-    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
-    if (f_7.anti_epipole.w > 0.5f) {
+    let rows_1 = f_8.sizes.w;
+    let phi_1 = atan2(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
+    yc = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
+    if (f_8.anti_epipole.w > 0.5f) {
         let _e22 = yc;
         let _e23 = yc;
         yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
@@ -442,19 +445,19 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_o
     return _e34;
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_7: vec3<f32>, s_1: f32, theta_1: f32, spot_1: bool) -> f32 {
-    if spot_1 {
-        let q_2 = ((eye_5 + (dir_7 * s_1)) - f_8.light_pos.xyz);
-        let to_eye = -(f_8.axis.xyz);
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_2: bool) -> f32 {
+    if spot_2 {
+        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        let to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_2: f32, s_2: f32, spot_2: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_2: f32, s_2: f32, spot_3: bool) -> f32 {
     var local_5: bool;
 
-    if spot_2 {
+    if spot_3 {
         let psi = (x_1 * delta);
         let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
@@ -466,39 +469,39 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_X
         if _e16 {
             return s_2;
         }
-        return min(((f_9.axis.w * sin(psi)) / den), s_2);
+        return min(((f_10.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_1 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_3: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_4: bool) -> f32 {
     if (x_2 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, f32(x_2), delta_1, theta_3, s_3, spot_3);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_2), delta_1, theta_3, s_3, spot_4);
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_8, a_3, b_3, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, spot_4: bool) -> f32 {
-    if spot_4 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, dir_9, a_4, b_4, max((f_12.sizes2_.z / 4u), 1u));
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_5: bool) -> f32 {
+    if spot_5 {
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_4, b_4);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
     return _e15;
 }
 
-fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_5: f32, b_5: f32, depth_break: f32) -> bool {
+fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_6: f32, b_6: f32, depth_break: f32) -> bool {
     var local_6: bool;
 
-    if !((a_5 == b_5)) {
-        local_6 = (abs((a_5 - b_5)) <= (depth_break * min(a_5, b_5)));
+    if !((a_6 == b_6)) {
+        local_6 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
         local_6 = true;
     }
@@ -581,13 +584,13 @@ fn epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLay
 
     let d_3 = ((vec2<f32>(p_3) + vec2<f32>(0.5f, 0.5f)) - l_1.origin);
     let _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_3);
-    let f_14 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5f);
+    let f_15 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5f);
     if (l_1.wrap != 0u) {
-        let fl = floor(f_14);
-        fs = (f_14 - fl);
+        let fl = floor(f_15);
+        fs = (f_15 - fl);
         s_lo = (u32((i32(fl) + i32(slices))) % slices);
     } else {
-        let fc = clamp(f_14, 0f, f32((slices - 1u)));
+        let fc = clamp(f_15, 0f, f32((slices - 1u)));
         s_lo = min(u32(fc), (slices - 2u));
         let _e41 = s_lo;
         fs = (fc - f32(_e41));
@@ -661,7 +664,7 @@ fn beta_at(theta_4: f32, h_2: u32) -> vec4<f32> {
     return _e14;
 }
 
-fn pst_leaf(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, row_1: u32, delta_2: f32, h_3: u32) -> vec4<f32> {
+fn pst_leaf(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, row_1: u32, delta_2: f32, h_3: u32) -> vec4<f32> {
     var leaf: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var g_1: u32 = 0u;
 
@@ -669,9 +672,9 @@ fn pst_leaf(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, ro
         let _e9 = gamma_at((f32(i) * delta_2), h_3);
         return _e9;
     }
-    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, row_1);
-    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e12);
-    let axis_2 = f_13.axis.xyz;
+    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, row_1);
+    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e12);
+    let axis_2 = f_14.axis.xyz;
     loop {
         let _e17 = g_1;
         if (_e17 < 2u) {
@@ -683,7 +686,7 @@ fn pst_leaf(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, ro
             let q_3 = select(GL2_, -0.57735026f, (_e20 == 0u));
             let psi_1 = (((f32(i) + 0.5f) + (0.5f * q_3)) * delta_2);
             let l_3 = ((-(axis_2) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_3, f_13.light_dir.xyz), f_13.light_pos.w, f_13.light_dir.w);
+            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_3, f_14.light_dir.xyz), f_14.light_pos.w, f_14.light_dir.w);
             let _e48 = leaf;
             let _e52 = gamma_at(psi_1, h_3);
             leaf = (_e48 + (((0.5f * delta_2) * _e46) * _e52));
@@ -703,23 +706,23 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     var local_9: bool;
     var local_10: bool;
 
-    let f_15 = frame;
-    let eye_8 = f_15.eye.xyz;
-    let ndc = vec2<f32>((((2f * pc.x) / f32(f_15.sizes.x)) - 1f), (1f - ((2f * pc.y) / f32(f_15.sizes.y))));
-    let t_7 = f_15.cam_forward.w;
-    let dir_11 = normalize(((f_15.cam_forward.xyz + (f_15.cam_right.xyz * ((ndc.x * t_7) * f_15.cam_right.w))) + (f_15.cam_up.xyz * (ndc.y * t_7))));
-    let s_4 = (min(max(z_1, 0f), f_15.theta.z) / max(dot(dir_11, f_15.cam_forward.xyz), 0.000001f));
-    r = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_8, dir_11, s_4, 0u, 0f, 0f, 0f);
+    let f_16 = frame;
+    let eye_9 = f_16.eye.xyz;
+    let ndc = vec2<f32>((((2f * pc.x) / f32(f_16.sizes.x)) - 1f), (1f - ((2f * pc.y) / f32(f_16.sizes.y))));
+    let t_7 = f_16.cam_forward.w;
+    let dir_12 = normalize(((f_16.cam_forward.xyz + (f_16.cam_right.xyz * ((ndc.x * t_7) * f_16.cam_right.w))) + (f_16.cam_up.xyz * (ndc.y * t_7))));
+    let s_4 = (min(max(z_1, 0f), f_16.theta.z) / max(dot(dir_12, f_16.cam_forward.xyz), 0.000001f));
+    r = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_9, dir_12, s_4, 0u, 0f, 0f, 0f);
     let px = vec3<f32>(pc, 0f);
-    let radius = f_15.epipole.w;
-    if (f_15.epipole.z > 0.5f) {
-        local_8 = (length((px - vec3<f32>(f_15.epipole.x, f_15.epipole.y, 0f))) < radius);
+    let radius = f_16.epipole.w;
+    if (f_16.epipole.z > 0.5f) {
+        local_8 = (length((px - vec3<f32>(f_16.epipole.x, f_16.epipole.y, 0f))) < radius);
     } else {
         local_8 = false;
     }
     let near_epi = local_8;
-    if (f_15.anti_epipole.z > 0.5f) {
-        local_9 = (length((px - vec3<f32>(f_15.anti_epipole.x, f_15.anti_epipole.y, 0f))) < radius);
+    if (f_16.anti_epipole.z > 0.5f) {
+        local_9 = (length((px - vec3<f32>(f_16.anti_epipole.x, f_16.anti_epipole.y, 0f))) < radius);
     } else {
         local_9 = false;
     }
@@ -733,19 +736,19 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     if _e109 {
         r.marched = true;
         let _e114 = frame;
-        let _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_8, dir_11, s_4, true);
-        r.color = (_e117 * f_15.light_color.xyz);
+        let _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_9, dir_12, s_4, true);
+        r.color = (_e117 * f_16.light_color.xyz);
     }
-    let _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_11);
+    let _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, dir_12);
     r.theta = _e122;
-    let _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_11);
-    let _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e124), f_15.sizes.w, (f_15.anti_epipole.w > 0.5f));
+    let _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, dir_12);
+    let _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e124), f_16.sizes.w, (f_16.anti_epipole.w > 0.5f));
     r.row = _e132;
     let _e135 = r.theta;
-    let _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_15.theta.x, f_15.theta.y);
+    let _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_16.theta.x, f_16.theta.y);
     r.d = _e140;
     let _e143 = r.theta;
-    let _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_8, dir_11, s_4, _e143, true);
+    let _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, eye_9, dir_12, s_4, _e143, true);
     r.xs_num = _e144;
     let _e145 = r;
     return _e145;
@@ -760,21 +763,21 @@ fn pst_columns_crossed(r_1: PstRay, delta_3: f32) -> u32 {
 fn pst_terms(r_2: PstRay, row_2: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     var tail: f32 = 0f;
 
-    let f_16 = frame;
+    let f_17 = frame;
     let sin_theta = max(sin(r_2.theta), 0.000001f);
     let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_2), 0i);
     if (r_2.d <= _e16.x) {
-        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if true {
         let _e37 = tail;
-        return vec2<f32>((f_16.medium.y / (f_16.axis.w * sin_theta)), _e37);
+        return vec2<f32>((f_17.medium.y / (f_17.axis.w * sin_theta)), _e37);
     }
-    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(dot(f_16.light_dir.xyz, r_2.dir)));
-    let sp = (f_16.medium.y * _e48);
-    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.x, 0f, (delta_4 / sin_theta));
+    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_17.medium.z, -(dot(f_17.light_dir.xyz, r_2.dir)));
+    let sp = (f_17.medium.y * _e48);
+    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_17.medium.x, 0f, (delta_4 / sin_theta));
     let _e56 = tail;
     return vec2<f32>((sp * _e54), (sp * _e56));
 }
@@ -785,7 +788,7 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
     var p_5: vec4<f32>;
     var i_1: u32;
 
-    let f_17 = frame;
+    let f_18 = frame;
     let _e16 = textureLoad(depth, vec2<u32>(x_4, y), 0i);
     let _e18 = pst_ray(vec2<f32>((f32(x_4) + 0.5f), (f32(y) + 0.5f)), _e16.x);
     if _e18.marched {
@@ -820,7 +823,7 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
                         let _e59 = p_5;
                         let _e60 = i_1;
                         let _e62 = h_4;
-                        let _e63 = pst_leaf(f_17, _e60, _e18.row, delta_5, _e62);
+                        let _e63 = pst_leaf(f_18, _e60, _e18.row, delta_5, _e62);
                         p_5 = (_e59 + _e63);
                     }
                 }
@@ -842,7 +845,7 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
     }
     let _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     let _e84 = sum_3;
-    return (f_17.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
+    return (f_18.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
 }
 
 @compute @workgroup_size(8, 8, 1) 

@@ -162,18 +162,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_1 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_8 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_8.z <= 0.000001f) {
+        let dir_9 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_9.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_8);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_9);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_8.z);
+        return ((z_2 + _e35) / dir_9.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -313,15 +313,14 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX
     return _e13;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, s: f32, spot: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_1: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
-    let steps = f_4.sizes2_.y;
-    let h_2 = (s / f32(steps));
-    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0f, s, steps);
+    let h_2 = ((b_3 - a_3) / f32(steps));
+    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_1;
         if (_e15 < steps) {
@@ -330,42 +329,46 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_o
         }
         {
             let _e17 = k_1;
-            t_2 = ((f32(_e17) + 0.5f) * h_2);
+            t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_2));
             w = h_2;
             if spot {
-                let _e25 = k_1;
-                let _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e25) + 0.5f));
-                t_2 = _e29.x;
-                w = _e29.y;
+                let _e26 = k_1;
+                let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            let _e32 = t_2;
-            let _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e32)));
+            let _e33 = t_2;
+            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e33)));
             if spot {
-                let _e38 = sum_1;
-                let _e39 = w;
-                let _e41 = t_2;
-                let _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e41);
-                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
+                let _e39 = sum_1;
+                let _e40 = w;
+                let _e42 = t_2;
+                let _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
+                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
             } else {
-                let _e45 = sum_1;
-                let _e48 = k_1;
-                let _e51 = k_1;
-                let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e48) * h_2), (f32((_e51 + 1u)) * h_2));
-                sum_1 = (_e45 + (_e36 * _e56));
+                let _e46 = sum_1;
+                let _e49 = k_1;
+                let _e53 = k_1;
+                let _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e49) * h_2)), (a_3 + (f32((_e53 + 1u)) * h_2)));
+                sum_1 = (_e46 + (_e37 * _e59));
             }
         }
         continuing {
-            let _e60 = k_1;
-            k_1 = (_e60 + 1u);
+            let _e63 = k_1;
+            k_1 = (_e63 + 1u);
         }
     }
-    if spot {
-        let _e62 = sum_1;
-        return _e62;
+    let _e65 = sum_1;
+    return _e65;
+}
+
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_1: bool) -> f32 {
+    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_5, dir_5, 0f, s, f_5.sizes2_.y, spot_1);
+    if spot_1 {
+        return _e9;
     } else {
-        let _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_4)));
-        let _e73 = sum_1;
-        return ((f_4.medium.y * _e71) * _e73);
+        let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_5)));
+        return ((f_5.medium.y * _e18) * _e9);
     }
 }
 
@@ -378,10 +381,10 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_2: bool) -> f32 {
     var local_5: bool;
 
-    if spot_1 {
+    if spot_2 {
         let psi = (x_2 * delta);
         let den = sin((theta_1 + psi));
         if !((den <= 0.000001f)) {
@@ -393,19 +396,19 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_X
         if _e16 {
             return s_1;
         }
-        return min(((f_5.axis.w * sin(psi)) / den), s_1);
+        return min(((f_6.axis.w * sin(psi)) / den), s_1);
     } else {
         return min(((x_2 * delta) / max(sin(theta_1), 0.000001f)), s_1);
     }
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_5: vec3<f32>) -> f32 {
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
     var yc: f32;
 
-    let rows_1 = f_6.sizes.w;
-    let phi_1 = atan2(dot(dir_5, f_6.e2_.xyz), dot(dir_5, f_6.e1_.xyz));
-    yc = ((phi_1 - f_6.e1_.w) / f_6.e2_.w);
-    if (f_6.anti_epipole.w > 0.5f) {
+    let rows_1 = f_7.sizes.w;
+    let phi_1 = atan2(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
+    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
+    if (f_7.anti_epipole.w > 0.5f) {
         let _e22 = yc;
         let _e23 = yc;
         yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
@@ -417,30 +420,30 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_o
     return _e34;
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_6: vec3<f32>, s_2: f32, theta_2: f32, spot_2: bool) -> f32 {
-    if spot_2 {
-        let q_2 = ((eye_5 + (dir_6 * s_2)) - f_7.light_pos.xyz);
-        let to_eye = -(f_7.axis.xyz);
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_3: bool) -> f32 {
+    if spot_3 {
+        let q_2 = ((eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz);
+        let to_eye = -(f_8.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_7, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_8: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
     return _e15;
 }
 
-fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
-    return ((f_9.e1_.xyz * cos(phi)) + (f_9.e2_.xyz * sin(phi)));
+fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
+    return ((f_10.e1_.xyz * cos(phi)) + (f_10.e2_.xyz * sin(phi)));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    return (f_10.e1_.w + ((f32(row) + 0.5f) * f_10.e2_.w));
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    return (f_11.e1_.w + ((f32(row) + 0.5f) * f_11.e2_.w));
 }
 
-fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_4: vec2<f32>, b_4: vec2<f32>) -> vec2<f32> {
-    return vec2<f32>(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_5: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(((a_5.x * b_5.y) + (a_5.y * b_5.x)), ((a_5.y * b_5.y) - (a_5.x * b_5.x)));
 }
 
 fn fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(first: vec2<f32>) -> vec2<f32> {
@@ -451,14 +454,14 @@ fn freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(k_2: u32) -> f32 {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * f32(((2u * k_2) - 1u)));
 }
 
-fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_5: vec2<f32>, layer: u32) -> vec4<f32> {
+fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_6: vec2<f32>, b_6: vec2<f32>, layer: u32) -> vec4<f32> {
     let _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 1u));
     let _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 2u));
-    return vec4<f32>(((2f / _e5) * a_5.y), ((-2f / _e5) * a_5.x), ((2f / _e10) * b_5.y), ((-2f / _e10) * b_5.x));
+    return vec4<f32>(((2f / _e5) * a_6.y), ((-2f / _e5) * a_6.x), ((2f / _e10) * b_6.y), ((-2f / _e10) * b_6.x));
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_3: bool) -> u32 {
-    if spot_3 {
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_4: bool) -> u32 {
+    if spot_4 {
         return ((r * width) / regions);
     }
     return (((r * r) * width) / (regions * regions));
@@ -504,22 +507,22 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     var local_15: bool;
     var local_16: bool;
 
-    let f_11 = frame;
-    let eye_7 = f_11.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, x_3, y_1);
+    let f_12 = frame;
+    let eye_8 = f_12.eye.xyz;
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_3, y_1);
     let _e14 = textureLoad(depth, vec2<u32>(x_3, y_1), 0i);
-    let s_3 = (min(max(_e14.x, 0f), f_11.theta.z) / max(dot(_e10, f_11.cam_forward.xyz), 0.000001f));
-    let color = f_11.light_color.xyz;
+    let s_3 = (min(max(_e14.x, 0f), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 0.000001f));
+    let color = f_12.light_color.xyz;
     let px = vec3<f32>((f32(x_3) + 0.5f), (f32(y_1) + 0.5f), 0f);
-    let radius = f_11.epipole.w;
-    if (f_11.epipole.z > 0.5f) {
-        local_6 = (length((px - vec3<f32>(f_11.epipole.x, f_11.epipole.y, 0f))) < radius);
+    let radius = f_12.epipole.w;
+    if (f_12.epipole.z > 0.5f) {
+        local_6 = (length((px - vec3<f32>(f_12.epipole.x, f_12.epipole.y, 0f))) < radius);
     } else {
         local_6 = false;
     }
     let near_epi = local_6;
-    if (f_11.anti_epipole.z > 0.5f) {
-        local_7 = (length((px - vec3<f32>(f_11.anti_epipole.x, f_11.anti_epipole.y, 0f))) < radius);
+    if (f_12.anti_epipole.z > 0.5f) {
+        local_7 = (length((px - vec3<f32>(f_12.anti_epipole.x, f_12.anti_epipole.y, 0f))) < radius);
     } else {
         local_7 = false;
     }
@@ -532,23 +535,23 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     let _e77 = local_8;
     if _e77 {
         let _e79 = frame;
-        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_7, _e10, s_3, true);
+        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_8, _e10, s_3, true);
         let l_1 = (_e82 * color);
         return l_1;
     }
-    let axis = f_11.axis.xyz;
-    let rows_2 = f_11.sizes.w;
-    let width_1 = f_11.sizes.z;
-    let wrap_1 = (f_11.anti_epipole.w > 0.5f);
+    let axis = f_12.axis.xyz;
+    let rows_2 = f_12.sizes.w;
+    let width_1 = f_12.sizes.z;
+    let wrap_1 = (f_12.anti_epipole.w > 0.5f);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, _e10);
+        let _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
         yc_1 = _e100;
         let _e102 = theta_3;
-        let _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_11.theta.x, f_11.theta.y);
+        let _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_12.theta.x, f_12.theta.y);
         d = _e107;
         let _e109 = theta_3;
-        let _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, s_3, _e109, true);
+        let _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e109, true);
         reach = _e110;
     }
     let _e112 = yc_1;
@@ -558,8 +561,8 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     let _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
     let row1_ = select(_e118, _e122, (yb > floor(yb)));
     let w1_ = select(0f, fy, (row1_ != _e118));
-    let cos_theta_l = -(dot(f_11.light_dir.xyz, _e10));
-    let panels_2 = max((f_11.sizes2_.z / 4u), 1u);
+    let cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
+    let panels_2 = max((f_12.sizes2_.z / 4u), 1u);
     let _e140 = d;
     let _e144 = d;
     angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e140)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e144)));
@@ -587,8 +590,8 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
             layer_1 = (_e165 + 1u);
         }
     }
-    let _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.z, cos_theta_l);
-    let sun_scatter = (f_11.medium.y * _e171);
+    let _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    let sun_scatter = (f_12.medium.y * _e171);
     let _e174 = xs;
     xs0_ = _e174;
     let _e176 = xs;
@@ -648,39 +651,39 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
             e1_ = f32();
             let _e276 = delta0_;
             let _e277 = theta_3;
-            let _e278 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b0_, _e276, _e277, s_3, true);
+            let _e278 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e276, _e277, s_3, true);
             a0_ = _e278;
             let _e279 = delta0_;
             let _e280 = theta_3;
-            let _e281 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b1_, _e279, _e280, s_3, true);
+            let _e281 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e279, _e280, s_3, true);
             e0_ = select(_e281, s_3, is_last0_);
             let _e283 = delta1_;
             let _e284 = theta_3;
-            let _e285 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b0_, _e283, _e284, s_3, true);
+            let _e285 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e283, _e284, s_3, true);
             a1_ = _e285;
             let _e286 = delta1_;
             let _e287 = theta_3;
-            let _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b1_, _e286, _e287, s_3, true);
+            let _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e286, _e287, s_3, true);
             e1_ = select(_e288, s_3, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if true {
                 let _e294 = a0_;
                 let _e295 = e0_;
-                let _e296 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, _e294, _e295, panels_2);
+                let _e296 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e294, _e295, panels_2);
                 weight0_ = _e296;
                 let _e297 = a1_;
                 let _e298 = e1_;
-                let _e299 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, _e297, _e298, panels_2);
+                let _e299 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e297, _e298, panels_2);
                 weight1_ = _e299;
             } else {
                 let _e302 = a0_;
                 let _e303 = e0_;
-                let _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, _e302, _e303);
+                let _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e302, _e303);
                 weight0_ = (sun_scatter * _e304);
                 let _e308 = a1_;
                 let _e309 = e1_;
-                let _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, _e308, _e309);
+                let _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e308, _e309);
                 weight1_ = (sun_scatter * _e310);
             }
             let xb0_ = (pos0_ - 0.5f);

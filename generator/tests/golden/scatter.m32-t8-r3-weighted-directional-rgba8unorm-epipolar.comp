@@ -161,18 +161,18 @@ float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     float near_1 = v_5.right.w;
     float far_1 = v_5.up.w;
     if ((v_5.origin.w > 0.5)) {
-        vec3 dir_8 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_8.z <= 1e-6)) {
+        vec3 dir_9 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if ((dir_9.z <= 1e-6)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_8);
+        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_9);
         float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if ((_e28 >= 1.0)) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
         float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_8.z);
+        return ((z_2 + _e35) / dir_9.z);
     } else {
         vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -315,19 +315,18 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, sampler2D sm_4, vec3 eye_4, vec3 dir_4, float s, bool spot) {
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, sampler2D sm_4, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot) {
     float sum_1 = 0.0;
     uint k_1 = 0u;
     float t_2 = 0.0;
     float w = 0.0;
-    uint steps = f_4.sizes2_.y;
-    float h_2 = (s / float(steps));
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0.0, s, steps);
+    float h_2 = ((b_3 - a_3) / float(steps));
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, a_3, b_3, steps);
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e60 = k_1;
-            k_1 = (_e60 + 1u);
+            uint _e63 = k_1;
+            k_1 = (_e63 + 1u);
         }
         loop_init_2 = false;
         uint _e15 = k_1;
@@ -337,38 +336,42 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
         }
         {
             uint _e17 = k_1;
-            t_2 = ((float(_e17) + 0.5) * h_2);
+            t_2 = (a_3 + ((float(_e17) + 0.5) * h_2));
             w = h_2;
             if (spot) {
-                uint _e25 = k_1;
-                vec2 _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e25) + 0.5));
-                t_2 = _e29.x;
-                w = _e29.y;
+                uint _e26 = k_1;
+                vec2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            float _e32 = t_2;
-            float _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e32)));
+            float _e33 = t_2;
+            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e33)));
             if (spot) {
-                float _e38 = sum_1;
-                float _e39 = w;
-                float _e41 = t_2;
-                float _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e41);
-                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
+                float _e39 = sum_1;
+                float _e40 = w;
+                float _e42 = t_2;
+                float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
+                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
             } else {
-                float _e45 = sum_1;
-                uint _e48 = k_1;
-                uint _e51 = k_1;
-                float _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (float(_e48) * h_2), (float((_e51 + 1u)) * h_2));
-                sum_1 = (_e45 + (_e36 * _e56));
+                float _e46 = sum_1;
+                uint _e49 = k_1;
+                uint _e53 = k_1;
+                float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (float(_e49) * h_2)), (a_3 + (float((_e53 + 1u)) * h_2)));
+                sum_1 = (_e46 + (_e37 * _e59));
             }
         }
     }
-    if (spot) {
-        float _e62 = sum_1;
-        return _e62;
+    float _e65 = sum_1;
+    return _e65;
+}
+
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_5, vec3 eye_5, vec3 dir_5, float s, bool spot_1) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_5, dir_5, 0.0, s, f_5.sizes2_.y, spot_1);
+    if (spot_1) {
+        return _e9;
     } else {
-        float _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_4)));
-        float _e73 = sum_1;
-        return ((f_4.medium.y * _e71) * _e73);
+        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_5)));
+        return ((f_5.medium.y * _e18) * _e9);
     }
 }
 
@@ -381,9 +384,9 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, 
     }
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float x_2, float delta, float theta_1, float s_1, bool spot_1) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float x_2, float delta, float theta_1, float s_1, bool spot_2) {
     bool local_5 = false;
-    if (spot_1) {
+    if (spot_2) {
         float psi = (x_2 * delta);
         float den = sin((theta_1 + psi));
         if (!((den <= 1e-6))) {
@@ -395,18 +398,18 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_1;
         }
-        return min(((f_5.axis.w * sin(psi)) / den), s_1);
+        return min(((f_6.axis.w * sin(psi)) / den), s_1);
     } else {
         return min(((x_2 * delta) / max(sin(theta_1), 1e-6)), s_1);
     }
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 dir_5) {
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 dir_6) {
     float yc = 0.0;
-    uint rows_1 = f_6.sizes.w;
-    float phi_1 = atan(dot(dir_5, f_6.e2_.xyz), dot(dir_5, f_6.e1_.xyz));
-    yc = ((phi_1 - f_6.e1_.w) / f_6.e2_.w);
-    if ((f_6.anti_epipole.w > 0.5)) {
+    uint rows_1 = f_7.sizes.w;
+    float phi_1 = atan(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
+    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
+    if ((f_7.anti_epipole.w > 0.5)) {
         float _e22 = yc;
         float _e23 = yc;
         yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
@@ -418,30 +421,30 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     return _e34;
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 eye_5, vec3 dir_6, float s_2, float theta_2, bool spot_2) {
-    if (spot_2) {
-        vec3 q_2 = ((eye_5 + (dir_6 * s_2)) - f_7.light_pos.xyz);
-        vec3 to_eye = -(f_7.axis.xyz);
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_6, vec3 dir_7, float s_2, float theta_2, bool spot_3) {
+    if (spot_3) {
+        vec3 q_2 = ((eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz);
+        vec3 to_eye = -(f_8.axis.xyz);
         return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_6, vec3 dir_7, float a_3, float b_3, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_7, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_7, vec3 dir_8, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
     return _e15;
 }
 
-vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float phi) {
-    return ((f_9.e1_.xyz * cos(phi)) + (f_9.e2_.xyz * sin(phi)));
+vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float phi) {
+    return ((f_10.e1_.xyz * cos(phi)) + (f_10.e2_.xyz * sin(phi)));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint row) {
-    return (f_10.e1_.w + ((float(row) + 0.5) * f_10.e2_.w));
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint row) {
+    return (f_11.e1_.w + ((float(row) + 0.5) * f_11.e2_.w));
 }
 
-vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_4, vec2 b_4) {
-    return vec2(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_5, vec2 b_5) {
+    return vec2(((a_5.x * b_5.y) + (a_5.y * b_5.x)), ((a_5.y * b_5.y) - (a_5.x * b_5.x)));
 }
 
 vec2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 first) {
@@ -452,14 +455,14 @@ float freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint k_2) {
     return (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * float(((2u * k_2) - 1u)));
 }
 
-vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_5, vec2 b_5, uint layer) {
+vec4 coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_6, vec2 b_6, uint layer) {
     float _e5 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 1u));
     float _e10 = freqX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(((2u * layer) + 2u));
-    return vec4(((2.0 / _e5) * a_5.y), ((-2.0 / _e5) * a_5.x), ((2.0 / _e10) * b_5.y), ((-2.0 / _e10) * b_5.x));
+    return vec4(((2.0 / _e5) * a_6.y), ((-2.0 / _e5) * a_6.x), ((2.0 / _e10) * b_6.y), ((-2.0 / _e10) * b_6.x));
 }
 
-uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_3) {
-    if (spot_3) {
+uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_4) {
+    if (spot_4) {
         return ((r * width) / regions);
     }
     return (((r * r) * width) / (regions * regions));
@@ -504,23 +507,23 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     bool local_14 = false;
     bool local_15 = false;
     bool local_16 = false;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11 = _group_0_binding_0_cs;
-    vec3 eye_7 = f_11.eye.xyz;
-    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, x_3, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = _group_0_binding_0_cs;
+    vec3 eye_8 = f_12.eye.xyz;
+    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_3, y_1);
     int _e14_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_3, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
-    float s_3 = (min(max(_e14.x, 0.0), f_11.theta.z) / max(dot(_e10, f_11.cam_forward.xyz), 1e-6));
-    vec3 color = f_11.light_color.xyz;
+    float s_3 = (min(max(_e14.x, 0.0), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 1e-6));
+    vec3 color = f_12.light_color.xyz;
     vec3 px = vec3((float(x_3) + 0.5), (float(y_1) + 0.5), 0.0);
-    float radius = f_11.epipole.w;
-    if ((f_11.epipole.z > 0.5)) {
-        local_6 = (length((px - vec3(f_11.epipole.x, f_11.epipole.y, 0.0))) < radius);
+    float radius = f_12.epipole.w;
+    if ((f_12.epipole.z > 0.5)) {
+        local_6 = (length((px - vec3(f_12.epipole.x, f_12.epipole.y, 0.0))) < radius);
     } else {
         local_6 = false;
     }
     bool near_epi = local_6;
-    if ((f_11.anti_epipole.z > 0.5)) {
-        local_7 = (length((px - vec3(f_11.anti_epipole.x, f_11.anti_epipole.y, 0.0))) < radius);
+    if ((f_12.anti_epipole.z > 0.5)) {
+        local_7 = (length((px - vec3(f_12.anti_epipole.x, f_12.anti_epipole.y, 0.0))) < radius);
     } else {
         local_7 = false;
     }
@@ -533,23 +536,23 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     bool _e77 = local_8;
     if (_e77) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = _group_0_binding_0_cs;
-        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, _group_0_binding_3_cs, eye_7, _e10, s_3, false);
+        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, _group_0_binding_3_cs, eye_8, _e10, s_3, false);
         vec3 l_1 = (_e82 * color);
         return l_1;
     }
-    vec3 axis = f_11.axis.xyz;
-    uint rows_2 = f_11.sizes.w;
-    uint width_1 = f_11.sizes.z;
-    bool wrap_1 = (f_11.anti_epipole.w > 0.5);
+    vec3 axis = f_12.axis.xyz;
+    uint rows_2 = f_12.sizes.w;
+    uint width_1 = f_12.sizes.z;
+    bool wrap_1 = (f_12.anti_epipole.w > 0.5);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
-        float _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, _e10);
+        float _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
         yc_1 = _e100;
         float _e102 = theta_3;
-        float _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_11.theta.x, f_11.theta.y);
+        float _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_12.theta.x, f_12.theta.y);
         d = _e107;
         float _e109 = theta_3;
-        float _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, s_3, _e109, false);
+        float _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e109, false);
         reach = _e110;
     }
     float _e112 = yc_1;
@@ -559,8 +562,8 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     uint _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
     uint row1_ = ((yb > floor(yb)) ? _e122 : _e118);
     float w1_ = ((row1_ != _e118) ? fy : 0.0);
-    float cos_theta_l = -(dot(f_11.light_dir.xyz, _e10));
-    uint panels_2 = max((f_11.sizes2_.z / 4u), 1u);
+    float cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
+    uint panels_2 = max((f_12.sizes2_.z / 4u), 1u);
     float _e140 = d;
     float _e144 = d;
     angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e140)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e144)));
@@ -590,8 +593,8 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
             angle = _e163;
         }
     }
-    float _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.z, cos_theta_l);
-    float sun_scatter = (f_11.medium.y * _e171);
+    float _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    float sun_scatter = (f_12.medium.y * _e171);
     float _e174 = xs;
     xs0_ = _e174;
     float _e176 = xs;
@@ -657,39 +660,39 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
             e1_ = 0.0;
             float _e276 = delta0_;
             float _e277 = theta_3;
-            float _e278 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b0_, _e276, _e277, s_3, false);
+            float _e278 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e276, _e277, s_3, false);
             a0_ = _e278;
             float _e279 = delta0_;
             float _e280 = theta_3;
-            float _e281 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b1_, _e279, _e280, s_3, false);
+            float _e281 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e279, _e280, s_3, false);
             e0_ = (is_last0_ ? s_3 : _e281);
             float _e283 = delta1_;
             float _e284 = theta_3;
-            float _e285 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b0_, _e283, _e284, s_3, false);
+            float _e285 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e283, _e284, s_3, false);
             a1_ = _e285;
             float _e286 = delta1_;
             float _e287 = theta_3;
-            float _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, b1_, _e286, _e287, s_3, false);
+            float _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e286, _e287, s_3, false);
             e1_ = (is_last1_ ? s_3 : _e288);
             weight0_ = 0.0;
             weight1_ = 0.0;
             if (false) {
                 float _e294 = a0_;
                 float _e295 = e0_;
-                float _e296 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, _e294, _e295, panels_2);
+                float _e296 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e294, _e295, panels_2);
                 weight0_ = _e296;
                 float _e297 = a1_;
                 float _e298 = e1_;
-                float _e299 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, eye_7, _e10, _e297, _e298, panels_2);
+                float _e299 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e297, _e298, panels_2);
                 weight1_ = _e299;
             } else {
                 float _e302 = a0_;
                 float _e303 = e0_;
-                float _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, _e302, _e303);
+                float _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e302, _e303);
                 weight0_ = (sun_scatter * _e304);
                 float _e308 = a1_;
                 float _e309 = e1_;
-                float _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_11.medium.x, _e308, _e309);
+                float _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e308, _e309);
                 weight1_ = (sun_scatter * _e310);
             }
             float xb0_ = (pos0_ - 0.5);

@@ -169,18 +169,18 @@ fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     let near_1 = v_5.right.w;
     let far_2 = v_5.up.w;
     if (v_5.origin.w > 0.5f) {
-        let dir_8 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_8.z <= 0.000001f) {
+        let dir_9 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
+        if (dir_9.z <= 0.000001f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_8);
+        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_9);
         let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
         if (_e28 >= 1f) {
             return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
         }
         let z_3 = (near_1 + (_e28 * (far_2 - near_1)));
         let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_8.z);
+        return ((z_3 + _e35) / dir_9.z);
     } else {
         let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
         let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
@@ -320,15 +320,14 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX
     return _e13;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, s: f32, spot: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_1: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
-    let steps = f_4.sizes2_.y;
-    let h_2 = (s / f32(steps));
-    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, 0f, s, steps);
+    let h_2 = ((b_3 - a_3) / f32(steps));
+    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_1;
         if (_e15 < steps) {
@@ -337,42 +336,46 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_o
         }
         {
             let _e17 = k_1;
-            t_2 = ((f32(_e17) + 0.5f) * h_2);
+            t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_2));
             w = h_2;
             if spot {
-                let _e25 = k_1;
-                let _e29 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e25) + 0.5f));
-                t_2 = _e29.x;
-                w = _e29.y;
+                let _e26 = k_1;
+                let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
+                t_2 = _e30.x;
+                w = _e30.y;
             }
-            let _e32 = t_2;
-            let _e36 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e32)));
+            let _e33 = t_2;
+            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e33)));
             if spot {
-                let _e38 = sum_1;
-                let _e39 = w;
-                let _e41 = t_2;
-                let _e42 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e41);
-                sum_1 = (_e38 + ((_e36 * _e39) * _e42));
+                let _e39 = sum_1;
+                let _e40 = w;
+                let _e42 = t_2;
+                let _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
+                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
             } else {
-                let _e45 = sum_1;
-                let _e48 = k_1;
-                let _e51 = k_1;
-                let _e56 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (f32(_e48) * h_2), (f32((_e51 + 1u)) * h_2));
-                sum_1 = (_e45 + (_e36 * _e56));
+                let _e46 = sum_1;
+                let _e49 = k_1;
+                let _e53 = k_1;
+                let _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e49) * h_2)), (a_3 + (f32((_e53 + 1u)) * h_2)));
+                sum_1 = (_e46 + (_e37 * _e59));
             }
         }
         continuing {
-            let _e60 = k_1;
-            k_1 = (_e60 + 1u);
+            let _e63 = k_1;
+            k_1 = (_e63 + 1u);
         }
     }
-    if spot {
-        let _e62 = sum_1;
-        return _e62;
+    let _e65 = sum_1;
+    return _e65;
+}
+
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_1: bool) -> f32 {
+    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_5, dir_5, 0f, s, f_5.sizes2_.y, spot_1);
+    if spot_1 {
+        return _e9;
     } else {
-        let _e71 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.z, -(dot(f_4.light_dir.xyz, dir_4)));
-        let _e73 = sum_1;
-        return ((f_4.medium.y * _e71) * _e73);
+        let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_5)));
+        return ((f_5.medium.y * _e18) * _e9);
     }
 }
 
@@ -385,10 +388,10 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_1: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_2: bool) -> f32 {
     var local_5: bool;
 
-    if spot_1 {
+    if spot_2 {
         let psi = (x_2 * delta);
         let den = sin((theta_1 + psi));
         if !((den <= 0.000001f)) {
@@ -400,19 +403,19 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_X
         if _e16 {
             return s_1;
         }
-        return min(((f_5.axis.w * sin(psi)) / den), s_1);
+        return min(((f_6.axis.w * sin(psi)) / den), s_1);
     } else {
         return min(((x_2 * delta) / max(sin(theta_1), 0.000001f)), s_1);
     }
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_5: vec3<f32>) -> f32 {
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
     var yc: f32;
 
-    let rows_1 = f_6.sizes.w;
-    let phi_1 = atan2(dot(dir_5, f_6.e2_.xyz), dot(dir_5, f_6.e1_.xyz));
-    yc = ((phi_1 - f_6.e1_.w) / f_6.e2_.w);
-    if (f_6.anti_epipole.w > 0.5f) {
+    let rows_1 = f_7.sizes.w;
+    let phi_1 = atan2(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
+    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
+    if (f_7.anti_epipole.w > 0.5f) {
         let _e22 = yc;
         let _e23 = yc;
         yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
@@ -424,17 +427,17 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_o
     return _e34;
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_5: vec3<f32>, dir_6: vec3<f32>, s_2: f32, theta_2: f32, spot_2: bool) -> f32 {
-    if spot_2 {
-        let q_3 = ((eye_5 + (dir_6 * s_2)) - f_7.light_pos.xyz);
-        let to_eye = -(f_7.axis.xyz);
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_3: bool) -> f32 {
+    if spot_3 {
+        let q_3 = ((eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz);
+        let to_eye = -(f_8.axis.xyz);
         return atan2(length(cross(q_3, to_eye)), dot(q_3, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, a_3: f32, b_3: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_6, dir_7, a_3, b_3, panels_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_8: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
     return _e15;
 }
 
@@ -442,8 +445,8 @@ fn moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d: f32) -> f32 {
     return ((2f * d) - 1f);
 }
 
-fn biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw: vec4<f32>, a_4: f32) -> vec4<f32> {
-    return vec4<f32>((raw.x * (1f - a_4)), ((raw.y * (1f - a_4)) + (a_4 / 3f)), (raw.z * (1f - a_4)), ((raw.w * (1f - a_4)) + (a_4 / 5f)));
+fn biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw: vec4<f32>, a_5: f32) -> vec4<f32> {
+    return vec4<f32>((raw.x * (1f - a_5)), ((raw.y * (1f - a_5)) + (a_5 / 3f)), (raw.z * (1f - a_5)), ((raw.w * (1f - a_5)) + (a_5 / 5f)));
 }
 
 fn sign_ofX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(x_3: f32, s_3: f32) -> f32 {
@@ -464,15 +467,15 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
         let _e22 = nonzeroX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX((-0.5f * (c2_ + _e18)));
         return CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec3<f32>((c1_ / _e22), (_e22 / c3_), 0f), true);
     }
-    let a_5 = (c3_ / c4_);
-    let b_4 = (c2_ / c4_);
+    let a_6 = (c3_ / c4_);
+    let b_5 = (c2_ / c4_);
     let c = (c1_ / c4_);
-    let p_3 = min((b_4 - ((a_5 * a_5) / 3f)), -0.000000000001f);
-    let qq = ((((((2f * a_5) * a_5) * a_5) / 27f) - ((a_5 * b_4) / 3f)) + c);
+    let p_3 = min((b_5 - ((a_6 * a_6) / 3f)), -0.000000000001f);
+    let qq = ((((((2f * a_6) * a_6) * a_6) / 27f) - ((a_6 * b_5) / 3f)) + c);
     let m = (2f * sqrt((-(p_3) / 3f)));
     let theta_4 = (acos(clamp(((3f * qq) / (p_3 * m)), -1f, 1f)) / 3f);
-    let greatest = ((m * cos(theta_4)) - (a_5 / 3f));
-    let least = ((m * cos((theta_4 - 4.1887903f))) - (a_5 / 3f));
+    let greatest = ((m * cos(theta_4)) - (a_6 / 3f));
+    let least = ((m * cos((theta_4 - 4.1887903f))) - (a_6 / 3f));
     z_1 = select(least, greatest, (abs(greatest) >= abs(least)));
     loop {
         let _e83 = i;
@@ -484,13 +487,13 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
             let _e86 = z_1;
             let _e87 = z_1;
             let _e88 = z_1;
-            let f_11 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
+            let f_12 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
             let _e95 = z_1;
             let _e98 = z_1;
             let df = (c2_ + (_e95 * ((2f * c3_) + ((3f * _e98) * c4_))));
             if (df != 0f) {
                 let _e107 = z_1;
-                z_1 = (_e107 - (f_11 / df));
+                z_1 = (_e107 - (f_12 / df));
             }
         }
         continuing {
@@ -580,16 +583,16 @@ fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw
     return clamp(((1f - _e129) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0f, 1f);
 }
 
-fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
-    return ((f_9.e1_.xyz * cos(phi)) + (f_9.e2_.xyz * sin(phi)));
+fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
+    return ((f_10.e1_.xyz * cos(phi)) + (f_10.e2_.xyz * sin(phi)));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    return (f_10.e1_.w + ((f32(row) + 0.5f) * f_10.e2_.w));
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    return (f_11.e1_.w + ((f32(row) + 0.5f) * f_11.e2_.w));
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_3: bool) -> u32 {
-    if spot_3 {
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_4: bool) -> u32 {
+    if spot_4 {
         return ((r * width) / regions);
     }
     return (((r * r) * width) / (regions * regions));
@@ -629,22 +632,22 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var local_15: bool;
     var local_16: bool;
 
-    let f_12 = frame;
-    let eye_7 = f_12.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
+    let f_13 = frame;
+    let eye_8 = f_13.eye.xyz;
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
     let _e14 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
-    let s_5 = (min(max(_e14.x, 0f), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 0.000001f));
-    let color = f_12.light_color.xyz;
+    let s_5 = (min(max(_e14.x, 0f), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 0.000001f));
+    let color = f_13.light_color.xyz;
     let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f), 0f);
-    let radius = f_12.epipole.w;
-    if (f_12.epipole.z > 0.5f) {
-        local_7 = (length((px - vec3<f32>(f_12.epipole.x, f_12.epipole.y, 0f))) < radius);
+    let radius = f_13.epipole.w;
+    if (f_13.epipole.z > 0.5f) {
+        local_7 = (length((px - vec3<f32>(f_13.epipole.x, f_13.epipole.y, 0f))) < radius);
     } else {
         local_7 = false;
     }
     let near_epi = local_7;
-    if (f_12.anti_epipole.z > 0.5f) {
-        local_8 = (length((px - vec3<f32>(f_12.anti_epipole.x, f_12.anti_epipole.y, 0f))) < radius);
+    if (f_13.anti_epipole.z > 0.5f) {
+        local_8 = (length((px - vec3<f32>(f_13.anti_epipole.x, f_13.anti_epipole.y, 0f))) < radius);
     } else {
         local_8 = false;
     }
@@ -657,23 +660,23 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     let _e77 = local_9;
     if _e77 {
         let _e79 = frame;
-        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_7, _e10, s_5, false);
+        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_8, _e10, s_5, false);
         let l_1 = (_e82 * color);
         return l_1;
     }
-    let axis = f_12.axis.xyz;
-    let rows_2 = f_12.sizes.w;
-    let width_1 = f_12.sizes.z;
-    let wrap_1 = (f_12.anti_epipole.w > 0.5f);
+    let axis = f_13.axis.xyz;
+    let rows_2 = f_13.sizes.w;
+    let width_1 = f_13.sizes.z;
+    let wrap_1 = (f_13.anti_epipole.w > 0.5f);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
+        let _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
         yc_1 = _e100;
         let _e102 = theta_3;
-        let _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_12.theta.x, f_12.theta.y);
+        let _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_13.theta.x, f_13.theta.y);
         d_1 = _e107;
         let _e109 = theta_3;
-        let _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, _e10, s_5, _e109, false);
+        let _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e109, false);
         reach = _e110;
     }
     let _e112 = yc_1;
@@ -683,12 +686,12 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     let _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
     let row1_ = select(_e118, _e122, (yb > floor(yb)));
     let w1_ = select(0f, fy, (row1_ != _e118));
-    let cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
-    let panels_2 = max((f_12.sizes2_.z / 4u), 1u);
+    let cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
+    let panels_2 = max((f_13.sizes2_.z / 4u), 1u);
     let _e139 = d_1;
     let _e140 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e139);
-    let _e145 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
-    let sun_scatter = (f_12.medium.y * _e145);
+    let _e145 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
+    let sun_scatter = (f_13.medium.y * _e145);
     let _e148 = xs;
     xs0_ = _e148;
     let _e150 = xs;
@@ -748,39 +751,39 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             e1_ = f32();
             let _e250 = delta0_;
             let _e251 = theta_3;
-            let _e252 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e250, _e251, s_5, false);
+            let _e252 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e250, _e251, s_5, false);
             a0_ = _e252;
             let _e253 = delta0_;
             let _e254 = theta_3;
-            let _e255 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_2, _e253, _e254, s_5, false);
+            let _e255 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e253, _e254, s_5, false);
             e0_ = select(_e255, s_5, is_last0_);
             let _e257 = delta1_;
             let _e258 = theta_3;
-            let _e259 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e257, _e258, s_5, false);
+            let _e259 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e257, _e258, s_5, false);
             a1_ = _e259;
             let _e260 = delta1_;
             let _e261 = theta_3;
-            let _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_2, _e260, _e261, s_5, false);
+            let _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e260, _e261, s_5, false);
             e1_ = select(_e262, s_5, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
                 let _e268 = a0_;
                 let _e269 = e0_;
-                let _e270 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, _e10, _e268, _e269, panels_2);
+                let _e270 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e268, _e269, panels_2);
                 weight0_ = _e270;
                 let _e271 = a1_;
                 let _e272 = e1_;
-                let _e273 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_7, _e10, _e271, _e272, panels_2);
+                let _e273 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e271, _e272, panels_2);
                 weight1_ = _e273;
             } else {
                 let _e276 = a0_;
                 let _e277 = e0_;
-                let _e278 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e276, _e277);
+                let _e278 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e276, _e277);
                 weight0_ = (sun_scatter * _e278);
                 let _e282 = a1_;
                 let _e283 = e1_;
-                let _e284 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e282, _e283);
+                let _e284 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e282, _e283);
                 weight1_ = (sun_scatter * _e284);
             }
             let xb0_ = (pos0_ - 0.5f);

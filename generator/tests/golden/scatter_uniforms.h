@@ -16,6 +16,61 @@
 #define SCATTER_STATIC_ASSERT(cond, msg) _Static_assert(cond, msg)
 #endif
 
+/* WGSL `Frame` of family hybrid_volume (scatter::epipolar), 400 bytes, alignment 16. */
+typedef struct ScatterHybridVolumeFrame {
+    float eye[4]; /* vec4<f32>, offset 0 */
+    float axis[4]; /* vec4<f32>, offset 16 */
+    float e1_[4]; /* vec4<f32>, offset 32 */
+    float e2_[4]; /* vec4<f32>, offset 48 */
+    float cam_forward[4]; /* vec4<f32>, offset 64 */
+    float cam_right[4]; /* vec4<f32>, offset 80 */
+    float cam_up[4]; /* vec4<f32>, offset 96 */
+    float theta[4]; /* vec4<f32>, offset 112 */
+    float medium[4]; /* vec4<f32>, offset 128 */
+    float light_color[4]; /* vec4<f32>, offset 144 */
+    float light_pos[4]; /* vec4<f32>, offset 160 */
+    float light_dir[4]; /* vec4<f32>, offset 176 */
+    float sm_right[4]; /* vec4<f32>, offset 192 */
+    float sm_up[4]; /* vec4<f32>, offset 208 */
+    float sm_forward[4]; /* vec4<f32>, offset 224 */
+    float sm_origin[4]; /* vec4<f32>, offset 240 */
+    float sm_proj[4]; /* vec4<f32>, offset 256 */
+    float epipole[4]; /* vec4<f32>, offset 272 */
+    float anti_epipole[4]; /* vec4<f32>, offset 288 */
+    uint32_t sizes[4]; /* vec4<u32>, offset 304 */
+    uint32_t sizes2_[4]; /* vec4<u32>, offset 320 */
+    float proj[4]; /* vec4<f32>, offset 336 */
+    float proj_g0_[4]; /* vec4<f32>, offset 352 */
+    float proj_g1_[4]; /* vec4<f32>, offset 368 */
+    float proj_g2_[4]; /* vec4<f32>, offset 384 */
+} ScatterHybridVolumeFrame;
+SCATTER_STATIC_ASSERT(sizeof(ScatterHybridVolumeFrame) == 400, "ScatterHybridVolumeFrame size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, eye) == 0, "ScatterHybridVolumeFrame.eye offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, axis) == 16, "ScatterHybridVolumeFrame.axis offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, e1_) == 32, "ScatterHybridVolumeFrame.e1_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, e2_) == 48, "ScatterHybridVolumeFrame.e2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, cam_forward) == 64, "ScatterHybridVolumeFrame.cam_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, cam_right) == 80, "ScatterHybridVolumeFrame.cam_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, cam_up) == 96, "ScatterHybridVolumeFrame.cam_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, theta) == 112, "ScatterHybridVolumeFrame.theta offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, medium) == 128, "ScatterHybridVolumeFrame.medium offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, light_color) == 144, "ScatterHybridVolumeFrame.light_color offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, light_pos) == 160, "ScatterHybridVolumeFrame.light_pos offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, light_dir) == 176, "ScatterHybridVolumeFrame.light_dir offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, sm_right) == 192, "ScatterHybridVolumeFrame.sm_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, sm_up) == 208, "ScatterHybridVolumeFrame.sm_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, sm_forward) == 224, "ScatterHybridVolumeFrame.sm_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, sm_origin) == 240, "ScatterHybridVolumeFrame.sm_origin offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, sm_proj) == 256, "ScatterHybridVolumeFrame.sm_proj offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, epipole) == 272, "ScatterHybridVolumeFrame.epipole offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, anti_epipole) == 288, "ScatterHybridVolumeFrame.anti_epipole offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, sizes) == 304, "ScatterHybridVolumeFrame.sizes offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, sizes2_) == 320, "ScatterHybridVolumeFrame.sizes2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, proj) == 336, "ScatterHybridVolumeFrame.proj offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, proj_g0_) == 352, "ScatterHybridVolumeFrame.proj_g0_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, proj_g1_) == 368, "ScatterHybridVolumeFrame.proj_g1_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, proj_g2_) == 384, "ScatterHybridVolumeFrame.proj_g2_ offset");
+
 /* WGSL `Frame` of family minmax (scatter::epipolar), 400 bytes, alignment 16. */
 typedef struct ScatterMinmaxFrame {
     float eye[4]; /* vec4<f32>, offset 0 */

@@ -5,6 +5,95 @@
 // explicit padding members keep them in `#[repr(C)]`. Use it with `include!` or as a
 // module file; it needs no dependencies.
 
+/// Uniform structs of the `hybrid_volume` kernels.
+#[allow(dead_code, reason = "generated")]
+pub mod hybrid_volume {
+    /// WGSL `Frame` (scatter::epipolar), 400 bytes, alignment 16.
+    #[repr(C)]
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Frame {
+        /// `vec4<f32>` at byte 0.
+        pub eye: [f32; 4],
+        /// `vec4<f32>` at byte 16.
+        pub axis: [f32; 4],
+        /// `vec4<f32>` at byte 32.
+        pub e1_: [f32; 4],
+        /// `vec4<f32>` at byte 48.
+        pub e2_: [f32; 4],
+        /// `vec4<f32>` at byte 64.
+        pub cam_forward: [f32; 4],
+        /// `vec4<f32>` at byte 80.
+        pub cam_right: [f32; 4],
+        /// `vec4<f32>` at byte 96.
+        pub cam_up: [f32; 4],
+        /// `vec4<f32>` at byte 112.
+        pub theta: [f32; 4],
+        /// `vec4<f32>` at byte 128.
+        pub medium: [f32; 4],
+        /// `vec4<f32>` at byte 144.
+        pub light_color: [f32; 4],
+        /// `vec4<f32>` at byte 160.
+        pub light_pos: [f32; 4],
+        /// `vec4<f32>` at byte 176.
+        pub light_dir: [f32; 4],
+        /// `vec4<f32>` at byte 192.
+        pub sm_right: [f32; 4],
+        /// `vec4<f32>` at byte 208.
+        pub sm_up: [f32; 4],
+        /// `vec4<f32>` at byte 224.
+        pub sm_forward: [f32; 4],
+        /// `vec4<f32>` at byte 240.
+        pub sm_origin: [f32; 4],
+        /// `vec4<f32>` at byte 256.
+        pub sm_proj: [f32; 4],
+        /// `vec4<f32>` at byte 272.
+        pub epipole: [f32; 4],
+        /// `vec4<f32>` at byte 288.
+        pub anti_epipole: [f32; 4],
+        /// `vec4<u32>` at byte 304.
+        pub sizes: [u32; 4],
+        /// `vec4<u32>` at byte 320.
+        pub sizes2_: [u32; 4],
+        /// `vec4<f32>` at byte 336.
+        pub proj: [f32; 4],
+        /// `vec4<f32>` at byte 352.
+        pub proj_g0_: [f32; 4],
+        /// `vec4<f32>` at byte 368.
+        pub proj_g1_: [f32; 4],
+        /// `vec4<f32>` at byte 384.
+        pub proj_g2_: [f32; 4],
+    }
+
+    const _: () = {
+        assert!(::core::mem::size_of::<Frame>() == 400);
+        assert!(::core::mem::offset_of!(Frame, eye) == 0);
+        assert!(::core::mem::offset_of!(Frame, axis) == 16);
+        assert!(::core::mem::offset_of!(Frame, e1_) == 32);
+        assert!(::core::mem::offset_of!(Frame, e2_) == 48);
+        assert!(::core::mem::offset_of!(Frame, cam_forward) == 64);
+        assert!(::core::mem::offset_of!(Frame, cam_right) == 80);
+        assert!(::core::mem::offset_of!(Frame, cam_up) == 96);
+        assert!(::core::mem::offset_of!(Frame, theta) == 112);
+        assert!(::core::mem::offset_of!(Frame, medium) == 128);
+        assert!(::core::mem::offset_of!(Frame, light_color) == 144);
+        assert!(::core::mem::offset_of!(Frame, light_pos) == 160);
+        assert!(::core::mem::offset_of!(Frame, light_dir) == 176);
+        assert!(::core::mem::offset_of!(Frame, sm_right) == 192);
+        assert!(::core::mem::offset_of!(Frame, sm_up) == 208);
+        assert!(::core::mem::offset_of!(Frame, sm_forward) == 224);
+        assert!(::core::mem::offset_of!(Frame, sm_origin) == 240);
+        assert!(::core::mem::offset_of!(Frame, sm_proj) == 256);
+        assert!(::core::mem::offset_of!(Frame, epipole) == 272);
+        assert!(::core::mem::offset_of!(Frame, anti_epipole) == 288);
+        assert!(::core::mem::offset_of!(Frame, sizes) == 304);
+        assert!(::core::mem::offset_of!(Frame, sizes2_) == 320);
+        assert!(::core::mem::offset_of!(Frame, proj) == 336);
+        assert!(::core::mem::offset_of!(Frame, proj_g0_) == 352);
+        assert!(::core::mem::offset_of!(Frame, proj_g1_) == 368);
+        assert!(::core::mem::offset_of!(Frame, proj_g2_) == 384);
+    };
+}
+
 /// Uniform structs of the `minmax` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod minmax {

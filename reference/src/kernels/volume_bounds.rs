@@ -1,7 +1,8 @@
 //! CPU mirror of `shaderlib/templates/volume_bounds.wgsl`: every rectified row's shadow-volume
 //! walls rasterised into depth bins, each bin keeping its first and last column edge
 //! (conventions: `scatter_frame::hybrid_volume`). The kernel's 64 invocations of a row combine
-//! with `atomicMin` / `atomicMax`, which do not depend on order: here one loop over the edges.
+//! with `atomicMax` in zero-initialised workgroup memory (the first edge as `NO_EDGE - c`),
+//! which does not depend on order: here one loop over the edges, min and max.
 
 use super::texture::Tex;
 use scatter_shaderlib::hybrid_volume::NO_EDGE;

@@ -20,14 +20,14 @@ fn crossings_buffer(v: &HybridVolumeVariant) -> Resource {
     Resource {
         kind: "storage_buffer",
         buffer: Some(BufferDesc {
-            elements: Some(format!("{} * rectified.height", v.bins)),
+            elements: Some(format!("{} * rectified.height", 2 * v.bins)),
             usage: vec!["storage", "copy_src"],
         }),
         ..scatter_resource(
             "crossings",
-            "per rectified row and ray-depth bin (index row * bins + bin), the first and last \
-             column edge where the shadow volume's boundary crosses a ray of that depth \
-             (vec2<u32>; first = 0xffffffff: none); written by volume_bounds, read by \
+            "per rectified row and ray-depth bin (u32 pair at 2 (row * bins + bin)), the \
+             first and last column edge where the shadow volume's boundary crosses a ray of \
+             that depth (first = 0xffffffff: none); written by volume_bounds, read by \
              volume_march",
         )
     }
