@@ -28,6 +28,7 @@ use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::prefiltered::{FrameInput, Inputs};
 use scatter_runtime::shaderlib::Kernel;
 use scatter_runtime::shaderlib::family::{Family, FamilyVariant, KernelFamily};
+use scatter_runtime::shaderlib::hybrid_volume::HybridVolumeVariant;
 use scatter_runtime::shaderlib::minmax::MinmaxVariant;
 use scatter_runtime::shaderlib::partial_sum_tree::PartialSumTreeVariant;
 use scatter_runtime::shaderlib::prefiltered::{
@@ -200,6 +201,13 @@ impl BenchConfig {
         }
         methods.push(Method::minmax_default());
         methods.push(Method::partial_sum_tree_default());
+        // Issue 16: hybrid shadow volumes, the samples in each pixel's interval.
+        for samples in [16, 32, 64] {
+            methods.push(Method::from(HybridVolumeVariant {
+                samples,
+                ..HybridVolumeVariant::default()
+            }));
+        }
         BenchConfig {
             cases: SceneName::ALL
                 .iter()
@@ -954,6 +962,36 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             }
         }
     }
+    // Issue 16: hybrid shadow volumes against brute-force marching at equal or better error
+    // (Wyman & Ramsey report 2.4-7.1x over marching the whole ray).
+    for knobs in ["n16", "n32", "n64"] {
+        let Some(h) = variants
+            .iter()
+            .find(|v| v.0 == "hybrid_volume" && v.1 == knobs)
+        else {
+            continue;
+        };
+        let matching = variants
+            .iter()
+            .filter(|v| v.0 == "raymarch" && v.3 <= h.3)
+            .min_by(|a, b| a.2.total_cmp(&b.2));
+        out.push(match matching {
+            Some(r) => format!(
+                "hybrid_volume {knobs} ({:.2} ms, mean rel L1 {:.2} %) vs the cheapest raymarch at equal or better error, {} ({:.2} ms, {:.2} %): raymarch takes {:.2}x the time",
+                h.2,
+                100.0 * h.3,
+                r.1,
+                r.2,
+                100.0 * r.3,
+                r.2 / h.2
+            ),
+            None => format!(
+                "hybrid_volume {knobs} ({:.2} ms, mean rel L1 {:.2} %): no raymarch variant in the sweep reaches its error",
+                h.2,
+                100.0 * h.3
+            ),
+        });
+    }
     // The same comparison at the headline configuration (times; the tag takes the errors
     // from the sweep above).
     let matching = reference.and_then(|p| {
@@ -1562,6 +1600,24 @@ pub fn tune_candidates() -> Vec<Method> {
     out.push(Method::new(
         PartialSumTreeVariant::default(),
         Some([512, 512]),
+    ));
+    // Issue 16: hybrid shadow volumes: the samples in the interval, the bins, and the
+    // rectified map the volume is built from.
+    for samples in [8, 16, 32, 64, 128] {
+        out.push(Method::from(HybridVolumeVariant {
+            samples,
+            ..HybridVolumeVariant::default()
+        }));
+    }
+    for bins in [64, 1024] {
+        out.push(Method::from(HybridVolumeVariant {
+            bins,
+            ..HybridVolumeVariant::default()
+        }));
+    }
+    out.push(Method::new(
+        HybridVolumeVariant::default(),
+        Some([256, 256]),
     ));
     out
 }

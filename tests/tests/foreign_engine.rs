@@ -16,8 +16,9 @@
 //!
 //! - every other family (`foreign_engine_matches_runtime_for_every_family`): raymarch
 //!   default (directional) and interleaved + jittered spot (the engine allocates `partial`
-//!   from the manifest), both minmax variants, against `run_raymarch_once` /
-//!   `run_minmax_once`; and `run_dir` on a raymarch and a minmax directory.
+//!   from the manifest), both minmax variants and two hybrid_volume variants, against
+//!   `run_raymarch_once` / `run_minmax_once` / `run_hybrid_volume_once`; and `run_dir` on a
+//!   raymarch, a minmax and a hybrid_volume directory.
 //!
 //! Each runs the SPIR-V files (naga's SPIR-V front-end inside wgpu) and the WGSL files.
 //! The projective trial also goes through the binary's file path (`frame.json` and PFM
@@ -35,6 +36,7 @@ use scatter_foreign_engine::files::{FrameFile, RunArgs, run_dir, write_inputs};
 use scatter_foreign_engine::prefiltered::{Inputs, Sizes, run_frame};
 use scatter_foreign_engine::{Engine, EngineError, Manifest, Target};
 use scatter_frame::frame::{PrefilteredFrame, prepare_frame};
+use scatter_frame::hybrid_volume::{HybridVolumeVariant, prepare_hybrid_volume};
 use scatter_frame::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_frame::partial_sum_tree::{PartialSumTreeVariant, prepare_partial_sum_tree};
 use scatter_frame::raymarch::{RaymarchVariant, prepare_raymarch};
@@ -42,8 +44,8 @@ use scatter_gen::{FamilyVariant, Request, generate, output};
 use scatter_reference::kernels::engine_rectified_map;
 use scatter_reference::suite::Pose;
 use scatter_runtime::{
-    Context, CpuInputs, FrameInput, RaymarchInput, run_minmax_once, run_partial_sum_tree_once,
-    run_prefiltered_once, run_raymarch_once,
+    Context, CpuInputs, FrameInput, RaymarchInput, run_hybrid_volume_once, run_minmax_once,
+    run_partial_sum_tree_once, run_prefiltered_once, run_raymarch_once,
 };
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, PrefilteredVariant, Rectification, Resolutions, Storage,
@@ -301,6 +303,21 @@ fn foreign_engine_matches_runtime() {
     );
 }
 
+/// The hybrid_volume trial variants: the directional default and the spot light with 8
+/// samples, 64 bins and no padding.
+fn hybrid_variants() -> [HybridVolumeVariant; 2] {
+    [
+        HybridVolumeVariant::default(),
+        HybridVolumeVariant {
+            light: LightKind::Spot,
+            samples: 8,
+            bins: 64,
+            pad: 0,
+            ..HybridVolumeVariant::default()
+        },
+    ]
+}
+
 /// A directory scatter-gen wrote for the other families' trial variants, SPIR-V and WGSL.
 fn other_families_dir() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
@@ -310,6 +327,11 @@ fn other_families_dir() -> &'static Path {
             .map(FamilyVariant::Raymarch)
             .into_iter()
             .chain(MinmaxVariant::grid().into_iter().map(FamilyVariant::Minmax))
+            .chain(
+                hybrid_variants()
+                    .into_iter()
+                    .map(FamilyVariant::HybridVolume),
+            )
             .chain(
                 pst_variants()
                     .into_iter()
@@ -398,8 +420,9 @@ fn compare_targets(
 }
 
 /// Every other family runs from its manifest alone too: raymarch (plain and interleaved,
-/// the second with the `partial` texture the engine allocates from the manifest) and both
-/// minmax variants, against the runtime, SPIR-V and WGSL.
+/// the second with the `partial` texture the engine allocates from the manifest), both
+/// minmax variants and two hybrid_volume variants (the `crossings` buffer the engine
+/// allocates from the manifest's formula), against the runtime, SPIR-V and WGSL.
 #[test]
 fn foreign_engine_matches_runtime_for_every_family() {
     let Some(ctx) = gpu() else { return };
@@ -529,6 +552,65 @@ fn foreign_engine_matches_runtime_for_every_family() {
             },
         ));
     }
+    for v in hybrid_variants() {
+        let fixture = fixture(v.light);
+        let name = format!(
+            "foreign::hybrid_volume::{}::{}::{}",
+            v.id(),
+            fixture.name,
+            fixture.pose
+        );
+        let f = fixture.input();
+        let res = Resolutions {
+            screen: fixture.sizes().screen,
+            rectified: RECTIFIED,
+        };
+        let runtime = run_hybrid_volume_once(
+            ctx,
+            &v,
+            res,
+            &f,
+            &fixture.gbuf.view_depth,
+            &fixture.shadow_map.depth,
+        )
+        .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
+        let frame = prepare_hybrid_volume(
+            &v,
+            &res,
+            &f.camera,
+            &f.light,
+            &f.medium,
+            &f.shadow_map,
+            &f.settings,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(
+            runtime.frame, frame,
+            "{name}: the runtime set up another frame"
+        );
+        lines.extend(compare_targets(
+            &name,
+            &runtime.output,
+            &[
+                "depth_columns",
+                "slice_fit",
+                "rectify",
+                "volume_bounds",
+                "volume_march",
+            ],
+            |target| {
+                let params = scatter_foreign_engine::hybrid_volume::params(&fixture.sizes());
+                let mut engine =
+                    Engine::load(ctx.device(), ctx.queue(), dir, &v.id(), target, &params)?;
+                scatter_foreign_engine::hybrid_volume::run_frame(
+                    &mut engine,
+                    &frame,
+                    &fixture.gbuf.view_depth,
+                    &fixture.shadow_map.depth,
+                )
+            },
+        ));
+    }
     for v in pst_variants() {
         let fixture = fixture(v.light);
         let name = format!(
@@ -592,7 +674,10 @@ fn foreign_engine_matches_runtime_for_every_family() {
     }
     assert_eq!(
         lines.len(),
-        2 * (raymarch_variants().len() + MinmaxVariant::grid().len() + pst_variants().len())
+        2 * (raymarch_variants().len()
+            + MinmaxVariant::grid().len()
+            + hybrid_variants().len()
+            + pst_variants().len())
     );
 }
 
@@ -604,11 +689,13 @@ fn foreign_engine_files_run_every_family() {
     for (id, family) in [
         (raymarch_variants()[1].id(), "raymarch"),
         (MinmaxVariant::grid()[0].id(), "minmax"),
+        (hybrid_variants()[1].id(), "hybrid_volume"),
         (pst_variants()[1].id(), "partial_sum_tree"),
     ] {
         let light = match family {
             "raymarch" => raymarch_variants()[1].light,
             "minmax" => MinmaxVariant::grid()[0].light,
+            "hybrid_volume" => hybrid_variants()[1].light,
             _ => pst_variants()[1].light,
         };
         let fixture = fixture(light);

@@ -32,13 +32,13 @@ use scatter_reference::kernels::common_epipolar::{
 };
 use scatter_reference::kernels::common_model::{phase_hg, transmittance_between};
 use scatter_reference::kernels::run_hybrid_volume;
-use scatter_reference::kernels::texture::{Tex, xyz};
+use scatter_reference::kernels::texture::{Tex, quantise, xyz};
 use scatter_reference::kernels::volume_bounds::depth_bin;
 use scatter_reference::kernels::volume_march::MarchInputs;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_shaderlib::hybrid_volume::{HybridVolumeVariant, NO_EDGE};
-use scatter_shaderlib::prefiltered::{FrameSettings, FrameUniforms, LightKind};
+use scatter_shaderlib::prefiltered::{FrameSettings, FrameUniforms, LightKind, Storage};
 
 const SCREEN: (u32, u32) = (96, 54);
 const RECTIFIED: [u32; 2] = [1024, 512];
@@ -109,7 +109,8 @@ fn bins_cover_every_crossing(inp: &MarchInputs, spot: bool) -> u32 {
     broken
 }
 
-/// Every pixel ray-marched whole with `n` samples (`span_march` over `[0, s]`).
+/// Every pixel ray-marched whole with `n` samples (`span_march` over `[0, s]`), rounded to
+/// rgba16float as the family's output is.
 fn raymarch(f: &FrameUniforms, depth: &Tex, sm: &Tex, n: u32, spot: bool) -> Vec<[f32; 3]> {
     let eye = xyz(f.eye);
     let color = xyz(f.light_color);
@@ -123,8 +124,10 @@ fn raymarch(f: &FrameUniforms, depth: &Tex, sm: &Tex, n: u32, spot: bool) -> Vec
             if !spot {
                 l *= f.medium[1] * phase_hg(f.medium[2], -xyz(f.light_dir).dot(dir));
             }
-            let c = color * l;
-            out.push([c.x, c.y, c.z]);
+            let c = (color * l)
+                .to_array()
+                .map(|v| quantise(v, Storage::Rgba16float));
+            out.push(c);
         }
     }
     out

@@ -92,6 +92,8 @@ const BARS: &[Bar] = &[
     ("prefiltered-m32-r3-ep64x64", 0.03, 0.07, NEAR_BLACK),
     ("raymarch-n64-i1-ep64x64", 0.03, 0.07, NEAR_BLACK),
     ("partial_sum_tree-r4-ep128x128-s1", 0.03, 0.07, NEAR_BLACK),
+    ("hybrid_volume-n32", 0.03, 0.07, NEAR_BLACK),
+    ("hybrid_volume-n32-ep64x64", 0.03, 0.07, NEAR_BLACK),
 ];
 
 /// The most a sampled variant's p90 may exceed its per-pixel variant's (issue 14's bar for
