@@ -6,6 +6,7 @@
 //! cargo run --release -p scatter-examples --example bench -- --quick --out-dir out/bench
 //! cargo run --release -p scatter-examples --example bench -- --headline-only
 //! cargo run --release -p scatter-examples --example bench -- --roofline
+//! cargo run --release -p scatter-examples --example bench -- --family raymarch --family hybrid_volume
 //! ```
 
 use std::path::PathBuf;
@@ -14,6 +15,7 @@ use std::process::ExitCode;
 use clap::Parser;
 use scatter_examples::bench::{BenchConfig, run, write_outputs};
 use scatter_runtime::Context;
+use scatter_runtime::shaderlib::family::Family;
 
 /// Speed against accuracy of every scatter family on the scene suite.
 #[derive(Debug, Parser)]
@@ -42,6 +44,18 @@ struct Args {
     /// no files written.
     #[arg(long, conflicts_with_all = ["quick", "no_scaling", "headline_only"])]
     roofline: bool,
+    /// Only this family's methods, in the sweep and the headline runs (repeatable; e.g.
+    /// `--family raymarch --family hybrid_volume` for one family against brute force).
+    #[arg(long = "family", value_name = "FAMILY", value_parser = parse_family)]
+    families: Vec<Family>,
+}
+
+/// A family name, or an error listing the known ones.
+fn parse_family(s: &str) -> Result<Family, String> {
+    s.parse::<Family>().map_err(|_| {
+        let names: Vec<&str> = Family::ALL.iter().map(|f| f.name()).collect();
+        format!("unknown family `{s}` (known: {})", names.join(", "))
+    })
 }
 
 fn main() -> ExitCode {
@@ -57,6 +71,7 @@ fn main() -> ExitCode {
     if args.no_scaling {
         config.scaling = false;
     }
+    config.only_families(&args.families);
     if args.headline_only {
         config.cases.clear();
         config.scaling = false;

@@ -162,6 +162,9 @@ pub struct BenchConfig {
     /// truth at 1280x720 (the truth costs about a minute per scene on two cores; off for
     /// `bench --headline-only`, which times a kernel change).
     pub headline_error: bool,
+    /// Only these families' methods, in the sweep and the headline runs (empty: every
+    /// family); `bench --family raymarch --family hybrid_volume`.
+    pub families: Vec<Family>,
 }
 
 impl BenchConfig {
@@ -222,6 +225,7 @@ impl BenchConfig {
             scaling: true,
             headline: true,
             headline_error: true,
+            families: Vec::new(),
         }
     }
 
@@ -255,6 +259,17 @@ impl BenchConfig {
             scaling: false,
             headline: false,
             headline_error: false,
+            families: Vec::new(),
+        }
+    }
+
+    /// Keeps only `families`' methods (in the sweep now, in the headline runs when they
+    /// run); an empty list keeps every family.
+    pub fn only_families(&mut self, families: &[Family]) {
+        self.families = families.to_vec();
+        if !families.is_empty() {
+            self.methods
+                .retain(|m| families.contains(&m.variant.family()));
         }
     }
 }
@@ -495,7 +510,7 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
     };
     let headline = if config.headline {
         bar.set_message("headline 1280x720");
-        headline_runs(ctx, config.frames, config.headline_error)?
+        headline_runs(ctx, config.frames, config.headline_error, &config.families)?
     } else {
         Vec::new()
     };
@@ -748,10 +763,16 @@ fn sampled_variants() -> Vec<(FamilyVariant, FamilyVariant)> {
 
 /// The headline configuration: 1280x720, 1024x1024 rectified, on sphere, foliage and
 /// terrain; with `errors`, each run's rel L1 against the `shadow_map` truth at that size.
-fn headline_runs(ctx: &Context, frames: u32, errors: bool) -> Result<Vec<HeadlineRow>, BoxError> {
+fn headline_runs(
+    ctx: &Context,
+    frames: u32,
+    errors: bool,
+    families: &[Family],
+) -> Result<Vec<HeadlineRow>, BoxError> {
     let mut methods = vec![
         Method::prefiltered_default(),
         Method::minmax_default(),
+        Method::from(HybridVolumeVariant::default()),
         Method::partial_sum_tree_default(),
         Method::new(Family::PartialSumTree.default_variant(), Some([512, 512])),
     ];
@@ -784,6 +805,9 @@ fn headline_runs(ctx: &Context, frames: u32, errors: bool) -> Result<Vec<Headlin
                 .with_sampling(SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES)),
             Some([512, 512]),
         ));
+    }
+    if !families.is_empty() {
+        methods.retain(|m| families.contains(&m.variant.family()));
     }
     let screen = [1280, 720];
     let mut out = Vec::new();

@@ -452,6 +452,27 @@ pub fn cases(width: u32, height: u32) -> Vec<StressCase> {
         s,
         Premise::EyeShadowed,
     ));
+    // Under the central tree of `foliage` (crown 5.4-6.9 m up, 2.0-2.6 m wide), the sun 60
+    // degrees up: every view ray starts in the crown's shadow and crosses the leaves' shadows
+    // of the trees around many times, so a shadow volume's first and last crossings span
+    // most of each ray (Wyman & Ramsey's degenerate case: the interval is the whole ray).
+    let mut s = suite::scene(
+        SceneName::Foliage,
+        Pose::Ordinary,
+        MediumPreset::Default,
+        width,
+        height,
+    );
+    look(&mut s, v(0.8, 1.7, 0.8), v(0.3, 0.15, 1.0));
+    let (sn, cs) = 60f64.to_radians().sin_cos();
+    sun(&mut s, -v(0.5 * cs, sn, -0.85 * cs));
+    out.push(case(
+        "foliage_under_canopy",
+        P,
+        "under a tree's crown among trees: the eye in the leaves' shadow, many shadow crossings per ray",
+        s,
+        Premise::None,
+    ));
     // Spot light cases on spot_grate.
     let spot = |pose| {
         suite::scene(

@@ -26,7 +26,8 @@
 //! `sampling = lowres` at scale 4, whose samples stand on fixed pixels, so that what moves
 //! is the scene under them, and `sampling = epipolar` (64 x 64, step 8), whose samples move
 //! with the epipole. The partial-sum-tree family (issue 15; epipolar samples only, 64 x 64,
-//! every sample answered) is reported and NaN-checked too.
+//! every sample answered) is reported and NaN-checked too, and so is the hybrid_volume
+//! default (issue 16).
 //!
 //! 64x36 pixels, 256x256 rectified map, 512^2 shadow map, truth with 512 cells per ray:
 //! small enough for CI (75 s here in the test profile with a warm Mesa cache).
@@ -47,6 +48,7 @@ use scatter_runtime::shaderlib::Kernel;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::{Context, FamilyPasses, FrameInput};
 use scatter_shaderlib::family::FamilyVariant;
+use scatter_shaderlib::hybrid_volume::HybridVolumeVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::partial_sum_tree::PartialSumTreeVariant;
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, PrefilteredVariant, Resolutions};
@@ -151,6 +153,12 @@ fn variants(light: LightKind) -> Vec<FamilyVariant> {
             ..epipolar_knobs()
         }),
     ));
+    // Issue 16: hybrid shadow volumes at their defaults (reported, NaN checked): the
+    // interval follows the rectified map, which moves with the camera and the light.
+    v.push(FamilyVariant::HybridVolume(HybridVolumeVariant {
+        light,
+        ..HybridVolumeVariant::default()
+    }));
     v
 }
 

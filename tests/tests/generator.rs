@@ -386,3 +386,81 @@ fn minmax_manifest_matches_the_runtime() {
         }
     }
 }
+
+/// The hybrid_volume family's manifest against the runtime: formats, the `Frame` block's
+/// size, the `crossings` buffer's size formula (two u32 per rectified row and bin) and the
+/// dispatch of the five passes at odd sizes (`volume_bounds`: one workgroup per row).
+#[test]
+fn hybrid_volume_manifest_matches_the_runtime() {
+    use scatter_shaderlib::hybrid_volume::HybridVolumeVariant;
+    use scatter_shaderlib::prefiltered::FrameUniforms;
+    let v = HybridVolumeVariant {
+        light: LightKind::Spot,
+        bins: 100,
+        ..HybridVolumeVariant::default()
+    };
+    let g = generate(&Request {
+        variants: vec![FamilyVariant::HybridVolume(v)],
+        targets: vec![Target::Wgsl],
+    })
+    .unwrap_or_else(|e| panic!("{v}: {e}"));
+    let m: Value = serde_json::from_slice(&g.manifest).unwrap_or_else(|e| panic!("{e}"));
+    let variant = &get(&m, "variants")[0];
+    let tex = |name: &str| get(resource(variant, name), "texture").clone();
+    assert_eq!(str_of(&tex("output"), "format"), wgpu_name(OUTPUT_FORMAT));
+    for name in ["depth", "shadow_map", "rectified"] {
+        assert_eq!(str_of(&tex(name), "format"), wgpu_name(DEPTH_FORMAT));
+    }
+    assert_eq!(
+        str_of(get(resource(variant, "frame"), "buffer"), "size_bytes"),
+        size_of::<FrameUniforms>().to_string()
+    );
+    let (w, h, wr, hr) = (333u32, 187u32, 300u32, 97u32);
+    let sizes = [
+        ("screen.width", w),
+        ("screen.height", h),
+        ("shadow.size", 512),
+        ("rectified.width", wr),
+        ("rectified.height", hr),
+    ];
+    let crossings = get(resource(variant, "crossings"), "buffer");
+    assert_eq!(
+        eval(str_of(crossings, "elements"), &sizes),
+        2 * v.bins * hr,
+        "crossings elements"
+    );
+    assert_eq!(
+        eval(str_of(crossings, "size_bytes"), &sizes),
+        8 * v.bins * hr,
+        "crossings bytes"
+    );
+    let passes = get(variant, "passes")
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    let params = KernelParams::hybrid_volume(v);
+    assert_eq!(passes.len(), params.len());
+    for ((pass, p), grid) in passes.iter().zip(params).zip([
+        [w, 1, 1],
+        [256, 1, 1],
+        [wr.div_ceil(RECTIFY_TEXELS), hr, 1],
+        [64, hr, 1],
+        [w, h, 1],
+    ]) {
+        let built = build(&p).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(str_of(pass, "kernel"), built.kernel.name());
+        let dispatch = get(pass, "dispatch")
+            .as_array()
+            .cloned()
+            .unwrap_or_default();
+        for (i, n) in grid.into_iter().enumerate() {
+            let got = eval(str_of(&dispatch[i], "workgroups"), &sizes);
+            assert_eq!(
+                got,
+                n.div_ceil(built.workgroup_size[i]),
+                "{} dim {i}",
+                built.kernel
+            );
+        }
+    }
+}

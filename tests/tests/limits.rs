@@ -7,7 +7,8 @@
 //! adapter with lowered limits (`Context::from_device`), which reaches the limits a
 //! software adapter is too generous to reach otherwise: `max_texture_array_layers` (the
 //! filtered bases), `max_storage_buffer_binding_size` and `max_buffer_size` (the slice
-//! table, a readback buffer, the partial-sum-tree sweep's leaves),
+//! table, a readback buffer, the partial-sum-tree sweep's leaves, the hybrid_volume
+//! crossings),
 //! `max_compute_workgroup_storage_size` (the sweep's per-sample arrays),
 //! `max_uniform_buffer_binding_size` (the uniform blocks),
 //! `max_compute_workgroups_per_dimension` (the scatter, raymarch and minmax dispatches).
@@ -15,8 +16,11 @@
 
 use scatter_conformance::gpu;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
-use scatter_runtime::{Context, Minmax, PartialSumTree, Prefiltered, Raymarch, RuntimeError, wgpu};
+use scatter_runtime::{
+    Context, HybridVolume, Minmax, PartialSumTree, Prefiltered, Raymarch, RuntimeError, wgpu,
+};
 use scatter_shaderlib::Kernel;
+use scatter_shaderlib::hybrid_volume::HybridVolumeVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
 use scatter_shaderlib::partial_sum_tree::PartialSumTreeVariant;
 use scatter_shaderlib::prefiltered::{PrefilteredVariant, Resolutions};
@@ -184,6 +188,16 @@ fn zero_sizes_are_refused_with_the_input_named() {
         "rectified 0x8",
     );
     assert_empty(
+        "hybrid_volume_rectified",
+        HybridVolume::new(
+            ctx,
+            &HybridVolumeVariant::default(),
+            res([8, 8], [0, 8]),
+            64,
+        ),
+        "rectified 0x8",
+    );
+    assert_empty(
         "upload_r32float",
         upload_r32float(ctx, Kernel::Rectify, "depth", [0, 4], &[]),
         "depth 0x4",
@@ -256,6 +270,19 @@ fn lowered_device_limits_are_named() {
         ),
         "max_storage_buffer_binding_size",
         512 * 64 * 16,
+        1024,
+    );
+    // The crossings: 256 bins x 16 rows x 8 bytes.
+    assert_limit(
+        "hybrid_volume_crossings",
+        HybridVolume::new(
+            ctx,
+            &HybridVolumeVariant::default(),
+            res([64, 36], [64, 16]),
+            64,
+        ),
+        "max_storage_buffer_binding_size",
+        256 * 16 * 8,
         1024,
     );
     // 256 pixels wide in 8x8 workgroups: 32 workgroups along x.
