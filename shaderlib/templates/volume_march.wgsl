@@ -2,7 +2,7 @@
 // [t_f, t_b] of the view ray that can hold a shadow boundary ray-marched against the
 // standard shadow map (Wyman & Ramsey 2008, Sec. 4-5): {{ samples }} samples there; the head
 // [0, t_f] and the tail [t_b, s] have one visibility each and add the unshadowed
-// in-scattering in closed form (`lit_span`). The interval comes from `volume_bounds`: the
+// in-scattering in closed form (`closed_form`). The interval comes from `volume_bounds`: the
 // two rectified rows whose slices bracket the ray each give their first and last boundary
 // crossing for the ray's depth inside its texels 0 .. n, padded by {{ pad }} texel(s); the
 // pixel's interval is their union, and a head or tail the two rows disagree on is marched
@@ -26,8 +26,8 @@
 //
 // Mirrors reference/src/kernels/volume_march.rs
 
-#import scatter::model::{phase_hg}
-#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index, slice_params, span_march}
+#import scatter::model::{phase_hg, transmittance_between}
+#import scatter::epipolar::{Frame, edge_t, epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index, slice_params, span_march, spot_segment}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
 {%- endif %}
@@ -89,6 +89,17 @@ fn row_span(row: u32, col: f32, d: f32, bin: u32, theta: f32, s: f32, spot: bool
     );
 }
 
+// Unshadowed in-scattering over [a, b] (the head or the tail), without sigma_s p E for the
+// sun: the sun's closed form; for a spot, Gauss-Legendre panels no coarser than the march,
+// SAMPLES / 4 panels of 4 nodes (at least the frame's spot quadrature), so that the head and
+// tail do not cap the accuracy the samples buy.
+fn closed_form(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, spot: bool) -> f32 {
+    if spot {
+        return spot_segment(f, eye, dir, a, b, max(max(f.sizes2_[2] / 4u, SAMPLES / 4u), 1u));
+    }
+    return transmittance_between(f.medium[0], a, b);
+}
+
 // The in-scattered radiance of pixel (x, y) (the sampling entry point below calls it).
 fn volume_march_pixel(x: u32, y: u32) -> vec3<f32> {
     let f = frame;
@@ -138,13 +149,13 @@ fn volume_march_pixel(x: u32, y: u32) -> vec3<f32> {
     // Head and tail in closed form, [t_f, t_b] marched.
     var total = 0.0;
     if a.head {
-        total += lit_span(f, eye, dir, 0.0, t_f, spot);
+        total += closed_form(f, eye, dir, 0.0, t_f, spot);
     }
     if t_b > t_f {
         total += span_march(f, shadow_map, eye, dir, t_f, t_b, SAMPLES, spot);
     }
     if a.tail {
-        total += lit_span(f, eye, dir, t_b, s, spot);
+        total += closed_form(f, eye, dir, t_b, s, spot);
     }
     var l = total;
     if !spot {

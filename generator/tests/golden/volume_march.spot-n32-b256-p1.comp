@@ -423,7 +423,12 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_2, float delta, float theta_2, float s_2, bool spot_3) {
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+    return _e15;
+}
+
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_3) {
     bool local_5 = false;
     if (spot_3) {
         float psi = (x_2 * delta);
@@ -437,39 +442,25 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_9.axis.w * sin(psi)) / den), s_2);
+        return min(((f_10.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4) {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_3), delta_1, theta_3, s_3, spot_4);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_4);
     return _e9;
-}
-
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
-    return _e15;
-}
-
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_5) {
-    if (spot_5) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max((f_12.sizes2_.z / 4u), 1u));
-        return _e12;
-    }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
-    return _e15;
 }
 
 uint depth_bin(float d) {
     return uint(clamp(floor((d * 256.0)), 0.0, 255.0));
 }
 
-RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float s_4, bool spot_6) {
+RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float s_4, bool spot_5) {
     bool local_6 = false;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = _group_0_binding_0_cs;
     uint width = f_13.sizes.z;
@@ -500,9 +491,18 @@ RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float 
     vec4 _e70 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(last, row)), ivec2(0), textureSize(_group_0_binding_4_cs, _e70_clamped_lod) - ivec2(1)), _e70_clamped_lod);
     bool tail = (d_1 <= _e70.x);
     uint first = ((first_edge < PAD) ? 0u : (first_edge - PAD));
-    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_6);
-    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
+    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_5);
+    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (last + PAD), n_3, delta_2, theta_4, s_4, spot_5);
     return RowSpan(_e81, _e84, head, tail);
+}
+
+float closed_form(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
+    if (spot_6) {
+        float _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max(max((f_12.sizes2_.z / 4u), 8u), 1u));
+        return _e14;
+    }
+    float _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
+    return _e17;
 }
 
 vec3 volume_march_pixel(uint x_4, uint y_1) {
@@ -575,7 +575,7 @@ vec3 volume_march_pixel(uint x_4, uint y_1) {
     if (_e100.head) {
         float _e125 = total;
         float _e126 = t_f;
-        float _e128 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e7, 0.0, _e126, true);
+        float _e128 = closed_form(f_14, eye_9, _e7, 0.0, _e126, true);
         total = (_e125 + _e128);
     }
     float _e130 = t_b;
@@ -590,7 +590,7 @@ vec3 volume_march_pixel(uint x_4, uint y_1) {
     if (_e100.tail) {
         float _e141 = total;
         float _e142 = t_b;
-        float _e143 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e7, _e142, s_5, true);
+        float _e143 = closed_form(f_14, eye_9, _e7, _e142, s_5, true);
         total = (_e141 + _e143);
     }
     float _e145 = total;

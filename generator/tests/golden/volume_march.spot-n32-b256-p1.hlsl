@@ -507,7 +507,13 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_2, float delta, float theta_2, float s_2, bool spot_3)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_7, float3 dir_9, float a_4, float b_4, uint panels_1)
+{
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+    return _e15;
+}
+
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_3)
 {
     bool local_5 = (bool)0;
 
@@ -523,39 +529,19 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_9.axis.w * sin(psi)) / den), s_2);
+        return min(((f_10.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4)
 {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_3), delta_1, theta_3, s_3, spot_4);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_4);
     return _e9;
-}
-
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float3 eye_7, float3 dir_9, float a_4, float b_4, uint panels_1)
-{
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
-    return _e15;
-}
-
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / (rhs == 0u ? 1u : rhs);
-}
-
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_5)
-{
-    if (spot_5) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max(naga_div(f_12.sizes2_.z, 4u), 1u));
-        return _e12;
-    }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
-    return _e15;
 }
 
 uint depth_bin(float d)
@@ -572,7 +558,7 @@ RowSpan ConstructRowSpan(float arg0, float arg1, bool arg2, bool arg3) {
     return ret;
 }
 
-RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float s_4, bool spot_6)
+RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float s_4, bool spot_5)
 {
     bool local_6 = (bool)0;
 
@@ -605,10 +591,24 @@ RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float 
     float4 _e70 = rectified.Load(int3(uint2(last, row), int(0)));
     bool tail = (d_1 <= _e70.x);
     uint first = ((first_edge < PAD) ? 0u : (first_edge - PAD));
-    const float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_6);
-    const float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
+    const float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_5);
+    const float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (last + PAD), n_3, delta_2, theta_4, s_4, spot_5);
     const RowSpan rowspan_2 = ConstructRowSpan(_e81, _e84, head, tail);
     return rowspan_2;
+}
+
+uint naga_div(uint lhs, uint rhs) {
+    return lhs / (rhs == 0u ? 1u : rhs);
+}
+
+float closed_form(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_6)
+{
+    if (spot_6) {
+        const float _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max(max(naga_div(f_12.sizes2_.z, 4u), 8u), 1u));
+        return _e14;
+    }
+    const float _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
+    return _e17;
 }
 
 float3 volume_march_pixel(uint x_4, uint y_1)
@@ -682,7 +682,7 @@ float3 volume_march_pixel(uint x_4, uint y_1)
     if (_e100.head) {
         float _e125 = total;
         float _e126 = t_f;
-        const float _e128 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e7, 0.0, _e126, true);
+        const float _e128 = closed_form(f_14, eye_9, _e7, 0.0, _e126, true);
         total = (_e125 + _e128);
     }
     float _e130 = t_b;
@@ -697,7 +697,7 @@ float3 volume_march_pixel(uint x_4, uint y_1)
     if (_e100.tail) {
         float _e141 = total;
         float _e142 = t_b;
-        const float _e143 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e7, _e142, s_5, true);
+        const float _e143 = closed_form(f_14, eye_9, _e7, _e142, s_5, true);
         total = (_e141 + _e143);
     }
     float _e145 = total;

@@ -562,8 +562,20 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return s_1 * metal::sin(theta_1);
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    metal::float3 eye_7,
+    metal::float3 dir_9,
+    float a_4,
+    float b_4,
+    uint panels_1
+) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+    return _e15;
+}
+
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     float x_2,
     float delta,
     float theta_2,
@@ -583,14 +595,14 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (_e16) {
             return s_2;
         }
-        return metal::min((f_9.axis.w * metal::sin(psi)) / den, s_2);
+        return metal::min((f_10.axis.w * metal::sin(psi)) / den, s_2);
     } else {
         return metal::min((x_2 * delta) / metal::max(metal::sin(theta_2), 0.000001), s_2);
     }
 }
 
 float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     uint x_3,
     uint n_1,
     float delta_1,
@@ -601,40 +613,8 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     if (x_3 >= n_1) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_4);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_4);
     return _e9;
-}
-
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
-    metal::float3 eye_7,
-    metal::float3 dir_9,
-    float a_4,
-    float b_4,
-    uint panels_1
-) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
-    return _e15;
-}
-
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / metal::select(rhs, 1u, rhs == 0u);
-}
-
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
-    metal::float3 eye_8,
-    metal::float3 dir_10,
-    float a_5,
-    float b_5,
-    bool spot_5
-) {
-    if (spot_5) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_12.sizes2_.z, 4u), 1u));
-        return _e12;
-    }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
-    return _e15;
 }
 
 uint depth_bin(
@@ -650,7 +630,7 @@ RowSpan row_span(
     uint bin,
     float theta_4,
     float s_4,
-    bool spot_6,
+    bool spot_5,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_10 const& slices,
     metal::texture2d<float, metal::access::sample> rectified,
@@ -687,9 +667,29 @@ RowSpan row_span(
     metal::float4 _e70 = rectified.read(metal::min(metal::uint2(metal::uint2(last, row)), metal::uint2(rectified.get_width(clamped_lod_e70), rectified.get_height(clamped_lod_e70)) - 1), clamped_lod_e70);
     bool tail = d_1 <= _e70.x;
     uint first = (first_edge < PAD) ? 0u : (first_edge - PAD);
-    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_6);
-    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, last + PAD, n_3, delta_2, theta_4, s_4, spot_6);
+    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_5);
+    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, last + PAD, n_3, delta_2, theta_4, s_4, spot_5);
     return RowSpan {_e81, _e84, head, tail};
+}
+
+uint naga_div(uint lhs, uint rhs) {
+    return lhs / metal::select(rhs, 1u, rhs == 0u);
+}
+
+float closed_form(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
+    metal::float3 eye_8,
+    metal::float3 dir_10,
+    float a_5,
+    float b_5,
+    bool spot_6
+) {
+    if (spot_6) {
+        float _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, metal::max(metal::max(naga_div(f_12.sizes2_.z, 4u), 8u), 1u));
+        return _e14;
+    }
+    float _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
+    return _e17;
 }
 
 metal::float3 volume_march_pixel(
@@ -772,7 +772,7 @@ metal::float3 volume_march_pixel(
     if (_e100.head) {
         float _e125 = total;
         float _e126 = t_f;
-        float _e128 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e7, 0.0, _e126, true);
+        float _e128 = closed_form(f_14, eye_9, _e7, 0.0, _e126, true);
         total = _e125 + _e128;
     }
     float _e130 = t_b;
@@ -787,7 +787,7 @@ metal::float3 volume_march_pixel(
     if (_e100.tail) {
         float _e141 = total;
         float _e142 = t_b;
-        float _e143 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e7, _e142, s_5, true);
+        float _e143 = closed_form(f_14, eye_9, _e7, _e142, s_5, true);
         total = _e141 + _e143;
     }
     float _e145 = total;

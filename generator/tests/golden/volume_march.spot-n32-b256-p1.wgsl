@@ -422,7 +422,12 @@ fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_
     return (s_1 * sin(theta_1));
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_3: bool) -> f32 {
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+    return _e15;
+}
+
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_3: bool) -> f32 {
     var local_5: bool;
 
     if spot_3 {
@@ -437,39 +442,25 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_X
         if _e16 {
             return s_2;
         }
-        return min(((f_9.axis.w * sin(psi)) / den), s_2);
+        return min(((f_10.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_4: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_4: bool) -> f32 {
     if (x_3 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, f32(x_3), delta_1, theta_3, s_3, spot_4);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_3), delta_1, theta_3, s_3, spot_4);
     return _e9;
-}
-
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
-    return _e15;
-}
-
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_5: bool) -> f32 {
-    if spot_5 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max((f_12.sizes2_.z / 4u), 1u));
-        return _e12;
-    }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
-    return _e15;
 }
 
 fn depth_bin(d: f32) -> u32 {
     return u32(clamp(floor((d * 256f)), 0f, 255f));
 }
 
-fn row_span(row: u32, col: f32, d_1: f32, bin: u32, theta_4: f32, s_4: f32, spot_6: bool) -> RowSpan {
+fn row_span(row: u32, col: f32, d_1: f32, bin: u32, theta_4: f32, s_4: f32, spot_5: bool) -> RowSpan {
     var local_6: bool;
 
     let f_13 = frame;
@@ -499,9 +490,18 @@ fn row_span(row: u32, col: f32, d_1: f32, bin: u32, theta_4: f32, s_4: f32, spot
     let _e70 = textureLoad(rectified, vec2<u32>(last, row), 0i);
     let tail = (d_1 <= _e70.x);
     let first = select((first_edge - PAD), 0u, (first_edge < PAD));
-    let _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_6);
-    let _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
+    let _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_5);
+    let _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (last + PAD), n_3, delta_2, theta_4, s_4, spot_5);
     return RowSpan(_e81, _e84, head, tail);
+}
+
+fn closed_form(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
+    if spot_6 {
+        let _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max(max((f_12.sizes2_.z / 4u), 8u), 1u));
+        return _e14;
+    }
+    let _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
+    return _e17;
 }
 
 fn volume_march_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
@@ -574,7 +574,7 @@ fn volume_march_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     if _e100.head {
         let _e125 = total;
         let _e126 = t_f;
-        let _e128 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e7, 0f, _e126, true);
+        let _e128 = closed_form(f_14, eye_9, _e7, 0f, _e126, true);
         total = (_e125 + _e128);
     }
     let _e130 = t_b;
@@ -589,7 +589,7 @@ fn volume_march_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     if _e100.tail {
         let _e141 = total;
         let _e142 = t_b;
-        let _e143 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e7, _e142, s_5, true);
+        let _e143 = closed_form(f_14, eye_9, _e7, _e142, s_5, true);
         total = (_e141 + _e143);
     }
     let _e145 = total;

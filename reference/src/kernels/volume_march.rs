@@ -10,10 +10,10 @@
 //! whole ray.
 
 use super::common_epipolar::{
-    edge_t, epipole_march, lit_span, normalised_depth, pixel_dir, ray_column, ray_row_coord,
-    ray_theta, row_index, span_march,
+    edge_t, epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta,
+    row_index, span_march, spot_segment,
 };
-use super::common_model::{max, min, phase_hg};
+use super::common_model::{max, max_u, min, phase_hg, transmittance_between};
 use super::common_sampling::{
     EpipolarCamera, EpipolarSamples, SampledOutput, epipolar_samples, run_sampled,
 };
@@ -202,8 +202,35 @@ pub fn pixel_span(inp: &MarchInputs, pad: u32, x: u32, y: u32, spot: bool) -> Op
     })
 }
 
-/// The sum of a pixel's span: head and tail in closed form, `[t_f, t_b]` marched with
-/// `samples` samples (without `sigma_s p E` for the sun, as `lit_span`).
+/// Unshadowed in-scattering over `[a, b]` (the head or the tail), without `sigma_s p E` for
+/// the sun: the sun's closed form; for a spot, Gauss-Legendre panels no coarser than the
+/// march, `samples / 4` panels of 4 nodes (at least the frame's spot quadrature), so that the
+/// head and tail do not cap the accuracy the samples buy (with the frame's 8 panels,
+/// `spot_grate/grazing` stalled at 0.27 % from 64 samples on, raymarch N = 64 0.24 %).
+pub fn closed_form(
+    f: &FrameUniforms,
+    eye: Vec3,
+    dir: Vec3,
+    a: f32,
+    b: f32,
+    samples: u32,
+    spot: bool,
+) -> f32 {
+    if spot {
+        return spot_segment(
+            f,
+            eye,
+            dir,
+            a,
+            b,
+            max_u(max_u(f.sizes2[2] / 4, samples / 4), 1),
+        );
+    }
+    transmittance_between(f.medium[0], a, b)
+}
+
+/// The sum of a pixel's span: head and tail in closed form ([`closed_form`]), `[t_f, t_b]`
+/// marched with `samples` samples (without `sigma_s p E` for the sun).
 pub fn span_sum(
     f: &FrameUniforms,
     sm: &Tex,
@@ -215,13 +242,13 @@ pub fn span_sum(
     let eye = xyz(f.eye);
     let mut total = 0.0;
     if p.head > 0.5 {
-        total += lit_span(f, eye, dir, 0.0, p.t_f, spot);
+        total += closed_form(f, eye, dir, 0.0, p.t_f, samples, spot);
     }
     if p.t_b > p.t_f {
         total += span_march(f, sm, eye, dir, p.t_f, p.t_b, samples, spot);
     }
     if p.tail > 0.5 {
-        total += lit_span(f, eye, dir, p.t_b, p.s, spot);
+        total += closed_form(f, eye, dir, p.t_b, p.s, samples, spot);
     }
     total
 }
