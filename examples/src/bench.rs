@@ -1078,6 +1078,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             ("minmax", "minmax"),
             ("partial_sum_tree", "r4-ep512-s1"),
             ("partial_sum_tree", "r4-ep512-s1-512x512"),
+            ("hybrid_volume", "n32"),
         ] {
             if let Some((t, e)) = headline_mean(family, knobs) {
                 out.push(format!(
@@ -1086,6 +1087,26 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                     100.0 * pe,
                     t / pt,
                     if e <= pe { "equal or lower" } else { "higher" }
+                ));
+            }
+        }
+    }
+    // Issue 16: hybrid_volume at the headline against brute-force marching, minmax and the
+    // prefiltered default (time and error from the same runs).
+    if let Some((ht, he)) = headline_mean("hybrid_volume", "n32") {
+        for (family, knobs) in [
+            ("raymarch", "n64-i1"),
+            ("raymarch", "n128-i1"),
+            ("raymarch", "n256-i1"),
+            ("minmax", "minmax"),
+            ("prefiltered", "m32-r3"),
+        ] {
+            if let Some((t, e)) = headline_mean(family, knobs) {
+                out.push(format!(
+                    "headline means (sphere, foliage, terrain): hybrid_volume n32 {ht:.1} ms at rel L1 {:.3} %; {family} {knobs} {t:.1} ms ({:.2}x the time) at {:.3} %",
+                    100.0 * he,
+                    t / ht,
+                    100.0 * e
                 ));
             }
         }
@@ -1406,6 +1427,18 @@ const FONT_PATHS: &[&str] = &[
     "/usr/share/fonts/TTF/DejaVuSans.ttf",
 ];
 
+/// The chart's colour of a family (an exhaustive match: a new family must pick one).
+fn family_colour(family: Family) -> plotters::style::RGBColor {
+    use plotters::style::colors::{BLUE, GREEN, MAGENTA, RED};
+    match family {
+        Family::Prefiltered => RED,
+        Family::Raymarch => BLUE,
+        Family::Minmax => GREEN,
+        Family::PartialSumTree => MAGENTA,
+        Family::HybridVolume => plotters::style::RGBColor(230, 140, 0),
+    }
+}
+
 /// Draws the chart into any plotters backend: x = time (log), y = mean rel L1 vs the
 /// `shadow_map` truth (log), one marker per variant, one colour per family, the Pareto
 /// front of all variants as a line.
@@ -1457,12 +1490,9 @@ where
         .draw_series(LineSeries::new(front.clone(), BLACK.stroke_width(1)))?
         .label("Pareto front")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK));
-    for (family, colour) in [
-        ("prefiltered", RED),
-        ("raymarch", BLUE),
-        ("minmax", GREEN),
-        ("partial_sum_tree", MAGENTA),
-    ] {
+    for &family in Family::ALL {
+        let colour = family_colour(family);
+        let family = family.name();
         let sel: Vec<_> = v.iter().zip(&pts).filter(|(p, _)| p.0 == family).collect();
         if sel.is_empty() {
             continue;

@@ -452,10 +452,10 @@ pub fn cases(width: u32, height: u32) -> Vec<StressCase> {
         s,
         Premise::EyeShadowed,
     ));
-    // Under the central tree of `foliage` (crown 5.4-6.9 m up, 2.0-2.6 m wide), the sun 60
-    // degrees up: every view ray starts in the crown's shadow and crosses the leaves' shadows
-    // of the trees around many times, so a shadow volume's first and last crossings span
-    // most of each ray (Wyman & Ramsey's degenerate case: the interval is the whole ray).
+    // Under the central tree of `foliage` (crown 5.4-6.9 m up, 2.0-2.6 m wide), looking
+    // between the trees, the sun 60 degrees up: view rays cross the leaves' shadows of several
+    // crowns, so a shadow volume's first and last crossings can span most of a ray (Wyman &
+    // Ramsey's degenerate case, where the interval is the whole ray).
     let mut s = suite::scene(
         SceneName::Foliage,
         Pose::Ordinary,
@@ -469,7 +469,7 @@ pub fn cases(width: u32, height: u32) -> Vec<StressCase> {
     out.push(case(
         "foliage_under_canopy",
         P,
-        "under a tree's crown among trees: the eye in the leaves' shadow, many shadow crossings per ray",
+        "under a tree's crown among trees: view rays cross the leaves' shadows of several crowns",
         s,
         Premise::None,
     ));

@@ -235,6 +235,31 @@ pub fn run_raymarch(
     })
 }
 
+/// The engine's inputs as the mirrors take them: the depth buffer and the standard shadow
+/// map.
+fn input_textures(gbuf: &GBuffer, shadow_map: &ShadowMap) -> (Tex, Tex) {
+    let depth = Tex {
+        width: gbuf.width,
+        height: gbuf.height,
+        data: gbuf.view_depth.clone(),
+    };
+    let sm = Tex {
+        width: shadow_map.size,
+        height: shadow_map.size,
+        data: shadow_map.depth.clone(),
+    };
+    (depth, sm)
+}
+
+/// The passes every rectified epipolar family starts with, on the CPU: `depth_columns`,
+/// `slice_fit` (which rewrites `frame.slices`) and `rectify`; returns the rectified map.
+fn rectify_passes(frame: &mut PrefilteredFrame, depth: &Tex, sm: &Tex, light: LightKind) -> Tex {
+    let spot = light == LightKind::Spot;
+    let column_depth = depth_columns::depth_columns(&frame.uniforms, depth);
+    slice_fit::slice_fit(&frame.uniforms, &mut frame.slices, &column_depth, spot);
+    rectify::rectify(&frame.uniforms, &frame.slices, sm, spot)
+}
+
 /// Every intermediate of one CPU run of the minmax family.
 #[derive(Clone, Debug)]
 pub struct MinmaxRun {
@@ -276,20 +301,8 @@ pub fn run_minmax(
         &shadow_map.desc(),
         settings,
     )?;
-    let sm = Tex {
-        width: shadow_map.size,
-        height: shadow_map.size,
-        data: shadow_map.depth.clone(),
-    };
-    let spot = variant.light == LightKind::Spot;
-    let depth = Tex {
-        width: gbuf.width,
-        height: gbuf.height,
-        data: gbuf.view_depth.clone(),
-    };
-    let column_depth = depth_columns::depth_columns(&frame.uniforms, &depth);
-    slice_fit::slice_fit(&frame.uniforms, &mut frame.slices, &column_depth, spot);
-    let rectified = rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot);
+    let (depth, sm) = input_textures(gbuf, shadow_map);
+    let rectified = rectify_passes(&mut frame, &depth, &sm, variant.light);
     Ok(minmax_from_rectified(
         variant, frame, rectified, &depth, &sm,
     ))
@@ -379,20 +392,8 @@ pub fn run_hybrid_volume(
         &shadow_map.desc(),
         settings,
     )?;
-    let sm = Tex {
-        width: shadow_map.size,
-        height: shadow_map.size,
-        data: shadow_map.depth.clone(),
-    };
-    let spot = variant.light == LightKind::Spot;
-    let depth = Tex {
-        width: gbuf.width,
-        height: gbuf.height,
-        data: gbuf.view_depth.clone(),
-    };
-    let column_depth = depth_columns::depth_columns(&frame.uniforms, &depth);
-    slice_fit::slice_fit(&frame.uniforms, &mut frame.slices, &column_depth, spot);
-    let rectified = rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot);
+    let (depth, sm) = input_textures(gbuf, shadow_map);
+    let rectified = rectify_passes(&mut frame, &depth, &sm, variant.light);
     Ok(hybrid_volume_from_rectified(
         variant, frame, rectified, &depth, &sm,
     ))
@@ -488,21 +489,8 @@ pub fn run_partial_sum_tree(
         &shadow_map.desc(),
         settings,
     )?;
-    let sm = Tex {
-        width: shadow_map.size,
-        height: shadow_map.size,
-        data: shadow_map.depth.clone(),
-    };
-    let spot = variant.light == LightKind::Spot;
-    let depth = Tex {
-        width: gbuf.width,
-        height: gbuf.height,
-        data: gbuf.view_depth.clone(),
-    };
-    let f = &mut frame.frame;
-    let column_depth = depth_columns::depth_columns(&f.uniforms, &depth);
-    slice_fit::slice_fit(&f.uniforms, &mut f.slices, &column_depth, spot);
-    let rectified = rectify::rectify(&f.uniforms, &f.slices, &sm, spot);
+    let (depth, sm) = input_textures(gbuf, shadow_map);
+    let rectified = rectify_passes(&mut frame.frame, &depth, &sm, variant.light);
     Ok(partial_sum_tree_from_rectified(
         variant, frame, rectified, &depth, &sm,
     ))
