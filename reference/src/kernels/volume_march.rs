@@ -112,7 +112,7 @@ pub fn row_span(
     }
     let last = e1.min(n - 1);
     let tail = d <= inp.rectified.load(last, row);
-    let first = if e0 < pad { 0 } else { e0 - pad };
+    let first = e0.saturating_sub(pad);
     RowSpan {
         t_f: edge_t(f, first, n, delta, theta, s, spot),
         t_b: edge_t(f, last + pad, n, delta, theta, s, spot),
