@@ -182,7 +182,21 @@ fn labels() -> Vec<String> {
     l.push(format!("raymarch n64-lr{SAMPLED_SCALE}"));
     l.push("raymarch n64-ep64x64".into());
     l.push("partial_sum_tree r4-ep64x64".into());
+    l.push("hybrid_volume n32".into());
     l
+}
+
+/// `labels()` names `variants()` column by column: a column added to one and not the other
+/// would index past the table (it did, stop 31's CI); checked without a GPU.
+#[test]
+fn every_variant_has_a_label() {
+    for light in [LightKind::Directional, LightKind::Spot] {
+        assert_eq!(
+            variants(light).len(),
+            labels().len(),
+            "flicker: variants({light:?}) and labels() list different numbers of columns"
+        );
+    }
 }
 
 /// The passes of every reported variant for one light kind (created once, as an engine keeps
