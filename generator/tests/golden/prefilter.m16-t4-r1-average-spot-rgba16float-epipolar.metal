@@ -18,9 +18,6 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct type_9 {
-    float inner[4];
-};
 struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float t_close;
     float dist;
@@ -60,14 +57,14 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_lo;
     float theta_hi;
 };
-typedef metal::float4 type_10[1];
-struct type_14 {
+typedef metal::float4 type_9[1];
+struct type_13 {
     metal::float4 inner[1];
 };
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
-constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
+constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
 constant uint REGIONS = 1u;
 constant uint BASES_PER_THREAD = 4u;
@@ -324,11 +321,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q_1;
-                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q_1;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
                 }
             }
         }
@@ -478,7 +475,7 @@ struct prefilterInput {
 kernel void prefilter(
   metal::uint3 id [[thread_position_in_grid]]
 , constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
-, device type_10 const& slices [[buffer(1)]]
+, device type_9 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(0)]]
 , metal::texture2d_array<float, metal::access::write> filtered [[texture(1)]]
 , metal::texture2d<float, metal::access::write> bounds [[texture(2)]]
@@ -486,7 +483,7 @@ kernel void prefilter(
 ) {
     bool local = {};
     bool local_1 = {};
-    type_14 acc = {};
+    type_13 acc = {};
     float wsum = 0.0;
     float lo = 1000000000000000000000000000000.0;
     float hi = -1000000000000000000000000000000.0;

@@ -80,8 +80,8 @@ struct PstRay {
 };
 const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](-0.8611363, -0.33998105, 0.33998105, 0.8611363);
-const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](0.34785485, 0.65214515, 0.65214515, 0.34785485);
+const vec4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+const vec4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 const float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 const uint SLICES = 512u;
@@ -98,7 +98,7 @@ const uint NONE = 4294967295u;
 
 layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _group_0_binding_0_cs; };
 
-layout(std430, binding = 1) readonly buffer type_10_block_1Compute { vec4 _group_0_binding_1_cs[]; };
+layout(std430, binding = 1) readonly buffer type_9_block_1Compute { vec4 _group_0_binding_1_cs[]; };
 
 layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
@@ -106,17 +106,17 @@ layout(binding = 3) uniform sampler2D _group_0_binding_3_cs;
 
 layout(binding = 4) uniform sampler2D _group_0_binding_4_cs;
 
-layout(std430, binding = 5) readonly buffer type_10_block_2Compute { vec4 _group_0_binding_5_cs[]; };
+layout(std430, binding = 5) readonly buffer type_9_block_2Compute { vec4 _group_0_binding_5_cs[]; };
 
-layout(std430, binding = 6) buffer type_10_block_3Compute { vec4 _group_0_binding_6_cs[]; };
+layout(std430, binding = 6) buffer type_9_block_3Compute { vec4 _group_0_binding_6_cs[]; };
 
-layout(std430, binding = 7) buffer type_10_block_4Compute { vec4 _group_0_binding_7_cs[]; };
+layout(std430, binding = 7) buffer type_9_block_4Compute { vec4 _group_0_binding_7_cs[]; };
 
-layout(std430, binding = 8) buffer type_11_block_5Compute { uint _group_0_binding_8_cs[]; };
+layout(std430, binding = 8) buffer type_10_block_5Compute { uint _group_0_binding_8_cs[]; };
 
 layout(binding = 9,rgba32f) writeonly uniform image2D _group_0_binding_9_cs;
 
-layout(std430, binding = 11) buffer type_13_block_6Compute { uint _group_0_binding_11_cs; };
+layout(std430, binding = 11) buffer type_12_block_6Compute { uint _group_0_binding_11_cs; };
 
 shared uint q_end[256];
 

@@ -22,9 +22,6 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct type_9 {
-    float inner[4];
-};
 struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float t_close;
     float dist;
@@ -93,21 +90,21 @@ struct PstRay {
     float d;
     float xs_num;
 };
-typedef metal::float4 type_10[1];
-typedef uint type_11[1];
-struct type_14 {
+typedef metal::float4 type_9[1];
+typedef uint type_10[1];
+struct type_13 {
     uint inner[256];
 };
-struct type_15 {
+struct type_14 {
     float inner[256];
 };
-struct type_16 {
+struct type_15 {
     uint inner[8];
 };
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
-constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
+constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 constant float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 constant uint SLICES = 512u;
@@ -373,11 +370,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q;
-                    float u_1 = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float u_1 = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_9 * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u_1 * u_1)));
+                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u_1 * u_1)));
                 }
             }
         }
@@ -905,7 +902,7 @@ metal::float4 factor_at(
     uint base,
     float x_4,
     uint h_4,
-    device type_10 const& pst_factors,
+    device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float p_7 = metal::min(metal::clamp(x_4, 0.0, 1.0) * 95.0, 95.0);
@@ -919,7 +916,7 @@ metal::float4 factor_at(
 metal::float4 gamma_at(
     float v_8,
     uint h_5,
-    device type_10 const& pst_factors,
+    device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float _e4 = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)].x;
@@ -930,7 +927,7 @@ metal::float4 gamma_at(
 metal::float4 beta_at(
     float theta_4,
     uint h_6,
-    device type_10 const& pst_factors,
+    device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 head = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)];
@@ -944,7 +941,7 @@ metal::float4 pst_leaf(
     uint row_1,
     float delta_2,
     uint h_7,
-    device type_10 const& pst_factors,
+    device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 leaf = metal::float4(0.0, 0.0, 0.0, 0.0);
@@ -1087,11 +1084,11 @@ metal::float3 pst_sweep_pixel(
     uint x_5,
     uint y,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
-    device type_10 const& slices_1,
+    device type_9 const& slices_1,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::sample> shadow_map,
     metal::texture2d<float, metal::access::sample> rectified,
-    device type_10 const& pst_factors,
+    device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float sum_2 = 0.0;
@@ -1212,25 +1209,25 @@ kernel void pst_sweep(
   metal::uint3 wid [[threadgroup_position_in_grid]]
 , uint li [[thread_index_in_threadgroup]]
 , constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
-, device type_10 const& slices_1 [[buffer(1)]]
+, device type_9 const& slices_1 [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(2)]]
-, device type_10 const& pst_factors [[buffer(2)]]
-, device type_10& pst_leaves [[buffer(3)]]
-, device type_10& pst_tree [[buffer(4)]]
-, device type_11& pst_columns [[buffer(5)]]
+, device type_9 const& pst_factors [[buffer(2)]]
+, device type_9& pst_leaves [[buffer(3)]]
+, device type_9& pst_tree [[buffer(4)]]
+, device type_10& pst_columns [[buffer(5)]]
 , metal::texture2d<float, metal::access::write> output [[texture(3)]]
 , device metal::atomic_uint& fallback_count [[buffer(6)]]
-, threadgroup type_14& q_end
-, threadgroup type_14& q_rank
-, threadgroup type_15& q_d
-, threadgroup type_15& q_theta
-, threadgroup type_15& q_a
-, threadgroup type_15& q_b
-, threadgroup type_14& by_end
+, threadgroup type_13& q_end
+, threadgroup type_13& q_rank
+, threadgroup type_14& q_d
+, threadgroup type_14& q_theta
+, threadgroup type_14& q_a
+, threadgroup type_14& q_b
+, threadgroup type_13& by_end
 , threadgroup metal::atomic_uint& live
-, threadgroup type_16& bucket
+, threadgroup type_15& bucket
 , constant _mslBufferSizes& _buffer_sizes [[buffer(7)]]
 ) {
     if (li == 0u) {
@@ -1266,7 +1263,7 @@ kernel void pst_sweep(
     bool local_4 = {};
     uint j_2 = {};
     bool local_5 = {};
-    type_16 mine = {};
+    type_15 mine = {};
     uint j_3 = {};
     uint j_4 = {};
     uint i = {};

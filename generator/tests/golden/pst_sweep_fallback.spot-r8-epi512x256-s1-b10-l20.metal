@@ -20,9 +20,6 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct type_9 {
-    float inner[4];
-};
 struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float t_close;
     float dist;
@@ -74,12 +71,12 @@ struct PstRay {
     float d;
     float xs_num;
 };
-typedef metal::float4 type_10[1];
-typedef uint type_12[1];
+typedef metal::float4 type_9[1];
+typedef uint type_11[1];
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
-constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
+constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 constant uint SLICES = 512u;
 constant uint SLICE_SAMPLES = 256u;
@@ -343,11 +340,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q;
-                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_5 * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
                 }
             }
         }
@@ -656,7 +653,7 @@ metal::float4 factor_at(
     uint base,
     float x_3,
     uint h,
-    device type_10 const& pst_factors,
+    device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float p_4 = metal::min(metal::clamp(x_3, 0.0, 1.0) * 95.0, 95.0);
@@ -670,7 +667,7 @@ metal::float4 factor_at(
 metal::float4 gamma_at(
     float v_7,
     uint h_1,
-    device type_10 const& pst_factors,
+    device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float _e4 = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)].x;
@@ -681,7 +678,7 @@ metal::float4 gamma_at(
 metal::float4 beta_at(
     float theta_4,
     uint h_2,
-    device type_10 const& pst_factors,
+    device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 head = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)];
@@ -695,7 +692,7 @@ metal::float4 pst_leaf(
     uint row_1,
     float delta_2,
     uint h_3,
-    device type_10 const& pst_factors,
+    device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 leaf = metal::float4(0.0, 0.0, 0.0, 0.0);
@@ -838,11 +835,11 @@ metal::float3 pst_sweep_pixel(
     uint x_4,
     uint y,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
-    device type_10 const& slices,
+    device type_9 const& slices,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::sample> shadow_map,
     metal::texture2d<float, metal::access::sample> rectified,
-    device type_10 const& pst_factors,
+    device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float sum_2 = 0.0;
@@ -930,14 +927,14 @@ struct pst_sweep_fallbackInput {
 kernel void pst_sweep_fallback(
   metal::uint3 id [[thread_position_in_grid]]
 , constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
-, device type_10 const& slices [[buffer(1)]]
+, device type_9 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(2)]]
-, device type_10 const& pst_factors [[buffer(2)]]
+, device type_9 const& pst_factors [[buffer(2)]]
 , metal::texture2d<float, metal::access::write> output [[texture(3)]]
 , device uint const& fallback_count [[buffer(3)]]
-, device type_12 const& fallback_pixels [[buffer(4)]]
+, device type_11 const& fallback_pixels [[buffer(4)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(5)]]
 ) {
     uint e = {};

@@ -77,8 +77,8 @@ struct PstRay {
 };
 const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](-0.8611363, -0.33998105, 0.33998105, 0.8611363);
-const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](0.34785485, 0.65214515, 0.65214515, 0.34785485);
+const vec4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+const vec4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 const uint SLICES = 512u;
 const uint SLICE_SAMPLES = 256u;
@@ -99,9 +99,9 @@ layout(binding = 9,rgba16f) writeonly uniform image2D _group_0_binding_9_cs;
 
 layout(binding = 10) uniform sampler2D _group_0_binding_10_cs;
 
-layout(std430, binding = 11) buffer type_13_block_1Compute { uint _group_0_binding_11_cs; };
+layout(std430, binding = 11) buffer type_12_block_1Compute { uint _group_0_binding_11_cs; };
 
-layout(std430, binding = 12) buffer type_14_block_2Compute { uint _group_0_binding_12_cs[]; };
+layout(std430, binding = 12) buffer type_13_block_2Compute { uint _group_0_binding_12_cs[]; };
 
 
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {

@@ -20,9 +20,6 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct type_9 {
-    float inner[4];
-};
 struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float t_close;
     float dist;
@@ -70,7 +67,7 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uint wrap;
     char _pad5[4];
 };
-struct type_10 {
+struct type_9 {
     metal::float3 inner[4];
 };
 struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
@@ -90,12 +87,12 @@ struct PstRay {
     float d;
     float xs_num;
 };
-typedef metal::float4 type_11[1];
-typedef uint type_14[1];
+typedef metal::float4 type_10[1];
+typedef uint type_13[1];
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
-constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
+constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 constant uint SLICES = 512u;
 constant uint SLICE_SAMPLES = 256u;
@@ -359,11 +356,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q;
-                    float u = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float u = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_5 * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
                 }
             }
         }
@@ -686,7 +683,7 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float4 w_1,
     metal::float4 depths_1,
-    type_10 light_1,
+    type_9 light_1,
     float d,
     float depth_break_1,
     float light_break
@@ -853,7 +850,7 @@ metal::float4 factor_at(
     uint base,
     float x_3,
     uint h,
-    device type_11 const& pst_factors,
+    device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float p_6 = metal::min(metal::clamp(x_3, 0.0, 1.0) * 95.0, 95.0);
@@ -867,7 +864,7 @@ metal::float4 factor_at(
 metal::float4 gamma_at(
     float v_7,
     uint h_1,
-    device type_11 const& pst_factors,
+    device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float _e4 = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)].x;
@@ -878,7 +875,7 @@ metal::float4 gamma_at(
 metal::float4 beta_at(
     float theta_4,
     uint h_2,
-    device type_11 const& pst_factors,
+    device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 head = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)];
@@ -892,7 +889,7 @@ metal::float4 pst_leaf(
     uint row_1,
     float delta_2,
     uint h_3,
-    device type_11 const& pst_factors,
+    device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 leaf = metal::float4(0.0, 0.0, 0.0, 0.0);
@@ -1035,11 +1032,11 @@ metal::float3 pst_sweep_pixel(
     uint x_4,
     uint y,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
-    device type_11 const& slices_1,
+    device type_10 const& slices_1,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::sample> shadow_map,
     metal::texture2d<float, metal::access::sample> rectified,
-    device type_11 const& pst_factors,
+    device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float sum_3 = 0.0;
@@ -1127,12 +1124,12 @@ kernel void pst_sweep_unwarp(
 , metal::texture2d<float, metal::access::write> output [[texture(1)]]
 , metal::texture2d<float, metal::access::sample> epipolar_samples [[texture(2)]]
 , device metal::atomic_uint& fallback_count [[buffer(1)]]
-, device type_14& fallback_pixels [[buffer(2)]]
+, device type_13& fallback_pixels [[buffer(2)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {
     bool local = {};
     metal::float4 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
-    type_10 light = {};
+    type_9 light = {};
     uint j = 0u;
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
@@ -1186,7 +1183,7 @@ kernel void pst_sweep_unwarp(
         }
     }
     metal::float4 _e96 = depths;
-    type_10 _e97 = light;
+    type_9 _e97 = light;
     uint clamped_lod_e100 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e100 = depth.read(metal::min(metal::uint2(q_4), metal::uint2(depth.get_width(clamped_lod_e100), depth.get_height(clamped_lod_e100)) - 1), clamped_lod_e100);
     metal::float4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);

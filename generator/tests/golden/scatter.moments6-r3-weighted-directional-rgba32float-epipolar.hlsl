@@ -56,16 +56,10 @@ struct CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX {
     bool at_infinity;
 };
 
-typedef float ret_Constructarray4_float_[4];
-ret_Constructarray4_float_ Constructarray4_float_(float arg0, float arg1, float arg2, float arg3) {
-    float ret[4] = { arg0, arg1, arg2, arg3 };
-    return ret;
-}
-
 static const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-static const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
-static const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = Constructarray4_float_(0.34785485, 0.65214515, 0.65214515, 0.34785485);
+static const float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+static const float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 static const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 static const float MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 0.0003;
 static const float FAR_ROOTX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 10000.0;

@@ -19,9 +19,6 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct type_9 {
-    float inner[4];
-};
 struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float t_close;
     float dist;
@@ -55,15 +52,15 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
 };
-typedef metal::float4 type_10[1];
-typedef float type_11[1];
-struct type_12 {
+typedef metal::float4 type_9[1];
+typedef float type_10[1];
+struct type_11 {
     float inner[256];
 };
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
-constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
+constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant uint THREADS = 256u;
 constant uint SPOT_SAMPLES = 32u;
 
@@ -318,11 +315,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q;
-                    float u = metal::tan(mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float u = metal::tan(mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
                 }
             }
         }
@@ -389,9 +386,9 @@ struct slice_fitInput {
 kernel void slice_fit(
   uint lid [[thread_index_in_threadgroup]]
 , constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
-, device type_10& slices [[buffer(1)]]
-, device type_11 const& column_depth [[buffer(2)]]
-, threadgroup type_12& deepest
+, device type_9& slices [[buffer(1)]]
+, device type_10 const& column_depth [[buffer(2)]]
+, threadgroup type_11& deepest
 , constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {
     if (lid == 0u) {

@@ -48,8 +48,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
 };
 const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](-0.8611363, -0.33998105, 0.33998105, 0.8611363);
-const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](0.34785485, 0.65214515, 0.65214515, 0.34785485);
+const vec4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+const vec4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 const uint BINS = 256u;
 const uint NO_EDGE = 4294967295u;
 
@@ -57,7 +57,7 @@ layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33
 
 layout(binding = 1) uniform sampler2D _group_0_binding_1_cs;
 
-layout(std430, binding = 2) buffer type_11_block_1Compute { uint _group_0_binding_2_cs[]; };
+layout(std430, binding = 2) buffer type_10_block_1Compute { uint _group_0_binding_2_cs[]; };
 
 
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {

@@ -60,8 +60,8 @@ struct RowSpan {
 };
 const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-const float GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](-0.8611363, -0.33998105, 0.33998105, 0.8611363);
-const float GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[4] = float[4](0.34785485, 0.65214515, 0.65214515, 0.34785485);
+const vec4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+const vec4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 const uint SAMPLES = 32u;
 const uint BINS = 256u;
@@ -70,7 +70,7 @@ const uint NO_EDGE = 4294967295u;
 
 layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _group_0_binding_0_cs; };
 
-layout(std430, binding = 1) readonly buffer type_10_block_1Compute { vec4 _group_0_binding_1_cs[]; };
+layout(std430, binding = 1) readonly buffer type_9_block_1Compute { vec4 _group_0_binding_1_cs[]; };
 
 layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
@@ -78,7 +78,7 @@ layout(binding = 3) uniform sampler2D _group_0_binding_3_cs;
 
 layout(binding = 4) uniform sampler2D _group_0_binding_4_cs;
 
-layout(std430, binding = 5) readonly buffer type_11_block_2Compute { uint _group_0_binding_5_cs[]; };
+layout(std430, binding = 5) readonly buffer type_10_block_2Compute { uint _group_0_binding_5_cs[]; };
 
 layout(binding = 6,rgba16f) writeonly uniform image2D _group_0_binding_6_cs;
 

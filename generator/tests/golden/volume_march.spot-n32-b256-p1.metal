@@ -19,9 +19,6 @@ struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     metal::float4 proj;
     metal::uint4 size;
 };
-struct type_9 {
-    float inner[4];
-};
 struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float t_close;
     float dist;
@@ -68,12 +65,12 @@ struct RowSpan {
     bool tail;
     char _pad4[2];
 };
-typedef metal::float4 type_10[1];
-typedef uint type_11[1];
+typedef metal::float4 type_9[1];
+typedef uint type_10[1];
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
-constant type_9 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{-0.8611363, -0.33998105, 0.33998105, 0.8611363}};
-constant type_9 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = type_9 {{0.34785485, 0.65214515, 0.65214515, 0.34785485}};
+constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
+constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 constant uint SAMPLES = 32u;
 constant uint BINS = 256u;
@@ -331,11 +328,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q;
-                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e46), 3u)]));
+                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX.inner[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
                 }
             }
         }
@@ -632,9 +629,9 @@ RowSpan row_span(
     float s_4,
     bool spot_5,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
-    device type_10 const& slices,
+    device type_9 const& slices,
     metal::texture2d<float, metal::access::sample> rectified,
-    device type_11 const& crossings,
+    device type_10 const& crossings,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     bool local_6 = {};
@@ -696,11 +693,11 @@ metal::float3 volume_march_pixel(
     uint x_4,
     uint y_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
-    device type_10 const& slices,
+    device type_9 const& slices,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::sample> shadow_map,
     metal::texture2d<float, metal::access::sample> rectified,
-    device type_11 const& crossings,
+    device type_10 const& crossings,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     bool local_7 = {};
@@ -807,11 +804,11 @@ struct volume_marchInput {
 kernel void volume_march(
   metal::uint3 id [[thread_position_in_grid]]
 , constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
-, device type_10 const& slices [[buffer(1)]]
+, device type_9 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(2)]]
-, device type_11 const& crossings [[buffer(2)]]
+, device type_10 const& crossings [[buffer(2)]]
 , metal::texture2d<float, metal::access::write> output [[texture(3)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {

@@ -62,10 +62,14 @@ fn spot_integrand(
     return medium[1] * p * cone * exp(-medium[0] * (d + t)) / d2;
 }
 
-// 4-point Gauss-Legendre abscissae on [-1, 1] (ascending).
-const GL4_X: array<f32, 4> = array<f32, 4>(-0.8611363f, -0.33998104f, 0.33998104f, 0.8611363f);
+// 4-point Gauss-Legendre abscissae on [-1, 1] (ascending). A vector, not an array: naga
+// writes a module-scope array constant to HLSL as `static const float X[4] =
+// Constructarray4_float_(...)`, and glslang's HLSL front end rejects a function call in a
+// static initializer ("Recursion detected", KhronosGroup/glslang#1216); a vector is
+// `float4(...)`, which every HLSL compiler takes.
+const GL4_X: vec4<f32> = vec4<f32>(-0.8611363f, -0.33998104f, 0.33998104f, 0.8611363f);
 // 4-point Gauss-Legendre weights.
-const GL4_W: array<f32, 4> = array<f32, 4>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
+const GL4_W: vec4<f32> = vec4<f32>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
 
 // Unshadowed spot in-scattering over `[a, b]` of the view ray `eye + t dir` (without the
 // light colour): `panels` 4-point Gauss-Legendre panels in the angle `gamma` under which the
