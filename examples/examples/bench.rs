@@ -7,13 +7,15 @@
 //! cargo run --release -p scatter-examples --example bench -- --headline-only
 //! cargo run --release -p scatter-examples --example bench -- --roofline
 //! cargo run --release -p scatter-examples --example bench -- --family raymarch --family hybrid_volume
+//! cargo run --release -p scatter-examples --example bench -- --scene-file reference/scenes/mesh_grate.json
 //! ```
 
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use clap::Parser;
-use scatter_examples::bench::{BenchConfig, run, write_outputs};
+use scatter_examples::bench::{BenchConfig, Case, run, write_outputs};
 use scatter_runtime::Context;
 use scatter_runtime::shaderlib::family::Family;
 
@@ -48,6 +50,11 @@ struct Args {
     /// `--family raymarch --family hybrid_volume` for one family against brute force).
     #[arg(long = "family", value_name = "FAMILY", value_parser = parse_family)]
     families: Vec<Family>,
+    /// Sweep a scene of one's own instead of the suite (JSON, `reference/scenes/README.md`;
+    /// OBJ meshes by `mesh_file`): its camera at the sweep's 320x180, the default grid of
+    /// every family; no scaling or headline runs (they time suite scenes).
+    #[arg(long, value_name = "PATH", conflicts_with_all = ["quick", "headline_only", "roofline"])]
+    scene_file: Option<PathBuf>,
 }
 
 /// A family name, or an error listing the known ones.
@@ -72,6 +79,20 @@ fn main() -> ExitCode {
         config.scaling = false;
     }
     config.only_families(&args.families);
+    if let Some(path) = &args.scene_file {
+        match scatter_examples::scene_file::load(path, Some(config.screen)) {
+            Ok(loaded) => {
+                eprintln!("{}", loaded.report(path));
+                config.cases = vec![Case::File(Arc::new(loaded.scene))];
+                config.scaling = false;
+                config.headline = false;
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        }
+    }
     if args.headline_only {
         config.cases.clear();
         config.scaling = false;

@@ -2,7 +2,12 @@
 //!
 //! ```text
 //! cargo run --release -p scatter-examples --example godrays -- --scene window --truth exact --out window.png
+//! cargo run --release -p scatter-examples --example godrays -- --scene-file reference/scenes/mesh_grate.json --method prefiltered --gpu --out grate.png
 //! ```
+//!
+//! `--scene-file PATH` renders a scene of one's own (JSON, `reference/scenes/README.md`; OBJ
+//! meshes by `mesh_file`) instead of a suite scene, at the file's camera size unless
+//! `--width`/`--height` are given; its triangle count and BVH build time are printed.
 //!
 //! Writes `<out>` (composite: surfaces attenuated by the fog plus in-scattering), and beside
 //! it `<stem>.inscatter.png` (in-scattered radiance only, tone-mapped) and
@@ -34,7 +39,7 @@ use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
 use scatter_reference::kernels::{CpuFrame, CpuRun, engine_rectified_map};
 use scatter_reference::metrics;
-use scatter_reference::scene::Scene;
+use scatter_reference::scene::{Scene, Shape};
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::textures::upload_r32float;
@@ -146,8 +151,12 @@ enum Truth {
 )]
 struct Args {
     /// Suite scene: sphere, columns, window, foliage, terrain, spot_grate.
-    #[arg(long, value_parser = |s: &str| s.parse::<SceneName>())]
-    scene: SceneName,
+    #[arg(long, value_parser = |s: &str| s.parse::<SceneName>(), required_unless_present = "scene_file")]
+    scene: Option<SceneName>,
+    /// A scene file instead of a suite scene (JSON, reference/scenes/README.md; OBJ meshes
+    /// by `mesh_file`), at its camera's size unless --width/--height are given.
+    #[arg(long, value_name = "PATH", conflicts_with_all = ["scene", "pose", "medium"])]
+    scene_file: Option<PathBuf>,
     /// Camera pose: ordinary, epipole_on_screen, light_behind, grazing.
     #[arg(long, default_value = "ordinary", value_parser = |s: &str| s.parse::<Pose>())]
     pose: Pose,
@@ -182,12 +191,12 @@ struct Args {
     /// --frames on a CPU adapter].
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=100))]
     pass_wall_frames: Option<u32>,
-    /// Image width in pixels (1..=8192).
-    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(1..=8192))]
-    width: u32,
-    /// Image height in pixels (1..=8192).
-    #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(1..=8192))]
-    height: u32,
+    /// Image width in pixels (1..=8192) [default: 640, or a scene file's].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    width: Option<u32>,
+    /// Image height in pixels (1..=8192) [default: 360, or a scene file's].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    height: Option<u32>,
     /// Shadow-map size for `--truth shadow-map` and every family (1..=16384).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=16384))]
     shadow_map_size: u32,
@@ -348,20 +357,44 @@ fn run(args: &Args) -> Result<(), BoxError> {
     if args.out.extension().and_then(|e| e.to_str()) != Some("png") {
         return Err(format!("--out must name a .png file, got {}", args.out.display()).into());
     }
-    let scene = suite::scene(args.scene, args.pose, args.medium, args.width, args.height);
+    let scene = match (&args.scene_file, args.scene) {
+        (Some(path), _) => {
+            let mut scene =
+                Scene::load(path).map_err(|e| format!("--scene-file {}: {e}", path.display()))?;
+            scene.camera.width = args.width.unwrap_or(scene.camera.width);
+            scene.camera.height = args.height.unwrap_or(scene.camera.height);
+            scene
+        }
+        (None, Some(name)) => suite::scene(
+            name,
+            args.pose,
+            args.medium,
+            args.width.unwrap_or(640),
+            args.height.unwrap_or(360),
+        ),
+        (None, None) => return Err("give --scene NAME or --scene-file PATH".into()),
+    };
     scene.validate()?;
     let light = scene.light.kind();
     let plan = check(args, light)?;
+    let (width, height) = (scene.camera.width, scene.camera.height);
     let t0 = Instant::now();
     let bvh = Bvh::build(&scene.geometry);
+    let bvh_time = t0.elapsed();
+    let t0 = Instant::now();
     let gbuf = GBuffer::cast(&scene, &bvh);
     eprintln!(
-        "{}: {} occluders, {} primitives; depth buffer {}x{} in {:.2?}",
+        "{}: {} occluders ({} triangles), {} primitives, BVH built in {:.2?}; depth buffer {width}x{height} in {:.2?}",
         scene.name,
         scene.occluder_count(),
+        scene
+            .geometry
+            .iter()
+            .filter(|s| matches!(s, Shape::Mesh { .. } | Shape::Heightfield { .. }))
+            .map(Shape::occluder_count)
+            .sum::<usize>(),
         bvh.prim_count(),
-        args.width,
-        args.height,
+        bvh_time,
         t0.elapsed()
     );
     let which = match plan {
@@ -382,7 +415,7 @@ fn run(args: &Args) -> Result<(), BoxError> {
             Visibility::ShadowMap(&sm)
         }
     };
-    let bar = ProgressBar::new(u64::from(args.height)).with_style(
+    let bar = ProgressBar::new(u64::from(scene.camera.height)).with_style(
         ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, eta {eta}")?
             .progress_chars("=> "),
     );
@@ -442,7 +475,7 @@ fn run_family(
         t.elapsed()
     );
     let t = Instant::now();
-    let settings = FrameSettings::for_screen(args.width, args.height);
+    let settings = FrameSettings::for_screen(scene.camera.width, scene.camera.height);
     let rectified = plan.rectified.unwrap_or(DEFAULT_RECTIFIED);
     let output = match &plan.gpu {
         Some(gpu) => run_on_gpu(gpu, plan, scene, bvh, gbuf, &sm, settings)?,
@@ -472,7 +505,7 @@ fn run_family(
     let composite = truth::surface_radiance(scene, gbuf, bvh).add(&output)?;
     write_outputs(args, &composite, &output)?;
     if plan.compare {
-        let bar = ProgressBar::new(u64::from(args.height)).with_style(
+        let bar = ProgressBar::new(u64::from(scene.camera.height)).with_style(
             ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, eta {eta}")?
                 .progress_chars("=> "),
         );
@@ -922,6 +955,33 @@ mod tests {
     }
 
     #[test]
+    fn a_scene_file_replaces_the_suite_scene_and_its_pose_and_medium() {
+        let parse = |a: &[&str]| Args::try_parse_from(a).map_err(|e| e.kind());
+        let a = parse(&["godrays", "--scene-file", "s.json", "--out", "x.png"])
+            .unwrap_or_else(|e| panic!("{e:?}"));
+        assert_eq!(a.scene_file, Some(PathBuf::from("s.json")));
+        assert_eq!(a.scene, None);
+        assert_eq!((a.width, a.height), (None, None));
+        for extra in [
+            ["--scene", "sphere"],
+            ["--pose", "grazing"],
+            ["--medium", "thick"],
+        ] {
+            let mut all = vec!["godrays", "--scene-file", "s.json", "--out", "x.png"];
+            all.extend_from_slice(&extra);
+            assert_eq!(
+                parse(&all).err(),
+                Some(clap::error::ErrorKind::ArgumentConflict),
+                "{extra:?}"
+            );
+        }
+        assert_eq!(
+            parse(&["godrays", "--out", "x.png"]).err(),
+            Some(clap::error::ErrorKind::MissingRequiredArgument)
+        );
+    }
+
+    #[test]
     fn help_describes_the_demo() {
         let about = Args::command()
             .get_about()
@@ -956,7 +1016,7 @@ mod tests {
         let e = parse_method("prefilter").unwrap_err();
         assert_eq!(
             e,
-            "method must be truth | minmax | prefiltered | raymarch, got prefilter"
+            "method must be truth | hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch, got prefilter"
         );
         assert!(
             Args::try_parse_from([
@@ -968,7 +1028,7 @@ mod tests {
 
     #[test]
     fn truth_refuses_family_options() {
-        let to = "applies to a kernel family (--method minmax | prefiltered | raymarch), not to --method truth";
+        let to = "applies to a kernel family (--method hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch), not to --method truth";
         assert_eq!(refused(&["--gpu"]), format!("--gpu {to}"));
         assert_eq!(refused(&["--compare"]), format!("--compare {to}"));
         assert_eq!(

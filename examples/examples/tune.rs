@@ -8,13 +8,19 @@
 //!
 //! ```sh
 //! cargo run --release -p scatter-examples --example tune -- --scene foliage --max-error 0.02
+//! cargo run --release -p scatter-examples --example tune -- --scene-file reference/scenes/mesh_grate.json --max-error 0.02
 //! ```
+//!
+//! With `--scene-file` the scene of one's own is the one view measured (its camera at the
+//! sweep's screen size) instead of a suite scene's four poses.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use clap::Parser;
 use scatter_examples::bench::{
-    BenchConfig, pareto_entries, run, scatter_gen_command, tune_candidates, tune_pick,
+    BenchConfig, Case, pareto_entries, run, scatter_gen_command, tune_candidates, tune_pick,
     tune_refinements, tune_table,
 };
 use scatter_reference::suite::{Pose, SceneName};
@@ -24,9 +30,17 @@ use scatter_runtime::Context;
 #[derive(Debug, Parser)]
 #[command(name = "tune")]
 struct Args {
-    /// Suite scene.
-    #[arg(long)]
-    scene: SceneName,
+    /// Suite scene (its four poses).
+    #[arg(
+        long,
+        required_unless_present = "scene_file",
+        conflicts_with = "scene_file"
+    )]
+    scene: Option<SceneName>,
+    /// A scene of one's own instead (JSON, `reference/scenes/README.md`; OBJ meshes by
+    /// `mesh_file`): its one view.
+    #[arg(long, value_name = "PATH")]
+    scene_file: Option<PathBuf>,
     /// Error budgets: worst rel L1 over the poses against the shadow_map truth, as fractions
     /// (0.02 = 2 %); several may be given.
     #[arg(long = "max-error", required = true, num_args = 1..)]
@@ -44,10 +58,32 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     }
     let mut config = BenchConfig::default_sweep();
-    config.cases = Pose::ALL.iter().map(|&p| (args.scene, p)).collect();
+    let scene_name = match (&args.scene_file, args.scene) {
+        (Some(path), _) => match scatter_examples::scene_file::load(path, Some(config.screen)) {
+            Ok(loaded) => {
+                eprintln!("{}", loaded.report(path));
+                let name = loaded.scene.name.clone();
+                config.cases = vec![Case::File(Arc::new(loaded.scene))];
+                name
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        },
+        (None, Some(scene)) => {
+            config.cases = Pose::ALL.iter().map(|&p| Case::Suite(scene, p)).collect();
+            scene.name().to_owned()
+        }
+        (None, None) => {
+            eprintln!("error: give --scene NAME or --scene-file PATH");
+            return ExitCode::from(2);
+        }
+    };
     config.rectified = [512, 512];
     config.scaling = false;
     config.headline = false;
+    config.skip_over_limits = true;
     let measure = |methods: Vec<scatter_examples::bench::Method>| -> Result<_, String> {
         let config = BenchConfig {
             methods,
@@ -72,12 +108,15 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    for (id, why) in first.skipped.iter().chain(&second.skipped) {
+        eprintln!("skipped {id}: {why}");
+    }
     let rows: Vec<_> = first.rows.iter().chain(&second.rows).cloned().collect();
     let table = tune_table(&rows);
     let front = pareto_entries(&table);
     println!(
         "{}: {} candidates ({} refinements) on {} poses ({}x{}, {} s)",
-        args.scene,
+        scene_name,
         table.len(),
         table.len() - tune_table(&first.rows).len(),
         config.cases.len(),

@@ -15,6 +15,7 @@
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -38,7 +39,7 @@ use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::shaderlib::sampling::SamplingKnobs;
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::wgpu::TextureView;
-use scatter_runtime::{Context, FamilyPasses, Prefiltered};
+use scatter_runtime::{Context, FamilyPasses, Prefiltered, RuntimeError};
 
 /// A variant of any family (the light is set per scene) with, for a family that rectifies,
 /// its rectified map when it differs from the run's (`BenchConfig::rectified`).
@@ -134,11 +135,60 @@ impl Method {
     }
 }
 
+/// A scene the sweep measures: a suite scene at a pose, or a scene of one's own.
+#[derive(Clone, Debug)]
+pub enum Case {
+    /// `suite::scene(name, pose, MediumPreset::Default, ...)` at the bench's screen.
+    Suite(SceneName, Pose),
+    /// A scene file's scene (`bench --scene-file`, `tune --scene-file`): its camera is sized
+    /// to the bench's screen (the aspect follows the screen); the pose column reads `file`.
+    File(Arc<Scene>),
+}
+
+impl Case {
+    /// The scene at `screen`.
+    pub fn scene(&self, [w, h]: [u32; 2]) -> Scene {
+        match self {
+            Case::Suite(name, pose) => suite::scene(*name, *pose, MediumPreset::Default, w, h),
+            Case::File(scene) => {
+                let mut scene = Scene::clone(scene);
+                scene.camera.width = w;
+                scene.camera.height = h;
+                scene
+            }
+        }
+    }
+
+    /// The scene's name (the `scene` column).
+    pub fn scene_name(&self) -> String {
+        match self {
+            Case::Suite(name, _) => name.name().to_owned(),
+            Case::File(scene) => scene.name.clone(),
+        }
+    }
+
+    /// The pose's name (the `pose` column): `file` for a scene file.
+    pub fn pose_name(&self) -> &'static str {
+        match self {
+            Case::Suite(_, pose) => pose.name(),
+            Case::File(_) => "file",
+        }
+    }
+
+    /// The scene's light type.
+    pub fn light(&self) -> LightKind {
+        match self {
+            Case::Suite(name, _) => light_of(*name),
+            Case::File(scene) => scene.light.kind(),
+        }
+    }
+}
+
 /// What to run.
 #[derive(Clone, Debug)]
 pub struct BenchConfig {
-    /// Scene and pose pairs.
-    pub cases: Vec<(SceneName, Pose)>,
+    /// The scenes of the sweep.
+    pub cases: Vec<Case>,
     /// Methods (their light is the scene's).
     pub methods: Vec<Method>,
     /// Screen size of the accuracy and timing runs.
@@ -165,6 +215,11 @@ pub struct BenchConfig {
     /// Only these families' methods, in the sweep and the headline runs (empty: every
     /// family); `bench --family raymarch --family hybrid_volume`.
     pub families: Vec<Family>,
+    /// Leave out (and list in [`BenchResult::skipped`]) a method whose resources exceed a
+    /// device limit, instead of failing the run: `tune`, whose grid spans layouts a small
+    /// device cannot hold (a partial-sum tree of rank 8 over 1024 x 512 samples needs a
+    /// 151 MB storage buffer; lavapipe binds at most 134 MB).
+    pub skip_over_limits: bool,
 }
 
 impl BenchConfig {
@@ -214,7 +269,12 @@ impl BenchConfig {
         BenchConfig {
             cases: SceneName::ALL
                 .iter()
-                .flat_map(|&s| [(s, Pose::Ordinary), (s, Pose::EpipoleOnScreen)])
+                .flat_map(|&s| {
+                    [
+                        Case::Suite(s, Pose::Ordinary),
+                        Case::Suite(s, Pose::EpipoleOnScreen),
+                    ]
+                })
                 .collect(),
             methods,
             screen: [320, 180],
@@ -226,6 +286,7 @@ impl BenchConfig {
             headline: true,
             headline_error: true,
             families: Vec::new(),
+            skip_over_limits: false,
         }
     }
 
@@ -234,8 +295,8 @@ impl BenchConfig {
     pub fn quick() -> BenchConfig {
         BenchConfig {
             cases: vec![
-                (SceneName::Sphere, Pose::Ordinary),
-                (SceneName::Foliage, Pose::Ordinary),
+                Case::Suite(SceneName::Sphere, Pose::Ordinary),
+                Case::Suite(SceneName::Foliage, Pose::Ordinary),
             ],
             methods: vec![
                 Method::prefiltered_default(),
@@ -260,6 +321,7 @@ impl BenchConfig {
             headline: false,
             headline_error: false,
             families: Vec::new(),
+            skip_over_limits: false,
         }
     }
 
@@ -285,10 +347,10 @@ pub struct Row {
     pub knobs: String,
     /// The method (light set to the scene's).
     pub method: Method,
-    /// Scene.
-    pub scene: SceneName,
-    /// Pose.
-    pub pose: Pose,
+    /// Scene ([`Case::scene_name`]).
+    pub scene: String,
+    /// Pose ([`Case::pose_name`]: `file` for a scene file).
+    pub pose: &'static str,
     /// rel L1 against the `exact` truth.
     pub rel_l1_exact: f64,
     /// rel L1 against the `shadow_map` truth.
@@ -381,6 +443,9 @@ pub struct BenchResult {
     pub scaling: Vec<ScalingRow>,
     /// Headline runs (1280x720, 1024x1024 rectified).
     pub headline: Vec<HeadlineRow>,
+    /// Methods left out by [`BenchConfig::skip_over_limits`]: (method id, the limit's error),
+    /// once per method.
+    pub skipped: Vec<(String, String)>,
     /// Wall time of the whole bench.
     pub elapsed: Duration,
 }
@@ -415,9 +480,11 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
         ProgressBar::hidden()
     };
     let mut rows = Vec::new();
+    let mut skipped = Vec::new();
     let [w, h] = config.screen;
-    for &(name, pose) in &config.cases {
-        let scene = suite::scene(name, pose, MediumPreset::Default, w, h);
+    for case in &config.cases {
+        let (name, pose) = (case.scene_name(), case.pose_name());
+        let scene = case.scene([w, h]);
         let bvh = Bvh::build(&scene.geometry);
         let gbuf = GBuffer::cast(&scene, &bvh);
         let sm = ShadowMap::build(&scene, &bvh, config.shadow_map)?;
@@ -456,12 +523,13 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
         let methods: Vec<Method> = config
             .methods
             .iter()
-            .map(|m| m.with_light(light_of(name)))
+            .map(|m| m.with_light(case.light()))
             .collect();
         let mut runs = Vec::with_capacity(methods.len());
+        let mut kept = Vec::with_capacity(methods.len());
         for &method in &methods {
             bar.set_message(format!("{name}/{pose}: {}", method.id()));
-            runs.push(run_method(
+            match run_method(
                 ctx,
                 method,
                 &scene,
@@ -470,8 +538,27 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
                 &shadow_view,
                 config.screen,
                 config.rectified,
-            )?);
+            ) {
+                Ok(run) => {
+                    runs.push(run);
+                    kept.push(method);
+                }
+                Err(e)
+                    if config.skip_over_limits
+                        && matches!(
+                            e.downcast_ref::<RuntimeError>(),
+                            Some(RuntimeError::LimitExceeded { .. })
+                        ) =>
+                {
+                    if !skipped.iter().any(|(id, _)| *id == method.id()) {
+                        skipped.push((method.id(), e.to_string()));
+                    }
+                    bar.inc(1);
+                }
+                Err(e) => return Err(e),
+            }
         }
+        let methods = kept;
         bar.set_message(format!("{name}/{pose}: timing, interleaved"));
         let inputs = Inputs {
             depth: &depth_view,
@@ -491,7 +578,7 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
                 variant: method.id(),
                 knobs: method.knobs(),
                 method,
-                scene: name,
+                scene: name.clone(),
                 pose,
                 rel_l1_exact: e.rel_l1,
                 rel_l1_shadow_map: s.rel_l1,
@@ -521,6 +608,7 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
         rows,
         scaling,
         headline,
+        skipped,
         elapsed: start.elapsed(),
     })
 }
@@ -1217,8 +1305,8 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 .find(|r| {
                     r.family == family
                         && (r.knobs == "m32-r3" || family == "minmax")
-                        && r.scene == scene
-                        && r.pose == Pose::Ordinary
+                        && r.scene == scene.name()
+                        && r.pose == Pose::Ordinary.name()
                 })
                 .map(|r| (ms(r.total()), r.rel_l1_shadow_map))
         };
@@ -1258,8 +1346,8 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 .find(|r| {
                     r.family == family
                         && r.knobs == knobs
-                        && r.scene == scene
-                        && r.pose == Pose::Ordinary
+                        && r.scene == scene.name()
+                        && r.pose == Pose::Ordinary.name()
                 })
                 .map(|r| ms(r.total()))
         };

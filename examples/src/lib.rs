@@ -2,3 +2,4 @@
 
 pub mod bench;
 pub mod roofline;
+pub mod scene_file;

@@ -389,22 +389,146 @@ fn check_positive(field: &str, v: f64) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// A `geometry` entry of type `mesh_file` in a scene file: a Wavefront OBJ file loaded as a
+/// [`Shape::Mesh`] (every object and group of the file, faces triangulated as fans;
+/// materials, normals and texture coordinates ignored), scaled then translated.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeshFile {
+    /// Always `mesh_file` (the tag).
+    #[serde(rename = "type")]
+    _type: String,
+    /// The OBJ file; relative paths are relative to the scene file's directory
+    /// ([`Scene::load`]) or to the working directory ([`Scene::from_json`]).
+    path: String,
+    /// Uniform scale applied first (> 0).
+    #[serde(default = "unit_scale")]
+    scale: f64,
+    /// Translation applied after the scale.
+    #[serde(default)]
+    translate: DVec3,
+    /// Diffuse albedo (RGB) for composites.
+    #[serde(default = "default_albedo")]
+    albedo: [f64; 3],
+}
+
+fn unit_scale() -> f64 {
+    1.0
+}
+
+/// Loads the OBJ file of `geometry[index]`.
+fn load_mesh_file(index: usize, file: &MeshFile, base: Option<&Path>) -> Result<Shape, SceneError> {
+    let field = |f: &str| format!("geometry[{index}].{f}");
+    check_positive(&field("scale"), file.scale)?;
+    check_vec(&field("translate"), file.translate)?;
+    let path = match base {
+        Some(dir) if Path::new(&file.path).is_relative() => dir.join(&file.path),
+        _ => Path::new(&file.path).to_path_buf(),
+    };
+    let is_obj = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if !is_obj {
+        return Err(invalid(
+            field("path"),
+            format!(
+                "must name a Wavefront OBJ file (.obj; glTF is not supported), got {}",
+                file.path
+            ),
+        ));
+    }
+    let options = tobj::LoadOptions {
+        single_index: true,
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, _materials) = tobj::load_obj(&path, &options).map_err(|e| {
+        invalid(
+            field("path"),
+            format!("cannot load OBJ file {}: {e}", path.display()),
+        )
+    })?;
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for model in &models {
+        let base = u32::try_from(vertices.len()).map_err(|_| {
+            invalid(
+                field("path"),
+                format!("{}: too many vertices", path.display()),
+            )
+        })?;
+        vertices.extend(model.mesh.positions.chunks_exact(3).map(|p| {
+            DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) * file.scale
+                + file.translate
+        }));
+        triangles.extend(
+            model
+                .mesh
+                .indices
+                .chunks_exact(3)
+                .map(|t| [base + t[0], base + t[1], base + t[2]]),
+        );
+    }
+    if triangles.is_empty() {
+        return Err(invalid(
+            field("path"),
+            format!("{}: the OBJ file has no faces", path.display()),
+        ));
+    }
+    Ok(Shape::Mesh {
+        vertices,
+        triangles,
+        albedo: file.albedo,
+    })
+}
+
 impl Scene {
-    /// Parses and validates a scene from JSON text.
+    /// Parses and validates a scene from JSON text; `mesh_file` entries load their OBJ files
+    /// relative to the working directory.
     pub fn from_json(text: &str) -> Result<Scene, SceneError> {
-        let scene: Scene = serde_json::from_str(text)?;
+        Scene::from_json_in(text, None)
+    }
+
+    /// Parses and validates a scene from JSON text; `mesh_file` entries load their OBJ files,
+    /// relative paths from `base` (the working directory when `None`).
+    pub fn from_json_in(text: &str, base: Option<&Path>) -> Result<Scene, SceneError> {
+        let mut value: serde_json::Value = serde_json::from_str(text)?;
+        // `mesh_file` entries are read here and stand as empty meshes until the scene is
+        // parsed: a parsed `Scene` only holds shapes every stage can render.
+        let mut meshes = Vec::new();
+        if let Some(geometry) = value
+            .get_mut("geometry")
+            .and_then(serde_json::Value::as_array_mut)
+        {
+            for (index, entry) in geometry.iter_mut().enumerate() {
+                if entry.get("type").and_then(serde_json::Value::as_str) != Some("mesh_file") {
+                    continue;
+                }
+                let file: MeshFile = serde_json::from_value(entry.take())
+                    .map_err(|e| invalid(format!("geometry[{index}]"), e.to_string()))?;
+                meshes.push((index, load_mesh_file(index, &file, base)?));
+                *entry = serde_json::json!({"type": "mesh", "vertices": [], "triangles": []});
+            }
+        }
+        let mut scene: Scene = serde_json::from_value(value)?;
+        for (index, mesh) in meshes {
+            scene.geometry[index] = mesh;
+        }
         scene.validate()?;
         Ok(scene)
     }
 
-    /// Reads, parses and validates a scene file.
+    /// Reads, parses and validates a scene file; `mesh_file` paths are relative to its
+    /// directory.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
             path: path.display().to_string(),
             source,
         })?;
-        Scene::from_json(&text)
+        Scene::from_json_in(&text, path.parent())
     }
 
     /// Serialises the scene as pretty JSON.

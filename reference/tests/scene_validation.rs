@@ -664,3 +664,136 @@ fn scene_files_match_the_suite() {
         );
     }
 }
+
+/// The example scene with a `mesh_file` entry: its OBJ (quads) loads as one triangle mesh,
+/// scaled and translated, and the scene validates.
+#[test]
+fn mesh_file_entries_load_their_obj_as_a_triangle_mesh() {
+    let scene = Scene::load(scenes_dir().join("mesh_grate.json")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.geometry.len(), 2);
+    let Shape::Mesh {
+        vertices,
+        triangles,
+        albedo,
+    } = &scene.geometry[1]
+    else {
+        panic!("geometry[1] is {:?}", scene.geometry[1]);
+    };
+    // 14 bars, 8 corners and 6 quads (12 triangles) each.
+    assert_eq!(vertices.len(), 14 * 8);
+    assert_eq!(triangles.len(), 14 * 12);
+    assert_eq!(scene.occluder_count(), 1 + 14 * 12);
+    assert_eq!(*albedo, [0.35, 0.3, 0.25]);
+    for v in vertices {
+        assert!(
+            (v.y - 5.0).abs() < 0.13 && v.x.abs() < 3.2 && v.z.abs() < 3.2,
+            "{v}"
+        );
+    }
+    // A parsed scene holds the mesh itself: it round-trips through JSON without the file.
+    let back = Scene::from_json(&scene.to_json()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(back, scene);
+}
+
+/// A scratch directory with `scene.json` (the `mesh_grate` scene with `entry` as its second
+/// shape) and `files`; the scene loaded from it.
+fn load_with_mesh_entry(
+    test: &str,
+    entry: serde_json::Value,
+    files: &[(&str, &str)],
+) -> Result<Scene, SceneError> {
+    let dir = std::env::temp_dir().join(format!("scatter-scene-{test}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    let text = std::fs::read_to_string(scenes_dir().join("mesh_grate.json"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut value: serde_json::Value =
+        serde_json::from_str(&text).unwrap_or_else(|e| panic!("{e}"));
+    value["geometry"][1] = entry;
+    std::fs::write(dir.join("scene.json"), value.to_string()).unwrap_or_else(|e| panic!("{e}"));
+    for (name, body) in files {
+        std::fs::write(dir.join(name), body).unwrap_or_else(|e| panic!("{e}"));
+    }
+    let scene = Scene::load(dir.join("scene.json"));
+    let _ = std::fs::remove_dir_all(&dir);
+    scene
+}
+
+/// (test name, the `mesh_file` entry, files beside the scene, expected error text).
+type BadMeshCase = (
+    &'static str,
+    serde_json::Value,
+    &'static [(&'static str, &'static str)],
+    &'static str,
+);
+
+/// Bad `mesh_file` entries: one error naming the field, never a panic.
+#[test]
+fn bad_mesh_file_entries_are_refused_naming_the_field() {
+    const SQUARE: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+    let cases: [BadMeshCase; 6] = [
+        (
+            "missing",
+            serde_json::json!({"type": "mesh_file", "path": "nowhere.obj"}),
+            &[],
+            "geometry[1].path cannot load OBJ file",
+        ),
+        (
+            "gltf",
+            serde_json::json!({"type": "mesh_file", "path": "m.gltf"}),
+            &[("m.gltf", "{}")],
+            "geometry[1].path must name a Wavefront OBJ file",
+        ),
+        (
+            "scale",
+            serde_json::json!({"type": "mesh_file", "path": "m.obj", "scale": 0.0}),
+            &[("m.obj", SQUARE)],
+            "geometry[1].scale must be > 0, got 0",
+        ),
+        (
+            "translate",
+            serde_json::json!({"type": "mesh_file", "path": "m.obj", "translate": [0.0, "up", 0.0]}),
+            &[("m.obj", SQUARE)],
+            "geometry[1] invalid type",
+        ),
+        (
+            "unknown",
+            serde_json::json!({"type": "mesh_file", "path": "m.obj", "rotate": 90}),
+            &[("m.obj", SQUARE)],
+            "geometry[1] unknown field `rotate`",
+        ),
+        (
+            "faceless",
+            serde_json::json!({"type": "mesh_file", "path": "m.obj"}),
+            &[("m.obj", "v 0 0 0\nv 1 0 0\n")],
+            "the OBJ file has no faces",
+        ),
+    ];
+    for (test, entry, files, expected) in cases {
+        match load_with_mesh_entry(test, entry, files) {
+            Ok(_) => panic!("{test}: accepted"),
+            Err(e) => {
+                let e = e.to_string();
+                assert!(e.contains(expected), "{test}: {e}");
+                assert!(!e.contains('\n'), "{test}: {e}");
+            }
+        }
+    }
+    // And a good one: the square (one quad) becomes two triangles, scaled then moved.
+    let scene = load_with_mesh_entry(
+        "square",
+        serde_json::json!({"type": "mesh_file", "path": "m.obj", "scale": 2.0, "translate": [0.0, 1.0, 0.0]}),
+        &[("m.obj", SQUARE)],
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let Shape::Mesh {
+        vertices,
+        triangles,
+        ..
+    } = &scene.geometry[1]
+    else {
+        panic!("{:?}", scene.geometry[1]);
+    };
+    assert_eq!(triangles.len(), 2);
+    assert_eq!(vertices[2], DVec3::new(2.0, 3.0, 0.0));
+}
