@@ -1,5 +1,6 @@
 //! Shared helpers of the scatter examples (see `examples/`).
 
 pub mod bench;
+pub mod raster;
 pub mod roofline;
 pub mod scene_file;

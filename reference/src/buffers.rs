@@ -201,12 +201,7 @@ fn light_basis(forward: DVec3) -> [DVec3; 3] {
 impl ShadowMap {
     /// Ray casts a `size x size` shadow map for the scene's light (see module docs).
     pub fn build(scene: &Scene, bvh: &Bvh, size: u32) -> Result<ShadowMap, ShadowMapError> {
-        if size == 0 {
-            return Err(ShadowMapError::ZeroSize(size));
-        }
-        if size > 16384 {
-            return Err(ShadowMapError::TooLarge(size));
-        }
+        let mut sm = ShadowMap::fit(scene, bvh, size)?;
         // Infinite planes the sun shines on from behind (a sun below the ground's horizon):
         // the near plane stops at the bounded geometry, so such a plane may cross a texel's
         // line between the sun and the map. Every point in front of it is then in its
@@ -226,9 +221,46 @@ impl ShadowMap {
                 .collect(),
             Light::Spot { .. } => Vec::new(),
         };
+        let n = size as usize;
+        sm.depth = (0..n * n)
+            .into_par_iter()
+            .map(|i| {
+                let (ix, iy) = (i % n, i / n);
+                let u = (ix as f64 + 0.5) / n as f64;
+                let v = (iy as f64 + 0.5) / n as f64;
+                let (ray, z_of_t) = sm.texel_ray(u, v);
+                if backlit
+                    .iter()
+                    .any(|(p, nrm)| (ray.origin - *p).dot(*nrm) > 0.0)
+                {
+                    return 0.0;
+                }
+                match bvh.closest(&ray, 0.0, f64::INFINITY) {
+                    Some(hit) => sm.normalise(z_of_t(hit.t)).clamp(0.0, 1.0) as f32,
+                    None => 1.0,
+                }
+            })
+            .collect();
+        Ok(sm)
+    }
+
+    /// The map's frame for the scene's light (light-space basis, projection, depth range:
+    /// see the module docs) with no depth yet: what an engine rasterising its own map
+    /// renders into (`scatter_examples::raster`); [`ShadowMap::build`] ray-casts it.
+    ///
+    /// # Errors
+    ///
+    /// As [`ShadowMap::build`].
+    pub fn fit(scene: &Scene, bvh: &Bvh, size: u32) -> Result<ShadowMap, ShadowMapError> {
+        if size == 0 {
+            return Err(ShadowMapError::ZeroSize(size));
+        }
+        if size > 16384 {
+            return Err(ShadowMapError::TooLarge(size));
+        }
         let corners = scene.camera.frustum_corners();
         let scene_bounds = bvh.bounds();
-        let mut sm = match &scene.light {
+        let sm = match &scene.light {
             Light::Directional { direction, .. } => {
                 let basis = light_basis(*direction);
                 let lc = |p: DVec3| DVec3::new(p.dot(basis[0]), p.dot(basis[1]), p.dot(basis[2]));
@@ -296,26 +328,6 @@ impl ShadowMap {
                 }
             }
         };
-        let n = size as usize;
-        sm.depth = (0..n * n)
-            .into_par_iter()
-            .map(|i| {
-                let (ix, iy) = (i % n, i / n);
-                let u = (ix as f64 + 0.5) / n as f64;
-                let v = (iy as f64 + 0.5) / n as f64;
-                let (ray, z_of_t) = sm.texel_ray(u, v);
-                if backlit
-                    .iter()
-                    .any(|(p, nrm)| (ray.origin - *p).dot(*nrm) > 0.0)
-                {
-                    return 0.0;
-                }
-                match bvh.closest(&ray, 0.0, f64::INFINITY) {
-                    Some(hit) => sm.normalise(z_of_t(hit.t)).clamp(0.0, 1.0) as f32,
-                    None => 1.0,
-                }
-            })
-            .collect();
         Ok(sm)
     }
 

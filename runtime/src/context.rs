@@ -215,8 +215,12 @@ impl Context {
                 },
             });
         };
-        let wanted_features =
-            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        // Timestamps for the pass times; depth-clip control for an engine that rasterises
+        // the projective rectified map on this device (the README's contract: depth
+        // clamping on; `scatter_examples::raster`). Each only where the adapter has it.
+        let wanted_features = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+            | wgpu::Features::DEPTH_CLIP_CONTROL;
         let required_features = adapter.features() & wanted_features;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("scatter"),
