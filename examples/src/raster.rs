@@ -586,28 +586,7 @@ impl Rasteriser {
             height: h,
             depth_or_array_layers: 1,
         };
-        let target = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("raster rectified"),
-            size: extent,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let zbuffer = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("raster rectified z-buffer"),
-            size: extent,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Depth32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
+        let (target, zbuffer) = targets(device, extent, "raster rectified");
         // Each region's triangles clipped to w >= W_MIN: with depth clamping on, near
         // clipping is off, and a triangle reaching behind the map's centre (w < 0) is
         // rasterised differently by different rasterisers (llvmpipe drew none of the ground
@@ -723,28 +702,7 @@ impl Rasteriser {
             height: h,
             depth_or_array_layers: 1,
         };
-        let target = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("raster target"),
-            size: extent,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let zbuffer = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("raster z-buffer"),
-            size: extent,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Depth32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
+        let (target, zbuffer) = targets(device, extent, "raster target");
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("raster view"),
             size: 96,
@@ -911,4 +869,36 @@ fn render_pipeline(
         multiview_mask: None,
         cache: None,
     })
+}
+
+/// An `R32Float` colour target (rendered, sampled, copied) and its `Depth32Float` z-buffer.
+fn targets(
+    device: &wgpu::Device,
+    extent: wgpu::Extent3d,
+    label: &str,
+) -> (wgpu::Texture, wgpu::Texture) {
+    let texture = |format, usage| {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: extent,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+    };
+    (
+        texture(
+            wgpu::TextureFormat::R32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+        ),
+        texture(
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        ),
+    )
 }
