@@ -772,8 +772,15 @@ fn run_on_gpu(
             let input = RaymarchInput::from(&frame);
             let ctx = &ctx;
             Box::new(move |_| {
-                let rb =
-                    run_raymarch_once(ctx, v, res.screen, &input, &gbuf.view_depth, &sm.depth)?;
+                let rb = run_raymarch_once(
+                    ctx,
+                    v,
+                    res.screen,
+                    &input,
+                    &gbuf.view_depth,
+                    &sm.depth,
+                    None,
+                )?;
                 Ok(GpuFrame {
                     output: rb.output,
                     report: None,

@@ -57,6 +57,11 @@ pub struct RaymarchVariant {
     pub slice_samples: u32,
     /// `sampling = epipolar`: the initial step between evaluated samples of a slice.
     pub step: u32,
+    /// A spot light's cookie: an RGB texture projected along the cone multiplies the
+    /// light's intensity per sample (`light = spot` only; the kernels bind the engine's
+    /// `cookie` texture, [`crate::cookie`]).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub cookie: bool,
 }
 
 impl Default for RaymarchVariant {
@@ -74,6 +79,7 @@ impl Default for RaymarchVariant {
             slices: SamplingKnobs::DEFAULT_SLICES,
             slice_samples: SamplingKnobs::DEFAULT_SLICE_SAMPLES,
             step: SamplingKnobs::DEFAULT_STEP,
+            cookie: false,
         }
     }
 }
@@ -104,6 +110,7 @@ impl RaymarchVariant {
             });
         }
         self.sampling_knobs().validate()?;
+        crate::cookie::validate_cookie(self.cookie, self.light)?;
         if self.interleaved() && self.sampling_knobs().is_sampled() {
             return Err(VariantError {
                 knob: "interleave",
@@ -123,20 +130,23 @@ impl RaymarchVariant {
         self.interleave > 1
     }
 
-    /// A short stable id: `n64-i4-jitter-directional`, `n128-i1-nojitter-spot`.
+    /// A short stable id: `n64-i4-jitter-directional`, `n128-i1-nojitter-spot`,
+    /// `n64-i1-nojitter-spot-cookie`.
     pub fn id(&self) -> String {
         format!(
-            "n{}-i{}-{}-{}{}",
+            "n{}-i{}-{}-{}{}{}",
             self.samples,
             self.interleave,
             if self.jitter { "jitter" } else { "nojitter" },
             self.light,
+            crate::cookie::id_suffix(self.cookie),
             self.sampling_knobs().id_suffix()
         )
     }
 
     /// The conformance grid: samples {8, 32, 128} x interleave {1, 2, 4} x jitter x light
-    /// (pairs whose samples are not a multiple of interleave^2 skipped).
+    /// (pairs whose samples are not a multiple of interleave^2 skipped), and the spot's
+    /// cookie at 32 samples with interleave 1 and 2, jittered or not.
     pub fn grid() -> Vec<RaymarchVariant> {
         let mut out = Vec::new();
         for samples in [8, 32, 128] {
@@ -152,6 +162,9 @@ impl RaymarchVariant {
                         };
                         if v.validate().is_ok() {
                             out.push(v);
+                        }
+                        if samples == 32 && interleave <= 2 && light == LightKind::Spot {
+                            out.push(RaymarchVariant { cookie: true, ..v });
                         }
                     }
                 }
@@ -325,6 +338,7 @@ impl KnobSet for RaymarchVariant {
         if self.jitter != Self::default().jitter {
             m += if self.jitter { "-jitter" } else { "-nojitter" };
         }
+        m += crate::cookie::id_suffix(self.cookie);
         m + &self.sampling_knobs().marker_suffix()
     }
 

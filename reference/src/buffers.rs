@@ -190,7 +190,9 @@ pub struct ShadowCoord {
     pub z: f64,
 }
 
-fn light_basis(forward: DVec3) -> [DVec3; 3] {
+/// The light frame (right, up, forward) of a spot or directional light travelling along
+/// `forward`: the shadow map's basis, and the frame a spot's cookie is projected in.
+pub fn light_basis(forward: DVec3) -> [DVec3; 3] {
     let f = forward.normalize();
     let helper = if f.y.abs() < 0.99 { DVec3::Y } else { DVec3::X };
     let right = f.cross(helper).normalize();

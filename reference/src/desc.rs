@@ -41,6 +41,7 @@ impl Scene {
                 inner_angle_deg,
                 outer_angle_deg,
                 intensity,
+                ..
             } => LightDesc::Spot {
                 position: *position,
                 direction: *direction,

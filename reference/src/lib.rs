@@ -23,6 +23,7 @@
 
 pub mod buffers;
 pub mod bvh;
+pub mod cookie;
 pub mod desc;
 pub mod geometry;
 pub mod image;

@@ -15,6 +15,8 @@
 //! integral (with its `sigma_t -> 0` limit) and the Sun et al. 2005 airlight integral for an
 //! isotropic point light (corrected form, `papers/notes.md`).
 
+use crate::buffers::light_basis;
+use crate::cookie::Cookie;
 use crate::scene::{Light, Medium};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -58,11 +60,13 @@ pub fn cone_falloff(cos_angle: f64, inner_deg: f64, outer_deg: f64) -> f64 {
 
 /// Per-ray constants of the integrand for one view ray and one light.
 #[derive(Clone, Copy, Debug)]
-pub struct RayIntegrand {
+pub struct RayIntegrand<'a> {
     origin: DVec3,
     dir: DVec3,
     medium: Medium,
     kind: LightKind,
+    /// A spot's cookie, its light frame (right, up, forward) and `tan(outer angle)`.
+    cookie: Option<(&'a Cookie, [DVec3; 3], f64)>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -78,10 +82,12 @@ enum LightKind {
     },
 }
 
-impl RayIntegrand {
+impl<'a> RayIntegrand<'a> {
     /// Integrand of the ray `origin + t dir` (`dir` unit) for `light` in `medium`. The RGB
-    /// light colour is left out: every method multiplies by `Light::color` at the end.
-    pub fn new(origin: DVec3, dir: DVec3, light: &Light, medium: &Medium) -> RayIntegrand {
+    /// light colour is left out: every method multiplies by `Light::color` at the end. A
+    /// spot's cookie is left out of [`Self::eval`] and [`Self::integrate`] and in
+    /// [`Self::eval_rgb`] and [`Self::integrate_rgb`].
+    pub fn new(origin: DVec3, dir: DVec3, light: &'a Light, medium: &Medium) -> RayIntegrand<'a> {
         let kind = match light {
             Light::Directional { direction, .. } => {
                 let cos_theta = -direction.normalize().dot(dir);
@@ -102,12 +108,78 @@ impl RayIntegrand {
                 outer_deg: *outer_angle_deg,
             },
         };
+        let cookie = match light {
+            Light::Spot {
+                direction,
+                outer_angle_deg,
+                cookie: Some(cookie),
+                ..
+            } => Some((
+                cookie,
+                light_basis(*direction),
+                outer_angle_deg.to_radians().tan(),
+            )),
+            _ => None,
+        };
         RayIntegrand {
             origin,
             dir,
             medium: *medium,
             kind,
+            cookie,
         }
+    }
+
+    /// Whether the light carries a cookie (the integrand is then RGB).
+    pub fn has_cookie(&self) -> bool {
+        self.cookie.is_some()
+    }
+
+    /// The cookie's value for the ray point at `t` (white without a cookie).
+    pub fn cookie_at(&self, t: f64) -> [f64; 3] {
+        match (self.cookie, self.kind) {
+            (Some((cookie, basis, tan_outer)), LightKind::Spot { position, .. }) => {
+                let travel = self.origin + self.dir * t - position;
+                cookie.sample_dir(travel, &basis, tan_outer)
+            }
+            _ => [1.0; 3],
+        }
+    }
+
+    /// [`Self::eval`] times the cookie (RGB).
+    pub fn eval_rgb(&self, t: f64) -> [f64; 3] {
+        let f = self.eval(t);
+        if f == 0.0 {
+            return [0.0; 3];
+        }
+        self.cookie_at(t).map(|c| c * f)
+    }
+
+    /// `integral_a^b` of [`Self::eval_rgb`]: [`Self::integrate`] per channel without a
+    /// cookie, 16-point Gauss-Legendre on `pieces` equal sub-intervals with one.
+    pub fn integrate_rgb(&self, a: f64, b: f64, pieces: usize) -> [f64; 3] {
+        if self.cookie.is_none() {
+            let f = self.integrate(a, b, pieces);
+            return [f; 3];
+        }
+        if b <= a {
+            return [0.0; 3];
+        }
+        let n = pieces.max(1);
+        let h = (b - a) / n as f64;
+        let mut sum = [0.0; 3];
+        for i in 0..n {
+            let lo = a + h * i as f64;
+            let m = lo + 0.5 * h;
+            let r = 0.5 * h;
+            for (x, w) in GL16_X.iter().zip(GL16_W) {
+                let (p, q) = (self.eval_rgb(m - r * x), self.eval_rgb(m + r * x));
+                for k in 0..3 {
+                    sum[k] += w * r * (p[k] + q[k]);
+                }
+            }
+        }
+        sum
     }
 
     /// Whether the unshadowed integrand over a segment has a closed form (directional).

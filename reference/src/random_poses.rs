@@ -533,6 +533,7 @@ fn draw(rng: &mut Rng, name: SceneName, base: &Scene) -> Option<(Scene, bool, Vi
                 inner_angle_deg: inner,
                 outer_angle_deg: outer,
                 intensity: intensity.map(|c| c * scale),
+                cookie: None,
             };
             (eye, (lamp - eye).normalize(), None)
         }

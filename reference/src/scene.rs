@@ -205,6 +205,10 @@ pub enum Light {
         outer_angle_deg: f64,
         /// Radiant intensity I (RGB) on the axis.
         intensity: [f64; 3],
+        /// An RGB texture projected along the cone that multiplies the intensity
+        /// ([`crate::cookie`]); needs `outer_angle_deg < 90`.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        cookie: Option<crate::cookie::Cookie>,
     },
 }
 
@@ -512,6 +516,16 @@ impl Scene {
                 *entry = serde_json::json!({"type": "mesh", "vertices": [], "triangles": []});
             }
         }
+        // A spot's cookie file is relative to the scene file's directory.
+        if let (Some(dir), Some(file)) = (
+            base,
+            value
+                .pointer_mut("/light/cookie/file")
+                .filter(|f| f.as_str().is_some_and(|f| Path::new(f).is_relative())),
+        ) {
+            let joined = dir.join(file.as_str().unwrap_or_default());
+            *file = serde_json::Value::String(joined.display().to_string());
+        }
         let mut scene: Scene = serde_json::from_value(value)?;
         for (index, mesh) in meshes {
             scene.geometry[index] = mesh;
@@ -614,6 +628,7 @@ impl Scene {
                 inner_angle_deg,
                 outer_angle_deg,
                 intensity,
+                cookie,
             } => {
                 check_vec("light.position", *position)?;
                 check_dir("light.direction", *direction)?;
@@ -634,6 +649,15 @@ impl Scene {
                     ));
                 }
                 check_rgb("light.intensity", *intensity)?;
+                if cookie.is_some() && *outer_angle_deg >= 90.0 {
+                    return Err(invalid(
+                        "light.cookie",
+                        format!(
+                            "needs light.outer_angle_deg < 90 (the cookie is projected onto a \
+                             plane across the cone), got {outer_angle_deg}"
+                        ),
+                    ));
+                }
             }
         }
         let m = &self.medium;

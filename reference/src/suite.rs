@@ -571,6 +571,7 @@ fn spot_grate(pose: Pose) -> Def {
             } else {
                 [200.0, 190.0, 170.0]
             },
+            cookie: None,
         },
         medium: Medium {
             sigma_t: 0.08,

@@ -79,7 +79,7 @@ pub fn visibility(vis: &Visibility, light: &Light, p: DVec3) -> bool {
 }
 
 /// In-scattered radiance along one view ray (`dir` unit) of length `s`, scalar (multiply by
-/// `Light::color`).
+/// `Light::color`; a spot's cookie is left out: [`ray_inscatter_rgb`] has it).
 pub fn ray_inscatter(
     scene: &Scene,
     vis: &Visibility,
@@ -89,15 +89,60 @@ pub fn ray_inscatter(
     s: f64,
 ) -> f64 {
     let f = RayIntegrand::new(origin, dir, &scene.light, &scene.medium);
+    let mut total = 0.0;
+    lit_intervals(scene, vis, settings, origin, dir, s, &mut |a, b, pieces| {
+        total += f.integrate(a, b, pieces);
+    });
+    total
+}
+
+/// In-scattered radiance (RGB) along one view ray (`dir` unit) of length `s`: the light's
+/// colour and, for a spot with a cookie, the cookie per point (integrated per channel over
+/// the same lit intervals as [`ray_inscatter`]).
+pub fn ray_inscatter_rgb(
+    scene: &Scene,
+    vis: &Visibility,
+    settings: &TruthSettings,
+    origin: DVec3,
+    dir: DVec3,
+    s: f64,
+) -> [f64; 3] {
+    let color = scene.light.color();
+    let f = RayIntegrand::new(origin, dir, &scene.light, &scene.medium);
+    if !f.has_cookie() {
+        let l = ray_inscatter(scene, vis, settings, origin, dir, s);
+        return color.map(|c| c * l);
+    }
+    let mut total = [0.0; 3];
+    lit_intervals(scene, vis, settings, origin, dir, s, &mut |a, b, pieces| {
+        let v = f.integrate_rgb(a, b, pieces);
+        for k in 0..3 {
+            total[k] += v[k];
+        }
+    });
+    [0, 1, 2].map(|k| color[k] * total[k])
+}
+
+/// Calls `lit(a, b, pieces)` for every lit interval `[a, b]` of the view ray, in order, with
+/// the Gauss-Legendre pieces for its smooth part (one per 4 cells).
+fn lit_intervals(
+    scene: &Scene,
+    vis: &Visibility,
+    settings: &TruthSettings,
+    origin: DVec3,
+    dir: DVec3,
+    s: f64,
+    lit: &mut dyn FnMut(f64, f64, usize),
+) {
     let n = settings.segments.max(1);
     let h = s / n as f64;
     if let Visibility::None = vis {
-        return f.integrate(0.0, s, n);
+        lit(0.0, s, n);
+        return;
     }
     let v = |t: f64| visibility(vis, &scene.light, origin + dir * t);
     // Gauss-Legendre pieces for the smooth part (spot): one 16-point rule per 4 cells.
     let pieces = |a: f64, b: f64| ((b - a) / (4.0 * h)).ceil().max(1.0) as usize;
-    let mut total = 0.0;
     let mut start = 0.0;
     let mut prev_t = 0.5 * h;
     let mut cur = v(prev_t);
@@ -116,7 +161,7 @@ pub fn ray_inscatter(
             }
             let b = 0.5 * (lo + hi);
             if cur {
-                total += f.integrate(start, b, pieces(start, b));
+                lit(start, b, pieces(start, b));
             }
             start = b;
             cur = vi;
@@ -124,9 +169,8 @@ pub fn ray_inscatter(
         prev_t = t;
     }
     if cur {
-        total += f.integrate(start, s, pieces(start, s));
+        lit(start, s, pieces(start, s));
     }
-    total
 }
 
 /// Renders the in-scattered radiance image (RGB) of a scene with the given visibility;
@@ -140,7 +184,6 @@ pub fn render(
 ) -> Image {
     let cam = &scene.camera;
     let frame = cam.frame();
-    let color = scene.light.color();
     let (w, h) = (gbuf.width, gbuf.height);
     let rows: Vec<Vec<[f32; 3]>> = (0..h)
         .into_par_iter()
@@ -149,9 +192,15 @@ pub fn render(
                 .map(|x| {
                     let i = (y * w + x) as usize;
                     let dir = camera_ray(scene, &frame, x, y);
-                    let l =
-                        ray_inscatter(scene, vis, settings, cam.position, dir, gbuf.ray_length[i]);
-                    color.map(|c| (c * l) as f32)
+                    let l = ray_inscatter_rgb(
+                        scene,
+                        vis,
+                        settings,
+                        cam.position,
+                        dir,
+                        gbuf.ray_length[i],
+                    );
+                    l.map(|c| c as f32)
                 })
                 .collect();
             on_row();
@@ -184,13 +233,14 @@ pub fn surface_radiance(scene: &Scene, gbuf: &GBuffer, bvh: &Bvh) -> Image {
             let dir = camera_ray(scene, &frame, x, y);
             let n = gbuf.normal[i];
             let p = cam.position + dir * s + n * 1e-4;
-            let (to_light, l_in) = match &scene.light {
-                Light::Directional { direction, .. } => (-direction.normalize(), 1.0),
+            let (to_light, l_in, tint) = match &scene.light {
+                Light::Directional { direction, .. } => (-direction.normalize(), 1.0, [1.0; 3]),
                 Light::Spot {
                     position,
                     direction,
                     inner_angle_deg,
                     outer_angle_deg,
+                    cookie,
                     ..
                 } => {
                     let d = *position - p;
@@ -200,7 +250,18 @@ pub fn surface_radiance(scene: &Scene, gbuf: &GBuffer, bvh: &Bvh) -> Image {
                         *inner_angle_deg,
                         *outer_angle_deg,
                     );
-                    (d / dist, cone * (-sigma_t * dist).exp() / (dist * dist))
+                    let tint = cookie.as_ref().map_or([1.0; 3], |c| {
+                        c.sample_dir(
+                            -d / dist,
+                            &crate::buffers::light_basis(*direction),
+                            outer_angle_deg.to_radians().tan(),
+                        )
+                    });
+                    (
+                        d / dist,
+                        cone * (-sigma_t * dist).exp() / (dist * dist),
+                        tint,
+                    )
                 }
             };
             let cos = n.dot(to_light).max(0.0);
@@ -212,7 +273,8 @@ pub fn surface_radiance(scene: &Scene, gbuf: &GBuffer, bvh: &Bvh) -> Image {
             let albedo = scene.geometry[shape as usize].albedo();
             let mut out = [0f32; 3];
             for k in 0..3 {
-                let direct = albedo[k] / std::f64::consts::PI * color[k] * l_in * cos * lit;
+                let direct =
+                    albedo[k] / std::f64::consts::PI * color[k] * tint[k] * l_in * cos * lit;
                 let ambient = albedo[k] * scene.sky[k];
                 out[k] = ((direct + ambient) * trans) as f32;
             }

@@ -217,6 +217,7 @@ fn edit_spot(
             inner_angle_deg,
             outer_angle_deg,
             intensity,
+            ..
         } => f(
             position,
             direction,

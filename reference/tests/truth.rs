@@ -227,6 +227,7 @@ fn unshadowed_isotropic_point_light_matches_sun_closed_form() {
         inner_angle_deg: 180.0,
         outer_angle_deg: 180.0,
         intensity: [1.0; 3],
+        cookie: None,
     };
     let s = scene(light, medium, Vec::new());
     let bvh = Bvh::build(&s.geometry);

@@ -93,6 +93,8 @@ pub struct Raymarch {
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
     prepared: Option<RaymarchUniforms>,
+    /// The spot's cookie ([`Self::set_cookie`]), for a variant with `cookie`.
+    cookie: Option<wgpu::TextureView>,
 }
 
 impl Raymarch {
@@ -170,7 +172,34 @@ impl Raymarch {
             output,
             output_view,
             prepared: None,
+            cookie: None,
         })
+    }
+
+    /// Sets the spot light's cookie a `cookie` variant reads (kept until replaced; any size,
+    /// one of [`crate::textures::COOKIE_FORMATS`], projected as `scatter_shaderlib::cookie`
+    /// says). [`crate::textures::upload_cookie`] makes one from texels.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::InvalidRaymarchVariant`] for a variant without `cookie`;
+    /// [`RuntimeError::InputMismatch`] for a view of the wrong format, dimension or usage.
+    pub fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        if !self.variant.cookie {
+            return Err(RuntimeError::InvalidRaymarchVariant {
+                variant: self.variant.id(),
+                source: scatter_shaderlib::prefiltered::VariantError {
+                    knob: "cookie",
+                    value: "false".into(),
+                    allowed: "true to read a cookie (this variant's kernels have no cookie \
+                              binding)"
+                        .into(),
+                },
+            });
+        }
+        crate::textures::check_cookie(RAYMARCH, cookie)?;
+        self.cookie = Some(cookie.clone());
+        Ok(())
     }
 
     /// Fills and uploads the uniform block of one frame.
@@ -282,13 +311,16 @@ impl Raymarch {
             shadow_map,
             [self.shadow_map_size; 2],
         )?;
-        self.exec.encode(
-            ctx.device(),
-            encoder,
-            &[("depth", depth), ("shadow_map", shadow_map)],
-            &[],
-            only,
-        )?;
+        let mut engine = vec![("depth", depth), ("shadow_map", shadow_map)];
+        if self.variant.cookie {
+            let cookie = self.cookie.as_ref().ok_or(RuntimeError::MissingInput {
+                kernel: RAYMARCH,
+                what: "the spot light's cookie (a `cookie` variant: call Raymarch::set_cookie)",
+            })?;
+            engine.push(("cookie", cookie));
+        }
+        self.exec
+            .encode(ctx.device(), encoder, &engine, &[], only)?;
         Ok(&self.output_view)
     }
 
@@ -355,7 +387,9 @@ pub struct RaymarchReadback {
 }
 
 /// Test helper: creates a [`Raymarch`], uploads `depth` (screen-sized) and `shadow_map`
-/// (`input.shadow_map.size` squared) as r32float textures, runs one frame and reads back.
+/// (`input.shadow_map.size` squared) as r32float textures and, for a `cookie` variant,
+/// `cookie` (its size and RGBA texels) with [`crate::textures::upload_cookie`], runs one
+/// frame and reads back.
 ///
 /// # Errors
 ///
@@ -368,9 +402,14 @@ pub fn run_raymarch_once(
     input: &RaymarchInput,
     depth: &[f32],
     shadow_map: &[f32],
+    cookie: Option<([u32; 2], &[[f32; 4]])>,
 ) -> Result<RaymarchReadback, RuntimeError> {
     let sm_size = input.shadow_map.size;
     let mut pass = Raymarch::new(ctx, variant, screen, sm_size)?;
+    if let Some((size, texels)) = cookie {
+        let texture = crate::textures::upload_cookie(ctx, RAYMARCH, size, texels)?;
+        pass.set_cookie(&texture.create_view(&wgpu::TextureViewDescriptor::default()))?;
+    }
     let views = upload_inputs(
         ctx,
         &[

@@ -47,6 +47,7 @@ use partial_sum_tree::PartialSumTreeVariant;
 use prefiltered::PrefilteredVariant;
 use raymarch::RaymarchVariant;
 pub use row_prefix::{RowPrefixMode, RowPrefixParams};
+pub use scatter_frame::cookie;
 
 // The kernel table: one line per kernel (name, template stem, parameter type, render
 // function), sorted by name. `Kernel`, `KernelParams` and `render` come from it.

@@ -164,6 +164,49 @@ pub fn depth_and_shadow_map() -> [Resource; 2] {
     ]
 }
 
+/// The binding of the engine's `cookie` texture in every kernel that reads a spot's cookie
+/// (above every family's own and sampling bindings).
+pub const COOKIE_BINDING: u32 = 8;
+
+/// The engine's spot-light cookie ([`scatter_frame::cookie`]): any size, loaded texel by
+/// texel, so any float format binds (`rgba16float` declared).
+pub fn cookie_texture() -> Resource {
+    Resource {
+        provided_by: "engine",
+        texture: Some(texture_2d(
+            scatter_frame::cookie::COOKIE_FORMAT,
+            "cookie.width",
+            "cookie.height",
+            "1",
+            SAMPLED,
+        )),
+        ..scatter_resource(
+            "cookie",
+            "the spot light's cookie: linear RGB (alpha ignored) projected along the cone, \
+             its square circumscribing the outer cone in the shadow map's right/up frame, \
+             texel (0, 0) top-left; any size 1..=4096 and any float format \
+             (rgba8unorm, rgba8unorm-srgb, rgba16float, rgba32float)",
+        )
+    }
+}
+
+/// The size of the engine's cookie texture, for [`cookie_texture`].
+pub fn cookie_parameters() -> Vec<Parameter> {
+    vec![
+        Parameter {
+            name: "cookie.width",
+            description: "width of the engine's cookie texture in texels (any; the kernels \
+                          filter it themselves)",
+            constraint: "1..=4096".into(),
+        },
+        Parameter {
+            name: "cookie.height",
+            description: "height of the engine's cookie texture in texels",
+            constraint: "1..=4096".into(),
+        },
+    ]
+}
+
 /// A size expression over the [`Plan::parameters`]: an integer, a parameter name
 /// (`screen.width`), or a product `16 * rectified.height`.
 pub type Formula = String;

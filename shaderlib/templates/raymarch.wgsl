@@ -20,14 +20,20 @@
 // | 1       | depth      | texture_2d<f32> (r32float, view depth)       | textureLoad  |
 // | 2       | shadow_map | texture_2d<f32> (r32float)                   | textureLoad  |
 // | 3       | output     | texture_storage_2d<{{ output_format }}, write>           | textureStore |
+{%- if cookie %}
+// | 8       | cookie     | texture_2d<f32> (rgba, linear RGB)           | textureLoad  |
+{%- endif %}
 // output: screen-sized; {% if interleaved %}the partial sums `interleave_sum` reads{% else %}in-scattered radiance (rgb, alpha 1){% endif %}.
+{%- if cookie %}
+// cookie: the spot's cookie (scatter_frame::cookie), multiplying each sample's integrand.
+{%- endif %}
 //
 // Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
 // (frame.sizes.xy); invocation id x = pixel column, y = pixel row.
 //
 // Mirrors reference/src/kernels/raymarch.rs
 
-#import scatter::model::{equiangular, equiangular_sample, phase_hg, spot_integrand, transmittance_between}
+#import scatter::model::{equiangular, equiangular_sample, phase_hg, spot_integrand, transmittance_between{% if cookie %}, spot_cookie{% endif %}}
 #import scatter::shadow::shadow_visibility
 #import scatter::raymarch::{RaymarchFrame, raymarch_pixel_dir, raymarch_shadow_view, pixel_jitter}
 {%- if !sampling.imports.is_empty() %}
@@ -38,6 +44,9 @@
 @group(0) @binding(1) var depth: texture_2d<f32>;
 @group(0) @binding(2) var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) var output: texture_storage_2d<{{ output_format }}, write>;
+{%- if cookie %}
+@group(0) @binding(8) var cookie: texture_2d<f32>;
+{%- endif %}
 {% include "include/sampled_bindings.wgsl" %}
 
 // The in-scattered radiance of pixel (x, y) (the sampling entry point below calls it).
@@ -60,7 +69,7 @@ fn raymarch_pixel(x: u32, y: u32) -> vec3<f32> {
     }
     let view = raymarch_shadow_view(m);
     let strata = equiangular(eye, dir, m.light_pos.xyz, 0.0, s, n);
-    var sum = 0.0;
+    var sum = {% if cookie %}vec3<f32>(0.0){% else %}0.0{% endif %};
     for (var j = pixel_class; j < n; j += stride) {
         var t = (f32(j) + u) * h;
         var w = h;
@@ -71,7 +80,12 @@ fn raymarch_pixel(x: u32, y: u32) -> vec3<f32> {
         }
         let v = shadow_visibility(view, shadow_map, eye + dir * t);
         if spot {
+{%- if cookie %}
+            let x = eye + dir * t;
+            sum += v * w * spot_integrand(eye, dir, t, m.light_pos.xyz, m.light_dir.xyz, m.light_pos[3], m.light_dir[3], m.medium) * spot_cookie(cookie, x, m.light_pos.xyz, m.sm_right.xyz, m.sm_up.xyz, m.sm_forward.xyz, m.light_dir[3]);
+{%- else %}
             sum += v * w * spot_integrand(eye, dir, t, m.light_pos.xyz, m.light_dir.xyz, m.light_pos[3], m.light_dir[3], m.medium);
+{%- endif %}
         } else {
             sum += v * transmittance_between(m.medium[0], f32(j) * h, f32(j + 1u) * h);
         }

@@ -135,6 +135,40 @@ impl Fixture {
         }
     }
 
+    /// The same fixture with `cookie` on its spot light (the depth buffer and shadow map do
+    /// not depend on it).
+    ///
+    /// # Panics
+    ///
+    /// When the fixture's light is not a spot (a defect of the caller).
+    pub fn with_cookie(&self, cookie: scatter_reference::cookie::Cookie) -> Self {
+        let mut scene = self.scene.clone();
+        match &mut scene.light {
+            scatter_reference::scene::Light::Spot { cookie: c, .. } => *c = Some(cookie),
+            scatter_reference::scene::Light::Directional { .. } => {
+                panic!("a cookie needs a spot light")
+            }
+        }
+        Self {
+            name: self.name,
+            pose: self.pose,
+            scene,
+            bvh: Bvh::build(&self.scene.geometry),
+            gbuf: self.gbuf.clone(),
+            shadow_map: self.shadow_map.clone(),
+        }
+    }
+
+    /// The spot light's cookie as `run_*_once` takes it: its size and RGBA texels.
+    pub fn cookie(&self) -> Option<([u32; 2], Vec<[f32; 4]>)> {
+        match &self.scene.light {
+            scatter_reference::scene::Light::Spot {
+                cookie: Some(c), ..
+            } => Some(([c.width(), c.height()], c.rgba())),
+            _ => None,
+        }
+    }
+
     /// `scene::pose`, the tail of trial names.
     pub fn trial_tail(&self) -> String {
         format!("{}::{}", self.name, self.pose)

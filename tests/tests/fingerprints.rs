@@ -131,6 +131,14 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
     for v in RaymarchVariant::grid() {
         for f in for_light(v.light).filter(|f| f.pose == Pose::Ordinary) {
             let trial = format!("raymarch::{}::{}", v.id(), f.trial_tail());
+            let f = if v.cookie {
+                &f.with_cookie(
+                    scatter_reference::cookie::Cookie::pattern("stained_glass", 64)
+                        .expect("a built-in pattern"),
+                )
+            } else {
+                f
+            };
             let gpu = run_raymarch_once(
                 ctx,
                 &v,
@@ -138,6 +146,7 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
                 &f.raymarch_input(),
                 &f.gbuf.view_depth,
                 &f.shadow_map.depth,
+                f.cookie().as_ref().map(|(size, t)| (*size, &t[..])),
             )
             .unwrap_or_else(|e| panic!("{trial}: {e}"));
             if let Some(partial) = &gpu.partial {

@@ -16,6 +16,7 @@ use std::process::ExitCode;
 use std::sync::OnceLock;
 
 use scatter_conformance::{Check, Fixture, gpu, run_trials, scene_for};
+use scatter_reference::cookie::Cookie;
 use scatter_reference::kernels::run_raymarch;
 use scatter_reference::suite::Pose;
 use scatter_runtime::{Raymarch, RuntimeError, run_raymarch_once};
@@ -27,15 +28,24 @@ const SCREEN: [u32; 2] = [67, 37];
 const SHADOW_MAP: u32 = 128;
 const REL_TOL: f32 = 1e-4;
 
-/// The fixture of a light type (built once, on first use).
-fn fixture(light: LightKind) -> &'static Fixture {
+/// The fixture of a variant (built once, on first use): its light's scene, with the
+/// `stained_glass` cookie (64^2) for a `cookie` variant.
+fn fixture(variant: &RaymarchVariant) -> &'static Fixture {
     static COLUMNS: OnceLock<Fixture> = OnceLock::new();
     static SPOT_GRATE: OnceLock<Fixture> = OnceLock::new();
-    let cell = match light {
-        LightKind::Directional => &COLUMNS,
-        LightKind::Spot => &SPOT_GRATE,
+    static SPOT_COOKIE: OnceLock<Fixture> = OnceLock::new();
+    let light = variant.light;
+    let plain = |cell: &'static OnceLock<Fixture>| {
+        cell.get_or_init(|| Fixture::new(scene_for(light), Pose::Ordinary, SCREEN, SHADOW_MAP))
     };
-    cell.get_or_init(|| Fixture::new(scene_for(light), Pose::Ordinary, SCREEN, SHADOW_MAP))
+    match light {
+        LightKind::Directional => plain(&COLUMNS),
+        LightKind::Spot if variant.cookie => SPOT_COOKIE.get_or_init(|| {
+            plain(&SPOT_GRATE)
+                .with_cookie(Cookie::pattern("stained_glass", 64).expect("a built-in pattern"))
+        }),
+        LightKind::Spot => plain(&SPOT_GRATE),
+    }
 }
 
 fn trial_name(variant: &RaymarchVariant) -> String {
@@ -57,7 +67,7 @@ fn f16_ulp(v: f32) -> f32 {
 }
 
 fn trial(ctx: &scatter_runtime::Context, variant: &RaymarchVariant) -> Result<String, String> {
-    let f = fixture(variant.light);
+    let f = fixture(variant);
     let name = trial_name(variant);
     let cpu = run_raymarch(variant, &f.scene, &f.gbuf, &f.shadow_map)
         .map_err(|e| format!("{name}: CPU mirror failed: {e}"))?;
@@ -68,6 +78,7 @@ fn trial(ctx: &scatter_runtime::Context, variant: &RaymarchVariant) -> Result<St
         &f.raymarch_input(),
         &f.gbuf.view_depth,
         &f.shadow_map.depth,
+        f.cookie().as_ref().map(|(size, t)| (*size, &t[..])),
     )
     .map_err(|e| format!("{name}: GPU run failed: {e}"))?;
     if gpu.uniforms != cpu.uniforms {
@@ -175,7 +186,7 @@ fn bad_input_is_an_error() {
         .expect_err("zero width");
     assert!(matches!(err, RuntimeError::EmptyInput { .. }), "{err}");
     eprintln!("ok   raymarch::errors::zero_size: {err}");
-    let f = fixture(LightKind::Directional);
+    let f = fixture(&RaymarchVariant::default());
     let mut pass = Raymarch::new(ctx, &RaymarchVariant::default(), SCREEN, SHADOW_MAP / 2)
         .unwrap_or_else(|e| panic!("{e}"));
     let err = pass
@@ -201,7 +212,89 @@ fn bad_input_is_an_error() {
         &f.raymarch_input(),
         &[5.0],
         &f.shadow_map.depth,
+        None,
     )
     .unwrap_or_else(|e| panic!("{e}"));
     assert!(tiny.output[0].iter().all(|v| v.is_finite()));
+    cookie_errors(ctx);
+}
+
+/// A cookie on a directional light, a `cookie` variant encoded without one, a cookie for
+/// a variant without the knob, and a cookie of the wrong format: each a clear error.
+fn cookie_errors(ctx: &scatter_runtime::Context) {
+    let cookie = RaymarchVariant {
+        light: LightKind::Spot,
+        cookie: true,
+        ..RaymarchVariant::default()
+    };
+    let err = Raymarch::new(
+        ctx,
+        &RaymarchVariant {
+            light: LightKind::Directional,
+            ..cookie
+        },
+        SCREEN,
+        SHADOW_MAP,
+    )
+    .expect_err("cookie on a directional light");
+    assert!(err.to_string().contains("cookie"), "{err}");
+    eprintln!("ok   raymarch::errors::cookie_directional: {err}");
+    let f = fixture(&cookie);
+    let mut pass =
+        Raymarch::new(ctx, &cookie, SCREEN, SHADOW_MAP).unwrap_or_else(|e| panic!("{e}"));
+    pass.prepare(ctx, &f.raymarch_input())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let views: Vec<_> = [
+        ("depth buffer", SCREEN, &f.gbuf.view_depth),
+        ("shadow map", [SHADOW_MAP; 2], &f.shadow_map.depth),
+    ]
+    .into_iter()
+    .map(|(what, size, data)| {
+        let t = scatter_runtime::textures::upload_r32float(
+            ctx,
+            scatter_runtime::shaderlib::Kernel::Raymarch,
+            what,
+            size,
+            data,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        let v = t.create_view(&Default::default());
+        (t, v)
+    })
+    .collect();
+    let mut encoder = ctx
+        .device()
+        .create_command_encoder(&scatter_runtime::wgpu::CommandEncoderDescriptor::default());
+    let err = pass
+        .encode(ctx, &mut encoder, &views[0].1, &views[1].1)
+        .expect_err("no cookie set");
+    assert!(matches!(err, RuntimeError::MissingInput { .. }), "{err}");
+    assert!(err.to_string().contains("set_cookie"), "{err}");
+    eprintln!("ok   raymarch::errors::cookie_missing: {err}");
+    // The depth buffer is r32float: not a cookie format.
+    let err = pass.set_cookie(&views[0].1).expect_err("r32float cookie");
+    assert!(matches!(err, RuntimeError::InputMismatch { .. }), "{err}");
+    eprintln!("ok   raymarch::errors::cookie_format: {err}");
+    let mut plain = Raymarch::new(
+        ctx,
+        &RaymarchVariant {
+            light: LightKind::Spot,
+            ..RaymarchVariant::default()
+        },
+        SCREEN,
+        SHADOW_MAP,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let texture = scatter_runtime::textures::upload_cookie(
+        ctx,
+        scatter_runtime::shaderlib::Kernel::Raymarch,
+        [2, 1],
+        &[[1.0; 4], [0.5; 4]],
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let err = plain
+        .set_cookie(&texture.create_view(&Default::default()))
+        .expect_err("cookie without the knob");
+    assert!(err.to_string().contains("cookie"), "{err}");
+    eprintln!("ok   raymarch::errors::cookie_without_knob: {err}");
 }

@@ -12,7 +12,7 @@ use crate::GenError;
 const SAMPLES_ALLOWED: &str = "in 4..=1024, a multiple of interleave^2";
 /// Allowed `interleave`.
 const INTERLEAVE_ALLOWED: &str = "in 1..=8";
-/// Allowed `jitter`.
+/// Allowed `jitter` and `cookie`.
 const JITTER_ALLOWED: &str = "true | false";
 
 /// The knobs of [`RaymarchVariant`], defaults from [`RaymarchVariant::default`].
@@ -52,7 +52,29 @@ pub fn knobs() -> Vec<KnobInfo> {
             default: d.light.to_string(),
             value_type: KnobType::Name,
         },
+        KnobInfo {
+            name: "cookie",
+            value_name: "BOOL",
+            help: "a spot light's cookie: an RGB texture (the engine's `cookie` input) \
+                   projected along the cone multiplies each sample (light = spot only)",
+            allowed: JITTER_ALLOWED.into(),
+            default: d.cookie.to_string(),
+            value_type: KnobType::Boolean,
+        },
     ]
+}
+
+/// A boolean knob's value.
+fn boolean(knob: &'static str, value: &str) -> Result<bool, VariantError> {
+    match value.trim() {
+        "true" | "on" | "1" => Ok(true),
+        "false" | "off" | "0" => Ok(false),
+        _ => Err(VariantError {
+            knob,
+            value: value.to_owned(),
+            allowed: JITTER_ALLOWED.into(),
+        }),
+    }
 }
 
 fn number(knob: &'static str, allowed: &str, value: &str) -> Result<u32, VariantError> {
@@ -74,20 +96,8 @@ pub fn parse(knobs: &[(String, String)]) -> Result<RaymarchVariant, GenError> {
         match name.as_str() {
             "samples" => v.samples = number("samples", SAMPLES_ALLOWED, value)?,
             "interleave" => v.interleave = number("interleave", INTERLEAVE_ALLOWED, value)?,
-            "jitter" => {
-                v.jitter = match value.trim() {
-                    "true" | "on" | "1" => true,
-                    "false" | "off" | "0" => false,
-                    _ => {
-                        return Err(VariantError {
-                            knob: "jitter",
-                            value: value.clone(),
-                            allowed: JITTER_ALLOWED.into(),
-                        }
-                        .into());
-                    }
-                };
-            }
+            "jitter" => v.jitter = boolean("jitter", value)?,
+            "cookie" => v.cookie = boolean("cookie", value)?,
             "light" => v.light = value.parse()?,
             other => {
                 return Err(GenError::Usage(format!(

@@ -189,3 +189,44 @@ pub fn select(f: f32, t: f32, cond: bool) -> f32 {
 pub fn mix(a: f32, b: f32, t: f32) -> f32 {
     a * (1.0 - t) + b * t
 }
+
+/// A spot light's cookie for the ray point `x` (see the WGSL comment): bilinear between
+/// texel centres of `cookie` (layer 0) from four loads, clamped to the edge; black behind
+/// the lamp.
+#[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+pub fn spot_cookie(
+    cookie: &super::texture::TexArray,
+    x: Vec3,
+    light_pos: Vec3,
+    right: Vec3,
+    up: Vec3,
+    forward: Vec3,
+    cos_outer: f32,
+) -> Vec3 {
+    let d = x - light_pos;
+    let z = d.dot(forward);
+    if z <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let tan_outer = sqrt(max(1.0 - cos_outer * cos_outer, 0.0)) / cos_outer;
+    let a = d.dot(right) / (z * tan_outer);
+    let b = d.dot(up) / (z * tan_outer);
+    let size = [cookie.width as i32, cookie.height as i32];
+    let p = [
+        0.5 * (a + 1.0) * size[0] as f32 - 0.5,
+        0.5 * (1.0 - b) * size[1] as f32 - 0.5,
+    ];
+    let p0 = [p[0].floor(), p[1].floor()];
+    let f = [p[0] - p0[0], p[1] - p0[1]];
+    // WGSL's f32 -> i32 conversion saturates, as Rust's `as` does.
+    let i0 = [0, 1].map(|k| (p0[k] as i32).clamp(0, size[k] - 1) as u32);
+    let i1 = [0, 1].map(|k| (p0[k] as i32).saturating_add(1).clamp(0, size[k] - 1) as u32);
+    let texel = |x: u32, y: u32| {
+        let t = cookie.load(x, y, 0);
+        Vec3::new(t[0], t[1], t[2])
+    };
+    let mix3 = |a: Vec3, b: Vec3, t: f32| a * (1.0 - t) + b * t;
+    let top = mix3(texel(i0[0], i0[1]), texel(i1[0], i0[1]), f[0]);
+    let bottom = mix3(texel(i0[0], i1[1]), texel(i1[0], i1[1]), f[0]);
+    mix3(top, bottom, f[1])
+}

@@ -216,7 +216,8 @@ pub fn run_raymarch(
         height: gbuf.height,
         data: gbuf.view_depth.clone(),
     };
-    let marched = raymarch::raymarch(variant, &uniforms, &depth, &sm);
+    let cookie = variant.cookie.then(|| cookie_texture(scene)).flatten();
+    let marched = raymarch::raymarch(variant, &uniforms, &depth, &sm, cookie.as_ref());
     let (partial, out) = if variant.interleaved() {
         let out = interleave_sum::interleave_sum(&uniforms, &marched);
         (Some(marched), out)
@@ -232,6 +233,28 @@ pub fn run_raymarch(
         uniforms,
         partial,
         output,
+    })
+}
+
+/// The scene's spot cookie as the kernels read it: the `rgba16float` texture the runtime
+/// uploads (each channel rounded to f16, alpha 1), or `None` without a cookie.
+pub fn cookie_texture(scene: &Scene) -> Option<TexArray> {
+    let crate::scene::Light::Spot {
+        cookie: Some(cookie),
+        ..
+    } = &scene.light
+    else {
+        return None;
+    };
+    Some(TexArray {
+        width: cookie.width(),
+        height: cookie.height(),
+        layers: 1,
+        data: cookie
+            .rgba()
+            .into_iter()
+            .map(|t| t.map(texture::round_f16))
+            .collect(),
     })
 }
 

@@ -4,7 +4,8 @@
 //! `scatter_frame::raymarch`.
 
 use super::common_model::{
-    equiangular, equiangular_sample, max, min, phase_hg, spot_integrand, transmittance_between,
+    equiangular, equiangular_sample, max, min, phase_hg, spot_cookie, spot_integrand,
+    transmittance_between,
 };
 use super::common_raymarch::{pixel_jitter, raymarch_pixel_dir, raymarch_shadow_view};
 use super::common_sampling::{
@@ -12,6 +13,7 @@ use super::common_sampling::{
 };
 use super::common_shadow::shadow_visibility;
 use super::texture::{Tex, TexArray, quantise, xyz};
+use glam::Vec3;
 use scatter_shaderlib::prefiltered::{LightKind, Storage};
 use scatter_shaderlib::raymarch::{RaymarchUniforms, RaymarchVariant};
 
@@ -23,6 +25,7 @@ pub fn raymarch_main(
     m: &RaymarchUniforms,
     depth: &Tex,
     shadow_map: &Tex,
+    cookie: Option<&TexArray>,
 ) -> Option<[f32; 4]> {
     let (x, y) = (id[0], id[1]);
     if x >= m.sizes[0] || y >= m.sizes[1] {
@@ -45,7 +48,7 @@ pub fn raymarch_main(
     }
     let view = raymarch_shadow_view(m);
     let strata = equiangular(eye, dir, xyz(m.light_pos), 0.0, s, n);
-    let mut sum = 0.0;
+    let mut sum = Vec3::ZERO;
     let mut j = pixel_class;
     while j < n {
         let mut t = (j as f32 + u) * h;
@@ -57,7 +60,7 @@ pub fn raymarch_main(
         }
         let v = shadow_visibility(&view, shadow_map, eye + dir * t);
         if spot {
-            sum += v
+            let f = v
                 * w
                 * spot_integrand(
                     eye,
@@ -69,8 +72,24 @@ pub fn raymarch_main(
                     m.light_dir[3],
                     m.medium,
                 );
+            sum += match cookie {
+                Some(cookie) => {
+                    f * spot_cookie(
+                        cookie,
+                        eye + dir * t,
+                        xyz(m.light_pos),
+                        xyz(m.sm_right),
+                        xyz(m.sm_up),
+                        xyz(m.sm_forward),
+                        m.light_dir[3],
+                    )
+                }
+                None => Vec3::splat(f),
+            };
         } else {
-            sum += v * transmittance_between(m.medium[0], j as f32 * h, (j + 1) as f32 * h);
+            sum += Vec3::splat(
+                v * transmittance_between(m.medium[0], j as f32 * h, (j + 1) as f32 * h),
+            );
         }
         j += stride;
     }
@@ -90,17 +109,18 @@ pub fn raymarch(
     m: &RaymarchUniforms,
     depth: &Tex,
     shadow_map: &Tex,
+    cookie: Option<&TexArray>,
 ) -> TexArray {
     use rayon::prelude::*;
     if !variant.interleaved() {
-        return raymarch_sampled(variant, m, depth, shadow_map).output;
+        return raymarch_sampled(variant, m, depth, shadow_map, cookie).output;
     }
     let (w, h) = (m.sizes[0], m.sizes[1]);
     let data = (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
             (0..w).map(move |x| {
-                raymarch_main([x, y, 0], variant, m, depth, shadow_map)
+                raymarch_main([x, y, 0], variant, m, depth, shadow_map, cookie)
                     .unwrap_or([0.0; 4])
                     .map(|c| quantise(c, Storage::Rgba32float))
             })
@@ -121,6 +141,7 @@ pub fn raymarch_sampled(
     m: &RaymarchUniforms,
     depth: &Tex,
     shadow_map: &Tex,
+    cookie: Option<&TexArray>,
 ) -> SampledOutput {
     run_sampled(
         &variant.sampling_knobs(),
@@ -128,7 +149,8 @@ pub fn raymarch_sampled(
         depth,
         &EpipolarCamera::of_raymarch(m, variant.light),
         &|x, y| {
-            let c = raymarch_main([x, y, 0], variant, m, depth, shadow_map).unwrap_or([0.0; 4]);
+            let c =
+                raymarch_main([x, y, 0], variant, m, depth, shadow_map, cookie).unwrap_or([0.0; 4]);
             [c[0], c[1], c[2]]
         },
     )
@@ -140,6 +162,7 @@ pub fn raymarch_epipolar_samples(
     m: &RaymarchUniforms,
     depth: &Tex,
     shadow_map: &Tex,
+    cookie: Option<&TexArray>,
 ) -> EpipolarSamples {
     epipolar_samples(
         &variant.sampling_knobs(),
@@ -147,7 +170,8 @@ pub fn raymarch_epipolar_samples(
         depth,
         &EpipolarCamera::of_raymarch(m, variant.light),
         &|x, y| {
-            let c = raymarch_main([x, y, 0], variant, m, depth, shadow_map).unwrap_or([0.0; 4]);
+            let c =
+                raymarch_main([x, y, 0], variant, m, depth, shadow_map, cookie).unwrap_or([0.0; 4]);
             [c[0], c[1], c[2]]
         },
     )

@@ -4,7 +4,7 @@
 
 use super::common_sampling::{EpipolarUnwarp, SampledOutput, epipolar_fallback};
 use super::raymarch::raymarch_main;
-use super::texture::Tex;
+use super::texture::{Tex, TexArray};
 use scatter_shaderlib::raymarch::{RaymarchUniforms, RaymarchVariant};
 
 /// The pixels `raymarch_unwarp` listed, marched themselves into its output.
@@ -13,10 +13,11 @@ pub fn raymarch_fallback(
     m: &RaymarchUniforms,
     depth: &Tex,
     shadow_map: &Tex,
+    cookie: Option<&TexArray>,
     unwarped: EpipolarUnwarp,
 ) -> SampledOutput {
     epipolar_fallback(unwarped, &|x, y| {
-        let c = raymarch_main([x, y, 0], variant, m, depth, shadow_map).unwrap_or([0.0; 4]);
+        let c = raymarch_main([x, y, 0], variant, m, depth, shadow_map, cookie).unwrap_or([0.0; 4]);
         [c[0], c[1], c[2]]
     })
 }

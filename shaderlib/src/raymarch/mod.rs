@@ -27,6 +27,7 @@ struct RaymarchTemplate {
     light_name: &'static str,
     spot: bool,
     interleaved: bool,
+    cookie: bool,
     output_format: &'static str,
     sampling: SamplingView,
 }
@@ -38,6 +39,7 @@ struct RaymarchUnwarpTemplate {
     light_name: &'static str,
     spot: bool,
     interleaved: bool,
+    cookie: bool,
     output_format: &'static str,
     sampling: SamplingView,
 }
@@ -49,6 +51,7 @@ struct RaymarchFallbackTemplate {
     light_name: &'static str,
     spot: bool,
     interleaved: bool,
+    cookie: bool,
     output_format: &'static str,
     sampling: SamplingView,
 }
@@ -88,6 +91,7 @@ pub(crate) fn render_raymarch(variant: &RaymarchVariant) -> Result<String, Shade
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
         interleaved: variant.interleaved(),
+        cookie: variant.cookie,
         output_format: if variant.interleaved() {
             PARTIAL_FORMAT
         } else if variant.sampling == Sampling::Epipolar {
@@ -114,6 +118,7 @@ pub(crate) fn render_raymarch_unwarp(variant: &RaymarchVariant) -> Result<String
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
         interleaved: false,
+        cookie: variant.cookie,
         output_format: "rgba16float",
         sampling: sampling_view(variant, Kernel::RaymarchUnwarp),
     }
@@ -134,6 +139,7 @@ pub(crate) fn render_raymarch_fallback(variant: &RaymarchVariant) -> Result<Stri
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
         interleaved: false,
+        cookie: variant.cookie,
         output_format: "rgba16float",
         sampling: sampling_view(variant, Kernel::RaymarchFallback),
     }

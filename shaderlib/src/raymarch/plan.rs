@@ -3,8 +3,8 @@
 //! `scatter-runtime` builds and dispatches from it.
 
 use crate::plan::{
-    OUTPUT_FORMAT, PassPlan, Plan, bind, depth_and_shadow_map, frame_buffer, scatter_texture,
-    screen_and_shadow_parameters,
+    COOKIE_BINDING, OUTPUT_FORMAT, PassPlan, Plan, bind, cookie_parameters, cookie_texture,
+    depth_and_shadow_map, frame_buffer, scatter_texture, screen_and_shadow_parameters,
 };
 use crate::raymarch::{PARTIAL_FORMAT, RaymarchVariant};
 use crate::sampling::{
@@ -15,7 +15,10 @@ use crate::{Kernel, KernelParams};
 
 /// The resources and passes of a variant, as `runtime/src/raymarch.rs` creates them.
 pub fn plan(v: &RaymarchVariant) -> Plan {
-    let parameters = screen_and_shadow_parameters();
+    let mut parameters = screen_and_shadow_parameters();
+    if v.cookie {
+        parameters.extend(cookie_parameters());
+    }
     let [depth, shadow_map] = depth_and_shadow_map();
     let mut resources = vec![
         frame_buffer(
@@ -34,6 +37,9 @@ pub fn plan(v: &RaymarchVariant) -> Plan {
             "screen.height",
         ),
     ];
+    if v.cookie {
+        resources.push(cookie_texture());
+    }
     resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
     resources.extend(fallback_buffers(&v.sampling_knobs()));
     if v.interleaved() {
@@ -73,7 +79,7 @@ pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations(&v.sampling_knobs()),
                 skip_when: None,
-                bindings: vec![
+                bindings: [
                     bind(0, "frame"),
                     bind(1, "depth"),
                     bind(2, "shadow_map"),
@@ -85,7 +91,10 @@ pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
                             sampled_output(&v.sampling_knobs())
                         },
                     ),
-                ],
+                ]
+                .into_iter()
+                .chain(v.cookie.then(|| bind(COOKIE_BINDING, "cookie")))
+                .collect(),
             },
             4,
         )),

@@ -139,3 +139,28 @@ fn equiangular_sample(e: Equiangular, x: f32) -> vec2<f32> {
     let tau = tan(e.theta_a + x * e.dtheta);
     return vec2<f32>(e.t_close + e.dist * tau, e.dtheta * e.dist * (1.0 + tau * tau));
 }
+
+// A spot light's cookie (scatter_frame::cookie) for the ray point `x`: the RGB texture
+// `cookie` projected along the cone from the lamp at `light_pos` in the light frame `right`,
+// `up`, `forward` (the spot's shadow-map basis), its square circumscribing the outer cone
+// (`cos_outer`); bilinear between texel centres from four loads, clamped to the edge; black
+// behind the lamp. Constant along each light ray.
+fn spot_cookie(cookie: texture_2d<f32>, x: vec3<f32>, light_pos: vec3<f32>, right: vec3<f32>, up: vec3<f32>, forward: vec3<f32>, cos_outer: f32) -> vec3<f32> {
+    let d = x - light_pos;
+    let z = dot(d, forward);
+    if z <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let tan_outer = sqrt(max(1.0 - cos_outer * cos_outer, 0.0)) / cos_outer;
+    let a = dot(d, right) / (z * tan_outer);
+    let b = dot(d, up) / (z * tan_outer);
+    let size = vec2<i32>(textureDimensions(cookie));
+    let p = vec2<f32>(0.5 * (a + 1.0), 0.5 * (1.0 - b)) * vec2<f32>(size) - 0.5;
+    let p0 = floor(p);
+    let f = p - p0;
+    let i0 = clamp(vec2<i32>(p0), vec2<i32>(0), size - 1);
+    let i1 = clamp(vec2<i32>(p0) + 1, vec2<i32>(0), size - 1);
+    let top = mix(textureLoad(cookie, vec2<i32>(i0.x, i0.y), 0).xyz, textureLoad(cookie, vec2<i32>(i1.x, i0.y), 0).xyz, f.x);
+    let bottom = mix(textureLoad(cookie, vec2<i32>(i0.x, i1.y), 0).xyz, textureLoad(cookie, vec2<i32>(i1.x, i1.y), 0).xyz, f.x);
+    return mix(top, bottom, f.y);
+}
