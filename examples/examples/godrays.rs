@@ -749,6 +749,7 @@ fn run_on_gpu(
                 shadow_map: sm.depth.clone(),
                 rectified: engine_rectified_map(scene, bvh, &prepared),
                 pass_wall_frames: 0,
+                cookie: None,
             };
             let ctx = &ctx;
             let pass_walls = &mut pass_walls;

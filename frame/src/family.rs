@@ -153,6 +153,21 @@ macro_rules! families {
                 }
             }
 
+            /// Whether the variant reads a spot light's cookie ([`KnobSet::cookie`]).
+            pub fn cookie(&self) -> bool {
+                match self {
+                    $(Self::$name(v) => KnobSet::cookie(v),)*
+                }
+            }
+
+            /// The variant with the `cookie` knob set, or `None` for a family without it
+            /// ([`KnobSet::with_cookie`]).
+            pub fn with_cookie(self, cookie: bool) -> Option<Self> {
+                match self {
+                    $(Self::$name(v) => KnobSet::with_cookie(v, cookie).map(Self::$name),)*
+                }
+            }
+
             /// The knobs without the light, short ([`KnobSet::marker`]); empty for a
             /// family whose only knob is the light.
             pub fn marker(&self) -> String {
@@ -274,6 +289,19 @@ pub trait KnobSet:
     /// raymarch variant that interleaves rejects sampled evaluation in `validate`).
     #[must_use]
     fn with_sampling(self, sampling: SamplingKnobs) -> Self;
+
+    /// Whether the variant reads a spot light's cookie ([`crate::cookie`]; `false` for a
+    /// family without the `cookie` knob).
+    fn cookie(&self) -> bool {
+        false
+    }
+
+    /// The variant with the `cookie` knob set, every other knob kept (not validated), or
+    /// `None` for a family without the knob.
+    fn with_cookie(self, cookie: bool) -> Option<Self> {
+        let _ = cookie;
+        None
+    }
 }
 
 impl fmt::Display for FamilyVariant {

@@ -350,6 +350,14 @@ impl KnobSet for RaymarchVariant {
         self.with_sampling_knobs(s)
     }
 
+    fn cookie(&self) -> bool {
+        self.cookie
+    }
+
+    fn with_cookie(self, cookie: bool) -> Option<Self> {
+        Some(Self { cookie, ..self })
+    }
+
     fn grid() -> Vec<Self> {
         RaymarchVariant::grid()
     }

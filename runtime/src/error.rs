@@ -124,6 +124,15 @@ pub enum RuntimeError {
         /// What was given.
         actual: String,
     },
+    /// A cookie was given to a variant that does not read one.
+    #[error(
+        "variant {variant} reads no cookie: only a variant with cookie = true (raymarch, \
+         light = spot) takes one"
+    )]
+    NoCookie {
+        /// The variant's id.
+        variant: String,
+    },
     /// A raymarch-family variant knob is out of range.
     #[error("raymarch variant {variant}: {source}")]
     InvalidRaymarchVariant {

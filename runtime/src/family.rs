@@ -95,6 +95,19 @@ pub trait FamilyRuntime: Sized {
     ///
     /// [`RuntimeError::Poll`] or [`RuntimeError::Readback`].
     fn fallback_pixels(&self, ctx: &Context) -> Result<Option<u32>, RuntimeError>;
+
+    /// Sets the spot light's cookie a `cookie` variant reads (`scatter_shaderlib::cookie`).
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::NoCookie`] for a family or variant without the `cookie` knob;
+    /// [`RuntimeError::InputMismatch`] for a view of the wrong format, dimension or usage.
+    fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        let _ = cookie;
+        Err(RuntimeError::NoCookie {
+            variant: self.knobs().into().to_string(),
+        })
+    }
 }
 
 /// The `fallback_count` buffer of `exec`'s plan read back (`None` when the plan has none:
@@ -228,6 +241,18 @@ macro_rules! runtime_families {
                 }
             }
 
+            /// Sets the spot light's cookie a `cookie` variant reads.
+            ///
+            /// # Errors
+            ///
+            /// As the family's `set_cookie`: [`RuntimeError::NoCookie`] for a variant
+            /// without the `cookie` knob.
+            pub fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+                match self {
+                    $(Self::$name(p) => p.set_cookie(cookie),)*
+                }
+            }
+
             /// How many pixels the last submitted frame's `_unwarp` pass listed for its
             /// `_fallback` pass, or `None` without epipolar sampling. Blocks until the GPU is
             /// done.
@@ -339,6 +364,10 @@ pub fn run_family_on(
         cpu.push((first, "rasterised rectified map", res.rectified, &data[..]));
     }
     let views = upload_inputs(ctx, &cpu)?;
+    if let Some((size, texels)) = &inputs.cookie {
+        let texture = crate::textures::upload_cookie(ctx, first, *size, texels)?;
+        pass.set_cookie(&texture.create_view(&wgpu::TextureViewDescriptor::default()))?;
+    }
     let report = pass.prepare(ctx, &inputs.frame)?;
     let gpu_inputs = Inputs {
         depth: &views[0].1,

@@ -574,6 +574,10 @@ pub struct CpuInputs {
     /// When non-zero, [`run_prefiltered_once`] also measures each pass on its own
     /// ([`Prefiltered::measure_pass_wall_times`]) over this many frames.
     pub pass_wall_frames: u32,
+    /// A spot light's cookie for a `cookie` variant: its size and RGBA texels (linear RGB,
+    /// row-major from the top-left), uploaded by [`crate::run_family_once`] with
+    /// [`crate::textures::upload_cookie`].
+    pub cookie: Option<([u32; 2], Vec<[f32; 4]>)>,
 }
 
 /// Everything [`run_prefiltered_once`] reads back.

@@ -182,19 +182,12 @@ impl Raymarch {
     ///
     /// # Errors
     ///
-    /// [`RuntimeError::InvalidRaymarchVariant`] for a variant without `cookie`;
+    /// [`RuntimeError::NoCookie`] for a variant without `cookie`;
     /// [`RuntimeError::InputMismatch`] for a view of the wrong format, dimension or usage.
     pub fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
         if !self.variant.cookie {
-            return Err(RuntimeError::InvalidRaymarchVariant {
+            return Err(RuntimeError::NoCookie {
                 variant: self.variant.id(),
-                source: scatter_shaderlib::prefiltered::VariantError {
-                    knob: "cookie",
-                    value: "false".into(),
-                    allowed: "true to read a cookie (this variant's kernels have no cookie \
-                              binding)"
-                        .into(),
-                },
             });
         }
         crate::textures::check_cookie(RAYMARCH, cookie)?;
@@ -525,5 +518,9 @@ impl crate::family::FamilyRuntime for Raymarch {
             passes.push((FALLBACK, t.fallback));
         }
         Ok(passes)
+    }
+
+    fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        Raymarch::set_cookie(self, cookie)
     }
 }

@@ -161,12 +161,7 @@ impl Fixture {
 
     /// The spot light's cookie as `run_*_once` takes it: its size and RGBA texels.
     pub fn cookie(&self) -> Option<([u32; 2], Vec<[f32; 4]>)> {
-        match &self.scene.light {
-            scatter_reference::scene::Light::Spot {
-                cookie: Some(c), ..
-            } => Some(([c.width(), c.height()], c.rgba())),
-            _ => None,
-        }
+        scene_cookie(&self.scene)
     }
 
     /// `scene::pose`, the tail of trial names.
@@ -193,6 +188,17 @@ impl Fixture {
             medium: self.scene.medium_desc(),
             shadow_map: self.shadow_map.desc(),
         }
+    }
+}
+
+/// A scene's spot cookie as `scatter_runtime::CpuInputs::cookie` takes it: its size and
+/// RGBA texels (`None` without one).
+pub fn scene_cookie(scene: &Scene) -> Option<([u32; 2], Vec<[f32; 4]>)> {
+    match &scene.light {
+        scatter_reference::scene::Light::Spot {
+            cookie: Some(c), ..
+        } => Some(([c.width(), c.height()], c.rgba())),
+        _ => None,
     }
 }
 
@@ -437,6 +443,11 @@ fn run_variant_in(
         shadow_map: frame.shadow_map.depth.clone(),
         rectified,
         pass_wall_frames: 0,
+        cookie: if variant.cookie() {
+            scene_cookie(scene)
+        } else {
+            None
+        },
     };
     let out = match cache {
         None => scatter_runtime::run_family_once(ctx, variant, res, &cpu),

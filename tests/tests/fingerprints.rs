@@ -119,6 +119,7 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
                     shadow_map: f.shadow_map.depth.clone(),
                     rectified,
                     pass_wall_frames: 0,
+                    cookie: None,
                 },
             )
             .unwrap_or_else(|e| panic!("{trial}: {e}"));

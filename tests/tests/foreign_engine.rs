@@ -206,6 +206,7 @@ fn trial(ctx: &Context, variant: &PrefilteredVariant) -> Vec<String> {
             shadow_map: fixture.shadow_map.depth.clone(),
             rectified: rectified.clone(),
             pass_wall_frames: 0,
+            cookie: None,
         },
     )
     .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
@@ -762,6 +763,7 @@ fn foreign_engine_comparison_detects_a_wrong_input() {
             shadow_map: fixture.shadow_map.depth.clone(),
             rectified: None,
             pass_wall_frames: 0,
+            cookie: None,
         },
     )
     .unwrap_or_else(|e| panic!("runtime: {e}"));

@@ -159,6 +159,7 @@ impl Prepared {
                 shadow_map: self.sm.depth.clone(),
                 rectified: None,
                 pass_wall_frames: 0,
+                cookie: None,
             },
         )
         .map_err(|e| e.to_string())?;

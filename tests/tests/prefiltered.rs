@@ -94,6 +94,7 @@ fn cpu_inputs(f: &Fixture) -> CpuInputs {
         shadow_map: f.shadow_map.depth.clone(),
         rectified: None,
         pass_wall_frames: 0,
+        cookie: None,
     }
 }
 
