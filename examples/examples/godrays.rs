@@ -696,6 +696,12 @@ struct GpuFrame {
 /// Runs one GPU frame; `true` for the last one.
 type FrameRunner<'a> = Box<dyn FnMut(bool) -> Result<GpuFrame, BoxError> + 'a>;
 
+/// The scene's cookie as the runtime uploads it, for a variant that reads one.
+fn cookie_texels(scene: &Scene, variant: FamilyVariant) -> Option<([u32; 2], Vec<[f32; 4]>)> {
+    let cookie = scene.light.cookie().filter(|_| variant.cookie())?;
+    Some(([cookie.width(), cookie.height()], cookie.rgba()))
+}
+
 /// Runs the family's GPU kernels `frames` times; prints the adapter, the frame wall time,
 /// the frame report, the GPU time per pass (not on a CPU adapter, whose timestamps are not
 /// usable) and the wall time per pass; returns the last output.
@@ -772,6 +778,7 @@ fn run_on_gpu(
         FamilyVariant::Raymarch(v) => {
             let input = RaymarchInput::from(&frame);
             let ctx = &ctx;
+            let cookie = cookie_texels(scene, variant);
             Box::new(move |_| {
                 let rb = run_raymarch_once(
                     ctx,
@@ -780,7 +787,7 @@ fn run_on_gpu(
                     &input,
                     &gbuf.view_depth,
                     &sm.depth,
-                    None,
+                    cookie.as_ref().map(|(size, t)| (*size, &t[..])),
                 )?;
                 Ok(GpuFrame {
                     output: rb.output,
@@ -792,8 +799,17 @@ fn run_on_gpu(
         }
         FamilyVariant::Minmax(v) => {
             let ctx = &ctx;
+            let cookie = cookie_texels(scene, variant);
             Box::new(move |_| {
-                let rb = run_minmax_once(ctx, v, res, &frame, &gbuf.view_depth, &sm.depth)?;
+                let rb = run_minmax_once(
+                    ctx,
+                    v,
+                    res,
+                    &frame,
+                    &gbuf.view_depth,
+                    &sm.depth,
+                    cookie.as_ref().map(|(size, t)| (*size, &t[..])),
+                )?;
                 Ok(GpuFrame {
                     output: rb.output,
                     report: Some(rb.frame.report),

@@ -71,6 +71,11 @@ pub struct MinmaxVariant {
     pub slice_samples: u32,
     /// `sampling = epipolar`: the initial step between evaluated samples of a slice.
     pub step: u32,
+    /// A spot light's cookie: an RGB texture projected along the cone multiplies each lit
+    /// span's quadrature nodes and the epipole march's samples (`light = spot` only; the
+    /// engine's `cookie` texture, [`crate::cookie`]).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub cookie: bool,
 }
 
 impl Default for MinmaxVariant {
@@ -85,6 +90,7 @@ impl Default for MinmaxVariant {
             slices: SamplingKnobs::DEFAULT_SLICES,
             slice_samples: SamplingKnobs::DEFAULT_SLICE_SAMPLES,
             step: SamplingKnobs::DEFAULT_STEP,
+            cookie: false,
         }
     }
 }
@@ -92,15 +98,21 @@ impl Default for MinmaxVariant {
 impl MinmaxVariant {
     /// Checks every knob; the error names the first offending one.
     pub fn validate(&self) -> Result<(), VariantError> {
-        self.sampling_knobs().validate()
+        self.sampling_knobs().validate()?;
+        crate::cookie::validate_cookie(self.cookie, self.light)
     }
 
-    /// A short stable id: `directional`, `spot`, `spot-lowres2-b5`.
+    /// A short stable id: `directional`, `spot`, `spot-cookie`, `spot-lowres2-b5`.
     pub fn id(&self) -> String {
-        format!("{}{}", self.light.name(), self.sampling_knobs().id_suffix())
+        format!(
+            "{}{}{}",
+            self.light.name(),
+            crate::cookie::id_suffix(self.cookie),
+            self.sampling_knobs().id_suffix()
+        )
     }
 
-    /// The conformance grid: both lights, every pixel.
+    /// The conformance grid: both lights, every pixel, and the spot with its cookie.
     pub fn grid() -> Vec<MinmaxVariant> {
         LightKind::ALL
             .iter()
@@ -108,6 +120,11 @@ impl MinmaxVariant {
                 light,
                 ..MinmaxVariant::default()
             })
+            .chain([MinmaxVariant {
+                light: LightKind::Spot,
+                cookie: true,
+                ..MinmaxVariant::default()
+            }])
             .collect()
     }
 
@@ -217,10 +234,10 @@ impl KnobSet for MinmaxVariant {
         Self { light, ..self }
     }
 
-    /// Empty (the light is not in markers), or the sampling's (`lr2`).
+    /// Empty (the light is not in markers), `cookie` with a cookie, and the sampling's
+    /// (`lr2`).
     fn marker(&self) -> String {
-        self.sampling_knobs()
-            .marker_suffix()
+        (crate::cookie::id_suffix(self.cookie).to_owned() + &self.sampling_knobs().marker_suffix())
             .trim_start_matches('-')
             .to_owned()
     }
@@ -235,6 +252,14 @@ impl KnobSet for MinmaxVariant {
 
     fn grid() -> Vec<Self> {
         MinmaxVariant::grid()
+    }
+
+    fn cookie(&self) -> bool {
+        self.cookie
+    }
+
+    fn with_cookie(self, cookie: bool) -> Option<Self> {
+        Some(Self { cookie, ..self })
     }
 }
 

@@ -222,6 +222,14 @@ impl Light {
         }
     }
 
+    /// A spot's cookie (`None` for the sun and a spot without one).
+    pub fn cookie(&self) -> Option<&crate::cookie::Cookie> {
+        match self {
+            Light::Spot { cookie, .. } => cookie.as_ref(),
+            Light::Directional { .. } => None,
+        }
+    }
+
     /// RGB scale of the light (irradiance or intensity).
     pub fn color(&self) -> [f64; 3] {
         match self {

@@ -21,6 +21,7 @@
 //! per-frame upload and its frame report. [`gpu`] holds the toolkit no family owns.
 
 mod context;
+mod cookie;
 mod error;
 mod executor;
 pub mod family;

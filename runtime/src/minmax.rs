@@ -89,6 +89,8 @@ pub struct Minmax {
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
     frame: Option<PrefilteredFrame>,
+    /// The spot's cookie ([`Self::set_cookie`]), for a variant with `cookie`.
+    cookie: crate::cookie::CookieSlot,
 }
 
 impl Minmax {
@@ -161,7 +163,21 @@ impl Minmax {
             output_view: output_view.clone(),
             exec,
             frame: None,
+            cookie: crate::cookie::CookieSlot::default(),
         })
+    }
+
+    /// Sets the spot light's cookie a `cookie` variant reads (kept until replaced; any size,
+    /// one of [`crate::textures::COOKIE_FORMATS`], projected as `scatter_shaderlib::cookie`
+    /// says). [`crate::textures::upload_cookie`] makes one from texels.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::NoCookie`] for a variant without `cookie`;
+    /// [`RuntimeError::InputMismatch`] for a view of the wrong format, dimension or usage.
+    pub fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        self.cookie
+            .set(self.variant.cookie, self.variant.id(), MARCH, cookie)
     }
 
     /// Sets up one frame ([`prepare_minmax`]) and uploads its uniforms and slice table.
@@ -299,13 +315,10 @@ impl Minmax {
             shadow_map,
             [self.shadow_map_size; 2],
         )?;
-        self.exec.encode(
-            ctx.device(),
-            encoder,
-            &[("depth", depth), ("shadow_map", shadow_map)],
-            &[],
-            only,
-        )?;
+        let mut engine = vec![("depth", depth), ("shadow_map", shadow_map)];
+        self.cookie.bind(self.variant.cookie, MARCH, &mut engine)?;
+        self.exec
+            .encode(ctx.device(), encoder, &engine, &[], only)?;
         Ok(&self.output_view)
     }
 
@@ -378,7 +391,8 @@ pub struct MinmaxReadback {
 }
 
 /// Test helper: creates a [`Minmax`], uploads `depth` (screen-sized) and `shadow_map`
-/// (`input.shadow_map.size` squared) as r32float textures, runs one frame and reads back.
+/// (`input.shadow_map.size` squared) as r32float textures and, for a `cookie` variant,
+/// `cookie` (its size and RGBA texels), runs one frame and reads back.
 ///
 /// # Errors
 ///
@@ -391,9 +405,14 @@ pub fn run_minmax_once(
     input: &FrameInput,
     depth: &[f32],
     shadow_map: &[f32],
+    cookie: Option<([u32; 2], &[[f32; 4]])>,
 ) -> Result<MinmaxReadback, RuntimeError> {
     let sm_size = input.shadow_map.size;
     let mut pass = Minmax::new(ctx, variant, res, sm_size)?;
+    if let Some((size, texels)) = cookie {
+        let texture = crate::textures::upload_cookie(ctx, MARCH, size, texels)?;
+        pass.set_cookie(&texture.create_view(&wgpu::TextureViewDescriptor::default()))?;
+    }
     let views = upload_inputs(
         ctx,
         &[
@@ -515,5 +534,9 @@ impl crate::family::FamilyRuntime for Minmax {
             passes.push((FALLBACK, t.fallback));
         }
         Ok(passes)
+    }
+
+    fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        Minmax::set_cookie(self, cookie)
     }
 }

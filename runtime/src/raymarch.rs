@@ -94,7 +94,7 @@ pub struct Raymarch {
     output_view: wgpu::TextureView,
     prepared: Option<RaymarchUniforms>,
     /// The spot's cookie ([`Self::set_cookie`]), for a variant with `cookie`.
-    cookie: Option<wgpu::TextureView>,
+    cookie: crate::cookie::CookieSlot,
 }
 
 impl Raymarch {
@@ -172,7 +172,7 @@ impl Raymarch {
             output,
             output_view,
             prepared: None,
-            cookie: None,
+            cookie: crate::cookie::CookieSlot::default(),
         })
     }
 
@@ -185,14 +185,8 @@ impl Raymarch {
     /// [`RuntimeError::NoCookie`] for a variant without `cookie`;
     /// [`RuntimeError::InputMismatch`] for a view of the wrong format, dimension or usage.
     pub fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
-        if !self.variant.cookie {
-            return Err(RuntimeError::NoCookie {
-                variant: self.variant.id(),
-            });
-        }
-        crate::textures::check_cookie(RAYMARCH, cookie)?;
-        self.cookie = Some(cookie.clone());
-        Ok(())
+        self.cookie
+            .set(self.variant.cookie, self.variant.id(), RAYMARCH, cookie)
     }
 
     /// Fills and uploads the uniform block of one frame.
@@ -305,13 +299,8 @@ impl Raymarch {
             [self.shadow_map_size; 2],
         )?;
         let mut engine = vec![("depth", depth), ("shadow_map", shadow_map)];
-        if self.variant.cookie {
-            let cookie = self.cookie.as_ref().ok_or(RuntimeError::MissingInput {
-                kernel: RAYMARCH,
-                what: "the spot light's cookie (a `cookie` variant: call Raymarch::set_cookie)",
-            })?;
-            engine.push(("cookie", cookie));
-        }
+        self.cookie
+            .bind(self.variant.cookie, RAYMARCH, &mut engine)?;
         self.exec
             .encode(ctx.device(), encoder, &engine, &[], only)?;
         Ok(&self.output_view)

@@ -166,7 +166,7 @@ pub fn depth_and_shadow_map() -> [Resource; 2] {
 
 /// The binding of the engine's `cookie` texture in every kernel that reads a spot's cookie
 /// (above every family's own and sampling bindings).
-pub const COOKIE_BINDING: u32 = 8;
+pub const COOKIE_BINDING: u32 = 12;
 
 /// The engine's spot-light cookie ([`scatter_frame::cookie`]): any size, loaded texel by
 /// texel, so any float format binds (`rgba16float` declared).

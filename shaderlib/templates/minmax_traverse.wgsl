@@ -17,6 +17,9 @@
 // | 3       | shadow_map | texture_2d<f32> (r32float)             | textureLoad  |
 // | 4       | tree       | texture_2d<f32> (rg32float, minmax_build's) | textureLoad |
 // | 5       | output     | texture_storage_2d<rgba16float, write> | textureStore |
+{%- if cookie %}
+// | 12      | cookie     | texture_2d<f32> (rgba, linear RGB)     | textureLoad  |
+{%- endif %}
 // slices: one vec4 per rectified row (x = delta, y = theta_ref, z = theta_lo, w = theta_hi).
 //
 // Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
@@ -25,7 +28,7 @@
 // Mirrors reference/src/kernels/minmax_traverse.rs
 
 #import scatter::model::{phase_hg}
-#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index, slice_params}
+#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index, slice_params{% if cookie %}, epipole_march_cookie, lit_span_cookie{% endif %}}
 #import scatter::minmax::{level_offset, tree_levels}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
@@ -37,6 +40,10 @@
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) var tree: texture_2d<f32>;
 @group(0) @binding(5) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
+{%- if cookie %}
+// The spot's cookie (scatter_frame::cookie): lit spans and the epipole march carry it per node.
+@group(0) @binding(12) var cookie: texture_2d<f32>;
+{%- endif %}
 {% include "include/sampled_bindings.wgsl" %}
 
 // The in-scattered radiance of pixel (x, y) (the sampling entry point below calls it).
@@ -56,7 +63,11 @@ fn minmax_traverse_pixel(x: u32, y: u32) -> vec3<f32> {
     let near_anti =
         f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
     if near_epi || near_anti {
+{%- if cookie %}
+        let l = epipole_march_cookie(frame, shadow_map, cookie, eye, dir, s) * color;
+{%- else %}
         let l = epipole_march(frame, shadow_map, eye, dir, s, spot) * color;
+{%- endif %}
         return l;
     }
 
@@ -75,7 +86,7 @@ fn minmax_traverse_pixel(x: u32, y: u32) -> vec3<f32> {
 
     // Walk the tree: climb to the largest aligned node inside [i, n), descend while mixed.
     let levels = tree_levels(width);
-    var total = 0.0;
+    var total = {% if cookie %}vec3<f32>(0.0){% else %}0.0{% endif %};
     var in_run = false;
     var run_a = 0.0;
     var i = 0u;
@@ -101,14 +112,22 @@ fn minmax_traverse_pixel(x: u32, y: u32) -> vec3<f32> {
             if lit {
                 run_a = t;
             } else {
+{%- if cookie %}
+                total += lit_span_cookie(f, cookie, eye, dir, run_a, t);
+{%- else %}
                 total += lit_span(f, eye, dir, run_a, t, spot);
+{%- endif %}
             }
             in_run = lit;
         }
         i += 1u << k;
     }
     if in_run {
+{%- if cookie %}
+        total += lit_span_cookie(f, cookie, eye, dir, run_a, s);
+{%- else %}
         total += lit_span(f, eye, dir, run_a, s, spot);
+{%- endif %}
     }
     var l = total;
     if !spot {

@@ -21,7 +21,7 @@
 // | 2       | shadow_map | texture_2d<f32> (r32float)                   | textureLoad  |
 // | 3       | output     | texture_storage_2d<{{ output_format }}, write>           | textureStore |
 {%- if cookie %}
-// | 8       | cookie     | texture_2d<f32> (rgba, linear RGB)           | textureLoad  |
+// | 12      | cookie     | texture_2d<f32> (rgba, linear RGB)           | textureLoad  |
 {%- endif %}
 // output: screen-sized; {% if interleaved %}the partial sums `interleave_sum` reads{% else %}in-scattered radiance (rgb, alpha 1){% endif %}.
 {%- if cookie %}
@@ -45,7 +45,7 @@
 @group(0) @binding(2) var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) var output: texture_storage_2d<{{ output_format }}, write>;
 {%- if cookie %}
-@group(0) @binding(8) var cookie: texture_2d<f32>;
+@group(0) @binding(12) var cookie: texture_2d<f32>;
 {%- endif %}
 {% include "include/sampled_bindings.wgsl" %}
 

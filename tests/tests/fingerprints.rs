@@ -160,6 +160,14 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
     for v in MinmaxVariant::grid() {
         for f in for_light(v.light) {
             let trial = format!("minmax::{}::{}", v.id(), f.trial_tail());
+            let f = if v.cookie {
+                &f.with_cookie(
+                    scatter_reference::cookie::Cookie::pattern("stained_glass", 64)
+                        .expect("a built-in pattern"),
+                )
+            } else {
+                f
+            };
             let gpu = run_minmax_once(
                 ctx,
                 &v,
@@ -167,6 +175,7 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
                 &frame_input(f),
                 &f.gbuf.view_depth,
                 &f.shadow_map.depth,
+                f.cookie().as_ref().map(|(size, t)| (*size, &t[..])),
             )
             .unwrap_or_else(|e| panic!("{trial}: {e}"));
             line(&trial, "rectified", hash(gpu.rectified.iter().copied()));

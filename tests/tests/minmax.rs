@@ -22,6 +22,7 @@ use std::process::ExitCode;
 use std::sync::OnceLock;
 
 use scatter_conformance::{Check, Fixture, compare_slices, gpu, run_trials, scene_for};
+use scatter_reference::cookie::Cookie;
 use scatter_reference::kernels::minmax_traverse::{Pixel, TraverseInputs, pixel_ray};
 use scatter_reference::kernels::texture::Tex;
 use scatter_reference::kernels::{depth_columns, minmax_from_rectified, rectify, slice_fit};
@@ -36,16 +37,20 @@ const RECTIFIED: [u32; 2] = [100, 60];
 const SHADOW_MAP: u32 = 128;
 const REL_TOL: f32 = 1e-4;
 
-/// The (light, pose, depth scale) of every trial: both lights (the grid), at the `ordinary`
-/// and `epipole_on_screen` poses, and at the `ordinary` pose with the depth buffer at 0.3x,
-/// where `slice_fit` narrows the rows (every suite pose here sees the sky, where it does not).
-const CASES: [(LightKind, Pose, f32); 6] = [
-    (LightKind::Directional, Pose::Ordinary, 1.0),
-    (LightKind::Directional, Pose::EpipoleOnScreen, 1.0),
-    (LightKind::Spot, Pose::Ordinary, 1.0),
-    (LightKind::Spot, Pose::EpipoleOnScreen, 1.0),
-    (LightKind::Directional, Pose::Ordinary, 0.3),
-    (LightKind::Spot, Pose::Ordinary, 0.3),
+/// The (light, pose, depth scale, cookie) of every trial: both lights (the grid), at the
+/// `ordinary` and `epipole_on_screen` poses, at the `ordinary` pose with the depth buffer at
+/// 0.3x, where `slice_fit` narrows the rows (every suite pose here sees the sky, where it
+/// does not), and the spot with the `stained_glass` cookie (64^2) at both poses (lit spans
+/// and the epipole march).
+const CASES: [(LightKind, Pose, f32, bool); 8] = [
+    (LightKind::Directional, Pose::Ordinary, 1.0, false),
+    (LightKind::Directional, Pose::EpipoleOnScreen, 1.0, false),
+    (LightKind::Spot, Pose::Ordinary, 1.0, false),
+    (LightKind::Spot, Pose::EpipoleOnScreen, 1.0, false),
+    (LightKind::Directional, Pose::Ordinary, 0.3, false),
+    (LightKind::Spot, Pose::Ordinary, 0.3, false),
+    (LightKind::Spot, Pose::Ordinary, 1.0, true),
+    (LightKind::Spot, Pose::EpipoleOnScreen, 1.0, true),
 ];
 
 /// The fixture of case `i` of [`CASES`] (all built once, on first use).
@@ -54,16 +59,30 @@ fn fixture(i: usize) -> &'static Fixture {
     &ALL.get_or_init(|| {
         CASES
             .iter()
-            .map(|&(light, pose, scale)| {
+            .map(|&(light, pose, scale, cookie)| {
                 let f = Fixture::new(scene_for(light), pose, SCREEN, SHADOW_MAP);
-                if scale == 1.0 {
+                let f = if scale == 1.0 {
                     f
                 } else {
                     f.with_depth_scaled(scale)
+                };
+                if cookie {
+                    f.with_cookie(Cookie::pattern("stained_glass", 64).expect("a built-in pattern"))
+                } else {
+                    f
                 }
             })
             .collect()
     })[i]
+}
+
+/// The variant a fixture is run with: its light, and the cookie where it has one.
+fn variant_of(f: &Fixture) -> MinmaxVariant {
+    MinmaxVariant {
+        light: light_of(f),
+        cookie: f.cookie().is_some(),
+        ..MinmaxVariant::default()
+    }
 }
 
 fn light_of(f: &Fixture) -> LightKind {
@@ -78,7 +97,7 @@ fn input(f: &Fixture) -> FrameInput {
     f.frame_input(FrameSettings::for_screen(SCREEN[0], SCREEN[1]))
 }
 
-fn trial_name(light: LightKind, pose: Pose, depth_scale: f32) -> String {
+fn trial_name(light: LightKind, pose: Pose, depth_scale: f32, cookie: bool) -> String {
     let tail = if depth_scale == 1.0 {
         String::new()
     } else {
@@ -88,6 +107,7 @@ fn trial_name(light: LightKind, pose: Pose, depth_scale: f32) -> String {
         "{}::{}::{pose}{tail}",
         FamilyVariant::from(MinmaxVariant {
             light,
+            cookie,
             ..MinmaxVariant::default()
         })
         .trial_name(),
@@ -112,11 +132,9 @@ fn f16_ulp(v: f32) -> f32 {
 }
 
 fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> {
-    let variant = MinmaxVariant {
-        light: light_of(f),
-        ..MinmaxVariant::default()
-    };
-    let name = format!("{}::{}", variant.light, f.pose);
+    let variant = variant_of(f);
+    let name = format!("{}::{}", variant.id(), f.pose);
+    let cookie = f.cookie();
     let gpu = run_minmax_once(
         ctx,
         &variant,
@@ -124,6 +142,7 @@ fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> 
         &input(f),
         &f.gbuf.view_depth,
         &f.shadow_map.depth,
+        cookie.as_ref().map(|(size, t)| (*size, &t[..])),
     )
     .map_err(|e| format!("{name}: GPU run failed: {e}"))?;
     let [wr, hr] = RECTIFIED;
@@ -172,7 +191,8 @@ fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> 
         height: hr,
         data: gpu.rectified.clone(),
     };
-    let cpu = minmax_from_rectified(&variant, frame, gpu_rect, &depth, &sm);
+    let cookie_tex = scatter_reference::kernels::cookie_texture(&f.scene);
+    let cpu = minmax_from_rectified(&variant, frame, gpu_rect, &depth, &sm, cookie_tex.as_ref());
     // minmax_build: bit for bit.
     if cpu.tree.data.len() != gpu.tree.len() {
         return Err(format!("{name}: tree sizes differ"));
@@ -210,6 +230,7 @@ fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> 
         depth: &depth,
         shadow_map: &sm,
         tree: &cpu.tree,
+        cookie: cookie_tex.as_ref(),
     };
     for (i, (g, c)) in gpu.output.iter().zip(&cpu.march.output.data).enumerate() {
         let pixel_over = (0..3).any(|k| {
@@ -297,12 +318,12 @@ fn main() -> ExitCode {
     let mut trials: Vec<(String, Check)> = CASES
         .iter()
         .enumerate()
-        .map(|(i, &(light, pose, scale))| {
+        .map(|(i, &(light, pose, scale, cookie))| {
             let check: Check = Box::new(move || {
                 let Some(ctx) = gpu() else { return Ok(()) };
                 trial(ctx, fixture(i)).map(drop)
             });
-            (trial_name(light, pose, scale), check)
+            (trial_name(light, pose, scale, cookie), check)
         })
         .collect();
     trials.push((

@@ -68,6 +68,7 @@ fn inputs<'a>(run: &'a MinmaxRun, depth: &'a Tex, sm: &'a Tex) -> TraverseInputs
         depth,
         shadow_map: sm,
         tree: &run.tree,
+        cookie: None,
     }
 }
 

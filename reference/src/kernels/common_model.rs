@@ -230,3 +230,99 @@ pub fn spot_cookie(
     let bottom = mix3(texel(i0[0], i1[1]), texel(i1[0], i1[1]), f[0]);
     mix3(top, bottom, f[1])
 }
+
+/// Most panels [`spot_span_cookie`] takes over one span.
+pub const MAX_COOKIE_PANELS: u32 = 64;
+
+/// Texture coordinates of world point `x` in the cookie's projection, clamped to [0, 1];
+/// `(-1, -1)` behind the lamp. See the WGSL comment.
+pub fn cookie_uv(x: Vec3, light_pos: Vec3, frame: [Vec3; 3], cos_outer: f32) -> [f32; 2] {
+    let d = x - light_pos;
+    let z = d.dot(frame[2]);
+    if z <= 0.0 {
+        return [-1.0, -1.0];
+    }
+    let tan_outer = sqrt(max(1.0 - cos_outer * cos_outer, 0.0)) / cos_outer;
+    let a = d.dot(frame[0]) / (z * tan_outer);
+    let b = d.dot(frame[1]) / (z * tan_outer);
+    [
+        clamp(0.5 * (a + 1.0), 0.0, 1.0),
+        clamp(0.5 * (1.0 - b), 0.0, 1.0),
+    ]
+}
+
+/// The panels [`spot_span_cookie`] takes over `[a, b]`: one per cookie texel the span's
+/// projection crosses, within `[panels, max(panels, MAX_COOKIE_PANELS)]`. See the WGSL
+/// comment.
+#[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+pub fn cookie_panels(
+    cookie: &super::texture::TexArray,
+    eye: Vec3,
+    dir: Vec3,
+    a: f32,
+    b: f32,
+    panels: u32,
+    light_pos: Vec3,
+    frame: [Vec3; 3],
+    cos_outer: f32,
+) -> u32 {
+    let ua = cookie_uv(eye + dir * a, light_pos, frame, cos_outer);
+    let ub = cookie_uv(eye + dir * b, light_pos, frame, cos_outer);
+    if ua[0] < 0.0 || ub[0] < 0.0 {
+        return panels.max(MAX_COOKIE_PANELS);
+    }
+    let tx = (ub[0] - ua[0]).abs() * cookie.width as f32;
+    let ty = (ub[1] - ua[1]).abs() * cookie.height as f32;
+    // WGSL's f32 -> u32 conversion saturates, as Rust's `as` does.
+    ((tx + ty).ceil() as u32).clamp(panels, panels.max(MAX_COOKIE_PANELS))
+}
+
+/// [`spot_span`] with the cookie ([`spot_cookie`]) at every node and [`cookie_panels`]
+/// panels (RGB). See the WGSL comment.
+#[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+pub fn spot_span_cookie(
+    cookie: &super::texture::TexArray,
+    eye: Vec3,
+    dir: Vec3,
+    a: f32,
+    b: f32,
+    panels: u32,
+    light_pos: Vec3,
+    light_dir: Vec3,
+    cos_inner: f32,
+    cos_outer: f32,
+    medium: [f32; 4],
+    frame: [Vec3; 3],
+) -> Vec3 {
+    let n = cookie_panels(cookie, eye, dir, a, b, panels, light_pos, frame, cos_outer);
+    let t0 = (light_pos - eye).dot(dir);
+    let h = max(
+        (eye + dir * t0 - light_pos).length(),
+        1e-4 * max(b - a, 1e-6),
+    );
+    let g0 = ((a - t0) / h).atan();
+    let w = (((b - t0) / h).atan() - g0) / n as f32;
+    let mut sum = Vec3::ZERO;
+    for k in 0..n {
+        let mid = g0 + (k as f32 + 0.5) * w;
+        for q in 0..4 {
+            let u = (mid + 0.5 * w * GL4_X[q]).tan();
+            let t = t0 + h * u;
+            sum += GL4_W[q]
+                * spot_integrand(
+                    eye, dir, t, light_pos, light_dir, cos_inner, cos_outer, medium,
+                )
+                * (1.0 + u * u)
+                * spot_cookie(
+                    cookie,
+                    eye + dir * t,
+                    light_pos,
+                    frame[0],
+                    frame[1],
+                    frame[2],
+                    cos_outer,
+                );
+        }
+    }
+    sum * (0.5 * w * h)
+}

@@ -10,7 +10,8 @@
 //! (the reference the hierarchy must equal), shares everything but the walk.
 
 use super::common_epipolar::{
-    epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index,
+    epipole_march, epipole_march_cookie, lit_span_cookie, normalised_depth, pixel_dir, ray_column,
+    ray_row_coord, ray_theta, row_index,
 };
 use super::common_minmax::{level_offset, tree_levels};
 use super::common_model::{max, min, phase_hg};
@@ -32,6 +33,8 @@ pub struct TraverseInputs<'a> {
     pub shadow_map: &'a Tex,
     /// The min-max trees (from `minmax_build`).
     pub tree: &'a TexArray,
+    /// A `cookie` variant's spot cookie (`None` otherwise).
+    pub cookie: Option<&'a TexArray>,
 }
 
 pub use super::common_epipolar::{edge_t, lit_span};
@@ -90,7 +93,10 @@ pub fn pixel_ray(id: [u32; 3], spot: bool, inp: &TraverseInputs) -> Option<Pixel
     let near_anti = f.anti_epipole[2] > 0.5
         && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
     if near_epi || near_anti {
-        let l = epipole_march(f, inp.shadow_map, eye, dir, s, spot) * color;
+        let l = match inp.cookie {
+            Some(cookie) => epipole_march_cookie(f, inp.shadow_map, cookie, eye, dir, s) * color,
+            None => epipole_march(f, inp.shadow_map, eye, dir, s, spot) * color,
+        };
         return Some(Pixel::Marched([l.x, l.y, l.z, 1.0]));
     }
 
@@ -120,13 +126,19 @@ pub fn pixel_ray(id: [u32; 3], spot: bool, inp: &TraverseInputs) -> Option<Pixel
 }
 
 /// The kernel's walk of the tree: climb to the largest aligned node inside `[i, n)`, descend
-/// while mixed; every maximal lit run adds [`lit_span`]. Returns the sum and the number of
-/// nodes visited.
-pub fn walk_tree(f: &FrameUniforms, tree: &TexArray, r: &RowRay, spot: bool) -> (f32, u32) {
+/// while mixed; every maximal lit run adds [`lit_span`] ([`lit_span_cookie`] with a cookie).
+/// Returns the sum (RGB) and the number of nodes visited.
+pub fn walk_tree(
+    f: &FrameUniforms,
+    tree: &TexArray,
+    r: &RowRay,
+    spot: bool,
+    cookie: Option<&TexArray>,
+) -> (Vec3, u32) {
     let width = f.sizes[2];
     let (eye, dir, s, d, n) = (r.eye, r.dir, r.s, r.d, r.n);
     let levels = tree_levels(width);
-    let mut total = 0.0;
+    let mut total = Vec3::ZERO;
     let mut in_run = false;
     let mut run_a = 0.0;
     let mut visits = 0;
@@ -154,24 +166,30 @@ pub fn walk_tree(f: &FrameUniforms, tree: &TexArray, r: &RowRay, spot: bool) -> 
             if lit {
                 run_a = t;
             } else {
-                total += lit_span(f, eye, dir, run_a, t, spot);
+                total += span(f, cookie, eye, dir, run_a, t, spot);
             }
             in_run = lit;
         }
         i += 1u32 << k;
     }
     if in_run {
-        total += lit_span(f, eye, dir, run_a, s, spot);
+        total += span(f, cookie, eye, dir, run_a, s, spot);
     }
     (total, visits)
 }
 
 /// The brute-force walk: every texel `0 .. n` of the row, lit iff `d <= d_i` read straight
-/// from the rectified map; every maximal lit run adds [`lit_span`]. Returns the sum and the
-/// number of texels visited (`n`).
-pub fn walk_texels(f: &FrameUniforms, rectified: &Tex, r: &RowRay, spot: bool) -> (f32, u32) {
+/// from the rectified map; every maximal lit run adds [`lit_span`] ([`lit_span_cookie`] with a
+/// cookie). Returns the sum (RGB) and the number of texels visited (`n`).
+pub fn walk_texels(
+    f: &FrameUniforms,
+    rectified: &Tex,
+    r: &RowRay,
+    spot: bool,
+    cookie: Option<&TexArray>,
+) -> (Vec3, u32) {
     let (eye, dir, s, d, n) = (r.eye, r.dir, r.s, r.d, r.n);
-    let mut total = 0.0;
+    let mut total = Vec3::ZERO;
     let mut in_run = false;
     let mut run_a = 0.0;
     for i in 0..n {
@@ -181,19 +199,45 @@ pub fn walk_texels(f: &FrameUniforms, rectified: &Tex, r: &RowRay, spot: bool) -
             if lit {
                 run_a = t;
             } else {
-                total += lit_span(f, eye, dir, run_a, t, spot);
+                total += span(f, cookie, eye, dir, run_a, t, spot);
             }
             in_run = lit;
         }
     }
     if in_run {
-        total += lit_span(f, eye, dir, run_a, s, spot);
+        total += span(f, cookie, eye, dir, run_a, s, spot);
     }
     (total, n)
 }
 
+/// A lit run's unshadowed in-scattering: [`lit_span`] in every channel, or
+/// [`lit_span_cookie`] with a cookie.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "the WGSL call's arguments and the cookie"
+)]
+fn span(
+    f: &FrameUniforms,
+    cookie: Option<&TexArray>,
+    eye: Vec3,
+    dir: Vec3,
+    a: f32,
+    b: f32,
+    spot: bool,
+) -> Vec3 {
+    match cookie {
+        Some(cookie) => lit_span_cookie(f, cookie, eye, dir, a, b),
+        None => Vec3::splat(lit_span(f, eye, dir, a, b, spot)),
+    }
+}
+
 /// The stored radiance of a walked ray's sum (`sigma_s p E` for the sun, `I` for a spot).
 pub fn radiance(f: &FrameUniforms, r: &RowRay, total: f32, spot: bool) -> [f32; 4] {
+    radiance_rgb(f, r, Vec3::splat(total), spot)
+}
+
+/// [`radiance`] of an RGB sum (a spot's cookie).
+pub fn radiance_rgb(f: &FrameUniforms, r: &RowRay, total: Vec3, spot: bool) -> [f32; 4] {
     let mut l = total;
     if !spot {
         l = f.medium[1] * phase_hg(f.medium[2], -xyz(f.light_dir).dot(r.dir)) * total;
@@ -213,8 +257,8 @@ pub fn minmax_traverse_main(
     Some(match pixel_ray(id, spot, inp)? {
         Pixel::Marched(c) => (c, 0),
         Pixel::Row(r) => {
-            let (total, visits) = walk_tree(inp.frame, inp.tree, &r, spot);
-            (radiance(inp.frame, &r, total, spot), visits)
+            let (total, visits) = walk_tree(inp.frame, inp.tree, &r, spot, inp.cookie);
+            (radiance_rgb(inp.frame, &r, total, spot), visits)
         }
     })
 }
@@ -231,8 +275,8 @@ pub fn minmax_brute_main(
     Some(match pixel_ray(id, spot, inp)? {
         Pixel::Marched(c) => (c, 0),
         Pixel::Row(r) => {
-            let (total, visits) = walk_texels(inp.frame, rectified, &r, spot);
-            (radiance(inp.frame, &r, total, spot), visits)
+            let (total, visits) = walk_texels(inp.frame, rectified, &r, spot, inp.cookie);
+            (radiance_rgb(inp.frame, &r, total, spot), visits)
         }
     })
 }

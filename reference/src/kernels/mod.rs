@@ -326,19 +326,26 @@ pub fn run_minmax(
     )?;
     let (depth, sm) = input_textures(gbuf, shadow_map);
     let rectified = rectify_passes(&mut frame, &depth, &sm, variant.light);
+    let cookie = variant.cookie.then(|| cookie_texture(scene)).flatten();
     Ok(minmax_from_rectified(
-        variant, frame, rectified, &depth, &sm,
+        variant,
+        frame,
+        rectified,
+        &depth,
+        &sm,
+        cookie.as_ref(),
     ))
 }
 
 /// `minmax_build`, `minmax_traverse` and the brute-force march for a given frame and
-/// rectified map (the GPU's, in the conformance test).
+/// rectified map (the GPU's, in the conformance test); `cookie` for a `cookie` variant.
 pub fn minmax_from_rectified(
     variant: &MinmaxVariant,
     frame: PrefilteredFrame,
     rectified: Tex,
     depth: &Tex,
     shadow_map: &Tex,
+    cookie: Option<&TexArray>,
 ) -> MinmaxRun {
     let tree = minmax_build::minmax_build(&frame.uniforms, &rectified);
     let inputs = minmax_traverse::TraverseInputs {
@@ -347,6 +354,7 @@ pub fn minmax_from_rectified(
         depth,
         shadow_map,
         tree: &tree,
+        cookie,
     };
     let march = minmax_traverse::minmax_traverse(variant, &inputs);
     let brute = minmax_traverse::minmax_brute(variant, &inputs, &rectified);

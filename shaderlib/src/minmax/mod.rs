@@ -39,6 +39,7 @@ struct BuildTemplate {}
 struct TraverseTemplate {
     light_name: &'static str,
     spot: bool,
+    cookie: bool,
     sampling: SamplingView,
 }
 
@@ -48,6 +49,7 @@ struct TraverseTemplate {
 struct TraverseUnwarpTemplate {
     light_name: &'static str,
     spot: bool,
+    cookie: bool,
     sampling: SamplingView,
 }
 
@@ -57,6 +59,7 @@ struct TraverseUnwarpTemplate {
 struct TraverseFallbackTemplate {
     light_name: &'static str,
     spot: bool,
+    cookie: bool,
     sampling: SamplingView,
 }
 
@@ -96,6 +99,7 @@ pub(crate) fn render_traverse(variant: &MinmaxVariant) -> Result<String, ShaderE
     TraverseTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
+        cookie: variant.cookie,
         sampling: sampling_view(variant, Kernel::MinmaxTraverse),
     }
     .render()
@@ -114,6 +118,7 @@ pub(crate) fn render_traverse_unwarp(variant: &MinmaxVariant) -> Result<String, 
     TraverseUnwarpTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
+        cookie: variant.cookie,
         sampling: sampling_view(variant, Kernel::MinmaxTraverseUnwarp),
     }
     .render()
@@ -132,6 +137,7 @@ pub(crate) fn render_traverse_fallback(variant: &MinmaxVariant) -> Result<String
     TraverseFallbackTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
+        cookie: variant.cookie,
         sampling: sampling_view(variant, Kernel::MinmaxTraverseFallback),
     }
     .render()

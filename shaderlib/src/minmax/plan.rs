@@ -6,9 +6,9 @@ use crate::Kernel;
 use crate::family::KernelFamily;
 use crate::minmax::{MinmaxVariant, TREE_FORMAT};
 use crate::plan::{
-    DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, SLICE_FIT_NOTE, TEXTURE_DIMENSION,
-    bind, column_depth_buffer, depth_and_shadow_map, frame_buffer, scatter_texture,
-    screen_and_shadow_parameters,
+    COOKIE_BINDING, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, SLICE_FIT_NOTE,
+    TEXTURE_DIMENSION, bind, column_depth_buffer, cookie_parameters, cookie_texture,
+    depth_and_shadow_map, frame_buffer, scatter_texture, screen_and_shadow_parameters,
 };
 use crate::sampling::{
     epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
@@ -82,6 +82,10 @@ pub fn plan(v: &MinmaxVariant) -> Plan {
             "screen.height",
         ),
     ];
+    if v.cookie {
+        parameters.extend(cookie_parameters());
+        resources.push(cookie_texture());
+    }
     resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
     resources.extend(fallback_buffers(&v.sampling_knobs()));
     let passes = v
@@ -151,14 +155,17 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations(&v.sampling_knobs()),
                 skip_when: None,
-                bindings: vec![
+                bindings: [
                     bind(0, "frame"),
                     bind(1, "slices"),
                     bind(2, "depth"),
                     bind(3, "shadow_map"),
                     bind(4, "tree"),
                     bind(5, sampled_output(&v.sampling_knobs())),
-                ],
+                ]
+                .into_iter()
+                .chain(v.cookie.then(|| bind(COOKIE_BINDING, "cookie")))
+                .collect(),
             },
             6,
         )),

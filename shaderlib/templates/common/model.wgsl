@@ -164,3 +164,72 @@ fn spot_cookie(cookie: texture_2d<f32>, x: vec3<f32>, light_pos: vec3<f32>, righ
     let bottom = mix(textureLoad(cookie, vec2<i32>(i0.x, i1.y), 0).xyz, textureLoad(cookie, vec2<i32>(i1.x, i1.y), 0).xyz, f.x);
     return mix(top, bottom, f.y);
 }
+
+// Most panels `spot_span_cookie` takes over one span.
+const MAX_COOKIE_PANELS: u32 = 64u;
+
+// Texture coordinates of world point `x` in the cookie's projection (`spot_cookie`), clamped
+// to [0, 1]; (-1, -1) behind the lamp.
+fn cookie_uv(x: vec3<f32>, light_pos: vec3<f32>, right: vec3<f32>, up: vec3<f32>, forward: vec3<f32>, cos_outer: f32) -> vec2<f32> {
+    let d = x - light_pos;
+    let z = dot(d, forward);
+    if z <= 0.0 {
+        return vec2<f32>(-1.0);
+    }
+    let tan_outer = sqrt(max(1.0 - cos_outer * cos_outer, 0.0)) / cos_outer;
+    let a = dot(d, right) / (z * tan_outer);
+    let b = dot(d, up) / (z * tan_outer);
+    return clamp(vec2<f32>(0.5 * (a + 1.0), 0.5 * (1.0 - b)), vec2<f32>(0.0), vec2<f32>(1.0));
+}
+
+// The panels `spot_span_cookie` takes over `[a, b]` of the ray: at least `panels`, and one per
+// cookie texel the span's projection crosses (a segment projects to a segment; counted along
+// both axes, clamped to the texture), at most MAX_COOKIE_PANELS; the most where the span
+// passes behind the lamp. A cookie's texels vary along the span at their own scale, which
+// the spot quadrature's few panels do not follow: with 4 panels minmax was 9.4 % off the
+// truth on spot_grate/ordinary with the 64^2 stained glass.
+fn cookie_panels(cookie: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, panels: u32, light_pos: vec3<f32>, right: vec3<f32>, up: vec3<f32>, forward: vec3<f32>, cos_outer: f32) -> u32 {
+    let ua = cookie_uv(eye + dir * a, light_pos, right, up, forward, cos_outer);
+    let ub = cookie_uv(eye + dir * b, light_pos, right, up, forward, cos_outer);
+    if ua.x < 0.0 || ub.x < 0.0 {
+        return max(panels, MAX_COOKIE_PANELS);
+    }
+    let texels = abs(ub - ua) * vec2<f32>(textureDimensions(cookie));
+    return clamp(u32(ceil(texels.x + texels.y)), panels, max(panels, MAX_COOKIE_PANELS));
+}
+
+// `spot_span` with the cookie (`spot_cookie`) at every node and `cookie_panels` panels: the
+// unshadowed RGB in-scattering of a spot with a cookie over `[a, b]` (without the light
+// colour). The light frame is the shadow map's (`right`, `up`, `forward`).
+fn spot_span_cookie(
+    cookie: texture_2d<f32>,
+    eye: vec3<f32>,
+    dir: vec3<f32>,
+    a: f32,
+    b: f32,
+    panels: u32,
+    light_pos: vec3<f32>,
+    light_dir: vec3<f32>,
+    cos_inner: f32,
+    cos_outer: f32,
+    medium: vec4<f32>,
+    right: vec3<f32>,
+    up: vec3<f32>,
+    forward: vec3<f32>,
+) -> vec3<f32> {
+    let n = cookie_panels(cookie, eye, dir, a, b, panels, light_pos, right, up, forward, cos_outer);
+    let t0 = dot(light_pos - eye, dir);
+    let h = max(length(eye + dir * t0 - light_pos), 1e-4 * max(b - a, 1e-6));
+    let g0 = atan((a - t0) / h);
+    let w = (atan((b - t0) / h) - g0) / f32(n);
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < n; k++) {
+        let mid = g0 + (f32(k) + 0.5) * w;
+        for (var q = 0u; q < 4u; q++) {
+            let u = tan(mid + 0.5 * w * GL4_X[q]);
+            let t = t0 + h * u;
+            sum += GL4_W[q] * spot_integrand(eye, dir, t, light_pos, light_dir, cos_inner, cos_outer, medium) * (1.0 + u * u) * spot_cookie(cookie, eye + dir * t, light_pos, right, up, forward, cos_outer);
+        }
+    }
+    return sum * (0.5 * w * h);
+}
