@@ -98,6 +98,11 @@ pub struct HybridVolumeVariant {
     pub slice_samples: u32,
     /// `sampling = epipolar`: the initial step between evaluated samples of a slice.
     pub step: u32,
+    /// A spot light's cookie: an RGB texture projected along the cone multiplies the head's,
+    /// the tail's and the march's nodes (`light = spot` only; the engine's `cookie`
+    /// texture, [`crate::cookie`]).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub cookie: bool,
 }
 
 impl Default for HybridVolumeVariant {
@@ -117,6 +122,7 @@ impl Default for HybridVolumeVariant {
             slices: SamplingKnobs::DEFAULT_SLICES,
             slice_samples: SamplingKnobs::DEFAULT_SLICE_SAMPLES,
             step: SamplingKnobs::DEFAULT_STEP,
+            cookie: false,
         }
     }
 }
@@ -140,23 +146,26 @@ impl HybridVolumeVariant {
         range("samples", self.samples, 1, MAX_SAMPLES)?;
         range("bins", self.bins, 1, MAX_BINS)?;
         range("pad", self.pad, 0, MAX_PAD)?;
-        self.sampling_knobs().validate()
+        self.sampling_knobs().validate()?;
+        crate::cookie::validate_cookie(self.cookie, self.light)
     }
 
     /// A short stable id: `directional-n32-b256-p1`, `spot-n64-b256-p1-lowres2-b5`.
     pub fn id(&self) -> String {
         format!(
-            "{}-n{}-b{}-p{}{}",
+            "{}-n{}-b{}-p{}{}{}",
             self.light.name(),
             self.samples,
             self.bins,
             self.pad,
+            crate::cookie::id_suffix(self.cookie),
             self.sampling_knobs().id_suffix()
         )
     }
 
-    /// The conformance grid: both lights at the defaults, and the directional light with 8
-    /// samples, 64 bins and no padding (every code path: few bins put many walls in a bin).
+    /// The conformance grid: both lights at the defaults, the directional light with 8
+    /// samples, 64 bins and no padding (every code path: few bins put many walls in a bin),
+    /// and the spot with its cookie.
     pub fn grid() -> Vec<HybridVolumeVariant> {
         let mut out: Vec<HybridVolumeVariant> = LightKind::ALL
             .iter()
@@ -169,6 +178,11 @@ impl HybridVolumeVariant {
             samples: 8,
             bins: 64,
             pad: 0,
+            ..HybridVolumeVariant::default()
+        });
+        out.push(HybridVolumeVariant {
+            light: LightKind::Spot,
+            cookie: true,
             ..HybridVolumeVariant::default()
         });
         out
@@ -242,9 +256,14 @@ impl KnobSet for HybridVolumeVariant {
         Self { light, ..self }
     }
 
-    /// `n32` (the samples, then the sampling's marker).
+    /// `n32` (the samples, `-cookie` with a cookie, then the sampling's marker).
     fn marker(&self) -> String {
-        format!("n{}{}", self.samples, self.sampling_knobs().marker_suffix())
+        format!(
+            "n{}{}{}",
+            self.samples,
+            crate::cookie::id_suffix(self.cookie),
+            self.sampling_knobs().marker_suffix()
+        )
     }
 
     fn sampling(&self) -> SamplingKnobs {
@@ -257,6 +276,14 @@ impl KnobSet for HybridVolumeVariant {
 
     fn grid() -> Vec<Self> {
         HybridVolumeVariant::grid()
+    }
+
+    fn cookie(&self) -> bool {
+        self.cookie
+    }
+
+    fn with_cookie(self, cookie: bool) -> Option<Self> {
+        Some(Self { cookie, ..self })
     }
 }
 

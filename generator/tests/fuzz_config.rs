@@ -524,6 +524,8 @@ fn valid_value(family: Family, name: &str, pick: usize) -> String {
         "samples" => &["64", "128"],
         "interleave" => &["1", "2", "4"],
         "jitter" => &["true", "false"],
+        // `cookie = true` needs `light = "spot"`, which another knob picks.
+        "cookie" => &["false"],
         _ => &["1"],
     };
     options[pick % options.len()].to_owned()
@@ -558,6 +560,7 @@ fn bad_value(name: &str, pick: usize) -> String {
         "pad" => &["9", "-1", "\"x\""],
         "interleave" => &["0", "9", "\"two\""],
         "jitter" => &["\"maybe\"", "2", "\"yes\""],
+        "cookie" => &["\"maybe\"", "2", "\"yes\""],
         "sampling" => &["\"epipole\"", "\"lowres2\"", "2"],
         "scale" => &["3", "0", "8", "\"two\""],
         "depth_break" => &["0", "51", "\"x\""],

@@ -87,6 +87,8 @@ pub struct HybridVolume {
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
     frame: Option<PrefilteredFrame>,
+    /// The spot's cookie ([`Self::set_cookie`]), for a variant with `cookie`.
+    cookie: crate::cookie::CookieSlot,
 }
 
 impl HybridVolume {
@@ -172,7 +174,21 @@ impl HybridVolume {
             output_view: output_view.clone(),
             exec,
             frame: None,
+            cookie: crate::cookie::CookieSlot::default(),
         })
+    }
+
+    /// Sets the spot light's cookie a `cookie` variant reads (kept until replaced; any size,
+    /// one of [`crate::textures::COOKIE_FORMATS`], projected as `scatter_shaderlib::cookie`
+    /// says). [`crate::textures::upload_cookie`] makes one from texels.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::NoCookie`] for a variant without `cookie`;
+    /// [`RuntimeError::InputMismatch`] for a view of the wrong format, dimension or usage.
+    pub fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        self.cookie
+            .set(self.variant.cookie, self.variant.id(), MARCH, cookie)
     }
 
     /// Sets up one frame ([`prepare_hybrid_volume`]) and uploads its uniforms and slice table.
@@ -310,13 +326,10 @@ impl HybridVolume {
             shadow_map,
             [self.shadow_map_size; 2],
         )?;
-        self.exec.encode(
-            ctx.device(),
-            encoder,
-            &[("depth", depth), ("shadow_map", shadow_map)],
-            &[],
-            only,
-        )?;
+        let mut engine = vec![("depth", depth), ("shadow_map", shadow_map)];
+        self.cookie.bind(self.variant.cookie, MARCH, &mut engine)?;
+        self.exec
+            .encode(ctx.device(), encoder, &engine, &[], only)?;
         Ok(&self.output_view)
     }
 
@@ -389,7 +402,8 @@ pub struct HybridVolumeReadback {
 }
 
 /// Test helper: creates a [`HybridVolume`], uploads `depth` (screen-sized) and `shadow_map`
-/// (`input.shadow_map.size` squared) as r32float textures, runs one frame and reads back.
+/// (`input.shadow_map.size` squared) as r32float textures and, for a `cookie` variant,
+/// `cookie` (its size and RGBA texels), runs one frame and reads back.
 ///
 /// # Errors
 ///
@@ -402,9 +416,14 @@ pub fn run_hybrid_volume_once(
     input: &FrameInput,
     depth: &[f32],
     shadow_map: &[f32],
+    cookie: Option<([u32; 2], &[[f32; 4]])>,
 ) -> Result<HybridVolumeReadback, RuntimeError> {
     let sm_size = input.shadow_map.size;
     let mut pass = HybridVolume::new(ctx, variant, res, sm_size)?;
+    if let Some((size, texels)) = cookie {
+        let texture = crate::textures::upload_cookie(ctx, MARCH, size, texels)?;
+        pass.set_cookie(&texture.create_view(&wgpu::TextureViewDescriptor::default()))?;
+    }
     let views = upload_inputs(
         ctx,
         &[
@@ -531,5 +550,9 @@ impl crate::family::FamilyRuntime for HybridVolume {
             passes.push((FALLBACK, t.fallback));
         }
         Ok(passes)
+    }
+
+    fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        HybridVolume::set_cookie(self, cookie)
     }
 }

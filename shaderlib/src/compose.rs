@@ -58,6 +58,10 @@ const COMMON_MODULES: &[(&str, &str)] = &[
         "common/sampling.wgsl",
         include_str!("../templates/common/sampling.wgsl"),
     ),
+    (
+        "common/cookie.wgsl",
+        include_str!("../templates/common/cookie.wgsl"),
+    ),
 ];
 
 thread_local! {

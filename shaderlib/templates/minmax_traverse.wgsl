@@ -28,7 +28,10 @@
 // Mirrors reference/src/kernels/minmax_traverse.rs
 
 #import scatter::model::{phase_hg}
-#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index, slice_params{% if cookie %}, epipole_march_cookie, lit_span_cookie{% endif %}}
+#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index, slice_params}
+{%- if cookie %}
+#import scatter::cookie::{epipole_march_cookie, lit_span_cookie}
+{%- endif %}
 #import scatter::minmax::{level_offset, tree_levels}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}

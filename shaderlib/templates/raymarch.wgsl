@@ -33,7 +33,10 @@
 //
 // Mirrors reference/src/kernels/raymarch.rs
 
-#import scatter::model::{equiangular, equiangular_sample, phase_hg, spot_integrand, transmittance_between{% if cookie %}, spot_cookie{% endif %}}
+#import scatter::model::{equiangular, equiangular_sample, phase_hg, spot_integrand, transmittance_between}
+{%- if cookie %}
+#import scatter::cookie::spot_cookie
+{%- endif %}
 #import scatter::shadow::shadow_visibility
 #import scatter::raymarch::{RaymarchFrame, raymarch_pixel_dir, raymarch_shadow_view, pixel_jitter}
 {%- if !sampling.imports.is_empty() %}

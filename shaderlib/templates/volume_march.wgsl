@@ -28,6 +28,9 @@
 
 #import scatter::model::{phase_hg, transmittance_between}
 #import scatter::epipolar::{Frame, edge_t, epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index, slice_params, span_march, spot_segment}
+{%- if cookie %}
+#import scatter::cookie::{epipole_march_cookie, span_march_cookie, spot_segment_cookie}
+{%- endif %}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
 {%- endif %}
@@ -44,6 +47,10 @@ const NO_EDGE: u32 = 0xffffffffu;
 @group(0) @binding(4) var rectified: texture_2d<f32>;
 @group(0) @binding(5) var<storage, read> crossings: array<u32>;
 @group(0) @binding(6) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
+{%- if cookie %}
+// The spot's cookie (scatter_frame::cookie): head, tail and march carry it per node.
+@group(0) @binding(12) var cookie: texture_2d<f32>;
+{%- endif %}
 {% include "include/sampled_bindings.wgsl" %}
 
 // What one rectified row says about a ray: the interval (t_f > t_b: no crossing) and the
@@ -99,6 +106,14 @@ fn closed_form(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, spot: b
     }
     return transmittance_between(f.medium[0], a, b);
 }
+{%- if cookie %}
+
+// `closed_form` of a spot with a cookie (RGB): at least as many panels, one per cookie texel
+// crossed (`scatter::model::cookie_panels`).
+fn closed_form_cookie(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32) -> vec3<f32> {
+    return spot_segment_cookie(f, cookie, eye, dir, a, b, max(max(f.sizes2_[2] / 4u, SAMPLES / 4u), 1u));
+}
+{%- endif %}
 
 // The in-scattered radiance of pixel (x, y) (the sampling entry point below calls it).
 fn volume_march_pixel(x: u32, y: u32) -> vec3<f32> {
@@ -117,7 +132,11 @@ fn volume_march_pixel(x: u32, y: u32) -> vec3<f32> {
     let near_anti =
         f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
     if near_epi || near_anti {
+{%- if cookie %}
+        let l = epipole_march_cookie(frame, shadow_map, cookie, eye, dir, s) * color;
+{%- else %}
         let l = epipole_march(frame, shadow_map, eye, dir, s, spot) * color;
+{%- endif %}
         return l;
     }
 
@@ -147,6 +166,18 @@ fn volume_march_pixel(x: u32, y: u32) -> vec3<f32> {
     }
 
     // Head and tail in closed form, [t_f, t_b] marched.
+{%- if cookie %}
+    var total = vec3<f32>(0.0);
+    if a.head {
+        total += closed_form_cookie(f, eye, dir, 0.0, t_f);
+    }
+    if t_b > t_f {
+        total += span_march_cookie(f, shadow_map, cookie, eye, dir, t_f, t_b, SAMPLES);
+    }
+    if a.tail {
+        total += closed_form_cookie(f, eye, dir, t_b, s);
+    }
+{%- else %}
     var total = 0.0;
     if a.head {
         total += closed_form(f, eye, dir, 0.0, t_f, spot);
@@ -157,6 +188,7 @@ fn volume_march_pixel(x: u32, y: u32) -> vec3<f32> {
     if a.tail {
         total += closed_form(f, eye, dir, t_b, s, spot);
     }
+{%- endif %}
     var l = total;
     if !spot {
         l = f.medium[1] * phase_hg(f.medium[2], -dot(f.light_dir.xyz, dir)) * total;

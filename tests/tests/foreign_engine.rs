@@ -584,6 +584,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
             &f,
             &fixture.gbuf.view_depth,
             &fixture.shadow_map.depth,
+            None,
         )
         .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
         let frame = prepare_hybrid_volume(

@@ -57,19 +57,26 @@ fn cases() -> Vec<(HybridVolumeVariant, Pose, f32)> {
     out
 }
 
-/// The fixture of (light, pose, depth scale), built once per distinct key.
-fn fixture(light: LightKind, pose: Pose, scale: f32) -> &'static Fixture {
-    type Key = (LightKind, Pose, u32);
+/// The fixture of (light, pose, depth scale, cookie), built once per distinct key; a cookie
+/// variant's has the `stained_glass` cookie (64^2).
+fn fixture(light: LightKind, pose: Pose, scale: f32, cookie: bool) -> &'static Fixture {
+    type Key = (LightKind, Pose, u32, bool);
     static ALL: OnceLock<Vec<(Key, Fixture)>> = OnceLock::new();
     let all = ALL.get_or_init(|| {
         let mut keys: Vec<Key> = cases()
             .iter()
-            .map(|&(v, pose, scale)| (v.light, pose, scale.to_bits()))
+            .map(|&(v, pose, scale)| (v.light, pose, scale.to_bits(), v.cookie))
+            .chain([(
+                LightKind::Directional,
+                Pose::Ordinary,
+                1f32.to_bits(),
+                false,
+            )])
             .collect();
         keys.sort();
         keys.dedup();
         keys.into_iter()
-            .map(|key @ (light, pose, bits)| {
+            .map(|key @ (light, pose, bits, cookie)| {
                 let f = Fixture::new(scene_for(light), pose, SCREEN, SHADOW_MAP);
                 let scale = f32::from_bits(bits);
                 let f = if scale == 1.0 {
@@ -77,11 +84,19 @@ fn fixture(light: LightKind, pose: Pose, scale: f32) -> &'static Fixture {
                 } else {
                     f.with_depth_scaled(scale)
                 };
+                let f = if cookie {
+                    f.with_cookie(
+                        scatter_reference::cookie::Cookie::pattern("stained_glass", 64)
+                            .expect("a built-in pattern"),
+                    )
+                } else {
+                    f
+                };
                 (key, f)
             })
             .collect()
     });
-    let key = (light, pose, scale.to_bits());
+    let key = (light, pose, scale.to_bits(), cookie);
     &all.iter()
         .find(|(k, _)| *k == key)
         .expect("a fixture for every case")
@@ -135,6 +150,7 @@ fn trial(
         &input(f),
         &f.gbuf.view_depth,
         &f.shadow_map.depth,
+        f.cookie().as_ref().map(|(size, t)| (*size, &t[..])),
     )
     .map_err(|e| format!("{name}: GPU run failed: {e}"))?;
     let [wr, hr] = RECTIFIED;
@@ -164,7 +180,9 @@ fn trial(
         height: hr,
         data: gpu.rectified.clone(),
     };
-    let cpu = hybrid_volume_from_rectified(variant, frame, gpu_rect, &depth, &sm);
+    let cookie_tex = scatter_reference::kernels::cookie_texture(&f.scene);
+    let cpu =
+        hybrid_volume_from_rectified(variant, frame, gpu_rect, &depth, &sm, cookie_tex.as_ref());
     // volume_bounds: bit for bit.
     if cpu.crossings.edges != gpu.crossings {
         let bad = cpu
@@ -205,6 +223,7 @@ fn trial(
         shadow_map: &sm,
         rectified: &cpu.rectified,
         crossings: &cpu.crossings,
+        cookie: cookie_tex.as_ref(),
     };
     let mut worst: f32 = 0.0;
     let mut worst_untied: f32 = 0.0;
@@ -306,7 +325,8 @@ fn main() -> ExitCode {
         .map(|(v, pose, scale)| {
             let check: Check = Box::new(move || {
                 let Some(ctx) = gpu() else { return Ok(()) };
-                trial(ctx, &v, fixture(v.light, pose, scale)).map(|m| eprintln!("     {m}"))
+                trial(ctx, &v, fixture(v.light, pose, scale, v.cookie))
+                    .map(|m| eprintln!("     {m}"))
             });
             (trial_name(&v, pose, scale), check)
         })
@@ -348,7 +368,7 @@ fn bad_input_is_an_error() {
     .expect_err("zero bins");
     assert!(err.to_string().contains("bins"), "{err}");
     eprintln!("ok   hybrid_volume::errors::zero_bins: {err}");
-    let f = fixture(LightKind::Directional, Pose::Ordinary, 1.0);
+    let f = fixture(LightKind::Directional, Pose::Ordinary, 1.0, false);
     let mut pass =
         HybridVolume::new(ctx, &v, res(), SHADOW_MAP / 2).unwrap_or_else(|e| panic!("{e}"));
     let err = pass.prepare(ctx, &input(f)).expect_err("shadow map size");

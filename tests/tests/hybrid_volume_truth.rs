@@ -223,6 +223,7 @@ fn every_suite_pose() {
                 shadow_map: &smt,
                 rectified: &run.rectified,
                 crossings: &run.crossings,
+                cookie: None,
             };
             // Brute-force ray marching of the whole ray, same shadow map, same sample
             // placement (`span_march` over `[0, s]`): the method's competitor.

@@ -103,6 +103,9 @@ macro_rules! cli_families {
                 let mut out = match self {
                     $(Self::$name => $module::knobs(),)*
                 };
+                if self.default_variant().with_cookie(true).is_some() {
+                    out.push(cookie_knob());
+                }
                 out.extend(sampling_knobs(self.default_variant().sampling()));
                 out
             }
@@ -125,16 +128,64 @@ macro_rules! cli_families {
                 }
                 let own: Vec<(String, String)> = knobs
                     .iter()
-                    .filter(|(name, _)| !SAMPLING_KNOBS.contains(&name.as_str()))
+                    .filter(|(name, _)| {
+                        !SAMPLING_KNOBS.contains(&name.as_str()) && name.as_str() != "cookie"
+                    })
                     .cloned()
                     .collect();
                 let variant = match self {
                     $(Self::$name => $module::parse(&own).map(FamilyVariant::$name)?,)*
                 };
-                apply_sampling(variant, knobs)
+                apply_sampling(apply_cookie(variant, knobs)?, knobs)
             }
         }
     };
+}
+
+/// Allowed `cookie`.
+const COOKIE_ALLOWED: &str = "true | false";
+
+/// The `cookie` knob of the families that read a spot's cookie
+/// ([`FamilyVariant::with_cookie`]), after the family's own.
+fn cookie_knob() -> KnobInfo {
+    KnobInfo {
+        name: "cookie",
+        value_name: "BOOL",
+        help: "a spot light's cookie: an RGB texture (the engine's `cookie` input) projected \
+               along the cone multiplies the light (light = spot only)",
+        allowed: COOKIE_ALLOWED.into(),
+        default: "false".into(),
+        value_type: KnobType::Boolean,
+    }
+}
+
+/// `variant` with the `cookie` knob among `knobs` applied (not validated).
+fn apply_cookie(
+    variant: FamilyVariant,
+    knobs: &[(String, String)],
+) -> Result<FamilyVariant, GenError> {
+    let mut out = variant;
+    for (name, value) in knobs.iter().filter(|(n, _)| n == "cookie") {
+        let cookie = match value.trim() {
+            "true" | "on" | "1" => true,
+            "false" | "off" | "0" => false,
+            _ => {
+                return Err(VariantError {
+                    knob: "cookie",
+                    value: value.clone(),
+                    allowed: COOKIE_ALLOWED.into(),
+                }
+                .into());
+            }
+        };
+        out = out.with_cookie(cookie).ok_or_else(|| {
+            GenError::Usage(format!(
+                "knob `{name}` does not apply to family {}",
+                out.family()
+            ))
+        })?;
+    }
+    Ok(out)
 }
 
 /// The names of the sampling knobs every family has.

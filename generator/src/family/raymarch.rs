@@ -12,7 +12,7 @@ use crate::GenError;
 const SAMPLES_ALLOWED: &str = "in 4..=1024, a multiple of interleave^2";
 /// Allowed `interleave`.
 const INTERLEAVE_ALLOWED: &str = "in 1..=8";
-/// Allowed `jitter` and `cookie`.
+/// Allowed `jitter`.
 const JITTER_ALLOWED: &str = "true | false";
 
 /// The knobs of [`RaymarchVariant`], defaults from [`RaymarchVariant::default`].
@@ -52,15 +52,6 @@ pub fn knobs() -> Vec<KnobInfo> {
             default: d.light.to_string(),
             value_type: KnobType::Name,
         },
-        KnobInfo {
-            name: "cookie",
-            value_name: "BOOL",
-            help: "a spot light's cookie: an RGB texture (the engine's `cookie` input) \
-                   projected along the cone multiplies each sample (light = spot only)",
-            allowed: JITTER_ALLOWED.into(),
-            default: d.cookie.to_string(),
-            value_type: KnobType::Boolean,
-        },
     ]
 }
 
@@ -97,7 +88,6 @@ pub fn parse(knobs: &[(String, String)]) -> Result<RaymarchVariant, GenError> {
             "samples" => v.samples = number("samples", SAMPLES_ALLOWED, value)?,
             "interleave" => v.interleave = number("interleave", INTERLEAVE_ALLOWED, value)?,
             "jitter" => v.jitter = boolean("jitter", value)?,
-            "cookie" => v.cookie = boolean("cookie", value)?,
             "light" => v.light = value.parse()?,
             other => {
                 return Err(GenError::Usage(format!(

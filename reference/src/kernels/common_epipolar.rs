@@ -11,7 +11,7 @@ use super::common_model::{
     spot_span, transmittance_between,
 };
 use super::common_shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility};
-use super::texture::{Tex, TexArray, xyz};
+use super::texture::{Tex, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::FrameUniforms;
 
@@ -262,81 +262,4 @@ pub fn lit_span(f: &FrameUniforms, eye: Vec3, dir: Vec3, a: f32, b: f32, spot: b
         return spot_segment(f, eye, dir, a, b, max_u(f.sizes2[2] / 4, 1));
     }
     transmittance_between(f.medium[0], a, b)
-}
-
-/// A spot's cookie at world point `x` in the frame's shadow-map frame
-/// ([`super::common_model::spot_cookie`]).
-pub fn frame_cookie(f: &FrameUniforms, cookie: &TexArray, x: Vec3) -> Vec3 {
-    super::common_model::spot_cookie(
-        cookie,
-        x,
-        xyz(f.light_pos),
-        xyz(f.sm_right),
-        xyz(f.sm_up),
-        xyz(f.sm_forward),
-        f.light_dir[3],
-    )
-}
-
-/// [`span_march`] of a spot with a cookie: each sample's integrand times the cookie (RGB).
-#[allow(
-    clippy::too_many_arguments,
-    reason = "line for line with the WGSL function's parameters"
-)]
-pub fn span_march_cookie(
-    f: &FrameUniforms,
-    sm: &Tex,
-    cookie: &TexArray,
-    eye: Vec3,
-    dir: Vec3,
-    a: f32,
-    b: f32,
-    steps: u32,
-) -> Vec3 {
-    let strata = equiangular(eye, dir, xyz(f.light_pos), a, b, steps);
-    let mut sum = Vec3::ZERO;
-    for k in 0..steps {
-        let tw = equiangular_sample(&strata, k as f32 + 0.5);
-        let x = eye + dir * tw.0;
-        let v = sm_visibility(f, sm, x);
-        sum += v * tw.1 * frame_spot_integrand(f, eye, dir, tw.0) * frame_cookie(f, cookie, x);
-    }
-    sum
-}
-
-/// [`epipole_march`] of a spot with a cookie (RGB, without the light colour).
-pub fn epipole_march_cookie(
-    f: &FrameUniforms,
-    sm: &Tex,
-    cookie: &TexArray,
-    eye: Vec3,
-    dir: Vec3,
-    s: f32,
-) -> Vec3 {
-    span_march_cookie(f, sm, cookie, eye, dir, 0.0, s, f.sizes2[1])
-}
-
-/// [`lit_span`] of a spot with a cookie (RGB, without the light colour).
-pub fn lit_span_cookie(
-    f: &FrameUniforms,
-    cookie: &TexArray,
-    eye: Vec3,
-    dir: Vec3,
-    a: f32,
-    b: f32,
-) -> Vec3 {
-    super::common_model::spot_span_cookie(
-        cookie,
-        eye,
-        dir,
-        a,
-        b,
-        max_u(f.sizes2[2] / 4, 1),
-        xyz(f.light_pos),
-        xyz(f.light_dir),
-        f.light_pos[3],
-        f.light_dir[3],
-        f.medium,
-        [xyz(f.sm_right), xyz(f.sm_up), xyz(f.sm_forward)],
-    )
 }

@@ -9,9 +9,9 @@
 //! [`minmax_brute_main`], the brute-force march over every texel of the same rectified row
 //! (the reference the hierarchy must equal), shares everything but the walk.
 
+use super::common_cookie::{epipole_march_cookie, lit_span_cookie};
 use super::common_epipolar::{
-    epipole_march, epipole_march_cookie, lit_span_cookie, normalised_depth, pixel_dir, ray_column,
-    ray_row_coord, ray_theta, row_index,
+    epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index,
 };
 use super::common_minmax::{level_offset, tree_levels};
 use super::common_model::{max, min, phase_hg};

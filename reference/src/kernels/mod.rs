@@ -3,6 +3,7 @@
 //! GPU result can be compared with its mirror at quantisation-level tolerance. Shared WGSL
 //! modules (`templates/common/<name>.wgsl`) are mirrored by `common_<name>.rs`.
 
+pub mod common_cookie;
 pub mod common_epipolar;
 pub mod common_minmax;
 pub mod common_model;
@@ -425,19 +426,26 @@ pub fn run_hybrid_volume(
     )?;
     let (depth, sm) = input_textures(gbuf, shadow_map);
     let rectified = rectify_passes(&mut frame, &depth, &sm, variant.light);
+    let cookie = variant.cookie.then(|| cookie_texture(scene)).flatten();
     Ok(hybrid_volume_from_rectified(
-        variant, frame, rectified, &depth, &sm,
+        variant,
+        frame,
+        rectified,
+        &depth,
+        &sm,
+        cookie.as_ref(),
     ))
 }
 
 /// `volume_bounds` and `volume_march` for a given frame (after `slice_fit`) and rectified
-/// map (the GPU's, in the conformance test).
+/// map (the GPU's, in the conformance test); `cookie` for a `cookie` variant.
 pub fn hybrid_volume_from_rectified(
     variant: &HybridVolumeVariant,
     frame: PrefilteredFrame,
     rectified: Tex,
     depth: &Tex,
     shadow_map: &Tex,
+    cookie: Option<&TexArray>,
 ) -> HybridVolumeRun {
     let crossings = volume_bounds::volume_bounds(&frame.uniforms, &rectified, variant.bins);
     let inputs = volume_march::MarchInputs {
@@ -447,6 +455,7 @@ pub fn hybrid_volume_from_rectified(
         shadow_map,
         rectified: &rectified,
         crossings: &crossings,
+        cookie,
     };
     let march = volume_march::volume_march(variant, &inputs);
     let spans = if variant.sampling_knobs().is_sampled() {

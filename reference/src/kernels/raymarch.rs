@@ -3,9 +3,9 @@
 //! 2009); a spot light's samples are equiangular (Kulla & Fajardo 2012). Conventions:
 //! `scatter_frame::raymarch`.
 
+use super::common_cookie::spot_cookie;
 use super::common_model::{
-    equiangular, equiangular_sample, max, min, phase_hg, spot_cookie, spot_integrand,
-    transmittance_between,
+    equiangular, equiangular_sample, max, min, phase_hg, spot_integrand, transmittance_between,
 };
 use super::common_raymarch::{pixel_jitter, raymarch_pixel_dir, raymarch_shadow_view};
 use super::common_sampling::{

@@ -9,6 +9,7 @@
 //! brute-force cast of the shadow map's volume and the march against `span_march` over the
 //! whole ray.
 
+use super::common_cookie::{epipole_march_cookie, span_march_cookie, spot_segment_cookie};
 use super::common_epipolar::{
     edge_t, epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta,
     row_index, span_march, spot_segment,
@@ -17,7 +18,7 @@ use super::common_model::{max, max_u, min, phase_hg, transmittance_between};
 use super::common_sampling::{
     EpipolarCamera, EpipolarSamples, SampledOutput, epipolar_samples, run_sampled,
 };
-use super::texture::{Tex, xyz};
+use super::texture::{Tex, TexArray, xyz};
 use super::volume_bounds::{VolumeBounds, depth_bin};
 use glam::Vec3;
 use scatter_shaderlib::hybrid_volume::{HybridVolumeVariant, NO_EDGE};
@@ -37,6 +38,8 @@ pub struct MarchInputs<'a> {
     pub rectified: &'a Tex,
     /// `volume_bounds`'s bins.
     pub crossings: &'a VolumeBounds,
+    /// A `cookie` variant's spot cookie (`None` otherwise).
+    pub cookie: Option<&'a TexArray>,
 }
 
 /// What one rectified row says about a ray: the interval (`t_f > t_b`: no crossing) and the
@@ -229,6 +232,52 @@ pub fn closed_form(
     transmittance_between(f.medium[0], a, b)
 }
 
+/// [`closed_form`] of a spot with a cookie (RGB): at least as many panels, one per cookie
+/// texel crossed.
+#[allow(clippy::too_many_arguments, reason = "closed_form's and the cookie")]
+pub fn closed_form_cookie(
+    f: &FrameUniforms,
+    cookie: &TexArray,
+    eye: Vec3,
+    dir: Vec3,
+    a: f32,
+    b: f32,
+    samples: u32,
+) -> Vec3 {
+    spot_segment_cookie(
+        f,
+        cookie,
+        eye,
+        dir,
+        a,
+        b,
+        max_u(max_u(f.sizes2[2] / 4, samples / 4), 1),
+    )
+}
+
+/// [`span_sum`] of a spot with a cookie (RGB, without the light colour).
+pub fn span_sum_cookie(
+    f: &FrameUniforms,
+    sm: &Tex,
+    cookie: &TexArray,
+    dir: Vec3,
+    p: &PixelSpan,
+    samples: u32,
+) -> Vec3 {
+    let eye = xyz(f.eye);
+    let mut total = Vec3::ZERO;
+    if p.head > 0.5 {
+        total += closed_form_cookie(f, cookie, eye, dir, 0.0, p.t_f, samples);
+    }
+    if p.t_b > p.t_f {
+        total += span_march_cookie(f, sm, cookie, eye, dir, p.t_f, p.t_b, samples);
+    }
+    if p.tail > 0.5 {
+        total += closed_form_cookie(f, cookie, eye, dir, p.t_b, p.s, samples);
+    }
+    total
+}
+
 /// The sum of a pixel's span: head and tail in closed form ([`closed_form`]), `[t_f, t_b]`
 /// marched with `samples` samples (without `sigma_s p E` for the sun).
 pub fn span_sum(
@@ -266,13 +315,21 @@ pub fn volume_march_pixel(
     let eye = xyz(f.eye);
     let dir = pixel_dir(f, x, y);
     let color = xyz(f.light_color);
-    let c = match pixel_span(inp, variant.pad, x, y, spot) {
-        None => {
+    let c = match (pixel_span(inp, variant.pad, x, y, spot), inp.cookie) {
+        (None, cookie) => {
             // Near the epipole and the anti-epipole the rectification degenerates: march.
             let s = surface_distance(f, inp.depth, x, y, dir);
-            epipole_march(f, inp.shadow_map, eye, dir, s, spot) * color
+            match cookie {
+                Some(cookie) => {
+                    epipole_march_cookie(f, inp.shadow_map, cookie, eye, dir, s) * color
+                }
+                None => epipole_march(f, inp.shadow_map, eye, dir, s, spot) * color,
+            }
         }
-        Some(p) => {
+        (Some(p), Some(cookie)) => {
+            color * span_sum_cookie(f, inp.shadow_map, cookie, dir, &p, variant.samples)
+        }
+        (Some(p), None) => {
             let total = span_sum(f, inp.shadow_map, dir, &p, variant.samples, spot);
             let mut l = total;
             if !spot {

@@ -40,6 +40,7 @@ struct BoundsTemplate {
 struct MarchTemplate {
     light_name: &'static str,
     spot: bool,
+    cookie: bool,
     samples: u32,
     bins: u32,
     pad: u32,
@@ -52,6 +53,7 @@ struct MarchTemplate {
 struct MarchUnwarpTemplate {
     light_name: &'static str,
     spot: bool,
+    cookie: bool,
     samples: u32,
     bins: u32,
     pad: u32,
@@ -64,6 +66,7 @@ struct MarchUnwarpTemplate {
 struct MarchFallbackTemplate {
     light_name: &'static str,
     spot: bool,
+    cookie: bool,
     samples: u32,
     bins: u32,
     pad: u32,
@@ -110,6 +113,7 @@ pub(crate) fn render_march(variant: &HybridVolumeVariant) -> Result<String, Shad
     MarchTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
+        cookie: variant.cookie,
         samples: variant.samples,
         bins: variant.bins,
         pad: variant.pad,
@@ -128,6 +132,7 @@ pub(crate) fn render_march_unwarp(variant: &HybridVolumeVariant) -> Result<Strin
     MarchUnwarpTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
+        cookie: variant.cookie,
         samples: variant.samples,
         bins: variant.bins,
         pad: variant.pad,
@@ -146,6 +151,7 @@ pub(crate) fn render_march_fallback(variant: &HybridVolumeVariant) -> Result<Str
     MarchFallbackTemplate {
         light_name: variant.light.name(),
         spot: variant.light == LightKind::Spot,
+        cookie: variant.cookie,
         samples: variant.samples,
         bins: variant.bins,
         pad: variant.pad,

@@ -6,9 +6,10 @@ use crate::Kernel;
 use crate::family::KernelFamily;
 use crate::hybrid_volume::HybridVolumeVariant;
 use crate::plan::{
-    BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource, SLICE_FIT_NOTE,
-    TEXTURE_DIMENSION, bind, column_depth_buffer, depth_and_shadow_map, frame_buffer,
-    scatter_resource, scatter_texture, screen_and_shadow_parameters,
+    BufferDesc, COOKIE_BINDING, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource,
+    SLICE_FIT_NOTE, TEXTURE_DIMENSION, bind, column_depth_buffer, cookie_parameters,
+    cookie_texture, depth_and_shadow_map, frame_buffer, scatter_resource, scatter_texture,
+    screen_and_shadow_parameters,
 };
 use crate::sampling::{
     epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
@@ -85,6 +86,10 @@ pub fn plan(v: &HybridVolumeVariant) -> Plan {
             "screen.height",
         ),
     ];
+    if v.cookie {
+        parameters.extend(cookie_parameters());
+        resources.push(cookie_texture());
+    }
     resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
     resources.extend(fallback_buffers(&v.sampling_knobs()));
     let passes = v
@@ -131,7 +136,7 @@ pub fn pass(v: &HybridVolumeVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations(&v.sampling_knobs()),
                 skip_when: None,
-                bindings: vec![
+                bindings: [
                     bind(0, "frame"),
                     bind(1, "slices"),
                     bind(2, "depth"),
@@ -139,7 +144,10 @@ pub fn pass(v: &HybridVolumeVariant, kernel: Kernel) -> Option<PassPlan> {
                     bind(4, "rectified"),
                     bind(5, "crossings"),
                     bind(6, sampled_output(&v.sampling_knobs())),
-                ],
+                ]
+                .into_iter()
+                .chain(v.cookie.then(|| bind(COOKIE_BINDING, "cookie")))
+                .collect(),
             },
             7,
         )),

@@ -10,7 +10,7 @@
 
 #define_import_path scatter::epipolar
 
-#import scatter::model::{PI, equiangular, equiangular_sample, phase_hg, spot_cookie, spot_integrand, spot_span, spot_span_cookie, transmittance_between}
+#import scatter::model::{PI, equiangular, equiangular_sample, phase_hg, spot_integrand, spot_span, transmittance_between}
 #import scatter::shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility}
 
 // The uniform block (host: `scatter_shaderlib::prefiltered::FrameUniforms`, field by field;
@@ -292,34 +292,4 @@ fn lit_span(f: Frame, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, spot: bool
         return spot_segment(f, eye, dir, a, b, max(f.sizes2_[2] / 4u, 1u));
     }
     return transmittance_between(f.medium[0], a, b);
-}
-
-// A spot's cookie (`scatter::model::spot_cookie`) at world point `x`, in the frame's shadow-map
-// frame. `cookie`: the kernel's `cookie` binding.
-fn frame_cookie(f: Frame, cookie: texture_2d<f32>, x: vec3<f32>) -> vec3<f32> {
-    return spot_cookie(cookie, x, f.light_pos.xyz, f.sm_right.xyz, f.sm_up.xyz, f.sm_forward.xyz, f.light_dir[3]);
-}
-
-// `span_march` of a spot with a cookie: each sample's integrand times the cookie (RGB).
-fn span_march_cookie(f: Frame, sm: texture_2d<f32>, cookie: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, steps: u32) -> vec3<f32> {
-    let strata = equiangular(eye, dir, f.light_pos.xyz, a, b, steps);
-    var sum = vec3<f32>(0.0);
-    for (var k = 0u; k < steps; k++) {
-        let tw = equiangular_sample(strata, f32(k) + 0.5);
-        let x = eye + dir * tw.x;
-        let v = sm_visibility(f, sm, x);
-        sum += v * tw.y * frame_spot_integrand(f, eye, dir, tw.x) * frame_cookie(f, cookie, x);
-    }
-    return sum;
-}
-
-// `epipole_march` of a spot with a cookie (RGB, without the light colour).
-fn epipole_march_cookie(f: Frame, sm: texture_2d<f32>, cookie: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, s: f32) -> vec3<f32> {
-    return span_march_cookie(f, sm, cookie, eye, dir, 0.0, s, f.sizes2_[1]);
-}
-
-// `lit_span` of a spot with a cookie: `spot_span_cookie` with `lit_span`'s panels (RGB,
-// without the light colour).
-fn lit_span_cookie(f: Frame, cookie: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32) -> vec3<f32> {
-    return spot_span_cookie(cookie, eye, dir, a, b, max(f.sizes2_[2] / 4u, 1u), f.light_pos.xyz, f.light_dir.xyz, f.light_pos[3], f.light_dir[3], f.medium, f.sm_right.xyz, f.sm_up.xyz, f.sm_forward.xyz);
 }
