@@ -304,6 +304,27 @@ fn check(args: &Args, light: LightKind) -> Result<Plan, String> {
     }))
 }
 
+/// `variant` reading the scene's spot cookie where the scene has one: an error for a family
+/// that reads none.
+fn cookie_follows_scene(variant: FamilyVariant, scene: &Scene) -> Result<FamilyVariant, String> {
+    if scene.light.cookie().is_none() {
+        return Ok(variant);
+    }
+    variant.with_cookie(true).ok_or_else(|| {
+        let with: Vec<&str> = Family::ALL
+            .iter()
+            .filter(|f| f.default_variant().with_cookie(true).is_some())
+            .map(|f| f.name())
+            .collect();
+        format!(
+            "the scene's spot light has a cookie, which the {} family does not read (these \
+             do: {})",
+            variant.family(),
+            with.join(", ")
+        )
+    })
+}
+
 /// Parses `--variant` (`knob=value` pairs separated by commas) with `scatter-gen`'s knob
 /// parser, the light set from the scene.
 fn parse_variant(family: Family, text: &str, light: LightKind) -> Result<FamilyVariant, String> {
@@ -317,6 +338,13 @@ fn parse_variant(family: Family, text: &str, light: LightKind) -> Result<FamilyV
             return Err(format!(
                 "--variant: the light follows the scene ({light} here); leave `light` out"
             ));
+        }
+        if k == "cookie" {
+            return Err(
+                "--variant: the cookie follows the scene (its spot's `cookie` entry); leave \
+                 `cookie` out"
+                    .to_owned(),
+            );
         }
         knobs.push((k.to_owned(), v.trim().to_owned()));
     }
@@ -376,7 +404,10 @@ fn run(args: &Args) -> Result<(), BoxError> {
     };
     scene.validate()?;
     let light = scene.light.kind();
-    let plan = check(args, light)?;
+    let mut plan = check(args, light)?;
+    if let Plan::Family(p) = &mut plan {
+        p.variant = cookie_follows_scene(p.variant, &scene)?;
+    }
     let (width, height) = (scene.camera.width, scene.camera.height);
     let t0 = Instant::now();
     let bvh = Bvh::build(&scene.geometry);
@@ -755,7 +786,7 @@ fn run_on_gpu(
                 shadow_map: sm.depth.clone(),
                 rectified: engine_rectified_map(scene, bvh, &prepared),
                 pass_wall_frames: 0,
-                cookie: None,
+                cookie: cookie_texels(scene, variant),
             };
             let ctx = &ctx;
             let pass_walls = &mut pass_walls;
@@ -874,6 +905,7 @@ fn run_on_gpu(
             &frame,
             gbuf,
             sm,
+            cookie_texels(scene, variant),
             pass_wall_frames,
         )?);
     }
@@ -925,6 +957,7 @@ fn run_on_gpu(
 
 /// The wall time of each of the variant's passes submitted on its own (median of `frames`),
 /// through [`FamilyPasses`] (any family whose `run_*_once` does not measure it).
+#[allow(clippy::too_many_arguments, reason = "the frame's inputs")]
 fn measure_pass_walls(
     ctx: &Context,
     variant: &FamilyVariant,
@@ -932,9 +965,15 @@ fn measure_pass_walls(
     frame: &FrameInput,
     gbuf: &GBuffer,
     sm: &ShadowMap,
+    cookie: Option<([u32; 2], Vec<[f32; 4]>)>,
     frames: u32,
 ) -> Result<PassTimes, BoxError> {
     let mut pass = FamilyPasses::new(ctx, variant, res, sm.size)?;
+    if let Some((size, texels)) = cookie {
+        let texture =
+            scatter_runtime::textures::upload_cookie(ctx, Kernel::Scatter, size, &texels)?;
+        pass.set_cookie(&texture.create_view(&Default::default()))?;
+    }
     pass.prepare(ctx, frame)?;
     let depth = upload_r32float(
         ctx,

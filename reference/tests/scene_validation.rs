@@ -798,3 +798,143 @@ fn bad_mesh_file_entries_are_refused_naming_the_field() {
     assert_eq!(triangles.len(), 2);
     assert_eq!(vertices[2], DVec3::new(2.0, 3.0, 0.0));
 }
+
+/// `scene` with `cookie` on its spot light.
+fn with_cookie(scene: &Scene, cookie: Option<scatter_reference::cookie::Cookie>) -> Scene {
+    let mut s = scene.clone();
+    match &mut s.light {
+        Light::Spot { cookie: c, .. } => *c = cookie,
+        Light::Directional { .. } => panic!("a cookie needs a spot light"),
+    }
+    s
+}
+
+/// The example scene with a cookie (`stained_glass.json`): the `spot_grate` suite scene at
+/// `ordinary` with the `stained_glass` pattern at 64^2, as `Scene::to_json` writes it.
+#[test]
+fn the_stained_glass_scene_file_is_spot_grate_with_a_cookie() {
+    use scatter_reference::cookie::Cookie;
+    let bless = std::env::var("SCATTER_BLESS").is_ok_and(|v| v == "1");
+    let (w, h) = suite::DEFAULT_SIZE;
+    let path = scenes_dir().join("stained_glass.json");
+    let mut built = with_cookie(
+        &suite::scene(
+            SceneName::SpotGrate,
+            Pose::Ordinary,
+            MediumPreset::Default,
+            w,
+            h,
+        ),
+        Some(Cookie::pattern("stained_glass", 64).expect("a built-in pattern")),
+    );
+    built.name = "stained_glass".into();
+    if bless {
+        let mut text = built.to_json();
+        text.push('\n');
+        std::fs::write(&path, text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    }
+    let loaded = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        loaded == built,
+        "{} differs from spot_grate/ordinary with the stained_glass cookie (SCATTER_BLESS=1 \
+         rewrites it)",
+        path.display()
+    );
+    let cookie = loaded.light.cookie().expect("a cookie");
+    assert_eq!((cookie.width(), cookie.height()), (64, 64));
+}
+
+/// A cookie read from a PNG file: sRGB decoded to linear, the path relative to the scene
+/// file, 8-bit gray and RGBA; and every way a cookie entry can be wrong, refused with one line.
+#[test]
+fn cookie_entries_load_pngs_and_refuse_bad_input() {
+    let dir = std::env::temp_dir().join(format!("scatter-cookie-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("cookies")).expect("temp dir");
+    // A 2x1 RGBA PNG: sRGB (255, 128, 0) and (0, 0, 255).
+    let png_path = dir.join("cookies").join("two.png");
+    {
+        let file = std::fs::File::create(&png_path).expect("png");
+        let mut enc = png::Encoder::new(file, 2, 1);
+        enc.set_color(png::ColorType::Rgba);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().expect("header");
+        w.write_image_data(&[255, 128, 0, 255, 0, 0, 255, 7])
+            .expect("data");
+    }
+    let base = spot();
+    let mut value: serde_json::Value = serde_json::from_str(&base.to_json()).expect("json");
+    value["light"]["cookie"] = serde_json::json!({ "file": "cookies/two.png" });
+    let scene_path = dir.join("scene.json");
+    std::fs::write(&scene_path, value.to_string()).expect("scene");
+    let loaded = Scene::load(&scene_path).unwrap_or_else(|e| panic!("{e}"));
+    let cookie = loaded.light.cookie().expect("a cookie");
+    assert_eq!((cookie.width(), cookie.height()), (2, 1));
+    let t = cookie.texels();
+    assert_eq!(t[0][0], 1.0);
+    assert!((t[0][1] - 0.2158605).abs() < 1e-6, "{:?}", t[0]);
+    assert_eq!(t[0][2], 0.0);
+    assert_eq!(t[1], [0.0, 0.0, 1.0]);
+    // Bilinear between texel centres, clamped to the edge.
+    assert_eq!(cookie.sample_uv(0.0, 0.5), [1.0, f64::from(t[0][1]), 0.0]);
+    let mid = cookie.sample_uv(0.5, 0.5);
+    assert!(
+        (mid[0] - 0.5).abs() < 1e-12 && (mid[2] - 0.5).abs() < 1e-12,
+        "{mid:?}"
+    );
+    // From JSON text without a base directory the path is the working directory's: absent.
+    let text = value.to_string();
+    let err = Scene::from_json(&text).expect_err("relative to the working directory");
+    assert!(err.to_string().contains("two.png"), "{err}");
+    for (cookie, needle) in [
+        (
+            serde_json::json!({ "file": "cookies/missing.png" }),
+            "missing.png",
+        ),
+        (
+            serde_json::json!({ "file": "scene.json" }),
+            "not a readable PNG",
+        ),
+        (serde_json::json!({ "pattern": "rose" }), "unknown pattern"),
+        (
+            serde_json::json!({ "pattern": "stained_glass", "size": 2 }),
+            "size must be in 4..=4096",
+        ),
+        (
+            serde_json::json!({ "file": "cookies/two.png", "pattern": "stained_glass" }),
+            "exactly one of file",
+        ),
+        (serde_json::json!({}), "exactly one of file"),
+        (
+            serde_json::json!({ "file": "cookies/two.png", "size": 8 }),
+            "size applies to a pattern",
+        ),
+        (
+            serde_json::json!({ "pattern": "stained_glass", "tint": 1 }),
+            "unknown field",
+        ),
+    ] {
+        let mut v = value.clone();
+        v["light"]["cookie"] = cookie.clone();
+        std::fs::write(&scene_path, v.to_string()).expect("scene");
+        let err = Scene::load(&scene_path).expect_err(&cookie.to_string());
+        let msg = err.to_string();
+        assert!(msg.contains(needle), "{cookie}: {msg}");
+        assert!(!msg.contains('\n'), "{cookie}: {msg}");
+    }
+    // A cookie needs a cone narrower than a hemisphere.
+    let mut wide = with_cookie(
+        &base,
+        Some(scatter_reference::cookie::Cookie::pattern("stained_glass", 8).expect("pattern")),
+    );
+    if let Light::Spot {
+        outer_angle_deg,
+        inner_angle_deg,
+        ..
+    } = &mut wide.light
+    {
+        *inner_angle_deg = 10.0;
+        *outer_angle_deg = 120.0;
+    }
+    assert_invalid(&wide, "light.cookie");
+    std::fs::remove_dir_all(&dir).ok();
+}
