@@ -118,6 +118,40 @@ fn fixture(light: LightKind) -> &'static Fixture {
     cell.get_or_init(|| Fixture::new(scene_for(light), Pose::Ordinary, SCREEN, SHADOW_MAP))
 }
 
+/// The fixture of a variant: its light's, with the `stained_glass` cookie (64^2) for a
+/// `cookie` variant.
+fn fixture_for(light: LightKind, cookie: bool) -> &'static Fixture {
+    static SPOT_COOKIE: OnceLock<Fixture> = OnceLock::new();
+    if !cookie {
+        return fixture(light);
+    }
+    SPOT_COOKIE.get_or_init(|| {
+        fixture(LightKind::Spot).with_cookie(
+            scatter_reference::cookie::Cookie::pattern("stained_glass", 64)
+                .expect("a built-in pattern"),
+        )
+    })
+}
+
+/// `params` with the cookie's size where `fixture` has a cookie.
+fn cookie_params(
+    mut params: scatter_foreign_engine::formula::Params,
+    fixture: &Fixture,
+) -> scatter_foreign_engine::formula::Params {
+    if let Some(([w, h], _)) = fixture.cookie() {
+        params.set("cookie.width", w.into());
+        params.set("cookie.height", h.into());
+    }
+    params
+}
+
+/// The fixture's cookie as the foreign engine uploads it: RGBA texels, flat.
+fn cookie_texels(fixture: &Fixture) -> Option<Vec<f32>> {
+    fixture
+        .cookie()
+        .map(|(_, t)| t.into_iter().flatten().collect())
+}
+
 /// What these trials need of a fixture beyond the shared one.
 trait ForeignFixture {
     fn input(&self) -> FrameInput;
@@ -236,6 +270,7 @@ fn trial(ctx: &Context, variant: &PrefilteredVariant) -> Vec<String> {
                 depth: &fixture.gbuf.view_depth,
                 shadow_map: Some(&fixture.shadow_map.depth),
                 rectified_raster: rectified.as_deref(),
+                cookie: None,
             },
         )
         .unwrap_or_else(|e| panic!("{name}::{target}: run: {e}"));
@@ -306,7 +341,7 @@ fn foreign_engine_matches_runtime() {
 
 /// The hybrid_volume trial variants: the directional default and the spot light with 8
 /// samples, 64 bins and no padding.
-fn hybrid_variants() -> [HybridVolumeVariant; 2] {
+fn hybrid_variants() -> [HybridVolumeVariant; 3] {
     [
         HybridVolumeVariant::default(),
         HybridVolumeVariant {
@@ -314,6 +349,11 @@ fn hybrid_variants() -> [HybridVolumeVariant; 2] {
             samples: 8,
             bins: 64,
             pad: 0,
+            ..HybridVolumeVariant::default()
+        },
+        HybridVolumeVariant {
+            light: LightKind::Spot,
+            cookie: true,
             ..HybridVolumeVariant::default()
         },
     ]
@@ -327,7 +367,7 @@ fn other_families_dir() -> &'static Path {
         let variants = raymarch_variants()
             .map(FamilyVariant::Raymarch)
             .into_iter()
-            .chain(minmax_variants().into_iter().map(FamilyVariant::Minmax))
+            .chain(MinmaxVariant::grid().into_iter().map(FamilyVariant::Minmax))
             .chain(
                 hybrid_variants()
                     .into_iter()
@@ -361,17 +401,9 @@ fn pst_variants() -> [PartialSumTreeVariant; 2] {
 /// `sampling = lowres` (scale 2) spot: the sampled dispatch and workgroup memory, and
 /// `sampling = epipolar` (64 slices x 64 samples) spot: the `epipolar_samples` texture the
 /// engine allocates from the manifest, the `raymarch_unwarp` pass, the fallback list
-/// (`fallback_count`, `fallback_pixels`) and the `raymarch_fallback` pass.
-/// The minmax grid without its `cookie` variant: the foreign engine binds the depth buffer
-/// and the shadow map, not a cookie (its conformance is `tests/tests/minmax.rs`).
-fn minmax_variants() -> Vec<MinmaxVariant> {
-    MinmaxVariant::grid()
-        .into_iter()
-        .filter(|v| !v.cookie)
-        .collect()
-}
-
-fn raymarch_variants() -> [RaymarchVariant; 4] {
+/// (`fallback_count`, `fallback_pixels`) and the `raymarch_fallback` pass; and the spot with
+/// the `stained_glass` cookie: the engine's `cookie` texture (rgba16float, its own size).
+fn raymarch_variants() -> [RaymarchVariant; 5] {
     [
         RaymarchVariant::default(),
         RaymarchVariant {
@@ -395,6 +427,11 @@ fn raymarch_variants() -> [RaymarchVariant; 4] {
             step: 8,
             ..scatter_frame::sampling::SamplingKnobs::epipolar(64)
         }),
+        RaymarchVariant {
+            light: LightKind::Spot,
+            cookie: true,
+            ..RaymarchVariant::default()
+        },
     ]
 }
 
@@ -439,7 +476,9 @@ fn foreign_engine_matches_runtime_for_every_family() {
     let dir = other_families_dir();
     let mut lines = Vec::new();
     for v in raymarch_variants() {
-        let fixture = fixture(v.light);
+        let fixture = fixture_for(v.light, v.cookie);
+        let cookie = fixture.cookie();
+        let flat_cookie = cookie_texels(fixture);
         let name = format!(
             "foreign::raymarch::{}::{}::{}",
             v.id(),
@@ -460,7 +499,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
             &input,
             &fixture.gbuf.view_depth,
             &fixture.shadow_map.depth,
-            None,
+            cookie.as_ref().map(|(size, t)| (*size, &t[..])),
         )
         .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
         let uniforms = prepare_raymarch(
@@ -494,18 +533,21 @@ fn foreign_engine_matches_runtime_for_every_family() {
                 dir,
                 &v.id(),
                 target,
-                &sizes.params(),
+                &cookie_params(sizes.params(), fixture),
             )?;
             scatter_foreign_engine::raymarch::run_frame(
                 &mut engine,
                 &uniforms,
                 &fixture.gbuf.view_depth,
                 &fixture.shadow_map.depth,
+                flat_cookie.as_deref(),
             )
         }));
     }
-    for v in minmax_variants() {
-        let fixture = fixture(v.light);
+    for v in MinmaxVariant::grid() {
+        let fixture = fixture_for(v.light, v.cookie);
+        let cookie = fixture.cookie();
+        let flat_cookie = cookie_texels(fixture);
         let name = format!(
             "foreign::minmax::{}::{}::{}",
             v.id(),
@@ -524,7 +566,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
             &f,
             &fixture.gbuf.view_depth,
             &fixture.shadow_map.depth,
-            None,
+            cookie.as_ref().map(|(size, t)| (*size, &t[..])),
         )
         .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
         let frame = prepare_minmax(
@@ -552,7 +594,10 @@ fn foreign_engine_matches_runtime_for_every_family() {
                 "minmax_traverse",
             ],
             |target| {
-                let params = scatter_foreign_engine::minmax::params(&fixture.sizes());
+                let params = cookie_params(
+                    scatter_foreign_engine::minmax::params(&fixture.sizes()),
+                    fixture,
+                );
                 let mut engine =
                     Engine::load(ctx.device(), ctx.queue(), dir, &v.id(), target, &params)?;
                 scatter_foreign_engine::minmax::run_frame(
@@ -560,12 +605,15 @@ fn foreign_engine_matches_runtime_for_every_family() {
                     &frame,
                     &fixture.gbuf.view_depth,
                     &fixture.shadow_map.depth,
+                    flat_cookie.as_deref(),
                 )
             },
         ));
     }
     for v in hybrid_variants() {
-        let fixture = fixture(v.light);
+        let fixture = fixture_for(v.light, v.cookie);
+        let cookie = fixture.cookie();
+        let flat_cookie = cookie_texels(fixture);
         let name = format!(
             "foreign::hybrid_volume::{}::{}::{}",
             v.id(),
@@ -584,7 +632,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
             &f,
             &fixture.gbuf.view_depth,
             &fixture.shadow_map.depth,
-            None,
+            cookie.as_ref().map(|(size, t)| (*size, &t[..])),
         )
         .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
         let frame = prepare_hybrid_volume(
@@ -612,7 +660,10 @@ fn foreign_engine_matches_runtime_for_every_family() {
                 "volume_march",
             ],
             |target| {
-                let params = scatter_foreign_engine::hybrid_volume::params(&fixture.sizes());
+                let params = cookie_params(
+                    scatter_foreign_engine::hybrid_volume::params(&fixture.sizes()),
+                    fixture,
+                );
                 let mut engine =
                     Engine::load(ctx.device(), ctx.queue(), dir, &v.id(), target, &params)?;
                 scatter_foreign_engine::hybrid_volume::run_frame(
@@ -620,6 +671,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
                     &frame,
                     &fixture.gbuf.view_depth,
                     &fixture.shadow_map.depth,
+                    flat_cookie.as_deref(),
                 )
             },
         ));
@@ -688,7 +740,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
     assert_eq!(
         lines.len(),
         2 * (raymarch_variants().len()
-            + minmax_variants().len()
+            + MinmaxVariant::grid().len()
             + hybrid_variants().len()
             + pst_variants().len())
     );
@@ -795,6 +847,7 @@ fn foreign_engine_comparison_detects_a_wrong_input() {
             depth: &short,
             shadow_map: Some(&fixture.shadow_map.depth),
             rectified_raster: None,
+            cookie: None,
         },
     )
     .unwrap_or_else(|e| panic!("{e}"));
@@ -868,6 +921,7 @@ fn foreign_engine_files_round_trip() {
             depth: &fixture.gbuf.view_depth,
             shadow_map: Some(&fixture.shadow_map.depth),
             rectified_raster: rectified.as_deref(),
+            cookie: None,
         },
     )
     .unwrap_or_else(|e| panic!("{e}"));
@@ -881,6 +935,7 @@ fn foreign_engine_files_round_trip() {
             depth: &fixture.gbuf.view_depth,
             shadow_map: None,
             rectified_raster: rectified.as_deref(),
+            cookie: None,
         },
     )
     .unwrap_or_else(|e| panic!("{e}"));
@@ -1036,6 +1091,7 @@ fn foreign_engine_reports_bad_directories() {
             depth: &fixture.gbuf.view_depth,
             shadow_map: None,
             rectified_raster: None,
+            cookie: None,
         },
     )
     .map(|_| ())
@@ -1052,6 +1108,7 @@ fn foreign_engine_reports_bad_directories() {
             depth: &fixture.gbuf.view_depth[1..],
             shadow_map: Some(&fixture.shadow_map.depth),
             rectified_raster: None,
+            cookie: None,
         },
     )
     .map(|_| ())

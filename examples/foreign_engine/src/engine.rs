@@ -67,7 +67,8 @@ pub struct FrameData<'a> {
     /// the uniform block, the slice table); each exactly the resource's `size_bytes`.
     pub buffers: &'a [(&'a str, &'a [u8])],
     /// Texels of the engine's textures (resources `provided_by: engine`), row-major from the
-    /// top-left texel, layer after layer, every channel of a 32-bit float format.
+    /// top-left texel, layer after layer, every channel of a 32- or 16-bit float format (as
+    /// f32; rounded to f16 for the latter).
     pub textures: &'a [(&'a str, &'a [f32])],
 }
 
@@ -752,10 +753,10 @@ impl Engine {
                     "scatter provides it (provided_by: scatter)",
                 ));
             }
-            let Some((channels, Encoding::F32)) = encoding(*format) else {
+            let Some((channels, enc @ (Encoding::F32 | Encoding::F16))) = encoding(*format) else {
                 return Err(unsupported(
                     format!("uploading engine texture {name}"),
-                    "upload format (only 32-bit float formats)",
+                    "upload format (only 32- and 16-bit float formats)",
                     &format!("{format:?}"),
                 ));
             };
@@ -772,13 +773,27 @@ impl Engine {
                     unit: "floats",
                 });
             }
+            // A 16-bit float texture (a spot's cookie) gets its texels rounded to f16.
+            let halves: Vec<u16> = if enc == Encoding::F16 {
+                texels
+                    .iter()
+                    .map(|t| half::f16::from_f32(*t).to_bits())
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            let bytes: &[u8] = if enc == Encoding::F16 {
+                bytemuck::cast_slice(&halves)
+            } else {
+                bytemuck::cast_slice(texels)
+            };
             scoped(device, format!("uploading {name}"), || {
                 self.queue.write_texture(
                     texture.as_image_copy(),
-                    bytemuck::cast_slice(texels),
+                    bytes,
                     wgpu::TexelCopyBufferLayout {
                         offset: 0,
-                        bytes_per_row: Some(size.width * 4 * channels as u32),
+                        bytes_per_row: Some(size.width * (enc.bytes() * channels) as u32),
                         rows_per_image: Some(size.height),
                     },
                     size,

@@ -688,6 +688,14 @@ pub fn run_dir(
     let load = |params: &crate::formula::Params| {
         Engine::load(device, queue, &args.shaders, &id, args.target, params)
     };
+    if knobs.cookie() {
+        return Err(EngineError::Unsupported {
+            context: format!("variant {id}"),
+            what: "knob of the file runner (the spot's cookie has no input file; drive it \
+                   through the library's run_frame with the cookie's texels)",
+            value: "cookie = true".to_owned(),
+        });
+    }
     let (frame, out) = match &knobs {
         Knobs::Prefiltered(variant) => {
             let frame = file.prepare(variant)?;
@@ -714,6 +722,7 @@ pub fn run_dir(
                     depth: &depth,
                     shadow_map: Some(&shadow),
                     rectified_raster: rectified.as_deref(),
+                    cookie: None,
                 },
             )?;
             (Some(frame), out)
@@ -721,13 +730,13 @@ pub fn run_dir(
         Knobs::HybridVolume(variant) => {
             let frame = file.prepare_hybrid_volume(variant)?;
             let mut engine = load(&crate::hybrid_volume::params(&file.sizes()))?;
-            let out = crate::hybrid_volume::run_frame(&mut engine, &frame, &depth, &shadow)?;
+            let out = crate::hybrid_volume::run_frame(&mut engine, &frame, &depth, &shadow, None)?;
             (Some(frame), out)
         }
         Knobs::Minmax(variant) => {
             let frame = file.prepare_minmax(variant)?;
             let mut engine = load(&crate::minmax::params(&file.sizes()))?;
-            let out = crate::minmax::run_frame(&mut engine, &frame, &depth, &shadow)?;
+            let out = crate::minmax::run_frame(&mut engine, &frame, &depth, &shadow, None)?;
             (Some(frame), out)
         }
         Knobs::PartialSumTree(variant) => {
@@ -743,7 +752,7 @@ pub fn run_dir(
                 shadow_map: file.shadow_map.size,
             };
             let mut engine = load(&sizes.params())?;
-            let out = crate::raymarch::run_frame(&mut engine, &uniforms, &depth, &shadow)?;
+            let out = crate::raymarch::run_frame(&mut engine, &uniforms, &depth, &shadow, None)?;
             (None, out)
         }
     };
@@ -774,6 +783,18 @@ pub enum Knobs {
     HybridVolume(HybridVolumeVariant),
     /// A `partial_sum_tree` variant.
     PartialSumTree(PartialSumTreeVariant),
+}
+
+impl Knobs {
+    /// Whether the variant reads a spot's cookie.
+    pub fn cookie(&self) -> bool {
+        match self {
+            Knobs::Raymarch(v) => v.cookie,
+            Knobs::Minmax(v) => v.cookie,
+            Knobs::HybridVolume(v) => v.cookie,
+            Knobs::Prefiltered(_) | Knobs::PartialSumTree(_) => false,
+        }
+    }
 }
 
 impl Knobs {

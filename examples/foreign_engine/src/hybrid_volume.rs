@@ -20,7 +20,8 @@ pub fn params(sizes: &Sizes) -> Params {
 }
 
 /// Runs one frame of a hybrid_volume variant: uploads the frame set-up and the engine's depth
-/// buffer and standard shadow map, dispatches and reads `output` back.
+/// buffer, standard shadow map and, for a `cookie` variant, the spot's cookie (RGBA texels),
+/// dispatches and reads `output` back.
 ///
 /// # Errors
 ///
@@ -30,6 +31,7 @@ pub fn run_frame(
     frame: &PrefilteredFrame,
     depth: &[f32],
     shadow_map: &[f32],
+    cookie: Option<&[f32]>,
 ) -> Result<Output, EngineError> {
     crate::prefiltered::run_frame(
         engine,
@@ -38,6 +40,7 @@ pub fn run_frame(
             depth,
             shadow_map: Some(shadow_map),
             rectified_raster: None,
+            cookie,
         },
     )
 }

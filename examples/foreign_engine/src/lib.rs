@@ -29,7 +29,7 @@
 //! let mut engine = Engine::load(device, queue, "shaders".as_ref(),
 //!     "m32-t8-r3-weighted-directional-rgba8unorm-epipolar", Target::Spirv, &sizes.params())?;
 //! let out = run_frame(&mut engine, frame,
-//!     &Inputs { depth, shadow_map: Some(shadow), rectified_raster: None })?;
+//!     &Inputs { depth, shadow_map: Some(shadow), rectified_raster: None, cookie: None })?;
 //! # let _ = out; Ok(()) }
 //! ```
 

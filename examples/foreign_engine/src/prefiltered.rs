@@ -24,6 +24,8 @@ pub const SLICES: &str = "slices";
 pub const DEPTH: &str = "depth";
 /// The engine's standard shadow map.
 pub const SHADOW_MAP: &str = "shadow_map";
+/// Resource of a spot's cookie (engine input of a `cookie` variant).
+pub const COOKIE: &str = "cookie";
 /// The engine's rasterised rectified map (projective variants).
 pub const RECTIFIED_RASTER: &str = "rectified_raster";
 /// In-scattered radiance.
@@ -64,6 +66,9 @@ pub struct Inputs<'a> {
     /// The rectified map rasterised with the frame's projective matrices (`Wr * Hr` clip
     /// depths): needed by projective frames.
     pub rectified_raster: Option<&'a [f32]>,
+    /// A spot's cookie (resource `cookie`, `cookie.width * cookie.height` RGBA texels, linear
+    /// RGB): needed by a `cookie` variant.
+    pub cookie: Option<&'a [f32]>,
 }
 
 /// Radiance of one frame and what ran.
@@ -219,6 +224,9 @@ pub fn run_frame(
     let mut textures = vec![(DEPTH, inputs.depth)];
     if let Some(sm) = inputs.shadow_map {
         textures.push((SHADOW_MAP, sm));
+    }
+    if let Some(c) = inputs.cookie {
+        textures.push((COOKIE, c));
     }
     if let Some(r) = inputs.rectified_raster {
         textures.push((RECTIFIED_RASTER, r));

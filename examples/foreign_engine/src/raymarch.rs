@@ -9,7 +9,7 @@ use std::mem::offset_of;
 use scatter_frame::raymarch::RaymarchUniforms;
 
 use crate::formula::Params;
-use crate::prefiltered::{DEPTH, Output, SHADOW_MAP, check_struct_layout, read_output};
+use crate::prefiltered::{COOKIE, DEPTH, Output, SHADOW_MAP, check_struct_layout, read_output};
 use crate::{Engine, EngineError, FrameData};
 
 /// Resource of the uniform block.
@@ -82,11 +82,16 @@ pub fn run_frame(
     uniforms: &RaymarchUniforms,
     depth: &[f32],
     shadow_map: &[f32],
+    cookie: Option<&[f32]>,
 ) -> Result<Output, EngineError> {
     check_raymarch_layout(engine)?;
+    let mut textures = vec![(DEPTH, depth), (SHADOW_MAP, shadow_map)];
+    if let Some(c) = cookie {
+        textures.push((COOKIE, c));
+    }
     let run = engine.run(&FrameData {
         buffers: &[(FRAME, bytemuck::bytes_of(uniforms))],
-        textures: &[(DEPTH, depth), (SHADOW_MAP, shadow_map)],
+        textures: &textures,
     })?;
     let radiance = read_output(engine)?;
     Ok(Output { radiance, run })
