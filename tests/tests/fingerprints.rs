@@ -208,21 +208,44 @@ fn every_family_outputs_the_pre_redesign_bits() {
     }
     let recorded = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("{}: {e} (bless it on the reference commit)", path.display()));
-    let differ: Vec<_> = recorded
-        .lines()
-        .zip(now.lines())
-        .filter(|(a, b)| a != b)
-        .map(|(a, b)| format!("  recorded {a}\n  now      {b}"))
+    // Keyed by trial and texture (the line without its hash), so that a texture added or
+    // removed is reported as such, not as every later line differing.
+    let key = |line: &str| {
+        line.rsplit_once(' ')
+            .map_or(line.to_owned(), |(k, _)| k.to_owned())
+    };
+    let recorded_keys: std::collections::BTreeMap<String, &str> =
+        recorded.lines().map(|l| (key(l), l)).collect();
+    let now_keys: std::collections::BTreeMap<String, &str> =
+        now.lines().map(|l| (key(l), l)).collect();
+    let differ: Vec<_> = recorded_keys
+        .iter()
+        .filter_map(|(k, a)| {
+            now_keys
+                .get(k)
+                .filter(|b| *b != a)
+                .map(|b| format!("  recorded {a}\n  now      {b}"))
+        })
+        .collect();
+    let gone: Vec<_> = recorded_keys
+        .keys()
+        .filter(|k| !now_keys.contains_key(*k))
+        .collect();
+    let added: Vec<_> = now_keys
+        .keys()
+        .filter(|k| !recorded_keys.contains_key(*k))
         .collect();
     eprintln!(
-        "fingerprints: {} textures compared, {} differ",
+        "fingerprints: {} textures compared, {} differ, {} no longer made, {} new",
         now.lines().count(),
-        differ.len()
+        differ.len(),
+        gone.len(),
+        added.len()
     );
-    assert_eq!(
-        recorded.lines().count(),
-        now.lines().count(),
-        "the set of fingerprinted textures changed"
+    assert!(
+        gone.is_empty() && added.is_empty(),
+        "the set of fingerprinted textures changed (bless on purpose with \
+         SCATTER_BLESS_FINGERPRINTS=1): no longer made {gone:#?}, new {added:#?}"
     );
     assert!(
         differ.is_empty(),
