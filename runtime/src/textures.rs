@@ -1,11 +1,48 @@
 //! Texture helpers for tools and tests that drive the passes directly (the bench): upload
-//! an r32float image, read back an rgba16float one.
+//! an r32float image or a spot's cookie, read back an rgba16float one.
 
 use scatter_shaderlib::Kernel;
 
 use crate::error::{ErrorScopes, check_limit};
 use crate::gpu::{DEPTH_FORMAT, Readback, decode_rgba};
 use crate::{Context, RuntimeError};
+
+/// The checks before an upload of `len` texels as a `size` texture named `label`: no zero
+/// side, no side beyond the device's `max_texture_dimension_2d`, `len` texels exactly.
+fn check_upload(
+    ctx: &Context,
+    kernel: Kernel,
+    label: &str,
+    size: [u32; 2],
+    len: usize,
+) -> Result<(), RuntimeError> {
+    if size[0] == 0 || size[1] == 0 {
+        return Err(RuntimeError::EmptyInput {
+            kernel,
+            size: format!("{label} {}x{}", size[0], size[1]),
+        });
+    }
+    let max_2d = u64::from(ctx.device().limits().max_texture_dimension_2d);
+    for (what, side) in [("texture width", size[0]), ("texture height", size[1])] {
+        check_limit(
+            kernel,
+            what,
+            side.into(),
+            "max_texture_dimension_2d",
+            max_2d,
+        )?;
+    }
+    let expected = u64::from(size[0]) * u64::from(size[1]);
+    if len as u64 != expected {
+        return Err(RuntimeError::DataLength {
+            kernel,
+            size: format!("{label} {}x{}", size[0], size[1]),
+            expected,
+            actual: len as u64,
+        });
+    }
+    Ok(())
+}
 
 /// Creates an r32float texture (`TEXTURE_BINDING | COPY_DST | COPY_SRC`) holding `data`
 /// (`size[0] * size[1]` values, row-major from the top-left texel).
@@ -24,36 +61,7 @@ pub fn upload_r32float(
     size: [u32; 2],
     data: &[f32],
 ) -> Result<wgpu::Texture, RuntimeError> {
-    if size[0] == 0 || size[1] == 0 {
-        return Err(RuntimeError::EmptyInput {
-            kernel,
-            size: format!("{label} {}x{}", size[0], size[1]),
-        });
-    }
-    let max_2d = u64::from(ctx.device().limits().max_texture_dimension_2d);
-    check_limit(
-        kernel,
-        "texture width",
-        size[0].into(),
-        "max_texture_dimension_2d",
-        max_2d,
-    )?;
-    check_limit(
-        kernel,
-        "texture height",
-        size[1].into(),
-        "max_texture_dimension_2d",
-        max_2d,
-    )?;
-    let expected = u64::from(size[0]) * u64::from(size[1]);
-    if data.len() as u64 != expected {
-        return Err(RuntimeError::DataLength {
-            kernel,
-            size: format!("{label} {}x{}", size[0], size[1]),
-            expected,
-            actual: data.len() as u64,
-        });
-    }
+    check_upload(ctx, kernel, label, size, data.len())?;
     let scope = ErrorScopes::push(ctx.device());
     let extent = wgpu::Extent3d {
         width: size[0],
@@ -136,31 +144,7 @@ pub fn upload_cookie(
     texels: &[[f32; 4]],
 ) -> Result<wgpu::Texture, RuntimeError> {
     let label = "cookie";
-    if size[0] == 0 || size[1] == 0 {
-        return Err(RuntimeError::EmptyInput {
-            kernel,
-            size: format!("{label} {}x{}", size[0], size[1]),
-        });
-    }
-    let max_2d = u64::from(ctx.device().limits().max_texture_dimension_2d);
-    for (what, side) in [("cookie width", size[0]), ("cookie height", size[1])] {
-        check_limit(
-            kernel,
-            what,
-            side.into(),
-            "max_texture_dimension_2d",
-            max_2d,
-        )?;
-    }
-    let expected = u64::from(size[0]) * u64::from(size[1]);
-    if texels.len() as u64 != expected {
-        return Err(RuntimeError::DataLength {
-            kernel,
-            size: format!("{label} {}x{}", size[0], size[1]),
-            expected,
-            actual: texels.len() as u64,
-        });
-    }
+    check_upload(ctx, kernel, label, size, texels.len())?;
     let halves: Vec<u16> = texels
         .iter()
         .flatten()
