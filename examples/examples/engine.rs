@@ -213,10 +213,7 @@ fn run(args: &Args) -> Result<(), String> {
             (None, None) => eprintln!("  rectification: {}", report.rectification),
         }
     }
-    eprintln!(
-        "  engine pipelines {:.1} ms",
-        pipelines.as_secs_f64() * 1e3
-    );
+    eprintln!("  engine pipelines {:.1} ms", pipelines.as_secs_f64() * 1e3);
     for (stage, time) in &frame.times {
         eprintln!("  {stage} {:.1} ms", time.as_secs_f64() * 1e3);
     }
@@ -229,8 +226,7 @@ fn run(args: &Args) -> Result<(), String> {
             " (99.5th percentile)"
         }
     );
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("--out {}: {e}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out).map_err(|e| format!("--out {}: {e}", args.out.display()))?;
     let written = write_outputs(&ctx, &frame, &scene, &args.out)?;
     let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
     eprintln!("wrote {}", names.join(", "));

@@ -36,7 +36,6 @@ use scatter_runtime::{Context, FamilyPasses, FrameInput, Inputs};
 
 use crate::raster::{RasterError, RasterFrame, Rasteriser, Triangles, read_texture};
 
-
 /// What to render a frame with.
 #[derive(Clone, Copy, Debug)]
 pub struct EngineSettings {
@@ -418,22 +417,12 @@ fn shade_uniform(scene: &Scene, map: &ShadowMap) -> Vec<u8> {
         v(f.right, 1.0 / (t * cam.aspect())),
         v(f.up, 1.0 / t),
         v(f.forward, cam.near),
-        [
-            cam.far as f32,
-            cam.width as f32,
-            cam.height as f32,
-            0.0,
-        ],
+        [cam.far as f32, cam.width as f32, cam.height as f32, 0.0],
         [sky[0] as f32, sky[1] as f32, sky[2] as f32, 0.0],
         [color[0] as f32, color[1] as f32, color[2] as f32, kind],
         v(pos, cos_outer),
         v(dir, cos_inner),
-        [
-            mode,
-            map.size as f32,
-            SHADOW_BIAS_TEXELS as f32,
-            0.0,
-        ],
+        [mode, map.size as f32, SHADOW_BIAS_TEXELS as f32, 0.0],
         v(map.origin, perspective),
         v(map.basis[0], map.near),
         v(map.basis[1], map.far),
@@ -513,47 +502,48 @@ impl Engine {
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &attributes,
         })];
-        let pipeline = |vs: &str, fs: &str, buffers: &[Option<wgpu::VertexBufferLayout<'_>>], sky: bool| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(if sky { "engine sky" } else { "engine shade" }),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(vs),
-                    compilation_options: Default::default(),
-                    buffers,
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: wgpu::TextureFormat::Depth32Float,
-                    depth_write_enabled: Some(!sky),
-                    depth_compare: Some(if sky {
-                        wgpu::CompareFunction::Always
-                    } else {
-                        wgpu::CompareFunction::Less
+        let pipeline =
+            |vs: &str, fs: &str, buffers: &[Option<wgpu::VertexBufferLayout<'_>>], sky: bool| {
+                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(if sky { "engine sky" } else { "engine shade" }),
+                    layout: Some(&layout),
+                    vertex: wgpu::VertexState {
+                        module: &module,
+                        entry_point: Some(vs),
+                        compilation_options: Default::default(),
+                        buffers,
+                    },
+                    primitive: wgpu::PrimitiveState {
+                        topology: wgpu::PrimitiveTopology::TriangleList,
+                        cull_mode: None,
+                        ..Default::default()
+                    },
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: wgpu::TextureFormat::Depth32Float,
+                        depth_write_enabled: Some(!sky),
+                        depth_compare: Some(if sky {
+                            wgpu::CompareFunction::Always
+                        } else {
+                            wgpu::CompareFunction::Less
+                        }),
+                        stencil: Default::default(),
+                        bias: Default::default(),
                     }),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: wgpu::TextureFormat::Rgba16Float,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &module,
+                        entry_point: Some(fs),
+                        compilation_options: Default::default(),
+                        targets: &[Some(wgpu::ColorTargetState {
+                            format: wgpu::TextureFormat::Rgba16Float,
+                            blend: None,
+                            write_mask: wgpu::ColorWrites::ALL,
+                        })],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+            };
         let shade = pipeline("vs", "fs", &buffers, false);
         let sky = pipeline("vs_sky", "fs_sky", &[], true);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -618,7 +608,9 @@ impl Engine {
         times.push((format!("{family_name} set-up (pipelines)"), t.elapsed()));
 
         let t = Instant::now();
-        let raster = self.rasteriser.render(ctx, scene, bvh, settings.shadow_map)?;
+        let raster = self
+            .rasteriser
+            .render(ctx, scene, bvh, settings.shadow_map)?;
         wait()?;
         times.push(("raster: camera depth + shadow map".to_owned(), t.elapsed()));
 
@@ -642,10 +634,7 @@ impl Engine {
                     .rectified(ctx, &raster, maps, settings.rectified)?;
                 wait()?;
                 times.push((
-                    format!(
-                        "raster: rectified map ({} regions)",
-                        maps.matrices.len()
-                    ),
+                    format!("raster: rectified map ({} regions)", maps.matrices.len()),
                     t.elapsed(),
                 ));
                 Some(map)
