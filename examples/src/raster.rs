@@ -34,19 +34,28 @@ pub const SEGMENTS: u32 = 200;
 /// Cells per side of the grid a plane is drawn as.
 pub const PLANE_CELLS: u32 = 64;
 
-/// A triangle soup.
+/// A triangle soup, with what shading needs per vertex.
 #[derive(Clone, Debug, Default)]
 pub struct Triangles {
     /// Vertex positions (world).
     pub positions: Vec<[f32; 3]>,
+    /// Unit vertex normals (world), one per position: the face's for planes, boxes, meshes
+    /// and heightfields (flat: their vertices are not shared between faces), the surface's
+    /// for spheres and cylinder sides. Their sign is arbitrary (surfaces are two-sided).
+    pub normals: Vec<[f32; 3]>,
+    /// Index of the vertex's shape in `Scene::geometry`, one per position.
+    pub shapes: Vec<u32>,
     /// Three indices per triangle.
     pub indices: Vec<u32>,
 }
 
 impl Triangles {
-    fn vertex(&mut self, p: DVec3) -> u32 {
+    fn vertex(&mut self, p: DVec3, n: DVec3, shape: u32) -> u32 {
         let i = self.positions.len() as u32;
-        self.positions.push([p.x as f32, p.y as f32, p.z as f32]);
+        let f = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
+        self.positions.push(f(p));
+        self.normals.push(f(n.normalize_or_zero()));
+        self.shapes.push(shape);
         i
     }
 
@@ -54,13 +63,16 @@ impl Triangles {
         self.indices.extend([a, b, c]);
     }
 
-    fn quad(&mut self, a: DVec3, b: DVec3, c: DVec3, d: DVec3) {
-        let i = [
-            self.vertex(a),
-            self.vertex(b),
-            self.vertex(c),
-            self.vertex(d),
-        ];
+    /// A flat triangle with its own three vertices.
+    fn flat(&mut self, [a, b, c]: [DVec3; 3], shape: u32) {
+        let n = (b - a).cross(c - a);
+        let i = [a, b, c].map(|p| self.vertex(p, n, shape));
+        self.triangle(i[0], i[1], i[2]);
+    }
+
+    fn quad(&mut self, a: DVec3, b: DVec3, c: DVec3, d: DVec3, shape: u32) {
+        let n = (c - a).cross(d - b);
+        let i = [a, b, c, d].map(|p| self.vertex(p, n, shape));
         self.triangle(i[0], i[1], i[2]);
         self.triangle(i[0], i[2], i[3]);
     }
@@ -89,7 +101,8 @@ fn tangents(n: DVec3) -> (DVec3, DVec3) {
 pub fn tessellate(scene: &Scene, segments: u32, half_extent: f64) -> Triangles {
     let mut t = Triangles::default();
     let seg = segments.max(3);
-    for shape in &scene.geometry {
+    for (index, shape) in scene.geometry.iter().enumerate() {
+        let id = index as u32;
         match shape {
             Shape::Plane { point, normal, .. } => {
                 let n = normal.normalize();
@@ -103,7 +116,7 @@ pub fn tessellate(scene: &Scene, segments: u32, half_extent: f64) -> Triangles {
                 let at = |i: u32, j: u32| centre + t1 * f(i) + t2 * f(j);
                 for i in 0..PLANE_CELLS {
                     for j in 0..PLANE_CELLS {
-                        t.quad(at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                        t.quad(at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1), id);
                     }
                 }
             }
@@ -127,6 +140,7 @@ pub fn tessellate(scene: &Scene, segments: u32, half_extent: f64) -> Triangles {
                             corner(true, false),
                             corner(true, true),
                             corner(false, true),
+                            id,
                         );
                     }
                 }
@@ -143,7 +157,7 @@ pub fn tessellate(scene: &Scene, segments: u32, half_extent: f64) -> Triangles {
                             theta.cos(),
                             theta.sin() * phi.sin(),
                         );
-                        t.vertex(*center + d * *radius);
+                        t.vertex(*center + d * *radius, d, id);
                     }
                 }
                 let at = |i: u32, j: u32| base + i * seg + j % seg;
@@ -161,19 +175,23 @@ pub fn tessellate(scene: &Scene, segments: u32, half_extent: f64) -> Triangles {
                     let phi = std::f64::consts::TAU * f64::from(k) / f64::from(seg);
                     (t1 * phi.cos() + t2 * phi.sin()) * *radius
                 };
-                let (ca, cb) = (t.vertex(*a), t.vertex(*b));
+                // The side's ring vertices carry radial normals; the caps have their own
+                // (same positions, axial normals).
+                let (ca, cb) = (t.vertex(*a, -axis, id), t.vertex(*b, axis, id));
                 let base = t.positions.len() as u32;
                 for k in 0..seg {
                     let r = ring(k);
-                    t.vertex(*a + r);
-                    t.vertex(*b + r);
+                    t.vertex(*a + r, r, id);
+                    t.vertex(*b + r, r, id);
+                    t.vertex(*a + r, -axis, id);
+                    t.vertex(*b + r, axis, id);
                 }
                 for k in 0..seg {
-                    let (i, j) = (base + 2 * k, base + 2 * ((k + 1) % seg));
+                    let (i, j) = (base + 4 * k, base + 4 * ((k + 1) % seg));
                     t.triangle(i, i + 1, j + 1);
                     t.triangle(i, j + 1, j);
-                    t.triangle(ca, i, j);
-                    t.triangle(cb, j + 1, i + 1);
+                    t.triangle(ca, i + 2, j + 2);
+                    t.triangle(cb, j + 3, i + 3);
                 }
             }
             Shape::Heightfield {
@@ -184,20 +202,14 @@ pub fn tessellate(scene: &Scene, segments: u32, half_extent: f64) -> Triangles {
                 ..
             } => {
                 let (nx, nz) = (samples[0], samples[1]);
-                let base = t.positions.len() as u32;
-                for iz in 0..nz {
-                    for ix in 0..nx {
-                        t.vertex(
-                            *origin
-                                + DVec3::new(
-                                    size[0] * f64::from(ix) / f64::from(nx - 1),
-                                    heights[(iz * nx + ix) as usize],
-                                    size[1] * f64::from(iz) / f64::from(nz - 1),
-                                ),
-                        );
-                    }
-                }
-                let at = |ix: u32, iz: u32| base + iz * nx + ix;
+                let at = |ix: u32, iz: u32| {
+                    *origin
+                        + DVec3::new(
+                            size[0] * f64::from(ix) / f64::from(nx - 1),
+                            heights[(iz * nx + ix) as usize],
+                            size[1] * f64::from(iz) / f64::from(nz - 1),
+                        )
+                };
                 for iz in 0..nz - 1 {
                     for ix in 0..nx - 1 {
                         let (a, b, c, d) = (
@@ -206,8 +218,8 @@ pub fn tessellate(scene: &Scene, segments: u32, half_extent: f64) -> Triangles {
                             at(ix, iz + 1),
                             at(ix + 1, iz + 1),
                         );
-                        t.triangle(a, c, b);
-                        t.triangle(b, c, d);
+                        t.flat([a, c, b], id);
+                        t.flat([b, c, d], id);
                     }
                 }
             }
@@ -216,12 +228,8 @@ pub fn tessellate(scene: &Scene, segments: u32, half_extent: f64) -> Triangles {
                 triangles,
                 ..
             } => {
-                let base = t.positions.len() as u32;
-                for v in vertices {
-                    t.vertex(*v);
-                }
                 for tri in triangles {
-                    t.triangle(base + tri[0], base + tri[1], base + tri[2]);
+                    t.flat(tri.map(|k| vertices[k as usize]), id);
                 }
             }
         }
@@ -766,8 +774,25 @@ impl Rasteriser {
 ///
 /// The map or the poll fails.
 pub fn read_r32float(ctx: &Context, texture: &wgpu::Texture) -> Result<Vec<f32>, RasterError> {
+    Ok(read_texture(ctx, texture, 4)?
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect())
+}
+
+/// Reads a 2D texture of `bytes_per_texel` back: its texels' bytes, rows unpadded, from the
+/// top-left texel.
+///
+/// # Errors
+///
+/// The map or the poll fails.
+pub fn read_texture(
+    ctx: &Context,
+    texture: &wgpu::Texture,
+    bytes_per_texel: u32,
+) -> Result<Vec<u8>, RasterError> {
     let (w, h) = (texture.width(), texture.height());
-    let row = (w * 4).div_ceil(256) * 256;
+    let row = (w * bytes_per_texel).div_ceil(256) * 256;
     let buffer = ctx.device().create_buffer(&wgpu::BufferDescriptor {
         label: Some("raster readback"),
         size: u64::from(row) * u64::from(h),
@@ -788,6 +813,20 @@ pub fn read_r32float(ctx: &Context, texture: &wgpu::Texture) -> Result<Vec<f32>,
         texture.size(),
     );
     ctx.queue().submit([encoder.finish()]);
+    let bytes = map_read(ctx, &buffer)?;
+    let used = (w * bytes_per_texel) as usize;
+    Ok(bytes
+        .chunks_exact(row as usize)
+        .flat_map(|r| r[..used].iter().copied())
+        .collect())
+}
+
+/// Maps a `MAP_READ` buffer once the queue is done and copies its bytes out.
+///
+/// # Errors
+///
+/// The map or the poll fails.
+pub fn map_read(ctx: &Context, buffer: &wgpu::Buffer) -> Result<Vec<u8>, RasterError> {
     let (sender, receiver) = mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, .., move |r| {
         let _ = sender.send(r);
@@ -804,14 +843,7 @@ pub fn read_r32float(ctx: &Context, texture: &wgpu::Texture) -> Result<Vec<f32>,
         .map_err(|e| format!("get_mapped_range: {e}"))?
         .to_vec();
     buffer.unmap();
-    Ok(bytes
-        .chunks_exact(row as usize)
-        .flat_map(|r| {
-            r[..w as usize * 4]
-                .chunks_exact(4)
-                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        })
-        .collect())
+    Ok(bytes)
 }
 
 /// A triangle-list pipeline drawing into `R32Float` with a `Depth32Float` test (`Less`), no

@@ -3,10 +3,14 @@
 //! poses (320x180, 1024^2 shadow map) the rasterised depth buffer and shadow map agree with
 //! the ray-cast ones except at silhouettes, and the prefiltered family's GPU output on the
 //! rasterised inputs, read by `scatter-runtime` straight from the render targets, meets the
-//! `shadow_map` truth as it does on the ray-cast inputs.
+//! `shadow_map` truth as it does on the ray-cast inputs. The projective rectified map
+//! agrees with the ray-casting stand-in (`reference/src/projective.rs`) except at
+//! silhouettes and where no view ray reaches ([`PROJECTIVE_REACHED_SHARE`] says where the
+//! rest is and why).
 //!
 //! `cargo test --release -p scatter-examples --test raster -- --nocapture` prints the table.
 
+use glam::{DMat4, DVec3, DVec4};
 use scatter_conformance::gpu;
 use scatter_examples::raster::{Rasteriser, read_r32float};
 use scatter_reference::buffers::{GBuffer, SKY, ShadowMap, ShadowProjection};
@@ -22,7 +26,8 @@ use scatter_runtime::prefiltered::{FrameInput, Inputs};
 use scatter_runtime::shaderlib::Kernel;
 use scatter_runtime::shaderlib::family::FamilyVariant;
 use scatter_runtime::shaderlib::prefiltered::{
-    FrameSettings, LightKind, PrefilteredVariant, ProjectiveMaps, Rectification, Resolutions,
+    FrameSettings, LightDesc, LightKind, PrefilteredVariant, ProjectiveMaps, Rectification,
+    Resolutions,
 };
 use scatter_runtime::textures::{read_rgba16float, upload_r32float};
 use scatter_runtime::wgpu;
@@ -44,15 +49,27 @@ const SHADOW_TOL: f64 = 5e-4;
 const INTERIOR_SHARE: f64 = 1e-4;
 /// Clip-depth (`z / w`) difference that counts as disagreement in the projective map.
 const RECTIFIED_TOL: f64 = 5e-4;
-/// The projective map's interior disagreement, a regression guard and not a bar (issue 18
-/// is open on it): two sources remain, measured 2026-12-04. `sphere/grazing` 0.08 %: texels
-/// below the ground, where the rasteriser's clamped ground quad stores 0 and the
-/// stand-in's directional rays, which start `scene_reach` before the map, miss the ground
-/// (1); no view ray reaches them. `spot_grate/grazing` 0.24 %: a one-texel diagonal where the
-/// stand-in finds a surface at clip depth 0.986-0.998 and llvmpipe draws nothing (not the
-/// plane's tessellation, not triangles behind the lamp: both ruled out). Neither moves the
-/// family's output (the rel L1 columns).
-const PROJECTIVE_INTERIOR_SHARE: f64 = 3e-3;
+/// Share of all texels of the projective map that may disagree with the stand-in away from
+/// silhouettes *where it matters*: some point on the texel's light ray whose clip depth lies
+/// between the two maps' values (the points the maps shadow differently) is reached by a
+/// view ray (inside the camera frustum, not behind the ray-cast depth buffer's surface:
+/// [`reachable`]). The same 1e-4 as the other buffers; measured 0 on every pose but
+/// `foliage/grazing` (one texel, 0.0004 %; lavapipe).
+///
+/// Unreached disagreements remain, measured 2026-12-05 and explained, and are only
+/// reported (the table's `unreached` column): `spot_grate/grazing` 0.24 % of the texels,
+/// a one-texel line along the ground's horizon as the lamp sees it, where the stand-in's
+/// analytic (infinite) ground plane is hit 650 m to 30 km from the lamp at clip depth
+/// 0.986-0.998 and the rasteriser's ground, a grid `8 x max(far, light reach)` (here about
+/// 400 m) around the camera, has ended: no triangle covers the texel. Making the grid 4x
+/// and 16x as wide cut the line's texels from 1324 to 333 and 81 (the horizon recedes but
+/// never ends); the camera's far plane is 40 m, so no view ray reaches those points.
+/// `sphere/grazing` 0.08 %: texels below the ground, where the rasteriser's clamped ground
+/// stores 0 and the stand-in's directional rays, which start `scene_reach` before the map,
+/// meet the ground before they start (1); the ground hides every point they decide. Neither
+/// is a flaw of the rasteriser or of the README's contract, and neither moves the family's
+/// output (the rel L1 columns).
+const PROJECTIVE_REACHED_SHARE: f64 = 1e-4;
 
 /// Agreement of a rasterised buffer with the ray-cast one.
 struct Agreement {
@@ -144,6 +161,129 @@ fn agreement(
     }
 }
 
+/// Whether a view ray reaches a point that the projective map's texel at clip `(x, y)`
+/// of region matrix `m` decides differently with stored depths `lo < hi`: a point of the
+/// texel's light ray (as the stand-in casts it: from the lamp, or from `reach` before the
+/// map along a directional light) with clip depth in `(lo, hi]`, inside the camera frustum
+/// and not behind the ray-cast surface of its pixel (relative `DEPTH_TOL`). The depth is
+/// monotonic along the ray where clip `w > 0` (a ratio of linear functions), so the
+/// interval is found by bisection and then sampled for occlusion.
+#[allow(clippy::too_many_arguments, reason = "the texel and what decides it")]
+fn reachable(
+    scene: &Scene,
+    gbuf: &GBuffer,
+    light: &LightDesc,
+    m: &DMat4,
+    [x, y]: [f64; 2],
+    [lo, hi]: [f64; 2],
+    reach: f64,
+) -> bool {
+    let inv = m.inverse();
+    let unproject = |z: f64| {
+        let h = inv * DVec4::new(x, y, z, 1.0);
+        h.truncate() / h.w
+    };
+    let (p0, p1) = (unproject(0.0), unproject(1.0));
+    let (origin, dir) = match *light {
+        LightDesc::Directional { direction, .. } => {
+            let l = direction.normalize();
+            (p0 - l * reach, l)
+        }
+        LightDesc::Spot { position, .. } => {
+            let mut v = (p1 - p0).normalize();
+            if (*m * v.extend(0.0)).w < 0.0 {
+                v = -v;
+            }
+            (position, v)
+        }
+    };
+    // Clip t >= 0 to the camera frustum: near <= z <= far, |x| <= z t a, |y| <= z t.
+    let cam = &scene.camera;
+    let f = cam.frame();
+    let (ta, tv) = (cam.tan_half_fov() * cam.aspect(), cam.tan_half_fov());
+    let view = |p: DVec3| {
+        let q = p - cam.position;
+        DVec3::new(q.dot(f.right), q.dot(f.up), q.dot(f.forward))
+    };
+    let (a, b) = (view(origin), view(origin + dir) - view(origin));
+    // Each constraint c0 + c1 t >= 0.
+    let constraints = [
+        (a.z - cam.near, b.z),
+        (cam.far - a.z, -b.z),
+        (a.z * ta - a.x, b.z * ta - b.x),
+        (a.z * ta + a.x, b.z * ta + b.x),
+        (a.z * tv - a.y, b.z * tv - b.y),
+        (a.z * tv + a.y, b.z * tv + b.y),
+    ];
+    let (mut t0, mut t1) = (0.0f64, 1e12f64);
+    for (c0, c1) in constraints {
+        if c1.abs() < 1e-300 {
+            if c0 < 0.0 {
+                return false;
+            }
+        } else if c1 > 0.0 {
+            t0 = t0.max(-c0 / c1);
+        } else {
+            t1 = t1.min(-c0 / c1);
+        }
+    }
+    let clip = |t: f64| *m * (origin + dir * t).extend(1.0);
+    // Keep clip w > 0 (w is linear in t).
+    let (w0, w1) = (clip(t0).w, clip(t1).w);
+    if w0 <= 0.0 && w1 <= 0.0 {
+        return false;
+    }
+    if w0 <= 0.0 || w1 <= 0.0 {
+        let tz = t0 + (t1 - t0) * w0 / (w0 - w1);
+        if w0 <= 0.0 {
+            t0 = tz + 1e-9 * (t1 - t0);
+        } else {
+            t1 = tz - 1e-9 * (t1 - t0);
+        }
+    }
+    if t0 >= t1 {
+        return false;
+    }
+    let depth = |t: f64| {
+        let c = clip(t);
+        c.z / c.w
+    };
+    // The t where the monotonic depth crosses `level` inside [t0, t1] (an end if it does
+    // not).
+    let increasing = depth(t1) >= depth(t0);
+    let cross = |level: f64| {
+        let (mut l, mut h) = (t0, t1);
+        for _ in 0..100 {
+            let mid = 0.5 * (l + h);
+            if (depth(mid) < level) == increasing {
+                l = mid;
+            } else {
+                h = mid;
+            }
+        }
+        0.5 * (l + h)
+    };
+    let (mut s0, mut s1) = (cross(lo), cross(hi));
+    if s0 > s1 {
+        std::mem::swap(&mut s0, &mut s1);
+    }
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    (0..=256).any(|k| {
+        let t = s0 + (s1 - s0) * f64::from(k) / 256.0;
+        let d = depth(t);
+        if !(d > lo && d <= hi) {
+            return false;
+        }
+        let v = view(origin + dir * t);
+        let px = ((v.x / (v.z * ta) + 1.0) * 0.5 * w as f64).floor();
+        let py = ((1.0 - v.y / (v.z * tv)) * 0.5 * h as f64).floor();
+        if !(0.0..w as f64).contains(&px) || !(0.0..h as f64).contains(&py) {
+            return false;
+        }
+        v.z <= f64::from(gbuf.view_depth[py as usize * w + px as usize]) * (1.0 + DEPTH_TOL)
+    })
+}
+
 /// `variant`'s GPU output from `depth` and `shadow` (textures on the GPU) and, for a
 /// projective frame, the rectified map `rectified` makes from the frame's matrices; its rel
 /// L1 against `truth` and the frame's projective maps (`None`: the frame fell back).
@@ -216,7 +356,7 @@ fn rasterised_inputs_agree_with_the_ray_cast_ones_and_feed_the_kernels() {
     let rasteriser = Rasteriser::new(ctx);
     let mut failures = Vec::new();
     let mut table = vec![
-        "| scene/pose | triangles | depth: disagree / interior / edge px | shadow map: disagree / interior / edge texels | prefiltered rel L1: ray-cast inputs / rasterised | projective map: disagree / interior / edge texels | projective rel L1: stand-in / rasterised |".to_owned(),
+        "| scene/pose | triangles | depth: disagree / interior / edge px | shadow map: disagree / interior / edge texels | prefiltered rel L1: ray-cast inputs / rasterised | projective map: disagree / interior / interior reached / edge texels | projective rel L1: stand-in / rasterised |".to_owned(),
         "|---|---|---|---|---|---|---|".to_owned(),
     ];
     for &name in SceneName::ALL {
@@ -363,15 +503,47 @@ fn rasterised_inputs_agree_with_the_ray_cast_ones_and_feed_the_kernels() {
                 &truth,
             );
             let projective_cells = match (maps, raster_map) {
-                (Some(_), Some(raster_map)) => {
+                (Some(maps), Some(raster_map)) => {
                     let (rw, rh) = (rw as usize, rh as usize);
                     let e = edges(rw, rh, &stand_in, |d| d, |_| 1.0, None, RECTIFIED_TOL);
-                    let r = agreement(&raster_map, &stand_in, &e, |r, c| {
-                        (r - c).abs() > RECTIFIED_TOL
-                    });
-                    if r.interior > PROJECTIVE_INTERIOR_SHARE {
+                    let differs = |r: f64, c: f64| (r - c).abs() > RECTIFIED_TOL;
+                    let r = agreement(&raster_map, &stand_in, &e, differs);
+                    // The interior disagreements a view ray reaches.
+                    let reach = scene_reach(&scene, &bvh);
+                    let light = scene.light_desc();
+                    let mut reached = 0usize;
+                    for (m, &[first, count]) in maps.matrices.iter().zip(&maps.viewports) {
+                        for row in 0..rh {
+                            for col in first as usize..(first + count) as usize {
+                                let i = row * rw + col;
+                                let (a, b) = (f64::from(raster_map[i]), f64::from(stand_in[i]));
+                                if e[i] || !differs(a, b) {
+                                    continue;
+                                }
+                                let x = -1.0
+                                    + 2.0 * ((col - first as usize) as f64 + 0.5)
+                                        / f64::from(count);
+                                let y = 1.0 - 2.0 * (row as f64 + 0.5) / rh as f64;
+                                if reachable(
+                                    &scene,
+                                    &gbuf,
+                                    &light,
+                                    m,
+                                    [x, y],
+                                    [a.min(b), a.max(b)],
+                                    reach,
+                                ) {
+                                    reached += 1;
+                                }
+                            }
+                        }
+                    }
+                    let reached = reached as f64 / (rw * rh) as f64;
+                    if reached > PROJECTIVE_REACHED_SHARE {
                         failures.push(format!(
-                            "{id}: {:.4} % of the rectified texels disagree away from silhouettes",
+                            "{id}: {:.4} % of the rectified texels disagree away from \
+                             silhouettes where a view ray reaches ({:.4} % in all)",
+                            100.0 * reached,
                             100.0 * r.interior
                         ));
                     }
@@ -388,9 +560,10 @@ fn rasterised_inputs_agree_with_the_ray_cast_ones_and_feed_the_kernels() {
                         ));
                     }
                     format!(
-                        "{:.3} / {:.4} / {:.2} % | {:.2} / {:.2} %",
+                        "{:.3} / {:.4} / {:.4} / {:.2} % | {:.2} / {:.2} %",
                         100.0 * r.disagree,
                         100.0 * r.interior,
+                        100.0 * reached,
                         100.0 * r.edges,
                         100.0 * p_cast,
                         100.0 * p_raster
