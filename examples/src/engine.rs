@@ -593,8 +593,17 @@ impl Engine {
         };
         let mut times = Vec::new();
         let screen = [scene.camera.width, scene.camera.height];
-        let variant = settings.variant;
-        let family_name = variant.family().name();
+        let family_name = settings.variant.family().name();
+        // The cookie follows the scene: a family that reads none refuses a scene with one.
+        let variant = match scene.light.cookie() {
+            None => settings.variant,
+            Some(_) => settings.variant.with_cookie(true).ok_or_else(|| {
+                format!(
+                    "the scene's spot light has a cookie, which the {family_name} family does \
+                     not read (raymarch, minmax and hybrid_volume do)"
+                )
+            })?,
+        };
 
         // The family's passes first: a variant or size it refuses ends the frame before
         // anything is drawn.
@@ -605,6 +614,18 @@ impl Engine {
         };
         let mut family = FamilyPasses::new(ctx, &variant, res, settings.shadow_map)
             .map_err(|e| format!("{family_name} {}: {e}", variant.id()))?;
+        if let Some(cookie) = scene.light.cookie() {
+            let texture = scatter_runtime::textures::upload_cookie(
+                ctx,
+                Kernel::Raymarch,
+                [cookie.width(), cookie.height()],
+                &cookie.rgba(),
+            )
+            .map_err(|e| format!("cookie: {e}"))?;
+            family
+                .set_cookie(&texture.create_view(&wgpu::TextureViewDescriptor::default()))
+                .map_err(|e| format!("cookie: {e}"))?;
+        }
         times.push((format!("{family_name} set-up (pipelines)"), t.elapsed()));
 
         let t = Instant::now();
