@@ -34,7 +34,7 @@ use scatter_runtime::textures::read_rgba16float;
 use scatter_runtime::wgpu;
 use scatter_runtime::{Context, FamilyPasses, FrameInput, Inputs};
 
-use crate::raster::{RasterError, RasterFrame, Rasteriser, Triangles, read_texture};
+use crate::raster::{RasterError, RasterFrame, Rasteriser, Triangles, cleared_depth, read_texture};
 
 /// What to render a frame with.
 #[derive(Clone, Copy, Debug)]
@@ -886,14 +886,7 @@ impl Engine {
                         store: wgpu::StoreOp::Store,
                     },
                 })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &z_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: Some(cleared_depth(&z_view)),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
