@@ -196,6 +196,13 @@ pub struct PrefilteredVariant {
     pub slice_samples: u32,
     /// `sampling = epipolar`: the initial step between evaluated samples of a slice.
     pub step: u32,
+    /// A spot light's cookie: an RGB texture projected along the cone ([`crate::cookie`];
+    /// `light = spot` only). It is constant along each light ray, so the prefilter folds it
+    /// into each rectified texel's weight: per colour channel the weighted means of the
+    /// cookie times the basis (three times the layers), plus the region's mean cookie in one
+    /// more layer; `scatter` reconstructs each channel's lit share from them.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub cookie: bool,
 }
 
 impl Default for PrefilteredVariant {
@@ -217,6 +224,7 @@ impl Default for PrefilteredVariant {
             slices: SamplingKnobs::DEFAULT_SLICES,
             slice_samples: SamplingKnobs::DEFAULT_SLICE_SAMPLES,
             step: SamplingKnobs::DEFAULT_STEP,
+            cookie: false,
         }
     }
 }
@@ -316,7 +324,8 @@ impl PrefilteredVariant {
                 allowed: "in 1..=8".into(),
             });
         }
-        self.sampling_knobs().validate()
+        self.sampling_knobs().validate()?;
+        crate::cookie::validate_cookie(self.cookie, self.light)
     }
 
     /// Every valid `bases_per_thread` for `bases`.
@@ -329,7 +338,9 @@ impl PrefilteredVariant {
 
     /// Every valid variant with bases in {4, 8, 16, 32, 64, 128} (the powers of two of the
     /// design card), every `bases_per_thread`, the given `regions`, both visibilities, both
-    /// lights, every storage format and both rectifications; sorted by those knobs.
+    /// lights, every storage format and both rectifications; sorted by those knobs; then the
+    /// moment basis; then the spot with a cookie (each basis, both visibilities and
+    /// rectifications, 3 regions where `regions` holds 3).
     pub fn grid(regions: std::ops::RangeInclusive<u32>) -> Vec<PrefilteredVariant> {
         let mut out = Vec::new();
         for bases in [4, 8, 16, 32, 64, 128] {
@@ -373,15 +384,44 @@ impl PrefilteredVariant {
                 }
             }
         }
+        // The spot with its cookie: each basis, both visibilities and both rectifications at
+        // the paper's bases (m32) and the default region count where it is in range.
+        let r = regions.clone().find(|r| *r == 3).unwrap_or(*regions.start());
+        for base in [Self::default(), Self::with_moments(4), Self::with_moments(6)] {
+            for &visibility in VisibilityMode::ALL {
+                for &rectification in Rectification::ALL {
+                    out.push(PrefilteredVariant {
+                        regions: r,
+                        visibility,
+                        light: LightKind::Spot,
+                        rectification,
+                        cookie: true,
+                        ..base
+                    });
+                }
+            }
+        }
         out
     }
 
-    /// rgba layers of the filtered-basis texture array: `bases / 4` (Fourier), or
-    /// `ceil(moments / 4)` (moments: `(z, z^2, z^3, z^4)` then `(z^5, z^6, 0, 0)`).
+    /// rgba layers of one colour channel's filtered basis: `bases / 4` (Fourier), or
+    /// `ceil(moments / 4)` (moments: `(z, z^2, z^3, z^4)` then `(z^5, z^6, 0, 0)`). The
+    /// texture array holds [`Self::filtered_layers`].
     pub fn layers(&self) -> u32 {
         match self.basis {
             Basis::Fourier => self.bases / 4,
             Basis::Moments => self.moments.div_ceil(4),
+        }
+    }
+
+    /// rgba layers of the filtered-basis texture array: [`Self::layers`], or with a cookie
+    /// `3 * layers + 1` (channel `c`'s layer `q` at `c * layers + q`, then the region's mean
+    /// cookie, rgb, in the last layer).
+    pub fn filtered_layers(&self) -> u32 {
+        if self.cookie {
+            3 * self.layers() + 1
+        } else {
+            self.layers()
         }
     }
 
@@ -412,15 +452,17 @@ impl PrefilteredVariant {
     }
 
     /// A short stable id, used in file names and trial names:
-    /// `m32-t8-r3-weighted-directional-rgba8unorm-epipolar`, or
-    /// `moments4-r3-weighted-directional-rgba32float-epipolar`.
+    /// `m32-t8-r3-weighted-directional-rgba8unorm-epipolar`,
+    /// `moments4-r3-weighted-directional-rgba32float-epipolar`, or with a cookie
+    /// `m32-t8-r3-weighted-spot-cookie-rgba8unorm-epipolar`.
     pub fn id(&self) -> String {
         format!(
-            "{}-r{}-{}-{}-{}-{}{}",
+            "{}-r{}-{}-{}{}-{}-{}{}",
             self.basis_id(),
             self.regions,
             self.visibility,
             self.light,
+            crate::cookie::id_suffix(self.cookie),
             self.storage,
             self.rectification,
             self.sampling_knobs().id_suffix()
@@ -482,6 +524,7 @@ impl KnobSet for PrefilteredVariant {
         if self.rectification != d.rectification {
             m += &format!("-{}", self.rectification);
         }
+        m += crate::cookie::id_suffix(self.cookie);
         m + &self.sampling_knobs().marker_suffix()
     }
 
@@ -496,5 +539,13 @@ impl KnobSet for PrefilteredVariant {
     /// Regions 1..=4 (every other knob at every value).
     fn grid() -> Vec<Self> {
         PrefilteredVariant::grid(1..=4)
+    }
+
+    fn cookie(&self) -> bool {
+        self.cookie
+    }
+
+    fn with_cookie(self, cookie: bool) -> Option<Self> {
+        Some(Self { cookie, ..self })
     }
 }

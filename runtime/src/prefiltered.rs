@@ -148,6 +148,8 @@ pub struct Prefiltered {
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
     frame: Option<PrefilteredFrame>,
+    /// The spot's cookie ([`Self::set_cookie`]), for a variant with `cookie`.
+    cookie: crate::cookie::CookieSlot,
 }
 
 impl Prefiltered {
@@ -209,8 +211,8 @@ impl Prefiltered {
         )?;
         check_limit(
             PREFILTER,
-            "filtered-basis layers (bases / 4, or 1-2 for moments)",
-            variant.layers().into(),
+            "filtered-basis layers (bases / 4, or 1-2 for moments; with a cookie 3x + 1)",
+            variant.filtered_layers().into(),
             "max_texture_array_layers",
             limits.max_texture_array_layers.into(),
         )?;
@@ -254,7 +256,22 @@ impl Prefiltered {
             output_view: output_view.clone(),
             exec,
             frame: None,
+            cookie: crate::cookie::CookieSlot::default(),
         })
+    }
+
+    /// Sets the spot light's cookie a `cookie` variant reads (kept until replaced; any size,
+    /// one of [`crate::textures::COOKIE_FORMATS`], projected as `scatter_shaderlib::cookie`
+    /// says): `prefilter` folds it into each texel's weight, `scatter` marches with it near
+    /// the epipole. [`crate::textures::upload_cookie`] makes one from texels.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::NoCookie`] for a variant without `cookie`;
+    /// [`RuntimeError::InputMismatch`] for a view of the wrong format, dimension or usage.
+    pub fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        self.cookie
+            .set(self.variant.cookie, self.variant.id(), PREFILTER, cookie)
     }
 
     /// Sets up one frame ([`prepare_frame`]) and uploads its uniforms and slice table.
@@ -430,6 +447,8 @@ impl Prefiltered {
         if projective {
             engine.extend(inputs.rectified.map(|v| (plan::RECTIFIED_RASTER, v)));
         }
+        self.cookie
+            .bind(self.variant.cookie, PREFILTER, &mut engine)?;
         let mut conditions = Vec::new();
         if projective {
             conditions.push(plan::PROJECTIVE_FRAME);
@@ -592,7 +611,7 @@ pub struct PrefilteredReadback {
     pub output: Vec<[f32; 4]>,
     /// Rectified map, `Wr * Hr` values, row-major.
     pub rectified: Vec<f32>,
-    /// Filtered bases, `Wr * Hr * bases/4` texels indexed `(layer * Hr + y) * Wr + x`,
+    /// Filtered bases, `Wr * Hr * filtered_layers` texels indexed `(layer * Hr + y) * Wr + x`,
     /// converted from the storage format to f32 (values in [0, 1]).
     pub filtered: Vec<[f32; 4]>,
     /// Region-prefix depth bounds (min, max) per rectified texel, row-major.
@@ -640,6 +659,10 @@ pub fn run_prefiltered_once(
     }
     let views = upload_inputs(ctx, &cpu)?;
     let engine_rectified = views.get(2).map(|(_, v)| v);
+    if let Some((size, texels)) = &inputs.cookie {
+        let texture = crate::textures::upload_cookie(ctx, PREFILTER, *size, texels)?;
+        pass.set_cookie(&texture.create_view(&wgpu::TextureViewDescriptor::default()))?;
+    }
     pass.prepare(ctx, &inputs.frame)?;
     let device = ctx.device();
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -804,6 +827,10 @@ impl crate::family::FamilyRuntime for Prefiltered {
 
     fn fallback_pixels(&self, ctx: &Context) -> Result<Option<u32>, RuntimeError> {
         crate::family::read_fallback_count(ctx, &self.exec, SCATTER_UNWARP)
+    }
+
+    fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        Prefiltered::set_cookie(self, cookie)
     }
 
     fn pass_wall_times(

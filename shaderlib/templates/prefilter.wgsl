@@ -23,6 +23,16 @@
 // greatest depth over the region up to the texel (`bounds`): where a ray's depth lies outside
 // them, scatter knows the region's visibility exactly and skips the Fourier estimate.
 {%- endif %}
+{%- if cookie %}
+//
+// Cookie (scatter_frame::cookie): a cookie is constant along each light ray, so it folds into
+// each texel's weight. Texel i's light ray has the cookie C_i (RGB; the ray through the
+// texel's centre), and per channel c the filter stores the running mean of C_i^c times the
+// basis, {% if moments %}sum w_i C_i^c z_i^k / sum w_i{% else %}F_k^c = sum w_i C_i^c B_k(d_i) / sum w_i (as F / 2 + 0.5){% endif %}, in layers c * {{ layers }} + q,
+// and thread 0 the region's mean cookie Cbar^c = sum w_i C_i^c / sum w_i (rgb) in layer {{ cbar_layer }}:
+// the lit share sum w_i C_i^c H(d_i - d) / sum w_i then has the same expansion as the
+// visibility with Cbar^c in place of 1 (scatter).
+{%- endif %}
 {%- if projective %}
 //
 // Projective variant: in a projective frame (frame.proj.x = 1) `rectified` is the engine's
@@ -38,7 +48,10 @@
 // | 2       | rectified | texture_2d<f32> (r32float)                      | textureLoad  |
 // | 3       | filtered  | texture_storage_2d_array<FORMAT, write>         | textureStore |
 // | 4       | bounds    | texture_storage_2d<rg32float, write>            | textureStore |
-// filtered: FORMAT = {{ storage }}; Wr x Hr x {{ layers }} layers{% if !moments %} (bases / 4){% endif %}, Wr x Hr = the rectified
+{%- if cookie %}
+// | 12      | cookie    | texture_2d<f32> (rgba, linear RGB)              | textureLoad  |
+{%- endif %}
+// filtered: FORMAT = {{ storage }}; Wr x Hr x {{ filtered_layers }} layers{% if !moments %} (bases / 4{% if cookie %} per channel, 3 channels, + 1{% endif %}){% endif %}, Wr x Hr = the rectified
 // size (frame.sizes.zw). bounds: Wr x Hr, (min, max) of the region's depths up to the texel.
 //
 // Dispatch: (ceil(Hr / 64), {{ regions }}, {{ threads_per_row_region }}) workgroups of (64, 1, 1);
@@ -46,7 +59,7 @@
 //
 // Mirrors reference/src/kernels/prefilter.rs
 
-#import scatter::epipolar::{Frame, slice_params}
+#import scatter::epipolar::{Frame, {% if cookie %}SliceParams, row_phi, slice_e, {% endif %}slice_params}
 {%- if moments %}
 #import scatter::prefiltered::{region_start, texel_weight}
 #import scatter::moments::{moment_layer, moment_z}
@@ -56,7 +69,14 @@
 {%- endif %}
 {%- if projective %}
 #import scatter::projective::proj_stored_depth
+{%- if cookie %}
+#import scatter::prefiltered_projective::{proj_region_g, proj_texel_weight}
+{%- else %}
 #import scatter::prefiltered_projective::proj_texel_weight
+{%- endif %}
+{%- endif %}
+{%- if cookie %}
+#import scatter::cookie::frame_cookie
 {%- endif %}
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -64,6 +84,10 @@
 @group(0) @binding(2) var rectified: texture_2d<f32>;
 @group(0) @binding(3) var filtered: texture_storage_2d_array<{{ storage }}, write>;
 @group(0) @binding(4) var bounds: texture_storage_2d<rg32float, write>;
+{%- if cookie %}
+// The spot's cookie (scatter_frame::cookie), folded into each texel's weight.
+@group(0) @binding(12) var cookie: texture_2d<f32>;
+{%- endif %}
 
 // Independent prefix regions per row.
 const REGIONS: u32 = {{ regions }}u;
@@ -71,6 +95,28 @@ const REGIONS: u32 = {{ regions }}u;
 const BASES_PER_THREAD: u32 = {{ bases_per_thread }}u;
 // Invocations per (row, region): bases / bases_per_thread.
 const THREADS_PER_ROW_REGION: u32 = {{ threads_per_row_region }}u;
+{%- if cookie %}
+// rgba layers of one colour channel's basis.
+const LAYERS: u32 = {{ layers }}u;
+
+// The cookie of texel `i` of a row (slice `slice`, slice direction `e`; in a projective frame
+// column `i` of region `region`): that of the light ray through the texel's centre, constant
+// along it. Epipolar: the ray leaving the lamp at angle psi = (i + 1/2) delta from the
+// direction towards the eye, as `rectify` casts it. Projective: the ray of the column
+// invariant G at the texel's centre in the row's plane k = slice.delta, along
+// e1 + k e2 - G axis (light space: the lamp at D on the axis, G = (D - qz) / qx).
+fn texel_cookie(i: u32, slice: SliceParams, e: vec3<f32>, region: u32, proj: bool) -> vec3<f32> {
+    let col = (f32(i) + 0.5) * slice.delta;
+    var l = -frame.axis.xyz * cos(col) + e * sin(col);
+{%- if projective %}
+    if proj {
+        let g = proj_region_g(frame, f32(i) + 0.5, region, REGIONS, frame.sizes[2], true);
+        l = frame.e1_.xyz + frame.e2_.xyz * slice.delta - frame.axis.xyz * g;
+    }
+{%- endif %}
+    return frame_cookie(frame, cookie, frame.light_pos.xyz + l);
+}
+{%- endif %}
 
 // The kernel body for invocation `id` = (row, region, thread).
 @compute @workgroup_size(64, 1, 1)
@@ -93,7 +139,18 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     let slice = slice_params(slices[row]);
     let start = region_start(region, REGIONS, width, spot);
     let end = region_start(region + 1u, REGIONS, width, spot);
+{%- if cookie %}
+    // Channel c's layer q of this thread at c * layers_per_thread + q.
+    var acc: array<vec4<f32>, {{ acc_layers }}>;
+    // The region's running mean of the cookie (thread 0 stores it).
+    var tint_mean = vec3<f32>(0.0);
+    let e = slice_e(frame, row_phi(frame, row));
+{%- if !projective %}
+    let proj = false;
+{%- endif %}
+{%- else %}
     var acc: array<vec4<f32>, {{ layers_per_thread }}>;
+{%- endif %}
     var wsum = 0.0;
     var lo = 1e30;
     var hi = -1e30;
@@ -118,12 +175,28 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             textureStore(bounds, vec2<u32>(i, row), vec4<f32>(lo, hi, 0.0, 0.0));
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);
+{%- if cookie %}
+        let tint = texel_cookie(i, slice, e, region, proj);
+        if thread == 0u {
+            tint_mean = tint_mean * (1.0 - blend) + tint * blend;
+            textureStore(filtered, vec2<u32>(i, row), 3u * LAYERS, vec4<f32>(tint_mean, 1.0));
+        }
+{%- endif %}
 {%- if moments %}
         // The power moments of z, stored as they are.
         let z = moment_z(d);
         for (var q = 0u; q < layers_per_thread; q++) {
+{%- if cookie %}
+            let b = moment_layer(z, q);
+            for (var c = 0u; c < 3u; c++) {
+                let slot = c * layers_per_thread + q;
+                acc[slot] = acc[slot] * (1.0 - blend) + b * (tint[c] * blend);
+                textureStore(filtered, vec2<u32>(i, row), c * LAYERS + q, acc[slot]);
+            }
+{%- else %}
             acc[q] = acc[q] * (1.0 - blend) + moment_layer(z, q) * blend;
             textureStore(filtered, vec2<u32>(i, row), q, acc[q]);
+{%- endif %}
         }
 {%- else %}
         // The basis angles c_k d by angle addition: (sin, cos)(pi d) turned by
@@ -139,10 +212,18 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             let second = turn(angle, step);
             let b = basis4(angle, second);
             angle = turn(second, step);
+{%- if cookie %}
+            for (var c = 0u; c < 3u; c++) {
+                let slot = c * layers_per_thread + q;
+                acc[slot] = acc[slot] * (1.0 - blend) + b * (tint[c] * blend);
+                textureStore(filtered, vec2<u32>(i, row), c * LAYERS + layer, acc[slot] * 0.5 + 0.5);
+            }
+{%- else %}
             let a = acc[q];
             acc[q] = a * (1.0 - blend) + b * blend;
             let stored = acc[q] * 0.5 + 0.5;
             textureStore(filtered, vec2<u32>(i, row), layer, stored);
+{%- endif %}
         }
 {%- endif %}
     }

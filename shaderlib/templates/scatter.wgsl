@@ -28,6 +28,20 @@
 // is ambiguous, and no light leaks where no light ray reaches.{% if moments %} (The moment reconstruction
 // is also exact outside the depths' range up to the moment bias; the bounds make it exact
 // and skip the solve.){% endif %}
+{%- if cookie %}
+//
+// Cookie (scatter_frame::cookie; prefilter folds it into each texel's weight): per channel c
+// the region's lit share S_j^c = sum w_i C_i^c H(d_i - d) / sum w_i, with the region's mean
+// cookie Cbar_j^c (filtered layer {{ cbar_layer }}) in place of 1: {% if moments %}Cbar^c times the lit fraction of the
+// moments divided by Cbar^c (the moments of the cookie-weighted depths){% else %}clamp(0.5 Cbar^c + a(d) . F_j^c, 0, Cbar^c){% endif %};
+// Cbar^c where the region is wholly lit, 0 where wholly shadowed. The region contributes
+// U_j^c S_j^c / Cbar_j^c, U_j^c the pixel's own unshadowed integral with the cookie over
+// its part of the ray (`spot_segment_cookie`): the ratio is the region's cookie-weighted lit
+// fraction, so a wholly lit region gives the pixel's exact cookie integral. (U_j S_j^c, the
+// cookie averaged along the reference ray instead of the pixel's, was 1.6-4.8 % rel L1 off
+// the truth on spot_grate, 0.06-1.9 % without the cookie.) The epipole march carries the
+// cookie per sample.
+{%- endif %}
 //
 // Bindings (group 0):
 // | binding | name             | type                                     | access             |
@@ -39,7 +53,10 @@
 // | 4       | filtered         | texture_2d_array<f32> (prefilter's)      | textureLoad        |
 // | 5       | output           | texture_storage_2d<rgba16float, write>   | textureStore       |
 // | 6       | bounds           | texture_2d<f32> (rg32float, prefilter's) | textureLoad        |
-// filtered: Wr x Hr x {{ layers }} layers, Wr x Hr = the rectified size (frame.sizes.zw),
+{%- if cookie %}
+// | 12      | cookie           | texture_2d<f32> (rgba, linear RGB)       | textureLoad        |
+{%- endif %}
+// filtered: Wr x Hr x {{ filtered_layers }} layers, Wr x Hr = the rectified size (frame.sizes.zw),
 // filtered by hand: linearly along each of the pixel's two rows, each row read at its own
 // column for the ray (clamp-to-edge in u; in v wrapping round when the slices do,
 // frame.anti_epipole.w > 0.5, else clamp-to-edge), and the rows' estimates blended. Texel
@@ -71,6 +88,9 @@
 #import scatter::projective::{proj_boundary, proj_ray_depth, proj_reach}
 #import scatter::prefiltered_projective::proj_column
 {%- endif %}
+{%- if cookie %}
+#import scatter::cookie::{epipole_march_cookie, spot_segment_cookie}
+{%- endif %}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
 {%- endif %}
@@ -82,13 +102,25 @@
 @group(0) @binding(4) var filtered: texture_2d_array<f32>;
 @group(0) @binding(5) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
 @group(0) @binding(6) var bounds: texture_2d<f32>;
+{%- if cookie %}
+// The spot's cookie (scatter_frame::cookie): the epipole march carries it per sample.
+@group(0) @binding(12) var cookie: texture_2d<f32>;
+{%- endif %}
 {% include "include/sampled_bindings.wgsl" %}
 
 // Independent prefix regions per rectified row.
 const REGIONS: u32 = {{ regions }}u;
 {%- if !moments %}
-// rgba layers of `filtered` (bases / 4).
+// rgba layers of `filtered` (bases / 4){% if cookie %} per colour channel{% endif %}.
 const LAYERS: u32 = {{ layers }}u;
+{%- endif %}
+{%- if cookie %}
+{%- if moments %}
+// rgba layers of one colour channel's moments.
+const LAYERS: u32 = {{ layers }}u;
+{%- endif %}
+// The layer of the region's mean cookie.
+const CBAR: u32 = {{ cbar_layer }}u;
 {%- endif %}
 
 // The in-scattered radiance of pixel (x, y) (the sampling entry point below calls it).
@@ -108,7 +140,11 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     let near_anti =
         f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
     if near_epi || near_anti {
+{%- if cookie %}
+        let l = epipole_march_cookie(frame, shadow_map, cookie, eye, dir, s) * color;
+{%- else %}
         let l = epipole_march(frame, shadow_map, eye, dir, s, spot) * color;
+{%- endif %}
         return l;
     }
 
@@ -211,8 +247,8 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     }
     let last0 = u32(min(max(xs0, 0.0), f32(width) - 1.0));
     let last1 = u32(min(max(xs1, 0.0), f32(width) - 1.0));
-    var total0 = 0.0;
-    var total1 = 0.0;
+    var total0 = {% if cookie %}vec3<f32>(0.0){% else %}0.0{% endif %};
+    var total1 = {% if cookie %}vec3<f32>(0.0){% else %}0.0{% endif %};
     var done0 = false;
     var done1 = false;
     for (var r = 0u; r < regions; r++) {
@@ -247,6 +283,18 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         a1 = ray_t(f, b0, delta1, theta, s, spot);
         e1 = select(ray_t(f, b1, delta1, theta, s, spot), s, is_last1);
 {%- endif %}
+{%- if cookie %}
+        // The pixel's own unshadowed integral with the cookie over its part of the ray (RGB;
+        // one quadrature panel per cookie texel crossed), for the rows not yet done.
+        var weight0 = vec3<f32>(0.0);
+        var weight1 = vec3<f32>(0.0);
+        if !done0 {
+            weight0 = spot_segment_cookie(f, cookie, eye, dir, a0, e0, panels);
+        }
+        if !done1 {
+            weight1 = spot_segment_cookie(f, cookie, eye, dir, a1, e1, panels);
+        }
+{%- else %}
         var weight0: f32;
         var weight1: f32;
         if spot {
@@ -256,6 +304,7 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
             weight0 = sun_scatter * transmittance_between(f.medium[0], a0, e0);
             weight1 = sun_scatter * transmittance_between(f.medium[0], a1, e1);
         }
+{%- endif %}
         // Per row, the (up to) two texels the linear fetch reads with a non-zero weight:
         // columns x0 <= x1 of the region (pos lies inside it).
         let xb0 = pos0 - 0.5;
@@ -270,6 +319,66 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         // x1's cover column x0's: one load per row.
         let lohi0 = textureLoad(bounds, vec2<u32>(x01, row0), 0);
         let lohi1 = textureLoad(bounds, vec2<u32>(x11, row1), 0);
+{%- if cookie %}
+        // The region's mean cookie up to the ray's end, per row: the channel's lit share
+        // lies in [0, Cbar].
+        let cbar0 = mix(textureLoad(filtered, vec2<u32>(x00, row0), CBAR, 0), textureLoad(filtered, vec2<u32>(x01, row0), CBAR, 0), fx0).xyz;
+        let cbar1 = mix(textureLoad(filtered, vec2<u32>(x10, row1), CBAR, 0), textureLoad(filtered, vec2<u32>(x11, row1), CBAR, 0), fx1).xyz;
+        var vis0 = 0.5 * cbar0;
+        var vis1 = 0.5 * cbar1;
+{%- if moments %}
+        // Per channel the moments of the cookie-weighted depths: the stored ones over Cbar.
+        for (var c = 0u; c < 3u; c++) {
+            if d > lohi0.x && d <= lohi0.y && cbar0[c] > 0.0 {
+                let m0 = mix(textureLoad(filtered, vec2<u32>(x00, row0), c * LAYERS, 0), textureLoad(filtered, vec2<u32>(x01, row0), c * LAYERS, 0), fx0) / cbar0[c];
+{%- if moment_count == 6 %}
+                let m1 = mix(textureLoad(filtered, vec2<u32>(x00, row0), c * LAYERS + 1u, 0), textureLoad(filtered, vec2<u32>(x01, row0), c * LAYERS + 1u, 0), fx0) / cbar0[c];
+                vis0[c] = cbar0[c] * lit_moments6(m0, m1.xy, zf);
+{%- else %}
+                vis0[c] = cbar0[c] * lit_moments4(m0, zf);
+{%- endif %}
+            }
+            if d > lohi1.x && d <= lohi1.y && cbar1[c] > 0.0 {
+                let m0 = mix(textureLoad(filtered, vec2<u32>(x10, row1), c * LAYERS, 0), textureLoad(filtered, vec2<u32>(x11, row1), c * LAYERS, 0), fx1) / cbar1[c];
+{%- if moment_count == 6 %}
+                let m1 = mix(textureLoad(filtered, vec2<u32>(x10, row1), c * LAYERS + 1u, 0), textureLoad(filtered, vec2<u32>(x11, row1), c * LAYERS + 1u, 0), fx1) / cbar1[c];
+                vis1[c] = cbar1[c] * lit_moments6(m0, m1.xy, zf);
+{%- else %}
+                vis1[c] = cbar1[c] * lit_moments4(m0, zf);
+{%- endif %}
+            }
+        }
+{%- else %}
+        if (d > lohi0.x && d <= lohi0.y) || (d > lohi1.x && d <= lohi1.y) {
+            for (var layer = 0u; layer < LAYERS; layer++) {
+                let coeff = coeffs[layer];
+                for (var c = 0u; c < 3u; c++) {
+                    let texel0 = mix(textureLoad(filtered, vec2<u32>(x00, row0), c * LAYERS + layer, 0), textureLoad(filtered, vec2<u32>(x01, row0), c * LAYERS + layer, 0), fx0);
+                    let texel1 = mix(textureLoad(filtered, vec2<u32>(x10, row1), c * LAYERS + layer, 0), textureLoad(filtered, vec2<u32>(x11, row1), c * LAYERS + layer, 0), fx1);
+                    for (var k = 0u; k < 4u; k++) {
+                        vis0[c] += coeff[k] * (texel0[k] * 2.0 - 1.0);
+                        vis1[c] += coeff[k] * (texel1[k] * 2.0 - 1.0);
+                    }
+                }
+            }
+        }
+{%- endif %}
+        // Outside the row's depth range the region is exactly lit (the mean cookie) or
+        // shadowed.
+        vis0 = select(select(vis0, vec3<f32>(0.0), d > lohi0.y), cbar0, d <= lohi0.x);
+        vis1 = select(select(vis1, vec3<f32>(0.0), d > lohi1.y), cbar1, d <= lohi1.x);
+        // The region's cookie-weighted lit fraction (the lit share over the mean cookie)
+        // times the pixel's own integral with the cookie: exact where the region is wholly
+        // lit or shadowed, whatever the cookie does along the ray.
+        let frac0 = select(vec3<f32>(0.0), clamp(vis0, vec3<f32>(0.0), cbar0) / cbar0, cbar0 > vec3<f32>(0.0));
+        let frac1 = select(vec3<f32>(0.0), clamp(vis1, vec3<f32>(0.0), cbar1) / cbar1, cbar1 > vec3<f32>(0.0));
+        if !done0 {
+            total0 += weight0 * frac0;
+        }
+        if !done1 {
+            total1 += weight1 * frac1;
+        }
+{%- else %}
         var vis0 = 0.5;
         var vis1 = 0.5;
 {%- if moments %}
@@ -315,6 +424,7 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         if !done1 {
             total1 += weight1 * clamp(vis1, 0.0, 1.0);
         }
+{%- endif %}
         done0 = done0 || is_last0;
         done1 = done1 || is_last1;
         if done0 && done1 {

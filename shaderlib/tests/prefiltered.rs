@@ -15,8 +15,9 @@ use scatter_shaderlib::prefiltered::{
 use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams, ShaderError, build, render};
 
 /// Every valid variant: bases {4, .., 128} x every bases_per_thread x regions 1..=8 x
-/// visibility x light x storage x rectification, and the moment basis (4 or 6 moments) x
-/// regions x visibility x light x rectification.
+/// visibility x light x storage x rectification, the moment basis (4 or 6 moments) x
+/// regions x visibility x light x rectification, and the spot's cookie (3 bases x visibility
+/// x rectification).
 fn cross_product() -> Vec<PrefilteredVariant> {
     PrefilteredVariant::grid(PrefilteredVariant::REGIONS)
 }
@@ -29,8 +30,8 @@ fn full_cross_product_validates() {
     let variants = cross_product();
     assert_eq!(
         variants.len(),
-        21 * 8 * 2 * 2 * 3 * 2 + 2 * 8 * 2 * 2 * 2,
-        "21 (bases, bases_per_thread) pairs; 2 moment counts (rgba32float only)"
+        21 * 8 * 2 * 2 * 3 * 2 + 2 * 8 * 2 * 2 * 2 + 3 * 2 * 2,
+        "21 (bases, bases_per_thread) pairs; 2 moment counts (rgba32float only); cookies"
     );
     let start = Instant::now();
     // (kernel, rendered source) -> first parameter set that produced it.
@@ -73,8 +74,12 @@ fn full_cross_product_validates() {
         "rectify depends on the light only"
     );
     // Scatter: the Fourier layer counts (6 bases values) and the 2 moment counts, each x
-    // regions x visibility x light x rectification.
-    assert_eq!(per_kernel[&Kernel::Scatter], (6 + 2) * 8 * 2 * 2 * 2);
+    // regions x visibility x light x rectification; the cookie's 3 bases x visibility x
+    // rectification.
+    assert_eq!(
+        per_kernel[&Kernel::Scatter],
+        (6 + 2) * 8 * 2 * 2 * 2 + 3 * 2 * 2
+    );
     assert_eq!(per_kernel[&Kernel::Prefilter], variants.len());
     eprintln!(
         "{} variants, {rendered} kernels rendered in {:.2?}; {total} distinct sources \

@@ -31,6 +31,7 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_shaderlib::family::{Family, FamilyVariant};
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind};
+use scatter_shaderlib::prefiltered::PrefilteredVariant;
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
 const SCREEN: [u32; 2] = [96, 54];
@@ -205,15 +206,13 @@ fn the_truth_converges_with_a_cookie() {
 }
 
 /// The families' `cookie` variants: each family's default with the knob on, where the family
-/// has it.
+/// has it, and prefiltered's moment basis (4 moments) beside its Fourier default.
 fn cookie_variants() -> Vec<FamilyVariant> {
     Family::ALL
         .iter()
-        .filter_map(|f| {
-            f.default_variant()
-                .with_light(LightKind::Spot)
-                .with_cookie(true)
-        })
+        .map(|f| f.default_variant())
+        .chain([FamilyVariant::from(PrefilteredVariant::with_moments(4))])
+        .filter_map(|v| v.with_light(LightKind::Spot).with_cookie(true))
         .collect()
 }
 

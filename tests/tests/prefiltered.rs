@@ -79,6 +79,27 @@ fn fixture(light: LightKind, rectification: Rectification) -> &'static Fixture {
     cell.get_or_init(|| Fixture::new(name, pose, SCREEN, SHADOW_MAP))
 }
 
+/// The fixture of `variant`: its light's and rectification's, with the `stained_glass`
+/// cookie (64^2) on the spot for a `cookie` variant (built once per rectification).
+fn variant_fixture(variant: &PrefilteredVariant) -> &'static Fixture {
+    static EPIPOLAR: OnceLock<Fixture> = OnceLock::new();
+    static PROJECTIVE: OnceLock<Fixture> = OnceLock::new();
+    let plain = fixture(variant.light, variant.rectification);
+    if !variant.cookie {
+        return plain;
+    }
+    let cell = match variant.rectification {
+        Rectification::Epipolar => &EPIPOLAR,
+        Rectification::Projective => &PROJECTIVE,
+    };
+    cell.get_or_init(|| {
+        plain.with_cookie(
+            scatter_reference::cookie::Cookie::pattern("stained_glass", 64)
+                .expect("a built-in pattern"),
+        )
+    })
+}
+
 fn for_light(light: LightKind) -> &'static Fixture {
     fixture(light, Rectification::Epipolar)
 }
@@ -94,7 +115,7 @@ fn cpu_inputs(f: &Fixture) -> CpuInputs {
         shadow_map: f.shadow_map.depth.clone(),
         rectified: None,
         pass_wall_frames: 0,
-        cookie: None,
+        cookie: f.cookie(),
     }
 }
 
@@ -317,7 +338,7 @@ fn describe(what: &str, w: &Worst, layout: impl Fn(usize) -> String) -> String {
 /// tolerance.
 fn conformance(variant: &PrefilteredVariant) -> Result<(), String> {
     let Some(ctx) = gpu() else { return Ok(()) };
-    compare(ctx, variant, fixture(variant.light, variant.rectification))
+    compare(ctx, variant, variant_fixture(variant))
 }
 
 /// `slice_fit` where it changes the slice table: the light's fixture with its depth buffer

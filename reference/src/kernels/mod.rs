@@ -120,8 +120,14 @@ pub fn run_prefiltered(
         },
         None => rectify::rectify(&frame.uniforms, &frame.slices, &sm, spot),
     };
-    let prefilter::PrefilterOutput { filtered, bounds } =
-        prefilter::prefilter(variant, &frame.uniforms, &frame.slices, &rectified);
+    let cookie = variant.cookie.then(|| cookie_texture(scene)).flatten();
+    let prefilter::PrefilterOutput { filtered, bounds } = prefilter::prefilter(
+        variant,
+        &frame.uniforms,
+        &frame.slices,
+        &rectified,
+        cookie.as_ref(),
+    );
     let out = scatter::scatter(
         variant,
         &scatter::ScatterInputs {
@@ -131,6 +137,7 @@ pub fn run_prefiltered(
             shadow_map: &sm,
             filtered: &filtered,
             bounds: &bounds,
+            cookie: cookie.as_ref(),
         },
     );
     let output = Image::from_pixels(

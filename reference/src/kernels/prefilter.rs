@@ -11,20 +11,52 @@
 //! ray inside the region, so no weight sums need to be stored. Thread 0 of a row-region also
 //! stores the least and the greatest depth over the region up to the texel (`bounds`,
 //! rg32float on the GPU; here a one-layer array of `[min, max, 0, 0]`).
+//!
+//! With a cookie (`cookie = true`, see the WGSL comment) each texel's light ray carries the
+//! cookie `C_i` ([`texel_cookie`]): per channel `c` the running means of `C_i^c` times the
+//! basis in layers `c * layers + q`, and thread 0 the region's mean cookie in layer
+//! `3 * layers`.
 
+use super::common_cookie::frame_cookie;
+use super::common_epipolar::{row_phi, slice_e};
 use super::common_model::PI;
 use super::common_model::select;
 use super::common_moments::{moment_layer, moment_z};
 use super::common_prefiltered::{basis4, fourier_step, region_start, texel_weight, turn};
-use super::common_prefiltered_projective::proj_texel_weight;
+use super::common_prefiltered_projective::{proj_region_g, proj_texel_weight};
 use super::common_projective::proj_stored_depth;
-use super::texture::{Tex, TexArray};
+use super::texture::{Tex, TexArray, xyz};
+use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
     Basis, FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, Storage,
     VisibilityMode,
 };
 
-/// The kernel body for invocation `id` = (row, region, thread).
+/// The cookie of texel `i` of a row (slice `slice`, slice direction `e`; in a projective
+/// frame column `i` of region `region`): that of the light ray through the texel's centre
+/// (see the WGSL comment).
+#[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+pub fn texel_cookie(
+    frame: &FrameUniforms,
+    cookie: &TexArray,
+    regions: u32,
+    i: u32,
+    slice: &SliceParams,
+    e: Vec3,
+    region: u32,
+    proj: bool,
+) -> Vec3 {
+    let col = (i as f32 + 0.5) * slice.delta;
+    let mut l = -xyz(frame.axis) * col.cos() + e * col.sin();
+    if proj {
+        let g = proj_region_g(frame, i as f32 + 0.5, region, regions, frame.sizes[2], true);
+        l = xyz(frame.e1) + xyz(frame.e2) * slice.delta - xyz(frame.axis) * g;
+    }
+    frame_cookie(frame, cookie, xyz(frame.light_pos) + l)
+}
+
+/// The kernel body for invocation `id` = (row, region, thread); `cookie` for a `cookie`
+/// variant.
 #[allow(clippy::too_many_arguments, reason = "bindings of the kernel")]
 pub fn prefilter_main(
     id: [u32; 3],
@@ -34,6 +66,7 @@ pub fn prefilter_main(
     rectified: &Tex,
     filtered: &mut TexArray,
     bounds: &mut TexArray,
+    cookie: Option<&TexArray>,
 ) {
     let (row, region, thread) = (id[0], id[1], id[2]);
     let width = frame.sizes[2];
@@ -51,7 +84,13 @@ pub fn prefilter_main(
     let slice = slices[row as usize];
     let start = region_start(region, variant.regions, width, spot);
     let end = region_start(region + 1, variant.regions, width, spot);
-    let mut acc = vec![[0.0f32; 4]; layers_per_thread as usize];
+    let tinted = variant.cookie;
+    let layers = variant.layers();
+    let e = slice_e(frame, row_phi(frame, row));
+    // With a cookie, channel c's layer q of this thread at c * layers_per_thread + q.
+    let channels = if tinted { 3 } else { 1 };
+    let mut acc = vec![[0.0f32; 4]; (channels * layers_per_thread) as usize];
+    let mut tint_mean = Vec3::ZERO;
     let mut wsum = 0.0f32;
     let mut lo = 1e30f32;
     let mut hi = -1e30f32;
@@ -71,16 +110,39 @@ pub fn prefilter_main(
             bounds.store(i, row, 0, [lo, hi, 0.0, 0.0], Storage::Rgba32float);
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);
+        let mut tint = Vec3::ONE;
+        if tinted {
+            if let Some(cookie) = cookie {
+                tint = texel_cookie(frame, cookie, variant.regions, i, &slice, e, region, proj);
+            }
+            if thread == 0 {
+                tint_mean = tint_mean * (1.0 - blend) + tint * blend;
+                let t = [tint_mean.x, tint_mean.y, tint_mean.z, 1.0];
+                filtered.store(i, row, 3 * layers, t, variant.storage);
+            }
+        }
+        // The running means of channel `c`'s `b` (the basis times the cookie; without a
+        // cookie the basis itself, as `a (1 - blend) + b blend`).
+        let mut update = |c: u32, q: u32, b: [f32; 4]| -> [f32; 4] {
+            let a = &mut acc[(c * layers_per_thread + q) as usize];
+            for k in 0..4 {
+                a[k] = if tinted {
+                    a[k] * (1.0 - blend) + b[k] * (tint[c as usize] * blend)
+                } else {
+                    a[k] * (1.0 - blend) + b[k] * blend
+                };
+            }
+            *a
+        };
         if moments {
             // The power moments of z, stored as they are.
             let z = moment_z(d);
             for q in 0..layers_per_thread {
                 let b = moment_layer(z, q);
-                let a = &mut acc[q as usize];
-                for c in 0..4 {
-                    a[c] = a[c] * (1.0 - blend) + b[c] * blend;
+                for c in 0..channels {
+                    let a = update(c, q, b);
+                    filtered.store(i, row, c * layers + q, a, variant.storage);
                 }
-                filtered.store(i, row, q, *a, variant.storage);
             }
             continue;
         }
@@ -95,17 +157,16 @@ pub fn prefilter_main(
             let second = turn(angle, step);
             let b = basis4(angle, second);
             angle = turn(second, step);
-            let a = &mut acc[q as usize];
-            for c in 0..4 {
-                a[c] = a[c] * (1.0 - blend) + b[c] * blend;
+            for c in 0..channels {
+                let a = update(c, q, b);
+                let stored = [
+                    a[0] * 0.5 + 0.5,
+                    a[1] * 0.5 + 0.5,
+                    a[2] * 0.5 + 0.5,
+                    a[3] * 0.5 + 0.5,
+                ];
+                filtered.store(i, row, c * layers + layer, stored, variant.storage);
             }
-            let stored = [
-                a[0] * 0.5 + 0.5,
-                a[1] * 0.5 + 0.5,
-                a[2] * 0.5 + 0.5,
-                a[3] * 0.5 + 0.5,
-            ];
-            filtered.store(i, row, layer, stored, variant.storage);
         }
     }
 }
@@ -120,14 +181,17 @@ pub struct PrefilterOutput {
 }
 
 /// Runs every invocation; returns the filtered-basis array and the region-prefix bounds.
+/// `cookie`: the spot's cookie texture for a `cookie` variant (ignored otherwise; a `cookie`
+/// variant without one filters as with a white cookie).
 pub fn prefilter(
     variant: &PrefilteredVariant,
     frame: &FrameUniforms,
     slices: &[SliceParams],
     rectified: &Tex,
+    cookie: Option<&TexArray>,
 ) -> PrefilterOutput {
     let (w, h) = (frame.sizes[2], frame.sizes[3]);
-    let mut filtered = TexArray::new(w, h, variant.layers());
+    let mut filtered = TexArray::new(w, h, variant.filtered_layers());
     let mut bounds = TexArray::new(w, h, 1);
     for row in 0..h {
         for region in 0..variant.regions {
@@ -140,6 +204,7 @@ pub fn prefilter(
                     rectified,
                     &mut filtered,
                     &mut bounds,
+                    cookie,
                 );
             }
         }

@@ -14,7 +14,12 @@
 //! every region count: along a ray towards the sun the shadowed part lies near the eye.
 //! Where the ray's depth `d` is at most the least depth of the texels the fetch reads
 //! (`prefilter`'s bounds), `Vbar_j = 1` exactly; above the greatest, `Vbar_j = 0`.
+//!
+//! With a cookie (see the WGSL comment) each channel's lit share is reconstructed from its
+//! own layers with the region's mean cookie `Cbar^c` in place of 1, and the epipole march
+//! carries the cookie per sample.
 
+use super::common_cookie::{epipole_march_cookie, spot_segment_cookie};
 use super::common_epipolar::{
     epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_t, row_index,
     spot_segment,
@@ -47,6 +52,8 @@ pub struct ScatterInputs<'a> {
     pub filtered: &'a TexArray,
     /// Region-prefix depth bounds `[min, max, 0, 0]` (from `prefilter`, one layer).
     pub bounds: &'a TexArray,
+    /// The spot's cookie, for a `cookie` variant (`None`: a white cookie).
+    pub cookie: Option<&'a TexArray>,
 }
 
 /// The kernel body for pixel `id`; returns the rgba16float texel it stores.
@@ -75,8 +82,20 @@ pub fn scatter_main(
         f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
     let near_anti = f.anti_epipole[2] > 0.5
         && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
+    let tinted = variant.cookie;
+    let white = TexArray {
+        width: 1,
+        height: 1,
+        layers: 1,
+        data: vec![[1.0; 4]],
+    };
+    let cookie = inp.cookie.unwrap_or(&white);
     if near_epi || near_anti {
-        let l = epipole_march(f, inp.shadow_map, eye, dir, s, spot) * color;
+        let l = if tinted {
+            epipole_march_cookie(f, inp.shadow_map, cookie, eye, dir, s) * color
+        } else {
+            epipole_march(f, inp.shadow_map, eye, dir, s, spot) * color
+        };
         return Some([l.x, l.y, l.z, 1.0]);
     }
 
@@ -170,7 +189,7 @@ pub fn scatter_main(
     }
     let last0 = min(max(xs0, 0.0), width as f32 - 1.0) as u32;
     let last1 = min(max(xs1, 0.0), width as f32 - 1.0) as u32;
-    let (mut total0, mut total1) = (0.0, 0.0);
+    let (mut total0, mut total1) = (Vec3::ZERO, Vec3::ZERO);
     let (mut done0, mut done1) = (false, false);
     for r in 0..regions {
         let b0 = region_start(r, regions, width, spot) as f32;
@@ -217,7 +236,23 @@ pub fn scatter_main(
                 sun_scatter * transmittance_between(f.medium[0], a, e)
             }
         };
-        let (weight0, weight1) = (weight_of(a0, e0), weight_of(a1, e1));
+        // With a cookie: the pixel's own unshadowed integral with the cookie (RGB), for the
+        // rows not yet done.
+        let (weight0, weight1) = if tinted {
+            let with_cookie = |done: bool, a: f32, e: f32| {
+                if done {
+                    Vec3::ZERO
+                } else {
+                    spot_segment_cookie(f, cookie, eye, dir, a, e, panels)
+                }
+            };
+            (with_cookie(done0, a0, e0), with_cookie(done1, a1, e1))
+        } else {
+            (
+                Vec3::splat(weight_of(a0, e0)),
+                Vec3::splat(weight_of(a1, e1)),
+            )
+        };
         // Per row, the (up to) two texels the linear fetch reads with a non-zero weight:
         // columns x0 <= x1 of the region.
         let texels = |pos: f32| {
@@ -238,57 +273,70 @@ pub fn scatter_main(
         let lohi0 = inp.bounds.load(x01, row0, 0);
         let lohi1 = inp.bounds.load(x11, row1, 0);
         let ambiguous = |lohi: [f32; 4]| d > lohi[0] && d <= lohi[1];
-        let (mut vis0, mut vis1) = (0.5, 0.5);
-        if moments {
-            // The region's moments, filtered linearly along each row.
-            let lit = |x0: u32, x1: u32, fx: f32, row: u32| {
-                let fetch = |layer: u32| {
-                    let load = |x: u32| inp.filtered.load(x, row, layer);
-                    mix4(load(x0), load(x1), fx)
+        let (add0, add1) = if tinted {
+            tinted_region(
+                inp,
+                variant,
+                [(x00, x01, fx0, row0), (x10, x11, fx1, row1)],
+                [lohi0, lohi1],
+                d,
+                zf,
+                &coeffs,
+            )
+        } else {
+            let (mut vis0, mut vis1) = (0.5, 0.5);
+            if moments {
+                // The region's moments, filtered linearly along each row.
+                let lit = |x0: u32, x1: u32, fx: f32, row: u32| {
+                    let fetch = |layer: u32| {
+                        let load = |x: u32| inp.filtered.load(x, row, layer);
+                        mix4(load(x0), load(x1), fx)
+                    };
+                    let m0 = fetch(0);
+                    if variant.moments == 6 {
+                        let m1 = fetch(1);
+                        lit_moments6(m0, [m1[0], m1[1]], zf)
+                    } else {
+                        lit_moments4(m0, zf)
+                    }
                 };
-                let m0 = fetch(0);
-                if variant.moments == 6 {
-                    let m1 = fetch(1);
-                    lit_moments6(m0, [m1[0], m1[1]], zf)
+                if ambiguous(lohi0) {
+                    vis0 = lit(x00, x01, fx0, row0);
+                }
+                if ambiguous(lohi1) {
+                    vis1 = lit(x10, x11, fx1, row1);
+                }
+            } else if ambiguous(lohi0) || ambiguous(lohi1) {
+                for layer in 0..variant.layers() {
+                    let coeff = coeffs[layer as usize];
+                    let load = |x: u32, row: u32| inp.filtered.load(x, row, layer);
+                    let texel0 = mix4(load(x00, row0), load(x01, row0), fx0);
+                    let texel1 = mix4(load(x10, row1), load(x11, row1), fx1);
+                    for k in 0..4 {
+                        vis0 += coeff[k] * (texel0[k] * 2.0 - 1.0);
+                        vis1 += coeff[k] * (texel1[k] * 2.0 - 1.0);
+                    }
+                }
+            }
+            // Outside the row's depth range the region is exactly lit or shadowed.
+            let exact = |vis: f32, lohi: [f32; 4]| {
+                if d <= lohi[0] {
+                    1.0
+                } else if d > lohi[1] {
+                    0.0
                 } else {
-                    lit_moments4(m0, zf)
+                    vis
                 }
             };
-            if ambiguous(lohi0) {
-                vis0 = lit(x00, x01, fx0, row0);
-            }
-            if ambiguous(lohi1) {
-                vis1 = lit(x10, x11, fx1, row1);
-            }
-        } else if ambiguous(lohi0) || ambiguous(lohi1) {
-            for layer in 0..variant.layers() {
-                let coeff = coeffs[layer as usize];
-                let load = |x: u32, row: u32| inp.filtered.load(x, row, layer);
-                let texel0 = mix4(load(x00, row0), load(x01, row0), fx0);
-                let texel1 = mix4(load(x10, row1), load(x11, row1), fx1);
-                for k in 0..4 {
-                    vis0 += coeff[k] * (texel0[k] * 2.0 - 1.0);
-                    vis1 += coeff[k] * (texel1[k] * 2.0 - 1.0);
-                }
-            }
-        }
-        // Outside the row's depth range the region is exactly lit or shadowed.
-        let exact = |vis: f32, lohi: [f32; 4]| {
-            if d <= lohi[0] {
-                1.0
-            } else if d > lohi[1] {
-                0.0
-            } else {
-                vis
-            }
+            vis0 = exact(vis0, lohi0);
+            vis1 = exact(vis1, lohi1);
+            (Vec3::splat(clamp(vis0, 0.0, 1.0)), Vec3::splat(clamp(vis1, 0.0, 1.0)))
         };
-        vis0 = exact(vis0, lohi0);
-        vis1 = exact(vis1, lohi1);
         if !done0 {
-            total0 += weight0 * clamp(vis0, 0.0, 1.0);
+            total0 += weight0 * add0;
         }
         if !done1 {
-            total1 += weight1 * clamp(vis1, 0.0, 1.0);
+            total1 += weight1 * add1;
         }
         done0 = done0 || is_last0;
         done1 = done1 || is_last1;
@@ -300,6 +348,78 @@ pub fn scatter_main(
     let l = total;
     let c = color * l;
     Some([c.x, c.y, c.z, 1.0])
+}
+
+/// A region's cookie-weighted lit fraction per colour channel, for both rows (`texels`: each
+/// row's two columns, the second's weight and the row; `lohi`: their depth bounds): the lit
+/// share clamped to [0, Cbar] over Cbar, 0 where Cbar is (see the WGSL comment).
+fn tinted_region(
+    inp: &ScatterInputs,
+    variant: &PrefilteredVariant,
+    texels: [(u32, u32, f32, u32); 2],
+    lohi: [[f32; 4]; 2],
+    d: f32,
+    zf: f32,
+    coeffs: &[[f32; 4]],
+) -> (Vec3, Vec3) {
+    let layers = variant.layers();
+    let fetch = |(x0, x1, fx, row): (u32, u32, f32, u32), layer: u32| {
+        mix4(
+            inp.filtered.load(x0, row, layer),
+            inp.filtered.load(x1, row, layer),
+            fx,
+        )
+    };
+    let cbar = texels.map(|t| {
+        let c = fetch(t, 3 * layers);
+        Vec3::new(c[0], c[1], c[2])
+    });
+    let mut vis = cbar.map(|c| 0.5 * c);
+    let ambiguous = |lohi: [f32; 4]| d > lohi[0] && d <= lohi[1];
+    if variant.basis == Basis::Moments {
+        // Per channel the moments of the cookie-weighted depths: the stored ones over Cbar.
+        for c in 0..3 {
+            for row in 0..2 {
+                let cb = cbar[row][c];
+                if ambiguous(lohi[row]) && cb > 0.0 {
+                    let m0 = fetch(texels[row], c as u32 * layers).map(|v| v / cb);
+                    vis[row][c] = cb
+                        * if variant.moments == 6 {
+                            let m1 = fetch(texels[row], c as u32 * layers + 1).map(|v| v / cb);
+                            lit_moments6(m0, [m1[0], m1[1]], zf)
+                        } else {
+                            lit_moments4(m0, zf)
+                        };
+                }
+            }
+        }
+    } else if ambiguous(lohi[0]) || ambiguous(lohi[1]) {
+        for layer in 0..layers {
+            let coeff = coeffs[layer as usize];
+            for c in 0..3 {
+                let texel = texels.map(|t| fetch(t, c * layers + layer));
+                for k in 0..4 {
+                    for row in 0..2 {
+                        vis[row][c as usize] += coeff[k] * (texel[row][k] * 2.0 - 1.0);
+                    }
+                }
+            }
+        }
+    }
+    // Outside the row's depth range the region is exactly lit (the mean cookie) or shadowed.
+    let fraction = |row: usize| {
+        let v = if d <= lohi[row][0] {
+            cbar[row]
+        } else if d > lohi[row][1] {
+            Vec3::ZERO
+        } else {
+            vis[row]
+        };
+        let c = cbar[row];
+        let f = |v: f32, c: f32| if c > 0.0 { clamp(v, 0.0, c) / c } else { 0.0 };
+        Vec3::new(f(v.x, c.x), f(v.y, c.y), f(v.z, c.z))
+    };
+    (fraction(0), fraction(1))
 }
 
 /// Runs every pixel (rows in parallel), or the samples and the upsample of a sampled

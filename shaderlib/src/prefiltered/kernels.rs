@@ -76,6 +76,10 @@ struct PrefilterTemplate {
     projective: bool,
     moments: bool,
     moment_count: u32,
+    cookie: bool,
+    filtered_layers: u32,
+    cbar_layer: u32,
+    acc_layers: u32,
 }
 
 /// The askama views of `scatter.wgsl` and of the two epipolar passes that render it with
@@ -97,6 +101,9 @@ macro_rules! scatter_templates {
             projective: bool,
             moments: bool,
             moment_count: u32,
+            cookie: bool,
+            filtered_layers: u32,
+            cbar_layer: u32,
             sampling: SamplingView,
         }
 
@@ -114,6 +121,9 @@ macro_rules! scatter_templates {
                     projective: variant.rectification == Rectification::Projective,
                     moments: variant.basis == Basis::Moments,
                     moment_count: variant.moments,
+                    cookie: variant.cookie,
+                    filtered_layers: variant.filtered_layers(),
+                    cbar_layer: 3 * variant.layers(),
                     sampling: scatter_sampling_view(variant, kernel),
                 }
             }
@@ -195,6 +205,10 @@ pub(crate) fn render_prefilter(variant: &PrefilteredVariant) -> Result<String, S
         projective: variant.rectification == Rectification::Projective,
         moments: variant.basis == Basis::Moments,
         moment_count: variant.moments,
+        cookie: variant.cookie,
+        filtered_layers: variant.filtered_layers(),
+        cbar_layer: 3 * variant.layers(),
+        acc_layers: 3 * variant.per_thread().div_ceil(4),
     }
     .render()
     .map_err(render_error(Kernel::Prefilter))

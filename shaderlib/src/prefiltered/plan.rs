@@ -5,10 +5,10 @@
 use crate::Kernel;
 use crate::family::KernelFamily;
 use crate::plan::{
-    Alternative, BindingSource, DEPTH_FORMAT, Formula, OUTPUT_FORMAT, Parameter, PassPlan, Plan,
-    Resource, SAMPLED, SLICE_FIT_NOTE, STORAGE_AND_SAMPLED, TEXTURE_DIMENSION, bind,
-    column_depth_buffer, depth_and_shadow_map, frame_buffer, scatter_resource, scatter_texture,
-    screen_and_shadow_parameters, texture_2d,
+    Alternative, BindingSource, COOKIE_BINDING, DEPTH_FORMAT, Formula, OUTPUT_FORMAT, Parameter,
+    PassPlan, Plan, Resource, SAMPLED, SLICE_FIT_NOTE, STORAGE_AND_SAMPLED, TEXTURE_DIMENSION,
+    bind, column_depth_buffer, cookie_parameters, cookie_texture, depth_and_shadow_map,
+    frame_buffer, scatter_resource, scatter_texture, screen_and_shadow_parameters, texture_2d,
 };
 use crate::prefiltered::{Basis, PrefilteredVariant, Rectification};
 use crate::sampling::{
@@ -81,7 +81,7 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
                 v.storage.name(),
                 "rectified.width",
                 "rectified.height",
-                &v.layers().to_string(),
+                &v.filtered_layers().to_string(),
                 STORAGE_AND_SAMPLED,
             )),
             ..scatter_resource("filtered", filtered_description(v))
@@ -123,6 +123,10 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
             )
         });
     }
+    if v.cookie {
+        parameters.extend(cookie_parameters());
+        resources.push(cookie_texture());
+    }
     resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
     resources.extend(fallback_buffers(&v.sampling_knobs()));
     // One pass per kernel shaderlib lists for the variant, in its order; a kernel this
@@ -160,18 +164,28 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
     }
 }
 
-/// What the `filtered` texture holds for the variant's basis.
+/// What the `filtered` texture holds for the variant's basis (and cookie).
 fn filtered_description(v: &PrefilteredVariant) -> &'static str {
-    match (v.basis, v.moments) {
-        (Basis::Fourier, _) => {
+    match (v.basis, v.moments, v.cookie) {
+        (Basis::Fourier, _, true) => {
+            "per colour channel c, the filtered Fourier bases times the spot's cookie, four \
+             per layer, in layers c * bases / 4 .., stored as F / 2 + 0.5; the region's mean \
+             cookie (rgb) in the last layer (written by prefilter)"
+        }
+        (Basis::Moments, _, true) => {
+            "per colour channel c, the filtered power moments of z = 2 d - 1 times the spot's \
+             cookie in layers c * ceil(moments / 4) .., stored as they are; the region's mean \
+             cookie (rgb) in the last layer (written by prefilter)"
+        }
+        (Basis::Fourier, _, false) => {
             "filtered Fourier bases, four per layer, stored as F / 2 + 0.5 (written by \
              prefilter); view it as a 2d array even with one layer"
         }
-        (Basis::Moments, 6) => {
+        (Basis::Moments, 6, false) => {
             "filtered power moments of z = 2 d - 1, (z, z^2, z^3, z^4) in layer 0 and \
              (z^5, z^6, 0, 0) in layer 1, stored as they are (written by prefilter)"
         }
-        (Basis::Moments, _) => {
+        (Basis::Moments, _, false) => {
             "filtered power moments of z = 2 d - 1, (z, z^2, z^3, z^4), stored as they are \
              (written by prefilter); view it as a 2d array even with one layer"
         }
@@ -214,7 +228,7 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                 v.threads_per_row_region().to_string(),
             ],
             skip_when: None,
-            bindings: vec![
+            bindings: [
                 bind(0, "frame"),
                 bind(1, "slices"),
                 BindingSource {
@@ -227,7 +241,10 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                 },
                 bind(3, "filtered"),
                 bind(4, "bounds"),
-            ],
+            ]
+            .into_iter()
+            .chain(v.cookie.then(|| bind(COOKIE_BINDING, "cookie")))
+            .collect(),
         }),
         Kernel::Scatter => Some(sampled_pass(
             &v.sampling_knobs(),
@@ -235,7 +252,7 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations(&v.sampling_knobs()),
                 skip_when: None,
-                bindings: vec![
+                bindings: [
                     bind(0, "frame"),
                     bind(1, "slices"),
                     bind(2, "depth"),
@@ -250,7 +267,10 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                     bind(4, "filtered"),
                     bind(5, sampled_output(&v.sampling_knobs())),
                     bind(6, "bounds"),
-                ],
+                ]
+                .into_iter()
+                .chain(v.cookie.then(|| bind(COOKIE_BINDING, "cookie")))
+                .collect(),
             },
             7,
         )),
