@@ -126,8 +126,8 @@ pub enum RuntimeError {
     },
     /// A cookie was given to a variant that does not read one.
     #[error(
-        "variant {variant} reads no cookie: only a variant with cookie = true (raymarch, \
-         light = spot) takes one"
+        "variant {variant} reads no cookie: only a variant with cookie = true and light = \
+         spot (prefiltered, raymarch, minmax, hybrid_volume) takes one"
     )]
     NoCookie {
         /// The variant's id.

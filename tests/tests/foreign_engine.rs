@@ -57,8 +57,8 @@ const SHADOW_MAP: u32 = 256;
 /// The bound: `max |foreign - runtime| <= REL_TOL * max radiance`.
 const REL_TOL: f32 = 1e-4;
 
-/// The four trial variants.
-fn variants() -> [PrefilteredVariant; 4] {
+/// The five trial variants (the last with the spot's cookie).
+fn variants() -> [PrefilteredVariant; 5] {
     [
         PrefilteredVariant::default(),
         PrefilteredVariant {
@@ -76,6 +76,11 @@ fn variants() -> [PrefilteredVariant; 4] {
         PrefilteredVariant {
             light: LightKind::Spot,
             ..PrefilteredVariant::with_moments(6)
+        },
+        PrefilteredVariant {
+            light: LightKind::Spot,
+            cookie: true,
+            ..PrefilteredVariant::default()
         },
     ]
 }
@@ -212,7 +217,9 @@ fn compare(foreign: &[[f32; 4]], runtime: &[[f32; 4]]) -> (f32, f32, usize) {
 }
 
 fn trial(ctx: &Context, variant: &PrefilteredVariant) -> Vec<String> {
-    let fixture = fixture(variant.light);
+    let fixture = fixture_for(variant.light, variant.cookie);
+    let cookie = fixture.cookie();
+    let flat_cookie = cookie_texels(fixture);
     let name = format!(
         "foreign::{}::{}::{}",
         variant.id(),
@@ -240,7 +247,7 @@ fn trial(ctx: &Context, variant: &PrefilteredVariant) -> Vec<String> {
             shadow_map: fixture.shadow_map.depth.clone(),
             rectified: rectified.clone(),
             pass_wall_frames: 0,
-            cookie: None,
+            cookie: cookie.clone(),
         },
     )
     .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
@@ -260,7 +267,7 @@ fn trial(ctx: &Context, variant: &PrefilteredVariant) -> Vec<String> {
             shaders,
             &variant.id(),
             target,
-            &fixture.sizes().params(),
+            &cookie_params(fixture.sizes().params(), fixture),
         )
         .unwrap_or_else(|e| panic!("{name}::{target}: load: {e}"));
         let out = run_frame(
@@ -270,7 +277,7 @@ fn trial(ctx: &Context, variant: &PrefilteredVariant) -> Vec<String> {
                 depth: &fixture.gbuf.view_depth,
                 shadow_map: Some(&fixture.shadow_map.depth),
                 rectified_raster: rectified.as_deref(),
-                cookie: None,
+                cookie: flat_cookie.as_deref(),
             },
         )
         .unwrap_or_else(|e| panic!("{name}::{target}: run: {e}"));

@@ -792,7 +792,8 @@ impl Knobs {
             Knobs::Raymarch(v) => v.cookie,
             Knobs::Minmax(v) => v.cookie,
             Knobs::HybridVolume(v) => v.cookie,
-            Knobs::Prefiltered(_) | Knobs::PartialSumTree(_) => false,
+            Knobs::Prefiltered(v) => v.cookie,
+            Knobs::PartialSumTree(_) => false,
         }
     }
 }
