@@ -872,9 +872,17 @@ fn run_on_gpu(
         }
         FamilyVariant::PartialSumTree(v) => {
             let ctx = &ctx;
+            let cookie = cookie_texels(scene, variant);
             Box::new(move |_| {
-                let rb =
-                    run_partial_sum_tree_once(ctx, v, res, &frame, &gbuf.view_depth, &sm.depth)?;
+                let rb = run_partial_sum_tree_once(
+                    ctx,
+                    v,
+                    res,
+                    &frame,
+                    &gbuf.view_depth,
+                    &sm.depth,
+                    cookie.as_ref().map(|(size, t)| (*size, &t[..])),
+                )?;
                 Ok(GpuFrame {
                     output: rb.output,
                     report: Some(rb.frame.frame.report),

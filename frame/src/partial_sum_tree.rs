@@ -100,6 +100,12 @@ pub struct PartialSumTreeVariant {
     pub slice_samples: u32,
     /// Must be 1: the sweep answers every sample of its slice.
     pub step: u32,
+    /// A spot light's cookie ([`crate::cookie`]; `light = spot` only). It is constant along
+    /// each light ray, so it multiplies each column's leaf: per colour channel its own leaf
+    /// (the column's quadrature over its light rays with the cookie at each node), three
+    /// times the leaf and tree entries, and the last partial column with the cookie.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub cookie: bool,
 }
 
 impl Default for PartialSumTreeVariant {
@@ -115,6 +121,7 @@ impl Default for PartialSumTreeVariant {
             slices: SamplingKnobs::DEFAULT_SLICES,
             slice_samples: SamplingKnobs::DEFAULT_SLICE_SAMPLES,
             step: 1,
+            cookie: false,
         }
     }
 }
@@ -149,21 +156,25 @@ impl PartialSumTreeVariant {
                     .into(),
             });
         }
-        self.sampling_knobs().validate()
+        self.sampling_knobs().validate()?;
+        crate::cookie::validate_cookie(self.cookie, self.light)
     }
 
-    /// A short stable id: `directional-r4-epi512x256-s1-b10-l20`.
+    /// A short stable id: `directional-r4-epi512x256-s1-b10-l20`, with a cookie
+    /// `spot-cookie-r4-epi512x256-s1-b10-l20`.
     pub fn id(&self) -> String {
         format!(
-            "{}-r{}{}",
+            "{}{}-r{}{}",
             self.light.name(),
+            crate::cookie::id_suffix(self.cookie),
             self.rank,
             self.sampling_knobs().id_suffix()
         )
     }
 
-    /// The conformance grid: both lights at rank 4 and 8 (8: two vec4 per leaf), and the
-    /// directional light at rank 1; 64 slices x 64 samples (the conformance screens are small).
+    /// The conformance grid: both lights at rank 4 and 8 (8: two vec4 per leaf), the
+    /// directional light at rank 1 and the spot with its cookie at rank 4; 64 slices x 64
+    /// samples (the conformance screens are small).
     pub fn grid() -> Vec<PartialSumTreeVariant> {
         let small = |light, rank| PartialSumTreeVariant {
             light,
@@ -178,6 +189,10 @@ impl PartialSumTreeVariant {
             small(LightKind::Spot, 4),
             small(LightKind::Directional, 8),
             small(LightKind::Spot, 8),
+            PartialSumTreeVariant {
+                cookie: true,
+                ..small(LightKind::Spot, 4)
+            },
         ]
     }
 
@@ -192,9 +207,19 @@ impl PartialSumTreeVariant {
         }
     }
 
-    /// vec4s per leaf and tree node: `ceil(rank / 4)`.
+    /// vec4s of the rank's factors: `ceil(rank / 4)`.
     pub fn rank_vecs(&self) -> u32 {
         self.rank.div_ceil(4)
+    }
+
+    /// vec4s per leaf and tree node: [`Self::rank_vecs`], three times that with a cookie (one
+    /// leaf per colour channel, channel `c` at `c * rank_vecs ..`).
+    pub fn leaf_vecs(&self) -> u32 {
+        if self.cookie {
+            3 * self.rank_vecs()
+        } else {
+            self.rank_vecs()
+        }
     }
 }
 
@@ -226,9 +251,14 @@ impl KnobSet for PartialSumTreeVariant {
         Self { light, ..self }
     }
 
-    /// `r4-ep512` (the rank, then the sampling's marker).
+    /// `r4-ep512` (the rank, `-cookie` with a cookie, then the sampling's marker).
     fn marker(&self) -> String {
-        format!("r{}{}", self.rank, self.sampling_knobs().marker_suffix())
+        format!(
+            "r{}{}{}",
+            self.rank,
+            crate::cookie::id_suffix(self.cookie),
+            self.sampling_knobs().marker_suffix()
+        )
     }
 
     fn sampling(&self) -> SamplingKnobs {
@@ -241,6 +271,14 @@ impl KnobSet for PartialSumTreeVariant {
 
     fn grid() -> Vec<Self> {
         PartialSumTreeVariant::grid()
+    }
+
+    fn cookie(&self) -> bool {
+        self.cookie
+    }
+
+    fn with_cookie(self, cookie: bool) -> Option<Self> {
+        Some(Self { cookie, ..self })
     }
 }
 

@@ -386,8 +386,15 @@ impl PrefilteredVariant {
         }
         // The spot with its cookie: each basis, both visibilities and both rectifications at
         // the paper's bases (m32) and the default region count where it is in range.
-        let r = regions.clone().find(|r| *r == 3).unwrap_or(*regions.start());
-        for base in [Self::default(), Self::with_moments(4), Self::with_moments(6)] {
+        let r = regions
+            .clone()
+            .find(|r| *r == 3)
+            .unwrap_or(*regions.start());
+        for base in [
+            Self::default(),
+            Self::with_moments(4),
+            Self::with_moments(6),
+        ] {
             for &visibility in VisibilityMode::ALL {
                 for &rectification in Rectification::ALL {
                     out.push(PrefilteredVariant {

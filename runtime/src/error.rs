@@ -127,7 +127,7 @@ pub enum RuntimeError {
     /// A cookie was given to a variant that does not read one.
     #[error(
         "variant {variant} reads no cookie: only a variant with cookie = true and light = \
-         spot (prefiltered, raymarch, minmax, hybrid_volume) takes one"
+         spot takes one"
     )]
     NoCookie {
         /// The variant's id.

@@ -88,12 +88,15 @@ pub struct PartialSumTree {
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
     frame: Option<PartialSumTreeFrame>,
+    /// The spot's cookie ([`Self::set_cookie`]), for a variant with `cookie`.
+    cookie: crate::cookie::CookieSlot,
 }
 
 impl PartialSumTree {
     /// Validates the sizes against the device and creates the pipelines, textures and
     /// buffers. `res.rectified` is the rectified map (`Wr` light rays per row by `Hr` rows);
-    /// the sweep's scratch holds `slices x Wr x ceil(rank / 4)` leaves (16 bytes each).
+    /// the sweep's scratch holds `slices x Wr x ceil(rank / 4)` leaves (16 bytes each; three
+    /// times that with a cookie).
     ///
     /// # Errors
     ///
@@ -128,11 +131,11 @@ impl PartialSumTree {
         )?;
         crate::prefiltered::check_frame_buffers(&limits, hr)?;
         let leaves =
-            u64::from(variant.slices) * u64::from(wr) * u64::from(variant.rank_vecs()) * 16;
+            u64::from(variant.slices) * u64::from(wr) * u64::from(variant.leaf_vecs()) * 16;
         let trees = u64::from(variant.slices)
             * u64::from(TREES + 1)
             * u64::from(variant.slice_samples)
-            * u64::from(variant.rank_vecs())
+            * u64::from(variant.leaf_vecs())
             * 16;
         for (name, limit) in [
             (
@@ -195,7 +198,22 @@ impl PartialSumTree {
             output_view: output_view.clone(),
             exec,
             frame: None,
+            cookie: crate::cookie::CookieSlot::default(),
         })
+    }
+
+    /// Sets the spot light's cookie a `cookie` variant reads (kept until replaced; any size,
+    /// one of [`crate::textures::COOKIE_FORMATS`], projected as `scatter_shaderlib::cookie`
+    /// says): every column's leaf, the last column and the march carry it.
+    /// [`crate::textures::upload_cookie`] makes one from texels.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::NoCookie`] for a variant without `cookie`;
+    /// [`RuntimeError::InputMismatch`] for a view of the wrong format, dimension or usage.
+    pub fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        self.cookie
+            .set(self.variant.cookie, self.variant.id(), SWEEP, cookie)
     }
 
     /// Sets up one frame ([`prepare_partial_sum_tree`]: the epipolar frame and the rank-r
@@ -318,13 +336,10 @@ impl PartialSumTree {
             shadow_map,
             [self.shadow_map_size; 2],
         )?;
-        self.exec.encode(
-            ctx.device(),
-            encoder,
-            &[("depth", depth), ("shadow_map", shadow_map)],
-            &[],
-            only,
-        )?;
+        let mut engine = vec![("depth", depth), ("shadow_map", shadow_map)];
+        self.cookie.bind(self.variant.cookie, SWEEP, &mut engine)?;
+        self.exec
+            .encode(ctx.device(), encoder, &engine, &[], only)?;
         Ok(&self.output_view)
     }
 
@@ -397,8 +412,8 @@ pub struct PartialSumTreeReadback {
 }
 
 /// Test helper: creates a [`PartialSumTree`], uploads `depth` (screen-sized) and
-/// `shadow_map` (`input.shadow_map.size` squared) as r32float textures, runs one frame and
-/// reads back.
+/// `shadow_map` (`input.shadow_map.size` squared) as r32float textures and, for a `cookie`
+/// variant, `cookie` (its size and RGBA texels), runs one frame and reads back.
 ///
 /// # Errors
 ///
@@ -412,9 +427,14 @@ pub fn run_partial_sum_tree_once(
     input: &FrameInput,
     depth: &[f32],
     shadow_map: &[f32],
+    cookie: Option<([u32; 2], &[[f32; 4]])>,
 ) -> Result<PartialSumTreeReadback, RuntimeError> {
     let sm_size = input.shadow_map.size;
     let mut pass = PartialSumTree::new(ctx, variant, res, sm_size)?;
+    if let Some((size, texels)) = cookie {
+        let texture = crate::textures::upload_cookie(ctx, SWEEP, size, texels)?;
+        pass.set_cookie(&texture.create_view(&wgpu::TextureViewDescriptor::default()))?;
+    }
     let views = upload_inputs(
         ctx,
         &[
@@ -514,6 +534,10 @@ impl crate::family::FamilyRuntime for PartialSumTree {
 
     fn fallback_pixels(&self, ctx: &Context) -> Result<Option<u32>, RuntimeError> {
         crate::family::read_fallback_count(ctx, &self.exec, UNWARP)
+    }
+
+    fn set_cookie(&mut self, cookie: &wgpu::TextureView) -> Result<(), RuntimeError> {
+        PartialSumTree::set_cookie(self, cookie)
     }
 
     fn pass_wall_times(

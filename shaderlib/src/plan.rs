@@ -165,7 +165,8 @@ pub fn depth_and_shadow_map() -> [Resource; 2] {
 }
 
 /// The binding of the engine's `cookie` texture in every kernel that reads a spot's cookie
-/// (above every family's own and sampling bindings).
+/// (above every family's own and sampling bindings), but `partial_sum_tree`'s, whose
+/// sampling bindings reach 12: [`crate::partial_sum_tree::COOKIE_BINDING`].
 pub const COOKIE_BINDING: u32 = 12;
 
 /// The engine's spot-light cookie ([`scatter_frame::cookie`]): any size, loaded texel by

@@ -16,6 +16,14 @@
 // cancels. The columns are split over TREES trees swept at once (step 4); the slice's 32
 // invocations first set up the samples, rank them, and compute every column's b_i and leaf. Samples near the epipole
 // and the anti-epipole are ray-marched, as every epipolar family marches them.
+{%- if cookie %}
+//
+// Cookie (scatter_frame::cookie): constant along each light ray, so it multiplies a column's
+// leaf. Each column has one leaf per colour channel (its quadrature over the column's light
+// rays with the cookie at each node), {{ leaf_vecs }} vec4 per leaf and tree entry (channel c at
+// c * {{ rank_vecs }} ..); the trees sum them as before, each query dots every channel's prefix with
+// beta(theta), and the last, partial column and the epipole march carry the cookie per node.
+{%- endif %}
 //
 // Bindings (group 0):
 // | binding | name        | type                                    | access       |
@@ -26,11 +34,14 @@
 // | 3       | shadow_map  | texture_2d<f32> (r32float)              | textureLoad  |
 // | 4       | rectified   | texture_2d<f32> (r32float, rectify's)   | textureLoad  |
 // | 5       | pst_factors | var<storage, read> array<vec4<f32>>     | read         |
-// | 6       | pst_leaves  | var<storage, read_write> array<vec4<f32>> (SLICES x Wr x {{ rank_vecs }}) | read_write |
-// | 7       | pst_tree    | var<storage, read_write> array<vec4<f32>> (SLICES x (TREES + 1) x SLICE_SAMPLES x {{ rank_vecs }}) | read_write |
+// | 6       | pst_leaves  | var<storage, read_write> array<vec4<f32>> (SLICES x Wr x {{ leaf_vecs }}) | read_write |
+// | 7       | pst_tree    | var<storage, read_write> array<vec4<f32>> (SLICES x (TREES + 1) x SLICE_SAMPLES x {{ leaf_vecs }}) | read_write |
 // | 8       | pst_columns | var<storage, read_write> array<u32> (SLICES x Wr) | read_write |
 // | 9       | output      | texture_storage_2d<rgba32float, write> (epipolar_samples) | textureStore |
 // | 11      | fallback_count | var<storage, read_write> atomic<u32> | read_write   |
+{%- if cookie %}
+// | {{ cookie_binding }}      | cookie      | texture_2d<f32> (rgba, linear RGB)      | textureLoad  |
+{%- endif %}
 // The unwarp and fallback passes (`pst_sweep_unwarp`, `pst_sweep_fallback`) bind 6-8 not.
 //
 // Dispatch: (SLICES, 1, 1) workgroups of (32, 1, 1).
@@ -39,6 +50,9 @@
 
 #import scatter::model::{cone_falloff, phase_hg, transmittance_between}
 #import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta, row_index, row_phi, slice_e, slice_params}
+{%- if cookie %}
+#import scatter::cookie::{epipole_march_cookie, frame_cookie, lit_span_cookie}
+{%- endif %}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
 {%- endif %}
@@ -55,11 +69,17 @@
 @group(0) @binding(8) var<storage, read_write> pst_columns: array<u32>;
 {%- endif %}
 @group(0) @binding(9) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
+{%- if cookie %}
+// The spot's cookie (scatter_frame::cookie): in every leaf, the last column and the march.
+@group(0) @binding({{ cookie_binding }}) var cookie: texture_2d<f32>;
+{%- endif %}
 {% include "include/sampled_bindings.wgsl" %}
 
-// vec4s per leaf (ceil(rank / 4)), grid nodes of the factors, the 2-point Gauss-Legendre node,
-// and the sweep's trees per slice.
+// vec4s of the rank's factors (ceil(rank / 4)), vec4s per leaf and tree entry ({% if cookie %}three
+// channels of RANK_VECS{% else %}RANK_VECS{% endif %}), grid nodes of the factors, the 2-point Gauss-Legendre node, and the
+// sweep's trees per slice.
 const RANK_VECS: u32 = {{ rank_vecs }}u;
+const LEAF_VECS: u32 = {{ leaf_vecs }}u;
 const TREES: u32 = {{ trees }}u;
 const GRID: u32 = {{ grid }}u;
 const GL2: f32 = 0.57735026f;
@@ -85,7 +105,9 @@ fn beta_at(theta: f32, h: u32) -> vec4<f32> {
 }
 
 // Leaf of column i of `row` (spacing `delta`), bases 4h ..: the sun's gamma(i delta); a spot's
-// integral over the column's light-ray angles of gamma(psi) cone(psi) (2-point Gauss-Legendre).
+// integral over the column's light-ray angles of gamma(psi) cone(psi) (2-point Gauss-Legendre){% if cookie %};
+// with the cookie, entry h < LEAF_VECS is channel h / RANK_VECS's: the integrand times that
+// channel of the node's light ray's cookie, bases 4 (h % RANK_VECS) ..{% endif %}.
 fn pst_leaf(f: Frame, i: u32, row: u32, delta: f32, h: u32) -> vec4<f32> {
     if !{{ spot }} {
         return gamma_at(f32(i) * delta, h);
@@ -98,7 +120,12 @@ fn pst_leaf(f: Frame, i: u32, row: u32, delta: f32, h: u32) -> vec4<f32> {
         let psi = (f32(i) + 0.5 + 0.5 * q) * delta;
         let l = -axis * cos(psi) + e * sin(psi);
         let cone = cone_falloff(dot(l, f.light_dir.xyz), f.light_pos[3], f.light_dir[3]);
+{%- if cookie %}
+        let tint = frame_cookie(f, cookie, f.light_pos.xyz + l)[h / RANK_VECS];
+        leaf += (0.5 * delta * cone * tint) * gamma_at(psi, h % RANK_VECS);
+{%- else %}
         leaf += (0.5 * delta * cone) * gamma_at(psi, h);
+{%- endif %}
     }
     return leaf;
 }
@@ -139,7 +166,11 @@ fn pst_ray(pc: vec2<f32>, z: f32) -> PstRay {
         f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
     if near_epi || near_anti {
         r.marched = true;
+{%- if cookie %}
+        r.color = epipole_march_cookie(frame, shadow_map, cookie, eye, dir, s) * f.light_color.xyz;
+{%- else %}
         r.color = epipole_march(frame, shadow_map, eye, dir, s, spot) * f.light_color.xyz;
+{%- endif %}
     }
 
     r.theta = ray_theta(f, dir);
@@ -174,6 +205,20 @@ fn pst_terms(r: PstRay, row: u32, delta: f32, n: u32) -> vec2<f32> {
     let sp = f.medium[1] * phase_hg(f.medium[2], -dot(f.light_dir.xyz, r.dir));
     return vec2<f32>(sp * transmittance_between(f.medium[0], 0.0, delta / sin_theta), sp * tail);
 }
+{%- if cookie %}
+
+// `pst_terms` of a spot with the cookie: x = a, yzw = b, the last column with the cookie (RGB).
+fn pst_terms_cookie(r: PstRay, row: u32, delta: f32, n: u32) -> vec4<f32> {
+    let f = frame;
+    let sin_theta = max(sin(r.theta), 1e-6);
+    var tail = vec3<f32>(0.0);
+    if r.d <= textureLoad(rectified, vec2<u32>(n - 1u, row), 0).x {
+        let a = edge_t(f, n - 1u, n, delta, r.theta, r.s, true);
+        tail = lit_span_cookie(f, cookie, r.eye, r.dir, a, r.s);
+    }
+    return vec4<f32>(f.medium[1] / (f.axis[3] * sin_theta), tail);
+}
+{%- endif %}
 
 // The in-scattered radiance of pixel (x, y) without the tree (the fallback's body): its own
 // nearest row, the lit whole columns' leaves summed in column order.
@@ -188,6 +233,20 @@ fn pst_sweep_pixel(x: u32, y: u32) -> vec3<f32> {
     if n == 0u {
         return vec3<f32>(0.0, 0.0, 0.0);
     }
+{%- if cookie %}
+    var sum = vec3<f32>(0.0);
+    for (var h = 0u; h < LEAF_VECS; h++) {
+        var p = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+        for (var i = 0u; i + 1u < n; i++) {
+            if r.d <= textureLoad(rectified, vec2<u32>(i, r.row), 0).x {
+                p += pst_leaf(f, i, r.row, delta, h);
+            }
+        }
+        sum[h / RANK_VECS] += dot(p, beta_at(r.theta, h % RANK_VECS));
+    }
+    let ab = pst_terms_cookie(r, r.row, delta, n);
+    return f.light_color.xyz * (max(ab.x * sum, vec3<f32>(0.0)) + ab.yzw);
+{%- else %}
     var sum = 0.0;
     for (var h = 0u; h < RANK_VECS; h++) {
         var p = vec4<f32>(0.0, 0.0, 0.0, 0.0);
@@ -200,6 +259,7 @@ fn pst_sweep_pixel(x: u32, y: u32) -> vec3<f32> {
     }
     let ab = pst_terms(r, r.row, delta, n);
     return f.light_color.xyz * (max(ab.x * sum, 0.0) + ab.y);
+{%- endif %}
 }
 {%- if !sampling.unwarp && !sampling.fallback %}
 
@@ -212,7 +272,7 @@ var<workgroup> q_rank: array<u32, {{ sampling.slice_samples }}>;
 var<workgroup> q_d: array<f32, {{ sampling.slice_samples }}>;
 var<workgroup> q_theta: array<f32, {{ sampling.slice_samples }}>;
 var<workgroup> q_a: array<f32, {{ sampling.slice_samples }}>;
-var<workgroup> q_b: array<f32, {{ sampling.slice_samples }}>;
+var<workgroup> q_b: array<{% if cookie %}vec3<f32>{% else %}f32{% endif %}, {{ sampling.slice_samples }}>;
 var<workgroup> by_end: array<u32, {{ sampling.slice_samples }}>;
 // How many queries are not done (V), and how many end in each tree's columns.
 var<workgroup> live: atomic<u32>;
@@ -301,12 +361,17 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
             let c = round_f16(r.color);
             textureStore(output, vec2<u32>(k, s), vec4<f32>(c.x, c.y, c.z, z));
         } else {
+{%- if cookie %}
+            let ab = pst_terms_cookie(r, row, delta, n);
+            q_b[k] = ab.yzw;
+{%- else %}
             let ab = pst_terms(r, row, delta, n);
+            q_b[k] = ab.y;
+{%- endif %}
             q_end[k] = n - 1u;
             q_d[k] = r.d;
             q_theta[k] = r.theta;
             q_a[k] = ab.x;
-            q_b[k] = ab.y;
             atomicAdd(&live, 1u);
         }
     }
@@ -412,8 +477,8 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         }
         pst_columns[base + i] = lo;
         if lo > 0u {
-            for (var h = 0u; h < RANK_VECS; h++) {
-                pst_leaves[(base + i) * RANK_VECS + h] = pst_leaf(f, i, row, delta, h);
+            for (var h = 0u; h < LEAF_VECS; h++) {
+                pst_leaves[(base + i) * LEAF_VECS + h] = pst_leaf(f, i, row, delta, h);
             }
         }
     }
@@ -427,11 +492,11 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     // then the trees are summed into exclusive prefixes over c (a Fenwick tree is linear in
     // its leaves) and every query adds the complete trees before its own: one step per
     // column on TREES invocations at once instead of all columns on one.
-    let trees = s * (TREES + 1u) * SLICE_SAMPLES * RANK_VECS;
-    let partials = trees + TREES * SLICE_SAMPLES * RANK_VECS;
+    let trees = s * (TREES + 1u) * SLICE_SAMPLES * LEAF_VECS;
+    let partials = trees + TREES * SLICE_SAMPLES * LEAF_VECS;
     if li < TREES {
-        let tree = trees + li * SLICE_SAMPLES * RANK_VECS;
-        for (var j = 0u; j < v * RANK_VECS; j++) {
+        let tree = trees + li * SLICE_SAMPLES * LEAF_VECS;
+        for (var j = 0u; j < v * LEAF_VECS; j++) {
             pst_tree[tree + j] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         }
         let lo = li * cw;
@@ -451,14 +516,14 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
             while next < v && q_end[by_end[next]] == i && (i < hi || li + 1u == TREES) {
                 let k = by_end[next];
                 next++;
-                for (var h = 0u; h < RANK_VECS; h++) {
+                for (var h = 0u; h < LEAF_VECS; h++) {
                     var p = vec4<f32>(0.0, 0.0, 0.0, 0.0);
                     var j = v - q_rank[k];
                     while j > 0u {
-                        p += pst_tree[tree + (j - 1u) * RANK_VECS + h];
+                        p += pst_tree[tree + (j - 1u) * LEAF_VECS + h];
                         j -= j & (~j + 1u);
                     }
-                    pst_tree[partials + k * RANK_VECS + h] = p;
+                    pst_tree[partials + k * LEAF_VECS + h] = p;
                 }
             }
             if i == hi {
@@ -466,11 +531,11 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
             }
             let b = pst_columns[base + i];
             if b > 0u {
-                for (var h = 0u; h < RANK_VECS; h++) {
-                    let leaf = pst_leaves[(base + i) * RANK_VECS + h];
+                for (var h = 0u; h < LEAF_VECS; h++) {
+                    let leaf = pst_leaves[(base + i) * LEAF_VECS + h];
                     var j = v - b + 1u;
                     while j <= v {
-                        pst_tree[tree + (j - 1u) * RANK_VECS + h] += leaf;
+                        pst_tree[tree + (j - 1u) * LEAF_VECS + h] += leaf;
                         j += j & (~j + 1u);
                     }
                 }
@@ -480,10 +545,10 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     storageBarrier();
     workgroupBarrier();
     // Exclusive prefix sums over the trees, entry by entry.
-    for (var x = li; x < v * RANK_VECS; x += SLICE_LANES) {
+    for (var x = li; x < v * LEAF_VECS; x += SLICE_LANES) {
         var running = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         for (var c = 0u; c < TREES; c++) {
-            let at = trees + c * SLICE_SAMPLES * RANK_VECS + x;
+            let at = trees + c * SLICE_SAMPLES * LEAF_VECS + x;
             let own = pst_tree[at];
             pst_tree[at] = running;
             running += own;
@@ -494,18 +559,24 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     // Every query: its partial sum plus the complete trees before its own.
     for (var k = li; k < SLICE_SAMPLES; k += SLICE_LANES) {
         if q_end[k] != NONE {
-            let tree = trees + min(q_end[k] / cw, TREES - 1u) * SLICE_SAMPLES * RANK_VECS;
-            var dotp = 0.0;
-            for (var h = 0u; h < RANK_VECS; h++) {
-                var p = pst_tree[partials + k * RANK_VECS + h];
+            let tree = trees + min(q_end[k] / cw, TREES - 1u) * SLICE_SAMPLES * LEAF_VECS;
+            var dotp = {% if cookie %}vec3<f32>(0.0){% else %}0.0{% endif %};
+            for (var h = 0u; h < LEAF_VECS; h++) {
+                var p = pst_tree[partials + k * LEAF_VECS + h];
                 var j = v - q_rank[k];
                 while j > 0u {
-                    p += pst_tree[tree + (j - 1u) * RANK_VECS + h];
+                    p += pst_tree[tree + (j - 1u) * LEAF_VECS + h];
                     j -= j & (~j + 1u);
                 }
+{%- if cookie %}
+                dotp[h / RANK_VECS] += dot(p, beta_at(q_theta[k], h % RANK_VECS));
+            }
+            let c = round_f16(f.light_color.xyz * (max(q_a[k] * dotp, vec3<f32>(0.0)) + q_b[k]));
+{%- else %}
                 dotp += dot(p, beta_at(q_theta[k], h));
             }
             let c = round_f16(f.light_color.xyz * (max(q_a[k] * dotp, 0.0) + q_b[k]));
+{%- endif %}
             let z = textureLoad(depth, slice_sample_pixel(lines, u, span, k, screen), 0).x;
             textureStore(output, vec2<u32>(k, s), vec4<f32>(c.x, c.y, c.z, z));
         }

@@ -12,8 +12,9 @@
 //!   10 % rel RMSE (`tests/tests/lamp.rs`), 0 NaN/Inf, on `spot_grate` at `ordinary`,
 //!   `grazing` and `epipole_on_screen` (the lamp on screen) and on every spot pose of the
 //!   random-pose generator's first 4 draws per scene (seed 2026);
-//! - a family without the knob says so (`FamilyVariant::with_cookie` is `None`) and the
-//!   runtime refuses a cookie for it (`RuntimeError::NoCookie`).
+//!   (prefiltered with both bases);
+//! - every family has the knob, a cookie on the sun names the `cookie` knob, and a variant
+//!   without it refuses a cookie (`RuntimeError::NoCookie`).
 //!
 //! `cargo test --release -p scatter-conformance --test cookie -- --nocapture` prints the
 //! table of the closing note.
@@ -30,8 +31,8 @@ use scatter_reference::scene::{Light, Scene};
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_shaderlib::family::{Family, FamilyVariant};
-use scatter_shaderlib::prefiltered::{FrameSettings, LightKind};
 use scatter_shaderlib::prefiltered::PrefilteredVariant;
+use scatter_shaderlib::prefiltered::{FrameSettings, LightKind};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
 const SCREEN: [u32; 2] = [96, 54];
@@ -217,27 +218,30 @@ fn cookie_variants() -> Vec<FamilyVariant> {
 }
 
 #[test]
-fn families_without_the_knob_say_so() {
+fn every_family_reads_a_cookie_and_a_variant_without_one_says_so() {
     let with: Vec<Family> = cookie_variants()
         .iter()
         .map(FamilyVariant::family)
         .collect();
-    assert!(with.contains(&Family::Raymarch), "{with:?}");
     for f in Family::ALL {
-        let v = f.default_variant().with_light(LightKind::Spot);
-        match v.with_cookie(true) {
-            Some(c) => assert!(c.validate().is_ok() && c.cookie(), "{c}"),
-            None => assert!(!with.contains(f), "{f}"),
-        }
+        assert!(with.contains(f), "{f} has no cookie knob");
+        let c = f
+            .default_variant()
+            .with_light(LightKind::Spot)
+            .with_cookie(true)
+            .expect("the knob");
+        assert!(c.validate().is_ok() && c.cookie(), "{c}");
+        // A cookie needs a spot: the knob names itself on a directional light.
+        let sun = c.with_light(LightKind::Directional);
+        let err = sun.validate().expect_err("a cookie on the sun");
+        assert_eq!(err.knob, "cookie", "{sun}: {err}");
     }
     let Some(ctx) = gpu() else {
         return;
     };
+    // A variant without the knob set refuses a cookie (the runtime's NoCookie).
     for f in Family::ALL {
         let v = f.default_variant().with_light(LightKind::Spot);
-        if v.with_cookie(true).is_some() {
-            continue;
-        }
         let mut pass = scatter_runtime::FamilyPasses::new(
             ctx,
             &v,
@@ -257,7 +261,7 @@ fn families_without_the_knob_say_so() {
         .unwrap_or_else(|e| panic!("{e}"));
         let err = pass
             .set_cookie(&texture.create_view(&Default::default()))
-            .expect_err("a family without the knob");
+            .expect_err("a variant without a cookie");
         assert!(
             matches!(err, scatter_runtime::RuntimeError::NoCookie { .. }),
             "{v}: {err}"

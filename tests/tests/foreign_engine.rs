@@ -396,12 +396,13 @@ fn other_families_dir() -> &'static Path {
     })
 }
 
-/// The partial-sum-tree trial variants: rank 4 directional and rank 8 spot (two vec4 per
-/// leaf), 64 slices x 64 samples: the `pst_factors` buffer the engine uploads, the sweep's
-/// scratch buffers it allocates from the manifest, and the unwarp and fallback passes.
-fn pst_variants() -> [PartialSumTreeVariant; 2] {
+/// The partial-sum-tree trial variants: rank 4 directional, rank 8 spot (two vec4 per
+/// leaf) and rank 4 spot with the cookie, 64 slices x 64 samples: the `pst_factors` buffer
+/// the engine uploads, the sweep's scratch buffers it allocates from the manifest, and the
+/// unwarp and fallback passes.
+fn pst_variants() -> [PartialSumTreeVariant; 3] {
     let g = PartialSumTreeVariant::grid();
-    [g[1], g[4]]
+    [g[1], g[4], g[5]]
 }
 
 /// The raymarch trial variants: plain directional, interleaved and jittered spot,
@@ -684,7 +685,9 @@ fn foreign_engine_matches_runtime_for_every_family() {
         ));
     }
     for v in pst_variants() {
-        let fixture = fixture(v.light);
+        let fixture = fixture_for(v.light, v.cookie);
+        let cookie = fixture.cookie();
+        let flat_cookie = cookie_texels(fixture);
         let name = format!(
             "foreign::partial_sum_tree::{}::{}::{}",
             v.id(),
@@ -703,6 +706,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
             &f,
             &fixture.gbuf.view_depth,
             &fixture.shadow_map.depth,
+            cookie.as_ref().map(|(size, t)| (*size, &t[..])),
         )
         .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
         let frame = prepare_partial_sum_tree(
@@ -732,7 +736,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
                 "pst_sweep_fallback",
             ],
             |target| {
-                let params = fixture.sizes().params();
+                let params = cookie_params(fixture.sizes().params(), fixture);
                 let mut engine =
                     Engine::load(ctx.device(), ctx.queue(), dir, &v.id(), target, &params)?;
                 scatter_foreign_engine::partial_sum_tree::run_frame(
@@ -740,6 +744,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
                     &frame,
                     &fixture.gbuf.view_depth,
                     &fixture.shadow_map.depth,
+                    flat_cookie.as_deref(),
                 )
             },
         ));

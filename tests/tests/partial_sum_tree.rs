@@ -81,6 +81,26 @@ fn fixture(light: LightKind, i: usize) -> &'static Fixture {
     &all[l * POSES.len() + i]
 }
 
+/// The fixture of `variant`'s trial `i`: its light's, with the `stained_glass` cookie (64^2)
+/// on the spot for a `cookie` variant (built once, on first use).
+fn variant_fixture(variant: &PartialSumTreeVariant, i: usize) -> &'static Fixture {
+    static COOKIE: OnceLock<Vec<Fixture>> = OnceLock::new();
+    if !variant.cookie {
+        return fixture(variant.light, i);
+    }
+    let all = COOKIE.get_or_init(|| {
+        (0..POSES.len())
+            .map(|i| {
+                fixture(LightKind::Spot, i).with_cookie(
+                    scatter_reference::cookie::Cookie::pattern("stained_glass", 64)
+                        .expect("a built-in pattern"),
+                )
+            })
+            .collect()
+    });
+    &all[i]
+}
+
 fn input(f: &Fixture) -> FrameInput {
     f.frame_input(FrameSettings::for_screen(SCREEN[0], SCREEN[1]))
 }
@@ -114,6 +134,8 @@ fn trial(
     f: &Fixture,
 ) -> Result<String, String> {
     let spot = variant.light == LightKind::Spot;
+    let cookie = f.cookie();
+    let cookie_tex = scatter_reference::kernels::cookie_texture(&f.scene);
     let gpu = run_partial_sum_tree_once(
         ctx,
         &variant,
@@ -121,6 +143,7 @@ fn trial(
         &input(f),
         &f.gbuf.view_depth,
         &f.shadow_map.depth,
+        cookie.as_ref().map(|(size, t)| (*size, &t[..])),
     )
     .map_err(|e| format!("GPU run failed: {e}"))?;
     let sm = Tex {
@@ -156,7 +179,14 @@ fn trial(
         height: RECTIFIED[1],
         data: gpu.rectified.clone(),
     };
-    let cpu = partial_sum_tree_from_rectified(&variant, frame, rectified.clone(), &depth, &sm);
+    let cpu = partial_sum_tree_from_rectified(
+        &variant,
+        frame,
+        rectified.clone(),
+        &depth,
+        &sm,
+        cookie_tex.as_ref(),
+    );
     let inp = PstInputs {
         frame: &cpu.frame.frame.uniforms,
         slices: &cpu.frame.frame.slices,
@@ -164,6 +194,7 @@ fn trial(
         shadow_map: &sm,
         rectified: &rectified,
         factors: &cpu.frame.factors,
+        cookie: cookie_tex.as_ref(),
     };
     let samples = &cpu.samples.samples;
     if samples.data.len() != gpu.samples.len() {
@@ -189,7 +220,7 @@ fn trial(
             let t = span[0] + k as f32 * span[1];
             [layout.origin[0] + u[0] * t, layout.origin[1] + u[1] * t]
         };
-        let lr = pst_ray(&inp, spot, at(m - 1), 0.0);
+        let lr = pst_ray(&inp, spot, at(m - 1), 0.0, None);
         let row = lr.row;
         let rows = f.sizes[3] as f32;
         let phi = lr
@@ -218,9 +249,10 @@ fn trial(
                     spot,
                     [p[0] as f32 + 0.5, p[1] as f32 + 0.5],
                     depth.load(p[0], p[1]),
+                    None,
                 )
             } else {
-                pst_ray(&inp, spot, at(k), footprint)
+                pst_ray(&inp, spot, at(k), footprint, None)
             };
             let n = pst_columns_crossed(f, &r, delta);
             let xs = r.xs_num / delta;
@@ -307,7 +339,7 @@ fn main() -> ExitCode {
             );
             let check: Check = Box::new(move || {
                 let Some(ctx) = gpu() else { return Ok(()) };
-                let report = trial(ctx, variant, fixture(variant.light, i))?;
+                let report = trial(ctx, variant, variant_fixture(&variant, i))?;
                 eprintln!("ok   {report}");
                 Ok(())
             });

@@ -742,7 +742,8 @@ pub fn run_dir(
         Knobs::PartialSumTree(variant) => {
             let frame = file.prepare_partial_sum_tree(variant)?;
             let mut engine = load(&file.sizes().params())?;
-            let out = crate::partial_sum_tree::run_frame(&mut engine, &frame, &depth, &shadow)?;
+            let out =
+                crate::partial_sum_tree::run_frame(&mut engine, &frame, &depth, &shadow, None)?;
             (Some(frame.frame), out)
         }
         Knobs::Raymarch(variant) => {
@@ -793,7 +794,7 @@ impl Knobs {
             Knobs::Minmax(v) => v.cookie,
             Knobs::HybridVolume(v) => v.cookie,
             Knobs::Prefiltered(v) => v.cookie,
-            Knobs::PartialSumTree(_) => false,
+            Knobs::PartialSumTree(v) => v.cookie,
         }
     }
 }

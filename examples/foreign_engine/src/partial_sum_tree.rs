@@ -9,7 +9,7 @@
 use scatter_frame::partial_sum_tree::PartialSumTreeFrame;
 
 use crate::prefiltered::{
-    DEPTH, FRAME, Output, SHADOW_MAP, SLICES, check_frame_layout, read_output,
+    COOKIE, DEPTH, FRAME, Output, SHADOW_MAP, SLICES, check_frame_layout, read_output,
 };
 use crate::{Engine, EngineError, FrameData};
 
@@ -17,7 +17,8 @@ use crate::{Engine, EngineError, FrameData};
 pub const FACTORS: &str = "pst_factors";
 
 /// Runs one frame: uploads the frame set-up (uniforms, slice table, factors) and the
-/// engine's depth buffer and standard shadow map, dispatches and reads `output` back.
+/// engine's depth buffer, standard shadow map and, for a `cookie` variant, the spot's cookie
+/// (RGBA texels), dispatches and reads `output` back.
 ///
 /// # Errors
 ///
@@ -27,6 +28,7 @@ pub fn run_frame(
     frame: &PartialSumTreeFrame,
     depth: &[f32],
     shadow_map: &[f32],
+    cookie: Option<&[f32]>,
 ) -> Result<Output, EngineError> {
     check_frame_layout(engine)?;
     let buffers = [
@@ -34,7 +36,10 @@ pub fn run_frame(
         (SLICES, bytemuck::cast_slice(&frame.frame.slices)),
         (FACTORS, bytemuck::cast_slice(&frame.factors)),
     ];
-    let textures = [(DEPTH, depth), (SHADOW_MAP, shadow_map)];
+    let mut textures = vec![(DEPTH, depth), (SHADOW_MAP, shadow_map)];
+    if let Some(c) = cookie {
+        textures.push((COOKIE, c));
+    }
     let run = engine.run(&FrameData {
         buffers: &buffers,
         textures: &textures,

@@ -91,6 +91,7 @@ const uint STEP = 1u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
 const uint RANK_VECS = 2u;
+const uint LEAF_VECS = 2u;
 const uint TREES = 8u;
 const uint GRID = 96u;
 const float GL2_ = 0.57735026;
@@ -1085,17 +1086,17 @@ void main() {
                 PstRay _e160 = r;
                 vec2 _e161 = pst_terms(_e160, row_3, delta_6, _e136);
                 uint _e163 = k;
-                q_end[_e163] = (_e136 - 1u);
-                uint _e168 = k;
-                float _e171 = r.d;
-                q_d[_e168] = _e171;
-                uint _e173 = k;
-                float _e176 = r.theta;
-                q_theta[_e173] = _e176;
-                uint _e178 = k;
-                q_a[_e178] = _e161.x;
+                q_b[_e163] = _e161.y;
+                uint _e167 = k;
+                q_end[_e167] = (_e136 - 1u);
+                uint _e172 = k;
+                float _e175 = r.d;
+                q_d[_e172] = _e175;
+                uint _e177 = k;
+                float _e180 = r.theta;
+                q_theta[_e177] = _e180;
                 uint _e182 = k;
-                q_b[_e182] = _e161.y;
+                q_a[_e182] = _e161.x;
                 uint _e187 = atomicAdd(live, 1u);
             }
         }
@@ -1452,7 +1453,7 @@ void main() {
                     }
                     loop_init_17 = false;
                     uint _e549 = h;
-                    if ((_e549 < RANK_VECS)) {
+                    if ((_e549 < LEAF_VECS)) {
                     } else {
                         break;
                     }
@@ -1462,7 +1463,7 @@ void main() {
                         uint _e560 = i;
                         uint _e561 = h;
                         vec4 _e562 = pst_leaf(f_18, _e560, row_3, delta_6, _e561);
-                        _group_0_binding_6_cs[(((base_1 + _e552) * RANK_VECS) + _e557)] = _e562;
+                        _group_0_binding_6_cs[(((base_1 + _e552) * LEAF_VECS) + _e557)] = _e562;
                     }
                 }
             }
@@ -1472,10 +1473,10 @@ void main() {
     barrier();
     memoryBarrierShared();
     barrier();
-    uint trees = (((s_7 * 9u) * SLICE_SAMPLES) * RANK_VECS);
+    uint trees = (((s_7 * 9u) * SLICE_SAMPLES) * LEAF_VECS);
     uint partials = (trees + 4096u);
     if ((li < TREES)) {
-        uint tree = (trees + ((li * SLICE_SAMPLES) * RANK_VECS));
+        uint tree = (trees + ((li * SLICE_SAMPLES) * LEAF_VECS));
         bool loop_init_18 = true;
         while(true) {
             if (!loop_init_18) {
@@ -1484,7 +1485,7 @@ void main() {
             }
             loop_init_18 = false;
             uint _e585 = j_5;
-            if ((_e585 < (v_9 * RANK_VECS))) {
+            if ((_e585 < (v_9 * LEAF_VECS))) {
             } else {
                 break;
             }
@@ -1573,7 +1574,7 @@ void main() {
                             }
                             loop_init_20 = false;
                             uint _e670 = h_1;
-                            if ((_e670 < RANK_VECS)) {
+                            if ((_e670 < LEAF_VECS)) {
                             } else {
                                 break;
                             }
@@ -1591,7 +1592,7 @@ void main() {
                                         vec4 _e687 = p;
                                         uint _e688 = j_6;
                                         uint _e695 = h_1;
-                                        vec4 _e698 = _group_0_binding_7_cs[((tree + ((_e688 - 1u) * RANK_VECS)) + _e695)];
+                                        vec4 _e698 = _group_0_binding_7_cs[((tree + ((_e688 - 1u) * LEAF_VECS)) + _e695)];
                                         p = (_e687 + _e698);
                                         uint _e700 = j_6;
                                         uint _e701 = j_6;
@@ -1601,7 +1602,7 @@ void main() {
                                 }
                                 uint _e712 = h_1;
                                 vec4 _e715 = p;
-                                _group_0_binding_7_cs[((partials + (k_10 * RANK_VECS)) + _e712)] = _e715;
+                                _group_0_binding_7_cs[((partials + (k_10 * LEAF_VECS)) + _e712)] = _e715;
                             }
                         }
                     }
@@ -1622,14 +1623,14 @@ void main() {
                         }
                         loop_init_21 = false;
                         uint _e730 = h_2;
-                        if ((_e730 < RANK_VECS)) {
+                        if ((_e730 < LEAF_VECS)) {
                         } else {
                             break;
                         }
                         {
                             uint _e733 = i_1;
                             uint _e738 = h_2;
-                            vec4 leaf_1 = _group_0_binding_6_cs[(((base_1 + _e733) * RANK_VECS) + _e738)];
+                            vec4 leaf_1 = _group_0_binding_6_cs[(((base_1 + _e733) * LEAF_VECS) + _e738)];
                             j_7 = ((v_9 - b_8) + 1u);
                             while(true) {
                                 uint _e746 = j_7;
@@ -1640,8 +1641,8 @@ void main() {
                                 {
                                     uint _e748 = j_7;
                                     uint _e755 = h_2;
-                                    vec4 _e758 = _group_0_binding_7_cs[((tree + ((_e748 - 1u) * RANK_VECS)) + _e755)];
-                                    _group_0_binding_7_cs[((tree + ((_e748 - 1u) * RANK_VECS)) + _e755)] = (_e758 + leaf_1);
+                                    vec4 _e758 = _group_0_binding_7_cs[((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755)];
+                                    _group_0_binding_7_cs[((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755)] = (_e758 + leaf_1);
                                     uint _e760 = j_7;
                                     uint _e761 = j_7;
                                     uint _e762 = j_7;
@@ -1667,7 +1668,7 @@ void main() {
         }
         loop_init_22 = false;
         uint _e775 = x;
-        if ((_e775 < (v_9 * RANK_VECS))) {
+        if ((_e775 < (v_9 * LEAF_VECS))) {
         } else {
             break;
         }
@@ -1689,7 +1690,7 @@ void main() {
                 {
                     uint _e790 = c_1;
                     uint _e796 = x;
-                    uint at = ((trees + ((_e790 * SLICE_SAMPLES) * RANK_VECS)) + _e796);
+                    uint at = ((trees + ((_e790 * SLICE_SAMPLES) * LEAF_VECS)) + _e796);
                     vec4 own = _group_0_binding_7_cs[at];
                     vec4 _e803 = running;
                     _group_0_binding_7_cs[at] = _e803;
@@ -1722,7 +1723,7 @@ void main() {
             if ((_e819 != NONE)) {
                 uint _e823 = k_4;
                 uint _e825 = q_end[_e823];
-                uint tree_1 = (trees + ((min((_e825 / cw), 7u) * SLICE_SAMPLES) * RANK_VECS));
+                uint tree_1 = (trees + ((min((_e825 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0.0;
                 h_3 = 0u;
                 bool loop_init_25 = true;
@@ -1733,14 +1734,14 @@ void main() {
                     }
                     loop_init_25 = false;
                     uint _e838 = h_3;
-                    if ((_e838 < RANK_VECS)) {
+                    if ((_e838 < LEAF_VECS)) {
                     } else {
                         break;
                     }
                     {
                         uint _e841 = k_4;
                         uint _e846 = h_3;
-                        vec4 _e849 = _group_0_binding_7_cs[((partials + (_e841 * RANK_VECS)) + _e846)];
+                        vec4 _e849 = _group_0_binding_7_cs[((partials + (_e841 * LEAF_VECS)) + _e846)];
                         p_1 = _e849;
                         uint _e852 = k_4;
                         uint _e854 = q_rank[_e852];
@@ -1755,7 +1756,7 @@ void main() {
                                 vec4 _e860 = p_1;
                                 uint _e861 = j_8;
                                 uint _e868 = h_3;
-                                vec4 _e871 = _group_0_binding_7_cs[((tree_1 + ((_e861 - 1u) * RANK_VECS)) + _e868)];
+                                vec4 _e871 = _group_0_binding_7_cs[((tree_1 + ((_e861 - 1u) * LEAF_VECS)) + _e868)];
                                 p_1 = (_e860 + _e871);
                                 uint _e873 = j_8;
                                 uint _e874 = j_8;

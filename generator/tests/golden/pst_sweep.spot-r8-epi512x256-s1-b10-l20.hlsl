@@ -105,6 +105,7 @@ static const uint STEP = 1u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
 static const uint RANK_VECS = 2u;
+static const uint LEAF_VECS = 2u;
 static const uint TREES = 8u;
 static const uint GRID = 96u;
 static const float GL2_ = 0.57735026;
@@ -1242,17 +1243,17 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 PstRay _e160 = r;
                 const float2 _e161 = pst_terms(_e160, row_3, delta_6, _e136);
                 uint _e163 = k;
-                q_end[min(uint(_e163), 255u)] = (_e136 - 1u);
-                uint _e168 = k;
-                float _e171 = r.d;
-                q_d[min(uint(_e168), 255u)] = _e171;
-                uint _e173 = k;
-                float _e176 = r.theta;
-                q_theta[min(uint(_e173), 255u)] = _e176;
-                uint _e178 = k;
-                q_a[min(uint(_e178), 255u)] = _e161.x;
+                q_b[min(uint(_e163), 255u)] = _e161.y;
+                uint _e167 = k;
+                q_end[min(uint(_e167), 255u)] = (_e136 - 1u);
+                uint _e172 = k;
+                float _e175 = r.d;
+                q_d[min(uint(_e172), 255u)] = _e175;
+                uint _e177 = k;
+                float _e180 = r.theta;
+                q_theta[min(uint(_e177), 255u)] = _e180;
                 uint _e182 = k;
-                q_b[min(uint(_e182), 255u)] = _e161.y;
+                q_a[min(uint(_e182), 255u)] = _e161.x;
                 uint _e187; InterlockedAdd(live, 1u, _e187);
             }
         }
@@ -1646,7 +1647,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     }
                     loop_init_17 = false;
                     uint _e549 = h;
-                    if ((_e549 < RANK_VECS)) {
+                    if ((_e549 < LEAF_VECS)) {
                     } else {
                         break;
                     }
@@ -1656,7 +1657,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                         uint _e560 = i;
                         uint _e561 = h;
                         const float4 _e562 = pst_leaf(f_18, _e560, row_3, delta_6, _e561);
-                        pst_leaves.Store4((((base_1 + _e552) * RANK_VECS) + _e557)*16, asuint(_e562));
+                        pst_leaves.Store4((((base_1 + _e552) * LEAF_VECS) + _e557)*16, asuint(_e562));
                     }
                 }
             }
@@ -1664,10 +1665,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     }
     DeviceMemoryBarrierWithGroupSync();
     GroupMemoryBarrierWithGroupSync();
-    uint trees = (((s_7 * 9u) * SLICE_SAMPLES) * RANK_VECS);
+    uint trees = (((s_7 * 9u) * SLICE_SAMPLES) * LEAF_VECS);
     uint partials = (trees + 4096u);
     if ((li < TREES)) {
-        uint tree = (trees + ((li * SLICE_SAMPLES) * RANK_VECS));
+        uint tree = (trees + ((li * SLICE_SAMPLES) * LEAF_VECS));
         uint2 loop_bound_23 = uint2(4294967295u, 4294967295u);
         bool loop_init_18 = true;
         while(true) {
@@ -1679,7 +1680,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             }
             loop_init_18 = false;
             uint _e585 = j_5;
-            if ((_e585 < (v_9 * RANK_VECS))) {
+            if ((_e585 < (v_9 * LEAF_VECS))) {
             } else {
                 break;
             }
@@ -1780,7 +1781,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                             }
                             loop_init_20 = false;
                             uint _e670 = h_1;
-                            if ((_e670 < RANK_VECS)) {
+                            if ((_e670 < LEAF_VECS)) {
                             } else {
                                 break;
                             }
@@ -1801,7 +1802,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                                         float4 _e687 = p;
                                         uint _e688 = j_6;
                                         uint _e695 = h_1;
-                                        float4 _e698 = asfloat(pst_tree.Load4(((tree + ((_e688 - 1u) * RANK_VECS)) + _e695)*16));
+                                        float4 _e698 = asfloat(pst_tree.Load4(((tree + ((_e688 - 1u) * LEAF_VECS)) + _e695)*16));
                                         p = (_e687 + _e698);
                                         uint _e700 = j_6;
                                         uint _e701 = j_6;
@@ -1811,7 +1812,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                                 }
                                 uint _e712 = h_1;
                                 float4 _e715 = p;
-                                pst_tree.Store4(((partials + (k_10 * RANK_VECS)) + _e712)*16, asuint(_e715));
+                                pst_tree.Store4(((partials + (k_10 * LEAF_VECS)) + _e712)*16, asuint(_e715));
                             }
                         }
                     }
@@ -1835,14 +1836,14 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                         }
                         loop_init_21 = false;
                         uint _e730 = h_2;
-                        if ((_e730 < RANK_VECS)) {
+                        if ((_e730 < LEAF_VECS)) {
                         } else {
                             break;
                         }
                         {
                             uint _e733 = i_1;
                             uint _e738 = h_2;
-                            float4 leaf_1 = asfloat(pst_leaves.Load4((((base_1 + _e733) * RANK_VECS) + _e738)*16));
+                            float4 leaf_1 = asfloat(pst_leaves.Load4((((base_1 + _e733) * LEAF_VECS) + _e738)*16));
                             j_7 = ((v_9 - b_8) + 1u);
                             uint2 loop_bound_30 = uint2(4294967295u, 4294967295u);
                             while(true) {
@@ -1856,8 +1857,8 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                                 {
                                     uint _e748 = j_7;
                                     uint _e755 = h_2;
-                                    float4 _e758 = asfloat(pst_tree.Load4(((tree + ((_e748 - 1u) * RANK_VECS)) + _e755)*16));
-                                    pst_tree.Store4(((tree + ((_e748 - 1u) * RANK_VECS)) + _e755)*16, asuint((_e758 + leaf_1)));
+                                    float4 _e758 = asfloat(pst_tree.Load4(((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755)*16));
+                                    pst_tree.Store4(((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755)*16, asuint((_e758 + leaf_1)));
                                     uint _e760 = j_7;
                                     uint _e761 = j_7;
                                     uint _e762 = j_7;
@@ -1884,7 +1885,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
         loop_init_22 = false;
         uint _e775 = x;
-        if ((_e775 < (v_9 * RANK_VECS))) {
+        if ((_e775 < (v_9 * LEAF_VECS))) {
         } else {
             break;
         }
@@ -1909,7 +1910,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 {
                     uint _e790 = c_1;
                     uint _e796 = x;
-                    uint at = ((trees + ((_e790 * SLICE_SAMPLES) * RANK_VECS)) + _e796);
+                    uint at = ((trees + ((_e790 * SLICE_SAMPLES) * LEAF_VECS)) + _e796);
                     float4 own = asfloat(pst_tree.Load4(at*16));
                     float4 _e803 = running;
                     pst_tree.Store4(at*16, asuint(_e803));
@@ -1943,7 +1944,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             if ((_e819 != NONE)) {
                 uint _e823 = k_4;
                 uint _e825 = q_end[min(uint(_e823), 255u)];
-                uint tree_1 = (trees + ((min(naga_div(_e825, cw), 7u) * SLICE_SAMPLES) * RANK_VECS));
+                uint tree_1 = (trees + ((min(naga_div(_e825, cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0.0;
                 h_3 = 0u;
                 uint2 loop_bound_34 = uint2(4294967295u, 4294967295u);
@@ -1957,14 +1958,14 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     }
                     loop_init_25 = false;
                     uint _e838 = h_3;
-                    if ((_e838 < RANK_VECS)) {
+                    if ((_e838 < LEAF_VECS)) {
                     } else {
                         break;
                     }
                     {
                         uint _e841 = k_4;
                         uint _e846 = h_3;
-                        float4 _e849 = asfloat(pst_tree.Load4(((partials + (_e841 * RANK_VECS)) + _e846)*16));
+                        float4 _e849 = asfloat(pst_tree.Load4(((partials + (_e841 * LEAF_VECS)) + _e846)*16));
                         p_1 = _e849;
                         uint _e852 = k_4;
                         uint _e854 = q_rank[min(uint(_e852), 255u)];
@@ -1982,7 +1983,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                                 float4 _e860 = p_1;
                                 uint _e861 = j_8;
                                 uint _e868 = h_3;
-                                float4 _e871 = asfloat(pst_tree.Load4(((tree_1 + ((_e861 - 1u) * RANK_VECS)) + _e868)*16));
+                                float4 _e871 = asfloat(pst_tree.Load4(((tree_1 + ((_e861 - 1u) * LEAF_VECS)) + _e868)*16));
                                 p_1 = (_e860 + _e871);
                                 uint _e873 = j_8;
                                 uint _e874 = j_8;

@@ -114,6 +114,7 @@ constant uint STEP = 1u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
 constant uint RANK_VECS = 2u;
+constant uint LEAF_VECS = 2u;
 constant uint TREES = 8u;
 constant uint GRID = 96u;
 constant float GL2_ = 0.57735026;
@@ -1370,17 +1371,17 @@ kernel void pst_sweep(
                 PstRay _e160 = r;
                 metal::float2 _e161 = pst_terms(_e160, row_3, delta_6, _e136, frame, rectified);
                 uint _e163 = k;
-                q_end.inner[metal::min(unsigned(_e163), 255u)] = _e136 - 1u;
-                uint _e168 = k;
-                float _e171 = r.d;
-                q_d.inner[metal::min(unsigned(_e168), 255u)] = _e171;
-                uint _e173 = k;
-                float _e176 = r.theta;
-                q_theta.inner[metal::min(unsigned(_e173), 255u)] = _e176;
-                uint _e178 = k;
-                q_a.inner[metal::min(unsigned(_e178), 255u)] = _e161.x;
+                q_b.inner[metal::min(unsigned(_e163), 255u)] = _e161.y;
+                uint _e167 = k;
+                q_end.inner[metal::min(unsigned(_e167), 255u)] = _e136 - 1u;
+                uint _e172 = k;
+                float _e175 = r.d;
+                q_d.inner[metal::min(unsigned(_e172), 255u)] = _e175;
+                uint _e177 = k;
+                float _e180 = r.theta;
+                q_theta.inner[metal::min(unsigned(_e177), 255u)] = _e180;
                 uint _e182 = k;
-                q_b.inner[metal::min(unsigned(_e182), 255u)] = _e161.y;
+                q_a.inner[metal::min(unsigned(_e182), 255u)] = _e161.x;
                 uint _e187 = metal::atomic_fetch_add_explicit(&live, 1u, metal::memory_order_relaxed);
             }
         }
@@ -1775,7 +1776,7 @@ kernel void pst_sweep(
                     }
                     loop_init_17 = false;
                     uint _e549 = h;
-                    if (_e549 < RANK_VECS) {
+                    if (_e549 < LEAF_VECS) {
                     } else {
                         break;
                     }
@@ -1785,7 +1786,7 @@ kernel void pst_sweep(
                         uint _e560 = i;
                         uint _e561 = h;
                         metal::float4 _e562 = pst_leaf(f_18, _e560, row_3, delta_6, _e561, pst_factors, _buffer_sizes);
-                        pst_leaves[metal::min(unsigned(((base_1 + _e552) * RANK_VECS) + _e557), (_buffer_sizes.size6 - 0 - 16) / 16)] = _e562;
+                        pst_leaves[metal::min(unsigned(((base_1 + _e552) * LEAF_VECS) + _e557), (_buffer_sizes.size6 - 0 - 16) / 16)] = _e562;
                     }
                 }
             }
@@ -1793,10 +1794,10 @@ kernel void pst_sweep(
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_device);
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    uint trees = ((s_7 * 9u) * SLICE_SAMPLES) * RANK_VECS;
+    uint trees = ((s_7 * 9u) * SLICE_SAMPLES) * LEAF_VECS;
     uint partials = trees + 4096u;
     if (li < TREES) {
-        uint tree = trees + ((li * SLICE_SAMPLES) * RANK_VECS);
+        uint tree = trees + ((li * SLICE_SAMPLES) * LEAF_VECS);
         uint2 loop_bound_23 = uint2(4294967295u);
         bool loop_init_18 = true;
         while(true) {
@@ -1808,7 +1809,7 @@ kernel void pst_sweep(
             }
             loop_init_18 = false;
             uint _e585 = j_5;
-            if (_e585 < (v_9 * RANK_VECS)) {
+            if (_e585 < (v_9 * LEAF_VECS)) {
             } else {
                 break;
             }
@@ -1909,7 +1910,7 @@ kernel void pst_sweep(
                             }
                             loop_init_20 = false;
                             uint _e670 = h_1;
-                            if (_e670 < RANK_VECS) {
+                            if (_e670 < LEAF_VECS) {
                             } else {
                                 break;
                             }
@@ -1930,7 +1931,7 @@ kernel void pst_sweep(
                                         metal::float4 _e687 = p;
                                         uint _e688 = j_6;
                                         uint _e695 = h_1;
-                                        metal::float4 _e698 = pst_tree[metal::min(unsigned((tree + ((_e688 - 1u) * RANK_VECS)) + _e695), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                                        metal::float4 _e698 = pst_tree[metal::min(unsigned((tree + ((_e688 - 1u) * LEAF_VECS)) + _e695), (_buffer_sizes.size7 - 0 - 16) / 16)];
                                         p = _e687 + _e698;
                                         uint _e700 = j_6;
                                         uint _e701 = j_6;
@@ -1940,7 +1941,7 @@ kernel void pst_sweep(
                                 }
                                 uint _e712 = h_1;
                                 metal::float4 _e715 = p;
-                                pst_tree[metal::min(unsigned((partials + (k_10 * RANK_VECS)) + _e712), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e715;
+                                pst_tree[metal::min(unsigned((partials + (k_10 * LEAF_VECS)) + _e712), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e715;
                             }
                         }
                     }
@@ -1964,14 +1965,14 @@ kernel void pst_sweep(
                         }
                         loop_init_21 = false;
                         uint _e730 = h_2;
-                        if (_e730 < RANK_VECS) {
+                        if (_e730 < LEAF_VECS) {
                         } else {
                             break;
                         }
                         {
                             uint _e733 = i_1;
                             uint _e738 = h_2;
-                            metal::float4 leaf_1 = pst_leaves[metal::min(unsigned(((base_1 + _e733) * RANK_VECS) + _e738), (_buffer_sizes.size6 - 0 - 16) / 16)];
+                            metal::float4 leaf_1 = pst_leaves[metal::min(unsigned(((base_1 + _e733) * LEAF_VECS) + _e738), (_buffer_sizes.size6 - 0 - 16) / 16)];
                             j_7 = (v_9 - b_8) + 1u;
                             uint2 loop_bound_30 = uint2(4294967295u);
                             while(true) {
@@ -1985,8 +1986,8 @@ kernel void pst_sweep(
                                 {
                                     uint _e748 = j_7;
                                     uint _e755 = h_2;
-                                    metal::float4 _e758 = pst_tree[metal::min(unsigned((tree + ((_e748 - 1u) * RANK_VECS)) + _e755), (_buffer_sizes.size7 - 0 - 16) / 16)];
-                                    pst_tree[metal::min(unsigned((tree + ((_e748 - 1u) * RANK_VECS)) + _e755), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e758 + leaf_1;
+                                    metal::float4 _e758 = pst_tree[metal::min(unsigned((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                                    pst_tree[metal::min(unsigned((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e758 + leaf_1;
                                     uint _e760 = j_7;
                                     uint _e761 = j_7;
                                     uint _e762 = j_7;
@@ -2013,7 +2014,7 @@ kernel void pst_sweep(
         }
         loop_init_22 = false;
         uint _e775 = x;
-        if (_e775 < (v_9 * RANK_VECS)) {
+        if (_e775 < (v_9 * LEAF_VECS)) {
         } else {
             break;
         }
@@ -2038,7 +2039,7 @@ kernel void pst_sweep(
                 {
                     uint _e790 = c_1;
                     uint _e796 = x;
-                    uint at = (trees + ((_e790 * SLICE_SAMPLES) * RANK_VECS)) + _e796;
+                    uint at = (trees + ((_e790 * SLICE_SAMPLES) * LEAF_VECS)) + _e796;
                     metal::float4 own = pst_tree[metal::min(unsigned(at), (_buffer_sizes.size7 - 0 - 16) / 16)];
                     metal::float4 _e803 = running;
                     pst_tree[metal::min(unsigned(at), (_buffer_sizes.size7 - 0 - 16) / 16)] = _e803;
@@ -2072,7 +2073,7 @@ kernel void pst_sweep(
             if (_e819 != NONE) {
                 uint _e823 = k_4;
                 uint _e825 = q_end.inner[metal::min(unsigned(_e823), 255u)];
-                uint tree_1 = trees + ((metal::min(naga_div(_e825, cw), 7u) * SLICE_SAMPLES) * RANK_VECS);
+                uint tree_1 = trees + ((metal::min(naga_div(_e825, cw), 7u) * SLICE_SAMPLES) * LEAF_VECS);
                 dotp = 0.0;
                 h_3 = 0u;
                 uint2 loop_bound_34 = uint2(4294967295u);
@@ -2086,14 +2087,14 @@ kernel void pst_sweep(
                     }
                     loop_init_25 = false;
                     uint _e838 = h_3;
-                    if (_e838 < RANK_VECS) {
+                    if (_e838 < LEAF_VECS) {
                     } else {
                         break;
                     }
                     {
                         uint _e841 = k_4;
                         uint _e846 = h_3;
-                        metal::float4 _e849 = pst_tree[metal::min(unsigned((partials + (_e841 * RANK_VECS)) + _e846), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                        metal::float4 _e849 = pst_tree[metal::min(unsigned((partials + (_e841 * LEAF_VECS)) + _e846), (_buffer_sizes.size7 - 0 - 16) / 16)];
                         p_1 = _e849;
                         uint _e852 = k_4;
                         uint _e854 = q_rank.inner[metal::min(unsigned(_e852), 255u)];
@@ -2111,7 +2112,7 @@ kernel void pst_sweep(
                                 metal::float4 _e860 = p_1;
                                 uint _e861 = j_8;
                                 uint _e868 = h_3;
-                                metal::float4 _e871 = pst_tree[metal::min(unsigned((tree_1 + ((_e861 - 1u) * RANK_VECS)) + _e868), (_buffer_sizes.size7 - 0 - 16) / 16)];
+                                metal::float4 _e871 = pst_tree[metal::min(unsigned((tree_1 + ((_e861 - 1u) * LEAF_VECS)) + _e868), (_buffer_sizes.size7 - 0 - 16) / 16)];
                                 p_1 = _e860 + _e871;
                                 uint _e873 = j_8;
                                 uint _e874 = j_8;

@@ -93,6 +93,7 @@ const STEP: u32 = 1u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
 const RANK_VECS: u32 = 2u;
+const LEAF_VECS: u32 = 2u;
 const TREES: u32 = 8u;
 const GRID: u32 = 96u;
 const GL2_: f32 = 0.57735026f;
@@ -1048,17 +1049,17 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                 let _e160 = r;
                 let _e161 = pst_terms(_e160, row_3, delta_6, _e136);
                 let _e163 = k;
-                q_end[_e163] = (_e136 - 1u);
-                let _e168 = k;
-                let _e171 = r.d;
-                q_d[_e168] = _e171;
-                let _e173 = k;
-                let _e176 = r.theta;
-                q_theta[_e173] = _e176;
-                let _e178 = k;
-                q_a[_e178] = _e161.x;
+                q_b[_e163] = _e161.y;
+                let _e167 = k;
+                q_end[_e167] = (_e136 - 1u);
+                let _e172 = k;
+                let _e175 = r.d;
+                q_d[_e172] = _e175;
+                let _e177 = k;
+                let _e180 = r.theta;
+                q_theta[_e177] = _e180;
                 let _e182 = k;
-                q_b[_e182] = _e161.y;
+                q_a[_e182] = _e161.x;
                 let _e187 = atomicAdd((&live), 1u);
             }
         }
@@ -1388,7 +1389,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                 h = 0u;
                 loop {
                     let _e549 = h;
-                    if (_e549 < RANK_VECS) {
+                    if (_e549 < LEAF_VECS) {
                     } else {
                         break;
                     }
@@ -1398,7 +1399,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                         let _e560 = i;
                         let _e561 = h;
                         let _e562 = pst_leaf(f_18, _e560, row_3, delta_6, _e561);
-                        pst_leaves[(((base_1 + _e552) * RANK_VECS) + _e557)] = _e562;
+                        pst_leaves[(((base_1 + _e552) * LEAF_VECS) + _e557)] = _e562;
                     }
                     continuing {
                         let _e564 = h;
@@ -1414,13 +1415,13 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     }
     storageBarrier();
     workgroupBarrier();
-    let trees = (((s_7 * 9u) * SLICE_SAMPLES) * RANK_VECS);
+    let trees = (((s_7 * 9u) * SLICE_SAMPLES) * LEAF_VECS);
     let partials = (trees + 4096u);
     if (li < TREES) {
-        let tree = (trees + ((li * SLICE_SAMPLES) * RANK_VECS));
+        let tree = (trees + ((li * SLICE_SAMPLES) * LEAF_VECS));
         loop {
             let _e585 = j_5;
-            if (_e585 < (v_9 * RANK_VECS)) {
+            if (_e585 < (v_9 * LEAF_VECS)) {
             } else {
                 break;
             }
@@ -1501,7 +1502,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                         h_1 = 0u;
                         loop {
                             let _e670 = h_1;
-                            if (_e670 < RANK_VECS) {
+                            if (_e670 < LEAF_VECS) {
                             } else {
                                 break;
                             }
@@ -1519,7 +1520,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                                         let _e687 = p;
                                         let _e688 = j_6;
                                         let _e695 = h_1;
-                                        let _e698 = pst_tree[((tree + ((_e688 - 1u) * RANK_VECS)) + _e695)];
+                                        let _e698 = pst_tree[((tree + ((_e688 - 1u) * LEAF_VECS)) + _e695)];
                                         p = (_e687 + _e698);
                                         let _e700 = j_6;
                                         let _e701 = j_6;
@@ -1529,7 +1530,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                                 }
                                 let _e712 = h_1;
                                 let _e715 = p;
-                                pst_tree[((partials + (k_10 * RANK_VECS)) + _e712)] = _e715;
+                                pst_tree[((partials + (k_10 * LEAF_VECS)) + _e712)] = _e715;
                             }
                             continuing {
                                 let _e717 = h_1;
@@ -1548,14 +1549,14 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                     h_2 = 0u;
                     loop {
                         let _e730 = h_2;
-                        if (_e730 < RANK_VECS) {
+                        if (_e730 < LEAF_VECS) {
                         } else {
                             break;
                         }
                         {
                             let _e733 = i_1;
                             let _e738 = h_2;
-                            let leaf_1 = pst_leaves[(((base_1 + _e733) * RANK_VECS) + _e738)];
+                            let leaf_1 = pst_leaves[(((base_1 + _e733) * LEAF_VECS) + _e738)];
                             j_7 = ((v_9 - b_8) + 1u);
                             loop {
                                 let _e746 = j_7;
@@ -1566,8 +1567,8 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                                 {
                                     let _e748 = j_7;
                                     let _e755 = h_2;
-                                    let _e758 = pst_tree[((tree + ((_e748 - 1u) * RANK_VECS)) + _e755)];
-                                    pst_tree[((tree + ((_e748 - 1u) * RANK_VECS)) + _e755)] = (_e758 + leaf_1);
+                                    let _e758 = pst_tree[((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755)];
+                                    pst_tree[((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755)] = (_e758 + leaf_1);
                                     let _e760 = j_7;
                                     let _e761 = j_7;
                                     let _e762 = j_7;
@@ -1593,7 +1594,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     x = li;
     loop {
         let _e775 = x;
-        if (_e775 < (v_9 * RANK_VECS)) {
+        if (_e775 < (v_9 * LEAF_VECS)) {
         } else {
             break;
         }
@@ -1609,7 +1610,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                 {
                     let _e790 = c_1;
                     let _e796 = x;
-                    let at = ((trees + ((_e790 * SLICE_SAMPLES) * RANK_VECS)) + _e796);
+                    let at = ((trees + ((_e790 * SLICE_SAMPLES) * LEAF_VECS)) + _e796);
                     let own = pst_tree[at];
                     let _e803 = running;
                     pst_tree[at] = _e803;
@@ -1642,19 +1643,19 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
             if (_e819 != NONE) {
                 let _e823 = k_4;
                 let _e825 = q_end[_e823];
-                let tree_1 = (trees + ((min((_e825 / cw), 7u) * SLICE_SAMPLES) * RANK_VECS));
+                let tree_1 = (trees + ((min((_e825 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0f;
                 h_3 = 0u;
                 loop {
                     let _e838 = h_3;
-                    if (_e838 < RANK_VECS) {
+                    if (_e838 < LEAF_VECS) {
                     } else {
                         break;
                     }
                     {
                         let _e841 = k_4;
                         let _e846 = h_3;
-                        let _e849 = pst_tree[((partials + (_e841 * RANK_VECS)) + _e846)];
+                        let _e849 = pst_tree[((partials + (_e841 * LEAF_VECS)) + _e846)];
                         p_1 = _e849;
                         let _e852 = k_4;
                         let _e854 = q_rank[_e852];
@@ -1669,7 +1670,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                                 let _e860 = p_1;
                                 let _e861 = j_8;
                                 let _e868 = h_3;
-                                let _e871 = pst_tree[((tree_1 + ((_e861 - 1u) * RANK_VECS)) + _e868)];
+                                let _e871 = pst_tree[((tree_1 + ((_e861 - 1u) * LEAF_VECS)) + _e868)];
                                 p_1 = (_e860 + _e871);
                                 let _e873 = j_8;
                                 let _e874 = j_8;

@@ -75,6 +75,7 @@ const uint STEP = 1u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
 const uint RANK_VECS = 2u;
+const uint LEAF_VECS = 2u;
 const uint TREES = 8u;
 const uint GRID = 96u;
 const float GL2_ = 0.57735026;

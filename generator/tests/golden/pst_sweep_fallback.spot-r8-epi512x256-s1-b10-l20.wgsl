@@ -75,6 +75,7 @@ const STEP: u32 = 1u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
 const RANK_VECS: u32 = 2u;
+const LEAF_VECS: u32 = 2u;
 const TREES: u32 = 8u;
 const GRID: u32 = 96u;
 const GL2_: f32 = 0.57735026f;

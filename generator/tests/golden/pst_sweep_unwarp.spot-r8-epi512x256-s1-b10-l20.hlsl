@@ -95,6 +95,7 @@ static const uint STEP = 1u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
 static const uint RANK_VECS = 2u;
+static const uint LEAF_VECS = 2u;
 static const uint TREES = 8u;
 static const uint GRID = 96u;
 static const float GL2_ = 0.57735026;

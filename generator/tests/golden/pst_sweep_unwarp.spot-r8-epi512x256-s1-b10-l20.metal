@@ -101,6 +101,7 @@ constant uint STEP = 1u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
 constant uint RANK_VECS = 2u;
+constant uint LEAF_VECS = 2u;
 constant uint TREES = 8u;
 constant uint GRID = 96u;
 constant float GL2_ = 0.57735026;

@@ -538,19 +538,26 @@ pub fn run_partial_sum_tree(
     )?;
     let (depth, sm) = input_textures(gbuf, shadow_map);
     let rectified = rectify_passes(&mut frame.frame, &depth, &sm, variant.light);
+    let cookie = variant.cookie.then(|| cookie_texture(scene)).flatten();
     Ok(partial_sum_tree_from_rectified(
-        variant, frame, rectified, &depth, &sm,
+        variant,
+        frame,
+        rectified,
+        &depth,
+        &sm,
+        cookie.as_ref(),
     ))
 }
 
 /// `pst_sweep`, its unwarp and its fallback for a given frame (after `slice_fit`) and
-/// rectified map (the GPU's, in the conformance test).
+/// rectified map (the GPU's, in the conformance test); `cookie` for a `cookie` variant.
 pub fn partial_sum_tree_from_rectified(
     variant: &PartialSumTreeVariant,
     frame: PartialSumTreeFrame,
     rectified: Tex,
     depth: &Tex,
     shadow_map: &Tex,
+    cookie: Option<&TexArray>,
 ) -> PartialSumTreeRun {
     let inputs = pst_sweep::PstInputs {
         frame: &frame.frame.uniforms,
@@ -559,6 +566,7 @@ pub fn partial_sum_tree_from_rectified(
         shadow_map,
         rectified: &rectified,
         factors: &frame.factors,
+        cookie,
     };
     let (samples, counts) = pst_sweep::pst_sweep(variant, &inputs);
     let unwarped = pst_sweep_unwarp::pst_sweep_unwarp(variant, &inputs, &samples.samples);

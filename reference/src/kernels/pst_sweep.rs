@@ -7,7 +7,12 @@
 //! swept at once, then summed into exclusive prefixes over the trees. Conventions and the derivation:
 //! `scatter_frame::partial_sum_tree`. The WGSL's four phases run one after the other here;
 //! every value is computed by the same expression in the same order.
+//!
+//! With a cookie (`cookie = true`, see the WGSL comment) every leaf and tree entry holds three
+//! channels of `rank_vecs` vec4s, each query's dot product is per channel, and the last
+//! column and the epipole march carry the cookie.
 
+use super::common_cookie::{epipole_march_cookie, frame_cookie, lit_span_cookie};
 use super::common_epipolar::{
     edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta,
     row_index, row_phi, slice_e,
@@ -36,6 +41,28 @@ pub struct PstInputs<'a> {
     pub rectified: &'a Tex,
     /// The factors buffer (`PartialSumTreeFrame::factors`).
     pub factors: &'a [[f32; 4]],
+    /// The spot's cookie, for a `cookie` variant (`None`: a white cookie).
+    pub cookie: Option<&'a TexArray>,
+}
+
+/// What a `cookie` variant's kernels read of the cookie: the texture (a white texel where
+/// the inputs hold none) and the rank's vec4s (a leaf entry `h` is channel `h / rank_vecs`).
+#[derive(Clone, Copy)]
+pub struct Tint<'a> {
+    /// The cookie texture.
+    pub cookie: &'a TexArray,
+    /// `rank_vecs` of the variant.
+    pub rank_vecs: u32,
+}
+
+/// A 1 x 1 white cookie (a `cookie` variant run without one).
+fn white() -> TexArray {
+    TexArray {
+        width: 1,
+        height: 1,
+        layers: 1,
+        data: vec![[1.0; 4]],
+    }
 }
 
 /// What the sweep of every slice did (not written by the kernel: counts for reports).
@@ -81,8 +108,17 @@ fn beta_at(inp: &PstInputs, theta: f32, h: u32) -> Vec4 {
     )
 }
 
-/// Leaf of column `i` of `row` (spacing `delta`), bases `4h ..`.
-pub fn pst_leaf(inp: &PstInputs, spot: bool, i: u32, row: u32, delta: f32, h: u32) -> Vec4 {
+/// Leaf of column `i` of `row` (spacing `delta`), bases `4h ..`; with a cookie (`tint`) entry
+/// `h` is channel `h / rank_vecs`'s, bases `4 (h % rank_vecs) ..`.
+pub fn pst_leaf(
+    inp: &PstInputs,
+    spot: bool,
+    i: u32,
+    row: u32,
+    delta: f32,
+    h: u32,
+    tint: Option<Tint>,
+) -> Vec4 {
     let f = inp.frame;
     if !spot {
         return gamma_at(inp, i as f32 * delta, h);
@@ -95,7 +131,12 @@ pub fn pst_leaf(inp: &PstInputs, spot: bool, i: u32, row: u32, delta: f32, h: u3
         let psi = (i as f32 + 0.5 + 0.5 * q) * delta;
         let l = -axis * psi.cos() + e * psi.sin();
         let cone = cone_falloff(l.dot(xyz(f.light_dir)), f.light_pos[3], f.light_dir[3]);
-        leaf += (0.5 * delta * cone) * gamma_at(inp, psi, h);
+        if let Some(t) = tint {
+            let c = frame_cookie(f, t.cookie, xyz(f.light_pos) + l)[(h / t.rank_vecs) as usize];
+            leaf += (0.5 * delta * cone * c) * gamma_at(inp, psi, h % t.rank_vecs);
+        } else {
+            leaf += (0.5 * delta * cone) * gamma_at(inp, psi, h);
+        }
     }
     leaf
 }
@@ -124,8 +165,8 @@ pub struct PstRay {
 }
 
 /// The ray through the continuous pixel position `pc` ending at view depth `z` (WGSL
-/// `pst_ray`).
-pub fn pst_ray(inp: &PstInputs, spot: bool, pc: [f32; 2], z: f32) -> PstRay {
+/// `pst_ray`); `tint` for a `cookie` variant (the march carries the cookie).
+pub fn pst_ray(inp: &PstInputs, spot: bool, pc: [f32; 2], z: f32, tint: Option<Tint>) -> PstRay {
     let f = inp.frame;
     let eye = xyz(f.eye);
     let ndc = [
@@ -158,7 +199,10 @@ pub fn pst_ray(inp: &PstInputs, spot: bool, pc: [f32; 2], z: f32) -> PstRay {
         && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
     if near_epi || near_anti {
         r.marched = true;
-        r.color = epipole_march(f, inp.shadow_map, eye, dir, s, spot) * xyz(f.light_color);
+        r.color = match tint {
+            Some(t) => epipole_march_cookie(f, inp.shadow_map, t.cookie, eye, dir, s),
+            None => Vec3::splat(epipole_march(f, inp.shadow_map, eye, dir, s, spot)),
+        } * xyz(f.light_color);
     }
     r.theta = ray_theta(f, dir);
     r.row = row_index(
@@ -177,7 +221,8 @@ pub fn pst_columns_crossed(f: &FrameUniforms, r: &PstRay, delta: f32) -> u32 {
     min(select(0.0, xs, xs > 0.0).ceil(), f.sizes[2] as f32) as u32
 }
 
-/// A query's factor and term (WGSL `pst_terms`): `(a, b)`.
+/// A query's factor and term (WGSL `pst_terms`, with a cookie `pst_terms_cookie`): `(a, b)`,
+/// `b` per colour channel (the same in each without a cookie).
 pub fn pst_terms(
     inp: &PstInputs,
     spot: bool,
@@ -185,22 +230,31 @@ pub fn pst_terms(
     row: u32,
     delta: f32,
     n: u32,
-) -> [f32; 2] {
+    tint: Option<Tint>,
+) -> (f32, Vec3) {
     let f = inp.frame;
     let sin_theta = max(r.theta.sin(), 1e-6);
+    if let Some(t) = tint {
+        let mut tail = Vec3::ZERO;
+        if r.d <= inp.rectified.load(n - 1, row) {
+            let a = edge_t(f, n - 1, n, delta, r.theta, r.s, true);
+            tail = lit_span_cookie(f, t.cookie, r.eye, r.dir, a, r.s);
+        }
+        return (f.medium[1] / (f.axis[3] * sin_theta), tail);
+    }
     let mut tail = 0.0;
     if r.d <= inp.rectified.load(n - 1, row) {
         let a = edge_t(f, n - 1, n, delta, r.theta, r.s, spot);
         tail = lit_span(f, r.eye, r.dir, a, r.s, spot);
     }
     if spot {
-        return [f.medium[1] / (f.axis[3] * sin_theta), tail];
+        return (f.medium[1] / (f.axis[3] * sin_theta), Vec3::splat(tail));
     }
     let sp = f.medium[1] * phase_hg(f.medium[2], -xyz(f.light_dir).dot(r.dir));
-    [
+    (
         sp * transmittance_between(f.medium[0], 0.0, delta / sin_theta),
-        sp * tail,
-    ]
+        Vec3::splat(sp * tail),
+    )
 }
 
 /// View depth at the continuous pixel position `pc` from the 2 x 2 pixels around it, `1 / z`
@@ -249,11 +303,17 @@ pub fn pst_sweep_pixel(
 ) -> [f32; 3] {
     let f = inp.frame;
     let spot = variant.light == LightKind::Spot;
+    let white = white();
+    let tint = variant.cookie.then(|| Tint {
+        cookie: inp.cookie.unwrap_or(&white),
+        rank_vecs: variant.rank_vecs(),
+    });
     let r = pst_ray(
         inp,
         spot,
         [x as f32 + 0.5, y as f32 + 0.5],
         inp.depth.load(x, y),
+        tint,
     );
     if r.marched {
         return r.color.to_array();
@@ -263,18 +323,22 @@ pub fn pst_sweep_pixel(
     if n == 0 {
         return [0.0; 3];
     }
-    let mut sum = 0.0;
-    for h in 0..variant.rank_vecs() {
+    let rv = variant.rank_vecs();
+    let mut sum = Vec3::ZERO;
+    for h in 0..variant.leaf_vecs() {
         let mut p = Vec4::ZERO;
         for i in 0..n - 1 {
             if r.d <= inp.rectified.load(i, r.row) {
-                p += pst_leaf(inp, spot, i, r.row, delta, h);
+                p += pst_leaf(inp, spot, i, r.row, delta, h, tint);
             }
         }
-        sum += p.dot(beta_at(inp, r.theta, h));
+        sum[(h / rv) as usize] += p.dot(beta_at(inp, r.theta, h % rv));
     }
-    let ab = pst_terms(inp, spot, &r, r.row, delta, n);
-    (xyz(f.light_color) * (max(ab[0] * sum, 0.0) + ab[1])).to_array()
+    if !variant.cookie {
+        sum = Vec3::splat(sum.x);
+    }
+    let (a, b) = pst_terms(inp, spot, &r, r.row, delta, n, tint);
+    (xyz(f.light_color) * ((a * sum).max(Vec3::ZERO) + b)).to_array()
 }
 
 /// The samples pass: every slice swept (slices in parallel). Returns the
@@ -292,7 +356,14 @@ pub fn pst_sweep(
     let (n_slices, m) = (knobs.slices, knobs.slice_samples);
     let screen = [f.sizes[0], f.sizes[1]];
     let width = f.sizes[2];
-    let rv = variant.rank_vecs();
+    // vec4s per leaf and tree entry; the rank's.
+    let rv = variant.leaf_vecs();
+    let rank_vecs = variant.rank_vecs();
+    let white = white();
+    let tint = variant.cookie.then(|| Tint {
+        cookie: inp.cookie.unwrap_or(&white),
+        rank_vecs,
+    });
     let layout = epipolar_layout(&EpipolarCamera::of_frame(f), screen, n_slices);
     let depth_break = knobs.depth_break_fraction();
     let lines: Vec<(Vec<[f32; 4]>, SweepCounts)> = (0..n_slices)
@@ -307,7 +378,7 @@ pub fn pst_sweep(
                 let t = span[0] + k as f32 * span[1];
                 [layout.origin[0] + u[0] * t, layout.origin[1] + u[1] * t]
             };
-            let row = pst_ray(inp, spot, at(m - 1), 0.0).row;
+            let row = pst_ray(inp, spot, at(m - 1), 0.0, tint).row;
             let delta = inp.slices[row as usize].delta;
             let mut counts = SweepCounts::default();
 
@@ -316,7 +387,7 @@ pub fn pst_sweep(
             let mut q_end = vec![NONE; m as usize];
             let mut q_d = vec![0.0f32; m as usize];
             let mut q_theta = vec![0.0f32; m as usize];
-            let mut q_ab = vec![[0.0f32; 2]; m as usize];
+            let mut q_ab = vec![(0.0f32, Vec3::ZERO); m as usize];
             let mut v = 0u32;
             for k in 0..m {
                 let p = slice_sample_pixel(&layout, u, span, k, screen);
@@ -324,9 +395,9 @@ pub fn pst_sweep(
                 let footprint = pst_footprint_depth(inp, at(k), screen, depth_break);
                 let r = if footprint < 0.0 {
                     counts.edges += 1;
-                    pst_ray(inp, spot, [p[0] as f32 + 0.5, p[1] as f32 + 0.5], z)
+                    pst_ray(inp, spot, [p[0] as f32 + 0.5, p[1] as f32 + 0.5], z, tint)
                 } else {
-                    pst_ray(inp, spot, at(k), footprint)
+                    pst_ray(inp, spot, at(k), footprint, tint)
                 };
                 let n = pst_columns_crossed(f, &r, delta);
                 let ku = k as usize;
@@ -335,7 +406,7 @@ pub fn pst_sweep(
                     out[ku] = [c[0], c[1], c[2], z];
                     counts.direct += 1;
                 } else {
-                    q_ab[ku] = pst_terms(inp, spot, &r, row, delta, n);
+                    q_ab[ku] = pst_terms(inp, spot, &r, row, delta, n, tint);
                     q_end[ku] = n - 1;
                     q_d[ku] = r.d;
                     q_theta[ku] = r.theta;
@@ -387,7 +458,7 @@ pub fn pst_sweep(
                 columns[i as usize] = b;
                 if b > 0 {
                     for h in 0..rv {
-                        leaves[(i * rv + h) as usize] = pst_leaf(inp, spot, i, row, delta, h);
+                        leaves[(i * rv + h) as usize] = pst_leaf(inp, spot, i, row, delta, h, tint);
                     }
                 }
             }
@@ -456,7 +527,7 @@ pub fn pst_sweep(
                     continue;
                 }
                 let tree = (q_end[k] / cw).min(TREES - 1) as usize * stride;
-                let mut dotp = 0.0;
+                let mut dotp = Vec3::ZERO;
                 for h in 0..rv {
                     let mut p = partials[k * rv as usize + h as usize];
                     let mut j = v - q_rank[k];
@@ -464,9 +535,14 @@ pub fn pst_sweep(
                         p += trees[tree + ((j - 1) * rv + h) as usize];
                         j -= j & j.wrapping_neg();
                     }
-                    dotp += p.dot(beta_at(inp, q_theta[k], h));
+                    dotp[(h / rank_vecs) as usize] +=
+                        p.dot(beta_at(inp, q_theta[k], h % rank_vecs));
                 }
-                let c = xyz(f.light_color) * (max(q_ab[k][0] * dotp, 0.0) + q_ab[k][1]);
+                if !variant.cookie {
+                    dotp = Vec3::splat(dotp.x);
+                }
+                let (a, b) = q_ab[k];
+                let c = xyz(f.light_color) * ((a * dotp).max(Vec3::ZERO) + b);
                 let c = round_f16_rgb(c.to_array());
                 let p = slice_sample_pixel(&layout, u, span, k as u32, screen);
                 out[k] = [c[0], c[1], c[2], inp.depth.load(p[0], p[1])];

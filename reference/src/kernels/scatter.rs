@@ -330,7 +330,10 @@ pub fn scatter_main(
             };
             vis0 = exact(vis0, lohi0);
             vis1 = exact(vis1, lohi1);
-            (Vec3::splat(clamp(vis0, 0.0, 1.0)), Vec3::splat(clamp(vis1, 0.0, 1.0)))
+            (
+                Vec3::splat(clamp(vis0, 0.0, 1.0)),
+                Vec3::splat(clamp(vis1, 0.0, 1.0)),
+            )
         };
         if !done0 {
             total0 += weight0 * add0;

@@ -30,6 +30,11 @@ pub const SWEEP_WORKGROUP_SIZE: [u32; 3] = [SLICE_LANES, 1, 1];
 /// unwarp; `fallback_count` and `fallback_pixels` at the next two).
 pub const SAMPLED_BINDING: u32 = 10;
 
+/// The binding of the engine's `cookie` texture in a `cookie` variant's sweep and fallback:
+/// after the sampling stage's (`fallback_pixels` at 12), where the other families bind it at
+/// [`crate::plan::COOKIE_BINDING`].
+pub const COOKIE_BINDING: u32 = SAMPLED_BINDING + 3;
+
 /// `pst_sweep` and its unwarp and fallback renderings: one view, three templates.
 macro_rules! sweep_template {
     ($name:ident, $path:literal) => {
@@ -40,6 +45,9 @@ macro_rules! sweep_template {
             spot: bool,
             rank: u32,
             rank_vecs: u32,
+            leaf_vecs: u32,
+            cookie: bool,
+            cookie_binding: u32,
             grid: usize,
             per_lane: u32,
             trees: u32,
@@ -79,6 +87,9 @@ fn render(kernel: Kernel, variant: &PartialSumTreeVariant) -> Result<String, Sha
             spot,
             rank,
             rank_vecs,
+            leaf_vecs: variant.leaf_vecs(),
+            cookie: variant.cookie,
+            cookie_binding: COOKIE_BINDING,
             grid,
             per_lane,
             trees: TREES,
@@ -90,6 +101,9 @@ fn render(kernel: Kernel, variant: &PartialSumTreeVariant) -> Result<String, Sha
             spot,
             rank,
             rank_vecs,
+            leaf_vecs: variant.leaf_vecs(),
+            cookie: variant.cookie,
+            cookie_binding: COOKIE_BINDING,
             grid,
             per_lane,
             trees: TREES,
@@ -101,6 +115,9 @@ fn render(kernel: Kernel, variant: &PartialSumTreeVariant) -> Result<String, Sha
             spot,
             rank,
             rank_vecs,
+            leaf_vecs: variant.leaf_vecs(),
+            cookie: variant.cookie,
+            cookie_binding: COOKIE_BINDING,
             grid,
             per_lane,
             trees: TREES,

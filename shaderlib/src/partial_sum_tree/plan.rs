@@ -5,11 +5,14 @@
 
 use crate::Kernel;
 use crate::family::KernelFamily;
-use crate::partial_sum_tree::{FACTOR_VECS, PartialSumTreeVariant, SAMPLED_BINDING, TREES};
+use crate::partial_sum_tree::{
+    COOKIE_BINDING, FACTOR_VECS, PartialSumTreeVariant, SAMPLED_BINDING, TREES,
+};
 use crate::plan::{
     BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource, SLICE_FIT_NOTE,
-    TEXTURE_DIMENSION, bind, column_depth_buffer, depth_and_shadow_map, frame_buffer,
-    scatter_resource, scatter_texture, screen_and_shadow_parameters,
+    TEXTURE_DIMENSION, bind, column_depth_buffer, cookie_parameters, cookie_texture,
+    depth_and_shadow_map, frame_buffer, scatter_resource, scatter_texture,
+    screen_and_shadow_parameters,
 };
 use crate::sampling::{
     epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
@@ -50,7 +53,8 @@ pub fn plan(v: &PartialSumTreeVariant) -> Plan {
         },
     ]);
     let [depth, shadow_map] = depth_and_shadow_map();
-    let rv = v.rank_vecs();
+    // vec4s per leaf and tree entry (three channels of the rank's with a cookie).
+    let rv = v.leaf_vecs();
     let mut resources = vec![
         frame_buffer(
             "frame",
@@ -109,6 +113,10 @@ pub fn plan(v: &PartialSumTreeVariant) -> Plan {
             "screen.height",
         ),
     ];
+    if v.cookie {
+        parameters.extend(cookie_parameters());
+        resources.push(cookie_texture());
+    }
     resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
     resources.extend(fallback_buffers(&v.sampling_knobs()));
     let passes = v
@@ -175,7 +183,7 @@ pub fn pass(v: &PartialSumTreeVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations(&knobs),
                 skip_when: None,
-                bindings: vec![
+                bindings: [
                     bind(0, "frame"),
                     bind(1, "slices"),
                     bind(2, "depth"),
@@ -186,7 +194,10 @@ pub fn pass(v: &PartialSumTreeVariant, kernel: Kernel) -> Option<PassPlan> {
                     bind(7, "pst_tree"),
                     bind(8, "pst_columns"),
                     bind(9, sampled_output(&knobs)),
-                ],
+                ]
+                .into_iter()
+                .chain(v.cookie.then(|| bind(COOKIE_BINDING, "cookie")))
+                .collect(),
             },
             SAMPLED_BINDING,
         )),
