@@ -5,7 +5,7 @@
 
 use super::common_epipolar::{frame_spot_integrand, sm_visibility};
 use super::common_model::{
-    GL4_W, GL4_X, clamp, equiangular, equiangular_sample, max, max_u, spot_integrand, sqrt,
+    GL4_W, GL4_X, clamp, equiangular, equiangular_sample, max, max_u, min, spot_integrand, sqrt,
 };
 use super::texture::{Tex, TexArray, xyz};
 use glam::Vec3;
@@ -98,8 +98,42 @@ pub fn cookie_panels(
     ((tx + ty).ceil() as u32).clamp(panels, panels.max(MAX_COOKIE_PANELS))
 }
 
+/// The part of `[a, b]` of the ray inside the cookie's square pyramid, as `(start, end)`;
+/// `start >= end` where the ray misses it. See the WGSL comment.
+#[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+pub fn cookie_clip(
+    eye: Vec3,
+    dir: Vec3,
+    a: f32,
+    b: f32,
+    light_pos: Vec3,
+    frame: [Vec3; 3],
+    cos_outer: f32,
+) -> [f32; 2] {
+    let tan_outer = sqrt(max(1.0 - cos_outer * cos_outer, 0.0)) / cos_outer;
+    let o = eye - light_pos;
+    let z0 = o.dot(frame[2]) * tan_outer;
+    let z1 = dir.dot(frame[2]) * tan_outer;
+    let (mut lo, mut hi) = (a, b);
+    for k in 0..4u32 {
+        let axis = if k < 2 { frame[0] } else { frame[1] };
+        let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+        let g0 = z0 + sign * o.dot(axis);
+        let g1 = z1 + sign * dir.dot(axis);
+        if g1 > 0.0 {
+            lo = max(lo, -g0 / g1);
+        } else if g1 < 0.0 {
+            hi = min(hi, -g0 / g1);
+        } else if g0 < 0.0 {
+            hi = lo;
+        }
+    }
+    [lo, hi]
+}
+
 /// [`spot_span`] with the cookie ([`spot_cookie`]) at every node and [`cookie_panels`]
-/// panels (RGB). See the WGSL comment.
+/// panels over the part of `[a, b]` inside the cookie's pyramid ([`cookie_clip`]) (RGB). See
+/// the WGSL comment.
 #[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
 pub fn spot_span_cookie(
     cookie: &TexArray,
@@ -115,14 +149,22 @@ pub fn spot_span_cookie(
     medium: [f32; 4],
     frame: [Vec3; 3],
 ) -> Vec3 {
-    let n = cookie_panels(cookie, eye, dir, a, b, panels, light_pos, frame, cos_outer);
+    let [lo, hi] = cookie_clip(eye, dir, a, b, light_pos, frame, cos_outer);
+    // (`!(lo < hi)`, not `lo >= hi`: a NaN bound is a miss, as in the WGSL.)
+    #[allow(clippy::neg_cmp_op_on_partial_ord, reason = "NaN is a miss")]
+    if !(lo < hi) {
+        return Vec3::ZERO;
+    }
+    let n = cookie_panels(
+        cookie, eye, dir, lo, hi, panels, light_pos, frame, cos_outer,
+    );
     let t0 = (light_pos - eye).dot(dir);
     let h = max(
         (eye + dir * t0 - light_pos).length(),
-        1e-4 * max(b - a, 1e-6),
+        1e-4 * max(hi - lo, 1e-6),
     );
-    let g0 = ((a - t0) / h).atan();
-    let w = (((b - t0) / h).atan() - g0) / n as f32;
+    let g0 = ((lo - t0) / h).atan();
+    let w = (((hi - t0) / h).atan() - g0) / n as f32;
     let mut sum = Vec3::ZERO;
     for k in 0..n {
         let mid = g0 + (k as f32 + 0.5) * w;

@@ -71,9 +71,40 @@ fn cookie_panels(cookie: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, a: f32
     return clamp(u32(ceil(texels.x + texels.y)), panels, max(panels, MAX_COOKIE_PANELS));
 }
 
-// `spot_span` with the cookie (`spot_cookie`) at every node and `cookie_panels` panels: the
-// unshadowed RGB in-scattering of a spot with a cookie over `[a, b]` (without the light
-// colour). The light frame is the shadow map's (`right`, `up`, `forward`).
+// The part of `[a, b]` of the ray inside the cookie's square pyramid (the lamp at its apex,
+// `|d.right|, |d.up| <= d.forward tan_outer`), as (start, end); start >= end where the ray
+// misses it. The outer cone is inscribed in the pyramid, so the spot's integrand is 0
+// outside it: clipping the span to it changes no integral and spends no panel there.
+fn cookie_clip(eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, light_pos: vec3<f32>, right: vec3<f32>, up: vec3<f32>, forward: vec3<f32>, cos_outer: f32) -> vec2<f32> {
+    let tan_outer = sqrt(max(1.0 - cos_outer * cos_outer, 0.0)) / cos_outer;
+    let o = eye - light_pos;
+    let z0 = dot(o, forward) * tan_outer;
+    let z1 = dot(dir, forward) * tan_outer;
+    var lo = a;
+    var hi = b;
+    // The four side planes g0 + g1 t >= 0: z tan -+ x >= 0, z tan -+ y >= 0.
+    for (var k = 0u; k < 4u; k++) {
+        let axis = select(up, right, k < 2u);
+        let sign = select(-1.0, 1.0, k % 2u == 0u);
+        let g0 = z0 + sign * dot(o, axis);
+        let g1 = z1 + sign * dot(dir, axis);
+        if g1 > 0.0 {
+            lo = max(lo, -g0 / g1);
+        } else if g1 < 0.0 {
+            hi = min(hi, -g0 / g1);
+        } else if g0 < 0.0 {
+            hi = lo;
+        }
+    }
+    return vec2<f32>(lo, hi);
+}
+
+// `spot_span` with the cookie (`spot_cookie`) at every node and `cookie_panels` panels over
+// the part of `[a, b]` inside the cookie's pyramid (`cookie_clip`): the unshadowed RGB
+// in-scattering of a spot with a cookie over `[a, b]` (without the light colour). The light
+// frame is the shadow map's (`right`, `up`, `forward`). (Unclipped, a ray from behind the
+// lamp took the most panels on every span: prefiltered's scatter with the cookie measured
+// 481 ms at 320x180 on stained_glass, 10x the pass without it.)
 fn spot_span_cookie(
     cookie: texture_2d<f32>,
     eye: vec3<f32>,
@@ -90,11 +121,15 @@ fn spot_span_cookie(
     up: vec3<f32>,
     forward: vec3<f32>,
 ) -> vec3<f32> {
-    let n = cookie_panels(cookie, eye, dir, a, b, panels, light_pos, right, up, forward, cos_outer);
+    let span = cookie_clip(eye, dir, a, b, light_pos, right, up, forward, cos_outer);
+    if !(span.x < span.y) {
+        return vec3<f32>(0.0);
+    }
+    let n = cookie_panels(cookie, eye, dir, span.x, span.y, panels, light_pos, right, up, forward, cos_outer);
     let t0 = dot(light_pos - eye, dir);
-    let h = max(length(eye + dir * t0 - light_pos), 1e-4 * max(b - a, 1e-6));
-    let g0 = atan((a - t0) / h);
-    let w = (atan((b - t0) / h) - g0) / f32(n);
+    let h = max(length(eye + dir * t0 - light_pos), 1e-4 * max(span.y - span.x, 1e-6));
+    let g0 = atan((span.x - t0) / h);
+    let w = (atan((span.y - t0) / h) - g0) / f32(n);
     var sum = vec3<f32>(0.0);
     for (var k = 0u; k < n; k++) {
         let mid = g0 + (f32(k) + 0.5) * w;
