@@ -17,6 +17,7 @@
 //! | pose | `closed_room` | inside `window` with the sun behind the back wall: no light enters, truth exactly 0 |
 //! | pose | `closed_room_windows` | as `closed_room`, looking at the windows from inside (the lit fog outside is seen through them) |
 //! | pose | `spot_epipole_centre` | the camera looks straight at a spot lamp |
+//! | pose | `spot_cookie_epipole_centre` | as `spot_epipole_centre`, the lamp with the `stained_glass` cookie (64^2): every family's `cookie` variant |
 //! | pose | `spot_in_cone` | the eye stands inside the spot's cone |
 //! | pose | `spot_outside_cone` | the eye stands outside the spot's cone |
 //! | medium | `sigma_t_0` | no medium: every method must output exactly 0 |
@@ -490,11 +491,30 @@ pub fn cases(width: u32, height: u32) -> Vec<StressCase> {
     };
     let eye = v(6.0, 1.5, 6.0);
     look(&mut s, eye, lamp - eye);
+    let mut tinted = s.clone();
     out.push(case(
         "spot_epipole_centre",
         P,
         "the camera looks straight at the spot lamp",
         s,
+        Premise::EpipoleAt {
+            x: centre.0,
+            y: centre.1,
+            tol_px: 1e-6,
+        },
+    ));
+    if let Light::Spot { cookie, .. } = &mut tinted.light {
+        *cookie = Some(
+            crate::cookie::Cookie::pattern("stained_glass", 64)
+                .expect("stained_glass is a built-in pattern"),
+        );
+    }
+    out.push(case(
+        "spot_cookie_epipole_centre",
+        P,
+        "the camera looks straight at a spot lamp with the stained_glass cookie (the coloured \
+         glow around the lamp is marched per sample, the rest integrated with the cookie)",
+        tinted,
         Premise::EpipoleAt {
             x: centre.0,
             y: centre.1,

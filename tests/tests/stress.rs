@@ -257,10 +257,13 @@ impl Prepared {
         }
     }
 
-    /// `method` as this case runs it: the case's light, and the case's bases for the
-    /// prefiltered family.
+    /// `method` as this case runs it: the case's light (with its cookie where the spot has
+    /// one: every family reads it), and the case's bases for the prefiltered family.
     fn variant(&self, method: &FamilyVariant) -> FamilyVariant {
         let mut v = method.with_light(self.light());
+        if self.case.scene.light.cookie().is_some() {
+            v = v.with_cookie(true).unwrap_or(v);
+        }
         if let (FamilyVariant::Prefiltered(p), Some(bases)) = (&mut v, self.case.bases)
             && p.basis == Basis::Fourier
         {
