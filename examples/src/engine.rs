@@ -147,7 +147,8 @@ struct Shade {
     light_pos: vec4<f32>,
     // direction light travels (the spot's axis), cos(inner)
     light_dir: vec4<f32>,
-    // cone: 0 none, 1 step at cos(outer), 2 smoothstep; shadow map size; bias texels; -
+    // cone: 0 none, 1 step at cos(outer), 2 smoothstep; shadow map size; bias texels;
+    // 1 = the spot has a cookie
     light_extra: vec4<f32>,
     // map origin, 1 = perspective
     sm_origin: vec4<f32>,
@@ -161,6 +162,8 @@ struct Shade {
 
 @group(0) @binding(0) var<uniform> u: Shade;
 @group(0) @binding(1) var shadow_map: texture_2d<f32>;
+// The spot's cookie (white 1 x 1 without one), the texture the family's passes read.
+@group(0) @binding(2) var cookie: texture_2d<f32>;
 
 const PI: f32 = 3.14159265358979;
 
@@ -235,6 +238,33 @@ fn cone(cos_angle: f32) -> f32 {
     return x * x * (3.0 - 2.0 * x);
 }
 
+// scatter_frame::cookie for a point `from_lamp` away from the spot lamp: the cookie in the
+// spot's shadow-map basis (its square circumscribing the outer cone), bilinear between texel
+// centres from four loads, clamped to the edge; black behind the lamp; white without a
+// cookie. The kernels' `scatter::cookie::spot_cookie`.
+fn cookie_tint(from_lamp: vec3<f32>) -> vec3<f32> {
+    if u.light_extra.w < 0.5 {
+        return vec3<f32>(1.0);
+    }
+    let z = dot(from_lamp, u.sm_forward.xyz);
+    if z <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let co = u.light_pos.w;
+    let tan_outer = sqrt(max(1.0 - co * co, 0.0)) / co;
+    let a = dot(from_lamp, u.sm_right.xyz) / (z * tan_outer);
+    let b = dot(from_lamp, u.sm_up.xyz) / (z * tan_outer);
+    let size = vec2<i32>(textureDimensions(cookie));
+    let q = vec2<f32>(0.5 * (a + 1.0), 0.5 * (1.0 - b)) * vec2<f32>(size) - 0.5;
+    let q0 = floor(q);
+    let t = q - q0;
+    let i0 = clamp(vec2<i32>(q0), vec2<i32>(0), size - 1);
+    let i1 = clamp(vec2<i32>(q0) + 1, vec2<i32>(0), size - 1);
+    let top = mix(textureLoad(cookie, i0, 0).rgb, textureLoad(cookie, vec2<i32>(i1.x, i0.y), 0).rgb, t.x);
+    let bottom = mix(textureLoad(cookie, vec2<i32>(i0.x, i1.y), 0).rgb, textureLoad(cookie, i1, 0).rgb, t.x);
+    return mix(top, bottom, t.y);
+}
+
 @fragment
 fn fs(in: Surface) -> @location(0) vec4<f32> {
     let sigma_t = u.cam_pos.w;
@@ -251,6 +281,7 @@ fn fs(in: Surface) -> @location(0) vec4<f32> {
     let p = in.world + n * 1e-4;
     var to_light: vec3<f32>;
     var l_in: f32;
+    var tint = vec3<f32>(1.0);
     if u.light_color.w < 0.5 {
         to_light = -u.light_dir.xyz;
         l_in = 1.0;
@@ -259,13 +290,14 @@ fn fs(in: Surface) -> @location(0) vec4<f32> {
         let dist = max(length(d), 1e-9);
         to_light = d / dist;
         l_in = cone(dot(-to_light, u.light_dir.xyz)) * exp(-sigma_t * dist) / (dist * dist);
+        tint = cookie_tint(-d);
     }
     let cos_n = max(dot(n, to_light), 0.0);
     var lit = 0.0;
     if cos_n > 0.0 {
         lit = visibility(p);
     }
-    let direct = in.albedo / PI * u.light_color.rgb * (l_in * cos_n * lit);
+    let direct = in.albedo / PI * u.light_color.rgb * tint * (l_in * cos_n * lit);
     let ambient = in.albedo * u.sky.rgb;
     return vec4<f32>((direct + ambient) * exp(-sigma_t * s), 1.0);
 }
@@ -422,7 +454,16 @@ fn shade_uniform(scene: &Scene, map: &ShadowMap) -> Vec<u8> {
         [color[0] as f32, color[1] as f32, color[2] as f32, kind],
         v(pos, cos_outer),
         v(dir, cos_inner),
-        [mode, map.size as f32, SHADOW_BIAS_TEXELS as f32, 0.0],
+        [
+            mode,
+            map.size as f32,
+            SHADOW_BIAS_TEXELS as f32,
+            if scene.light.cookie().is_some() {
+                1.0
+            } else {
+                0.0
+            },
+        ],
         v(map.origin, perspective),
         v(map.basis[0], map.near),
         v(map.basis[1], map.far),
@@ -481,6 +522,16 @@ impl Engine {
                 },
                 wgpu::BindGroupLayoutEntry {
                     binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
                     visibility: wgpu::ShaderStages::FRAGMENT,
                     ty: wgpu::BindingType::Texture {
                         sample_type: wgpu::TextureSampleType::Float { filterable: false },
@@ -600,7 +651,7 @@ impl Engine {
             Some(_) => settings.variant.with_cookie(true).ok_or_else(|| {
                 format!(
                     "the scene's spot light has a cookie, which the {family_name} family does \
-                     not read (raymarch, minmax and hybrid_volume do)"
+                     not read"
                 )
             })?,
         };
@@ -614,16 +665,23 @@ impl Engine {
         };
         let mut family = FamilyPasses::new(ctx, &variant, res, settings.shadow_map)
             .map_err(|e| format!("{family_name} {}: {e}", variant.id()))?;
-        if let Some(cookie) = scene.light.cookie() {
-            let texture = scatter_runtime::textures::upload_cookie(
-                ctx,
-                Kernel::Raymarch,
-                [cookie.width(), cookie.height()],
-                &cookie.rgba(),
-            )
-            .map_err(|e| format!("cookie: {e}"))?;
+        // The cookie the family's passes and the shading read (white 1 x 1 without one,
+        // for the shading's binding).
+        let (cookie_size, cookie_texels) = scene.light.cookie().map_or_else(
+            || ([1, 1], vec![[1.0; 4]]),
+            |c| ([c.width(), c.height()], c.rgba()),
+        );
+        let cookie = scatter_runtime::textures::upload_cookie(
+            ctx,
+            Kernel::Raymarch,
+            cookie_size,
+            &cookie_texels,
+        )
+        .map_err(|e| format!("cookie: {e}"))?
+        .create_view(&wgpu::TextureViewDescriptor::default());
+        if scene.light.cookie().is_some() {
             family
-                .set_cookie(&texture.create_view(&wgpu::TextureViewDescriptor::default()))
+                .set_cookie(&cookie)
                 .map_err(|e| format!("cookie: {e}"))?;
         }
         times.push((format!("{family_name} set-up (pipelines)"), t.elapsed()));
@@ -686,7 +744,7 @@ impl Engine {
         times.push((format!("{family_name} passes"), t.elapsed()));
 
         let t = Instant::now();
-        let shaded = self.shade(ctx, scene, &raster, screen);
+        let shaded = self.shade(ctx, scene, &raster, &cookie, screen);
         wait()?;
         times.push(("shade".to_owned(), t.elapsed()));
 
@@ -796,6 +854,7 @@ impl Engine {
         ctx: &Context,
         scene: &Scene,
         raster: &RasterFrame,
+        cookie: &wgpu::TextureView,
         [w, h]: [u32; 2],
     ) -> wgpu::Texture {
         let device = ctx.device();
@@ -868,6 +927,10 @@ impl Engine {
                 wgpu::BindGroupEntry {
                     binding: 1,
                     resource: wgpu::BindingResource::TextureView(&shadow_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(cookie),
                 },
             ],
         });

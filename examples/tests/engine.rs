@@ -1,6 +1,7 @@
 //! The engine example's frame (`scatter_examples::engine`, issue 18 part 1) on three suite
 //! poses at 160x90, each with the prefiltered family (one of them projective: its
-//! rectified map rasterised) and one with raymarch:
+//! rectified map rasterised), one with raymarch, and `spot_grate` with the `stained_glass`
+//! cookie (prefiltered; the shading carries the cookie too):
 //! - the 8-bit composite is the tone map of shaded + shafts read back (within one level of
 //!   the 255, from the GPU's f32 to the CPU's), at the exposure the GPU's histogram found,
 //!   which is the CPU's 99.5th percentile to within its bin;
@@ -16,8 +17,10 @@ use scatter_conformance::gpu;
 use scatter_examples::engine::{Engine, EngineSettings, OUTPUTS, tonemap, write_outputs};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
+use scatter_reference::cookie::Cookie;
 use scatter_reference::image::Image;
 use scatter_reference::metrics;
+use scatter_reference::scene::Light;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::shaderlib::family::FamilyVariant;
@@ -69,28 +72,41 @@ fn the_engine_composites_shafts_over_the_shaded_scene() {
     let Some(ctx) = gpu() else { return };
     let engine = Engine::new(ctx);
     let dir = TempDir::new("composite");
-    // `None`: raymarch; otherwise prefiltered with that rectification.
+    // `None`: raymarch; otherwise prefiltered with that rectification; the last flag puts
+    // the `stained_glass` cookie (64^2) on the spot (the shafts and the shading carry it).
     let cases = [
         (
             SceneName::Sphere,
             Pose::Ordinary,
             Some(Rectification::Epipolar),
+            false,
         ),
         (
             SceneName::Columns,
             Pose::Ordinary,
             Some(Rectification::Projective),
+            false,
         ),
         (
             SceneName::SpotGrate,
             Pose::Ordinary,
             Some(Rectification::Epipolar),
+            false,
         ),
-        (SceneName::SpotGrate, Pose::Ordinary, None),
+        (SceneName::SpotGrate, Pose::Ordinary, None, false),
+        (
+            SceneName::SpotGrate,
+            Pose::Ordinary,
+            Some(Rectification::Epipolar),
+            true,
+        ),
     ];
     let mut failures = Vec::new();
-    for (name, pose, rectification) in cases {
-        let scene = suite::scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
+    for (name, pose, rectification, tinted) in cases {
+        let mut scene = suite::scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
+        if let (true, Light::Spot { cookie, .. }) = (tinted, &mut scene.light) {
+            *cookie = Some(Cookie::pattern("stained_glass", 64).expect("a built-in pattern"));
+        }
         let light = scene.light.kind();
         let variant = match rectification {
             Some(rectification) => FamilyVariant::Prefiltered(PrefilteredVariant {
@@ -102,6 +118,13 @@ fn the_engine_composites_shafts_over_the_shaded_scene() {
                 light,
                 ..RaymarchVariant::default()
             }),
+        };
+        let variant = if tinted {
+            variant
+                .with_cookie(true)
+                .expect("every family reads a cookie")
+        } else {
+            variant
         };
         let id = format!("{name}/{pose} {}", variant.trial_name());
         let bvh = Bvh::build(&scene.geometry);
