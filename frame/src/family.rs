@@ -327,8 +327,8 @@ mod tests {
             assert_eq!(family.default_variant().family(), family);
             assert!(family.default_variant().validate().is_ok());
         }
-        // 2016 Fourier variants and 64 of the moment basis.
-        assert_eq!(Family::Prefiltered.grid().len(), 2016 + 64);
+        // 2016 Fourier variants, 64 of the moment basis and 12 with a cookie.
+        assert_eq!(Family::Prefiltered.grid().len(), 2016 + 64 + 12);
     }
 
     #[test]
