@@ -55,16 +55,6 @@ pub struct Tint<'a> {
     pub rank_vecs: u32,
 }
 
-/// A 1 x 1 white cookie (a `cookie` variant run without one).
-fn white() -> TexArray {
-    TexArray {
-        width: 1,
-        height: 1,
-        layers: 1,
-        data: vec![[1.0; 4]],
-    }
-}
-
 /// What the sweep of every slice did (not written by the kernel: counts for reports).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SweepCounts {
@@ -303,7 +293,7 @@ pub fn pst_sweep_pixel(
 ) -> [f32; 3] {
     let f = inp.frame;
     let spot = variant.light == LightKind::Spot;
-    let white = white();
+    let white = TexArray::white();
     let tint = variant.cookie.then(|| Tint {
         cookie: inp.cookie.unwrap_or(&white),
         rank_vecs: variant.rank_vecs(),
@@ -359,7 +349,7 @@ pub fn pst_sweep(
     // vec4s per leaf and tree entry; the rank's.
     let rv = variant.leaf_vecs();
     let rank_vecs = variant.rank_vecs();
-    let white = white();
+    let white = TexArray::white();
     let tint = variant.cookie.then(|| Tint {
         cookie: inp.cookie.unwrap_or(&white),
         rank_vecs,

@@ -83,12 +83,7 @@ pub fn scatter_main(
     let near_anti = f.anti_epipole[2] > 0.5
         && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
     let tinted = variant.cookie;
-    let white = TexArray {
-        width: 1,
-        height: 1,
-        layers: 1,
-        data: vec![[1.0; 4]],
-    };
+    let white = TexArray::white();
     let cookie = inp.cookie.unwrap_or(&white);
     if near_epi || near_anti {
         let l = if tinted {

@@ -50,6 +50,16 @@ pub struct TexArray {
 }
 
 impl TexArray {
+    /// A 1 x 1 white texel: the cookie a `cookie` variant's mirror reads when it is given none.
+    pub fn white() -> TexArray {
+        TexArray {
+            width: 1,
+            height: 1,
+            layers: 1,
+            data: vec![[1.0; 4]],
+        }
+    }
+
     /// A zeroed array.
     pub fn new(width: u32, height: u32, layers: u32) -> TexArray {
         TexArray {
