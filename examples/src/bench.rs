@@ -224,12 +224,12 @@ pub struct BenchConfig {
 
 impl BenchConfig {
     /// The default sweep: every scene at `ordinary` and `epipole_on_screen`, prefiltered
-    /// (M, R) in {(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)} and raymarch N in {16, 32,
+    /// (M, R) in {(16, 4), (32, 1), (32, 3), (32, 4), (32, 8), (64, 4)} and raymarch N in {16, 32,
     /// 64, 128, 256} plus interleaved (64, 4x4) and (256, 4x4), and minmax, at 320x180 with
     /// a 512x512 rectified map (prefiltered and minmax) and a 1024^2 shadow map, 5 frames;
     /// plus the scaling and headline runs.
     pub fn default_sweep() -> BenchConfig {
-        let mut methods: Vec<Method> = [(16, 3), (32, 1), (32, 3), (32, 8), (64, 3)]
+        let mut methods: Vec<Method> = [(16, 4), (32, 1), (32, 3), (32, 4), (32, 8), (64, 4)]
             .into_iter()
             .map(|(bases, regions)| {
                 Method::from(PrefilteredVariant {
@@ -1038,7 +1038,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
     let variants = per_variant(&result.rows);
     let reference = variants
         .iter()
-        .find(|v| v.0 == "prefiltered" && v.1 == "m32-r3");
+        .find(|v| v.0 == "prefiltered" && v.1 == "m32-r4");
     if let Some(p) = reference {
         let matching = variants
             .iter()
@@ -1046,7 +1046,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             .min_by(|a, b| a.2.total_cmp(&b.2));
         match matching {
             Some(r) => out.push(format!(
-                "prefiltered m32-r3 ({:.2} ms, mean rel L1 {:.2} %) vs the cheapest raymarch at equal or better error, {} ({:.2} ms, {:.2} %): raymarch takes {:.2}x the time",
+                "prefiltered m32-r4 ({:.2} ms, mean rel L1 {:.2} %) vs the cheapest raymarch at equal or better error, {} ({:.2} ms, {:.2} %): raymarch takes {:.2}x the time",
                 p.2,
                 100.0 * p.3,
                 r.1,
@@ -1061,7 +1061,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                     .min_by(|a, b| a.3.total_cmp(&b.3));
                 out.push(match best {
                     Some(b) => format!(
-                        "prefiltered m32-r3 ({:.2} ms, mean rel L1 {:.2} %): no raymarch variant in the sweep reaches its error; the most accurate, {} ({:.2} ms), has {:.2} % ({:.2}x the time)",
+                        "prefiltered m32-r4 ({:.2} ms, mean rel L1 {:.2} %): no raymarch variant in the sweep reaches its error; the most accurate, {} ({:.2} ms), has {:.2} % ({:.2}x the time)",
                         p.2,
                         100.0 * p.3,
                         b.1,
@@ -1121,7 +1121,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 .find(|r| r.family == family && r.knobs == knobs && r.scene == scene)
                 .map(|r| ms(r.total()))
         };
-        if let Some(p) = time("prefiltered", "m32-r3") {
+        if let Some(p) = time("prefiltered", "m32-r4") {
             for knobs in ["n64-i1", "n128-i1", "n64-i4"] {
                 if let Some(r) = time("raymarch", knobs) {
                     let tag = if matching.as_deref() == Some(knobs) {
@@ -1130,7 +1130,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                         ""
                     };
                     out.push(format!(
-                        "headline 1280x720, 1024x1024 rectified, {scene}/ordinary: raymarch {knobs}{tag} {r:.1} ms / prefiltered m32-r3 {p:.1} ms = {:.2}",
+                        "headline 1280x720, 1024x1024 rectified, {scene}/ordinary: raymarch {knobs}{tag} {r:.1} ms / prefiltered m32-r4 {p:.1} ms = {:.2}",
                         r / p
                     ));
                 }
@@ -1154,10 +1154,10 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             _ => None,
         }
     };
-    if let Some((pt, pe)) = headline_mean("prefiltered", "m32-r3") {
+    if let Some((pt, pe)) = headline_mean("prefiltered", "m32-r4") {
         for (family, knobs) in [
-            ("prefiltered", "moments4-r3"),
-            ("prefiltered", "moments6-r3"),
+            ("prefiltered", "moments4-r4"),
+            ("prefiltered", "moments6-r4"),
             ("prefiltered", "moments6-r8"),
             ("raymarch", "n64-i1"),
             ("raymarch", "n128-i1"),
@@ -1170,7 +1170,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
         ] {
             if let Some((t, e)) = headline_mean(family, knobs) {
                 out.push(format!(
-                    "headline 1280x720, means over sphere, foliage and terrain (ordinary): {family} {knobs} {t:.1} ms at rel L1 {:.3} % / prefiltered m32-r3 {pt:.1} ms at {:.3} %: {:.2}x the time, {} error",
+                    "headline 1280x720, means over sphere, foliage and terrain (ordinary): {family} {knobs} {t:.1} ms at rel L1 {:.3} % / prefiltered m32-r4 {pt:.1} ms at {:.3} %: {:.2}x the time, {} error",
                     100.0 * e,
                     100.0 * pe,
                     t / pt,
@@ -1187,7 +1187,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             ("raymarch", "n128-i1"),
             ("raymarch", "n256-i1"),
             ("minmax", "minmax"),
-            ("prefiltered", "m32-r3"),
+            ("prefiltered", "m32-r4"),
         ] {
             if let Some((t, e)) = headline_mean(family, knobs) {
                 out.push(format!(
@@ -1201,7 +1201,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
     }
     // Issue 13's targets, per prefiltered basis: the brute-force march at about the same
     // error, how much longer it takes, and whether the prefiltered error is at or below it.
-    for prefiltered in ["m32-r3", "moments4-r3", "moments6-r3", "moments6-r8"] {
+    for prefiltered in ["m32-r4", "moments4-r4", "moments6-r4", "moments6-r8"] {
         let Some((pt, pe)) = headline_mean("prefiltered", prefiltered) else {
             continue;
         };
@@ -1275,7 +1275,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
         }
     }
     for family_knobs in [
-        ("prefiltered", "m32-r3"),
+        ("prefiltered", "m32-r4"),
         ("raymarch", "n64-i1"),
         ("minmax", "minmax"),
     ] {
@@ -1304,7 +1304,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 .iter()
                 .find(|r| {
                     r.family == family
-                        && (r.knobs == "m32-r3" || family == "minmax")
+                        && (r.knobs == "m32-r4" || family == "minmax")
                         && r.scene == scene.name()
                         && r.pose == Pose::Ordinary.name()
                 })
@@ -1312,7 +1312,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
         };
         if let (Some(p), Some(m)) = (sweep("prefiltered"), sweep("minmax")) {
             out.push(format!(
-                "{scene}/ordinary at the sweep size: minmax {:.1} ms ({:.2} %) / prefiltered m32-r3 {:.1} ms ({:.2} %) = {:.2}",
+                "{scene}/ordinary at the sweep size: minmax {:.1} ms ({:.2} %) / prefiltered m32-r4 {:.1} ms ({:.2} %) = {:.2}",
                 m.0,
                 100.0 * m.1,
                 p.0,
@@ -1327,15 +1327,15 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 .find(|r| r.family == family && r.knobs == knobs && r.scene == scene)
                 .map(|r| ms(r.total()))
         };
-        if let (Some(p), Some(m)) = (head("prefiltered", "m32-r3"), head("minmax", "minmax")) {
+        if let (Some(p), Some(m)) = (head("prefiltered", "m32-r4"), head("minmax", "minmax")) {
             out.push(format!(
-                "{scene}/ordinary at 1280x720, 1024x1024 rectified: minmax {m:.1} ms / prefiltered m32-r3 {p:.1} ms = {:.2}",
+                "{scene}/ordinary at 1280x720, 1024x1024 rectified: minmax {m:.1} ms / prefiltered m32-r4 {p:.1} ms = {:.2}",
                 m / p
             ));
         }
     }
     for (family, knobs) in [
-        ("prefiltered", "m32-r3"),
+        ("prefiltered", "m32-r4"),
         ("raymarch", "n64-i1"),
         ("minmax", "minmax"),
     ] {
@@ -1367,7 +1367,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
         for r in &result.scaling {
             let t: f64 = r.passes.iter().copied().map(ms).sum();
             out.push(format!(
-                "prefiltered m32-r3 scaling, {}x{} screen, {}x{} rectified: {:.1} ms (depth_columns {:.1}, slice_fit {:.1}, rectify {:.1}, prefilter {:.1}, scatter {:.1}) = {:.2}x the 1280x720 / 512x1024 time",
+                "prefiltered m32-r4 scaling, {}x{} screen, {}x{} rectified: {:.1} ms (depth_columns {:.1}, slice_fit {:.1}, rectify {:.1}, prefilter {:.1}, scatter {:.1}) = {:.2}x the 1280x720 / 512x1024 time",
                 r.screen[0],
                 r.screen[1],
                 r.rectified[0],
@@ -1661,8 +1661,8 @@ pub fn write_outputs(
     Ok(written)
 }
 
-/// The `tune` first-stage grid: prefiltered (M, R) over {16, 32, 64} x {1, 3, 8} (the
-/// paper's 8 bases per thread, rgba8unorm) and the moment basis with 4 or 6 moments and 3 or
+/// The `tune` first-stage grid: prefiltered (M, R) over {16, 32, 64} x {1, 4, 8} (the
+/// paper's 8 bases per thread, rgba8unorm) and the moment basis with 4 or 6 moments and 4 or
 /// 8 regions, each with a 512x512 and a 256x256 rectified map,
 /// raymarch N over {16, 32, 64, 128, 256, 512} plus interleaved (64, 4x4) and (256, 4x4),
 /// minmax with both maps. Run it with `BenchConfig::rectified` = 512x512.
@@ -1670,7 +1670,7 @@ pub fn tune_candidates() -> Vec<Method> {
     let mut out = Vec::new();
     for rectified in [None, Some([256, 256])] {
         for bases in [16, 32, 64] {
-            for regions in [1, 3, 8] {
+            for regions in [1, 4, 8] {
                 out.push(Method::new(
                     PrefilteredVariant {
                         bases,
@@ -1682,7 +1682,7 @@ pub fn tune_candidates() -> Vec<Method> {
             }
         }
         for moments in PrefilteredVariant::MOMENTS {
-            for regions in [3, 8] {
+            for regions in [4, 8] {
                 out.push(Method::new(
                     PrefilteredVariant {
                         regions,
@@ -1994,7 +1994,7 @@ mod tests {
         );
         assert_eq!(
             tune_pick(&table, 0.02).map(|e| e.knobs.as_str()),
-            Some("m32-r3-256x256")
+            Some("m32-r4-256x256")
         );
         assert_eq!(
             tune_pick(&table, 0.01).map(|e| e.knobs.as_str()),
@@ -2003,7 +2003,7 @@ mod tests {
         assert_eq!(tune_pick(&table, 0.001), None);
         assert_eq!(
             scatter_gen_command(&table[2].method, [512, 512]),
-            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 8 --basis fourier --depth-break 10 --light spot --light-break 20 --moments 4 --rectification epipolar --regions 3 --sampling pixels --scale 2 --slice-samples 256 --slices 512 --step 8 --storage rgba8unorm --visibility weighted --out shaders/  # runtime: rectified map 256x256"
+            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 8 --basis fourier --depth-break 10 --light spot --light-break 20 --moments 4 --rectification epipolar --regions 4 --sampling pixels --scale 2 --slice-samples 256 --slices 512 --step 8 --storage rgba8unorm --visibility weighted --out shaders/  # runtime: rectified map 256x256"
         );
         assert_eq!(
             scatter_gen_command(&table[1].method, [512, 512]),
@@ -2056,19 +2056,19 @@ mod tests {
         assert_eq!(
             knobs,
             [
-                "m16-r3-t4-256x256",
-                "m16-r3-t16-256x256",
-                "m16-r3-rgba16float-256x256",
-                "m16-r3-rgba32float-256x256",
-                "m16-r3-128x128",
-                "m16-r3", // 512x512 is the run's map
-                "m32-r3-t4",
-                "m32-r3-t16",
-                "m32-r3-t32",
-                "m32-r3-rgba16float",
-                "m32-r3-rgba32float",
-                "m32-r3-256x256",
-                "m32-r3-1024x1024",
+                "m16-r4-t4-256x256",
+                "m16-r4-t16-256x256",
+                "m16-r4-rgba16float-256x256",
+                "m16-r4-rgba32float-256x256",
+                "m16-r4-128x128",
+                "m16-r4", // 512x512 is the run's map
+                "m32-r4-t4",
+                "m32-r4-t16",
+                "m32-r4-t32",
+                "m32-r4-rgba16float",
+                "m32-r4-rgba32float",
+                "m32-r4-256x256",
+                "m32-r4-1024x1024",
             ]
         );
         assert_eq!(
@@ -2076,7 +2076,7 @@ mod tests {
                 .iter()
                 .map(|e| e.knobs.as_str())
                 .collect::<Vec<_>>(),
-            ["m16-r3-256x256", "n128-i1"]
+            ["m16-r4-256x256", "n128-i1"]
         );
     }
 }

@@ -345,7 +345,7 @@ pub const RECTIFIED: [u32; 2] = [1024, 1024];
 /// One kernel's cost model at the headline configuration.
 #[derive(Clone, Debug)]
 pub struct KernelCost {
-    /// The method whose pass it is (`prefiltered m32-t8-r3`, `raymarch n64`, ...).
+    /// The method whose pass it is (`prefiltered m32-t8-r4`, `raymarch n64`, ...).
     pub method: &'static str,
     /// The kernel.
     pub kernel: &'static str,
@@ -368,8 +368,9 @@ pub fn kernel_costs() -> Vec<KernelCost> {
     let [wr, hr] = RECTIFIED.map(u64::from);
     let pixels = w * h;
     // Default prefiltered variant: 32 bases (8 layers), 8 per thread (2 layers, 4 threads per
-    // row and region), 3 regions, rgba8unorm.
-    let (layers, lpt, threads, regions) = (8.0, 2.0, 4u64, 3u64);
+    // row and region), its regions (4), rgba8unorm.
+    let (layers, lpt, threads) = (8.0, 2.0, 4u64);
+    let regions = u64::from(PrefilteredVariant::default().regions);
     let region_texels = wr as f64 / regions as f64;
     let mut out = vec![
         KernelCost {
@@ -416,10 +417,10 @@ pub fn kernel_costs() -> Vec<KernelCost> {
             trips: "RECTIFY_TEXELS columns",
         },
         KernelCost {
-            method: "prefiltered m32-t8-r3",
+            method: "prefiltered m32-t8-r4",
             kernel: "prefilter",
             invocations: hr * regions * threads,
-            // Per texel of its region (Wr/3 on average): one load; sin(theta_ref) twice
+            // Per texel of its region (Wr/regions on average): one load; sin(theta_ref) twice
             // (ref_t), two exp (transmittance_between), sin and cos of pi d; a skip of
             // 2*thread*lpt turns (3 on average: 12 FMAs) and per layer 2 turns, the blend
             // and the store scale (about 28 FMAs); stores of lpt rgba8 texels, and thread 0
@@ -435,11 +436,11 @@ pub fn kernel_costs() -> Vec<KernelCost> {
             trips: "Wr/regions texels x (2 thread lpt skip turns + lpt layers)",
         },
         KernelCost {
-            method: "prefiltered m32-t8-r3",
+            method: "prefiltered m32-t8-r4",
             kernel: "scatter",
             invocations: pixels,
             // Per pixel: the depth load; acos, atan2, sin and cos of pi d, sin(theta) for x_s
-            // (the phase takes a sqrt, not counted); per region (3 at most): 2 bounds loads,
+            // (the phase takes a sqrt, not counted); per region (4 at most): 2 bounds loads,
             // 4 loads per layer when the bounds are ambiguous, sin(theta) in each of two
             // ray_t and two exp; the coefficient set-up
             // (8 layers x 2 turns and 4 scales: about 16 FMAs each), per ambiguous region
@@ -462,7 +463,7 @@ pub fn kernel_costs() -> Vec<KernelCost> {
             trips: "regions x layers where ambiguous (none .. all)",
         },
         KernelCost {
-            method: "prefiltered moments4-r3",
+            method: "prefiltered moments4-r4",
             kernel: "prefilter",
             invocations: hr * regions,
             // One thread per row and region. Per texel of its region: one load; sin(theta_ref)
@@ -480,7 +481,7 @@ pub fn kernel_costs() -> Vec<KernelCost> {
             trips: "Wr/regions texels x 1 layer",
         },
         KernelCost {
-            method: "prefiltered moments4-r3",
+            method: "prefiltered moments4-r4",
             kernel: "scatter",
             invocations: pixels,
             // Scatter's set-up without the Fourier coefficients (acos, atan2, sin(theta) for

@@ -274,7 +274,7 @@ pub trait KnobSet:
     #[must_use]
     fn with_light(self, light: LightKind) -> Self;
 
-    /// The knobs without the light, short, for tables and charts (`m32-r3`, `n64-i1`): the
+    /// The knobs without the light, short, for tables and charts (`m32-r4`, `n64-i1`): the
     /// knobs a sweep usually varies always, every other knob only where it differs from
     /// its default; empty when the light is the only knob.
     fn marker(&self) -> String;
@@ -354,7 +354,7 @@ mod tests {
         }
         assert_eq!(
             Family::Prefiltered.default_variant().label(),
-            "prefiltered-m32-r3"
+            "prefiltered-m32-r4"
         );
         assert_eq!(
             Family::Raymarch.default_variant().label(),

@@ -8,7 +8,7 @@ use std::fs;
 
 use common::{files, scatter_gen, scratch, text};
 
-const DEFAULT_ID: &str = "m32-t8-r3-weighted-directional-rgba8unorm-epipolar";
+const DEFAULT_ID: &str = "m32-t8-r4-weighted-directional-rgba8unorm-epipolar";
 
 /// Runs scatter-gen expecting failure with `code`; returns the single stderr line.
 fn fails(args: &[&str], code: i32) -> String {
@@ -250,7 +250,7 @@ fn never_overwrites_or_deletes_foreign_files_without_force() {
     assert_eq!(files(&out).len(), 19);
 
     // A foreign file with a kernel's name next to our manifest: refused.
-    let stray = out.join("prefilter.m16-t8-r3-weighted-directional-rgba8unorm-epipolar.wgsl");
+    let stray = out.join("prefilter.m16-t8-r4-weighted-directional-rgba8unorm-epipolar.wgsl");
     fs::write(&stray, "// someone else's\n").unwrap_or_else(|e| panic!("{e}"));
     let line = fails(&["--out", o, "--bases", "16"], 1);
     assert!(line.contains("not listed in manifest.json"), "{line}");
@@ -336,9 +336,9 @@ fn config_emits_exactly_its_variants() {
     // twice, a target twice, a number or boolean written as a string.
     let bad: &[(&str, &str)] = &[
         (
-            "[[variant]]\nlight = \"spot\"\n[[variant]]\nlight = \"spot\"\nregions = 3\n",
+            "[[variant]]\nlight = \"spot\"\n[[variant]]\nlight = \"spot\"\nregions = 4\n",
             "variants.toml: variant 2: same variant as variant 1 \
-             (prefiltered::m32-t8-r3-weighted-spot-rgba8unorm-epipolar): list each variant once",
+             (prefiltered::m32-t8-r4-weighted-spot-rgba8unorm-epipolar): list each variant once",
         ),
         (
             "targets = [\"wgsl\", \"wgsl\"]\n[[variant]]\n",

@@ -174,7 +174,7 @@ fn epipolar_knobs() -> SamplingKnobs {
 
 fn labels() -> Vec<String> {
     let mut l = vec![
-        "prefiltered m32-r3".to_owned(),
+        "prefiltered m32-r4".to_owned(),
         "prefiltered moments6-r8".to_owned(),
     ];
     l.extend(samples().iter().map(|n| format!("raymarch n{n}")));

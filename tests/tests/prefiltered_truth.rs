@@ -533,7 +533,7 @@ fn moment_basis_on_every_pose() {
                     ..PrefilteredVariant::default()
                 },
             );
-        let mut line = format!("{name}/{pose}: fourier m32-r3 {fourier:.3} %");
+        let mut line = format!("{name}/{pose}: fourier m32-r4 {fourier:.3} %");
         let mut last = 0.0;
         for (i, (moments, regions)) in configs.into_iter().enumerate() {
             let variant = PrefilteredVariant {

@@ -150,7 +150,11 @@ fn methods() -> Vec<FamilyVariant> {
             ..PrefilteredVariant::default()
         }
         .into(),
-        PrefilteredVariant::with_moments(4).into(),
+        PrefilteredVariant {
+            regions: 3,
+            ..PrefilteredVariant::with_moments(4)
+        }
+        .into(),
         PrefilteredVariant {
             regions: 8,
             ..PrefilteredVariant::with_moments(6)
