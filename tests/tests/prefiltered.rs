@@ -605,14 +605,14 @@ fn zero_resolution_is_an_error() {
         rectified: [8, 64],
     };
     let err =
-        Prefiltered::new(ctx, &base_variant(), res, SHADOW_MAP).expect_err("8 columns, 3 regions");
+        Prefiltered::new(ctx, &base_variant(), res, SHADOW_MAP).expect_err("8 columns, 4 regions");
     assert!(
         matches!(
             err,
             RuntimeError::TooFewColumns {
-                regions: 3,
+                regions: 4,
                 width: 8,
-                min: 9,
+                min: 16,
                 ..
             }
         ),

@@ -4,7 +4,8 @@
 //! Bars (issue 3): rel L1 <= 3 % for a directional light and <= 5 % for a spot light with 32
 //! bases, weighted visibility, rgba8unorm; error falls as the bases go 4 -> 8 -> 16 -> 32;
 //! weighted visibility beats average visibility in the `thick` medium; no NaN/Inf anywhere.
-//! The default variant (3 regions, 8 bases per thread) meets the bar on 18 of 24 poses; the
+//! The default variant (4 regions, 8 bases per thread) meets the bar on 22 of 24 poses (3
+//! regions, the default until stop 35: 18 of 24); the
 //! rest are listed in [`EXCEPTIONS`] with the measured error, the bound asserted instead and
 //! the error source that dominates (measured by changing one knob at a time):
 //! - reference-ray weighting (epipole on screen, `window`): visibility is averaged with the
@@ -47,38 +48,17 @@ const RECTIFIED: [u32; 2] = [512, 512];
 /// asserted bound in %, dominating error source).
 const EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
     (
-        "columns/epipole_on_screen",
-        3.29,
-        3.7,
-        "reference-ray weighting (8 regions: 1.26 %)",
-    ),
-    (
         "foliage/epipole_on_screen",
-        3.89,
-        4.3,
-        "reference-ray weighting (8 regions: 1.61 %)",
-    ),
-    (
-        "window/ordinary",
-        3.11,
-        3.5,
-        "reference-ray weighting and ringing where the depth bounds leave a region ambiguous \
-         (before the occluder depth range, at 3.47 %: 8 regions 2.47 %, 64 bases 2.89 %, both \
-         1.91 %; 15.23 % before the bounds)",
-    ),
-    (
-        "window/epipole_on_screen",
-        5.15,
-        5.7,
-        "reference-ray weighting (before the occluder depth range, at 5.18 %: 8 regions \
-         2.51 %, with 64 bases 2.37 %; 64 bases alone 5.11 %)",
+        3.68,
+        4.1,
+        "reference-ray weighting (3 regions: 3.89 %; 8 regions: 1.61 %)",
     ),
     (
         "window/grazing",
-        3.96,
-        4.4,
-        "ringing and weighting (8.04 % before the occluder depth range, where 8 regions gave \
-         4.78 %, 64 bases 5.38 %, both 3.84 %)",
+        3.15,
+        3.5,
+        "ringing and weighting (3 regions: 3.96 %; 8.04 % before the occluder depth range, \
+         where 8 regions gave 4.78 %, 64 bases 5.38 %, both 3.84 %)",
     ),
 ];
 
@@ -87,15 +67,16 @@ const EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
 const PROJECTIVE_EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
     (
         "window/ordinary",
-        4.83,
-        5.3,
-        "as epipolar (3.11 %), plus the projective map's coverage",
+        5.18,
+        5.7,
+        "as epipolar (2.75 %), plus the projective map's coverage (3 regions: 4.83 %; the \
+         fourth region made this frame worse, the epipolar one better)",
     ),
     (
         "window/grazing",
-        5.75,
-        6.3,
-        "as epipolar (3.96 %), plus the projective map's coverage",
+        4.19,
+        4.6,
+        "as epipolar (3.15 %), plus the projective map's coverage (3 regions: 5.75 %)",
     ),
 ];
 
@@ -207,10 +188,11 @@ fn default_variant_meets_the_bars_or_the_listed_bounds() {
                     "prefiltered::{}::{name}::{pose}: rel L1 {e:.3} % (bar {bar} % missed: {source}; measured {measured} %, bound {bound} %)",
                     variant.id()
                 );
-                assert!(
-                    e > bar,
-                    "{key} now meets the {bar} % bar ({e:.3} %): remove it from EXCEPTIONS"
-                );
+                if e <= bar {
+                    failures.push(format!(
+                        "{key} now meets the {bar} % bar ({e:.3} %): remove it from EXCEPTIONS"
+                    ));
+                }
                 bound
             }
             None => {
@@ -333,7 +315,10 @@ const AVERAGE_EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
 fn average_visibility_on_every_pose() {
     let mut failures = Vec::new();
     let mut table = vec![
-        "| scene/pose | R = 1 | R = 2 | R = 4 | R = 8 | weighted R = 3 |".to_owned(),
+        format!(
+            "| scene/pose | R = 1 | R = 2 | R = 4 | R = 8 | weighted R = {} (default) |",
+            PrefilteredVariant::default().regions
+        ),
         "|---|---|---|---|---|---|".to_owned(),
     ];
     for (name, pose) in all_poses() {
