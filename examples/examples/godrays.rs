@@ -126,7 +126,7 @@ fn variant_help() -> String {
         .collect();
     format!(
         "The family's knobs as knob=value pairs, e.g. `bases=64,regions=8` (prefiltered) or \
-         `samples=128,interleave=2` (raymarch); knobs not named keep the paper's defaults, the \
+         `samples=128,interleave=2` (raymarch); knobs not named keep the defaults (the papers', but prefiltered regions = 4), the \
          light follows the scene (`scatter-gen list` shows allowed values). Knobs: {}",
         knobs.join("; ")
     )

@@ -49,7 +49,8 @@ macro_rules! families {
                 }
             }
 
-            /// The family's variant with every knob at its default (the paper's choice).
+            /// The family's variant with every knob at its default (the paper's choice; the
+            /// prefiltered family's 4 regions are measured, `PrefilteredVariant`'s docs).
             pub fn default_variant(self) -> FamilyVariant {
                 match self {
                     $(Self::$name => <$ty>::default().into(),)*

@@ -154,14 +154,14 @@ pub struct VariantError {
     pub allowed: String,
 }
 
-/// One compiled configuration of the prefiltered family. `Default` is the paper's choice
-/// but for one knob: the Fourier basis, 32 bases, 8 per thread, 4 regions (the design
-/// card says 3), weighted visibility, rgba8unorm, epipolar,
-/// directional. Four regions because of the random poses (issue 12; `cargo test --release
-/// -p scatter-conformance --test random_poses`, 150 poses at 96x54): p90 rel L1 2.27 -> 1.66 %,
-/// max 6.48 -> 5.94 %, against raymarch n64's 2.08 / 4.39 %, while `scatter` at 1280x720
-/// took the same time within this machine's noise (about 2 %). [`PrefilteredVariant::with_moments`]
-/// is the moment basis.
+/// One compiled configuration of the prefiltered family. `Default` is the design card's
+/// choice but for one knob: the Fourier basis, 32 bases, 8 per thread, 4 regions (the card
+/// says 3), weighted visibility, rgba8unorm, epipolar, directional. Four regions because of
+/// the random poses (issue 12; `cargo test --release -p scatter-conformance --test
+/// random_poses`, 150 poses at 96x54): p90 rel L1 2.27 -> 1.66 %, max 6.48 -> 5.94 %,
+/// against raymarch n64's 2.08 / 4.39 %, for 1.02-1.05x the time (`scatter` at 1280x720;
+/// the bench's 320x180 sweep). [`PrefilteredVariant::with_moments`] is the
+/// moment basis.
 ///
 /// Knobs of one basis only: `bases` and `bases_per_thread` belong to the Fourier basis,
 /// `moments` to the moment basis; the other basis's knobs must stay at their defaults, so

@@ -4,7 +4,7 @@
 //! ```toml
 //! targets = ["wgsl", "spirv"]      # optional; --target overrides it
 //!
-//! [[variant]]                      # knobs not named keep the paper's defaults
+//! [[variant]]                      # knobs not named keep their defaults
 //! light = "directional"
 //!
 //! [[variant]]
