@@ -8,8 +8,9 @@
 //! (equiangular sampling, `scatter::model::equiangular`): the epipole disc shared by
 //! `prefiltered` and `minmax`, and `raymarch`.
 //!
-//! Asserted, per pose and size, for the prefiltered default (M = 32, R = 3, weighted),
-//! minmax and raymarch N = 64 (GPU on lavapipe; the CPU mirrors when no GPU is allowed):
+//! Asserted, per pose and size, for the prefiltered default (M = 32, R = 4, weighted),
+//! minmax, raymarch N = 64, partial_sum_tree and hybrid_volume at their defaults (GPU on
+//! lavapipe; the CPU mirrors when no GPU is allowed):
 //! rel L1 within 5 % and rel RMSE within 10 % of the truth (the same 1024^2 shadow map), 0
 //! NaN/Inf, and the lamp really on screen (the frame report marches the epipole disc).
 //!
@@ -30,7 +31,9 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::{Context, CpuInputs, FrameInput, run_family_once};
 use scatter_shaderlib::family::FamilyVariant;
+use scatter_shaderlib::hybrid_volume::HybridVolumeVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
+use scatter_shaderlib::partial_sum_tree::PartialSumTreeVariant;
 use scatter_shaderlib::prefiltered::{
     FrameReport, FrameSettings, LightKind, PrefilteredVariant, Resolutions,
 };
@@ -43,8 +46,8 @@ const REL_RMSE_BAR: f64 = 0.10;
 const SHADOW_MAP: u32 = 1024;
 const RECTIFIED: [u32; 2] = [1024, 512];
 
-/// The families run on every pose: the prefiltered default, minmax and raymarch N = 64, all
-/// with the spot light.
+/// The families run on every pose: the prefiltered default, minmax, raymarch N = 64,
+/// partial_sum_tree and hybrid_volume (their defaults), all with the spot light.
 fn methods() -> Vec<FamilyVariant> {
     vec![
         PrefilteredVariant::default().into(),
@@ -53,6 +56,8 @@ fn methods() -> Vec<FamilyVariant> {
             samples: 64,
             ..RaymarchVariant::default()
         }),
+        PartialSumTreeVariant::default().into(),
+        HybridVolumeVariant::default().into(),
     ]
     .into_iter()
     .map(|v: FamilyVariant| v.with_light(LightKind::Spot))
