@@ -222,6 +222,10 @@ pub struct BenchConfig {
     pub skip_over_limits: bool,
 }
 
+/// The knobs of the prefiltered default (`Method::knobs` of `PrefilteredVariant::default()`),
+/// the variant every prefiltered ratio is read against.
+pub const PREFILTERED_DEFAULT: &str = "m32-r4";
+
 impl BenchConfig {
     /// The default sweep: every scene at `ordinary` and `epipole_on_screen`, prefiltered
     /// (M, R) in {(16, 4), (32, 1), (32, 3), (32, 4), (32, 8), (64, 4)} and raymarch N in {16, 32,
@@ -1038,7 +1042,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
     let variants = per_variant(&result.rows);
     let reference = variants
         .iter()
-        .find(|v| v.0 == "prefiltered" && v.1 == "m32-r4");
+        .find(|v| v.0 == "prefiltered" && v.1 == PREFILTERED_DEFAULT);
     if let Some(p) = reference {
         let matching = variants
             .iter()
@@ -1046,7 +1050,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             .min_by(|a, b| a.2.total_cmp(&b.2));
         match matching {
             Some(r) => out.push(format!(
-                "prefiltered m32-r4 ({:.2} ms, mean rel L1 {:.2} %) vs the cheapest raymarch at equal or better error, {} ({:.2} ms, {:.2} %): raymarch takes {:.2}x the time",
+                "prefiltered {PREFILTERED_DEFAULT} ({:.2} ms, mean rel L1 {:.2} %) vs the cheapest raymarch at equal or better error, {} ({:.2} ms, {:.2} %): raymarch takes {:.2}x the time",
                 p.2,
                 100.0 * p.3,
                 r.1,
@@ -1061,7 +1065,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                     .min_by(|a, b| a.3.total_cmp(&b.3));
                 out.push(match best {
                     Some(b) => format!(
-                        "prefiltered m32-r4 ({:.2} ms, mean rel L1 {:.2} %): no raymarch variant in the sweep reaches its error; the most accurate, {} ({:.2} ms), has {:.2} % ({:.2}x the time)",
+                        "prefiltered {PREFILTERED_DEFAULT} ({:.2} ms, mean rel L1 {:.2} %): no raymarch variant in the sweep reaches its error; the most accurate, {} ({:.2} ms), has {:.2} % ({:.2}x the time)",
                         p.2,
                         100.0 * p.3,
                         b.1,
@@ -1121,7 +1125,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 .find(|r| r.family == family && r.knobs == knobs && r.scene == scene)
                 .map(|r| ms(r.total()))
         };
-        if let Some(p) = time("prefiltered", "m32-r4") {
+        if let Some(p) = time("prefiltered", PREFILTERED_DEFAULT) {
             for knobs in ["n64-i1", "n128-i1", "n64-i4"] {
                 if let Some(r) = time("raymarch", knobs) {
                     let tag = if matching.as_deref() == Some(knobs) {
@@ -1130,7 +1134,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                         ""
                     };
                     out.push(format!(
-                        "headline 1280x720, 1024x1024 rectified, {scene}/ordinary: raymarch {knobs}{tag} {r:.1} ms / prefiltered m32-r4 {p:.1} ms = {:.2}",
+                        "headline 1280x720, 1024x1024 rectified, {scene}/ordinary: raymarch {knobs}{tag} {r:.1} ms / prefiltered {PREFILTERED_DEFAULT} {p:.1} ms = {:.2}",
                         r / p
                     ));
                 }
@@ -1154,7 +1158,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             _ => None,
         }
     };
-    if let Some((pt, pe)) = headline_mean("prefiltered", "m32-r4") {
+    if let Some((pt, pe)) = headline_mean("prefiltered", PREFILTERED_DEFAULT) {
         for (family, knobs) in [
             ("prefiltered", "moments4-r4"),
             ("prefiltered", "moments6-r4"),
@@ -1170,7 +1174,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
         ] {
             if let Some((t, e)) = headline_mean(family, knobs) {
                 out.push(format!(
-                    "headline 1280x720, means over sphere, foliage and terrain (ordinary): {family} {knobs} {t:.1} ms at rel L1 {:.3} % / prefiltered m32-r4 {pt:.1} ms at {:.3} %: {:.2}x the time, {} error",
+                    "headline 1280x720, means over sphere, foliage and terrain (ordinary): {family} {knobs} {t:.1} ms at rel L1 {:.3} % / prefiltered {PREFILTERED_DEFAULT} {pt:.1} ms at {:.3} %: {:.2}x the time, {} error",
                     100.0 * e,
                     100.0 * pe,
                     t / pt,
@@ -1187,7 +1191,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             ("raymarch", "n128-i1"),
             ("raymarch", "n256-i1"),
             ("minmax", "minmax"),
-            ("prefiltered", "m32-r4"),
+            ("prefiltered", PREFILTERED_DEFAULT),
         ] {
             if let Some((t, e)) = headline_mean(family, knobs) {
                 out.push(format!(
@@ -1201,7 +1205,12 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
     }
     // Issue 13's targets, per prefiltered basis: the brute-force march at about the same
     // error, how much longer it takes, and whether the prefiltered error is at or below it.
-    for prefiltered in ["m32-r4", "moments4-r4", "moments6-r4", "moments6-r8"] {
+    for prefiltered in [
+        PREFILTERED_DEFAULT,
+        "moments4-r4",
+        "moments6-r4",
+        "moments6-r8",
+    ] {
         let Some((pt, pe)) = headline_mean("prefiltered", prefiltered) else {
             continue;
         };
@@ -1275,7 +1284,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
         }
     }
     for family_knobs in [
-        ("prefiltered", "m32-r4"),
+        ("prefiltered", PREFILTERED_DEFAULT),
         ("raymarch", "n64-i1"),
         ("minmax", "minmax"),
     ] {
@@ -1304,7 +1313,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 .iter()
                 .find(|r| {
                     r.family == family
-                        && (r.knobs == "m32-r4" || family == "minmax")
+                        && (r.knobs == PREFILTERED_DEFAULT || family == "minmax")
                         && r.scene == scene.name()
                         && r.pose == Pose::Ordinary.name()
                 })
@@ -1312,7 +1321,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
         };
         if let (Some(p), Some(m)) = (sweep("prefiltered"), sweep("minmax")) {
             out.push(format!(
-                "{scene}/ordinary at the sweep size: minmax {:.1} ms ({:.2} %) / prefiltered m32-r4 {:.1} ms ({:.2} %) = {:.2}",
+                "{scene}/ordinary at the sweep size: minmax {:.1} ms ({:.2} %) / prefiltered {PREFILTERED_DEFAULT} {:.1} ms ({:.2} %) = {:.2}",
                 m.0,
                 100.0 * m.1,
                 p.0,
@@ -1327,15 +1336,18 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 .find(|r| r.family == family && r.knobs == knobs && r.scene == scene)
                 .map(|r| ms(r.total()))
         };
-        if let (Some(p), Some(m)) = (head("prefiltered", "m32-r4"), head("minmax", "minmax")) {
+        if let (Some(p), Some(m)) = (
+            head("prefiltered", PREFILTERED_DEFAULT),
+            head("minmax", "minmax"),
+        ) {
             out.push(format!(
-                "{scene}/ordinary at 1280x720, 1024x1024 rectified: minmax {m:.1} ms / prefiltered m32-r4 {p:.1} ms = {:.2}",
+                "{scene}/ordinary at 1280x720, 1024x1024 rectified: minmax {m:.1} ms / prefiltered {PREFILTERED_DEFAULT} {p:.1} ms = {:.2}",
                 m / p
             ));
         }
     }
     for (family, knobs) in [
-        ("prefiltered", "m32-r4"),
+        ("prefiltered", PREFILTERED_DEFAULT),
         ("raymarch", "n64-i1"),
         ("minmax", "minmax"),
     ] {
@@ -1367,7 +1379,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
         for r in &result.scaling {
             let t: f64 = r.passes.iter().copied().map(ms).sum();
             out.push(format!(
-                "prefiltered m32-r4 scaling, {}x{} screen, {}x{} rectified: {:.1} ms (depth_columns {:.1}, slice_fit {:.1}, rectify {:.1}, prefilter {:.1}, scatter {:.1}) = {:.2}x the 1280x720 / 512x1024 time",
+                "prefiltered {PREFILTERED_DEFAULT} scaling, {}x{} screen, {}x{} rectified: {:.1} ms (depth_columns {:.1}, slice_fit {:.1}, rectify {:.1}, prefilter {:.1}, scatter {:.1}) = {:.2}x the 1280x720 / 512x1024 time",
                 r.screen[0],
                 r.screen[1],
                 r.rectified[0],
@@ -1955,6 +1967,14 @@ pub fn scene_light(name: SceneName) -> LightKind {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn prefiltered_default_names_the_default_variant() {
+        assert_eq!(
+            Method::from(PrefilteredVariant::default()).knobs(),
+            PREFILTERED_DEFAULT
+        );
+    }
 
     fn entry(method: Method, worst_error: f64, mean_ms: f64) -> TuneEntry {
         TuneEntry {
