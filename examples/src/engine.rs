@@ -413,8 +413,13 @@ fn shade_uniform(scene: &Scene, map: &ShadowMap) -> Vec<u8> {
     let t = cam.tan_half_fov();
     let v = |d: glam::DVec3, w: f64| [d.x as f32, d.y as f32, d.z as f32, w as f32];
     let sky = scene.sky;
-    let color = scene.light.color();
-    let (kind, pos, dir, cos_outer, cos_inner, mode) = match &scene.light {
+    // An area light shades as its point limit (the kernels' passes are per point light).
+    let light = scene
+        .light
+        .area()
+        .map_or_else(|| scene.light.clone(), |a| a.point_limit());
+    let color = light.color();
+    let (kind, pos, dir, cos_outer, cos_inner, mode) = match &light {
         Light::Directional { direction, .. } => {
             (0.0, glam::DVec3::ZERO, direction.normalize(), 0.0, 0.0, 0.0)
         }
@@ -439,6 +444,7 @@ fn shade_uniform(scene: &Scene, map: &ShadowMap) -> Vec<u8> {
             };
             (1.0, *position, direction.normalize(), co, ci, mode)
         }
+        Light::Area(_) => unreachable!("replaced by its point limit above"),
     };
     let (perspective, window) = match map.projection {
         ShadowProjection::Orthographic { x0, x1, y0, y1 } => (0.0, [x0, x1, y0, y1]),

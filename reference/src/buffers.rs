@@ -156,6 +156,11 @@ pub enum ShadowMapError {
         "light.outer_angle_deg must be below 80 degrees for a single perspective shadow map, got {0}"
     )]
     ConeTooWide(f64),
+    /// An area light has no one shadow map.
+    #[error(
+        "an area light has one shadow map per virtual point light: build them from Scene::point_light_scenes"
+    )]
+    AreaLight,
 }
 
 /// A standard light shadow map (see the module docs for the exact conventions).
@@ -221,7 +226,7 @@ impl ShadowMap {
                     _ => None,
                 })
                 .collect(),
-            Light::Spot { .. } => Vec::new(),
+            Light::Spot { .. } | Light::Area(_) => Vec::new(),
         };
         let n = size as usize;
         sm.depth = (0..n * n)
@@ -329,6 +334,7 @@ impl ShadowMap {
                     far,
                 }
             }
+            Light::Area(_) => return Err(ShadowMapError::AreaLight),
         };
         Ok(sm)
     }

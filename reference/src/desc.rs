@@ -25,31 +25,12 @@ impl Scene {
         }
     }
 
-    /// The light as the kernels see it.
+    /// The light as the kernels see it. An area light is seen as its point limit
+    /// ([`crate::scene::AreaLight::point_limit`]): the kernels render one point light per
+    /// pass, so an area light's soft shadows are its VPL scenes' passes
+    /// ([`Scene::point_light_scenes`]).
     pub fn light_desc(&self) -> LightDesc {
-        match &self.light {
-            Light::Directional {
-                direction,
-                irradiance,
-            } => LightDesc::Directional {
-                direction: *direction,
-                color: *irradiance,
-            },
-            Light::Spot {
-                position,
-                direction,
-                inner_angle_deg,
-                outer_angle_deg,
-                intensity,
-                ..
-            } => LightDesc::Spot {
-                position: *position,
-                direction: *direction,
-                inner_deg: *inner_angle_deg,
-                outer_deg: *outer_angle_deg,
-                color: *intensity,
-            },
-        }
+        light_desc(&self.light)
     }
 
     /// The medium as the kernels see it.
@@ -59,6 +40,34 @@ impl Scene {
             albedo: self.medium.albedo,
             g: self.medium.g,
         }
+    }
+}
+
+/// [`Scene::light_desc`] of one light.
+fn light_desc(light: &Light) -> LightDesc {
+    match light {
+        Light::Directional {
+            direction,
+            irradiance,
+        } => LightDesc::Directional {
+            direction: *direction,
+            color: *irradiance,
+        },
+        Light::Spot {
+            position,
+            direction,
+            inner_angle_deg,
+            outer_angle_deg,
+            intensity,
+            ..
+        } => LightDesc::Spot {
+            position: *position,
+            direction: *direction,
+            inner_deg: *inner_angle_deg,
+            outer_deg: *outer_angle_deg,
+            color: *intensity,
+        },
+        Light::Area(a) => light_desc(&a.point_limit()),
     }
 }
 

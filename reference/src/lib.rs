@@ -3,6 +3,7 @@
 //! - [`scene`]: the serde scene description (camera, light, medium, geometry) with validation;
 //! - [`suite`]: the named scene suite (`sphere`, `columns`, `window`, `foliage`, `terrain`,
 //!   `spot_grate`), its camera poses and medium presets;
+//! - [`area_suite`]: the suite's `columns`, `window` and `spot_grate` lit by area lights;
 //! - [`stress`]: the stress configurations where methods break (issue 6);
 //! - [`random_poses`]: seeded random camera and light poses on every suite scene (issue 12);
 //! - [`paths`]: 60-frame camera paths and light rotations for the flicker measurements;
@@ -21,6 +22,7 @@
 //! metres, `sigma_t` in 1/m. A directional light's `direction` is the direction the light
 //! *travels* (from the sun into the scene).
 
+pub mod area_suite;
 pub mod buffers;
 pub mod bvh;
 pub mod cookie;

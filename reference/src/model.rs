@@ -79,6 +79,11 @@ enum LightKind {
         axis: DVec3,
         inner_deg: f64,
         outer_deg: f64,
+        /// Intensity per unit `Light::color` (1; an area light's point limit: its area).
+        scale: f64,
+        /// Squared radius of the disk the point stands for (0: a point; see
+        /// [`RayIntegrand::softened`]).
+        soft_r2: f64,
     },
 }
 
@@ -86,7 +91,9 @@ impl<'a> RayIntegrand<'a> {
     /// Integrand of the ray `origin + t dir` (`dir` unit) for `light` in `medium`. The RGB
     /// light colour is left out: every method multiplies by `Light::color` at the end. A
     /// spot's cookie is left out of [`Self::eval`] and [`Self::integrate`] and in
-    /// [`Self::eval_rgb`] and [`Self::integrate_rgb`].
+    /// [`Self::eval_rgb`] and [`Self::integrate_rgb`]. An area light's integrand is its point
+    /// limit's ([`crate::scene::AreaLight::point_limit`]): the truth integrates over its
+    /// points instead.
     pub fn new(origin: DVec3, dir: DVec3, light: &'a Light, medium: &Medium) -> RayIntegrand<'a> {
         let kind = match light {
             Light::Directional { direction, .. } => {
@@ -106,6 +113,18 @@ impl<'a> RayIntegrand<'a> {
                 axis: direction.normalize(),
                 inner_deg: *inner_angle_deg,
                 outer_deg: *outer_angle_deg,
+                scale: 1.0,
+                soft_r2: 0.0,
+            },
+            // The point limit (per unit radiance, so times the area); the truth integrates
+            // over the light's points instead (`truth::point_lights`).
+            Light::Area(a) => LightKind::Spot {
+                position: a.position,
+                axis: a.frame().2,
+                inner_deg: a.inner_angle_deg,
+                outer_deg: a.outer_angle_deg,
+                scale: a.shape.area(),
+                soft_r2: 0.0,
             },
         };
         let cookie = match light {
@@ -128,6 +147,20 @@ impl<'a> RayIntegrand<'a> {
             kind,
             cookie,
         }
+    }
+
+    /// The same integrand with a spot's point replaced by a small disk of squared radius `r2`
+    /// facing along the axis, of the same total intensity: `1 / d^2` becomes
+    /// `ln(1 + r2 / d^2) / r2`, exact on the disk's axis for a flat emission profile and
+    /// `1 / d^2 (1 - r2 / (2 d^2) + ...)` away from it. The `exact` truth of an area light
+    /// gives each point of its quadrature the disk of its cell's area, so that a view ray
+    /// passing next to a point does not pick up a `1 / d^2` spike the light's surface does
+    /// not have (the integral over the surface is bounded). No effect on a directional light.
+    pub fn softened(mut self, r2: f64) -> Self {
+        if let LightKind::Spot { soft_r2, .. } = &mut self.kind {
+            *soft_r2 = r2.max(0.0);
+        }
+        self
     }
 
     /// Whether the light carries a cookie (the integrand is then RGB).
@@ -198,6 +231,8 @@ impl<'a> RayIntegrand<'a> {
                 axis,
                 inner_deg,
                 outer_deg,
+                scale,
+                soft_r2,
             } => {
                 let x = self.origin + self.dir * t;
                 let to_x = x - position;
@@ -212,7 +247,13 @@ impl<'a> RayIntegrand<'a> {
                     return 0.0;
                 }
                 let p = phase_hg(self.medium.g, -travel.dot(self.dir));
-                self.medium.sigma_s() * p * cone * (-sigma_t * (d + t)).exp() / d2
+                // 1 / d^2, or a disk of radius^2 soft_r2 seen on its axis.
+                let falloff = if soft_r2 > 0.0 {
+                    (soft_r2 / d2).ln_1p() / soft_r2
+                } else {
+                    1.0 / d2
+                };
+                scale * self.medium.sigma_s() * p * cone * (-sigma_t * (d + t)).exp() * falloff
             }
         }
     }

@@ -93,6 +93,14 @@ pub fn frame(
                     let moved = aim + DVec3::new(a.cos() - 1.0, 0.0, a.sin());
                     *direction = moved - *position;
                 }
+                Light::Area(area) => {
+                    // As a spot: the aim point of the normal circles 1 m around its start.
+                    let t = -area.position.y / area.direction.y.min(-1e-6);
+                    let aim = area.position + area.direction * t;
+                    let a = std::f64::consts::TAU * ease;
+                    let moved = aim + DVec3::new(a.cos() - 1.0, 0.0, a.sin());
+                    area.direction = moved - area.position;
+                }
             }
         }
     }

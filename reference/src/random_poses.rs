@@ -469,6 +469,18 @@ fn classify(name: SceneName, scene: &Scene, b: &Bounds) -> (Category, bool) {
             };
             (cat, in_cone)
         }
+        Light::Area(a) => {
+            let in_cone = (eye - a.position).normalize().dot(a.frame().2)
+                > a.outer_angle_deg.to_radians().cos();
+            let cat = if on_screen(scene, a.position - eye) {
+                Category::LampOnScreen
+            } else if in_cone {
+                Category::LampInCone
+            } else {
+                Category::LampOffScreen
+            };
+            (cat, in_cone)
+        }
     }
 }
 
@@ -537,6 +549,8 @@ fn draw(rng: &mut Rng, name: SceneName, base: &Scene) -> Option<(Scene, bool, Vi
             };
             (eye, (lamp - eye).normalize(), None)
         }
+        // The suite scenes random poses are drawn on have a sun or a spot.
+        Light::Area(_) => return None,
     };
     let forward = draw_forward(rng, view, to_light, eye, b.centre);
     scene.camera.position = eye;

@@ -210,31 +210,298 @@ pub enum Light {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         cookie: Option<crate::cookie::Cookie>,
     },
+    /// A rectangular or disk-shaped area light ([`AreaLight`]): soft shadows. The methods
+    /// and the `vpl` truth render it as N virtual point lights ([`AreaLight::vpls`]), each a
+    /// spot; the `exact` truth integrates over its surface.
+    Area(AreaLight),
+}
+
+/// The outline of an area light, in its own plane.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum AreaShape {
+    /// A rectangle centred on the light's position.
+    Rect {
+        /// Extent along the light's right axis (> 0, metres).
+        width: f64,
+        /// Extent along the light's up axis (> 0, metres).
+        height: f64,
+    },
+    /// A disk centred on the light's position.
+    Disk {
+        /// Radius (> 0, metres).
+        radius: f64,
+    },
+}
+
+impl AreaShape {
+    /// Surface area (one side), m^2.
+    pub fn area(&self) -> f64 {
+        match *self {
+            AreaShape::Rect { width, height } => width * height,
+            AreaShape::Disk { radius } => std::f64::consts::PI * radius * radius,
+        }
+    }
+
+    /// The point of the outline for `(u, v)` in the unit square, in the light's plane
+    /// coordinates (right, up): a rectangle maps linearly, a disk by Shirley and Chiu's
+    /// concentric map; both preserve area, so uniform or low-discrepancy points in the square
+    /// stay so on the light.
+    pub fn point(&self, u: f64, v: f64) -> (f64, f64) {
+        match *self {
+            AreaShape::Rect { width, height } => ((u - 0.5) * width, (v - 0.5) * height),
+            AreaShape::Disk { radius } => {
+                let (a, b) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+                if a == 0.0 && b == 0.0 {
+                    return (0.0, 0.0);
+                }
+                let q = std::f64::consts::FRAC_PI_4;
+                let (r, phi) = if a.abs() > b.abs() {
+                    (a, q * (b / a))
+                } else {
+                    (b, 2.0 * q - q * (a / b))
+                };
+                (radius * r * phi.cos(), radius * r * phi.sin())
+            }
+        }
+    }
+
+    /// The largest distance of a point of the outline from its centre.
+    pub fn radius(&self) -> f64 {
+        match *self {
+            AreaShape::Rect { width, height } => 0.5 * width.hypot(height),
+            AreaShape::Disk { radius } => radius,
+        }
+    }
+}
+
+/// An area light: a flat emitter whose every surface element `dA` is a small spot light of
+/// radiant intensity `radiance * cone(angle) * dA` (W/sr), `angle` measured from the
+/// emitting normal and `cone` the spot's smoothstep from the outer to the inner half-angle.
+///
+/// Along the normal `radiance` is the radiance an observer sees. The emission profile is the
+/// spot's cone, not Lambert's cosine, so that each virtual point light is exactly a
+/// [`Light::Spot`] with a single perspective shadow map (which needs `outer_angle_deg < 80`),
+/// and a small light tends to the spot light of intensity `radiance * area`
+/// ([`AreaLight::point_limit`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AreaLight {
+    /// Centre of the light.
+    pub position: DVec3,
+    /// The emitting normal (the cone's axis); need not be normalised.
+    pub direction: DVec3,
+    /// The outline's up axis, made orthogonal to `direction` (need not be normalised); when
+    /// absent, the up axis of the light frame ([`crate::buffers::light_basis`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<DVec3>,
+    /// The outline (rectangle or disk) in the light's plane.
+    pub shape: AreaShape,
+    /// Full emission inside this half-angle from the normal (degrees).
+    pub inner_angle_deg: f64,
+    /// No emission beyond this half-angle from the normal (degrees, in (0, 90]).
+    pub outer_angle_deg: f64,
+    /// Radiance along the normal (RGB, W sr^-1 m^-2).
+    pub radiance: [f64; 3],
+    /// Whether the back face emits too (the same cone about the reversed normal); one-sided
+    /// when false (the default).
+    #[serde(default)]
+    pub two_sided: bool,
+}
+
+impl AreaLight {
+    /// The light's frame: right and up span its plane, `normal` is the emitting normal.
+    pub fn frame(&self) -> (DVec3, DVec3, DVec3) {
+        let n = self.direction.normalize();
+        let up = match self.up {
+            Some(up) => (up - n * up.dot(n)).normalize(),
+            None => crate::buffers::light_basis(n)[1],
+        };
+        (up.cross(n), up, n)
+    }
+
+    /// The world point of the light for `(u, v)` in the unit square ([`AreaShape::point`]).
+    pub fn point(&self, u: f64, v: f64) -> DVec3 {
+        let (right, up, _) = self.frame();
+        let (x, y) = self.shape.point(u, v);
+        self.position + right * x + up * y
+    }
+
+    /// Emitting faces: 1, or 2 when two-sided.
+    pub fn faces(&self) -> usize {
+        if self.two_sided { 2 } else { 1 }
+    }
+
+    /// `n` virtual point lights on the light (per face: `2 n` when two-sided), each a spot at
+    /// the `i`-th point (i = 1..=n) of the Halton sequence in bases 2 and 3 mapped onto the
+    /// outline, aimed along the emitting normal with the light's cone, and carrying the
+    /// intensity `radiance * area / n`: their sum tends to the light as `n` grows, and
+    /// the first `n` of `m > n` points are the same `n` points.
+    pub fn vpls(&self, n: usize) -> Vec<Light> {
+        let (_, _, normal) = self.frame();
+        let scale = self.shape.area() / n.max(1) as f64;
+        let intensity = self.radiance.map(|c| c * scale);
+        let mut out = Vec::with_capacity(n * self.faces());
+        for i in 1..=n {
+            let p = self.point(halton(i, 2), halton(i, 3));
+            for side in [1.0, -1.0].into_iter().take(self.faces()) {
+                out.push(Light::Spot {
+                    position: p,
+                    direction: normal * side,
+                    inner_angle_deg: self.inner_angle_deg,
+                    outer_angle_deg: self.outer_angle_deg,
+                    intensity,
+                    cookie: None,
+                });
+            }
+        }
+        out
+    }
+
+    /// The `exact` truth's `m` points of the light as spots (`2 m` when two-sided), each
+    /// with intensity `radiance * area / m`: the midpoint rule on an `a x b` grid of equal-area
+    /// cells (`a b = m`, `a` the power of two nearest `sqrt(m)` that divides `m`) of the unit
+    /// square, mapped onto the outline (a rectangle linearly; a disk in polar coordinates,
+    /// `r = radius sqrt(u)`, `phi = 2 pi v`, which keeps the cells' areas equal and the map
+    /// smooth, where the concentric map of [`AreaShape::point`] has kinks). For a smooth
+    /// integrand the midpoint rule converges as `1 / m` with first-order terms cancelled per
+    /// cell; the Halton set of [`Self::vpls`] converges more slowly.
+    pub fn quadrature(&self, m: usize) -> Vec<Light> {
+        let m = m.max(1);
+        let mut a = 1usize;
+        while a * a * 2 <= m && m.is_multiple_of(a * 2) {
+            a *= 2;
+        }
+        let b = m / a;
+        let (right, up, normal) = self.frame();
+        let scale = self.shape.area() / (a * b) as f64;
+        let intensity = self.radiance.map(|c| c * scale);
+        let mut out = Vec::with_capacity(a * b * self.faces());
+        for j in 0..b {
+            for i in 0..a {
+                let (u, v) = ((i as f64 + 0.5) / a as f64, (j as f64 + 0.5) / b as f64);
+                let (x, y) = match self.shape {
+                    AreaShape::Rect { .. } => self.shape.point(u, v),
+                    AreaShape::Disk { radius } => {
+                        let (s, c) = (std::f64::consts::TAU * v).sin_cos();
+                        let r = radius * u.sqrt();
+                        (r * c, r * s)
+                    }
+                };
+                let p = self.position + right * x + up * y;
+                for side in [1.0, -1.0].into_iter().take(self.faces()) {
+                    out.push(Light::Spot {
+                        position: p,
+                        direction: normal * side,
+                        inner_angle_deg: self.inner_angle_deg,
+                        outer_angle_deg: self.outer_angle_deg,
+                        intensity,
+                        cookie: None,
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// The emitter's housing: its outline as a triangle mesh (a disk as a 48-sided polygon
+    /// around it) `behind` metres behind the emitting face, so that view rays that reach the
+    /// light end at it, as at any lamp, instead of crossing the emitting surface. It casts no
+    /// shadow on its own light (every lit point is in front of the face, and a shadow ray
+    /// stops at the emitting point). Two-sided lights have none (both faces emit).
+    pub fn housing(&self, behind: f64, albedo: [f64; 3]) -> Option<Shape> {
+        if self.two_sided {
+            return None;
+        }
+        let (right, up, normal) = self.frame();
+        let centre = self.position - normal * behind;
+        let at = |(x, y): (f64, f64)| centre + right * x + up * y;
+        let outline: Vec<DVec3> = match self.shape {
+            AreaShape::Rect { width, height } => {
+                let (w, h) = (0.5 * width, 0.5 * height);
+                [(-w, -h), (w, -h), (w, h), (-w, h)].map(at).to_vec()
+            }
+            AreaShape::Disk { radius } => (0..48)
+                .map(|i| {
+                    let (s, c) = (std::f64::consts::TAU * f64::from(i) / 48.0).sin_cos();
+                    // The polygon circumscribes the disk: it covers every emitting point.
+                    let r = radius / (std::f64::consts::PI / 48.0).cos();
+                    at((r * c, r * s))
+                })
+                .collect(),
+        };
+        let n = outline.len() as u32;
+        let mut vertices = vec![centre];
+        vertices.extend(outline);
+        let triangles = (0..n).map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
+        Some(Shape::Mesh {
+            vertices,
+            triangles,
+            albedo,
+        })
+    }
+
+    /// The spot light the area light tends to as it shrinks: at its centre, intensity
+    /// `radiance * area` (front face only: the back face's spot is the same with the
+    /// reversed axis).
+    pub fn point_limit(&self) -> Light {
+        Light::Spot {
+            position: self.position,
+            direction: self.frame().2,
+            inner_angle_deg: self.inner_angle_deg,
+            outer_angle_deg: self.outer_angle_deg,
+            intensity: self.radiance.map(|c| c * self.shape.area()),
+            cookie: None,
+        }
+    }
+}
+
+/// The `i`-th point of the van der Corput sequence in `base` (radical inverse), in [0, 1).
+pub fn halton(mut i: usize, base: usize) -> f64 {
+    let mut f = 1.0;
+    let mut r = 0.0;
+    let b = base as f64;
+    while i > 0 {
+        f /= b;
+        r += f * (i % base) as f64;
+        i /= base;
+    }
+    r
 }
 
 impl Light {
     /// The light type, as variants are compiled for it.
+    /// An area light is rendered by passes over its virtual point lights, which are spots:
+    /// its kind is [`LightKind::Spot`](scatter_shaderlib::prefiltered::LightKind::Spot).
     pub fn kind(&self) -> scatter_shaderlib::prefiltered::LightKind {
         use scatter_shaderlib::prefiltered::LightKind;
         match self {
             Light::Directional { .. } => LightKind::Directional,
-            Light::Spot { .. } => LightKind::Spot,
+            Light::Spot { .. } | Light::Area(_) => LightKind::Spot,
         }
     }
 
-    /// A spot's cookie (`None` for the sun and a spot without one).
+    /// A spot's cookie (`None` for the sun, an area light and a spot without one).
     pub fn cookie(&self) -> Option<&crate::cookie::Cookie> {
         match self {
             Light::Spot { cookie, .. } => cookie.as_ref(),
-            Light::Directional { .. } => None,
+            Light::Directional { .. } | Light::Area(_) => None,
         }
     }
 
-    /// RGB scale of the light (irradiance or intensity).
+    /// RGB scale of the light (irradiance, intensity, or an area light's radiance).
     pub fn color(&self) -> [f64; 3] {
         match self {
             Light::Directional { irradiance, .. } => *irradiance,
             Light::Spot { intensity, .. } => *intensity,
+            Light::Area(a) => a.radiance,
+        }
+    }
+
+    /// The area light, if this is one.
+    pub fn area(&self) -> Option<&AreaLight> {
+        match self {
+            Light::Area(a) => Some(a),
+            _ => None,
         }
     }
 }
@@ -558,6 +825,26 @@ impl Scene {
         serde_json::to_string_pretty(self).expect("a validated scene always serialises")
     }
 
+    /// The scene once per point light: for an area light one scene per virtual point light
+    /// ([`AreaLight::vpls`] with `n` points, `2 n` scenes when two-sided), named
+    /// `{name}/vpl{i}`, whose results add up to the area light's; any other light is one
+    /// point light already (the scene itself).
+    pub fn point_light_scenes(&self, n: usize) -> Vec<Scene> {
+        match &self.light {
+            Light::Area(a) => a
+                .vpls(n)
+                .into_iter()
+                .enumerate()
+                .map(|(i, light)| Scene {
+                    name: format!("{}/vpl{i}", self.name),
+                    light,
+                    ..self.clone()
+                })
+                .collect(),
+            _ => vec![self.clone()],
+        }
+    }
+
     /// Number of occluders (analytic shapes, plus every mesh and heightfield triangle).
     pub fn occluder_count(&self) -> usize {
         self.geometry.iter().map(Shape::occluder_count).sum()
@@ -667,6 +954,7 @@ impl Scene {
                     ));
                 }
             }
+            Light::Area(a) => validate_area(a)?,
         }
         let m = &self.medium;
         check_finite("medium.sigma_t", m.sigma_t)?;
@@ -696,6 +984,48 @@ impl Scene {
         }
         Ok(())
     }
+}
+
+fn validate_area(a: &AreaLight) -> Result<(), SceneError> {
+    check_vec("light.position", a.position)?;
+    check_dir("light.direction", a.direction)?;
+    if let Some(up) = a.up {
+        check_dir("light.up", up)?;
+        if a.direction.normalize().cross(up.normalize()).length() < 1e-6 {
+            return Err(invalid(
+                "light.up",
+                "must not be parallel to light.direction",
+            ));
+        }
+    }
+    match a.shape {
+        AreaShape::Rect { width, height } => {
+            check_positive("light.shape.width", width)?;
+            check_positive("light.shape.height", height)?;
+        }
+        AreaShape::Disk { radius } => check_positive("light.shape.radius", radius)?,
+    }
+    check_finite("light.inner_angle_deg", a.inner_angle_deg)?;
+    check_finite("light.outer_angle_deg", a.outer_angle_deg)?;
+    if !(a.outer_angle_deg > 0.0 && a.outer_angle_deg <= 90.0) {
+        return Err(invalid(
+            "light.outer_angle_deg",
+            format!(
+                "must be in (0, 90] degrees (a face emits into its own half-space), got {}",
+                a.outer_angle_deg
+            ),
+        ));
+    }
+    if !(a.inner_angle_deg >= 0.0 && a.inner_angle_deg <= a.outer_angle_deg) {
+        return Err(invalid(
+            "light.inner_angle_deg",
+            format!(
+                "must be in [0, light.outer_angle_deg = {}], got {}",
+                a.outer_angle_deg, a.inner_angle_deg
+            ),
+        ));
+    }
+    check_rgb("light.radiance", a.radiance)
 }
 
 fn validate_shape(p: &str, s: &Shape) -> Result<(), SceneError> {

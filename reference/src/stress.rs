@@ -145,6 +145,7 @@ impl StressCase {
             match &self.scene.light {
                 Light::Directional { direction, .. } => -direction.normalize(),
                 Light::Spot { position, .. } => (*position - p).normalize(),
+                Light::Area(a) => (a.position - p).normalize(),
             }
         };
         let fail = |what: String| Err(format!("stress case {}: {what}", self.name));
@@ -180,6 +181,7 @@ impl StressCase {
                 let reach = match &self.scene.light {
                     Light::Directional { .. } => 1e6,
                     Light::Spot { position, .. } => (*position - cam.position).length(),
+                    Light::Area(a) => (a.position - cam.position).length(),
                 };
                 if bvh.occluded(&Ray::new(cam.position, dir), 1e-6, reach) {
                     Ok(())
@@ -487,7 +489,7 @@ pub fn cases(width: u32, height: u32) -> Vec<StressCase> {
     let mut s = spot(Pose::Ordinary);
     let lamp = match s.light {
         Light::Spot { position, .. } => position,
-        Light::Directional { .. } => unreachable!("spot_grate has a spot light"),
+        Light::Directional { .. } | Light::Area(_) => unreachable!("spot_grate has a spot light"),
     };
     let eye = v(6.0, 1.5, 6.0);
     look(&mut s, eye, lamp - eye);

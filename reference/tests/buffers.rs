@@ -219,7 +219,9 @@ fn shadow_map_matrix_agrees_with_lookup() {
             assert!((0.5 * (x + 1.0) - sc.u).abs() < 1e-9 && (0.5 * (1.0 - y) - sc.v).abs() < 1e-9);
             match s.light {
                 Light::Directional { .. } => assert!((clip.z - sc.depth).abs() < 1e-9),
-                Light::Spot { .. } => assert!((clip.w - sc.z).abs() < 1e-9 * sc.z.max(1.0)),
+                Light::Spot { .. } | Light::Area(_) => {
+                    assert!((clip.w - sc.z).abs() < 1e-9 * sc.z.max(1.0))
+                }
             }
             checked += 1;
         }
@@ -352,6 +354,10 @@ fn poses_place_the_light_as_named() {
                 } => (
                     (*position - cam.position).normalize(),
                     -direction.normalize().y.asin().to_degrees(),
+                ),
+                Light::Area(a) => (
+                    (a.position - cam.position).normalize(),
+                    -a.frame().2.y.asin().to_degrees(),
                 ),
             };
             let epipole = on_screen(to_light);

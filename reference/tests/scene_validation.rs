@@ -804,7 +804,7 @@ fn with_cookie(scene: &Scene, cookie: Option<scatter_reference::cookie::Cookie>)
     let mut s = scene.clone();
     match &mut s.light {
         Light::Spot { cookie: c, .. } => *c = cookie,
-        Light::Directional { .. } => panic!("a cookie needs a spot light"),
+        Light::Directional { .. } | Light::Area(_) => panic!("a cookie needs a spot light"),
     }
     s
 }

@@ -145,7 +145,8 @@ impl Fixture {
         let mut scene = self.scene.clone();
         match &mut scene.light {
             scatter_reference::scene::Light::Spot { cookie: c, .. } => *c = Some(cookie),
-            scatter_reference::scene::Light::Directional { .. } => {
+            scatter_reference::scene::Light::Directional { .. }
+            | scatter_reference::scene::Light::Area(_) => {
                 panic!("a cookie needs a spot light")
             }
         }

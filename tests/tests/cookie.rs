@@ -53,7 +53,9 @@ fn with_cookie(scene: &Scene, cookie: Option<Cookie>) -> Scene {
     let mut s = scene.clone();
     match &mut s.light {
         Light::Spot { cookie: c, .. } => *c = cookie,
-        Light::Directional { .. } => panic!("{}: a cookie needs a spot light", scene.name),
+        Light::Directional { .. } | Light::Area(_) => {
+            panic!("{}: a cookie needs a spot light", scene.name)
+        }
     }
     s
 }
