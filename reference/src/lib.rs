@@ -3,6 +3,8 @@
 //! - [`scene`]: the serde scene description (camera, light, medium, geometry) with validation;
 //! - [`suite`]: the named scene suite (`sphere`, `columns`, `window`, `foliage`, `terrain`,
 //!   `spot_grate`), its camera poses and medium presets;
+//! - [`area_ivsv`]: imperfect voxelized shadow volumes (Wyman & Dai 2013) for area lights on
+//!   the CPU, the reference its kernels will mirror (issue 17; no kernel yet);
 //! - [`area_suite`]: the suite's `columns`, `window` and `spot_grate` lit by area lights;
 //! - [`stress`]: the stress configurations where methods break (issue 6);
 //! - [`random_poses`]: seeded random camera and light poses on every suite scene (issue 12);
@@ -22,6 +24,7 @@
 //! metres, `sigma_t` in 1/m. A directional light's `direction` is the direction the light
 //! *travels* (from the sun into the scene).
 
+pub mod area_ivsv;
 pub mod area_suite;
 pub mod buffers;
 pub mod bvh;

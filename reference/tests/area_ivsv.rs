@@ -1,0 +1,245 @@
+//! The `area_ivsv` method on the CPU (Wyman & Dai 2013): its epipolar coordinates, the
+//! rectified and extruded voxel bits, and its accuracy against the `vpl` truth.
+
+use glam::DVec3;
+use scatter_reference::area_ivsv::{self, EpipolarGrid, IvsvError, IvsvSettings, PHI_BITS};
+use scatter_reference::area_suite::{self, AreaSceneName};
+use scatter_reference::buffers::{GBuffer, ShadowMap};
+use scatter_reference::bvh::Bvh;
+use scatter_reference::metrics;
+use scatter_reference::scene::Light;
+use scatter_reference::suite::{MediumPreset, Pose};
+use scatter_reference::truth::{self, TruthSettings};
+use std::f64::consts::PI;
+
+/// Whether the full (opt-in) grid runs: `SCATTER_FULL=1`.
+fn full() -> bool {
+    std::env::var("SCATTER_FULL").is_ok_and(|v| v == "1")
+}
+
+fn grid_for(name: AreaSceneName, pose: Pose, vpl: usize) -> (EpipolarGrid, ShadowMap) {
+    let s = area_suite::scene(name, pose, MediumPreset::Default, 32, 18);
+    let bvh = Bvh::build(&s.geometry);
+    let v = &s.point_light_scenes(16)[vpl];
+    let Light::Spot { position, .. } = v.light else {
+        panic!("a VPL is a spot")
+    };
+    let sm = ShadowMap::build(v, &bvh, 128).unwrap();
+    (EpipolarGrid::new(s.camera.position, position, 64, 64), sm)
+}
+
+#[test]
+fn epipolar_coordinates_round_trip() {
+    let (g, _) = grid_for(AreaSceneName::Grate, Pose::Ordinary, 3);
+    for k in 0..200 {
+        let x = f64::from(k);
+        let dir = DVec3::new((x * 0.37).sin(), (x * 0.71).cos(), (x * 1.3).sin() + 0.1).normalize();
+        let (alpha, theta) = g.eye_angles(dir);
+        assert!((0.0..=PI).contains(&alpha) && (-PI..=PI).contains(&theta));
+        assert!((g.eye_dir(alpha, theta) - dir).length() < 1e-9);
+        for t in [0.1, 1.0, 7.5, 40.0] {
+            let phi = g.phi_at(alpha, t);
+            assert!((0.0..PI - alpha + 1e-12).contains(&phi), "{phi}");
+            assert!((g.t_at(alpha, phi) - t).abs() < 1e-8 * t.max(1.0), "{t}");
+            // The point lies on the light ray of (theta, phi).
+            let p = g.eye + dir * t;
+            let u = g.light_dir(theta, phi);
+            assert!(((p - g.light).normalize() - u).length() < 1e-8);
+        }
+    }
+}
+
+/// After the scan every bit stays set along `alpha` (the shadow is extruded away from the
+/// light), and the voxels agree with the VPL's shadow map at their centres except where the
+/// map's occluder falls inside the voxel's `alpha` bin.
+#[test]
+fn extruded_bits_are_monotone_and_match_the_shadow_map() {
+    for (name, pose) in [
+        (AreaSceneName::Grate, Pose::Ordinary),
+        (AreaSceneName::Columns, Pose::EpipoleOnScreen),
+        (AreaSceneName::Window, Pose::Grazing),
+    ] {
+        let (mut g, sm) = grid_for(name, pose, 5);
+        g.rectify(&sm);
+        let set_before: usize = g
+            .bits
+            .iter()
+            .map(|w| w.iter().map(|x| x.count_ones() as usize).sum::<usize>())
+            .sum();
+        g.scan();
+        let (mut checked, mut mismatched, mut shadowed) = (0usize, 0usize, 0usize);
+        let d_phi = PI / f64::from(PHI_BITS);
+        for j in 0..g.theta {
+            let theta = -PI + (f64::from(j) + 0.5) * g.d_theta();
+            for k in 0..PHI_BITS {
+                let phi = (f64::from(k) + 0.5) * d_phi;
+                for i in 0..g.alpha {
+                    let bit = g.bit(i, j, k);
+                    if i + 1 < g.alpha {
+                        assert!(
+                            !bit || g.bit(i + 1, j, k),
+                            "{name}/{pose}: bit ({i}, {j}, {k}) not extruded"
+                        );
+                    }
+                    let alpha = g.alpha_centre(i);
+                    if alpha + phi >= PI - 1e-9 {
+                        continue;
+                    }
+                    let p = g.eye + g.eye_dir(alpha, theta) * g.t_at(alpha, phi);
+                    // Inside the map's footprint and depth range (beyond its far plane the map
+                    // says nothing: "shadowed" there is an artefact of the depth compare).
+                    if sm.coord(p).is_none_or(|c| c.depth > 1.0) {
+                        continue;
+                    }
+                    checked += 1;
+                    let lit = sm.visibility(p) > 0.5;
+                    shadowed += usize::from(!lit);
+                    if lit == bit {
+                        // Disagreement: allowed only next to the occluder's bin.
+                        let near = (i > 0 && g.bit(i - 1, j, k) != bit)
+                            || (i + 1 < g.alpha && g.bit(i + 1, j, k) != bit);
+                        if !near {
+                            mismatched += 1;
+                        }
+                    }
+                }
+            }
+        }
+        println!(
+            "{name}/{pose}: {set_before} bits rectified, {checked} voxels in the map, {shadowed} shadowed, {mismatched} disagree away from a boundary"
+        );
+        assert!(
+            shadowed > 0 && checked > 1000,
+            "{name}/{pose}: nothing checked"
+        );
+        assert_eq!(
+            mismatched, 0,
+            "{name}/{pose}: {mismatched} of {checked} voxels disagree with the shadow map"
+        );
+    }
+}
+
+#[test]
+fn bad_settings_are_refused_naming_the_knob() {
+    let s = area_suite::scene(
+        AreaSceneName::Grate,
+        Pose::Ordinary,
+        MediumPreset::Default,
+        8,
+        4,
+    );
+    let bvh = Bvh::build(&s.geometry);
+    let gbuf = GBuffer::cast(&s, &bvh);
+    for (settings, knob) in [
+        (
+            IvsvSettings {
+                vpls: 0,
+                ..IvsvSettings::default()
+            },
+            "vpls",
+        ),
+        (
+            IvsvSettings {
+                alpha: 1,
+                ..IvsvSettings::default()
+            },
+            "alpha",
+        ),
+        (
+            IvsvSettings {
+                chunks: 3,
+                ..IvsvSettings::default()
+            },
+            "chunks",
+        ),
+        (
+            IvsvSettings {
+                chunks: 256,
+                ..IvsvSettings::default()
+            },
+            "chunks",
+        ),
+    ] {
+        let err = area_ivsv::render(&s, &gbuf, &bvh, &settings).unwrap_err();
+        assert!(matches!(err, IvsvError::Settings(_)));
+        assert!(err.to_string().contains(knob), "{err}");
+    }
+}
+
+/// Poses where the default misses the 5 % bar: (pose, measured rel RMSE, cause).
+const EXPECTED_FAILURES: &[(&str, f64, &str)] = &[(
+    "area_grate/epipole_on_screen",
+    0.0604,
+    "the lamp on screen: view rays passing centimetres from a VPL, where the 1 / d^2 peak \
+     falls within one phi bit (rel L1 1.6 %)",
+)];
+
+/// Against the `vpl` truth (the same VPLs and shadow maps): rel RMSE <= 5 % on every
+/// area-light pose (the paper's range is 3-5 %) but the listed expected failures, which must
+/// still fail (a fixed one is taken off the list). Printed beside the default: the paper's
+/// uniform average of the bits times the unshadowed integral (`chunks = 1`) on its 128^2
+/// grid. CI: 16 VPLs at 48x27; `SCATTER_FULL=1` also 64 VPLs.
+#[test]
+fn area_ivsv_matches_the_vpl_truth() {
+    let counts: &[usize] = if full() { &[16, 64] } else { &[16] };
+    let truth_settings = TruthSettings {
+        segments: 256,
+        ..TruthSettings::default()
+    };
+    let mut worst = (0.0, String::new());
+    let mut failures = Vec::new();
+    for &n in counts {
+        for (name, pose) in area_suite::all() {
+            let s = area_suite::scene(name, pose, MediumPreset::Default, 48, 27);
+            let bvh = Bvh::build(&s.geometry);
+            let gbuf = GBuffer::cast(&s, &bvh);
+            let settings = IvsvSettings {
+                vpls: n,
+                ..IvsvSettings::default()
+            };
+            let truth =
+                truth::render_vpl(&s, &gbuf, &bvh, n, settings.map_size, &truth_settings).unwrap();
+            let paper = IvsvSettings {
+                alpha: 128,
+                theta: 128,
+                chunks: 1,
+                ..settings
+            };
+            let mut line = format!("{} N={n}:", s.name);
+            let mut rmse = 0.0;
+            for (label, config) in [("default", settings), ("paper (uniform, 128^2)", paper)] {
+                let img = area_ivsv::render(&s, &gbuf, &bvh, &config).unwrap();
+                assert_eq!(metrics::non_finite_count(&img), 0);
+                let e = metrics::rel_rmse(&img, &truth).unwrap();
+                let l1 = metrics::rel_l1(&img, &truth).unwrap();
+                line += &format!(
+                    " {label}: rel RMSE {:.2} % / rel L1 {:.2} %",
+                    100.0 * e,
+                    100.0 * l1
+                );
+                if config == settings {
+                    rmse = e;
+                }
+            }
+            println!("{line}");
+            let expected = EXPECTED_FAILURES.iter().find(|f| f.0 == s.name);
+            match (rmse <= 0.05, expected) {
+                (true, Some(f)) => failures.push(format!(
+                    "{}: now meets the bar ({rmse}); take it off EXPECTED_FAILURES ({})",
+                    s.name, f.2
+                )),
+                (false, None) => failures.push(format!("{} N={n}: rel RMSE {rmse} > 5 %", s.name)),
+                _ => {}
+            }
+            if expected.is_none() && rmse > worst.0 {
+                worst = (rmse, format!("{} N={n}", s.name));
+            }
+        }
+    }
+    println!(
+        "worst outside the expected failures: {} at {:.2} %",
+        worst.1,
+        100.0 * worst.0
+    );
+    assert!(failures.is_empty(), "{failures:#?}");
+}
