@@ -433,3 +433,29 @@ fn area_truth_is_converged_in_light_samples() {
     }
     println!("worst: {} at {:.4} %", worst.1, 100.0 * worst.0);
 }
+
+/// The example scene file with an area light (`reference/scenes/area_grate.json`) is
+/// `area_grate/ordinary` at the suite size; `SCATTER_BLESS=1` rewrites it.
+#[test]
+fn the_area_grate_scene_file_is_the_suite_scene() {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/area_grate.json");
+    let (w, h) = scatter_reference::suite::DEFAULT_SIZE;
+    let built = area_suite::scene(
+        AreaSceneName::Grate,
+        Pose::Ordinary,
+        MediumPreset::Default,
+        w,
+        h,
+    );
+    if std::env::var("SCATTER_BLESS").is_ok_and(|v| v == "1") {
+        std::fs::write(&path, built.to_json() + "\n").unwrap();
+    }
+    let loaded = Scene::load(&path).unwrap_or_else(|e| {
+        panic!("{e} (rewrite it with SCATTER_BLESS=1 cargo test -p scatter-reference --test area)")
+    });
+    assert!(
+        loaded == built,
+        "{} differs from the suite scene",
+        path.display()
+    );
+}

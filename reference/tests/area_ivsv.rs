@@ -7,9 +7,9 @@ use scatter_reference::area_suite::{self, AreaSceneName};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::metrics;
-use scatter_reference::scene::Light;
+use scatter_reference::scene::{AreaShape, Light};
 use scatter_reference::suite::{MediumPreset, Pose};
-use scatter_reference::truth::{self, TruthSettings};
+use scatter_reference::truth::{self, TruthSettings, Visibility};
 use std::f64::consts::PI;
 
 /// Whether the full (opt-in) grid runs: `SCATTER_FULL=1`.
@@ -241,5 +241,182 @@ fn area_ivsv_matches_the_vpl_truth() {
         worst.1,
         100.0 * worst.0
     );
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// How many VPLs a soft shadow needs: against the `exact` truth (the light's surface), the
+/// `vpl` truth and the method with N = 16, 64 and 256 VPLs. The `vpl` truth's error is the
+/// VPL discretisation alone and falls with N; the method's falls with it towards the floor
+/// its grid and shadow maps set. CI: `area_columns/ordinary` and `area_grate/grazing` at
+/// 32x18; `SCATTER_FULL=1` every area pose at 48x27.
+#[test]
+fn error_against_the_exact_truth_falls_with_the_vpl_count() {
+    let (poses, (w, h)) = if full() {
+        (area_suite::all(), (48, 27))
+    } else {
+        (
+            vec![
+                (AreaSceneName::Columns, Pose::Ordinary),
+                (AreaSceneName::Grate, Pose::Grazing),
+            ],
+            (32, 18),
+        )
+    };
+    let settings = TruthSettings {
+        segments: 256,
+        ..TruthSettings::default()
+    };
+    let mut failures = Vec::new();
+    for (name, pose) in poses {
+        let s = area_suite::scene(name, pose, MediumPreset::Default, w, h);
+        let bvh = Bvh::build(&s.geometry);
+        let gbuf = GBuffer::cast(&s, &bvh);
+        let exact = truth::render(&s, &gbuf, &Visibility::Exact(&bvh), &settings, &|| ());
+        let mut line = format!("{}:", s.name);
+        let mut prev: Option<(f64, f64)> = None;
+        for n in [16, 64, 256] {
+            let ivsv = IvsvSettings {
+                vpls: n,
+                ..IvsvSettings::default()
+            };
+            let vpl = truth::render_vpl(&s, &gbuf, &bvh, n, ivsv.map_size, &settings).unwrap();
+            let img = area_ivsv::render(&s, &gbuf, &bvh, &ivsv).unwrap();
+            let (ev, em) = (
+                metrics::rel_rmse(&vpl, &exact).unwrap(),
+                metrics::rel_rmse(&img, &exact).unwrap(),
+            );
+            line += &format!(
+                " N={n}: vpl {:.2} % / area_ivsv {:.2} %",
+                100.0 * ev,
+                100.0 * em
+            );
+            if let Some((pv, _)) = prev
+                && n == 64
+                && ev >= pv
+            {
+                failures.push(format!(
+                    "{}: the vpl truth's error does not fall from 16 to 64 VPLs ({pv} -> {ev})",
+                    s.name
+                ));
+            }
+            prev = Some((ev, em));
+        }
+        println!("{line}");
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Where area lights stress a method (issue 17): a light a millimetre across (all VPLs in
+/// one point: the spot's `shadow_map` truth of its point limit), a huge light (a 6 m x 6 m
+/// panel over the 4 m grate: no umbra left under it), and the camera inside the penumbra
+/// (under the grate, seeing part of the panel between the bars). Against the `vpl` truth
+/// (the point limit's shadow-map truth for the tiny light): rel RMSE <= 5 % and no NaN/Inf.
+#[test]
+fn stress_cases_stay_within_the_bar() {
+    let settings = TruthSettings {
+        segments: 256,
+        ..TruthSettings::default()
+    };
+    let ivsv = IvsvSettings {
+        vpls: 16,
+        ..IvsvSettings::default()
+    };
+    let base = |pose| area_suite::scene(AreaSceneName::Grate, pose, MediumPreset::Default, 48, 27);
+    let mut failures = Vec::new();
+    let resize = |s: &mut scatter_reference::scene::Scene, side: f64| {
+        if let Light::Area(a) = &mut s.light {
+            let area = a.shape.area();
+            a.shape = AreaShape::Rect {
+                width: side,
+                height: side,
+            };
+            // The same power: the radiance scales with 1 / area.
+            a.radiance = a.radiance.map(|r| r * area / (side * side));
+        }
+        // Only the lamp's housing is resized with it: rebuild it.
+        let last = s.geometry.len() - 1;
+        if let Light::Area(a) = &s.light
+            && let Some(h) = a.housing(area_suite::HOUSING_BEHIND, [0.3, 0.3, 0.3])
+        {
+            s.geometry[last] = h;
+        }
+    };
+    let mut cases = Vec::new();
+    for pose in [Pose::Ordinary, Pose::EpipoleOnScreen] {
+        let mut tiny = base(pose);
+        resize(&mut tiny, 1e-3);
+        tiny.name = format!("{}/tiny", tiny.name);
+        cases.push(tiny);
+        let mut huge = base(pose);
+        resize(&mut huge, 6.0);
+        huge.name = format!("{}/huge", huge.name);
+        cases.push(huge);
+    }
+    let mut inside = base(Pose::Ordinary);
+    inside.camera.position = DVec3::new(0.6, 1.2, 0.3);
+    inside.camera.orientation = scatter_reference::scene::Orientation::LookAt {
+        target: DVec3::new(4.0, 2.0, 2.0),
+        up: DVec3::Y,
+    };
+    inside.name = format!("{}/eye_in_penumbra", inside.name);
+    {
+        // Premise: the eye sees some of the VPLs and not others.
+        let bvh = Bvh::build(&inside.geometry);
+        let eye = inside.camera.position;
+        let vpls = inside.light.area().unwrap().vpls(ivsv.vpls);
+        let seen = vpls
+            .iter()
+            .filter(|l| {
+                let Light::Spot { position, .. } = l else {
+                    return false;
+                };
+                let d = *position - eye;
+                !bvh.occluded(
+                    &scatter_reference::geometry::Ray::new(eye, d.normalize()),
+                    1e-6,
+                    d.length() - 1e-3,
+                )
+            })
+            .count();
+        assert!(
+            0 < seen && seen < vpls.len(),
+            "the eye sees {seen} of {} VPLs: not in the penumbra",
+            vpls.len()
+        );
+    }
+    cases.push(inside);
+    for s in cases {
+        s.validate().unwrap();
+        let bvh = Bvh::build(&s.geometry);
+        let gbuf = GBuffer::cast(&s, &bvh);
+        let img = area_ivsv::render(&s, &gbuf, &bvh, &ivsv).unwrap();
+        let truth = if s.name.ends_with("/tiny") {
+            let point = scatter_reference::scene::Scene {
+                light: s.light.area().unwrap().point_limit(),
+                ..s.clone()
+            };
+            let sm = ShadowMap::build(&point, &bvh, ivsv.map_size).unwrap();
+            truth::render(
+                &point,
+                &gbuf,
+                &Visibility::ShadowMap(&sm),
+                &settings,
+                &|| (),
+            )
+        } else {
+            truth::render_vpl(&s, &gbuf, &bvh, ivsv.vpls, ivsv.map_size, &settings).unwrap()
+        };
+        let nan = metrics::non_finite_count(&img);
+        let e = metrics::rel_rmse(&img, &truth).unwrap();
+        println!(
+            "{}: rel RMSE {:.2} % / rel L1 {:.2} %, {nan} NaN/Inf",
+            s.name,
+            100.0 * e,
+            100.0 * metrics::rel_l1(&img, &truth).unwrap()
+        );
+        if nan > 0 || e > 0.05 {
+            failures.push(format!("{}: rel RMSE {e}, {nan} NaN/Inf", s.name));
+        }
+    }
     assert!(failures.is_empty(), "{failures:#?}");
 }
