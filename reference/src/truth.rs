@@ -250,8 +250,12 @@ pub fn ray_inscatter_rgb(
     dir: DVec3,
     s: f64,
 ) -> [f64; 3] {
-    let lights = point_lights(&scene.light, settings);
     let soft = NearField::of(&scene.light, settings);
+    if !matches!(scene.light, Light::Area(_)) {
+        let one = std::slice::from_ref(&scene.light);
+        return ray_inscatter_lights(scene, one, &soft, vis, settings, origin, dir, s);
+    }
+    let lights = point_lights(&scene.light, settings);
     ray_inscatter_lights(scene, &lights, &soft, vis, settings, origin, dir, s)
 }
 
