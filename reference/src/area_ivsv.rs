@@ -393,12 +393,12 @@ fn gather(grid: &EpipolarGrid, scene: &Scene, dir: DVec3, s: f64, chunks: u32) -
         + w * gather_texel(grid, &f, alpha, phi_s, i, b, chunks)
 }
 
-/// Renders an area-light scene with the method (RGB: each VPL's colour); any other light is
-/// rendered as its one point light.
+/// Renders an area-light scene with the method (RGB: each VPL's colour); a spot is rendered
+/// as its one VPL.
 ///
 /// # Errors
 ///
-/// A knob out of range, or a VPL whose shadow map cannot be built.
+/// A knob out of range, a directional light, or a VPL whose shadow map cannot be built.
 pub fn render(
     scene: &Scene,
     gbuf: &GBuffer,

@@ -130,11 +130,12 @@ pub fn ray_inscatter(
 }
 
 /// How the `exact` truth of an area light treats the light's neighbourhood: each quadrature
-/// point stands for a disk of its cell's area ([`RayIntegrand::softened`]: a view ray passing
-/// next to a point picks up no `1 / d^2` spike the light's surface does not have), and where
-/// a view ray passes within twice the light's radius of its centre, the Gauss-Legendre pieces
-/// there are 8 disk radii long (nodes half a radius apart), so that the peaks next to the
-/// points are resolved. Nothing for other lights.
+/// point stands for a disk of its cell's area ([`RayIntegrand::softened`]: the integrand over
+/// the surface is bounded, a point's `1 / d^2` is not), and where a view ray passes within
+/// twice the light's radius of its centre, the Gauss-Legendre pieces there are 8 disk radii
+/// long (nodes half a radius apart). Not enough for the fog next to the emitting face: the
+/// pixels whose ray ends on the lamp's housing converge slowly in the light's points (the
+/// convergence test reports them apart). Nothing for other lights.
 #[derive(Clone, Copy, Debug, Default)]
 struct NearField {
     /// Squared disk radius (0: points).
