@@ -326,6 +326,23 @@ impl AreaLight {
         self.position + right * x + up * y
     }
 
+    /// The spots a point `p` of the light stands for: one per emitting face, along the
+    /// face's normal, with the light's cone and the given intensity.
+    fn spots_at(&self, p: DVec3, intensity: [f64; 3]) -> impl Iterator<Item = Light> + '_ {
+        let normal = self.frame().2;
+        [1.0, -1.0]
+            .into_iter()
+            .take(self.faces())
+            .map(move |side| Light::Spot {
+                position: p,
+                direction: normal * side,
+                inner_angle_deg: self.inner_angle_deg,
+                outer_angle_deg: self.outer_angle_deg,
+                intensity,
+                cookie: None,
+            })
+    }
+
     /// Emitting faces: 1, or 2 when two-sided.
     pub fn faces(&self) -> usize {
         if self.two_sided { 2 } else { 1 }
@@ -337,22 +354,12 @@ impl AreaLight {
     /// intensity `radiance * area / n`: their sum tends to the light as `n` grows, and
     /// the first `n` of `m > n` points are the same `n` points.
     pub fn vpls(&self, n: usize) -> Vec<Light> {
-        let (_, _, normal) = self.frame();
         let scale = self.shape.area() / n.max(1) as f64;
         let intensity = self.radiance.map(|c| c * scale);
         let mut out = Vec::with_capacity(n * self.faces());
         for i in 1..=n {
             let p = self.point(halton(i, 2), halton(i, 3));
-            for side in [1.0, -1.0].into_iter().take(self.faces()) {
-                out.push(Light::Spot {
-                    position: p,
-                    direction: normal * side,
-                    inner_angle_deg: self.inner_angle_deg,
-                    outer_angle_deg: self.outer_angle_deg,
-                    intensity,
-                    cookie: None,
-                });
-            }
+            out.extend(self.spots_at(p, intensity));
         }
         out
     }
@@ -372,7 +379,7 @@ impl AreaLight {
             a *= 2;
         }
         let b = m / a;
-        let (right, up, normal) = self.frame();
+        let (right, up, _) = self.frame();
         let scale = self.shape.area() / (a * b) as f64;
         let intensity = self.radiance.map(|c| c * scale);
         let mut out = Vec::with_capacity(a * b * self.faces());
@@ -387,17 +394,7 @@ impl AreaLight {
                         (r * c, r * s)
                     }
                 };
-                let p = self.position + right * x + up * y;
-                for side in [1.0, -1.0].into_iter().take(self.faces()) {
-                    out.push(Light::Spot {
-                        position: p,
-                        direction: normal * side,
-                        inner_angle_deg: self.inner_angle_deg,
-                        outer_angle_deg: self.outer_angle_deg,
-                        intensity,
-                        cookie: None,
-                    });
-                }
+                out.extend(self.spots_at(self.position + right * x + up * y, intensity));
             }
         }
         out
