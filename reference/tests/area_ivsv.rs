@@ -2,7 +2,9 @@
 //! rectified and extruded voxel bits, and its accuracy against the `vpl` truth.
 
 use glam::DVec3;
-use scatter_reference::area_ivsv::{self, EpipolarGrid, IvsvError, IvsvSettings, PHI_BITS};
+use scatter_reference::area_ivsv::{
+    self, EpipolarGrid, IvsvError, IvsvSettings, PHI_BITS, Weights,
+};
 use scatter_reference::area_suite::{self, AreaSceneName};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
@@ -147,17 +149,17 @@ fn bad_settings_are_refused_naming_the_knob() {
         ),
         (
             IvsvSettings {
-                chunks: 3,
+                weights: Weights::Linear(3),
                 ..IvsvSettings::default()
             },
-            "chunks",
+            "segments",
         ),
         (
             IvsvSettings {
-                chunks: 256,
+                weights: Weights::Linear(256),
                 ..IvsvSettings::default()
             },
-            "chunks",
+            "segments",
         ),
     ] {
         let err = area_ivsv::render(&s, &gbuf, &bvh, &settings).unwrap_err();
@@ -169,9 +171,10 @@ fn bad_settings_are_refused_naming_the_knob() {
 /// Poses where the default misses the 5 % bar: (pose, measured rel RMSE, cause).
 const EXPECTED_FAILURES: &[(&str, f64, &str)] = &[(
     "area_grate/epipole_on_screen",
-    0.0604,
-    "the lamp on screen: view rays passing centimetres from a VPL, where the 1 / d^2 peak \
-     falls within one phi bit (rel L1 1.6 %)",
+    0.0617,
+    "the lamp on screen: view rays passing centimetres from a VPL, where the alpha bin \
+     holding the ray spans many times the ray's own angle, so its bits belong to rays passing \
+     farther from the VPL (the grid's alpha resolution next to the axis; rel L1 1.80 %)",
 )];
 
 /// Against the `vpl` truth (the same VPLs and shadow maps): rel RMSE <= 5 % on every
@@ -202,7 +205,7 @@ fn area_ivsv_matches_the_vpl_truth() {
             let paper = IvsvSettings {
                 alpha: 128,
                 theta: 128,
-                chunks: 1,
+                weights: Weights::Uniform,
                 ..settings
             };
             let mut line = format!("{} N={n}:", s.name);
@@ -419,4 +422,49 @@ fn stress_cases_stay_within_the_bar() {
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// How many knots of the integrand in `phi` the gather needs: rel RMSE against the `vpl`
+/// truth (16 VPLs, 48x27) for the paper's uniform weights and 1, 2, 4, 8 and 128 linear
+/// segments, every area pose. A measurement, not a bar (the bar is
+/// `area_ivsv_matches_the_vpl_truth`): `cargo test --release -p scatter-reference --test
+/// area_ivsv -- --ignored --nocapture weights`.
+#[test]
+#[ignore = "a measurement (a table), run on demand"]
+fn weights_sweep() {
+    let truth_settings = TruthSettings {
+        segments: 256,
+        ..TruthSettings::default()
+    };
+    let modes = [
+        Weights::Uniform,
+        Weights::Linear(1),
+        Weights::Linear(2),
+        Weights::Linear(4),
+        Weights::Linear(8),
+        Weights::Linear(16),
+        Weights::Linear(128),
+    ];
+    println!("pose | {modes:?}");
+    for (name, pose) in area_suite::all() {
+        let s = area_suite::scene(name, pose, MediumPreset::Default, 48, 27);
+        let bvh = Bvh::build(&s.geometry);
+        let gbuf = GBuffer::cast(&s, &bvh);
+        let base = IvsvSettings {
+            vpls: 16,
+            ..IvsvSettings::default()
+        };
+        let truth = truth::render_vpl(&s, &gbuf, &bvh, 16, base.map_size, &truth_settings).unwrap();
+        let mut line = format!("{} |", s.name);
+        for weights in modes {
+            let img =
+                area_ivsv::render(&s, &gbuf, &bvh, &IvsvSettings { weights, ..base }).unwrap();
+            line += &format!(
+                " {:.2} / {:.2} % |",
+                100.0 * metrics::rel_rmse(&img, &truth).unwrap(),
+                100.0 * metrics::rel_l1(&img, &truth).unwrap()
+            );
+        }
+        println!("{line}");
+    }
 }
