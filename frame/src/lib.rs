@@ -11,6 +11,7 @@
 //! knobs and set-up are in [`raymarch`] and [`minmax`]. [`family`] lists the families and
 //! holds the one enum of every family's variant ([`family::FamilyVariant`]).
 
+pub mod area_ivsv;
 pub mod cookie;
 pub mod family;
 pub mod frame;
