@@ -163,9 +163,9 @@ pub struct VplRecord {
     /// Unit axis from the eye to the VPL; w = `alpha_0`.
     pub axis: [f32; 4],
     /// `b1` (`theta = 0`); w = `alpha` bin width.
-    pub b1: [f32; 4],
-    /// `b2 = axis x b1`; w = `phi_max`.
-    pub b2: [f32; 4],
+    pub perp_x: [f32; 4],
+    /// `b2 = axis x b1` (`theta = pi / 2`); w = `phi_max`.
+    pub perp_y: [f32; 4],
     /// Spot axis; w = cos(inner angle).
     pub spot_dir: [f32; 4],
     /// Shadow-map right; w = near.
@@ -354,8 +354,8 @@ pub fn prepare_area_ivsv(
                 sc.cos_out as f32,
             ],
             axis: v4(g.axis, g.alpha_range.0),
-            b1: v4(g.basis[0], d_alpha),
-            b2: v4(g.basis[1], g.phi_max),
+            perp_x: v4(g.basis[0], d_alpha),
+            perp_y: v4(g.basis[1], g.phi_max),
             spot_dir: v4(sc.light_dir, sc.cos_in),
             sm_right: v4(sm.basis[0], sm.near),
             sm_up: v4(sm.basis[1], sm.far),
@@ -367,8 +367,8 @@ pub fn prepare_area_ivsv(
             ("VPL position", r.position),
             ("VPL color", r.color),
             ("VPL axis", r.axis),
-            ("VPL b1", r.b1),
-            ("VPL b2", r.b2),
+            ("VPL perp_x", r.perp_x),
+            ("VPL perp_y", r.perp_y),
             ("VPL spot_dir", r.spot_dir),
             ("VPL sm_right", r.sm_right),
             ("VPL sm_up", r.sm_up),

@@ -62,6 +62,10 @@ const COMMON_MODULES: &[(&str, &str)] = &[
         "common/cookie.wgsl",
         include_str!("../templates/common/cookie.wgsl"),
     ),
+    (
+        "common/ivsv.wgsl",
+        include_str!("../templates/common/ivsv.wgsl"),
+    ),
 ];
 
 thread_local! {

@@ -25,6 +25,7 @@
 //! # Ok::<(), scatter_shaderlib::ShaderError>(())
 //! ```
 
+pub mod area_ivsv;
 mod compose;
 mod error;
 pub mod family;
@@ -39,6 +40,7 @@ pub mod reflect;
 pub mod row_prefix;
 pub mod sampling;
 
+use area_ivsv::AreaIvsvVariant;
 pub use error::ShaderError;
 use family::{Family, KernelFamily};
 use hybrid_volume::HybridVolumeVariant;
@@ -58,6 +60,13 @@ kernel::kernels! {
     /// Separable sum filter of interleaved sampling over the `raymarch` partial sums (Tóth &
     /// Umenhoffer 2009).
     InterleaveSum("interleave_sum", RaymarchVariant, raymarch::render_interleave_sum),
+    /// area_ivsv: per pixel, the lit integral of every VPL from its voxel bits (Wyman & Dai
+    /// 2013).
+    IvsvGather("ivsv_gather", AreaIvsvVariant, area_ivsv::render_gather),
+    /// area_ivsv: per VPL and epipolar light ray, the voxel where its shadow starts.
+    IvsvRectify("ivsv_rectify", AreaIvsvVariant, area_ivsv::render_rectify),
+    /// area_ivsv: the extrusion of the marked voxels, an OR scan along alpha.
+    IvsvScan("ivsv_scan", AreaIvsvVariant, area_ivsv::render_scan),
     /// The 1D min-max tree of every rectified row (Chen et al. 2011).
     MinmaxBuild("minmax_build", MinmaxVariant, minmax::render_build),
     /// Per pixel: the rectified row marched through its min-max tree, skipping nodes wholly
@@ -139,6 +148,8 @@ impl KernelParams {
                 })
             })
             .collect();
+        // Not yet in the family table (`scatter_shaderlib::area_ivsv`'s docs).
+        out.extend(Self::area_ivsv(AreaIvsvVariant::default()));
         for &family in Family::ALL {
             // The variant with the most passes, then the default with epipolar sampling
             // (its `_unwarp` and `_fallback` kernels).

@@ -103,8 +103,8 @@ fn vpl_lit(m: IvsvFrame, r: Vpl, v: u32, dir: vec3<f32>, s: f32) -> f32 {
     let axis = r.axis.xyz;
     let alpha = clamp(atan2(length(cross(dir, axis)), dot(dir, axis)), 1e-6, PI - 1e-6);
     let sa = sin(alpha);
-    let theta = atan2(dot(dir, r.b2.xyz), dot(dir, r.b1.xyz));
-    let phi_max = r.b2[3];
+    let theta = atan2(dot(dir, r.perp_y.xyz), dot(dir, r.perp_x.xyz));
+    let phi_max = r.perp_y[3];
     let phi_s = min(min(atan2(s * sa, big_d - s * cos(alpha)), PI - alpha), phi_max);
     // The phi interval inside the outer cone.
     let c = -dot(axis, r.spot_dir.xyz);
@@ -131,7 +131,7 @@ fn vpl_lit(m: IvsvFrame, r: Vpl, v: u32, dir: vec3<f32>, s: f32) -> f32 {
     let tw = xt - j0;
     let ja = u32((i32(j0) + i32(rows)) % i32(rows));
     let jb = (ja + 1u) % rows;
-    let i = u32(clamp(floor((alpha - r.axis[3]) / r.b1[3]), 0.0, f32(m.grid[0] - 1u)));
+    let i = u32(clamp(floor((alpha - r.axis[3]) / r.perp_x[3]), 0.0, f32(m.grid[0] - 1u)));
     let bits_a = voxel(m, v, ja, i);
     let bits_b = voxel(m, v, jb, i);
     // Bits below phi_s, and the one holding it (covered part `cover`, centre `pc`).

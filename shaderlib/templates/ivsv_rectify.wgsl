@@ -69,7 +69,7 @@ fn ivsv_rectify(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let r = vpls[v];
     let theta = -PI + (f32(j) + 0.5) * (2.0 * PI / f32(m.grid[1]));
-    let phi = (f32(k) + 0.5) * (r.b2[3] / f32(PHI_BITS));
+    let phi = (f32(k) + 0.5) * (r.perp_y[3] / f32(PHI_BITS));
     let u = -r.axis.xyz * cos(phi) + plane_normal(r, theta) * sin(phi);
     let s = vpl_occluder_distance(vpl_shadow_view(m, r), v, u);
     if s < 0.0 {
@@ -77,7 +77,7 @@ fn ivsv_rectify(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let alpha_occ = atan2(s * sin(phi), r.position[3] - s * cos(phi));
     // The first bin whose centre exceeds alpha_occ.
-    let x = (alpha_occ - r.axis[3]) / r.b1[3];
+    let x = (alpha_occ - r.axis[3]) / r.perp_x[3];
     let first = floor(x - 0.5) + 1.0;
     if first < f32(m.grid[0]) {
         let i = u32(max(first, 0.0));

@@ -5,6 +5,7 @@
 
 pub mod common_cookie;
 pub mod common_epipolar;
+pub mod common_ivsv;
 pub mod common_minmax;
 pub mod common_model;
 pub mod common_moments;
@@ -17,6 +18,9 @@ pub mod common_shadow;
 pub mod depth_columns;
 pub mod family;
 pub mod interleave_sum;
+pub mod ivsv_gather;
+pub mod ivsv_rectify;
+pub mod ivsv_scan;
 pub mod minmax_build;
 pub mod minmax_traverse;
 pub mod minmax_traverse_fallback;
@@ -47,6 +51,7 @@ use crate::image::Image;
 use crate::projective::rasterise_rectified;
 use crate::scene::Scene;
 pub use family::{CpuFamily, CpuFrame, CpuRun, FamilyRun, run_family};
+use scatter_shaderlib::area_ivsv::{AreaIvsvFrame, AreaIvsvVariant, VplInput, prepare_area_ivsv};
 use scatter_shaderlib::hybrid_volume::{HybridVolumeVariant, prepare_hybrid_volume};
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_shaderlib::partial_sum_tree::{
@@ -587,6 +592,123 @@ pub fn partial_sum_tree_from_rectified(
         samples,
         counts,
         sampled,
+        output,
+    }
+}
+
+/// The inputs of the `area_ivsv` kernels for a scene: its VPLs (each a spot scene of
+/// [`Scene::point_light_scenes`]) with their ray-cast shadow maps, the frame set-up, and the
+/// textures (VPL maps as layers, channel 0; the depth buffer).
+#[derive(Clone, Debug)]
+pub struct IvsvInputs {
+    /// The frame set-up.
+    pub frame: AreaIvsvFrame,
+    /// Every VPL's shadow map, one layer each (channel 0).
+    pub maps: TexArray,
+    /// The same, as the GPU's `vpl_maps` takes them: layer-major, then row-major.
+    pub map_data: Vec<f32>,
+    /// The depth buffer.
+    pub depth: Tex,
+}
+
+/// Why the `area_ivsv` inputs cannot be built.
+#[derive(Debug, thiserror::Error)]
+pub enum IvsvInputError {
+    /// A VPL's shadow map.
+    #[error(transparent)]
+    ShadowMap(#[from] crate::buffers::ShadowMapError),
+    /// The frame set-up.
+    #[error(transparent)]
+    Frame(#[from] FrameError),
+}
+
+/// Builds the `area_ivsv` inputs of `scene` (an area light: `variant.vpls` VPLs, which for a
+/// two-sided light must be even: half the points, each twice) with `map_size`^2 VPL maps.
+///
+/// # Errors
+///
+/// A VPL's shadow map that cannot be built, or the frame set-up's error.
+pub fn ivsv_inputs(
+    scene: &Scene,
+    gbuf: &GBuffer,
+    bvh: &Bvh,
+    variant: &AreaIvsvVariant,
+    map_size: u32,
+) -> Result<IvsvInputs, IvsvInputError> {
+    let two_sided = matches!(&scene.light, crate::scene::Light::Area(a) if a.two_sided);
+    let points = if two_sided {
+        variant.vpls as usize / 2
+    } else {
+        variant.vpls as usize
+    };
+    let scenes = scene.point_light_scenes(points.max(1));
+    let mut maps = TexArray::new(map_size, map_size, scenes.len() as u32);
+    let mut map_data = Vec::with_capacity(scenes.len() * (map_size * map_size) as usize);
+    let mut vpls = Vec::with_capacity(scenes.len());
+    for (layer, vpl) in (0u32..).zip(&scenes) {
+        let sm = ShadowMap::build(vpl, bvh, map_size)?;
+        for (k, &d) in sm.depth.iter().enumerate() {
+            let k = k as u32;
+            maps.data[((layer * map_size + k / map_size) * map_size + k % map_size) as usize] =
+                [d, 0.0, 0.0, 0.0];
+        }
+        map_data.extend_from_slice(&sm.depth);
+        vpls.push(VplInput {
+            light: vpl.light_desc(),
+            shadow_map: sm.desc(),
+        });
+    }
+    let frame = prepare_area_ivsv(
+        variant,
+        [gbuf.width, gbuf.height],
+        &scene.camera_desc(),
+        &scene.medium_desc(),
+        &vpls,
+        map_size,
+    )?;
+    let depth = Tex {
+        width: gbuf.width,
+        height: gbuf.height,
+        data: gbuf.view_depth.clone(),
+    };
+    Ok(IvsvInputs {
+        frame,
+        maps,
+        map_data,
+        depth,
+    })
+}
+
+/// What the `area_ivsv` mirrors compute for one frame.
+#[derive(Clone, Debug)]
+pub struct IvsvRun {
+    /// `marks` after `ivsv_rectify`.
+    pub marks: Vec<u32>,
+    /// `volume` after `ivsv_scan`.
+    pub volume: Vec<u32>,
+    /// `ivsv_gather`'s output (rgb, not rounded to `rgba16float`).
+    pub output: Vec<[f32; 3]>,
+}
+
+/// Runs `ivsv_rectify`, `ivsv_scan` and `ivsv_gather` on the CPU.
+pub fn run_area_ivsv(variant: &AreaIvsvVariant, inputs: &IvsvInputs) -> IvsvRun {
+    let m = &inputs.frame.uniforms;
+    let words = 4 * (variant.vpls * variant.alpha * variant.theta) as usize;
+    let mut marks = vec![0u32; words];
+    ivsv_rectify::ivsv_rectify(m, &inputs.frame.vpls, &inputs.maps, &mut marks);
+    let rectified = marks.clone();
+    let mut volume = vec![0u32; words];
+    ivsv_scan::ivsv_scan(m, &mut marks, &mut volume);
+    let output = ivsv_gather::ivsv_gather(
+        m,
+        &inputs.frame.vpls,
+        &volume,
+        &inputs.depth,
+        variant.segments,
+    );
+    IvsvRun {
+        marks: rectified,
+        volume,
         output,
     }
 }

@@ -40,9 +40,9 @@ struct Vpl {
     // Unit axis from the eye to the VPL; w = alpha_0, the first alpha bin's start.
     axis: vec4<f32>,
     // Unit normal to the axis (theta = 0); w = alpha bin width.
-    b1: vec4<f32>,
-    // axis x b1 (theta = pi / 2); w = phi_max (the 128 phi bits cover [0, phi_max]).
-    b2: vec4<f32>,
+    perp_x: vec4<f32>,
+    // axis x perp_x (theta = pi / 2); w = phi_max (the 128 phi bits cover [0, phi_max]).
+    perp_y: vec4<f32>,
     // Spot axis (the direction light travels); w = cos(inner angle).
     spot_dir: vec4<f32>,
     // The VPL's shadow map (a perspective `ShadowMapView` without its size: frame.sizes.z).
@@ -63,7 +63,7 @@ fn voxel_word(m: IvsvFrame, v: u32, j: u32, i: u32) -> u32 {
 
 // The unit vector in the epipolar plane of angle `theta` normal to the VPL's axis.
 fn plane_normal(r: Vpl, theta: f32) -> vec3<f32> {
-    return r.b1.xyz * cos(theta) + r.b2.xyz * sin(theta);
+    return r.perp_x.xyz * cos(theta) + r.perp_y.xyz * sin(theta);
 }
 
 // The VPL's shadow map as `scatter::shadow` reads one.

@@ -1,0 +1,97 @@
+//! The `area_ivsv` family (Wyman & Dai 2013): the askama views of
+//! `templates/ivsv_rectify.wgsl`, `templates/ivsv_scan.wgsl` and `templates/ivsv_gather.wgsl`
+//! and their rendering from an [`AreaIvsvVariant`]. CPU mirrors:
+//! `reference/src/kernels/{ivsv_rectify,ivsv_scan,ivsv_gather}.rs`. Host-side knobs and frame
+//! set-up: [`scatter_frame::area_ivsv`] (re-exported here).
+//!
+//! Not yet in the family tables (`Family`, the generator's `--family`, the runtime's
+//! `FamilyPasses`): the engine's frame inputs of every other family hold one light and one
+//! shadow map, and an area light needs `N` of each; `scatter_runtime::area_ivsv` drives the
+//! passes from this family's plan meanwhile.
+
+pub mod plan;
+
+use askama::Template;
+
+pub use scatter_frame::area_ivsv::{
+    AreaIvsvFrame, AreaIvsvVariant, IvsvUniforms, MAX_SEGMENTS, MAX_VPLS, PHI_BITS, VplGrid,
+    VplInput, VplRecord, fit_grid, prepare_area_ivsv,
+};
+
+use crate::compose::template_path;
+use crate::{Kernel, ShaderError};
+
+/// Workgroup size of `ivsv_rectify` (x: phi bits) and `ivsv_scan` (x: row words).
+pub const LINE_WORKGROUP_SIZE: [u32; 3] = [64, 1, 1];
+
+/// Workgroup size of `ivsv_gather`: one invocation per pixel.
+pub const GATHER_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
+
+/// `ivsv_rectify` (no parameters: every knob is a uniform or a buffer size).
+#[derive(Template)]
+#[template(path = "ivsv_rectify.wgsl")]
+struct RectifyTemplate;
+
+/// `ivsv_scan`.
+#[derive(Template)]
+#[template(path = "ivsv_scan.wgsl")]
+struct ScanTemplate;
+
+/// `ivsv_gather`: the pieces of the integrand are a constant loop count.
+#[derive(Template)]
+#[template(path = "ivsv_gather.wgsl")]
+struct GatherTemplate {
+    segments: u32,
+}
+
+fn validate(kernel: Kernel, variant: &AreaIvsvVariant) -> Result<(), ShaderError> {
+    variant
+        .validate()
+        .map_err(|source| ShaderError::Variant { kernel, source })
+}
+
+fn render_error(kernel: Kernel) -> impl FnOnce(askama::Error) -> ShaderError {
+    move |source| ShaderError::Render {
+        kernel,
+        template: template_path(kernel),
+        source,
+    }
+}
+
+/// Renders `templates/ivsv_rectify.wgsl`.
+pub(crate) fn render_rectify(variant: &AreaIvsvVariant) -> Result<String, ShaderError> {
+    validate(Kernel::IvsvRectify, variant)?;
+    RectifyTemplate
+        .render()
+        .map_err(render_error(Kernel::IvsvRectify))
+}
+
+/// Renders `templates/ivsv_scan.wgsl`.
+pub(crate) fn render_scan(variant: &AreaIvsvVariant) -> Result<String, ShaderError> {
+    validate(Kernel::IvsvScan, variant)?;
+    ScanTemplate
+        .render()
+        .map_err(render_error(Kernel::IvsvScan))
+}
+
+/// Renders `templates/ivsv_gather.wgsl` for `variant`'s segments.
+pub(crate) fn render_gather(variant: &AreaIvsvVariant) -> Result<String, ShaderError> {
+    validate(Kernel::IvsvGather, variant)?;
+    GatherTemplate {
+        segments: variant.segments,
+    }
+    .render()
+    .map_err(render_error(Kernel::IvsvGather))
+}
+
+impl crate::KernelParams {
+    /// The kernels of an area_ivsv-family variant, in pass order: `ivsv_rectify`,
+    /// `ivsv_scan`, `ivsv_gather`.
+    pub fn area_ivsv(variant: AreaIvsvVariant) -> [Self; 3] {
+        [
+            Self::IvsvRectify(variant),
+            Self::IvsvScan(variant),
+            Self::IvsvGather(variant),
+        ]
+    }
+}

@@ -1,0 +1,165 @@
+//! The plan of an `area_ivsv` variant: its textures and buffers and its passes
+//! (`ivsv_rectify`, `ivsv_scan`, `ivsv_gather`), from which `scatter-runtime` builds and
+//! dispatches.
+
+use crate::Kernel;
+use crate::area_ivsv::AreaIvsvVariant;
+use crate::plan::{
+    BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource, SAMPLED,
+    TEXTURE_DIMENSION, bind, frame_buffer, scatter_resource, scatter_texture, texture_2d,
+};
+
+/// A voxel buffer (`marks`, `volume`): four `u32` per texel of every VPL's grid.
+fn voxel_buffer(v: &AreaIvsvVariant, name: &'static str, contents: &'static str) -> Resource {
+    Resource {
+        kind: "storage_buffer",
+        buffer: Some(BufferDesc {
+            elements: Some(format!("{}", 4 * v.vpls * v.alpha * v.theta)),
+            usage: vec!["storage", "copy_src"],
+        }),
+        ..scatter_resource(name, contents)
+    }
+}
+
+/// The resources and passes of a variant, as `runtime/src/area_ivsv.rs` creates them.
+pub fn plan(v: &AreaIvsvVariant) -> Plan {
+    let parameters = vec![
+        Parameter {
+            name: "screen.width",
+            description: "screen width in pixels (depth buffer and output)",
+            constraint: TEXTURE_DIMENSION.into(),
+        },
+        Parameter {
+            name: "screen.height",
+            description: "screen height in pixels (depth buffer and output)",
+            constraint: TEXTURE_DIMENSION.into(),
+        },
+        Parameter {
+            name: "shadow.size",
+            description: "side of every VPL's square standard shadow map in texels",
+            constraint: TEXTURE_DIMENSION.into(),
+        },
+    ];
+    let vpls = v.vpls.to_string();
+    let resources = vec![
+        frame_buffer(
+            "frame",
+            "the uniform block of the frame (Rust: scatter_frame::area_ivsv::IvsvUniforms from \
+             prepare_area_ivsv), written once per frame",
+            None,
+        ),
+        frame_buffer(
+            "vpls",
+            "one record per VPL: position, intensity, epipolar grid, cone, shadow map (Rust: \
+             VplRecord from prepare_area_ivsv), written once per frame",
+            Some(&vpls),
+        ),
+        Resource {
+            provided_by: "engine",
+            texture: Some(texture_2d(
+                DEPTH_FORMAT,
+                "screen.width",
+                "screen.height",
+                "1",
+                SAMPLED,
+            )),
+            ..scatter_resource(
+                "depth",
+                "linear view depth per pixel (far plane distance for sky)",
+            )
+        },
+        Resource {
+            provided_by: "engine",
+            texture: Some(texture_2d(
+                DEPTH_FORMAT,
+                "shadow.size",
+                "shadow.size",
+                &vpls,
+                SAMPLED,
+            )),
+            ..scatter_resource(
+                "vpl_maps",
+                "one standard shadow map per VPL (layer = VPL index): normalised linear light \
+                 depth of the VPL's perspective map (1 where nothing was hit)",
+            )
+        },
+        voxel_buffer(
+            v,
+            "marks",
+            "per VPL, theta row and alpha texel, 128 phi bits: where a light ray's shadow \
+             starts (written by ivsv_rectify with atomicOr, zeroed by ivsv_scan; zero when \
+             created)",
+        ),
+        voxel_buffer(
+            v,
+            "volume",
+            "the extruded voxel bits (written by ivsv_scan, read by ivsv_gather)",
+        ),
+        scatter_texture(
+            "output",
+            "in-scattered radiance, rgb, alpha 1 (written by ivsv_gather); add it to the \
+             attenuated scene",
+            OUTPUT_FORMAT,
+            "screen.width",
+            "screen.height",
+        ),
+    ];
+    let passes = [Kernel::IvsvRectify, Kernel::IvsvScan, Kernel::IvsvGather]
+        .into_iter()
+        .filter_map(|k| pass(v, k))
+        .collect();
+    Plan {
+        parameters,
+        resources,
+        passes,
+        notes: vec![
+            "Run the passes in order; each reads what the previous ones wrote: put a \
+             compute-to-compute memory barrier between them.",
+            "Write `frame` and `vpls` once per frame before the first pass (Rust: \
+             scatter_frame::area_ivsv::prepare_area_ivsv from the camera, the medium and each \
+             VPL's spot light and shadow-map description). Render every VPL's shadow map into \
+             its layer of `vpl_maps` first.",
+            "`marks` must be zero when created (WebGPU buffers are); `ivsv_scan` leaves it zero \
+             for the next frame.",
+            "Group 0 holds every binding; bind by group and binding number, not by name: \
+             emitted names may be mangled (naga_oil) or carry a trailing `_` (naga).",
+        ],
+    }
+}
+
+/// The pass of one kernel, or `None` for a kernel that is not in this family.
+pub fn pass(v: &AreaIvsvVariant, kernel: Kernel) -> Option<PassPlan> {
+    let f = |s: &str| s.to_owned();
+    match kernel {
+        Kernel::IvsvRectify => Some(PassPlan {
+            kernel,
+            invocations: [f("128"), v.theta.to_string(), v.vpls.to_string()],
+            skip_when: None,
+            bindings: vec![
+                bind(0, "frame"),
+                bind(1, "vpls"),
+                bind(2, "vpl_maps"),
+                bind(3, "marks"),
+            ],
+        }),
+        Kernel::IvsvScan => Some(PassPlan {
+            kernel,
+            invocations: [(4 * v.theta).to_string(), v.vpls.to_string(), f("1")],
+            skip_when: None,
+            bindings: vec![bind(0, "frame"), bind(1, "marks"), bind(2, "volume")],
+        }),
+        Kernel::IvsvGather => Some(PassPlan {
+            kernel,
+            invocations: [f("screen.width"), f("screen.height"), f("1")],
+            skip_when: None,
+            bindings: vec![
+                bind(0, "frame"),
+                bind(1, "vpls"),
+                bind(2, "volume"),
+                bind(3, "depth"),
+                bind(4, "output"),
+            ],
+        }),
+        _ => None,
+    }
+}
