@@ -20,6 +20,7 @@
 //! pipelines, resources and dispatches; a family type keeps only its input checks, its
 //! per-frame upload and its frame report. [`gpu`] holds the toolkit no family owns.
 
+pub mod area_ivsv;
 mod context;
 mod cookie;
 mod error;
@@ -35,6 +36,7 @@ pub mod row_prefix;
 pub mod textures;
 mod timer;
 
+pub use area_ivsv::{AreaIvsv, AreaIvsvReadback, AreaIvsvTimes, run_area_ivsv_once};
 pub use context::{AdapterReport, Context, ContextError, GpuPolicy};
 pub use error::RuntimeError;
 pub use family::{FamilyPasses, FamilyReadback, FamilyRuntime, run_family_on, run_family_once};

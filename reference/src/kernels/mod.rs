@@ -603,6 +603,8 @@ pub fn partial_sum_tree_from_rectified(
 pub struct IvsvInputs {
     /// The frame set-up.
     pub frame: AreaIvsvFrame,
+    /// The VPLs as the frame set-up takes them (spot light, shadow-map description).
+    pub vpls: Vec<VplInput>,
     /// Every VPL's shadow map, one layer each (channel 0).
     pub maps: TexArray,
     /// The same, as the GPU's `vpl_maps` takes them: layer-major, then row-major.
@@ -673,6 +675,7 @@ pub fn ivsv_inputs(
     };
     Ok(IvsvInputs {
         frame,
+        vpls,
         maps,
         map_data,
         depth,
