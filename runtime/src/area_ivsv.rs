@@ -344,6 +344,63 @@ fn u32s(bytes: &[u8]) -> Vec<u32> {
         .collect()
 }
 
+/// Uploads `layers` VPL shadow maps of `map_size` squared values each (layer-major, then
+/// row-major from the top-left texel) as an r32float array texture, and its 2D-array view
+/// (the view [`AreaIvsv::encode`] takes).
+///
+/// # Errors
+///
+/// [`RuntimeError::DataLength`] when `data` does not hold every texel; GPU errors.
+pub fn upload_vpl_maps(
+    ctx: &Context,
+    map_size: u32,
+    layers: u32,
+    data: &[f32],
+) -> Result<(wgpu::Texture, wgpu::TextureView), RuntimeError> {
+    let expected = u64::from(map_size) * u64::from(map_size) * u64::from(layers);
+    if data.len() as u64 != expected {
+        return Err(RuntimeError::DataLength {
+            kernel: RECTIFY,
+            size: format!("VPL shadow maps {map_size}x{map_size}x{layers}"),
+            expected,
+            actual: data.len() as u64,
+        });
+    }
+    let device = ctx.device();
+    let scope = ErrorScopes::push(device);
+    let extent = wgpu::Extent3d {
+        width: map_size,
+        height: map_size,
+        depth_or_array_layers: layers,
+    };
+    let maps = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("vpl_maps"),
+        size: extent,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    ctx.queue().write_texture(
+        maps.as_image_copy(),
+        bytemuck::cast_slice(data),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(map_size * 4),
+            rows_per_image: Some(map_size),
+        },
+        extent,
+    );
+    let view = maps.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..wgpu::TextureViewDescriptor::default()
+    });
+    scope.pop(RECTIFY, "uploading the VPL shadow maps")?;
+    Ok((maps, view))
+}
+
 /// Test helper: creates an [`AreaIvsv`], uploads `depth` (screen-sized) and `vpl_maps`
 /// (`vpls.len()` layers of `map_size` squared values, layer-major), runs one frame pass by
 /// pass and reads back the marks after `ivsv_rectify`, the voxels and the marks after
@@ -370,49 +427,9 @@ pub fn run_area_ivsv_once(
 ) -> Result<AreaIvsvReadback, RuntimeError> {
     let mut pass = AreaIvsv::new(ctx, variant, screen, map_size)?;
     let layers = variant.vpls;
-    // The maps as one tall texture's rows, then copied into the array's layers.
     let views = upload_inputs(ctx, &[(GATHER, "depth buffer", screen, depth)])?;
-    let expected = u64::from(map_size) * u64::from(map_size) * u64::from(layers);
-    if vpl_maps.len() as u64 != expected {
-        return Err(RuntimeError::DataLength {
-            kernel: RECTIFY,
-            size: format!("VPL shadow maps {map_size}x{map_size}x{layers}"),
-            expected,
-            actual: vpl_maps.len() as u64,
-        });
-    }
+    let (_maps, maps_view) = upload_vpl_maps(ctx, map_size, layers, vpl_maps)?;
     let device = ctx.device();
-    let scope = ErrorScopes::push(device);
-    let extent = wgpu::Extent3d {
-        width: map_size,
-        height: map_size,
-        depth_or_array_layers: layers,
-    };
-    let maps = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("vpl_maps"),
-        size: extent,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: DEPTH_FORMAT,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    ctx.queue().write_texture(
-        maps.as_image_copy(),
-        bytemuck::cast_slice(vpl_maps),
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(map_size * 4),
-            rows_per_image: Some(map_size),
-        },
-        extent,
-    );
-    let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
-        dimension: Some(wgpu::TextureViewDimension::D2Array),
-        ..wgpu::TextureViewDescriptor::default()
-    });
-    scope.pop(RECTIFY, "uploading the VPL shadow maps")?;
     pass.prepare(ctx, camera, medium, vpls)?;
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
         label: Some("run_area_ivsv_once"),

@@ -36,7 +36,9 @@ pub mod row_prefix;
 pub mod textures;
 mod timer;
 
-pub use area_ivsv::{AreaIvsv, AreaIvsvReadback, AreaIvsvTimes, run_area_ivsv_once};
+pub use area_ivsv::{
+    AreaIvsv, AreaIvsvReadback, AreaIvsvTimes, run_area_ivsv_once, upload_vpl_maps,
+};
 pub use context::{AdapterReport, Context, ContextError, GpuPolicy};
 pub use error::RuntimeError;
 pub use family::{FamilyPasses, FamilyReadback, FamilyRuntime, run_family_on, run_family_once};

@@ -10,7 +10,7 @@
 // [lo, hi] where the ray is inside the VPL's outer cone: u(phi) . spot = c cos(phi) +
 // s sin(phi) = R cos(phi - phi0), so the cone is |phi - phi0| <= acos(cos_outer / R),
 // clipped to [0, phi_s]. g is evaluated at the ends of {{ segments }} equal pieces of [lo, hi]
-// and is linear between them; bit k (centre (k + 0.5) d_phi, d_phi = phi_max / 128) weighs
+// (their angles' sines and cosines by rotation from lo's) and is linear between them; bit k (centre (k + 0.5) d_phi, d_phi = phi_max / 128) weighs
 // d_phi times the interpolant at its centre, the bit holding phi_s its covered part. The lit
 // integral of a texel is the weight of its unset bits: per piece, with the weight
 // d_phi (A + B k), A n + B sum(k) over the unset bits of the piece, from masked popcounts.
@@ -79,17 +79,23 @@ fn unset_moments(bits: vec4<u32>, k0: u32, k1: u32) -> vec2<f32> {
 }
 
 // The integrand in phi of a ray of eye angle alpha (sin: sa) in the plane where the spot
-// axis has components (c, sn) along -axis and the plane normal.
-fn density(m: IvsvFrame, r: Vpl, alpha: f32, sa: f32, c: f32, sn: f32, phi: f32) -> f32 {
-    let sap = sin(alpha + phi);
+// axis has components (c, sn) along -axis and the plane normal, at the angle phi given by
+// (cos, sin) of phi (`cs`) and of alpha + phi (`cs_ap`).
+fn density(m: IvsvFrame, r: Vpl, sa: f32, c: f32, sn: f32, cs: vec2<f32>, cs_ap: vec2<f32>) -> f32 {
+    let sap = cs_ap.y;
     if sap <= 0.0 {
         return 0.0;
     }
-    let cone = cone_falloff(c * cos(phi) + sn * sin(phi), r.spot_dir[3], r.color[3]);
-    let p = phase_hg(m.medium[2], cos(alpha + phi));
+    let cone = cone_falloff(c * cs.x + sn * cs.y, r.spot_dir[3], r.color[3]);
+    let p = phase_hg(m.medium[2], cs_ap.x);
     let big_d = r.position[3];
-    let path = big_d * (sa + sin(phi)) / sap;
+    let path = big_d * (sa + cs.y) / sap;
     return m.medium[1] * p * cone * exp(-m.medium[0] * path) / (big_d * sa);
+}
+
+// (cos, sin) of a + b from (cos, sin) of a and of b.
+fn rotate(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(a.x * b.x - a.y * b.y, a.y * b.x + a.x * b.y);
 }
 
 // The first bit whose centre is at or beyond phi.
@@ -150,13 +156,19 @@ fn vpl_lit(m: IvsvFrame, r: Vpl, v: u32, dir: vec3<f32>, s: f32) -> f32 {
     let step = (hi - lo) / f32(SEGMENTS);
     var lit_a = 0.0;
     var lit_b = 0.0;
-    var g_hi = density(m, r, alpha, sa, c, sn, lo);
+    // The knots' angles by rotation: two sines and cosines per VPL, not four per knot.
+    let rot = vec2<f32>(cos(step), sin(step));
+    var cs = vec2<f32>(cos(lo), sin(lo));
+    var cs_ap = vec2<f32>(cos(alpha + lo), sin(alpha + lo));
+    var g_hi = density(m, r, sa, c, sn, cs, cs_ap);
     for (var p = 0u; p < SEGMENTS; p += 1u) {
         let pa = lo + step * f32(p);
         let last = p + 1u == SEGMENTS;
         let pb = select(lo + step * f32(p + 1u), hi, last);
+        cs = rotate(cs, rot);
+        cs_ap = rotate(cs_ap, rot);
         let g_lo = g_hi;
-        g_hi = density(m, r, alpha, sa, c, sn, pb);
+        g_hi = density(m, r, sa, c, sn, cs, cs_ap);
         let slope = (g_hi - g_lo) / step;
         // Bits with their centre in [pa, pb) ([pa, hi] in the last piece), below ks.
         let k0 = first_bit_from(pa, d_phi);

@@ -52,25 +52,31 @@ pub fn unset_moments(bits: [u32; 4], k0: u32, k1: u32) -> (f32, f32) {
 }
 
 /// The integrand in `phi` of a ray of eye angle `alpha` (sine `sa`) in the plane where the
-/// spot axis has components `(c, sn)` along `-axis` and the plane normal.
+/// spot axis has components `(c, sn)` along `-axis` and the plane normal, at the angle `phi`
+/// given by `(cos, sin)` of `phi` (`cs`) and of `alpha + phi` (`cs_ap`).
 pub fn density(
     m: &IvsvUniforms,
     r: &VplRecord,
-    alpha: f32,
     sa: f32,
     c: f32,
     sn: f32,
-    phi: f32,
+    cs: [f32; 2],
+    cs_ap: [f32; 2],
 ) -> f32 {
-    let sap = (alpha + phi).sin();
+    let sap = cs_ap[1];
     if sap <= 0.0 {
         return 0.0;
     }
-    let cone = cone_falloff(c * phi.cos() + sn * phi.sin(), r.spot_dir[3], r.color[3]);
-    let p = phase_hg(m.medium[2], (alpha + phi).cos());
+    let cone = cone_falloff(c * cs[0] + sn * cs[1], r.spot_dir[3], r.color[3]);
+    let p = phase_hg(m.medium[2], cs_ap[0]);
     let big_d = r.position[3];
-    let path = big_d * (sa + phi.sin()) / sap;
+    let path = big_d * (sa + cs[1]) / sap;
     m.medium[1] * p * cone * (-m.medium[0] * path).exp() / (big_d * sa)
+}
+
+/// `(cos, sin)` of `a + b` from `(cos, sin)` of `a` and of `b`.
+pub fn rotate(a: [f32; 2], b: [f32; 2]) -> [f32; 2] {
+    [a[0] * b[0] - a[1] * b[1], a[1] * b[0] + a[0] * b[1]]
 }
 
 /// The first bit whose centre is at or beyond `phi`.
@@ -147,13 +153,19 @@ pub fn vpl_lit(
     }
     let step = (hi - lo) / segments as f32;
     let (mut lit_a, mut lit_b) = (0.0f32, 0.0f32);
-    let mut g_hi = density(m, r, alpha, sa, c, sn, lo);
+    // The knots' angles by rotation: two sines and cosines per VPL, not four per knot.
+    let rot = [step.cos(), step.sin()];
+    let mut cs = [lo.cos(), lo.sin()];
+    let mut cs_ap = [(alpha + lo).cos(), (alpha + lo).sin()];
+    let mut g_hi = density(m, r, sa, c, sn, cs, cs_ap);
     for p in 0..segments {
         let pa = lo + step * p as f32;
         let last = p + 1 == segments;
         let pb = if last { hi } else { lo + step * (p + 1) as f32 };
+        cs = rotate(cs, rot);
+        cs_ap = rotate(cs_ap, rot);
         let g_lo = g_hi;
-        g_hi = density(m, r, alpha, sa, c, sn, pb);
+        g_hi = density(m, r, sa, c, sn, cs, cs_ap);
         let slope = (g_hi - g_lo) / step;
         // Bits with their centre in [pa, pb) ([pa, hi] in the last piece), below ks.
         let k0 = first_bit_from(pa, d_phi);

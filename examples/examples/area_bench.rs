@@ -1,0 +1,406 @@
+//! `area_bench`: the `area_ivsv` family (Wyman & Dai 2013) against its brute force, ray
+//! marching every VPL's shadow map (the `raymarch` family once per VPL spot, outputs added),
+//! both on the GPU (lavapipe here), at the same `N` VPLs and shadow maps.
+//!
+//! - Error: rel RMSE and rel L1 against the `vpl` truth (the same VPLs and maps) on every
+//!   area pose at `--error-size`, mean and worst over the poses.
+//! - Time: the median wall time of each pass submitted on its own (`--frames` frames after a
+//!   warm-up) at `--time-size` on `area_columns/ordinary`: `ivsv_rectify`, `ivsv_scan`,
+//!   `ivsv_gather`; for the brute force the sum over the VPLs of the `raymarch` pass (the
+//!   sum of the `N` outputs is not counted: in the brute force's favour).
+//!
+//! ```text
+//! cargo run --release -p scatter-examples --example area_bench -- --out docs/bench
+//! ```
+//!
+//! Writes `area.csv` and `area.md` into `--out`. Speed is a ratio from one run (never a
+//! timed test); the machine is shared and noisy.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Duration;
+
+use clap::Parser;
+use scatter_reference::area_suite::{self, AreaSceneName};
+use scatter_reference::buffers::{GBuffer, ShadowMap};
+use scatter_reference::bvh::Bvh;
+use scatter_reference::image::Image;
+use scatter_reference::kernels::ivsv_inputs;
+use scatter_reference::metrics;
+use scatter_reference::scene::Scene;
+use scatter_reference::suite::{MediumPreset, Pose};
+use scatter_reference::truth::{self, TruthSettings};
+use scatter_runtime::{
+    AreaIvsv, Context, CpuInputs, FamilyPasses, FrameInput, run_area_ivsv_once, run_family_on,
+    textures::upload_r32float, upload_vpl_maps,
+};
+use scatter_shaderlib::Kernel;
+use scatter_shaderlib::area_ivsv::AreaIvsvVariant;
+use scatter_shaderlib::family::FamilyVariant;
+use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions};
+use scatter_shaderlib::raymarch::RaymarchVariant;
+
+/// The command line.
+#[derive(Parser, Debug)]
+#[command(about = "area_ivsv against per-VPL ray marching: error and time")]
+struct Args {
+    /// Output folder for area.csv and area.md.
+    #[arg(long, default_value = "docs/bench")]
+    out: PathBuf,
+    /// Screen size of the error sweep (WxH).
+    #[arg(long, default_value = "64x36", value_parser = parse_size)]
+    error_size: [u32; 2],
+    /// Screen size of the timing (WxH).
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    time_size: [u32; 2],
+    /// VPL counts.
+    #[arg(long, value_delimiter = ',', default_values_t = [16u32, 64])]
+    vpls: Vec<u32>,
+    /// Samples per view ray of the per-VPL ray march.
+    #[arg(long, value_delimiter = ',', default_values_t = [4u32, 8, 16, 32, 64])]
+    samples: Vec<u32>,
+    /// VPL shadow-map size.
+    #[arg(long, default_value_t = 128)]
+    map_size: u32,
+    /// Frames per timing (median, after one warm-up).
+    #[arg(long, default_value_t = 3)]
+    frames: u32,
+}
+
+fn parse_size(s: &str) -> Result<[u32; 2], String> {
+    let (w, h) = s
+        .split_once('x')
+        .ok_or_else(|| format!("size `{s}` must be WxH, e.g. 1280x720"))?;
+    let p = |v: &str| {
+        v.parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=16384).contains(&n))
+            .ok_or_else(|| format!("size `{s}`: `{v}` must be an integer in 1..=16384"))
+    };
+    Ok([p(w)?, p(h)?])
+}
+
+/// One method: `area_ivsv` with N VPLs, or per-VPL ray marching with N VPLs and n samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Method {
+    Ivsv { vpls: u32 },
+    Raymarch { vpls: u32, samples: u32 },
+}
+
+impl Method {
+    fn label(self) -> String {
+        match self {
+            Method::Ivsv { vpls } => format!("area_ivsv N={vpls}"),
+            Method::Raymarch { vpls, samples } => format!("raymarch per VPL N={vpls} n={samples}"),
+        }
+    }
+    fn vpls(self) -> u32 {
+        match self {
+            Method::Ivsv { vpls } | Method::Raymarch { vpls, .. } => vpls,
+        }
+    }
+}
+
+fn ivsv_variant(vpls: u32) -> AreaIvsvVariant {
+    AreaIvsvVariant {
+        vpls,
+        ..AreaIvsvVariant::default()
+    }
+}
+
+fn raymarch_variant(samples: u32) -> FamilyVariant {
+    FamilyVariant::Raymarch(RaymarchVariant {
+        light: LightKind::Spot,
+        samples,
+        ..RaymarchVariant::default()
+    })
+}
+
+/// A VPL scene's inputs for a single-light family.
+fn vpl_inputs(vpl: &Scene, gbuf: &GBuffer, sm: &ShadowMap) -> CpuInputs {
+    CpuInputs {
+        frame: FrameInput {
+            camera: vpl.camera_desc(),
+            light: vpl.light_desc(),
+            medium: vpl.medium_desc(),
+            shadow_map: sm.desc(),
+            settings: FrameSettings::default(),
+        },
+        depth: gbuf.view_depth.clone(),
+        shadow_map: sm.depth.clone(),
+        rectified: None,
+        pass_wall_frames: 0,
+        cookie: None,
+    }
+}
+
+/// One method's image of `scene` on the GPU.
+fn render(
+    ctx: &Context,
+    method: Method,
+    scene: &Scene,
+    gbuf: &GBuffer,
+    bvh: &Bvh,
+    map_size: u32,
+) -> Result<Image, String> {
+    let (w, h) = (gbuf.width, gbuf.height);
+    match method {
+        Method::Ivsv { vpls } => {
+            let v = ivsv_variant(vpls);
+            let inputs = ivsv_inputs(scene, gbuf, bvh, &v, map_size).map_err(|e| e.to_string())?;
+            let out = run_area_ivsv_once(
+                ctx,
+                &v,
+                [w, h],
+                &scene.camera_desc(),
+                &scene.medium_desc(),
+                &inputs.vpls,
+                map_size,
+                &gbuf.view_depth,
+                &inputs.map_data,
+            )
+            .map_err(|e| e.to_string())?;
+            Ok(Image::from_pixels(
+                w,
+                h,
+                out.output.iter().map(|p| [p[0], p[1], p[2]]).collect(),
+            ))
+        }
+        Method::Raymarch { vpls, samples } => {
+            let res = Resolutions {
+                screen: [w, h],
+                rectified: [1, 1],
+            };
+            let mut pass = FamilyPasses::new(ctx, &raymarch_variant(samples), res, map_size)
+                .map_err(|e| e.to_string())?;
+            let mut sum = vec![[0.0f32; 3]; (w * h) as usize];
+            for vpl in scene.point_light_scenes(vpls as usize) {
+                let sm = ShadowMap::build(&vpl, bvh, map_size).map_err(|e| e.to_string())?;
+                let out = run_family_on(ctx, &mut pass, res, &vpl_inputs(&vpl, gbuf, &sm))
+                    .map_err(|e| e.to_string())?;
+                for (acc, p) in sum.iter_mut().zip(&out.output) {
+                    for k in 0..3 {
+                        acc[k] += p[k];
+                    }
+                }
+            }
+            Ok(Image::from_pixels(w, h, sum))
+        }
+    }
+}
+
+/// Median pass wall times of `method` at `size` on `scene`: `(pass, time)` in order.
+fn time(
+    ctx: &Context,
+    method: Method,
+    scene: &Scene,
+    bvh: &Bvh,
+    map_size: u32,
+    frames: u32,
+) -> Result<Vec<(String, Duration)>, String> {
+    let gbuf = GBuffer::cast(scene, bvh);
+    let screen = [gbuf.width, gbuf.height];
+    let err = |e: scatter_runtime::RuntimeError| e.to_string();
+    match method {
+        Method::Ivsv { vpls } => {
+            let v = ivsv_variant(vpls);
+            let inputs = ivsv_inputs(scene, &gbuf, bvh, &v, map_size).map_err(|e| e.to_string())?;
+            let mut pass = AreaIvsv::new(ctx, &v, screen, map_size).map_err(err)?;
+            pass.prepare(
+                ctx,
+                &scene.camera_desc(),
+                &scene.medium_desc(),
+                &inputs.vpls,
+            )
+            .map_err(err)?;
+            let depth = upload_r32float(ctx, Kernel::IvsvGather, "depth", screen, &gbuf.view_depth)
+                .map_err(err)?;
+            let depth_view = depth.create_view(&Default::default());
+            let (_maps, maps_view) =
+                upload_vpl_maps(ctx, map_size, vpls, &inputs.map_data).map_err(err)?;
+            let t = pass
+                .measure_pass_wall_times(ctx, &depth_view, &maps_view, frames)
+                .map_err(err)?;
+            Ok(vec![
+                ("ivsv_rectify".into(), t.rectify),
+                ("ivsv_scan".into(), t.scan),
+                ("ivsv_gather".into(), t.gather),
+            ])
+        }
+        Method::Raymarch { vpls, samples } => {
+            let res = Resolutions {
+                screen,
+                rectified: [1, 1],
+            };
+            let mut pass =
+                FamilyPasses::new(ctx, &raymarch_variant(samples), res, map_size).map_err(err)?;
+            let mut total = Duration::ZERO;
+            for vpl in scene.point_light_scenes(vpls as usize) {
+                let sm = ShadowMap::build(&vpl, bvh, map_size).map_err(|e| e.to_string())?;
+                let inputs = CpuInputs {
+                    pass_wall_frames: frames,
+                    ..vpl_inputs(&vpl, &gbuf, &sm)
+                };
+                let out = run_family_on(ctx, &mut pass, res, &inputs).map_err(err)?;
+                total += out.pass_wall_times.iter().map(|p| p.1).sum::<Duration>();
+            }
+            Ok(vec![(format!("raymarch x {vpls}"), total)])
+        }
+    }
+}
+
+fn main() -> Result<(), String> {
+    let args = Args::parse();
+    let ctx = Context::new().map_err(|e| e.to_string())?;
+    eprintln!("area_bench: adapter {}", ctx.report());
+    let mut methods = Vec::new();
+    for &n in &args.vpls {
+        methods.push(Method::Ivsv { vpls: n });
+        for &s in &args.samples {
+            methods.push(Method::Raymarch {
+                vpls: n,
+                samples: s,
+            });
+        }
+    }
+    let truth_settings = TruthSettings {
+        segments: 256,
+        ..TruthSettings::default()
+    };
+    // Errors: per method, per pose.
+    let mut errors: Vec<Vec<(String, f64, f64)>> = vec![Vec::new(); methods.len()];
+    let [ew, eh] = args.error_size;
+    for (name, pose) in area_suite::all() {
+        let s = area_suite::scene(name, pose, MediumPreset::Default, ew, eh);
+        let bvh = Bvh::build(&s.geometry);
+        let gbuf = GBuffer::cast(&s, &bvh);
+        for &n in &args.vpls {
+            let truth =
+                truth::render_vpl(&s, &gbuf, &bvh, n as usize, args.map_size, &truth_settings)
+                    .map_err(|e| e.to_string())?;
+            for (i, &m) in methods.iter().enumerate() {
+                if m.vpls() != n {
+                    continue;
+                }
+                let img = render(&ctx, m, &s, &gbuf, &bvh, args.map_size)?;
+                let rmse = metrics::rel_rmse(&img, &truth).map_err(|e| e.to_string())?;
+                let l1 = metrics::rel_l1(&img, &truth).map_err(|e| e.to_string())?;
+                eprintln!(
+                    "{} {}: rel RMSE {:.2} %, rel L1 {:.2} %",
+                    s.name,
+                    m.label(),
+                    100.0 * rmse,
+                    100.0 * l1
+                );
+                errors[i].push((s.name.clone(), rmse, l1));
+            }
+        }
+    }
+    // Times.
+    let [tw, th] = args.time_size;
+    let scene = area_suite::scene(
+        AreaSceneName::Columns,
+        Pose::Ordinary,
+        MediumPreset::Default,
+        tw,
+        th,
+    );
+    let bvh = Bvh::build(&scene.geometry);
+    let mut rows = Vec::new();
+    let mut csv = String::from(
+        "method,vpls,samples,mean_rel_rmse,worst_rel_rmse,mean_rel_l1,passes,time_ms\n",
+    );
+    for (i, &m) in methods.iter().enumerate() {
+        let passes = time(&ctx, m, &scene, &bvh, args.map_size, args.frames)?;
+        let total: Duration = passes.iter().map(|p| p.1).sum();
+        let e = &errors[i];
+        let mean = |k: usize| {
+            e.iter()
+                .map(|x| if k == 0 { x.1 } else { x.2 })
+                .sum::<f64>()
+                / e.len().max(1) as f64
+        };
+        let worst = e.iter().map(|x| x.1).fold(0.0, f64::max);
+        let split = passes
+            .iter()
+            .map(|(p, t)| format!("{p} {:.1}", t.as_secs_f64() * 1e3))
+            .collect::<Vec<_>>()
+            .join(", ");
+        eprintln!(
+            "{}: {:.1} ms ({split}); mean rel RMSE {:.2} %",
+            m.label(),
+            total.as_secs_f64() * 1e3,
+            100.0 * mean(0)
+        );
+        let samples = match m {
+            Method::Raymarch { samples, .. } => samples.to_string(),
+            Method::Ivsv { .. } => String::new(),
+        };
+        let _ = writeln!(
+            csv,
+            "{},{},{samples},{:.6},{:.6},{:.6},\"{split}\",{:.3}",
+            m.label(),
+            m.vpls(),
+            mean(0),
+            worst,
+            mean(1),
+            total.as_secs_f64() * 1e3
+        );
+        rows.push((m, mean(0), worst, mean(1), total, split));
+    }
+    let mut md = format!(
+        "# area_ivsv against per-VPL ray marching\n\n`cargo run --release -p scatter-examples --example area_bench` (adapter: {}). Error: against the `vpl` truth on the 12 area poses at {ew}x{eh} (mean and worst rel RMSE, mean rel L1); time: median pass wall times on `area_columns/ordinary` at {tw}x{th}, {} frames after a warm-up, {}^2 VPL maps.\n\n| method | mean rel RMSE | worst rel RMSE | mean rel L1 | time (ms) | passes (ms) |\n|---|---|---|---|---|---|\n",
+        ctx.report(),
+        args.frames,
+        args.map_size
+    );
+    for (m, rmse, worst, l1, total, split) in &rows {
+        let _ = writeln!(
+            md,
+            "| {} | {:.2} % | {:.2} % | {:.2} % | {:.1} | {split} |",
+            m.label(),
+            100.0 * rmse,
+            100.0 * worst,
+            100.0 * l1,
+            total.as_secs_f64() * 1e3
+        );
+    }
+    // Ratio at equal or lower error: per N, the fastest ray march at or below area_ivsv's mean error.
+    md += "\n";
+    for &n in &args.vpls {
+        let Some(ivsv) = rows.iter().find(|r| r.0 == Method::Ivsv { vpls: n }) else {
+            continue;
+        };
+        let competitor = rows
+            .iter()
+            .filter(|r| matches!(r.0, Method::Raymarch { vpls, .. } if vpls == n) && r.1 <= ivsv.1)
+            .min_by_key(|r| r.4);
+        match competitor {
+            Some(c) => {
+                let _ = writeln!(
+                    md,
+                    "- N = {n}: the fastest per-VPL ray march at or below area_ivsv's mean error ({}, {:.2} %) takes {:.2}x area_ivsv's time.",
+                    c.0.label(),
+                    100.0 * c.1,
+                    c.4.as_secs_f64() / ivsv.4.as_secs_f64()
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    md,
+                    "- N = {n}: no per-VPL ray march measured reaches area_ivsv's mean error ({:.2} %).",
+                    100.0 * ivsv.1
+                );
+            }
+        }
+    }
+    std::fs::create_dir_all(&args.out).map_err(|e| e.to_string())?;
+    for (file, text) in [("area.csv", &csv), ("area.md", &md)] {
+        let path = args.out.join(file);
+        let tmp = path.with_extension("tmp");
+        std::fs::write(&tmp, text).map_err(|e| format!("{}: {e}", tmp.display()))?;
+        std::fs::rename(&tmp, &path).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    println!("{md}");
+    Ok(())
+}
