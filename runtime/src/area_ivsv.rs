@@ -70,7 +70,8 @@ impl AreaIvsv {
     ///
     /// [`RuntimeError::EmptyInput`] for a zero size; [`RuntimeError::LimitExceeded`] naming
     /// the device limit (the screen or map side, the VPL count against
-    /// `max_texture_array_layers`, a voxel buffer against `max_storage_buffer_binding_size`);
+    /// `max_texture_array_layers`, the VPL records against `max_uniform_buffer_binding_size`,
+    /// a voxel buffer against `max_storage_buffer_binding_size`);
     /// [`RuntimeError::Shader`] for a bad knob; [`RuntimeError::Wgpu`] when a resource fails.
     pub fn new(
         ctx: &Context,
@@ -97,6 +98,13 @@ impl AreaIvsv {
             u64::from(variant.vpls),
             "max_texture_array_layers",
             u64::from(limits.max_texture_array_layers),
+        )?;
+        check_limit(
+            GATHER,
+            "VPL record bytes (176 per VPL, one uniform array)",
+            176 * u64::from(variant.vpls),
+            "max_uniform_buffer_binding_size",
+            u64::from(limits.max_uniform_buffer_binding_size),
         )?;
         for (name, limit) in [
             (

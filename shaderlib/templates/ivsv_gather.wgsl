@@ -21,7 +21,7 @@
 // | binding | name   | type                                           | access       |
 // |---------|--------|------------------------------------------------|--------------|
 // | 0       | frame  | var<uniform> IvsvFrame (112 bytes)             | uniform      |
-// | 1       | vpls   | var<storage, read> array<Vpl> (176 bytes each) | read         |
+// | 1       | vpls   | var<uniform> array<Vpl, {{ vpls }}> (176 bytes each) | uniform |
 // | 2       | volume | var<storage, read> array<u32> (`ivsv_scan`'s)  | read         |
 // | 3       | depth  | texture_2d<f32> (r32float, view depth)         | textureLoad  |
 // | 4       | output | texture_storage_2d<rgba16float, write>         | textureStore |
@@ -38,7 +38,7 @@
 const SEGMENTS: u32 = {{ segments }}u;
 
 @group(0) @binding(0) var<uniform> frame: IvsvFrame;
-@group(0) @binding(1) var<storage, read> vpls: array<Vpl>;
+@group(0) @binding(1) var<uniform> vpls: array<Vpl, {{ vpls }}>;
 @group(0) @binding(2) var<storage, read> volume: array<u32>;
 @group(0) @binding(3) var depth: texture_2d<f32>;
 @group(0) @binding(4) var output: texture_storage_2d<rgba16float, write>;

@@ -14,7 +14,7 @@
 // | binding | name     | type                                         | access      |
 // |---------|----------|----------------------------------------------|-------------|
 // | 0       | frame    | var<uniform> IvsvFrame (112 bytes)           | uniform     |
-// | 1       | vpls     | var<storage, read> array<Vpl> (176 bytes each) | read      |
+// | 1       | vpls     | var<uniform> array<Vpl, {{ vpls }}> (176 bytes each) | uniform |
 // | 2       | vpl_maps | texture_2d_array<f32> (r32float, N layers)   | textureLoad |
 // | 3       | marks    | var<storage, read_write> array<atomic<u32>>  | atomicOr    |
 // marks: 4 N theta alpha u32, zero before the pass (`ivsv_scan` zeroes what it reads).
@@ -29,7 +29,7 @@
 #import scatter::ivsv::{IvsvFrame, Vpl, PHI_BITS, plane_normal, voxel_word, vpl_shadow_view}
 
 @group(0) @binding(0) var<uniform> frame: IvsvFrame;
-@group(0) @binding(1) var<storage, read> vpls: array<Vpl>;
+@group(0) @binding(1) var<uniform> vpls: array<Vpl, {{ vpls }}>;
 @group(0) @binding(2) var vpl_maps: texture_2d_array<f32>;
 @group(0) @binding(3) var<storage, read_write> marks: array<atomic<u32>>;
 

@@ -27,21 +27,25 @@ pub const LINE_WORKGROUP_SIZE: [u32; 3] = [64, 1, 1];
 /// Workgroup size of `ivsv_gather`: one invocation per pixel.
 pub const GATHER_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
 
-/// `ivsv_rectify` (no parameters: every knob is a uniform or a buffer size).
+/// `ivsv_rectify`: the VPL records are a uniform array of the variant's length.
 #[derive(Template)]
 #[template(path = "ivsv_rectify.wgsl")]
-struct RectifyTemplate;
+struct RectifyTemplate {
+    vpls: u32,
+}
 
 /// `ivsv_scan`.
 #[derive(Template)]
 #[template(path = "ivsv_scan.wgsl")]
 struct ScanTemplate;
 
-/// `ivsv_gather`: the pieces of the integrand are a constant loop count.
+/// `ivsv_gather`: the pieces of the integrand are a constant loop count, the VPL records a
+/// uniform array.
 #[derive(Template)]
 #[template(path = "ivsv_gather.wgsl")]
 struct GatherTemplate {
     segments: u32,
+    vpls: u32,
 }
 
 fn validate(kernel: Kernel, variant: &AreaIvsvVariant) -> Result<(), ShaderError> {
@@ -61,7 +65,7 @@ fn render_error(kernel: Kernel) -> impl FnOnce(askama::Error) -> ShaderError {
 /// Renders `templates/ivsv_rectify.wgsl`.
 pub(crate) fn render_rectify(variant: &AreaIvsvVariant) -> Result<String, ShaderError> {
     validate(Kernel::IvsvRectify, variant)?;
-    RectifyTemplate
+    RectifyTemplate { vpls: variant.vpls }
         .render()
         .map_err(render_error(Kernel::IvsvRectify))
 }
@@ -79,6 +83,7 @@ pub(crate) fn render_gather(variant: &AreaIvsvVariant) -> Result<String, ShaderE
     validate(Kernel::IvsvGather, variant)?;
     GatherTemplate {
         segments: variant.segments,
+        vpls: variant.vpls,
     }
     .render()
     .map_err(render_error(Kernel::IvsvGather))

@@ -50,9 +50,10 @@ pub fn plan(v: &AreaIvsvVariant) -> Plan {
         ),
         frame_buffer(
             "vpls",
-            "one record per VPL: position, intensity, epipolar grid, cone, shadow map (Rust: \
-             VplRecord from prepare_area_ivsv), written once per frame",
-            Some(&vpls),
+            "one record per VPL (a uniform array of the variant's `vpls`): position, \
+             intensity, epipolar grid, cone, shadow map (Rust: VplRecord from \
+             prepare_area_ivsv), written once per frame",
+            None,
         ),
         Resource {
             provided_by: "engine",

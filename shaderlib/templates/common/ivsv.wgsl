@@ -30,7 +30,8 @@ struct IvsvFrame {
     grid: vec4<u32>,
 }
 
-// One virtual point light (host: `scatter_frame::area_ivsv::VplRecord`, 11 * 16 = 176 bytes):
+// One virtual point light (host: `scatter_frame::area_ivsv::VplRecord`, 11 * 16 = 176 bytes;
+// the kernels read them as a uniform array: 45 KiB at 256 VPLs):
 // a spot with its own perspective shadow map and its epipolar grid about the eye-VPL axis.
 struct Vpl {
     // Position; w = D, the eye-VPL distance.
