@@ -381,18 +381,15 @@ fn split_rel_l1(
 /// changes every area-light pose by less than 0.1 % rel L1 over the pixels that do not look
 /// at the lamp. The few that do (their view ray ends on the housing, 1 mm behind the
 /// emitting face) integrate fog up to the emitting surface, where the integrand has a
-/// logarithmic peak the quadrature resolves slowly; they are reported separately. CI runs one
-/// pose per scene at 24x14; `SCATTER_FULL=1` all twelve.
+/// logarithmic peak the quadrature resolves slowly; they are reported separately. CI runs
+/// `area_grate/epipole_on_screen` at 24x14 (the lamp on screen; the slowest of the three
+/// poses measured, 0.0073 %); `SCATTER_FULL=1` all twelve.
 #[test]
 fn area_truth_is_converged_in_light_samples() {
     let poses: Vec<(AreaSceneName, Pose)> = if full() {
         area_suite::all()
     } else {
-        vec![
-            (AreaSceneName::Columns, Pose::Grazing),
-            (AreaSceneName::Window, Pose::Ordinary),
-            (AreaSceneName::Grate, Pose::EpipoleOnScreen),
-        ]
+        vec![(AreaSceneName::Grate, Pose::EpipoleOnScreen)]
     };
     let coarse = TruthSettings {
         segments: 256,
