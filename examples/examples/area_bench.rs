@@ -65,6 +65,18 @@ struct Args {
     /// Frames per timing (median, after one warm-up).
     #[arg(long, default_value_t = 3)]
     frames: u32,
+    /// Instead of the bench: write this PNG of `area_grate` (`--image-pose`) lit by its
+    /// area light (area_ivsv, 64 VPLs, on the GPU) beside the same scene lit by the light's
+    /// point limit (a spot of the same intensity; per-pixel ray marching, 64 samples), one
+    /// exposure for both.
+    #[arg(long)]
+    image: Option<PathBuf>,
+    /// The pose of `--image`.
+    #[arg(long, default_value = "ordinary")]
+    image_pose: Pose,
+    /// The size of each half of `--image` (WxH).
+    #[arg(long, default_value = "480x270", value_parser = parse_size)]
+    image_size: [u32; 2],
 }
 
 fn parse_size(s: &str) -> Result<[u32; 2], String> {
@@ -249,10 +261,65 @@ fn time(
     }
 }
 
+/// `--image`: soft shafts from the area light beside hard ones from its point limit.
+fn image(ctx: &Context, args: &Args, path: &std::path::Path) -> Result<(), String> {
+    let [w, h] = args.image_size;
+    let area = area_suite::scene(
+        AreaSceneName::Grate,
+        args.image_pose,
+        MediumPreset::Default,
+        w,
+        h,
+    );
+    let scatter_reference::scene::Light::Area(light) = &area.light else {
+        return Err("area_grate has no area light".into());
+    };
+    let point = Scene {
+        light: light.point_limit(),
+        ..area.clone()
+    };
+    let bvh = Bvh::build(&area.geometry);
+    let gbuf = GBuffer::cast(&area, &bvh);
+    let soft = render(
+        ctx,
+        Method::Ivsv { vpls: 64 },
+        &area,
+        &gbuf,
+        &bvh,
+        args.map_size,
+    )?;
+    let hard = render(
+        ctx,
+        Method::Raymarch {
+            vpls: 1,
+            samples: 64,
+        },
+        &point,
+        &gbuf,
+        &bvh,
+        512,
+    )?;
+    let e = |x: Result<Image, scatter_reference::image::ImageError>| x.map_err(|e| e.to_string());
+    let hard = e(truth::surface_radiance(&point, &gbuf, &bvh).add(&hard))?;
+    let soft = e(truth::surface_radiance(&area, &gbuf, &bvh).add(&soft))?;
+    let exposure = hard.auto_exposure();
+    e(Image::hstack(&[&hard, &soft]))?
+        .write_png(path, Some(exposure))
+        .map_err(|e| e.to_string())?;
+    eprintln!(
+        "wrote {} (left: point limit, right: area light)",
+        path.display()
+    );
+    Ok(())
+}
+
 fn main() -> Result<(), String> {
     let args = Args::parse();
     let ctx = Context::new().map_err(|e| e.to_string())?;
     eprintln!("area_bench: adapter {}", ctx.report());
+    if let Some(path) = &args.image {
+        return image(&ctx, &args, path);
+    }
     let mut methods = Vec::new();
     for &n in &args.vpls {
         methods.push(Method::Ivsv { vpls: n });

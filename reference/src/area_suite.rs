@@ -197,3 +197,85 @@ pub fn all() -> Vec<(AreaSceneName, Pose)> {
         .flat_map(|&n| Pose::ALL.iter().map(move |&p| (n, p)))
         .collect()
 }
+
+/// Rebuilds the lamp's housing (the suite scene's last shape) after its light moved or
+/// changed size.
+pub fn rebuild_housing(scene: &mut Scene) {
+    if let Light::Area(a) = &scene.light
+        && let Some(h) = a.housing(HOUSING_BEHIND, [0.3, 0.3, 0.3])
+        && let Some(last) = scene.geometry.last_mut()
+    {
+        *last = h;
+    }
+}
+
+/// Frame `frame` of `frames` of `path` ([`crate::paths`]: the camera dollies, or the light's
+/// aim circles) for area scene `name` from its `ordinary` pose, the housing moved with the
+/// light.
+pub fn animated(
+    name: AreaSceneName,
+    path: crate::paths::Path,
+    frame: usize,
+    frames: usize,
+    width: u32,
+    height: u32,
+) -> Scene {
+    let mut s = scene(name, Pose::Ordinary, MediumPreset::Default, width, height);
+    crate::paths::animate(&mut s, path, frame, frames);
+    rebuild_housing(&mut s);
+    s
+}
+
+/// `area_grate` with its light resized to a `side` x `side` square of the same power.
+fn resized(pose: Pose, side: f64, width: u32, height: u32) -> Scene {
+    let mut s = scene(
+        AreaSceneName::Grate,
+        pose,
+        MediumPreset::Default,
+        width,
+        height,
+    );
+    if let Light::Area(a) = &mut s.light {
+        let area = a.shape.area();
+        a.shape = AreaShape::Rect {
+            width: side,
+            height: side,
+        };
+        // The same power: the radiance scales with 1 / area.
+        a.radiance = a.radiance.map(|r| r * area / (side * side));
+    }
+    rebuild_housing(&mut s);
+    s
+}
+
+/// Where area lights stress a method (issue 17), each named `area_grate/<pose>/<case>`: a
+/// light a millimetre across (`tiny`: all VPLs in one point, which must give its point
+/// limit) and a 6 m x 6 m panel over the 4 m grate (`huge`: no umbra left under it), at the
+/// `ordinary` and `epipole_on_screen` poses, and the eye inside the penumbra
+/// (`eye_in_penumbra`: under the grate, seeing part of the panel between the bars).
+pub fn stress_scenes(width: u32, height: u32) -> Vec<Scene> {
+    let mut cases = Vec::new();
+    for pose in [Pose::Ordinary, Pose::EpipoleOnScreen] {
+        let mut tiny = resized(pose, 1e-3, width, height);
+        tiny.name = format!("{}/tiny", tiny.name);
+        cases.push(tiny);
+        let mut huge = resized(pose, 6.0, width, height);
+        huge.name = format!("{}/huge", huge.name);
+        cases.push(huge);
+    }
+    let mut inside = scene(
+        AreaSceneName::Grate,
+        Pose::Ordinary,
+        MediumPreset::Default,
+        width,
+        height,
+    );
+    inside.camera.position = DVec3::new(0.6, 1.2, 0.3);
+    inside.camera.orientation = crate::scene::Orientation::LookAt {
+        target: DVec3::new(4.0, 2.0, 2.0),
+        up: DVec3::Y,
+    };
+    inside.name = format!("{}/eye_in_penumbra", inside.name);
+    cases.push(inside);
+    cases
+}

@@ -55,6 +55,13 @@ pub fn frame(
     height: u32,
 ) -> Scene {
     let mut scene = suite::scene(name, Pose::Ordinary, MediumPreset::Default, width, height);
+    animate(&mut scene, path, frame, frames);
+    scene
+}
+
+/// Moves `scene` (at its start) to frame `frame` of `frames` of `path` and appends
+/// `/<path>/<frame>` to its name: what [`frame`] does to a suite scene, for any scene.
+pub fn animate(scene: &mut Scene, path: Path, frame: usize, frames: usize) {
     let u = if frames > 1 {
         frame.min(frames - 1) as f64 / (frames - 1) as f64
     } else {
@@ -105,5 +112,4 @@ pub fn frame(
         }
     }
     scene.name = format!("{}/{path}/{frame}", scene.name);
-    scene
 }

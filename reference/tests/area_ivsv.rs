@@ -9,7 +9,7 @@ use scatter_reference::area_suite::{self, AreaSceneName};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::metrics;
-use scatter_reference::scene::{AreaShape, Light};
+use scatter_reference::scene::Light;
 use scatter_reference::suite::{MediumPreset, Pose};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use std::f64::consts::PI;
@@ -322,44 +322,12 @@ fn stress_cases_stay_within_the_bar() {
         vpls: 16,
         ..IvsvSettings::default()
     };
-    let base = |pose| area_suite::scene(AreaSceneName::Grate, pose, MediumPreset::Default, 48, 27);
     let mut failures = Vec::new();
-    let resize = |s: &mut scatter_reference::scene::Scene, side: f64| {
-        if let Light::Area(a) = &mut s.light {
-            let area = a.shape.area();
-            a.shape = AreaShape::Rect {
-                width: side,
-                height: side,
-            };
-            // The same power: the radiance scales with 1 / area.
-            a.radiance = a.radiance.map(|r| r * area / (side * side));
-        }
-        // Only the lamp's housing is resized with it: rebuild it.
-        let last = s.geometry.len() - 1;
-        if let Light::Area(a) = &s.light
-            && let Some(h) = a.housing(area_suite::HOUSING_BEHIND, [0.3, 0.3, 0.3])
-        {
-            s.geometry[last] = h;
-        }
-    };
-    let mut cases = Vec::new();
-    for pose in [Pose::Ordinary, Pose::EpipoleOnScreen] {
-        let mut tiny = base(pose);
-        resize(&mut tiny, 1e-3);
-        tiny.name = format!("{}/tiny", tiny.name);
-        cases.push(tiny);
-        let mut huge = base(pose);
-        resize(&mut huge, 6.0);
-        huge.name = format!("{}/huge", huge.name);
-        cases.push(huge);
-    }
-    let mut inside = base(Pose::Ordinary);
-    inside.camera.position = DVec3::new(0.6, 1.2, 0.3);
-    inside.camera.orientation = scatter_reference::scene::Orientation::LookAt {
-        target: DVec3::new(4.0, 2.0, 2.0),
-        up: DVec3::Y,
-    };
-    inside.name = format!("{}/eye_in_penumbra", inside.name);
+    let cases = area_suite::stress_scenes(48, 27);
+    let inside = cases
+        .iter()
+        .find(|s| s.name.ends_with("/eye_in_penumbra"))
+        .expect("the penumbra case");
     {
         // Premise: the eye sees some of the VPLs and not others.
         let bvh = Bvh::build(&inside.geometry);
@@ -385,7 +353,6 @@ fn stress_cases_stay_within_the_bar() {
             vpls.len()
         );
     }
-    cases.push(inside);
     for s in cases {
         s.validate().unwrap();
         let bvh = Bvh::build(&s.geometry);

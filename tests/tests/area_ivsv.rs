@@ -3,7 +3,9 @@
 //! (`reference/src/kernels/ivsv_*.rs`) on every area pose (`area_columns`, `area_window`,
 //! `area_grate` x the suite's four poses) for the variants of [`variants`], at 37x21 pixels
 //! with 64^2 VPL maps. Trials are named `area_ivsv::<variant id>::<scene>::<pose>`;
-//! `area_ivsv::errors` checks the error paths.
+//! `area_ivsv::errors` checks the error paths; `area_ivsv::stress::<case>` the stress cases
+//! against the truth and `area_ivsv::flicker::area_grate::<path>` temporal stability (both
+//! documented at their functions).
 //!
 //! Each kernel is compared on the same input (the mirror of a pass runs on the GPU's result
 //! of the pass before):
@@ -23,11 +25,16 @@ use std::process::ExitCode;
 use scatter_conformance::{Check, gpu, run_trials};
 use scatter_reference::area_suite::{self, AreaSceneName};
 use scatter_reference::buffers::GBuffer;
+use scatter_reference::buffers::ShadowMap;
 use scatter_reference::bvh::Bvh;
+use scatter_reference::image::Image;
 use scatter_reference::kernels::ivsv_rectify::rectify_bit;
 use scatter_reference::kernels::texture::Tex;
 use scatter_reference::kernels::{IvsvInputs, ivsv_gather, ivsv_inputs, ivsv_scan};
+use scatter_reference::metrics;
+use scatter_reference::paths::Path;
 use scatter_reference::suite::{MediumPreset, Pose};
+use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::{AreaIvsv, RuntimeError, run_area_ivsv_once};
 use scatter_shaderlib::area_ivsv::{AreaIvsvVariant, PHI_BITS};
 
@@ -188,6 +195,163 @@ fn trial(ctx: &scatter_runtime::Context, v: &AreaIvsvVariant, c: &Case) -> Resul
     ))
 }
 
+/// The method on the GPU over a scene: its image (rgb).
+fn gpu_image(
+    ctx: &scatter_runtime::Context,
+    v: &AreaIvsvVariant,
+    scene: &scatter_reference::scene::Scene,
+    map: u32,
+) -> Result<(Image, GBuffer, Bvh), String> {
+    let bvh = Bvh::build(&scene.geometry);
+    let gbuf = GBuffer::cast(scene, &bvh);
+    let inputs = ivsv_inputs(scene, &gbuf, &bvh, v, map).map_err(|e| e.to_string())?;
+    let out = run_area_ivsv_once(
+        ctx,
+        v,
+        [gbuf.width, gbuf.height],
+        &scene.camera_desc(),
+        &scene.medium_desc(),
+        &inputs.vpls,
+        map,
+        &gbuf.view_depth,
+        &inputs.map_data,
+    )
+    .map_err(|e| e.to_string())?;
+    let img = Image::from_pixels(
+        gbuf.width,
+        gbuf.height,
+        out.output.iter().map(|p| [p[0], p[1], p[2]]).collect(),
+    );
+    Ok((img, gbuf, bvh))
+}
+
+/// The stress cases (`area_suite::stress_scenes`) on the GPU, 16 VPLs, the default grid, at
+/// 48x27: rel RMSE <= 5 % against the `vpl` truth (the point limit's `shadow_map` truth for
+/// the tiny light) and no NaN/Inf.
+fn stress(scene: scatter_reference::scene::Scene) -> Result<String, String> {
+    let Some(ctx) = gpu() else {
+        return Ok(String::new());
+    };
+    let v = AreaIvsvVariant {
+        vpls: 16,
+        ..AreaIvsvVariant::default()
+    };
+    let settings = TruthSettings {
+        segments: 256,
+        ..TruthSettings::default()
+    };
+    let (img, gbuf, bvh) = gpu_image(ctx, &v, &scene, 128)?;
+    let truth = if scene.name.ends_with("/tiny") {
+        let point = scatter_reference::scene::Scene {
+            light: scene.light.area().ok_or("no area light")?.point_limit(),
+            ..scene.clone()
+        };
+        let sm = ShadowMap::build(&point, &bvh, 128).map_err(|e| e.to_string())?;
+        truth::render(
+            &point,
+            &gbuf,
+            &Visibility::ShadowMap(&sm),
+            &settings,
+            &|| (),
+        )
+    } else {
+        truth::render_vpl(&scene, &gbuf, &bvh, 16, 128, &settings).map_err(|e| e.to_string())?
+    };
+    let nan = metrics::non_finite_count(&img);
+    let e = metrics::rel_rmse(&img, &truth).map_err(|e| e.to_string())?;
+    let l1 = metrics::rel_l1(&img, &truth).map_err(|e| e.to_string())?;
+    if nan > 0 || e > 0.05 {
+        return Err(format!("rel RMSE {e}, {nan} NaN/Inf"));
+    }
+    Ok(format!(
+        "rel RMSE {:.2} % / rel L1 {:.2} %, 0 NaN/Inf",
+        100.0 * e,
+        100.0 * l1
+    ))
+}
+
+/// Temporal stability: `area_grate` along a camera path and a light rotation
+/// (`area_suite::animated`, 16 frames at 32x18), area_ivsv (16 VPLs, the default grid) and,
+/// for comparison, ray marching every VPL's map with n = 16 (about area_ivsv's time at
+/// 1280x720: `docs/bench/area.md`), each frame against its `vpl` truth. Asserted: 0 NaN/Inf
+/// in every frame, and area_ivsv flickers no more than the per-VPL ray march.
+fn flicker(path: Path) -> Result<String, String> {
+    let Some(ctx) = gpu() else {
+        return Ok(String::new());
+    };
+    const FRAMES: usize = 16;
+    let v = AreaIvsvVariant {
+        vpls: 16,
+        ..AreaIvsvVariant::default()
+    };
+    let settings = TruthSettings {
+        segments: 256,
+        ..TruthSettings::default()
+    };
+    let march = scatter_shaderlib::family::FamilyVariant::Raymarch(
+        scatter_shaderlib::raymarch::RaymarchVariant {
+            light: scatter_shaderlib::prefiltered::LightKind::Spot,
+            samples: 16,
+            ..Default::default()
+        },
+    );
+    let res = scatter_shaderlib::prefiltered::Resolutions {
+        screen: [32, 18],
+        rectified: [1, 1],
+    };
+    let mut pass =
+        scatter_runtime::FamilyPasses::new(ctx, &march, res, 128).map_err(|e| e.to_string())?;
+    let (mut ivsv, mut marched, mut truths) = (Vec::new(), Vec::new(), Vec::new());
+    for f in 0..FRAMES {
+        let s = area_suite::animated(AreaSceneName::Grate, path, f, FRAMES, 32, 18);
+        let (img, gbuf, bvh) = gpu_image(ctx, &v, &s, 128)?;
+        if metrics::non_finite_count(&img) > 0 {
+            return Err(format!("{}: NaN/Inf", s.name));
+        }
+        let mut sum = vec![[0.0f32; 3]; (32 * 18) as usize];
+        for vpl in s.point_light_scenes(16) {
+            let sm = ShadowMap::build(&vpl, &bvh, 128).map_err(|e| e.to_string())?;
+            let inputs = scatter_runtime::CpuInputs {
+                frame: scatter_runtime::FrameInput {
+                    camera: vpl.camera_desc(),
+                    light: vpl.light_desc(),
+                    medium: vpl.medium_desc(),
+                    shadow_map: sm.desc(),
+                    settings: scatter_shaderlib::prefiltered::FrameSettings::default(),
+                },
+                depth: gbuf.view_depth.clone(),
+                shadow_map: sm.depth.clone(),
+                rectified: None,
+                pass_wall_frames: 0,
+                cookie: None,
+            };
+            let out = scatter_runtime::run_family_on(ctx, &mut pass, res, &inputs)
+                .map_err(|e| e.to_string())?;
+            for (acc, p) in sum.iter_mut().zip(&out.output) {
+                for k in 0..3 {
+                    acc[k] += p[k];
+                }
+            }
+        }
+        marched.push(Image::from_pixels(32, 18, sum));
+        truths.push(
+            truth::render_vpl(&s, &gbuf, &bvh, 16, 128, &settings).map_err(|e| e.to_string())?,
+        );
+        ivsv.push(img);
+    }
+    let fi = metrics::flicker(&ivsv, &truths).map_err(|e| e.to_string())?;
+    let fm = metrics::flicker(&marched, &truths).map_err(|e| e.to_string())?;
+    let line = format!(
+        "flicker: area_ivsv {:.2} %, per-VPL raymarch n16 {:.2} %",
+        100.0 * fi,
+        100.0 * fm
+    );
+    if fi > fm {
+        return Err(line);
+    }
+    Ok(line)
+}
+
 fn errors() -> Result<(), String> {
     let Some(ctx) = gpu() else { return Ok(()) };
     let v = AreaIvsvVariant::default();
@@ -233,6 +397,19 @@ fn main() -> ExitCode {
             });
             trials.push((trial_name, check));
         }
+    }
+    for scene in area_suite::stress_scenes(48, 27) {
+        let name = format!("area_ivsv::stress::{}", scene.name);
+        trials.push((
+            name,
+            Box::new(move || stress(scene).map(|m| eprintln!("     {m}"))),
+        ));
+    }
+    for path in Path::ALL {
+        trials.push((
+            format!("area_ivsv::flicker::area_grate::{path}"),
+            Box::new(move || flicker(path).map(|m| eprintln!("     {m}"))),
+        ));
     }
     trials.push(("area_ivsv::errors".into(), Box::new(errors)));
     run_trials(trials, &[])
