@@ -104,7 +104,7 @@ impl AreaIvsv {
             "VPL record bytes (176 per VPL, one uniform array)",
             176 * u64::from(variant.vpls),
             "max_uniform_buffer_binding_size",
-            u64::from(limits.max_uniform_buffer_binding_size),
+            limits.max_uniform_buffer_binding_size,
         )?;
         for (name, limit) in [
             (
