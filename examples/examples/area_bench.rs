@@ -56,6 +56,9 @@ struct Args {
     /// VPL counts.
     #[arg(long, value_delimiter = ',', default_values_t = [16u32, 64])]
     vpls: Vec<u32>,
+    /// Interleaving of area_ivsv's gather (1: none; 2, 4: the paper's interleaved gather).
+    #[arg(long, value_delimiter = ',', default_values_t = [1u32, 2, 4])]
+    interleave: Vec<u32>,
     /// Samples per view ray of the per-VPL ray march.
     #[arg(long, value_delimiter = ',', default_values_t = [4u32, 8, 16, 32, 64])]
     samples: Vec<u32>,
@@ -95,27 +98,34 @@ fn parse_size(s: &str) -> Result<[u32; 2], String> {
 /// One method: `area_ivsv` with N VPLs, or per-VPL ray marching with N VPLs and n samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Method {
-    Ivsv { vpls: u32 },
+    Ivsv { vpls: u32, interleave: u32 },
     Raymarch { vpls: u32, samples: u32 },
 }
 
 impl Method {
     fn label(self) -> String {
         match self {
-            Method::Ivsv { vpls } => format!("area_ivsv N={vpls}"),
+            Method::Ivsv {
+                vpls,
+                interleave: 1,
+            } => format!("area_ivsv N={vpls}"),
+            Method::Ivsv { vpls, interleave } => {
+                format!("area_ivsv N={vpls} interleave {interleave}")
+            }
             Method::Raymarch { vpls, samples } => format!("raymarch per VPL N={vpls} n={samples}"),
         }
     }
     fn vpls(self) -> u32 {
         match self {
-            Method::Ivsv { vpls } | Method::Raymarch { vpls, .. } => vpls,
+            Method::Ivsv { vpls, .. } | Method::Raymarch { vpls, .. } => vpls,
         }
     }
 }
 
-fn ivsv_variant(vpls: u32) -> AreaIvsvVariant {
+fn ivsv_variant(vpls: u32, interleave: u32) -> AreaIvsvVariant {
     AreaIvsvVariant {
         vpls,
+        interleave,
         ..AreaIvsvVariant::default()
     }
 }
@@ -157,8 +167,8 @@ fn render(
 ) -> Result<Image, String> {
     let (w, h) = (gbuf.width, gbuf.height);
     match method {
-        Method::Ivsv { vpls } => {
-            let v = ivsv_variant(vpls);
+        Method::Ivsv { vpls, interleave } => {
+            let v = ivsv_variant(vpls, interleave);
             let inputs = ivsv_inputs(scene, gbuf, bvh, &v, map_size).map_err(|e| e.to_string())?;
             let out = run_area_ivsv_once(
                 ctx,
@@ -214,8 +224,8 @@ fn time(
     let screen = [gbuf.width, gbuf.height];
     let err = |e: scatter_runtime::RuntimeError| e.to_string();
     match method {
-        Method::Ivsv { vpls } => {
-            let v = ivsv_variant(vpls);
+        Method::Ivsv { vpls, interleave } => {
+            let v = ivsv_variant(vpls, interleave);
             let inputs = ivsv_inputs(scene, &gbuf, bvh, &v, map_size).map_err(|e| e.to_string())?;
             let mut pass = AreaIvsv::new(ctx, &v, screen, map_size).map_err(err)?;
             pass.prepare(
@@ -233,11 +243,15 @@ fn time(
             let t = pass
                 .measure_pass_wall_times(ctx, &depth_view, &maps_view, frames)
                 .map_err(err)?;
-            Ok(vec![
+            let mut out = vec![
                 ("ivsv_rectify".into(), t.rectify),
                 ("ivsv_scan".into(), t.scan),
                 ("ivsv_gather".into(), t.gather),
-            ])
+            ];
+            if interleave > 1 {
+                out.push(("ivsv_interleave_sum".into(), t.interleave_sum));
+            }
+            Ok(out)
         }
         Method::Raymarch { vpls, samples } => {
             let res = Resolutions {
@@ -282,7 +296,10 @@ fn image(ctx: &Context, args: &Args, path: &std::path::Path) -> Result<(), Strin
     let gbuf = GBuffer::cast(&area, &bvh);
     let soft = render(
         ctx,
-        Method::Ivsv { vpls: 64 },
+        Method::Ivsv {
+            vpls: 64,
+            interleave: 1,
+        },
         &area,
         &gbuf,
         &bvh,
@@ -322,7 +339,14 @@ fn main() -> Result<(), String> {
     }
     let mut methods = Vec::new();
     for &n in &args.vpls {
-        methods.push(Method::Ivsv { vpls: n });
+        for &i in &args.interleave {
+            if n.is_multiple_of(i * i) {
+                methods.push(Method::Ivsv {
+                    vpls: n,
+                    interleave: i,
+                });
+            }
+        }
         for &s in &args.samples {
             methods.push(Method::Raymarch {
                 vpls: n,
@@ -401,7 +425,7 @@ fn main() -> Result<(), String> {
         );
         let samples = match m {
             Method::Raymarch { samples, .. } => samples.to_string(),
-            Method::Ivsv { .. } => String::new(),
+            Method::Ivsv { interleave, .. } => format!("i{interleave}"),
         };
         let _ = writeln!(
             csv,
@@ -432,12 +456,11 @@ fn main() -> Result<(), String> {
             total.as_secs_f64() * 1e3
         );
     }
-    // Ratio at equal or lower error: per N, the fastest ray march at or below area_ivsv's mean error.
+    // Ratio at equal or lower error: per area_ivsv row, the fastest ray march with the same
+    // VPLs at or below its mean error.
     md += "\n";
-    for &n in &args.vpls {
-        let Some(ivsv) = rows.iter().find(|r| r.0 == Method::Ivsv { vpls: n }) else {
-            continue;
-        };
+    for ivsv in rows.iter().filter(|r| matches!(r.0, Method::Ivsv { .. })) {
+        let n = ivsv.0.vpls();
         let competitor = rows
             .iter()
             .filter(|r| matches!(r.0, Method::Raymarch { vpls, .. } if vpls == n) && r.1 <= ivsv.1)
@@ -446,7 +469,8 @@ fn main() -> Result<(), String> {
             Some(c) => {
                 let _ = writeln!(
                     md,
-                    "- N = {n}: the fastest per-VPL ray march at or below area_ivsv's mean error ({}, {:.2} %) takes {:.2}x area_ivsv's time.",
+                    "- {}: the fastest per-VPL ray march at or below its mean error ({}, {:.2} %) takes {:.2}x its time.",
+                    ivsv.0.label(),
                     c.0.label(),
                     100.0 * c.1,
                     c.4.as_secs_f64() / ivsv.4.as_secs_f64()
@@ -455,7 +479,8 @@ fn main() -> Result<(), String> {
             None => {
                 let _ = writeln!(
                     md,
-                    "- N = {n}: no per-VPL ray march measured reaches area_ivsv's mean error ({:.2} %).",
+                    "- {}: no per-VPL ray march measured with N = {n} reaches its mean error ({:.2} %).",
+                    ivsv.0.label(),
                     100.0 * ivsv.1
                 );
             }

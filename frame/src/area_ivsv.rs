@@ -54,6 +54,17 @@ pub struct AreaIvsvVariant {
     /// Pieces of the cone's `phi` interval the integrand is linear on, a power of two in
     /// 1..=32 (a template constant: the loop of `ivsv_gather`).
     pub segments: u32,
+    /// Interleaved gather (the paper's): 1 (every pixel gathers every VPL), 2 or 4: pixel
+    /// class `c = (x mod M) + M (y mod M)` gathers the `c`-th of `M^2` runs of consecutive
+    /// VPLs and
+    /// `ivsv_interleave_sum` adds the `M x M` window around each pixel (`vpls` a multiple
+    /// of `M^2`).
+    #[serde(skip_serializing_if = "is_one")]
+    pub interleave: u32,
+}
+
+fn is_one(v: &u32) -> bool {
+    *v == 1
 }
 
 impl Default for AreaIvsvVariant {
@@ -63,6 +74,7 @@ impl Default for AreaIvsvVariant {
             alpha: 256,
             theta: 256,
             segments: 8,
+            interleave: 1,
         }
     }
 }
@@ -91,6 +103,23 @@ impl AreaIvsvVariant {
                 allowed: format!("a power of two in 1..={MAX_SEGMENTS}"),
             });
         }
+        if !matches!(self.interleave, 1 | 2 | 4) {
+            return Err(VariantError {
+                knob: "interleave",
+                value: self.interleave.to_string(),
+                allowed: "1, 2 or 4".into(),
+            });
+        }
+        let classes = self.interleave * self.interleave;
+        if !self.vpls.is_multiple_of(classes) {
+            return Err(VariantError {
+                knob: "vpls",
+                value: self.vpls.to_string(),
+                allowed: format!(
+                    "a multiple of interleave^2 = {classes} (every pixel class gathers as many VPLs)"
+                ),
+            });
+        }
         if self.voxel_bytes() > MAX_VOXEL_BYTES {
             return Err(VariantError {
                 knob: "vpls x alpha x theta",
@@ -115,10 +144,15 @@ impl AreaIvsvVariant {
         16 * u64::from(self.vpls) * u64::from(self.alpha) * u64::from(self.theta)
     }
 
-    /// A short stable id: `v64-a256-t256-k8`.
+    /// A short stable id: `v64-a256-t256-k8`, `v64-a256-t256-k8-i2`.
     pub fn id(&self) -> String {
+        let interleave = if self.interleave > 1 {
+            format!("-i{}", self.interleave)
+        } else {
+            String::new()
+        };
         format!(
-            "v{}-a{}-t{}-k{}",
+            "v{}-a{}-t{}-k{}{interleave}",
             self.vpls, self.alpha, self.theta, self.segments
         )
     }
@@ -141,7 +175,7 @@ pub struct IvsvUniforms {
     pub medium: [f32; 4],
     /// Screen width, height, VPL shadow-map size, VPL count.
     pub sizes: [u32; 4],
-    /// `alpha` bins, `theta` bins, unused, unused.
+    /// `alpha` bins, `theta` bins, interleave `M`, unused.
     pub grid: [u32; 4],
 }
 
@@ -314,6 +348,17 @@ pub fn prepare_area_ivsv(
         }
     }
     require(
+        screen[0] >= variant.interleave && screen[1] >= variant.interleave,
+        "screen size",
+        "at least `interleave` pixels on each side (the interleaving window)",
+        || {
+            format!(
+                "{}x{} for interleave {}",
+                screen[0], screen[1], variant.interleave
+            )
+        },
+    )?;
+    require(
         vpls.len() == variant.vpls as usize,
         "VPL count",
         "the variant's `vpls`",
@@ -391,7 +436,7 @@ pub fn prepare_area_ivsv(
             0.0,
         ],
         sizes: [screen[0], screen[1], map_size, variant.vpls],
-        grid: [variant.alpha, variant.theta, 0, 0],
+        grid: [variant.alpha, variant.theta, variant.interleave, 0],
     };
     finite_fields([
         ("eye", uniforms.eye),
@@ -441,6 +486,25 @@ mod tests {
                     ..AreaIvsvVariant::default()
                 },
                 "vpls x alpha x theta",
+            ),
+        ] {
+            assert_eq!(v.validate().unwrap_err().knob, knob);
+        }
+        for (v, knob) in [
+            (
+                AreaIvsvVariant {
+                    interleave: 3,
+                    ..AreaIvsvVariant::default()
+                },
+                "interleave",
+            ),
+            (
+                AreaIvsvVariant {
+                    vpls: 6,
+                    interleave: 2,
+                    ..AreaIvsvVariant::default()
+                },
+                "vpls",
             ),
         ] {
             assert_eq!(v.validate().unwrap_err().knob, knob);

@@ -26,6 +26,7 @@ use crate::{Context, RuntimeError};
 const RECTIFY: Kernel = Kernel::IvsvRectify;
 const SCAN: Kernel = Kernel::IvsvScan;
 const GATHER: Kernel = Kernel::IvsvGather;
+const INTERLEAVE_SUM: Kernel = Kernel::IvsvInterleaveSum;
 
 /// GPU (or wall) time of each pass of one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -36,12 +37,14 @@ pub struct AreaIvsvTimes {
     pub scan: Duration,
     /// `ivsv_gather`.
     pub gather: Duration,
+    /// `ivsv_interleave_sum` (zero without interleaving).
+    pub interleave_sum: Duration,
 }
 
 impl AreaIvsvTimes {
     /// Sum of the passes.
     pub fn total(&self) -> Duration {
-        self.rectify + self.scan + self.gather
+        self.rectify + self.scan + self.gather + self.interleave_sum
     }
 }
 
@@ -59,6 +62,8 @@ pub struct AreaIvsv {
     volume: wgpu::Buffer,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
+    /// The interleaved gather's partial sums (rgba32float), when interleaved.
+    partial: Option<wgpu::Texture>,
     frame: Option<AreaIvsvFrame>,
 }
 
@@ -121,6 +126,15 @@ impl AreaIvsv {
                 limit,
             )?;
         }
+        if screen[0] < variant.interleave || screen[1] < variant.interleave {
+            return Err(RuntimeError::EmptyInput {
+                kernel: GATHER,
+                size: format!(
+                    "screen {}x{} (smaller than the interleaving window {})",
+                    screen[0], screen[1], variant.interleave
+                ),
+            });
+        }
         let built = scatter_shaderlib::KernelParams::area_ivsv(*variant)
             .iter()
             .map(scatter_shaderlib::build)
@@ -136,6 +150,11 @@ impl AreaIvsv {
             ],
         )?;
         let (output, output_view) = exec.texture("output")?;
+        let partial = if variant.interleave > 1 {
+            Some(exec.texture("partial")?.0.clone())
+        } else {
+            None
+        };
         Ok(AreaIvsv {
             variant: *variant,
             screen,
@@ -146,6 +165,7 @@ impl AreaIvsv {
             volume: exec.buffer("volume")?.clone(),
             output: output.clone(),
             output_view: output_view.clone(),
+            partial,
             exec,
             frame: None,
         })
@@ -182,7 +202,7 @@ impl AreaIvsv {
         Ok(())
     }
 
-    /// Records the three passes (with GPU timestamps when the device has them) and returns
+    /// Records the passes (with GPU timestamps when the device has them) and returns
     /// the output view: in-scattered radiance, rgba16float, screen-sized. `depth` is linear
     /// view depth (r32float, screen-sized); `vpl_maps` an r32float 2D-array view of one
     /// layer per VPL, each `map_size` squared.
@@ -274,15 +294,20 @@ impl AreaIvsv {
         vpl_maps: &wgpu::TextureView,
         frames: u32,
     ) -> Result<AreaIvsvTimes, RuntimeError> {
-        let [rectify, scan, gather] =
-            median_pass_wall_times(ctx, [RECTIFY, SCAN, GATHER], frames, |encoder, kernel| {
+        let [rectify, scan, gather, interleave_sum] = median_pass_wall_times(
+            ctx,
+            [RECTIFY, SCAN, GATHER, INTERLEAVE_SUM],
+            frames,
+            |encoder, kernel| {
                 self.encode_selected(ctx, encoder, depth, vpl_maps, Some(kernel))
                     .map(|_| ())
-            })?;
+            },
+        )?;
         Ok(AreaIvsvTimes {
             rectify,
             scan,
             gather,
+            interleave_sum: crate::timer::when(self.variant.interleave > 1, interleave_sum),
         })
     }
 
@@ -302,6 +327,7 @@ impl AreaIvsv {
             rectify: at(0),
             scan: at(1),
             gather: at(2),
+            interleave_sum: at(3),
         }))
     }
 
@@ -337,6 +363,9 @@ pub struct AreaIvsvReadback {
     pub volume: Vec<u32>,
     /// `marks` after `ivsv_scan` (zero: the scan clears what it read).
     pub marks_after_scan: Vec<u32>,
+    /// The interleaved gather's partial sums (rgba32float), row-major; empty without
+    /// interleaving.
+    pub partial: Vec<[f32; 4]>,
     /// In-scattered radiance per pixel (rgba16float converted to f32), row-major.
     pub output: Vec<[f32; 4]>,
     /// GPU time per pass, when the device has timestamps.
@@ -449,6 +478,17 @@ pub fn run_area_ivsv_once(
     let volume = encode_buffer_readback(device, &mut encoder, &pass.volume);
     let marks_after = encode_buffer_readback(device, &mut encoder, &pass.marks);
     pass.encode_selected(ctx, &mut encoder, &views[0].1, &maps_view, Some(GATHER))?;
+    let partial = match &pass.partial {
+        Some(t) => Some(Readback::encode(device, &mut encoder, t, 16, GATHER)?),
+        None => None,
+    };
+    pass.encode_selected(
+        ctx,
+        &mut encoder,
+        &views[0].1,
+        &maps_view,
+        Some(INTERLEAVE_SUM),
+    )?;
     let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, GATHER)?;
     let start = Instant::now();
     ctx.queue().submit([encoder.finish()]);
@@ -456,6 +496,14 @@ pub fn run_area_ivsv_once(
     let marks = u32s(&crate::timer::read_buffer(ctx, RECTIFY, &marks)?);
     let volume = u32s(&crate::timer::read_buffer(ctx, SCAN, &volume)?);
     let marks_after_scan = u32s(&crate::timer::read_buffer(ctx, SCAN, &marks_after)?);
+    let partial = match partial {
+        Some(p) => p
+            .read(ctx, GATHER)?
+            .chunks_exact(16)
+            .map(|t| decode_rgba(t, Storage::Rgba32float))
+            .collect(),
+        None => Vec::new(),
+    };
     let output = output
         .read(ctx, GATHER)?
         .chunks_exact(8)
@@ -471,6 +519,7 @@ pub fn run_area_ivsv_once(
         marks,
         volume,
         marks_after_scan,
+        partial,
         output,
         gpu_times,
         wall_time,

@@ -63,6 +63,8 @@ kernel::kernels! {
     /// area_ivsv: per pixel, the lit integral of every VPL from its voxel bits (Wyman & Dai
     /// 2013).
     IvsvGather("ivsv_gather", AreaIvsvVariant, area_ivsv::render_gather),
+    /// area_ivsv, interleaved gather: the sum of each pixel's window of partial sums.
+    IvsvInterleaveSum("ivsv_interleave_sum", AreaIvsvVariant, area_ivsv::render_interleave_sum),
     /// area_ivsv: per VPL and epipolar light ray, the voxel where its shadow starts.
     IvsvRectify("ivsv_rectify", AreaIvsvVariant, area_ivsv::render_rectify),
     /// area_ivsv: the extrusion of the marked voxels, an OR scan along alpha.
@@ -149,7 +151,10 @@ impl KernelParams {
             })
             .collect();
         // Not yet in the family table (`scatter_shaderlib::area_ivsv`'s docs).
-        out.extend(Self::area_ivsv(AreaIvsvVariant::default()));
+        out.extend(Self::area_ivsv(AreaIvsvVariant {
+            interleave: 2,
+            ..AreaIvsvVariant::default()
+        }));
         for &family in Family::ALL {
             // The variant with the most passes, then the default with epipolar sampling
             // (its `_unwarp` and `_fallback` kernels).

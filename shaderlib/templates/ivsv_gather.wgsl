@@ -16,6 +16,12 @@
 // d_phi (A + B k), A n + B sum(k) over the unset bits of the piece, from masked popcounts.
 // The two rows nearest in theta are gathered and interpolated linearly (the grid wraps);
 // alpha is the bin holding the ray. The sum over VPLs, each times its intensity, is the pixel.
+{%- if interleave > 1 %}
+// Interleaved (M = {{ interleave }}): pixel class c = (x mod M) + M (y mod M) sums only the c-th
+// of M^2 consecutive runs of VPLs into `partial` (a run of consecutive Halton points is spread
+// over the whole light; every M^2-th point is not: the base-2 digits put them in one strip);
+// `ivsv_interleave_sum` adds the M x M window of each pixel.
+{%- endif %}
 //
 // Bindings (group 0):
 // | binding | name   | type                                           | access       |
@@ -24,8 +30,13 @@
 // | 1       | vpls   | var<uniform> array<Vpl, {{ vpls }}> (176 bytes each) | uniform |
 // | 2       | volume | var<storage, read> array<u32> (`ivsv_scan`'s)  | read         |
 // | 3       | depth  | texture_2d<f32> (r32float, view depth)         | textureLoad  |
+{%- if interleave > 1 %}
+// | 4       | partial | texture_storage_2d<rgba32float, write>        | textureStore |
+// partial: screen-sized, the pixel's class's share (rgb, alpha 1).
+{%- else %}
 // | 4       | output | texture_storage_2d<rgba16float, write>         | textureStore |
 // output: screen-sized, in-scattered radiance (rgb, alpha 1).
+{%- endif %}
 //
 // Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
 // (frame.sizes.xy); invocation id x = pixel column, y = pixel row.
@@ -41,7 +52,11 @@ const SEGMENTS: u32 = {{ segments }}u;
 @group(0) @binding(1) var<uniform> vpls: array<Vpl, {{ vpls }}>;
 @group(0) @binding(2) var<storage, read> volume: array<u32>;
 @group(0) @binding(3) var depth: texture_2d<f32>;
+{%- if interleave > 1 %}
+@group(0) @binding(4) var partial: texture_storage_2d<rgba32float, write>;
+{%- else %}
 @group(0) @binding(4) var output: texture_storage_2d<rgba16float, write>;
+{%- endif %}
 
 // Unit view direction through the centre of pixel (x, y).
 fn ivsv_pixel_dir(m: IvsvFrame, x: u32, y: u32) -> vec3<f32> {
@@ -204,9 +219,20 @@ fn ivsv_gather(@builtin(global_invocation_id) id: vec3<u32>) {
     // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
     let s = min(max(textureLoad(depth, id.xy, 0).x, 0.0), m.eye.w) / max(dot(dir, m.cam_forward.xyz), 1e-6);
     var sum = vec3<f32>(0.0);
+{%- if interleave > 1 %}
+    let mi = {{ interleave }}u;
+    let per_class = m.sizes[3] / (mi * mi);
+    let first = ((id.x % mi) + mi * (id.y % mi)) * per_class;
+    for (var v = first; v < first + per_class; v += 1u) {
+        let r = vpls[v];
+        sum += r.color.xyz * vpl_lit(m, r, v, dir, s);
+    }
+    textureStore(partial, id.xy, vec4<f32>(sum, 1.0));
+{%- else %}
     for (var v = 0u; v < m.sizes[3]; v += 1u) {
         let r = vpls[v];
         sum += r.color.xyz * vpl_lit(m, r, v, dir, s);
     }
     textureStore(output, id.xy, vec4<f32>(sum, 1.0));
+{%- endif %}
 }

@@ -191,13 +191,20 @@ pub fn vpl_lit(
     d_phi * ((1.0 - tw) * lit_a + tw * lit_b)
 }
 
-/// The invocation of pixel `(x, y)`: its in-scattered radiance (rgb).
+/// The invocation of pixel `(x, y)`: its in-scattered radiance (rgb); with `interleave`
+/// `M > 1` only its class's VPLs (the `c`-th of `M^2` consecutive runs, `c = (x mod M) +
+/// M (y mod M)`), the partial sum.
+#[expect(
+    clippy::too_many_arguments,
+    reason = "line-comparable to the WGSL entry point"
+)]
 pub fn gather_pixel(
     m: &IvsvUniforms,
     vpls: &[VplRecord],
     volume: &[u32],
     depth: &Tex,
     segments: u32,
+    interleave: u32,
     x: u32,
     y: u32,
 ) -> [f32; 3] {
@@ -205,19 +212,25 @@ pub fn gather_pixel(
     // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
     let s = depth.load(x, y).max(0.0).min(m.eye[3]) / dir.dot(xyz(m.cam_forward)).max(1e-6);
     let mut sum = Vec3::ZERO;
-    for (v, r) in (0u32..).zip(vpls) {
+    let mi = interleave;
+    let per_class = m.sizes[3] / (mi * mi);
+    let first = ((x % mi) + mi * (y % mi)) * per_class;
+    for v in first..first + per_class {
+        let r = &vpls[v as usize];
         sum += xyz(r.color) * vpl_lit(m, r, volume, v, dir, s, segments);
     }
     sum.to_array()
 }
 
-/// The whole pass: the screen's radiance, row-major (not yet rounded to `rgba16float`).
+/// The whole pass: the screen's radiance (`interleave = 1`, not yet rounded to
+/// `rgba16float`) or partial sums (`rgba32float`), row-major.
 pub fn ivsv_gather(
     m: &IvsvUniforms,
     vpls: &[VplRecord],
     volume: &[u32],
     depth: &Tex,
     segments: u32,
+    interleave: u32,
 ) -> Vec<[f32; 3]> {
     use rayon::prelude::*;
     (0..m.sizes[0] * m.sizes[1])
@@ -229,6 +242,7 @@ pub fn ivsv_gather(
                 volume,
                 depth,
                 segments,
+                interleave,
                 p % m.sizes[0],
                 p / m.sizes[0],
             )

@@ -19,6 +19,7 @@ pub mod depth_columns;
 pub mod family;
 pub mod interleave_sum;
 pub mod ivsv_gather;
+pub mod ivsv_interleave_sum;
 pub mod ivsv_rectify;
 pub mod ivsv_scan;
 pub mod minmax_build;
@@ -689,11 +690,15 @@ pub struct IvsvRun {
     pub marks: Vec<u32>,
     /// `volume` after `ivsv_scan`.
     pub volume: Vec<u32>,
-    /// `ivsv_gather`'s output (rgb, not rounded to `rgba16float`).
+    /// `ivsv_gather`'s partial sums when interleaved (else empty).
+    pub partial: Vec<[f32; 3]>,
+    /// The output (rgb, not rounded to `rgba16float`): `ivsv_gather`'s, or
+    /// `ivsv_interleave_sum`'s when interleaved.
     pub output: Vec<[f32; 3]>,
 }
 
-/// Runs `ivsv_rectify`, `ivsv_scan` and `ivsv_gather` on the CPU.
+/// Runs `ivsv_rectify`, `ivsv_scan`, `ivsv_gather` and, when interleaved,
+/// `ivsv_interleave_sum` on the CPU.
 pub fn run_area_ivsv(variant: &AreaIvsvVariant, inputs: &IvsvInputs) -> IvsvRun {
     let m = &inputs.frame.uniforms;
     let words = 4 * (variant.vpls * variant.alpha * variant.theta) as usize;
@@ -702,16 +707,24 @@ pub fn run_area_ivsv(variant: &AreaIvsvVariant, inputs: &IvsvInputs) -> IvsvRun 
     let rectified = marks.clone();
     let mut volume = vec![0u32; words];
     ivsv_scan::ivsv_scan(m, &mut marks, &mut volume);
-    let output = ivsv_gather::ivsv_gather(
+    let gathered = ivsv_gather::ivsv_gather(
         m,
         &inputs.frame.vpls,
         &volume,
         &inputs.depth,
         variant.segments,
+        variant.interleave,
     );
+    let (partial, output) = if variant.interleave > 1 {
+        let out = ivsv_interleave_sum::ivsv_interleave_sum(m, &gathered, variant.interleave);
+        (gathered, out)
+    } else {
+        (Vec::new(), gathered)
+    };
     IvsvRun {
         marks: rectified,
         volume,
+        partial,
         output,
     }
 }

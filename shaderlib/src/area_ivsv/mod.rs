@@ -46,6 +46,14 @@ struct ScanTemplate;
 struct GatherTemplate {
     segments: u32,
     vpls: u32,
+    interleave: u32,
+}
+
+/// `ivsv_interleave_sum`: the window side.
+#[derive(Template)]
+#[template(path = "ivsv_interleave_sum.wgsl")]
+struct InterleaveSumTemplate {
+    interleave: u32,
 }
 
 fn validate(kernel: Kernel, variant: &AreaIvsvVariant) -> Result<(), ShaderError> {
@@ -84,19 +92,46 @@ pub(crate) fn render_gather(variant: &AreaIvsvVariant) -> Result<String, ShaderE
     GatherTemplate {
         segments: variant.segments,
         vpls: variant.vpls,
+        interleave: variant.interleave,
     }
     .render()
     .map_err(render_error(Kernel::IvsvGather))
 }
 
+/// Renders `templates/ivsv_interleave_sum.wgsl` for an interleaved variant (an error for
+/// `interleave = 1`, which has no such pass).
+pub(crate) fn render_interleave_sum(variant: &AreaIvsvVariant) -> Result<String, ShaderError> {
+    let kernel = Kernel::IvsvInterleaveSum;
+    validate(kernel, variant)?;
+    if variant.interleave < 2 {
+        return Err(ShaderError::Variant {
+            kernel,
+            source: scatter_frame::variant::VariantError {
+                knob: "interleave",
+                value: variant.interleave.to_string(),
+                allowed: "2 or 4 (ivsv_interleave_sum is the interleaved gather's pass)".into(),
+            },
+        });
+    }
+    InterleaveSumTemplate {
+        interleave: variant.interleave,
+    }
+    .render()
+    .map_err(render_error(kernel))
+}
+
 impl crate::KernelParams {
     /// The kernels of an area_ivsv-family variant, in pass order: `ivsv_rectify`,
-    /// `ivsv_scan`, `ivsv_gather`.
-    pub fn area_ivsv(variant: AreaIvsvVariant) -> [Self; 3] {
-        [
+    /// `ivsv_scan`, `ivsv_gather`, and `ivsv_interleave_sum` when interleaved.
+    pub fn area_ivsv(variant: AreaIvsvVariant) -> Vec<Self> {
+        let mut out = vec![
             Self::IvsvRectify(variant),
             Self::IvsvScan(variant),
             Self::IvsvGather(variant),
-        ]
+        ];
+        if variant.interleave > 1 {
+            out.push(Self::IvsvInterleaveSum(variant));
+        }
+        out
     }
 }

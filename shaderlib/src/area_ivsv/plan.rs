@@ -41,7 +41,7 @@ pub fn plan(v: &AreaIvsvVariant) -> Plan {
         },
     ];
     let vpls = v.vpls.to_string();
-    let resources = vec![
+    let mut resources = vec![
         frame_buffer(
             "frame",
             "the uniform block of the frame (Rust: scatter_frame::area_ivsv::IvsvUniforms from \
@@ -98,17 +98,32 @@ pub fn plan(v: &AreaIvsvVariant) -> Plan {
         ),
         scatter_texture(
             "output",
-            "in-scattered radiance, rgb, alpha 1 (written by ivsv_gather); add it to the \
-             attenuated scene",
+            "in-scattered radiance, rgb, alpha 1 (written by ivsv_gather, or \
+             ivsv_interleave_sum when interleaved); add it to the attenuated scene",
             OUTPUT_FORMAT,
             "screen.width",
             "screen.height",
         ),
     ];
-    let passes = [Kernel::IvsvRectify, Kernel::IvsvScan, Kernel::IvsvGather]
-        .into_iter()
-        .filter_map(|k| pass(v, k))
-        .collect();
+    if v.interleave > 1 {
+        resources.push(scatter_texture(
+            "partial",
+            "per pixel the share of its interleaving class's VPLs (written by ivsv_gather, \
+             summed over each pixel's window by ivsv_interleave_sum)",
+            "rgba32float",
+            "screen.width",
+            "screen.height",
+        ));
+    }
+    let passes = [
+        Kernel::IvsvRectify,
+        Kernel::IvsvScan,
+        Kernel::IvsvGather,
+        Kernel::IvsvInterleaveSum,
+    ]
+    .into_iter()
+    .filter_map(|k| pass(v, k))
+    .collect();
     Plan {
         parameters,
         resources,
@@ -158,8 +173,21 @@ pub fn pass(v: &AreaIvsvVariant, kernel: Kernel) -> Option<PassPlan> {
                 bind(1, "vpls"),
                 bind(2, "volume"),
                 bind(3, "depth"),
-                bind(4, "output"),
+                bind(
+                    4,
+                    if v.interleave > 1 {
+                        "partial"
+                    } else {
+                        "output"
+                    },
+                ),
             ],
+        }),
+        Kernel::IvsvInterleaveSum if v.interleave > 1 => Some(PassPlan {
+            kernel,
+            invocations: [f("screen.width"), f("screen.height"), f("1")],
+            skip_when: None,
+            bindings: vec![bind(0, "frame"), bind(1, "partial"), bind(2, "output")],
         }),
         _ => None,
     }
