@@ -279,3 +279,38 @@ pub fn stress_scenes(width: u32, height: u32) -> Vec<Scene> {
     cases.push(inside);
     cases
 }
+
+/// The truth a stress case of [`stress_scenes`] is measured against: the `vpl` truth with
+/// `vpls` VPLs and `map_size`^2 maps, except for the tiny light, whose VPLs all stand in one
+/// point: there the `shadow_map` truth of its point limit (what a shrinking light must tend
+/// to).
+///
+/// # Errors
+///
+/// A shadow map that cannot be built.
+pub fn stress_truth(
+    scene: &Scene,
+    gbuf: &crate::buffers::GBuffer,
+    bvh: &crate::bvh::Bvh,
+    vpls: usize,
+    map_size: u32,
+    settings: &crate::truth::TruthSettings,
+) -> Result<crate::image::Image, crate::buffers::ShadowMapError> {
+    match &scene.light {
+        Light::Area(a) if scene.name.ends_with("/tiny") => {
+            let point = Scene {
+                light: a.point_limit(),
+                ..scene.clone()
+            };
+            let sm = crate::buffers::ShadowMap::build(&point, bvh, map_size)?;
+            Ok(crate::truth::render(
+                &point,
+                gbuf,
+                &crate::truth::Visibility::ShadowMap(&sm),
+                settings,
+                &|| (),
+            ))
+        }
+        _ => crate::truth::render_vpl(scene, gbuf, bvh, vpls, map_size, settings),
+    }
+}

@@ -358,22 +358,8 @@ fn stress_cases_stay_within_the_bar() {
         let bvh = Bvh::build(&s.geometry);
         let gbuf = GBuffer::cast(&s, &bvh);
         let img = area_ivsv::render(&s, &gbuf, &bvh, &ivsv).unwrap();
-        let truth = if s.name.ends_with("/tiny") {
-            let point = scatter_reference::scene::Scene {
-                light: s.light.area().unwrap().point_limit(),
-                ..s.clone()
-            };
-            let sm = ShadowMap::build(&point, &bvh, ivsv.map_size).unwrap();
-            truth::render(
-                &point,
-                &gbuf,
-                &Visibility::ShadowMap(&sm),
-                &settings,
-                &|| (),
-            )
-        } else {
-            truth::render_vpl(&s, &gbuf, &bvh, ivsv.vpls, ivsv.map_size, &settings).unwrap()
-        };
+        let truth =
+            area_suite::stress_truth(&s, &gbuf, &bvh, ivsv.vpls, ivsv.map_size, &settings).unwrap();
         let nan = metrics::non_finite_count(&img);
         let e = metrics::rel_rmse(&img, &truth).unwrap();
         println!(

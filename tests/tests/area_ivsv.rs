@@ -38,7 +38,7 @@ use scatter_reference::kernels::{
 use scatter_reference::metrics;
 use scatter_reference::paths::Path;
 use scatter_reference::suite::{MediumPreset, Pose};
-use scatter_reference::truth::{self, TruthSettings, Visibility};
+use scatter_reference::truth::{self, TruthSettings};
 use scatter_runtime::{AreaIvsv, RuntimeError, run_area_ivsv_once};
 use scatter_shaderlib::area_ivsv::{AreaIvsvVariant, PHI_BITS};
 
@@ -279,22 +279,8 @@ fn stress(scene: scatter_reference::scene::Scene) -> Result<String, String> {
         ..TruthSettings::default()
     };
     let (img, gbuf, bvh) = gpu_image(ctx, &v, &scene, 128)?;
-    let truth = if scene.name.ends_with("/tiny") {
-        let point = scatter_reference::scene::Scene {
-            light: scene.light.area().ok_or("no area light")?.point_limit(),
-            ..scene.clone()
-        };
-        let sm = ShadowMap::build(&point, &bvh, 128).map_err(|e| e.to_string())?;
-        truth::render(
-            &point,
-            &gbuf,
-            &Visibility::ShadowMap(&sm),
-            &settings,
-            &|| (),
-        )
-    } else {
-        truth::render_vpl(&scene, &gbuf, &bvh, 16, 128, &settings).map_err(|e| e.to_string())?
-    };
+    let truth = area_suite::stress_truth(&scene, &gbuf, &bvh, 16, 128, &settings)
+        .map_err(|e| e.to_string())?;
     let nan = metrics::non_finite_count(&img);
     let e = metrics::rel_rmse(&img, &truth).map_err(|e| e.to_string())?;
     let l1 = metrics::rel_l1(&img, &truth).map_err(|e| e.to_string())?;
