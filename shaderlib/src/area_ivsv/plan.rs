@@ -5,8 +5,9 @@
 use crate::Kernel;
 use crate::area_ivsv::AreaIvsvVariant;
 use crate::plan::{
-    BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, Parameter, PassPlan, Plan, Resource, SAMPLED,
-    TEXTURE_DIMENSION, bind, frame_buffer, scatter_resource, scatter_texture, texture_2d,
+    BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, PassPlan, Plan, Resource, SAMPLED, bind,
+    depth_and_shadow_map, frame_buffer, scatter_resource, scatter_texture,
+    screen_and_shadow_parameters, texture_2d,
 };
 
 /// A voxel buffer (`marks`, `volume`): four `u32` per texel of every VPL's grid.
@@ -23,23 +24,14 @@ fn voxel_buffer(v: &AreaIvsvVariant, name: &'static str, contents: &'static str)
 
 /// The resources and passes of a variant, as `runtime/src/area_ivsv.rs` creates them.
 pub fn plan(v: &AreaIvsvVariant) -> Plan {
-    let parameters = vec![
-        Parameter {
-            name: "screen.width",
-            description: "screen width in pixels (depth buffer and output)",
-            constraint: TEXTURE_DIMENSION.into(),
-        },
-        Parameter {
-            name: "screen.height",
-            description: "screen height in pixels (depth buffer and output)",
-            constraint: TEXTURE_DIMENSION.into(),
-        },
-        Parameter {
-            name: "shadow.size",
-            description: "side of every VPL's square standard shadow map in texels",
-            constraint: TEXTURE_DIMENSION.into(),
-        },
-    ];
+    // The shared parameters; `shadow.size` is the side of every VPL's map here.
+    let mut parameters = screen_and_shadow_parameters();
+    for p in &mut parameters {
+        if p.name == "shadow.size" {
+            p.description = "side of every VPL's square standard shadow map in texels";
+        }
+    }
+    let [depth, _] = depth_and_shadow_map();
     let vpls = v.vpls.to_string();
     let mut resources = vec![
         frame_buffer(
@@ -55,20 +47,7 @@ pub fn plan(v: &AreaIvsvVariant) -> Plan {
              prepare_area_ivsv), written once per frame",
             None,
         ),
-        Resource {
-            provided_by: "engine",
-            texture: Some(texture_2d(
-                DEPTH_FORMAT,
-                "screen.width",
-                "screen.height",
-                "1",
-                SAMPLED,
-            )),
-            ..scatter_resource(
-                "depth",
-                "linear view depth per pixel (far plane distance for sky)",
-            )
-        },
+        depth,
         Resource {
             provided_by: "engine",
             texture: Some(texture_2d(
