@@ -18,7 +18,11 @@
 //! cover `phi` in `[0, phi_max]`, `phi_max = pi - alpha_0`. Voxel bits: a storage buffer of
 //! `4 N theta alpha` `u32`, texel `(i, j)` of VPL `v` at `4 ((v theta + j) alpha + i)`.
 
+use std::fmt;
+
+use crate::family::{Family, KnobSet};
 use crate::frame::v4;
+use crate::sampling::{Sampling, SamplingKnobs};
 use crate::scene::{
     CameraDesc, FrameError, LightDesc, MediumDesc, ShadowMapDesc, ShadowProjectionDesc,
     finite_fields, require, validate_scene, validate_shadow_map,
@@ -45,6 +49,9 @@ pub const MAX_VOXEL_BYTES: u64 = 1 << 27;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct AreaIvsvVariant {
+    /// Must be `area` (the family renders area lights; a spot is the single-light
+    /// families').
+    pub light: LightKind,
     /// VPLs, 1..=256: the shadow maps (layers of `vpl_maps`) and voxel grids per frame.
     pub vpls: u32,
     /// `alpha` bins (texels per row), 2..=4096.
@@ -61,7 +68,24 @@ pub struct AreaIvsvVariant {
     /// of `M^2`).
     #[serde(skip_serializing_if = "is_one")]
     pub interleave: u32,
+    /// Must be `pixels`: the gather runs per pixel (epipolar and low-resolution sampling are
+    /// not built for this family).
+    pub sampling: Sampling,
+    /// Unused (must stay at its default).
+    pub scale: u32,
+    /// Unused (must stay at its default).
+    pub depth_break: u32,
+    /// Unused (must stay at its default).
+    pub light_break: u32,
+    /// Unused (must stay at its default).
+    pub slices: u32,
+    /// Unused (must stay at its default).
+    pub slice_samples: u32,
+    /// Unused (must stay at its default).
+    pub step: u32,
 }
+
+crate::sampling::sampling_fields!(AreaIvsvVariant);
 
 fn is_one(v: &u32) -> bool {
     *v == 1
@@ -69,12 +93,21 @@ fn is_one(v: &u32) -> bool {
 
 impl Default for AreaIvsvVariant {
     fn default() -> Self {
+        let s = SamplingKnobs::default();
         AreaIvsvVariant {
+            light: LightKind::Area,
             vpls: 64,
             alpha: 256,
             theta: 256,
             segments: 8,
             interleave: 1,
+            sampling: s.sampling,
+            scale: s.scale,
+            depth_break: s.depth_break,
+            light_break: s.light_break,
+            slices: s.slices,
+            slice_samples: s.slice_samples,
+            step: s.step,
         }
     }
 }
@@ -82,6 +115,24 @@ impl Default for AreaIvsvVariant {
 impl AreaIvsvVariant {
     /// Checks every knob; the error names the first offending one.
     pub fn validate(&self) -> Result<(), VariantError> {
+        if self.light != LightKind::Area {
+            return Err(VariantError {
+                knob: "light",
+                value: self.light.to_string(),
+                allowed: "area (directional and spot lights are the single-light families')"
+                    .into(),
+            });
+        }
+        if self.sampling_knobs() != SamplingKnobs::default() {
+            let knobs = self.sampling_knobs();
+            return Err(VariantError {
+                knob: "sampling",
+                value: format!("{}{}", knobs.sampling, knobs.id_suffix()),
+                allowed: "pixels with the sampling knobs at their defaults (the gather runs per \
+                          pixel; epipolar and lowres sampling are not built for area_ivsv)"
+                    .into(),
+            });
+        }
         let range = |knob: &'static str, value: u32, lo: u32, hi: u32| {
             if (lo..=hi).contains(&value) {
                 Ok(())
@@ -155,6 +206,75 @@ impl AreaIvsvVariant {
             "v{}-a{}-t{}-k{}{interleave}",
             self.vpls, self.alpha, self.theta, self.segments
         )
+    }
+}
+
+impl AreaIvsvVariant {
+    /// The conformance grid: small grids that exercise every knob (a VPL count that is not
+    /// a power of two, bins that are not, every segment count's loop shape, both interleaves).
+    pub fn grid() -> Vec<AreaIvsvVariant> {
+        let v = |vpls, alpha, theta, segments, interleave| AreaIvsvVariant {
+            vpls,
+            alpha,
+            theta,
+            segments,
+            interleave,
+            ..AreaIvsvVariant::default()
+        };
+        vec![
+            v(8, 64, 64, 8, 1),
+            v(3, 37, 19, 1, 1),
+            v(4, 128, 96, 32, 1),
+            v(8, 64, 64, 8, 2),
+            v(16, 64, 48, 4, 4),
+        ]
+    }
+}
+
+impl fmt::Display for AreaIvsvVariant {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.id())
+    }
+}
+
+impl KnobSet for AreaIvsvVariant {
+    const FAMILY_NAME: &'static str = "area_ivsv";
+    const FAMILY: Family = Family::AreaIvsv;
+    const SUMMARY: &'static str = "Wyman & Dai 2013, imperfect voxelized shadow volumes: an area \
+         light as N virtual point lights, per VPL an epipolar voxel grid of shadow bits, \
+         extruded by an OR scan and gathered per pixel";
+
+    fn validate(&self) -> Result<(), VariantError> {
+        AreaIvsvVariant::validate(self)
+    }
+
+    fn id(&self) -> String {
+        AreaIvsvVariant::id(self)
+    }
+
+    fn light(&self) -> LightKind {
+        self.light
+    }
+
+    fn with_light(self, light: LightKind) -> Self {
+        Self { light, ..self }
+    }
+
+    /// `v64-a256-t256-k8` (the id: every knob but the light).
+    fn marker(&self) -> String {
+        AreaIvsvVariant::id(self)
+    }
+
+    fn grid() -> Vec<Self> {
+        AreaIvsvVariant::grid()
+    }
+
+    fn sampling(&self) -> SamplingKnobs {
+        self.sampling_knobs()
+    }
+
+    fn with_sampling(self, s: SamplingKnobs) -> Self {
+        self.with_sampling_knobs(s)
     }
 }
 
@@ -450,6 +570,36 @@ pub fn prepare_area_ivsv(
         vpls: records,
         grids,
     })
+}
+
+/// Sets up one frame of an area light ([`LightDesc::Area`]): its `variant.vpls` VPLs and
+/// their shadow maps ([`crate::area_light::AreaLightDesc::vpl_inputs`], from `template`, the
+/// standard shadow map of the light's point limit), then [`prepare_area_ivsv`]. Returns the
+/// frame and the VPLs: layer `i` of the engine's VPL map array is rendered with
+/// `vpls[i].shadow_map`.
+///
+/// # Errors
+///
+/// [`FrameError::LightMismatch`] for a light that is not an area light; the errors of
+/// [`crate::area_light::AreaLightDesc::vpl_inputs`] and [`prepare_area_ivsv`].
+pub fn prepare_area_light(
+    variant: &AreaIvsvVariant,
+    screen: [u32; 2],
+    camera: &CameraDesc,
+    light: &LightDesc,
+    medium: &MediumDesc,
+    template: &ShadowMapDesc,
+) -> Result<(AreaIvsvFrame, Vec<VplInput>), FrameError> {
+    let LightDesc::Area(area) = light else {
+        return Err(FrameError::LightMismatch {
+            expected: LightKind::Area,
+            got: light.kind(),
+        });
+    };
+    variant.validate().map_err(FrameError::Variant)?;
+    let vpls = area.vpl_inputs(variant.vpls, template)?;
+    let frame = prepare_area_ivsv(variant, screen, camera, medium, &vpls, template.size)?;
+    Ok((frame, vpls))
 }
 
 #[cfg(test)]

@@ -624,7 +624,8 @@ fn prepare_frame_unchecked(
                 .into_iter()
                 .map(|t| far_t(t) * t.sin())
                 .fold(0.0, f64::max),
-            LightKind::Spot => (0..=32)
+            // `Area` never gets here: the variant refuses it (`single_light`).
+            LightKind::Spot | LightKind::Area => (0..=32)
                 .map(|k| lo + (hi - lo) * f64::from(k) / 32.0)
                 .map(|t| {
                     let tf = far_t(t);

@@ -132,6 +132,7 @@ crate::sampling::sampling_fields!(HybridVolumeVariant);
 impl HybridVolumeVariant {
     /// Checks every knob; the error names the first offending one.
     pub fn validate(&self) -> Result<(), VariantError> {
+        crate::variant::validate_single_light(self.light)?;
         let range = |knob: &'static str, value: u32, lo: u32, hi: u32| {
             if (lo..=hi).contains(&value) {
                 Ok(())
@@ -167,7 +168,7 @@ impl HybridVolumeVariant {
     /// samples, 64 bins and no padding (every code path: few bins put many walls in a bin),
     /// and the spot with its cookie.
     pub fn grid() -> Vec<HybridVolumeVariant> {
-        let mut out: Vec<HybridVolumeVariant> = LightKind::ALL
+        let mut out: Vec<HybridVolumeVariant> = LightKind::SINGLE
             .iter()
             .map(|&light| HybridVolumeVariant {
                 light,

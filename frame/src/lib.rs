@@ -12,6 +12,7 @@
 //! holds the one enum of every family's variant ([`family::FamilyVariant`]).
 
 pub mod area_ivsv;
+pub mod area_light;
 pub mod cookie;
 pub mod family;
 pub mod frame;

@@ -98,6 +98,7 @@ impl Default for MinmaxVariant {
 impl MinmaxVariant {
     /// Checks every knob; the error names the first offending one.
     pub fn validate(&self) -> Result<(), VariantError> {
+        crate::variant::validate_single_light(self.light)?;
         self.sampling_knobs().validate()?;
         crate::cookie::validate_cookie(self.cookie, self.light)
     }
@@ -114,7 +115,7 @@ impl MinmaxVariant {
 
     /// The conformance grid: both lights, every pixel, and the spot with its cookie.
     pub fn grid() -> Vec<MinmaxVariant> {
-        LightKind::ALL
+        LightKind::SINGLE
             .iter()
             .map(|&light| MinmaxVariant {
                 light,

@@ -131,6 +131,7 @@ crate::sampling::sampling_fields!(PartialSumTreeVariant);
 impl PartialSumTreeVariant {
     /// Checks every knob; the error names the first offending one.
     pub fn validate(&self) -> Result<(), VariantError> {
+        crate::variant::validate_single_light(self.light)?;
         if !(1..=MAX_RANK).contains(&self.rank) {
             return Err(VariantError {
                 knob: "rank",

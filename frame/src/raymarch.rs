@@ -92,6 +92,7 @@ impl RaymarchVariant {
 
     /// Checks every knob; the error names the first offending one.
     pub fn validate(&self) -> Result<(), VariantError> {
+        crate::variant::validate_single_light(self.light)?;
         if !Self::INTERLEAVE.contains(&self.interleave) {
             return Err(VariantError {
                 knob: "interleave",
@@ -152,7 +153,7 @@ impl RaymarchVariant {
         for samples in [8, 32, 128] {
             for interleave in [1, 2, 4] {
                 for jitter in [false, true] {
-                    for &light in LightKind::ALL {
+                    for &light in LightKind::SINGLE {
                         let v = RaymarchVariant {
                             samples,
                             interleave,

@@ -21,6 +21,18 @@ pub enum LightKind {
     Directional,
     /// A spot light (rays from a point, cone falloff, 1/d^2, extinction along the light path).
     Spot,
+    /// An area light ([`crate::area_light::AreaLightDesc`]): soft shadows, rendered by the
+    /// `area_ivsv` family as virtual point lights. The single-light families refuse it (they
+    /// render its point limit, a spot, instead).
+    Area,
+}
+
+impl LightKind {
+    /// The lights one standard shadow map serves: what every single-light family renders.
+    pub const SINGLE: &'static [LightKind] = &[LightKind::Directional, LightKind::Spot];
+
+    /// [`Self::SINGLE`]'s names, as the single-light families' `light` knob lists them.
+    pub const SINGLE_ALLOWED: &'static str = "directional | spot";
 }
 
 /// The camera of one frame (the engine's view).
@@ -65,6 +77,10 @@ pub enum LightDesc {
         /// Intensity I (RGB).
         color: [f64; 3],
     },
+    /// Area light: the `area_ivsv` family's. With it, the frame's standard shadow map is the
+    /// light's point limit's ([`crate::area_light::AreaLightDesc::point_limit`]), the
+    /// template of every VPL's map.
+    Area(crate::area_light::AreaLightDesc),
 }
 
 impl LightDesc {
@@ -73,6 +89,7 @@ impl LightDesc {
         match self {
             LightDesc::Directional { .. } => LightKind::Directional,
             LightDesc::Spot { .. } => LightKind::Spot,
+            LightDesc::Area(_) => LightKind::Area,
         }
     }
 }
@@ -388,6 +405,13 @@ pub(crate) fn validate_scene(
                 inner_deg.to_radians().cos(),
                 outer_deg.to_radians().cos(),
             )
+        }
+        LightDesc::Area(_) => {
+            return Err(FrameError::OutOfRange {
+                what: "light",
+                allowed: "a directional or spot light (an area light's VPLs are spots)",
+                value: "an area light".into(),
+            });
         }
     };
     require(

@@ -117,8 +117,29 @@ fn stringify_knob<T: 'static>() -> &'static str {
     }
 }
 
+/// Checks a single-light family's `light` knob: one standard shadow map serves a directional
+/// or a spot light; an area light is the `area_ivsv` family's.
+///
+/// # Errors
+///
+/// A [`VariantError`] naming `light` for [`LightKind::Area`].
+pub fn validate_single_light(light: LightKind) -> Result<(), VariantError> {
+    if LightKind::SINGLE.contains(&light) {
+        Ok(())
+    } else {
+        Err(VariantError {
+            knob: "light",
+            value: light.to_string(),
+            allowed: format!(
+                "{} (an area light is rendered by the area_ivsv family, or as its point limit, a spot)",
+                LightKind::SINGLE_ALLOWED
+            ),
+        })
+    }
+}
+
 names!(VisibilityMode, [Average => "average", Weighted => "weighted"]);
-names!(LightKind, [Directional => "directional", Spot => "spot"]);
+names!(LightKind, [Directional => "directional", Spot => "spot", Area => "area"]);
 names!(Storage, [Rgba16float => "rgba16float", Rgba32float => "rgba32float", Rgba8unorm => "rgba8unorm"]);
 names!(Rectification, [Epipolar => "epipolar", Projective => "projective"]);
 names!(Basis, [Fourier => "fourier", Moments => "moments"]);
@@ -258,6 +279,7 @@ impl PrefilteredVariant {
 
     /// Checks every knob; the error names the first offending one.
     pub fn validate(&self) -> Result<(), VariantError> {
+        validate_single_light(self.light)?;
         let d = Self::default();
         if self.basis == Basis::Moments {
             if !Self::MOMENTS.contains(&self.moments) {
@@ -352,7 +374,7 @@ impl PrefilteredVariant {
             for bases_per_thread in Self::bases_per_thread_options(bases) {
                 for r in regions.clone() {
                     for &visibility in VisibilityMode::ALL {
-                        for &light in LightKind::ALL {
+                        for &light in LightKind::SINGLE {
                             for &storage in Storage::ALL {
                                 for &rectification in Rectification::ALL {
                                     out.push(PrefilteredVariant {
@@ -375,7 +397,7 @@ impl PrefilteredVariant {
         for moments in Self::MOMENTS {
             for r in regions.clone() {
                 for &visibility in VisibilityMode::ALL {
-                    for &light in LightKind::ALL {
+                    for &light in LightKind::SINGLE {
                         for &rectification in Rectification::ALL {
                             out.push(PrefilteredVariant {
                                 regions: r,

@@ -22,6 +22,8 @@ use std::time::Instant;
 use glam::DVec3;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
+use scatter_frame::area_ivsv::{AreaIvsvFrame, AreaIvsvVariant, prepare_area_light};
+use scatter_frame::area_light::{AreaLightDesc, AreaShapeDesc};
 use scatter_frame::family::FamilyVariant;
 use scatter_frame::frame::{
     CameraDesc, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame, Resolutions,
@@ -428,16 +430,32 @@ fn base_case(
                 },
             )
         }
-        LightKind::Spot => {
+        LightKind::Spot | LightKind::Area => {
             let position = camera.position - travel * 12.0 + DVec3::new(0.3, 0.2, -0.1);
             let axis = (camera.position + forward * 5.0 - position).normalize();
             (
-                LightDesc::Spot {
-                    position,
-                    direction: axis,
-                    inner_deg: 20.0,
-                    outer_deg: 30.0,
-                    color: [40.0, 35.0, 30.0],
+                if family.light() == LightKind::Area {
+                    LightDesc::Area(AreaLightDesc {
+                        position,
+                        direction: axis,
+                        up: None,
+                        shape: AreaShapeDesc::Rect {
+                            width: 1.5,
+                            height: 0.75,
+                        },
+                        inner_deg: 20.0,
+                        outer_deg: 30.0,
+                        radiance: [40.0, 35.0, 30.0],
+                        two_sided: false,
+                    })
+                } else {
+                    LightDesc::Spot {
+                        position,
+                        direction: axis,
+                        inner_deg: 20.0,
+                        outer_deg: 30.0,
+                        color: [40.0, 35.0, 30.0],
+                    }
                 },
                 ShadowMapDesc {
                     origin: position,
@@ -484,25 +502,34 @@ impl Case {
                 Mutation::NearFromFar(f) => self.camera.near = self.camera.far * f,
                 Mutation::LightDirection(v) => match &mut self.light {
                     LightDesc::Directional { direction, .. }
-                    | LightDesc::Spot { direction, .. } => *direction = v.get(&cam0),
+                    | LightDesc::Spot { direction, .. }
+                    | LightDesc::Area(AreaLightDesc { direction, .. }) => {
+                        *direction = v.get(&cam0);
+                    }
                 },
-                Mutation::LightPosition(v) => {
-                    if let LightDesc::Spot { position, .. } = &mut self.light {
+                Mutation::LightPosition(v) => match &mut self.light {
+                    LightDesc::Spot { position, .. }
+                    | LightDesc::Area(AreaLightDesc { position, .. }) => {
                         *position = v.get(&cam0);
                     }
-                }
-                Mutation::InnerDeg(x) => {
-                    if let LightDesc::Spot { inner_deg, .. } = &mut self.light {
-                        *inner_deg = x;
-                    }
-                }
-                Mutation::OuterDeg(x) => {
-                    if let LightDesc::Spot { outer_deg, .. } = &mut self.light {
-                        *outer_deg = x;
-                    }
-                }
+                    LightDesc::Directional { .. } => {}
+                },
+                Mutation::InnerDeg(x) => match &mut self.light {
+                    LightDesc::Spot { inner_deg, .. }
+                    | LightDesc::Area(AreaLightDesc { inner_deg, .. }) => *inner_deg = x,
+                    LightDesc::Directional { .. } => {}
+                },
+                Mutation::OuterDeg(x) => match &mut self.light {
+                    LightDesc::Spot { outer_deg, .. }
+                    | LightDesc::Area(AreaLightDesc { outer_deg, .. }) => *outer_deg = x,
+                    LightDesc::Directional { .. } => {}
+                },
                 Mutation::LightColor(i, x) => match &mut self.light {
-                    LightDesc::Directional { color, .. } | LightDesc::Spot { color, .. } => {
+                    LightDesc::Directional { color, .. }
+                    | LightDesc::Spot { color, .. }
+                    | LightDesc::Area(AreaLightDesc {
+                        radiance: color, ..
+                    }) => {
                         color[i] = x;
                     }
                 },
@@ -550,6 +577,7 @@ impl Case {
                         LightDesc::Spot {
                             direction, color, ..
                         } => LightDesc::Directional { direction, color },
+                        LightDesc::Area(a) => a.point_limit(),
                     };
                 }
             }
@@ -565,6 +593,7 @@ fn family() -> impl Strategy<Value = FamilyVariant> {
         prop::sample::select(MinmaxVariant::grid()).prop_map(FamilyVariant::Minmax),
         prop::sample::select(HybridVolumeVariant::grid()).prop_map(FamilyVariant::HybridVolume),
         prop::sample::select(PartialSumTreeVariant::grid()).prop_map(FamilyVariant::PartialSumTree),
+        prop::sample::select(AreaIvsvVariant::grid()).prop_map(FamilyVariant::AreaIvsv),
     ]
 }
 
@@ -733,8 +762,39 @@ fn check_raymarch_uniforms(u: &RaymarchUniforms) -> Result<(), TestCaseError> {
     Ok(())
 }
 
+fn check_area_frame(frame: &AreaIvsvFrame) -> Result<(), TestCaseError> {
+    for (i, r) in frame.vpls.iter().enumerate() {
+        for (what, v) in [
+            ("position", r.position),
+            ("color", r.color),
+            ("axis", r.axis),
+            ("perp_x", r.perp_x),
+            ("perp_y", r.perp_y),
+            ("spot_dir", r.spot_dir),
+            ("sm_origin", r.sm_origin),
+            ("sm_proj", r.sm_proj),
+        ] {
+            finite4(&format!("vpl[{i}].{what}"), v)?;
+        }
+        prop_assert!(r.perp_x[3] > 0.0, "vpl[{i}] alpha bin width {}", r.perp_x[3]);
+    }
+    for (what, v) in [("eye", frame.uniforms.eye), ("medium", frame.uniforms.medium)] {
+        finite4(what, v)?;
+    }
+    Ok(())
+}
+
 fn check_case(case: Case) -> Result<(), TestCaseError> {
     let result = match case.family {
+        FamilyVariant::AreaIvsv(v) => prepare_area_light(
+            &v,
+            case.res.screen,
+            &case.camera,
+            &case.light,
+            &case.medium,
+            &case.shadow,
+        )
+        .map(|(f, _)| check_area_frame(&f)),
         FamilyVariant::Prefiltered(v) => prepare_frame(
             &v,
             &case.res,
@@ -891,6 +951,16 @@ fn every_family_on_arbitrary_numbers() {
                     direction: light.1,
                     color: [light.2, light.3, light.4],
                 },
+                LightKind::Area => LightDesc::Area(AreaLightDesc {
+                    position: light.0,
+                    direction: light.1,
+                    up: None,
+                    shape: AreaShapeDesc::Disk { radius: light.4 },
+                    inner_deg: light.2,
+                    outer_deg: light.3,
+                    radiance: [light.4; 3],
+                    two_sided: false,
+                }),
                 LightKind::Spot => LightDesc::Spot {
                     position: light.0,
                     direction: light.1,
