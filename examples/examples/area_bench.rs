@@ -153,6 +153,7 @@ fn vpl_inputs(vpl: &Scene, gbuf: &GBuffer, sm: &ShadowMap) -> CpuInputs {
         rectified: None,
         pass_wall_frames: 0,
         cookie: None,
+        vpl_maps: None,
     }
 }
 

@@ -20,8 +20,7 @@ use scatter_reference::bvh::Bvh;
 use scatter_reference::kernels::engine_rectified_map;
 use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightDesc, LightKind, PrefilteredVariant, Rectification, Resolutions,
-    prepare_frame,
+    FrameSettings, PrefilteredVariant, Rectification, Resolutions, prepare_frame,
 };
 
 /// Writes frame.json and the PFM inputs of the foreign engine for a suite scene.
@@ -74,10 +73,7 @@ fn run(args: &Args) -> Result<(), String> {
     let settings = FrameSettings::for_screen(gbuf.width, gbuf.height);
     let (camera, light, medium) = (scene.camera_desc(), scene.light_desc(), scene.medium_desc());
     let variant = PrefilteredVariant {
-        light: match light {
-            LightDesc::Directional { .. } => LightKind::Directional,
-            LightDesc::Spot { .. } => LightKind::Spot,
-        },
+        light: light.kind(),
         rectification: args.rectification,
         ..PrefilteredVariant::default()
     };

@@ -664,6 +664,18 @@ fn minmax_times(t: MinmaxTimes) -> PassTimes {
     out
 }
 
+fn area_ivsv_times(t: scatter_runtime::AreaIvsvTimes, interleaved: bool) -> PassTimes {
+    let mut out = vec![
+        (Kernel::IvsvRectify.name(), t.rectify),
+        (Kernel::IvsvScan.name(), t.scan),
+        (Kernel::IvsvGather.name(), t.gather),
+    ];
+    if interleaved {
+        out.push((Kernel::IvsvInterleaveSum.name(), t.interleave_sum));
+    }
+    out
+}
+
 fn hybrid_volume_times(t: HybridVolumeTimes) -> PassTimes {
     let mut out = vec![
         (Kernel::DepthColumns.name(), t.depth_columns),
@@ -767,7 +779,38 @@ fn run_on_gpu(
     };
     let variant = plan.variant;
     let mut pass_walls: Option<PassTimes> = None;
+    // An area light's VPL maps (the engine's path: placed and framed by the frame set-up,
+    // ray-cast here).
+    let area_inputs = match &variant {
+        FamilyVariant::AreaIvsv(v) => Some(scatter_reference::kernels::ivsv_inputs(
+            scene, gbuf, bvh, v, sm.size,
+        )?),
+        _ => None,
+    };
     let mut run_frame: FrameRunner<'_> = match &variant {
+        FamilyVariant::AreaIvsv(v) => {
+            let ctx = &ctx;
+            let inputs = area_inputs.as_ref().ok_or("no VPL maps")?;
+            Box::new(move |_| {
+                let rb = scatter_runtime::run_area_ivsv_once(
+                    ctx,
+                    v,
+                    res.screen,
+                    &frame.camera,
+                    &frame.medium,
+                    &inputs.vpls,
+                    sm.size,
+                    &gbuf.view_depth,
+                    &inputs.map_data,
+                )?;
+                Ok(GpuFrame {
+                    output: rb.output,
+                    report: None,
+                    wall_time: rb.wall_time,
+                    gpu_times: rb.gpu_times.map(|t| area_ivsv_times(t, v.interleave > 1)),
+                })
+            })
+        }
         FamilyVariant::Prefiltered(v) => {
             // A projective frame needs the engine's rasterised rectified map (ray cast
             // here).
@@ -787,6 +830,7 @@ fn run_on_gpu(
                 rectified: engine_rectified_map(scene, bvh, &prepared),
                 pass_wall_frames: 0,
                 cookie: cookie_texels(scene, variant),
+                vpl_maps: None,
             };
             let ctx = &ctx;
             let pass_walls = &mut pass_walls;
@@ -914,6 +958,7 @@ fn run_on_gpu(
             gbuf,
             sm,
             cookie_texels(scene, variant),
+            area_inputs.as_ref().map(|i| &i.map_data[..]),
             pass_wall_frames,
         )?);
     }
@@ -974,6 +1019,7 @@ fn measure_pass_walls(
     gbuf: &GBuffer,
     sm: &ShadowMap,
     cookie: Option<([u32; 2], Vec<[f32; 4]>)>,
+    vpl_maps: Option<&[f32]>,
     frames: u32,
 ) -> Result<PassTimes, BoxError> {
     let mut pass = FamilyPasses::new(ctx, variant, res, sm.size)?;
@@ -1001,10 +1047,20 @@ fn measure_pass_walls(
         depth.create_view(&Default::default()),
         shadow.create_view(&Default::default()),
     );
+    let vpl_maps = match vpl_maps {
+        Some(data) => {
+            let layers = u32::try_from(data.len() / (sm.size as usize).pow(2))?;
+            Some(scatter_runtime::upload_vpl_maps(
+                ctx, sm.size, layers, data,
+            )?)
+        }
+        None => None,
+    };
     let inputs = Inputs {
         depth: &dv,
         shadow_map: Some(&sv),
         rectified: None,
+        vpl_maps: vpl_maps.as_ref().map(|(_, v)| v),
     };
     Ok(pass
         .measure_pass_wall_times(ctx, &inputs, frames)?

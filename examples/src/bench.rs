@@ -568,6 +568,7 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
             depth: &depth_view,
             shadow_map: Some(&shadow_view),
             rectified: None,
+            vpl_maps: None,
         };
         let times = time_interleaved(ctx, &runs, &inputs, config.frames)?;
         for ((method, (_, output, gpu_timestamps)), passes) in
@@ -653,6 +654,7 @@ fn run_method(
         depth: dv,
         shadow_map: Some(sv),
         rectified: None,
+        vpl_maps: None,
     };
     let mut encoder = ctx.device().create_command_encoder(&Default::default());
     pass.encode(ctx, &mut encoder, &inputs)?;
@@ -797,6 +799,7 @@ fn time_methods_on(
         depth: dv,
         shadow_map: Some(sv),
         rectified: None,
+        vpl_maps: None,
     };
     let times = time_interleaved(ctx, &runs, &inputs, frames)?;
     Ok(times
@@ -973,6 +976,7 @@ fn scaling_runs(ctx: &Context, frames: u32) -> Result<Vec<ScalingRow>, BoxError>
                 depth: &dv,
                 shadow_map: Some(&sv),
                 rectified: None,
+                vpl_maps: None,
             },
             frames,
         )?;
@@ -1536,6 +1540,7 @@ fn family_colour(family: Family) -> plotters::style::RGBColor {
         Family::Minmax => GREEN,
         Family::PartialSumTree => MAGENTA,
         Family::HybridVolume => plotters::style::RGBColor(230, 140, 0),
+        Family::AreaIvsv => plotters::style::RGBColor(0, 150, 150),
     }
 }
 

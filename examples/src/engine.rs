@@ -735,6 +735,7 @@ impl Engine {
                     depth: &depth_view,
                     shadow_map: Some(&shadow_view),
                     rectified: rectified_view.as_ref(),
+                    vpl_maps: None,
                 },
             )
             .map_err(|e| format!("{family_name} encode: {e}"))?;

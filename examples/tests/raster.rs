@@ -189,7 +189,9 @@ fn reachable(
             let l = direction.normalize();
             (p0 - l * reach, l)
         }
-        LightDesc::Spot { position, .. } => {
+        // An area light's projective map is its point limit's.
+        LightDesc::Spot { position, .. }
+        | LightDesc::Area(scatter_shaderlib::area_ivsv::AreaLightDesc { position, .. }) => {
             let mut v = (p1 - p0).normalize();
             if (*m * v.extend(0.0)).w < 0.0 {
                 v = -v;
@@ -334,6 +336,7 @@ fn gpu_error(
             depth: &dv,
             shadow_map: Some(&sv),
             rectified: rv.as_ref(),
+            vpl_maps: None,
         },
     )
     .unwrap_or_else(|e| panic!("encode: {e}"));

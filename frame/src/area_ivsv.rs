@@ -119,8 +119,7 @@ impl AreaIvsvVariant {
             return Err(VariantError {
                 knob: "light",
                 value: self.light.to_string(),
-                allowed: "area (directional and spot lights are the single-light families')"
-                    .into(),
+                allowed: "area (directional and spot lights are the single-light families')".into(),
             });
         }
         if self.sampling_knobs() != SamplingKnobs::default() {

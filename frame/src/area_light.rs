@@ -18,8 +18,8 @@
 
 use crate::area_ivsv::VplInput;
 use crate::scene::{
-    FrameError, LightDesc, MAX_COLOR, ShadowMapDesc, ShadowProjectionDesc, in_world, require,
-    show, unit,
+    FrameError, LightDesc, MAX_COLOR, ShadowMapDesc, ShadowProjectionDesc, in_world, require, show,
+    unit,
 };
 use glam::DVec3;
 
@@ -178,7 +178,12 @@ impl AreaLightDesc {
                 && self.outer_deg < MAX_AREA_OUTER_DEG,
             "area light cone angles",
             "0 <= inner_deg <= outer_deg < 80 (each VPL has one perspective shadow map)",
-            || format!("inner_deg {:?}, outer_deg {:?}", self.inner_deg, self.outer_deg),
+            || {
+                format!(
+                    "inner_deg {:?}, outer_deg {:?}",
+                    self.inner_deg, self.outer_deg
+                )
+            },
         )?;
         require(
             self.radiance.iter().all(|c| (0.0..=MAX_COLOR).contains(c)),

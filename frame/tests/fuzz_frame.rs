@@ -776,9 +776,16 @@ fn check_area_frame(frame: &AreaIvsvFrame) -> Result<(), TestCaseError> {
         ] {
             finite4(&format!("vpl[{i}].{what}"), v)?;
         }
-        prop_assert!(r.perp_x[3] > 0.0, "vpl[{i}] alpha bin width {}", r.perp_x[3]);
+        prop_assert!(
+            r.perp_x[3] > 0.0,
+            "vpl[{i}] alpha bin width {}",
+            r.perp_x[3]
+        );
     }
-    for (what, v) in [("eye", frame.uniforms.eye), ("medium", frame.uniforms.medium)] {
+    for (what, v) in [
+        ("eye", frame.uniforms.eye),
+        ("medium", frame.uniforms.medium),
+    ] {
         finite4(what, v)?;
     }
     Ok(())

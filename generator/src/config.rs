@@ -263,7 +263,7 @@ mod tests {
             ),
             (
                 "family = 1",
-                "variant 1: family must be hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch, got 1",
+                "variant 1: family must be area_ivsv | hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch, got 1",
             ),
             (
                 "family = [1]",

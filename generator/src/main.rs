@@ -14,13 +14,22 @@ use clap::{Arg, ArgMatches, Args, Command, FromArgMatches, Parser, Subcommand};
 use scatter_gen::family::KnobInfo;
 use scatter_gen::{Family, FamilyCli, GenError, Request, Target, generate, output};
 
-/// Every knob of every family, deduplicated by name (first family wins the help text).
+/// Every knob of every family, deduplicated by name: the default family (`prefiltered`)
+/// first, whose help text and default win; a family that allows other values adds them
+/// (`directional | spot; area_ivsv: area`).
 fn all_knobs() -> Vec<(KnobInfo, Vec<Family>)> {
     let mut out: Vec<(KnobInfo, Vec<Family>)> = Vec::new();
-    for &f in Family::ALL {
+    let first = Family::Prefiltered;
+    let order = std::iter::once(first).chain(Family::ALL.iter().copied().filter(|&f| f != first));
+    for f in order {
         for k in f.knobs() {
             match out.iter_mut().find(|(e, _)| e.name == k.name) {
-                Some((_, families)) => families.push(f),
+                Some((e, families)) => {
+                    if !e.allowed.split("; ").any(|a| a == k.allowed) {
+                        e.allowed = format!("{}; {f}: {}", e.allowed, k.allowed);
+                    }
+                    families.push(f);
+                }
                 None => out.push((k, vec![f])),
             }
         }

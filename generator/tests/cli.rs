@@ -58,7 +58,7 @@ fn bad_knobs_exit_2_with_one_line_and_write_nothing() {
         ),
         (
             &["--light", "area"],
-            "light must be directional | spot, got area",
+            "light must be directional | spot (an area light is rendered by the area_ivsv family, or as its point limit, a spot), got area",
         ),
         (
             &["--storage", "rgba8"],
@@ -78,7 +78,7 @@ fn bad_knobs_exit_2_with_one_line_and_write_nothing() {
         ),
         (
             &["--family", "raytrace"],
-            "family must be hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch, got raytrace",
+            "family must be area_ivsv | hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch, got raytrace",
         ),
     ];
     for (args, message) in cases {

@@ -130,7 +130,7 @@ fn knob_value() -> impl Strategy<Value = String> {
             "18446744073709551616", "", " ", "true", "false", "on", "off", "TRUE", "average",
             "weighted", "directional", "spot", "rgba8unorm", "rgba16float", "rgba32float",
             "epipolar", "projective", "Spot", " spot", "spot\n", "３２", "NaN", "inf",
-            "prefiltered", "raymarch", "minmax", "partial_sum_tree",
+            "prefiltered", "raymarch", "minmax", "partial_sum_tree", "area", "area_ivsv",
         ])
         .prop_map(str::to_owned),
         2 => (0u32..300).prop_map(|n| n.to_string()),
@@ -147,6 +147,7 @@ fn validates(v: &FamilyVariant) -> bool {
         FamilyVariant::PartialSumTree(v) => v.validate().is_ok(),
         FamilyVariant::Prefiltered(v) => v.validate().is_ok(),
         FamilyVariant::Raymarch(v) => v.validate().is_ok(),
+        FamilyVariant::AreaIvsv(v) => v.validate().is_ok(),
     }
 }
 

@@ -2,8 +2,8 @@
 //! small spot-light variant with average visibility and rgba16float, the moment basis with
 //! 6 moments, an interleaved raymarch variant, the spot-light minmax variant, raymarch
 //! with `sampling = lowres`, scale 4, raymarch with `sampling = epipolar`, 256 slices, and
-//! the spot-light partial-sum-tree variant at rank 8, the spot-light hybrid_volume variant) in
-//! every target, kept
+//! the spot-light partial-sum-tree variant at rank 8, the spot-light hybrid_volume variant,
+//! the interleaved area_ivsv variant with 16 VPLs) in every target, kept
 //! as reviewable text in `tests/golden/` (SPIR-V as `spirv-dis` text; its exact bytes are
 //! pinned by the sha256 in the golden `manifest.json`). Any change to a template, to naga or
 //! to the generator shows up here as a diff.
@@ -67,6 +67,12 @@ fn canonical() -> Generated {
     let hybrid = Family::HybridVolume
         .variant(&[("light".into(), "spot".into())])
         .unwrap_or_else(|e| panic!("{e}"));
+    let area = Family::AreaIvsv
+        .variant(&[
+            ("vpls".into(), "16".into()),
+            ("interleave".into(), "2".into()),
+        ])
+        .unwrap_or_else(|e| panic!("{e}"));
     generate(&Request {
         variants: vec![
             Family::Prefiltered.default_variant(),
@@ -78,6 +84,7 @@ fn canonical() -> Generated {
             epipolar,
             pst,
             hybrid,
+            area,
         ],
         targets: Target::ALL.to_vec(),
     })

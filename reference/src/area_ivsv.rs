@@ -498,7 +498,7 @@ pub fn render(
     let frame = cam.frame();
     let (w, h) = (gbuf.width, gbuf.height);
     let mut sum = vec![[0.0f64; 3]; (w * h) as usize];
-    for vpl in scene.point_light_scenes(settings.vpls) {
+    for (vpl, sm) in ShadowMap::vpl_maps(scene, bvh, settings.vpls, settings.map_size)? {
         let Light::Spot {
             position,
             intensity,
@@ -510,7 +510,6 @@ pub fn render(
                 scene.name
             )));
         };
-        let sm = ShadowMap::build(&vpl, bvh, settings.map_size)?;
         let mut grid = EpipolarGrid::new(cam.position, *position, settings.alpha, settings.theta);
         grid.fit(&vpl);
         grid.rectify(&sm);

@@ -156,11 +156,9 @@ pub enum ShadowMapError {
         "light.outer_angle_deg must be below 80 degrees for a single perspective shadow map, got {0}"
     )]
     ConeTooWide(f64),
-    /// An area light has no one shadow map.
-    #[error(
-        "an area light has one shadow map per virtual point light: build them from Scene::point_light_scenes"
-    )]
-    AreaLight,
+    /// The VPLs of an area light cannot be placed (`AreaLightDesc::vpl_inputs`).
+    #[error("area light VPLs: {0}")]
+    Vpl(#[from] scatter_shaderlib::prefiltered::FrameError),
 }
 
 /// A standard light shadow map (see the module docs for the exact conventions).
@@ -197,15 +195,103 @@ pub struct ShadowCoord {
 
 /// The light frame (right, up, forward) of a spot or directional light travelling along
 /// `forward`: the shadow map's basis, and the frame a spot's cookie is projected in.
-pub fn light_basis(forward: DVec3) -> [DVec3; 3] {
-    let f = forward.normalize();
-    let helper = if f.y.abs() < 0.99 { DVec3::Y } else { DVec3::X };
-    let right = f.cross(helper).normalize();
-    let up = right.cross(f);
-    [right, up, f]
-}
+pub use scatter_shaderlib::area_ivsv::light_basis;
 
 impl ShadowMap {
+    /// A map with `desc`'s frame and no depth yet ([`ShadowMap::cast`] fills it).
+    pub fn from_desc(desc: &scatter_shaderlib::prefiltered::ShadowMapDesc) -> ShadowMap {
+        use scatter_shaderlib::prefiltered::ShadowProjectionDesc;
+        ShadowMap {
+            size: desc.size,
+            depth: Vec::new(),
+            origin: desc.origin,
+            basis: desc.basis,
+            projection: match desc.projection {
+                ShadowProjectionDesc::Orthographic { x0, x1, y0, y1 } => {
+                    ShadowProjection::Orthographic { x0, x1, y0, y1 }
+                }
+                ShadowProjectionDesc::Perspective { tan_half } => {
+                    ShadowProjection::Perspective { tan_half }
+                }
+            },
+            near: desc.near,
+            far: desc.far,
+        }
+    }
+
+    /// Ray casts the depth of a map whose frame is set (a spot's or a VPL's: no backlit
+    /// planes to account for).
+    pub fn cast(mut self, bvh: &Bvh) -> ShadowMap {
+        let n = self.size as usize;
+        self.depth = (0..n * n)
+            .into_par_iter()
+            .map(|i| {
+                let (ix, iy) = (i % n, i / n);
+                let u = (ix as f64 + 0.5) / n as f64;
+                let v = (iy as f64 + 0.5) / n as f64;
+                let (ray, z_of_t) = self.texel_ray(u, v);
+                match bvh.closest(&ray, 0.0, f64::INFINITY) {
+                    Some(hit) => self.normalise(z_of_t(hit.t)).clamp(0.0, 1.0) as f32,
+                    None => 1.0,
+                }
+            })
+            .collect();
+        self
+    }
+
+    /// The template of an area scene's VPL maps: the standard map [`ShadowMap::fit`] fits
+    /// for the light's point limit, as an engine fits it (for any other scene, its own
+    /// map's frame).
+    ///
+    /// # Errors
+    ///
+    /// As [`ShadowMap::fit`].
+    pub fn area_template(
+        scene: &Scene,
+        bvh: &Bvh,
+        size: u32,
+    ) -> Result<scatter_shaderlib::prefiltered::ShadowMapDesc, ShadowMapError> {
+        Ok(ShadowMap::fit(scene, bvh, size)?.desc())
+    }
+
+    /// The `points` VPLs of an area scene (`points * faces`; [`crate::scene::AreaLight::vpls`])
+    /// as spot scenes, each with its shadow map: the frames `scatter_frame`'s
+    /// `AreaLightDesc::vpl_inputs` derives from the map the point limit's scene fits
+    /// ([`ShadowMap::fit`]), which an engine renders too, ray-cast. Any other scene: itself
+    /// and its standard map ([`ShadowMap::build`]).
+    ///
+    /// # Errors
+    ///
+    /// As [`ShadowMap::build`], and [`ShadowMapError::Vpl`] for VPLs that cannot be placed.
+    pub fn vpl_maps(
+        scene: &Scene,
+        bvh: &Bvh,
+        points: usize,
+        size: u32,
+    ) -> Result<Vec<(Scene, ShadowMap)>, ShadowMapError> {
+        let Light::Area(area) = &scene.light else {
+            return Ok(vec![(scene.clone(), ShadowMap::build(scene, bvh, size)?)]);
+        };
+        let template = ShadowMap::area_template(scene, bvh, size)?;
+        let desc = area.desc();
+        let count = u32::try_from(points * desc.faces()).unwrap_or(u32::MAX);
+        let inputs = desc.vpl_inputs(count, &template)?;
+        Ok(inputs
+            .into_iter()
+            .enumerate()
+            .map(|(i, vpl)| {
+                let light = Light::from_spot_desc(&vpl.light);
+                let map = ShadowMap::from_desc(&vpl.shadow_map).cast(bvh);
+                let s = Scene {
+                    name: format!("{}/vpl{i}", scene.name),
+                    light,
+                    ..scene.clone()
+                };
+                (s, map)
+            })
+            .collect())
+    }
+
     /// Ray casts a `size x size` shadow map for the scene's light (see module docs).
     pub fn build(scene: &Scene, bvh: &Bvh, size: u32) -> Result<ShadowMap, ShadowMapError> {
         let mut sm = ShadowMap::fit(scene, bvh, size)?;
@@ -334,7 +420,15 @@ impl ShadowMap {
                     far,
                 }
             }
-            Light::Area(_) => return Err(ShadowMapError::AreaLight),
+            // The standard map of an area light is its point limit's: the template of its
+            // VPLs' maps (`ShadowMap::vpl_maps`).
+            Light::Area(area) => {
+                let limit = Scene {
+                    light: area.point_limit(),
+                    ..scene.clone()
+                };
+                return ShadowMap::fit(&limit, bvh, size);
+            }
         };
         Ok(sm)
     }

@@ -25,10 +25,9 @@ impl Scene {
         }
     }
 
-    /// The light as the kernels see it. An area light is seen as its point limit
-    /// ([`crate::scene::AreaLight::point_limit`]): the kernels render one point light per
-    /// pass, so an area light's soft shadows are its VPL scenes' passes
-    /// ([`Scene::point_light_scenes`]).
+    /// The light as the kernels see it (an area light as `LightDesc::Area`: the
+    /// `area_ivsv` family's; the single-light families refuse it and render its point
+    /// limit's scene or its VPL scenes, [`Scene::point_light_scenes`]).
     pub fn light_desc(&self) -> LightDesc {
         light_desc(&self.light)
     }
@@ -67,7 +66,7 @@ fn light_desc(light: &Light) -> LightDesc {
             outer_deg: *outer_angle_deg,
             color: *intensity,
         },
-        Light::Area(a) => light_desc(&a.point_limit()),
+        Light::Area(a) => LightDesc::Area(a.desc()),
     }
 }
 

@@ -54,7 +54,12 @@ pub fn rasterise_rectified(
                             let l = direction.normalize();
                             Ray::new(p0 - l * reach, l)
                         }
-                        LightDesc::Spot { position, .. } => {
+                        // An area light's projective map is its point limit's.
+                        LightDesc::Spot { position, .. }
+                        | LightDesc::Area(scatter_shaderlib::area_ivsv::AreaLightDesc {
+                            position,
+                            ..
+                        }) => {
                             // Both unprojected points lie on the texel's line through the
                             // lamp (maybe on its far side); the light ray leaves the lamp
                             // towards the frustum's side, where clip w (the distance along

@@ -235,6 +235,15 @@ pub enum AreaShape {
 }
 
 impl AreaShape {
+    /// The outline as the kernels' set-up takes it.
+    pub fn desc(&self) -> scatter_shaderlib::area_ivsv::AreaShapeDesc {
+        use scatter_shaderlib::area_ivsv::AreaShapeDesc;
+        match *self {
+            AreaShape::Rect { width, height } => AreaShapeDesc::Rect { width, height },
+            AreaShape::Disk { radius } => AreaShapeDesc::Disk { radius },
+        }
+    }
+
     /// Surface area (one side), m^2.
     pub fn area(&self) -> f64 {
         match *self {
@@ -248,22 +257,7 @@ impl AreaShape {
     /// concentric map; both preserve area, so uniform or low-discrepancy points in the square
     /// stay so on the light.
     pub fn point(&self, u: f64, v: f64) -> (f64, f64) {
-        match *self {
-            AreaShape::Rect { width, height } => ((u - 0.5) * width, (v - 0.5) * height),
-            AreaShape::Disk { radius } => {
-                let (a, b) = (2.0 * u - 1.0, 2.0 * v - 1.0);
-                if a == 0.0 && b == 0.0 {
-                    return (0.0, 0.0);
-                }
-                let q = std::f64::consts::FRAC_PI_4;
-                let (r, phi) = if a.abs() > b.abs() {
-                    (a, q * (b / a))
-                } else {
-                    (b, 2.0 * q - q * (a / b))
-                };
-                (radius * r * phi.cos(), radius * r * phi.sin())
-            }
-        }
+        self.desc().point(u, v)
     }
 
     /// The largest distance of a point of the outline from its centre.
@@ -309,21 +303,30 @@ pub struct AreaLight {
 }
 
 impl AreaLight {
+    /// The light as the kernels' set-up takes it (`LightDesc::Area`): the VPL placement
+    /// and the VPLs' maps are its ([`scatter_shaderlib::area_ivsv::AreaLightDesc`]).
+    pub fn desc(&self) -> scatter_shaderlib::area_ivsv::AreaLightDesc {
+        scatter_shaderlib::area_ivsv::AreaLightDesc {
+            position: self.position,
+            direction: self.direction,
+            up: self.up,
+            shape: self.shape.desc(),
+            inner_deg: self.inner_angle_deg,
+            outer_deg: self.outer_angle_deg,
+            radiance: self.radiance,
+            two_sided: self.two_sided,
+        }
+    }
+
     /// The light's frame: right and up span its plane, `normal` is the emitting normal.
     pub fn frame(&self) -> (DVec3, DVec3, DVec3) {
-        let n = self.direction.normalize();
-        let up = match self.up {
-            Some(up) => (up - n * up.dot(n)).normalize(),
-            None => crate::buffers::light_basis(n)[1],
-        };
-        (up.cross(n), up, n)
+        let [right, up, n] = self.desc().frame();
+        (right, up, n)
     }
 
     /// The world point of the light for `(u, v)` in the unit square ([`AreaShape::point`]).
     pub fn point(&self, u: f64, v: f64) -> DVec3 {
-        let (right, up, _) = self.frame();
-        let (x, y) = self.shape.point(u, v);
-        self.position + right * x + up * y
+        self.desc().point(u, v)
     }
 
     /// The spots a point `p` of the light stands for: one per emitting face, along the
@@ -354,14 +357,11 @@ impl AreaLight {
     /// intensity `radiance * area / n`: their sum tends to the light as `n` grows, and
     /// the first `n` of `m > n` points are the same `n` points.
     pub fn vpls(&self, n: usize) -> Vec<Light> {
-        let scale = self.shape.area() / n.max(1) as f64;
-        let intensity = self.radiance.map(|c| c * scale);
-        let mut out = Vec::with_capacity(n * self.faces());
-        for i in 1..=n {
-            let p = self.point(halton(i, 2), halton(i, 3));
-            out.extend(self.spots_at(p, intensity));
-        }
-        out
+        self.desc()
+            .vpl_lights(n)
+            .iter()
+            .map(Light::from_spot_desc)
+            .collect()
     }
 
     /// The `exact` truth's `m` points of the light as spots (`2 m` when two-sided), each
@@ -452,28 +452,51 @@ impl AreaLight {
     }
 }
 
-/// The `i`-th point of the van der Corput sequence in `base` (radical inverse), in [0, 1).
-pub fn halton(mut i: usize, base: usize) -> f64 {
-    let mut f = 1.0;
-    let mut r = 0.0;
-    let b = base as f64;
-    while i > 0 {
-        f /= b;
-        r += f * (i % base) as f64;
-        i /= base;
-    }
-    r
-}
+pub use scatter_shaderlib::area_ivsv::halton;
 
 impl Light {
-    /// The light type, as variants are compiled for it.
-    /// An area light is rendered by passes over its virtual point lights, which are spots:
-    /// its kind is [`LightKind::Spot`](scatter_shaderlib::prefiltered::LightKind::Spot).
+    /// The light type, as variants are compiled for it (an area light's is `area`: the
+    /// `area_ivsv` family's; the single-light families render its point limit's scene).
     pub fn kind(&self) -> scatter_shaderlib::prefiltered::LightKind {
         use scatter_shaderlib::prefiltered::LightKind;
         match self {
             Light::Directional { .. } => LightKind::Directional,
-            Light::Spot { .. } | Light::Area(_) => LightKind::Spot,
+            Light::Spot { .. } => LightKind::Spot,
+            Light::Area(_) => LightKind::Area,
+        }
+    }
+
+    /// The light of the kernels' description: a VPL's spot as a spot, a sun as a sun, an
+    /// area light as its point limit.
+    pub(crate) fn from_spot_desc(desc: &scatter_shaderlib::prefiltered::LightDesc) -> Light {
+        use scatter_shaderlib::prefiltered::LightDesc;
+        match *desc {
+            LightDesc::Spot {
+                position,
+                direction,
+                inner_deg,
+                outer_deg,
+                color,
+            } => Light::Spot {
+                position,
+                direction,
+                inner_angle_deg: inner_deg,
+                outer_angle_deg: outer_deg,
+                intensity: color,
+                cookie: None,
+            },
+            LightDesc::Directional { direction, color } => Light::Directional {
+                direction,
+                irradiance: color,
+            },
+            LightDesc::Area(a) => Light::Spot {
+                position: a.position,
+                direction: a.direction,
+                inner_angle_deg: a.inner_deg,
+                outer_angle_deg: a.outer_deg,
+                intensity: a.radiance.map(|c| c * a.shape.area()),
+                cookie: None,
+            },
         }
     }
 

@@ -394,7 +394,7 @@ pub fn render(
 
 /// The `vpl` truth of an area light: the sum of the spot truths of its `n` virtual point
 /// lights ([`crate::scene::AreaLight::vpls`]; `2 n` when two-sided), each looked up in its
-/// own `map_size`^2 shadow map ([`ShadowMap::build`]). For any other light, the
+/// own `map_size`^2 shadow map ([`ShadowMap::vpl_maps`]: the maps an engine renders). For any other light, the
 /// `shadow_map` truth with one map of that size.
 ///
 /// # Errors
@@ -410,8 +410,7 @@ pub fn render_vpl(
 ) -> Result<Image, ShadowMapError> {
     // Summed in f64: 2 n images of similar magnitude.
     let mut sum = vec![[0.0f64; 3]; (gbuf.width * gbuf.height) as usize];
-    for vpl in scene.point_light_scenes(n) {
-        let sm = ShadowMap::build(&vpl, bvh, map_size)?;
+    for (vpl, sm) in ShadowMap::vpl_maps(scene, bvh, n, map_size)? {
         let img = render(&vpl, gbuf, &Visibility::ShadowMap(&sm), settings, &|| ());
         for (acc, px) in sum.iter_mut().zip(&img.data) {
             for k in 0..3 {

@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use scatter_reference::area_suite::{self, AreaSceneName};
-use scatter_reference::buffers::{GBuffer, ShadowMap, ShadowMapError};
+use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::metrics;
 use scatter_reference::scene::{AreaLight, AreaShape, Light, Scene, SceneError, halton};
@@ -262,26 +262,40 @@ fn disk_points_are_uniform_in_area() {
 }
 
 #[test]
-fn an_area_light_has_no_single_shadow_map_and_point_light_scenes_expand_it() {
+fn an_area_light_s_standard_map_is_its_point_limit_s_and_vpl_maps_expand_it() {
     let s = base();
     let bvh = Bvh::build(&s.geometry);
-    let err = ShadowMap::build(&s, &bvh, 64).unwrap_err();
-    assert_eq!(err, ShadowMapError::AreaLight);
-    assert!(err.to_string().contains("point_light_scenes"), "{err}");
-    let vpls = s.point_light_scenes(8);
-    assert_eq!(vpls.len(), 8);
-    for (i, v) in vpls.iter().enumerate() {
-        assert_eq!(v.name, format!("{}/vpl{i}", s.name));
-        assert!(matches!(v.light, Light::Spot { .. }));
-        v.validate().unwrap();
-        ShadowMap::build(v, &bvh, 64).unwrap();
-    }
-    // Any other light is its own point light.
     let spot = Scene {
         light: area(&s).point_limit(),
         ..s.clone()
     };
+    let standard = ShadowMap::build(&s, &bvh, 64).unwrap();
+    let limit = ShadowMap::build(&spot, &bvh, 64).unwrap();
+    assert_eq!(standard.desc(), limit.desc());
+    assert_eq!(standard.depth, limit.depth);
+    let vpls = s.point_light_scenes(8);
+    let maps = ShadowMap::vpl_maps(&s, &bvh, 8, 64).unwrap();
+    assert_eq!(vpls.len(), 8);
+    assert_eq!(maps.len(), 8);
+    for (i, (v, (w, map))) in vpls.iter().zip(&maps).enumerate() {
+        assert_eq!(v.name, format!("{}/vpl{i}", s.name));
+        assert_eq!(v, w);
+        let Light::Spot { position, .. } = v.light else {
+            panic!("{}: a VPL is a spot", v.name)
+        };
+        v.validate().unwrap();
+        // The engine's frame: at the VPL, the template's projection, a far plane that
+        // reaches what the template's reaches.
+        assert_eq!(map.origin, position);
+        assert_eq!(map.size, 64);
+        assert!(map.far >= limit.far);
+        assert_eq!(map.depth.len(), 64 * 64);
+    }
+    // Any other light is its own point light, with its own map.
     assert_eq!(spot.point_light_scenes(8), vec![spot.clone()]);
+    let own = ShadowMap::vpl_maps(&spot, &bvh, 8, 64).unwrap();
+    assert_eq!(own.len(), 1);
+    assert_eq!(own[0].1.depth, limit.depth);
 }
 
 /// A light a millimetre across is its point limit: a spot of intensity `radiance * area`,

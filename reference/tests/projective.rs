@@ -19,10 +19,7 @@ fn check(name: SceneName, pose: Pose, regions: u32) {
     let sc = scene(name, pose, MediumPreset::Default, 160, 90);
     let bvh = Bvh::build(&sc.geometry);
     let sm = ShadowMap::build(&sc, &bvh, 64).expect("shadow map");
-    let light = match sc.light_desc() {
-        LightDesc::Directional { .. } => LightKind::Directional,
-        LightDesc::Spot { .. } => LightKind::Spot,
-    };
+    let light = sc.light_desc().kind();
     let variant = PrefilteredVariant {
         light,
         regions,
@@ -107,6 +104,7 @@ fn check(name: SceneName, pose: Pose, regions: u32) {
                 let l = match sc.light_desc() {
                     LightDesc::Directional { direction, .. } => direction.normalize(),
                     LightDesc::Spot { position, .. } => (p - position).normalize(),
+                    LightDesc::Area(_) => unreachable!("the suite scenes have a sun or a spot"),
                 };
                 let c2 = maps.matrices[r] * (p + l * 0.37).extend(1.0);
                 let col2 = f64::from(first) + (c2.x / c2.w + 1.0) * 0.5 * f64::from(count);
@@ -162,10 +160,7 @@ fn map_matches_shadow_rays(name: SceneName, pose: Pose) -> f64 {
     let sc = scene(name, pose, MediumPreset::Default, 160, 90);
     let bvh = Bvh::build(&sc.geometry);
     let sm = ShadowMap::build(&sc, &bvh, 64).expect("shadow map");
-    let light = match sc.light_desc() {
-        LightDesc::Directional { .. } => LightKind::Directional,
-        LightDesc::Spot { .. } => LightKind::Spot,
-    };
+    let light = sc.light_desc().kind();
     let variant = PrefilteredVariant {
         light,
         rectification: Rectification::Projective,
@@ -214,6 +209,7 @@ fn map_matches_shadow_rays(name: SceneName, pose: Pose) -> f64 {
                     LightDesc::Spot { position, .. } => {
                         ((position - p).normalize(), (position - p).length())
                     }
+                    LightDesc::Area(_) => unreachable!("the suite scenes have a sun or a spot"),
                 };
                 let exact_lit = !bvh.occluded(&Ray::new(p, to_light), 1e-4, dist);
                 let mut map_lit = None;

@@ -8,8 +8,7 @@ use scatter_reference::bvh::Bvh;
 use scatter_reference::suite::{MediumPreset, Pose, SceneName, scene};
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_shaderlib::prefiltered::{
-    FrameSettings, LightDesc, LightKind, PrefilteredVariant, Rectification, Resolutions,
-    prepare_frame,
+    FrameSettings, PrefilteredVariant, Rectification, Resolutions, prepare_frame,
 };
 use scatter_shaderlib::raymarch::{RaymarchVariant, prepare_raymarch};
 
@@ -27,10 +26,7 @@ fn every_suite_frame_is_accepted() {
                 let sc = scene(name, pose, preset, w, h);
                 let bvh = Bvh::build(&sc.geometry);
                 let sm = ShadowMap::build(&sc, &bvh, 16).unwrap_or_else(|e| panic!("{e}"));
-                let light = match sc.light_desc() {
-                    LightDesc::Directional { .. } => LightKind::Directional,
-                    LightDesc::Spot { .. } => LightKind::Spot,
-                };
+                let light = sc.light_desc().kind();
                 let trial = format!("{name:?}/{pose:?}/{preset:?}");
                 let (camera, light_desc, medium, shadow) = (
                     sc.camera_desc(),

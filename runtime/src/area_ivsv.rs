@@ -2,17 +2,22 @@
 //! `ivsv_gather`, built and dispatched from the family's plan
 //! (`scatter_shaderlib::area_ivsv::plan`) by the shared executor.
 //!
-//! Its inputs differ from every other family's: `N` VPLs, each a spot light with its own
-//! standard shadow map (the engine renders them into the layers of one `r32float` array
-//! texture), instead of one light and one map. So it is not yet one of
-//! [`crate::FamilyPasses`]; [`AreaIvsv`] is its own driver and [`run_area_ivsv_once`] its test
-//! convenience.
+//! Its inputs beyond every family's: an area light (`LightDesc::Area` in the
+//! [`FrameInput`]), whose `N` VPLs each have their own shadow map, which the engine renders
+//! into the layers of one `r32float` array texture ([`Inputs::vpl_maps`]) with the frames
+//! [`AreaIvsv::vpls`] gives after [`AreaIvsv::prepare_light`] (each derived from the frame's
+//! standard shadow map, the light's point limit's). It is one of [`crate::FamilyPasses`];
+//! [`run_area_ivsv_once`] is its pass-by-pass test convenience.
 
 use std::time::{Duration, Instant};
 
 use scatter_shaderlib::Kernel;
-use scatter_shaderlib::area_ivsv::{AreaIvsvFrame, AreaIvsvVariant, VplInput, prepare_area_ivsv};
-use scatter_shaderlib::prefiltered::{CameraDesc, MediumDesc, Storage};
+use scatter_shaderlib::area_ivsv::{
+    AreaIvsvFrame, AreaIvsvVariant, VplInput, prepare_area_ivsv, prepare_area_light,
+};
+use scatter_shaderlib::prefiltered::{CameraDesc, MediumDesc, Resolutions, Storage};
+
+use crate::prefiltered::{FrameInput, Inputs};
 
 use crate::error::{ErrorScopes, check_limit};
 use crate::executor::Executor;
@@ -65,6 +70,8 @@ pub struct AreaIvsv {
     /// The interleaved gather's partial sums (rgba32float), when interleaved.
     partial: Option<wgpu::Texture>,
     frame: Option<AreaIvsvFrame>,
+    /// The VPLs of the last [`AreaIvsv::prepare_light`] (empty after [`AreaIvsv::prepare`]).
+    vpl_inputs: Vec<VplInput>,
 }
 
 impl AreaIvsv {
@@ -168,6 +175,7 @@ impl AreaIvsv {
             partial,
             exec,
             frame: None,
+            vpl_inputs: Vec::new(),
         })
     }
 
@@ -199,7 +207,52 @@ impl AreaIvsv {
         queue.write_buffer(&self.vpls, 0, bytemuck::cast_slice(&prepared.vpls));
         scope.pop(GATHER, "uploading frame parameters")?;
         self.frame = Some(prepared);
+        self.vpl_inputs.clear();
         Ok(())
+    }
+
+    /// Sets up and uploads one frame of an area light: `input.light` must be a
+    /// `LightDesc::Area`, `input.shadow_map` the standard map of its point limit (a
+    /// perspective map of the size [`Self::new`] took), from which each VPL's map is derived
+    /// ([`Self::vpls`]: render layer `i` of the VPL map array with `vpls()[i].shadow_map`).
+    /// `input.settings` is not used.
+    ///
+    /// # Errors
+    ///
+    /// [`RuntimeError::Frame`] for another light, a bad area light, a template that is not
+    /// a perspective map of the right size, NaN or degenerate input; [`RuntimeError::Wgpu`]
+    /// when an upload fails.
+    pub fn prepare_light(&mut self, ctx: &Context, input: &FrameInput) -> Result<(), RuntimeError> {
+        if input.shadow_map.size != self.map_size {
+            return Err(scatter_shaderlib::prefiltered::FrameError::OutOfRange {
+                what: "shadow map size",
+                allowed: "the VPL map size the passes were built for",
+                value: format!("{} (built for {})", input.shadow_map.size, self.map_size),
+            }
+            .into());
+        }
+        let (prepared, vpls) = prepare_area_light(
+            &self.variant,
+            self.screen,
+            &input.camera,
+            &input.light,
+            &input.medium,
+            &input.shadow_map,
+        )?;
+        let scope = ErrorScopes::push(ctx.device());
+        let queue = ctx.queue();
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&prepared.uniforms));
+        queue.write_buffer(&self.vpls, 0, bytemuck::cast_slice(&prepared.vpls));
+        scope.pop(GATHER, "uploading frame parameters")?;
+        self.frame = Some(prepared);
+        self.vpl_inputs = vpls;
+        Ok(())
+    }
+
+    /// The VPLs of the last [`Self::prepare_light`], in layer order: each one's spot light
+    /// and the shadow map the engine renders into its layer of the VPL map array.
+    pub fn vpls(&self) -> &[VplInput] {
+        &self.vpl_inputs
     }
 
     /// Records the passes (with GPU timestamps when the device has them) and returns
@@ -350,6 +403,77 @@ impl AreaIvsv {
     pub fn output_texture(&self) -> &wgpu::Texture {
         &self.output
     }
+}
+
+impl crate::family::FamilyRuntime for AreaIvsv {
+    type Variant = AreaIvsvVariant;
+
+    /// `shadow_map_size` is the VPL maps' size (the standard map's: the template's).
+    fn create(
+        ctx: &Context,
+        variant: &AreaIvsvVariant,
+        res: Resolutions,
+        shadow_map_size: u32,
+    ) -> Result<Self, RuntimeError> {
+        Self::new(ctx, variant, res.screen, shadow_map_size)
+    }
+
+    fn knobs(&self) -> AreaIvsvVariant {
+        self.variant
+    }
+
+    fn prepare_frame(
+        &mut self,
+        ctx: &Context,
+        input: &FrameInput,
+    ) -> Result<Option<scatter_shaderlib::prefiltered::FrameReport>, RuntimeError> {
+        self.prepare_light(ctx, input)?;
+        Ok(None)
+    }
+
+    fn encode_frame(
+        &self,
+        ctx: &Context,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &Inputs<'_>,
+    ) -> Result<&wgpu::TextureView, RuntimeError> {
+        self.encode(ctx, encoder, inputs.depth, required_vpl_maps(inputs)?)
+    }
+
+    fn output(&self) -> &wgpu::Texture {
+        &self.output
+    }
+
+    fn total_pass_time(&self, ctx: &Context) -> Result<Option<Duration>, RuntimeError> {
+        Ok(self.pass_times(ctx)?.map(|t| t.total()))
+    }
+
+    fn fallback_pixels(&self, _ctx: &Context) -> Result<Option<u32>, RuntimeError> {
+        Ok(None)
+    }
+
+    fn pass_wall_times(
+        &self,
+        ctx: &Context,
+        inputs: &Inputs<'_>,
+        frames: u32,
+    ) -> Result<Vec<(Kernel, Duration)>, RuntimeError> {
+        let t =
+            self.measure_pass_wall_times(ctx, inputs.depth, required_vpl_maps(inputs)?, frames)?;
+        let mut passes = vec![(RECTIFY, t.rectify), (SCAN, t.scan), (GATHER, t.gather)];
+        if self.variant.interleave > 1 {
+            passes.push((INTERLEAVE_SUM, t.interleave_sum));
+        }
+        Ok(passes)
+    }
+}
+
+/// The VPL map array of `inputs`, which every area_ivsv frame needs.
+fn required_vpl_maps<'a>(inputs: &Inputs<'a>) -> Result<&'a wgpu::TextureView, RuntimeError> {
+    inputs.vpl_maps.ok_or(RuntimeError::MissingInput {
+        kernel: RECTIFY,
+        what: "the VPL shadow maps (an r32float array, one layer per VPL)",
+    })
 }
 
 /// Everything [`run_area_ivsv_once`] reads back.

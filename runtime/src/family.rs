@@ -16,7 +16,9 @@ use scatter_shaderlib::prefiltered::{FrameReport, Resolutions};
 use crate::gpu::upload_inputs;
 use crate::prefiltered::{CpuInputs, FrameInput, Inputs};
 use crate::textures::read_rgba16float;
-use crate::{Context, HybridVolume, Minmax, PartialSumTree, Prefiltered, Raymarch, RuntimeError};
+use crate::{
+    AreaIvsv, Context, HybridVolume, Minmax, PartialSumTree, Prefiltered, Raymarch, RuntimeError,
+};
 
 /// What a family's runtime type offers with the inputs every family takes: the frame input
 /// of the epipolar families (a family ignores what it does not use) and the engine's
@@ -287,6 +289,8 @@ macro_rules! runtime_families {
 }
 
 runtime_families! {
+    /// The area-light family (imperfect voxelized shadow volumes).
+    AreaIvsv(AreaIvsv),
     /// The hybrid shadow-volume family.
     HybridVolume(HybridVolume),
     /// The minmax family.
@@ -364,6 +368,24 @@ pub fn run_family_on(
         cpu.push((first, "rasterised rectified map", res.rectified, &data[..]));
     }
     let views = upload_inputs(ctx, &cpu)?;
+    let vpl_maps = match &inputs.vpl_maps {
+        Some(data) => {
+            let per_layer = (sm_size as usize).pow(2);
+            if per_layer == 0 || data.len() % per_layer != 0 {
+                return Err(RuntimeError::DataLength {
+                    kernel: first,
+                    size: format!("VPL shadow maps of {sm_size}x{sm_size} per layer"),
+                    expected: (data.len().div_ceil(per_layer.max(1)) * per_layer) as u64,
+                    actual: data.len() as u64,
+                });
+            }
+            let layers = u32::try_from(data.len() / per_layer).unwrap_or(u32::MAX);
+            Some(crate::area_ivsv::upload_vpl_maps(
+                ctx, sm_size, layers, data,
+            )?)
+        }
+        None => None,
+    };
     if let Some((size, texels)) = &inputs.cookie {
         let texture = crate::textures::upload_cookie(ctx, first, *size, texels)?;
         pass.set_cookie(&texture.create_view(&wgpu::TextureViewDescriptor::default()))?;
@@ -373,6 +395,7 @@ pub fn run_family_on(
         depth: &views[0].1,
         shadow_map: Some(&views[1].1),
         rectified: views.get(2).map(|(_, v)| v),
+        vpl_maps: vpl_maps.as_ref().map(|(_, v)| v),
     };
     let mut encoder = ctx
         .device()

@@ -93,6 +93,10 @@ pub struct Inputs<'a> {
     /// The rectified depth map the engine rasterised with [`FrameReport::projective`]'s
     /// matrices (`Wr x Hr`): needed by every projective frame.
     pub rectified: Option<&'a wgpu::TextureView>,
+    /// An area light's VPL shadow maps: an r32float 2D-array view of one layer per VPL,
+    /// each the standard map's size, rendered with the frames `AreaIvsv::vpls` gives:
+    /// needed by the `area_ivsv` family, ignored by the others.
+    pub vpl_maps: Option<&'a wgpu::TextureView>,
 }
 
 /// GPU time of each pass of one frame (from timestamps at the start and end of each pass).
@@ -597,6 +601,10 @@ pub struct CpuInputs {
     /// row-major from the top-left), uploaded by [`crate::run_family_once`] with
     /// [`crate::textures::upload_cookie`].
     pub cookie: Option<([u32; 2], Vec<[f32; 4]>)>,
+    /// An area light's VPL shadow maps for an `area_ivsv` variant: every layer's
+    /// `frame.shadow_map.size` squared values, layer-major then row-major, uploaded by
+    /// [`crate::run_family_once`] with [`crate::upload_vpl_maps`].
+    pub vpl_maps: Option<Vec<f32>>,
 }
 
 /// Everything [`run_prefiltered_once`] reads back.
@@ -674,6 +682,7 @@ pub fn run_prefiltered_once(
             depth: &views[0].1,
             shadow_map: Some(&views[1].1),
             rectified: engine_rectified,
+            vpl_maps: None,
         },
     )?;
     let scope = ErrorScopes::push(device);
@@ -731,6 +740,7 @@ pub fn run_prefiltered_once(
                 depth: &views[0].1,
                 shadow_map: Some(&views[1].1),
                 rectified: engine_rectified,
+                vpl_maps: None,
             },
             inputs.pass_wall_frames,
         )?)

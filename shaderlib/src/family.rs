@@ -4,6 +4,7 @@
 
 pub use scatter_frame::family::{Family, FamilyVariant, KnobSet, UnknownFamily};
 
+use crate::area_ivsv::AreaIvsvVariant;
 use crate::hybrid_volume::HybridVolumeVariant;
 use crate::minmax::MinmaxVariant;
 use crate::partial_sum_tree::PartialSumTreeVariant;
@@ -72,6 +73,7 @@ macro_rules! kernel_families {
 }
 
 kernel_families! {
+    AreaIvsv(AreaIvsvVariant),
     HybridVolume(HybridVolumeVariant),
     Minmax(MinmaxVariant),
     PartialSumTree(PartialSumTreeVariant),

@@ -150,11 +150,6 @@ impl KernelParams {
                 })
             })
             .collect();
-        // Not yet in the family table (`scatter_shaderlib::area_ivsv`'s docs).
-        out.extend(Self::area_ivsv(AreaIvsvVariant {
-            interleave: 2,
-            ..AreaIvsvVariant::default()
-        }));
         for &family in Family::ALL {
             // The variant with the most passes, then the default with epipolar sampling
             // (its `_unwarp` and `_fallback` kernels).
@@ -167,7 +162,13 @@ impl KernelParams {
             for params in family::most_passes(family)
                 .kernel_params()
                 .into_iter()
-                .chain(epipolar.kernel_params())
+                .chain(
+                    // A family without epipolar sampling (area_ivsv) refuses the variant.
+                    epipolar
+                        .validate()
+                        .map(|()| epipolar.kernel_params())
+                        .unwrap_or_default(),
+                )
             {
                 if !out.iter().any(|p| p.kernel() == params.kernel()) {
                     out.push(params);

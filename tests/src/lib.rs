@@ -67,11 +67,13 @@ pub fn gpu() -> Option<&'static Context> {
 }
 
 /// The suite scene the conformance trials use for a light type: `columns` for the sun,
-/// `spot_grate` for the spot lamp.
+/// `spot_grate` for the spot lamp and for an area light the base of `area_grate` (which
+/// `scatter_reference::area_suite::scene` lights with its area light: the area family's
+/// trials build their scenes there).
 pub const fn scene_for(light: LightKind) -> SceneName {
     match light {
         LightKind::Directional => SceneName::Columns,
-        LightKind::Spot => SceneName::SpotGrate,
+        LightKind::Spot | LightKind::Area => SceneName::SpotGrate,
     }
 }
 
@@ -449,6 +451,7 @@ fn run_variant_in(
         } else {
             None
         },
+        vpl_maps: None,
     };
     let out = match cache {
         None => scatter_runtime::run_family_once(ctx, variant, res, &cpu),

@@ -45,46 +45,11 @@ use scatter_shaderlib::area_ivsv::{AreaIvsvVariant, PHI_BITS};
 const SCREEN: [u32; 2] = [37, 21];
 const MAP: u32 = 64;
 
-/// The variants: a small default-like grid, and an odd one (3 VPLs, 37 x 19 texels, one
-/// segment), and many segments.
+/// The variants: the family's conformance grid ([`AreaIvsvVariant::grid`]: a small
+/// default-like grid, an odd one (3 VPLs, 37 x 19 texels, one segment), many segments, and
+/// both interleaves).
 fn variants() -> Vec<AreaIvsvVariant> {
-    vec![
-        AreaIvsvVariant {
-            vpls: 8,
-            alpha: 64,
-            theta: 64,
-            segments: 8,
-            interleave: 1,
-        },
-        AreaIvsvVariant {
-            vpls: 3,
-            alpha: 37,
-            theta: 19,
-            segments: 1,
-            interleave: 1,
-        },
-        AreaIvsvVariant {
-            vpls: 4,
-            alpha: 128,
-            theta: 96,
-            segments: 32,
-            interleave: 1,
-        },
-        AreaIvsvVariant {
-            vpls: 8,
-            alpha: 64,
-            theta: 64,
-            segments: 8,
-            interleave: 2,
-        },
-        AreaIvsvVariant {
-            vpls: 16,
-            alpha: 64,
-            theta: 48,
-            segments: 4,
-            interleave: 4,
-        },
-    ]
+    AreaIvsvVariant::grid()
 }
 
 struct Case {
@@ -348,6 +313,7 @@ fn flicker(path: Path) -> Result<String, String> {
                 rectified: None,
                 pass_wall_frames: 0,
                 cookie: None,
+                vpl_maps: None,
             };
             let out = scatter_runtime::run_family_on(ctx, &mut pass, res, &inputs)
                 .map_err(|e| e.to_string())?;
@@ -396,6 +362,7 @@ fn errors() -> Result<(), String> {
             theta: 8,
             segments: 1,
             interleave: 1,
+            ..AreaIvsvVariant::default()
         },
         [8, 8],
         16,

@@ -120,6 +120,7 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
                     rectified,
                     pass_wall_frames: 0,
                     cookie: None,
+                    vpl_maps: None,
                 },
             )
             .unwrap_or_else(|e| panic!("{trial}: {e}"));

@@ -251,6 +251,7 @@ fn render(
         depth: &dv,
         shadow_map: Some(&sv),
         rectified: None,
+        vpl_maps: None,
     };
     passes
         .iter_mut()

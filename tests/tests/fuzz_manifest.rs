@@ -684,6 +684,16 @@ fn real_frame_file(light: LightKind) -> Value {
             outer_deg: 30.0,
             color: [50.0; 3],
         },
+        LightKind::Area => LightDesc::Area(scatter_frame::area_light::AreaLightDesc {
+            position: DVec3::new(2.0, 10.0, 0.0),
+            direction: travel,
+            up: None,
+            shape: scatter_frame::area_light::AreaShapeDesc::Disk { radius: 0.5 },
+            inner_deg: 20.0,
+            outer_deg: 30.0,
+            radiance: [50.0; 3],
+            two_sided: false,
+        }),
     };
     let shadow = ShadowMapDesc {
         origin: DVec3::new(0.0, 20.0, 0.0),

@@ -165,6 +165,7 @@ impl Prepared {
                 rectified: None,
                 pass_wall_frames: 0,
                 cookie: None,
+                vpl_maps: None,
             },
         )
         .map_err(|e| e.to_string())?;

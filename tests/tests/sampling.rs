@@ -90,12 +90,19 @@ fn f16_ulp(v: f32) -> f32 {
 
 /// The families' default variants with `light`, per pixel: the families that have a
 /// per-pixel body the stage samples (not `partial_sum_tree`, whose sweep answers epipolar
-/// samples only and is checked against its mirror in `tests/tests/partial_sum_tree_gpu.rs`).
+/// samples only and is checked against its mirror in `tests/tests/partial_sum_tree_gpu.rs`,
+/// nor `area_ivsv`, which renders area lights per pixel only and refuses the other
+/// samplings: its variant says so).
 fn bases(light: LightKind) -> Vec<FamilyVariant> {
     Family::ALL
         .iter()
         .map(|f| f.default_variant().with_light(light))
-        .filter(|v| v.sampling().sampling == Sampling::Pixels)
+        .filter(|v| v.validate().is_ok() && v.sampling().sampling == Sampling::Pixels)
+        .filter(|v| {
+            knobs()
+                .iter()
+                .all(|k| v.with_sampling(*k).validate().is_ok())
+        })
         .collect()
 }
 
@@ -163,6 +170,7 @@ fn epipolar_camera(variant: &FamilyVariant, f: &Fixture) -> Result<EpipolarCamer
         )
         .map(|m| EpipolarCamera::of_raymarch(&m, v.light))
         .map_err(|e| e.to_string()),
+        FamilyVariant::AreaIvsv(v) => Err(format!("{v}: area_ivsv has no epipolar sampling")),
     }
 }
 

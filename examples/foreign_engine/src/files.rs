@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+use scatter_frame::area_light::{AreaLightDesc, AreaShapeDesc};
 use scatter_frame::frame::{
     CameraDesc, FrameSettings, LightDesc, MediumDesc, PrefilteredFrame, Resolutions, ShadowMapDesc,
     ShadowProjectionDesc, prepare_frame,
@@ -96,6 +97,45 @@ pub enum LightFile {
         outer_deg: f64,
         /// Intensity (RGB).
         color: [f64; 3],
+    },
+    /// Area light (`scatter_frame::area_light::AreaLightDesc`).
+    Area {
+        /// Centre.
+        position: [f64; 3],
+        /// Emitting normal.
+        direction: [f64; 3],
+        /// The outline's up axis (absent: the light basis's).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        up: Option<[f64; 3]>,
+        /// The outline.
+        shape: AreaShapeFile,
+        /// Full-emission half-angle, degrees.
+        inner_deg: f64,
+        /// Zero-emission half-angle, degrees.
+        outer_deg: f64,
+        /// Radiance along the normal (RGB).
+        radiance: [f64; 3],
+        /// Whether the back face emits too.
+        #[serde(default)]
+        two_sided: bool,
+    },
+}
+
+/// An area light's outline as plain numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum AreaShapeFile {
+    /// A rectangle.
+    Rect {
+        /// Extent along the light's right axis.
+        width: f64,
+        /// Extent along its up axis.
+        height: f64,
+    },
+    /// A disk.
+    Disk {
+        /// Radius.
+        radius: f64,
     },
 }
 
@@ -210,6 +250,21 @@ impl FrameFile {
                     inner_deg,
                     outer_deg,
                     color,
+                },
+                LightDesc::Area(a) => LightFile::Area {
+                    position: a.position.to_array(),
+                    direction: a.direction.to_array(),
+                    up: a.up.map(|u| u.to_array()),
+                    shape: match a.shape {
+                        AreaShapeDesc::Rect { width, height } => {
+                            AreaShapeFile::Rect { width, height }
+                        }
+                        AreaShapeDesc::Disk { radius } => AreaShapeFile::Disk { radius },
+                    },
+                    inner_deg: a.inner_deg,
+                    outer_deg: a.outer_deg,
+                    radiance: a.radiance,
+                    two_sided: a.two_sided,
                 },
             },
             medium: MediumFile {
@@ -388,6 +443,28 @@ impl FrameFile {
                 outer_deg,
                 color,
             },
+            LightFile::Area {
+                position,
+                direction,
+                up,
+                shape,
+                inner_deg,
+                outer_deg,
+                radiance,
+                two_sided,
+            } => LightDesc::Area(AreaLightDesc {
+                position: v3(position),
+                direction: v3(direction),
+                up: up.map(v3),
+                shape: match shape {
+                    AreaShapeFile::Rect { width, height } => AreaShapeDesc::Rect { width, height },
+                    AreaShapeFile::Disk { radius } => AreaShapeDesc::Disk { radius },
+                },
+                inner_deg,
+                outer_deg,
+                radiance,
+                two_sided,
+            }),
         };
         let medium = MediumDesc {
             sigma_t: self.medium.sigma_t,

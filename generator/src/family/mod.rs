@@ -8,6 +8,7 @@
 //! config file, the manifest and the tests pick a family up from [`Family::ALL`]; see
 //! `docs/adding-a-family.md`.
 
+pub mod area_ivsv;
 pub mod hybrid_volume;
 pub mod minmax;
 pub mod partial_sum_tree;
@@ -322,6 +323,7 @@ pub fn knobs_json(v: &FamilyVariant) -> serde_json::Value {
 }
 
 cli_families! {
+    AreaIvsv => area_ivsv,
     HybridVolume => hybrid_volume,
     Minmax => minmax,
     PartialSumTree => partial_sum_tree,

@@ -19,7 +19,7 @@ pub fn knobs() -> Vec<KnobInfo> {
             name: "light",
             value_name: "KIND",
             help: "light type the kernels are compiled for",
-            allowed: LightKind::ALLOWED.trim_end().replace(' ', " | "),
+            allowed: LightKind::SINGLE_ALLOWED.into(),
             default: d.light.to_string(),
             value_type: KnobType::Name,
         },

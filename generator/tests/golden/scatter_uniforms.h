@@ -16,6 +16,52 @@
 #define SCATTER_STATIC_ASSERT(cond, msg) _Static_assert(cond, msg)
 #endif
 
+/* WGSL `IvsvFrame` of family area_ivsv (scatter::ivsv), 112 bytes, alignment 16. */
+typedef struct ScatterAreaIvsvIvsvFrame {
+    float eye[4]; /* vec4<f32>, offset 0 */
+    float cam_forward[4]; /* vec4<f32>, offset 16 */
+    float cam_right[4]; /* vec4<f32>, offset 32 */
+    float cam_up[4]; /* vec4<f32>, offset 48 */
+    float medium[4]; /* vec4<f32>, offset 64 */
+    uint32_t sizes[4]; /* vec4<u32>, offset 80 */
+    uint32_t grid[4]; /* vec4<u32>, offset 96 */
+} ScatterAreaIvsvIvsvFrame;
+SCATTER_STATIC_ASSERT(sizeof(ScatterAreaIvsvIvsvFrame) == 112, "ScatterAreaIvsvIvsvFrame size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, eye) == 0, "ScatterAreaIvsvIvsvFrame.eye offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, cam_forward) == 16, "ScatterAreaIvsvIvsvFrame.cam_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, cam_right) == 32, "ScatterAreaIvsvIvsvFrame.cam_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, cam_up) == 48, "ScatterAreaIvsvIvsvFrame.cam_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, medium) == 64, "ScatterAreaIvsvIvsvFrame.medium offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, sizes) == 80, "ScatterAreaIvsvIvsvFrame.sizes offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, grid) == 96, "ScatterAreaIvsvIvsvFrame.grid offset");
+
+/* WGSL `Vpl` of family area_ivsv (scatter::ivsv), 176 bytes, alignment 16. */
+typedef struct ScatterAreaIvsvVpl {
+    float position[4]; /* vec4<f32>, offset 0 */
+    float color[4]; /* vec4<f32>, offset 16 */
+    float axis[4]; /* vec4<f32>, offset 32 */
+    float perp_x[4]; /* vec4<f32>, offset 48 */
+    float perp_y[4]; /* vec4<f32>, offset 64 */
+    float spot_dir[4]; /* vec4<f32>, offset 80 */
+    float sm_right[4]; /* vec4<f32>, offset 96 */
+    float sm_up[4]; /* vec4<f32>, offset 112 */
+    float sm_forward[4]; /* vec4<f32>, offset 128 */
+    float sm_origin[4]; /* vec4<f32>, offset 144 */
+    float sm_proj[4]; /* vec4<f32>, offset 160 */
+} ScatterAreaIvsvVpl;
+SCATTER_STATIC_ASSERT(sizeof(ScatterAreaIvsvVpl) == 176, "ScatterAreaIvsvVpl size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, position) == 0, "ScatterAreaIvsvVpl.position offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, color) == 16, "ScatterAreaIvsvVpl.color offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, axis) == 32, "ScatterAreaIvsvVpl.axis offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, perp_x) == 48, "ScatterAreaIvsvVpl.perp_x offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, perp_y) == 64, "ScatterAreaIvsvVpl.perp_y offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, spot_dir) == 80, "ScatterAreaIvsvVpl.spot_dir offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, sm_right) == 96, "ScatterAreaIvsvVpl.sm_right offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, sm_up) == 112, "ScatterAreaIvsvVpl.sm_up offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, sm_forward) == 128, "ScatterAreaIvsvVpl.sm_forward offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, sm_origin) == 144, "ScatterAreaIvsvVpl.sm_origin offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, sm_proj) == 160, "ScatterAreaIvsvVpl.sm_proj offset");
+
 /* WGSL `Frame` of family hybrid_volume (scatter::epipolar), 400 bytes, alignment 16. */
 typedef struct ScatterHybridVolumeFrame {
     float eye[4]; /* vec4<f32>, offset 0 */

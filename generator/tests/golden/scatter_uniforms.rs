@@ -5,6 +5,83 @@
 // explicit padding members keep them in `#[repr(C)]`. Use it with `include!` or as a
 // module file; it needs no dependencies.
 
+/// Uniform structs of the `area_ivsv` kernels.
+#[allow(dead_code, reason = "generated")]
+pub mod area_ivsv {
+    /// WGSL `IvsvFrame` (scatter::ivsv), 112 bytes, alignment 16.
+    #[repr(C)]
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct IvsvFrame {
+        /// `vec4<f32>` at byte 0.
+        pub eye: [f32; 4],
+        /// `vec4<f32>` at byte 16.
+        pub cam_forward: [f32; 4],
+        /// `vec4<f32>` at byte 32.
+        pub cam_right: [f32; 4],
+        /// `vec4<f32>` at byte 48.
+        pub cam_up: [f32; 4],
+        /// `vec4<f32>` at byte 64.
+        pub medium: [f32; 4],
+        /// `vec4<u32>` at byte 80.
+        pub sizes: [u32; 4],
+        /// `vec4<u32>` at byte 96.
+        pub grid: [u32; 4],
+    }
+
+    const _: () = {
+        assert!(::core::mem::size_of::<IvsvFrame>() == 112);
+        assert!(::core::mem::offset_of!(IvsvFrame, eye) == 0);
+        assert!(::core::mem::offset_of!(IvsvFrame, cam_forward) == 16);
+        assert!(::core::mem::offset_of!(IvsvFrame, cam_right) == 32);
+        assert!(::core::mem::offset_of!(IvsvFrame, cam_up) == 48);
+        assert!(::core::mem::offset_of!(IvsvFrame, medium) == 64);
+        assert!(::core::mem::offset_of!(IvsvFrame, sizes) == 80);
+        assert!(::core::mem::offset_of!(IvsvFrame, grid) == 96);
+    };
+    /// WGSL `Vpl` (scatter::ivsv), 176 bytes, alignment 16.
+    #[repr(C)]
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Vpl {
+        /// `vec4<f32>` at byte 0.
+        pub position: [f32; 4],
+        /// `vec4<f32>` at byte 16.
+        pub color: [f32; 4],
+        /// `vec4<f32>` at byte 32.
+        pub axis: [f32; 4],
+        /// `vec4<f32>` at byte 48.
+        pub perp_x: [f32; 4],
+        /// `vec4<f32>` at byte 64.
+        pub perp_y: [f32; 4],
+        /// `vec4<f32>` at byte 80.
+        pub spot_dir: [f32; 4],
+        /// `vec4<f32>` at byte 96.
+        pub sm_right: [f32; 4],
+        /// `vec4<f32>` at byte 112.
+        pub sm_up: [f32; 4],
+        /// `vec4<f32>` at byte 128.
+        pub sm_forward: [f32; 4],
+        /// `vec4<f32>` at byte 144.
+        pub sm_origin: [f32; 4],
+        /// `vec4<f32>` at byte 160.
+        pub sm_proj: [f32; 4],
+    }
+
+    const _: () = {
+        assert!(::core::mem::size_of::<Vpl>() == 176);
+        assert!(::core::mem::offset_of!(Vpl, position) == 0);
+        assert!(::core::mem::offset_of!(Vpl, color) == 16);
+        assert!(::core::mem::offset_of!(Vpl, axis) == 32);
+        assert!(::core::mem::offset_of!(Vpl, perp_x) == 48);
+        assert!(::core::mem::offset_of!(Vpl, perp_y) == 64);
+        assert!(::core::mem::offset_of!(Vpl, spot_dir) == 80);
+        assert!(::core::mem::offset_of!(Vpl, sm_right) == 96);
+        assert!(::core::mem::offset_of!(Vpl, sm_up) == 112);
+        assert!(::core::mem::offset_of!(Vpl, sm_forward) == 128);
+        assert!(::core::mem::offset_of!(Vpl, sm_origin) == 144);
+        assert!(::core::mem::offset_of!(Vpl, sm_proj) == 160);
+    };
+}
+
 /// Uniform structs of the `hybrid_volume` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod hybrid_volume {

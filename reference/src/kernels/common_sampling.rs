@@ -262,7 +262,9 @@ impl EpipolarCamera {
             scatter_shaderlib::prefiltered::LightKind::Directional => {
                 [-m.light_dir[0], -m.light_dir[1], -m.light_dir[2]]
             }
-            scatter_shaderlib::prefiltered::LightKind::Spot => [
+            // `Area` is refused by the raymarch variant before any frame is set up.
+            scatter_shaderlib::prefiltered::LightKind::Spot
+            | scatter_shaderlib::prefiltered::LightKind::Area => [
                 m.light_pos[0] - m.eye[0],
                 m.light_pos[1] - m.eye[1],
                 m.light_pos[2] - m.eye[2],

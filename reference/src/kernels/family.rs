@@ -6,6 +6,7 @@
 //! Each family implements [`CpuFamily`] for its variant type (next to its `run_<family>`
 //! in [`super`]); [`FamilyRun`] and [`run_family`] come from one table, one line per family.
 
+use scatter_shaderlib::area_ivsv::AreaIvsvVariant;
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::hybrid_volume::HybridVolumeVariant;
 use scatter_shaderlib::minmax::MinmaxVariant;
@@ -69,6 +70,37 @@ impl CpuRun for PrefilteredRun {
 
     fn report(&self) -> Option<&FrameReport> {
         Some(&self.frame.report)
+    }
+}
+
+impl CpuRun for super::IvsvRun {
+    fn output(&self) -> &Image {
+        &self.image
+    }
+
+    fn report(&self) -> Option<&FrameReport> {
+        None
+    }
+}
+
+impl CpuFamily for AreaIvsvVariant {
+    type Run = super::IvsvRun;
+
+    /// Ray-casts the VPLs' maps from the frame's standard map (the area light's point
+    /// limit's: `f.shadow_map`'s size is theirs), then runs the mirrors.
+    fn run_cpu(&self, f: &CpuFrame<'_>) -> Result<super::IvsvRun, FrameError> {
+        let inputs = super::ivsv_inputs(f.scene, f.gbuf, f.bvh, self, f.shadow_map.size).map_err(
+            |e| match e {
+                super::IvsvInputError::Frame(e)
+                | super::IvsvInputError::ShadowMap(crate::buffers::ShadowMapError::Vpl(e)) => e,
+                super::IvsvInputError::ShadowMap(e) => FrameError::OutOfRange {
+                    what: "VPL shadow map",
+                    allowed: "a map the reference can ray-cast",
+                    value: e.to_string(),
+                },
+            },
+        )?;
+        Ok(super::run_area_ivsv(self, &inputs))
     }
 }
 
@@ -198,6 +230,7 @@ macro_rules! cpu_families {
 }
 
 cpu_families! {
+    AreaIvsv(AreaIvsvVariant),
     HybridVolume(HybridVolumeVariant),
     Minmax(MinmaxVariant),
     PartialSumTree(PartialSumTreeVariant),

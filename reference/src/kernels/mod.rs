@@ -52,7 +52,7 @@ use crate::image::Image;
 use crate::projective::rasterise_rectified;
 use crate::scene::Scene;
 pub use family::{CpuFamily, CpuFrame, CpuRun, FamilyRun, run_family};
-use scatter_shaderlib::area_ivsv::{AreaIvsvFrame, AreaIvsvVariant, VplInput, prepare_area_ivsv};
+use scatter_shaderlib::area_ivsv::{AreaIvsvFrame, AreaIvsvVariant, VplInput};
 use scatter_shaderlib::hybrid_volume::{HybridVolumeVariant, prepare_hybrid_volume};
 use scatter_shaderlib::minmax::{MinmaxVariant, prepare_minmax};
 use scatter_shaderlib::partial_sum_tree::{
@@ -638,37 +638,30 @@ pub fn ivsv_inputs(
     variant: &AreaIvsvVariant,
     map_size: u32,
 ) -> Result<IvsvInputs, IvsvInputError> {
-    let two_sided = matches!(&scene.light, crate::scene::Light::Area(a) if a.two_sided);
-    let points = if two_sided {
-        variant.vpls as usize / 2
-    } else {
-        variant.vpls as usize
-    };
-    let scenes = scene.point_light_scenes(points.max(1));
-    let mut maps = TexArray::new(map_size, map_size, scenes.len() as u32);
-    let mut map_data = Vec::with_capacity(scenes.len() * (map_size * map_size) as usize);
-    let mut vpls = Vec::with_capacity(scenes.len());
-    for (layer, vpl) in (0u32..).zip(&scenes) {
-        let sm = ShadowMap::build(vpl, bvh, map_size)?;
+    // The engine's path: the point limit's standard map is the template, the frame set-up
+    // places the VPLs and derives their maps, and each map is ray-cast as an engine
+    // rasterises it.
+    let template = ShadowMap::area_template(scene, bvh, map_size)?;
+    let (frame, vpls) = scatter_shaderlib::area_ivsv::prepare_area_light(
+        variant,
+        [gbuf.width, gbuf.height],
+        &scene.camera_desc(),
+        &scene.light_desc(),
+        &scene.medium_desc(),
+        &template,
+    )?;
+    let layers = vpls.len() as u32;
+    let mut maps = TexArray::new(map_size, map_size, layers);
+    let mut map_data = Vec::with_capacity((layers * map_size * map_size) as usize);
+    for (layer, vpl) in (0u32..).zip(&vpls) {
+        let sm = ShadowMap::from_desc(&vpl.shadow_map).cast(bvh);
         for (k, &d) in sm.depth.iter().enumerate() {
             let k = k as u32;
             maps.data[((layer * map_size + k / map_size) * map_size + k % map_size) as usize] =
                 [d, 0.0, 0.0, 0.0];
         }
         map_data.extend_from_slice(&sm.depth);
-        vpls.push(VplInput {
-            light: vpl.light_desc(),
-            shadow_map: sm.desc(),
-        });
     }
-    let frame = prepare_area_ivsv(
-        variant,
-        [gbuf.width, gbuf.height],
-        &scene.camera_desc(),
-        &scene.medium_desc(),
-        &vpls,
-        map_size,
-    )?;
     let depth = Tex {
         width: gbuf.width,
         height: gbuf.height,
@@ -695,6 +688,8 @@ pub struct IvsvRun {
     /// The output (rgb, not rounded to `rgba16float`): `ivsv_gather`'s, or
     /// `ivsv_interleave_sum`'s when interleaved.
     pub output: Vec<[f32; 3]>,
+    /// The output as stored in `rgba16float`.
+    pub image: Image,
 }
 
 /// Runs `ivsv_rectify`, `ivsv_scan`, `ivsv_gather` and, when interleaved,
@@ -721,10 +716,19 @@ pub fn run_area_ivsv(variant: &AreaIvsvVariant, inputs: &IvsvInputs) -> IvsvRun 
     } else {
         (Vec::new(), gathered)
     };
+    let image = Image::from_pixels(
+        m.sizes[0],
+        m.sizes[1],
+        output
+            .iter()
+            .map(|&p| common_sampling::round_f16_rgb(p))
+            .collect(),
+    );
     IvsvRun {
         marks: rectified,
         volume,
         partial,
         output,
+        image,
     }
 }

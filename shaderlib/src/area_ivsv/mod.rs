@@ -3,11 +3,8 @@
 //! and their rendering from an [`AreaIvsvVariant`]. CPU mirrors:
 //! `reference/src/kernels/{ivsv_rectify,ivsv_scan,ivsv_gather}.rs`. Host-side knobs and frame
 //! set-up: [`scatter_frame::area_ivsv`] (re-exported here).
-//!
-//! Not yet in the family tables (`Family`, the generator's `--family`, the runtime's
-//! `FamilyPasses`): the engine's frame inputs of every other family hold one light and one
-//! shadow map, and an area light needs `N` of each; `scatter_runtime::area_ivsv` drives the
-//! passes from this family's plan meanwhile.
+//! The family renders area lights only (`light = area`, [`scatter_frame::area_light`]); its
+//! frame's standard shadow map is the template of its VPLs' maps.
 
 pub mod plan;
 
@@ -15,8 +12,9 @@ use askama::Template;
 
 pub use scatter_frame::area_ivsv::{
     AreaIvsvFrame, AreaIvsvVariant, IvsvUniforms, MAX_SEGMENTS, MAX_VPLS, PHI_BITS, VplGrid,
-    VplInput, VplRecord, fit_grid, prepare_area_ivsv,
+    VplInput, VplRecord, fit_grid, prepare_area_ivsv, prepare_area_light,
 };
+pub use scatter_frame::area_light::{AreaLightDesc, AreaShapeDesc, halton, light_basis};
 
 use crate::compose::template_path;
 use crate::{Kernel, ShaderError};
@@ -133,5 +131,23 @@ impl crate::KernelParams {
             out.push(Self::IvsvInterleaveSum(variant));
         }
         out
+    }
+}
+
+impl crate::family::KernelFamily for AreaIvsvVariant {
+    fn kernel_params(&self) -> Vec<crate::KernelParams> {
+        crate::KernelParams::area_ivsv(*self)
+    }
+
+    fn plan(&self) -> crate::plan::Plan {
+        plan::plan(self)
+    }
+
+    /// Interleaved (the `ivsv_interleave_sum` pass).
+    fn with_most_passes() -> Self {
+        Self {
+            interleave: 2,
+            ..Self::default()
+        }
     }
 }

@@ -72,7 +72,8 @@ fn validate(kernel: Kernel, variant: &RaymarchVariant) -> Result<(), ShaderError
 fn sampling_view(variant: &RaymarchVariant, kernel: Kernel) -> SamplingView {
     let toward = match variant.light {
         LightKind::Directional => "-frame.light_dir.xyz",
-        LightKind::Spot => "frame.light_pos.xyz - frame.eye.xyz",
+        // `Area` is refused by `validate` before any template renders.
+        LightKind::Spot | LightKind::Area => "frame.light_pos.xyz - frame.eye.xyz",
     };
     SamplingView::new(
         &variant.sampling_knobs(),
