@@ -812,12 +812,18 @@ fn time_methods_on(
 /// The per-pixel variants the headline also runs sampled: every family's default and the
 /// moment basis with 4 moments.
 fn sampled_bases() -> Vec<FamilyVariant> {
-    // The families with a per-pixel mode (not partial_sum_tree, which samples epipolar
-    // lines only and is timed on its own).
+    // The families with a per-pixel mode and the sampled ones (not partial_sum_tree, which
+    // samples epipolar lines only and is timed on its own, nor area_ivsv, which renders area
+    // lights per pixel only: `examples/area_bench` measures it).
     let mut out: Vec<FamilyVariant> = Family::ALL
         .iter()
         .map(|f| f.default_variant())
         .filter(|v| !v.sampling().is_sampled())
+        .filter(|v| {
+            sampled_configs()
+                .iter()
+                .all(|k| v.with_sampling(*k).validate().is_ok())
+        })
         .collect();
     out.push(PrefilteredVariant::with_moments(4).into());
     out

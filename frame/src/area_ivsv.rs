@@ -122,15 +122,32 @@ impl AreaIvsvVariant {
                 allowed: "area (directional and spot lights are the single-light families')".into(),
             });
         }
-        if self.sampling_knobs() != SamplingKnobs::default() {
-            let knobs = self.sampling_knobs();
+        let d = SamplingKnobs::default();
+        let k = self.sampling_knobs();
+        let why = "(the gather runs per pixel; epipolar and lowres sampling are not built for \
+                   area_ivsv)";
+        if k.sampling != d.sampling {
             return Err(VariantError {
                 knob: "sampling",
-                value: format!("{}{}", knobs.sampling, knobs.id_suffix()),
-                allowed: "pixels with the sampling knobs at their defaults (the gather runs per \
-                          pixel; epipolar and lowres sampling are not built for area_ivsv)"
-                    .into(),
+                value: k.sampling.to_string(),
+                allowed: format!("{} {why}", d.sampling),
             });
+        }
+        for (knob, value, default) in [
+            ("scale", k.scale, d.scale),
+            ("depth_break", k.depth_break, d.depth_break),
+            ("light_break", k.light_break, d.light_break),
+            ("slices", k.slices, d.slices),
+            ("slice_samples", k.slice_samples, d.slice_samples),
+            ("step", k.step, d.step),
+        ] {
+            if value != default {
+                return Err(VariantError {
+                    knob,
+                    value: value.to_string(),
+                    allowed: format!("{default}, its default {why}"),
+                });
+            }
         }
         let range = |knob: &'static str, value: u32, lo: u32, hi: u32| {
             if (lo..=hi).contains(&value) {

@@ -512,7 +512,13 @@ fn valid_value(family: Family, name: &str, pick: usize) -> String {
             _ => k.default,
         };
     }
+    let area = family == Family::AreaIvsv;
     let options: &[&str] = match name {
+        "light" if area => &["\"area\""],
+        // Multiples of every interleave^2.
+        "vpls" => &["16", "64"],
+        "alpha" | "theta" => &["2", "64", "256"],
+        "segments" => &["1", "8", "32"],
         "basis" => &["\"fourier\""],
         "moments" => &["4"],
         "bases" => &["32"],
@@ -543,9 +549,13 @@ const SAMPLING_KNOB_NAMES: [&str; 7] = [
     "step",
 ];
 
-/// A bad value for knob `name`, as TOML source.
-fn bad_value(name: &str, pick: usize) -> String {
+/// A bad value for `family`'s knob `name`, as TOML source.
+fn bad_value(family: Family, name: &str, pick: usize) -> String {
     let options: &[&str] = match name {
+        "light" if family == Family::AreaIvsv => &["\"spot\"", "\"directional\"", "\"Area\""],
+        "vpls" => &["0", "257", "\"many\""],
+        "alpha" | "theta" => &["1", "4097", "-2"],
+        "segments" => &["3", "0", "64"],
         "basis" => &["\"moment\"", "\"Fourier\"", "1"],
         "moments" => &["5", "0", "8", "\"six\""],
         "bases" => &["30", "132", "0", "-4", "\"abc\"", "4294967296", "\"\""],
@@ -613,7 +623,7 @@ fn config_with_one_fault() {
             let fault = match kind {
                 0 => Fault::UnknownKnob(junk),
                 1 => Fault::WrongType(knob.to_owned(), wrong.to_owned()),
-                2 => Fault::BadValue(knob.to_owned(), bad_value(knob, pick.index(97))),
+                2 => Fault::BadValue(knob.to_owned(), bad_value(*family, knob, pick.index(97))),
                 3 => Fault::BadFamily(junk),
                 4 => Fault::TopLevel(junk),
                 5 => Fault::BadTarget(junk),
