@@ -627,6 +627,59 @@ pub fn kernel_costs() -> Vec<KernelCost> {
         low: None,
         trips: "listed pixels, data-dependent (none .. a few per cent of the screen)",
     });
+    // area_ivsv at its defaults: 64 VPLs, 256 x 256 texels per VPL, 8 segments (the
+    // interleaved sum at M = 2); its passes are measured by `examples/area_bench`, not the
+    // headline (an area light, not the suite's sun).
+    let (vpls, alpha, theta, segments) = (64.0, 256.0, 256u64, 8.0);
+    out.push(KernelCost {
+        method: "area_ivsv v64-a256-t256-k8",
+        kernel: "ivsv_rectify",
+        invocations: 128 * theta * 64,
+        // One light ray: its direction (sin, cos of phi; the plane normal's sin and cos of
+        // theta), one nearest shadow-map load, the occluder's eye angle (atan2), the bias and
+        // the light-space transform (about 60 FMAs), one 4-byte atomicOr.
+        counts: [4.0, 1.0, 0.0, 5.0, 60.0],
+        low: None,
+        trips: "none (one light ray)",
+    });
+    out.push(KernelCost {
+        method: "area_ivsv v64-a256-t256-k8",
+        kernel: "ivsv_scan",
+        invocations: 4 * theta * 64,
+        // One word of a row, scanned along alpha: per texel an atomicExchange of `marks`
+        // (a load and a 4-byte store), an OR and a 4-byte store to `volume`.
+        counts: [8.0 * alpha, alpha, 0.0, 0.0, 2.0 * alpha],
+        low: None,
+        trips: "alpha texels",
+    });
+    out.push(KernelCost {
+        method: "area_ivsv v64-a256-t256-k8",
+        kernel: "ivsv_gather",
+        invocations: pixels,
+        // The depth load; per VPL: alpha, theta, phi_s, phi0 (4 atan2), sin and cos of alpha,
+        // acos and sqrt of the cone's interval, cos and sin of the step, of lo and of
+        // alpha + lo (11), then per knot (segments + 1) an exp and the phase's pow (2);
+        // 8 storage loads (two rows' 128 bits); per segment two masked popcount moments
+        // (about 60 operations each) and the density (about 25): about 150, plus 80 of set-up.
+        counts: [
+            8.0,
+            1.0 + 8.0 * vpls,
+            0.0,
+            vpls * (11.0 + 2.0 * (segments + 1.0)),
+            vpls * (150.0 * segments + 80.0),
+        ],
+        low: None,
+        trips: "N VPLs x segments pieces",
+    });
+    out.push(KernelCost {
+        method: "area_ivsv v64-a256-t256-k8-i2",
+        kernel: "ivsv_interleave_sum",
+        invocations: pixels,
+        // The 2 x 2 window of partial sums (rgba32float loads), 3 x 3 adds, the store.
+        counts: [8.0, 4.0, 0.0, 0.0, 12.0],
+        low: None,
+        trips: "M x M taps",
+    });
     out
 }
 

@@ -451,7 +451,21 @@ fn run_variant_in(
         } else {
             None
         },
-        vpl_maps: None,
+        // An area light's VPL maps, as the engine renders them (framed by the set-up).
+        vpl_maps: match variant {
+            FamilyVariant::AreaIvsv(v) => Some(
+                scatter_reference::kernels::ivsv_inputs(
+                    scene,
+                    gbuf,
+                    frame.bvh,
+                    v,
+                    frame.shadow_map.size,
+                )
+                .map_err(|e| e.to_string())?
+                .map_data,
+            ),
+            _ => None,
+        },
     };
     let out = match cache {
         None => scatter_runtime::run_family_once(ctx, variant, res, &cpu),

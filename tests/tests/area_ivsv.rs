@@ -3,7 +3,9 @@
 //! (`reference/src/kernels/ivsv_*.rs`) on every area pose (`area_columns`, `area_window`,
 //! `area_grate` x the suite's four poses) for the variants of [`variants`], at 37x21 pixels
 //! with 64^2 VPL maps. Trials are named `area_ivsv::<variant id>::<scene>::<pose>`;
-//! `area_ivsv::errors` checks the error paths; `area_ivsv::stress::<case>` the stress cases
+//! `area_ivsv::errors` checks the error paths; `area_ivsv::family_table::<scene>::<pose>` the
+//! family through the tables every family shares (`FamilyPasses` with the frame's area light
+//! and VPL map array, against `run_family`'s mirrors); `area_ivsv::stress::<case>` the stress cases
 //! against the truth and `area_ivsv::flicker::area_grate::<path>` temporal stability (both
 //! documented at their functions).
 //!
@@ -377,8 +379,55 @@ fn errors() -> Result<(), String> {
     }
 }
 
+/// The family through the shared tables: `scatter_runtime::FamilyPasses` (the frame's
+/// `LightDesc::Area`, the VPL frames from its standard map, the VPL map array as an input)
+/// against `scatter_reference::kernels::run_family`, both as `scatter_conformance::run_variant`
+/// drives every family, within the gather's bar (rel L1 <= 1e-3); the frame the runtime set
+/// up is the one the mirrors ran.
+fn family_table(name: AreaSceneName, pose: Pose) -> Result<String, String> {
+    use scatter_reference::kernels::CpuFrame;
+    use scatter_shaderlib::family::FamilyVariant;
+    use scatter_shaderlib::prefiltered::FrameSettings;
+    let Some(ctx) = gpu() else { return Ok(String::new()) };
+    let v = FamilyVariant::AreaIvsv(AreaIvsvVariant::grid()[0]);
+    let scene = area_suite::scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
+    let bvh = Bvh::build(&scene.geometry);
+    let gbuf = GBuffer::cast(&scene, &bvh);
+    // An area light's standard map is its point limit's: the VPL maps' template.
+    let sm = ShadowMap::build(&scene, &bvh, MAP).map_err(|e| e.to_string())?;
+    let settings = FrameSettings::for_screen(SCREEN[0], SCREEN[1]);
+    let frame = CpuFrame {
+        scene: &scene,
+        bvh: &bvh,
+        gbuf: &gbuf,
+        shadow_map: &sm,
+        rectified: [64, 64],
+        settings: &settings,
+    };
+    let (gpu_out, report) = scatter_conformance::run_variant(Some(ctx), &v, &frame)?;
+    let (cpu_out, _) = scatter_conformance::run_variant(None, &v, &frame)?;
+    if report.is_some() {
+        return Err("area_ivsv has no epipolar frame report".into());
+    }
+    let e = metrics::rel_l1(&gpu_out, &cpu_out).map_err(|e| e.to_string())?;
+    let peak = cpu_out.data.iter().flatten().fold(0.0f32, |m, &x| m.max(x));
+    if !(e <= 1e-3) || peak <= 0.0 {
+        return Err(format!("GPU vs mirrors through the family tables: rel L1 {e:.2e}, peak {peak}"));
+    }
+    Ok(format!("rel L1 {e:.2e} (peak {peak:.3e})"))
+}
+
 fn main() -> ExitCode {
     let mut trials: Vec<(String, Check)> = Vec::new();
+    for (name, pose) in [
+        (AreaSceneName::Grate, Pose::Ordinary),
+        (AreaSceneName::Window, Pose::EpipoleOnScreen),
+    ] {
+        trials.push((
+            format!("area_ivsv::family_table::{name}::{pose}"),
+            Box::new(move || family_table(name, pose).map(|m| eprintln!("     {m}"))),
+        ));
+    }
     for v in variants() {
         for (name, pose) in area_suite::all() {
             let trial_name = format!("area_ivsv::{}::{name}::{pose}", v.id());
