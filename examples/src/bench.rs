@@ -14,6 +14,7 @@
 //! in one run, never asserted.
 
 use std::fmt::Write as _;
+use std::ops::Not as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -28,6 +29,7 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_runtime::prefiltered::{FrameInput, Inputs};
 use scatter_runtime::shaderlib::Kernel;
+use scatter_runtime::shaderlib::area_ivsv::AreaIvsvVariant;
 use scatter_runtime::shaderlib::family::{Family, FamilyVariant, KernelFamily};
 use scatter_runtime::shaderlib::hybrid_volume::HybridVolumeVariant;
 use scatter_runtime::shaderlib::minmax::MinmaxVariant;
@@ -457,8 +459,30 @@ pub struct BenchResult {
 /// Any error of a bench run.
 pub type BoxError = Box<dyn std::error::Error>;
 
-/// A run: its passes, its output (rgba, row-major) and its GPU timestamps.
-type MethodRun = (FamilyPasses, Vec<[f32; 4]>, Option<Duration>);
+/// A run: its passes, its output (rgba, row-major), its GPU timestamps and, for an area
+/// light's family, the VPL map array it reads (uploaded once, kept for the timing).
+struct MethodRun {
+    pass: FamilyPasses,
+    output: Vec<[f32; 4]>,
+    gpu_timestamps: Option<Duration>,
+    vpl_maps: Option<(scatter_runtime::wgpu::Texture, TextureView)>,
+}
+
+/// The VPLs of the `vpl` truth an area case's second error column is measured against:
+/// the most a variant takes (`scatter_frame::area_ivsv::MAX_VPLS`), so that every candidate's
+/// VPL count is compared with one converged VPL set (with the engine's map size).
+pub const AREA_TRUTH_VPLS: usize = 256;
+
+/// Whether `method` renders `light` (the single-light families a sun or a spot, `area_ivsv`
+/// an area light): a method of another light is left out of a case, not failed.
+fn renders(method: &Method, light: LightKind) -> bool {
+    method
+        .variant
+        .with_light(light)
+        .validate()
+        .is_err_and(|e| e.knob == "light")
+        .not()
+}
 
 fn light_of(name: SceneName) -> LightKind {
     if name == SceneName::SpotGrate {
@@ -500,13 +524,18 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
         let exact = truth::render(&scene, &gbuf, &Visibility::Exact(&bvh), &settings, &|| ());
         bar.inc(1);
         bar.set_message(format!("{name}/{pose}: shadow_map truth"));
-        let sm_truth = truth::render(
-            &scene,
-            &gbuf,
-            &Visibility::ShadowMap(&sm),
-            &settings,
-            &|| (),
-        );
+        // An area light's: the `vpl` truth of the most VPLs, each with its engine map.
+        let sm_truth = if scene.light.area().is_some() {
+            truth::render_vpl(&scene, &gbuf, &bvh, AREA_TRUTH_VPLS, sm.size, &settings)?
+        } else {
+            truth::render(
+                &scene,
+                &gbuf,
+                &Visibility::ShadowMap(&sm),
+                &settings,
+                &|| (),
+            )
+        };
         bar.inc(1);
         let depth = upload_r32float(
             ctx,
@@ -527,6 +556,7 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
         let methods: Vec<Method> = config
             .methods
             .iter()
+            .filter(|m| renders(m, case.light()))
             .map(|m| m.with_light(case.light()))
             .collect();
         let mut runs = Vec::with_capacity(methods.len());
@@ -536,7 +566,7 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
             match run_method(
                 ctx,
                 method,
-                &scene,
+                (&scene, &bvh, &gbuf),
                 &sm,
                 &depth_view,
                 &shadow_view,
@@ -564,16 +594,9 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
         }
         let methods = kept;
         bar.set_message(format!("{name}/{pose}: timing, interleaved"));
-        let inputs = Inputs {
-            depth: &depth_view,
-            shadow_map: Some(&shadow_view),
-            rectified: None,
-            vpl_maps: None,
-        };
-        let times = time_interleaved(ctx, &runs, &inputs, config.frames)?;
-        for ((method, (_, output, gpu_timestamps)), passes) in
-            methods.into_iter().zip(runs).zip(times)
-        {
+        let times = time_interleaved(ctx, &runs, &depth_view, &shadow_view, config.frames)?;
+        for ((method, run), passes) in methods.into_iter().zip(runs).zip(times) {
+            let (output, gpu_timestamps) = (run.output, run.gpu_timestamps);
             let image =
                 Image::from_pixels(w, h, output.iter().map(|c| [c[0], c[1], c[2]]).collect());
             let e = metrics::compare(&image, &exact)?;
@@ -619,8 +642,9 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
 }
 
 /// Runs `method` once on a prepared scene (the engine's depth buffer `dv` and shadow map
-/// `sv` already uploaded): its passes (for [`time_interleaved`]), its output, and the GPU
-/// timestamps of one frame when the adapter has them.
+/// `sv` already uploaded; an area light's VPL maps ray-cast and uploaded here, as an engine
+/// renders them): its passes (for [`time_interleaved`]), its output, and the GPU timestamps
+/// of one frame when the adapter has them.
 #[allow(
     clippy::too_many_arguments,
     reason = "the scene's buffers and the sizes"
@@ -628,7 +652,7 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
 fn run_method(
     ctx: &Context,
     method: Method,
-    scene: &Scene,
+    (scene, bvh, gbuf): (&Scene, &Bvh, &GBuffer),
     sm: &ShadowMap,
     dv: &TextureView,
     sv: &TextureView,
@@ -650,18 +674,35 @@ fn run_method(
             settings: FrameSettings::for_screen(screen[0], screen[1]),
         },
     )?;
+    let vpl_maps = match method.variant {
+        FamilyVariant::AreaIvsv(v) => {
+            let inputs = scatter_reference::kernels::ivsv_inputs(scene, gbuf, bvh, &v, sm.size)?;
+            Some(scatter_runtime::upload_vpl_maps(
+                ctx,
+                sm.size,
+                v.vpls,
+                &inputs.map_data,
+            )?)
+        }
+        _ => None,
+    };
     let inputs = Inputs {
         depth: dv,
         shadow_map: Some(sv),
         rectified: None,
-        vpl_maps: None,
+        vpl_maps: vpl_maps.as_ref().map(|(_, v)| v),
     };
     let mut encoder = ctx.device().create_command_encoder(&Default::default());
     pass.encode(ctx, &mut encoder, &inputs)?;
     ctx.queue().submit([encoder.finish()]);
     let ts = pass.total_pass_time(ctx)?;
     let output = read_rgba16float(ctx, Kernel::Scatter, pass.output_texture())?;
-    Ok((pass, output, ts))
+    Ok(MethodRun {
+        pass,
+        output,
+        gpu_timestamps: ts,
+        vpl_maps,
+    })
 }
 
 /// The median wall time of each pass of each run over `frames` rounds; a round times one
@@ -670,16 +711,26 @@ fn run_method(
 fn time_interleaved(
     ctx: &Context,
     runs: &[MethodRun],
-    inputs: &Inputs<'_>,
+    dv: &TextureView,
+    sv: &TextureView,
     frames: u32,
 ) -> Result<Vec<Vec<(&'static str, Duration)>>, BoxError> {
-    for (pass, _, _) in runs {
-        pass.measure_pass_wall_times(ctx, inputs, 1)?;
+    fn inputs<'a>(run: &'a MethodRun, dv: &'a TextureView, sv: &'a TextureView) -> Inputs<'a> {
+        Inputs {
+            depth: dv,
+            shadow_map: Some(sv),
+            rectified: None,
+            vpl_maps: run.vpl_maps.as_ref().map(|(_, v)| v),
+        }
+    }
+    let inputs = |run| inputs(run, dv, sv);
+    for run in runs {
+        run.pass.measure_pass_wall_times(ctx, &inputs(run), 1)?;
     }
     let mut samples: Vec<Vec<(&'static str, Vec<Duration>)>> = vec![Vec::new(); runs.len()];
     for _ in 0..frames.max(1) {
-        for ((pass, _, _), s) in runs.iter().zip(&mut samples) {
-            let t = pass.measure_pass_wall_times(ctx, inputs, 1)?;
+        for (run, s) in runs.iter().zip(&mut samples) {
+            let t = run.pass.measure_pass_wall_times(ctx, &inputs(run), 1)?;
             if s.is_empty() {
                 *s = t.iter().map(|(k, _)| (k.name(), Vec::new())).collect();
             }
@@ -705,6 +756,7 @@ fn time_interleaved(
 /// and the engine's depth buffer and shadow map uploaded.
 struct BenchScene {
     scene: Scene,
+    bvh: Bvh,
     gbuf: GBuffer,
     sm: ShadowMap,
     dv: TextureView,
@@ -740,6 +792,7 @@ fn bench_scene(ctx: &Context, name: SceneName, screen: [u32; 2]) -> Result<Bench
         dv: depth.create_view(&Default::default()),
         sv: shadow.create_view(&Default::default()),
         scene,
+        bvh,
         gbuf,
         sm,
     })
@@ -778,7 +831,12 @@ fn time_methods_on(
     frames: u32,
 ) -> Result<Vec<TimedOutput>, BoxError> {
     let BenchScene {
-        scene, sm, dv, sv, ..
+        scene,
+        bvh,
+        gbuf,
+        sm,
+        dv,
+        sv,
     } = bench;
     let runs = methods
         .iter()
@@ -786,7 +844,7 @@ fn time_methods_on(
             run_method(
                 ctx,
                 m.with_light(light_of(name)),
-                scene,
+                (scene, bvh, gbuf),
                 sm,
                 dv,
                 sv,
@@ -795,17 +853,11 @@ fn time_methods_on(
             )
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let inputs = Inputs {
-        depth: dv,
-        shadow_map: Some(sv),
-        rectified: None,
-        vpl_maps: None,
-    };
-    let times = time_interleaved(ctx, &runs, &inputs, frames)?;
+    let times = time_interleaved(ctx, &runs, dv, sv, frames)?;
     Ok(times
         .into_iter()
         .zip(runs)
-        .map(|(t, (_, output, _))| (t, output))
+        .map(|(t, run)| (t, run.output))
         .collect())
 }
 
@@ -1688,9 +1740,28 @@ pub fn write_outputs(
 /// paper's 8 bases per thread, rgba8unorm) and the moment basis with 4 or 6 moments and 4 or
 /// 8 regions, each with a 512x512 and a 256x256 rectified map,
 /// raymarch N over {16, 32, 64, 128, 256, 512} plus interleaved (64, 4x4) and (256, 4x4),
-/// minmax with both maps. Run it with `BenchConfig::rectified` = 512x512.
+/// minmax with both maps; for an area light (a case runs only the methods of its light),
+/// `area_ivsv` with 16, 64 and 256 VPLs, two grid sizes and the interleaved gather. Run it
+/// with `BenchConfig::rectified` = 512x512.
 pub fn tune_candidates() -> Vec<Method> {
     let mut out = Vec::new();
+    // Issue 17: area lights, the VPL count (how soft a shadow needs), the grid, the gather.
+    for (vpls, bins, interleave) in [
+        (16, 256, 1),
+        (64, 128, 1),
+        (64, 256, 1),
+        (64, 256, 2),
+        (256, 128, 1),
+        (256, 128, 4),
+    ] {
+        out.push(Method::from(AreaIvsvVariant {
+            vpls,
+            alpha: bins,
+            theta: bins,
+            interleave,
+            ..AreaIvsvVariant::default()
+        }));
+    }
     for rectified in [None, Some([256, 256])] {
         for bases in [16, 32, 64] {
             for regions in [1, 4, 8] {
