@@ -256,13 +256,27 @@ pub fn reflect(
                         b.min_binding_size = Some(*stride);
                         cx.collect_structs(*base, &mut structs);
                     }
+                    TypeInner::Array { stride, .. } => {
+                        b.array_stride = Some(*stride);
+                        b.min_binding_size = Some(layouter[var.ty].size);
+                        cx.collect_structs(var.ty, &mut structs);
+                    }
                     _ => {
                         b.min_binding_size = Some(layouter[var.ty].size);
                         cx.collect_structs(var.ty, &mut structs);
                     }
                 }
-                if let TypeInner::Struct { .. } = inner {
-                    b.struct_name = Some(demangle(&b.ty).to_owned());
+                match inner {
+                    TypeInner::Struct { .. } => {
+                        b.struct_name = Some(demangle(&b.ty).to_owned());
+                    }
+                    // An array of structs (a slice table, VPL records): its element's.
+                    TypeInner::Array { base, .. }
+                        if matches!(module.types[*base].inner, TypeInner::Struct { .. }) =>
+                    {
+                        b.struct_name = Some(demangle(&cx.type_name(*base)).to_owned());
+                    }
+                    _ => {}
                 }
             }
             AddressSpace::Handle => match inner {

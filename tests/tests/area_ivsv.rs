@@ -388,7 +388,9 @@ fn family_table(name: AreaSceneName, pose: Pose) -> Result<String, String> {
     use scatter_reference::kernels::CpuFrame;
     use scatter_shaderlib::family::FamilyVariant;
     use scatter_shaderlib::prefiltered::FrameSettings;
-    let Some(ctx) = gpu() else { return Ok(String::new()) };
+    let Some(ctx) = gpu() else {
+        return Ok(String::new());
+    };
     let v = FamilyVariant::AreaIvsv(AreaIvsvVariant::grid()[0]);
     let scene = area_suite::scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
     let bvh = Bvh::build(&scene.geometry);
@@ -412,7 +414,9 @@ fn family_table(name: AreaSceneName, pose: Pose) -> Result<String, String> {
     let e = metrics::rel_l1(&gpu_out, &cpu_out).map_err(|e| e.to_string())?;
     let peak = cpu_out.data.iter().flatten().fold(0.0f32, |m, &x| m.max(x));
     if !(e <= 1e-3) || peak <= 0.0 {
-        return Err(format!("GPU vs mirrors through the family tables: rel L1 {e:.2e}, peak {peak}"));
+        return Err(format!(
+            "GPU vs mirrors through the family tables: rel L1 {e:.2e}, peak {peak}"
+        ));
     }
     Ok(format!("rel L1 {e:.2e} (peak {peak:.3e})"))
 }

@@ -387,6 +387,7 @@ fn other_families_dir() -> &'static Path {
                     .into_iter()
                     .map(FamilyVariant::PartialSumTree),
             )
+            .chain(area_variants().into_iter().map(FamilyVariant::AreaIvsv))
             .collect();
         let generated = generate(&Request {
             variants,
@@ -397,6 +398,17 @@ fn other_families_dir() -> &'static Path {
         dir
     })
 }
+
+/// The area_ivsv trial variants: 8 VPLs per pixel, and interleaved (2 x 2, the `partial`
+/// texture and the `ivsv_interleave_sum` pass): the `vpls` uniform array and the VPL map
+/// array the engine uploads, the voxel buffers it allocates from the manifest.
+fn area_variants() -> [scatter_frame::area_ivsv::AreaIvsvVariant; 2] {
+    let g = scatter_frame::area_ivsv::AreaIvsvVariant::grid();
+    [g[0], g[3]]
+}
+
+/// The area light's VPL map size of the area_ivsv trials.
+const AREA_MAP: u32 = 64;
 
 /// The partial-sum-tree trial variants: rank 4 directional, rank 8 spot (two vec4 per
 /// leaf) and rank 4 spot with the cookie, 64 slices x 64 samples: the `pst_factors` buffer
@@ -751,12 +763,74 @@ fn foreign_engine_matches_runtime_for_every_family() {
             },
         ));
     }
+    // The area light: `area_grate/ordinary`, its VPL maps framed by the set-up from the
+    // point limit's standard map and ray-cast (as an engine renders them).
+    let area = {
+        use scatter_reference::area_suite::{self, AreaSceneName};
+        let scene = area_suite::scene(
+            AreaSceneName::Grate,
+            Pose::Ordinary,
+            scatter_reference::suite::MediumPreset::Default,
+            SCREEN[0],
+            SCREEN[1],
+        );
+        let bvh = scatter_reference::bvh::Bvh::build(&scene.geometry);
+        let gbuf = scatter_reference::buffers::GBuffer::cast(&scene, &bvh);
+        (scene, bvh, gbuf)
+    };
+    for v in area_variants() {
+        let (scene, bvh, gbuf) = &area;
+        let name = format!("foreign::area_ivsv::{}::area_grate::ordinary", v.id());
+        let inputs = scatter_reference::kernels::ivsv_inputs(scene, gbuf, bvh, &v, AREA_MAP)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let runtime = scatter_runtime::run_area_ivsv_once(
+            ctx,
+            &v,
+            SCREEN,
+            &scene.camera_desc(),
+            &scene.medium_desc(),
+            &inputs.vpls,
+            AREA_MAP,
+            &gbuf.view_depth,
+            &inputs.map_data,
+        )
+        .unwrap_or_else(|e| panic!("{name}: runtime: {e}"));
+        assert_eq!(
+            runtime.frame, inputs.frame,
+            "{name}: the runtime set up another frame"
+        );
+        let mut expect = vec!["ivsv_rectify", "ivsv_scan", "ivsv_gather"];
+        if v.interleave > 1 {
+            expect.push("ivsv_interleave_sum");
+        }
+        lines.extend(compare_targets(&name, &runtime.output, &expect, |target| {
+            let sizes = scatter_foreign_engine::area_ivsv::Sizes {
+                screen: SCREEN,
+                shadow_map: AREA_MAP,
+            };
+            let mut engine = Engine::load(
+                ctx.device(),
+                ctx.queue(),
+                dir,
+                &v.id(),
+                target,
+                &sizes.params(),
+            )?;
+            scatter_foreign_engine::area_ivsv::run_frame(
+                &mut engine,
+                &inputs.frame,
+                &gbuf.view_depth,
+                &inputs.map_data,
+            )
+        }));
+    }
     assert_eq!(
         lines.len(),
         2 * (raymarch_variants().len()
             + MinmaxVariant::grid().len()
             + hybrid_variants().len()
-            + pst_variants().len())
+            + pst_variants().len()
+            + area_variants().len())
     );
 }
 

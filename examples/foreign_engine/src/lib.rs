@@ -12,7 +12,8 @@
 //! - [`formula`]: size and dispatch formulas, parameter constraints;
 //! - [`condition`]: per-frame conditions (`skip_when`, `alternative.when`);
 //! - [`engine`]: [`Engine`], family-agnostic;
-//! - [`prefiltered`], [`raymarch`], [`minmax`], [`partial_sum_tree`]: what each family's
+//! - [`prefiltered`], [`raymarch`], [`minmax`], [`partial_sum_tree`], [`hybrid_volume`],
+//!   [`area_ivsv`]: what each family's
 //!   resources hold, one
 //!   frame end to end (the only family-specific code: which host struct goes into which
 //!   buffer, which engine texture into which resource, the family's size parameters);
@@ -33,6 +34,7 @@
 //! # let _ = out; Ok(()) }
 //! ```
 
+pub mod area_ivsv;
 pub mod condition;
 pub mod engine;
 mod error;

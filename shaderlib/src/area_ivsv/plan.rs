@@ -111,9 +111,11 @@ pub fn plan(v: &AreaIvsvVariant) -> Plan {
             "Run the passes in order; each reads what the previous ones wrote: put a \
              compute-to-compute memory barrier between them.",
             "Write `frame` and `vpls` once per frame before the first pass (Rust: \
-             scatter_frame::area_ivsv::prepare_area_ivsv from the camera, the medium and each \
-             VPL's spot light and shadow-map description). Render every VPL's shadow map into \
-             its layer of `vpl_maps` first.",
+             scatter_frame::area_ivsv::prepare_area_light from the camera, the area light, the \
+             medium and the standard shadow map of the light's point limit, a perspective map \
+             of `shadow.size` at its centre; it places the VPLs and gives each one's \
+             shadow-map frame). Render every VPL's shadow map with its frame into its layer of \
+             `vpl_maps` first.",
             "`marks` must be zero when created (WebGPU buffers are); `ivsv_scan` leaves it zero \
              for the next frame.",
             "Group 0 holds every binding; bind by group and binding number, not by name: \
