@@ -413,7 +413,7 @@ fn family_table(name: AreaSceneName, pose: Pose) -> Result<String, String> {
     }
     let e = metrics::rel_l1(&gpu_out, &cpu_out).map_err(|e| e.to_string())?;
     let peak = cpu_out.data.iter().flatten().fold(0.0f32, |m, &x| m.max(x));
-    if !(e <= 1e-3) || peak <= 0.0 {
+    if e.is_nan() || e > 1e-3 || peak <= 0.0 {
         return Err(format!(
             "GPU vs mirrors through the family tables: rel L1 {e:.2e}, peak {peak}"
         ));

@@ -891,6 +891,81 @@ fn foreign_engine_files_run_every_family() {
             .fold(0.0f32, |m, &v| m.max(v));
         assert!(max > 0.0, "{family} through run_dir: black output");
     }
+    // An area light: frame.json with the light, the point limit's map as the template, the
+    // VPL maps stacked in vpl_maps.pfm; the same radiance as the in-memory path.
+    use scatter_reference::area_suite::{self, AreaSceneName};
+    let v = area_variants()[0];
+    let scene = area_suite::scene(
+        AreaSceneName::Grate,
+        Pose::Ordinary,
+        scatter_reference::suite::MediumPreset::Default,
+        SCREEN[0],
+        SCREEN[1],
+    );
+    let bvh = scatter_reference::bvh::Bvh::build(&scene.geometry);
+    let gbuf = scatter_reference::buffers::GBuffer::cast(&scene, &bvh);
+    let template = scatter_reference::buffers::ShadowMap::build(&scene, &bvh, AREA_MAP)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let area = scatter_reference::kernels::ivsv_inputs(&scene, &gbuf, &bvh, &v, AREA_MAP)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let file = FrameFile::new(
+        Sizes {
+            screen: SCREEN,
+            rectified: RECTIFIED,
+            shadow_map: AREA_MAP,
+        },
+        &scene.camera_desc(),
+        &scene.light_desc(),
+        &scene.medium_desc(),
+        &template.desc(),
+        &FrameSettings::for_screen(SCREEN[0], SCREEN[1]),
+    );
+    let inputs = scratch("inputs-area_ivsv");
+    write_inputs(&inputs, &file, &gbuf.view_depth, &template.depth, None)
+        .unwrap_or_else(|e| panic!("{e}"));
+    scatter_foreign_engine::files::write_vpl_maps(&inputs, AREA_MAP, v.vpls, &area.map_data)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let summary = run_dir(
+        ctx.device(),
+        ctx.queue(),
+        &RunArgs {
+            shaders: other_families_dir().to_path_buf(),
+            variant: Some(v.id()),
+            inputs,
+            out: None,
+            target: Target::Spirv,
+        },
+    )
+    .unwrap_or_else(|e| panic!("run_dir area_ivsv: {e}"));
+    assert_eq!(summary.family, "area_ivsv");
+    let mut engine = Engine::load(
+        ctx.device(),
+        ctx.queue(),
+        other_families_dir(),
+        &v.id(),
+        Target::Spirv,
+        &scatter_foreign_engine::area_ivsv::Sizes {
+            screen: SCREEN,
+            shadow_map: AREA_MAP,
+        }
+        .params(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let direct = scatter_foreign_engine::area_ivsv::run_frame(
+        &mut engine,
+        &area.frame,
+        &gbuf.view_depth,
+        &area.map_data,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        summary.radiance, direct.radiance,
+        "area_ivsv: files vs memory"
+    );
+    assert!(
+        direct.radiance.iter().any(|p| p[0] > 0.0),
+        "area_ivsv through run_dir: black output"
+    );
 }
 
 /// The comparison can fail: the foreign engine fed a depth buffer 10 % short differs from

@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+use scatter_frame::area_ivsv::{AreaIvsvVariant, prepare_area_light};
 use scatter_frame::area_light::{AreaLightDesc, AreaShapeDesc};
 use scatter_frame::frame::{
     CameraDesc, FrameSettings, LightDesc, MediumDesc, PrefilteredFrame, Resolutions, ShadowMapDesc,
@@ -674,6 +675,28 @@ pub const DEPTH_FILE: &str = "depth.pfm";
 pub const SHADOW_MAP_FILE: &str = "shadow_map.pfm";
 /// The rasterised rectified map of a projective frame.
 pub const RECTIFIED_FILE: &str = "rectified.pfm";
+/// An area light's VPL shadow maps: one `size x size` map per VPL stacked top to bottom in
+/// VPL order (`size` wide, `size * VPLs` tall), each rendered with the frame the set-up
+/// gives its VPL (`scatter_frame::area_ivsv::prepare_area_light`).
+pub const VPL_MAPS_FILE: &str = "vpl_maps.pfm";
+
+/// Writes an area light's VPL shadow maps ([`VPL_MAPS_FILE`]) beside [`write_inputs`]'s files:
+/// `maps` holds `layers` maps of `size` squared texels, layer after layer.
+///
+/// # Errors
+///
+/// [`EngineError::Io`] when a file cannot be written; [`EngineError::InputFile`] when `maps`
+/// does not hold `layers` maps.
+pub fn write_vpl_maps(dir: &Path, size: u32, layers: u32, maps: &[f32]) -> Result<(), EngineError> {
+    let path = dir.join(VPL_MAPS_FILE);
+    if maps.len() as u64 != u64::from(size) * u64::from(size) * u64::from(layers) {
+        return Err(EngineError::InputFile {
+            path,
+            reason: format!("{} texels for {layers} maps of {size}x{size}", maps.len()),
+        });
+    }
+    write_pfm(&path, size, size * layers, maps, 1, 1)
+}
 
 /// What [`run_dir`] needs.
 #[derive(Clone, Debug)]
@@ -823,6 +846,30 @@ pub fn run_dir(
                 crate::partial_sum_tree::run_frame(&mut engine, &frame, &depth, &shadow, None)?;
             (Some(frame.frame), out)
         }
+        Knobs::AreaIvsv(variant) => {
+            let d = file.descs();
+            let (frame, _) = prepare_area_light(
+                variant,
+                file.screen,
+                &d.camera,
+                &d.light,
+                &d.medium,
+                &d.shadow_map,
+            )
+            .map_err(EngineError::Frame)?;
+            let size = file.shadow_map.size;
+            let maps = read_sized(
+                &args.inputs.join(VPL_MAPS_FILE),
+                [size, size.saturating_mul(variant.vpls)],
+            )?;
+            let sizes = crate::area_ivsv::Sizes {
+                screen: file.screen,
+                shadow_map: size,
+            };
+            let mut engine = load(&sizes.params())?;
+            let out = crate::area_ivsv::run_frame(&mut engine, &frame, &depth, &maps)?;
+            (None, out)
+        }
         Knobs::Raymarch(variant) => {
             let uniforms = file.prepare_raymarch(variant)?;
             let sizes = crate::raymarch::Sizes {
@@ -861,6 +908,8 @@ pub enum Knobs {
     HybridVolume(HybridVolumeVariant),
     /// A `partial_sum_tree` variant.
     PartialSumTree(PartialSumTreeVariant),
+    /// An `area_ivsv` variant.
+    AreaIvsv(AreaIvsvVariant),
 }
 
 impl Knobs {
@@ -872,6 +921,7 @@ impl Knobs {
             Knobs::HybridVolume(v) => v.cookie,
             Knobs::Prefiltered(v) => v.cookie,
             Knobs::PartialSumTree(v) => v.cookie,
+            Knobs::AreaIvsv(_) => false,
         }
     }
 }
@@ -885,6 +935,7 @@ impl Knobs {
             Self::Minmax(_) => "minmax",
             Self::HybridVolume(_) => "hybrid_volume",
             Self::PartialSumTree(_) => "partial_sum_tree",
+            Self::AreaIvsv(_) => "area_ivsv",
         }
     }
 }
@@ -949,6 +1000,12 @@ pub fn knobs_of(manifest: &crate::Manifest, id: &str) -> Result<Knobs, EngineErr
             PartialSumTreeVariant::id,
         )
         .map(Knobs::PartialSumTree),
+        "area_ivsv" => parse_knobs(
+            entry,
+            |v: &AreaIvsvVariant| v.validate().map_err(|e| e.to_string()),
+            AreaIvsvVariant::id,
+        )
+        .map(Knobs::AreaIvsv),
         _ => Err(EngineError::Unsupported {
             context: format!("variant {id}"),
             what: "family",

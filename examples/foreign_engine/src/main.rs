@@ -1,6 +1,7 @@
 //! `scatter-foreign-engine`: runs one frame of a variant that `scatter-gen` emitted, on raw
 //! wgpu, from the shader directory's `manifest.json` and an input directory of plain files
-//! (`frame.json`, `depth.pfm`, `shadow_map.pfm`, `rectified.pfm` for projective frames; see
+//! (`frame.json`, `depth.pfm`, `shadow_map.pfm`, `rectified.pfm` for projective frames,
+//! `vpl_maps.pfm` for an area light; see
 //! the library's `files` module), and writes the in-scattered radiance as a colour PFM.
 //!
 //! Exit codes: 0 success, 1 failure (one line on stderr), 2 bad command line.
@@ -29,7 +30,8 @@ struct Cli {
     /// PrefilteredVariant id (from the manifest); may be left out when it has only one.
     #[arg(long, value_name = "ID")]
     variant: Option<String>,
-    /// Input directory: frame.json, depth.pfm, shadow_map.pfm (rectified.pfm).
+    /// Input directory: frame.json, depth.pfm, shadow_map.pfm (rectified.pfm; an area
+    /// light's vpl_maps.pfm).
     #[arg(long, value_name = "DIR")]
     inputs: PathBuf,
     /// Output PFM (colour) of the in-scattered radiance.
