@@ -2,7 +2,7 @@
 //! `PrefilteredVariant::grid(1..=4)`, every `bases` power of two with every
 //! `bases_per_thread`, 1-4 regions, both visibilities and lights, every storage format and
 //! every rectification; raymarch samples 8/32/128, interleave 1/2/4, jitter, both lights;
-//! minmax, partial-sum-tree and hybrid-volume grids as their modules list) through the
+//! minmax, partial-sum-tree, hybrid-volume and area_ivsv grids as their modules list) through the
 //! generator with every target, then every distinct emitted SPIR-V through `spirv-val`,
 //! every distinct GLSL through `glslangValidator` and every distinct HLSL through
 //! `glslangValidator -D` (its HLSL front end, to SPIR-V). Identical files (e.g. `rectify`
