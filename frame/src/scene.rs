@@ -150,7 +150,7 @@ pub struct ShadowMapDesc {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FrameError {
     /// The light type differs from the variant's.
-    #[error("the variant is compiled for a {expected} light but the frame has a {got} light")]
+    #[error("the variant is compiled for light = {expected} but the frame has light = {got}")]
     LightMismatch {
         /// The variant's light.
         expected: LightKind,

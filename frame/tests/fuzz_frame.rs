@@ -281,7 +281,7 @@ impl Mutation {
             Self::MarchSteps(_) => &["march steps"],
             Self::SpotQuadrature(_) => &["spot quadrature"],
             Self::ProjectiveMaxHalfAngle(_) => &["projective_max_half_angle_deg"],
-            Self::SwapLight => &["light but the frame has a"],
+            Self::SwapLight => &["but the frame has light = "],
             Self::Knobs(..) => &["regions", "bases"],
         }
     }

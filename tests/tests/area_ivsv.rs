@@ -374,8 +374,74 @@ fn errors() -> Result<(), String> {
     let camera = c.scene.camera_desc();
     let medium = c.scene.medium_desc();
     match pass.prepare(ctx, &camera, &medium, &[]) {
-        Err(e) if e.to_string().contains("VPL count") => Ok(()),
-        other => Err(format!("no VPLs: {other:?}")),
+        Err(e) if e.to_string().contains("VPL count") => {}
+        other => return Err(format!("no VPLs: {other:?}")),
+    }
+    family_errors(ctx, &c.scene)
+}
+
+/// The error paths of the family through the shared tables: a spot light, a template of
+/// another size, a frame without its VPL map array, each named.
+fn family_errors(
+    ctx: &scatter_runtime::Context,
+    scene: &scatter_reference::scene::Scene,
+) -> Result<(), String> {
+    use scatter_runtime::{FamilyPasses, FrameInput, Inputs};
+    use scatter_shaderlib::family::FamilyVariant;
+    use scatter_shaderlib::prefiltered::{FrameSettings, Resolutions};
+    let v = FamilyVariant::AreaIvsv(AreaIvsvVariant::grid()[1]);
+    let res = Resolutions {
+        screen: [8, 8],
+        rectified: [64, 64],
+    };
+    let mut passes = FamilyPasses::new(ctx, &v, res, 16).map_err(|e| e.to_string())?;
+    let bvh = Bvh::build(&scene.geometry);
+    let template = ShadowMap::build(scene, &bvh, 16).map_err(|e| e.to_string())?;
+    let input = FrameInput {
+        camera: scene.camera_desc(),
+        light: scene.light_desc(),
+        medium: scene.medium_desc(),
+        shadow_map: template.desc(),
+        settings: FrameSettings::for_screen(8, 8),
+    };
+    let spot = FrameInput {
+        light: scene
+            .light
+            .area()
+            .map(|a| a.desc().point_limit())
+            .ok_or("the area scene has an area light")?,
+        ..input
+    };
+    match passes.prepare(ctx, &spot) {
+        Err(e) if e.to_string().contains("compiled for light = area") => {}
+        other => return Err(format!("a spot light: {other:?}")),
+    }
+    let mut other_size = input;
+    other_size.shadow_map.size = 32;
+    match passes.prepare(ctx, &other_size) {
+        Err(e) if e.to_string().contains("shadow map size") => {}
+        other => return Err(format!("a 32^2 template for 16^2 maps: {other:?}")),
+    }
+    passes.prepare(ctx, &input).map_err(|e| e.to_string())?;
+    let depth = scatter_runtime::textures::upload_r32float(
+        ctx,
+        scatter_shaderlib::Kernel::IvsvGather,
+        "depth",
+        [8, 8],
+        &[1.0; 64],
+    )
+    .map_err(|e| e.to_string())?;
+    let view = depth.create_view(&Default::default());
+    let mut encoder = ctx.device().create_command_encoder(&Default::default());
+    let inputs = Inputs {
+        depth: &view,
+        shadow_map: None,
+        rectified: None,
+        vpl_maps: None,
+    };
+    match passes.encode(ctx, &mut encoder, &inputs) {
+        Err(e) if e.to_string().contains("VPL shadow maps") => Ok(()),
+        other => Err(format!("no VPL maps: {:?}", other.map(|_| ()))),
     }
 }
 
