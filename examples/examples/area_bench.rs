@@ -13,7 +13,8 @@
 //! cargo run --release -p scatter-examples --example area_bench -- --out docs/bench
 //! ```
 //!
-//! Writes `area.csv` and `area.md` into `--out`. Speed is a ratio from one run (never a
+//! Writes `area.csv`, `area.md` and the chart (`area.svg`, `area.png`: error against time,
+//! one line per method and VPL count) into `--out`. Speed is a ratio from one run (never a
 //! timed test); the machine is shared and noisy.
 
 use std::fmt::Write as _;
@@ -21,6 +22,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::Parser;
+use scatter_examples::bench::{AreaPoint, write_area_chart};
 use scatter_reference::area_suite::{self, AreaSceneName};
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
@@ -36,7 +38,7 @@ use scatter_runtime::{
 };
 use scatter_shaderlib::Kernel;
 use scatter_shaderlib::area_ivsv::AreaIvsvVariant;
-use scatter_shaderlib::family::FamilyVariant;
+use scatter_shaderlib::family::{Family, FamilyVariant};
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions};
 use scatter_shaderlib::raymarch::RaymarchVariant;
 
@@ -44,7 +46,7 @@ use scatter_shaderlib::raymarch::RaymarchVariant;
 #[derive(Parser, Debug)]
 #[command(about = "area_ivsv against per-VPL ray marching: error and time")]
 struct Args {
-    /// Output folder for area.csv and area.md.
+    /// Output folder for area.csv, area.md and the chart (area.svg, area.png).
     #[arg(long, default_value = "docs/bench")]
     out: PathBuf,
     /// Screen size of the error sweep (WxH).
@@ -197,9 +199,11 @@ fn render(
             let mut pass = FamilyPasses::new(ctx, &raymarch_variant(samples), res, map_size)
                 .map_err(|e| e.to_string())?;
             let mut sum = vec![[0.0f32; 3]; (w * h) as usize];
-            for vpl in scene.point_light_scenes(vpls as usize) {
-                let sm = ShadowMap::build(&vpl, bvh, map_size).map_err(|e| e.to_string())?;
-                let out = run_family_on(ctx, &mut pass, res, &vpl_inputs(&vpl, gbuf, &sm))
+            // The VPL maps area_ivsv and the `vpl` truth read (`ShadowMap::vpl_maps`).
+            let maps = ShadowMap::vpl_maps(scene, bvh, vpls as usize, map_size)
+                .map_err(|e| e.to_string())?;
+            for (vpl, sm) in &maps {
+                let out = run_family_on(ctx, &mut pass, res, &vpl_inputs(vpl, gbuf, sm))
                     .map_err(|e| e.to_string())?;
                 for (acc, p) in sum.iter_mut().zip(&out.output) {
                     for k in 0..3 {
@@ -262,11 +266,12 @@ fn time(
             let mut pass =
                 FamilyPasses::new(ctx, &raymarch_variant(samples), res, map_size).map_err(err)?;
             let mut total = Duration::ZERO;
-            for vpl in scene.point_light_scenes(vpls as usize) {
-                let sm = ShadowMap::build(&vpl, bvh, map_size).map_err(|e| e.to_string())?;
+            let maps = ShadowMap::vpl_maps(scene, bvh, vpls as usize, map_size)
+                .map_err(|e| e.to_string())?;
+            for (vpl, sm) in &maps {
                 let inputs = CpuInputs {
                     pass_wall_frames: frames,
-                    ..vpl_inputs(&vpl, &gbuf, &sm)
+                    ..vpl_inputs(vpl, &gbuf, sm)
                 };
                 let out = run_family_on(ctx, &mut pass, res, &inputs).map_err(err)?;
                 total += out.pass_wall_times.iter().map(|p| p.1).sum::<Duration>();
@@ -488,6 +493,37 @@ fn main() -> Result<(), String> {
         }
     }
     std::fs::create_dir_all(&args.out).map_err(|e| e.to_string())?;
+    let points: Vec<AreaPoint> = rows
+        .iter()
+        .map(|(m, rmse, _, _, total, _)| AreaPoint {
+            family: match m {
+                Method::Ivsv { .. } => Family::AreaIvsv,
+                Method::Raymarch { .. } => Family::Raymarch,
+            },
+            vpls: m.vpls(),
+            label: match m {
+                Method::Ivsv { interleave: 1, .. } => String::new(),
+                Method::Ivsv { interleave, .. } => format!("i{interleave}"),
+                Method::Raymarch { samples, .. } => format!("n{samples}"),
+            },
+            ms: total.as_secs_f64() * 1e3,
+            error_pct: 100.0 * rmse,
+        })
+        .collect();
+    let chart = write_area_chart(
+        &args.out,
+        "area",
+        &format!(
+            "area_ivsv vs per-VPL ray marching ({tw}x{th}, {})",
+            ctx.report().driver.split(" (").next().unwrap_or("")
+        ),
+        "mean rel RMSE vs the vpl truth, 12 area poses (%, log)",
+        &points,
+    )
+    .map_err(|e| e.to_string())?;
+    if !chart.is_empty() {
+        md += "\n![area_ivsv and per-VPL ray marching: error against time](area.png)\n";
+    }
     for (file, text) in [("area.csv", &csv), ("area.md", &md)] {
         let path = args.out.join(file);
         let tmp = path.with_extension("tmp");

@@ -1736,6 +1736,140 @@ pub fn write_outputs(
     Ok(written)
 }
 
+/// One point of [`write_area_chart`]: a method's mean error (%) and time (ms).
+#[derive(Clone, Debug)]
+pub struct AreaPoint {
+    /// `area_ivsv` or the competitor's family (`raymarch`): the colour.
+    pub family: Family,
+    /// The VPL count: points of one count and family are joined by a line.
+    pub vpls: u32,
+    /// The label beside the marker.
+    pub label: String,
+    /// Time per frame (ms).
+    pub ms: f64,
+    /// Mean error (%).
+    pub error_pct: f64,
+}
+
+/// Registers DejaVu Sans as plotters' `sans-serif`, or `None` without one installed.
+fn register_chart_font() -> Option<()> {
+    let font = FONT_PATHS.iter().find_map(|p| std::fs::read(p).ok())?;
+    let font: &'static [u8] = Box::leak(font.into_boxed_slice());
+    plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, font).ok()
+}
+
+fn draw_area<DB: plotters::prelude::DrawingBackend>(
+    root: plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    y_desc: &str,
+    points: &[AreaPoint],
+) -> Result<(), BoxError>
+where
+    DB::ErrorType: 'static,
+{
+    use plotters::prelude::*;
+    root.fill(&WHITE)?;
+    let pts: Vec<(f64, f64)> = points
+        .iter()
+        .map(|p| (p.ms.max(1e-3), p.error_pct.max(1e-3)))
+        .collect();
+    let (xmin, xmax) = pts
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let (ymin, ymax) = pts
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(
+            (xmin / 1.5..xmax * 1.5).log_scale(),
+            (ymin / 1.5..ymax * 1.5).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("time per frame, sum of pass wall times (ms, log)")
+        .y_desc(y_desc)
+        .label_style(("sans-serif", 12))
+        .draw()?;
+    let mut series: Vec<(Family, u32)> = points.iter().map(|p| (p.family, p.vpls)).collect();
+    series.sort();
+    series.dedup();
+    for (family, vpls) in series {
+        let colour = family_colour(family);
+        let mut sel: Vec<(&AreaPoint, (f64, f64))> = points
+            .iter()
+            .zip(pts.iter().copied())
+            .filter(|(p, _)| p.family == family && p.vpls == vpls)
+            .collect();
+        sel.sort_by(|a, b| a.1.0.total_cmp(&b.1.0));
+        chart
+            .draw_series(LineSeries::new(
+                sel.iter().map(|s| s.1),
+                colour.stroke_width(1),
+            ))?
+            .label(format!("{family} N={vpls}"))
+            .legend(move |(x, y)| Circle::new((x + 8, y), 5, colour.filled()));
+        chart.draw_series(sel.iter().map(|s| Circle::new(s.1, 5, colour.filled())))?;
+        chart.draw_series(
+            sel.iter()
+                .map(|s| Text::new(s.0.label.clone(), s.1, ("sans-serif", 11).into_font())),
+        )?;
+    }
+    chart
+        .configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.9))
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// Writes `<stem>.svg` and `<stem>.png` into `dir` (atomically): `points` on log-log axes of
+/// time and error, one line per family and VPL count (`examples/area_bench`'s chart). Skipped
+/// (an empty list) without a DejaVu Sans font.
+///
+/// # Errors
+///
+/// I/O or drawing errors.
+pub fn write_area_chart(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    y_desc: &str,
+    points: &[AreaPoint],
+) -> Result<Vec<PathBuf>, BoxError> {
+    use plotters::prelude::IntoDrawingArea as _;
+    if points.is_empty() || register_chart_font().is_none() {
+        eprintln!(
+            "chart skipped: no points, or no DejaVu Sans font ({})",
+            FONT_PATHS.join(", ")
+        );
+        return Ok(Vec::new());
+    }
+    std::fs::create_dir_all(dir)?;
+    let mut svg = String::new();
+    {
+        let root =
+            plotters::prelude::SVGBackend::with_string(&mut svg, (900, 600)).into_drawing_area();
+        draw_area(root, title, y_desc, points)?;
+    }
+    let svg_path = dir.join(format!("{stem}.svg"));
+    write_atomic(&svg_path, svg.as_bytes())?;
+    let (w, h) = (900u32, 600u32);
+    let mut pixels = vec![0u8; (w * h * 3) as usize];
+    {
+        let root =
+            plotters::prelude::BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
+        draw_area(root, title, y_desc, points)?;
+    }
+    let png_path = dir.join(format!("{stem}.png"));
+    write_png_rgb8(&png_path, w, h, &pixels)?;
+    Ok(vec![svg_path, png_path])
+}
+
 /// The `tune` first-stage grid: prefiltered (M, R) over {16, 32, 64} x {1, 4, 8} (the
 /// paper's 8 bases per thread, rgba8unorm) and the moment basis with 4 or 6 moments and 4 or
 /// 8 regions, each with a 512x512 and a 256x256 rectified map,
