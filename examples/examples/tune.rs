@@ -87,6 +87,7 @@ fn main() -> ExitCode {
     config.scaling = false;
     config.headline = false;
     config.skip_over_limits = true;
+    config.exact_truth = false;
     let measure = |methods: Vec<scatter_examples::bench::Method>| -> Result<_, String> {
         let config = BenchConfig {
             methods,
