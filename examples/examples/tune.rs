@@ -15,7 +15,8 @@
 //! sweep's screen size) instead of a suite scene's four poses. A scene lit by an area light
 //! (`reference/scenes/area_grate.json`) runs the `area_ivsv` candidates (VPL count, grid,
 //! gather), its error measured against the `vpl` truth of 256 VPLs with the engine's map
-//! size (the analogue of the `shadow_map` truth: the light's converged VPL set).
+//! size (the analogue of the `shadow_map` truth: the light's converged VPL set), with 256^2
+//! VPL maps.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -27,6 +28,10 @@ use scatter_examples::bench::{
     tune_refinements, tune_table,
 };
 use scatter_reference::suite::{Pose, SceneName};
+use scatter_runtime::shaderlib::prefiltered::LightKind;
+
+/// The VPL map size of an area light's scene.
+const AREA_SHADOW_MAP: u32 = 256;
 use scatter_runtime::Context;
 
 /// Picks the cheapest variant that meets an error budget on a scene.
@@ -83,6 +88,11 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    // An area light's maps are one per VPL (up to 256 layers): 256^2 each, not the sweep's
+    // 1024^2 standard map (a 256-layer array of 1024^2 r32float would be 1 GiB).
+    if config.cases.iter().any(|c| c.light() == LightKind::Area) {
+        config.shadow_map = AREA_SHADOW_MAP;
+    }
     config.rectified = [512, 512];
     config.scaling = false;
     config.headline = false;

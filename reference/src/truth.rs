@@ -229,14 +229,97 @@ fn ray_inscatter_point(
 ) -> f64 {
     let f = RayIntegrand::new(origin, dir, light, &scene.medium).softened(soft.soft_r2);
     let window = soft.window(origin, dir, s);
+    let peak = if soft.soft_r2 > 0.0 {
+        None
+    } else {
+        PointPeak::of(light, settings, origin, dir, s)
+    };
     let mut total = 0.0;
     lit_intervals(light, vis, settings, origin, dir, s, &mut |a, b, pieces| {
-        total += match window {
-            None => f.integrate(a, b, pieces),
-            Some(_) => integrate_refined(&f, a, b, pieces, window)[0],
+        total += match (window, peak) {
+            (Some(_), _) => integrate_refined(&f, a, b, pieces, window)[0],
+            (None, Some(p)) => p.integrate(&f, a, b, pieces),
+            (None, None) => f.integrate(a, b, pieces),
         };
     });
     total
+}
+
+/// A point light's `1 / d^2` peak along a view ray that passes closer to it than the
+/// Gauss-Legendre pieces are long: the peak is `h` wide (`d^2 = h^2 + (t - t_c)^2`, `h` the
+/// ray's distance from the light at its closest approach `t_c`), and 16 nodes on a piece
+/// many times longer miss it (a lamp pixel of `area_grate/epipole_on_screen`, whose rays pass
+/// 2 cm from the VPLs, was 10 % off at 256 segments, converged 0.03 % at 16384). Near the
+/// peak the integral is taken in the equiangular variable `t = t_c + h tan(u)`, where
+/// `dt/du = d^2 / h` cancels the `1 / d^2` and what is left is smooth.
+#[derive(Clone, Copy, Debug)]
+struct PointPeak {
+    /// Closest approach along the ray (unclamped).
+    t_c: f64,
+    /// Distance of the ray from the light there.
+    h: f64,
+    /// Half-width of the window integrated equiangularly.
+    reach: f64,
+}
+
+impl PointPeak {
+    /// Pieces of the equiangular window.
+    const PIECES: usize = 32;
+
+    fn of(
+        light: &Light,
+        settings: &TruthSettings,
+        origin: DVec3,
+        dir: DVec3,
+        s: f64,
+    ) -> Option<PointPeak> {
+        let Light::Spot { position, .. } = light else {
+            return None;
+        };
+        // The Gauss-Legendre piece length of `lit_intervals` (one rule per 4 cells).
+        let piece = 4.0 * s / settings.segments.max(1) as f64;
+        let t_c = (*position - origin).dot(dir);
+        let h = (origin + dir * t_c - *position).length();
+        (h < piece && h > 0.0).then_some(PointPeak {
+            t_c,
+            h,
+            reach: 8.0 * piece,
+        })
+    }
+
+    /// `f.integrate(a, b, pieces)`, the part of `[a, b]` within `reach` of `t_c` in the
+    /// equiangular variable.
+    fn integrate(&self, f: &RayIntegrand, a: f64, b: f64, pieces: usize) -> f64 {
+        let (lo, hi) = (a.max(self.t_c - self.reach), b.min(self.t_c + self.reach));
+        if hi <= lo {
+            return f.integrate(a, b, pieces);
+        }
+        let share = |x: f64, y: f64| ((pieces as f64 * (y - x) / (b - a)).ceil() as usize).max(1);
+        let mut out = 0.0;
+        for (x, y) in [(a, lo), (hi, b)] {
+            if y > x {
+                out += f.integrate(x, y, share(x, y));
+            }
+        }
+        let (u0, u1) = (
+            ((lo - self.t_c) / self.h).atan(),
+            ((hi - self.t_c) / self.h).atan(),
+        );
+        let step = (u1 - u0) / Self::PIECES as f64;
+        for i in 0..Self::PIECES {
+            let (x, y) = (u0 + step * i as f64, u0 + step * (i + 1) as f64);
+            out += crate::model::gauss_legendre_16(
+                |u| {
+                    let t = self.t_c + self.h * u.tan();
+                    let d2 = self.h * self.h + (t - self.t_c) * (t - self.t_c);
+                    f.eval(t) * d2 / self.h
+                },
+                x,
+                y,
+            );
+        }
+        out
+    }
 }
 
 /// In-scattered radiance (RGB) along one view ray (`dir` unit) of length `s`: the light's
