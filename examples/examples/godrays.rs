@@ -1138,21 +1138,27 @@ mod tests {
         assert_eq!(parse_method("truth"), Ok(Method::Truth));
         for &f in Family::ALL {
             assert_eq!(parse_method(f.name()), Ok(Method::Family(f)));
-            let Ok(Plan::Family(p)) = check(&args(&["--method", f.name()]), LightKind::Spot) else {
+            // A scene of the family's light: a spot, or an area light for area_ivsv.
+            let light = if f == Family::AreaIvsv {
+                LightKind::Area
+            } else {
+                LightKind::Spot
+            };
+            let Ok(Plan::Family(p)) = check(&args(&["--method", f.name()]), light) else {
                 panic!("{f}");
             };
             assert_eq!(p.variant.family(), f);
-            assert_eq!(p.variant.light(), LightKind::Spot);
+            assert_eq!(p.variant.light(), light);
             // The family's defaults with the scene's light.
             let expected = f
-                .variant(&[("light".into(), "spot".into())])
+                .variant(&[("light".into(), light.name().into())])
                 .unwrap_or_else(|e| panic!("{f}: {e}"));
             assert_eq!(p.variant, expected);
         }
         let e = parse_method("prefilter").unwrap_err();
         assert_eq!(
             e,
-            "method must be truth | hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch, got prefilter"
+            "method must be truth | area_ivsv | hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch, got prefilter"
         );
         assert!(
             Args::try_parse_from([
@@ -1164,7 +1170,7 @@ mod tests {
 
     #[test]
     fn truth_refuses_family_options() {
-        let to = "applies to a kernel family (--method hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch), not to --method truth";
+        let to = "applies to a kernel family (--method area_ivsv | hybrid_volume | minmax | partial_sum_tree | prefiltered | raymarch), not to --method truth";
         assert_eq!(refused(&["--gpu"]), format!("--gpu {to}"));
         assert_eq!(refused(&["--compare"]), format!("--compare {to}"));
         assert_eq!(
