@@ -30,7 +30,12 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
     );
     // Every family with a per-pixel mode sampled (lowres and epipolar: workgroup memory,
     // atomics, the unwarp passes), both lights; `partial_sum_tree` (epipolar only) over its
-    // grid (ranks 1, 4, 8: one and two vec4 per leaf).
+    // grid (ranks 1, 4, 8: one and two vec4 per leaf); area_ivsv over its grid.
+    variants.extend(
+        scatter_shaderlib::area_ivsv::AreaIvsvVariant::grid()
+            .into_iter()
+            .map(FamilyVariant::AreaIvsv),
+    );
     variants.extend(
         scatter_shaderlib::partial_sum_tree::PartialSumTreeVariant::grid()
             .into_iter()
@@ -45,12 +50,14 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
                 scatter_shaderlib::sampling::SamplingKnobs::lowres(4),
                 scatter_shaderlib::sampling::SamplingKnobs::epipolar(64),
             ] {
-                variants.push(
-                    family
-                        .default_variant()
-                        .with_light(light)
-                        .with_sampling(knobs),
-                );
+                // Families of another light or without sampling (area_ivsv) are left out.
+                let v = family
+                    .default_variant()
+                    .with_light(light)
+                    .with_sampling(knobs);
+                if v.validate().is_ok() {
+                    variants.push(v);
+                }
             }
         }
     }
