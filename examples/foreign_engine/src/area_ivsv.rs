@@ -9,7 +9,6 @@ use std::mem::offset_of;
 
 use scatter_frame::area_ivsv::{AreaIvsvFrame, IvsvUniforms, VplRecord};
 
-use crate::formula::Params;
 use crate::prefiltered::{DEPTH, Output, check_struct_layout, read_output};
 use crate::{Engine, EngineError, FrameData};
 
@@ -20,25 +19,9 @@ pub const VPLS: &str = "vpls";
 /// The engine's VPL shadow maps (an array texture, one layer per VPL).
 pub const VPL_MAPS: &str = "vpl_maps";
 
-/// Texture sizes of one configuration: the values of the manifest's parameters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Sizes {
-    /// Screen width and height (depth buffer and output).
-    pub screen: [u32; 2],
-    /// Side of every VPL's shadow map (the area light's point limit's standard map's).
-    pub shadow_map: u32,
-}
-
-impl Sizes {
-    /// The manifest parameters: `screen.width`, `screen.height`, `shadow.size`.
-    pub fn params(&self) -> Params {
-        let mut p = Params::default();
-        p.set("screen.width", self.screen[0].into());
-        p.set("screen.height", self.screen[1].into());
-        p.set("shadow.size", self.shadow_map.into());
-        p
-    }
-}
+/// Texture sizes of one configuration: the screen and the VPL maps' side (`shadow.size`),
+/// the same parameters as the raymarch family's.
+pub use crate::raymarch::Sizes;
 
 /// Host field names and offsets of [`IvsvUniforms`], in the manifest's spelling.
 const FRAME_FIELDS: [(&str, usize); 7] = [
