@@ -1718,16 +1718,13 @@ pub fn write_outputs(
     written.push(md_path);
     // plotters lays text out with a TTF font (no system font libraries): without one the
     // chart is skipped, the tables are not.
-    let Some(font) = FONT_PATHS.iter().find_map(|p| std::fs::read(p).ok()) else {
+    if register_chart_font().is_none() {
         eprintln!(
             "bench: no DejaVu Sans font ({}); install Debian's fonts-dejavu-core for the chart",
             FONT_PATHS.join(", ")
         );
         return Ok(written);
-    };
-    let font: &'static [u8] = Box::leak(font.into_boxed_slice());
-    plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, font)
-        .map_err(|_| "the TTF font could not be registered")?;
+    }
     let mut svg = String::new();
     {
         let root =

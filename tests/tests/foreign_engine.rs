@@ -407,6 +407,25 @@ fn area_variants() -> [scatter_frame::area_ivsv::AreaIvsvVariant; 2] {
     [g[0], g[3]]
 }
 
+/// `area_grate/ordinary` at [`SCREEN`], its BVH and depth buffer: the area_ivsv trials' scene.
+fn area_grate() -> (
+    scatter_reference::scene::Scene,
+    scatter_reference::bvh::Bvh,
+    scatter_reference::buffers::GBuffer,
+) {
+    use scatter_reference::area_suite::{self, AreaSceneName};
+    let scene = area_suite::scene(
+        AreaSceneName::Grate,
+        Pose::Ordinary,
+        scatter_reference::suite::MediumPreset::Default,
+        SCREEN[0],
+        SCREEN[1],
+    );
+    let bvh = scatter_reference::bvh::Bvh::build(&scene.geometry);
+    let gbuf = scatter_reference::buffers::GBuffer::cast(&scene, &bvh);
+    (scene, bvh, gbuf)
+}
+
 /// The area light's VPL map size of the area_ivsv trials.
 const AREA_MAP: u32 = 64;
 
@@ -765,19 +784,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
     }
     // The area light: `area_grate/ordinary`, its VPL maps framed by the set-up from the
     // point limit's standard map and ray-cast (as an engine renders them).
-    let area = {
-        use scatter_reference::area_suite::{self, AreaSceneName};
-        let scene = area_suite::scene(
-            AreaSceneName::Grate,
-            Pose::Ordinary,
-            scatter_reference::suite::MediumPreset::Default,
-            SCREEN[0],
-            SCREEN[1],
-        );
-        let bvh = scatter_reference::bvh::Bvh::build(&scene.geometry);
-        let gbuf = scatter_reference::buffers::GBuffer::cast(&scene, &bvh);
-        (scene, bvh, gbuf)
-    };
+    let area = area_grate();
     for v in area_variants() {
         let (scene, bvh, gbuf) = &area;
         let name = format!("foreign::area_ivsv::{}::area_grate::ordinary", v.id());
@@ -893,17 +900,8 @@ fn foreign_engine_files_run_every_family() {
     }
     // An area light: frame.json with the light, the point limit's map as the template, the
     // VPL maps stacked in vpl_maps.pfm; the same radiance as the in-memory path.
-    use scatter_reference::area_suite::{self, AreaSceneName};
     let v = area_variants()[0];
-    let scene = area_suite::scene(
-        AreaSceneName::Grate,
-        Pose::Ordinary,
-        scatter_reference::suite::MediumPreset::Default,
-        SCREEN[0],
-        SCREEN[1],
-    );
-    let bvh = scatter_reference::bvh::Bvh::build(&scene.geometry);
-    let gbuf = scatter_reference::buffers::GBuffer::cast(&scene, &bvh);
+    let (scene, bvh, gbuf) = area_grate();
     let template = scatter_reference::buffers::ShadowMap::build(&scene, &bvh, AREA_MAP)
         .unwrap_or_else(|e| panic!("{e}"));
     let area = scatter_reference::kernels::ivsv_inputs(&scene, &gbuf, &bvh, &v, AREA_MAP)
