@@ -68,20 +68,20 @@ pub struct AreaIvsvVariant {
     /// of `M^2`).
     #[serde(skip_serializing_if = "is_one")]
     pub interleave: u32,
-    /// Must be `pixels`: the gather runs per pixel (epipolar and low-resolution sampling are
-    /// not built for this family).
+    /// Where `ivsv_gather` runs: every pixel, a low-resolution grid or epipolar samples
+    /// ([`crate::sampling`]; `interleave` must be 1 when sampled).
     pub sampling: Sampling,
-    /// Unused (must stay at its default).
+    /// `sampling = lowres`: the block side, 2 or 4.
     pub scale: u32,
-    /// Unused (must stay at its default).
+    /// `sampling = lowres | epipolar`: the depth break in percent of the nearer depth.
     pub depth_break: u32,
-    /// Unused (must stay at its default).
+    /// `sampling = lowres | epipolar`: the light break in percent of the brightest sample.
     pub light_break: u32,
-    /// Unused (must stay at its default).
+    /// `sampling = epipolar`: epipolar slices (radiating from the VPLs' centroid).
     pub slices: u32,
-    /// Unused (must stay at its default).
+    /// `sampling = epipolar`: samples per slice.
     pub slice_samples: u32,
-    /// Unused (must stay at its default).
+    /// `sampling = epipolar`: the initial step between evaluated samples of a slice.
     pub step: u32,
 }
 
@@ -122,32 +122,17 @@ impl AreaIvsvVariant {
                 allowed: "area (directional and spot lights are the single-light families')".into(),
             });
         }
-        let d = SamplingKnobs::default();
-        let k = self.sampling_knobs();
-        let why = "(the gather runs per pixel; epipolar and lowres sampling are not built for \
-                   area_ivsv)";
-        if k.sampling != d.sampling {
+        self.sampling_knobs().validate()?;
+        if self.interleave > 1 && self.sampling_knobs().is_sampled() {
             return Err(VariantError {
-                knob: "sampling",
-                value: k.sampling.to_string(),
-                allowed: format!("{} {why}", d.sampling),
+                knob: "interleave",
+                value: self.interleave.to_string(),
+                allowed: format!(
+                    "1 with sampling = {} (interleaving spreads a pixel's VPLs over its \
+                     neighbours, which a sampled variant does not evaluate)",
+                    self.sampling
+                ),
             });
-        }
-        for (knob, value, default) in [
-            ("scale", k.scale, d.scale),
-            ("depth_break", k.depth_break, d.depth_break),
-            ("light_break", k.light_break, d.light_break),
-            ("slices", k.slices, d.slices),
-            ("slice_samples", k.slice_samples, d.slice_samples),
-            ("step", k.step, d.step),
-        ] {
-            if value != default {
-                return Err(VariantError {
-                    knob,
-                    value: value.to_string(),
-                    allowed: format!("{default}, its default {why}"),
-                });
-            }
         }
         let range = |knob: &'static str, value: u32, lo: u32, hi: u32| {
             if (lo..=hi).contains(&value) {
@@ -211,7 +196,8 @@ impl AreaIvsvVariant {
         16 * u64::from(self.vpls) * u64::from(self.alpha) * u64::from(self.theta)
     }
 
-    /// A short stable id: `v64-a256-t256-k8`, `v64-a256-t256-k8-i2`.
+    /// A short stable id: `v64-a256-t256-k8`, `v64-a256-t256-k8-i2`,
+    /// `v64-a256-t256-k8-epi512x256-s8-b10-l20`.
     pub fn id(&self) -> String {
         let interleave = if self.interleave > 1 {
             format!("-i{}", self.interleave)
@@ -219,8 +205,29 @@ impl AreaIvsvVariant {
             String::new()
         };
         format!(
-            "v{}-a{}-t{}-k{}{interleave}",
-            self.vpls, self.alpha, self.theta, self.segments
+            "v{}-a{}-t{}-k{}{interleave}{}",
+            self.vpls,
+            self.alpha,
+            self.theta,
+            self.segments,
+            self.sampling_knobs().id_suffix()
+        )
+    }
+
+    /// The short label of tables and charts: `v64-a256-t256-k8`, `v64-a256-t256-k8-ep512`.
+    pub fn marker(&self) -> String {
+        let interleave = if self.interleave > 1 {
+            format!("-i{}", self.interleave)
+        } else {
+            String::new()
+        };
+        format!(
+            "v{}-a{}-t{}-k{}{interleave}{}",
+            self.vpls,
+            self.alpha,
+            self.theta,
+            self.segments,
+            self.sampling_knobs().marker_suffix()
         )
     }
 }
@@ -276,9 +283,9 @@ impl KnobSet for AreaIvsvVariant {
         Self { light, ..self }
     }
 
-    /// `v64-a256-t256-k8` (the id: every knob but the light).
+    /// `v64-a256-t256-k8`, `v64-a256-t256-k8-lr2` (every knob but the light).
     fn marker(&self) -> String {
-        AreaIvsvVariant::id(self)
+        AreaIvsvVariant::marker(self)
     }
 
     fn grid() -> Vec<Self> {
@@ -313,13 +320,17 @@ pub struct IvsvUniforms {
     pub sizes: [u32; 4],
     /// `alpha` bins, `theta` bins, interleave `M`, unused.
     pub grid: [u32; 4],
+    /// The VPLs' centroid (where epipolar sampling puts the light: its slices radiate from
+    /// its screen point); w unused.
+    pub centre: [f32; 4],
 }
 
 const _: () = {
-    assert!(size_of::<IvsvUniforms>() == 7 * 16);
+    assert!(size_of::<IvsvUniforms>() == 8 * 16);
     assert!(std::mem::offset_of!(IvsvUniforms, medium) == 4 * 16);
     assert!(std::mem::offset_of!(IvsvUniforms, sizes) == 5 * 16);
     assert!(std::mem::offset_of!(IvsvUniforms, grid) == 6 * 16);
+    assert!(std::mem::offset_of!(IvsvUniforms, centre) == 7 * 16);
 };
 
 /// One VPL's record (WGSL `struct Vpl`, an element of the `vpls` storage buffer).
@@ -503,8 +514,10 @@ pub fn prepare_area_ivsv(
     let mut records = Vec::with_capacity(vpls.len());
     let mut grids = Vec::with_capacity(vpls.len());
     let mut cam = *camera;
+    let mut centroid = DVec3::ZERO;
     for vpl in vpls {
         let sc = validate_scene(LightKind::Spot, camera, &vpl.light, medium)?;
+        centroid += sc.light_pos / vpls.len() as f64;
         cam = sc.cam;
         let sm = &vpl.shadow_map;
         validate_shadow_map(sm)?;
@@ -573,6 +586,7 @@ pub fn prepare_area_ivsv(
         ],
         sizes: [screen[0], screen[1], map_size, variant.vpls],
         grid: [variant.alpha, variant.theta, variant.interleave, 0],
+        centre: v4(centroid, 0.0),
     };
     finite_fields([
         ("eye", uniforms.eye),
@@ -580,6 +594,7 @@ pub fn prepare_area_ivsv(
         ("cam_right", uniforms.cam_right),
         ("cam_up", uniforms.cam_up),
         ("medium", uniforms.medium),
+        ("centre", uniforms.centre),
     ])?;
     Ok(AreaIvsvFrame {
         uniforms,

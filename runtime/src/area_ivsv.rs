@@ -32,6 +32,8 @@ const RECTIFY: Kernel = Kernel::IvsvRectify;
 const SCAN: Kernel = Kernel::IvsvScan;
 const GATHER: Kernel = Kernel::IvsvGather;
 const INTERLEAVE_SUM: Kernel = Kernel::IvsvInterleaveSum;
+const UNWARP: Kernel = Kernel::IvsvGatherUnwarp;
+const FALLBACK: Kernel = Kernel::IvsvGatherFallback;
 
 /// GPU (or wall) time of each pass of one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -44,12 +46,16 @@ pub struct AreaIvsvTimes {
     pub gather: Duration,
     /// `ivsv_interleave_sum` (zero without interleaving).
     pub interleave_sum: Duration,
+    /// `ivsv_gather_unwarp` (zero without epipolar sampling).
+    pub unwarp: Duration,
+    /// `ivsv_gather_fallback` (zero without epipolar sampling).
+    pub fallback: Duration,
 }
 
 impl AreaIvsvTimes {
     /// Sum of the passes.
     pub fn total(&self) -> Duration {
-        self.rectify + self.scan + self.gather + self.interleave_sum
+        self.rectify + self.scan + self.gather + self.interleave_sum + self.unwarp + self.fallback
     }
 }
 
@@ -347,9 +353,9 @@ impl AreaIvsv {
         vpl_maps: &wgpu::TextureView,
         frames: u32,
     ) -> Result<AreaIvsvTimes, RuntimeError> {
-        let [rectify, scan, gather, interleave_sum] = median_pass_wall_times(
+        let [rectify, scan, gather, interleave_sum, unwarp, fallback] = median_pass_wall_times(
             ctx,
-            [RECTIFY, SCAN, GATHER, INTERLEAVE_SUM],
+            [RECTIFY, SCAN, GATHER, INTERLEAVE_SUM, UNWARP, FALLBACK],
             frames,
             |encoder, kernel| {
                 self.encode_selected(ctx, encoder, depth, vpl_maps, Some(kernel))
@@ -361,7 +367,15 @@ impl AreaIvsv {
             scan,
             gather,
             interleave_sum: crate::timer::when(self.variant.interleave > 1, interleave_sum),
+            unwarp: crate::timer::when(self.epipolar(), unwarp),
+            fallback: crate::timer::when(self.epipolar(), fallback),
         })
+    }
+
+    /// Whether the variant samples epipolar lines (and has the `ivsv_gather_unwarp` and
+    /// `ivsv_gather_fallback` passes).
+    fn epipolar(&self) -> bool {
+        self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
     }
 
     /// GPU time of each pass of the last submitted [`Self::encode`], or `None` without
@@ -376,11 +390,16 @@ impl AreaIvsv {
         };
         let t = timer.read_all(ctx, GATHER)?;
         let at = |i: usize| t.get(i).copied().unwrap_or_default();
+        // The passes in plan order: rectify, scan, gather, then interleave_sum or the
+        // unwarp and the fallback.
+        let interleaved = self.variant.interleave > 1;
         Ok(Some(AreaIvsvTimes {
             rectify: at(0),
             scan: at(1),
             gather: at(2),
-            interleave_sum: at(3),
+            interleave_sum: crate::timer::when(interleaved, at(3)),
+            unwarp: crate::timer::when(self.epipolar(), at(3)),
+            fallback: crate::timer::when(self.epipolar(), at(4)),
         }))
     }
 
@@ -448,8 +467,8 @@ impl crate::family::FamilyRuntime for AreaIvsv {
         Ok(self.pass_times(ctx)?.map(|t| t.total()))
     }
 
-    fn fallback_pixels(&self, _ctx: &Context) -> Result<Option<u32>, RuntimeError> {
-        Ok(None)
+    fn fallback_pixels(&self, ctx: &Context) -> Result<Option<u32>, RuntimeError> {
+        crate::family::read_fallback_count(ctx, &self.exec, UNWARP)
     }
 
     fn pass_wall_times(
@@ -463,6 +482,10 @@ impl crate::family::FamilyRuntime for AreaIvsv {
         let mut passes = vec![(RECTIFY, t.rectify), (SCAN, t.scan), (GATHER, t.gather)];
         if self.variant.interleave > 1 {
             passes.push((INTERLEAVE_SUM, t.interleave_sum));
+        }
+        if self.epipolar() {
+            passes.push((UNWARP, t.unwarp));
+            passes.push((FALLBACK, t.fallback));
         }
         Ok(passes)
     }
@@ -606,13 +629,9 @@ pub fn run_area_ivsv_once(
         Some(t) => Some(Readback::encode(device, &mut encoder, t, 16, GATHER)?),
         None => None,
     };
-    pass.encode_selected(
-        ctx,
-        &mut encoder,
-        &views[0].1,
-        &maps_view,
-        Some(INTERLEAVE_SUM),
-    )?;
+    for kernel in [INTERLEAVE_SUM, UNWARP, FALLBACK] {
+        pass.encode_selected(ctx, &mut encoder, &views[0].1, &maps_view, Some(kernel))?;
+    }
     let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, GATHER)?;
     let start = Instant::now();
     ctx.queue().submit([encoder.finish()]);

@@ -63,6 +63,12 @@ kernel::kernels! {
     /// area_ivsv: per pixel, the lit integral of every VPL from its voxel bits (Wyman & Dai
     /// 2013).
     IvsvGather("ivsv_gather", AreaIvsvVariant, area_ivsv::render_gather),
+    /// `sampling = epipolar`: the pixels `ivsv_gather_unwarp` listed (no sample stands for
+    /// them), gathered themselves.
+    IvsvGatherFallback("ivsv_gather_fallback", AreaIvsvVariant, area_ivsv::render_gather_fallback),
+    /// `sampling = epipolar`: every pixel gathered from the `ivsv_gather` samples of the two
+    /// slices around it, or listed for `ivsv_gather_fallback` where none stands for it.
+    IvsvGatherUnwarp("ivsv_gather_unwarp", AreaIvsvVariant, area_ivsv::render_gather_unwarp),
     /// area_ivsv, interleaved gather: the sum of each pixel's window of partial sums.
     IvsvInterleaveSum("ivsv_interleave_sum", AreaIvsvVariant, area_ivsv::render_interleave_sum),
     /// area_ivsv: per VPL and epipolar light ray, the voxel where its shadow starts.
@@ -163,7 +169,7 @@ impl KernelParams {
                 .kernel_params()
                 .into_iter()
                 .chain(
-                    // A family without epipolar sampling (area_ivsv) refuses the variant.
+                    // A family without epipolar sampling would refuse the variant.
                     epipolar
                         .validate()
                         .map(|()| epipolar.kernel_params())

@@ -18,23 +18,29 @@
 // alpha is the bin holding the ray. The sum over VPLs, each times its intensity, is the pixel.
 {%- if interleave > 1 %}
 // Interleaved (M = {{ interleave }}): pixel class c = (x mod M) + M (y mod M) sums only the c-th
-// of M^2 consecutive runs of VPLs into `partial` (a run of consecutive Halton points is spread
-// over the whole light; every M^2-th point is not: the base-2 digits put them in one strip);
-// `ivsv_interleave_sum` adds the M x M window of each pixel.
+// of M^2 consecutive runs of VPLs into `output` (the `partial` resource; a run of consecutive
+// Halton points is spread over the whole light; every M^2-th point is not: the base-2 digits
+// put them in one strip); `ivsv_interleave_sum` adds the M x M window of each pixel.
+{%- endif %}
+{%- if sampling.lowres || sampling.epipolar %}
+// Sampled ({{ sampling.entry }}): the per-pixel body `ivsv_gather_pixel` runs on the sampling
+// stage's samples (scatter::sampling; epipolar slices radiate from the screen point of the
+// VPLs' centroid, frame.centre).
 {%- endif %}
 //
 // Bindings (group 0):
 // | binding | name   | type                                           | access       |
 // |---------|--------|------------------------------------------------|--------------|
-// | 0       | frame  | var<uniform> IvsvFrame (112 bytes)             | uniform      |
+// | 0       | frame  | var<uniform> IvsvFrame (128 bytes)             | uniform      |
 // | 1       | vpls   | var<uniform> array<Vpl, {{ vpls }}> (176 bytes each) | uniform |
 // | 2       | volume | var<storage, read> array<u32> (`ivsv_scan`'s)  | read         |
 // | 3       | depth  | texture_2d<f32> (r32float, view depth)         | textureLoad  |
+// | 4       | output | texture_storage_2d<{{ output_format }}, write>         | textureStore |
 {%- if interleave > 1 %}
-// | 4       | partial | texture_storage_2d<rgba32float, write>        | textureStore |
-// partial: screen-sized, the pixel's class's share (rgb, alpha 1).
+// output: the `partial` resource, screen-sized, the pixel's class's share (rgb, alpha 1).
+{%- else if sampling.epipolar && !sampling.unwarp && !sampling.fallback %}
+// output: the `epipolar_samples` resource (scatter::sampling).
 {%- else %}
-// | 4       | output | texture_storage_2d<rgba16float, write>         | textureStore |
 // output: screen-sized, in-scattered radiance (rgb, alpha 1).
 {%- endif %}
 //
@@ -45,6 +51,9 @@
 
 #import scatter::model::{PI, cone_falloff, phase_hg}
 #import scatter::ivsv::{IvsvFrame, Vpl, PHI_BITS, plane_normal, voxel_word}
+{%- if !sampling.imports.is_empty() %}
+{{ sampling.imports }}
+{%- endif %}
 
 const SEGMENTS: u32 = {{ segments }}u;
 
@@ -52,11 +61,8 @@ const SEGMENTS: u32 = {{ segments }}u;
 @group(0) @binding(1) var<uniform> vpls: array<Vpl, {{ vpls }}>;
 @group(0) @binding(2) var<storage, read> volume: array<u32>;
 @group(0) @binding(3) var depth: texture_2d<f32>;
-{%- if interleave > 1 %}
-@group(0) @binding(4) var partial: texture_storage_2d<rgba32float, write>;
-{%- else %}
-@group(0) @binding(4) var output: texture_storage_2d<rgba16float, write>;
-{%- endif %}
+@group(0) @binding(4) var output: texture_storage_2d<{{ output_format }}, write>;
+{% include "include/sampled_bindings.wgsl" %}
 
 // Unit view direction through the centre of pixel (x, y).
 fn ivsv_pixel_dir(m: IvsvFrame, x: u32, y: u32) -> vec3<f32> {
@@ -209,30 +215,24 @@ fn vpl_lit(m: IvsvFrame, r: Vpl, v: u32, dir: vec3<f32>, s: f32) -> f32 {
     return d_phi * ((1.0 - tw) * lit_a + tw * lit_b);
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn ivsv_gather(@builtin(global_invocation_id) id: vec3<u32>) {
+// The in-scattered radiance of pixel (x, y){% if interleave > 1 %}, its class's VPLs only{% endif %} (the sampling entry point below calls it).
+fn ivsv_gather_pixel(x: u32, y: u32) -> vec3<f32> {
     let m = frame;
-    if id.x >= m.sizes[0] || id.y >= m.sizes[1] {
-        return;
-    }
-    let dir = ivsv_pixel_dir(m, id.x, id.y);
+    let dir = ivsv_pixel_dir(m, x, y);
     // Depth is clamped to [0, far]: engines with an infinite far plane write +inf on sky pixels.
-    let s = min(max(textureLoad(depth, id.xy, 0).x, 0.0), m.eye.w) / max(dot(dir, m.cam_forward.xyz), 1e-6);
+    let s = min(max(textureLoad(depth, vec2<u32>(x, y), 0).x, 0.0), m.eye.w) / max(dot(dir, m.cam_forward.xyz), 1e-6);
     var sum = vec3<f32>(0.0);
 {%- if interleave > 1 %}
     let mi = {{ interleave }}u;
     let per_class = m.sizes[3] / (mi * mi);
-    let first = ((id.x % mi) + mi * (id.y % mi)) * per_class;
+    let first = ((x % mi) + mi * (y % mi)) * per_class;
     for (var v = first; v < first + per_class; v += 1u) {
-        let r = vpls[v];
-        sum += r.color.xyz * vpl_lit(m, r, v, dir, s);
-    }
-    textureStore(partial, id.xy, vec4<f32>(sum, 1.0));
 {%- else %}
     for (var v = 0u; v < m.sizes[3]; v += 1u) {
+{%- endif %}
         let r = vpls[v];
         sum += r.color.xyz * vpl_lit(m, r, v, dir, s);
     }
-    textureStore(output, id.xy, vec4<f32>(sum, 1.0));
-{%- endif %}
+    return sum;
 }
+{% include "include/sampled_entry.wgsl" %}

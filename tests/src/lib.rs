@@ -116,6 +116,40 @@ impl Fixture {
         }
     }
 
+    /// The area scene `name` (`scatter_reference::area_suite`) at `screen` pixels, its
+    /// standard shadow map (its area light's point limit's, the VPL maps' template)
+    /// `shadow_map_size`^2; `name` is the scene's base ([`scene_for`] of an area light).
+    ///
+    /// # Panics
+    ///
+    /// When the suite's shadow map cannot be built (a defect of the suite).
+    pub fn area(
+        name: scatter_reference::area_suite::AreaSceneName,
+        pose: Pose,
+        screen: [u32; 2],
+        shadow_map_size: u32,
+    ) -> Self {
+        let scene = scatter_reference::area_suite::scene(
+            name,
+            pose,
+            MediumPreset::Default,
+            screen[0],
+            screen[1],
+        );
+        let bvh = Bvh::build(&scene.geometry);
+        let gbuf = GBuffer::cast(&scene, &bvh);
+        let shadow_map = ShadowMap::build(&scene, &bvh, shadow_map_size)
+            .unwrap_or_else(|e| panic!("shadow map of {name}/{pose}: {e}"));
+        Self {
+            name: scene_for(LightKind::Area),
+            pose,
+            scene,
+            bvh,
+            gbuf,
+            shadow_map,
+        }
+    }
+
     /// The same fixture with every depth-buffer value times `k` (and the ray lengths with
     /// them): a frame whose deepest pixel lies closer than the far plane, where `slice_fit`
     /// rewrites the slice table (almost every suite pose sees the sky, where it does not).

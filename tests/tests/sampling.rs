@@ -31,6 +31,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use scatter_conformance::{
     Check, Fixture, gpu, run_trials, run_variant, run_variant_counted, scene_for,
 };
+use scatter_reference::area_suite::AreaSceneName;
 use scatter_reference::buffers::{GBuffer, ShadowMap};
 use scatter_reference::bvh::Bvh;
 use scatter_reference::image::Image;
@@ -90,9 +91,8 @@ fn f16_ulp(v: f32) -> f32 {
 
 /// The families' default variants with `light`, per pixel: the families that have a
 /// per-pixel body the stage samples (not `partial_sum_tree`, whose sweep answers epipolar
-/// samples only and is checked against its mirror in `tests/tests/partial_sum_tree_gpu.rs`,
-/// nor `area_ivsv`, which renders area lights per pixel only and refuses the other
-/// samplings: its variant says so).
+/// samples only and is checked against its mirror in `tests/tests/partial_sum_tree_gpu.rs`;
+/// `area_ivsv` for `light = area` only, on `area_grate`).
 fn bases(light: LightKind) -> Vec<FamilyVariant> {
     Family::ALL
         .iter()
@@ -170,7 +170,16 @@ fn epipolar_camera(variant: &FamilyVariant, f: &Fixture) -> Result<EpipolarCamer
         )
         .map(|m| EpipolarCamera::of_raymarch(&m, v.light))
         .map_err(|e| e.to_string()),
-        FamilyVariant::AreaIvsv(v) => Err(format!("{v}: area_ivsv has no epipolar sampling")),
+        FamilyVariant::AreaIvsv(v) => scatter_shaderlib::area_ivsv::prepare_area_light(
+            v,
+            SCREEN,
+            &f.scene.camera_desc(),
+            &f.scene.light_desc(),
+            &f.scene.medium_desc(),
+            &f.shadow_map.desc(),
+        )
+        .map(|(m, _)| EpipolarCamera::of_ivsv(&m.uniforms))
+        .map_err(|e| e.to_string()),
     }
 }
 
@@ -257,7 +266,7 @@ fn epipolar_stage_trial(
     println!(
         "sampling::{}::{}::{pose}: {} samples and pixels evaluated ({} for depth, {} for light) of {} pixels, {listed} listed for the fallback pass (mirror {expected}); {over} pixels over tolerance (layout ulps); max |diff| elsewhere {:.2e} of max",
         sampled.trial_name(),
-        scene_for(base.light()),
+        scene_label(base.light()),
         cpu.evaluated,
         cpu.depth_refined,
         cpu.light_refined,
@@ -265,6 +274,15 @@ fn epipolar_stage_trial(
         worst / max
     );
     Ok(())
+}
+
+/// The scene of the trials of `light`, as the trial names spell it.
+fn scene_label(light: LightKind) -> String {
+    if light == LightKind::Area {
+        AreaSceneName::Grate.to_string()
+    } else {
+        scene_for(light).to_string()
+    }
 }
 
 fn fixture(light: LightKind, pose: Pose) -> Arc<Fixture> {
@@ -280,8 +298,14 @@ fn fixture(light: LightKind, pose: Pose) -> Arc<Fixture> {
             c
         }
     };
-    cell.get_or_init(|| Arc::new(Fixture::new(scene_for(light), pose, SCREEN, SHADOW_MAP)))
-        .clone()
+    cell.get_or_init(|| {
+        Arc::new(if light == LightKind::Area {
+            Fixture::area(AreaSceneName::Grate, pose, SCREEN, SHADOW_MAP)
+        } else {
+            Fixture::new(scene_for(light), pose, SCREEN, SHADOW_MAP)
+        })
+    })
+    .clone()
 }
 
 fn depth_tex(gbuf: &GBuffer) -> Tex {
@@ -401,7 +425,7 @@ fn stage_trial(
     println!(
         "sampling::{}::{}::{pose}: {blended} pixels blended, {refined} evaluated themselves; max |diff| {:.2e} of max",
         sampled.trial_name(),
-        scene_for(base.light()),
+        scene_label(base.light()),
         worst / max
     );
     Ok(())
@@ -631,14 +655,14 @@ fn accuracy_trial(base: FamilyVariant, knobs: SamplingKnobs) -> Result<(), Strin
 fn main() -> ExitCode {
     let mut trials: Vec<(String, Check)> = Vec::new();
     if let Some(ctx) = gpu() {
-        for light in [LightKind::Directional, LightKind::Spot] {
+        for light in [LightKind::Directional, LightKind::Spot, LightKind::Area] {
             for base in bases(light) {
                 for knobs in knobs() {
                     for pose in [Pose::Ordinary, Pose::EpipoleOnScreen] {
                         let name = format!(
                             "sampling::{}::{}::{pose}",
                             base.with_sampling(knobs).trial_name(),
-                            scene_for(light)
+                            scene_label(light)
                         );
                         trials.push((
                             name,

@@ -21,6 +21,7 @@ struct IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     vec4 medium;
     uvec4 sizes;
     uvec4 grid;
+    vec4 centre;
 };
 struct VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     vec4 position;
@@ -50,8 +51,8 @@ layout(binding = 3) uniform sampler2D _group_0_binding_3_cs;
 layout(binding = 4,rgba32f) writeonly uniform image2D _group_0_binding_4_cs;
 
 
-uint voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m, uint v_1, uint j, uint i) {
-    return (((((v_1 * m.grid.y) + j) * m.grid.x) + i) * 4u);
+uint voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m, uint v, uint j, uint i) {
+    return (((((v * m.grid.y) + j) * m.grid.x) + i) * 4u);
 }
 
 vec3 plane_normalX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r, float theta) {
@@ -67,8 +68,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_1 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_1 * x_1) * (3.0 - (2.0 * x_1)));
+    float x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_2 * x_2) * (3.0 - (2.0 * x_2)));
 }
 
 vec3 ivsv_pixel_dir(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_1, uint x, uint y) {
@@ -78,8 +79,8 @@ vec3 ivsv_pixel_dir(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_1, uint x,
     return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t))));
 }
 
-uvec4 voxel(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_2, uint v_2, uint j_1, uint i_1) {
-    uint _e4 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_2, v_2, j_1, i_1);
+uvec4 voxel(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_2, uint v_1, uint j_1, uint i_1) {
+    uint _e4 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_2, v_1, j_1, i_1);
     uint _e7 = _group_0_binding_2_cs[_e4];
     uint _e12 = _group_0_binding_2_cs[(_e4 + 1u)];
     uint _e17 = _group_0_binding_2_cs[(_e4 + 2u)];
@@ -89,7 +90,7 @@ uvec4 voxel(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_2, uint v_2, uint 
 
 vec2 unset_moments(uvec4 bits, uint k0_, uint k1_) {
     uint n = 0u;
-    uint sum_1 = 0u;
+    uint sum = 0u;
     uint w = 0u;
     bool loop_init = true;
     while(true) {
@@ -111,17 +112,17 @@ vec2 unset_moments(uvec4 bits, uint k0_, uint k1_) {
             if ((hi > lo)) {
                 uint upper = ((hi == 32u) ? 4294967295u : ((1u << hi) - 1u));
                 uint _e28 = w;
-                uint x_2 = ((~(bits[_e28]) & upper) & ~(((1u << lo) - 1u)));
-                uint c_1 = uint(bitCount(x_2));
+                uint x_3 = ((~(bits[_e28]) & upper) & ~(((1u << lo) - 1u)));
+                uint c_1 = uint(bitCount(x_3));
                 uint _e40 = n;
                 n = (_e40 + c_1);
-                uint _e43 = sum_1;
-                sum_1 = (_e43 + ((((((base * c_1) + uint(bitCount((x_2 & 2863311530u)))) + (2u * uint(bitCount((x_2 & 3435973836u))))) + (4u * uint(bitCount((x_2 & 4042322160u))))) + (8u * uint(bitCount((x_2 & 4278255360u))))) + (16u * uint(bitCount((x_2 & 4294901760u))))));
+                uint _e43 = sum;
+                sum = (_e43 + ((((((base * c_1) + uint(bitCount((x_3 & 2863311530u)))) + (2u * uint(bitCount((x_3 & 3435973836u))))) + (4u * uint(bitCount((x_3 & 4042322160u))))) + (8u * uint(bitCount((x_3 & 4278255360u))))) + (16u * uint(bitCount((x_3 & 4294901760u))))));
             }
         }
     }
     uint _e77 = n;
-    uint _e79 = sum_1;
+    uint _e79 = sum;
     return vec2(float(_e77), float(_e79));
 }
 
@@ -145,7 +146,7 @@ uint first_bit_from(float phi, float d_phi) {
     return uint(clamp(ceil(((phi / d_phi) - 0.5)), 0.0, 128.0));
 }
 
-float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_2, uint v_3, vec3 dir, float s) {
+float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_2, uint v_2, vec3 dir, float s) {
     float phi0_ = 0.0;
     bool local_1 = false;
     bool set_a = false;
@@ -197,8 +198,8 @@ float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil
     uint ja = uint(((int(j0_) + int(rows)) % int(rows)));
     uint jb = ((ja + 1u) % rows);
     uint i_2 = uint(clamp(floor(((alpha - r_2.axis.w) / r_2.perp_x.w)), 0.0, float((m_4.grid.x - 1u))));
-    uvec4 _e112 = voxel(m_4, v_3, ja, i_2);
-    uvec4 _e113 = voxel(m_4, v_3, jb, i_2);
+    uvec4 _e112 = voxel(m_4, v_2, ja, i_2);
+    uvec4 _e113 = voxel(m_4, v_2, jb, i_2);
     float d_phi_1 = (phi_max / 128.0);
     float xs = (phi_s / d_phi_1);
     uint ks = min(uint(xs), PHI_BITSX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX);
@@ -209,8 +210,8 @@ float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil
     } else {
         local_1 = false;
     }
-    bool partial_1 = local_1;
-    if (partial_1) {
+    bool partial = local_1;
+    if (partial) {
         set_a = (((_e112[(ks / 32u)] >> (ks % 32u)) & 1u) == 1u);
         set_b = (((_e113[(ks / 32u)] >> (ks % 32u)) & 1u) == 1u);
     }
@@ -275,7 +276,7 @@ float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil
                 float _e244 = lit_b;
                 lit_b = (_e244 + ((a0_ * _e234.x) + (b0_ * _e234.y)));
             }
-            if (partial_1) {
+            if (partial) {
                 local_2 = (pc >= pa);
             } else {
                 local_2 = false;
@@ -315,14 +316,49 @@ float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil
     return (d_phi_1 * (((1.0 - tw) * _e290) + (tw * _e292)));
 }
 
+vec3 ivsv_gather_pixel(uint x_1, uint y_1) {
+    vec3 sum_1 = vec3(0.0);
+    uint v_3 = 0u;
+    IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_5 = _group_0_binding_0_cs;
+    vec3 _e6 = ivsv_pixel_dir(m_5, x_1, y_1);
+    int _e10_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_3_cs) - 1);
+    vec4 _e10 = texelFetch(_group_0_binding_3_cs, clamp(ivec2(uvec2(x_1, y_1)), ivec2(0), textureSize(_group_0_binding_3_cs, _e10_clamped_lod) - ivec2(1)), _e10_clamped_lod);
+    float s_1 = (min(max(_e10.x, 0.0), m_5.eye.w) / max(dot(_e6, m_5.cam_forward.xyz), 1e-6));
+    uint per_class = (m_5.sizes.w / (2u * 2u));
+    uint first = (((x_1 % 2u) + (2u * (y_1 % 2u))) * per_class);
+    v_3 = first;
+    bool loop_init_2 = true;
+    while(true) {
+        if (!loop_init_2) {
+            uint _e49 = v_3;
+            v_3 = (_e49 + 1u);
+        }
+        loop_init_2 = false;
+        uint _e34 = v_3;
+        if ((_e34 < (first + per_class))) {
+        } else {
+            break;
+        }
+        {
+            uint _e38 = v_3;
+            VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_3 = _group_0_binding_1_cs[_e38];
+            vec3 _e42 = sum_1;
+            uint _e45 = v_3;
+            float _e46 = vpl_lit(m_5, r_3, _e45, _e6, s_1);
+            sum_1 = (_e42 + (r_3.color.xyz * _e46));
+        }
+    }
+    vec3 _e52 = sum_1;
+    return _e52;
+}
+
 void main() {
     uvec3 id = gl_GlobalInvocationID;
     bool local = false;
-    vec3 sum = vec3(0.0);
-    uint v = 0u;
-    IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_5 = _group_0_binding_0_cs;
-    if (!((id.x >= m_5.sizes.x))) {
-        local = (id.y >= m_5.sizes.y);
+    uint _e5 = _group_0_binding_0_cs.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = _group_0_binding_0_cs.sizes.y;
+        local = (id.y >= _e12);
     } else {
         local = true;
     }
@@ -330,36 +366,8 @@ void main() {
     if (_e17) {
         return;
     }
-    vec3 _e20 = ivsv_pixel_dir(m_5, id.x, id.y);
-    int _e24_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_3_cs) - 1);
-    vec4 _e24 = texelFetch(_group_0_binding_3_cs, clamp(ivec2(id.xy), ivec2(0), textureSize(_group_0_binding_3_cs, _e24_clamped_lod) - ivec2(1)), _e24_clamped_lod);
-    float s_1 = (min(max(_e24.x, 0.0), m_5.eye.w) / max(dot(_e20, m_5.cam_forward.xyz), 1e-6));
-    uint per_class = (m_5.sizes.w / (2u * 2u));
-    uint first = (((id.x % 2u) + (2u * (id.y % 2u))) * per_class);
-    v = first;
-    bool loop_init_2 = true;
-    while(true) {
-        if (!loop_init_2) {
-            uint _e65 = v;
-            v = (_e65 + 1u);
-        }
-        loop_init_2 = false;
-        uint _e50 = v;
-        if ((_e50 < (first + per_class))) {
-        } else {
-            break;
-        }
-        {
-            uint _e54 = v;
-            VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_3 = _group_0_binding_1_cs[_e54];
-            vec3 _e58 = sum;
-            uint _e61 = v;
-            float _e62 = vpl_lit(m_5, r_3, _e61, _e20, s_1);
-            sum = (_e58 + (r_3.color.xyz * _e62));
-        }
-    }
-    vec3 _e69 = sum;
-    imageStore(_group_0_binding_4_cs, ivec2(id.xy), vec4(_e69, 1.0));
+    vec3 _e20 = ivsv_gather_pixel(id.x, id.y);
+    imageStore(_group_0_binding_4_cs, ivec2(id.xy), vec4(_e20.x, _e20.y, _e20.z, 1.0));
     return;
 }
 

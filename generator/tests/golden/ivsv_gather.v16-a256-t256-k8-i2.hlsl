@@ -17,6 +17,7 @@ struct IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     float4 medium;
     uint4 sizes;
     uint4 grid;
+    float4 centre;
 };
 
 struct VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
@@ -41,11 +42,11 @@ cbuffer frame : register(b0) { IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX f
 cbuffer vpls : register(b1) { VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX vpls[16]; }
 ByteAddressBuffer volume : register(t2);
 Texture2D<float4> depth : register(t3);
-RWTexture2D<float4> partial : register(u4);
+RWTexture2D<float4> output : register(u4);
 
-uint voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m, uint v_1, uint j, uint i)
+uint voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m, uint v, uint j, uint i)
 {
-    return (((((v_1 * m.grid.y) + j) * m.grid.x) + i) * 4u);
+    return (((((v * m.grid.y) + j) * m.grid.x) + i) * 4u);
 }
 
 float3 plane_normalX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r, float theta)
@@ -64,8 +65,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_1 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_1 * x_1) * (3.0 - (2.0 * x_1)));
+    float x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_2 * x_2) * (3.0 - (2.0 * x_2)));
 }
 
 float3 ivsv_pixel_dir(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_1, uint x, uint y)
@@ -76,9 +77,9 @@ float3 ivsv_pixel_dir(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_1, uint 
     return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t))));
 }
 
-uint4 voxel(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_2, uint v_2, uint j_1, uint i_1)
+uint4 voxel(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_2, uint v_1, uint j_1, uint i_1)
 {
-    const uint _e4 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_2, v_2, j_1, i_1);
+    const uint _e4 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_2, v_1, j_1, i_1);
     uint _e7 = asuint(volume.Load(_e4*4));
     uint _e12 = asuint(volume.Load((_e4 + 1u)*4));
     uint _e17 = asuint(volume.Load((_e4 + 2u)*4));
@@ -89,7 +90,7 @@ uint4 voxel(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_2, uint v_2, uint 
 float2 unset_moments(uint4 bits, uint k0_, uint k1_)
 {
     uint n = 0u;
-    uint sum_1 = 0u;
+    uint sum = 0u;
     uint w = 0u;
 
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
@@ -115,17 +116,17 @@ float2 unset_moments(uint4 bits, uint k0_, uint k1_)
             if ((hi > lo)) {
                 uint upper = ((hi == 32u) ? 4294967295u : ((1u << hi) - 1u));
                 uint _e28 = w;
-                uint x_2 = ((~(bits[min(uint(_e28), 3u)]) & upper) & ~(((1u << lo) - 1u)));
-                uint c_1 = countbits(x_2);
+                uint x_3 = ((~(bits[min(uint(_e28), 3u)]) & upper) & ~(((1u << lo) - 1u)));
+                uint c_1 = countbits(x_3);
                 uint _e40 = n;
                 n = (_e40 + c_1);
-                uint _e43 = sum_1;
-                sum_1 = (_e43 + ((((((base * c_1) + countbits((x_2 & 2863311530u))) + (2u * countbits((x_2 & 3435973836u)))) + (4u * countbits((x_2 & 4042322160u)))) + (8u * countbits((x_2 & 4278255360u)))) + (16u * countbits((x_2 & 4294901760u)))));
+                uint _e43 = sum;
+                sum = (_e43 + ((((((base * c_1) + countbits((x_3 & 2863311530u))) + (2u * countbits((x_3 & 3435973836u)))) + (4u * countbits((x_3 & 4042322160u)))) + (8u * countbits((x_3 & 4278255360u)))) + (16u * countbits((x_3 & 4294901760u)))));
             }
         }
     }
     uint _e77 = n;
-    uint _e79 = sum_1;
+    uint _e79 = sum;
     return float2(float(_e77), float(_e79));
 }
 
@@ -173,7 +174,7 @@ int naga_f2i32(float value) {
     return int(clamp(value, -2147483600.0, 2147483500.0));
 }
 
-float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_2, uint v_3, float3 dir, float s)
+float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_2, uint v_2, float3 dir, float s)
 {
     float phi0_ = (float)0;
     bool local_1 = (bool)0;
@@ -227,8 +228,8 @@ float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil
     uint ja = uint(naga_mod(asint(asuint(naga_f2i32(j0_)) + asuint(int(rows))), int(rows)));
     uint jb = naga_mod((ja + 1u), rows);
     uint i_2 = naga_f2u32(clamp(floor(((alpha - r_2.axis.w) / r_2.perp_x.w)), 0.0, float((m_4.grid.x - 1u))));
-    const uint4 _e112 = voxel(m_4, v_3, ja, i_2);
-    const uint4 _e113 = voxel(m_4, v_3, jb, i_2);
+    const uint4 _e112 = voxel(m_4, v_2, ja, i_2);
+    const uint4 _e113 = voxel(m_4, v_2, jb, i_2);
     float d_phi_1 = (phi_max / 128.0);
     float xs = (phi_s / d_phi_1);
     uint ks = min(naga_f2u32(xs), PHI_BITSX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX);
@@ -239,8 +240,8 @@ float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil
     } else {
         local_1 = false;
     }
-    bool partial_1 = local_1;
-    if (partial_1) {
+    bool partial = local_1;
+    if (partial) {
         set_a = (((_e112[min(uint(naga_div(ks, 32u)), 3u)] >> naga_mod(ks, 32u)) & 1u) == 1u);
         set_b = (((_e113[min(uint(naga_div(ks, 32u)), 3u)] >> naga_mod(ks, 32u)) & 1u) == 1u);
     }
@@ -308,7 +309,7 @@ float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil
                 float _e244 = lit_b;
                 lit_b = (_e244 + ((a0_ * _e234.x) + (b0_ * _e234.y)));
             }
-            if (partial_1) {
+            if (partial) {
                 local_2 = (pc >= pa);
             } else {
                 local_2 = false;
@@ -348,16 +349,55 @@ float vpl_lit(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4, VplX_naga_oil
     return (d_phi_1 * (((1.0 - tw) * _e290) + (tw * _e292)));
 }
 
+float3 ivsv_gather_pixel(uint x_1, uint y_1)
+{
+    float3 sum_1 = (0.0).xxx;
+    uint v_3 = (uint)0;
+
+    IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_5 = frame;
+    const float3 _e6 = ivsv_pixel_dir(m_5, x_1, y_1);
+    float4 _e10 = depth.Load(int3(uint2(x_1, y_1), int(0)));
+    float s_1 = (min(max(_e10.x, 0.0), m_5.eye.w) / max(dot(_e6, m_5.cam_forward.xyz), 1e-6));
+    uint per_class = naga_div(m_5.sizes.w, (2u * 2u));
+    uint first = ((naga_mod(x_1, 2u) + (2u * naga_mod(y_1, 2u))) * per_class);
+    v_3 = first;
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e49 = v_3;
+            v_3 = (_e49 + 1u);
+        }
+        loop_init_2 = false;
+        uint _e34 = v_3;
+        if ((_e34 < (first + per_class))) {
+        } else {
+            break;
+        }
+        {
+            uint _e38 = v_3;
+            VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_3 = vpls[min(uint(_e38), 15u)];
+            float3 _e42 = sum_1;
+            uint _e45 = v_3;
+            const float _e46 = vpl_lit(m_5, r_3, _e45, _e6, s_1);
+            sum_1 = (_e42 + (r_3.color.xyz * _e46));
+        }
+    }
+    float3 _e52 = sum_1;
+    return _e52;
+}
+
 [numthreads(8, 8, 1)]
 void ivsv_gather(uint3 id : SV_DispatchThreadID)
 {
     bool local = (bool)0;
-    float3 sum = (0.0).xxx;
-    uint v = (uint)0;
 
-    IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_5 = frame;
-    if (!((id.x >= m_5.sizes.x))) {
-        local = (id.y >= m_5.sizes.y);
+    uint _e5 = frame.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = frame.sizes.y;
+        local = (id.y >= _e12);
     } else {
         local = true;
     }
@@ -365,37 +405,7 @@ void ivsv_gather(uint3 id : SV_DispatchThreadID)
     if (_e17) {
         return;
     }
-    const float3 _e20 = ivsv_pixel_dir(m_5, id.x, id.y);
-    float4 _e24 = depth.Load(int3(id.xy, int(0)));
-    float s_1 = (min(max(_e24.x, 0.0), m_5.eye.w) / max(dot(_e20, m_5.cam_forward.xyz), 1e-6));
-    uint per_class = naga_div(m_5.sizes.w, (2u * 2u));
-    uint first = ((naga_mod(id.x, 2u) + (2u * naga_mod(id.y, 2u))) * per_class);
-    v = first;
-    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e65 = v;
-            v = (_e65 + 1u);
-        }
-        loop_init_2 = false;
-        uint _e50 = v;
-        if ((_e50 < (first + per_class))) {
-        } else {
-            break;
-        }
-        {
-            uint _e54 = v;
-            VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_3 = vpls[min(uint(_e54), 15u)];
-            float3 _e58 = sum;
-            uint _e61 = v;
-            const float _e62 = vpl_lit(m_5, r_3, _e61, _e20, s_1);
-            sum = (_e58 + (r_3.color.xyz * _e62));
-        }
-    }
-    float3 _e69 = sum;
-    partial[id.xy] = float4(_e69, 1.0);
+    const float3 _e20 = ivsv_gather_pixel(id.x, id.y);
+    output[id.xy] = float4(_e20.x, _e20.y, _e20.z, 1.0);
     return;
 }

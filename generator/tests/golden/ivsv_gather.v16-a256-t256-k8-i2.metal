@@ -26,6 +26,7 @@ struct IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     metal::float4 medium;
     metal::uint4 sizes;
     metal::uint4 grid;
+    metal::float4 centre;
 };
 struct VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     metal::float4 position;
@@ -50,11 +51,11 @@ constant uint SEGMENTS = 8u;
 
 uint voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(
     IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m,
-    uint v_1,
+    uint v,
     uint j,
     uint i
 ) {
-    return ((((v_1 * m.grid.y) + j) * m.grid.x) + i) * 4u;
+    return ((((v * m.grid.y) + j) * m.grid.x) + i) * 4u;
 }
 
 metal::float3 plane_normalX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(
@@ -80,8 +81,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_1 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_1 * x_1) * (3.0 - (2.0 * x_1));
+    float x_2 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_2 * x_2) * (3.0 - (2.0 * x_2));
 }
 
 metal::float3 ivsv_pixel_dir(
@@ -97,13 +98,13 @@ metal::float3 ivsv_pixel_dir(
 
 metal::uint4 voxel(
     IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_2,
-    uint v_2,
+    uint v_1,
     uint j_1,
     uint i_1,
     device type_6 const& volume,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    uint _e4 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_2, v_2, j_1, i_1);
+    uint _e4 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_2, v_1, j_1, i_1);
     uint _e7 = volume[metal::min(unsigned(_e4), (_buffer_sizes.size2 - 0 - 4) / 4)];
     uint _e12 = volume[metal::min(unsigned(_e4 + 1u), (_buffer_sizes.size2 - 0 - 4) / 4)];
     uint _e17 = volume[metal::min(unsigned(_e4 + 2u), (_buffer_sizes.size2 - 0 - 4) / 4)];
@@ -117,7 +118,7 @@ metal::float2 unset_moments(
     uint k1_
 ) {
     uint n = 0u;
-    uint sum_1 = 0u;
+    uint sum = 0u;
     uint w = 0u;
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
@@ -142,17 +143,17 @@ metal::float2 unset_moments(
             if (hi > lo) {
                 uint upper = (hi == 32u) ? 4294967295u : ((1u << hi) - 1u);
                 uint _e28 = w;
-                uint x_2 = (~(bits[metal::min(unsigned(_e28), 3u)]) & upper) & ~(((1u << lo) - 1u));
-                uint c_1 = metal::popcount(x_2);
+                uint x_3 = (~(bits[metal::min(unsigned(_e28), 3u)]) & upper) & ~(((1u << lo) - 1u));
+                uint c_1 = metal::popcount(x_3);
                 uint _e40 = n;
                 n = _e40 + c_1;
-                uint _e43 = sum_1;
-                sum_1 = _e43 + ((((((base * c_1) + metal::popcount(x_2 & 2863311530u)) + (2u * metal::popcount(x_2 & 3435973836u))) + (4u * metal::popcount(x_2 & 4042322160u))) + (8u * metal::popcount(x_2 & 4278255360u))) + (16u * metal::popcount(x_2 & 4294901760u)));
+                uint _e43 = sum;
+                sum = _e43 + ((((((base * c_1) + metal::popcount(x_3 & 2863311530u)) + (2u * metal::popcount(x_3 & 3435973836u))) + (4u * metal::popcount(x_3 & 4042322160u))) + (8u * metal::popcount(x_3 & 4278255360u))) + (16u * metal::popcount(x_3 & 4294901760u)));
             }
         }
     }
     uint _e77 = n;
-    uint _e79 = sum_1;
+    uint _e79 = sum;
     return metal::float2(static_cast<float>(_e77), static_cast<float>(_e79));
 }
 
@@ -214,7 +215,7 @@ uint naga_div(uint lhs, uint rhs) {
 float vpl_lit(
     IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_4,
     VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_2,
-    uint v_3,
+    uint v_2,
     metal::float3 dir,
     float s,
     device type_6 const& volume,
@@ -271,8 +272,8 @@ float vpl_lit(
     uint ja = static_cast<uint>(naga_mod(as_type<int>(as_type<uint>(naga_f2i32(j0_)) + as_type<uint>(static_cast<int>(rows))), static_cast<int>(rows)));
     uint jb = naga_mod(ja + 1u, rows);
     uint i_2 = naga_f2u32(metal::clamp(metal::floor((alpha - r_2.axis.w) / r_2.perp_x.w), 0.0, static_cast<float>(m_4.grid.x - 1u)));
-    metal::uint4 _e112 = voxel(m_4, v_3, ja, i_2, volume, _buffer_sizes);
-    metal::uint4 _e113 = voxel(m_4, v_3, jb, i_2, volume, _buffer_sizes);
+    metal::uint4 _e112 = voxel(m_4, v_2, ja, i_2, volume, _buffer_sizes);
+    metal::uint4 _e113 = voxel(m_4, v_2, jb, i_2, volume, _buffer_sizes);
     float d_phi_1 = phi_max / 128.0;
     float xs = phi_s / d_phi_1;
     uint ks = metal::min(naga_f2u32(xs), PHI_BITSX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX);
@@ -283,8 +284,8 @@ float vpl_lit(
     } else {
         local_1 = false;
     }
-    bool partial_1 = local_1;
-    if (partial_1) {
+    bool partial = local_1;
+    if (partial) {
         set_a = ((_e112[metal::min(unsigned(naga_div(ks, 32u)), 3u)] >> naga_mod(ks, 32u)) & 1u) == 1u;
         set_b = ((_e113[metal::min(unsigned(naga_div(ks, 32u)), 3u)] >> naga_mod(ks, 32u)) & 1u) == 1u;
     }
@@ -352,7 +353,7 @@ float vpl_lit(
                 float _e244 = lit_b;
                 lit_b = _e244 + ((a0_ * _e234.x) + (b0_ * _e234.y));
             }
-            if (partial_1) {
+            if (partial) {
                 local_2 = pc >= pa;
             } else {
                 local_2 = false;
@@ -392,6 +393,53 @@ float vpl_lit(
     return d_phi_1 * (((1.0 - tw) * _e290) + (tw * _e292));
 }
 
+metal::float3 ivsv_gather_pixel(
+    uint x_1,
+    uint y_1,
+    constant IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX& frame,
+    constant type_5& vpls,
+    device type_6 const& volume,
+    metal::texture2d<float, metal::access::sample> depth,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    metal::float3 sum_1 = metal::float3(0.0);
+    uint v_3 = {};
+    IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_5 = frame;
+    metal::float3 _e6 = ivsv_pixel_dir(m_5, x_1, y_1);
+    uint clamped_lod_e10 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e10 = depth.read(metal::min(metal::uint2(metal::uint2(x_1, y_1)), metal::uint2(depth.get_width(clamped_lod_e10), depth.get_height(clamped_lod_e10)) - 1), clamped_lod_e10);
+    float s_1 = metal::min(metal::max(_e10.x, 0.0), m_5.eye.w) / metal::max(metal::dot(_e6, m_5.cam_forward.xyz), 0.000001);
+    uint per_class = naga_div(m_5.sizes.w, 2u * 2u);
+    uint first = (naga_mod(x_1, 2u) + (2u * naga_mod(y_1, 2u))) * per_class;
+    v_3 = first;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e49 = v_3;
+            v_3 = _e49 + 1u;
+        }
+        loop_init_2 = false;
+        uint _e34 = v_3;
+        if (_e34 < (first + per_class)) {
+        } else {
+            break;
+        }
+        {
+            uint _e38 = v_3;
+            VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_3 = vpls.inner[metal::min(unsigned(_e38), 15u)];
+            metal::float3 _e42 = sum_1;
+            uint _e45 = v_3;
+            float _e46 = vpl_lit(m_5, r_3, _e45, _e6, s_1, volume, _buffer_sizes);
+            sum_1 = _e42 + (r_3.color.xyz * _e46);
+        }
+    }
+    metal::float3 _e52 = sum_1;
+    return _e52;
+}
+
 struct ivsv_gatherInput {
 };
 kernel void ivsv_gather(
@@ -400,15 +448,14 @@ kernel void ivsv_gather(
 , constant type_5& vpls [[buffer(1)]]
 , device type_6 const& volume [[buffer(2)]]
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
-, metal::texture2d<float, metal::access::write> partial [[texture(1)]]
+, metal::texture2d<float, metal::access::write> output [[texture(1)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {
     bool local = {};
-    metal::float3 sum = metal::float3(0.0);
-    uint v = {};
-    IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_5 = frame;
-    if (!((id.x >= m_5.sizes.x))) {
-        local = id.y >= m_5.sizes.y;
+    uint _e5 = frame.sizes.x;
+    if (!((id.x >= _e5))) {
+        uint _e12 = frame.sizes.y;
+        local = id.y >= _e12;
     } else {
         local = true;
     }
@@ -416,38 +463,7 @@ kernel void ivsv_gather(
     if (_e17) {
         return;
     }
-    metal::float3 _e20 = ivsv_pixel_dir(m_5, id.x, id.y);
-    uint clamped_lod_e24 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e24 = depth.read(metal::min(metal::uint2(id.xy), metal::uint2(depth.get_width(clamped_lod_e24), depth.get_height(clamped_lod_e24)) - 1), clamped_lod_e24);
-    float s_1 = metal::min(metal::max(_e24.x, 0.0), m_5.eye.w) / metal::max(metal::dot(_e20, m_5.cam_forward.xyz), 0.000001);
-    uint per_class = naga_div(m_5.sizes.w, 2u * 2u);
-    uint first = (naga_mod(id.x, 2u) + (2u * naga_mod(id.y, 2u))) * per_class;
-    v = first;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e65 = v;
-            v = _e65 + 1u;
-        }
-        loop_init_2 = false;
-        uint _e50 = v;
-        if (_e50 < (first + per_class)) {
-        } else {
-            break;
-        }
-        {
-            uint _e54 = v;
-            VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX r_3 = vpls.inner[metal::min(unsigned(_e54), 15u)];
-            metal::float3 _e58 = sum;
-            uint _e61 = v;
-            float _e62 = vpl_lit(m_5, r_3, _e61, _e20, s_1, volume, _buffer_sizes);
-            sum = _e58 + (r_3.color.xyz * _e62);
-        }
-    }
-    metal::float3 _e69 = sum;
-    partial.write(metal::float4(_e69, 1.0), metal::uint2(id.xy));
+    metal::float3 _e20 = ivsv_gather_pixel(id.x, id.y, frame, vpls, volume, depth, _buffer_sizes);
+    output.write(metal::float4(_e20.x, _e20.y, _e20.z, 1.0), metal::uint2(id.xy));
     return;
 }

@@ -17,6 +17,7 @@ struct IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     medium: vec4<f32>,
     sizes: vec4<u32>,
     grid: vec4<u32>,
+    centre: vec4<f32>,
 }
 
 struct VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
@@ -46,10 +47,10 @@ var<storage> volume: array<u32>;
 @group(0) @binding(3) 
 var depth: texture_2d<f32>;
 @group(0) @binding(4) 
-var partial: texture_storage_2d<rgba32float,write>;
+var output: texture_storage_2d<rgba32float,write>;
 
-fn voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, v_1: u32, j: u32, i: u32) -> u32 {
-    return (((((v_1 * m.grid.y) + j) * m.grid.x) + i) * 4u);
+fn voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, v: u32, j: u32, i: u32) -> u32 {
+    return (((((v * m.grid.y) + j) * m.grid.x) + i) * 4u);
 }
 
 fn plane_normalX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(r: VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, theta: f32) -> vec3<f32> {
@@ -65,8 +66,8 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_1 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_1 * x_1) * (3f - (2f * x_1)));
+    let x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_2 * x_2) * (3f - (2f * x_2)));
 }
 
 fn ivsv_pixel_dir(m_1: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, x: u32, y: u32) -> vec3<f32> {
@@ -76,8 +77,8 @@ fn ivsv_pixel_dir(m_1: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, x: u32, 
     return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t))));
 }
 
-fn voxel(m_2: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, v_2: u32, j_1: u32, i_1: u32) -> vec4<u32> {
-    let _e4 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_2, v_2, j_1, i_1);
+fn voxel(m_2: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, v_1: u32, j_1: u32, i_1: u32) -> vec4<u32> {
+    let _e4 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_2, v_1, j_1, i_1);
     let _e7 = volume[_e4];
     let _e12 = volume[(_e4 + 1u)];
     let _e17 = volume[(_e4 + 2u)];
@@ -87,7 +88,7 @@ fn voxel(m_2: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, v_2: u32, j_1: u3
 
 fn unset_moments(bits: vec4<u32>, k0_: u32, k1_: u32) -> vec2<f32> {
     var n: u32 = 0u;
-    var sum_1: u32 = 0u;
+    var sum: u32 = 0u;
     var w: u32 = 0u;
 
     loop {
@@ -104,12 +105,12 @@ fn unset_moments(bits: vec4<u32>, k0_: u32, k1_: u32) -> vec2<f32> {
             if (hi > lo) {
                 let upper = select(((1u << hi) - 1u), 4294967295u, (hi == 32u));
                 let _e28 = w;
-                let x_2 = ((~(bits[_e28]) & upper) & ~(((1u << lo) - 1u)));
-                let c_1 = countOneBits(x_2);
+                let x_3 = ((~(bits[_e28]) & upper) & ~(((1u << lo) - 1u)));
+                let c_1 = countOneBits(x_3);
                 let _e40 = n;
                 n = (_e40 + c_1);
-                let _e43 = sum_1;
-                sum_1 = (_e43 + ((((((base * c_1) + countOneBits((x_2 & 2863311530u))) + (2u * countOneBits((x_2 & 3435973836u)))) + (4u * countOneBits((x_2 & 4042322160u)))) + (8u * countOneBits((x_2 & 4278255360u)))) + (16u * countOneBits((x_2 & 4294901760u)))));
+                let _e43 = sum;
+                sum = (_e43 + ((((((base * c_1) + countOneBits((x_3 & 2863311530u))) + (2u * countOneBits((x_3 & 3435973836u)))) + (4u * countOneBits((x_3 & 4042322160u)))) + (8u * countOneBits((x_3 & 4278255360u)))) + (16u * countOneBits((x_3 & 4294901760u)))));
             }
         }
         continuing {
@@ -118,7 +119,7 @@ fn unset_moments(bits: vec4<u32>, k0_: u32, k1_: u32) -> vec2<f32> {
         }
     }
     let _e77 = n;
-    let _e79 = sum_1;
+    let _e79 = sum;
     return vec2<f32>(f32(_e77), f32(_e79));
 }
 
@@ -142,7 +143,7 @@ fn first_bit_from(phi: f32, d_phi: f32) -> u32 {
     return u32(clamp(ceil(((phi / d_phi) - 0.5f)), 0f, 128f));
 }
 
-fn vpl_lit(m_4: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, r_2: VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, v_3: u32, dir: vec3<f32>, s: f32) -> f32 {
+fn vpl_lit(m_4: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, r_2: VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, v_2: u32, dir: vec3<f32>, s: f32) -> f32 {
     var phi0_: f32;
     var local_1: bool;
     var set_a: bool = false;
@@ -195,8 +196,8 @@ fn vpl_lit(m_4: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, r_2: VplX_naga_
     let ja = u32(((i32(j0_) + i32(rows)) % i32(rows)));
     let jb = ((ja + 1u) % rows);
     let i_2 = u32(clamp(floor(((alpha - r_2.axis.w) / r_2.perp_x.w)), 0f, f32((m_4.grid.x - 1u))));
-    let _e112 = voxel(m_4, v_3, ja, i_2);
-    let _e113 = voxel(m_4, v_3, jb, i_2);
+    let _e112 = voxel(m_4, v_2, ja, i_2);
+    let _e113 = voxel(m_4, v_2, jb, i_2);
     let d_phi_1 = (phi_max / 128f);
     let xs = (phi_s / d_phi_1);
     let ks = min(u32(xs), PHI_BITSX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX);
@@ -207,8 +208,8 @@ fn vpl_lit(m_4: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, r_2: VplX_naga_
     } else {
         local_1 = false;
     }
-    let partial_1 = local_1;
-    if partial_1 {
+    let partial = local_1;
+    if partial {
         set_a = (((_e112[(ks / 32u)] >> (ks % 32u)) & 1u) == 1u);
         set_b = (((_e113[(ks / 32u)] >> (ks % 32u)) & 1u) == 1u);
     }
@@ -267,7 +268,7 @@ fn vpl_lit(m_4: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, r_2: VplX_naga_
                 let _e244 = lit_b;
                 lit_b = (_e244 + ((a0_ * _e234.x) + (b0_ * _e234.y)));
             }
-            if partial_1 {
+            if partial {
                 local_2 = (pc >= pa);
             } else {
                 local_2 = false;
@@ -311,15 +312,48 @@ fn vpl_lit(m_4: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, r_2: VplX_naga_
     return (d_phi_1 * (((1f - tw) * _e290) + (tw * _e292)));
 }
 
+fn ivsv_gather_pixel(x_1: u32, y_1: u32) -> vec3<f32> {
+    var sum_1: vec3<f32> = vec3(0f);
+    var v_3: u32;
+
+    let m_5 = frame;
+    let _e6 = ivsv_pixel_dir(m_5, x_1, y_1);
+    let _e10 = textureLoad(depth, vec2<u32>(x_1, y_1), 0i);
+    let s_1 = (min(max(_e10.x, 0f), m_5.eye.w) / max(dot(_e6, m_5.cam_forward.xyz), 0.000001f));
+    let per_class = (m_5.sizes.w / (2u * 2u));
+    let first = (((x_1 % 2u) + (2u * (y_1 % 2u))) * per_class);
+    v_3 = first;
+    loop {
+        let _e34 = v_3;
+        if (_e34 < (first + per_class)) {
+        } else {
+            break;
+        }
+        {
+            let _e38 = v_3;
+            let r_3 = vpls[_e38];
+            let _e42 = sum_1;
+            let _e45 = v_3;
+            let _e46 = vpl_lit(m_5, r_3, _e45, _e6, s_1);
+            sum_1 = (_e42 + (r_3.color.xyz * _e46));
+        }
+        continuing {
+            let _e49 = v_3;
+            v_3 = (_e49 + 1u);
+        }
+    }
+    let _e52 = sum_1;
+    return _e52;
+}
+
 @compute @workgroup_size(8, 8, 1) 
 fn ivsv_gather(@builtin(global_invocation_id) id: vec3<u32>) {
     var local: bool;
-    var sum: vec3<f32> = vec3(0f);
-    var v: u32;
 
-    let m_5 = frame;
-    if !((id.x >= m_5.sizes.x)) {
-        local = (id.y >= m_5.sizes.y);
+    let _e5 = frame.sizes.x;
+    if !((id.x >= _e5)) {
+        let _e12 = frame.sizes.y;
+        local = (id.y >= _e12);
     } else {
         local = true;
     }
@@ -327,32 +361,7 @@ fn ivsv_gather(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e17 {
         return;
     }
-    let _e20 = ivsv_pixel_dir(m_5, id.x, id.y);
-    let _e24 = textureLoad(depth, id.xy, 0i);
-    let s_1 = (min(max(_e24.x, 0f), m_5.eye.w) / max(dot(_e20, m_5.cam_forward.xyz), 0.000001f));
-    let per_class = (m_5.sizes.w / (2u * 2u));
-    let first = (((id.x % 2u) + (2u * (id.y % 2u))) * per_class);
-    v = first;
-    loop {
-        let _e50 = v;
-        if (_e50 < (first + per_class)) {
-        } else {
-            break;
-        }
-        {
-            let _e54 = v;
-            let r_3 = vpls[_e54];
-            let _e58 = sum;
-            let _e61 = v;
-            let _e62 = vpl_lit(m_5, r_3, _e61, _e20, s_1);
-            sum = (_e58 + (r_3.color.xyz * _e62));
-        }
-        continuing {
-            let _e65 = v;
-            v = (_e65 + 1u);
-        }
-    }
-    let _e69 = sum;
-    textureStore(partial, id.xy, vec4<f32>(_e69, 1f));
+    let _e20 = ivsv_gather_pixel(id.x, id.y);
+    textureStore(output, id.xy, vec4<f32>(_e20.x, _e20.y, _e20.z, 1f));
     return;
 }

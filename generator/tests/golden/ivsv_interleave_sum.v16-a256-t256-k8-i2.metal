@@ -22,6 +22,7 @@ struct IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     metal::float4 medium;
     metal::uint4 sizes;
     metal::uint4 grid;
+    metal::float4 centre;
 };
 constant uint M = 2u;
 

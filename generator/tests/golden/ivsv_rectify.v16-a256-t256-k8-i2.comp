@@ -21,6 +21,7 @@ struct IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     vec4 medium;
     uvec4 sizes;
     uvec4 grid;
+    vec4 centre;
 };
 struct VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     vec4 position;

@@ -17,6 +17,7 @@ struct IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     medium: vec4<f32>,
     sizes: vec4<u32>,
     grid: vec4<u32>,
+    centre: vec4<f32>,
 }
 
 struct VplX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {

@@ -21,6 +21,7 @@ struct IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     vec4 medium;
     uvec4 sizes;
     uvec4 grid;
+    vec4 centre;
 };
 layout(std140, binding = 0) uniform IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX_block_0Compute { IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX _group_0_binding_0_cs; };
 

@@ -17,6 +17,7 @@ struct IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     float4 medium;
     uint4 sizes;
     uint4 grid;
+    float4 centre;
 };
 
 cbuffer frame : register(b0) { IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX frame; }

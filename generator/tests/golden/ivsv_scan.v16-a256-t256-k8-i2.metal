@@ -27,6 +27,7 @@ struct IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX {
     metal::float4 medium;
     metal::uint4 sizes;
     metal::uint4 grid;
+    metal::float4 centre;
 };
 typedef metal::atomic_uint type_4[1];
 typedef uint type_5[1];

@@ -16,7 +16,7 @@
 #define SCATTER_STATIC_ASSERT(cond, msg) _Static_assert(cond, msg)
 #endif
 
-/* WGSL `IvsvFrame` of family area_ivsv (scatter::ivsv), 112 bytes, alignment 16. */
+/* WGSL `IvsvFrame` of family area_ivsv (scatter::ivsv), 128 bytes, alignment 16. */
 typedef struct ScatterAreaIvsvIvsvFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
     float cam_forward[4]; /* vec4<f32>, offset 16 */
@@ -25,8 +25,9 @@ typedef struct ScatterAreaIvsvIvsvFrame {
     float medium[4]; /* vec4<f32>, offset 64 */
     uint32_t sizes[4]; /* vec4<u32>, offset 80 */
     uint32_t grid[4]; /* vec4<u32>, offset 96 */
+    float centre[4]; /* vec4<f32>, offset 112 */
 } ScatterAreaIvsvIvsvFrame;
-SCATTER_STATIC_ASSERT(sizeof(ScatterAreaIvsvIvsvFrame) == 112, "ScatterAreaIvsvIvsvFrame size");
+SCATTER_STATIC_ASSERT(sizeof(ScatterAreaIvsvIvsvFrame) == 128, "ScatterAreaIvsvIvsvFrame size");
 SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, eye) == 0, "ScatterAreaIvsvIvsvFrame.eye offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, cam_forward) == 16, "ScatterAreaIvsvIvsvFrame.cam_forward offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, cam_right) == 32, "ScatterAreaIvsvIvsvFrame.cam_right offset");
@@ -34,6 +35,7 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, cam_up) == 48, "Scatter
 SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, medium) == 64, "ScatterAreaIvsvIvsvFrame.medium offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, sizes) == 80, "ScatterAreaIvsvIvsvFrame.sizes offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, grid) == 96, "ScatterAreaIvsvIvsvFrame.grid offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvIvsvFrame, centre) == 112, "ScatterAreaIvsvIvsvFrame.centre offset");
 
 /* WGSL `Vpl` of family area_ivsv (scatter::ivsv), 176 bytes, alignment 16. */
 typedef struct ScatterAreaIvsvVpl {

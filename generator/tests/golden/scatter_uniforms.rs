@@ -8,7 +8,7 @@
 /// Uniform structs of the `area_ivsv` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod area_ivsv {
-    /// WGSL `IvsvFrame` (scatter::ivsv), 112 bytes, alignment 16.
+    /// WGSL `IvsvFrame` (scatter::ivsv), 128 bytes, alignment 16.
     #[repr(C)]
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct IvsvFrame {
@@ -26,10 +26,12 @@ pub mod area_ivsv {
         pub sizes: [u32; 4],
         /// `vec4<u32>` at byte 96.
         pub grid: [u32; 4],
+        /// `vec4<f32>` at byte 112.
+        pub centre: [f32; 4],
     }
 
     const _: () = {
-        assert!(::core::mem::size_of::<IvsvFrame>() == 112);
+        assert!(::core::mem::size_of::<IvsvFrame>() == 128);
         assert!(::core::mem::offset_of!(IvsvFrame, eye) == 0);
         assert!(::core::mem::offset_of!(IvsvFrame, cam_forward) == 16);
         assert!(::core::mem::offset_of!(IvsvFrame, cam_right) == 32);
@@ -37,6 +39,7 @@ pub mod area_ivsv {
         assert!(::core::mem::offset_of!(IvsvFrame, medium) == 64);
         assert!(::core::mem::offset_of!(IvsvFrame, sizes) == 80);
         assert!(::core::mem::offset_of!(IvsvFrame, grid) == 96);
+        assert!(::core::mem::offset_of!(IvsvFrame, centre) == 112);
     };
     /// WGSL `Vpl` (scatter::ivsv), 176 bytes, alignment 16.
     #[repr(C)]

@@ -273,6 +273,21 @@ impl EpipolarCamera {
         Self::new(m.cam_forward, m.cam_right, m.cam_up, toward)
     }
 
+    /// The camera of `IvsvFrame` (area_ivsv): towards the light is `centre - eye`, the
+    /// VPLs' centroid.
+    pub fn of_ivsv(m: &scatter_shaderlib::area_ivsv::IvsvUniforms) -> Self {
+        Self::new(
+            m.cam_forward,
+            m.cam_right,
+            m.cam_up,
+            [
+                m.centre[0] - m.eye[0],
+                m.centre[1] - m.eye[1],
+                m.centre[2] - m.eye[2],
+            ],
+        )
+    }
+
     /// From a uniform block's `cam_forward` (w = tan(fov_y / 2)), `cam_right` (w = aspect),
     /// `cam_up` and the direction towards the light.
     pub fn new(

@@ -5,9 +5,12 @@
 
 use super::common_ivsv::{PHI_BITS, plane_normal, voxel_word};
 use super::common_model::{cone_falloff, phase_hg};
+use super::common_sampling::{
+    EpipolarCamera, EpipolarSamples, SampledOutput, epipolar_samples, run_sampled,
+};
 use super::texture::{Tex, xyz};
 use glam::Vec3;
-use scatter_shaderlib::area_ivsv::{IvsvUniforms, VplRecord};
+use scatter_shaderlib::area_ivsv::{AreaIvsvVariant, IvsvUniforms, VplRecord};
 use std::f32::consts::PI;
 
 /// Unit view direction through the centre of pixel `(x, y)`.
@@ -248,4 +251,41 @@ pub fn ivsv_gather(
             )
         })
         .collect()
+}
+
+/// A variant without interleaving through its sampling (every pixel, `lowres` with its
+/// upsample, or `epipolar` with `ivsv_gather_unwarp` and `ivsv_gather_fallback`):
+/// [`run_sampled`] with [`gather_pixel`] as the pixel body; the slices radiate from the
+/// VPLs' centroid.
+pub fn ivsv_gather_sampled(
+    variant: &AreaIvsvVariant,
+    m: &IvsvUniforms,
+    vpls: &[VplRecord],
+    volume: &[u32],
+    depth: &Tex,
+) -> SampledOutput {
+    run_sampled(
+        &variant.sampling_knobs(),
+        [m.sizes[0], m.sizes[1]],
+        depth,
+        &EpipolarCamera::of_ivsv(m),
+        &|x, y| gather_pixel(m, vpls, volume, depth, variant.segments, 1, x, y),
+    )
+}
+
+/// `ivsv_gather` of an `epipolar` variant: the samples of every slice (sampling pass 1).
+pub fn ivsv_gather_epipolar_samples(
+    variant: &AreaIvsvVariant,
+    m: &IvsvUniforms,
+    vpls: &[VplRecord],
+    volume: &[u32],
+    depth: &Tex,
+) -> EpipolarSamples {
+    epipolar_samples(
+        &variant.sampling_knobs(),
+        [m.sizes[0], m.sizes[1]],
+        depth,
+        &EpipolarCamera::of_ivsv(m),
+        &|x, y| gather_pixel(m, vpls, volume, depth, variant.segments, 1, x, y),
+    )
 }

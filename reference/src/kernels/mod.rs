@@ -19,6 +19,8 @@ pub mod depth_columns;
 pub mod family;
 pub mod interleave_sum;
 pub mod ivsv_gather;
+pub mod ivsv_gather_fallback;
+pub mod ivsv_gather_unwarp;
 pub mod ivsv_interleave_sum;
 pub mod ivsv_rectify;
 pub mod ivsv_scan;
@@ -686,14 +688,16 @@ pub struct IvsvRun {
     /// `ivsv_gather`'s partial sums when interleaved (else empty).
     pub partial: Vec<[f32; 3]>,
     /// The output (rgb, not rounded to `rgba16float`): `ivsv_gather`'s, or
-    /// `ivsv_interleave_sum`'s when interleaved.
+    /// `ivsv_interleave_sum`'s when interleaved; when sampled the stage's output, rounded
+    /// (its samples are stored as rgba16float before they are blended).
     pub output: Vec<[f32; 3]>,
     /// The output as stored in `rgba16float`.
     pub image: Image,
 }
 
 /// Runs `ivsv_rectify`, `ivsv_scan`, `ivsv_gather` and, when interleaved,
-/// `ivsv_interleave_sum` on the CPU.
+/// `ivsv_interleave_sum`, or when sampled the sampling stage around `ivsv_gather`'s pixel
+/// body (`ivsv_gather_unwarp` and `ivsv_gather_fallback` for `epipolar`), on the CPU.
 pub fn run_area_ivsv(variant: &AreaIvsvVariant, inputs: &IvsvInputs) -> IvsvRun {
     let m = &inputs.frame.uniforms;
     let words = 4 * (variant.vpls * variant.alpha * variant.theta) as usize;
@@ -702,6 +706,31 @@ pub fn run_area_ivsv(variant: &AreaIvsvVariant, inputs: &IvsvInputs) -> IvsvRun 
     let rectified = marks.clone();
     let mut volume = vec![0u32; words];
     ivsv_scan::ivsv_scan(m, &mut marks, &mut volume);
+    if variant.sampling_knobs().is_sampled() {
+        // Sampled (interleave 1): the stage's passes with the gather's pixel body; the
+        // output is already rounded to rgba16float.
+        let sampled = ivsv_gather::ivsv_gather_sampled(
+            variant,
+            m,
+            &inputs.frame.vpls,
+            &volume,
+            &inputs.depth,
+        );
+        let output: Vec<[f32; 3]> = sampled
+            .output
+            .data
+            .iter()
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        let image = Image::from_pixels(m.sizes[0], m.sizes[1], output.clone());
+        return IvsvRun {
+            marks: rectified,
+            volume,
+            partial: Vec::new(),
+            output,
+            image,
+        };
+    }
     let gathered = ivsv_gather::ivsv_gather(
         m,
         &inputs.frame.vpls,

@@ -17,6 +17,7 @@ pub use scatter_frame::area_ivsv::{
 pub use scatter_frame::area_light::{AreaLightDesc, AreaShapeDesc, halton, light_basis};
 
 use crate::compose::template_path;
+use crate::sampling::{EPIPOLAR_SAMPLES_FORMAT, Sampling, SamplingView, camera_expr, unwarp_only};
 use crate::{Kernel, ShaderError};
 
 /// Workgroup size of `ivsv_rectify` (x: phi bits) and `ivsv_scan` (x: row words).
@@ -38,13 +39,49 @@ struct RectifyTemplate {
 struct ScanTemplate;
 
 /// `ivsv_gather`: the pieces of the integrand are a constant loop count, the VPL records a
-/// uniform array.
+/// uniform array; the sampling stage's entry points.
 #[derive(Template)]
 #[template(path = "ivsv_gather.wgsl")]
 struct GatherTemplate {
     segments: u32,
     vpls: u32,
     interleave: u32,
+    output_format: &'static str,
+    sampling: SamplingView,
+}
+
+/// `ivsv_gather_unwarp`: `ivsv_gather` with the unwarp entry point.
+#[derive(Template)]
+#[template(path = "ivsv_gather_unwarp.wgsl")]
+struct GatherUnwarpTemplate {
+    segments: u32,
+    vpls: u32,
+    interleave: u32,
+    output_format: &'static str,
+    sampling: SamplingView,
+}
+
+/// `ivsv_gather_fallback`: `ivsv_gather` with the fallback entry point.
+#[derive(Template)]
+#[template(path = "ivsv_gather_fallback.wgsl")]
+struct GatherFallbackTemplate {
+    segments: u32,
+    vpls: u32,
+    interleave: u32,
+    output_format: &'static str,
+    sampling: SamplingView,
+}
+
+/// The sampling view of `kernel` (`ivsv_gather` or its unwarp or fallback): epipolar
+/// slices radiate from the VPLs' centroid (`frame.centre`); the first free binding is 5.
+fn sampling_view(variant: &AreaIvsvVariant, kernel: Kernel) -> SamplingView {
+    SamplingView::new(
+        &variant.sampling_knobs(),
+        kernel,
+        Kernel::IvsvGather,
+        camera_expr("frame.centre.xyz - frame.eye.xyz"),
+        5,
+    )
 }
 
 /// `ivsv_interleave_sum`: the window side.
@@ -84,16 +121,56 @@ pub(crate) fn render_scan(variant: &AreaIvsvVariant) -> Result<String, ShaderErr
         .map_err(render_error(Kernel::IvsvScan))
 }
 
-/// Renders `templates/ivsv_gather.wgsl` for `variant`'s segments.
+/// Renders `templates/ivsv_gather.wgsl` for `variant`'s segments and sampling.
 pub(crate) fn render_gather(variant: &AreaIvsvVariant) -> Result<String, ShaderError> {
     validate(Kernel::IvsvGather, variant)?;
     GatherTemplate {
         segments: variant.segments,
         vpls: variant.vpls,
         interleave: variant.interleave,
+        output_format: if variant.interleave > 1 {
+            "rgba32float"
+        } else if variant.sampling == Sampling::Epipolar {
+            EPIPOLAR_SAMPLES_FORMAT
+        } else {
+            "rgba16float"
+        },
+        sampling: sampling_view(variant, Kernel::IvsvGather),
     }
     .render()
     .map_err(render_error(Kernel::IvsvGather))
+}
+
+/// Renders `templates/ivsv_gather_unwarp.wgsl` (`sampling = epipolar` only).
+pub(crate) fn render_gather_unwarp(variant: &AreaIvsvVariant) -> Result<String, ShaderError> {
+    let kernel = Kernel::IvsvGatherUnwarp;
+    validate(kernel, variant)?;
+    unwarp_only(kernel, variant.sampling)?;
+    GatherUnwarpTemplate {
+        segments: variant.segments,
+        vpls: variant.vpls,
+        interleave: variant.interleave,
+        output_format: "rgba16float",
+        sampling: sampling_view(variant, kernel),
+    }
+    .render()
+    .map_err(render_error(kernel))
+}
+
+/// Renders `templates/ivsv_gather_fallback.wgsl` (`sampling = epipolar` only).
+pub(crate) fn render_gather_fallback(variant: &AreaIvsvVariant) -> Result<String, ShaderError> {
+    let kernel = Kernel::IvsvGatherFallback;
+    validate(kernel, variant)?;
+    unwarp_only(kernel, variant.sampling)?;
+    GatherFallbackTemplate {
+        segments: variant.segments,
+        vpls: variant.vpls,
+        interleave: variant.interleave,
+        output_format: "rgba16float",
+        sampling: sampling_view(variant, kernel),
+    }
+    .render()
+    .map_err(render_error(kernel))
 }
 
 /// Renders `templates/ivsv_interleave_sum.wgsl` for an interleaved variant (an error for
@@ -120,7 +197,8 @@ pub(crate) fn render_interleave_sum(variant: &AreaIvsvVariant) -> Result<String,
 
 impl crate::KernelParams {
     /// The kernels of an area_ivsv-family variant, in pass order: `ivsv_rectify`,
-    /// `ivsv_scan`, `ivsv_gather`, and `ivsv_interleave_sum` when interleaved.
+    /// `ivsv_scan`, `ivsv_gather`, then `ivsv_interleave_sum` when interleaved, or
+    /// `ivsv_gather_unwarp` and `ivsv_gather_fallback` with `sampling = epipolar`.
     pub fn area_ivsv(variant: AreaIvsvVariant) -> Vec<Self> {
         let mut out = vec![
             Self::IvsvRectify(variant),
@@ -129,6 +207,10 @@ impl crate::KernelParams {
         ];
         if variant.interleave > 1 {
             out.push(Self::IvsvInterleaveSum(variant));
+        }
+        if variant.sampling == Sampling::Epipolar {
+            out.push(Self::IvsvGatherUnwarp(variant));
+            out.push(Self::IvsvGatherFallback(variant));
         }
         out
     }

@@ -1,14 +1,19 @@
 //! The plan of an `area_ivsv` variant: its textures and buffers and its passes
-//! (`ivsv_rectify`, `ivsv_scan`, `ivsv_gather`), from which `scatter-runtime` builds and
-//! dispatches.
+//! (`ivsv_rectify`, `ivsv_scan`, `ivsv_gather`, then `ivsv_interleave_sum` when
+//! interleaved, or `ivsv_gather_unwarp` and `ivsv_gather_fallback` with `sampling =
+//! epipolar`), from which `scatter-runtime` builds and dispatches.
 
-use crate::Kernel;
 use crate::area_ivsv::AreaIvsvVariant;
 use crate::plan::{
     BufferDesc, DEPTH_FORMAT, OUTPUT_FORMAT, PassPlan, Plan, Resource, SAMPLED, bind,
     depth_and_shadow_map, frame_buffer, scatter_resource, scatter_texture,
     screen_and_shadow_parameters, texture_2d,
 };
+use crate::sampling::{
+    epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
+    sampling_invocations, unwarp_pass,
+};
+use crate::{Kernel, KernelParams};
 
 /// A voxel buffer (`marks`, `volume`): four `u32` per texel of every VPL's grid.
 fn voxel_buffer(v: &AreaIvsvVariant, name: &'static str, contents: &'static str) -> Resource {
@@ -94,15 +99,12 @@ pub fn plan(v: &AreaIvsvVariant) -> Plan {
             "screen.height",
         ));
     }
-    let passes = [
-        Kernel::IvsvRectify,
-        Kernel::IvsvScan,
-        Kernel::IvsvGather,
-        Kernel::IvsvInterleaveSum,
-    ]
-    .into_iter()
-    .filter_map(|k| pass(v, k))
-    .collect();
+    resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
+    resources.extend(fallback_buffers(&v.sampling_knobs()));
+    let passes = KernelParams::area_ivsv(*v)
+        .iter()
+        .filter_map(|p| pass(v, p.kernel()))
+        .collect();
     Plan {
         parameters,
         resources,
@@ -145,25 +147,33 @@ pub fn pass(v: &AreaIvsvVariant, kernel: Kernel) -> Option<PassPlan> {
             skip_when: None,
             bindings: vec![bind(0, "frame"), bind(1, "marks"), bind(2, "volume")],
         }),
-        Kernel::IvsvGather => Some(PassPlan {
-            kernel,
-            invocations: [f("screen.width"), f("screen.height"), f("1")],
-            skip_when: None,
-            bindings: vec![
-                bind(0, "frame"),
-                bind(1, "vpls"),
-                bind(2, "volume"),
-                bind(3, "depth"),
-                bind(
-                    4,
-                    if v.interleave > 1 {
-                        "partial"
-                    } else {
-                        "output"
-                    },
-                ),
-            ],
-        }),
+        Kernel::IvsvGather => Some(sampled_pass(
+            &v.sampling_knobs(),
+            PassPlan {
+                kernel,
+                invocations: sampling_invocations(&v.sampling_knobs()),
+                skip_when: None,
+                bindings: vec![
+                    bind(0, "frame"),
+                    bind(1, "vpls"),
+                    bind(2, "volume"),
+                    bind(3, "depth"),
+                    bind(
+                        4,
+                        if v.interleave > 1 {
+                            "partial"
+                        } else {
+                            sampled_output(&v.sampling_knobs())
+                        },
+                    ),
+                ],
+            },
+            5,
+        )),
+        Kernel::IvsvGatherUnwarp => pass(v, Kernel::IvsvGather).map(|p| unwarp_pass(p, kernel, 5)),
+        Kernel::IvsvGatherFallback => {
+            pass(v, Kernel::IvsvGather).map(|p| fallback_pass(p, kernel, 5))
+        }
         Kernel::IvsvInterleaveSum if v.interleave > 1 => Some(PassPlan {
             kernel,
             invocations: [f("screen.width"), f("screen.height"), f("1")],

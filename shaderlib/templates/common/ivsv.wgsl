@@ -11,7 +11,7 @@
 
 #import scatter::shadow::ShadowMapView
 
-// The frame's uniform block (host: `scatter_frame::area_ivsv::IvsvUniforms`, 7 * 16 = 112
+// The frame's uniform block (host: `scatter_frame::area_ivsv::IvsvUniforms`, 8 * 16 = 128
 // bytes).
 struct IvsvFrame {
     // Eye position; w = camera far (depth is clamped to it).
@@ -26,8 +26,10 @@ struct IvsvFrame {
     medium: vec4<f32>,
     // Screen width, height, VPL shadow-map size, VPL count N.
     sizes: vec4<u32>,
-    // alpha bins (texels per row), theta bins (rows per VPL), unused, unused.
+    // alpha bins (texels per row), theta bins (rows per VPL), interleave M, unused.
     grid: vec4<u32>,
+    // The VPLs' centroid (the light's point of epipolar sampling); w unused.
+    centre: vec4<f32>,
 }
 
 // One virtual point light (host: `scatter_frame::area_ivsv::VplRecord`, 11 * 16 = 176 bytes;
