@@ -879,11 +879,13 @@ fn time_methods_on(
 /// moment basis with 4 moments.
 fn sampled_bases() -> Vec<FamilyVariant> {
     // The families with a per-pixel mode and the sampled ones (not partial_sum_tree, which
-    // samples epipolar lines only and is timed on its own, nor area_ivsv, which renders area
-    // lights per pixel only: `examples/area_bench` measures it).
+    // samples epipolar lines only and is timed on its own, nor area_ivsv, which renders
+    // area lights, not the headline's sun: `examples/area_bench` measures it, per pixel and
+    // sampled).
     let mut out: Vec<FamilyVariant> = Family::ALL
         .iter()
         .map(|f| f.default_variant())
+        .filter(|v| v.family() != Family::AreaIvsv)
         .filter(|v| !v.sampling().is_sampled())
         .filter(|v| {
             sampled_configs()

@@ -41,7 +41,7 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
             .into_iter()
             .map(FamilyVariant::PartialSumTree),
     );
-    for &light in LightKind::SINGLE {
+    for light in LightKind::SINGLE.iter().copied().chain([LightKind::Area]) {
         for family in scatter_shaderlib::family::Family::ALL
             .iter()
             .filter(|f| f.default_variant().sampling().sampling == Sampling::Pixels)
@@ -50,7 +50,7 @@ fn emitted_spirv_passes_naga_spirv_front_end() {
                 scatter_shaderlib::sampling::SamplingKnobs::lowres(4),
                 scatter_shaderlib::sampling::SamplingKnobs::epipolar(64),
             ] {
-                // Families of another light or without sampling (area_ivsv) are left out.
+                // Families of another light are left out (area_ivsv takes only `area`).
                 let v = family
                     .default_variant()
                     .with_light(light)

@@ -72,7 +72,8 @@ pub fn lowres_taps(p: [u32; 2], screen: [u32; 2], scale: u32) -> LowresTaps {
 /// The pixel's radiance from its taps (`w` bilinear weights, `depths` of the taps' pixels,
 /// `light` their radiance, `d` the pixel's depth): the bilinear blend of the taps with a
 /// positive weight that lie within `depth_break` of `d`; `None` where the pixel needs its
-/// own evaluation (no such tap, or their spread over `light_break` of the brightest).
+/// own evaluation (no such tap, only one of several, or their spread over `light_break` of
+/// the brightest).
 pub fn lowres_blend(
     w: [f32; 4],
     depths: [f32; 4],
@@ -85,8 +86,11 @@ pub fn lowres_blend(
     let mut total = 0.0f32;
     let mut lo = [3.4e38f32; 3];
     let mut hi = [0.0f32; 3];
+    let (mut taps, mut close) = (0u32, 0u32);
     for k in 0..4 {
+        taps += u32::from(w[k] > 0.0);
         if w[k] > 0.0 && depth_close(depths[k], d, depth_break) {
+            close += 1;
             for c in 0..3 {
                 sum[c] += w[k] * light[k][c];
                 lo[c] = lo[c].min(light[k][c]);
@@ -95,7 +99,10 @@ pub fn lowres_blend(
             total += w[k];
         }
     }
-    if total <= 0.0 {
+    // One close tap of several stands for nothing but itself (its light would be spread
+    // over the pixels between it and the far taps, and the light criterion has nothing to
+    // compare it with): a pixel beside a silhouette is evaluated unless it lies on the tap.
+    if total <= 0.0 || close < taps.min(2) {
         return None;
     }
     let spread = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];

@@ -68,23 +68,30 @@ fn lowres_taps(p: vec2<u32>, screen: vec2<u32>, scale: u32) -> LowresTaps {
 // The pixel's radiance from its taps (`w` bilinear weights, `depths` of the taps' pixels,
 // `light` their radiance, `d` the pixel's depth): the bilinear blend of the taps with a
 // positive weight that lie within `depth_break` of `d`, in (rgb, 1); or alpha 0 where the
-// pixel needs its own evaluation: no such tap (a depth break: a thin occluder, a
-// silhouette), or the taps differ by more than `light_break` of the brightest channel of
+// pixel needs its own evaluation: no such tap, or only one of several (a depth break: a
+// thin occluder, a silhouette), or the taps differ by more than `light_break` of the brightest channel of
 // the brightest one (a shadow edge, the lamp; Yusov 2013's second criterion).
 fn lowres_blend(w: vec4<f32>, depths: vec4<f32>, light: array<vec3<f32>, 4>, d: f32, depth_break: f32, light_break: f32) -> vec4<f32> {
     var sum = vec3<f32>(0.0, 0.0, 0.0);
     var total = 0.0;
     var lo = vec3<f32>(3.4e38, 3.4e38, 3.4e38);
     var hi = vec3<f32>(0.0, 0.0, 0.0);
+    var taps = 0u;
+    var close = 0u;
     for (var k = 0u; k < 4u; k++) {
+        taps += select(0u, 1u, w[k] > 0.0);
         if w[k] > 0.0 && depth_close(depths[k], d, depth_break) {
+            close += 1u;
             sum += w[k] * light[k];
             total += w[k];
             lo = min(lo, light[k]);
             hi = max(hi, light[k]);
         }
     }
-    if total <= 0.0 {
+    // One close tap of several stands for nothing but itself (its light would be spread
+    // over the pixels between it and the far taps, and the light criterion has nothing to
+    // compare it with): a pixel beside a silhouette is evaluated unless it lies on the tap.
+    if total <= 0.0 || close < min(taps, 2u) {
         return vec4<f32>(0.0, 0.0, 0.0, 0.0);
     }
     let spread = hi - lo;
