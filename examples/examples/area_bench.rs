@@ -6,8 +6,14 @@
 //!   area pose at `--error-size`, mean and worst over the poses.
 //! - Time: the median wall time of each pass submitted on its own (`--frames` frames after a
 //!   warm-up) at `--time-size` on `area_columns/ordinary`: `ivsv_rectify`, `ivsv_scan`,
-//!   `ivsv_gather`; for the brute force the sum over the VPLs of the `raymarch` pass (the
-//!   sum of the `N` outputs is not counted: in the brute force's favour).
+//!   `ivsv_gather` (with `sampling = epipolar` its unwarp and fallback); for the brute force
+//!   the sum over the VPLs of the `raymarch` pass (the sum of the `N` outputs is not counted:
+//!   in the brute force's favour).
+//! - Sampled area_ivsv (`--sampling`: lowres 2 and 4, epipolar 512 x 256): the interpolation
+//!   error, rel L1 and rel RMSE of the sampled image against the same variant per pixel on
+//!   every area pose at `--time-size` (GPU), beside the time; the sweep's 64 x 36 is too
+//!   small to sample. Its chart point is at the per-pixel variant's truth error plus that
+//!   rel RMSE (a bound on its error against the truth, by the triangle inequality).
 //!
 //! ```text
 //! cargo run --release -p scatter-examples --example area_bench -- --out docs/bench
@@ -41,6 +47,7 @@ use scatter_shaderlib::area_ivsv::AreaIvsvVariant;
 use scatter_shaderlib::family::{Family, FamilyVariant};
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions};
 use scatter_shaderlib::raymarch::RaymarchVariant;
+use scatter_shaderlib::sampling::{Sampling, SamplingKnobs};
 
 /// The command line.
 #[derive(Parser, Debug)]
@@ -61,6 +68,10 @@ struct Args {
     /// Interleaving of area_ivsv's gather (1: none; 2, 4: the paper's interleaved gather).
     #[arg(long, value_delimiter = ',', default_values_t = [1u32, 2, 4])]
     interleave: Vec<u32>,
+    /// Sampling of area_ivsv's gather beside per pixel (without interleaving): `lowres2`,
+    /// `lowres4`, `epipolar` (512 slices x 256 samples, step 8); `none` for none.
+    #[arg(long, value_delimiter = ',', default_values_t = ["lowres2".to_owned(), "lowres4".to_owned(), "epipolar".to_owned()])]
+    sampling: Vec<String>,
     /// Samples per view ray of the per-VPL ray march.
     #[arg(long, value_delimiter = ',', default_values_t = [4u32, 8, 16, 32, 64])]
     samples: Vec<u32>,
@@ -84,6 +95,19 @@ struct Args {
     image_size: [u32; 2],
 }
 
+/// The sampling knobs of a `--sampling` value.
+fn parse_sampling(s: &str) -> Result<Option<SamplingKnobs>, String> {
+    match s.trim() {
+        "none" => Ok(None),
+        "lowres2" => Ok(Some(SamplingKnobs::lowres(2))),
+        "lowres4" => Ok(Some(SamplingKnobs::lowres(4))),
+        "epipolar" => Ok(Some(SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES))),
+        other => Err(format!(
+            "--sampling `{other}`: expected lowres2, lowres4, epipolar or none"
+        )),
+    }
+}
+
 fn parse_size(s: &str) -> Result<[u32; 2], String> {
     let (w, h) = s
         .split_once('x')
@@ -97,11 +121,19 @@ fn parse_size(s: &str) -> Result<[u32; 2], String> {
     Ok([p(w)?, p(h)?])
 }
 
-/// One method: `area_ivsv` with N VPLs, or per-VPL ray marching with N VPLs and n samples.
+/// One method: `area_ivsv` with N VPLs (per pixel, interleaved or sampled), or per-VPL ray
+/// marching with N VPLs and n samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Method {
-    Ivsv { vpls: u32, interleave: u32 },
-    Raymarch { vpls: u32, samples: u32 },
+    Ivsv {
+        vpls: u32,
+        interleave: u32,
+        sampling: SamplingKnobs,
+    },
+    Raymarch {
+        vpls: u32,
+        samples: u32,
+    },
 }
 
 impl Method {
@@ -110,8 +142,11 @@ impl Method {
             Method::Ivsv {
                 vpls,
                 interleave: 1,
-            } => format!("area_ivsv N={vpls}"),
-            Method::Ivsv { vpls, interleave } => {
+                sampling,
+            } => format!("area_ivsv N={vpls}{}", sampling.marker_suffix()),
+            Method::Ivsv {
+                vpls, interleave, ..
+            } => {
                 format!("area_ivsv N={vpls} interleave {interleave}")
             }
             Method::Raymarch { vpls, samples } => format!("raymarch per VPL N={vpls} n={samples}"),
@@ -122,14 +157,32 @@ impl Method {
             Method::Ivsv { vpls, .. } | Method::Raymarch { vpls, .. } => vpls,
         }
     }
+    /// A sampled area_ivsv method.
+    fn sampled(self) -> bool {
+        matches!(self, Method::Ivsv { sampling, .. } if sampling.is_sampled())
+    }
+    /// The same method per pixel.
+    fn per_pixel(self) -> Method {
+        match self {
+            Method::Ivsv {
+                vpls, interleave, ..
+            } => Method::Ivsv {
+                vpls,
+                interleave,
+                sampling: SamplingKnobs::default(),
+            },
+            other => other,
+        }
+    }
 }
 
-fn ivsv_variant(vpls: u32, interleave: u32) -> AreaIvsvVariant {
+fn ivsv_variant(vpls: u32, interleave: u32, sampling: SamplingKnobs) -> AreaIvsvVariant {
     AreaIvsvVariant {
         vpls,
         interleave,
         ..AreaIvsvVariant::default()
     }
+    .with_sampling_knobs(sampling)
 }
 
 fn raymarch_variant(samples: u32) -> FamilyVariant {
@@ -170,8 +223,12 @@ fn render(
 ) -> Result<Image, String> {
     let (w, h) = (gbuf.width, gbuf.height);
     match method {
-        Method::Ivsv { vpls, interleave } => {
-            let v = ivsv_variant(vpls, interleave);
+        Method::Ivsv {
+            vpls,
+            interleave,
+            sampling,
+        } => {
+            let v = ivsv_variant(vpls, interleave, sampling);
             let inputs = ivsv_inputs(scene, gbuf, bvh, &v, map_size).map_err(|e| e.to_string())?;
             let out = run_area_ivsv_once(
                 ctx,
@@ -229,8 +286,12 @@ fn time(
     let screen = [gbuf.width, gbuf.height];
     let err = |e: scatter_runtime::RuntimeError| e.to_string();
     match method {
-        Method::Ivsv { vpls, interleave } => {
-            let v = ivsv_variant(vpls, interleave);
+        Method::Ivsv {
+            vpls,
+            interleave,
+            sampling,
+        } => {
+            let v = ivsv_variant(vpls, interleave, sampling);
             let inputs = ivsv_inputs(scene, &gbuf, bvh, &v, map_size).map_err(|e| e.to_string())?;
             let mut pass = AreaIvsv::new(ctx, &v, screen, map_size).map_err(err)?;
             pass.prepare(
@@ -255,6 +316,10 @@ fn time(
             ];
             if interleave > 1 {
                 out.push(("ivsv_interleave_sum".into(), t.interleave_sum));
+            }
+            if sampling.sampling == Sampling::Epipolar {
+                out.push(("ivsv_gather_unwarp".into(), t.unwarp));
+                out.push(("ivsv_gather_fallback".into(), t.fallback));
             }
             Ok(out)
         }
@@ -305,6 +370,7 @@ fn image(ctx: &Context, args: &Args, path: &std::path::Path) -> Result<(), Strin
         Method::Ivsv {
             vpls: 64,
             interleave: 1,
+            sampling: SamplingKnobs::default(),
         },
         &area,
         &gbuf,
@@ -343,6 +409,11 @@ fn main() -> Result<(), String> {
     if let Some(path) = &args.image {
         return image(&ctx, &args, path);
     }
+    let samplings = args
+        .sampling
+        .iter()
+        .map(|s| parse_sampling(s))
+        .collect::<Result<Vec<_>, _>>()?;
     let mut methods = Vec::new();
     for &n in &args.vpls {
         for &i in &args.interleave {
@@ -350,8 +421,16 @@ fn main() -> Result<(), String> {
                 methods.push(Method::Ivsv {
                     vpls: n,
                     interleave: i,
+                    sampling: SamplingKnobs::default(),
                 });
             }
+        }
+        for &sampling in samplings.iter().flatten() {
+            methods.push(Method::Ivsv {
+                vpls: n,
+                interleave: 1,
+                sampling,
+            });
         }
         for &s in &args.samples {
             methods.push(Method::Raymarch {
@@ -376,7 +455,7 @@ fn main() -> Result<(), String> {
                 truth::render_vpl(&s, &gbuf, &bvh, n as usize, args.map_size, &truth_settings)
                     .map_err(|e| e.to_string())?;
             for (i, &m) in methods.iter().enumerate() {
-                if m.vpls() != n {
+                if m.vpls() != n || m.sampled() {
                     continue;
                 }
                 let img = render(&ctx, m, &s, &gbuf, &bvh, args.map_size)?;
@@ -393,8 +472,65 @@ fn main() -> Result<(), String> {
             }
         }
     }
-    // Times.
+    // Sampled: the interpolation error against the same variant per pixel at the time size.
     let [tw, th] = args.time_size;
+    let mut interpolation: Vec<Vec<(String, f64, f64)>> = vec![Vec::new(); methods.len()];
+    if methods.iter().any(|m| m.sampled()) {
+        for (name, pose) in area_suite::all() {
+            let s = area_suite::scene(name, pose, MediumPreset::Default, tw, th);
+            let bvh = Bvh::build(&s.geometry);
+            let gbuf = GBuffer::cast(&s, &bvh);
+            for &n in &args.vpls {
+                let mut per_pixel: Option<Image> = None;
+                for (i, &m) in methods.iter().enumerate() {
+                    if m.vpls() != n || !m.sampled() {
+                        continue;
+                    }
+                    let reference = match &per_pixel {
+                        Some(img) => img,
+                        None => per_pixel.insert(render(
+                            &ctx,
+                            m.per_pixel(),
+                            &s,
+                            &gbuf,
+                            &bvh,
+                            args.map_size,
+                        )?),
+                    };
+                    let img = render(&ctx, m, &s, &gbuf, &bvh, args.map_size)?;
+                    if metrics::non_finite_count(&img) > 0 {
+                        return Err(format!("{} {}: NaN or Inf", s.name, m.label()));
+                    }
+                    let rmse = metrics::rel_rmse(&img, reference).map_err(|e| e.to_string())?;
+                    let l1 = metrics::rel_l1(&img, reference).map_err(|e| e.to_string())?;
+                    eprintln!(
+                        "{} {} against per pixel at {tw}x{th}: rel RMSE {:.2} %, rel L1 {:.2} %",
+                        s.name,
+                        m.label(),
+                        100.0 * rmse,
+                        100.0 * l1
+                    );
+                    interpolation[i].push((s.name.clone(), rmse, l1));
+                }
+            }
+        }
+        // A sampled row's error against the truth is bounded by its per-pixel variant's
+        // plus the interpolation error; the chart places it there.
+        for (i, &m) in methods.iter().enumerate() {
+            if m.sampled() {
+                let p = methods
+                    .iter()
+                    .position(|&q| q == m.per_pixel())
+                    .ok_or_else(|| format!("{}: its per-pixel variant was not run", m.label()))?;
+                errors[i] = errors[p]
+                    .iter()
+                    .zip(&interpolation[i])
+                    .map(|(t, s)| (t.0.clone(), t.1 + s.1, t.2 + s.2))
+                    .collect();
+            }
+        }
+    }
+    // Times.
     let scene = area_suite::scene(
         AreaSceneName::Columns,
         Pose::Ordinary,
@@ -431,7 +567,11 @@ fn main() -> Result<(), String> {
         );
         let samples = match m {
             Method::Raymarch { samples, .. } => samples.to_string(),
-            Method::Ivsv { interleave, .. } => format!("i{interleave}"),
+            Method::Ivsv {
+                interleave,
+                sampling,
+                ..
+            } => format!("i{interleave}{}", sampling.marker_suffix()),
         };
         let _ = writeln!(
             csv,
@@ -492,6 +632,37 @@ fn main() -> Result<(), String> {
             }
         }
     }
+    // Sampled rows: speed against the same variant per pixel, and the interpolation error.
+    if rows.iter().any(|r| r.0.sampled()) {
+        let _ = write!(
+            md,
+            "\nSampled area_ivsv (a sampled row's errors above are its per-pixel variant's plus the interpolation error below: a bound on its error against the truth): the sampled image against the same variant per pixel on the 12 area poses at {tw}x{th}, and the time against per pixel.\n\n| method | time (ms) | faster than per pixel | interpolation rel L1, mean / worst | interpolation rel RMSE, mean / worst |\n|---|---|---|---|---|\n"
+        );
+        for (i, r) in rows.iter().enumerate() {
+            if !r.0.sampled() {
+                continue;
+            }
+            let Some(p) = rows.iter().find(|q| q.0 == r.0.per_pixel()) else {
+                continue;
+            };
+            let e = &interpolation[i];
+            let mean = |f: fn(&(String, f64, f64)) -> f64| {
+                e.iter().map(f).sum::<f64>() / e.len().max(1) as f64
+            };
+            let worst = |f: fn(&(String, f64, f64)) -> f64| e.iter().map(f).fold(0.0, f64::max);
+            let _ = writeln!(
+                md,
+                "| {} | {:.1} | {:.2}x | {:.2} / {:.2} % | {:.2} / {:.2} % |",
+                r.0.label(),
+                r.4.as_secs_f64() * 1e3,
+                p.4.as_secs_f64() / r.4.as_secs_f64(),
+                100.0 * mean(|x| x.2),
+                100.0 * worst(|x| x.2),
+                100.0 * mean(|x| x.1),
+                100.0 * worst(|x| x.1),
+            );
+        }
+    }
     std::fs::create_dir_all(&args.out).map_err(|e| e.to_string())?;
     let points: Vec<AreaPoint> = rows
         .iter()
@@ -502,8 +673,14 @@ fn main() -> Result<(), String> {
             },
             vpls: m.vpls(),
             label: match m {
-                Method::Ivsv { interleave: 1, .. } => String::new(),
-                Method::Ivsv { interleave, .. } => format!("i{interleave}"),
+                Method::Ivsv {
+                    vpls,
+                    interleave: 1,
+                    sampling,
+                } => format!("N{vpls}{}", sampling.marker_suffix().replace('-', " ")),
+                Method::Ivsv {
+                    vpls, interleave, ..
+                } => format!("N{vpls} i{interleave}"),
                 Method::Raymarch { samples, .. } => format!("n{samples}"),
             },
             ms: total.as_secs_f64() * 1e3,

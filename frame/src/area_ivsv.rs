@@ -693,4 +693,26 @@ mod tests {
         AreaIvsvVariant::default().validate().unwrap();
         assert_eq!(AreaIvsvVariant::default().id(), "v64-a256-t256-k8");
     }
+
+    #[test]
+    fn sampling_knobs_are_the_stage_s() {
+        let epipolar = AreaIvsvVariant::default()
+            .with_sampling_knobs(SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES));
+        epipolar.validate().unwrap();
+        assert_eq!(epipolar.id(), "v64-a256-t256-k8-epi512x256-s8-b10-l20");
+        assert_eq!(epipolar.marker(), "v64-a256-t256-k8-ep512");
+        let lowres = AreaIvsvVariant::default().with_sampling_knobs(SamplingKnobs::lowres(4));
+        lowres.validate().unwrap();
+        assert_eq!(lowres.marker(), "v64-a256-t256-k8-lr4");
+        // Interleaving spreads a pixel's VPLs over neighbours a sampled variant does not
+        // evaluate.
+        let both = AreaIvsvVariant {
+            interleave: 2,
+            ..lowres
+        };
+        assert_eq!(both.validate().unwrap_err().knob, "interleave");
+        // The stage's own checks name its knobs.
+        let bad = AreaIvsvVariant { scale: 3, ..lowres };
+        assert_eq!(bad.validate().unwrap_err().knob, "scale");
+    }
 }

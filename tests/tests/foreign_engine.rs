@@ -399,12 +399,21 @@ fn other_families_dir() -> &'static Path {
     })
 }
 
-/// The area_ivsv trial variants: 8 VPLs per pixel, and interleaved (2 x 2, the `partial`
-/// texture and the `ivsv_interleave_sum` pass): the `vpls` uniform array and the VPL map
-/// array the engine uploads, the voxel buffers it allocates from the manifest.
-fn area_variants() -> [scatter_frame::area_ivsv::AreaIvsvVariant; 2] {
+/// The area_ivsv trial variants: 8 VPLs per pixel, interleaved (2 x 2, the `partial`
+/// texture and the `ivsv_interleave_sum` pass), and along 64 epipolar slices of 64 samples
+/// (the `epipolar_samples` texture, the fallback buffers and the unwarp and fallback
+/// passes): the `vpls` uniform array and the VPL map array the engine uploads, the voxel
+/// buffers it allocates from the manifest.
+fn area_variants() -> [scatter_frame::area_ivsv::AreaIvsvVariant; 3] {
     let g = scatter_frame::area_ivsv::AreaIvsvVariant::grid();
-    [g[0], g[3]]
+    [
+        g[0],
+        g[3],
+        g[0].with_sampling_knobs(scatter_frame::sampling::SamplingKnobs {
+            slice_samples: 64,
+            ..scatter_frame::sampling::SamplingKnobs::epipolar(64)
+        }),
+    ]
 }
 
 /// `area_grate/ordinary` at [`SCREEN`], its BVH and depth buffer: the area_ivsv trials' scene.
@@ -809,6 +818,9 @@ fn foreign_engine_matches_runtime_for_every_family() {
         let mut expect = vec!["ivsv_rectify", "ivsv_scan", "ivsv_gather"];
         if v.interleave > 1 {
             expect.push("ivsv_interleave_sum");
+        }
+        if v.sampling_knobs().is_sampled() {
+            expect.extend(["ivsv_gather_unwarp", "ivsv_gather_fallback"]);
         }
         lines.extend(compare_targets(&name, &runtime.output, &expect, |target| {
             let sizes = scatter_foreign_engine::area_ivsv::Sizes {

@@ -24,7 +24,7 @@ pub const VPL_MAPS: &str = "vpl_maps";
 pub use crate::raymarch::Sizes;
 
 /// Host field names and offsets of [`IvsvUniforms`], in the manifest's spelling.
-const FRAME_FIELDS: [(&str, usize); 7] = [
+const FRAME_FIELDS: [(&str, usize); 8] = [
     ("eye", offset_of!(IvsvUniforms, eye)),
     ("cam_forward", offset_of!(IvsvUniforms, cam_forward)),
     ("cam_right", offset_of!(IvsvUniforms, cam_right)),
@@ -32,6 +32,7 @@ const FRAME_FIELDS: [(&str, usize); 7] = [
     ("medium", offset_of!(IvsvUniforms, medium)),
     ("sizes", offset_of!(IvsvUniforms, sizes)),
     ("grid", offset_of!(IvsvUniforms, grid)),
+    ("centre", offset_of!(IvsvUniforms, centre)),
 ];
 
 /// Host field names and offsets of [`VplRecord`].
