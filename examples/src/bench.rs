@@ -966,12 +966,22 @@ fn headline_runs(
         methods.push(Method::from(sampled));
     }
     // Epipolar sampling with a rectified map of as many rows as slices (512x512): a quarter
-    // of the fixed passes' texels, which dominate the sampled prefiltered and minmax frames.
+    // of the fixed passes' texels, which dominate the sampled prefiltered and minmax frames;
+    // and the prefiltered default at lowres 2 and 4 with that map (candidates of issue 13's
+    // "best prefiltered configuration").
     for family in [Family::Prefiltered, Family::Minmax] {
         methods.push(Method::new(
             family
                 .default_variant()
                 .with_sampling(SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES)),
+            Some([512, 512]),
+        ));
+    }
+    for scale in [2, 4] {
+        methods.push(Method::new(
+            Family::Prefiltered
+                .default_variant()
+                .with_sampling(SamplingKnobs::lowres(scale)),
             Some([512, 512]),
         ));
     }
@@ -1308,6 +1318,68 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                 ));
             }
         }
+    }
+    // Issue 13's targets over every prefiltered configuration the headline ran (either
+    // basis, per pixel or sampled, either rectified map): the cheapest one at or below each
+    // competitor's error, and how much longer the competitor takes.
+    let mut configs: Vec<String> = result
+        .headline
+        .iter()
+        .filter(|r| r.family == "prefiltered")
+        .map(|r| r.knobs.clone())
+        .collect();
+    configs.sort();
+    configs.dedup();
+    let cheapest_at_or_below = |error: f64, measure: &dyn Fn(&str) -> Option<(f64, f64)>| {
+        configs
+            .iter()
+            .filter_map(|k| measure(k).map(|m| (k.clone(), m)))
+            .filter(|(_, m)| m.1 <= error)
+            .min_by(|a, b| a.1.0.total_cmp(&b.1.0))
+    };
+    for (family, knobs, target) in [("raymarch", "n64-i1", 3.0), ("raymarch", "n256-i1", 5.0)] {
+        let Some((t, e)) = headline_mean(family, knobs) else {
+            continue;
+        };
+        out.push(
+            match cheapest_at_or_below(e, &|k| headline_mean("prefiltered", k)) {
+                Some((k, (pt, pe))) => format!(
+                    "best prefiltered configuration at or below {family} {knobs}'s error, headline means: prefiltered {k} {pt:.1} ms at rel L1 {:.3} % / {family} {knobs} {t:.1} ms at {:.3} %: {family} takes {:.2}x the time (issue 13's target: {target}x)",
+                    100.0 * pe,
+                    100.0 * e,
+                    t / pt
+                ),
+                None => format!(
+                    "best prefiltered configuration at or below {family} {knobs}'s error, headline means: none of the {} the headline ran reaches {:.3} %",
+                    configs.len(),
+                    100.0 * e
+                ),
+            },
+        );
+    }
+    let on_foliage = |family: &str, knobs: &str| {
+        result
+            .headline
+            .iter()
+            .find(|r| r.family == family && r.knobs == knobs && r.scene == SceneName::Foliage)
+            .and_then(|r| r.rel_l1_shadow_map.map(|e| (ms(r.total()), e)))
+    };
+    if let Some((t, e)) = on_foliage("minmax", "minmax") {
+        out.push(
+            match cheapest_at_or_below(e, &|k| on_foliage("prefiltered", k)) {
+                Some((k, (pt, pe))) => format!(
+                    "best prefiltered configuration at or below minmax's error on foliage/ordinary at 1280x720: prefiltered {k} {pt:.1} ms at rel L1 {:.3} % / minmax {t:.1} ms at {:.3} %: minmax takes {:.2}x the time (issue 13's target: more than 1x)",
+                    100.0 * pe,
+                    100.0 * e,
+                    t / pt
+                ),
+                None => format!(
+                    "best prefiltered configuration at or below minmax's error on foliage/ordinary at 1280x720: none of the {} the headline ran reaches {:.3} %",
+                    configs.len(),
+                    100.0 * e
+                ),
+            },
+        );
     }
     // Issue 14: each family sampled against itself per pixel, and the best sampled
     // configuration against brute-force raymarch n256 at equal or lower error.
