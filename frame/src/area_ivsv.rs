@@ -199,35 +199,24 @@ impl AreaIvsvVariant {
     /// A short stable id: `v64-a256-t256-k8`, `v64-a256-t256-k8-i2`,
     /// `v64-a256-t256-k8-epi512x256-s8-b10-l20`.
     pub fn id(&self) -> String {
-        let interleave = if self.interleave > 1 {
-            format!("-i{}", self.interleave)
-        } else {
-            String::new()
-        };
-        format!(
-            "v{}-a{}-t{}-k{}{interleave}{}",
-            self.vpls,
-            self.alpha,
-            self.theta,
-            self.segments,
-            self.sampling_knobs().id_suffix()
-        )
+        self.label_with(&self.sampling_knobs().id_suffix())
     }
 
     /// The short label of tables and charts: `v64-a256-t256-k8`, `v64-a256-t256-k8-ep512`.
     pub fn marker(&self) -> String {
+        self.label_with(&self.sampling_knobs().marker_suffix())
+    }
+
+    /// `v{vpls}-a{alpha}-t{theta}-k{segments}`, `-i{M}` when interleaved, then `sampling`.
+    fn label_with(&self, sampling: &str) -> String {
         let interleave = if self.interleave > 1 {
             format!("-i{}", self.interleave)
         } else {
             String::new()
         };
         format!(
-            "v{}-a{}-t{}-k{}{interleave}{}",
-            self.vpls,
-            self.alpha,
-            self.theta,
-            self.segments,
-            self.sampling_knobs().marker_suffix()
+            "v{}-a{}-t{}-k{}{interleave}{sampling}",
+            self.vpls, self.alpha, self.theta, self.segments
         )
     }
 }

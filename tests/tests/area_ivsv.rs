@@ -503,17 +503,14 @@ fn family_table(
         return Ok(String::new());
     };
     let v = FamilyVariant::AreaIvsv(variant);
-    let scene = area_suite::scene(name, pose, MediumPreset::Default, SCREEN[0], SCREEN[1]);
-    let bvh = Bvh::build(&scene.geometry);
-    let gbuf = GBuffer::cast(&scene, &bvh);
     // An area light's standard map is its point limit's: the VPL maps' template.
-    let sm = ShadowMap::build(&scene, &bvh, MAP).map_err(|e| e.to_string())?;
+    let f = scatter_conformance::Fixture::area(name, pose, SCREEN, MAP);
     let settings = FrameSettings::for_screen(SCREEN[0], SCREEN[1]);
     let frame = CpuFrame {
-        scene: &scene,
-        bvh: &bvh,
-        gbuf: &gbuf,
-        shadow_map: &sm,
+        scene: &f.scene,
+        bvh: &f.bvh,
+        gbuf: &f.gbuf,
+        shadow_map: &f.shadow_map,
         rectified: [64, 64],
         settings: &settings,
     };
@@ -581,16 +578,13 @@ fn sampled_accuracy(knobs: SamplingKnobs) -> Result<String, String> {
     let poses = area_suite::all();
     for &(name, pose) in &poses {
         let [w, h] = SAMPLED_SCREEN;
-        let scene = area_suite::scene(name, pose, MediumPreset::Default, w, h);
-        let bvh = Bvh::build(&scene.geometry);
-        let gbuf = GBuffer::cast(&scene, &bvh);
-        let sm = ShadowMap::build(&scene, &bvh, 128).map_err(|e| e.to_string())?;
+        let f = scatter_conformance::Fixture::area(name, pose, SAMPLED_SCREEN, 128);
         let settings = FrameSettings::for_screen(w, h);
         let frame = CpuFrame {
-            scene: &scene,
-            bvh: &bvh,
-            gbuf: &gbuf,
-            shadow_map: &sm,
+            scene: &f.scene,
+            bvh: &f.bvh,
+            gbuf: &f.gbuf,
+            shadow_map: &f.shadow_map,
             rectified: [64, 64],
             settings: &settings,
         };
