@@ -604,8 +604,11 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w_1, flo
     float total = 0.0;
     float3 lo_1 = float3(3.4e38, 3.4e38, 3.4e38);
     float3 hi_1 = float3(0.0, 0.0, 0.0);
+    uint taps = 0u;
+    uint close = 0u;
     uint k_2 = 0u;
     bool local_7 = (bool)0;
+    bool local_8 = (bool)0;
 
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
@@ -613,8 +616,8 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w_1, flo
         if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e49 = k_2;
-            k_2 = (_e49 + 1u);
+            uint _e63 = k_2;
+            k_2 = (_e63 + 1u);
         }
         loop_init_3 = false;
         uint _e6 = k_2;
@@ -623,48 +626,61 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w_1, flo
             break;
         }
         {
-            uint _e10 = k_2;
-            if ((w_1[min(uint(_e10), 3u)] > 0.0)) {
-                uint _e15 = k_2;
-                const bool _e19 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e15), 3u)], d, depth_break_1);
-                local_7 = _e19;
+            uint _e10 = taps;
+            uint _e12 = k_2;
+            taps = (_e10 + ((w_1[min(uint(_e12), 3u)] > 0.0) ? 1u : 0u));
+            uint _e20 = k_2;
+            if ((w_1[min(uint(_e20), 3u)] > 0.0)) {
+                uint _e25 = k_2;
+                const bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e25), 3u)], d, depth_break_1);
+                local_7 = _e29;
             } else {
                 local_7 = false;
             }
-            bool _e23 = local_7;
-            if (_e23) {
-                float3 _e26 = sum_2;
-                uint _e27 = k_2;
-                uint _e29 = k_2;
-                sum_2 = (_e26 + (w_1[min(uint(_e27), 3u)] * light_1[min(uint(_e29), 3u)]));
-                float _e34 = total;
-                uint _e35 = k_2;
-                total = (_e34 + w_1[min(uint(_e35), 3u)]);
-                float3 _e39 = lo_1;
-                uint _e40 = k_2;
-                lo_1 = min(_e39, light_1[min(uint(_e40), 3u)]);
-                float3 _e44 = hi_1;
-                uint _e45 = k_2;
-                hi_1 = max(_e44, light_1[min(uint(_e45), 3u)]);
+            bool _e33 = local_7;
+            if (_e33) {
+                uint _e35 = close;
+                close = (_e35 + 1u);
+                float3 _e40 = sum_2;
+                uint _e41 = k_2;
+                uint _e43 = k_2;
+                sum_2 = (_e40 + (w_1[min(uint(_e41), 3u)] * light_1[min(uint(_e43), 3u)]));
+                float _e48 = total;
+                uint _e49 = k_2;
+                total = (_e48 + w_1[min(uint(_e49), 3u)]);
+                float3 _e53 = lo_1;
+                uint _e54 = k_2;
+                lo_1 = min(_e53, light_1[min(uint(_e54), 3u)]);
+                float3 _e58 = hi_1;
+                uint _e59 = k_2;
+                hi_1 = max(_e58, light_1[min(uint(_e59), 3u)]);
             }
         }
     }
-    float _e51 = total;
-    if ((_e51 <= 0.0)) {
+    float _e65 = total;
+    if (!((_e65 <= 0.0))) {
+        uint _e69 = close;
+        uint _e70 = taps;
+        local_8 = (_e69 < min(_e70, 2u));
+    } else {
+        local_8 = true;
+    }
+    bool _e77 = local_8;
+    if (_e77) {
         return float4(0.0, 0.0, 0.0, 0.0);
     }
-    float3 _e59 = hi_1;
-    float3 _e60 = lo_1;
-    float3 spread = (_e59 - _e60);
-    float _e69 = hi_1.x;
-    float _e71 = hi_1.y;
-    float _e73 = hi_1.z;
-    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e69, max(_e71, _e73))))) {
+    float3 _e83 = hi_1;
+    float3 _e84 = lo_1;
+    float3 spread = (_e83 - _e84);
+    float _e93 = hi_1.x;
+    float _e95 = hi_1.y;
+    float _e97 = hi_1.z;
+    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97))))) {
         return float4(0.0, 0.0, 0.0, 0.0);
     }
-    float3 _e83 = sum_2;
-    float _e84 = total;
-    float3 c = (_e83 / (_e84).xxx);
+    float3 _e107 = sum_2;
+    float _e108 = total;
+    float3 c = (_e107 / (_e108).xxx);
     return float4(c.x, c.y, c.z, 1.0);
 }
 

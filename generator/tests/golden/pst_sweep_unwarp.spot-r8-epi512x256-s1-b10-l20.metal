@@ -693,16 +693,19 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     float total = 0.0;
     metal::float3 lo_1 = metal::float3(340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0);
     metal::float3 hi_1 = metal::float3(0.0, 0.0, 0.0);
+    uint taps = 0u;
+    uint close = 0u;
     uint k_2 = 0u;
     bool local_7 = {};
+    bool local_8 = {};
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e49 = k_2;
-            k_2 = _e49 + 1u;
+            uint _e63 = k_2;
+            k_2 = _e63 + 1u;
         }
         loop_init_3 = false;
         uint _e6 = k_2;
@@ -711,48 +714,61 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
             break;
         }
         {
-            uint _e10 = k_2;
-            if (w_1[metal::min(unsigned(_e10), 3u)] > 0.0) {
-                uint _e15 = k_2;
-                bool _e19 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e15), 3u)], d, depth_break_1);
-                local_7 = _e19;
+            uint _e10 = taps;
+            uint _e12 = k_2;
+            taps = _e10 + ((w_1[metal::min(unsigned(_e12), 3u)] > 0.0) ? 1u : 0u);
+            uint _e20 = k_2;
+            if (w_1[metal::min(unsigned(_e20), 3u)] > 0.0) {
+                uint _e25 = k_2;
+                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
+                local_7 = _e29;
             } else {
                 local_7 = false;
             }
-            bool _e23 = local_7;
-            if (_e23) {
-                metal::float3 _e26 = sum_2;
-                uint _e27 = k_2;
-                uint _e29 = k_2;
-                sum_2 = _e26 + (w_1[metal::min(unsigned(_e27), 3u)] * light_1.inner[metal::min(unsigned(_e29), 3u)]);
-                float _e34 = total;
-                uint _e35 = k_2;
-                total = _e34 + w_1[metal::min(unsigned(_e35), 3u)];
-                metal::float3 _e39 = lo_1;
-                uint _e40 = k_2;
-                lo_1 = metal::min(_e39, light_1.inner[metal::min(unsigned(_e40), 3u)]);
-                metal::float3 _e44 = hi_1;
-                uint _e45 = k_2;
-                hi_1 = metal::max(_e44, light_1.inner[metal::min(unsigned(_e45), 3u)]);
+            bool _e33 = local_7;
+            if (_e33) {
+                uint _e35 = close;
+                close = _e35 + 1u;
+                metal::float3 _e40 = sum_2;
+                uint _e41 = k_2;
+                uint _e43 = k_2;
+                sum_2 = _e40 + (w_1[metal::min(unsigned(_e41), 3u)] * light_1.inner[metal::min(unsigned(_e43), 3u)]);
+                float _e48 = total;
+                uint _e49 = k_2;
+                total = _e48 + w_1[metal::min(unsigned(_e49), 3u)];
+                metal::float3 _e53 = lo_1;
+                uint _e54 = k_2;
+                lo_1 = metal::min(_e53, light_1.inner[metal::min(unsigned(_e54), 3u)]);
+                metal::float3 _e58 = hi_1;
+                uint _e59 = k_2;
+                hi_1 = metal::max(_e58, light_1.inner[metal::min(unsigned(_e59), 3u)]);
             }
         }
     }
-    float _e51 = total;
-    if (_e51 <= 0.0) {
+    float _e65 = total;
+    if (!((_e65 <= 0.0))) {
+        uint _e69 = close;
+        uint _e70 = taps;
+        local_8 = _e69 < metal::min(_e70, 2u);
+    } else {
+        local_8 = true;
+    }
+    bool _e77 = local_8;
+    if (_e77) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
-    metal::float3 _e59 = hi_1;
-    metal::float3 _e60 = lo_1;
-    metal::float3 spread = _e59 - _e60;
-    float _e69 = hi_1.x;
-    float _e71 = hi_1.y;
-    float _e73 = hi_1.z;
-    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e69, metal::max(_e71, _e73)))) {
+    metal::float3 _e83 = hi_1;
+    metal::float3 _e84 = lo_1;
+    metal::float3 spread = _e83 - _e84;
+    float _e93 = hi_1.x;
+    float _e95 = hi_1.y;
+    float _e97 = hi_1.z;
+    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e93, metal::max(_e95, _e97)))) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
-    metal::float3 _e83 = sum_2;
-    float _e84 = total;
-    metal::float3 c = _e83 / metal::float3(_e84);
+    metal::float3 _e107 = sum_2;
+    float _e108 = total;
+    metal::float3 c = _e107 / metal::float3(_e108);
     return metal::float4(c.x, c.y, c.z, 1.0);
 }
 
@@ -939,9 +955,9 @@ PstRay pst_ray(
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     PstRay r = {};
-    bool local_8 = {};
     bool local_9 = {};
     bool local_10 = {};
+    bool local_11 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
     metal::float3 eye_9 = f_16.eye.xyz;
     metal::float2 ndc = metal::float2(((2.0 * pc.x) / static_cast<float>(f_16.sizes.x)) - 1.0, 1.0 - ((2.0 * pc.y) / static_cast<float>(f_16.sizes.y)));
@@ -952,23 +968,23 @@ PstRay pst_ray(
     metal::float3 px = metal::float3(pc, 0.0);
     float radius = f_16.epipole.w;
     if (f_16.epipole.z > 0.5) {
-        local_8 = metal::length(px - metal::float3(f_16.epipole.x, f_16.epipole.y, 0.0)) < radius;
-    } else {
-        local_8 = false;
-    }
-    bool near_epi = local_8;
-    if (f_16.anti_epipole.z > 0.5) {
-        local_9 = metal::length(px - metal::float3(f_16.anti_epipole.x, f_16.anti_epipole.y, 0.0)) < radius;
+        local_9 = metal::length(px - metal::float3(f_16.epipole.x, f_16.epipole.y, 0.0)) < radius;
     } else {
         local_9 = false;
     }
-    bool near_anti = local_9;
-    if (!(near_epi)) {
-        local_10 = near_anti;
+    bool near_epi = local_9;
+    if (f_16.anti_epipole.z > 0.5) {
+        local_10 = metal::length(px - metal::float3(f_16.anti_epipole.x, f_16.anti_epipole.y, 0.0)) < radius;
     } else {
-        local_10 = true;
+        local_10 = false;
     }
-    bool _e109 = local_10;
+    bool near_anti = local_10;
+    if (!(near_epi)) {
+        local_11 = near_anti;
+    } else {
+        local_11 = true;
+    }
+    bool _e109 = local_11;
     if (_e109) {
         r.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;

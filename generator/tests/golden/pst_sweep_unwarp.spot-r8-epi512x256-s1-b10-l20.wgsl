@@ -515,8 +515,11 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1: vec4<f32>, dep
     var total: f32 = 0f;
     var lo_1: vec3<f32> = vec3<f32>(340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f);
     var hi_1: vec3<f32> = vec3<f32>(0f, 0f, 0f);
+    var taps: u32 = 0u;
+    var close: u32 = 0u;
     var k_2: u32 = 0u;
     var local_7: bool;
+    var local_8: bool;
 
     loop {
         let _e6 = k_2;
@@ -525,52 +528,65 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1: vec4<f32>, dep
             break;
         }
         {
-            let _e10 = k_2;
-            if (w_1[_e10] > 0f) {
-                let _e15 = k_2;
-                let _e19 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e15], d, depth_break_1);
-                local_7 = _e19;
+            let _e10 = taps;
+            let _e12 = k_2;
+            taps = (_e10 + select(0u, 1u, (w_1[_e12] > 0f)));
+            let _e20 = k_2;
+            if (w_1[_e20] > 0f) {
+                let _e25 = k_2;
+                let _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
+                local_7 = _e29;
             } else {
                 local_7 = false;
             }
-            let _e23 = local_7;
-            if _e23 {
-                let _e26 = sum_2;
-                let _e27 = k_2;
-                let _e29 = k_2;
-                sum_2 = (_e26 + (w_1[_e27] * light_1[_e29]));
-                let _e34 = total;
-                let _e35 = k_2;
-                total = (_e34 + w_1[_e35]);
-                let _e39 = lo_1;
-                let _e40 = k_2;
-                lo_1 = min(_e39, light_1[_e40]);
-                let _e44 = hi_1;
-                let _e45 = k_2;
-                hi_1 = max(_e44, light_1[_e45]);
+            let _e33 = local_7;
+            if _e33 {
+                let _e35 = close;
+                close = (_e35 + 1u);
+                let _e40 = sum_2;
+                let _e41 = k_2;
+                let _e43 = k_2;
+                sum_2 = (_e40 + (w_1[_e41] * light_1[_e43]));
+                let _e48 = total;
+                let _e49 = k_2;
+                total = (_e48 + w_1[_e49]);
+                let _e53 = lo_1;
+                let _e54 = k_2;
+                lo_1 = min(_e53, light_1[_e54]);
+                let _e58 = hi_1;
+                let _e59 = k_2;
+                hi_1 = max(_e58, light_1[_e59]);
             }
         }
         continuing {
-            let _e49 = k_2;
-            k_2 = (_e49 + 1u);
+            let _e63 = k_2;
+            k_2 = (_e63 + 1u);
         }
     }
-    let _e51 = total;
-    if (_e51 <= 0f) {
+    let _e65 = total;
+    if !((_e65 <= 0f)) {
+        let _e69 = close;
+        let _e70 = taps;
+        local_8 = (_e69 < min(_e70, 2u));
+    } else {
+        local_8 = true;
+    }
+    let _e77 = local_8;
+    if _e77 {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
-    let _e59 = hi_1;
-    let _e60 = lo_1;
-    let spread = (_e59 - _e60);
-    let _e69 = hi_1.x;
-    let _e71 = hi_1.y;
-    let _e73 = hi_1.z;
-    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e69, max(_e71, _e73)))) {
+    let _e83 = hi_1;
+    let _e84 = lo_1;
+    let spread = (_e83 - _e84);
+    let _e93 = hi_1.x;
+    let _e95 = hi_1.y;
+    let _e97 = hi_1.z;
+    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97)))) {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
-    let _e83 = sum_2;
-    let _e84 = total;
-    let c = (_e83 / vec3(_e84));
+    let _e107 = sum_2;
+    let _e108 = total;
+    let c = (_e107 / vec3(_e108));
     return vec4<f32>(c.x, c.y, c.z, 1f);
 }
 
@@ -703,9 +719,9 @@ fn pst_leaf(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, ro
 
 fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     var r: PstRay;
-    var local_8: bool;
     var local_9: bool;
     var local_10: bool;
+    var local_11: bool;
 
     let f_16 = frame;
     let eye_9 = f_16.eye.xyz;
@@ -717,23 +733,23 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     let px = vec3<f32>(pc, 0f);
     let radius = f_16.epipole.w;
     if (f_16.epipole.z > 0.5f) {
-        local_8 = (length((px - vec3<f32>(f_16.epipole.x, f_16.epipole.y, 0f))) < radius);
-    } else {
-        local_8 = false;
-    }
-    let near_epi = local_8;
-    if (f_16.anti_epipole.z > 0.5f) {
-        local_9 = (length((px - vec3<f32>(f_16.anti_epipole.x, f_16.anti_epipole.y, 0f))) < radius);
+        local_9 = (length((px - vec3<f32>(f_16.epipole.x, f_16.epipole.y, 0f))) < radius);
     } else {
         local_9 = false;
     }
-    let near_anti = local_9;
-    if !(near_epi) {
-        local_10 = near_anti;
+    let near_epi = local_9;
+    if (f_16.anti_epipole.z > 0.5f) {
+        local_10 = (length((px - vec3<f32>(f_16.anti_epipole.x, f_16.anti_epipole.y, 0f))) < radius);
     } else {
-        local_10 = true;
+        local_10 = false;
     }
-    let _e109 = local_10;
+    let near_anti = local_10;
+    if !(near_epi) {
+        local_11 = near_anti;
+    } else {
+        local_11 = true;
+    }
+    let _e109 = local_11;
     if _e109 {
         r.marched = true;
         let _e114 = frame;

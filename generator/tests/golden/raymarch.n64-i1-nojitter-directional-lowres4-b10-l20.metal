@@ -353,16 +353,19 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     float total = 0.0;
     metal::float3 lo = metal::float3(340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0);
     metal::float3 hi = metal::float3(0.0, 0.0, 0.0);
+    uint taps = 0u;
+    uint close = 0u;
     uint k_2 = 0u;
     bool local_6 = {};
+    bool local_7 = {};
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e49 = k_2;
-            k_2 = _e49 + 1u;
+            uint _e63 = k_2;
+            k_2 = _e63 + 1u;
         }
         loop_init = false;
         uint _e6 = k_2;
@@ -371,48 +374,61 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
             break;
         }
         {
-            uint _e10 = k_2;
-            if (w[metal::min(unsigned(_e10), 3u)] > 0.0) {
-                uint _e15 = k_2;
-                bool _e19 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e15), 3u)], d, depth_break_1);
-                local_6 = _e19;
+            uint _e10 = taps;
+            uint _e12 = k_2;
+            taps = _e10 + ((w[metal::min(unsigned(_e12), 3u)] > 0.0) ? 1u : 0u);
+            uint _e20 = k_2;
+            if (w[metal::min(unsigned(_e20), 3u)] > 0.0) {
+                uint _e25 = k_2;
+                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
+                local_6 = _e29;
             } else {
                 local_6 = false;
             }
-            bool _e23 = local_6;
-            if (_e23) {
-                metal::float3 _e26 = sum;
-                uint _e27 = k_2;
-                uint _e29 = k_2;
-                sum = _e26 + (w[metal::min(unsigned(_e27), 3u)] * light_1.inner[metal::min(unsigned(_e29), 3u)]);
-                float _e34 = total;
-                uint _e35 = k_2;
-                total = _e34 + w[metal::min(unsigned(_e35), 3u)];
-                metal::float3 _e39 = lo;
-                uint _e40 = k_2;
-                lo = metal::min(_e39, light_1.inner[metal::min(unsigned(_e40), 3u)]);
-                metal::float3 _e44 = hi;
-                uint _e45 = k_2;
-                hi = metal::max(_e44, light_1.inner[metal::min(unsigned(_e45), 3u)]);
+            bool _e33 = local_6;
+            if (_e33) {
+                uint _e35 = close;
+                close = _e35 + 1u;
+                metal::float3 _e40 = sum;
+                uint _e41 = k_2;
+                uint _e43 = k_2;
+                sum = _e40 + (w[metal::min(unsigned(_e41), 3u)] * light_1.inner[metal::min(unsigned(_e43), 3u)]);
+                float _e48 = total;
+                uint _e49 = k_2;
+                total = _e48 + w[metal::min(unsigned(_e49), 3u)];
+                metal::float3 _e53 = lo;
+                uint _e54 = k_2;
+                lo = metal::min(_e53, light_1.inner[metal::min(unsigned(_e54), 3u)]);
+                metal::float3 _e58 = hi;
+                uint _e59 = k_2;
+                hi = metal::max(_e58, light_1.inner[metal::min(unsigned(_e59), 3u)]);
             }
         }
     }
-    float _e51 = total;
-    if (_e51 <= 0.0) {
+    float _e65 = total;
+    if (!((_e65 <= 0.0))) {
+        uint _e69 = close;
+        uint _e70 = taps;
+        local_7 = _e69 < metal::min(_e70, 2u);
+    } else {
+        local_7 = true;
+    }
+    bool _e77 = local_7;
+    if (_e77) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
-    metal::float3 _e59 = hi;
-    metal::float3 _e60 = lo;
-    metal::float3 spread = _e59 - _e60;
-    float _e69 = hi.x;
-    float _e71 = hi.y;
-    float _e73 = hi.z;
-    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e69, metal::max(_e71, _e73)))) {
+    metal::float3 _e83 = hi;
+    metal::float3 _e84 = lo;
+    metal::float3 spread = _e83 - _e84;
+    float _e93 = hi.x;
+    float _e95 = hi.y;
+    float _e97 = hi.z;
+    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e93, metal::max(_e95, _e97)))) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
-    metal::float3 _e83 = sum;
-    float _e84 = total;
-    metal::float3 c = _e83 / metal::float3(_e84);
+    metal::float3 _e107 = sum;
+    float _e108 = total;
+    metal::float3 c = _e107 / metal::float3(_e108);
     return metal::float4(c.x, c.y, c.z, 1.0);
 }
 

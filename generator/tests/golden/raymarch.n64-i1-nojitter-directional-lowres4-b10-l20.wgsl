@@ -266,8 +266,11 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
     var total: f32 = 0f;
     var lo: vec3<f32> = vec3<f32>(340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f);
     var hi: vec3<f32> = vec3<f32>(0f, 0f, 0f);
+    var taps: u32 = 0u;
+    var close: u32 = 0u;
     var k_2: u32 = 0u;
     var local_6: bool;
+    var local_7: bool;
 
     loop {
         let _e6 = k_2;
@@ -276,52 +279,65 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
             break;
         }
         {
-            let _e10 = k_2;
-            if (w[_e10] > 0f) {
-                let _e15 = k_2;
-                let _e19 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e15], d, depth_break_1);
-                local_6 = _e19;
+            let _e10 = taps;
+            let _e12 = k_2;
+            taps = (_e10 + select(0u, 1u, (w[_e12] > 0f)));
+            let _e20 = k_2;
+            if (w[_e20] > 0f) {
+                let _e25 = k_2;
+                let _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
+                local_6 = _e29;
             } else {
                 local_6 = false;
             }
-            let _e23 = local_6;
-            if _e23 {
-                let _e26 = sum;
-                let _e27 = k_2;
-                let _e29 = k_2;
-                sum = (_e26 + (w[_e27] * light_1[_e29]));
-                let _e34 = total;
-                let _e35 = k_2;
-                total = (_e34 + w[_e35]);
-                let _e39 = lo;
-                let _e40 = k_2;
-                lo = min(_e39, light_1[_e40]);
-                let _e44 = hi;
-                let _e45 = k_2;
-                hi = max(_e44, light_1[_e45]);
+            let _e33 = local_6;
+            if _e33 {
+                let _e35 = close;
+                close = (_e35 + 1u);
+                let _e40 = sum;
+                let _e41 = k_2;
+                let _e43 = k_2;
+                sum = (_e40 + (w[_e41] * light_1[_e43]));
+                let _e48 = total;
+                let _e49 = k_2;
+                total = (_e48 + w[_e49]);
+                let _e53 = lo;
+                let _e54 = k_2;
+                lo = min(_e53, light_1[_e54]);
+                let _e58 = hi;
+                let _e59 = k_2;
+                hi = max(_e58, light_1[_e59]);
             }
         }
         continuing {
-            let _e49 = k_2;
-            k_2 = (_e49 + 1u);
+            let _e63 = k_2;
+            k_2 = (_e63 + 1u);
         }
     }
-    let _e51 = total;
-    if (_e51 <= 0f) {
+    let _e65 = total;
+    if !((_e65 <= 0f)) {
+        let _e69 = close;
+        let _e70 = taps;
+        local_7 = (_e69 < min(_e70, 2u));
+    } else {
+        local_7 = true;
+    }
+    let _e77 = local_7;
+    if _e77 {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
-    let _e59 = hi;
-    let _e60 = lo;
-    let spread = (_e59 - _e60);
-    let _e69 = hi.x;
-    let _e71 = hi.y;
-    let _e73 = hi.z;
-    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e69, max(_e71, _e73)))) {
+    let _e83 = hi;
+    let _e84 = lo;
+    let spread = (_e83 - _e84);
+    let _e93 = hi.x;
+    let _e95 = hi.y;
+    let _e97 = hi.z;
+    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97)))) {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
-    let _e83 = sum;
-    let _e84 = total;
-    let c = (_e83 / vec3(_e84));
+    let _e107 = sum;
+    let _e108 = total;
+    let c = (_e107 / vec3(_e108));
     return vec4<f32>(c.x, c.y, c.z, 1f);
 }
 

@@ -241,13 +241,16 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
     float total = 0.0;
     vec3 lo = vec3(3.4e38, 3.4e38, 3.4e38);
     vec3 hi = vec3(0.0, 0.0, 0.0);
+    uint taps = 0u;
+    uint close = 0u;
     uint k = 0u;
     bool local_6 = false;
+    bool local_7 = false;
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e49 = k;
-            k = (_e49 + 1u);
+            uint _e63 = k;
+            k = (_e63 + 1u);
         }
         loop_init = false;
         uint _e6 = k;
@@ -256,48 +259,61 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
             break;
         }
         {
-            uint _e10 = k;
-            if ((w[_e10] > 0.0)) {
-                uint _e15 = k;
-                bool _e19 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e15], d, depth_break_1);
-                local_6 = _e19;
+            uint _e10 = taps;
+            uint _e12 = k;
+            taps = (_e10 + ((w[_e12] > 0.0) ? 1u : 0u));
+            uint _e20 = k;
+            if ((w[_e20] > 0.0)) {
+                uint _e25 = k;
+                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
+                local_6 = _e29;
             } else {
                 local_6 = false;
             }
-            bool _e23 = local_6;
-            if (_e23) {
-                vec3 _e26 = sum;
-                uint _e27 = k;
-                uint _e29 = k;
-                sum = (_e26 + (w[_e27] * light_1[_e29]));
-                float _e34 = total;
-                uint _e35 = k;
-                total = (_e34 + w[_e35]);
-                vec3 _e39 = lo;
-                uint _e40 = k;
-                lo = min(_e39, light_1[_e40]);
-                vec3 _e44 = hi;
-                uint _e45 = k;
-                hi = max(_e44, light_1[_e45]);
+            bool _e33 = local_6;
+            if (_e33) {
+                uint _e35 = close;
+                close = (_e35 + 1u);
+                vec3 _e40 = sum;
+                uint _e41 = k;
+                uint _e43 = k;
+                sum = (_e40 + (w[_e41] * light_1[_e43]));
+                float _e48 = total;
+                uint _e49 = k;
+                total = (_e48 + w[_e49]);
+                vec3 _e53 = lo;
+                uint _e54 = k;
+                lo = min(_e53, light_1[_e54]);
+                vec3 _e58 = hi;
+                uint _e59 = k;
+                hi = max(_e58, light_1[_e59]);
             }
         }
     }
-    float _e51 = total;
-    if ((_e51 <= 0.0)) {
+    float _e65 = total;
+    if (!((_e65 <= 0.0))) {
+        uint _e69 = close;
+        uint _e70 = taps;
+        local_7 = (_e69 < min(_e70, 2u));
+    } else {
+        local_7 = true;
+    }
+    bool _e77 = local_7;
+    if (_e77) {
         return vec4(0.0, 0.0, 0.0, 0.0);
     }
-    vec3 _e59 = hi;
-    vec3 _e60 = lo;
-    vec3 spread = (_e59 - _e60);
-    float _e69 = hi.x;
-    float _e71 = hi.y;
-    float _e73 = hi.z;
-    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e69, max(_e71, _e73))))) {
+    vec3 _e83 = hi;
+    vec3 _e84 = lo;
+    vec3 spread = (_e83 - _e84);
+    float _e93 = hi.x;
+    float _e95 = hi.y;
+    float _e97 = hi.z;
+    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97))))) {
         return vec4(0.0, 0.0, 0.0, 0.0);
     }
-    vec3 _e83 = sum;
-    float _e84 = total;
-    vec3 c = (_e83 / vec3(_e84));
+    vec3 _e107 = sum;
+    float _e108 = total;
+    vec3 c = (_e107 / vec3(_e108));
     return vec4(c.x, c.y, c.z, 1.0);
 }
 
