@@ -102,6 +102,7 @@ static const uint SLICES = 512u;
 static const uint SLICE_SAMPLES = 256u;
 static const uint SLICE_LANES = 32u;
 static const uint STEP = 1u;
+static const uint SLICE_RUNS = 256u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
 static const uint RANK_VECS = 2u;

@@ -90,6 +90,7 @@ const SLICES: u32 = 512u;
 const SLICE_SAMPLES: u32 = 256u;
 const SLICE_LANES: u32 = 32u;
 const STEP: u32 = 1u;
+const SLICE_RUNS: u32 = 256u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
 const RANK_VECS: u32 = 2u;

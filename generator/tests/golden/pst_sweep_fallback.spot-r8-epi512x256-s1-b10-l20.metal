@@ -82,6 +82,7 @@ constant uint SLICES = 512u;
 constant uint SLICE_SAMPLES = 256u;
 constant uint SLICE_LANES = 32u;
 constant uint STEP = 1u;
+constant uint SLICE_RUNS = 256u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
 constant uint RANK_VECS = 2u;

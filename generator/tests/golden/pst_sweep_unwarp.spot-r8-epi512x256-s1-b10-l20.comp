@@ -84,6 +84,7 @@ const uint SLICES = 512u;
 const uint SLICE_SAMPLES = 256u;
 const uint SLICE_LANES = 32u;
 const uint STEP = 1u;
+const uint SLICE_RUNS = 256u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
 const uint RANK_VECS = 2u;

@@ -63,6 +63,7 @@ static const uint SLICES = 256u;
 static const uint SLICE_SAMPLES = 256u;
 static const uint SLICE_LANES = 32u;
 static const uint STEP = 8u;
+static const uint SLICE_RUNS = 32u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
 
@@ -72,7 +73,7 @@ Texture2D<float4> shadow_map : register(t2);
 RWTexture2D<float4> output : register(u3);
 RWByteAddressBuffer fallback_count : register(u5);
 groupshared float line_depth[256];
-groupshared uint line_flag[256];
+groupshared uint line_ab[256];
 groupshared float3 line_light[256];
 groupshared uint line_list[256];
 groupshared uint line_count;
@@ -121,10 +122,10 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y
     return (float((_e29 >> 8u)) / 16777216.0);
 }
 
-float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g_1, float cos_theta)
 {
-    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
-    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
+    float denom = max(((1.0 + (g_1 * g_1)) - ((2.0 * g_1) * cos_theta)), 1e-8);
+    return ((1.0 - (g_1 * g_1)) / ((12.566371 * denom) * sqrt(denom)));
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
@@ -136,10 +137,10 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma
     return ((1.0 - exp(-(x_4))) / sigma_t);
 }
 
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a_1, float b_1)
 {
-    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
+    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
+    return (exp((-(sigma_t_1) * a_1)) * _e7);
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
@@ -172,12 +173,12 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_o
     return ret;
 }
 
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float3 light_pos_1, float a_1, float b_1, uint n)
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float3 light_pos_1, float a_2, float b_2, uint n)
 {
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
-    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
-    float theta_a = atan(((a_1 - t0_) / h_1));
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_1 - t0_) / h_1)) - theta_a) / float(n)));
+    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_) / h_1));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_2 - t0_) / h_1)) - theta_a) / float(n)));
     return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
 }
 
@@ -279,12 +280,12 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
     return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
 }
 
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_2, float b_2, float depth_break)
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_3, float b_3, float depth_break)
 {
     bool local_8 = (bool)0;
 
-    if (!((a_2 == b_2))) {
-        local_8 = (abs((a_2 - b_2)) <= (depth_break * min(a_2, b_2)));
+    if (!((a_3 == b_3))) {
+        local_8 = (abs((a_3 - b_3)) <= (depth_break * min(a_3, b_3)));
     } else {
         local_8 = true;
     }
@@ -313,9 +314,9 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     bool local_9 = (bool)0;
     bool local_10 = (bool)0;
     bool local_11 = (bool)0;
-    float a_3 = 0.0;
-    float b_3 = 0.0;
-    uint k_4 = 0u;
+    float a_4 = 0.0;
+    float b_4 = 0.0;
+    uint k_5 = 0u;
 
     float2 size_1 = float2(screen);
     float2 centre = (0.5 * size_1);
@@ -373,38 +374,38 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
             if (all(loop_bound == uint2(0u, 0u))) { break; }
             loop_bound -= uint2(loop_bound.y == 0u, 1u);
             if (!loop_init) {
-                uint _e153 = k_4;
-                k_4 = (_e153 + 1u);
+                uint _e153 = k_5;
+                k_5 = (_e153 + 1u);
             }
             loop_init = false;
-            uint _e118 = k_4;
+            uint _e118 = k_5;
             if ((_e118 < 4u)) {
             } else {
                 break;
             }
             {
-                uint _e123 = k_4;
-                uint _e131 = k_4;
+                uint _e123 = k_5;
+                uint _e131 = k_5;
                 float2 corner = float2((((_e123 & 1u) != 0u) ? hi.x : lo.x), (((_e131 & 2u) != 0u) ? hi.y : lo.y));
                 float2 _e139 = l.axis;
                 float2 _e140 = origin;
                 const float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
-                uint _e143 = k_4;
+                uint _e143 = k_5;
                 if ((_e143 == 0u)) {
-                    a_3 = _e142;
-                    b_3 = _e142;
+                    a_4 = _e142;
+                    b_4 = _e142;
                 } else {
-                    float _e148 = a_3;
-                    a_3 = min(_e148, _e142);
-                    float _e150 = b_3;
-                    b_3 = max(_e150, _e142);
+                    float _e148 = a_4;
+                    a_4 = min(_e148, _e142);
+                    float _e150 = b_4;
+                    b_4 = max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_3;
+        float _e156 = a_4;
         l.phi_start = _e156;
-        float _e158 = b_3;
-        float _e159 = a_3;
+        float _e158 = b_4;
+        float _e159 = a_4;
         l.dphi = ((_e158 - _e159) / float(slices));
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l;
@@ -424,7 +425,7 @@ float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_n
 {
     float t_in = 0.0;
     float t_out = 3.4e38;
-    uint a_4 = 0u;
+    uint a_5 = 0u;
 
     const float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2, s_1);
     float2 lo_1 = float2(0.5, 0.5);
@@ -435,25 +436,25 @@ float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_n
         if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
         loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
         if (!loop_init_1) {
-            uint _e51 = a_4;
-            a_4 = (_e51 + 1u);
+            uint _e51 = a_5;
+            a_5 = (_e51 + 1u);
         }
         loop_init_1 = false;
-        uint _e16 = a_4;
+        uint _e16 = a_5;
         if ((_e16 < 2u)) {
         } else {
             break;
         }
         {
-            uint _e19 = a_4;
+            uint _e19 = a_5;
             if ((abs(_e5[min(uint(_e19), 1u)]) > 1e-12)) {
-                uint _e24 = a_4;
-                uint _e27 = a_4;
-                uint _e30 = a_4;
+                uint _e24 = a_5;
+                uint _e27 = a_5;
+                uint _e30 = a_5;
                 float ta = ((lo_1[min(uint(_e24), 1u)] - l_2.origin[min(uint(_e27), 1u)]) / _e5[min(uint(_e30), 1u)]);
-                uint _e33 = a_4;
-                uint _e36 = a_4;
-                uint _e39 = a_4;
+                uint _e33 = a_5;
+                uint _e36 = a_5;
+                uint _e39 = a_5;
                 float tb = ((hi_1[min(uint(_e33), 1u)] - l_2.origin[min(uint(_e36), 1u)]) / _e5[min(uint(_e39), 1u)]);
                 float _e43 = t_in;
                 t_in = max(_e43, min(ta, tb));
@@ -475,9 +476,9 @@ uint2 naga_f2u32(float2 value) {
     return uint2(clamp(value, 0.0, 4294967000.0));
 }
 
-uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_3, float2 u, float2 span, uint k_5, uint2 screen_2)
+uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_3, float2 u, float2 span, uint k_6, uint2 screen_2)
 {
-    float2 p_2 = (l_3.origin + (u * (span.x + (float(k_5) * span.y))));
+    float2 p_2 = (l_3.origin + (u * (span.x + (float(k_6) * span.y))));
     float2 last = (float2(screen_2) - float2(1.0, 1.0));
     return naga_f2u32(clamp(floor(p_2), float2(0.0, 0.0), last));
 }
@@ -569,46 +570,16 @@ float3 raymarch_pixel(uint x_3, uint y_2)
     return c_2;
 }
 
-uint2 line_bracket(uint k_6)
+uint2 line_bracket(uint k_7)
 {
-    uint a_5 = (uint)0;
-    uint b_4 = (uint)0;
+    uint v_6 = line_ab[min(uint(k_7), 255u)];
+    return uint2((v_6 & 65535u), (v_6 >> 16u));
+}
 
-    a_5 = k_6;
-    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
-    while(true) {
-        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        uint _e3 = a_5;
-        uint _e5 = line_flag[min(uint(_e3), 255u)];
-        if ((_e5 == 0u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_5;
-            a_5 = (_e8 - 1u);
-        }
-    }
-    b_4 = k_6;
-    uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
-    while(true) {
-        if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        uint _e13 = b_4;
-        uint _e15 = line_flag[min(uint(_e13), 255u)];
-        if ((_e15 == 0u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e18 = b_4;
-            b_4 = (_e18 + 1u);
-        }
-    }
-    uint _e21 = a_5;
-    uint _e22 = b_4;
-    return uint2(_e21, _e22);
+bool line_marked(uint k_8)
+{
+    uint _e3 = line_ab[min(uint(k_8), 255u)];
+    return ((_e3 & 65535u) == k_8);
 }
 
 bool line_spread_over(uint2 ab)
@@ -636,7 +607,7 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
 {
     if (li == 0) {
         line_depth = (float[256])0;
-        line_flag = (uint[256])0;
+        line_ab = (uint[256])0;
         line_light = (float3[256])0;
         line_list = (uint[256])0;
         line_count = (uint)0;
@@ -644,16 +615,20 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     }
     GroupMemoryBarrierWithGroupSync();
     uint k = (uint)0;
+    uint g = (uint)0;
+    uint a = (uint)0;
     uint k_1 = (uint)0;
     bool local = (bool)0;
     bool marked = (bool)0;
     bool local_1 = (bool)0;
     bool local_2 = (bool)0;
-    uint e = (uint)0;
+    uint b = (uint)0;
     uint k_2 = (uint)0;
+    uint e = (uint)0;
+    uint k_3 = (uint)0;
     bool local_3 = (bool)0;
     uint e_1 = (uint)0;
-    uint k_3 = (uint)0;
+    uint k_4 = (uint)0;
     float3 c = (float3)0;
 
     uint _e3 = frame.sizes.x;
@@ -678,11 +653,11 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
     }
     k = li;
-    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
+    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
     while(true) {
-        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
             uint _e87 = k;
             k = (_e87 + SLICE_LANES);
@@ -702,70 +677,128 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
     }
     GroupMemoryBarrierWithGroupSync();
-    k_1 = li;
-    uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
+    g = li;
+    uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
     bool loop_init_4 = true;
     while(true) {
-        if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
-        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+        if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e166 = k_1;
-            k_1 = (_e166 + SLICE_LANES);
+            uint _e220 = g;
+            g = (_e220 + SLICE_LANES);
         }
         loop_init_4 = false;
-        uint _e91 = k_1;
-        if ((_e91 < SLICE_SAMPLES)) {
+        uint _e91 = g;
+        if ((_e91 < SLICE_RUNS)) {
         } else {
             break;
         }
         {
-            uint _e94 = k_1;
-            if (!((naga_mod(_e94, STEP) == 0u))) {
-                uint _e100 = k_1;
-                local = (_e100 == 255u);
-            } else {
-                local = true;
+            uint _e94 = g;
+            uint s0_ = (_e94 * STEP);
+            uint e_3 = min((s0_ + STEP), SLICE_SAMPLES);
+            a = s0_;
+            k_1 = s0_;
+            uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
+            bool loop_init_5 = true;
+            while(true) {
+                if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
+                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+                if (!loop_init_5) {
+                    uint _e183 = k_1;
+                    k_1 = (_e183 + 1u);
+                }
+                loop_init_5 = false;
+                uint _e103 = k_1;
+                if ((_e103 < e_3)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e105 = k_1;
+                    if (!((naga_mod(_e105, STEP) == 0u))) {
+                        uint _e111 = k_1;
+                        local = (_e111 == 255u);
+                    } else {
+                        local = true;
+                    }
+                    bool _e117 = local;
+                    marked = _e117;
+                    uint _e119 = k_1;
+                    if ((_e119 > 0u)) {
+                        uint _e122 = k_1;
+                        float _e127 = line_depth[min(uint((_e122 - 1u)), 255u)];
+                        uint _e129 = k_1;
+                        float _e131 = line_depth[min(uint(_e129), 255u)];
+                        const bool _e133 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e127, _e131, DEPTH_BREAK);
+                        local_1 = !(_e133);
+                    } else {
+                        local_1 = false;
+                    }
+                    bool _e138 = local_1;
+                    if (_e138) {
+                        marked = true;
+                    }
+                    uint _e140 = k_1;
+                    if (((_e140 + 1u) < SLICE_SAMPLES)) {
+                        uint _e146 = k_1;
+                        float _e148 = line_depth[min(uint(_e146), 255u)];
+                        uint _e149 = k_1;
+                        float _e154 = line_depth[min(uint((_e149 + 1u)), 255u)];
+                        const bool _e156 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e148, _e154, DEPTH_BREAK);
+                        local_2 = !(_e156);
+                    } else {
+                        local_2 = false;
+                    }
+                    bool _e161 = local_2;
+                    if (_e161) {
+                        marked = true;
+                    }
+                    bool _e163 = marked;
+                    if (_e163) {
+                        uint _e164 = k_1;
+                        a = _e164;
+                        uint _e167; InterlockedAdd(line_count, 1u, _e167);
+                        uint _e170 = k_1;
+                        line_list[min(uint(_e167), 255u)] = _e170;
+                    }
+                    uint _e172 = k_1;
+                    uint _e174 = a;
+                    uint _e176 = k_1;
+                    bool _e177 = marked;
+                    line_ab[min(uint(_e172), 255u)] = (_e174 | ((_e177 ? _e176 : 65535u) << 16u));
+                }
             }
-            bool _e106 = local;
-            marked = _e106;
-            uint _e108 = k_1;
-            if ((_e108 > 0u)) {
-                uint _e111 = k_1;
-                float _e116 = line_depth[min(uint((_e111 - 1u)), 255u)];
-                uint _e118 = k_1;
-                float _e120 = line_depth[min(uint(_e118), 255u)];
-                const bool _e122 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e116, _e120, DEPTH_BREAK);
-                local_1 = !(_e122);
-            } else {
-                local_1 = false;
-            }
-            bool _e127 = local_1;
-            if (_e127) {
-                marked = true;
-            }
-            uint _e129 = k_1;
-            if (((_e129 + 1u) < SLICE_SAMPLES)) {
-                uint _e135 = k_1;
-                float _e137 = line_depth[min(uint(_e135), 255u)];
-                uint _e138 = k_1;
-                float _e143 = line_depth[min(uint((_e138 + 1u)), 255u)];
-                const bool _e145 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e137, _e143, DEPTH_BREAK);
-                local_2 = !(_e145);
-            } else {
-                local_2 = false;
-            }
-            bool _e150 = local_2;
-            if (_e150) {
-                marked = true;
-            }
-            uint _e153 = k_1;
-            bool _e157 = marked;
-            line_flag[min(uint(_e153), 255u)] = (_e157 ? 1u : 0u);
-            bool _e159 = marked;
-            if (_e159) {
-                uint _e162; InterlockedAdd(line_count, 1u, _e162);
-                uint _e165 = k_1;
-                line_list[min(uint(_e162), 255u)] = _e165;
+            b = min(e_3, 255u);
+            k_2 = e_3;
+            uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
+            bool loop_init_6 = true;
+            while(true) {
+                if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
+                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                if (!loop_init_6) {
+                    uint _e218 = k_2;
+                    k_2 = (_e218 - 1u);
+                }
+                loop_init_6 = false;
+                uint _e189 = k_2;
+                if ((_e189 > s0_)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e191 = k_2;
+                    uint v_7 = line_ab[min(uint((_e191 - 1u)), 255u)];
+                    uint _e199 = k_2;
+                    if (((v_7 & 65535u) == (_e199 - 1u))) {
+                        uint _e203 = k_2;
+                        b = (_e203 - 1u);
+                    } else {
+                        uint _e206 = k_2;
+                        uint _e213 = b;
+                        line_ab[min(uint((_e206 - 1u)), 255u)] = ((v_7 & 65535u) | (_e213 << 16u));
+                    }
+                }
             }
         }
     }
@@ -773,62 +806,62 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     uint n_3; InterlockedOr(line_count, 0, n_3);
     e = li;
     uint2 loop_bound_7 = uint2(4294967295u, 4294967295u);
-    bool loop_init_5 = true;
+    bool loop_init_7 = true;
     while(true) {
         if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
         loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-        if (!loop_init_5) {
-            uint _e185 = e;
-            e = (_e185 + SLICE_LANES);
+        if (!loop_init_7) {
+            uint _e239 = e;
+            e = (_e239 + SLICE_LANES);
         }
-        loop_init_5 = false;
-        uint _e172 = e;
-        if ((_e172 < n_3)) {
+        loop_init_7 = false;
+        uint _e226 = e;
+        if ((_e226 < n_3)) {
         } else {
             break;
         }
         {
-            uint _e175 = e;
-            uint k_7 = line_list[min(uint(_e175), 255u)];
-            const uint2 _e178 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
-            const float3 _e183 = raymarch_pixel(_e178.x, _e178.y);
-            const float3 _e184 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e183);
-            line_light[min(uint(k_7), 255u)] = _e184;
+            uint _e229 = e;
+            uint k_9 = line_list[min(uint(_e229), 255u)];
+            const uint2 _e232 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_9, screen_3);
+            const float3 _e237 = raymarch_pixel(_e232.x, _e232.y);
+            const float3 _e238 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e237);
+            line_light[min(uint(k_9), 255u)] = _e238;
         }
     }
     GroupMemoryBarrierWithGroupSync();
-    k_2 = li;
+    k_3 = li;
     uint2 loop_bound_8 = uint2(4294967295u, 4294967295u);
-    bool loop_init_6 = true;
+    bool loop_init_8 = true;
     while(true) {
         if (all(loop_bound_8 == uint2(0u, 0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
-        if (!loop_init_6) {
-            uint _e211 = k_2;
-            k_2 = (_e211 + SLICE_LANES);
+        if (!loop_init_8) {
+            uint _e262 = k_3;
+            k_3 = (_e262 + SLICE_LANES);
         }
-        loop_init_6 = false;
-        uint _e189 = k_2;
-        if ((_e189 < SLICE_SAMPLES)) {
+        loop_init_8 = false;
+        uint _e243 = k_3;
+        if ((_e243 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e193 = k_2;
-            uint _e195 = line_flag[min(uint(_e193), 255u)];
-            if ((_e195 == 0u)) {
-                uint _e198 = k_2;
-                const uint2 _e199 = line_bracket(_e198);
-                const bool _e200 = line_spread_over(_e199);
-                local_3 = _e200;
+            uint _e246 = k_3;
+            const bool _e247 = line_marked(_e246);
+            if (!(_e247)) {
+                uint _e249 = k_3;
+                const uint2 _e250 = line_bracket(_e249);
+                const bool _e251 = line_spread_over(_e250);
+                local_3 = _e251;
             } else {
                 local_3 = false;
             }
-            bool _e204 = local_3;
-            if (_e204) {
-                uint _e207; InterlockedAdd(line_count_light, 1u, _e207);
-                uint _e210 = k_2;
-                line_list[min(uint(_e207), 255u)] = _e210;
+            bool _e255 = local_3;
+            if (_e255) {
+                uint _e258; InterlockedAdd(line_count_light, 1u, _e258);
+                uint _e261 = k_3;
+                line_list[min(uint(_e258), 255u)] = _e261;
             }
         }
     }
@@ -836,71 +869,71 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     uint n2_; InterlockedOr(line_count_light, 0, n2_);
     e_1 = li;
     uint2 loop_bound_9 = uint2(4294967295u, 4294967295u);
-    bool loop_init_7 = true;
+    bool loop_init_9 = true;
     while(true) {
         if (all(loop_bound_9 == uint2(0u, 0u))) { break; }
         loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
-        if (!loop_init_7) {
-            uint _e230 = e_1;
-            e_1 = (_e230 + SLICE_LANES);
+        if (!loop_init_9) {
+            uint _e281 = e_1;
+            e_1 = (_e281 + SLICE_LANES);
         }
-        loop_init_7 = false;
-        uint _e217 = e_1;
-        if ((_e217 < n2_)) {
+        loop_init_9 = false;
+        uint _e268 = e_1;
+        if ((_e268 < n2_)) {
         } else {
             break;
         }
         {
-            uint _e220 = e_1;
-            uint k_8 = line_list[min(uint(_e220), 255u)];
-            const uint2 _e223 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-            const float3 _e228 = raymarch_pixel(_e223.x, _e223.y);
-            const float3 _e229 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e228);
-            line_light[min(uint(k_8), 255u)] = _e229;
+            uint _e271 = e_1;
+            uint k_10 = line_list[min(uint(_e271), 255u)];
+            const uint2 _e274 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_10, screen_3);
+            const float3 _e279 = raymarch_pixel(_e274.x, _e274.y);
+            const float3 _e280 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e279);
+            line_light[min(uint(k_10), 255u)] = _e280;
         }
     }
     GroupMemoryBarrierWithGroupSync();
-    k_3 = li;
+    k_4 = li;
     uint2 loop_bound_10 = uint2(4294967295u, 4294967295u);
-    bool loop_init_8 = true;
+    bool loop_init_10 = true;
     while(true) {
         if (all(loop_bound_10 == uint2(0u, 0u))) { break; }
         loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
-        if (!loop_init_8) {
-            uint _e288 = k_3;
-            k_3 = (_e288 + SLICE_LANES);
+        if (!loop_init_10) {
+            uint _e336 = k_4;
+            k_4 = (_e336 + SLICE_LANES);
         }
-        loop_init_8 = false;
-        uint _e234 = k_3;
-        if ((_e234 < SLICE_SAMPLES)) {
+        loop_init_10 = false;
+        uint _e285 = k_4;
+        if ((_e285 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e238 = k_3;
-            float3 _e240 = line_light[min(uint(_e238), 255u)];
-            c = _e240;
-            uint _e243 = k_3;
-            uint _e245 = line_flag[min(uint(_e243), 255u)];
-            if ((_e245 == 0u)) {
-                uint _e248 = k_3;
-                const uint2 _e249 = line_bracket(_e248);
-                const bool _e250 = line_spread_over(_e249);
-                if (!(_e250)) {
-                    uint _e252 = k_3;
-                    float t_4 = (float((_e252 - _e249.x)) / float((_e249.y - _e249.x)));
-                    float3 _e264 = line_light[min(uint(_e249.x), 255u)];
-                    float3 _e271 = line_light[min(uint(_e249.y), 255u)];
-                    c = ((_e264 * (1.0 - t_4)) + (_e271 * t_4));
+            uint _e289 = k_4;
+            float3 _e291 = line_light[min(uint(_e289), 255u)];
+            c = _e291;
+            uint _e293 = k_4;
+            const bool _e294 = line_marked(_e293);
+            if (!(_e294)) {
+                uint _e296 = k_4;
+                const uint2 _e297 = line_bracket(_e296);
+                const bool _e298 = line_spread_over(_e297);
+                if (!(_e298)) {
+                    uint _e300 = k_4;
+                    float t_4 = (float((_e300 - _e297.x)) / float((_e297.y - _e297.x)));
+                    float3 _e312 = line_light[min(uint(_e297.x), 255u)];
+                    float3 _e319 = line_light[min(uint(_e297.y), 255u)];
+                    c = ((_e312 * (1.0 - t_4)) + (_e319 * t_4));
                 }
             }
-            uint _e274 = k_3;
-            float _e277 = c.x;
-            float _e279 = c.y;
-            float _e281 = c.z;
-            uint _e283 = k_3;
-            float _e285 = line_depth[min(uint(_e283), 255u)];
-            output[uint2(_e274, s_3)] = float4(_e277, _e279, _e281, _e285);
+            uint _e322 = k_4;
+            float _e325 = c.x;
+            float _e327 = c.y;
+            float _e329 = c.z;
+            uint _e331 = k_4;
+            float _e333 = line_depth[min(uint(_e331), 255u)];
+            output[uint2(_e322, s_3)] = float4(_e325, _e327, _e329, _e333);
         }
     }
     return;

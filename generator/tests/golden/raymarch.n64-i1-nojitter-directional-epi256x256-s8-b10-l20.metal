@@ -68,6 +68,7 @@ constant uint SLICES = 256u;
 constant uint SLICE_SAMPLES = 256u;
 constant uint SLICE_LANES = 32u;
 constant uint STEP = 8u;
+constant uint SLICE_RUNS = 32u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
 
@@ -108,11 +109,11 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float g,
+    float g_1,
     float cos_theta
 ) {
-    float denom = metal::max((1.0 + (g * g)) - ((2.0 * g) * cos_theta), 0.00000001);
-    return (1.0 - (g * g)) / ((12.566371 * denom) * metal::sqrt(denom));
+    float denom = metal::max((1.0 + (g_1 * g_1)) - ((2.0 * g_1) * cos_theta), 0.00000001);
+    return (1.0 - (g_1 * g_1)) / ((12.566371 * denom) * metal::sqrt(denom));
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -128,11 +129,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t_1,
-    float a,
-    float b
+    float a_1,
+    float b_1
 ) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
-    return metal::exp(-(sigma_t_1) * a) * _e7;
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b_1 - a_1);
+    return metal::exp(-(sigma_t_1) * a_1) * _e7;
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -171,14 +172,14 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
     metal::float3 eye_1,
     metal::float3 dir_1,
     metal::float3 light_pos_1,
-    float a_1,
-    float b_1,
+    float a_2,
+    float b_2,
     uint n
 ) {
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
-    float h_1 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
-    float theta_a = metal::atan((a_1 - t0_) / h_1);
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_, h_1, theta_a, (metal::atan((b_1 - t0_) / h_1) - theta_a) / static_cast<float>(n)};
+    float h_1 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float theta_a = metal::atan((a_2 - t0_) / h_1);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_, h_1, theta_a, (metal::atan((b_2 - t0_) / h_1) - theta_a) / static_cast<float>(n)};
 }
 
 metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -292,13 +293,13 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_2,
-    float b_2,
+    float a_3,
+    float b_3,
     float depth_break
 ) {
     bool local_8 = {};
-    if (!((a_2 == b_2))) {
-        local_8 = metal::abs(a_2 - b_2) <= (depth_break * metal::min(a_2, b_2));
+    if (!((a_3 == b_3))) {
+        local_8 = metal::abs(a_3 - b_3) <= (depth_break * metal::min(a_3, b_3));
     } else {
         local_8 = true;
     }
@@ -333,9 +334,9 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     bool local_9 = {};
     bool local_10 = {};
     bool local_11 = {};
-    float a_3 = 0.0;
-    float b_3 = 0.0;
-    uint k_4 = 0u;
+    float a_4 = 0.0;
+    float b_4 = 0.0;
+    uint k_5 = 0u;
     metal::float2 size_1 = static_cast<metal::float2>(screen);
     metal::float2 centre = 0.5 * size_1;
     float z_2 = metal::dot(cam.toward, cam.forward);
@@ -392,38 +393,38 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
             if (metal::all(loop_bound == uint2(0u))) { break; }
             loop_bound -= uint2(loop_bound.y == 0u, 1u);
             if (!loop_init) {
-                uint _e153 = k_4;
-                k_4 = _e153 + 1u;
+                uint _e153 = k_5;
+                k_5 = _e153 + 1u;
             }
             loop_init = false;
-            uint _e118 = k_4;
+            uint _e118 = k_5;
             if (_e118 < 4u) {
             } else {
                 break;
             }
             {
-                uint _e123 = k_4;
-                uint _e131 = k_4;
+                uint _e123 = k_5;
+                uint _e131 = k_5;
                 metal::float2 corner = metal::float2(((_e123 & 1u) != 0u) ? hi.x : lo.x, ((_e131 & 2u) != 0u) ? hi.y : lo.y);
                 metal::float2 _e139 = l.axis;
                 metal::float2 _e140 = origin;
                 float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, corner - _e140);
-                uint _e143 = k_4;
+                uint _e143 = k_5;
                 if (_e143 == 0u) {
-                    a_3 = _e142;
-                    b_3 = _e142;
+                    a_4 = _e142;
+                    b_4 = _e142;
                 } else {
-                    float _e148 = a_3;
-                    a_3 = metal::min(_e148, _e142);
-                    float _e150 = b_3;
-                    b_3 = metal::max(_e150, _e142);
+                    float _e148 = a_4;
+                    a_4 = metal::min(_e148, _e142);
+                    float _e150 = b_4;
+                    b_4 = metal::max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_3;
+        float _e156 = a_4;
         l.phi_start = _e156;
-        float _e158 = b_3;
-        float _e159 = a_3;
+        float _e158 = b_4;
+        float _e159 = a_4;
         l.dphi = (_e158 - _e159) / static_cast<float>(slices);
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l;
@@ -448,7 +449,7 @@ metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 ) {
     float t_in = 0.0;
     float t_out = 340000000000000000000000000000000000000.0;
-    uint a_4 = 0u;
+    uint a_5 = 0u;
     metal::float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2, s_1);
     metal::float2 lo_1 = metal::float2(0.5, 0.5);
     metal::float2 hi_1 = static_cast<metal::float2>(screen_1) - metal::float2(0.5, 0.5);
@@ -458,25 +459,25 @@ metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
         if (metal::all(loop_bound_1 == uint2(0u))) { break; }
         loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
         if (!loop_init_1) {
-            uint _e51 = a_4;
-            a_4 = _e51 + 1u;
+            uint _e51 = a_5;
+            a_5 = _e51 + 1u;
         }
         loop_init_1 = false;
-        uint _e16 = a_4;
+        uint _e16 = a_5;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            uint _e19 = a_4;
+            uint _e19 = a_5;
             if (metal::abs(_e5[metal::min(unsigned(_e19), 1u)]) > 0.000000000001) {
-                uint _e24 = a_4;
-                uint _e27 = a_4;
-                uint _e30 = a_4;
+                uint _e24 = a_5;
+                uint _e27 = a_5;
+                uint _e30 = a_5;
                 float ta = (lo_1[metal::min(unsigned(_e24), 1u)] - l_2.origin[metal::min(unsigned(_e27), 1u)]) / _e5[metal::min(unsigned(_e30), 1u)];
-                uint _e33 = a_4;
-                uint _e36 = a_4;
-                uint _e39 = a_4;
+                uint _e33 = a_5;
+                uint _e36 = a_5;
+                uint _e39 = a_5;
                 float tb = (hi_1[metal::min(unsigned(_e33), 1u)] - l_2.origin[metal::min(unsigned(_e36), 1u)]) / _e5[metal::min(unsigned(_e39), 1u)];
                 float _e43 = t_in;
                 t_in = metal::max(_e43, metal::min(ta, tb));
@@ -502,10 +503,10 @@ metal::uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_3,
     metal::float2 u,
     metal::float2 span,
-    uint k_5,
+    uint k_6,
     metal::uint2 screen_2
 ) {
-    metal::float2 p_2 = l_3.origin + (u * (span.x + (static_cast<float>(k_5) * span.y)));
+    metal::float2 p_2 = l_3.origin + (u * (span.x + (static_cast<float>(k_6) * span.y)));
     metal::float2 last = static_cast<metal::float2>(screen_2) - metal::float2(1.0, 1.0);
     return naga_f2u32(metal::clamp(metal::floor(p_2), metal::float2(0.0, 0.0), last));
 }
@@ -603,46 +604,19 @@ metal::float3 raymarch_pixel(
 }
 
 metal::uint2 line_bracket(
-    uint k_6,
-    threadgroup type_12& line_flag
+    uint k_7,
+    threadgroup type_12& line_ab
 ) {
-    uint a_5 = {};
-    uint b_4 = {};
-    a_5 = k_6;
-    uint2 loop_bound_3 = uint2(4294967295u);
-    while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        uint _e3 = a_5;
-        uint _e5 = line_flag.inner[metal::min(unsigned(_e3), 255u)];
-        if (_e5 == 0u) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_5;
-            a_5 = _e8 - 1u;
-        }
-    }
-    b_4 = k_6;
-    uint2 loop_bound_4 = uint2(4294967295u);
-    while(true) {
-        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        uint _e13 = b_4;
-        uint _e15 = line_flag.inner[metal::min(unsigned(_e13), 255u)];
-        if (_e15 == 0u) {
-        } else {
-            break;
-        }
-        {
-            uint _e18 = b_4;
-            b_4 = _e18 + 1u;
-        }
-    }
-    uint _e21 = a_5;
-    uint _e22 = b_4;
-    return metal::uint2(_e21, _e22);
+    uint v_6 = line_ab.inner[metal::min(unsigned(k_7), 255u)];
+    return metal::uint2(v_6 & 65535u, v_6 >> 16u);
+}
+
+bool line_marked(
+    uint k_8,
+    threadgroup type_12& line_ab
+) {
+    uint _e3 = line_ab.inner[metal::min(unsigned(k_8), 255u)];
+    return (_e3 & 65535u) == k_8;
 }
 
 bool line_spread_over(
@@ -667,7 +641,7 @@ kernel void raymarch(
 , metal::texture2d<float, metal::access::write> output [[texture(2)]]
 , device metal::atomic_uint& fallback_count [[buffer(1)]]
 , threadgroup type_11& line_depth
-, threadgroup type_12& line_flag
+, threadgroup type_12& line_ab
 , threadgroup type_13& line_light
 , threadgroup type_12& line_list
 , threadgroup metal::atomic_uint& line_count
@@ -675,7 +649,7 @@ kernel void raymarch(
 ) {
     if (li == 0u) {
         line_depth = {};
-        line_flag = {};
+        line_ab = {};
         line_light = {};
         line_list = {};
         metal::atomic_store_explicit(&line_count, 0, metal::memory_order_relaxed);
@@ -683,16 +657,20 @@ kernel void raymarch(
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     uint k = {};
+    uint g = {};
+    uint a = {};
     uint k_1 = {};
     bool local = {};
     bool marked = {};
     bool local_1 = {};
     bool local_2 = {};
-    uint e = {};
+    uint b = {};
     uint k_2 = {};
+    uint e = {};
+    uint k_3 = {};
     bool local_3 = {};
     uint e_1 = {};
-    uint k_3 = {};
+    uint k_4 = {};
     metal::float3 c = {};
     uint _e3 = frame.sizes.x;
     uint _e7 = frame.sizes.y;
@@ -716,11 +694,11 @@ kernel void raymarch(
         }
     }
     k = li;
-    uint2 loop_bound_5 = uint2(4294967295u);
+    uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
             uint _e87 = k;
             k = _e87 + SLICE_LANES;
@@ -741,70 +719,128 @@ kernel void raymarch(
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    k_1 = li;
-    uint2 loop_bound_6 = uint2(4294967295u);
+    g = li;
+    uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
-        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e166 = k_1;
-            k_1 = _e166 + SLICE_LANES;
+            uint _e220 = g;
+            g = _e220 + SLICE_LANES;
         }
         loop_init_4 = false;
-        uint _e91 = k_1;
-        if (_e91 < SLICE_SAMPLES) {
+        uint _e91 = g;
+        if (_e91 < SLICE_RUNS) {
         } else {
             break;
         }
         {
-            uint _e94 = k_1;
-            if (!((naga_mod(_e94, STEP) == 0u))) {
-                uint _e100 = k_1;
-                local = _e100 == 255u;
-            } else {
-                local = true;
+            uint _e94 = g;
+            uint s0_ = _e94 * STEP;
+            uint e_3 = metal::min(s0_ + STEP, SLICE_SAMPLES);
+            a = s0_;
+            k_1 = s0_;
+            uint2 loop_bound_5 = uint2(4294967295u);
+            bool loop_init_5 = true;
+            while(true) {
+                if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+                if (!loop_init_5) {
+                    uint _e183 = k_1;
+                    k_1 = _e183 + 1u;
+                }
+                loop_init_5 = false;
+                uint _e103 = k_1;
+                if (_e103 < e_3) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e105 = k_1;
+                    if (!((naga_mod(_e105, STEP) == 0u))) {
+                        uint _e111 = k_1;
+                        local = _e111 == 255u;
+                    } else {
+                        local = true;
+                    }
+                    bool _e117 = local;
+                    marked = _e117;
+                    uint _e119 = k_1;
+                    if (_e119 > 0u) {
+                        uint _e122 = k_1;
+                        float _e127 = line_depth.inner[metal::min(unsigned(_e122 - 1u), 255u)];
+                        uint _e129 = k_1;
+                        float _e131 = line_depth.inner[metal::min(unsigned(_e129), 255u)];
+                        bool _e133 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e127, _e131, DEPTH_BREAK);
+                        local_1 = !(_e133);
+                    } else {
+                        local_1 = false;
+                    }
+                    bool _e138 = local_1;
+                    if (_e138) {
+                        marked = true;
+                    }
+                    uint _e140 = k_1;
+                    if ((_e140 + 1u) < SLICE_SAMPLES) {
+                        uint _e146 = k_1;
+                        float _e148 = line_depth.inner[metal::min(unsigned(_e146), 255u)];
+                        uint _e149 = k_1;
+                        float _e154 = line_depth.inner[metal::min(unsigned(_e149 + 1u), 255u)];
+                        bool _e156 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e148, _e154, DEPTH_BREAK);
+                        local_2 = !(_e156);
+                    } else {
+                        local_2 = false;
+                    }
+                    bool _e161 = local_2;
+                    if (_e161) {
+                        marked = true;
+                    }
+                    bool _e163 = marked;
+                    if (_e163) {
+                        uint _e164 = k_1;
+                        a = _e164;
+                        uint _e167 = metal::atomic_fetch_add_explicit(&line_count, 1u, metal::memory_order_relaxed);
+                        uint _e170 = k_1;
+                        line_list.inner[metal::min(unsigned(_e167), 255u)] = _e170;
+                    }
+                    uint _e172 = k_1;
+                    uint _e174 = a;
+                    uint _e176 = k_1;
+                    bool _e177 = marked;
+                    line_ab.inner[metal::min(unsigned(_e172), 255u)] = _e174 | ((_e177 ? _e176 : 65535u) << 16u);
+                }
             }
-            bool _e106 = local;
-            marked = _e106;
-            uint _e108 = k_1;
-            if (_e108 > 0u) {
-                uint _e111 = k_1;
-                float _e116 = line_depth.inner[metal::min(unsigned(_e111 - 1u), 255u)];
-                uint _e118 = k_1;
-                float _e120 = line_depth.inner[metal::min(unsigned(_e118), 255u)];
-                bool _e122 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e116, _e120, DEPTH_BREAK);
-                local_1 = !(_e122);
-            } else {
-                local_1 = false;
-            }
-            bool _e127 = local_1;
-            if (_e127) {
-                marked = true;
-            }
-            uint _e129 = k_1;
-            if ((_e129 + 1u) < SLICE_SAMPLES) {
-                uint _e135 = k_1;
-                float _e137 = line_depth.inner[metal::min(unsigned(_e135), 255u)];
-                uint _e138 = k_1;
-                float _e143 = line_depth.inner[metal::min(unsigned(_e138 + 1u), 255u)];
-                bool _e145 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e137, _e143, DEPTH_BREAK);
-                local_2 = !(_e145);
-            } else {
-                local_2 = false;
-            }
-            bool _e150 = local_2;
-            if (_e150) {
-                marked = true;
-            }
-            uint _e153 = k_1;
-            bool _e157 = marked;
-            line_flag.inner[metal::min(unsigned(_e153), 255u)] = _e157 ? 1u : 0u;
-            bool _e159 = marked;
-            if (_e159) {
-                uint _e162 = metal::atomic_fetch_add_explicit(&line_count, 1u, metal::memory_order_relaxed);
-                uint _e165 = k_1;
-                line_list.inner[metal::min(unsigned(_e162), 255u)] = _e165;
+            b = metal::min(e_3, 255u);
+            k_2 = e_3;
+            uint2 loop_bound_6 = uint2(4294967295u);
+            bool loop_init_6 = true;
+            while(true) {
+                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                if (!loop_init_6) {
+                    uint _e218 = k_2;
+                    k_2 = _e218 - 1u;
+                }
+                loop_init_6 = false;
+                uint _e189 = k_2;
+                if (_e189 > s0_) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e191 = k_2;
+                    uint v_7 = line_ab.inner[metal::min(unsigned(_e191 - 1u), 255u)];
+                    uint _e199 = k_2;
+                    if ((v_7 & 65535u) == (_e199 - 1u)) {
+                        uint _e203 = k_2;
+                        b = _e203 - 1u;
+                    } else {
+                        uint _e206 = k_2;
+                        uint _e213 = b;
+                        line_ab.inner[metal::min(unsigned(_e206 - 1u), 255u)] = (v_7 & 65535u) | (_e213 << 16u);
+                    }
+                }
             }
         }
     }
@@ -812,62 +848,62 @@ kernel void raymarch(
     uint n_3 = metal::atomic_load_explicit(&line_count, metal::memory_order_relaxed);
     e = li;
     uint2 loop_bound_7 = uint2(4294967295u);
-    bool loop_init_5 = true;
+    bool loop_init_7 = true;
     while(true) {
         if (metal::all(loop_bound_7 == uint2(0u))) { break; }
         loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-        if (!loop_init_5) {
-            uint _e185 = e;
-            e = _e185 + SLICE_LANES;
+        if (!loop_init_7) {
+            uint _e239 = e;
+            e = _e239 + SLICE_LANES;
         }
-        loop_init_5 = false;
-        uint _e172 = e;
-        if (_e172 < n_3) {
+        loop_init_7 = false;
+        uint _e226 = e;
+        if (_e226 < n_3) {
         } else {
             break;
         }
         {
-            uint _e175 = e;
-            uint k_7 = line_list.inner[metal::min(unsigned(_e175), 255u)];
-            metal::uint2 _e178 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
-            metal::float3 _e183 = raymarch_pixel(_e178.x, _e178.y, frame, depth, shadow_map);
-            metal::float3 _e184 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e183);
-            line_light.inner[metal::min(unsigned(k_7), 255u)] = _e184;
+            uint _e229 = e;
+            uint k_9 = line_list.inner[metal::min(unsigned(_e229), 255u)];
+            metal::uint2 _e232 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_9, screen_3);
+            metal::float3 _e237 = raymarch_pixel(_e232.x, _e232.y, frame, depth, shadow_map);
+            metal::float3 _e238 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e237);
+            line_light.inner[metal::min(unsigned(k_9), 255u)] = _e238;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    k_2 = li;
+    k_3 = li;
     uint2 loop_bound_8 = uint2(4294967295u);
-    bool loop_init_6 = true;
+    bool loop_init_8 = true;
     while(true) {
         if (metal::all(loop_bound_8 == uint2(0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
-        if (!loop_init_6) {
-            uint _e211 = k_2;
-            k_2 = _e211 + SLICE_LANES;
+        if (!loop_init_8) {
+            uint _e262 = k_3;
+            k_3 = _e262 + SLICE_LANES;
         }
-        loop_init_6 = false;
-        uint _e189 = k_2;
-        if (_e189 < SLICE_SAMPLES) {
+        loop_init_8 = false;
+        uint _e243 = k_3;
+        if (_e243 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e193 = k_2;
-            uint _e195 = line_flag.inner[metal::min(unsigned(_e193), 255u)];
-            if (_e195 == 0u) {
-                uint _e198 = k_2;
-                metal::uint2 _e199 = line_bracket(_e198, line_flag);
-                bool _e200 = line_spread_over(_e199, line_light);
-                local_3 = _e200;
+            uint _e246 = k_3;
+            bool _e247 = line_marked(_e246, line_ab);
+            if (!(_e247)) {
+                uint _e249 = k_3;
+                metal::uint2 _e250 = line_bracket(_e249, line_ab);
+                bool _e251 = line_spread_over(_e250, line_light);
+                local_3 = _e251;
             } else {
                 local_3 = false;
             }
-            bool _e204 = local_3;
-            if (_e204) {
-                uint _e207 = metal::atomic_fetch_add_explicit(&line_count_light, 1u, metal::memory_order_relaxed);
-                uint _e210 = k_2;
-                line_list.inner[metal::min(unsigned(_e207), 255u)] = _e210;
+            bool _e255 = local_3;
+            if (_e255) {
+                uint _e258 = metal::atomic_fetch_add_explicit(&line_count_light, 1u, metal::memory_order_relaxed);
+                uint _e261 = k_3;
+                line_list.inner[metal::min(unsigned(_e258), 255u)] = _e261;
             }
         }
     }
@@ -875,71 +911,71 @@ kernel void raymarch(
     uint n2_ = metal::atomic_load_explicit(&line_count_light, metal::memory_order_relaxed);
     e_1 = li;
     uint2 loop_bound_9 = uint2(4294967295u);
-    bool loop_init_7 = true;
+    bool loop_init_9 = true;
     while(true) {
         if (metal::all(loop_bound_9 == uint2(0u))) { break; }
         loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
-        if (!loop_init_7) {
-            uint _e230 = e_1;
-            e_1 = _e230 + SLICE_LANES;
+        if (!loop_init_9) {
+            uint _e281 = e_1;
+            e_1 = _e281 + SLICE_LANES;
         }
-        loop_init_7 = false;
-        uint _e217 = e_1;
-        if (_e217 < n2_) {
+        loop_init_9 = false;
+        uint _e268 = e_1;
+        if (_e268 < n2_) {
         } else {
             break;
         }
         {
-            uint _e220 = e_1;
-            uint k_8 = line_list.inner[metal::min(unsigned(_e220), 255u)];
-            metal::uint2 _e223 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-            metal::float3 _e228 = raymarch_pixel(_e223.x, _e223.y, frame, depth, shadow_map);
-            metal::float3 _e229 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e228);
-            line_light.inner[metal::min(unsigned(k_8), 255u)] = _e229;
+            uint _e271 = e_1;
+            uint k_10 = line_list.inner[metal::min(unsigned(_e271), 255u)];
+            metal::uint2 _e274 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_10, screen_3);
+            metal::float3 _e279 = raymarch_pixel(_e274.x, _e274.y, frame, depth, shadow_map);
+            metal::float3 _e280 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e279);
+            line_light.inner[metal::min(unsigned(k_10), 255u)] = _e280;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    k_3 = li;
+    k_4 = li;
     uint2 loop_bound_10 = uint2(4294967295u);
-    bool loop_init_8 = true;
+    bool loop_init_10 = true;
     while(true) {
         if (metal::all(loop_bound_10 == uint2(0u))) { break; }
         loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
-        if (!loop_init_8) {
-            uint _e288 = k_3;
-            k_3 = _e288 + SLICE_LANES;
+        if (!loop_init_10) {
+            uint _e336 = k_4;
+            k_4 = _e336 + SLICE_LANES;
         }
-        loop_init_8 = false;
-        uint _e234 = k_3;
-        if (_e234 < SLICE_SAMPLES) {
+        loop_init_10 = false;
+        uint _e285 = k_4;
+        if (_e285 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            uint _e238 = k_3;
-            metal::float3 _e240 = line_light.inner[metal::min(unsigned(_e238), 255u)];
-            c = _e240;
-            uint _e243 = k_3;
-            uint _e245 = line_flag.inner[metal::min(unsigned(_e243), 255u)];
-            if (_e245 == 0u) {
-                uint _e248 = k_3;
-                metal::uint2 _e249 = line_bracket(_e248, line_flag);
-                bool _e250 = line_spread_over(_e249, line_light);
-                if (!(_e250)) {
-                    uint _e252 = k_3;
-                    float t_4 = static_cast<float>(_e252 - _e249.x) / static_cast<float>(_e249.y - _e249.x);
-                    metal::float3 _e264 = line_light.inner[metal::min(unsigned(_e249.x), 255u)];
-                    metal::float3 _e271 = line_light.inner[metal::min(unsigned(_e249.y), 255u)];
-                    c = (_e264 * (1.0 - t_4)) + (_e271 * t_4);
+            uint _e289 = k_4;
+            metal::float3 _e291 = line_light.inner[metal::min(unsigned(_e289), 255u)];
+            c = _e291;
+            uint _e293 = k_4;
+            bool _e294 = line_marked(_e293, line_ab);
+            if (!(_e294)) {
+                uint _e296 = k_4;
+                metal::uint2 _e297 = line_bracket(_e296, line_ab);
+                bool _e298 = line_spread_over(_e297, line_light);
+                if (!(_e298)) {
+                    uint _e300 = k_4;
+                    float t_4 = static_cast<float>(_e300 - _e297.x) / static_cast<float>(_e297.y - _e297.x);
+                    metal::float3 _e312 = line_light.inner[metal::min(unsigned(_e297.x), 255u)];
+                    metal::float3 _e319 = line_light.inner[metal::min(unsigned(_e297.y), 255u)];
+                    c = (_e312 * (1.0 - t_4)) + (_e319 * t_4);
                 }
             }
-            uint _e274 = k_3;
-            float _e277 = c.x;
-            float _e279 = c.y;
-            float _e281 = c.z;
-            uint _e283 = k_3;
-            float _e285 = line_depth.inner[metal::min(unsigned(_e283), 255u)];
-            output.write(metal::float4(_e277, _e279, _e281, _e285), metal::uint2(metal::uint2(_e274, s_3)));
+            uint _e322 = k_4;
+            float _e325 = c.x;
+            float _e327 = c.y;
+            float _e329 = c.z;
+            uint _e331 = k_4;
+            float _e333 = line_depth.inner[metal::min(unsigned(_e331), 255u)];
+            output.write(metal::float4(_e325, _e327, _e329, _e333), metal::uint2(metal::uint2(_e322, s_3)));
         }
     }
     return;

@@ -56,6 +56,7 @@ const SLICES: u32 = 256u;
 const SLICE_SAMPLES: u32 = 256u;
 const SLICE_LANES: u32 = 32u;
 const STEP: u32 = 8u;
+const SLICE_RUNS: u32 = 32u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
 
@@ -70,7 +71,7 @@ var output: texture_storage_2d<rgba32float,write>;
 @group(0) @binding(5) 
 var<storage, read_write> fallback_count: atomic<u32>;
 var<workgroup> line_depth: array<f32, 256>;
-var<workgroup> line_flag: array<u32, 256>;
+var<workgroup> line_ab: array<u32, 256>;
 var<workgroup> line_light: array<vec3<f32>, 256>;
 var<workgroup> line_list: array<u32, 256>;
 var<workgroup> line_count: atomic<u32>;
@@ -104,9 +105,9 @@ fn pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_1: u32, y_1: u32)
     return (f32((_e29 >> 8u)) / 16777216f);
 }
 
-fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
-    let denom = max(((1f + (g * g)) - ((2f * g) * cos_theta)), 0.00000001f);
-    return ((1f - (g * g)) / ((12.566371f * denom) * sqrt(denom)));
+fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g_1: f32, cos_theta: f32) -> f32 {
+    let denom = max(((1f + (g_1 * g_1)) - ((2f * g_1) * cos_theta)), 0.00000001f);
+    return ((1f - (g_1 * g_1)) / ((12.566371f * denom) * sqrt(denom)));
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
@@ -117,9 +118,9 @@ fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, 
     return ((1f - exp(-(x_4))) / sigma_t);
 }
 
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a_1: f32, b_1: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
+    return (exp((-(sigma_t_1) * a_1)) * _e7);
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
@@ -141,11 +142,11 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
 }
 
-fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, light_pos_1: vec3<f32>, a_1: f32, b_1: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, light_pos_1: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
-    let h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
-    let theta_a = atan(((a_1 - t0_) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_1 - t0_) / h_1)) - theta_a) / f32(n)));
+    let h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_2 - a_2), 0.000001f)));
+    let theta_a = atan(((a_2 - t0_) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_2 - t0_) / h_1)) - theta_a) / f32(n)));
 }
 
 fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e_2: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x_2: f32) -> vec2<f32> {
@@ -236,11 +237,11 @@ fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapView
     return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
 }
 
-fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_2: f32, b_2: f32, depth_break: f32) -> bool {
+fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_3: f32, b_3: f32, depth_break: f32) -> bool {
     var local_8: bool;
 
-    if !((a_2 == b_2)) {
-        local_8 = (abs((a_2 - b_2)) <= (depth_break * min(a_2, b_2)));
+    if !((a_3 == b_3)) {
+        local_8 = (abs((a_3 - b_3)) <= (depth_break * min(a_3, b_3)));
     } else {
         local_8 = true;
     }
@@ -266,9 +267,9 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     var local_9: bool;
     var local_10: bool;
     var local_11: bool;
-    var a_3: f32 = 0f;
-    var b_3: f32 = 0f;
-    var k_4: u32 = 0u;
+    var a_4: f32 = 0f;
+    var b_4: f32 = 0f;
+    var k_5: u32 = 0u;
 
     let size_1 = vec2<f32>(screen);
     let centre = (0.5f * size_1);
@@ -321,38 +322,38 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     } else {
         l.wrap = 0u;
         loop {
-            let _e118 = k_4;
+            let _e118 = k_5;
             if (_e118 < 4u) {
             } else {
                 break;
             }
             {
-                let _e123 = k_4;
-                let _e131 = k_4;
+                let _e123 = k_5;
+                let _e131 = k_5;
                 let corner = vec2<f32>(select(lo.x, hi.x, ((_e123 & 1u) != 0u)), select(lo.y, hi.y, ((_e131 & 2u) != 0u)));
                 let _e139 = l.axis;
                 let _e140 = origin;
                 let _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
-                let _e143 = k_4;
+                let _e143 = k_5;
                 if (_e143 == 0u) {
-                    a_3 = _e142;
-                    b_3 = _e142;
+                    a_4 = _e142;
+                    b_4 = _e142;
                 } else {
-                    let _e148 = a_3;
-                    a_3 = min(_e148, _e142);
-                    let _e150 = b_3;
-                    b_3 = max(_e150, _e142);
+                    let _e148 = a_4;
+                    a_4 = min(_e148, _e142);
+                    let _e150 = b_4;
+                    b_4 = max(_e150, _e142);
                 }
             }
             continuing {
-                let _e153 = k_4;
-                k_4 = (_e153 + 1u);
+                let _e153 = k_5;
+                k_5 = (_e153 + 1u);
             }
         }
-        let _e156 = a_3;
+        let _e156 = a_4;
         l.phi_start = _e156;
-        let _e158 = b_3;
-        let _e159 = a_3;
+        let _e158 = b_4;
+        let _e159 = a_4;
         l.dphi = ((_e158 - _e159) / f32(slices));
     }
     let _e163 = l;
@@ -369,27 +370,27 @@ fn slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLay
 fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_1: u32, screen_1: vec2<u32>, samples: u32) -> vec2<f32> {
     var t_in: f32 = 0f;
     var t_out: f32 = 340000000000000000000000000000000000000f;
-    var a_4: u32 = 0u;
+    var a_5: u32 = 0u;
 
     let _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2, s_1);
     let lo_1 = vec2<f32>(0.5f, 0.5f);
     let hi_1 = (vec2<f32>(screen_1) - vec2<f32>(0.5f, 0.5f));
     loop {
-        let _e16 = a_4;
+        let _e16 = a_5;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            let _e19 = a_4;
+            let _e19 = a_5;
             if (abs(_e5[_e19]) > 0.000000000001f) {
-                let _e24 = a_4;
-                let _e27 = a_4;
-                let _e30 = a_4;
+                let _e24 = a_5;
+                let _e27 = a_5;
+                let _e30 = a_5;
                 let ta = ((lo_1[_e24] - l_2.origin[_e27]) / _e5[_e30]);
-                let _e33 = a_4;
-                let _e36 = a_4;
-                let _e39 = a_4;
+                let _e33 = a_5;
+                let _e36 = a_5;
+                let _e39 = a_5;
                 let tb = ((hi_1[_e33] - l_2.origin[_e36]) / _e5[_e39]);
                 let _e43 = t_in;
                 t_in = max(_e43, min(ta, tb));
@@ -398,8 +399,8 @@ fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_
             }
         }
         continuing {
-            let _e51 = a_4;
-            a_4 = (_e51 + 1u);
+            let _e51 = a_5;
+            a_5 = (_e51 + 1u);
         }
     }
     let _e53 = t_out;
@@ -411,8 +412,8 @@ fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_
     return vec2<f32>(_e56, ((_e57 - _e58) / f32((samples - 1u))));
 }
 
-fn slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, u: vec2<f32>, span: vec2<f32>, k_5: u32, screen_2: vec2<u32>) -> vec2<u32> {
-    let p_2 = (l_3.origin + (u * (span.x + (f32(k_5) * span.y))));
+fn slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, u: vec2<f32>, span: vec2<f32>, k_6: u32, screen_2: vec2<u32>) -> vec2<u32> {
+    let p_2 = (l_3.origin + (u * (span.x + (f32(k_6) * span.y))));
     let last = (vec2<f32>(screen_2) - vec2<f32>(1f, 1f));
     return vec2<u32>(clamp(floor(p_2), vec2<f32>(0f, 0f), last));
 }
@@ -494,39 +495,14 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     return c_2;
 }
 
-fn line_bracket(k_6: u32) -> vec2<u32> {
-    var a_5: u32;
-    var b_4: u32;
+fn line_bracket(k_7: u32) -> vec2<u32> {
+    let v_6 = line_ab[k_7];
+    return vec2<u32>((v_6 & 65535u), (v_6 >> 16u));
+}
 
-    a_5 = k_6;
-    loop {
-        let _e3 = a_5;
-        let _e5 = line_flag[_e3];
-        if (_e5 == 0u) {
-        } else {
-            break;
-        }
-        {
-            let _e8 = a_5;
-            a_5 = (_e8 - 1u);
-        }
-    }
-    b_4 = k_6;
-    loop {
-        let _e13 = b_4;
-        let _e15 = line_flag[_e13];
-        if (_e15 == 0u) {
-        } else {
-            break;
-        }
-        {
-            let _e18 = b_4;
-            b_4 = (_e18 + 1u);
-        }
-    }
-    let _e21 = a_5;
-    let _e22 = b_4;
-    return vec2<u32>(_e21, _e22);
+fn line_marked(k_8: u32) -> bool {
+    let _e3 = line_ab[k_8];
+    return ((_e3 & 65535u) == k_8);
 }
 
 fn line_spread_over(ab: vec2<u32>) -> bool {
@@ -540,16 +516,20 @@ fn line_spread_over(ab: vec2<u32>) -> bool {
 @compute @workgroup_size(32, 1, 1) 
 fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     var k: u32;
+    var g: u32;
+    var a: u32;
     var k_1: u32;
     var local: bool;
     var marked: bool;
     var local_1: bool;
     var local_2: bool;
-    var e: u32;
+    var b: u32;
     var k_2: u32;
+    var e: u32;
+    var k_3: u32;
     var local_3: bool;
     var e_1: u32;
-    var k_3: u32;
+    var k_4: u32;
     var c: vec3<f32>;
 
     let _e3 = frame.sizes.x;
@@ -593,180 +573,228 @@ fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_ind
         }
     }
     workgroupBarrier();
-    k_1 = li;
+    g = li;
     loop {
-        let _e91 = k_1;
-        if (_e91 < SLICE_SAMPLES) {
+        let _e91 = g;
+        if (_e91 < SLICE_RUNS) {
         } else {
             break;
         }
         {
-            let _e94 = k_1;
-            if !(((_e94 % STEP) == 0u)) {
-                let _e100 = k_1;
-                local = (_e100 == 255u);
-            } else {
-                local = true;
+            let _e94 = g;
+            let s0_ = (_e94 * STEP);
+            let e_3 = min((s0_ + STEP), SLICE_SAMPLES);
+            a = s0_;
+            k_1 = s0_;
+            loop {
+                let _e103 = k_1;
+                if (_e103 < e_3) {
+                } else {
+                    break;
+                }
+                {
+                    let _e105 = k_1;
+                    if !(((_e105 % STEP) == 0u)) {
+                        let _e111 = k_1;
+                        local = (_e111 == 255u);
+                    } else {
+                        local = true;
+                    }
+                    let _e117 = local;
+                    marked = _e117;
+                    let _e119 = k_1;
+                    if (_e119 > 0u) {
+                        let _e122 = k_1;
+                        let _e127 = line_depth[(_e122 - 1u)];
+                        let _e129 = k_1;
+                        let _e131 = line_depth[_e129];
+                        let _e133 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e127, _e131, DEPTH_BREAK);
+                        local_1 = !(_e133);
+                    } else {
+                        local_1 = false;
+                    }
+                    let _e138 = local_1;
+                    if _e138 {
+                        marked = true;
+                    }
+                    let _e140 = k_1;
+                    if ((_e140 + 1u) < SLICE_SAMPLES) {
+                        let _e146 = k_1;
+                        let _e148 = line_depth[_e146];
+                        let _e149 = k_1;
+                        let _e154 = line_depth[(_e149 + 1u)];
+                        let _e156 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e148, _e154, DEPTH_BREAK);
+                        local_2 = !(_e156);
+                    } else {
+                        local_2 = false;
+                    }
+                    let _e161 = local_2;
+                    if _e161 {
+                        marked = true;
+                    }
+                    let _e163 = marked;
+                    if _e163 {
+                        let _e164 = k_1;
+                        a = _e164;
+                        let _e167 = atomicAdd((&line_count), 1u);
+                        let _e170 = k_1;
+                        line_list[_e167] = _e170;
+                    }
+                    let _e172 = k_1;
+                    let _e174 = a;
+                    let _e176 = k_1;
+                    let _e177 = marked;
+                    line_ab[_e172] = (_e174 | (select(65535u, _e176, _e177) << 16u));
+                }
+                continuing {
+                    let _e183 = k_1;
+                    k_1 = (_e183 + 1u);
+                }
             }
-            let _e106 = local;
-            marked = _e106;
-            let _e108 = k_1;
-            if (_e108 > 0u) {
-                let _e111 = k_1;
-                let _e116 = line_depth[(_e111 - 1u)];
-                let _e118 = k_1;
-                let _e120 = line_depth[_e118];
-                let _e122 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e116, _e120, DEPTH_BREAK);
-                local_1 = !(_e122);
-            } else {
-                local_1 = false;
-            }
-            let _e127 = local_1;
-            if _e127 {
-                marked = true;
-            }
-            let _e129 = k_1;
-            if ((_e129 + 1u) < SLICE_SAMPLES) {
-                let _e135 = k_1;
-                let _e137 = line_depth[_e135];
-                let _e138 = k_1;
-                let _e143 = line_depth[(_e138 + 1u)];
-                let _e145 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e137, _e143, DEPTH_BREAK);
-                local_2 = !(_e145);
-            } else {
-                local_2 = false;
-            }
-            let _e150 = local_2;
-            if _e150 {
-                marked = true;
-            }
-            let _e153 = k_1;
-            let _e157 = marked;
-            line_flag[_e153] = select(0u, 1u, _e157);
-            let _e159 = marked;
-            if _e159 {
-                let _e162 = atomicAdd((&line_count), 1u);
-                let _e165 = k_1;
-                line_list[_e162] = _e165;
+            b = min(e_3, 255u);
+            k_2 = e_3;
+            loop {
+                let _e189 = k_2;
+                if (_e189 > s0_) {
+                } else {
+                    break;
+                }
+                {
+                    let _e191 = k_2;
+                    let v_7 = line_ab[(_e191 - 1u)];
+                    let _e199 = k_2;
+                    if ((v_7 & 65535u) == (_e199 - 1u)) {
+                        let _e203 = k_2;
+                        b = (_e203 - 1u);
+                    } else {
+                        let _e206 = k_2;
+                        let _e213 = b;
+                        line_ab[(_e206 - 1u)] = ((v_7 & 65535u) | (_e213 << 16u));
+                    }
+                }
+                continuing {
+                    let _e218 = k_2;
+                    k_2 = (_e218 - 1u);
+                }
             }
         }
         continuing {
-            let _e166 = k_1;
-            k_1 = (_e166 + SLICE_LANES);
+            let _e220 = g;
+            g = (_e220 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let n_3 = atomicLoad((&line_count));
     e = li;
     loop {
-        let _e172 = e;
-        if (_e172 < n_3) {
+        let _e226 = e;
+        if (_e226 < n_3) {
         } else {
             break;
         }
         {
-            let _e175 = e;
-            let k_7 = line_list[_e175];
-            let _e178 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_7, screen_3);
-            let _e183 = raymarch_pixel(_e178.x, _e178.y);
-            let _e184 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e183);
-            line_light[k_7] = _e184;
+            let _e229 = e;
+            let k_9 = line_list[_e229];
+            let _e232 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_9, screen_3);
+            let _e237 = raymarch_pixel(_e232.x, _e232.y);
+            let _e238 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e237);
+            line_light[k_9] = _e238;
         }
         continuing {
-            let _e185 = e;
-            e = (_e185 + SLICE_LANES);
+            let _e239 = e;
+            e = (_e239 + SLICE_LANES);
         }
     }
     workgroupBarrier();
-    k_2 = li;
+    k_3 = li;
     loop {
-        let _e189 = k_2;
-        if (_e189 < SLICE_SAMPLES) {
+        let _e243 = k_3;
+        if (_e243 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e193 = k_2;
-            let _e195 = line_flag[_e193];
-            if (_e195 == 0u) {
-                let _e198 = k_2;
-                let _e199 = line_bracket(_e198);
-                let _e200 = line_spread_over(_e199);
-                local_3 = _e200;
+            let _e246 = k_3;
+            let _e247 = line_marked(_e246);
+            if !(_e247) {
+                let _e249 = k_3;
+                let _e250 = line_bracket(_e249);
+                let _e251 = line_spread_over(_e250);
+                local_3 = _e251;
             } else {
                 local_3 = false;
             }
-            let _e204 = local_3;
-            if _e204 {
-                let _e207 = atomicAdd((&line_count_light), 1u);
-                let _e210 = k_2;
-                line_list[_e207] = _e210;
+            let _e255 = local_3;
+            if _e255 {
+                let _e258 = atomicAdd((&line_count_light), 1u);
+                let _e261 = k_3;
+                line_list[_e258] = _e261;
             }
         }
         continuing {
-            let _e211 = k_2;
-            k_2 = (_e211 + SLICE_LANES);
+            let _e262 = k_3;
+            k_3 = (_e262 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let n2_ = atomicLoad((&line_count_light));
     e_1 = li;
     loop {
-        let _e217 = e_1;
-        if (_e217 < n2_) {
+        let _e268 = e_1;
+        if (_e268 < n2_) {
         } else {
             break;
         }
         {
-            let _e220 = e_1;
-            let k_8 = line_list[_e220];
-            let _e223 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_8, screen_3);
-            let _e228 = raymarch_pixel(_e223.x, _e223.y);
-            let _e229 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e228);
-            line_light[k_8] = _e229;
+            let _e271 = e_1;
+            let k_10 = line_list[_e271];
+            let _e274 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_10, screen_3);
+            let _e279 = raymarch_pixel(_e274.x, _e274.y);
+            let _e280 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e279);
+            line_light[k_10] = _e280;
         }
         continuing {
-            let _e230 = e_1;
-            e_1 = (_e230 + SLICE_LANES);
+            let _e281 = e_1;
+            e_1 = (_e281 + SLICE_LANES);
         }
     }
     workgroupBarrier();
-    k_3 = li;
+    k_4 = li;
     loop {
-        let _e234 = k_3;
-        if (_e234 < SLICE_SAMPLES) {
+        let _e285 = k_4;
+        if (_e285 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e238 = k_3;
-            let _e240 = line_light[_e238];
-            c = _e240;
-            let _e243 = k_3;
-            let _e245 = line_flag[_e243];
-            if (_e245 == 0u) {
-                let _e248 = k_3;
-                let _e249 = line_bracket(_e248);
-                let _e250 = line_spread_over(_e249);
-                if !(_e250) {
-                    let _e252 = k_3;
-                    let t_4 = (f32((_e252 - _e249.x)) / f32((_e249.y - _e249.x)));
-                    let _e264 = line_light[_e249.x];
-                    let _e271 = line_light[_e249.y];
-                    c = ((_e264 * (1f - t_4)) + (_e271 * t_4));
+            let _e289 = k_4;
+            let _e291 = line_light[_e289];
+            c = _e291;
+            let _e293 = k_4;
+            let _e294 = line_marked(_e293);
+            if !(_e294) {
+                let _e296 = k_4;
+                let _e297 = line_bracket(_e296);
+                let _e298 = line_spread_over(_e297);
+                if !(_e298) {
+                    let _e300 = k_4;
+                    let t_4 = (f32((_e300 - _e297.x)) / f32((_e297.y - _e297.x)));
+                    let _e312 = line_light[_e297.x];
+                    let _e319 = line_light[_e297.y];
+                    c = ((_e312 * (1f - t_4)) + (_e319 * t_4));
                 }
             }
-            let _e274 = k_3;
-            let _e277 = c.x;
-            let _e279 = c.y;
-            let _e281 = c.z;
-            let _e283 = k_3;
-            let _e285 = line_depth[_e283];
-            textureStore(output, vec2<u32>(_e274, s_3), vec4<f32>(_e277, _e279, _e281, _e285));
+            let _e322 = k_4;
+            let _e325 = c.x;
+            let _e327 = c.y;
+            let _e329 = c.z;
+            let _e331 = k_4;
+            let _e333 = line_depth[_e331];
+            textureStore(output, vec2<u32>(_e322, s_3), vec4<f32>(_e325, _e327, _e329, _e333));
         }
         continuing {
-            let _e288 = k_3;
-            k_3 = (_e288 + SLICE_LANES);
+            let _e336 = k_4;
+            k_4 = (_e336 + SLICE_LANES);
         }
     }
     return;

@@ -40,6 +40,7 @@ const uint SLICES = 256u;
 const uint SLICE_SAMPLES = 256u;
 const uint SLICE_LANES = 32u;
 const uint STEP = 8u;
+const uint SLICE_RUNS = 32u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
 

@@ -53,6 +53,7 @@ static const uint SLICES = 256u;
 static const uint SLICE_SAMPLES = 256u;
 static const uint SLICE_LANES = 32u;
 static const uint STEP = 8u;
+static const uint SLICE_RUNS = 32u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
 

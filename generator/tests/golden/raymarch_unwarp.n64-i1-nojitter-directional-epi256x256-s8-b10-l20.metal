@@ -62,6 +62,7 @@ constant uint SLICES = 256u;
 constant uint SLICE_SAMPLES = 256u;
 constant uint SLICE_LANES = 32u;
 constant uint STEP = 8u;
+constant uint SLICE_RUNS = 32u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
 

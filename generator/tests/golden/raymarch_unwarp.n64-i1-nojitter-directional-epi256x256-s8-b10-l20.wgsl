@@ -52,6 +52,7 @@ const SLICES: u32 = 256u;
 const SLICE_SAMPLES: u32 = 256u;
 const SLICE_LANES: u32 = 32u;
 const STEP: u32 = 8u;
+const SLICE_RUNS: u32 = 32u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
 

@@ -13,6 +13,8 @@ const SLICES: u32 = {{ sampling.slices }}u;
 const SLICE_SAMPLES: u32 = {{ sampling.slice_samples }}u;
 const SLICE_LANES: u32 = {{ sampling.slice_lanes }}u;
 const STEP: u32 = {{ sampling.step }}u;
+// Runs of STEP samples from every STEP-th one (the samples pass's unit of work).
+const SLICE_RUNS: u32 = (SLICE_SAMPLES + STEP - 1u) / STEP;
 const DEPTH_BREAK: f32 = {{ sampling.depth_break }};
 const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 {%- endif %}
