@@ -5,6 +5,7 @@
 //! cargo run --release -p scatter-examples --example bench -- --out-dir docs/bench
 //! cargo run --release -p scatter-examples --example bench -- --quick --out-dir out/bench
 //! cargo run --release -p scatter-examples --example bench -- --headline-only
+//! cargo run --release -p scatter-examples --example bench -- --headline-only --headline-errors --family prefiltered --family raymarch
 //! cargo run --release -p scatter-examples --example bench -- --roofline
 //! cargo run --release -p scatter-examples --example bench -- --family raymarch --family hybrid_volume
 //! cargo run --release -p scatter-examples --example bench -- --scene-file reference/scenes/mesh_grate.json
@@ -40,6 +41,11 @@ struct Args {
     /// a kernel change before and after.
     #[arg(long, conflicts_with_all = ["quick", "no_scaling"])]
     headline_only: bool,
+    /// With `--headline-only`: also each run's rel L1 against the `shadow_map` truth at the
+    /// headline size (the truth takes about 10 s per scene on two cores), and then, for
+    /// the families run, the ratio lines the full bench reads from the headline.
+    #[arg(long, requires = "headline_only")]
+    headline_errors: bool,
     /// Only the machine's bounds (probe kernels: copy bandwidth, texel loads, filtered
     /// fetches, transcendentals, FMAs) and every kernel's cost model against them at the
     /// headline configuration (`scatter_examples::roofline`): two markdown tables printed,
@@ -97,7 +103,7 @@ fn main() -> ExitCode {
         config.cases.clear();
         config.scaling = false;
         config.headline = true;
-        config.headline_error = false;
+        config.headline_error = args.headline_errors;
     }
     if args.roofline {
         return roofline(args.frames.unwrap_or(5));
@@ -113,6 +119,11 @@ fn main() -> ExitCode {
             if args.headline_only {
                 for line in scatter_examples::bench::headline_lines(&r) {
                     println!("{line}");
+                }
+                if args.headline_errors {
+                    for line in scatter_examples::bench::ratios(&r) {
+                        println!("{line}");
+                    }
                 }
                 return Ok((r, Vec::new()));
             }
