@@ -56,7 +56,11 @@
 //! evaluated samples around it (which lie on the same surface: no break between them). It
 //! writes `epipolar_samples` (`(slice_samples + 1) x (slices + 1)`, rgba32float: radiance
 //! rounded to f16 as a per-pixel pass stores it, and the view depth of the sample's pixel;
-//! each slice's line in the last column, the layout in the last row).
+//! each slice's line in the last column, the layout in the last row). Each invocation of the
+//! pass takes runs of `step` samples from a `step`-th one: it marks them walking forward and
+//! notes in each unmarked sample the marked ones around it walking back, so that the light
+//! criterion and the interpolation read them instead of searching (searching from every
+//! sample cost the raymarch n64 samples pass 4-6 ms of 16 at 1280x720 on llvmpipe).
 //!
 //! Pass 2, `<kernel>_unwarp`, gathers every screen pixel from the two slices around its
 //! angle and the two samples around its distance from `o` on each (bilinear weights), kept

@@ -46,7 +46,7 @@ use scatter_reference::suite::{self, MediumPreset, Pose, SceneName};
 use scatter_reference::truth::{self, TruthSettings, Visibility};
 use scatter_shaderlib::family::{Family, FamilyVariant};
 use scatter_shaderlib::prefiltered::{FrameSettings, LightKind, Resolutions, prepare_frame};
-use scatter_shaderlib::raymarch::prepare_raymarch;
+use scatter_shaderlib::raymarch::{RaymarchVariant, prepare_raymarch};
 use scatter_shaderlib::sampling::{Sampling, SamplingKnobs};
 
 /// Screen of the GPU-against-mirror trials.
@@ -676,6 +676,29 @@ fn main() -> ExitCode {
                         ));
                     }
                 }
+            }
+        }
+    }
+    // The samples pass's walk over runs of `step` samples at the longest and shortest runs
+    // (the pass is shared by every family: raymarch, the cheapest body, stands for them).
+    if let Some(ctx) = gpu() {
+        let base: FamilyVariant = RaymarchVariant::default().into();
+        for step in [1, 32] {
+            let knobs = SamplingKnobs {
+                slice_samples: 128,
+                step,
+                ..SamplingKnobs::epipolar(128)
+            };
+            for pose in [Pose::Ordinary, Pose::EpipoleOnScreen] {
+                let name = format!(
+                    "sampling::{}::{}::{pose}",
+                    base.with_sampling(knobs).trial_name(),
+                    scene_label(LightKind::Directional)
+                );
+                trials.push((
+                    name,
+                    Box::new(move || epipolar_stage_trial(ctx, base, knobs, pose)),
+                ));
             }
         }
     }
