@@ -31,6 +31,8 @@ pub(crate) struct SamplingView {
     pub step: u32,
     /// Invocations per slice of the epipolar samples pass ([`SLICE_LANES`]).
     pub slice_lanes: u32,
+    /// Invocations per workgroup of the lowres pass ([`LOWRES_LANES`]).
+    pub lowres_lanes: u32,
     /// The kernel's entry point.
     pub entry: &'static str,
     /// The family kernel's entry point (`entry` without `_unwarp` or `_fallback`).
@@ -88,6 +90,7 @@ impl SamplingView {
             slice_samples: knobs.slice_samples,
             step: knobs.step,
             slice_lanes: SLICE_LANES,
+            lowres_lanes: LOWRES_LANES,
             entry: kernel.name(),
             family_entry: family_kernel.name(),
             pixel: format!("{}_pixel", family_kernel.name()),
@@ -124,15 +127,16 @@ fn wgsl_f32(v: f32) -> String {
 }
 
 /// The invocations of a family's per-pixel pass: the screen for `pixels`; for `lowres`,
-/// one workgroup of 8 x 8 invocations per 8 x 8 blocks of S x S pixels:
-/// `8 * ceil(screen.width / (8 S))` by `8 * ceil(screen.height / (8 S))`; for `epipolar`,
-/// one workgroup of [`SLICE_LANES`] invocations per slice: `SLICE_LANES * slices` by 1.
+/// one workgroup of [`LOWRES_LANES`] invocations per 8 x 8 blocks of S x S pixels:
+/// `LOWRES_LANES * ceil(screen.width / (8 S))` by `ceil(screen.height / (8 S))`; for
+/// `epipolar`, one workgroup of [`SLICE_LANES`] invocations per slice: `SLICE_LANES * slices`
+/// by 1.
 pub fn sampling_invocations(knobs: &SamplingKnobs) -> [String; 3] {
     match knobs.sampling {
         Sampling::Pixels => ["screen.width".into(), "screen.height".into(), "1".into()],
         Sampling::Lowres => [
-            format!("8 * ceil(screen.width / {})", 8 * knobs.scale),
-            format!("8 * ceil(screen.height / {})", 8 * knobs.scale),
+            format!("{LOWRES_LANES} * ceil(screen.width / {})", 8 * knobs.scale),
+            format!("ceil(screen.height / {})", 8 * knobs.scale),
             "1".into(),
         ],
         Sampling::Epipolar => [
@@ -313,6 +317,18 @@ pub const FALLBACK_TILE: u32 = 8;
 /// where the batch has nothing to do, and a slice lists 32-40 samples to evaluate at the
 /// default step (measured: the raymarch n64 samples pass at 1280x720 took 16-19 ms with 64).
 pub const SLICE_LANES: u32 = 32;
+
+/// Invocations per workgroup of the lowres pass (one workgroup per 8 x 8 blocks). Two
+/// llvmpipe batches of 8 lanes, not 64 lanes: llvmpipe runs a loop's body at least once for
+/// every 8-lane batch, under an empty mask where the batch has nothing to do, so the list of
+/// pixels a workgroup evaluates itself (usually a few, often none) cost 8 evaluations of the
+/// per-pixel body per workgroup with 64 lanes. Measured, the raymarch n64 lowres 2 pass at
+/// 1280x720 (`bench --headline-only --family raymarch`): 80-92 ms with 64 lanes, 71-77 with
+/// 16, 69-75 with 8. Not 8: with one batch per workgroup lavapipe gave minmax lowres 4 on
+/// `spot_grate` at 320x180 another image (3.66 % rel L1 against the truth where 16 and 64
+/// lanes give 1.05 %, deterministically; the stage's GPU-against-mirror trial passes at 8 on
+/// its own fixture), which this stop did not explain.
+pub const LOWRES_LANES: u32 = 16;
 
 /// Format of `epipolar_samples`.
 pub const EPIPOLAR_SAMPLES_FORMAT: &str = "rgba32float";

@@ -41,6 +41,7 @@ struct LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
 };
 
 static const uint SCALE = 4u;
+static const uint LOWRES_LANES = 16u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
 
@@ -490,7 +491,7 @@ ret_ZeroValuearray4_float3_ ZeroValuearray4_float3_() {
     return (float3[4])0;
 }
 
-[numthreads(8, 8, 1)]
+[numthreads(16, 1, 1)]
 void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
 {
     if (li == 0) {
@@ -521,7 +522,7 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
             uint _e50 = k;
-            k = (_e50 + 64u);
+            k = (_e50 + LOWRES_LANES);
         }
         loop_init_2 = false;
         uint _e18 = k;
@@ -555,13 +556,13 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
         loop_init_3 = false;
         uint _e54 = k_1;
-        if ((_e54 < 16u)) {
+        if ((_e54 < 64u)) {
         } else {
             break;
         }
         {
             uint _e58 = k_1;
-            uint e_2 = (li + (64u * _e58));
+            uint e_2 = (li + (LOWRES_LANES * _e58));
             uint2 q_1 = ((origin * SCALE) + uint2(naga_mod(e_2, 32u), naga_div(e_2, 32u)));
             if ((q_1.x < screen_3.x)) {
                 local = (q_1.y < screen_3.y);
@@ -625,7 +626,7 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
             uint _e178 = e;
-            e = (_e178 + 64u);
+            e = (_e178 + LOWRES_LANES);
         }
         loop_init_5 = false;
         uint _e154 = e;

@@ -55,6 +55,7 @@ struct type_13 {
     uint inner[1024];
 };
 constant uint SCALE = 4u;
+constant uint LOWRES_LANES = 16u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
 
@@ -569,7 +570,7 @@ kernel void raymarch(
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
             uint _e50 = k;
-            k = _e50 + 64u;
+            k = _e50 + LOWRES_LANES;
         }
         loop_init_2 = false;
         uint _e18 = k;
@@ -604,13 +605,13 @@ kernel void raymarch(
         }
         loop_init_3 = false;
         uint _e54 = k_1;
-        if (_e54 < 16u) {
+        if (_e54 < 64u) {
         } else {
             break;
         }
         {
             uint _e58 = k_1;
-            uint e_2 = li + (64u * _e58);
+            uint e_2 = li + (LOWRES_LANES * _e58);
             metal::uint2 q_1 = (origin * SCALE) + metal::uint2(naga_mod(e_2, 32u), naga_div(e_2, 32u));
             if (q_1.x < screen_3.x) {
                 local = q_1.y < screen_3.y;
@@ -675,7 +676,7 @@ kernel void raymarch(
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
             uint _e178 = e;
-            e = _e178 + 64u;
+            e = _e178 + LOWRES_LANES;
         }
         loop_init_5 = false;
         uint _e154 = e;

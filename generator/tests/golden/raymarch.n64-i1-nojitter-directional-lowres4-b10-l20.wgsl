@@ -41,6 +41,7 @@ struct LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
 }
 
 const SCALE: u32 = 4u;
+const LOWRES_LANES: u32 = 16u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
 
@@ -418,7 +419,7 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     return c_1;
 }
 
-@compute @workgroup_size(8, 8, 1) 
+@compute @workgroup_size(16, 1, 1) 
 fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     var k: u32;
     var k_1: u32 = 0u;
@@ -455,19 +456,19 @@ fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_ind
         }
         continuing {
             let _e50 = k;
-            k = (_e50 + 64u);
+            k = (_e50 + LOWRES_LANES);
         }
     }
     workgroupBarrier();
     loop {
         let _e54 = k_1;
-        if (_e54 < 16u) {
+        if (_e54 < 64u) {
         } else {
             break;
         }
         {
             let _e58 = k_1;
-            let e_2 = (li + (64u * _e58));
+            let e_2 = (li + (LOWRES_LANES * _e58));
             let q_1 = ((origin * SCALE) + vec2<u32>((e_2 % 32u), (e_2 / 32u)));
             if (q_1.x < screen_3.x) {
                 local = (q_1.y < screen_3.y);
@@ -540,7 +541,7 @@ fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_ind
         }
         continuing {
             let _e178 = e;
-            e = (_e178 + 64u);
+            e = (_e178 + LOWRES_LANES);
         }
     }
     return;

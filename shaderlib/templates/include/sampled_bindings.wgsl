@@ -2,6 +2,8 @@
 
 // The low-resolution grid's block side S, and its depth and light breaks (fractions).
 const SCALE: u32 = {{ sampling.scale }}u;
+// Invocations per workgroup (one per 8 x 8 blocks).
+const LOWRES_LANES: u32 = {{ sampling.lowres_lanes }}u;
 const DEPTH_BREAK: f32 = {{ sampling.depth_break }};
 const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 {%- endif %}

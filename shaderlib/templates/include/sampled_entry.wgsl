@@ -11,31 +11,32 @@ var<workgroup> refine: array<u32, {{ 64 * sampling.scale * sampling.scale }}>;
 var<workgroup> refine_count: atomic<u32>;
 
 // Sampling pass (`sampling = lowres`, scatter::sampling): workgroup `wid` owns the 8 x 8
-// blocks from block 8 wid. Phase 1: its invocations evaluate the 9 x 9 samples of those
+// blocks from block 8 wid. Phase 1: its LOWRES_LANES invocations evaluate the 9 x 9 samples of those
 // blocks and the next ones (sample = the block's first pixel) into workgroup memory,
 // rounded to f16 as a per-pixel pass would store them.
-// Phase 2: the invocations take the workgroup's 8 S x 8 S pixels, 64 neighbouring ones at a
-// time: each gets the blend of its taps (`lowres_blend`), or goes on the workgroup's list
-// where the taps cannot stand for it.
-// Phase 3: the invocations evaluate the listed pixels, 64 at a time (lanes stay busy where
-// a few blocks hold most of the list: an edge, the lamp). Dispatch: (ceil(W / (8 S)),
-// ceil(H / (8 S)), 1) workgroups of (8, 8, 1).
-@compute @workgroup_size(8, 8, 1)
+// Phase 2: the invocations take the workgroup's 8 S x 8 S pixels, LOWRES_LANES neighbouring
+// ones at a time: each gets the blend of its taps (`lowres_blend`), or goes on the
+// workgroup's list where the taps cannot stand for it.
+// Phase 3: the invocations evaluate the listed pixels. LOWRES_LANES = 16, not 64: llvmpipe
+// runs a loop's body at least once for every 8-lane batch, under an empty mask where the
+// batch has nothing to do, and the list is usually short or empty.
+// Dispatch: (ceil(W / (8 S)), ceil(H / (8 S)), 1) workgroups of (LOWRES_LANES, 1, 1).
+@compute @workgroup_size({{ sampling.lowres_lanes }}, 1, 1)
 fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
     let grid = lowres_grid(screen, SCALE);
     let origin = wid.xy * 8u;
-    for (var k = li; k < 81u; k += 64u) {
+    for (var k = li; k < 81u; k += LOWRES_LANES) {
         let i = min(origin + vec2<u32>(k % 9u, k / 9u), grid - vec2<u32>(1u, 1u));
         let p = lowres_pixel(i, screen, SCALE);
         tile_light[k] = round_f16({{ sampling.pixel }}(p.x, p.y));
         tile_depth[k] = textureLoad(depth, p, 0).x;
     }
     workgroupBarrier();
-    // Pixel e of the workgroup's 8 S x 8 S pixels goes to invocation e mod 64: neighbouring
-    // invocations take neighbouring pixels.
-    for (var k = 0u; k < SCALE * SCALE; k++) {
-        let e = li + 64u * k;
+    // Pixel e of the workgroup's 8 S x 8 S pixels goes to invocation e mod LOWRES_LANES:
+    // neighbouring invocations take neighbouring pixels.
+    for (var k = 0u; k < 64u * SCALE * SCALE / LOWRES_LANES; k++) {
+        let e = li + LOWRES_LANES * k;
         let q = origin * SCALE + vec2<u32>(e % (8u * SCALE), e / (8u * SCALE));
         if q.x < screen.x && q.y < screen.y {
             let t = lowres_taps(q, screen, SCALE);
@@ -57,7 +58,7 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
     }
     workgroupBarrier();
     let n = atomicLoad(&refine_count);
-    for (var e = li; e < n; e += 64u) {
+    for (var e = li; e < n; e += LOWRES_LANES) {
         let q = vec2<u32>(refine[e] & 0xffffu, refine[e] >> 16u);
         let c = {{ sampling.pixel }}(q.x, q.y);
         textureStore(output, q, vec4<f32>(c.x, c.y, c.z, 1.0));
