@@ -326,8 +326,10 @@ pub const SLICE_LANES: u32 = 32;
 /// 1280x720 (`bench --headline-only --family raymarch`): 80-92 ms with 64 lanes, 71-77 with
 /// 16, 69-75 with 8. Not 8: with one batch per workgroup lavapipe gave minmax lowres 4 on
 /// `spot_grate` at 320x180 another image (3.66 % rel L1 against the truth where 16 and 64
-/// lanes give 1.05 %, deterministically; the stage's GPU-against-mirror trial passes at 8 on
-/// its own fixture), which this stop did not explain.
+/// lanes give 1.05 %, deterministically): there the pixels the pass evaluates itself get
+/// another value from minmax's per-pixel body than the per-pixel pass gives (with 1024^2
+/// shadow and 512x512 rectified maps; the stage trial's 128^2 map does not show it). Not
+/// explained.
 pub const LOWRES_LANES: u32 = 16;
 
 /// Format of `epipolar_samples`.
