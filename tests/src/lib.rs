@@ -206,6 +206,22 @@ impl Fixture {
         format!("{}::{}", self.name, self.pose)
     }
 
+    /// The CPU mirrors' view of this fixture with a `rectified` map and `settings`.
+    pub fn cpu_frame<'a>(
+        &'a self,
+        rectified: [u32; 2],
+        settings: &'a FrameSettings,
+    ) -> scatter_reference::kernels::CpuFrame<'a> {
+        scatter_reference::kernels::CpuFrame {
+            scene: &self.scene,
+            bvh: &self.bvh,
+            gbuf: &self.gbuf,
+            shadow_map: &self.shadow_map,
+            rectified,
+            settings,
+        }
+    }
+
     /// The frame input of the epipolar families with `settings`.
     pub fn frame_input(&self, settings: FrameSettings) -> FrameInput {
         FrameInput {

@@ -496,7 +496,6 @@ fn family_table(
     pose: Pose,
     variant: AreaIvsvVariant,
 ) -> Result<String, String> {
-    use scatter_reference::kernels::CpuFrame;
     use scatter_shaderlib::family::FamilyVariant;
     use scatter_shaderlib::prefiltered::FrameSettings;
     let Some(ctx) = gpu() else {
@@ -506,14 +505,7 @@ fn family_table(
     // An area light's standard map is its point limit's: the VPL maps' template.
     let f = scatter_conformance::Fixture::area(name, pose, SCREEN, MAP);
     let settings = FrameSettings::for_screen(SCREEN[0], SCREEN[1]);
-    let frame = CpuFrame {
-        scene: &f.scene,
-        bvh: &f.bvh,
-        gbuf: &f.gbuf,
-        shadow_map: &f.shadow_map,
-        rectified: [64, 64],
-        settings: &settings,
-    };
+    let frame = f.cpu_frame([64, 64], &settings);
     let (gpu_out, report) = scatter_conformance::run_variant(Some(ctx), &v, &frame)?;
     let (cpu_out, _) = scatter_conformance::run_variant(None, &v, &frame)?;
     if report.is_some() {
@@ -562,7 +554,6 @@ const SAMPLED_POSE: f64 = 0.01;
 /// (|e(s, t) - e(p, t)| <= e(s, p)); `tests/tests/sampling.rs` checks the stage's passes
 /// against their mirrors. Reports the pixels evaluated themselves (fallback) per pose.
 fn sampled_accuracy(knobs: SamplingKnobs) -> Result<String, String> {
-    use scatter_reference::kernels::CpuFrame;
     use scatter_shaderlib::family::FamilyVariant;
     use scatter_shaderlib::prefiltered::FrameSettings;
     let Some(ctx) = gpu() else {
@@ -580,14 +571,7 @@ fn sampled_accuracy(knobs: SamplingKnobs) -> Result<String, String> {
         let [w, h] = SAMPLED_SCREEN;
         let f = scatter_conformance::Fixture::area(name, pose, SAMPLED_SCREEN, 128);
         let settings = FrameSettings::for_screen(w, h);
-        let frame = CpuFrame {
-            scene: &f.scene,
-            bvh: &f.bvh,
-            gbuf: &f.gbuf,
-            shadow_map: &f.shadow_map,
-            rectified: [64, 64],
-            settings: &settings,
-        };
+        let frame = f.cpu_frame([64, 64], &settings);
         let (pixels, _) = scatter_conformance::run_variant(Some(ctx), &per_pixel, &frame)?;
         let (out, _, listed) =
             scatter_conformance::run_variant_counted(Some(ctx), &sampled, &frame)?;
