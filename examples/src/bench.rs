@@ -430,7 +430,7 @@ pub fn headline_lines(result: &BenchResult) -> Vec<String> {
                 .join(", ");
             let error = h
                 .rel_l1_shadow_map
-                .map_or(String::new(), |e| format!(", rel L1 {:.2} %", 100.0 * e));
+                .map_or(String::new(), |e| format!(", rel L1 {:.3} %", 100.0 * e));
             format!(
                 "{} {} {}: {:.1} ms ({passes}){error}",
                 h.family,
