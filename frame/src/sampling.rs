@@ -21,20 +21,20 @@
 //! shadow edge crossing the block, the lamp on screen: the second refinement criterion of
 //! Yusov 2013).
 //!
-//! All of it is one pass of the family's per-pixel kernel: a workgroup evaluates the samples
-//! of its 8 x 8 blocks and of the next column and row of blocks (the taps of a block's
-//! pixels) into workgroup memory, then blends each of its blocks' pixels or puts it on a
-//! list, then evaluates the list with every invocation (so that the lanes stay busy where a
-//! few blocks hold most of it). A workgroup has 16 invocations (two of llvmpipe's 8-lane
-//! batches): a loop runs its body once for every batch even when the list is empty, which
-//! with 64 invocations cost the raymarch n64 lowres 2 pass 10-15 of 80-92 ms at 1280x720
-//! (`scatter_shaderlib::sampling::LOWRES_LANES`). The extra column and row cost `(9^2 - 8^2) / 8^2 = 27 %`
-//! more sample evaluations, 7 % (scale 2) or 1.7 % (scale 4) of a per-pixel evaluation
-//! (samples at block centres would need a ring on every side, 56 %); in exchange no sample
-//! texture, no second pass and no list in memory outside the workgroup exist, and the light
-//! criterion, which needs the samples' values, costs nothing extra.
+//! Three passes, as with `epipolar` below: pass 1, the family's per-pixel kernel, evaluates
+//! every sample of the grid (one invocation each) into `lowres_samples` (rgba32float:
+//! radiance rounded to f16 as a per-pixel pass stores it, and the view depth of the sample's
+//! pixel); pass 2, `<kernel>_unwarp`, blends every pixel from its four samples or lists it in
+//! `fallback_pixels`; pass 3, `<kernel>_fallback`, evaluates the listed pixels with the
+//! family's per-pixel body. Until stop 41 it was one pass: a workgroup evaluated the samples
+//! of its 8 x 8 blocks and of the next column and row (27 % more than it owned) into
+//! workgroup memory, blended its pixels or listed them, then evaluated its list, with
+//! barriers between the phases. On llvmpipe the three passes are faster (`bench
+//! --headline-only`, 1280x720, means over sphere, foliage and terrain): prefiltered m32-r8
+//! lowres 2 from 121.2 to 107.9 ms for the frame (its sampled passes 61-76 ms -> 44-56 ms),
+//! raymarch n64 lowres 2 from 74.5 to 56.4 ms and lowres 4 from 35.1 to 27.3 ms, with the same
+//! images (the sampling trials compare them with the mirror pixel by pixel).
 
-//!
 //! # The epipolar passes
 //!
 //! In-scattered light varies slowly along an epipolar line (the screen image of a plane

@@ -46,9 +46,9 @@ pub struct AreaIvsvTimes {
     pub gather: Duration,
     /// `ivsv_interleave_sum` (zero without interleaving).
     pub interleave_sum: Duration,
-    /// `ivsv_gather_unwarp` (zero without epipolar sampling).
+    /// `ivsv_gather_unwarp` (zero per pixel).
     pub unwarp: Duration,
-    /// `ivsv_gather_fallback` (zero without epipolar sampling).
+    /// `ivsv_gather_fallback` (zero per pixel).
     pub fallback: Duration,
 }
 
@@ -367,15 +367,15 @@ impl AreaIvsv {
             scan,
             gather,
             interleave_sum: crate::timer::when(self.variant.interleave > 1, interleave_sum),
-            unwarp: crate::timer::when(self.epipolar(), unwarp),
-            fallback: crate::timer::when(self.epipolar(), fallback),
+            unwarp: crate::timer::when(self.sampled(), unwarp),
+            fallback: crate::timer::when(self.sampled(), fallback),
         })
     }
 
-    /// Whether the variant samples epipolar lines (and has the `ivsv_gather_unwarp` and
-    /// `ivsv_gather_fallback` passes).
-    fn epipolar(&self) -> bool {
-        self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
+    /// Whether the variant samples (lowres or epipolar: it has the unwarp and fallback
+    /// passes).
+    fn sampled(&self) -> bool {
+        self.variant.sampling != scatter_shaderlib::sampling::Sampling::Pixels
     }
 
     /// GPU time of each pass of the last submitted [`Self::encode`], or `None` without
@@ -398,8 +398,8 @@ impl AreaIvsv {
             scan: at(1),
             gather: at(2),
             interleave_sum: crate::timer::when(interleaved, at(3)),
-            unwarp: crate::timer::when(self.epipolar(), at(3)),
-            fallback: crate::timer::when(self.epipolar(), at(4)),
+            unwarp: crate::timer::when(self.sampled(), at(3)),
+            fallback: crate::timer::when(self.sampled(), at(4)),
         }))
     }
 
@@ -483,7 +483,7 @@ impl crate::family::FamilyRuntime for AreaIvsv {
         if self.variant.interleave > 1 {
             passes.push((INTERLEAVE_SUM, t.interleave_sum));
         }
-        if self.epipolar() {
+        if self.sampled() {
             passes.push((UNWARP, t.unwarp));
             passes.push((FALLBACK, t.fallback));
         }

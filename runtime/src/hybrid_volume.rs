@@ -52,9 +52,9 @@ pub struct HybridVolumeTimes {
     pub bounds: Duration,
     /// The `volume_march` pass.
     pub march: Duration,
-    /// The `volume_march_unwarp` pass (zero without epipolar sampling).
+    /// The `volume_march_unwarp` pass (zero per pixel).
     pub unwarp: Duration,
-    /// The `volume_march_fallback` pass (zero without epipolar sampling).
+    /// The `volume_march_fallback` pass (zero per pixel).
     pub fallback: Duration,
 }
 
@@ -265,7 +265,7 @@ impl HybridVolume {
         shadow_map: &wgpu::TextureView,
         frames: u32,
     ) -> Result<HybridVolumeTimes, RuntimeError> {
-        // Without epipolar sampling there are no unwarp and fallback passes: their slots
+        // Per pixel there are no unwarp and fallback passes: their slots
         // record nothing.
         let [
             depth_columns,
@@ -298,14 +298,15 @@ impl HybridVolume {
             rectify,
             bounds,
             march,
-            unwarp: crate::timer::when(self.epipolar(), unwarp),
-            fallback: crate::timer::when(self.epipolar(), fallback),
+            unwarp: crate::timer::when(self.sampled(), unwarp),
+            fallback: crate::timer::when(self.sampled(), fallback),
         })
     }
 
-    /// Whether the variant samples epipolar lines (and has the unwarp and fallback passes).
-    fn epipolar(&self) -> bool {
-        self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
+    /// Whether the variant samples (lowres or epipolar: it has the unwarp and fallback
+    /// passes).
+    fn sampled(&self) -> bool {
+        self.variant.sampling != scatter_shaderlib::sampling::Sampling::Pixels
     }
 
     fn encode_selected(
@@ -545,7 +546,7 @@ impl crate::family::FamilyRuntime for HybridVolume {
             (BOUNDS, t.bounds),
             (MARCH, t.march),
         ];
-        if self.epipolar() {
+        if self.sampled() {
             passes.push((UNWARP, t.unwarp));
             passes.push((FALLBACK, t.fallback));
         }

@@ -54,9 +54,9 @@ pub struct MinmaxTimes {
     pub build: Duration,
     /// The `minmax_traverse` pass.
     pub march: Duration,
-    /// The `minmax_traverse_unwarp` pass (zero without epipolar sampling).
+    /// The `minmax_traverse_unwarp` pass (zero per pixel).
     pub unwarp: Duration,
-    /// The `minmax_traverse_fallback` pass (zero without epipolar sampling).
+    /// The `minmax_traverse_fallback` pass (zero per pixel).
     pub fallback: Duration,
 }
 
@@ -254,7 +254,7 @@ impl Minmax {
         shadow_map: &wgpu::TextureView,
         frames: u32,
     ) -> Result<MinmaxTimes, RuntimeError> {
-        // Without epipolar sampling there are no unwarp and fallback passes: their slots
+        // Per pixel there are no unwarp and fallback passes: their slots
         // record nothing.
         let [
             depth_columns,
@@ -287,14 +287,15 @@ impl Minmax {
             rectify,
             build,
             march,
-            unwarp: crate::timer::when(self.epipolar(), unwarp),
-            fallback: crate::timer::when(self.epipolar(), fallback),
+            unwarp: crate::timer::when(self.sampled(), unwarp),
+            fallback: crate::timer::when(self.sampled(), fallback),
         })
     }
 
-    /// Whether the variant samples epipolar lines (and has the unwarp and fallback passes).
-    fn epipolar(&self) -> bool {
-        self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
+    /// Whether the variant samples (lowres or epipolar: it has the unwarp and fallback
+    /// passes).
+    fn sampled(&self) -> bool {
+        self.variant.sampling != scatter_shaderlib::sampling::Sampling::Pixels
     }
 
     fn encode_selected(
@@ -529,7 +530,7 @@ impl crate::family::FamilyRuntime for Minmax {
             (BUILD, t.build),
             (MARCH, t.march),
         ];
-        if self.epipolar() {
+        if self.sampled() {
             passes.push((UNWARP, t.unwarp));
             passes.push((FALLBACK, t.fallback));
         }

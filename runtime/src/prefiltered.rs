@@ -112,9 +112,9 @@ pub struct PrefilteredTimes {
     pub prefilter: Duration,
     /// The `scatter` pass.
     pub scatter: Duration,
-    /// The `scatter_unwarp` pass (zero without epipolar sampling).
+    /// The `scatter_unwarp` pass (zero per pixel).
     pub unwarp: Duration,
-    /// The `scatter_fallback` pass (zero without epipolar sampling).
+    /// The `scatter_fallback` pass (zero per pixel).
     pub fallback: Duration,
 }
 
@@ -380,7 +380,7 @@ impl Prefiltered {
         inputs: &Inputs<'_>,
         frames: u32,
     ) -> Result<PrefilteredTimes, RuntimeError> {
-        // Without epipolar sampling there are no `scatter_unwarp` and `scatter_fallback`
+        // Per pixel there are no `scatter_unwarp` and `scatter_fallback`
         // passes: their slots record nothing.
         let [
             depth_columns,
@@ -410,8 +410,8 @@ impl Prefiltered {
             rectify,
             prefilter,
             scatter,
-            unwarp: crate::timer::when(self.epipolar(), unwarp),
-            fallback: crate::timer::when(self.epipolar(), fallback),
+            unwarp: crate::timer::when(self.sampled(), unwarp),
+            fallback: crate::timer::when(self.sampled(), fallback),
         })
     }
 
@@ -481,7 +481,7 @@ impl Prefiltered {
             .as_ref()
             .is_some_and(|f| f.report.rectification == Rectification::Projective);
         let (times, unwarp, fallback) = match times[..] {
-            [ref head @ .., unwarp, fallback] if self.epipolar() && times.len() == 7 => {
+            [ref head @ .., unwarp, fallback] if self.sampled() && times.len() == 7 => {
                 (head, unwarp, fallback)
             }
             _ => (&times[..], Duration::ZERO, Duration::ZERO),
@@ -508,17 +508,17 @@ impl Prefiltered {
                 kernel: SCATTER,
                 message: format!(
                     "expected {} pass times, got {}",
-                    if self.epipolar() { 7 } else { 5 },
-                    times.len() + 2 * usize::from(self.epipolar())
+                    if self.sampled() { 7 } else { 5 },
+                    times.len() + 2 * usize::from(self.sampled())
                 ),
             }),
         }
     }
 
-    /// Whether the variant samples epipolar lines (and has the `scatter_unwarp` and
-    /// `scatter_fallback` passes).
-    fn epipolar(&self) -> bool {
-        self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
+    /// Whether the variant samples (lowres or epipolar: it has the unwarp and fallback
+    /// passes).
+    fn sampled(&self) -> bool {
+        self.variant.sampling != scatter_shaderlib::sampling::Sampling::Pixels
     }
 
     /// The variant the pipelines were built for.
@@ -857,7 +857,7 @@ impl crate::family::FamilyRuntime for Prefiltered {
             (PREFILTER, t.prefilter),
             (SCATTER, t.scatter),
         ];
-        if self.epipolar() {
+        if self.sampled() {
             passes.push((SCATTER_UNWARP, t.unwarp));
             passes.push((SCATTER_FALLBACK, t.fallback));
         }

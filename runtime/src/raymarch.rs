@@ -66,9 +66,9 @@ pub struct RaymarchTimes {
     pub raymarch: Duration,
     /// The `interleave_sum` pass (zero without interleaving).
     pub interleave_sum: Duration,
-    /// The `raymarch_unwarp` pass (zero without epipolar sampling).
+    /// The `raymarch_unwarp` pass (zero per pixel).
     pub unwarp: Duration,
-    /// The `raymarch_fallback` pass (zero without epipolar sampling).
+    /// The `raymarch_fallback` pass (zero per pixel).
     pub fallback: Duration,
 }
 
@@ -269,15 +269,15 @@ impl Raymarch {
             } else {
                 Duration::ZERO
             },
-            unwarp: crate::timer::when(self.epipolar(), unwarp),
-            fallback: crate::timer::when(self.epipolar(), fallback),
+            unwarp: crate::timer::when(self.sampled(), unwarp),
+            fallback: crate::timer::when(self.sampled(), fallback),
         })
     }
 
-    /// Whether the variant samples epipolar lines (and has the `raymarch_unwarp` and
-    /// `raymarch_fallback` passes).
-    fn epipolar(&self) -> bool {
-        self.variant.sampling == scatter_shaderlib::sampling::Sampling::Epipolar
+    /// Whether the variant samples (lowres or epipolar: it has the unwarp and fallback
+    /// passes).
+    fn sampled(&self) -> bool {
+        self.variant.sampling != scatter_shaderlib::sampling::Sampling::Pixels
     }
 
     fn encode_selected(
@@ -324,11 +324,8 @@ impl Raymarch {
             } else {
                 Duration::ZERO
             },
-            unwarp: crate::timer::when(self.epipolar(), times.get(1).copied().unwrap_or_default()),
-            fallback: crate::timer::when(
-                self.epipolar(),
-                times.get(2).copied().unwrap_or_default(),
-            ),
+            unwarp: crate::timer::when(self.sampled(), times.get(1).copied().unwrap_or_default()),
+            fallback: crate::timer::when(self.sampled(), times.get(2).copied().unwrap_or_default()),
         }))
     }
 
@@ -502,7 +499,7 @@ impl crate::family::FamilyRuntime for Raymarch {
         if self.variant.interleaved() {
             passes.push((INTERLEAVE_SUM, t.interleave_sum));
         }
-        if self.epipolar() {
+        if self.sampled() {
             passes.push((UNWARP, t.unwarp));
             passes.push((FALLBACK, t.fallback));
         }

@@ -363,14 +363,25 @@ impl BindingSource {
     }
 }
 
-/// Evaluates a plan formula (an integer, a parameter name, `ceil(a / b)` of two of those, or
-/// a product of those, e.g. `16 * rectified.height`, `ceil(screen.width / 2)`) with the
-/// parameters' values.
+/// Evaluates a plan formula (an integer, a parameter name, `ceil(a / b)` of two of those, a
+/// product of those, or a sum of products, e.g. `16 * rectified.height`,
+/// `ceil(screen.width / 2) + 1`) with the parameters' values.
 ///
 /// # Errors
 ///
 /// A message naming the formula and the unknown symbol, the malformed term or the overflow.
 pub fn eval(formula: &str, params: &[(&str, u64)]) -> Result<u64, String> {
+    let mut sum: u64 = 0;
+    for product in formula.split('+') {
+        sum = sum
+            .checked_add(eval_product(formula, product, params)?)
+            .ok_or_else(|| format!("formula `{formula}` overflows 64 bits"))?;
+    }
+    Ok(sum)
+}
+
+/// One product of the formula `formula`'s sum.
+fn eval_product(formula: &str, product: &str, params: &[(&str, u64)]) -> Result<u64, String> {
     let atom = |term: &str| -> Result<u64, String> {
         if let Ok(n) = term.parse::<u64>() {
             Ok(n)
@@ -387,7 +398,7 @@ pub fn eval(formula: &str, params: &[(&str, u64)]) -> Result<u64, String> {
         }
     };
     let mut value: u64 = 1;
-    for term in formula.split('*') {
+    for term in product.split('*') {
         let term = term.trim();
         // `ceil(a / b)`: integer division rounding up (a sample grid of the screen).
         let factor =
@@ -428,5 +439,9 @@ mod tests {
         assert_eq!(eval("2 * ceil(7 / 2)", &p), Ok(8));
         assert!(eval("ceil(7 / 0)", &p).unwrap_err().contains("zero"));
         assert!(eval("ceil(7)", &p).unwrap_err().contains("a / b"));
+        assert_eq!(eval("ceil(screen.width / 2) + 1", &p), Ok(641));
+        assert_eq!(eval("2 * 3 + rectified.height * 2", &p), Ok(1030));
+        assert!(eval("1 + ", &p).unwrap_err().contains("empty term"));
+        assert!(eval("18446744073709551615 + 1", &p).is_err());
     }
 }

@@ -11,13 +11,14 @@ use crate::Kernel;
 /// What a family's per-pixel template needs of the sampling knobs (its field `sampling`).
 #[derive(Clone, Debug)]
 pub(crate) struct SamplingView {
-    /// Whether the kernel is the lowres pass (`sampling = lowres`).
+    /// Whether the kernel is one of the lowres passes (`sampling = lowres`).
     pub lowres: bool,
     /// Whether the kernel is one of the epipolar passes (`sampling = epipolar`).
     pub epipolar: bool,
-    /// Whether the kernel is the epipolar unwarp (`<kernel>_unwarp`).
+    /// Whether the kernel is the unwarp (`<kernel>_unwarp`: the gather of every pixel from
+    /// the samples, lowres or epipolar).
     pub unwarp: bool,
-    /// Whether the kernel is the epipolar fallback (`<kernel>_fallback`).
+    /// Whether the kernel is the fallback (`<kernel>_fallback`).
     pub fallback: bool,
     /// Block side S.
     pub scale: u32,
@@ -31,8 +32,6 @@ pub(crate) struct SamplingView {
     pub step: u32,
     /// Invocations per slice of the epipolar samples pass ([`SLICE_LANES`]).
     pub slice_lanes: u32,
-    /// Invocations per workgroup of the lowres pass ([`LOWRES_LANES`]).
-    pub lowres_lanes: u32,
     /// The kernel's entry point.
     pub entry: &'static str,
     /// The family kernel's entry point (`entry` without `_unwarp` or `_fallback`).
@@ -42,12 +41,14 @@ pub(crate) struct SamplingView {
     /// A WGSL expression of type `scatter::sampling::EpipolarCamera` from the kernel's
     /// uniform block.
     pub camera: String,
-    /// The family's first free binding B: `epipolar_samples` in the unwarp pass; B + 1 is
-    /// `fallback_count` and B + 2 `fallback_pixels` in the passes that bind them.
+    /// The family's first free binding B: the samples texture (`lowres_samples` or
+    /// `epipolar_samples`) in the unwarp pass; B + 1 is `fallback_count` and B + 2
+    /// `fallback_pixels` in the passes that bind them.
     pub binding: u32,
     /// The `#import scatter::sampling::{..}` line the kernel needs (empty for `pixels`).
     pub imports: &'static str,
-    /// The format of `output`: rgba32float for the epipolar samples, else rgba16float.
+    /// The format of `output`: rgba32float for the samples pass's samples, else
+    /// rgba16float.
     pub output_format: &'static str,
 }
 
@@ -67,10 +68,11 @@ impl SamplingView {
         let unwarp = kernel != family_kernel && !fallback;
         let imports = match knobs.sampling {
             Sampling::Pixels => "",
-            Sampling::Lowres => {
-                "#import scatter::sampling::{lowres_blend, lowres_grid, lowres_pixel, lowres_taps, round_f16}"
+            Sampling::Lowres | Sampling::Epipolar if fallback => "",
+            Sampling::Lowres if unwarp => {
+                "#import scatter::sampling::{lowres_blend, lowres_grid, lowres_taps}"
             }
-            Sampling::Epipolar if fallback => "",
+            Sampling::Lowres => "#import scatter::sampling::{lowres_grid, lowres_pixel, round_f16}",
             Sampling::Epipolar if unwarp => {
                 "#import scatter::sampling::{EpipolarLayout, epipolar_slices, epipolar_taps, lowres_blend}"
             }
@@ -90,15 +92,14 @@ impl SamplingView {
             slice_samples: knobs.slice_samples,
             step: knobs.step,
             slice_lanes: SLICE_LANES,
-            lowres_lanes: LOWRES_LANES,
             entry: kernel.name(),
             family_entry: family_kernel.name(),
             pixel: format!("{}_pixel", family_kernel.name()),
             camera,
             binding,
             imports,
-            output_format: if knobs.sampling == Sampling::Epipolar && !unwarp && !fallback {
-                EPIPOLAR_SAMPLES_FORMAT
+            output_format: if knobs.is_sampled() && !unwarp && !fallback {
+                SAMPLES_FORMAT
             } else {
                 "rgba16float"
             },
@@ -127,18 +128,16 @@ fn wgsl_f32(v: f32) -> String {
 }
 
 /// The invocations of a family's per-pixel pass: the screen for `pixels`; for `lowres`,
-/// one workgroup of [`LOWRES_LANES`] invocations per 8 x 8 blocks of S x S pixels:
-/// `LOWRES_LANES * ceil(screen.width / (8 S))` by `ceil(screen.height / (8 S))`; for
-/// `epipolar`, one workgroup of [`SLICE_LANES`] invocations per slice: `SLICE_LANES * slices`
-/// by 1.
+/// one per sample of the grid ([`lowres_grid_formula`]: one more than the grid where the
+/// block side divides the screen; the kernel skips the extra ones); for `epipolar`, one
+/// workgroup of [`SLICE_LANES`] invocations per slice: `SLICE_LANES * slices` by 1.
 pub fn sampling_invocations(knobs: &SamplingKnobs) -> [String; 3] {
     match knobs.sampling {
         Sampling::Pixels => ["screen.width".into(), "screen.height".into(), "1".into()],
-        Sampling::Lowres => [
-            format!("{LOWRES_LANES} * ceil(screen.width / {})", 8 * knobs.scale),
-            format!("ceil(screen.height / {})", 8 * knobs.scale),
-            "1".into(),
-        ],
+        Sampling::Lowres => {
+            let [w, h] = lowres_grid_formula(knobs.scale);
+            [w, h, "1".into()]
+        }
         Sampling::Epipolar => [
             (SLICE_LANES * knobs.slices).to_string(),
             "1".into(),
@@ -147,51 +146,82 @@ pub fn sampling_invocations(knobs: &SamplingKnobs) -> [String; 3] {
     }
 }
 
-/// The `epipolar_samples` texture of an `epipolar` plan (`(slice_samples + 1) x (slices +
-/// 1)`, rgba32float: the last column holds each slice's line, the last row the layout), or
-/// `None` for the other modes.
-pub fn epipolar_samples_texture(knobs: &SamplingKnobs) -> Option<crate::plan::Resource> {
-    (knobs.sampling == Sampling::Epipolar).then(|| {
-        crate::plan::scatter_texture(
-            "epipolar_samples",
+/// A bound of the lowres sample grid of block side `scale` (`lowres_grid`: ceil((screen -
+/// 1) / S) + 1 per axis) as plan formulas: ceil(screen / S) + 1.
+pub fn lowres_grid_formula(scale: u32) -> [String; 2] {
+    [
+        format!("ceil(screen.width / {scale}) + 1"),
+        format!("ceil(screen.height / {scale}) + 1"),
+    ]
+}
+
+/// The texture the samples pass of a sampled plan writes and its `_unwarp` pass reads:
+/// `lowres_samples` or `epipolar_samples` (`None` for `pixels`).
+pub fn samples_name(knobs: &SamplingKnobs) -> Option<&'static str> {
+    match knobs.sampling {
+        Sampling::Pixels => None,
+        Sampling::Lowres => Some(LOWRES_SAMPLES),
+        Sampling::Epipolar => Some(EPIPOLAR_SAMPLES),
+    }
+}
+
+/// The samples texture of a sampled plan: for `lowres` the grid's samples (at most
+/// `(ceil(screen.width / S) + 1) x (ceil(screen.height / S) + 1)`, rgba32float: radiance,
+/// the sample pixel's depth in alpha); for `epipolar` (`(slice_samples + 1) x (slices +
+/// 1)`, rgba32float: the last column holds each slice's line, the last row the layout);
+/// `None` for `pixels`.
+pub fn samples_texture(knobs: &SamplingKnobs) -> Option<crate::plan::Resource> {
+    match knobs.sampling {
+        Sampling::Pixels => None,
+        Sampling::Lowres => {
+            let [w, h] = lowres_grid_formula(knobs.scale);
+            Some(crate::plan::scatter_texture(
+                LOWRES_SAMPLES,
+                "sampling = lowres: the samples of the low-resolution grid (x, y = sample \
+                 column and row; sample (i, j) stands on pixel min((i, j) S, screen - 1)): \
+                 radiance rgb rounded to f16, the view depth of the sample's pixel in alpha \
+                 (written by the family's per-pixel kernel, read by its _unwarp pass)",
+                SAMPLES_FORMAT,
+                &w,
+                &h,
+            ))
+        }
+        Sampling::Epipolar => Some(crate::plan::scatter_texture(
+            EPIPOLAR_SAMPLES,
             "sampling = epipolar: the samples of every slice (x = sample, y = slice): radiance \
              rgb, the view depth of the sample's pixel in alpha; the last column holds the \
              slice's line (direction xy, first distance, distance between samples), the last \
              row's first two texels the layout (origin xy, axis xy; first angle, angle per \
              slice, wrap) (written by the family's per-pixel kernel, read by its _unwarp pass)",
-            EPIPOLAR_SAMPLES_FORMAT,
+            SAMPLES_FORMAT,
             &(knobs.slice_samples + 1).to_string(),
             &(knobs.slices + 1).to_string(),
-        )
-    })
+        )),
+    }
 }
 
-/// An error for the `_unwarp` or `_fallback` pass `kernel` of a variant whose sampling is
-/// not `epipolar`.
+/// An error for the `_unwarp` or `_fallback` pass `kernel` of a variant that samples every
+/// pixel.
 pub(crate) fn unwarp_only(kernel: Kernel, sampling: Sampling) -> Result<(), crate::ShaderError> {
-    if sampling == Sampling::Epipolar {
+    if sampling != Sampling::Pixels {
         Ok(())
     } else {
         Err(crate::ShaderError::InvalidParameter {
             kernel,
             knob: "sampling",
             value: sampling.to_string(),
-            allowed: "epipolar (only epipolar sampling has unwarp and fallback passes)",
+            allowed: "lowres or epipolar (only the sampled modes have unwarp and fallback passes)",
         })
     }
 }
 
-/// The resource a family's per-pixel kernel writes: `output`, or `epipolar_samples` with
-/// epipolar sampling (its `_unwarp` pass writes `output`).
+/// The resource a family's per-pixel kernel writes: `output`, or the samples texture with
+/// `lowres` or `epipolar` sampling (its `_unwarp` pass writes `output`).
 pub fn sampled_output(knobs: &SamplingKnobs) -> &'static str {
-    if knobs.sampling == Sampling::Epipolar {
-        "epipolar_samples"
-    } else {
-        "output"
-    }
+    samples_name(knobs).unwrap_or("output")
 }
 
-/// The family kernel's pass `family` as `knobs` sample it: with `epipolar`,
+/// The family kernel's pass `family` as `knobs` sample it: with `lowres` or `epipolar`,
 /// `fallback_count` bound at `binding + 1` (the samples pass zeroes it for the unwarp);
 /// unchanged otherwise.
 pub fn sampled_pass(
@@ -199,7 +229,7 @@ pub fn sampled_pass(
     mut family: crate::plan::PassPlan,
     binding: u32,
 ) -> crate::plan::PassPlan {
-    if knobs.sampling == Sampling::Epipolar {
+    if knobs.is_sampled() {
         family
             .bindings
             .push(crate::plan::bind(binding + 1, FALLBACK_COUNT));
@@ -208,7 +238,7 @@ pub fn sampled_pass(
 }
 
 /// The bindings of the family kernel's pass `family` as its `_unwarp` and `_fallback`
-/// passes take them: `output` where `family` writes `epipolar_samples`, without what
+/// passes take them: `output` where `family` writes the samples texture, without what
 /// [`sampled_pass`] added.
 fn family_bindings(family: &crate::plan::PassPlan) -> Vec<crate::plan::BindingSource> {
     family
@@ -217,7 +247,7 @@ fn family_bindings(family: &crate::plan::PassPlan) -> Vec<crate::plan::BindingSo
         .filter(|b| b.resource != FALLBACK_COUNT)
         .cloned()
         .map(|mut b| {
-            if b.resource == "epipolar_samples" {
+            if [LOWRES_SAMPLES, EPIPOLAR_SAMPLES].contains(&b.resource) {
                 b.resource = "output";
             }
             b
@@ -225,21 +255,27 @@ fn family_bindings(family: &crate::plan::PassPlan) -> Vec<crate::plan::BindingSo
         .collect()
 }
 
-/// The `_unwarp` pass `kernel` of a family kernel's epipolar pass `family`: its `frame` and
-/// `depth` bindings, `output` where `family` writes `epipolar_samples`, `epipolar_samples`
-/// read at `binding`, `fallback_count` and `fallback_pixels` at `binding + 1` and `+ 2`; one
-/// invocation per screen pixel.
+/// The `_unwarp` pass `kernel` of a family kernel's sampled pass `family`: its `frame` and
+/// `depth` bindings, `output` where `family` writes the samples texture, the samples
+/// texture read at `binding`, `fallback_count` and `fallback_pixels` at `binding + 1` and
+/// `+ 2`; one invocation per screen pixel.
 pub fn unwarp_pass(
     family: crate::plan::PassPlan,
     kernel: Kernel,
     binding: u32,
 ) -> crate::plan::PassPlan {
+    let samples = family
+        .bindings
+        .iter()
+        .map(|b| b.resource)
+        .find(|r| [LOWRES_SAMPLES, EPIPOLAR_SAMPLES].contains(r))
+        .unwrap_or(EPIPOLAR_SAMPLES);
     // The gather reads only the uniform block, the depth buffer and the samples.
     let mut bindings: Vec<_> = family_bindings(&family)
         .into_iter()
         .filter(|b| ["frame", "depth", "output"].contains(&b.resource))
         .collect();
-    bindings.push(crate::plan::bind(binding, "epipolar_samples"));
+    bindings.push(crate::plan::bind(binding, samples));
     bindings.push(crate::plan::bind(binding + 1, FALLBACK_COUNT));
     bindings.push(crate::plan::bind(binding + 2, FALLBACK_PIXELS));
     crate::plan::PassPlan {
@@ -250,8 +286,8 @@ pub fn unwarp_pass(
     }
 }
 
-/// The `_fallback` pass `kernel` of a family kernel's epipolar pass `family`: the same
-/// bindings with `output` where `family` writes `epipolar_samples`, and `fallback_count`
+/// The `_fallback` pass `kernel` of a family kernel's sampled pass `family`: the same
+/// bindings with `output` where `family` writes the samples texture, and `fallback_count`
 /// and `fallback_pixels` read at `binding + 1` and `+ 2`; one invocation per 8 x 8 pixels,
 /// each evaluating every `invocations`-th listed pixel.
 pub fn fallback_pass(
@@ -274,10 +310,10 @@ pub fn fallback_pass(
     }
 }
 
-/// The buffers of an `epipolar` plan's fallback list (`fallback_count`, `fallback_pixels`),
-/// or none for the other modes.
+/// The buffers of a sampled plan's fallback list (`fallback_count`, `fallback_pixels`), or
+/// none for `pixels`.
 pub fn fallback_buffers(knobs: &SamplingKnobs) -> Vec<crate::plan::Resource> {
-    if knobs.sampling != Sampling::Epipolar {
+    if !knobs.is_sampled() {
         return Vec::new();
     }
     let buffer = |name, contents, elements: Option<&str>, usage| crate::plan::Resource {
@@ -291,14 +327,14 @@ pub fn fallback_buffers(knobs: &SamplingKnobs) -> Vec<crate::plan::Resource> {
     vec![
         buffer(
             FALLBACK_COUNT,
-            "sampling = epipolar: how many pixels the _unwarp pass listed in fallback_pixels              (zeroed by the family's samples pass, incremented by the _unwarp pass, read by              the _fallback pass; no host upload or clear; copy it back to report how many \
+            "sampling = lowres | epipolar: how many pixels the _unwarp pass listed in fallback_pixels              (zeroed by the family's samples pass, incremented by the _unwarp pass, read by              the _fallback pass; no host upload or clear; copy it back to report how many \
              pixels fell back)",
             None,
             vec!["storage", "copy_src"],
         ),
         buffer(
             FALLBACK_PIXELS,
-            "sampling = epipolar: the pixels no sample stands for, packed x | y << 16, in no              particular order (written by the _unwarp pass, evaluated by the _fallback pass)",
+            "sampling = lowres | epipolar: the pixels no sample stands for, packed x | y << 16, in no              particular order (written by the _unwarp pass, evaluated by the _fallback pass)",
             Some("screen.width * screen.height"),
             vec!["storage"],
         ),
@@ -318,22 +354,16 @@ pub const FALLBACK_TILE: u32 = 8;
 /// default step (measured: the raymarch n64 samples pass at 1280x720 took 16-19 ms with 64).
 pub const SLICE_LANES: u32 = 32;
 
-/// Invocations per workgroup of the lowres pass (one workgroup per 8 x 8 blocks). Two
-/// llvmpipe batches of 8 lanes, not 64 lanes: llvmpipe runs a loop's body at least once for
-/// every 8-lane batch, under an empty mask where the batch has nothing to do, so the list of
-/// pixels a workgroup evaluates itself (usually a few, often none) cost 8 evaluations of the
-/// per-pixel body per workgroup with 64 lanes. Measured, the raymarch n64 lowres 2 pass at
-/// 1280x720 (`bench --headline-only --family raymarch`): 80-92 ms with 64 lanes, 71-77 with
-/// 16, 69-75 with 8. Not 8: with one batch per workgroup lavapipe gave minmax lowres 4 on
-/// `spot_grate` at 320x180 another image (3.66 % rel L1 against the truth where 16 and 64
-/// lanes give 1.05 %, deterministically): there the pixels the pass evaluates itself get
-/// another value from minmax's per-pixel body than the per-pixel pass gives (with 1024^2
-/// shadow and 512x512 rectified maps; the stage trial's 128^2 map does not show it). Not
-/// explained.
-pub const LOWRES_LANES: u32 = 16;
+/// The lowres samples texture.
+pub const LOWRES_SAMPLES: &str = "lowres_samples";
+/// The epipolar samples texture.
+pub const EPIPOLAR_SAMPLES: &str = "epipolar_samples";
 
-/// Format of `epipolar_samples`.
-pub const EPIPOLAR_SAMPLES_FORMAT: &str = "rgba32float";
+/// Format of the samples textures (`lowres_samples`, `epipolar_samples`).
+pub const SAMPLES_FORMAT: &str = "rgba32float";
+
+/// Format of `epipolar_samples` (the samples textures' format).
+pub const EPIPOLAR_SAMPLES_FORMAT: &str = SAMPLES_FORMAT;
 
 #[cfg(test)]
 mod tests {

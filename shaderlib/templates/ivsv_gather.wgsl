@@ -38,6 +38,8 @@
 // | 4       | output | texture_storage_2d<{{ output_format }}, write>         | textureStore |
 {%- if interleave > 1 %}
 // output: the `partial` resource, screen-sized, the pixel's class's share (rgb, alpha 1).
+{%- else if sampling.lowres && !sampling.unwarp && !sampling.fallback %}
+// output: the `lowres_samples` resource (scatter::sampling).
 {%- else if sampling.epipolar && !sampling.unwarp && !sampling.fallback %}
 // output: the `epipolar_samples` resource (scatter::sampling).
 {%- else %}

@@ -448,8 +448,8 @@ fn pst_variants() -> [PartialSumTreeVariant; 3] {
 }
 
 /// The raymarch trial variants: plain directional, interleaved and jittered spot,
-/// `sampling = lowres` (scale 2) spot: the sampled dispatch and workgroup memory, and
-/// `sampling = epipolar` (64 slices x 64 samples) spot: the `epipolar_samples` texture the
+/// `sampling = lowres` (scale 2) spot: the `lowres_samples` texture sized by a sum formula,
+/// and `sampling = epipolar` (64 slices x 64 samples) spot: the `epipolar_samples` texture the
 /// engine allocates from the manifest, the `raymarch_unwarp` pass, the fallback list
 /// (`fallback_count`, `fallback_pixels`) and the `raymarch_fallback` pass; and the spot with
 /// the `stained_glass` cookie: the engine's `cookie` texture (rgba16float, its own size).
@@ -567,7 +567,7 @@ fn foreign_engine_matches_runtime_for_every_family() {
         );
         let expect: &[&str] = if v.interleaved() {
             &["raymarch", "interleave_sum"]
-        } else if v.sampling == scatter_frame::sampling::Sampling::Epipolar {
+        } else if v.sampling != scatter_frame::sampling::Sampling::Pixels {
             &["raymarch", "raymarch_unwarp", "raymarch_fallback"]
         } else {
             &["raymarch"]

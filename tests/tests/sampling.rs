@@ -346,7 +346,7 @@ fn stage_trial(
         settings: &settings,
     };
     let (pixels, _) = run_variant(Some(ctx), &base, &frame)?;
-    let (gpu, _) = run_variant(Some(ctx), &sampled, &frame)?;
+    let (gpu, _, listed) = run_variant_counted(Some(ctx), &sampled, &frame)?;
     let depth = depth_tex(&f.gbuf);
     let [w, _] = SCREEN;
     let at = |p: [u32; 2]| pixels.data[(p[1] * w + p[0]) as usize];
@@ -360,6 +360,8 @@ fn stage_trial(
     }
     let (depth_break, light_break) = (knobs.depth_break_fraction(), knobs.light_break_fraction());
     let (mut blended, mut refined, mut over) = (0, 0, 0);
+    // The pixels the unwarp must list for the fallback pass, and those it may list either way.
+    let (mut must_list, mut may_list) = (0u32, 0u32);
     let mut worst = 0.0f32;
     let mut first = None;
     for (i, g) in gpu.data.iter().enumerate() {
@@ -383,6 +385,11 @@ fn stage_trial(
         let ambiguous = lowres_blend(t.w, depths, light, d, depth_break, light_break - edge)
             .is_some()
             != lowres_blend(t.w, depths, light, d, depth_break, light_break + edge).is_some();
+        if ambiguous {
+            may_list += 1;
+        } else if blend.is_none() {
+            must_list += 1;
+        }
         if ambiguous {
             let own = at(q);
             let other = blend.or(lowres_blend(
@@ -430,6 +437,16 @@ fn stage_trial(
             "{over} pixels over tolerance, first at {}; worst |diff| {worst:e} (max {max:e})",
             first.unwrap_or_default()
         ));
+    }
+    // The unwarp's list, read back: every pixel whose taps cannot stand for it, and no other.
+    match listed {
+        Some(n) if (must_list..=must_list + may_list).contains(&n) => {}
+        Some(n) => {
+            return Err(format!(
+                "the unwarp listed {n} pixels for the fallback pass; expected {must_list} (+ up to {may_list} at the light threshold)"
+            ));
+        }
+        None => return Err("no fallback_count to read back".into()),
     }
     println!(
         "sampling::{}::{}::{pose}: {blended} pixels blended, {refined} evaluated themselves; max |diff| {:.2e} of max",

@@ -1,6 +1,7 @@
 //! The manifest's size and dispatch formulas (`generator/MANIFEST.md`, "Formulas"): an
-//! integer (`8`), a parameter (`rectified.width`), a product (`16 * rectified.height`) or
-//! `ceil(a / b)` (integer division rounding up), nested freely. [`Params`] holds the values
+//! integer (`8`), a parameter (`rectified.width`), a product (`16 * rectified.height`),
+//! `ceil(a / b)` (integer division rounding up) or a sum (`ceil(screen.width / 2) + 1`),
+//! nested freely. [`Params`] holds the values
 //! of the parameters; [`eval`] parses and evaluates in one go, in `u64` with overflow and
 //! division by zero reported as errors. Also the parameters' `lo..=hi` constraints
 //! ([`check_constraint`]).
@@ -50,7 +51,7 @@ pub fn eval(formula: &str, params: &Params, context: &str) -> Result<u64, Engine
         params,
         context,
     };
-    let value = p.product()?;
+    let value = p.sum()?;
     p.skip_ws();
     if p.pos != formula.len() {
         return Err(p.error(format!("unexpected {:?}", &formula[p.pos..])));
@@ -104,6 +105,18 @@ impl Parser<'_> {
         }
     }
 
+    /// `product ('+' product)*`
+    fn sum(&mut self) -> Result<u64, EngineError> {
+        let mut value = self.product()?;
+        while self.eat("+") {
+            let rhs = self.product()?;
+            value = value
+                .checked_add(rhs)
+                .ok_or_else(|| self.error(format!("{value} + {rhs} overflows")))?;
+        }
+        Ok(value)
+    }
+
     /// `factor ('*' factor)*`
     fn product(&mut self) -> Result<u64, EngineError> {
         let mut value = self.factor()?;
@@ -116,7 +129,7 @@ impl Parser<'_> {
         Ok(value)
     }
 
-    /// `integer | name | 'ceil' '(' product '/' product ')'`
+    /// `integer | name | 'ceil' '(' sum '/' sum ')'`
     fn factor(&mut self) -> Result<u64, EngineError> {
         self.skip_ws();
         let rest = &self.src[self.pos..];
@@ -136,11 +149,11 @@ impl Parser<'_> {
             if !self.eat("(") {
                 return Err(self.error("`ceil` must be followed by `(`".to_owned()));
             }
-            let a = self.product()?;
+            let a = self.sum()?;
             if !self.eat("/") {
                 return Err(self.error("`ceil(` takes `a / b`".to_owned()));
             }
-            let b = self.product()?;
+            let b = self.sum()?;
             if !self.eat(")") {
                 return Err(self.error("`ceil(a / b` lacks its `)`".to_owned()));
             }
@@ -249,6 +262,9 @@ mod tests {
         assert_eq!(eval("ceil(rectified.height / 64)", &p, "t").ok(), Some(16));
         assert_eq!(eval("ceil(screen.width / 8)", &p, "t").ok(), Some(160));
         assert_eq!(eval("2 * ceil(7 / 2) * 3", &p, "t").ok(), Some(24));
+        assert_eq!(eval("ceil(screen.width / 2) + 1", &p, "t").ok(), Some(641));
+        assert_eq!(eval("1 + 2 * 3 + 4", &p, "t").ok(), Some(11));
+        assert_eq!(eval("ceil(screen.width + 1 / 2)", &p, "t").ok(), Some(641));
     }
 
     #[test]
@@ -276,6 +292,8 @@ mod tests {
             assert!(matches!(e, EngineError::Formula { .. }), "{bad}: {e}");
         }
         let e = eval("4294967296 * 4294967296", &p, "t").unwrap_err();
+        assert!(e.to_string().contains("overflows"), "{e}");
+        let e = eval("18446744073709551615 + 1", &p, "t").unwrap_err();
         assert!(e.to_string().contains("overflows"), "{e}");
     }
 

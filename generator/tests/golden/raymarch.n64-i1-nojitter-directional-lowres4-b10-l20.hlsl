@@ -34,14 +34,7 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float dtheta;
 };
 
-struct LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    uint2 cols;
-    uint2 rows;
-    float4 w;
-};
-
 static const uint SCALE = 4u;
-static const uint LOWRES_LANES = 16u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
 
@@ -49,10 +42,7 @@ cbuffer frame : register(b0) { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W
 Texture2D<float4> depth : register(t1);
 Texture2D<float4> shadow_map : register(t2);
 RWTexture2D<float4> output : register(u3);
-groupshared float3 tile_light[81];
-groupshared float tile_depth[81];
-groupshared uint refine[1024];
-groupshared uint refine_count;
+RWByteAddressBuffer fallback_count : register(u5);
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(float4 arg0, float4 arg1, float4 arg2, float4 arg3, float4 arg4, uint4 arg5) {
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ret = (ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX)0;
@@ -75,8 +65,8 @@ float3 raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(RaymarchF
 {
     float ndc_x = (((2.0 * (float(x) + 0.5)) / float(m_1.sizes.x)) - 1.0);
     float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(m_1.sizes.y)));
-    float t_3 = m_1.cam_forward.w;
-    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_3) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_3))));
+    float t_2 = m_1.cam_forward.w;
+    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2))));
 }
 
 float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y_1)
@@ -132,11 +122,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 
     float3 x_6 = (eye + (dir * t));
     float3 to_x = (x_6 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d_1 = sqrt(d2_);
-    float3 travel = (to_x / (d_1).xxx);
+    float d = sqrt(d2_);
+    float3 travel = (to_x / (d).xxx);
     const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
@@ -157,10 +147,10 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
     return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
 }
 
-float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e_1, float x_2)
+float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_2)
 {
-    float tau = tan((e_1.theta_a + (x_2 * e_1.dtheta)));
-    return float2((e_1.t_close + (e_1.dist * tau)), ((e_1.dtheta * e_1.dist) * (1.0 + (tau * tau))));
+    float tau = tan((e.theta_a + (x_2 * e.dtheta)));
+    return float2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
@@ -173,8 +163,8 @@ float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oi
 {
     if ((v_1.origin.w > 0.5)) {
         float z_1 = max(ls.z, 1e-6);
-        float t_4 = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_4))), (0.5 - ((0.5 * ls.y) / (z_1 * t_4))));
+        float t_3 = v_1.proj.x;
+        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
     } else {
         return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
@@ -186,28 +176,28 @@ uint naga_f2u32(float value) {
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
 {
-    bool local_1 = (bool)0;
     bool local_2 = (bool)0;
     bool local_3 = (bool)0;
+    bool local_4 = (bool)0;
 
     if (!((uv.x < 0.0))) {
-        local_1 = (uv.x > 1.0);
-    } else {
-        local_1 = true;
-    }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = (uv.y < 0.0);
+        local_2 = (uv.x > 1.0);
     } else {
         local_2 = true;
     }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = (uv.y > 1.0);
+    bool _e11 = local_2;
+    if (!(_e11)) {
+        local_3 = (uv.y < 0.0);
     } else {
         local_3 = true;
     }
-    bool _e27 = local_3;
+    bool _e19 = local_3;
+    if (!(_e19)) {
+        local_4 = (uv.y > 1.0);
+    } else {
+        local_4 = true;
+    }
+    bool _e27 = local_4;
     if (_e27) {
         return 2.0;
     }
@@ -234,17 +224,17 @@ float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_o
 
 float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, Texture2D<float4> sm_1, float3 p_1)
 {
-    bool local_4 = (bool)0;
+    bool local_5 = (bool)0;
 
     const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     float near = v_4.right.w;
     float far = v_4.up.w;
     if ((v_4.origin.w > 0.5)) {
-        local_4 = (_e2.z <= near);
+        local_5 = (_e2.z <= near);
     } else {
-        local_4 = false;
+        local_5 = false;
     }
-    bool _e16 = local_4;
+    bool _e16 = local_5;
     if (_e16) {
         return 1.0;
     }
@@ -271,128 +261,11 @@ uint2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uint2 i, uint2 s
 
 float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 v_5)
 {
-    float3 a_3 = min(abs(v_5), (65504.0).xxx);
-    uint3 u_1 = asuint(a_3);
+    float3 a_2 = min(abs(v_5), (65504.0).xxx);
+    uint3 u_1 = asuint(a_2);
     float3 normal = asfloat((((u_1 + (4095u).xxx) + ((u_1 >> (13u).xxx) & (1u).xxx)) & (4294959104u).xxx));
-    float3 subnormal = (round((a_3 * 16777216.0)) / (16777216.0).xxx);
-    return (sign(v_5) * ((a_3 < (6.1035156e-5).xxx) ? subnormal : normal));
-}
-
-LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uint2 p_2, uint2 screen_2, uint scale_2)
-{
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = (LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
-
-    const uint2 _e2 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, scale_2);
-    uint2 lo_1 = naga_div(p_2, (scale_2).xx);
-    uint2 hi_1 = min((lo_1 + uint2(1u, 1u)), (_e2 - uint2(1u, 1u)));
-    const uint2 _e15 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lo_1, screen_2, scale_2);
-    const uint2 _e16 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(hi_1, screen_2, scale_2);
-    float2 fr = (float2((p_2 - _e15)) / float2(max((_e16 - _e15), uint2(1u, 1u))));
-    t_1.cols = uint2(lo_1.x, hi_1.x);
-    t_1.rows = uint2(lo_1.y, hi_1.y);
-    t_1.w = float4(((1.0 - fr.x) * (1.0 - fr.y)), (fr.x * (1.0 - fr.y)), ((1.0 - fr.x) * fr.y), (fr.x * fr.y));
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e57 = t_1;
-    const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowrestapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx = _e57;
-    return lowrestapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx;
-}
-
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_2, float b_2, float depth_break)
-{
-    bool local_5 = (bool)0;
-
-    if (!((a_2 == b_2))) {
-        local_5 = (abs((a_2 - b_2)) <= (depth_break * min(a_2, b_2)));
-    } else {
-        local_5 = true;
-    }
-    bool _e13 = local_5;
-    return _e13;
-}
-
-float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float4 depths_1, float3 light_1[4], float d, float depth_break_1, float light_break)
-{
-    float3 sum = float3(0.0, 0.0, 0.0);
-    float total = 0.0;
-    float3 lo = float3(3.4e38, 3.4e38, 3.4e38);
-    float3 hi = float3(0.0, 0.0, 0.0);
-    uint taps = 0u;
-    uint close = 0u;
-    uint k_2 = 0u;
-    bool local_6 = (bool)0;
-    bool local_7 = (bool)0;
-
-    uint2 loop_bound = uint2(4294967295u, 4294967295u);
-    bool loop_init = true;
-    while(true) {
-        if (all(loop_bound == uint2(0u, 0u))) { break; }
-        loop_bound -= uint2(loop_bound.y == 0u, 1u);
-        if (!loop_init) {
-            uint _e63 = k_2;
-            k_2 = (_e63 + 1u);
-        }
-        loop_init = false;
-        uint _e6 = k_2;
-        if ((_e6 < 4u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e10 = taps;
-            uint _e12 = k_2;
-            taps = (_e10 + ((w[min(uint(_e12), 3u)] > 0.0) ? 1u : 0u));
-            uint _e20 = k_2;
-            if ((w[min(uint(_e20), 3u)] > 0.0)) {
-                uint _e25 = k_2;
-                const bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e25), 3u)], d, depth_break_1);
-                local_6 = _e29;
-            } else {
-                local_6 = false;
-            }
-            bool _e33 = local_6;
-            if (_e33) {
-                uint _e35 = close;
-                close = (_e35 + 1u);
-                float3 _e40 = sum;
-                uint _e41 = k_2;
-                uint _e43 = k_2;
-                sum = (_e40 + (w[min(uint(_e41), 3u)] * light_1[min(uint(_e43), 3u)]));
-                float _e48 = total;
-                uint _e49 = k_2;
-                total = (_e48 + w[min(uint(_e49), 3u)]);
-                float3 _e53 = lo;
-                uint _e54 = k_2;
-                lo = min(_e53, light_1[min(uint(_e54), 3u)]);
-                float3 _e58 = hi;
-                uint _e59 = k_2;
-                hi = max(_e58, light_1[min(uint(_e59), 3u)]);
-            }
-        }
-    }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_7 = (_e69 < min(_e70, 2u));
-    } else {
-        local_7 = true;
-    }
-    bool _e77 = local_7;
-    if (_e77) {
-        return float4(0.0, 0.0, 0.0, 0.0);
-    }
-    float3 _e83 = hi;
-    float3 _e84 = lo;
-    float3 spread = (_e83 - _e84);
-    float _e93 = hi.x;
-    float _e95 = hi.y;
-    float _e97 = hi.z;
-    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97))))) {
-        return float4(0.0, 0.0, 0.0, 0.0);
-    }
-    float3 _e107 = sum;
-    float _e108 = total;
-    float3 c = (_e107 / (_e108).xxx);
-    return float4(c.x, c.y, c.z, 1.0);
+    float3 subnormal = (round((a_2 * 16777216.0)) / (16777216.0).xxx);
+    return (sign(v_5) * ((a_2 < (6.1035156e-5).xxx) ? subnormal : normal));
 }
 
 uint naga_mod(uint lhs, uint rhs) {
@@ -402,10 +275,10 @@ uint naga_mod(uint lhs, uint rhs) {
 float3 raymarch_pixel(uint x_3, uint y_2)
 {
     float u = 0.5;
-    float sum_1 = 0.0;
-    uint j_1 = (uint)0;
-    float t_2 = (float)0;
-    float w_1 = (float)0;
+    float sum = 0.0;
+    uint j = (uint)0;
+    float t_1 = (float)0;
+    float w = (float)0;
     float l = (float)0;
 
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
@@ -425,224 +298,95 @@ float3 raymarch_pixel(uint x_3, uint y_2)
     }
     const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0.0, s, n_2);
-    j_1 = pixel_class;
-    uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
-    bool loop_init_1 = true;
+    j = pixel_class;
+    uint2 loop_bound = uint2(4294967295u, 4294967295u);
+    bool loop_init = true;
     while(true) {
-        if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init_1) {
-            uint _e103 = j_1;
-            j_1 = (_e103 + stride);
+        if (all(loop_bound == uint2(0u, 0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e103 = j;
+            j = (_e103 + stride);
         }
-        loop_init_1 = false;
-        uint _e50 = j_1;
+        loop_init = false;
+        uint _e50 = j;
         if ((_e50 < n_2)) {
         } else {
             break;
         }
         {
-            uint _e52 = j_1;
+            uint _e52 = j;
             float _e54 = u;
-            t_2 = ((float(_e52) + _e54) * h_2);
-            w_1 = h_2;
+            t_1 = ((float(_e52) + _e54) * h_2);
+            w = h_2;
             if (false) {
-                uint _e60 = j_1;
+                uint _e60 = j;
                 float _e62 = u;
                 const float2 _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (float(_e60) + _e62));
-                t_2 = _e64.x;
-                w_1 = _e64.y;
+                t_1 = _e64.x;
+                w = _e64.y;
             }
-            float _e67 = t_2;
+            float _e67 = t_1;
             const float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)));
             if (false) {
-                float _e73 = sum_1;
-                float _e74 = w_1;
-                float _e76 = t_2;
+                float _e73 = sum;
+                float _e74 = w;
+                float _e76 = t_1;
                 const float _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum_1 = (_e73 + ((_e71 * _e74) * _e86));
+                sum = (_e73 + ((_e71 * _e74) * _e86));
             } else {
-                float _e89 = sum_1;
-                uint _e92 = j_1;
-                uint _e95 = j_1;
+                float _e89 = sum;
+                uint _e92 = j;
+                uint _e95 = j;
                 const float _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e92) * h_2), (float((_e95 + 1u)) * h_2));
-                sum_1 = (_e89 + (_e71 * _e100));
+                sum = (_e89 + (_e71 * _e100));
             }
         }
     }
-    float _e105 = sum_1;
+    float _e105 = sum;
     l = _e105;
     if (!(false)) {
         const float _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e8)));
-        float _e118 = sum_1;
+        float _e118 = sum;
         l = ((m_2.medium.y * _e116) * _e118);
     }
     float _e122 = l;
-    float3 c_1 = (m_2.light_color.xyz * _e122);
-    return c_1;
+    float3 c = (m_2.light_color.xyz * _e122);
+    return c;
 }
 
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / (rhs == 0u ? 1u : rhs);
-}
-
-typedef float3 ret_ZeroValuearray4_float3_[4];
-ret_ZeroValuearray4_float3_ ZeroValuearray4_float3_() {
-    return (float3[4])0;
-}
-
-[numthreads(16, 1, 1)]
-void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
+[numthreads(8, 8, 1)]
+void raymarch(uint3 id : SV_DispatchThreadID)
 {
-    if (li == 0) {
-        tile_light = (float3[81])0;
-        tile_depth = (float[81])0;
-        refine = (uint[1024])0;
-        refine_count = (uint)0;
-    }
-    GroupMemoryBarrierWithGroupSync();
-    uint k = (uint)0;
-    uint k_1 = 0u;
     bool local = (bool)0;
-    float4 depths = (float4)0;
-    float3 light[4] = (float3[4])0;
-    uint j = (uint)0;
-    uint e = (uint)0;
+    bool local_1 = (bool)0;
 
-    uint _e4 = frame.sizes.x;
-    uint _e8 = frame.sizes.y;
-    uint2 screen_3 = uint2(_e4, _e8);
-    const uint2 _e11 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_3, SCALE);
-    uint2 origin = (wid.xy * 8u);
-    k = li;
-    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e50 = k;
-            k = (_e50 + LOWRES_LANES);
-        }
-        loop_init_2 = false;
-        uint _e18 = k;
-        if ((_e18 < 81u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e21 = k;
-            uint _e24 = k;
-            uint2 i_1 = min((origin + uint2(naga_mod(_e21, 9u), naga_div(_e24, 9u))), (_e11 - uint2(1u, 1u)));
-            const uint2 _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i_1, screen_3, SCALE);
-            uint _e37 = k;
-            const float3 _e41 = raymarch_pixel(_e35.x, _e35.y);
-            const float3 _e42 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e41);
-            tile_light[min(uint(_e37), 80u)] = _e42;
-            uint _e44 = k;
-            float4 _e48 = depth.Load(int3(_e35, int(0)));
-            tile_depth[min(uint(_e44), 80u)] = _e48.x;
-        }
+    uint _e3 = frame.sizes.x;
+    uint _e7 = frame.sizes.y;
+    uint2 screen_2 = uint2(_e3, _e7);
+    if ((id.x == 0u)) {
+        local = (id.y == 0u);
+    } else {
+        local = false;
     }
-    GroupMemoryBarrierWithGroupSync();
-    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
-    bool loop_init_3 = true;
-    while(true) {
-        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
-            uint _e149 = k_1;
-            k_1 = (_e149 + 1u);
-        }
-        loop_init_3 = false;
-        uint _e54 = k_1;
-        if ((_e54 < 64u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e58 = k_1;
-            uint e_2 = (li + (LOWRES_LANES * _e58));
-            uint2 q_1 = ((origin * SCALE) + uint2(naga_mod(e_2, 32u), naga_div(e_2, 32u)));
-            if ((q_1.x < screen_3.x)) {
-                local = (q_1.y < screen_3.y);
-            } else {
-                local = false;
-            }
-            bool _e78 = local;
-            if (_e78) {
-                const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e80 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
-                depths = float4(0.0, 0.0, 0.0, 0.0);
-                light = ZeroValuearray4_float3_();
-                j = 0u;
-                uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
-                bool loop_init_4 = true;
-                while(true) {
-                    if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
-                    loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-                    if (!loop_init_4) {
-                        uint _e122 = j;
-                        j = (_e122 + 1u);
-                    }
-                    loop_init_4 = false;
-                    uint _e91 = j;
-                    if ((_e91 < 4u)) {
-                    } else {
-                        break;
-                    }
-                    {
-                        uint _e95 = j;
-                        uint _e100 = j;
-                        uint2 s_1 = (uint2(_e80.cols[min(uint(naga_mod(_e95, 2u)), 1u)], _e80.rows[min(uint(naga_div(_e100, 2u)), 1u)]) - origin);
-                        uint at = ((s_1.y * 9u) + s_1.x);
-                        uint _e111 = j;
-                        float _e115 = tile_depth[min(uint(at), 80u)];
-                        depths[min(uint(_e111), 3u)] = _e115;
-                        uint _e116 = j;
-                        float3 _e120 = tile_light[min(uint(at), 80u)];
-                        light[min(uint(_e116), 3u)] = _e120;
-                    }
-                }
-                float4 _e125 = depths;
-                float3 _e126[4] = light;
-                float4 _e129 = depth.Load(int3(q_1, int(0)));
-                const float4 _e133 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e80.w, _e125, _e126, _e129.x, DEPTH_BREAK, LIGHT_BREAK);
-                if ((_e133.w == 0.0)) {
-                    uint _e139; InterlockedAdd(refine_count, 1u, _e139);
-                    refine[min(uint(_e139), 1023u)] = (q_1.x | (q_1.y << 16u));
-                } else {
-                    output[q_1] = _e133;
-                }
-            }
-        }
+    bool _e19 = local;
+    if (_e19) {
+        { uint dummy = 0; fallback_count.InterlockedExchange(0, 0u, dummy); }
     }
-    GroupMemoryBarrierWithGroupSync();
-    uint n_3; InterlockedOr(refine_count, 0, n_3);
-    e = li;
-    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
-    bool loop_init_5 = true;
-    while(true) {
-        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
-            uint _e178 = e;
-            e = (_e178 + LOWRES_LANES);
-        }
-        loop_init_5 = false;
-        uint _e154 = e;
-        if ((_e154 < n_3)) {
-        } else {
-            break;
-        }
-        {
-            uint _e157 = e;
-            uint _e159 = refine[min(uint(_e157), 1023u)];
-            uint _e163 = e;
-            uint _e165 = refine[min(uint(_e163), 1023u)];
-            uint2 q_2 = uint2((_e159 & 65535u), (_e165 >> 16u));
-            const float3 _e171 = raymarch_pixel(q_2.x, q_2.y);
-            output[q_2] = float4(_e171.x, _e171.y, _e171.z, 1.0);
-        }
+    const uint2 _e23 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
+    if (!((id.x >= _e23.x))) {
+        local_1 = (id.y >= _e23.y);
+    } else {
+        local_1 = true;
     }
+    bool _e34 = local_1;
+    if (_e34) {
+        return;
+    }
+    const uint2 _e37 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
+    const float3 _e40 = raymarch_pixel(_e37.x, _e37.y);
+    const float3 _e41 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e40);
+    float4 _e48 = depth.Load(int3(_e37, int(0)));
+    output[id.xy] = float4(_e41.x, _e41.y, _e41.z, _e48.x);
     return;
 }

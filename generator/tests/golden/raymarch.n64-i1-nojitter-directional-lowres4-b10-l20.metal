@@ -37,25 +37,7 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float theta_a;
     float dtheta;
 };
-struct LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    metal::uint2 cols;
-    metal::uint2 rows;
-    metal::float4 w;
-};
-struct type_9 {
-    metal::float3 inner[4];
-};
-struct type_11 {
-    metal::float3 inner[81];
-};
-struct type_12 {
-    float inner[81];
-};
-struct type_13 {
-    uint inner[1024];
-};
 constant uint SCALE = 4u;
-constant uint LOWRES_LANES = 16u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
 
@@ -72,8 +54,8 @@ metal::float3 raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
 ) {
     float ndc_x = ((2.0 * (static_cast<float>(x) + 0.5)) / static_cast<float>(m_1.sizes.x)) - 1.0;
     float ndc_y = 1.0 - ((2.0 * (static_cast<float>(y) + 0.5)) / static_cast<float>(m_1.sizes.y));
-    float t_3 = m_1.cam_forward.w;
-    return metal::normalize((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_3) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_3)));
+    float t_2 = m_1.cam_forward.w;
+    return metal::normalize((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2)));
 }
 
 float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
@@ -148,11 +130,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 x_6 = eye + (dir * t);
     metal::float3 to_x = x_6 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
-    float d_1 = metal::sqrt(d2_);
-    metal::float3 travel = to_x / metal::float3(d_1);
+    float d = metal::sqrt(d2_);
+    metal::float3 travel = to_x / metal::float3(d);
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_1 + t))) / d2_;
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t))) / d2_;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -170,11 +152,11 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
 }
 
 metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e_1,
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e,
     float x_2
 ) {
-    float tau = metal::tan(e_1.theta_a + (x_2 * e_1.dtheta));
-    return metal::float2(e_1.t_close + (e_1.dist * tau), (e_1.dtheta * e_1.dist) * (1.0 + (tau * tau)));
+    float tau = metal::tan(e.theta_a + (x_2 * e.dtheta));
+    return metal::float2(e.t_close + (e.dist * tau), (e.dtheta * e.dist) * (1.0 + (tau * tau)));
 }
 
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
@@ -191,8 +173,8 @@ metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     if (v_1.origin.w > 0.5) {
         float z_1 = metal::max(ls.z, 0.000001);
-        float t_4 = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_4)), 0.5 - ((0.5 * ls.y) / (z_1 * t_4)));
+        float t_3 = v_1.proj.x;
+        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_3)), 0.5 - ((0.5 * ls.y) / (z_1 * t_3)));
     } else {
         return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
     }
@@ -207,27 +189,27 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_1 = {};
     bool local_2 = {};
     bool local_3 = {};
+    bool local_4 = {};
     if (!((uv.x < 0.0))) {
-        local_1 = uv.x > 1.0;
-    } else {
-        local_1 = true;
-    }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = uv.y < 0.0;
+        local_2 = uv.x > 1.0;
     } else {
         local_2 = true;
     }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = uv.y > 1.0;
+    bool _e11 = local_2;
+    if (!(_e11)) {
+        local_3 = uv.y < 0.0;
     } else {
         local_3 = true;
     }
-    bool _e27 = local_3;
+    bool _e19 = local_3;
+    if (!(_e19)) {
+        local_4 = uv.y > 1.0;
+    } else {
+        local_4 = true;
+    }
+    bool _e27 = local_4;
     if (_e27) {
         return 2.0;
     }
@@ -259,16 +241,16 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm_1,
     metal::float3 p_1
 ) {
-    bool local_4 = {};
+    bool local_5 = {};
     metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     float near = v_4.right.w;
     float far = v_4.up.w;
     if (v_4.origin.w > 0.5) {
-        local_4 = _e2.z <= near;
+        local_5 = _e2.z <= near;
     } else {
-        local_4 = false;
+        local_5 = false;
     }
-    bool _e16 = local_4;
+    bool _e16 = local_5;
     if (_e16) {
         return 1.0;
     }
@@ -301,136 +283,11 @@ metal::uint2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 metal::float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float3 v_5
 ) {
-    metal::float3 a_3 = metal::min(metal::abs(v_5), metal::float3(65504.0));
-    metal::uint3 u_1 = as_type<metal::uint3>(a_3);
+    metal::float3 a_2 = metal::min(metal::abs(v_5), metal::float3(65504.0));
+    metal::uint3 u_1 = as_type<metal::uint3>(a_2);
     metal::float3 normal = as_type<metal::float3>(((u_1 + metal::uint3(4095u)) + ((u_1 >> metal::uint3(13u)) & metal::uint3(1u))) & metal::uint3(4294959104u));
-    metal::float3 subnormal = metal::rint(a_3 * 16777216.0) / metal::float3(16777216.0);
-    return metal::sign(v_5) * metal::select(normal, subnormal, a_3 < metal::float3(0.000061035156));
-}
-
-LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    metal::uint2 p_2,
-    metal::uint2 screen_2,
-    uint scale_2
-) {
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = {};
-    metal::uint2 _e2 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, scale_2);
-    metal::uint2 lo_1 = naga_div(p_2, metal::uint2(scale_2));
-    metal::uint2 hi_1 = metal::min(lo_1 + metal::uint2(1u, 1u), _e2 - metal::uint2(1u, 1u));
-    metal::uint2 _e15 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lo_1, screen_2, scale_2);
-    metal::uint2 _e16 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(hi_1, screen_2, scale_2);
-    metal::float2 fr = static_cast<metal::float2>(p_2 - _e15) / static_cast<metal::float2>(metal::max(_e16 - _e15, metal::uint2(1u, 1u)));
-    t_1.cols = metal::uint2(lo_1.x, hi_1.x);
-    t_1.rows = metal::uint2(lo_1.y, hi_1.y);
-    t_1.w = metal::float4((1.0 - fr.x) * (1.0 - fr.y), fr.x * (1.0 - fr.y), (1.0 - fr.x) * fr.y, fr.x * fr.y);
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e57 = t_1;
-    return _e57;
-}
-
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_2,
-    float b_2,
-    float depth_break
-) {
-    bool local_5 = {};
-    if (!((a_2 == b_2))) {
-        local_5 = metal::abs(a_2 - b_2) <= (depth_break * metal::min(a_2, b_2));
-    } else {
-        local_5 = true;
-    }
-    bool _e13 = local_5;
-    return _e13;
-}
-
-metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    metal::float4 w,
-    metal::float4 depths_1,
-    type_9 light_1,
-    float d,
-    float depth_break_1,
-    float light_break
-) {
-    metal::float3 sum = metal::float3(0.0, 0.0, 0.0);
-    float total = 0.0;
-    metal::float3 lo = metal::float3(340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0);
-    metal::float3 hi = metal::float3(0.0, 0.0, 0.0);
-    uint taps = 0u;
-    uint close = 0u;
-    uint k_2 = 0u;
-    bool local_6 = {};
-    bool local_7 = {};
-    uint2 loop_bound = uint2(4294967295u);
-    bool loop_init = true;
-    while(true) {
-        if (metal::all(loop_bound == uint2(0u))) { break; }
-        loop_bound -= uint2(loop_bound.y == 0u, 1u);
-        if (!loop_init) {
-            uint _e63 = k_2;
-            k_2 = _e63 + 1u;
-        }
-        loop_init = false;
-        uint _e6 = k_2;
-        if (_e6 < 4u) {
-        } else {
-            break;
-        }
-        {
-            uint _e10 = taps;
-            uint _e12 = k_2;
-            taps = _e10 + ((w[metal::min(unsigned(_e12), 3u)] > 0.0) ? 1u : 0u);
-            uint _e20 = k_2;
-            if (w[metal::min(unsigned(_e20), 3u)] > 0.0) {
-                uint _e25 = k_2;
-                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
-                local_6 = _e29;
-            } else {
-                local_6 = false;
-            }
-            bool _e33 = local_6;
-            if (_e33) {
-                uint _e35 = close;
-                close = _e35 + 1u;
-                metal::float3 _e40 = sum;
-                uint _e41 = k_2;
-                uint _e43 = k_2;
-                sum = _e40 + (w[metal::min(unsigned(_e41), 3u)] * light_1.inner[metal::min(unsigned(_e43), 3u)]);
-                float _e48 = total;
-                uint _e49 = k_2;
-                total = _e48 + w[metal::min(unsigned(_e49), 3u)];
-                metal::float3 _e53 = lo;
-                uint _e54 = k_2;
-                lo = metal::min(_e53, light_1.inner[metal::min(unsigned(_e54), 3u)]);
-                metal::float3 _e58 = hi;
-                uint _e59 = k_2;
-                hi = metal::max(_e58, light_1.inner[metal::min(unsigned(_e59), 3u)]);
-            }
-        }
-    }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_7 = _e69 < metal::min(_e70, 2u);
-    } else {
-        local_7 = true;
-    }
-    bool _e77 = local_7;
-    if (_e77) {
-        return metal::float4(0.0, 0.0, 0.0, 0.0);
-    }
-    metal::float3 _e83 = hi;
-    metal::float3 _e84 = lo;
-    metal::float3 spread = _e83 - _e84;
-    float _e93 = hi.x;
-    float _e95 = hi.y;
-    float _e97 = hi.z;
-    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e93, metal::max(_e95, _e97)))) {
-        return metal::float4(0.0, 0.0, 0.0, 0.0);
-    }
-    metal::float3 _e107 = sum;
-    float _e108 = total;
-    metal::float3 c = _e107 / metal::float3(_e108);
-    return metal::float4(c.x, c.y, c.z, 1.0);
+    metal::float3 subnormal = metal::rint(a_2 * 16777216.0) / metal::float3(16777216.0);
+    return metal::sign(v_5) * metal::select(normal, subnormal, a_2 < metal::float3(0.000061035156));
 }
 
 uint naga_mod(uint lhs, uint rhs) {
@@ -445,10 +302,10 @@ metal::float3 raymarch_pixel(
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     float u = 0.5;
-    float sum_1 = 0.0;
-    uint j_1 = {};
-    float t_2 = {};
-    float w_1 = {};
+    float sum = 0.0;
+    uint j = {};
+    float t_1 = {};
+    float w = {};
     float l = {};
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
     metal::float3 eye_2 = m_2.eye.xyz;
@@ -468,231 +325,102 @@ metal::float3 raymarch_pixel(
     }
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0.0, s, n_2);
-    j_1 = pixel_class;
-    uint2 loop_bound_1 = uint2(4294967295u);
-    bool loop_init_1 = true;
+    j = pixel_class;
+    uint2 loop_bound = uint2(4294967295u);
+    bool loop_init = true;
     while(true) {
-        if (metal::all(loop_bound_1 == uint2(0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init_1) {
-            uint _e103 = j_1;
-            j_1 = _e103 + stride;
+        if (metal::all(loop_bound == uint2(0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e103 = j;
+            j = _e103 + stride;
         }
-        loop_init_1 = false;
-        uint _e50 = j_1;
+        loop_init = false;
+        uint _e50 = j;
         if (_e50 < n_2) {
         } else {
             break;
         }
         {
-            uint _e52 = j_1;
+            uint _e52 = j;
             float _e54 = u;
-            t_2 = (static_cast<float>(_e52) + _e54) * h_2;
-            w_1 = h_2;
+            t_1 = (static_cast<float>(_e52) + _e54) * h_2;
+            w = h_2;
             if (false) {
-                uint _e60 = j_1;
+                uint _e60 = j;
                 float _e62 = u;
                 metal::float2 _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, static_cast<float>(_e60) + _e62);
-                t_2 = _e64.x;
-                w_1 = _e64.y;
+                t_1 = _e64.x;
+                w = _e64.y;
             }
-            float _e67 = t_2;
+            float _e67 = t_1;
             float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, eye_2 + (_e8 * _e67));
             if (false) {
-                float _e73 = sum_1;
-                float _e74 = w_1;
-                float _e76 = t_2;
+                float _e73 = sum;
+                float _e74 = w;
+                float _e76 = t_1;
                 float _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum_1 = _e73 + ((_e71 * _e74) * _e86);
+                sum = _e73 + ((_e71 * _e74) * _e86);
             } else {
-                float _e89 = sum_1;
-                uint _e92 = j_1;
-                uint _e95 = j_1;
+                float _e89 = sum;
+                uint _e92 = j;
+                uint _e95 = j;
                 float _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e92) * h_2, static_cast<float>(_e95 + 1u) * h_2);
-                sum_1 = _e89 + (_e71 * _e100);
+                sum = _e89 + (_e71 * _e100);
             }
         }
     }
-    float _e105 = sum_1;
+    float _e105 = sum;
     l = _e105;
     if (!(false)) {
         float _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(metal::dot(m_2.light_dir.xyz, _e8)));
-        float _e118 = sum_1;
+        float _e118 = sum;
         l = (m_2.medium.y * _e116) * _e118;
     }
     float _e122 = l;
-    metal::float3 c_1 = m_2.light_color.xyz * _e122;
-    return c_1;
+    metal::float3 c = m_2.light_color.xyz * _e122;
+    return c;
 }
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / metal::select(rhs, 1u, rhs == 0u);
-}
-
 
 struct raymarchInput {
 };
 kernel void raymarch(
-  metal::uint3 wid [[threadgroup_position_in_grid]]
-, uint li [[thread_index_in_threadgroup]]
+  metal::uint3 id [[thread_position_in_grid]]
 , constant RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX& frame [[buffer(0)]]
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
 , metal::texture2d<float, metal::access::write> output [[texture(2)]]
-, threadgroup type_11& tile_light
-, threadgroup type_12& tile_depth
-, threadgroup type_13& refine
-, threadgroup metal::atomic_uint& refine_count
+, device metal::atomic_uint& fallback_count [[buffer(1)]]
 ) {
-    if (li == 0u) {
-        tile_light = {};
-        tile_depth = {};
-        refine = {};
-        metal::atomic_store_explicit(&refine_count, 0, metal::memory_order_relaxed);
-    }
-    metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    uint k = {};
-    uint k_1 = 0u;
     bool local = {};
-    metal::float4 depths = {};
-    type_9 light = {};
-    uint j = {};
-    uint e = {};
-    uint _e4 = frame.sizes.x;
-    uint _e8 = frame.sizes.y;
-    metal::uint2 screen_3 = metal::uint2(_e4, _e8);
-    metal::uint2 _e11 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_3, SCALE);
-    metal::uint2 origin = wid.xy * 8u;
-    k = li;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e50 = k;
-            k = _e50 + LOWRES_LANES;
-        }
-        loop_init_2 = false;
-        uint _e18 = k;
-        if (_e18 < 81u) {
-        } else {
-            break;
-        }
-        {
-            uint _e21 = k;
-            uint _e24 = k;
-            metal::uint2 i_1 = metal::min(origin + metal::uint2(naga_mod(_e21, 9u), naga_div(_e24, 9u)), _e11 - metal::uint2(1u, 1u));
-            metal::uint2 _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i_1, screen_3, SCALE);
-            uint _e37 = k;
-            metal::float3 _e41 = raymarch_pixel(_e35.x, _e35.y, frame, depth, shadow_map);
-            metal::float3 _e42 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e41);
-            tile_light.inner[metal::min(unsigned(_e37), 80u)] = _e42;
-            uint _e44 = k;
-            uint clamped_lod_e48 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-            metal::float4 _e48 = depth.read(metal::min(metal::uint2(_e35), metal::uint2(depth.get_width(clamped_lod_e48), depth.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
-            tile_depth.inner[metal::min(unsigned(_e44), 80u)] = _e48.x;
-        }
+    bool local_1 = {};
+    uint _e3 = frame.sizes.x;
+    uint _e7 = frame.sizes.y;
+    metal::uint2 screen_2 = metal::uint2(_e3, _e7);
+    if (id.x == 0u) {
+        local = id.y == 0u;
+    } else {
+        local = false;
     }
-    metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
-    while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
-            uint _e149 = k_1;
-            k_1 = _e149 + 1u;
-        }
-        loop_init_3 = false;
-        uint _e54 = k_1;
-        if (_e54 < 64u) {
-        } else {
-            break;
-        }
-        {
-            uint _e58 = k_1;
-            uint e_2 = li + (LOWRES_LANES * _e58);
-            metal::uint2 q_1 = (origin * SCALE) + metal::uint2(naga_mod(e_2, 32u), naga_div(e_2, 32u));
-            if (q_1.x < screen_3.x) {
-                local = q_1.y < screen_3.y;
-            } else {
-                local = false;
-            }
-            bool _e78 = local;
-            if (_e78) {
-                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e80 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
-                depths = metal::float4(0.0, 0.0, 0.0, 0.0);
-                light = type_9 {};
-                j = 0u;
-                uint2 loop_bound_4 = uint2(4294967295u);
-                bool loop_init_4 = true;
-                while(true) {
-                    if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-                    loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-                    if (!loop_init_4) {
-                        uint _e122 = j;
-                        j = _e122 + 1u;
-                    }
-                    loop_init_4 = false;
-                    uint _e91 = j;
-                    if (_e91 < 4u) {
-                    } else {
-                        break;
-                    }
-                    {
-                        uint _e95 = j;
-                        uint _e100 = j;
-                        metal::uint2 s_1 = metal::uint2(_e80.cols[metal::min(unsigned(naga_mod(_e95, 2u)), 1u)], _e80.rows[metal::min(unsigned(naga_div(_e100, 2u)), 1u)]) - origin;
-                        uint at = (s_1.y * 9u) + s_1.x;
-                        uint _e111 = j;
-                        float _e115 = tile_depth.inner[metal::min(unsigned(at), 80u)];
-                        depths[metal::min(unsigned(_e111), 3u)] = _e115;
-                        uint _e116 = j;
-                        metal::float3 _e120 = tile_light.inner[metal::min(unsigned(at), 80u)];
-                        light.inner[metal::min(unsigned(_e116), 3u)] = _e120;
-                    }
-                }
-                metal::float4 _e125 = depths;
-                type_9 _e126 = light;
-                uint clamped_lod_e129 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-                metal::float4 _e129 = depth.read(metal::min(metal::uint2(q_1), metal::uint2(depth.get_width(clamped_lod_e129), depth.get_height(clamped_lod_e129)) - 1), clamped_lod_e129);
-                metal::float4 _e133 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e80.w, _e125, _e126, _e129.x, DEPTH_BREAK, LIGHT_BREAK);
-                if (_e133.w == 0.0) {
-                    uint _e139 = metal::atomic_fetch_add_explicit(&refine_count, 1u, metal::memory_order_relaxed);
-                    refine.inner[metal::min(unsigned(_e139), 1023u)] = q_1.x | (q_1.y << 16u);
-                } else {
-                    output.write(_e133, metal::uint2(q_1));
-                }
-            }
-        }
+    bool _e19 = local;
+    if (_e19) {
+        metal::atomic_store_explicit(&fallback_count, 0u, metal::memory_order_relaxed);
     }
-    metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    uint n_3 = metal::atomic_load_explicit(&refine_count, metal::memory_order_relaxed);
-    e = li;
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
-    while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
-            uint _e178 = e;
-            e = _e178 + LOWRES_LANES;
-        }
-        loop_init_5 = false;
-        uint _e154 = e;
-        if (_e154 < n_3) {
-        } else {
-            break;
-        }
-        {
-            uint _e157 = e;
-            uint _e159 = refine.inner[metal::min(unsigned(_e157), 1023u)];
-            uint _e163 = e;
-            uint _e165 = refine.inner[metal::min(unsigned(_e163), 1023u)];
-            metal::uint2 q_2 = metal::uint2(_e159 & 65535u, _e165 >> 16u);
-            metal::float3 _e171 = raymarch_pixel(q_2.x, q_2.y, frame, depth, shadow_map);
-            output.write(metal::float4(_e171.x, _e171.y, _e171.z, 1.0), metal::uint2(q_2));
-        }
+    metal::uint2 _e23 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
+    if (!((id.x >= _e23.x))) {
+        local_1 = id.y >= _e23.y;
+    } else {
+        local_1 = true;
     }
+    bool _e34 = local_1;
+    if (_e34) {
+        return;
+    }
+    metal::uint2 _e37 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
+    metal::float3 _e40 = raymarch_pixel(_e37.x, _e37.y, frame, depth, shadow_map);
+    metal::float3 _e41 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e40);
+    uint clamped_lod_e48 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e48 = depth.read(metal::min(metal::uint2(_e37), metal::uint2(depth.get_width(clamped_lod_e48), depth.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
+    output.write(metal::float4(_e41.x, _e41.y, _e41.z, _e48.x), metal::uint2(id.xy));
     return;
 }

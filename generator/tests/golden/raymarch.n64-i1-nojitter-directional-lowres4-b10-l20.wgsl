@@ -34,14 +34,7 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     dtheta: f32,
 }
 
-struct LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    cols: vec2<u32>,
-    rows: vec2<u32>,
-    w: vec4<f32>,
-}
-
 const SCALE: u32 = 4u;
-const LOWRES_LANES: u32 = 16u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
 
@@ -52,11 +45,9 @@ var depth: texture_2d<f32>;
 @group(0) @binding(2) 
 var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) 
-var output: texture_storage_2d<rgba16float,write>;
-var<workgroup> tile_light: array<vec3<f32>, 81>;
-var<workgroup> tile_depth: array<f32, 81>;
-var<workgroup> refine: array<u32, 1024>;
-var<workgroup> refine_count: atomic<u32>;
+var output: texture_storage_2d<rgba32float,write>;
+@group(0) @binding(5) 
+var<storage, read_write> fallback_count: atomic<u32>;
 
 fn raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(m.sm_right, m.sm_up, m.sm_forward, m.sm_origin, m.sm_proj, vec4<u32>(m.sizes.z, 0u, 0u, 0u));
@@ -65,8 +56,8 @@ fn raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m: Raymarch
 fn raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_1: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX, x: u32, y: u32) -> vec3<f32> {
     let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(m_1.sizes.x)) - 1f);
     let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(m_1.sizes.y)));
-    let t_3 = m_1.cam_forward.w;
-    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_3) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_3))));
+    let t_2 = m_1.cam_forward.w;
+    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2))));
 }
 
 fn pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_1: u32, y_1: u32) -> f32 {
@@ -116,11 +107,11 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     let x_6 = (eye + (dir * t));
     let to_x = (x_6 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
-    let d_1 = sqrt(d2_);
-    let travel = (to_x / vec3(d_1));
+    let d = sqrt(d2_);
+    let travel = (to_x / vec3(d));
     let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, light_pos_1: vec3<f32>, a_1: f32, b_1: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -130,9 +121,9 @@ fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: 
     return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_1 - t0_) / h_1)) - theta_a) / f32(n)));
 }
 
-fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e_1: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x_2: f32) -> vec2<f32> {
-    let tau = tan((e_1.theta_a + (x_2 * e_1.dtheta)));
-    return vec2<f32>((e_1.t_close + (e_1.dist * tau)), ((e_1.dtheta * e_1.dist) * (1f + (tau * tau))));
+fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x_2: f32) -> vec2<f32> {
+    let tau = tan((e.theta_a + (x_2 * e.dtheta)));
+    return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
@@ -143,36 +134,36 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
 fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
     if (v_1.origin.w > 0.5f) {
         let z_1 = max(ls.z, 0.000001f);
-        let t_4 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_4))), (0.5f - ((0.5f * ls.y) / (z_1 * t_4))));
+        let t_3 = v_1.proj.x;
+        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
     } else {
         return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
     }
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_1: bool;
     var local_2: bool;
     var local_3: bool;
+    var local_4: bool;
 
     if !((uv.x < 0f)) {
-        local_1 = (uv.x > 1f);
-    } else {
-        local_1 = true;
-    }
-    let _e11 = local_1;
-    if !(_e11) {
-        local_2 = (uv.y < 0f);
+        local_2 = (uv.x > 1f);
     } else {
         local_2 = true;
     }
-    let _e19 = local_2;
-    if !(_e19) {
-        local_3 = (uv.y > 1f);
+    let _e11 = local_2;
+    if !(_e11) {
+        local_3 = (uv.y < 0f);
     } else {
         local_3 = true;
     }
-    let _e27 = local_3;
+    let _e19 = local_3;
+    if !(_e19) {
+        local_4 = (uv.y > 1f);
+    } else {
+        local_4 = true;
+    }
+    let _e27 = local_4;
     if _e27 {
         return 2f;
     }
@@ -197,17 +188,17 @@ fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga
 }
 
 fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_4: bool;
+    var local_5: bool;
 
     let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
     let near = v_4.right.w;
     let far = v_4.up.w;
     if (v_4.origin.w > 0.5f) {
-        local_4 = (_e2.z <= near);
+        local_5 = (_e2.z <= near);
     } else {
-        local_4 = false;
+        local_5 = false;
     }
-    let _e16 = local_4;
+    let _e16 = local_5;
     if _e16 {
         return 1f;
     }
@@ -227,127 +218,19 @@ fn lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i: vec2<u32>, scree
 }
 
 fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_5: vec3<f32>) -> vec3<f32> {
-    let a_3 = min(abs(v_5), vec3(65504f));
-    let u_1 = bitcast<vec3<u32>>(a_3);
+    let a_2 = min(abs(v_5), vec3(65504f));
+    let u_1 = bitcast<vec3<u32>>(a_2);
     let normal = bitcast<vec3<f32>>((((u_1 + vec3(4095u)) + ((u_1 >> vec3(13u)) & vec3(1u))) & vec3(4294959104u)));
-    let subnormal = (round((a_3 * 16777216f)) / vec3(16777216f));
-    return (sign(v_5) * select(normal, subnormal, (a_3 < vec3(0.000061035156f))));
-}
-
-fn lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(p_2: vec2<u32>, screen_2: vec2<u32>, scale_2: u32) -> LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    var t_1: LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
-
-    let _e2 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, scale_2);
-    let lo_1 = (p_2 / vec2(scale_2));
-    let hi_1 = min((lo_1 + vec2<u32>(1u, 1u)), (_e2 - vec2<u32>(1u, 1u)));
-    let _e15 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lo_1, screen_2, scale_2);
-    let _e16 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(hi_1, screen_2, scale_2);
-    let fr = (vec2<f32>((p_2 - _e15)) / vec2<f32>(max((_e16 - _e15), vec2<u32>(1u, 1u))));
-    t_1.cols = vec2<u32>(lo_1.x, hi_1.x);
-    t_1.rows = vec2<u32>(lo_1.y, hi_1.y);
-    t_1.w = vec4<f32>(((1f - fr.x) * (1f - fr.y)), (fr.x * (1f - fr.y)), ((1f - fr.x) * fr.y), (fr.x * fr.y));
-    let _e57 = t_1;
-    return _e57;
-}
-
-fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_2: f32, b_2: f32, depth_break: f32) -> bool {
-    var local_5: bool;
-
-    if !((a_2 == b_2)) {
-        local_5 = (abs((a_2 - b_2)) <= (depth_break * min(a_2, b_2)));
-    } else {
-        local_5 = true;
-    }
-    let _e13 = local_5;
-    return _e13;
-}
-
-fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depths_1: vec4<f32>, light_1: array<vec3<f32>, 4>, d: f32, depth_break_1: f32, light_break: f32) -> vec4<f32> {
-    var sum: vec3<f32> = vec3<f32>(0f, 0f, 0f);
-    var total: f32 = 0f;
-    var lo: vec3<f32> = vec3<f32>(340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f);
-    var hi: vec3<f32> = vec3<f32>(0f, 0f, 0f);
-    var taps: u32 = 0u;
-    var close: u32 = 0u;
-    var k_2: u32 = 0u;
-    var local_6: bool;
-    var local_7: bool;
-
-    loop {
-        let _e6 = k_2;
-        if (_e6 < 4u) {
-        } else {
-            break;
-        }
-        {
-            let _e10 = taps;
-            let _e12 = k_2;
-            taps = (_e10 + select(0u, 1u, (w[_e12] > 0f)));
-            let _e20 = k_2;
-            if (w[_e20] > 0f) {
-                let _e25 = k_2;
-                let _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_6 = _e29;
-            } else {
-                local_6 = false;
-            }
-            let _e33 = local_6;
-            if _e33 {
-                let _e35 = close;
-                close = (_e35 + 1u);
-                let _e40 = sum;
-                let _e41 = k_2;
-                let _e43 = k_2;
-                sum = (_e40 + (w[_e41] * light_1[_e43]));
-                let _e48 = total;
-                let _e49 = k_2;
-                total = (_e48 + w[_e49]);
-                let _e53 = lo;
-                let _e54 = k_2;
-                lo = min(_e53, light_1[_e54]);
-                let _e58 = hi;
-                let _e59 = k_2;
-                hi = max(_e58, light_1[_e59]);
-            }
-        }
-        continuing {
-            let _e63 = k_2;
-            k_2 = (_e63 + 1u);
-        }
-    }
-    let _e65 = total;
-    if !((_e65 <= 0f)) {
-        let _e69 = close;
-        let _e70 = taps;
-        local_7 = (_e69 < min(_e70, 2u));
-    } else {
-        local_7 = true;
-    }
-    let _e77 = local_7;
-    if _e77 {
-        return vec4<f32>(0f, 0f, 0f, 0f);
-    }
-    let _e83 = hi;
-    let _e84 = lo;
-    let spread = (_e83 - _e84);
-    let _e93 = hi.x;
-    let _e95 = hi.y;
-    let _e97 = hi.z;
-    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97)))) {
-        return vec4<f32>(0f, 0f, 0f, 0f);
-    }
-    let _e107 = sum;
-    let _e108 = total;
-    let c = (_e107 / vec3(_e108));
-    return vec4<f32>(c.x, c.y, c.z, 1f);
+    let subnormal = (round((a_2 * 16777216f)) / vec3(16777216f));
+    return (sign(v_5) * select(normal, subnormal, (a_2 < vec3(0.000061035156f))));
 }
 
 fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     var u: f32 = 0.5f;
-    var sum_1: f32 = 0f;
-    var j_1: u32;
-    var t_2: f32;
-    var w_1: f32;
+    var sum: f32 = 0f;
+    var j: u32;
+    var t_1: f32;
+    var w: f32;
     var l: f32;
 
     let m_2 = frame;
@@ -367,182 +250,89 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     }
     let _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     let _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0f, s, n_2);
-    j_1 = pixel_class;
+    j = pixel_class;
     loop {
-        let _e50 = j_1;
+        let _e50 = j;
         if (_e50 < n_2) {
         } else {
             break;
         }
         {
-            let _e52 = j_1;
+            let _e52 = j;
             let _e54 = u;
-            t_2 = ((f32(_e52) + _e54) * h_2);
-            w_1 = h_2;
+            t_1 = ((f32(_e52) + _e54) * h_2);
+            w = h_2;
             if false {
-                let _e60 = j_1;
+                let _e60 = j;
                 let _e62 = u;
                 let _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (f32(_e60) + _e62));
-                t_2 = _e64.x;
-                w_1 = _e64.y;
+                t_1 = _e64.x;
+                w = _e64.y;
             }
-            let _e67 = t_2;
+            let _e67 = t_1;
             let _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)));
             if false {
-                let _e73 = sum_1;
-                let _e74 = w_1;
-                let _e76 = t_2;
+                let _e73 = sum;
+                let _e74 = w;
+                let _e76 = t_1;
                 let _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum_1 = (_e73 + ((_e71 * _e74) * _e86));
+                sum = (_e73 + ((_e71 * _e74) * _e86));
             } else {
-                let _e89 = sum_1;
-                let _e92 = j_1;
-                let _e95 = j_1;
+                let _e89 = sum;
+                let _e92 = j;
+                let _e95 = j;
                 let _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e92) * h_2), (f32((_e95 + 1u)) * h_2));
-                sum_1 = (_e89 + (_e71 * _e100));
+                sum = (_e89 + (_e71 * _e100));
             }
         }
         continuing {
-            let _e103 = j_1;
-            j_1 = (_e103 + stride);
+            let _e103 = j;
+            j = (_e103 + stride);
         }
     }
-    let _e105 = sum_1;
+    let _e105 = sum;
     l = _e105;
     if !(false) {
         let _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e8)));
-        let _e118 = sum_1;
+        let _e118 = sum;
         l = ((m_2.medium.y * _e116) * _e118);
     }
     let _e122 = l;
-    let c_1 = (m_2.light_color.xyz * _e122);
-    return c_1;
+    let c = (m_2.light_color.xyz * _e122);
+    return c;
 }
 
-@compute @workgroup_size(16, 1, 1) 
-fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
-    var k: u32;
-    var k_1: u32 = 0u;
+@compute @workgroup_size(8, 8, 1) 
+fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
     var local: bool;
-    var depths: vec4<f32>;
-    var light: array<vec3<f32>, 4>;
-    var j: u32;
-    var e: u32;
+    var local_1: bool;
 
-    let _e4 = frame.sizes.x;
-    let _e8 = frame.sizes.y;
-    let screen_3 = vec2<u32>(_e4, _e8);
-    let _e11 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_3, SCALE);
-    let origin = (wid.xy * 8u);
-    k = li;
-    loop {
-        let _e18 = k;
-        if (_e18 < 81u) {
-        } else {
-            break;
-        }
-        {
-            let _e21 = k;
-            let _e24 = k;
-            let i_1 = min((origin + vec2<u32>((_e21 % 9u), (_e24 / 9u))), (_e11 - vec2<u32>(1u, 1u)));
-            let _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i_1, screen_3, SCALE);
-            let _e37 = k;
-            let _e41 = raymarch_pixel(_e35.x, _e35.y);
-            let _e42 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e41);
-            tile_light[_e37] = _e42;
-            let _e44 = k;
-            let _e48 = textureLoad(depth, _e35, 0i);
-            tile_depth[_e44] = _e48.x;
-        }
-        continuing {
-            let _e50 = k;
-            k = (_e50 + LOWRES_LANES);
-        }
+    let _e3 = frame.sizes.x;
+    let _e7 = frame.sizes.y;
+    let screen_2 = vec2<u32>(_e3, _e7);
+    if (id.x == 0u) {
+        local = (id.y == 0u);
+    } else {
+        local = false;
     }
-    workgroupBarrier();
-    loop {
-        let _e54 = k_1;
-        if (_e54 < 64u) {
-        } else {
-            break;
-        }
-        {
-            let _e58 = k_1;
-            let e_2 = (li + (LOWRES_LANES * _e58));
-            let q_1 = ((origin * SCALE) + vec2<u32>((e_2 % 32u), (e_2 / 32u)));
-            if (q_1.x < screen_3.x) {
-                local = (q_1.y < screen_3.y);
-            } else {
-                local = false;
-            }
-            let _e78 = local;
-            if _e78 {
-                let _e80 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
-                depths = vec4<f32>(0f, 0f, 0f, 0f);
-                light = array<vec3<f32>, 4>();
-                j = 0u;
-                loop {
-                    let _e91 = j;
-                    if (_e91 < 4u) {
-                    } else {
-                        break;
-                    }
-                    {
-                        let _e95 = j;
-                        let _e100 = j;
-                        let s_1 = (vec2<u32>(_e80.cols[(_e95 % 2u)], _e80.rows[(_e100 / 2u)]) - origin);
-                        let at = ((s_1.y * 9u) + s_1.x);
-                        let _e111 = j;
-                        let _e115 = tile_depth[at];
-                        depths[_e111] = _e115;
-                        let _e116 = j;
-                        let _e120 = tile_light[at];
-                        light[_e116] = _e120;
-                    }
-                    continuing {
-                        let _e122 = j;
-                        j = (_e122 + 1u);
-                    }
-                }
-                let _e125 = depths;
-                let _e126 = light;
-                let _e129 = textureLoad(depth, q_1, 0i);
-                let _e133 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e80.w, _e125, _e126, _e129.x, DEPTH_BREAK, LIGHT_BREAK);
-                if (_e133.w == 0f) {
-                    let _e139 = atomicAdd((&refine_count), 1u);
-                    refine[_e139] = (q_1.x | (q_1.y << 16u));
-                } else {
-                    textureStore(output, q_1, _e133);
-                }
-            }
-        }
-        continuing {
-            let _e149 = k_1;
-            k_1 = (_e149 + 1u);
-        }
+    let _e19 = local;
+    if _e19 {
+        atomicStore((&fallback_count), 0u);
     }
-    workgroupBarrier();
-    let n_3 = atomicLoad((&refine_count));
-    e = li;
-    loop {
-        let _e154 = e;
-        if (_e154 < n_3) {
-        } else {
-            break;
-        }
-        {
-            let _e157 = e;
-            let _e159 = refine[_e157];
-            let _e163 = e;
-            let _e165 = refine[_e163];
-            let q_2 = vec2<u32>((_e159 & 65535u), (_e165 >> 16u));
-            let _e171 = raymarch_pixel(q_2.x, q_2.y);
-            textureStore(output, q_2, vec4<f32>(_e171.x, _e171.y, _e171.z, 1f));
-        }
-        continuing {
-            let _e178 = e;
-            e = (_e178 + LOWRES_LANES);
-        }
+    let _e23 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
+    if !((id.x >= _e23.x)) {
+        local_1 = (id.y >= _e23.y);
+    } else {
+        local_1 = true;
     }
+    let _e34 = local_1;
+    if _e34 {
+        return;
+    }
+    let _e37 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
+    let _e40 = raymarch_pixel(_e37.x, _e37.y);
+    let _e41 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e40);
+    let _e48 = textureLoad(depth, _e37, 0i);
+    textureStore(output, id.xy, vec4<f32>(_e41.x, _e41.y, _e41.z, _e48.x));
     return;
 }

@@ -117,8 +117,8 @@ pub fn lowres_blend(
 pub struct SampledOutput {
     /// The screen-sized output as stored (rgba16float).
     pub output: TexArray,
-    /// Pixel evaluations (every pixel for `pixels`; for `lowres` the samples, without the
-    /// ring a workgroup evaluates again, plus the pixels evaluated themselves).
+    /// Pixel evaluations (every pixel for `pixels`; for `lowres` the samples plus the pixels
+    /// evaluated themselves).
     pub evaluated: u64,
     /// `lowres`: the pixels evaluated themselves because no sample is close in depth.
     pub depth_refined: u64,
@@ -129,10 +129,11 @@ pub struct SampledOutput {
 /// The family's sampling entry point (`include/sampled_entry.wgsl`): `pixel(x, y)` is the
 /// family's per-pixel body (radiance before rounding), `screen` the screen size, `camera`
 /// what the epipolar layout is built from (read only by `epipolar`).
-/// `pixels`: every pixel (rows in parallel). `lowres`: every sample, then every pixel the
-/// blend of its taps or its own evaluation. `epipolar`: its three passes
-/// ([`epipolar_samples`], [`epipolar_unwarp`], [`epipolar_fallback`]). (The GPU evaluates the samples of a workgroup's
-/// ring again; the same pixel gives the same value, so the mirror evaluates each once.)
+/// `pixels`: every pixel (rows in parallel). `lowres`: its three passes in one (every
+/// sample, as the family's kernel stores them in `lowres_samples`; every pixel the blend of
+/// its taps, as `<kernel>_unwarp` writes it, or its own evaluation, as `<kernel>_fallback`
+/// writes it). `epipolar`: its three passes ([`epipolar_samples`], [`epipolar_unwarp`],
+/// [`epipolar_fallback`]).
 pub fn run_sampled(
     knobs: &SamplingKnobs,
     screen: [u32; 2],

@@ -130,7 +130,7 @@ pub(crate) fn render_gather(variant: &AreaIvsvVariant) -> Result<String, ShaderE
         interleave: variant.interleave,
         output_format: if variant.interleave > 1 {
             "rgba32float"
-        } else if variant.sampling == Sampling::Epipolar {
+        } else if variant.sampling != Sampling::Pixels {
             EPIPOLAR_SAMPLES_FORMAT
         } else {
             "rgba16float"
@@ -208,7 +208,7 @@ impl crate::KernelParams {
         if variant.interleave > 1 {
             out.push(Self::IvsvInterleaveSum(variant));
         }
-        if variant.sampling == Sampling::Epipolar {
+        if variant.sampling != Sampling::Pixels {
             out.push(Self::IvsvGatherUnwarp(variant));
             out.push(Self::IvsvGatherFallback(variant));
         }

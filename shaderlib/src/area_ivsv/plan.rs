@@ -10,7 +10,7 @@ use crate::plan::{
     screen_and_shadow_parameters, texture_2d,
 };
 use crate::sampling::{
-    epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
+    fallback_buffers, fallback_pass, sampled_output, sampled_pass, samples_texture,
     sampling_invocations, unwarp_pass,
 };
 use crate::{Kernel, KernelParams};
@@ -99,7 +99,7 @@ pub fn plan(v: &AreaIvsvVariant) -> Plan {
             "screen.height",
         ));
     }
-    resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
+    resources.extend(samples_texture(&v.sampling_knobs()));
     resources.extend(fallback_buffers(&v.sampling_knobs()));
     let passes = KernelParams::area_ivsv(*v)
         .iter()

@@ -179,7 +179,7 @@ impl crate::KernelParams {
 impl crate::family::KernelFamily for HybridVolumeVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
         let mut out = crate::KernelParams::hybrid_volume(*self).to_vec();
-        if self.sampling == crate::sampling::Sampling::Epipolar {
+        if self.sampling != crate::sampling::Sampling::Pixels {
             out.push(crate::KernelParams::VolumeMarchUnwarp(*self));
             out.push(crate::KernelParams::VolumeMarchFallback(*self));
         }

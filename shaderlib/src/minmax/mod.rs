@@ -166,7 +166,7 @@ impl crate::KernelParams {
 impl crate::family::KernelFamily for MinmaxVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
         let mut out = crate::KernelParams::minmax(*self).to_vec();
-        if self.sampling == crate::sampling::Sampling::Epipolar {
+        if self.sampling != crate::sampling::Sampling::Pixels {
             out.push(crate::KernelParams::MinmaxTraverseUnwarp(*self));
             out.push(crate::KernelParams::MinmaxTraverseFallback(*self));
         }

@@ -15,7 +15,7 @@ use crate::plan::{
     screen_and_shadow_parameters,
 };
 use crate::sampling::{
-    epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
+    fallback_buffers, fallback_pass, sampled_output, sampled_pass, samples_texture,
     sampling_invocations, unwarp_pass,
 };
 
@@ -117,7 +117,7 @@ pub fn plan(v: &PartialSumTreeVariant) -> Plan {
         parameters.extend(cookie_parameters());
         resources.push(cookie_texture());
     }
-    resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
+    resources.extend(samples_texture(&v.sampling_knobs()));
     resources.extend(fallback_buffers(&v.sampling_knobs()));
     let passes = v
         .kernel_params()

@@ -38,7 +38,7 @@ impl crate::KernelParams {
 impl crate::family::KernelFamily for PrefilteredVariant {
     fn kernel_params(&self) -> Vec<crate::KernelParams> {
         let mut out = crate::KernelParams::prefiltered(*self).to_vec();
-        if self.sampling == crate::sampling::Sampling::Epipolar {
+        if self.sampling != crate::sampling::Sampling::Pixels {
             out.push(crate::KernelParams::ScatterUnwarp(*self));
             out.push(crate::KernelParams::ScatterFallback(*self));
         }

@@ -12,7 +12,7 @@ use crate::plan::{
 };
 use crate::prefiltered::{Basis, PrefilteredVariant, Rectification};
 use crate::sampling::{
-    epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
+    fallback_buffers, fallback_pass, sampled_output, sampled_pass, samples_texture,
     sampling_invocations, unwarp_pass,
 };
 
@@ -127,7 +127,7 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
         parameters.extend(cookie_parameters());
         resources.push(cookie_texture());
     }
-    resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
+    resources.extend(samples_texture(&v.sampling_knobs()));
     resources.extend(fallback_buffers(&v.sampling_knobs()));
     // One pass per kernel shaderlib lists for the variant, in its order; a kernel this
     // module does not know gets no pass, and generation names it.

@@ -95,7 +95,7 @@ pub(crate) fn render_raymarch(variant: &RaymarchVariant) -> Result<String, Shade
         cookie: variant.cookie,
         output_format: if variant.interleaved() {
             PARTIAL_FORMAT
-        } else if variant.sampling == Sampling::Epipolar {
+        } else if variant.sampling != Sampling::Pixels {
             EPIPOLAR_SAMPLES_FORMAT
         } else {
             "rgba16float"
@@ -182,7 +182,7 @@ impl crate::KernelParams {
         if variant.interleaved() {
             out.push(Self::InterleaveSum(variant));
         }
-        if variant.sampling == Sampling::Epipolar {
+        if variant.sampling != Sampling::Pixels {
             out.push(Self::RaymarchUnwarp(variant));
             out.push(Self::RaymarchFallback(variant));
         }

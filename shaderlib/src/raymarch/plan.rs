@@ -8,7 +8,7 @@ use crate::plan::{
 };
 use crate::raymarch::{PARTIAL_FORMAT, RaymarchVariant};
 use crate::sampling::{
-    epipolar_samples_texture, fallback_buffers, fallback_pass, sampled_output, sampled_pass,
+    fallback_buffers, fallback_pass, sampled_output, sampled_pass, samples_texture,
     sampling_invocations, unwarp_pass,
 };
 use crate::{Kernel, KernelParams};
@@ -40,7 +40,7 @@ pub fn plan(v: &RaymarchVariant) -> Plan {
     if v.cookie {
         resources.push(cookie_texture());
     }
-    resources.extend(epipolar_samples_texture(&v.sampling_knobs()));
+    resources.extend(samples_texture(&v.sampling_knobs()));
     resources.extend(fallback_buffers(&v.sampling_knobs()));
     if v.interleaved() {
         resources.push(scatter_texture(

@@ -2,8 +2,6 @@
 
 // The low-resolution grid's block side S, and its depth and light breaks (fractions).
 const SCALE: u32 = {{ sampling.scale }}u;
-// Invocations per workgroup (one per 8 x 8 blocks).
-const LOWRES_LANES: u32 = {{ sampling.lowres_lanes }}u;
 const DEPTH_BREAK: f32 = {{ sampling.depth_break }};
 const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 {%- endif %}
@@ -20,7 +18,11 @@ const SLICE_RUNS: u32 = (SLICE_SAMPLES + STEP - 1u) / STEP;
 const DEPTH_BREAK: f32 = {{ sampling.depth_break }};
 const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 {%- endif %}
-{%- if sampling.unwarp %}
+{%- if sampling.unwarp && sampling.lowres %}
+// The samples of the low-resolution grid (written by `{{ sampling.family_entry }}`): radiance, and the
+// view depth of the sample's pixel in w.
+@group(0) @binding({{ sampling.binding }}) var lowres_samples: texture_2d<f32>;
+{%- else if sampling.unwarp %}
 // The samples of every slice (written by `{{ sampling.family_entry }}`): radiance, and the view depth
 // of the sample's pixel in w.
 @group(0) @binding({{ sampling.binding }}) var epipolar_samples: texture_2d<f32>;
@@ -30,7 +32,7 @@ const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 // x | y << 16) and their count.
 @group(0) @binding({{ sampling.binding + 1 }}) var<storage, read> fallback_count: u32;
 @group(0) @binding({{ sampling.binding + 2 }}) var<storage, read> fallback_pixels: array<u32>;
-{%- else if sampling.epipolar %}
+{%- else if sampling.lowres || sampling.epipolar %}
 // How many pixels `{{ sampling.family_entry }}_unwarp` listed for `{{ sampling.family_entry }}_fallback` (zeroed by `{{ sampling.family_entry }}`).
 @group(0) @binding({{ sampling.binding + 1 }}) var<storage, read_write> fallback_count: atomic<u32>;
 {%- endif %}

@@ -1,67 +1,57 @@
-{%- if sampling.lowres %}
+{%- if sampling.lowres && !sampling.unwarp && !sampling.fallback %}
 
-// Samples of the workgroup's 8 x 8 blocks and of the next column and row of blocks (the
-// taps of a block's pixels are its own sample and its right and lower neighbours'), and
-// the depths of their pixels.
-var<workgroup> tile_light: array<vec3<f32>, 81>;
-var<workgroup> tile_depth: array<f32, 81>;
-// The blocks' pixels to evaluate themselves, packed x | y << 16, and their count (workgroup
-// memory starts zeroed).
-var<workgroup> refine: array<u32, {{ 64 * sampling.scale * sampling.scale }}>;
-var<workgroup> refine_count: atomic<u32>;
-
-// Sampling pass (`sampling = lowres`, scatter::sampling): workgroup `wid` owns the 8 x 8
-// blocks from block 8 wid. Phase 1: its LOWRES_LANES invocations evaluate the 9 x 9 samples of those
-// blocks and the next ones (sample = the block's first pixel) into workgroup memory,
-// rounded to f16 as a per-pixel pass would store them.
-// Phase 2: the invocations take the workgroup's 8 S x 8 S pixels, LOWRES_LANES neighbouring
-// ones at a time: each gets the blend of its taps (`lowres_blend`), or goes on the
-// workgroup's list where the taps cannot stand for it.
-// Phase 3: the invocations evaluate the listed pixels. LOWRES_LANES = 16, not 64: llvmpipe
-// runs a loop's body at least once for every 8-lane batch, under an empty mask where the
-// batch has nothing to do, and the list is usually short or empty.
-// Dispatch: (ceil(W / (8 S)), ceil(H / (8 S)), 1) workgroups of (LOWRES_LANES, 1, 1).
-@compute @workgroup_size({{ sampling.lowres_lanes }}, 1, 1)
-fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+// Sampling pass 1 (`sampling = lowres`, scatter::sampling): invocation `id` evaluates sample
+// `id` of the low-resolution grid (`lowres_pixel`: the first pixel of block `id`, or the
+// screen's last pixel) into `output` (`lowres_samples`, rgba32float: the radiance rounded to
+// f16 as a per-pixel pass would store it, the sample pixel's view depth in w), and zeroes
+// `fallback_count` for the unwarp. Three passes, as with epipolar sampling, not one with the
+// blend and the refinement in workgroup memory: there (one workgroup per 8 x 8 blocks) the
+// workgroups evaluated their 9 x 9 samples, 27 % more than they own, and llvmpipe runs the
+// code between barriers as separately resumed parts; the single pass took 61-76 ms for
+// prefiltered m32-r8 at lowres 2 and 1280x720 (eleventh bench run).
+// Dispatch: (ceil((ceil(W / S) + 1) / 8), ceil((ceil(H / S) + 1) / 8), 1) workgroups of
+// (8, 8, 1); the invocations beyond the grid (ceil((W - 1) / S) + 1 per axis) return.
+@compute @workgroup_size(8, 8, 1)
+fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
+    if id.x == 0u && id.y == 0u {
+        // An empty fallback list for the unwarp (no host clear).
+        atomicStore(&fallback_count, 0u);
+    }
     let grid = lowres_grid(screen, SCALE);
-    let origin = wid.xy * 8u;
-    for (var k = li; k < 81u; k += LOWRES_LANES) {
-        let i = min(origin + vec2<u32>(k % 9u, k / 9u), grid - vec2<u32>(1u, 1u));
-        let p = lowres_pixel(i, screen, SCALE);
-        tile_light[k] = round_f16({{ sampling.pixel }}(p.x, p.y));
-        tile_depth[k] = textureLoad(depth, p, 0).x;
+    if id.x >= grid.x || id.y >= grid.y {
+        return;
     }
-    workgroupBarrier();
-    // Pixel e of the workgroup's 8 S x 8 S pixels goes to invocation e mod LOWRES_LANES:
-    // neighbouring invocations take neighbouring pixels.
-    for (var k = 0u; k < 64u * SCALE * SCALE / LOWRES_LANES; k++) {
-        let e = li + LOWRES_LANES * k;
-        let q = origin * SCALE + vec2<u32>(e % (8u * SCALE), e / (8u * SCALE));
-        if q.x < screen.x && q.y < screen.y {
-            let t = lowres_taps(q, screen, SCALE);
-            var depths = vec4<f32>(0.0, 0.0, 0.0, 0.0);
-            var light: array<vec3<f32>, 4>;
-            for (var j = 0u; j < 4u; j++) {
-                let s = vec2<u32>(t.cols[j % 2u], t.rows[j / 2u]) - origin;
-                let at = s.y * 9u + s.x;
-                depths[j] = tile_depth[at];
-                light[j] = tile_light[at];
-            }
-            let c = lowres_blend(t.w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
-            if c.w == 0.0 {
-                refine[atomicAdd(&refine_count, 1u)] = q.x | (q.y << 16u);
-            } else {
-                textureStore(output, q, c);
-            }
-        }
+    let p = lowres_pixel(id.xy, screen, SCALE);
+    let c = round_f16({{ sampling.pixel }}(p.x, p.y));
+    textureStore(output, id.xy, vec4<f32>(c.x, c.y, c.z, textureLoad(depth, p, 0).x));
+}
+{%- else if sampling.lowres && sampling.unwarp %}
+
+// Sampling pass 2 (`sampling = lowres`, scatter::sampling): invocation `id` gives pixel `id`
+// the blend of its four samples (`lowres_taps`) kept by depth and light spread
+// (`lowres_blend`), or, where they cannot stand for it, lists it in `fallback_pixels` for
+// pass 3 and writes nothing. Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1).
+@compute @workgroup_size(8, 8, 1)
+fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
+    let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
+    let q = id.xy;
+    if q.x >= screen.x || q.y >= screen.y {
+        return;
     }
-    workgroupBarrier();
-    let n = atomicLoad(&refine_count);
-    for (var e = li; e < n; e += LOWRES_LANES) {
-        let q = vec2<u32>(refine[e] & 0xffffu, refine[e] >> 16u);
-        let c = {{ sampling.pixel }}(q.x, q.y);
-        textureStore(output, q, vec4<f32>(c.x, c.y, c.z, 1.0));
+    let t = lowres_taps(q, screen, SCALE);
+    var depths = vec4<f32>(0.0, 0.0, 0.0, 0.0);
+    var light: array<vec3<f32>, 4>;
+    for (var j = 0u; j < 4u; j++) {
+        let v = textureLoad(lowres_samples, vec2<u32>(t.cols[j % 2u], t.rows[j / 2u]), 0);
+        depths[j] = v.w;
+        light[j] = v.xyz;
+    }
+    let c = lowres_blend(t.w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
+    if c.w == 0.0 {
+        fallback_pixels[atomicAdd(&fallback_count, 1u)] = q.x | (q.y << 16u);
+    } else {
+        textureStore(output, q, c);
     }
 }
 {%- else if sampling.epipolar && !sampling.unwarp && !sampling.fallback %}
@@ -246,7 +236,7 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 {%- else if sampling.fallback %}
 
-// Sampling pass 3 (`sampling = epipolar`, scatter::sampling): the pixels the unwarp listed
+// Sampling pass 3 (`sampling = lowres | epipolar`, scatter::sampling): the pixels the unwarp listed
 // in `fallback_pixels`, evaluated with the family's per-pixel body: invocation i of the N
 // takes entries i, i + N, ... (one invocation per 8 x 8 pixels: a fixed dispatch, no
 // indirect one; where nothing is listed each 8-lane batch runs the body once under an
