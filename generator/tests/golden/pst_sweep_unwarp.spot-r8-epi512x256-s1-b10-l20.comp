@@ -107,8 +107,8 @@ layout(std430, binding = 12) buffer type_13_block_2Compute { uint _group_0_bindi
 
 
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
-    vec3 q_1 = (p - v.origin.xyz);
-    return vec3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+    vec3 q_2 = (p - v.origin.xyz);
+    return vec3(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
 }
 
 vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
@@ -260,7 +260,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
     float h_5 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
     float g0_ = atan(((a_1 - t0_) / h_5));
-    float w_2 = ((atan(((b_1 - t0_) / h_5)) - g0_) / float(panels));
+    float w_3 = ((atan(((b_1 - t0_) / h_5)) - g0_) / float(panels));
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
@@ -275,7 +275,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
         }
         {
             uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_2));
+            float mid = (g0_ + ((float(_e32) + 0.5) * w_3));
             q = 0u;
             bool loop_init_1 = true;
             while(true) {
@@ -291,7 +291,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                 }
                 {
                     uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    float u = tan((mid + ((0.5 * w_3) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -301,7 +301,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w_2) * h_5);
+    return (((_e75 * 0.5) * w_3) * h_5);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
@@ -440,9 +440,9 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_2) {
     if (spot_2) {
-        vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        vec3 q_3 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
         vec3 to_eye = -(f_9.axis.xyz);
-        return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
+        return atan(length(cross(q_3, to_eye)), dot(q_3, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
@@ -651,6 +651,20 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
     return _e70;
 }
 
+void unwarp_pixel(uvec2 q_1, vec4 w_2, vec4 depths_2, vec3 light_2[4]) {
+    int _e3_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+    vec4 _e3 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(q_1), ivec2(0), textureSize(_group_0_binding_2_cs, _e3_clamped_lod) - ivec2(1)), _e3_clamped_lod);
+    vec4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e10.w == 0.0)) {
+        uint _e16 = atomicAdd(_group_0_binding_11_cs, 1u);
+        _group_0_binding_12_cs[_e16] = (q_1.x | (q_1.y << 16u));
+        return;
+    } else {
+        imageStore(_group_0_binding_9_cs, ivec2(q_1), _e10);
+        return;
+    }
+}
+
 uint pst_columns_crossed(PstRay r_1, float delta_3) {
     float xs = (r_1.xs_num / delta_3);
     uint _e12 = _group_0_binding_0_cs.sizes.z;
@@ -666,9 +680,9 @@ void main() {
     uint _e6 = _group_0_binding_0_cs.sizes.x;
     uint _e10 = _group_0_binding_0_cs.sizes.y;
     uvec2 screen = uvec2(_e6, _e10);
-    uvec2 q_3 = id.xy;
-    if (!((q_3.x >= screen.x))) {
-        local = (q_3.y >= screen.y);
+    uvec2 q_4 = id.xy;
+    if (!((q_4.x >= screen.x))) {
+        local = (q_4.y >= screen.y);
     } else {
         local = true;
     }
@@ -681,12 +695,12 @@ void main() {
     int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
     vec4 angles = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(1u, 512u)), ivec2(0), textureSize(_group_0_binding_10_cs, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, uint(angles.z));
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_3, SLICES);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, SLICES);
     int _e52_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
     vec4 line_lo_1 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.x)), ivec2(0), textureSize(_group_0_binding_10_cs, _e52_clamped_lod) - ivec2(1)), _e52_clamped_lod);
     int _e59_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
     vec4 line_hi_1 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.y)), ivec2(0), textureSize(_group_0_binding_10_cs, _e59_clamped_lod) - ivec2(1)), _e59_clamped_lod);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_3, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     bool loop_init_5 = true;
     while(true) {
         if (!loop_init_5) {
@@ -713,16 +727,7 @@ void main() {
     }
     vec4 _e96 = depths;
     vec3 _e97[4] = light;
-    int _e100_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e100 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(q_3), ivec2(0), textureSize(_group_0_binding_2_cs, _e100_clamped_lod) - ivec2(1)), _e100_clamped_lod);
-    vec4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e104.w == 0.0)) {
-        uint _e110 = atomicAdd(_group_0_binding_11_cs, 1u);
-        _group_0_binding_12_cs[_e110] = (q_3.x | (q_3.y << 16u));
-        return;
-    } else {
-        imageStore(_group_0_binding_9_cs, ivec2(q_3), _e104);
-        return;
-    }
+    unwarp_pixel(q_4, _e61.w, _e96, _e97);
+    return;
 }
 

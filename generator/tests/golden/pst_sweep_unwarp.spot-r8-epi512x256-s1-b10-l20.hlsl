@@ -110,8 +110,8 @@ RWByteAddressBuffer fallback_pixels : register(u12);
 
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
-    float3 q_1 = (p - v.origin.xyz);
-    return float3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+    float3 q_2 = (p - v.origin.xyz);
+    return float3(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
 }
 
 float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
@@ -281,7 +281,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
     float h_5 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
     float g0_ = atan(((a_1 - t0_) / h_5));
-    float w_2 = ((atan(((b_1 - t0_) / h_5)) - g0_) / float(panels));
+    float w_3 = ((atan(((b_1 - t0_) / h_5)) - g0_) / float(panels));
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
     while(true) {
@@ -299,7 +299,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         }
         {
             uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_2));
+            float mid = (g0_ + ((float(_e32) + 0.5) * w_3));
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
             bool loop_init_1 = true;
@@ -318,7 +318,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
                 }
                 {
                     uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
+                    float u = tan((mid + ((0.5 * w_3) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
                     float _e52 = sum;
                     uint _e54 = q;
                     const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -328,7 +328,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w_2) * h_5);
+    return (((_e75 * 0.5) * w_3) * h_5);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
@@ -528,9 +528,9 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_2)
 {
     if (spot_2) {
-        float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        float3 q_3 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
         float3 to_eye = -(f_9.axis.xyz);
-        return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
+        return atan2(length(cross(q_3, to_eye)), dot(q_3, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
@@ -769,6 +769,20 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
     return epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1;
 }
 
+void unwarp_pixel(uint2 q_1, float4 w_2, float4 depths_2, float3 light_2[4])
+{
+    float4 _e3 = depth.Load(int3(q_1, int(0)));
+    const float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e10.w == 0.0)) {
+        uint _e16; fallback_count.InterlockedAdd(0, 1u, _e16);
+        fallback_pixels.Store(_e16*4, asuint((q_1.x | (q_1.y << 16u))));
+        return;
+    } else {
+        output[q_1] = _e10;
+        return;
+    }
+}
+
 uint pst_columns_crossed(PstRay r_1, float delta_3)
 {
     float xs = (r_1.xs_num / delta_3);
@@ -797,9 +811,9 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     uint2 screen = uint2(_e6, _e10);
-    uint2 q_3 = id.xy;
-    if (!((q_3.x >= screen.x))) {
-        local = (q_3.y >= screen.y);
+    uint2 q_4 = id.xy;
+    if (!((q_4.x >= screen.x))) {
+        local = (q_4.y >= screen.y);
     } else {
         local = true;
     }
@@ -810,10 +824,10 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
     float4 head = epipolar_samples.Load(int3(uint2(0u, 512u), int(0)));
     float4 angles = epipolar_samples.Load(int3(uint2(1u, 512u), int(0)));
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = ConstructEpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_3, SLICES);
+    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, SLICES);
     float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.x), int(0)));
     float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.y), int(0)));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_3, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
     bool loop_init_5 = true;
     while(true) {
@@ -842,14 +856,6 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
     }
     float4 _e96 = depths;
     float3 _e97[4] = light;
-    float4 _e100 = depth.Load(int3(q_3, int(0)));
-    const float4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e104.w == 0.0)) {
-        uint _e110; fallback_count.InterlockedAdd(0, 1u, _e110);
-        fallback_pixels.Store(_e110*4, asuint((q_3.x | (q_3.y << 16u))));
-        return;
-    } else {
-        output[q_3] = _e104;
-        return;
-    }
+    unwarp_pixel(q_4, _e61.w, _e96, _e97);
+    return;
 }

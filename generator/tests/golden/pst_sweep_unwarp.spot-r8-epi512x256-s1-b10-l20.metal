@@ -111,8 +111,8 @@ metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
     metal::float3 p
 ) {
-    metal::float3 q_1 = p - v.origin.xyz;
-    return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
+    metal::float3 q_2 = p - v.origin.xyz;
+    return metal::float3(metal::dot(q_2, v.right.xyz), metal::dot(q_2, v.up.xyz), metal::dot(q_2, v.forward.xyz));
 }
 
 metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
@@ -321,7 +321,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
     float h_5 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
     float g0_ = metal::atan((a_1 - t0_) / h_5);
-    float w_2 = (metal::atan((b_1 - t0_) / h_5) - g0_) / static_cast<float>(panels);
+    float w_3 = (metal::atan((b_1 - t0_) / h_5) - g0_) / static_cast<float>(panels);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
@@ -339,7 +339,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
         {
             uint _e32 = k;
-            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_2);
+            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_3);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
@@ -358,7 +358,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q;
-                    float u = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
+                    float u = metal::tan(mid + ((0.5 * w_3) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_5 * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -368,7 +368,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
     }
     float _e75 = sum;
-    return ((_e75 * 0.5) * w_2) * h_5;
+    return ((_e75 * 0.5) * w_3) * h_5;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -585,9 +585,9 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_2
 ) {
     if (spot_2) {
-        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz;
+        metal::float3 q_3 = (eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz;
         metal::float3 to_eye = -(f_9.axis.xyz);
-        return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
+        return metal::atan2(metal::length(metal::cross(q_3, to_eye)), metal::dot(q_3, to_eye));
     }
     return s_1 * metal::sin(theta_1);
 }
@@ -864,6 +864,30 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
     return _e70;
 }
 
+void unwarp_pixel(
+    metal::uint2 q_1,
+    metal::float4 w_2,
+    metal::float4 depths_2,
+    type_9 light_2,
+    metal::texture2d<float, metal::access::sample> depth,
+    metal::texture2d<float, metal::access::write> output,
+    device metal::atomic_uint& fallback_count,
+    device type_13& fallback_pixels,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    uint clamped_lod_e3 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e3 = depth.read(metal::min(metal::uint2(q_1), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
+    metal::float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e10.w == 0.0) {
+        uint _e16 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
+        fallback_pixels[metal::min(unsigned(_e16), (_buffer_sizes.size9 - 0 - 4) / 4)] = q_1.x | (q_1.y << 16u);
+        return;
+    } else {
+        output.write(_e10, metal::uint2(q_1));
+        return;
+    }
+}
+
 metal::float4 factor_at(
     uint base,
     float x_3,
@@ -936,8 +960,8 @@ metal::float4 pst_leaf(
         }
         {
             uint _e20 = g_1;
-            float q_3 = (_e20 == 0u) ? -0.57735026 : GL2_;
-            float psi_1 = ((static_cast<float>(i) + 0.5) + (0.5 * q_3)) * delta_2;
+            float q_4 = (_e20 == 0u) ? -0.57735026 : GL2_;
+            float psi_1 = ((static_cast<float>(i) + 0.5) + (0.5 * q_4)) * delta_2;
             metal::float3 l_3 = (-(axis_2) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
             float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_3, f_14.light_dir.xyz), f_14.light_pos.w, f_14.light_dir.w);
             metal::float4 _e48 = leaf;
@@ -1152,9 +1176,9 @@ kernel void pst_sweep_unwarp(
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     metal::uint2 screen = metal::uint2(_e6, _e10);
-    metal::uint2 q_4 = id.xy;
-    if (!((q_4.x >= screen.x))) {
-        local = q_4.y >= screen.y;
+    metal::uint2 q_5 = id.xy;
+    if (!((q_5.x >= screen.x))) {
+        local = q_5.y >= screen.y;
     } else {
         local = true;
     }
@@ -1167,12 +1191,12 @@ kernel void pst_sweep_unwarp(
     uint clamped_lod_e36 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 angles = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(1u, 512u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e36), epipolar_samples.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {head_1.xy, head_1.zw, angles.x, angles.y, naga_f2u32(angles.z)};
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, SLICES);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_5, SLICES);
     uint clamped_lod_e52 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 line_lo_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.x)), metal::uint2(epipolar_samples.get_width(clamped_lod_e52), epipolar_samples.get_height(clamped_lod_e52)) - 1), clamped_lod_e52);
     uint clamped_lod_e59 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e59), epipolar_samples.get_height(clamped_lod_e59)) - 1), clamped_lod_e59);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_5, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     uint2 loop_bound_8 = uint2(4294967295u);
     bool loop_init_8 = true;
     while(true) {
@@ -1202,15 +1226,6 @@ kernel void pst_sweep_unwarp(
     }
     metal::float4 _e96 = depths;
     type_9 _e97 = light;
-    uint clamped_lod_e100 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e100 = depth.read(metal::min(metal::uint2(q_4), metal::uint2(depth.get_width(clamped_lod_e100), depth.get_height(clamped_lod_e100)) - 1), clamped_lod_e100);
-    metal::float4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e104.w == 0.0) {
-        uint _e110 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e110), (_buffer_sizes.size9 - 0 - 4) / 4)] = q_4.x | (q_4.y << 16u);
-        return;
-    } else {
-        output.write(_e104, metal::uint2(q_4));
-        return;
-    }
+    unwarp_pixel(q_5, _e61.w, _e96, _e97, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+    return;
 }

@@ -117,8 +117,8 @@ var<storage, read_write> fallback_count: atomic<u32>;
 var<storage, read_write> fallback_pixels: array<u32>;
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
-    let q_1 = (p - v.origin.xyz);
-    return vec3<f32>(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+    let q_2 = (p - v.origin.xyz);
+    return vec3<f32>(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
 }
 
 fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
@@ -273,7 +273,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
     let h_5 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
     let g0_ = atan(((a_1 - t0_) / h_5));
-    let w_2 = ((atan(((b_1 - t0_) / h_5)) - g0_) / f32(panels));
+    let w_3 = ((atan(((b_1 - t0_) / h_5)) - g0_) / f32(panels));
     loop {
         let _e30 = k;
         if (_e30 < panels) {
@@ -282,7 +282,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
         {
             let _e32 = k;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_2));
+            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_3));
             q = 0u;
             loop {
                 let _e40 = q;
@@ -292,7 +292,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                 }
                 {
                     let _e46 = q;
-                    let u = tan((mid + ((0.5f * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    let u = tan((mid + ((0.5f * w_3) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     let _e52 = sum;
                     let _e54 = q;
                     let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -310,7 +310,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
     }
     let _e75 = sum;
-    return (((_e75 * 0.5f) * w_2) * h_5);
+    return (((_e75 * 0.5f) * w_3) * h_5);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -449,9 +449,9 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_o
 
 fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_2: bool) -> f32 {
     if spot_2 {
-        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        let q_3 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
         let to_eye = -(f_9.axis.xyz);
-        return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
+        return atan2(length(cross(q_3, to_eye)), dot(q_3, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
@@ -661,6 +661,19 @@ fn epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayou
     return _e70;
 }
 
+fn unwarp_pixel(q_1: vec2<u32>, w_2: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
+    let _e3 = textureLoad(depth, q_1, 0i);
+    let _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e10.w == 0f) {
+        let _e16 = atomicAdd((&fallback_count), 1u);
+        fallback_pixels[_e16] = (q_1.x | (q_1.y << 16u));
+        return;
+    } else {
+        textureStore(output, q_1, _e10);
+        return;
+    }
+}
+
 fn factor_at(base: u32, x_3: f32, h: u32) -> vec4<f32> {
     let p_6 = min((clamp(x_3, 0f, 1f) * 95f), 95f);
     let j_3 = min(u32(floor(p_6)), 94u);
@@ -701,8 +714,8 @@ fn pst_leaf(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, ro
         }
         {
             let _e20 = g_1;
-            let q_3 = select(GL2_, -0.57735026f, (_e20 == 0u));
-            let psi_1 = (((f32(i) + 0.5f) + (0.5f * q_3)) * delta_2);
+            let q_4 = select(GL2_, -0.57735026f, (_e20 == 0u));
+            let psi_1 = (((f32(i) + 0.5f) + (0.5f * q_4)) * delta_2);
             let l_3 = ((-(axis_2) * cos(psi_1)) + (_e13 * sin(psi_1)));
             let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_3, f_14.light_dir.xyz), f_14.light_pos.w, f_14.light_dir.w);
             let _e48 = leaf;
@@ -876,9 +889,9 @@ fn pst_sweep_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e6 = frame.sizes.x;
     let _e10 = frame.sizes.y;
     let screen = vec2<u32>(_e6, _e10);
-    let q_4 = id.xy;
-    if !((q_4.x >= screen.x)) {
-        local = (q_4.y >= screen.y);
+    let q_5 = id.xy;
+    if !((q_5.x >= screen.x)) {
+        local = (q_5.y >= screen.y);
     } else {
         local = true;
     }
@@ -889,10 +902,10 @@ fn pst_sweep_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     let head_1 = textureLoad(epipolar_samples, vec2<u32>(0u, 512u), 0i);
     let angles = textureLoad(epipolar_samples, vec2<u32>(1u, 512u), 0i);
     let lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head_1.xy, head_1.zw, angles.x, angles.y, u32(angles.z));
-    let _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, SLICES);
+    let _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_5, SLICES);
     let line_lo_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e45.slices.x), 0i);
     let line_hi_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e45.slices.y), 0i);
-    let _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    let _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_5, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     loop {
         let _e63 = j;
         if (_e63 < 4u) {
@@ -916,14 +929,6 @@ fn pst_sweep_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let _e96 = depths;
     let _e97 = light;
-    let _e100 = textureLoad(depth, q_4, 0i);
-    let _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e104.w == 0f) {
-        let _e110 = atomicAdd((&fallback_count), 1u);
-        fallback_pixels[_e110] = (q_4.x | (q_4.y << 16u));
-        return;
-    } else {
-        textureStore(output, q_4, _e104);
-        return;
-    }
+    unwarp_pixel(q_5, _e61.w, _e96, _e97);
+    return;
 }

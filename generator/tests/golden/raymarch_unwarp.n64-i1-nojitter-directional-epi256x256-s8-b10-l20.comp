@@ -30,12 +30,6 @@ struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     uvec4 sizes;
     uvec4 interleave;
 };
-struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
-    float t_close;
-    float dist;
-    float theta_a;
-    float dtheta;
-};
 struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     vec2 origin;
     vec2 axis;
@@ -47,6 +41,12 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uvec2 slices;
     uvec2 k;
     vec4 w;
+};
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
 };
 const uint SLICES = 256u;
 const uint SLICE_SAMPLES = 256u;
@@ -96,144 +96,14 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y
     return (float((_e29 >> 8u)) / 16777216.0);
 }
 
-float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta) {
-    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
-    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
-}
-
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_4 = (sigma_t * len);
-    if ((x_4 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_4)));
-    }
-    return ((1.0 - exp(-(x_4))) / sigma_t);
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
-    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
-}
-
-float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_6 = (eye + (dir * t));
-    vec3 to_x = (x_6 - light_pos);
-    float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d_2 = sqrt(d2_);
-    vec3 travel = (to_x / vec3(d_2));
-    float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
-    float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
-}
-
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, vec3 light_pos_1, float a_1, float b_1, uint n) {
-    float t0_ = dot((light_pos_1 - eye_1), dir_1);
-    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
-    float theta_a = atan(((a_1 - t0_) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_1 - t0_) / h_1)) - theta_a) / float(n)));
-}
-
-vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_2) {
-    float tau = tan((e.theta_a + (x_2 * e.dtheta)));
-    return vec2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
-}
-
-vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
-    vec3 q = (p - v.origin.xyz);
-    return vec3(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
-}
-
-vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
-    if ((v_1.origin.w > 0.5)) {
-        float z_1 = max(ls.z, 1e-6);
-        float t_5 = v_1.proj.x;
-        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_5))), (0.5 - ((0.5 * ls.y) / (z_1 * t_5))));
-    } else {
-        return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
-}
-
-float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a, float b, float depth_break) {
     bool local_1 = false;
-    bool local_2 = false;
-    bool local_3 = false;
-    if (!((uv.x < 0.0))) {
-        local_1 = (uv.x > 1.0);
+    if (!((a == b))) {
+        local_1 = (abs((a - b)) <= (depth_break * min(a, b)));
     } else {
         local_1 = true;
     }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = (uv.y < 0.0);
-    } else {
-        local_2 = true;
-    }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = (uv.y > 1.0);
-    } else {
-        local_3 = true;
-    }
-    bool _e27 = local_3;
-    if (_e27) {
-        return 2.0;
-    }
-    uint n_1 = v_2.size.x;
-    uint x_7 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
-    uint y_3 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
-    int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_7, y_3)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
-    return _e49.x;
-}
-
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
-    float texel = 0.0;
-    float size = float(v_3.size.x);
-    if ((v_3.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_3.forward.w * _e32);
-}
-
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_1) {
-    bool local_4 = false;
-    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if ((v_4.origin.w > 0.5)) {
-        local_4 = (_e2.z <= near);
-    } else {
-        local_4 = false;
-    }
-    bool _e16 = local_4;
-    if (_e16) {
-        return 1.0;
-    }
-    vec2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = ((_e2.z - near) / (far - near));
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
-}
-
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_2, float b_2, float depth_break) {
-    bool local_5 = false;
-    if (!((a_2 == b_2))) {
-        local_5 = (abs((a_2 - b_2)) <= (depth_break * min(a_2, b_2)));
-    } else {
-        local_5 = true;
-    }
-    bool _e13 = local_5;
+    bool _e13 = local_1;
     return _e13;
 }
 
@@ -245,8 +115,8 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
     uint taps = 0u;
     uint close = 0u;
     uint k = 0u;
-    bool local_6 = false;
-    bool local_7 = false;
+    bool local_2 = false;
+    bool local_3 = false;
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
@@ -267,11 +137,11 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
             if ((w[_e20] > 0.0)) {
                 uint _e25 = k;
                 bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_6 = _e29;
+                local_2 = _e29;
             } else {
-                local_6 = false;
+                local_2 = false;
             }
-            bool _e33 = local_6;
+            bool _e33 = local_2;
             if (_e33) {
                 uint _e35 = close;
                 close = (_e35 + 1u);
@@ -295,11 +165,11 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
     if (!((_e65 <= 0.0))) {
         uint _e69 = close;
         uint _e70 = taps;
-        local_7 = (_e69 < min(_e70, 2u));
+        local_3 = (_e69 < min(_e70, 2u));
     } else {
-        local_7 = true;
+        local_3 = true;
     }
-    bool _e77 = local_7;
+    bool _e77 = local_3;
     if (_e77) {
         return vec4(0.0, 0.0, 0.0, 0.0);
     }
@@ -322,12 +192,12 @@ float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec
     return atan(((axis.x * d_1.y) - (axis.y * d_1.x)), ((axis.x * d_1.x) + (axis.y * d_1.y)));
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l, uvec2 p_2, uint slices) {
+EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l, uvec2 p, uint slices) {
     uint s_lo = 0u;
     float fs = 0.0;
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
-    vec2 d_3 = ((vec2(p_2) + vec2(0.5, 0.5)) - l.origin);
-    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_3);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
+    vec2 d_2 = ((vec2(p) + vec2(0.5, 0.5)) - l.origin);
+    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
     float f = (((_e12 - l.phi_start) / l.dphi) - 0.5);
     if ((l.wrap != 0u)) {
         float fl = floor(f);
@@ -341,19 +211,19 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     }
     uint _e46 = s_lo;
     uint _e47 = s_lo;
-    t_1.slices = uvec2(_e46, ((_e47 + 1u) % slices));
+    t.slices = uvec2(_e46, ((_e47 + 1u) % slices));
     float _e53 = fs;
     float _e56 = fs;
-    t_1.w = vec4((1.0 - _e53), _e56, 0.0, 0.0);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t_1;
+    t.w = vec4((1.0 - _e53), _e56, 0.0, 0.0);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t;
     return _e60;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uvec2 p_3, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, vec4 line_lo, vec4 line_hi, uint samples) {
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_2 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
+EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uvec2 p_1, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, vec4 line_lo, vec4 line_hi, uint samples) {
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
     uint j_1 = 0u;
-    vec2 d_4 = ((vec2(p_3) + vec2(0.5, 0.5)) - l_1.origin);
-    t_2 = pair;
+    vec2 d_3 = ((vec2(p_1) + vec2(0.5, 0.5)) - l_1.origin);
+    t_1 = pair;
     vec2 ws = pair.w.xy;
     bool loop_init_1 = true;
     while(true) {
@@ -370,22 +240,166 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
         {
             uint _e18 = j_1;
             vec4 line = ((_e18 == 1u) ? line_hi : line_lo);
-            float g_1 = ((dot(d_4, line.xy) - line.z) / max(line.w, 1e-20));
+            float g_1 = ((dot(d_3, line.xy) - line.z) / max(line.w, 1e-20));
             float gc = clamp(g_1, 0.0, float((samples - 1u)));
             uint k_lo = min(uint(gc), (samples - 2u));
             float fk = (gc - float(k_lo));
             uint _e45 = j_1;
-            t_2.k[_e45] = k_lo;
+            t_1.k[_e45] = k_lo;
             uint _e49 = j_1;
             uint _e52 = j_1;
-            t_2.w[(2u * _e49)] = (ws[_e52] * (1.0 - fk));
+            t_1.w[(2u * _e49)] = (ws[_e52] * (1.0 - fk));
             uint _e59 = j_1;
             uint _e64 = j_1;
-            t_2.w[((2u * _e59) + 1u)] = (ws[_e64] * fk);
+            t_1.w[((2u * _e59) + 1u)] = (ws[_e64] * fk);
         }
     }
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_2;
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_1;
     return _e70;
+}
+
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta) {
+    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
+    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
+    float x_4 = (sigma_t * len);
+    if ((x_4 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_4)));
+    }
+    return ((1.0 - exp(-(x_4))) / sigma_t);
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a_1, float b_1) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
+    return (exp((-(sigma_t_1) * a_1)) * _e7);
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
+    if (((cos_inner - cos_outer) <= 1e-6)) {
+        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
+    }
+    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t_2, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
+    vec3 x_6 = (eye + (dir * t_2));
+    vec3 to_x = (x_6 - light_pos);
+    float d2_ = max(dot(to_x, to_x), 1e-12);
+    float d_4 = sqrt(d2_);
+    vec3 travel = (to_x / vec3(d_4));
+    float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_4 + t_2)))) / d2_);
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, vec3 light_pos_1, float a_2, float b_2, uint n) {
+    float t0_ = dot((light_pos_1 - eye_1), dir_1);
+    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_2 - t0_) / h_1)) - theta_a) / float(n)));
+}
+
+vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_2) {
+    float tau = tan((e.theta_a + (x_2 * e.dtheta)));
+    return vec2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
+}
+
+vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p_2) {
+    vec3 q_1 = (p_2 - v.origin.xyz);
+    return vec3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+}
+
+vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
+    if ((v_1.origin.w > 0.5)) {
+        float z_1 = max(ls.z, 1e-6);
+        float t_5 = v_1.proj.x;
+        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_5))), (0.5 - ((0.5 * ls.y) / (z_1 * t_5))));
+    } else {
+        return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
+    }
+}
+
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
+    bool local_4 = false;
+    bool local_5 = false;
+    bool local_6 = false;
+    if (!((uv.x < 0.0))) {
+        local_4 = (uv.x > 1.0);
+    } else {
+        local_4 = true;
+    }
+    bool _e11 = local_4;
+    if (!(_e11)) {
+        local_5 = (uv.y < 0.0);
+    } else {
+        local_5 = true;
+    }
+    bool _e19 = local_5;
+    if (!(_e19)) {
+        local_6 = (uv.y > 1.0);
+    } else {
+        local_6 = true;
+    }
+    bool _e27 = local_6;
+    if (_e27) {
+        return 2.0;
+    }
+    uint n_1 = v_2.size.x;
+    uint x_7 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint y_3 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
+    int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
+    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_7, y_3)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
+    return _e49.x;
+}
+
+float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
+    float texel = 0.0;
+    float size = float(v_3.size.x);
+    if ((v_3.origin.w > 0.5)) {
+        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
+    } else {
+        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
+    }
+    float _e32 = texel;
+    return (v_3.forward.w * _e32);
+}
+
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_3) {
+    bool local_7 = false;
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
+    float near = v_4.right.w;
+    float far = v_4.up.w;
+    if ((v_4.origin.w > 0.5)) {
+        local_7 = (_e2.z <= near);
+    } else {
+        local_7 = false;
+    }
+    bool _e16 = local_7;
+    if (_e16) {
+        return 1.0;
+    }
+    vec2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
+    float depth_1 = ((_e2.z - near) / (far - near));
+    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
+    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+}
+
+void unwarp_pixel(uvec2 q, vec4 w_1, vec4 depths_2, vec3 light_2[4]) {
+    int _e3_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+    vec4 _e3 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q), ivec2(0), textureSize(_group_0_binding_1_cs, _e3_clamped_lod) - ivec2(1)), _e3_clamped_lod);
+    vec4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e10.w == 0.0)) {
+        uint _e16 = atomicAdd(_group_0_binding_5_cs, 1u);
+        _group_0_binding_6_cs[_e16] = (q.x | (q.y << 16u));
+        return;
+    } else {
+        imageStore(_group_0_binding_3_cs, ivec2(q), _e10);
+        return;
+    }
 }
 
 void main() {
@@ -397,9 +411,9 @@ void main() {
     uint _e6 = _group_0_binding_0_cs.sizes.x;
     uint _e10 = _group_0_binding_0_cs.sizes.y;
     uvec2 screen = uvec2(_e6, _e10);
-    uvec2 q_1 = id.xy;
-    if (!((q_1.x >= screen.x))) {
-        local = (q_1.y >= screen.y);
+    uvec2 q_2 = id.xy;
+    if (!((q_2.x >= screen.x))) {
+        local = (q_2.y >= screen.y);
     } else {
         local = true;
     }
@@ -412,12 +426,12 @@ void main() {
     int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 angles = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(1u, 256u)), ivec2(0), textureSize(_group_0_binding_4_cs, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, uint(angles.z));
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, SLICES);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, SLICES);
     int _e52_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 line_lo_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.x)), ivec2(0), textureSize(_group_0_binding_4_cs, _e52_clamped_lod) - ivec2(1)), _e52_clamped_lod);
     int _e59_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 line_hi_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.y)), ivec2(0), textureSize(_group_0_binding_4_cs, _e59_clamped_lod) - ivec2(1)), _e59_clamped_lod);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
@@ -444,16 +458,7 @@ void main() {
     }
     vec4 _e96 = depths;
     vec3 _e97[4] = light;
-    int _e100_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
-    vec4 _e100 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q_1), ivec2(0), textureSize(_group_0_binding_1_cs, _e100_clamped_lod) - ivec2(1)), _e100_clamped_lod);
-    vec4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e104.w == 0.0)) {
-        uint _e110 = atomicAdd(_group_0_binding_5_cs, 1u);
-        _group_0_binding_6_cs[_e110] = (q_1.x | (q_1.y << 16u));
-        return;
-    } else {
-        imageStore(_group_0_binding_3_cs, ivec2(q_1), _e104);
-        return;
-    }
+    unwarp_pixel(q_2, _e61.w, _e96, _e97);
+    return;
 }
 

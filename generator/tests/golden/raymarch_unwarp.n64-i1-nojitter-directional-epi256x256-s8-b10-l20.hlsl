@@ -27,13 +27,6 @@ struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     uint4 interleave;
 };
 
-struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
-    float t_close;
-    float dist;
-    float theta_a;
-    float dtheta;
-};
-
 struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     float2 origin;
     float2 axis;
@@ -47,6 +40,13 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uint2 slices;
     uint2 k;
     float4 w;
+};
+
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
 };
 
 static const uint SLICES = 256u;
@@ -107,174 +107,16 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y
     return (float((_e29 >> 8u)) / 16777216.0);
 }
 
-float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
-{
-    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
-    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
-}
-
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
-{
-    float x_4 = (sigma_t * len);
-    if ((x_4 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_4)));
-    }
-    return ((1.0 - exp(-(x_4))) / sigma_t);
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
-{
-    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
-{
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
-    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
-}
-
-float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
-{
-    float3 x_6 = (eye + (dir * t));
-    float3 to_x = (x_6 - light_pos);
-    float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d_2 = sqrt(d2_);
-    float3 travel = (to_x / (d_2).xxx);
-    const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
-    const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
-}
-
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ret = (EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX)0;
-    ret.t_close = arg0;
-    ret.dist = arg1;
-    ret.theta_a = arg2;
-    ret.dtheta = arg3;
-    return ret;
-}
-
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float3 light_pos_1, float a_1, float b_1, uint n)
-{
-    float t0_ = dot((light_pos_1 - eye_1), dir_1);
-    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
-    float theta_a = atan(((a_1 - t0_) / h_1));
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_1 - t0_) / h_1)) - theta_a) / float(n)));
-    return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
-}
-
-float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_2)
-{
-    float tau = tan((e.theta_a + (x_2 * e.dtheta)));
-    return float2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
-}
-
-float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
-{
-    float3 q = (p - v.origin.xyz);
-    return float3(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
-}
-
-float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
-{
-    if ((v_1.origin.w > 0.5)) {
-        float z_1 = max(ls.z, 1e-6);
-        float t_5 = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_5))), (0.5 - ((0.5 * ls.y) / (z_1 * t_5))));
-    } else {
-        return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
-}
-
-uint naga_f2u32(float value) {
-    return uint(clamp(value, 0.0, 4294967000.0));
-}
-
-float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a, float b, float depth_break)
 {
     bool local_1 = (bool)0;
-    bool local_2 = (bool)0;
-    bool local_3 = (bool)0;
 
-    if (!((uv.x < 0.0))) {
-        local_1 = (uv.x > 1.0);
+    if (!((a == b))) {
+        local_1 = (abs((a - b)) <= (depth_break * min(a, b)));
     } else {
         local_1 = true;
     }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = (uv.y < 0.0);
-    } else {
-        local_2 = true;
-    }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = (uv.y > 1.0);
-    } else {
-        local_3 = true;
-    }
-    bool _e27 = local_3;
-    if (_e27) {
-        return 2.0;
-    }
-    uint n_1 = v_2.size.x;
-    uint x_7 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
-    uint y_3 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_7, y_3), int(0)));
-    return _e49.x;
-}
-
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
-{
-    float texel = (float)0;
-
-    float size = float(v_3.size.x);
-    if ((v_3.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_3.forward.w * _e32);
-}
-
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, Texture2D<float4> sm_1, float3 p_1)
-{
-    bool local_4 = (bool)0;
-
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if ((v_4.origin.w > 0.5)) {
-        local_4 = (_e2.z <= near);
-    } else {
-        local_4 = false;
-    }
-    bool _e16 = local_4;
-    if (_e16) {
-        return 1.0;
-    }
-    const float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    const float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = ((_e2.z - near) / (far - near));
-    const float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
-}
-
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_2, float b_2, float depth_break)
-{
-    bool local_5 = (bool)0;
-
-    if (!((a_2 == b_2))) {
-        local_5 = (abs((a_2 - b_2)) <= (depth_break * min(a_2, b_2)));
-    } else {
-        local_5 = true;
-    }
-    bool _e13 = local_5;
+    bool _e13 = local_1;
     return _e13;
 }
 
@@ -287,8 +129,8 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
     uint taps = 0u;
     uint close = 0u;
     uint k = 0u;
-    bool local_6 = (bool)0;
-    bool local_7 = (bool)0;
+    bool local_2 = (bool)0;
+    bool local_3 = (bool)0;
 
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
@@ -313,11 +155,11 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
             if ((w[min(uint(_e20), 3u)] > 0.0)) {
                 uint _e25 = k;
                 const bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e25), 3u)], d, depth_break_1);
-                local_6 = _e29;
+                local_2 = _e29;
             } else {
-                local_6 = false;
+                local_2 = false;
             }
-            bool _e33 = local_6;
+            bool _e33 = local_2;
             if (_e33) {
                 uint _e35 = close;
                 close = (_e35 + 1u);
@@ -341,11 +183,11 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
     if (!((_e65 <= 0.0))) {
         uint _e69 = close;
         uint _e70 = taps;
-        local_7 = (_e69 < min(_e70, 2u));
+        local_3 = (_e69 < min(_e70, 2u));
     } else {
-        local_7 = true;
+        local_3 = true;
     }
-    bool _e77 = local_7;
+    bool _e77 = local_3;
     if (_e77) {
         return float4(0.0, 0.0, 0.0, 0.0);
     }
@@ -377,14 +219,18 @@ int naga_f2i32(float value) {
     return int(clamp(value, -2147483600.0, 2147483500.0));
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l, uint2 p_2, uint slices)
+uint naga_f2u32(float value) {
+    return uint(clamp(value, 0.0, 4294967000.0));
+}
+
+EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l, uint2 p, uint slices)
 {
     uint s_lo = 0u;
     float fs = 0.0;
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = (EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t = (EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
 
-    float2 d_3 = ((float2(p_2) + float2(0.5, 0.5)) - l.origin);
-    const float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_3);
+    float2 d_2 = ((float2(p) + float2(0.5, 0.5)) - l.origin);
+    const float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
     float f = (((_e12 - l.phi_start) / l.dphi) - 0.5);
     if ((l.wrap != 0u)) {
         float fl = floor(f);
@@ -398,22 +244,22 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     }
     uint _e46 = s_lo;
     uint _e47 = s_lo;
-    t_1.slices = uint2(_e46, naga_mod((_e47 + 1u), slices));
+    t.slices = uint2(_e46, naga_mod((_e47 + 1u), slices));
     float _e53 = fs;
     float _e56 = fs;
-    t_1.w = float4((1.0 - _e53), _e56, 0.0, 0.0);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t_1;
+    t.w = float4((1.0 - _e53), _e56, 0.0, 0.0);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t;
     const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx = _e60;
     return epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uint2 p_3, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, float4 line_lo, float4 line_hi, uint samples)
+EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uint2 p_1, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, float4 line_lo, float4 line_hi, uint samples)
 {
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_2 = (EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = (EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
     uint j_1 = 0u;
 
-    float2 d_4 = ((float2(p_3) + float2(0.5, 0.5)) - l_1.origin);
-    t_2 = pair;
+    float2 d_3 = ((float2(p_1) + float2(0.5, 0.5)) - l_1.origin);
+    t_1 = pair;
     float2 ws = pair.w.xy;
     uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
     bool loop_init_1 = true;
@@ -433,23 +279,191 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
         {
             uint _e18 = j_1;
             float4 line_ = ((_e18 == 1u) ? line_hi : line_lo);
-            float g_1 = ((dot(d_4, line_.xy) - line_.z) / max(line_.w, 1e-20));
+            float g_1 = ((dot(d_3, line_.xy) - line_.z) / max(line_.w, 1e-20));
             float gc = clamp(g_1, 0.0, float((samples - 1u)));
             uint k_lo = min(naga_f2u32(gc), (samples - 2u));
             float fk = (gc - float(k_lo));
             uint _e45 = j_1;
-            t_2.k[min(uint(_e45), 1u)] = k_lo;
+            t_1.k[min(uint(_e45), 1u)] = k_lo;
             uint _e49 = j_1;
             uint _e52 = j_1;
-            t_2.w[min(uint((2u * _e49)), 3u)] = (ws[min(uint(_e52), 1u)] * (1.0 - fk));
+            t_1.w[min(uint((2u * _e49)), 3u)] = (ws[min(uint(_e52), 1u)] * (1.0 - fk));
             uint _e59 = j_1;
             uint _e64 = j_1;
-            t_2.w[min(uint(((2u * _e59) + 1u)), 3u)] = (ws[min(uint(_e64), 1u)] * fk);
+            t_1.w[min(uint(((2u * _e59) + 1u)), 3u)] = (ws[min(uint(_e64), 1u)] * fk);
         }
     }
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_2;
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_1;
     const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1 = _e70;
     return epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1;
+}
+
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
+{
+    float denom = max(((1.0 + (g * g)) - ((2.0 * g) * cos_theta)), 1e-8);
+    return ((1.0 - (g * g)) / ((12.566371 * denom) * sqrt(denom)));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
+{
+    float x_4 = (sigma_t * len);
+    if ((x_4 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_4)));
+    }
+    return ((1.0 - exp(-(x_4))) / sigma_t);
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a_1, float b_1)
+{
+    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
+    return (exp((-(sigma_t_1) * a_1)) * _e7);
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
+{
+    if (((cos_inner - cos_outer) <= 1e-6)) {
+        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
+    }
+    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t_2, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
+{
+    float3 x_6 = (eye + (dir * t_2));
+    float3 to_x = (x_6 - light_pos);
+    float d2_ = max(dot(to_x, to_x), 1e-12);
+    float d_4 = sqrt(d2_);
+    float3 travel = (to_x / (d_4).xxx);
+    const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_4 + t_2)))) / d2_);
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ret = (EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX)0;
+    ret.t_close = arg0;
+    ret.dist = arg1;
+    ret.theta_a = arg2;
+    ret.dtheta = arg3;
+    return ret;
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float3 light_pos_1, float a_2, float b_2, uint n)
+{
+    float t0_ = dot((light_pos_1 - eye_1), dir_1);
+    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float theta_a = atan(((a_2 - t0_) / h_1));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_2 - t0_) / h_1)) - theta_a) / float(n)));
+    return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
+}
+
+float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_2)
+{
+    float tau = tan((e.theta_a + (x_2 * e.dtheta)));
+    return float2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
+}
+
+float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p_2)
+{
+    float3 q_1 = (p_2 - v.origin.xyz);
+    return float3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+}
+
+float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
+{
+    if ((v_1.origin.w > 0.5)) {
+        float z_1 = max(ls.z, 1e-6);
+        float t_5 = v_1.proj.x;
+        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_5))), (0.5 - ((0.5 * ls.y) / (z_1 * t_5))));
+    } else {
+        return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
+    }
+}
+
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
+{
+    bool local_4 = (bool)0;
+    bool local_5 = (bool)0;
+    bool local_6 = (bool)0;
+
+    if (!((uv.x < 0.0))) {
+        local_4 = (uv.x > 1.0);
+    } else {
+        local_4 = true;
+    }
+    bool _e11 = local_4;
+    if (!(_e11)) {
+        local_5 = (uv.y < 0.0);
+    } else {
+        local_5 = true;
+    }
+    bool _e19 = local_5;
+    if (!(_e19)) {
+        local_6 = (uv.y > 1.0);
+    } else {
+        local_6 = true;
+    }
+    bool _e27 = local_6;
+    if (_e27) {
+        return 2.0;
+    }
+    uint n_1 = v_2.size.x;
+    uint x_7 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint y_3 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
+    float4 _e49 = sm.Load(int3(uint2(x_7, y_3), int(0)));
+    return _e49.x;
+}
+
+float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
+{
+    float texel = (float)0;
+
+    float size = float(v_3.size.x);
+    if ((v_3.origin.w > 0.5)) {
+        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
+    } else {
+        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
+    }
+    float _e32 = texel;
+    return (v_3.forward.w * _e32);
+}
+
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, Texture2D<float4> sm_1, float3 p_3)
+{
+    bool local_7 = (bool)0;
+
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
+    float near = v_4.right.w;
+    float far = v_4.up.w;
+    if ((v_4.origin.w > 0.5)) {
+        local_7 = (_e2.z <= near);
+    } else {
+        local_7 = false;
+    }
+    bool _e16 = local_7;
+    if (_e16) {
+        return 1.0;
+    }
+    const float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    const float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
+    float depth_1 = ((_e2.z - near) / (far - near));
+    const float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
+    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+}
+
+void unwarp_pixel(uint2 q, float4 w_1, float4 depths_2, float3 light_2[4])
+{
+    float4 _e3 = depth.Load(int3(q, int(0)));
+    const float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e10.w == 0.0)) {
+        uint _e16; fallback_count.InterlockedAdd(0, 1u, _e16);
+        fallback_pixels.Store(_e16*4, asuint((q.x | (q.y << 16u))));
+        return;
+    } else {
+        output[q] = _e10;
+        return;
+    }
 }
 
 uint naga_div(uint lhs, uint rhs) {
@@ -477,9 +491,9 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     uint2 screen = uint2(_e6, _e10);
-    uint2 q_1 = id.xy;
-    if (!((q_1.x >= screen.x))) {
-        local = (q_1.y >= screen.y);
+    uint2 q_2 = id.xy;
+    if (!((q_2.x >= screen.x))) {
+        local = (q_2.y >= screen.y);
     } else {
         local = true;
     }
@@ -490,10 +504,10 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     float4 head = epipolar_samples.Load(int3(uint2(0u, 256u), int(0)));
     float4 angles = epipolar_samples.Load(int3(uint2(1u, 256u), int(0)));
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = ConstructEpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, SLICES);
+    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, SLICES);
     float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.x), int(0)));
     float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.y), int(0)));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
     while(true) {
@@ -522,14 +536,6 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     }
     float4 _e96 = depths;
     float3 _e97[4] = light;
-    float4 _e100 = depth.Load(int3(q_1, int(0)));
-    const float4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e104.w == 0.0)) {
-        uint _e110; fallback_count.InterlockedAdd(0, 1u, _e110);
-        fallback_pixels.Store(_e110*4, asuint((q_1.x | (q_1.y << 16u))));
-        return;
-    } else {
-        output[q_1] = _e104;
-        return;
-    }
+    unwarp_pixel(q_2, _e61.w, _e96, _e97);
+    return;
 }

@@ -35,12 +35,6 @@ struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     metal::uint4 sizes;
     metal::uint4 interleave;
 };
-struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
-    float t_close;
-    float dist;
-    float theta_a;
-    float dtheta;
-};
 struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     metal::float2 origin;
     metal::float2 axis;
@@ -49,13 +43,19 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uint wrap;
     char _pad5[4];
 };
-struct type_9 {
+struct type_6 {
     metal::float3 inner[4];
 };
 struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     metal::uint2 slices;
     metal::uint2 k;
     metal::float4 w;
+};
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
 };
 typedef uint type_12[1];
 constant uint SLICES = 256u;
@@ -102,209 +102,25 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
     return static_cast<float>(_e29 >> 8u) / 16777216.0;
 }
 
-float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float g,
-    float cos_theta
-) {
-    float denom = metal::max((1.0 + (g * g)) - ((2.0 * g) * cos_theta), 0.00000001);
-    return (1.0 - (g * g)) / ((12.566371 * denom) * metal::sqrt(denom));
-}
-
-float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float sigma_t,
-    float len
-) {
-    float x_4 = sigma_t * len;
-    if (x_4 < 0.0001) {
-        return len * (1.0 - (0.5 * x_4));
-    }
-    return (1.0 - metal::exp(-(x_4))) / sigma_t;
-}
-
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float sigma_t_1,
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     float a,
-    float b
-) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
-    return metal::exp(-(sigma_t_1) * a) * _e7;
-}
-
-float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    float cos_angle,
-    float cos_inner,
-    float cos_outer
-) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
-    float x_5 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_5 * x_5) * (3.0 - (2.0 * x_5));
-}
-
-float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    metal::float3 eye,
-    metal::float3 dir,
-    float t,
-    metal::float3 light_pos,
-    metal::float3 light_dir,
-    float cos_inner_1,
-    float cos_outer_1,
-    metal::float4 medium
-) {
-    metal::float3 x_6 = eye + (dir * t);
-    metal::float3 to_x = x_6 - light_pos;
-    float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
-    float d_2 = metal::sqrt(d2_);
-    metal::float3 travel = to_x / metal::float3(d_2);
-    float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
-    float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_2 + t))) / d2_;
-}
-
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    metal::float3 eye_1,
-    metal::float3 dir_1,
-    metal::float3 light_pos_1,
-    float a_1,
-    float b_1,
-    uint n
-) {
-    float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
-    float h_1 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
-    float theta_a = metal::atan((a_1 - t0_) / h_1);
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_, h_1, theta_a, (metal::atan((b_1 - t0_) / h_1) - theta_a) / static_cast<float>(n)};
-}
-
-metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e,
-    float x_2
-) {
-    float tau = metal::tan(e.theta_a + (x_2 * e.dtheta));
-    return metal::float2(e.t_close + (e.dist * tau), (e.dtheta * e.dist) * (1.0 + (tau * tau)));
-}
-
-metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
-    metal::float3 p
-) {
-    metal::float3 q = p - v.origin.xyz;
-    return metal::float3(metal::dot(q, v.right.xyz), metal::dot(q, v.up.xyz), metal::dot(q, v.forward.xyz));
-}
-
-metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
-    metal::float3 ls
-) {
-    if (v_1.origin.w > 0.5) {
-        float z_1 = metal::max(ls.z, 0.000001);
-        float t_5 = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_5)), 0.5 - ((0.5 * ls.y) / (z_1 * t_5)));
-    } else {
-        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
-    }
-}
-
-uint naga_f2u32(float value) {
-    return static_cast<uint>(metal::clamp(value, 0.0, 4294967000.0));
-}
-
-float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2,
-    metal::texture2d<float, metal::access::sample> sm,
-    metal::float2 uv
+    float b,
+    float depth_break
 ) {
     bool local_1 = {};
-    bool local_2 = {};
-    bool local_3 = {};
-    if (!((uv.x < 0.0))) {
-        local_1 = uv.x > 1.0;
+    if (!((a == b))) {
+        local_1 = metal::abs(a - b) <= (depth_break * metal::min(a, b));
     } else {
         local_1 = true;
     }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = uv.y < 0.0;
-    } else {
-        local_2 = true;
-    }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = uv.y > 1.0;
-    } else {
-        local_3 = true;
-    }
-    bool _e27 = local_3;
-    if (_e27) {
-        return 2.0;
-    }
-    uint n_1 = v_2.size.x;
-    uint x_7 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
-    uint y_3 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
-    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_7, y_3)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
-    return _e49.x;
-}
-
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
-    float z
-) {
-    float texel = {};
-    float size = static_cast<float>(v_3.size.x);
-    if (v_3.origin.w > 0.5) {
-        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
-    } else {
-        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
-    }
-    float _e32 = texel;
-    return v_3.forward.w * _e32;
-}
-
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
-    metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_1
-) {
-    bool local_4 = {};
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if (v_4.origin.w > 0.5) {
-        local_4 = _e2.z <= near;
-    } else {
-        local_4 = false;
-    }
-    bool _e16 = local_4;
-    if (_e16) {
-        return 1.0;
-    }
-    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = (_e2.z - near) / (far - near);
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
-}
-
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_2,
-    float b_2,
-    float depth_break
-) {
-    bool local_5 = {};
-    if (!((a_2 == b_2))) {
-        local_5 = metal::abs(a_2 - b_2) <= (depth_break * metal::min(a_2, b_2));
-    } else {
-        local_5 = true;
-    }
-    bool _e13 = local_5;
+    bool _e13 = local_1;
     return _e13;
 }
 
 metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float4 w,
     metal::float4 depths_1,
-    type_9 light_1,
+    type_6 light_1,
     float d,
     float depth_break_1,
     float light_break
@@ -316,8 +132,8 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     uint taps = 0u;
     uint close = 0u;
     uint k = 0u;
-    bool local_6 = {};
-    bool local_7 = {};
+    bool local_2 = {};
+    bool local_3 = {};
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
@@ -341,11 +157,11 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
             if (w[metal::min(unsigned(_e20), 3u)] > 0.0) {
                 uint _e25 = k;
                 bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
-                local_6 = _e29;
+                local_2 = _e29;
             } else {
-                local_6 = false;
+                local_2 = false;
             }
-            bool _e33 = local_6;
+            bool _e33 = local_2;
             if (_e33) {
                 uint _e35 = close;
                 close = _e35 + 1u;
@@ -369,11 +185,11 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     if (!((_e65 <= 0.0))) {
         uint _e69 = close;
         uint _e70 = taps;
-        local_7 = _e69 < metal::min(_e70, 2u);
+        local_3 = _e69 < metal::min(_e70, 2u);
     } else {
-        local_7 = true;
+        local_3 = true;
     }
-    bool _e77 = local_7;
+    bool _e77 = local_3;
     if (_e77) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
@@ -407,16 +223,20 @@ uint naga_mod(uint lhs, uint rhs) {
     return lhs % metal::select(rhs, 1u, rhs == 0u);
 }
 
+uint naga_f2u32(float value) {
+    return static_cast<uint>(metal::clamp(value, 0.0, 4294967000.0));
+}
+
 EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l,
-    metal::uint2 p_2,
+    metal::uint2 p,
     uint slices
 ) {
     uint s_lo = 0u;
     float fs = 0.0;
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = {};
-    metal::float2 d_3 = (static_cast<metal::float2>(p_2) + metal::float2(0.5, 0.5)) - l.origin;
-    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_3);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t = {};
+    metal::float2 d_2 = (static_cast<metal::float2>(p) + metal::float2(0.5, 0.5)) - l.origin;
+    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
     float f = ((_e12 - l.phi_start) / l.dphi) - 0.5;
     if (l.wrap != 0u) {
         float fl = metal::floor(f);
@@ -430,26 +250,26 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     }
     uint _e46 = s_lo;
     uint _e47 = s_lo;
-    t_1.slices = metal::uint2(_e46, naga_mod(_e47 + 1u, slices));
+    t.slices = metal::uint2(_e46, naga_mod(_e47 + 1u, slices));
     float _e53 = fs;
     float _e56 = fs;
-    t_1.w = metal::float4(1.0 - _e53, _e56, 0.0, 0.0);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t_1;
+    t.w = metal::float4(1.0 - _e53, _e56, 0.0, 0.0);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t;
     return _e60;
 }
 
 EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1,
-    metal::uint2 p_3,
+    metal::uint2 p_1,
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair,
     metal::float4 line_lo,
     metal::float4 line_hi,
     uint samples
 ) {
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_2 = {};
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = {};
     uint j_1 = 0u;
-    metal::float2 d_4 = (static_cast<metal::float2>(p_3) + metal::float2(0.5, 0.5)) - l_1.origin;
-    t_2 = pair;
+    metal::float2 d_3 = (static_cast<metal::float2>(p_1) + metal::float2(0.5, 0.5)) - l_1.origin;
+    t_1 = pair;
     metal::float2 ws = pair.w.xy;
     uint2 loop_bound_1 = uint2(4294967295u);
     bool loop_init_1 = true;
@@ -469,22 +289,226 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
         {
             uint _e18 = j_1;
             metal::float4 line = (_e18 == 1u) ? line_hi : line_lo;
-            float g_1 = (metal::dot(d_4, line.xy) - line.z) / metal::max(line.w, 0.00000000000000000001);
+            float g_1 = (metal::dot(d_3, line.xy) - line.z) / metal::max(line.w, 0.00000000000000000001);
             float gc = metal::clamp(g_1, 0.0, static_cast<float>(samples - 1u));
             uint k_lo = metal::min(naga_f2u32(gc), samples - 2u);
             float fk = gc - static_cast<float>(k_lo);
             uint _e45 = j_1;
-            t_2.k[metal::min(unsigned(_e45), 1u)] = k_lo;
+            t_1.k[metal::min(unsigned(_e45), 1u)] = k_lo;
             uint _e49 = j_1;
             uint _e52 = j_1;
-            t_2.w[metal::min(unsigned(2u * _e49), 3u)] = ws[metal::min(unsigned(_e52), 1u)] * (1.0 - fk);
+            t_1.w[metal::min(unsigned(2u * _e49), 3u)] = ws[metal::min(unsigned(_e52), 1u)] * (1.0 - fk);
             uint _e59 = j_1;
             uint _e64 = j_1;
-            t_2.w[metal::min(unsigned((2u * _e59) + 1u), 3u)] = ws[metal::min(unsigned(_e64), 1u)] * fk;
+            t_1.w[metal::min(unsigned((2u * _e59) + 1u), 3u)] = ws[metal::min(unsigned(_e64), 1u)] * fk;
         }
     }
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_2;
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_1;
     return _e70;
+}
+
+float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float g,
+    float cos_theta
+) {
+    float denom = metal::max((1.0 + (g * g)) - ((2.0 * g) * cos_theta), 0.00000001);
+    return (1.0 - (g * g)) / ((12.566371 * denom) * metal::sqrt(denom));
+}
+
+float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float sigma_t,
+    float len
+) {
+    float x_4 = sigma_t * len;
+    if (x_4 < 0.0001) {
+        return len * (1.0 - (0.5 * x_4));
+    }
+    return (1.0 - metal::exp(-(x_4))) / sigma_t;
+}
+
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float sigma_t_1,
+    float a_1,
+    float b_1
+) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b_1 - a_1);
+    return metal::exp(-(sigma_t_1) * a_1) * _e7;
+}
+
+float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    float cos_angle,
+    float cos_inner,
+    float cos_outer
+) {
+    if ((cos_inner - cos_outer) <= 0.000001) {
+        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
+    }
+    float x_5 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_5 * x_5) * (3.0 - (2.0 * x_5));
+}
+
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye,
+    metal::float3 dir,
+    float t_2,
+    metal::float3 light_pos,
+    metal::float3 light_dir,
+    float cos_inner_1,
+    float cos_outer_1,
+    metal::float4 medium
+) {
+    metal::float3 x_6 = eye + (dir * t_2);
+    metal::float3 to_x = x_6 - light_pos;
+    float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
+    float d_4 = metal::sqrt(d2_);
+    metal::float3 travel = to_x / metal::float3(d_4);
+    float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_4 + t_2))) / d2_;
+}
+
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    metal::float3 eye_1,
+    metal::float3 dir_1,
+    metal::float3 light_pos_1,
+    float a_2,
+    float b_2,
+    uint n
+) {
+    float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
+    float h_1 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float theta_a = metal::atan((a_2 - t0_) / h_1);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_, h_1, theta_a, (metal::atan((b_2 - t0_) / h_1) - theta_a) / static_cast<float>(n)};
+}
+
+metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e,
+    float x_2
+) {
+    float tau = metal::tan(e.theta_a + (x_2 * e.dtheta));
+    return metal::float2(e.t_close + (e.dist * tau), (e.dtheta * e.dist) * (1.0 + (tau * tau)));
+}
+
+metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
+    metal::float3 p_2
+) {
+    metal::float3 q_1 = p_2 - v.origin.xyz;
+    return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
+}
+
+metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
+    metal::float3 ls
+) {
+    if (v_1.origin.w > 0.5) {
+        float z_1 = metal::max(ls.z, 0.000001);
+        float t_5 = v_1.proj.x;
+        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_5)), 0.5 - ((0.5 * ls.y) / (z_1 * t_5)));
+    } else {
+        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
+    }
+}
+
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2,
+    metal::texture2d<float, metal::access::sample> sm,
+    metal::float2 uv
+) {
+    bool local_4 = {};
+    bool local_5 = {};
+    bool local_6 = {};
+    if (!((uv.x < 0.0))) {
+        local_4 = uv.x > 1.0;
+    } else {
+        local_4 = true;
+    }
+    bool _e11 = local_4;
+    if (!(_e11)) {
+        local_5 = uv.y < 0.0;
+    } else {
+        local_5 = true;
+    }
+    bool _e19 = local_5;
+    if (!(_e19)) {
+        local_6 = uv.y > 1.0;
+    } else {
+        local_6 = true;
+    }
+    bool _e27 = local_6;
+    if (_e27) {
+        return 2.0;
+    }
+    uint n_1 = v_2.size.x;
+    uint x_7 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint y_3 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
+    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
+    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_7, y_3)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
+    return _e49.x;
+}
+
+float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
+    float z
+) {
+    float texel = {};
+    float size = static_cast<float>(v_3.size.x);
+    if (v_3.origin.w > 0.5) {
+        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
+    } else {
+        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
+    }
+    float _e32 = texel;
+    return v_3.forward.w * _e32;
+}
+
+float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
+    metal::texture2d<float, metal::access::sample> sm_1,
+    metal::float3 p_3
+) {
+    bool local_7 = {};
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
+    float near = v_4.right.w;
+    float far = v_4.up.w;
+    if (v_4.origin.w > 0.5) {
+        local_7 = _e2.z <= near;
+    } else {
+        local_7 = false;
+    }
+    bool _e16 = local_7;
+    if (_e16) {
+        return 1.0;
+    }
+    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
+    float depth_1 = (_e2.z - near) / (far - near);
+    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
+    return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
+}
+
+void unwarp_pixel(
+    metal::uint2 q,
+    metal::float4 w_1,
+    metal::float4 depths_2,
+    type_6 light_2,
+    metal::texture2d<float, metal::access::sample> depth,
+    metal::texture2d<float, metal::access::write> output,
+    device metal::atomic_uint& fallback_count,
+    device type_12& fallback_pixels,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    uint clamped_lod_e3 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e3 = depth.read(metal::min(metal::uint2(q), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
+    metal::float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e10.w == 0.0) {
+        uint _e16 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
+        fallback_pixels[metal::min(unsigned(_e16), (_buffer_sizes.size6 - 0 - 4) / 4)] = q.x | (q.y << 16u);
+        return;
+    } else {
+        output.write(_e10, metal::uint2(q));
+        return;
+    }
 }
 
 metal::float3 raymarch_pixel(
@@ -498,7 +522,7 @@ metal::float3 raymarch_pixel(
     float sum_1 = 0.0;
     uint j_2 = {};
     float t_3 = {};
-    float w_1 = {};
+    float w_2 = {};
     float l_2 = {};
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
     metal::float3 eye_2 = m_2.eye.xyz;
@@ -538,19 +562,19 @@ metal::float3 raymarch_pixel(
             uint _e52 = j_2;
             float _e54 = u;
             t_3 = (static_cast<float>(_e52) + _e54) * h_2;
-            w_1 = h_2;
+            w_2 = h_2;
             if (false) {
                 uint _e60 = j_2;
                 float _e62 = u;
                 metal::float2 _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, static_cast<float>(_e60) + _e62);
                 t_3 = _e64.x;
-                w_1 = _e64.y;
+                w_2 = _e64.y;
             }
             float _e67 = t_3;
             float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, eye_2 + (_e8 * _e67));
             if (false) {
                 float _e73 = sum_1;
-                float _e74 = w_1;
+                float _e74 = w_2;
                 float _e76 = t_3;
                 float _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
                 sum_1 = _e73 + ((_e71 * _e74) * _e86);
@@ -593,14 +617,14 @@ kernel void raymarch_unwarp(
 ) {
     bool local = {};
     metal::float4 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
-    type_9 light = {};
+    type_6 light = {};
     uint j = 0u;
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     metal::uint2 screen = metal::uint2(_e6, _e10);
-    metal::uint2 q_1 = id.xy;
-    if (!((q_1.x >= screen.x))) {
-        local = q_1.y >= screen.y;
+    metal::uint2 q_2 = id.xy;
+    if (!((q_2.x >= screen.x))) {
+        local = q_2.y >= screen.y;
     } else {
         local = true;
     }
@@ -613,12 +637,12 @@ kernel void raymarch_unwarp(
     uint clamped_lod_e36 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 angles = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(1u, 256u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e36), epipolar_samples.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z)};
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, SLICES);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, SLICES);
     uint clamped_lod_e52 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 line_lo_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.x)), metal::uint2(epipolar_samples.get_width(clamped_lod_e52), epipolar_samples.get_height(clamped_lod_e52)) - 1), clamped_lod_e52);
     uint clamped_lod_e59 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e59), epipolar_samples.get_height(clamped_lod_e59)) - 1), clamped_lod_e59);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
@@ -647,16 +671,7 @@ kernel void raymarch_unwarp(
         }
     }
     metal::float4 _e96 = depths;
-    type_9 _e97 = light;
-    uint clamped_lod_e100 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e100 = depth.read(metal::min(metal::uint2(q_1), metal::uint2(depth.get_width(clamped_lod_e100), depth.get_height(clamped_lod_e100)) - 1), clamped_lod_e100);
-    metal::float4 _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e104.w == 0.0) {
-        uint _e110 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e110), (_buffer_sizes.size6 - 0 - 4) / 4)] = q_1.x | (q_1.y << 16u);
-        return;
-    } else {
-        output.write(_e104, metal::uint2(q_1));
-        return;
-    }
+    type_6 _e97 = light;
+    unwarp_pixel(q_2, _e61.w, _e96, _e97, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+    return;
 }

@@ -27,13 +27,6 @@ struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     interleave: vec4<u32>,
 }
 
-struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
-    t_close: f32,
-    dist: f32,
-    theta_a: f32,
-    dtheta: f32,
-}
-
 struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     origin: vec2<f32>,
     axis: vec2<f32>,
@@ -46,6 +39,13 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     slices: vec2<u32>,
     k: vec2<u32>,
     w: vec4<f32>,
+}
+
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    t_close: f32,
+    dist: f32,
+    theta_a: f32,
+    dtheta: f32,
 }
 
 const SLICES: u32 = 256u;
@@ -99,147 +99,15 @@ fn pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_1: u32, y_1: u32)
     return (f32((_e29 >> 8u)) / 16777216f);
 }
 
-fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
-    let denom = max(((1f + (g * g)) - ((2f * g) * cos_theta)), 0.00000001f);
-    return ((1f - (g * g)) / ((12.566371f * denom) * sqrt(denom)));
-}
-
-fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_4 = (sigma_t * len);
-    if (x_4 < 0.0001f) {
-        return (len * (1f - (0.5f * x_4)));
-    }
-    return ((1f - exp(-(x_4))) / sigma_t);
-}
-
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b - a));
-    return (exp((-(sigma_t_1) * a)) * _e7);
-}
-
-fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
-    let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_5 * x_5) * (3f - (2f * x_5)));
-}
-
-fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_6 = (eye + (dir * t));
-    let to_x = (x_6 - light_pos);
-    let d2_ = max(dot(to_x, to_x), 0.000000000001f);
-    let d_2 = sqrt(d2_);
-    let travel = (to_x / vec3(d_2));
-    let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
-    let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
-}
-
-fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, light_pos_1: vec3<f32>, a_1: f32, b_1: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
-    let t0_ = dot((light_pos_1 - eye_1), dir_1);
-    let h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
-    let theta_a = atan(((a_1 - t0_) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_1 - t0_) / h_1)) - theta_a) / f32(n)));
-}
-
-fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x_2: f32) -> vec2<f32> {
-    let tau = tan((e.theta_a + (x_2 * e.dtheta)));
-    return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
-}
-
-fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
-    let q = (p - v.origin.xyz);
-    return vec3<f32>(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
-}
-
-fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
-    if (v_1.origin.w > 0.5f) {
-        let z_1 = max(ls.z, 0.000001f);
-        let t_5 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_5))), (0.5f - ((0.5f * ls.y) / (z_1 * t_5))));
-    } else {
-        return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
-}
-
-fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
+fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a: f32, b: f32, depth_break: f32) -> bool {
     var local_1: bool;
-    var local_2: bool;
-    var local_3: bool;
 
-    if !((uv.x < 0f)) {
-        local_1 = (uv.x > 1f);
+    if !((a == b)) {
+        local_1 = (abs((a - b)) <= (depth_break * min(a, b)));
     } else {
         local_1 = true;
     }
-    let _e11 = local_1;
-    if !(_e11) {
-        local_2 = (uv.y < 0f);
-    } else {
-        local_2 = true;
-    }
-    let _e19 = local_2;
-    if !(_e19) {
-        local_3 = (uv.y > 1f);
-    } else {
-        local_3 = true;
-    }
-    let _e27 = local_3;
-    if _e27 {
-        return 2f;
-    }
-    let n_1 = v_2.size.x;
-    let x_7 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
-    let y_3 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_7, y_3), 0i);
-    return _e49.x;
-}
-
-fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
-    var texel: f32;
-
-    let size = f32(v_3.size.x);
-    if (v_3.origin.w > 0.5f) {
-        texel = (((2f * max(z, 0f)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    let _e32 = texel;
-    return (v_3.forward.w * _e32);
-}
-
-fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_4: bool;
-
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    let near = v_4.right.w;
-    let far = v_4.up.w;
-    if (v_4.origin.w > 0.5f) {
-        local_4 = (_e2.z <= near);
-    } else {
-        local_4 = false;
-    }
-    let _e16 = local_4;
-    if _e16 {
-        return 1f;
-    }
-    let _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    let _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    let depth_1 = ((_e2.z - near) / (far - near));
-    let _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
-}
-
-fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_2: f32, b_2: f32, depth_break: f32) -> bool {
-    var local_5: bool;
-
-    if !((a_2 == b_2)) {
-        local_5 = (abs((a_2 - b_2)) <= (depth_break * min(a_2, b_2)));
-    } else {
-        local_5 = true;
-    }
-    let _e13 = local_5;
+    let _e13 = local_1;
     return _e13;
 }
 
@@ -251,8 +119,8 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
     var taps: u32 = 0u;
     var close: u32 = 0u;
     var k: u32 = 0u;
-    var local_6: bool;
-    var local_7: bool;
+    var local_2: bool;
+    var local_3: bool;
 
     loop {
         let _e6 = k;
@@ -268,11 +136,11 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
             if (w[_e20] > 0f) {
                 let _e25 = k;
                 let _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_6 = _e29;
+                local_2 = _e29;
             } else {
-                local_6 = false;
+                local_2 = false;
             }
-            let _e33 = local_6;
+            let _e33 = local_2;
             if _e33 {
                 let _e35 = close;
                 close = (_e35 + 1u);
@@ -300,11 +168,11 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
     if !((_e65 <= 0f)) {
         let _e69 = close;
         let _e70 = taps;
-        local_7 = (_e69 < min(_e70, 2u));
+        local_3 = (_e69 < min(_e70, 2u));
     } else {
-        local_7 = true;
+        local_3 = true;
     }
-    let _e77 = local_7;
+    let _e77 = local_3;
     if _e77 {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
@@ -327,13 +195,13 @@ fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, 
     return atan2(((axis.x * d_1.y) - (axis.y * d_1.x)), ((axis.x * d_1.x) + (axis.y * d_1.y)));
 }
 
-fn epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p_2: vec2<u32>, slices: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+fn epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p: vec2<u32>, slices: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     var s_lo: u32 = 0u;
     var fs: f32 = 0f;
-    var t_1: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
+    var t: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
 
-    let d_3 = ((vec2<f32>(p_2) + vec2<f32>(0.5f, 0.5f)) - l.origin);
-    let _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_3);
+    let d_2 = ((vec2<f32>(p) + vec2<f32>(0.5f, 0.5f)) - l.origin);
+    let _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
     let f = (((_e12 - l.phi_start) / l.dphi) - 0.5f);
     if (l.wrap != 0u) {
         let fl = floor(f);
@@ -347,20 +215,20 @@ fn epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l: EpipolarLayou
     }
     let _e46 = s_lo;
     let _e47 = s_lo;
-    t_1.slices = vec2<u32>(_e46, ((_e47 + 1u) % slices));
+    t.slices = vec2<u32>(_e46, ((_e47 + 1u) % slices));
     let _e53 = fs;
     let _e56 = fs;
-    t_1.w = vec4<f32>((1f - _e53), _e56, 0f, 0f);
-    let _e60 = t_1;
+    t.w = vec4<f32>((1f - _e53), _e56, 0f, 0f);
+    let _e60 = t;
     return _e60;
 }
 
-fn epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p_3: vec2<u32>, pair: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, line_lo: vec4<f32>, line_hi: vec4<f32>, samples: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    var t_2: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
+fn epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p_1: vec2<u32>, pair: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, line_lo: vec4<f32>, line_hi: vec4<f32>, samples: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+    var t_1: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
     var j_1: u32 = 0u;
 
-    let d_4 = ((vec2<f32>(p_3) + vec2<f32>(0.5f, 0.5f)) - l_1.origin);
-    t_2 = pair;
+    let d_3 = ((vec2<f32>(p_1) + vec2<f32>(0.5f, 0.5f)) - l_1.origin);
+    t_1 = pair;
     let ws = pair.w.xy;
     loop {
         let _e15 = j_1;
@@ -371,26 +239,171 @@ fn epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLayou
         {
             let _e18 = j_1;
             let line = select(line_lo, line_hi, (_e18 == 1u));
-            let g_1 = ((dot(d_4, line.xy) - line.z) / max(line.w, 0.00000000000000000001f));
+            let g_1 = ((dot(d_3, line.xy) - line.z) / max(line.w, 0.00000000000000000001f));
             let gc = clamp(g_1, 0f, f32((samples - 1u)));
             let k_lo = min(u32(gc), (samples - 2u));
             let fk = (gc - f32(k_lo));
             let _e45 = j_1;
-            t_2.k[_e45] = k_lo;
+            t_1.k[_e45] = k_lo;
             let _e49 = j_1;
             let _e52 = j_1;
-            t_2.w[(2u * _e49)] = (ws[_e52] * (1f - fk));
+            t_1.w[(2u * _e49)] = (ws[_e52] * (1f - fk));
             let _e59 = j_1;
             let _e64 = j_1;
-            t_2.w[((2u * _e59) + 1u)] = (ws[_e64] * fk);
+            t_1.w[((2u * _e59) + 1u)] = (ws[_e64] * fk);
         }
         continuing {
             let _e68 = j_1;
             j_1 = (_e68 + 1u);
         }
     }
-    let _e70 = t_2;
+    let _e70 = t_1;
     return _e70;
+}
+
+fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
+    let denom = max(((1f + (g * g)) - ((2f * g) * cos_theta)), 0.00000001f);
+    return ((1f - (g * g)) / ((12.566371f * denom) * sqrt(denom)));
+}
+
+fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
+    let x_4 = (sigma_t * len);
+    if (x_4 < 0.0001f) {
+        return (len * (1f - (0.5f * x_4)));
+    }
+    return ((1f - exp(-(x_4))) / sigma_t);
+}
+
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a_1: f32, b_1: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
+    return (exp((-(sigma_t_1) * a_1)) * _e7);
+}
+
+fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
+    if ((cos_inner - cos_outer) <= 0.000001f) {
+        return select(0f, 1f, (cos_angle >= cos_outer));
+    }
+    let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_5 * x_5) * (3f - (2f * x_5)));
+}
+
+fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t_2: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
+    let x_6 = (eye + (dir * t_2));
+    let to_x = (x_6 - light_pos);
+    let d2_ = max(dot(to_x, to_x), 0.000000000001f);
+    let d_4 = sqrt(d2_);
+    let travel = (to_x / vec3(d_4));
+    let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
+    let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_4 + t_2)))) / d2_);
+}
+
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, light_pos_1: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    let t0_ = dot((light_pos_1 - eye_1), dir_1);
+    let h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_2 - a_2), 0.000001f)));
+    let theta_a = atan(((a_2 - t0_) / h_1));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_2 - t0_) / h_1)) - theta_a) / f32(n)));
+}
+
+fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x_2: f32) -> vec2<f32> {
+    let tau = tan((e.theta_a + (x_2 * e.dtheta)));
+    return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
+}
+
+fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p_2: vec3<f32>) -> vec3<f32> {
+    let q_1 = (p_2 - v.origin.xyz);
+    return vec3<f32>(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+}
+
+fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
+    if (v_1.origin.w > 0.5f) {
+        let z_1 = max(ls.z, 0.000001f);
+        let t_5 = v_1.proj.x;
+        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_5))), (0.5f - ((0.5f * ls.y) / (z_1 * t_5))));
+    } else {
+        return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
+    }
+}
+
+fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
+    var local_4: bool;
+    var local_5: bool;
+    var local_6: bool;
+
+    if !((uv.x < 0f)) {
+        local_4 = (uv.x > 1f);
+    } else {
+        local_4 = true;
+    }
+    let _e11 = local_4;
+    if !(_e11) {
+        local_5 = (uv.y < 0f);
+    } else {
+        local_5 = true;
+    }
+    let _e19 = local_5;
+    if !(_e19) {
+        local_6 = (uv.y > 1f);
+    } else {
+        local_6 = true;
+    }
+    let _e27 = local_6;
+    if _e27 {
+        return 2f;
+    }
+    let n_1 = v_2.size.x;
+    let x_7 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let y_3 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
+    let _e49 = textureLoad(sm, vec2<u32>(x_7, y_3), 0i);
+    return _e49.x;
+}
+
+fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
+    var texel: f32;
+
+    let size = f32(v_3.size.x);
+    if (v_3.origin.w > 0.5f) {
+        texel = (((2f * max(z, 0f)) * v_3.proj.x) / size);
+    } else {
+        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
+    }
+    let _e32 = texel;
+    return (v_3.forward.w * _e32);
+}
+
+fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_3: vec3<f32>) -> f32 {
+    var local_7: bool;
+
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
+    let near = v_4.right.w;
+    let far = v_4.up.w;
+    if (v_4.origin.w > 0.5f) {
+        local_7 = (_e2.z <= near);
+    } else {
+        local_7 = false;
+    }
+    let _e16 = local_7;
+    if _e16 {
+        return 1f;
+    }
+    let _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
+    let _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
+    let depth_1 = ((_e2.z - near) / (far - near));
+    let _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
+    return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
+}
+
+fn unwarp_pixel(q: vec2<u32>, w_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
+    let _e3 = textureLoad(depth, q, 0i);
+    let _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e10.w == 0f) {
+        let _e16 = atomicAdd((&fallback_count), 1u);
+        fallback_pixels[_e16] = (q.x | (q.y << 16u));
+        return;
+    } else {
+        textureStore(output, q, _e10);
+        return;
+    }
 }
 
 fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
@@ -398,7 +411,7 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     var sum_1: f32 = 0f;
     var j_2: u32;
     var t_3: f32;
-    var w_1: f32;
+    var w_2: f32;
     var l_2: f32;
 
     let m_2 = frame;
@@ -429,19 +442,19 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
             let _e52 = j_2;
             let _e54 = u;
             t_3 = ((f32(_e52) + _e54) * h_2);
-            w_1 = h_2;
+            w_2 = h_2;
             if false {
                 let _e60 = j_2;
                 let _e62 = u;
                 let _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (f32(_e60) + _e62));
                 t_3 = _e64.x;
-                w_1 = _e64.y;
+                w_2 = _e64.y;
             }
             let _e67 = t_3;
             let _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)));
             if false {
                 let _e73 = sum_1;
-                let _e74 = w_1;
+                let _e74 = w_2;
                 let _e76 = t_3;
                 let _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
                 sum_1 = (_e73 + ((_e71 * _e74) * _e86));
@@ -480,9 +493,9 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e6 = frame.sizes.x;
     let _e10 = frame.sizes.y;
     let screen = vec2<u32>(_e6, _e10);
-    let q_1 = id.xy;
-    if !((q_1.x >= screen.x)) {
-        local = (q_1.y >= screen.y);
+    let q_2 = id.xy;
+    if !((q_2.x >= screen.x)) {
+        local = (q_2.y >= screen.y);
     } else {
         local = true;
     }
@@ -493,10 +506,10 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     let head = textureLoad(epipolar_samples, vec2<u32>(0u, 256u), 0i);
     let angles = textureLoad(epipolar_samples, vec2<u32>(1u, 256u), 0i);
     let lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, u32(angles.z));
-    let _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, SLICES);
+    let _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, SLICES);
     let line_lo_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e45.slices.x), 0i);
     let line_hi_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e45.slices.y), 0i);
-    let _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_1, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    let _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
     loop {
         let _e63 = j;
         if (_e63 < 4u) {
@@ -520,14 +533,6 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let _e96 = depths;
     let _e97 = light;
-    let _e100 = textureLoad(depth, q_1, 0i);
-    let _e104 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e61.w, _e96, _e97, _e100.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e104.w == 0f) {
-        let _e110 = atomicAdd((&fallback_count), 1u);
-        fallback_pixels[_e110] = (q_1.x | (q_1.y << 16u));
-        return;
-    } else {
-        textureStore(output, q_1, _e104);
-        return;
-    }
+    unwarp_pixel(q_2, _e61.w, _e96, _e97);
+    return;
 }

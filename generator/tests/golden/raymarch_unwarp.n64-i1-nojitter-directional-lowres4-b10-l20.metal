@@ -35,19 +35,19 @@ struct RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX {
     metal::uint4 sizes;
     metal::uint4 interleave;
 };
-struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
-    float t_close;
-    float dist;
-    float theta_a;
-    float dtheta;
-};
 struct LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     metal::uint2 cols;
     metal::uint2 rows;
     metal::float4 w;
 };
-struct type_9 {
+struct type_6 {
     metal::float3 inner[4];
+};
+struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+    float t_close;
+    float dist;
+    float theta_a;
+    float dtheta;
 };
 typedef uint type_12[1];
 constant uint SCALE = 4u;
@@ -90,6 +90,150 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
     return static_cast<float>(_e29 >> 8u) / 16777216.0;
 }
 
+metal::uint2 naga_div(metal::uint2 lhs, metal::uint2 rhs) {
+    return lhs / metal::select(rhs, 1u, rhs == 0u);
+}
+
+metal::uint2 lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+    metal::uint2 screen,
+    uint scale
+) {
+    return naga_div((screen - metal::uint2(1u, 1u)) + metal::uint2(scale - 1u, scale - 1u), metal::uint2(scale)) + metal::uint2(1u, 1u);
+}
+
+metal::uint2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+    metal::uint2 i,
+    metal::uint2 screen_1,
+    uint scale_1
+) {
+    return metal::min(i * scale_1, screen_1 - metal::uint2(1u, 1u));
+}
+
+LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+    metal::uint2 p,
+    metal::uint2 screen_2,
+    uint scale_2
+) {
+    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t = {};
+    metal::uint2 _e2 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, scale_2);
+    metal::uint2 lo_1 = naga_div(p, metal::uint2(scale_2));
+    metal::uint2 hi_1 = metal::min(lo_1 + metal::uint2(1u, 1u), _e2 - metal::uint2(1u, 1u));
+    metal::uint2 _e15 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lo_1, screen_2, scale_2);
+    metal::uint2 _e16 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(hi_1, screen_2, scale_2);
+    metal::float2 fr = static_cast<metal::float2>(p - _e15) / static_cast<metal::float2>(metal::max(_e16 - _e15, metal::uint2(1u, 1u)));
+    t.cols = metal::uint2(lo_1.x, hi_1.x);
+    t.rows = metal::uint2(lo_1.y, hi_1.y);
+    t.w = metal::float4((1.0 - fr.x) * (1.0 - fr.y), fr.x * (1.0 - fr.y), (1.0 - fr.x) * fr.y, fr.x * fr.y);
+    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e57 = t;
+    return _e57;
+}
+
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+    float a,
+    float b,
+    float depth_break
+) {
+    bool local_1 = {};
+    if (!((a == b))) {
+        local_1 = metal::abs(a - b) <= (depth_break * metal::min(a, b));
+    } else {
+        local_1 = true;
+    }
+    bool _e13 = local_1;
+    return _e13;
+}
+
+metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+    metal::float4 w,
+    metal::float4 depths_1,
+    type_6 light_1,
+    float d,
+    float depth_break_1,
+    float light_break
+) {
+    metal::float3 sum = metal::float3(0.0, 0.0, 0.0);
+    float total = 0.0;
+    metal::float3 lo = metal::float3(340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0);
+    metal::float3 hi = metal::float3(0.0, 0.0, 0.0);
+    uint taps = 0u;
+    uint close = 0u;
+    uint k = 0u;
+    bool local_2 = {};
+    bool local_3 = {};
+    uint2 loop_bound = uint2(4294967295u);
+    bool loop_init = true;
+    while(true) {
+        if (metal::all(loop_bound == uint2(0u))) { break; }
+        loop_bound -= uint2(loop_bound.y == 0u, 1u);
+        if (!loop_init) {
+            uint _e63 = k;
+            k = _e63 + 1u;
+        }
+        loop_init = false;
+        uint _e6 = k;
+        if (_e6 < 4u) {
+        } else {
+            break;
+        }
+        {
+            uint _e10 = taps;
+            uint _e12 = k;
+            taps = _e10 + ((w[metal::min(unsigned(_e12), 3u)] > 0.0) ? 1u : 0u);
+            uint _e20 = k;
+            if (w[metal::min(unsigned(_e20), 3u)] > 0.0) {
+                uint _e25 = k;
+                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
+                local_2 = _e29;
+            } else {
+                local_2 = false;
+            }
+            bool _e33 = local_2;
+            if (_e33) {
+                uint _e35 = close;
+                close = _e35 + 1u;
+                metal::float3 _e40 = sum;
+                uint _e41 = k;
+                uint _e43 = k;
+                sum = _e40 + (w[metal::min(unsigned(_e41), 3u)] * light_1.inner[metal::min(unsigned(_e43), 3u)]);
+                float _e48 = total;
+                uint _e49 = k;
+                total = _e48 + w[metal::min(unsigned(_e49), 3u)];
+                metal::float3 _e53 = lo;
+                uint _e54 = k;
+                lo = metal::min(_e53, light_1.inner[metal::min(unsigned(_e54), 3u)]);
+                metal::float3 _e58 = hi;
+                uint _e59 = k;
+                hi = metal::max(_e58, light_1.inner[metal::min(unsigned(_e59), 3u)]);
+            }
+        }
+    }
+    float _e65 = total;
+    if (!((_e65 <= 0.0))) {
+        uint _e69 = close;
+        uint _e70 = taps;
+        local_3 = _e69 < metal::min(_e70, 2u);
+    } else {
+        local_3 = true;
+    }
+    bool _e77 = local_3;
+    if (_e77) {
+        return metal::float4(0.0, 0.0, 0.0, 0.0);
+    }
+    metal::float3 _e83 = hi;
+    metal::float3 _e84 = lo;
+    metal::float3 spread = _e83 - _e84;
+    float _e93 = hi.x;
+    float _e95 = hi.y;
+    float _e97 = hi.z;
+    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e93, metal::max(_e95, _e97)))) {
+        return metal::float4(0.0, 0.0, 0.0, 0.0);
+    }
+    metal::float3 _e107 = sum;
+    float _e108 = total;
+    metal::float3 c = _e107 / metal::float3(_e108);
+    return metal::float4(c.x, c.y, c.z, 1.0);
+}
+
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float g,
     float cos_theta
@@ -111,11 +255,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t_1,
-    float a,
-    float b
+    float a_1,
+    float b_1
 ) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b - a);
-    return metal::exp(-(sigma_t_1) * a) * _e7;
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b_1 - a_1);
+    return metal::exp(-(sigma_t_1) * a_1) * _e7;
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -133,35 +277,35 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 eye,
     metal::float3 dir,
-    float t,
+    float t_1,
     metal::float3 light_pos,
     metal::float3 light_dir,
     float cos_inner_1,
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_6 = eye + (dir * t);
+    metal::float3 x_6 = eye + (dir * t_1);
     metal::float3 to_x = x_6 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_1 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_1);
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_1 + t))) / d2_;
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_1 + t_1))) / d2_;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 eye_1,
     metal::float3 dir_1,
     metal::float3 light_pos_1,
-    float a_1,
-    float b_1,
+    float a_2,
+    float b_2,
     uint n
 ) {
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
-    float h_1 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
-    float theta_a = metal::atan((a_1 - t0_) / h_1);
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_, h_1, theta_a, (metal::atan((b_1 - t0_) / h_1) - theta_a) / static_cast<float>(n)};
+    float h_1 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float theta_a = metal::atan((a_2 - t0_) / h_1);
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_, h_1, theta_a, (metal::atan((b_2 - t0_) / h_1) - theta_a) / static_cast<float>(n)};
 }
 
 metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -174,10 +318,10 @@ metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
-    metal::float3 p
+    metal::float3 p_1
 ) {
-    metal::float3 q = p - v.origin.xyz;
-    return metal::float3(metal::dot(q, v.right.xyz), metal::dot(q, v.up.xyz), metal::dot(q, v.forward.xyz));
+    metal::float3 q_1 = p_1 - v.origin.xyz;
+    return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
 }
 
 metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
@@ -202,27 +346,27 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_1 = {};
-    bool local_2 = {};
-    bool local_3 = {};
+    bool local_4 = {};
+    bool local_5 = {};
+    bool local_6 = {};
     if (!((uv.x < 0.0))) {
-        local_1 = uv.x > 1.0;
+        local_4 = uv.x > 1.0;
     } else {
-        local_1 = true;
+        local_4 = true;
     }
-    bool _e11 = local_1;
+    bool _e11 = local_4;
     if (!(_e11)) {
-        local_2 = uv.y < 0.0;
+        local_5 = uv.y < 0.0;
     } else {
-        local_2 = true;
+        local_5 = true;
     }
-    bool _e19 = local_2;
+    bool _e19 = local_5;
     if (!(_e19)) {
-        local_3 = uv.y > 1.0;
+        local_6 = uv.y > 1.0;
     } else {
-        local_3 = true;
+        local_6 = true;
     }
-    bool _e27 = local_3;
+    bool _e27 = local_6;
     if (_e27) {
         return 2.0;
     }
@@ -252,18 +396,18 @@ float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
     metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_1
+    metal::float3 p_2
 ) {
-    bool local_4 = {};
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
+    bool local_7 = {};
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_2);
     float near = v_4.right.w;
     float far = v_4.up.w;
     if (v_4.origin.w > 0.5) {
-        local_4 = _e2.z <= near;
+        local_7 = _e2.z <= near;
     } else {
-        local_4 = false;
+        local_7 = false;
     }
-    bool _e16 = local_4;
+    bool _e16 = local_7;
     if (_e16) {
         return 1.0;
     }
@@ -274,148 +418,28 @@ float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
 }
 
-metal::uint2 naga_div(metal::uint2 lhs, metal::uint2 rhs) {
-    return lhs / metal::select(rhs, 1u, rhs == 0u);
-}
-
-metal::uint2 lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    metal::uint2 screen,
-    uint scale
+void unwarp_pixel(
+    metal::uint2 q,
+    metal::float4 w_1,
+    metal::float4 depths_2,
+    type_6 light_2,
+    metal::texture2d<float, metal::access::sample> depth,
+    metal::texture2d<float, metal::access::write> output,
+    device metal::atomic_uint& fallback_count,
+    device type_12& fallback_pixels,
+    constant _mslBufferSizes& _buffer_sizes
 ) {
-    return naga_div((screen - metal::uint2(1u, 1u)) + metal::uint2(scale - 1u, scale - 1u), metal::uint2(scale)) + metal::uint2(1u, 1u);
-}
-
-metal::uint2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    metal::uint2 i,
-    metal::uint2 screen_1,
-    uint scale_1
-) {
-    return metal::min(i * scale_1, screen_1 - metal::uint2(1u, 1u));
-}
-
-LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    metal::uint2 p_2,
-    metal::uint2 screen_2,
-    uint scale_2
-) {
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = {};
-    metal::uint2 _e2 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, scale_2);
-    metal::uint2 lo_1 = naga_div(p_2, metal::uint2(scale_2));
-    metal::uint2 hi_1 = metal::min(lo_1 + metal::uint2(1u, 1u), _e2 - metal::uint2(1u, 1u));
-    metal::uint2 _e15 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lo_1, screen_2, scale_2);
-    metal::uint2 _e16 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(hi_1, screen_2, scale_2);
-    metal::float2 fr = static_cast<metal::float2>(p_2 - _e15) / static_cast<metal::float2>(metal::max(_e16 - _e15, metal::uint2(1u, 1u)));
-    t_1.cols = metal::uint2(lo_1.x, hi_1.x);
-    t_1.rows = metal::uint2(lo_1.y, hi_1.y);
-    t_1.w = metal::float4((1.0 - fr.x) * (1.0 - fr.y), fr.x * (1.0 - fr.y), (1.0 - fr.x) * fr.y, fr.x * fr.y);
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e57 = t_1;
-    return _e57;
-}
-
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_2,
-    float b_2,
-    float depth_break
-) {
-    bool local_5 = {};
-    if (!((a_2 == b_2))) {
-        local_5 = metal::abs(a_2 - b_2) <= (depth_break * metal::min(a_2, b_2));
+    uint clamped_lod_e3 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e3 = depth.read(metal::min(metal::uint2(q), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
+    metal::float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e10.w == 0.0) {
+        uint _e16 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
+        fallback_pixels[metal::min(unsigned(_e16), (_buffer_sizes.size6 - 0 - 4) / 4)] = q.x | (q.y << 16u);
+        return;
     } else {
-        local_5 = true;
+        output.write(_e10, metal::uint2(q));
+        return;
     }
-    bool _e13 = local_5;
-    return _e13;
-}
-
-metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    metal::float4 w,
-    metal::float4 depths_1,
-    type_9 light_1,
-    float d,
-    float depth_break_1,
-    float light_break
-) {
-    metal::float3 sum = metal::float3(0.0, 0.0, 0.0);
-    float total = 0.0;
-    metal::float3 lo = metal::float3(340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0);
-    metal::float3 hi = metal::float3(0.0, 0.0, 0.0);
-    uint taps = 0u;
-    uint close = 0u;
-    uint k = 0u;
-    bool local_6 = {};
-    bool local_7 = {};
-    uint2 loop_bound = uint2(4294967295u);
-    bool loop_init = true;
-    while(true) {
-        if (metal::all(loop_bound == uint2(0u))) { break; }
-        loop_bound -= uint2(loop_bound.y == 0u, 1u);
-        if (!loop_init) {
-            uint _e63 = k;
-            k = _e63 + 1u;
-        }
-        loop_init = false;
-        uint _e6 = k;
-        if (_e6 < 4u) {
-        } else {
-            break;
-        }
-        {
-            uint _e10 = taps;
-            uint _e12 = k;
-            taps = _e10 + ((w[metal::min(unsigned(_e12), 3u)] > 0.0) ? 1u : 0u);
-            uint _e20 = k;
-            if (w[metal::min(unsigned(_e20), 3u)] > 0.0) {
-                uint _e25 = k;
-                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
-                local_6 = _e29;
-            } else {
-                local_6 = false;
-            }
-            bool _e33 = local_6;
-            if (_e33) {
-                uint _e35 = close;
-                close = _e35 + 1u;
-                metal::float3 _e40 = sum;
-                uint _e41 = k;
-                uint _e43 = k;
-                sum = _e40 + (w[metal::min(unsigned(_e41), 3u)] * light_1.inner[metal::min(unsigned(_e43), 3u)]);
-                float _e48 = total;
-                uint _e49 = k;
-                total = _e48 + w[metal::min(unsigned(_e49), 3u)];
-                metal::float3 _e53 = lo;
-                uint _e54 = k;
-                lo = metal::min(_e53, light_1.inner[metal::min(unsigned(_e54), 3u)]);
-                metal::float3 _e58 = hi;
-                uint _e59 = k;
-                hi = metal::max(_e58, light_1.inner[metal::min(unsigned(_e59), 3u)]);
-            }
-        }
-    }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_7 = _e69 < metal::min(_e70, 2u);
-    } else {
-        local_7 = true;
-    }
-    bool _e77 = local_7;
-    if (_e77) {
-        return metal::float4(0.0, 0.0, 0.0, 0.0);
-    }
-    metal::float3 _e83 = hi;
-    metal::float3 _e84 = lo;
-    metal::float3 spread = _e83 - _e84;
-    float _e93 = hi.x;
-    float _e95 = hi.y;
-    float _e97 = hi.z;
-    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e93, metal::max(_e95, _e97)))) {
-        return metal::float4(0.0, 0.0, 0.0, 0.0);
-    }
-    metal::float3 _e107 = sum;
-    float _e108 = total;
-    metal::float3 c = _e107 / metal::float3(_e108);
-    return metal::float4(c.x, c.y, c.z, 1.0);
 }
 
 uint naga_mod(uint lhs, uint rhs) {
@@ -433,7 +457,7 @@ metal::float3 raymarch_pixel(
     float sum_1 = 0.0;
     uint j_1 = {};
     float t_2 = {};
-    float w_1 = {};
+    float w_2 = {};
     float l = {};
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
     metal::float3 eye_2 = m_2.eye.xyz;
@@ -473,19 +497,19 @@ metal::float3 raymarch_pixel(
             uint _e52 = j_1;
             float _e54 = u;
             t_2 = (static_cast<float>(_e52) + _e54) * h_2;
-            w_1 = h_2;
+            w_2 = h_2;
             if (false) {
                 uint _e60 = j_1;
                 float _e62 = u;
                 metal::float2 _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, static_cast<float>(_e60) + _e62);
                 t_2 = _e64.x;
-                w_1 = _e64.y;
+                w_2 = _e64.y;
             }
             float _e67 = t_2;
             float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, eye_2 + (_e8 * _e67));
             if (false) {
                 float _e73 = sum_1;
-                float _e74 = w_1;
+                float _e74 = w_2;
                 float _e76 = t_2;
                 float _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
                 sum_1 = _e73 + ((_e71 * _e74) * _e86);
@@ -528,14 +552,14 @@ kernel void raymarch_unwarp(
 ) {
     bool local = {};
     metal::float4 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
-    type_9 light = {};
+    type_6 light = {};
     uint j = 0u;
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     metal::uint2 screen_3 = metal::uint2(_e6, _e10);
-    metal::uint2 q_1 = id.xy;
-    if (!((q_1.x >= screen_3.x))) {
-        local = q_1.y >= screen_3.y;
+    metal::uint2 q_2 = id.xy;
+    if (!((q_2.x >= screen_3.x))) {
+        local = q_2.y >= screen_3.y;
     } else {
         local = true;
     }
@@ -543,7 +567,7 @@ kernel void raymarch_unwarp(
     if (_e24) {
         return;
     }
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e26 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_1, screen_3, SCALE);
+    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e26 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
@@ -571,16 +595,7 @@ kernel void raymarch_unwarp(
         }
     }
     metal::float4 _e57 = depths;
-    type_9 _e58 = light;
-    uint clamped_lod_e61 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e61 = depth.read(metal::min(metal::uint2(q_1), metal::uint2(depth.get_width(clamped_lod_e61), depth.get_height(clamped_lod_e61)) - 1), clamped_lod_e61);
-    metal::float4 _e65 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e26.w, _e57, _e58, _e61.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e65.w == 0.0) {
-        uint _e71 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e71), (_buffer_sizes.size6 - 0 - 4) / 4)] = q_1.x | (q_1.y << 16u);
-        return;
-    } else {
-        output.write(_e65, metal::uint2(q_1));
-        return;
-    }
+    type_6 _e58 = light;
+    unwarp_pixel(q_2, _e26.w, _e57, _e58, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+    return;
 }

@@ -39,4 +39,17 @@ const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 {%- if sampling.unwarp %}
 // The pixels no sample stands for, packed x | y << 16, for `{{ sampling.family_entry }}_fallback`.
 @group(0) @binding({{ sampling.binding + 2 }}) var<storage, read_write> fallback_pixels: array<u32>;
+
+// The unwarp's end for pixel `q` (both sampled modes): the blend of its taps (`w` their
+// weights, `depths` their pixels' depths, `light` their radiance) kept by depth and light
+// spread (`lowres_blend`) into `output`, or `q` listed in `fallback_pixels` where they cannot
+// stand for it (nothing written).
+fn unwarp_pixel(q: vec2<u32>, w: vec4<f32>, depths: vec4<f32>, light: array<vec3<f32>, 4>) {
+    let c = lowres_blend(w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
+    if c.w == 0.0 {
+        fallback_pixels[atomicAdd(&fallback_count, 1u)] = q.x | (q.y << 16u);
+    } else {
+        textureStore(output, q, c);
+    }
+}
 {%- endif %}

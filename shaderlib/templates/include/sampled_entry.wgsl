@@ -47,12 +47,7 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
         depths[j] = v.w;
         light[j] = v.xyz;
     }
-    let c = lowres_blend(t.w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
-    if c.w == 0.0 {
-        fallback_pixels[atomicAdd(&fallback_count, 1u)] = q.x | (q.y << 16u);
-    } else {
-        textureStore(output, q, c);
-    }
+    unwarp_pixel(q, t.w, depths, light);
 }
 {%- else if sampling.epipolar && !sampling.unwarp && !sampling.fallback %}
 
@@ -227,12 +222,7 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
         depths[j] = v.w;
         light[j] = v.xyz;
     }
-    let c = lowres_blend(t.w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
-    if c.w == 0.0 {
-        fallback_pixels[atomicAdd(&fallback_count, 1u)] = q.x | (q.y << 16u);
-    } else {
-        textureStore(output, q, c);
-    }
+    unwarp_pixel(q, t.w, depths, light);
 }
 {%- else if sampling.fallback %}
 
