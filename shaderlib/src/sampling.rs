@@ -128,8 +128,9 @@ fn wgsl_f32(v: f32) -> String {
 }
 
 /// The invocations of a family's per-pixel pass: the screen for `pixels`; for `lowres`,
-/// one per sample of the grid ([`lowres_grid_formula`]: one more than the grid where the
-/// block side divides the screen; the kernel skips the extra ones); for `epipolar`, one
+/// one per sample of the grid ([`lowres_grid_formula`]: one more than the grid along an
+/// axis whose size minus one the block side divides; the kernel skips the extra ones); for
+/// `epipolar`, one
 /// workgroup of [`SLICE_LANES`] invocations per slice: `SLICE_LANES * slices` by 1.
 pub fn sampling_invocations(knobs: &SamplingKnobs) -> [String; 3] {
     match knobs.sampling {
