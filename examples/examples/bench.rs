@@ -46,6 +46,11 @@ struct Args {
     /// the families run, the ratio lines the full bench reads from the headline.
     #[arg(long, requires = "headline_only")]
     headline_errors: bool,
+    /// With `--headline-only`: only the methods with these knobs, as the headline table
+    /// names them (repeatable; e.g. `--knobs n64-i1-ep512 --knobs n64-i1`). A name no
+    /// headline method has is an error.
+    #[arg(long = "knobs", value_name = "KNOBS", requires = "headline_only")]
+    knobs: Vec<String>,
     /// Only the machine's bounds (probe kernels: copy bandwidth, texel loads, filtered
     /// fetches, transcendentals, FMAs) and every kernel's cost model against them at the
     /// headline configuration (`scatter_examples::roofline`): two markdown tables printed,
@@ -104,6 +109,7 @@ fn main() -> ExitCode {
         config.scaling = false;
         config.headline = true;
         config.headline_error = args.headline_errors;
+        config.headline_knobs = args.knobs.clone();
     }
     if args.roofline {
         return roofline(args.frames.unwrap_or(5));

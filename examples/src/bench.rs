@@ -217,6 +217,9 @@ pub struct BenchConfig {
     /// Only these families' methods, in the sweep and the headline runs (empty: every
     /// family); `bench --family raymarch --family hybrid_volume`.
     pub families: Vec<Family>,
+    /// Only the headline methods with these knobs, as the headline table names them
+    /// (`n64-i1-ep512`; empty: every one); `bench --headline-only --knobs n64-i1-ep512`.
+    pub headline_knobs: Vec<String>,
     /// Leave out (and list in [`BenchResult::skipped`]) a method whose resources exceed a
     /// device limit, instead of failing the run: `tune`, whose grid spans layouts a small
     /// device cannot hold (a partial-sum tree of rank 8 over 1024 x 512 samples needs a
@@ -296,6 +299,7 @@ impl BenchConfig {
             headline: true,
             headline_error: true,
             families: Vec::new(),
+            headline_knobs: Vec::new(),
             skip_over_limits: false,
             exact_truth: true,
         }
@@ -332,6 +336,7 @@ impl BenchConfig {
             headline: false,
             headline_error: false,
             families: Vec::new(),
+            headline_knobs: Vec::new(),
             skip_over_limits: false,
             exact_truth: true,
         }
@@ -639,7 +644,7 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
     };
     let headline = if config.headline {
         bar.set_message("headline 1280x720");
-        headline_runs(ctx, config.frames, config.headline_error, &config.families)?
+        headline_runs(ctx, config)?
     } else {
         Vec::new()
     };
@@ -932,12 +937,8 @@ fn sampled_variants() -> Vec<(FamilyVariant, FamilyVariant)> {
 
 /// The headline configuration: 1280x720, 1024x1024 rectified, on sphere, foliage and
 /// terrain; with `errors`, each run's rel L1 against the `shadow_map` truth at that size.
-fn headline_runs(
-    ctx: &Context,
-    frames: u32,
-    errors: bool,
-    families: &[Family],
-) -> Result<Vec<HeadlineRow>, BoxError> {
+fn headline_runs(ctx: &Context, config: &BenchConfig) -> Result<Vec<HeadlineRow>, BoxError> {
+    let (frames, errors, families) = (config.frames, config.headline_error, &config.families);
     let mut methods = vec![
         Method::prefiltered_default(),
         Method::minmax_default(),
@@ -999,6 +1000,17 @@ fn headline_runs(
     }
     if !families.is_empty() {
         methods.retain(|m| families.contains(&m.variant.family()));
+    }
+    if !config.headline_knobs.is_empty() {
+        let known: Vec<String> = methods.iter().map(Method::knobs).collect();
+        if let Some(k) = config.headline_knobs.iter().find(|k| !known.contains(k)) {
+            return Err(format!(
+                "no headline method has the knobs `{k}` (the headline's: {})",
+                known.join(", ")
+            )
+            .into());
+        }
+        methods.retain(|m| config.headline_knobs.contains(&m.knobs()));
     }
     let screen = [1280, 720];
     let mut out = Vec::new();
@@ -1389,6 +1401,39 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
                     "best prefiltered configuration at or below minmax's error on foliage/ordinary at 1280x720: none of the {} the headline ran reaches {:.3} %",
                     configs.len(),
                     100.0 * e
+                ),
+            },
+        );
+    }
+    // The same comparison along minmax's whole speed-error curve on foliage: for every
+    // minmax configuration the headline ran (per pixel, sampled, either map), the cheapest
+    // prefiltered one at or below its error. Where the prefiltered curve lies below
+    // minmax's, and where it stops (the error it cannot reach), read from one run.
+    let mut minmax_configs: Vec<(String, (f64, f64))> = result
+        .headline
+        .iter()
+        .filter(|r| r.family == "minmax" && r.scene == SceneName::Foliage)
+        .filter_map(|r| on_foliage("minmax", &r.knobs).map(|m| (r.knobs.clone(), m)))
+        .collect();
+    minmax_configs.sort_by(|a, b| a.1.1.total_cmp(&b.1.1));
+    minmax_configs.dedup_by(|a, b| a.0 == b.0);
+    for (knobs, (t, e)) in &minmax_configs {
+        out.push(
+            match cheapest_at_or_below(*e, &|k| on_foliage("prefiltered", k)) {
+                Some((k, (pt, pe))) => format!(
+                    "foliage/ordinary at 1280x720, minmax {knobs} {t:.1} ms at rel L1 {:.3} %: the cheapest prefiltered configuration at or below its error, {k}, {pt:.1} ms at {:.3} %: {}",
+                    100.0 * e,
+                    100.0 * pe,
+                    if pt < *t {
+                        format!("minmax takes {:.2}x the time", t / pt)
+                    } else {
+                        format!("prefiltered takes {:.2}x the time", pt / t)
+                    }
+                ),
+                None => format!(
+                    "foliage/ordinary at 1280x720, minmax {knobs} {t:.1} ms at rel L1 {:.3} %: no prefiltered configuration of the {} reaches its error",
+                    100.0 * e,
+                    configs.len()
                 ),
             },
         );

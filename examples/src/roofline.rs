@@ -26,6 +26,7 @@ use scatter_runtime::Context;
 use scatter_runtime::shaderlib::minmax::tree_width;
 use scatter_runtime::shaderlib::prefiltered::{PrefilteredVariant, RECTIFY_TEXELS};
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
+use scatter_runtime::shaderlib::sampling::{SLICE_LANES, SamplingKnobs};
 use scatter_runtime::wgpu;
 
 use crate::bench::{BoxError, Method, time_methods};
@@ -580,6 +581,7 @@ pub fn kernel_costs() -> Vec<KernelCost> {
         low: None,
         trips: "2 x 4 taps",
     });
+    sampled_costs(&mut out, pixels, n);
     // partial_sum_tree, rank 4, 512 slices x 256 samples: one workgroup of 32 lanes per
     // slice; counts per invocation averaged over the slice's lanes (the sweep runs on one
     // of them). Per slice: Q = 256 sample set-ups (depth and tail loads, two atan2, sin,
@@ -608,10 +610,11 @@ pub fn kernel_costs() -> Vec<KernelCost> {
         method: "partial_sum_tree r4",
         kernel: "pst_sweep_unwarp",
         invocations: pixels,
-        // The layout (two loads), the two slices' lines, four sample loads and the pixel's
-        // depth; two atan2 (the pixel's angle and slice), the bilinear weights and the
-        // depth- and light-aware blend (about 60 FMAs); the rgba16float store.
-        counts: [8.0, 9.0, 0.0, 2.0, 60.0],
+        // The shared epipolar unwarp (`raymarch n64 ep512`'s `raymarch_unwarp` line): the
+        // layout (two loads), the two slices' lines, four sample loads and the pixel's
+        // depth; one atan2 (the pixel's angle) and three divisions, the bilinear weights and
+        // the depth- and light-aware blend (about 90 FMAs); the rgba16float store.
+        counts: [8.0, 9.0, 0.0, 4.0, 90.0],
         low: None,
         trips: "4 taps",
     });
@@ -683,6 +686,100 @@ pub fn kernel_costs() -> Vec<KernelCost> {
     out
 }
 
+/// The sampled passes (`scatter::sampling`, shared by every family) at their defaults, for
+/// raymarch N = `n` (the family without fixed passes; another family's samples pass is its
+/// per-pixel body per sample, its unwarp and fallback the same code): epipolar 512 slices x
+/// 256 samples at step 8, and lowres at scale 2.
+fn sampled_costs(out: &mut Vec<KernelCost>, pixels: u64, n: f64) {
+    let [w, h] = SCREEN.map(u64::from);
+    // One raymarch evaluation (the per-pixel line without its depth load), rounded to f16.
+    let eval = [0.0, n, 0.0, 2.0 * n + 2.0, 25.0 * n + 30.0];
+    let (slices, samples, step) = (
+        u64::from(SamplingKnobs::DEFAULT_SLICES),
+        f64::from(SamplingKnobs::DEFAULT_SLICE_SAMPLES),
+        f64::from(SamplingKnobs::DEFAULT_STEP),
+    );
+    let lanes = f64::from(SLICE_LANES);
+    let per_lane = samples / lanes;
+    // Evaluated samples per lane: every STEP-th and the last (none at a break), .. every one.
+    let evaluated = |e: f64| {
+        std::array::from_fn(|i| {
+            // Per lane: its samples' depth loads, marking, interpolation and stores (16 B
+            // each); the layout (four atan2 of the corners), the slice's direction and span
+            // (two sin/cos pairs) once.
+            let fixed = [16.0 * per_lane, per_lane, 0.0, 8.0, 80.0 + per_lane * 22.0];
+            fixed[i] + e * eval[i]
+        })
+    };
+    out.push(KernelCost {
+        method: "raymarch n64 ep512",
+        kernel: "raymarch",
+        invocations: slices * u64::from(SLICE_LANES),
+        // A workgroup of SLICE_LANES per slice; counts per lane, the evaluations at their
+        // largest (every sample: depth breaks everywhere).
+        counts: evaluated(per_lane),
+        low: Some(evaluated((samples / step + 1.0) / lanes)),
+        trips: "per lane: samples / lanes set-ups, evaluations (samples / step + 1 .. samples) / lanes",
+    });
+    out.push(KernelCost {
+        method: "raymarch n64 ep512",
+        kernel: "raymarch_unwarp",
+        invocations: pixels,
+        // The layout (two loads), the slices' lines (two), four samples and the pixel's
+        // depth; the pixel's angle (one atan2) and three divisions (counted as
+        // transcendentals); the taps' weights and the blend by depth and light (about 90
+        // FMAs); the rgba16float store (or a 4-byte list entry).
+        counts: [8.0, 9.0, 0.0, 4.0, 90.0],
+        low: None,
+        trips: "4 taps",
+    });
+    let grid = lowres_grid(w, 2) * lowres_grid(h, 2);
+    out.push(KernelCost {
+        method: "raymarch n64 lr2",
+        kernel: "raymarch",
+        invocations: grid,
+        // One evaluation per grid sample: the depth load, the march, a 16-byte store.
+        counts: [16.0, 1.0 + n, 0.0, eval[3], eval[4] + 10.0],
+        low: None,
+        trips: "N samples",
+    });
+    out.push(KernelCost {
+        method: "raymarch n64 lr2",
+        kernel: "raymarch_unwarp",
+        invocations: pixels,
+        // Four sample loads and the pixel's depth; the taps (two divisions) and the blend
+        // (about 75 FMAs); the rgba16float store (or a 4-byte list entry).
+        counts: [8.0, 5.0, 0.0, 2.0, 75.0],
+        low: None,
+        trips: "4 taps",
+    });
+    for method in ["raymarch n64 ep512", "raymarch n64 lr2"] {
+        // One invocation per 8 x 8 pixels walks the list: per listed pixel one entry load
+        // and the per-pixel body. Counted for none listed .. 5 % of the pixels (3.2 per
+        // invocation; the headline lists 0.3-4 %).
+        let listed = 0.05 * 64.0;
+        out.push(KernelCost {
+            method,
+            kernel: "raymarch_fallback",
+            invocations: pixels.div_ceil(64),
+            counts: [
+                8.0 * listed,
+                1.0 + listed * (2.0 + n),
+                0.0,
+                listed * eval[3],
+                4.0 + listed * eval[4],
+            ],
+            low: Some([0.0, 1.0, 0.0, 0.0, 4.0]),
+            trips: "listed pixels, data-dependent (none .. 5 % of the screen)",
+        });
+    }
+}
+
+/// `ceil((side - 1) / scale) + 1`: the lowres grid along one axis.
+fn lowres_grid(side: u64, scale: u64) -> u64 {
+    (side - 1).div_ceil(scale) + 1
+}
+
 /// One row of the roofline table: a kernel's model, its bound and its measured time.
 #[derive(Clone, Debug)]
 pub struct RooflineRow {
@@ -742,20 +839,31 @@ pub fn roofline(
             ..RaymarchVariant::default()
         }),
         Method::from(PrefilteredVariant::with_moments(4)),
+        Method::from(sampled_raymarch(SamplingKnobs::epipolar(
+            SamplingKnobs::DEFAULT_SLICES,
+        ))),
+        Method::from(sampled_raymarch(SamplingKnobs::lowres(2))),
     ];
     let times = time_methods(ctx, &methods, SceneName::Sphere, SCREEN, RECTIFIED, frames)?;
-    // (kernel, time): raymarch from the plain run, interleave_sum from the interleaved one.
-    // The moment basis's prefilter and scatter (method 4) go to its own cost lines, keyed
-    // by the method; its shared first passes are the default's.
-    let mut measured: Vec<(bool, &'static str, Duration)> = Vec::new();
+    // (run, kernel, time): raymarch from the plain run, interleave_sum from the interleaved
+    // one. The moment basis's prefilter and scatter (method 4) and the sampled runs' passes
+    // (methods 5 and 6) go to their own cost lines, keyed by the method (`run_of`); the
+    // moment basis's shared first passes are the default's.
+    let mut measured: Vec<(Run, &'static str, Duration)> = Vec::new();
     for (i, passes) in times.into_iter().enumerate() {
+        let run = match i {
+            4 => Run::Moments,
+            5 => Run::Epipolar,
+            6 => Run::Lowres,
+            _ => Run::Default,
+        };
         for (name, t) in passes {
             let keep = !matches!(
                 (i, name),
                 (3, "raymarch") | (1 | 4, "depth_columns" | "slice_fit" | "rectify")
             );
             if keep {
-                measured.push((i == 4, name, t));
+                measured.push((run, name, t));
             }
         }
     }
@@ -772,10 +880,10 @@ pub fn roofline(
                 |counts: [f64; 5]| std::array::from_fn(|i| counts[i] * cost_of(OpKind::ALL[i]));
             let bound_ns = per_kind(cost.counts);
             let low_bound_ns = cost.low.map(per_kind);
-            let moments = cost.method.contains("moments");
+            let run = run_of(cost.method);
             let measured_ns = measured
                 .iter()
-                .find(|(m, n, _)| *m == moments && *n == cost.kernel)
+                .find(|(m, n, _)| *m == run && *n == cost.kernel)
                 .map(|(_, _, t)| t.as_secs_f64() * 1e9 / cost.invocations as f64);
             RooflineRow {
                 cost,
@@ -785,6 +893,43 @@ pub fn roofline(
             }
         })
         .collect())
+}
+
+/// Which timed run measures a cost line's kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Run {
+    /// The per-pixel defaults (prefiltered, minmax, raymarch n64 with and without 4x4).
+    Default,
+    /// Prefiltered with 4 moments.
+    Moments,
+    /// Raymarch n64, `sampling = epipolar` at its defaults.
+    Epipolar,
+    /// Raymarch n64, `sampling = lowres`, scale 2.
+    Lowres,
+}
+
+/// The run a cost line's method is measured in.
+fn run_of(method: &str) -> Run {
+    if method.contains("moments") {
+        Run::Moments
+    } else if method.ends_with("ep512") {
+        Run::Epipolar
+    } else if method.ends_with("lr2") {
+        Run::Lowres
+    } else {
+        Run::Default
+    }
+}
+
+/// Raymarch N = 64 (the headline's) with `sampling`.
+fn sampled_raymarch(sampling: SamplingKnobs) -> RaymarchVariant {
+    use scatter_runtime::shaderlib::family::KnobSet;
+    RaymarchVariant {
+        samples: 64,
+        interleave: 1,
+        ..RaymarchVariant::default()
+    }
+    .with_sampling(sampling)
 }
 
 /// The bounds as a markdown table.
