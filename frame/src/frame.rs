@@ -48,6 +48,7 @@ pub use crate::scene::{
 };
 pub(crate) use crate::scene::{
     ScenePart, finite_fields, require, shadow_projection, validate_scene, validate_shadow_map,
+    validate_shadow_projection,
 };
 
 /// Texture sizes of one configuration.
@@ -525,6 +526,7 @@ fn prepare_frame_unchecked(
         cos_out,
     } = validate_scene(variant.light, camera, light, medium)?;
     validate_shadow_map(shadow)?;
+    validate_shadow_projection(variant.light, shadow)?;
     // e1: the view axis made perpendicular to A (so phi = 0 looks ahead), else any.
     let mut e1 = cam.forward - axis * cam.forward.dot(axis);
     if e1.length() < 1e-6 {

@@ -27,7 +27,7 @@ use std::fmt;
 
 use crate::frame::{
     CameraDesc, FrameError, LightDesc, MediumDesc, ShadowMapDesc, finite_fields, shadow_projection,
-    v4, validate_scene, validate_shadow_map,
+    v4, validate_scene, validate_shadow_map, validate_shadow_projection,
 };
 use crate::variant::{LightKind, VariantError};
 
@@ -257,6 +257,7 @@ pub fn prepare_raymarch(
     }
     let sc = validate_scene(variant.light, camera, light, medium)?;
     validate_shadow_map(shadow)?;
+    validate_shadow_projection(variant.light, shadow)?;
     let (sm_kind, sm_proj) = shadow_projection(shadow);
     let cam = sc.cam;
     let m = variant.interleave;

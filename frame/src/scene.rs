@@ -478,6 +478,28 @@ pub(crate) fn validate_shadow_map(shadow: &ShadowMapDesc) -> Result<(), FrameErr
 
 /// The shadow-map kind (0 orthographic, 1 perspective) and projection vector of the
 /// uniform blocks.
+/// Fails unless the shadow map's projection is the light's: orthographic for a
+/// directional light (parallel rays), perspective for a spot (rays from the light). The
+/// kernels are generated for one light kind and test only that kind's map (llvmpipe runs
+/// both halves of a branch on the map's kind, so they do not branch on it).
+pub(crate) fn validate_shadow_projection(
+    light: LightKind,
+    shadow: &ShadowMapDesc,
+) -> Result<(), FrameError> {
+    let orthographic = matches!(shadow.projection, ShadowProjectionDesc::Orthographic { .. });
+    let (ok, allowed) = match light {
+        LightKind::Directional => (orthographic, "orthographic (a directional light's map)"),
+        LightKind::Spot | LightKind::Area => (!orthographic, "perspective (a spot's map)"),
+    };
+    require(ok, "shadow map projection", allowed, || {
+        if orthographic {
+            "orthographic".to_owned()
+        } else {
+            "perspective".to_owned()
+        }
+    })
+}
+
 pub(crate) fn shadow_projection(shadow: &ShadowMapDesc) -> (f64, [f32; 4]) {
     match shadow.projection {
         ShadowProjectionDesc::Orthographic { x0, x1, y0, y1 } => {
@@ -498,5 +520,48 @@ pub(crate) fn finite_fields<const N: usize>(
     {
         Some(&(what, _)) => Err(FrameError::NotRepresentable { what }),
         None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sun takes an orthographic map and a spot a perspective one; the error names the
+    /// projection the light needs.
+    #[test]
+    fn shadow_projection_matches_the_light() {
+        let map = |projection| ShadowMapDesc {
+            origin: DVec3::ZERO,
+            basis: [DVec3::X, DVec3::Y, DVec3::Z],
+            projection,
+            near: 0.1,
+            far: 10.0,
+            size: 1024,
+            bias_texels: 1.5,
+        };
+        let ortho = map(ShadowProjectionDesc::Orthographic {
+            x0: -1.0,
+            x1: 1.0,
+            y0: -1.0,
+            y1: 1.0,
+        });
+        let persp = map(ShadowProjectionDesc::Perspective { tan_half: 0.5 });
+        assert!(validate_shadow_projection(LightKind::Directional, &ortho).is_ok());
+        assert!(validate_shadow_projection(LightKind::Spot, &persp).is_ok());
+        let e = validate_shadow_projection(LightKind::Directional, &persp)
+            .expect_err("a sun with a perspective map")
+            .to_string();
+        assert!(
+            e.contains("shadow map projection") && e.contains("orthographic"),
+            "{e}"
+        );
+        let e = validate_shadow_projection(LightKind::Spot, &ortho)
+            .expect_err("a spot with an orthographic map")
+            .to_string();
+        assert!(
+            e.contains("shadow map projection") && e.contains("perspective"),
+            "{e}"
+        );
     }
 }

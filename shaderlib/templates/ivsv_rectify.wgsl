@@ -25,7 +25,7 @@
 // Mirrors reference/src/kernels/ivsv_rectify.rs
 
 #import scatter::model::PI
-#import scatter::shadow::{ShadowMapView, shadow_bias, shadow_uv}
+#import scatter::shadow::{ShadowMapView, shadow_bias_perspective, shadow_uv_perspective}
 #import scatter::ivsv::{IvsvFrame, Vpl, PHI_BITS, plane_normal, voxel_word, vpl_shadow_view}
 
 @group(0) @binding(0) var<uniform> frame: IvsvFrame;
@@ -41,7 +41,7 @@ fn vpl_occluder_distance(v: ShadowMapView, layer: u32, l: vec3<f32>) -> f32 {
     if dir.z <= 1e-6 {
         return -1.0;
     }
-    let uv = shadow_uv(v, dir);
+    let uv = shadow_uv_perspective(v, dir);
     if uv[0] < 0.0 || uv[0] > 1.0 || uv[1] < 0.0 || uv[1] > 1.0 {
         return -1.0;
     }
@@ -55,7 +55,7 @@ fn vpl_occluder_distance(v: ShadowMapView, layer: u32, l: vec3<f32>) -> f32 {
     let near = v.right[3];
     let far = v.up[3];
     let z = near + stored * (far - near);
-    return (z + shadow_bias(v, z)) / dir.z;
+    return (z + shadow_bias_perspective(v, z)) / dir.z;
 }
 
 @compute @workgroup_size(64, 1, 1)

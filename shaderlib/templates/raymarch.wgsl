@@ -37,7 +37,7 @@
 {%- if cookie %}
 #import scatter::cookie::spot_cookie
 {%- endif %}
-#import scatter::shadow::shadow_visibility
+#import scatter::shadow::shadow_visibility_for
 #import scatter::raymarch::{RaymarchFrame, raymarch_pixel_dir, raymarch_shadow_view, pixel_jitter}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
@@ -81,7 +81,7 @@ fn raymarch_pixel(x: u32, y: u32) -> vec3<f32> {
             t = tw.x;
             w = tw.y;
         }
-        let v = shadow_visibility(view, shadow_map, eye + dir * t);
+        let v = shadow_visibility_for(view, shadow_map, eye + dir * t, spot);
         if spot {
 {%- if cookie %}
             let x = eye + dir * t;

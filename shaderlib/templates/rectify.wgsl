@@ -23,7 +23,7 @@
 // Mirrors reference/src/kernels/rectify.rs
 
 #import scatter::model::PI
-#import scatter::epipolar::{Frame, SliceParams, light_point_theta, occluder_depth, row_phi, slice_e, slice_params, sm_occluder_distance}
+#import scatter::epipolar::{Frame, SliceParams, light_point_theta, occluder_depth, row_phi, slice_e, slice_params, sm_occluder_distance_spot, sm_occluder_distance_sun}
 #import scatter::shadow::NO_OCCLUDER
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -45,17 +45,15 @@ fn rectify_texel(x: u32, slice: SliceParams, e: vec3<f32>, spot: bool) -> f32 {
     if spot {
         // The light ray leaving the light at angle psi = col from the direction towards the eye.
         let l = -axis * cos(col) + e * sin(col);
-        let s = sm_occluder_distance(frame, shadow_map, frame.light_pos.xyz, l);
+        let s = sm_occluder_distance_spot(frame, shadow_map, l);
         if s < NO_OCCLUDER {
             theta_occ = light_point_theta(frame, col, s, true);
         }
     } else {
         // The light ray at distance v = col from the axis, travelling along -axis.
         let o = frame.eye.xyz + e * col;
-        let s = sm_occluder_distance(frame, shadow_map, o, -axis);
-        if s < NO_OCCLUDER {
-            theta_occ = light_point_theta(frame, col, s, false);
-        }
+        let s = sm_occluder_distance_sun(frame, shadow_map, o);
+        theta_occ = select(PI, light_point_theta(frame, col, s, false), s < NO_OCCLUDER);
     }
     return occluder_depth(theta_occ, frame.theta[0], frame.theta[1]);
 }

@@ -292,7 +292,7 @@ fn every_suite_pose() {
                     } else {
                         transmittance_between(f.medium[0], a, b)
                     };
-                    let v = sm_visibility(&f, &smt, eye + dir * t);
+                    let v = sm_visibility(&f, &smt, eye + dir * t, spot);
                     total += f64::from(v * w);
                     let assumed = if b <= p.t_f {
                         Some(p.head)

@@ -61,111 +61,80 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
     return vec3<f32>(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
-fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
-    if (v_1.origin.w > 0.5f) {
-        let z_2 = max(ls.z, 0.000001f);
-        let t_1 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_2 * t_1))), (0.5f - ((0.5f * ls.y) / (z_2 * t_1))));
-    } else {
-        return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
+    let z_2 = max(ls.z, 0.000001f);
+    let t_1 = v_1.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_2 * t_1))), (0.5f - ((0.5f * ls.y) / (z_2 * t_1))));
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local: bool;
-    var local_1: bool;
-    var local_2: bool;
-
-    if !((uv.x < 0f)) {
-        local = (uv.x > 1f);
-    } else {
-        local = true;
-    }
-    let _e11 = local;
-    if !(_e11) {
-        local_1 = (uv.y < 0f);
-    } else {
-        local_1 = true;
-    }
-    let _e19 = local_1;
-    if !(_e19) {
-        local_2 = (uv.y > 1f);
-    } else {
-        local_2 = true;
-    }
-    let _e27 = local_2;
-    if _e27 {
-        return 2f;
-    }
+    let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
     let x_1 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y_1 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_1, y_1), 0i);
-    return _e49.x;
+    let _e36 = textureLoad(sm, vec2<u32>(x_1, y_1), 0i);
+    return select(_e36.x, 2f, outside);
 }
 
-fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z_1: f32) -> f32 {
-    var texel: f32;
-
-    let size = f32(v_3.size.x);
-    if (v_3.origin.w > 0.5f) {
-        texel = (((2f * max(z_1, 0f)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    let _e32 = texel;
-    return (v_3.forward.w * _e32);
+fn shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z_1: f32) -> f32 {
+    let texel = (((2f * max(z_1, 0f)) * v_3.proj.x) / f32(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_3: bool;
-
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    let near = v_4.right.w;
-    let far = v_4.up.w;
-    if (v_4.origin.w > 0.5f) {
-        local_3 = (_e2.z <= near);
-    } else {
-        local_3 = false;
-    }
-    let _e16 = local_3;
-    if _e16 {
-        return 1f;
-    }
-    let _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    let _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    let depth_1 = ((_e2.z - near) / (far - near));
-    let _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
+fn shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls_1: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
 }
 
-fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    let near_1 = v_5.right.w;
-    let far_1 = v_5.up.w;
-    if (v_5.origin.w > 0.5f) {
-        let dir_3 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_3.z <= 0.000001f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_3);
-        let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if (_e28 >= 1f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let z_3 = (near_1 + (_e28 * (far_1 - near_1)));
-        let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_3.z);
-    } else {
-        let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if (_e40 >= 1f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let z_4 = (near_1 + (_e40 * (far_1 - near_1)));
-        let _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_4);
-        return ((z_4 + _e47) - _e2.z);
+fn shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) -> f32 {
+    let texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / f32(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>, perspective: bool) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    let near = v_6.right.w;
+    let far = v_6.up.w;
+    if perspective {
+        let _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        let _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        let depth_1 = ((_e2.z - near) / (far - near));
+        let _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        let lit = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return select(0f, 1f, (lit | (_e2.z <= near)));
     }
+    let _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    let depth_2 = ((_e2.z - near) / (far - near));
+    let _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return select(0f, 1f, (depth_2 <= (_e28 + (_e33 / (far - near)))));
+}
+
+fn shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, l: vec3<f32>) -> f32 {
+    let near_1 = v_7.right.w;
+    let far_1 = v_7.up.w;
+    let dir_3 = vec3<f32>(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+    if (dir_3.z <= 0.000001f) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    let _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_3);
+    let _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if (_e22 >= 1f) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    let z_3 = (near_1 + (_e22 * (far_1 - near_1)));
+    let _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_3);
+    return ((z_3 + _e29) / dir_3.z);
+}
+
+fn shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_3: texture_2d<f32>, o: vec3<f32>) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    let near_2 = v_8.right.w;
+    let far_2 = v_8.up.w;
+    let _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    let _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    let z_4 = (near_2 + (_e9 * (far_2 - near_2)));
+    let _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return select(((z_4 + _e13) - _e2.z), NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, (_e9 >= 1f));
 }
 
 fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
@@ -275,7 +244,7 @@ fn depth_columns(@builtin(global_invocation_id) id: vec3<u32>) {
     if (x_5 >= f.sizes.x) {
         return;
     }
-    let far_2 = f.theta.z;
+    let far_3 = f.theta.z;
     loop {
         let _e12 = y;
         if (_e12 < f.sizes.y) {
@@ -285,9 +254,9 @@ fn depth_columns(@builtin(global_invocation_id) id: vec3<u32>) {
         {
             let _e16 = y;
             let _e20 = textureLoad(depth, vec2<u32>(x_5, _e16), 0i);
-            let v_6 = _e20.x;
+            let v_9 = _e20.x;
             let _e23 = z;
-            z = max(_e23, min(max(v_6, 0f), far_2));
+            z = max(_e23, min(max(v_9, 0f), far_3));
         }
         continuing {
             let _e29 = y;

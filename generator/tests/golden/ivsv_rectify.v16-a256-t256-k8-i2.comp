@@ -60,26 +60,15 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX vpl_shadow_viewX_naga_oil
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(r_1.sm_right, r_1.sm_up, r_1.sm_forward, r_1.sm_origin, r_1.sm_proj, uvec4(m_1.sizes.z, 0u, 0u, 0u));
 }
 
-vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
-    if ((v_1.origin.w > 0.5)) {
-        float z_1 = max(ls.z, 1e-6);
-        float t = v_1.proj.x;
-        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t))), (0.5 - ((0.5 * ls.y) / (z_1 * t))));
-    } else {
-        return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
+    float z_1 = max(ls.z, 1e-6);
+    float t = v_1.proj.x;
+    return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t))), (0.5 - ((0.5 * ls.y) / (z_1 * t))));
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, float z) {
-    float texel = 0.0;
-    float size = float(v_2.size.x);
-    if ((v_2.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_2.proj.x) / size);
-    } else {
-        texel = (max((v_2.proj.y - v_2.proj.x), (v_2.proj.w - v_2.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_2.forward.w * _e32);
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, float z) {
+    float texel = (((2.0 * max(z, 0.0)) * v_2.proj.x) / float(v_2.size.x));
+    return (v_2.forward.w * texel);
 }
 
 float vpl_occluder_distance(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, uint layer, vec3 l) {
@@ -90,7 +79,7 @@ float vpl_occluder_distance(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33
     if ((dir.z <= 1e-6)) {
         return -1.0;
     }
-    vec2 _e16 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, dir);
+    vec2 _e16 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, dir);
     if (!((_e16.x < 0.0))) {
         local_2 = (_e16.x > 1.0);
     } else {
@@ -124,7 +113,7 @@ float vpl_occluder_distance(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33
     float near = v_3.right.w;
     float far = v_3.up.w;
     float z_2 = (near + (stored * (far - near)));
-    float _e77 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, z_2);
+    float _e77 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, z_2);
     return ((z_2 + _e77) / dir.z);
 }
 

@@ -69,29 +69,17 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX vpl_shadow_viewX_naga_oil
     return shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx;
 }
 
-float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
+float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
 {
-    if ((v_1.origin.w > 0.5)) {
-        float z_1 = max(ls.z, 1e-6);
-        float t = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t))), (0.5 - ((0.5 * ls.y) / (z_1 * t))));
-    } else {
-        return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+    float z_1 = max(ls.z, 1e-6);
+    float t = v_1.proj.x;
+    return float2((0.5 + ((0.5 * ls.x) / (z_1 * t))), (0.5 - ((0.5 * ls.y) / (z_1 * t))));
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, float z)
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, float z)
 {
-    float texel = (float)0;
-
-    float size = float(v_2.size.x);
-    if ((v_2.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_2.proj.x) / size);
-    } else {
-        texel = (max((v_2.proj.y - v_2.proj.x), (v_2.proj.w - v_2.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_2.forward.w * _e32);
+    float texel = (((2.0 * max(z, 0.0)) * v_2.proj.x) / float(v_2.size.x));
+    return (v_2.forward.w * texel);
 }
 
 uint naga_f2u32(float value) {
@@ -108,7 +96,7 @@ float vpl_occluder_distance(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33
     if ((dir.z <= 1e-6)) {
         return -1.0;
     }
-    const float2 _e16 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, dir);
+    const float2 _e16 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, dir);
     if (!((_e16.x < 0.0))) {
         local_2 = (_e16.x > 1.0);
     } else {
@@ -141,7 +129,7 @@ float vpl_occluder_distance(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33
     float near = v_3.right.w;
     float far = v_3.up.w;
     float z_2 = (near + (stored * (far - near)));
-    const float _e77 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, z_2);
+    const float _e77 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, z_2);
     return ((z_2 + _e77) / dir.z);
 }
 

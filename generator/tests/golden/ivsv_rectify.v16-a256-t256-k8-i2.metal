@@ -71,32 +71,21 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX vpl_shadow_viewX_naga_oil
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {r_1.sm_right, r_1.sm_up, r_1.sm_forward, r_1.sm_origin, r_1.sm_proj, metal::uint4(m_1.sizes.z, 0u, 0u, 0u)};
 }
 
-metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
     metal::float3 ls
 ) {
-    if (v_1.origin.w > 0.5) {
-        float z_1 = metal::max(ls.z, 0.000001);
-        float t = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t)), 0.5 - ((0.5 * ls.y) / (z_1 * t)));
-    } else {
-        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
-    }
+    float z_1 = metal::max(ls.z, 0.000001);
+    float t = v_1.proj.x;
+    return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t)), 0.5 - ((0.5 * ls.y) / (z_1 * t)));
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2,
     float z
 ) {
-    float texel = {};
-    float size = static_cast<float>(v_2.size.x);
-    if (v_2.origin.w > 0.5) {
-        texel = ((2.0 * metal::max(z, 0.0)) * v_2.proj.x) / size;
-    } else {
-        texel = metal::max(v_2.proj.y - v_2.proj.x, v_2.proj.w - v_2.proj.z) / size;
-    }
-    float _e32 = texel;
-    return v_2.forward.w * _e32;
+    float texel = ((2.0 * metal::max(z, 0.0)) * v_2.proj.x) / static_cast<float>(v_2.size.x);
+    return v_2.forward.w * texel;
 }
 
 uint naga_f2u32(float value) {
@@ -116,7 +105,7 @@ float vpl_occluder_distance(
     if (dir.z <= 0.000001) {
         return -1.0;
     }
-    metal::float2 _e16 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, dir);
+    metal::float2 _e16 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, dir);
     if (!((_e16.x < 0.0))) {
         local_2 = _e16.x > 1.0;
     } else {
@@ -150,7 +139,7 @@ float vpl_occluder_distance(
     float near = v_3.right.w;
     float far = v_3.up.w;
     float z_2 = near + (stored * (far - near));
-    float _e77 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, z_2);
+    float _e77 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, z_2);
     return (z_2 + _e77) / dir.z;
 }
 uint naga_div(uint lhs, uint rhs) {

@@ -58,27 +58,15 @@ fn vpl_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_1: IvsvFrameX_naga_oi
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(r_1.sm_right, r_1.sm_up, r_1.sm_forward, r_1.sm_origin, r_1.sm_proj, vec4<u32>(m_1.sizes.z, 0u, 0u, 0u));
 }
 
-fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
-    if (v_1.origin.w > 0.5f) {
-        let z_1 = max(ls.z, 0.000001f);
-        let t = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t))), (0.5f - ((0.5f * ls.y) / (z_1 * t))));
-    } else {
-        return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
+    let z_1 = max(ls.z, 0.000001f);
+    let t = v_1.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t))), (0.5f - ((0.5f * ls.y) / (z_1 * t))));
 }
 
-fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
-    var texel: f32;
-
-    let size = f32(v_2.size.x);
-    if (v_2.origin.w > 0.5f) {
-        texel = (((2f * max(z, 0f)) * v_2.proj.x) / size);
-    } else {
-        texel = (max((v_2.proj.y - v_2.proj.x), (v_2.proj.w - v_2.proj.z)) / size);
-    }
-    let _e32 = texel;
-    return (v_2.forward.w * _e32);
+fn shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
+    let texel = (((2f * max(z, 0f)) * v_2.proj.x) / f32(v_2.size.x));
+    return (v_2.forward.w * texel);
 }
 
 fn vpl_occluder_distance(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, layer: u32, l: vec3<f32>) -> f32 {
@@ -90,7 +78,7 @@ fn vpl_occluder_distance(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI
     if (dir.z <= 0.000001f) {
         return -1f;
     }
-    let _e16 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, dir);
+    let _e16 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, dir);
     if !((_e16.x < 0f)) {
         local_2 = (_e16.x > 1f);
     } else {
@@ -123,7 +111,7 @@ fn vpl_occluder_distance(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI
     let near = v_3.right.w;
     let far = v_3.up.w;
     let z_2 = (near + (stored * (far - near)));
-    let _e77 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, z_2);
+    let _e77 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3, z_2);
     return ((z_2 + _e77) / dir.z);
 }
 

@@ -70,15 +70,11 @@ float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapView
     return float3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
-float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
+float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
 {
-    if ((v_1.origin.w > 0.5)) {
-        float z_1 = max(ls.z, 1e-6);
-        float t_3 = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
-    } else {
-        return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+    float z_1 = max(ls.z, 1e-6);
+    float t_3 = v_1.proj.x;
+    return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
 }
 
 uint naga_f2u32(float value) {
@@ -87,103 +83,79 @@ uint naga_f2u32(float value) {
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
 {
-    bool local_1 = (bool)0;
-    bool local_2 = (bool)0;
-    bool local_3 = (bool)0;
-
-    if (!((uv.x < 0.0))) {
-        local_1 = (uv.x > 1.0);
-    } else {
-        local_1 = true;
-    }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = (uv.y < 0.0);
-    } else {
-        local_2 = true;
-    }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = (uv.y > 1.0);
-    } else {
-        local_3 = true;
-    }
-    bool _e27 = local_3;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_2 = v_2.size.x;
     uint x_5 = min(naga_f2u32((uv.x * float(n_2))), (n_2 - 1u));
     uint y_2 = min(naga_f2u32((uv.y * float(n_2))), (n_2 - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_5, y_2), int(0)));
-    return _e49.x;
+    float4 _e36 = sm.Load(int3(uint2(x_5, y_2), int(0)));
+    return (outside ? 2.0 : _e36.x);
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
 {
-    float texel = (float)0;
-
-    float size = float(v_3.size.x);
-    if ((v_3.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_3.forward.w * _e32);
+    float texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / float(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, Texture2D<float4> sm_1, float3 p_1)
+float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, float3 ls_1)
 {
-    bool local_4 = (bool)0;
-
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if ((v_4.origin.w > 0.5)) {
-        local_4 = (_e2.z <= near);
-    } else {
-        local_4 = false;
-    }
-    bool _e16 = local_4;
-    if (_e16) {
-        return 1.0;
-    }
-    const float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    const float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = ((_e2.z - near) / (far - near));
-    const float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+    return float2(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
 }
 
-float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5, Texture2D<float4> sm_2, float3 o, float3 l)
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5)
 {
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    float near_1 = v_5.right.w;
-    float far_1 = v_5.up.w;
-    if ((v_5.origin.w > 0.5)) {
-        float3 dir_11 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_11.z <= 1e-6)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
-        const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if ((_e28 >= 1.0)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
-        const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_11.z);
-    } else {
-        const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if ((_e40 >= 1.0)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_3 = (near_1 + (_e40 * (far_1 - near_1)));
-        const float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e47) - _e2.z);
+    float texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / float(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, Texture2D<float4> sm_1, float3 p_1, bool perspective)
+{
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        const float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        const float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = ((_e2.z - near) / (far - near));
+        const float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit_1 = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return ((lit_1 | (_e2.z <= near)) ? 1.0 : 0.0);
     }
+    const float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = ((_e2.z - near) / (far - near));
+    const float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return ((depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0);
+}
+
+float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7, Texture2D<float4> sm_2, float3 l)
+{
+    float near_1 = v_7.right.w;
+    float far_1 = v_7.up.w;
+    float3 dir_11 = float3(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+    if ((dir_11.z <= 1e-6)) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    const float2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_11);
+    const float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if ((_e22 >= 1.0)) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    float z_2 = (near_1 + (_e22 * (far_1 - near_1)));
+    const float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_2);
+    return ((z_2 + _e29) / dir_11.z);
+}
+
+float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8, Texture2D<float4> sm_3, float3 o)
+{
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    float near_2 = v_8.right.w;
+    float far_2 = v_8.up.w;
+    const float2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    const float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    float z_3 = (near_2 + (_e9 * (far_2 - near_2)));
+    const float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return ((_e9 >= 1.0) ? NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX : ((z_3 + _e13) - _e2.z));
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
@@ -320,9 +292,9 @@ SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX ConstructSliceParamsX_n
     return ret;
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float4 v_6)
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float4 v_9)
 {
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax = ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax = ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9.x, v_9.y, v_9.z, v_9.w);
     return sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax;
 }
 
@@ -356,11 +328,11 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XON
     return shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx;
 }
 
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, Texture2D<float4> sm_3, float3 p_2)
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, Texture2D<float4> sm_4, float3 p_2, bool spot)
 {
     const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2);
-    const float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
+    const float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_2, spot);
+    return _e5;
 }
 
 float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, float3 eye_3, float3 dir_3, float t_1)
@@ -369,7 +341,7 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, Texture2D<float4> sm_4, float3 eye_4, float3 dir_4, float a_3, float b_3, uint steps, bool spot)
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, Texture2D<float4> sm_5, float3 eye_4, float3 dir_4, float a_3, float b_3, uint steps, bool spot_1)
 {
     float sum_1 = 0.0;
     uint k_1 = 0u;
@@ -397,15 +369,15 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
             uint _e17 = k_1;
             t_2 = (a_3 + ((float(_e17) + 0.5) * h_2));
             w = h_2;
-            if (spot) {
+            if (spot_1) {
                 uint _e26 = k_1;
                 const float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             float _e33 = t_2;
-            const float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e33)));
-            if (spot) {
+            const float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            if (spot_1) {
                 float _e39 = sum_1;
                 float _e40 = w;
                 float _e42 = t_2;
@@ -424,10 +396,10 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return _e65;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, Texture2D<float4> sm_5, float3 eye_5, float3 dir_5, float s, bool spot_1)
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, Texture2D<float4> sm_6, float3 eye_5, float3 dir_5, float s, bool spot_2)
 {
-    const float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_5, dir_5, 0.0, s, f_5.sizes2_.y, spot_1);
-    if (spot_1) {
+    const float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_6, eye_5, dir_5, 0.0, s, f_5.sizes2_.y, spot_2);
+    if (spot_2) {
         return _e9;
     } else {
         const float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_5)));
@@ -479,9 +451,9 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     return _e34;
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_2)
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_3)
 {
-    if (spot_2) {
+    if (spot_3) {
         float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_8.light_pos.xyz);
         float3 to_eye = -(f_8.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
@@ -489,19 +461,19 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_2, float delta, float theta_2, float s_2, bool spot_3)
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_2, float delta, float theta_2, float s_2, bool spot_4)
 {
-    bool local_5 = (bool)0;
+    bool local_1 = (bool)0;
 
-    if (spot_3) {
+    if (spot_4) {
         float psi = (x_2 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local_5 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_1 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_5 = true;
+            local_1 = true;
         }
-        bool _e16 = local_5;
+        bool _e16 = local_1;
         if (_e16) {
             return s_2;
         }
@@ -511,12 +483,12 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5)
 {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_3), delta_1, theta_3, s_3, spot_4);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -530,9 +502,9 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_5)
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_6)
 {
-    if (spot_5) {
+    if (spot_6) {
         const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max(naga_div(f_12.sizes2_.z, 4u), 1u));
         return _e12;
     }
@@ -601,18 +573,18 @@ uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_1, uint wi
 
 float3 minmax_traverse_pixel(uint x_4, uint y_1)
 {
-    bool local_6 = (bool)0;
-    bool local_7 = (bool)0;
-    bool local_8 = (bool)0;
+    bool local_2 = (bool)0;
+    bool local_3 = (bool)0;
+    bool local_4 = (bool)0;
     float total = 0.0;
     bool in_run = false;
     float run_a = 0.0;
     uint i = 0u;
     uint k_4 = (uint)0;
-    bool local_9 = (bool)0;
-    bool local_10 = (bool)0;
+    bool local_5 = (bool)0;
+    bool local_6 = (bool)0;
     bool lit_ = (bool)0;
-    bool local_11 = (bool)0;
+    bool local_7 = (bool)0;
     float l_1 = (float)0;
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
@@ -624,23 +596,23 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
     float3 px = float3((float(x_4) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_13.epipole.w;
     if ((f_13.epipole.z > 0.5)) {
-        local_6 = (length((px - float3(f_13.epipole.x, f_13.epipole.y, 0.0))) < radius);
+        local_2 = (length((px - float3(f_13.epipole.x, f_13.epipole.y, 0.0))) < radius);
     } else {
-        local_6 = false;
+        local_2 = false;
     }
-    bool near_epi = local_6;
+    bool near_epi = local_2;
     if ((f_13.anti_epipole.z > 0.5)) {
-        local_7 = (length((px - float3(f_13.anti_epipole.x, f_13.anti_epipole.y, 0.0))) < radius);
+        local_3 = (length((px - float3(f_13.anti_epipole.x, f_13.anti_epipole.y, 0.0))) < radius);
     } else {
-        local_7 = false;
+        local_3 = false;
     }
-    bool near_anti = local_7;
+    bool near_anti = local_3;
     if (!(near_epi)) {
-        local_8 = near_anti;
+        local_4 = near_anti;
     } else {
-        local_8 = true;
+        local_4 = true;
     }
-    bool _e76 = local_8;
+    bool _e76 = local_4;
     if (_e76) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = frame;
         const float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_9, _e9, s_4, true);
@@ -680,19 +652,19 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
                 if (((_e121 + 1u) < _e115)) {
                     uint _e125 = i;
                     uint _e127 = k_4;
-                    local_9 = ((_e125 & ((2u << _e127) - 1u)) == 0u);
+                    local_5 = ((_e125 & ((2u << _e127) - 1u)) == 0u);
                 } else {
-                    local_9 = false;
+                    local_5 = false;
                 }
-                bool _e137 = local_9;
+                bool _e137 = local_5;
                 if (_e137) {
                     uint _e138 = i;
                     uint _e140 = k_4;
-                    local_10 = ((_e138 + (2u << _e140)) <= n_3);
+                    local_6 = ((_e138 + (2u << _e140)) <= n_3);
                 } else {
-                    local_10 = false;
+                    local_6 = false;
                 }
-                bool _e147 = local_10;
+                bool _e147 = local_6;
                 if (_e147) {
                 } else {
                     break;
@@ -718,11 +690,11 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
                 }
                 if (!((_e104 > node.y))) {
                     uint _e169 = k_4;
-                    local_11 = (_e169 == 0u);
+                    local_7 = (_e169 == 0u);
                 } else {
-                    local_11 = true;
+                    local_7 = true;
                 }
-                bool _e175 = local_11;
+                bool _e175 = local_7;
                 if (_e175) {
                     break;
                 }

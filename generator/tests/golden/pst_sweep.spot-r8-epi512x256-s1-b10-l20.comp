@@ -144,109 +144,81 @@ vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
     return vec3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
-vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
-    if ((v_1.origin.w > 0.5)) {
-        float z_2 = max(ls.z, 1e-6);
-        float t_3 = v_1.proj.x;
-        return vec2((0.5 + ((0.5 * ls.x) / (z_2 * t_3))), (0.5 - ((0.5 * ls.y) / (z_2 * t_3))));
-    } else {
-        return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
+    float z_2 = max(ls.z, 1e-6);
+    float t_3 = v_1.proj.x;
+    return vec2((0.5 + ((0.5 * ls.x) / (z_2 * t_3))), (0.5 - ((0.5 * ls.y) / (z_2 * t_3))));
 }
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
-    bool local_9 = false;
-    bool local_10 = false;
-    bool local_11 = false;
-    if (!((uv.x < 0.0))) {
-        local_9 = (uv.x > 1.0);
-    } else {
-        local_9 = true;
-    }
-    bool _e11 = local_9;
-    if (!(_e11)) {
-        local_10 = (uv.y < 0.0);
-    } else {
-        local_10 = true;
-    }
-    bool _e19 = local_10;
-    if (!(_e19)) {
-        local_11 = (uv.y > 1.0);
-    } else {
-        local_11 = true;
-    }
-    bool _e27 = local_11;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = ((((uv.x < 0.0) || (uv.x > 1.0)) || (uv.y < 0.0)) || (uv.y > 1.0));
     uint n_3 = v_2.size.x;
     uint x_6 = min(uint((uv.x * float(n_3))), (n_3 - 1u));
     uint y_1 = min(uint((uv.y * float(n_3))), (n_3 - 1u));
-    int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
-    return _e49.x;
+    int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
+    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    return (outside ? 2.0 : _e36.x);
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
-    float texel = 0.0;
-    float size = float(v_3.size.x);
-    if ((v_3.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_3.forward.w * _e32);
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
+    float texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / float(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_3) {
-    bool local_12 = false;
-    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if ((v_4.origin.w > 0.5)) {
-        local_12 = (_e2.z <= near);
-    } else {
-        local_12 = false;
-    }
-    bool _e16 = local_12;
-    if (_e16) {
-        return 1.0;
-    }
-    vec2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = ((_e2.z - near) / (far - near));
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+vec2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, vec3 ls_1) {
+    return vec2(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
 }
 
-float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5, sampler2D sm_2, vec3 o, vec3 l) {
-    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    float near_1 = v_5.right.w;
-    float far_1 = v_5.up.w;
-    if ((v_5.origin.w > 0.5)) {
-        vec3 dir_11 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_11.z <= 1e-6)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
-        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if ((_e28 >= 1.0)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_3 = (near_1 + (_e28 * (far_1 - near_1)));
-        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_11.z);
-    } else {
-        vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if ((_e40 >= 1.0)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_4 = (near_1 + (_e40 * (far_1 - near_1)));
-        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_4);
-        return ((z_4 + _e47) - _e2.z);
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5) {
+    float texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / float(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, sampler2D sm_1, vec3 p_3, bool perspective) {
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_3);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        vec2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = ((_e2.z - near) / (far - near));
+        float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return ((lit || (_e2.z <= near)) ? 1.0 : 0.0);
     }
+    vec2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = ((_e2.z - near) / (far - near));
+    float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return ((depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0);
+}
+
+float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7, sampler2D sm_2, vec3 l) {
+    float near_1 = v_7.right.w;
+    float far_1 = v_7.up.w;
+    vec3 dir_11 = vec3(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+    if ((dir_11.z <= 1e-6)) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    vec2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_11);
+    float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if ((_e22 >= 1.0)) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    float z_3 = (near_1 + (_e22 * (far_1 - near_1)));
+    float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_3);
+    return ((z_3 + _e29) / dir_11.z);
+}
+
+float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8, sampler2D sm_3, vec3 o) {
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    float near_2 = v_8.right.w;
+    float far_2 = v_8.up.w;
+    vec2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    float z_4 = (near_2 + (_e9 * (far_2 - near_2)));
+    float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return ((_e9 >= 1.0) ? NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX : ((z_4 + _e13) - _e2.z));
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta) {
@@ -349,8 +321,8 @@ vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_nag
     return vec2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec4 v_6) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec4 v_9) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9.x, v_9.y, v_9.z, v_9.w);
 }
 
 vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f, float phi) {
@@ -369,10 +341,10 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XON
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, uvec4(f_2.sizes2_.x, 0u, 0u, 0u));
 }
 
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, sampler2D sm_3, vec3 p_4) {
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, sampler2D sm_4, vec3 p_4, bool spot) {
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_4);
-    return _e4;
+    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_4, spot);
+    return _e5;
 }
 
 float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, vec3 eye_3, vec3 dir_3, float t_1) {
@@ -380,7 +352,7 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_4, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot) {
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot_1) {
     float sum_1 = 0.0;
     uint k_6 = 0u;
     float t_2 = 0.0;
@@ -403,15 +375,15 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
             uint _e17 = k_6;
             t_2 = (a_3 + ((float(_e17) + 0.5) * h_11));
             w = h_11;
-            if (spot) {
+            if (spot_1) {
                 uint _e26 = k_6;
                 vec2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e33)));
-            if (spot) {
+            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            if (spot_1) {
                 float _e39 = sum_1;
                 float _e40 = w;
                 float _e42 = t_2;
@@ -430,9 +402,9 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return _e65;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, sampler2D sm_5, vec3 eye_5, vec3 dir_5, float s, bool spot_1) {
-    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_1);
-    if (spot_1) {
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, sampler2D sm_6, vec3 eye_5, vec3 dir_5, float s, bool spot_2) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_2);
+    if (spot_2) {
         return _e9;
     } else {
         float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
@@ -471,8 +443,8 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     return _e34;
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_2) {
-    if (spot_2) {
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
+    if (spot_3) {
         vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
         vec3 to_eye = -(f_9.axis.xyz);
         return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
@@ -480,17 +452,17 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_3) {
-    bool local_13 = false;
-    if (spot_3) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_4) {
+    bool local_9 = false;
+    if (spot_4) {
         float psi = (x_2 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local_13 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_13 = true;
+            local_9 = true;
         }
-        bool _e16 = local_13;
+        bool _e16 = local_9;
         if (_e16) {
             return s_2;
         }
@@ -500,11 +472,11 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_4);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -513,8 +485,8 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_5) {
-    if (spot_5) {
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
+    if (spot_6) {
         float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
         return _e12;
     }
@@ -523,22 +495,22 @@ float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b_6, float depth_break) {
-    bool local_14 = false;
+    bool local_10 = false;
     if (!((a_6 == b_6))) {
-        local_14 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
+        local_10 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
-        local_14 = true;
+        local_10 = true;
     }
-    bool _e13 = local_14;
+    bool _e13 = local_10;
     return _e13;
 }
 
-vec3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec3 v_7) {
-    vec3 a_9 = min(abs(v_7), vec3(65504.0));
+vec3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec3 v_10) {
+    vec3 a_9 = min(abs(v_10), vec3(65504.0));
     uvec3 u_2 = floatBitsToUint(a_9);
     vec3 normal = uintBitsToFloat((((u_2 + uvec3(4095u)) + ((u_2 >> uvec3(13u)) & uvec3(1u))) & uvec3(4294959104u)));
     vec3 subnormal = (roundEven((a_9 * 16777216.0)) / vec3(16777216.0));
-    return (sign(v_7) * mix(normal, subnormal, lessThan(a_9, vec3(6.1035156e-5))));
+    return (sign(v_10) * mix(normal, subnormal, lessThan(a_9, vec3(6.1035156e-5))));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec2 d) {
@@ -548,21 +520,21 @@ float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec
 EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX cam, uvec2 screen, uint slices) {
     vec2 origin = vec2(0.0);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1 = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2(0.0), vec2(0.0), 0.0, 0.0, 0u);
-    bool local_15 = false;
-    bool local_16 = false;
-    bool local_17 = false;
+    bool local_11 = false;
+    bool local_12 = false;
+    bool local_13 = false;
     float a_7 = 0.0;
     float b_7 = 0.0;
     uint k_7 = 0u;
-    vec2 size_1 = vec2(screen);
-    vec2 centre = (0.5 * size_1);
+    vec2 size = vec2(screen);
+    vec2 centre = (0.5 * size);
     float z_5 = dot(cam.toward, cam.forward);
     vec2 q_3 = vec2(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
-    float far_2 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
+    float far_3 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size.x, size.y));
     float lq = length(q_3);
     origin = centre;
-    if ((lq >= (far_2 * abs(z_5)))) {
-        origin = (centre + ((q_3 * (far_2 / max(lq, 1e-30))) * ((z_5 < 0.0) ? -1.0 : 1.0)));
+    if ((lq >= (far_3 * abs(z_5)))) {
+        origin = (centre + ((q_3 * (far_3 / max(lq, 1e-30))) * ((z_5 < 0.0) ? -1.0 : 1.0)));
     } else {
         if ((lq > 0.0)) {
             origin = (centre + (q_3 / vec2(z_5)));
@@ -575,29 +547,29 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     float lc = length(to_centre);
     l_1.axis = ((lc > 0.0) ? (to_centre / vec2(max(lc, 1e-30))) : vec2(1.0, 0.0));
     vec2 lo_2 = vec2(0.5, 0.5);
-    vec2 hi_2 = (size_1 - vec2(0.5, 0.5));
+    vec2 hi_2 = (size - vec2(0.5, 0.5));
     float _e79 = origin.x;
     if ((_e79 >= lo_2.x)) {
         float _e83 = origin.x;
-        local_15 = (_e83 <= hi_2.x);
+        local_11 = (_e83 <= hi_2.x);
     } else {
-        local_15 = false;
+        local_11 = false;
     }
-    bool _e89 = local_15;
+    bool _e89 = local_11;
     if (_e89) {
         float _e91 = origin.y;
-        local_16 = (_e91 >= lo_2.y);
+        local_12 = (_e91 >= lo_2.y);
     } else {
-        local_16 = false;
+        local_12 = false;
     }
-    bool _e97 = local_16;
+    bool _e97 = local_12;
     if (_e97) {
         float _e99 = origin.y;
-        local_17 = (_e99 <= hi_2.y);
+        local_13 = (_e99 <= hi_2.y);
     } else {
-        local_17 = false;
+        local_13 = false;
     }
-    bool inside = local_17;
+    bool inside = local_13;
     if (inside) {
         l_1.wrap = 1u;
         l_1.phi_start = -3.1415927;
@@ -713,9 +685,9 @@ vec4 factor_at(uint base, float x_4, uint h_4) {
     return ((_e22 * (1.0 - t_4)) + (_e34 * t_4));
 }
 
-vec4 gamma_at(float v_8, uint h_5) {
+vec4 gamma_at(float v_11, uint h_5) {
     float _e4 = _group_0_binding_5_cs[0].x;
-    vec4 _e8 = factor_at(1u, (v_8 / _e4), h_5);
+    vec4 _e8 = factor_at(1u, (v_11 / _e4), h_5);
     return _e8;
 }
 
@@ -764,9 +736,9 @@ vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, uint i_2,
 
 PstRay pst_ray(vec2 pc, float z_1) {
     PstRay r_1 = PstRay(false, vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0u, 0.0, 0.0, 0.0);
-    bool local_18 = false;
-    bool local_19 = false;
-    bool local_20 = false;
+    bool local_14 = false;
+    bool local_15 = false;
+    bool local_16 = false;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = _group_0_binding_0_cs;
     vec3 eye_9 = f_15.eye.xyz;
     vec2 ndc = vec2((((2.0 * pc.x) / float(f_15.sizes.x)) - 1.0), (1.0 - ((2.0 * pc.y) / float(f_15.sizes.y))));
@@ -777,23 +749,23 @@ PstRay pst_ray(vec2 pc, float z_1) {
     vec3 px = vec3(pc, 0.0);
     float radius = f_15.epipole.w;
     if ((f_15.epipole.z > 0.5)) {
-        local_18 = (length((px - vec3(f_15.epipole.x, f_15.epipole.y, 0.0))) < radius);
+        local_14 = (length((px - vec3(f_15.epipole.x, f_15.epipole.y, 0.0))) < radius);
     } else {
-        local_18 = false;
+        local_14 = false;
     }
-    bool near_epi = local_18;
+    bool near_epi = local_14;
     if ((f_15.anti_epipole.z > 0.5)) {
-        local_19 = (length((px - vec3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0))) < radius);
+        local_15 = (length((px - vec3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0))) < radius);
     } else {
-        local_19 = false;
+        local_15 = false;
     }
-    bool near_anti = local_19;
+    bool near_anti = local_15;
     if (!(near_epi)) {
-        local_20 = near_anti;
+        local_16 = near_anti;
     } else {
-        local_20 = true;
+        local_16 = true;
     }
-    bool _e109 = local_20;
+    bool _e109 = local_16;
     if (_e109) {
         r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = _group_0_binding_0_cs;
@@ -1104,7 +1076,7 @@ void main() {
     }
     memoryBarrierShared();
     barrier();
-    uint v_9 = atomicOr(live, 0u);
+    uint v_12 = atomicOr(live, 0u);
     uint cw = (((width + TREES) - 1u) / TREES);
     if ((li < TREES)) {
         bool loop_init_9 = true;
@@ -1140,7 +1112,7 @@ void main() {
         bucket[li] = _e232;
     } else {
         if ((li == TREES)) {
-            local_2 = (v_9 > 0u);
+            local_2 = (v_12 > 0u);
         } else {
             local_2 = false;
         }
@@ -1243,7 +1215,7 @@ void main() {
                     }
                     loop_init_11 = false;
                     uint _e345 = j_1;
-                    if ((_e345 < (v_9 / 2u))) {
+                    if ((_e345 < (v_12 / 2u))) {
                     } else {
                         break;
                     }
@@ -1252,18 +1224,18 @@ void main() {
                         float d_3 = q_d[_e350];
                         uint _e354 = j_1;
                         uint _e359 = j_1;
-                        float _e362 = q_d[((v_9 - 1u) - _e359)];
+                        float _e362 = q_d[((v_12 - 1u) - _e359)];
                         q_d[_e354] = _e362;
                         uint _e366 = j_1;
-                        q_d[((v_9 - 1u) - _e366)] = d_3;
+                        q_d[((v_12 - 1u) - _e366)] = d_3;
                         uint _e370 = j_1;
                         uint k_9 = q_rank[_e370];
                         uint _e374 = j_1;
                         uint _e379 = j_1;
-                        uint _e382 = q_rank[((v_9 - 1u) - _e379)];
+                        uint _e382 = q_rank[((v_12 - 1u) - _e379)];
                         q_rank[_e374] = _e382;
                         uint _e386 = j_1;
-                        q_rank[((v_9 - 1u) - _e386)] = k_9;
+                        q_rank[((v_12 - 1u) - _e386)] = k_9;
                     }
                 }
             }
@@ -1365,7 +1337,7 @@ void main() {
         }
         loop_init_14 = false;
         uint _e484 = j_3;
-        if ((_e484 < v_9)) {
+        if ((_e484 < v_12)) {
         } else {
             break;
         }
@@ -1387,7 +1359,7 @@ void main() {
         }
         loop_init_15 = false;
         uint _e499 = j_4;
-        if ((_e499 < v_9)) {
+        if ((_e499 < v_12)) {
         } else {
             break;
         }
@@ -1420,7 +1392,7 @@ void main() {
             vec4 _e520 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e516, row_3)), ivec2(0), textureSize(_group_0_binding_4_cs, _e520_clamped_lod) - ivec2(1)), _e520_clamped_lod);
             float occluder = _e520.x;
             lo = 0u;
-            hi = v_9;
+            hi = v_12;
             while(true) {
                 uint _e525 = lo;
                 uint _e526 = hi;
@@ -1486,7 +1458,7 @@ void main() {
             }
             loop_init_18 = false;
             uint _e585 = j_5;
-            if ((_e585 < (v_9 * LEAF_VECS))) {
+            if ((_e585 < (v_12 * LEAF_VECS))) {
             } else {
                 break;
             }
@@ -1497,7 +1469,7 @@ void main() {
         }
         uint lo_5 = (li * cw);
         uint hi_5 = (((li + 1u) == TREES) ? width : min((lo_5 + cw), width));
-        top = v_9;
+        top = v_12;
         while(true) {
             uint _e611 = next;
             uint _e612 = top;
@@ -1534,7 +1506,7 @@ void main() {
             {
                 while(true) {
                     uint _e631 = next;
-                    if ((_e631 < v_9)) {
+                    if ((_e631 < v_12)) {
                         uint _e635 = next;
                         uint _e637 = by_end[_e635];
                         uint _e639 = q_end[_e637];
@@ -1582,7 +1554,7 @@ void main() {
                             {
                                 p = vec4(0.0, 0.0, 0.0, 0.0);
                                 uint _e681 = q_rank[k_10];
-                                j_6 = (v_9 - _e681);
+                                j_6 = (v_12 - _e681);
                                 while(true) {
                                     uint _e684 = j_6;
                                     if ((_e684 > 0u)) {
@@ -1632,10 +1604,10 @@ void main() {
                             uint _e733 = i_1;
                             uint _e738 = h_2;
                             vec4 leaf_1 = _group_0_binding_6_cs[(((base_1 + _e733) * LEAF_VECS) + _e738)];
-                            j_7 = ((v_9 - b_8) + 1u);
+                            j_7 = ((v_12 - b_8) + 1u);
                             while(true) {
                                 uint _e746 = j_7;
-                                if ((_e746 <= v_9)) {
+                                if ((_e746 <= v_12)) {
                                 } else {
                                     break;
                                 }
@@ -1669,7 +1641,7 @@ void main() {
         }
         loop_init_22 = false;
         uint _e775 = x;
-        if ((_e775 < (v_9 * LEAF_VECS))) {
+        if ((_e775 < (v_12 * LEAF_VECS))) {
         } else {
             break;
         }
@@ -1746,7 +1718,7 @@ void main() {
                         p_1 = _e849;
                         uint _e852 = k_4;
                         uint _e854 = q_rank[_e852];
-                        j_8 = (v_9 - _e854);
+                        j_8 = (v_12 - _e854);
                         while(true) {
                             uint _e857 = j_8;
                             if ((_e857 > 0u)) {

@@ -139,15 +139,11 @@ float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapView
     return float3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
-float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
+float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
 {
-    if ((v_1.origin.w > 0.5)) {
-        float z_2 = max(ls.z, 1e-6);
-        float t_3 = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_2 * t_3))), (0.5 - ((0.5 * ls.y) / (z_2 * t_3))));
-    } else {
-        return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+    float z_2 = max(ls.z, 1e-6);
+    float t_3 = v_1.proj.x;
+    return float2((0.5 + ((0.5 * ls.x) / (z_2 * t_3))), (0.5 - ((0.5 * ls.y) / (z_2 * t_3))));
 }
 
 uint naga_f2u32(float value) {
@@ -156,103 +152,79 @@ uint naga_f2u32(float value) {
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
 {
-    bool local_9 = (bool)0;
-    bool local_10 = (bool)0;
-    bool local_11 = (bool)0;
-
-    if (!((uv.x < 0.0))) {
-        local_9 = (uv.x > 1.0);
-    } else {
-        local_9 = true;
-    }
-    bool _e11 = local_9;
-    if (!(_e11)) {
-        local_10 = (uv.y < 0.0);
-    } else {
-        local_10 = true;
-    }
-    bool _e19 = local_10;
-    if (!(_e19)) {
-        local_11 = (uv.y > 1.0);
-    } else {
-        local_11 = true;
-    }
-    bool _e27 = local_11;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_3 = v_2.size.x;
     uint x_6 = min(naga_f2u32((uv.x * float(n_3))), (n_3 - 1u));
     uint y_1 = min(naga_f2u32((uv.y * float(n_3))), (n_3 - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_6, y_1), int(0)));
-    return _e49.x;
+    float4 _e36 = sm.Load(int3(uint2(x_6, y_1), int(0)));
+    return (outside ? 2.0 : _e36.x);
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
 {
-    float texel = (float)0;
-
-    float size = float(v_3.size.x);
-    if ((v_3.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_3.forward.w * _e32);
+    float texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / float(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, Texture2D<float4> sm_1, float3 p_3)
+float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, float3 ls_1)
 {
-    bool local_12 = (bool)0;
-
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if ((v_4.origin.w > 0.5)) {
-        local_12 = (_e2.z <= near);
-    } else {
-        local_12 = false;
-    }
-    bool _e16 = local_12;
-    if (_e16) {
-        return 1.0;
-    }
-    const float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    const float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = ((_e2.z - near) / (far - near));
-    const float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+    return float2(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
 }
 
-float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5, Texture2D<float4> sm_2, float3 o, float3 l)
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5)
 {
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    float near_1 = v_5.right.w;
-    float far_1 = v_5.up.w;
-    if ((v_5.origin.w > 0.5)) {
-        float3 dir_11 = float3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_11.z <= 1e-6)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        const float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
-        const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if ((_e28 >= 1.0)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_3 = (near_1 + (_e28 * (far_1 - near_1)));
-        const float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_11.z);
-    } else {
-        const float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        const float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if ((_e40 >= 1.0)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_4 = (near_1 + (_e40 * (far_1 - near_1)));
-        const float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_4);
-        return ((z_4 + _e47) - _e2.z);
+    float texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / float(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, Texture2D<float4> sm_1, float3 p_3, bool perspective)
+{
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_3);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        const float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        const float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = ((_e2.z - near) / (far - near));
+        const float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit_ = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return ((lit_ | (_e2.z <= near)) ? 1.0 : 0.0);
     }
+    const float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = ((_e2.z - near) / (far - near));
+    const float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return ((depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0);
+}
+
+float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7, Texture2D<float4> sm_2, float3 l)
+{
+    float near_1 = v_7.right.w;
+    float far_1 = v_7.up.w;
+    float3 dir_11 = float3(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+    if ((dir_11.z <= 1e-6)) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    const float2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_11);
+    const float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if ((_e22 >= 1.0)) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    float z_3 = (near_1 + (_e22 * (far_1 - near_1)));
+    const float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_3);
+    return ((z_3 + _e29) / dir_11.z);
+}
+
+float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8, Texture2D<float4> sm_3, float3 o)
+{
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    float near_2 = v_8.right.w;
+    float far_2 = v_8.up.w;
+    const float2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    const float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    float z_4 = (near_2 + (_e9 * (far_2 - near_2)));
+    const float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return ((_e9 >= 1.0) ? NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX : ((z_4 + _e13) - _e2.z));
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
@@ -389,9 +361,9 @@ SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX ConstructSliceParamsX_n
     return ret;
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float4 v_6)
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float4 v_9)
 {
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax = ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax = ConstructSliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9.x, v_9.y, v_9.z, v_9.w);
     return sliceparamsx_naga_oil_mod_xonrwc5dumvzduotfobuxa33mmfzax;
 }
 
@@ -427,11 +399,11 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XON
     return shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx;
 }
 
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, Texture2D<float4> sm_3, float3 p_4)
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, Texture2D<float4> sm_4, float3 p_4, bool spot)
 {
     const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    const float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_4);
-    return _e4;
+    const float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_4, spot);
+    return _e5;
 }
 
 float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, float3 eye_3, float3 dir_3, float t_1)
@@ -440,7 +412,7 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, Texture2D<float4> sm_4, float3 eye_4, float3 dir_4, float a_3, float b_3, uint steps, bool spot)
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, Texture2D<float4> sm_5, float3 eye_4, float3 dir_4, float a_3, float b_3, uint steps, bool spot_1)
 {
     float sum_1 = 0.0;
     uint k_6 = 0u;
@@ -468,15 +440,15 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
             uint _e17 = k_6;
             t_2 = (a_3 + ((float(_e17) + 0.5) * h_11));
             w = h_11;
-            if (spot) {
+            if (spot_1) {
                 uint _e26 = k_6;
                 const float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             float _e33 = t_2;
-            const float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e33)));
-            if (spot) {
+            const float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            if (spot_1) {
                 float _e39 = sum_1;
                 float _e40 = w;
                 float _e42 = t_2;
@@ -495,10 +467,10 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return _e65;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, Texture2D<float4> sm_5, float3 eye_5, float3 dir_5, float s, bool spot_1)
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, Texture2D<float4> sm_6, float3 eye_5, float3 dir_5, float s, bool spot_2)
 {
-    const float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_1);
-    if (spot_1) {
+    const float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_2);
+    if (spot_2) {
         return _e9;
     } else {
         const float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
@@ -550,9 +522,9 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     return _e34;
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_2)
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_3)
 {
-    if (spot_2) {
+    if (spot_3) {
         float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
         float3 to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
@@ -560,19 +532,19 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_3)
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_4)
 {
-    bool local_13 = (bool)0;
+    bool local_9 = (bool)0;
 
-    if (spot_3) {
+    if (spot_4) {
         float psi = (x_2 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local_13 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_13 = true;
+            local_9 = true;
         }
-        bool _e16 = local_13;
+        bool _e16 = local_9;
         if (_e16) {
             return s_2;
         }
@@ -582,12 +554,12 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5)
 {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_4);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -601,9 +573,9 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_5)
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_6)
 {
-    if (spot_5) {
+    if (spot_6) {
         const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max(naga_div(f_13.sizes2_.z, 4u), 1u));
         return _e12;
     }
@@ -613,24 +585,24 @@ float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b_6, float depth_break)
 {
-    bool local_14 = (bool)0;
+    bool local_10 = (bool)0;
 
     if (!((a_6 == b_6))) {
-        local_14 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
+        local_10 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
-        local_14 = true;
+        local_10 = true;
     }
-    bool _e13 = local_14;
+    bool _e13 = local_10;
     return _e13;
 }
 
-float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 v_7)
+float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 v_10)
 {
-    float3 a_9 = min(abs(v_7), (65504.0).xxx);
+    float3 a_9 = min(abs(v_10), (65504.0).xxx);
     uint3 u_2 = asuint(a_9);
     float3 normal = asfloat((((u_2 + (4095u).xxx) + ((u_2 >> (13u).xxx) & (1u).xxx)) & (4294959104u).xxx));
     float3 subnormal = (round((a_9 * 16777216.0)) / (16777216.0).xxx);
-    return (sign(v_7) * ((a_9 < (6.1035156e-5).xxx) ? subnormal : normal));
+    return (sign(v_10) * ((a_9 < (6.1035156e-5).xxx) ? subnormal : normal));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float2 axis, float2 d)
@@ -642,22 +614,22 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
 {
     float2 origin = (float2)0;
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1 = (EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
-    bool local_15 = (bool)0;
-    bool local_16 = (bool)0;
-    bool local_17 = (bool)0;
+    bool local_11 = (bool)0;
+    bool local_12 = (bool)0;
+    bool local_13 = (bool)0;
     float a_7 = 0.0;
     float b_7 = 0.0;
     uint k_7 = 0u;
 
-    float2 size_1 = float2(screen);
-    float2 centre = (0.5 * size_1);
+    float2 size = float2(screen);
+    float2 centre = (0.5 * size);
     float z_5 = dot(cam.toward, cam.forward);
     float2 q_3 = float2(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
-    float far_2 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
+    float far_3 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size.x, size.y));
     float lq = length(q_3);
     origin = centre;
-    if ((lq >= (far_2 * abs(z_5)))) {
-        origin = (centre + ((q_3 * (far_2 / max(lq, 1e-30))) * ((z_5 < 0.0) ? -1.0 : 1.0)));
+    if ((lq >= (far_3 * abs(z_5)))) {
+        origin = (centre + ((q_3 * (far_3 / max(lq, 1e-30))) * ((z_5 < 0.0) ? -1.0 : 1.0)));
     } else {
         if ((lq > 0.0)) {
             origin = (centre + (q_3 / (z_5).xx));
@@ -670,29 +642,29 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     float lc = length(to_centre);
     l_1.axis = ((lc > 0.0) ? (to_centre / (max(lc, 1e-30)).xx) : float2(1.0, 0.0));
     float2 lo_2 = float2(0.5, 0.5);
-    float2 hi_2 = (size_1 - float2(0.5, 0.5));
+    float2 hi_2 = (size - float2(0.5, 0.5));
     float _e79 = origin.x;
     if ((_e79 >= lo_2.x)) {
         float _e83 = origin.x;
-        local_15 = (_e83 <= hi_2.x);
+        local_11 = (_e83 <= hi_2.x);
     } else {
-        local_15 = false;
+        local_11 = false;
     }
-    bool _e89 = local_15;
+    bool _e89 = local_11;
     if (_e89) {
         float _e91 = origin.y;
-        local_16 = (_e91 >= lo_2.y);
+        local_12 = (_e91 >= lo_2.y);
     } else {
-        local_16 = false;
+        local_12 = false;
     }
-    bool _e97 = local_16;
+    bool _e97 = local_12;
     if (_e97) {
         float _e99 = origin.y;
-        local_17 = (_e99 <= hi_2.y);
+        local_13 = (_e99 <= hi_2.y);
     } else {
-        local_17 = false;
+        local_13 = false;
     }
-    bool inside = local_17;
+    bool inside = local_13;
     if (inside) {
         l_1.wrap = 1u;
         l_1.phi_start = -3.1415927;
@@ -824,10 +796,10 @@ float4 factor_at(uint base, float x_4, uint h_4)
     return ((_e22 * (1.0 - t_4)) + (_e34 * t_4));
 }
 
-float4 gamma_at(float v_8, uint h_5)
+float4 gamma_at(float v_11, uint h_5)
 {
     float _e4 = asfloat(pst_factors.Load(0+0));
-    const float4 _e8 = factor_at(1u, (v_8 / _e4), h_5);
+    const float4 _e8 = factor_at(1u, (v_11 / _e4), h_5);
     return _e8;
 }
 
@@ -897,9 +869,9 @@ PstRay ConstructPstRay(bool arg0, float3 arg1, float3 arg2, float3 arg3, float a
 PstRay pst_ray(float2 pc, float z_1)
 {
     PstRay r_1 = (PstRay)0;
-    bool local_18 = (bool)0;
-    bool local_19 = (bool)0;
-    bool local_20 = (bool)0;
+    bool local_14 = (bool)0;
+    bool local_15 = (bool)0;
+    bool local_16 = (bool)0;
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
     float3 eye_9 = f_15.eye.xyz;
@@ -911,23 +883,23 @@ PstRay pst_ray(float2 pc, float z_1)
     float3 px = float3(pc, 0.0);
     float radius = f_15.epipole.w;
     if ((f_15.epipole.z > 0.5)) {
-        local_18 = (length((px - float3(f_15.epipole.x, f_15.epipole.y, 0.0))) < radius);
+        local_14 = (length((px - float3(f_15.epipole.x, f_15.epipole.y, 0.0))) < radius);
     } else {
-        local_18 = false;
+        local_14 = false;
     }
-    bool near_epi = local_18;
+    bool near_epi = local_14;
     if ((f_15.anti_epipole.z > 0.5)) {
-        local_19 = (length((px - float3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0))) < radius);
+        local_15 = (length((px - float3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0))) < radius);
     } else {
-        local_19 = false;
+        local_15 = false;
     }
-    bool near_anti = local_19;
+    bool near_anti = local_15;
     if (!(near_epi)) {
-        local_20 = near_anti;
+        local_16 = near_anti;
     } else {
-        local_20 = true;
+        local_16 = true;
     }
-    bool _e109 = local_20;
+    bool _e109 = local_16;
     if (_e109) {
         r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
@@ -1260,7 +1232,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
     }
     GroupMemoryBarrierWithGroupSync();
-    uint v_9; InterlockedOr(live, 0, v_9);
+    uint v_12; InterlockedOr(live, 0, v_12);
     uint cw = naga_div(((width + TREES) - 1u), TREES);
     if ((li < TREES)) {
         uint2 loop_bound_9 = uint2(4294967295u, 4294967295u);
@@ -1299,7 +1271,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         bucket[min(uint(li), 7u)] = _e232;
     } else {
         if ((li == TREES)) {
-            local_2 = (v_9 > 0u);
+            local_2 = (v_12 > 0u);
         } else {
             local_2 = false;
         }
@@ -1417,7 +1389,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     }
                     loop_init_11 = false;
                     uint _e345 = j_1;
-                    if ((_e345 < naga_div(v_9, 2u))) {
+                    if ((_e345 < naga_div(v_12, 2u))) {
                     } else {
                         break;
                     }
@@ -1426,18 +1398,18 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                         float d_3 = q_d[min(uint(_e350), 255u)];
                         uint _e354 = j_1;
                         uint _e359 = j_1;
-                        float _e362 = q_d[min(uint(((v_9 - 1u) - _e359)), 255u)];
+                        float _e362 = q_d[min(uint(((v_12 - 1u) - _e359)), 255u)];
                         q_d[min(uint(_e354), 255u)] = _e362;
                         uint _e366 = j_1;
-                        q_d[min(uint(((v_9 - 1u) - _e366)), 255u)] = d_3;
+                        q_d[min(uint(((v_12 - 1u) - _e366)), 255u)] = d_3;
                         uint _e370 = j_1;
                         uint k_9 = q_rank[min(uint(_e370), 255u)];
                         uint _e374 = j_1;
                         uint _e379 = j_1;
-                        uint _e382 = q_rank[min(uint(((v_9 - 1u) - _e379)), 255u)];
+                        uint _e382 = q_rank[min(uint(((v_12 - 1u) - _e379)), 255u)];
                         q_rank[min(uint(_e374), 255u)] = _e382;
                         uint _e386 = j_1;
-                        q_rank[min(uint(((v_9 - 1u) - _e386)), 255u)] = k_9;
+                        q_rank[min(uint(((v_12 - 1u) - _e386)), 255u)] = k_9;
                     }
                 }
             }
@@ -1550,7 +1522,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
         loop_init_14 = false;
         uint _e484 = j_3;
-        if ((_e484 < v_9)) {
+        if ((_e484 < v_12)) {
         } else {
             break;
         }
@@ -1574,7 +1546,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
         loop_init_15 = false;
         uint _e499 = j_4;
-        if ((_e499 < v_9)) {
+        if ((_e499 < v_12)) {
         } else {
             break;
         }
@@ -1608,7 +1580,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             float4 _e520 = rectified.Load(int3(uint2(_e516, row_3), int(0)));
             float occluder = _e520.x;
             lo = 0u;
-            hi = v_9;
+            hi = v_12;
             uint2 loop_bound_21 = uint2(4294967295u, 4294967295u);
             while(true) {
                 if (all(loop_bound_21 == uint2(0u, 0u))) { break; }
@@ -1681,7 +1653,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             }
             loop_init_18 = false;
             uint _e585 = j_5;
-            if ((_e585 < (v_9 * LEAF_VECS))) {
+            if ((_e585 < (v_12 * LEAF_VECS))) {
             } else {
                 break;
             }
@@ -1692,7 +1664,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
         uint lo_5 = (li * cw);
         uint hi_5 = (((li + 1u) == TREES) ? width : min((lo_5 + cw), width));
-        top = v_9;
+        top = v_12;
         uint2 loop_bound_24 = uint2(4294967295u, 4294967295u);
         while(true) {
             if (all(loop_bound_24 == uint2(0u, 0u))) { break; }
@@ -1738,7 +1710,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     if (all(loop_bound_26 == uint2(0u, 0u))) { break; }
                     loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
                     uint _e631 = next;
-                    if ((_e631 < v_9)) {
+                    if ((_e631 < v_12)) {
                         uint _e635 = next;
                         uint _e637 = by_end[min(uint(_e635), 255u)];
                         uint _e639 = q_end[min(uint(_e637), 255u)];
@@ -1789,7 +1761,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                             {
                                 p = float4(0.0, 0.0, 0.0, 0.0);
                                 uint _e681 = q_rank[min(uint(k_10), 255u)];
-                                j_6 = (v_9 - _e681);
+                                j_6 = (v_12 - _e681);
                                 uint2 loop_bound_28 = uint2(4294967295u, 4294967295u);
                                 while(true) {
                                     if (all(loop_bound_28 == uint2(0u, 0u))) { break; }
@@ -1845,13 +1817,13 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                             uint _e733 = i_1;
                             uint _e738 = h_2;
                             float4 leaf_1 = asfloat(pst_leaves.Load4((((base_1 + _e733) * LEAF_VECS) + _e738)*16));
-                            j_7 = ((v_9 - b_8) + 1u);
+                            j_7 = ((v_12 - b_8) + 1u);
                             uint2 loop_bound_30 = uint2(4294967295u, 4294967295u);
                             while(true) {
                                 if (all(loop_bound_30 == uint2(0u, 0u))) { break; }
                                 loop_bound_30 -= uint2(loop_bound_30.y == 0u, 1u);
                                 uint _e746 = j_7;
-                                if ((_e746 <= v_9)) {
+                                if ((_e746 <= v_12)) {
                                 } else {
                                     break;
                                 }
@@ -1886,7 +1858,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
         loop_init_22 = false;
         uint _e775 = x;
-        if ((_e775 < (v_9 * LEAF_VECS))) {
+        if ((_e775 < (v_12 * LEAF_VECS))) {
         } else {
             break;
         }
@@ -1970,7 +1942,7 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                         p_1 = _e849;
                         uint _e852 = k_4;
                         uint _e854 = q_rank[min(uint(_e852), 255u)];
-                        j_8 = (v_9 - _e854);
+                        j_8 = (v_12 - _e854);
                         uint2 loop_bound_35 = uint2(4294967295u, 4294967295u);
                         while(true) {
                             if (all(loop_bound_35 == uint2(0u, 0u))) { break; }

@@ -129,17 +129,13 @@ metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
 }
 
-metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
     metal::float3 ls
 ) {
-    if (v_1.origin.w > 0.5) {
-        float z_2 = metal::max(ls.z, 0.000001);
-        float t_3 = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_2 * t_3)), 0.5 - ((0.5 * ls.y) / (z_2 * t_3)));
-    } else {
-        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
-    }
+    float z_2 = metal::max(ls.z, 0.000001);
+    float t_3 = v_1.proj.x;
+    return metal::float2(0.5 + ((0.5 * ls.x) / (z_2 * t_3)), 0.5 - ((0.5 * ls.y) / (z_2 * t_3)));
 }
 
 uint naga_f2u32(float value) {
@@ -151,110 +147,95 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_9 = {};
-    bool local_10 = {};
-    bool local_11 = {};
-    if (!((uv.x < 0.0))) {
-        local_9 = uv.x > 1.0;
-    } else {
-        local_9 = true;
-    }
-    bool _e11 = local_9;
-    if (!(_e11)) {
-        local_10 = uv.y < 0.0;
-    } else {
-        local_10 = true;
-    }
-    bool _e19 = local_10;
-    if (!(_e19)) {
-        local_11 = uv.y > 1.0;
-    } else {
-        local_11 = true;
-    }
-    bool _e27 = local_11;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_3 = v_2.size.x;
     uint x_6 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_3)), n_3 - 1u);
     uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_3)), n_3 - 1u);
-    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
-    return _e49.x;
+    uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    return outside ? 2.0 : _e36.x;
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
     float z
 ) {
-    float texel = {};
-    float size = static_cast<float>(v_3.size.x);
-    if (v_3.origin.w > 0.5) {
-        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
-    } else {
-        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
-    }
-    float _e32 = texel;
-    return v_3.forward.w * _e32;
+    float texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / static_cast<float>(v_3.size.x);
+    return v_3.forward.w * texel;
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
-    metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_3
+    metal::float3 ls_1
 ) {
-    bool local_12 = {};
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if (v_4.origin.w > 0.5) {
-        local_12 = _e2.z <= near;
-    } else {
-        local_12 = false;
-    }
-    bool _e16 = local_12;
-    if (_e16) {
-        return 1.0;
-    }
-    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = (_e2.z - near) / (far - near);
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
+    return metal::float2((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x), (v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z));
 }
 
-float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5,
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5
+) {
+    float texel_1 = metal::max(v_5.proj.y - v_5.proj.x, v_5.proj.w - v_5.proj.z) / static_cast<float>(v_5.size.x);
+    return v_5.forward.w * texel_1;
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6,
+    metal::texture2d<float, metal::access::sample> sm_1,
+    metal::float3 p_3,
+    bool perspective
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_3);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        metal::float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = (_e2.z - near) / (far - near);
+        float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit = depth_1 <= (_e10 + (_e16 / (far - near)));
+        return (lit | (_e2.z <= near)) ? 1.0 : 0.0;
+    }
+    metal::float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = (_e2.z - near) / (far - near);
+    float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return (depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0;
+}
+
+float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7,
     metal::texture2d<float, metal::access::sample> sm_2,
-    metal::float3 o,
     metal::float3 l
 ) {
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    float near_1 = v_5.right.w;
-    float far_1 = v_5.up.w;
-    if (v_5.origin.w > 0.5) {
-        metal::float3 dir_11 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_11.z <= 0.000001) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
-        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if (_e28 >= 1.0) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_3 = near_1 + (_e28 * (far_1 - near_1));
-        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return (z_3 + _e35) / dir_11.z;
-    } else {
-        metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if (_e40 >= 1.0) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_4 = near_1 + (_e40 * (far_1 - near_1));
-        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_4);
-        return (z_4 + _e47) - _e2.z;
+    float near_1 = v_7.right.w;
+    float far_1 = v_7.up.w;
+    metal::float3 dir_11 = metal::float3(metal::dot(l, v_7.right.xyz), metal::dot(l, v_7.up.xyz), metal::dot(l, v_7.forward.xyz));
+    if (dir_11.z <= 0.000001) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
     }
+    metal::float2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_11);
+    float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if (_e22 >= 1.0) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    float z_3 = near_1 + (_e22 * (far_1 - near_1));
+    float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_3);
+    return (z_3 + _e29) / dir_11.z;
+}
+
+float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8,
+    metal::texture2d<float, metal::access::sample> sm_3,
+    metal::float3 o
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    float near_2 = v_8.right.w;
+    float far_2 = v_8.up.w;
+    metal::float2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    float z_4 = near_2 + (_e9 * (far_2 - near_2));
+    float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return (_e9 >= 1.0) ? NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX : ((z_4 + _e13) - _e2.z);
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -408,9 +389,9 @@ metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 }
 
 SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    metal::float4 v_6
+    metal::float4 v_9
 ) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {v_6.x, v_6.y, v_6.z, v_6.w};
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {v_9.x, v_9.y, v_9.z, v_9.w};
 }
 
 metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -443,12 +424,13 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XON
 
 float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
-    metal::texture2d<float, metal::access::sample> sm_3,
-    metal::float3 p_4
+    metal::texture2d<float, metal::access::sample> sm_4,
+    metal::float3 p_4,
+    bool spot
 ) {
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_4);
-    return _e4;
+    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_4, spot);
+    return _e5;
 }
 
 float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -463,13 +445,13 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 
 float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
-    metal::texture2d<float, metal::access::sample> sm_4,
+    metal::texture2d<float, metal::access::sample> sm_5,
     metal::float3 eye_4,
     metal::float3 dir_4,
     float a_3,
     float b_3,
     uint steps,
-    bool spot
+    bool spot_1
 ) {
     float sum_1 = 0.0;
     uint k_6 = 0u;
@@ -496,15 +478,15 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
             uint _e17 = k_6;
             t_2 = a_3 + ((static_cast<float>(_e17) + 0.5) * h_11);
             w = h_11;
-            if (spot) {
+            if (spot_1) {
                 uint _e26 = k_6;
                 metal::float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e26) + 0.5);
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, eye_4 + (dir_4 * _e33));
-            if (spot) {
+            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_4 + (dir_4 * _e33), spot_1);
+            if (spot_1) {
                 float _e39 = sum_1;
                 float _e40 = w;
                 float _e42 = t_2;
@@ -525,14 +507,14 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
-    metal::texture2d<float, metal::access::sample> sm_5,
+    metal::texture2d<float, metal::access::sample> sm_6,
     metal::float3 eye_5,
     metal::float3 dir_5,
     float s,
-    bool spot_1
+    bool spot_2
 ) {
-    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_1);
-    if (spot_1) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_2);
+    if (spot_2) {
         return _e9;
     } else {
         float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(metal::dot(f_6.light_dir.xyz, dir_5)));
@@ -596,9 +578,9 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float3 dir_8,
     float s_1,
     float theta_1,
-    bool spot_2
+    bool spot_3
 ) {
-    if (spot_2) {
+    if (spot_3) {
         metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz;
         metal::float3 to_eye = -(f_9.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
@@ -612,18 +594,18 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float delta,
     float theta_2,
     float s_2,
-    bool spot_3
+    bool spot_4
 ) {
-    bool local_13 = {};
-    if (spot_3) {
+    bool local_9 = {};
+    if (spot_4) {
         float psi = x_2 * delta;
         float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
-            local_13 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_9 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local_13 = true;
+            local_9 = true;
         }
-        bool _e16 = local_13;
+        bool _e16 = local_9;
         if (_e16) {
             return s_2;
         }
@@ -640,12 +622,12 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float delta_1,
     float theta_3,
     float s_3,
-    bool spot_4
+    bool spot_5
 ) {
     if (x_3 >= n_1) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_4);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -671,9 +653,9 @@ float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float3 dir_10,
     float a_5,
     float b_5,
-    bool spot_5
+    bool spot_6
 ) {
-    if (spot_5) {
+    if (spot_6) {
         float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_13.sizes2_.z, 4u), 1u));
         return _e12;
     }
@@ -686,24 +668,24 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     float b_6,
     float depth_break
 ) {
-    bool local_14 = {};
+    bool local_10 = {};
     if (!((a_6 == b_6))) {
-        local_14 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
+        local_10 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
     } else {
-        local_14 = true;
+        local_10 = true;
     }
-    bool _e13 = local_14;
+    bool _e13 = local_10;
     return _e13;
 }
 
 metal::float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    metal::float3 v_7
+    metal::float3 v_10
 ) {
-    metal::float3 a_9 = metal::min(metal::abs(v_7), metal::float3(65504.0));
+    metal::float3 a_9 = metal::min(metal::abs(v_10), metal::float3(65504.0));
     metal::uint3 u_2 = as_type<metal::uint3>(a_9);
     metal::float3 normal = as_type<metal::float3>(((u_2 + metal::uint3(4095u)) + ((u_2 >> metal::uint3(13u)) & metal::uint3(1u))) & metal::uint3(4294959104u));
     metal::float3 subnormal = metal::rint(a_9 * 16777216.0) / metal::float3(16777216.0);
-    return metal::sign(v_7) * metal::select(normal, subnormal, a_9 < metal::float3(0.000061035156));
+    return metal::sign(v_10) * metal::select(normal, subnormal, a_9 < metal::float3(0.000061035156));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
@@ -720,21 +702,21 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
 ) {
     metal::float2 origin = {};
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1 = {};
-    bool local_15 = {};
-    bool local_16 = {};
-    bool local_17 = {};
+    bool local_11 = {};
+    bool local_12 = {};
+    bool local_13 = {};
     float a_7 = 0.0;
     float b_7 = 0.0;
     uint k_7 = 0u;
-    metal::float2 size_1 = static_cast<metal::float2>(screen);
-    metal::float2 centre = 0.5 * size_1;
+    metal::float2 size = static_cast<metal::float2>(screen);
+    metal::float2 centre = 0.5 * size;
     float z_5 = metal::dot(cam.toward, cam.forward);
     metal::float2 q_3 = metal::float2((metal::dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect), (-(metal::dot(cam.toward, cam.up)) * centre.y) / cam.tan_half);
-    float far_2 = EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * metal::max(size_1.x, size_1.y);
+    float far_3 = EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * metal::max(size.x, size.y);
     float lq = metal::length(q_3);
     origin = centre;
-    if (lq >= (far_2 * metal::abs(z_5))) {
-        origin = centre + ((q_3 * (far_2 / metal::max(lq, 0.000000000000000000000000000001))) * ((z_5 < 0.0) ? -1.0 : 1.0));
+    if (lq >= (far_3 * metal::abs(z_5))) {
+        origin = centre + ((q_3 * (far_3 / metal::max(lq, 0.000000000000000000000000000001))) * ((z_5 < 0.0) ? -1.0 : 1.0));
     } else {
         if (lq > 0.0) {
             origin = centre + (q_3 / metal::float2(z_5));
@@ -747,29 +729,29 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     float lc = metal::length(to_centre);
     l_1.axis = (lc > 0.0) ? (to_centre / metal::float2(metal::max(lc, 0.000000000000000000000000000001))) : metal::float2(1.0, 0.0);
     metal::float2 lo_2 = metal::float2(0.5, 0.5);
-    metal::float2 hi_2 = size_1 - metal::float2(0.5, 0.5);
+    metal::float2 hi_2 = size - metal::float2(0.5, 0.5);
     float _e79 = origin.x;
     if (_e79 >= lo_2.x) {
         float _e83 = origin.x;
-        local_15 = _e83 <= hi_2.x;
+        local_11 = _e83 <= hi_2.x;
     } else {
-        local_15 = false;
+        local_11 = false;
     }
-    bool _e89 = local_15;
+    bool _e89 = local_11;
     if (_e89) {
         float _e91 = origin.y;
-        local_16 = _e91 >= lo_2.y;
+        local_12 = _e91 >= lo_2.y;
     } else {
-        local_16 = false;
+        local_12 = false;
     }
-    bool _e97 = local_16;
+    bool _e97 = local_12;
     if (_e97) {
         float _e99 = origin.y;
-        local_17 = _e99 <= hi_2.y;
+        local_13 = _e99 <= hi_2.y;
     } else {
-        local_17 = false;
+        local_13 = false;
     }
-    bool inside = local_17;
+    bool inside = local_13;
     if (inside) {
         l_1.wrap = 1u;
         l_1.phi_start = -3.1415927;
@@ -916,13 +898,13 @@ metal::float4 factor_at(
 }
 
 metal::float4 gamma_at(
-    float v_8,
+    float v_11,
     uint h_5,
     device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float _e4 = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)].x;
-    metal::float4 _e8 = factor_at(1u, v_8 / _e4, h_5, pst_factors, _buffer_sizes);
+    metal::float4 _e8 = factor_at(1u, v_11 / _e4, h_5, pst_factors, _buffer_sizes);
     return _e8;
 }
 
@@ -992,9 +974,9 @@ PstRay pst_ray(
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     PstRay r_1 = {};
-    bool local_18 = {};
-    bool local_19 = {};
-    bool local_20 = {};
+    bool local_14 = {};
+    bool local_15 = {};
+    bool local_16 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
     metal::float3 eye_9 = f_15.eye.xyz;
     metal::float2 ndc = metal::float2(((2.0 * pc.x) / static_cast<float>(f_15.sizes.x)) - 1.0, 1.0 - ((2.0 * pc.y) / static_cast<float>(f_15.sizes.y)));
@@ -1005,23 +987,23 @@ PstRay pst_ray(
     metal::float3 px = metal::float3(pc, 0.0);
     float radius = f_15.epipole.w;
     if (f_15.epipole.z > 0.5) {
-        local_18 = metal::length(px - metal::float3(f_15.epipole.x, f_15.epipole.y, 0.0)) < radius;
+        local_14 = metal::length(px - metal::float3(f_15.epipole.x, f_15.epipole.y, 0.0)) < radius;
     } else {
-        local_18 = false;
+        local_14 = false;
     }
-    bool near_epi = local_18;
+    bool near_epi = local_14;
     if (f_15.anti_epipole.z > 0.5) {
-        local_19 = metal::length(px - metal::float3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0)) < radius;
+        local_15 = metal::length(px - metal::float3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0)) < radius;
     } else {
-        local_19 = false;
+        local_15 = false;
     }
-    bool near_anti = local_19;
+    bool near_anti = local_15;
     if (!(near_epi)) {
-        local_20 = near_anti;
+        local_16 = near_anti;
     } else {
-        local_20 = true;
+        local_16 = true;
     }
-    bool _e109 = local_20;
+    bool _e109 = local_16;
     if (_e109) {
         r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
@@ -1388,7 +1370,7 @@ kernel void pst_sweep(
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    uint v_9 = metal::atomic_load_explicit(&live, metal::memory_order_relaxed);
+    uint v_12 = metal::atomic_load_explicit(&live, metal::memory_order_relaxed);
     uint cw = naga_div((width + TREES) - 1u, TREES);
     if (li < TREES) {
         uint2 loop_bound_9 = uint2(4294967295u);
@@ -1427,7 +1409,7 @@ kernel void pst_sweep(
         bucket.inner[metal::min(unsigned(li), 7u)] = _e232;
     } else {
         if (li == TREES) {
-            local_2 = v_9 > 0u;
+            local_2 = v_12 > 0u;
         } else {
             local_2 = false;
         }
@@ -1545,7 +1527,7 @@ kernel void pst_sweep(
                     }
                     loop_init_11 = false;
                     uint _e345 = j_1;
-                    if (_e345 < naga_div(v_9, 2u)) {
+                    if (_e345 < naga_div(v_12, 2u)) {
                     } else {
                         break;
                     }
@@ -1554,18 +1536,18 @@ kernel void pst_sweep(
                         float d_3 = q_d.inner[metal::min(unsigned(_e350), 255u)];
                         uint _e354 = j_1;
                         uint _e359 = j_1;
-                        float _e362 = q_d.inner[metal::min(unsigned((v_9 - 1u) - _e359), 255u)];
+                        float _e362 = q_d.inner[metal::min(unsigned((v_12 - 1u) - _e359), 255u)];
                         q_d.inner[metal::min(unsigned(_e354), 255u)] = _e362;
                         uint _e366 = j_1;
-                        q_d.inner[metal::min(unsigned((v_9 - 1u) - _e366), 255u)] = d_3;
+                        q_d.inner[metal::min(unsigned((v_12 - 1u) - _e366), 255u)] = d_3;
                         uint _e370 = j_1;
                         uint k_9 = q_rank.inner[metal::min(unsigned(_e370), 255u)];
                         uint _e374 = j_1;
                         uint _e379 = j_1;
-                        uint _e382 = q_rank.inner[metal::min(unsigned((v_9 - 1u) - _e379), 255u)];
+                        uint _e382 = q_rank.inner[metal::min(unsigned((v_12 - 1u) - _e379), 255u)];
                         q_rank.inner[metal::min(unsigned(_e374), 255u)] = _e382;
                         uint _e386 = j_1;
-                        q_rank.inner[metal::min(unsigned((v_9 - 1u) - _e386), 255u)] = k_9;
+                        q_rank.inner[metal::min(unsigned((v_12 - 1u) - _e386), 255u)] = k_9;
                     }
                 }
             }
@@ -1678,7 +1660,7 @@ kernel void pst_sweep(
         }
         loop_init_14 = false;
         uint _e484 = j_3;
-        if (_e484 < v_9) {
+        if (_e484 < v_12) {
         } else {
             break;
         }
@@ -1702,7 +1684,7 @@ kernel void pst_sweep(
         }
         loop_init_15 = false;
         uint _e499 = j_4;
-        if (_e499 < v_9) {
+        if (_e499 < v_12) {
         } else {
             break;
         }
@@ -1737,7 +1719,7 @@ kernel void pst_sweep(
             metal::float4 _e520 = rectified.read(metal::min(metal::uint2(metal::uint2(_e516, row_3)), metal::uint2(rectified.get_width(clamped_lod_e520), rectified.get_height(clamped_lod_e520)) - 1), clamped_lod_e520);
             float occluder = _e520.x;
             lo = 0u;
-            hi = v_9;
+            hi = v_12;
             uint2 loop_bound_21 = uint2(4294967295u);
             while(true) {
                 if (metal::all(loop_bound_21 == uint2(0u))) { break; }
@@ -1810,7 +1792,7 @@ kernel void pst_sweep(
             }
             loop_init_18 = false;
             uint _e585 = j_5;
-            if (_e585 < (v_9 * LEAF_VECS)) {
+            if (_e585 < (v_12 * LEAF_VECS)) {
             } else {
                 break;
             }
@@ -1821,7 +1803,7 @@ kernel void pst_sweep(
         }
         uint lo_5 = li * cw;
         uint hi_5 = ((li + 1u) == TREES) ? width : metal::min(lo_5 + cw, width);
-        top = v_9;
+        top = v_12;
         uint2 loop_bound_24 = uint2(4294967295u);
         while(true) {
             if (metal::all(loop_bound_24 == uint2(0u))) { break; }
@@ -1867,7 +1849,7 @@ kernel void pst_sweep(
                     if (metal::all(loop_bound_26 == uint2(0u))) { break; }
                     loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
                     uint _e631 = next;
-                    if (_e631 < v_9) {
+                    if (_e631 < v_12) {
                         uint _e635 = next;
                         uint _e637 = by_end.inner[metal::min(unsigned(_e635), 255u)];
                         uint _e639 = q_end.inner[metal::min(unsigned(_e637), 255u)];
@@ -1918,7 +1900,7 @@ kernel void pst_sweep(
                             {
                                 p = metal::float4(0.0, 0.0, 0.0, 0.0);
                                 uint _e681 = q_rank.inner[metal::min(unsigned(k_10), 255u)];
-                                j_6 = v_9 - _e681;
+                                j_6 = v_12 - _e681;
                                 uint2 loop_bound_28 = uint2(4294967295u);
                                 while(true) {
                                     if (metal::all(loop_bound_28 == uint2(0u))) { break; }
@@ -1974,13 +1956,13 @@ kernel void pst_sweep(
                             uint _e733 = i_1;
                             uint _e738 = h_2;
                             metal::float4 leaf_1 = pst_leaves[metal::min(unsigned(((base_1 + _e733) * LEAF_VECS) + _e738), (_buffer_sizes.size6 - 0 - 16) / 16)];
-                            j_7 = (v_9 - b_8) + 1u;
+                            j_7 = (v_12 - b_8) + 1u;
                             uint2 loop_bound_30 = uint2(4294967295u);
                             while(true) {
                                 if (metal::all(loop_bound_30 == uint2(0u))) { break; }
                                 loop_bound_30 -= uint2(loop_bound_30.y == 0u, 1u);
                                 uint _e746 = j_7;
-                                if (_e746 <= v_9) {
+                                if (_e746 <= v_12) {
                                 } else {
                                     break;
                                 }
@@ -2015,7 +1997,7 @@ kernel void pst_sweep(
         }
         loop_init_22 = false;
         uint _e775 = x;
-        if (_e775 < (v_9 * LEAF_VECS)) {
+        if (_e775 < (v_12 * LEAF_VECS)) {
         } else {
             break;
         }
@@ -2099,7 +2081,7 @@ kernel void pst_sweep(
                         p_1 = _e849;
                         uint _e852 = k_4;
                         uint _e854 = q_rank.inner[metal::min(unsigned(_e852), 255u)];
-                        j_8 = v_9 - _e854;
+                        j_8 = v_12 - _e854;
                         uint2 loop_bound_35 = uint2(4294967295u);
                         while(true) {
                             if (metal::all(loop_bound_35 == uint2(0u))) { break; }

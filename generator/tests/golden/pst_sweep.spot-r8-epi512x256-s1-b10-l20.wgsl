@@ -137,111 +137,80 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
     return vec3<f32>(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
-fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
-    if (v_1.origin.w > 0.5f) {
-        let z_2 = max(ls.z, 0.000001f);
-        let t_3 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_2 * t_3))), (0.5f - ((0.5f * ls.y) / (z_2 * t_3))));
-    } else {
-        return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
+    let z_2 = max(ls.z, 0.000001f);
+    let t_3 = v_1.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_2 * t_3))), (0.5f - ((0.5f * ls.y) / (z_2 * t_3))));
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_9: bool;
-    var local_10: bool;
-    var local_11: bool;
-
-    if !((uv.x < 0f)) {
-        local_9 = (uv.x > 1f);
-    } else {
-        local_9 = true;
-    }
-    let _e11 = local_9;
-    if !(_e11) {
-        local_10 = (uv.y < 0f);
-    } else {
-        local_10 = true;
-    }
-    let _e19 = local_10;
-    if !(_e19) {
-        local_11 = (uv.y > 1f);
-    } else {
-        local_11 = true;
-    }
-    let _e27 = local_11;
-    if _e27 {
-        return 2f;
-    }
+    let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_3 = v_2.size.x;
     let x_6 = min(u32((uv.x * f32(n_3))), (n_3 - 1u));
     let y_1 = min(u32((uv.y * f32(n_3))), (n_3 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_6, y_1), 0i);
-    return _e49.x;
+    let _e36 = textureLoad(sm, vec2<u32>(x_6, y_1), 0i);
+    return select(_e36.x, 2f, outside);
 }
 
-fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
-    var texel: f32;
-
-    let size = f32(v_3.size.x);
-    if (v_3.origin.w > 0.5f) {
-        texel = (((2f * max(z, 0f)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    let _e32 = texel;
-    return (v_3.forward.w * _e32);
+fn shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
+    let texel = (((2f * max(z, 0f)) * v_3.proj.x) / f32(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_3: vec3<f32>) -> f32 {
-    var local_12: bool;
-
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_3);
-    let near = v_4.right.w;
-    let far = v_4.up.w;
-    if (v_4.origin.w > 0.5f) {
-        local_12 = (_e2.z <= near);
-    } else {
-        local_12 = false;
-    }
-    let _e16 = local_12;
-    if _e16 {
-        return 1f;
-    }
-    let _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    let _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    let depth_1 = ((_e2.z - near) / (far - near));
-    let _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
+fn shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls_1: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
 }
 
-fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    let near_1 = v_5.right.w;
-    let far_1 = v_5.up.w;
-    if (v_5.origin.w > 0.5f) {
-        let dir_11 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_11.z <= 0.000001f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
-        let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if (_e28 >= 1f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let z_3 = (near_1 + (_e28 * (far_1 - near_1)));
-        let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_11.z);
-    } else {
-        let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if (_e40 >= 1f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let z_4 = (near_1 + (_e40 * (far_1 - near_1)));
-        let _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_4);
-        return ((z_4 + _e47) - _e2.z);
+fn shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) -> f32 {
+    let texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / f32(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_3: vec3<f32>, perspective: bool) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_3);
+    let near = v_6.right.w;
+    let far = v_6.up.w;
+    if perspective {
+        let _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        let _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        let depth_1 = ((_e2.z - near) / (far - near));
+        let _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        let lit = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return select(0f, 1f, (lit | (_e2.z <= near)));
     }
+    let _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    let depth_2 = ((_e2.z - near) / (far - near));
+    let _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return select(0f, 1f, (depth_2 <= (_e28 + (_e33 / (far - near)))));
+}
+
+fn shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, l: vec3<f32>) -> f32 {
+    let near_1 = v_7.right.w;
+    let far_1 = v_7.up.w;
+    let dir_11 = vec3<f32>(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+    if (dir_11.z <= 0.000001f) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    let _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_11);
+    let _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if (_e22 >= 1f) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    let z_3 = (near_1 + (_e22 * (far_1 - near_1)));
+    let _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_3);
+    return ((z_3 + _e29) / dir_11.z);
+}
+
+fn shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_3: texture_2d<f32>, o: vec3<f32>) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    let near_2 = v_8.right.w;
+    let far_2 = v_8.up.w;
+    let _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    let _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    let z_4 = (near_2 + (_e9 * (far_2 - near_2)));
+    let _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return select(((z_4 + _e13) - _e2.z), NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, (_e9 >= 1f));
 }
 
 fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
@@ -341,8 +310,8 @@ fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_na
     return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
-fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9.x, v_9.y, v_9.z, v_9.w);
 }
 
 fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
@@ -361,10 +330,10 @@ fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, vec4<u32>(f_2.sizes2_.x, 0u, 0u, 0u));
 }
 
-fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_3: texture_2d<f32>, p_4: vec3<f32>) -> f32 {
+fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, p_4: vec3<f32>, spot: bool) -> f32 {
     let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    let _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_4);
-    return _e4;
+    let _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_4, spot);
+    return _e5;
 }
 
 fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_3: vec3<f32>, dir_3: vec3<f32>, t_1: f32) -> f32 {
@@ -372,7 +341,7 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX
     return _e13;
 }
 
-fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot_1: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_6: u32 = 0u;
     var t_2: f32;
@@ -390,15 +359,15 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_
             let _e17 = k_6;
             t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_11));
             w = h_11;
-            if spot {
+            if spot_1 {
                 let _e26 = k_6;
                 let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             let _e33 = t_2;
-            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e33)));
-            if spot {
+            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            if spot_1 {
                 let _e39 = sum_1;
                 let _e40 = w;
                 let _e42 = t_2;
@@ -421,9 +390,9 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_
     return _e65;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_1: bool) -> f32 {
-    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0f, s, f_6.sizes2_.y, spot_1);
-    if spot_1 {
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
+    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0f, s, f_6.sizes2_.y, spot_2);
+    if spot_2 {
         return _e9;
     } else {
         let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
@@ -463,8 +432,8 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_o
     return _e34;
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_2: bool) -> f32 {
-    if spot_2 {
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
+    if spot_3 {
         let q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
         let to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
@@ -472,18 +441,18 @@ fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_
     return (s_1 * sin(theta_1));
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_3: bool) -> f32 {
-    var local_13: bool;
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
+    var local_9: bool;
 
-    if spot_3 {
+    if spot_4 {
         let psi = (x_2 * delta);
         let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
-            local_13 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_9 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_13 = true;
+            local_9 = true;
         }
-        let _e16 = local_13;
+        let _e16 = local_9;
         if _e16 {
             return s_2;
         }
@@ -493,11 +462,11 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_4: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
     if (x_3 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_3), delta_1, theta_3, s_3, spot_4);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -506,8 +475,8 @@ fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_o
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_5: bool) -> f32 {
-    if spot_5 {
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
+    if spot_6 {
         let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
         return _e12;
     }
@@ -516,23 +485,23 @@ fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_m
 }
 
 fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_6: f32, b_6: f32, depth_break: f32) -> bool {
-    var local_14: bool;
+    var local_10: bool;
 
     if !((a_6 == b_6)) {
-        local_14 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
+        local_10 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
-        local_14 = true;
+        local_10 = true;
     }
-    let _e13 = local_14;
+    let _e13 = local_10;
     return _e13;
 }
 
-fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_7: vec3<f32>) -> vec3<f32> {
-    let a_9 = min(abs(v_7), vec3(65504f));
+fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_10: vec3<f32>) -> vec3<f32> {
+    let a_9 = min(abs(v_10), vec3(65504f));
     let u_2 = bitcast<vec3<u32>>(a_9);
     let normal = bitcast<vec3<f32>>((((u_2 + vec3(4095u)) + ((u_2 >> vec3(13u)) & vec3(1u))) & vec3(4294959104u)));
     let subnormal = (round((a_9 * 16777216f)) / vec3(16777216f));
-    return (sign(v_7) * select(normal, subnormal, (a_9 < vec3(0.000061035156f))));
+    return (sign(v_10) * select(normal, subnormal, (a_9 < vec3(0.000061035156f))));
 }
 
 fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, d: vec2<f32>) -> f32 {
@@ -542,22 +511,22 @@ fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, 
 fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, screen: vec2<u32>, slices: u32) -> EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     var origin: vec2<f32>;
     var l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
-    var local_15: bool;
-    var local_16: bool;
-    var local_17: bool;
+    var local_11: bool;
+    var local_12: bool;
+    var local_13: bool;
     var a_7: f32 = 0f;
     var b_7: f32 = 0f;
     var k_7: u32 = 0u;
 
-    let size_1 = vec2<f32>(screen);
-    let centre = (0.5f * size_1);
+    let size = vec2<f32>(screen);
+    let centre = (0.5f * size);
     let z_5 = dot(cam.toward, cam.forward);
     let q_3 = vec2<f32>(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
-    let far_2 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
+    let far_3 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size.x, size.y));
     let lq = length(q_3);
     origin = centre;
-    if (lq >= (far_2 * abs(z_5))) {
-        origin = (centre + ((q_3 * (far_2 / max(lq, 0.000000000000000000000000000001f))) * select(1f, -1f, (z_5 < 0f))));
+    if (lq >= (far_3 * abs(z_5))) {
+        origin = (centre + ((q_3 * (far_3 / max(lq, 0.000000000000000000000000000001f))) * select(1f, -1f, (z_5 < 0f))));
     } else {
         if (lq > 0f) {
             origin = (centre + (q_3 / vec2(z_5)));
@@ -570,29 +539,29 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     let lc = length(to_centre);
     l_1.axis = select(vec2<f32>(1f, 0f), (to_centre / vec2(max(lc, 0.000000000000000000000000000001f))), (lc > 0f));
     let lo_2 = vec2<f32>(0.5f, 0.5f);
-    let hi_2 = (size_1 - vec2<f32>(0.5f, 0.5f));
+    let hi_2 = (size - vec2<f32>(0.5f, 0.5f));
     let _e79 = origin.x;
     if (_e79 >= lo_2.x) {
         let _e83 = origin.x;
-        local_15 = (_e83 <= hi_2.x);
+        local_11 = (_e83 <= hi_2.x);
     } else {
-        local_15 = false;
+        local_11 = false;
     }
-    let _e89 = local_15;
+    let _e89 = local_11;
     if _e89 {
         let _e91 = origin.y;
-        local_16 = (_e91 >= lo_2.y);
+        local_12 = (_e91 >= lo_2.y);
     } else {
-        local_16 = false;
+        local_12 = false;
     }
-    let _e97 = local_16;
+    let _e97 = local_12;
     if _e97 {
         let _e99 = origin.y;
-        local_17 = (_e99 <= hi_2.y);
+        local_13 = (_e99 <= hi_2.y);
     } else {
-        local_17 = false;
+        local_13 = false;
     }
-    let inside = local_17;
+    let inside = local_13;
     if inside {
         l_1.wrap = 1u;
         l_1.phi_start = -3.1415927f;
@@ -705,9 +674,9 @@ fn factor_at(base: u32, x_4: f32, h_4: u32) -> vec4<f32> {
     return ((_e22 * (1f - t_4)) + (_e34 * t_4));
 }
 
-fn gamma_at(v_8: f32, h_5: u32) -> vec4<f32> {
+fn gamma_at(v_11: f32, h_5: u32) -> vec4<f32> {
     let _e4 = pst_factors[0].x;
-    let _e8 = factor_at(1u, (v_8 / _e4), h_5);
+    let _e8 = factor_at(1u, (v_11 / _e4), h_5);
     return _e8;
 }
 
@@ -755,9 +724,9 @@ fn pst_leaf(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
 
 fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     var r_1: PstRay;
-    var local_18: bool;
-    var local_19: bool;
-    var local_20: bool;
+    var local_14: bool;
+    var local_15: bool;
+    var local_16: bool;
 
     let f_15 = frame;
     let eye_9 = f_15.eye.xyz;
@@ -769,23 +738,23 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     let px = vec3<f32>(pc, 0f);
     let radius = f_15.epipole.w;
     if (f_15.epipole.z > 0.5f) {
-        local_18 = (length((px - vec3<f32>(f_15.epipole.x, f_15.epipole.y, 0f))) < radius);
+        local_14 = (length((px - vec3<f32>(f_15.epipole.x, f_15.epipole.y, 0f))) < radius);
     } else {
-        local_18 = false;
+        local_14 = false;
     }
-    let near_epi = local_18;
+    let near_epi = local_14;
     if (f_15.anti_epipole.z > 0.5f) {
-        local_19 = (length((px - vec3<f32>(f_15.anti_epipole.x, f_15.anti_epipole.y, 0f))) < radius);
+        local_15 = (length((px - vec3<f32>(f_15.anti_epipole.x, f_15.anti_epipole.y, 0f))) < radius);
     } else {
-        local_19 = false;
+        local_15 = false;
     }
-    let near_anti = local_19;
+    let near_anti = local_15;
     if !(near_epi) {
-        local_20 = near_anti;
+        local_16 = near_anti;
     } else {
-        local_20 = true;
+        local_16 = true;
     }
-    let _e109 = local_20;
+    let _e109 = local_16;
     if _e109 {
         r_1.marched = true;
         let _e114 = frame;
@@ -1070,7 +1039,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         }
     }
     workgroupBarrier();
-    let v_9 = atomicLoad((&live));
+    let v_12 = atomicLoad((&live));
     let cw = (((width + TREES) - 1u) / TREES);
     if (li < TREES) {
         loop {
@@ -1104,7 +1073,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         bucket[li] = _e232;
     } else {
         if (li == TREES) {
-            local_2 = (v_9 > 0u);
+            local_2 = (v_12 > 0u);
         } else {
             local_2 = false;
         }
@@ -1199,7 +1168,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
             if !(up) {
                 loop {
                     let _e345 = j_1;
-                    if (_e345 < (v_9 / 2u)) {
+                    if (_e345 < (v_12 / 2u)) {
                     } else {
                         break;
                     }
@@ -1208,18 +1177,18 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                         let d_3 = q_d[_e350];
                         let _e354 = j_1;
                         let _e359 = j_1;
-                        let _e362 = q_d[((v_9 - 1u) - _e359)];
+                        let _e362 = q_d[((v_12 - 1u) - _e359)];
                         q_d[_e354] = _e362;
                         let _e366 = j_1;
-                        q_d[((v_9 - 1u) - _e366)] = d_3;
+                        q_d[((v_12 - 1u) - _e366)] = d_3;
                         let _e370 = j_1;
                         let k_9 = q_rank[_e370];
                         let _e374 = j_1;
                         let _e379 = j_1;
-                        let _e382 = q_rank[((v_9 - 1u) - _e379)];
+                        let _e382 = q_rank[((v_12 - 1u) - _e379)];
                         q_rank[_e374] = _e382;
                         let _e386 = j_1;
-                        q_rank[((v_9 - 1u) - _e386)] = k_9;
+                        q_rank[((v_12 - 1u) - _e386)] = k_9;
                     }
                     continuing {
                         let _e390 = j_1;
@@ -1314,7 +1283,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     j_3 = li;
     loop {
         let _e484 = j_3;
-        if (_e484 < v_9) {
+        if (_e484 < v_12) {
         } else {
             break;
         }
@@ -1333,7 +1302,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     j_4 = li;
     loop {
         let _e499 = j_4;
-        if (_e499 < v_9) {
+        if (_e499 < v_12) {
         } else {
             break;
         }
@@ -1362,7 +1331,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
             let _e520 = textureLoad(rectified, vec2<u32>(_e516, row_3), 0i);
             let occluder = _e520.x;
             lo = 0u;
-            hi = v_9;
+            hi = v_12;
             loop {
                 let _e525 = lo;
                 let _e526 = hi;
@@ -1422,7 +1391,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         let tree = (trees + ((li * SLICE_SAMPLES) * LEAF_VECS));
         loop {
             let _e585 = j_5;
-            if (_e585 < (v_9 * LEAF_VECS)) {
+            if (_e585 < (v_12 * LEAF_VECS)) {
             } else {
                 break;
             }
@@ -1437,7 +1406,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         }
         let lo_5 = (li * cw);
         let hi_5 = select(min((lo_5 + cw), width), width, ((li + 1u) == TREES));
-        top = v_9;
+        top = v_12;
         loop {
             let _e611 = next;
             let _e612 = top;
@@ -1468,7 +1437,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
             {
                 loop {
                     let _e631 = next;
-                    if (_e631 < v_9) {
+                    if (_e631 < v_12) {
                         let _e635 = next;
                         let _e637 = by_end[_e635];
                         let _e639 = q_end[_e637];
@@ -1510,7 +1479,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                             {
                                 p = vec4<f32>(0f, 0f, 0f, 0f);
                                 let _e681 = q_rank[k_10];
-                                j_6 = (v_9 - _e681);
+                                j_6 = (v_12 - _e681);
                                 loop {
                                     let _e684 = j_6;
                                     if (_e684 > 0u) {
@@ -1558,10 +1527,10 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                             let _e733 = i_1;
                             let _e738 = h_2;
                             let leaf_1 = pst_leaves[(((base_1 + _e733) * LEAF_VECS) + _e738)];
-                            j_7 = ((v_9 - b_8) + 1u);
+                            j_7 = ((v_12 - b_8) + 1u);
                             loop {
                                 let _e746 = j_7;
-                                if (_e746 <= v_9) {
+                                if (_e746 <= v_12) {
                                 } else {
                                     break;
                                 }
@@ -1595,7 +1564,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     x = li;
     loop {
         let _e775 = x;
-        if (_e775 < (v_9 * LEAF_VECS)) {
+        if (_e775 < (v_12 * LEAF_VECS)) {
         } else {
             break;
         }
@@ -1660,7 +1629,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                         p_1 = _e849;
                         let _e852 = k_4;
                         let _e854 = q_rank[_e852];
-                        j_8 = (v_9 - _e854);
+                        j_8 = (v_12 - _e854);
                         loop {
                             let _e857 = j_8;
                             if (_e857 > 0u) {

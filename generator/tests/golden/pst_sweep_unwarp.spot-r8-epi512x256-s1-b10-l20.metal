@@ -115,17 +115,13 @@ metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     return metal::float3(metal::dot(q_2, v.right.xyz), metal::dot(q_2, v.up.xyz), metal::dot(q_2, v.forward.xyz));
 }
 
-metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
     metal::float3 ls
 ) {
-    if (v_1.origin.w > 0.5) {
-        float z_2 = metal::max(ls.z, 0.000001);
-        float t_5 = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_2 * t_5)), 0.5 - ((0.5 * ls.y) / (z_2 * t_5)));
-    } else {
-        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
-    }
+    float z_2 = metal::max(ls.z, 0.000001);
+    float t_5 = v_1.proj.x;
+    return metal::float2(0.5 + ((0.5 * ls.x) / (z_2 * t_5)), 0.5 - ((0.5 * ls.y) / (z_2 * t_5)));
 }
 
 uint naga_f2u32(float value) {
@@ -137,110 +133,95 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_1 = {};
-    bool local_2 = {};
-    bool local_3 = {};
-    if (!((uv.x < 0.0))) {
-        local_1 = uv.x > 1.0;
-    } else {
-        local_1 = true;
-    }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = uv.y < 0.0;
-    } else {
-        local_2 = true;
-    }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = uv.y > 1.0;
-    } else {
-        local_3 = true;
-    }
-    bool _e27 = local_3;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_3 = v_2.size.x;
     uint x_5 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_3)), n_3 - 1u);
     uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_3)), n_3 - 1u);
-    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_5, y_1)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
-    return _e49.x;
+    uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_5, y_1)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    return outside ? 2.0 : _e36.x;
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
     float z
 ) {
-    float texel = {};
-    float size = static_cast<float>(v_3.size.x);
-    if (v_3.origin.w > 0.5) {
-        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
-    } else {
-        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
-    }
-    float _e32 = texel;
-    return v_3.forward.w * _e32;
+    float texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / static_cast<float>(v_3.size.x);
+    return v_3.forward.w * texel;
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
-    metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_1
+    metal::float3 ls_1
 ) {
-    bool local_4 = {};
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if (v_4.origin.w > 0.5) {
-        local_4 = _e2.z <= near;
-    } else {
-        local_4 = false;
-    }
-    bool _e16 = local_4;
-    if (_e16) {
-        return 1.0;
-    }
-    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = (_e2.z - near) / (far - near);
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
+    return metal::float2((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x), (v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z));
 }
 
-float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5,
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5
+) {
+    float texel_1 = metal::max(v_5.proj.y - v_5.proj.x, v_5.proj.w - v_5.proj.z) / static_cast<float>(v_5.size.x);
+    return v_5.forward.w * texel_1;
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6,
+    metal::texture2d<float, metal::access::sample> sm_1,
+    metal::float3 p_1,
+    bool perspective
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        metal::float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = (_e2.z - near) / (far - near);
+        float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit = depth_1 <= (_e10 + (_e16 / (far - near)));
+        return (lit | (_e2.z <= near)) ? 1.0 : 0.0;
+    }
+    metal::float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = (_e2.z - near) / (far - near);
+    float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return (depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0;
+}
+
+float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7,
     metal::texture2d<float, metal::access::sample> sm_2,
-    metal::float3 o,
     metal::float3 l
 ) {
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    float near_1 = v_5.right.w;
-    float far_1 = v_5.up.w;
-    if (v_5.origin.w > 0.5) {
-        metal::float3 dir_11 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_11.z <= 0.000001) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
-        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if (_e28 >= 1.0) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_3 = near_1 + (_e28 * (far_1 - near_1));
-        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return (z_3 + _e35) / dir_11.z;
-    } else {
-        metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if (_e40 >= 1.0) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_4 = near_1 + (_e40 * (far_1 - near_1));
-        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_4);
-        return (z_4 + _e47) - _e2.z;
+    float near_1 = v_7.right.w;
+    float far_1 = v_7.up.w;
+    metal::float3 dir_11 = metal::float3(metal::dot(l, v_7.right.xyz), metal::dot(l, v_7.up.xyz), metal::dot(l, v_7.forward.xyz));
+    if (dir_11.z <= 0.000001) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
     }
+    metal::float2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_11);
+    float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if (_e22 >= 1.0) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    float z_3 = near_1 + (_e22 * (far_1 - near_1));
+    float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_3);
+    return (z_3 + _e29) / dir_11.z;
+}
+
+float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8,
+    metal::texture2d<float, metal::access::sample> sm_3,
+    metal::float3 o
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    float near_2 = v_8.right.w;
+    float far_2 = v_8.up.w;
+    metal::float2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    float z_4 = near_2 + (_e9 * (far_2 - near_2));
+    float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return (_e9 >= 1.0) ? NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX : ((z_4 + _e13) - _e2.z);
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -394,9 +375,9 @@ metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 }
 
 SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    metal::float4 v_6
+    metal::float4 v_9
 ) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {v_6.x, v_6.y, v_6.z, v_6.w};
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {v_9.x, v_9.y, v_9.z, v_9.w};
 }
 
 metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -429,12 +410,13 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XON
 
 float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
-    metal::texture2d<float, metal::access::sample> sm_3,
-    metal::float3 p_2
+    metal::texture2d<float, metal::access::sample> sm_4,
+    metal::float3 p_2,
+    bool spot
 ) {
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
+    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_2, spot);
+    return _e5;
 }
 
 float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -449,13 +431,13 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 
 float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
-    metal::texture2d<float, metal::access::sample> sm_4,
+    metal::texture2d<float, metal::access::sample> sm_5,
     metal::float3 eye_4,
     metal::float3 dir_4,
     float a_3,
     float b_3,
     uint steps,
-    bool spot
+    bool spot_1
 ) {
     float sum_1 = 0.0;
     uint k_1 = 0u;
@@ -482,15 +464,15 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
             uint _e17 = k_1;
             t_2 = a_3 + ((static_cast<float>(_e17) + 0.5) * h_7);
             w = h_7;
-            if (spot) {
+            if (spot_1) {
                 uint _e26 = k_1;
                 metal::float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e26) + 0.5);
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, eye_4 + (dir_4 * _e33));
-            if (spot) {
+            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_4 + (dir_4 * _e33), spot_1);
+            if (spot_1) {
                 float _e39 = sum_1;
                 float _e40 = w;
                 float _e42 = t_2;
@@ -511,14 +493,14 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
-    metal::texture2d<float, metal::access::sample> sm_5,
+    metal::texture2d<float, metal::access::sample> sm_6,
     metal::float3 eye_5,
     metal::float3 dir_5,
     float s,
-    bool spot_1
+    bool spot_2
 ) {
-    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_1);
-    if (spot_1) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_2);
+    if (spot_2) {
         return _e9;
     } else {
         float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(metal::dot(f_6.light_dir.xyz, dir_5)));
@@ -582,9 +564,9 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float3 dir_8,
     float s_1,
     float theta_1,
-    bool spot_2
+    bool spot_3
 ) {
-    if (spot_2) {
+    if (spot_3) {
         metal::float3 q_3 = (eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz;
         metal::float3 to_eye = -(f_9.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_3, to_eye)), metal::dot(q_3, to_eye));
@@ -598,18 +580,18 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float delta,
     float theta_2,
     float s_2,
-    bool spot_3
+    bool spot_4
 ) {
-    bool local_5 = {};
-    if (spot_3) {
+    bool local_1 = {};
+    if (spot_4) {
         float psi = x_1 * delta;
         float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
-            local_5 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_1 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local_5 = true;
+            local_1 = true;
         }
-        bool _e16 = local_5;
+        bool _e16 = local_1;
         if (_e16) {
             return s_2;
         }
@@ -626,12 +608,12 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float delta_1,
     float theta_3,
     float s_3,
-    bool spot_4
+    bool spot_5
 ) {
     if (x_2 >= n_1) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, static_cast<float>(x_2), delta_1, theta_3, s_3, spot_4);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, static_cast<float>(x_2), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -657,9 +639,9 @@ float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float3 dir_10,
     float a_5,
     float b_5,
-    bool spot_5
+    bool spot_6
 ) {
-    if (spot_5) {
+    if (spot_6) {
         float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_13.sizes2_.z, 4u), 1u));
         return _e12;
     }
@@ -672,13 +654,13 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     float b_6,
     float depth_break
 ) {
-    bool local_6 = {};
+    bool local_2 = {};
     if (!((a_6 == b_6))) {
-        local_6 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
+        local_2 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
     } else {
-        local_6 = true;
+        local_2 = true;
     }
-    bool _e13 = local_6;
+    bool _e13 = local_2;
     return _e13;
 }
 
@@ -697,8 +679,8 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     uint taps = 0u;
     uint close = 0u;
     uint k_2 = 0u;
-    bool local_7 = {};
-    bool local_8 = {};
+    bool local_3 = {};
+    bool local_4 = {};
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
@@ -722,11 +704,11 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
             if (w_1[metal::min(unsigned(_e20), 3u)] > 0.0) {
                 uint _e25 = k_2;
                 bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
-                local_7 = _e29;
+                local_3 = _e29;
             } else {
-                local_7 = false;
+                local_3 = false;
             }
-            bool _e33 = local_7;
+            bool _e33 = local_3;
             if (_e33) {
                 uint _e35 = close;
                 close = _e35 + 1u;
@@ -750,11 +732,11 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     if (!((_e65 <= 0.0))) {
         uint _e69 = close;
         uint _e70 = taps;
-        local_8 = _e69 < metal::min(_e70, 2u);
+        local_4 = _e69 < metal::min(_e70, 2u);
     } else {
-        local_8 = true;
+        local_4 = true;
     }
-    bool _e77 = local_8;
+    bool _e77 = local_4;
     if (_e77) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
@@ -904,13 +886,13 @@ metal::float4 factor_at(
 }
 
 metal::float4 gamma_at(
-    float v_7,
+    float v_10,
     uint h_1,
     device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float _e4 = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)].x;
-    metal::float4 _e8 = factor_at(1u, v_7 / _e4, h_1, pst_factors, _buffer_sizes);
+    metal::float4 _e8 = factor_at(1u, v_10 / _e4, h_1, pst_factors, _buffer_sizes);
     return _e8;
 }
 
@@ -980,9 +962,9 @@ PstRay pst_ray(
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     PstRay r = {};
-    bool local_9 = {};
-    bool local_10 = {};
-    bool local_11 = {};
+    bool local_5 = {};
+    bool local_6 = {};
+    bool local_7 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
     metal::float3 eye_9 = f_16.eye.xyz;
     metal::float2 ndc = metal::float2(((2.0 * pc.x) / static_cast<float>(f_16.sizes.x)) - 1.0, 1.0 - ((2.0 * pc.y) / static_cast<float>(f_16.sizes.y)));
@@ -993,23 +975,23 @@ PstRay pst_ray(
     metal::float3 px = metal::float3(pc, 0.0);
     float radius = f_16.epipole.w;
     if (f_16.epipole.z > 0.5) {
-        local_9 = metal::length(px - metal::float3(f_16.epipole.x, f_16.epipole.y, 0.0)) < radius;
+        local_5 = metal::length(px - metal::float3(f_16.epipole.x, f_16.epipole.y, 0.0)) < radius;
     } else {
-        local_9 = false;
+        local_5 = false;
     }
-    bool near_epi = local_9;
+    bool near_epi = local_5;
     if (f_16.anti_epipole.z > 0.5) {
-        local_10 = metal::length(px - metal::float3(f_16.anti_epipole.x, f_16.anti_epipole.y, 0.0)) < radius;
+        local_6 = metal::length(px - metal::float3(f_16.anti_epipole.x, f_16.anti_epipole.y, 0.0)) < radius;
     } else {
-        local_10 = false;
+        local_6 = false;
     }
-    bool near_anti = local_10;
+    bool near_anti = local_6;
     if (!(near_epi)) {
-        local_11 = near_anti;
+        local_7 = near_anti;
     } else {
-        local_11 = true;
+        local_7 = true;
     }
-    bool _e109 = local_11;
+    bool _e109 = local_7;
     if (_e109) {
         r.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
@@ -1217,11 +1199,11 @@ kernel void pst_sweep_unwarp(
             uint _e71 = j;
             uint _e76 = j;
             uint clamped_lod_e83 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-            metal::float4 v_8 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(_e61.k[metal::min(unsigned(naga_div(_e67, 2u)), 1u)] + naga_mod(_e71, 2u), _e61.slices[metal::min(unsigned(naga_div(_e76, 2u)), 1u)])), metal::uint2(epipolar_samples.get_width(clamped_lod_e83), epipolar_samples.get_height(clamped_lod_e83)) - 1), clamped_lod_e83);
+            metal::float4 v_11 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(_e61.k[metal::min(unsigned(naga_div(_e67, 2u)), 1u)] + naga_mod(_e71, 2u), _e61.slices[metal::min(unsigned(naga_div(_e76, 2u)), 1u)])), metal::uint2(epipolar_samples.get_width(clamped_lod_e83), epipolar_samples.get_height(clamped_lod_e83)) - 1), clamped_lod_e83);
             uint _e85 = j;
-            depths[metal::min(unsigned(_e85), 3u)] = v_8.w;
+            depths[metal::min(unsigned(_e85), 3u)] = v_11.w;
             uint _e89 = j;
-            light.inner[metal::min(unsigned(_e89), 3u)] = v_8.xyz;
+            light.inner[metal::min(unsigned(_e89), 3u)] = v_11.xyz;
         }
     }
     metal::float4 _e96 = depths;

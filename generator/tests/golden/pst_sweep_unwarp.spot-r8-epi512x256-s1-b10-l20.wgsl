@@ -121,111 +121,80 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
     return vec3<f32>(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
 }
 
-fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
-    if (v_1.origin.w > 0.5f) {
-        let z_2 = max(ls.z, 0.000001f);
-        let t_5 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_2 * t_5))), (0.5f - ((0.5f * ls.y) / (z_2 * t_5))));
-    } else {
-        return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
+    let z_2 = max(ls.z, 0.000001f);
+    let t_5 = v_1.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_2 * t_5))), (0.5f - ((0.5f * ls.y) / (z_2 * t_5))));
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_1: bool;
-    var local_2: bool;
-    var local_3: bool;
-
-    if !((uv.x < 0f)) {
-        local_1 = (uv.x > 1f);
-    } else {
-        local_1 = true;
-    }
-    let _e11 = local_1;
-    if !(_e11) {
-        local_2 = (uv.y < 0f);
-    } else {
-        local_2 = true;
-    }
-    let _e19 = local_2;
-    if !(_e19) {
-        local_3 = (uv.y > 1f);
-    } else {
-        local_3 = true;
-    }
-    let _e27 = local_3;
-    if _e27 {
-        return 2f;
-    }
+    let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_3 = v_2.size.x;
     let x_5 = min(u32((uv.x * f32(n_3))), (n_3 - 1u));
     let y_1 = min(u32((uv.y * f32(n_3))), (n_3 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_5, y_1), 0i);
-    return _e49.x;
+    let _e36 = textureLoad(sm, vec2<u32>(x_5, y_1), 0i);
+    return select(_e36.x, 2f, outside);
 }
 
-fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
-    var texel: f32;
-
-    let size = f32(v_3.size.x);
-    if (v_3.origin.w > 0.5f) {
-        texel = (((2f * max(z, 0f)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    let _e32 = texel;
-    return (v_3.forward.w * _e32);
+fn shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
+    let texel = (((2f * max(z, 0f)) * v_3.proj.x) / f32(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_4: bool;
-
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    let near = v_4.right.w;
-    let far = v_4.up.w;
-    if (v_4.origin.w > 0.5f) {
-        local_4 = (_e2.z <= near);
-    } else {
-        local_4 = false;
-    }
-    let _e16 = local_4;
-    if _e16 {
-        return 1f;
-    }
-    let _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    let _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    let depth_1 = ((_e2.z - near) / (far - near));
-    let _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
+fn shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls_1: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
 }
 
-fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    let near_1 = v_5.right.w;
-    let far_1 = v_5.up.w;
-    if (v_5.origin.w > 0.5f) {
-        let dir_11 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_11.z <= 0.000001f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
-        let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if (_e28 >= 1f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let z_3 = (near_1 + (_e28 * (far_1 - near_1)));
-        let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_11.z);
-    } else {
-        let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if (_e40 >= 1f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let z_4 = (near_1 + (_e40 * (far_1 - near_1)));
-        let _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_4);
-        return ((z_4 + _e47) - _e2.z);
+fn shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) -> f32 {
+    let texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / f32(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>, perspective: bool) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    let near = v_6.right.w;
+    let far = v_6.up.w;
+    if perspective {
+        let _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        let _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        let depth_1 = ((_e2.z - near) / (far - near));
+        let _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        let lit = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return select(0f, 1f, (lit | (_e2.z <= near)));
     }
+    let _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    let depth_2 = ((_e2.z - near) / (far - near));
+    let _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return select(0f, 1f, (depth_2 <= (_e28 + (_e33 / (far - near)))));
+}
+
+fn shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, l: vec3<f32>) -> f32 {
+    let near_1 = v_7.right.w;
+    let far_1 = v_7.up.w;
+    let dir_11 = vec3<f32>(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+    if (dir_11.z <= 0.000001f) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    let _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_11);
+    let _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if (_e22 >= 1f) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    let z_3 = (near_1 + (_e22 * (far_1 - near_1)));
+    let _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_3);
+    return ((z_3 + _e29) / dir_11.z);
+}
+
+fn shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_3: texture_2d<f32>, o: vec3<f32>) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    let near_2 = v_8.right.w;
+    let far_2 = v_8.up.w;
+    let _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    let _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    let z_4 = (near_2 + (_e9 * (far_2 - near_2)));
+    let _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return select(((z_4 + _e13) - _e2.z), NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, (_e9 >= 1f));
 }
 
 fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
@@ -325,8 +294,8 @@ fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_na
     return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
-fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9.x, v_9.y, v_9.z, v_9.w);
 }
 
 fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
@@ -345,10 +314,10 @@ fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, vec4<u32>(f_2.sizes2_.x, 0u, 0u, 0u));
 }
 
-fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_3: texture_2d<f32>, p_2: vec3<f32>) -> f32 {
+fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, p_2: vec3<f32>, spot: bool) -> f32 {
     let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    let _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
+    let _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_2, spot);
+    return _e5;
 }
 
 fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_3: vec3<f32>, dir_3: vec3<f32>, t_1: f32) -> f32 {
@@ -356,7 +325,7 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX
     return _e13;
 }
 
-fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot_1: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_1: u32 = 0u;
     var t_2: f32;
@@ -374,15 +343,15 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_
             let _e17 = k_1;
             t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_7));
             w = h_7;
-            if spot {
+            if spot_1 {
                 let _e26 = k_1;
                 let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             let _e33 = t_2;
-            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_4, (eye_4 + (dir_4 * _e33)));
-            if spot {
+            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            if spot_1 {
                 let _e39 = sum_1;
                 let _e40 = w;
                 let _e42 = t_2;
@@ -405,9 +374,9 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_
     return _e65;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_1: bool) -> f32 {
-    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_5, eye_5, dir_5, 0f, s, f_6.sizes2_.y, spot_1);
-    if spot_1 {
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
+    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0f, s, f_6.sizes2_.y, spot_2);
+    if spot_2 {
         return _e9;
     } else {
         let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
@@ -447,8 +416,8 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_o
     return _e34;
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_2: bool) -> f32 {
-    if spot_2 {
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
+    if spot_3 {
         let q_3 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
         let to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_3, to_eye)), dot(q_3, to_eye));
@@ -456,18 +425,18 @@ fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_
     return (s_1 * sin(theta_1));
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_2: f32, s_2: f32, spot_3: bool) -> f32 {
-    var local_5: bool;
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
+    var local_1: bool;
 
-    if spot_3 {
+    if spot_4 {
         let psi = (x_1 * delta);
         let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
-            local_5 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_1 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_5 = true;
+            local_1 = true;
         }
-        let _e16 = local_5;
+        let _e16 = local_1;
         if _e16 {
             return s_2;
         }
@@ -477,11 +446,11 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_4: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
     if (x_2 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_2), delta_1, theta_3, s_3, spot_4);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_2), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -490,8 +459,8 @@ fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_o
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_5: bool) -> f32 {
-    if spot_5 {
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
+    if spot_6 {
         let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
         return _e12;
     }
@@ -500,14 +469,14 @@ fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_m
 }
 
 fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_6: f32, b_6: f32, depth_break: f32) -> bool {
-    var local_6: bool;
+    var local_2: bool;
 
     if !((a_6 == b_6)) {
-        local_6 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
+        local_2 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
-        local_6 = true;
+        local_2 = true;
     }
-    let _e13 = local_6;
+    let _e13 = local_2;
     return _e13;
 }
 
@@ -519,8 +488,8 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1: vec4<f32>, dep
     var taps: u32 = 0u;
     var close: u32 = 0u;
     var k_2: u32 = 0u;
-    var local_7: bool;
-    var local_8: bool;
+    var local_3: bool;
+    var local_4: bool;
 
     loop {
         let _e6 = k_2;
@@ -536,11 +505,11 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1: vec4<f32>, dep
             if (w_1[_e20] > 0f) {
                 let _e25 = k_2;
                 let _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_7 = _e29;
+                local_3 = _e29;
             } else {
-                local_7 = false;
+                local_3 = false;
             }
-            let _e33 = local_7;
+            let _e33 = local_3;
             if _e33 {
                 let _e35 = close;
                 close = (_e35 + 1u);
@@ -568,11 +537,11 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1: vec4<f32>, dep
     if !((_e65 <= 0f)) {
         let _e69 = close;
         let _e70 = taps;
-        local_8 = (_e69 < min(_e70, 2u));
+        local_4 = (_e69 < min(_e70, 2u));
     } else {
-        local_8 = true;
+        local_4 = true;
     }
-    let _e77 = local_8;
+    let _e77 = local_4;
     if _e77 {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
@@ -683,9 +652,9 @@ fn factor_at(base: u32, x_3: f32, h: u32) -> vec4<f32> {
     return ((_e22 * (1f - t_6)) + (_e34 * t_6));
 }
 
-fn gamma_at(v_7: f32, h_1: u32) -> vec4<f32> {
+fn gamma_at(v_10: f32, h_1: u32) -> vec4<f32> {
     let _e4 = pst_factors[0].x;
-    let _e8 = factor_at(1u, (v_7 / _e4), h_1);
+    let _e8 = factor_at(1u, (v_10 / _e4), h_1);
     return _e8;
 }
 
@@ -733,9 +702,9 @@ fn pst_leaf(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, ro
 
 fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     var r: PstRay;
-    var local_9: bool;
-    var local_10: bool;
-    var local_11: bool;
+    var local_5: bool;
+    var local_6: bool;
+    var local_7: bool;
 
     let f_16 = frame;
     let eye_9 = f_16.eye.xyz;
@@ -747,23 +716,23 @@ fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
     let px = vec3<f32>(pc, 0f);
     let radius = f_16.epipole.w;
     if (f_16.epipole.z > 0.5f) {
-        local_9 = (length((px - vec3<f32>(f_16.epipole.x, f_16.epipole.y, 0f))) < radius);
+        local_5 = (length((px - vec3<f32>(f_16.epipole.x, f_16.epipole.y, 0f))) < radius);
     } else {
-        local_9 = false;
+        local_5 = false;
     }
-    let near_epi = local_9;
+    let near_epi = local_5;
     if (f_16.anti_epipole.z > 0.5f) {
-        local_10 = (length((px - vec3<f32>(f_16.anti_epipole.x, f_16.anti_epipole.y, 0f))) < radius);
+        local_6 = (length((px - vec3<f32>(f_16.anti_epipole.x, f_16.anti_epipole.y, 0f))) < radius);
     } else {
-        local_10 = false;
+        local_6 = false;
     }
-    let near_anti = local_10;
+    let near_anti = local_6;
     if !(near_epi) {
-        local_11 = near_anti;
+        local_7 = near_anti;
     } else {
-        local_11 = true;
+        local_7 = true;
     }
-    let _e109 = local_11;
+    let _e109 = local_7;
     if _e109 {
         r.marched = true;
         let _e114 = frame;
@@ -916,11 +885,11 @@ fn pst_sweep_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
             let _e67 = j;
             let _e71 = j;
             let _e76 = j;
-            let v_8 = textureLoad(epipolar_samples, vec2<u32>((_e61.k[(_e67 / 2u)] + (_e71 % 2u)), _e61.slices[(_e76 / 2u)]), 0i);
+            let v_11 = textureLoad(epipolar_samples, vec2<u32>((_e61.k[(_e67 / 2u)] + (_e71 % 2u)), _e61.slices[(_e76 / 2u)]), 0i);
             let _e85 = j;
-            depths[_e85] = v_8.w;
+            depths[_e85] = v_11.w;
             let _e89 = j;
-            light[_e89] = v_8.xyz;
+            light[_e89] = v_11.xyz;
         }
         continuing {
             let _e93 = j;

@@ -194,15 +194,11 @@ float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapView
     return float3(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
 }
 
-float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
+float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
 {
-    if ((v_1.origin.w > 0.5)) {
-        float z_1 = max(ls.z, 1e-6);
-        float t_3 = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
-    } else {
-        return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+    float z_1 = max(ls.z, 1e-6);
+    float t_3 = v_1.proj.x;
+    return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
 }
 
 uint naga_f2u32(float value) {
@@ -211,95 +207,71 @@ uint naga_f2u32(float value) {
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
 {
-    bool local_4 = (bool)0;
-    bool local_5 = (bool)0;
-    bool local_6 = (bool)0;
-
-    if (!((uv.x < 0.0))) {
-        local_4 = (uv.x > 1.0);
-    } else {
-        local_4 = true;
-    }
-    bool _e11 = local_4;
-    if (!(_e11)) {
-        local_5 = (uv.y < 0.0);
-    } else {
-        local_5 = true;
-    }
-    bool _e19 = local_5;
-    if (!(_e19)) {
-        local_6 = (uv.y > 1.0);
-    } else {
-        local_6 = true;
-    }
-    bool _e27 = local_6;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_1 = v_2.size.x;
     uint x_7 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
     uint y_3 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_7, y_3), int(0)));
-    return _e49.x;
+    float4 _e36 = sm.Load(int3(uint2(x_7, y_3), int(0)));
+    return (outside ? 2.0 : _e36.x);
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
 {
-    float texel = (float)0;
-
-    float size = float(v_3.size.x);
-    if ((v_3.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_3.forward.w * _e32);
+    float texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / float(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, Texture2D<float4> sm_1, float3 p_1)
+float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, float3 ls_1)
 {
-    bool local_7 = (bool)0;
+    return float2(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
+}
 
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if ((v_4.origin.w > 0.5)) {
-        local_7 = (_e2.z <= near);
-    } else {
-        local_7 = false;
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5)
+{
+    float texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / float(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, Texture2D<float4> sm_1, float3 p_1, bool perspective)
+{
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        const float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        const float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = ((_e2.z - near) / (far - near));
+        const float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit_ = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return ((lit_ | (_e2.z <= near)) ? 1.0 : 0.0);
     }
-    bool _e16 = local_7;
-    if (_e16) {
-        return 1.0;
-    }
-    const float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    const float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = ((_e2.z - near) / (far - near));
-    const float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+    const float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = ((_e2.z - near) / (far - near));
+    const float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return ((depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0);
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_3, float b_3, float depth_break)
 {
-    bool local_8 = (bool)0;
+    bool local_4 = (bool)0;
 
     if (!((a_3 == b_3))) {
-        local_8 = (abs((a_3 - b_3)) <= (depth_break * min(a_3, b_3)));
+        local_4 = (abs((a_3 - b_3)) <= (depth_break * min(a_3, b_3)));
     } else {
-        local_8 = true;
+        local_4 = true;
     }
-    bool _e13 = local_8;
+    bool _e13 = local_4;
     return _e13;
 }
 
-float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 v_5)
+float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 v_7)
 {
-    float3 a_6 = min(abs(v_5), (65504.0).xxx);
+    float3 a_6 = min(abs(v_7), (65504.0).xxx);
     uint3 u_2 = asuint(a_6);
     float3 normal = asfloat((((u_2 + (4095u).xxx) + ((u_2 >> (13u).xxx) & (1u).xxx)) & (4294959104u).xxx));
     float3 subnormal = (round((a_6 * 16777216.0)) / (16777216.0).xxx);
-    return (sign(v_5) * ((a_6 < (6.1035156e-5).xxx) ? subnormal : normal));
+    return (sign(v_7) * ((a_6 < (6.1035156e-5).xxx) ? subnormal : normal));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float2 axis, float2 d)
@@ -311,18 +283,18 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
 {
     float2 origin = (float2)0;
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l = (EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
-    bool local_9 = (bool)0;
-    bool local_10 = (bool)0;
-    bool local_11 = (bool)0;
+    bool local_5 = (bool)0;
+    bool local_6 = (bool)0;
+    bool local_7 = (bool)0;
     float a_4 = 0.0;
     float b_4 = 0.0;
     uint k_5 = 0u;
 
-    float2 size_1 = float2(screen);
-    float2 centre = (0.5 * size_1);
+    float2 size = float2(screen);
+    float2 centre = (0.5 * size);
     float z_2 = dot(cam.toward, cam.forward);
     float2 q_1 = float2(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
-    float far_1 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
+    float far_1 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size.x, size.y));
     float lq = length(q_1);
     origin = centre;
     if ((lq >= (far_1 * abs(z_2)))) {
@@ -339,29 +311,29 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     float lc = length(to_centre);
     l.axis = ((lc > 0.0) ? (to_centre / (max(lc, 1e-30)).xx) : float2(1.0, 0.0));
     float2 lo = float2(0.5, 0.5);
-    float2 hi = (size_1 - float2(0.5, 0.5));
+    float2 hi = (size - float2(0.5, 0.5));
     float _e79 = origin.x;
     if ((_e79 >= lo.x)) {
         float _e83 = origin.x;
-        local_9 = (_e83 <= hi.x);
+        local_5 = (_e83 <= hi.x);
     } else {
-        local_9 = false;
+        local_5 = false;
     }
-    bool _e89 = local_9;
+    bool _e89 = local_5;
     if (_e89) {
         float _e91 = origin.y;
-        local_10 = (_e91 >= lo.y);
+        local_6 = (_e91 >= lo.y);
     } else {
-        local_10 = false;
+        local_6 = false;
     }
-    bool _e97 = local_10;
+    bool _e97 = local_6;
     if (_e97) {
         float _e99 = origin.y;
-        local_11 = (_e99 <= hi.y);
+        local_7 = (_e99 <= hi.y);
     } else {
-        local_11 = false;
+        local_7 = false;
     }
-    bool inside = local_11;
+    bool inside = local_7;
     if (inside) {
         l.wrap = 1u;
         l.phi_start = -3.1415927;
@@ -542,7 +514,7 @@ float3 raymarch_pixel(uint x_3, uint y_2)
                 w = _e64.y;
             }
             float _e67 = t_1;
-            const float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)));
+            const float _e71 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)), false);
             if (false) {
                 float _e73 = sum;
                 float _e74 = w;
@@ -572,8 +544,8 @@ float3 raymarch_pixel(uint x_3, uint y_2)
 
 uint2 line_bracket(uint k_7)
 {
-    uint v_6 = line_ab[min(uint(k_7), 255u)];
-    return uint2((v_6 & 65535u), (v_6 >> 16u));
+    uint v_8 = line_ab[min(uint(k_7), 255u)];
+    return uint2((v_8 & 65535u), (v_8 >> 16u));
 }
 
 bool line_marked(uint k_8)
@@ -788,15 +760,15 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 }
                 {
                     uint _e191 = k_2;
-                    uint v_7 = line_ab[min(uint((_e191 - 1u)), 255u)];
+                    uint v_9 = line_ab[min(uint((_e191 - 1u)), 255u)];
                     uint _e199 = k_2;
-                    if (((v_7 & 65535u) == (_e199 - 1u))) {
+                    if (((v_9 & 65535u) == (_e199 - 1u))) {
                         uint _e203 = k_2;
                         b = (_e203 - 1u);
                     } else {
                         uint _e206 = k_2;
                         uint _e213 = b;
-                        line_ab[min(uint((_e206 - 1u)), 255u)] = ((v_7 & 65535u) | (_e213 << 16u));
+                        line_ab[min(uint((_e206 - 1u)), 255u)] = ((v_9 & 65535u) | (_e213 << 16u));
                     }
                 }
             }

@@ -159,102 +159,72 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
     return vec3<f32>(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
 }
 
-fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
-    if (v_1.origin.w > 0.5f) {
-        let z_1 = max(ls.z, 0.000001f);
-        let t_3 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
-    } else {
-        return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
+    let z_1 = max(ls.z, 0.000001f);
+    let t_3 = v_1.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_4: bool;
-    var local_5: bool;
-    var local_6: bool;
-
-    if !((uv.x < 0f)) {
-        local_4 = (uv.x > 1f);
-    } else {
-        local_4 = true;
-    }
-    let _e11 = local_4;
-    if !(_e11) {
-        local_5 = (uv.y < 0f);
-    } else {
-        local_5 = true;
-    }
-    let _e19 = local_5;
-    if !(_e19) {
-        local_6 = (uv.y > 1f);
-    } else {
-        local_6 = true;
-    }
-    let _e27 = local_6;
-    if _e27 {
-        return 2f;
-    }
+    let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
     let x_7 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y_3 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_7, y_3), 0i);
-    return _e49.x;
+    let _e36 = textureLoad(sm, vec2<u32>(x_7, y_3), 0i);
+    return select(_e36.x, 2f, outside);
 }
 
-fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
-    var texel: f32;
-
-    let size = f32(v_3.size.x);
-    if (v_3.origin.w > 0.5f) {
-        texel = (((2f * max(z, 0f)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    let _e32 = texel;
-    return (v_3.forward.w * _e32);
+fn shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
+    let texel = (((2f * max(z, 0f)) * v_3.proj.x) / f32(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_7: bool;
+fn shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls_1: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
+}
 
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    let near = v_4.right.w;
-    let far = v_4.up.w;
-    if (v_4.origin.w > 0.5f) {
-        local_7 = (_e2.z <= near);
-    } else {
-        local_7 = false;
+fn shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) -> f32 {
+    let texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / f32(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>, perspective: bool) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    let near = v_6.right.w;
+    let far = v_6.up.w;
+    if perspective {
+        let _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        let _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        let depth_1 = ((_e2.z - near) / (far - near));
+        let _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        let lit = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return select(0f, 1f, (lit | (_e2.z <= near)));
     }
-    let _e16 = local_7;
-    if _e16 {
-        return 1f;
-    }
-    let _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    let _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    let depth_1 = ((_e2.z - near) / (far - near));
-    let _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
+    let _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    let depth_2 = ((_e2.z - near) / (far - near));
+    let _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return select(0f, 1f, (depth_2 <= (_e28 + (_e33 / (far - near)))));
 }
 
 fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_3: f32, b_3: f32, depth_break: f32) -> bool {
-    var local_8: bool;
+    var local_4: bool;
 
     if !((a_3 == b_3)) {
-        local_8 = (abs((a_3 - b_3)) <= (depth_break * min(a_3, b_3)));
+        local_4 = (abs((a_3 - b_3)) <= (depth_break * min(a_3, b_3)));
     } else {
-        local_8 = true;
+        local_4 = true;
     }
-    let _e13 = local_8;
+    let _e13 = local_4;
     return _e13;
 }
 
-fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_5: vec3<f32>) -> vec3<f32> {
-    let a_6 = min(abs(v_5), vec3(65504f));
+fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_7: vec3<f32>) -> vec3<f32> {
+    let a_6 = min(abs(v_7), vec3(65504f));
     let u_2 = bitcast<vec3<u32>>(a_6);
     let normal = bitcast<vec3<f32>>((((u_2 + vec3(4095u)) + ((u_2 >> vec3(13u)) & vec3(1u))) & vec3(4294959104u)));
     let subnormal = (round((a_6 * 16777216f)) / vec3(16777216f));
-    return (sign(v_5) * select(normal, subnormal, (a_6 < vec3(0.000061035156f))));
+    return (sign(v_7) * select(normal, subnormal, (a_6 < vec3(0.000061035156f))));
 }
 
 fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, d: vec2<f32>) -> f32 {
@@ -264,18 +234,18 @@ fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, 
 fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, screen: vec2<u32>, slices: u32) -> EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     var origin: vec2<f32>;
     var l: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
-    var local_9: bool;
-    var local_10: bool;
-    var local_11: bool;
+    var local_5: bool;
+    var local_6: bool;
+    var local_7: bool;
     var a_4: f32 = 0f;
     var b_4: f32 = 0f;
     var k_5: u32 = 0u;
 
-    let size_1 = vec2<f32>(screen);
-    let centre = (0.5f * size_1);
+    let size = vec2<f32>(screen);
+    let centre = (0.5f * size);
     let z_2 = dot(cam.toward, cam.forward);
     let q_1 = vec2<f32>(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
-    let far_1 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
+    let far_1 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size.x, size.y));
     let lq = length(q_1);
     origin = centre;
     if (lq >= (far_1 * abs(z_2))) {
@@ -292,29 +262,29 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     let lc = length(to_centre);
     l.axis = select(vec2<f32>(1f, 0f), (to_centre / vec2(max(lc, 0.000000000000000000000000000001f))), (lc > 0f));
     let lo = vec2<f32>(0.5f, 0.5f);
-    let hi = (size_1 - vec2<f32>(0.5f, 0.5f));
+    let hi = (size - vec2<f32>(0.5f, 0.5f));
     let _e79 = origin.x;
     if (_e79 >= lo.x) {
         let _e83 = origin.x;
-        local_9 = (_e83 <= hi.x);
+        local_5 = (_e83 <= hi.x);
     } else {
-        local_9 = false;
+        local_5 = false;
     }
-    let _e89 = local_9;
+    let _e89 = local_5;
     if _e89 {
         let _e91 = origin.y;
-        local_10 = (_e91 >= lo.y);
+        local_6 = (_e91 >= lo.y);
     } else {
-        local_10 = false;
+        local_6 = false;
     }
-    let _e97 = local_10;
+    let _e97 = local_6;
     if _e97 {
         let _e99 = origin.y;
-        local_11 = (_e99 <= hi.y);
+        local_7 = (_e99 <= hi.y);
     } else {
-        local_11 = false;
+        local_7 = false;
     }
-    let inside = local_11;
+    let inside = local_7;
     if inside {
         l.wrap = 1u;
         l.phi_start = -3.1415927f;
@@ -463,7 +433,7 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
                 w = _e64.y;
             }
             let _e67 = t_1;
-            let _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)));
+            let _e71 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)), false);
             if false {
                 let _e73 = sum;
                 let _e74 = w;
@@ -496,8 +466,8 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
 }
 
 fn line_bracket(k_7: u32) -> vec2<u32> {
-    let v_6 = line_ab[k_7];
-    return vec2<u32>((v_6 & 65535u), (v_6 >> 16u));
+    let v_8 = line_ab[k_7];
+    return vec2<u32>((v_8 & 65535u), (v_8 >> 16u));
 }
 
 fn line_marked(k_8: u32) -> bool {
@@ -661,15 +631,15 @@ fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_ind
                 }
                 {
                     let _e191 = k_2;
-                    let v_7 = line_ab[(_e191 - 1u)];
+                    let v_9 = line_ab[(_e191 - 1u)];
                     let _e199 = k_2;
-                    if ((v_7 & 65535u) == (_e199 - 1u)) {
+                    if ((v_9 & 65535u) == (_e199 - 1u)) {
                         let _e203 = k_2;
                         b = (_e203 - 1u);
                     } else {
                         let _e206 = k_2;
                         let _e213 = b;
-                        line_ab[(_e206 - 1u)] = ((v_7 & 65535u) | (_e213 << 16u));
+                        line_ab[(_e206 - 1u)] = ((v_9 & 65535u) | (_e213 << 16u));
                     }
                 }
                 continuing {

@@ -125,80 +125,53 @@ vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
     return vec3(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
 }
 
-vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
-    if ((v_1.origin.w > 0.5)) {
-        float z_1 = max(ls.z, 1e-6);
-        float t_3 = v_1.proj.x;
-        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
-    } else {
-        return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
+    float z_1 = max(ls.z, 1e-6);
+    float t_3 = v_1.proj.x;
+    return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
 }
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
-    bool local_1 = false;
-    bool local_2 = false;
-    bool local_3 = false;
-    if (!((uv.x < 0.0))) {
-        local_1 = (uv.x > 1.0);
-    } else {
-        local_1 = true;
-    }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = (uv.y < 0.0);
-    } else {
-        local_2 = true;
-    }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = (uv.y > 1.0);
-    } else {
-        local_3 = true;
-    }
-    bool _e27 = local_3;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = ((((uv.x < 0.0) || (uv.x > 1.0)) || (uv.y < 0.0)) || (uv.y > 1.0));
     uint n_1 = v_2.size.x;
     uint x_7 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
     uint y_3 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
-    int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_7, y_3)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
-    return _e49.x;
+    int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
+    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_7, y_3)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    return (outside ? 2.0 : _e36.x);
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
-    float texel = 0.0;
-    float size = float(v_3.size.x);
-    if ((v_3.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_3.forward.w * _e32);
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
+    float texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / float(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_1) {
-    bool local_4 = false;
-    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if ((v_4.origin.w > 0.5)) {
-        local_4 = (_e2.z <= near);
-    } else {
-        local_4 = false;
+vec2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, vec3 ls_1) {
+    return vec2(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
+}
+
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5) {
+    float texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / float(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, sampler2D sm_1, vec3 p_1, bool perspective) {
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        vec2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = ((_e2.z - near) / (far - near));
+        float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return ((lit || (_e2.z <= near)) ? 1.0 : 0.0);
     }
-    bool _e16 = local_4;
-    if (_e16) {
-        return 1.0;
-    }
-    vec2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = ((_e2.z - near) / (far - near));
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+    vec2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = ((_e2.z - near) / (far - near));
+    float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return ((depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0);
 }
 
 vec3 raymarch_pixel(uint x_3, uint y_2) {
@@ -252,7 +225,7 @@ vec3 raymarch_pixel(uint x_3, uint y_2) {
                 w = _e64.y;
             }
             float _e67 = t_1;
-            float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, _group_0_binding_2_cs, (eye_2 + (_e8 * _e67)));
+            float _e71 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, _group_0_binding_2_cs, (eye_2 + (_e8 * _e67)), false);
             if (false) {
                 float _e73 = sum;
                 float _e74 = w;

@@ -164,17 +164,13 @@ metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     return metal::float3(metal::dot(q, v.right.xyz), metal::dot(q, v.up.xyz), metal::dot(q, v.forward.xyz));
 }
 
-metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
     metal::float3 ls
 ) {
-    if (v_1.origin.w > 0.5) {
-        float z_1 = metal::max(ls.z, 0.000001);
-        float t_3 = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_3)), 0.5 - ((0.5 * ls.y) / (z_1 * t_3)));
-    } else {
-        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
-    }
+    float z_1 = metal::max(ls.z, 0.000001);
+    float t_3 = v_1.proj.x;
+    return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_3)), 0.5 - ((0.5 * ls.y) / (z_1 * t_3)));
 }
 
 uint naga_f2u32(float value) {
@@ -186,76 +182,59 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_1 = {};
-    bool local_2 = {};
-    bool local_3 = {};
-    if (!((uv.x < 0.0))) {
-        local_1 = uv.x > 1.0;
-    } else {
-        local_1 = true;
-    }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = uv.y < 0.0;
-    } else {
-        local_2 = true;
-    }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = uv.y > 1.0;
-    } else {
-        local_3 = true;
-    }
-    bool _e27 = local_3;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
     uint x_7 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y_3 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
-    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_7, y_3)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
-    return _e49.x;
+    uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_7, y_3)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    return outside ? 2.0 : _e36.x;
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
     float z
 ) {
-    float texel = {};
-    float size = static_cast<float>(v_3.size.x);
-    if (v_3.origin.w > 0.5) {
-        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
-    } else {
-        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
-    }
-    float _e32 = texel;
-    return v_3.forward.w * _e32;
+    float texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / static_cast<float>(v_3.size.x);
+    return v_3.forward.w * texel;
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
-    metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_1
+    metal::float3 ls_1
 ) {
-    bool local_4 = {};
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if (v_4.origin.w > 0.5) {
-        local_4 = _e2.z <= near;
-    } else {
-        local_4 = false;
+    return metal::float2((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x), (v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z));
+}
+
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5
+) {
+    float texel_1 = metal::max(v_5.proj.y - v_5.proj.x, v_5.proj.w - v_5.proj.z) / static_cast<float>(v_5.size.x);
+    return v_5.forward.w * texel_1;
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6,
+    metal::texture2d<float, metal::access::sample> sm_1,
+    metal::float3 p_1,
+    bool perspective
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        metal::float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = (_e2.z - near) / (far - near);
+        float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit = depth_1 <= (_e10 + (_e16 / (far - near)));
+        return (lit | (_e2.z <= near)) ? 1.0 : 0.0;
     }
-    bool _e16 = local_4;
-    if (_e16) {
-        return 1.0;
-    }
-    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = (_e2.z - near) / (far - near);
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
+    metal::float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = (_e2.z - near) / (far - near);
+    float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return (depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0;
 }
 
 uint naga_mod(uint lhs, uint rhs) {
@@ -322,7 +301,7 @@ metal::float3 raymarch_pixel(
                 w = _e64.y;
             }
             float _e67 = t_1;
-            float _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, eye_2 + (_e8 * _e67));
+            float _e71 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, eye_2 + (_e8 * _e67), false);
             if (false) {
                 float _e73 = sum;
                 float _e74 = w;

@@ -137,82 +137,52 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
     return vec3<f32>(dot(q, v.right.xyz), dot(q, v.up.xyz), dot(q, v.forward.xyz));
 }
 
-fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
-    if (v_1.origin.w > 0.5f) {
-        let z_1 = max(ls.z, 0.000001f);
-        let t_3 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
-    } else {
-        return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
+    let z_1 = max(ls.z, 0.000001f);
+    let t_3 = v_1.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local: bool;
-    var local_1: bool;
-    var local_2: bool;
-
-    if !((uv.x < 0f)) {
-        local = (uv.x > 1f);
-    } else {
-        local = true;
-    }
-    let _e11 = local;
-    if !(_e11) {
-        local_1 = (uv.y < 0f);
-    } else {
-        local_1 = true;
-    }
-    let _e19 = local_1;
-    if !(_e19) {
-        local_2 = (uv.y > 1f);
-    } else {
-        local_2 = true;
-    }
-    let _e27 = local_2;
-    if _e27 {
-        return 2f;
-    }
+    let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
     let x_7 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y_3 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_7, y_3), 0i);
-    return _e49.x;
+    let _e36 = textureLoad(sm, vec2<u32>(x_7, y_3), 0i);
+    return select(_e36.x, 2f, outside);
 }
 
-fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
-    var texel: f32;
-
-    let size = f32(v_3.size.x);
-    if (v_3.origin.w > 0.5f) {
-        texel = (((2f * max(z, 0f)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    let _e32 = texel;
-    return (v_3.forward.w * _e32);
+fn shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
+    let texel = (((2f * max(z, 0f)) * v_3.proj.x) / f32(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_3: bool;
+fn shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls_1: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
+}
 
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    let near = v_4.right.w;
-    let far = v_4.up.w;
-    if (v_4.origin.w > 0.5f) {
-        local_3 = (_e2.z <= near);
-    } else {
-        local_3 = false;
+fn shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) -> f32 {
+    let texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / f32(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>, perspective: bool) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    let near = v_6.right.w;
+    let far = v_6.up.w;
+    if perspective {
+        let _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        let _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        let depth_1 = ((_e2.z - near) / (far - near));
+        let _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        let lit = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return select(0f, 1f, (lit | (_e2.z <= near)));
     }
-    let _e16 = local_3;
-    if _e16 {
-        return 1f;
-    }
-    let _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    let _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    let depth_1 = ((_e2.z - near) / (far - near));
-    let _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
+    let _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    let depth_2 = ((_e2.z - near) / (far - near));
+    let _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return select(0f, 1f, (depth_2 <= (_e28 + (_e33 / (far - near)))));
 }
 
 fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
@@ -260,7 +230,7 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
                 w = _e64.y;
             }
             let _e67 = t_1;
-            let _e71 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)));
+            let _e71 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)), false);
             if false {
                 let _e73 = sum;
                 let _e74 = w;

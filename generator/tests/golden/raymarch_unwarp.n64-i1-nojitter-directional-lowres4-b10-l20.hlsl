@@ -297,15 +297,11 @@ float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapView
     return float3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
-float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
+float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
 {
-    if ((v_1.origin.w > 0.5)) {
-        float z_1 = max(ls.z, 1e-6);
-        float t_4 = v_1.proj.x;
-        return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_4))), (0.5 - ((0.5 * ls.y) / (z_1 * t_4))));
-    } else {
-        return float2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+    float z_1 = max(ls.z, 1e-6);
+    float t_4 = v_1.proj.x;
+    return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_4))), (0.5 - ((0.5 * ls.y) / (z_1 * t_4))));
 }
 
 uint naga_f2u32(float value) {
@@ -314,73 +310,49 @@ uint naga_f2u32(float value) {
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
 {
-    bool local_4 = (bool)0;
-    bool local_5 = (bool)0;
-    bool local_6 = (bool)0;
-
-    if (!((uv.x < 0.0))) {
-        local_4 = (uv.x > 1.0);
-    } else {
-        local_4 = true;
-    }
-    bool _e11 = local_4;
-    if (!(_e11)) {
-        local_5 = (uv.y < 0.0);
-    } else {
-        local_5 = true;
-    }
-    bool _e19 = local_5;
-    if (!(_e19)) {
-        local_6 = (uv.y > 1.0);
-    } else {
-        local_6 = true;
-    }
-    bool _e27 = local_6;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_1 = v_2.size.x;
     uint x_7 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
     uint y_3 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e49 = sm.Load(int3(uint2(x_7, y_3), int(0)));
-    return _e49.x;
+    float4 _e36 = sm.Load(int3(uint2(x_7, y_3), int(0)));
+    return (outside ? 2.0 : _e36.x);
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
 {
-    float texel = (float)0;
-
-    float size = float(v_3.size.x);
-    if ((v_3.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_3.forward.w * _e32);
+    float texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / float(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, Texture2D<float4> sm_1, float3 p_2)
+float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, float3 ls_1)
 {
-    bool local_7 = (bool)0;
+    return float2(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
+}
 
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_2);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if ((v_4.origin.w > 0.5)) {
-        local_7 = (_e2.z <= near);
-    } else {
-        local_7 = false;
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5)
+{
+    float texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / float(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, Texture2D<float4> sm_1, float3 p_2, bool perspective)
+{
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_2);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        const float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        const float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = ((_e2.z - near) / (far - near));
+        const float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit_ = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return ((lit_ | (_e2.z <= near)) ? 1.0 : 0.0);
     }
-    bool _e16 = local_7;
-    if (_e16) {
-        return 1.0;
-    }
-    const float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    const float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = ((_e2.z - near) / (far - near));
-    const float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+    const float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = ((_e2.z - near) / (far - near));
+    const float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return ((depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0);
 }
 
 void unwarp_pixel(uint2 q, float4 w_1, float4 depths_2, float3 light_2[4])
@@ -445,11 +417,11 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
         {
             uint _e32 = j;
             uint _e37 = j;
-            float4 v_5 = lowres_samples.Load(int3(uint2(_e26.cols[min(uint(naga_mod(_e32, 2u)), 1u)], _e26.rows[min(uint(naga_div(_e37, 2u)), 1u)]), int(0)));
+            float4 v_7 = lowres_samples.Load(int3(uint2(_e26.cols[min(uint(naga_mod(_e32, 2u)), 1u)], _e26.rows[min(uint(naga_div(_e37, 2u)), 1u)]), int(0)));
             uint _e46 = j;
-            depths[min(uint(_e46), 3u)] = v_5.w;
+            depths[min(uint(_e46), 3u)] = v_7.w;
             uint _e50 = j;
-            light[min(uint(_e50), 3u)] = v_5.xyz;
+            light[min(uint(_e50), 3u)] = v_7.xyz;
         }
     }
     float4 _e57 = depths;

@@ -77,17 +77,13 @@ metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
 }
 
-metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
     metal::float3 ls
 ) {
-    if (v_1.origin.w > 0.5) {
-        float z_1 = metal::max(ls.z, 0.000001);
-        float t_3 = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_3)), 0.5 - ((0.5 * ls.y) / (z_1 * t_3)));
-    } else {
-        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
-    }
+    float z_1 = metal::max(ls.z, 0.000001);
+    float t_3 = v_1.proj.x;
+    return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_3)), 0.5 - ((0.5 * ls.y) / (z_1 * t_3)));
 }
 
 uint naga_f2u32(float value) {
@@ -99,110 +95,95 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_1 = {};
-    bool local_2 = {};
-    bool local_3 = {};
-    if (!((uv.x < 0.0))) {
-        local_1 = uv.x > 1.0;
-    } else {
-        local_1 = true;
-    }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = uv.y < 0.0;
-    } else {
-        local_2 = true;
-    }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = uv.y > 1.0;
-    } else {
-        local_3 = true;
-    }
-    bool _e27 = local_3;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
     uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y_2 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
-    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y_2)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
-    return _e49.x;
+    uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y_2)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    return outside ? 2.0 : _e36.x;
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
     float z
 ) {
-    float texel = {};
-    float size = static_cast<float>(v_3.size.x);
-    if (v_3.origin.w > 0.5) {
-        texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / size;
-    } else {
-        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
-    }
-    float _e32 = texel;
-    return v_3.forward.w * _e32;
+    float texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / static_cast<float>(v_3.size.x);
+    return v_3.forward.w * texel;
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
-    metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_1
+    metal::float3 ls_1
 ) {
-    bool local_4 = {};
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if (v_4.origin.w > 0.5) {
-        local_4 = _e2.z <= near;
-    } else {
-        local_4 = false;
-    }
-    bool _e16 = local_4;
-    if (_e16) {
-        return 1.0;
-    }
-    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = (_e2.z - near) / (far - near);
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return (depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
+    return metal::float2((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x), (v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z));
 }
 
-float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5,
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5
+) {
+    float texel_1 = metal::max(v_5.proj.y - v_5.proj.x, v_5.proj.w - v_5.proj.z) / static_cast<float>(v_5.size.x);
+    return v_5.forward.w * texel_1;
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6,
+    metal::texture2d<float, metal::access::sample> sm_1,
+    metal::float3 p_1,
+    bool perspective
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        metal::float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = (_e2.z - near) / (far - near);
+        float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit = depth_1 <= (_e10 + (_e16 / (far - near)));
+        return (lit | (_e2.z <= near)) ? 1.0 : 0.0;
+    }
+    metal::float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = (_e2.z - near) / (far - near);
+    float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return (depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0;
+}
+
+float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7,
     metal::texture2d<float, metal::access::sample> sm_2,
-    metal::float3 o,
     metal::float3 l
 ) {
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    float near_1 = v_5.right.w;
-    float far_1 = v_5.up.w;
-    if (v_5.origin.w > 0.5) {
-        metal::float3 dir_9 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_9.z <= 0.000001) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_9);
-        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if (_e28 >= 1.0) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_2 = near_1 + (_e28 * (far_1 - near_1));
-        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return (z_2 + _e35) / dir_9.z;
-    } else {
-        metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if (_e40 >= 1.0) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_3 = near_1 + (_e40 * (far_1 - near_1));
-        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return (z_3 + _e47) - _e2.z;
+    float near_1 = v_7.right.w;
+    float far_1 = v_7.up.w;
+    metal::float3 dir_9 = metal::float3(metal::dot(l, v_7.right.xyz), metal::dot(l, v_7.up.xyz), metal::dot(l, v_7.forward.xyz));
+    if (dir_9.z <= 0.000001) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
     }
+    metal::float2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_9);
+    float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if (_e22 >= 1.0) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    float z_2 = near_1 + (_e22 * (far_1 - near_1));
+    float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_2);
+    return (z_2 + _e29) / dir_9.z;
+}
+
+float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8,
+    metal::texture2d<float, metal::access::sample> sm_3,
+    metal::float3 o
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    float near_2 = v_8.right.w;
+    float far_2 = v_8.up.w;
+    metal::float2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    float z_3 = near_2 + (_e9 * (far_2 - near_2));
+    float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return (_e9 >= 1.0) ? NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX : ((z_3 + _e13) - _e2.z);
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -356,9 +337,9 @@ metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 }
 
 SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    metal::float4 v_6
+    metal::float4 v_9
 ) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {v_6.x, v_6.y, v_6.z, v_6.w};
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {v_9.x, v_9.y, v_9.z, v_9.w};
 }
 
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -388,12 +369,13 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XON
 
 float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
-    metal::texture2d<float, metal::access::sample> sm_3,
-    metal::float3 p_2
+    metal::texture2d<float, metal::access::sample> sm_4,
+    metal::float3 p_2,
+    bool spot
 ) {
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2);
-    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
+    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_2, spot);
+    return _e5;
 }
 
 float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -408,13 +390,13 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 
 float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
-    metal::texture2d<float, metal::access::sample> sm_4,
+    metal::texture2d<float, metal::access::sample> sm_5,
     metal::float3 eye_4,
     metal::float3 dir_4,
     float a_3,
     float b_3,
     uint steps,
-    bool spot
+    bool spot_1
 ) {
     float sum_1 = 0.0;
     uint k_1 = 0u;
@@ -441,15 +423,15 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
             uint _e17 = k_1;
             t_2 = a_3 + ((static_cast<float>(_e17) + 0.5) * h_2);
             w = h_2;
-            if (spot) {
+            if (spot_1) {
                 uint _e26 = k_1;
                 metal::float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e26) + 0.5);
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, eye_4 + (dir_4 * _e33));
-            if (spot) {
+            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, eye_4 + (dir_4 * _e33), spot_1);
+            if (spot_1) {
                 float _e39 = sum_1;
                 float _e40 = w;
                 float _e42 = t_2;
@@ -470,14 +452,14 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
-    metal::texture2d<float, metal::access::sample> sm_5,
+    metal::texture2d<float, metal::access::sample> sm_6,
     metal::float3 eye_5,
     metal::float3 dir_5,
     float s,
-    bool spot_1
+    bool spot_2
 ) {
-    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_5, dir_5, 0.0, s, f_5.sizes2_.y, spot_1);
-    if (spot_1) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_6, eye_5, dir_5, 0.0, s, f_5.sizes2_.y, spot_2);
+    if (spot_2) {
         return _e9;
     } else {
         float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(metal::dot(f_5.light_dir.xyz, dir_5)));
@@ -513,18 +495,18 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float delta,
     float theta_1,
     float s_1,
-    bool spot_2
+    bool spot_3
 ) {
-    bool local_5 = {};
-    if (spot_2) {
+    bool local_1 = {};
+    if (spot_3) {
         float psi = x_2 * delta;
         float den = metal::sin(theta_1 + psi);
         if (!((den <= 0.000001))) {
-            local_5 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_1 = (theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local_5 = true;
+            local_1 = true;
         }
-        bool _e16 = local_5;
+        bool _e16 = local_1;
         if (_e16) {
             return s_1;
         }
@@ -560,9 +542,9 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float3 dir_7,
     float s_2,
     float theta_2,
-    bool spot_3
+    bool spot_4
 ) {
-    if (spot_3) {
+    if (spot_4) {
         metal::float3 q_2 = (eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz;
         metal::float3 to_eye = -(f_8.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
@@ -633,9 +615,9 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     uint r,
     uint regions,
     uint width,
-    bool spot_4
+    bool spot_5
 ) {
-    if (spot_4) {
+    if (spot_5) {
         return naga_div(r * width, regions);
     }
     return naga_div((r * r) * width, regions * regions);
@@ -652,9 +634,9 @@ metal::float3 scatter_pixel(
     metal::texture2d<float, metal::access::sample> bounds,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    bool local_6 = {};
-    bool local_7 = {};
-    bool local_8 = {};
+    bool local_2 = {};
+    bool local_3 = {};
+    bool local_4 = {};
     float yc_1 = {};
     float d = {};
     float xs = 0.0;
@@ -672,8 +654,8 @@ metal::float3 scatter_pixel(
     bool done0_ = false;
     bool done1_ = false;
     uint r_1 = 0u;
-    bool local_9 = {};
-    bool local_10 = {};
+    bool local_5 = {};
+    bool local_6 = {};
     float a0_ = {};
     float e0_ = {};
     float a1_ = {};
@@ -682,14 +664,14 @@ metal::float3 scatter_pixel(
     float weight1_ = {};
     float vis0_ = {};
     float vis1_ = {};
-    bool local_11 = {};
-    bool local_12 = {};
-    bool local_13 = {};
+    bool local_7 = {};
+    bool local_8 = {};
+    bool local_9 = {};
     uint layer_2 = {};
     uint k_3 = {};
-    bool local_14 = {};
-    bool local_15 = {};
-    bool local_16 = {};
+    bool local_10 = {};
+    bool local_11 = {};
+    bool local_12 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
     metal::float3 eye_8 = f_12.eye.xyz;
     metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_3, y_1);
@@ -700,23 +682,23 @@ metal::float3 scatter_pixel(
     metal::float3 px = metal::float3(static_cast<float>(x_3) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
     float radius = f_12.epipole.w;
     if (f_12.epipole.z > 0.5) {
-        local_6 = metal::length(px - metal::float3(f_12.epipole.x, f_12.epipole.y, 0.0)) < radius;
+        local_2 = metal::length(px - metal::float3(f_12.epipole.x, f_12.epipole.y, 0.0)) < radius;
     } else {
-        local_6 = false;
+        local_2 = false;
     }
-    bool near_epi = local_6;
+    bool near_epi = local_2;
     if (f_12.anti_epipole.z > 0.5) {
-        local_7 = metal::length(px - metal::float3(f_12.anti_epipole.x, f_12.anti_epipole.y, 0.0)) < radius;
+        local_3 = metal::length(px - metal::float3(f_12.anti_epipole.x, f_12.anti_epipole.y, 0.0)) < radius;
     } else {
-        local_7 = false;
+        local_3 = false;
     }
-    bool near_anti = local_7;
+    bool near_anti = local_3;
     if (!(near_epi)) {
-        local_8 = near_anti;
+        local_4 = near_anti;
     } else {
-        local_8 = true;
+        local_4 = true;
     }
-    bool _e77 = local_8;
+    bool _e77 = local_4;
     if (_e77) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = frame;
         float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_8, _e10, s_3, false);
@@ -827,18 +809,18 @@ metal::float3 scatter_pixel(
             float b1_ = static_cast<float>(_e222);
             if (!((last0_ < naga_f2u32(b1_)))) {
                 uint _e227 = r_1;
-                local_9 = (_e227 + 1u) == REGIONS;
+                local_5 = (_e227 + 1u) == REGIONS;
             } else {
-                local_9 = true;
+                local_5 = true;
             }
-            bool is_last0_ = local_9;
+            bool is_last0_ = local_5;
             if (!((last1_ < naga_f2u32(b1_)))) {
                 uint _e238 = r_1;
-                local_10 = (_e238 + 1u) == REGIONS;
+                local_6 = (_e238 + 1u) == REGIONS;
             } else {
-                local_10 = true;
+                local_6 = true;
             }
-            bool is_last1_ = local_10;
+            bool is_last1_ = local_6;
             float _e248 = xs0_;
             float pos0_ = is_last0_ ? metal::clamp(_e248 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
             float _e259 = xs1_;
@@ -901,25 +883,25 @@ metal::float3 scatter_pixel(
             float _e362 = d;
             if (_e362 > lohi0_.x) {
                 float _e365 = d;
-                local_11 = _e365 <= lohi0_.y;
+                local_7 = _e365 <= lohi0_.y;
             } else {
-                local_11 = false;
+                local_7 = false;
             }
-            bool _e371 = local_11;
+            bool _e371 = local_7;
             if (!(_e371)) {
                 float _e373 = d;
                 if (_e373 > lohi1_.x) {
                     float _e376 = d;
-                    local_13 = _e376 <= lohi1_.y;
+                    local_9 = _e376 <= lohi1_.y;
                 } else {
-                    local_13 = false;
+                    local_9 = false;
                 }
-                bool _e382 = local_13;
-                local_12 = _e382;
+                bool _e382 = local_9;
+                local_8 = _e382;
             } else {
-                local_12 = true;
+                local_8 = true;
             }
-            bool _e386 = local_12;
+            bool _e386 = local_8;
             if (_e386) {
                 layer_2 = 0u;
                 uint2 loop_bound_5 = uint2(4294967295u);
@@ -1008,28 +990,28 @@ metal::float3 scatter_pixel(
             }
             bool _e496 = done0_;
             if (!(_e496)) {
-                local_14 = is_last0_;
+                local_10 = is_last0_;
             } else {
-                local_14 = true;
+                local_10 = true;
             }
-            bool _e501 = local_14;
+            bool _e501 = local_10;
             done0_ = _e501;
             bool _e502 = done1_;
             if (!(_e502)) {
-                local_15 = is_last1_;
+                local_11 = is_last1_;
             } else {
-                local_15 = true;
+                local_11 = true;
             }
-            bool _e507 = local_15;
+            bool _e507 = local_11;
             done1_ = _e507;
             bool _e508 = done0_;
             if (_e508) {
                 bool _e509 = done1_;
-                local_16 = _e509;
+                local_12 = _e509;
             } else {
-                local_16 = false;
+                local_12 = false;
             }
-            bool _e513 = local_16;
+            bool _e513 = local_12;
             if (_e513) {
                 break;
             }

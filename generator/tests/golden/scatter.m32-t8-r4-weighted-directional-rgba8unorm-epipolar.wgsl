@@ -79,111 +79,80 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
     return vec3<f32>(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
-fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
-    if (v_1.origin.w > 0.5f) {
-        let z_1 = max(ls.z, 0.000001f);
-        let t_3 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
-    } else {
-        return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
+    let z_1 = max(ls.z, 0.000001f);
+    let t_3 = v_1.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_1: bool;
-    var local_2: bool;
-    var local_3: bool;
-
-    if !((uv.x < 0f)) {
-        local_1 = (uv.x > 1f);
-    } else {
-        local_1 = true;
-    }
-    let _e11 = local_1;
-    if !(_e11) {
-        local_2 = (uv.y < 0f);
-    } else {
-        local_2 = true;
-    }
-    let _e19 = local_2;
-    if !(_e19) {
-        local_3 = (uv.y > 1f);
-    } else {
-        local_3 = true;
-    }
-    let _e27 = local_3;
-    if _e27 {
-        return 2f;
-    }
+    let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
     let x_4 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y_2 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_4, y_2), 0i);
-    return _e49.x;
+    let _e36 = textureLoad(sm, vec2<u32>(x_4, y_2), 0i);
+    return select(_e36.x, 2f, outside);
 }
 
-fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
-    var texel: f32;
-
-    let size = f32(v_3.size.x);
-    if (v_3.origin.w > 0.5f) {
-        texel = (((2f * max(z, 0f)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    let _e32 = texel;
-    return (v_3.forward.w * _e32);
+fn shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
+    let texel = (((2f * max(z, 0f)) * v_3.proj.x) / f32(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_4: bool;
-
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    let near = v_4.right.w;
-    let far = v_4.up.w;
-    if (v_4.origin.w > 0.5f) {
-        local_4 = (_e2.z <= near);
-    } else {
-        local_4 = false;
-    }
-    let _e16 = local_4;
-    if _e16 {
-        return 1f;
-    }
-    let _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    let _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    let depth_1 = ((_e2.z - near) / (far - near));
-    let _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far - near)))));
+fn shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls_1: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
 }
 
-fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    let near_1 = v_5.right.w;
-    let far_1 = v_5.up.w;
-    if (v_5.origin.w > 0.5f) {
-        let dir_9 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_9.z <= 0.000001f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_9);
-        let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if (_e28 >= 1f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let z_2 = (near_1 + (_e28 * (far_1 - near_1)));
-        let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_9.z);
-    } else {
-        let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if (_e40 >= 1f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let z_3 = (near_1 + (_e40 * (far_1 - near_1)));
-        let _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e47) - _e2.z);
+fn shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) -> f32 {
+    let texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / f32(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>, perspective: bool) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    let near = v_6.right.w;
+    let far = v_6.up.w;
+    if perspective {
+        let _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        let _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        let depth_1 = ((_e2.z - near) / (far - near));
+        let _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        let lit = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return select(0f, 1f, (lit | (_e2.z <= near)));
     }
+    let _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    let depth_2 = ((_e2.z - near) / (far - near));
+    let _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return select(0f, 1f, (depth_2 <= (_e28 + (_e33 / (far - near)))));
+}
+
+fn shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, l: vec3<f32>) -> f32 {
+    let near_1 = v_7.right.w;
+    let far_1 = v_7.up.w;
+    let dir_9 = vec3<f32>(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+    if (dir_9.z <= 0.000001f) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    let _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_9);
+    let _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if (_e22 >= 1f) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    let z_2 = (near_1 + (_e22 * (far_1 - near_1)));
+    let _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_2);
+    return ((z_2 + _e29) / dir_9.z);
+}
+
+fn shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_3: texture_2d<f32>, o: vec3<f32>) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    let near_2 = v_8.right.w;
+    let far_2 = v_8.up.w;
+    let _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    let _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    let z_3 = (near_2 + (_e9 * (far_2 - near_2)));
+    let _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return select(((z_3 + _e13) - _e2.z), NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, (_e9 >= 1f));
 }
 
 fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
@@ -283,8 +252,8 @@ fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_na
     return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
-fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9.x, v_9.y, v_9.z, v_9.w);
 }
 
 fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta: f32, lo: f32, hi: f32) -> f32 {
@@ -302,10 +271,10 @@ fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_1.sm_right, f_1.sm_up, f_1.sm_forward, f_1.sm_origin, f_1.sm_proj, vec4<u32>(f_1.sizes2_.x, 0u, 0u, 0u));
 }
 
-fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_3: texture_2d<f32>, p_2: vec3<f32>) -> f32 {
+fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, p_2: vec3<f32>, spot: bool) -> f32 {
     let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2);
-    let _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
+    let _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_2, spot);
+    return _e5;
 }
 
 fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_3: vec3<f32>, dir_3: vec3<f32>, t_1: f32) -> f32 {
@@ -313,7 +282,7 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX
     return _e13;
 }
 
-fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot_1: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_1: u32 = 0u;
     var t_2: f32;
@@ -331,15 +300,15 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_
             let _e17 = k_1;
             t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_2));
             w = h_2;
-            if spot {
+            if spot_1 {
                 let _e26 = k_1;
                 let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             let _e33 = t_2;
-            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e33)));
-            if spot {
+            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            if spot_1 {
                 let _e39 = sum_1;
                 let _e40 = w;
                 let _e42 = t_2;
@@ -362,9 +331,9 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_
     return _e65;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_1: bool) -> f32 {
-    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_5, dir_5, 0f, s, f_5.sizes2_.y, spot_1);
-    if spot_1 {
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
+    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_6, eye_5, dir_5, 0f, s, f_5.sizes2_.y, spot_2);
+    if spot_2 {
         return _e9;
     } else {
         let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_5)));
@@ -381,18 +350,18 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_2: bool) -> f32 {
-    var local_5: bool;
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_3: bool) -> f32 {
+    var local_1: bool;
 
-    if spot_2 {
+    if spot_3 {
         let psi = (x_2 * delta);
         let den = sin((theta_1 + psi));
         if !((den <= 0.000001f)) {
-            local_5 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_1 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_5 = true;
+            local_1 = true;
         }
-        let _e16 = local_5;
+        let _e16 = local_1;
         if _e16 {
             return s_1;
         }
@@ -420,8 +389,8 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_o
     return _e34;
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_3: bool) -> f32 {
-    if spot_3 {
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_4: bool) -> f32 {
+    if spot_4 {
         let q_2 = ((eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz);
         let to_eye = -(f_8.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
@@ -460,17 +429,17 @@ fn coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_6: vec2<f32>, b_6: 
     return vec4<f32>(((2f / _e5) * a_6.y), ((-2f / _e5) * a_6.x), ((2f / _e10) * b_6.y), ((-2f / _e10) * b_6.x));
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_4: bool) -> u32 {
-    if spot_4 {
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_5: bool) -> u32 {
+    if spot_5 {
         return ((r * width) / regions);
     }
     return (((r * r) * width) / (regions * regions));
 }
 
 fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
-    var local_6: bool;
-    var local_7: bool;
-    var local_8: bool;
+    var local_2: bool;
+    var local_3: bool;
+    var local_4: bool;
     var yc_1: f32;
     var d: f32;
     var xs: f32 = 0f;
@@ -488,8 +457,8 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     var done0_: bool = false;
     var done1_: bool = false;
     var r_1: u32 = 0u;
-    var local_9: bool;
-    var local_10: bool;
+    var local_5: bool;
+    var local_6: bool;
     var a0_: f32;
     var e0_: f32;
     var a1_: f32;
@@ -498,14 +467,14 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     var weight1_: f32;
     var vis0_: f32;
     var vis1_: f32;
-    var local_11: bool;
-    var local_12: bool;
-    var local_13: bool;
+    var local_7: bool;
+    var local_8: bool;
+    var local_9: bool;
     var layer_2: u32;
     var k_3: u32;
-    var local_14: bool;
-    var local_15: bool;
-    var local_16: bool;
+    var local_10: bool;
+    var local_11: bool;
+    var local_12: bool;
 
     let f_12 = frame;
     let eye_8 = f_12.eye.xyz;
@@ -516,23 +485,23 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     let px = vec3<f32>((f32(x_3) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_12.epipole.w;
     if (f_12.epipole.z > 0.5f) {
-        local_6 = (length((px - vec3<f32>(f_12.epipole.x, f_12.epipole.y, 0f))) < radius);
+        local_2 = (length((px - vec3<f32>(f_12.epipole.x, f_12.epipole.y, 0f))) < radius);
     } else {
-        local_6 = false;
+        local_2 = false;
     }
-    let near_epi = local_6;
+    let near_epi = local_2;
     if (f_12.anti_epipole.z > 0.5f) {
-        local_7 = (length((px - vec3<f32>(f_12.anti_epipole.x, f_12.anti_epipole.y, 0f))) < radius);
+        local_3 = (length((px - vec3<f32>(f_12.anti_epipole.x, f_12.anti_epipole.y, 0f))) < radius);
     } else {
-        local_7 = false;
+        local_3 = false;
     }
-    let near_anti = local_7;
+    let near_anti = local_3;
     if !(near_epi) {
-        local_8 = near_anti;
+        local_4 = near_anti;
     } else {
-        local_8 = true;
+        local_4 = true;
     }
-    let _e77 = local_8;
+    let _e77 = local_4;
     if _e77 {
         let _e79 = frame;
         let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_8, _e10, s_3, false);
@@ -629,18 +598,18 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
             let b1_ = f32(_e222);
             if !((last0_ < u32(b1_))) {
                 let _e227 = r_1;
-                local_9 = ((_e227 + 1u) == REGIONS);
+                local_5 = ((_e227 + 1u) == REGIONS);
             } else {
-                local_9 = true;
+                local_5 = true;
             }
-            let is_last0_ = local_9;
+            let is_last0_ = local_5;
             if !((last1_ < u32(b1_))) {
                 let _e238 = r_1;
-                local_10 = ((_e238 + 1u) == REGIONS);
+                local_6 = ((_e238 + 1u) == REGIONS);
             } else {
-                local_10 = true;
+                local_6 = true;
             }
-            let is_last1_ = local_10;
+            let is_last1_ = local_6;
             let _e248 = xs0_;
             let pos0_ = select((b1_ - 0.5f), clamp((_e248 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
             let _e259 = xs1_;
@@ -701,25 +670,25 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
             let _e362 = d;
             if (_e362 > lohi0_.x) {
                 let _e365 = d;
-                local_11 = (_e365 <= lohi0_.y);
+                local_7 = (_e365 <= lohi0_.y);
             } else {
-                local_11 = false;
+                local_7 = false;
             }
-            let _e371 = local_11;
+            let _e371 = local_7;
             if !(_e371) {
                 let _e373 = d;
                 if (_e373 > lohi1_.x) {
                     let _e376 = d;
-                    local_13 = (_e376 <= lohi1_.y);
+                    local_9 = (_e376 <= lohi1_.y);
                 } else {
-                    local_13 = false;
+                    local_9 = false;
                 }
-                let _e382 = local_13;
-                local_12 = _e382;
+                let _e382 = local_9;
+                local_8 = _e382;
             } else {
-                local_12 = true;
+                local_8 = true;
             }
-            let _e386 = local_12;
+            let _e386 = local_8;
             if _e386 {
                 layer_2 = 0u;
                 loop {
@@ -794,28 +763,28 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
             }
             let _e496 = done0_;
             if !(_e496) {
-                local_14 = is_last0_;
+                local_10 = is_last0_;
             } else {
-                local_14 = true;
+                local_10 = true;
             }
-            let _e501 = local_14;
+            let _e501 = local_10;
             done0_ = _e501;
             let _e502 = done1_;
             if !(_e502) {
-                local_15 = is_last1_;
+                local_11 = is_last1_;
             } else {
-                local_15 = true;
+                local_11 = true;
             }
-            let _e507 = local_15;
+            let _e507 = local_11;
             done1_ = _e507;
             let _e508 = done0_;
             if _e508 {
                 let _e509 = done1_;
-                local_16 = _e509;
+                local_12 = _e509;
             } else {
-                local_16 = false;
+                local_12 = false;
             }
-            let _e513 = local_16;
+            let _e513 = local_12;
             if _e513 {
                 break;
             }

@@ -86,111 +86,80 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
     return vec3<f32>(dot(q_2, v.right.xyz), dot(q_2, v.up.xyz), dot(q_2, v.forward.xyz));
 }
 
-fn shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
-    if (v_1.origin.w > 0.5f) {
-        let z_2 = max(ls.z, 0.000001f);
-        let t_3 = v_1.proj.x;
-        return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_2 * t_3))), (0.5f - ((0.5f * ls.y) / (z_2 * t_3))));
-    } else {
-        return vec2<f32>(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
+    let z_2 = max(ls.z, 0.000001f);
+    let t_3 = v_1.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_2 * t_3))), (0.5f - ((0.5f * ls.y) / (z_2 * t_3))));
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    var local_1: bool;
-    var local_2: bool;
-    var local_3: bool;
-
-    if !((uv.x < 0f)) {
-        local_1 = (uv.x > 1f);
-    } else {
-        local_1 = true;
-    }
-    let _e11 = local_1;
-    if !(_e11) {
-        local_2 = (uv.y < 0f);
-    } else {
-        local_2 = true;
-    }
-    let _e19 = local_2;
-    if !(_e19) {
-        local_3 = (uv.y > 1f);
-    } else {
-        local_3 = true;
-    }
-    let _e27 = local_3;
-    if _e27 {
-        return 2f;
-    }
+    let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
     let x_7 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y_2 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e49 = textureLoad(sm, vec2<u32>(x_7, y_2), 0i);
-    return _e49.x;
+    let _e36 = textureLoad(sm, vec2<u32>(x_7, y_2), 0i);
+    return select(_e36.x, 2f, outside);
 }
 
-fn shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
-    var texel: f32;
-
-    let size = f32(v_3.size.x);
-    if (v_3.origin.w > 0.5f) {
-        texel = (((2f * max(z, 0f)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    let _e32 = texel;
-    return (v_3.forward.w * _e32);
+fn shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
+    let texel = (((2f * max(z, 0f)) * v_3.proj.x) / f32(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-fn shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>) -> f32 {
-    var local_4: bool;
-
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    let near = v_4.right.w;
-    let far_1 = v_4.up.w;
-    if (v_4.origin.w > 0.5f) {
-        local_4 = (_e2.z <= near);
-    } else {
-        local_4 = false;
-    }
-    let _e16 = local_4;
-    if _e16 {
-        return 1f;
-    }
-    let _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    let _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    let depth_1 = ((_e2.z - near) / (far_1 - near));
-    let _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return select(0f, 1f, (depth_1 <= (_e20 + (_e26 / (far_1 - near)))));
+fn shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls_1: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
 }
 
-fn shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    let near_1 = v_5.right.w;
-    let far_2 = v_5.up.w;
-    if (v_5.origin.w > 0.5f) {
-        let dir_9 = vec3<f32>(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if (dir_9.z <= 0.000001f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_9);
-        let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if (_e28 >= 1f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let z_3 = (near_1 + (_e28 * (far_2 - near_1)));
-        let _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e35) / dir_9.z);
-    } else {
-        let _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        let _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if (_e40 >= 1f) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        let z_4 = (near_1 + (_e40 * (far_2 - near_1)));
-        let _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_4);
-        return ((z_4 + _e47) - _e2.z);
+fn shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) -> f32 {
+    let texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / f32(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>, perspective: bool) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    let near = v_6.right.w;
+    let far_1 = v_6.up.w;
+    if perspective {
+        let _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        let _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        let depth_1 = ((_e2.z - near) / (far_1 - near));
+        let _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        let lit = (depth_1 <= (_e10 + (_e16 / (far_1 - near))));
+        return select(0f, 1f, (lit | (_e2.z <= near)));
     }
+    let _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    let depth_2 = ((_e2.z - near) / (far_1 - near));
+    let _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return select(0f, 1f, (depth_2 <= (_e28 + (_e33 / (far_1 - near)))));
+}
+
+fn shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, l: vec3<f32>) -> f32 {
+    let near_1 = v_7.right.w;
+    let far_2 = v_7.up.w;
+    let dir_9 = vec3<f32>(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+    if (dir_9.z <= 0.000001f) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    let _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_9);
+    let _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if (_e22 >= 1f) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    let z_3 = (near_1 + (_e22 * (far_2 - near_1)));
+    let _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_3);
+    return ((z_3 + _e29) / dir_9.z);
+}
+
+fn shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_3: texture_2d<f32>, o: vec3<f32>) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    let near_2 = v_8.right.w;
+    let far_3 = v_8.up.w;
+    let _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    let _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    let z_4 = (near_2 + (_e9 * (far_3 - near_2)));
+    let _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return select(((z_4 + _e13) - _e2.z), NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, (_e9 >= 1f));
 }
 
 fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
@@ -290,8 +259,8 @@ fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_na
     return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
-fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+fn slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9: vec4<f32>) -> SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9.x, v_9.y, v_9.z, v_9.w);
 }
 
 fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta: f32, lo: f32, hi: f32) -> f32 {
@@ -309,10 +278,10 @@ fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_1.sm_right, f_1.sm_up, f_1.sm_forward, f_1.sm_origin, f_1.sm_proj, vec4<u32>(f_1.sizes2_.x, 0u, 0u, 0u));
 }
 
-fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_3: texture_2d<f32>, p_2: vec3<f32>) -> f32 {
+fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, p_2: vec3<f32>, spot: bool) -> f32 {
     let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2);
-    let _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
+    let _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_2, spot);
+    return _e5;
 }
 
 fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_3: vec3<f32>, dir_3: vec3<f32>, t_1: f32) -> f32 {
@@ -320,7 +289,7 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX
     return _e13;
 }
 
-fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot_1: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_1: u32 = 0u;
     var t_2: f32;
@@ -338,15 +307,15 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_
             let _e17 = k_1;
             t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_2));
             w = h_2;
-            if spot {
+            if spot_1 {
                 let _e26 = k_1;
                 let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             let _e33 = t_2;
-            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e33)));
-            if spot {
+            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            if spot_1 {
                 let _e39 = sum_1;
                 let _e40 = w;
                 let _e42 = t_2;
@@ -369,9 +338,9 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_
     return _e65;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_1: bool) -> f32 {
-    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_5, dir_5, 0f, s, f_5.sizes2_.y, spot_1);
-    if spot_1 {
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
+    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_6, eye_5, dir_5, 0f, s, f_5.sizes2_.y, spot_2);
+    if spot_2 {
         return _e9;
     } else {
         let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_5)));
@@ -388,18 +357,18 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wra
     }
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_2: bool) -> f32 {
-    var local_5: bool;
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_3: bool) -> f32 {
+    var local_1: bool;
 
-    if spot_2 {
+    if spot_3 {
         let psi = (x_2 * delta);
         let den = sin((theta_1 + psi));
         if !((den <= 0.000001f)) {
-            local_5 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_1 = ((theta_1 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_5 = true;
+            local_1 = true;
         }
-        let _e16 = local_5;
+        let _e16 = local_1;
         if _e16 {
             return s_1;
         }
@@ -427,8 +396,8 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_o
     return _e34;
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_3: bool) -> f32 {
-    if spot_3 {
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_4: bool) -> f32 {
+    if spot_4 {
         let q_3 = ((eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz);
         let to_eye = -(f_8.axis.xyz);
         return atan2(length(cross(q_3, to_eye)), dot(q_3, to_eye));
@@ -520,17 +489,17 @@ fn far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(x_4: f32, far: f32, at_infin
     return (1f / (x_4 - far));
 }
 
-fn atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_: f32, b2_: f32, b3_: f32, x_5: f32, u: f32, v_7: f32, k_2: f32) -> f32 {
-    let s_4 = (u + v_7);
-    let p_4 = (u * v_7);
+fn atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_: f32, b2_: f32, b3_: f32, x_5: f32, u: f32, v_10: f32, k_2: f32) -> f32 {
+    let s_4 = (u + v_10);
+    let p_4 = (u * v_10);
     let e2_ = ((b2_ - (b1_ * s_4)) + p_4);
     let e3_ = (((b3_ - (b2_ * (s_4 + x_5))) + (b1_ * (p_4 + (s_4 * x_5)))) - (p_4 * x_5));
-    return ((e2_ + (e3_ * k_2)) / ((x_5 - u) * (x_5 - v_7)));
+    return ((e2_ + (e3_ * k_2)) / ((x_5 - u) * (x_5 - v_10)));
 }
 
 fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw1_: vec2<f32>, zf: f32) -> f32 {
     var shadow: f32 = 0f;
-    var local_6: bool;
+    var local_2: bool;
 
     let _e3 = biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_, MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX);
     let b1_1 = _e3.x;
@@ -569,11 +538,11 @@ fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw
         shadow = (_e104 + _e110);
     }
     if !(at_infinity_1) {
-        local_6 = (r_2.z < zf);
+        local_2 = (r_2.z < zf);
     } else {
-        local_6 = false;
+        local_2 = false;
     }
-    let _e118 = local_6;
+    let _e118 = local_2;
     if _e118 {
         let _e119 = shadow;
         let _e127 = atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_1, b2_1, b3_1, r_2.z, zf, r_2.x, (1f / (r_2.z - r_2.y)));
@@ -591,17 +560,17 @@ fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mo
     return (f_11.e1_.w + ((f32(row) + 0.5f) * f_11.e2_.w));
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_4: bool) -> u32 {
-    if spot_4 {
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_5: bool) -> u32 {
+    if spot_5 {
         return ((r * width) / regions);
     }
     return (((r * r) * width) / (regions * regions));
 }
 
 fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
-    var local_7: bool;
-    var local_8: bool;
-    var local_9: bool;
+    var local_3: bool;
+    var local_4: bool;
+    var local_5: bool;
     var yc_1: f32;
     var d_1: f32;
     var xs: f32 = 0f;
@@ -616,8 +585,8 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var done0_: bool = false;
     var done1_: bool = false;
     var r_1: u32 = 0u;
-    var local_10: bool;
-    var local_11: bool;
+    var local_6: bool;
+    var local_7: bool;
     var a0_: f32;
     var e0_: f32;
     var a1_: f32;
@@ -626,11 +595,11 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var weight1_: f32;
     var vis0_: f32;
     var vis1_: f32;
+    var local_8: bool;
+    var local_9: bool;
+    var local_10: bool;
+    var local_11: bool;
     var local_12: bool;
-    var local_13: bool;
-    var local_14: bool;
-    var local_15: bool;
-    var local_16: bool;
 
     let f_13 = frame;
     let eye_8 = f_13.eye.xyz;
@@ -641,23 +610,23 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_13.epipole.w;
     if (f_13.epipole.z > 0.5f) {
-        local_7 = (length((px - vec3<f32>(f_13.epipole.x, f_13.epipole.y, 0f))) < radius);
+        local_3 = (length((px - vec3<f32>(f_13.epipole.x, f_13.epipole.y, 0f))) < radius);
     } else {
-        local_7 = false;
+        local_3 = false;
     }
-    let near_epi = local_7;
+    let near_epi = local_3;
     if (f_13.anti_epipole.z > 0.5f) {
-        local_8 = (length((px - vec3<f32>(f_13.anti_epipole.x, f_13.anti_epipole.y, 0f))) < radius);
+        local_4 = (length((px - vec3<f32>(f_13.anti_epipole.x, f_13.anti_epipole.y, 0f))) < radius);
     } else {
-        local_8 = false;
+        local_4 = false;
     }
-    let near_anti = local_8;
+    let near_anti = local_4;
     if !(near_epi) {
-        local_9 = near_anti;
+        local_5 = near_anti;
     } else {
-        local_9 = true;
+        local_5 = true;
     }
-    let _e77 = local_9;
+    let _e77 = local_5;
     if _e77 {
         let _e79 = frame;
         let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_8, _e10, s_5, false);
@@ -729,18 +698,18 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             let b1_2 = f32(_e196);
             if !((last0_ < u32(b1_2))) {
                 let _e201 = r_1;
-                local_10 = ((_e201 + 1u) == REGIONS);
+                local_6 = ((_e201 + 1u) == REGIONS);
             } else {
-                local_10 = true;
+                local_6 = true;
             }
-            let is_last0_ = local_10;
+            let is_last0_ = local_6;
             if !((last1_ < u32(b1_2))) {
                 let _e212 = r_1;
-                local_11 = ((_e212 + 1u) == REGIONS);
+                local_7 = ((_e212 + 1u) == REGIONS);
             } else {
-                local_11 = true;
+                local_7 = true;
             }
-            let is_last1_ = local_11;
+            let is_last1_ = local_7;
             let _e222 = xs0_;
             let pos0_ = select((b1_2 - 0.5f), clamp((_e222 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
             let _e233 = xs1_;
@@ -801,11 +770,11 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             let _e336 = d_1;
             if (_e336 > lohi0_.x) {
                 let _e339 = d_1;
-                local_12 = (_e339 <= lohi0_.y);
+                local_8 = (_e339 <= lohi0_.y);
             } else {
-                local_12 = false;
+                local_8 = false;
             }
-            let _e345 = local_12;
+            let _e345 = local_8;
             if _e345 {
                 let _e350 = textureLoad(filtered, vec2<u32>(x00_, _e118), 0i, 0i);
                 let _e355 = textureLoad(filtered, vec2<u32>(x01_, _e118), 0i, 0i);
@@ -819,11 +788,11 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             let _e370 = d_1;
             if (_e370 > lohi1_.x) {
                 let _e373 = d_1;
-                local_13 = (_e373 <= lohi1_.y);
+                local_9 = (_e373 <= lohi1_.y);
             } else {
-                local_13 = false;
+                local_9 = false;
             }
-            let _e379 = local_13;
+            let _e379 = local_9;
             if _e379 {
                 let _e384 = textureLoad(filtered, vec2<u32>(x10_, row1_), 0i, 0i);
                 let _e389 = textureLoad(filtered, vec2<u32>(x11_, row1_), 0i, 0i);
@@ -858,28 +827,28 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             }
             let _e450 = done0_;
             if !(_e450) {
-                local_14 = is_last0_;
+                local_10 = is_last0_;
             } else {
-                local_14 = true;
+                local_10 = true;
             }
-            let _e455 = local_14;
+            let _e455 = local_10;
             done0_ = _e455;
             let _e456 = done1_;
             if !(_e456) {
-                local_15 = is_last1_;
+                local_11 = is_last1_;
             } else {
-                local_15 = true;
+                local_11 = true;
             }
-            let _e461 = local_15;
+            let _e461 = local_11;
             done1_ = _e461;
             let _e462 = done0_;
             if _e462 {
                 let _e463 = done1_;
-                local_16 = _e463;
+                local_12 = _e463;
             } else {
-                local_16 = false;
+                local_12 = false;
             }
-            let _e467 = local_16;
+            let _e467 = local_12;
             if _e467 {
                 break;
             }

@@ -72,17 +72,13 @@ metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
 }
 
-metal::float2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
     metal::float3 ls
 ) {
-    if (v_1.origin.w > 0.5) {
-        float z_3 = metal::max(ls.z, 0.000001);
-        float t_1 = v_1.proj.x;
-        return metal::float2(0.5 + ((0.5 * ls.x) / (z_3 * t_1)), 0.5 - ((0.5 * ls.y) / (z_3 * t_1)));
-    } else {
-        return metal::float2((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x), (v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z));
-    }
+    float z_3 = metal::max(ls.z, 0.000001);
+    float t_1 = v_1.proj.x;
+    return metal::float2(0.5 + ((0.5 * ls.x) / (z_3 * t_1)), 0.5 - ((0.5 * ls.y) / (z_3 * t_1)));
 }
 
 uint naga_f2u32(float value) {
@@ -94,110 +90,95 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
-    bool local_2 = {};
-    bool local_3 = {};
-    bool local_4 = {};
-    if (!((uv.x < 0.0))) {
-        local_2 = uv.x > 1.0;
-    } else {
-        local_2 = true;
-    }
-    bool _e11 = local_2;
-    if (!(_e11)) {
-        local_3 = uv.y < 0.0;
-    } else {
-        local_3 = true;
-    }
-    bool _e19 = local_3;
-    if (!(_e19)) {
-        local_4 = uv.y > 1.0;
-    } else {
-        local_4 = true;
-    }
-    bool _e27 = local_4;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
     uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
-    uint clamped_lod_e49 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e49 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y)), metal::uint2(sm.get_width(clamped_lod_e49), sm.get_height(clamped_lod_e49)) - 1), clamped_lod_e49);
-    return _e49.x;
+    uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    return outside ? 2.0 : _e36.x;
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
     float z_1
 ) {
-    float texel = {};
-    float size = static_cast<float>(v_3.size.x);
-    if (v_3.origin.w > 0.5) {
-        texel = ((2.0 * metal::max(z_1, 0.0)) * v_3.proj.x) / size;
-    } else {
-        texel = metal::max(v_3.proj.y - v_3.proj.x, v_3.proj.w - v_3.proj.z) / size;
-    }
-    float _e32 = texel;
-    return v_3.forward.w * _e32;
+    float texel = ((2.0 * metal::max(z_1, 0.0)) * v_3.proj.x) / static_cast<float>(v_3.size.x);
+    return v_3.forward.w * texel;
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+metal::float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
-    metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_1
+    metal::float3 ls_1
 ) {
-    bool local_5 = {};
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if (v_4.origin.w > 0.5) {
-        local_5 = _e2.z <= near;
-    } else {
-        local_5 = false;
-    }
-    bool _e16 = local_5;
-    if (_e16) {
-        return 1.0;
-    }
-    metal::float2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth = (_e2.z - near) / (far - near);
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return (depth <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0;
+    return metal::float2((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x), (v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z));
 }
 
-float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5,
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5
+) {
+    float texel_1 = metal::max(v_5.proj.y - v_5.proj.x, v_5.proj.w - v_5.proj.z) / static_cast<float>(v_5.size.x);
+    return v_5.forward.w * texel_1;
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6,
+    metal::texture2d<float, metal::access::sample> sm_1,
+    metal::float3 p_1,
+    bool perspective
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        metal::float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth = (_e2.z - near) / (far - near);
+        float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit = depth <= (_e10 + (_e16 / (far - near)));
+        return (lit | (_e2.z <= near)) ? 1.0 : 0.0;
+    }
+    metal::float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_1 = (_e2.z - near) / (far - near);
+    float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return (depth_1 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0;
+}
+
+float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7,
     metal::texture2d<float, metal::access::sample> sm_2,
-    metal::float3 o,
     metal::float3 l
 ) {
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    float near_1 = v_5.right.w;
-    float far_1 = v_5.up.w;
-    if (v_5.origin.w > 0.5) {
-        metal::float3 dir_3 = metal::float3(metal::dot(l, v_5.right.xyz), metal::dot(l, v_5.up.xyz), metal::dot(l, v_5.forward.xyz));
-        if (dir_3.z <= 0.000001) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        metal::float2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_3);
-        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if (_e28 >= 1.0) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_4 = near_1 + (_e28 * (far_1 - near_1));
-        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_4);
-        return (z_4 + _e35) / dir_3.z;
-    } else {
-        metal::float2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if (_e40 >= 1.0) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_5 = near_1 + (_e40 * (far_1 - near_1));
-        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_5);
-        return (z_5 + _e47) - _e2.z;
+    float near_1 = v_7.right.w;
+    float far_1 = v_7.up.w;
+    metal::float3 dir_3 = metal::float3(metal::dot(l, v_7.right.xyz), metal::dot(l, v_7.up.xyz), metal::dot(l, v_7.forward.xyz));
+    if (dir_3.z <= 0.000001) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
     }
+    metal::float2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_3);
+    float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if (_e22 >= 1.0) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    float z_4 = near_1 + (_e22 * (far_1 - near_1));
+    float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_4);
+    return (z_4 + _e29) / dir_3.z;
+}
+
+float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8,
+    metal::texture2d<float, metal::access::sample> sm_3,
+    metal::float3 o
+) {
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    float near_2 = v_8.right.w;
+    float far_2 = v_8.up.w;
+    metal::float2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    float z_5 = near_2 + (_e9 * (far_2 - near_2));
+    float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return (_e9 >= 1.0) ? NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX : ((z_5 + _e13) - _e2.z);
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -405,7 +386,7 @@ kernel void slice_fit(
     uint k = {};
     bool local_1 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3 = frame;
-    float far_2 = f_3.theta.z;
+    float far_3 = f_3.theta.z;
     x = lid;
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
@@ -462,7 +443,7 @@ kernel void slice_fit(
     z = _e47;
     if (!((f_3.proj.x > 0.5))) {
         float _e53 = z;
-        local = !((_e53 < far_2));
+        local = !((_e53 < far_3));
     } else {
         local = true;
     }
@@ -493,7 +474,7 @@ kernel void slice_fit(
             uint _e71 = row;
             metal::float4 old = slices[metal::min(unsigned(_e71), (_buffer_sizes.size1 - 0 - 16) / 16)];
             float _e75 = z;
-            delta = old.x * (_e75 / far_2);
+            delta = old.x * (_e75 / far_3);
             if (false) {
                 uint _e80 = row;
                 float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e80);

@@ -88,109 +88,81 @@ vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
     return vec3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
-vec2 shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
-    if ((v_1.origin.w > 0.5)) {
-        float z_1 = max(ls.z, 1e-6);
-        float t_3 = v_1.proj.x;
-        return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
-    } else {
-        return vec2(((ls.x - v_1.proj.x) / (v_1.proj.y - v_1.proj.x)), ((v_1.proj.w - ls.y) / (v_1.proj.w - v_1.proj.z)));
-    }
+vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
+    float z_1 = max(ls.z, 1e-6);
+    float t_3 = v_1.proj.x;
+    return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
 }
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
-    bool local_1 = false;
-    bool local_2 = false;
-    bool local_3 = false;
-    if (!((uv.x < 0.0))) {
-        local_1 = (uv.x > 1.0);
-    } else {
-        local_1 = true;
-    }
-    bool _e11 = local_1;
-    if (!(_e11)) {
-        local_2 = (uv.y < 0.0);
-    } else {
-        local_2 = true;
-    }
-    bool _e19 = local_2;
-    if (!(_e19)) {
-        local_3 = (uv.y > 1.0);
-    } else {
-        local_3 = true;
-    }
-    bool _e27 = local_3;
-    if (_e27) {
-        return 2.0;
-    }
+    bool outside = ((((uv.x < 0.0) || (uv.x > 1.0)) || (uv.y < 0.0)) || (uv.y > 1.0));
     uint n_2 = v_2.size.x;
     uint x_5 = min(uint((uv.x * float(n_2))), (n_2 - 1u));
     uint y_2 = min(uint((uv.y * float(n_2))), (n_2 - 1u));
-    int _e49_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e49 = texelFetch(sm, clamp(ivec2(uvec2(x_5, y_2)), ivec2(0), textureSize(sm, _e49_clamped_lod) - ivec2(1)), _e49_clamped_lod);
-    return _e49.x;
+    int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
+    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_5, y_2)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    return (outside ? 2.0 : _e36.x);
 }
 
-float shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
-    float texel = 0.0;
-    float size = float(v_3.size.x);
-    if ((v_3.origin.w > 0.5)) {
-        texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / size);
-    } else {
-        texel = (max((v_3.proj.y - v_3.proj.x), (v_3.proj.w - v_3.proj.z)) / size);
-    }
-    float _e32 = texel;
-    return (v_3.forward.w * _e32);
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z) {
+    float texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / float(v_3.size.x));
+    return (v_3.forward.w * texel);
 }
 
-float shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, sampler2D sm_1, vec3 p_1) {
-    bool local_4 = false;
-    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, p_1);
-    float near = v_4.right.w;
-    float far = v_4.up.w;
-    if ((v_4.origin.w > 0.5)) {
-        local_4 = (_e2.z <= near);
-    } else {
-        local_4 = false;
-    }
-    bool _e16 = local_4;
-    if (_e16) {
-        return 1.0;
-    }
-    vec2 _e18 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2);
-    float _e20 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, sm_1, _e18);
-    float depth_1 = ((_e2.z - near) / (far - near));
-    float _e26 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4, _e2.z);
-    return ((depth_1 <= (_e20 + (_e26 / (far - near)))) ? 1.0 : 0.0);
+vec2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, vec3 ls_1) {
+    return vec2(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
 }
 
-float shadow_occluder_distanceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5, sampler2D sm_2, vec3 o, vec3 l) {
-    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, o);
-    float near_1 = v_5.right.w;
-    float far_1 = v_5.up.w;
-    if ((v_5.origin.w > 0.5)) {
-        vec3 dir_11 = vec3(dot(l, v_5.right.xyz), dot(l, v_5.up.xyz), dot(l, v_5.forward.xyz));
-        if ((dir_11.z <= 1e-6)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        vec2 _e26 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, dir_11);
-        float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e26);
-        if ((_e28 >= 1.0)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_2 = (near_1 + (_e28 * (far_1 - near_1)));
-        float _e35 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_2);
-        return ((z_2 + _e35) / dir_11.z);
-    } else {
-        vec2 _e39 = shadow_uvX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, _e2);
-        float _e40 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, sm_2, _e39);
-        if ((_e40 >= 1.0)) {
-            return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
-        }
-        float z_3 = (near_1 + (_e40 * (far_1 - near_1)));
-        float _e47 = shadow_biasX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5, z_3);
-        return ((z_3 + _e47) - _e2.z);
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5) {
+    float texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / float(v_5.size.x));
+    return (v_5.forward.w * texel_1);
+}
+
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, sampler2D sm_1, vec3 p_1, bool perspective) {
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
+    float near = v_6.right.w;
+    float far = v_6.up.w;
+    if (perspective) {
+        vec2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+        float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        float depth_1 = ((_e2.z - near) / (far - near));
+        float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        bool lit = (depth_1 <= (_e10 + (_e16 / (far - near))));
+        return ((lit || (_e2.z <= near)) ? 1.0 : 0.0);
     }
+    vec2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
+    float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    float depth_2 = ((_e2.z - near) / (far - near));
+    float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    return ((depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0);
+}
+
+float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7, sampler2D sm_2, vec3 l) {
+    float near_1 = v_7.right.w;
+    float far_1 = v_7.up.w;
+    vec3 dir_11 = vec3(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+    if ((dir_11.z <= 1e-6)) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    vec2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_11);
+    float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    if ((_e22 >= 1.0)) {
+        return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
+    }
+    float z_2 = (near_1 + (_e22 * (far_1 - near_1)));
+    float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_2);
+    return ((z_2 + _e29) / dir_11.z);
+}
+
+float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8, sampler2D sm_3, vec3 o) {
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
+    float near_2 = v_8.right.w;
+    float far_2 = v_8.up.w;
+    vec2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
+    float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    float z_3 = (near_2 + (_e9 * (far_2 - near_2)));
+    float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    return ((_e9 >= 1.0) ? NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX : ((z_3 + _e13) - _e2.z));
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta) {
@@ -293,8 +265,8 @@ vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_nag
     return vec2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
-SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec4 v_6) {
-    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_6.x, v_6.y, v_6.z, v_6.w);
+SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec4 v_9) {
+    return SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(v_9.x, v_9.y, v_9.z, v_9.w);
 }
 
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi) {
@@ -312,10 +284,10 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XON
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_1.sm_right, f_1.sm_up, f_1.sm_forward, f_1.sm_origin, f_1.sm_proj, uvec4(f_1.sizes2_.x, 0u, 0u, 0u));
 }
 
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, sampler2D sm_3, vec3 p_2) {
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, sampler2D sm_4, vec3 p_2, bool spot) {
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2);
-    float _e4 = shadow_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_3, p_2);
-    return _e4;
+    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_2, spot);
+    return _e5;
 }
 
 float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec3 eye_3, vec3 dir_3, float t_1) {
@@ -323,7 +295,7 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, sampler2D sm_4, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot) {
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot_1) {
     float sum_1 = 0.0;
     uint k_1 = 0u;
     float t_2 = 0.0;
@@ -346,15 +318,15 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
             uint _e17 = k_1;
             t_2 = (a_3 + ((float(_e17) + 0.5) * h_2));
             w = h_2;
-            if (spot) {
+            if (spot_1) {
                 uint _e26 = k_1;
                 vec2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
                 t_2 = _e30.x;
                 w = _e30.y;
             }
             float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_4, (eye_4 + (dir_4 * _e33)));
-            if (spot) {
+            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            if (spot_1) {
                 float _e39 = sum_1;
                 float _e40 = w;
                 float _e42 = t_2;
@@ -373,9 +345,9 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return _e65;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_5, vec3 eye_5, vec3 dir_5, float s, bool spot_1) {
-    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_5, dir_5, 0.0, s, f_5.sizes2_.y, spot_1);
-    if (spot_1) {
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_6, vec3 eye_5, vec3 dir_5, float s, bool spot_2) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_6, eye_5, dir_5, 0.0, s, f_5.sizes2_.y, spot_2);
+    if (spot_2) {
         return _e9;
     } else {
         float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_5)));
@@ -414,8 +386,8 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     return _e34;
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_2) {
-    if (spot_2) {
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
+    if (spot_3) {
         vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_8.light_pos.xyz);
         vec3 to_eye = -(f_8.axis.xyz);
         return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
@@ -428,17 +400,17 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_
     return _e15;
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_3) {
-    bool local_5 = false;
-    if (spot_3) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_4) {
+    bool local_1 = false;
+    if (spot_4) {
         float psi = (x_2 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local_5 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_1 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_5 = true;
+            local_1 = true;
         }
-        bool _e16 = local_5;
+        bool _e16 = local_1;
         if (_e16) {
             return s_2;
         }
@@ -448,11 +420,11 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_4) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_4);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -460,8 +432,8 @@ uint depth_bin(float d) {
     return uint(clamp(floor((d * 256.0)), 0.0, 255.0));
 }
 
-RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float s_4, bool spot_5) {
-    bool local_6 = false;
+RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float s_4, bool spot_6) {
+    bool local_2 = false;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = _group_0_binding_0_cs;
     uint width = f_13.sizes.z;
     vec4 _e7 = _group_0_binding_1_cs[row];
@@ -477,11 +449,11 @@ RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float 
     bool head = (d_1 <= _e32.x);
     uint first_edge = _group_0_binding_5_cs[(2u * ((row * BINS) + bin))];
     if (!((first_edge == NO_EDGE))) {
-        local_6 = (first_edge >= n_3);
+        local_2 = (first_edge >= n_3);
     } else {
-        local_6 = true;
+        local_2 = true;
     }
-    bool _e51 = local_6;
+    bool _e51 = local_2;
     if (_e51) {
         return RowSpan(s_4, 0.0, head, head);
     }
@@ -491,13 +463,13 @@ RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float 
     vec4 _e70 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(last, row)), ivec2(0), textureSize(_group_0_binding_4_cs, _e70_clamped_lod) - ivec2(1)), _e70_clamped_lod);
     bool tail = (d_1 <= _e70.x);
     uint first = ((first_edge < PAD) ? 0u : (first_edge - PAD));
-    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_5);
-    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (last + PAD), n_3, delta_2, theta_4, s_4, spot_5);
+    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_6);
+    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
     return RowSpan(_e81, _e84, head, tail);
 }
 
-float closed_form(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
-    if (spot_6) {
+float closed_form(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_7) {
+    if (spot_7) {
         float _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max(max((f_12.sizes2_.z / 4u), 8u), 1u));
         return _e14;
     }
@@ -506,9 +478,9 @@ float closed_form(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 
 }
 
 vec3 volume_march_pixel(uint x_4, uint y_1) {
-    bool local_7 = false;
-    bool local_8 = false;
-    bool local_9 = false;
+    bool local_3 = false;
+    bool local_4 = false;
+    bool local_5 = false;
     float t_f = 0.0;
     float t_b = 0.0;
     float total = 0.0;
@@ -523,23 +495,23 @@ vec3 volume_march_pixel(uint x_4, uint y_1) {
     vec3 px = vec3((float(x_4) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_14.epipole.w;
     if ((f_14.epipole.z > 0.5)) {
-        local_7 = (length((px - vec3(f_14.epipole.x, f_14.epipole.y, 0.0))) < radius);
+        local_3 = (length((px - vec3(f_14.epipole.x, f_14.epipole.y, 0.0))) < radius);
     } else {
-        local_7 = false;
+        local_3 = false;
     }
-    bool near_epi = local_7;
+    bool near_epi = local_3;
     if ((f_14.anti_epipole.z > 0.5)) {
-        local_8 = (length((px - vec3(f_14.anti_epipole.x, f_14.anti_epipole.y, 0.0))) < radius);
+        local_4 = (length((px - vec3(f_14.anti_epipole.x, f_14.anti_epipole.y, 0.0))) < radius);
     } else {
-        local_8 = false;
+        local_4 = false;
     }
-    bool near_anti = local_8;
+    bool near_anti = local_4;
     if (!(near_epi)) {
-        local_9 = near_anti;
+        local_5 = near_anti;
     } else {
-        local_9 = true;
+        local_5 = true;
     }
-    bool _e74 = local_9;
+    bool _e74 = local_5;
     if (_e74) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e76 = _group_0_binding_0_cs;
         float _e79 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e76, _group_0_binding_3_cs, eye_9, _e7, s_5, true);

@@ -224,7 +224,7 @@ pub fn span_march_cookie(
     for k in 0..steps {
         let tw = equiangular_sample(&strata, k as f32 + 0.5);
         let x = eye + dir * tw.0;
-        let v = sm_visibility(f, sm, x);
+        let v = sm_visibility(f, sm, x, true);
         sum += v * tw.1 * frame_spot_integrand(f, eye, dir, tw.0) * frame_cookie(f, cookie, x);
     }
     sum

@@ -10,7 +10,10 @@ use super::common_model::{
     PI, clamp, equiangular, equiangular_sample, max, max_u, min, phase_hg, spot_integrand,
     spot_span, transmittance_between,
 };
-use super::common_shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility};
+use super::common_shadow::{
+    ShadowMapView, shadow_occluder_distance_orthographic, shadow_occluder_distance_perspective,
+    shadow_visibility_for,
+};
 use super::texture::{Tex, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::FrameUniforms;
@@ -62,15 +65,22 @@ pub fn sm_view(f: &FrameUniforms) -> ShadowMapView {
     }
 }
 
-/// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed).
-pub fn sm_visibility(f: &FrameUniforms, sm: &Tex, p: Vec3) -> f32 {
-    shadow_visibility(&sm_view(f), sm, p)
+/// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed); `spot`: the
+/// kernel's light switch.
+pub fn sm_visibility(f: &FrameUniforms, sm: &Tex, p: Vec3, spot: bool) -> f32 {
+    shadow_visibility_for(&sm_view(f), sm, p, spot)
 }
 
-/// Travel distance from `o` along the light ray `o + s l` to its first occluder, or
-/// [`NO_OCCLUDER`](super::common_shadow::NO_OCCLUDER).
-pub fn sm_occluder_distance(f: &FrameUniforms, sm: &Tex, o: Vec3, l: Vec3) -> f32 {
-    shadow_occluder_distance(&sm_view(f), sm, o, l)
+/// Travel distance along a light ray to its first occluder, or
+/// [`NO_OCCLUDER`](super::common_shadow::NO_OCCLUDER): the sun's light ray from `o` along
+/// the light's direction.
+pub fn sm_occluder_distance_sun(f: &FrameUniforms, sm: &Tex, o: Vec3) -> f32 {
+    shadow_occluder_distance_orthographic(&sm_view(f), sm, o)
+}
+
+/// [`sm_occluder_distance_sun`] of a spot: the light ray from the light along `l`.
+pub fn sm_occluder_distance_spot(f: &FrameUniforms, sm: &Tex, l: Vec3) -> f32 {
+    shadow_occluder_distance_perspective(&sm_view(f), sm, l)
 }
 
 /// Unit view direction through the centre of pixel (x, y).
@@ -127,7 +137,7 @@ pub fn span_march(
             t = tw.0;
             w = tw.1;
         }
-        let v = sm_visibility(f, sm, eye + dir * t);
+        let v = sm_visibility(f, sm, eye + dir * t, spot);
         if spot {
             sum += v * w * frame_spot_integrand(f, eye, dir, t);
         } else {

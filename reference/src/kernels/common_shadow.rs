@@ -37,53 +37,81 @@ pub fn shadow_light_space(v: &ShadowMapView, p: Vec3) -> Vec3 {
 /// Texture coordinates (u, v) in [0, 1] of light-space point `ls` (outside: no coverage).
 pub fn shadow_uv(v: &ShadowMapView, ls: Vec3) -> [f32; 2] {
     if v.origin[3] > 0.5 {
-        let z = max(ls.z, 1e-6);
-        let t = v.proj[0];
-        [0.5 + 0.5 * ls.x / (z * t), 0.5 - 0.5 * ls.y / (z * t)]
+        shadow_uv_perspective(v, ls)
     } else {
-        [
-            (ls.x - v.proj[0]) / (v.proj[1] - v.proj[0]),
-            (v.proj[3] - ls.y) / (v.proj[3] - v.proj[2]),
-        ]
+        shadow_uv_orthographic(v, ls)
     }
+}
+
+/// [`shadow_uv`] of an orthographic map (the sun).
+pub fn shadow_uv_orthographic(v: &ShadowMapView, ls: Vec3) -> [f32; 2] {
+    [
+        (ls.x - v.proj[0]) / (v.proj[1] - v.proj[0]),
+        (v.proj[3] - ls.y) / (v.proj[3] - v.proj[2]),
+    ]
+}
+
+/// [`shadow_uv`] of a perspective map (a spot).
+pub fn shadow_uv_perspective(v: &ShadowMapView, ls: Vec3) -> [f32; 2] {
+    let z = max(ls.z, 1e-6);
+    let t = v.proj[0];
+    [0.5 + 0.5 * ls.x / (z * t), 0.5 - 0.5 * ls.y / (z * t)]
 }
 
 /// Depth bias in world units at light-space depth `z`.
 pub fn shadow_bias(v: &ShadowMapView, z: f32) -> f32 {
-    let size = v.size[0] as f32;
-    let texel = if v.origin[3] > 0.5 {
-        2.0 * max(z, 0.0) * v.proj[0] / size
+    if v.origin[3] > 0.5 {
+        shadow_bias_perspective(v, z)
     } else {
-        max(v.proj[1] - v.proj[0], v.proj[3] - v.proj[2]) / size
-    };
+        shadow_bias_orthographic(v)
+    }
+}
+
+/// [`shadow_bias`] of an orthographic map (the same at every depth).
+pub fn shadow_bias_orthographic(v: &ShadowMapView) -> f32 {
+    let texel = max(v.proj[1] - v.proj[0], v.proj[3] - v.proj[2]) / v.size[0] as f32;
+    v.forward[3] * texel
+}
+
+/// [`shadow_bias`] of a perspective map.
+pub fn shadow_bias_perspective(v: &ShadowMapView, z: f32) -> f32 {
+    let texel = 2.0 * max(z, 0.0) * v.proj[0] / v.size[0] as f32;
     v.forward[3] * texel
 }
 
 /// Stored depth of the nearest texel at (u, v), or 2 (beyond everything) outside the map.
 pub fn shadow_fetch(v: &ShadowMapView, sm: &Tex, uv: [f32; 2]) -> f32 {
-    if uv[0] < 0.0 || uv[0] > 1.0 || uv[1] < 0.0 || uv[1] > 1.0 {
-        return 2.0;
-    }
+    let outside = uv[0] < 0.0 || uv[0] > 1.0 || uv[1] < 0.0 || uv[1] > 1.0;
     let n = v.size[0];
     let x = ((uv[0] * n as f32) as u32).min(n - 1);
     let y = ((uv[1] * n as f32) as u32).min(n - 1);
-    sm.load(x, y)
+    select(sm.load(x, y), 2.0, outside)
 }
 
 /// Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed): nearest texel,
 /// biased, exactly the test of the `shadow_map` ground truth.
 pub fn shadow_visibility(v: &ShadowMapView, sm: &Tex, p: Vec3) -> f32 {
+    shadow_visibility_for(v, sm, p, v.origin[3] > 0.5)
+}
+
+/// [`shadow_visibility`] of a perspective map when `perspective`, else of an orthographic
+/// one (the kernels pass their light kind, a template constant).
+pub fn shadow_visibility_for(v: &ShadowMapView, sm: &Tex, p: Vec3, perspective: bool) -> f32 {
     let ls = shadow_light_space(v, p);
     let (near, far) = (v.right[3], v.up[3]);
-    if v.origin[3] > 0.5 && ls.z <= near {
-        return 1.0;
+    if perspective {
+        let stored = shadow_fetch(v, sm, shadow_uv_perspective(v, ls));
+        let depth = (ls.z - near) / (far - near);
+        let lit = depth <= stored + shadow_bias_perspective(v, ls.z) / (far - near);
+        // In front of the light's near plane: lit.
+        return select(0.0, 1.0, lit | (ls.z <= near));
     }
-    let stored = shadow_fetch(v, sm, shadow_uv(v, ls));
+    let stored = shadow_fetch(v, sm, shadow_uv_orthographic(v, ls));
     let depth = (ls.z - near) / (far - near);
     select(
         0.0,
         1.0,
-        depth <= stored + shadow_bias(v, ls.z) / (far - near),
+        depth <= stored + shadow_bias_orthographic(v) / (far - near),
     )
 }
 
@@ -91,25 +119,39 @@ pub fn shadow_visibility(v: &ShadowMapView, sm: &Tex, p: Vec3) -> f32 {
 /// [`shadow_visibility`] biases (points before it are lit), or [`NO_OCCLUDER`]. For a spot the
 /// ray must start at the shadow map's origin (the light).
 pub fn shadow_occluder_distance(v: &ShadowMapView, sm: &Tex, o: Vec3, l: Vec3) -> f32 {
+    let perspective = v.origin[3] > 0.5;
+    if perspective {
+        shadow_occluder_distance_perspective(v, sm, l)
+    } else {
+        shadow_occluder_distance_orthographic(v, sm, o)
+    }
+}
+
+/// [`shadow_occluder_distance`] of an orthographic map: the ray from `o` travels along the
+/// light's forward.
+pub fn shadow_occluder_distance_orthographic(v: &ShadowMapView, sm: &Tex, o: Vec3) -> f32 {
     let ls = shadow_light_space(v, o);
     let (near, far) = (v.right[3], v.up[3]);
-    if v.origin[3] > 0.5 {
-        let dir = Vec3::new(l.dot(xyz(v.right)), l.dot(xyz(v.up)), l.dot(xyz(v.forward)));
-        if dir.z <= 1e-6 {
-            return NO_OCCLUDER;
-        }
-        let stored = shadow_fetch(v, sm, shadow_uv(v, dir));
-        if stored >= 1.0 {
-            return NO_OCCLUDER;
-        }
-        let z = near + stored * (far - near);
-        (z + shadow_bias(v, z)) / dir.z
-    } else {
-        let stored = shadow_fetch(v, sm, shadow_uv(v, ls));
-        if stored >= 1.0 {
-            return NO_OCCLUDER;
-        }
-        let z = near + stored * (far - near);
-        z + shadow_bias(v, z) - ls.z
+    let stored = shadow_fetch(v, sm, shadow_uv_orthographic(v, ls));
+    let z = near + stored * (far - near);
+    select(
+        z + shadow_bias_orthographic(v) - ls.z,
+        NO_OCCLUDER,
+        stored >= 1.0,
+    )
+}
+
+/// [`shadow_occluder_distance`] of a perspective map: the ray from the light along `l`.
+pub fn shadow_occluder_distance_perspective(v: &ShadowMapView, sm: &Tex, l: Vec3) -> f32 {
+    let (near, far) = (v.right[3], v.up[3]);
+    let dir = Vec3::new(l.dot(xyz(v.right)), l.dot(xyz(v.up)), l.dot(xyz(v.forward)));
+    if dir.z <= 1e-6 {
+        return NO_OCCLUDER;
     }
+    let stored = shadow_fetch(v, sm, shadow_uv_perspective(v, dir));
+    if stored >= 1.0 {
+        return NO_OCCLUDER;
+    }
+    let z = near + stored * (far - near);
+    (z + shadow_bias_perspective(v, z)) / dir.z
 }

@@ -8,7 +8,7 @@
 
 use super::common_ivsv::{PHI_BITS, plane_normal, voxel_word, vpl_shadow_view};
 use super::common_model::max;
-use super::common_shadow::{ShadowMapView, shadow_bias, shadow_uv};
+use super::common_shadow::{ShadowMapView, shadow_bias_perspective, shadow_uv_perspective};
 use super::texture::{TexArray, xyz};
 use glam::Vec3;
 use scatter_shaderlib::area_ivsv::{IvsvUniforms, VplRecord};
@@ -28,7 +28,7 @@ pub fn vpl_occluder_distance(
     if dir.z <= 1e-6 {
         return (-1.0, f32::INFINITY);
     }
-    let uv = shadow_uv(v, dir);
+    let uv = shadow_uv_perspective(v, dir);
     if uv[0] < 0.0 || uv[0] > 1.0 || uv[1] < 0.0 || uv[1] > 1.0 {
         return (-1.0, f32::INFINITY);
     }
@@ -44,7 +44,7 @@ pub fn vpl_occluder_distance(
     let near = v.right[3];
     let far = v.up[3];
     let z = near + stored * (far - near);
-    ((z + shadow_bias(v, z)) / dir.z, margin)
+    ((z + shadow_bias_perspective(v, z)) / dir.z, margin)
 }
 
 /// One set bit: the word index in `marks` and the bit mask, with the decision's margin (the

@@ -11,7 +11,7 @@ use super::common_raymarch::{pixel_jitter, raymarch_pixel_dir, raymarch_shadow_v
 use super::common_sampling::{
     EpipolarCamera, EpipolarSamples, SampledOutput, epipolar_samples, run_sampled,
 };
-use super::common_shadow::shadow_visibility;
+use super::common_shadow::shadow_visibility_for;
 use super::texture::{Tex, TexArray, quantise, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{LightKind, Storage};
@@ -58,7 +58,7 @@ pub fn raymarch_main(
             t = tw.0;
             w = tw.1;
         }
-        let v = shadow_visibility(&view, shadow_map, eye + dir * t);
+        let v = shadow_visibility_for(&view, shadow_map, eye + dir * t, spot);
         if spot {
             let f = v
                 * w

@@ -7,9 +7,10 @@
 //! consecutive columns of a row, its row's constants once.
 
 use super::common_epipolar::{
-    light_point_theta, occluder_depth, row_phi, slice_e, sm_occluder_distance,
+    light_point_theta, occluder_depth, row_phi, slice_e, sm_occluder_distance_spot,
+    sm_occluder_distance_sun,
 };
-use super::common_model::PI;
+use super::common_model::{PI, select};
 use super::common_shadow::NO_OCCLUDER;
 use super::texture::{Tex, xyz};
 use glam::Vec3;
@@ -31,17 +32,15 @@ pub fn rectify_texel(
     if spot {
         // The light ray leaving the light at angle psi = col from the direction towards the eye.
         let l = -axis * col.cos() + e * col.sin();
-        let s = sm_occluder_distance(frame, shadow_map, xyz(frame.light_pos), l);
+        let s = sm_occluder_distance_spot(frame, shadow_map, l);
         if s < NO_OCCLUDER {
             theta_occ = light_point_theta(frame, col, s, true);
         }
     } else {
         // The light ray at distance v = col from the axis, travelling along -axis.
         let o = xyz(frame.eye) + e * col;
-        let s = sm_occluder_distance(frame, shadow_map, o, -axis);
-        if s < NO_OCCLUDER {
-            theta_occ = light_point_theta(frame, col, s, false);
-        }
+        let s = sm_occluder_distance_sun(frame, shadow_map, o);
+        theta_occ = select(PI, light_point_theta(frame, col, s, false), s < NO_OCCLUDER);
     }
     occluder_depth(theta_occ, frame.theta[0], frame.theta[1])
 }

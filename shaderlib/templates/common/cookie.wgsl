@@ -155,7 +155,7 @@ fn span_march_cookie(f: Frame, sm: texture_2d<f32>, cookie: texture_2d<f32>, eye
     for (var k = 0u; k < steps; k++) {
         let tw = equiangular_sample(strata, f32(k) + 0.5);
         let x = eye + dir * tw.x;
-        let v = sm_visibility(f, sm, x);
+        let v = sm_visibility(f, sm, x, true);
         sum += v * tw.y * frame_spot_integrand(f, eye, dir, tw.x) * frame_cookie(f, cookie, x);
     }
     return sum;

@@ -11,7 +11,7 @@
 #define_import_path scatter::epipolar
 
 #import scatter::model::{PI, equiangular, equiangular_sample, phase_hg, spot_integrand, spot_span, transmittance_between}
-#import scatter::shadow::{ShadowMapView, shadow_occluder_distance, shadow_visibility}
+#import scatter::shadow::{ShadowMapView, shadow_occluder_distance_orthographic, shadow_occluder_distance_perspective, shadow_visibility_for}
 
 // The uniform block (host: `scatter_shaderlib::prefiltered::FrameUniforms`, field by field;
 // every member is 16 bytes, 25 * 16 = 400 bytes in all). The host's `e1`, `e2`, `sizes2` and
@@ -131,14 +131,22 @@ fn sm_view(f: Frame) -> ShadowMapView {
 
 // Standard shadow-map visibility of world point `p` (1 lit, 0 shadowed), as the `shadow_map`
 // ground truth tests it. `sm`: the kernel's r32float `shadow_map` binding.
-fn sm_visibility(f: Frame, sm: texture_2d<f32>, p: vec3<f32>) -> f32 {
-    return shadow_visibility(sm_view(f), sm, p);
+// `spot`: the kernel's light switch (a template constant: the other light's test is
+// compiled out, `scatter::shadow::shadow_visibility_for`).
+fn sm_visibility(f: Frame, sm: texture_2d<f32>, p: vec3<f32>, spot: bool) -> f32 {
+    return shadow_visibility_for(sm_view(f), sm, p, spot);
 }
 
-// Travel distance from `o` along the light ray `o + s l` to its first occluder, or
-// NO_OCCLUDER (`scatter::shadow::shadow_occluder_distance`).
-fn sm_occluder_distance(f: Frame, sm: texture_2d<f32>, o: vec3<f32>, l: vec3<f32>) -> f32 {
-    return shadow_occluder_distance(sm_view(f), sm, o, l);
+// Travel distance along a light ray to its first occluder, or
+// NO_OCCLUDER (`scatter::shadow::shadow_occluder_distance`); the sun's light ray from `o`
+// along the light's direction, a spot's from the light along `l`, for kernels generated for
+// one light kind.
+fn sm_occluder_distance_sun(f: Frame, sm: texture_2d<f32>, o: vec3<f32>) -> f32 {
+    return shadow_occluder_distance_orthographic(sm_view(f), sm, o);
+}
+
+fn sm_occluder_distance_spot(f: Frame, sm: texture_2d<f32>, l: vec3<f32>) -> f32 {
+    return shadow_occluder_distance_perspective(sm_view(f), sm, l);
 }
 
 
@@ -175,7 +183,7 @@ fn span_march(f: Frame, sm: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, a: 
             t = tw.x;
             w = tw.y;
         }
-        let v = sm_visibility(f, sm, eye + dir * t);
+        let v = sm_visibility(f, sm, eye + dir * t, spot);
         if spot {
             sum += v * w * frame_spot_integrand(f, eye, dir, t);
         } else {
