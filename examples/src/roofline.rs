@@ -23,7 +23,7 @@ use std::time::{Duration, Instant};
 
 use scatter_reference::suite::SceneName;
 use scatter_runtime::Context;
-use scatter_runtime::shaderlib::minmax::tree_width;
+use scatter_runtime::shaderlib::minmax::BUILD_LANES;
 use scatter_runtime::shaderlib::prefiltered::{PrefilteredVariant, RECTIFY_TEXELS};
 use scatter_runtime::shaderlib::raymarch::RaymarchVariant;
 use scatter_runtime::shaderlib::sampling::{SLICE_LANES, SamplingKnobs};
@@ -373,6 +373,8 @@ pub fn kernel_costs() -> Vec<KernelCost> {
     let (layers, lpt, threads) = (8.0, 2.0, 4u64);
     let regions = u64::from(PrefilteredVariant::default().regions);
     let region_texels = wr as f64 / regions as f64;
+    // minmax_build's block side at the headline's rectified width.
+    let build_block = wr as f64 / f64::from(BUILD_LANES);
     let mut out = vec![
         KernelCost {
             method: "prefiltered, minmax",
@@ -508,11 +510,21 @@ pub fn kernel_costs() -> Vec<KernelCost> {
         KernelCost {
             method: "minmax",
             kernel: "minmax_build",
-            invocations: u64::from(tree_width(RECTIFIED[0])) * hr,
-            // A leaf loads its texel, an inner node its two children; 8 bytes stored.
-            counts: [8.0, 2.0, 0.0, 0.0, 12.0],
+            invocations: u64::from(BUILD_LANES) * hr,
+            // One workgroup of BUILD_LANES per row, blocks of B = Wr / BUILD_LANES = 8
+            // texels (t = 3): per invocation levels 0..=t of its block, each level B loads
+            // (32) and 2B - 1 = 15 nodes stored (8 bytes each), a min and a max per load;
+            // then at most one node above t from workgroup memory (counted as texel loads:
+            // 2 on average, the root's 128 in one invocation).
+            counts: [
+                8.0 * 16.0,
+                4.0 * build_block + 2.0,
+                0.0,
+                0.0,
+                2.0 * 4.0 * build_block + 20.0,
+            ],
             low: None,
-            trips: "log2(Wr) level search per node",
+            trips: "(t + 1) levels x B texels, then one node above t",
         },
         KernelCost {
             method: "minmax",

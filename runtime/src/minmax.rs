@@ -10,7 +10,7 @@
 //! | `depth_columns` | 0 uniform `Frame`, 1 depth r32float, 2 column_depth (storage, one f32 per screen column) | `ceil(W/64) x 1 x 1` |
 //! | `slice_fit` | 0 uniform `Frame`, 1 slices (read_write), 2 column_depth | `1 x 1 x 1` (one workgroup of 256) |
 //! | `rectify` | 0 uniform `Frame`, 1 slices, 2 shadow map r32float, 3 rectified r32float (storage, write) | `ceil(Wr/8) x ceil(Hr/8) x 1` |
-//! | `minmax_build` | 0 uniform `Frame`, 1 rectified r32float, 2 tree rg32float (storage, write) | `ceil(tree_width(Wr)/64) x Hr x 1` |
+//! | `minmax_build` | 0 uniform `Frame`, 1 rectified r32float, 2 tree rg32float (storage, write) | `1 x Hr x 1` (128 invocations per row) |
 //! | `minmax_traverse` | 0 uniform `Frame`, 1 slices, 2 depth r32float, 3 shadow map r32float, 4 tree rg32float, 5 output rgba16float (storage, write) | `ceil(W/8) x ceil(H/8) x 1` |
 
 use std::time::{Duration, Instant};

@@ -323,7 +323,7 @@ fn raymarch_manifest_matches_the_runtime() {
 #[test]
 fn minmax_manifest_matches_the_runtime() {
     use scatter_runtime::minmax::TREE_FORMAT;
-    use scatter_shaderlib::minmax::{MinmaxVariant, tree_width};
+    use scatter_shaderlib::minmax::{BUILD_LANES, MinmaxVariant, tree_width};
     use scatter_shaderlib::prefiltered::FrameUniforms;
     let v = MinmaxVariant {
         light: LightKind::Spot,
@@ -366,7 +366,7 @@ fn minmax_manifest_matches_the_runtime() {
         [w, 1, 1],
         [256, 1, 1],
         [wr.div_ceil(RECTIFY_TEXELS), hr, 1],
-        [tw, hr, 1],
+        [BUILD_LANES, hr, 1],
         [w, h, 1],
     ]) {
         let built = build(&p).unwrap_or_else(|e| panic!("{e}"));

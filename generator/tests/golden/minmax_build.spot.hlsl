@@ -48,102 +48,104 @@ static const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 static const float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 static const float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
+static const uint LANES = 128u;
 
 cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX frame; }
 Texture2D<float4> rectified : register(t1);
 RWTexture2D<float4> tree : register(u2);
+groupshared float2 block_nodes[128];
 
-float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
+float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 p)
 {
-    float3 q_1 = (p - v.origin.xyz);
-    return float3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+    float3 q_1 = (p - v_1.origin.xyz);
+    return float3(dot(q_1, v_1.right.xyz), dot(q_1, v_1.up.xyz), dot(q_1, v_1.forward.xyz));
 }
 
-float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
+float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, float3 ls)
 {
     float z_1 = max(ls.z, 1e-6);
-    float t_1 = v_1.proj.x;
-    return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_1))), (0.5 - ((0.5 * ls.y) / (z_1 * t_1))));
+    float t_2 = v_2.proj.x;
+    return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_2))), (0.5 - ((0.5 * ls.y) / (z_1 * t_2))));
 }
 
 uint naga_f2u32(float value) {
     return uint(clamp(value, 0.0, 4294967000.0));
 }
 
-float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
+float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, Texture2D<float4> sm, float2 uv)
 {
     bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
-    uint n_1 = v_2.size.x;
-    uint x_1 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
-    uint y = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e36 = sm.Load(int3(uint2(x_1, y), int(0)));
+    uint n_2 = v_3.size.x;
+    uint x_2 = min(naga_f2u32((uv.x * float(n_2))), (n_2 - 1u));
+    uint y_1 = min(naga_f2u32((uv.y * float(n_2))), (n_2 - 1u));
+    float4 _e36 = sm.Load(int3(uint2(x_2, y_1), int(0)));
     return (outside ? 2.0 : _e36.x);
 }
 
-float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3, float z)
+float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, float z)
 {
-    float texel = (((2.0 * max(z, 0.0)) * v_3.proj.x) / float(v_3.size.x));
-    return (v_3.forward.w * texel);
+    float texel = (((2.0 * max(z, 0.0)) * v_4.proj.x) / float(v_4.size.x));
+    return (v_4.forward.w * texel);
 }
 
-float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4, float3 ls_1)
+float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5, float3 ls_1)
 {
-    return float2(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
+    return float2(((ls_1.x - v_5.proj.x) / (v_5.proj.y - v_5.proj.x)), ((v_5.proj.w - ls_1.y) / (v_5.proj.w - v_5.proj.z)));
 }
 
-float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5)
+float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6)
 {
-    float texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / float(v_5.size.x));
-    return (v_5.forward.w * texel_1);
+    float texel_1 = (max((v_6.proj.y - v_6.proj.x), (v_6.proj.w - v_6.proj.z)) / float(v_6.size.x));
+    return (v_6.forward.w * texel_1);
 }
 
-float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, Texture2D<float4> sm_1, float3 p_1, bool perspective)
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7, Texture2D<float4> sm_1, float3 p_1, bool perspective)
 {
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
-    float near = v_6.right.w;
-    float far = v_6.up.w;
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, p_1);
+    float near = v_7.right.w;
+    float far = v_7.up.w;
     if (perspective) {
-        const float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
-        const float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        const float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, _e2);
+        const float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_1, _e8);
         float depth = ((_e2.z - near) / (far - near));
-        const float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        const float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, _e2.z);
         bool lit_ = (depth <= (_e10 + (_e16 / (far - near))));
         return ((lit_ | (_e2.z <= near)) ? 1.0 : 0.0);
     }
-    const float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
-    const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    const float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, _e2);
+    const float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_1, _e27);
     float depth_1 = ((_e2.z - near) / (far - near));
-    const float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    const float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7);
     return ((depth_1 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0);
 }
 
-float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7, Texture2D<float4> sm_2, float3 l)
+float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8, Texture2D<float4> sm_2, float3 l)
 {
-    float near_1 = v_7.right.w;
-    float far_1 = v_7.up.w;
-    float3 dir_3 = float3(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+    float near_1 = v_8.right.w;
+    float far_1 = v_8.up.w;
+    float3 dir_3 = float3(dot(l, v_8.right.xyz), dot(l, v_8.up.xyz), dot(l, v_8.forward.xyz));
     if ((dir_3.z <= 1e-6)) {
         return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
     }
-    const float2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_3);
-    const float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    const float2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, dir_3);
+    const float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_2, _e20);
     if ((_e22 >= 1.0)) {
         return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
     }
     float z_2 = (near_1 + (_e22 * (far_1 - near_1)));
-    const float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_2);
+    const float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, z_2);
     return ((z_2 + _e29) / dir_3.z);
 }
 
-float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8, Texture2D<float4> sm_3, float3 o)
+float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_9, Texture2D<float4> sm_3, float3 o)
 {
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
-    float near_2 = v_8.right.w;
-    float far_2 = v_8.up.w;
-    const float2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
-    const float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9, o);
+    float near_2 = v_9.right.w;
+    float far_2 = v_9.up.w;
+    const float2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9, _e2);
+    const float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9, sm_3, _e7);
     float z_3 = (near_2 + (_e9 * (far_2 - near_2)));
-    const float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    const float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9);
     return ((_e9 >= 1.0) ? NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX : ((z_3 + _e13) - _e2.z));
 }
 
@@ -155,11 +157,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_2 = (sigma_t * len);
-    if ((x_2 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_2)));
+    float x_3 = (sigma_t * len);
+    if ((x_3 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_3)));
     }
-    return ((1.0 - exp(-(x_2))) / sigma_t);
+    return ((1.0 - exp(-(x_3))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -173,26 +175,26 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_3 * x_3) * (3.0 - (2.0 * x_3)));
+    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
 }
 
-float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t_1, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_4 = (eye + (dir * t));
-    float3 to_x = (x_4 - light_pos);
+    float3 x_5 = (eye + (dir * t_1));
+    float3 to_x = (x_5 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     float3 travel = (to_x / (d).xxx);
     const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t_1)))) / d2_);
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
 {
     float sum = 0.0;
-    uint k = 0u;
+    uint k_2 = 0u;
     uint q = (uint)0;
 
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
@@ -205,17 +207,17 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = (_e73 + 1u);
+            uint _e73 = k_2;
+            k_2 = (_e73 + 1u);
         }
         loop_init = false;
-        uint _e30 = k;
+        uint _e30 = k_2;
         if ((_e30 < panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
+            uint _e32 = k_2;
             float mid = (g0_ + ((float(_e32) + 0.5) * w));
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
@@ -257,12 +259,12 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_o
     return ret;
 }
 
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_2, float3 dir_2, float3 light_pos_2, float a_2, float b_2, uint n)
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_2, float3 dir_2, float3 light_pos_2, float a_2, float b_2, uint n_1)
 {
     float t0_1 = dot((light_pos_2 - eye_2), dir_2);
     float h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001 * max((b_2 - a_2), 1e-6)));
     float theta_a = atan(((a_2 - t0_1) / h_1));
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / float(n)));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / float(n_1)));
     return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
 }
 
@@ -272,148 +274,239 @@ float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_n
     return float2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
-uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_1, uint width)
+uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level, uint width)
 {
-    return (((width + (1u << level_1)) - 1u) >> level_1);
+    return (((width + (1u << level)) - 1u) >> level);
 }
 
-uint tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint width_1)
+uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_1, uint width_1)
 {
-    uint k_1 = 0u;
+    uint off = 0u;
+    uint k_3 = 0u;
 
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
     while(true) {
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        uint _e2 = k_1;
-        const uint _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
-        if ((_e4 > 1u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = k_1;
-            k_1 = (_e8 + 1u);
-        }
-    }
-    uint _e10 = k_1;
-    return (_e10 + 1u);
-}
-
-uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_2, uint width_2)
-{
-    uint off_1 = 0u;
-    uint k_2 = 0u;
-
-    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e12 = k_2;
-            k_2 = (_e12 + 1u);
+            uint _e12 = k_3;
+            k_3 = (_e12 + 1u);
         }
         loop_init_2 = false;
-        uint _e3 = k_2;
-        if ((_e3 < level_2)) {
+        uint _e3 = k_3;
+        if ((_e3 < level_1)) {
         } else {
             break;
         }
         {
-            uint _e6 = off_1;
-            uint _e7 = k_2;
-            const uint _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
-            off_1 = (_e6 + _e9);
+            uint _e6 = off;
+            uint _e7 = k_3;
+            const uint _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_1);
+            off = (_e6 + _e9);
         }
     }
-    uint _e14 = off_1;
+    uint _e14 = off;
     return _e14;
 }
 
-uint tree_widthX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint width_3)
+float2 span_min_max(uint a_3, uint b_3, uint y)
 {
-    const uint _e1 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
-    const uint _e2 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e1, width_3);
-    return _e2;
+    float2 v_10 = (float2)0;
+    uint x_1 = (uint)0;
+
+    float4 _e5 = rectified.Load(int3(uint2(a_3, y), int(0)));
+    float d0_ = _e5.x;
+    v_10 = float2(d0_, d0_);
+    x_1 = (a_3 + 1u);
+    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
+    bool loop_init_3 = true;
+    while(true) {
+        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e29 = x_1;
+            x_1 = (_e29 + 1u);
+        }
+        loop_init_3 = false;
+        uint _e13 = x_1;
+        if ((_e13 < b_3)) {
+        } else {
+            break;
+        }
+        {
+            uint _e15 = x_1;
+            float4 _e19 = rectified.Load(int3(uint2(_e15, y), int(0)));
+            float d_1 = _e19.x;
+            float _e22 = v_10.x;
+            float _e25 = v_10.y;
+            v_10 = float2(min(_e22, d_1), max(_e25, d_1));
+        }
+    }
+    float2 _e31 = v_10;
+    return _e31;
 }
 
-[numthreads(64, 1, 1)]
-void minmax_build(uint3 id : SV_DispatchThreadID)
+[numthreads(128, 1, 1)]
+void minmax_build(uint3 wid : SV_GroupID, uint i : SV_GroupIndex)
 {
-    bool local = (bool)0;
-    uint level = 0u;
-    uint off = 0u;
-    float lo = (float)0;
-    float hi = (float)0;
-    uint i = (uint)0;
-
-    uint width_4 = frame.sizes.z;
-    uint c = id.x;
-    uint y_1 = id.y;
-    const uint _e8 = tree_widthX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_4);
-    if (!((c >= _e8))) {
-        uint _e14 = frame.sizes.w;
-        local = (y_1 >= _e14);
-    } else {
-        local = true;
+    if (i == 0) {
+        block_nodes = (float2[128])0;
     }
-    bool _e19 = local;
-    if (_e19) {
+    GroupMemoryBarrierWithGroupSync();
+    uint t = 0u;
+    float2 top = float2(0.0, 0.0);
+    uint k = 0u;
+    uint n = (uint)0;
+    uint c = (uint)0;
+    uint k_1 = (uint)0;
+    float2 v = (float2)0;
+    uint m = (uint)0;
+
+    uint width_2 = frame.sizes.z;
+    uint y_2 = wid.y;
+    uint _e12 = frame.sizes.w;
+    if ((y_2 >= _e12)) {
         return;
     }
     uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
     while(true) {
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        uint _e21 = level;
-        const uint _e22 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e21, width_4);
-        uint _e24 = off;
-        if ((c < (_e24 + _e22))) {
-            break;
-        }
-        uint _e27 = off;
-        off = (_e27 + _e22);
-        uint _e30 = level;
-        level = (_e30 + 1u);
-    }
-    uint _e32 = off;
-    uint _e34 = level;
-    uint first = ((c - _e32) << _e34);
-    uint _e37 = level;
-    uint end = min((first + (1u << _e37)), width_4);
-    float4 _e44 = rectified.Load(int3(uint2(first, y_1), int(0)));
-    float d0_ = _e44.x;
-    lo = d0_;
-    hi = d0_;
-    i = (first + 1u);
-    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
-    bool loop_init_3 = true;
-    while(true) {
-        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_3) {
-            uint _e64 = i;
-            i = (_e64 + 1u);
-        }
-        loop_init_3 = false;
-        uint _e51 = i;
-        if ((_e51 < end)) {
+        uint _e16 = t;
+        if (((LANES << _e16) < width_2)) {
         } else {
             break;
         }
         {
-            uint _e53 = i;
-            float4 _e57 = rectified.Load(int3(uint2(_e53, y_1), int(0)));
-            float d_1 = _e57.x;
-            float _e59 = lo;
-            lo = min(_e59, d_1);
-            float _e61 = hi;
-            hi = max(_e61, d_1);
+            uint _e20 = t;
+            t = (_e20 + 1u);
         }
     }
-    float _e67 = lo;
-    float _e68 = hi;
-    tree[uint2(c, y_1)] = float4(_e67, _e68, 0.0, 0.0);
+    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
+    bool loop_init_4 = true;
+    while(true) {
+        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_4) {
+            uint _e65 = k;
+            k = (_e65 + 1u);
+        }
+        loop_init_4 = false;
+        uint _e23 = k;
+        uint _e24 = t;
+        if ((_e23 <= _e24)) {
+        } else {
+            break;
+        }
+        {
+            uint _e26 = k;
+            const uint _e27 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e26, width_2);
+            uint _e28 = k;
+            const uint _e29 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e28, width_2);
+            uint _e31 = t;
+            uint _e32 = k;
+            uint per_block = (1u << (_e31 - _e32));
+            n = 0u;
+            uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
+            bool loop_init_5 = true;
+            while(true) {
+                if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
+                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                if (!loop_init_5) {
+                    uint _e62 = n;
+                    n = (_e62 + 1u);
+                }
+                loop_init_5 = false;
+                uint _e37 = n;
+                if ((_e37 < per_block)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e41 = n;
+                    uint j = ((i * per_block) + _e41);
+                    if ((j < _e27)) {
+                        uint _e44 = k;
+                        uint _e48 = k;
+                        const float2 _e51 = span_min_max((j << _e44), min(((j + 1u) << _e48), width_2), y_2);
+                        tree[uint2((_e29 + j), y_2)] = float4(_e51.x, _e51.y, 0.0, 0.0);
+                        top = _e51;
+                    }
+                }
+            }
+        }
+    }
+    float2 _e69 = top;
+    block_nodes[min(uint(i), 127u)] = _e69;
+    GroupMemoryBarrierWithGroupSync();
+    uint _e70 = t;
+    const uint _e71 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e70, width_2);
+    c = i;
+    uint _e73 = t;
+    k_1 = (_e73 + 1u);
+    uint2 loop_bound_7 = uint2(4294967295u, 4294967295u);
+    while(true) {
+        if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
+        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+        uint _e77 = k_1;
+        const uint _e80 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX((_e77 - 1u), width_2);
+        if ((_e80 > 1u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e83 = k_1;
+            const uint _e84 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e83, width_2);
+            uint _e85 = c;
+            if ((_e85 < _e84)) {
+                uint _e87 = c;
+                uint _e88 = k_1;
+                uint _e89 = t;
+                uint a_4 = (_e87 << (_e88 - _e89));
+                uint _e92 = c;
+                uint _e95 = k_1;
+                uint _e96 = t;
+                uint b_4 = min(((_e92 + 1u) << (_e95 - _e96)), _e71);
+                float2 _e102 = block_nodes[min(uint(a_4), 127u)];
+                v = _e102;
+                m = (a_4 + 1u);
+                uint2 loop_bound_8 = uint2(4294967295u, 4294967295u);
+                bool loop_init_6 = true;
+                while(true) {
+                    if (all(loop_bound_8 == uint2(0u, 0u))) { break; }
+                    loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
+                    if (!loop_init_6) {
+                        uint _e123 = m;
+                        m = (_e123 + 1u);
+                    }
+                    loop_init_6 = false;
+                    uint _e107 = m;
+                    if ((_e107 < b_4)) {
+                    } else {
+                        break;
+                    }
+                    {
+                        uint _e110 = m;
+                        float2 w_1 = block_nodes[min(uint(_e110), 127u)];
+                        float _e114 = v.x;
+                        float _e118 = v.y;
+                        v = float2(min(_e114, w_1.x), max(_e118, w_1.y));
+                    }
+                }
+                uint _e125 = k_1;
+                const uint _e126 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e125, width_2);
+                uint _e127 = c;
+                float _e131 = v.x;
+                float _e133 = v.y;
+                tree[uint2((_e126 + _e127), y_2)] = float4(_e131, _e133, 0.0, 0.0);
+                break;
+            }
+            uint _e138 = c;
+            c = (_e138 - _e84);
+            uint _e141 = k_1;
+            k_1 = (_e141 + 1u);
+        }
+    }
     return;
 }

@@ -47,26 +47,30 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
 };
+struct type_10 {
+    metal::float2 inner[128];
+};
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
+constant uint LANES = 128u;
 
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
     metal::float3 p
 ) {
-    metal::float3 q_1 = p - v.origin.xyz;
-    return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
+    metal::float3 q_1 = p - v_1.origin.xyz;
+    return metal::float3(metal::dot(q_1, v_1.right.xyz), metal::dot(q_1, v_1.up.xyz), metal::dot(q_1, v_1.forward.xyz));
 }
 
 metal::float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2,
     metal::float3 ls
 ) {
     float z_1 = metal::max(ls.z, 0.000001);
-    float t_1 = v_1.proj.x;
-    return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_1)), 0.5 - ((0.5 * ls.y) / (z_1 * t_1)));
+    float t_2 = v_2.proj.x;
+    return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_2)), 0.5 - ((0.5 * ls.y) / (z_1 * t_2)));
 }
 
 uint naga_f2u32(float value) {
@@ -74,98 +78,98 @@ uint naga_f2u32(float value) {
 }
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2,
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
     metal::texture2d<float, metal::access::sample> sm,
     metal::float2 uv
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
-    uint n_1 = v_2.size.x;
-    uint x_1 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
-    uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
+    uint n_2 = v_3.size.x;
+    uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_2)), n_2 - 1u);
+    uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_2)), n_2 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_1, y)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y_1)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
 float shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_3,
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
     float z
 ) {
-    float texel = ((2.0 * metal::max(z, 0.0)) * v_3.proj.x) / static_cast<float>(v_3.size.x);
-    return v_3.forward.w * texel;
+    float texel = ((2.0 * metal::max(z, 0.0)) * v_4.proj.x) / static_cast<float>(v_4.size.x);
+    return v_4.forward.w * texel;
 }
 
 metal::float2 shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_4,
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5,
     metal::float3 ls_1
 ) {
-    return metal::float2((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x), (v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z));
+    return metal::float2((ls_1.x - v_5.proj.x) / (v_5.proj.y - v_5.proj.x), (v_5.proj.w - ls_1.y) / (v_5.proj.w - v_5.proj.z));
 }
 
 float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_5
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6
 ) {
-    float texel_1 = metal::max(v_5.proj.y - v_5.proj.x, v_5.proj.w - v_5.proj.z) / static_cast<float>(v_5.size.x);
-    return v_5.forward.w * texel_1;
+    float texel_1 = metal::max(v_6.proj.y - v_6.proj.x, v_6.proj.w - v_6.proj.z) / static_cast<float>(v_6.size.x);
+    return v_6.forward.w * texel_1;
 }
 
 float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6,
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7,
     metal::texture2d<float, metal::access::sample> sm_1,
     metal::float3 p_1,
     bool perspective
 ) {
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
-    float near = v_6.right.w;
-    float far = v_6.up.w;
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, p_1);
+    float near = v_7.right.w;
+    float far = v_7.up.w;
     if (perspective) {
-        metal::float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
-        float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        metal::float2 _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, _e2);
+        float _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_1, _e8);
         float depth = (_e2.z - near) / (far - near);
-        float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        float _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, _e2.z);
         bool lit = depth <= (_e10 + (_e16 / (far - near)));
         return (lit | (_e2.z <= near)) ? 1.0 : 0.0;
     }
-    metal::float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
-    float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    metal::float2 _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, _e2);
+    float _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_1, _e27);
     float depth_1 = (_e2.z - near) / (far - near);
-    float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    float _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7);
     return (depth_1 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0;
 }
 
 float shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_7,
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8,
     metal::texture2d<float, metal::access::sample> sm_2,
     metal::float3 l
 ) {
-    float near_1 = v_7.right.w;
-    float far_1 = v_7.up.w;
-    metal::float3 dir_3 = metal::float3(metal::dot(l, v_7.right.xyz), metal::dot(l, v_7.up.xyz), metal::dot(l, v_7.forward.xyz));
+    float near_1 = v_8.right.w;
+    float far_1 = v_8.up.w;
+    metal::float3 dir_3 = metal::float3(metal::dot(l, v_8.right.xyz), metal::dot(l, v_8.up.xyz), metal::dot(l, v_8.forward.xyz));
     if (dir_3.z <= 0.000001) {
         return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
     }
-    metal::float2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_3);
-    float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    metal::float2 _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, dir_3);
+    float _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_2, _e20);
     if (_e22 >= 1.0) {
         return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
     }
     float z_2 = near_1 + (_e22 * (far_1 - near_1));
-    float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_2);
+    float _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, z_2);
     return (z_2 + _e29) / dir_3.z;
 }
 
 float shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_8,
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_9,
     metal::texture2d<float, metal::access::sample> sm_3,
     metal::float3 o
 ) {
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
-    float near_2 = v_8.right.w;
-    float far_2 = v_8.up.w;
-    metal::float2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
-    float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9, o);
+    float near_2 = v_9.right.w;
+    float far_2 = v_9.up.w;
+    metal::float2 _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9, _e2);
+    float _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9, sm_3, _e7);
     float z_3 = near_2 + (_e9 * (far_2 - near_2));
-    float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    float _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9);
     return (_e9 >= 1.0) ? NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX : ((z_3 + _e13) - _e2.z);
 }
 
@@ -181,11 +185,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_2 = sigma_t * len;
-    if (x_2 < 0.0001) {
-        return len * (1.0 - (0.5 * x_2));
+    float x_3 = sigma_t * len;
+    if (x_3 < 0.0001) {
+        return len * (1.0 - (0.5 * x_3));
     }
-    return (1.0 - metal::exp(-(x_2))) / sigma_t;
+    return (1.0 - metal::exp(-(x_3))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -205,28 +209,28 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_3 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_3 * x_3) * (3.0 - (2.0 * x_3));
+    float x_4 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_4 * x_4) * (3.0 - (2.0 * x_4));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 eye,
     metal::float3 dir,
-    float t,
+    float t_1,
     metal::float3 light_pos,
     metal::float3 light_dir,
     float cos_inner_1,
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_4 = eye + (dir * t);
-    metal::float3 to_x = x_4 - light_pos;
+    metal::float3 x_5 = eye + (dir * t_1);
+    metal::float3 to_x = x_5 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d);
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t))) / d2_;
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d + t_1))) / d2_;
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -242,7 +246,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float4 medium_1
 ) {
     float sum = 0.0;
-    uint k = 0u;
+    uint k_2 = 0u;
     uint q = {};
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
     float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
@@ -254,17 +258,17 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = _e73 + 1u;
+            uint _e73 = k_2;
+            k_2 = _e73 + 1u;
         }
         loop_init = false;
-        uint _e30 = k;
+        uint _e30 = k_2;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
+            uint _e32 = k_2;
             float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
@@ -303,12 +307,12 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
     metal::float3 light_pos_2,
     float a_2,
     float b_2,
-    uint n
+    uint n_1
 ) {
     float t0_1 = metal::dot(light_pos_2 - eye_2, dir_2);
     float h_1 = metal::max(metal::length((eye_2 + (dir_2 * t0_1)) - light_pos_2), 0.0001 * metal::max(b_2 - a_2, 0.000001));
     float theta_a = metal::atan((a_2 - t0_1) / h_1);
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_1, theta_a, (metal::atan((b_2 - t0_1) / h_1) - theta_a) / static_cast<float>(n)};
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_1, h_1, theta_a, (metal::atan((b_2 - t0_1) / h_1) - theta_a) / static_cast<float>(n_1)};
 }
 
 metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -320,157 +324,252 @@ metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
 }
 
 uint level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
-    uint level_1,
+    uint level,
     uint width
 ) {
-    return ((width + (1u << level_1)) - 1u) >> level_1;
-}
-
-uint tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
-    uint width_1
-) {
-    uint k_1 = 0u;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        uint _e2 = k_1;
-        uint _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
-        if (_e4 > 1u) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = k_1;
-            k_1 = _e8 + 1u;
-        }
-    }
-    uint _e10 = k_1;
-    return _e10 + 1u;
+    return ((width + (1u << level)) - 1u) >> level;
 }
 
 uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
-    uint level_2,
-    uint width_2
+    uint level_1,
+    uint width_1
 ) {
-    uint off_1 = 0u;
-    uint k_2 = 0u;
-    uint2 loop_bound_3 = uint2(4294967295u);
+    uint off = 0u;
+    uint k_3 = 0u;
+    uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e12 = k_2;
-            k_2 = _e12 + 1u;
+            uint _e12 = k_3;
+            k_3 = _e12 + 1u;
         }
         loop_init_2 = false;
-        uint _e3 = k_2;
-        if (_e3 < level_2) {
+        uint _e3 = k_3;
+        if (_e3 < level_1) {
         } else {
             break;
         }
         {
-            uint _e6 = off_1;
-            uint _e7 = k_2;
-            uint _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
-            off_1 = _e6 + _e9;
+            uint _e6 = off;
+            uint _e7 = k_3;
+            uint _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_1);
+            off = _e6 + _e9;
         }
     }
-    uint _e14 = off_1;
+    uint _e14 = off;
     return _e14;
 }
 
-uint tree_widthX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
-    uint width_3
+metal::float2 span_min_max(
+    uint a_3,
+    uint b_3,
+    uint y,
+    metal::texture2d<float, metal::access::sample> rectified
 ) {
-    uint _e1 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
-    uint _e2 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e1, width_3);
-    return _e2;
+    metal::float2 v_10 = {};
+    uint x_1 = {};
+    uint clamped_lod_e5 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+    metal::float4 _e5 = rectified.read(metal::min(metal::uint2(metal::uint2(a_3, y)), metal::uint2(rectified.get_width(clamped_lod_e5), rectified.get_height(clamped_lod_e5)) - 1), clamped_lod_e5);
+    float d0_ = _e5.x;
+    v_10 = metal::float2(d0_, d0_);
+    x_1 = a_3 + 1u;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
+    while(true) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e29 = x_1;
+            x_1 = _e29 + 1u;
+        }
+        loop_init_3 = false;
+        uint _e13 = x_1;
+        if (_e13 < b_3) {
+        } else {
+            break;
+        }
+        {
+            uint _e15 = x_1;
+            uint clamped_lod_e19 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+            metal::float4 _e19 = rectified.read(metal::min(metal::uint2(metal::uint2(_e15, y)), metal::uint2(rectified.get_width(clamped_lod_e19), rectified.get_height(clamped_lod_e19)) - 1), clamped_lod_e19);
+            float d_1 = _e19.x;
+            float _e22 = v_10.x;
+            float _e25 = v_10.y;
+            v_10 = metal::float2(metal::min(_e22, d_1), metal::max(_e25, d_1));
+        }
+    }
+    metal::float2 _e31 = v_10;
+    return _e31;
 }
 
 struct minmax_buildInput {
 };
 kernel void minmax_build(
-  metal::uint3 id [[thread_position_in_grid]]
+  metal::uint3 wid [[threadgroup_position_in_grid]]
+, uint i [[thread_index_in_threadgroup]]
 , constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(0)]]
 , metal::texture2d<float, metal::access::write> tree [[texture(1)]]
+, threadgroup type_10& block_nodes
 ) {
-    bool local = {};
-    uint level = 0u;
-    uint off = 0u;
-    float lo = {};
-    float hi = {};
-    uint i = {};
-    uint width_4 = frame.sizes.z;
-    uint c = id.x;
-    uint y_1 = id.y;
-    uint _e8 = tree_widthX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_4);
-    if (!((c >= _e8))) {
-        uint _e14 = frame.sizes.w;
-        local = y_1 >= _e14;
-    } else {
-        local = true;
+    if (i == 0u) {
+        block_nodes = {};
     }
-    bool _e19 = local;
-    if (_e19) {
+    metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
+    uint t = 0u;
+    metal::float2 top = metal::float2(0.0, 0.0);
+    uint k = 0u;
+    uint n = {};
+    uint c = {};
+    uint k_1 = {};
+    metal::float2 v = {};
+    uint m = {};
+    uint width_2 = frame.sizes.z;
+    uint y_2 = wid.y;
+    uint _e12 = frame.sizes.w;
+    if (y_2 >= _e12) {
         return;
     }
     uint2 loop_bound_4 = uint2(4294967295u);
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        uint _e21 = level;
-        uint _e22 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e21, width_4);
-        uint _e24 = off;
-        if (c < (_e24 + _e22)) {
-            break;
-        }
-        uint _e27 = off;
-        off = _e27 + _e22;
-        uint _e30 = level;
-        level = _e30 + 1u;
-    }
-    uint _e32 = off;
-    uint _e34 = level;
-    uint first = (c - _e32) << _e34;
-    uint _e37 = level;
-    uint end = metal::min(first + (1u << _e37), width_4);
-    uint clamped_lod_e44 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-    metal::float4 _e44 = rectified.read(metal::min(metal::uint2(metal::uint2(first, y_1)), metal::uint2(rectified.get_width(clamped_lod_e44), rectified.get_height(clamped_lod_e44)) - 1), clamped_lod_e44);
-    float d0_ = _e44.x;
-    lo = d0_;
-    hi = d0_;
-    i = first + 1u;
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_3 = true;
-    while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_3) {
-            uint _e64 = i;
-            i = _e64 + 1u;
-        }
-        loop_init_3 = false;
-        uint _e51 = i;
-        if (_e51 < end) {
+        uint _e16 = t;
+        if ((LANES << _e16) < width_2) {
         } else {
             break;
         }
         {
-            uint _e53 = i;
-            uint clamped_lod_e57 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e57 = rectified.read(metal::min(metal::uint2(metal::uint2(_e53, y_1)), metal::uint2(rectified.get_width(clamped_lod_e57), rectified.get_height(clamped_lod_e57)) - 1), clamped_lod_e57);
-            float d_1 = _e57.x;
-            float _e59 = lo;
-            lo = metal::min(_e59, d_1);
-            float _e61 = hi;
-            hi = metal::max(_e61, d_1);
+            uint _e20 = t;
+            t = _e20 + 1u;
         }
     }
-    float _e67 = lo;
-    float _e68 = hi;
-    tree.write(metal::float4(_e67, _e68, 0.0, 0.0), metal::uint2(metal::uint2(c, y_1)));
+    uint2 loop_bound_5 = uint2(4294967295u);
+    bool loop_init_4 = true;
+    while(true) {
+        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_4) {
+            uint _e65 = k;
+            k = _e65 + 1u;
+        }
+        loop_init_4 = false;
+        uint _e23 = k;
+        uint _e24 = t;
+        if (_e23 <= _e24) {
+        } else {
+            break;
+        }
+        {
+            uint _e26 = k;
+            uint _e27 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e26, width_2);
+            uint _e28 = k;
+            uint _e29 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e28, width_2);
+            uint _e31 = t;
+            uint _e32 = k;
+            uint per_block = 1u << (_e31 - _e32);
+            n = 0u;
+            uint2 loop_bound_6 = uint2(4294967295u);
+            bool loop_init_5 = true;
+            while(true) {
+                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                if (!loop_init_5) {
+                    uint _e62 = n;
+                    n = _e62 + 1u;
+                }
+                loop_init_5 = false;
+                uint _e37 = n;
+                if (_e37 < per_block) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e41 = n;
+                    uint j = (i * per_block) + _e41;
+                    if (j < _e27) {
+                        uint _e44 = k;
+                        uint _e48 = k;
+                        metal::float2 _e51 = span_min_max(j << _e44, metal::min((j + 1u) << _e48, width_2), y_2, rectified);
+                        tree.write(metal::float4(_e51.x, _e51.y, 0.0, 0.0), metal::uint2(metal::uint2(_e29 + j, y_2)));
+                        top = _e51;
+                    }
+                }
+            }
+        }
+    }
+    metal::float2 _e69 = top;
+    block_nodes.inner[metal::min(unsigned(i), 127u)] = _e69;
+    metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
+    uint _e70 = t;
+    uint _e71 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e70, width_2);
+    c = i;
+    uint _e73 = t;
+    k_1 = _e73 + 1u;
+    uint2 loop_bound_7 = uint2(4294967295u);
+    while(true) {
+        if (metal::all(loop_bound_7 == uint2(0u))) { break; }
+        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+        uint _e77 = k_1;
+        uint _e80 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e77 - 1u, width_2);
+        if (_e80 > 1u) {
+        } else {
+            break;
+        }
+        {
+            uint _e83 = k_1;
+            uint _e84 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e83, width_2);
+            uint _e85 = c;
+            if (_e85 < _e84) {
+                uint _e87 = c;
+                uint _e88 = k_1;
+                uint _e89 = t;
+                uint a_4 = _e87 << (_e88 - _e89);
+                uint _e92 = c;
+                uint _e95 = k_1;
+                uint _e96 = t;
+                uint b_4 = metal::min((_e92 + 1u) << (_e95 - _e96), _e71);
+                metal::float2 _e102 = block_nodes.inner[metal::min(unsigned(a_4), 127u)];
+                v = _e102;
+                m = a_4 + 1u;
+                uint2 loop_bound_8 = uint2(4294967295u);
+                bool loop_init_6 = true;
+                while(true) {
+                    if (metal::all(loop_bound_8 == uint2(0u))) { break; }
+                    loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
+                    if (!loop_init_6) {
+                        uint _e123 = m;
+                        m = _e123 + 1u;
+                    }
+                    loop_init_6 = false;
+                    uint _e107 = m;
+                    if (_e107 < b_4) {
+                    } else {
+                        break;
+                    }
+                    {
+                        uint _e110 = m;
+                        metal::float2 w_1 = block_nodes.inner[metal::min(unsigned(_e110), 127u)];
+                        float _e114 = v.x;
+                        float _e118 = v.y;
+                        v = metal::float2(metal::min(_e114, w_1.x), metal::max(_e118, w_1.y));
+                    }
+                }
+                uint _e125 = k_1;
+                uint _e126 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e125, width_2);
+                uint _e127 = c;
+                float _e131 = v.x;
+                float _e133 = v.y;
+                tree.write(metal::float4(_e131, _e133, 0.0, 0.0), metal::uint2(metal::uint2(_e126 + _e127, y_2)));
+                break;
+            }
+            uint _e138 = c;
+            c = _e138 - _e84;
+            uint _e141 = k_1;
+            k_1 = _e141 + 1u;
+        }
+    }
     return;
 }

@@ -48,6 +48,7 @@ const NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX: f32 = 10000000000000
 const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
+const LANES: u32 = 128u;
 
 @group(0) @binding(0) 
 var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX;
@@ -55,85 +56,86 @@ var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX;
 var rectified: texture_2d<f32>;
 @group(0) @binding(2) 
 var tree: texture_storage_2d<rg32float,write>;
+var<workgroup> block_nodes: array<vec2<f32>, 128>;
 
-fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
-    let q_1 = (p - v.origin.xyz);
-    return vec3<f32>(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
+fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
+    let q_1 = (p - v_1.origin.xyz);
+    return vec3<f32>(dot(q_1, v_1.right.xyz), dot(q_1, v_1.up.xyz), dot(q_1, v_1.forward.xyz));
 }
 
-fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
+fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
     let z_1 = max(ls.z, 0.000001f);
-    let t_1 = v_1.proj.x;
-    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_1))), (0.5f - ((0.5f * ls.y) / (z_1 * t_1))));
+    let t_2 = v_2.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_2))), (0.5f - ((0.5f * ls.y) / (z_1 * t_2))));
 }
 
-fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
+fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
-    let n_1 = v_2.size.x;
-    let x_1 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
-    let y = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e36 = textureLoad(sm, vec2<u32>(x_1, y), 0i);
+    let n_2 = v_3.size.x;
+    let x_2 = min(u32((uv.x * f32(n_2))), (n_2 - 1u));
+    let y_1 = min(u32((uv.y * f32(n_2))), (n_2 - 1u));
+    let _e36 = textureLoad(sm, vec2<u32>(x_2, y_1), 0i);
     return select(_e36.x, 2f, outside);
 }
 
-fn shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
-    let texel = (((2f * max(z, 0f)) * v_3.proj.x) / f32(v_3.size.x));
-    return (v_3.forward.w * texel);
+fn shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, z: f32) -> f32 {
+    let texel = (((2f * max(z, 0f)) * v_4.proj.x) / f32(v_4.size.x));
+    return (v_4.forward.w * texel);
 }
 
-fn shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_4: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls_1: vec3<f32>) -> vec2<f32> {
-    return vec2<f32>(((ls_1.x - v_4.proj.x) / (v_4.proj.y - v_4.proj.x)), ((v_4.proj.w - ls_1.y) / (v_4.proj.w - v_4.proj.z)));
+fn shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls_1: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(((ls_1.x - v_5.proj.x) / (v_5.proj.y - v_5.proj.x)), ((v_5.proj.w - ls_1.y) / (v_5.proj.w - v_5.proj.z)));
 }
 
-fn shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) -> f32 {
-    let texel_1 = (max((v_5.proj.y - v_5.proj.x), (v_5.proj.w - v_5.proj.z)) / f32(v_5.size.x));
-    return (v_5.forward.w * texel_1);
+fn shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX) -> f32 {
+    let texel_1 = (max((v_6.proj.y - v_6.proj.x), (v_6.proj.w - v_6.proj.z)) / f32(v_6.size.x));
+    return (v_6.forward.w * texel_1);
 }
 
-fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>, perspective: bool) -> f32 {
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
-    let near = v_6.right.w;
-    let far = v_6.up.w;
+fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>, perspective: bool) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, p_1);
+    let near = v_7.right.w;
+    let far = v_7.up.w;
     if perspective {
-        let _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
-        let _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e8);
+        let _e8 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, _e2);
+        let _e10 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_1, _e8);
         let depth = ((_e2.z - near) / (far - near));
-        let _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2.z);
+        let _e16 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, _e2.z);
         let lit = (depth <= (_e10 + (_e16 / (far - near))));
         return select(0f, 1f, (lit | (_e2.z <= near)));
     }
-    let _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, _e2);
-    let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, sm_1, _e27);
+    let _e27 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, _e2);
+    let _e28 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_1, _e27);
     let depth_1 = ((_e2.z - near) / (far - near));
-    let _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6);
+    let _e33 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7);
     return select(0f, 1f, (depth_1 <= (_e28 + (_e33 / (far - near)))));
 }
 
-fn shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, l: vec3<f32>) -> f32 {
-    let near_1 = v_7.right.w;
-    let far_1 = v_7.up.w;
-    let dir_3 = vec3<f32>(dot(l, v_7.right.xyz), dot(l, v_7.up.xyz), dot(l, v_7.forward.xyz));
+fn shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_2: texture_2d<f32>, l: vec3<f32>) -> f32 {
+    let near_1 = v_8.right.w;
+    let far_1 = v_8.up.w;
+    let dir_3 = vec3<f32>(dot(l, v_8.right.xyz), dot(l, v_8.up.xyz), dot(l, v_8.forward.xyz));
     if (dir_3.z <= 0.000001f) {
         return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
     }
-    let _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, dir_3);
-    let _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, sm_2, _e20);
+    let _e20 = shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, dir_3);
+    let _e22 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_2, _e20);
     if (_e22 >= 1f) {
         return NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX;
     }
     let z_2 = (near_1 + (_e22 * (far_1 - near_1)));
-    let _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_7, z_2);
+    let _e29 = shadow_bias_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, z_2);
     return ((z_2 + _e29) / dir_3.z);
 }
 
-fn shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_3: texture_2d<f32>, o: vec3<f32>) -> f32 {
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, o);
-    let near_2 = v_8.right.w;
-    let far_2 = v_8.up.w;
-    let _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, _e2);
-    let _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8, sm_3, _e7);
+fn shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_3: texture_2d<f32>, o: vec3<f32>) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9, o);
+    let near_2 = v_9.right.w;
+    let far_2 = v_9.up.w;
+    let _e7 = shadow_uv_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9, _e2);
+    let _e9 = shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9, sm_3, _e7);
     let z_3 = (near_2 + (_e9 * (far_2 - near_2)));
-    let _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_8);
+    let _e13 = shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_9);
     return select(((z_3 + _e13) - _e2.z), NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, (_e9 >= 1f));
 }
 
@@ -143,11 +145,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_2 = (sigma_t * len);
-    if (x_2 < 0.0001f) {
-        return (len * (1f - (0.5f * x_2)));
+    let x_3 = (sigma_t * len);
+    if (x_3 < 0.0001f) {
+        return (len * (1f - (0.5f * x_3)));
     }
-    return ((1f - exp(-(x_2))) / sigma_t);
+    return ((1f - exp(-(x_3))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -159,24 +161,24 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_3 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_3 * x_3) * (3f - (2f * x_3)));
+    let x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_4 * x_4) * (3f - (2f * x_4)));
 }
 
-fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_4 = (eye + (dir * t));
-    let to_x = (x_4 - light_pos);
+fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t_1: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
+    let x_5 = (eye + (dir * t_1));
+    let to_x = (x_5 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d = sqrt(d2_);
     let travel = (to_x / vec3(d));
     let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d + t_1)))) / d2_);
 }
 
 fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
     var sum: f32 = 0f;
-    var k: u32 = 0u;
+    var k_2: u32 = 0u;
     var q: u32;
 
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
@@ -184,13 +186,13 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let g0_ = atan(((a_1 - t0_) / h));
     let w = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
-        let _e30 = k;
+        let _e30 = k_2;
         if (_e30 < panels) {
         } else {
             break;
         }
         {
-            let _e32 = k;
+            let _e32 = k_2;
             let mid = (g0_ + ((f32(_e32) + 0.5f) * w));
             q = 0u;
             loop {
@@ -214,19 +216,19 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
             }
         }
         continuing {
-            let _e73 = k;
-            k = (_e73 + 1u);
+            let _e73 = k_2;
+            k_2 = (_e73 + 1u);
         }
     }
     let _e75 = sum;
     return (((_e75 * 0.5f) * w) * h);
 }
 
-fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n_1: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     let t0_1 = dot((light_pos_2 - eye_2), dir_2);
     let h_1 = max(length(((eye_2 + (dir_2 * t0_1)) - light_pos_2)), (0.0001f * max((b_2 - a_2), 0.000001f)));
     let theta_a = atan(((a_2 - t0_1) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / f32(n)));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_1, h_1, theta_a, ((atan(((b_2 - t0_1) / h_1)) - theta_a) / f32(n_1)));
 }
 
 fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x: f32) -> vec2<f32> {
@@ -234,127 +236,200 @@ fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_na
     return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
-fn level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_1: u32, width: u32) -> u32 {
-    return (((width + (1u << level_1)) - 1u) >> level_1);
+fn level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level: u32, width: u32) -> u32 {
+    return (((width + (1u << level)) - 1u) >> level);
 }
 
-fn tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_1: u32) -> u32 {
-    var k_1: u32 = 0u;
+fn level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_1: u32, width_1: u32) -> u32 {
+    var off: u32 = 0u;
+    var k_3: u32 = 0u;
 
     loop {
-        let _e2 = k_1;
-        let _e4 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e2, width_1);
-        if (_e4 > 1u) {
+        let _e3 = k_3;
+        if (_e3 < level_1) {
         } else {
             break;
         }
         {
-            let _e8 = k_1;
-            k_1 = (_e8 + 1u);
-        }
-    }
-    let _e10 = k_1;
-    return (_e10 + 1u);
-}
-
-fn level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_2: u32, width_2: u32) -> u32 {
-    var off_1: u32 = 0u;
-    var k_2: u32 = 0u;
-
-    loop {
-        let _e3 = k_2;
-        if (_e3 < level_2) {
-        } else {
-            break;
-        }
-        {
-            let _e6 = off_1;
-            let _e7 = k_2;
-            let _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_2);
-            off_1 = (_e6 + _e9);
+            let _e6 = off;
+            let _e7 = k_3;
+            let _e9 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e7, width_1);
+            off = (_e6 + _e9);
         }
         continuing {
-            let _e12 = k_2;
-            k_2 = (_e12 + 1u);
+            let _e12 = k_3;
+            k_3 = (_e12 + 1u);
         }
     }
-    let _e14 = off_1;
+    let _e14 = off;
     return _e14;
 }
 
-fn tree_widthX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3: u32) -> u32 {
-    let _e1 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
-    let _e2 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e1, width_3);
-    return _e2;
-}
+fn span_min_max(a_3: u32, b_3: u32, y: u32) -> vec2<f32> {
+    var v_10: vec2<f32>;
+    var x_1: u32;
 
-@compute @workgroup_size(64, 1, 1) 
-fn minmax_build(@builtin(global_invocation_id) id: vec3<u32>) {
-    var local: bool;
-    var level: u32 = 0u;
-    var off: u32 = 0u;
-    var lo: f32;
-    var hi: f32;
-    var i: u32;
-
-    let width_4 = frame.sizes.z;
-    let c = id.x;
-    let y_1 = id.y;
-    let _e8 = tree_widthX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_4);
-    if !((c >= _e8)) {
-        let _e14 = frame.sizes.w;
-        local = (y_1 >= _e14);
-    } else {
-        local = true;
-    }
-    let _e19 = local;
-    if _e19 {
-        return;
-    }
+    let _e5 = textureLoad(rectified, vec2<u32>(a_3, y), 0i);
+    let d0_ = _e5.x;
+    v_10 = vec2<f32>(d0_, d0_);
+    x_1 = (a_3 + 1u);
     loop {
-        let _e21 = level;
-        let _e22 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e21, width_4);
-        let _e24 = off;
-        if (c < (_e24 + _e22)) {
-            break;
-        }
-        let _e27 = off;
-        off = (_e27 + _e22);
-        let _e30 = level;
-        level = (_e30 + 1u);
-    }
-    let _e32 = off;
-    let _e34 = level;
-    let first = ((c - _e32) << _e34);
-    let _e37 = level;
-    let end = min((first + (1u << _e37)), width_4);
-    let _e44 = textureLoad(rectified, vec2<u32>(first, y_1), 0i);
-    let d0_ = _e44.x;
-    lo = d0_;
-    hi = d0_;
-    i = (first + 1u);
-    loop {
-        let _e51 = i;
-        if (_e51 < end) {
+        let _e13 = x_1;
+        if (_e13 < b_3) {
         } else {
             break;
         }
         {
-            let _e53 = i;
-            let _e57 = textureLoad(rectified, vec2<u32>(_e53, y_1), 0i);
-            let d_1 = _e57.x;
-            let _e59 = lo;
-            lo = min(_e59, d_1);
-            let _e61 = hi;
-            hi = max(_e61, d_1);
+            let _e15 = x_1;
+            let _e19 = textureLoad(rectified, vec2<u32>(_e15, y), 0i);
+            let d_1 = _e19.x;
+            let _e22 = v_10.x;
+            let _e25 = v_10.y;
+            v_10 = vec2<f32>(min(_e22, d_1), max(_e25, d_1));
         }
         continuing {
-            let _e64 = i;
-            i = (_e64 + 1u);
+            let _e29 = x_1;
+            x_1 = (_e29 + 1u);
         }
     }
-    let _e67 = lo;
-    let _e68 = hi;
-    textureStore(tree, vec2<u32>(c, y_1), vec4<f32>(_e67, _e68, 0f, 0f));
+    let _e31 = v_10;
+    return _e31;
+}
+
+@compute @workgroup_size(128, 1, 1) 
+fn minmax_build(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) i: u32) {
+    var t: u32 = 0u;
+    var top: vec2<f32> = vec2<f32>(0f, 0f);
+    var k: u32 = 0u;
+    var n: u32;
+    var c: u32;
+    var k_1: u32;
+    var v: vec2<f32>;
+    var m: u32;
+
+    let width_2 = frame.sizes.z;
+    let y_2 = wid.y;
+    let _e12 = frame.sizes.w;
+    if (y_2 >= _e12) {
+        return;
+    }
+    loop {
+        let _e16 = t;
+        if ((LANES << _e16) < width_2) {
+        } else {
+            break;
+        }
+        {
+            let _e20 = t;
+            t = (_e20 + 1u);
+        }
+    }
+    loop {
+        let _e23 = k;
+        let _e24 = t;
+        if (_e23 <= _e24) {
+        } else {
+            break;
+        }
+        {
+            let _e26 = k;
+            let _e27 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e26, width_2);
+            let _e28 = k;
+            let _e29 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e28, width_2);
+            let _e31 = t;
+            let _e32 = k;
+            let per_block = (1u << (_e31 - _e32));
+            n = 0u;
+            loop {
+                let _e37 = n;
+                if (_e37 < per_block) {
+                } else {
+                    break;
+                }
+                {
+                    let _e41 = n;
+                    let j = ((i * per_block) + _e41);
+                    if (j < _e27) {
+                        let _e44 = k;
+                        let _e48 = k;
+                        let _e51 = span_min_max((j << _e44), min(((j + 1u) << _e48), width_2), y_2);
+                        textureStore(tree, vec2<u32>((_e29 + j), y_2), vec4<f32>(_e51.x, _e51.y, 0f, 0f));
+                        top = _e51;
+                    }
+                }
+                continuing {
+                    let _e62 = n;
+                    n = (_e62 + 1u);
+                }
+            }
+        }
+        continuing {
+            let _e65 = k;
+            k = (_e65 + 1u);
+        }
+    }
+    let _e69 = top;
+    block_nodes[i] = _e69;
+    workgroupBarrier();
+    let _e70 = t;
+    let _e71 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e70, width_2);
+    c = i;
+    let _e73 = t;
+    k_1 = (_e73 + 1u);
+    loop {
+        let _e77 = k_1;
+        let _e80 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX((_e77 - 1u), width_2);
+        if (_e80 > 1u) {
+        } else {
+            break;
+        }
+        {
+            let _e83 = k_1;
+            let _e84 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e83, width_2);
+            let _e85 = c;
+            if (_e85 < _e84) {
+                let _e87 = c;
+                let _e88 = k_1;
+                let _e89 = t;
+                let a_4 = (_e87 << (_e88 - _e89));
+                let _e92 = c;
+                let _e95 = k_1;
+                let _e96 = t;
+                let b_4 = min(((_e92 + 1u) << (_e95 - _e96)), _e71);
+                let _e102 = block_nodes[a_4];
+                v = _e102;
+                m = (a_4 + 1u);
+                loop {
+                    let _e107 = m;
+                    if (_e107 < b_4) {
+                    } else {
+                        break;
+                    }
+                    {
+                        let _e110 = m;
+                        let w_1 = block_nodes[_e110];
+                        let _e114 = v.x;
+                        let _e118 = v.y;
+                        v = vec2<f32>(min(_e114, w_1.x), max(_e118, w_1.y));
+                    }
+                    continuing {
+                        let _e123 = m;
+                        m = (_e123 + 1u);
+                    }
+                }
+                let _e125 = k_1;
+                let _e126 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e125, width_2);
+                let _e127 = c;
+                let _e131 = v.x;
+                let _e133 = v.y;
+                textureStore(tree, vec2<u32>((_e126 + _e127), y_2), vec4<f32>(_e131, _e133, 0f, 0f));
+                break;
+            }
+            let _e138 = c;
+            c = (_e138 - _e84);
+            let _e141 = k_1;
+            k_1 = (_e141 + 1u);
+        }
+    }
     return;
 }

@@ -1,52 +1,94 @@
 //! CPU mirror of `shaderlib/templates/minmax_build.wgsl`: the 1D min-max binary tree of
 //! every rectified row (Chen et al. 2011), all levels packed into one rg32float row per
-//! rectified row (layout: `scatter_frame::minmax`).
+//! rectified row (layout: `scatter_frame::minmax`). One workgroup of [`BUILD_LANES`]
+//! invocations per row: phase 1 writes the levels 0 ..= t of each invocation's block of 2^t
+//! texels, phase 2 (after the barrier) the levels above t from the blocks' level-t nodes.
 
-use super::common_minmax::{level_count, tree_width};
+use super::common_minmax::{level_count, level_offset, tree_width};
 use super::texture::{Tex, TexArray};
+use scatter_shaderlib::minmax::BUILD_LANES;
 use scatter_shaderlib::prefiltered::FrameUniforms;
 
-/// The kernel body for invocation `id`; returns the node `(min, max, 0, 0)` it stores at
-/// tree texel `id.xy` (None: out of range, no store).
-pub fn minmax_build_main(id: [u32; 3], frame: &FrameUniforms, rectified: &Tex) -> Option<[f32; 4]> {
-    let width = frame.sizes[2];
-    let (c, y) = (id[0], id[1]);
-    if c >= tree_width(width) || y >= frame.sizes[3] {
-        return None;
+/// (min, max) of the stored depths of texels [a, b) of row y (a < b).
+fn span_min_max(rectified: &Tex, a: u32, b: u32, y: u32) -> [f32; 2] {
+    let d0 = rectified.load(a, y);
+    let mut v = [d0, d0];
+    for x in a + 1..b {
+        let d = rectified.load(x, y);
+        v = [v[0].min(d), v[1].max(d)];
     }
-    // The level and node of packed column c.
-    let mut level = 0u32;
-    let mut off = 0u32;
-    loop {
-        let count = level_count(level, width);
-        if c < off + count {
-            break;
-        }
-        off += count;
-        level += 1;
-    }
-    let first = (c - off) << level;
-    let end = (first + (1u32 << level)).min(width);
-    let d0 = rectified.load(first, y);
-    let mut lo = d0;
-    let mut hi = d0;
-    for i in first + 1..end {
-        let d = rectified.load(i, y);
-        lo = lo.min(d);
-        hi = hi.max(d);
-    }
-    Some([lo, hi, 0.0, 0.0])
+    v
 }
 
-/// Runs every invocation (rows in parallel); returns the `tree_width(Wr) x Hr` tree texture
-/// (one layer; b and a are 0).
+/// The workgroup of row `y`: the nodes it stores, `(packed column, (min, max, 0, 0))`.
+pub fn minmax_build_row(y: u32, frame: &FrameUniforms, rectified: &Tex) -> Vec<(u32, [f32; 4])> {
+    let width = frame.sizes[2];
+    let mut out = Vec::new();
+    if y >= frame.sizes[3] {
+        return out;
+    }
+    // The block side B = 2^t.
+    let mut t = 0u32;
+    while (BUILD_LANES << t) < width {
+        t += 1;
+    }
+    // Phase 1, invocation i: levels 0 ..= t of block i.
+    let mut block_nodes = vec![[0.0f32; 2]; BUILD_LANES as usize];
+    for i in 0..BUILD_LANES {
+        let mut top = [0.0f32; 2];
+        for k in 0..=t {
+            let count = level_count(k, width);
+            let off = level_offset(k, width);
+            let per_block = 1u32 << (t - k);
+            for n in 0..per_block {
+                let j = i * per_block + n;
+                if j < count {
+                    let v = span_min_max(rectified, j << k, ((j + 1) << k).min(width), y);
+                    out.push((off + j, [v[0], v[1], 0.0, 0.0]));
+                    top = v;
+                }
+            }
+        }
+        block_nodes[i as usize] = top;
+    }
+    // Phase 2, invocation i: node i of the levels above t, counted across them in order.
+    let count_t = level_count(t, width);
+    for i in 0..BUILD_LANES {
+        let mut c = i;
+        let mut k = t + 1;
+        while level_count(k - 1, width) > 1 {
+            let count = level_count(k, width);
+            if c < count {
+                let a = c << (k - t);
+                let b = ((c + 1) << (k - t)).min(count_t);
+                let mut v = block_nodes[a as usize];
+                for m in a + 1..b {
+                    let w = block_nodes[m as usize];
+                    v = [v[0].min(w[0]), v[1].max(w[1])];
+                }
+                out.push((level_offset(k, width) + c, [v[0], v[1], 0.0, 0.0]));
+                break;
+            }
+            c -= count;
+            k += 1;
+        }
+    }
+    out
+}
+
+/// Runs every workgroup (rows in parallel); returns the `tree_width(Wr) x Hr` tree texture
+/// (one layer; b and a are 0; a texel no invocation stores stays 0).
 pub fn minmax_build(frame: &FrameUniforms, rectified: &Tex) -> TexArray {
     use rayon::prelude::*;
     let (tw, h) = (tree_width(frame.sizes[2]), frame.sizes[3]);
     let data = (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
-            (0..tw).map(move |c| minmax_build_main([c, y, 0], frame, rectified).unwrap_or([0.0; 4]))
+            let mut row = vec![[0.0f32; 4]; tw as usize];
+            for (c, v) in minmax_build_row(y, frame, rectified) {
+                row[c as usize] = v;
+            }
+            row
         })
         .collect();
     TexArray {
@@ -54,5 +96,47 @@ pub fn minmax_build(frame: &FrameUniforms, rectified: &Tex) -> TexArray {
         height: h,
         layers: 1,
         data,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every packed column of the tree is stored exactly once, with the (min, max) of its
+    /// node's texels, for widths around the block boundaries.
+    #[test]
+    fn every_node_once_with_its_span() {
+        for width in [
+            1u32, 2, 3, 7, 127, 128, 129, 255, 256, 300, 1000, 1024, 1025, 4096,
+        ] {
+            let mut frame: FrameUniforms = bytemuck::Zeroable::zeroed();
+            frame.sizes[2] = width;
+            frame.sizes[3] = 1;
+            let data: Vec<f32> = (0..width).map(|x| ((x * 7919) % 1009) as f32).collect();
+            let mut rectified = Tex::new(width, 1);
+            for (x, &d) in data.iter().enumerate() {
+                rectified.store(x as u32, 0, d);
+            }
+            let nodes = minmax_build_row(0, &frame, &rectified);
+            let tw = tree_width(width);
+            let mut seen = vec![0u32; tw as usize];
+            for &(c, _) in &nodes {
+                seen[c as usize] += 1;
+            }
+            assert!(seen.iter().all(|&n| n == 1), "width {width}: {seen:?}");
+            for (c, v) in nodes {
+                // The node's level and index.
+                let mut k = 0;
+                while c >= level_offset(k + 1, width) {
+                    k += 1;
+                }
+                let j = c - level_offset(k, width);
+                let span = &data[(j << k) as usize..((j + 1) << k).min(width) as usize];
+                let lo = span.iter().copied().fold(f32::INFINITY, f32::min);
+                let hi = span.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+                assert_eq!([v[0], v[1]], [lo, hi], "width {width}, level {k}, node {j}");
+            }
+        }
     }
 }

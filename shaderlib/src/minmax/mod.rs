@@ -19,8 +19,13 @@ use crate::compose::template_path;
 use crate::prefiltered::LightKind;
 use crate::{Kernel, ShaderError};
 
-/// Workgroup size of `minmax_build`: one invocation per tree node, 64 along a row.
-pub const BUILD_WORKGROUP_SIZE: [u32; 3] = [64, 1, 1];
+/// Workgroup size of `minmax_build`: one workgroup of 128 invocations per rectified row
+/// (`LANES` in the template).
+pub const BUILD_WORKGROUP_SIZE: [u32; 3] = [BUILD_LANES, 1, 1];
+
+/// Invocations of `minmax_build` per rectified row: the row is cut into this many blocks of
+/// a power-of-two side.
+pub const BUILD_LANES: u32 = 128;
 
 /// Workgroup size of `minmax_traverse`: one invocation per pixel.
 pub const MARCH_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];

@@ -145,7 +145,7 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
         }),
         Kernel::MinmaxBuild => Some(PassPlan {
             kernel,
-            invocations: [f("tree.width"), f("rectified.height"), f("1")],
+            invocations: [f("128"), f("rectified.height"), f("1")],
             skip_when: None,
             bindings: vec![bind(0, "frame"), bind(1, "rectified"), bind(2, "tree")],
         }),
