@@ -157,7 +157,8 @@ pub fn depth_and_shadow_map() -> [Resource; 2] {
         input(
             "shadow_map",
             "standard shadow map: normalised linear light depth, 1 where nothing was hit, \
-             texel (0, 0) top-left",
+             texel (0, 0) top-left; orthographic for a directional light, perspective for a \
+             spot (the kernels are generated for one light kind and test only its map kind)",
             "shadow.size",
             "shadow.size",
         ),

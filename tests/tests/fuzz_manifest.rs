@@ -653,7 +653,7 @@ fn pfm_reader_on_hostile_files() {
     });
 }
 
-/// A valid `frame.json` of a directional frame.
+/// A valid `frame.json` of a frame with `light` (its shadow map of that light's kind).
 fn real_frame_file(light: LightKind) -> Value {
     let forward = DVec3::new(0.1, -0.2, -1.0).normalize();
     let right = forward.cross(DVec3::Y).normalize();
@@ -695,15 +695,28 @@ fn real_frame_file(light: LightKind) -> Value {
             two_sided: false,
         }),
     };
+    // The light's kind of map: orthographic for the sun, perspective from a spot's position.
+    let (origin, projection) = match light {
+        LightDesc::Directional { .. } => (
+            DVec3::new(0.0, 20.0, 0.0),
+            ShadowProjectionDesc::Orthographic {
+                x0: -20.0,
+                x1: 20.0,
+                y0: -20.0,
+                y1: 20.0,
+            },
+        ),
+        _ => (
+            DVec3::new(2.0, 10.0, 0.0),
+            ShadowProjectionDesc::Perspective {
+                tan_half: 30f64.to_radians().tan(),
+            },
+        ),
+    };
     let shadow = ShadowMapDesc {
-        origin: DVec3::new(0.0, 20.0, 0.0),
+        origin,
         basis,
-        projection: ShadowProjectionDesc::Orthographic {
-            x0: -20.0,
-            x1: 20.0,
-            y0: -20.0,
-            y1: 20.0,
-        },
+        projection,
         near: 0.0,
         far: 60.0,
         size: 64,
