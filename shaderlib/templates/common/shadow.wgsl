@@ -46,8 +46,8 @@ fn shadow_uv(v: ShadowMapView, ls: vec3<f32>) -> vec2<f32> {
 
 // `shadow_uv` of an orthographic map (the sun) and of a perspective one (a spot). A kernel
 // generated for one light kind calls its half directly: llvmpipe runs both sides of a
-// branch on the uniform `origin.w` under a mask, and `rectify` spent 9 of its 13.5 ms
-// (1024x1024 map) in the branches of `shadow_occluder_distance`.
+// branch on the uniform `origin.w` under a mask (`rectify`, 1024x1024 map at 1280x720: 13.5
+// ms with the branch, 11.0 ms calling its half).
 fn shadow_uv_orthographic(v: ShadowMapView, ls: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(
         (ls.x - v.proj[0]) / (v.proj[1] - v.proj[0]),
@@ -82,8 +82,9 @@ fn shadow_bias_perspective(v: ShadowMapView, z: f32) -> f32 {
 }
 
 fn shadow_fetch(v: ShadowMapView, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
-    // Without a branch (a texel at the clamped coordinates loaded either way): llvmpipe
-    // runs a function's early return as a mask over the rest, and `||` as nested branches.
+    // Without a branch: a texel at the clamped coordinates is loaded either way and the
+    // outside case selected (as fast on llvmpipe as the early return it replaces, which
+    // llvmpipe runs as a mask over the rest anyway).
     let outside = (uv[0] < 0.0) | (uv[0] > 1.0) | (uv[1] < 0.0) | (uv[1] > 1.0);
     let n = v.size.x;
     let x = min(u32(uv[0] * f32(n)), n - 1u);
