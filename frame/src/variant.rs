@@ -26,7 +26,8 @@ pub enum VisibilityMode {
 // names (`ALL`, `name`, parsing) are given below with the prefiltered knobs'.
 pub use crate::scene::LightKind;
 
-/// Storage format of the filtered-basis texture array.
+/// Storage format of the filtered bases (the bits of one texel of this format per layer and
+/// rectified texel in the `filtered` storage buffer).
 #[derive(
     Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
 )]
@@ -440,7 +441,7 @@ impl PrefilteredVariant {
 
     /// rgba layers of one colour channel's filtered basis: `bases / 4` (Fourier), or
     /// `ceil(moments / 4)` (moments: `(z, z^2, z^3, z^4)` then `(z^5, z^6, 0, 0)`). The
-    /// texture array holds [`Self::filtered_layers`].
+    /// `filtered` buffer holds [`Self::filtered_layers`].
     pub fn layers(&self) -> u32 {
         match self.basis {
             Basis::Fourier => self.bases / 4,
@@ -448,7 +449,7 @@ impl PrefilteredVariant {
         }
     }
 
-    /// rgba layers of the filtered-basis texture array: [`Self::layers`], or with a cookie
+    /// rgba layers of the `filtered` buffer: [`Self::layers`], or with a cookie
     /// `3 * layers + 1` (channel `c`'s layer `q` at `c * layers + q`, then the region's mean
     /// cookie, rgb, in the last layer).
     pub fn filtered_layers(&self) -> u32 {

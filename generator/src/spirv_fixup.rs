@@ -17,8 +17,8 @@
 //! `textureLoad` from a `texture_2d_array` (`min(coords, size - 1)` on a `vec3`) does not
 //! validate there, although the module is valid SPIR-V. [`fix_arrayed_load_clamps`] feeds
 //! that clamp the query's width and height only, with the layer bound `u32::MAX`: the texel
-//! coordinates stay clamped, the layer index is left as the kernel computed it (scatter's
-//! loop counter, below the layer count the manifest gives the texture). Queries used for
+//! coordinates stay clamped, the layer index is left as the kernel computed it (`ivsv_rectify`'s
+//! VPL index, below the layer count the manifest gives the texture). Queries used for
 //! anything but such a clamp are left alone.
 
 use std::collections::HashMap;

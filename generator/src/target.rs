@@ -19,7 +19,7 @@ use std::fmt;
 
 use naga::back::{glsl, hlsl, msl, spv};
 use naga::proc::{BoundsCheckPolicies, BoundsCheckPolicy};
-use naga::valid::{Capabilities, ModuleInfo, ValidationFlags, Validator};
+use naga::valid::{ModuleInfo, ValidationFlags, Validator};
 use naga::{Module, ResourceBinding, ShaderStage};
 use serde_json::{Value, json};
 
@@ -182,7 +182,7 @@ fn comment(banner: &[String], prefix: &str) -> String {
 ///
 /// naga's validation error and its causes.
 pub fn validate(module: &Module) -> Result<ModuleInfo, String> {
-    Validator::new(ValidationFlags::all(), Capabilities::default())
+    Validator::new(ValidationFlags::all(), scatter_shaderlib::capabilities())
         .validate(module)
         .map_err(|e| {
             let mut message = e.as_inner().to_string();

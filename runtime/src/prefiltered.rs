@@ -25,7 +25,7 @@ use scatter_shaderlib::prefiltered::plan;
 use scatter_shaderlib::prefiltered::{
     CameraDesc, FrameReport, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame,
     PrefilteredVariant, Rectification, Resolutions, ShadowMapDesc, SliceParams, Storage,
-    prepare_frame,
+    filtered_word_bytes, prepare_frame,
 };
 
 use crate::error::{ErrorScopes, check_limit};
@@ -34,7 +34,7 @@ use crate::gpu::{
     DEPTH_NAMES, RECTIFIED_NAMES, Readback, SHADOW_NAMES, check_nonempty, check_texture_sides,
     check_view, decode_rgba, encode_buffer_readback, read_slices, upload_inputs,
 };
-use crate::timer::median_pass_wall_times;
+use crate::timer::{median_pass_wall_times, read_buffer};
 use crate::{Context, RuntimeError};
 
 const DEPTH_COLUMNS: Kernel = Kernel::DepthColumns;
@@ -46,24 +46,6 @@ const SCATTER_UNWARP: Kernel = Kernel::ScatterUnwarp;
 const SCATTER_FALLBACK: Kernel = Kernel::ScatterFallback;
 
 pub use crate::gpu::{DEPTH_FORMAT, OUTPUT_FORMAT};
-
-/// The texture format of a filtered-basis storage choice.
-pub const fn storage_format(storage: Storage) -> wgpu::TextureFormat {
-    match storage {
-        Storage::Rgba8unorm => wgpu::TextureFormat::Rgba8Unorm,
-        Storage::Rgba16float => wgpu::TextureFormat::Rgba16Float,
-        Storage::Rgba32float => wgpu::TextureFormat::Rgba32Float,
-    }
-}
-
-/// Bytes per texel of a filtered-basis storage choice.
-const fn storage_texel_bytes(storage: Storage) -> u32 {
-    match storage {
-        Storage::Rgba8unorm => 4,
-        Storage::Rgba16float => 8,
-        Storage::Rgba32float => 16,
-    }
-}
 
 /// Everything [`Prefiltered::prepare`] needs about one frame besides the textures: the engine's
 /// camera, light, medium and standard shadow map, and the runtime settings.
@@ -145,9 +127,7 @@ pub struct Prefiltered {
     slices: wgpu::Buffer,
     rectified: wgpu::Texture,
     rectified_view: wgpu::TextureView,
-    filtered: wgpu::Texture,
-    /// `D2Array` view (also for one layer).
-    filtered_view: wgpu::TextureView,
+    filtered: wgpu::Buffer,
     bounds: wgpu::Texture,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
@@ -213,14 +193,27 @@ impl Prefiltered {
                 (RECTIFY, "shadow map size", shadow_map_size),
             ],
         )?;
-        check_limit(
-            PREFILTER,
-            "filtered-basis layers (bases / 4, or 1-2 for moments; with a cookie 3x + 1)",
-            variant.filtered_layers().into(),
-            "max_texture_array_layers",
-            limits.max_texture_array_layers.into(),
-        )?;
         check_frame_buffers(&limits, hr)?;
+        // The filtered bases: one storage-format texel per layer and rectified texel.
+        let filtered_bytes = u64::from(wr)
+            * u64::from(hr)
+            * u64::from(variant.filtered_layers())
+            * u64::from(filtered_word_bytes(variant.storage));
+        for (name, limit) in [
+            (
+                "max_storage_buffer_binding_size",
+                limits.max_storage_buffer_binding_size,
+            ),
+            ("max_buffer_size", limits.max_buffer_size),
+        ] {
+            check_limit(
+                PREFILTER,
+                "filtered-basis bytes (rectified width x height x layers x bytes per layer)",
+                filtered_bytes,
+                name,
+                limit,
+            )?;
+        }
 
         // CPU work only: render, compose and validate the three kernels.
         let built = variant
@@ -241,7 +234,7 @@ impl Prefiltered {
             ],
         )?;
         let (rectified, rectified_view) = exec.texture("rectified")?;
-        let (filtered, filtered_view) = exec.texture("filtered")?;
+        let filtered = exec.buffer("filtered")?.clone();
         let (bounds, _) = exec.texture("bounds")?;
         let (output, output_view) = exec.texture("output")?;
         Ok(Self {
@@ -253,8 +246,7 @@ impl Prefiltered {
             slices: exec.buffer("slices")?.clone(),
             rectified: rectified.clone(),
             rectified_view: rectified_view.clone(),
-            filtered: filtered.clone(),
-            filtered_view: filtered_view.clone(),
+            filtered,
             bounds: bounds.clone(),
             output: output.clone(),
             output_view: output_view.clone(),
@@ -552,9 +544,11 @@ impl Prefiltered {
         &self.rectified_view
     }
 
-    /// The filtered bases: `Wr x Hr x bases/4` layers in the variant's storage format,
-    /// values `F / 2 + 0.5` in [0, 1] (written by `prefilter`).
-    pub fn filtered_texture(&self) -> &wgpu::Texture {
+    /// The filtered bases (written by `prefilter`): a storage buffer of
+    /// [`PrefilteredVariant::filtered_layers`] layers of `Wr x Hr` texels, layer `q` of texel
+    /// `(x, y)` at element `(q * Wr + x) * Hr + y`, each element the bits of one texel of the
+    /// variant's storage format (Fourier bases as `F / 2 + 0.5` in [0, 1]).
+    pub fn filtered_buffer(&self) -> &wgpu::Buffer {
         &self.filtered
     }
 
@@ -562,11 +556,6 @@ impl Prefiltered {
     /// (`Wr x Hr`, rg32float: min, max).
     pub fn bounds_texture(&self) -> &wgpu::Texture {
         &self.bounds
-    }
-
-    /// A `D2Array` view of [`Self::filtered_texture`].
-    pub fn filtered_view(&self) -> &wgpu::TextureView {
-        &self.filtered_view
     }
 
     /// The output: rgba16float, screen-sized, in-scattered radiance (written by `scatter`).
@@ -691,13 +680,7 @@ pub fn run_prefiltered_once(
         _ => pass.rectified_texture(),
     };
     let rectified = Readback::encode(device, &mut encoder, rectified_texture, 4, RECTIFY)?;
-    let filtered = Readback::encode(
-        device,
-        &mut encoder,
-        pass.filtered_texture(),
-        storage_texel_bytes(variant.storage),
-        PREFILTER,
-    )?;
+    let filtered = encode_buffer_readback(device, &mut encoder, pass.filtered_buffer());
     let bounds = Readback::encode(device, &mut encoder, pass.bounds_texture(), 8, PREFILTER)?;
     let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, SCATTER)?;
     let slices = encode_buffer_readback(device, &mut encoder, &pass.slices);
@@ -711,11 +694,11 @@ pub fn run_prefiltered_once(
         .chunks_exact(4)
         .map(|t| f32::from_le_bytes([t[0], t[1], t[2], t[3]]))
         .collect();
-    let filtered = filtered
-        .read(ctx, PREFILTER)?
-        .chunks_exact(storage_texel_bytes(variant.storage) as usize)
-        .map(|t| decode_rgba(t, variant.storage))
-        .collect();
+    let filtered = filtered_layer_major(
+        &read_buffer(ctx, PREFILTER, &filtered)?,
+        variant,
+        res.rectified,
+    );
     let bounds = bounds
         .read(ctx, PREFILTER)?
         .chunks_exact(8)
@@ -762,6 +745,27 @@ pub fn run_prefiltered_once(
         pass_wall_times,
         wall_time,
     })
+}
+
+/// The `filtered` buffer's bytes (element `(layer * Wr + x) * Hr + y`: column-major layers)
+/// decoded and reordered row-major, `(layer * Hr + y) * Wr + x`, as
+/// [`PrefilteredReadback::filtered`] documents.
+fn filtered_layer_major(
+    bytes: &[u8],
+    variant: &PrefilteredVariant,
+    [wr, hr]: [u32; 2],
+) -> Vec<[f32; 4]> {
+    let word = filtered_word_bytes(variant.storage) as usize;
+    let (wr, hr) = (wr as usize, hr as usize);
+    let layers = variant.filtered_layers() as usize;
+    let mut out = vec![[0.0; 4]; wr * hr * layers];
+    // Element (layer * Wr + x) * Hr + y of the buffer.
+    for (i, bits) in bytes.chunks_exact(word).take(out.len()).enumerate() {
+        let (layer_x, y) = (i / hr, i % hr);
+        let (layer, x) = (layer_x / wr, layer_x % wr);
+        out[(layer * hr + y) * wr + x] = decode_rgba(bits, variant.storage);
+    }
+    out
 }
 
 /// The slice table (16 bytes per rectified row, `hr` rows) and the uniform block of the

@@ -75,9 +75,17 @@ thread_local! {
     static COMPOSER: RefCell<Option<Composer>> = const { RefCell::new(None) };
 }
 
+/// The naga capabilities a kernel may use: naga's default and `SHADER_FLOAT16_IN_FLOAT32`
+/// (`pack2x16float` / `unpack2x16float`: the rgba16float `filtered` buffer of the prefiltered
+/// family), which wgpu grants with `DownlevelFlags::SHADER_F16_IN_F32` (Vulkan, Metal and
+/// DX12 devices have it; GLSL ES 3.0 has `packHalf2x16`).
+pub fn capabilities() -> Capabilities {
+    Capabilities::default() | Capabilities::SHADER_FLOAT16_IN_FLOAT32
+}
+
 /// A fresh composer with every shared module of [`COMMON_MODULES`] added.
 fn new_composer(kernel: Kernel) -> Result<Composer, ShaderError> {
-    let mut composer = Composer::default();
+    let mut composer = Composer::default().with_capabilities(capabilities());
     for &(file, common) in COMMON_MODULES {
         composer
             .add_composable_module(ComposableModuleDescriptor {
@@ -139,7 +147,7 @@ fn make_module(
 
 /// Validates a composed module with every check naga has.
 pub(crate) fn validate(kernel: Kernel, module: &naga::Module) -> Result<ModuleInfo, ShaderError> {
-    Validator::new(ValidationFlags::all(), Capabilities::default())
+    Validator::new(ValidationFlags::all(), capabilities())
         .validate(module)
         .map_err(|e| {
             let mut message = e.as_inner().to_string();

@@ -41,6 +41,7 @@ pub mod row_prefix;
 pub mod sampling;
 
 use area_ivsv::AreaIvsvVariant;
+pub use compose::capabilities;
 pub use error::ShaderError;
 use family::{Family, KernelFamily};
 use hybrid_volume::HybridVolumeVariant;

@@ -46,12 +46,12 @@
 // | 0       | frame     | var<uniform> Frame (400 bytes)                  | uniform      |
 // | 1       | slices    | var<storage, read> array<vec4<f32>>             | read         |
 // | 2       | rectified | texture_2d<f32> (r32float)                      | textureLoad  |
-// | 3       | filtered  | texture_storage_2d_array<FORMAT, write>         | textureStore |
+// | 3       | filtered  | var<storage, read_write> array<{{ filtered_word }}> | write  |
 // | 4       | bounds    | texture_storage_2d<rg32float, write>            | textureStore |
 {%- if cookie %}
 // | 12      | cookie    | texture_2d<f32> (rgba, linear RGB)              | textureLoad  |
 {%- endif %}
-// filtered: FORMAT = {{ storage }}; Wr x Hr x {{ filtered_layers }} layers{% if !moments %} (bases / 4{% if cookie %} per channel, 3 channels, + 1{% endif %}){% endif %}, Wr x Hr = the rectified
+// filtered: Wr x Hr texels of {{ filtered_layers }} {{ storage }} layers each{% if !moments %} (bases / 4{% if cookie %} per channel, 3 channels, + 1{% endif %}){% endif %}, Wr x Hr = the rectified
 // size (frame.sizes.zw). bounds: Wr x Hr, (min, max) of the region's depths up to the texel.
 //
 // Dispatch: (ceil(Hr / 64), {{ regions }}, {{ threads_per_row_region }}) workgroups of (64, 1, 1);
@@ -82,12 +82,13 @@
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
 @group(0) @binding(2) var rectified: texture_2d<f32>;
-@group(0) @binding(3) var filtered: texture_storage_2d_array<{{ storage }}, write>;
+@group(0) @binding(3) var<storage, read_write> filtered: array<{{ filtered_word }}>;
 @group(0) @binding(4) var bounds: texture_storage_2d<rg32float, write>;
 {%- if cookie %}
 // The spot's cookie (scatter_frame::cookie), folded into each texel's weight.
 @group(0) @binding(12) var cookie: texture_2d<f32>;
 {%- endif %}
+{% include "include/filtered_layers.wgsl" %}
 
 // Independent prefix regions per row.
 const REGIONS: u32 = {{ regions }}u;
@@ -179,7 +180,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         let tint = texel_cookie(i, slice, e, region, proj);
         if thread == 0u {
             tint_mean = tint_mean * (1.0 - blend) + tint * blend;
-            textureStore(filtered, vec2<u32>(i, row), 3u * LAYERS, vec4<f32>(tint_mean, 1.0));
+            filtered[filtered_index(i, row, 3u * LAYERS)] = encode_layer(vec4<f32>(tint_mean, 1.0));
         }
 {%- endif %}
 {%- if moments %}
@@ -191,11 +192,11 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var c = 0u; c < 3u; c++) {
                 let slot = c * layers_per_thread + q;
                 acc[slot] = acc[slot] * (1.0 - blend) + b * (tint[c] * blend);
-                textureStore(filtered, vec2<u32>(i, row), c * LAYERS + q, acc[slot]);
+                filtered[filtered_index(i, row, c * LAYERS + q)] = encode_layer(acc[slot]);
             }
 {%- else %}
             acc[q] = acc[q] * (1.0 - blend) + moment_layer(z, q) * blend;
-            textureStore(filtered, vec2<u32>(i, row), q, acc[q]);
+            filtered[filtered_index(i, row, q)] = encode_layer(acc[q]);
 {%- endif %}
         }
 {%- else %}
@@ -216,13 +217,13 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var c = 0u; c < 3u; c++) {
                 let slot = c * layers_per_thread + q;
                 acc[slot] = acc[slot] * (1.0 - blend) + b * (tint[c] * blend);
-                textureStore(filtered, vec2<u32>(i, row), c * LAYERS + layer, acc[slot] * 0.5 + 0.5);
+                filtered[filtered_index(i, row, c * LAYERS + layer)] = encode_layer(acc[slot] * 0.5 + 0.5);
             }
 {%- else %}
             let a = acc[q];
             acc[q] = a * (1.0 - blend) + b * blend;
             let stored = acc[q] * 0.5 + 0.5;
-            textureStore(filtered, vec2<u32>(i, row), layer, stored);
+            filtered[filtered_index(i, row, layer)] = encode_layer(stored);
 {%- endif %}
         }
 {%- endif %}

@@ -50,19 +50,19 @@
 // | 1       | slices           | var<storage, read> array<vec4<f32>>      | read               |
 // | 2       | depth            | texture_2d<f32> (r32float, view depth)   | textureLoad        |
 // | 3       | shadow_map       | texture_2d<f32> (r32float)               | textureLoad        |
-// | 4       | filtered         | texture_2d_array<f32> (prefilter's)      | textureLoad        |
+// | 4       | filtered         | var<storage, read> array<{{ filtered_word }}> (prefilter's) | read |
 // | 5       | output           | texture_storage_2d<rgba16float, write>   | textureStore       |
 // | 6       | bounds           | texture_2d<f32> (rg32float, prefilter's) | textureLoad        |
 {%- if cookie %}
 // | 12      | cookie           | texture_2d<f32> (rgba, linear RGB)       | textureLoad        |
 {%- endif %}
-// filtered: Wr x Hr x {{ filtered_layers }} layers, Wr x Hr = the rectified size (frame.sizes.zw),
-// filtered by hand: linearly along each of the pixel's two rows, each row read at its own
+// filtered: Wr x Hr texels of {{ filtered_layers }} {{ storage }} layers each (below), Wr x Hr = the rectified
+// size (frame.sizes.zw), filtered by hand: linearly along each of the pixel's two rows, each row read at its own
 // column for the ray (clamp-to-edge in u; in v wrapping round when the slices do,
 // frame.anti_epipole.w > 0.5, else clamp-to-edge), and the rows' estimates blended. Texel
 // loads instead of a filtering sampler measured 1.9x faster for the whole pass on lavapipe
-// (1280x720, sphere), the weights are exact floats, and rgba32float bases need no
-// FLOAT32_FILTERABLE.
+// (1280x720, sphere) and the weights are exact floats; a storage buffer in place of the
+// texture array that followed is faster still (below).
 //
 // Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
 // (frame.sizes.xy); invocation id x = pixel column, y = pixel row.
@@ -99,7 +99,7 @@
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
 @group(0) @binding(2) var depth: texture_2d<f32>;
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
-@group(0) @binding(4) var filtered: texture_2d_array<f32>;
+@group(0) @binding(4) var<storage, read> filtered: array<{{ filtered_word }}>;
 @group(0) @binding(5) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
 @group(0) @binding(6) var bounds: texture_2d<f32>;
 {%- if cookie %}
@@ -107,6 +107,7 @@
 @group(0) @binding(12) var cookie: texture_2d<f32>;
 {%- endif %}
 {% include "include/sampled_bindings.wgsl" %}
+{%- include "include/filtered_layers.wgsl" %}
 
 // Independent prefix regions per rectified row.
 const REGIONS: u32 = {{ regions }}u;
@@ -322,26 +323,26 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
 {%- if cookie %}
         // The region's mean cookie up to the ray's end, per row: the channel's lit share
         // lies in [0, Cbar].
-        let cbar0 = mix(textureLoad(filtered, vec2<u32>(x00, row0), CBAR, 0), textureLoad(filtered, vec2<u32>(x01, row0), CBAR, 0), fx0).xyz;
-        let cbar1 = mix(textureLoad(filtered, vec2<u32>(x10, row1), CBAR, 0), textureLoad(filtered, vec2<u32>(x11, row1), CBAR, 0), fx1).xyz;
+        let cbar0 = mix(filtered_load(x00, row0, CBAR), filtered_load(x01, row0, CBAR), fx0).xyz;
+        let cbar1 = mix(filtered_load(x10, row1, CBAR), filtered_load(x11, row1, CBAR), fx1).xyz;
         var vis0 = 0.5 * cbar0;
         var vis1 = 0.5 * cbar1;
 {%- if moments %}
         // Per channel the moments of the cookie-weighted depths: the stored ones over Cbar.
         for (var c = 0u; c < 3u; c++) {
             if d > lohi0.x && d <= lohi0.y && cbar0[c] > 0.0 {
-                let m0 = mix(textureLoad(filtered, vec2<u32>(x00, row0), c * LAYERS, 0), textureLoad(filtered, vec2<u32>(x01, row0), c * LAYERS, 0), fx0) / cbar0[c];
+                let m0 = mix(filtered_load(x00, row0, c * LAYERS), filtered_load(x01, row0, c * LAYERS), fx0) / cbar0[c];
 {%- if moment_count == 6 %}
-                let m1 = mix(textureLoad(filtered, vec2<u32>(x00, row0), c * LAYERS + 1u, 0), textureLoad(filtered, vec2<u32>(x01, row0), c * LAYERS + 1u, 0), fx0) / cbar0[c];
+                let m1 = mix(filtered_load(x00, row0, c * LAYERS + 1u), filtered_load(x01, row0, c * LAYERS + 1u), fx0) / cbar0[c];
                 vis0[c] = cbar0[c] * lit_moments6(m0, m1.xy, zf);
 {%- else %}
                 vis0[c] = cbar0[c] * lit_moments4(m0, zf);
 {%- endif %}
             }
             if d > lohi1.x && d <= lohi1.y && cbar1[c] > 0.0 {
-                let m0 = mix(textureLoad(filtered, vec2<u32>(x10, row1), c * LAYERS, 0), textureLoad(filtered, vec2<u32>(x11, row1), c * LAYERS, 0), fx1) / cbar1[c];
+                let m0 = mix(filtered_load(x10, row1, c * LAYERS), filtered_load(x11, row1, c * LAYERS), fx1) / cbar1[c];
 {%- if moment_count == 6 %}
-                let m1 = mix(textureLoad(filtered, vec2<u32>(x10, row1), c * LAYERS + 1u, 0), textureLoad(filtered, vec2<u32>(x11, row1), c * LAYERS + 1u, 0), fx1) / cbar1[c];
+                let m1 = mix(filtered_load(x10, row1, c * LAYERS + 1u), filtered_load(x11, row1, c * LAYERS + 1u), fx1) / cbar1[c];
                 vis1[c] = cbar1[c] * lit_moments6(m0, m1.xy, zf);
 {%- else %}
                 vis1[c] = cbar1[c] * lit_moments4(m0, zf);
@@ -353,8 +354,8 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
             for (var layer = 0u; layer < LAYERS; layer++) {
                 let coeff = coeffs[layer];
                 for (var c = 0u; c < 3u; c++) {
-                    let texel0 = mix(textureLoad(filtered, vec2<u32>(x00, row0), c * LAYERS + layer, 0), textureLoad(filtered, vec2<u32>(x01, row0), c * LAYERS + layer, 0), fx0);
-                    let texel1 = mix(textureLoad(filtered, vec2<u32>(x10, row1), c * LAYERS + layer, 0), textureLoad(filtered, vec2<u32>(x11, row1), c * LAYERS + layer, 0), fx1);
+                    let texel0 = mix(filtered_load(x00, row0, c * LAYERS + layer), filtered_load(x01, row0, c * LAYERS + layer), fx0);
+                    let texel1 = mix(filtered_load(x10, row1, c * LAYERS + layer), filtered_load(x11, row1, c * LAYERS + layer), fx1);
                     for (var k = 0u; k < 4u; k++) {
                         vis0[c] += coeff[k] * (texel0[k] * 2.0 - 1.0);
                         vis1[c] += coeff[k] * (texel1[k] * 2.0 - 1.0);
@@ -385,18 +386,18 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         // The region's moments, filtered linearly along each row (a mix of moments is the
         // moments of the mixed depths: still a valid moment vector).
         if d > lohi0.x && d <= lohi0.y {
-            let m0 = mix(textureLoad(filtered, vec2<u32>(x00, row0), 0, 0), textureLoad(filtered, vec2<u32>(x01, row0), 0, 0), fx0);
+            let m0 = mix(filtered_load(x00, row0, 0), filtered_load(x01, row0, 0), fx0);
 {%- if moment_count == 6 %}
-            let m1 = mix(textureLoad(filtered, vec2<u32>(x00, row0), 1, 0), textureLoad(filtered, vec2<u32>(x01, row0), 1, 0), fx0);
+            let m1 = mix(filtered_load(x00, row0, 1), filtered_load(x01, row0, 1), fx0);
             vis0 = lit_moments6(m0, m1.xy, zf);
 {%- else %}
             vis0 = lit_moments4(m0, zf);
 {%- endif %}
         }
         if d > lohi1.x && d <= lohi1.y {
-            let m0 = mix(textureLoad(filtered, vec2<u32>(x10, row1), 0, 0), textureLoad(filtered, vec2<u32>(x11, row1), 0, 0), fx1);
+            let m0 = mix(filtered_load(x10, row1, 0), filtered_load(x11, row1, 0), fx1);
 {%- if moment_count == 6 %}
-            let m1 = mix(textureLoad(filtered, vec2<u32>(x10, row1), 1, 0), textureLoad(filtered, vec2<u32>(x11, row1), 1, 0), fx1);
+            let m1 = mix(filtered_load(x10, row1, 1), filtered_load(x11, row1, 1), fx1);
             vis1 = lit_moments6(m0, m1.xy, zf);
 {%- else %}
             vis1 = lit_moments4(m0, zf);
@@ -406,8 +407,8 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         if (d > lohi0.x && d <= lohi0.y) || (d > lohi1.x && d <= lohi1.y) {
             for (var layer = 0u; layer < LAYERS; layer++) {
                 let coeff = coeffs[layer];
-                let texel0 = mix(textureLoad(filtered, vec2<u32>(x00, row0), layer, 0), textureLoad(filtered, vec2<u32>(x01, row0), layer, 0), fx0);
-                let texel1 = mix(textureLoad(filtered, vec2<u32>(x10, row1), layer, 0), textureLoad(filtered, vec2<u32>(x11, row1), layer, 0), fx1);
+                let texel0 = mix(filtered_load(x00, row0, layer), filtered_load(x01, row0, layer), fx0);
+                let texel1 = mix(filtered_load(x10, row1, layer), filtered_load(x11, row1, layer), fx1);
                 for (var k = 0u; k < 4u; k++) {
                     vis0 += coeff[k] * (texel0[k] * 2.0 - 1.0);
                     vis1 += coeff[k] * (texel1[k] * 2.0 - 1.0);

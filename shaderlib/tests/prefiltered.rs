@@ -24,7 +24,7 @@ fn cross_product() -> Vec<PrefilteredVariant> {
 
 /// Renders every kernel of every variant and validates each distinct rendered source once
 /// (rendering is deterministic, so identical sources validate identically: `rectify` only
-/// depends on the light, `scatter` not on `bases_per_thread` or `storage`). Two threads.
+/// depends on the light, `scatter` not on `bases_per_thread`). Two threads.
 #[test]
 fn full_cross_product_validates() {
     let variants = cross_product();
@@ -73,12 +73,13 @@ fn full_cross_product_validates() {
         2,
         "rectify depends on the light only"
     );
-    // Scatter: the Fourier layer counts (6 bases values) and the 2 moment counts, each x
+    // Scatter: the Fourier layer counts (6 bases values) x the 3 storage formats (the
+    // `filtered` buffer's element) and the 2 moment counts (rgba32float only), each x
     // regions x visibility x light x rectification; the cookie's 3 bases x visibility x
     // rectification.
     assert_eq!(
         per_kernel[&Kernel::Scatter],
-        (6 + 2) * 8 * 2 * 2 * 2 + 3 * 2 * 2
+        (6 * 3 + 2) * 8 * 2 * 2 * 2 + 3 * 2 * 2
     );
     assert_eq!(per_kernel[&Kernel::Prefilter], variants.len());
     eprintln!(
@@ -252,11 +253,15 @@ fn bindings_match_the_documented_tables() {
         )
     };
     for &light in LightKind::SINGLE {
-        for (&storage_knob, format) in Storage::ALL.iter().zip([
-            StorageFormat::Rgba16Float,
-            StorageFormat::Rgba32Float,
-            StorageFormat::Rgba8Unorm,
+        // `filtered` is a storage buffer of one storage-format texel's bits per element.
+        for (&storage_knob, word) in Storage::ALL.iter().zip([
+            "Vector { size: Bi, scalar: Scalar { kind: Uint, width: 4 } }",
+            "Vector { size: Quad, scalar: Scalar { kind: Float, width: 4 } }",
+            "Scalar(Scalar { kind: Uint, width: 4 })",
         ]) {
+            let filtered_rw =
+                format!("Storage {{ access: StorageAccess(LOAD | STORE) }} array<{word}>");
+            let filtered_read = format!("Storage {{ access: StorageAccess(LOAD) }} array<{word}>");
             let variant = PrefilteredVariant {
                 light,
                 storage: storage_knob,
@@ -296,7 +301,7 @@ fn bindings_match_the_documented_tables() {
                     b(0, "frame", &uniform),
                     b(1, "slices", &slices),
                     b(2, "rectified", &sampled(false)),
-                    b(3, "filtered", &storage(format, true)),
+                    b(3, "filtered", &filtered_rw),
                     b(4, "bounds", &storage(StorageFormat::Rg32Float, false)),
                 ]
             );
@@ -307,7 +312,7 @@ fn bindings_match_the_documented_tables() {
                     b(1, "slices", &slices),
                     b(2, "depth", &sampled(false)),
                     b(3, "shadow_map", &sampled(false)),
-                    b(4, "filtered", &sampled(true)),
+                    b(4, "filtered", &filtered_read),
                     b(5, "output", &storage(StorageFormat::Rgba16Float, false)),
                     b(6, "bounds", &sampled(false)),
                 ]
@@ -455,7 +460,8 @@ fn templates_receive_the_variant_s_values() {
     assert!(rectify.contains("let spot = true;"), "{rectify}");
     assert!(rectify.contains("Mirrors reference/src/kernels/rectify.rs"));
     for needle in [
-        "texture_storage_2d_array<rgba16float, write>",
+        "var<storage, read_write> filtered: array<vec2<u32>>;",
+        "pack2x16float",
         "const REGIONS: u32 = 5u;",
         "const BASES_PER_THREAD: u32 = 16u;",
         "const THREADS_PER_ROW_REGION: u32 = 4u;",
@@ -473,6 +479,8 @@ fn templates_receive_the_variant_s_values() {
         // texel weights); the header names the mode.
         "5 regions, average visibility",
         "let spot = true;",
+        "var<storage, read> filtered: array<vec2<u32>>;",
+        "unpack2x16float",
         "Mirrors reference/src/kernels/scatter.rs",
     ] {
         assert!(scatter.contains(needle), "{needle}\n{scatter}");

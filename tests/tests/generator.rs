@@ -5,10 +5,10 @@
 //! workgroup sizes of the kernels the runtime builds.
 
 use scatter_gen::{FamilyVariant, Request, Target, generate};
-use scatter_runtime::prefiltered::{DEPTH_FORMAT, OUTPUT_FORMAT, storage_format};
+use scatter_runtime::prefiltered::{DEPTH_FORMAT, OUTPUT_FORMAT};
 use scatter_shaderlib::prefiltered::{
     FrameUniforms, LightKind, PrefilteredVariant, RECTIFY_TEXELS, Rectification, SliceParams,
-    Storage, VisibilityMode,
+    Storage, VisibilityMode, filtered_word_bytes,
 };
 use scatter_shaderlib::{KernelParams, build};
 use serde_json::Value;
@@ -83,13 +83,18 @@ fn manifest_resources_match_the_runtime() {
             let m = manifest(v);
             let variant = &get(&m, "variants")[0];
             let tex = |name: &str| get(resource(variant, name), "texture").clone();
+            // The runtime's buffer: one storage-format texel's bytes per layer and texel.
+            let filtered = get(resource(variant, "filtered"), "buffer");
             assert_eq!(
-                str_of(&tex("filtered"), "format"),
-                wgpu_name(storage_format(storage)),
+                str_of(filtered, "size_bytes"),
+                format!(
+                    "{} * {} * rectified.width * rectified.height",
+                    filtered_word_bytes(storage),
+                    v.filtered_layers()
+                ),
                 "{}",
                 v.id()
             );
-            assert_eq!(str_of(&tex("filtered"), "layers"), v.layers().to_string());
             for name in ["depth", "shadow_map", "rectified"] {
                 assert_eq!(
                     str_of(&tex(name), "format"),

@@ -5,8 +5,8 @@
 //! Two devices: the shared one at the adapter's limits (texture sizes beyond
 //! `max_texture_dimension_2d`, the minmax tree, zero sizes), and one created on the same
 //! adapter with lowered limits (`Context::from_device`), which reaches the limits a
-//! software adapter is too generous to reach otherwise: `max_texture_array_layers` (the
-//! filtered bases), `max_storage_buffer_binding_size` and `max_buffer_size` (the slice
+//! software adapter is too generous to reach otherwise: `max_texture_array_layers`,
+//! `max_storage_buffer_binding_size` and `max_buffer_size` (the filtered bases, the slice
 //! table, a readback buffer, the partial-sum-tree sweep's leaves, the hybrid_volume
 //! crossings),
 //! `max_compute_workgroup_storage_size` (the sweep's per-sample arrays),
@@ -231,14 +231,15 @@ fn lowered_device_limits_are_named() {
         l.max_compute_workgroups_per_dimension = 16;
     });
     let ctx = &ctx;
-    // 32 bases are 8 rgba layers of filtered bases; 16 bases (4 layers) fit.
+    // 32 bases are 8 rgba8unorm layers of filtered bases, 4 bytes per layer and texel:
+    // 64 x 16 texels take 32 KiB of storage buffer.
     let v32 = PrefilteredVariant::default();
     assert_limit(
-        "scatter_layers",
+        "scatter_filtered_bytes",
         Prefiltered::new(ctx, &v32, res([64, 36], [64, 16]), 64),
-        "max_texture_array_layers",
-        8,
-        4,
+        "max_storage_buffer_binding_size",
+        64 * 16 * 8 * 4,
+        1024,
     );
     let v16 = PrefilteredVariant {
         bases: 16,
@@ -285,10 +286,11 @@ fn lowered_device_limits_are_named() {
         256 * 16 * 8,
         1024,
     );
-    // 256 pixels wide in 8x8 workgroups: 32 workgroups along x.
+    // 256 pixels wide in 8x8 workgroups: 32 workgroups along x (a 16 x 4 rectified map,
+    // whose filtered bases, 4 layers of 4 bytes per texel, fit in 1024 bytes).
     assert_limit(
         "scatter_workgroups",
-        Prefiltered::new(ctx, &v16, res([256, 8], [64, 16]), 64),
+        Prefiltered::new(ctx, &v16, res([256, 8], [16, 4]), 64),
         "max_compute_workgroups_per_dimension",
         32,
         16,

@@ -67,7 +67,7 @@ layout(std430, binding = 1) readonly buffer type_9_block_1Compute { vec4 _group_
 
 layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
-layout(binding = 3,rgba16f) writeonly uniform image2DArray _group_0_binding_3_cs;
+layout(std430, binding = 3) buffer type_10_block_2Compute { uvec2 _group_0_binding_3_cs[]; };
 
 layout(binding = 4,rg32f) writeonly uniform image2D _group_0_binding_4_cs;
 
@@ -86,10 +86,10 @@ vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapVie
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
     bool outside = ((((uv.x < 0.0) || (uv.x > 1.0)) || (uv.y < 0.0)) || (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_2 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_4 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
     uint y = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_2, y)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_4, y)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -160,11 +160,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_3 = (sigma_t * len);
-    if ((x_3 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_3)));
+    float x_5 = (sigma_t * len);
+    if ((x_5 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_5)));
     }
-    return ((1.0 - exp(-(x_3))) / sigma_t);
+    return ((1.0 - exp(-(x_5))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -176,13 +176,13 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
+    float x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_6 * x_6) * (3.0 - (2.0 * x_6)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_5 = (eye + (dir * t));
-    vec3 to_x = (x_5 - light_pos);
+    vec3 x_7 = (eye + (dir * t));
+    vec3 to_x = (x_7 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     vec3 travel = (to_x / vec3(d));
@@ -198,7 +198,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
     float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
     float g0_ = atan(((a_1 - t0_) / h));
-    float w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
+    float w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
@@ -213,7 +213,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
         }
         {
             uint _e32 = k_1;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
+            float mid = (g0_ + ((float(_e32) + 0.5) * w_2));
             q_1 = 0u;
             bool loop_init_1 = true;
             while(true) {
@@ -229,7 +229,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                 }
                 {
                     uint _e46 = q_1;
-                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     float _e52 = sum;
                     uint _e54 = q_1;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -239,7 +239,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w_1) * h);
+    return (((_e75 * 0.5) * w_2) * h);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
@@ -331,6 +331,20 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_
     return _e66;
 }
 
+uint filtered_index(uint x_2, uint row_2, uint layer) {
+    uint _e5 = _group_0_binding_0_cs.sizes.z;
+    uint _e12 = _group_0_binding_0_cs.sizes.w;
+    return ((((layer * _e5) + x_2) * _e12) + row_2);
+}
+
+uvec2 encode_layer(vec4 v_10) {
+    return uvec2(packHalf2x16(v_10.xy), packHalf2x16(v_10.zw));
+}
+
+vec4 decode_layer(uvec2 w_1) {
+    return vec4(unpackHalf2x16(w_1.x), unpackHalf2x16(w_1.y));
+}
+
 void main() {
     uvec3 id = gl_GlobalInvocationID;
     bool local = false;
@@ -343,12 +357,12 @@ void main() {
     vec2 angle = vec2(0.0);
     uint k = 0u;
     uint q = 0u;
-    uint row_2 = id.x;
+    uint row_4 = id.x;
     uint region = id.y;
     uint thread = id.z;
     uint width_1 = _group_0_binding_0_cs.sizes.z;
     uint _e14 = _group_0_binding_0_cs.sizes.w;
-    if (!((row_2 >= _e14))) {
+    if (!((row_4 >= _e14))) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -363,7 +377,7 @@ void main() {
     if (_e29) {
         return;
     }
-    vec4 _e32 = _group_0_binding_1_cs[row_2];
+    vec4 _e32 = _group_0_binding_1_cs[row_4];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
     uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
@@ -371,8 +385,8 @@ void main() {
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e142 = i;
-            i = (_e142 + 1u);
+            uint _e144 = i;
+            i = (_e144 + 1u);
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -383,11 +397,11 @@ void main() {
         {
             uint _e44 = i;
             int _e48_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-            vec4 _e48 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e44, row_2)), ivec2(0), textureSize(_group_0_binding_2_cs, _e48_clamped_lod) - ivec2(1)), _e48_clamped_lod);
+            vec4 _e48 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e44, row_4)), ivec2(0), textureSize(_group_0_binding_2_cs, _e48_clamped_lod) - ivec2(1)), _e48_clamped_lod);
             float d_1 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = _group_0_binding_0_cs;
             uint _e52 = i;
-            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, false, true);
+            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, false, true);
             float _e56 = wsum;
             wsum = (_e56 + _e54);
             if ((thread == 0u)) {
@@ -398,7 +412,7 @@ void main() {
                 uint _e66 = i;
                 float _e68 = lo;
                 float _e69 = hi;
-                imageStore(_group_0_binding_4_cs, ivec2(uvec2(_e66, row_2)), vec4(_e68, _e69, 0.0, 0.0));
+                imageStore(_group_0_binding_4_cs, ivec2(uvec2(_e66, row_4)), vec4(_e68, _e69, 0.0, 0.0));
             }
             float _e74 = wsum;
             float _e76 = wsum;
@@ -429,8 +443,8 @@ void main() {
             bool loop_init_4 = true;
             while(true) {
                 if (!loop_init_4) {
-                    uint _e139 = q;
-                    q = (_e139 + 1u);
+                    uint _e141 = q;
+                    q = (_e141 + 1u);
                 }
                 loop_init_4 = false;
                 uint _e106 = q;
@@ -440,7 +454,7 @@ void main() {
                 }
                 {
                     uint _e109 = q;
-                    uint layer = ((thread * 1u) + _e109);
+                    uint layer_2 = ((thread * 1u) + _e109);
                     vec2 _e111 = angle;
                     vec2 _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
                     vec2 _e113 = angle;
@@ -455,7 +469,9 @@ void main() {
                     vec4 _e129 = acc[_e127];
                     vec4 stored = ((_e129 * 0.5) + vec4(0.5));
                     uint _e135 = i;
-                    imageStore(_group_0_binding_3_cs, ivec3(uvec2(_e135, row_2), layer), stored);
+                    uint _e136 = filtered_index(_e135, row_4, layer_2);
+                    uvec2 _e139 = encode_layer(stored);
+                    _group_0_binding_3_cs[_e136] = _e139;
                 }
             }
         }

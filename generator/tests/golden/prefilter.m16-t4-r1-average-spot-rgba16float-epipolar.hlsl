@@ -63,7 +63,7 @@ static const uint THREADS_PER_ROW_REGION = 4u;
 cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX frame; }
 ByteAddressBuffer slices : register(t1);
 Texture2D<float4> rectified : register(t2);
-RWTexture2DArray<float4> filtered : register(u3);
+RWByteAddressBuffer filtered : register(u3);
 RWTexture2D<float4> bounds : register(u4);
 
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
@@ -87,9 +87,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
 {
     bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_2 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_4 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
     uint y = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e36 = sm.Load(int3(uint2(x_2, y), int(0)));
+    float4 _e36 = sm.Load(int3(uint2(x_4, y), int(0)));
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -168,11 +168,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_3 = (sigma_t * len);
-    if ((x_3 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_3)));
+    float x_5 = (sigma_t * len);
+    if ((x_5 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_5)));
     }
-    return ((1.0 - exp(-(x_3))) / sigma_t);
+    return ((1.0 - exp(-(x_5))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -186,14 +186,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
+    float x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_6 * x_6) * (3.0 - (2.0 * x_6)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_5 = (eye + (dir * t));
-    float3 to_x = (x_5 - light_pos);
+    float3 x_7 = (eye + (dir * t));
+    float3 to_x = (x_7 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     float3 travel = (to_x / (d).xxx);
@@ -211,7 +211,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
     float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
     float g0_ = atan(((a_1 - t0_) / h));
-    float w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
+    float w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
     while(true) {
@@ -229,7 +229,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         }
         {
             uint _e32 = k_1;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
+            float mid = (g0_ + ((float(_e32) + 0.5) * w_2));
             q_1 = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
             bool loop_init_1 = true;
@@ -248,7 +248,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
                 }
                 {
                     uint _e46 = q_1;
-                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
+                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
                     float _e52 = sum;
                     uint _e54 = q_1;
                     const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -258,7 +258,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w_1) * h);
+    return (((_e75 * 0.5) * w_2) * h);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
@@ -387,6 +387,35 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_
     return _e66;
 }
 
+uint filtered_index(uint x_2, uint row_2, uint layer)
+{
+    uint _e5 = frame.sizes.z;
+    uint _e12 = frame.sizes.w;
+    return ((((layer * _e5) + x_2) * _e12) + row_2);
+}
+
+uint2 encode_layer(float4 v_10)
+{
+    float2 _e1 = v_10.xy;
+    float2 _e3 = v_10.zw;
+    return uint2((f32tof16(_e1[0]) | f32tof16(_e1[1]) << 16), (f32tof16(_e3[0]) | f32tof16(_e3[1]) << 16));
+}
+
+float4 decode_layer(uint2 w_1)
+{
+    uint _e1 = w_1.x;
+    uint _e3 = w_1.y;
+    return float4(float2(f16tof32(_e1), f16tof32((_e1) >> 16)), float2(f16tof32(_e3), f16tof32((_e3) >> 16)));
+}
+
+float4 filtered_load(uint x_3, uint row_3, uint layer_1)
+{
+    const uint _e3 = filtered_index(x_3, row_3, layer_1);
+    uint2 _e6 = asuint(filtered.Load2(_e3*8));
+    const float4 _e7 = decode_layer(_e6);
+    return _e7;
+}
+
 [numthreads(64, 1, 1)]
 void prefilter(uint3 id : SV_DispatchThreadID)
 {
@@ -401,12 +430,12 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     uint k = (uint)0;
     uint q = (uint)0;
 
-    uint row_2 = id.x;
+    uint row_4 = id.x;
     uint region = id.y;
     uint thread = id.z;
     uint width_1 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
-    if (!((row_2 >= _e14))) {
+    if (!((row_4 >= _e14))) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -421,7 +450,7 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     if (_e29) {
         return;
     }
-    float4 _e32 = asfloat(slices.Load4(row_2*16));
+    float4 _e32 = asfloat(slices.Load4(row_4*16));
     const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     const uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
     const uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
@@ -432,8 +461,8 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e142 = i;
-            i = (_e142 + 1u);
+            uint _e144 = i;
+            i = (_e144 + 1u);
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -443,11 +472,11 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         }
         {
             uint _e44 = i;
-            float4 _e48 = rectified.Load(int3(uint2(_e44, row_2), int(0)));
+            float4 _e48 = rectified.Load(int3(uint2(_e44, row_4), int(0)));
             float d_1 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
             uint _e52 = i;
-            const float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, false, true);
+            const float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, false, true);
             float _e56 = wsum;
             wsum = (_e56 + _e54);
             if ((thread == 0u)) {
@@ -458,7 +487,7 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 uint _e66 = i;
                 float _e68 = lo;
                 float _e69 = hi;
-                bounds[uint2(_e66, row_2)] = float4(_e68, _e69, 0.0, 0.0);
+                bounds[uint2(_e66, row_4)] = float4(_e68, _e69, 0.0, 0.0);
             }
             float _e74 = wsum;
             float _e76 = wsum;
@@ -495,8 +524,8 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
                 loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
                 if (!loop_init_4) {
-                    uint _e139 = q;
-                    q = (_e139 + 1u);
+                    uint _e141 = q;
+                    q = (_e141 + 1u);
                 }
                 loop_init_4 = false;
                 uint _e106 = q;
@@ -506,7 +535,7 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 }
                 {
                     uint _e109 = q;
-                    uint layer = ((thread * 1u) + _e109);
+                    uint layer_2 = ((thread * 1u) + _e109);
                     float2 _e111 = angle;
                     const float2 _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
                     float2 _e113 = angle;
@@ -521,7 +550,9 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                     float4 _e129 = acc[min(uint(_e127), 0u)];
                     float4 stored = ((_e129 * 0.5) + (0.5).xxxx);
                     uint _e135 = i;
-                    filtered[int3(uint2(_e135, row_2), layer)] = stored;
+                    const uint _e136 = filtered_index(_e135, row_4, layer_2);
+                    const uint2 _e139 = encode_layer(stored);
+                    filtered.Store2(_e136*8, asuint(_e139));
                 }
             }
         }

@@ -67,7 +67,7 @@ var<storage> slices: array<vec4<f32>>;
 @group(0) @binding(2) 
 var rectified: texture_2d<f32>;
 @group(0) @binding(3) 
-var filtered: texture_storage_2d_array<rgba16float,write>;
+var<storage, read_write> filtered: array<vec2<u32>>;
 @group(0) @binding(4) 
 var bounds: texture_storage_2d<rg32float,write>;
 
@@ -85,9 +85,9 @@ fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMap
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
-    let x_2 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let x_4 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e36 = textureLoad(sm, vec2<u32>(x_2, y), 0i);
+    let _e36 = textureLoad(sm, vec2<u32>(x_4, y), 0i);
     return select(_e36.x, 2f, outside);
 }
 
@@ -158,11 +158,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_3 = (sigma_t * len);
-    if (x_3 < 0.0001f) {
-        return (len * (1f - (0.5f * x_3)));
+    let x_5 = (sigma_t * len);
+    if (x_5 < 0.0001f) {
+        return (len * (1f - (0.5f * x_5)));
     }
-    return ((1f - exp(-(x_3))) / sigma_t);
+    return ((1f - exp(-(x_5))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -174,13 +174,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_4 * x_4) * (3f - (2f * x_4)));
+    let x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_6 * x_6) * (3f - (2f * x_6)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_5 = (eye + (dir * t));
-    let to_x = (x_5 - light_pos);
+    let x_7 = (eye + (dir * t));
+    let to_x = (x_7 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d = sqrt(d2_);
     let travel = (to_x / vec3(d));
@@ -197,7 +197,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
     let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
     let g0_ = atan(((a_1 - t0_) / h));
-    let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
+    let w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k_1;
         if (_e30 < panels) {
@@ -206,7 +206,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
         {
             let _e32 = k_1;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
+            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_2));
             q_1 = 0u;
             loop {
                 let _e40 = q_1;
@@ -216,7 +216,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                 }
                 {
                     let _e46 = q_1;
-                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    let u = tan((mid + ((0.5f * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     let _e52 = sum;
                     let _e54 = q_1;
                     let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -234,7 +234,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
     }
     let _e75 = sum;
-    return (((_e75 * 0.5f) * w_1) * h);
+    return (((_e75 * 0.5f) * w_2) * h);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -328,6 +328,27 @@ fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3: FrameX_nag
     return _e66;
 }
 
+fn filtered_index(x_2: u32, row_2: u32, layer: u32) -> u32 {
+    let _e5 = frame.sizes.z;
+    let _e12 = frame.sizes.w;
+    return ((((layer * _e5) + x_2) * _e12) + row_2);
+}
+
+fn encode_layer(v_10: vec4<f32>) -> vec2<u32> {
+    return vec2<u32>(pack2x16float(v_10.xy), pack2x16float(v_10.zw));
+}
+
+fn decode_layer(w_1: vec2<u32>) -> vec4<f32> {
+    return vec4<f32>(unpack2x16float(w_1.x), unpack2x16float(w_1.y));
+}
+
+fn filtered_load(x_3: u32, row_3: u32, layer_1: u32) -> vec4<f32> {
+    let _e3 = filtered_index(x_3, row_3, layer_1);
+    let _e6 = filtered[_e3];
+    let _e7 = decode_layer(_e6);
+    return _e7;
+}
+
 @compute @workgroup_size(64, 1, 1) 
 fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var local: bool;
@@ -341,12 +362,12 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var k: u32;
     var q: u32;
 
-    let row_2 = id.x;
+    let row_4 = id.x;
     let region = id.y;
     let thread = id.z;
     let width_1 = frame.sizes.z;
     let _e14 = frame.sizes.w;
-    if !((row_2 >= _e14)) {
+    if !((row_4 >= _e14)) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -361,7 +382,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e29 {
         return;
     }
-    let _e32 = slices[row_2];
+    let _e32 = slices[row_4];
     let _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     let _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
     let _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
@@ -374,11 +395,11 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         {
             let _e44 = i;
-            let _e48 = textureLoad(rectified, vec2<u32>(_e44, row_2), 0i);
+            let _e48 = textureLoad(rectified, vec2<u32>(_e44, row_4), 0i);
             let d_1 = _e48.x;
             let _e51 = frame;
             let _e52 = i;
-            let _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, false, true);
+            let _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, false, true);
             let _e56 = wsum;
             wsum = (_e56 + _e54);
             if (thread == 0u) {
@@ -389,7 +410,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
                 let _e66 = i;
                 let _e68 = lo;
                 let _e69 = hi;
-                textureStore(bounds, vec2<u32>(_e66, row_2), vec4<f32>(_e68, _e69, 0f, 0f));
+                textureStore(bounds, vec2<u32>(_e66, row_4), vec4<f32>(_e68, _e69, 0f, 0f));
             }
             let _e74 = wsum;
             let _e76 = wsum;
@@ -423,7 +444,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
                 {
                     let _e109 = q;
-                    let layer = ((thread * 1u) + _e109);
+                    let layer_2 = ((thread * 1u) + _e109);
                     let _e111 = angle;
                     let _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
                     let _e113 = angle;
@@ -438,17 +459,19 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
                     let _e129 = acc[_e127];
                     let stored = ((_e129 * 0.5f) + vec4(0.5f));
                     let _e135 = i;
-                    textureStore(filtered, vec2<u32>(_e135, row_2), layer, stored);
+                    let _e136 = filtered_index(_e135, row_4, layer_2);
+                    let _e139 = encode_layer(stored);
+                    filtered[_e136] = _e139;
                 }
                 continuing {
-                    let _e139 = q;
-                    q = (_e139 + 1u);
+                    let _e141 = q;
+                    q = (_e141 + 1u);
                 }
             }
         }
         continuing {
-            let _e142 = i;
-            i = (_e142 + 1u);
+            let _e144 = i;
+            i = (_e144 + 1u);
         }
     }
     return;

@@ -8,6 +8,7 @@ using metal::uint;
 
 struct _mslBufferSizes {
     uint size1;
+    uint size3;
 };
 
 struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
@@ -58,6 +59,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_hi;
 };
 typedef metal::float4 type_9[1];
+typedef uint type_10[1];
 struct type_13 {
     metal::float4 inner[2];
 };
@@ -98,10 +100,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
-    uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
@@ -199,11 +201,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_3 = sigma_t * len;
-    if (x_3 < 0.0001) {
-        return len * (1.0 - (0.5 * x_3));
+    float x_5 = sigma_t * len;
+    if (x_5 < 0.0001) {
+        return len * (1.0 - (0.5 * x_5));
     }
-    return (1.0 - metal::exp(-(x_3))) / sigma_t;
+    return (1.0 - metal::exp(-(x_5))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -223,8 +225,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_4 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_4 * x_4) * (3.0 - (2.0 * x_4));
+    float x_6 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_6 * x_6) * (3.0 - (2.0 * x_6));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -237,8 +239,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_5 = eye + (dir * t);
-    metal::float3 to_x = x_5 - light_pos;
+    metal::float3 x_7 = eye + (dir * t);
+    metal::float3 to_x = x_7 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d);
@@ -265,7 +267,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
     float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
     float g0_ = metal::atan((a_1 - t0_) / h);
-    float w_1 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
+    float w_2 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
@@ -283,7 +285,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
         {
             uint _e32 = k_1;
-            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
+            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_2);
             q_1 = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
@@ -302,7 +304,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q_1;
-                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
+                    float u = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q_1;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -312,7 +314,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
     }
     float _e75 = sum;
-    return ((_e75 * 0.5) * w_1) * h;
+    return ((_e75 * 0.5) * w_2) * h;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -451,6 +453,43 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     return _e66;
 }
 
+uint filtered_index(
+    uint x_2,
+    uint row_2,
+    uint layer,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
+) {
+    uint _e5 = frame.sizes.z;
+    uint _e12 = frame.sizes.w;
+    return (((layer * _e5) + x_2) * _e12) + row_2;
+}
+
+uint encode_layer(
+    metal::float4 v_10
+) {
+    return metal::pack_float_to_unorm4x8(v_10);
+}
+
+metal::float4 decode_layer(
+    uint w_1
+) {
+    return metal::unpack_unorm4x8_to_float(w_1);
+}
+
+metal::float4 filtered_load(
+    uint x_3,
+    uint row_3,
+    uint layer_1,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
+    device type_10 const& filtered,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    uint _e3 = filtered_index(x_3, row_3, layer_1, frame);
+    uint _e6 = filtered[metal::min(unsigned(_e3), (_buffer_sizes.size3 - 0 - 4) / 4)];
+    metal::float4 _e7 = decode_layer(_e6);
+    return _e7;
+}
+
 struct prefilterInput {
 };
 kernel void prefilter(
@@ -458,9 +497,9 @@ kernel void prefilter(
 , constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
 , device type_9 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(0)]]
-, metal::texture2d_array<float, metal::access::write> filtered [[texture(1)]]
-, metal::texture2d<float, metal::access::write> bounds [[texture(2)]]
-, constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
+, device type_10& filtered [[buffer(2)]]
+, metal::texture2d<float, metal::access::write> bounds [[texture(1)]]
+, constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {
     bool local = {};
     bool local_1 = {};
@@ -472,12 +511,12 @@ kernel void prefilter(
     metal::float2 angle = {};
     uint k = {};
     uint q = {};
-    uint row_2 = id.x;
+    uint row_4 = id.x;
     uint region = id.y;
     uint thread_ = id.z;
     uint width_1 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
-    if (!((row_2 >= _e14))) {
+    if (!((row_4 >= _e14))) {
         local = region >= REGIONS;
     } else {
         local = true;
@@ -492,7 +531,7 @@ kernel void prefilter(
     if (_e29) {
         return;
     }
-    metal::float4 _e32 = slices[metal::min(unsigned(row_2), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    metal::float4 _e32 = slices[metal::min(unsigned(row_4), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, false);
@@ -503,8 +542,8 @@ kernel void prefilter(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e142 = i;
-            i = _e142 + 1u;
+            uint _e144 = i;
+            i = _e144 + 1u;
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -515,11 +554,11 @@ kernel void prefilter(
         {
             uint _e44 = i;
             uint clamped_lod_e48 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_2)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
+            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_4)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
             float d_1 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
             uint _e52 = i;
-            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, true, false);
+            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, true, false);
             float _e56 = wsum;
             wsum = _e56 + _e54;
             if (thread_ == 0u) {
@@ -530,7 +569,7 @@ kernel void prefilter(
                 uint _e66 = i;
                 float _e68 = lo;
                 float _e69 = hi;
-                bounds.write(metal::float4(_e68, _e69, 0.0, 0.0), metal::uint2(metal::uint2(_e66, row_2)));
+                bounds.write(metal::float4(_e68, _e69, 0.0, 0.0), metal::uint2(metal::uint2(_e66, row_4)));
             }
             float _e74 = wsum;
             float _e76 = wsum;
@@ -567,8 +606,8 @@ kernel void prefilter(
                 if (metal::all(loop_bound_4 == uint2(0u))) { break; }
                 loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
                 if (!loop_init_4) {
-                    uint _e139 = q;
-                    q = _e139 + 1u;
+                    uint _e141 = q;
+                    q = _e141 + 1u;
                 }
                 loop_init_4 = false;
                 uint _e106 = q;
@@ -578,7 +617,7 @@ kernel void prefilter(
                 }
                 {
                     uint _e109 = q;
-                    uint layer = (thread_ * 2u) + _e109;
+                    uint layer_2 = (thread_ * 2u) + _e109;
                     metal::float2 _e111 = angle;
                     metal::float2 _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
                     metal::float2 _e113 = angle;
@@ -593,7 +632,9 @@ kernel void prefilter(
                     metal::float4 _e129 = acc.inner[metal::min(unsigned(_e127), 1u)];
                     metal::float4 stored = (_e129 * 0.5) + metal::float4(0.5);
                     uint _e135 = i;
-                    filtered.write(stored, metal::uint2(metal::uint2(_e135, row_2)), layer);
+                    uint _e136 = filtered_index(_e135, row_4, layer_2, frame);
+                    uint _e139 = encode_layer(stored);
+                    filtered[metal::min(unsigned(_e136), (_buffer_sizes.size3 - 0 - 4) / 4)] = _e139;
                 }
             }
         }

@@ -8,6 +8,7 @@ using metal::uint;
 
 struct _mslBufferSizes {
     uint size1;
+    uint size3;
 };
 
 struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
@@ -58,7 +59,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_hi;
 };
 typedef metal::float4 type_9[1];
-struct type_13 {
+struct type_12 {
     metal::float4 inner[2];
 };
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
@@ -98,10 +99,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
-    uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
@@ -199,11 +200,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_3 = sigma_t * len;
-    if (x_3 < 0.0001) {
-        return len * (1.0 - (0.5 * x_3));
+    float x_5 = sigma_t * len;
+    if (x_5 < 0.0001) {
+        return len * (1.0 - (0.5 * x_5));
     }
-    return (1.0 - metal::exp(-(x_3))) / sigma_t;
+    return (1.0 - metal::exp(-(x_5))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -223,8 +224,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_4 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_4 * x_4) * (3.0 - (2.0 * x_4));
+    float x_6 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_6 * x_6) * (3.0 - (2.0 * x_6));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -237,8 +238,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_5 = eye + (dir * t);
-    metal::float3 to_x = x_5 - light_pos;
+    metal::float3 x_7 = eye + (dir * t);
+    metal::float3 to_x = x_7 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_1 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_1);
@@ -265,7 +266,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
     float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
     float g0_ = metal::atan((a_1 - t0_) / h);
-    float w_1 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
+    float w_2 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
@@ -283,7 +284,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
         {
             uint _e32 = k;
-            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
+            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_2);
             q_1 = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
@@ -302,7 +303,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q_1;
-                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
+                    float u = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q_1;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -312,7 +313,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
     }
     float _e75 = sum;
-    return ((_e75 * 0.5) * w_1) * h;
+    return ((_e75 * 0.5) * w_2) * h;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -449,6 +450,43 @@ metal::float4 moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
     return metal::float4(z4_ * z_1, z4_ * z2_, 0.0, 0.0);
 }
 
+uint filtered_index(
+    uint x_2,
+    uint row_2,
+    uint layer_1,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
+) {
+    uint _e5 = frame.sizes.z;
+    uint _e12 = frame.sizes.w;
+    return (((layer_1 * _e5) + x_2) * _e12) + row_2;
+}
+
+metal::float4 encode_layer(
+    metal::float4 v_10
+) {
+    return v_10;
+}
+
+metal::float4 decode_layer(
+    metal::float4 w_1
+) {
+    return w_1;
+}
+
+metal::float4 filtered_load(
+    uint x_3,
+    uint row_3,
+    uint layer_2,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
+    device type_9 const& filtered,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    uint _e3 = filtered_index(x_3, row_3, layer_2, frame);
+    metal::float4 _e6 = filtered[metal::min(unsigned(_e3), (_buffer_sizes.size3 - 0 - 16) / 16)];
+    metal::float4 _e7 = decode_layer(_e6);
+    return _e7;
+}
+
 struct prefilterInput {
 };
 kernel void prefilter(
@@ -456,24 +494,24 @@ kernel void prefilter(
 , constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame [[buffer(0)]]
 , device type_9 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(0)]]
-, metal::texture2d_array<float, metal::access::write> filtered [[texture(1)]]
-, metal::texture2d<float, metal::access::write> bounds [[texture(2)]]
-, constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
+, device type_9& filtered [[buffer(2)]]
+, metal::texture2d<float, metal::access::write> bounds [[texture(1)]]
+, constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {
     bool local = {};
     bool local_1 = {};
-    type_13 acc = {};
+    type_12 acc = {};
     float wsum = 0.0;
     float lo = 1000000000000000000000000000000.0;
     float hi = -1000000000000000000000000000000.0;
     uint i = {};
     uint q = {};
-    uint row_2 = id.x;
+    uint row_4 = id.x;
     uint region = id.y;
     uint thread_ = id.z;
     uint width_1 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
-    if (!((row_2 >= _e14))) {
+    if (!((row_4 >= _e14))) {
         local = region >= REGIONS;
     } else {
         local = true;
@@ -488,7 +526,7 @@ kernel void prefilter(
     if (_e29) {
         return;
     }
-    metal::float4 _e32 = slices[metal::min(unsigned(row_2), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    metal::float4 _e32 = slices[metal::min(unsigned(row_4), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, false);
@@ -499,8 +537,8 @@ kernel void prefilter(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e111 = i;
-            i = _e111 + 1u;
+            uint _e113 = i;
+            i = _e113 + 1u;
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -511,11 +549,11 @@ kernel void prefilter(
         {
             uint _e44 = i;
             uint clamped_lod_e48 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_2)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
+            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_4)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
             float d_2 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
             uint _e52 = i;
-            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_2, _e52, true, false);
+            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, true, false);
             float _e56 = wsum;
             wsum = _e56 + _e54;
             if (thread_ == 0u) {
@@ -526,7 +564,7 @@ kernel void prefilter(
                 uint _e66 = i;
                 float _e68 = lo;
                 float _e69 = hi;
-                bounds.write(metal::float4(_e68, _e69, 0.0, 0.0), metal::uint2(metal::uint2(_e66, row_2)));
+                bounds.write(metal::float4(_e68, _e69, 0.0, 0.0), metal::uint2(metal::uint2(_e66, row_4)));
             }
             float _e74 = wsum;
             float _e76 = wsum;
@@ -539,8 +577,8 @@ kernel void prefilter(
                 if (metal::all(loop_bound_3 == uint2(0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e108 = q;
-                    q = _e108 + 1u;
+                    uint _e110 = q;
+                    q = _e110 + 1u;
                 }
                 loop_init_3 = false;
                 uint _e85 = q;
@@ -556,10 +594,12 @@ kernel void prefilter(
                     metal::float4 _e97 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e81, _e96);
                     acc.inner[metal::min(unsigned(_e88), 1u)] = (_e92 * (1.0 - blend)) + (_e97 * blend);
                     uint _e100 = i;
-                    uint _e102 = q;
-                    uint _e103 = q;
-                    metal::float4 _e105 = acc.inner[metal::min(unsigned(_e103), 1u)];
-                    filtered.write(_e105, metal::uint2(metal::uint2(_e100, row_2)), _e102);
+                    uint _e101 = q;
+                    uint _e102 = filtered_index(_e100, row_4, _e101, frame);
+                    uint _e105 = q;
+                    metal::float4 _e107 = acc.inner[metal::min(unsigned(_e105), 1u)];
+                    metal::float4 _e108 = encode_layer(_e107);
+                    filtered[metal::min(unsigned(_e102), (_buffer_sizes.size3 - 0 - 16) / 16)] = _e108;
                 }
             }
         }

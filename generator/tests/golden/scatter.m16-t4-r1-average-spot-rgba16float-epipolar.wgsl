@@ -68,7 +68,7 @@ var depth: texture_2d<f32>;
 @group(0) @binding(3) 
 var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) 
-var filtered: texture_2d_array<f32>;
+var<storage> filtered: array<vec2<u32>>;
 @group(0) @binding(5) 
 var output: texture_storage_2d<rgba16float,write>;
 @group(0) @binding(6) 
@@ -88,9 +88,9 @@ fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMap
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
-    let x_4 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let x_6 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y_2 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e36 = textureLoad(sm, vec2<u32>(x_4, y_2), 0i);
+    let _e36 = textureLoad(sm, vec2<u32>(x_6, y_2), 0i);
     return select(_e36.x, 2f, outside);
 }
 
@@ -161,11 +161,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_5 = (sigma_t * len);
-    if (x_5 < 0.0001f) {
-        return (len * (1f - (0.5f * x_5)));
+    let x_7 = (sigma_t * len);
+    if (x_7 < 0.0001f) {
+        return (len * (1f - (0.5f * x_7)));
     }
-    return ((1f - exp(-(x_5))) / sigma_t);
+    return ((1f - exp(-(x_7))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -177,13 +177,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_6 * x_6) * (3f - (2f * x_6)));
+    let x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_8 * x_8) * (3f - (2f * x_8)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_7 = (eye + (dir * t));
-    let to_x = (x_7 - light_pos);
+    let x_9 = (eye + (dir * t));
+    let to_x = (x_9 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d_1 = sqrt(d2_);
     let travel = (to_x / vec3(d_1));
@@ -200,7 +200,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
     let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
     let g0_ = atan(((a_1 - t0_) / h));
-    let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
+    let w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k;
         if (_e30 < panels) {
@@ -209,7 +209,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
         {
             let _e32 = k;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
+            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_2));
             q = 0u;
             loop {
                 let _e40 = q;
@@ -219,7 +219,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                 }
                 {
                     let _e46 = q;
-                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    let u = tan((mid + ((0.5f * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     let _e52 = sum;
                     let _e54 = q;
                     let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -237,7 +237,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
     }
     let _e75 = sum;
-    return (((_e75 * 0.5f) * w_1) * h);
+    return (((_e75 * 0.5f) * w_2) * h);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -436,7 +436,28 @@ fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions
     return (((r * r) * width) / (regions * regions));
 }
 
-fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
+fn filtered_index(x_3: u32, row_1: u32, layer_1: u32) -> u32 {
+    let _e5 = frame.sizes.z;
+    let _e12 = frame.sizes.w;
+    return ((((layer_1 * _e5) + x_3) * _e12) + row_1);
+}
+
+fn encode_layer(v_10: vec4<f32>) -> vec2<u32> {
+    return vec2<u32>(pack2x16float(v_10.xy), pack2x16float(v_10.zw));
+}
+
+fn decode_layer(w_1: vec2<u32>) -> vec4<f32> {
+    return vec4<f32>(unpack2x16float(w_1.x), unpack2x16float(w_1.y));
+}
+
+fn filtered_load(x_4: u32, row_2: u32, layer_2: u32) -> vec4<f32> {
+    let _e3 = filtered_index(x_4, row_2, layer_2);
+    let _e6 = filtered[_e3];
+    let _e7 = decode_layer(_e6);
+    return _e7;
+}
+
+fn scatter_pixel(x_5: u32, y_1: u32) -> vec3<f32> {
     var local_2: bool;
     var local_3: bool;
     var local_4: bool;
@@ -447,7 +468,7 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     var theta_3: f32 = 0f;
     var coeffs: array<vec4<f32>, 4>;
     var angle: vec2<f32>;
-    var layer_1: u32 = 0u;
+    var layer_3: u32 = 0u;
     var delta0_: f32 = 1f;
     var delta1_: f32 = 1f;
     var xs0_: f32;
@@ -470,7 +491,7 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     var local_7: bool;
     var local_8: bool;
     var local_9: bool;
-    var layer_2: u32;
+    var layer_4: u32;
     var k_3: u32;
     var local_10: bool;
     var local_11: bool;
@@ -478,11 +499,11 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
 
     let f_12 = frame;
     let eye_8 = f_12.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_3, y_1);
-    let _e14 = textureLoad(depth, vec2<u32>(x_3, y_1), 0i);
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_5, y_1);
+    let _e14 = textureLoad(depth, vec2<u32>(x_5, y_1), 0i);
     let s_3 = (min(max(_e14.x, 0f), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 0.000001f));
     let color = f_12.light_color.xyz;
-    let px = vec3<f32>((f32(x_3) + 0.5f), (f32(y_1) + 0.5f), 0f);
+    let px = vec3<f32>((f32(x_5) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_12.epipole.w;
     if (f_12.epipole.z > 0.5f) {
         local_2 = (length((px - vec3<f32>(f_12.epipole.x, f_12.epipole.y, 0f))) < radius);
@@ -538,7 +559,7 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
     let _e149 = angle;
     let _e150 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
     loop {
-        let _e152 = layer_1;
+        let _e152 = layer_3;
         if (_e152 < LAYERS) {
         } else {
             break;
@@ -546,17 +567,17 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
         {
             let _e155 = angle;
             let _e156 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, _e150);
-            let _e158 = layer_1;
+            let _e158 = layer_3;
             let _e160 = angle;
-            let _e161 = layer_1;
+            let _e161 = layer_3;
             let _e162 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e160, _e156, _e161);
             coeffs[_e158] = _e162;
             let _e163 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156, _e150);
             angle = _e163;
         }
         continuing {
-            let _e165 = layer_1;
-            layer_1 = (_e165 + 1u);
+            let _e165 = layer_3;
+            layer_3 = (_e165 + 1u);
         }
     }
     let _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
@@ -690,113 +711,113 @@ fn scatter_pixel(x_3: u32, y_1: u32) -> vec3<f32> {
             }
             let _e386 = local_8;
             if _e386 {
-                layer_2 = 0u;
+                layer_4 = 0u;
                 loop {
-                    let _e389 = layer_2;
+                    let _e389 = layer_4;
                     if (_e389 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        let _e392 = layer_2;
+                        let _e392 = layer_4;
                         let coeff = coeffs[_e392];
-                        let _e396 = layer_2;
-                        let _e399 = textureLoad(filtered, vec2<u32>(x00_, _e118), _e396, 0i);
-                        let _e401 = layer_2;
-                        let _e404 = textureLoad(filtered, vec2<u32>(x01_, _e118), _e401, 0i);
-                        let texel0_ = mix(_e399, _e404, fx0_);
-                        let _e407 = layer_2;
-                        let _e410 = textureLoad(filtered, vec2<u32>(x10_, row1_), _e407, 0i);
-                        let _e412 = layer_2;
-                        let _e415 = textureLoad(filtered, vec2<u32>(x11_, row1_), _e412, 0i);
-                        let texel1_ = mix(_e410, _e415, fx1_);
+                        let _e395 = layer_4;
+                        let _e396 = filtered_load(x00_, _e118, _e395);
+                        let _e397 = layer_4;
+                        let _e398 = filtered_load(x01_, _e118, _e397);
+                        let texel0_ = mix(_e396, _e398, fx0_);
+                        let _e400 = layer_4;
+                        let _e401 = filtered_load(x10_, row1_, _e400);
+                        let _e402 = layer_4;
+                        let _e403 = filtered_load(x11_, row1_, _e402);
+                        let texel1_ = mix(_e401, _e403, fx1_);
                         k_3 = 0u;
                         loop {
-                            let _e419 = k_3;
-                            if (_e419 < 4u) {
+                            let _e407 = k_3;
+                            if (_e407 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                let _e422 = vis0_;
-                                let _e423 = k_3;
-                                let _e425 = k_3;
-                                vis0_ = (_e422 + (coeff[_e423] * ((texel0_[_e425] * 2f) - 1f)));
-                                let _e433 = vis1_;
-                                let _e434 = k_3;
-                                let _e436 = k_3;
-                                vis1_ = (_e433 + (coeff[_e434] * ((texel1_[_e436] * 2f) - 1f)));
+                                let _e410 = vis0_;
+                                let _e411 = k_3;
+                                let _e413 = k_3;
+                                vis0_ = (_e410 + (coeff[_e411] * ((texel0_[_e413] * 2f) - 1f)));
+                                let _e421 = vis1_;
+                                let _e422 = k_3;
+                                let _e424 = k_3;
+                                vis1_ = (_e421 + (coeff[_e422] * ((texel1_[_e424] * 2f) - 1f)));
                             }
                             continuing {
-                                let _e445 = k_3;
-                                k_3 = (_e445 + 1u);
+                                let _e433 = k_3;
+                                k_3 = (_e433 + 1u);
                             }
                         }
                     }
                     continuing {
-                        let _e448 = layer_2;
-                        layer_2 = (_e448 + 1u);
+                        let _e436 = layer_4;
+                        layer_4 = (_e436 + 1u);
                     }
                 }
             }
-            let _e450 = vis0_;
-            let _e451 = d;
-            let _e456 = d;
-            vis0_ = select(select(_e450, 0f, (_e451 > lohi0_.y)), 1f, (_e456 <= lohi0_.x));
-            let _e461 = vis1_;
-            let _e462 = d;
-            let _e467 = d;
-            vis1_ = select(select(_e461, 0f, (_e462 > lohi1_.y)), 1f, (_e467 <= lohi1_.x));
-            let _e473 = done0_;
+            let _e438 = vis0_;
+            let _e439 = d;
+            let _e444 = d;
+            vis0_ = select(select(_e438, 0f, (_e439 > lohi0_.y)), 1f, (_e444 <= lohi0_.x));
+            let _e449 = vis1_;
+            let _e450 = d;
+            let _e455 = d;
+            vis1_ = select(select(_e449, 0f, (_e450 > lohi1_.y)), 1f, (_e455 <= lohi1_.x));
+            let _e461 = done0_;
+            if !(_e461) {
+                let _e464 = total0_;
+                let _e465 = weight0_;
+                let _e466 = vis0_;
+                total0_ = (_e464 + (_e465 * clamp(_e466, 0f, 1f)));
+            }
+            let _e473 = done1_;
             if !(_e473) {
-                let _e476 = total0_;
-                let _e477 = weight0_;
-                let _e478 = vis0_;
-                total0_ = (_e476 + (_e477 * clamp(_e478, 0f, 1f)));
+                let _e476 = total1_;
+                let _e477 = weight1_;
+                let _e478 = vis1_;
+                total1_ = (_e476 + (_e477 * clamp(_e478, 0f, 1f)));
             }
-            let _e485 = done1_;
-            if !(_e485) {
-                let _e488 = total1_;
-                let _e489 = weight1_;
-                let _e490 = vis1_;
-                total1_ = (_e488 + (_e489 * clamp(_e490, 0f, 1f)));
-            }
-            let _e496 = done0_;
-            if !(_e496) {
+            let _e484 = done0_;
+            if !(_e484) {
                 local_10 = is_last0_;
             } else {
                 local_10 = true;
             }
-            let _e501 = local_10;
-            done0_ = _e501;
-            let _e502 = done1_;
-            if !(_e502) {
+            let _e489 = local_10;
+            done0_ = _e489;
+            let _e490 = done1_;
+            if !(_e490) {
                 local_11 = is_last1_;
             } else {
                 local_11 = true;
             }
-            let _e507 = local_11;
-            done1_ = _e507;
-            let _e508 = done0_;
-            if _e508 {
-                let _e509 = done1_;
-                local_12 = _e509;
+            let _e495 = local_11;
+            done1_ = _e495;
+            let _e496 = done0_;
+            if _e496 {
+                let _e497 = done1_;
+                local_12 = _e497;
             } else {
                 local_12 = false;
             }
-            let _e513 = local_12;
-            if _e513 {
+            let _e501 = local_12;
+            if _e501 {
                 break;
             }
         }
         continuing {
-            let _e515 = r_1;
-            r_1 = (_e515 + 1u);
+            let _e503 = r_1;
+            r_1 = (_e503 + 1u);
         }
     }
-    let _e519 = total0_;
-    let _e521 = total1_;
-    let l_2 = (((1f - w1_) * _e519) + (w1_ * _e521));
+    let _e507 = total0_;
+    let _e509 = total1_;
+    let l_2 = (((1f - w1_) * _e507) + (w1_ * _e509));
     let c = (color * l_2);
     return c;
 }

@@ -68,7 +68,7 @@ layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
 layout(binding = 3) uniform sampler2D _group_0_binding_3_cs;
 
-layout(binding = 4) uniform sampler2DArray _group_0_binding_4_cs;
+layout(std430, binding = 4) readonly buffer type_10_block_2Compute { uint _group_0_binding_4_cs[]; };
 
 layout(binding = 5,rgba16f) writeonly uniform image2D _group_0_binding_5_cs;
 
@@ -89,10 +89,10 @@ vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapVie
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
     bool outside = ((((uv.x < 0.0) || (uv.x > 1.0)) || (uv.y < 0.0)) || (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_4 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_6 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
     uint y_2 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_4, y_2)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_6, y_2)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -163,11 +163,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_5 = (sigma_t * len);
-    if ((x_5 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_5)));
+    float x_7 = (sigma_t * len);
+    if ((x_7 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_7)));
     }
-    return ((1.0 - exp(-(x_5))) / sigma_t);
+    return ((1.0 - exp(-(x_7))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -179,13 +179,13 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_6 * x_6) * (3.0 - (2.0 * x_6)));
+    float x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_8 * x_8) * (3.0 - (2.0 * x_8)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_7 = (eye + (dir * t));
-    vec3 to_x = (x_7 - light_pos);
+    vec3 x_9 = (eye + (dir * t));
+    vec3 to_x = (x_9 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_1 = sqrt(d2_);
     vec3 travel = (to_x / vec3(d_1));
@@ -201,7 +201,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
     float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
     float g0_ = atan(((a_1 - t0_) / h));
-    float w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
+    float w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
@@ -216,7 +216,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
         }
         {
             uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
+            float mid = (g0_ + ((float(_e32) + 0.5) * w_2));
             q = 0u;
             bool loop_init_1 = true;
             while(true) {
@@ -232,7 +232,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                 }
                 {
                     uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -242,7 +242,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w_1) * h);
+    return (((_e75 * 0.5) * w_2) * h);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
@@ -440,7 +440,28 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return (((r * r) * width) / (regions * regions));
 }
 
-vec3 scatter_pixel(uint x_3, uint y_1) {
+uint filtered_index(uint x_3, uint row_1, uint layer_1) {
+    uint _e5 = _group_0_binding_0_cs.sizes.z;
+    uint _e12 = _group_0_binding_0_cs.sizes.w;
+    return ((((layer_1 * _e5) + x_3) * _e12) + row_1);
+}
+
+uint encode_layer(vec4 v_10) {
+    return packUnorm4x8(v_10);
+}
+
+vec4 decode_layer(uint w_1) {
+    return unpackUnorm4x8(w_1);
+}
+
+vec4 filtered_load(uint x_4, uint row_2, uint layer_2) {
+    uint _e3 = filtered_index(x_4, row_2, layer_2);
+    uint _e6 = _group_0_binding_4_cs[_e3];
+    vec4 _e7 = decode_layer(_e6);
+    return _e7;
+}
+
+vec3 scatter_pixel(uint x_5, uint y_1) {
     bool local_2 = false;
     bool local_3 = false;
     bool local_4 = false;
@@ -451,7 +472,7 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     float theta_3 = 0.0;
     vec4 coeffs[8] = vec4[8](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
     vec2 angle = vec2(0.0);
-    uint layer_1 = 0u;
+    uint layer_3 = 0u;
     float delta0_ = 1.0;
     float delta1_ = 1.0;
     float xs0_ = 0.0;
@@ -474,19 +495,19 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     bool local_7 = false;
     bool local_8 = false;
     bool local_9 = false;
-    uint layer_2 = 0u;
+    uint layer_4 = 0u;
     uint k_3 = 0u;
     bool local_10 = false;
     bool local_11 = false;
     bool local_12 = false;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = _group_0_binding_0_cs;
     vec3 eye_8 = f_12.eye.xyz;
-    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_3, y_1);
+    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_5, y_1);
     int _e14_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_3, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
+    vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_5, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
     float s_3 = (min(max(_e14.x, 0.0), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 1e-6));
     vec3 color = f_12.light_color.xyz;
-    vec3 px = vec3((float(x_3) + 0.5), (float(y_1) + 0.5), 0.0);
+    vec3 px = vec3((float(x_5) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_12.epipole.w;
     if ((f_12.epipole.z > 0.5)) {
         local_2 = (length((px - vec3(f_12.epipole.x, f_12.epipole.y, 0.0))) < radius);
@@ -544,11 +565,11 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e165 = layer_1;
-            layer_1 = (_e165 + 1u);
+            uint _e165 = layer_3;
+            layer_3 = (_e165 + 1u);
         }
         loop_init_3 = false;
-        uint _e152 = layer_1;
+        uint _e152 = layer_3;
         if ((_e152 < LAYERS)) {
         } else {
             break;
@@ -556,9 +577,9 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
         {
             vec2 _e155 = angle;
             vec2 _e156 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, _e150);
-            uint _e158 = layer_1;
+            uint _e158 = layer_3;
             vec2 _e160 = angle;
-            uint _e161 = layer_1;
+            uint _e161 = layer_3;
             vec4 _e162 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e160, _e156, _e161);
             coeffs[_e158] = _e162;
             vec2 _e163 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156, _e150);
@@ -592,8 +613,8 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e515 = r_1;
-            r_1 = (_e515 + 1u);
+            uint _e503 = r_1;
+            r_1 = (_e503 + 1u);
         }
         loop_init_4 = false;
         uint _e214 = r_1;
@@ -704,117 +725,113 @@ vec3 scatter_pixel(uint x_3, uint y_1) {
             }
             bool _e386 = local_8;
             if (_e386) {
-                layer_2 = 0u;
+                layer_4 = 0u;
                 bool loop_init_5 = true;
                 while(true) {
                     if (!loop_init_5) {
-                        uint _e448 = layer_2;
-                        layer_2 = (_e448 + 1u);
+                        uint _e436 = layer_4;
+                        layer_4 = (_e436 + 1u);
                     }
                     loop_init_5 = false;
-                    uint _e389 = layer_2;
+                    uint _e389 = layer_4;
                     if ((_e389 < LAYERS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e392 = layer_2;
+                        uint _e392 = layer_4;
                         vec4 coeff = coeffs[_e392];
-                        uint _e396 = layer_2;
-                        int _e399_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                        vec4 _e399 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x00_, _e118), _e396), ivec3(0), textureSize(_group_0_binding_4_cs, _e399_clamped_lod) - ivec3(1)), _e399_clamped_lod);
-                        uint _e401 = layer_2;
-                        int _e404_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                        vec4 _e404 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x01_, _e118), _e401), ivec3(0), textureSize(_group_0_binding_4_cs, _e404_clamped_lod) - ivec3(1)), _e404_clamped_lod);
-                        vec4 texel0_ = mix(_e399, _e404, fx0_);
-                        uint _e407 = layer_2;
-                        int _e410_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                        vec4 _e410 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x10_, row1_), _e407), ivec3(0), textureSize(_group_0_binding_4_cs, _e410_clamped_lod) - ivec3(1)), _e410_clamped_lod);
-                        uint _e412 = layer_2;
-                        int _e415_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                        vec4 _e415 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x11_, row1_), _e412), ivec3(0), textureSize(_group_0_binding_4_cs, _e415_clamped_lod) - ivec3(1)), _e415_clamped_lod);
-                        vec4 texel1_ = mix(_e410, _e415, fx1_);
+                        uint _e395 = layer_4;
+                        vec4 _e396 = filtered_load(x00_, _e118, _e395);
+                        uint _e397 = layer_4;
+                        vec4 _e398 = filtered_load(x01_, _e118, _e397);
+                        vec4 texel0_ = mix(_e396, _e398, fx0_);
+                        uint _e400 = layer_4;
+                        vec4 _e401 = filtered_load(x10_, row1_, _e400);
+                        uint _e402 = layer_4;
+                        vec4 _e403 = filtered_load(x11_, row1_, _e402);
+                        vec4 texel1_ = mix(_e401, _e403, fx1_);
                         k_3 = 0u;
                         bool loop_init_6 = true;
                         while(true) {
                             if (!loop_init_6) {
-                                uint _e445 = k_3;
-                                k_3 = (_e445 + 1u);
+                                uint _e433 = k_3;
+                                k_3 = (_e433 + 1u);
                             }
                             loop_init_6 = false;
-                            uint _e419 = k_3;
-                            if ((_e419 < 4u)) {
+                            uint _e407 = k_3;
+                            if ((_e407 < 4u)) {
                             } else {
                                 break;
                             }
                             {
-                                float _e422 = vis0_;
-                                uint _e423 = k_3;
-                                uint _e425 = k_3;
-                                vis0_ = (_e422 + (coeff[_e423] * ((texel0_[_e425] * 2.0) - 1.0)));
-                                float _e433 = vis1_;
-                                uint _e434 = k_3;
-                                uint _e436 = k_3;
-                                vis1_ = (_e433 + (coeff[_e434] * ((texel1_[_e436] * 2.0) - 1.0)));
+                                float _e410 = vis0_;
+                                uint _e411 = k_3;
+                                uint _e413 = k_3;
+                                vis0_ = (_e410 + (coeff[_e411] * ((texel0_[_e413] * 2.0) - 1.0)));
+                                float _e421 = vis1_;
+                                uint _e422 = k_3;
+                                uint _e424 = k_3;
+                                vis1_ = (_e421 + (coeff[_e422] * ((texel1_[_e424] * 2.0) - 1.0)));
                             }
                         }
                     }
                 }
             }
-            float _e450 = vis0_;
-            float _e451 = d;
-            float _e456 = d;
-            vis0_ = ((_e456 <= lohi0_.x) ? 1.0 : ((_e451 > lohi0_.y) ? 0.0 : _e450));
-            float _e461 = vis1_;
-            float _e462 = d;
-            float _e467 = d;
-            vis1_ = ((_e467 <= lohi1_.x) ? 1.0 : ((_e462 > lohi1_.y) ? 0.0 : _e461));
-            bool _e473 = done0_;
+            float _e438 = vis0_;
+            float _e439 = d;
+            float _e444 = d;
+            vis0_ = ((_e444 <= lohi0_.x) ? 1.0 : ((_e439 > lohi0_.y) ? 0.0 : _e438));
+            float _e449 = vis1_;
+            float _e450 = d;
+            float _e455 = d;
+            vis1_ = ((_e455 <= lohi1_.x) ? 1.0 : ((_e450 > lohi1_.y) ? 0.0 : _e449));
+            bool _e461 = done0_;
+            if (!(_e461)) {
+                float _e464 = total0_;
+                float _e465 = weight0_;
+                float _e466 = vis0_;
+                total0_ = (_e464 + (_e465 * clamp(_e466, 0.0, 1.0)));
+            }
+            bool _e473 = done1_;
             if (!(_e473)) {
-                float _e476 = total0_;
-                float _e477 = weight0_;
-                float _e478 = vis0_;
-                total0_ = (_e476 + (_e477 * clamp(_e478, 0.0, 1.0)));
+                float _e476 = total1_;
+                float _e477 = weight1_;
+                float _e478 = vis1_;
+                total1_ = (_e476 + (_e477 * clamp(_e478, 0.0, 1.0)));
             }
-            bool _e485 = done1_;
-            if (!(_e485)) {
-                float _e488 = total1_;
-                float _e489 = weight1_;
-                float _e490 = vis1_;
-                total1_ = (_e488 + (_e489 * clamp(_e490, 0.0, 1.0)));
-            }
-            bool _e496 = done0_;
-            if (!(_e496)) {
+            bool _e484 = done0_;
+            if (!(_e484)) {
                 local_10 = is_last0_;
             } else {
                 local_10 = true;
             }
-            bool _e501 = local_10;
-            done0_ = _e501;
-            bool _e502 = done1_;
-            if (!(_e502)) {
+            bool _e489 = local_10;
+            done0_ = _e489;
+            bool _e490 = done1_;
+            if (!(_e490)) {
                 local_11 = is_last1_;
             } else {
                 local_11 = true;
             }
-            bool _e507 = local_11;
-            done1_ = _e507;
-            bool _e508 = done0_;
-            if (_e508) {
-                bool _e509 = done1_;
-                local_12 = _e509;
+            bool _e495 = local_11;
+            done1_ = _e495;
+            bool _e496 = done0_;
+            if (_e496) {
+                bool _e497 = done1_;
+                local_12 = _e497;
             } else {
                 local_12 = false;
             }
-            bool _e513 = local_12;
-            if (_e513) {
+            bool _e501 = local_12;
+            if (_e501) {
                 break;
             }
         }
     }
-    float _e519 = total0_;
-    float _e521 = total1_;
-    float l_2 = (((1.0 - w1_) * _e519) + (w1_ * _e521));
+    float _e507 = total0_;
+    float _e509 = total1_;
+    float l_2 = (((1.0 - w1_) * _e507) + (w1_ * _e509));
     vec3 c = (color * l_2);
     return c;
 }

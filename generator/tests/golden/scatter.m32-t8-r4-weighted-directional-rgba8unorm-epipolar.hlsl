@@ -63,7 +63,7 @@ cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZA
 ByteAddressBuffer slices : register(t1);
 Texture2D<float4> depth : register(t2);
 Texture2D<float4> shadow_map : register(t3);
-Texture2DArray<float4> filtered : register(t4);
+ByteAddressBuffer filtered : register(t4);
 RWTexture2D<float4> output : register(u5);
 Texture2D<float4> bounds : register(t6);
 
@@ -88,9 +88,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
 {
     bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_4 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_6 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
     uint y_2 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e36 = sm.Load(int3(uint2(x_4, y_2), int(0)));
+    float4 _e36 = sm.Load(int3(uint2(x_6, y_2), int(0)));
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -169,11 +169,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_5 = (sigma_t * len);
-    if ((x_5 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_5)));
+    float x_7 = (sigma_t * len);
+    if ((x_7 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_7)));
     }
-    return ((1.0 - exp(-(x_5))) / sigma_t);
+    return ((1.0 - exp(-(x_7))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -187,14 +187,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_6 * x_6) * (3.0 - (2.0 * x_6)));
+    float x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_8 * x_8) * (3.0 - (2.0 * x_8)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_7 = (eye + (dir * t));
-    float3 to_x = (x_7 - light_pos);
+    float3 x_9 = (eye + (dir * t));
+    float3 to_x = (x_9 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_1 = sqrt(d2_);
     float3 travel = (to_x / (d_1).xxx);
@@ -212,7 +212,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
     float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
     float g0_ = atan(((a_1 - t0_) / h));
-    float w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
+    float w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
     while(true) {
@@ -230,7 +230,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         }
         {
             uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
+            float mid = (g0_ + ((float(_e32) + 0.5) * w_2));
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
             bool loop_init_1 = true;
@@ -249,7 +249,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
                 }
                 {
                     uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
+                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
                     float _e52 = sum;
                     uint _e54 = q;
                     const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -259,7 +259,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w_1) * h);
+    return (((_e75 * 0.5) * w_2) * h);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
@@ -530,11 +530,36 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return naga_div(((r * r) * width), (regions * regions));
 }
 
+uint filtered_index(uint x_3, uint row_1, uint layer_1)
+{
+    uint _e5 = frame.sizes.z;
+    uint _e12 = frame.sizes.w;
+    return ((((layer_1 * _e5) + x_3) * _e12) + row_1);
+}
+
+uint encode_layer(float4 v_10)
+{
+    return (uint(round(clamp(v_10[0], 0.0, 1.0) * 255.0)) | uint(round(clamp(v_10[1], 0.0, 1.0) * 255.0)) << 8 | uint(round(clamp(v_10[2], 0.0, 1.0) * 255.0)) << 16 | uint(round(clamp(v_10[3], 0.0, 1.0) * 255.0)) << 24);
+}
+
+float4 decode_layer(uint w_1)
+{
+    return (float4(w_1 & 0xFF, w_1 >> 8 & 0xFF, w_1 >> 16 & 0xFF, w_1 >> 24) / 255.0);
+}
+
+float4 filtered_load(uint x_4, uint row_2, uint layer_2)
+{
+    const uint _e3 = filtered_index(x_4, row_2, layer_2);
+    uint _e6 = asuint(filtered.Load(_e3*4));
+    const float4 _e7 = decode_layer(_e6);
+    return _e7;
+}
+
 float ZeroValuefloat() {
     return (float)0;
 }
 
-float3 scatter_pixel(uint x_3, uint y_1)
+float3 scatter_pixel(uint x_5, uint y_1)
 {
     bool local_2 = (bool)0;
     bool local_3 = (bool)0;
@@ -546,7 +571,7 @@ float3 scatter_pixel(uint x_3, uint y_1)
     float theta_3 = 0.0;
     float4 coeffs[8] = (float4[8])0;
     float2 angle = (float2)0;
-    uint layer_1 = 0u;
+    uint layer_3 = 0u;
     float delta0_ = 1.0;
     float delta1_ = 1.0;
     float xs0_ = (float)0;
@@ -569,7 +594,7 @@ float3 scatter_pixel(uint x_3, uint y_1)
     bool local_7 = (bool)0;
     bool local_8 = (bool)0;
     bool local_9 = (bool)0;
-    uint layer_2 = (uint)0;
+    uint layer_4 = (uint)0;
     uint k_3 = (uint)0;
     bool local_10 = (bool)0;
     bool local_11 = (bool)0;
@@ -577,11 +602,11 @@ float3 scatter_pixel(uint x_3, uint y_1)
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
     float3 eye_8 = f_12.eye.xyz;
-    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_3, y_1);
-    float4 _e14 = depth.Load(int3(uint2(x_3, y_1), int(0)));
+    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_5, y_1);
+    float4 _e14 = depth.Load(int3(uint2(x_5, y_1), int(0)));
     float s_3 = (min(max(_e14.x, 0.0), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 1e-6));
     float3 color = f_12.light_color.xyz;
-    float3 px = float3((float(x_3) + 0.5), (float(y_1) + 0.5), 0.0);
+    float3 px = float3((float(x_5) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_12.epipole.w;
     if ((f_12.epipole.z > 0.5)) {
         local_2 = (length((px - float3(f_12.epipole.x, f_12.epipole.y, 0.0))) < radius);
@@ -642,11 +667,11 @@ float3 scatter_pixel(uint x_3, uint y_1)
         if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e165 = layer_1;
-            layer_1 = (_e165 + 1u);
+            uint _e165 = layer_3;
+            layer_3 = (_e165 + 1u);
         }
         loop_init_3 = false;
-        uint _e152 = layer_1;
+        uint _e152 = layer_3;
         if ((_e152 < LAYERS)) {
         } else {
             break;
@@ -654,9 +679,9 @@ float3 scatter_pixel(uint x_3, uint y_1)
         {
             float2 _e155 = angle;
             const float2 _e156 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, _e150);
-            uint _e158 = layer_1;
+            uint _e158 = layer_3;
             float2 _e160 = angle;
-            uint _e161 = layer_1;
+            uint _e161 = layer_3;
             const float4 _e162 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e160, _e156, _e161);
             coeffs[min(uint(_e158), 7u)] = _e162;
             const float2 _e163 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156, _e150);
@@ -693,8 +718,8 @@ float3 scatter_pixel(uint x_3, uint y_1)
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e515 = r_1;
-            r_1 = (_e515 + 1u);
+            uint _e503 = r_1;
+            r_1 = (_e503 + 1u);
         }
         loop_init_4 = false;
         uint _e214 = r_1;
@@ -803,35 +828,35 @@ float3 scatter_pixel(uint x_3, uint y_1)
             }
             bool _e386 = local_8;
             if (_e386) {
-                layer_2 = 0u;
+                layer_4 = 0u;
                 uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
                 bool loop_init_5 = true;
                 while(true) {
                     if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
                     loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                     if (!loop_init_5) {
-                        uint _e448 = layer_2;
-                        layer_2 = (_e448 + 1u);
+                        uint _e436 = layer_4;
+                        layer_4 = (_e436 + 1u);
                     }
                     loop_init_5 = false;
-                    uint _e389 = layer_2;
+                    uint _e389 = layer_4;
                     if ((_e389 < LAYERS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e392 = layer_2;
+                        uint _e392 = layer_4;
                         float4 coeff = coeffs[min(uint(_e392), 7u)];
-                        uint _e396 = layer_2;
-                        float4 _e399 = filtered.Load(int4(uint2(x00_, _e118), _e396, int(0)));
-                        uint _e401 = layer_2;
-                        float4 _e404 = filtered.Load(int4(uint2(x01_, _e118), _e401, int(0)));
-                        float4 texel0_ = lerp(_e399, _e404, fx0_);
-                        uint _e407 = layer_2;
-                        float4 _e410 = filtered.Load(int4(uint2(x10_, row1_), _e407, int(0)));
-                        uint _e412 = layer_2;
-                        float4 _e415 = filtered.Load(int4(uint2(x11_, row1_), _e412, int(0)));
-                        float4 texel1_ = lerp(_e410, _e415, fx1_);
+                        uint _e395 = layer_4;
+                        const float4 _e396 = filtered_load(x00_, _e118, _e395);
+                        uint _e397 = layer_4;
+                        const float4 _e398 = filtered_load(x01_, _e118, _e397);
+                        float4 texel0_ = lerp(_e396, _e398, fx0_);
+                        uint _e400 = layer_4;
+                        const float4 _e401 = filtered_load(x10_, row1_, _e400);
+                        uint _e402 = layer_4;
+                        const float4 _e403 = filtered_load(x11_, row1_, _e402);
+                        float4 texel1_ = lerp(_e401, _e403, fx1_);
                         k_3 = 0u;
                         uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
                         bool loop_init_6 = true;
@@ -839,83 +864,83 @@ float3 scatter_pixel(uint x_3, uint y_1)
                             if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
                             loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                             if (!loop_init_6) {
-                                uint _e445 = k_3;
-                                k_3 = (_e445 + 1u);
+                                uint _e433 = k_3;
+                                k_3 = (_e433 + 1u);
                             }
                             loop_init_6 = false;
-                            uint _e419 = k_3;
-                            if ((_e419 < 4u)) {
+                            uint _e407 = k_3;
+                            if ((_e407 < 4u)) {
                             } else {
                                 break;
                             }
                             {
-                                float _e422 = vis0_;
-                                uint _e423 = k_3;
-                                uint _e425 = k_3;
-                                vis0_ = (_e422 + (coeff[min(uint(_e423), 3u)] * ((texel0_[min(uint(_e425), 3u)] * 2.0) - 1.0)));
-                                float _e433 = vis1_;
-                                uint _e434 = k_3;
-                                uint _e436 = k_3;
-                                vis1_ = (_e433 + (coeff[min(uint(_e434), 3u)] * ((texel1_[min(uint(_e436), 3u)] * 2.0) - 1.0)));
+                                float _e410 = vis0_;
+                                uint _e411 = k_3;
+                                uint _e413 = k_3;
+                                vis0_ = (_e410 + (coeff[min(uint(_e411), 3u)] * ((texel0_[min(uint(_e413), 3u)] * 2.0) - 1.0)));
+                                float _e421 = vis1_;
+                                uint _e422 = k_3;
+                                uint _e424 = k_3;
+                                vis1_ = (_e421 + (coeff[min(uint(_e422), 3u)] * ((texel1_[min(uint(_e424), 3u)] * 2.0) - 1.0)));
                             }
                         }
                     }
                 }
             }
-            float _e450 = vis0_;
-            float _e451 = d;
-            float _e456 = d;
-            vis0_ = ((_e456 <= lohi0_.x) ? 1.0 : ((_e451 > lohi0_.y) ? 0.0 : _e450));
-            float _e461 = vis1_;
-            float _e462 = d;
-            float _e467 = d;
-            vis1_ = ((_e467 <= lohi1_.x) ? 1.0 : ((_e462 > lohi1_.y) ? 0.0 : _e461));
-            bool _e473 = done0_;
+            float _e438 = vis0_;
+            float _e439 = d;
+            float _e444 = d;
+            vis0_ = ((_e444 <= lohi0_.x) ? 1.0 : ((_e439 > lohi0_.y) ? 0.0 : _e438));
+            float _e449 = vis1_;
+            float _e450 = d;
+            float _e455 = d;
+            vis1_ = ((_e455 <= lohi1_.x) ? 1.0 : ((_e450 > lohi1_.y) ? 0.0 : _e449));
+            bool _e461 = done0_;
+            if (!(_e461)) {
+                float _e464 = total0_;
+                float _e465 = weight0_;
+                float _e466 = vis0_;
+                total0_ = (_e464 + (_e465 * clamp(_e466, 0.0, 1.0)));
+            }
+            bool _e473 = done1_;
             if (!(_e473)) {
-                float _e476 = total0_;
-                float _e477 = weight0_;
-                float _e478 = vis0_;
-                total0_ = (_e476 + (_e477 * clamp(_e478, 0.0, 1.0)));
+                float _e476 = total1_;
+                float _e477 = weight1_;
+                float _e478 = vis1_;
+                total1_ = (_e476 + (_e477 * clamp(_e478, 0.0, 1.0)));
             }
-            bool _e485 = done1_;
-            if (!(_e485)) {
-                float _e488 = total1_;
-                float _e489 = weight1_;
-                float _e490 = vis1_;
-                total1_ = (_e488 + (_e489 * clamp(_e490, 0.0, 1.0)));
-            }
-            bool _e496 = done0_;
-            if (!(_e496)) {
+            bool _e484 = done0_;
+            if (!(_e484)) {
                 local_10 = is_last0_;
             } else {
                 local_10 = true;
             }
-            bool _e501 = local_10;
-            done0_ = _e501;
-            bool _e502 = done1_;
-            if (!(_e502)) {
+            bool _e489 = local_10;
+            done0_ = _e489;
+            bool _e490 = done1_;
+            if (!(_e490)) {
                 local_11 = is_last1_;
             } else {
                 local_11 = true;
             }
-            bool _e507 = local_11;
-            done1_ = _e507;
-            bool _e508 = done0_;
-            if (_e508) {
-                bool _e509 = done1_;
-                local_12 = _e509;
+            bool _e495 = local_11;
+            done1_ = _e495;
+            bool _e496 = done0_;
+            if (_e496) {
+                bool _e497 = done1_;
+                local_12 = _e497;
             } else {
                 local_12 = false;
             }
-            bool _e513 = local_12;
-            if (_e513) {
+            bool _e501 = local_12;
+            if (_e501) {
                 break;
             }
         }
     }
-    float _e519 = total0_;
-    float _e521 = total1_;
-    float l_2 = (((1.0 - w1_) * _e519) + (w1_ * _e521));
+    float _e507 = total0_;
+    float _e509 = total1_;
+    float l_2 = (((1.0 - w1_) * _e507) + (w1_ * _e509));
     float3 c = (color * l_2);
     return c;
 }

@@ -8,6 +8,7 @@ using metal::uint;
 
 struct _mslBufferSizes {
     uint size1;
+    uint size4;
 };
 
 struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
@@ -58,6 +59,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_hi;
 };
 typedef metal::float4 type_9[1];
+typedef uint type_10[1];
 struct type_12 {
     metal::float4 inner[8];
 };
@@ -97,10 +99,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
-    uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_6 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y_2 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y_2)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_6, y_2)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
@@ -198,11 +200,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_5 = sigma_t * len;
-    if (x_5 < 0.0001) {
-        return len * (1.0 - (0.5 * x_5));
+    float x_7 = sigma_t * len;
+    if (x_7 < 0.0001) {
+        return len * (1.0 - (0.5 * x_7));
     }
-    return (1.0 - metal::exp(-(x_5))) / sigma_t;
+    return (1.0 - metal::exp(-(x_7))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -222,8 +224,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_6 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_6 * x_6) * (3.0 - (2.0 * x_6));
+    float x_8 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_8 * x_8) * (3.0 - (2.0 * x_8));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -236,8 +238,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_7 = eye + (dir * t);
-    metal::float3 to_x = x_7 - light_pos;
+    metal::float3 x_9 = eye + (dir * t);
+    metal::float3 to_x = x_9 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_1 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_1);
@@ -264,7 +266,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
     float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
     float g0_ = metal::atan((a_1 - t0_) / h);
-    float w_1 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
+    float w_2 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
@@ -282,7 +284,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
         {
             uint _e32 = k;
-            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
+            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_2);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
@@ -301,7 +303,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q;
-                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
+                    float u = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -311,7 +313,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
     }
     float _e75 = sum;
-    return ((_e75 * 0.5) * w_1) * h;
+    return ((_e75 * 0.5) * w_2) * h;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -623,14 +625,51 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     return naga_div((r * r) * width, regions * regions);
 }
 
-metal::float3 scatter_pixel(
+uint filtered_index(
     uint x_3,
+    uint row_1,
+    uint layer_1,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
+) {
+    uint _e5 = frame.sizes.z;
+    uint _e12 = frame.sizes.w;
+    return (((layer_1 * _e5) + x_3) * _e12) + row_1;
+}
+
+uint encode_layer(
+    metal::float4 v_10
+) {
+    return metal::pack_float_to_unorm4x8(v_10);
+}
+
+metal::float4 decode_layer(
+    uint w_1
+) {
+    return metal::unpack_unorm4x8_to_float(w_1);
+}
+
+metal::float4 filtered_load(
+    uint x_4,
+    uint row_2,
+    uint layer_2,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
+    device type_10 const& filtered,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    uint _e3 = filtered_index(x_4, row_2, layer_2, frame);
+    uint _e6 = filtered[metal::min(unsigned(_e3), (_buffer_sizes.size4 - 0 - 4) / 4)];
+    metal::float4 _e7 = decode_layer(_e6);
+    return _e7;
+}
+
+metal::float3 scatter_pixel(
+    uint x_5,
     uint y_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_9 const& slices,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::sample> shadow_map,
-    metal::texture2d_array<float, metal::access::sample> filtered,
+    device type_10 const& filtered,
     metal::texture2d<float, metal::access::sample> bounds,
     constant _mslBufferSizes& _buffer_sizes
 ) {
@@ -644,7 +683,7 @@ metal::float3 scatter_pixel(
     float theta_3 = 0.0;
     type_12 coeffs = {};
     metal::float2 angle = {};
-    uint layer_1 = 0u;
+    uint layer_3 = 0u;
     float delta0_ = 1.0;
     float delta1_ = 1.0;
     float xs0_ = {};
@@ -667,19 +706,19 @@ metal::float3 scatter_pixel(
     bool local_7 = {};
     bool local_8 = {};
     bool local_9 = {};
-    uint layer_2 = {};
+    uint layer_4 = {};
     uint k_3 = {};
     bool local_10 = {};
     bool local_11 = {};
     bool local_12 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
     metal::float3 eye_8 = f_12.eye.xyz;
-    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_3, y_1);
+    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_5, y_1);
     uint clamped_lod_e14 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
+    metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
     float s_3 = metal::min(metal::max(_e14.x, 0.0), f_12.theta.z) / metal::max(metal::dot(_e10, f_12.cam_forward.xyz), 0.000001);
     metal::float3 color = f_12.light_color.xyz;
-    metal::float3 px = metal::float3(static_cast<float>(x_3) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
+    metal::float3 px = metal::float3(static_cast<float>(x_5) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
     float radius = f_12.epipole.w;
     if (f_12.epipole.z > 0.5) {
         local_2 = metal::length(px - metal::float3(f_12.epipole.x, f_12.epipole.y, 0.0)) < radius;
@@ -740,11 +779,11 @@ metal::float3 scatter_pixel(
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e165 = layer_1;
-            layer_1 = _e165 + 1u;
+            uint _e165 = layer_3;
+            layer_3 = _e165 + 1u;
         }
         loop_init_3 = false;
-        uint _e152 = layer_1;
+        uint _e152 = layer_3;
         if (_e152 < LAYERS) {
         } else {
             break;
@@ -752,9 +791,9 @@ metal::float3 scatter_pixel(
         {
             metal::float2 _e155 = angle;
             metal::float2 _e156 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, _e150);
-            uint _e158 = layer_1;
+            uint _e158 = layer_3;
             metal::float2 _e160 = angle;
-            uint _e161 = layer_1;
+            uint _e161 = layer_3;
             metal::float4 _e162 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e160, _e156, _e161);
             coeffs.inner[metal::min(unsigned(_e158), 7u)] = _e162;
             metal::float2 _e163 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156, _e150);
@@ -791,8 +830,8 @@ metal::float3 scatter_pixel(
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e515 = r_1;
-            r_1 = _e515 + 1u;
+            uint _e503 = r_1;
+            r_1 = _e503 + 1u;
         }
         loop_init_4 = false;
         uint _e214 = r_1;
@@ -903,39 +942,35 @@ metal::float3 scatter_pixel(
             }
             bool _e386 = local_8;
             if (_e386) {
-                layer_2 = 0u;
+                layer_4 = 0u;
                 uint2 loop_bound_5 = uint2(4294967295u);
                 bool loop_init_5 = true;
                 while(true) {
                     if (metal::all(loop_bound_5 == uint2(0u))) { break; }
                     loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                     if (!loop_init_5) {
-                        uint _e448 = layer_2;
-                        layer_2 = _e448 + 1u;
+                        uint _e436 = layer_4;
+                        layer_4 = _e436 + 1u;
                     }
                     loop_init_5 = false;
-                    uint _e389 = layer_2;
+                    uint _e389 = layer_4;
                     if (_e389 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        uint _e392 = layer_2;
+                        uint _e392 = layer_4;
                         metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e392), 7u)];
-                        uint _e396 = layer_2;
-                        uint clamped_lod_e399 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                        metal::float4 _e399 = filtered.read(metal::min(metal::uint2(metal::uint2(x00_, _e118)), metal::uint2(filtered.get_width(clamped_lod_e399), filtered.get_height(clamped_lod_e399)) - 1), metal::min(uint(_e396), filtered.get_array_size() - 1), clamped_lod_e399);
-                        uint _e401 = layer_2;
-                        uint clamped_lod_e404 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                        metal::float4 _e404 = filtered.read(metal::min(metal::uint2(metal::uint2(x01_, _e118)), metal::uint2(filtered.get_width(clamped_lod_e404), filtered.get_height(clamped_lod_e404)) - 1), metal::min(uint(_e401), filtered.get_array_size() - 1), clamped_lod_e404);
-                        metal::float4 texel0_ = metal::mix(_e399, _e404, fx0_);
-                        uint _e407 = layer_2;
-                        uint clamped_lod_e410 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                        metal::float4 _e410 = filtered.read(metal::min(metal::uint2(metal::uint2(x10_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e410), filtered.get_height(clamped_lod_e410)) - 1), metal::min(uint(_e407), filtered.get_array_size() - 1), clamped_lod_e410);
-                        uint _e412 = layer_2;
-                        uint clamped_lod_e415 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                        metal::float4 _e415 = filtered.read(metal::min(metal::uint2(metal::uint2(x11_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e415), filtered.get_height(clamped_lod_e415)) - 1), metal::min(uint(_e412), filtered.get_array_size() - 1), clamped_lod_e415);
-                        metal::float4 texel1_ = metal::mix(_e410, _e415, fx1_);
+                        uint _e395 = layer_4;
+                        metal::float4 _e396 = filtered_load(x00_, _e118, _e395, frame, filtered, _buffer_sizes);
+                        uint _e397 = layer_4;
+                        metal::float4 _e398 = filtered_load(x01_, _e118, _e397, frame, filtered, _buffer_sizes);
+                        metal::float4 texel0_ = metal::mix(_e396, _e398, fx0_);
+                        uint _e400 = layer_4;
+                        metal::float4 _e401 = filtered_load(x10_, row1_, _e400, frame, filtered, _buffer_sizes);
+                        uint _e402 = layer_4;
+                        metal::float4 _e403 = filtered_load(x11_, row1_, _e402, frame, filtered, _buffer_sizes);
+                        metal::float4 texel1_ = metal::mix(_e401, _e403, fx1_);
                         k_3 = 0u;
                         uint2 loop_bound_6 = uint2(4294967295u);
                         bool loop_init_6 = true;
@@ -943,83 +978,83 @@ metal::float3 scatter_pixel(
                             if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                             loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                             if (!loop_init_6) {
-                                uint _e445 = k_3;
-                                k_3 = _e445 + 1u;
+                                uint _e433 = k_3;
+                                k_3 = _e433 + 1u;
                             }
                             loop_init_6 = false;
-                            uint _e419 = k_3;
-                            if (_e419 < 4u) {
+                            uint _e407 = k_3;
+                            if (_e407 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                float _e422 = vis0_;
-                                uint _e423 = k_3;
-                                uint _e425 = k_3;
-                                vis0_ = _e422 + (coeff[metal::min(unsigned(_e423), 3u)] * ((texel0_[metal::min(unsigned(_e425), 3u)] * 2.0) - 1.0));
-                                float _e433 = vis1_;
-                                uint _e434 = k_3;
-                                uint _e436 = k_3;
-                                vis1_ = _e433 + (coeff[metal::min(unsigned(_e434), 3u)] * ((texel1_[metal::min(unsigned(_e436), 3u)] * 2.0) - 1.0));
+                                float _e410 = vis0_;
+                                uint _e411 = k_3;
+                                uint _e413 = k_3;
+                                vis0_ = _e410 + (coeff[metal::min(unsigned(_e411), 3u)] * ((texel0_[metal::min(unsigned(_e413), 3u)] * 2.0) - 1.0));
+                                float _e421 = vis1_;
+                                uint _e422 = k_3;
+                                uint _e424 = k_3;
+                                vis1_ = _e421 + (coeff[metal::min(unsigned(_e422), 3u)] * ((texel1_[metal::min(unsigned(_e424), 3u)] * 2.0) - 1.0));
                             }
                         }
                     }
                 }
             }
-            float _e450 = vis0_;
-            float _e451 = d;
-            float _e456 = d;
-            vis0_ = (_e456 <= lohi0_.x) ? 1.0 : ((_e451 > lohi0_.y) ? 0.0 : _e450);
-            float _e461 = vis1_;
-            float _e462 = d;
-            float _e467 = d;
-            vis1_ = (_e467 <= lohi1_.x) ? 1.0 : ((_e462 > lohi1_.y) ? 0.0 : _e461);
-            bool _e473 = done0_;
+            float _e438 = vis0_;
+            float _e439 = d;
+            float _e444 = d;
+            vis0_ = (_e444 <= lohi0_.x) ? 1.0 : ((_e439 > lohi0_.y) ? 0.0 : _e438);
+            float _e449 = vis1_;
+            float _e450 = d;
+            float _e455 = d;
+            vis1_ = (_e455 <= lohi1_.x) ? 1.0 : ((_e450 > lohi1_.y) ? 0.0 : _e449);
+            bool _e461 = done0_;
+            if (!(_e461)) {
+                float _e464 = total0_;
+                float _e465 = weight0_;
+                float _e466 = vis0_;
+                total0_ = _e464 + (_e465 * metal::clamp(_e466, 0.0, 1.0));
+            }
+            bool _e473 = done1_;
             if (!(_e473)) {
-                float _e476 = total0_;
-                float _e477 = weight0_;
-                float _e478 = vis0_;
-                total0_ = _e476 + (_e477 * metal::clamp(_e478, 0.0, 1.0));
+                float _e476 = total1_;
+                float _e477 = weight1_;
+                float _e478 = vis1_;
+                total1_ = _e476 + (_e477 * metal::clamp(_e478, 0.0, 1.0));
             }
-            bool _e485 = done1_;
-            if (!(_e485)) {
-                float _e488 = total1_;
-                float _e489 = weight1_;
-                float _e490 = vis1_;
-                total1_ = _e488 + (_e489 * metal::clamp(_e490, 0.0, 1.0));
-            }
-            bool _e496 = done0_;
-            if (!(_e496)) {
+            bool _e484 = done0_;
+            if (!(_e484)) {
                 local_10 = is_last0_;
             } else {
                 local_10 = true;
             }
-            bool _e501 = local_10;
-            done0_ = _e501;
-            bool _e502 = done1_;
-            if (!(_e502)) {
+            bool _e489 = local_10;
+            done0_ = _e489;
+            bool _e490 = done1_;
+            if (!(_e490)) {
                 local_11 = is_last1_;
             } else {
                 local_11 = true;
             }
-            bool _e507 = local_11;
-            done1_ = _e507;
-            bool _e508 = done0_;
-            if (_e508) {
-                bool _e509 = done1_;
-                local_12 = _e509;
+            bool _e495 = local_11;
+            done1_ = _e495;
+            bool _e496 = done0_;
+            if (_e496) {
+                bool _e497 = done1_;
+                local_12 = _e497;
             } else {
                 local_12 = false;
             }
-            bool _e513 = local_12;
-            if (_e513) {
+            bool _e501 = local_12;
+            if (_e501) {
                 break;
             }
         }
     }
-    float _e519 = total0_;
-    float _e521 = total1_;
-    float l_2 = ((1.0 - w1_) * _e519) + (w1_ * _e521);
+    float _e507 = total0_;
+    float _e509 = total1_;
+    float l_2 = ((1.0 - w1_) * _e507) + (w1_ * _e509);
     metal::float3 c = color * l_2;
     return c;
 }
@@ -1032,10 +1067,10 @@ kernel void scatter(
 , device type_9 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
-, metal::texture2d_array<float, metal::access::sample> filtered [[texture(2)]]
-, metal::texture2d<float, metal::access::write> output [[texture(3)]]
-, metal::texture2d<float, metal::access::sample> bounds [[texture(4)]]
-, constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
+, device type_10 const& filtered [[buffer(2)]]
+, metal::texture2d<float, metal::access::write> output [[texture(2)]]
+, metal::texture2d<float, metal::access::sample> bounds [[texture(3)]]
+, constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {
     bool local = {};
     uint _e5 = frame.sizes.x;

@@ -74,7 +74,7 @@ layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
 layout(binding = 3) uniform sampler2D _group_0_binding_3_cs;
 
-layout(binding = 4) uniform sampler2DArray _group_0_binding_4_cs;
+layout(std430, binding = 4) readonly buffer type_9_block_2Compute { vec4 _group_0_binding_4_cs[]; };
 
 layout(binding = 5,rgba16f) writeonly uniform image2D _group_0_binding_5_cs;
 
@@ -95,10 +95,10 @@ vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapVie
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
     bool outside = ((((uv.x < 0.0) || (uv.x > 1.0)) || (uv.y < 0.0)) || (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_7 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_9 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
     uint y_2 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_7, y_2)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_9, y_2)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -169,11 +169,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_8 = (sigma_t * len);
-    if ((x_8 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_8)));
+    float x_10 = (sigma_t * len);
+    if ((x_10 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_10)));
     }
-    return ((1.0 - exp(-(x_8))) / sigma_t);
+    return ((1.0 - exp(-(x_10))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -185,13 +185,13 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_9 * x_9) * (3.0 - (2.0 * x_9)));
+    float x_11 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_11 * x_11) * (3.0 - (2.0 * x_11)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_10 = (eye + (dir * t));
-    vec3 to_x = (x_10 - light_pos);
+    vec3 x_12 = (eye + (dir * t));
+    vec3 to_x = (x_12 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_2 = sqrt(d2_);
     vec3 travel = (to_x / vec3(d_2));
@@ -207,7 +207,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
     float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
     float g0_ = atan(((a_1 - t0_) / h));
-    float w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
+    float w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / float(panels));
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
@@ -222,7 +222,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
         }
         {
             uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
+            float mid = (g0_ + ((float(_e32) + 0.5) * w_2));
             q = 0u;
             bool loop_init_1 = true;
             while(true) {
@@ -238,7 +238,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                 }
                 {
                     uint _e46 = q;
-                    float u_1 = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    float u_1 = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -248,7 +248,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
         }
     }
     float _e75 = sum;
-    return (((_e75 * 0.5) * w_1) * h);
+    return (((_e75 * 0.5) * w_2) * h);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
@@ -570,7 +570,28 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return (((r * r) * width) / (regions * regions));
 }
 
-vec3 scatter_pixel(uint x_6, uint y_1) {
+uint filtered_index(uint x_6, uint row_1, uint layer) {
+    uint _e5 = _group_0_binding_0_cs.sizes.z;
+    uint _e12 = _group_0_binding_0_cs.sizes.w;
+    return ((((layer * _e5) + x_6) * _e12) + row_1);
+}
+
+vec4 encode_layer(vec4 v_11) {
+    return v_11;
+}
+
+vec4 decode_layer(vec4 w_1) {
+    return w_1;
+}
+
+vec4 filtered_load(uint x_7, uint row_2, uint layer_1) {
+    uint _e3 = filtered_index(x_7, row_2, layer_1);
+    vec4 _e6 = _group_0_binding_4_cs[_e3];
+    vec4 _e7 = decode_layer(_e6);
+    return _e7;
+}
+
+vec3 scatter_pixel(uint x_8, uint y_1) {
     bool local_3 = false;
     bool local_4 = false;
     bool local_5 = false;
@@ -605,12 +626,12 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     bool local_12 = false;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = _group_0_binding_0_cs;
     vec3 eye_8 = f_13.eye.xyz;
-    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
+    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_8, y_1);
     int _e14_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
+    vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_8, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
     float s_5 = (min(max(_e14.x, 0.0), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 1e-6));
     vec3 color = f_13.light_color.xyz;
-    vec3 px = vec3((float(x_6) + 0.5), (float(y_1) + 0.5), 0.0);
+    vec3 px = vec3((float(x_8) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_13.epipole.w;
     if ((f_13.epipole.z > 0.5)) {
         local_3 = (length((px - vec3(f_13.epipole.x, f_13.epipole.y, 0.0))) < radius);
@@ -689,8 +710,8 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e469 = r_1;
-            r_1 = (_e469 + 1u);
+            uint _e445 = r_1;
+            r_1 = (_e445 + 1u);
         }
         loop_init_4 = false;
         uint _e188 = r_1;
@@ -787,95 +808,87 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
             }
             bool _e345 = local_8;
             if (_e345) {
-                int _e350_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e350 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x00_, _e118), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e350_clamped_lod) - ivec3(1)), _e350_clamped_lod);
-                int _e355_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e355 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x01_, _e118), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e355_clamped_lod) - ivec3(1)), _e355_clamped_lod);
-                vec4 m0_ = mix(_e350, _e355, fx0_);
-                int _e361_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e361 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x00_, _e118), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e361_clamped_lod) - ivec3(1)), _e361_clamped_lod);
-                int _e366_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e366 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x01_, _e118), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e366_clamped_lod) - ivec3(1)), _e366_clamped_lod);
-                vec4 m1_ = mix(_e361, _e366, fx0_);
-                float _e369 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e140);
-                vis0_ = _e369;
+                vec4 _e347 = filtered_load(x00_, _e118, 0u);
+                vec4 _e349 = filtered_load(x01_, _e118, 0u);
+                vec4 m0_ = mix(_e347, _e349, fx0_);
+                vec4 _e352 = filtered_load(x00_, _e118, 1u);
+                vec4 _e354 = filtered_load(x01_, _e118, 1u);
+                vec4 m1_ = mix(_e352, _e354, fx0_);
+                float _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e140);
+                vis0_ = _e357;
             }
-            float _e370 = d_1;
-            if ((_e370 > lohi1_.x)) {
-                float _e373 = d_1;
-                local_9 = (_e373 <= lohi1_.y);
+            float _e358 = d_1;
+            if ((_e358 > lohi1_.x)) {
+                float _e361 = d_1;
+                local_9 = (_e361 <= lohi1_.y);
             } else {
                 local_9 = false;
             }
-            bool _e379 = local_9;
-            if (_e379) {
-                int _e384_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e384 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x10_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e384_clamped_lod) - ivec3(1)), _e384_clamped_lod);
-                int _e389_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e389 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x11_, row1_), 0), ivec3(0), textureSize(_group_0_binding_4_cs, _e389_clamped_lod) - ivec3(1)), _e389_clamped_lod);
-                vec4 m0_1 = mix(_e384, _e389, fx1_);
-                int _e395_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e395 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x10_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e395_clamped_lod) - ivec3(1)), _e395_clamped_lod);
-                int _e400_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                vec4 _e400 = texelFetch(_group_0_binding_4_cs, clamp(ivec3(uvec2(x11_, row1_), 1), ivec3(0), textureSize(_group_0_binding_4_cs, _e400_clamped_lod) - ivec3(1)), _e400_clamped_lod);
-                vec4 m1_1 = mix(_e395, _e400, fx1_);
-                float _e403 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e140);
-                vis1_ = _e403;
+            bool _e367 = local_9;
+            if (_e367) {
+                vec4 _e369 = filtered_load(x10_, row1_, 0u);
+                vec4 _e371 = filtered_load(x11_, row1_, 0u);
+                vec4 m0_1 = mix(_e369, _e371, fx1_);
+                vec4 _e374 = filtered_load(x10_, row1_, 1u);
+                vec4 _e376 = filtered_load(x11_, row1_, 1u);
+                vec4 m1_1 = mix(_e374, _e376, fx1_);
+                float _e379 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e140);
+                vis1_ = _e379;
             }
-            float _e404 = vis0_;
-            float _e405 = d_1;
-            float _e410 = d_1;
-            vis0_ = ((_e410 <= lohi0_.x) ? 1.0 : ((_e405 > lohi0_.y) ? 0.0 : _e404));
-            float _e415 = vis1_;
-            float _e416 = d_1;
-            float _e421 = d_1;
-            vis1_ = ((_e421 <= lohi1_.x) ? 1.0 : ((_e416 > lohi1_.y) ? 0.0 : _e415));
-            bool _e427 = done0_;
-            if (!(_e427)) {
-                float _e430 = total0_;
-                float _e431 = weight0_;
-                float _e432 = vis0_;
-                total0_ = (_e430 + (_e431 * clamp(_e432, 0.0, 1.0)));
+            float _e380 = vis0_;
+            float _e381 = d_1;
+            float _e386 = d_1;
+            vis0_ = ((_e386 <= lohi0_.x) ? 1.0 : ((_e381 > lohi0_.y) ? 0.0 : _e380));
+            float _e391 = vis1_;
+            float _e392 = d_1;
+            float _e397 = d_1;
+            vis1_ = ((_e397 <= lohi1_.x) ? 1.0 : ((_e392 > lohi1_.y) ? 0.0 : _e391));
+            bool _e403 = done0_;
+            if (!(_e403)) {
+                float _e406 = total0_;
+                float _e407 = weight0_;
+                float _e408 = vis0_;
+                total0_ = (_e406 + (_e407 * clamp(_e408, 0.0, 1.0)));
             }
-            bool _e439 = done1_;
-            if (!(_e439)) {
-                float _e442 = total1_;
-                float _e443 = weight1_;
-                float _e444 = vis1_;
-                total1_ = (_e442 + (_e443 * clamp(_e444, 0.0, 1.0)));
+            bool _e415 = done1_;
+            if (!(_e415)) {
+                float _e418 = total1_;
+                float _e419 = weight1_;
+                float _e420 = vis1_;
+                total1_ = (_e418 + (_e419 * clamp(_e420, 0.0, 1.0)));
             }
-            bool _e450 = done0_;
-            if (!(_e450)) {
+            bool _e426 = done0_;
+            if (!(_e426)) {
                 local_10 = is_last0_;
             } else {
                 local_10 = true;
             }
-            bool _e455 = local_10;
-            done0_ = _e455;
-            bool _e456 = done1_;
-            if (!(_e456)) {
+            bool _e431 = local_10;
+            done0_ = _e431;
+            bool _e432 = done1_;
+            if (!(_e432)) {
                 local_11 = is_last1_;
             } else {
                 local_11 = true;
             }
-            bool _e461 = local_11;
-            done1_ = _e461;
-            bool _e462 = done0_;
-            if (_e462) {
-                bool _e463 = done1_;
-                local_12 = _e463;
+            bool _e437 = local_11;
+            done1_ = _e437;
+            bool _e438 = done0_;
+            if (_e438) {
+                bool _e439 = done1_;
+                local_12 = _e439;
             } else {
                 local_12 = false;
             }
-            bool _e467 = local_12;
-            if (_e467) {
+            bool _e443 = local_12;
+            if (_e443) {
                 break;
             }
         }
     }
-    float _e473 = total0_;
-    float _e475 = total1_;
-    float l_2 = (((1.0 - w1_) * _e473) + (w1_ * _e475));
+    float _e449 = total0_;
+    float _e451 = total1_;
+    float l_2 = (((1.0 - w1_) * _e449) + (w1_ * _e451));
     vec3 c_1 = (color * l_2);
     return c_1;
 }

@@ -8,6 +8,7 @@ using metal::uint;
 
 struct _mslBufferSizes {
     uint size1;
+    uint size4;
 };
 
 struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
@@ -101,10 +102,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
-    uint x_7 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_9 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y_2 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_7, y_2)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_9, y_2)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
@@ -202,11 +203,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_8 = sigma_t * len;
-    if (x_8 < 0.0001) {
-        return len * (1.0 - (0.5 * x_8));
+    float x_10 = sigma_t * len;
+    if (x_10 < 0.0001) {
+        return len * (1.0 - (0.5 * x_10));
     }
-    return (1.0 - metal::exp(-(x_8))) / sigma_t;
+    return (1.0 - metal::exp(-(x_10))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -226,8 +227,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_9 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_9 * x_9) * (3.0 - (2.0 * x_9));
+    float x_11 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_11 * x_11) * (3.0 - (2.0 * x_11));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -240,8 +241,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_10 = eye + (dir * t);
-    metal::float3 to_x = x_10 - light_pos;
+    metal::float3 x_12 = eye + (dir * t);
+    metal::float3 to_x = x_12 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_2 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_2);
@@ -268,7 +269,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
     float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
     float g0_ = metal::atan((a_1 - t0_) / h);
-    float w_1 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
+    float w_2 = (metal::atan((b_1 - t0_) / h) - g0_) / static_cast<float>(panels);
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
@@ -286,7 +287,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
         {
             uint _e32 = k;
-            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
+            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_2);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
@@ -305,7 +306,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e46 = q;
-                    float u_1 = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
+                    float u_1 = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
                     float _e52 = sum;
                     uint _e54 = q;
                     float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -315,7 +316,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         }
     }
     float _e75 = sum;
-    return ((_e75 * 0.5) * w_1) * h;
+    return ((_e75 * 0.5) * w_2) * h;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -774,14 +775,51 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     return naga_div((r * r) * width, regions * regions);
 }
 
-metal::float3 scatter_pixel(
+uint filtered_index(
     uint x_6,
+    uint row_1,
+    uint layer,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
+) {
+    uint _e5 = frame.sizes.z;
+    uint _e12 = frame.sizes.w;
+    return (((layer * _e5) + x_6) * _e12) + row_1;
+}
+
+metal::float4 encode_layer(
+    metal::float4 v_11
+) {
+    return v_11;
+}
+
+metal::float4 decode_layer(
+    metal::float4 w_1
+) {
+    return w_1;
+}
+
+metal::float4 filtered_load(
+    uint x_7,
+    uint row_2,
+    uint layer_1,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
+    device type_9 const& filtered,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    uint _e3 = filtered_index(x_7, row_2, layer_1, frame);
+    metal::float4 _e6 = filtered[metal::min(unsigned(_e3), (_buffer_sizes.size4 - 0 - 16) / 16)];
+    metal::float4 _e7 = decode_layer(_e6);
+    return _e7;
+}
+
+metal::float3 scatter_pixel(
+    uint x_8,
     uint y_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_9 const& slices,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::sample> shadow_map,
-    metal::texture2d_array<float, metal::access::sample> filtered,
+    device type_9 const& filtered,
     metal::texture2d<float, metal::access::sample> bounds,
     constant _mslBufferSizes& _buffer_sizes
 ) {
@@ -819,12 +857,12 @@ metal::float3 scatter_pixel(
     bool local_12 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
     metal::float3 eye_8 = f_13.eye.xyz;
-    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
+    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_8, y_1);
     uint clamped_lod_e14 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
+    metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_8, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
     float s_5 = metal::min(metal::max(_e14.x, 0.0), f_13.theta.z) / metal::max(metal::dot(_e10, f_13.cam_forward.xyz), 0.000001);
     metal::float3 color = f_13.light_color.xyz;
-    metal::float3 px = metal::float3(static_cast<float>(x_6) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
+    metal::float3 px = metal::float3(static_cast<float>(x_8) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
     float radius = f_13.epipole.w;
     if (f_13.epipole.z > 0.5) {
         local_3 = metal::length(px - metal::float3(f_13.epipole.x, f_13.epipole.y, 0.0)) < radius;
@@ -906,8 +944,8 @@ metal::float3 scatter_pixel(
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e469 = r_1;
-            r_1 = _e469 + 1u;
+            uint _e445 = r_1;
+            r_1 = _e445 + 1u;
         }
         loop_init_4 = false;
         uint _e188 = r_1;
@@ -1004,95 +1042,87 @@ metal::float3 scatter_pixel(
             }
             bool _e345 = local_8;
             if (_e345) {
-                uint clamped_lod_e350 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                metal::float4 _e350 = filtered.read(metal::min(metal::uint2(metal::uint2(x00_, _e118)), metal::uint2(filtered.get_width(clamped_lod_e350), filtered.get_height(clamped_lod_e350)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e350);
-                uint clamped_lod_e355 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                metal::float4 _e355 = filtered.read(metal::min(metal::uint2(metal::uint2(x01_, _e118)), metal::uint2(filtered.get_width(clamped_lod_e355), filtered.get_height(clamped_lod_e355)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e355);
-                metal::float4 m0_ = metal::mix(_e350, _e355, fx0_);
-                uint clamped_lod_e361 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                metal::float4 _e361 = filtered.read(metal::min(metal::uint2(metal::uint2(x00_, _e118)), metal::uint2(filtered.get_width(clamped_lod_e361), filtered.get_height(clamped_lod_e361)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e361);
-                uint clamped_lod_e366 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                metal::float4 _e366 = filtered.read(metal::min(metal::uint2(metal::uint2(x01_, _e118)), metal::uint2(filtered.get_width(clamped_lod_e366), filtered.get_height(clamped_lod_e366)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e366);
-                metal::float4 m1_ = metal::mix(_e361, _e366, fx0_);
-                float _e369 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e140);
-                vis0_ = _e369;
+                metal::float4 _e347 = filtered_load(x00_, _e118, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 _e349 = filtered_load(x01_, _e118, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 m0_ = metal::mix(_e347, _e349, fx0_);
+                metal::float4 _e352 = filtered_load(x00_, _e118, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 _e354 = filtered_load(x01_, _e118, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 m1_ = metal::mix(_e352, _e354, fx0_);
+                float _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e140);
+                vis0_ = _e357;
             }
-            float _e370 = d_1;
-            if (_e370 > lohi1_.x) {
-                float _e373 = d_1;
-                local_9 = _e373 <= lohi1_.y;
+            float _e358 = d_1;
+            if (_e358 > lohi1_.x) {
+                float _e361 = d_1;
+                local_9 = _e361 <= lohi1_.y;
             } else {
                 local_9 = false;
             }
-            bool _e379 = local_9;
-            if (_e379) {
-                uint clamped_lod_e384 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                metal::float4 _e384 = filtered.read(metal::min(metal::uint2(metal::uint2(x10_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e384), filtered.get_height(clamped_lod_e384)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e384);
-                uint clamped_lod_e389 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                metal::float4 _e389 = filtered.read(metal::min(metal::uint2(metal::uint2(x11_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e389), filtered.get_height(clamped_lod_e389)) - 1), metal::min(uint(0), filtered.get_array_size() - 1), clamped_lod_e389);
-                metal::float4 m0_1 = metal::mix(_e384, _e389, fx1_);
-                uint clamped_lod_e395 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                metal::float4 _e395 = filtered.read(metal::min(metal::uint2(metal::uint2(x10_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e395), filtered.get_height(clamped_lod_e395)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e395);
-                uint clamped_lod_e400 = metal::min(uint(0), filtered.get_num_mip_levels() - 1);
-                metal::float4 _e400 = filtered.read(metal::min(metal::uint2(metal::uint2(x11_, row1_)), metal::uint2(filtered.get_width(clamped_lod_e400), filtered.get_height(clamped_lod_e400)) - 1), metal::min(uint(1), filtered.get_array_size() - 1), clamped_lod_e400);
-                metal::float4 m1_1 = metal::mix(_e395, _e400, fx1_);
-                float _e403 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e140);
-                vis1_ = _e403;
+            bool _e367 = local_9;
+            if (_e367) {
+                metal::float4 _e369 = filtered_load(x10_, row1_, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 _e371 = filtered_load(x11_, row1_, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 m0_1 = metal::mix(_e369, _e371, fx1_);
+                metal::float4 _e374 = filtered_load(x10_, row1_, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 _e376 = filtered_load(x11_, row1_, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 m1_1 = metal::mix(_e374, _e376, fx1_);
+                float _e379 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e140);
+                vis1_ = _e379;
             }
-            float _e404 = vis0_;
-            float _e405 = d_1;
-            float _e410 = d_1;
-            vis0_ = (_e410 <= lohi0_.x) ? 1.0 : ((_e405 > lohi0_.y) ? 0.0 : _e404);
-            float _e415 = vis1_;
-            float _e416 = d_1;
-            float _e421 = d_1;
-            vis1_ = (_e421 <= lohi1_.x) ? 1.0 : ((_e416 > lohi1_.y) ? 0.0 : _e415);
-            bool _e427 = done0_;
-            if (!(_e427)) {
-                float _e430 = total0_;
-                float _e431 = weight0_;
-                float _e432 = vis0_;
-                total0_ = _e430 + (_e431 * metal::clamp(_e432, 0.0, 1.0));
+            float _e380 = vis0_;
+            float _e381 = d_1;
+            float _e386 = d_1;
+            vis0_ = (_e386 <= lohi0_.x) ? 1.0 : ((_e381 > lohi0_.y) ? 0.0 : _e380);
+            float _e391 = vis1_;
+            float _e392 = d_1;
+            float _e397 = d_1;
+            vis1_ = (_e397 <= lohi1_.x) ? 1.0 : ((_e392 > lohi1_.y) ? 0.0 : _e391);
+            bool _e403 = done0_;
+            if (!(_e403)) {
+                float _e406 = total0_;
+                float _e407 = weight0_;
+                float _e408 = vis0_;
+                total0_ = _e406 + (_e407 * metal::clamp(_e408, 0.0, 1.0));
             }
-            bool _e439 = done1_;
-            if (!(_e439)) {
-                float _e442 = total1_;
-                float _e443 = weight1_;
-                float _e444 = vis1_;
-                total1_ = _e442 + (_e443 * metal::clamp(_e444, 0.0, 1.0));
+            bool _e415 = done1_;
+            if (!(_e415)) {
+                float _e418 = total1_;
+                float _e419 = weight1_;
+                float _e420 = vis1_;
+                total1_ = _e418 + (_e419 * metal::clamp(_e420, 0.0, 1.0));
             }
-            bool _e450 = done0_;
-            if (!(_e450)) {
+            bool _e426 = done0_;
+            if (!(_e426)) {
                 local_10 = is_last0_;
             } else {
                 local_10 = true;
             }
-            bool _e455 = local_10;
-            done0_ = _e455;
-            bool _e456 = done1_;
-            if (!(_e456)) {
+            bool _e431 = local_10;
+            done0_ = _e431;
+            bool _e432 = done1_;
+            if (!(_e432)) {
                 local_11 = is_last1_;
             } else {
                 local_11 = true;
             }
-            bool _e461 = local_11;
-            done1_ = _e461;
-            bool _e462 = done0_;
-            if (_e462) {
-                bool _e463 = done1_;
-                local_12 = _e463;
+            bool _e437 = local_11;
+            done1_ = _e437;
+            bool _e438 = done0_;
+            if (_e438) {
+                bool _e439 = done1_;
+                local_12 = _e439;
             } else {
                 local_12 = false;
             }
-            bool _e467 = local_12;
-            if (_e467) {
+            bool _e443 = local_12;
+            if (_e443) {
                 break;
             }
         }
     }
-    float _e473 = total0_;
-    float _e475 = total1_;
-    float l_2 = ((1.0 - w1_) * _e473) + (w1_ * _e475);
+    float _e449 = total0_;
+    float _e451 = total1_;
+    float l_2 = ((1.0 - w1_) * _e449) + (w1_ * _e451);
     metal::float3 c_1 = color * l_2;
     return c_1;
 }
@@ -1105,10 +1135,10 @@ kernel void scatter(
 , device type_9 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
-, metal::texture2d_array<float, metal::access::sample> filtered [[texture(2)]]
-, metal::texture2d<float, metal::access::write> output [[texture(3)]]
-, metal::texture2d<float, metal::access::sample> bounds [[texture(4)]]
-, constant _mslBufferSizes& _buffer_sizes [[buffer(2)]]
+, device type_9 const& filtered [[buffer(2)]]
+, metal::texture2d<float, metal::access::write> output [[texture(2)]]
+, metal::texture2d<float, metal::access::sample> bounds [[texture(3)]]
+, constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {
     bool local = {};
     uint _e5 = frame.sizes.x;

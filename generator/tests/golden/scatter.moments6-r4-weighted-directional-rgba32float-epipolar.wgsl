@@ -75,7 +75,7 @@ var depth: texture_2d<f32>;
 @group(0) @binding(3) 
 var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) 
-var filtered: texture_2d_array<f32>;
+var<storage> filtered: array<vec4<f32>>;
 @group(0) @binding(5) 
 var output: texture_storage_2d<rgba16float,write>;
 @group(0) @binding(6) 
@@ -95,9 +95,9 @@ fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMap
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
-    let x_7 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let x_9 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y_2 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e36 = textureLoad(sm, vec2<u32>(x_7, y_2), 0i);
+    let _e36 = textureLoad(sm, vec2<u32>(x_9, y_2), 0i);
     return select(_e36.x, 2f, outside);
 }
 
@@ -168,11 +168,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_8 = (sigma_t * len);
-    if (x_8 < 0.0001f) {
-        return (len * (1f - (0.5f * x_8)));
+    let x_10 = (sigma_t * len);
+    if (x_10 < 0.0001f) {
+        return (len * (1f - (0.5f * x_10)));
     }
-    return ((1f - exp(-(x_8))) / sigma_t);
+    return ((1f - exp(-(x_10))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -184,13 +184,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_9 * x_9) * (3f - (2f * x_9)));
+    let x_11 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_11 * x_11) * (3f - (2f * x_11)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_10 = (eye + (dir * t));
-    let to_x = (x_10 - light_pos);
+    let x_12 = (eye + (dir * t));
+    let to_x = (x_12 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d_2 = sqrt(d2_);
     let travel = (to_x / vec3(d_2));
@@ -207,7 +207,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
     let h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_1 - a_1), 0.000001f)));
     let g0_ = atan(((a_1 - t0_) / h));
-    let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
+    let w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k;
         if (_e30 < panels) {
@@ -216,7 +216,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
         {
             let _e32 = k;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
+            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_2));
             q = 0u;
             loop {
                 let _e40 = q;
@@ -226,7 +226,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                 }
                 {
                     let _e46 = q;
-                    let u_1 = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
+                    let u_1 = tan((mid + ((0.5f * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
                     let _e52 = sum;
                     let _e54 = q;
                     let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
@@ -244,7 +244,7 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
         }
     }
     let _e75 = sum;
-    return (((_e75 * 0.5f) * w_1) * h);
+    return (((_e75 * 0.5f) * w_2) * h);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -567,7 +567,28 @@ fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions
     return (((r * r) * width) / (regions * regions));
 }
 
-fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
+fn filtered_index(x_6: u32, row_1: u32, layer: u32) -> u32 {
+    let _e5 = frame.sizes.z;
+    let _e12 = frame.sizes.w;
+    return ((((layer * _e5) + x_6) * _e12) + row_1);
+}
+
+fn encode_layer(v_11: vec4<f32>) -> vec4<f32> {
+    return v_11;
+}
+
+fn decode_layer(w_1: vec4<f32>) -> vec4<f32> {
+    return w_1;
+}
+
+fn filtered_load(x_7: u32, row_2: u32, layer_1: u32) -> vec4<f32> {
+    let _e3 = filtered_index(x_7, row_2, layer_1);
+    let _e6 = filtered[_e3];
+    let _e7 = decode_layer(_e6);
+    return _e7;
+}
+
+fn scatter_pixel(x_8: u32, y_1: u32) -> vec3<f32> {
     var local_3: bool;
     var local_4: bool;
     var local_5: bool;
@@ -603,11 +624,11 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
 
     let f_13 = frame;
     let eye_8 = f_13.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
-    let _e14 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_8, y_1);
+    let _e14 = textureLoad(depth, vec2<u32>(x_8, y_1), 0i);
     let s_5 = (min(max(_e14.x, 0f), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 0.000001f));
     let color = f_13.light_color.xyz;
-    let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f), 0f);
+    let px = vec3<f32>((f32(x_8) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_13.epipole.w;
     if (f_13.epipole.z > 0.5f) {
         local_3 = (length((px - vec3<f32>(f_13.epipole.x, f_13.epipole.y, 0f))) < radius);
@@ -776,91 +797,91 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             }
             let _e345 = local_8;
             if _e345 {
-                let _e350 = textureLoad(filtered, vec2<u32>(x00_, _e118), 0i, 0i);
-                let _e355 = textureLoad(filtered, vec2<u32>(x01_, _e118), 0i, 0i);
-                let m0_ = mix(_e350, _e355, fx0_);
-                let _e361 = textureLoad(filtered, vec2<u32>(x00_, _e118), 1i, 0i);
-                let _e366 = textureLoad(filtered, vec2<u32>(x01_, _e118), 1i, 0i);
-                let m1_ = mix(_e361, _e366, fx0_);
-                let _e369 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e140);
-                vis0_ = _e369;
+                let _e347 = filtered_load(x00_, _e118, 0u);
+                let _e349 = filtered_load(x01_, _e118, 0u);
+                let m0_ = mix(_e347, _e349, fx0_);
+                let _e352 = filtered_load(x00_, _e118, 1u);
+                let _e354 = filtered_load(x01_, _e118, 1u);
+                let m1_ = mix(_e352, _e354, fx0_);
+                let _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e140);
+                vis0_ = _e357;
             }
-            let _e370 = d_1;
-            if (_e370 > lohi1_.x) {
-                let _e373 = d_1;
-                local_9 = (_e373 <= lohi1_.y);
+            let _e358 = d_1;
+            if (_e358 > lohi1_.x) {
+                let _e361 = d_1;
+                local_9 = (_e361 <= lohi1_.y);
             } else {
                 local_9 = false;
             }
-            let _e379 = local_9;
-            if _e379 {
-                let _e384 = textureLoad(filtered, vec2<u32>(x10_, row1_), 0i, 0i);
-                let _e389 = textureLoad(filtered, vec2<u32>(x11_, row1_), 0i, 0i);
-                let m0_1 = mix(_e384, _e389, fx1_);
-                let _e395 = textureLoad(filtered, vec2<u32>(x10_, row1_), 1i, 0i);
-                let _e400 = textureLoad(filtered, vec2<u32>(x11_, row1_), 1i, 0i);
-                let m1_1 = mix(_e395, _e400, fx1_);
-                let _e403 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e140);
-                vis1_ = _e403;
+            let _e367 = local_9;
+            if _e367 {
+                let _e369 = filtered_load(x10_, row1_, 0u);
+                let _e371 = filtered_load(x11_, row1_, 0u);
+                let m0_1 = mix(_e369, _e371, fx1_);
+                let _e374 = filtered_load(x10_, row1_, 1u);
+                let _e376 = filtered_load(x11_, row1_, 1u);
+                let m1_1 = mix(_e374, _e376, fx1_);
+                let _e379 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e140);
+                vis1_ = _e379;
             }
-            let _e404 = vis0_;
-            let _e405 = d_1;
-            let _e410 = d_1;
-            vis0_ = select(select(_e404, 0f, (_e405 > lohi0_.y)), 1f, (_e410 <= lohi0_.x));
-            let _e415 = vis1_;
-            let _e416 = d_1;
-            let _e421 = d_1;
-            vis1_ = select(select(_e415, 0f, (_e416 > lohi1_.y)), 1f, (_e421 <= lohi1_.x));
-            let _e427 = done0_;
-            if !(_e427) {
-                let _e430 = total0_;
-                let _e431 = weight0_;
-                let _e432 = vis0_;
-                total0_ = (_e430 + (_e431 * clamp(_e432, 0f, 1f)));
+            let _e380 = vis0_;
+            let _e381 = d_1;
+            let _e386 = d_1;
+            vis0_ = select(select(_e380, 0f, (_e381 > lohi0_.y)), 1f, (_e386 <= lohi0_.x));
+            let _e391 = vis1_;
+            let _e392 = d_1;
+            let _e397 = d_1;
+            vis1_ = select(select(_e391, 0f, (_e392 > lohi1_.y)), 1f, (_e397 <= lohi1_.x));
+            let _e403 = done0_;
+            if !(_e403) {
+                let _e406 = total0_;
+                let _e407 = weight0_;
+                let _e408 = vis0_;
+                total0_ = (_e406 + (_e407 * clamp(_e408, 0f, 1f)));
             }
-            let _e439 = done1_;
-            if !(_e439) {
-                let _e442 = total1_;
-                let _e443 = weight1_;
-                let _e444 = vis1_;
-                total1_ = (_e442 + (_e443 * clamp(_e444, 0f, 1f)));
+            let _e415 = done1_;
+            if !(_e415) {
+                let _e418 = total1_;
+                let _e419 = weight1_;
+                let _e420 = vis1_;
+                total1_ = (_e418 + (_e419 * clamp(_e420, 0f, 1f)));
             }
-            let _e450 = done0_;
-            if !(_e450) {
+            let _e426 = done0_;
+            if !(_e426) {
                 local_10 = is_last0_;
             } else {
                 local_10 = true;
             }
-            let _e455 = local_10;
-            done0_ = _e455;
-            let _e456 = done1_;
-            if !(_e456) {
+            let _e431 = local_10;
+            done0_ = _e431;
+            let _e432 = done1_;
+            if !(_e432) {
                 local_11 = is_last1_;
             } else {
                 local_11 = true;
             }
-            let _e461 = local_11;
-            done1_ = _e461;
-            let _e462 = done0_;
-            if _e462 {
-                let _e463 = done1_;
-                local_12 = _e463;
+            let _e437 = local_11;
+            done1_ = _e437;
+            let _e438 = done0_;
+            if _e438 {
+                let _e439 = done1_;
+                local_12 = _e439;
             } else {
                 local_12 = false;
             }
-            let _e467 = local_12;
-            if _e467 {
+            let _e443 = local_12;
+            if _e443 {
                 break;
             }
         }
         continuing {
-            let _e469 = r_1;
-            r_1 = (_e469 + 1u);
+            let _e445 = r_1;
+            r_1 = (_e445 + 1u);
         }
     }
-    let _e473 = total0_;
-    let _e475 = total1_;
-    let l_2 = (((1f - w1_) * _e473) + (w1_ * _e475));
+    let _e449 = total0_;
+    let _e451 = total1_;
+    let l_2 = (((1f - w1_) * _e449) + (w1_ * _e451));
     let c_1 = (color * l_2);
     return c_1;
 }

@@ -12,6 +12,11 @@
 //! stores the least and the greatest depth over the region up to the texel (`bounds`,
 //! rg32float on the GPU; here a one-layer array of `[min, max, 0, 0]`).
 //!
+//! The GPU's `filtered` is a storage buffer (`include/filtered_layers.wgsl`: element
+//! `(layer * Wr + x) * Hr + row`, each the bits of one storage-format texel, packed with the
+//! rounding a texture store of that format does); here it is the layer-major [`TexArray`] the
+//! runtime's readback reorders it into, and `store` quantises as the packing does.
+//!
 //! With a cookie (`cookie = true`, see the WGSL comment) each texel's light ray carries the
 //! cookie `C_i` ([`texel_cookie`]): per channel `c` the running means of `C_i^c` times the
 //! basis in layers `c * layers + q`, and thread 0 the region's mean cookie in layer

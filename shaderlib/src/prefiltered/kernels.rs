@@ -11,7 +11,9 @@ use askama::Template;
 
 use crate::sampling::{SamplingView, camera_expr, unwarp_only};
 
-use super::variant::{Basis, LightKind, PrefilteredVariant, Rectification, VisibilityMode};
+use super::variant::{
+    Basis, LightKind, PrefilteredVariant, Rectification, Storage, VisibilityMode,
+};
 use crate::compose::template_path;
 use crate::{Kernel, ShaderError};
 
@@ -56,6 +58,25 @@ struct RectifyTemplate {
     texels: u32,
 }
 
+/// The WGSL element of the `filtered` storage buffer for a storage format: one layer of one
+/// rectified texel, the bits of one texel of that format (`include/filtered_layers.wgsl`).
+pub const fn filtered_word(storage: Storage) -> &'static str {
+    match storage {
+        Storage::Rgba8unorm => "u32",
+        Storage::Rgba16float => "vec2<u32>",
+        Storage::Rgba32float => "vec4<f32>",
+    }
+}
+
+/// Bytes of one layer of one rectified texel in the `filtered` storage buffer.
+pub const fn filtered_word_bytes(storage: Storage) -> u32 {
+    match storage {
+        Storage::Rgba8unorm => 4,
+        Storage::Rgba16float => 8,
+        Storage::Rgba32float => 16,
+    }
+}
+
 /// `prefilter`: basis transform (Fourier or power moments) and weighted running mean per row
 /// and region.
 #[derive(Template)]
@@ -64,6 +85,7 @@ struct PrefilterTemplate {
     light_name: &'static str,
     visibility_name: &'static str,
     storage: &'static str,
+    filtered_word: &'static str,
     spot: bool,
     weighted: bool,
     bases: u32,
@@ -93,6 +115,8 @@ macro_rules! scatter_templates {
         struct $name {
             light_name: &'static str,
             visibility_name: &'static str,
+            storage: &'static str,
+            filtered_word: &'static str,
             spot: bool,
             bases: u32,
             layers: u32,
@@ -113,6 +137,8 @@ macro_rules! scatter_templates {
                 Self {
                     light_name: variant.light.name(),
                     visibility_name: variant.visibility.name(),
+                    storage: variant.storage.name(),
+                    filtered_word: filtered_word(variant.storage),
                     spot: variant.light == LightKind::Spot,
                     bases: variant.bases,
                     layers: variant.layers(),
@@ -193,6 +219,7 @@ pub(crate) fn render_prefilter(variant: &PrefilteredVariant) -> Result<String, S
         light_name: variant.light.name(),
         visibility_name: variant.visibility.name(),
         storage: variant.storage.name(),
+        filtered_word: filtered_word(variant.storage),
         spot: variant.light == LightKind::Spot,
         weighted: variant.visibility == VisibilityMode::Weighted,
         bases: variant.bases,
@@ -214,8 +241,7 @@ pub(crate) fn render_prefilter(variant: &PrefilteredVariant) -> Result<String, S
     .map_err(render_error(Kernel::Prefilter))
 }
 
-/// Renders `templates/scatter.wgsl` for `variant` (`bases_per_thread` and `storage` do not
-/// matter).
+/// Renders `templates/scatter.wgsl` for `variant` (`bases_per_thread` does not matter).
 pub(crate) fn render_scatter(variant: &PrefilteredVariant) -> Result<String, ShaderError> {
     validate(Kernel::Scatter, variant)?;
     ScatterTemplate::of(variant, Kernel::Scatter)

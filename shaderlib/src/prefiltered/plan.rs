@@ -5,12 +5,12 @@
 use crate::Kernel;
 use crate::family::KernelFamily;
 use crate::plan::{
-    Alternative, BindingSource, COOKIE_BINDING, DEPTH_FORMAT, Formula, OUTPUT_FORMAT, Parameter,
-    PassPlan, Plan, Resource, SAMPLED, SLICE_FIT_NOTE, STORAGE_AND_SAMPLED, TEXTURE_DIMENSION,
-    bind, column_depth_buffer, cookie_parameters, cookie_texture, depth_and_shadow_map,
-    frame_buffer, scatter_resource, scatter_texture, screen_and_shadow_parameters, texture_2d,
+    Alternative, BindingSource, BufferDesc, COOKIE_BINDING, DEPTH_FORMAT, Formula, OUTPUT_FORMAT,
+    Parameter, PassPlan, Plan, Resource, SAMPLED, SLICE_FIT_NOTE, TEXTURE_DIMENSION, bind,
+    column_depth_buffer, cookie_parameters, cookie_texture, depth_and_shadow_map, frame_buffer,
+    scatter_resource, scatter_texture, screen_and_shadow_parameters, texture_2d,
 };
-use crate::prefiltered::{Basis, PrefilteredVariant, Rectification};
+use crate::prefiltered::{Basis, PrefilteredVariant, Rectification, Storage};
 use crate::sampling::{
     fallback_buffers, fallback_pass, sampled_output, sampled_pass, samples_texture,
     sampling_invocations, unwarp_pass,
@@ -77,13 +77,11 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
             "rectified.height",
         ),
         Resource {
-            texture: Some(texture_2d(
-                v.storage.name(),
-                "rectified.width",
-                "rectified.height",
-                &v.filtered_layers().to_string(),
-                STORAGE_AND_SAMPLED,
-            )),
+            kind: "storage_buffer",
+            buffer: Some(BufferDesc {
+                elements: Some(filtered_elements(v)),
+                usage: vec!["storage", "copy_src"],
+            }),
             ..scatter_resource("filtered", filtered_description(v))
         },
         scatter_texture(
@@ -146,6 +144,14 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
         "Group 0 holds every binding; bind by group and binding number, not by name: \
              emitted names may be mangled (naga_oil) or carry a trailing `_` (naga).",
     ];
+    if v.storage == Storage::Rgba16float {
+        notes.push(
+            "rgba16float storage: prefilter and scatter pack and unpack the filtered layers with \
+             pack2x16float / unpack2x16float, so the device needs them in 32-bit shaders (wgpu: \
+             DownlevelFlags::SHADER_F16_IN_F32, naga: SHADER_FLOAT16_IN_FLOAT32; Vulkan, Metal \
+             and DX12 have it, GLSL ES 3.0 as packHalf2x16).",
+        );
+    }
     if v.rectification == Rectification::Projective {
         notes.push(
             "Projective variant: the frame set-up decides per frame (FrameReport::rectification) \
@@ -164,30 +170,64 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
     }
 }
 
-/// What the `filtered` texture holds for the variant's basis (and cookie).
+/// The elements of the `filtered` storage buffer: one per layer of every rectified texel.
+pub fn filtered_elements(v: &PrefilteredVariant) -> Formula {
+    format!(
+        "{} * rectified.width * rectified.height",
+        v.filtered_layers()
+    )
+}
+
+/// The layout every description of `filtered` ends with (a macro, for `concat!`).
+macro_rules! filtered_layout {
+    () => {
+        "; a storage buffer, layer q of rectified texel (x, row) at element (q * \
+         rectified.width + x) * rectified.height + row (column-major layers: prefilter's \
+         invocations, one per row, store side by side), each element the bits of one texel \
+         of the storage format (rgba8unorm: a u32 from pack4x8unorm; rgba16float: two u32 from \
+         pack2x16float; rgba32float: four f32)"
+    };
+}
+
+/// What the `filtered` buffer holds for the variant's basis (and cookie), and its layout.
 fn filtered_description(v: &PrefilteredVariant) -> &'static str {
     match (v.basis, v.moments, v.cookie) {
         (Basis::Fourier, _, true) => {
-            "per colour channel c, the filtered Fourier bases times the spot's cookie, four \
+            concat!(
+                "per colour channel c, the filtered Fourier bases times the spot's cookie, four \
              per layer, in layers c * bases / 4 .., stored as F / 2 + 0.5; the region's mean \
-             cookie (rgb) in the last layer (written by prefilter)"
+             cookie (rgb) in the last layer (written by prefilter)",
+                filtered_layout!()
+            )
         }
         (Basis::Moments, _, true) => {
-            "per colour channel c, the filtered power moments of z = 2 d - 1 times the spot's \
+            concat!(
+                "per colour channel c, the filtered power moments of z = 2 d - 1 times the spot's \
              cookie in layers c * ceil(moments / 4) .., stored as they are; the region's mean \
-             cookie (rgb) in the last layer (written by prefilter)"
+             cookie (rgb) in the last layer (written by prefilter)",
+                filtered_layout!()
+            )
         }
         (Basis::Fourier, _, false) => {
-            "filtered Fourier bases, four per layer, stored as F / 2 + 0.5 (written by \
-             prefilter); view it as a 2d array even with one layer"
+            concat!(
+                "filtered Fourier bases, four per layer, stored as F / 2 + 0.5 (written by \
+             prefilter)",
+                filtered_layout!()
+            )
         }
         (Basis::Moments, 6, false) => {
-            "filtered power moments of z = 2 d - 1, (z, z^2, z^3, z^4) in layer 0 and \
-             (z^5, z^6, 0, 0) in layer 1, stored as they are (written by prefilter)"
+            concat!(
+                "filtered power moments of z = 2 d - 1, (z, z^2, z^3, z^4) in layer 0 and \
+             (z^5, z^6, 0, 0) in layer 1, stored as they are (written by prefilter)",
+                filtered_layout!()
+            )
         }
         (Basis::Moments, _, false) => {
-            "filtered power moments of z = 2 d - 1, (z, z^2, z^3, z^4), stored as they are \
-             (written by prefilter); view it as a 2d array even with one layer"
+            concat!(
+                "filtered power moments of z = 2 d - 1, (z, z^2, z^3, z^4), stored as they are \
+             (written by prefilter)",
+                filtered_layout!()
+            )
         }
     }
 }
