@@ -2397,7 +2397,7 @@ mod tests {
         assert_eq!(tune_pick(&table, 0.001), None);
         assert_eq!(
             scatter_gen_command(&table[2].method, [512, 512]),
-            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 8 --basis fourier --depth-break 10 --light spot --light-break 20 --moments 4 --rectification epipolar --regions 4 --sampling pixels --scale 2 --slice-samples 256 --slices 512 --step 8 --storage rgba8unorm --visibility weighted --out shaders/  # runtime: rectified map 256x256"
+            "scatter-gen --family prefiltered --bases 32 --bases-per-thread 16 --basis fourier --depth-break 10 --light spot --light-break 20 --moments 4 --rectification epipolar --regions 4 --sampling pixels --scale 2 --slice-samples 256 --slices 512 --step 8 --storage rgba8unorm --visibility weighted --out shaders/  # runtime: rectified map 256x256"
         );
         assert_eq!(
             scatter_gen_command(&table[1].method, [512, 512]),
@@ -2451,13 +2451,13 @@ mod tests {
             knobs,
             [
                 "m16-r4-t4-256x256",
-                "m16-r4-t16-256x256",
+                "m16-r4-t8-256x256",
                 "m16-r4-rgba16float-256x256",
                 "m16-r4-rgba32float-256x256",
                 "m16-r4-128x128",
                 "m16-r4", // 512x512 is the run's map
                 "m32-r4-t4",
-                "m32-r4-t16",
+                "m32-r4-t8",
                 "m32-r4-t32",
                 "m32-r4-rgba16float",
                 "m32-r4-rgba32float",

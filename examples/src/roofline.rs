@@ -346,7 +346,7 @@ pub const RECTIFIED: [u32; 2] = [1024, 1024];
 /// One kernel's cost model at the headline configuration.
 #[derive(Clone, Debug)]
 pub struct KernelCost {
-    /// The method whose pass it is (`prefiltered m32-t8-r4`, `raymarch n64`, ...).
+    /// The method whose pass it is (`prefiltered m32-t16-r4`, `raymarch n64`, ...).
     pub method: &'static str,
     /// The kernel.
     pub kernel: &'static str,
@@ -368,10 +368,13 @@ pub fn kernel_costs() -> Vec<KernelCost> {
     let [w, h] = SCREEN.map(u64::from);
     let [wr, hr] = RECTIFIED.map(u64::from);
     let pixels = w * h;
-    // Default prefiltered variant: 32 bases (8 layers), 8 per thread (2 layers, 4 threads per
+    // Default prefiltered variant: 32 bases (8 layers), 16 per thread (4 layers, 2 threads per
     // row and region), its regions (4), rgba8unorm.
-    let (layers, lpt, threads) = (8.0, 2.0, 4u64);
-    let regions = u64::from(PrefilteredVariant::default().regions);
+    let d = PrefilteredVariant::default();
+    let layers = f64::from(d.layers());
+    let lpt = f64::from(d.per_thread() / 4);
+    let threads = u64::from(d.threads_per_row_region());
+    let regions = u64::from(d.regions);
     let region_texels = wr as f64 / regions as f64;
     // minmax_build's block side at the headline's rectified width.
     let build_block = wr as f64 / f64::from(BUILD_LANES);
@@ -420,26 +423,26 @@ pub fn kernel_costs() -> Vec<KernelCost> {
             trips: "RECTIFY_TEXELS columns",
         },
         KernelCost {
-            method: "prefiltered m32-t8-r4",
+            method: "prefiltered m32-t16-r4",
             kernel: "prefilter",
             invocations: hr * regions * threads,
             // Per texel of its region (Wr/regions on average): one load; sin(theta_ref) twice
             // (ref_t), two exp (transmittance_between), sin and cos of pi d; a skip of
-            // 2*thread*lpt turns (3 on average: 12 FMAs) and per layer 2 turns, the blend
-            // and the store scale (about 28 FMAs); stores of lpt rgba8 texels, and thread 0
-            // the rg32float bounds (8 bytes, a quarter per thread).
+            // 2 thread lpt turns (lpt (threads - 1) on average, 4 FMAs each) and per layer 2
+            // turns, the blend and the store scale (about 28 FMAs); stores of lpt rgba8
+            // texels, and thread 0 the rg32float bounds (8 bytes, 8 / threads per thread).
             counts: [
                 region_texels * (4.0 * lpt + 8.0 / threads as f64),
                 region_texels,
                 0.0,
                 region_texels * 6.0,
-                region_texels * (12.0 + 28.0 * lpt + 10.0),
+                region_texels * (4.0 * lpt * (threads - 1) as f64 + 28.0 * lpt + 10.0),
             ],
             low: None,
             trips: "Wr/regions texels x (2 thread lpt skip turns + lpt layers)",
         },
         KernelCost {
-            method: "prefiltered m32-t8-r4",
+            method: "prefiltered m32-t16-r4",
             kernel: "scatter",
             invocations: pixels,
             // Per pixel: the depth load; acos, atan2, sin and cos of pi d, sin(theta) for x_s

@@ -288,7 +288,7 @@ mod tests {
         assert_eq!(
             e,
             "variant 3: same variant as variant 1 \
-             (prefiltered::m32-t8-r4-weighted-spot-rgba8unorm-epipolar): list each variant once"
+             (prefiltered::m32-t16-r4-weighted-spot-rgba8unorm-epipolar): list each variant once"
         );
         let e = parse("[[variant]]\nfamily = \"minmax\"\n[[variant]]\nfamily = \"minmax\"\n")
             .unwrap_err();

@@ -8,7 +8,7 @@ use std::fs;
 
 use common::{files, scatter_gen, scratch, text};
 
-const DEFAULT_ID: &str = "m32-t8-r4-weighted-directional-rgba8unorm-epipolar";
+const DEFAULT_ID: &str = "m32-t16-r4-weighted-directional-rgba8unorm-epipolar";
 
 /// Runs scatter-gen expecting failure with `code`; returns the single stderr line.
 fn fails(args: &[&str], code: i32) -> String {
@@ -250,7 +250,7 @@ fn never_overwrites_or_deletes_foreign_files_without_force() {
     assert_eq!(files(&out).len(), 19);
 
     // A foreign file with a kernel's name next to our manifest: refused.
-    let stray = out.join("prefilter.m16-t8-r4-weighted-directional-rgba8unorm-epipolar.wgsl");
+    let stray = out.join("prefilter.m16-t16-r4-weighted-directional-rgba8unorm-epipolar.wgsl");
     fs::write(&stray, "// someone else's\n").unwrap_or_else(|e| panic!("{e}"));
     let line = fails(&["--out", o, "--bases", "16"], 1);
     assert!(line.contains("not listed in manifest.json"), "{line}");
@@ -300,7 +300,7 @@ fn config_emits_exactly_its_variants() {
     let names: Vec<_> = files(&out).into_iter().map(|f| f.0).collect();
     // 2 variants x 5 kernels x 2 targets + manifest + C header + Rust module.
     assert_eq!(names.len(), 2 * 5 * 2 + 3, "{names:?}");
-    let spot = "m16-t8-r1-weighted-spot-rgba8unorm-epipolar";
+    let spot = "m16-t16-r1-weighted-spot-rgba8unorm-epipolar";
     for k in [
         "depth_columns",
         "slice_fit",
@@ -338,7 +338,7 @@ fn config_emits_exactly_its_variants() {
         (
             "[[variant]]\nlight = \"spot\"\n[[variant]]\nlight = \"spot\"\nregions = 4\n",
             "variants.toml: variant 2: same variant as variant 1 \
-             (prefiltered::m32-t8-r4-weighted-spot-rgba8unorm-epipolar): list each variant once",
+             (prefiltered::m32-t16-r4-weighted-spot-rgba8unorm-epipolar): list each variant once",
         ),
         (
             "targets = [\"wgsl\", \"wgsl\"]\n[[variant]]\n",

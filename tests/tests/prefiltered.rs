@@ -28,7 +28,7 @@
 //!   `max |diff| / max radiance` without that allowance.
 //!
 //! Each variant is one libtest trial (`cargo test -p scatter-conformance --test prefiltered
-//! -- m32-t8-r4` runs those whose name contains the filter, `-- --list` lists the 2080);
+//! -- m32-t16-r4` runs those whose name contains the filter, `-- --list` lists the 2080);
 //! `prefiltered::errors::*` check the error paths.
 
 use std::process::ExitCode;

@@ -28,7 +28,7 @@
 //!
 //! let sizes = Sizes { screen: [1280, 720], rectified: [1024, 1024], shadow_map: 2048 };
 //! let mut engine = Engine::load(device, queue, "shaders".as_ref(),
-//!     "m32-t8-r4-weighted-directional-rgba8unorm-epipolar", Target::Spirv, &sizes.params())?;
+//!     "m32-t16-r4-weighted-directional-rgba8unorm-epipolar", Target::Spirv, &sizes.params())?;
 //! let out = run_frame(&mut engine, frame,
 //!     &Inputs { depth, shadow_map: Some(shadow), rectified_raster: None, cookie: None })?;
 //! # let _ = out; Ok(()) }

@@ -115,7 +115,8 @@ fn number(knob: &'static str, allowed: &str, value: &str) -> Result<u32, Variant
 
 /// Parses `(knob, value)` pairs over the default variant and validates the result. With
 /// `basis = moments` and no `storage` given, the storage is rgba32float (the only one the
-/// moment basis allows).
+/// moment basis allows); with no `bases_per_thread` given, the largest valid one up to the
+/// default (`PrefilteredVariant::default_bases_per_thread`: `bases = 8` gets 8).
 ///
 /// # Errors
 ///
@@ -123,6 +124,7 @@ fn number(knob: &'static str, allowed: &str, value: &str) -> Result<u32, Variant
 pub fn parse(knobs: &[(String, String)]) -> Result<PrefilteredVariant, GenError> {
     let mut v = PrefilteredVariant::default();
     let mut storage_given = false;
+    let mut per_thread_given = false;
     for (name, value) in knobs {
         match name.as_str() {
             "basis" => v.basis = value.parse()?,
@@ -130,6 +132,7 @@ pub fn parse(knobs: &[(String, String)]) -> Result<PrefilteredVariant, GenError>
             "bases" => v.bases = number("bases", BASES_ALLOWED, value)?,
             "bases_per_thread" => {
                 v.bases_per_thread = number("bases_per_thread", BASES_PER_THREAD_ALLOWED, value)?;
+                per_thread_given = true;
             }
             "regions" => v.regions = number("regions", REGIONS_ALLOWED, value)?,
             "visibility" => v.visibility = value.parse()?,
@@ -149,6 +152,9 @@ pub fn parse(knobs: &[(String, String)]) -> Result<PrefilteredVariant, GenError>
     }
     if v.basis == Basis::Moments && !storage_given {
         v.storage = Storage::Rgba32float;
+    }
+    if !per_thread_given {
+        v.bases_per_thread = PrefilteredVariant::default_bases_per_thread(v.bases);
     }
     v.validate()?;
     Ok(v)
