@@ -12,8 +12,8 @@
 //! | `depth_columns` | 0 uniform `Frame`, 1 depth r32float, 2 column_depth (storage, one f32 per screen column) | `ceil(W/64) x 1 x 1` |
 //! | `slice_fit` | 0 uniform `Frame`, 1 slices (read_write), 2 column_depth | `1 x 1 x 1` (one workgroup of 256) |
 //! | `rectify` | 0 uniform `Frame`, 1 slices, 2 shadow map r32float, 3 rectified r32float (storage, write) | `ceil(Wr/8) x ceil(Hr/8) x 1` |
-//! | `prefilter` | 0, 1, 2 rectified r32float, 3 filtered bases (storage array, write, the variant's format), 4 bounds rg32float (storage, write) | `ceil(Hr/64) x regions x bases/bases_per_thread` |
-//! | `scatter` | 0, 1, 2 depth r32float, 3 shadow map r32float, 4 filtered bases (loaded array), 5 output rgba16float (storage, write), 6 bounds rg32float | `ceil(W/8) x ceil(H/8) x 1` |
+//! | `prefilter` | 0, 1, 2 rectified r32float, 3 filtered bases (storage buffer, read_write, the variant's format's texel bits), 4 bounds (storage buffer of vec2<f32>, read_write) | `ceil(Hr/64) x regions x bases/bases_per_thread` |
+//! | `scatter` | 0, 1, 2 depth r32float, 3 shadow map r32float, 4 filtered bases (storage buffer, read), 5 output rgba16float (storage, write), 6 bounds (storage buffer, read) | `ceil(W/8) x ceil(H/8) x 1` |
 //!
 //! Projective frames skip `depth_columns`, `slice_fit` and `rectify`.
 
@@ -128,7 +128,7 @@ pub struct Prefiltered {
     rectified: wgpu::Texture,
     rectified_view: wgpu::TextureView,
     filtered: wgpu::Buffer,
-    bounds: wgpu::Texture,
+    bounds: wgpu::Buffer,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
     frame: Option<PrefilteredFrame>,
@@ -213,6 +213,13 @@ impl Prefiltered {
                 name,
                 limit,
             )?;
+            check_limit(
+                PREFILTER,
+                "depth-bounds bytes (8 per rectified texel)",
+                u64::from(wr) * u64::from(hr) * 8,
+                name,
+                limit,
+            )?;
         }
 
         // CPU work only: render, compose and validate the three kernels.
@@ -235,7 +242,7 @@ impl Prefiltered {
         )?;
         let (rectified, rectified_view) = exec.texture("rectified")?;
         let filtered = exec.buffer("filtered")?.clone();
-        let (bounds, _) = exec.texture("bounds")?;
+        let bounds = exec.buffer("bounds")?.clone();
         let (output, output_view) = exec.texture("output")?;
         Ok(Self {
             device: device.clone(),
@@ -247,7 +254,7 @@ impl Prefiltered {
             rectified: rectified.clone(),
             rectified_view: rectified_view.clone(),
             filtered,
-            bounds: bounds.clone(),
+            bounds,
             output: output.clone(),
             output_view: output_view.clone(),
             exec,
@@ -552,9 +559,9 @@ impl Prefiltered {
         &self.filtered
     }
 
-    /// The region-prefix depth bounds `prefilter` writes beside the filtered bases
-    /// (`Wr x Hr`, rg32float: min, max).
-    pub fn bounds_texture(&self) -> &wgpu::Texture {
+    /// The region-prefix depth bounds `prefilter` writes beside the filtered bases: a storage
+    /// buffer of `Wr x Hr` `vec2<f32>` (min, max), texel `(x, y)` at element `x * Hr + y`.
+    pub fn bounds_buffer(&self) -> &wgpu::Buffer {
         &self.bounds
     }
 
@@ -681,7 +688,7 @@ pub fn run_prefiltered_once(
     };
     let rectified = Readback::encode(device, &mut encoder, rectified_texture, 4, RECTIFY)?;
     let filtered = encode_buffer_readback(device, &mut encoder, pass.filtered_buffer());
-    let bounds = Readback::encode(device, &mut encoder, pass.bounds_texture(), 8, PREFILTER)?;
+    let bounds = encode_buffer_readback(device, &mut encoder, pass.bounds_buffer());
     let output = Readback::encode(device, &mut encoder, pass.output_texture(), 8, SCATTER)?;
     let slices = encode_buffer_readback(device, &mut encoder, &pass.slices);
     let start = Instant::now();
@@ -699,16 +706,7 @@ pub fn run_prefiltered_once(
         variant,
         res.rectified,
     );
-    let bounds = bounds
-        .read(ctx, PREFILTER)?
-        .chunks_exact(8)
-        .map(|t| {
-            [
-                f32::from_le_bytes([t[0], t[1], t[2], t[3]]),
-                f32::from_le_bytes([t[4], t[5], t[6], t[7]]),
-            ]
-        })
-        .collect();
+    let bounds = bounds_row_major(&read_buffer(ctx, PREFILTER, &bounds)?, res.rectified);
     let output = output
         .read(ctx, SCATTER)?
         .chunks_exact(8)
@@ -764,6 +762,21 @@ fn filtered_layer_major(
         let (layer_x, y) = (i / hr, i % hr);
         let (layer, x) = (layer_x / wr, layer_x % wr);
         out[(layer * hr + y) * wr + x] = decode_rgba(bits, variant.storage);
+    }
+    out
+}
+
+/// The `bounds` buffer's bytes (element `x * Hr + y`, column-major) as `(min, max)` pairs
+/// row-major, `y * Wr + x`, as [`PrefilteredReadback::bounds`] documents.
+fn bounds_row_major(bytes: &[u8], [wr, hr]: [u32; 2]) -> Vec<[f32; 2]> {
+    let (wr, hr) = (wr as usize, hr as usize);
+    let mut out = vec![[0.0; 2]; wr * hr];
+    for (i, t) in bytes.chunks_exact(8).take(out.len()).enumerate() {
+        let (x, y) = (i / hr, i % hr);
+        out[y * wr + x] = [
+            f32::from_le_bytes([t[0], t[1], t[2], t[3]]),
+            f32::from_le_bytes([t[4], t[5], t[6], t[7]]),
+        ];
     }
     out
 }

@@ -47,12 +47,12 @@
 // | 1       | slices    | var<storage, read> array<vec4<f32>>             | read         |
 // | 2       | rectified | texture_2d<f32> (r32float)                      | textureLoad  |
 // | 3       | filtered  | var<storage, read_write> array<{{ filtered_word }}> | write  |
-// | 4       | bounds    | texture_storage_2d<rg32float, write>            | textureStore |
+// | 4       | bounds    | var<storage, read_write> array<vec2<f32>>       | write        |
 {%- if cookie %}
 // | 12      | cookie    | texture_2d<f32> (rgba, linear RGB)              | textureLoad  |
 {%- endif %}
 // filtered: Wr x Hr texels of {{ filtered_layers }} {{ storage }} layers each{% if !moments %} (bases / 4{% if cookie %} per channel, 3 channels, + 1{% endif %}){% endif %}, Wr x Hr = the rectified
-// size (frame.sizes.zw). bounds: Wr x Hr, (min, max) of the region's depths up to the texel.
+// size (frame.sizes.zw). bounds: Wr x Hr, (min, max) of the region's depths up to the texel (`bounds_index`).
 //
 // Dispatch: (ceil(Hr / 64), {{ regions }}, {{ threads_per_row_region }}) workgroups of (64, 1, 1);
 // invocation id x = row, y = region, z = thread.
@@ -83,12 +83,12 @@
 @group(0) @binding(1) var<storage, read> slices: array<vec4<f32>>;
 @group(0) @binding(2) var rectified: texture_2d<f32>;
 @group(0) @binding(3) var<storage, read_write> filtered: array<{{ filtered_word }}>;
-@group(0) @binding(4) var bounds: texture_storage_2d<rg32float, write>;
+@group(0) @binding(4) var<storage, read_write> bounds: array<vec2<f32>>;
 {%- if cookie %}
 // The spot's cookie (scatter_frame::cookie), folded into each texel's weight.
 @group(0) @binding(12) var cookie: texture_2d<f32>;
 {%- endif %}
-{% include "include/filtered_layers.wgsl" %}
+{% include "include/prefiltered_buffers.wgsl" %}
 
 // Independent prefix regions per row.
 const REGIONS: u32 = {{ regions }}u;
@@ -173,7 +173,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         if thread == 0u {
             lo = min(lo, d);
             hi = max(hi, d);
-            textureStore(bounds, vec2<u32>(i, row), vec4<f32>(lo, hi, 0.0, 0.0));
+            bounds[bounds_index(i, row)] = vec2<f32>(lo, hi);
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);
 {%- if cookie %}

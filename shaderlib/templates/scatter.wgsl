@@ -52,7 +52,7 @@
 // | 3       | shadow_map       | texture_2d<f32> (r32float)               | textureLoad        |
 // | 4       | filtered         | var<storage, read> array<{{ filtered_word }}> (prefilter's) | read |
 // | 5       | output           | texture_storage_2d<rgba16float, write>   | textureStore       |
-// | 6       | bounds           | texture_2d<f32> (rg32float, prefilter's) | textureLoad        |
+// | 6       | bounds           | var<storage, read> array<vec2<f32>> (prefilter's) | read      |
 {%- if cookie %}
 // | 12      | cookie           | texture_2d<f32> (rgba, linear RGB)       | textureLoad        |
 {%- endif %}
@@ -101,13 +101,13 @@
 @group(0) @binding(3) var shadow_map: texture_2d<f32>;
 @group(0) @binding(4) var<storage, read> filtered: array<{{ filtered_word }}>;
 @group(0) @binding(5) var output: texture_storage_2d<{{ sampling.output_format }}, write>;
-@group(0) @binding(6) var bounds: texture_2d<f32>;
+@group(0) @binding(6) var<storage, read> bounds: array<vec2<f32>>;
 {%- if cookie %}
 // The spot's cookie (scatter_frame::cookie): the epipole march carries it per sample.
 @group(0) @binding(12) var cookie: texture_2d<f32>;
 {%- endif %}
 {% include "include/sampled_bindings.wgsl" %}
-{%- include "include/filtered_layers.wgsl" %}
+{%- include "include/prefiltered_buffers.wgsl" %}
 
 // Independent prefix regions per rectified row.
 const REGIONS: u32 = {{ regions }}u;
@@ -318,8 +318,8 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         let x11 = select(x10, min(x10 + 1u, width - 1u), xb1 > floor(xb1));
         // Their depth bounds. A region's prefix bounds only widen along the row, so column
         // x1's cover column x0's: one load per row.
-        let lohi0 = textureLoad(bounds, vec2<u32>(x01, row0), 0);
-        let lohi1 = textureLoad(bounds, vec2<u32>(x11, row1), 0);
+        let lohi0 = bounds[bounds_index(x01, row0)];
+        let lohi1 = bounds[bounds_index(x11, row1)];
 {%- if cookie %}
         // The region's mean cookie up to the ray's end, per row: the channel's lit share
         // lies in [0, Cbar].

@@ -229,6 +229,12 @@ fn bindings_match_the_documented_tables() {
     let column_depth_rw = "Storage { access: StorageAccess(LOAD | STORE) } array<Scalar(Scalar { \
                         kind: Float, width: 4 })>"
         .to_owned();
+    let bounds_rw = "Storage { access: StorageAccess(LOAD | STORE) } array<Vector { size: Bi, \
+                     scalar: Scalar { kind: Float, width: 4 } }>"
+        .to_owned();
+    let bounds_read = "Storage { access: StorageAccess(LOAD) } array<Vector { size: Bi, scalar: \
+                       Scalar { kind: Float, width: 4 } }>"
+        .to_owned();
     let column_depth_read = "Storage { access: StorageAccess(LOAD) } array<Scalar(Scalar { kind: \
                           Float, width: 4 })>"
         .to_owned();
@@ -302,7 +308,7 @@ fn bindings_match_the_documented_tables() {
                     b(1, "slices", &slices),
                     b(2, "rectified", &sampled(false)),
                     b(3, "filtered", &filtered_rw),
-                    b(4, "bounds", &storage(StorageFormat::Rg32Float, false)),
+                    b(4, "bounds", &bounds_rw),
                 ]
             );
             assert_eq!(
@@ -314,7 +320,7 @@ fn bindings_match_the_documented_tables() {
                     b(3, "shadow_map", &sampled(false)),
                     b(4, "filtered", &filtered_read),
                     b(5, "output", &storage(StorageFormat::Rgba16Float, false)),
-                    b(6, "bounds", &sampled(false)),
+                    b(6, "bounds", &bounds_read),
                 ]
             );
         }

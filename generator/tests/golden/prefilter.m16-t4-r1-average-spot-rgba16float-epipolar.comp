@@ -69,7 +69,7 @@ layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
 layout(std430, binding = 3) buffer type_10_block_2Compute { uvec2 _group_0_binding_3_cs[]; };
 
-layout(binding = 4,rg32f) writeonly uniform image2D _group_0_binding_4_cs;
+layout(std430, binding = 4) buffer type_11_block_3Compute { vec2 _group_0_binding_4_cs[]; };
 
 
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
@@ -86,10 +86,10 @@ vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapVie
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
     bool outside = ((((uv.x < 0.0) || (uv.x > 1.0)) || (uv.y < 0.0)) || (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_4 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_5 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
     uint y = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_4, y)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_5, y)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -160,11 +160,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_5 = (sigma_t * len);
-    if ((x_5 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_5)));
+    float x_6 = (sigma_t * len);
+    if ((x_6 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_6)));
     }
-    return ((1.0 - exp(-(x_5))) / sigma_t);
+    return ((1.0 - exp(-(x_6))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -176,13 +176,13 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_6 * x_6) * (3.0 - (2.0 * x_6)));
+    float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_7 = (eye + (dir * t));
-    vec3 to_x = (x_7 - light_pos);
+    vec3 x_8 = (eye + (dir * t));
+    vec3 to_x = (x_8 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     vec3 travel = (to_x / vec3(d));
@@ -331,10 +331,15 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_
     return _e66;
 }
 
-uint filtered_index(uint x_2, uint row_2, uint layer) {
+uint bounds_index(uint x_2, uint row_2) {
+    uint _e5 = _group_0_binding_0_cs.sizes.w;
+    return ((x_2 * _e5) + row_2);
+}
+
+uint filtered_index(uint x_3, uint row_3, uint layer) {
     uint _e5 = _group_0_binding_0_cs.sizes.z;
     uint _e12 = _group_0_binding_0_cs.sizes.w;
-    return ((((layer * _e5) + x_2) * _e12) + row_2);
+    return ((((layer * _e5) + x_3) * _e12) + row_3);
 }
 
 uvec2 encode_layer(vec4 v_10) {
@@ -357,12 +362,12 @@ void main() {
     vec2 angle = vec2(0.0);
     uint k = 0u;
     uint q = 0u;
-    uint row_4 = id.x;
+    uint row_5 = id.x;
     uint region = id.y;
     uint thread = id.z;
     uint width_1 = _group_0_binding_0_cs.sizes.z;
     uint _e14 = _group_0_binding_0_cs.sizes.w;
-    if (!((row_4 >= _e14))) {
+    if (!((row_5 >= _e14))) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -377,7 +382,7 @@ void main() {
     if (_e29) {
         return;
     }
-    vec4 _e32 = _group_0_binding_1_cs[row_4];
+    vec4 _e32 = _group_0_binding_1_cs[row_5];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
     uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
@@ -385,8 +390,8 @@ void main() {
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e144 = i;
-            i = (_e144 + 1u);
+            uint _e143 = i;
+            i = (_e143 + 1u);
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -397,11 +402,11 @@ void main() {
         {
             uint _e44 = i;
             int _e48_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-            vec4 _e48 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e44, row_4)), ivec2(0), textureSize(_group_0_binding_2_cs, _e48_clamped_lod) - ivec2(1)), _e48_clamped_lod);
+            vec4 _e48 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e44, row_5)), ivec2(0), textureSize(_group_0_binding_2_cs, _e48_clamped_lod) - ivec2(1)), _e48_clamped_lod);
             float d_1 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = _group_0_binding_0_cs;
             uint _e52 = i;
-            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, false, true);
+            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, false, true);
             float _e56 = wsum;
             wsum = (_e56 + _e54);
             if ((thread == 0u)) {
@@ -410,68 +415,69 @@ void main() {
                 float _e64 = hi;
                 hi = max(_e64, d_1);
                 uint _e66 = i;
-                float _e68 = lo;
-                float _e69 = hi;
-                imageStore(_group_0_binding_4_cs, ivec2(uvec2(_e66, row_4)), vec4(_e68, _e69, 0.0, 0.0));
+                uint _e67 = bounds_index(_e66, row_5);
+                float _e70 = lo;
+                float _e71 = hi;
+                _group_0_binding_4_cs[_e67] = vec2(_e70, _e71);
             }
-            float _e74 = wsum;
-            float _e76 = wsum;
-            float blend = ((_e76 > 0.0) ? (_e54 / _e74) : 0.0);
+            float _e73 = wsum;
+            float _e75 = wsum;
+            float blend = ((_e75 > 0.0) ? (_e54 / _e73) : 0.0);
             angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
-            vec2 _e89 = angle;
-            vec2 _e90 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e89);
+            vec2 _e88 = angle;
+            vec2 _e89 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e88);
             k = 0u;
             bool loop_init_3 = true;
             while(true) {
                 if (!loop_init_3) {
-                    uint _e102 = k;
-                    k = (_e102 + 1u);
+                    uint _e101 = k;
+                    k = (_e101 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e93 = k;
-                if ((_e93 < ((2u * thread) * 1u))) {
+                uint _e92 = k;
+                if ((_e92 < ((2u * thread) * 1u))) {
                 } else {
                     break;
                 }
                 {
-                    vec2 _e99 = angle;
-                    vec2 _e100 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e99, _e90);
-                    angle = _e100;
+                    vec2 _e98 = angle;
+                    vec2 _e99 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e98, _e89);
+                    angle = _e99;
                 }
             }
             q = 0u;
             bool loop_init_4 = true;
             while(true) {
                 if (!loop_init_4) {
-                    uint _e141 = q;
-                    q = (_e141 + 1u);
+                    uint _e140 = q;
+                    q = (_e140 + 1u);
                 }
                 loop_init_4 = false;
-                uint _e106 = q;
-                if ((_e106 < 1u)) {
+                uint _e105 = q;
+                if ((_e105 < 1u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e109 = q;
-                    uint layer_2 = ((thread * 1u) + _e109);
-                    vec2 _e111 = angle;
-                    vec2 _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
-                    vec2 _e113 = angle;
-                    vec4 _e114 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e112);
-                    vec2 _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e90);
-                    angle = _e115;
-                    uint _e117 = q;
-                    vec4 a_5 = acc[_e117];
-                    uint _e120 = q;
-                    acc[_e120] = ((a_5 * (1.0 - blend)) + (_e114 * blend));
-                    uint _e127 = q;
-                    vec4 _e129 = acc[_e127];
-                    vec4 stored = ((_e129 * 0.5) + vec4(0.5));
-                    uint _e135 = i;
-                    uint _e136 = filtered_index(_e135, row_4, layer_2);
-                    uvec2 _e139 = encode_layer(stored);
-                    _group_0_binding_3_cs[_e136] = _e139;
+                    uint _e108 = q;
+                    uint layer_2 = ((thread * 1u) + _e108);
+                    vec2 _e110 = angle;
+                    vec2 _e111 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110, _e89);
+                    vec2 _e112 = angle;
+                    vec4 _e113 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e111);
+                    vec2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e89);
+                    angle = _e114;
+                    uint _e116 = q;
+                    vec4 a_5 = acc[_e116];
+                    uint _e119 = q;
+                    acc[_e119] = ((a_5 * (1.0 - blend)) + (_e113 * blend));
+                    uint _e126 = q;
+                    vec4 _e128 = acc[_e126];
+                    vec4 stored = ((_e128 * 0.5) + vec4(0.5));
+                    uint _e134 = i;
+                    uint _e135 = filtered_index(_e134, row_5, layer_2);
+                    uvec2 _e138 = encode_layer(stored);
+                    _group_0_binding_3_cs[_e135] = _e138;
                 }
             }
         }

@@ -9,6 +9,7 @@ using metal::uint;
 struct _mslBufferSizes {
     uint size1;
     uint size3;
+    uint size4;
 };
 
 struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
@@ -60,6 +61,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
 };
 typedef metal::float4 type_9[1];
 typedef metal::uint2 type_10[1];
+typedef metal::float2 type_11[1];
 struct type_13 {
     metal::float4 inner[1];
 };
@@ -100,10 +102,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
-    uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_5 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_5, y)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
@@ -201,11 +203,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_5 = sigma_t * len;
-    if (x_5 < 0.0001) {
-        return len * (1.0 - (0.5 * x_5));
+    float x_6 = sigma_t * len;
+    if (x_6 < 0.0001) {
+        return len * (1.0 - (0.5 * x_6));
     }
-    return (1.0 - metal::exp(-(x_5))) / sigma_t;
+    return (1.0 - metal::exp(-(x_6))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -225,8 +227,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_6 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_6 * x_6) * (3.0 - (2.0 * x_6));
+    float x_7 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_7 * x_7) * (3.0 - (2.0 * x_7));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -239,8 +241,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_7 = eye + (dir * t);
-    metal::float3 to_x = x_7 - light_pos;
+    metal::float3 x_8 = eye + (dir * t);
+    metal::float3 to_x = x_8 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d);
@@ -453,15 +455,24 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     return _e66;
 }
 
-uint filtered_index(
+uint bounds_index(
     uint x_2,
     uint row_2,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
+) {
+    uint _e5 = frame.sizes.w;
+    return (x_2 * _e5) + row_2;
+}
+
+uint filtered_index(
+    uint x_3,
+    uint row_3,
     uint layer,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return (((layer * _e5) + x_2) * _e12) + row_2;
+    return (((layer * _e5) + x_3) * _e12) + row_3;
 }
 
 metal::uint2 encode_layer(
@@ -477,14 +488,14 @@ metal::float4 decode_layer(
 }
 
 metal::float4 filtered_load(
-    uint x_3,
-    uint row_3,
+    uint x_4,
+    uint row_4,
     uint layer_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_10 const& filtered,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    uint _e3 = filtered_index(x_3, row_3, layer_1, frame);
+    uint _e3 = filtered_index(x_4, row_4, layer_1, frame);
     metal::uint2 _e6 = filtered[metal::min(unsigned(_e3), (_buffer_sizes.size3 - 0 - 8) / 8)];
     metal::float4 _e7 = decode_layer(_e6);
     return _e7;
@@ -498,8 +509,8 @@ kernel void prefilter(
 , device type_9 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(0)]]
 , device type_10& filtered [[buffer(2)]]
-, metal::texture2d<float, metal::access::write> bounds [[texture(1)]]
-, constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
+, device type_11& bounds [[buffer(3)]]
+, constant _mslBufferSizes& _buffer_sizes [[buffer(4)]]
 ) {
     bool local = {};
     bool local_1 = {};
@@ -511,12 +522,12 @@ kernel void prefilter(
     metal::float2 angle = {};
     uint k = {};
     uint q = {};
-    uint row_4 = id.x;
+    uint row_5 = id.x;
     uint region = id.y;
     uint thread_ = id.z;
     uint width_1 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
-    if (!((row_4 >= _e14))) {
+    if (!((row_5 >= _e14))) {
         local = region >= REGIONS;
     } else {
         local = true;
@@ -531,7 +542,7 @@ kernel void prefilter(
     if (_e29) {
         return;
     }
-    metal::float4 _e32 = slices[metal::min(unsigned(row_4), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    metal::float4 _e32 = slices[metal::min(unsigned(row_5), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
     uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, true);
@@ -542,8 +553,8 @@ kernel void prefilter(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e144 = i;
-            i = _e144 + 1u;
+            uint _e143 = i;
+            i = _e143 + 1u;
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -554,11 +565,11 @@ kernel void prefilter(
         {
             uint _e44 = i;
             uint clamped_lod_e48 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_4)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
+            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_5)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
             float d_1 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
             uint _e52 = i;
-            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, false, true);
+            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, false, true);
             float _e56 = wsum;
             wsum = _e56 + _e54;
             if (thread_ == 0u) {
@@ -567,16 +578,17 @@ kernel void prefilter(
                 float _e64 = hi;
                 hi = metal::max(_e64, d_1);
                 uint _e66 = i;
-                float _e68 = lo;
-                float _e69 = hi;
-                bounds.write(metal::float4(_e68, _e69, 0.0, 0.0), metal::uint2(metal::uint2(_e66, row_4)));
+                uint _e67 = bounds_index(_e66, row_5, frame);
+                float _e70 = lo;
+                float _e71 = hi;
+                bounds[metal::min(unsigned(_e67), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e70, _e71);
             }
-            float _e74 = wsum;
-            float _e76 = wsum;
-            float blend = (_e76 > 0.0) ? (_e54 / _e74) : 0.0;
+            float _e73 = wsum;
+            float _e75 = wsum;
+            float blend = (_e75 > 0.0) ? (_e54 / _e73) : 0.0;
             angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1));
-            metal::float2 _e89 = angle;
-            metal::float2 _e90 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e89);
+            metal::float2 _e88 = angle;
+            metal::float2 _e89 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e88);
             k = 0u;
             uint2 loop_bound_3 = uint2(4294967295u);
             bool loop_init_3 = true;
@@ -584,19 +596,19 @@ kernel void prefilter(
                 if (metal::all(loop_bound_3 == uint2(0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e102 = k;
-                    k = _e102 + 1u;
+                    uint _e101 = k;
+                    k = _e101 + 1u;
                 }
                 loop_init_3 = false;
-                uint _e93 = k;
-                if (_e93 < ((2u * thread_) * 1u)) {
+                uint _e92 = k;
+                if (_e92 < ((2u * thread_) * 1u)) {
                 } else {
                     break;
                 }
                 {
-                    metal::float2 _e99 = angle;
-                    metal::float2 _e100 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e99, _e90);
-                    angle = _e100;
+                    metal::float2 _e98 = angle;
+                    metal::float2 _e99 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e98, _e89);
+                    angle = _e99;
                 }
             }
             q = 0u;
@@ -606,35 +618,35 @@ kernel void prefilter(
                 if (metal::all(loop_bound_4 == uint2(0u))) { break; }
                 loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
                 if (!loop_init_4) {
-                    uint _e141 = q;
-                    q = _e141 + 1u;
+                    uint _e140 = q;
+                    q = _e140 + 1u;
                 }
                 loop_init_4 = false;
-                uint _e106 = q;
-                if (_e106 < 1u) {
+                uint _e105 = q;
+                if (_e105 < 1u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e109 = q;
-                    uint layer_2 = (thread_ * 1u) + _e109;
-                    metal::float2 _e111 = angle;
-                    metal::float2 _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
-                    metal::float2 _e113 = angle;
-                    metal::float4 _e114 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e112);
-                    metal::float2 _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e90);
-                    angle = _e115;
-                    uint _e117 = q;
-                    metal::float4 a_5 = acc.inner[metal::min(unsigned(_e117), 0u)];
-                    uint _e120 = q;
-                    acc.inner[metal::min(unsigned(_e120), 0u)] = (a_5 * (1.0 - blend)) + (_e114 * blend);
-                    uint _e127 = q;
-                    metal::float4 _e129 = acc.inner[metal::min(unsigned(_e127), 0u)];
-                    metal::float4 stored = (_e129 * 0.5) + metal::float4(0.5);
-                    uint _e135 = i;
-                    uint _e136 = filtered_index(_e135, row_4, layer_2, frame);
-                    metal::uint2 _e139 = encode_layer(stored);
-                    filtered[metal::min(unsigned(_e136), (_buffer_sizes.size3 - 0 - 8) / 8)] = _e139;
+                    uint _e108 = q;
+                    uint layer_2 = (thread_ * 1u) + _e108;
+                    metal::float2 _e110 = angle;
+                    metal::float2 _e111 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110, _e89);
+                    metal::float2 _e112 = angle;
+                    metal::float4 _e113 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e111);
+                    metal::float2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e89);
+                    angle = _e114;
+                    uint _e116 = q;
+                    metal::float4 a_5 = acc.inner[metal::min(unsigned(_e116), 0u)];
+                    uint _e119 = q;
+                    acc.inner[metal::min(unsigned(_e119), 0u)] = (a_5 * (1.0 - blend)) + (_e113 * blend);
+                    uint _e126 = q;
+                    metal::float4 _e128 = acc.inner[metal::min(unsigned(_e126), 0u)];
+                    metal::float4 stored = (_e128 * 0.5) + metal::float4(0.5);
+                    uint _e134 = i;
+                    uint _e135 = filtered_index(_e134, row_5, layer_2, frame);
+                    metal::uint2 _e138 = encode_layer(stored);
+                    filtered[metal::min(unsigned(_e135), (_buffer_sizes.size3 - 0 - 8) / 8)] = _e138;
                 }
             }
         }

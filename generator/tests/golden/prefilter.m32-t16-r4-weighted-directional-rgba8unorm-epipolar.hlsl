@@ -64,7 +64,7 @@ cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZA
 ByteAddressBuffer slices : register(t1);
 Texture2D<float4> rectified : register(t2);
 RWByteAddressBuffer filtered : register(u3);
-RWTexture2D<float4> bounds : register(u4);
+RWByteAddressBuffer bounds : register(u4);
 
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
@@ -87,9 +87,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
 {
     bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_4 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_5 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
     uint y = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e36 = sm.Load(int3(uint2(x_4, y), int(0)));
+    float4 _e36 = sm.Load(int3(uint2(x_5, y), int(0)));
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -168,11 +168,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_5 = (sigma_t * len);
-    if ((x_5 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_5)));
+    float x_6 = (sigma_t * len);
+    if ((x_6 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_6)));
     }
-    return ((1.0 - exp(-(x_5))) / sigma_t);
+    return ((1.0 - exp(-(x_6))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -186,14 +186,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_6 * x_6) * (3.0 - (2.0 * x_6)));
+    float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_7 = (eye + (dir * t));
-    float3 to_x = (x_7 - light_pos);
+    float3 x_8 = (eye + (dir * t));
+    float3 to_x = (x_8 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d = sqrt(d2_);
     float3 travel = (to_x / (d).xxx);
@@ -387,11 +387,17 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_
     return _e66;
 }
 
-uint filtered_index(uint x_2, uint row_2, uint layer)
+uint bounds_index(uint x_2, uint row_2)
+{
+    uint _e5 = frame.sizes.w;
+    return ((x_2 * _e5) + row_2);
+}
+
+uint filtered_index(uint x_3, uint row_3, uint layer)
 {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return ((((layer * _e5) + x_2) * _e12) + row_2);
+    return ((((layer * _e5) + x_3) * _e12) + row_3);
 }
 
 uint encode_layer(float4 v_10)
@@ -404,9 +410,9 @@ float4 decode_layer(uint w_1)
     return (float4(w_1 & 0xFF, w_1 >> 8 & 0xFF, w_1 >> 16 & 0xFF, w_1 >> 24) / 255.0);
 }
 
-float4 filtered_load(uint x_3, uint row_3, uint layer_1)
+float4 filtered_load(uint x_4, uint row_4, uint layer_1)
 {
-    const uint _e3 = filtered_index(x_3, row_3, layer_1);
+    const uint _e3 = filtered_index(x_4, row_4, layer_1);
     uint _e6 = asuint(filtered.Load(_e3*4));
     const float4 _e7 = decode_layer(_e6);
     return _e7;
@@ -426,12 +432,12 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     uint k = (uint)0;
     uint q = (uint)0;
 
-    uint row_4 = id.x;
+    uint row_5 = id.x;
     uint region = id.y;
     uint thread = id.z;
     uint width_1 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
-    if (!((row_4 >= _e14))) {
+    if (!((row_5 >= _e14))) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -446,7 +452,7 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     if (_e29) {
         return;
     }
-    float4 _e32 = asfloat(slices.Load4(row_4*16));
+    float4 _e32 = asfloat(slices.Load4(row_5*16));
     const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     const uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     const uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
@@ -457,8 +463,8 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e144 = i;
-            i = (_e144 + 1u);
+            uint _e143 = i;
+            i = (_e143 + 1u);
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -468,11 +474,11 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         }
         {
             uint _e44 = i;
-            float4 _e48 = rectified.Load(int3(uint2(_e44, row_4), int(0)));
+            float4 _e48 = rectified.Load(int3(uint2(_e44, row_5), int(0)));
             float d_1 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
             uint _e52 = i;
-            const float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, true, false);
+            const float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, true, false);
             float _e56 = wsum;
             wsum = (_e56 + _e54);
             if ((thread == 0u)) {
@@ -481,16 +487,17 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 float _e64 = hi;
                 hi = max(_e64, d_1);
                 uint _e66 = i;
-                float _e68 = lo;
-                float _e69 = hi;
-                bounds[uint2(_e66, row_4)] = float4(_e68, _e69, 0.0, 0.0);
+                const uint _e67 = bounds_index(_e66, row_5);
+                float _e70 = lo;
+                float _e71 = hi;
+                bounds.Store2(_e67*8, asuint(float2(_e70, _e71)));
             }
-            float _e74 = wsum;
-            float _e76 = wsum;
-            float blend = ((_e76 > 0.0) ? (_e54 / _e74) : 0.0);
+            float _e73 = wsum;
+            float _e75 = wsum;
+            float blend = ((_e75 > 0.0) ? (_e54 / _e73) : 0.0);
             angle = float2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
-            float2 _e89 = angle;
-            const float2 _e90 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e89);
+            float2 _e88 = angle;
+            const float2 _e89 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e88);
             k = 0u;
             uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
             bool loop_init_3 = true;
@@ -498,19 +505,19 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e102 = k;
-                    k = (_e102 + 1u);
+                    uint _e101 = k;
+                    k = (_e101 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e93 = k;
-                if ((_e93 < ((2u * thread) * 4u))) {
+                uint _e92 = k;
+                if ((_e92 < ((2u * thread) * 4u))) {
                 } else {
                     break;
                 }
                 {
-                    float2 _e99 = angle;
-                    const float2 _e100 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e99, _e90);
-                    angle = _e100;
+                    float2 _e98 = angle;
+                    const float2 _e99 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e98, _e89);
+                    angle = _e99;
                 }
             }
             q = 0u;
@@ -520,35 +527,35 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
                 loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
                 if (!loop_init_4) {
-                    uint _e141 = q;
-                    q = (_e141 + 1u);
+                    uint _e140 = q;
+                    q = (_e140 + 1u);
                 }
                 loop_init_4 = false;
-                uint _e106 = q;
-                if ((_e106 < 4u)) {
+                uint _e105 = q;
+                if ((_e105 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e109 = q;
-                    uint layer_2 = ((thread * 4u) + _e109);
-                    float2 _e111 = angle;
-                    const float2 _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
-                    float2 _e113 = angle;
-                    const float4 _e114 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e112);
-                    const float2 _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e90);
-                    angle = _e115;
-                    uint _e117 = q;
-                    float4 a_5 = acc[min(uint(_e117), 3u)];
-                    uint _e120 = q;
-                    acc[min(uint(_e120), 3u)] = ((a_5 * (1.0 - blend)) + (_e114 * blend));
-                    uint _e127 = q;
-                    float4 _e129 = acc[min(uint(_e127), 3u)];
-                    float4 stored = ((_e129 * 0.5) + (0.5).xxxx);
-                    uint _e135 = i;
-                    const uint _e136 = filtered_index(_e135, row_4, layer_2);
-                    const uint _e139 = encode_layer(stored);
-                    filtered.Store(_e136*4, asuint(_e139));
+                    uint _e108 = q;
+                    uint layer_2 = ((thread * 4u) + _e108);
+                    float2 _e110 = angle;
+                    const float2 _e111 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110, _e89);
+                    float2 _e112 = angle;
+                    const float4 _e113 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e111);
+                    const float2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e89);
+                    angle = _e114;
+                    uint _e116 = q;
+                    float4 a_5 = acc[min(uint(_e116), 3u)];
+                    uint _e119 = q;
+                    acc[min(uint(_e119), 3u)] = ((a_5 * (1.0 - blend)) + (_e113 * blend));
+                    uint _e126 = q;
+                    float4 _e128 = acc[min(uint(_e126), 3u)];
+                    float4 stored = ((_e128 * 0.5) + (0.5).xxxx);
+                    uint _e134 = i;
+                    const uint _e135 = filtered_index(_e134, row_5, layer_2);
+                    const uint _e138 = encode_layer(stored);
+                    filtered.Store(_e135*4, asuint(_e138));
                 }
             }
         }

@@ -69,7 +69,7 @@ var rectified: texture_2d<f32>;
 @group(0) @binding(3) 
 var<storage, read_write> filtered: array<u32>;
 @group(0) @binding(4) 
-var bounds: texture_storage_2d<rg32float,write>;
+var<storage, read_write> bounds: array<vec2<f32>>;
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
     let q_2 = (p - v.origin.xyz);
@@ -85,9 +85,9 @@ fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMap
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
-    let x_4 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let x_5 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e36 = textureLoad(sm, vec2<u32>(x_4, y), 0i);
+    let _e36 = textureLoad(sm, vec2<u32>(x_5, y), 0i);
     return select(_e36.x, 2f, outside);
 }
 
@@ -158,11 +158,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_5 = (sigma_t * len);
-    if (x_5 < 0.0001f) {
-        return (len * (1f - (0.5f * x_5)));
+    let x_6 = (sigma_t * len);
+    if (x_6 < 0.0001f) {
+        return (len * (1f - (0.5f * x_6)));
     }
-    return ((1f - exp(-(x_5))) / sigma_t);
+    return ((1f - exp(-(x_6))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -174,13 +174,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_6 * x_6) * (3f - (2f * x_6)));
+    let x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_7 * x_7) * (3f - (2f * x_7)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_7 = (eye + (dir * t));
-    let to_x = (x_7 - light_pos);
+    let x_8 = (eye + (dir * t));
+    let to_x = (x_8 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d = sqrt(d2_);
     let travel = (to_x / vec3(d));
@@ -328,10 +328,15 @@ fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3: FrameX_nag
     return _e66;
 }
 
-fn filtered_index(x_2: u32, row_2: u32, layer: u32) -> u32 {
+fn bounds_index(x_2: u32, row_2: u32) -> u32 {
+    let _e5 = frame.sizes.w;
+    return ((x_2 * _e5) + row_2);
+}
+
+fn filtered_index(x_3: u32, row_3: u32, layer: u32) -> u32 {
     let _e5 = frame.sizes.z;
     let _e12 = frame.sizes.w;
-    return ((((layer * _e5) + x_2) * _e12) + row_2);
+    return ((((layer * _e5) + x_3) * _e12) + row_3);
 }
 
 fn encode_layer(v_10: vec4<f32>) -> u32 {
@@ -342,8 +347,8 @@ fn decode_layer(w_1: u32) -> vec4<f32> {
     return unpack4x8unorm(w_1);
 }
 
-fn filtered_load(x_3: u32, row_3: u32, layer_1: u32) -> vec4<f32> {
-    let _e3 = filtered_index(x_3, row_3, layer_1);
+fn filtered_load(x_4: u32, row_4: u32, layer_1: u32) -> vec4<f32> {
+    let _e3 = filtered_index(x_4, row_4, layer_1);
     let _e6 = filtered[_e3];
     let _e7 = decode_layer(_e6);
     return _e7;
@@ -362,12 +367,12 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var k: u32;
     var q: u32;
 
-    let row_4 = id.x;
+    let row_5 = id.x;
     let region = id.y;
     let thread = id.z;
     let width_1 = frame.sizes.z;
     let _e14 = frame.sizes.w;
-    if !((row_4 >= _e14)) {
+    if !((row_5 >= _e14)) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -382,7 +387,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e29 {
         return;
     }
-    let _e32 = slices[row_4];
+    let _e32 = slices[row_5];
     let _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     let _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     let _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
@@ -395,11 +400,11 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         {
             let _e44 = i;
-            let _e48 = textureLoad(rectified, vec2<u32>(_e44, row_4), 0i);
+            let _e48 = textureLoad(rectified, vec2<u32>(_e44, row_5), 0i);
             let d_1 = _e48.x;
             let _e51 = frame;
             let _e52 = i;
-            let _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, true, false);
+            let _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, true, false);
             let _e56 = wsum;
             wsum = (_e56 + _e54);
             if (thread == 0u) {
@@ -408,70 +413,71 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
                 let _e64 = hi;
                 hi = max(_e64, d_1);
                 let _e66 = i;
-                let _e68 = lo;
-                let _e69 = hi;
-                textureStore(bounds, vec2<u32>(_e66, row_4), vec4<f32>(_e68, _e69, 0f, 0f));
+                let _e67 = bounds_index(_e66, row_5);
+                let _e70 = lo;
+                let _e71 = hi;
+                bounds[_e67] = vec2<f32>(_e70, _e71);
             }
-            let _e74 = wsum;
-            let _e76 = wsum;
-            let blend = select(0f, (_e54 / _e74), (_e76 > 0f));
+            let _e73 = wsum;
+            let _e75 = wsum;
+            let blend = select(0f, (_e54 / _e73), (_e75 > 0f));
             angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
-            let _e89 = angle;
-            let _e90 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e89);
+            let _e88 = angle;
+            let _e89 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e88);
             k = 0u;
             loop {
-                let _e93 = k;
-                if (_e93 < ((2u * thread) * 4u)) {
+                let _e92 = k;
+                if (_e92 < ((2u * thread) * 4u)) {
                 } else {
                     break;
                 }
                 {
-                    let _e99 = angle;
-                    let _e100 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e99, _e90);
-                    angle = _e100;
+                    let _e98 = angle;
+                    let _e99 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e98, _e89);
+                    angle = _e99;
                 }
                 continuing {
-                    let _e102 = k;
-                    k = (_e102 + 1u);
+                    let _e101 = k;
+                    k = (_e101 + 1u);
                 }
             }
             q = 0u;
             loop {
-                let _e106 = q;
-                if (_e106 < 4u) {
+                let _e105 = q;
+                if (_e105 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    let _e109 = q;
-                    let layer_2 = ((thread * 4u) + _e109);
-                    let _e111 = angle;
-                    let _e112 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e90);
-                    let _e113 = angle;
-                    let _e114 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e112);
-                    let _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e90);
-                    angle = _e115;
-                    let _e117 = q;
-                    let a_5 = acc[_e117];
-                    let _e120 = q;
-                    acc[_e120] = ((a_5 * (1f - blend)) + (_e114 * blend));
-                    let _e127 = q;
-                    let _e129 = acc[_e127];
-                    let stored = ((_e129 * 0.5f) + vec4(0.5f));
-                    let _e135 = i;
-                    let _e136 = filtered_index(_e135, row_4, layer_2);
-                    let _e139 = encode_layer(stored);
-                    filtered[_e136] = _e139;
+                    let _e108 = q;
+                    let layer_2 = ((thread * 4u) + _e108);
+                    let _e110 = angle;
+                    let _e111 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110, _e89);
+                    let _e112 = angle;
+                    let _e113 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e111);
+                    let _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e89);
+                    angle = _e114;
+                    let _e116 = q;
+                    let a_5 = acc[_e116];
+                    let _e119 = q;
+                    acc[_e119] = ((a_5 * (1f - blend)) + (_e113 * blend));
+                    let _e126 = q;
+                    let _e128 = acc[_e126];
+                    let stored = ((_e128 * 0.5f) + vec4(0.5f));
+                    let _e134 = i;
+                    let _e135 = filtered_index(_e134, row_5, layer_2);
+                    let _e138 = encode_layer(stored);
+                    filtered[_e135] = _e138;
                 }
                 continuing {
-                    let _e141 = q;
-                    q = (_e141 + 1u);
+                    let _e140 = q;
+                    q = (_e140 + 1u);
                 }
             }
         }
         continuing {
-            let _e144 = i;
-            i = (_e144 + 1u);
+            let _e143 = i;
+            i = (_e143 + 1u);
         }
     }
     return;

@@ -64,7 +64,7 @@ cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZA
 ByteAddressBuffer slices : register(t1);
 Texture2D<float4> rectified : register(t2);
 RWByteAddressBuffer filtered : register(u3);
-RWTexture2D<float4> bounds : register(u4);
+RWByteAddressBuffer bounds : register(u4);
 
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
@@ -87,9 +87,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
 {
     bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_4 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_5 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
     uint y = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e36 = sm.Load(int3(uint2(x_4, y), int(0)));
+    float4 _e36 = sm.Load(int3(uint2(x_5, y), int(0)));
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -168,11 +168,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_5 = (sigma_t * len);
-    if ((x_5 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_5)));
+    float x_6 = (sigma_t * len);
+    if ((x_6 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_6)));
     }
-    return ((1.0 - exp(-(x_5))) / sigma_t);
+    return ((1.0 - exp(-(x_6))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -186,14 +186,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_6 * x_6) * (3.0 - (2.0 * x_6)));
+    float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_7 = (eye + (dir * t));
-    float3 to_x = (x_7 - light_pos);
+    float3 x_8 = (eye + (dir * t));
+    float3 to_x = (x_8 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_1 = sqrt(d2_);
     float3 travel = (to_x / (d_1).xxx);
@@ -387,11 +387,17 @@ float4 moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float z_1, uint l
     return float4((z4_ * z_1), (z4_ * z2_), 0.0, 0.0);
 }
 
-uint filtered_index(uint x_2, uint row_2, uint layer_1)
+uint bounds_index(uint x_2, uint row_2)
+{
+    uint _e5 = frame.sizes.w;
+    return ((x_2 * _e5) + row_2);
+}
+
+uint filtered_index(uint x_3, uint row_3, uint layer_1)
 {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return ((((layer_1 * _e5) + x_2) * _e12) + row_2);
+    return ((((layer_1 * _e5) + x_3) * _e12) + row_3);
 }
 
 float4 encode_layer(float4 v_10)
@@ -404,9 +410,9 @@ float4 decode_layer(float4 w_1)
     return w_1;
 }
 
-float4 filtered_load(uint x_3, uint row_3, uint layer_2)
+float4 filtered_load(uint x_4, uint row_4, uint layer_2)
 {
-    const uint _e3 = filtered_index(x_3, row_3, layer_2);
+    const uint _e3 = filtered_index(x_4, row_4, layer_2);
     float4 _e6 = asfloat(filtered.Load4(_e3*16));
     const float4 _e7 = decode_layer(_e6);
     return _e7;
@@ -424,12 +430,12 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     uint i = (uint)0;
     uint q = (uint)0;
 
-    uint row_4 = id.x;
+    uint row_5 = id.x;
     uint region = id.y;
     uint thread = id.z;
     uint width_1 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
-    if (!((row_4 >= _e14))) {
+    if (!((row_5 >= _e14))) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -444,7 +450,7 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     if (_e29) {
         return;
     }
-    float4 _e32 = asfloat(slices.Load4(row_4*16));
+    float4 _e32 = asfloat(slices.Load4(row_5*16));
     const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     const uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     const uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
@@ -455,8 +461,8 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e113 = i;
-            i = (_e113 + 1u);
+            uint _e112 = i;
+            i = (_e112 + 1u);
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -466,11 +472,11 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         }
         {
             uint _e44 = i;
-            float4 _e48 = rectified.Load(int3(uint2(_e44, row_4), int(0)));
+            float4 _e48 = rectified.Load(int3(uint2(_e44, row_5), int(0)));
             float d_2 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
             uint _e52 = i;
-            const float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, true, false);
+            const float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, true, false);
             float _e56 = wsum;
             wsum = (_e56 + _e54);
             if ((thread == 0u)) {
@@ -479,14 +485,15 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 float _e64 = hi;
                 hi = max(_e64, d_2);
                 uint _e66 = i;
-                float _e68 = lo;
-                float _e69 = hi;
-                bounds[uint2(_e66, row_4)] = float4(_e68, _e69, 0.0, 0.0);
+                const uint _e67 = bounds_index(_e66, row_5);
+                float _e70 = lo;
+                float _e71 = hi;
+                bounds.Store2(_e67*8, asuint(float2(_e70, _e71)));
             }
-            float _e74 = wsum;
-            float _e76 = wsum;
-            float blend = ((_e76 > 0.0) ? (_e54 / _e74) : 0.0);
-            const float _e81 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            float _e73 = wsum;
+            float _e75 = wsum;
+            float blend = ((_e75 > 0.0) ? (_e54 / _e73) : 0.0);
+            const float _e80 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
             q = 0u;
             uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
             bool loop_init_3 = true;
@@ -494,29 +501,29 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e110 = q;
-                    q = (_e110 + 1u);
+                    uint _e109 = q;
+                    q = (_e109 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e85 = q;
-                if ((_e85 < 2u)) {
+                uint _e84 = q;
+                if ((_e84 < 2u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e88 = q;
-                    uint _e90 = q;
-                    float4 _e92 = acc[min(uint(_e90), 1u)];
-                    uint _e96 = q;
-                    const float4 _e97 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e81, _e96);
-                    acc[min(uint(_e88), 1u)] = ((_e92 * (1.0 - blend)) + (_e97 * blend));
-                    uint _e100 = i;
-                    uint _e101 = q;
-                    const uint _e102 = filtered_index(_e100, row_4, _e101);
-                    uint _e105 = q;
-                    float4 _e107 = acc[min(uint(_e105), 1u)];
-                    const float4 _e108 = encode_layer(_e107);
-                    filtered.Store4(_e102*16, asuint(_e108));
+                    uint _e87 = q;
+                    uint _e89 = q;
+                    float4 _e91 = acc[min(uint(_e89), 1u)];
+                    uint _e95 = q;
+                    const float4 _e96 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e80, _e95);
+                    acc[min(uint(_e87), 1u)] = ((_e91 * (1.0 - blend)) + (_e96 * blend));
+                    uint _e99 = i;
+                    uint _e100 = q;
+                    const uint _e101 = filtered_index(_e99, row_5, _e100);
+                    uint _e104 = q;
+                    float4 _e106 = acc[min(uint(_e104), 1u)];
+                    const float4 _e107 = encode_layer(_e106);
+                    filtered.Store4(_e101*16, asuint(_e107));
                 }
             }
         }

@@ -9,6 +9,7 @@ using metal::uint;
 struct _mslBufferSizes {
     uint size1;
     uint size3;
+    uint size4;
 };
 
 struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
@@ -59,6 +60,7 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_hi;
 };
 typedef metal::float4 type_9[1];
+typedef metal::float2 type_10[1];
 struct type_12 {
     metal::float4 inner[2];
 };
@@ -99,10 +101,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
-    uint x_4 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_5 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_4, y)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_5, y)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
@@ -200,11 +202,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_5 = sigma_t * len;
-    if (x_5 < 0.0001) {
-        return len * (1.0 - (0.5 * x_5));
+    float x_6 = sigma_t * len;
+    if (x_6 < 0.0001) {
+        return len * (1.0 - (0.5 * x_6));
     }
-    return (1.0 - metal::exp(-(x_5))) / sigma_t;
+    return (1.0 - metal::exp(-(x_6))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -224,8 +226,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_6 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_6 * x_6) * (3.0 - (2.0 * x_6));
+    float x_7 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_7 * x_7) * (3.0 - (2.0 * x_7));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -238,8 +240,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_7 = eye + (dir * t);
-    metal::float3 to_x = x_7 - light_pos;
+    metal::float3 x_8 = eye + (dir * t);
+    metal::float3 to_x = x_8 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_1 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_1);
@@ -450,15 +452,24 @@ metal::float4 moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
     return metal::float4(z4_ * z_1, z4_ * z2_, 0.0, 0.0);
 }
 
-uint filtered_index(
+uint bounds_index(
     uint x_2,
     uint row_2,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
+) {
+    uint _e5 = frame.sizes.w;
+    return (x_2 * _e5) + row_2;
+}
+
+uint filtered_index(
+    uint x_3,
+    uint row_3,
     uint layer_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return (((layer_1 * _e5) + x_2) * _e12) + row_2;
+    return (((layer_1 * _e5) + x_3) * _e12) + row_3;
 }
 
 metal::float4 encode_layer(
@@ -474,14 +485,14 @@ metal::float4 decode_layer(
 }
 
 metal::float4 filtered_load(
-    uint x_3,
-    uint row_3,
+    uint x_4,
+    uint row_4,
     uint layer_2,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_9 const& filtered,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    uint _e3 = filtered_index(x_3, row_3, layer_2, frame);
+    uint _e3 = filtered_index(x_4, row_4, layer_2, frame);
     metal::float4 _e6 = filtered[metal::min(unsigned(_e3), (_buffer_sizes.size3 - 0 - 16) / 16)];
     metal::float4 _e7 = decode_layer(_e6);
     return _e7;
@@ -495,8 +506,8 @@ kernel void prefilter(
 , device type_9 const& slices [[buffer(1)]]
 , metal::texture2d<float, metal::access::sample> rectified [[texture(0)]]
 , device type_9& filtered [[buffer(2)]]
-, metal::texture2d<float, metal::access::write> bounds [[texture(1)]]
-, constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
+, device type_10& bounds [[buffer(3)]]
+, constant _mslBufferSizes& _buffer_sizes [[buffer(4)]]
 ) {
     bool local = {};
     bool local_1 = {};
@@ -506,12 +517,12 @@ kernel void prefilter(
     float hi = -1000000000000000000000000000000.0;
     uint i = {};
     uint q = {};
-    uint row_4 = id.x;
+    uint row_5 = id.x;
     uint region = id.y;
     uint thread_ = id.z;
     uint width_1 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
-    if (!((row_4 >= _e14))) {
+    if (!((row_5 >= _e14))) {
         local = region >= REGIONS;
     } else {
         local = true;
@@ -526,7 +537,7 @@ kernel void prefilter(
     if (_e29) {
         return;
     }
-    metal::float4 _e32 = slices[metal::min(unsigned(row_4), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    metal::float4 _e32 = slices[metal::min(unsigned(row_5), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, false);
@@ -537,8 +548,8 @@ kernel void prefilter(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e113 = i;
-            i = _e113 + 1u;
+            uint _e112 = i;
+            i = _e112 + 1u;
         }
         loop_init_2 = false;
         uint _e42 = i;
@@ -549,11 +560,11 @@ kernel void prefilter(
         {
             uint _e44 = i;
             uint clamped_lod_e48 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_4)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
+            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_5)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
             float d_2 = _e48.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
             uint _e52 = i;
-            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, true, false);
+            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, true, false);
             float _e56 = wsum;
             wsum = _e56 + _e54;
             if (thread_ == 0u) {
@@ -562,14 +573,15 @@ kernel void prefilter(
                 float _e64 = hi;
                 hi = metal::max(_e64, d_2);
                 uint _e66 = i;
-                float _e68 = lo;
-                float _e69 = hi;
-                bounds.write(metal::float4(_e68, _e69, 0.0, 0.0), metal::uint2(metal::uint2(_e66, row_4)));
+                uint _e67 = bounds_index(_e66, row_5, frame);
+                float _e70 = lo;
+                float _e71 = hi;
+                bounds[metal::min(unsigned(_e67), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e70, _e71);
             }
-            float _e74 = wsum;
-            float _e76 = wsum;
-            float blend = (_e76 > 0.0) ? (_e54 / _e74) : 0.0;
-            float _e81 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            float _e73 = wsum;
+            float _e75 = wsum;
+            float blend = (_e75 > 0.0) ? (_e54 / _e73) : 0.0;
+            float _e80 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
             q = 0u;
             uint2 loop_bound_3 = uint2(4294967295u);
             bool loop_init_3 = true;
@@ -577,29 +589,29 @@ kernel void prefilter(
                 if (metal::all(loop_bound_3 == uint2(0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e110 = q;
-                    q = _e110 + 1u;
+                    uint _e109 = q;
+                    q = _e109 + 1u;
                 }
                 loop_init_3 = false;
-                uint _e85 = q;
-                if (_e85 < 2u) {
+                uint _e84 = q;
+                if (_e84 < 2u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e88 = q;
-                    uint _e90 = q;
-                    metal::float4 _e92 = acc.inner[metal::min(unsigned(_e90), 1u)];
-                    uint _e96 = q;
-                    metal::float4 _e97 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e81, _e96);
-                    acc.inner[metal::min(unsigned(_e88), 1u)] = (_e92 * (1.0 - blend)) + (_e97 * blend);
-                    uint _e100 = i;
-                    uint _e101 = q;
-                    uint _e102 = filtered_index(_e100, row_4, _e101, frame);
-                    uint _e105 = q;
-                    metal::float4 _e107 = acc.inner[metal::min(unsigned(_e105), 1u)];
-                    metal::float4 _e108 = encode_layer(_e107);
-                    filtered[metal::min(unsigned(_e102), (_buffer_sizes.size3 - 0 - 16) / 16)] = _e108;
+                    uint _e87 = q;
+                    uint _e89 = q;
+                    metal::float4 _e91 = acc.inner[metal::min(unsigned(_e89), 1u)];
+                    uint _e95 = q;
+                    metal::float4 _e96 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e80, _e95);
+                    acc.inner[metal::min(unsigned(_e87), 1u)] = (_e91 * (1.0 - blend)) + (_e96 * blend);
+                    uint _e99 = i;
+                    uint _e100 = q;
+                    uint _e101 = filtered_index(_e99, row_5, _e100, frame);
+                    uint _e104 = q;
+                    metal::float4 _e106 = acc.inner[metal::min(unsigned(_e104), 1u)];
+                    metal::float4 _e107 = encode_layer(_e106);
+                    filtered[metal::min(unsigned(_e101), (_buffer_sizes.size3 - 0 - 16) / 16)] = _e107;
                 }
             }
         }

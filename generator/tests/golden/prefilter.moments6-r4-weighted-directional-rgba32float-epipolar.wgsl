@@ -69,7 +69,7 @@ var rectified: texture_2d<f32>;
 @group(0) @binding(3) 
 var<storage, read_write> filtered: array<vec4<f32>>;
 @group(0) @binding(4) 
-var bounds: texture_storage_2d<rg32float,write>;
+var<storage, read_write> bounds: array<vec2<f32>>;
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
     let q_2 = (p - v.origin.xyz);
@@ -85,9 +85,9 @@ fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMap
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
-    let x_4 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let x_5 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e36 = textureLoad(sm, vec2<u32>(x_4, y), 0i);
+    let _e36 = textureLoad(sm, vec2<u32>(x_5, y), 0i);
     return select(_e36.x, 2f, outside);
 }
 
@@ -158,11 +158,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_5 = (sigma_t * len);
-    if (x_5 < 0.0001f) {
-        return (len * (1f - (0.5f * x_5)));
+    let x_6 = (sigma_t * len);
+    if (x_6 < 0.0001f) {
+        return (len * (1f - (0.5f * x_6)));
     }
-    return ((1f - exp(-(x_5))) / sigma_t);
+    return ((1f - exp(-(x_6))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -174,13 +174,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_6 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_6 * x_6) * (3f - (2f * x_6)));
+    let x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_7 * x_7) * (3f - (2f * x_7)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_7 = (eye + (dir * t));
-    let to_x = (x_7 - light_pos);
+    let x_8 = (eye + (dir * t));
+    let to_x = (x_8 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d_1 = sqrt(d2_);
     let travel = (to_x / vec3(d_1));
@@ -329,10 +329,15 @@ fn moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(z_1: f32, layer: u32)
     return vec4<f32>((z4_ * z_1), (z4_ * z2_), 0f, 0f);
 }
 
-fn filtered_index(x_2: u32, row_2: u32, layer_1: u32) -> u32 {
+fn bounds_index(x_2: u32, row_2: u32) -> u32 {
+    let _e5 = frame.sizes.w;
+    return ((x_2 * _e5) + row_2);
+}
+
+fn filtered_index(x_3: u32, row_3: u32, layer_1: u32) -> u32 {
     let _e5 = frame.sizes.z;
     let _e12 = frame.sizes.w;
-    return ((((layer_1 * _e5) + x_2) * _e12) + row_2);
+    return ((((layer_1 * _e5) + x_3) * _e12) + row_3);
 }
 
 fn encode_layer(v_10: vec4<f32>) -> vec4<f32> {
@@ -343,8 +348,8 @@ fn decode_layer(w_1: vec4<f32>) -> vec4<f32> {
     return w_1;
 }
 
-fn filtered_load(x_3: u32, row_3: u32, layer_2: u32) -> vec4<f32> {
-    let _e3 = filtered_index(x_3, row_3, layer_2);
+fn filtered_load(x_4: u32, row_4: u32, layer_2: u32) -> vec4<f32> {
+    let _e3 = filtered_index(x_4, row_4, layer_2);
     let _e6 = filtered[_e3];
     let _e7 = decode_layer(_e6);
     return _e7;
@@ -361,12 +366,12 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var i: u32;
     var q: u32;
 
-    let row_4 = id.x;
+    let row_5 = id.x;
     let region = id.y;
     let thread = id.z;
     let width_1 = frame.sizes.z;
     let _e14 = frame.sizes.w;
-    if !((row_4 >= _e14)) {
+    if !((row_5 >= _e14)) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -381,7 +386,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e29 {
         return;
     }
-    let _e32 = slices[row_4];
+    let _e32 = slices[row_5];
     let _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     let _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     let _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
@@ -394,11 +399,11 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         {
             let _e44 = i;
-            let _e48 = textureLoad(rectified, vec2<u32>(_e44, row_4), 0i);
+            let _e48 = textureLoad(rectified, vec2<u32>(_e44, row_5), 0i);
             let d_2 = _e48.x;
             let _e51 = frame;
             let _e52 = i;
-            let _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_4, _e52, true, false);
+            let _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, true, false);
             let _e56 = wsum;
             wsum = (_e56 + _e54);
             if (thread == 0u) {
@@ -407,45 +412,46 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
                 let _e64 = hi;
                 hi = max(_e64, d_2);
                 let _e66 = i;
-                let _e68 = lo;
-                let _e69 = hi;
-                textureStore(bounds, vec2<u32>(_e66, row_4), vec4<f32>(_e68, _e69, 0f, 0f));
+                let _e67 = bounds_index(_e66, row_5);
+                let _e70 = lo;
+                let _e71 = hi;
+                bounds[_e67] = vec2<f32>(_e70, _e71);
             }
-            let _e74 = wsum;
-            let _e76 = wsum;
-            let blend = select(0f, (_e54 / _e74), (_e76 > 0f));
-            let _e81 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            let _e73 = wsum;
+            let _e75 = wsum;
+            let blend = select(0f, (_e54 / _e73), (_e75 > 0f));
+            let _e80 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
             q = 0u;
             loop {
-                let _e85 = q;
-                if (_e85 < 2u) {
+                let _e84 = q;
+                if (_e84 < 2u) {
                 } else {
                     break;
                 }
                 {
-                    let _e88 = q;
-                    let _e90 = q;
-                    let _e92 = acc[_e90];
-                    let _e96 = q;
-                    let _e97 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e81, _e96);
-                    acc[_e88] = ((_e92 * (1f - blend)) + (_e97 * blend));
-                    let _e100 = i;
-                    let _e101 = q;
-                    let _e102 = filtered_index(_e100, row_4, _e101);
-                    let _e105 = q;
-                    let _e107 = acc[_e105];
-                    let _e108 = encode_layer(_e107);
-                    filtered[_e102] = _e108;
+                    let _e87 = q;
+                    let _e89 = q;
+                    let _e91 = acc[_e89];
+                    let _e95 = q;
+                    let _e96 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e80, _e95);
+                    acc[_e87] = ((_e91 * (1f - blend)) + (_e96 * blend));
+                    let _e99 = i;
+                    let _e100 = q;
+                    let _e101 = filtered_index(_e99, row_5, _e100);
+                    let _e104 = q;
+                    let _e106 = acc[_e104];
+                    let _e107 = encode_layer(_e106);
+                    filtered[_e101] = _e107;
                 }
                 continuing {
-                    let _e110 = q;
-                    q = (_e110 + 1u);
+                    let _e109 = q;
+                    q = (_e109 + 1u);
                 }
             }
         }
         continuing {
-            let _e113 = i;
-            i = (_e113 + 1u);
+            let _e112 = i;
+            i = (_e112 + 1u);
         }
     }
     return;

@@ -65,7 +65,7 @@ Texture2D<float4> depth : register(t2);
 Texture2D<float4> shadow_map : register(t3);
 ByteAddressBuffer filtered : register(t4);
 RWTexture2D<float4> output : register(u5);
-Texture2D<float4> bounds : register(t6);
+ByteAddressBuffer bounds : register(t6);
 
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
@@ -88,9 +88,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
 {
     bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_6 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_7 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
     uint y_2 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e36 = sm.Load(int3(uint2(x_6, y_2), int(0)));
+    float4 _e36 = sm.Load(int3(uint2(x_7, y_2), int(0)));
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -169,11 +169,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_7 = (sigma_t * len);
-    if ((x_7 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_7)));
+    float x_8 = (sigma_t * len);
+    if ((x_8 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_8)));
     }
-    return ((1.0 - exp(-(x_7))) / sigma_t);
+    return ((1.0 - exp(-(x_8))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -187,14 +187,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_8 * x_8) * (3.0 - (2.0 * x_8)));
+    float x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_9 * x_9) * (3.0 - (2.0 * x_9)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_9 = (eye + (dir * t));
-    float3 to_x = (x_9 - light_pos);
+    float3 x_10 = (eye + (dir * t));
+    float3 to_x = (x_10 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_1 = sqrt(d2_);
     float3 travel = (to_x / (d_1).xxx);
@@ -530,11 +530,17 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return naga_div(((r * r) * width), (regions * regions));
 }
 
-uint filtered_index(uint x_3, uint row_1, uint layer_1)
+uint bounds_index(uint x_3, uint row_1)
+{
+    uint _e5 = frame.sizes.w;
+    return ((x_3 * _e5) + row_1);
+}
+
+uint filtered_index(uint x_4, uint row_2, uint layer_1)
 {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return ((((layer_1 * _e5) + x_3) * _e12) + row_1);
+    return ((((layer_1 * _e5) + x_4) * _e12) + row_2);
 }
 
 uint2 encode_layer(float4 v_10)
@@ -551,9 +557,9 @@ float4 decode_layer(uint2 w_1)
     return float4(float2(f16tof32(_e1), f16tof32((_e1) >> 16)), float2(f16tof32(_e3), f16tof32((_e3) >> 16)));
 }
 
-float4 filtered_load(uint x_4, uint row_2, uint layer_2)
+float4 filtered_load(uint x_5, uint row_3, uint layer_2)
 {
-    const uint _e3 = filtered_index(x_4, row_2, layer_2);
+    const uint _e3 = filtered_index(x_5, row_3, layer_2);
     uint2 _e6 = asuint(filtered.Load2(_e3*8));
     const float4 _e7 = decode_layer(_e6);
     return _e7;
@@ -563,7 +569,7 @@ float ZeroValuefloat() {
     return (float)0;
 }
 
-float3 scatter_pixel(uint x_5, uint y_1)
+float3 scatter_pixel(uint x_6, uint y_1)
 {
     bool local_2 = (bool)0;
     bool local_3 = (bool)0;
@@ -606,11 +612,11 @@ float3 scatter_pixel(uint x_5, uint y_1)
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
     float3 eye_8 = f_12.eye.xyz;
-    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_5, y_1);
-    float4 _e14 = depth.Load(int3(uint2(x_5, y_1), int(0)));
+    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
+    float4 _e14 = depth.Load(int3(uint2(x_6, y_1), int(0)));
     float s_3 = (min(max(_e14.x, 0.0), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 1e-6));
     float3 color = f_12.light_color.xyz;
-    float3 px = float3((float(x_5) + 0.5), (float(y_1) + 0.5), 0.0);
+    float3 px = float3((float(x_6) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_12.epipole.w;
     if ((f_12.epipole.z > 0.5)) {
         local_2 = (length((px - float3(f_12.epipole.x, f_12.epipole.y, 0.0))) < radius);
@@ -805,8 +811,10 @@ float3 scatter_pixel(uint x_5, uint y_1)
             float fx1_ = (xb1_ - floor(xb1_));
             uint x10_ = naga_f2u32(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
-            float4 lohi0_ = bounds.Load(int3(uint2(x01_, _e118), int(0)));
-            float4 lohi1_ = bounds.Load(int3(uint2(x11_, row1_), int(0)));
+            const uint _e350 = bounds_index(x01_, _e118);
+            float2 lohi0_ = asfloat(bounds.Load2(_e350*8));
+            const uint _e354 = bounds_index(x11_, row1_);
+            float2 lohi1_ = asfloat(bounds.Load2(_e354*8));
             vis0_ = 0.5;
             vis1_ = 0.5;
             float _e362 = d;

@@ -72,7 +72,7 @@ var<storage> filtered: array<vec2<u32>>;
 @group(0) @binding(5) 
 var output: texture_storage_2d<rgba16float,write>;
 @group(0) @binding(6) 
-var bounds: texture_2d<f32>;
+var<storage> bounds: array<vec2<f32>>;
 
 fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
     let q_1 = (p - v.origin.xyz);
@@ -88,9 +88,9 @@ fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMap
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
-    let x_6 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let x_7 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y_2 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e36 = textureLoad(sm, vec2<u32>(x_6, y_2), 0i);
+    let _e36 = textureLoad(sm, vec2<u32>(x_7, y_2), 0i);
     return select(_e36.x, 2f, outside);
 }
 
@@ -161,11 +161,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_7 = (sigma_t * len);
-    if (x_7 < 0.0001f) {
-        return (len * (1f - (0.5f * x_7)));
+    let x_8 = (sigma_t * len);
+    if (x_8 < 0.0001f) {
+        return (len * (1f - (0.5f * x_8)));
     }
-    return ((1f - exp(-(x_7))) / sigma_t);
+    return ((1f - exp(-(x_8))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -177,13 +177,13 @@ fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inne
     if ((cos_inner - cos_outer) <= 0.000001f) {
         return select(0f, 1f, (cos_angle >= cos_outer));
     }
-    let x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_8 * x_8) * (3f - (2f * x_8)));
+    let x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return ((x_9 * x_9) * (3f - (2f * x_9)));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_9 = (eye + (dir * t));
-    let to_x = (x_9 - light_pos);
+    let x_10 = (eye + (dir * t));
+    let to_x = (x_10 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d_1 = sqrt(d2_);
     let travel = (to_x / vec3(d_1));
@@ -436,10 +436,15 @@ fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions
     return (((r * r) * width) / (regions * regions));
 }
 
-fn filtered_index(x_3: u32, row_1: u32, layer_1: u32) -> u32 {
+fn bounds_index(x_3: u32, row_1: u32) -> u32 {
+    let _e5 = frame.sizes.w;
+    return ((x_3 * _e5) + row_1);
+}
+
+fn filtered_index(x_4: u32, row_2: u32, layer_1: u32) -> u32 {
     let _e5 = frame.sizes.z;
     let _e12 = frame.sizes.w;
-    return ((((layer_1 * _e5) + x_3) * _e12) + row_1);
+    return ((((layer_1 * _e5) + x_4) * _e12) + row_2);
 }
 
 fn encode_layer(v_10: vec4<f32>) -> vec2<u32> {
@@ -450,14 +455,14 @@ fn decode_layer(w_1: vec2<u32>) -> vec4<f32> {
     return vec4<f32>(unpack2x16float(w_1.x), unpack2x16float(w_1.y));
 }
 
-fn filtered_load(x_4: u32, row_2: u32, layer_2: u32) -> vec4<f32> {
-    let _e3 = filtered_index(x_4, row_2, layer_2);
+fn filtered_load(x_5: u32, row_3: u32, layer_2: u32) -> vec4<f32> {
+    let _e3 = filtered_index(x_5, row_3, layer_2);
     let _e6 = filtered[_e3];
     let _e7 = decode_layer(_e6);
     return _e7;
 }
 
-fn scatter_pixel(x_5: u32, y_1: u32) -> vec3<f32> {
+fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var local_2: bool;
     var local_3: bool;
     var local_4: bool;
@@ -499,11 +504,11 @@ fn scatter_pixel(x_5: u32, y_1: u32) -> vec3<f32> {
 
     let f_12 = frame;
     let eye_8 = f_12.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_5, y_1);
-    let _e14 = textureLoad(depth, vec2<u32>(x_5, y_1), 0i);
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
+    let _e14 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
     let s_3 = (min(max(_e14.x, 0f), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 0.000001f));
     let color = f_12.light_color.xyz;
-    let px = vec3<f32>((f32(x_5) + 0.5f), (f32(y_1) + 0.5f), 0f);
+    let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f), 0f);
     let radius = f_12.epipole.w;
     if (f_12.epipole.z > 0.5f) {
         local_2 = (length((px - vec3<f32>(f_12.epipole.x, f_12.epipole.y, 0f))) < radius);
@@ -684,8 +689,10 @@ fn scatter_pixel(x_5: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let lohi0_ = textureLoad(bounds, vec2<u32>(x01_, _e118), 0i);
-            let lohi1_ = textureLoad(bounds, vec2<u32>(x11_, row1_), 0i);
+            let _e350 = bounds_index(x01_, _e118);
+            let lohi0_ = bounds[_e350];
+            let _e354 = bounds_index(x11_, row1_);
+            let lohi1_ = bounds[_e354];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
             let _e362 = d;

@@ -72,7 +72,7 @@ layout(std430, binding = 4) readonly buffer type_10_block_2Compute { uint _group
 
 layout(binding = 5,rgba16f) writeonly uniform image2D _group_0_binding_5_cs;
 
-layout(binding = 6) uniform sampler2D _group_0_binding_6_cs;
+layout(std430, binding = 6) readonly buffer type_12_block_3Compute { vec2 _group_0_binding_6_cs[]; };
 
 
 vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
@@ -89,10 +89,10 @@ vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapVie
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
     bool outside = ((((uv.x < 0.0) || (uv.x > 1.0)) || (uv.y < 0.0)) || (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_6 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_7 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
     uint y_2 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_6, y_2)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_7, y_2)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -163,11 +163,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_7 = (sigma_t * len);
-    if ((x_7 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_7)));
+    float x_8 = (sigma_t * len);
+    if ((x_8 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_8)));
     }
-    return ((1.0 - exp(-(x_7))) / sigma_t);
+    return ((1.0 - exp(-(x_8))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -179,13 +179,13 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_8 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_8 * x_8) * (3.0 - (2.0 * x_8)));
+    float x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_9 * x_9) * (3.0 - (2.0 * x_9)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_9 = (eye + (dir * t));
-    vec3 to_x = (x_9 - light_pos);
+    vec3 x_10 = (eye + (dir * t));
+    vec3 to_x = (x_10 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_1 = sqrt(d2_);
     vec3 travel = (to_x / vec3(d_1));
@@ -440,10 +440,15 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return (((r * r) * width) / (regions * regions));
 }
 
-uint filtered_index(uint x_3, uint row_1, uint layer_1) {
+uint bounds_index(uint x_3, uint row_1) {
+    uint _e5 = _group_0_binding_0_cs.sizes.w;
+    return ((x_3 * _e5) + row_1);
+}
+
+uint filtered_index(uint x_4, uint row_2, uint layer_1) {
     uint _e5 = _group_0_binding_0_cs.sizes.z;
     uint _e12 = _group_0_binding_0_cs.sizes.w;
-    return ((((layer_1 * _e5) + x_3) * _e12) + row_1);
+    return ((((layer_1 * _e5) + x_4) * _e12) + row_2);
 }
 
 uint encode_layer(vec4 v_10) {
@@ -454,14 +459,14 @@ vec4 decode_layer(uint w_1) {
     return unpackUnorm4x8(w_1);
 }
 
-vec4 filtered_load(uint x_4, uint row_2, uint layer_2) {
-    uint _e3 = filtered_index(x_4, row_2, layer_2);
+vec4 filtered_load(uint x_5, uint row_3, uint layer_2) {
+    uint _e3 = filtered_index(x_5, row_3, layer_2);
     uint _e6 = _group_0_binding_4_cs[_e3];
     vec4 _e7 = decode_layer(_e6);
     return _e7;
 }
 
-vec3 scatter_pixel(uint x_5, uint y_1) {
+vec3 scatter_pixel(uint x_6, uint y_1) {
     bool local_2 = false;
     bool local_3 = false;
     bool local_4 = false;
@@ -502,12 +507,12 @@ vec3 scatter_pixel(uint x_5, uint y_1) {
     bool local_12 = false;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = _group_0_binding_0_cs;
     vec3 eye_8 = f_12.eye.xyz;
-    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_5, y_1);
+    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
     int _e14_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-    vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_5, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
+    vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
     float s_3 = (min(max(_e14.x, 0.0), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 1e-6));
     vec3 color = f_12.light_color.xyz;
-    vec3 px = vec3((float(x_5) + 0.5), (float(y_1) + 0.5), 0.0);
+    vec3 px = vec3((float(x_6) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_12.epipole.w;
     if ((f_12.epipole.z > 0.5)) {
         local_2 = (length((px - vec3(f_12.epipole.x, f_12.epipole.y, 0.0))) < radius);
@@ -696,10 +701,10 @@ vec3 scatter_pixel(uint x_5, uint y_1) {
             float fx1_ = (xb1_ - floor(xb1_));
             uint x10_ = uint(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
-            int _e353_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 lohi0_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x01_, _e118)), ivec2(0), textureSize(_group_0_binding_6_cs, _e353_clamped_lod) - ivec2(1)), _e353_clamped_lod);
-            int _e357_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_6_cs) - 1);
-            vec4 lohi1_ = texelFetch(_group_0_binding_6_cs, clamp(ivec2(uvec2(x11_, row1_)), ivec2(0), textureSize(_group_0_binding_6_cs, _e357_clamped_lod) - ivec2(1)), _e357_clamped_lod);
+            uint _e350 = bounds_index(x01_, _e118);
+            vec2 lohi0_ = _group_0_binding_6_cs[_e350];
+            uint _e354 = bounds_index(x11_, row1_);
+            vec2 lohi1_ = _group_0_binding_6_cs[_e354];
             vis0_ = 0.5;
             vis1_ = 0.5;
             float _e362 = d;

@@ -9,6 +9,7 @@ using metal::uint;
 struct _mslBufferSizes {
     uint size1;
     uint size4;
+    uint size6;
 };
 
 struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
@@ -60,7 +61,8 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
 };
 typedef metal::float4 type_9[1];
 typedef uint type_10[1];
-struct type_12 {
+typedef metal::float2 type_12[1];
+struct type_13 {
     metal::float4 inner[8];
 };
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
@@ -99,10 +101,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
-    uint x_6 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_7 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y_2 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_6, y_2)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_7, y_2)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
@@ -200,11 +202,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_7 = sigma_t * len;
-    if (x_7 < 0.0001) {
-        return len * (1.0 - (0.5 * x_7));
+    float x_8 = sigma_t * len;
+    if (x_8 < 0.0001) {
+        return len * (1.0 - (0.5 * x_8));
     }
-    return (1.0 - metal::exp(-(x_7))) / sigma_t;
+    return (1.0 - metal::exp(-(x_8))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -224,8 +226,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     if ((cos_inner - cos_outer) <= 0.000001) {
         return (cos_angle >= cos_outer) ? 1.0 : 0.0;
     }
-    float x_8 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_8 * x_8) * (3.0 - (2.0 * x_8));
+    float x_9 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return (x_9 * x_9) * (3.0 - (2.0 * x_9));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -238,8 +240,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_9 = eye + (dir * t);
-    metal::float3 to_x = x_9 - light_pos;
+    metal::float3 x_10 = eye + (dir * t);
+    metal::float3 to_x = x_10 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_1 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_1);
@@ -625,15 +627,24 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     return naga_div((r * r) * width, regions * regions);
 }
 
-uint filtered_index(
+uint bounds_index(
     uint x_3,
     uint row_1,
+    constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
+) {
+    uint _e5 = frame.sizes.w;
+    return (x_3 * _e5) + row_1;
+}
+
+uint filtered_index(
+    uint x_4,
+    uint row_2,
     uint layer_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return (((layer_1 * _e5) + x_3) * _e12) + row_1;
+    return (((layer_1 * _e5) + x_4) * _e12) + row_2;
 }
 
 uint encode_layer(
@@ -649,28 +660,28 @@ metal::float4 decode_layer(
 }
 
 metal::float4 filtered_load(
-    uint x_4,
-    uint row_2,
+    uint x_5,
+    uint row_3,
     uint layer_2,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_10 const& filtered,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    uint _e3 = filtered_index(x_4, row_2, layer_2, frame);
+    uint _e3 = filtered_index(x_5, row_3, layer_2, frame);
     uint _e6 = filtered[metal::min(unsigned(_e3), (_buffer_sizes.size4 - 0 - 4) / 4)];
     metal::float4 _e7 = decode_layer(_e6);
     return _e7;
 }
 
 metal::float3 scatter_pixel(
-    uint x_5,
+    uint x_6,
     uint y_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_9 const& slices,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::sample> shadow_map,
     device type_10 const& filtered,
-    metal::texture2d<float, metal::access::sample> bounds,
+    device type_12 const& bounds,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     bool local_2 = {};
@@ -681,7 +692,7 @@ metal::float3 scatter_pixel(
     float xs = 0.0;
     float reach = 0.0;
     float theta_3 = 0.0;
-    type_12 coeffs = {};
+    type_13 coeffs = {};
     metal::float2 angle = {};
     uint layer_3 = 0u;
     float delta0_ = 1.0;
@@ -713,12 +724,12 @@ metal::float3 scatter_pixel(
     bool local_12 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
     metal::float3 eye_8 = f_12.eye.xyz;
-    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_5, y_1);
+    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
     uint clamped_lod_e14 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
+    metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
     float s_3 = metal::min(metal::max(_e14.x, 0.0), f_12.theta.z) / metal::max(metal::dot(_e10, f_12.cam_forward.xyz), 0.000001);
     metal::float3 color = f_12.light_color.xyz;
-    metal::float3 px = metal::float3(static_cast<float>(x_5) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
+    metal::float3 px = metal::float3(static_cast<float>(x_6) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
     float radius = f_12.epipole.w;
     if (f_12.epipole.z > 0.5) {
         local_2 = metal::length(px - metal::float3(f_12.epipole.x, f_12.epipole.y, 0.0)) < radius;
@@ -913,10 +924,10 @@ metal::float3 scatter_pixel(
             float fx1_ = xb1_ - metal::floor(xb1_);
             uint x10_ = naga_f2u32(metal::clamp(metal::floor(xb1_), 0.0, static_cast<float>(width_1) - 1.0));
             uint x11_ = (xb1_ > metal::floor(xb1_)) ? metal::min(x10_ + 1u, width_1 - 1u) : x10_;
-            uint clamped_lod_e353 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 lohi0_ = bounds.read(metal::min(metal::uint2(metal::uint2(x01_, _e118)), metal::uint2(bounds.get_width(clamped_lod_e353), bounds.get_height(clamped_lod_e353)) - 1), clamped_lod_e353);
-            uint clamped_lod_e357 = metal::min(uint(0), bounds.get_num_mip_levels() - 1);
-            metal::float4 lohi1_ = bounds.read(metal::min(metal::uint2(metal::uint2(x11_, row1_)), metal::uint2(bounds.get_width(clamped_lod_e357), bounds.get_height(clamped_lod_e357)) - 1), clamped_lod_e357);
+            uint _e350 = bounds_index(x01_, _e118, frame);
+            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e350), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint _e354 = bounds_index(x11_, row1_, frame);
+            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e354), (_buffer_sizes.size6 - 0 - 8) / 8)];
             vis0_ = 0.5;
             vis1_ = 0.5;
             float _e362 = d;
@@ -1069,8 +1080,8 @@ kernel void scatter(
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
 , device type_10 const& filtered [[buffer(2)]]
 , metal::texture2d<float, metal::access::write> output [[texture(2)]]
-, metal::texture2d<float, metal::access::sample> bounds [[texture(3)]]
-, constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
+, device type_12 const& bounds [[buffer(3)]]
+, constant _mslBufferSizes& _buffer_sizes [[buffer(4)]]
 ) {
     bool local = {};
     uint _e5 = frame.sizes.x;

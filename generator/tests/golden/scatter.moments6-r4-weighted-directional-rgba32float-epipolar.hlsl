@@ -72,7 +72,7 @@ Texture2D<float4> depth : register(t2);
 Texture2D<float4> shadow_map : register(t3);
 ByteAddressBuffer filtered : register(t4);
 RWTexture2D<float4> output : register(u5);
-Texture2D<float4> bounds : register(t6);
+ByteAddressBuffer bounds : register(t6);
 
 float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
@@ -95,9 +95,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
 {
     bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_9 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_10 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
     uint y_2 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e36 = sm.Load(int3(uint2(x_9, y_2), int(0)));
+    float4 _e36 = sm.Load(int3(uint2(x_10, y_2), int(0)));
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -176,11 +176,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_10 = (sigma_t * len);
-    if ((x_10 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_10)));
+    float x_11 = (sigma_t * len);
+    if ((x_11 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_11)));
     }
-    return ((1.0 - exp(-(x_10))) / sigma_t);
+    return ((1.0 - exp(-(x_11))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -194,14 +194,14 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, floa
     if (((cos_inner - cos_outer) <= 1e-6)) {
         return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
     }
-    float x_11 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_11 * x_11) * (3.0 - (2.0 * x_11)));
+    float x_12 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return ((x_12 * x_12) * (3.0 - (2.0 * x_12)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_12 = (eye + (dir * t));
-    float3 to_x = (x_12 - light_pos);
+    float3 x_13 = (eye + (dir * t));
+    float3 to_x = (x_13 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_2 = sqrt(d2_);
     float3 travel = (to_x / (d_2).xxx);
@@ -679,11 +679,17 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return naga_div(((r * r) * width), (regions * regions));
 }
 
-uint filtered_index(uint x_6, uint row_1, uint layer)
+uint bounds_index(uint x_6, uint row_1)
+{
+    uint _e5 = frame.sizes.w;
+    return ((x_6 * _e5) + row_1);
+}
+
+uint filtered_index(uint x_7, uint row_2, uint layer)
 {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return ((((layer * _e5) + x_6) * _e12) + row_1);
+    return ((((layer * _e5) + x_7) * _e12) + row_2);
 }
 
 float4 encode_layer(float4 v_11)
@@ -696,9 +702,9 @@ float4 decode_layer(float4 w_1)
     return w_1;
 }
 
-float4 filtered_load(uint x_7, uint row_2, uint layer_1)
+float4 filtered_load(uint x_8, uint row_3, uint layer_1)
 {
-    const uint _e3 = filtered_index(x_7, row_2, layer_1);
+    const uint _e3 = filtered_index(x_8, row_3, layer_1);
     float4 _e6 = asfloat(filtered.Load4(_e3*16));
     const float4 _e7 = decode_layer(_e6);
     return _e7;
@@ -708,7 +714,7 @@ float ZeroValuefloat() {
     return (float)0;
 }
 
-float3 scatter_pixel(uint x_8, uint y_1)
+float3 scatter_pixel(uint x_9, uint y_1)
 {
     bool local_3 = (bool)0;
     bool local_4 = (bool)0;
@@ -745,11 +751,11 @@ float3 scatter_pixel(uint x_8, uint y_1)
 
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
     float3 eye_8 = f_13.eye.xyz;
-    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_8, y_1);
-    float4 _e14 = depth.Load(int3(uint2(x_8, y_1), int(0)));
+    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_9, y_1);
+    float4 _e14 = depth.Load(int3(uint2(x_9, y_1), int(0)));
     float s_5 = (min(max(_e14.x, 0.0), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 1e-6));
     float3 color = f_13.light_color.xyz;
-    float3 px = float3((float(x_8) + 0.5), (float(y_1) + 0.5), 0.0);
+    float3 px = float3((float(x_9) + 0.5), (float(y_1) + 0.5), 0.0);
     float radius = f_13.epipole.w;
     if ((f_13.epipole.z > 0.5)) {
         local_3 = (length((px - float3(f_13.epipole.x, f_13.epipole.y, 0.0))) < radius);
@@ -914,8 +920,10 @@ float3 scatter_pixel(uint x_8, uint y_1)
             float fx1_ = (xb1_ - floor(xb1_));
             uint x10_ = naga_f2u32(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
-            float4 lohi0_ = bounds.Load(int3(uint2(x01_, _e118), int(0)));
-            float4 lohi1_ = bounds.Load(int3(uint2(x11_, row1_), int(0)));
+            const uint _e324 = bounds_index(x01_, _e118);
+            float2 lohi0_ = asfloat(bounds.Load2(_e324*8));
+            const uint _e328 = bounds_index(x11_, row1_);
+            float2 lohi1_ = asfloat(bounds.Load2(_e328*8));
             vis0_ = 0.5;
             vis1_ = 0.5;
             float _e336 = d_1;

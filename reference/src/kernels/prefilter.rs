@@ -12,7 +12,7 @@
 //! stores the least and the greatest depth over the region up to the texel (`bounds`,
 //! rg32float on the GPU; here a one-layer array of `[min, max, 0, 0]`).
 //!
-//! The GPU's `filtered` is a storage buffer (`include/filtered_layers.wgsl`: element
+//! The GPU's `filtered` is a storage buffer (`include/prefiltered_buffers.wgsl`: element
 //! `(layer * Wr + x) * Hr + row`, each the bits of one storage-format texel, packed with the
 //! rounding a texture store of that format does); here it is the layer-major [`TexArray`] the
 //! runtime's readback reorders it into, and `store` quantises as the packing does.

@@ -59,7 +59,7 @@ struct RectifyTemplate {
 }
 
 /// The WGSL element of the `filtered` storage buffer for a storage format: one layer of one
-/// rectified texel, the bits of one texel of that format (`include/filtered_layers.wgsl`).
+/// rectified texel, the bits of one texel of that format (`include/prefiltered_buffers.wgsl`).
 pub const fn filtered_word(storage: Storage) -> &'static str {
     match storage {
         Storage::Rgba8unorm => "u32",

@@ -24,9 +24,10 @@ pub const PROJECTIVE_FRAME: &str = "frame.proj.x > 0.5 (a projective frame)";
 pub const PROJECTIVE_WITHOUT_SHADOW_MAP: &str = "the frame is projective and the engine has no \
                                                  standard shadow map (the binding is not read \
                                                  then)";
-/// Format of the region-prefix depth bounds written by `prefilter` (r = min, g = max):
-/// 32-bit, so that the bound tests compare the very depths the filter saw.
-pub const BOUNDS_FORMAT: &str = "rg32float";
+/// Elements of the region-prefix depth bounds written by `prefilter`: one `vec2<f32>` (min,
+/// max) per rectified texel, 32-bit so that the bound tests compare the very depths the filter
+/// saw.
+pub const BOUNDS_ELEMENTS: &str = "rectified.width * rectified.height";
 /// The engine's rasterised rectified map of projective variants.
 pub const RECTIFIED_RASTER: &str = "rectified_raster";
 
@@ -84,16 +85,22 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
             }),
             ..scatter_resource("filtered", filtered_description(v))
         },
-        scatter_texture(
-            "bounds",
-            "per texel, the least and the greatest rectified depth over its region's prefix \
-             up to the texel (min, max), written by prefilter beside the filtered bases: \
-             scatter takes a region as wholly lit (ray depth <= min) or wholly shadowed \
-             (> max) without its Fourier estimate, so no light rings where none can arrive",
-            BOUNDS_FORMAT,
-            "rectified.width",
-            "rectified.height",
-        ),
+        Resource {
+            kind: "storage_buffer",
+            buffer: Some(BufferDesc {
+                elements: Some(BOUNDS_ELEMENTS.to_owned()),
+                usage: vec!["storage", "copy_src"],
+            }),
+            ..scatter_resource(
+                "bounds",
+                "per texel, the least and the greatest rectified depth over its region's \
+                 prefix up to the texel (min, max), written by prefilter beside the filtered \
+                 bases: scatter takes a region as wholly lit (ray depth <= min) or wholly \
+                 shadowed (> max) without its Fourier estimate, so no light rings where none \
+                 can arrive; a storage buffer of vec2<f32>, texel (x, row) at element x * \
+                 rectified.height + row (column-major, as filtered's layers)",
+            )
+        },
         scatter_texture(
             "output",
             "in-scattered radiance, rgb, alpha 1 (written by scatter); add it to the \

@@ -14,6 +14,15 @@
 // against 40-49). Column-major puts the rows `prefilter`'s SIMD lanes filter side by side
 // (40-41 ms; row-major 41-42); a texel's layers side by side instead made the invocations
 // that filter one texel's other layers share its cache lines (63-113 ms).
+
+// The index in `bounds` of rectified texel (x, row): column-major as `filtered`'s layers.
+// A storage buffer of vec2<f32> in place of an rg32float texture: `scatter` 68.5-93.5 ms
+// against 75.7-99.4 (m32-r4 per pixel, the three scenes, binaries alternated), its lowres 2
+// samples pass 25-34 against 30-38 (m32-r8); `prefilter` unchanged.
+fn bounds_index(x: u32, row: u32) -> u32 {
+    return x * frame.sizes[3] + row;
+}
+
 // The index in `filtered` of layer `layer` of rectified texel (x, row).
 fn filtered_index(x: u32, row: u32, layer: u32) -> u32 {
     return (layer * frame.sizes[2] + x) * frame.sizes[3] + row;
