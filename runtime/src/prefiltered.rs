@@ -25,7 +25,7 @@ use scatter_shaderlib::prefiltered::plan;
 use scatter_shaderlib::prefiltered::{
     CameraDesc, FrameReport, FrameSettings, FrameUniforms, LightDesc, MediumDesc, PrefilteredFrame,
     PrefilteredVariant, Rectification, Resolutions, ShadowMapDesc, SliceParams, Storage,
-    filtered_word_bytes, prepare_frame,
+    filtered_column_major, filtered_word_bytes, prepare_frame,
 };
 
 use crate::error::{ErrorScopes, check_limit};
@@ -553,8 +553,9 @@ impl Prefiltered {
 
     /// The filtered bases (written by `prefilter`): a storage buffer of
     /// [`PrefilteredVariant::filtered_layers`] layers of `Wr x Hr` texels, layer `q` of texel
-    /// `(x, y)` at element `(q * Wr + x) * Hr + y`, each element the bits of one texel of the
-    /// variant's storage format (Fourier bases as `F / 2 + 0.5` in [0, 1]).
+    /// `(x, y)` at element `(q * Wr + x) * Hr + y` (rgba32float: `(q * Hr + y) * Wr + x`,
+    /// `scatter_shaderlib::prefiltered::filtered_column_major`), each element the bits of one
+    /// texel of the variant's storage format (Fourier bases as `F / 2 + 0.5` in [0, 1]).
     pub fn filtered_buffer(&self) -> &wgpu::Buffer {
         &self.filtered
     }
@@ -745,8 +746,8 @@ pub fn run_prefiltered_once(
     })
 }
 
-/// The `filtered` buffer's bytes (element `(layer * Wr + x) * Hr + y`: column-major layers)
-/// decoded and reordered row-major, `(layer * Hr + y) * Wr + x`, as
+/// The `filtered` buffer's bytes (element `(layer * Wr + x) * Hr + y`, column-major layers, or
+/// row-major for rgba32float: `filtered_column_major`) decoded and reordered row-major, `(layer * Hr + y) * Wr + x`, as
 /// [`PrefilteredReadback::filtered`] documents.
 fn filtered_layer_major(
     bytes: &[u8],
@@ -757,11 +758,18 @@ fn filtered_layer_major(
     let (wr, hr) = (wr as usize, hr as usize);
     let layers = variant.filtered_layers() as usize;
     let mut out = vec![[0.0; 4]; wr * hr * layers];
-    // Element (layer * Wr + x) * Hr + y of the buffer.
+    let column_major = filtered_column_major(variant.storage);
     for (i, bits) in bytes.chunks_exact(word).take(out.len()).enumerate() {
-        let (layer_x, y) = (i / hr, i % hr);
-        let (layer, x) = (layer_x / wr, layer_x % wr);
-        out[(layer * hr + y) * wr + x] = decode_rgba(bits, variant.storage);
+        let texel = decode_rgba(bits, variant.storage);
+        if column_major {
+            // Element (layer * Wr + x) * Hr + y.
+            let (layer_x, y) = (i / hr, i % hr);
+            let (layer, x) = (layer_x / wr, layer_x % wr);
+            out[(layer * hr + y) * wr + x] = texel;
+        } else {
+            // Row-major already: element (layer * Hr + y) * Wr + x.
+            out[i] = texel;
+        }
     }
     out
 }

@@ -338,9 +338,9 @@ uint bounds_index(uint x_2, uint row_2) {
 }
 
 uint filtered_index(uint x_3, uint row_3, uint layer_1) {
-    uint _e5 = _group_0_binding_0_cs.sizes.z;
-    uint _e12 = _group_0_binding_0_cs.sizes.w;
-    return ((((layer_1 * _e5) + x_3) * _e12) + row_3);
+    uint _e5 = _group_0_binding_0_cs.sizes.w;
+    uint _e12 = _group_0_binding_0_cs.sizes.z;
+    return ((((layer_1 * _e5) + row_3) * _e12) + x_3);
 }
 
 vec4 encode_layer(vec4 v_10) {

@@ -395,9 +395,9 @@ uint bounds_index(uint x_2, uint row_2)
 
 uint filtered_index(uint x_3, uint row_3, uint layer_1)
 {
-    uint _e5 = frame.sizes.z;
-    uint _e12 = frame.sizes.w;
-    return ((((layer_1 * _e5) + x_3) * _e12) + row_3);
+    uint _e5 = frame.sizes.w;
+    uint _e12 = frame.sizes.z;
+    return ((((layer_1 * _e5) + row_3) * _e12) + x_3);
 }
 
 float4 encode_layer(float4 v_10)

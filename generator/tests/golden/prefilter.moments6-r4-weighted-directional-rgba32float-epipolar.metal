@@ -467,9 +467,9 @@ uint filtered_index(
     uint layer_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
-    uint _e5 = frame.sizes.z;
-    uint _e12 = frame.sizes.w;
-    return (((layer_1 * _e5) + x_3) * _e12) + row_3;
+    uint _e5 = frame.sizes.w;
+    uint _e12 = frame.sizes.z;
+    return (((layer_1 * _e5) + row_3) * _e12) + x_3;
 }
 
 metal::float4 encode_layer(

@@ -335,9 +335,9 @@ fn bounds_index(x_2: u32, row_2: u32) -> u32 {
 }
 
 fn filtered_index(x_3: u32, row_3: u32, layer_1: u32) -> u32 {
-    let _e5 = frame.sizes.z;
-    let _e12 = frame.sizes.w;
-    return ((((layer_1 * _e5) + x_3) * _e12) + row_3);
+    let _e5 = frame.sizes.w;
+    let _e12 = frame.sizes.z;
+    return ((((layer_1 * _e5) + row_3) * _e12) + x_3);
 }
 
 fn encode_layer(v_10: vec4<f32>) -> vec4<f32> {

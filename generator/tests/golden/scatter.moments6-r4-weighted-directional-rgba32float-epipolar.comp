@@ -576,9 +576,9 @@ uint bounds_index(uint x_6, uint row_1) {
 }
 
 uint filtered_index(uint x_7, uint row_2, uint layer) {
-    uint _e5 = _group_0_binding_0_cs.sizes.z;
-    uint _e12 = _group_0_binding_0_cs.sizes.w;
-    return ((((layer * _e5) + x_7) * _e12) + row_2);
+    uint _e5 = _group_0_binding_0_cs.sizes.w;
+    uint _e12 = _group_0_binding_0_cs.sizes.z;
+    return ((((layer * _e5) + row_2) * _e12) + x_7);
 }
 
 vec4 encode_layer(vec4 v_11) {

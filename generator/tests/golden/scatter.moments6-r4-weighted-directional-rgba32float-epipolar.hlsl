@@ -687,9 +687,9 @@ uint bounds_index(uint x_6, uint row_1)
 
 uint filtered_index(uint x_7, uint row_2, uint layer)
 {
-    uint _e5 = frame.sizes.z;
-    uint _e12 = frame.sizes.w;
-    return ((((layer * _e5) + x_7) * _e12) + row_2);
+    uint _e5 = frame.sizes.w;
+    uint _e12 = frame.sizes.z;
+    return ((((layer * _e5) + row_2) * _e12) + x_7);
 }
 
 float4 encode_layer(float4 v_11)

@@ -792,9 +792,9 @@ uint filtered_index(
     uint layer,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
-    uint _e5 = frame.sizes.z;
-    uint _e12 = frame.sizes.w;
-    return (((layer * _e5) + x_7) * _e12) + row_2;
+    uint _e5 = frame.sizes.w;
+    uint _e12 = frame.sizes.z;
+    return (((layer * _e5) + row_2) * _e12) + x_7;
 }
 
 metal::float4 encode_layer(

@@ -573,9 +573,9 @@ fn bounds_index(x_6: u32, row_1: u32) -> u32 {
 }
 
 fn filtered_index(x_7: u32, row_2: u32, layer: u32) -> u32 {
-    let _e5 = frame.sizes.z;
-    let _e12 = frame.sizes.w;
-    return ((((layer * _e5) + x_7) * _e12) + row_2);
+    let _e5 = frame.sizes.w;
+    let _e12 = frame.sizes.z;
+    return ((((layer * _e5) + row_2) * _e12) + x_7);
 }
 
 fn encode_layer(v_11: vec4<f32>) -> vec4<f32> {

@@ -13,9 +13,10 @@
 //! rg32float on the GPU; here a one-layer array of `[min, max, 0, 0]`).
 //!
 //! The GPU's `filtered` is a storage buffer (`include/prefiltered_buffers.wgsl`: element
-//! `(layer * Wr + x) * Hr + row`, each the bits of one storage-format texel, packed with the
-//! rounding a texture store of that format does); here it is the layer-major [`TexArray`] the
-//! runtime's readback reorders it into, and `store` quantises as the packing does.
+//! `(layer * Wr + x) * Hr + row`, rgba32float `(layer * Hr + row) * Wr + x`, each the bits of
+//! one storage-format texel, packed with the rounding a texture store of that format does);
+//! here it is the layer-major [`TexArray`] the runtime's readback reorders it into, and
+//! `store` quantises as the packing does.
 //!
 //! With a cookie (`cookie = true`, see the WGSL comment) each texel's light ray carries the
 //! cookie `C_i` ([`texel_cookie`]): per channel `c` the running means of `C_i^c` times the

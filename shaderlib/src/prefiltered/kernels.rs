@@ -68,6 +68,14 @@ pub const fn filtered_word(storage: Storage) -> &'static str {
     }
 }
 
+/// Whether the `filtered` storage buffer holds each layer column-major (element
+/// `(layer * Wr + x) * Hr + row`: 4- and 8-byte elements, `prefilter`'s lanes, one row each,
+/// store side by side) or row-major (`(layer * Hr + row) * Wr + x`: rgba32float, whose
+/// 16-byte elements `prefilter` stored twice as slowly column-major on lavapipe).
+pub const fn filtered_column_major(storage: Storage) -> bool {
+    !matches!(storage, Storage::Rgba32float)
+}
+
 /// Bytes of one layer of one rectified texel in the `filtered` storage buffer.
 pub const fn filtered_word_bytes(storage: Storage) -> u32 {
     match storage {

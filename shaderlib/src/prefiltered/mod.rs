@@ -15,8 +15,8 @@ pub use frame::{
 };
 pub use kernels::{
     DEPTH_COLUMNS_WORKGROUP_SIZE, MAX_REGIONS, PREFILTER_WORKGROUP_SIZE, RECTIFY_TEXELS,
-    RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE, SLICE_FIT_WORKGROUP_SIZE, filtered_word,
-    filtered_word_bytes,
+    RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE, SLICE_FIT_WORKGROUP_SIZE,
+    filtered_column_major, filtered_word, filtered_word_bytes,
 };
 pub use variant::{
     Basis, LightKind, PrefilteredVariant, Rectification, Storage, VariantError, VisibilityMode,

@@ -190,7 +190,8 @@ macro_rules! filtered_layout {
     () => {
         "; a storage buffer, layer q of rectified texel (x, row) at element (q * \
          rectified.width + x) * rectified.height + row (column-major layers: prefilter's \
-         invocations, one per row, store side by side), each element the bits of one texel \
+         invocations, one per row, store side by side; rgba32float row-major, (q * \
+         rectified.height + row) * rectified.width + x), each element the bits of one texel \
          of the storage format (rgba8unorm: a u32 from pack4x8unorm; rgba16float: two u32 from \
          pack2x16float; rgba32float: four f32)"
     };

@@ -1,7 +1,7 @@
 
-// `filtered` is a storage buffer, layer-major and column-major within a layer: layer q of
-// rectified texel (x, row) at (q * Wr + x) * Hr + row, each element one {{ storage }}
-// texel's bits
+// `filtered` is a storage buffer, layer-major and, for 4- and 8-byte elements, column-major
+// within a layer: layer q of rectified texel (x, row) at (q * Wr + x) * Hr + row (rgba32float:
+// row-major, (q * Hr + row) * Wr + x), each element one {{ storage }} texel's bits
 {%- if storage == "rgba8unorm" %}
 // (pack4x8unorm: the rounding an rgba8unorm texture store does).
 {%- elif storage == "rgba16float" %}
@@ -13,7 +13,10 @@
 // 74-97 ms against 83-125 ms from an rgba texture array, `prefilter` unchanged (40-41 ms
 // against 40-49). Column-major puts the rows `prefilter`'s SIMD lanes filter side by side
 // (40-41 ms; row-major 41-42); a texel's layers side by side instead made the invocations
-// that filter one texel's other layers share its cache lines (63-113 ms).
+// that filter one texel's other layers share its cache lines (63-113 ms). For 16-byte
+// rgba32float elements column-major was the slower one: the moment basis's `prefilter` took
+// 19.3-22.1 ms column-major against 9.7-10.6 row-major (its `scatter` 57-61 against 58-65;
+// m32-r4's rgba8unorm `scatter` 68-91 column-major against 70-97 row-major).
 
 // The index in `bounds` of rectified texel (x, row): column-major as `filtered`'s layers.
 // A storage buffer of vec2<f32> in place of an rg32float texture: `scatter` 68.5-93.5 ms
@@ -25,7 +28,11 @@ fn bounds_index(x: u32, row: u32) -> u32 {
 
 // The index in `filtered` of layer `layer` of rectified texel (x, row).
 fn filtered_index(x: u32, row: u32, layer: u32) -> u32 {
+{%- if storage == "rgba32float" %}
+    return (layer * frame.sizes[3] + row) * frame.sizes[2] + x;
+{%- else %}
     return (layer * frame.sizes[2] + x) * frame.sizes[3] + row;
+{%- endif %}
 }
 {%- if storage == "rgba8unorm" %}
 
