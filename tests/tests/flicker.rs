@@ -31,6 +31,8 @@
 //!
 //! 64x36 pixels, 256x256 rectified map, 512^2 shadow map, truth with 512 cells per ray:
 //! small enough for CI (75 s here in the test profile with a warm Mesa cache).
+//! With `SCATTER_FULL=1` the prefiltered and minmax defaults are reported sampled too (lowres
+//! 4 and epipolar 64 x 64, NaN-checked; issue 14's flicker rows for its three families).
 //! `SCATTER_FLICKER_SCENE=foliage` runs one scene. `cargo test --release -p
 //! scatter-conformance --test flicker -- --nocapture` prints the table of the closing note.
 
@@ -94,11 +96,20 @@ const SAMPLES: [u32; 4] = [32, 64, 128, 256];
 /// the table, not asserted (leaving them out saved no measurable time with a cold Mesa cache,
 /// 694 s against 713 s for the file; the passes created per scene were that cost, below).
 fn samples() -> Vec<u32> {
-    if std::env::var("SCATTER_FULL").is_ok_and(|v| v == "1") {
+    if full() {
         SAMPLES.to_vec()
     } else {
         vec![EQUAL_TIME_SAMPLES]
     }
+}
+
+/// Whether `SCATTER_FULL=1` asks for the context columns too: raymarch at every
+/// [`SAMPLES`], and the prefiltered and minmax defaults sampled (lowres at
+/// [`SAMPLED_SCALE`] and [`epipolar_knobs`]; issue 14's flicker rows for each of its three
+/// families, reported and NaN-checked; each sampled column costs CI a minute or two of
+/// shader compilation with a cold Mesa cache, so CI runs raymarch's only).
+fn full() -> bool {
+    std::env::var("SCATTER_FULL").is_ok_and(|v| v == "1")
 }
 
 /// The variants reported, in column order: the prefiltered default, the moment basis (6
@@ -159,6 +170,20 @@ fn variants(light: LightKind) -> Vec<FamilyVariant> {
         light,
         ..HybridVolumeVariant::default()
     }));
+    if full() {
+        let prefiltered = FamilyVariant::Prefiltered(PrefilteredVariant {
+            light,
+            ..PrefilteredVariant::default()
+        });
+        let minmax = FamilyVariant::Minmax(MinmaxVariant {
+            light,
+            ..MinmaxVariant::default()
+        });
+        for base in [prefiltered, minmax] {
+            v.push(base.with_sampling(SamplingKnobs::lowres(SAMPLED_SCALE)));
+            v.push(base.with_sampling(epipolar_knobs()));
+        }
+    }
     v
 }
 
@@ -183,6 +208,12 @@ fn labels() -> Vec<String> {
     l.push("raymarch n64-ep64x64".into());
     l.push("partial_sum_tree r4-ep64x64".into());
     l.push("hybrid_volume n32".into());
+    if full() {
+        for base in ["prefiltered m32-r4", "minmax"] {
+            l.push(format!("{base}-lr{SAMPLED_SCALE}"));
+            l.push(format!("{base}-ep64x64"));
+        }
+    }
     l
 }
 
