@@ -133,17 +133,19 @@ fn wgsl_f32(v: f32) -> String {
 /// `epipolar`, one
 /// workgroup of [`SLICE_LANES`] invocations per slice: `SLICE_LANES * slices` by 1.
 pub fn sampling_invocations(knobs: &SamplingKnobs) -> [String; 3] {
+    sampling_invocations_with_lanes(knobs, SLICE_LANES)
+}
+
+/// [`sampling_invocations`] with `lanes` invocations per slice for `epipolar` (a family
+/// whose samples pass is its own, `pst_sweep`).
+pub fn sampling_invocations_with_lanes(knobs: &SamplingKnobs, lanes: u32) -> [String; 3] {
     match knobs.sampling {
         Sampling::Pixels => ["screen.width".into(), "screen.height".into(), "1".into()],
         Sampling::Lowres => {
             let [w, h] = lowres_grid_formula(knobs.scale);
             [w, h, "1".into()]
         }
-        Sampling::Epipolar => [
-            (SLICE_LANES * knobs.slices).to_string(),
-            "1".into(),
-            "1".into(),
-        ],
+        Sampling::Epipolar => [(lanes * knobs.slices).to_string(), "1".into(), "1".into()],
     }
 }
 
@@ -349,11 +351,18 @@ pub const FALLBACK_PIXELS: &str = "fallback_pixels";
 /// The `_fallback` pass runs one invocation per `FALLBACK_TILE` x `FALLBACK_TILE` pixels.
 pub const FALLBACK_TILE: u32 = 8;
 
-/// Invocations (one workgroup) per slice of the epipolar samples pass. 32 rather than 64:
-/// llvmpipe runs a loop's body at least once for every 8-lane batch, under an empty mask
-/// where the batch has nothing to do, and a slice lists 32-40 samples to evaluate at the
-/// default step (measured: the raymarch n64 samples pass at 1280x720 took 16-19 ms with 64).
-pub const SLICE_LANES: u32 = 32;
+/// Invocations (one workgroup) per slice of the epipolar samples pass: one 8-lane batch of
+/// llvmpipe's (256-bit vectors). llvmpipe runs a loop's body at least once for every 8-lane
+/// batch, under an empty mask where the batch has nothing to do, and the pass has two
+/// evaluation loops, the second usually empty; with one batch per slice no batch idles
+/// through them, and the loops over a slice's samples take as many batch trips as with
+/// more lanes. Measured (stop 44, `bench --headline-only --knobs ..-ep512`, 1280x720,
+/// binaries alternated, medians over 12 runs), the samples pass at 8 / 16 / 32 lanes:
+/// raymarch n64 10.6 / 10.6 / 11.4 ms, prefiltered m32-r4 6.3-6.6 / 7.1-7.3 / 8.2-8.6,
+/// minmax 7.2 / 6.8 / 8.1, hybrid_volume n32 5.9 / 6.6 / 7.8; at 64 the raymarch pass took
+/// 16-19 ms. (`pst_sweep` keeps its own 32, `partial_sum_tree::SWEEP_LANES`: its sweep
+/// spreads a slice's columns and tree steps over the lanes.)
+pub const SLICE_LANES: u32 = 8;
 
 /// The lowres samples texture.
 pub const LOWRES_SAMPLES: &str = "lowres_samples";

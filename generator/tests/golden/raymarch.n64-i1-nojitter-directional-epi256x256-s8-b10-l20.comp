@@ -3,7 +3,7 @@
 // Do not edit: edit shaderlib/templates/raymarch.wgsl and run scatter-gen again. Bindings, resources and dispatch: manifest.json.
 #extension GL_ARB_compute_shader : require
 #extension GL_ARB_shader_storage_buffer_object : require
-layout(local_size_x = 32, local_size_y = 1, local_size_z = 1) in;
+layout(local_size_x = 8, local_size_y = 1, local_size_z = 1) in;
 
 struct ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     vec4 right;
@@ -54,7 +54,7 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
 const float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 const uint SLICES = 256u;
 const uint SLICE_SAMPLES = 256u;
-const uint SLICE_LANES = 32u;
+const uint SLICE_LANES = 8u;
 const uint STEP = 8u;
 const uint SLICE_RUNS = 32u;
 const float DEPTH_BREAK = 0.1;

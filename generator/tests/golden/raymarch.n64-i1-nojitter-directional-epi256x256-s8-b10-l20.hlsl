@@ -61,7 +61,7 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
 static const float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 static const uint SLICES = 256u;
 static const uint SLICE_SAMPLES = 256u;
-static const uint SLICE_LANES = 32u;
+static const uint SLICE_LANES = 8u;
 static const uint STEP = 8u;
 static const uint SLICE_RUNS = 32u;
 static const float DEPTH_BREAK = 0.1;
@@ -574,7 +574,7 @@ EpipolarCameraX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX ConstructEpipolarCam
     return ret;
 }
 
-[numthreads(32, 1, 1)]
+[numthreads(8, 1, 1)]
 void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
 {
     if (li == 0) {

@@ -66,7 +66,7 @@ struct type_13 {
 constant float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 constant uint SLICES = 256u;
 constant uint SLICE_SAMPLES = 256u;
-constant uint SLICE_LANES = 32u;
+constant uint SLICE_LANES = 8u;
 constant uint STEP = 8u;
 constant uint SLICE_RUNS = 32u;
 constant float DEPTH_BREAK = 0.1;

@@ -54,7 +54,7 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
 const EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX: f32 = 100f;
 const SLICES: u32 = 256u;
 const SLICE_SAMPLES: u32 = 256u;
-const SLICE_LANES: u32 = 32u;
+const SLICE_LANES: u32 = 8u;
 const STEP: u32 = 8u;
 const SLICE_RUNS: u32 = 32u;
 const DEPTH_BREAK: f32 = 0.1f;
@@ -483,7 +483,7 @@ fn line_spread_over(ab: vec2<u32>) -> bool {
     return (max(spread.x, max(spread.y, spread.z)) > (LIGHT_BREAK * max(hi_2.x, max(hi_2.y, hi_2.z))));
 }
 
-@compute @workgroup_size(32, 1, 1) 
+@compute @workgroup_size(8, 1, 1) 
 fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) li: u32) {
     var k: u32;
     var g: u32;

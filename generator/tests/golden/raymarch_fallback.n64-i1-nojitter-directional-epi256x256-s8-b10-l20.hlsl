@@ -36,7 +36,7 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
 
 static const uint SLICES = 256u;
 static const uint SLICE_SAMPLES = 256u;
-static const uint SLICE_LANES = 32u;
+static const uint SLICE_LANES = 8u;
 static const uint STEP = 8u;
 static const uint SLICE_RUNS = 32u;
 static const float DEPTH_BREAK = 0.1;

@@ -44,7 +44,7 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
 typedef uint type_10[1];
 constant uint SLICES = 256u;
 constant uint SLICE_SAMPLES = 256u;
-constant uint SLICE_LANES = 32u;
+constant uint SLICE_LANES = 8u;
 constant uint STEP = 8u;
 constant uint SLICE_RUNS = 32u;
 constant float DEPTH_BREAK = 0.1;

@@ -36,7 +36,7 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
 
 const SLICES: u32 = 256u;
 const SLICE_SAMPLES: u32 = 256u;
-const SLICE_LANES: u32 = 32u;
+const SLICE_LANES: u32 = 8u;
 const STEP: u32 = 8u;
 const SLICE_RUNS: u32 = 32u;
 const DEPTH_BREAK: f32 = 0.1f;

@@ -50,7 +50,7 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
 };
 const uint SLICES = 256u;
 const uint SLICE_SAMPLES = 256u;
-const uint SLICE_LANES = 32u;
+const uint SLICE_LANES = 8u;
 const uint STEP = 8u;
 const uint SLICE_RUNS = 32u;
 const float DEPTH_BREAK = 0.1;

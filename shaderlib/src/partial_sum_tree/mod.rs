@@ -11,7 +11,7 @@ pub mod plan;
 
 use askama::Template;
 
-use crate::sampling::{SLICE_LANES, SamplingView, camera_expr};
+use crate::sampling::{SamplingView, camera_expr};
 
 pub use scatter_frame::partial_sum_tree::{
     DEFAULT_RANK, FACTOR_VECS, GL2, GRID, MAX_RANK, PartialSumTreeFrame, PartialSumTreeVariant,
@@ -23,8 +23,13 @@ use crate::compose::template_path;
 use crate::prefiltered::LightKind;
 use crate::{Kernel, ShaderError};
 
+/// Invocations per slice of `pst_sweep` (the sampling stage's samples pass of the other
+/// families takes [`crate::sampling::SLICE_LANES`]): its sweep spreads a slice's columns,
+/// ranks and tree steps over them.
+pub const SWEEP_LANES: u32 = 32;
+
 /// Workgroup size of `pst_sweep`: one workgroup per epipolar slice.
-pub const SWEEP_WORKGROUP_SIZE: [u32; 3] = [SLICE_LANES, 1, 1];
+pub const SWEEP_WORKGROUP_SIZE: [u32; 3] = [SWEEP_LANES, 1, 1];
 
 /// The first binding after the family's own (the sampling stage's `epipolar_samples` in the
 /// unwarp; `fallback_count` and `fallback_pixels` at the next two).
@@ -70,17 +75,20 @@ fn validate(kernel: Kernel, variant: &PartialSumTreeVariant) -> Result<(), Shade
 fn render(kernel: Kernel, variant: &PartialSumTreeVariant) -> Result<String, ShaderError> {
     // (The variant's sampling is epipolar: `validate` refuses the others.)
     validate(kernel, variant)?;
-    let sampling = SamplingView::new(
-        &variant.sampling_knobs(),
-        kernel,
-        Kernel::PstSweep,
-        camera_expr("frame.axis.xyz"),
-        SAMPLED_BINDING,
-    );
+    let sampling = SamplingView {
+        slice_lanes: SWEEP_LANES,
+        ..SamplingView::new(
+            &variant.sampling_knobs(),
+            kernel,
+            Kernel::PstSweep,
+            camera_expr("frame.axis.xyz"),
+            SAMPLED_BINDING,
+        )
+    };
     let light_name = variant.light.name();
     let spot = variant.light == LightKind::Spot;
     let (rank, rank_vecs, grid) = (variant.rank, variant.rank_vecs(), GRID);
-    let per_lane = variant.slice_samples.div_ceil(SLICE_LANES);
+    let per_lane = variant.slice_samples.div_ceil(SWEEP_LANES);
     let rendered = match kernel {
         Kernel::PstSweepUnwarp => SweepUnwarpTemplate {
             light_name,

@@ -16,7 +16,7 @@ use crate::plan::{
 };
 use crate::sampling::{
     fallback_buffers, fallback_pass, sampled_output, sampled_pass, samples_texture,
-    sampling_invocations, unwarp_pass,
+    sampling_invocations_with_lanes, unwarp_pass,
 };
 
 /// The sweep's scratch buffers (bound by `pst_sweep` only).
@@ -181,7 +181,7 @@ pub fn pass(v: &PartialSumTreeVariant, kernel: Kernel) -> Option<PassPlan> {
             &knobs,
             PassPlan {
                 kernel,
-                invocations: sampling_invocations(&knobs),
+                invocations: sampling_invocations_with_lanes(&knobs, super::SWEEP_LANES),
                 skip_when: None,
                 bindings: [
                     bind(0, "frame"),
