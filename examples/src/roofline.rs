@@ -761,12 +761,13 @@ fn sampled_costs(out: &mut Vec<KernelCost>, pixels: u64, n: f64) {
     out.push(KernelCost {
         method: "raymarch n64 lr2",
         kernel: "raymarch_unwarp",
-        invocations: pixels,
-        // Four sample loads and the pixel's depth; the taps (two divisions) and the blend
-        // (about 75 FMAs); the rgba16float store (or a 4-byte list entry).
-        counts: [8.0, 5.0, 0.0, 2.0, 75.0],
+        // One invocation per 2 x 2 block (its pixels share their four samples).
+        invocations: w.div_ceil(2) * h.div_ceil(2),
+        // Four sample loads, then per pixel its depth, the taps' weights (two divisions) and
+        // the blend (about 75 FMAs), the rgba16float store (or a 4-byte list entry).
+        counts: [32.0, 8.0, 0.0, 8.0, 300.0],
         low: None,
-        trips: "4 taps",
+        trips: "S x S pixels x 4 taps",
     });
     for method in ["raymarch n64 ep512", "raymarch n64 lr2"] {
         // One invocation per 8 x 8 pixels walks the list: per listed pixel one entry load

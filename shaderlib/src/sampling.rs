@@ -261,12 +261,15 @@ fn family_bindings(family: &crate::plan::PassPlan) -> Vec<crate::plan::BindingSo
 /// The `_unwarp` pass `kernel` of a family kernel's sampled pass `family`: its `frame` and
 /// `depth` bindings, `output` where `family` writes the samples texture, the samples
 /// texture read at `binding`, `fallback_count` and `fallback_pixels` at `binding + 1` and
-/// `+ 2`; one invocation per screen pixel.
+/// `+ 2`; one invocation per block of pixels that share their samples
+/// ([`unwarp_block`] per axis: S for `lowres`, 1 for `epipolar`).
 pub fn unwarp_pass(
     family: crate::plan::PassPlan,
     kernel: Kernel,
     binding: u32,
+    knobs: &SamplingKnobs,
 ) -> crate::plan::PassPlan {
+    let block = unwarp_block(knobs);
     let samples = family
         .bindings
         .iter()
@@ -283,9 +286,32 @@ pub fn unwarp_pass(
     bindings.push(crate::plan::bind(binding + 2, FALLBACK_PIXELS));
     crate::plan::PassPlan {
         kernel,
-        invocations: ["screen.width".into(), "screen.height".into(), "1".into()],
+        invocations: if block == 1 {
+            ["screen.width".into(), "screen.height".into(), "1".into()]
+        } else {
+            [
+                format!("ceil(screen.width / {block})"),
+                format!("ceil(screen.height / {block})"),
+                "1".into(),
+            ]
+        },
         skip_when: family.skip_when,
         bindings,
+    }
+}
+
+/// Pixels per axis one invocation of the `_unwarp` pass gathers: the lowres block side S (a
+/// block's pixels share their four samples, loaded once: `raymarch_unwarp` at lowres 4 took
+/// 6.4-7.8 ms at 1280x720 against 8.9-9.4 ms with one invocation per pixel; at lowres 2 no
+/// change, stop 45), or 1 for `epipolar`. A 2 x 2 quad gathering its pixels from shared
+/// loads of its three slices (14 loads for four pixels instead of 32) was measured and not
+/// kept: 13.3-14.2 ms against 13.9-14.3 even with the pixels whose taps it had not loaded
+/// left wrong, 19.4-22.9 ms with them loading their own (the unwarp is its per-pixel
+/// arithmetic and store more than its loads; docs/roofline.md, "Stop 45").
+pub fn unwarp_block(knobs: &SamplingKnobs) -> u32 {
+    match knobs.sampling {
+        Sampling::Lowres => knobs.scale,
+        _ => 1,
     }
 }
 

@@ -89,8 +89,8 @@ uvec2 lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2 screen, uin
     return ((((screen - uvec2(1u, 1u)) + uvec2((scale - 1u), (scale - 1u))) / uvec2(scale)) + uvec2(1u, 1u));
 }
 
-uvec2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2 i, uvec2 screen_1, uint scale_1) {
-    return min((i * scale_1), (screen_1 - uvec2(1u, 1u)));
+uvec2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2 i_1, uvec2 screen_1, uint scale_1) {
+    return min((i_1 * scale_1), (screen_1 - uvec2(1u, 1u)));
 }
 
 LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2 p, uvec2 screen_2, uint scale_2) {
@@ -109,13 +109,13 @@ LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mo
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a, float b, float depth_break) {
-    bool local_1 = false;
+    bool local_2 = false;
     if (!((a == b))) {
-        local_1 = (abs((a - b)) <= (depth_break * min(a, b)));
+        local_2 = (abs((a - b)) <= (depth_break * min(a, b)));
     } else {
-        local_1 = true;
+        local_2 = true;
     }
-    bool _e13 = local_1;
+    bool _e13 = local_2;
     return _e13;
 }
 
@@ -127,8 +127,8 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
     uint taps = 0u;
     uint close = 0u;
     uint k = 0u;
-    bool local_2 = false;
     bool local_3 = false;
+    bool local_4 = false;
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
@@ -149,11 +149,11 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
             if ((w[_e20] > 0.0)) {
                 uint _e25 = k;
                 bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_2 = _e29;
+                local_3 = _e29;
             } else {
-                local_2 = false;
+                local_3 = false;
             }
-            bool _e33 = local_2;
+            bool _e33 = local_3;
             if (_e33) {
                 uint _e35 = close;
                 close = (_e35 + 1u);
@@ -177,11 +177,11 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
     if (!((_e65 <= 0.0))) {
         uint _e69 = close;
         uint _e70 = taps;
-        local_3 = (_e69 < min(_e70, 2u));
+        local_4 = (_e69 < min(_e70, 2u));
     } else {
-        local_3 = true;
+        local_4 = true;
     }
-    bool _e77 = local_3;
+    bool _e77 = local_4;
     if (_e77) {
         return vec4(0.0, 0.0, 0.0, 0.0);
     }
@@ -323,46 +323,75 @@ void main() {
     vec4 depths = vec4(0.0, 0.0, 0.0, 0.0);
     vec3 light[4] = vec3[4](vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0));
     uint j = 0u;
+    uint i = 0u;
+    bool local_1 = false;
     uint _e6 = _group_0_binding_0_cs.sizes.x;
     uint _e10 = _group_0_binding_0_cs.sizes.y;
     uvec2 screen_3 = uvec2(_e6, _e10);
-    uvec2 q_2 = id.xy;
-    if (!((q_2.x >= screen_3.x))) {
-        local = (q_2.y >= screen_3.y);
+    uvec2 q0_ = (id.xy * SCALE);
+    if (!((q0_.x >= screen_3.x))) {
+        local = (q0_.y >= screen_3.y);
     } else {
         local = true;
     }
-    bool _e24 = local;
-    if (_e24) {
+    bool _e26 = local;
+    if (_e26) {
         return;
     }
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e26 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_, screen_3, SCALE);
     bool loop_init_1 = true;
     while(true) {
         if (!loop_init_1) {
-            uint _e54 = j;
-            j = (_e54 + 1u);
+            uint _e56 = j;
+            j = (_e56 + 1u);
         }
         loop_init_1 = false;
-        uint _e28 = j;
-        if ((_e28 < 4u)) {
+        uint _e30 = j;
+        if ((_e30 < 4u)) {
         } else {
             break;
         }
         {
-            uint _e32 = j;
-            uint _e37 = j;
-            int _e44_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-            vec4 v_7 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e26.cols[(_e32 % 2u)], _e26.rows[(_e37 / 2u)])), ivec2(0), textureSize(_group_0_binding_4_cs, _e44_clamped_lod) - ivec2(1)), _e44_clamped_lod);
-            uint _e46 = j;
-            depths[_e46] = v_7.w;
-            uint _e50 = j;
-            light[_e50] = v_7.xyz;
+            uint _e34 = j;
+            uint _e39 = j;
+            int _e46_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+            vec4 v_7 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e28.cols[(_e34 % 2u)], _e28.rows[(_e39 / 2u)])), ivec2(0), textureSize(_group_0_binding_4_cs, _e46_clamped_lod) - ivec2(1)), _e46_clamped_lod);
+            uint _e48 = j;
+            depths[_e48] = v_7.w;
+            uint _e52 = j;
+            light[_e52] = v_7.xyz;
         }
     }
-    vec4 _e57 = depths;
-    vec3 _e58[4] = light;
-    unwarp_pixel(q_2, _e26.w, _e57, _e58);
+    bool loop_init_2 = true;
+    while(true) {
+        if (!loop_init_2) {
+            uint _e86 = i;
+            i = (_e86 + 1u);
+        }
+        loop_init_2 = false;
+        uint _e59 = i;
+        if ((_e59 < 16u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e62 = i;
+            uint _e65 = i;
+            uvec2 q_2 = (q0_ + uvec2((_e62 % SCALE), (_e65 / SCALE)));
+            if ((q_2.x < screen_3.x)) {
+                local_1 = (q_2.y < screen_3.y);
+            } else {
+                local_1 = false;
+            }
+            bool _e79 = local_1;
+            if (_e79) {
+                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                vec4 _e83 = depths;
+                vec3 _e84[4] = light;
+                unwarp_pixel(q_2, _e81.w, _e83, _e84);
+            }
+        }
+    }
     return;
 }
 

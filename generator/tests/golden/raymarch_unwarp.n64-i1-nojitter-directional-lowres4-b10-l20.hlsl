@@ -103,9 +103,9 @@ uint2 lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uint2 screen, uin
     return (naga_div(((screen - uint2(1u, 1u)) + uint2((scale - 1u), (scale - 1u))), (scale).xx) + uint2(1u, 1u));
 }
 
-uint2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uint2 i, uint2 screen_1, uint scale_1)
+uint2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uint2 i_1, uint2 screen_1, uint scale_1)
 {
-    return min((i * scale_1), (screen_1 - uint2(1u, 1u)));
+    return min((i_1 * scale_1), (screen_1 - uint2(1u, 1u)));
 }
 
 LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uint2 p, uint2 screen_2, uint scale_2)
@@ -128,14 +128,14 @@ LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mo
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a, float b, float depth_break)
 {
-    bool local_1 = (bool)0;
+    bool local_2 = (bool)0;
 
     if (!((a == b))) {
-        local_1 = (abs((a - b)) <= (depth_break * min(a, b)));
+        local_2 = (abs((a - b)) <= (depth_break * min(a, b)));
     } else {
-        local_1 = true;
+        local_2 = true;
     }
-    bool _e13 = local_1;
+    bool _e13 = local_2;
     return _e13;
 }
 
@@ -148,8 +148,8 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
     uint taps = 0u;
     uint close = 0u;
     uint k = 0u;
-    bool local_2 = (bool)0;
     bool local_3 = (bool)0;
+    bool local_4 = (bool)0;
 
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
@@ -174,11 +174,11 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
             if ((w[min(uint(_e20), 3u)] > 0.0)) {
                 uint _e25 = k;
                 const bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e25), 3u)], d, depth_break_1);
-                local_2 = _e29;
+                local_3 = _e29;
             } else {
-                local_2 = false;
+                local_3 = false;
             }
-            bool _e33 = local_2;
+            bool _e33 = local_3;
             if (_e33) {
                 uint _e35 = close;
                 close = (_e35 + 1u);
@@ -202,11 +202,11 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
     if (!((_e65 <= 0.0))) {
         uint _e69 = close;
         uint _e70 = taps;
-        local_3 = (_e69 < min(_e70, 2u));
+        local_4 = (_e69 < min(_e70, 2u));
     } else {
-        local_3 = true;
+        local_4 = true;
     }
-    bool _e77 = local_3;
+    bool _e77 = local_4;
     if (_e77) {
         return float4(0.0, 0.0, 0.0, 0.0);
     }
@@ -384,48 +384,80 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     float4 depths = float4(0.0, 0.0, 0.0, 0.0);
     float3 light[4] = (float3[4])0;
     uint j = 0u;
+    uint i = 0u;
+    bool local_1 = (bool)0;
 
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     uint2 screen_3 = uint2(_e6, _e10);
-    uint2 q_2 = id.xy;
-    if (!((q_2.x >= screen_3.x))) {
-        local = (q_2.y >= screen_3.y);
+    uint2 q0_ = (id.xy * SCALE);
+    if (!((q0_.x >= screen_3.x))) {
+        local = (q0_.y >= screen_3.y);
     } else {
         local = true;
     }
-    bool _e24 = local;
-    if (_e24) {
+    bool _e26 = local;
+    if (_e26) {
         return;
     }
-    const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e26 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+    const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_, screen_3, SCALE);
     uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
     bool loop_init_1 = true;
     while(true) {
         if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
         loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
         if (!loop_init_1) {
-            uint _e54 = j;
-            j = (_e54 + 1u);
+            uint _e56 = j;
+            j = (_e56 + 1u);
         }
         loop_init_1 = false;
-        uint _e28 = j;
-        if ((_e28 < 4u)) {
+        uint _e30 = j;
+        if ((_e30 < 4u)) {
         } else {
             break;
         }
         {
-            uint _e32 = j;
-            uint _e37 = j;
-            float4 v_7 = lowres_samples.Load(int3(uint2(_e26.cols[min(uint(naga_mod(_e32, 2u)), 1u)], _e26.rows[min(uint(naga_div(_e37, 2u)), 1u)]), int(0)));
-            uint _e46 = j;
-            depths[min(uint(_e46), 3u)] = v_7.w;
-            uint _e50 = j;
-            light[min(uint(_e50), 3u)] = v_7.xyz;
+            uint _e34 = j;
+            uint _e39 = j;
+            float4 v_7 = lowres_samples.Load(int3(uint2(_e28.cols[min(uint(naga_mod(_e34, 2u)), 1u)], _e28.rows[min(uint(naga_div(_e39, 2u)), 1u)]), int(0)));
+            uint _e48 = j;
+            depths[min(uint(_e48), 3u)] = v_7.w;
+            uint _e52 = j;
+            light[min(uint(_e52), 3u)] = v_7.xyz;
         }
     }
-    float4 _e57 = depths;
-    float3 _e58[4] = light;
-    unwarp_pixel(q_2, _e26.w, _e57, _e58);
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e86 = i;
+            i = (_e86 + 1u);
+        }
+        loop_init_2 = false;
+        uint _e59 = i;
+        if ((_e59 < 16u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e62 = i;
+            uint _e65 = i;
+            uint2 q_2 = (q0_ + uint2(naga_mod(_e62, SCALE), naga_div(_e65, SCALE)));
+            if ((q_2.x < screen_3.x)) {
+                local_1 = (q_2.y < screen_3.y);
+            } else {
+                local_1 = false;
+            }
+            bool _e79 = local_1;
+            if (_e79) {
+                const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                float4 _e83 = depths;
+                float3 _e84[4] = light;
+                unwarp_pixel(q_2, _e81.w, _e83, _e84);
+            }
+        }
+    }
     return;
 }

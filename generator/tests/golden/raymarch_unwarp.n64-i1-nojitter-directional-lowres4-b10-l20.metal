@@ -102,11 +102,11 @@ metal::uint2 lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 }
 
 metal::uint2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    metal::uint2 i,
+    metal::uint2 i_1,
     metal::uint2 screen_1,
     uint scale_1
 ) {
-    return metal::min(i * scale_1, screen_1 - metal::uint2(1u, 1u));
+    return metal::min(i_1 * scale_1, screen_1 - metal::uint2(1u, 1u));
 }
 
 LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
@@ -133,13 +133,13 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     float b,
     float depth_break
 ) {
-    bool local_1 = {};
+    bool local_2 = {};
     if (!((a == b))) {
-        local_1 = metal::abs(a - b) <= (depth_break * metal::min(a, b));
+        local_2 = metal::abs(a - b) <= (depth_break * metal::min(a, b));
     } else {
-        local_1 = true;
+        local_2 = true;
     }
-    bool _e13 = local_1;
+    bool _e13 = local_2;
     return _e13;
 }
 
@@ -158,8 +158,8 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     uint taps = 0u;
     uint close = 0u;
     uint k = 0u;
-    bool local_2 = {};
     bool local_3 = {};
+    bool local_4 = {};
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
@@ -183,11 +183,11 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
             if (w[metal::min(unsigned(_e20), 3u)] > 0.0) {
                 uint _e25 = k;
                 bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
-                local_2 = _e29;
+                local_3 = _e29;
             } else {
-                local_2 = false;
+                local_3 = false;
             }
-            bool _e33 = local_2;
+            bool _e33 = local_3;
             if (_e33) {
                 uint _e35 = close;
                 close = _e35 + 1u;
@@ -211,11 +211,11 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     if (!((_e65 <= 0.0))) {
         uint _e69 = close;
         uint _e70 = taps;
-        local_3 = _e69 < metal::min(_e70, 2u);
+        local_4 = _e69 < metal::min(_e70, 2u);
     } else {
-        local_3 = true;
+        local_4 = true;
     }
-    bool _e77 = local_3;
+    bool _e77 = local_4;
     if (_e77) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
@@ -533,48 +533,80 @@ kernel void raymarch_unwarp(
     metal::float4 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
     type_6 light = {};
     uint j = 0u;
+    uint i = 0u;
+    bool local_1 = {};
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     metal::uint2 screen_3 = metal::uint2(_e6, _e10);
-    metal::uint2 q_2 = id.xy;
-    if (!((q_2.x >= screen_3.x))) {
-        local = q_2.y >= screen_3.y;
+    metal::uint2 q0_ = id.xy * SCALE;
+    if (!((q0_.x >= screen_3.x))) {
+        local = q0_.y >= screen_3.y;
     } else {
         local = true;
     }
-    bool _e24 = local;
-    if (_e24) {
+    bool _e26 = local;
+    if (_e26) {
         return;
     }
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e26 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_, screen_3, SCALE);
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e54 = j;
-            j = _e54 + 1u;
+            uint _e56 = j;
+            j = _e56 + 1u;
         }
         loop_init_2 = false;
-        uint _e28 = j;
-        if (_e28 < 4u) {
+        uint _e30 = j;
+        if (_e30 < 4u) {
         } else {
             break;
         }
         {
-            uint _e32 = j;
-            uint _e37 = j;
-            uint clamped_lod_e44 = metal::min(uint(0), lowres_samples.get_num_mip_levels() - 1);
-            metal::float4 v_7 = lowres_samples.read(metal::min(metal::uint2(metal::uint2(_e26.cols[metal::min(unsigned(naga_mod(_e32, 2u)), 1u)], _e26.rows[metal::min(unsigned(naga_div(_e37, 2u)), 1u)])), metal::uint2(lowres_samples.get_width(clamped_lod_e44), lowres_samples.get_height(clamped_lod_e44)) - 1), clamped_lod_e44);
-            uint _e46 = j;
-            depths[metal::min(unsigned(_e46), 3u)] = v_7.w;
-            uint _e50 = j;
-            light.inner[metal::min(unsigned(_e50), 3u)] = v_7.xyz;
+            uint _e34 = j;
+            uint _e39 = j;
+            uint clamped_lod_e46 = metal::min(uint(0), lowres_samples.get_num_mip_levels() - 1);
+            metal::float4 v_7 = lowres_samples.read(metal::min(metal::uint2(metal::uint2(_e28.cols[metal::min(unsigned(naga_mod(_e34, 2u)), 1u)], _e28.rows[metal::min(unsigned(naga_div(_e39, 2u)), 1u)])), metal::uint2(lowres_samples.get_width(clamped_lod_e46), lowres_samples.get_height(clamped_lod_e46)) - 1), clamped_lod_e46);
+            uint _e48 = j;
+            depths[metal::min(unsigned(_e48), 3u)] = v_7.w;
+            uint _e52 = j;
+            light.inner[metal::min(unsigned(_e52), 3u)] = v_7.xyz;
         }
     }
-    metal::float4 _e57 = depths;
-    type_6 _e58 = light;
-    unwarp_pixel(q_2, _e26.w, _e57, _e58, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
+    while(true) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e86 = i;
+            i = _e86 + 1u;
+        }
+        loop_init_3 = false;
+        uint _e59 = i;
+        if (_e59 < 16u) {
+        } else {
+            break;
+        }
+        {
+            uint _e62 = i;
+            uint _e65 = i;
+            metal::uint2 q_2 = q0_ + metal::uint2(naga_mod(_e62, SCALE), naga_div(_e65, SCALE));
+            if (q_2.x < screen_3.x) {
+                local_1 = q_2.y < screen_3.y;
+            } else {
+                local_1 = false;
+            }
+            bool _e79 = local_1;
+            if (_e79) {
+                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                metal::float4 _e83 = depths;
+                type_6 _e84 = light;
+                unwarp_pixel(q_2, _e81.w, _e83, _e84, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+            }
+        }
+    }
     return;
 }

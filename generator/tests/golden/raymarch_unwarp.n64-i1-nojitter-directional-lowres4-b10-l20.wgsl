@@ -91,8 +91,8 @@ fn lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen: vec2<u32>, s
     return ((((screen - vec2<u32>(1u, 1u)) + vec2<u32>((scale - 1u), (scale - 1u))) / vec2(scale)) + vec2<u32>(1u, 1u));
 }
 
-fn lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i: vec2<u32>, screen_1: vec2<u32>, scale_1: u32) -> vec2<u32> {
-    return min((i * scale_1), (screen_1 - vec2<u32>(1u, 1u)));
+fn lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(i_1: vec2<u32>, screen_1: vec2<u32>, scale_1: u32) -> vec2<u32> {
+    return min((i_1 * scale_1), (screen_1 - vec2<u32>(1u, 1u)));
 }
 
 fn lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(p: vec2<u32>, screen_2: vec2<u32>, scale_2: u32) -> LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
@@ -112,14 +112,14 @@ fn lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(p: vec2<u32>, screen
 }
 
 fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a: f32, b: f32, depth_break: f32) -> bool {
-    var local_1: bool;
+    var local_2: bool;
 
     if !((a == b)) {
-        local_1 = (abs((a - b)) <= (depth_break * min(a, b)));
+        local_2 = (abs((a - b)) <= (depth_break * min(a, b)));
     } else {
-        local_1 = true;
+        local_2 = true;
     }
-    let _e13 = local_1;
+    let _e13 = local_2;
     return _e13;
 }
 
@@ -131,8 +131,8 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
     var taps: u32 = 0u;
     var close: u32 = 0u;
     var k: u32 = 0u;
-    var local_2: bool;
     var local_3: bool;
+    var local_4: bool;
 
     loop {
         let _e6 = k;
@@ -148,11 +148,11 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
             if (w[_e20] > 0f) {
                 let _e25 = k;
                 let _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_2 = _e29;
+                local_3 = _e29;
             } else {
-                local_2 = false;
+                local_3 = false;
             }
-            let _e33 = local_2;
+            let _e33 = local_3;
             if _e33 {
                 let _e35 = close;
                 close = (_e35 + 1u);
@@ -180,11 +180,11 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
     if !((_e65 <= 0f)) {
         let _e69 = close;
         let _e70 = taps;
-        local_3 = (_e69 < min(_e70, 2u));
+        local_4 = (_e69 < min(_e70, 2u));
     } else {
-        local_3 = true;
+        local_4 = true;
     }
-    let _e77 = local_3;
+    let _e77 = local_4;
     if _e77 {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
@@ -401,43 +401,70 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     var depths: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var light: array<vec3<f32>, 4>;
     var j: u32 = 0u;
+    var i: u32 = 0u;
+    var local_1: bool;
 
     let _e6 = frame.sizes.x;
     let _e10 = frame.sizes.y;
     let screen_3 = vec2<u32>(_e6, _e10);
-    let q_2 = id.xy;
-    if !((q_2.x >= screen_3.x)) {
-        local = (q_2.y >= screen_3.y);
+    let q0_ = (id.xy * SCALE);
+    if !((q0_.x >= screen_3.x)) {
+        local = (q0_.y >= screen_3.y);
     } else {
         local = true;
     }
-    let _e24 = local;
-    if _e24 {
+    let _e26 = local;
+    if _e26 {
         return;
     }
-    let _e26 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+    let _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_, screen_3, SCALE);
     loop {
-        let _e28 = j;
-        if (_e28 < 4u) {
+        let _e30 = j;
+        if (_e30 < 4u) {
         } else {
             break;
         }
         {
-            let _e32 = j;
-            let _e37 = j;
-            let v_7 = textureLoad(lowres_samples, vec2<u32>(_e26.cols[(_e32 % 2u)], _e26.rows[(_e37 / 2u)]), 0i);
-            let _e46 = j;
-            depths[_e46] = v_7.w;
-            let _e50 = j;
-            light[_e50] = v_7.xyz;
+            let _e34 = j;
+            let _e39 = j;
+            let v_7 = textureLoad(lowres_samples, vec2<u32>(_e28.cols[(_e34 % 2u)], _e28.rows[(_e39 / 2u)]), 0i);
+            let _e48 = j;
+            depths[_e48] = v_7.w;
+            let _e52 = j;
+            light[_e52] = v_7.xyz;
         }
         continuing {
-            let _e54 = j;
-            j = (_e54 + 1u);
+            let _e56 = j;
+            j = (_e56 + 1u);
         }
     }
-    let _e57 = depths;
-    let _e58 = light;
-    unwarp_pixel(q_2, _e26.w, _e57, _e58);
+    loop {
+        let _e59 = i;
+        if (_e59 < 16u) {
+        } else {
+            break;
+        }
+        {
+            let _e62 = i;
+            let _e65 = i;
+            let q_2 = (q0_ + vec2<u32>((_e62 % SCALE), (_e65 / SCALE)));
+            if (q_2.x < screen_3.x) {
+                local_1 = (q_2.y < screen_3.y);
+            } else {
+                local_1 = false;
+            }
+            let _e79 = local_1;
+            if _e79 {
+                let _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                let _e83 = depths;
+                let _e84 = light;
+                unwarp_pixel(q_2, _e81.w, _e83, _e84);
+            }
+        }
+        continuing {
+            let _e86 = i;
+            i = (_e86 + 1u);
+        }
+    }
     return;
 }

@@ -170,7 +170,9 @@ pub fn pass(v: &AreaIvsvVariant, kernel: Kernel) -> Option<PassPlan> {
             },
             5,
         )),
-        Kernel::IvsvGatherUnwarp => pass(v, Kernel::IvsvGather).map(|p| unwarp_pass(p, kernel, 5)),
+        Kernel::IvsvGatherUnwarp => {
+            pass(v, Kernel::IvsvGather).map(|p| unwarp_pass(p, kernel, 5, &v.sampling_knobs()))
+        }
         Kernel::IvsvGatherFallback => {
             pass(v, Kernel::IvsvGather).map(|p| fallback_pass(p, kernel, 5))
         }

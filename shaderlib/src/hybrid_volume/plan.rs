@@ -152,7 +152,7 @@ pub fn pass(v: &HybridVolumeVariant, kernel: Kernel) -> Option<PassPlan> {
             7,
         )),
         Kernel::VolumeMarchUnwarp => {
-            pass(v, Kernel::VolumeMarch).map(|p| unwarp_pass(p, kernel, 7))
+            pass(v, Kernel::VolumeMarch).map(|p| unwarp_pass(p, kernel, 7, &v.sampling_knobs()))
         }
         Kernel::VolumeMarchFallback => {
             pass(v, Kernel::VolumeMarch).map(|p| fallback_pass(p, kernel, 7))

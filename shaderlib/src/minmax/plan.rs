@@ -170,7 +170,7 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
             6,
         )),
         Kernel::MinmaxTraverseUnwarp => {
-            pass(v, Kernel::MinmaxTraverse).map(|p| unwarp_pass(p, kernel, 6))
+            pass(v, Kernel::MinmaxTraverse).map(|p| unwarp_pass(p, kernel, 6, &v.sampling_knobs()))
         }
         Kernel::MinmaxTraverseFallback => {
             pass(v, Kernel::MinmaxTraverse).map(|p| fallback_pass(p, kernel, 6))

@@ -201,9 +201,8 @@ pub fn pass(v: &PartialSumTreeVariant, kernel: Kernel) -> Option<PassPlan> {
             },
             SAMPLED_BINDING,
         )),
-        Kernel::PstSweepUnwarp => {
-            pass(v, Kernel::PstSweep).map(|p| unwarp_pass(p, kernel, SAMPLED_BINDING))
-        }
+        Kernel::PstSweepUnwarp => pass(v, Kernel::PstSweep)
+            .map(|p| unwarp_pass(p, kernel, SAMPLED_BINDING, &v.sampling_knobs())),
         Kernel::PstSweepFallback => pass(v, Kernel::PstSweep).map(|p| {
             let mut p = fallback_pass(p, kernel, SAMPLED_BINDING);
             p.bindings.retain(|b| !SCRATCH.contains(&b.resource));

@@ -322,7 +322,9 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
             },
             7,
         )),
-        Kernel::ScatterUnwarp => pass(v, Kernel::Scatter).map(|p| unwarp_pass(p, kernel, 7)),
+        Kernel::ScatterUnwarp => {
+            pass(v, Kernel::Scatter).map(|p| unwarp_pass(p, kernel, 7, &v.sampling_knobs()))
+        }
         Kernel::ScatterFallback => pass(v, Kernel::Scatter).map(|p| fallback_pass(p, kernel, 7)),
         _ => None,
     }

@@ -98,7 +98,9 @@ pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
             },
             4,
         )),
-        Kernel::RaymarchUnwarp => pass(v, Kernel::Raymarch).map(|p| unwarp_pass(p, kernel, 4)),
+        Kernel::RaymarchUnwarp => {
+            pass(v, Kernel::Raymarch).map(|p| unwarp_pass(p, kernel, 4, &v.sampling_knobs()))
+        }
         Kernel::RaymarchFallback => pass(v, Kernel::Raymarch).map(|p| fallback_pass(p, kernel, 4)),
         Kernel::InterleaveSum => Some(PassPlan {
             kernel,
