@@ -17,6 +17,7 @@ use std::sync::Arc;
 
 use clap::Parser;
 use scatter_examples::bench::{BenchConfig, Case, run, write_outputs};
+use scatter_reference::suite::Pose;
 use scatter_runtime::Context;
 use scatter_runtime::shaderlib::family::Family;
 
@@ -51,6 +52,11 @@ struct Args {
     /// headline method has is an error.
     #[arg(long = "knobs", value_name = "KNOBS", requires = "headline_only")]
     knobs: Vec<String>,
+    /// With `--headline-only`: the camera pose of the three scenes (ordinary,
+    /// epipole_on_screen, light_behind, grazing; the full bench reads its ratios at
+    /// ordinary).
+    #[arg(long, value_name = "POSE", default_value = "ordinary", requires = "headline_only", value_parser = |s: &str| s.parse::<Pose>())]
+    headline_pose: Pose,
     /// Only the machine's bounds (probe kernels: copy bandwidth, texel loads, filtered
     /// fetches, transcendentals, FMAs) and every kernel's cost model against them at the
     /// headline configuration (`scatter_examples::roofline`): two markdown tables printed,
@@ -110,6 +116,8 @@ fn main() -> ExitCode {
         config.headline = true;
         config.headline_error = args.headline_errors;
         config.headline_knobs = args.knobs.clone();
+        config.headline_pose = args.headline_pose;
+        eprintln!("headline pose: {}", args.headline_pose);
     }
     if args.roofline {
         return roofline(args.frames.unwrap_or(5));

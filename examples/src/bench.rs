@@ -220,6 +220,10 @@ pub struct BenchConfig {
     /// Only the headline methods with these knobs, as the headline table names them
     /// (`n64-i1-ep512`; empty: every one); `bench --headline-only --knobs n64-i1-ep512`.
     pub headline_knobs: Vec<String>,
+    /// The camera pose of the headline's three scenes (`ordinary` in the full bench, whose
+    /// ratios are read at it); `bench --headline-only --headline-pose epipole_on_screen`
+    /// measures the headline methods at another.
+    pub headline_pose: Pose,
     /// Leave out (and list in [`BenchResult::skipped`]) a method whose resources exceed a
     /// device limit, instead of failing the run: `tune`, whose grid spans layouts a small
     /// device cannot hold (a partial-sum tree of rank 8 over 1024 x 512 samples needs a
@@ -300,6 +304,7 @@ impl BenchConfig {
             headline_error: true,
             families: Vec::new(),
             headline_knobs: Vec::new(),
+            headline_pose: Pose::Ordinary,
             skip_over_limits: false,
             exact_truth: true,
         }
@@ -337,6 +342,7 @@ impl BenchConfig {
             headline_error: false,
             families: Vec::new(),
             headline_knobs: Vec::new(),
+            headline_pose: Pose::Ordinary,
             skip_over_limits: false,
             exact_truth: true,
         }
@@ -782,14 +788,13 @@ struct BenchScene {
     sv: TextureView,
 }
 
-fn bench_scene(ctx: &Context, name: SceneName, screen: [u32; 2]) -> Result<BenchScene, BoxError> {
-    let scene = suite::scene(
-        name,
-        Pose::Ordinary,
-        MediumPreset::Default,
-        screen[0],
-        screen[1],
-    );
+fn bench_scene(
+    ctx: &Context,
+    name: SceneName,
+    pose: Pose,
+    screen: [u32; 2],
+) -> Result<BenchScene, BoxError> {
+    let scene = suite::scene(name, pose, MediumPreset::Default, screen[0], screen[1]);
     let bvh = Bvh::build(&scene.geometry);
     let gbuf = GBuffer::cast(&scene, &bvh);
     let sm = ShadowMap::build(&scene, &bvh, 1024)?;
@@ -827,7 +832,7 @@ pub(crate) fn time_methods(
     rectified: [u32; 2],
     frames: u32,
 ) -> Result<Vec<Vec<(&'static str, Duration)>>, BoxError> {
-    let bench = bench_scene(ctx, name, screen)?;
+    let bench = bench_scene(ctx, name, Pose::Ordinary, screen)?;
     Ok(
         time_methods_on(ctx, methods, name, &bench, screen, rectified, frames)?
             .into_iter()
@@ -914,24 +919,45 @@ fn sampled_configs() -> Vec<SamplingKnobs> {
     out
 }
 
-/// Every sampled variant of the headline: each base in each configuration, and raymarch
-/// n256 epipolar (the brute-force anchor sampled: its evaluations are the fewest).
-fn sampled_variants() -> Vec<(FamilyVariant, FamilyVariant)> {
+/// Epipolar slices that give a 1280x720 screen the slice spacing Yusov 2013's 512 give
+/// 2560x1600 (about 16 pixels of the screen's border per slice).
+pub const HEADLINE_SLICES: u32 = 256;
+
+/// The rectified map of the headline's epipolar frames at [`HEADLINE_SLICES`]: one row per
+/// slice and one column per sample (the epipolar sample grid; Yusov 2013 builds one min/max
+/// tree per slice). The per-pixel frame keeps the run's map (1024x1024).
+pub const SLICE_GRID_RECTIFIED: [u32; 2] = [256, 256];
+
+/// Every sampled method of the headline with the per-pixel method it is compared with: each
+/// base in each configuration; each base at [`HEADLINE_SLICES`] slices, and a base that
+/// rectifies also with the [`SLICE_GRID_RECTIFIED`] map; and raymarch n256 epipolar (the
+/// brute-force anchor sampled: its evaluations are the fewest) at both slice counts.
+fn sampled_variants() -> Vec<(Method, Method)> {
     let mut out = Vec::new();
-    for base in sampled_bases() {
-        for knobs in sampled_configs() {
-            out.push((base, base.with_sampling(knobs)));
-        }
-    }
     let n256: FamilyVariant = RaymarchVariant {
         samples: 256,
         ..RaymarchVariant::default()
     }
     .into();
-    out.push((
-        n256,
-        n256.with_sampling(SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES)),
-    ));
+    for base in sampled_bases() {
+        for knobs in sampled_configs() {
+            out.push((Method::from(base), Method::from(base.with_sampling(knobs))));
+        }
+    }
+    for base in sampled_bases() {
+        let sampled = base.with_sampling(SamplingKnobs::epipolar(HEADLINE_SLICES));
+        out.push((Method::from(base), Method::from(sampled)));
+        let grid = Method::new(sampled, Some(SLICE_GRID_RECTIFIED));
+        if grid.rectifies() {
+            out.push((Method::from(base), grid));
+        }
+    }
+    for slices in [SamplingKnobs::DEFAULT_SLICES, HEADLINE_SLICES] {
+        out.push((
+            Method::from(n256),
+            Method::from(n256.with_sampling(SamplingKnobs::epipolar(slices))),
+        ));
+    }
     out
 }
 
@@ -964,7 +990,7 @@ fn headline_runs(ctx: &Context, config: &BenchConfig) -> Result<Vec<HeadlineRow>
     // The sampling stage (issue 14): each family's default, and the moment basis's
     // cheapest, at 1/2 and 1/4 of the screen per axis and epipolar.
     for (_, sampled) in sampled_variants() {
-        methods.push(Method::from(sampled));
+        methods.push(sampled);
     }
     // Epipolar sampling with a rectified map of as many rows as slices (512x512): a quarter
     // of the fixed passes' texels, which dominate the sampled prefiltered and minmax frames;
@@ -1015,7 +1041,7 @@ fn headline_runs(ctx: &Context, config: &BenchConfig) -> Result<Vec<HeadlineRow>
     let screen = [1280, 720];
     let mut out = Vec::new();
     for name in [SceneName::Sphere, SceneName::Foliage, SceneName::Terrain] {
-        let bench = bench_scene(ctx, name, screen)?;
+        let bench = bench_scene(ctx, name, config.headline_pose, screen)?;
         let runs = time_methods_on(ctx, &methods, name, &bench, screen, [1024, 1024], frames)?;
         let truth = errors.then(|| {
             truth::render(
@@ -1061,7 +1087,7 @@ fn scaling_runs(ctx: &Context, frames: u32) -> Result<Vec<ScalingRow>, BoxError>
     for (screen, rectified) in configs {
         let BenchScene {
             scene, sm, dv, sv, ..
-        } = bench_scene(ctx, SceneName::Sphere, screen)?;
+        } = bench_scene(ctx, SceneName::Sphere, Pose::Ordinary, screen)?;
         let mut pass = Prefiltered::new(
             ctx,
             &PrefilteredVariant::default(),
@@ -1441,13 +1467,11 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
     // Issue 14: each family sampled against itself per pixel, and the best sampled
     // configuration against brute-force raymarch n256 at equal or lower error.
     let mut best: Option<(String, f64, f64)> = None;
-    for (base, sampled) in sampled_variants() {
-        let px = Method::from(base);
+    for (px, m) in sampled_variants() {
         let Some((pt, pe)) = headline_mean(px.family(), &px.knobs()) else {
             continue;
         };
         {
-            let m = Method::from(sampled);
             if let Some((t, e)) = headline_mean(m.family(), &m.knobs()) {
                 out.push(format!(
                     "sampled vs per pixel, headline means: {} {} {t:.1} ms at rel L1 {:.3} % / {} {pt:.1} ms at {:.3} %: {:.2}x faster, {:+.3} points",
@@ -1468,8 +1492,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
     if let (Some((name, _, _)), Some((rt, re))) = (&best, headline_mean("raymarch", "n256-i1")) {
         // The fastest sampled configuration whose error is at or below raymarch n256's.
         let mut at_error: Option<(String, f64, f64)> = None;
-        for (_, sampled) in sampled_variants() {
-            let m = Method::from(sampled);
+        for (_, m) in sampled_variants() {
             if let Some((t, e)) = headline_mean(m.family(), &m.knobs())
                 && e <= re
                 && at_error.as_ref().is_none_or(|b| t < b.1)
