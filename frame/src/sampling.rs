@@ -197,7 +197,12 @@ impl SamplingKnobs {
 
     /// Allowed `slices`.
     pub const SLICES: [u32; 5] = [64, 128, 256, 512, 1024];
-    /// `slices` when not chosen (Yusov 2013's high-quality setting).
+    /// `slices` when not chosen (Yusov 2013's high-quality setting, for screens up to
+    /// 2560x1600: about 16 pixels of the screen's border per slice). At 1280x720 and below 256
+    /// give that spacing: measured there (raymarch N = 64, stop 45), 256 slices took 15-17 %
+    /// less of the frame than 512 (5.96x against 5.02x faster than per pixel in the sixteenth
+    /// bench run) for 0.005 points of rel L1 on the bench's scenes, and on all 24 suite poses
+    /// stayed 0.096 points below per pixel on the mean (the worst pose +0.150).
     pub const DEFAULT_SLICES: u32 = 512;
     /// Allowed `slice_samples`.
     pub const SLICE_SAMPLES: [u32; 4] = [64, 128, 256, 512];
