@@ -962,10 +962,49 @@ fn run_on_gpu(
             pass_wall_frames,
         )?);
     }
+    // With lowres or epipolar sampling: the pixels no sample stood for, which the
+    // `_fallback` pass evaluated per pixel (one more frame through the generic runtime,
+    // which reads the unwarp's count back).
+    let fallback = if variant.sampling().is_sampled() {
+        let rectified = match &variant {
+            FamilyVariant::Prefiltered(v) => {
+                let prepared = prepare_frame(
+                    v,
+                    &res,
+                    &frame.camera,
+                    &frame.light,
+                    &frame.medium,
+                    &frame.shadow_map,
+                    &frame.settings,
+                )?;
+                engine_rectified_map(scene, bvh, &prepared)
+            }
+            _ => None,
+        };
+        let inputs = CpuInputs {
+            frame,
+            depth: gbuf.view_depth.clone(),
+            shadow_map: sm.depth.clone(),
+            rectified,
+            pass_wall_frames: 0,
+            cookie: cookie_texels(scene, variant),
+            vpl_maps: area_inputs.as_ref().map(|i| i.map_data.clone()),
+        };
+        scatter_runtime::run_family_once(&ctx, &variant, res, &inputs)?.fallback_pixels
+    } else {
+        None
+    };
     let family = variant.family();
     let sizes = sizes(gbuf, plan.rectified);
     eprintln!("{family} {} on the GPU ({sizes})", variant.id());
     print_report(report.as_ref());
+    if let Some(n) = fallback {
+        let pixels = u64::from(gbuf.width) * u64::from(gbuf.height);
+        println!(
+            "fallback: {n} of {pixels} pixels ({:.2} %) had no sample close in depth or in light and were evaluated per pixel",
+            100.0 * f64::from(n) / pixels.max(1) as f64
+        );
+    }
     println!(
         "wall time per frame, submission to mapped readback of every texture (min of {} frames): {:.3} ms",
         gpu.frames,
