@@ -812,26 +812,7 @@ fn run_on_gpu(
             })
         }
         FamilyVariant::Prefiltered(v) => {
-            // A projective frame needs the engine's rasterised rectified map (ray cast
-            // here).
-            let prepared = prepare_frame(
-                v,
-                &res,
-                &frame.camera,
-                &frame.light,
-                &frame.medium,
-                &frame.shadow_map,
-                &frame.settings,
-            )?;
-            let mut inputs = CpuInputs {
-                frame,
-                depth: gbuf.view_depth.clone(),
-                shadow_map: sm.depth.clone(),
-                rectified: engine_rectified_map(scene, bvh, &prepared),
-                pass_wall_frames: 0,
-                cookie: cookie_texels(scene, variant),
-                vpl_maps: None,
-            };
+            let mut inputs = cpu_inputs(&variant, res, frame, scene, bvh, gbuf, sm, None)?;
             let ctx = &ctx;
             let pass_walls = &mut pass_walls;
             Box::new(move |last| {
@@ -966,30 +947,8 @@ fn run_on_gpu(
     // `_fallback` pass evaluated per pixel (one more frame through the generic runtime,
     // which reads the unwarp's count back).
     let fallback = if variant.sampling().is_sampled() {
-        let rectified = match &variant {
-            FamilyVariant::Prefiltered(v) => {
-                let prepared = prepare_frame(
-                    v,
-                    &res,
-                    &frame.camera,
-                    &frame.light,
-                    &frame.medium,
-                    &frame.shadow_map,
-                    &frame.settings,
-                )?;
-                engine_rectified_map(scene, bvh, &prepared)
-            }
-            _ => None,
-        };
-        let inputs = CpuInputs {
-            frame,
-            depth: gbuf.view_depth.clone(),
-            shadow_map: sm.depth.clone(),
-            rectified,
-            pass_wall_frames: 0,
-            cookie: cookie_texels(scene, variant),
-            vpl_maps: area_inputs.as_ref().map(|i| i.map_data.clone()),
-        };
+        let vpl_maps = area_inputs.as_ref().map(|i| i.map_data.clone());
+        let inputs = cpu_inputs(&variant, res, frame, scene, bvh, gbuf, sm, vpl_maps)?;
         scatter_runtime::run_family_once(&ctx, &variant, res, &inputs)?.fallback_pixels
     } else {
         None
@@ -1045,6 +1004,45 @@ fn run_on_gpu(
         output.iter().map(|c| [c[0], c[1], c[2]]).collect(),
     );
     Ok(image)
+}
+
+/// A frame's inputs as the runtime's `run_*_once` helpers take them: for a prefiltered
+/// variant also the engine's rectified map (ray cast here), which a projective frame needs.
+#[allow(clippy::too_many_arguments, reason = "the frame's inputs")]
+fn cpu_inputs(
+    variant: &FamilyVariant,
+    res: Resolutions,
+    frame: FrameInput,
+    scene: &Scene,
+    bvh: &Bvh,
+    gbuf: &GBuffer,
+    sm: &ShadowMap,
+    vpl_maps: Option<Vec<f32>>,
+) -> Result<CpuInputs, BoxError> {
+    let rectified = match variant {
+        FamilyVariant::Prefiltered(v) => {
+            let prepared = prepare_frame(
+                v,
+                &res,
+                &frame.camera,
+                &frame.light,
+                &frame.medium,
+                &frame.shadow_map,
+                &frame.settings,
+            )?;
+            engine_rectified_map(scene, bvh, &prepared)
+        }
+        _ => None,
+    };
+    Ok(CpuInputs {
+        frame,
+        depth: gbuf.view_depth.clone(),
+        shadow_map: sm.depth.clone(),
+        rectified,
+        pass_wall_frames: 0,
+        cookie: cookie_texels(scene, *variant),
+        vpl_maps,
+    })
 }
 
 /// The wall time of each of the variant's passes submitted on its own (median of `frames`),
