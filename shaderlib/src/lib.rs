@@ -39,6 +39,7 @@ pub mod raymarch;
 pub mod reflect;
 pub mod row_prefix;
 pub mod sampling;
+pub mod uniform_branches;
 
 use area_ivsv::AreaIvsvVariant;
 pub use compose::capabilities;

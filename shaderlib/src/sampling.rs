@@ -32,6 +32,8 @@ pub(crate) struct SamplingView {
     pub step: u32,
     /// Invocations per slice of the epipolar samples pass ([`SLICE_LANES`]).
     pub slice_lanes: u32,
+    /// Pixels per axis per invocation of the `_fallback` pass ([`FALLBACK_TILE`]).
+    pub fallback_tile: u32,
     /// The kernel's entry point.
     pub entry: &'static str,
     /// The family kernel's entry point (`entry` without `_unwarp` or `_fallback`).
@@ -92,6 +94,7 @@ impl SamplingView {
             slice_samples: knobs.slice_samples,
             step: knobs.step,
             slice_lanes: SLICE_LANES,
+            fallback_tile: FALLBACK_TILE,
             entry: kernel.name(),
             family_entry: family_kernel.name(),
             pixel: format!("{}_pixel", family_kernel.name()),
@@ -317,8 +320,9 @@ pub fn unwarp_block(knobs: &SamplingKnobs) -> u32 {
 
 /// The `_fallback` pass `kernel` of a family kernel's sampled pass `family`: the same
 /// bindings with `output` where `family` writes the samples texture, and `fallback_count`
-/// and `fallback_pixels` read at `binding + 1` and `+ 2`; one invocation per 8 x 8 pixels,
-/// each evaluating every `invocations`-th listed pixel.
+/// and `fallback_pixels` read at `binding + 1` and `+ 2`; one invocation per
+/// [`FALLBACK_TILE`] x [`FALLBACK_TILE`] pixels, each evaluating every `invocations`-th listed
+/// pixel.
 pub fn fallback_pass(
     family: crate::plan::PassPlan,
     kernel: Kernel,
@@ -374,8 +378,15 @@ pub fn fallback_buffers(knobs: &SamplingKnobs) -> Vec<crate::plan::Resource> {
 pub const FALLBACK_COUNT: &str = "fallback_count";
 /// The fallback list's pixels.
 pub const FALLBACK_PIXELS: &str = "fallback_pixels";
-/// The `_fallback` pass runs one invocation per `FALLBACK_TILE` x `FALLBACK_TILE` pixels.
-pub const FALLBACK_TILE: u32 = 8;
+/// The `_fallback` pass runs one invocation per `FALLBACK_TILE` x `FALLBACK_TILE` pixels (40 x 23
+/// at 1280x720: 15 workgroups of 64). llvmpipe runs a loop's body once for every 8-lane batch
+/// of a workgroup even where no lane takes it, so every batch of an empty stretch of the list
+/// cost one evaluation of the family's body: with one invocation per 8 x 8 pixels (240
+/// workgroups) the pass took 1.1 ms (`scatter_fallback`) and 2.5 ms (`minmax_traverse_fallback`)
+/// on `sphere` with a few hundred pixels listed, 0.3 and 0.2 ms with 32 x 32; on `foliage`
+/// (1.3 % of the pixels listed) 3.2-5.1 and 4.6-5.2 ms against 2.1-2.2 and 2.4 (stop 46,
+/// docs/roofline.md). A list of 1 % of a 1920x1080 screen is 10 pixels per invocation.
+pub const FALLBACK_TILE: u32 = 32;
 
 /// Invocations (one workgroup) per slice of the epipolar samples pass: one 8-lane batch of
 /// llvmpipe's (256-bit vectors). llvmpipe runs a loop's body at least once for every 8-lane

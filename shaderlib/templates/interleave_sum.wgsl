@@ -61,7 +61,8 @@ fn interleave_sum(
         var acc = vec3<f32>(0.0, 0.0, 0.0);
         if row < end_row && col < w {
             let start = window_start(col, mx, w);
-            for (var i = 0u; i < mx; i++) {
+            // `i + 1u <= mx`: see the rows loop below.
+            for (var i = 0u; i + 1u <= mx; i++) {
                 acc += textureLoad(partial, vec2<u32>(start + i, row), 0).xyz;
             }
         }
@@ -76,7 +77,9 @@ fn interleave_sum(
     }
     let start = window_start(y, my, h) - first_row;
     var total = vec3<f32>(0.0, 0.0, 0.0);
-    for (var i = 0u; i < my; i++) {
+    // `i + 1u <= n`, not `i < n`: lavapipe re-specialises a shader at every dispatch when a loop
+    // compares its counter with a uniform (`scatter_shaderlib::uniform_branches`).
+    for (var i = 0u; i + 1u <= my; i++) {
         total += hsum[start + i][x - x0];
     }
     textureStore(output, vec2<u32>(x, y), vec4<f32>(total.x, total.y, total.z, 1.0));

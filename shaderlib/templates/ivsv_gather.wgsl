@@ -230,7 +230,9 @@ fn ivsv_gather_pixel(x: u32, y: u32) -> vec3<f32> {
     let first = ((x % mi) + mi * (y % mi)) * per_class;
     for (var v = first; v < first + per_class; v += 1u) {
 {%- else %}
-    for (var v = 0u; v < m.sizes[3]; v += 1u) {
+    // `v + 1u <= n`, not `v < n`: lavapipe re-specialises a shader at every dispatch when a loop
+    // compares its counter with a uniform (`scatter_shaderlib::uniform_branches`).
+    for (var v = 0u; v + 1u <= m.sizes[3]; v += 1u) {
 {%- endif %}
         let r = vpls[v];
         sum += r.color.xyz * vpl_lit(m, r, v, dir, s);

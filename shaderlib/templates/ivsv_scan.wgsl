@@ -37,7 +37,9 @@ fn ivsv_scan(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     var acc = 0u;
-    for (var i = 0u; i < m.grid[0]; i += 1u) {
+    // `i + 1u <= n`, not `i < n`: lavapipe re-specialises a shader at every dispatch when a loop
+    // compares its counter with a uniform (`scatter_shaderlib::uniform_branches`).
+    for (var i = 0u; i + 1u <= m.grid[0]; i += 1u) {
         let at = voxel_word(m, v, j, i) + w;
         acc = acc | atomicExchange(&marks[at], 0u);
         volume[at] = acc;

@@ -49,7 +49,7 @@
 // Mirrors reference/src/kernels/pst_sweep.rs
 
 #import scatter::model::{cone_falloff, phase_hg, transmittance_between}
-#import scatter::epipolar::{Frame, edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta, row_index, row_phi, slice_e, slice_params}
+#import scatter::epipolar::{Frame, in_epipole_disc, edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta, row_index, row_phi, slice_e, slice_params}
 {%- if cookie %}
 #import scatter::cookie::{epipole_march_cookie, frame_cookie, lit_span_cookie}
 {%- endif %}
@@ -159,12 +159,7 @@ fn pst_ray(pc: vec2<f32>, z: f32) -> PstRay {
     var r = PstRay(false, vec3<f32>(0.0, 0.0, 0.0), eye, dir, s, 0u, 0.0, 0.0, 0.0);
 
     // Near the epipole and the anti-epipole the rectification degenerates: march instead.
-    let px = vec3<f32>(pc, 0.0);
-    let radius = f.epipole[3];
-    let near_epi = f.epipole[2] > 0.5 && length(px - vec3<f32>(f.epipole[0], f.epipole[1], 0.0)) < radius;
-    let near_anti =
-        f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
-    if near_epi || near_anti {
+    if in_epipole_disc(f, pc) {
         r.marched = true;
 {%- if cookie %}
         r.color = epipole_march_cookie(frame, shadow_map, cookie, eye, dir, s) * f.light_color.xyz;

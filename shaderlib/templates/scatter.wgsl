@@ -77,7 +77,7 @@
 // Mirrors reference/src/kernels/scatter.rs
 
 #import scatter::model::{ {%- if !moments %}PI, {% endif %}phase_hg, transmittance_between, transmittance_integral}
-#import scatter::epipolar::{Frame, epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_t, row_index, slice_params, spot_segment}
+#import scatter::epipolar::{Frame, in_epipole_disc, epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_t, row_index, slice_params, spot_segment}
 {%- if moments %}
 #import scatter::prefiltered::region_start
 #import scatter::moments::{lit_moments{{ moment_count }}, moment_z}
@@ -135,12 +135,7 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     let color = f.light_color.xyz;
 
     // Near the epipole and the anti-epipole the rectification degenerates: march instead.
-    let px = vec3<f32>(f32(x) + 0.5, f32(y) + 0.5, 0.0);
-    let radius = f.epipole[3];
-    let near_epi = f.epipole[2] > 0.5 && length(px - vec3<f32>(f.epipole[0], f.epipole[1], 0.0)) < radius;
-    let near_anti =
-        f.anti_epipole[2] > 0.5 && length(px - vec3<f32>(f.anti_epipole[0], f.anti_epipole[1], 0.0)) < radius;
-    if near_epi || near_anti {
+    if in_epipole_disc(f, vec2<f32>(f32(x) + 0.5, f32(y) + 0.5)) {
 {%- if cookie %}
         let l = epipole_march_cookie(frame, shadow_map, cookie, eye, dir, s) * color;
 {%- else %}

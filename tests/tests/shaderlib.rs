@@ -3,7 +3,9 @@
 
 use std::path::Path;
 
-use scatter_shaderlib::family::{Family, kernels};
+use scatter_shaderlib::family::{Family, KernelFamily, kernels};
+use scatter_shaderlib::sampling::SamplingKnobs;
+use scatter_shaderlib::uniform_branches::uniform_branches;
 use scatter_shaderlib::{Kernel, KernelParams, build};
 
 fn workspace_root() -> &'static Path {
@@ -62,4 +64,84 @@ fn every_template_names_its_existing_mirror() {
             "missing CPU mirror {mirror}"
         );
     }
+}
+
+/// No kernel of any family's grid branches on uniforms alone: lavapipe 22.3 re-specialises
+/// such a shader at every dispatch (`scatter_shaderlib::uniform_branches`; the raymarch
+/// epipolar samples pass 6.9-7.7 ms with one such branch, 3.3-4.2 without). The one exception
+/// is the projective variants' rectification switch (`frame.proj[0]`, chosen per frame in
+/// `rectification = projective`): a branch between two whole algorithms, which on a GPU costs
+/// nothing and as a select would run both for every pixel.
+#[test]
+fn no_kernel_branches_on_uniforms_only() {
+    // Every grid variant, and every family's default with each sampling (the samples
+    // passes are kernels of their own).
+    let mut params: Vec<KernelParams> = KernelParams::all_modes();
+    for &f in Family::ALL {
+        let sampled = [
+            SamplingKnobs::lowres(2),
+            SamplingKnobs::lowres(4),
+            SamplingKnobs::epipolar(256),
+            SamplingKnobs::epipolar(SamplingKnobs::DEFAULT_SLICES),
+        ]
+        .map(|k| f.default_variant().with_sampling(k))
+        .into_iter()
+        .filter(|v| v.validate().is_ok());
+        for v in f.grid().into_iter().chain(sampled) {
+            for p in v.kernel_params() {
+                if !params.contains(&p) {
+                    params.push(p);
+                }
+            }
+        }
+    }
+    let mut failures = Vec::new();
+    let mut switches = 0;
+    for p in &params {
+        let built = build(p).unwrap_or_else(|e| panic!("{}: {e}", p.kernel()));
+        // The `proj` member of the kernel's `frame` uniform, where it has one.
+        let proj = built.module.global_variables.iter().find_map(|(_, g)| {
+            let naga::TypeInner::Struct { members, .. } = &built.module.types[g.ty].inner else {
+                return None;
+            };
+            let i = members
+                .iter()
+                .position(|m| m.name.as_deref() == Some("proj"))?;
+            (g.name.as_deref() == Some("frame")).then(|| format!("frame.{i}.0"))
+        });
+        for b in uniform_branches(&built.module, built.entry_point) {
+            // `depth_columns` loops over the rows up to `frame.sizes[1]`; lavapipe leaves it
+            // alone (a shader under 100 NIR values, `lvp_shader_init`: no shader-cache reads
+            // per frame under strace), and with the bound written `y + 1u <= n` the pass took
+            // 0.3 ms longer (1.8-2.2 ms against 1.5-1.9, stop 46).
+            if p.kernel() == Kernel::DepthColumns {
+                continue;
+            }
+            let switch = proj.as_ref().is_some_and(|proj| b.reads == [proj.clone()])
+                && matches!(
+                    p.kernel(),
+                    Kernel::Scatter | Kernel::Prefilter | Kernel::SliceFit
+                );
+            if switch {
+                switches += 1;
+            } else {
+                failures.push(format!("{}: {b}", p.kernel()));
+            }
+        }
+    }
+    failures.sort();
+    failures.dedup();
+    eprintln!(
+        "{} parameter sets, {switches} rectification switches (projective variants)",
+        params.len()
+    );
+    assert!(
+        failures.is_empty(),
+        "branches on uniforms alone:\n{}",
+        failures.join("\n")
+    );
+    assert!(
+        switches > 0,
+        "the projective variants' switch was not seen: the check reads nothing"
+    );
 }

@@ -76,8 +76,8 @@ void main() {
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e75 = k;
-            k = (_e75 + 64u);
+            uint _e77 = k;
+            k = (_e77 + 64u);
         }
         loop_init = false;
         uint _e32 = k;
@@ -105,26 +105,26 @@ void main() {
                 bool loop_init_1 = true;
                 while(true) {
                     if (!loop_init_1) {
-                        uint _e69 = i;
-                        i = (_e69 + 1u);
+                        uint _e71 = i;
+                        i = (_e71 + 1u);
                     }
                     loop_init_1 = false;
                     uint _e57 = i;
-                    if ((_e57 < mx)) {
+                    if (((_e57 + 1u) <= mx)) {
                     } else {
                         break;
                     }
                     {
-                        vec3 _e59 = acc;
-                        uint _e60 = i;
-                        int _e65_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
-                        vec4 _e65 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2((_e54 + _e60), row)), ivec2(0), textureSize(_group_0_binding_1_cs, _e65_clamped_lod) - ivec2(1)), _e65_clamped_lod);
-                        acc = (_e59 + _e65.xyz);
+                        vec3 _e61 = acc;
+                        uint _e62 = i;
+                        int _e67_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+                        vec4 _e67 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2((_e54 + _e62), row)), ivec2(0), textureSize(_group_0_binding_1_cs, _e67_clamped_lod) - ivec2(1)), _e67_clamped_lod);
+                        acc = (_e61 + _e67.xyz);
                     }
                 }
             }
-            vec3 _e74 = acc;
-            hsum[r][c] = _e74;
+            vec3 _e76 = acc;
+            hsum[r][c] = _e76;
         }
     }
     memoryBarrierShared();
@@ -136,35 +136,35 @@ void main() {
     } else {
         local_1 = true;
     }
-    bool _e87 = local_1;
-    if (_e87) {
+    bool _e89 = local_1;
+    if (_e89) {
         return;
     }
-    uint _e88 = window_startX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(y, my, h);
-    uint start = (_e88 - _e27);
+    uint _e90 = window_startX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(y, my, h);
+    uint start = (_e90 - _e27);
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e104 = i_1;
-            i_1 = (_e104 + 1u);
+            uint _e108 = i_1;
+            i_1 = (_e108 + 1u);
         }
         loop_init_2 = false;
-        uint _e91 = i_1;
-        if ((_e91 < my)) {
+        uint _e93 = i_1;
+        if (((_e93 + 1u) <= my)) {
         } else {
             break;
         }
         {
-            vec3 _e94 = total;
-            uint _e96 = i_1;
-            vec3 _e101 = hsum[(start + _e96)][(x - x0_)];
-            total = (_e94 + _e101);
+            vec3 _e98 = total;
+            uint _e100 = i_1;
+            vec3 _e105 = hsum[(start + _e100)][(x - x0_)];
+            total = (_e98 + _e105);
         }
     }
-    float _e108 = total.x;
-    float _e110 = total.y;
-    float _e112 = total.z;
-    imageStore(_group_0_binding_2_cs, ivec2(uvec2(x, y)), vec4(_e108, _e110, _e112, 1.0));
+    float _e112 = total.x;
+    float _e114 = total.y;
+    float _e116 = total.z;
+    imageStore(_group_0_binding_2_cs, ivec2(uvec2(x, y)), vec4(_e112, _e114, _e116, 1.0));
     return;
 }
 

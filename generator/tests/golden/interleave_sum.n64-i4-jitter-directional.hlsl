@@ -81,8 +81,8 @@ void interleave_sum(uint3 gid : SV_DispatchThreadID, uint3 wid : SV_GroupID, uin
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e75 = k;
-            k = (_e75 + 64u);
+            uint _e77 = k;
+            k = (_e77 + 64u);
         }
         loop_init = false;
         uint _e32 = k;
@@ -113,25 +113,25 @@ void interleave_sum(uint3 gid : SV_DispatchThreadID, uint3 wid : SV_GroupID, uin
                     if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
                     loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
                     if (!loop_init_1) {
-                        uint _e69 = i;
-                        i = (_e69 + 1u);
+                        uint _e71 = i;
+                        i = (_e71 + 1u);
                     }
                     loop_init_1 = false;
                     uint _e57 = i;
-                    if ((_e57 < mx)) {
+                    if (((_e57 + 1u) <= mx)) {
                     } else {
                         break;
                     }
                     {
-                        float3 _e59 = acc;
-                        uint _e60 = i;
-                        float4 _e65 = partial.Load(int3(uint2((_e54 + _e60), row), int(0)));
-                        acc = (_e59 + _e65.xyz);
+                        float3 _e61 = acc;
+                        uint _e62 = i;
+                        float4 _e67 = partial.Load(int3(uint2((_e54 + _e62), row), int(0)));
+                        acc = (_e61 + _e67.xyz);
                     }
                 }
             }
-            float3 _e74 = acc;
-            hsum[min(uint(r), 14u)][min(uint(c), 7u)] = _e74;
+            float3 _e76 = acc;
+            hsum[min(uint(r), 14u)][min(uint(c), 7u)] = _e76;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -142,37 +142,37 @@ void interleave_sum(uint3 gid : SV_DispatchThreadID, uint3 wid : SV_GroupID, uin
     } else {
         local_1 = true;
     }
-    bool _e87 = local_1;
-    if (_e87) {
+    bool _e89 = local_1;
+    if (_e89) {
         return;
     }
-    const uint _e88 = window_startX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(y, my, h);
-    uint start = (_e88 - _e27);
+    const uint _e90 = window_startX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(y, my, h);
+    uint start = (_e90 - _e27);
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e104 = i_1;
-            i_1 = (_e104 + 1u);
+            uint _e108 = i_1;
+            i_1 = (_e108 + 1u);
         }
         loop_init_2 = false;
-        uint _e91 = i_1;
-        if ((_e91 < my)) {
+        uint _e93 = i_1;
+        if (((_e93 + 1u) <= my)) {
         } else {
             break;
         }
         {
-            float3 _e94 = total;
-            uint _e96 = i_1;
-            float3 _e101 = hsum[min(uint((start + _e96)), 14u)][min(uint((x - x0_)), 7u)];
-            total = (_e94 + _e101);
+            float3 _e98 = total;
+            uint _e100 = i_1;
+            float3 _e105 = hsum[min(uint((start + _e100)), 14u)][min(uint((x - x0_)), 7u)];
+            total = (_e98 + _e105);
         }
     }
-    float _e108 = total.x;
-    float _e110 = total.y;
-    float _e112 = total.z;
-    output[uint2(x, y)] = float4(_e108, _e110, _e112, 1.0);
+    float _e112 = total.x;
+    float _e114 = total.y;
+    float _e116 = total.z;
+    output[uint2(x, y)] = float4(_e112, _e114, _e116, 1.0);
     return;
 }

@@ -96,8 +96,8 @@ kernel void interleave_sum(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e75 = k;
-            k = _e75 + 64u;
+            uint _e77 = k;
+            k = _e77 + 64u;
         }
         loop_init = false;
         uint _e32 = k;
@@ -128,26 +128,26 @@ kernel void interleave_sum(
                     if (metal::all(loop_bound_1 == uint2(0u))) { break; }
                     loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
                     if (!loop_init_1) {
-                        uint _e69 = i;
-                        i = _e69 + 1u;
+                        uint _e71 = i;
+                        i = _e71 + 1u;
                     }
                     loop_init_1 = false;
                     uint _e57 = i;
-                    if (_e57 < mx) {
+                    if ((_e57 + 1u) <= mx) {
                     } else {
                         break;
                     }
                     {
-                        metal::float3 _e59 = acc;
-                        uint _e60 = i;
-                        uint clamped_lod_e65 = metal::min(uint(0), partial.get_num_mip_levels() - 1);
-                        metal::float4 _e65 = partial.read(metal::min(metal::uint2(metal::uint2(_e54 + _e60, row)), metal::uint2(partial.get_width(clamped_lod_e65), partial.get_height(clamped_lod_e65)) - 1), clamped_lod_e65);
-                        acc = _e59 + _e65.xyz;
+                        metal::float3 _e61 = acc;
+                        uint _e62 = i;
+                        uint clamped_lod_e67 = metal::min(uint(0), partial.get_num_mip_levels() - 1);
+                        metal::float4 _e67 = partial.read(metal::min(metal::uint2(metal::uint2(_e54 + _e62, row)), metal::uint2(partial.get_width(clamped_lod_e67), partial.get_height(clamped_lod_e67)) - 1), clamped_lod_e67);
+                        acc = _e61 + _e67.xyz;
                     }
                 }
             }
-            metal::float3 _e74 = acc;
-            hsum.inner[metal::min(unsigned(r), 14u)].inner[metal::min(unsigned(c), 7u)] = _e74;
+            metal::float3 _e76 = acc;
+            hsum.inner[metal::min(unsigned(r), 14u)].inner[metal::min(unsigned(c), 7u)] = _e76;
         }
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
@@ -158,37 +158,37 @@ kernel void interleave_sum(
     } else {
         local_1 = true;
     }
-    bool _e87 = local_1;
-    if (_e87) {
+    bool _e89 = local_1;
+    if (_e89) {
         return;
     }
-    uint _e88 = window_startX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(y, my, h);
-    uint start = _e88 - _e27;
+    uint _e90 = window_startX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(y, my, h);
+    uint start = _e90 - _e27;
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e104 = i_1;
-            i_1 = _e104 + 1u;
+            uint _e108 = i_1;
+            i_1 = _e108 + 1u;
         }
         loop_init_2 = false;
-        uint _e91 = i_1;
-        if (_e91 < my) {
+        uint _e93 = i_1;
+        if ((_e93 + 1u) <= my) {
         } else {
             break;
         }
         {
-            metal::float3 _e94 = total;
-            uint _e96 = i_1;
-            metal::float3 _e101 = hsum.inner[metal::min(unsigned(start + _e96), 14u)].inner[metal::min(unsigned(x - x0_), 7u)];
-            total = _e94 + _e101;
+            metal::float3 _e98 = total;
+            uint _e100 = i_1;
+            metal::float3 _e105 = hsum.inner[metal::min(unsigned(start + _e100), 14u)].inner[metal::min(unsigned(x - x0_), 7u)];
+            total = _e98 + _e105;
         }
     }
-    float _e108 = total.x;
-    float _e110 = total.y;
-    float _e112 = total.z;
-    output.write(metal::float4(_e108, _e110, _e112, 1.0), metal::uint2(metal::uint2(x, y)));
+    float _e112 = total.x;
+    float _e114 = total.y;
+    float _e116 = total.z;
+    output.write(metal::float4(_e112, _e114, _e116, 1.0), metal::uint2(metal::uint2(x, y)));
     return;
 }

@@ -89,28 +89,28 @@ fn interleave_sum(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(workgr
                 i = 0u;
                 loop {
                     let _e57 = i;
-                    if (_e57 < mx) {
+                    if ((_e57 + 1u) <= mx) {
                     } else {
                         break;
                     }
                     {
-                        let _e59 = acc;
-                        let _e60 = i;
-                        let _e65 = textureLoad(partial, vec2<u32>((_e54 + _e60), row), 0i);
-                        acc = (_e59 + _e65.xyz);
+                        let _e61 = acc;
+                        let _e62 = i;
+                        let _e67 = textureLoad(partial, vec2<u32>((_e54 + _e62), row), 0i);
+                        acc = (_e61 + _e67.xyz);
                     }
                     continuing {
-                        let _e69 = i;
-                        i = (_e69 + 1u);
+                        let _e71 = i;
+                        i = (_e71 + 1u);
                     }
                 }
             }
-            let _e74 = acc;
-            hsum[r][c] = _e74;
+            let _e76 = acc;
+            hsum[r][c] = _e76;
         }
         continuing {
-            let _e75 = k;
-            k = (_e75 + 64u);
+            let _e77 = k;
+            k = (_e77 + 64u);
         }
     }
     workgroupBarrier();
@@ -121,32 +121,32 @@ fn interleave_sum(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(workgr
     } else {
         local_1 = true;
     }
-    let _e87 = local_1;
-    if _e87 {
+    let _e89 = local_1;
+    if _e89 {
         return;
     }
-    let _e88 = window_startX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(y, my, h);
-    let start = (_e88 - _e27);
+    let _e90 = window_startX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(y, my, h);
+    let start = (_e90 - _e27);
     loop {
-        let _e91 = i_1;
-        if (_e91 < my) {
+        let _e93 = i_1;
+        if ((_e93 + 1u) <= my) {
         } else {
             break;
         }
         {
-            let _e94 = total;
-            let _e96 = i_1;
-            let _e101 = hsum[(start + _e96)][(x - x0_)];
-            total = (_e94 + _e101);
+            let _e98 = total;
+            let _e100 = i_1;
+            let _e105 = hsum[(start + _e100)][(x - x0_)];
+            total = (_e98 + _e105);
         }
         continuing {
-            let _e104 = i_1;
-            i_1 = (_e104 + 1u);
+            let _e108 = i_1;
+            i_1 = (_e108 + 1u);
         }
     }
-    let _e108 = total.x;
-    let _e110 = total.y;
-    let _e112 = total.z;
-    textureStore(output, vec2<u32>(x, y), vec4<f32>(_e108, _e110, _e112, 1f));
+    let _e112 = total.x;
+    let _e114 = total.y;
+    let _e116 = total.z;
+    textureStore(output, vec2<u32>(x, y), vec4<f32>(_e112, _e114, _e116, 1f));
     return;
 }

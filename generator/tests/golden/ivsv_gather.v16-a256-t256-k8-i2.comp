@@ -65,11 +65,8 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
     float x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_2 * x_2) * (3.0 - (2.0 * x_2)));
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_2 * x_2) * (3.0 - (2.0 * x_2))));
 }
 
 vec3 ivsv_pixel_dir(IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX m_1, uint x, uint y) {

@@ -78,11 +78,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_inner,
     float cos_outer
 ) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
     float x_2 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_2 * x_2) * (3.0 - (2.0 * x_2));
+    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_2 * x_2) * (3.0 - (2.0 * x_2)));
 }
 
 metal::float3 ivsv_pixel_dir(

@@ -63,11 +63,8 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
     let x_2 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_2 * x_2) * (3f - (2f * x_2)));
+    return select(((x_2 * x_2) * (3f - (2f * x_2))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
 fn ivsv_pixel_dir(m_1: IvsvFrameX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX, x: u32, y: u32) -> vec3<f32> {

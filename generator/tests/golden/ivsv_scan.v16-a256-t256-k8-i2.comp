@@ -55,24 +55,24 @@ void main() {
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e40 = i;
-            i = (_e40 + 1u);
+            uint _e42 = i;
+            i = (_e42 + 1u);
         }
         loop_init = false;
         uint _e23 = i;
-        if ((_e23 < m_1.grid.x)) {
+        if (((_e23 + 1u) <= m_1.grid.x)) {
         } else {
             break;
         }
         {
-            uint _e27 = i;
-            uint _e28 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_1, v_1, j_1, _e27);
-            uint at = (_e28 + w);
-            uint _e31 = acc;
-            uint _e35 = atomicExchange(_group_0_binding_1_cs[at], 0u);
-            acc = (_e31 | _e35);
-            uint _e39 = acc;
-            _group_0_binding_2_cs[at] = _e39;
+            uint _e29 = i;
+            uint _e30 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_1, v_1, j_1, _e29);
+            uint at = (_e30 + w);
+            uint _e33 = acc;
+            uint _e37 = atomicExchange(_group_0_binding_1_cs[at], 0u);
+            acc = (_e33 | _e37);
+            uint _e41 = acc;
+            _group_0_binding_2_cs[at] = _e41;
         }
     }
     return;

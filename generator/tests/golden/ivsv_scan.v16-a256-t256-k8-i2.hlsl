@@ -63,24 +63,24 @@ void ivsv_scan(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e40 = i;
-            i = (_e40 + 1u);
+            uint _e42 = i;
+            i = (_e42 + 1u);
         }
         loop_init = false;
         uint _e23 = i;
-        if ((_e23 < m_1.grid.x)) {
+        if (((_e23 + 1u) <= m_1.grid.x)) {
         } else {
             break;
         }
         {
-            uint _e27 = i;
-            const uint _e28 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_1, v_1, j_1, _e27);
-            uint at = (_e28 + w);
-            uint _e31 = acc;
-            uint _e35; marks.InterlockedExchange(at*4, 0u, _e35);
-            acc = (_e31 | _e35);
-            uint _e39 = acc;
-            volume.Store(at*4, asuint(_e39));
+            uint _e29 = i;
+            const uint _e30 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_1, v_1, j_1, _e29);
+            uint at = (_e30 + w);
+            uint _e33 = acc;
+            uint _e37; marks.InterlockedExchange(at*4, 0u, _e37);
+            acc = (_e33 | _e37);
+            uint _e41 = acc;
+            volume.Store(at*4, asuint(_e41));
         }
     }
     return;

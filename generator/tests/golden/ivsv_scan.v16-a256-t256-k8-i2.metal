@@ -80,24 +80,24 @@ kernel void ivsv_scan(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e40 = i;
-            i = _e40 + 1u;
+            uint _e42 = i;
+            i = _e42 + 1u;
         }
         loop_init = false;
         uint _e23 = i;
-        if (_e23 < m_1.grid.x) {
+        if ((_e23 + 1u) <= m_1.grid.x) {
         } else {
             break;
         }
         {
-            uint _e27 = i;
-            uint _e28 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_1, v_1, j_1, _e27);
-            uint at = _e28 + w;
-            uint _e31 = acc;
-            uint _e35 = metal::atomic_exchange_explicit(&marks[metal::min(unsigned(at), (_buffer_sizes.size1 - 0 - 4) / 4)], 0u, metal::memory_order_relaxed);
-            acc = _e31 | _e35;
-            uint _e39 = acc;
-            volume[metal::min(unsigned(at), (_buffer_sizes.size2 - 0 - 4) / 4)] = _e39;
+            uint _e29 = i;
+            uint _e30 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_1, v_1, j_1, _e29);
+            uint at = _e30 + w;
+            uint _e33 = acc;
+            uint _e37 = metal::atomic_exchange_explicit(&marks[metal::min(unsigned(at), (_buffer_sizes.size1 - 0 - 4) / 4)], 0u, metal::memory_order_relaxed);
+            acc = _e33 | _e37;
+            uint _e41 = acc;
+            volume[metal::min(unsigned(at), (_buffer_sizes.size2 - 0 - 4) / 4)] = _e41;
         }
     }
     return;

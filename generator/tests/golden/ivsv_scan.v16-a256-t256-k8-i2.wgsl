@@ -52,23 +52,23 @@ fn ivsv_scan(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     loop {
         let _e23 = i;
-        if (_e23 < m_1.grid.x) {
+        if ((_e23 + 1u) <= m_1.grid.x) {
         } else {
             break;
         }
         {
-            let _e27 = i;
-            let _e28 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_1, v_1, j_1, _e27);
-            let at = (_e28 + w);
-            let _e31 = acc;
-            let _e35 = atomicExchange((&marks[at]), 0u);
-            acc = (_e31 | _e35);
-            let _e39 = acc;
-            volume[at] = _e39;
+            let _e29 = i;
+            let _e30 = voxel_wordX_naga_oil_mod_XONRWC5DUMVZDUOTJOZZXMX(m_1, v_1, j_1, _e29);
+            let at = (_e30 + w);
+            let _e33 = acc;
+            let _e37 = atomicExchange((&marks[at]), 0u);
+            acc = (_e33 | _e37);
+            let _e41 = acc;
+            volume[at] = _e41;
         }
         continuing {
-            let _e40 = i;
-            i = (_e40 + 1u);
+            let _e42 = i;
+            i = (_e42 + 1u);
         }
     }
     return;

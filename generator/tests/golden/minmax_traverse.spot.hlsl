@@ -181,11 +181,8 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
 {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
     float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
@@ -216,18 +213,18 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = (_e73 + 1u);
+            uint _e75 = k;
+            k = (_e75 + 1u);
         }
         loop_init = false;
         uint _e30 = k;
-        if ((_e30 < panels)) {
+        if (((_e30 + 1u) <= panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
+            uint _e34 = k;
+            float mid = (g0_ + ((float(_e34) + 0.5) * w_1));
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
             bool loop_init_1 = true;
@@ -235,28 +232,28 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
                 if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
                 loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
                 if (!loop_init_1) {
-                    uint _e70 = q;
-                    q = (_e70 + 1u);
+                    uint _e72 = q;
+                    q = (_e72 + 1u);
                 }
                 loop_init_1 = false;
-                uint _e40 = q;
-                if ((_e40 < 4u)) {
+                uint _e42 = q;
+                if ((_e42 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
-                    float _e52 = sum;
-                    uint _e54 = q;
-                    const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e54), 3u)] * _e62) * (1.0 + (u * u))));
+                    uint _e48 = q;
+                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e48), 3u)])));
+                    float _e54 = sum;
+                    uint _e56 = q;
+                    const float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e56), 3u)] * _e64) * (1.0 + (u * u))));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return (((_e75 * 0.5) * w_1) * h);
+    float _e77 = sum;
+    return (((_e77 * 0.5) * w_1) * h);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
@@ -356,44 +353,44 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e63 = k_1;
-            k_1 = (_e63 + 1u);
+            uint _e65 = k_1;
+            k_1 = (_e65 + 1u);
         }
         loop_init_2 = false;
         uint _e15 = k_1;
-        if ((_e15 < steps)) {
+        if (((_e15 + 1u) <= steps)) {
         } else {
             break;
         }
         {
-            uint _e17 = k_1;
-            t_2 = (a_3 + ((float(_e17) + 0.5) * h_2));
+            uint _e19 = k_1;
+            t_2 = (a_3 + ((float(_e19) + 0.5) * h_2));
             w = h_2;
             if (spot_1) {
-                uint _e26 = k_1;
-                const float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
-                t_2 = _e30.x;
-                w = _e30.y;
+                uint _e28 = k_1;
+                const float2 _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e28) + 0.5));
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            float _e33 = t_2;
-            const float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            float _e35 = t_2;
+            const float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if (spot_1) {
-                float _e39 = sum_1;
-                float _e40 = w;
-                float _e42 = t_2;
-                const float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
-                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
+                float _e41 = sum_1;
+                float _e42 = w;
+                float _e44 = t_2;
+                const float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e44);
+                sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
-                float _e46 = sum_1;
-                uint _e49 = k_1;
-                uint _e53 = k_1;
-                const float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (float(_e49) * h_2)), (a_3 + (float((_e53 + 1u)) * h_2)));
-                sum_1 = (_e46 + (_e37 * _e59));
+                float _e48 = sum_1;
+                uint _e51 = k_1;
+                uint _e55 = k_1;
+                const float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (float(_e51) * h_2)), (a_3 + (float((_e55 + 1u)) * h_2)));
+                sum_1 = (_e48 + (_e39 * _e61));
             }
         }
     }
-    float _e65 = sum_1;
-    return _e65;
+    float _e67 = sum_1;
+    return _e67;
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, Texture2D<float4> sm_6, float3 eye_5, float3 dir_5, float s, bool spot_2)
@@ -405,6 +402,14 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
         const float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.z, -(dot(f_5.light_dir.xyz, dir_5)));
         return ((f_5.medium.y * _e18) * _e9);
     }
+}
+
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float2 pc)
+{
+    float radius = f_6.epipole.w;
+    bool near_epi = ((f_6.epipole.z > 0.5) & (length((pc - f_6.epipole.xy)) < radius));
+    bool near_anti = ((f_6.anti_epipole.z > 0.5) & (length((pc - f_6.anti_epipole.xy)) < radius));
+    return (near_epi | near_anti);
 }
 
 int naga_mod(int lhs, int rhs) {
@@ -419,49 +424,34 @@ int naga_f2i32(float value) {
 uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, bool wrap)
 {
     int ji = naga_f2i32(j);
-    if (wrap) {
-        return uint(naga_mod(asint(asuint(naga_mod(ji, int(rows))) + asuint(int(rows))), int(rows)));
-    } else {
-        return uint(clamp(ji, int(0), asint(asuint(int(rows)) - asuint(int(1)))));
-    }
+    return (wrap ? uint(naga_mod(asint(asuint(naga_mod(ji, int(rows))) + asuint(int(rows))), int(rows))) : uint(clamp(ji, int(0), asint(asuint(int(rows)) - asuint(int(1))))));
 }
 
-float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float3 dir_6)
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 dir_6)
 {
-    float3 axis = f_6.axis.xyz;
+    float3 axis = f_7.axis.xyz;
     return atan2(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 dir_7)
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 dir_7)
 {
-    float yc = (float)0;
-
-    uint rows_1 = f_7.sizes.w;
-    float phi = atan2(dot(dir_7, f_7.e2_.xyz), dot(dir_7, f_7.e1_.xyz));
-    yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
-    if ((f_7.anti_epipole.w > 0.5)) {
-        float _e22 = yc;
-        float _e23 = yc;
-        yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
-    } else {
-        float _e30 = yc;
-        yc = clamp(_e30, 0.0, float(rows_1));
-    }
-    float _e34 = yc;
-    return _e34;
+    uint rows_1 = f_8.sizes.w;
+    float phi = atan2(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
+    float yc = ((phi - f_8.e1_.w) / f_8.e2_.w);
+    return ((f_8.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_3)
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_3)
 {
     if (spot_3) {
-        float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_8.light_pos.xyz);
-        float3 to_eye = -(f_8.axis.xyz);
+        float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        float3 to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float x_2, float delta, float theta_2, float s_2, bool spot_4)
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_4)
 {
     bool local_1 = (bool)0;
 
@@ -477,24 +467,24 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_9.axis.w * sin(psi)) / den), s_2);
+        return min(((f_10.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5)
 {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, float(x_3), delta_1, theta_3, s_3, spot_5);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float3 eye_7, float3 dir_9, float a_4, float b_4, uint panels_1)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_7, float3 dir_9, float a_4, float b_4, uint panels_1)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
     return _e15;
 }
 
@@ -502,13 +492,13 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_6)
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_6)
 {
     if (spot_6) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max(naga_div(f_12.sizes2_.z, 4u), 1u));
+        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max(naga_div(f_13.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -573,72 +563,50 @@ uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(uint level_1, uint wi
 
 float3 minmax_traverse_pixel(uint x_4, uint y_1)
 {
-    bool local_2 = (bool)0;
-    bool local_3 = (bool)0;
-    bool local_4 = (bool)0;
     float total = 0.0;
     bool in_run = false;
     float run_a = 0.0;
     uint i = 0u;
     uint k_4 = (uint)0;
-    bool local_5 = (bool)0;
-    bool local_6 = (bool)0;
+    bool local_2 = (bool)0;
+    bool local_3 = (bool)0;
     bool lit_ = (bool)0;
-    bool local_7 = (bool)0;
+    bool local_4 = (bool)0;
     float l_1 = (float)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
-    float3 eye_9 = f_13.eye.xyz;
-    const float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_4, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = frame;
+    float3 eye_9 = f_14.eye.xyz;
+    const float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_4, y_1);
     float4 _e13 = depth.Load(int3(uint2(x_4, y_1), int(0)));
-    float s_4 = (min(max(_e13.x, 0.0), f_13.theta.z) / max(dot(_e9, f_13.cam_forward.xyz), 1e-6));
-    float3 color = f_13.light_color.xyz;
-    float3 px = float3((float(x_4) + 0.5), (float(y_1) + 0.5), 0.0);
-    float radius = f_13.epipole.w;
-    if ((f_13.epipole.z > 0.5)) {
-        local_2 = (length((px - float3(f_13.epipole.x, f_13.epipole.y, 0.0))) < radius);
-    } else {
-        local_2 = false;
-    }
-    bool near_epi = local_2;
-    if ((f_13.anti_epipole.z > 0.5)) {
-        local_3 = (length((px - float3(f_13.anti_epipole.x, f_13.anti_epipole.y, 0.0))) < radius);
-    } else {
-        local_3 = false;
-    }
-    bool near_anti = local_3;
-    if (!(near_epi)) {
-        local_4 = near_anti;
-    } else {
-        local_4 = true;
-    }
-    bool _e76 = local_4;
-    if (_e76) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e78 = frame;
-        const float _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_9, _e9, s_4, true);
-        float3 l_2 = (_e81 * color);
+    float s_4 = (min(max(_e13.x, 0.0), f_14.theta.z) / max(dot(_e9, f_14.cam_forward.xyz), 1e-6));
+    float3 color = f_14.light_color.xyz;
+    const bool _e35 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, float2((float(x_4) + 0.5), (float(y_1) + 0.5)));
+    if (_e35) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
+        const float _e40 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, shadow_map, eye_9, _e9, s_4, true);
+        float3 l_2 = (_e40 * color);
         return l_2;
     }
-    uint rows_2 = f_13.sizes.w;
-    uint width_3 = f_13.sizes.z;
-    bool wrap_1 = (f_13.anti_epipole.w > 0.5);
-    const float _e91 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e9);
-    const float _e92 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e9);
-    const uint _e94 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e92), rows_2, wrap_1);
-    float4 _e97 = asfloat(slices.Load4(_e94*16));
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e98 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e97);
-    float delta_2 = _e98.delta;
-    const float _e104 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e91, f_13.theta.x, f_13.theta.y);
-    const float _e105 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, s_4, _e91, true);
-    float xs = (_e105 / delta_2);
+    uint rows_2 = f_14.sizes.w;
+    uint width_3 = f_14.sizes.z;
+    bool wrap_1 = (f_14.anti_epipole.w > 0.5);
+    const float _e50 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e9);
+    const float _e51 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e9);
+    const uint _e53 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e51), rows_2, wrap_1);
+    float4 _e56 = asfloat(slices.Load4(_e53*16));
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56);
+    float delta_2 = _e57.delta;
+    const float _e63 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e50, f_14.theta.x, f_14.theta.y);
+    const float _e64 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, s_4, _e50, true);
+    float xs = (_e64 / delta_2);
     uint n_3 = naga_f2u32(min(ceil(((xs > 0.0) ? xs : 0.0)), float(width_3)));
-    const uint _e115 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
+    const uint _e74 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
     while(true) {
         if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        uint _e117 = i;
-        if ((_e117 < n_3)) {
+        uint _e76 = i;
+        if ((_e76 < n_3)) {
         } else {
             break;
         }
@@ -648,30 +616,30 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
             while(true) {
                 if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
                 loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                uint _e121 = k_4;
-                if (((_e121 + 1u) < _e115)) {
-                    uint _e125 = i;
-                    uint _e127 = k_4;
-                    local_5 = ((_e125 & ((2u << _e127) - 1u)) == 0u);
+                uint _e80 = k_4;
+                if (((_e80 + 1u) < _e74)) {
+                    uint _e84 = i;
+                    uint _e86 = k_4;
+                    local_2 = ((_e84 & ((2u << _e86) - 1u)) == 0u);
                 } else {
-                    local_5 = false;
+                    local_2 = false;
                 }
-                bool _e137 = local_5;
-                if (_e137) {
-                    uint _e138 = i;
-                    uint _e140 = k_4;
-                    local_6 = ((_e138 + (2u << _e140)) <= n_3);
+                bool _e96 = local_2;
+                if (_e96) {
+                    uint _e97 = i;
+                    uint _e99 = k_4;
+                    local_3 = ((_e97 + (2u << _e99)) <= n_3);
                 } else {
-                    local_6 = false;
+                    local_3 = false;
                 }
-                bool _e147 = local_6;
-                if (_e147) {
+                bool _e106 = local_3;
+                if (_e106) {
                 } else {
                     break;
                 }
                 {
-                    uint _e149 = k_4;
-                    k_4 = (_e149 + 1u);
+                    uint _e108 = k_4;
+                    k_4 = (_e108 + 1u);
                 }
             }
             lit_ = false;
@@ -679,66 +647,66 @@ float3 minmax_traverse_pixel(uint x_4, uint y_1)
             while(true) {
                 if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
                 loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-                uint _e153 = k_4;
-                const uint _e154 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e153, width_3);
-                uint _e155 = i;
-                uint _e156 = k_4;
-                float4 node = tree.Load(int3(uint2((_e154 + (_e155 >> _e156)), _e94), int(0)));
-                if ((_e104 <= node.x)) {
+                uint _e112 = k_4;
+                const uint _e113 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e112, width_3);
+                uint _e114 = i;
+                uint _e115 = k_4;
+                float4 node = tree.Load(int3(uint2((_e113 + (_e114 >> _e115)), _e53), int(0)));
+                if ((_e63 <= node.x)) {
                     lit_ = true;
                     break;
                 }
-                if (!((_e104 > node.y))) {
-                    uint _e169 = k_4;
-                    local_7 = (_e169 == 0u);
+                if (!((_e63 > node.y))) {
+                    uint _e128 = k_4;
+                    local_4 = (_e128 == 0u);
                 } else {
-                    local_7 = true;
+                    local_4 = true;
                 }
-                bool _e175 = local_7;
-                if (_e175) {
+                bool _e134 = local_4;
+                if (_e134) {
                     break;
                 }
-                uint _e177 = k_4;
-                k_4 = (_e177 - 1u);
+                uint _e136 = k_4;
+                k_4 = (_e136 - 1u);
             }
-            bool _e180 = lit_;
-            bool _e181 = in_run;
-            if ((_e180 != _e181)) {
-                uint _e183 = i;
-                const float _e184 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e183, n_3, delta_2, _e91, s_4, true);
-                bool _e185 = lit_;
-                if (_e185) {
-                    run_a = _e184;
+            bool _e139 = lit_;
+            bool _e140 = in_run;
+            if ((_e139 != _e140)) {
+                uint _e142 = i;
+                const float _e143 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e142, n_3, delta_2, _e50, s_4, true);
+                bool _e144 = lit_;
+                if (_e144) {
+                    run_a = _e143;
                 } else {
-                    float _e188 = total;
-                    float _e189 = run_a;
-                    const float _e190 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, _e189, _e184, true);
-                    total = (_e188 + _e190);
+                    float _e147 = total;
+                    float _e148 = run_a;
+                    const float _e149 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, _e148, _e143, true);
+                    total = (_e147 + _e149);
                 }
-                bool _e192 = lit_;
-                in_run = _e192;
+                bool _e151 = lit_;
+                in_run = _e151;
             }
-            uint _e193 = i;
-            uint _e195 = k_4;
-            i = (_e193 + (1u << _e195));
+            uint _e152 = i;
+            uint _e154 = k_4;
+            i = (_e152 + (1u << _e154));
         }
     }
-    bool _e198 = in_run;
-    if (_e198) {
-        float _e199 = total;
-        float _e200 = run_a;
-        const float _e201 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, _e200, s_4, true);
-        total = (_e199 + _e201);
+    bool _e157 = in_run;
+    if (_e157) {
+        float _e158 = total;
+        float _e159 = run_a;
+        const float _e160 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, _e159, s_4, true);
+        total = (_e158 + _e160);
     }
-    float _e203 = total;
-    l_1 = _e203;
+    float _e162 = total;
+    l_1 = _e162;
     if (!(true)) {
-        const float _e214 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, -(dot(f_13.light_dir.xyz, _e9)));
-        float _e216 = total;
-        l_1 = ((f_13.medium.y * _e214) * _e216);
+        const float _e173 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, -(dot(f_14.light_dir.xyz, _e9)));
+        float _e175 = total;
+        l_1 = ((f_14.medium.y * _e173) * _e175);
     }
-    float _e218 = l_1;
-    float3 c = (color * _e218);
+    float _e177 = l_1;
+    float3 c = (color * _e177);
     return c;
 }
 

@@ -170,11 +170,8 @@ fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32,
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
     let x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_7 * x_7) * (3f - (2f * x_7)));
+    return select(((x_7 * x_7) * (3f - (2f * x_7))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
@@ -199,41 +196,41 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k;
-        if (_e30 < panels) {
+        if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            let _e32 = k;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
+            let _e34 = k;
+            let mid = (g0_ + ((f32(_e34) + 0.5f) * w_1));
             q = 0u;
             loop {
-                let _e40 = q;
-                if (_e40 < 4u) {
+                let _e42 = q;
+                if (_e42 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    let _e46 = q;
-                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
-                    let _e52 = sum;
-                    let _e54 = q;
-                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u * u))));
+                    let _e48 = q;
+                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    let _e54 = sum;
+                    let _e56 = q;
+                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u * u))));
                 }
                 continuing {
-                    let _e70 = q;
-                    q = (_e70 + 1u);
+                    let _e72 = q;
+                    q = (_e72 + 1u);
                 }
             }
         }
         continuing {
-            let _e73 = k;
-            k = (_e73 + 1u);
+            let _e75 = k;
+            k = (_e75 + 1u);
         }
     }
-    let _e75 = sum;
-    return (((_e75 * 0.5f) * w_1) * h);
+    let _e77 = sum;
+    return (((_e77 * 0.5f) * w_1) * h);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -288,43 +285,43 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_
     let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_1;
-        if (_e15 < steps) {
+        if ((_e15 + 1u) <= steps) {
         } else {
             break;
         }
         {
-            let _e17 = k_1;
-            t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_2));
+            let _e19 = k_1;
+            t_2 = (a_3 + ((f32(_e19) + 0.5f) * h_2));
             w = h_2;
             if spot_1 {
-                let _e26 = k_1;
-                let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
-                t_2 = _e30.x;
-                w = _e30.y;
+                let _e28 = k_1;
+                let _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e28) + 0.5f));
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            let _e33 = t_2;
-            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            let _e35 = t_2;
+            let _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if spot_1 {
-                let _e39 = sum_1;
-                let _e40 = w;
-                let _e42 = t_2;
-                let _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
-                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
+                let _e41 = sum_1;
+                let _e42 = w;
+                let _e44 = t_2;
+                let _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e44);
+                sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
-                let _e46 = sum_1;
-                let _e49 = k_1;
-                let _e53 = k_1;
-                let _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e49) * h_2)), (a_3 + (f32((_e53 + 1u)) * h_2)));
-                sum_1 = (_e46 + (_e37 * _e59));
+                let _e48 = sum_1;
+                let _e51 = k_1;
+                let _e55 = k_1;
+                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e51) * h_2)), (a_3 + (f32((_e55 + 1u)) * h_2)));
+                sum_1 = (_e48 + (_e39 * _e61));
             }
         }
         continuing {
-            let _e63 = k_1;
-            k_1 = (_e63 + 1u);
+            let _e65 = k_1;
+            k_1 = (_e65 + 1u);
         }
     }
-    let _e65 = sum_1;
-    return _e65;
+    let _e67 = sum_1;
+    return _e67;
 }
 
 fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
@@ -337,48 +334,40 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_o
     }
 }
 
-fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
-    let ji = i32(j);
-    if wrap {
-        return u32((((ji % i32(rows)) + i32(rows)) % i32(rows)));
-    } else {
-        return u32(clamp(ji, 0i, (i32(rows) - 1i)));
-    }
+fn in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, pc: vec2<f32>) -> bool {
+    let radius = f_6.epipole.w;
+    let near_epi = ((f_6.epipole.z > 0.5f) & (length((pc - f_6.epipole.xy)) < radius));
+    let near_anti = ((f_6.anti_epipole.z > 0.5f) & (length((pc - f_6.anti_epipole.xy)) < radius));
+    return (near_epi | near_anti);
 }
 
-fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
-    let axis = f_6.axis.xyz;
+fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = i32(j);
+    return select(u32(clamp(ji, 0i, (i32(rows) - 1i))), u32((((ji % i32(rows)) + i32(rows)) % i32(rows))), wrap);
+}
+
+fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let axis = f_7.axis.xyz;
     return atan2(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
-    var yc: f32;
-
-    let rows_1 = f_7.sizes.w;
-    let phi = atan2(dot(dir_7, f_7.e2_.xyz), dot(dir_7, f_7.e1_.xyz));
-    yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
-    if (f_7.anti_epipole.w > 0.5f) {
-        let _e22 = yc;
-        let _e23 = yc;
-        yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
-    } else {
-        let _e30 = yc;
-        yc = clamp(_e30, 0f, f32(rows_1));
-    }
-    let _e34 = yc;
-    return _e34;
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
+    let rows_1 = f_8.sizes.w;
+    let phi = atan2(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
+    let yc = ((phi - f_8.e1_.w) / f_8.e2_.w);
+    return select(clamp(yc, 0f, f32(rows_1)), (yc - (floor((yc / f32(rows_1))) * f32(rows_1))), (f_8.anti_epipole.w > 0.5f));
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
     if spot_3 {
-        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_8.light_pos.xyz);
-        let to_eye = -(f_8.axis.xyz);
+        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        let to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
     var local_1: bool;
 
     if spot_4 {
@@ -393,31 +382,31 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_X
         if _e16 {
             return s_2;
         }
-        return min(((f_9.axis.w * sin(psi)) / den), s_2);
+        return min(((f_10.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
     if (x_3 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, f32(x_3), delta_1, theta_3, s_3, spot_5);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
     if spot_6 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max((f_12.sizes2_.z / 4u), 1u));
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -470,163 +459,141 @@ fn level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_1: u32, width_2: 
 }
 
 fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
-    var local_2: bool;
-    var local_3: bool;
-    var local_4: bool;
     var total: f32 = 0f;
     var in_run: bool = false;
     var run_a: f32 = 0f;
     var i: u32 = 0u;
     var k_4: u32;
-    var local_5: bool;
-    var local_6: bool;
+    var local_2: bool;
+    var local_3: bool;
     var lit: bool;
-    var local_7: bool;
+    var local_4: bool;
     var l_1: f32;
 
-    let f_13 = frame;
-    let eye_9 = f_13.eye.xyz;
-    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_4, y_1);
+    let f_14 = frame;
+    let eye_9 = f_14.eye.xyz;
+    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_4, y_1);
     let _e13 = textureLoad(depth, vec2<u32>(x_4, y_1), 0i);
-    let s_4 = (min(max(_e13.x, 0f), f_13.theta.z) / max(dot(_e9, f_13.cam_forward.xyz), 0.000001f));
-    let color = f_13.light_color.xyz;
-    let px = vec3<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f), 0f);
-    let radius = f_13.epipole.w;
-    if (f_13.epipole.z > 0.5f) {
-        local_2 = (length((px - vec3<f32>(f_13.epipole.x, f_13.epipole.y, 0f))) < radius);
-    } else {
-        local_2 = false;
-    }
-    let near_epi = local_2;
-    if (f_13.anti_epipole.z > 0.5f) {
-        local_3 = (length((px - vec3<f32>(f_13.anti_epipole.x, f_13.anti_epipole.y, 0f))) < radius);
-    } else {
-        local_3 = false;
-    }
-    let near_anti = local_3;
-    if !(near_epi) {
-        local_4 = near_anti;
-    } else {
-        local_4 = true;
-    }
-    let _e76 = local_4;
-    if _e76 {
-        let _e78 = frame;
-        let _e81 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e78, shadow_map, eye_9, _e9, s_4, true);
-        let l_2 = (_e81 * color);
+    let s_4 = (min(max(_e13.x, 0f), f_14.theta.z) / max(dot(_e9, f_14.cam_forward.xyz), 0.000001f));
+    let color = f_14.light_color.xyz;
+    let _e35 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, vec2<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f)));
+    if _e35 {
+        let _e37 = frame;
+        let _e40 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, shadow_map, eye_9, _e9, s_4, true);
+        let l_2 = (_e40 * color);
         return l_2;
     }
-    let rows_2 = f_13.sizes.w;
-    let width_3 = f_13.sizes.z;
-    let wrap_1 = (f_13.anti_epipole.w > 0.5f);
-    let _e91 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e9);
-    let _e92 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e9);
-    let _e94 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e92), rows_2, wrap_1);
-    let _e97 = slices[_e94];
-    let _e98 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e97);
-    let delta_2 = _e98.delta;
-    let _e104 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e91, f_13.theta.x, f_13.theta.y);
-    let _e105 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, s_4, _e91, true);
-    let xs = (_e105 / delta_2);
+    let rows_2 = f_14.sizes.w;
+    let width_3 = f_14.sizes.z;
+    let wrap_1 = (f_14.anti_epipole.w > 0.5f);
+    let _e50 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e9);
+    let _e51 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e9);
+    let _e53 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e51), rows_2, wrap_1);
+    let _e56 = slices[_e53];
+    let _e57 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56);
+    let delta_2 = _e57.delta;
+    let _e63 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e50, f_14.theta.x, f_14.theta.y);
+    let _e64 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, s_4, _e50, true);
+    let xs = (_e64 / delta_2);
     let n_3 = u32(min(ceil(select(0f, xs, (xs > 0f))), f32(width_3)));
-    let _e115 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
+    let _e74 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
     loop {
-        let _e117 = i;
-        if (_e117 < n_3) {
+        let _e76 = i;
+        if (_e76 < n_3) {
         } else {
             break;
         }
         {
             k_4 = 0u;
             loop {
-                let _e121 = k_4;
-                if ((_e121 + 1u) < _e115) {
-                    let _e125 = i;
-                    let _e127 = k_4;
-                    local_5 = ((_e125 & ((2u << _e127) - 1u)) == 0u);
+                let _e80 = k_4;
+                if ((_e80 + 1u) < _e74) {
+                    let _e84 = i;
+                    let _e86 = k_4;
+                    local_2 = ((_e84 & ((2u << _e86) - 1u)) == 0u);
                 } else {
-                    local_5 = false;
+                    local_2 = false;
                 }
-                let _e137 = local_5;
-                if _e137 {
-                    let _e138 = i;
-                    let _e140 = k_4;
-                    local_6 = ((_e138 + (2u << _e140)) <= n_3);
+                let _e96 = local_2;
+                if _e96 {
+                    let _e97 = i;
+                    let _e99 = k_4;
+                    local_3 = ((_e97 + (2u << _e99)) <= n_3);
                 } else {
-                    local_6 = false;
+                    local_3 = false;
                 }
-                let _e147 = local_6;
-                if _e147 {
+                let _e106 = local_3;
+                if _e106 {
                 } else {
                     break;
                 }
                 {
-                    let _e149 = k_4;
-                    k_4 = (_e149 + 1u);
+                    let _e108 = k_4;
+                    k_4 = (_e108 + 1u);
                 }
             }
             lit = false;
             loop {
-                let _e153 = k_4;
-                let _e154 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e153, width_3);
-                let _e155 = i;
-                let _e156 = k_4;
-                let node = textureLoad(tree, vec2<u32>((_e154 + (_e155 >> _e156)), _e94), 0i);
-                if (_e104 <= node.x) {
+                let _e112 = k_4;
+                let _e113 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e112, width_3);
+                let _e114 = i;
+                let _e115 = k_4;
+                let node = textureLoad(tree, vec2<u32>((_e113 + (_e114 >> _e115)), _e53), 0i);
+                if (_e63 <= node.x) {
                     lit = true;
                     break;
                 }
-                if !((_e104 > node.y)) {
-                    let _e169 = k_4;
-                    local_7 = (_e169 == 0u);
+                if !((_e63 > node.y)) {
+                    let _e128 = k_4;
+                    local_4 = (_e128 == 0u);
                 } else {
-                    local_7 = true;
+                    local_4 = true;
                 }
-                let _e175 = local_7;
-                if _e175 {
+                let _e134 = local_4;
+                if _e134 {
                     break;
                 }
-                let _e177 = k_4;
-                k_4 = (_e177 - 1u);
+                let _e136 = k_4;
+                k_4 = (_e136 - 1u);
             }
-            let _e180 = lit;
-            let _e181 = in_run;
-            if (_e180 != _e181) {
-                let _e183 = i;
-                let _e184 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e183, n_3, delta_2, _e91, s_4, true);
-                let _e185 = lit;
-                if _e185 {
-                    run_a = _e184;
+            let _e139 = lit;
+            let _e140 = in_run;
+            if (_e139 != _e140) {
+                let _e142 = i;
+                let _e143 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e142, n_3, delta_2, _e50, s_4, true);
+                let _e144 = lit;
+                if _e144 {
+                    run_a = _e143;
                 } else {
-                    let _e188 = total;
-                    let _e189 = run_a;
-                    let _e190 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, _e189, _e184, true);
-                    total = (_e188 + _e190);
+                    let _e147 = total;
+                    let _e148 = run_a;
+                    let _e149 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, _e148, _e143, true);
+                    total = (_e147 + _e149);
                 }
-                let _e192 = lit;
-                in_run = _e192;
+                let _e151 = lit;
+                in_run = _e151;
             }
-            let _e193 = i;
-            let _e195 = k_4;
-            i = (_e193 + (1u << _e195));
+            let _e152 = i;
+            let _e154 = k_4;
+            i = (_e152 + (1u << _e154));
         }
     }
-    let _e198 = in_run;
-    if _e198 {
-        let _e199 = total;
-        let _e200 = run_a;
-        let _e201 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_9, _e9, _e200, s_4, true);
-        total = (_e199 + _e201);
+    let _e157 = in_run;
+    if _e157 {
+        let _e158 = total;
+        let _e159 = run_a;
+        let _e160 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, _e159, s_4, true);
+        total = (_e158 + _e160);
     }
-    let _e203 = total;
-    l_1 = _e203;
+    let _e162 = total;
+    l_1 = _e162;
     if !(true) {
-        let _e214 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, -(dot(f_13.light_dir.xyz, _e9)));
-        let _e216 = total;
-        l_1 = ((f_13.medium.y * _e214) * _e216);
+        let _e173 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, -(dot(f_14.light_dir.xyz, _e9)));
+        let _e175 = total;
+        l_1 = ((f_14.medium.y * _e173) * _e175);
     }
-    let _e218 = l_1;
-    let c = (color * _e218);
+    let _e177 = l_1;
+    let c = (color * _e177);
     return c;
 }
 

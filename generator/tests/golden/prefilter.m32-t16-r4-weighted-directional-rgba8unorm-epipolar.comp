@@ -173,11 +173,8 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
     float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
@@ -202,44 +199,44 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e73 = k_1;
-            k_1 = (_e73 + 1u);
+            uint _e75 = k_1;
+            k_1 = (_e75 + 1u);
         }
         loop_init = false;
         uint _e30 = k_1;
-        if ((_e30 < panels)) {
+        if (((_e30 + 1u) <= panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k_1;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_2));
+            uint _e34 = k_1;
+            float mid = (g0_ + ((float(_e34) + 0.5) * w_2));
             q_1 = 0u;
             bool loop_init_1 = true;
             while(true) {
                 if (!loop_init_1) {
-                    uint _e70 = q_1;
-                    q_1 = (_e70 + 1u);
+                    uint _e72 = q_1;
+                    q_1 = (_e72 + 1u);
                 }
                 loop_init_1 = false;
-                uint _e40 = q_1;
-                if ((_e40 < 4u)) {
+                uint _e42 = q_1;
+                if ((_e42 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q_1;
-                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
-                    float _e52 = sum;
-                    uint _e54 = q_1;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1.0 + (u * u))));
+                    uint _e48 = q_1;
+                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    float _e54 = sum;
+                    uint _e56 = q_1;
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u * u))));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return (((_e75 * 0.5) * w_2) * h);
+    float _e77 = sum;
+    return (((_e77 * 0.5) * w_2) * h);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {

@@ -213,11 +213,8 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
 {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
     float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
@@ -248,18 +245,18 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = (_e73 + 1u);
+            uint _e75 = k;
+            k = (_e75 + 1u);
         }
         loop_init = false;
         uint _e30 = k;
-        if ((_e30 < panels)) {
+        if (((_e30 + 1u) <= panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
+            uint _e34 = k;
+            float mid = (g0_ + ((float(_e34) + 0.5) * w_1));
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
             bool loop_init_1 = true;
@@ -267,28 +264,28 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
                 if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
                 loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
                 if (!loop_init_1) {
-                    uint _e70 = q;
-                    q = (_e70 + 1u);
+                    uint _e72 = q;
+                    q = (_e72 + 1u);
                 }
                 loop_init_1 = false;
-                uint _e40 = q;
-                if ((_e40 < 4u)) {
+                uint _e42 = q;
+                if ((_e42 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
-                    float _e52 = sum;
-                    uint _e54 = q;
-                    const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e54), 3u)] * _e62) * (1.0 + (u * u))));
+                    uint _e48 = q;
+                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e48), 3u)])));
+                    float _e54 = sum;
+                    uint _e56 = q;
+                    const float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e56), 3u)] * _e64) * (1.0 + (u * u))));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return (((_e75 * 0.5) * w_1) * h_5);
+    float _e77 = sum;
+    return (((_e77 * 0.5) * w_1) * h_5);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
@@ -390,44 +387,44 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e63 = k_1;
-            k_1 = (_e63 + 1u);
+            uint _e65 = k_1;
+            k_1 = (_e65 + 1u);
         }
         loop_init_2 = false;
         uint _e15 = k_1;
-        if ((_e15 < steps)) {
+        if (((_e15 + 1u) <= steps)) {
         } else {
             break;
         }
         {
-            uint _e17 = k_1;
-            t_2 = (a_3 + ((float(_e17) + 0.5) * h_7));
+            uint _e19 = k_1;
+            t_2 = (a_3 + ((float(_e19) + 0.5) * h_7));
             w = h_7;
             if (spot_1) {
-                uint _e26 = k_1;
-                const float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
-                t_2 = _e30.x;
-                w = _e30.y;
+                uint _e28 = k_1;
+                const float2 _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e28) + 0.5));
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            float _e33 = t_2;
-            const float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            float _e35 = t_2;
+            const float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if (spot_1) {
-                float _e39 = sum_1;
-                float _e40 = w;
-                float _e42 = t_2;
-                const float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e42);
-                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
+                float _e41 = sum_1;
+                float _e42 = w;
+                float _e44 = t_2;
+                const float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e44);
+                sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
-                float _e46 = sum_1;
-                uint _e49 = k_1;
-                uint _e53 = k_1;
-                const float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (float(_e49) * h_7)), (a_3 + (float((_e53 + 1u)) * h_7)));
-                sum_1 = (_e46 + (_e37 * _e59));
+                float _e48 = sum_1;
+                uint _e51 = k_1;
+                uint _e55 = k_1;
+                const float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (float(_e51) * h_7)), (a_3 + (float((_e55 + 1u)) * h_7)));
+                sum_1 = (_e48 + (_e39 * _e61));
             }
         }
     }
-    float _e65 = sum_1;
-    return _e65;
+    float _e67 = sum_1;
+    return _e67;
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, Texture2D<float4> sm_6, float3 eye_5, float3 dir_5, float s, bool spot_2)
@@ -439,6 +436,14 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
         const float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
         return ((f_6.medium.y * _e18) * _e9);
     }
+}
+
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float2 pc)
+{
+    float radius = f_7.epipole.w;
+    bool near_epi = ((f_7.epipole.z > 0.5) & (length((pc - f_7.epipole.xy)) < radius));
+    bool near_anti = ((f_7.anti_epipole.z > 0.5) & (length((pc - f_7.anti_epipole.xy)) < radius));
+    return (near_epi | near_anti);
 }
 
 int naga_mod(int lhs, int rhs) {
@@ -453,49 +458,34 @@ int naga_f2i32(float value) {
 uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, bool wrap)
 {
     int ji = naga_f2i32(j);
-    if (wrap) {
-        return uint(naga_mod(asint(asuint(naga_mod(ji, int(rows))) + asuint(int(rows))), int(rows)));
-    } else {
-        return uint(clamp(ji, int(0), asint(asuint(int(rows)) - asuint(int(1)))));
-    }
+    return (wrap ? uint(naga_mod(asint(asuint(naga_mod(ji, int(rows))) + asuint(int(rows))), int(rows))) : uint(clamp(ji, int(0), asint(asuint(int(rows)) - asuint(int(1))))));
 }
 
-float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float3 dir_6)
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 dir_6)
 {
-    float3 axis = f_7.axis.xyz;
+    float3 axis = f_8.axis.xyz;
     return atan2(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 dir_7)
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 dir_7)
 {
-    float yc = (float)0;
-
-    uint rows_1 = f_8.sizes.w;
-    float phi_1 = atan2(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
-    yc = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
-    if ((f_8.anti_epipole.w > 0.5)) {
-        float _e22 = yc;
-        float _e23 = yc;
-        yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
-    } else {
-        float _e30 = yc;
-        yc = clamp(_e30, 0.0, float(rows_1));
-    }
-    float _e34 = yc;
-    return _e34;
+    uint rows_1 = f_9.sizes.w;
+    float phi_1 = atan2(dot(dir_7, f_9.e2_.xyz), dot(dir_7, f_9.e1_.xyz));
+    float yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
+    return ((f_9.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_3)
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_3)
 {
     if (spot_3) {
-        float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
-        float3 to_eye = -(f_9.axis.xyz);
+        float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_10.light_pos.xyz);
+        float3 to_eye = -(f_10.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_1, float delta, float theta_2, float s_2, bool spot_4)
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float x_1, float delta, float theta_2, float s_2, bool spot_4)
 {
     bool local = (bool)0;
 
@@ -511,24 +501,24 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_10.axis.w * sin(psi)) / den), s_2);
+        return min(((f_11.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_1 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5)
 {
     if ((x_2 >= n_1)) {
         return s_3;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_2), delta_1, theta_3, s_3, spot_5);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, float(x_2), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 eye_7, float3 dir_9, float a_4, float b_4, uint panels_1)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, float3 eye_7, float3 dir_9, float a_4, float b_4, uint panels_1)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_13.light_pos.xyz, f_13.light_dir.xyz, f_13.light_pos.w, f_13.light_dir.w, f_13.medium);
     return _e15;
 }
 
@@ -536,13 +526,13 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_6)
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_6)
 {
     if (spot_6) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max(naga_div(f_13.sizes2_.z, 4u), 1u));
+        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_10, a_5, b_5, max(naga_div(f_14.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -570,7 +560,7 @@ float4 beta_at(float theta_4, uint h_2)
     return _e14;
 }
 
-float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, uint i, uint row_1, float delta_2, uint h_3)
+float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, uint i, uint row_1, float delta_2, uint h_3)
 {
     float4 leaf = float4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
@@ -579,9 +569,9 @@ float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, uint i,
         const float4 _e9 = gamma_at((float(i) * delta_2), h_3);
         return _e9;
     }
-    const float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, row_1);
-    const float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e12);
-    float3 axis_1 = f_14.axis.xyz;
+    const float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, row_1);
+    const float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e12);
+    float3 axis_1 = f_15.axis.xyz;
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
     while(true) {
@@ -602,7 +592,7 @@ float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, uint i,
             float q_3 = ((_e20 == 0u) ? -0.57735026 : GL2_);
             float psi_1 = (((float(i) + 0.5) + (0.5 * q_3)) * delta_2);
             float3 l_1 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            const float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_14.light_dir.xyz), f_14.light_pos.w, f_14.light_dir.w);
+            const float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_15.light_dir.xyz), f_15.light_pos.w, f_15.light_dir.w);
             float4 _e48 = leaf;
             const float4 _e52 = gamma_at(psi_1, h_3);
             leaf = (_e48 + (((0.5 * delta_2) * _e46) * _e52));
@@ -626,59 +616,37 @@ PstRay ConstructPstRay(bool arg0, float3 arg1, float3 arg2, float3 arg3, float a
     return ret;
 }
 
-PstRay pst_ray(float2 pc, float z_1)
+PstRay pst_ray(float2 pc_1, float z_1)
 {
     PstRay r = (PstRay)0;
-    bool local_1 = (bool)0;
-    bool local_2 = (bool)0;
-    bool local_3 = (bool)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
-    float3 eye_9 = f_15.eye.xyz;
-    float2 ndc = float2((((2.0 * pc.x) / float(f_15.sizes.x)) - 1.0), (1.0 - ((2.0 * pc.y) / float(f_15.sizes.y))));
-    float t_5 = f_15.cam_forward.w;
-    float3 dir_12 = normalize(((f_15.cam_forward.xyz + (f_15.cam_right.xyz * ((ndc.x * t_5) * f_15.cam_right.w))) + (f_15.cam_up.xyz * (ndc.y * t_5))));
-    float s_4 = (min(max(z_1, 0.0), f_15.theta.z) / max(dot(dir_12, f_15.cam_forward.xyz), 1e-6));
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
+    float3 eye_9 = f_16.eye.xyz;
+    float2 ndc = float2((((2.0 * pc_1.x) / float(f_16.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_16.sizes.y))));
+    float t_5 = f_16.cam_forward.w;
+    float3 dir_12 = normalize(((f_16.cam_forward.xyz + (f_16.cam_right.xyz * ((ndc.x * t_5) * f_16.cam_right.w))) + (f_16.cam_up.xyz * (ndc.y * t_5))));
+    float s_4 = (min(max(z_1, 0.0), f_16.theta.z) / max(dot(dir_12, f_16.cam_forward.xyz), 1e-6));
     r = ConstructPstRay(false, float3(0.0, 0.0, 0.0), eye_9, dir_12, s_4, 0u, 0.0, 0.0, 0.0);
-    float3 px = float3(pc, 0.0);
-    float radius = f_15.epipole.w;
-    if ((f_15.epipole.z > 0.5)) {
-        local_1 = (length((px - float3(f_15.epipole.x, f_15.epipole.y, 0.0))) < radius);
-    } else {
-        local_1 = false;
-    }
-    bool near_epi = local_1;
-    if ((f_15.anti_epipole.z > 0.5)) {
-        local_2 = (length((px - float3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0))) < radius);
-    } else {
-        local_2 = false;
-    }
-    bool near_anti = local_2;
-    if (!(near_epi)) {
-        local_3 = near_anti;
-    } else {
-        local_3 = true;
-    }
-    bool _e109 = local_3;
-    if (_e109) {
+    const bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, pc_1);
+    if (_e67) {
         r.marched = true;
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
-        const float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_9, dir_12, s_4, true);
-        r.color = (_e117 * f_15.light_color.xyz);
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e72 = frame;
+        const float _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_4, true);
+        r.color = (_e75 * f_16.light_color.xyz);
     }
-    const float _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
-    r.theta = _e122;
-    const float _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
-    const uint _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e124), f_15.sizes.w, (f_15.anti_epipole.w > 0.5));
-    r.row = _e132;
-    float _e135 = r.theta;
-    const float _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_15.theta.x, f_15.theta.y);
-    r.d = _e140;
-    float _e143 = r.theta;
-    const float _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, dir_12, s_4, _e143, true);
-    r.xs_num = _e144;
-    PstRay _e145 = r;
-    const PstRay pstray = _e145;
+    const float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, dir_12);
+    r.theta = _e80;
+    const float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, dir_12);
+    const uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_16.sizes.w, (f_16.anti_epipole.w > 0.5));
+    r.row = _e90;
+    float _e93 = r.theta;
+    const float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_16.theta.x, f_16.theta.y);
+    r.d = _e98;
+    float _e101 = r.theta;
+    const float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, eye_9, dir_12, s_4, _e101, true);
+    r.xs_num = _e102;
+    PstRay _e103 = r;
+    const PstRay pstray = _e103;
     return pstray;
 }
 
@@ -693,21 +661,21 @@ float2 pst_terms(PstRay r_2, uint row_2, float delta_4, uint n_2)
 {
     float tail = 0.0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
     float sin_theta = max(sin(r_2.theta), 1e-6);
     float4 _e16 = rectified.Load(int3(uint2((n_2 - 1u), row_2), int(0)));
     if ((r_2.d <= _e16.x)) {
-        const float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        const float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        const float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        const float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return float2((f_16.medium.y / (f_16.axis.w * sin_theta)), _e37);
+        return float2((f_17.medium.y / (f_17.axis.w * sin_theta)), _e37);
     }
-    const float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(dot(f_16.light_dir.xyz, r_2.dir)));
-    float sp = (f_16.medium.y * _e48);
-    const float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.x, 0.0, (delta_4 / sin_theta));
+    const float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_17.medium.z, -(dot(f_17.light_dir.xyz, r_2.dir)));
+    float sp = (f_17.medium.y * _e48);
+    const float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_17.medium.x, 0.0, (delta_4 / sin_theta));
     float _e56 = tail;
     return float2((sp * _e54), (sp * _e56));
 }
@@ -719,7 +687,7 @@ float3 pst_sweep_pixel(uint x_4, uint y)
     float4 p_3 = (float4)0;
     uint i_1 = (uint)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18 = frame;
     float4 _e16 = depth.Load(int3(uint2(x_4, y), int(0)));
     const PstRay _e18 = pst_ray(float2((float(x_4) + 0.5), (float(y) + 0.5)), _e16.x);
     if (_e18.marched) {
@@ -772,7 +740,7 @@ float3 pst_sweep_pixel(uint x_4, uint y)
                         float4 _e59 = p_3;
                         uint _e60 = i_1;
                         uint _e62 = h_4;
-                        const float4 _e63 = pst_leaf(f_17, _e60, _e18.row, delta_5, _e62);
+                        const float4 _e63 = pst_leaf(f_18, _e60, _e18.row, delta_5, _e62);
                         p_3 = (_e59 + _e63);
                     }
                 }
@@ -786,7 +754,7 @@ float3 pst_sweep_pixel(uint x_4, uint y)
     }
     const float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     float _e84 = sum_2;
-    return (f_17.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
+    return (f_18.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
 }
 
 uint2 naga_div(uint2 lhs, uint2 rhs) {
@@ -801,7 +769,7 @@ void pst_sweep_fallback(uint3 id : SV_DispatchThreadID)
     uint _e3 = frame.sizes.x;
     uint _e7 = frame.sizes.y;
     uint2 screen = uint2(_e3, _e7);
-    uint2 lanes = (8u * naga_div((screen + (63u).xx), (64u).xx));
+    uint2 lanes = (8u * naga_div((screen + (255u).xx), (256u).xx));
     uint _e18 = asuint(fallback_count.Load(0));
     uint n_4 = min(_e18, (screen.x * screen.y));
     e = ((id.y * lanes.x) + id.x);

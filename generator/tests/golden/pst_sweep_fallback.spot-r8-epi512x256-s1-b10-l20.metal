@@ -241,11 +241,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_inner,
     float cos_outer
 ) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
     float x_7 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_7 * x_7) * (3.0 - (2.0 * x_7));
+    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -293,18 +290,18 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = _e73 + 1u;
+            uint _e75 = k;
+            k = _e75 + 1u;
         }
         loop_init = false;
         uint _e30 = k;
-        if (_e30 < panels) {
+        if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
-            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_1);
+            uint _e34 = k;
+            float mid = g0_ + ((static_cast<float>(_e34) + 0.5) * w_1);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
@@ -312,28 +309,28 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 if (metal::all(loop_bound_1 == uint2(0u))) { break; }
                 loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
                 if (!loop_init_1) {
-                    uint _e70 = q;
-                    q = _e70 + 1u;
+                    uint _e72 = q;
+                    q = _e72 + 1u;
                 }
                 loop_init_1 = false;
-                uint _e40 = q;
-                if (_e40 < 4u) {
+                uint _e42 = q;
+                if (_e42 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q;
-                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
-                    float _e52 = sum;
-                    uint _e54 = q;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_5 * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                    uint _e48 = q;
+                    float u = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
+                    float _e54 = sum;
+                    uint _e56 = q;
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_5 * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u * u)));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return ((_e75 * 0.5) * w_1) * h_5;
+    float _e77 = sum;
+    return ((_e77 * 0.5) * w_1) * h_5;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -435,44 +432,44 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e63 = k_1;
-            k_1 = _e63 + 1u;
+            uint _e65 = k_1;
+            k_1 = _e65 + 1u;
         }
         loop_init_2 = false;
         uint _e15 = k_1;
-        if (_e15 < steps) {
+        if ((_e15 + 1u) <= steps) {
         } else {
             break;
         }
         {
-            uint _e17 = k_1;
-            t_2 = a_3 + ((static_cast<float>(_e17) + 0.5) * h_7);
+            uint _e19 = k_1;
+            t_2 = a_3 + ((static_cast<float>(_e19) + 0.5) * h_7);
             w = h_7;
             if (spot_1) {
-                uint _e26 = k_1;
-                metal::float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e26) + 0.5);
-                t_2 = _e30.x;
-                w = _e30.y;
+                uint _e28 = k_1;
+                metal::float2 _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e28) + 0.5);
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_4 + (dir_4 * _e33), spot_1);
+            float _e35 = t_2;
+            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_4 + (dir_4 * _e35), spot_1);
             if (spot_1) {
-                float _e39 = sum_1;
-                float _e40 = w;
-                float _e42 = t_2;
-                float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e42);
-                sum_1 = _e39 + ((_e37 * _e40) * _e43);
+                float _e41 = sum_1;
+                float _e42 = w;
+                float _e44 = t_2;
+                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e44);
+                sum_1 = _e41 + ((_e39 * _e42) * _e45);
             } else {
-                float _e46 = sum_1;
-                uint _e49 = k_1;
-                uint _e53 = k_1;
-                float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, a_3 + (static_cast<float>(_e49) * h_7), a_3 + (static_cast<float>(_e53 + 1u) * h_7));
-                sum_1 = _e46 + (_e37 * _e59);
+                float _e48 = sum_1;
+                uint _e51 = k_1;
+                uint _e55 = k_1;
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, a_3 + (static_cast<float>(_e51) * h_7), a_3 + (static_cast<float>(_e55 + 1u) * h_7));
+                sum_1 = _e48 + (_e39 * _e61);
             }
         }
     }
-    float _e65 = sum_1;
-    return _e65;
+    float _e67 = sum_1;
+    return _e67;
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -492,6 +489,16 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     }
 }
 
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    metal::float2 pc
+) {
+    float radius = f_7.epipole.w;
+    bool near_epi = (f_7.epipole.z > 0.5) & (metal::length(pc - f_7.epipole.xy) < radius);
+    bool near_anti = (f_7.anti_epipole.z > 0.5) & (metal::length(pc - f_7.anti_epipole.xy) < radius);
+    return near_epi | near_anti;
+}
+
 int naga_f2i32(float value) {
     return static_cast<int>(metal::clamp(value, -2147483600.0, 2147483500.0));
 }
@@ -507,43 +514,29 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool wrap
 ) {
     int ji = naga_f2i32(j);
-    if (wrap) {
-        return static_cast<uint>(naga_mod(as_type<int>(as_type<uint>(naga_mod(ji, static_cast<int>(rows))) + as_type<uint>(static_cast<int>(rows))), static_cast<int>(rows)));
-    } else {
-        return static_cast<uint>(metal::clamp(ji, 0, as_type<int>(as_type<uint>(static_cast<int>(rows)) - as_type<uint>(1))));
-    }
+    return wrap ? static_cast<uint>(naga_mod(as_type<int>(as_type<uint>(naga_mod(ji, static_cast<int>(rows))) + as_type<uint>(static_cast<int>(rows))), static_cast<int>(rows))) : static_cast<uint>(metal::clamp(ji, 0, as_type<int>(as_type<uint>(static_cast<int>(rows)) - as_type<uint>(1))));
 }
 
 float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
     metal::float3 dir_6
 ) {
-    metal::float3 axis = f_7.axis.xyz;
+    metal::float3 axis = f_8.axis.xyz;
     return metal::atan2(metal::length(metal::cross(dir_6, axis)), metal::dot(dir_6, axis));
 }
 
 float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     metal::float3 dir_7
 ) {
-    float yc = {};
-    uint rows_1 = f_8.sizes.w;
-    float phi_1 = metal::atan2(metal::dot(dir_7, f_8.e2_.xyz), metal::dot(dir_7, f_8.e1_.xyz));
-    yc = (phi_1 - f_8.e1_.w) / f_8.e2_.w;
-    if (f_8.anti_epipole.w > 0.5) {
-        float _e22 = yc;
-        float _e23 = yc;
-        yc = _e22 - (metal::floor(_e23 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
-    } else {
-        float _e30 = yc;
-        yc = metal::clamp(_e30, 0.0, static_cast<float>(rows_1));
-    }
-    float _e34 = yc;
-    return _e34;
+    uint rows_1 = f_9.sizes.w;
+    float phi_1 = metal::atan2(metal::dot(dir_7, f_9.e2_.xyz), metal::dot(dir_7, f_9.e1_.xyz));
+    float yc = (phi_1 - f_9.e1_.w) / f_9.e2_.w;
+    return (f_9.anti_epipole.w > 0.5) ? (yc - (metal::floor(yc / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc, 0.0, static_cast<float>(rows_1));
 }
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     metal::float3 eye_6,
     metal::float3 dir_8,
     float s_1,
@@ -551,15 +544,15 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_3
 ) {
     if (spot_3) {
-        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz;
-        metal::float3 to_eye = -(f_9.axis.xyz);
+        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_10.light_pos.xyz;
+        metal::float3 to_eye = -(f_10.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
     }
     return s_1 * metal::sin(theta_1);
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     float x_1,
     float delta,
     float theta_2,
@@ -579,14 +572,14 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (_e16) {
             return s_2;
         }
-        return metal::min((f_10.axis.w * metal::sin(psi)) / den, s_2);
+        return metal::min((f_11.axis.w * metal::sin(psi)) / den, s_2);
     } else {
         return metal::min((x_1 * delta) / metal::max(metal::sin(theta_2), 0.000001), s_2);
     }
 }
 
 float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
     uint x_2,
     uint n_1,
     float delta_1,
@@ -597,19 +590,19 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     if (x_2 >= n_1) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, static_cast<float>(x_2), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, static_cast<float>(x_2), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
     metal::float3 eye_7,
     metal::float3 dir_9,
     float a_4,
     float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_13.light_pos.xyz, f_13.light_dir.xyz, f_13.light_pos.w, f_13.light_dir.w, f_13.medium);
     return _e15;
 }
 
@@ -618,7 +611,7 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14,
     metal::float3 eye_8,
     metal::float3 dir_10,
     float a_5,
@@ -626,10 +619,10 @@ float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_6
 ) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_13.sizes2_.z, 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_14.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -671,7 +664,7 @@ metal::float4 beta_at(
 }
 
 metal::float4 pst_leaf(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15,
     uint i,
     uint row_1,
     float delta_2,
@@ -685,9 +678,9 @@ metal::float4 pst_leaf(
         metal::float4 _e9 = gamma_at(static_cast<float>(i) * delta_2, h_3, pst_factors, _buffer_sizes);
         return _e9;
     }
-    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, row_1);
-    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e12);
-    metal::float3 axis_1 = f_14.axis.xyz;
+    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, row_1);
+    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e12);
+    metal::float3 axis_1 = f_15.axis.xyz;
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
@@ -708,7 +701,7 @@ metal::float4 pst_leaf(
             float q_3 = (_e20 == 0u) ? -0.57735026 : GL2_;
             float psi_1 = ((static_cast<float>(i) + 0.5) + (0.5 * q_3)) * delta_2;
             metal::float3 l_1 = (-(axis_1) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_14.light_dir.xyz), f_14.light_pos.w, f_14.light_dir.w);
+            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_15.light_dir.xyz), f_15.light_pos.w, f_15.light_dir.w);
             metal::float4 _e48 = leaf;
             metal::float4 _e52 = gamma_at(psi_1, h_3, pst_factors, _buffer_sizes);
             leaf = _e48 + (((0.5 * delta_2) * _e46) * _e52);
@@ -719,61 +712,39 @@ metal::float4 pst_leaf(
 }
 
 PstRay pst_ray(
-    metal::float2 pc,
+    metal::float2 pc_1,
     float z_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     PstRay r = {};
-    bool local_1 = {};
-    bool local_2 = {};
-    bool local_3 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
-    metal::float3 eye_9 = f_15.eye.xyz;
-    metal::float2 ndc = metal::float2(((2.0 * pc.x) / static_cast<float>(f_15.sizes.x)) - 1.0, 1.0 - ((2.0 * pc.y) / static_cast<float>(f_15.sizes.y)));
-    float t_5 = f_15.cam_forward.w;
-    metal::float3 dir_12 = metal::normalize((f_15.cam_forward.xyz + (f_15.cam_right.xyz * ((ndc.x * t_5) * f_15.cam_right.w))) + (f_15.cam_up.xyz * (ndc.y * t_5)));
-    float s_4 = metal::min(metal::max(z_1, 0.0), f_15.theta.z) / metal::max(metal::dot(dir_12, f_15.cam_forward.xyz), 0.000001);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
+    metal::float3 eye_9 = f_16.eye.xyz;
+    metal::float2 ndc = metal::float2(((2.0 * pc_1.x) / static_cast<float>(f_16.sizes.x)) - 1.0, 1.0 - ((2.0 * pc_1.y) / static_cast<float>(f_16.sizes.y)));
+    float t_5 = f_16.cam_forward.w;
+    metal::float3 dir_12 = metal::normalize((f_16.cam_forward.xyz + (f_16.cam_right.xyz * ((ndc.x * t_5) * f_16.cam_right.w))) + (f_16.cam_up.xyz * (ndc.y * t_5)));
+    float s_4 = metal::min(metal::max(z_1, 0.0), f_16.theta.z) / metal::max(metal::dot(dir_12, f_16.cam_forward.xyz), 0.000001);
     r = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_9, dir_12, s_4, 0u, 0.0, 0.0, 0.0};
-    metal::float3 px = metal::float3(pc, 0.0);
-    float radius = f_15.epipole.w;
-    if (f_15.epipole.z > 0.5) {
-        local_1 = metal::length(px - metal::float3(f_15.epipole.x, f_15.epipole.y, 0.0)) < radius;
-    } else {
-        local_1 = false;
-    }
-    bool near_epi = local_1;
-    if (f_15.anti_epipole.z > 0.5) {
-        local_2 = metal::length(px - metal::float3(f_15.anti_epipole.x, f_15.anti_epipole.y, 0.0)) < radius;
-    } else {
-        local_2 = false;
-    }
-    bool near_anti = local_2;
-    if (!(near_epi)) {
-        local_3 = near_anti;
-    } else {
-        local_3 = true;
-    }
-    bool _e109 = local_3;
-    if (_e109) {
+    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, pc_1);
+    if (_e67) {
         r.marched = true;
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = frame;
-        float _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_9, dir_12, s_4, true);
-        r.color = _e117 * f_15.light_color.xyz;
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e72 = frame;
+        float _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_4, true);
+        r.color = _e75 * f_16.light_color.xyz;
     }
-    float _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
-    r.theta = _e122;
-    float _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
-    uint _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e124), f_15.sizes.w, f_15.anti_epipole.w > 0.5);
-    r.row = _e132;
-    float _e135 = r.theta;
-    float _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_15.theta.x, f_15.theta.y);
-    r.d = _e140;
-    float _e143 = r.theta;
-    float _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, dir_12, s_4, _e143, true);
-    r.xs_num = _e144;
-    PstRay _e145 = r;
-    return _e145;
+    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, dir_12);
+    r.theta = _e80;
+    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, dir_12);
+    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e82), f_16.sizes.w, f_16.anti_epipole.w > 0.5);
+    r.row = _e90;
+    float _e93 = r.theta;
+    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_16.theta.x, f_16.theta.y);
+    r.d = _e98;
+    float _e101 = r.theta;
+    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, eye_9, dir_12, s_4, _e101, true);
+    r.xs_num = _e102;
+    PstRay _e103 = r;
+    return _e103;
 }
 
 uint pst_columns_crossed(
@@ -795,22 +766,22 @@ metal::float2 pst_terms(
     metal::texture2d<float, metal::access::sample> rectified
 ) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
     float sin_theta = metal::max(metal::sin(r_2.theta), 0.000001);
     uint clamped_lod_e16 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
     metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_2)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     if (r_2.d <= _e16.x) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return metal::float2(f_16.medium.y / (f_16.axis.w * sin_theta), _e37);
+        return metal::float2(f_17.medium.y / (f_17.axis.w * sin_theta), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(metal::dot(f_16.light_dir.xyz, r_2.dir)));
-    float sp = f_16.medium.y * _e48;
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.x, 0.0, delta_4 / sin_theta);
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_17.medium.z, -(metal::dot(f_17.light_dir.xyz, r_2.dir)));
+    float sp = f_17.medium.y * _e48;
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_17.medium.x, 0.0, delta_4 / sin_theta);
     float _e56 = tail;
     return metal::float2(sp * _e54, sp * _e56);
 }
@@ -830,7 +801,7 @@ metal::float3 pst_sweep_pixel(
     uint h_4 = 0u;
     metal::float4 p_3 = {};
     uint i_1 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18 = frame;
     uint clamped_lod_e16 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_4, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_4) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
@@ -885,7 +856,7 @@ metal::float3 pst_sweep_pixel(
                         metal::float4 _e59 = p_3;
                         uint _e60 = i_1;
                         uint _e62 = h_4;
-                        metal::float4 _e63 = pst_leaf(f_17, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
+                        metal::float4 _e63 = pst_leaf(f_18, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
                         p_3 = _e59 + _e63;
                     }
                 }
@@ -899,7 +870,7 @@ metal::float3 pst_sweep_pixel(
     }
     metal::float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27, frame, rectified);
     float _e84 = sum_2;
-    return f_17.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
+    return f_18.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
 }
 metal::uint2 naga_div(metal::uint2 lhs, metal::uint2 rhs) {
     return lhs / metal::select(rhs, 1u, rhs == 0u);
@@ -925,7 +896,7 @@ kernel void pst_sweep_fallback(
     uint _e3 = frame.sizes.x;
     uint _e7 = frame.sizes.y;
     metal::uint2 screen = metal::uint2(_e3, _e7);
-    metal::uint2 lanes = 8u * naga_div(screen + metal::uint2(63u), metal::uint2(64u));
+    metal::uint2 lanes = 8u * naga_div(screen + metal::uint2(255u), metal::uint2(256u));
     uint _e18 = fallback_count;
     uint n_4 = metal::min(_e18, screen.x * screen.y);
     e = (id.y * lanes.x) + id.x;

@@ -200,11 +200,8 @@ fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32,
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
     let x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_7 * x_7) * (3f - (2f * x_7)));
+    return select(((x_7 * x_7) * (3f - (2f * x_7))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
@@ -229,41 +226,41 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let w_1 = ((atan(((b_1 - t0_) / h_5)) - g0_) / f32(panels));
     loop {
         let _e30 = k;
-        if (_e30 < panels) {
+        if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            let _e32 = k;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
+            let _e34 = k;
+            let mid = (g0_ + ((f32(_e34) + 0.5f) * w_1));
             q = 0u;
             loop {
-                let _e40 = q;
-                if (_e40 < 4u) {
+                let _e42 = q;
+                if (_e42 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    let _e46 = q;
-                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
-                    let _e52 = sum;
-                    let _e54 = q;
-                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u * u))));
+                    let _e48 = q;
+                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    let _e54 = sum;
+                    let _e56 = q;
+                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u * u))));
                 }
                 continuing {
-                    let _e70 = q;
-                    q = (_e70 + 1u);
+                    let _e72 = q;
+                    q = (_e72 + 1u);
                 }
             }
         }
         continuing {
-            let _e73 = k;
-            k = (_e73 + 1u);
+            let _e75 = k;
+            k = (_e75 + 1u);
         }
     }
-    let _e75 = sum;
-    return (((_e75 * 0.5f) * w_1) * h_5);
+    let _e77 = sum;
+    return (((_e77 * 0.5f) * w_1) * h_5);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -319,43 +316,43 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_
     let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_1;
-        if (_e15 < steps) {
+        if ((_e15 + 1u) <= steps) {
         } else {
             break;
         }
         {
-            let _e17 = k_1;
-            t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_7));
+            let _e19 = k_1;
+            t_2 = (a_3 + ((f32(_e19) + 0.5f) * h_7));
             w = h_7;
             if spot_1 {
-                let _e26 = k_1;
-                let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
-                t_2 = _e30.x;
-                w = _e30.y;
+                let _e28 = k_1;
+                let _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e28) + 0.5f));
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            let _e33 = t_2;
-            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            let _e35 = t_2;
+            let _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if spot_1 {
-                let _e39 = sum_1;
-                let _e40 = w;
-                let _e42 = t_2;
-                let _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e42);
-                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
+                let _e41 = sum_1;
+                let _e42 = w;
+                let _e44 = t_2;
+                let _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e44);
+                sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
-                let _e46 = sum_1;
-                let _e49 = k_1;
-                let _e53 = k_1;
-                let _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (f32(_e49) * h_7)), (a_3 + (f32((_e53 + 1u)) * h_7)));
-                sum_1 = (_e46 + (_e37 * _e59));
+                let _e48 = sum_1;
+                let _e51 = k_1;
+                let _e55 = k_1;
+                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (f32(_e51) * h_7)), (a_3 + (f32((_e55 + 1u)) * h_7)));
+                sum_1 = (_e48 + (_e39 * _e61));
             }
         }
         continuing {
-            let _e63 = k_1;
-            k_1 = (_e63 + 1u);
+            let _e65 = k_1;
+            k_1 = (_e65 + 1u);
         }
     }
-    let _e65 = sum_1;
-    return _e65;
+    let _e67 = sum_1;
+    return _e67;
 }
 
 fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
@@ -368,48 +365,40 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_o
     }
 }
 
-fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
-    let ji = i32(j);
-    if wrap {
-        return u32((((ji % i32(rows)) + i32(rows)) % i32(rows)));
-    } else {
-        return u32(clamp(ji, 0i, (i32(rows) - 1i)));
-    }
+fn in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, pc: vec2<f32>) -> bool {
+    let radius = f_7.epipole.w;
+    let near_epi = ((f_7.epipole.z > 0.5f) & (length((pc - f_7.epipole.xy)) < radius));
+    let near_anti = ((f_7.anti_epipole.z > 0.5f) & (length((pc - f_7.anti_epipole.xy)) < radius));
+    return (near_epi | near_anti);
 }
 
-fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
-    let axis = f_7.axis.xyz;
+fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = i32(j);
+    return select(u32(clamp(ji, 0i, (i32(rows) - 1i))), u32((((ji % i32(rows)) + i32(rows)) % i32(rows))), wrap);
+}
+
+fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let axis = f_8.axis.xyz;
     return atan2(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
-    var yc: f32;
-
-    let rows_1 = f_8.sizes.w;
-    let phi_1 = atan2(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
-    yc = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
-    if (f_8.anti_epipole.w > 0.5f) {
-        let _e22 = yc;
-        let _e23 = yc;
-        yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
-    } else {
-        let _e30 = yc;
-        yc = clamp(_e30, 0f, f32(rows_1));
-    }
-    let _e34 = yc;
-    return _e34;
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
+    let rows_1 = f_9.sizes.w;
+    let phi_1 = atan2(dot(dir_7, f_9.e2_.xyz), dot(dir_7, f_9.e1_.xyz));
+    let yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
+    return select(clamp(yc, 0f, f32(rows_1)), (yc - (floor((yc / f32(rows_1))) * f32(rows_1))), (f_9.anti_epipole.w > 0.5f));
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
     if spot_3 {
-        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
-        let to_eye = -(f_9.axis.xyz);
+        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_10.light_pos.xyz);
+        let to_eye = -(f_10.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
     var local: bool;
 
     if spot_4 {
@@ -424,31 +413,31 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_
         if _e16 {
             return s_2;
         }
-        return min(((f_10.axis.w * sin(psi)) / den), s_2);
+        return min(((f_11.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_1 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
     if (x_2 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_2), delta_1, theta_3, s_3, spot_5);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, f32(x_2), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_13.light_pos.xyz, f_13.light_dir.xyz, f_13.light_pos.w, f_13.light_dir.w, f_13.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
     if spot_6 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_10, a_5, b_5, max((f_14.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -473,7 +462,7 @@ fn beta_at(theta_4: f32, h_2: u32) -> vec4<f32> {
     return _e14;
 }
 
-fn pst_leaf(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, row_1: u32, delta_2: f32, h_3: u32) -> vec4<f32> {
+fn pst_leaf(f_15: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, row_1: u32, delta_2: f32, h_3: u32) -> vec4<f32> {
     var leaf: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var g_1: u32 = 0u;
 
@@ -481,9 +470,9 @@ fn pst_leaf(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, ro
         let _e9 = gamma_at((f32(i) * delta_2), h_3);
         return _e9;
     }
-    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, row_1);
-    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e12);
-    let axis_1 = f_14.axis.xyz;
+    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, row_1);
+    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e12);
+    let axis_1 = f_15.axis.xyz;
     loop {
         let _e17 = g_1;
         if (_e17 < 2u) {
@@ -495,7 +484,7 @@ fn pst_leaf(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, ro
             let q_3 = select(GL2_, -0.57735026f, (_e20 == 0u));
             let psi_1 = (((f32(i) + 0.5f) + (0.5f * q_3)) * delta_2);
             let l_1 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_14.light_dir.xyz), f_14.light_pos.w, f_14.light_dir.w);
+            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_15.light_dir.xyz), f_15.light_pos.w, f_15.light_dir.w);
             let _e48 = leaf;
             let _e52 = gamma_at(psi_1, h_3);
             leaf = (_e48 + (((0.5f * delta_2) * _e46) * _e52));
@@ -509,58 +498,36 @@ fn pst_leaf(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, ro
     return _e58;
 }
 
-fn pst_ray(pc: vec2<f32>, z_1: f32) -> PstRay {
+fn pst_ray(pc_1: vec2<f32>, z_1: f32) -> PstRay {
     var r: PstRay;
-    var local_1: bool;
-    var local_2: bool;
-    var local_3: bool;
 
-    let f_15 = frame;
-    let eye_9 = f_15.eye.xyz;
-    let ndc = vec2<f32>((((2f * pc.x) / f32(f_15.sizes.x)) - 1f), (1f - ((2f * pc.y) / f32(f_15.sizes.y))));
-    let t_5 = f_15.cam_forward.w;
-    let dir_12 = normalize(((f_15.cam_forward.xyz + (f_15.cam_right.xyz * ((ndc.x * t_5) * f_15.cam_right.w))) + (f_15.cam_up.xyz * (ndc.y * t_5))));
-    let s_4 = (min(max(z_1, 0f), f_15.theta.z) / max(dot(dir_12, f_15.cam_forward.xyz), 0.000001f));
+    let f_16 = frame;
+    let eye_9 = f_16.eye.xyz;
+    let ndc = vec2<f32>((((2f * pc_1.x) / f32(f_16.sizes.x)) - 1f), (1f - ((2f * pc_1.y) / f32(f_16.sizes.y))));
+    let t_5 = f_16.cam_forward.w;
+    let dir_12 = normalize(((f_16.cam_forward.xyz + (f_16.cam_right.xyz * ((ndc.x * t_5) * f_16.cam_right.w))) + (f_16.cam_up.xyz * (ndc.y * t_5))));
+    let s_4 = (min(max(z_1, 0f), f_16.theta.z) / max(dot(dir_12, f_16.cam_forward.xyz), 0.000001f));
     r = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_9, dir_12, s_4, 0u, 0f, 0f, 0f);
-    let px = vec3<f32>(pc, 0f);
-    let radius = f_15.epipole.w;
-    if (f_15.epipole.z > 0.5f) {
-        local_1 = (length((px - vec3<f32>(f_15.epipole.x, f_15.epipole.y, 0f))) < radius);
-    } else {
-        local_1 = false;
-    }
-    let near_epi = local_1;
-    if (f_15.anti_epipole.z > 0.5f) {
-        local_2 = (length((px - vec3<f32>(f_15.anti_epipole.x, f_15.anti_epipole.y, 0f))) < radius);
-    } else {
-        local_2 = false;
-    }
-    let near_anti = local_2;
-    if !(near_epi) {
-        local_3 = near_anti;
-    } else {
-        local_3 = true;
-    }
-    let _e109 = local_3;
-    if _e109 {
+    let _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, pc_1);
+    if _e67 {
         r.marched = true;
-        let _e114 = frame;
-        let _e117 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e114, shadow_map, eye_9, dir_12, s_4, true);
-        r.color = (_e117 * f_15.light_color.xyz);
+        let _e72 = frame;
+        let _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_4, true);
+        r.color = (_e75 * f_16.light_color.xyz);
     }
-    let _e122 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
-    r.theta = _e122;
-    let _e124 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, dir_12);
-    let _e132 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e124), f_15.sizes.w, (f_15.anti_epipole.w > 0.5f));
-    r.row = _e132;
-    let _e135 = r.theta;
-    let _e140 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e135, f_15.theta.x, f_15.theta.y);
-    r.d = _e140;
-    let _e143 = r.theta;
-    let _e144 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, dir_12, s_4, _e143, true);
-    r.xs_num = _e144;
-    let _e145 = r;
-    return _e145;
+    let _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, dir_12);
+    r.theta = _e80;
+    let _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, dir_12);
+    let _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_16.sizes.w, (f_16.anti_epipole.w > 0.5f));
+    r.row = _e90;
+    let _e93 = r.theta;
+    let _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_16.theta.x, f_16.theta.y);
+    r.d = _e98;
+    let _e101 = r.theta;
+    let _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, eye_9, dir_12, s_4, _e101, true);
+    r.xs_num = _e102;
+    let _e103 = r;
+    return _e103;
 }
 
 fn pst_columns_crossed(r_1: PstRay, delta_3: f32) -> u32 {
@@ -572,21 +539,21 @@ fn pst_columns_crossed(r_1: PstRay, delta_3: f32) -> u32 {
 fn pst_terms(r_2: PstRay, row_2: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     var tail: f32 = 0f;
 
-    let f_16 = frame;
+    let f_17 = frame;
     let sin_theta = max(sin(r_2.theta), 0.000001f);
     let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_2), 0i);
     if (r_2.d <= _e16.x) {
-        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if true {
         let _e37 = tail;
-        return vec2<f32>((f_16.medium.y / (f_16.axis.w * sin_theta)), _e37);
+        return vec2<f32>((f_17.medium.y / (f_17.axis.w * sin_theta)), _e37);
     }
-    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(dot(f_16.light_dir.xyz, r_2.dir)));
-    let sp = (f_16.medium.y * _e48);
-    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.x, 0f, (delta_4 / sin_theta));
+    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_17.medium.z, -(dot(f_17.light_dir.xyz, r_2.dir)));
+    let sp = (f_17.medium.y * _e48);
+    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_17.medium.x, 0f, (delta_4 / sin_theta));
     let _e56 = tail;
     return vec2<f32>((sp * _e54), (sp * _e56));
 }
@@ -597,7 +564,7 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
     var p_3: vec4<f32>;
     var i_1: u32;
 
-    let f_17 = frame;
+    let f_18 = frame;
     let _e16 = textureLoad(depth, vec2<u32>(x_4, y), 0i);
     let _e18 = pst_ray(vec2<f32>((f32(x_4) + 0.5f), (f32(y) + 0.5f)), _e16.x);
     if _e18.marched {
@@ -632,7 +599,7 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
                         let _e59 = p_3;
                         let _e60 = i_1;
                         let _e62 = h_4;
-                        let _e63 = pst_leaf(f_17, _e60, _e18.row, delta_5, _e62);
+                        let _e63 = pst_leaf(f_18, _e60, _e18.row, delta_5, _e62);
                         p_3 = (_e59 + _e63);
                     }
                 }
@@ -654,7 +621,7 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
     }
     let _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     let _e84 = sum_2;
-    return (f_17.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
+    return (f_18.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
 }
 
 @compute @workgroup_size(8, 8, 1) 
@@ -664,7 +631,7 @@ fn pst_sweep_fallback(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e3 = frame.sizes.x;
     let _e7 = frame.sizes.y;
     let screen = vec2<u32>(_e3, _e7);
-    let lanes = (8u * ((screen + vec2(63u)) / vec2(64u)));
+    let lanes = (8u * ((screen + vec2(255u)) / vec2(256u)));
     let _e18 = fallback_count;
     let n_4 = min(_e18, (screen.x * screen.y));
     e = ((id.y * lanes.x) + id.x);

@@ -207,11 +207,8 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
     float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
@@ -236,44 +233,44 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e73 = k;
-            k = (_e73 + 1u);
+            uint _e75 = k;
+            k = (_e75 + 1u);
         }
         loop_init = false;
         uint _e30 = k;
-        if ((_e30 < panels)) {
+        if (((_e30 + 1u) <= panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_3));
+            uint _e34 = k;
+            float mid = (g0_ + ((float(_e34) + 0.5) * w_3));
             q = 0u;
             bool loop_init_1 = true;
             while(true) {
                 if (!loop_init_1) {
-                    uint _e70 = q;
-                    q = (_e70 + 1u);
+                    uint _e72 = q;
+                    q = (_e72 + 1u);
                 }
                 loop_init_1 = false;
-                uint _e40 = q;
-                if ((_e40 < 4u)) {
+                uint _e42 = q;
+                if ((_e42 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w_3) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
-                    float _e52 = sum;
-                    uint _e54 = q;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1.0 + (u * u))));
+                    uint _e48 = q;
+                    float u = tan((mid + ((0.5 * w_3) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    float _e54 = sum;
+                    uint _e56 = q;
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u * u))));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return (((_e75 * 0.5) * w_3) * h_5);
+    float _e77 = sum;
+    return (((_e77 * 0.5) * w_3) * h_5);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
@@ -329,44 +326,44 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e63 = k_1;
-            k_1 = (_e63 + 1u);
+            uint _e65 = k_1;
+            k_1 = (_e65 + 1u);
         }
         loop_init_2 = false;
         uint _e15 = k_1;
-        if ((_e15 < steps)) {
+        if (((_e15 + 1u) <= steps)) {
         } else {
             break;
         }
         {
-            uint _e17 = k_1;
-            t_2 = (a_3 + ((float(_e17) + 0.5) * h_7));
+            uint _e19 = k_1;
+            t_2 = (a_3 + ((float(_e19) + 0.5) * h_7));
             w = h_7;
             if (spot_1) {
-                uint _e26 = k_1;
-                vec2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
-                t_2 = _e30.x;
-                w = _e30.y;
+                uint _e28 = k_1;
+                vec2 _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e28) + 0.5));
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            float _e35 = t_2;
+            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if (spot_1) {
-                float _e39 = sum_1;
-                float _e40 = w;
-                float _e42 = t_2;
-                float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e42);
-                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
+                float _e41 = sum_1;
+                float _e42 = w;
+                float _e44 = t_2;
+                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e44);
+                sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
-                float _e46 = sum_1;
-                uint _e49 = k_1;
-                uint _e53 = k_1;
-                float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (float(_e49) * h_7)), (a_3 + (float((_e53 + 1u)) * h_7)));
-                sum_1 = (_e46 + (_e37 * _e59));
+                float _e48 = sum_1;
+                uint _e51 = k_1;
+                uint _e55 = k_1;
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (float(_e51) * h_7)), (a_3 + (float((_e55 + 1u)) * h_7)));
+                sum_1 = (_e48 + (_e39 * _e61));
             }
         }
     }
-    float _e65 = sum_1;
-    return _e65;
+    float _e67 = sum_1;
+    return _e67;
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, sampler2D sm_6, vec3 eye_5, vec3 dir_5, float s, bool spot_2) {
@@ -379,47 +376,40 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     }
 }
 
-uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_1, uint rows, bool wrap) {
-    int ji = int(j_1);
-    if (wrap) {
-        return uint((((ji % int(rows)) + int(rows)) % int(rows)));
-    } else {
-        return uint(min(max(ji, 0), (int(rows) - 1)));
-    }
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec2 pc) {
+    float radius = f_7.epipole.w;
+    bool near_epi = ((f_7.epipole.z > 0.5) && (length((pc - f_7.epipole.xy)) < radius));
+    bool near_anti = ((f_7.anti_epipole.z > 0.5) && (length((pc - f_7.anti_epipole.xy)) < radius));
+    return (near_epi || near_anti);
 }
 
-float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 dir_6) {
-    vec3 axis_1 = f_7.axis.xyz;
+uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_1, uint rows, bool wrap) {
+    int ji = int(j_1);
+    return (wrap ? uint((((ji % int(rows)) + int(rows)) % int(rows))) : uint(min(max(ji, 0), (int(rows) - 1))));
+}
+
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_6) {
+    vec3 axis_1 = f_8.axis.xyz;
     return atan(length(cross(dir_6, axis_1)), dot(dir_6, axis_1));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_7) {
-    float yc = 0.0;
-    uint rows_1 = f_8.sizes.w;
-    float phi_1 = atan(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
-    yc = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
-    if ((f_8.anti_epipole.w > 0.5)) {
-        float _e22 = yc;
-        float _e23 = yc;
-        yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
-    } else {
-        float _e30 = yc;
-        yc = clamp(_e30, 0.0, float(rows_1));
-    }
-    float _e34 = yc;
-    return _e34;
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 dir_7) {
+    uint rows_1 = f_9.sizes.w;
+    float phi_1 = atan(dot(dir_7, f_9.e2_.xyz), dot(dir_7, f_9.e1_.xyz));
+    float yc = ((phi_1 - f_9.e1_.w) / f_9.e2_.w);
+    return ((f_9.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
     if (spot_3) {
-        vec3 q_3 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
-        vec3 to_eye = -(f_9.axis.xyz);
+        vec3 q_3 = ((eye_6 + (dir_8 * s_1)) - f_10.light_pos.xyz);
+        vec3 to_eye = -(f_10.axis.xyz);
         return atan(length(cross(q_3, to_eye)), dot(q_3, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_1, float delta, float theta_2, float s_2, bool spot_4) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float x_1, float delta, float theta_2, float s_2, bool spot_4) {
     bool local_1 = false;
     if (spot_4) {
         float psi = (x_1 * delta);
@@ -433,31 +423,31 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_10.axis.w * sin(psi)) / den), s_2);
+        return min(((f_11.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_1 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
     if ((x_2 >= n_1)) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_2), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, float(x_2), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_13.light_pos.xyz, f_13.light_dir.xyz, f_13.light_pos.w, f_13.light_dir.w, f_13.medium);
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_10, a_5, b_5, max((f_14.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -563,13 +553,13 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_3 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
     vec2 d_3 = ((vec2(p_3) + vec2(0.5, 0.5)) - l_1.origin);
     float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_3);
-    float f_15 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
+    float f_16 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
     if ((l_1.wrap != 0u)) {
-        float fl = floor(f_15);
-        fs = (f_15 - fl);
+        float fl = floor(f_16);
+        fs = (f_16 - fl);
         s_lo = (uint((int(fl) + int(slices))) % slices);
     } else {
-        float fc = clamp(f_15, 0.0, float((slices - 1u)));
+        float fc = clamp(f_16, 0.0, float((slices - 1u)));
         s_lo = min(uint(fc), (slices - 2u));
         uint _e41 = s_lo;
         fs = (fc - float(_e41));

@@ -110,11 +110,8 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
 {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
     float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_5 * x_5) * (3.0 - (2.0 * x_5))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
@@ -234,8 +231,8 @@ uint2 lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uint2 i, uint2 s
 float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 v_7)
 {
     float3 a_2 = min(abs(v_7), (65504.0).xxx);
-    uint3 u_1 = asuint(a_2);
-    float3 normal = asfloat((((u_1 + (4095u).xxx) + ((u_1 >> (13u).xxx) & (1u).xxx)) & (4294959104u).xxx));
+    uint3 u = asuint(a_2);
+    float3 normal = asfloat((((u + (4095u).xxx) + ((u >> (13u).xxx) & (1u).xxx)) & (4294959104u).xxx));
     float3 subnormal = (round((a_2 * 16777216.0)) / (16777216.0).xxx);
     return (sign(v_7) * ((a_2 < (6.1035156e-5).xxx) ? subnormal : normal));
 }
@@ -246,7 +243,6 @@ uint naga_mod(uint lhs, uint rhs) {
 
 float3 raymarch_pixel(uint x_3, uint y_2)
 {
-    float u = 0.5;
     float sum = 0.0;
     uint j = (uint)0;
     float t_1 = (float)0;
@@ -255,21 +251,19 @@ float3 raymarch_pixel(uint x_3, uint y_2)
 
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
     float3 eye_2 = m_2.eye.xyz;
-    const float3 _e8 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
-    float4 _e12 = depth.Load(int3(uint2(x_3, y_2), int(0)));
-    float s = (min(max(_e12.x, 0.0), m_2.eye.w) / max(dot(_e8, m_2.cam_forward.xyz), 1e-6));
+    const float3 _e7 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
+    float4 _e11 = depth.Load(int3(uint2(x_3, y_2), int(0)));
+    float s = (min(max(_e11.x, 0.0), m_2.eye.w) / max(dot(_e7, m_2.cam_forward.xyz), 1e-6));
     uint n_2 = m_2.sizes.w;
     float h_2 = (s / float(n_2));
     uint mx = m_2.interleave.x;
     uint my = m_2.interleave.y;
     uint stride = (mx * my);
     uint pixel_class = (naga_mod(x_3, mx) + (mx * naga_mod(y_2, my)));
-    if ((m_2.interleave.z != 0u)) {
-        const float _e42 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
-        u = _e42;
-    }
+    const float _e37 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
+    float u_1 = ((m_2.interleave.z != 0u) ? _e37 : 0.5);
     const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0.0, s, n_2);
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0.0, s, n_2);
     j = pixel_class;
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
@@ -277,8 +271,8 @@ float3 raymarch_pixel(uint x_3, uint y_2)
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e103 = j;
-            j = (_e103 + stride);
+            uint _e101 = j;
+            j = (_e101 + stride);
         }
         loop_init = false;
         uint _e50 = j;
@@ -288,42 +282,40 @@ float3 raymarch_pixel(uint x_3, uint y_2)
         }
         {
             uint _e52 = j;
-            float _e54 = u;
-            t_1 = ((float(_e52) + _e54) * h_2);
+            t_1 = ((float(_e52) + u_1) * h_2);
             w = h_2;
             if (false) {
-                uint _e60 = j;
-                float _e62 = u;
-                const float2 _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (float(_e60) + _e62));
-                t_1 = _e64.x;
-                w = _e64.y;
+                uint _e59 = j;
+                const float2 _e62 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (float(_e59) + u_1));
+                t_1 = _e62.x;
+                w = _e62.y;
             }
-            float _e67 = t_1;
-            const float _e71 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)), false);
+            float _e65 = t_1;
+            const float _e69 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e7 * _e65)), false);
             if (false) {
-                float _e73 = sum;
-                float _e74 = w;
-                float _e76 = t_1;
-                const float _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = (_e73 + ((_e71 * _e74) * _e86));
+                float _e71 = sum;
+                float _e72 = w;
+                float _e74 = t_1;
+                const float _e84 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, _e74, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = (_e71 + ((_e69 * _e72) * _e84));
             } else {
-                float _e89 = sum;
-                uint _e92 = j;
-                uint _e95 = j;
-                const float _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e92) * h_2), (float((_e95 + 1u)) * h_2));
-                sum = (_e89 + (_e71 * _e100));
+                float _e87 = sum;
+                uint _e90 = j;
+                uint _e93 = j;
+                const float _e98 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (float(_e90) * h_2), (float((_e93 + 1u)) * h_2));
+                sum = (_e87 + (_e69 * _e98));
             }
         }
     }
-    float _e105 = sum;
-    l = _e105;
+    float _e103 = sum;
+    l = _e103;
     if (!(false)) {
-        const float _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e8)));
-        float _e118 = sum;
-        l = ((m_2.medium.y * _e116) * _e118);
+        const float _e114 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e7)));
+        float _e116 = sum;
+        l = ((m_2.medium.y * _e114) * _e116);
     }
-    float _e122 = l;
-    float3 c = (m_2.light_color.xyz * _e122);
+    float _e120 = l;
+    float3 c = (m_2.light_color.xyz * _e120);
     return c;
 }
 

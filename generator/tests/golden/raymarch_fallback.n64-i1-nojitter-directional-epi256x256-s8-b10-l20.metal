@@ -119,11 +119,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_inner,
     float cos_outer
 ) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
     float x_5 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_5 * x_5) * (3.0 - (2.0 * x_5));
+    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -260,7 +257,6 @@ metal::float3 raymarch_pixel(
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
-    float u = 0.5;
     float sum = 0.0;
     uint j = {};
     float t_1 = {};
@@ -268,22 +264,20 @@ metal::float3 raymarch_pixel(
     float l = {};
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
     metal::float3 eye_2 = m_2.eye.xyz;
-    metal::float3 _e8 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
-    uint clamped_lod_e12 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e12 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_2)), metal::uint2(depth.get_width(clamped_lod_e12), depth.get_height(clamped_lod_e12)) - 1), clamped_lod_e12);
-    float s = metal::min(metal::max(_e12.x, 0.0), m_2.eye.w) / metal::max(metal::dot(_e8, m_2.cam_forward.xyz), 0.000001);
+    metal::float3 _e7 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
+    uint clamped_lod_e11 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e11 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_2)), metal::uint2(depth.get_width(clamped_lod_e11), depth.get_height(clamped_lod_e11)) - 1), clamped_lod_e11);
+    float s = metal::min(metal::max(_e11.x, 0.0), m_2.eye.w) / metal::max(metal::dot(_e7, m_2.cam_forward.xyz), 0.000001);
     uint n_2 = m_2.sizes.w;
     float h_2 = s / static_cast<float>(n_2);
     uint mx = m_2.interleave.x;
     uint my = m_2.interleave.y;
     uint stride = mx * my;
     uint pixel_class = naga_mod(x_3, mx) + (mx * naga_mod(y_2, my));
-    if (m_2.interleave.z != 0u) {
-        float _e42 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
-        u = _e42;
-    }
+    float _e37 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
+    float u = (m_2.interleave.z != 0u) ? _e37 : 0.5;
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0.0, s, n_2);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0.0, s, n_2);
     j = pixel_class;
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
@@ -291,8 +285,8 @@ metal::float3 raymarch_pixel(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e103 = j;
-            j = _e103 + stride;
+            uint _e101 = j;
+            j = _e101 + stride;
         }
         loop_init = false;
         uint _e50 = j;
@@ -302,42 +296,40 @@ metal::float3 raymarch_pixel(
         }
         {
             uint _e52 = j;
-            float _e54 = u;
-            t_1 = (static_cast<float>(_e52) + _e54) * h_2;
+            t_1 = (static_cast<float>(_e52) + u) * h_2;
             w = h_2;
             if (false) {
-                uint _e60 = j;
-                float _e62 = u;
-                metal::float2 _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, static_cast<float>(_e60) + _e62);
-                t_1 = _e64.x;
-                w = _e64.y;
+                uint _e59 = j;
+                metal::float2 _e62 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, static_cast<float>(_e59) + u);
+                t_1 = _e62.x;
+                w = _e62.y;
             }
-            float _e67 = t_1;
-            float _e71 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, eye_2 + (_e8 * _e67), false);
+            float _e65 = t_1;
+            float _e69 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, eye_2 + (_e7 * _e65), false);
             if (false) {
-                float _e73 = sum;
-                float _e74 = w;
-                float _e76 = t_1;
-                float _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = _e73 + ((_e71 * _e74) * _e86);
+                float _e71 = sum;
+                float _e72 = w;
+                float _e74 = t_1;
+                float _e84 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, _e74, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = _e71 + ((_e69 * _e72) * _e84);
             } else {
-                float _e89 = sum;
-                uint _e92 = j;
-                uint _e95 = j;
-                float _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e92) * h_2, static_cast<float>(_e95 + 1u) * h_2);
-                sum = _e89 + (_e71 * _e100);
+                float _e87 = sum;
+                uint _e90 = j;
+                uint _e93 = j;
+                float _e98 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e90) * h_2, static_cast<float>(_e93 + 1u) * h_2);
+                sum = _e87 + (_e69 * _e98);
             }
         }
     }
-    float _e105 = sum;
-    l = _e105;
+    float _e103 = sum;
+    l = _e103;
     if (!(false)) {
-        float _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(metal::dot(m_2.light_dir.xyz, _e8)));
-        float _e118 = sum;
-        l = (m_2.medium.y * _e116) * _e118;
+        float _e114 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(metal::dot(m_2.light_dir.xyz, _e7)));
+        float _e116 = sum;
+        l = (m_2.medium.y * _e114) * _e116;
     }
-    float _e122 = l;
-    metal::float3 c = m_2.light_color.xyz * _e122;
+    float _e120 = l;
+    metal::float3 c = m_2.light_color.xyz * _e120;
     return c;
 }
 metal::uint2 naga_div(metal::uint2 lhs, metal::uint2 rhs) {
@@ -361,7 +353,7 @@ kernel void raymarch_fallback(
     uint _e3 = frame.sizes.x;
     uint _e7 = frame.sizes.y;
     metal::uint2 screen = metal::uint2(_e3, _e7);
-    metal::uint2 lanes = 8u * naga_div(screen + metal::uint2(63u), metal::uint2(64u));
+    metal::uint2 lanes = 8u * naga_div(screen + metal::uint2(255u), metal::uint2(256u));
     uint _e18 = fallback_count;
     uint n_3 = metal::min(_e18, screen.x * screen.y);
     e = (id.y * lanes.x) + id.x;

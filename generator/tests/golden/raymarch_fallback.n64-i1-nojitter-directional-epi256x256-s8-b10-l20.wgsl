@@ -102,11 +102,8 @@ fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32,
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
     let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_5 * x_5) * (3f - (2f * x_5)));
+    return select(((x_5 * x_5) * (3f - (2f * x_5))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
@@ -186,7 +183,6 @@ fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMap
 }
 
 fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
-    var u: f32 = 0.5f;
     var sum: f32 = 0f;
     var j: u32;
     var t_1: f32;
@@ -195,21 +191,19 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
 
     let m_2 = frame;
     let eye_2 = m_2.eye.xyz;
-    let _e8 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
-    let _e12 = textureLoad(depth, vec2<u32>(x_3, y_2), 0i);
-    let s = (min(max(_e12.x, 0f), m_2.eye.w) / max(dot(_e8, m_2.cam_forward.xyz), 0.000001f));
+    let _e7 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
+    let _e11 = textureLoad(depth, vec2<u32>(x_3, y_2), 0i);
+    let s = (min(max(_e11.x, 0f), m_2.eye.w) / max(dot(_e7, m_2.cam_forward.xyz), 0.000001f));
     let n_2 = m_2.sizes.w;
     let h_2 = (s / f32(n_2));
     let mx = m_2.interleave.x;
     let my = m_2.interleave.y;
     let stride = (mx * my);
     let pixel_class = ((x_3 % mx) + (mx * (y_2 % my)));
-    if (m_2.interleave.z != 0u) {
-        let _e42 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
-        u = _e42;
-    }
+    let _e37 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
+    let u = select(0.5f, _e37, (m_2.interleave.z != 0u));
     let _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    let _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, m_2.light_pos.xyz, 0f, s, n_2);
+    let _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0f, s, n_2);
     j = pixel_class;
     loop {
         let _e50 = j;
@@ -219,46 +213,44 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
         }
         {
             let _e52 = j;
-            let _e54 = u;
-            t_1 = ((f32(_e52) + _e54) * h_2);
+            t_1 = ((f32(_e52) + u) * h_2);
             w = h_2;
             if false {
-                let _e60 = j;
-                let _e62 = u;
-                let _e64 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (f32(_e60) + _e62));
-                t_1 = _e64.x;
-                w = _e64.y;
+                let _e59 = j;
+                let _e62 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (f32(_e59) + u));
+                t_1 = _e62.x;
+                w = _e62.y;
             }
-            let _e67 = t_1;
-            let _e71 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e8 * _e67)), false);
+            let _e65 = t_1;
+            let _e69 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e7 * _e65)), false);
             if false {
-                let _e73 = sum;
-                let _e74 = w;
-                let _e76 = t_1;
-                let _e86 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e8, _e76, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
-                sum = (_e73 + ((_e71 * _e74) * _e86));
+                let _e71 = sum;
+                let _e72 = w;
+                let _e74 = t_1;
+                let _e84 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, _e74, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
+                sum = (_e71 + ((_e69 * _e72) * _e84));
             } else {
-                let _e89 = sum;
-                let _e92 = j;
-                let _e95 = j;
-                let _e100 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e92) * h_2), (f32((_e95 + 1u)) * h_2));
-                sum = (_e89 + (_e71 * _e100));
+                let _e87 = sum;
+                let _e90 = j;
+                let _e93 = j;
+                let _e98 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e90) * h_2), (f32((_e93 + 1u)) * h_2));
+                sum = (_e87 + (_e69 * _e98));
             }
         }
         continuing {
-            let _e103 = j;
-            j = (_e103 + stride);
+            let _e101 = j;
+            j = (_e101 + stride);
         }
     }
-    let _e105 = sum;
-    l = _e105;
+    let _e103 = sum;
+    l = _e103;
     if !(false) {
-        let _e116 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e8)));
-        let _e118 = sum;
-        l = ((m_2.medium.y * _e116) * _e118);
+        let _e114 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.z, -(dot(m_2.light_dir.xyz, _e7)));
+        let _e116 = sum;
+        l = ((m_2.medium.y * _e114) * _e116);
     }
-    let _e122 = l;
-    let c = (m_2.light_color.xyz * _e122);
+    let _e120 = l;
+    let c = (m_2.light_color.xyz * _e120);
     return c;
 }
 
@@ -269,7 +261,7 @@ fn raymarch_fallback(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e3 = frame.sizes.x;
     let _e7 = frame.sizes.y;
     let screen = vec2<u32>(_e3, _e7);
-    let lanes = (8u * ((screen + vec2(63u)) / vec2(64u)));
+    let lanes = (8u * ((screen + vec2(255u)) / vec2(256u)));
     let _e18 = fallback_count;
     let n_3 = min(_e18, (screen.x * screen.y));
     e = ((id.y * lanes.x) + id.x);

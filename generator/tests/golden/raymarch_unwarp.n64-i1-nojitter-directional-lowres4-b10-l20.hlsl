@@ -248,11 +248,8 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
 {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
     float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_5 * x_5) * (3.0 - (2.0 * x_5))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t_1, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)

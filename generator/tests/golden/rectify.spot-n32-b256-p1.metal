@@ -215,11 +215,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_inner,
     float cos_outer
 ) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
     float x_5 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_5 * x_5) * (3.0 - (2.0 * x_5));
+    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -267,18 +264,18 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = _e73 + 1u;
+            uint _e75 = k;
+            k = _e75 + 1u;
         }
         loop_init = false;
         uint _e30 = k;
-        if (_e30 < panels) {
+        if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
-            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w);
+            uint _e34 = k;
+            float mid = g0_ + ((static_cast<float>(_e34) + 0.5) * w);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
@@ -286,28 +283,28 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 if (metal::all(loop_bound_1 == uint2(0u))) { break; }
                 loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
                 if (!loop_init_1) {
-                    uint _e70 = q;
-                    q = _e70 + 1u;
+                    uint _e72 = q;
+                    q = _e72 + 1u;
                 }
                 loop_init_1 = false;
-                uint _e40 = q;
-                if (_e40 < 4u) {
+                uint _e42 = q;
+                if (_e42 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q;
-                    float u = metal::tan(mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
-                    float _e52 = sum;
-                    uint _e54 = q;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                    uint _e48 = q;
+                    float u = metal::tan(mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
+                    float _e54 = sum;
+                    uint _e56 = q;
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u * u)));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return ((_e75 * 0.5) * w) * h;
+    float _e77 = sum;
+    return ((_e77 * 0.5) * w) * h;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(

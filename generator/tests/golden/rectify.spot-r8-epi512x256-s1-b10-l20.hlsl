@@ -180,11 +180,8 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
 {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
     float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_5 * x_5) * (3.0 - (2.0 * x_5))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
@@ -215,18 +212,18 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = (_e73 + 1u);
+            uint _e75 = k;
+            k = (_e75 + 1u);
         }
         loop_init = false;
         uint _e30 = k;
-        if ((_e30 < panels)) {
+        if (((_e30 + 1u) <= panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w));
+            uint _e34 = k;
+            float mid = (g0_ + ((float(_e34) + 0.5) * w));
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
             bool loop_init_1 = true;
@@ -234,28 +231,28 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
                 if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
                 loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
                 if (!loop_init_1) {
-                    uint _e70 = q;
-                    q = (_e70 + 1u);
+                    uint _e72 = q;
+                    q = (_e72 + 1u);
                 }
                 loop_init_1 = false;
-                uint _e40 = q;
-                if ((_e40 < 4u)) {
+                uint _e42 = q;
+                if ((_e42 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e46), 3u)])));
-                    float _e52 = sum;
-                    uint _e54 = q;
-                    const float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e54), 3u)] * _e62) * (1.0 + (u * u))));
+                    uint _e48 = q;
+                    float u = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e48), 3u)])));
+                    float _e54 = sum;
+                    uint _e56 = q;
+                    const float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e56), 3u)] * _e64) * (1.0 + (u * u))));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return (((_e75 * 0.5) * w) * h);
+    float _e77 = sum;
+    return (((_e77 * 0.5) * w) * h);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {

@@ -223,11 +223,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_inner,
     float cos_outer
 ) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
     float x_9 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_9 * x_9) * (3.0 - (2.0 * x_9));
+    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_9 * x_9) * (3.0 - (2.0 * x_9)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -275,18 +272,18 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = _e73 + 1u;
+            uint _e75 = k;
+            k = _e75 + 1u;
         }
         loop_init = false;
         uint _e30 = k;
-        if (_e30 < panels) {
+        if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
-            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_2);
+            uint _e34 = k;
+            float mid = g0_ + ((static_cast<float>(_e34) + 0.5) * w_2);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
@@ -294,28 +291,28 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 if (metal::all(loop_bound_1 == uint2(0u))) { break; }
                 loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
                 if (!loop_init_1) {
-                    uint _e70 = q;
-                    q = _e70 + 1u;
+                    uint _e72 = q;
+                    q = _e72 + 1u;
                 }
                 loop_init_1 = false;
-                uint _e40 = q;
-                if (_e40 < 4u) {
+                uint _e42 = q;
+                if (_e42 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q;
-                    float u = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
-                    float _e52 = sum;
-                    uint _e54 = q;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u * u)));
+                    uint _e48 = q;
+                    float u = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
+                    float _e54 = sum;
+                    uint _e56 = q;
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u * u)));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return ((_e75 * 0.5) * w_2) * h;
+    float _e77 = sum;
+    return ((_e77 * 0.5) * w_2) * h;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -414,44 +411,44 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e63 = k_1;
-            k_1 = _e63 + 1u;
+            uint _e65 = k_1;
+            k_1 = _e65 + 1u;
         }
         loop_init_2 = false;
         uint _e15 = k_1;
-        if (_e15 < steps) {
+        if ((_e15 + 1u) <= steps) {
         } else {
             break;
         }
         {
-            uint _e17 = k_1;
-            t_2 = a_3 + ((static_cast<float>(_e17) + 0.5) * h_2);
+            uint _e19 = k_1;
+            t_2 = a_3 + ((static_cast<float>(_e19) + 0.5) * h_2);
             w = h_2;
             if (spot_1) {
-                uint _e26 = k_1;
-                metal::float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e26) + 0.5);
-                t_2 = _e30.x;
-                w = _e30.y;
+                uint _e28 = k_1;
+                metal::float2 _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e28) + 0.5);
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, eye_4 + (dir_4 * _e33), spot_1);
+            float _e35 = t_2;
+            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, eye_4 + (dir_4 * _e35), spot_1);
             if (spot_1) {
-                float _e39 = sum_1;
-                float _e40 = w;
-                float _e42 = t_2;
-                float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
-                sum_1 = _e39 + ((_e37 * _e40) * _e43);
+                float _e41 = sum_1;
+                float _e42 = w;
+                float _e44 = t_2;
+                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e44);
+                sum_1 = _e41 + ((_e39 * _e42) * _e45);
             } else {
-                float _e46 = sum_1;
-                uint _e49 = k_1;
-                uint _e53 = k_1;
-                float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, a_3 + (static_cast<float>(_e49) * h_2), a_3 + (static_cast<float>(_e53 + 1u) * h_2));
-                sum_1 = _e46 + (_e37 * _e59);
+                float _e48 = sum_1;
+                uint _e51 = k_1;
+                uint _e55 = k_1;
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, a_3 + (static_cast<float>(_e51) * h_2), a_3 + (static_cast<float>(_e55 + 1u) * h_2));
+                sum_1 = _e48 + (_e39 * _e61);
             }
         }
     }
-    float _e65 = sum_1;
-    return _e65;
+    float _e67 = sum_1;
+    return _e67;
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -471,6 +468,16 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     }
 }
 
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    metal::float2 pc
+) {
+    float radius = f_6.epipole.w;
+    bool near_epi = (f_6.epipole.z > 0.5) & (metal::length(pc - f_6.epipole.xy) < radius);
+    bool near_anti = (f_6.anti_epipole.z > 0.5) & (metal::length(pc - f_6.anti_epipole.xy) < radius);
+    return near_epi | near_anti;
+}
+
 int naga_f2i32(float value) {
     return static_cast<int>(metal::clamp(value, -2147483600.0, 2147483500.0));
 }
@@ -486,15 +493,11 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool wrap
 ) {
     int ji = naga_f2i32(j);
-    if (wrap) {
-        return static_cast<uint>(naga_mod(as_type<int>(as_type<uint>(naga_mod(ji, static_cast<int>(rows))) + as_type<uint>(static_cast<int>(rows))), static_cast<int>(rows)));
-    } else {
-        return static_cast<uint>(metal::clamp(ji, 0, as_type<int>(as_type<uint>(static_cast<int>(rows)) - as_type<uint>(1))));
-    }
+    return wrap ? static_cast<uint>(naga_mod(as_type<int>(as_type<uint>(naga_mod(ji, static_cast<int>(rows))) + as_type<uint>(static_cast<int>(rows))), static_cast<int>(rows))) : static_cast<uint>(metal::clamp(ji, 0, as_type<int>(as_type<uint>(static_cast<int>(rows)) - as_type<uint>(1))));
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
     float x_2,
     float delta,
     float theta_1,
@@ -514,34 +517,24 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (_e16) {
             return s_1;
         }
-        return metal::min((f_6.axis.w * metal::sin(psi)) / den, s_1);
+        return metal::min((f_7.axis.w * metal::sin(psi)) / den, s_1);
     } else {
         return metal::min((x_2 * delta) / metal::max(metal::sin(theta_1), 0.000001), s_1);
     }
 }
 
 float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
     metal::float3 dir_6
 ) {
-    float yc = {};
-    uint rows_1 = f_7.sizes.w;
-    float phi_1 = metal::atan2(metal::dot(dir_6, f_7.e2_.xyz), metal::dot(dir_6, f_7.e1_.xyz));
-    yc = (phi_1 - f_7.e1_.w) / f_7.e2_.w;
-    if (f_7.anti_epipole.w > 0.5) {
-        float _e22 = yc;
-        float _e23 = yc;
-        yc = _e22 - (metal::floor(_e23 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
-    } else {
-        float _e30 = yc;
-        yc = metal::clamp(_e30, 0.0, static_cast<float>(rows_1));
-    }
-    float _e34 = yc;
-    return _e34;
+    uint rows_1 = f_8.sizes.w;
+    float phi_1 = metal::atan2(metal::dot(dir_6, f_8.e2_.xyz), metal::dot(dir_6, f_8.e1_.xyz));
+    float yc_1 = (phi_1 - f_8.e1_.w) / f_8.e2_.w;
+    return (f_8.anti_epipole.w > 0.5) ? (yc_1 - (metal::floor(yc_1 / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc_1, 0.0, static_cast<float>(rows_1));
 }
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     metal::float3 eye_6,
     metal::float3 dir_7,
     float s_2,
@@ -549,37 +542,37 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_4
 ) {
     if (spot_4) {
-        metal::float3 q_2 = (eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz;
-        metal::float3 to_eye = -(f_8.axis.xyz);
+        metal::float3 q_2 = (eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz;
+        metal::float3 to_eye = -(f_9.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
     }
     return s_2 * metal::sin(theta_2);
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     metal::float3 eye_7,
     metal::float3 dir_8,
     float a_4,
     float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
     return _e15;
 }
 
 metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     float phi
 ) {
-    return (f_10.e1_.xyz * metal::cos(phi)) + (f_10.e2_.xyz * metal::sin(phi));
+    return (f_11.e1_.xyz * metal::cos(phi)) + (f_11.e2_.xyz * metal::sin(phi));
 }
 
 float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
     uint row
 ) {
-    return f_11.e1_.w + ((static_cast<float>(row) + 0.5) * f_11.e2_.w);
+    return f_12.e1_.w + ((static_cast<float>(row) + 0.5) * f_12.e2_.w);
 }
 
 metal::float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -684,10 +677,7 @@ metal::float3 scatter_pixel(
     device type_12 const& bounds,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    bool local_2 = {};
-    bool local_3 = {};
-    bool local_4 = {};
-    float yc_1 = {};
+    float yc = {};
     float d = {};
     float xs = 0.0;
     float reach = 0.0;
@@ -704,8 +694,8 @@ metal::float3 scatter_pixel(
     bool done0_ = false;
     bool done1_ = false;
     uint r_1 = 0u;
-    bool local_5 = {};
-    bool local_6 = {};
+    bool local_2 = {};
+    bool local_3 = {};
     float a0_ = {};
     float e0_ = {};
     float a1_ = {};
@@ -714,207 +704,188 @@ metal::float3 scatter_pixel(
     float weight1_ = {};
     float vis0_ = {};
     float vis1_ = {};
+    bool local_4 = {};
+    bool local_5 = {};
+    bool local_6 = {};
+    uint layer_4 = {};
+    uint k_3 = {};
     bool local_7 = {};
     bool local_8 = {};
     bool local_9 = {};
-    uint layer_4 = {};
-    uint k_3 = {};
-    bool local_10 = {};
-    bool local_11 = {};
-    bool local_12 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
-    metal::float3 eye_8 = f_12.eye.xyz;
-    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
+    metal::float3 eye_8 = f_13.eye.xyz;
+    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
     uint clamped_lod_e14 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
-    float s_3 = metal::min(metal::max(_e14.x, 0.0), f_12.theta.z) / metal::max(metal::dot(_e10, f_12.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_12.light_color.xyz;
-    metal::float3 px = metal::float3(static_cast<float>(x_6) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
-    float radius = f_12.epipole.w;
-    if (f_12.epipole.z > 0.5) {
-        local_2 = metal::length(px - metal::float3(f_12.epipole.x, f_12.epipole.y, 0.0)) < radius;
-    } else {
-        local_2 = false;
-    }
-    bool near_epi = local_2;
-    if (f_12.anti_epipole.z > 0.5) {
-        local_3 = metal::length(px - metal::float3(f_12.anti_epipole.x, f_12.anti_epipole.y, 0.0)) < radius;
-    } else {
-        local_3 = false;
-    }
-    bool near_anti = local_3;
-    if (!(near_epi)) {
-        local_4 = near_anti;
-    } else {
-        local_4 = true;
-    }
-    bool _e77 = local_4;
-    if (_e77) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = frame;
-        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_8, _e10, s_3, true);
-        metal::float3 l_1 = _e82 * color;
+    float s_3 = metal::min(metal::max(_e14.x, 0.0), f_13.theta.z) / metal::max(metal::dot(_e10, f_13.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_13.light_color.xyz;
+    bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, metal::float2(static_cast<float>(x_6) + 0.5, static_cast<float>(y_1) + 0.5));
+    if (_e36) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e38 = frame;
+        float _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, shadow_map, eye_8, _e10, s_3, true);
+        metal::float3 l_1 = _e41 * color;
         return l_1;
     }
-    metal::float3 axis = f_12.axis.xyz;
-    uint rows_2 = f_12.sizes.w;
-    uint width_1 = f_12.sizes.z;
-    bool wrap_1 = f_12.anti_epipole.w > 0.5;
+    metal::float3 axis = f_13.axis.xyz;
+    uint rows_2 = f_13.sizes.w;
+    uint width_1 = f_13.sizes.z;
+    bool wrap_1 = f_13.anti_epipole.w > 0.5;
     {
         theta_3 = metal::acos(metal::clamp(metal::dot(_e10, axis), -1.0, 1.0));
-        float _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
-        yc_1 = _e100;
-        float _e102 = theta_3;
-        float _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_12.theta.x, f_12.theta.y);
-        d = _e107;
-        float _e109 = theta_3;
-        float _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e109, true);
-        reach = _e110;
+        float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        yc = _e59;
+        float _e61 = theta_3;
+        float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
+        d = _e66;
+        float _e68 = theta_3;
+        float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_3, _e68, true);
+        reach = _e69;
     }
-    float _e112 = yc_1;
-    float yb = _e112 - 0.5;
+    float _e71 = yc;
+    float yb = _e71 - 0.5;
     float fy = yb - metal::floor(yb);
-    uint _e118 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_2, wrap_1);
-    uint _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_2, wrap_1);
-    uint row1_ = (yb > metal::floor(yb)) ? _e122 : _e118;
-    float w1_ = (row1_ != _e118) ? fy : 0.0;
-    float cos_theta_l = -(metal::dot(f_12.light_dir.xyz, _e10));
-    uint panels_2 = metal::max(naga_div(f_12.sizes2_.z, 4u), 1u);
-    float _e140 = d;
-    float _e144 = d;
-    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e140), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e144));
-    metal::float2 _e149 = angle;
-    metal::float2 _e150 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
+    uint _e77 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_2, wrap_1);
+    uint _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_2, wrap_1);
+    uint row1_ = (yb > metal::floor(yb)) ? _e81 : _e77;
+    float w1_ = (row1_ != _e77) ? fy : 0.0;
+    float cos_theta_l = -(metal::dot(f_13.light_dir.xyz, _e10));
+    uint panels_2 = metal::max(naga_div(f_13.sizes2_.z, 4u), 1u);
+    float _e99 = d;
+    float _e103 = d;
+    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e99), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e103));
+    metal::float2 _e108 = angle;
+    metal::float2 _e109 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e108);
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e165 = layer_3;
-            layer_3 = _e165 + 1u;
+            uint _e124 = layer_3;
+            layer_3 = _e124 + 1u;
         }
         loop_init_3 = false;
-        uint _e152 = layer_3;
-        if (_e152 < LAYERS) {
+        uint _e111 = layer_3;
+        if (_e111 < LAYERS) {
         } else {
             break;
         }
         {
-            metal::float2 _e155 = angle;
-            metal::float2 _e156 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, _e150);
-            uint _e158 = layer_3;
-            metal::float2 _e160 = angle;
-            uint _e161 = layer_3;
-            metal::float4 _e162 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e160, _e156, _e161);
-            coeffs.inner[metal::min(unsigned(_e158), 3u)] = _e162;
-            metal::float2 _e163 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156, _e150);
-            angle = _e163;
+            metal::float2 _e114 = angle;
+            metal::float2 _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e114, _e109);
+            uint _e117 = layer_3;
+            metal::float2 _e119 = angle;
+            uint _e120 = layer_3;
+            metal::float4 _e121 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e119, _e115, _e120);
+            coeffs.inner[metal::min(unsigned(_e117), 3u)] = _e121;
+            metal::float2 _e122 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e115, _e109);
+            angle = _e122;
         }
     }
-    float _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
-    float sun_scatter = f_12.medium.y * _e171;
-    float _e174 = xs;
-    xs0_ = _e174;
-    float _e176 = xs;
-    xs1_ = _e176;
+    float _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
+    float sun_scatter = f_13.medium.y * _e130;
+    float _e133 = xs;
+    xs0_ = _e133;
+    float _e135 = xs;
+    xs1_ = _e135;
     {
-        metal::float4 _e180 = slices[metal::min(unsigned(_e118), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e181 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e180);
-        delta0_ = _e181.delta;
-        metal::float4 _e186 = slices[metal::min(unsigned(row1_), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e187 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e186);
-        delta1_ = _e187.delta;
-        float _e190 = reach;
-        float _e191 = delta0_;
-        xs0_ = _e190 / _e191;
-        float _e193 = reach;
-        float _e194 = delta1_;
-        xs1_ = _e193 / _e194;
+        metal::float4 _e139 = slices[metal::min(unsigned(_e77), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e140 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e139);
+        delta0_ = _e140.delta;
+        metal::float4 _e145 = slices[metal::min(unsigned(row1_), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e146 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e145);
+        delta1_ = _e146.delta;
+        float _e149 = reach;
+        float _e150 = delta0_;
+        xs0_ = _e149 / _e150;
+        float _e152 = reach;
+        float _e153 = delta1_;
+        xs1_ = _e152 / _e153;
     }
-    float _e196 = xs0_;
-    uint last0_ = naga_f2u32(metal::min(metal::max(_e196, 0.0), static_cast<float>(width_1) - 1.0));
-    float _e204 = xs1_;
-    uint last1_ = naga_f2u32(metal::min(metal::max(_e204, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e155 = xs0_;
+    uint last0_ = naga_f2u32(metal::min(metal::max(_e155, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e163 = xs1_;
+    uint last1_ = naga_f2u32(metal::min(metal::max(_e163, 0.0), static_cast<float>(width_1) - 1.0));
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e503 = r_1;
-            r_1 = _e503 + 1u;
+            uint _e462 = r_1;
+            r_1 = _e462 + 1u;
         }
         loop_init_4 = false;
-        uint _e214 = r_1;
-        if (_e214 < REGIONS) {
+        uint _e173 = r_1;
+        if (_e173 < REGIONS) {
         } else {
             break;
         }
         {
-            uint _e216 = r_1;
-            uint _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, true);
-            float b0_ = static_cast<float>(_e217);
-            uint _e219 = r_1;
-            uint _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e219 + 1u, REGIONS, width_1, true);
-            float b1_ = static_cast<float>(_e222);
+            uint _e175 = r_1;
+            uint _e176 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e175, REGIONS, width_1, true);
+            float b0_ = static_cast<float>(_e176);
+            uint _e178 = r_1;
+            uint _e181 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e178 + 1u, REGIONS, width_1, true);
+            float b1_ = static_cast<float>(_e181);
             if (!((last0_ < naga_f2u32(b1_)))) {
-                uint _e227 = r_1;
-                local_5 = (_e227 + 1u) == REGIONS;
+                uint _e186 = r_1;
+                local_2 = (_e186 + 1u) == REGIONS;
             } else {
-                local_5 = true;
+                local_2 = true;
             }
-            bool is_last0_ = local_5;
+            bool is_last0_ = local_2;
             if (!((last1_ < naga_f2u32(b1_)))) {
-                uint _e238 = r_1;
-                local_6 = (_e238 + 1u) == REGIONS;
+                uint _e197 = r_1;
+                local_3 = (_e197 + 1u) == REGIONS;
             } else {
-                local_6 = true;
+                local_3 = true;
             }
-            bool is_last1_ = local_6;
-            float _e248 = xs0_;
-            float pos0_ = is_last0_ ? metal::clamp(_e248 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-            float _e259 = xs1_;
-            float pos1_ = is_last1_ ? metal::clamp(_e259 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            bool is_last1_ = local_3;
+            float _e207 = xs0_;
+            float pos0_ = is_last0_ ? metal::clamp(_e207 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            float _e218 = xs1_;
+            float pos1_ = is_last1_ ? metal::clamp(_e218 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
             a0_ = float {};
             e0_ = float {};
             a1_ = float {};
             e1_ = float {};
-            float _e276 = delta0_;
-            float _e277 = theta_3;
-            float _e278 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e276, _e277, s_3, true);
-            a0_ = _e278;
-            float _e279 = delta0_;
-            float _e280 = theta_3;
-            float _e281 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e279, _e280, s_3, true);
-            e0_ = is_last0_ ? s_3 : _e281;
-            float _e283 = delta1_;
-            float _e284 = theta_3;
-            float _e285 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e283, _e284, s_3, true);
-            a1_ = _e285;
-            float _e286 = delta1_;
-            float _e287 = theta_3;
-            float _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e286, _e287, s_3, true);
-            e1_ = is_last1_ ? s_3 : _e288;
+            float _e235 = delta0_;
+            float _e236 = theta_3;
+            float _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e235, _e236, s_3, true);
+            a0_ = _e237;
+            float _e238 = delta0_;
+            float _e239 = theta_3;
+            float _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e238, _e239, s_3, true);
+            e0_ = is_last0_ ? s_3 : _e240;
+            float _e242 = delta1_;
+            float _e243 = theta_3;
+            float _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e242, _e243, s_3, true);
+            a1_ = _e244;
+            float _e245 = delta1_;
+            float _e246 = theta_3;
+            float _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e245, _e246, s_3, true);
+            e1_ = is_last1_ ? s_3 : _e247;
             weight0_ = float {};
             weight1_ = float {};
             if (true) {
-                float _e294 = a0_;
-                float _e295 = e0_;
-                float _e296 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e294, _e295, panels_2);
-                weight0_ = _e296;
-                float _e297 = a1_;
-                float _e298 = e1_;
-                float _e299 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e297, _e298, panels_2);
-                weight1_ = _e299;
+                float _e253 = a0_;
+                float _e254 = e0_;
+                float _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e253, _e254, panels_2);
+                weight0_ = _e255;
+                float _e256 = a1_;
+                float _e257 = e1_;
+                float _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e256, _e257, panels_2);
+                weight1_ = _e258;
             } else {
-                float _e302 = a0_;
-                float _e303 = e0_;
-                float _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e302, _e303);
-                weight0_ = sun_scatter * _e304;
-                float _e308 = a1_;
-                float _e309 = e1_;
-                float _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e308, _e309);
-                weight1_ = sun_scatter * _e310;
+                float _e261 = a0_;
+                float _e262 = e0_;
+                float _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e261, _e262);
+                weight0_ = sun_scatter * _e263;
+                float _e267 = a1_;
+                float _e268 = e1_;
+                float _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e267, _e268);
+                weight1_ = sun_scatter * _e269;
             }
             float xb0_ = pos0_ - 0.5;
             float fx0_ = xb0_ - metal::floor(xb0_);
@@ -924,35 +895,35 @@ metal::float3 scatter_pixel(
             float fx1_ = xb1_ - metal::floor(xb1_);
             uint x10_ = naga_f2u32(metal::clamp(metal::floor(xb1_), 0.0, static_cast<float>(width_1) - 1.0));
             uint x11_ = (xb1_ > metal::floor(xb1_)) ? metal::min(x10_ + 1u, width_1 - 1u) : x10_;
-            uint _e350 = bounds_index(x01_, _e118, frame);
-            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e350), (_buffer_sizes.size6 - 0 - 8) / 8)];
-            uint _e354 = bounds_index(x11_, row1_, frame);
-            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e354), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint _e309 = bounds_index(x01_, _e77, frame);
+            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e309), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint _e313 = bounds_index(x11_, row1_, frame);
+            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e313), (_buffer_sizes.size6 - 0 - 8) / 8)];
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e362 = d;
-            if (_e362 > lohi0_.x) {
-                float _e365 = d;
-                local_7 = _e365 <= lohi0_.y;
+            float _e321 = d;
+            if (_e321 > lohi0_.x) {
+                float _e324 = d;
+                local_4 = _e324 <= lohi0_.y;
             } else {
-                local_7 = false;
+                local_4 = false;
             }
-            bool _e371 = local_7;
-            if (!(_e371)) {
-                float _e373 = d;
-                if (_e373 > lohi1_.x) {
-                    float _e376 = d;
-                    local_9 = _e376 <= lohi1_.y;
+            bool _e330 = local_4;
+            if (!(_e330)) {
+                float _e332 = d;
+                if (_e332 > lohi1_.x) {
+                    float _e335 = d;
+                    local_6 = _e335 <= lohi1_.y;
                 } else {
-                    local_9 = false;
+                    local_6 = false;
                 }
-                bool _e382 = local_9;
-                local_8 = _e382;
+                bool _e341 = local_6;
+                local_5 = _e341;
             } else {
-                local_8 = true;
+                local_5 = true;
             }
-            bool _e386 = local_8;
-            if (_e386) {
+            bool _e345 = local_5;
+            if (_e345) {
                 layer_4 = 0u;
                 uint2 loop_bound_5 = uint2(4294967295u);
                 bool loop_init_5 = true;
@@ -960,28 +931,28 @@ metal::float3 scatter_pixel(
                     if (metal::all(loop_bound_5 == uint2(0u))) { break; }
                     loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                     if (!loop_init_5) {
-                        uint _e436 = layer_4;
-                        layer_4 = _e436 + 1u;
+                        uint _e395 = layer_4;
+                        layer_4 = _e395 + 1u;
                     }
                     loop_init_5 = false;
-                    uint _e389 = layer_4;
-                    if (_e389 < LAYERS) {
+                    uint _e348 = layer_4;
+                    if (_e348 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        uint _e392 = layer_4;
-                        metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e392), 3u)];
-                        uint _e395 = layer_4;
-                        metal::float4 _e396 = filtered_load(x00_, _e118, _e395, frame, filtered, _buffer_sizes);
-                        uint _e397 = layer_4;
-                        metal::float4 _e398 = filtered_load(x01_, _e118, _e397, frame, filtered, _buffer_sizes);
-                        metal::float4 texel0_ = metal::mix(_e396, _e398, fx0_);
-                        uint _e400 = layer_4;
-                        metal::float4 _e401 = filtered_load(x10_, row1_, _e400, frame, filtered, _buffer_sizes);
-                        uint _e402 = layer_4;
-                        metal::float4 _e403 = filtered_load(x11_, row1_, _e402, frame, filtered, _buffer_sizes);
-                        metal::float4 texel1_ = metal::mix(_e401, _e403, fx1_);
+                        uint _e351 = layer_4;
+                        metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e351), 3u)];
+                        uint _e354 = layer_4;
+                        metal::float4 _e355 = filtered_load(x00_, _e77, _e354, frame, filtered, _buffer_sizes);
+                        uint _e356 = layer_4;
+                        metal::float4 _e357 = filtered_load(x01_, _e77, _e356, frame, filtered, _buffer_sizes);
+                        metal::float4 texel0_ = metal::mix(_e355, _e357, fx0_);
+                        uint _e359 = layer_4;
+                        metal::float4 _e360 = filtered_load(x10_, row1_, _e359, frame, filtered, _buffer_sizes);
+                        uint _e361 = layer_4;
+                        metal::float4 _e362 = filtered_load(x11_, row1_, _e361, frame, filtered, _buffer_sizes);
+                        metal::float4 texel1_ = metal::mix(_e360, _e362, fx1_);
                         k_3 = 0u;
                         uint2 loop_bound_6 = uint2(4294967295u);
                         bool loop_init_6 = true;
@@ -989,83 +960,83 @@ metal::float3 scatter_pixel(
                             if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                             loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                             if (!loop_init_6) {
-                                uint _e433 = k_3;
-                                k_3 = _e433 + 1u;
+                                uint _e392 = k_3;
+                                k_3 = _e392 + 1u;
                             }
                             loop_init_6 = false;
-                            uint _e407 = k_3;
-                            if (_e407 < 4u) {
+                            uint _e366 = k_3;
+                            if (_e366 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                float _e410 = vis0_;
-                                uint _e411 = k_3;
-                                uint _e413 = k_3;
-                                vis0_ = _e410 + (coeff[metal::min(unsigned(_e411), 3u)] * ((texel0_[metal::min(unsigned(_e413), 3u)] * 2.0) - 1.0));
-                                float _e421 = vis1_;
-                                uint _e422 = k_3;
-                                uint _e424 = k_3;
-                                vis1_ = _e421 + (coeff[metal::min(unsigned(_e422), 3u)] * ((texel1_[metal::min(unsigned(_e424), 3u)] * 2.0) - 1.0));
+                                float _e369 = vis0_;
+                                uint _e370 = k_3;
+                                uint _e372 = k_3;
+                                vis0_ = _e369 + (coeff[metal::min(unsigned(_e370), 3u)] * ((texel0_[metal::min(unsigned(_e372), 3u)] * 2.0) - 1.0));
+                                float _e380 = vis1_;
+                                uint _e381 = k_3;
+                                uint _e383 = k_3;
+                                vis1_ = _e380 + (coeff[metal::min(unsigned(_e381), 3u)] * ((texel1_[metal::min(unsigned(_e383), 3u)] * 2.0) - 1.0));
                             }
                         }
                     }
                 }
             }
-            float _e438 = vis0_;
-            float _e439 = d;
-            float _e444 = d;
-            vis0_ = (_e444 <= lohi0_.x) ? 1.0 : ((_e439 > lohi0_.y) ? 0.0 : _e438);
-            float _e449 = vis1_;
-            float _e450 = d;
-            float _e455 = d;
-            vis1_ = (_e455 <= lohi1_.x) ? 1.0 : ((_e450 > lohi1_.y) ? 0.0 : _e449);
-            bool _e461 = done0_;
-            if (!(_e461)) {
-                float _e464 = total0_;
-                float _e465 = weight0_;
-                float _e466 = vis0_;
-                total0_ = _e464 + (_e465 * metal::clamp(_e466, 0.0, 1.0));
+            float _e397 = vis0_;
+            float _e398 = d;
+            float _e403 = d;
+            vis0_ = (_e403 <= lohi0_.x) ? 1.0 : ((_e398 > lohi0_.y) ? 0.0 : _e397);
+            float _e408 = vis1_;
+            float _e409 = d;
+            float _e414 = d;
+            vis1_ = (_e414 <= lohi1_.x) ? 1.0 : ((_e409 > lohi1_.y) ? 0.0 : _e408);
+            bool _e420 = done0_;
+            if (!(_e420)) {
+                float _e423 = total0_;
+                float _e424 = weight0_;
+                float _e425 = vis0_;
+                total0_ = _e423 + (_e424 * metal::clamp(_e425, 0.0, 1.0));
             }
-            bool _e473 = done1_;
-            if (!(_e473)) {
-                float _e476 = total1_;
-                float _e477 = weight1_;
-                float _e478 = vis1_;
-                total1_ = _e476 + (_e477 * metal::clamp(_e478, 0.0, 1.0));
+            bool _e432 = done1_;
+            if (!(_e432)) {
+                float _e435 = total1_;
+                float _e436 = weight1_;
+                float _e437 = vis1_;
+                total1_ = _e435 + (_e436 * metal::clamp(_e437, 0.0, 1.0));
             }
-            bool _e484 = done0_;
-            if (!(_e484)) {
-                local_10 = is_last0_;
+            bool _e443 = done0_;
+            if (!(_e443)) {
+                local_7 = is_last0_;
             } else {
-                local_10 = true;
+                local_7 = true;
             }
-            bool _e489 = local_10;
-            done0_ = _e489;
-            bool _e490 = done1_;
-            if (!(_e490)) {
-                local_11 = is_last1_;
+            bool _e448 = local_7;
+            done0_ = _e448;
+            bool _e449 = done1_;
+            if (!(_e449)) {
+                local_8 = is_last1_;
             } else {
-                local_11 = true;
+                local_8 = true;
             }
-            bool _e495 = local_11;
-            done1_ = _e495;
-            bool _e496 = done0_;
-            if (_e496) {
-                bool _e497 = done1_;
-                local_12 = _e497;
+            bool _e454 = local_8;
+            done1_ = _e454;
+            bool _e455 = done0_;
+            if (_e455) {
+                bool _e456 = done1_;
+                local_9 = _e456;
             } else {
-                local_12 = false;
+                local_9 = false;
             }
-            bool _e501 = local_12;
-            if (_e501) {
+            bool _e460 = local_9;
+            if (_e460) {
                 break;
             }
         }
     }
-    float _e507 = total0_;
-    float _e509 = total1_;
-    float l_2 = ((1.0 - w1_) * _e507) + (w1_ * _e509);
+    float _e466 = total0_;
+    float _e468 = total1_;
+    float l_2 = ((1.0 - w1_) * _e466) + (w1_ * _e468);
     metal::float3 c = color * l_2;
     return c;
 }

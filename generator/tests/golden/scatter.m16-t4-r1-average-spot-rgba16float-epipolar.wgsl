@@ -174,11 +174,8 @@ fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32,
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
     let x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_9 * x_9) * (3f - (2f * x_9)));
+    return select(((x_9 * x_9) * (3f - (2f * x_9))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
@@ -203,41 +200,41 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k;
-        if (_e30 < panels) {
+        if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            let _e32 = k;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_2));
+            let _e34 = k;
+            let mid = (g0_ + ((f32(_e34) + 0.5f) * w_2));
             q = 0u;
             loop {
-                let _e40 = q;
-                if (_e40 < 4u) {
+                let _e42 = q;
+                if (_e42 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    let _e46 = q;
-                    let u = tan((mid + ((0.5f * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
-                    let _e52 = sum;
-                    let _e54 = q;
-                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u * u))));
+                    let _e48 = q;
+                    let u = tan((mid + ((0.5f * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    let _e54 = sum;
+                    let _e56 = q;
+                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u * u))));
                 }
                 continuing {
-                    let _e70 = q;
-                    q = (_e70 + 1u);
+                    let _e72 = q;
+                    q = (_e72 + 1u);
                 }
             }
         }
         continuing {
-            let _e73 = k;
-            k = (_e73 + 1u);
+            let _e75 = k;
+            k = (_e75 + 1u);
         }
     }
-    let _e75 = sum;
-    return (((_e75 * 0.5f) * w_2) * h);
+    let _e77 = sum;
+    return (((_e77 * 0.5f) * w_2) * h);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -292,43 +289,43 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_
     let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_1;
-        if (_e15 < steps) {
+        if ((_e15 + 1u) <= steps) {
         } else {
             break;
         }
         {
-            let _e17 = k_1;
-            t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_2));
+            let _e19 = k_1;
+            t_2 = (a_3 + ((f32(_e19) + 0.5f) * h_2));
             w = h_2;
             if spot_1 {
-                let _e26 = k_1;
-                let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
-                t_2 = _e30.x;
-                w = _e30.y;
+                let _e28 = k_1;
+                let _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e28) + 0.5f));
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            let _e33 = t_2;
-            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            let _e35 = t_2;
+            let _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if spot_1 {
-                let _e39 = sum_1;
-                let _e40 = w;
-                let _e42 = t_2;
-                let _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
-                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
+                let _e41 = sum_1;
+                let _e42 = w;
+                let _e44 = t_2;
+                let _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e44);
+                sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
-                let _e46 = sum_1;
-                let _e49 = k_1;
-                let _e53 = k_1;
-                let _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e49) * h_2)), (a_3 + (f32((_e53 + 1u)) * h_2)));
-                sum_1 = (_e46 + (_e37 * _e59));
+                let _e48 = sum_1;
+                let _e51 = k_1;
+                let _e55 = k_1;
+                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e51) * h_2)), (a_3 + (f32((_e55 + 1u)) * h_2)));
+                sum_1 = (_e48 + (_e39 * _e61));
             }
         }
         continuing {
-            let _e63 = k_1;
-            k_1 = (_e63 + 1u);
+            let _e65 = k_1;
+            k_1 = (_e65 + 1u);
         }
     }
-    let _e65 = sum_1;
-    return _e65;
+    let _e67 = sum_1;
+    return _e67;
 }
 
 fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
@@ -341,16 +338,19 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_o
     }
 }
 
-fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
-    let ji = i32(j);
-    if wrap {
-        return u32((((ji % i32(rows)) + i32(rows)) % i32(rows)));
-    } else {
-        return u32(clamp(ji, 0i, (i32(rows) - 1i)));
-    }
+fn in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, pc: vec2<f32>) -> bool {
+    let radius = f_6.epipole.w;
+    let near_epi = ((f_6.epipole.z > 0.5f) & (length((pc - f_6.epipole.xy)) < radius));
+    let near_anti = ((f_6.anti_epipole.z > 0.5f) & (length((pc - f_6.anti_epipole.xy)) < radius));
+    return (near_epi | near_anti);
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_3: bool) -> f32 {
+fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = i32(j);
+    return select(u32(clamp(ji, 0i, (i32(rows) - 1i))), u32((((ji % i32(rows)) + i32(rows)) % i32(rows))), wrap);
+}
+
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_3: bool) -> f32 {
     var local_1: bool;
 
     if spot_3 {
@@ -365,50 +365,39 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_X
         if _e16 {
             return s_1;
         }
-        return min(((f_6.axis.w * sin(psi)) / den), s_1);
+        return min(((f_7.axis.w * sin(psi)) / den), s_1);
     } else {
         return min(((x_2 * delta) / max(sin(theta_1), 0.000001f)), s_1);
     }
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
-    var yc: f32;
-
-    let rows_1 = f_7.sizes.w;
-    let phi_1 = atan2(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
-    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
-    if (f_7.anti_epipole.w > 0.5f) {
-        let _e22 = yc;
-        let _e23 = yc;
-        yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
-    } else {
-        let _e30 = yc;
-        yc = clamp(_e30, 0f, f32(rows_1));
-    }
-    let _e34 = yc;
-    return _e34;
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let rows_1 = f_8.sizes.w;
+    let phi_1 = atan2(dot(dir_6, f_8.e2_.xyz), dot(dir_6, f_8.e1_.xyz));
+    let yc_1 = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
+    return select(clamp(yc_1, 0f, f32(rows_1)), (yc_1 - (floor((yc_1 / f32(rows_1))) * f32(rows_1))), (f_8.anti_epipole.w > 0.5f));
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_4: bool) -> f32 {
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_4: bool) -> f32 {
     if spot_4 {
-        let q_2 = ((eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz);
-        let to_eye = -(f_8.axis.xyz);
+        let q_2 = ((eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz);
+        let to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_8: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_8: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
     return _e15;
 }
 
-fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
-    return ((f_10.e1_.xyz * cos(phi)) + (f_10.e2_.xyz * sin(phi)));
+fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
+    return ((f_11.e1_.xyz * cos(phi)) + (f_11.e2_.xyz * sin(phi)));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    return (f_11.e1_.w + ((f32(row) + 0.5f) * f_11.e2_.w));
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    return (f_12.e1_.w + ((f32(row) + 0.5f) * f_12.e2_.w));
 }
 
 fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_5: vec2<f32>) -> vec2<f32> {
@@ -463,10 +452,7 @@ fn filtered_load(x_5: u32, row_3: u32, layer_2: u32) -> vec4<f32> {
 }
 
 fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
-    var local_2: bool;
-    var local_3: bool;
-    var local_4: bool;
-    var yc_1: f32;
+    var yc: f32;
     var d: f32;
     var xs: f32 = 0f;
     var reach: f32 = 0f;
@@ -483,8 +469,8 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var done0_: bool = false;
     var done1_: bool = false;
     var r_1: u32 = 0u;
-    var local_5: bool;
-    var local_6: bool;
+    var local_2: bool;
+    var local_3: bool;
     var a0_: f32;
     var e0_: f32;
     var a1_: f32;
@@ -493,193 +479,174 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var weight1_: f32;
     var vis0_: f32;
     var vis1_: f32;
+    var local_4: bool;
+    var local_5: bool;
+    var local_6: bool;
+    var layer_4: u32;
+    var k_3: u32;
     var local_7: bool;
     var local_8: bool;
     var local_9: bool;
-    var layer_4: u32;
-    var k_3: u32;
-    var local_10: bool;
-    var local_11: bool;
-    var local_12: bool;
 
-    let f_12 = frame;
-    let eye_8 = f_12.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
+    let f_13 = frame;
+    let eye_8 = f_13.eye.xyz;
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
     let _e14 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
-    let s_3 = (min(max(_e14.x, 0f), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 0.000001f));
-    let color = f_12.light_color.xyz;
-    let px = vec3<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f), 0f);
-    let radius = f_12.epipole.w;
-    if (f_12.epipole.z > 0.5f) {
-        local_2 = (length((px - vec3<f32>(f_12.epipole.x, f_12.epipole.y, 0f))) < radius);
-    } else {
-        local_2 = false;
-    }
-    let near_epi = local_2;
-    if (f_12.anti_epipole.z > 0.5f) {
-        local_3 = (length((px - vec3<f32>(f_12.anti_epipole.x, f_12.anti_epipole.y, 0f))) < radius);
-    } else {
-        local_3 = false;
-    }
-    let near_anti = local_3;
-    if !(near_epi) {
-        local_4 = near_anti;
-    } else {
-        local_4 = true;
-    }
-    let _e77 = local_4;
-    if _e77 {
-        let _e79 = frame;
-        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_8, _e10, s_3, true);
-        let l_1 = (_e82 * color);
+    let s_3 = (min(max(_e14.x, 0f), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 0.000001f));
+    let color = f_13.light_color.xyz;
+    let _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, vec2<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f)));
+    if _e36 {
+        let _e38 = frame;
+        let _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, shadow_map, eye_8, _e10, s_3, true);
+        let l_1 = (_e41 * color);
         return l_1;
     }
-    let axis = f_12.axis.xyz;
-    let rows_2 = f_12.sizes.w;
-    let width_1 = f_12.sizes.z;
-    let wrap_1 = (f_12.anti_epipole.w > 0.5f);
+    let axis = f_13.axis.xyz;
+    let rows_2 = f_13.sizes.w;
+    let width_1 = f_13.sizes.z;
+    let wrap_1 = (f_13.anti_epipole.w > 0.5f);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
-        yc_1 = _e100;
-        let _e102 = theta_3;
-        let _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_12.theta.x, f_12.theta.y);
-        d = _e107;
-        let _e109 = theta_3;
-        let _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e109, true);
-        reach = _e110;
+        let _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        yc = _e59;
+        let _e61 = theta_3;
+        let _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
+        d = _e66;
+        let _e68 = theta_3;
+        let _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_3, _e68, true);
+        reach = _e69;
     }
-    let _e112 = yc_1;
-    let yb = (_e112 - 0.5f);
+    let _e71 = yc;
+    let yb = (_e71 - 0.5f);
     let fy = (yb - floor(yb));
-    let _e118 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
-    let _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
-    let row1_ = select(_e118, _e122, (yb > floor(yb)));
-    let w1_ = select(0f, fy, (row1_ != _e118));
-    let cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
-    let panels_2 = max((f_12.sizes2_.z / 4u), 1u);
-    let _e140 = d;
-    let _e144 = d;
-    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e140)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e144)));
-    let _e149 = angle;
-    let _e150 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
+    let _e77 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    let _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
+    let row1_ = select(_e77, _e81, (yb > floor(yb)));
+    let w1_ = select(0f, fy, (row1_ != _e77));
+    let cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
+    let panels_2 = max((f_13.sizes2_.z / 4u), 1u);
+    let _e99 = d;
+    let _e103 = d;
+    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e99)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e103)));
+    let _e108 = angle;
+    let _e109 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e108);
     loop {
-        let _e152 = layer_3;
-        if (_e152 < LAYERS) {
+        let _e111 = layer_3;
+        if (_e111 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e155 = angle;
-            let _e156 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, _e150);
-            let _e158 = layer_3;
-            let _e160 = angle;
-            let _e161 = layer_3;
-            let _e162 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e160, _e156, _e161);
-            coeffs[_e158] = _e162;
-            let _e163 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156, _e150);
-            angle = _e163;
+            let _e114 = angle;
+            let _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e114, _e109);
+            let _e117 = layer_3;
+            let _e119 = angle;
+            let _e120 = layer_3;
+            let _e121 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e119, _e115, _e120);
+            coeffs[_e117] = _e121;
+            let _e122 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e115, _e109);
+            angle = _e122;
         }
         continuing {
-            let _e165 = layer_3;
-            layer_3 = (_e165 + 1u);
+            let _e124 = layer_3;
+            layer_3 = (_e124 + 1u);
         }
     }
-    let _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
-    let sun_scatter = (f_12.medium.y * _e171);
-    let _e174 = xs;
-    xs0_ = _e174;
-    let _e176 = xs;
-    xs1_ = _e176;
+    let _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
+    let sun_scatter = (f_13.medium.y * _e130);
+    let _e133 = xs;
+    xs0_ = _e133;
+    let _e135 = xs;
+    xs1_ = _e135;
     {
-        let _e180 = slices[_e118];
-        let _e181 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e180);
-        delta0_ = _e181.delta;
-        let _e186 = slices[row1_];
-        let _e187 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e186);
-        delta1_ = _e187.delta;
-        let _e190 = reach;
-        let _e191 = delta0_;
-        xs0_ = (_e190 / _e191);
-        let _e193 = reach;
-        let _e194 = delta1_;
-        xs1_ = (_e193 / _e194);
+        let _e139 = slices[_e77];
+        let _e140 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e139);
+        delta0_ = _e140.delta;
+        let _e145 = slices[row1_];
+        let _e146 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e145);
+        delta1_ = _e146.delta;
+        let _e149 = reach;
+        let _e150 = delta0_;
+        xs0_ = (_e149 / _e150);
+        let _e152 = reach;
+        let _e153 = delta1_;
+        xs1_ = (_e152 / _e153);
     }
-    let _e196 = xs0_;
-    let last0_ = u32(min(max(_e196, 0f), (f32(width_1) - 1f)));
-    let _e204 = xs1_;
-    let last1_ = u32(min(max(_e204, 0f), (f32(width_1) - 1f)));
+    let _e155 = xs0_;
+    let last0_ = u32(min(max(_e155, 0f), (f32(width_1) - 1f)));
+    let _e163 = xs1_;
+    let last1_ = u32(min(max(_e163, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e214 = r_1;
-        if (_e214 < REGIONS) {
+        let _e173 = r_1;
+        if (_e173 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e216 = r_1;
-            let _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, true);
-            let b0_ = f32(_e217);
-            let _e219 = r_1;
-            let _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e219 + 1u), REGIONS, width_1, true);
-            let b1_ = f32(_e222);
+            let _e175 = r_1;
+            let _e176 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e175, REGIONS, width_1, true);
+            let b0_ = f32(_e176);
+            let _e178 = r_1;
+            let _e181 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e178 + 1u), REGIONS, width_1, true);
+            let b1_ = f32(_e181);
             if !((last0_ < u32(b1_))) {
-                let _e227 = r_1;
-                local_5 = ((_e227 + 1u) == REGIONS);
+                let _e186 = r_1;
+                local_2 = ((_e186 + 1u) == REGIONS);
             } else {
-                local_5 = true;
+                local_2 = true;
             }
-            let is_last0_ = local_5;
+            let is_last0_ = local_2;
             if !((last1_ < u32(b1_))) {
-                let _e238 = r_1;
-                local_6 = ((_e238 + 1u) == REGIONS);
+                let _e197 = r_1;
+                local_3 = ((_e197 + 1u) == REGIONS);
             } else {
-                local_6 = true;
+                local_3 = true;
             }
-            let is_last1_ = local_6;
-            let _e248 = xs0_;
-            let pos0_ = select((b1_ - 0.5f), clamp((_e248 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
-            let _e259 = xs1_;
-            let pos1_ = select((b1_ - 0.5f), clamp((_e259 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
+            let is_last1_ = local_3;
+            let _e207 = xs0_;
+            let pos0_ = select((b1_ - 0.5f), clamp((_e207 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
+            let _e218 = xs1_;
+            let pos1_ = select((b1_ - 0.5f), clamp((_e218 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
             a0_ = f32();
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e276 = delta0_;
-            let _e277 = theta_3;
-            let _e278 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e276, _e277, s_3, true);
-            a0_ = _e278;
-            let _e279 = delta0_;
-            let _e280 = theta_3;
-            let _e281 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e279, _e280, s_3, true);
-            e0_ = select(_e281, s_3, is_last0_);
-            let _e283 = delta1_;
-            let _e284 = theta_3;
-            let _e285 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e283, _e284, s_3, true);
-            a1_ = _e285;
-            let _e286 = delta1_;
-            let _e287 = theta_3;
-            let _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e286, _e287, s_3, true);
-            e1_ = select(_e288, s_3, is_last1_);
+            let _e235 = delta0_;
+            let _e236 = theta_3;
+            let _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e235, _e236, s_3, true);
+            a0_ = _e237;
+            let _e238 = delta0_;
+            let _e239 = theta_3;
+            let _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e238, _e239, s_3, true);
+            e0_ = select(_e240, s_3, is_last0_);
+            let _e242 = delta1_;
+            let _e243 = theta_3;
+            let _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e242, _e243, s_3, true);
+            a1_ = _e244;
+            let _e245 = delta1_;
+            let _e246 = theta_3;
+            let _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e245, _e246, s_3, true);
+            e1_ = select(_e247, s_3, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if true {
-                let _e294 = a0_;
-                let _e295 = e0_;
-                let _e296 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e294, _e295, panels_2);
-                weight0_ = _e296;
-                let _e297 = a1_;
-                let _e298 = e1_;
-                let _e299 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e297, _e298, panels_2);
-                weight1_ = _e299;
+                let _e253 = a0_;
+                let _e254 = e0_;
+                let _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e253, _e254, panels_2);
+                weight0_ = _e255;
+                let _e256 = a1_;
+                let _e257 = e1_;
+                let _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e256, _e257, panels_2);
+                weight1_ = _e258;
             } else {
-                let _e302 = a0_;
-                let _e303 = e0_;
-                let _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e302, _e303);
-                weight0_ = (sun_scatter * _e304);
-                let _e308 = a1_;
-                let _e309 = e1_;
-                let _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e308, _e309);
-                weight1_ = (sun_scatter * _e310);
+                let _e261 = a0_;
+                let _e262 = e0_;
+                let _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e261, _e262);
+                weight0_ = (sun_scatter * _e263);
+                let _e267 = a1_;
+                let _e268 = e1_;
+                let _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e267, _e268);
+                weight1_ = (sun_scatter * _e269);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -689,142 +656,142 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let _e350 = bounds_index(x01_, _e118);
-            let lohi0_ = bounds[_e350];
-            let _e354 = bounds_index(x11_, row1_);
-            let lohi1_ = bounds[_e354];
+            let _e309 = bounds_index(x01_, _e77);
+            let lohi0_ = bounds[_e309];
+            let _e313 = bounds_index(x11_, row1_);
+            let lohi1_ = bounds[_e313];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e362 = d;
-            if (_e362 > lohi0_.x) {
-                let _e365 = d;
-                local_7 = (_e365 <= lohi0_.y);
+            let _e321 = d;
+            if (_e321 > lohi0_.x) {
+                let _e324 = d;
+                local_4 = (_e324 <= lohi0_.y);
             } else {
-                local_7 = false;
+                local_4 = false;
             }
-            let _e371 = local_7;
-            if !(_e371) {
-                let _e373 = d;
-                if (_e373 > lohi1_.x) {
-                    let _e376 = d;
-                    local_9 = (_e376 <= lohi1_.y);
+            let _e330 = local_4;
+            if !(_e330) {
+                let _e332 = d;
+                if (_e332 > lohi1_.x) {
+                    let _e335 = d;
+                    local_6 = (_e335 <= lohi1_.y);
                 } else {
-                    local_9 = false;
+                    local_6 = false;
                 }
-                let _e382 = local_9;
-                local_8 = _e382;
+                let _e341 = local_6;
+                local_5 = _e341;
             } else {
-                local_8 = true;
+                local_5 = true;
             }
-            let _e386 = local_8;
-            if _e386 {
+            let _e345 = local_5;
+            if _e345 {
                 layer_4 = 0u;
                 loop {
-                    let _e389 = layer_4;
-                    if (_e389 < LAYERS) {
+                    let _e348 = layer_4;
+                    if (_e348 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        let _e392 = layer_4;
-                        let coeff = coeffs[_e392];
-                        let _e395 = layer_4;
-                        let _e396 = filtered_load(x00_, _e118, _e395);
-                        let _e397 = layer_4;
-                        let _e398 = filtered_load(x01_, _e118, _e397);
-                        let texel0_ = mix(_e396, _e398, fx0_);
-                        let _e400 = layer_4;
-                        let _e401 = filtered_load(x10_, row1_, _e400);
-                        let _e402 = layer_4;
-                        let _e403 = filtered_load(x11_, row1_, _e402);
-                        let texel1_ = mix(_e401, _e403, fx1_);
+                        let _e351 = layer_4;
+                        let coeff = coeffs[_e351];
+                        let _e354 = layer_4;
+                        let _e355 = filtered_load(x00_, _e77, _e354);
+                        let _e356 = layer_4;
+                        let _e357 = filtered_load(x01_, _e77, _e356);
+                        let texel0_ = mix(_e355, _e357, fx0_);
+                        let _e359 = layer_4;
+                        let _e360 = filtered_load(x10_, row1_, _e359);
+                        let _e361 = layer_4;
+                        let _e362 = filtered_load(x11_, row1_, _e361);
+                        let texel1_ = mix(_e360, _e362, fx1_);
                         k_3 = 0u;
                         loop {
-                            let _e407 = k_3;
-                            if (_e407 < 4u) {
+                            let _e366 = k_3;
+                            if (_e366 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                let _e410 = vis0_;
-                                let _e411 = k_3;
-                                let _e413 = k_3;
-                                vis0_ = (_e410 + (coeff[_e411] * ((texel0_[_e413] * 2f) - 1f)));
-                                let _e421 = vis1_;
-                                let _e422 = k_3;
-                                let _e424 = k_3;
-                                vis1_ = (_e421 + (coeff[_e422] * ((texel1_[_e424] * 2f) - 1f)));
+                                let _e369 = vis0_;
+                                let _e370 = k_3;
+                                let _e372 = k_3;
+                                vis0_ = (_e369 + (coeff[_e370] * ((texel0_[_e372] * 2f) - 1f)));
+                                let _e380 = vis1_;
+                                let _e381 = k_3;
+                                let _e383 = k_3;
+                                vis1_ = (_e380 + (coeff[_e381] * ((texel1_[_e383] * 2f) - 1f)));
                             }
                             continuing {
-                                let _e433 = k_3;
-                                k_3 = (_e433 + 1u);
+                                let _e392 = k_3;
+                                k_3 = (_e392 + 1u);
                             }
                         }
                     }
                     continuing {
-                        let _e436 = layer_4;
-                        layer_4 = (_e436 + 1u);
+                        let _e395 = layer_4;
+                        layer_4 = (_e395 + 1u);
                     }
                 }
             }
-            let _e438 = vis0_;
-            let _e439 = d;
-            let _e444 = d;
-            vis0_ = select(select(_e438, 0f, (_e439 > lohi0_.y)), 1f, (_e444 <= lohi0_.x));
-            let _e449 = vis1_;
-            let _e450 = d;
-            let _e455 = d;
-            vis1_ = select(select(_e449, 0f, (_e450 > lohi1_.y)), 1f, (_e455 <= lohi1_.x));
-            let _e461 = done0_;
-            if !(_e461) {
-                let _e464 = total0_;
-                let _e465 = weight0_;
-                let _e466 = vis0_;
-                total0_ = (_e464 + (_e465 * clamp(_e466, 0f, 1f)));
+            let _e397 = vis0_;
+            let _e398 = d;
+            let _e403 = d;
+            vis0_ = select(select(_e397, 0f, (_e398 > lohi0_.y)), 1f, (_e403 <= lohi0_.x));
+            let _e408 = vis1_;
+            let _e409 = d;
+            let _e414 = d;
+            vis1_ = select(select(_e408, 0f, (_e409 > lohi1_.y)), 1f, (_e414 <= lohi1_.x));
+            let _e420 = done0_;
+            if !(_e420) {
+                let _e423 = total0_;
+                let _e424 = weight0_;
+                let _e425 = vis0_;
+                total0_ = (_e423 + (_e424 * clamp(_e425, 0f, 1f)));
             }
-            let _e473 = done1_;
-            if !(_e473) {
-                let _e476 = total1_;
-                let _e477 = weight1_;
-                let _e478 = vis1_;
-                total1_ = (_e476 + (_e477 * clamp(_e478, 0f, 1f)));
+            let _e432 = done1_;
+            if !(_e432) {
+                let _e435 = total1_;
+                let _e436 = weight1_;
+                let _e437 = vis1_;
+                total1_ = (_e435 + (_e436 * clamp(_e437, 0f, 1f)));
             }
-            let _e484 = done0_;
-            if !(_e484) {
-                local_10 = is_last0_;
+            let _e443 = done0_;
+            if !(_e443) {
+                local_7 = is_last0_;
             } else {
-                local_10 = true;
+                local_7 = true;
             }
-            let _e489 = local_10;
-            done0_ = _e489;
-            let _e490 = done1_;
-            if !(_e490) {
-                local_11 = is_last1_;
+            let _e448 = local_7;
+            done0_ = _e448;
+            let _e449 = done1_;
+            if !(_e449) {
+                local_8 = is_last1_;
             } else {
-                local_11 = true;
+                local_8 = true;
             }
-            let _e495 = local_11;
-            done1_ = _e495;
-            let _e496 = done0_;
-            if _e496 {
-                let _e497 = done1_;
-                local_12 = _e497;
+            let _e454 = local_8;
+            done1_ = _e454;
+            let _e455 = done0_;
+            if _e455 {
+                let _e456 = done1_;
+                local_9 = _e456;
             } else {
-                local_12 = false;
+                local_9 = false;
             }
-            let _e501 = local_12;
-            if _e501 {
+            let _e460 = local_9;
+            if _e460 {
                 break;
             }
         }
         continuing {
-            let _e503 = r_1;
-            r_1 = (_e503 + 1u);
+            let _e462 = r_1;
+            r_1 = (_e462 + 1u);
         }
     }
-    let _e507 = total0_;
-    let _e509 = total1_;
-    let l_2 = (((1f - w1_) * _e507) + (w1_ * _e509));
+    let _e466 = total0_;
+    let _e468 = total1_;
+    let l_2 = (((1f - w1_) * _e466) + (w1_ * _e468));
     let c = (color * l_2);
     return c;
 }

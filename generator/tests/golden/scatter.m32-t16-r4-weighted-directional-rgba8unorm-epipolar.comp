@@ -176,11 +176,8 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
     float x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_9 * x_9) * (3.0 - (2.0 * x_9)));
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_9 * x_9) * (3.0 - (2.0 * x_9))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
@@ -205,44 +202,44 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e73 = k;
-            k = (_e73 + 1u);
+            uint _e75 = k;
+            k = (_e75 + 1u);
         }
         loop_init = false;
         uint _e30 = k;
-        if ((_e30 < panels)) {
+        if (((_e30 + 1u) <= panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_2));
+            uint _e34 = k;
+            float mid = (g0_ + ((float(_e34) + 0.5) * w_2));
             q = 0u;
             bool loop_init_1 = true;
             while(true) {
                 if (!loop_init_1) {
-                    uint _e70 = q;
-                    q = (_e70 + 1u);
+                    uint _e72 = q;
+                    q = (_e72 + 1u);
                 }
                 loop_init_1 = false;
-                uint _e40 = q;
-                if ((_e40 < 4u)) {
+                uint _e42 = q;
+                if ((_e42 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
-                    float _e52 = sum;
-                    uint _e54 = q;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1.0 + (u * u))));
+                    uint _e48 = q;
+                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    float _e54 = sum;
+                    uint _e56 = q;
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u * u))));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return (((_e75 * 0.5) * w_2) * h);
+    float _e77 = sum;
+    return (((_e77 * 0.5) * w_2) * h);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
@@ -297,44 +294,44 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e63 = k_1;
-            k_1 = (_e63 + 1u);
+            uint _e65 = k_1;
+            k_1 = (_e65 + 1u);
         }
         loop_init_2 = false;
         uint _e15 = k_1;
-        if ((_e15 < steps)) {
+        if (((_e15 + 1u) <= steps)) {
         } else {
             break;
         }
         {
-            uint _e17 = k_1;
-            t_2 = (a_3 + ((float(_e17) + 0.5) * h_2));
+            uint _e19 = k_1;
+            t_2 = (a_3 + ((float(_e19) + 0.5) * h_2));
             w = h_2;
             if (spot_1) {
-                uint _e26 = k_1;
-                vec2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
-                t_2 = _e30.x;
-                w = _e30.y;
+                uint _e28 = k_1;
+                vec2 _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e28) + 0.5));
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            float _e35 = t_2;
+            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if (spot_1) {
-                float _e39 = sum_1;
-                float _e40 = w;
-                float _e42 = t_2;
-                float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
-                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
+                float _e41 = sum_1;
+                float _e42 = w;
+                float _e44 = t_2;
+                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e44);
+                sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
-                float _e46 = sum_1;
-                uint _e49 = k_1;
-                uint _e53 = k_1;
-                float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (float(_e49) * h_2)), (a_3 + (float((_e53 + 1u)) * h_2)));
-                sum_1 = (_e46 + (_e37 * _e59));
+                float _e48 = sum_1;
+                uint _e51 = k_1;
+                uint _e55 = k_1;
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (float(_e51) * h_2)), (a_3 + (float((_e55 + 1u)) * h_2)));
+                sum_1 = (_e48 + (_e39 * _e61));
             }
         }
     }
-    float _e65 = sum_1;
-    return _e65;
+    float _e67 = sum_1;
+    return _e67;
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_6, vec3 eye_5, vec3 dir_5, float s, bool spot_2) {
@@ -347,16 +344,19 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     }
 }
 
-uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, bool wrap) {
-    int ji = int(j);
-    if (wrap) {
-        return uint((((ji % int(rows)) + int(rows)) % int(rows)));
-    } else {
-        return uint(min(max(ji, 0), (int(rows) - 1)));
-    }
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec2 pc) {
+    float radius = f_6.epipole.w;
+    bool near_epi = ((f_6.epipole.z > 0.5) && (length((pc - f_6.epipole.xy)) < radius));
+    bool near_anti = ((f_6.anti_epipole.z > 0.5) && (length((pc - f_6.anti_epipole.xy)) < radius));
+    return (near_epi || near_anti);
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float x_2, float delta, float theta_1, float s_1, bool spot_3) {
+uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, bool wrap) {
+    int ji = int(j);
+    return (wrap ? uint((((ji % int(rows)) + int(rows)) % int(rows))) : uint(min(max(ji, 0), (int(rows) - 1))));
+}
+
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float x_2, float delta, float theta_1, float s_1, bool spot_3) {
     bool local_1 = false;
     if (spot_3) {
         float psi = (x_2 * delta);
@@ -370,49 +370,39 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_1;
         }
-        return min(((f_6.axis.w * sin(psi)) / den), s_1);
+        return min(((f_7.axis.w * sin(psi)) / den), s_1);
     } else {
         return min(((x_2 * delta) / max(sin(theta_1), 1e-6)), s_1);
     }
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 dir_6) {
-    float yc = 0.0;
-    uint rows_1 = f_7.sizes.w;
-    float phi_1 = atan(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
-    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
-    if ((f_7.anti_epipole.w > 0.5)) {
-        float _e22 = yc;
-        float _e23 = yc;
-        yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
-    } else {
-        float _e30 = yc;
-        yc = clamp(_e30, 0.0, float(rows_1));
-    }
-    float _e34 = yc;
-    return _e34;
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_6) {
+    uint rows_1 = f_8.sizes.w;
+    float phi_1 = atan(dot(dir_6, f_8.e2_.xyz), dot(dir_6, f_8.e1_.xyz));
+    float yc_1 = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
+    return ((f_8.anti_epipole.w > 0.5) ? (yc_1 - (floor((yc_1 / float(rows_1))) * float(rows_1))) : clamp(yc_1, 0.0, float(rows_1)));
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_6, vec3 dir_7, float s_2, float theta_2, bool spot_4) {
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_7, float s_2, float theta_2, bool spot_4) {
     if (spot_4) {
-        vec3 q_2 = ((eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz);
-        vec3 to_eye = -(f_8.axis.xyz);
+        vec3 q_2 = ((eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz);
+        vec3 to_eye = -(f_9.axis.xyz);
         return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_7, vec3 dir_8, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 eye_7, vec3 dir_8, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
     return _e15;
 }
 
-vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float phi) {
-    return ((f_10.e1_.xyz * cos(phi)) + (f_10.e2_.xyz * sin(phi)));
+vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float phi) {
+    return ((f_11.e1_.xyz * cos(phi)) + (f_11.e2_.xyz * sin(phi)));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint row) {
-    return (f_11.e1_.w + ((float(row) + 0.5) * f_11.e2_.w));
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, uint row) {
+    return (f_12.e1_.w + ((float(row) + 0.5) * f_12.e2_.w));
 }
 
 vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_5, vec2 b_5) {
@@ -467,10 +457,7 @@ vec4 filtered_load(uint x_5, uint row_3, uint layer_2) {
 }
 
 vec3 scatter_pixel(uint x_6, uint y_1) {
-    bool local_2 = false;
-    bool local_3 = false;
-    bool local_4 = false;
-    float yc_1 = 0.0;
+    float yc = 0.0;
     float d = 0.0;
     float xs = 0.0;
     float reach = 0.0;
@@ -487,8 +474,8 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     bool done0_ = false;
     bool done1_ = false;
     uint r_1 = 0u;
-    bool local_5 = false;
-    bool local_6 = false;
+    bool local_2 = false;
+    bool local_3 = false;
     float a0_ = 0.0;
     float e0_ = 0.0;
     float a1_ = 0.0;
@@ -497,201 +484,182 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     float weight1_ = 0.0;
     float vis0_ = 0.0;
     float vis1_ = 0.0;
+    bool local_4 = false;
+    bool local_5 = false;
+    bool local_6 = false;
+    uint layer_4 = 0u;
+    uint k_3 = 0u;
     bool local_7 = false;
     bool local_8 = false;
     bool local_9 = false;
-    uint layer_4 = 0u;
-    uint k_3 = 0u;
-    bool local_10 = false;
-    bool local_11 = false;
-    bool local_12 = false;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = _group_0_binding_0_cs;
-    vec3 eye_8 = f_12.eye.xyz;
-    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = _group_0_binding_0_cs;
+    vec3 eye_8 = f_13.eye.xyz;
+    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
     int _e14_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
-    float s_3 = (min(max(_e14.x, 0.0), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 1e-6));
-    vec3 color = f_12.light_color.xyz;
-    vec3 px = vec3((float(x_6) + 0.5), (float(y_1) + 0.5), 0.0);
-    float radius = f_12.epipole.w;
-    if ((f_12.epipole.z > 0.5)) {
-        local_2 = (length((px - vec3(f_12.epipole.x, f_12.epipole.y, 0.0))) < radius);
-    } else {
-        local_2 = false;
-    }
-    bool near_epi = local_2;
-    if ((f_12.anti_epipole.z > 0.5)) {
-        local_3 = (length((px - vec3(f_12.anti_epipole.x, f_12.anti_epipole.y, 0.0))) < radius);
-    } else {
-        local_3 = false;
-    }
-    bool near_anti = local_3;
-    if (!(near_epi)) {
-        local_4 = near_anti;
-    } else {
-        local_4 = true;
-    }
-    bool _e77 = local_4;
-    if (_e77) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = _group_0_binding_0_cs;
-        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, _group_0_binding_3_cs, eye_8, _e10, s_3, false);
-        vec3 l_1 = (_e82 * color);
+    float s_3 = (min(max(_e14.x, 0.0), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 1e-6));
+    vec3 color = f_13.light_color.xyz;
+    bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, vec2((float(x_6) + 0.5), (float(y_1) + 0.5)));
+    if (_e36) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e38 = _group_0_binding_0_cs;
+        float _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, _group_0_binding_3_cs, eye_8, _e10, s_3, false);
+        vec3 l_1 = (_e41 * color);
         return l_1;
     }
-    vec3 axis = f_12.axis.xyz;
-    uint rows_2 = f_12.sizes.w;
-    uint width_1 = f_12.sizes.z;
-    bool wrap_1 = (f_12.anti_epipole.w > 0.5);
+    vec3 axis = f_13.axis.xyz;
+    uint rows_2 = f_13.sizes.w;
+    uint width_1 = f_13.sizes.z;
+    bool wrap_1 = (f_13.anti_epipole.w > 0.5);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
-        float _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
-        yc_1 = _e100;
-        float _e102 = theta_3;
-        float _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_12.theta.x, f_12.theta.y);
-        d = _e107;
-        float _e109 = theta_3;
-        float _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e109, false);
-        reach = _e110;
+        float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        yc = _e59;
+        float _e61 = theta_3;
+        float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
+        d = _e66;
+        float _e68 = theta_3;
+        float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_3, _e68, false);
+        reach = _e69;
     }
-    float _e112 = yc_1;
-    float yb = (_e112 - 0.5);
+    float _e71 = yc;
+    float yb = (_e71 - 0.5);
     float fy = (yb - floor(yb));
-    uint _e118 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
-    uint _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e122 : _e118);
-    float w1_ = ((row1_ != _e118) ? fy : 0.0);
-    float cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
-    uint panels_2 = max((f_12.sizes2_.z / 4u), 1u);
-    float _e140 = d;
-    float _e144 = d;
-    angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e140)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e144)));
-    vec2 _e149 = angle;
-    vec2 _e150 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149);
+    uint _e77 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    uint _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e81 : _e77);
+    float w1_ = ((row1_ != _e77) ? fy : 0.0);
+    float cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
+    uint panels_2 = max((f_13.sizes2_.z / 4u), 1u);
+    float _e99 = d;
+    float _e103 = d;
+    angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e99)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e103)));
+    vec2 _e108 = angle;
+    vec2 _e109 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e108);
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e165 = layer_3;
-            layer_3 = (_e165 + 1u);
+            uint _e124 = layer_3;
+            layer_3 = (_e124 + 1u);
         }
         loop_init_3 = false;
-        uint _e152 = layer_3;
-        if ((_e152 < LAYERS)) {
+        uint _e111 = layer_3;
+        if ((_e111 < LAYERS)) {
         } else {
             break;
         }
         {
-            vec2 _e155 = angle;
-            vec2 _e156 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, _e150);
-            uint _e158 = layer_3;
-            vec2 _e160 = angle;
-            uint _e161 = layer_3;
-            vec4 _e162 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e160, _e156, _e161);
-            coeffs[_e158] = _e162;
-            vec2 _e163 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e156, _e150);
-            angle = _e163;
+            vec2 _e114 = angle;
+            vec2 _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e114, _e109);
+            uint _e117 = layer_3;
+            vec2 _e119 = angle;
+            uint _e120 = layer_3;
+            vec4 _e121 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e119, _e115, _e120);
+            coeffs[_e117] = _e121;
+            vec2 _e122 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e115, _e109);
+            angle = _e122;
         }
     }
-    float _e171 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
-    float sun_scatter = (f_12.medium.y * _e171);
-    float _e174 = xs;
-    xs0_ = _e174;
-    float _e176 = xs;
-    xs1_ = _e176;
+    float _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
+    float sun_scatter = (f_13.medium.y * _e130);
+    float _e133 = xs;
+    xs0_ = _e133;
+    float _e135 = xs;
+    xs1_ = _e135;
     {
-        vec4 _e180 = _group_0_binding_1_cs[_e118];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e181 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e180);
-        delta0_ = _e181.delta;
-        vec4 _e186 = _group_0_binding_1_cs[row1_];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e187 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e186);
-        delta1_ = _e187.delta;
-        float _e190 = reach;
-        float _e191 = delta0_;
-        xs0_ = (_e190 / _e191);
-        float _e193 = reach;
-        float _e194 = delta1_;
-        xs1_ = (_e193 / _e194);
+        vec4 _e139 = _group_0_binding_1_cs[_e77];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e140 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e139);
+        delta0_ = _e140.delta;
+        vec4 _e145 = _group_0_binding_1_cs[row1_];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e146 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e145);
+        delta1_ = _e146.delta;
+        float _e149 = reach;
+        float _e150 = delta0_;
+        xs0_ = (_e149 / _e150);
+        float _e152 = reach;
+        float _e153 = delta1_;
+        xs1_ = (_e152 / _e153);
     }
-    float _e196 = xs0_;
-    uint last0_ = uint(min(max(_e196, 0.0), (float(width_1) - 1.0)));
-    float _e204 = xs1_;
-    uint last1_ = uint(min(max(_e204, 0.0), (float(width_1) - 1.0)));
+    float _e155 = xs0_;
+    uint last0_ = uint(min(max(_e155, 0.0), (float(width_1) - 1.0)));
+    float _e163 = xs1_;
+    uint last1_ = uint(min(max(_e163, 0.0), (float(width_1) - 1.0)));
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e503 = r_1;
-            r_1 = (_e503 + 1u);
+            uint _e462 = r_1;
+            r_1 = (_e462 + 1u);
         }
         loop_init_4 = false;
-        uint _e214 = r_1;
-        if ((_e214 < REGIONS)) {
+        uint _e173 = r_1;
+        if ((_e173 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e216 = r_1;
-            uint _e217 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e216, REGIONS, width_1, false);
-            float b0_ = float(_e217);
-            uint _e219 = r_1;
-            uint _e222 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e219 + 1u), REGIONS, width_1, false);
-            float b1_ = float(_e222);
+            uint _e175 = r_1;
+            uint _e176 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e175, REGIONS, width_1, false);
+            float b0_ = float(_e176);
+            uint _e178 = r_1;
+            uint _e181 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e178 + 1u), REGIONS, width_1, false);
+            float b1_ = float(_e181);
             if (!((last0_ < uint(b1_)))) {
-                uint _e227 = r_1;
-                local_5 = ((_e227 + 1u) == REGIONS);
+                uint _e186 = r_1;
+                local_2 = ((_e186 + 1u) == REGIONS);
             } else {
-                local_5 = true;
+                local_2 = true;
             }
-            bool is_last0_ = local_5;
+            bool is_last0_ = local_2;
             if (!((last1_ < uint(b1_)))) {
-                uint _e238 = r_1;
-                local_6 = ((_e238 + 1u) == REGIONS);
+                uint _e197 = r_1;
+                local_3 = ((_e197 + 1u) == REGIONS);
             } else {
-                local_6 = true;
+                local_3 = true;
             }
-            bool is_last1_ = local_6;
-            float _e248 = xs0_;
-            float pos0_ = (is_last0_ ? clamp((_e248 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            float _e259 = xs1_;
-            float pos1_ = (is_last1_ ? clamp((_e259 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            bool is_last1_ = local_3;
+            float _e207 = xs0_;
+            float pos0_ = (is_last0_ ? clamp((_e207 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            float _e218 = xs1_;
+            float pos1_ = (is_last1_ ? clamp((_e218 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
             a0_ = 0.0;
             e0_ = 0.0;
             a1_ = 0.0;
             e1_ = 0.0;
-            float _e276 = delta0_;
-            float _e277 = theta_3;
-            float _e278 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e276, _e277, s_3, false);
-            a0_ = _e278;
-            float _e279 = delta0_;
-            float _e280 = theta_3;
-            float _e281 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e279, _e280, s_3, false);
-            e0_ = (is_last0_ ? s_3 : _e281);
-            float _e283 = delta1_;
-            float _e284 = theta_3;
-            float _e285 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e283, _e284, s_3, false);
-            a1_ = _e285;
-            float _e286 = delta1_;
-            float _e287 = theta_3;
-            float _e288 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e286, _e287, s_3, false);
-            e1_ = (is_last1_ ? s_3 : _e288);
+            float _e235 = delta0_;
+            float _e236 = theta_3;
+            float _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e235, _e236, s_3, false);
+            a0_ = _e237;
+            float _e238 = delta0_;
+            float _e239 = theta_3;
+            float _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e238, _e239, s_3, false);
+            e0_ = (is_last0_ ? s_3 : _e240);
+            float _e242 = delta1_;
+            float _e243 = theta_3;
+            float _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e242, _e243, s_3, false);
+            a1_ = _e244;
+            float _e245 = delta1_;
+            float _e246 = theta_3;
+            float _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e245, _e246, s_3, false);
+            e1_ = (is_last1_ ? s_3 : _e247);
             weight0_ = 0.0;
             weight1_ = 0.0;
             if (false) {
-                float _e294 = a0_;
-                float _e295 = e0_;
-                float _e296 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e294, _e295, panels_2);
-                weight0_ = _e296;
-                float _e297 = a1_;
-                float _e298 = e1_;
-                float _e299 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e297, _e298, panels_2);
-                weight1_ = _e299;
+                float _e253 = a0_;
+                float _e254 = e0_;
+                float _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e253, _e254, panels_2);
+                weight0_ = _e255;
+                float _e256 = a1_;
+                float _e257 = e1_;
+                float _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e256, _e257, panels_2);
+                weight1_ = _e258;
             } else {
-                float _e302 = a0_;
-                float _e303 = e0_;
-                float _e304 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e302, _e303);
-                weight0_ = (sun_scatter * _e304);
-                float _e308 = a1_;
-                float _e309 = e1_;
-                float _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e308, _e309);
-                weight1_ = (sun_scatter * _e310);
+                float _e261 = a0_;
+                float _e262 = e0_;
+                float _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e261, _e262);
+                weight0_ = (sun_scatter * _e263);
+                float _e267 = a1_;
+                float _e268 = e1_;
+                float _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e267, _e268);
+                weight1_ = (sun_scatter * _e269);
             }
             float xb0_ = (pos0_ - 0.5);
             float fx0_ = (xb0_ - floor(xb0_));
@@ -701,142 +669,142 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
             float fx1_ = (xb1_ - floor(xb1_));
             uint x10_ = uint(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
-            uint _e350 = bounds_index(x01_, _e118);
-            vec2 lohi0_ = _group_0_binding_6_cs[_e350];
-            uint _e354 = bounds_index(x11_, row1_);
-            vec2 lohi1_ = _group_0_binding_6_cs[_e354];
+            uint _e309 = bounds_index(x01_, _e77);
+            vec2 lohi0_ = _group_0_binding_6_cs[_e309];
+            uint _e313 = bounds_index(x11_, row1_);
+            vec2 lohi1_ = _group_0_binding_6_cs[_e313];
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e362 = d;
-            if ((_e362 > lohi0_.x)) {
-                float _e365 = d;
-                local_7 = (_e365 <= lohi0_.y);
+            float _e321 = d;
+            if ((_e321 > lohi0_.x)) {
+                float _e324 = d;
+                local_4 = (_e324 <= lohi0_.y);
             } else {
-                local_7 = false;
+                local_4 = false;
             }
-            bool _e371 = local_7;
-            if (!(_e371)) {
-                float _e373 = d;
-                if ((_e373 > lohi1_.x)) {
-                    float _e376 = d;
-                    local_9 = (_e376 <= lohi1_.y);
+            bool _e330 = local_4;
+            if (!(_e330)) {
+                float _e332 = d;
+                if ((_e332 > lohi1_.x)) {
+                    float _e335 = d;
+                    local_6 = (_e335 <= lohi1_.y);
                 } else {
-                    local_9 = false;
+                    local_6 = false;
                 }
-                bool _e382 = local_9;
-                local_8 = _e382;
+                bool _e341 = local_6;
+                local_5 = _e341;
             } else {
-                local_8 = true;
+                local_5 = true;
             }
-            bool _e386 = local_8;
-            if (_e386) {
+            bool _e345 = local_5;
+            if (_e345) {
                 layer_4 = 0u;
                 bool loop_init_5 = true;
                 while(true) {
                     if (!loop_init_5) {
-                        uint _e436 = layer_4;
-                        layer_4 = (_e436 + 1u);
+                        uint _e395 = layer_4;
+                        layer_4 = (_e395 + 1u);
                     }
                     loop_init_5 = false;
-                    uint _e389 = layer_4;
-                    if ((_e389 < LAYERS)) {
+                    uint _e348 = layer_4;
+                    if ((_e348 < LAYERS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e392 = layer_4;
-                        vec4 coeff = coeffs[_e392];
-                        uint _e395 = layer_4;
-                        vec4 _e396 = filtered_load(x00_, _e118, _e395);
-                        uint _e397 = layer_4;
-                        vec4 _e398 = filtered_load(x01_, _e118, _e397);
-                        vec4 texel0_ = mix(_e396, _e398, fx0_);
-                        uint _e400 = layer_4;
-                        vec4 _e401 = filtered_load(x10_, row1_, _e400);
-                        uint _e402 = layer_4;
-                        vec4 _e403 = filtered_load(x11_, row1_, _e402);
-                        vec4 texel1_ = mix(_e401, _e403, fx1_);
+                        uint _e351 = layer_4;
+                        vec4 coeff = coeffs[_e351];
+                        uint _e354 = layer_4;
+                        vec4 _e355 = filtered_load(x00_, _e77, _e354);
+                        uint _e356 = layer_4;
+                        vec4 _e357 = filtered_load(x01_, _e77, _e356);
+                        vec4 texel0_ = mix(_e355, _e357, fx0_);
+                        uint _e359 = layer_4;
+                        vec4 _e360 = filtered_load(x10_, row1_, _e359);
+                        uint _e361 = layer_4;
+                        vec4 _e362 = filtered_load(x11_, row1_, _e361);
+                        vec4 texel1_ = mix(_e360, _e362, fx1_);
                         k_3 = 0u;
                         bool loop_init_6 = true;
                         while(true) {
                             if (!loop_init_6) {
-                                uint _e433 = k_3;
-                                k_3 = (_e433 + 1u);
+                                uint _e392 = k_3;
+                                k_3 = (_e392 + 1u);
                             }
                             loop_init_6 = false;
-                            uint _e407 = k_3;
-                            if ((_e407 < 4u)) {
+                            uint _e366 = k_3;
+                            if ((_e366 < 4u)) {
                             } else {
                                 break;
                             }
                             {
-                                float _e410 = vis0_;
-                                uint _e411 = k_3;
-                                uint _e413 = k_3;
-                                vis0_ = (_e410 + (coeff[_e411] * ((texel0_[_e413] * 2.0) - 1.0)));
-                                float _e421 = vis1_;
-                                uint _e422 = k_3;
-                                uint _e424 = k_3;
-                                vis1_ = (_e421 + (coeff[_e422] * ((texel1_[_e424] * 2.0) - 1.0)));
+                                float _e369 = vis0_;
+                                uint _e370 = k_3;
+                                uint _e372 = k_3;
+                                vis0_ = (_e369 + (coeff[_e370] * ((texel0_[_e372] * 2.0) - 1.0)));
+                                float _e380 = vis1_;
+                                uint _e381 = k_3;
+                                uint _e383 = k_3;
+                                vis1_ = (_e380 + (coeff[_e381] * ((texel1_[_e383] * 2.0) - 1.0)));
                             }
                         }
                     }
                 }
             }
-            float _e438 = vis0_;
-            float _e439 = d;
-            float _e444 = d;
-            vis0_ = ((_e444 <= lohi0_.x) ? 1.0 : ((_e439 > lohi0_.y) ? 0.0 : _e438));
-            float _e449 = vis1_;
-            float _e450 = d;
-            float _e455 = d;
-            vis1_ = ((_e455 <= lohi1_.x) ? 1.0 : ((_e450 > lohi1_.y) ? 0.0 : _e449));
-            bool _e461 = done0_;
-            if (!(_e461)) {
-                float _e464 = total0_;
-                float _e465 = weight0_;
-                float _e466 = vis0_;
-                total0_ = (_e464 + (_e465 * clamp(_e466, 0.0, 1.0)));
+            float _e397 = vis0_;
+            float _e398 = d;
+            float _e403 = d;
+            vis0_ = ((_e403 <= lohi0_.x) ? 1.0 : ((_e398 > lohi0_.y) ? 0.0 : _e397));
+            float _e408 = vis1_;
+            float _e409 = d;
+            float _e414 = d;
+            vis1_ = ((_e414 <= lohi1_.x) ? 1.0 : ((_e409 > lohi1_.y) ? 0.0 : _e408));
+            bool _e420 = done0_;
+            if (!(_e420)) {
+                float _e423 = total0_;
+                float _e424 = weight0_;
+                float _e425 = vis0_;
+                total0_ = (_e423 + (_e424 * clamp(_e425, 0.0, 1.0)));
             }
-            bool _e473 = done1_;
-            if (!(_e473)) {
-                float _e476 = total1_;
-                float _e477 = weight1_;
-                float _e478 = vis1_;
-                total1_ = (_e476 + (_e477 * clamp(_e478, 0.0, 1.0)));
+            bool _e432 = done1_;
+            if (!(_e432)) {
+                float _e435 = total1_;
+                float _e436 = weight1_;
+                float _e437 = vis1_;
+                total1_ = (_e435 + (_e436 * clamp(_e437, 0.0, 1.0)));
             }
-            bool _e484 = done0_;
-            if (!(_e484)) {
-                local_10 = is_last0_;
+            bool _e443 = done0_;
+            if (!(_e443)) {
+                local_7 = is_last0_;
             } else {
-                local_10 = true;
+                local_7 = true;
             }
-            bool _e489 = local_10;
-            done0_ = _e489;
-            bool _e490 = done1_;
-            if (!(_e490)) {
-                local_11 = is_last1_;
+            bool _e448 = local_7;
+            done0_ = _e448;
+            bool _e449 = done1_;
+            if (!(_e449)) {
+                local_8 = is_last1_;
             } else {
-                local_11 = true;
+                local_8 = true;
             }
-            bool _e495 = local_11;
-            done1_ = _e495;
-            bool _e496 = done0_;
-            if (_e496) {
-                bool _e497 = done1_;
-                local_12 = _e497;
+            bool _e454 = local_8;
+            done1_ = _e454;
+            bool _e455 = done0_;
+            if (_e455) {
+                bool _e456 = done1_;
+                local_9 = _e456;
             } else {
-                local_12 = false;
+                local_9 = false;
             }
-            bool _e501 = local_12;
-            if (_e501) {
+            bool _e460 = local_9;
+            if (_e460) {
                 break;
             }
         }
     }
-    float _e507 = total0_;
-    float _e509 = total1_;
-    float l_2 = (((1.0 - w1_) * _e507) + (w1_ * _e509));
+    float _e466 = total0_;
+    float _e468 = total1_;
+    float l_2 = (((1.0 - w1_) * _e466) + (w1_ * _e468));
     vec3 c = (color * l_2);
     return c;
 }

@@ -226,11 +226,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_inner,
     float cos_outer
 ) {
-    if ((cos_inner - cos_outer) <= 0.000001) {
-        return (cos_angle >= cos_outer) ? 1.0 : 0.0;
-    }
     float x_12 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return (x_12 * x_12) * (3.0 - (2.0 * x_12));
+    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_12 * x_12) * (3.0 - (2.0 * x_12)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -278,18 +275,18 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e73 = k;
-            k = _e73 + 1u;
+            uint _e75 = k;
+            k = _e75 + 1u;
         }
         loop_init = false;
         uint _e30 = k;
-        if (_e30 < panels) {
+        if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
-            float mid = g0_ + ((static_cast<float>(_e32) + 0.5) * w_2);
+            uint _e34 = k;
+            float mid = g0_ + ((static_cast<float>(_e34) + 0.5) * w_2);
             q = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
             bool loop_init_1 = true;
@@ -297,28 +294,28 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 if (metal::all(loop_bound_1 == uint2(0u))) { break; }
                 loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
                 if (!loop_init_1) {
-                    uint _e70 = q;
-                    q = _e70 + 1u;
+                    uint _e72 = q;
+                    q = _e72 + 1u;
                 }
                 loop_init_1 = false;
-                uint _e40 = q;
-                if (_e40 < 4u) {
+                uint _e42 = q;
+                if (_e42 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q;
-                    float u_1 = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e46), 3u)]));
-                    float _e52 = sum;
-                    uint _e54 = q;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e54), 3u)] * _e62) * (1.0 + (u_1 * u_1)));
+                    uint _e48 = q;
+                    float u_1 = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
+                    float _e54 = sum;
+                    uint _e56 = q;
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u_1 * u_1)));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return ((_e75 * 0.5) * w_2) * h;
+    float _e77 = sum;
+    return ((_e77 * 0.5) * w_2) * h;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -417,44 +414,44 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e63 = k_1;
-            k_1 = _e63 + 1u;
+            uint _e65 = k_1;
+            k_1 = _e65 + 1u;
         }
         loop_init_2 = false;
         uint _e15 = k_1;
-        if (_e15 < steps) {
+        if ((_e15 + 1u) <= steps) {
         } else {
             break;
         }
         {
-            uint _e17 = k_1;
-            t_2 = a_3 + ((static_cast<float>(_e17) + 0.5) * h_2);
+            uint _e19 = k_1;
+            t_2 = a_3 + ((static_cast<float>(_e19) + 0.5) * h_2);
             w = h_2;
             if (spot_1) {
-                uint _e26 = k_1;
-                metal::float2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e26) + 0.5);
-                t_2 = _e30.x;
-                w = _e30.y;
+                uint _e28 = k_1;
+                metal::float2 _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, static_cast<float>(_e28) + 0.5);
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, eye_4 + (dir_4 * _e33), spot_1);
+            float _e35 = t_2;
+            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, eye_4 + (dir_4 * _e35), spot_1);
             if (spot_1) {
-                float _e39 = sum_1;
-                float _e40 = w;
-                float _e42 = t_2;
-                float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
-                sum_1 = _e39 + ((_e37 * _e40) * _e43);
+                float _e41 = sum_1;
+                float _e42 = w;
+                float _e44 = t_2;
+                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e44);
+                sum_1 = _e41 + ((_e39 * _e42) * _e45);
             } else {
-                float _e46 = sum_1;
-                uint _e49 = k_1;
-                uint _e53 = k_1;
-                float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, a_3 + (static_cast<float>(_e49) * h_2), a_3 + (static_cast<float>(_e53 + 1u) * h_2));
-                sum_1 = _e46 + (_e37 * _e59);
+                float _e48 = sum_1;
+                uint _e51 = k_1;
+                uint _e55 = k_1;
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, a_3 + (static_cast<float>(_e51) * h_2), a_3 + (static_cast<float>(_e55 + 1u) * h_2));
+                sum_1 = _e48 + (_e39 * _e61);
             }
         }
     }
-    float _e65 = sum_1;
-    return _e65;
+    float _e67 = sum_1;
+    return _e67;
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -474,6 +471,16 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     }
 }
 
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    metal::float2 pc
+) {
+    float radius = f_6.epipole.w;
+    bool near_epi = (f_6.epipole.z > 0.5) & (metal::length(pc - f_6.epipole.xy) < radius);
+    bool near_anti = (f_6.anti_epipole.z > 0.5) & (metal::length(pc - f_6.anti_epipole.xy) < radius);
+    return near_epi | near_anti;
+}
+
 int naga_f2i32(float value) {
     return static_cast<int>(metal::clamp(value, -2147483600.0, 2147483500.0));
 }
@@ -489,15 +496,11 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool wrap
 ) {
     int ji = naga_f2i32(j);
-    if (wrap) {
-        return static_cast<uint>(naga_mod(as_type<int>(as_type<uint>(naga_mod(ji, static_cast<int>(rows))) + as_type<uint>(static_cast<int>(rows))), static_cast<int>(rows)));
-    } else {
-        return static_cast<uint>(metal::clamp(ji, 0, as_type<int>(as_type<uint>(static_cast<int>(rows)) - as_type<uint>(1))));
-    }
+    return wrap ? static_cast<uint>(naga_mod(as_type<int>(as_type<uint>(naga_mod(ji, static_cast<int>(rows))) + as_type<uint>(static_cast<int>(rows))), static_cast<int>(rows))) : static_cast<uint>(metal::clamp(ji, 0, as_type<int>(as_type<uint>(static_cast<int>(rows)) - as_type<uint>(1))));
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
     float x_2,
     float delta,
     float theta_1,
@@ -517,34 +520,24 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (_e16) {
             return s_1;
         }
-        return metal::min((f_6.axis.w * metal::sin(psi)) / den, s_1);
+        return metal::min((f_7.axis.w * metal::sin(psi)) / den, s_1);
     } else {
         return metal::min((x_2 * delta) / metal::max(metal::sin(theta_1), 0.000001), s_1);
     }
 }
 
 float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
     metal::float3 dir_6
 ) {
-    float yc = {};
-    uint rows_1 = f_7.sizes.w;
-    float phi_1 = metal::atan2(metal::dot(dir_6, f_7.e2_.xyz), metal::dot(dir_6, f_7.e1_.xyz));
-    yc = (phi_1 - f_7.e1_.w) / f_7.e2_.w;
-    if (f_7.anti_epipole.w > 0.5) {
-        float _e22 = yc;
-        float _e23 = yc;
-        yc = _e22 - (metal::floor(_e23 / static_cast<float>(rows_1)) * static_cast<float>(rows_1));
-    } else {
-        float _e30 = yc;
-        yc = metal::clamp(_e30, 0.0, static_cast<float>(rows_1));
-    }
-    float _e34 = yc;
-    return _e34;
+    uint rows_1 = f_8.sizes.w;
+    float phi_1 = metal::atan2(metal::dot(dir_6, f_8.e2_.xyz), metal::dot(dir_6, f_8.e1_.xyz));
+    float yc_1 = (phi_1 - f_8.e1_.w) / f_8.e2_.w;
+    return (f_8.anti_epipole.w > 0.5) ? (yc_1 - (metal::floor(yc_1 / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc_1, 0.0, static_cast<float>(rows_1));
 }
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     metal::float3 eye_6,
     metal::float3 dir_7,
     float s_2,
@@ -552,22 +545,22 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_4
 ) {
     if (spot_4) {
-        metal::float3 q_3 = (eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz;
-        metal::float3 to_eye = -(f_8.axis.xyz);
+        metal::float3 q_3 = (eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz;
+        metal::float3 to_eye = -(f_9.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_3, to_eye)), metal::dot(q_3, to_eye));
     }
     return s_2 * metal::sin(theta_2);
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     metal::float3 eye_7,
     metal::float3 dir_8,
     float a_4,
     float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
     return _e15;
 }
 
@@ -640,13 +633,13 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
             float _e86 = z_1;
             float _e87 = z_1;
             float _e88 = z_1;
-            float f_12 = c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_)))));
+            float f_13 = c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_)))));
             float _e95 = z_1;
             float _e98 = z_1;
             float df = c2_ + (_e95 * ((2.0 * c3_) + ((3.0 * _e98) * c4_)));
             if (df != 0.0) {
                 float _e107 = z_1;
-                z_1 = _e107 - (f_12 / df);
+                z_1 = _e107 - (f_13 / df);
             }
         }
     }
@@ -748,17 +741,17 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
 }
 
 metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     float phi
 ) {
-    return (f_10.e1_.xyz * metal::cos(phi)) + (f_10.e2_.xyz * metal::sin(phi));
+    return (f_11.e1_.xyz * metal::cos(phi)) + (f_11.e2_.xyz * metal::sin(phi));
 }
 
 float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
     uint row
 ) {
-    return f_11.e1_.w + ((static_cast<float>(row) + 0.5) * f_11.e2_.w);
+    return f_12.e1_.w + ((static_cast<float>(row) + 0.5) * f_12.e2_.w);
 }
 
 uint naga_div(uint lhs, uint rhs) {
@@ -834,10 +827,7 @@ metal::float3 scatter_pixel(
     device type_11 const& bounds,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    bool local_3 = {};
-    bool local_4 = {};
-    bool local_5 = {};
-    float yc_1 = {};
+    float yc = {};
     float d_1 = {};
     float xs = 0.0;
     float reach = 0.0;
@@ -851,8 +841,8 @@ metal::float3 scatter_pixel(
     bool done0_ = false;
     bool done1_ = false;
     uint r_1 = 0u;
-    bool local_6 = {};
-    bool local_7 = {};
+    bool local_3 = {};
+    bool local_4 = {};
     float a0_ = {};
     float e0_ = {};
     float a1_ = {};
@@ -861,174 +851,155 @@ metal::float3 scatter_pixel(
     float weight1_ = {};
     float vis0_ = {};
     float vis1_ = {};
+    bool local_5 = {};
+    bool local_6 = {};
+    bool local_7 = {};
     bool local_8 = {};
     bool local_9 = {};
-    bool local_10 = {};
-    bool local_11 = {};
-    bool local_12 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
-    metal::float3 eye_8 = f_13.eye.xyz;
-    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_9, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = frame;
+    metal::float3 eye_8 = f_14.eye.xyz;
+    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_9, y_1);
     uint clamped_lod_e14 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_9, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
-    float s_5 = metal::min(metal::max(_e14.x, 0.0), f_13.theta.z) / metal::max(metal::dot(_e10, f_13.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_13.light_color.xyz;
-    metal::float3 px = metal::float3(static_cast<float>(x_9) + 0.5, static_cast<float>(y_1) + 0.5, 0.0);
-    float radius = f_13.epipole.w;
-    if (f_13.epipole.z > 0.5) {
-        local_3 = metal::length(px - metal::float3(f_13.epipole.x, f_13.epipole.y, 0.0)) < radius;
-    } else {
-        local_3 = false;
-    }
-    bool near_epi = local_3;
-    if (f_13.anti_epipole.z > 0.5) {
-        local_4 = metal::length(px - metal::float3(f_13.anti_epipole.x, f_13.anti_epipole.y, 0.0)) < radius;
-    } else {
-        local_4 = false;
-    }
-    bool near_anti = local_4;
-    if (!(near_epi)) {
-        local_5 = near_anti;
-    } else {
-        local_5 = true;
-    }
-    bool _e77 = local_5;
-    if (_e77) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e79 = frame;
-        float _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_8, _e10, s_5, false);
-        metal::float3 l_1 = _e82 * color;
+    float s_5 = metal::min(metal::max(_e14.x, 0.0), f_14.theta.z) / metal::max(metal::dot(_e10, f_14.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_14.light_color.xyz;
+    bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, metal::float2(static_cast<float>(x_9) + 0.5, static_cast<float>(y_1) + 0.5));
+    if (_e36) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e38 = frame;
+        float _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, shadow_map, eye_8, _e10, s_5, false);
+        metal::float3 l_1 = _e41 * color;
         return l_1;
     }
-    metal::float3 axis = f_13.axis.xyz;
-    uint rows_2 = f_13.sizes.w;
-    uint width_1 = f_13.sizes.z;
-    bool wrap_1 = f_13.anti_epipole.w > 0.5;
+    metal::float3 axis = f_14.axis.xyz;
+    uint rows_2 = f_14.sizes.w;
+    uint width_1 = f_14.sizes.z;
+    bool wrap_1 = f_14.anti_epipole.w > 0.5;
     {
         theta_3 = metal::acos(metal::clamp(metal::dot(_e10, axis), -1.0, 1.0));
-        float _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
-        yc_1 = _e100;
-        float _e102 = theta_3;
-        float _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_13.theta.x, f_13.theta.y);
-        d_1 = _e107;
-        float _e109 = theta_3;
-        float _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e109, false);
-        reach = _e110;
+        float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e10);
+        yc = _e59;
+        float _e61 = theta_3;
+        float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_14.theta.x, f_14.theta.y);
+        d_1 = _e66;
+        float _e68 = theta_3;
+        float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, s_5, _e68, false);
+        reach = _e69;
     }
-    float _e112 = yc_1;
-    float yb = _e112 - 0.5;
+    float _e71 = yc;
+    float yb = _e71 - 0.5;
     float fy = yb - metal::floor(yb);
-    uint _e118 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_2, wrap_1);
-    uint _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_2, wrap_1);
-    uint row1_ = (yb > metal::floor(yb)) ? _e122 : _e118;
-    float w1_ = (row1_ != _e118) ? fy : 0.0;
-    float cos_theta_l = -(metal::dot(f_13.light_dir.xyz, _e10));
-    uint panels_2 = metal::max(naga_div(f_13.sizes2_.z, 4u), 1u);
-    float _e139 = d_1;
-    float _e140 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e139);
-    float _e145 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
-    float sun_scatter = f_13.medium.y * _e145;
-    float _e148 = xs;
-    xs0_ = _e148;
-    float _e150 = xs;
-    xs1_ = _e150;
+    uint _e77 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_2, wrap_1);
+    uint _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_2, wrap_1);
+    uint row1_ = (yb > metal::floor(yb)) ? _e81 : _e77;
+    float w1_ = (row1_ != _e77) ? fy : 0.0;
+    float cos_theta_l = -(metal::dot(f_14.light_dir.xyz, _e10));
+    uint panels_2 = metal::max(naga_div(f_14.sizes2_.z, 4u), 1u);
+    float _e98 = d_1;
+    float _e99 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e98);
+    float _e104 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, cos_theta_l);
+    float sun_scatter = f_14.medium.y * _e104;
+    float _e107 = xs;
+    xs0_ = _e107;
+    float _e109 = xs;
+    xs1_ = _e109;
     {
-        metal::float4 _e154 = slices[metal::min(unsigned(_e118), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e155 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e154);
-        delta0_ = _e155.delta;
-        metal::float4 _e160 = slices[metal::min(unsigned(row1_), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e161 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e160);
-        delta1_ = _e161.delta;
-        float _e164 = reach;
-        float _e165 = delta0_;
-        xs0_ = _e164 / _e165;
-        float _e167 = reach;
-        float _e168 = delta1_;
-        xs1_ = _e167 / _e168;
+        metal::float4 _e113 = slices[metal::min(unsigned(_e77), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e113);
+        delta0_ = _e114.delta;
+        metal::float4 _e119 = slices[metal::min(unsigned(row1_), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e120 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e119);
+        delta1_ = _e120.delta;
+        float _e123 = reach;
+        float _e124 = delta0_;
+        xs0_ = _e123 / _e124;
+        float _e126 = reach;
+        float _e127 = delta1_;
+        xs1_ = _e126 / _e127;
     }
-    float _e170 = xs0_;
-    uint last0_ = naga_f2u32(metal::min(metal::max(_e170, 0.0), static_cast<float>(width_1) - 1.0));
-    float _e178 = xs1_;
-    uint last1_ = naga_f2u32(metal::min(metal::max(_e178, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e129 = xs0_;
+    uint last0_ = naga_f2u32(metal::min(metal::max(_e129, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e137 = xs1_;
+    uint last1_ = naga_f2u32(metal::min(metal::max(_e137, 0.0), static_cast<float>(width_1) - 1.0));
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e445 = r_1;
-            r_1 = _e445 + 1u;
+            uint _e404 = r_1;
+            r_1 = _e404 + 1u;
         }
         loop_init_4 = false;
-        uint _e188 = r_1;
-        if (_e188 < REGIONS) {
+        uint _e147 = r_1;
+        if (_e147 < REGIONS) {
         } else {
             break;
         }
         {
-            uint _e190 = r_1;
-            uint _e191 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e190, REGIONS, width_1, false);
-            float b0_ = static_cast<float>(_e191);
-            uint _e193 = r_1;
-            uint _e196 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e193 + 1u, REGIONS, width_1, false);
-            float b1_2 = static_cast<float>(_e196);
+            uint _e149 = r_1;
+            uint _e150 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149, REGIONS, width_1, false);
+            float b0_ = static_cast<float>(_e150);
+            uint _e152 = r_1;
+            uint _e155 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e152 + 1u, REGIONS, width_1, false);
+            float b1_2 = static_cast<float>(_e155);
             if (!((last0_ < naga_f2u32(b1_2)))) {
-                uint _e201 = r_1;
-                local_6 = (_e201 + 1u) == REGIONS;
+                uint _e160 = r_1;
+                local_3 = (_e160 + 1u) == REGIONS;
             } else {
-                local_6 = true;
+                local_3 = true;
             }
-            bool is_last0_ = local_6;
+            bool is_last0_ = local_3;
             if (!((last1_ < naga_f2u32(b1_2)))) {
-                uint _e212 = r_1;
-                local_7 = (_e212 + 1u) == REGIONS;
+                uint _e171 = r_1;
+                local_4 = (_e171 + 1u) == REGIONS;
             } else {
-                local_7 = true;
+                local_4 = true;
             }
-            bool is_last1_ = local_7;
-            float _e222 = xs0_;
-            float pos0_ = is_last0_ ? metal::clamp(_e222 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
-            float _e233 = xs1_;
-            float pos1_ = is_last1_ ? metal::clamp(_e233 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
+            bool is_last1_ = local_4;
+            float _e181 = xs0_;
+            float pos0_ = is_last0_ ? metal::clamp(_e181 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
+            float _e192 = xs1_;
+            float pos1_ = is_last1_ ? metal::clamp(_e192 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
             a0_ = float {};
             e0_ = float {};
             a1_ = float {};
             e1_ = float {};
-            float _e250 = delta0_;
-            float _e251 = theta_3;
-            float _e252 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e250, _e251, s_5, false);
-            a0_ = _e252;
-            float _e253 = delta0_;
-            float _e254 = theta_3;
-            float _e255 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e253, _e254, s_5, false);
-            e0_ = is_last0_ ? s_5 : _e255;
-            float _e257 = delta1_;
-            float _e258 = theta_3;
-            float _e259 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e257, _e258, s_5, false);
-            a1_ = _e259;
-            float _e260 = delta1_;
-            float _e261 = theta_3;
-            float _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e260, _e261, s_5, false);
-            e1_ = is_last1_ ? s_5 : _e262;
+            float _e209 = delta0_;
+            float _e210 = theta_3;
+            float _e211 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b0_, _e209, _e210, s_5, false);
+            a0_ = _e211;
+            float _e212 = delta0_;
+            float _e213 = theta_3;
+            float _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b1_2, _e212, _e213, s_5, false);
+            e0_ = is_last0_ ? s_5 : _e214;
+            float _e216 = delta1_;
+            float _e217 = theta_3;
+            float _e218 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b0_, _e216, _e217, s_5, false);
+            a1_ = _e218;
+            float _e219 = delta1_;
+            float _e220 = theta_3;
+            float _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b1_2, _e219, _e220, s_5, false);
+            e1_ = is_last1_ ? s_5 : _e221;
             weight0_ = float {};
             weight1_ = float {};
             if (false) {
-                float _e268 = a0_;
-                float _e269 = e0_;
-                float _e270 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e268, _e269, panels_2);
-                weight0_ = _e270;
-                float _e271 = a1_;
-                float _e272 = e1_;
-                float _e273 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e271, _e272, panels_2);
-                weight1_ = _e273;
+                float _e227 = a0_;
+                float _e228 = e0_;
+                float _e229 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, _e227, _e228, panels_2);
+                weight0_ = _e229;
+                float _e230 = a1_;
+                float _e231 = e1_;
+                float _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, _e230, _e231, panels_2);
+                weight1_ = _e232;
             } else {
-                float _e276 = a0_;
-                float _e277 = e0_;
-                float _e278 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e276, _e277);
-                weight0_ = sun_scatter * _e278;
-                float _e282 = a1_;
-                float _e283 = e1_;
-                float _e284 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e282, _e283);
-                weight1_ = sun_scatter * _e284;
+                float _e235 = a0_;
+                float _e236 = e0_;
+                float _e237 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, _e235, _e236);
+                weight0_ = sun_scatter * _e237;
+                float _e241 = a1_;
+                float _e242 = e1_;
+                float _e243 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, _e241, _e242);
+                weight1_ = sun_scatter * _e243;
             }
             float xb0_ = pos0_ - 0.5;
             float fx0_ = xb0_ - metal::floor(xb0_);
@@ -1038,102 +1009,102 @@ metal::float3 scatter_pixel(
             float fx1_ = xb1_ - metal::floor(xb1_);
             uint x10_ = naga_f2u32(metal::clamp(metal::floor(xb1_), 0.0, static_cast<float>(width_1) - 1.0));
             uint x11_ = (xb1_ > metal::floor(xb1_)) ? metal::min(x10_ + 1u, width_1 - 1u) : x10_;
-            uint _e324 = bounds_index(x01_, _e118, frame);
-            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e324), (_buffer_sizes.size6 - 0 - 8) / 8)];
-            uint _e328 = bounds_index(x11_, row1_, frame);
-            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e328), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint _e283 = bounds_index(x01_, _e77, frame);
+            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e283), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint _e287 = bounds_index(x11_, row1_, frame);
+            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e287), (_buffer_sizes.size6 - 0 - 8) / 8)];
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e336 = d_1;
-            if (_e336 > lohi0_.x) {
-                float _e339 = d_1;
-                local_8 = _e339 <= lohi0_.y;
+            float _e295 = d_1;
+            if (_e295 > lohi0_.x) {
+                float _e298 = d_1;
+                local_5 = _e298 <= lohi0_.y;
             } else {
-                local_8 = false;
+                local_5 = false;
             }
-            bool _e345 = local_8;
-            if (_e345) {
-                metal::float4 _e347 = filtered_load(x00_, _e118, 0u, frame, filtered, _buffer_sizes);
-                metal::float4 _e349 = filtered_load(x01_, _e118, 0u, frame, filtered, _buffer_sizes);
-                metal::float4 m0_ = metal::mix(_e347, _e349, fx0_);
-                metal::float4 _e352 = filtered_load(x00_, _e118, 1u, frame, filtered, _buffer_sizes);
-                metal::float4 _e354 = filtered_load(x01_, _e118, 1u, frame, filtered, _buffer_sizes);
-                metal::float4 m1_ = metal::mix(_e352, _e354, fx0_);
-                float _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e140);
-                vis0_ = _e357;
+            bool _e304 = local_5;
+            if (_e304) {
+                metal::float4 _e306 = filtered_load(x00_, _e77, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 _e308 = filtered_load(x01_, _e77, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 m0_ = metal::mix(_e306, _e308, fx0_);
+                metal::float4 _e311 = filtered_load(x00_, _e77, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 _e313 = filtered_load(x01_, _e77, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 m1_ = metal::mix(_e311, _e313, fx0_);
+                float _e316 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e99);
+                vis0_ = _e316;
             }
-            float _e358 = d_1;
-            if (_e358 > lohi1_.x) {
-                float _e361 = d_1;
-                local_9 = _e361 <= lohi1_.y;
+            float _e317 = d_1;
+            if (_e317 > lohi1_.x) {
+                float _e320 = d_1;
+                local_6 = _e320 <= lohi1_.y;
+            } else {
+                local_6 = false;
+            }
+            bool _e326 = local_6;
+            if (_e326) {
+                metal::float4 _e328 = filtered_load(x10_, row1_, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 _e330 = filtered_load(x11_, row1_, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 m0_1 = metal::mix(_e328, _e330, fx1_);
+                metal::float4 _e333 = filtered_load(x10_, row1_, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 _e335 = filtered_load(x11_, row1_, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 m1_1 = metal::mix(_e333, _e335, fx1_);
+                float _e338 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e99);
+                vis1_ = _e338;
+            }
+            float _e339 = vis0_;
+            float _e340 = d_1;
+            float _e345 = d_1;
+            vis0_ = (_e345 <= lohi0_.x) ? 1.0 : ((_e340 > lohi0_.y) ? 0.0 : _e339);
+            float _e350 = vis1_;
+            float _e351 = d_1;
+            float _e356 = d_1;
+            vis1_ = (_e356 <= lohi1_.x) ? 1.0 : ((_e351 > lohi1_.y) ? 0.0 : _e350);
+            bool _e362 = done0_;
+            if (!(_e362)) {
+                float _e365 = total0_;
+                float _e366 = weight0_;
+                float _e367 = vis0_;
+                total0_ = _e365 + (_e366 * metal::clamp(_e367, 0.0, 1.0));
+            }
+            bool _e374 = done1_;
+            if (!(_e374)) {
+                float _e377 = total1_;
+                float _e378 = weight1_;
+                float _e379 = vis1_;
+                total1_ = _e377 + (_e378 * metal::clamp(_e379, 0.0, 1.0));
+            }
+            bool _e385 = done0_;
+            if (!(_e385)) {
+                local_7 = is_last0_;
+            } else {
+                local_7 = true;
+            }
+            bool _e390 = local_7;
+            done0_ = _e390;
+            bool _e391 = done1_;
+            if (!(_e391)) {
+                local_8 = is_last1_;
+            } else {
+                local_8 = true;
+            }
+            bool _e396 = local_8;
+            done1_ = _e396;
+            bool _e397 = done0_;
+            if (_e397) {
+                bool _e398 = done1_;
+                local_9 = _e398;
             } else {
                 local_9 = false;
             }
-            bool _e367 = local_9;
-            if (_e367) {
-                metal::float4 _e369 = filtered_load(x10_, row1_, 0u, frame, filtered, _buffer_sizes);
-                metal::float4 _e371 = filtered_load(x11_, row1_, 0u, frame, filtered, _buffer_sizes);
-                metal::float4 m0_1 = metal::mix(_e369, _e371, fx1_);
-                metal::float4 _e374 = filtered_load(x10_, row1_, 1u, frame, filtered, _buffer_sizes);
-                metal::float4 _e376 = filtered_load(x11_, row1_, 1u, frame, filtered, _buffer_sizes);
-                metal::float4 m1_1 = metal::mix(_e374, _e376, fx1_);
-                float _e379 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e140);
-                vis1_ = _e379;
-            }
-            float _e380 = vis0_;
-            float _e381 = d_1;
-            float _e386 = d_1;
-            vis0_ = (_e386 <= lohi0_.x) ? 1.0 : ((_e381 > lohi0_.y) ? 0.0 : _e380);
-            float _e391 = vis1_;
-            float _e392 = d_1;
-            float _e397 = d_1;
-            vis1_ = (_e397 <= lohi1_.x) ? 1.0 : ((_e392 > lohi1_.y) ? 0.0 : _e391);
-            bool _e403 = done0_;
-            if (!(_e403)) {
-                float _e406 = total0_;
-                float _e407 = weight0_;
-                float _e408 = vis0_;
-                total0_ = _e406 + (_e407 * metal::clamp(_e408, 0.0, 1.0));
-            }
-            bool _e415 = done1_;
-            if (!(_e415)) {
-                float _e418 = total1_;
-                float _e419 = weight1_;
-                float _e420 = vis1_;
-                total1_ = _e418 + (_e419 * metal::clamp(_e420, 0.0, 1.0));
-            }
-            bool _e426 = done0_;
-            if (!(_e426)) {
-                local_10 = is_last0_;
-            } else {
-                local_10 = true;
-            }
-            bool _e431 = local_10;
-            done0_ = _e431;
-            bool _e432 = done1_;
-            if (!(_e432)) {
-                local_11 = is_last1_;
-            } else {
-                local_11 = true;
-            }
-            bool _e437 = local_11;
-            done1_ = _e437;
-            bool _e438 = done0_;
-            if (_e438) {
-                bool _e439 = done1_;
-                local_12 = _e439;
-            } else {
-                local_12 = false;
-            }
-            bool _e443 = local_12;
-            if (_e443) {
+            bool _e402 = local_9;
+            if (_e402) {
                 break;
             }
         }
     }
-    float _e449 = total0_;
-    float _e451 = total1_;
-    float l_2 = ((1.0 - w1_) * _e449) + (w1_ * _e451);
+    float _e408 = total0_;
+    float _e410 = total1_;
+    float l_2 = ((1.0 - w1_) * _e408) + (w1_ * _e410);
     metal::float3 c_1 = color * l_2;
     return c_1;
 }

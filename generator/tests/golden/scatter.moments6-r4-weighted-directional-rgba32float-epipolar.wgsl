@@ -181,11 +181,8 @@ fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32,
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
     let x_12 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_12 * x_12) * (3f - (2f * x_12)));
+    return select(((x_12 * x_12) * (3f - (2f * x_12))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
@@ -210,41 +207,41 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k;
-        if (_e30 < panels) {
+        if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            let _e32 = k;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_2));
+            let _e34 = k;
+            let mid = (g0_ + ((f32(_e34) + 0.5f) * w_2));
             q = 0u;
             loop {
-                let _e40 = q;
-                if (_e40 < 4u) {
+                let _e42 = q;
+                if (_e42 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    let _e46 = q;
-                    let u_1 = tan((mid + ((0.5f * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
-                    let _e52 = sum;
-                    let _e54 = q;
-                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u_1 * u_1))));
+                    let _e48 = q;
+                    let u_1 = tan((mid + ((0.5f * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    let _e54 = sum;
+                    let _e56 = q;
+                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u_1 * u_1))));
                 }
                 continuing {
-                    let _e70 = q;
-                    q = (_e70 + 1u);
+                    let _e72 = q;
+                    q = (_e72 + 1u);
                 }
             }
         }
         continuing {
-            let _e73 = k;
-            k = (_e73 + 1u);
+            let _e75 = k;
+            k = (_e75 + 1u);
         }
     }
-    let _e75 = sum;
-    return (((_e75 * 0.5f) * w_2) * h);
+    let _e77 = sum;
+    return (((_e77 * 0.5f) * w_2) * h);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -299,43 +296,43 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_
     let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_1;
-        if (_e15 < steps) {
+        if ((_e15 + 1u) <= steps) {
         } else {
             break;
         }
         {
-            let _e17 = k_1;
-            t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_2));
+            let _e19 = k_1;
+            t_2 = (a_3 + ((f32(_e19) + 0.5f) * h_2));
             w = h_2;
             if spot_1 {
-                let _e26 = k_1;
-                let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
-                t_2 = _e30.x;
-                w = _e30.y;
+                let _e28 = k_1;
+                let _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e28) + 0.5f));
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            let _e33 = t_2;
-            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            let _e35 = t_2;
+            let _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if spot_1 {
-                let _e39 = sum_1;
-                let _e40 = w;
-                let _e42 = t_2;
-                let _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
-                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
+                let _e41 = sum_1;
+                let _e42 = w;
+                let _e44 = t_2;
+                let _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e44);
+                sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
-                let _e46 = sum_1;
-                let _e49 = k_1;
-                let _e53 = k_1;
-                let _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e49) * h_2)), (a_3 + (f32((_e53 + 1u)) * h_2)));
-                sum_1 = (_e46 + (_e37 * _e59));
+                let _e48 = sum_1;
+                let _e51 = k_1;
+                let _e55 = k_1;
+                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e51) * h_2)), (a_3 + (f32((_e55 + 1u)) * h_2)));
+                sum_1 = (_e48 + (_e39 * _e61));
             }
         }
         continuing {
-            let _e63 = k_1;
-            k_1 = (_e63 + 1u);
+            let _e65 = k_1;
+            k_1 = (_e65 + 1u);
         }
     }
-    let _e65 = sum_1;
-    return _e65;
+    let _e67 = sum_1;
+    return _e67;
 }
 
 fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
@@ -348,16 +345,19 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_o
     }
 }
 
-fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
-    let ji = i32(j);
-    if wrap {
-        return u32((((ji % i32(rows)) + i32(rows)) % i32(rows)));
-    } else {
-        return u32(clamp(ji, 0i, (i32(rows) - 1i)));
-    }
+fn in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, pc: vec2<f32>) -> bool {
+    let radius = f_6.epipole.w;
+    let near_epi = ((f_6.epipole.z > 0.5f) & (length((pc - f_6.epipole.xy)) < radius));
+    let near_anti = ((f_6.anti_epipole.z > 0.5f) & (length((pc - f_6.anti_epipole.xy)) < radius));
+    return (near_epi | near_anti);
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_3: bool) -> f32 {
+fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = i32(j);
+    return select(u32(clamp(ji, 0i, (i32(rows) - 1i))), u32((((ji % i32(rows)) + i32(rows)) % i32(rows))), wrap);
+}
+
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_1: f32, s_1: f32, spot_3: bool) -> f32 {
     var local_1: bool;
 
     if spot_3 {
@@ -372,41 +372,30 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_X
         if _e16 {
             return s_1;
         }
-        return min(((f_6.axis.w * sin(psi)) / den), s_1);
+        return min(((f_7.axis.w * sin(psi)) / den), s_1);
     } else {
         return min(((x_2 * delta) / max(sin(theta_1), 0.000001f)), s_1);
     }
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
-    var yc: f32;
-
-    let rows_1 = f_7.sizes.w;
-    let phi_1 = atan2(dot(dir_6, f_7.e2_.xyz), dot(dir_6, f_7.e1_.xyz));
-    yc = ((phi_1 - f_7.e1_.w) / f_7.e2_.w);
-    if (f_7.anti_epipole.w > 0.5f) {
-        let _e22 = yc;
-        let _e23 = yc;
-        yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
-    } else {
-        let _e30 = yc;
-        yc = clamp(_e30, 0f, f32(rows_1));
-    }
-    let _e34 = yc;
-    return _e34;
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let rows_1 = f_8.sizes.w;
+    let phi_1 = atan2(dot(dir_6, f_8.e2_.xyz), dot(dir_6, f_8.e1_.xyz));
+    let yc_1 = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
+    return select(clamp(yc_1, 0f, f32(rows_1)), (yc_1 - (floor((yc_1 / f32(rows_1))) * f32(rows_1))), (f_8.anti_epipole.w > 0.5f));
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_4: bool) -> f32 {
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_4: bool) -> f32 {
     if spot_4 {
-        let q_3 = ((eye_6 + (dir_7 * s_2)) - f_8.light_pos.xyz);
-        let to_eye = -(f_8.axis.xyz);
+        let q_3 = ((eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz);
+        let to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_3, to_eye)), dot(q_3, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_8: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_8: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
     return _e15;
 }
 
@@ -456,13 +445,13 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
             let _e86 = z_1;
             let _e87 = z_1;
             let _e88 = z_1;
-            let f_12 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
+            let f_13 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
             let _e95 = z_1;
             let _e98 = z_1;
             let df = (c2_ + (_e95 * ((2f * c3_) + ((3f * _e98) * c4_))));
             if (df != 0f) {
                 let _e107 = z_1;
-                z_1 = (_e107 - (f_12 / df));
+                z_1 = (_e107 - (f_13 / df));
             }
         }
         continuing {
@@ -552,12 +541,12 @@ fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw
     return clamp(((1f - _e129) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0f, 1f);
 }
 
-fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
-    return ((f_10.e1_.xyz * cos(phi)) + (f_10.e2_.xyz * sin(phi)));
+fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
+    return ((f_11.e1_.xyz * cos(phi)) + (f_11.e2_.xyz * sin(phi)));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    return (f_11.e1_.w + ((f32(row) + 0.5f) * f_11.e2_.w));
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    return (f_12.e1_.w + ((f32(row) + 0.5f) * f_12.e2_.w));
 }
 
 fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_5: bool) -> u32 {
@@ -594,10 +583,7 @@ fn filtered_load(x_8: u32, row_3: u32, layer_1: u32) -> vec4<f32> {
 }
 
 fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
-    var local_3: bool;
-    var local_4: bool;
-    var local_5: bool;
-    var yc_1: f32;
+    var yc: f32;
     var d_1: f32;
     var xs: f32 = 0f;
     var reach: f32 = 0f;
@@ -611,8 +597,8 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
     var done0_: bool = false;
     var done1_: bool = false;
     var r_1: u32 = 0u;
-    var local_6: bool;
-    var local_7: bool;
+    var local_3: bool;
+    var local_4: bool;
     var a0_: f32;
     var e0_: f32;
     var a1_: f32;
@@ -621,165 +607,146 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
     var weight1_: f32;
     var vis0_: f32;
     var vis1_: f32;
+    var local_5: bool;
+    var local_6: bool;
+    var local_7: bool;
     var local_8: bool;
     var local_9: bool;
-    var local_10: bool;
-    var local_11: bool;
-    var local_12: bool;
 
-    let f_13 = frame;
-    let eye_8 = f_13.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_9, y_1);
+    let f_14 = frame;
+    let eye_8 = f_14.eye.xyz;
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_9, y_1);
     let _e14 = textureLoad(depth, vec2<u32>(x_9, y_1), 0i);
-    let s_5 = (min(max(_e14.x, 0f), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 0.000001f));
-    let color = f_13.light_color.xyz;
-    let px = vec3<f32>((f32(x_9) + 0.5f), (f32(y_1) + 0.5f), 0f);
-    let radius = f_13.epipole.w;
-    if (f_13.epipole.z > 0.5f) {
-        local_3 = (length((px - vec3<f32>(f_13.epipole.x, f_13.epipole.y, 0f))) < radius);
-    } else {
-        local_3 = false;
-    }
-    let near_epi = local_3;
-    if (f_13.anti_epipole.z > 0.5f) {
-        local_4 = (length((px - vec3<f32>(f_13.anti_epipole.x, f_13.anti_epipole.y, 0f))) < radius);
-    } else {
-        local_4 = false;
-    }
-    let near_anti = local_4;
-    if !(near_epi) {
-        local_5 = near_anti;
-    } else {
-        local_5 = true;
-    }
-    let _e77 = local_5;
-    if _e77 {
-        let _e79 = frame;
-        let _e82 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e79, shadow_map, eye_8, _e10, s_5, false);
-        let l_1 = (_e82 * color);
+    let s_5 = (min(max(_e14.x, 0f), f_14.theta.z) / max(dot(_e10, f_14.cam_forward.xyz), 0.000001f));
+    let color = f_14.light_color.xyz;
+    let _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, vec2<f32>((f32(x_9) + 0.5f), (f32(y_1) + 0.5f)));
+    if _e36 {
+        let _e38 = frame;
+        let _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, shadow_map, eye_8, _e10, s_5, false);
+        let l_1 = (_e41 * color);
         return l_1;
     }
-    let axis = f_13.axis.xyz;
-    let rows_2 = f_13.sizes.w;
-    let width_1 = f_13.sizes.z;
-    let wrap_1 = (f_13.anti_epipole.w > 0.5f);
+    let axis = f_14.axis.xyz;
+    let rows_2 = f_14.sizes.w;
+    let width_1 = f_14.sizes.z;
+    let wrap_1 = (f_14.anti_epipole.w > 0.5f);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let _e100 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
-        yc_1 = _e100;
-        let _e102 = theta_3;
-        let _e107 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e102, f_13.theta.x, f_13.theta.y);
-        d_1 = _e107;
-        let _e109 = theta_3;
-        let _e110 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e109, false);
-        reach = _e110;
+        let _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e10);
+        yc = _e59;
+        let _e61 = theta_3;
+        let _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_14.theta.x, f_14.theta.y);
+        d_1 = _e66;
+        let _e68 = theta_3;
+        let _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, s_5, _e68, false);
+        reach = _e69;
     }
-    let _e112 = yc_1;
-    let yb = (_e112 - 0.5f);
+    let _e71 = yc;
+    let yb = (_e71 - 0.5f);
     let fy = (yb - floor(yb));
-    let _e118 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
-    let _e122 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
-    let row1_ = select(_e118, _e122, (yb > floor(yb)));
-    let w1_ = select(0f, fy, (row1_ != _e118));
-    let cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
-    let panels_2 = max((f_13.sizes2_.z / 4u), 1u);
-    let _e139 = d_1;
-    let _e140 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e139);
-    let _e145 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
-    let sun_scatter = (f_13.medium.y * _e145);
-    let _e148 = xs;
-    xs0_ = _e148;
-    let _e150 = xs;
-    xs1_ = _e150;
+    let _e77 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    let _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
+    let row1_ = select(_e77, _e81, (yb > floor(yb)));
+    let w1_ = select(0f, fy, (row1_ != _e77));
+    let cos_theta_l = -(dot(f_14.light_dir.xyz, _e10));
+    let panels_2 = max((f_14.sizes2_.z / 4u), 1u);
+    let _e98 = d_1;
+    let _e99 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e98);
+    let _e104 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, cos_theta_l);
+    let sun_scatter = (f_14.medium.y * _e104);
+    let _e107 = xs;
+    xs0_ = _e107;
+    let _e109 = xs;
+    xs1_ = _e109;
     {
-        let _e154 = slices[_e118];
-        let _e155 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e154);
-        delta0_ = _e155.delta;
-        let _e160 = slices[row1_];
-        let _e161 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e160);
-        delta1_ = _e161.delta;
-        let _e164 = reach;
-        let _e165 = delta0_;
-        xs0_ = (_e164 / _e165);
-        let _e167 = reach;
-        let _e168 = delta1_;
-        xs1_ = (_e167 / _e168);
+        let _e113 = slices[_e77];
+        let _e114 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e113);
+        delta0_ = _e114.delta;
+        let _e119 = slices[row1_];
+        let _e120 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e119);
+        delta1_ = _e120.delta;
+        let _e123 = reach;
+        let _e124 = delta0_;
+        xs0_ = (_e123 / _e124);
+        let _e126 = reach;
+        let _e127 = delta1_;
+        xs1_ = (_e126 / _e127);
     }
-    let _e170 = xs0_;
-    let last0_ = u32(min(max(_e170, 0f), (f32(width_1) - 1f)));
-    let _e178 = xs1_;
-    let last1_ = u32(min(max(_e178, 0f), (f32(width_1) - 1f)));
+    let _e129 = xs0_;
+    let last0_ = u32(min(max(_e129, 0f), (f32(width_1) - 1f)));
+    let _e137 = xs1_;
+    let last1_ = u32(min(max(_e137, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e188 = r_1;
-        if (_e188 < REGIONS) {
+        let _e147 = r_1;
+        if (_e147 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e190 = r_1;
-            let _e191 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e190, REGIONS, width_1, false);
-            let b0_ = f32(_e191);
-            let _e193 = r_1;
-            let _e196 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e193 + 1u), REGIONS, width_1, false);
-            let b1_2 = f32(_e196);
+            let _e149 = r_1;
+            let _e150 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149, REGIONS, width_1, false);
+            let b0_ = f32(_e150);
+            let _e152 = r_1;
+            let _e155 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e152 + 1u), REGIONS, width_1, false);
+            let b1_2 = f32(_e155);
             if !((last0_ < u32(b1_2))) {
-                let _e201 = r_1;
-                local_6 = ((_e201 + 1u) == REGIONS);
+                let _e160 = r_1;
+                local_3 = ((_e160 + 1u) == REGIONS);
             } else {
-                local_6 = true;
+                local_3 = true;
             }
-            let is_last0_ = local_6;
+            let is_last0_ = local_3;
             if !((last1_ < u32(b1_2))) {
-                let _e212 = r_1;
-                local_7 = ((_e212 + 1u) == REGIONS);
+                let _e171 = r_1;
+                local_4 = ((_e171 + 1u) == REGIONS);
             } else {
-                local_7 = true;
+                local_4 = true;
             }
-            let is_last1_ = local_7;
-            let _e222 = xs0_;
-            let pos0_ = select((b1_2 - 0.5f), clamp((_e222 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
-            let _e233 = xs1_;
-            let pos1_ = select((b1_2 - 0.5f), clamp((_e233 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
+            let is_last1_ = local_4;
+            let _e181 = xs0_;
+            let pos0_ = select((b1_2 - 0.5f), clamp((_e181 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
+            let _e192 = xs1_;
+            let pos1_ = select((b1_2 - 0.5f), clamp((_e192 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
             a0_ = f32();
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e250 = delta0_;
-            let _e251 = theta_3;
-            let _e252 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e250, _e251, s_5, false);
-            a0_ = _e252;
-            let _e253 = delta0_;
-            let _e254 = theta_3;
-            let _e255 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e253, _e254, s_5, false);
-            e0_ = select(_e255, s_5, is_last0_);
-            let _e257 = delta1_;
-            let _e258 = theta_3;
-            let _e259 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e257, _e258, s_5, false);
-            a1_ = _e259;
-            let _e260 = delta1_;
-            let _e261 = theta_3;
-            let _e262 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e260, _e261, s_5, false);
-            e1_ = select(_e262, s_5, is_last1_);
+            let _e209 = delta0_;
+            let _e210 = theta_3;
+            let _e211 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b0_, _e209, _e210, s_5, false);
+            a0_ = _e211;
+            let _e212 = delta0_;
+            let _e213 = theta_3;
+            let _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b1_2, _e212, _e213, s_5, false);
+            e0_ = select(_e214, s_5, is_last0_);
+            let _e216 = delta1_;
+            let _e217 = theta_3;
+            let _e218 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b0_, _e216, _e217, s_5, false);
+            a1_ = _e218;
+            let _e219 = delta1_;
+            let _e220 = theta_3;
+            let _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b1_2, _e219, _e220, s_5, false);
+            e1_ = select(_e221, s_5, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
-                let _e268 = a0_;
-                let _e269 = e0_;
-                let _e270 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e268, _e269, panels_2);
-                weight0_ = _e270;
-                let _e271 = a1_;
-                let _e272 = e1_;
-                let _e273 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e271, _e272, panels_2);
-                weight1_ = _e273;
+                let _e227 = a0_;
+                let _e228 = e0_;
+                let _e229 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, _e227, _e228, panels_2);
+                weight0_ = _e229;
+                let _e230 = a1_;
+                let _e231 = e1_;
+                let _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, _e230, _e231, panels_2);
+                weight1_ = _e232;
             } else {
-                let _e276 = a0_;
-                let _e277 = e0_;
-                let _e278 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e276, _e277);
-                weight0_ = (sun_scatter * _e278);
-                let _e282 = a1_;
-                let _e283 = e1_;
-                let _e284 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e282, _e283);
-                weight1_ = (sun_scatter * _e284);
+                let _e235 = a0_;
+                let _e236 = e0_;
+                let _e237 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, _e235, _e236);
+                weight0_ = (sun_scatter * _e237);
+                let _e241 = a1_;
+                let _e242 = e1_;
+                let _e243 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, _e241, _e242);
+                weight1_ = (sun_scatter * _e243);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -789,106 +756,106 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let _e324 = bounds_index(x01_, _e118);
-            let lohi0_ = bounds[_e324];
-            let _e328 = bounds_index(x11_, row1_);
-            let lohi1_ = bounds[_e328];
+            let _e283 = bounds_index(x01_, _e77);
+            let lohi0_ = bounds[_e283];
+            let _e287 = bounds_index(x11_, row1_);
+            let lohi1_ = bounds[_e287];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e336 = d_1;
-            if (_e336 > lohi0_.x) {
-                let _e339 = d_1;
-                local_8 = (_e339 <= lohi0_.y);
+            let _e295 = d_1;
+            if (_e295 > lohi0_.x) {
+                let _e298 = d_1;
+                local_5 = (_e298 <= lohi0_.y);
             } else {
-                local_8 = false;
+                local_5 = false;
             }
-            let _e345 = local_8;
-            if _e345 {
-                let _e347 = filtered_load(x00_, _e118, 0u);
-                let _e349 = filtered_load(x01_, _e118, 0u);
-                let m0_ = mix(_e347, _e349, fx0_);
-                let _e352 = filtered_load(x00_, _e118, 1u);
-                let _e354 = filtered_load(x01_, _e118, 1u);
-                let m1_ = mix(_e352, _e354, fx0_);
-                let _e357 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e140);
-                vis0_ = _e357;
+            let _e304 = local_5;
+            if _e304 {
+                let _e306 = filtered_load(x00_, _e77, 0u);
+                let _e308 = filtered_load(x01_, _e77, 0u);
+                let m0_ = mix(_e306, _e308, fx0_);
+                let _e311 = filtered_load(x00_, _e77, 1u);
+                let _e313 = filtered_load(x01_, _e77, 1u);
+                let m1_ = mix(_e311, _e313, fx0_);
+                let _e316 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e99);
+                vis0_ = _e316;
             }
-            let _e358 = d_1;
-            if (_e358 > lohi1_.x) {
-                let _e361 = d_1;
-                local_9 = (_e361 <= lohi1_.y);
+            let _e317 = d_1;
+            if (_e317 > lohi1_.x) {
+                let _e320 = d_1;
+                local_6 = (_e320 <= lohi1_.y);
+            } else {
+                local_6 = false;
+            }
+            let _e326 = local_6;
+            if _e326 {
+                let _e328 = filtered_load(x10_, row1_, 0u);
+                let _e330 = filtered_load(x11_, row1_, 0u);
+                let m0_1 = mix(_e328, _e330, fx1_);
+                let _e333 = filtered_load(x10_, row1_, 1u);
+                let _e335 = filtered_load(x11_, row1_, 1u);
+                let m1_1 = mix(_e333, _e335, fx1_);
+                let _e338 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e99);
+                vis1_ = _e338;
+            }
+            let _e339 = vis0_;
+            let _e340 = d_1;
+            let _e345 = d_1;
+            vis0_ = select(select(_e339, 0f, (_e340 > lohi0_.y)), 1f, (_e345 <= lohi0_.x));
+            let _e350 = vis1_;
+            let _e351 = d_1;
+            let _e356 = d_1;
+            vis1_ = select(select(_e350, 0f, (_e351 > lohi1_.y)), 1f, (_e356 <= lohi1_.x));
+            let _e362 = done0_;
+            if !(_e362) {
+                let _e365 = total0_;
+                let _e366 = weight0_;
+                let _e367 = vis0_;
+                total0_ = (_e365 + (_e366 * clamp(_e367, 0f, 1f)));
+            }
+            let _e374 = done1_;
+            if !(_e374) {
+                let _e377 = total1_;
+                let _e378 = weight1_;
+                let _e379 = vis1_;
+                total1_ = (_e377 + (_e378 * clamp(_e379, 0f, 1f)));
+            }
+            let _e385 = done0_;
+            if !(_e385) {
+                local_7 = is_last0_;
+            } else {
+                local_7 = true;
+            }
+            let _e390 = local_7;
+            done0_ = _e390;
+            let _e391 = done1_;
+            if !(_e391) {
+                local_8 = is_last1_;
+            } else {
+                local_8 = true;
+            }
+            let _e396 = local_8;
+            done1_ = _e396;
+            let _e397 = done0_;
+            if _e397 {
+                let _e398 = done1_;
+                local_9 = _e398;
             } else {
                 local_9 = false;
             }
-            let _e367 = local_9;
-            if _e367 {
-                let _e369 = filtered_load(x10_, row1_, 0u);
-                let _e371 = filtered_load(x11_, row1_, 0u);
-                let m0_1 = mix(_e369, _e371, fx1_);
-                let _e374 = filtered_load(x10_, row1_, 1u);
-                let _e376 = filtered_load(x11_, row1_, 1u);
-                let m1_1 = mix(_e374, _e376, fx1_);
-                let _e379 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e140);
-                vis1_ = _e379;
-            }
-            let _e380 = vis0_;
-            let _e381 = d_1;
-            let _e386 = d_1;
-            vis0_ = select(select(_e380, 0f, (_e381 > lohi0_.y)), 1f, (_e386 <= lohi0_.x));
-            let _e391 = vis1_;
-            let _e392 = d_1;
-            let _e397 = d_1;
-            vis1_ = select(select(_e391, 0f, (_e392 > lohi1_.y)), 1f, (_e397 <= lohi1_.x));
-            let _e403 = done0_;
-            if !(_e403) {
-                let _e406 = total0_;
-                let _e407 = weight0_;
-                let _e408 = vis0_;
-                total0_ = (_e406 + (_e407 * clamp(_e408, 0f, 1f)));
-            }
-            let _e415 = done1_;
-            if !(_e415) {
-                let _e418 = total1_;
-                let _e419 = weight1_;
-                let _e420 = vis1_;
-                total1_ = (_e418 + (_e419 * clamp(_e420, 0f, 1f)));
-            }
-            let _e426 = done0_;
-            if !(_e426) {
-                local_10 = is_last0_;
-            } else {
-                local_10 = true;
-            }
-            let _e431 = local_10;
-            done0_ = _e431;
-            let _e432 = done1_;
-            if !(_e432) {
-                local_11 = is_last1_;
-            } else {
-                local_11 = true;
-            }
-            let _e437 = local_11;
-            done1_ = _e437;
-            let _e438 = done0_;
-            if _e438 {
-                let _e439 = done1_;
-                local_12 = _e439;
-            } else {
-                local_12 = false;
-            }
-            let _e443 = local_12;
-            if _e443 {
+            let _e402 = local_9;
+            if _e402 {
                 break;
             }
         }
         continuing {
-            let _e445 = r_1;
-            r_1 = (_e445 + 1u);
+            let _e404 = r_1;
+            r_1 = (_e404 + 1u);
         }
     }
-    let _e449 = total0_;
-    let _e451 = total1_;
-    let l_2 = (((1f - w1_) * _e449) + (w1_ * _e451));
+    let _e408 = total0_;
+    let _e410 = total1_;
+    let l_2 = (((1f - w1_) * _e408) + (w1_ * _e410));
     let c_1 = (color * l_2);
     return c_1;
 }

@@ -159,11 +159,8 @@ fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32,
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
     let x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_4 * x_4) * (3f - (2f * x_4)));
+    return select(((x_4 * x_4) * (3f - (2f * x_4))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
@@ -188,41 +185,41 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let w = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k_1;
-        if (_e30 < panels) {
+        if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            let _e32 = k_1;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w));
+            let _e34 = k_1;
+            let mid = (g0_ + ((f32(_e34) + 0.5f) * w));
             q = 0u;
             loop {
-                let _e40 = q;
-                if (_e40 < 4u) {
+                let _e42 = q;
+                if (_e42 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    let _e46 = q;
-                    let u = tan((mid + ((0.5f * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
-                    let _e52 = sum;
-                    let _e54 = q;
-                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u * u))));
+                    let _e48 = q;
+                    let u = tan((mid + ((0.5f * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    let _e54 = sum;
+                    let _e56 = q;
+                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u * u))));
                 }
                 continuing {
-                    let _e70 = q;
-                    q = (_e70 + 1u);
+                    let _e72 = q;
+                    q = (_e72 + 1u);
                 }
             }
         }
         continuing {
-            let _e73 = k_1;
-            k_1 = (_e73 + 1u);
+            let _e75 = k_1;
+            k_1 = (_e75 + 1u);
         }
     }
-    let _e75 = sum;
-    return (((_e75 * 0.5f) * w) * h);
+    let _e77 = sum;
+    return (((_e77 * 0.5f) * w) * h);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {

@@ -184,11 +184,8 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    if (((cos_inner - cos_outer) <= 1e-6)) {
-        return ((cos_angle >= cos_outer) ? 1.0 : 0.0);
-    }
     float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
@@ -213,44 +210,44 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e73 = k;
-            k = (_e73 + 1u);
+            uint _e75 = k;
+            k = (_e75 + 1u);
         }
         loop_init = false;
         uint _e30 = k;
-        if ((_e30 < panels)) {
+        if (((_e30 + 1u) <= panels)) {
         } else {
             break;
         }
         {
-            uint _e32 = k;
-            float mid = (g0_ + ((float(_e32) + 0.5) * w_1));
+            uint _e34 = k;
+            float mid = (g0_ + ((float(_e34) + 0.5) * w_1));
             q = 0u;
             bool loop_init_1 = true;
             while(true) {
                 if (!loop_init_1) {
-                    uint _e70 = q;
-                    q = (_e70 + 1u);
+                    uint _e72 = q;
+                    q = (_e72 + 1u);
                 }
                 loop_init_1 = false;
-                uint _e40 = q;
-                if ((_e40 < 4u)) {
+                uint _e42 = q;
+                if ((_e42 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e46 = q;
-                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
-                    float _e52 = sum;
-                    uint _e54 = q;
-                    float _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1.0 + (u * u))));
+                    uint _e48 = q;
+                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    float _e54 = sum;
+                    uint _e56 = q;
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u * u))));
                 }
             }
         }
     }
-    float _e75 = sum;
-    return (((_e75 * 0.5) * w_1) * h);
+    float _e77 = sum;
+    return (((_e77 * 0.5) * w_1) * h);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_2, vec3 dir_2, vec3 light_pos_2, float a_2, float b_2, uint n) {
@@ -305,44 +302,44 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e63 = k_1;
-            k_1 = (_e63 + 1u);
+            uint _e65 = k_1;
+            k_1 = (_e65 + 1u);
         }
         loop_init_2 = false;
         uint _e15 = k_1;
-        if ((_e15 < steps)) {
+        if (((_e15 + 1u) <= steps)) {
         } else {
             break;
         }
         {
-            uint _e17 = k_1;
-            t_2 = (a_3 + ((float(_e17) + 0.5) * h_2));
+            uint _e19 = k_1;
+            t_2 = (a_3 + ((float(_e19) + 0.5) * h_2));
             w = h_2;
             if (spot_1) {
-                uint _e26 = k_1;
-                vec2 _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e26) + 0.5));
-                t_2 = _e30.x;
-                w = _e30.y;
+                uint _e28 = k_1;
+                vec2 _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (float(_e28) + 0.5));
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            float _e33 = t_2;
-            float _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            float _e35 = t_2;
+            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if (spot_1) {
-                float _e39 = sum_1;
-                float _e40 = w;
-                float _e42 = t_2;
-                float _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
-                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
+                float _e41 = sum_1;
+                float _e42 = w;
+                float _e44 = t_2;
+                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e44);
+                sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
-                float _e46 = sum_1;
-                uint _e49 = k_1;
-                uint _e53 = k_1;
-                float _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (float(_e49) * h_2)), (a_3 + (float((_e53 + 1u)) * h_2)));
-                sum_1 = (_e46 + (_e37 * _e59));
+                float _e48 = sum_1;
+                uint _e51 = k_1;
+                uint _e55 = k_1;
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (float(_e51) * h_2)), (a_3 + (float((_e55 + 1u)) * h_2)));
+                sum_1 = (_e48 + (_e39 * _e61));
             }
         }
     }
-    float _e65 = sum_1;
-    return _e65;
+    float _e67 = sum_1;
+    return _e67;
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_6, vec3 eye_5, vec3 dir_5, float s, bool spot_2) {
@@ -355,52 +352,45 @@ float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     }
 }
 
-uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, bool wrap) {
-    int ji = int(j);
-    if (wrap) {
-        return uint((((ji % int(rows)) + int(rows)) % int(rows)));
-    } else {
-        return uint(min(max(ji, 0), (int(rows) - 1)));
-    }
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec2 pc) {
+    float radius = f_6.epipole.w;
+    bool near_epi = ((f_6.epipole.z > 0.5) && (length((pc - f_6.epipole.xy)) < radius));
+    bool near_anti = ((f_6.anti_epipole.z > 0.5) && (length((pc - f_6.anti_epipole.xy)) < radius));
+    return (near_epi || near_anti);
 }
 
-float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, vec3 dir_6) {
-    vec3 axis = f_6.axis.xyz;
+uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, bool wrap) {
+    int ji = int(j);
+    return (wrap ? uint((((ji % int(rows)) + int(rows)) % int(rows))) : uint(min(max(ji, 0), (int(rows) - 1))));
+}
+
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 dir_6) {
+    vec3 axis = f_7.axis.xyz;
     return atan(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec3 dir_7) {
-    float yc = 0.0;
-    uint rows_1 = f_7.sizes.w;
-    float phi = atan(dot(dir_7, f_7.e2_.xyz), dot(dir_7, f_7.e1_.xyz));
-    yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
-    if ((f_7.anti_epipole.w > 0.5)) {
-        float _e22 = yc;
-        float _e23 = yc;
-        yc = (_e22 - (floor((_e23 / float(rows_1))) * float(rows_1)));
-    } else {
-        float _e30 = yc;
-        yc = clamp(_e30, 0.0, float(rows_1));
-    }
-    float _e34 = yc;
-    return _e34;
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_7) {
+    uint rows_1 = f_8.sizes.w;
+    float phi = atan(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
+    float yc = ((phi - f_8.e1_.w) / f_8.e2_.w);
+    return ((f_8.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
     if (spot_3) {
-        vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_8.light_pos.xyz);
-        vec3 to_eye = -(f_8.axis.xyz);
+        vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        vec3 to_eye = -(f_9.axis.xyz);
         return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
     return _e15;
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_4) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float x_2, float delta, float theta_2, float s_2, bool spot_4) {
     bool local_1 = false;
     if (spot_4) {
         float psi = (x_2 * delta);
@@ -414,17 +404,17 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_10.axis.w * sin(psi)) / den), s_2);
+        return min(((f_11.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, float(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -434,8 +424,8 @@ uint depth_bin(float d) {
 
 RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float s_4, bool spot_6) {
     bool local_2 = false;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = _group_0_binding_0_cs;
-    uint width = f_13.sizes.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = _group_0_binding_0_cs;
+    uint width = f_14.sizes.z;
     vec4 _e7 = _group_0_binding_1_cs[row];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e8 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e7);
     float delta_2 = _e8.delta;
@@ -463,117 +453,95 @@ RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float 
     vec4 _e70 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(last, row)), ivec2(0), textureSize(_group_0_binding_4_cs, _e70_clamped_lod) - ivec2(1)), _e70_clamped_lod);
     bool tail = (d_1 <= _e70.x);
     uint first = ((first_edge < PAD) ? 0u : (first_edge - PAD));
-    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_6);
-    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
+    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, first, n_3, delta_2, theta_4, s_4, spot_6);
+    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
     return RowSpan(_e81, _e84, head, tail);
 }
 
-float closed_form(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_7) {
+float closed_form(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_7) {
     if (spot_7) {
-        float _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max(max((f_12.sizes2_.z / 4u), 8u), 1u));
+        float _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max(max((f_13.sizes2_.z / 4u), 8u), 1u));
         return _e14;
     }
-    float _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
+    float _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
     return _e17;
 }
 
 vec3 volume_march_pixel(uint x_4, uint y_1) {
-    bool local_3 = false;
-    bool local_4 = false;
-    bool local_5 = false;
     float t_f = 0.0;
     float t_b = 0.0;
     float total = 0.0;
     float l_1 = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = _group_0_binding_0_cs;
-    vec3 eye_9 = f_14.eye.xyz;
-    vec3 _e7 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_4, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = _group_0_binding_0_cs;
+    vec3 eye_9 = f_15.eye.xyz;
+    vec3 _e7 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, x_4, y_1);
     int _e11_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e11 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_4, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e11_clamped_lod) - ivec2(1)), _e11_clamped_lod);
-    float s_5 = (min(max(_e11.x, 0.0), f_14.theta.z) / max(dot(_e7, f_14.cam_forward.xyz), 1e-6));
-    vec3 color = f_14.light_color.xyz;
-    vec3 px = vec3((float(x_4) + 0.5), (float(y_1) + 0.5), 0.0);
-    float radius = f_14.epipole.w;
-    if ((f_14.epipole.z > 0.5)) {
-        local_3 = (length((px - vec3(f_14.epipole.x, f_14.epipole.y, 0.0))) < radius);
-    } else {
-        local_3 = false;
-    }
-    bool near_epi = local_3;
-    if ((f_14.anti_epipole.z > 0.5)) {
-        local_4 = (length((px - vec3(f_14.anti_epipole.x, f_14.anti_epipole.y, 0.0))) < radius);
-    } else {
-        local_4 = false;
-    }
-    bool near_anti = local_4;
-    if (!(near_epi)) {
-        local_5 = near_anti;
-    } else {
-        local_5 = true;
-    }
-    bool _e74 = local_5;
-    if (_e74) {
-        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e76 = _group_0_binding_0_cs;
-        float _e79 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e76, _group_0_binding_3_cs, eye_9, _e7, s_5, true);
-        vec3 l_2 = (_e79 * color);
+    float s_5 = (min(max(_e11.x, 0.0), f_15.theta.z) / max(dot(_e7, f_15.cam_forward.xyz), 1e-6));
+    vec3 color = f_15.light_color.xyz;
+    bool _e33 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, vec2((float(x_4) + 0.5), (float(y_1) + 0.5)));
+    if (_e33) {
+        FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = _group_0_binding_0_cs;
+        float _e38 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _group_0_binding_3_cs, eye_9, _e7, s_5, true);
+        vec3 l_2 = (_e38 * color);
         return l_2;
     }
-    uint rows_2 = f_14.sizes.w;
-    bool wrap_1 = (f_14.anti_epipole.w > 0.5);
-    float _e87 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e7);
-    float _e88 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e7);
-    float _e93 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e87, f_14.theta.x, f_14.theta.y);
-    uint _e94 = depth_bin(_e93);
-    float _e95 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e7, s_5, _e87, true);
-    float j_1 = floor((_e88 - 0.5));
-    uint _e99 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_1, rows_2, wrap_1);
-    RowSpan _e100 = row_span(_e99, _e95, _e93, _e94, _e87, s_5, true);
-    uint _e103 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j_1 + 1.0), rows_2, wrap_1);
-    RowSpan _e104 = row_span(_e103, _e95, _e93, _e94, _e87, s_5, true);
-    t_f = min(_e100.t_f, _e104.t_f);
-    t_b = max(_e100.t_b, _e104.t_b);
-    if ((_e100.head != _e104.head)) {
+    uint rows_2 = f_15.sizes.w;
+    bool wrap_1 = (f_15.anti_epipole.w > 0.5);
+    float _e46 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e7);
+    float _e47 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e7);
+    float _e52 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, f_15.theta.x, f_15.theta.y);
+    uint _e53 = depth_bin(_e52);
+    float _e54 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e7, s_5, _e46, true);
+    float j_1 = floor((_e47 - 0.5));
+    uint _e58 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_1, rows_2, wrap_1);
+    RowSpan _e59 = row_span(_e58, _e54, _e52, _e53, _e46, s_5, true);
+    uint _e62 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j_1 + 1.0), rows_2, wrap_1);
+    RowSpan _e63 = row_span(_e62, _e54, _e52, _e53, _e46, s_5, true);
+    t_f = min(_e59.t_f, _e63.t_f);
+    t_b = max(_e59.t_b, _e63.t_b);
+    if ((_e59.head != _e63.head)) {
         t_f = 0.0;
     }
-    if ((_e100.tail != _e104.tail)) {
+    if ((_e59.tail != _e63.tail)) {
         t_b = s_5;
     }
-    float _e120 = t_b;
-    float _e121 = t_f;
-    if ((_e120 < _e121)) {
+    float _e79 = t_b;
+    float _e80 = t_f;
+    if ((_e79 < _e80)) {
         t_f = s_5;
         t_b = s_5;
     }
-    if (_e100.head) {
-        float _e125 = total;
-        float _e126 = t_f;
-        float _e128 = closed_form(f_14, eye_9, _e7, 0.0, _e126, true);
-        total = (_e125 + _e128);
+    if (_e59.head) {
+        float _e84 = total;
+        float _e85 = t_f;
+        float _e87 = closed_form(f_15, eye_9, _e7, 0.0, _e85, true);
+        total = (_e84 + _e87);
     }
-    float _e130 = t_b;
-    float _e131 = t_f;
-    if ((_e130 > _e131)) {
-        float _e133 = total;
-        float _e134 = t_f;
-        float _e135 = t_b;
-        float _e138 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _group_0_binding_3_cs, eye_9, _e7, _e134, _e135, SAMPLES, true);
-        total = (_e133 + _e138);
+    float _e89 = t_b;
+    float _e90 = t_f;
+    if ((_e89 > _e90)) {
+        float _e92 = total;
+        float _e93 = t_f;
+        float _e94 = t_b;
+        float _e97 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _group_0_binding_3_cs, eye_9, _e7, _e93, _e94, SAMPLES, true);
+        total = (_e92 + _e97);
     }
-    if (_e100.tail) {
-        float _e141 = total;
-        float _e142 = t_b;
-        float _e143 = closed_form(f_14, eye_9, _e7, _e142, s_5, true);
-        total = (_e141 + _e143);
+    if (_e59.tail) {
+        float _e100 = total;
+        float _e101 = t_b;
+        float _e102 = closed_form(f_15, eye_9, _e7, _e101, s_5, true);
+        total = (_e100 + _e102);
     }
-    float _e145 = total;
-    l_1 = _e145;
+    float _e104 = total;
+    l_1 = _e104;
     if (!(true)) {
-        float _e156 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, -(dot(f_14.light_dir.xyz, _e7)));
-        float _e158 = total;
-        l_1 = ((f_14.medium.y * _e156) * _e158);
+        float _e115 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(dot(f_15.light_dir.xyz, _e7)));
+        float _e117 = total;
+        l_1 = ((f_15.medium.y * _e115) * _e117);
     }
-    float _e160 = l_1;
-    vec3 c = (color * _e160);
+    float _e119 = l_1;
+    vec3 c = (color * _e119);
     return c;
 }
 

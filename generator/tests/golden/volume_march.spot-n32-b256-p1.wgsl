@@ -183,11 +183,8 @@ fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32,
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if ((cos_inner - cos_outer) <= 0.000001f) {
-        return select(0f, 1f, (cos_angle >= cos_outer));
-    }
     let x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return ((x_7 * x_7) * (3f - (2f * x_7)));
+    return select(((x_7 * x_7) * (3f - (2f * x_7))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
@@ -212,41 +209,41 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let w_1 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
         let _e30 = k;
-        if (_e30 < panels) {
+        if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            let _e32 = k;
-            let mid = (g0_ + ((f32(_e32) + 0.5f) * w_1));
+            let _e34 = k;
+            let mid = (g0_ + ((f32(_e34) + 0.5f) * w_1));
             q = 0u;
             loop {
-                let _e40 = q;
-                if (_e40 < 4u) {
+                let _e42 = q;
+                if (_e42 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    let _e46 = q;
-                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e46])));
-                    let _e52 = sum;
-                    let _e54 = q;
-                    let _e62 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e52 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e54] * _e62) * (1f + (u * u))));
+                    let _e48 = q;
+                    let u = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    let _e54 = sum;
+                    let _e56 = q;
+                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u * u))));
                 }
                 continuing {
-                    let _e70 = q;
-                    q = (_e70 + 1u);
+                    let _e72 = q;
+                    q = (_e72 + 1u);
                 }
             }
         }
         continuing {
-            let _e73 = k;
-            k = (_e73 + 1u);
+            let _e75 = k;
+            k = (_e75 + 1u);
         }
     }
-    let _e75 = sum;
-    return (((_e75 * 0.5f) * w_1) * h);
+    let _e77 = sum;
+    return (((_e77 * 0.5f) * w_1) * h);
 }
 
 fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2: vec3<f32>, dir_2: vec3<f32>, light_pos_2: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -301,43 +298,43 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_
     let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_4.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_1;
-        if (_e15 < steps) {
+        if ((_e15 + 1u) <= steps) {
         } else {
             break;
         }
         {
-            let _e17 = k_1;
-            t_2 = (a_3 + ((f32(_e17) + 0.5f) * h_2));
+            let _e19 = k_1;
+            t_2 = (a_3 + ((f32(_e19) + 0.5f) * h_2));
             w = h_2;
             if spot_1 {
-                let _e26 = k_1;
-                let _e30 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e26) + 0.5f));
-                t_2 = _e30.x;
-                w = _e30.y;
+                let _e28 = k_1;
+                let _e32 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e13, (f32(_e28) + 0.5f));
+                t_2 = _e32.x;
+                w = _e32.y;
             }
-            let _e33 = t_2;
-            let _e37 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e33)), spot_1);
+            let _e35 = t_2;
+            let _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if spot_1 {
-                let _e39 = sum_1;
-                let _e40 = w;
-                let _e42 = t_2;
-                let _e43 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e42);
-                sum_1 = (_e39 + ((_e37 * _e40) * _e43));
+                let _e41 = sum_1;
+                let _e42 = w;
+                let _e44 = t_2;
+                let _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, eye_4, dir_4, _e44);
+                sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
-                let _e46 = sum_1;
-                let _e49 = k_1;
-                let _e53 = k_1;
-                let _e59 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e49) * h_2)), (a_3 + (f32((_e53 + 1u)) * h_2)));
-                sum_1 = (_e46 + (_e37 * _e59));
+                let _e48 = sum_1;
+                let _e51 = k_1;
+                let _e55 = k_1;
+                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_4.medium.x, (a_3 + (f32(_e51) * h_2)), (a_3 + (f32((_e55 + 1u)) * h_2)));
+                sum_1 = (_e48 + (_e39 * _e61));
             }
         }
         continuing {
-            let _e63 = k_1;
-            k_1 = (_e63 + 1u);
+            let _e65 = k_1;
+            k_1 = (_e65 + 1u);
         }
     }
-    let _e65 = sum_1;
-    return _e65;
+    let _e67 = sum_1;
+    return _e67;
 }
 
 fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
@@ -350,53 +347,45 @@ fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_o
     }
 }
 
-fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
-    let ji = i32(j);
-    if wrap {
-        return u32((((ji % i32(rows)) + i32(rows)) % i32(rows)));
-    } else {
-        return u32(clamp(ji, 0i, (i32(rows) - 1i)));
-    }
+fn in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, pc: vec2<f32>) -> bool {
+    let radius = f_6.epipole.w;
+    let near_epi = ((f_6.epipole.z > 0.5f) & (length((pc - f_6.epipole.xy)) < radius));
+    let near_anti = ((f_6.anti_epipole.z > 0.5f) & (length((pc - f_6.anti_epipole.xy)) < radius));
+    return (near_epi | near_anti);
 }
 
-fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
-    let axis = f_6.axis.xyz;
+fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j: f32, rows: u32, wrap: bool) -> u32 {
+    let ji = i32(j);
+    return select(u32(clamp(ji, 0i, (i32(rows) - 1i))), u32((((ji % i32(rows)) + i32(rows)) % i32(rows))), wrap);
+}
+
+fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let axis = f_7.axis.xyz;
     return atan2(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
-    var yc: f32;
-
-    let rows_1 = f_7.sizes.w;
-    let phi = atan2(dot(dir_7, f_7.e2_.xyz), dot(dir_7, f_7.e1_.xyz));
-    yc = ((phi - f_7.e1_.w) / f_7.e2_.w);
-    if (f_7.anti_epipole.w > 0.5f) {
-        let _e22 = yc;
-        let _e23 = yc;
-        yc = (_e22 - (floor((_e23 / f32(rows_1))) * f32(rows_1)));
-    } else {
-        let _e30 = yc;
-        yc = clamp(_e30, 0f, f32(rows_1));
-    }
-    let _e34 = yc;
-    return _e34;
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
+    let rows_1 = f_8.sizes.w;
+    let phi = atan2(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
+    let yc = ((phi - f_8.e1_.w) / f_8.e2_.w);
+    return select(clamp(yc, 0f, f32(rows_1)), (yc - (floor((yc / f32(rows_1))) * f32(rows_1))), (f_8.anti_epipole.w > 0.5f));
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
     if spot_3 {
-        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_8.light_pos.xyz);
-        let to_eye = -(f_8.axis.xyz);
+        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
+        let to_eye = -(f_9.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_9.light_pos.xyz, f_9.light_dir.xyz, f_9.light_pos.w, f_9.light_dir.w, f_9.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
     return _e15;
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
     var local_1: bool;
 
     if spot_4 {
@@ -411,17 +400,17 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_
         if _e16 {
             return s_2;
         }
-        return min(((f_10.axis.w * sin(psi)) / den), s_2);
+        return min(((f_11.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
     if (x_3 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_3), delta_1, theta_3, s_3, spot_5);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, f32(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -432,8 +421,8 @@ fn depth_bin(d: f32) -> u32 {
 fn row_span(row: u32, col: f32, d_1: f32, bin: u32, theta_4: f32, s_4: f32, spot_6: bool) -> RowSpan {
     var local_2: bool;
 
-    let f_13 = frame;
-    let width = f_13.sizes.z;
+    let f_14 = frame;
+    let width = f_14.sizes.z;
     let _e7 = slices[row];
     let _e8 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e7);
     let delta_2 = _e8.delta;
@@ -459,117 +448,95 @@ fn row_span(row: u32, col: f32, d_1: f32, bin: u32, theta_4: f32, s_4: f32, spot
     let _e70 = textureLoad(rectified, vec2<u32>(last, row), 0i);
     let tail = (d_1 <= _e70.x);
     let first = select((first_edge - PAD), 0u, (first_edge < PAD));
-    let _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, first, n_3, delta_2, theta_4, s_4, spot_6);
-    let _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
+    let _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, first, n_3, delta_2, theta_4, s_4, spot_6);
+    let _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
     return RowSpan(_e81, _e84, head, tail);
 }
 
-fn closed_form(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_7: bool) -> f32 {
+fn closed_form(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_7: bool) -> f32 {
     if spot_7 {
-        let _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, dir_10, a_5, b_5, max(max((f_12.sizes2_.z / 4u), 8u), 1u));
+        let _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max(max((f_13.sizes2_.z / 4u), 8u), 1u));
         return _e14;
     }
-    let _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, a_5, b_5);
+    let _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
     return _e17;
 }
 
 fn volume_march_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
-    var local_3: bool;
-    var local_4: bool;
-    var local_5: bool;
     var t_f: f32;
     var t_b: f32;
     var total: f32 = 0f;
     var l_1: f32;
 
-    let f_14 = frame;
-    let eye_9 = f_14.eye.xyz;
-    let _e7 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_4, y_1);
+    let f_15 = frame;
+    let eye_9 = f_15.eye.xyz;
+    let _e7 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, x_4, y_1);
     let _e11 = textureLoad(depth, vec2<u32>(x_4, y_1), 0i);
-    let s_5 = (min(max(_e11.x, 0f), f_14.theta.z) / max(dot(_e7, f_14.cam_forward.xyz), 0.000001f));
-    let color = f_14.light_color.xyz;
-    let px = vec3<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f), 0f);
-    let radius = f_14.epipole.w;
-    if (f_14.epipole.z > 0.5f) {
-        local_3 = (length((px - vec3<f32>(f_14.epipole.x, f_14.epipole.y, 0f))) < radius);
-    } else {
-        local_3 = false;
-    }
-    let near_epi = local_3;
-    if (f_14.anti_epipole.z > 0.5f) {
-        local_4 = (length((px - vec3<f32>(f_14.anti_epipole.x, f_14.anti_epipole.y, 0f))) < radius);
-    } else {
-        local_4 = false;
-    }
-    let near_anti = local_4;
-    if !(near_epi) {
-        local_5 = near_anti;
-    } else {
-        local_5 = true;
-    }
-    let _e74 = local_5;
-    if _e74 {
-        let _e76 = frame;
-        let _e79 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e76, shadow_map, eye_9, _e7, s_5, true);
-        let l_2 = (_e79 * color);
+    let s_5 = (min(max(_e11.x, 0f), f_15.theta.z) / max(dot(_e7, f_15.cam_forward.xyz), 0.000001f));
+    let color = f_15.light_color.xyz;
+    let _e33 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, vec2<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f)));
+    if _e33 {
+        let _e35 = frame;
+        let _e38 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, shadow_map, eye_9, _e7, s_5, true);
+        let l_2 = (_e38 * color);
         return l_2;
     }
-    let rows_2 = f_14.sizes.w;
-    let wrap_1 = (f_14.anti_epipole.w > 0.5f);
-    let _e87 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e7);
-    let _e88 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e7);
-    let _e93 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e87, f_14.theta.x, f_14.theta.y);
-    let _e94 = depth_bin(_e93);
-    let _e95 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e7, s_5, _e87, true);
-    let j_1 = floor((_e88 - 0.5f));
-    let _e99 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_1, rows_2, wrap_1);
-    let _e100 = row_span(_e99, _e95, _e93, _e94, _e87, s_5, true);
-    let _e103 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j_1 + 1f), rows_2, wrap_1);
-    let _e104 = row_span(_e103, _e95, _e93, _e94, _e87, s_5, true);
-    t_f = min(_e100.t_f, _e104.t_f);
-    t_b = max(_e100.t_b, _e104.t_b);
-    if (_e100.head != _e104.head) {
+    let rows_2 = f_15.sizes.w;
+    let wrap_1 = (f_15.anti_epipole.w > 0.5f);
+    let _e46 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e7);
+    let _e47 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e7);
+    let _e52 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, f_15.theta.x, f_15.theta.y);
+    let _e53 = depth_bin(_e52);
+    let _e54 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e7, s_5, _e46, true);
+    let j_1 = floor((_e47 - 0.5f));
+    let _e58 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_1, rows_2, wrap_1);
+    let _e59 = row_span(_e58, _e54, _e52, _e53, _e46, s_5, true);
+    let _e62 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((j_1 + 1f), rows_2, wrap_1);
+    let _e63 = row_span(_e62, _e54, _e52, _e53, _e46, s_5, true);
+    t_f = min(_e59.t_f, _e63.t_f);
+    t_b = max(_e59.t_b, _e63.t_b);
+    if (_e59.head != _e63.head) {
         t_f = 0f;
     }
-    if (_e100.tail != _e104.tail) {
+    if (_e59.tail != _e63.tail) {
         t_b = s_5;
     }
-    let _e120 = t_b;
-    let _e121 = t_f;
-    if (_e120 < _e121) {
+    let _e79 = t_b;
+    let _e80 = t_f;
+    if (_e79 < _e80) {
         t_f = s_5;
         t_b = s_5;
     }
-    if _e100.head {
-        let _e125 = total;
-        let _e126 = t_f;
-        let _e128 = closed_form(f_14, eye_9, _e7, 0f, _e126, true);
-        total = (_e125 + _e128);
+    if _e59.head {
+        let _e84 = total;
+        let _e85 = t_f;
+        let _e87 = closed_form(f_15, eye_9, _e7, 0f, _e85, true);
+        total = (_e84 + _e87);
     }
-    let _e130 = t_b;
-    let _e131 = t_f;
-    if (_e130 > _e131) {
-        let _e133 = total;
-        let _e134 = t_f;
-        let _e135 = t_b;
-        let _e138 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, shadow_map, eye_9, _e7, _e134, _e135, SAMPLES, true);
-        total = (_e133 + _e138);
+    let _e89 = t_b;
+    let _e90 = t_f;
+    if (_e89 > _e90) {
+        let _e92 = total;
+        let _e93 = t_f;
+        let _e94 = t_b;
+        let _e97 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, shadow_map, eye_9, _e7, _e93, _e94, SAMPLES, true);
+        total = (_e92 + _e97);
     }
-    if _e100.tail {
-        let _e141 = total;
-        let _e142 = t_b;
-        let _e143 = closed_form(f_14, eye_9, _e7, _e142, s_5, true);
-        total = (_e141 + _e143);
+    if _e59.tail {
+        let _e100 = total;
+        let _e101 = t_b;
+        let _e102 = closed_form(f_15, eye_9, _e7, _e101, s_5, true);
+        total = (_e100 + _e102);
     }
-    let _e145 = total;
-    l_1 = _e145;
+    let _e104 = total;
+    l_1 = _e104;
     if !(true) {
-        let _e156 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, -(dot(f_14.light_dir.xyz, _e7)));
-        let _e158 = total;
-        l_1 = ((f_14.medium.y * _e156) * _e158);
+        let _e115 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(dot(f_15.light_dir.xyz, _e7)));
+        let _e117 = total;
+        l_1 = ((f_15.medium.y * _e115) * _e117);
     }
-    let _e160 = l_1;
-    let c = (color * _e160);
+    let _e119 = l_1;
+    let c = (color * _e119);
     return c;
 }
 

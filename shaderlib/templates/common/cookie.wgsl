@@ -152,7 +152,8 @@ fn frame_cookie(f: Frame, cookie: texture_2d<f32>, x: vec3<f32>) -> vec3<f32> {
 fn span_march_cookie(f: Frame, sm: texture_2d<f32>, cookie: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, a: f32, b: f32, steps: u32) -> vec3<f32> {
     let strata = equiangular(eye, dir, f.light_pos.xyz, a, b, steps);
     var sum = vec3<f32>(0.0);
-    for (var k = 0u; k < steps; k++) {
+    // `k + 1u <= steps`: see `span_march` (scatter::epipolar).
+    for (var k = 0u; k + 1u <= steps; k++) {
         let tw = equiangular_sample(strata, f32(k) + 0.5);
         let x = eye + dir * tw.x;
         let v = sm_visibility(f, sm, x, true);

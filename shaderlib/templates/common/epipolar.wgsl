@@ -175,7 +175,9 @@ fn span_march(f: Frame, sm: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, a: 
     let h = (b - a) / f32(steps);
     let strata = equiangular(eye, dir, f.light_pos.xyz, a, b, steps);
     var sum = 0.0;
-    for (var k = 0u; k < steps; k++) {
+    // `k + 1u <= steps`, not `k < steps`: lavapipe re-specialises a shader at every dispatch
+    // when a loop compares its counter with a uniform count (`scatter_shaderlib::uniform_branches`).
+    for (var k = 0u; k + 1u <= steps; k++) {
         var t = a + (f32(k) + 0.5) * h;
         var w = h;
         if spot {
@@ -206,15 +208,24 @@ fn epipole_march(f: Frame, sm: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, 
     }
 }
 
+// Whether the pixel centred at `pc` lies in the epipole's or the anti-epipole's disc (radius
+// `epipole.w`, where the rectification degenerates and the families march instead; mirrors
+// `in_epipole_disc` of reference/src/kernels/volume_march.rs). `&`, not `&&`: naga writes a
+// short-circuit as a branch, here on a uniform, and lavapipe re-specialises a shader branching
+// on uniforms at every dispatch (`scatter_shaderlib::uniform_branches`).
+fn in_epipole_disc(f: Frame, pc: vec2<f32>) -> bool {
+    let radius = f.epipole[3];
+    let near_epi = (f.epipole[2] > 0.5) & (length(pc - f.epipole.xy) < radius);
+    let near_anti = (f.anti_epipole[2] > 0.5) & (length(pc - f.anti_epipole.xy) < radius);
+    return near_epi | near_anti;
+}
+
 // Row of the `slices` table for row coordinate `j` (a whole number): wrapped around when
 // the slices cover the full circle, else clamped.
 fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {
     let ji = i32(j);
-    if wrap {
-        return u32(((ji % i32(rows)) + i32(rows)) % i32(rows));
-    } else {
-        return u32(clamp(ji, 0, i32(rows) - 1));
-    }
+    // Selected, not branched on (`wrap` is a uniform's: `scatter_shaderlib::uniform_branches`).
+    return select(u32(clamp(ji, 0, i32(rows) - 1)), u32(((ji % i32(rows)) + i32(rows)) % i32(rows)), wrap);
 }
 
 // Distance along the pixel's own ray (angle `theta` to the axis) of column edge `x`, capped
@@ -245,13 +256,9 @@ fn ray_theta(f: Frame, dir: vec3<f32>) -> f32 {
 fn ray_row_coord(f: Frame, dir: vec3<f32>) -> f32 {
     let rows = f.sizes[3];
     let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
-    var yc = (phi - f.e1_[3]) / f.e2_[3];
-    if f.anti_epipole[3] > 0.5 {
-        yc -= floor(yc / f32(rows)) * f32(rows);
-    } else {
-        yc = clamp(yc, 0.0, f32(rows));
-    }
-    return yc;
+    let yc = (phi - f.e1_[3]) / f.e2_[3];
+    // Selected, not branched on (a uniform: `scatter_shaderlib::uniform_branches`).
+    return select(clamp(yc, 0.0, f32(rows)), yc - floor(yc / f32(rows)) * f32(rows), f.anti_epipole[3] > 0.5);
 }
 
 // Column coordinate, before division by a row's spacing, of the point at distance `s` along

@@ -31,12 +31,12 @@ fn transmittance_between(sigma_t: f32, a: f32, b: f32) -> f32 {
 }
 
 // Smoothstep cone falloff from the cosines of the outer and inner half-angles.
+// A hard edge where the two cones coincide. Selected, not branched on: the cosines are
+// uniforms, and lavapipe re-specialises a shader branching on uniforms at every dispatch
+// (`scatter_shaderlib::uniform_branches`).
 fn cone_falloff(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    if cos_inner - cos_outer <= 1e-6 {
-        return select(0.0, 1.0, cos_angle >= cos_outer);
-    }
     let x = clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return x * x * (3.0 - 2.0 * x);
+    return select(x * x * (3.0 - 2.0 * x), select(0.0, 1.0, cos_angle >= cos_outer), cos_inner - cos_outer <= 1e-6);
 }
 
 // Spot-light integrand `sigma_s p I_cone exp(-sigma_t (d + t)) / d^2` at ray parameter
@@ -95,7 +95,8 @@ fn spot_span(
     let g0 = atan((a - t0) / h);
     let w = (atan((b - t0) / h) - g0) / f32(panels);
     var sum = 0.0;
-    for (var k = 0u; k < panels; k++) {
+    // `k + 1u <= panels`: see `span_march` (scatter::epipolar).
+    for (var k = 0u; k + 1u <= panels; k++) {
         let mid = g0 + (f32(k) + 0.5) * w;
         for (var q = 0u; q < 4u; q++) {
             let u = tan(mid + 0.5 * w * GL4_X[q]);

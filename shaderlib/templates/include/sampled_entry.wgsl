@@ -239,14 +239,15 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // Sampling pass 3 (`sampling = lowres | epipolar`, scatter::sampling): the pixels the unwarp listed
 // in `fallback_pixels`, evaluated with the family's per-pixel body: invocation i of the N
-// takes entries i, i + N, ... (one invocation per 8 x 8 pixels: a fixed dispatch, no
-// indirect one; where nothing is listed each 8-lane batch runs the body once under an
-// empty mask). Dispatch: (ceil(ceil(W / 8) / 8), ceil(ceil(H / 8) / 8), 1) workgroups of
-// (8, 8, 1).
+// takes entries i, i + N, ... (one invocation per T x T pixels, T = {{ sampling.fallback_tile }}
+// (`scatter_shaderlib::sampling::FALLBACK_TILE`): a fixed dispatch, no indirect one; where
+// nothing is listed each 8-lane batch runs the body once under an empty mask, so the
+// dispatch is kept small). Dispatch: (ceil(ceil(W / T) / 8), ceil(ceil(H / T) / 8), 1)
+// workgroups of (8, 8, 1).
 @compute @workgroup_size(8, 8, 1)
 fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
-    let lanes = 8u * ((screen + 63u) / 64u);
+    let lanes = 8u * ((screen + {{ 8 * sampling.fallback_tile - 1 }}u) / {{ 8 * sampling.fallback_tile }}u);
     let n = min(fallback_count, screen.x * screen.y);
     for (var e = id.y * lanes.x + id.x; e < n; e += lanes.x * lanes.y) {
         let q = vec2<u32>(fallback_pixels[e] & 0xffffu, fallback_pixels[e] >> 16u);
