@@ -110,13 +110,6 @@ fn no_kernel_branches_on_uniforms_only() {
             (g.name.as_deref() == Some("frame")).then(|| format!("frame.{i}.0"))
         });
         for b in uniform_branches(&built.module, built.entry_point) {
-            // `depth_columns` loops over the rows up to `frame.sizes[1]`; lavapipe leaves it
-            // alone (a shader under 100 NIR values, `lvp_shader_init`: no shader-cache reads
-            // per frame under strace), and with the bound written `y + 1u <= n` the pass took
-            // 0.3 ms longer (1.8-2.2 ms against 1.5-1.9, stop 46).
-            if p.kernel() == Kernel::DepthColumns {
-                continue;
-            }
             let switch = proj.as_ref().is_some_and(|proj| b.reads == [proj.clone()])
                 && matches!(
                     p.kernel(),

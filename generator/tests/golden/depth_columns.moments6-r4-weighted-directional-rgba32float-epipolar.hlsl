@@ -281,30 +281,63 @@ void depth_columns(uint3 id : SV_DispatchThreadID)
         return;
     }
     float far_3 = f.theta.z;
+    uint rows = f.sizes.y;
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e29 = y;
-            y = (_e29 + 1u);
+            uint _e66 = y;
+            y = (_e66 + 4u);
         }
         loop_init_2 = false;
-        uint _e12 = y;
-        if ((_e12 < f.sizes.y)) {
+        uint _e14 = y;
+        if (((_e14 + 4u) <= rows)) {
         } else {
             break;
         }
         {
-            uint _e16 = y;
-            float4 _e20 = depth.Load(int3(uint2(x_5, _e16), int(0)));
-            float v_9 = _e20.x;
-            float _e23 = z;
-            z = max(_e23, min(max(v_9, 0.0), far_3));
+            uint _e18 = y;
+            float4 _e22 = depth.Load(int3(uint2(x_5, _e18), int(0)));
+            float a_3 = min(max(_e22.x, 0.0), far_3);
+            uint _e27 = y;
+            float4 _e33 = depth.Load(int3(uint2(x_5, (_e27 + 1u)), int(0)));
+            float b_3 = min(max(_e33.x, 0.0), far_3);
+            uint _e38 = y;
+            float4 _e44 = depth.Load(int3(uint2(x_5, (_e38 + 2u)), int(0)));
+            float c = min(max(_e44.x, 0.0), far_3);
+            uint _e49 = y;
+            float4 _e55 = depth.Load(int3(uint2(x_5, (_e49 + 3u)), int(0)));
+            float d_1 = min(max(_e55.x, 0.0), far_3);
+            float _e61 = z;
+            z = max(_e61, max(max(a_3, b_3), max(c, d_1)));
         }
     }
-    float _e33 = z;
-    column_depth.Store(x_5*4, asuint(_e33));
+    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
+    bool loop_init_3 = true;
+    while(true) {
+        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e85 = y;
+            y = (_e85 + 1u);
+        }
+        loop_init_3 = false;
+        uint _e69 = y;
+        if (((_e69 + 1u) <= rows)) {
+        } else {
+            break;
+        }
+        {
+            uint _e73 = y;
+            float4 _e77 = depth.Load(int3(uint2(x_5, _e73), int(0)));
+            float v_9 = _e77.x;
+            float _e79 = z;
+            z = max(_e79, min(max(v_9, 0.0), far_3));
+        }
+    }
+    float _e89 = z;
+    column_depth.Store(x_5*4, asuint(_e89));
     return;
 }

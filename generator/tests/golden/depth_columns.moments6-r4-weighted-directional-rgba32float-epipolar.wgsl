@@ -242,25 +242,53 @@ fn depth_columns(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let far_3 = f.theta.z;
+    let rows = f.sizes.y;
     loop {
-        let _e12 = y;
-        if (_e12 < f.sizes.y) {
+        let _e14 = y;
+        if ((_e14 + 4u) <= rows) {
         } else {
             break;
         }
         {
-            let _e16 = y;
-            let _e20 = textureLoad(depth, vec2<u32>(x_5, _e16), 0i);
-            let v_9 = _e20.x;
-            let _e23 = z;
-            z = max(_e23, min(max(v_9, 0f), far_3));
+            let _e18 = y;
+            let _e22 = textureLoad(depth, vec2<u32>(x_5, _e18), 0i);
+            let a_3 = min(max(_e22.x, 0f), far_3);
+            let _e27 = y;
+            let _e33 = textureLoad(depth, vec2<u32>(x_5, (_e27 + 1u)), 0i);
+            let b_3 = min(max(_e33.x, 0f), far_3);
+            let _e38 = y;
+            let _e44 = textureLoad(depth, vec2<u32>(x_5, (_e38 + 2u)), 0i);
+            let c = min(max(_e44.x, 0f), far_3);
+            let _e49 = y;
+            let _e55 = textureLoad(depth, vec2<u32>(x_5, (_e49 + 3u)), 0i);
+            let d_1 = min(max(_e55.x, 0f), far_3);
+            let _e61 = z;
+            z = max(_e61, max(max(a_3, b_3), max(c, d_1)));
         }
         continuing {
-            let _e29 = y;
-            y = (_e29 + 1u);
+            let _e66 = y;
+            y = (_e66 + 4u);
         }
     }
-    let _e33 = z;
-    column_depth[x_5] = _e33;
+    loop {
+        let _e69 = y;
+        if ((_e69 + 1u) <= rows) {
+        } else {
+            break;
+        }
+        {
+            let _e73 = y;
+            let _e77 = textureLoad(depth, vec2<u32>(x_5, _e73), 0i);
+            let v_9 = _e77.x;
+            let _e79 = z;
+            z = max(_e79, min(max(v_9, 0f), far_3));
+        }
+        continuing {
+            let _e85 = y;
+            y = (_e85 + 1u);
+        }
+    }
+    let _e89 = z;
+    column_depth[x_5] = _e89;
     return;
 }

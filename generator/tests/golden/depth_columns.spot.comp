@@ -247,29 +247,63 @@ void main() {
         return;
     }
     float far_3 = f.theta.z;
+    uint rows = f.sizes.y;
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e29 = y;
-            y = (_e29 + 1u);
+            uint _e66 = y;
+            y = (_e66 + 4u);
         }
         loop_init_2 = false;
-        uint _e12 = y;
-        if ((_e12 < f.sizes.y)) {
+        uint _e14 = y;
+        if (((_e14 + 4u) <= rows)) {
         } else {
             break;
         }
         {
-            uint _e16 = y;
-            int _e20_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
-            vec4 _e20 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_5, _e16)), ivec2(0), textureSize(_group_0_binding_1_cs, _e20_clamped_lod) - ivec2(1)), _e20_clamped_lod);
-            float v_9 = _e20.x;
-            float _e23 = z;
-            z = max(_e23, min(max(v_9, 0.0), far_3));
+            uint _e18 = y;
+            int _e22_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+            vec4 _e22 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_5, _e18)), ivec2(0), textureSize(_group_0_binding_1_cs, _e22_clamped_lod) - ivec2(1)), _e22_clamped_lod);
+            float a_3 = min(max(_e22.x, 0.0), far_3);
+            uint _e27 = y;
+            int _e33_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+            vec4 _e33 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_5, (_e27 + 1u))), ivec2(0), textureSize(_group_0_binding_1_cs, _e33_clamped_lod) - ivec2(1)), _e33_clamped_lod);
+            float b_3 = min(max(_e33.x, 0.0), far_3);
+            uint _e38 = y;
+            int _e44_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+            vec4 _e44 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_5, (_e38 + 2u))), ivec2(0), textureSize(_group_0_binding_1_cs, _e44_clamped_lod) - ivec2(1)), _e44_clamped_lod);
+            float c = min(max(_e44.x, 0.0), far_3);
+            uint _e49 = y;
+            int _e55_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+            vec4 _e55 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_5, (_e49 + 3u))), ivec2(0), textureSize(_group_0_binding_1_cs, _e55_clamped_lod) - ivec2(1)), _e55_clamped_lod);
+            float d_1 = min(max(_e55.x, 0.0), far_3);
+            float _e61 = z;
+            z = max(_e61, max(max(a_3, b_3), max(c, d_1)));
         }
     }
-    float _e33 = z;
-    _group_0_binding_2_cs[x_5] = _e33;
+    bool loop_init_3 = true;
+    while(true) {
+        if (!loop_init_3) {
+            uint _e85 = y;
+            y = (_e85 + 1u);
+        }
+        loop_init_3 = false;
+        uint _e69 = y;
+        if (((_e69 + 1u) <= rows)) {
+        } else {
+            break;
+        }
+        {
+            uint _e73 = y;
+            int _e77_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+            vec4 _e77 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(uvec2(x_5, _e73)), ivec2(0), textureSize(_group_0_binding_1_cs, _e77_clamped_lod) - ivec2(1)), _e77_clamped_lod);
+            float v_9 = _e77.x;
+            float _e79 = z;
+            z = max(_e79, min(max(v_9, 0.0), far_3));
+        }
+    }
+    float _e89 = z;
+    _group_0_binding_2_cs[x_5] = _e89;
     return;
 }
 

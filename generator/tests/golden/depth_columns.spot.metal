@@ -338,31 +338,68 @@ kernel void depth_columns(
         return;
     }
     float far_3 = f.theta.z;
+    uint rows = f.sizes.y;
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e29 = y;
-            y = _e29 + 1u;
+            uint _e66 = y;
+            y = _e66 + 4u;
         }
         loop_init_2 = false;
-        uint _e12 = y;
-        if (_e12 < f.sizes.y) {
+        uint _e14 = y;
+        if ((_e14 + 4u) <= rows) {
         } else {
             break;
         }
         {
-            uint _e16 = y;
-            uint clamped_lod_e20 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-            metal::float4 _e20 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, _e16)), metal::uint2(depth.get_width(clamped_lod_e20), depth.get_height(clamped_lod_e20)) - 1), clamped_lod_e20);
-            float v_9 = _e20.x;
-            float _e23 = z;
-            z = metal::max(_e23, metal::min(metal::max(v_9, 0.0), far_3));
+            uint _e18 = y;
+            uint clamped_lod_e22 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+            metal::float4 _e22 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, _e18)), metal::uint2(depth.get_width(clamped_lod_e22), depth.get_height(clamped_lod_e22)) - 1), clamped_lod_e22);
+            float a_3 = metal::min(metal::max(_e22.x, 0.0), far_3);
+            uint _e27 = y;
+            uint clamped_lod_e33 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+            metal::float4 _e33 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, _e27 + 1u)), metal::uint2(depth.get_width(clamped_lod_e33), depth.get_height(clamped_lod_e33)) - 1), clamped_lod_e33);
+            float b_3 = metal::min(metal::max(_e33.x, 0.0), far_3);
+            uint _e38 = y;
+            uint clamped_lod_e44 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+            metal::float4 _e44 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, _e38 + 2u)), metal::uint2(depth.get_width(clamped_lod_e44), depth.get_height(clamped_lod_e44)) - 1), clamped_lod_e44);
+            float c = metal::min(metal::max(_e44.x, 0.0), far_3);
+            uint _e49 = y;
+            uint clamped_lod_e55 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+            metal::float4 _e55 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, _e49 + 3u)), metal::uint2(depth.get_width(clamped_lod_e55), depth.get_height(clamped_lod_e55)) - 1), clamped_lod_e55);
+            float d_1 = metal::min(metal::max(_e55.x, 0.0), far_3);
+            float _e61 = z;
+            z = metal::max(_e61, metal::max(metal::max(a_3, b_3), metal::max(c, d_1)));
         }
     }
-    float _e33 = z;
-    column_depth[metal::min(unsigned(x_5), (_buffer_sizes.size2 - 0 - 4) / 4)] = _e33;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
+    while(true) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e85 = y;
+            y = _e85 + 1u;
+        }
+        loop_init_3 = false;
+        uint _e69 = y;
+        if ((_e69 + 1u) <= rows) {
+        } else {
+            break;
+        }
+        {
+            uint _e73 = y;
+            uint clamped_lod_e77 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+            metal::float4 _e77 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, _e73)), metal::uint2(depth.get_width(clamped_lod_e77), depth.get_height(clamped_lod_e77)) - 1), clamped_lod_e77);
+            float v_9 = _e77.x;
+            float _e79 = z;
+            z = metal::max(_e79, metal::min(metal::max(v_9, 0.0), far_3));
+        }
+    }
+    float _e89 = z;
+    column_depth[metal::min(unsigned(x_5), (_buffer_sizes.size2 - 0 - 4) / 4)] = _e89;
     return;
 }
