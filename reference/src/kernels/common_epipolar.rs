@@ -159,6 +159,19 @@ pub fn epipole_march(f: &FrameUniforms, sm: &Tex, eye: Vec3, dir: Vec3, s: f32, 
     }
 }
 
+/// Whether the pixel centred at `pc` lies in the epipole's or the anti-epipole's disc (radius
+/// `epipole.w`), where the rectification degenerates and the families march instead
+/// (`in_epipole_disc`).
+pub fn in_epipole_disc(f: &FrameUniforms, pc: [f32; 2]) -> bool {
+    let px = Vec3::new(pc[0], pc[1], 0.0);
+    let radius = f.epipole[3];
+    let near_epi =
+        f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
+    let near_anti = f.anti_epipole[2] > 0.5
+        && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
+    near_epi || near_anti
+}
+
 /// Row of the `slices` table for row coordinate `j` (a whole number): wrapped around when
 /// the slices cover the full circle, else clamped.
 pub fn row_index(j: f32, rows: u32, wrap: bool) -> u32 {

@@ -11,7 +11,8 @@
 
 use super::common_cookie::{epipole_march_cookie, lit_span_cookie};
 use super::common_epipolar::{
-    epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta, row_index,
+    epipole_march, in_epipole_disc, normalised_depth, pixel_dir, ray_column, ray_row_coord,
+    ray_theta, row_index,
 };
 use super::common_minmax::{level_offset, tree_levels};
 use super::common_model::{max, min, phase_hg};
@@ -86,13 +87,7 @@ pub fn pixel_ray(id: [u32; 3], spot: bool, inp: &TraverseInputs) -> Option<Pixel
     let color = xyz(f.light_color);
 
     // Near the epipole and the anti-epipole the rectification degenerates: march instead.
-    let px = Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 0.0);
-    let radius = f.epipole[3];
-    let near_epi =
-        f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
-    let near_anti = f.anti_epipole[2] > 0.5
-        && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
-    if near_epi || near_anti {
+    if in_epipole_disc(f, [x as f32 + 0.5, y as f32 + 0.5]) {
         let l = match inp.cookie {
             Some(cookie) => epipole_march_cookie(f, inp.shadow_map, cookie, eye, dir, s) * color,
             None => epipole_march(f, inp.shadow_map, eye, dir, s, spot) * color,

@@ -14,8 +14,8 @@
 
 use super::common_cookie::{epipole_march_cookie, frame_cookie, lit_span_cookie};
 use super::common_epipolar::{
-    edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta,
-    row_index, row_phi, slice_e,
+    edge_t, epipole_march, in_epipole_disc, lit_span, normalised_depth, ray_column, ray_row_coord,
+    ray_theta, row_index, row_phi, slice_e,
 };
 use super::common_model::{clamp, cone_falloff, max, min, phase_hg, select, transmittance_between};
 use super::common_sampling::{
@@ -181,13 +181,7 @@ pub fn pst_ray(inp: &PstInputs, spot: bool, pc: [f32; 2], z: f32, tint: Option<T
         d: 0.0,
         xs_num: 0.0,
     };
-    let px = Vec3::new(pc[0], pc[1], 0.0);
-    let radius = f.epipole[3];
-    let near_epi =
-        f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
-    let near_anti = f.anti_epipole[2] > 0.5
-        && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
-    if near_epi || near_anti {
+    if in_epipole_disc(f, [pc[0], pc[1]]) {
         r.marched = true;
         r.color = match tint {
             Some(t) => epipole_march_cookie(f, inp.shadow_map, t.cookie, eye, dir, s),

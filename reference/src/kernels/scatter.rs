@@ -21,8 +21,8 @@
 
 use super::common_cookie::{epipole_march_cookie, spot_segment_cookie};
 use super::common_epipolar::{
-    epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_t, row_index,
-    spot_segment,
+    epipole_march, in_epipole_disc, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_t,
+    row_index, spot_segment,
 };
 use super::common_model::{PI, clamp, max, max_u, min, phase_hg, transmittance_between};
 use super::common_moments::{lit_moments4, lit_moments6, moment_z};
@@ -76,16 +76,10 @@ pub fn scatter_main(
     let color = xyz(f.light_color);
 
     // Near the epipole and the anti-epipole the rectification degenerates: march instead.
-    let px = Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 0.0);
-    let radius = f.epipole[3];
-    let near_epi =
-        f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
-    let near_anti = f.anti_epipole[2] > 0.5
-        && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
     let tinted = variant.cookie;
     let white = TexArray::white();
     let cookie = inp.cookie.unwrap_or(&white);
-    if near_epi || near_anti {
+    if in_epipole_disc(f, [x as f32 + 0.5, y as f32 + 0.5]) {
         let l = if tinted {
             epipole_march_cookie(f, inp.shadow_map, cookie, eye, dir, s) * color
         } else {

@@ -11,8 +11,8 @@
 
 use super::common_cookie::{epipole_march_cookie, span_march_cookie, spot_segment_cookie};
 use super::common_epipolar::{
-    edge_t, epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_theta,
-    row_index, span_march, spot_segment,
+    edge_t, epipole_march, in_epipole_disc, normalised_depth, pixel_dir, ray_column, ray_row_coord,
+    ray_theta, row_index, span_march, spot_segment,
 };
 use super::common_model::{max, max_u, min, phase_hg, transmittance_between};
 use super::common_sampling::{
@@ -124,17 +124,6 @@ pub fn row_span(
     }
 }
 
-/// Whether pixel `(x, y)` lies in the epipole's or the anti-epipole's marched disc.
-pub fn in_epipole_disc(f: &FrameUniforms, x: u32, y: u32) -> bool {
-    let px = Vec3::new(x as f32 + 0.5, y as f32 + 0.5, 0.0);
-    let radius = f.epipole[3];
-    let near_epi =
-        f.epipole[2] > 0.5 && (px - Vec3::new(f.epipole[0], f.epipole[1], 0.0)).length() < radius;
-    let near_anti = f.anti_epipole[2] > 0.5
-        && (px - Vec3::new(f.anti_epipole[0], f.anti_epipole[1], 0.0)).length() < radius;
-    near_epi || near_anti
-}
-
 /// The surface distance of pixel `(x, y)` along `dir`: depth clamped to `[0, far]` (engines
 /// with an infinite far plane write +inf on sky pixels).
 pub fn surface_distance(f: &FrameUniforms, depth: &Tex, x: u32, y: u32, dir: Vec3) -> f32 {
@@ -148,7 +137,7 @@ pub fn pixel_span(inp: &MarchInputs, pad: u32, x: u32, y: u32, spot: bool) -> Op
     let eye = xyz(f.eye);
     let dir = pixel_dir(f, x, y);
     let s = surface_distance(f, inp.depth, x, y, dir);
-    if in_epipole_disc(f, x, y) {
+    if in_epipole_disc(f, [x as f32 + 0.5, y as f32 + 0.5]) {
         return None;
     }
     // The ray's depth and the two rows whose slices bracket it (row r's centre is r + 0.5).

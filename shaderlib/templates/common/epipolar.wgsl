@@ -210,7 +210,7 @@ fn epipole_march(f: Frame, sm: texture_2d<f32>, eye: vec3<f32>, dir: vec3<f32>, 
 
 // Whether the pixel centred at `pc` lies in the epipole's or the anti-epipole's disc (radius
 // `epipole.w`, where the rectification degenerates and the families march instead; mirrors
-// `in_epipole_disc` of reference/src/kernels/volume_march.rs). `&`, not `&&`: naga writes a
+// `in_epipole_disc` of reference/src/kernels/common_epipolar.rs). `&`, not `&&`: naga writes a
 // short-circuit as a branch, here on a uniform, and lavapipe re-specialises a shader branching
 // on uniforms at every dispatch (`scatter_shaderlib::uniform_branches`).
 fn in_epipole_disc(f: Frame, pc: vec2<f32>) -> bool {
