@@ -40,6 +40,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{DMat4, DVec3, DVec4};
 use std::f64::consts::PI;
 
+use crate::sampling::Sampling;
 use crate::variant::{LightKind, PrefilteredVariant, Rectification};
 
 pub use crate::scene::{
@@ -76,6 +77,13 @@ pub struct FrameSettings {
     /// resampling. Rows are uniform in `tan` of the slice angle, so at the fan's edge the
     /// slices are `cos^2(half-angle)` times as dense as in the middle.
     pub projective_max_half_angle_deg: f64,
+    /// Where an epipolar frame's rectified rows lie. `None` (the default): on the epipolar
+    /// sampling's slices for variants with `sampling = epipolar` (a sample on slice s reads
+    /// row s, whose light rays lie in its own plane; `FrameUniforms::fan_angles`), uniform in
+    /// the angle around the light axis otherwise. `Some(true)` aligns them for any variant
+    /// (a per-pixel run whose rows are a sampled run's: the sampling trials compare the two),
+    /// `Some(false)` never.
+    pub aligned_rows: Option<bool>,
 }
 
 impl Default for FrameSettings {
@@ -95,6 +103,7 @@ impl FrameSettings {
             march_steps: 128,
             spot_quadrature: 32,
             projective_max_half_angle_deg: 60.0,
+            aligned_rows: None,
         }
     }
 }
@@ -158,6 +167,16 @@ pub struct FrameUniforms {
     pub proj_g1: [f32; 4],
     /// `G_8`; yzw unused.
     pub proj_g2: [f32; 4],
+    /// Rows aligned with the epipolar sampling's slices (`fan_angles.z = 1`, variants with
+    /// `sampling = epipolar` and epipolar rectification): the slices' origin on screen (the
+    /// epipole, or a point far along its direction when it lies near infinity; pixels,
+    /// centres at + 0.5) in xy, the unit screen direction of angle 0 in zw
+    /// (`scatter::sampling::epipolar_layout`). Zero otherwise.
+    pub fan_origin: [f32; 4],
+    /// Aligned rows: x = the screen angle where row 0 starts, y = the screen angle per row
+    /// (rows uniform in the angle around `fan_origin`, as the slices are), z = 1; all zero
+    /// for rows uniform in the angle around the light axis (`e1.w`, `e2.w`).
+    pub fan_angles: [f32; 4],
 }
 
 /// Per-slice parameters (WGSL `array<vec4<f32>>`): `delta` (world units or radians per
@@ -180,7 +199,8 @@ pub struct SliceParams {
 }
 
 const _: () = {
-    assert!(size_of::<FrameUniforms>() == 25 * 16);
+    assert!(size_of::<FrameUniforms>() == 27 * 16);
+    assert!(std::mem::offset_of!(FrameUniforms, fan_origin) == 25 * 16);
     assert!(std::mem::offset_of!(FrameUniforms, proj) == 21 * 16);
     assert!(std::mem::offset_of!(FrameUniforms, proj_g2) == 24 * 16);
     assert!(std::mem::offset_of!(FrameUniforms, theta) == 7 * 16);
@@ -295,6 +315,38 @@ fn wrap(a: f64) -> f64 {
     a
 }
 
+/// The epipolar sampling's fan of slices on screen ([`Setup::fan`]; WGSL `EpipolarLayout`).
+struct Fan {
+    origin: (f64, f64),
+    axis: (f64, f64),
+    start: f64,
+    step: f64,
+    wrap: bool,
+}
+
+/// `scatter::sampling::EPIPOLE_FAR`: the farthest the fan's origin lies from the screen
+/// centre, in screens.
+const FAN_EPIPOLE_FAR: f64 = 100.0;
+
+/// Angle of `d` from `axis` (counter-clockwise towards (-axis.y, axis.x)).
+fn fan_angle(axis: (f64, f64), d: (f64, f64)) -> f64 {
+    (axis.0 * d.1 - axis.1 * d.0).atan2(axis.0 * d.0 + axis.1 * d.1)
+}
+
+/// Distance from `origin` along `u` of the midpoint of the line's part inside the rectangle
+/// of pixel centres of a `w` x `h` screen (its nearest point when it misses the rectangle).
+fn fan_line_mid(origin: (f64, f64), u: (f64, f64), w: f64, h: f64) -> f64 {
+    let (mut t_in, mut t_out) = (0.0f64, f64::INFINITY);
+    for (ua, oa, lo, hi) in [(u.0, origin.0, 0.5, w - 0.5), (u.1, origin.1, 0.5, h - 0.5)] {
+        if ua.abs() > 1e-12 {
+            let (ta, tb) = ((lo - oa) / ua, (hi - oa) / ua);
+            t_in = t_in.max(ta.min(tb));
+            t_out = t_out.min(ta.max(tb));
+        }
+    }
+    0.5 * (t_in + t_out.max(t_in))
+}
+
 struct Setup {
     cam: CameraDesc,
     aspect: f64,
@@ -337,6 +389,69 @@ impl Setup {
 
     fn phi(&self, d: DVec3) -> f64 {
         d.dot(self.e2).atan2(d.dot(self.e1))
+    }
+
+    /// The epipolar sampling's fan of `rows` slices towards the light direction `toward`
+    /// (`scatter::sampling::epipolar_layout` in f64: the same origin, axis, range and wrap).
+    fn fan(&self, toward: DVec3, rows: usize) -> Fan {
+        let (w, h) = (self.width, self.height);
+        let centre = (0.5 * w, 0.5 * h);
+        let t = self.cam.tan_half_fov_y;
+        let z = toward.dot(self.cam.forward);
+        let q = (
+            toward.dot(self.cam.right) * centre.0 / (t * self.aspect),
+            -toward.dot(self.cam.up) * centre.1 / t,
+        );
+        let far = FAN_EPIPOLE_FAR * w.max(h);
+        let lq = q.0.hypot(q.1);
+        let origin = if lq >= far * z.abs() {
+            let k = far / lq.max(1e-30) * if z < 0.0 { -1.0 } else { 1.0 };
+            (centre.0 + q.0 * k, centre.1 + q.1 * k)
+        } else if lq > 0.0 {
+            (centre.0 + q.0 / z, centre.1 + q.1 / z)
+        } else {
+            centre
+        };
+        let to_centre = (centre.0 - origin.0, centre.1 - origin.1);
+        let lc = to_centre.0.hypot(to_centre.1);
+        let axis = if lc > 0.0 {
+            (to_centre.0 / lc, to_centre.1 / lc)
+        } else {
+            (1.0, 0.0)
+        };
+        let (lo, hi) = ((0.5, 0.5), (w - 0.5, h - 0.5));
+        let wrap = origin.0 >= lo.0 && origin.0 <= hi.0 && origin.1 >= lo.1 && origin.1 <= hi.1;
+        let (start, range) = if wrap {
+            (-PI, 2.0 * PI)
+        } else {
+            let angles = [(lo.0, lo.1), (hi.0, lo.1), (lo.0, hi.1), (hi.0, hi.1)]
+                .map(|c| fan_angle(axis, (c.0 - origin.0, c.1 - origin.1)));
+            let a = angles.into_iter().fold(f64::INFINITY, f64::min);
+            let b = angles.into_iter().fold(f64::NEG_INFINITY, f64::max);
+            (a, b - a)
+        };
+        Fan {
+            origin,
+            axis,
+            start,
+            step: range / rows as f64,
+            wrap,
+        }
+    }
+
+    /// The slice angle around the light axis of row `row` of the fan: that of the view ray
+    /// through the midpoint of its screen line inside the rectangle of pixel centres (any
+    /// point of the line would do when the origin is the epipole; the midpoint keeps a
+    /// near-infinite epipole, whose origin is clamped, on the slice's own plane).
+    fn fan_phi(&self, f: &Fan, row: usize) -> f64 {
+        let (ox, oy) = f.origin;
+        let a = f.start + (row as f64 + 0.5) * f.step;
+        let u = (
+            f.axis.0 * a.cos() - f.axis.1 * a.sin(),
+            f.axis.1 * a.cos() + f.axis.0 * a.sin(),
+        );
+        let mid = fan_line_mid(f.origin, u, self.width, self.height);
+        self.phi(self.dir(ox + u.0 * mid, oy + u.1 * mid))
     }
 
     fn slice_dir(&self, phi: f64, theta: f64) -> DVec3 {
@@ -587,6 +702,14 @@ fn prepare_frame_unchecked(
     let rows = res.rectified[1] as usize;
     let cols = f64::from(res.rectified[0]);
     let dphi = phi_range / rows as f64;
+    // Rows aligned with the epipolar sampling's slices: row j on the plane of the screen
+    // slice at angle `fan.start + (j + 0.5) fan.step` around the layout's origin.
+    let aligned = settings
+        .aligned_rows
+        .unwrap_or(variant.sampling == Sampling::Epipolar);
+    let fan =
+        (aligned && variant.rectification == Rectification::Epipolar).then(|| s.fan(axis, rows));
+    let full_circle = fan.as_ref().map_or(full_circle, |f| f.wrap);
 
     // The largest gap between neighbouring slices on the screen border (where they are
     // farthest apart): the image distance between a border point and the point at the same
@@ -606,7 +729,10 @@ fn prepare_frame_unchecked(
     let mut fallback_delta: f64 = 0.0;
     let mut missing = Vec::new();
     for j in 0..rows {
-        let phi = phi0 + (j as f64 + 0.5) * dphi;
+        let phi = match &fan {
+            Some(f) => s.fan_phi(f, j),
+            None => phi0 + (j as f64 + 0.5) * dphi,
+        };
         let range = s.slice_theta_range(phi);
         let (lo, hi) = match range {
             Some(r) => r,
@@ -711,6 +837,17 @@ fn prepare_frame_unchecked(
         proj_g0: [0.0; 4],
         proj_g1: [0.0; 4],
         proj_g2: [0.0; 4],
+        fan_origin: fan.as_ref().map_or([0.0; 4], |f| {
+            [
+                f.origin.0 as f32,
+                f.origin.1 as f32,
+                f.axis.0 as f32,
+                f.axis.1 as f32,
+            ]
+        }),
+        fan_angles: fan
+            .as_ref()
+            .map_or([0.0; 4], |f| [f.start as f32, f.step as f32, 1.0, 0.0]),
     };
     let half_fan = if full_circle { PI } else { 0.5 * phi_range };
     let fallback = if variant.rectification != Rectification::Projective {

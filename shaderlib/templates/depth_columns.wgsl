@@ -10,7 +10,7 @@
 // Bindings (group 0):
 // | binding | name         | type                                   | access      |
 // |---------|--------------|----------------------------------------|-------------|
-// | 0       | frame        | var<uniform> Frame (400 bytes)         | uniform     |
+// | 0       | frame        | var<uniform> Frame (432 bytes)         | uniform     |
 // | 1       | depth        | texture_2d<f32> (r32float, view depth) | textureLoad |
 // | 2       | column_depth | var<storage, read_write> array<f32>    | write       |
 // column_depth: one f32 per screen column (frame.sizes.x).

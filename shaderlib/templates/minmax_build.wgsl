@@ -16,7 +16,7 @@
 // Bindings (group 0):
 // | binding | name      | type                                    | access       |
 // |---------|-----------|-----------------------------------------|--------------|
-// | 0       | frame     | var<uniform> Frame (400 bytes)          | uniform      |
+// | 0       | frame     | var<uniform> Frame (432 bytes)          | uniform      |
 // | 1       | rectified | texture_2d<f32> (r32float, `rectify`'s) | textureLoad  |
 // | 2       | tree      | texture_storage_2d<rg32float, write>    | textureStore |
 // tree: tree_width(Wr) x Hr, Wr x Hr = the rectified size (frame.sizes.zw).

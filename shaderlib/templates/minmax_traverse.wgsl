@@ -11,7 +11,7 @@
 // Bindings (group 0):
 // | binding | name       | type                                   | access       |
 // |---------|------------|----------------------------------------|--------------|
-// | 0       | frame      | var<uniform> Frame (400 bytes)         | uniform      |
+// | 0       | frame      | var<uniform> Frame (432 bytes)         | uniform      |
 // | 1       | slices     | var<storage, read> array<vec4<f32>>    | read         |
 // | 2       | depth      | texture_2d<f32> (r32float, view depth) | textureLoad  |
 // | 3       | shadow_map | texture_2d<f32> (r32float)             | textureLoad  |

@@ -43,7 +43,7 @@
 // Bindings (group 0):
 // | binding | name      | type                                            | access       |
 // |---------|-----------|-------------------------------------------------|--------------|
-// | 0       | frame     | var<uniform> Frame (400 bytes)                  | uniform      |
+// | 0       | frame     | var<uniform> Frame (432 bytes)                  | uniform      |
 // | 1       | slices    | var<storage, read> array<vec4<f32>>             | read         |
 // | 2       | rectified | texture_2d<f32> (r32float)                      | textureLoad  |
 // | 3       | filtered  | var<storage, read_write> array<{{ filtered_word }}> | write  |
@@ -59,7 +59,7 @@
 //
 // Mirrors reference/src/kernels/prefilter.rs
 
-#import scatter::epipolar::{Frame, {% if cookie %}SliceParams, row_phi, slice_e, {% endif %}slice_params}
+#import scatter::epipolar::{Frame, {% if cookie %}SliceParams, {% endif %}row_phi, slice_e, slice_params}
 {%- if moments %}
 #import scatter::prefiltered::{region_start, texel_weight}
 #import scatter::moments::{moment_layer, moment_z}
@@ -138,6 +138,8 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     let layers_per_thread = BASES_PER_THREAD / 4u;
 {%- endif %}
     let slice = slice_params(slices[row]);
+    // The row's slice direction (the spot weights' light rays, the cookie's).
+    let e = slice_e(frame, row_phi(frame, row));
     let start = region_start(region, REGIONS, width, spot);
     let end = region_start(region + 1u, REGIONS, width, spot);
 {%- if cookie %}
@@ -145,7 +147,6 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var acc: array<vec4<f32>, {{ acc_layers }}>;
     // The region's running mean of the cookie (thread 0 stores it).
     var tint_mean = vec3<f32>(0.0);
-    let e = slice_e(frame, row_phi(frame, row));
 {%- if !projective %}
     let proj = false;
 {%- endif %}
@@ -163,11 +164,11 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             d = proj_stored_depth(d);
             w = proj_texel_weight(frame, slice, i, region, REGIONS, weighted, spot);
         } else {
-            w = texel_weight(frame, slice, row, i, weighted, spot);
+            w = texel_weight(frame, slice, e, i, weighted, spot);
         }
 {%- else %}
         let d = textureLoad(rectified, vec2<u32>(i, row), 0).x;
-        let w = texel_weight(frame, slice, row, i, weighted, spot);
+        let w = texel_weight(frame, slice, e, i, weighted, spot);
 {%- endif %}
         wsum += w;
         if thread == 0u {

@@ -10,7 +10,7 @@
 // Bindings (group 0):
 // | binding | name       | type                                     | access       |
 // |---------|------------|------------------------------------------|--------------|
-// | 0       | frame      | var<uniform> Frame (336 bytes)           | uniform      |
+// | 0       | frame      | var<uniform> Frame (432 bytes)           | uniform      |
 // | 1       | slices     | var<storage, read> array<vec4<f32>>      | read         |
 // | 2       | shadow_map | texture_2d<f32> (r32float)               | textureLoad  |
 // | 3       | rectified  | texture_storage_2d<r32float, write>      | textureStore |

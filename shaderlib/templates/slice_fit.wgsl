@@ -21,7 +21,7 @@
 // Bindings (group 0):
 // | binding | name   | type                                   | access      |
 // |---------|--------|----------------------------------------|-------------|
-// | 0       | frame  | var<uniform> Frame (400 bytes)         | uniform     |
+// | 0       | frame  | var<uniform> Frame (432 bytes)         | uniform     |
 // | 1       | slices | var<storage, read_write> array<vec4<f32>> | read_write |
 // | 2       | column_depth | var<storage, read> array<f32>     | read        |
 // slices: one vec4 per rectified row (x = delta, y = theta_ref, z = theta_lo, w = theta_hi);

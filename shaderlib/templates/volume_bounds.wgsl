@@ -18,7 +18,7 @@
 // Bindings (group 0):
 // | binding | name      | type                                        | access      |
 // |---------|-----------|---------------------------------------------|-------------|
-// | 0       | frame     | var<uniform> Frame (400 bytes)              | uniform     |
+// | 0       | frame     | var<uniform> Frame (432 bytes)              | uniform     |
 // | 1       | rectified | texture_2d<f32> (r32float, `rectify`'s)     | textureLoad |
 // | 2       | crossings | var<storage, read_write> array<atomic<u32>> | atomics     |
 // crossings: 2 B Hr u32, bin (row, k) at 2 (row * B + k): the first edge, then the last; first

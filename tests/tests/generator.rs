@@ -166,6 +166,8 @@ fn manifest_frame_layout_matches_the_host_struct() {
         ("proj_g0_", offset_of!(FrameUniforms, proj_g0)),
         ("proj_g1_", offset_of!(FrameUniforms, proj_g1)),
         ("proj_g2_", offset_of!(FrameUniforms, proj_g2)),
+        ("fan_origin", offset_of!(FrameUniforms, fan_origin)),
+        ("fan_angles", offset_of!(FrameUniforms, fan_angles)),
     ];
     let fields = get(frame, "fields").as_array().cloned().unwrap_or_default();
     assert_eq!(fields.len(), host.len(), "{fields:?}");

@@ -331,7 +331,7 @@ fn lowered_device_limits_are_named() {
 
     // A device whose buffers are smaller than its bindings (the slice table, a readback
     // buffer of 8x8 rgba16float, rows padded to 256 bytes: 2048 bytes) and whose uniform
-    // bindings are smaller than the uniform blocks (400 bytes of `Frame`, 240 of `RaymarchFrame`).
+    // bindings are smaller than the uniform blocks (432 bytes of `Frame`, 240 of `RaymarchFrame`).
     let ctx = lowered(shared, |l| {
         l.max_buffer_size = 1024;
         l.max_uniform_buffer_binding_size = 128;
@@ -341,14 +341,14 @@ fn lowered_device_limits_are_named() {
         "scatter_uniform_block",
         Prefiltered::new(ctx, &v16, res([64, 36], [64, 16]), 64),
         "max_uniform_buffer_binding_size",
-        400,
+        432,
         128,
     );
     assert_limit(
         "minmax_uniform_block",
         Minmax::new(ctx, &MinmaxVariant::default(), res([64, 36], [64, 16]), 64),
         "max_uniform_buffer_binding_size",
-        400,
+        432,
         128,
     );
     assert_limit(

@@ -207,7 +207,12 @@ fn epipolar_stage_trial(
 ) -> Result<(), String> {
     let f = fixture(base.light(), pose);
     let sampled = base.with_sampling(knobs);
-    let settings = FrameSettings::for_screen(SCREEN[0], SCREEN[1]);
+    // The per-pixel run with the sampled run's rows (on the slices: `aligned_rows`), so
+    // that its pixels are the sampled run's body.
+    let settings = FrameSettings {
+        aligned_rows: Some(true),
+        ..FrameSettings::for_screen(SCREEN[0], SCREEN[1])
+    };
     let frame = CpuFrame {
         scene: &f.scene,
         bvh: &f.bvh,
@@ -340,7 +345,12 @@ fn stage_trial(
 ) -> Result<(), String> {
     let f = fixture(base.light(), pose);
     let sampled = base.with_sampling(knobs);
-    let settings = FrameSettings::for_screen(SCREEN[0], SCREEN[1]);
+    // The per-pixel run with the sampled run's rows (on the slices: `aligned_rows`), so
+    // that its pixels are the sampled run's body.
+    let settings = FrameSettings {
+        aligned_rows: Some(true),
+        ..FrameSettings::for_screen(SCREEN[0], SCREEN[1])
+    };
     let frame = CpuFrame {
         scene: &f.scene,
         bvh: &f.bvh,

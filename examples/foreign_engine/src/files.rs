@@ -495,6 +495,7 @@ impl FrameFile {
                 march_steps: s.march_steps,
                 spot_quadrature: s.spot_quadrature,
                 projective_max_half_angle_deg: s.projective_max_half_angle_deg,
+                aligned_rows: None,
             },
             None => FrameSettings::for_screen(self.screen[0], self.screen[1]),
         };

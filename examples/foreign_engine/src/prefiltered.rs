@@ -82,7 +82,7 @@ pub struct Output {
 
 /// Host field names and offsets of [`FrameUniforms`], in the manifest's spelling (naga
 /// appends `_` to names ending in a digit).
-const HOST_FIELDS: [(&str, usize); 25] = [
+const HOST_FIELDS: [(&str, usize); 27] = [
     ("eye", offset_of!(FrameUniforms, eye)),
     ("axis", offset_of!(FrameUniforms, axis)),
     ("e1_", offset_of!(FrameUniforms, e1)),
@@ -108,6 +108,8 @@ const HOST_FIELDS: [(&str, usize); 25] = [
     ("proj_g0_", offset_of!(FrameUniforms, proj_g0)),
     ("proj_g1_", offset_of!(FrameUniforms, proj_g1)),
     ("proj_g2_", offset_of!(FrameUniforms, proj_g2)),
+    ("fan_origin", offset_of!(FrameUniforms, fan_origin)),
+    ("fan_angles", offset_of!(FrameUniforms, fan_angles)),
 ];
 
 /// Checks that the struct the manifest's `frame` bindings hold has exactly the fields,

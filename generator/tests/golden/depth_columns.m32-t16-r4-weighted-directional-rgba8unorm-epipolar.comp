@@ -45,6 +45,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 proj_g0_;
     vec4 proj_g1_;
     vec4 proj_g2_;
+    vec4 fan_origin;
+    vec4 fan_angles;
 };
 const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;

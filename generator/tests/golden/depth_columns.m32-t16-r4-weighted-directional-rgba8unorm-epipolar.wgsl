@@ -42,6 +42,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     proj_g0_: vec4<f32>,
     proj_g1_: vec4<f32>,
     proj_g2_: vec4<f32>,
+    fan_origin: vec4<f32>,
+    fan_angles: vec4<f32>,
 }
 
 const NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX: f32 = 1000000000000000000000000000000f;

@@ -42,6 +42,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float4 proj_g0_;
     float4 proj_g1_;
     float4 proj_g2_;
+    float4 fan_origin;
+    float4 fan_angles;
 };
 
 static const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;

@@ -50,6 +50,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 proj_g0_;
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
+    metal::float4 fan_origin;
+    metal::float4 fan_angles;
 };
 typedef float type_9[1];
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;

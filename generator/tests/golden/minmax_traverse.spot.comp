@@ -45,6 +45,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 proj_g0_;
     vec4 proj_g1_;
     vec4 proj_g2_;
+    vec4 fan_origin;
+    vec4 fan_angles;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
@@ -357,23 +359,35 @@ float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod
     return atan(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_7) {
-    uint rows_1 = f_8.sizes.w;
-    float phi = atan(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
-    float yc = ((phi - f_8.e1_.w) / f_8.e2_.w);
-    return ((f_8.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8) {
+    return vec2(float(f_8.sizes.x), float(f_8.sizes.y));
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 dir_7) {
+    uint rows_1 = f_9.sizes.w;
+    float phi = atan(dot(dir_7, f_9.e2_.xyz), dot(dir_7, f_9.e1_.xyz));
+    float z_4 = dot(dir_7, f_9.cam_forward.xyz);
+    float t_5 = f_9.cam_forward.w;
+    vec2 ndc = vec2((dot(dir_7, f_9.cam_right.xyz) / ((z_4 * t_5) * f_9.cam_right.w)), (dot(dir_7, f_9.cam_up.xyz) / (z_4 * t_5)));
+    vec2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    vec2 p_3 = (vec2(((ndc.x + 1.0) * 0.5), ((1.0 - ndc.y) * 0.5)) * _e41);
+    vec2 d_1 = (p_3 - f_9.fan_origin.xy);
+    vec2 ax = f_9.fan_origin.zw;
+    float fan = ((atan(((ax.x * d_1.y) - (ax.y * d_1.x)), ((ax.x * d_1.x) + (ax.y * d_1.y))) - f_9.fan_angles.x) / f_9.fan_angles.y);
+    float yc = ((f_9.fan_angles.z > 0.5) ? fan : ((phi - f_9.e1_.w) / f_9.e2_.w));
+    return ((f_9.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
     if (spot_3) {
-        vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
-        vec3 to_eye = -(f_9.axis.xyz);
+        vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_10.light_pos.xyz);
+        vec3 to_eye = -(f_10.axis.xyz);
         return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float x_2, float delta, float theta_2, float s_2, bool spot_4) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float x_2, float delta, float theta_2, float s_2, bool spot_4) {
     bool local_1 = false;
     if (spot_4) {
         float psi = (x_2 * delta);
@@ -387,31 +401,31 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_10.axis.w * sin(psi)) / den), s_2);
+        return min(((f_11.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, float(x_3), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, float(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_13.light_pos.xyz, f_13.light_dir.xyz, f_13.light_pos.w, f_13.light_dir.w, f_13.medium);
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_10, a_5, b_5, max((f_14.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -474,31 +488,31 @@ vec3 minmax_traverse_pixel(uint x_4, uint y_1) {
     bool lit = false;
     bool local_4 = false;
     float l_1 = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = _group_0_binding_0_cs;
-    vec3 eye_9 = f_14.eye.xyz;
-    vec3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_4, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = _group_0_binding_0_cs;
+    vec3 eye_9 = f_15.eye.xyz;
+    vec3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, x_4, y_1);
     int _e13_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e13 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_4, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e13_clamped_lod) - ivec2(1)), _e13_clamped_lod);
-    float s_4 = (min(max(_e13.x, 0.0), f_14.theta.z) / max(dot(_e9, f_14.cam_forward.xyz), 1e-6));
-    vec3 color = f_14.light_color.xyz;
-    bool _e35 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, vec2((float(x_4) + 0.5), (float(y_1) + 0.5)));
+    float s_4 = (min(max(_e13.x, 0.0), f_15.theta.z) / max(dot(_e9, f_15.cam_forward.xyz), 1e-6));
+    vec3 color = f_15.light_color.xyz;
+    bool _e35 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, vec2((float(x_4) + 0.5), (float(y_1) + 0.5)));
     if (_e35) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = _group_0_binding_0_cs;
         float _e40 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, _group_0_binding_3_cs, eye_9, _e9, s_4, true);
         vec3 l_2 = (_e40 * color);
         return l_2;
     }
-    uint rows_2 = f_14.sizes.w;
-    uint width_3 = f_14.sizes.z;
-    bool wrap_1 = (f_14.anti_epipole.w > 0.5);
-    float _e50 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e9);
-    float _e51 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e9);
+    uint rows_2 = f_15.sizes.w;
+    uint width_3 = f_15.sizes.z;
+    bool wrap_1 = (f_15.anti_epipole.w > 0.5);
+    float _e50 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e9);
+    float _e51 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e9);
     uint _e53 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e51), rows_2, wrap_1);
     vec4 _e56 = _group_0_binding_1_cs[_e53];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56);
     float delta_2 = _e57.delta;
-    float _e63 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e50, f_14.theta.x, f_14.theta.y);
-    float _e64 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, s_4, _e50, true);
+    float _e63 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e50, f_15.theta.x, f_15.theta.y);
+    float _e64 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e9, s_4, _e50, true);
     float xs = (_e64 / delta_2);
     uint n_3 = uint(min(ceil(((xs > 0.0) ? xs : 0.0)), float(width_3)));
     uint _e74 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
@@ -566,14 +580,14 @@ vec3 minmax_traverse_pixel(uint x_4, uint y_1) {
             bool _e140 = in_run;
             if ((_e139 != _e140)) {
                 uint _e142 = i;
-                float _e143 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e142, n_3, delta_2, _e50, s_4, true);
+                float _e143 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e142, n_3, delta_2, _e50, s_4, true);
                 bool _e144 = lit;
                 if (_e144) {
                     run_a = _e143;
                 } else {
                     float _e147 = total;
                     float _e148 = run_a;
-                    float _e149 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, _e148, _e143, true);
+                    float _e149 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e9, _e148, _e143, true);
                     total = (_e147 + _e149);
                 }
                 bool _e151 = lit;
@@ -588,15 +602,15 @@ vec3 minmax_traverse_pixel(uint x_4, uint y_1) {
     if (_e157) {
         float _e158 = total;
         float _e159 = run_a;
-        float _e160 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, _e159, s_4, true);
+        float _e160 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e9, _e159, s_4, true);
         total = (_e158 + _e160);
     }
     float _e162 = total;
     l_1 = _e162;
     if (!(true)) {
-        float _e173 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, -(dot(f_14.light_dir.xyz, _e9)));
+        float _e173 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(dot(f_15.light_dir.xyz, _e9)));
         float _e175 = total;
-        l_1 = ((f_14.medium.y * _e173) * _e175);
+        l_1 = ((f_15.medium.y * _e173) * _e175);
     }
     float _e177 = l_1;
     vec3 c = (color * _e177);

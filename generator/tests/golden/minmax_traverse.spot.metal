@@ -50,6 +50,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 proj_g0_;
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
+    metal::float4 fan_origin;
+    metal::float4 fan_angles;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
@@ -495,18 +497,32 @@ float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return metal::atan2(metal::length(metal::cross(dir_6, axis)), metal::dot(dir_6, axis));
 }
 
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8
+) {
+    return metal::float2(static_cast<float>(f_8.sizes.x), static_cast<float>(f_8.sizes.y));
+}
+
 float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     metal::float3 dir_7
 ) {
-    uint rows_1 = f_8.sizes.w;
-    float phi = metal::atan2(metal::dot(dir_7, f_8.e2_.xyz), metal::dot(dir_7, f_8.e1_.xyz));
-    float yc = (phi - f_8.e1_.w) / f_8.e2_.w;
-    return (f_8.anti_epipole.w > 0.5) ? (yc - (metal::floor(yc / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc, 0.0, static_cast<float>(rows_1));
+    uint rows_1 = f_9.sizes.w;
+    float phi = metal::atan2(metal::dot(dir_7, f_9.e2_.xyz), metal::dot(dir_7, f_9.e1_.xyz));
+    float z_4 = metal::dot(dir_7, f_9.cam_forward.xyz);
+    float t_5 = f_9.cam_forward.w;
+    metal::float2 ndc = metal::float2(metal::dot(dir_7, f_9.cam_right.xyz) / ((z_4 * t_5) * f_9.cam_right.w), metal::dot(dir_7, f_9.cam_up.xyz) / (z_4 * t_5));
+    metal::float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    metal::float2 p_3 = metal::float2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * _e41;
+    metal::float2 d_1 = p_3 - f_9.fan_origin.xy;
+    metal::float2 ax = f_9.fan_origin.zw;
+    float fan = (metal::atan2((ax.x * d_1.y) - (ax.y * d_1.x), (ax.x * d_1.x) + (ax.y * d_1.y)) - f_9.fan_angles.x) / f_9.fan_angles.y;
+    float yc = (f_9.fan_angles.z > 0.5) ? fan : ((phi - f_9.e1_.w) / f_9.e2_.w);
+    return (f_9.anti_epipole.w > 0.5) ? (yc - (metal::floor(yc / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc, 0.0, static_cast<float>(rows_1));
 }
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     metal::float3 eye_6,
     metal::float3 dir_8,
     float s_1,
@@ -514,15 +530,15 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_3
 ) {
     if (spot_3) {
-        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz;
-        metal::float3 to_eye = -(f_9.axis.xyz);
+        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_10.light_pos.xyz;
+        metal::float3 to_eye = -(f_10.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
     }
     return s_1 * metal::sin(theta_1);
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     float x_2,
     float delta,
     float theta_2,
@@ -542,14 +558,14 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (_e16) {
             return s_2;
         }
-        return metal::min((f_10.axis.w * metal::sin(psi)) / den, s_2);
+        return metal::min((f_11.axis.w * metal::sin(psi)) / den, s_2);
     } else {
         return metal::min((x_2 * delta) / metal::max(metal::sin(theta_2), 0.000001), s_2);
     }
 }
 
 float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
     uint x_3,
     uint n_1,
     float delta_1,
@@ -560,19 +576,19 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     if (x_3 >= n_1) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
     metal::float3 eye_7,
     metal::float3 dir_9,
     float a_4,
     float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_13.light_pos.xyz, f_13.light_dir.xyz, f_13.light_pos.w, f_13.light_dir.w, f_13.medium);
     return _e15;
 }
 
@@ -581,7 +597,7 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14,
     metal::float3 eye_8,
     metal::float3 dir_10,
     float a_5,
@@ -589,10 +605,10 @@ float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_6
 ) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_13.sizes2_.z, 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_14.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -678,31 +694,31 @@ metal::float3 minmax_traverse_pixel(
     bool lit = {};
     bool local_4 = {};
     float l_1 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = frame;
-    metal::float3 eye_9 = f_14.eye.xyz;
-    metal::float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_4, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
+    metal::float3 eye_9 = f_15.eye.xyz;
+    metal::float3 _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, x_4, y_1);
     uint clamped_lod_e13 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e13 = depth.read(metal::min(metal::uint2(metal::uint2(x_4, y_1)), metal::uint2(depth.get_width(clamped_lod_e13), depth.get_height(clamped_lod_e13)) - 1), clamped_lod_e13);
-    float s_4 = metal::min(metal::max(_e13.x, 0.0), f_14.theta.z) / metal::max(metal::dot(_e9, f_14.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_14.light_color.xyz;
-    bool _e35 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, metal::float2(static_cast<float>(x_4) + 0.5, static_cast<float>(y_1) + 0.5));
+    float s_4 = metal::min(metal::max(_e13.x, 0.0), f_15.theta.z) / metal::max(metal::dot(_e9, f_15.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_15.light_color.xyz;
+    bool _e35 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, metal::float2(static_cast<float>(x_4) + 0.5, static_cast<float>(y_1) + 0.5));
     if (_e35) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
         float _e40 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, shadow_map, eye_9, _e9, s_4, true);
         metal::float3 l_2 = _e40 * color;
         return l_2;
     }
-    uint rows_2 = f_14.sizes.w;
-    uint width_3 = f_14.sizes.z;
-    bool wrap_1 = f_14.anti_epipole.w > 0.5;
-    float _e50 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e9);
-    float _e51 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e9);
+    uint rows_2 = f_15.sizes.w;
+    uint width_3 = f_15.sizes.z;
+    bool wrap_1 = f_15.anti_epipole.w > 0.5;
+    float _e50 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e9);
+    float _e51 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e9);
     uint _e53 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e51), rows_2, wrap_1);
     metal::float4 _e56 = slices[metal::min(unsigned(_e53), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56);
     float delta_2 = _e57.delta;
-    float _e63 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e50, f_14.theta.x, f_14.theta.y);
-    float _e64 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, s_4, _e50, true);
+    float _e63 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e50, f_15.theta.x, f_15.theta.y);
+    float _e64 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e9, s_4, _e50, true);
     float xs = _e64 / delta_2;
     uint n_3 = naga_f2u32(metal::min(metal::ceil((xs > 0.0) ? xs : 0.0), static_cast<float>(width_3)));
     uint _e74 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
@@ -779,14 +795,14 @@ metal::float3 minmax_traverse_pixel(
             bool _e140 = in_run;
             if (_e139 != _e140) {
                 uint _e142 = i;
-                float _e143 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e142, n_3, delta_2, _e50, s_4, true);
+                float _e143 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e142, n_3, delta_2, _e50, s_4, true);
                 bool _e144 = lit;
                 if (_e144) {
                     run_a = _e143;
                 } else {
                     float _e147 = total;
                     float _e148 = run_a;
-                    float _e149 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, _e148, _e143, true);
+                    float _e149 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e9, _e148, _e143, true);
                     total = _e147 + _e149;
                 }
                 bool _e151 = lit;
@@ -801,15 +817,15 @@ metal::float3 minmax_traverse_pixel(
     if (_e157) {
         float _e158 = total;
         float _e159 = run_a;
-        float _e160 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, _e159, s_4, true);
+        float _e160 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e9, _e159, s_4, true);
         total = _e158 + _e160;
     }
     float _e162 = total;
     l_1 = _e162;
     if (!(true)) {
-        float _e173 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, -(metal::dot(f_14.light_dir.xyz, _e9)));
+        float _e173 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(metal::dot(f_15.light_dir.xyz, _e9)));
         float _e175 = total;
-        l_1 = (f_14.medium.y * _e173) * _e175;
+        l_1 = (f_15.medium.y * _e173) * _e175;
     }
     float _e177 = l_1;
     metal::float3 c = color * _e177;

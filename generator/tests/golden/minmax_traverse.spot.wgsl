@@ -42,6 +42,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     proj_g0_: vec4<f32>,
     proj_g1_: vec4<f32>,
     proj_g2_: vec4<f32>,
+    fan_origin: vec4<f32>,
+    fan_angles: vec4<f32>,
 }
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
@@ -351,23 +353,35 @@ fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_m
     return atan2(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
-    let rows_1 = f_8.sizes.w;
-    let phi = atan2(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
-    let yc = ((phi - f_8.e1_.w) / f_8.e2_.w);
-    return select(clamp(yc, 0f, f32(rows_1)), (yc - (floor((yc / f32(rows_1))) * f32(rows_1))), (f_8.anti_epipole.w > 0.5f));
+fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
+    return vec2<f32>(f32(f_8.sizes.x), f32(f_8.sizes.y));
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
+    let rows_1 = f_9.sizes.w;
+    let phi = atan2(dot(dir_7, f_9.e2_.xyz), dot(dir_7, f_9.e1_.xyz));
+    let z_4 = dot(dir_7, f_9.cam_forward.xyz);
+    let t_5 = f_9.cam_forward.w;
+    let ndc = vec2<f32>((dot(dir_7, f_9.cam_right.xyz) / ((z_4 * t_5) * f_9.cam_right.w)), (dot(dir_7, f_9.cam_up.xyz) / (z_4 * t_5)));
+    let _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    let p_3 = (vec2<f32>(((ndc.x + 1f) * 0.5f), ((1f - ndc.y) * 0.5f)) * _e41);
+    let d_1 = (p_3 - f_9.fan_origin.xy);
+    let ax = f_9.fan_origin.zw;
+    let fan = ((atan2(((ax.x * d_1.y) - (ax.y * d_1.x)), ((ax.x * d_1.x) + (ax.y * d_1.y))) - f_9.fan_angles.x) / f_9.fan_angles.y);
+    let yc = select(((phi - f_9.e1_.w) / f_9.e2_.w), fan, (f_9.fan_angles.z > 0.5f));
+    return select(clamp(yc, 0f, f32(rows_1)), (yc - (floor((yc / f32(rows_1))) * f32(rows_1))), (f_9.anti_epipole.w > 0.5f));
+}
+
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
     if spot_3 {
-        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
-        let to_eye = -(f_9.axis.xyz);
+        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_10.light_pos.xyz);
+        let to_eye = -(f_10.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
     var local_1: bool;
 
     if spot_4 {
@@ -382,31 +396,31 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_
         if _e16 {
             return s_2;
         }
-        return min(((f_10.axis.w * sin(psi)) / den), s_2);
+        return min(((f_11.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
     if (x_3 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11, f32(x_3), delta_1, theta_3, s_3, spot_5);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, f32(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_12.light_pos.xyz, f_12.light_dir.xyz, f_12.light_pos.w, f_12.light_dir.w, f_12.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_13.light_pos.xyz, f_13.light_dir.xyz, f_13.light_pos.w, f_13.light_dir.w, f_13.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
     if spot_6 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max((f_13.sizes2_.z / 4u), 1u));
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_10, a_5, b_5, max((f_14.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -470,30 +484,30 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     var local_4: bool;
     var l_1: f32;
 
-    let f_14 = frame;
-    let eye_9 = f_14.eye.xyz;
-    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_4, y_1);
+    let f_15 = frame;
+    let eye_9 = f_15.eye.xyz;
+    let _e9 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, x_4, y_1);
     let _e13 = textureLoad(depth, vec2<u32>(x_4, y_1), 0i);
-    let s_4 = (min(max(_e13.x, 0f), f_14.theta.z) / max(dot(_e9, f_14.cam_forward.xyz), 0.000001f));
-    let color = f_14.light_color.xyz;
-    let _e35 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, vec2<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f)));
+    let s_4 = (min(max(_e13.x, 0f), f_15.theta.z) / max(dot(_e9, f_15.cam_forward.xyz), 0.000001f));
+    let color = f_15.light_color.xyz;
+    let _e35 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, vec2<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f)));
     if _e35 {
         let _e37 = frame;
         let _e40 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, shadow_map, eye_9, _e9, s_4, true);
         let l_2 = (_e40 * color);
         return l_2;
     }
-    let rows_2 = f_14.sizes.w;
-    let width_3 = f_14.sizes.z;
-    let wrap_1 = (f_14.anti_epipole.w > 0.5f);
-    let _e50 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e9);
-    let _e51 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e9);
+    let rows_2 = f_15.sizes.w;
+    let width_3 = f_15.sizes.z;
+    let wrap_1 = (f_15.anti_epipole.w > 0.5f);
+    let _e50 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e9);
+    let _e51 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e9);
     let _e53 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e51), rows_2, wrap_1);
     let _e56 = slices[_e53];
     let _e57 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e56);
     let delta_2 = _e57.delta;
-    let _e63 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e50, f_14.theta.x, f_14.theta.y);
-    let _e64 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, s_4, _e50, true);
+    let _e63 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e50, f_15.theta.x, f_15.theta.y);
+    let _e64 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e9, s_4, _e50, true);
     let xs = (_e64 / delta_2);
     let n_3 = u32(min(ceil(select(0f, xs, (xs > 0f))), f32(width_3)));
     let _e74 = tree_levelsX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(width_3);
@@ -560,14 +574,14 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
             let _e140 = in_run;
             if (_e139 != _e140) {
                 let _e142 = i;
-                let _e143 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e142, n_3, delta_2, _e50, s_4, true);
+                let _e143 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e142, n_3, delta_2, _e50, s_4, true);
                 let _e144 = lit;
                 if _e144 {
                     run_a = _e143;
                 } else {
                     let _e147 = total;
                     let _e148 = run_a;
-                    let _e149 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, _e148, _e143, true);
+                    let _e149 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e9, _e148, _e143, true);
                     total = (_e147 + _e149);
                 }
                 let _e151 = lit;
@@ -582,15 +596,15 @@ fn minmax_traverse_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     if _e157 {
         let _e158 = total;
         let _e159 = run_a;
-        let _e160 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_9, _e9, _e159, s_4, true);
+        let _e160 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e9, _e159, s_4, true);
         total = (_e158 + _e160);
     }
     let _e162 = total;
     l_1 = _e162;
     if !(true) {
-        let _e173 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, -(dot(f_14.light_dir.xyz, _e9)));
+        let _e173 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(dot(f_15.light_dir.xyz, _e9)));
         let _e175 = total;
-        l_1 = ((f_14.medium.y * _e173) * _e175);
+        l_1 = ((f_15.medium.y * _e173) * _e175);
     }
     let _e177 = l_1;
     let c = (color * _e177);

@@ -45,6 +45,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 proj_g0_;
     vec4 proj_g1_;
     vec4 proj_g2_;
+    vec4 fan_origin;
+    vec4 fan_angles;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
@@ -226,11 +228,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                 }
                 {
                     uint _e48 = q_1;
-                    float u = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    float u_1 = tan((mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
                     float _e54 = sum;
                     uint _e56 = q_1;
-                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u * u))));
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u_1 * u_1))));
                 }
             }
         }
@@ -259,16 +261,77 @@ vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XO
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row) {
-    return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1) {
+    return vec2(float(f_1.sizes.x), float(f_1.sizes.y));
 }
 
-vec4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_3, vec2 b_3) {
-    return vec4(a_3.x, a_3.y, b_3.x, b_3.y);
+float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
+    float t_in = 0.0;
+    float t_out = 3.4e38;
+    uint a_3 = 0u;
+    bool loop_init_2 = true;
+    while(true) {
+        if (!loop_init_2) {
+            uint _e45 = a_3;
+            a_3 = (_e45 + 1u);
+        }
+        loop_init_2 = false;
+        uint _e4 = a_3;
+        if ((_e4 < 2u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = a_3;
+            uint _e13 = a_3;
+            float ta = ((0.5 - o_1[_e8]) / u[_e13]);
+            uint _e17 = a_3;
+            uint _e21 = a_3;
+            uint _e24 = a_3;
+            float tb = (((size[_e17] - 0.5) - o_1[_e21]) / u[_e24]);
+            uint _e27 = a_3;
+            bool crosses = (abs(u[_e27]) > 1e-12);
+            float _e33 = t_in;
+            float _e34 = t_in;
+            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
+            float _e39 = t_out;
+            float _e40 = t_out;
+            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
+        }
+    }
+    float _e47 = t_in;
+    float _e48 = t_out;
+    float _e49 = t_in;
+    return (0.5 * (_e47 + max(_e48, _e49)));
 }
 
-vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_4, vec2 b_4) {
-    return vec2(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, vec2 p_2) {
+    vec2 ndc = vec2((((2.0 * p_2.x) / float(f_2.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_2.sizes.y))));
+    float t_2 = f_2.cam_forward.w;
+    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+}
+
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, uint row) {
+    float a_6 = (f_3.fan_angles.x + ((float(row) + 0.5) * f_3.fan_angles.y));
+    vec2 ax = f_3.fan_origin.zw;
+    vec2 u_2 = vec2(((ax.x * cos(a_6)) - (ax.y * sin(a_6))), ((ax.y * cos(a_6)) + (ax.x * sin(a_6))));
+    vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
+    vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
+    return atan(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
+    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
+    return ((f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((float(row_1) + 0.5) * f_4.e2_.w)));
+}
+
+vec4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_4, vec2 b_3) {
+    return vec4(a_4.x, a_4.y, b_3.x, b_3.y);
+}
+
+vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_5, vec2 b_4) {
+    return vec2(((a_5.x * b_4.y) + (a_5.y * b_4.x)), ((a_5.y * b_4.y) - (a_5.x * b_4.x)));
 }
 
 vec2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 first) {
@@ -282,9 +345,9 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return (((r * r) * width) / (regions * regions));
 }
 
-float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_1) {
+float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_1) {
     bool local_2 = false;
-    float cap = (4.0 * f_2.theta.z);
+    float cap = (4.0 * f_5.theta.z);
     if (spot_1) {
         float psi = (x_1 * s.delta);
         float den = sin((s.theta_ref + psi));
@@ -297,35 +360,33 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod
         if (_e23) {
             return cap;
         }
-        return min(((f_2.axis.w * sin(psi)) / den), cap);
+        return min(((f_5.axis.w * sin(psi)) / den), cap);
     } else {
         return min(((x_1 * s.delta) / max(sin(s.theta_ref), 0.0001)), cap);
     }
 }
 
-float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, uint row_1, uint i_1, bool weighted, bool spot_2) {
+float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, vec3 e_1, uint i_1, bool weighted, bool spot_2) {
     float w = 0.0;
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, s_1, float(i_1), spot_2);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, s_1, float((i_1 + 1u)), spot_2);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, float(i_1), spot_2);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, float((i_1 + 1u)), spot_2);
     if (!(weighted)) {
         return (_e9 - _e5);
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_3.medium.x, _e5, _e9);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, _e5, _e9);
     w = _e15;
     if (spot_2) {
         float psi_1 = ((float(i_1) + 0.5) * s_1.delta);
-        float _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, row_1);
-        vec3 _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e23);
-        vec3 l_1 = ((-(f_3.axis.xyz) * cos(psi_1)) + (_e24 * sin(psi_1)));
+        vec3 l_1 = ((-(f_6.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
-        float r_1 = max(((f_3.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
-        float _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
-        float cone = max(_e53, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
-        float _e56 = w;
-        w = (_e56 * ((cone * exp((-(f_3.medium.x) * r_1))) / (r_1 * r_1)));
+        float r_1 = max(((f_6.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
+        float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_6.light_dir.xyz), f_6.light_pos.w, f_6.light_dir.w);
+        float cone = max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
+        float _e54 = w;
+        w = (_e54 * ((cone * exp((-(f_6.medium.x) * r_1))) / (r_1 * r_1)));
     }
-    float _e66 = w;
-    return _e66;
+    float _e64 = w;
+    return _e64;
 }
 
 uint bounds_index(uint x_2, uint row_2) {
@@ -381,100 +442,104 @@ void main() {
     }
     vec4 _e32 = _group_0_binding_1_cs[row_5];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
-    uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
-    uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
-    i = _e36;
-    bool loop_init_2 = true;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = _group_0_binding_0_cs;
+    float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_5);
+    vec3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
+    uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
+    uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
+    i = _e42;
+    bool loop_init_3 = true;
     while(true) {
-        if (!loop_init_2) {
-            uint _e143 = i;
-            i = (_e143 + 1u);
+        if (!loop_init_3) {
+            uint _e149 = i;
+            i = (_e149 + 1u);
         }
-        loop_init_2 = false;
-        uint _e42 = i;
-        if ((_e42 < _e40)) {
+        loop_init_3 = false;
+        uint _e48 = i;
+        if ((_e48 < _e46)) {
         } else {
             break;
         }
         {
-            uint _e44 = i;
-            int _e48_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-            vec4 _e48 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e44, row_5)), ivec2(0), textureSize(_group_0_binding_2_cs, _e48_clamped_lod) - ivec2(1)), _e48_clamped_lod);
-            float d_1 = _e48.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = _group_0_binding_0_cs;
-            uint _e52 = i;
-            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, false, true);
-            float _e56 = wsum;
-            wsum = (_e56 + _e54);
+            uint _e50 = i;
+            int _e54_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+            vec4 _e54 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e50, row_5)), ivec2(0), textureSize(_group_0_binding_2_cs, _e54_clamped_lod) - ivec2(1)), _e54_clamped_lod);
+            float d_1 = _e54.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = _group_0_binding_0_cs;
+            uint _e58 = i;
+            float _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, false, true);
+            float _e62 = wsum;
+            wsum = (_e62 + _e60);
             if ((thread == 0u)) {
-                float _e61 = lo;
-                lo = min(_e61, d_1);
-                float _e64 = hi;
-                hi = max(_e64, d_1);
-                uint _e66 = i;
-                uint _e67 = bounds_index(_e66, row_5);
-                float _e70 = lo;
-                float _e71 = hi;
-                _group_0_binding_4_cs[_e67] = vec2(_e70, _e71);
+                float _e67 = lo;
+                lo = min(_e67, d_1);
+                float _e70 = hi;
+                hi = max(_e70, d_1);
+                uint _e72 = i;
+                uint _e73 = bounds_index(_e72, row_5);
+                float _e76 = lo;
+                float _e77 = hi;
+                _group_0_binding_4_cs[_e73] = vec2(_e76, _e77);
             }
-            float _e73 = wsum;
-            float _e75 = wsum;
-            float blend = ((_e75 > 0.0) ? (_e54 / _e73) : 0.0);
+            float _e79 = wsum;
+            float _e81 = wsum;
+            float blend = ((_e81 > 0.0) ? (_e60 / _e79) : 0.0);
             angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
-            vec2 _e88 = angle;
-            vec2 _e89 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e88);
+            vec2 _e94 = angle;
+            vec2 _e95 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e94);
             k = 0u;
-            bool loop_init_3 = true;
-            while(true) {
-                if (!loop_init_3) {
-                    uint _e101 = k;
-                    k = (_e101 + 1u);
-                }
-                loop_init_3 = false;
-                uint _e92 = k;
-                if ((_e92 < ((2u * thread) * 1u))) {
-                } else {
-                    break;
-                }
-                {
-                    vec2 _e98 = angle;
-                    vec2 _e99 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e98, _e89);
-                    angle = _e99;
-                }
-            }
-            q = 0u;
             bool loop_init_4 = true;
             while(true) {
                 if (!loop_init_4) {
-                    uint _e140 = q;
-                    q = (_e140 + 1u);
+                    uint _e107 = k;
+                    k = (_e107 + 1u);
                 }
                 loop_init_4 = false;
-                uint _e105 = q;
-                if ((_e105 < 1u)) {
+                uint _e98 = k;
+                if ((_e98 < ((2u * thread) * 1u))) {
                 } else {
                     break;
                 }
                 {
-                    uint _e108 = q;
-                    uint layer_2 = ((thread * 1u) + _e108);
-                    vec2 _e110 = angle;
-                    vec2 _e111 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110, _e89);
-                    vec2 _e112 = angle;
-                    vec4 _e113 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e111);
-                    vec2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e89);
-                    angle = _e114;
-                    uint _e116 = q;
-                    vec4 a_5 = acc[_e116];
-                    uint _e119 = q;
-                    acc[_e119] = ((a_5 * (1.0 - blend)) + (_e113 * blend));
-                    uint _e126 = q;
-                    vec4 _e128 = acc[_e126];
-                    vec4 stored = ((_e128 * 0.5) + vec4(0.5));
-                    uint _e134 = i;
-                    uint _e135 = filtered_index(_e134, row_5, layer_2);
-                    uvec2 _e138 = encode_layer(stored);
-                    _group_0_binding_3_cs[_e135] = _e138;
+                    vec2 _e104 = angle;
+                    vec2 _e105 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e104, _e95);
+                    angle = _e105;
+                }
+            }
+            q = 0u;
+            bool loop_init_5 = true;
+            while(true) {
+                if (!loop_init_5) {
+                    uint _e146 = q;
+                    q = (_e146 + 1u);
+                }
+                loop_init_5 = false;
+                uint _e111 = q;
+                if ((_e111 < 1u)) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e114 = q;
+                    uint layer_2 = ((thread * 1u) + _e114);
+                    vec2 _e116 = angle;
+                    vec2 _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e95);
+                    vec2 _e118 = angle;
+                    vec4 _e119 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e118, _e117);
+                    vec2 _e120 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e95);
+                    angle = _e120;
+                    uint _e122 = q;
+                    vec4 a_7 = acc[_e122];
+                    uint _e125 = q;
+                    acc[_e125] = ((a_7 * (1.0 - blend)) + (_e119 * blend));
+                    uint _e132 = q;
+                    vec4 _e134 = acc[_e132];
+                    vec4 stored = ((_e134 * 0.5) + vec4(0.5));
+                    uint _e140 = i;
+                    uint _e141 = filtered_index(_e140, row_5, layer_2);
+                    uvec2 _e144 = encode_layer(stored);
+                    _group_0_binding_3_cs[_e141] = _e144;
                 }
             }
         }

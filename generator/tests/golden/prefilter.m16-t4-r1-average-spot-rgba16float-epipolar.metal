@@ -52,6 +52,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 proj_g0_;
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
+    metal::float4 fan_origin;
+    metal::float4 fan_angles;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
@@ -303,11 +305,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e48 = q_1;
-                    float u = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
+                    float u_1 = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
                     float _e54 = sum;
                     uint _e56 = q_1;
-                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u * u)));
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u_1 * u_1)));
                 }
             }
         }
@@ -351,25 +353,101 @@ metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return (f.e1_.xyz * metal::cos(phi)) + (f.e2_.xyz * metal::sin(phi));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1,
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1
+) {
+    return metal::float2(static_cast<float>(f_1.sizes.x), static_cast<float>(f_1.sizes.y));
+}
+
+float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    metal::float2 o_1,
+    metal::float2 u,
+    metal::float2 size
+) {
+    float t_in = 0.0;
+    float t_out = 340000000000000000000000000000000000000.0;
+    uint a_3 = 0u;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e45 = a_3;
+            a_3 = _e45 + 1u;
+        }
+        loop_init_2 = false;
+        uint _e4 = a_3;
+        if (_e4 < 2u) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = a_3;
+            uint _e13 = a_3;
+            float ta = (0.5 - o_1[metal::min(unsigned(_e8), 1u)]) / u[metal::min(unsigned(_e13), 1u)];
+            uint _e17 = a_3;
+            uint _e21 = a_3;
+            uint _e24 = a_3;
+            float tb = ((size[metal::min(unsigned(_e17), 1u)] - 0.5) - o_1[metal::min(unsigned(_e21), 1u)]) / u[metal::min(unsigned(_e24), 1u)];
+            uint _e27 = a_3;
+            bool crosses = metal::abs(u[metal::min(unsigned(_e27), 1u)]) > 0.000000000001;
+            float _e33 = t_in;
+            float _e34 = t_in;
+            t_in = crosses ? metal::max(_e34, metal::min(ta, tb)) : _e33;
+            float _e39 = t_out;
+            float _e40 = t_out;
+            t_out = crosses ? metal::min(_e40, metal::max(ta, tb)) : _e39;
+        }
+    }
+    float _e47 = t_in;
+    float _e48 = t_out;
+    float _e49 = t_in;
+    return 0.5 * (_e47 + metal::max(_e48, _e49));
+}
+
+metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    metal::float2 p_2
+) {
+    metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_2.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_2.sizes.y)));
+    float t_2 = f_2.cam_forward.w;
+    return metal::normalize((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2)));
+}
+
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
     uint row
 ) {
-    return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
+    float a_6 = f_3.fan_angles.x + ((static_cast<float>(row) + 0.5) * f_3.fan_angles.y);
+    metal::float2 ax = f_3.fan_origin.zw;
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_6)) - (ax.y * metal::sin(a_6)), (ax.y * metal::cos(a_6)) + (ax.x * metal::sin(a_6)));
+    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
+    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, f_3.fan_origin.xy + (u_2 * _e33));
+    return metal::atan2(metal::dot(_e36, f_3.e2_.xyz), metal::dot(_e36, f_3.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
+    uint row_1
+) {
+    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
+    return (f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((static_cast<float>(row_1) + 0.5) * f_4.e2_.w));
 }
 
 metal::float4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float2 a_3,
+    metal::float2 a_4,
     metal::float2 b_3
 ) {
-    return metal::float4(a_3.x, a_3.y, b_3.x, b_3.y);
+    return metal::float4(a_4.x, a_4.y, b_3.x, b_3.y);
 }
 
 metal::float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float2 a_4,
+    metal::float2 a_5,
     metal::float2 b_4
 ) {
-    return metal::float2((a_4.x * b_4.y) + (a_4.y * b_4.x), (a_4.y * b_4.y) - (a_4.x * b_4.x));
+    return metal::float2((a_5.x * b_4.y) + (a_5.y * b_4.x), (a_5.y * b_4.y) - (a_5.x * b_4.x));
 }
 
 metal::float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -395,13 +473,13 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 }
 
 float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s,
     float x_1,
     bool spot_1
 ) {
     bool local_2 = {};
-    float cap = 4.0 * f_2.theta.z;
+    float cap = 4.0 * f_5.theta.z;
     if (spot_1) {
         float psi = x_1 * s.delta;
         float den = metal::sin(s.theta_ref + psi);
@@ -414,42 +492,40 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
         if (_e23) {
             return cap;
         }
-        return metal::min((f_2.axis.w * metal::sin(psi)) / den, cap);
+        return metal::min((f_5.axis.w * metal::sin(psi)) / den, cap);
     } else {
         return metal::min((x_1 * s.delta) / metal::max(metal::sin(s.theta_ref), 0.0001), cap);
     }
 }
 
 float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1,
-    uint row_1,
+    metal::float3 e_1,
     uint i_1,
     bool weighted,
     bool spot_2
 ) {
     float w = {};
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, s_1, static_cast<float>(i_1), spot_2);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, s_1, static_cast<float>(i_1 + 1u), spot_2);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, static_cast<float>(i_1), spot_2);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, static_cast<float>(i_1 + 1u), spot_2);
     if (!(weighted)) {
         return _e9 - _e5;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_3.medium.x, _e5, _e9);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, _e5, _e9);
     w = _e15;
     if (spot_2) {
         float psi_1 = (static_cast<float>(i_1) + 0.5) * s_1.delta;
-        float _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, row_1);
-        metal::float3 _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e23);
-        metal::float3 l_1 = (-(f_3.axis.xyz) * metal::cos(psi_1)) + (_e24 * metal::sin(psi_1));
+        metal::float3 l_1 = (-(f_6.axis.xyz) * metal::cos(psi_1)) + (e_1 * metal::sin(psi_1));
         float den_1 = metal::max(metal::sin(s_1.theta_ref + psi_1), 0.0001);
-        float r_1 = metal::max((f_3.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
-        float _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
-        float cone = metal::max(_e53, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
-        float _e56 = w;
-        w = _e56 * ((cone * metal::exp(-(f_3.medium.x) * r_1)) / (r_1 * r_1));
+        float r_1 = metal::max((f_6.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
+        float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_6.light_dir.xyz), f_6.light_pos.w, f_6.light_dir.w);
+        float cone = metal::max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
+        float _e54 = w;
+        w = _e54 * ((cone * metal::exp(-(f_6.medium.x) * r_1)) / (r_1 * r_1));
     }
-    float _e66 = w;
-    return _e66;
+    float _e64 = w;
+    return _e64;
 }
 
 uint bounds_index(
@@ -541,109 +617,113 @@ kernel void prefilter(
     }
     metal::float4 _e32 = slices[metal::min(unsigned(row_5), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
-    uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
-    uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, true);
-    i = _e36;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
+    float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_5);
+    metal::float3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
+    uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
+    uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, true);
+    i = _e42;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e143 = i;
-            i = _e143 + 1u;
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e149 = i;
+            i = _e149 + 1u;
         }
-        loop_init_2 = false;
-        uint _e42 = i;
-        if (_e42 < _e40) {
+        loop_init_3 = false;
+        uint _e48 = i;
+        if (_e48 < _e46) {
         } else {
             break;
         }
         {
-            uint _e44 = i;
-            uint clamped_lod_e48 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_5)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
-            float d_1 = _e48.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
-            uint _e52 = i;
-            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, false, true);
-            float _e56 = wsum;
-            wsum = _e56 + _e54;
+            uint _e50 = i;
+            uint clamped_lod_e54 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+            metal::float4 _e54 = rectified.read(metal::min(metal::uint2(metal::uint2(_e50, row_5)), metal::uint2(rectified.get_width(clamped_lod_e54), rectified.get_height(clamped_lod_e54)) - 1), clamped_lod_e54);
+            float d_1 = _e54.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = frame;
+            uint _e58 = i;
+            float _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, false, true);
+            float _e62 = wsum;
+            wsum = _e62 + _e60;
             if (thread_ == 0u) {
-                float _e61 = lo;
-                lo = metal::min(_e61, d_1);
-                float _e64 = hi;
-                hi = metal::max(_e64, d_1);
-                uint _e66 = i;
-                uint _e67 = bounds_index(_e66, row_5, frame);
-                float _e70 = lo;
-                float _e71 = hi;
-                bounds[metal::min(unsigned(_e67), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e70, _e71);
+                float _e67 = lo;
+                lo = metal::min(_e67, d_1);
+                float _e70 = hi;
+                hi = metal::max(_e70, d_1);
+                uint _e72 = i;
+                uint _e73 = bounds_index(_e72, row_5, frame);
+                float _e76 = lo;
+                float _e77 = hi;
+                bounds[metal::min(unsigned(_e73), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e76, _e77);
             }
-            float _e73 = wsum;
-            float _e75 = wsum;
-            float blend = (_e75 > 0.0) ? (_e54 / _e73) : 0.0;
+            float _e79 = wsum;
+            float _e81 = wsum;
+            float blend = (_e81 > 0.0) ? (_e60 / _e79) : 0.0;
             angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1));
-            metal::float2 _e88 = angle;
-            metal::float2 _e89 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e88);
+            metal::float2 _e94 = angle;
+            metal::float2 _e95 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e94);
             k = 0u;
-            uint2 loop_bound_3 = uint2(4294967295u);
-            bool loop_init_3 = true;
-            while(true) {
-                if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-                loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-                if (!loop_init_3) {
-                    uint _e101 = k;
-                    k = _e101 + 1u;
-                }
-                loop_init_3 = false;
-                uint _e92 = k;
-                if (_e92 < ((2u * thread_) * 1u)) {
-                } else {
-                    break;
-                }
-                {
-                    metal::float2 _e98 = angle;
-                    metal::float2 _e99 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e98, _e89);
-                    angle = _e99;
-                }
-            }
-            q = 0u;
             uint2 loop_bound_4 = uint2(4294967295u);
             bool loop_init_4 = true;
             while(true) {
                 if (metal::all(loop_bound_4 == uint2(0u))) { break; }
                 loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
                 if (!loop_init_4) {
-                    uint _e140 = q;
-                    q = _e140 + 1u;
+                    uint _e107 = k;
+                    k = _e107 + 1u;
                 }
                 loop_init_4 = false;
-                uint _e105 = q;
-                if (_e105 < 1u) {
+                uint _e98 = k;
+                if (_e98 < ((2u * thread_) * 1u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e108 = q;
-                    uint layer_2 = (thread_ * 1u) + _e108;
-                    metal::float2 _e110 = angle;
-                    metal::float2 _e111 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110, _e89);
-                    metal::float2 _e112 = angle;
-                    metal::float4 _e113 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e111);
-                    metal::float2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e89);
-                    angle = _e114;
-                    uint _e116 = q;
-                    metal::float4 a_5 = acc.inner[metal::min(unsigned(_e116), 0u)];
-                    uint _e119 = q;
-                    acc.inner[metal::min(unsigned(_e119), 0u)] = (a_5 * (1.0 - blend)) + (_e113 * blend);
-                    uint _e126 = q;
-                    metal::float4 _e128 = acc.inner[metal::min(unsigned(_e126), 0u)];
-                    metal::float4 stored = (_e128 * 0.5) + metal::float4(0.5);
-                    uint _e134 = i;
-                    uint _e135 = filtered_index(_e134, row_5, layer_2, frame);
-                    metal::uint2 _e138 = encode_layer(stored);
-                    filtered[metal::min(unsigned(_e135), (_buffer_sizes.size3 - 0 - 8) / 8)] = _e138;
+                    metal::float2 _e104 = angle;
+                    metal::float2 _e105 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e104, _e95);
+                    angle = _e105;
+                }
+            }
+            q = 0u;
+            uint2 loop_bound_5 = uint2(4294967295u);
+            bool loop_init_5 = true;
+            while(true) {
+                if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+                if (!loop_init_5) {
+                    uint _e146 = q;
+                    q = _e146 + 1u;
+                }
+                loop_init_5 = false;
+                uint _e111 = q;
+                if (_e111 < 1u) {
+                } else {
+                    break;
+                }
+                {
+                    uint _e114 = q;
+                    uint layer_2 = (thread_ * 1u) + _e114;
+                    metal::float2 _e116 = angle;
+                    metal::float2 _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e95);
+                    metal::float2 _e118 = angle;
+                    metal::float4 _e119 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e118, _e117);
+                    metal::float2 _e120 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e95);
+                    angle = _e120;
+                    uint _e122 = q;
+                    metal::float4 a_7 = acc.inner[metal::min(unsigned(_e122), 0u)];
+                    uint _e125 = q;
+                    acc.inner[metal::min(unsigned(_e125), 0u)] = (a_7 * (1.0 - blend)) + (_e119 * blend);
+                    uint _e132 = q;
+                    metal::float4 _e134 = acc.inner[metal::min(unsigned(_e132), 0u)];
+                    metal::float4 stored = (_e134 * 0.5) + metal::float4(0.5);
+                    uint _e140 = i;
+                    uint _e141 = filtered_index(_e140, row_5, layer_2, frame);
+                    metal::uint2 _e144 = encode_layer(stored);
+                    filtered[metal::min(unsigned(_e141), (_buffer_sizes.size3 - 0 - 8) / 8)] = _e144;
                 }
             }
         }

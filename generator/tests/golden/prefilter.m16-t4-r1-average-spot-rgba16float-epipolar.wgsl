@@ -42,6 +42,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     proj_g0_: vec4<f32>,
     proj_g1_: vec4<f32>,
     proj_g2_: vec4<f32>,
+    fan_origin: vec4<f32>,
+    fan_angles: vec4<f32>,
 }
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
@@ -213,11 +215,11 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                 }
                 {
                     let _e48 = q_1;
-                    let u = tan((mid + ((0.5f * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    let u_1 = tan((mid + ((0.5f * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
                     let _e54 = sum;
                     let _e56 = q_1;
-                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u * u))));
+                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u_1 * u_1))));
                 }
                 continuing {
                     let _e72 = q_1;
@@ -254,16 +256,76 @@ fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_X
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    return (f_1.e1_.w + ((f32(row) + 0.5f) * f_1.e2_.w));
+fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
+    return vec2<f32>(f32(f_1.sizes.x), f32(f_1.sizes.y));
 }
 
-fn basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_3: vec2<f32>, b_3: vec2<f32>) -> vec4<f32> {
-    return vec4<f32>(a_3.x, a_3.y, b_3.x, b_3.y);
+fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
+    var t_in: f32 = 0f;
+    var t_out: f32 = 340000000000000000000000000000000000000f;
+    var a_3: u32 = 0u;
+
+    loop {
+        let _e4 = a_3;
+        if (_e4 < 2u) {
+        } else {
+            break;
+        }
+        {
+            let _e8 = a_3;
+            let _e13 = a_3;
+            let ta = ((0.5f - o_1[_e8]) / u[_e13]);
+            let _e17 = a_3;
+            let _e21 = a_3;
+            let _e24 = a_3;
+            let tb = (((size[_e17] - 0.5f) - o_1[_e21]) / u[_e24]);
+            let _e27 = a_3;
+            let crosses = (abs(u[_e27]) > 0.000000000001f);
+            let _e33 = t_in;
+            let _e34 = t_in;
+            t_in = select(_e33, max(_e34, min(ta, tb)), crosses);
+            let _e39 = t_out;
+            let _e40 = t_out;
+            t_out = select(_e39, min(_e40, max(ta, tb)), crosses);
+        }
+        continuing {
+            let _e45 = a_3;
+            a_3 = (_e45 + 1u);
+        }
+    }
+    let _e47 = t_in;
+    let _e48 = t_out;
+    let _e49 = t_in;
+    return (0.5f * (_e47 + max(_e48, _e49)));
 }
 
-fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_4: vec2<f32>, b_4: vec2<f32>) -> vec2<f32> {
-    return vec2<f32>(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
+fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
+    let ndc = vec2<f32>((((2f * p_2.x) / f32(f_2.sizes.x)) - 1f), (1f - ((2f * p_2.y) / f32(f_2.sizes.y))));
+    let t_2 = f_2.cam_forward.w;
+    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+}
+
+fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    let a_6 = (f_3.fan_angles.x + ((f32(row) + 0.5f) * f_3.fan_angles.y));
+    let ax = f_3.fan_origin.zw;
+    let u_2 = vec2<f32>(((ax.x * cos(a_6)) - (ax.y * sin(a_6))), ((ax.y * cos(a_6)) + (ax.x * sin(a_6))));
+    let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
+    let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
+    let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
+    return atan2(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+}
+
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
+    let _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
+    return select((f_4.e1_.w + ((f32(row_1) + 0.5f) * f_4.e2_.w)), _e11, (f_4.fan_angles.z > 0.5f));
+}
+
+fn basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_4: vec2<f32>, b_3: vec2<f32>) -> vec4<f32> {
+    return vec4<f32>(a_4.x, a_4.y, b_3.x, b_3.y);
+}
+
+fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_4: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(((a_5.x * b_4.y) + (a_5.y * b_4.x)), ((a_5.y * b_4.y) - (a_5.x * b_4.x)));
 }
 
 fn fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(first: vec2<f32>) -> vec2<f32> {
@@ -277,10 +339,10 @@ fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions
     return (((r * r) * width) / (regions * regions));
 }
 
-fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, spot_1: bool) -> f32 {
+fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, spot_1: bool) -> f32 {
     var local_2: bool;
 
-    let cap = (4f * f_2.theta.z);
+    let cap = (4f * f_5.theta.z);
     if spot_1 {
         let psi = (x_1 * s.delta);
         let den = sin((s.theta_ref + psi));
@@ -293,36 +355,34 @@ fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_2: FrameX_naga_oil_m
         if _e23 {
             return cap;
         }
-        return min(((f_2.axis.w * sin(psi)) / den), cap);
+        return min(((f_5.axis.w * sin(psi)) / den), cap);
     } else {
         return min(((x_1 * s.delta) / max(sin(s.theta_ref), 0.0001f)), cap);
     }
 }
 
-fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32, i_1: u32, weighted: bool, spot_2: bool) -> f32 {
+fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, i_1: u32, weighted: bool, spot_2: bool) -> f32 {
     var w: f32;
 
-    let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, s_1, f32(i_1), spot_2);
-    let _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, s_1, f32((i_1 + 1u)), spot_2);
+    let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, f32(i_1), spot_2);
+    let _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, f32((i_1 + 1u)), spot_2);
     if !(weighted) {
         return (_e9 - _e5);
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_3.medium.x, _e5, _e9);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, _e5, _e9);
     w = _e15;
     if spot_2 {
         let psi_1 = ((f32(i_1) + 0.5f) * s_1.delta);
-        let _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, row_1);
-        let _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e23);
-        let l_1 = ((-(f_3.axis.xyz) * cos(psi_1)) + (_e24 * sin(psi_1)));
+        let l_1 = ((-(f_6.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         let den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001f);
-        let r_1 = max(((f_3.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
-        let _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
-        let cone = max(_e53, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
-        let _e56 = w;
-        w = (_e56 * ((cone * exp((-(f_3.medium.x) * r_1))) / (r_1 * r_1)));
+        let r_1 = max(((f_6.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
+        let _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_6.light_dir.xyz), f_6.light_pos.w, f_6.light_dir.w);
+        let cone = max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
+        let _e54 = w;
+        w = (_e54 * ((cone * exp((-(f_6.medium.x) * r_1))) / (r_1 * r_1)));
     }
-    let _e66 = w;
-    return _e66;
+    let _e64 = w;
+    return _e64;
 }
 
 fn bounds_index(x_2: u32, row_2: u32) -> u32 {
@@ -386,95 +446,99 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let _e32 = slices[row_5];
     let _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
-    let _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
-    let _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
-    i = _e36;
+    let _e35 = frame;
+    let _e37 = frame;
+    let _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_5);
+    let _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
+    let _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
+    let _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
+    i = _e42;
     loop {
-        let _e42 = i;
-        if (_e42 < _e40) {
+        let _e48 = i;
+        if (_e48 < _e46) {
         } else {
             break;
         }
         {
-            let _e44 = i;
-            let _e48 = textureLoad(rectified, vec2<u32>(_e44, row_5), 0i);
-            let d_1 = _e48.x;
-            let _e51 = frame;
-            let _e52 = i;
-            let _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, false, true);
-            let _e56 = wsum;
-            wsum = (_e56 + _e54);
+            let _e50 = i;
+            let _e54 = textureLoad(rectified, vec2<u32>(_e50, row_5), 0i);
+            let d_1 = _e54.x;
+            let _e57 = frame;
+            let _e58 = i;
+            let _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, false, true);
+            let _e62 = wsum;
+            wsum = (_e62 + _e60);
             if (thread == 0u) {
-                let _e61 = lo;
-                lo = min(_e61, d_1);
-                let _e64 = hi;
-                hi = max(_e64, d_1);
-                let _e66 = i;
-                let _e67 = bounds_index(_e66, row_5);
-                let _e70 = lo;
-                let _e71 = hi;
-                bounds[_e67] = vec2<f32>(_e70, _e71);
+                let _e67 = lo;
+                lo = min(_e67, d_1);
+                let _e70 = hi;
+                hi = max(_e70, d_1);
+                let _e72 = i;
+                let _e73 = bounds_index(_e72, row_5);
+                let _e76 = lo;
+                let _e77 = hi;
+                bounds[_e73] = vec2<f32>(_e76, _e77);
             }
-            let _e73 = wsum;
-            let _e75 = wsum;
-            let blend = select(0f, (_e54 / _e73), (_e75 > 0f));
+            let _e79 = wsum;
+            let _e81 = wsum;
+            let blend = select(0f, (_e60 / _e79), (_e81 > 0f));
             angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
-            let _e88 = angle;
-            let _e89 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e88);
+            let _e94 = angle;
+            let _e95 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e94);
             k = 0u;
             loop {
-                let _e92 = k;
-                if (_e92 < ((2u * thread) * 1u)) {
+                let _e98 = k;
+                if (_e98 < ((2u * thread) * 1u)) {
                 } else {
                     break;
                 }
                 {
-                    let _e98 = angle;
-                    let _e99 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e98, _e89);
-                    angle = _e99;
+                    let _e104 = angle;
+                    let _e105 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e104, _e95);
+                    angle = _e105;
                 }
                 continuing {
-                    let _e101 = k;
-                    k = (_e101 + 1u);
+                    let _e107 = k;
+                    k = (_e107 + 1u);
                 }
             }
             q = 0u;
             loop {
-                let _e105 = q;
-                if (_e105 < 1u) {
+                let _e111 = q;
+                if (_e111 < 1u) {
                 } else {
                     break;
                 }
                 {
-                    let _e108 = q;
-                    let layer_2 = ((thread * 1u) + _e108);
-                    let _e110 = angle;
-                    let _e111 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110, _e89);
-                    let _e112 = angle;
-                    let _e113 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e112, _e111);
-                    let _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e111, _e89);
-                    angle = _e114;
-                    let _e116 = q;
-                    let a_5 = acc[_e116];
-                    let _e119 = q;
-                    acc[_e119] = ((a_5 * (1f - blend)) + (_e113 * blend));
-                    let _e126 = q;
-                    let _e128 = acc[_e126];
-                    let stored = ((_e128 * 0.5f) + vec4(0.5f));
-                    let _e134 = i;
-                    let _e135 = filtered_index(_e134, row_5, layer_2);
-                    let _e138 = encode_layer(stored);
-                    filtered[_e135] = _e138;
+                    let _e114 = q;
+                    let layer_2 = ((thread * 1u) + _e114);
+                    let _e116 = angle;
+                    let _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e95);
+                    let _e118 = angle;
+                    let _e119 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e118, _e117);
+                    let _e120 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e95);
+                    angle = _e120;
+                    let _e122 = q;
+                    let a_7 = acc[_e122];
+                    let _e125 = q;
+                    acc[_e125] = ((a_7 * (1f - blend)) + (_e119 * blend));
+                    let _e132 = q;
+                    let _e134 = acc[_e132];
+                    let stored = ((_e134 * 0.5f) + vec4(0.5f));
+                    let _e140 = i;
+                    let _e141 = filtered_index(_e140, row_5, layer_2);
+                    let _e144 = encode_layer(stored);
+                    filtered[_e141] = _e144;
                 }
                 continuing {
-                    let _e140 = q;
-                    q = (_e140 + 1u);
+                    let _e146 = q;
+                    q = (_e146 + 1u);
                 }
             }
         }
         continuing {
-            let _e143 = i;
-            i = (_e143 + 1u);
+            let _e149 = i;
+            i = (_e149 + 1u);
         }
     }
     return;

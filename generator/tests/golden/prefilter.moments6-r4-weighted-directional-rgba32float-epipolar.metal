@@ -52,6 +52,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 proj_g0_;
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
+    metal::float4 fan_origin;
+    metal::float4 fan_angles;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
@@ -302,11 +304,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e48 = q_1;
-                    float u = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
+                    float u_1 = metal::tan(mid + ((0.5 * w_2) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
                     float _e54 = sum;
                     uint _e56 = q_1;
-                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u * u)));
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u_1 * u_1)));
                 }
             }
         }
@@ -350,11 +352,87 @@ metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return (f.e1_.xyz * metal::cos(phi)) + (f.e2_.xyz * metal::sin(phi));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1,
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1
+) {
+    return metal::float2(static_cast<float>(f_1.sizes.x), static_cast<float>(f_1.sizes.y));
+}
+
+float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    metal::float2 o_1,
+    metal::float2 u,
+    metal::float2 size
+) {
+    float t_in = 0.0;
+    float t_out = 340000000000000000000000000000000000000.0;
+    uint a_3 = 0u;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e45 = a_3;
+            a_3 = _e45 + 1u;
+        }
+        loop_init_2 = false;
+        uint _e4 = a_3;
+        if (_e4 < 2u) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = a_3;
+            uint _e13 = a_3;
+            float ta = (0.5 - o_1[metal::min(unsigned(_e8), 1u)]) / u[metal::min(unsigned(_e13), 1u)];
+            uint _e17 = a_3;
+            uint _e21 = a_3;
+            uint _e24 = a_3;
+            float tb = ((size[metal::min(unsigned(_e17), 1u)] - 0.5) - o_1[metal::min(unsigned(_e21), 1u)]) / u[metal::min(unsigned(_e24), 1u)];
+            uint _e27 = a_3;
+            bool crosses = metal::abs(u[metal::min(unsigned(_e27), 1u)]) > 0.000000000001;
+            float _e33 = t_in;
+            float _e34 = t_in;
+            t_in = crosses ? metal::max(_e34, metal::min(ta, tb)) : _e33;
+            float _e39 = t_out;
+            float _e40 = t_out;
+            t_out = crosses ? metal::min(_e40, metal::max(ta, tb)) : _e39;
+        }
+    }
+    float _e47 = t_in;
+    float _e48 = t_out;
+    float _e49 = t_in;
+    return 0.5 * (_e47 + metal::max(_e48, _e49));
+}
+
+metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    metal::float2 p_2
+) {
+    metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_2.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_2.sizes.y)));
+    float t_2 = f_2.cam_forward.w;
+    return metal::normalize((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2)));
+}
+
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
     uint row
 ) {
-    return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
+    float a_4 = f_3.fan_angles.x + ((static_cast<float>(row) + 0.5) * f_3.fan_angles.y);
+    metal::float2 ax = f_3.fan_origin.zw;
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_4)) - (ax.y * metal::sin(a_4)), (ax.y * metal::cos(a_4)) + (ax.x * metal::sin(a_4)));
+    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
+    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, f_3.fan_origin.xy + (u_2 * _e33));
+    return metal::atan2(metal::dot(_e36, f_3.e2_.xyz), metal::dot(_e36, f_3.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
+    uint row_1
+) {
+    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
+    return (f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((static_cast<float>(row_1) + 0.5) * f_4.e2_.w));
 }
 
 uint naga_div(uint lhs, uint rhs) {
@@ -374,13 +452,13 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 }
 
 float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s,
     float x_1,
     bool spot_1
 ) {
     bool local_2 = {};
-    float cap = 4.0 * f_2.theta.z;
+    float cap = 4.0 * f_5.theta.z;
     if (spot_1) {
         float psi = x_1 * s.delta;
         float den = metal::sin(s.theta_ref + psi);
@@ -393,42 +471,40 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
         if (_e23) {
             return cap;
         }
-        return metal::min((f_2.axis.w * metal::sin(psi)) / den, cap);
+        return metal::min((f_5.axis.w * metal::sin(psi)) / den, cap);
     } else {
         return metal::min((x_1 * s.delta) / metal::max(metal::sin(s.theta_ref), 0.0001), cap);
     }
 }
 
 float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1,
-    uint row_1,
+    metal::float3 e_1,
     uint i_1,
     bool weighted,
     bool spot_2
 ) {
     float w = {};
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, s_1, static_cast<float>(i_1), spot_2);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_3, s_1, static_cast<float>(i_1 + 1u), spot_2);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, static_cast<float>(i_1), spot_2);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, static_cast<float>(i_1 + 1u), spot_2);
     if (!(weighted)) {
         return _e9 - _e5;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_3.medium.x, _e5, _e9);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, _e5, _e9);
     w = _e15;
     if (spot_2) {
         float psi_1 = (static_cast<float>(i_1) + 0.5) * s_1.delta;
-        float _e23 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, row_1);
-        metal::float3 _e24 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e23);
-        metal::float3 l_1 = (-(f_3.axis.xyz) * metal::cos(psi_1)) + (_e24 * metal::sin(psi_1));
+        metal::float3 l_1 = (-(f_6.axis.xyz) * metal::cos(psi_1)) + (e_1 * metal::sin(psi_1));
         float den_1 = metal::max(metal::sin(s_1.theta_ref + psi_1), 0.0001);
-        float r_1 = metal::max((f_3.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
-        float _e53 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_3.light_dir.xyz), f_3.light_pos.w, f_3.light_dir.w);
-        float cone = metal::max(_e53, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
-        float _e56 = w;
-        w = _e56 * ((cone * metal::exp(-(f_3.medium.x) * r_1)) / (r_1 * r_1));
+        float r_1 = metal::max((f_6.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
+        float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_6.light_dir.xyz), f_6.light_pos.w, f_6.light_dir.w);
+        float cone = metal::max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
+        float _e54 = w;
+        w = _e54 * ((cone * metal::exp(-(f_6.medium.x) * r_1)) / (r_1 * r_1));
     }
-    float _e66 = w;
-    return _e66;
+    float _e64 = w;
+    return _e64;
 }
 
 float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
@@ -536,79 +612,83 @@ kernel void prefilter(
     }
     metal::float4 _e32 = slices[metal::min(unsigned(row_5), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
-    uint _e36 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
-    uint _e40 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, false);
-    i = _e36;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
+    float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_5);
+    metal::float3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
+    uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
+    uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, false);
+    i = _e42;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e112 = i;
-            i = _e112 + 1u;
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e118 = i;
+            i = _e118 + 1u;
         }
-        loop_init_2 = false;
-        uint _e42 = i;
-        if (_e42 < _e40) {
+        loop_init_3 = false;
+        uint _e48 = i;
+        if (_e48 < _e46) {
         } else {
             break;
         }
         {
-            uint _e44 = i;
-            uint clamped_lod_e48 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e48 = rectified.read(metal::min(metal::uint2(metal::uint2(_e44, row_5)), metal::uint2(rectified.get_width(clamped_lod_e48), rectified.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
-            float d_2 = _e48.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e51 = frame;
-            uint _e52 = i;
-            float _e54 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e51, _e33, row_5, _e52, true, false);
-            float _e56 = wsum;
-            wsum = _e56 + _e54;
+            uint _e50 = i;
+            uint clamped_lod_e54 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+            metal::float4 _e54 = rectified.read(metal::min(metal::uint2(metal::uint2(_e50, row_5)), metal::uint2(rectified.get_width(clamped_lod_e54), rectified.get_height(clamped_lod_e54)) - 1), clamped_lod_e54);
+            float d_2 = _e54.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = frame;
+            uint _e58 = i;
+            float _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, true, false);
+            float _e62 = wsum;
+            wsum = _e62 + _e60;
             if (thread_ == 0u) {
-                float _e61 = lo;
-                lo = metal::min(_e61, d_2);
-                float _e64 = hi;
-                hi = metal::max(_e64, d_2);
-                uint _e66 = i;
-                uint _e67 = bounds_index(_e66, row_5, frame);
-                float _e70 = lo;
-                float _e71 = hi;
-                bounds[metal::min(unsigned(_e67), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e70, _e71);
+                float _e67 = lo;
+                lo = metal::min(_e67, d_2);
+                float _e70 = hi;
+                hi = metal::max(_e70, d_2);
+                uint _e72 = i;
+                uint _e73 = bounds_index(_e72, row_5, frame);
+                float _e76 = lo;
+                float _e77 = hi;
+                bounds[metal::min(unsigned(_e73), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e76, _e77);
             }
-            float _e73 = wsum;
-            float _e75 = wsum;
-            float blend = (_e75 > 0.0) ? (_e54 / _e73) : 0.0;
-            float _e80 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            float _e79 = wsum;
+            float _e81 = wsum;
+            float blend = (_e81 > 0.0) ? (_e60 / _e79) : 0.0;
+            float _e86 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
             q = 0u;
-            uint2 loop_bound_3 = uint2(4294967295u);
-            bool loop_init_3 = true;
+            uint2 loop_bound_4 = uint2(4294967295u);
+            bool loop_init_4 = true;
             while(true) {
-                if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-                loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-                if (!loop_init_3) {
-                    uint _e109 = q;
-                    q = _e109 + 1u;
+                if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+                if (!loop_init_4) {
+                    uint _e115 = q;
+                    q = _e115 + 1u;
                 }
-                loop_init_3 = false;
-                uint _e84 = q;
-                if (_e84 < 2u) {
+                loop_init_4 = false;
+                uint _e90 = q;
+                if (_e90 < 2u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e87 = q;
-                    uint _e89 = q;
-                    metal::float4 _e91 = acc.inner[metal::min(unsigned(_e89), 1u)];
+                    uint _e93 = q;
                     uint _e95 = q;
-                    metal::float4 _e96 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e80, _e95);
-                    acc.inner[metal::min(unsigned(_e87), 1u)] = (_e91 * (1.0 - blend)) + (_e96 * blend);
-                    uint _e99 = i;
-                    uint _e100 = q;
-                    uint _e101 = filtered_index(_e99, row_5, _e100, frame);
-                    uint _e104 = q;
-                    metal::float4 _e106 = acc.inner[metal::min(unsigned(_e104), 1u)];
-                    metal::float4 _e107 = encode_layer(_e106);
-                    filtered[metal::min(unsigned(_e101), (_buffer_sizes.size3 - 0 - 16) / 16)] = _e107;
+                    metal::float4 _e97 = acc.inner[metal::min(unsigned(_e95), 1u)];
+                    uint _e101 = q;
+                    metal::float4 _e102 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e86, _e101);
+                    acc.inner[metal::min(unsigned(_e93), 1u)] = (_e97 * (1.0 - blend)) + (_e102 * blend);
+                    uint _e105 = i;
+                    uint _e106 = q;
+                    uint _e107 = filtered_index(_e105, row_5, _e106, frame);
+                    uint _e110 = q;
+                    metal::float4 _e112 = acc.inner[metal::min(unsigned(_e110), 1u)];
+                    metal::float4 _e113 = encode_layer(_e112);
+                    filtered[metal::min(unsigned(_e107), (_buffer_sizes.size3 - 0 - 16) / 16)] = _e113;
                 }
             }
         }

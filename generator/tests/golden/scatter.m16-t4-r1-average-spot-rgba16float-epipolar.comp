@@ -45,6 +45,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 proj_g0_;
     vec4 proj_g1_;
     vec4 proj_g2_;
+    vec4 fan_origin;
+    vec4 fan_angles;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
@@ -376,33 +378,37 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_6) {
-    uint rows_1 = f_8.sizes.w;
-    float phi_1 = atan(dot(dir_6, f_8.e2_.xyz), dot(dir_6, f_8.e1_.xyz));
-    float yc_1 = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
-    return ((f_8.anti_epipole.w > 0.5) ? (yc_1 - (floor((yc_1 / float(rows_1))) * float(rows_1))) : clamp(yc_1, 0.0, float(rows_1)));
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8) {
+    return vec2(float(f_8.sizes.x), float(f_8.sizes.y));
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_7, float s_2, float theta_2, bool spot_4) {
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 dir_6) {
+    uint rows_1 = f_9.sizes.w;
+    float phi = atan(dot(dir_6, f_9.e2_.xyz), dot(dir_6, f_9.e1_.xyz));
+    float z_4 = dot(dir_6, f_9.cam_forward.xyz);
+    float t_5 = f_9.cam_forward.w;
+    vec2 ndc = vec2((dot(dir_6, f_9.cam_right.xyz) / ((z_4 * t_5) * f_9.cam_right.w)), (dot(dir_6, f_9.cam_up.xyz) / (z_4 * t_5)));
+    vec2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    vec2 p_3 = (vec2(((ndc.x + 1.0) * 0.5), ((1.0 - ndc.y) * 0.5)) * _e41);
+    vec2 d_2 = (p_3 - f_9.fan_origin.xy);
+    vec2 ax = f_9.fan_origin.zw;
+    float fan = ((atan(((ax.x * d_2.y) - (ax.y * d_2.x)), ((ax.x * d_2.x) + (ax.y * d_2.y))) - f_9.fan_angles.x) / f_9.fan_angles.y);
+    float yc_1 = ((f_9.fan_angles.z > 0.5) ? fan : ((phi - f_9.e1_.w) / f_9.e2_.w));
+    return ((f_9.anti_epipole.w > 0.5) ? (yc_1 - (floor((yc_1 / float(rows_1))) * float(rows_1))) : clamp(yc_1, 0.0, float(rows_1)));
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 eye_6, vec3 dir_7, float s_2, float theta_2, bool spot_4) {
     if (spot_4) {
-        vec3 q_2 = ((eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz);
-        vec3 to_eye = -(f_9.axis.xyz);
+        vec3 q_2 = ((eye_6 + (dir_7 * s_2)) - f_10.light_pos.xyz);
+        vec3 to_eye = -(f_10.axis.xyz);
         return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 eye_7, vec3 dir_8, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec3 eye_7, vec3 dir_8, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
-}
-
-vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float phi) {
-    return ((f_11.e1_.xyz * cos(phi)) + (f_11.e2_.xyz * sin(phi)));
-}
-
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, uint row) {
-    return (f_12.e1_.w + ((float(row) + 0.5) * f_12.e2_.w));
 }
 
 vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_5, vec2 b_5) {
@@ -430,15 +436,15 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return (((r * r) * width) / (regions * regions));
 }
 
-uint bounds_index(uint x_3, uint row_1) {
+uint bounds_index(uint x_3, uint row) {
     uint _e5 = _group_0_binding_0_cs.sizes.w;
-    return ((x_3 * _e5) + row_1);
+    return ((x_3 * _e5) + row);
 }
 
-uint filtered_index(uint x_4, uint row_2, uint layer_1) {
+uint filtered_index(uint x_4, uint row_1, uint layer_1) {
     uint _e5 = _group_0_binding_0_cs.sizes.z;
     uint _e12 = _group_0_binding_0_cs.sizes.w;
-    return ((((layer_1 * _e5) + x_4) * _e12) + row_2);
+    return ((((layer_1 * _e5) + x_4) * _e12) + row_1);
 }
 
 uvec2 encode_layer(vec4 v_10) {
@@ -449,8 +455,8 @@ vec4 decode_layer(uvec2 w_1) {
     return vec4(unpackHalf2x16(w_1.x), unpackHalf2x16(w_1.y));
 }
 
-vec4 filtered_load(uint x_5, uint row_3, uint layer_2) {
-    uint _e3 = filtered_index(x_5, row_3, layer_2);
+vec4 filtered_load(uint x_5, uint row_2, uint layer_2) {
+    uint _e3 = filtered_index(x_5, row_2, layer_2);
     uvec2 _e6 = _group_0_binding_4_cs[_e3];
     vec4 _e7 = decode_layer(_e6);
     return _e7;
@@ -492,33 +498,33 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     bool local_7 = false;
     bool local_8 = false;
     bool local_9 = false;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = _group_0_binding_0_cs;
-    vec3 eye_8 = f_13.eye.xyz;
-    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = _group_0_binding_0_cs;
+    vec3 eye_8 = f_12.eye.xyz;
+    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
     int _e14_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_6, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
-    float s_3 = (min(max(_e14.x, 0.0), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 1e-6));
-    vec3 color = f_13.light_color.xyz;
-    bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, vec2((float(x_6) + 0.5), (float(y_1) + 0.5)));
+    float s_3 = (min(max(_e14.x, 0.0), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 1e-6));
+    vec3 color = f_12.light_color.xyz;
+    bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, vec2((float(x_6) + 0.5), (float(y_1) + 0.5)));
     if (_e36) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e38 = _group_0_binding_0_cs;
         float _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, _group_0_binding_3_cs, eye_8, _e10, s_3, true);
         vec3 l_1 = (_e41 * color);
         return l_1;
     }
-    vec3 axis = f_13.axis.xyz;
-    uint rows_2 = f_13.sizes.w;
-    uint width_1 = f_13.sizes.z;
-    bool wrap_1 = (f_13.anti_epipole.w > 0.5);
+    vec3 axis = f_12.axis.xyz;
+    uint rows_2 = f_12.sizes.w;
+    uint width_1 = f_12.sizes.z;
+    bool wrap_1 = (f_12.anti_epipole.w > 0.5);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
-        float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
         yc = _e59;
         float _e61 = theta_3;
-        float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
+        float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_12.theta.x, f_12.theta.y);
         d = _e66;
         float _e68 = theta_3;
-        float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_3, _e68, true);
+        float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e68, true);
         reach = _e69;
     }
     float _e71 = yc;
@@ -528,8 +534,8 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     uint _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
     uint row1_ = ((yb > floor(yb)) ? _e81 : _e77);
     float w1_ = ((row1_ != _e77) ? fy : 0.0);
-    float cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
-    uint panels_2 = max((f_13.sizes2_.z / 4u), 1u);
+    float cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
+    uint panels_2 = max((f_12.sizes2_.z / 4u), 1u);
     float _e99 = d;
     float _e103 = d;
     angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e99)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e103)));
@@ -559,8 +565,8 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
             angle = _e122;
         }
     }
-    float _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
-    float sun_scatter = (f_13.medium.y * _e130);
+    float _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    float sun_scatter = (f_12.medium.y * _e130);
     float _e133 = xs;
     xs0_ = _e133;
     float _e135 = xs;
@@ -626,39 +632,39 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
             e1_ = 0.0;
             float _e235 = delta0_;
             float _e236 = theta_3;
-            float _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e235, _e236, s_3, true);
+            float _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e235, _e236, s_3, true);
             a0_ = _e237;
             float _e238 = delta0_;
             float _e239 = theta_3;
-            float _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e238, _e239, s_3, true);
+            float _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e238, _e239, s_3, true);
             e0_ = (is_last0_ ? s_3 : _e240);
             float _e242 = delta1_;
             float _e243 = theta_3;
-            float _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e242, _e243, s_3, true);
+            float _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e242, _e243, s_3, true);
             a1_ = _e244;
             float _e245 = delta1_;
             float _e246 = theta_3;
-            float _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e245, _e246, s_3, true);
+            float _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e245, _e246, s_3, true);
             e1_ = (is_last1_ ? s_3 : _e247);
             weight0_ = 0.0;
             weight1_ = 0.0;
             if (true) {
                 float _e253 = a0_;
                 float _e254 = e0_;
-                float _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e253, _e254, panels_2);
+                float _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e253, _e254, panels_2);
                 weight0_ = _e255;
                 float _e256 = a1_;
                 float _e257 = e1_;
-                float _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e256, _e257, panels_2);
+                float _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e256, _e257, panels_2);
                 weight1_ = _e258;
             } else {
                 float _e261 = a0_;
                 float _e262 = e0_;
-                float _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e261, _e262);
+                float _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e261, _e262);
                 weight0_ = (sun_scatter * _e263);
                 float _e267 = a1_;
                 float _e268 = e1_;
-                float _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e267, _e268);
+                float _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e267, _e268);
                 weight1_ = (sun_scatter * _e269);
             }
             float xb0_ = (pos0_ - 0.5);

@@ -42,6 +42,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float4 proj_g0_;
     float4 proj_g1_;
     float4 proj_g2_;
+    float4 fan_origin;
+    float4 fan_angles;
 };
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
@@ -452,38 +454,41 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 dir_6)
+float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8)
 {
-    uint rows_1 = f_8.sizes.w;
-    float phi_1 = atan2(dot(dir_6, f_8.e2_.xyz), dot(dir_6, f_8.e1_.xyz));
-    float yc_1 = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
-    return ((f_8.anti_epipole.w > 0.5) ? (yc_1 - (floor((yc_1 / float(rows_1))) * float(rows_1))) : clamp(yc_1, 0.0, float(rows_1)));
+    return float2(float(f_8.sizes.x), float(f_8.sizes.y));
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 eye_6, float3 dir_7, float s_2, float theta_2, bool spot_4)
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float3 dir_6)
+{
+    uint rows_1 = f_9.sizes.w;
+    float phi = atan2(dot(dir_6, f_9.e2_.xyz), dot(dir_6, f_9.e1_.xyz));
+    float z_4 = dot(dir_6, f_9.cam_forward.xyz);
+    float t_5 = f_9.cam_forward.w;
+    float2 ndc = float2((dot(dir_6, f_9.cam_right.xyz) / ((z_4 * t_5) * f_9.cam_right.w)), (dot(dir_6, f_9.cam_up.xyz) / (z_4 * t_5)));
+    const float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    float2 p_3 = (float2(((ndc.x + 1.0) * 0.5), ((1.0 - ndc.y) * 0.5)) * _e41);
+    float2 d_2 = (p_3 - f_9.fan_origin.xy);
+    float2 ax = f_9.fan_origin.zw;
+    float fan = ((atan2(((ax.x * d_2.y) - (ax.y * d_2.x)), ((ax.x * d_2.x) + (ax.y * d_2.y))) - f_9.fan_angles.x) / f_9.fan_angles.y);
+    float yc_1 = ((f_9.fan_angles.z > 0.5) ? fan : ((phi - f_9.e1_.w) / f_9.e2_.w));
+    return ((f_9.anti_epipole.w > 0.5) ? (yc_1 - (floor((yc_1 / float(rows_1))) * float(rows_1))) : clamp(yc_1, 0.0, float(rows_1)));
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float3 eye_6, float3 dir_7, float s_2, float theta_2, bool spot_4)
 {
     if (spot_4) {
-        float3 q_2 = ((eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz);
-        float3 to_eye = -(f_9.axis.xyz);
+        float3 q_2 = ((eye_6 + (dir_7 * s_2)) - f_10.light_pos.xyz);
+        float3 to_eye = -(f_10.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float3 eye_7, float3 dir_8, float a_4, float b_4, uint panels_1)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float3 eye_7, float3 dir_8, float a_4, float b_4, uint panels_1)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
-}
-
-float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float phi)
-{
-    return ((f_11.e1_.xyz * cos(phi)) + (f_11.e2_.xyz * sin(phi)));
-}
-
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, uint row)
-{
-    return (f_12.e1_.w + ((float(row) + 0.5) * f_12.e2_.w));
 }
 
 float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_5, float2 b_5)
@@ -520,17 +525,17 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return naga_div(((r * r) * width), (regions * regions));
 }
 
-uint bounds_index(uint x_3, uint row_1)
+uint bounds_index(uint x_3, uint row)
 {
     uint _e5 = frame.sizes.w;
-    return ((x_3 * _e5) + row_1);
+    return ((x_3 * _e5) + row);
 }
 
-uint filtered_index(uint x_4, uint row_2, uint layer_1)
+uint filtered_index(uint x_4, uint row_1, uint layer_1)
 {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return ((((layer_1 * _e5) + x_4) * _e12) + row_2);
+    return ((((layer_1 * _e5) + x_4) * _e12) + row_1);
 }
 
 uint2 encode_layer(float4 v_10)
@@ -547,9 +552,9 @@ float4 decode_layer(uint2 w_1)
     return float4(float2(f16tof32(_e1), f16tof32((_e1) >> 16)), float2(f16tof32(_e3), f16tof32((_e3) >> 16)));
 }
 
-float4 filtered_load(uint x_5, uint row_3, uint layer_2)
+float4 filtered_load(uint x_5, uint row_2, uint layer_2)
 {
-    const uint _e3 = filtered_index(x_5, row_3, layer_2);
+    const uint _e3 = filtered_index(x_5, row_2, layer_2);
     uint2 _e6 = asuint(filtered.Load2(_e3*8));
     const float4 _e7 = decode_layer(_e6);
     return _e7;
@@ -597,32 +602,32 @@ float3 scatter_pixel(uint x_6, uint y_1)
     bool local_8 = (bool)0;
     bool local_9 = (bool)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
-    float3 eye_8 = f_13.eye.xyz;
-    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
+    float3 eye_8 = f_12.eye.xyz;
+    const float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
     float4 _e14 = depth.Load(int3(uint2(x_6, y_1), int(0)));
-    float s_3 = (min(max(_e14.x, 0.0), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 1e-6));
-    float3 color = f_13.light_color.xyz;
-    const bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, float2((float(x_6) + 0.5), (float(y_1) + 0.5)));
+    float s_3 = (min(max(_e14.x, 0.0), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 1e-6));
+    float3 color = f_12.light_color.xyz;
+    const bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, float2((float(x_6) + 0.5), (float(y_1) + 0.5)));
     if (_e36) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e38 = frame;
         const float _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, shadow_map, eye_8, _e10, s_3, true);
         float3 l_1 = (_e41 * color);
         return l_1;
     }
-    float3 axis = f_13.axis.xyz;
-    uint rows_2 = f_13.sizes.w;
-    uint width_1 = f_13.sizes.z;
-    bool wrap_1 = (f_13.anti_epipole.w > 0.5);
+    float3 axis = f_12.axis.xyz;
+    uint rows_2 = f_12.sizes.w;
+    uint width_1 = f_12.sizes.z;
+    bool wrap_1 = (f_12.anti_epipole.w > 0.5);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
-        const float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        const float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
         yc = _e59;
         float _e61 = theta_3;
-        const float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
+        const float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_12.theta.x, f_12.theta.y);
         d = _e66;
         float _e68 = theta_3;
-        const float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_3, _e68, true);
+        const float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e68, true);
         reach = _e69;
     }
     float _e71 = yc;
@@ -632,8 +637,8 @@ float3 scatter_pixel(uint x_6, uint y_1)
     const uint _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
     uint row1_ = ((yb > floor(yb)) ? _e81 : _e77);
     float w1_ = ((row1_ != _e77) ? fy : 0.0);
-    float cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
-    uint panels_2 = max(naga_div(f_13.sizes2_.z, 4u), 1u);
+    float cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
+    uint panels_2 = max(naga_div(f_12.sizes2_.z, 4u), 1u);
     float _e99 = d;
     float _e103 = d;
     angle = float2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e99)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e103)));
@@ -666,8 +671,8 @@ float3 scatter_pixel(uint x_6, uint y_1)
             angle = _e122;
         }
     }
-    const float _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
-    float sun_scatter = (f_13.medium.y * _e130);
+    const float _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    float sun_scatter = (f_12.medium.y * _e130);
     float _e133 = xs;
     xs0_ = _e133;
     float _e135 = xs;
@@ -736,39 +741,39 @@ float3 scatter_pixel(uint x_6, uint y_1)
             e1_ = ZeroValuefloat();
             float _e235 = delta0_;
             float _e236 = theta_3;
-            const float _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e235, _e236, s_3, true);
+            const float _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e235, _e236, s_3, true);
             a0_ = _e237;
             float _e238 = delta0_;
             float _e239 = theta_3;
-            const float _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e238, _e239, s_3, true);
+            const float _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e238, _e239, s_3, true);
             e0_ = (is_last0_ ? s_3 : _e240);
             float _e242 = delta1_;
             float _e243 = theta_3;
-            const float _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e242, _e243, s_3, true);
+            const float _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e242, _e243, s_3, true);
             a1_ = _e244;
             float _e245 = delta1_;
             float _e246 = theta_3;
-            const float _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e245, _e246, s_3, true);
+            const float _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e245, _e246, s_3, true);
             e1_ = (is_last1_ ? s_3 : _e247);
             weight0_ = ZeroValuefloat();
             weight1_ = ZeroValuefloat();
             if (true) {
                 float _e253 = a0_;
                 float _e254 = e0_;
-                const float _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e253, _e254, panels_2);
+                const float _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e253, _e254, panels_2);
                 weight0_ = _e255;
                 float _e256 = a1_;
                 float _e257 = e1_;
-                const float _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e256, _e257, panels_2);
+                const float _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e256, _e257, panels_2);
                 weight1_ = _e258;
             } else {
                 float _e261 = a0_;
                 float _e262 = e0_;
-                const float _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e261, _e262);
+                const float _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e261, _e262);
                 weight0_ = (sun_scatter * _e263);
                 float _e267 = a1_;
                 float _e268 = e1_;
-                const float _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e267, _e268);
+                const float _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e267, _e268);
                 weight1_ = (sun_scatter * _e269);
             }
             float xb0_ = (pos0_ - 0.5);

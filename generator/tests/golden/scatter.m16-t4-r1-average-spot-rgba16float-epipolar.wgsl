@@ -42,6 +42,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     proj_g0_: vec4<f32>,
     proj_g1_: vec4<f32>,
     proj_g2_: vec4<f32>,
+    fan_origin: vec4<f32>,
+    fan_angles: vec4<f32>,
 }
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
@@ -371,33 +373,37 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_X
     }
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
-    let rows_1 = f_8.sizes.w;
-    let phi_1 = atan2(dot(dir_6, f_8.e2_.xyz), dot(dir_6, f_8.e1_.xyz));
-    let yc_1 = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
-    return select(clamp(yc_1, 0f, f32(rows_1)), (yc_1 - (floor((yc_1 / f32(rows_1))) * f32(rows_1))), (f_8.anti_epipole.w > 0.5f));
+fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
+    return vec2<f32>(f32(f_8.sizes.x), f32(f_8.sizes.y));
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_4: bool) -> f32 {
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let rows_1 = f_9.sizes.w;
+    let phi = atan2(dot(dir_6, f_9.e2_.xyz), dot(dir_6, f_9.e1_.xyz));
+    let z_4 = dot(dir_6, f_9.cam_forward.xyz);
+    let t_5 = f_9.cam_forward.w;
+    let ndc = vec2<f32>((dot(dir_6, f_9.cam_right.xyz) / ((z_4 * t_5) * f_9.cam_right.w)), (dot(dir_6, f_9.cam_up.xyz) / (z_4 * t_5)));
+    let _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    let p_3 = (vec2<f32>(((ndc.x + 1f) * 0.5f), ((1f - ndc.y) * 0.5f)) * _e41);
+    let d_2 = (p_3 - f_9.fan_origin.xy);
+    let ax = f_9.fan_origin.zw;
+    let fan = ((atan2(((ax.x * d_2.y) - (ax.y * d_2.x)), ((ax.x * d_2.x) + (ax.y * d_2.y))) - f_9.fan_angles.x) / f_9.fan_angles.y);
+    let yc_1 = select(((phi - f_9.e1_.w) / f_9.e2_.w), fan, (f_9.fan_angles.z > 0.5f));
+    return select(clamp(yc_1, 0f, f32(rows_1)), (yc_1 - (floor((yc_1 / f32(rows_1))) * f32(rows_1))), (f_9.anti_epipole.w > 0.5f));
+}
+
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_4: bool) -> f32 {
     if spot_4 {
-        let q_2 = ((eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz);
-        let to_eye = -(f_9.axis.xyz);
+        let q_2 = ((eye_6 + (dir_7 * s_2)) - f_10.light_pos.xyz);
+        let to_eye = -(f_10.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_8: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_8: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
-}
-
-fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
-    return ((f_11.e1_.xyz * cos(phi)) + (f_11.e2_.xyz * sin(phi)));
-}
-
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    return (f_12.e1_.w + ((f32(row) + 0.5f) * f_12.e2_.w));
 }
 
 fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_5: vec2<f32>) -> vec2<f32> {
@@ -425,15 +431,15 @@ fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions
     return (((r * r) * width) / (regions * regions));
 }
 
-fn bounds_index(x_3: u32, row_1: u32) -> u32 {
+fn bounds_index(x_3: u32, row: u32) -> u32 {
     let _e5 = frame.sizes.w;
-    return ((x_3 * _e5) + row_1);
+    return ((x_3 * _e5) + row);
 }
 
-fn filtered_index(x_4: u32, row_2: u32, layer_1: u32) -> u32 {
+fn filtered_index(x_4: u32, row_1: u32, layer_1: u32) -> u32 {
     let _e5 = frame.sizes.z;
     let _e12 = frame.sizes.w;
-    return ((((layer_1 * _e5) + x_4) * _e12) + row_2);
+    return ((((layer_1 * _e5) + x_4) * _e12) + row_1);
 }
 
 fn encode_layer(v_10: vec4<f32>) -> vec2<u32> {
@@ -444,8 +450,8 @@ fn decode_layer(w_1: vec2<u32>) -> vec4<f32> {
     return vec4<f32>(unpack2x16float(w_1.x), unpack2x16float(w_1.y));
 }
 
-fn filtered_load(x_5: u32, row_3: u32, layer_2: u32) -> vec4<f32> {
-    let _e3 = filtered_index(x_5, row_3, layer_2);
+fn filtered_load(x_5: u32, row_2: u32, layer_2: u32) -> vec4<f32> {
+    let _e3 = filtered_index(x_5, row_2, layer_2);
     let _e6 = filtered[_e3];
     let _e7 = decode_layer(_e6);
     return _e7;
@@ -488,32 +494,32 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var local_8: bool;
     var local_9: bool;
 
-    let f_13 = frame;
-    let eye_8 = f_13.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
+    let f_12 = frame;
+    let eye_8 = f_12.eye.xyz;
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
     let _e14 = textureLoad(depth, vec2<u32>(x_6, y_1), 0i);
-    let s_3 = (min(max(_e14.x, 0f), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 0.000001f));
-    let color = f_13.light_color.xyz;
-    let _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, vec2<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f)));
+    let s_3 = (min(max(_e14.x, 0f), f_12.theta.z) / max(dot(_e10, f_12.cam_forward.xyz), 0.000001f));
+    let color = f_12.light_color.xyz;
+    let _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, vec2<f32>((f32(x_6) + 0.5f), (f32(y_1) + 0.5f)));
     if _e36 {
         let _e38 = frame;
         let _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, shadow_map, eye_8, _e10, s_3, true);
         let l_1 = (_e41 * color);
         return l_1;
     }
-    let axis = f_13.axis.xyz;
-    let rows_2 = f_13.sizes.w;
-    let width_1 = f_13.sizes.z;
-    let wrap_1 = (f_13.anti_epipole.w > 0.5f);
+    let axis = f_12.axis.xyz;
+    let rows_2 = f_12.sizes.w;
+    let width_1 = f_12.sizes.z;
+    let wrap_1 = (f_12.anti_epipole.w > 0.5f);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        let _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
         yc = _e59;
         let _e61 = theta_3;
-        let _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
+        let _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_12.theta.x, f_12.theta.y);
         d = _e66;
         let _e68 = theta_3;
-        let _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_3, _e68, true);
+        let _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e68, true);
         reach = _e69;
     }
     let _e71 = yc;
@@ -523,8 +529,8 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     let _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
     let row1_ = select(_e77, _e81, (yb > floor(yb)));
     let w1_ = select(0f, fy, (row1_ != _e77));
-    let cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
-    let panels_2 = max((f_13.sizes2_.z / 4u), 1u);
+    let cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
+    let panels_2 = max((f_12.sizes2_.z / 4u), 1u);
     let _e99 = d;
     let _e103 = d;
     angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e99)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e103)));
@@ -552,8 +558,8 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             layer_3 = (_e124 + 1u);
         }
     }
-    let _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
-    let sun_scatter = (f_13.medium.y * _e130);
+    let _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    let sun_scatter = (f_12.medium.y * _e130);
     let _e133 = xs;
     xs0_ = _e133;
     let _e135 = xs;
@@ -613,39 +619,39 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             e1_ = f32();
             let _e235 = delta0_;
             let _e236 = theta_3;
-            let _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e235, _e236, s_3, true);
+            let _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e235, _e236, s_3, true);
             a0_ = _e237;
             let _e238 = delta0_;
             let _e239 = theta_3;
-            let _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e238, _e239, s_3, true);
+            let _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e238, _e239, s_3, true);
             e0_ = select(_e240, s_3, is_last0_);
             let _e242 = delta1_;
             let _e243 = theta_3;
-            let _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e242, _e243, s_3, true);
+            let _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e242, _e243, s_3, true);
             a1_ = _e244;
             let _e245 = delta1_;
             let _e246 = theta_3;
-            let _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e245, _e246, s_3, true);
+            let _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e245, _e246, s_3, true);
             e1_ = select(_e247, s_3, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if true {
                 let _e253 = a0_;
                 let _e254 = e0_;
-                let _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e253, _e254, panels_2);
+                let _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e253, _e254, panels_2);
                 weight0_ = _e255;
                 let _e256 = a1_;
                 let _e257 = e1_;
-                let _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e256, _e257, panels_2);
+                let _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e256, _e257, panels_2);
                 weight1_ = _e258;
             } else {
                 let _e261 = a0_;
                 let _e262 = e0_;
-                let _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e261, _e262);
+                let _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e261, _e262);
                 weight0_ = (sun_scatter * _e263);
                 let _e267 = a1_;
                 let _e268 = e1_;
-                let _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e267, _e268);
+                let _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e267, _e268);
                 weight1_ = (sun_scatter * _e269);
             }
             let xb0_ = (pos0_ - 0.5f);

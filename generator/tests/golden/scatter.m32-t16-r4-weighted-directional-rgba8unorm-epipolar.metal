@@ -52,6 +52,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 proj_g0_;
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
+    metal::float4 fan_origin;
+    metal::float4 fan_angles;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
@@ -523,18 +525,32 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     }
 }
 
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8
+) {
+    return metal::float2(static_cast<float>(f_8.sizes.x), static_cast<float>(f_8.sizes.y));
+}
+
 float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     metal::float3 dir_6
 ) {
-    uint rows_1 = f_8.sizes.w;
-    float phi_1 = metal::atan2(metal::dot(dir_6, f_8.e2_.xyz), metal::dot(dir_6, f_8.e1_.xyz));
-    float yc_1 = (phi_1 - f_8.e1_.w) / f_8.e2_.w;
-    return (f_8.anti_epipole.w > 0.5) ? (yc_1 - (metal::floor(yc_1 / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc_1, 0.0, static_cast<float>(rows_1));
+    uint rows_1 = f_9.sizes.w;
+    float phi = metal::atan2(metal::dot(dir_6, f_9.e2_.xyz), metal::dot(dir_6, f_9.e1_.xyz));
+    float z_4 = metal::dot(dir_6, f_9.cam_forward.xyz);
+    float t_5 = f_9.cam_forward.w;
+    metal::float2 ndc = metal::float2(metal::dot(dir_6, f_9.cam_right.xyz) / ((z_4 * t_5) * f_9.cam_right.w), metal::dot(dir_6, f_9.cam_up.xyz) / (z_4 * t_5));
+    metal::float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    metal::float2 p_3 = metal::float2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * _e41;
+    metal::float2 d_2 = p_3 - f_9.fan_origin.xy;
+    metal::float2 ax = f_9.fan_origin.zw;
+    float fan = (metal::atan2((ax.x * d_2.y) - (ax.y * d_2.x), (ax.x * d_2.x) + (ax.y * d_2.y)) - f_9.fan_angles.x) / f_9.fan_angles.y;
+    float yc_1 = (f_9.fan_angles.z > 0.5) ? fan : ((phi - f_9.e1_.w) / f_9.e2_.w);
+    return (f_9.anti_epipole.w > 0.5) ? (yc_1 - (metal::floor(yc_1 / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc_1, 0.0, static_cast<float>(rows_1));
 }
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     metal::float3 eye_6,
     metal::float3 dir_7,
     float s_2,
@@ -542,37 +558,23 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_4
 ) {
     if (spot_4) {
-        metal::float3 q_2 = (eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz;
-        metal::float3 to_eye = -(f_9.axis.xyz);
+        metal::float3 q_2 = (eye_6 + (dir_7 * s_2)) - f_10.light_pos.xyz;
+        metal::float3 to_eye = -(f_10.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
     }
     return s_2 * metal::sin(theta_2);
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     metal::float3 eye_7,
     metal::float3 dir_8,
     float a_4,
     float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
-}
-
-metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
-    float phi
-) {
-    return (f_11.e1_.xyz * metal::cos(phi)) + (f_11.e2_.xyz * metal::sin(phi));
-}
-
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
-    uint row
-) {
-    return f_12.e1_.w + ((static_cast<float>(row) + 0.5) * f_12.e2_.w);
 }
 
 metal::float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -622,22 +624,22 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 
 uint bounds_index(
     uint x_3,
-    uint row_1,
+    uint row,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
     uint _e5 = frame.sizes.w;
-    return (x_3 * _e5) + row_1;
+    return (x_3 * _e5) + row;
 }
 
 uint filtered_index(
     uint x_4,
-    uint row_2,
+    uint row_1,
     uint layer_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return (((layer_1 * _e5) + x_4) * _e12) + row_2;
+    return (((layer_1 * _e5) + x_4) * _e12) + row_1;
 }
 
 uint encode_layer(
@@ -654,13 +656,13 @@ metal::float4 decode_layer(
 
 metal::float4 filtered_load(
     uint x_5,
-    uint row_3,
+    uint row_2,
     uint layer_2,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_10 const& filtered,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    uint _e3 = filtered_index(x_5, row_3, layer_2, frame);
+    uint _e3 = filtered_index(x_5, row_2, layer_2, frame);
     uint _e6 = filtered[metal::min(unsigned(_e3), (_buffer_sizes.size4 - 0 - 4) / 4)];
     metal::float4 _e7 = decode_layer(_e6);
     return _e7;
@@ -712,33 +714,33 @@ metal::float3 scatter_pixel(
     bool local_7 = {};
     bool local_8 = {};
     bool local_9 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
-    metal::float3 eye_8 = f_13.eye.xyz;
-    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_6, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
+    metal::float3 eye_8 = f_12.eye.xyz;
+    metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
     uint clamped_lod_e14 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e14 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y_1)), metal::uint2(depth.get_width(clamped_lod_e14), depth.get_height(clamped_lod_e14)) - 1), clamped_lod_e14);
-    float s_3 = metal::min(metal::max(_e14.x, 0.0), f_13.theta.z) / metal::max(metal::dot(_e10, f_13.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_13.light_color.xyz;
-    bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, metal::float2(static_cast<float>(x_6) + 0.5, static_cast<float>(y_1) + 0.5));
+    float s_3 = metal::min(metal::max(_e14.x, 0.0), f_12.theta.z) / metal::max(metal::dot(_e10, f_12.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_12.light_color.xyz;
+    bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, metal::float2(static_cast<float>(x_6) + 0.5, static_cast<float>(y_1) + 0.5));
     if (_e36) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e38 = frame;
         float _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, shadow_map, eye_8, _e10, s_3, false);
         metal::float3 l_1 = _e41 * color;
         return l_1;
     }
-    metal::float3 axis = f_13.axis.xyz;
-    uint rows_2 = f_13.sizes.w;
-    uint width_1 = f_13.sizes.z;
-    bool wrap_1 = f_13.anti_epipole.w > 0.5;
+    metal::float3 axis = f_12.axis.xyz;
+    uint rows_2 = f_12.sizes.w;
+    uint width_1 = f_12.sizes.z;
+    bool wrap_1 = f_12.anti_epipole.w > 0.5;
     {
         theta_3 = metal::acos(metal::clamp(metal::dot(_e10, axis), -1.0, 1.0));
-        float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
         yc = _e59;
         float _e61 = theta_3;
-        float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
+        float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_12.theta.x, f_12.theta.y);
         d = _e66;
         float _e68 = theta_3;
-        float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_3, _e68, false);
+        float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e68, false);
         reach = _e69;
     }
     float _e71 = yc;
@@ -748,8 +750,8 @@ metal::float3 scatter_pixel(
     uint _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_2, wrap_1);
     uint row1_ = (yb > metal::floor(yb)) ? _e81 : _e77;
     float w1_ = (row1_ != _e77) ? fy : 0.0;
-    float cos_theta_l = -(metal::dot(f_13.light_dir.xyz, _e10));
-    uint panels_2 = metal::max(naga_div(f_13.sizes2_.z, 4u), 1u);
+    float cos_theta_l = -(metal::dot(f_12.light_dir.xyz, _e10));
+    uint panels_2 = metal::max(naga_div(f_12.sizes2_.z, 4u), 1u);
     float _e99 = d;
     float _e103 = d;
     angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e99), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e103));
@@ -782,8 +784,8 @@ metal::float3 scatter_pixel(
             angle = _e122;
         }
     }
-    float _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
-    float sun_scatter = f_13.medium.y * _e130;
+    float _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    float sun_scatter = f_12.medium.y * _e130;
     float _e133 = xs;
     xs0_ = _e133;
     float _e135 = xs;
@@ -852,39 +854,39 @@ metal::float3 scatter_pixel(
             e1_ = float {};
             float _e235 = delta0_;
             float _e236 = theta_3;
-            float _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e235, _e236, s_3, false);
+            float _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e235, _e236, s_3, false);
             a0_ = _e237;
             float _e238 = delta0_;
             float _e239 = theta_3;
-            float _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e238, _e239, s_3, false);
+            float _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e238, _e239, s_3, false);
             e0_ = is_last0_ ? s_3 : _e240;
             float _e242 = delta1_;
             float _e243 = theta_3;
-            float _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e242, _e243, s_3, false);
+            float _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e242, _e243, s_3, false);
             a1_ = _e244;
             float _e245 = delta1_;
             float _e246 = theta_3;
-            float _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_, _e245, _e246, s_3, false);
+            float _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e245, _e246, s_3, false);
             e1_ = is_last1_ ? s_3 : _e247;
             weight0_ = float {};
             weight1_ = float {};
             if (false) {
                 float _e253 = a0_;
                 float _e254 = e0_;
-                float _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e253, _e254, panels_2);
+                float _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e253, _e254, panels_2);
                 weight0_ = _e255;
                 float _e256 = a1_;
                 float _e257 = e1_;
-                float _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e256, _e257, panels_2);
+                float _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e256, _e257, panels_2);
                 weight1_ = _e258;
             } else {
                 float _e261 = a0_;
                 float _e262 = e0_;
-                float _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e261, _e262);
+                float _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e261, _e262);
                 weight0_ = sun_scatter * _e263;
                 float _e267 = a1_;
                 float _e268 = e1_;
-                float _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e267, _e268);
+                float _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e267, _e268);
                 weight1_ = sun_scatter * _e269;
             }
             float xb0_ = pos0_ - 0.5;

@@ -45,6 +45,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 proj_g0_;
     vec4 proj_g1_;
     vec4 proj_g2_;
+    vec4 fan_origin;
+    vec4 fan_angles;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
@@ -382,24 +384,36 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
     }
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_6) {
-    uint rows_1 = f_8.sizes.w;
-    float phi_1 = atan(dot(dir_6, f_8.e2_.xyz), dot(dir_6, f_8.e1_.xyz));
-    float yc_1 = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
-    return ((f_8.anti_epipole.w > 0.5) ? (yc_1 - (floor((yc_1 / float(rows_1))) * float(rows_1))) : clamp(yc_1, 0.0, float(rows_1)));
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8) {
+    return vec2(float(f_8.sizes.x), float(f_8.sizes.y));
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_7, float s_2, float theta_2, bool spot_4) {
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 dir_6) {
+    uint rows_1 = f_9.sizes.w;
+    float phi = atan(dot(dir_6, f_9.e2_.xyz), dot(dir_6, f_9.e1_.xyz));
+    float z_5 = dot(dir_6, f_9.cam_forward.xyz);
+    float t_5 = f_9.cam_forward.w;
+    vec2 ndc = vec2((dot(dir_6, f_9.cam_right.xyz) / ((z_5 * t_5) * f_9.cam_right.w)), (dot(dir_6, f_9.cam_up.xyz) / (z_5 * t_5)));
+    vec2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    vec2 p_3 = (vec2(((ndc.x + 1.0) * 0.5), ((1.0 - ndc.y) * 0.5)) * _e41);
+    vec2 d_3 = (p_3 - f_9.fan_origin.xy);
+    vec2 ax = f_9.fan_origin.zw;
+    float fan = ((atan(((ax.x * d_3.y) - (ax.y * d_3.x)), ((ax.x * d_3.x) + (ax.y * d_3.y))) - f_9.fan_angles.x) / f_9.fan_angles.y);
+    float yc_1 = ((f_9.fan_angles.z > 0.5) ? fan : ((phi - f_9.e1_.w) / f_9.e2_.w));
+    return ((f_9.anti_epipole.w > 0.5) ? (yc_1 - (floor((yc_1 / float(rows_1))) * float(rows_1))) : clamp(yc_1, 0.0, float(rows_1)));
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 eye_6, vec3 dir_7, float s_2, float theta_2, bool spot_4) {
     if (spot_4) {
-        vec3 q_3 = ((eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz);
-        vec3 to_eye = -(f_9.axis.xyz);
+        vec3 q_3 = ((eye_6 + (dir_7 * s_2)) - f_10.light_pos.xyz);
+        vec3 to_eye = -(f_10.axis.xyz);
         return atan(length(cross(q_3, to_eye)), dot(q_3, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 eye_7, vec3 dir_8, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec3 eye_7, vec3 dir_8, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
@@ -431,10 +445,10 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
     float a_6 = (c3_ / c4_);
     float b_5 = (c2_ / c4_);
     float c = (c1_ / c4_);
-    float p_3 = min((b_5 - ((a_6 * a_6) / 3.0)), -1e-12);
+    float p_4 = min((b_5 - ((a_6 * a_6) / 3.0)), -1e-12);
     float qq = ((((((2.0 * a_6) * a_6) * a_6) / 27.0) - ((a_6 * b_5) / 3.0)) + c);
-    float m = (2.0 * sqrt((-(p_3) / 3.0)));
-    float theta_4 = (acos(clamp(((3.0 * qq) / (p_3 * m)), -1.0, 1.0)) / 3.0);
+    float m = (2.0 * sqrt((-(p_4) / 3.0)));
+    float theta_4 = (acos(clamp(((3.0 * qq) / (p_4 * m)), -1.0, 1.0)) / 3.0);
     float greatest = ((m * cos(theta_4)) - (a_6 / 3.0));
     float least = ((m * cos((theta_4 - 4.1887903))) - (a_6 / 3.0));
     z_1 = ((abs(greatest) >= abs(least)) ? greatest : least);
@@ -454,13 +468,13 @@ CubicRootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX cubic_rootsX_naga_oil_mod_
             float _e86 = z_1;
             float _e87 = z_1;
             float _e88 = z_1;
-            float f_13 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
+            float f_12 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
             float _e95 = z_1;
             float _e98 = z_1;
             float df = (c2_ + (_e95 * ((2.0 * c3_) + ((3.0 * _e98) * c4_))));
             if ((df != 0.0)) {
                 float _e107 = z_1;
-                z_1 = (_e107 - (f_13 / df));
+                z_1 = (_e107 - (f_12 / df));
             }
         }
     }
@@ -485,9 +499,9 @@ float far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float x_4, float far, boo
 
 float atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float b1_, float b2_, float b3_, float x_5, float u, float v_10, float k_2) {
     float s_4 = (u + v_10);
-    float p_4 = (u * v_10);
-    float e2_ = ((b2_ - (b1_ * s_4)) + p_4);
-    float e3_ = (((b3_ - (b2_ * (s_4 + x_5))) + (b1_ * (p_4 + (s_4 * x_5)))) - (p_4 * x_5));
+    float p_5 = (u * v_10);
+    float e2_ = ((b2_ - (b1_ * s_4)) + p_5);
+    float e3_ = (((b3_ - (b2_ * (s_4 + x_5))) + (b1_ * (p_5 + (s_4 * x_5)))) - (p_5 * x_5));
     return ((e2_ + (e3_ * k_2)) / ((x_5 - u) * (x_5 - v_10)));
 }
 
@@ -545,14 +559,6 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw0_, vec2 r
     return clamp(((1.0 - _e129) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0.0, 1.0);
 }
 
-vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float phi) {
-    return ((f_11.e1_.xyz * cos(phi)) + (f_11.e2_.xyz * sin(phi)));
-}
-
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, uint row) {
-    return (f_12.e1_.w + ((float(row) + 0.5) * f_12.e2_.w));
-}
-
 uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_5) {
     if (spot_5) {
         return ((r * width) / regions);
@@ -560,15 +566,15 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return (((r * r) * width) / (regions * regions));
 }
 
-uint bounds_index(uint x_6, uint row_1) {
+uint bounds_index(uint x_6, uint row) {
     uint _e5 = _group_0_binding_0_cs.sizes.w;
-    return ((x_6 * _e5) + row_1);
+    return ((x_6 * _e5) + row);
 }
 
-uint filtered_index(uint x_7, uint row_2, uint layer) {
+uint filtered_index(uint x_7, uint row_1, uint layer) {
     uint _e5 = _group_0_binding_0_cs.sizes.w;
     uint _e12 = _group_0_binding_0_cs.sizes.z;
-    return ((((layer * _e5) + row_2) * _e12) + x_7);
+    return ((((layer * _e5) + row_1) * _e12) + x_7);
 }
 
 vec4 encode_layer(vec4 v_11) {
@@ -579,8 +585,8 @@ vec4 decode_layer(vec4 w_1) {
     return w_1;
 }
 
-vec4 filtered_load(uint x_8, uint row_3, uint layer_1) {
-    uint _e3 = filtered_index(x_8, row_3, layer_1);
+vec4 filtered_load(uint x_8, uint row_2, uint layer_1) {
+    uint _e3 = filtered_index(x_8, row_2, layer_1);
     vec4 _e6 = _group_0_binding_4_cs[_e3];
     vec4 _e7 = decode_layer(_e6);
     return _e7;
@@ -616,33 +622,33 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
     bool local_7 = false;
     bool local_8 = false;
     bool local_9 = false;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = _group_0_binding_0_cs;
-    vec3 eye_8 = f_14.eye.xyz;
-    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_9, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = _group_0_binding_0_cs;
+    vec3 eye_8 = f_13.eye.xyz;
+    vec3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_9, y_1);
     int _e14_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e14 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_9, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e14_clamped_lod) - ivec2(1)), _e14_clamped_lod);
-    float s_5 = (min(max(_e14.x, 0.0), f_14.theta.z) / max(dot(_e10, f_14.cam_forward.xyz), 1e-6));
-    vec3 color = f_14.light_color.xyz;
-    bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, vec2((float(x_9) + 0.5), (float(y_1) + 0.5)));
+    float s_5 = (min(max(_e14.x, 0.0), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 1e-6));
+    vec3 color = f_13.light_color.xyz;
+    bool _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, vec2((float(x_9) + 0.5), (float(y_1) + 0.5)));
     if (_e36) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e38 = _group_0_binding_0_cs;
         float _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, _group_0_binding_3_cs, eye_8, _e10, s_5, false);
         vec3 l_1 = (_e41 * color);
         return l_1;
     }
-    vec3 axis = f_14.axis.xyz;
-    uint rows_2 = f_14.sizes.w;
-    uint width_1 = f_14.sizes.z;
-    bool wrap_1 = (f_14.anti_epipole.w > 0.5);
+    vec3 axis = f_13.axis.xyz;
+    uint rows_2 = f_13.sizes.w;
+    uint width_1 = f_13.sizes.z;
+    bool wrap_1 = (f_13.anti_epipole.w > 0.5);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
-        float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e10);
+        float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
         yc = _e59;
         float _e61 = theta_3;
-        float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_14.theta.x, f_14.theta.y);
+        float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
         d_1 = _e66;
         float _e68 = theta_3;
-        float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, s_5, _e68, false);
+        float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e68, false);
         reach = _e69;
     }
     float _e71 = yc;
@@ -652,12 +658,12 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
     uint _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
     uint row1_ = ((yb > floor(yb)) ? _e81 : _e77);
     float w1_ = ((row1_ != _e77) ? fy : 0.0);
-    float cos_theta_l = -(dot(f_14.light_dir.xyz, _e10));
-    uint panels_2 = max((f_14.sizes2_.z / 4u), 1u);
+    float cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
+    uint panels_2 = max((f_13.sizes2_.z / 4u), 1u);
     float _e98 = d_1;
     float _e99 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e98);
-    float _e104 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, cos_theta_l);
-    float sun_scatter = (f_14.medium.y * _e104);
+    float _e104 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
+    float sun_scatter = (f_13.medium.y * _e104);
     float _e107 = xs;
     xs0_ = _e107;
     float _e109 = xs;
@@ -723,39 +729,39 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
             e1_ = 0.0;
             float _e209 = delta0_;
             float _e210 = theta_3;
-            float _e211 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b0_, _e209, _e210, s_5, false);
+            float _e211 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e209, _e210, s_5, false);
             a0_ = _e211;
             float _e212 = delta0_;
             float _e213 = theta_3;
-            float _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b1_2, _e212, _e213, s_5, false);
+            float _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e212, _e213, s_5, false);
             e0_ = (is_last0_ ? s_5 : _e214);
             float _e216 = delta1_;
             float _e217 = theta_3;
-            float _e218 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b0_, _e216, _e217, s_5, false);
+            float _e218 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e216, _e217, s_5, false);
             a1_ = _e218;
             float _e219 = delta1_;
             float _e220 = theta_3;
-            float _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b1_2, _e219, _e220, s_5, false);
+            float _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e219, _e220, s_5, false);
             e1_ = (is_last1_ ? s_5 : _e221);
             weight0_ = 0.0;
             weight1_ = 0.0;
             if (false) {
                 float _e227 = a0_;
                 float _e228 = e0_;
-                float _e229 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, _e227, _e228, panels_2);
+                float _e229 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e227, _e228, panels_2);
                 weight0_ = _e229;
                 float _e230 = a1_;
                 float _e231 = e1_;
-                float _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, _e230, _e231, panels_2);
+                float _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e230, _e231, panels_2);
                 weight1_ = _e232;
             } else {
                 float _e235 = a0_;
                 float _e236 = e0_;
-                float _e237 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, _e235, _e236);
+                float _e237 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e235, _e236);
                 weight0_ = (sun_scatter * _e237);
                 float _e241 = a1_;
                 float _e242 = e1_;
-                float _e243 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, _e241, _e242);
+                float _e243 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e241, _e242);
                 weight1_ = (sun_scatter * _e243);
             }
             float xb0_ = (pos0_ - 0.5);

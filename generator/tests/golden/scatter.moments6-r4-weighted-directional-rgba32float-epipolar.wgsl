@@ -42,6 +42,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     proj_g0_: vec4<f32>,
     proj_g1_: vec4<f32>,
     proj_g2_: vec4<f32>,
+    fan_origin: vec4<f32>,
+    fan_angles: vec4<f32>,
 }
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
@@ -378,24 +380,36 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_X
     }
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
-    let rows_1 = f_8.sizes.w;
-    let phi_1 = atan2(dot(dir_6, f_8.e2_.xyz), dot(dir_6, f_8.e1_.xyz));
-    let yc_1 = ((phi_1 - f_8.e1_.w) / f_8.e2_.w);
-    return select(clamp(yc_1, 0f, f32(rows_1)), (yc_1 - (floor((yc_1 / f32(rows_1))) * f32(rows_1))), (f_8.anti_epipole.w > 0.5f));
+fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
+    return vec2<f32>(f32(f_8.sizes.x), f32(f_8.sizes.y));
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_4: bool) -> f32 {
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let rows_1 = f_9.sizes.w;
+    let phi = atan2(dot(dir_6, f_9.e2_.xyz), dot(dir_6, f_9.e1_.xyz));
+    let z_5 = dot(dir_6, f_9.cam_forward.xyz);
+    let t_5 = f_9.cam_forward.w;
+    let ndc = vec2<f32>((dot(dir_6, f_9.cam_right.xyz) / ((z_5 * t_5) * f_9.cam_right.w)), (dot(dir_6, f_9.cam_up.xyz) / (z_5 * t_5)));
+    let _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    let p_3 = (vec2<f32>(((ndc.x + 1f) * 0.5f), ((1f - ndc.y) * 0.5f)) * _e41);
+    let d_3 = (p_3 - f_9.fan_origin.xy);
+    let ax = f_9.fan_origin.zw;
+    let fan = ((atan2(((ax.x * d_3.y) - (ax.y * d_3.x)), ((ax.x * d_3.x) + (ax.y * d_3.y))) - f_9.fan_angles.x) / f_9.fan_angles.y);
+    let yc_1 = select(((phi - f_9.e1_.w) / f_9.e2_.w), fan, (f_9.fan_angles.z > 0.5f));
+    return select(clamp(yc_1, 0f, f32(rows_1)), (yc_1 - (floor((yc_1 / f32(rows_1))) * f32(rows_1))), (f_9.anti_epipole.w > 0.5f));
+}
+
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_7: vec3<f32>, s_2: f32, theta_2: f32, spot_4: bool) -> f32 {
     if spot_4 {
-        let q_3 = ((eye_6 + (dir_7 * s_2)) - f_9.light_pos.xyz);
-        let to_eye = -(f_9.axis.xyz);
+        let q_3 = ((eye_6 + (dir_7 * s_2)) - f_10.light_pos.xyz);
+        let to_eye = -(f_10.axis.xyz);
         return atan2(length(cross(q_3, to_eye)), dot(q_3, to_eye));
     }
     return (s_2 * sin(theta_2));
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_8: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_8: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_8, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
@@ -428,10 +442,10 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
     let a_6 = (c3_ / c4_);
     let b_5 = (c2_ / c4_);
     let c = (c1_ / c4_);
-    let p_3 = min((b_5 - ((a_6 * a_6) / 3f)), -0.000000000001f);
+    let p_4 = min((b_5 - ((a_6 * a_6) / 3f)), -0.000000000001f);
     let qq = ((((((2f * a_6) * a_6) * a_6) / 27f) - ((a_6 * b_5) / 3f)) + c);
-    let m = (2f * sqrt((-(p_3) / 3f)));
-    let theta_4 = (acos(clamp(((3f * qq) / (p_3 * m)), -1f, 1f)) / 3f);
+    let m = (2f * sqrt((-(p_4) / 3f)));
+    let theta_4 = (acos(clamp(((3f * qq) / (p_4 * m)), -1f, 1f)) / 3f);
     let greatest = ((m * cos(theta_4)) - (a_6 / 3f));
     let least = ((m * cos((theta_4 - 4.1887903f))) - (a_6 / 3f));
     z_1 = select(least, greatest, (abs(greatest) >= abs(least)));
@@ -445,13 +459,13 @@ fn cubic_rootsX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(c1_: f32, c2_: f32, c3
             let _e86 = z_1;
             let _e87 = z_1;
             let _e88 = z_1;
-            let f_13 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
+            let f_12 = (c1_ + (_e86 * (c2_ + (_e87 * (c3_ + (_e88 * c4_))))));
             let _e95 = z_1;
             let _e98 = z_1;
             let df = (c2_ + (_e95 * ((2f * c3_) + ((3f * _e98) * c4_))));
             if (df != 0f) {
                 let _e107 = z_1;
-                z_1 = (_e107 - (f_13 / df));
+                z_1 = (_e107 - (f_12 / df));
             }
         }
         continuing {
@@ -480,9 +494,9 @@ fn far_kX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(x_4: f32, far: f32, at_infin
 
 fn atom_weight3X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(b1_: f32, b2_: f32, b3_: f32, x_5: f32, u: f32, v_10: f32, k_2: f32) -> f32 {
     let s_4 = (u + v_10);
-    let p_4 = (u * v_10);
-    let e2_ = ((b2_ - (b1_ * s_4)) + p_4);
-    let e3_ = (((b3_ - (b2_ * (s_4 + x_5))) + (b1_ * (p_4 + (s_4 * x_5)))) - (p_4 * x_5));
+    let p_5 = (u * v_10);
+    let e2_ = ((b2_ - (b1_ * s_4)) + p_5);
+    let e3_ = (((b3_ - (b2_ * (s_4 + x_5))) + (b1_ * (p_5 + (s_4 * x_5)))) - (p_5 * x_5));
     return ((e2_ + (e3_ * k_2)) / ((x_5 - u) * (x_5 - v_10)));
 }
 
@@ -541,14 +555,6 @@ fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw
     return clamp(((1f - _e129) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0f, 1f);
 }
 
-fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi: f32) -> vec3<f32> {
-    return ((f_11.e1_.xyz * cos(phi)) + (f_11.e2_.xyz * sin(phi)));
-}
-
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    return (f_12.e1_.w + ((f32(row) + 0.5f) * f_12.e2_.w));
-}
-
 fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_5: bool) -> u32 {
     if spot_5 {
         return ((r * width) / regions);
@@ -556,15 +562,15 @@ fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions
     return (((r * r) * width) / (regions * regions));
 }
 
-fn bounds_index(x_6: u32, row_1: u32) -> u32 {
+fn bounds_index(x_6: u32, row: u32) -> u32 {
     let _e5 = frame.sizes.w;
-    return ((x_6 * _e5) + row_1);
+    return ((x_6 * _e5) + row);
 }
 
-fn filtered_index(x_7: u32, row_2: u32, layer: u32) -> u32 {
+fn filtered_index(x_7: u32, row_1: u32, layer: u32) -> u32 {
     let _e5 = frame.sizes.w;
     let _e12 = frame.sizes.z;
-    return ((((layer * _e5) + row_2) * _e12) + x_7);
+    return ((((layer * _e5) + row_1) * _e12) + x_7);
 }
 
 fn encode_layer(v_11: vec4<f32>) -> vec4<f32> {
@@ -575,8 +581,8 @@ fn decode_layer(w_1: vec4<f32>) -> vec4<f32> {
     return w_1;
 }
 
-fn filtered_load(x_8: u32, row_3: u32, layer_1: u32) -> vec4<f32> {
-    let _e3 = filtered_index(x_8, row_3, layer_1);
+fn filtered_load(x_8: u32, row_2: u32, layer_1: u32) -> vec4<f32> {
+    let _e3 = filtered_index(x_8, row_2, layer_1);
     let _e6 = filtered[_e3];
     let _e7 = decode_layer(_e6);
     return _e7;
@@ -613,32 +619,32 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
     var local_8: bool;
     var local_9: bool;
 
-    let f_14 = frame;
-    let eye_8 = f_14.eye.xyz;
-    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, x_9, y_1);
+    let f_13 = frame;
+    let eye_8 = f_13.eye.xyz;
+    let _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_9, y_1);
     let _e14 = textureLoad(depth, vec2<u32>(x_9, y_1), 0i);
-    let s_5 = (min(max(_e14.x, 0f), f_14.theta.z) / max(dot(_e10, f_14.cam_forward.xyz), 0.000001f));
-    let color = f_14.light_color.xyz;
-    let _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, vec2<f32>((f32(x_9) + 0.5f), (f32(y_1) + 0.5f)));
+    let s_5 = (min(max(_e14.x, 0f), f_13.theta.z) / max(dot(_e10, f_13.cam_forward.xyz), 0.000001f));
+    let color = f_13.light_color.xyz;
+    let _e36 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, vec2<f32>((f32(x_9) + 0.5f), (f32(y_1) + 0.5f)));
     if _e36 {
         let _e38 = frame;
         let _e41 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, shadow_map, eye_8, _e10, s_5, false);
         let l_1 = (_e41 * color);
         return l_1;
     }
-    let axis = f_14.axis.xyz;
-    let rows_2 = f_14.sizes.w;
-    let width_1 = f_14.sizes.z;
-    let wrap_1 = (f_14.anti_epipole.w > 0.5f);
+    let axis = f_13.axis.xyz;
+    let rows_2 = f_13.sizes.w;
+    let width_1 = f_13.sizes.z;
+    let wrap_1 = (f_13.anti_epipole.w > 0.5f);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, _e10);
+        let _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
         yc = _e59;
         let _e61 = theta_3;
-        let _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_14.theta.x, f_14.theta.y);
+        let _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
         d_1 = _e66;
         let _e68 = theta_3;
-        let _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, s_5, _e68, false);
+        let _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e68, false);
         reach = _e69;
     }
     let _e71 = yc;
@@ -648,12 +654,12 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
     let _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
     let row1_ = select(_e77, _e81, (yb > floor(yb)));
     let w1_ = select(0f, fy, (row1_ != _e77));
-    let cos_theta_l = -(dot(f_14.light_dir.xyz, _e10));
-    let panels_2 = max((f_14.sizes2_.z / 4u), 1u);
+    let cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
+    let panels_2 = max((f_13.sizes2_.z / 4u), 1u);
     let _e98 = d_1;
     let _e99 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e98);
-    let _e104 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.z, cos_theta_l);
-    let sun_scatter = (f_14.medium.y * _e104);
+    let _e104 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
+    let sun_scatter = (f_13.medium.y * _e104);
     let _e107 = xs;
     xs0_ = _e107;
     let _e109 = xs;
@@ -713,39 +719,39 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
             e1_ = f32();
             let _e209 = delta0_;
             let _e210 = theta_3;
-            let _e211 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b0_, _e209, _e210, s_5, false);
+            let _e211 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e209, _e210, s_5, false);
             a0_ = _e211;
             let _e212 = delta0_;
             let _e213 = theta_3;
-            let _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b1_2, _e212, _e213, s_5, false);
+            let _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e212, _e213, s_5, false);
             e0_ = select(_e214, s_5, is_last0_);
             let _e216 = delta1_;
             let _e217 = theta_3;
-            let _e218 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b0_, _e216, _e217, s_5, false);
+            let _e218 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e216, _e217, s_5, false);
             a1_ = _e218;
             let _e219 = delta1_;
             let _e220 = theta_3;
-            let _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, b1_2, _e219, _e220, s_5, false);
+            let _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e219, _e220, s_5, false);
             e1_ = select(_e221, s_5, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
                 let _e227 = a0_;
                 let _e228 = e0_;
-                let _e229 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, _e227, _e228, panels_2);
+                let _e229 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e227, _e228, panels_2);
                 weight0_ = _e229;
                 let _e230 = a1_;
                 let _e231 = e1_;
-                let _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, _e10, _e230, _e231, panels_2);
+                let _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e230, _e231, panels_2);
                 weight1_ = _e232;
             } else {
                 let _e235 = a0_;
                 let _e236 = e0_;
-                let _e237 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, _e235, _e236);
+                let _e237 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e235, _e236);
                 weight0_ = (sun_scatter * _e237);
                 let _e241 = a1_;
                 let _e242 = e1_;
-                let _e243 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, _e241, _e242);
+                let _e243 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e241, _e242);
                 weight1_ = (sun_scatter * _e243);
             }
             let xb0_ = (pos0_ - 0.5f);

@@ -64,7 +64,7 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, sm_forward) == 128, "ScatterA
 SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, sm_origin) == 144, "ScatterAreaIvsvVpl.sm_origin offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterAreaIvsvVpl, sm_proj) == 160, "ScatterAreaIvsvVpl.sm_proj offset");
 
-/* WGSL `Frame` of family hybrid_volume (scatter::epipolar), 400 bytes, alignment 16. */
+/* WGSL `Frame` of family hybrid_volume (scatter::epipolar), 432 bytes, alignment 16. */
 typedef struct ScatterHybridVolumeFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
     float axis[4]; /* vec4<f32>, offset 16 */
@@ -91,8 +91,10 @@ typedef struct ScatterHybridVolumeFrame {
     float proj_g0_[4]; /* vec4<f32>, offset 352 */
     float proj_g1_[4]; /* vec4<f32>, offset 368 */
     float proj_g2_[4]; /* vec4<f32>, offset 384 */
+    float fan_origin[4]; /* vec4<f32>, offset 400 */
+    float fan_angles[4]; /* vec4<f32>, offset 416 */
 } ScatterHybridVolumeFrame;
-SCATTER_STATIC_ASSERT(sizeof(ScatterHybridVolumeFrame) == 400, "ScatterHybridVolumeFrame size");
+SCATTER_STATIC_ASSERT(sizeof(ScatterHybridVolumeFrame) == 432, "ScatterHybridVolumeFrame size");
 SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, eye) == 0, "ScatterHybridVolumeFrame.eye offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, axis) == 16, "ScatterHybridVolumeFrame.axis offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, e1_) == 32, "ScatterHybridVolumeFrame.e1_ offset");
@@ -118,8 +120,10 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, proj) == 336, "ScatterH
 SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, proj_g0_) == 352, "ScatterHybridVolumeFrame.proj_g0_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, proj_g1_) == 368, "ScatterHybridVolumeFrame.proj_g1_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, proj_g2_) == 384, "ScatterHybridVolumeFrame.proj_g2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, fan_origin) == 400, "ScatterHybridVolumeFrame.fan_origin offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterHybridVolumeFrame, fan_angles) == 416, "ScatterHybridVolumeFrame.fan_angles offset");
 
-/* WGSL `Frame` of family minmax (scatter::epipolar), 400 bytes, alignment 16. */
+/* WGSL `Frame` of family minmax (scatter::epipolar), 432 bytes, alignment 16. */
 typedef struct ScatterMinmaxFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
     float axis[4]; /* vec4<f32>, offset 16 */
@@ -146,8 +150,10 @@ typedef struct ScatterMinmaxFrame {
     float proj_g0_[4]; /* vec4<f32>, offset 352 */
     float proj_g1_[4]; /* vec4<f32>, offset 368 */
     float proj_g2_[4]; /* vec4<f32>, offset 384 */
+    float fan_origin[4]; /* vec4<f32>, offset 400 */
+    float fan_angles[4]; /* vec4<f32>, offset 416 */
 } ScatterMinmaxFrame;
-SCATTER_STATIC_ASSERT(sizeof(ScatterMinmaxFrame) == 400, "ScatterMinmaxFrame size");
+SCATTER_STATIC_ASSERT(sizeof(ScatterMinmaxFrame) == 432, "ScatterMinmaxFrame size");
 SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, eye) == 0, "ScatterMinmaxFrame.eye offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, axis) == 16, "ScatterMinmaxFrame.axis offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, e1_) == 32, "ScatterMinmaxFrame.e1_ offset");
@@ -173,8 +179,10 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj) == 336, "ScatterMinmaxF
 SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g0_) == 352, "ScatterMinmaxFrame.proj_g0_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g1_) == 368, "ScatterMinmaxFrame.proj_g1_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, proj_g2_) == 384, "ScatterMinmaxFrame.proj_g2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, fan_origin) == 400, "ScatterMinmaxFrame.fan_origin offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterMinmaxFrame, fan_angles) == 416, "ScatterMinmaxFrame.fan_angles offset");
 
-/* WGSL `Frame` of family partial_sum_tree (scatter::epipolar), 400 bytes, alignment 16. */
+/* WGSL `Frame` of family partial_sum_tree (scatter::epipolar), 432 bytes, alignment 16. */
 typedef struct ScatterPartialSumTreeFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
     float axis[4]; /* vec4<f32>, offset 16 */
@@ -201,8 +209,10 @@ typedef struct ScatterPartialSumTreeFrame {
     float proj_g0_[4]; /* vec4<f32>, offset 352 */
     float proj_g1_[4]; /* vec4<f32>, offset 368 */
     float proj_g2_[4]; /* vec4<f32>, offset 384 */
+    float fan_origin[4]; /* vec4<f32>, offset 400 */
+    float fan_angles[4]; /* vec4<f32>, offset 416 */
 } ScatterPartialSumTreeFrame;
-SCATTER_STATIC_ASSERT(sizeof(ScatterPartialSumTreeFrame) == 400, "ScatterPartialSumTreeFrame size");
+SCATTER_STATIC_ASSERT(sizeof(ScatterPartialSumTreeFrame) == 432, "ScatterPartialSumTreeFrame size");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, eye) == 0, "ScatterPartialSumTreeFrame.eye offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, axis) == 16, "ScatterPartialSumTreeFrame.axis offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, e1_) == 32, "ScatterPartialSumTreeFrame.e1_ offset");
@@ -228,8 +238,10 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, proj) == 336, "Scatte
 SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, proj_g0_) == 352, "ScatterPartialSumTreeFrame.proj_g0_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, proj_g1_) == 368, "ScatterPartialSumTreeFrame.proj_g1_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, proj_g2_) == 384, "ScatterPartialSumTreeFrame.proj_g2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, fan_origin) == 400, "ScatterPartialSumTreeFrame.fan_origin offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, fan_angles) == 416, "ScatterPartialSumTreeFrame.fan_angles offset");
 
-/* WGSL `Frame` of family prefiltered (scatter::epipolar), 400 bytes, alignment 16. */
+/* WGSL `Frame` of family prefiltered (scatter::epipolar), 432 bytes, alignment 16. */
 typedef struct ScatterPrefilteredFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
     float axis[4]; /* vec4<f32>, offset 16 */
@@ -256,8 +268,10 @@ typedef struct ScatterPrefilteredFrame {
     float proj_g0_[4]; /* vec4<f32>, offset 352 */
     float proj_g1_[4]; /* vec4<f32>, offset 368 */
     float proj_g2_[4]; /* vec4<f32>, offset 384 */
+    float fan_origin[4]; /* vec4<f32>, offset 400 */
+    float fan_angles[4]; /* vec4<f32>, offset 416 */
 } ScatterPrefilteredFrame;
-SCATTER_STATIC_ASSERT(sizeof(ScatterPrefilteredFrame) == 400, "ScatterPrefilteredFrame size");
+SCATTER_STATIC_ASSERT(sizeof(ScatterPrefilteredFrame) == 432, "ScatterPrefilteredFrame size");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, eye) == 0, "ScatterPrefilteredFrame.eye offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, axis) == 16, "ScatterPrefilteredFrame.axis offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, e1_) == 32, "ScatterPrefilteredFrame.e1_ offset");
@@ -283,6 +297,8 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj) == 336, "ScatterPr
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g0_) == 352, "ScatterPrefilteredFrame.proj_g0_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g1_) == 368, "ScatterPrefilteredFrame.proj_g1_ offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, proj_g2_) == 384, "ScatterPrefilteredFrame.proj_g2_ offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, fan_origin) == 400, "ScatterPrefilteredFrame.fan_origin offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPrefilteredFrame, fan_angles) == 416, "ScatterPrefilteredFrame.fan_angles offset");
 
 /* WGSL `RaymarchFrame` of family raymarch (scatter::raymarch), 240 bytes, alignment 16. */
 typedef struct ScatterRaymarchRaymarchFrame {

@@ -88,7 +88,7 @@ pub mod area_ivsv {
 /// Uniform structs of the `hybrid_volume` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod hybrid_volume {
-    /// WGSL `Frame` (scatter::epipolar), 400 bytes, alignment 16.
+    /// WGSL `Frame` (scatter::epipolar), 432 bytes, alignment 16.
     #[repr(C)]
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct Frame {
@@ -142,10 +142,14 @@ pub mod hybrid_volume {
         pub proj_g1_: [f32; 4],
         /// `vec4<f32>` at byte 384.
         pub proj_g2_: [f32; 4],
+        /// `vec4<f32>` at byte 400.
+        pub fan_origin: [f32; 4],
+        /// `vec4<f32>` at byte 416.
+        pub fan_angles: [f32; 4],
     }
 
     const _: () = {
-        assert!(::core::mem::size_of::<Frame>() == 400);
+        assert!(::core::mem::size_of::<Frame>() == 432);
         assert!(::core::mem::offset_of!(Frame, eye) == 0);
         assert!(::core::mem::offset_of!(Frame, axis) == 16);
         assert!(::core::mem::offset_of!(Frame, e1_) == 32);
@@ -171,13 +175,15 @@ pub mod hybrid_volume {
         assert!(::core::mem::offset_of!(Frame, proj_g0_) == 352);
         assert!(::core::mem::offset_of!(Frame, proj_g1_) == 368);
         assert!(::core::mem::offset_of!(Frame, proj_g2_) == 384);
+        assert!(::core::mem::offset_of!(Frame, fan_origin) == 400);
+        assert!(::core::mem::offset_of!(Frame, fan_angles) == 416);
     };
 }
 
 /// Uniform structs of the `minmax` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod minmax {
-    /// WGSL `Frame` (scatter::epipolar), 400 bytes, alignment 16.
+    /// WGSL `Frame` (scatter::epipolar), 432 bytes, alignment 16.
     #[repr(C)]
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct Frame {
@@ -231,10 +237,14 @@ pub mod minmax {
         pub proj_g1_: [f32; 4],
         /// `vec4<f32>` at byte 384.
         pub proj_g2_: [f32; 4],
+        /// `vec4<f32>` at byte 400.
+        pub fan_origin: [f32; 4],
+        /// `vec4<f32>` at byte 416.
+        pub fan_angles: [f32; 4],
     }
 
     const _: () = {
-        assert!(::core::mem::size_of::<Frame>() == 400);
+        assert!(::core::mem::size_of::<Frame>() == 432);
         assert!(::core::mem::offset_of!(Frame, eye) == 0);
         assert!(::core::mem::offset_of!(Frame, axis) == 16);
         assert!(::core::mem::offset_of!(Frame, e1_) == 32);
@@ -260,13 +270,15 @@ pub mod minmax {
         assert!(::core::mem::offset_of!(Frame, proj_g0_) == 352);
         assert!(::core::mem::offset_of!(Frame, proj_g1_) == 368);
         assert!(::core::mem::offset_of!(Frame, proj_g2_) == 384);
+        assert!(::core::mem::offset_of!(Frame, fan_origin) == 400);
+        assert!(::core::mem::offset_of!(Frame, fan_angles) == 416);
     };
 }
 
 /// Uniform structs of the `partial_sum_tree` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod partial_sum_tree {
-    /// WGSL `Frame` (scatter::epipolar), 400 bytes, alignment 16.
+    /// WGSL `Frame` (scatter::epipolar), 432 bytes, alignment 16.
     #[repr(C)]
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct Frame {
@@ -320,10 +332,14 @@ pub mod partial_sum_tree {
         pub proj_g1_: [f32; 4],
         /// `vec4<f32>` at byte 384.
         pub proj_g2_: [f32; 4],
+        /// `vec4<f32>` at byte 400.
+        pub fan_origin: [f32; 4],
+        /// `vec4<f32>` at byte 416.
+        pub fan_angles: [f32; 4],
     }
 
     const _: () = {
-        assert!(::core::mem::size_of::<Frame>() == 400);
+        assert!(::core::mem::size_of::<Frame>() == 432);
         assert!(::core::mem::offset_of!(Frame, eye) == 0);
         assert!(::core::mem::offset_of!(Frame, axis) == 16);
         assert!(::core::mem::offset_of!(Frame, e1_) == 32);
@@ -349,13 +365,15 @@ pub mod partial_sum_tree {
         assert!(::core::mem::offset_of!(Frame, proj_g0_) == 352);
         assert!(::core::mem::offset_of!(Frame, proj_g1_) == 368);
         assert!(::core::mem::offset_of!(Frame, proj_g2_) == 384);
+        assert!(::core::mem::offset_of!(Frame, fan_origin) == 400);
+        assert!(::core::mem::offset_of!(Frame, fan_angles) == 416);
     };
 }
 
 /// Uniform structs of the `prefiltered` kernels.
 #[allow(dead_code, reason = "generated")]
 pub mod prefiltered {
-    /// WGSL `Frame` (scatter::epipolar), 400 bytes, alignment 16.
+    /// WGSL `Frame` (scatter::epipolar), 432 bytes, alignment 16.
     #[repr(C)]
     #[derive(Clone, Copy, Debug, PartialEq)]
     pub struct Frame {
@@ -409,10 +427,14 @@ pub mod prefiltered {
         pub proj_g1_: [f32; 4],
         /// `vec4<f32>` at byte 384.
         pub proj_g2_: [f32; 4],
+        /// `vec4<f32>` at byte 400.
+        pub fan_origin: [f32; 4],
+        /// `vec4<f32>` at byte 416.
+        pub fan_angles: [f32; 4],
     }
 
     const _: () = {
-        assert!(::core::mem::size_of::<Frame>() == 400);
+        assert!(::core::mem::size_of::<Frame>() == 432);
         assert!(::core::mem::offset_of!(Frame, eye) == 0);
         assert!(::core::mem::offset_of!(Frame, axis) == 16);
         assert!(::core::mem::offset_of!(Frame, e1_) == 32);
@@ -438,6 +460,8 @@ pub mod prefiltered {
         assert!(::core::mem::offset_of!(Frame, proj_g0_) == 352);
         assert!(::core::mem::offset_of!(Frame, proj_g1_) == 368);
         assert!(::core::mem::offset_of!(Frame, proj_g2_) == 384);
+        assert!(::core::mem::offset_of!(Frame, fan_origin) == 400);
+        assert!(::core::mem::offset_of!(Frame, fan_angles) == 416);
     };
 }
 

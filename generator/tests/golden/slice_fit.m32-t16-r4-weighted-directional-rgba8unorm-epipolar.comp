@@ -45,6 +45,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 proj_g0_;
     vec4 proj_g1_;
     vec4 proj_g2_;
+    vec4 fan_origin;
+    vec4 fan_angles;
 };
 const float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1e30;
 const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
@@ -216,11 +218,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                 }
                 {
                     uint _e48 = q;
-                    float u = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    float u_1 = tan((mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
                     float _e54 = sum;
                     uint _e56 = q;
-                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u * u))));
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u_1 * u_1))));
                 }
             }
         }
@@ -245,15 +247,76 @@ vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XO
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row_1) {
-    return (f_1.e1_.w + ((float(row_1) + 0.5) * f_1.e2_.w));
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1) {
+    return vec2(float(f_1.sizes.x), float(f_1.sizes.y));
 }
 
-float spot_psi(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, float phi_1, float theta, float z_2, float dist) {
-    vec3 _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2, phi_1);
-    vec3 d_1 = ((f_2.axis.xyz * cos(theta)) + (_e7 * sin(theta)));
-    float t_2 = (z_2 / max(dot(d_1, f_2.cam_forward.xyz), 1e-6));
-    return atan((t_2 * sin(theta)), (dist - (t_2 * cos(theta))));
+float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
+    float t_in = 0.0;
+    float t_out = 3.4e38;
+    uint a_3 = 0u;
+    bool loop_init_2 = true;
+    while(true) {
+        if (!loop_init_2) {
+            uint _e45 = a_3;
+            a_3 = (_e45 + 1u);
+        }
+        loop_init_2 = false;
+        uint _e4 = a_3;
+        if ((_e4 < 2u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = a_3;
+            uint _e13 = a_3;
+            float ta = ((0.5 - o_1[_e8]) / u[_e13]);
+            uint _e17 = a_3;
+            uint _e21 = a_3;
+            uint _e24 = a_3;
+            float tb = (((size[_e17] - 0.5) - o_1[_e21]) / u[_e24]);
+            uint _e27 = a_3;
+            bool crosses = (abs(u[_e27]) > 1e-12);
+            float _e33 = t_in;
+            float _e34 = t_in;
+            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
+            float _e39 = t_out;
+            float _e40 = t_out;
+            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
+        }
+    }
+    float _e47 = t_in;
+    float _e48 = t_out;
+    float _e49 = t_in;
+    return (0.5 * (_e47 + max(_e48, _e49)));
+}
+
+vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, vec2 p_2) {
+    vec2 ndc = vec2((((2.0 * p_2.x) / float(f_2.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_2.sizes.y))));
+    float t_2 = f_2.cam_forward.w;
+    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+}
+
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, uint row_1) {
+    float a_4 = (f_3.fan_angles.x + ((float(row_1) + 0.5) * f_3.fan_angles.y));
+    vec2 ax = f_3.fan_origin.zw;
+    vec2 u_2 = vec2(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
+    vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
+    vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
+    return atan(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_2) {
+    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_2);
+    return ((f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((float(row_2) + 0.5) * f_4.e2_.w)));
+}
+
+float spot_psi(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float phi_1, float theta, float z_2, float dist) {
+    vec3 _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, phi_1);
+    vec3 d_1 = ((f_5.axis.xyz * cos(theta)) + (_e7 * sin(theta)));
+    float t_3 = (z_2 / max(dot(d_1, f_5.cam_forward.xyz), 1e-6));
+    return atan((t_3 * sin(theta)), (dist - (t_3 * cos(theta))));
 }
 
 void main() {
@@ -272,18 +335,18 @@ void main() {
     float extent = 0.0;
     uint k = 0u;
     bool local_1 = false;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3 = _group_0_binding_0_cs;
-    float far_3 = f_3.theta.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6 = _group_0_binding_0_cs;
+    float far_3 = f_6.theta.z;
     x = lid;
-    bool loop_init_2 = true;
+    bool loop_init_3 = true;
     while(true) {
-        if (!loop_init_2) {
+        if (!loop_init_3) {
             uint _e19 = x;
             x = (_e19 + THREADS);
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e8 = x;
-        if ((_e8 < f_3.sizes.x)) {
+        if ((_e8 < f_6.sizes.x)) {
         } else {
             break;
         }
@@ -296,13 +359,13 @@ void main() {
     }
     float _e24 = z;
     deepest[lid] = _e24;
-    bool loop_init_3 = true;
+    bool loop_init_4 = true;
     while(true) {
-        if (!loop_init_3) {
+        if (!loop_init_4) {
             uint _e42 = half_;
             half_ = (_e42 / 2u);
         }
-        loop_init_3 = false;
+        loop_init_4 = false;
         uint _e26 = half_;
         if ((_e26 > 0u)) {
         } else {
@@ -324,7 +387,7 @@ void main() {
     barrier();
     float _e47 = deepest[0];
     z = _e47;
-    if (!((f_3.proj.x > 0.5))) {
+    if (!((f_6.proj.x > 0.5))) {
         float _e53 = z;
         local = !((_e53 < far_3));
     } else {
@@ -334,17 +397,17 @@ void main() {
     if (_e59) {
         return;
     }
-    uint rows = f_3.sizes.w;
-    float cols = float(f_3.sizes.z);
-    float dist_1 = f_3.axis.w;
+    uint rows = f_6.sizes.w;
+    float cols = float(f_6.sizes.z);
+    float dist_1 = f_6.axis.w;
     row = lid;
-    bool loop_init_4 = true;
+    bool loop_init_5 = true;
     while(true) {
-        if (!loop_init_4) {
+        if (!loop_init_5) {
             uint _e128 = row;
             row = (_e128 + THREADS);
         }
-        loop_init_4 = false;
+        loop_init_5 = false;
         uint _e68 = row;
         if ((_e68 < rows)) {
         } else {
@@ -357,16 +420,16 @@ void main() {
             delta = (old.x * (_e75 / far_3));
             if (false) {
                 uint _e80 = row;
-                float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e80);
+                float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, _e80);
                 extent = 0.0;
                 k = 0u;
-                bool loop_init_5 = true;
+                bool loop_init_6 = true;
                 while(true) {
-                    if (!loop_init_5) {
+                    if (!loop_init_6) {
                         uint _e104 = k;
                         k = (_e104 + 1u);
                     }
-                    loop_init_5 = false;
+                    loop_init_6 = false;
                     uint _e86 = k;
                     if ((_e86 <= SPOT_SAMPLES)) {
                     } else {
@@ -377,7 +440,7 @@ void main() {
                         float theta_1 = (old.z + (((old.w - old.z) * float(_e93)) / 32.0));
                         float _e99 = extent;
                         float _e100 = z;
-                        float _e101 = spot_psi(f_3, _e81, theta_1, _e100, dist_1);
+                        float _e101 = spot_psi(f_6, _e81, theta_1, _e100, dist_1);
                         extent = max(_e99, _e101);
                     }
                 }

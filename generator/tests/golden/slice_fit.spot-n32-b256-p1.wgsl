@@ -42,6 +42,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     proj_g0_: vec4<f32>,
     proj_g1_: vec4<f32>,
     proj_g2_: vec4<f32>,
+    fan_origin: vec4<f32>,
+    fan_angles: vec4<f32>,
 }
 
 const NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX: f32 = 1000000000000000000000000000000f;
@@ -201,11 +203,11 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                 }
                 {
                     let _e48 = q;
-                    let u = tan((mid + ((0.5f * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    let u_1 = tan((mid + ((0.5f * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
                     let _e54 = sum;
                     let _e56 = q;
-                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u * u))));
+                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u_1 * u_1))));
                 }
                 continuing {
                     let _e72 = q;
@@ -238,15 +240,75 @@ fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_X
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
-    return (f_1.e1_.w + ((f32(row_1) + 0.5f) * f_1.e2_.w));
+fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
+    return vec2<f32>(f32(f_1.sizes.x), f32(f_1.sizes.y));
 }
 
-fn spot_psi(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi_1: f32, theta: f32, z_2: f32, dist: f32) -> f32 {
-    let _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2, phi_1);
-    let d_1 = ((f_2.axis.xyz * cos(theta)) + (_e7 * sin(theta)));
-    let t_2 = (z_2 / max(dot(d_1, f_2.cam_forward.xyz), 0.000001f));
-    return atan2((t_2 * sin(theta)), (dist - (t_2 * cos(theta))));
+fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
+    var t_in: f32 = 0f;
+    var t_out: f32 = 340000000000000000000000000000000000000f;
+    var a_3: u32 = 0u;
+
+    loop {
+        let _e4 = a_3;
+        if (_e4 < 2u) {
+        } else {
+            break;
+        }
+        {
+            let _e8 = a_3;
+            let _e13 = a_3;
+            let ta = ((0.5f - o_1[_e8]) / u[_e13]);
+            let _e17 = a_3;
+            let _e21 = a_3;
+            let _e24 = a_3;
+            let tb = (((size[_e17] - 0.5f) - o_1[_e21]) / u[_e24]);
+            let _e27 = a_3;
+            let crosses = (abs(u[_e27]) > 0.000000000001f);
+            let _e33 = t_in;
+            let _e34 = t_in;
+            t_in = select(_e33, max(_e34, min(ta, tb)), crosses);
+            let _e39 = t_out;
+            let _e40 = t_out;
+            t_out = select(_e39, min(_e40, max(ta, tb)), crosses);
+        }
+        continuing {
+            let _e45 = a_3;
+            a_3 = (_e45 + 1u);
+        }
+    }
+    let _e47 = t_in;
+    let _e48 = t_out;
+    let _e49 = t_in;
+    return (0.5f * (_e47 + max(_e48, _e49)));
+}
+
+fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
+    let ndc = vec2<f32>((((2f * p_2.x) / f32(f_2.sizes.x)) - 1f), (1f - ((2f * p_2.y) / f32(f_2.sizes.y))));
+    let t_2 = f_2.cam_forward.w;
+    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+}
+
+fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
+    let a_4 = (f_3.fan_angles.x + ((f32(row_1) + 0.5f) * f_3.fan_angles.y));
+    let ax = f_3.fan_origin.zw;
+    let u_2 = vec2<f32>(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
+    let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
+    let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
+    let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
+    return atan2(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+}
+
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_2: u32) -> f32 {
+    let _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_2);
+    return select((f_4.e1_.w + ((f32(row_2) + 0.5f) * f_4.e2_.w)), _e11, (f_4.fan_angles.z > 0.5f));
+}
+
+fn spot_psi(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi_1: f32, theta: f32, z_2: f32, dist: f32) -> f32 {
+    let _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, phi_1);
+    let d_1 = ((f_5.axis.xyz * cos(theta)) + (_e7 * sin(theta)));
+    let t_3 = (z_2 / max(dot(d_1, f_5.cam_forward.xyz), 0.000001f));
+    return atan2((t_3 * sin(theta)), (dist - (t_3 * cos(theta))));
 }
 
 @compute @workgroup_size(256, 1, 1) 
@@ -261,12 +323,12 @@ fn slice_fit(@builtin(local_invocation_index) lid: u32) {
     var k: u32;
     var local_1: bool;
 
-    let f_3 = frame;
-    let far_3 = f_3.theta.z;
+    let f_6 = frame;
+    let far_3 = f_6.theta.z;
     x = lid;
     loop {
         let _e8 = x;
-        if (_e8 < f_3.sizes.x) {
+        if (_e8 < f_6.sizes.x) {
         } else {
             break;
         }
@@ -307,7 +369,7 @@ fn slice_fit(@builtin(local_invocation_index) lid: u32) {
     workgroupBarrier();
     let _e47 = deepest[0];
     z = _e47;
-    if !((f_3.proj.x > 0.5f)) {
+    if !((f_6.proj.x > 0.5f)) {
         let _e53 = z;
         local = !((_e53 < far_3));
     } else {
@@ -317,9 +379,9 @@ fn slice_fit(@builtin(local_invocation_index) lid: u32) {
     if _e59 {
         return;
     }
-    let rows = f_3.sizes.w;
-    let cols = f32(f_3.sizes.z);
-    let dist_1 = f_3.axis.w;
+    let rows = f_6.sizes.w;
+    let cols = f32(f_6.sizes.z);
+    let dist_1 = f_6.axis.w;
     row = lid;
     loop {
         let _e68 = row;
@@ -334,7 +396,7 @@ fn slice_fit(@builtin(local_invocation_index) lid: u32) {
             delta = (old.x * (_e75 / far_3));
             if true {
                 let _e80 = row;
-                let _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e80);
+                let _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, _e80);
                 extent = 0f;
                 k = 0u;
                 loop {
@@ -348,7 +410,7 @@ fn slice_fit(@builtin(local_invocation_index) lid: u32) {
                         let theta_1 = (old.z + (((old.w - old.z) * f32(_e93)) / 32f));
                         let _e99 = extent;
                         let _e100 = z;
-                        let _e101 = spot_psi(f_3, _e81, theta_1, _e100, dist_1);
+                        let _e101 = spot_psi(f_6, _e81, theta_1, _e100, dist_1);
                         extent = max(_e99, _e101);
                     }
                     continuing {

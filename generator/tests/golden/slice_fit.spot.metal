@@ -51,6 +51,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 proj_g0_;
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
+    metal::float4 fan_origin;
+    metal::float4 fan_angles;
 };
 typedef metal::float4 type_9[1];
 typedef float type_10[1];
@@ -293,11 +295,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e48 = q;
-                    float u = metal::tan(mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
+                    float u_1 = metal::tan(mid + ((0.5 * w) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
                     float _e54 = sum;
                     uint _e56 = q;
-                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u * u)));
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u_1 * u_1)));
                 }
             }
         }
@@ -335,24 +337,100 @@ metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return (f.e1_.xyz * metal::cos(phi)) + (f.e2_.xyz * metal::sin(phi));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1,
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1
+) {
+    return metal::float2(static_cast<float>(f_1.sizes.x), static_cast<float>(f_1.sizes.y));
+}
+
+float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    metal::float2 o_1,
+    metal::float2 u,
+    metal::float2 size
+) {
+    float t_in = 0.0;
+    float t_out = 340000000000000000000000000000000000000.0;
+    uint a_3 = 0u;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e45 = a_3;
+            a_3 = _e45 + 1u;
+        }
+        loop_init_2 = false;
+        uint _e4 = a_3;
+        if (_e4 < 2u) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = a_3;
+            uint _e13 = a_3;
+            float ta = (0.5 - o_1[metal::min(unsigned(_e8), 1u)]) / u[metal::min(unsigned(_e13), 1u)];
+            uint _e17 = a_3;
+            uint _e21 = a_3;
+            uint _e24 = a_3;
+            float tb = ((size[metal::min(unsigned(_e17), 1u)] - 0.5) - o_1[metal::min(unsigned(_e21), 1u)]) / u[metal::min(unsigned(_e24), 1u)];
+            uint _e27 = a_3;
+            bool crosses = metal::abs(u[metal::min(unsigned(_e27), 1u)]) > 0.000000000001;
+            float _e33 = t_in;
+            float _e34 = t_in;
+            t_in = crosses ? metal::max(_e34, metal::min(ta, tb)) : _e33;
+            float _e39 = t_out;
+            float _e40 = t_out;
+            t_out = crosses ? metal::min(_e40, metal::max(ta, tb)) : _e39;
+        }
+    }
+    float _e47 = t_in;
+    float _e48 = t_out;
+    float _e49 = t_in;
+    return 0.5 * (_e47 + metal::max(_e48, _e49));
+}
+
+metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    metal::float2 p_2
+) {
+    metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_2.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_2.sizes.y)));
+    float t_2 = f_2.cam_forward.w;
+    return metal::normalize((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2)));
+}
+
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
     uint row_1
 ) {
-    return f_1.e1_.w + ((static_cast<float>(row_1) + 0.5) * f_1.e2_.w);
+    float a_4 = f_3.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_3.fan_angles.y);
+    metal::float2 ax = f_3.fan_origin.zw;
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_4)) - (ax.y * metal::sin(a_4)), (ax.y * metal::cos(a_4)) + (ax.x * metal::sin(a_4)));
+    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
+    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, f_3.fan_origin.xy + (u_2 * _e33));
+    return metal::atan2(metal::dot(_e36, f_3.e2_.xyz), metal::dot(_e36, f_3.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
+    uint row_2
+) {
+    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_2);
+    return (f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((static_cast<float>(row_2) + 0.5) * f_4.e2_.w));
 }
 
 float spot_psi(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
     float phi_1,
     float theta,
     float z_2,
     float dist
 ) {
-    metal::float3 _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2, phi_1);
-    metal::float3 d_1 = (f_2.axis.xyz * metal::cos(theta)) + (_e7 * metal::sin(theta));
-    float t_2 = z_2 / metal::max(metal::dot(d_1, f_2.cam_forward.xyz), 0.000001);
-    return metal::atan2(t_2 * metal::sin(theta), dist - (t_2 * metal::cos(theta)));
+    metal::float3 _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, phi_1);
+    metal::float3 d_1 = (f_5.axis.xyz * metal::cos(theta)) + (_e7 * metal::sin(theta));
+    float t_3 = z_2 / metal::max(metal::dot(d_1, f_5.cam_forward.xyz), 0.000001);
+    return metal::atan2(t_3 * metal::sin(theta), dist - (t_3 * metal::cos(theta)));
 }
 uint naga_div(uint lhs, uint rhs) {
     return lhs / metal::select(rhs, 1u, rhs == 0u);
@@ -382,21 +460,21 @@ kernel void slice_fit(
     float extent = {};
     uint k = {};
     bool local_1 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3 = frame;
-    float far_3 = f_3.theta.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6 = frame;
+    float far_3 = f_6.theta.z;
     x = lid;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e19 = x;
             x = _e19 + THREADS;
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e8 = x;
-        if (_e8 < f_3.sizes.x) {
+        if (_e8 < f_6.sizes.x) {
         } else {
             break;
         }
@@ -409,16 +487,16 @@ kernel void slice_fit(
     }
     float _e24 = z;
     deepest.inner[metal::min(unsigned(lid), 255u)] = _e24;
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
             uint _e42 = half_;
             half_ = naga_div(_e42, 2u);
         }
-        loop_init_3 = false;
+        loop_init_4 = false;
         uint _e26 = half_;
         if (_e26 > 0u) {
         } else {
@@ -438,7 +516,7 @@ kernel void slice_fit(
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     float _e47 = deepest.inner[0];
     z = _e47;
-    if (!((f_3.proj.x > 0.5))) {
+    if (!((f_6.proj.x > 0.5))) {
         float _e53 = z;
         local = !((_e53 < far_3));
     } else {
@@ -448,20 +526,20 @@ kernel void slice_fit(
     if (_e59) {
         return;
     }
-    uint rows = f_3.sizes.w;
-    float cols = static_cast<float>(f_3.sizes.z);
-    float dist_1 = f_3.axis.w;
+    uint rows = f_6.sizes.w;
+    float cols = static_cast<float>(f_6.sizes.z);
+    float dist_1 = f_6.axis.w;
     row = lid;
-    uint2 loop_bound_4 = uint2(4294967295u);
-    bool loop_init_4 = true;
+    uint2 loop_bound_5 = uint2(4294967295u);
+    bool loop_init_5 = true;
     while(true) {
-        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
+        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
             uint _e128 = row;
             row = _e128 + THREADS;
         }
-        loop_init_4 = false;
+        loop_init_5 = false;
         uint _e68 = row;
         if (_e68 < rows) {
         } else {
@@ -474,19 +552,19 @@ kernel void slice_fit(
             delta = old.x * (_e75 / far_3);
             if (true) {
                 uint _e80 = row;
-                float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, _e80);
+                float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, _e80);
                 extent = 0.0;
                 k = 0u;
-                uint2 loop_bound_5 = uint2(4294967295u);
-                bool loop_init_5 = true;
+                uint2 loop_bound_6 = uint2(4294967295u);
+                bool loop_init_6 = true;
                 while(true) {
-                    if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-                    loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-                    if (!loop_init_5) {
+                    if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+                    loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                    if (!loop_init_6) {
                         uint _e104 = k;
                         k = _e104 + 1u;
                     }
-                    loop_init_5 = false;
+                    loop_init_6 = false;
                     uint _e86 = k;
                     if (_e86 <= SPOT_SAMPLES) {
                     } else {
@@ -497,7 +575,7 @@ kernel void slice_fit(
                         float theta_1 = old.z + (((old.w - old.z) * static_cast<float>(_e93)) / 32.0);
                         float _e99 = extent;
                         float _e100 = z;
-                        float _e101 = spot_psi(f_3, _e81, theta_1, _e100, dist_1);
+                        float _e101 = spot_psi(f_6, _e81, theta_1, _e100, dist_1);
                         extent = metal::max(_e99, _e101);
                     }
                 }

@@ -45,6 +45,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     vec4 proj_g0_;
     vec4 proj_g1_;
     vec4 proj_g2_;
+    vec4 fan_origin;
+    vec4 fan_angles;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
@@ -369,28 +371,40 @@ float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod
     return atan(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_7) {
-    uint rows_1 = f_8.sizes.w;
-    float phi = atan(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
-    float yc = ((phi - f_8.e1_.w) / f_8.e2_.w);
-    return ((f_8.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8) {
+    return vec2(float(f_8.sizes.x), float(f_8.sizes.y));
 }
 
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, vec3 dir_7) {
+    uint rows_1 = f_9.sizes.w;
+    float phi = atan(dot(dir_7, f_9.e2_.xyz), dot(dir_7, f_9.e1_.xyz));
+    float z_4 = dot(dir_7, f_9.cam_forward.xyz);
+    float t_5 = f_9.cam_forward.w;
+    vec2 ndc = vec2((dot(dir_7, f_9.cam_right.xyz) / ((z_4 * t_5) * f_9.cam_right.w)), (dot(dir_7, f_9.cam_up.xyz) / (z_4 * t_5)));
+    vec2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    vec2 p_3 = (vec2(((ndc.x + 1.0) * 0.5), ((1.0 - ndc.y) * 0.5)) * _e41);
+    vec2 d_3 = (p_3 - f_9.fan_origin.xy);
+    vec2 ax = f_9.fan_origin.zw;
+    float fan = ((atan(((ax.x * d_3.y) - (ax.y * d_3.x)), ((ax.x * d_3.x) + (ax.y * d_3.y))) - f_9.fan_angles.x) / f_9.fan_angles.y);
+    float yc = ((f_9.fan_angles.z > 0.5) ? fan : ((phi - f_9.e1_.w) / f_9.e2_.w));
+    return ((f_9.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
+}
+
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
     if (spot_3) {
-        vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
-        vec3 to_eye = -(f_9.axis.xyz);
+        vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_10.light_pos.xyz);
+        vec3 to_eye = -(f_10.axis.xyz);
         return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float x_2, float delta, float theta_2, float s_2, bool spot_4) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float x_2, float delta, float theta_2, float s_2, bool spot_4) {
     bool local_1 = false;
     if (spot_4) {
         float psi = (x_2 * delta);
@@ -404,17 +418,17 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_11.axis.w * sin(psi)) / den), s_2);
+        return min(((f_12.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, float(x_3), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, float(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -424,8 +438,8 @@ uint depth_bin(float d) {
 
 RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float s_4, bool spot_6) {
     bool local_2 = false;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = _group_0_binding_0_cs;
-    uint width = f_14.sizes.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = _group_0_binding_0_cs;
+    uint width = f_15.sizes.z;
     vec4 _e7 = _group_0_binding_1_cs[row];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e8 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e7);
     float delta_2 = _e8.delta;
@@ -453,17 +467,17 @@ RowSpan row_span(uint row, float col, float d_1, uint bin, float theta_4, float 
     vec4 _e70 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(last, row)), ivec2(0), textureSize(_group_0_binding_4_cs, _e70_clamped_lod) - ivec2(1)), _e70_clamped_lod);
     bool tail = (d_1 <= _e70.x);
     uint first = ((first_edge < PAD) ? 0u : (first_edge - PAD));
-    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, first, n_3, delta_2, theta_4, s_4, spot_6);
-    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
+    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, first, n_3, delta_2, theta_4, s_4, spot_6);
+    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
     return RowSpan(_e81, _e84, head, tail);
 }
 
-float closed_form(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_7) {
+float closed_form(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_7) {
     if (spot_7) {
-        float _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max(max((f_13.sizes2_.z / 4u), 8u), 1u));
+        float _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_10, a_5, b_5, max(max((f_14.sizes2_.z / 4u), 8u), 1u));
         return _e14;
     }
-    float _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
+    float _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, a_5, b_5);
     return _e17;
 }
 
@@ -472,27 +486,27 @@ vec3 volume_march_pixel(uint x_4, uint y_1) {
     float t_b = 0.0;
     float total = 0.0;
     float l_1 = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = _group_0_binding_0_cs;
-    vec3 eye_9 = f_15.eye.xyz;
-    vec3 _e7 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, x_4, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = _group_0_binding_0_cs;
+    vec3 eye_9 = f_16.eye.xyz;
+    vec3 _e7 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, x_4, y_1);
     int _e11_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e11 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_4, y_1)), ivec2(0), textureSize(_group_0_binding_2_cs, _e11_clamped_lod) - ivec2(1)), _e11_clamped_lod);
-    float s_5 = (min(max(_e11.x, 0.0), f_15.theta.z) / max(dot(_e7, f_15.cam_forward.xyz), 1e-6));
-    vec3 color = f_15.light_color.xyz;
-    bool _e33 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, vec2((float(x_4) + 0.5), (float(y_1) + 0.5)));
+    float s_5 = (min(max(_e11.x, 0.0), f_16.theta.z) / max(dot(_e7, f_16.cam_forward.xyz), 1e-6));
+    vec3 color = f_16.light_color.xyz;
+    bool _e33 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, vec2((float(x_4) + 0.5), (float(y_1) + 0.5)));
     if (_e33) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = _group_0_binding_0_cs;
         float _e38 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _group_0_binding_3_cs, eye_9, _e7, s_5, true);
         vec3 l_2 = (_e38 * color);
         return l_2;
     }
-    uint rows_2 = f_15.sizes.w;
-    bool wrap_1 = (f_15.anti_epipole.w > 0.5);
-    float _e46 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e7);
-    float _e47 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e7);
-    float _e52 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, f_15.theta.x, f_15.theta.y);
+    uint rows_2 = f_16.sizes.w;
+    bool wrap_1 = (f_16.anti_epipole.w > 0.5);
+    float _e46 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e7);
+    float _e47 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e7);
+    float _e52 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, f_16.theta.x, f_16.theta.y);
     uint _e53 = depth_bin(_e52);
-    float _e54 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e7, s_5, _e46, true);
+    float _e54 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, eye_9, _e7, s_5, _e46, true);
     float j_1 = floor((_e47 - 0.5));
     uint _e58 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_1, rows_2, wrap_1);
     RowSpan _e59 = row_span(_e58, _e54, _e52, _e53, _e46, s_5, true);
@@ -515,7 +529,7 @@ vec3 volume_march_pixel(uint x_4, uint y_1) {
     if (_e59.head) {
         float _e84 = total;
         float _e85 = t_f;
-        float _e87 = closed_form(f_15, eye_9, _e7, 0.0, _e85, true);
+        float _e87 = closed_form(f_16, eye_9, _e7, 0.0, _e85, true);
         total = (_e84 + _e87);
     }
     float _e89 = t_b;
@@ -524,21 +538,21 @@ vec3 volume_march_pixel(uint x_4, uint y_1) {
         float _e92 = total;
         float _e93 = t_f;
         float _e94 = t_b;
-        float _e97 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _group_0_binding_3_cs, eye_9, _e7, _e93, _e94, SAMPLES, true);
+        float _e97 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _group_0_binding_3_cs, eye_9, _e7, _e93, _e94, SAMPLES, true);
         total = (_e92 + _e97);
     }
     if (_e59.tail) {
         float _e100 = total;
         float _e101 = t_b;
-        float _e102 = closed_form(f_15, eye_9, _e7, _e101, s_5, true);
+        float _e102 = closed_form(f_16, eye_9, _e7, _e101, s_5, true);
         total = (_e100 + _e102);
     }
     float _e104 = total;
     l_1 = _e104;
     if (!(true)) {
-        float _e115 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(dot(f_15.light_dir.xyz, _e7)));
+        float _e115 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(dot(f_16.light_dir.xyz, _e7)));
         float _e117 = total;
-        l_1 = ((f_15.medium.y * _e115) * _e117);
+        l_1 = ((f_16.medium.y * _e115) * _e117);
     }
     float _e119 = l_1;
     vec3 c = (color * _e119);

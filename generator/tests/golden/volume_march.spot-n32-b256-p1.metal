@@ -51,6 +51,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     metal::float4 proj_g0_;
     metal::float4 proj_g1_;
     metal::float4 proj_g2_;
+    metal::float4 fan_origin;
+    metal::float4 fan_angles;
 };
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float delta;
@@ -508,18 +510,32 @@ float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return metal::atan2(metal::length(metal::cross(dir_6, axis)), metal::dot(dir_6, axis));
 }
 
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8
+) {
+    return metal::float2(static_cast<float>(f_8.sizes.x), static_cast<float>(f_8.sizes.y));
+}
+
 float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     metal::float3 dir_7
 ) {
-    uint rows_1 = f_8.sizes.w;
-    float phi = metal::atan2(metal::dot(dir_7, f_8.e2_.xyz), metal::dot(dir_7, f_8.e1_.xyz));
-    float yc = (phi - f_8.e1_.w) / f_8.e2_.w;
-    return (f_8.anti_epipole.w > 0.5) ? (yc - (metal::floor(yc / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc, 0.0, static_cast<float>(rows_1));
+    uint rows_1 = f_9.sizes.w;
+    float phi = metal::atan2(metal::dot(dir_7, f_9.e2_.xyz), metal::dot(dir_7, f_9.e1_.xyz));
+    float z_4 = metal::dot(dir_7, f_9.cam_forward.xyz);
+    float t_5 = f_9.cam_forward.w;
+    metal::float2 ndc = metal::float2(metal::dot(dir_7, f_9.cam_right.xyz) / ((z_4 * t_5) * f_9.cam_right.w), metal::dot(dir_7, f_9.cam_up.xyz) / (z_4 * t_5));
+    metal::float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    metal::float2 p_3 = metal::float2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * _e41;
+    metal::float2 d_3 = p_3 - f_9.fan_origin.xy;
+    metal::float2 ax = f_9.fan_origin.zw;
+    float fan = (metal::atan2((ax.x * d_3.y) - (ax.y * d_3.x), (ax.x * d_3.x) + (ax.y * d_3.y)) - f_9.fan_angles.x) / f_9.fan_angles.y;
+    float yc = (f_9.fan_angles.z > 0.5) ? fan : ((phi - f_9.e1_.w) / f_9.e2_.w);
+    return (f_9.anti_epipole.w > 0.5) ? (yc - (metal::floor(yc / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc, 0.0, static_cast<float>(rows_1));
 }
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     metal::float3 eye_6,
     metal::float3 dir_8,
     float s_1,
@@ -527,27 +543,27 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_3
 ) {
     if (spot_3) {
-        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz;
-        metal::float3 to_eye = -(f_9.axis.xyz);
+        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_10.light_pos.xyz;
+        metal::float3 to_eye = -(f_10.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
     }
     return s_1 * metal::sin(theta_1);
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     metal::float3 eye_7,
     metal::float3 dir_9,
     float a_4,
     float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
     float x_2,
     float delta,
     float theta_2,
@@ -567,14 +583,14 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (_e16) {
             return s_2;
         }
-        return metal::min((f_11.axis.w * metal::sin(psi)) / den, s_2);
+        return metal::min((f_12.axis.w * metal::sin(psi)) / den, s_2);
     } else {
         return metal::min((x_2 * delta) / metal::max(metal::sin(theta_2), 0.000001), s_2);
     }
 }
 
 float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
     uint x_3,
     uint n_1,
     float delta_1,
@@ -585,7 +601,7 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     if (x_3 >= n_1) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -610,8 +626,8 @@ RowSpan row_span(
     constant _mslBufferSizes& _buffer_sizes
 ) {
     bool local_2 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14 = frame;
-    uint width = f_14.sizes.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
+    uint width = f_15.sizes.z;
     metal::float4 _e7 = slices[metal::min(unsigned(row), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e8 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e7);
     float delta_2 = _e8.delta;
@@ -639,8 +655,8 @@ RowSpan row_span(
     metal::float4 _e70 = rectified.read(metal::min(metal::uint2(metal::uint2(last, row)), metal::uint2(rectified.get_width(clamped_lod_e70), rectified.get_height(clamped_lod_e70)) - 1), clamped_lod_e70);
     bool tail = d_1 <= _e70.x;
     uint first = (first_edge < PAD) ? 0u : (first_edge - PAD);
-    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, first, n_3, delta_2, theta_4, s_4, spot_6);
-    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, last + PAD, n_3, delta_2, theta_4, s_4, spot_6);
+    float _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, first, n_3, delta_2, theta_4, s_4, spot_6);
+    float _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, last + PAD, n_3, delta_2, theta_4, s_4, spot_6);
     return RowSpan {_e81, _e84, head, tail};
 }
 
@@ -649,7 +665,7 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 float closed_form(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14,
     metal::float3 eye_8,
     metal::float3 dir_10,
     float a_5,
@@ -657,10 +673,10 @@ float closed_form(
     bool spot_7
 ) {
     if (spot_7) {
-        float _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, metal::max(metal::max(naga_div(f_13.sizes2_.z, 4u), 8u), 1u));
+        float _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_10, a_5, b_5, metal::max(metal::max(naga_div(f_14.sizes2_.z, 4u), 8u), 1u));
         return _e14;
     }
-    float _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
+    float _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, a_5, b_5);
     return _e17;
 }
 
@@ -679,27 +695,27 @@ metal::float3 volume_march_pixel(
     float t_b = {};
     float total = 0.0;
     float l_1 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15 = frame;
-    metal::float3 eye_9 = f_15.eye.xyz;
-    metal::float3 _e7 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, x_4, y_1);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16 = frame;
+    metal::float3 eye_9 = f_16.eye.xyz;
+    metal::float3 _e7 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, x_4, y_1);
     uint clamped_lod_e11 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e11 = depth.read(metal::min(metal::uint2(metal::uint2(x_4, y_1)), metal::uint2(depth.get_width(clamped_lod_e11), depth.get_height(clamped_lod_e11)) - 1), clamped_lod_e11);
-    float s_5 = metal::min(metal::max(_e11.x, 0.0), f_15.theta.z) / metal::max(metal::dot(_e7, f_15.cam_forward.xyz), 0.000001);
-    metal::float3 color = f_15.light_color.xyz;
-    bool _e33 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, metal::float2(static_cast<float>(x_4) + 0.5, static_cast<float>(y_1) + 0.5));
+    float s_5 = metal::min(metal::max(_e11.x, 0.0), f_16.theta.z) / metal::max(metal::dot(_e7, f_16.cam_forward.xyz), 0.000001);
+    metal::float3 color = f_16.light_color.xyz;
+    bool _e33 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, metal::float2(static_cast<float>(x_4) + 0.5, static_cast<float>(y_1) + 0.5));
     if (_e33) {
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = frame;
         float _e38 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, shadow_map, eye_9, _e7, s_5, true);
         metal::float3 l_2 = _e38 * color;
         return l_2;
     }
-    uint rows_2 = f_15.sizes.w;
-    bool wrap_1 = f_15.anti_epipole.w > 0.5;
-    float _e46 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e7);
-    float _e47 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e7);
-    float _e52 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, f_15.theta.x, f_15.theta.y);
+    uint rows_2 = f_16.sizes.w;
+    bool wrap_1 = f_16.anti_epipole.w > 0.5;
+    float _e46 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e7);
+    float _e47 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e7);
+    float _e52 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, f_16.theta.x, f_16.theta.y);
     uint _e53 = depth_bin(_e52);
-    float _e54 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e7, s_5, _e46, true);
+    float _e54 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, eye_9, _e7, s_5, _e46, true);
     float j_1 = metal::floor(_e47 - 0.5);
     uint _e58 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_1, rows_2, wrap_1);
     RowSpan _e59 = row_span(_e58, _e54, _e52, _e53, _e46, s_5, true, frame, slices, rectified, crossings, _buffer_sizes);
@@ -722,7 +738,7 @@ metal::float3 volume_march_pixel(
     if (_e59.head) {
         float _e84 = total;
         float _e85 = t_f;
-        float _e87 = closed_form(f_15, eye_9, _e7, 0.0, _e85, true);
+        float _e87 = closed_form(f_16, eye_9, _e7, 0.0, _e85, true);
         total = _e84 + _e87;
     }
     float _e89 = t_b;
@@ -731,21 +747,21 @@ metal::float3 volume_march_pixel(
         float _e92 = total;
         float _e93 = t_f;
         float _e94 = t_b;
-        float _e97 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, shadow_map, eye_9, _e7, _e93, _e94, SAMPLES, true);
+        float _e97 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, shadow_map, eye_9, _e7, _e93, _e94, SAMPLES, true);
         total = _e92 + _e97;
     }
     if (_e59.tail) {
         float _e100 = total;
         float _e101 = t_b;
-        float _e102 = closed_form(f_15, eye_9, _e7, _e101, s_5, true);
+        float _e102 = closed_form(f_16, eye_9, _e7, _e101, s_5, true);
         total = _e100 + _e102;
     }
     float _e104 = total;
     l_1 = _e104;
     if (!(true)) {
-        float _e115 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(metal::dot(f_15.light_dir.xyz, _e7)));
+        float _e115 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(metal::dot(f_16.light_dir.xyz, _e7)));
         float _e117 = total;
-        l_1 = (f_15.medium.y * _e115) * _e117;
+        l_1 = (f_16.medium.y * _e115) * _e117;
     }
     float _e119 = l_1;
     metal::float3 c = color * _e119;

@@ -42,6 +42,8 @@ struct FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     proj_g0_: vec4<f32>,
     proj_g1_: vec4<f32>,
     proj_g2_: vec4<f32>,
+    fan_origin: vec4<f32>,
+    fan_angles: vec4<f32>,
 }
 
 struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
@@ -364,28 +366,40 @@ fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_m
     return atan2(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
-    let rows_1 = f_8.sizes.w;
-    let phi = atan2(dot(dir_7, f_8.e2_.xyz), dot(dir_7, f_8.e1_.xyz));
-    let yc = ((phi - f_8.e1_.w) / f_8.e2_.w);
-    return select(clamp(yc, 0f, f32(rows_1)), (yc - (floor((yc / f32(rows_1))) * f32(rows_1))), (f_8.anti_epipole.w > 0.5f));
+fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
+    return vec2<f32>(f32(f_8.sizes.x), f32(f_8.sizes.y));
 }
 
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
+    let rows_1 = f_9.sizes.w;
+    let phi = atan2(dot(dir_7, f_9.e2_.xyz), dot(dir_7, f_9.e1_.xyz));
+    let z_4 = dot(dir_7, f_9.cam_forward.xyz);
+    let t_5 = f_9.cam_forward.w;
+    let ndc = vec2<f32>((dot(dir_7, f_9.cam_right.xyz) / ((z_4 * t_5) * f_9.cam_right.w)), (dot(dir_7, f_9.cam_up.xyz) / (z_4 * t_5)));
+    let _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9);
+    let p_3 = (vec2<f32>(((ndc.x + 1f) * 0.5f), ((1f - ndc.y) * 0.5f)) * _e41);
+    let d_3 = (p_3 - f_9.fan_origin.xy);
+    let ax = f_9.fan_origin.zw;
+    let fan = ((atan2(((ax.x * d_3.y) - (ax.y * d_3.x)), ((ax.x * d_3.x) + (ax.y * d_3.y))) - f_9.fan_angles.x) / f_9.fan_angles.y);
+    let yc = select(((phi - f_9.e1_.w) / f_9.e2_.w), fan, (f_9.fan_angles.z > 0.5f));
+    return select(clamp(yc, 0f, f32(rows_1)), (yc - (floor((yc / f32(rows_1))) * f32(rows_1))), (f_9.anti_epipole.w > 0.5f));
+}
+
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
     if spot_3 {
-        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_9.light_pos.xyz);
-        let to_eye = -(f_9.axis.xyz);
+        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_10.light_pos.xyz);
+        let to_eye = -(f_10.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_10.light_pos.xyz, f_10.light_dir.xyz, f_10.light_pos.w, f_10.light_dir.w, f_10.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_11.light_pos.xyz, f_11.light_dir.xyz, f_11.light_pos.w, f_11.light_dir.w, f_11.medium);
     return _e15;
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
     var local_1: bool;
 
     if spot_4 {
@@ -400,17 +414,17 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_
         if _e16 {
             return s_2;
         }
-        return min(((f_11.axis.w * sin(psi)) / den), s_2);
+        return min(((f_12.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
     if (x_3 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, f32(x_3), delta_1, theta_3, s_3, spot_5);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, f32(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
@@ -421,8 +435,8 @@ fn depth_bin(d: f32) -> u32 {
 fn row_span(row: u32, col: f32, d_1: f32, bin: u32, theta_4: f32, s_4: f32, spot_6: bool) -> RowSpan {
     var local_2: bool;
 
-    let f_14 = frame;
-    let width = f_14.sizes.z;
+    let f_15 = frame;
+    let width = f_15.sizes.z;
     let _e7 = slices[row];
     let _e8 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e7);
     let delta_2 = _e8.delta;
@@ -448,17 +462,17 @@ fn row_span(row: u32, col: f32, d_1: f32, bin: u32, theta_4: f32, s_4: f32, spot
     let _e70 = textureLoad(rectified, vec2<u32>(last, row), 0i);
     let tail = (d_1 <= _e70.x);
     let first = select((first_edge - PAD), 0u, (first_edge < PAD));
-    let _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, first, n_3, delta_2, theta_4, s_4, spot_6);
-    let _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
+    let _e81 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, first, n_3, delta_2, theta_4, s_4, spot_6);
+    let _e84 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, (last + PAD), n_3, delta_2, theta_4, s_4, spot_6);
     return RowSpan(_e81, _e84, head, tail);
 }
 
-fn closed_form(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_7: bool) -> f32 {
+fn closed_form(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_7: bool) -> f32 {
     if spot_7 {
-        let _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, dir_10, a_5, b_5, max(max((f_13.sizes2_.z / 4u), 8u), 1u));
+        let _e14 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14, eye_8, dir_10, a_5, b_5, max(max((f_14.sizes2_.z / 4u), 8u), 1u));
         return _e14;
     }
-    let _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, a_5, b_5);
+    let _e17 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_14.medium.x, a_5, b_5);
     return _e17;
 }
 
@@ -468,26 +482,26 @@ fn volume_march_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     var total: f32 = 0f;
     var l_1: f32;
 
-    let f_15 = frame;
-    let eye_9 = f_15.eye.xyz;
-    let _e7 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, x_4, y_1);
+    let f_16 = frame;
+    let eye_9 = f_16.eye.xyz;
+    let _e7 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, x_4, y_1);
     let _e11 = textureLoad(depth, vec2<u32>(x_4, y_1), 0i);
-    let s_5 = (min(max(_e11.x, 0f), f_15.theta.z) / max(dot(_e7, f_15.cam_forward.xyz), 0.000001f));
-    let color = f_15.light_color.xyz;
-    let _e33 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, vec2<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f)));
+    let s_5 = (min(max(_e11.x, 0f), f_16.theta.z) / max(dot(_e7, f_16.cam_forward.xyz), 0.000001f));
+    let color = f_16.light_color.xyz;
+    let _e33 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, vec2<f32>((f32(x_4) + 0.5f), (f32(y_1) + 0.5f)));
     if _e33 {
         let _e35 = frame;
         let _e38 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, shadow_map, eye_9, _e7, s_5, true);
         let l_2 = (_e38 * color);
         return l_2;
     }
-    let rows_2 = f_15.sizes.w;
-    let wrap_1 = (f_15.anti_epipole.w > 0.5f);
-    let _e46 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e7);
-    let _e47 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, _e7);
-    let _e52 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, f_15.theta.x, f_15.theta.y);
+    let rows_2 = f_16.sizes.w;
+    let wrap_1 = (f_16.anti_epipole.w > 0.5f);
+    let _e46 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e7);
+    let _e47 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e7);
+    let _e52 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e46, f_16.theta.x, f_16.theta.y);
     let _e53 = depth_bin(_e52);
-    let _e54 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_9, _e7, s_5, _e46, true);
+    let _e54 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, eye_9, _e7, s_5, _e46, true);
     let j_1 = floor((_e47 - 0.5f));
     let _e58 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_1, rows_2, wrap_1);
     let _e59 = row_span(_e58, _e54, _e52, _e53, _e46, s_5, true);
@@ -510,7 +524,7 @@ fn volume_march_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
     if _e59.head {
         let _e84 = total;
         let _e85 = t_f;
-        let _e87 = closed_form(f_15, eye_9, _e7, 0f, _e85, true);
+        let _e87 = closed_form(f_16, eye_9, _e7, 0f, _e85, true);
         total = (_e84 + _e87);
     }
     let _e89 = t_b;
@@ -519,21 +533,21 @@ fn volume_march_pixel(x_4: u32, y_1: u32) -> vec3<f32> {
         let _e92 = total;
         let _e93 = t_f;
         let _e94 = t_b;
-        let _e97 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, shadow_map, eye_9, _e7, _e93, _e94, SAMPLES, true);
+        let _e97 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, shadow_map, eye_9, _e7, _e93, _e94, SAMPLES, true);
         total = (_e92 + _e97);
     }
     if _e59.tail {
         let _e100 = total;
         let _e101 = t_b;
-        let _e102 = closed_form(f_15, eye_9, _e7, _e101, s_5, true);
+        let _e102 = closed_form(f_16, eye_9, _e7, _e101, s_5, true);
         total = (_e100 + _e102);
     }
     let _e104 = total;
     l_1 = _e104;
     if !(true) {
-        let _e115 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.z, -(dot(f_15.light_dir.xyz, _e7)));
+        let _e115 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_16.medium.z, -(dot(f_16.light_dir.xyz, _e7)));
         let _e117 = total;
-        l_1 = ((f_15.medium.y * _e115) * _e117);
+        l_1 = ((f_16.medium.y * _e115) * _e117);
     }
     let _e119 = l_1;
     let c = (color * _e119);

@@ -25,7 +25,55 @@ pub fn slice_e(f: &FrameUniforms, phi: f32) -> Vec3 {
 
 /// Slice angle at the centre of row `row`.
 pub fn row_phi(f: &FrameUniforms, row: u32) -> f32 {
-    f.e1[3] + (row as f32 + 0.5) * f.e2[3]
+    if f.fan_angles[2] > 0.5 {
+        fan_phi(f, row)
+    } else {
+        f.e1[3] + (row as f32 + 0.5) * f.e2[3]
+    }
+}
+
+/// The screen size in pixels.
+fn screen_size(f: &FrameUniforms) -> [f32; 2] {
+    [f.sizes[0] as f32, f.sizes[1] as f32]
+}
+
+/// Unit view direction through screen position `p` (pixels from the top-left corner).
+pub fn screen_dir(f: &FrameUniforms, p: [f32; 2]) -> Vec3 {
+    let ndc_x = 2.0 * p[0] / f.sizes[0] as f32 - 1.0;
+    let ndc_y = 1.0 - 2.0 * p[1] / f.sizes[1] as f32;
+    let t = f.cam_forward[3];
+    (xyz(f.cam_forward)
+        + xyz(f.cam_right) * (ndc_x * t * f.cam_right[3])
+        + xyz(f.cam_up) * (ndc_y * t))
+        .normalize()
+}
+
+/// Distance from `o` along `u` of the midpoint of the line's part inside the rectangle of
+/// pixel centres of a screen of `size` pixels (its nearest point when it misses it).
+fn fan_line_mid(o: [f32; 2], u: [f32; 2], size: [f32; 2]) -> f32 {
+    let mut t_in = 0.0f32;
+    let mut t_out = 3.4e38f32;
+    for a in 0..2 {
+        if u[a].abs() > 1e-12 {
+            let ta = (0.5 - o[a]) / u[a];
+            let tb = (size[a] - 0.5 - o[a]) / u[a];
+            t_in = max(t_in, ta.min(tb));
+            t_out = t_out.min(ta.max(tb));
+        }
+    }
+    0.5 * (t_in + max(t_out, t_in))
+}
+
+/// The slice angle (around the light axis) of aligned row `row` (`FrameUniforms::fan_angles`):
+/// that of the view ray through the midpoint of its screen slice.
+pub fn fan_phi(f: &FrameUniforms, row: u32) -> f32 {
+    let a = f.fan_angles[0] + (row as f32 + 0.5) * f.fan_angles[1];
+    let (ax, ay) = (f.fan_origin[2], f.fan_origin[3]);
+    let u = [ax * a.cos() - ay * a.sin(), ay * a.cos() + ax * a.sin()];
+    let o = [f.fan_origin[0], f.fan_origin[1]];
+    let mid = fan_line_mid(o, u, screen_size(f));
+    let d = screen_dir(f, [o[0] + u[0] * mid, o[1] + u[1] * mid]);
+    d.dot(xyz(f.e2)).atan2(d.dot(xyz(f.e1)))
 }
 
 /// Normalised rectified depth of view angle `theta`, the frame's view angles spanning
@@ -210,8 +258,21 @@ pub fn ray_theta(f: &FrameUniforms, dir: Vec3) -> f32 {
 /// circle, else clamped to `[0, rows]`. Row `floor(yc)` is the nearest ([`row_index`]).
 pub fn ray_row_coord(f: &FrameUniforms, dir: Vec3) -> f32 {
     let rows = f.sizes[3];
-    let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
-    let mut yc = (phi - f.e1[3]) / f.e2[3];
+    let mut yc = if f.fan_angles[2] > 0.5 {
+        // Aligned rows: the screen angle of the ray's screen point around the fan's origin.
+        let z = dir.dot(xyz(f.cam_forward));
+        let t = f.cam_forward[3];
+        let nx = dir.dot(xyz(f.cam_right)) / (z * t * f.cam_right[3]);
+        let ny = dir.dot(xyz(f.cam_up)) / (z * t);
+        let size = screen_size(f);
+        let p = [(nx + 1.0) * 0.5 * size[0], (1.0 - ny) * 0.5 * size[1]];
+        let d = [p[0] - f.fan_origin[0], p[1] - f.fan_origin[1]];
+        let (ax, ay) = (f.fan_origin[2], f.fan_origin[3]);
+        ((ax * d[1] - ay * d[0]).atan2(ax * d[0] + ay * d[1]) - f.fan_angles[0]) / f.fan_angles[1]
+    } else {
+        let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
+        (phi - f.e1[3]) / f.e2[3]
+    };
     if f.anti_epipole[3] > 0.5 {
         yc -= (yc / rows as f32).floor() * rows as f32;
     } else {

@@ -6,9 +6,9 @@
 //!
 //! Conventions are documented in `scatter_shaderlib::prefiltered::frame`.
 
-use super::common_epipolar::{row_phi, slice_e};
 use super::common_model::{PI, cone_falloff, exp, max, min, transmittance_between};
 use super::texture::xyz;
+use glam::Vec3;
 use scatter_shaderlib::prefiltered::{FrameUniforms, SliceParams};
 
 /// Smallest cone factor of a spot texel weight (see the WGSL): a region of the reference ray
@@ -67,13 +67,14 @@ pub fn ref_t(f: &FrameUniforms, s: &SliceParams, x: f32, spot: bool) -> f32 {
     }
 }
 
-/// Prefilter weight of column `i` of row `row`: the length of the reference ray it covers
-/// (average), or the transmittance integral over that span (weighted), times the cone
-/// falloff and `exp(-sigma_t r) / r^2` at the span's middle for a spot light.
+/// Prefilter weight of column `i` of a row (slice parameters `s`, slice direction `e`, which
+/// the caller computes once per row): the length of the reference ray it covers (average),
+/// or the transmittance integral over that span (weighted), times the cone falloff and
+/// `exp(-sigma_t r) / r^2` at the span's middle for a spot light.
 pub fn texel_weight(
     f: &FrameUniforms,
     s: &SliceParams,
-    row: u32,
+    e: Vec3,
     i: u32,
     weighted: bool,
     spot: bool,
@@ -86,7 +87,6 @@ pub fn texel_weight(
     let mut w = transmittance_between(f.medium[0], t0, t1);
     if spot {
         let psi = (i as f32 + 0.5) * s.delta;
-        let e = slice_e(f, row_phi(f, row));
         let l = -xyz(f.axis) * psi.cos() + e * psi.sin();
         let den = max((s.theta_ref + psi).sin(), 1e-4);
         let r = max(f.axis[3] * s.theta_ref.sin() / den, 1e-4);

@@ -107,7 +107,7 @@ pub fn prefilter_main(
             d = proj_stored_depth(d);
             w = proj_texel_weight(frame, &slice, i, region, variant.regions, weighted, spot);
         } else {
-            w = texel_weight(frame, &slice, row, i, weighted, spot);
+            w = texel_weight(frame, &slice, e, i, weighted, spot);
         }
         wsum += w;
         if thread == 0 {

@@ -14,7 +14,7 @@
 #import scatter::shadow::{ShadowMapView, shadow_occluder_distance_orthographic, shadow_occluder_distance_perspective, shadow_visibility_for}
 
 // The uniform block (host: `scatter_shaderlib::prefiltered::FrameUniforms`, field by field;
-// every member is 16 bytes, 25 * 16 = 400 bytes in all). The host's `e1`, `e2`, `sizes2` and
+// every member is 16 bytes, 27 * 16 = 432 bytes in all). The host's `e1`, `e2`, `sizes2` and
 // `proj_g0..2` are spelled `e1_`, `e2_`, `sizes2_` and `proj_g0_..2_`: naga's back-ends append
 // `_` to identifiers that end in a digit, and naga_oil requires shared modules to use the
 // written-back spelling.
@@ -70,6 +70,12 @@ struct Frame {
     proj_g1_: vec4<f32>,
     // G_8; yzw unused.
     proj_g2_: vec4<f32>,
+    // Rows aligned with the epipolar sampling's slices (fan_angles.z = 1): the slices'
+    // origin on screen (pixels) in xy, the unit screen direction of angle 0 in zw.
+    fan_origin: vec4<f32>,
+    // Aligned rows: x = screen angle where row 0 starts, y = screen angle per row, z = 1;
+    // all zero for rows uniform in the angle around the light axis.
+    fan_angles: vec4<f32>,
 }
 
 // One rectified row's parameters (host: `SliceParams`), unpacked from the kernels'
@@ -98,9 +104,53 @@ fn slice_e(f: Frame, phi: f32) -> vec3<f32> {
     return f.e1_.xyz * cos(phi) + f.e2_.xyz * sin(phi);
 }
 
-// Slice angle at the centre of row `row`.
+// Slice angle at the centre of row `row`: uniform in the angle around the light axis, or,
+// with rows aligned with the epipolar sampling's slices (`f.fan_angles.z`; variants with
+// `sampling = epipolar`), that of the plane of the row's screen slice (`fan_phi`), so that a
+// sample on slice s reads row s's light rays, not a neighbour's up to half a row away.
+// Selected, not branched on (a uniform: `scatter_shaderlib::uniform_branches`).
 fn row_phi(f: Frame, row: u32) -> f32 {
-    return f.e1_[3] + (f32(row) + 0.5) * f.e2_[3];
+    return select(f.e1_[3] + (f32(row) + 0.5) * f.e2_[3], fan_phi(f, row), f.fan_angles[2] > 0.5);
+}
+
+// The screen size in pixels.
+fn screen_size(f: Frame) -> vec2<f32> {
+    return vec2<f32>(f32(f.sizes[0]), f32(f.sizes[1]));
+}
+
+// Unit view direction through screen position `p` (pixels from the top-left corner).
+fn screen_dir(f: Frame, p: vec2<f32>) -> vec3<f32> {
+    let ndc = vec2<f32>(2.0 * p.x / f32(f.sizes[0]) - 1.0, 1.0 - 2.0 * p.y / f32(f.sizes[1]));
+    let t = f.cam_forward[3];
+    return normalize(f.cam_forward.xyz + f.cam_right.xyz * (ndc.x * t * f.cam_right[3]) + f.cam_up.xyz * (ndc.y * t));
+}
+
+// Distance from `o` along `u` of the midpoint of the line's part inside the rectangle of
+// pixel centres of a screen of `size` pixels (its nearest point when it misses it).
+fn fan_line_mid(o: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
+    var t_in = 0.0;
+    var t_out = 3.4e38;
+    for (var a = 0u; a < 2u; a++) {
+        let ta = (0.5 - o[a]) / u[a];
+        let tb = (size[a] - 0.5 - o[a]) / u[a];
+        let crosses = abs(u[a]) > 1e-12;
+        t_in = select(t_in, max(t_in, min(ta, tb)), crosses);
+        t_out = select(t_out, min(t_out, max(ta, tb)), crosses);
+    }
+    return 0.5 * (t_in + max(t_out, t_in));
+}
+
+// The slice angle (around the light axis) of aligned row `row`: that of the view ray through
+// the midpoint of its screen slice, the line from `f.fan_origin.xy` at screen angle
+// `fan_angles.x + (row + 1/2) fan_angles.y` (every point of the line lies on one plane
+// through the axis when the origin is the epipole; the midpoint keeps a near-infinite
+// epipole, whose origin the layout clamps, on the slice's own plane).
+fn fan_phi(f: Frame, row: u32) -> f32 {
+    let a = f.fan_angles[0] + (f32(row) + 0.5) * f.fan_angles[1];
+    let ax = f.fan_origin.zw;
+    let u = vec2<f32>(ax.x * cos(a) - ax.y * sin(a), ax.y * cos(a) + ax.x * sin(a));
+    let d = screen_dir(f, f.fan_origin.xy + u * fan_line_mid(f.fan_origin.xy, u, screen_size(f)));
+    return atan2(dot(d, f.e2_.xyz), dot(d, f.e1_.xyz));
 }
 
 // Normalised rectified depth of view angle `theta`, the frame's view angles spanning
@@ -251,12 +301,22 @@ fn ray_theta(f: Frame, dir: vec3<f32>) -> f32 {
 }
 
 // Continuous row coordinate of the slice holding direction `dir`: its slice angle in rows
-// from the first row's start, wrapped into [0, rows) when the slices cover the full circle,
+// from the first row's start (with aligned rows, `row_phi`, its screen angle around the
+// fan's origin in rows), wrapped into [0, rows) when the slices cover the full circle,
 // else clamped to [0, rows]. Row `floor(yc)` is the nearest (`row_index`).
 fn ray_row_coord(f: Frame, dir: vec3<f32>) -> f32 {
     let rows = f.sizes[3];
     let phi = atan2(dot(dir, f.e2_.xyz), dot(dir, f.e1_.xyz));
-    let yc = (phi - f.e1_[3]) / f.e2_[3];
+    // Aligned rows (`row_phi`): the screen angle of the ray's screen point around the fan's
+    // origin, in rows.
+    let z = dot(dir, f.cam_forward.xyz);
+    let t = f.cam_forward[3];
+    let ndc = vec2<f32>(dot(dir, f.cam_right.xyz) / (z * t * f.cam_right[3]), dot(dir, f.cam_up.xyz) / (z * t));
+    let p = vec2<f32>((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * screen_size(f);
+    let d = p - f.fan_origin.xy;
+    let ax = f.fan_origin.zw;
+    let fan = (atan2(ax.x * d.y - ax.y * d.x, ax.x * d.x + ax.y * d.y) - f.fan_angles[0]) / f.fan_angles[1];
+    let yc = select((phi - f.e1_[3]) / f.e2_[3], fan, f.fan_angles[2] > 0.5);
     // Selected, not branched on (a uniform: `scatter_shaderlib::uniform_branches`).
     return select(clamp(yc, 0.0, f32(rows)), yc - floor(yc / f32(rows)) * f32(rows), f.anti_epipole[3] > 0.5);
 }

@@ -14,7 +14,7 @@
 #define_import_path scatter::prefiltered
 
 #import scatter::model::{PI, cone_falloff, transmittance_between}
-#import scatter::epipolar::{Frame, SliceParams, row_phi, slice_e}
+#import scatter::epipolar::{Frame, SliceParams}
 
 
 // Smallest cone factor of a spot texel weight: where a region of the reference ray lies
@@ -85,10 +85,11 @@ fn ref_t(f: Frame, s: SliceParams, x: f32, spot: bool) -> f32 {
     }
 }
 
-// Prefilter weight of column `i` of row `row`: the length of the reference ray it covers
-// (average), or the transmittance integral over that span (weighted), times the cone
-// falloff and `exp(-sigma_t r) / r^2` at the span's middle for a spot light.
-fn texel_weight(f: Frame, s: SliceParams, row: u32, i: u32, weighted: bool, spot: bool) -> f32 {
+// Prefilter weight of column `i` of a row (slice parameters `s`, slice direction `e`, which
+// the caller computes once per row): the length of the reference ray it covers (average), or
+// the transmittance integral over that span (weighted), times the cone falloff and
+// `exp(-sigma_t r) / r^2` at the span's middle for a spot light.
+fn texel_weight(f: Frame, s: SliceParams, e: vec3<f32>, i: u32, weighted: bool, spot: bool) -> f32 {
     let t0 = ref_t(f, s, f32(i), spot);
     let t1 = ref_t(f, s, f32(i + 1u), spot);
     if !weighted {
@@ -97,7 +98,6 @@ fn texel_weight(f: Frame, s: SliceParams, row: u32, i: u32, weighted: bool, spot
     var w = transmittance_between(f.medium[0], t0, t1);
     if spot {
         let psi = (f32(i) + 0.5) * s.delta;
-        let e = slice_e(f, row_phi(f, row));
         let l = -f.axis.xyz * cos(psi) + e * sin(psi);
         let den = max(sin(s.theta_ref + psi), 1e-4);
         let r = max(f.axis[3] * sin(s.theta_ref) / den, 1e-4);
