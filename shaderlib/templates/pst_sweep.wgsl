@@ -49,7 +49,7 @@
 // Mirrors reference/src/kernels/pst_sweep.rs
 
 #import scatter::model::{cone_falloff, phase_hg, transmittance_between}
-#import scatter::epipolar::{Frame, in_epipole_disc, edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta, row_index, row_phi, slice_e, slice_params}
+#import scatter::epipolar::{Frame, in_epipole_disc, edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta, row_index, axis_row_phi, slice_e, slice_params}
 {%- if cookie %}
 #import scatter::cookie::{epipole_march_cookie, frame_cookie, lit_span_cookie}
 {%- endif %}
@@ -112,7 +112,7 @@ fn pst_leaf(f: Frame, i: u32, row: u32, delta: f32, h: u32) -> vec4<f32> {
     if !{{ spot }} {
         return gamma_at(f32(i) * delta, h);
     }
-    let e = slice_e(f, row_phi(f, row));
+    let e = slice_e(f, axis_row_phi(f, row));
     let axis = f.axis.xyz;
     var leaf = vec4<f32>(0.0, 0.0, 0.0, 0.0);
     for (var g = 0u; g < 2u; g++) {

@@ -304,9 +304,14 @@ float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1)
+float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row)
 {
-    return float2(float(f_1.sizes.x), float(f_1.sizes.y));
+    return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
+}
+
+float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2)
+{
+    return float2(float(f_2.sizes.x), float(f_2.sizes.y));
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float2 o_1, float2 u, float2 size)
@@ -354,28 +359,29 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float2 o_1, floa
     return (0.5 * (_e47 + max(_e48, _e49)));
 }
 
-float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, float2 p_2)
+float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, float2 p_2)
 {
-    float2 ndc = float2((((2.0 * p_2.x) / float(f_2.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_2.sizes.y))));
-    float t_2 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+    float2 ndc = float2((((2.0 * p_2.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_3.sizes.y))));
+    float t_2 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2))));
 }
 
-float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, uint row)
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1)
 {
-    float a_6 = (f_3.fan_angles.x + ((float(row) + 0.5) * f_3.fan_angles.y));
-    float2 ax = f_3.fan_origin.zw;
+    float a_6 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    float2 ax = f_4.fan_origin.zw;
     float2 u_2 = float2(((ax.x * cos(a_6)) - (ax.y * sin(a_6))), ((ax.y * cos(a_6)) + (ax.x * sin(a_6))));
-    const float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    const float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    const float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
-    return atan2(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+    const float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    const float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    const float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan2(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1)
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, uint row_2)
 {
-    const float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
-    return ((f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((float(row_1) + 0.5) * f_4.e2_.w)));
+    const float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    const float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return ((f_5.fan_angles.z > 0.5) ? _e3 : _e2);
 }
 
 float4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(float2 a_4, float2 b_3)
@@ -405,11 +411,11 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return naga_div(((r * r) * width), (regions * regions));
 }
 
-float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_1)
+float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_1)
 {
     bool local_2 = (bool)0;
 
-    float cap = (4.0 * f_5.theta.z);
+    float cap = (4.0 * f_6.theta.z);
     if (spot_1) {
         float psi = (x_1 * s.delta);
         float den = sin((s.theta_ref + psi));
@@ -422,48 +428,48 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod
         if (_e23) {
             return cap;
         }
-        return min(((f_5.axis.w * sin(psi)) / den), cap);
+        return min(((f_6.axis.w * sin(psi)) / den), cap);
     } else {
         return min(((x_1 * s.delta) / max(sin(s.theta_ref), 0.0001)), cap);
     }
 }
 
-float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, float3 e_1, uint i_1, bool weighted, bool spot_2)
+float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, float3 e_1, uint i_1, bool weighted, bool spot_2)
 {
     float w = (float)0;
 
-    const float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, float(i_1), spot_2);
-    const float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, float((i_1 + 1u)), spot_2);
+    const float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_1), spot_2);
+    const float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_1 + 1u)), spot_2);
     if (!(weighted)) {
         return (_e9 - _e5);
     }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, _e5, _e9);
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
     if (spot_2) {
         float psi_1 = ((float(i_1) + 0.5) * s_1.delta);
-        float3 l_1 = ((-(f_6.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
+        float3 l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
-        float r_1 = max(((f_6.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
-        const float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_6.light_dir.xyz), f_6.light_pos.w, f_6.light_dir.w);
+        float r_1 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
+        const float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         float cone = max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         float _e54 = w;
-        w = (_e54 * ((cone * exp((-(f_6.medium.x) * r_1))) / (r_1 * r_1)));
+        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_1))) / (r_1 * r_1)));
     }
     float _e64 = w;
     return _e64;
 }
 
-uint bounds_index(uint x_2, uint row_2)
+uint bounds_index(uint x_2, uint row_3)
 {
     uint _e5 = frame.sizes.w;
-    return ((x_2 * _e5) + row_2);
+    return ((x_2 * _e5) + row_3);
 }
 
-uint filtered_index(uint x_3, uint row_3, uint layer)
+uint filtered_index(uint x_3, uint row_4, uint layer)
 {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return ((((layer * _e5) + x_3) * _e12) + row_3);
+    return ((((layer * _e5) + x_3) * _e12) + row_4);
 }
 
 uint encode_layer(float4 v_10)
@@ -476,9 +482,9 @@ float4 decode_layer(uint w_1)
     return (float4(w_1 & 0xFF, w_1 >> 8 & 0xFF, w_1 >> 16 & 0xFF, w_1 >> 24) / 255.0);
 }
 
-float4 filtered_load(uint x_4, uint row_4, uint layer_1)
+float4 filtered_load(uint x_4, uint row_5, uint layer_1)
 {
-    const uint _e3 = filtered_index(x_4, row_4, layer_1);
+    const uint _e3 = filtered_index(x_4, row_5, layer_1);
     uint _e6 = asuint(filtered.Load(_e3*4));
     const float4 _e7 = decode_layer(_e6);
     return _e7;
@@ -498,12 +504,12 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     uint k = (uint)0;
     uint q = (uint)0;
 
-    uint row_5 = id.x;
+    uint row_6 = id.x;
     uint region = id.y;
     uint thread = id.z;
     uint width_1 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
-    if (!((row_5 >= _e14))) {
+    if (!((row_6 >= _e14))) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -518,11 +524,11 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     if (_e29) {
         return;
     }
-    float4 _e32 = asfloat(slices.Load4(row_5*16));
+    float4 _e32 = asfloat(slices.Load4(row_6*16));
     const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = frame;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
-    const float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_5);
+    const float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     const float3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
     const uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     const uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
@@ -544,7 +550,7 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         }
         {
             uint _e50 = i;
-            float4 _e54 = rectified.Load(int3(uint2(_e50, row_5), int(0)));
+            float4 _e54 = rectified.Load(int3(uint2(_e50, row_6), int(0)));
             float d_1 = _e54.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = frame;
             uint _e58 = i;
@@ -557,7 +563,7 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 float _e70 = hi;
                 hi = max(_e70, d_1);
                 uint _e72 = i;
-                const uint _e73 = bounds_index(_e72, row_5);
+                const uint _e73 = bounds_index(_e72, row_6);
                 float _e76 = lo;
                 float _e77 = hi;
                 bounds.Store2(_e73*8, asuint(float2(_e76, _e77)));
@@ -623,7 +629,7 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                     float4 _e134 = acc[min(uint(_e132), 3u)];
                     float4 stored = ((_e134 * 0.5) + (0.5).xxxx);
                     uint _e140 = i;
-                    const uint _e141 = filtered_index(_e140, row_5, layer_2);
+                    const uint _e141 = filtered_index(_e140, row_6, layer_2);
                     const uint _e144 = encode_layer(stored);
                     filtered.Store(_e141*4, asuint(_e144));
                 }

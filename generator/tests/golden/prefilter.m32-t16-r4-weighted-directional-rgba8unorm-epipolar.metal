@@ -353,10 +353,17 @@ metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return (f.e1_.xyz * metal::cos(phi)) + (f.e2_.xyz * metal::sin(phi));
 }
 
-metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1
+float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1,
+    uint row
 ) {
-    return metal::float2(static_cast<float>(f_1.sizes.x), static_cast<float>(f_1.sizes.y));
+    return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
+}
+
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2
+) {
+    return metal::float2(static_cast<float>(f_2.sizes.x), static_cast<float>(f_2.sizes.y));
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -407,33 +414,34 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
     metal::float2 p_2
 ) {
-    metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_2.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_2.sizes.y)));
-    float t_2 = f_2.cam_forward.w;
-    return metal::normalize((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2)));
+    metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_3.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_3.sizes.y)));
+    float t_2 = f_3.cam_forward.w;
+    return metal::normalize((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2)));
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
-    uint row
-) {
-    float a_6 = f_3.fan_angles.x + ((static_cast<float>(row) + 0.5) * f_3.fan_angles.y);
-    metal::float2 ax = f_3.fan_origin.zw;
-    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_6)) - (ax.y * metal::sin(a_6)), (ax.y * metal::cos(a_6)) + (ax.x * metal::sin(a_6)));
-    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, f_3.fan_origin.xy + (u_2 * _e33));
-    return metal::atan2(metal::dot(_e36, f_3.e2_.xyz), metal::dot(_e36, f_3.e1_.xyz));
-}
-
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
     uint row_1
 ) {
-    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
-    return (f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((static_cast<float>(row_1) + 0.5) * f_4.e2_.w));
+    float a_6 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
+    metal::float2 ax = f_4.fan_origin.zw;
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_6)) - (ax.y * metal::sin(a_6)), (ax.y * metal::cos(a_6)) + (ax.x * metal::sin(a_6)));
+    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, f_4.fan_origin.xy + (u_2 * _e33));
+    return metal::atan2(metal::dot(_e36, f_4.e2_.xyz), metal::dot(_e36, f_4.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
+    uint row_2
+) {
+    float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return (f_5.fan_angles.z > 0.5) ? _e3 : _e2;
 }
 
 metal::float4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -473,13 +481,13 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 }
 
 float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s,
     float x_1,
     bool spot_1
 ) {
     bool local_2 = {};
-    float cap = 4.0 * f_5.theta.z;
+    float cap = 4.0 * f_6.theta.z;
     if (spot_1) {
         float psi = x_1 * s.delta;
         float den = metal::sin(s.theta_ref + psi);
@@ -492,14 +500,14 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
         if (_e23) {
             return cap;
         }
-        return metal::min((f_5.axis.w * metal::sin(psi)) / den, cap);
+        return metal::min((f_6.axis.w * metal::sin(psi)) / den, cap);
     } else {
         return metal::min((x_1 * s.delta) / metal::max(metal::sin(s.theta_ref), 0.0001), cap);
     }
 }
 
 float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1,
     metal::float3 e_1,
     uint i_1,
@@ -507,22 +515,22 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     bool spot_2
 ) {
     float w = {};
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, static_cast<float>(i_1), spot_2);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, static_cast<float>(i_1 + 1u), spot_2);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1), spot_2);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1 + 1u), spot_2);
     if (!(weighted)) {
         return _e9 - _e5;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, _e5, _e9);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
     if (spot_2) {
         float psi_1 = (static_cast<float>(i_1) + 0.5) * s_1.delta;
-        metal::float3 l_1 = (-(f_6.axis.xyz) * metal::cos(psi_1)) + (e_1 * metal::sin(psi_1));
+        metal::float3 l_1 = (-(f_7.axis.xyz) * metal::cos(psi_1)) + (e_1 * metal::sin(psi_1));
         float den_1 = metal::max(metal::sin(s_1.theta_ref + psi_1), 0.0001);
-        float r_1 = metal::max((f_6.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
-        float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_6.light_dir.xyz), f_6.light_pos.w, f_6.light_dir.w);
+        float r_1 = metal::max((f_7.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
+        float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         float cone = metal::max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         float _e54 = w;
-        w = _e54 * ((cone * metal::exp(-(f_6.medium.x) * r_1)) / (r_1 * r_1));
+        w = _e54 * ((cone * metal::exp(-(f_7.medium.x) * r_1)) / (r_1 * r_1));
     }
     float _e64 = w;
     return _e64;
@@ -530,22 +538,22 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 
 uint bounds_index(
     uint x_2,
-    uint row_2,
+    uint row_3,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
     uint _e5 = frame.sizes.w;
-    return (x_2 * _e5) + row_2;
+    return (x_2 * _e5) + row_3;
 }
 
 uint filtered_index(
     uint x_3,
-    uint row_3,
+    uint row_4,
     uint layer,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
     uint _e5 = frame.sizes.z;
     uint _e12 = frame.sizes.w;
-    return (((layer * _e5) + x_3) * _e12) + row_3;
+    return (((layer * _e5) + x_3) * _e12) + row_4;
 }
 
 uint encode_layer(
@@ -562,13 +570,13 @@ metal::float4 decode_layer(
 
 metal::float4 filtered_load(
     uint x_4,
-    uint row_4,
+    uint row_5,
     uint layer_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_10 const& filtered,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    uint _e3 = filtered_index(x_4, row_4, layer_1, frame);
+    uint _e3 = filtered_index(x_4, row_5, layer_1, frame);
     uint _e6 = filtered[metal::min(unsigned(_e3), (_buffer_sizes.size3 - 0 - 4) / 4)];
     metal::float4 _e7 = decode_layer(_e6);
     return _e7;
@@ -595,12 +603,12 @@ kernel void prefilter(
     metal::float2 angle = {};
     uint k = {};
     uint q = {};
-    uint row_5 = id.x;
+    uint row_6 = id.x;
     uint region = id.y;
     uint thread_ = id.z;
     uint width_1 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
-    if (!((row_5 >= _e14))) {
+    if (!((row_6 >= _e14))) {
         local = region >= REGIONS;
     } else {
         local = true;
@@ -615,11 +623,11 @@ kernel void prefilter(
     if (_e29) {
         return;
     }
-    metal::float4 _e32 = slices[metal::min(unsigned(row_5), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    metal::float4 _e32 = slices[metal::min(unsigned(row_6), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = frame;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
-    float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_5);
+    float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     metal::float3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
     uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, false);
@@ -642,7 +650,7 @@ kernel void prefilter(
         {
             uint _e50 = i;
             uint clamped_lod_e54 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e54 = rectified.read(metal::min(metal::uint2(metal::uint2(_e50, row_5)), metal::uint2(rectified.get_width(clamped_lod_e54), rectified.get_height(clamped_lod_e54)) - 1), clamped_lod_e54);
+            metal::float4 _e54 = rectified.read(metal::min(metal::uint2(metal::uint2(_e50, row_6)), metal::uint2(rectified.get_width(clamped_lod_e54), rectified.get_height(clamped_lod_e54)) - 1), clamped_lod_e54);
             float d_1 = _e54.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = frame;
             uint _e58 = i;
@@ -655,7 +663,7 @@ kernel void prefilter(
                 float _e70 = hi;
                 hi = metal::max(_e70, d_1);
                 uint _e72 = i;
-                uint _e73 = bounds_index(_e72, row_5, frame);
+                uint _e73 = bounds_index(_e72, row_6, frame);
                 float _e76 = lo;
                 float _e77 = hi;
                 bounds[metal::min(unsigned(_e73), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e76, _e77);
@@ -721,7 +729,7 @@ kernel void prefilter(
                     metal::float4 _e134 = acc.inner[metal::min(unsigned(_e132), 3u)];
                     metal::float4 stored = (_e134 * 0.5) + metal::float4(0.5);
                     uint _e140 = i;
-                    uint _e141 = filtered_index(_e140, row_5, layer_2, frame);
+                    uint _e141 = filtered_index(_e140, row_6, layer_2, frame);
                     uint _e144 = encode_layer(stored);
                     filtered[metal::min(unsigned(_e141), (_buffer_sizes.size3 - 0 - 4) / 4)] = _e144;
                 }

@@ -261,8 +261,12 @@ vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XO
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1) {
-    return vec2(float(f_1.sizes.x), float(f_1.sizes.y));
+float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row) {
+    return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
+}
+
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2) {
+    return vec2(float(f_2.sizes.x), float(f_2.sizes.y));
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
@@ -305,25 +309,26 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u
     return (0.5 * (_e47 + max(_e48, _e49)));
 }
 
-vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, vec2 p_2) {
-    vec2 ndc = vec2((((2.0 * p_2.x) / float(f_2.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_2.sizes.y))));
-    float t_2 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_2) {
+    vec2 ndc = vec2((((2.0 * p_2.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_3.sizes.y))));
+    float t_2 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2))));
 }
 
-float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, uint row) {
-    float a_4 = (f_3.fan_angles.x + ((float(row) + 0.5) * f_3.fan_angles.y));
-    vec2 ax = f_3.fan_origin.zw;
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
+    float a_4 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    vec2 ax = f_4.fan_origin.zw;
     vec2 u_2 = vec2(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
-    vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
-    return atan(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+    vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
-    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
-    return ((f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((float(row_1) + 0.5) * f_4.e2_.w)));
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, uint row_2) {
+    float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return ((f_5.fan_angles.z > 0.5) ? _e3 : _e2);
 }
 
 uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot) {
@@ -333,9 +338,9 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return (((r * r) * width) / (regions * regions));
 }
 
-float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_1) {
+float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_1) {
     bool local_2 = false;
-    float cap = (4.0 * f_5.theta.z);
+    float cap = (4.0 * f_6.theta.z);
     if (spot_1) {
         float psi = (x_1 * s.delta);
         float den = sin((s.theta_ref + psi));
@@ -348,30 +353,30 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod
         if (_e23) {
             return cap;
         }
-        return min(((f_5.axis.w * sin(psi)) / den), cap);
+        return min(((f_6.axis.w * sin(psi)) / den), cap);
     } else {
         return min(((x_1 * s.delta) / max(sin(s.theta_ref), 0.0001)), cap);
     }
 }
 
-float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, vec3 e_1, uint i_1, bool weighted, bool spot_2) {
+float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, vec3 e_1, uint i_1, bool weighted, bool spot_2) {
     float w = 0.0;
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, float(i_1), spot_2);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, float((i_1 + 1u)), spot_2);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_1), spot_2);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_1 + 1u)), spot_2);
     if (!(weighted)) {
         return (_e9 - _e5);
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, _e5, _e9);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
     if (spot_2) {
         float psi_1 = ((float(i_1) + 0.5) * s_1.delta);
-        vec3 l_1 = ((-(f_6.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
+        vec3 l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
-        float r_1 = max(((f_6.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
-        float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_6.light_dir.xyz), f_6.light_pos.w, f_6.light_dir.w);
+        float r_1 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
+        float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         float cone = max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         float _e54 = w;
-        w = (_e54 * ((cone * exp((-(f_6.medium.x) * r_1))) / (r_1 * r_1)));
+        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_1))) / (r_1 * r_1)));
     }
     float _e64 = w;
     return _e64;
@@ -390,15 +395,15 @@ vec4 moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float z_1, uint lay
     return vec4((z4_ * z_1), (z4_ * z2_), 0.0, 0.0);
 }
 
-uint bounds_index(uint x_2, uint row_2) {
+uint bounds_index(uint x_2, uint row_3) {
     uint _e5 = _group_0_binding_0_cs.sizes.w;
-    return ((x_2 * _e5) + row_2);
+    return ((x_2 * _e5) + row_3);
 }
 
-uint filtered_index(uint x_3, uint row_3, uint layer_1) {
+uint filtered_index(uint x_3, uint row_4, uint layer_1) {
     uint _e5 = _group_0_binding_0_cs.sizes.w;
     uint _e12 = _group_0_binding_0_cs.sizes.z;
-    return ((((layer_1 * _e5) + row_3) * _e12) + x_3);
+    return ((((layer_1 * _e5) + row_4) * _e12) + x_3);
 }
 
 vec4 encode_layer(vec4 v_10) {
@@ -419,12 +424,12 @@ void main() {
     float hi = -1e30;
     uint i = 0u;
     uint q = 0u;
-    uint row_5 = id.x;
+    uint row_6 = id.x;
     uint region = id.y;
     uint thread = id.z;
     uint width_1 = _group_0_binding_0_cs.sizes.z;
     uint _e14 = _group_0_binding_0_cs.sizes.w;
-    if (!((row_5 >= _e14))) {
+    if (!((row_6 >= _e14))) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -439,11 +444,11 @@ void main() {
     if (_e29) {
         return;
     }
-    vec4 _e32 = _group_0_binding_1_cs[row_5];
+    vec4 _e32 = _group_0_binding_1_cs[row_6];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = _group_0_binding_0_cs;
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = _group_0_binding_0_cs;
-    float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_5);
+    float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     vec3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
     uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
@@ -463,7 +468,7 @@ void main() {
         {
             uint _e50 = i;
             int _e54_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-            vec4 _e54 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e50, row_5)), ivec2(0), textureSize(_group_0_binding_2_cs, _e54_clamped_lod) - ivec2(1)), _e54_clamped_lod);
+            vec4 _e54 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e50, row_6)), ivec2(0), textureSize(_group_0_binding_2_cs, _e54_clamped_lod) - ivec2(1)), _e54_clamped_lod);
             float d_2 = _e54.x;
             FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = _group_0_binding_0_cs;
             uint _e58 = i;
@@ -476,7 +481,7 @@ void main() {
                 float _e70 = hi;
                 hi = max(_e70, d_2);
                 uint _e72 = i;
-                uint _e73 = bounds_index(_e72, row_5);
+                uint _e73 = bounds_index(_e72, row_6);
                 float _e76 = lo;
                 float _e77 = hi;
                 _group_0_binding_4_cs[_e73] = vec2(_e76, _e77);
@@ -507,7 +512,7 @@ void main() {
                     acc[_e93] = ((_e97 * (1.0 - blend)) + (_e102 * blend));
                     uint _e105 = i;
                     uint _e106 = q;
-                    uint _e107 = filtered_index(_e105, row_5, _e106);
+                    uint _e107 = filtered_index(_e105, row_6, _e106);
                     uint _e110 = q;
                     vec4 _e112 = acc[_e110];
                     vec4 _e113 = encode_layer(_e112);

@@ -256,8 +256,12 @@ fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_X
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
-    return vec2<f32>(f32(f_1.sizes.x), f32(f_1.sizes.y));
+fn axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    return (f_1.e1_.w + ((f32(row) + 0.5f) * f_1.e2_.w));
+}
+
+fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
+    return vec2<f32>(f32(f_2.sizes.x), f32(f_2.sizes.y));
 }
 
 fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
@@ -299,25 +303,26 @@ fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: 
     return (0.5f * (_e47 + max(_e48, _e49)));
 }
 
-fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
-    let ndc = vec2<f32>((((2f * p_2.x) / f32(f_2.sizes.x)) - 1f), (1f - ((2f * p_2.y) / f32(f_2.sizes.y))));
-    let t_2 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
+    let ndc = vec2<f32>((((2f * p_2.x) / f32(f_3.sizes.x)) - 1f), (1f - ((2f * p_2.y) / f32(f_3.sizes.y))));
+    let t_2 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2))));
 }
 
-fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    let a_4 = (f_3.fan_angles.x + ((f32(row) + 0.5f) * f_3.fan_angles.y));
-    let ax = f_3.fan_origin.zw;
+fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
+    let a_4 = (f_4.fan_angles.x + ((f32(row_1) + 0.5f) * f_4.fan_angles.y));
+    let ax = f_4.fan_origin.zw;
     let u_2 = vec2<f32>(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
-    let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
-    return atan2(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+    let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan2(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
-    let _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
-    return select((f_4.e1_.w + ((f32(row_1) + 0.5f) * f_4.e2_.w)), _e11, (f_4.fan_angles.z > 0.5f));
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_2: u32) -> f32 {
+    let _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    let _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return select(_e2, _e3, (f_5.fan_angles.z > 0.5f));
 }
 
 fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
@@ -327,10 +332,10 @@ fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions
     return (((r * r) * width) / (regions * regions));
 }
 
-fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, spot_1: bool) -> f32 {
+fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, spot_1: bool) -> f32 {
     var local_2: bool;
 
-    let cap = (4f * f_5.theta.z);
+    let cap = (4f * f_6.theta.z);
     if spot_1 {
         let psi = (x_1 * s.delta);
         let den = sin((s.theta_ref + psi));
@@ -343,31 +348,31 @@ fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_5: FrameX_naga_oil_m
         if _e23 {
             return cap;
         }
-        return min(((f_5.axis.w * sin(psi)) / den), cap);
+        return min(((f_6.axis.w * sin(psi)) / den), cap);
     } else {
         return min(((x_1 * s.delta) / max(sin(s.theta_ref), 0.0001f)), cap);
     }
 }
 
-fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, i_1: u32, weighted: bool, spot_2: bool) -> f32 {
+fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, i_1: u32, weighted: bool, spot_2: bool) -> f32 {
     var w: f32;
 
-    let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, f32(i_1), spot_2);
-    let _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6, s_1, f32((i_1 + 1u)), spot_2);
+    let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32(i_1), spot_2);
+    let _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32((i_1 + 1u)), spot_2);
     if !(weighted) {
         return (_e9 - _e5);
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.x, _e5, _e9);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
     if spot_2 {
         let psi_1 = ((f32(i_1) + 0.5f) * s_1.delta);
-        let l_1 = ((-(f_6.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
+        let l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         let den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001f);
-        let r_1 = max(((f_6.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
-        let _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_6.light_dir.xyz), f_6.light_pos.w, f_6.light_dir.w);
+        let r_1 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
+        let _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         let cone = max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         let _e54 = w;
-        w = (_e54 * ((cone * exp((-(f_6.medium.x) * r_1))) / (r_1 * r_1)));
+        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_1))) / (r_1 * r_1)));
     }
     let _e64 = w;
     return _e64;
@@ -386,15 +391,15 @@ fn moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(z_1: f32, layer: u32)
     return vec4<f32>((z4_ * z_1), (z4_ * z2_), 0f, 0f);
 }
 
-fn bounds_index(x_2: u32, row_2: u32) -> u32 {
+fn bounds_index(x_2: u32, row_3: u32) -> u32 {
     let _e5 = frame.sizes.w;
-    return ((x_2 * _e5) + row_2);
+    return ((x_2 * _e5) + row_3);
 }
 
-fn filtered_index(x_3: u32, row_3: u32, layer_1: u32) -> u32 {
+fn filtered_index(x_3: u32, row_4: u32, layer_1: u32) -> u32 {
     let _e5 = frame.sizes.w;
     let _e12 = frame.sizes.z;
-    return ((((layer_1 * _e5) + row_3) * _e12) + x_3);
+    return ((((layer_1 * _e5) + row_4) * _e12) + x_3);
 }
 
 fn encode_layer(v_10: vec4<f32>) -> vec4<f32> {
@@ -405,8 +410,8 @@ fn decode_layer(w_1: vec4<f32>) -> vec4<f32> {
     return w_1;
 }
 
-fn filtered_load(x_4: u32, row_4: u32, layer_2: u32) -> vec4<f32> {
-    let _e3 = filtered_index(x_4, row_4, layer_2);
+fn filtered_load(x_4: u32, row_5: u32, layer_2: u32) -> vec4<f32> {
+    let _e3 = filtered_index(x_4, row_5, layer_2);
     let _e6 = filtered[_e3];
     let _e7 = decode_layer(_e6);
     return _e7;
@@ -423,12 +428,12 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var i: u32;
     var q: u32;
 
-    let row_5 = id.x;
+    let row_6 = id.x;
     let region = id.y;
     let thread = id.z;
     let width_1 = frame.sizes.z;
     let _e14 = frame.sizes.w;
-    if !((row_5 >= _e14)) {
+    if !((row_6 >= _e14)) {
         local = (region >= REGIONS);
     } else {
         local = true;
@@ -443,11 +448,11 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e29 {
         return;
     }
-    let _e32 = slices[row_5];
+    let _e32 = slices[row_6];
     let _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
     let _e35 = frame;
     let _e37 = frame;
-    let _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_5);
+    let _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     let _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
     let _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
     let _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
@@ -460,7 +465,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         {
             let _e50 = i;
-            let _e54 = textureLoad(rectified, vec2<u32>(_e50, row_5), 0i);
+            let _e54 = textureLoad(rectified, vec2<u32>(_e50, row_6), 0i);
             let d_2 = _e54.x;
             let _e57 = frame;
             let _e58 = i;
@@ -473,7 +478,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
                 let _e70 = hi;
                 hi = max(_e70, d_2);
                 let _e72 = i;
-                let _e73 = bounds_index(_e72, row_5);
+                let _e73 = bounds_index(_e72, row_6);
                 let _e76 = lo;
                 let _e77 = hi;
                 bounds[_e73] = vec2<f32>(_e76, _e77);
@@ -498,7 +503,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
                     acc[_e93] = ((_e97 * (1f - blend)) + (_e102 * blend));
                     let _e105 = i;
                     let _e106 = q;
-                    let _e107 = filtered_index(_e105, row_5, _e106);
+                    let _e107 = filtered_index(_e105, row_6, _e106);
                     let _e110 = q;
                     let _e112 = acc[_e110];
                     let _e113 = encode_layer(_e112);

@@ -252,8 +252,12 @@ fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_X
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
-    return vec2<f32>(f32(f_1.sizes.x), f32(f_1.sizes.y));
+fn axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
+    return (f_1.e1_.w + ((f32(row) + 0.5f) * f_1.e2_.w));
+}
+
+fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
+    return vec2<f32>(f32(f_2.sizes.x), f32(f_2.sizes.y));
 }
 
 fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
@@ -295,50 +299,51 @@ fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: 
     return (0.5f * (_e47 + max(_e48, _e49)));
 }
 
-fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
-    let ndc = vec2<f32>((((2f * p_2.x) / f32(f_2.sizes.x)) - 1f), (1f - ((2f * p_2.y) / f32(f_2.sizes.y))));
-    let t_2 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
+    let ndc = vec2<f32>((((2f * p_2.x) / f32(f_3.sizes.x)) - 1f), (1f - ((2f * p_2.y) / f32(f_3.sizes.y))));
+    let t_2 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2))));
 }
 
-fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row: u32) -> f32 {
-    let a_4 = (f_3.fan_angles.x + ((f32(row) + 0.5f) * f_3.fan_angles.y));
-    let ax = f_3.fan_origin.zw;
+fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
+    let a_4 = (f_4.fan_angles.x + ((f32(row_1) + 0.5f) * f_4.fan_angles.y));
+    let ax = f_4.fan_origin.zw;
     let u_2 = vec2<f32>(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
-    let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
-    return atan2(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+    let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan2(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
-    let _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
-    return select((f_4.e1_.w + ((f32(row_1) + 0.5f) * f_4.e2_.w)), _e11, (f_4.fan_angles.z > 0.5f));
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_2: u32) -> f32 {
+    let _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    let _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return select(_e2, _e3, (f_5.fan_angles.z > 0.5f));
 }
 
 fn occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta: f32, lo: f32, hi: f32) -> f32 {
     return clamp((DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * ((theta - lo) / max((hi - lo), 0.000001f)))), 0f, 1f);
 }
 
-fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_5.sm_right, f_5.sm_up, f_5.sm_forward, f_5.sm_origin, f_5.sm_proj, vec4<u32>(f_5.sizes2_.x, 0u, 0u, 0u));
+fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_6.sm_right, f_6.sm_up, f_6.sm_forward, f_6.sm_origin, f_6.sm_proj, vec4<u32>(f_6.sizes2_.x, 0u, 0u, 0u));
 }
 
-fn sm_occluder_distance_sunX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, o_2: vec3<f32>) -> f32 {
-    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6);
+fn sm_occluder_distance_sunX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, o_2: vec3<f32>) -> f32 {
+    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
     let _e4 = shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, o_2);
     return _e4;
 }
 
-fn sm_occluder_distance_spotX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, l_1: vec3<f32>) -> f32 {
-    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
+fn sm_occluder_distance_spotX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, l_1: vec3<f32>) -> f32 {
+    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8);
     let _e4 = shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_5, l_1);
     return _e4;
 }
 
-fn light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, col: f32, s: f32, spot: bool) -> f32 {
+fn light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, col: f32, s: f32, spot: bool) -> f32 {
     if spot {
-        return atan2((s * sin(col)), (f_8.axis.w - (s * cos(col))));
+        return atan2((s * sin(col)), (f_9.axis.w - (s * cos(col))));
     } else {
         return atan2(col, -(s));
     }

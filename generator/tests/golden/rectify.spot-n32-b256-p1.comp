@@ -257,8 +257,12 @@ vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XO
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1) {
-    return vec2(float(f_1.sizes.x), float(f_1.sizes.y));
+float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row) {
+    return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
+}
+
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2) {
+    return vec2(float(f_2.sizes.x), float(f_2.sizes.y));
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
@@ -301,50 +305,51 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u
     return (0.5 * (_e47 + max(_e48, _e49)));
 }
 
-vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, vec2 p_2) {
-    vec2 ndc = vec2((((2.0 * p_2.x) / float(f_2.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_2.sizes.y))));
-    float t_2 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_2) {
+    vec2 ndc = vec2((((2.0 * p_2.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_3.sizes.y))));
+    float t_2 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2))));
 }
 
-float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, uint row) {
-    float a_4 = (f_3.fan_angles.x + ((float(row) + 0.5) * f_3.fan_angles.y));
-    vec2 ax = f_3.fan_origin.zw;
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
+    float a_4 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    vec2 ax = f_4.fan_origin.zw;
     vec2 u_2 = vec2(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
-    vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
-    return atan(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+    vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
-    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
-    return ((f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((float(row_1) + 0.5) * f_4.e2_.w)));
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, uint row_2) {
+    float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return ((f_5.fan_angles.z > 0.5) ? _e3 : _e2);
 }
 
 float occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi) {
     return clamp((DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * ((theta - lo) / max((hi - lo), 1e-6)))), 0.0, 1.0);
 }
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5) {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_5.sm_right, f_5.sm_up, f_5.sm_forward, f_5.sm_origin, f_5.sm_proj, uvec4(f_5.sizes2_.x, 0u, 0u, 0u));
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6) {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_6.sm_right, f_6.sm_up, f_6.sm_forward, f_6.sm_origin, f_6.sm_proj, uvec4(f_6.sizes2_.x, 0u, 0u, 0u));
 }
 
-float sm_occluder_distance_sunX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, sampler2D sm_4, vec3 o_2) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6);
+float sm_occluder_distance_sunX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, sampler2D sm_4, vec3 o_2) {
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
     float _e4 = shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, o_2);
     return _e4;
 }
 
-float sm_occluder_distance_spotX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, sampler2D sm_5, vec3 l_1) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
+float sm_occluder_distance_spotX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, sampler2D sm_5, vec3 l_1) {
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8);
     float _e4 = shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_5, l_1);
     return _e4;
 }
 
-float light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float col, float s, bool spot) {
+float light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float col, float s, bool spot) {
     if (spot) {
-        return atan((s * sin(col)), (f_8.axis.w - (s * cos(col))));
+        return atan((s * sin(col)), (f_9.axis.w - (s * cos(col))));
     } else {
         return atan(col, -(s));
     }

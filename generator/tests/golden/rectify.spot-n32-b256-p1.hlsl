@@ -301,9 +301,14 @@ float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1)
+float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row)
 {
-    return float2(float(f_1.sizes.x), float(f_1.sizes.y));
+    return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
+}
+
+float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2)
+{
+    return float2(float(f_2.sizes.x), float(f_2.sizes.y));
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float2 o_1, float2 u, float2 size)
@@ -351,28 +356,29 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float2 o_1, floa
     return (0.5 * (_e47 + max(_e48, _e49)));
 }
 
-float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, float2 p_2)
+float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, float2 p_2)
 {
-    float2 ndc = float2((((2.0 * p_2.x) / float(f_2.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_2.sizes.y))));
-    float t_2 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+    float2 ndc = float2((((2.0 * p_2.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_3.sizes.y))));
+    float t_2 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2))));
 }
 
-float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, uint row)
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1)
 {
-    float a_4 = (f_3.fan_angles.x + ((float(row) + 0.5) * f_3.fan_angles.y));
-    float2 ax = f_3.fan_origin.zw;
+    float a_4 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    float2 ax = f_4.fan_origin.zw;
     float2 u_2 = float2(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
-    const float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    const float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    const float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
-    return atan2(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+    const float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    const float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    const float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan2(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1)
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, uint row_2)
 {
-    const float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
-    return ((f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((float(row_1) + 0.5) * f_4.e2_.w)));
+    const float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    const float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return ((f_5.fan_angles.z > 0.5) ? _e3 : _e2);
 }
 
 float occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi)
@@ -391,30 +397,30 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ConstructShadowMapViewX_n
     return ret;
 }
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5)
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6)
 {
-    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx = ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_5.sm_right, f_5.sm_up, f_5.sm_forward, f_5.sm_origin, f_5.sm_proj, uint4(f_5.sizes2_.x, 0u, 0u, 0u));
+    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx = ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_6.sm_right, f_6.sm_up, f_6.sm_forward, f_6.sm_origin, f_6.sm_proj, uint4(f_6.sizes2_.x, 0u, 0u, 0u));
     return shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx;
 }
 
-float sm_occluder_distance_sunX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, Texture2D<float4> sm_4, float3 o_2)
+float sm_occluder_distance_sunX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, Texture2D<float4> sm_4, float3 o_2)
 {
-    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6);
+    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
     const float _e4 = shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, o_2);
     return _e4;
 }
 
-float sm_occluder_distance_spotX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, Texture2D<float4> sm_5, float3 l_1)
+float sm_occluder_distance_spotX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, Texture2D<float4> sm_5, float3 l_1)
 {
-    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
+    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8);
     const float _e4 = shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_5, l_1);
     return _e4;
 }
 
-float light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float col, float s, bool spot)
+float light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, float col, float s, bool spot)
 {
     if (spot) {
-        return atan2((s * sin(col)), (f_8.axis.w - (s * cos(col))));
+        return atan2((s * sin(col)), (f_9.axis.w - (s * cos(col))));
     } else {
         return atan2(col, -(s));
     }

@@ -344,10 +344,17 @@ metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return (f.e1_.xyz * metal::cos(phi)) + (f.e2_.xyz * metal::sin(phi));
 }
 
-metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1
+float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1,
+    uint row
 ) {
-    return metal::float2(static_cast<float>(f_1.sizes.x), static_cast<float>(f_1.sizes.y));
+    return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
+}
+
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2
+) {
+    return metal::float2(static_cast<float>(f_2.sizes.x), static_cast<float>(f_2.sizes.y));
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -398,33 +405,34 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
     metal::float2 p_2
 ) {
-    metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_2.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_2.sizes.y)));
-    float t_2 = f_2.cam_forward.w;
-    return metal::normalize((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2)));
+    metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_3.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_3.sizes.y)));
+    float t_2 = f_3.cam_forward.w;
+    return metal::normalize((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2)));
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
-    uint row
-) {
-    float a_4 = f_3.fan_angles.x + ((static_cast<float>(row) + 0.5) * f_3.fan_angles.y);
-    metal::float2 ax = f_3.fan_origin.zw;
-    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_4)) - (ax.y * metal::sin(a_4)), (ax.y * metal::cos(a_4)) + (ax.x * metal::sin(a_4)));
-    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, f_3.fan_origin.xy + (u_2 * _e33));
-    return metal::atan2(metal::dot(_e36, f_3.e2_.xyz), metal::dot(_e36, f_3.e1_.xyz));
-}
-
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
     uint row_1
 ) {
-    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_1);
-    return (f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((static_cast<float>(row_1) + 0.5) * f_4.e2_.w));
+    float a_4 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
+    metal::float2 ax = f_4.fan_origin.zw;
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_4)) - (ax.y * metal::sin(a_4)), (ax.y * metal::cos(a_4)) + (ax.x * metal::sin(a_4)));
+    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, f_4.fan_origin.xy + (u_2 * _e33));
+    return metal::atan2(metal::dot(_e36, f_4.e2_.xyz), metal::dot(_e36, f_4.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
+    uint row_2
+) {
+    float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return (f_5.fan_angles.z > 0.5) ? _e3 : _e2;
 }
 
 float occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -436,39 +444,39 @@ float occluder_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6
 ) {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f_5.sm_right, f_5.sm_up, f_5.sm_forward, f_5.sm_origin, f_5.sm_proj, metal::uint4(f_5.sizes2_.x, 0u, 0u, 0u)};
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f_6.sm_right, f_6.sm_up, f_6.sm_forward, f_6.sm_origin, f_6.sm_proj, metal::uint4(f_6.sizes2_.x, 0u, 0u, 0u)};
 }
 
 float sm_occluder_distance_sunX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
     metal::texture2d<float, metal::access::sample> sm_4,
     metal::float3 o_2
 ) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6);
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
     float _e4 = shadow_occluder_distance_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, o_2);
     return _e4;
 }
 
 float sm_occluder_distance_spotX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
     metal::texture2d<float, metal::access::sample> sm_5,
     metal::float3 l_1
 ) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8);
     float _e4 = shadow_occluder_distance_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_5, l_1);
     return _e4;
 }
 
 float light_point_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     float col,
     float s,
     bool spot
 ) {
     if (spot) {
-        return metal::atan2(s * metal::sin(col), f_8.axis.w - (s * metal::cos(col)));
+        return metal::atan2(s * metal::sin(col), f_9.axis.w - (s * metal::cos(col)));
     } else {
         return metal::atan2(col, -(s));
     }

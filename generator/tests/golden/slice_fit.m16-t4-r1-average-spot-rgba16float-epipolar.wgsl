@@ -240,8 +240,12 @@ fn slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f: FrameX_naga_oil_mod_X
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
-    return vec2<f32>(f32(f_1.sizes.x), f32(f_1.sizes.y));
+fn axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
+    return (f_1.e1_.w + ((f32(row_1) + 0.5f) * f_1.e2_.w));
+}
+
+fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
+    return vec2<f32>(f32(f_2.sizes.x), f32(f_2.sizes.y));
 }
 
 fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
@@ -283,31 +287,32 @@ fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: 
     return (0.5f * (_e47 + max(_e48, _e49)));
 }
 
-fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
-    let ndc = vec2<f32>((((2f * p_2.x) / f32(f_2.sizes.x)) - 1f), (1f - ((2f * p_2.y) / f32(f_2.sizes.y))));
-    let t_2 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
+    let ndc = vec2<f32>((((2f * p_2.x) / f32(f_3.sizes.x)) - 1f), (1f - ((2f * p_2.y) / f32(f_3.sizes.y))));
+    let t_2 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2))));
 }
 
-fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
-    let a_4 = (f_3.fan_angles.x + ((f32(row_1) + 0.5f) * f_3.fan_angles.y));
-    let ax = f_3.fan_origin.zw;
+fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_2: u32) -> f32 {
+    let a_4 = (f_4.fan_angles.x + ((f32(row_2) + 0.5f) * f_4.fan_angles.y));
+    let ax = f_4.fan_origin.zw;
     let u_2 = vec2<f32>(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
-    let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
-    return atan2(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+    let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan2(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
 }
 
-fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_2: u32) -> f32 {
-    let _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_2);
-    return select((f_4.e1_.w + ((f32(row_2) + 0.5f) * f_4.e2_.w)), _e11, (f_4.fan_angles.z > 0.5f));
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_3: u32) -> f32 {
+    let _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_3);
+    let _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_3);
+    return select(_e2, _e3, (f_5.fan_angles.z > 0.5f));
 }
 
-fn spot_psi(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi_1: f32, theta: f32, z_2: f32, dist: f32) -> f32 {
-    let _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, phi_1);
-    let d_1 = ((f_5.axis.xyz * cos(theta)) + (_e7 * sin(theta)));
-    let t_3 = (z_2 / max(dot(d_1, f_5.cam_forward.xyz), 0.000001f));
+fn spot_psi(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, phi_1: f32, theta: f32, z_2: f32, dist: f32) -> f32 {
+    let _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, phi_1);
+    let d_1 = ((f_6.axis.xyz * cos(theta)) + (_e7 * sin(theta)));
+    let t_3 = (z_2 / max(dot(d_1, f_6.cam_forward.xyz), 0.000001f));
     return atan2((t_3 * sin(theta)), (dist - (t_3 * cos(theta))));
 }
 
@@ -323,12 +328,12 @@ fn slice_fit(@builtin(local_invocation_index) lid: u32) {
     var k: u32;
     var local_1: bool;
 
-    let f_6 = frame;
-    let far_3 = f_6.theta.z;
+    let f_7 = frame;
+    let far_3 = f_7.theta.z;
     x = lid;
     loop {
         let _e8 = x;
-        if (_e8 < f_6.sizes.x) {
+        if (_e8 < f_7.sizes.x) {
         } else {
             break;
         }
@@ -369,7 +374,7 @@ fn slice_fit(@builtin(local_invocation_index) lid: u32) {
     workgroupBarrier();
     let _e47 = deepest[0];
     z = _e47;
-    if !((f_6.proj.x > 0.5f)) {
+    if !((f_7.proj.x > 0.5f)) {
         let _e53 = z;
         local = !((_e53 < far_3));
     } else {
@@ -379,9 +384,9 @@ fn slice_fit(@builtin(local_invocation_index) lid: u32) {
     if _e59 {
         return;
     }
-    let rows = f_6.sizes.w;
-    let cols = f32(f_6.sizes.z);
-    let dist_1 = f_6.axis.w;
+    let rows = f_7.sizes.w;
+    let cols = f32(f_7.sizes.z);
+    let dist_1 = f_7.axis.w;
     row = lid;
     loop {
         let _e68 = row;
@@ -396,7 +401,7 @@ fn slice_fit(@builtin(local_invocation_index) lid: u32) {
             delta = (old.x * (_e75 / far_3));
             if true {
                 let _e80 = row;
-                let _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, _e80);
+                let _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, _e80);
                 extent = 0f;
                 k = 0u;
                 loop {
@@ -410,7 +415,7 @@ fn slice_fit(@builtin(local_invocation_index) lid: u32) {
                         let theta_1 = (old.z + (((old.w - old.z) * f32(_e93)) / 32f));
                         let _e99 = extent;
                         let _e100 = z;
-                        let _e101 = spot_psi(f_6, _e81, theta_1, _e100, dist_1);
+                        let _e101 = spot_psi(f_7, _e81, theta_1, _e100, dist_1);
                         extent = max(_e99, _e101);
                     }
                     continuing {

@@ -337,10 +337,17 @@ metal::float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return (f.e1_.xyz * metal::cos(phi)) + (f.e2_.xyz * metal::sin(phi));
 }
 
-metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1
+float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1,
+    uint row_1
 ) {
-    return metal::float2(static_cast<float>(f_1.sizes.x), static_cast<float>(f_1.sizes.y));
+    return f_1.e1_.w + ((static_cast<float>(row_1) + 0.5) * f_1.e2_.w);
+}
+
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2
+) {
+    return metal::float2(static_cast<float>(f_2.sizes.x), static_cast<float>(f_2.sizes.y));
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -391,45 +398,46 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
     metal::float2 p_2
 ) {
-    metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_2.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_2.sizes.y)));
-    float t_2 = f_2.cam_forward.w;
-    return metal::normalize((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2)));
+    metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_3.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_3.sizes.y)));
+    float t_2 = f_3.cam_forward.w;
+    return metal::normalize((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2)));
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
-    uint row_1
-) {
-    float a_4 = f_3.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_3.fan_angles.y);
-    metal::float2 ax = f_3.fan_origin.zw;
-    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_4)) - (ax.y * metal::sin(a_4)), (ax.y * metal::cos(a_4)) + (ax.x * metal::sin(a_4)));
-    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, f_3.fan_origin.xy + (u_2 * _e33));
-    return metal::atan2(metal::dot(_e36, f_3.e2_.xyz), metal::dot(_e36, f_3.e1_.xyz));
-}
-
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
     uint row_2
 ) {
-    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_2);
-    return (f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((static_cast<float>(row_2) + 0.5) * f_4.e2_.w));
+    float a_4 = f_4.fan_angles.x + ((static_cast<float>(row_2) + 0.5) * f_4.fan_angles.y);
+    metal::float2 ax = f_4.fan_origin.zw;
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_4)) - (ax.y * metal::sin(a_4)), (ax.y * metal::cos(a_4)) + (ax.x * metal::sin(a_4)));
+    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, f_4.fan_origin.xy + (u_2 * _e33));
+    return metal::atan2(metal::dot(_e36, f_4.e2_.xyz), metal::dot(_e36, f_4.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
+    uint row_3
+) {
+    float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_3);
+    float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_3);
+    return (f_5.fan_angles.z > 0.5) ? _e3 : _e2;
 }
 
 float spot_psi(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
     float phi_1,
     float theta,
     float z_2,
     float dist
 ) {
-    metal::float3 _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, phi_1);
-    metal::float3 d_1 = (f_5.axis.xyz * metal::cos(theta)) + (_e7 * metal::sin(theta));
-    float t_3 = z_2 / metal::max(metal::dot(d_1, f_5.cam_forward.xyz), 0.000001);
+    metal::float3 _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, phi_1);
+    metal::float3 d_1 = (f_6.axis.xyz * metal::cos(theta)) + (_e7 * metal::sin(theta));
+    float t_3 = z_2 / metal::max(metal::dot(d_1, f_6.cam_forward.xyz), 0.000001);
     return metal::atan2(t_3 * metal::sin(theta), dist - (t_3 * metal::cos(theta)));
 }
 uint naga_div(uint lhs, uint rhs) {
@@ -460,8 +468,8 @@ kernel void slice_fit(
     float extent = {};
     uint k = {};
     bool local_1 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6 = frame;
-    float far_3 = f_6.theta.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7 = frame;
+    float far_3 = f_7.theta.z;
     x = lid;
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
@@ -474,7 +482,7 @@ kernel void slice_fit(
         }
         loop_init_3 = false;
         uint _e8 = x;
-        if (_e8 < f_6.sizes.x) {
+        if (_e8 < f_7.sizes.x) {
         } else {
             break;
         }
@@ -516,7 +524,7 @@ kernel void slice_fit(
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     float _e47 = deepest.inner[0];
     z = _e47;
-    if (!((f_6.proj.x > 0.5))) {
+    if (!((f_7.proj.x > 0.5))) {
         float _e53 = z;
         local = !((_e53 < far_3));
     } else {
@@ -526,9 +534,9 @@ kernel void slice_fit(
     if (_e59) {
         return;
     }
-    uint rows = f_6.sizes.w;
-    float cols = static_cast<float>(f_6.sizes.z);
-    float dist_1 = f_6.axis.w;
+    uint rows = f_7.sizes.w;
+    float cols = static_cast<float>(f_7.sizes.z);
+    float dist_1 = f_7.axis.w;
     row = lid;
     uint2 loop_bound_5 = uint2(4294967295u);
     bool loop_init_5 = true;
@@ -552,7 +560,7 @@ kernel void slice_fit(
             delta = old.x * (_e75 / far_3);
             if (false) {
                 uint _e80 = row;
-                float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, _e80);
+                float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, _e80);
                 extent = 0.0;
                 k = 0u;
                 uint2 loop_bound_6 = uint2(4294967295u);
@@ -575,7 +583,7 @@ kernel void slice_fit(
                         float theta_1 = old.z + (((old.w - old.z) * static_cast<float>(_e93)) / 32.0);
                         float _e99 = extent;
                         float _e100 = z;
-                        float _e101 = spot_psi(f_6, _e81, theta_1, _e100, dist_1);
+                        float _e101 = spot_psi(f_7, _e81, theta_1, _e100, dist_1);
                         extent = metal::max(_e99, _e101);
                     }
                 }

@@ -279,9 +279,14 @@ float3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1)
+float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row_1)
 {
-    return float2(float(f_1.sizes.x), float(f_1.sizes.y));
+    return (f_1.e1_.w + ((float(row_1) + 0.5) * f_1.e2_.w));
+}
+
+float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2)
+{
+    return float2(float(f_2.sizes.x), float(f_2.sizes.y));
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float2 o_1, float2 u, float2 size)
@@ -329,35 +334,36 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float2 o_1, floa
     return (0.5 * (_e47 + max(_e48, _e49)));
 }
 
-float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, float2 p_2)
+float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, float2 p_2)
 {
-    float2 ndc = float2((((2.0 * p_2.x) / float(f_2.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_2.sizes.y))));
-    float t_2 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+    float2 ndc = float2((((2.0 * p_2.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_3.sizes.y))));
+    float t_2 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2))));
 }
 
-float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, uint row_1)
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_2)
 {
-    float a_4 = (f_3.fan_angles.x + ((float(row_1) + 0.5) * f_3.fan_angles.y));
-    float2 ax = f_3.fan_origin.zw;
+    float a_4 = (f_4.fan_angles.x + ((float(row_2) + 0.5) * f_4.fan_angles.y));
+    float2 ax = f_4.fan_origin.zw;
     float2 u_2 = float2(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
-    const float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    const float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    const float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
-    return atan2(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+    const float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    const float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    const float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan2(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_2)
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, uint row_3)
 {
-    const float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_2);
-    return ((f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((float(row_2) + 0.5) * f_4.e2_.w)));
+    const float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_3);
+    const float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_3);
+    return ((f_5.fan_angles.z > 0.5) ? _e3 : _e2);
 }
 
-float spot_psi(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float phi_1, float theta, float z_2, float dist)
+float spot_psi(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float phi_1, float theta, float z_2, float dist)
 {
-    const float3 _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, phi_1);
-    float3 d_1 = ((f_5.axis.xyz * cos(theta)) + (_e7 * sin(theta)));
-    float t_3 = (z_2 / max(dot(d_1, f_5.cam_forward.xyz), 1e-6));
+    const float3 _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, phi_1);
+    float3 d_1 = ((f_6.axis.xyz * cos(theta)) + (_e7 * sin(theta)));
+    float t_3 = (z_2 / max(dot(d_1, f_6.cam_forward.xyz), 1e-6));
     return atan2((t_3 * sin(theta)), (dist - (t_3 * cos(theta))));
 }
 
@@ -382,8 +388,8 @@ void slice_fit(uint lid : SV_GroupIndex)
     uint k = (uint)0;
     bool local_1 = (bool)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6 = frame;
-    float far_3 = f_6.theta.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7 = frame;
+    float far_3 = f_7.theta.z;
     x = lid;
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
@@ -396,7 +402,7 @@ void slice_fit(uint lid : SV_GroupIndex)
         }
         loop_init_3 = false;
         uint _e8 = x;
-        if ((_e8 < f_6.sizes.x)) {
+        if ((_e8 < f_7.sizes.x)) {
         } else {
             break;
         }
@@ -438,7 +444,7 @@ void slice_fit(uint lid : SV_GroupIndex)
     GroupMemoryBarrierWithGroupSync();
     float _e47 = deepest[0];
     z = _e47;
-    if (!((f_6.proj.x > 0.5))) {
+    if (!((f_7.proj.x > 0.5))) {
         float _e53 = z;
         local = !((_e53 < far_3));
     } else {
@@ -448,9 +454,9 @@ void slice_fit(uint lid : SV_GroupIndex)
     if (_e59) {
         return;
     }
-    uint rows = f_6.sizes.w;
-    float cols = float(f_6.sizes.z);
-    float dist_1 = f_6.axis.w;
+    uint rows = f_7.sizes.w;
+    float cols = float(f_7.sizes.z);
+    float dist_1 = f_7.axis.w;
     row = lid;
     uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
     bool loop_init_5 = true;
@@ -474,7 +480,7 @@ void slice_fit(uint lid : SV_GroupIndex)
             delta = (old.x * (_e75 / far_3));
             if (true) {
                 uint _e80 = row;
-                const float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, _e80);
+                const float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, _e80);
                 extent = 0.0;
                 k = 0u;
                 uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
@@ -497,7 +503,7 @@ void slice_fit(uint lid : SV_GroupIndex)
                         float theta_1 = (old.z + (((old.w - old.z) * float(_e93)) / 32.0));
                         float _e99 = extent;
                         float _e100 = z;
-                        const float _e101 = spot_psi(f_6, _e81, theta_1, _e100, dist_1);
+                        const float _e101 = spot_psi(f_7, _e81, theta_1, _e100, dist_1);
                         extent = max(_e99, _e101);
                     }
                 }

@@ -247,8 +247,12 @@ vec3 slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XO
     return ((f.e1_.xyz * cos(phi)) + (f.e2_.xyz * sin(phi)));
 }
 
-vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1) {
-    return vec2(float(f_1.sizes.x), float(f_1.sizes.y));
+float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_1, uint row_1) {
+    return (f_1.e1_.w + ((float(row_1) + 0.5) * f_1.e2_.w));
+}
+
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2) {
+    return vec2(float(f_2.sizes.x), float(f_2.sizes.y));
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
@@ -291,31 +295,32 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u
     return (0.5 * (_e47 + max(_e48, _e49)));
 }
 
-vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2, vec2 p_2) {
-    vec2 ndc = vec2((((2.0 * p_2.x) / float(f_2.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_2.sizes.y))));
-    float t_2 = f_2.cam_forward.w;
-    return normalize(((f_2.cam_forward.xyz + (f_2.cam_right.xyz * ((ndc.x * t_2) * f_2.cam_right.w))) + (f_2.cam_up.xyz * (ndc.y * t_2))));
+vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_2) {
+    vec2 ndc = vec2((((2.0 * p_2.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_3.sizes.y))));
+    float t_2 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_2) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_2))));
 }
 
-float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, uint row_1) {
-    float a_4 = (f_3.fan_angles.x + ((float(row_1) + 0.5) * f_3.fan_angles.y));
-    vec2 ax = f_3.fan_origin.zw;
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_2) {
+    float a_4 = (f_4.fan_angles.x + ((float(row_2) + 0.5) * f_4.fan_angles.y));
+    vec2 ax = f_4.fan_origin.zw;
     vec2 u_2 = vec2(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
-    vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3.fan_origin.xy, u_2, _e32);
-    vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3, (f_3.fan_origin.xy + (u_2 * _e33)));
-    return atan(dot(_e36, f_3.e2_.xyz), dot(_e36, f_3.e1_.xyz));
+    vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
 }
 
-float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_2) {
-    float _e11 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, row_2);
-    return ((f_4.fan_angles.z > 0.5) ? _e11 : (f_4.e1_.w + ((float(row_2) + 0.5) * f_4.e2_.w)));
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, uint row_3) {
+    float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_3);
+    float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_3);
+    return ((f_5.fan_angles.z > 0.5) ? _e3 : _e2);
 }
 
-float spot_psi(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, float phi_1, float theta, float z_2, float dist) {
-    vec3 _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, phi_1);
-    vec3 d_1 = ((f_5.axis.xyz * cos(theta)) + (_e7 * sin(theta)));
-    float t_3 = (z_2 / max(dot(d_1, f_5.cam_forward.xyz), 1e-6));
+float spot_psi(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, float phi_1, float theta, float z_2, float dist) {
+    vec3 _e7 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, phi_1);
+    vec3 d_1 = ((f_6.axis.xyz * cos(theta)) + (_e7 * sin(theta)));
+    float t_3 = (z_2 / max(dot(d_1, f_6.cam_forward.xyz), 1e-6));
     return atan((t_3 * sin(theta)), (dist - (t_3 * cos(theta))));
 }
 
@@ -335,8 +340,8 @@ void main() {
     float extent = 0.0;
     uint k = 0u;
     bool local_1 = false;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6 = _group_0_binding_0_cs;
-    float far_3 = f_6.theta.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7 = _group_0_binding_0_cs;
+    float far_3 = f_7.theta.z;
     x = lid;
     bool loop_init_3 = true;
     while(true) {
@@ -346,7 +351,7 @@ void main() {
         }
         loop_init_3 = false;
         uint _e8 = x;
-        if ((_e8 < f_6.sizes.x)) {
+        if ((_e8 < f_7.sizes.x)) {
         } else {
             break;
         }
@@ -387,7 +392,7 @@ void main() {
     barrier();
     float _e47 = deepest[0];
     z = _e47;
-    if (!((f_6.proj.x > 0.5))) {
+    if (!((f_7.proj.x > 0.5))) {
         float _e53 = z;
         local = !((_e53 < far_3));
     } else {
@@ -397,9 +402,9 @@ void main() {
     if (_e59) {
         return;
     }
-    uint rows = f_6.sizes.w;
-    float cols = float(f_6.sizes.z);
-    float dist_1 = f_6.axis.w;
+    uint rows = f_7.sizes.w;
+    float cols = float(f_7.sizes.z);
+    float dist_1 = f_7.axis.w;
     row = lid;
     bool loop_init_5 = true;
     while(true) {
@@ -420,7 +425,7 @@ void main() {
             delta = (old.x * (_e75 / far_3));
             if (true) {
                 uint _e80 = row;
-                float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, _e80);
+                float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, _e80);
                 extent = 0.0;
                 k = 0u;
                 bool loop_init_6 = true;
@@ -440,7 +445,7 @@ void main() {
                         float theta_1 = (old.z + (((old.w - old.z) * float(_e93)) / 32.0));
                         float _e99 = extent;
                         float _e100 = z;
-                        float _e101 = spot_psi(f_6, _e81, theta_1, _e100, dist_1);
+                        float _e101 = spot_psi(f_7, _e81, theta_1, _e100, dist_1);
                         extent = max(_e99, _e101);
                     }
                 }

@@ -28,8 +28,15 @@ pub fn row_phi(f: &FrameUniforms, row: u32) -> f32 {
     if f.fan_angles[2] > 0.5 {
         fan_phi(f, row)
     } else {
-        f.e1[3] + (row as f32 + 0.5) * f.e2[3]
+        axis_row_phi(f, row)
     }
+}
+
+/// Slice angle at the centre of row `row` of rows uniform in the angle around the light
+/// axis: [`row_phi`] of a frame whose rows do not follow the sampling's slices, for the
+/// families that never align them (`pst_sweep`; see the WGSL for why it is its own function).
+pub fn axis_row_phi(f: &FrameUniforms, row: u32) -> f32 {
+    f.e1[3] + (row as f32 + 0.5) * f.e2[3]
 }
 
 /// The screen size in pixels.
