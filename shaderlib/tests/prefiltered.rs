@@ -328,7 +328,7 @@ fn bindings_match_the_documented_tables() {
 }
 
 /// The `Frame` struct has the host `FrameUniforms` layout: 19 vec4<f32>, 2 vec4<u32>, then
-/// 4 vec4<f32>.
+/// 6 vec4<f32>.
 #[test]
 fn frame_layout_matches_the_host_struct() {
     let built = built(KernelParams::Scatter(PrefilteredVariant::default()));
@@ -345,7 +345,7 @@ fn frame_layout_matches_the_host_struct() {
         *span as usize,
         size_of::<scatter_shaderlib::prefiltered::FrameUniforms>()
     );
-    assert_eq!(members.len(), 25);
+    assert_eq!(members.len(), 27);
     for (i, member) in members.iter().enumerate() {
         assert_eq!(member.offset as usize, 16 * i, "{:?}", member.name);
         let naga::TypeInner::Vector { size, scalar } = m.types[member.ty].inner else {
@@ -388,6 +388,8 @@ fn frame_layout_matches_the_host_struct() {
             "proj_g0_",
             "proj_g1_",
             "proj_g2_",
+            "fan_origin",
+            "fan_angles",
         ]
     );
 }
