@@ -515,19 +515,20 @@ pub fn kernel_costs() -> Vec<KernelCost> {
             kernel: "minmax_build",
             invocations: u64::from(BUILD_LANES) * hr,
             // One workgroup of BUILD_LANES per row, blocks of B = Wr / BUILD_LANES = 8
-            // texels (t = 3): per invocation levels 0..=t of its block, each level B loads
-            // (32) and 2B - 1 = 15 nodes stored (8 bytes each), a min and a max per load;
-            // then at most one node above t from workgroup memory (counted as texel loads:
-            // 2 on average, the root's 128 in one invocation).
+            // texels (t = 3): per invocation levels 0..=3 of its block from its B loads,
+            // reduced in registers (2B - 1 = 15 nodes stored, 8 bytes each; a select per
+            // load, a min and a max per node); then at most one node above t from
+            // workgroup memory (counted as texel loads: 2 on average, the root's 128 in one
+            // invocation).
             counts: [
                 8.0 * 16.0,
-                4.0 * build_block + 2.0,
+                build_block + 2.0,
                 0.0,
                 0.0,
-                2.0 * 4.0 * build_block + 20.0,
+                2.0 * 2.0 * build_block + 20.0,
             ],
             low: None,
-            trips: "(t + 1) levels x B texels, then one node above t",
+            trips: "B texels, then one node above t",
         },
         KernelCost {
             method: "minmax",

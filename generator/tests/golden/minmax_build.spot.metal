@@ -57,6 +57,9 @@ constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant uint LANES = 128u;
+constant uint GROUP = 8u;
+constant uint GROUP_LEVELS = 3u;
+constant metal::float2 EMPTY = metal::float2(340000000000000000000000000000000000000.0, -340000000000000000000000000000000000000.0);
 
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1,
@@ -86,10 +89,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_2 = v_3.size.x;
-    uint x_2 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_2)), n_2 - 1u);
-    uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_2)), n_2 - 1u);
+    uint x_3 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_2)), n_2 - 1u);
+    uint y_3 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_2)), n_2 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_2, y_1)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_3, y_3)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
@@ -187,11 +190,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_3 = sigma_t * len;
-    if (x_3 < 0.0001) {
-        return len * (1.0 - (0.5 * x_3));
+    float x_4 = sigma_t * len;
+    if (x_4 < 0.0001) {
+        return len * (1.0 - (0.5 * x_4));
     }
-    return (1.0 - metal::exp(-(x_3))) / sigma_t;
+    return (1.0 - metal::exp(-(x_4))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -208,8 +211,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_inner,
     float cos_outer
 ) {
-    float x_4 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_4 * x_4) * (3.0 - (2.0 * x_4)));
+    float x_5 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -222,8 +225,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_5 = eye + (dir * t_1);
-    metal::float3 to_x = x_5 - light_pos;
+    metal::float3 x_6 = eye + (dir * t_1);
+    metal::float3 to_x = x_6 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d);
@@ -361,45 +364,80 @@ uint level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(
     return _e14;
 }
 
-metal::float2 span_min_max(
-    uint a_3,
-    uint b_3,
+metal::float2 join(
+    metal::float2 a_3,
+    metal::float2 b_3
+) {
+    return metal::float2(metal::min(a_3.x, b_3.x), metal::max(a_3.y, b_3.y));
+}
+
+metal::float2 leaf(
+    uint x_1,
+    uint end,
     uint y,
     metal::texture2d<float, metal::access::sample> rectified
 ) {
-    metal::float2 v_10 = {};
-    uint x_1 = {};
+    uint clamped_lod_e9 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+    metal::float4 _e9 = rectified.read(metal::min(metal::uint2(metal::uint2(metal::min(x_1, end - 1u), y)), metal::uint2(rectified.get_width(clamped_lod_e9), rectified.get_height(clamped_lod_e9)) - 1), clamped_lod_e9);
+    float d_1 = _e9.x;
+    return (x_1 < end) ? metal::float2(d_1, d_1) : EMPTY;
+}
+
+void store_node(
+    uint off_1,
+    uint j,
+    uint count,
+    uint y_1,
+    metal::float2 v_10,
+    metal::texture2d<float, metal::access::write> tree
+) {
+    if (j < count) {
+        tree.write(metal::float4(v_10.x, v_10.y, 0.0, 0.0), metal::uint2(metal::uint2(off_1 + j, y_1)));
+        return;
+    } else {
+        return;
+    }
+}
+
+metal::float2 span_min_max(
+    uint a_4,
+    uint b_4,
+    uint y_2,
+    metal::texture2d<float, metal::access::sample> rectified
+) {
+    metal::float2 v_11 = {};
+    uint x_2 = {};
     uint clamped_lod_e5 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-    metal::float4 _e5 = rectified.read(metal::min(metal::uint2(metal::uint2(a_3, y)), metal::uint2(rectified.get_width(clamped_lod_e5), rectified.get_height(clamped_lod_e5)) - 1), clamped_lod_e5);
+    metal::float4 _e5 = rectified.read(metal::min(metal::uint2(metal::uint2(a_4, y_2)), metal::uint2(rectified.get_width(clamped_lod_e5), rectified.get_height(clamped_lod_e5)) - 1), clamped_lod_e5);
     float d0_ = _e5.x;
-    v_10 = metal::float2(d0_, d0_);
-    x_1 = a_3 + 1u;
+    v_11 = metal::float2(d0_, d0_);
+    x_2 = a_4 + 1u;
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e29 = x_1;
-            x_1 = _e29 + 1u;
+            uint _e29 = x_2;
+            x_2 = _e29 + 1u;
         }
         loop_init_3 = false;
-        uint _e13 = x_1;
-        if (_e13 < b_3) {
+        uint _e13 = x_2;
+        if (_e13 < b_4) {
         } else {
             break;
         }
         {
-            uint _e15 = x_1;
+            uint _e15 = x_2;
             uint clamped_lod_e19 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e19 = rectified.read(metal::min(metal::uint2(metal::uint2(_e15, y)), metal::uint2(rectified.get_width(clamped_lod_e19), rectified.get_height(clamped_lod_e19)) - 1), clamped_lod_e19);
-            float d_1 = _e19.x;
-            float _e22 = v_10.x;
-            float _e25 = v_10.y;
-            v_10 = metal::float2(metal::min(_e22, d_1), metal::max(_e25, d_1));
+            metal::float4 _e19 = rectified.read(metal::min(metal::uint2(metal::uint2(_e15, y_2)), metal::uint2(rectified.get_width(clamped_lod_e19), rectified.get_height(clamped_lod_e19)) - 1), clamped_lod_e19);
+            float d_2 = _e19.x;
+            float _e22 = v_11.x;
+            float _e25 = v_11.y;
+            v_11 = metal::float2(metal::min(_e22, d_2), metal::max(_e25, d_2));
         }
     }
-    metal::float2 _e31 = v_10;
+    metal::float2 _e31 = v_11;
     return _e31;
 }
 
@@ -419,16 +457,18 @@ kernel void minmax_build(
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     uint t = 0u;
     metal::float2 top = metal::float2(0.0, 0.0);
-    uint k = 0u;
+    uint k_map = 0u;
+    uint base = {};
+    uint k = {};
     uint n = {};
     uint c = {};
     uint k_1 = {};
     metal::float2 v = {};
     uint m = {};
     uint width_2 = frame.sizes.z;
-    uint y_2 = wid.y;
+    uint y_4 = wid.y;
     uint _e12 = frame.sizes.w;
-    if (y_2 >= _e12) {
+    if (y_4 >= _e12) {
         return;
     }
     uint2 loop_bound_4 = uint2(4294967295u);
@@ -445,129 +485,216 @@ kernel void minmax_build(
             t = _e20 + 1u;
         }
     }
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_4 = true;
-    while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_4) {
-            uint _e65 = k;
-            k = _e65 + 1u;
+    uint _e22 = t;
+    uint _e28 = frame.sizes.w;
+    if ((_e22 >= GROUP_LEVELS) & (y_4 < _e28)) {
+        k_map = 4u;
+        uint _e34 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(0u, width_2);
+        uint _e36 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(1u, width_2);
+        uint _e38 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(2u, width_2);
+        uint _e40 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(3u, width_2);
+        uint _e44 = t;
+        uint stop = metal::min((i + 1u) << _e44, width_2);
+        uint _e47 = t;
+        base = i << _e47;
+        uint2 loop_bound_5 = uint2(4294967295u);
+        bool loop_init_4 = true;
+        while(true) {
+            if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+            loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+            if (!loop_init_4) {
+                uint _e145 = base;
+                base = _e145 + GROUP;
+            }
+            loop_init_4 = false;
+            uint _e50 = base;
+            if (_e50 < stop) {
+            } else {
+                break;
+            }
+            {
+                uint _e52 = base;
+                uint end_1 = metal::min(_e52 + GROUP, width_2);
+                uint _e56 = base;
+                metal::float2 _e57 = leaf(_e56, end_1, y_4, rectified);
+                uint _e58 = base;
+                metal::float2 _e61 = leaf(_e58 + 1u, end_1, y_4, rectified);
+                uint _e62 = base;
+                metal::float2 _e65 = leaf(_e62 + 2u, end_1, y_4, rectified);
+                uint _e66 = base;
+                metal::float2 _e69 = leaf(_e66 + 3u, end_1, y_4, rectified);
+                uint _e70 = base;
+                metal::float2 _e73 = leaf(_e70 + 4u, end_1, y_4, rectified);
+                uint _e74 = base;
+                metal::float2 _e77 = leaf(_e74 + 5u, end_1, y_4, rectified);
+                uint _e78 = base;
+                metal::float2 _e81 = leaf(_e78 + 6u, end_1, y_4, rectified);
+                uint _e82 = base;
+                metal::float2 _e85 = leaf(_e82 + 7u, end_1, y_4, rectified);
+                uint _e86 = base;
+                store_node(0u, _e86, _e34, y_4, _e57, tree);
+                uint _e88 = base;
+                store_node(0u, _e88 + 1u, _e34, y_4, _e61, tree);
+                uint _e92 = base;
+                store_node(0u, _e92 + 2u, _e34, y_4, _e65, tree);
+                uint _e96 = base;
+                store_node(0u, _e96 + 3u, _e34, y_4, _e69, tree);
+                uint _e100 = base;
+                store_node(0u, _e100 + 4u, _e34, y_4, _e73, tree);
+                uint _e104 = base;
+                store_node(0u, _e104 + 5u, _e34, y_4, _e77, tree);
+                uint _e108 = base;
+                store_node(0u, _e108 + 6u, _e34, y_4, _e81, tree);
+                uint _e112 = base;
+                store_node(0u, _e112 + 7u, _e34, y_4, _e85, tree);
+                metal::float2 _e116 = join(_e57, _e61);
+                metal::float2 _e117 = join(_e65, _e69);
+                metal::float2 _e118 = join(_e73, _e77);
+                metal::float2 _e119 = join(_e81, _e85);
+                uint _e120 = base;
+                uint j1_ = _e120 >> 1u;
+                store_node(_e34, j1_, _e36, y_4, _e116, tree);
+                store_node(_e34, j1_ + 1u, _e36, y_4, _e117, tree);
+                store_node(_e34, j1_ + 2u, _e36, y_4, _e118, tree);
+                store_node(_e34, j1_ + 3u, _e36, y_4, _e119, tree);
+                metal::float2 _e129 = join(_e116, _e117);
+                metal::float2 _e130 = join(_e118, _e119);
+                uint _e131 = base;
+                uint j2_ = _e131 >> 2u;
+                store_node(_e34 + _e36, j2_, _e38, y_4, _e129, tree);
+                store_node(_e34 + _e36, j2_ + 1u, _e38, y_4, _e130, tree);
+                metal::float2 _e138 = join(_e129, _e130);
+                uint _e141 = base;
+                store_node((_e34 + _e36) + _e38, _e141 >> 3u, _e40, y_4, _e138, tree);
+                top = _e138;
+            }
         }
-        loop_init_4 = false;
-        uint _e23 = k;
-        uint _e24 = t;
-        if (_e23 <= _e24) {
+    }
+    uint _e148 = k_map;
+    k = _e148;
+    uint2 loop_bound_6 = uint2(4294967295u);
+    bool loop_init_5 = true;
+    while(true) {
+        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+        if (!loop_init_5) {
+            uint _e190 = k;
+            k = _e190 + 1u;
+        }
+        loop_init_5 = false;
+        uint _e150 = k;
+        uint _e151 = t;
+        if (_e150 <= _e151) {
         } else {
             break;
         }
         {
-            uint _e26 = k;
-            uint _e27 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e26, width_2);
-            uint _e28 = k;
-            uint _e29 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e28, width_2);
-            uint _e31 = t;
-            uint _e32 = k;
-            uint per_block = 1u << (_e31 - _e32);
+            uint _e153 = k;
+            uint _e154 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e153, width_2);
+            uint _e155 = k;
+            uint _e156 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e155, width_2);
+            uint _e158 = t;
+            uint _e159 = k;
+            uint per_block = 1u << (_e158 - _e159);
             n = 0u;
-            uint2 loop_bound_6 = uint2(4294967295u);
-            bool loop_init_5 = true;
+            uint2 loop_bound_7 = uint2(4294967295u);
+            bool loop_init_6 = true;
             while(true) {
-                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                if (!loop_init_5) {
-                    uint _e62 = n;
-                    n = _e62 + 1u;
+                if (metal::all(loop_bound_7 == uint2(0u))) { break; }
+                loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+                if (!loop_init_6) {
+                    uint _e187 = n;
+                    n = _e187 + 1u;
                 }
-                loop_init_5 = false;
-                uint _e37 = n;
-                if (_e37 < per_block) {
+                loop_init_6 = false;
+                uint _e164 = n;
+                if (_e164 < per_block) {
                 } else {
                     break;
                 }
                 {
-                    uint _e41 = n;
-                    uint j = (i * per_block) + _e41;
-                    if (j < _e27) {
-                        uint _e44 = k;
-                        uint _e48 = k;
-                        metal::float2 _e51 = span_min_max(j << _e44, metal::min((j + 1u) << _e48, width_2), y_2, rectified);
-                        tree.write(metal::float4(_e51.x, _e51.y, 0.0, 0.0), metal::uint2(metal::uint2(_e29 + j, y_2)));
-                        top = _e51;
+                    uint _e167 = n;
+                    uint j_1 = (i * per_block) + _e167;
+                    if (j_1 < _e154) {
+                        uint _e170 = k;
+                        uint _e174 = k;
+                        metal::float2 _e177 = span_min_max(j_1 << _e170, metal::min((j_1 + 1u) << _e174, width_2), y_4, rectified);
+                        tree.write(metal::float4(_e177.x, _e177.y, 0.0, 0.0), metal::uint2(metal::uint2(_e156 + j_1, y_4)));
+                        top = _e177;
                     }
                 }
             }
         }
     }
-    metal::float2 _e69 = top;
-    block_nodes.inner[metal::min(unsigned(i), 127u)] = _e69;
+    metal::float2 _e194 = top;
+    block_nodes.inner[metal::min(unsigned(i), 127u)] = _e194;
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
-    uint _e70 = t;
-    uint _e71 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e70, width_2);
+    uint _e195 = t;
+    uint _e196 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e195, width_2);
     c = i;
-    uint _e73 = t;
-    k_1 = _e73 + 1u;
-    uint2 loop_bound_7 = uint2(4294967295u);
+    uint _e198 = t;
+    k_1 = _e198 + 1u;
+    uint2 loop_bound_8 = uint2(4294967295u);
     while(true) {
-        if (metal::all(loop_bound_7 == uint2(0u))) { break; }
-        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-        uint _e77 = k_1;
-        uint _e80 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e77 - 1u, width_2);
-        if (_e80 > 1u) {
+        if (metal::all(loop_bound_8 == uint2(0u))) { break; }
+        loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
+        uint _e202 = k_1;
+        uint _e205 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e202 - 1u, width_2);
+        if (_e205 > 1u) {
         } else {
             break;
         }
         {
-            uint _e83 = k_1;
-            uint _e84 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e83, width_2);
-            uint _e85 = c;
-            if (_e85 < _e84) {
-                uint _e87 = c;
-                uint _e88 = k_1;
-                uint _e89 = t;
-                uint a_4 = _e87 << (_e88 - _e89);
-                uint _e92 = c;
-                uint _e95 = k_1;
-                uint _e96 = t;
-                uint b_4 = metal::min((_e92 + 1u) << (_e95 - _e96), _e71);
-                metal::float2 _e102 = block_nodes.inner[metal::min(unsigned(a_4), 127u)];
-                v = _e102;
-                m = a_4 + 1u;
-                uint2 loop_bound_8 = uint2(4294967295u);
-                bool loop_init_6 = true;
+            uint _e208 = k_1;
+            uint _e209 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e208, width_2);
+            uint _e210 = c;
+            if (_e210 < _e209) {
+                uint _e212 = c;
+                uint _e213 = k_1;
+                uint _e214 = t;
+                uint a_5 = _e212 << (_e213 - _e214);
+                uint _e217 = c;
+                uint _e220 = k_1;
+                uint _e221 = t;
+                uint b_5 = metal::min((_e217 + 1u) << (_e220 - _e221), _e196);
+                metal::float2 _e227 = block_nodes.inner[metal::min(unsigned(a_5), 127u)];
+                v = _e227;
+                m = a_5 + 1u;
+                uint2 loop_bound_9 = uint2(4294967295u);
+                bool loop_init_7 = true;
                 while(true) {
-                    if (metal::all(loop_bound_8 == uint2(0u))) { break; }
-                    loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
-                    if (!loop_init_6) {
-                        uint _e123 = m;
-                        m = _e123 + 1u;
+                    if (metal::all(loop_bound_9 == uint2(0u))) { break; }
+                    loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
+                    if (!loop_init_7) {
+                        uint _e248 = m;
+                        m = _e248 + 1u;
                     }
-                    loop_init_6 = false;
-                    uint _e107 = m;
-                    if (_e107 < b_4) {
+                    loop_init_7 = false;
+                    uint _e232 = m;
+                    if (_e232 < b_5) {
                     } else {
                         break;
                     }
                     {
-                        uint _e110 = m;
-                        metal::float2 w_1 = block_nodes.inner[metal::min(unsigned(_e110), 127u)];
-                        float _e114 = v.x;
-                        float _e118 = v.y;
-                        v = metal::float2(metal::min(_e114, w_1.x), metal::max(_e118, w_1.y));
+                        uint _e235 = m;
+                        metal::float2 w_1 = block_nodes.inner[metal::min(unsigned(_e235), 127u)];
+                        float _e239 = v.x;
+                        float _e243 = v.y;
+                        v = metal::float2(metal::min(_e239, w_1.x), metal::max(_e243, w_1.y));
                     }
                 }
-                uint _e125 = k_1;
-                uint _e126 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e125, width_2);
-                uint _e127 = c;
-                float _e131 = v.x;
-                float _e133 = v.y;
-                tree.write(metal::float4(_e131, _e133, 0.0, 0.0), metal::uint2(metal::uint2(_e126 + _e127, y_2)));
+                uint _e250 = k_1;
+                uint _e251 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e250, width_2);
+                uint _e252 = c;
+                float _e256 = v.x;
+                float _e258 = v.y;
+                tree.write(metal::float4(_e256, _e258, 0.0, 0.0), metal::uint2(metal::uint2(_e251 + _e252, y_4)));
                 break;
             }
-            uint _e138 = c;
-            c = _e138 - _e84;
-            uint _e141 = k_1;
-            k_1 = _e141 + 1u;
+            uint _e263 = c;
+            c = _e263 - _e209;
+            uint _e266 = k_1;
+            k_1 = _e266 + 1u;
         }
     }
     return;

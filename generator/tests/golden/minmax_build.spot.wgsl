@@ -51,6 +51,9 @@ const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
 const LANES: u32 = 128u;
+const GROUP: u32 = 8u;
+const GROUP_LEVELS: u32 = 3u;
+const EMPTY: vec2<f32> = vec2<f32>(340000000000000000000000000000000000000f, -340000000000000000000000000000000000000f);
 
 @group(0) @binding(0) 
 var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX;
@@ -74,9 +77,9 @@ fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMap
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_3: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_2 = v_3.size.x;
-    let x_2 = min(u32((uv.x * f32(n_2))), (n_2 - 1u));
-    let y_1 = min(u32((uv.y * f32(n_2))), (n_2 - 1u));
-    let _e36 = textureLoad(sm, vec2<u32>(x_2, y_1), 0i);
+    let x_3 = min(u32((uv.x * f32(n_2))), (n_2 - 1u));
+    let y_3 = min(u32((uv.y * f32(n_2))), (n_2 - 1u));
+    let _e36 = textureLoad(sm, vec2<u32>(x_3, y_3), 0i);
     return select(_e36.x, 2f, outside);
 }
 
@@ -147,11 +150,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_3 = (sigma_t * len);
-    if (x_3 < 0.0001f) {
-        return (len * (1f - (0.5f * x_3)));
+    let x_4 = (sigma_t * len);
+    if (x_4 < 0.0001f) {
+        return (len * (1f - (0.5f * x_4)));
     }
-    return ((1f - exp(-(x_3))) / sigma_t);
+    return ((1f - exp(-(x_4))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -160,13 +163,13 @@ fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32,
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    let x_4 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return select(((x_4 * x_4) * (3f - (2f * x_4))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
+    let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return select(((x_5 * x_5) * (3f - (2f * x_5))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t_1: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_5 = (eye + (dir * t_1));
-    let to_x = (x_5 - light_pos);
+    let x_6 = (eye + (dir * t_1));
+    let to_x = (x_6 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d = sqrt(d2_);
     let travel = (to_x / vec3(d));
@@ -264,34 +267,53 @@ fn level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(level_1: u32, width_1: 
     return _e14;
 }
 
-fn span_min_max(a_3: u32, b_3: u32, y: u32) -> vec2<f32> {
-    var v_10: vec2<f32>;
-    var x_1: u32;
+fn join(a_3: vec2<f32>, b_3: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(min(a_3.x, b_3.x), max(a_3.y, b_3.y));
+}
 
-    let _e5 = textureLoad(rectified, vec2<u32>(a_3, y), 0i);
+fn leaf(x_1: u32, end: u32, y: u32) -> vec2<f32> {
+    let _e9 = textureLoad(rectified, vec2<u32>(min(x_1, (end - 1u)), y), 0i);
+    let d_1 = _e9.x;
+    return select(EMPTY, vec2<f32>(d_1, d_1), (x_1 < end));
+}
+
+fn store_node(off_1: u32, j: u32, count: u32, y_1: u32, v_10: vec2<f32>) {
+    if (j < count) {
+        textureStore(tree, vec2<u32>((off_1 + j), y_1), vec4<f32>(v_10.x, v_10.y, 0f, 0f));
+        return;
+    } else {
+        return;
+    }
+}
+
+fn span_min_max(a_4: u32, b_4: u32, y_2: u32) -> vec2<f32> {
+    var v_11: vec2<f32>;
+    var x_2: u32;
+
+    let _e5 = textureLoad(rectified, vec2<u32>(a_4, y_2), 0i);
     let d0_ = _e5.x;
-    v_10 = vec2<f32>(d0_, d0_);
-    x_1 = (a_3 + 1u);
+    v_11 = vec2<f32>(d0_, d0_);
+    x_2 = (a_4 + 1u);
     loop {
-        let _e13 = x_1;
-        if (_e13 < b_3) {
+        let _e13 = x_2;
+        if (_e13 < b_4) {
         } else {
             break;
         }
         {
-            let _e15 = x_1;
-            let _e19 = textureLoad(rectified, vec2<u32>(_e15, y), 0i);
-            let d_1 = _e19.x;
-            let _e22 = v_10.x;
-            let _e25 = v_10.y;
-            v_10 = vec2<f32>(min(_e22, d_1), max(_e25, d_1));
+            let _e15 = x_2;
+            let _e19 = textureLoad(rectified, vec2<u32>(_e15, y_2), 0i);
+            let d_2 = _e19.x;
+            let _e22 = v_11.x;
+            let _e25 = v_11.y;
+            v_11 = vec2<f32>(min(_e22, d_2), max(_e25, d_2));
         }
         continuing {
-            let _e29 = x_1;
-            x_1 = (_e29 + 1u);
+            let _e29 = x_2;
+            x_2 = (_e29 + 1u);
         }
     }
-    let _e31 = v_10;
+    let _e31 = v_11;
     return _e31;
 }
 
@@ -299,7 +321,9 @@ fn span_min_max(a_3: u32, b_3: u32, y: u32) -> vec2<f32> {
 fn minmax_build(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) i: u32) {
     var t: u32 = 0u;
     var top: vec2<f32> = vec2<f32>(0f, 0f);
-    var k: u32 = 0u;
+    var k_map: u32 = 0u;
+    var base: u32;
+    var k: u32;
     var n: u32;
     var c: u32;
     var k_1: u32;
@@ -307,9 +331,9 @@ fn minmax_build(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
     var m: u32;
 
     let width_2 = frame.sizes.z;
-    let y_2 = wid.y;
+    let y_4 = wid.y;
     let _e12 = frame.sizes.w;
-    if (y_2 >= _e12) {
+    if (y_4 >= _e12) {
         return;
     }
     loop {
@@ -323,111 +347,193 @@ fn minmax_build(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
             t = (_e20 + 1u);
         }
     }
+    let _e22 = t;
+    let _e28 = frame.sizes.w;
+    if ((_e22 >= GROUP_LEVELS) & (y_4 < _e28)) {
+        k_map = 4u;
+        let _e34 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(0u, width_2);
+        let _e36 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(1u, width_2);
+        let _e38 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(2u, width_2);
+        let _e40 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(3u, width_2);
+        let _e44 = t;
+        let stop = min(((i + 1u) << _e44), width_2);
+        let _e47 = t;
+        base = (i << _e47);
+        loop {
+            let _e50 = base;
+            if (_e50 < stop) {
+            } else {
+                break;
+            }
+            {
+                let _e52 = base;
+                let end_1 = min((_e52 + GROUP), width_2);
+                let _e56 = base;
+                let _e57 = leaf(_e56, end_1, y_4);
+                let _e58 = base;
+                let _e61 = leaf((_e58 + 1u), end_1, y_4);
+                let _e62 = base;
+                let _e65 = leaf((_e62 + 2u), end_1, y_4);
+                let _e66 = base;
+                let _e69 = leaf((_e66 + 3u), end_1, y_4);
+                let _e70 = base;
+                let _e73 = leaf((_e70 + 4u), end_1, y_4);
+                let _e74 = base;
+                let _e77 = leaf((_e74 + 5u), end_1, y_4);
+                let _e78 = base;
+                let _e81 = leaf((_e78 + 6u), end_1, y_4);
+                let _e82 = base;
+                let _e85 = leaf((_e82 + 7u), end_1, y_4);
+                let _e86 = base;
+                store_node(0u, _e86, _e34, y_4, _e57);
+                let _e88 = base;
+                store_node(0u, (_e88 + 1u), _e34, y_4, _e61);
+                let _e92 = base;
+                store_node(0u, (_e92 + 2u), _e34, y_4, _e65);
+                let _e96 = base;
+                store_node(0u, (_e96 + 3u), _e34, y_4, _e69);
+                let _e100 = base;
+                store_node(0u, (_e100 + 4u), _e34, y_4, _e73);
+                let _e104 = base;
+                store_node(0u, (_e104 + 5u), _e34, y_4, _e77);
+                let _e108 = base;
+                store_node(0u, (_e108 + 6u), _e34, y_4, _e81);
+                let _e112 = base;
+                store_node(0u, (_e112 + 7u), _e34, y_4, _e85);
+                let _e116 = join(_e57, _e61);
+                let _e117 = join(_e65, _e69);
+                let _e118 = join(_e73, _e77);
+                let _e119 = join(_e81, _e85);
+                let _e120 = base;
+                let j1_ = (_e120 >> 1u);
+                store_node(_e34, j1_, _e36, y_4, _e116);
+                store_node(_e34, (j1_ + 1u), _e36, y_4, _e117);
+                store_node(_e34, (j1_ + 2u), _e36, y_4, _e118);
+                store_node(_e34, (j1_ + 3u), _e36, y_4, _e119);
+                let _e129 = join(_e116, _e117);
+                let _e130 = join(_e118, _e119);
+                let _e131 = base;
+                let j2_ = (_e131 >> 2u);
+                store_node((_e34 + _e36), j2_, _e38, y_4, _e129);
+                store_node((_e34 + _e36), (j2_ + 1u), _e38, y_4, _e130);
+                let _e138 = join(_e129, _e130);
+                let _e141 = base;
+                store_node(((_e34 + _e36) + _e38), (_e141 >> 3u), _e40, y_4, _e138);
+                top = _e138;
+            }
+            continuing {
+                let _e145 = base;
+                base = (_e145 + GROUP);
+            }
+        }
+    }
+    let _e148 = k_map;
+    k = _e148;
     loop {
-        let _e23 = k;
-        let _e24 = t;
-        if (_e23 <= _e24) {
+        let _e150 = k;
+        let _e151 = t;
+        if (_e150 <= _e151) {
         } else {
             break;
         }
         {
-            let _e26 = k;
-            let _e27 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e26, width_2);
-            let _e28 = k;
-            let _e29 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e28, width_2);
-            let _e31 = t;
-            let _e32 = k;
-            let per_block = (1u << (_e31 - _e32));
+            let _e153 = k;
+            let _e154 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e153, width_2);
+            let _e155 = k;
+            let _e156 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e155, width_2);
+            let _e158 = t;
+            let _e159 = k;
+            let per_block = (1u << (_e158 - _e159));
             n = 0u;
             loop {
-                let _e37 = n;
-                if (_e37 < per_block) {
+                let _e164 = n;
+                if (_e164 < per_block) {
                 } else {
                     break;
                 }
                 {
-                    let _e41 = n;
-                    let j = ((i * per_block) + _e41);
-                    if (j < _e27) {
-                        let _e44 = k;
-                        let _e48 = k;
-                        let _e51 = span_min_max((j << _e44), min(((j + 1u) << _e48), width_2), y_2);
-                        textureStore(tree, vec2<u32>((_e29 + j), y_2), vec4<f32>(_e51.x, _e51.y, 0f, 0f));
-                        top = _e51;
+                    let _e167 = n;
+                    let j_1 = ((i * per_block) + _e167);
+                    if (j_1 < _e154) {
+                        let _e170 = k;
+                        let _e174 = k;
+                        let _e177 = span_min_max((j_1 << _e170), min(((j_1 + 1u) << _e174), width_2), y_4);
+                        textureStore(tree, vec2<u32>((_e156 + j_1), y_4), vec4<f32>(_e177.x, _e177.y, 0f, 0f));
+                        top = _e177;
                     }
                 }
                 continuing {
-                    let _e62 = n;
-                    n = (_e62 + 1u);
+                    let _e187 = n;
+                    n = (_e187 + 1u);
                 }
             }
         }
         continuing {
-            let _e65 = k;
-            k = (_e65 + 1u);
+            let _e190 = k;
+            k = (_e190 + 1u);
         }
     }
-    let _e69 = top;
-    block_nodes[i] = _e69;
+    let _e194 = top;
+    block_nodes[i] = _e194;
     workgroupBarrier();
-    let _e70 = t;
-    let _e71 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e70, width_2);
+    let _e195 = t;
+    let _e196 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e195, width_2);
     c = i;
-    let _e73 = t;
-    k_1 = (_e73 + 1u);
+    let _e198 = t;
+    k_1 = (_e198 + 1u);
     loop {
-        let _e77 = k_1;
-        let _e80 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX((_e77 - 1u), width_2);
-        if (_e80 > 1u) {
+        let _e202 = k_1;
+        let _e205 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX((_e202 - 1u), width_2);
+        if (_e205 > 1u) {
         } else {
             break;
         }
         {
-            let _e83 = k_1;
-            let _e84 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e83, width_2);
-            let _e85 = c;
-            if (_e85 < _e84) {
-                let _e87 = c;
-                let _e88 = k_1;
-                let _e89 = t;
-                let a_4 = (_e87 << (_e88 - _e89));
-                let _e92 = c;
-                let _e95 = k_1;
-                let _e96 = t;
-                let b_4 = min(((_e92 + 1u) << (_e95 - _e96)), _e71);
-                let _e102 = block_nodes[a_4];
-                v = _e102;
-                m = (a_4 + 1u);
+            let _e208 = k_1;
+            let _e209 = level_countX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e208, width_2);
+            let _e210 = c;
+            if (_e210 < _e209) {
+                let _e212 = c;
+                let _e213 = k_1;
+                let _e214 = t;
+                let a_5 = (_e212 << (_e213 - _e214));
+                let _e217 = c;
+                let _e220 = k_1;
+                let _e221 = t;
+                let b_5 = min(((_e217 + 1u) << (_e220 - _e221)), _e196);
+                let _e227 = block_nodes[a_5];
+                v = _e227;
+                m = (a_5 + 1u);
                 loop {
-                    let _e107 = m;
-                    if (_e107 < b_4) {
+                    let _e232 = m;
+                    if (_e232 < b_5) {
                     } else {
                         break;
                     }
                     {
-                        let _e110 = m;
-                        let w_1 = block_nodes[_e110];
-                        let _e114 = v.x;
-                        let _e118 = v.y;
-                        v = vec2<f32>(min(_e114, w_1.x), max(_e118, w_1.y));
+                        let _e235 = m;
+                        let w_1 = block_nodes[_e235];
+                        let _e239 = v.x;
+                        let _e243 = v.y;
+                        v = vec2<f32>(min(_e239, w_1.x), max(_e243, w_1.y));
                     }
                     continuing {
-                        let _e123 = m;
-                        m = (_e123 + 1u);
+                        let _e248 = m;
+                        m = (_e248 + 1u);
                     }
                 }
-                let _e125 = k_1;
-                let _e126 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e125, width_2);
-                let _e127 = c;
-                let _e131 = v.x;
-                let _e133 = v.y;
-                textureStore(tree, vec2<u32>((_e126 + _e127), y_2), vec4<f32>(_e131, _e133, 0f, 0f));
+                let _e250 = k_1;
+                let _e251 = level_offsetX_naga_oil_mod_XONRWC5DUMVZDUOTNNFXG2YLYX(_e250, width_2);
+                let _e252 = c;
+                let _e256 = v.x;
+                let _e258 = v.y;
+                textureStore(tree, vec2<u32>((_e251 + _e252), y_4), vec4<f32>(_e256, _e258, 0f, 0f));
                 break;
             }
-            let _e138 = c;
-            c = (_e138 - _e84);
-            let _e141 = k_1;
-            k_1 = (_e141 + 1u);
+            let _e263 = c;
+            c = (_e263 - _e209);
+            let _e266 = k_1;
+            k_1 = (_e266 + 1u);
         }
     }
     return;

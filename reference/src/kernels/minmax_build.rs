@@ -2,12 +2,40 @@
 //! every rectified row (Chen et al. 2011), all levels packed into one rg32float row per
 //! rectified row (layout: `scatter_frame::minmax`). One workgroup of [`BUILD_LANES`]
 //! invocations per row: phase 1 writes the levels 0 ..= t of each invocation's block of 2^t
-//! texels, phase 2 (after the barrier) the levels above t from the blocks' level-t nodes.
+//! texels (levels 0 ..= 3 of each group of 8 texels from its 8 loads where t >= 3, the rest
+//! from the map), phase 2 (after the barrier) the levels above t from the blocks' level-t
+//! nodes.
 
 use super::common_minmax::{level_count, level_offset, tree_width};
 use super::texture::{Tex, TexArray};
 use scatter_shaderlib::minmax::BUILD_LANES;
 use scatter_shaderlib::prefiltered::FrameUniforms;
+
+/// Texels per group of phase 1's register reduction (levels 0 ..= GROUP_LEVELS).
+const GROUP: u32 = 8;
+const GROUP_LEVELS: u32 = 3;
+
+/// The (min, max) of no texel: the identity of [`join`].
+const EMPTY: [f32; 2] = [3.4e38, -3.4e38];
+
+/// The node of two nodes.
+fn join(a: [f32; 2], b: [f32; 2]) -> [f32; 2] {
+    [a[0].min(b[0]), a[1].max(b[1])]
+}
+
+/// Texel x of row y as a level-0 node, or EMPTY at or beyond `end` (`end` > 0; the load
+/// clamped inside [0, end)).
+fn leaf(rectified: &Tex, x: u32, end: u32, y: u32) -> [f32; 2] {
+    let d = rectified.load(x.min(end - 1), y);
+    if x < end { [d, d] } else { EMPTY }
+}
+
+/// Stores node j of the level at packed column `off` when the level has it (j < count).
+fn store_node(out: &mut Vec<(u32, [f32; 4])>, off: u32, j: u32, count: u32, v: [f32; 2]) {
+    if j < count {
+        out.push((off + j, [v[0], v[1], 0.0, 0.0]));
+    }
+}
 
 /// (min, max) of the stored depths of texels [a, b) of row y (a < b).
 fn span_min_max(rectified: &Tex, a: u32, b: u32, y: u32) -> [f32; 2] {
@@ -36,7 +64,38 @@ pub fn minmax_build_row(y: u32, frame: &FrameUniforms, rectified: &Tex) -> Vec<(
     let mut block_nodes = vec![[0.0f32; 2]; BUILD_LANES as usize];
     for i in 0..BUILD_LANES {
         let mut top = [0.0f32; 2];
-        for k in 0..=t {
+        // Levels from the map: all of them for narrow rows, those above the groups' otherwise.
+        let mut k_map = 0;
+        if t >= GROUP_LEVELS {
+            k_map = GROUP_LEVELS + 1;
+            let c0 = level_count(0, width);
+            let c1 = level_count(1, width);
+            let c2 = level_count(2, width);
+            let c3 = level_count(3, width);
+            let stop = ((i + 1) << t).min(width);
+            let mut base = i << t;
+            while base < stop {
+                let end = (base + GROUP).min(width);
+                let n: [[f32; 2]; 8] =
+                    std::array::from_fn(|m| leaf(rectified, base + m as u32, end, y));
+                for (m, v) in n.iter().enumerate() {
+                    store_node(&mut out, 0, base + m as u32, c0, *v);
+                }
+                let m: [[f32; 2]; 4] = std::array::from_fn(|a| join(n[2 * a], n[2 * a + 1]));
+                for (a, v) in m.iter().enumerate() {
+                    store_node(&mut out, c0, (base >> 1) + a as u32, c1, *v);
+                }
+                let q = [join(m[0], m[1]), join(m[2], m[3])];
+                for (a, v) in q.iter().enumerate() {
+                    store_node(&mut out, c0 + c1, (base >> 2) + a as u32, c2, *v);
+                }
+                let r = join(q[0], q[1]);
+                store_node(&mut out, c0 + c1 + c2, base >> 3, c3, r);
+                top = r;
+                base += GROUP;
+            }
+        }
+        for k in k_map..=t {
             let count = level_count(k, width);
             let off = level_offset(k, width);
             let per_block = 1u32 << (t - k);
