@@ -5,7 +5,9 @@
 //! `MinmaxVariant::grid()`, directional on `columns`, spot on `spot_grate`, at the
 //! `ordinary` and `epipole_on_screen` poses (the latter marches pixels near the epipole), at
 //! 67x37 pixels with a 100x60 rectified map (neither a power of two nor a multiple of the
-//! workgroups) and a 128^2 shadow map. Trials are named
+//! workgroups) and a 128^2 shadow map; and two rows wide enough for `minmax_build`'s
+//! register groups (700x12: levels 0..3 from each group of 8 texels; 1100x8: level 4 from
+//! the map above them; trials `...::map_WxH`). Trials are named
 //! `minmax::<variant id>::<scene>::<pose>` (libtest trials: `cargo test -p scatter-conformance
 //! -- minmax::` runs this family, `-- --list` lists them); `minmax::errors` checks the error
 //! paths.
@@ -42,15 +44,55 @@ const REL_TOL: f32 = 1e-4;
 /// 0.3x, where `slice_fit` narrows the rows (every suite pose here sees the sky, where it
 /// does not), and the spot with the `stained_glass` cookie (64^2) at both poses (lit spans
 /// and the epipole march).
-const CASES: [(LightKind, Pose, f32, bool); 8] = [
-    (LightKind::Directional, Pose::Ordinary, 1.0, false),
-    (LightKind::Directional, Pose::EpipoleOnScreen, 1.0, false),
-    (LightKind::Spot, Pose::Ordinary, 1.0, false),
-    (LightKind::Spot, Pose::EpipoleOnScreen, 1.0, false),
-    (LightKind::Directional, Pose::Ordinary, 0.3, false),
-    (LightKind::Spot, Pose::Ordinary, 0.3, false),
-    (LightKind::Spot, Pose::Ordinary, 1.0, true),
-    (LightKind::Spot, Pose::EpipoleOnScreen, 1.0, true),
+/// And the rectified map of each (`RECTIFIED`, or a row wider than 4 x 128 texels, where
+/// `minmax_build` reduces groups of 8 texels in registers).
+const CASES: [(LightKind, Pose, f32, bool, [u32; 2]); 10] = [
+    (
+        LightKind::Directional,
+        Pose::Ordinary,
+        1.0,
+        false,
+        RECTIFIED,
+    ),
+    (
+        LightKind::Directional,
+        Pose::EpipoleOnScreen,
+        1.0,
+        false,
+        RECTIFIED,
+    ),
+    (LightKind::Spot, Pose::Ordinary, 1.0, false, RECTIFIED),
+    (
+        LightKind::Spot,
+        Pose::EpipoleOnScreen,
+        1.0,
+        false,
+        RECTIFIED,
+    ),
+    (
+        LightKind::Directional,
+        Pose::Ordinary,
+        0.3,
+        false,
+        RECTIFIED,
+    ),
+    (LightKind::Spot, Pose::Ordinary, 0.3, false, RECTIFIED),
+    (LightKind::Spot, Pose::Ordinary, 1.0, true, RECTIFIED),
+    (LightKind::Spot, Pose::EpipoleOnScreen, 1.0, true, RECTIFIED),
+    (
+        LightKind::Directional,
+        Pose::Ordinary,
+        1.0,
+        false,
+        [700, 12],
+    ),
+    (
+        LightKind::Spot,
+        Pose::EpipoleOnScreen,
+        1.0,
+        false,
+        [1100, 8],
+    ),
 ];
 
 /// The fixture of case `i` of [`CASES`] (all built once, on first use).
@@ -59,7 +101,7 @@ fn fixture(i: usize) -> &'static Fixture {
     &ALL.get_or_init(|| {
         CASES
             .iter()
-            .map(|&(light, pose, scale, cookie)| {
+            .map(|&(light, pose, scale, cookie, _)| {
                 let f = Fixture::new(scene_for(light), pose, SCREEN, SHADOW_MAP);
                 let f = if scale == 1.0 {
                     f
@@ -97,12 +139,21 @@ fn input(f: &Fixture) -> FrameInput {
     f.frame_input(FrameSettings::for_screen(SCREEN[0], SCREEN[1]))
 }
 
-fn trial_name(light: LightKind, pose: Pose, depth_scale: f32, cookie: bool) -> String {
-    let tail = if depth_scale == 1.0 {
+fn trial_name(
+    light: LightKind,
+    pose: Pose,
+    depth_scale: f32,
+    cookie: bool,
+    rectified: [u32; 2],
+) -> String {
+    let mut tail = if depth_scale == 1.0 {
         String::new()
     } else {
         format!("::depth_x{depth_scale}")
     };
+    if rectified != RECTIFIED {
+        tail += &format!("::map_{}x{}", rectified[0], rectified[1]);
+    }
     format!(
         "{}::{}::{pose}{tail}",
         FamilyVariant::from(MinmaxVariant {
@@ -116,9 +167,13 @@ fn trial_name(light: LightKind, pose: Pose, depth_scale: f32, cookie: bool) -> S
 }
 
 fn res() -> Resolutions {
+    res_with(RECTIFIED)
+}
+
+fn res_with(rectified: [u32; 2]) -> Resolutions {
     Resolutions {
         screen: SCREEN,
-        rectified: RECTIFIED,
+        rectified,
     }
 }
 
@@ -131,21 +186,25 @@ fn f16_ulp(v: f32) -> f32 {
     2f32.powi(a.log2().floor() as i32 - 10)
 }
 
-fn trial(ctx: &scatter_runtime::Context, f: &Fixture) -> Result<String, String> {
+fn trial(
+    ctx: &scatter_runtime::Context,
+    f: &Fixture,
+    rectified: [u32; 2],
+) -> Result<String, String> {
     let variant = variant_of(f);
     let name = format!("{}::{}", variant.id(), f.pose);
     let cookie = f.cookie();
     let gpu = run_minmax_once(
         ctx,
         &variant,
-        res(),
+        res_with(rectified),
         &input(f),
         &f.gbuf.view_depth,
         &f.shadow_map.depth,
         cookie.as_ref().map(|(size, t)| (*size, &t[..])),
     )
     .map_err(|e| format!("{name}: GPU run failed: {e}"))?;
-    let [wr, hr] = RECTIFIED;
+    let [wr, hr] = rectified;
     let sm = Tex {
         width: SHADOW_MAP,
         height: SHADOW_MAP,
@@ -318,12 +377,12 @@ fn main() -> ExitCode {
     let mut trials: Vec<(String, Check)> = CASES
         .iter()
         .enumerate()
-        .map(|(i, &(light, pose, scale, cookie))| {
+        .map(|(i, &(light, pose, scale, cookie, rectified))| {
             let check: Check = Box::new(move || {
                 let Some(ctx) = gpu() else { return Ok(()) };
-                trial(ctx, fixture(i)).map(drop)
+                trial(ctx, fixture(i), rectified).map(drop)
             });
-            (trial_name(light, pose, scale, cookie), check)
+            (trial_name(light, pose, scale, cookie, rectified), check)
         })
         .collect();
     trials.push((
