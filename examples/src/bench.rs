@@ -937,8 +937,9 @@ pub const SLICE_ROWS_RECTIFIED: [u32; 2] = [1024, 256];
 
 /// Every sampled method of the headline with the per-pixel method it is compared with: each
 /// base in each configuration; each base at [`HEADLINE_SLICES`] slices, and a base that
-/// rectifies also with the [`SLICE_GRID_RECTIFIED`] and [`SLICE_ROWS_RECTIFIED`] maps; and raymarch n256 epipolar (the
-/// brute-force anchor sampled: its evaluations are the fewest) at both slice counts.
+/// rectifies also with the [`SLICE_GRID_RECTIFIED`] and [`SLICE_ROWS_RECTIFIED`] maps; and
+/// raymarch n256 epipolar (the brute-force anchor sampled: its evaluations are the fewest) at
+/// both slice counts.
 fn sampled_variants() -> Vec<(Method, Method)> {
     let mut out = Vec::new();
     let n256: FamilyVariant = RaymarchVariant {
@@ -955,9 +956,9 @@ fn sampled_variants() -> Vec<(Method, Method)> {
         let sampled = base.with_sampling(SamplingKnobs::epipolar(HEADLINE_SLICES));
         out.push((Method::from(base), Method::from(sampled)));
         for map in [SLICE_GRID_RECTIFIED, SLICE_ROWS_RECTIFIED] {
-            let grid = Method::new(sampled, Some(map));
-            if grid.rectifies() {
-                out.push((Method::from(base), grid));
+            let with_map = Method::new(sampled, Some(map));
+            if with_map.rectifies() {
+                out.push((Method::from(base), with_map));
             }
         }
     }
