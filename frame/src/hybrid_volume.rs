@@ -223,8 +223,11 @@ pub fn prepare_hybrid_volume(
     settings: &FrameSettings,
 ) -> Result<PrefilteredFrame, FrameError> {
     variant.validate()?;
+    // With the sampling knobs: epipolar sampling aligns the rows with its slices.
     prepare_frame(
-        &variant.prefiltered(),
+        &variant
+            .prefiltered()
+            .with_sampling_knobs(variant.sampling_knobs()),
         res,
         camera,
         light,
