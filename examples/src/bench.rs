@@ -980,6 +980,8 @@ fn headline_runs(ctx: &Context, config: &BenchConfig) -> Result<Vec<HeadlineRow>
         Method::minmax_default(),
         Method::from(HybridVolumeVariant::default()),
         Method::partial_sum_tree_default(),
+        // As many rows as slices: the rows the sweep reads, on the slices (stop 50).
+        Method::new(Family::PartialSumTree.default_variant(), Some([1024, 512])),
         Method::new(Family::PartialSumTree.default_variant(), Some([512, 512])),
     ];
     for moments in PrefilteredVariant::MOMENTS {

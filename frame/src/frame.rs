@@ -79,10 +79,11 @@ pub struct FrameSettings {
     pub projective_max_half_angle_deg: f64,
     /// Where an epipolar frame's rectified rows lie. `None` (the default): on the epipolar
     /// sampling's slices for variants with `sampling = epipolar` (a sample on slice s reads
-    /// row s, whose light rays lie in its own plane; `FrameUniforms::fan_angles`), uniform in
-    /// the angle around the light axis otherwise. `Some(true)` aligns them for any variant
-    /// (a per-pixel run whose rows are a sampled run's: the sampling trials compare the two),
-    /// `Some(false)` never.
+    /// row s, whose light rays lie in its own plane; `FrameUniforms::fan_angles`; with k
+    /// times as many rows as slices, row k s + k / 2), uniform in the angle around the light
+    /// axis otherwise. `Some(true)` aligns them for any variant, to a fan of the variant's
+    /// `slices` (a per-pixel run whose rows are a sampled run's: the sampling trials compare
+    /// the two), `Some(false)` never.
     pub aligned_rows: Option<bool>,
 }
 
@@ -392,8 +393,13 @@ impl Setup {
     }
 
     /// The epipolar sampling's fan of `rows` slices towards the light direction `toward`
-    /// (`scatter::sampling::epipolar_layout` in f64: the same origin, axis, range and wrap).
-    fn fan(&self, toward: DVec3, rows: usize) -> Fan {
+    /// (`scatter::sampling::epipolar_layout` in f64: the same origin, axis, range and wrap),
+    /// for a sampling of `slices` slices: where `rows` is an even multiple k of `slices`,
+    /// every slice would lie on a boundary between two rows, half a row from the planes of
+    /// both, so the rows move half a row back, and row k s + k / 2 lies on slice s (with an
+    /// odd multiple row k s + (k - 1) / 2 already does). The last half row of the screen's
+    /// fan then reads the last row, half a row beyond its centre.
+    fn fan(&self, toward: DVec3, rows: usize, slices: usize) -> Fan {
         let (w, h) = (self.width, self.height);
         let centre = (0.5 * w, 0.5 * h);
         let t = self.cam.tan_half_fov_y;
@@ -430,11 +436,17 @@ impl Setup {
             let b = angles.into_iter().fold(f64::NEG_INFINITY, f64::max);
             (a, b - a)
         };
+        let step = range / rows as f64;
+        let even_multiple = slices > 0 && rows % slices == 0 && (rows / slices) % 2 == 0;
         Fan {
             origin,
             axis,
-            start,
-            step: range / rows as f64,
+            start: if even_multiple {
+                start - 0.5 * step
+            } else {
+                start
+            },
+            step,
             wrap,
         }
     }
@@ -707,8 +719,8 @@ fn prepare_frame_unchecked(
     let aligned = settings
         .aligned_rows
         .unwrap_or(variant.sampling == Sampling::Epipolar);
-    let fan =
-        (aligned && variant.rectification == Rectification::Epipolar).then(|| s.fan(axis, rows));
+    let fan = (aligned && variant.rectification == Rectification::Epipolar)
+        .then(|| s.fan(axis, rows, variant.slices as usize));
     let full_circle = fan.as_ref().map_or(full_circle, |f| f.wrap);
 
     // The largest gap between neighbouring slices on the screen border (where they are

@@ -795,8 +795,12 @@ pub fn prepare_partial_sum_tree(
     settings: &FrameSettings,
 ) -> Result<PartialSumTreeFrame, FrameError> {
     variant.validate()?;
+    // With the sampling knobs: the rows lie on the epipolar sampling's slices (row s of a
+    // map with as many rows as slices is slice s's plane, as for `minmax`).
     let frame = prepare_frame(
-        &variant.prefiltered(),
+        &variant
+            .prefiltered()
+            .with_sampling_knobs(variant.sampling_knobs()),
         res,
         camera,
         light,

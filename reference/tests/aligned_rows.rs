@@ -1,16 +1,18 @@
 //! Rows aligned with the epipolar sampling's slices (`FrameUniforms::fan_origin`,
 //! `fan_angles`; variants with `sampling = epipolar`): on the 24 suite poses and random ones,
-//! sun and spot, with as many rows as slices, every point of screen slice s that a pixel
-//! sees outside the epipole rings
+//! sun and spot, with as many rows as slices and with 2 and 3 times as many (k rows per
+//! slice), every point of screen slice s that a pixel sees outside the epipole rings
 //!
-//! - lies on row s's plane: its view ray's slice angle around the light axis is
-//!   `row_phi(s)` to 2e-3 of the angle between neighbouring rows (a quarter of it where the
+//! - lies on the plane of row r = k s + k / 2 (row s with as many rows as slices; with an
+//!   even k the frame moves the rows half a row so that a slice is not on a boundary between
+//!   two): its view ray's slice angle around the light axis is
+//!   `row_phi(r)` to 2e-3 of the angle between neighbouring rows (a quarter of it where the
 //!   layout clamps a near-infinite epipole, whose lines are only nearly epipolar; measured
 //!   up to 0.072 on window/grazing, against up to half a row for rows uniform around the
 //!   light axis), so `rectify` casts row s's light rays in the plane of the samples that
 //!   read it;
-//! - has the row coordinate s + 1/2 (`ray_row_coord`, to 2e-3 rows; wrapped when the
-//!   slices go around the origin), so `scatter` and `minmax_traverse` read row s alone;
+//! - has the row coordinate r + 1/2 (`ray_row_coord`, to 2e-3 rows; wrapped when the
+//!   slices go around the origin), so `scatter` and `minmax_traverse` read row r alone;
 //!
 //! and the frame's fan is the sampling's layout (`common_sampling::epipolar_layout`, which the
 //! samples pass computes on the GPU): the same origin, axis, range and wrap. The slices are
@@ -37,8 +39,10 @@ use scatter_shaderlib::prefiltered::{
 use scatter_shaderlib::sampling::SamplingKnobs;
 
 const SCREEN: [u32; 2] = [320, 180];
-/// Slices of the sampling, and rows of the map.
+/// Slices of the sampling.
 const SLICES: u32 = 64;
+/// Rows of the map per slice.
+const ROWS_PER_SLICE: [u32; 3] = [1, 2, 3];
 /// Random poses per suite scene (on top of the 24 suite poses).
 const RANDOM_PER_SCENE: u32 = 4;
 /// Points per slice.
@@ -53,8 +57,8 @@ const ROW_BAR: f32 = 2e-3;
 const CLAMPED_ROW_BAR: f32 = 0.25;
 
 /// The frame of `scene` for the prefiltered default with epipolar sampling of SLICES slices
-/// and as many rows.
-fn frame(scene: &Scene) -> FrameUniforms {
+/// and `k` rows per slice.
+fn frame(scene: &Scene, k: u32) -> FrameUniforms {
     let bvh = Bvh::build(&scene.geometry);
     let sm = ShadowMap::build(scene, &bvh, 64).expect("shadow map");
     let variant = PrefilteredVariant {
@@ -64,7 +68,7 @@ fn frame(scene: &Scene) -> FrameUniforms {
     .with_sampling_knobs(SamplingKnobs::epipolar(SLICES));
     let res = Resolutions {
         screen: SCREEN,
-        rectified: [256, SLICES],
+        rectified: [256, k * SLICES],
     };
     prepare_frame(
         &variant,
@@ -86,8 +90,9 @@ fn angle_diff(a: f32, b: f32) -> f32 {
 
 /// The worst deviations of one frame: (row angle, row coordinate, points checked), and its
 /// failures.
-fn check(name: &str, f: &FrameUniforms) -> (f32, f32, u32, Vec<String>) {
+fn check(name: &str, f: &FrameUniforms, k: u32) -> (f32, f32, u32, Vec<String>) {
     let mut failures = Vec::new();
+    let rows = k * SLICES;
     let layout = epipolar_layout(&EpipolarCamera::of_frame(f), SCREEN, SLICES);
     if f.fan_angles[2] <= 0.5 {
         failures.push(format!("{name}: rows not aligned"));
@@ -97,9 +102,12 @@ fn check(name: &str, f: &FrameUniforms) -> (f32, f32, u32, Vec<String>) {
     let scale = SCREEN[0].max(SCREEN[1]) as f32;
     let origin_off = (o[0] - layout.origin[0]).hypot(o[1] - layout.origin[1]);
     let axis_off = (f.fan_origin[2] - layout.axis[0]).hypot(f.fan_origin[3] - layout.axis[1]);
-    let range_off = (f.fan_angles[0] - layout.phi_start)
+    // The fan's rows: k per slice, half a row back for an even k.
+    let step = layout.dphi / k as f32;
+    let start = layout.phi_start - if k % 2 == 0 { 0.5 * step } else { 0.0 };
+    let range_off = (f.fan_angles[0] - start)
         .abs()
-        .max((f.fan_angles[1] - layout.dphi).abs() * SLICES as f32);
+        .max((f.fan_angles[1] - step).abs() * rows as f32);
     if origin_off > 1e-5 * scale.max(o[0].abs()).max(o[1].abs())
         || axis_off > 1e-5
         || range_off > 1e-4
@@ -118,6 +126,7 @@ fn check(name: &str, f: &FrameUniforms) -> (f32, f32, u32, Vec<String>) {
     let plane_bar = if clamped { CLAMPED_ROW_BAR } else { ROW_BAR };
     let (mut worst_phi, mut worst_row, mut points) = (0.0f32, 0.0f32, 0);
     for s in 0..SLICES {
+        let r = k * s + k / 2;
         let u = slice_direction(&layout, s);
         let span = slice_span(&layout, s, SCREEN, POINTS);
         for k in 0..POINTS {
@@ -130,13 +139,13 @@ fn check(name: &str, f: &FrameUniforms) -> (f32, f32, u32, Vec<String>) {
             let phi = dir.dot(xyz(f.e2)).atan2(dir.dot(xyz(f.e1)));
             // In rows: the angle between the point's plane and the row's, over the angle
             // between the row's plane and its neighbour's.
-            let next = if s + 1 < SLICES { s + 1 } else { s - 1 };
-            let spacing = angle_diff(row_phi(f, next), row_phi(f, s)).abs();
-            let dphi = angle_diff(phi, row_phi(f, s)).abs() / spacing;
+            let next = if r + 1 < rows { r + 1 } else { r - 1 };
+            let spacing = angle_diff(row_phi(f, next), row_phi(f, r)).abs();
+            let dphi = angle_diff(phi, row_phi(f, r)).abs() / spacing;
             let yc = ray_row_coord(f, dir);
-            let mut dy = (yc - (s as f32 + 0.5)).abs();
+            let mut dy = (yc - (r as f32 + 0.5)).abs();
             if f.anti_epipole[3] > 0.5 {
-                dy = dy.min(SLICES as f32 - dy);
+                dy = dy.min(rows as f32 - dy);
             }
             worst_phi = worst_phi.max(dphi);
             worst_row = worst_row.max(dy);
@@ -144,7 +153,7 @@ fn check(name: &str, f: &FrameUniforms) -> (f32, f32, u32, Vec<String>) {
             if dphi > plane_bar || dy > ROW_BAR {
                 failures.push(format!(
                     "{name}: slice {s} point {k} ({:.1}, {:.1}): plane off by {dphi:.2e} rows, \
-                     row coordinate {yc:.4} for row {s}",
+                     row coordinate {yc:.4} for row {r} of {rows}",
                     p[0], p[1]
                 ));
             }
@@ -175,14 +184,17 @@ fn sampled_rows_lie_on_their_slices() {
     let mut failures = Vec::new();
     let mut total = 0;
     for scene in &scenes {
-        let f = frame(scene);
-        let (phi, row, points, fails) = check(&scene.name, &f);
-        println!(
-            "{}: plane {phi:.2e} rows, row coordinate {row:.2e} rows ({points} points)",
-            scene.name
-        );
-        total += points;
-        failures.extend(fails);
+        for k in ROWS_PER_SLICE {
+            let f = frame(scene, k);
+            let (phi, row, points, fails) = check(&scene.name, &f, k);
+            println!(
+                "{} ({k} rows per slice): plane {phi:.2e} rows, row coordinate {row:.2e} rows \
+                 ({points} points)",
+                scene.name
+            );
+            total += points;
+            failures.extend(fails);
+        }
     }
     assert!(total > 0, "no point checked");
     assert!(

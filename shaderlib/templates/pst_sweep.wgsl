@@ -1,7 +1,8 @@
 // pst_sweep ({{ light_name }} light, rank {{ rank }}): the partial-sum-tree method of Baran et al.
 // 2010 on the epipolar samples (`sampling = epipolar`): workgroup s takes epipolar sample
 // slice s, whose samples are the queries of one sweep through a Fenwick tree over the
-// rectified row the slice lies in (the row of its last sample's pixel). Each query is a view
+// rectified row the slice lies in (the row of its last sample's pixel: row s where the map
+// has as many rows as there are slices, whose rows then lie on the slices). Each query is a view
 // ray of the row: normalised view angle d, whole columns 0 .. n - 1 (its last, partial column
 // n - 1 is added exactly, as `minmax_traverse` adds it), lit where d <= S_i. The column
 // weights are separable, `w_i(theta) ~ a(theta) sum_k leaf_k(i) beta_k(theta)` (the frame's
@@ -49,7 +50,7 @@
 // Mirrors reference/src/kernels/pst_sweep.rs
 
 #import scatter::model::{cone_falloff, phase_hg, transmittance_between}
-#import scatter::epipolar::{Frame, in_epipole_disc, edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta, row_index, axis_row_phi, slice_e, slice_params}
+#import scatter::epipolar::{Frame, in_epipole_disc, edge_t, epipole_march, lit_span, normalised_depth, ray_column, ray_row_coord, ray_theta, row_index, row_phi, slice_e, slice_params}
 {%- if cookie %}
 #import scatter::cookie::{epipole_march_cookie, frame_cookie, lit_span_cookie}
 {%- endif %}
@@ -112,7 +113,7 @@ fn pst_leaf(f: Frame, i: u32, row: u32, delta: f32, h: u32) -> vec4<f32> {
     if !{{ spot }} {
         return gamma_at(f32(i) * delta, h);
     }
-    let e = slice_e(f, axis_row_phi(f, row));
+    let e = slice_e(f, row_phi(f, row));
     let axis = f.axis.xyz;
     var leaf = vec4<f32>(0.0, 0.0, 0.0, 0.0);
     for (var g = 0u; g < 2u; g++) {
@@ -327,7 +328,8 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     // A sample's ray runs through its point on the slice's line (the unwarp places it
     // there), to the depth of the pixel under it: every sample of the slice then lies in
     // the slice's plane through the axis, in one rectified row (the nearest to the line's
-    // farthest sample). Through the pixel's centre instead, 0.5 pixel off the line, it fell
+    // farthest sample; with the rows on the slices, the slice's own plane where the map has
+    // as many rows as slices). Through the pixel's centre instead, 0.5 pixel off the line, it fell
     // in a neighbouring row for 75 % of the samples at 96x54 (512 rows), whose shadow it
     // read (up to 5 % rel L1 from the pixel body on `window`).
     let far_end = lines.origin + u * (span.x + f32(SLICE_SAMPLES - 1u) * span.y);

@@ -295,11 +295,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                 }
                 {
                     uint _e48 = q;
-                    float u_1 = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    float u_2 = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
                     float _e54 = sum;
                     uint _e56 = q;
-                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_9 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u_1 * u_1))));
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_9 * u_2)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u_2 * u_2))));
                 }
             }
         }
@@ -332,39 +332,105 @@ float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_
     return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
 }
 
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2) {
+    return vec2(float(f_2.sizes.x), float(f_2.sizes.y));
+}
+
+float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
+    float t_in = 0.0;
+    float t_out = 3.4e38;
+    uint a_3 = 0u;
+    bool loop_init_2 = true;
+    while(true) {
+        if (!loop_init_2) {
+            uint _e45 = a_3;
+            a_3 = (_e45 + 1u);
+        }
+        loop_init_2 = false;
+        uint _e4 = a_3;
+        if ((_e4 < 2u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = a_3;
+            uint _e13 = a_3;
+            float ta = ((0.5 - o_1[_e8]) / u[_e13]);
+            uint _e17 = a_3;
+            uint _e21 = a_3;
+            uint _e24 = a_3;
+            float tb = (((size[_e17] - 0.5) - o_1[_e21]) / u[_e24]);
+            uint _e27 = a_3;
+            bool crosses = (abs(u[_e27]) > 1e-12);
+            float _e33 = t_in;
+            float _e34 = t_in;
+            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
+            float _e39 = t_out;
+            float _e40 = t_out;
+            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
+        }
+    }
+    float _e47 = t_in;
+    float _e48 = t_out;
+    float _e49 = t_in;
+    return (0.5 * (_e47 + max(_e48, _e49)));
+}
+
+vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_4) {
+    vec2 ndc = vec2((((2.0 * p_4.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_4.y) / float(f_3.sizes.y))));
+    float t_4 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_4) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_4))));
+}
+
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
+    float a_10 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    vec2 ax = f_4.fan_origin.zw;
+    vec2 u_3 = vec2(((ax.x * cos(a_10)) - (ax.y * sin(a_10))), ((ax.y * cos(a_10)) + (ax.x * sin(a_10))));
+    vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_3, _e32);
+    vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_3 * _e33)));
+    return atan(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, uint row_2) {
+    float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return ((f_5.fan_angles.z > 0.5) ? _e3 : _e2);
+}
+
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo_1, float hi_1) {
     return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta - lo_1) / max((hi_1 - lo_1), 1e-6)), 0.0, 1.0)));
 }
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2) {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, uvec4(f_2.sizes2_.x, 0u, 0u, 0u));
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6) {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_6.sm_right, f_6.sm_up, f_6.sm_forward, f_6.sm_origin, f_6.sm_proj, uvec4(f_6.sizes2_.x, 0u, 0u, 0u));
 }
 
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, sampler2D sm_4, vec3 p_4, bool spot) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_4, spot);
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, sampler2D sm_4, vec3 p_5, bool spot) {
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
+    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_5, spot);
     return _e5;
 }
 
-float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, vec3 eye_3, vec3 dir_3, float t_1) {
-    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_4.light_pos.xyz, f_4.light_dir.xyz, f_4.light_pos.w, f_4.light_dir.w, f_4.medium);
+float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_3, vec3 dir_3, float t_1) {
+    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot_1) {
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_4, float b_3, uint steps, bool spot_1) {
     float sum_1 = 0.0;
     uint k_6 = 0u;
     float t_2 = 0.0;
     float w = 0.0;
-    float h_11 = ((b_3 - a_3) / float(steps));
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
-    bool loop_init_2 = true;
+    float h_11 = ((b_3 - a_4) / float(steps));
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
+    bool loop_init_3 = true;
     while(true) {
-        if (!loop_init_2) {
+        if (!loop_init_3) {
             uint _e65 = k_6;
             k_6 = (_e65 + 1u);
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e15 = k_6;
         if (((_e15 + 1u) <= steps)) {
         } else {
@@ -372,7 +438,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
         }
         {
             uint _e19 = k_6;
-            t_2 = (a_3 + ((float(_e19) + 0.5) * h_11));
+            t_2 = (a_4 + ((float(_e19) + 0.5) * h_11));
             w = h_11;
             if (spot_1) {
                 uint _e28 = k_6;
@@ -381,18 +447,18 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
                 w = _e32.y;
             }
             float _e35 = t_2;
-            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
+            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if (spot_1) {
                 float _e41 = sum_1;
                 float _e42 = w;
                 float _e44 = t_2;
-                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e44);
+                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_4, dir_4, _e44);
                 sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
                 float _e48 = sum_1;
                 uint _e51 = k_6;
                 uint _e55 = k_6;
-                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (float(_e51) * h_11)), (a_3 + (float((_e55 + 1u)) * h_11)));
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_4 + (float(_e51) * h_11)), (a_4 + (float((_e55 + 1u)) * h_11)));
                 sum_1 = (_e48 + (_e39 * _e61));
             }
         }
@@ -401,20 +467,20 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return _e67;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, sampler2D sm_6, vec3 eye_5, vec3 dir_5, float s, bool spot_2) {
-    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_2);
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, sampler2D sm_6, vec3 eye_5, vec3 dir_5, float s, bool spot_2) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, sm_6, eye_5, dir_5, 0.0, s, f_10.sizes2_.y, spot_2);
     if (spot_2) {
         return _e9;
     } else {
-        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
-        return ((f_6.medium.y * _e18) * _e9);
+        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, -(dot(f_10.light_dir.xyz, dir_5)));
+        return ((f_10.medium.y * _e18) * _e9);
     }
 }
 
-bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec2 pc) {
-    float radius = f_7.epipole.w;
-    bool near_epi = ((f_7.epipole.z > 0.5) && (length((pc - f_7.epipole.xy)) < radius));
-    bool near_anti = ((f_7.anti_epipole.z > 0.5) && (length((pc - f_7.anti_epipole.xy)) < radius));
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec2 pc) {
+    float radius = f_11.epipole.w;
+    bool near_epi = ((f_11.epipole.z > 0.5) && (length((pc - f_11.epipole.xy)) < radius));
+    bool near_anti = ((f_11.anti_epipole.z > 0.5) && (length((pc - f_11.anti_epipole.xy)) < radius));
     return (near_epi || near_anti);
 }
 
@@ -423,40 +489,36 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_9, uint rows
     return (wrap ? uint((((ji % int(rows)) + int(rows)) % int(rows))) : uint(min(max(ji, 0), (int(rows) - 1))));
 }
 
-float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_6) {
-    vec3 axis_1 = f_8.axis.xyz;
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 dir_6) {
+    vec3 axis_1 = f_12.axis.xyz;
     return atan(length(cross(dir_6, axis_1)), dot(dir_6, axis_1));
 }
 
-vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9) {
-    return vec2(float(f_9.sizes.x), float(f_9.sizes.y));
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 dir_7) {
+    uint rows_1 = f_13.sizes.w;
+    float phi_1 = atan(dot(dir_7, f_13.e2_.xyz), dot(dir_7, f_13.e1_.xyz));
+    float z_5 = dot(dir_7, f_13.cam_forward.xyz);
+    float t_5 = f_13.cam_forward.w;
+    vec2 ndc_1 = vec2((dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_5) * f_13.cam_right.w)), (dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_5)));
+    vec2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13);
+    vec2 p_7 = (vec2(((ndc_1.x + 1.0) * 0.5), ((1.0 - ndc_1.y) * 0.5)) * _e41);
+    vec2 d_2 = (p_7 - f_13.fan_origin.xy);
+    vec2 ax_1 = f_13.fan_origin.zw;
+    float fan = ((atan(((ax_1.x * d_2.y) - (ax_1.y * d_2.x)), ((ax_1.x * d_2.x) + (ax_1.y * d_2.y))) - f_13.fan_angles.x) / f_13.fan_angles.y);
+    float yc = ((f_13.fan_angles.z > 0.5) ? fan : ((phi_1 - f_13.e1_.w) / f_13.e2_.w));
+    return ((f_13.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 dir_7) {
-    uint rows_1 = f_10.sizes.w;
-    float phi_1 = atan(dot(dir_7, f_10.e2_.xyz), dot(dir_7, f_10.e1_.xyz));
-    float z_5 = dot(dir_7, f_10.cam_forward.xyz);
-    float t_4 = f_10.cam_forward.w;
-    vec2 ndc = vec2((dot(dir_7, f_10.cam_right.xyz) / ((z_5 * t_4) * f_10.cam_right.w)), (dot(dir_7, f_10.cam_up.xyz) / (z_5 * t_4)));
-    vec2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10);
-    vec2 p_6 = (vec2(((ndc.x + 1.0) * 0.5), ((1.0 - ndc.y) * 0.5)) * _e41);
-    vec2 d_2 = (p_6 - f_10.fan_origin.xy);
-    vec2 ax = f_10.fan_origin.zw;
-    float fan = ((atan(((ax.x * d_2.y) - (ax.y * d_2.x)), ((ax.x * d_2.x) + (ax.y * d_2.y))) - f_10.fan_angles.x) / f_10.fan_angles.y);
-    float yc = ((f_10.fan_angles.z > 0.5) ? fan : ((phi_1 - f_10.e1_.w) / f_10.e2_.w));
-    return ((f_10.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
-}
-
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
     if (spot_3) {
-        vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_11.light_pos.xyz);
-        vec3 to_eye = -(f_11.axis.xyz);
+        vec3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_14.light_pos.xyz);
+        vec3 to_eye = -(f_14.axis.xyz);
         return atan(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float x_2, float delta, float theta_2, float s_2, bool spot_4) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, float x_2, float delta, float theta_2, float s_2, bool spot_4) {
     bool local_9 = false;
     if (spot_4) {
         float psi = (x_2 * delta);
@@ -470,38 +532,38 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_12.axis.w * sin(psi)) / den), s_2);
+        return min(((f_15.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16, uint x_3, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
     if ((x_3 >= n_1)) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, float(x_3), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, float(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_14.light_pos.xyz, f_14.light_dir.xyz, f_14.light_pos.w, f_14.light_dir.w, f_14.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, vec3 eye_7, vec3 dir_9, float a_5, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, vec3 eye_8, vec3 dir_10, float a_6, float b_5, bool spot_6) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_8, dir_10, a_5, b_5, max((f_15.sizes2_.z / 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, max((f_18.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, a_5, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
     return _e15;
 }
 
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b_6, float depth_break) {
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_7, float b_6, float depth_break) {
     bool local_10 = false;
-    if (!((a_6 == b_6))) {
-        local_10 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
+    if (!((a_7 == b_6))) {
+        local_10 = (abs((a_7 - b_6)) <= (depth_break * min(a_7, b_6)));
     } else {
         local_10 = true;
     }
@@ -510,11 +572,11 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b
 }
 
 vec3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec3 v_10) {
-    vec3 a_9 = min(abs(v_10), vec3(65504.0));
-    uvec3 u_2 = floatBitsToUint(a_9);
-    vec3 normal = uintBitsToFloat((((u_2 + uvec3(4095u)) + ((u_2 >> uvec3(13u)) & uvec3(1u))) & uvec3(4294959104u)));
-    vec3 subnormal = (roundEven((a_9 * 16777216.0)) / vec3(16777216.0));
-    return (sign(v_10) * mix(normal, subnormal, lessThan(a_9, vec3(6.1035156e-5))));
+    vec3 a_11 = min(abs(v_10), vec3(65504.0));
+    uvec3 u_4 = floatBitsToUint(a_11);
+    vec3 normal = uintBitsToFloat((((u_4 + uvec3(4095u)) + ((u_4 >> uvec3(13u)) & uvec3(1u))) & uvec3(4294959104u)));
+    vec3 subnormal = (roundEven((a_11 * 16777216.0)) / vec3(16777216.0));
+    return (sign(v_10) * mix(normal, subnormal, lessThan(a_11, vec3(6.1035156e-5))));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec2 d) {
@@ -527,14 +589,14 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     bool local_11 = false;
     bool local_12 = false;
     bool local_13 = false;
-    float a_7 = 0.0;
+    float a_8 = 0.0;
     float b_7 = 0.0;
     uint k_7 = 0u;
-    vec2 size = vec2(screen);
-    vec2 centre = (0.5 * size);
+    vec2 size_1 = vec2(screen);
+    vec2 centre = (0.5 * size_1);
     float z_6 = dot(cam.toward, cam.forward);
     vec2 q_3 = vec2(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
-    float far_3 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size.x, size.y));
+    float far_3 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
     float lq = length(q_3);
     origin = centre;
     if ((lq >= (far_3 * abs(z_6)))) {
@@ -551,7 +613,7 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     float lc = length(to_centre);
     l_1.axis = ((lc > 0.0) ? (to_centre / vec2(max(lc, 1e-30))) : vec2(1.0, 0.0));
     vec2 lo_2 = vec2(0.5, 0.5);
-    vec2 hi_2 = (size - vec2(0.5, 0.5));
+    vec2 hi_2 = (size_1 - vec2(0.5, 0.5));
     float _e79 = origin.x;
     if ((_e79 >= lo_2.x)) {
         float _e83 = origin.x;
@@ -580,13 +642,13 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
         l_1.dphi = (6.2831855 / float(slices));
     } else {
         l_1.wrap = 0u;
-        bool loop_init_3 = true;
+        bool loop_init_4 = true;
         while(true) {
-            if (!loop_init_3) {
+            if (!loop_init_4) {
                 uint _e153 = k_7;
                 k_7 = (_e153 + 1u);
             }
-            loop_init_3 = false;
+            loop_init_4 = false;
             uint _e118 = k_7;
             if ((_e118 < 4u)) {
             } else {
@@ -601,20 +663,20 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
                 float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
                 uint _e143 = k_7;
                 if ((_e143 == 0u)) {
-                    a_7 = _e142;
+                    a_8 = _e142;
                     b_7 = _e142;
                 } else {
-                    float _e148 = a_7;
-                    a_7 = min(_e148, _e142);
+                    float _e148 = a_8;
+                    a_8 = min(_e148, _e142);
                     float _e150 = b_7;
                     b_7 = max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_7;
+        float _e156 = a_8;
         l_1.phi_start = _e156;
         float _e158 = b_7;
-        float _e159 = a_7;
+        float _e159 = a_8;
         l_1.dphi = ((_e158 - _e159) / float(slices));
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l_1;
@@ -629,64 +691,64 @@ vec2 slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayout
 }
 
 vec2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_3, uint s_5, uvec2 screen_1, uint samples) {
-    float t_in = 0.0;
-    float t_out = 3.4e38;
-    uint a_8 = 0u;
+    float t_in_1 = 0.0;
+    float t_out_1 = 3.4e38;
+    uint a_9 = 0u;
     vec2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     vec2 lo_3 = vec2(0.5, 0.5);
     vec2 hi_3 = (vec2(screen_1) - vec2(0.5, 0.5));
-    bool loop_init_4 = true;
+    bool loop_init_5 = true;
     while(true) {
-        if (!loop_init_4) {
-            uint _e51 = a_8;
-            a_8 = (_e51 + 1u);
+        if (!loop_init_5) {
+            uint _e51 = a_9;
+            a_9 = (_e51 + 1u);
         }
-        loop_init_4 = false;
-        uint _e16 = a_8;
+        loop_init_5 = false;
+        uint _e16 = a_9;
         if ((_e16 < 2u)) {
         } else {
             break;
         }
         {
-            uint _e19 = a_8;
+            uint _e19 = a_9;
             if ((abs(_e5[_e19]) > 1e-12)) {
-                uint _e24 = a_8;
-                uint _e27 = a_8;
-                uint _e30 = a_8;
-                float ta = ((lo_3[_e24] - l_3.origin[_e27]) / _e5[_e30]);
-                uint _e33 = a_8;
-                uint _e36 = a_8;
-                uint _e39 = a_8;
-                float tb = ((hi_3[_e33] - l_3.origin[_e36]) / _e5[_e39]);
-                float _e43 = t_in;
-                t_in = max(_e43, min(ta, tb));
-                float _e47 = t_out;
-                t_out = min(_e47, max(ta, tb));
+                uint _e24 = a_9;
+                uint _e27 = a_9;
+                uint _e30 = a_9;
+                float ta_1 = ((lo_3[_e24] - l_3.origin[_e27]) / _e5[_e30]);
+                uint _e33 = a_9;
+                uint _e36 = a_9;
+                uint _e39 = a_9;
+                float tb_1 = ((hi_3[_e33] - l_3.origin[_e36]) / _e5[_e39]);
+                float _e43 = t_in_1;
+                t_in_1 = max(_e43, min(ta_1, tb_1));
+                float _e47 = t_out_1;
+                t_out_1 = min(_e47, max(ta_1, tb_1));
             }
         }
     }
-    float _e53 = t_out;
-    float _e54 = t_in;
-    t_out = max(_e53, _e54);
-    float _e56 = t_in;
-    float _e57 = t_out;
-    float _e58 = t_in;
+    float _e53 = t_out_1;
+    float _e54 = t_in_1;
+    t_out_1 = max(_e53, _e54);
+    float _e56 = t_in_1;
+    float _e57 = t_out_1;
+    float _e58 = t_in_1;
     return vec2(_e56, ((_e57 - _e58) / float((samples - 1u))));
 }
 
-uvec2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_4, vec2 u, vec2 span, uint k_8, uvec2 screen_2) {
-    vec2 p_7 = (l_4.origin + (u * (span.x + (float(k_8) * span.y))));
+uvec2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_4, vec2 u_1, vec2 span, uint k_8, uvec2 screen_2) {
+    vec2 p_8 = (l_4.origin + (u_1 * (span.x + (float(k_8) * span.y))));
     vec2 last_1 = (vec2(screen_2) - vec2(1.0, 1.0));
-    return uvec2(clamp(floor(p_7), vec2(0.0, 0.0), last_1));
+    return uvec2(clamp(floor(p_8), vec2(0.0, 0.0), last_1));
 }
 
 vec4 factor_at(uint base, float x_4, uint h_4) {
-    float p_8 = min((clamp(x_4, 0.0, 1.0) * 95.0), 95.0);
-    uint j_10 = min(uint(floor(p_8)), 94u);
-    float t_5 = (p_8 - float(j_10));
+    float p_9 = min((clamp(x_4, 0.0, 1.0) * 95.0), 95.0);
+    uint j_10 = min(uint(floor(p_9)), 94u);
+    float t_6 = (p_9 - float(j_10));
     vec4 _e22 = _group_0_binding_5_cs[((base + (2u * j_10)) + h_4)];
     vec4 _e34 = _group_0_binding_5_cs[((base + (2u * (j_10 + 1u))) + h_4)];
-    return ((_e22 * (1.0 - t_5)) + (_e34 * t_5));
+    return ((_e22 * (1.0 - t_6)) + (_e34 * t_6));
 }
 
 vec4 gamma_at(float v_11, uint h_5) {
@@ -701,23 +763,23 @@ vec4 beta_at(float theta_4, uint h_6) {
     return _e14;
 }
 
-vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16, uint i_2, uint row_1, float delta_2, uint h_7) {
+vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint i_2, uint row_3, float delta_2, uint h_7) {
     vec4 leaf = vec4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
     if (false) {
         vec4 _e9 = gamma_at((float(i_2) * delta_2), h_7);
         return _e9;
     }
-    float _e12 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, row_1);
-    vec3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e12);
-    vec3 axis_2 = f_16.axis.xyz;
-    bool loop_init_5 = true;
+    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    vec3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
+    vec3 axis_2 = f_19.axis.xyz;
+    bool loop_init_6 = true;
     while(true) {
-        if (!loop_init_5) {
+        if (!loop_init_6) {
             uint _e56 = g_1;
             g_1 = (_e56 + 1u);
         }
-        loop_init_5 = false;
+        loop_init_6 = false;
         uint _e17 = g_1;
         if ((_e17 < 2u)) {
         } else {
@@ -728,7 +790,7 @@ vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16, uint i_2,
             float q_4 = ((_e20 == 0u) ? -0.57735026 : GL2_);
             float psi_1 = (((float(i_2) + 0.5) + (0.5 * q_4)) * delta_2);
             vec3 l_5 = ((-(axis_2) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_16.light_dir.xyz), f_16.light_pos.w, f_16.light_dir.w);
+            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
             vec4 _e48 = leaf;
             vec4 _e52 = gamma_at(psi_1, h_7);
             leaf = (_e48 + (((0.5 * delta_2) * _e46) * _e52));
@@ -740,30 +802,30 @@ vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16, uint i_2,
 
 PstRay pst_ray(vec2 pc_1, float z_1) {
     PstRay r_1 = PstRay(false, vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0u, 0.0, 0.0, 0.0);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = _group_0_binding_0_cs;
-    vec3 eye_9 = f_17.eye.xyz;
-    vec2 ndc_1 = vec2((((2.0 * pc_1.x) / float(f_17.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_17.sizes.y))));
-    float t_6 = f_17.cam_forward.w;
-    vec3 dir_12 = normalize(((f_17.cam_forward.xyz + (f_17.cam_right.xyz * ((ndc_1.x * t_6) * f_17.cam_right.w))) + (f_17.cam_up.xyz * (ndc_1.y * t_6))));
-    float s_6 = (min(max(z_1, 0.0), f_17.theta.z) / max(dot(dir_12, f_17.cam_forward.xyz), 1e-6));
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20 = _group_0_binding_0_cs;
+    vec3 eye_9 = f_20.eye.xyz;
+    vec2 ndc_2 = vec2((((2.0 * pc_1.x) / float(f_20.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_20.sizes.y))));
+    float t_7 = f_20.cam_forward.w;
+    vec3 dir_12 = normalize(((f_20.cam_forward.xyz + (f_20.cam_right.xyz * ((ndc_2.x * t_7) * f_20.cam_right.w))) + (f_20.cam_up.xyz * (ndc_2.y * t_7))));
+    float s_6 = (min(max(z_1, 0.0), f_20.theta.z) / max(dot(dir_12, f_20.cam_forward.xyz), 1e-6));
     r_1 = PstRay(false, vec3(0.0, 0.0, 0.0), eye_9, dir_12, s_6, 0u, 0.0, 0.0, 0.0);
-    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, pc_1);
+    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, pc_1);
     if (_e67) {
         r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e72 = _group_0_binding_0_cs;
         float _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, _group_0_binding_3_cs, eye_9, dir_12, s_6, true);
-        r_1.color = (_e75 * f_17.light_color.xyz);
+        r_1.color = (_e75 * f_20.light_color.xyz);
     }
-    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, dir_12);
+    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
     r_1.theta = _e80;
-    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, dir_12);
-    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_17.sizes.w, (f_17.anti_epipole.w > 0.5));
+    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
+    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_20.sizes.w, (f_20.anti_epipole.w > 0.5));
     r_1.row = _e90;
     float _e93 = r_1.theta;
-    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_17.theta.x, f_17.theta.y);
+    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_20.theta.x, f_20.theta.y);
     r_1.d = _e98;
     float _e101 = r_1.theta;
-    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, eye_9, dir_12, s_6, _e101, true);
+    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, eye_9, dir_12, s_6, _e101, true);
     r_1.xs_num = _e102;
     PstRay _e103 = r_1;
     return _e103;
@@ -775,24 +837,24 @@ uint pst_columns_crossed(PstRay r_2, float delta_3) {
     return uint(min(ceil(((xs > 0.0) ? xs : 0.0)), float(_e12)));
 }
 
-vec2 pst_terms(PstRay r_3, uint row_2, float delta_4, uint n_2) {
+vec2 pst_terms(PstRay r_3, uint row_4, float delta_4, uint n_2) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = _group_0_binding_0_cs;
     float sin_theta = max(sin(r_3.theta), 1e-6);
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-    vec4 _e16 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((n_2 - 1u), row_2)), ivec2(0), textureSize(_group_0_binding_4_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
+    vec4 _e16 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((n_2 - 1u), row_4)), ivec2(0), textureSize(_group_0_binding_4_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
     if ((r_3.d <= _e16.x)) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return vec2((f_18.medium.y / (f_18.axis.w * sin_theta)), _e37);
+        return vec2((f_21.medium.y / (f_21.axis.w * sin_theta)), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.z, -(dot(f_18.light_dir.xyz, r_3.dir)));
-    float sp = (f_18.medium.y * _e48);
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, 0.0, (delta_4 / sin_theta));
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.z, -(dot(f_21.light_dir.xyz, r_3.dir)));
+    float sp = (f_21.medium.y * _e48);
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.x, 0.0, (delta_4 / sin_theta));
     float _e56 = tail;
     return vec2((sp * _e54), (sp * _e56));
 }
@@ -800,9 +862,9 @@ vec2 pst_terms(PstRay r_3, uint row_2, float delta_4, uint n_2) {
 vec3 pst_sweep_pixel(uint x_5, uint y) {
     float sum_2 = 0.0;
     uint h_8 = 0u;
-    vec4 p_5 = vec4(0.0);
+    vec4 p_6 = vec4(0.0);
     uint i_3 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = _group_0_binding_0_cs;
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e16 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_5, y)), ivec2(0), textureSize(_group_0_binding_2_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
     PstRay _e18 = pst_ray(vec2((float(x_5) + 0.5), (float(y) + 0.5)), _e16.x);
@@ -816,28 +878,28 @@ vec3 pst_sweep_pixel(uint x_5, uint y) {
     if ((_e27 == 0u)) {
         return vec3(0.0, 0.0, 0.0);
     }
-    bool loop_init_6 = true;
+    bool loop_init_7 = true;
     while(true) {
-        if (!loop_init_6) {
+        if (!loop_init_7) {
             uint _e77 = h_8;
             h_8 = (_e77 + 1u);
         }
-        loop_init_6 = false;
+        loop_init_7 = false;
         uint _e35 = h_8;
         if ((_e35 < RANK_VECS)) {
         } else {
             break;
         }
         {
-            p_5 = vec4(0.0, 0.0, 0.0, 0.0);
+            p_6 = vec4(0.0, 0.0, 0.0, 0.0);
             i_3 = 0u;
-            bool loop_init_7 = true;
+            bool loop_init_8 = true;
             while(true) {
-                if (!loop_init_7) {
+                if (!loop_init_8) {
                     uint _e66 = i_3;
                     i_3 = (_e66 + 1u);
                 }
-                loop_init_7 = false;
+                loop_init_8 = false;
                 uint _e46 = i_3;
                 if (((_e46 + 1u) < _e27)) {
                 } else {
@@ -848,16 +910,16 @@ vec3 pst_sweep_pixel(uint x_5, uint y) {
                     int _e56_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
                     vec4 _e56 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e51, _e18.row)), ivec2(0), textureSize(_group_0_binding_4_cs, _e56_clamped_lod) - ivec2(1)), _e56_clamped_lod);
                     if ((_e18.d <= _e56.x)) {
-                        vec4 _e59 = p_5;
+                        vec4 _e59 = p_6;
                         uint _e60 = i_3;
                         uint _e62 = h_8;
-                        vec4 _e63 = pst_leaf(f_19, _e60, _e18.row, delta_5, _e62);
-                        p_5 = (_e59 + _e63);
+                        vec4 _e63 = pst_leaf(f_22, _e60, _e18.row, delta_5, _e62);
+                        p_6 = (_e59 + _e63);
                     }
                 }
             }
             float _e69 = sum_2;
-            vec4 _e70 = p_5;
+            vec4 _e70 = p_6;
             uint _e72 = h_8;
             vec4 _e73 = beta_at(_e18.theta, _e72);
             sum_2 = (_e69 + dot(_e70, _e73));
@@ -865,7 +927,7 @@ vec3 pst_sweep_pixel(uint x_5, uint y) {
     }
     vec2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     float _e84 = sum_2;
-    return (f_19.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
+    return (f_22.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
 }
 
 float pst_footprint_depth(vec2 pc_2, uvec2 screen_3) {
@@ -873,7 +935,7 @@ float pst_footprint_depth(vec2 pc_2, uvec2 screen_3) {
     vec2 q_5 = clamp((pc_2 - vec2(0.5, 0.5)), vec2(0.0, 0.0), last_2);
     uvec2 i0_ = uvec2(floor(q_5));
     uvec2 i1_ = min((i0_ + uvec2(1u, 1u)), (screen_3 - uvec2(1u, 1u)));
-    vec2 t_7 = (q_5 - floor(q_5));
+    vec2 t_8 = (q_5 - floor(q_5));
     int _e30_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e30 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(i0_), ivec2(0), textureSize(_group_0_binding_2_cs, _e30_clamped_lod) - ivec2(1)), _e30_clamped_lod);
     float z00_ = _e30.x;
@@ -895,9 +957,9 @@ float pst_footprint_depth(vec2 pc_2, uvec2 screen_3) {
     if ((lo_4 == hi_4)) {
         return lo_4;
     }
-    float w0_ = (((1.0 / z00_) * (1.0 - t_7.x)) + ((1.0 / z10_) * t_7.x));
-    float w1_ = (((1.0 / z01_) * (1.0 - t_7.x)) + ((1.0 / z11_) * t_7.x));
-    return (1.0 / ((w0_ * (1.0 - t_7.y)) + (w1_ * t_7.y)));
+    float w0_ = (((1.0 / z00_) * (1.0 - t_8.x)) + ((1.0 / z10_) * t_8.x));
+    float w1_ = (((1.0 / z01_) * (1.0 - t_8.x)) + ((1.0 / z11_) * t_8.x));
+    return (1.0 / ((w0_ * (1.0 - t_8.y)) + (w1_ * t_8.y)));
 }
 
 void main() {
@@ -964,9 +1026,9 @@ void main() {
     uint h_3 = 0u;
     vec4 p_1 = vec4(0.0);
     uint j_8 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20 = _group_0_binding_0_cs;
-    uvec2 screen_4 = uvec2(f_20.sizes.x, f_20.sizes.y);
-    uint width = f_20.sizes.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_23 = _group_0_binding_0_cs;
+    uvec2 screen_4 = uvec2(f_23.sizes.x, f_23.sizes.y);
+    uint width = f_23.sizes.z;
     vec4 _e13 = _group_0_binding_0_cs.cam_forward;
     vec4 _e17 = _group_0_binding_0_cs.cam_right;
     vec4 _e21 = _group_0_binding_0_cs.cam_up;
@@ -987,18 +1049,18 @@ void main() {
     }
     vec2 far_end = (_e37.origin + (_e40 * (_e42.x + (255.0 * _e42.y))));
     PstRay _e84 = pst_ray(far_end, 0.0);
-    uint row_3 = _e84.row;
-    vec4 _e88 = _group_0_binding_1_cs[row_3];
+    uint row_5 = _e84.row;
+    vec4 _e88 = _group_0_binding_1_cs[row_5];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
     float delta_6 = _e89.delta;
     k = li;
-    bool loop_init_8 = true;
+    bool loop_init_9 = true;
     while(true) {
-        if (!loop_init_8) {
+        if (!loop_init_9) {
             uint _e188 = k;
             k = (_e188 + SLICE_LANES);
         }
-        loop_init_8 = false;
+        loop_init_9 = false;
         uint _e92 = k;
         if ((_e92 < SLICE_SAMPLES)) {
         } else {
@@ -1039,7 +1101,7 @@ void main() {
                 imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e153, s_7)), vec4(_e152.x, _e152.y, _e152.z, z_7));
             } else {
                 PstRay _e160 = r;
-                vec2 _e161 = pst_terms(_e160, row_3, delta_6, _e136);
+                vec2 _e161 = pst_terms(_e160, row_5, delta_6, _e136);
                 uint _e163 = k;
                 q_b[_e163] = _e161.y;
                 uint _e167 = k;
@@ -1061,13 +1123,13 @@ void main() {
     uint v_12 = atomicOr(live, 0u);
     uint cw = (((width + TREES) - 1u) / TREES);
     if ((li < TREES)) {
-        bool loop_init_9 = true;
+        bool loop_init_10 = true;
         while(true) {
-            if (!loop_init_9) {
+            if (!loop_init_10) {
                 uint _e228 = k_1;
                 k_1 = (_e228 + 1u);
             }
-            loop_init_9 = false;
+            loop_init_10 = false;
             uint _e202 = k_1;
             if ((_e202 < SLICE_SAMPLES)) {
             } else {
@@ -1129,13 +1191,13 @@ void main() {
             uint _e266 = last;
             float _e268 = q_d[_e266];
             bool up = (_e264 <= _e268);
-            bool loop_init_10 = true;
+            bool loop_init_11 = true;
             while(true) {
-                if (!loop_init_10) {
+                if (!loop_init_11) {
                     uint _e341 = k_2;
                     k_2 = (_e341 + 1u);
                 }
-                loop_init_10 = false;
+                loop_init_11 = false;
                 uint _e271 = k_2;
                 if ((_e271 < SLICE_SAMPLES)) {
                 } else {
@@ -1189,13 +1251,13 @@ void main() {
                 }
             }
             if (!(up)) {
-                bool loop_init_11 = true;
+                bool loop_init_12 = true;
                 while(true) {
-                    if (!loop_init_11) {
+                    if (!loop_init_12) {
                         uint _e390 = j_1;
                         j_1 = (_e390 + 1u);
                     }
-                    loop_init_11 = false;
+                    loop_init_12 = false;
                     uint _e345 = j_1;
                     if ((_e345 < (v_12 / 2u))) {
                     } else {
@@ -1226,13 +1288,13 @@ void main() {
     memoryBarrierShared();
     barrier();
     if ((li < TREES)) {
-        bool loop_init_12 = true;
+        bool loop_init_13 = true;
         while(true) {
-            if (!loop_init_12) {
+            if (!loop_init_13) {
                 uint _e405 = c;
                 c = (_e405 + 1u);
             }
-            loop_init_12 = false;
+            loop_init_13 = false;
             uint _e395 = c;
             if ((_e395 < li)) {
             } else {
@@ -1245,13 +1307,13 @@ void main() {
                 start = (_e398 + _e402);
             }
         }
-        bool loop_init_13 = true;
+        bool loop_init_14 = true;
         while(true) {
-            if (!loop_init_13) {
+            if (!loop_init_14) {
                 uint _e481 = k_3;
                 k_3 = (_e481 + 1u);
             }
-            loop_init_13 = false;
+            loop_init_14 = false;
             uint _e408 = k_3;
             if ((_e408 < SLICE_SAMPLES)) {
             } else {
@@ -1311,13 +1373,13 @@ void main() {
         }
     }
     j_3 = li;
-    bool loop_init_14 = true;
+    bool loop_init_15 = true;
     while(true) {
-        if (!loop_init_14) {
+        if (!loop_init_15) {
             uint _e495 = j_3;
             j_3 = (_e495 + SLICE_LANES);
         }
-        loop_init_14 = false;
+        loop_init_15 = false;
         uint _e484 = j_3;
         if ((_e484 < v_12)) {
         } else {
@@ -1333,13 +1395,13 @@ void main() {
     memoryBarrierShared();
     barrier();
     j_4 = li;
-    bool loop_init_15 = true;
+    bool loop_init_16 = true;
     while(true) {
-        if (!loop_init_15) {
+        if (!loop_init_16) {
             uint _e509 = j_4;
             j_4 = (_e509 + SLICE_LANES);
         }
-        loop_init_15 = false;
+        loop_init_16 = false;
         uint _e499 = j_4;
         if ((_e499 < v_12)) {
         } else {
@@ -1356,13 +1418,13 @@ void main() {
     barrier();
     uint base_1 = (s_7 * width);
     i = li;
-    bool loop_init_16 = true;
+    bool loop_init_17 = true;
     while(true) {
-        if (!loop_init_16) {
+        if (!loop_init_17) {
             uint _e566 = i;
             i = (_e566 + SLICE_LANES);
         }
-        loop_init_16 = false;
+        loop_init_17 = false;
         uint _e514 = i;
         if ((_e514 < width)) {
         } else {
@@ -1371,7 +1433,7 @@ void main() {
         {
             uint _e516 = i;
             int _e520_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-            vec4 _e520 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e516, row_3)), ivec2(0), textureSize(_group_0_binding_4_cs, _e520_clamped_lod) - ivec2(1)), _e520_clamped_lod);
+            vec4 _e520 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e516, row_5)), ivec2(0), textureSize(_group_0_binding_4_cs, _e520_clamped_lod) - ivec2(1)), _e520_clamped_lod);
             float occluder = _e520.x;
             lo = 0u;
             hi = v_12;
@@ -1400,13 +1462,13 @@ void main() {
             uint _e544 = lo;
             if ((_e544 > 0u)) {
                 h = 0u;
-                bool loop_init_17 = true;
+                bool loop_init_18 = true;
                 while(true) {
-                    if (!loop_init_17) {
+                    if (!loop_init_18) {
                         uint _e564 = h;
                         h = (_e564 + 1u);
                     }
-                    loop_init_17 = false;
+                    loop_init_18 = false;
                     uint _e549 = h;
                     if ((_e549 < LEAF_VECS)) {
                     } else {
@@ -1417,7 +1479,7 @@ void main() {
                         uint _e557 = h;
                         uint _e560 = i;
                         uint _e561 = h;
-                        vec4 _e562 = pst_leaf(f_20, _e560, row_3, delta_6, _e561);
+                        vec4 _e562 = pst_leaf(f_23, _e560, row_5, delta_6, _e561);
                         _group_0_binding_6_cs[(((base_1 + _e552) * LEAF_VECS) + _e557)] = _e562;
                     }
                 }
@@ -1432,13 +1494,13 @@ void main() {
     uint partials = (trees + 4096u);
     if ((li < TREES)) {
         uint tree = (trees + ((li * SLICE_SAMPLES) * LEAF_VECS));
-        bool loop_init_18 = true;
+        bool loop_init_19 = true;
         while(true) {
-            if (!loop_init_18) {
+            if (!loop_init_19) {
                 uint _e599 = j_5;
                 j_5 = (_e599 + 1u);
             }
-            loop_init_18 = false;
+            loop_init_19 = false;
             uint _e585 = j_5;
             if ((_e585 < (v_12 * LEAF_VECS))) {
             } else {
@@ -1473,13 +1535,13 @@ void main() {
             }
         }
         i_1 = lo_5;
-        bool loop_init_19 = true;
+        bool loop_init_20 = true;
         while(true) {
-            if (!loop_init_19) {
+            if (!loop_init_20) {
                 uint _e772 = i_1;
                 i_1 = (_e772 + 1u);
             }
-            loop_init_19 = false;
+            loop_init_20 = false;
             uint _e629 = i_1;
             if ((_e629 <= hi_5)) {
             } else {
@@ -1521,13 +1583,13 @@ void main() {
                         uint _e666 = next;
                         next = (_e666 + 1u);
                         h_1 = 0u;
-                        bool loop_init_20 = true;
+                        bool loop_init_21 = true;
                         while(true) {
-                            if (!loop_init_20) {
+                            if (!loop_init_21) {
                                 uint _e717 = h_1;
                                 h_1 = (_e717 + 1u);
                             }
-                            loop_init_20 = false;
+                            loop_init_21 = false;
                             uint _e670 = h_1;
                             if ((_e670 < LEAF_VECS)) {
                             } else {
@@ -1570,13 +1632,13 @@ void main() {
                 uint b_8 = _group_0_binding_8_cs[(base_1 + _e722)];
                 if ((b_8 > 0u)) {
                     h_2 = 0u;
-                    bool loop_init_21 = true;
+                    bool loop_init_22 = true;
                     while(true) {
-                        if (!loop_init_21) {
+                        if (!loop_init_22) {
                             uint _e769 = h_2;
                             h_2 = (_e769 + 1u);
                         }
-                        loop_init_21 = false;
+                        loop_init_22 = false;
                         uint _e730 = h_2;
                         if ((_e730 < LEAF_VECS)) {
                         } else {
@@ -1615,13 +1677,13 @@ void main() {
     memoryBarrierShared();
     barrier();
     x = li;
-    bool loop_init_22 = true;
+    bool loop_init_23 = true;
     while(true) {
-        if (!loop_init_22) {
+        if (!loop_init_23) {
             uint _e809 = x;
             x = (_e809 + SLICE_LANES);
         }
-        loop_init_22 = false;
+        loop_init_23 = false;
         uint _e775 = x;
         if ((_e775 < (v_12 * LEAF_VECS))) {
         } else {
@@ -1630,13 +1692,13 @@ void main() {
         {
             running = vec4(0.0, 0.0, 0.0, 0.0);
             c_1 = 0u;
-            bool loop_init_23 = true;
+            bool loop_init_24 = true;
             while(true) {
-                if (!loop_init_23) {
+                if (!loop_init_24) {
                     uint _e807 = c_1;
                     c_1 = (_e807 + 1u);
                 }
-                loop_init_23 = false;
+                loop_init_24 = false;
                 uint _e787 = c_1;
                 if ((_e787 < TREES)) {
                 } else {
@@ -1660,13 +1722,13 @@ void main() {
     memoryBarrierShared();
     barrier();
     k_4 = li;
-    bool loop_init_24 = true;
+    bool loop_init_25 = true;
     while(true) {
-        if (!loop_init_24) {
+        if (!loop_init_25) {
             uint _e924 = k_4;
             k_4 = (_e924 + SLICE_LANES);
         }
-        loop_init_24 = false;
+        loop_init_25 = false;
         uint _e813 = k_4;
         if ((_e813 < SLICE_SAMPLES)) {
         } else {
@@ -1681,13 +1743,13 @@ void main() {
                 uint tree_1 = (trees + ((min((_e825 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0.0;
                 h_3 = 0u;
-                bool loop_init_25 = true;
+                bool loop_init_26 = true;
                 while(true) {
-                    if (!loop_init_25) {
+                    if (!loop_init_26) {
                         uint _e892 = h_3;
                         h_3 = (_e892 + 1u);
                     }
-                    loop_init_25 = false;
+                    loop_init_26 = false;
                     uint _e838 = h_3;
                     if ((_e838 < LEAF_VECS)) {
                     } else {
@@ -1733,7 +1795,7 @@ void main() {
                 float _e900 = dotp;
                 uint _e905 = k_4;
                 float _e907 = q_b[_e905];
-                vec3 _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_20.light_color.xyz * (max((_e899 * _e900), 0.0) + _e907)));
+                vec3 _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_23.light_color.xyz * (max((_e899 * _e900), 0.0) + _e907)));
                 uint _e911 = k_4;
                 uvec2 _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
                 int _e915_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);

@@ -352,11 +352,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e48 = q;
-                    float u_1 = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
+                    float u_2 = metal::tan(mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
                     float _e54 = sum;
                     uint _e56 = q;
-                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_9 * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u_1 * u_1)));
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_9 * u_2), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u_2 * u_2)));
                 }
             }
         }
@@ -407,6 +407,90 @@ float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
 }
 
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2
+) {
+    return metal::float2(static_cast<float>(f_2.sizes.x), static_cast<float>(f_2.sizes.y));
+}
+
+float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    metal::float2 o_1,
+    metal::float2 u,
+    metal::float2 size
+) {
+    float t_in = 0.0;
+    float t_out = 340000000000000000000000000000000000000.0;
+    uint a_3 = 0u;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e45 = a_3;
+            a_3 = _e45 + 1u;
+        }
+        loop_init_2 = false;
+        uint _e4 = a_3;
+        if (_e4 < 2u) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = a_3;
+            uint _e13 = a_3;
+            float ta = (0.5 - o_1[metal::min(unsigned(_e8), 1u)]) / u[metal::min(unsigned(_e13), 1u)];
+            uint _e17 = a_3;
+            uint _e21 = a_3;
+            uint _e24 = a_3;
+            float tb = ((size[metal::min(unsigned(_e17), 1u)] - 0.5) - o_1[metal::min(unsigned(_e21), 1u)]) / u[metal::min(unsigned(_e24), 1u)];
+            uint _e27 = a_3;
+            bool crosses = metal::abs(u[metal::min(unsigned(_e27), 1u)]) > 0.000000000001;
+            float _e33 = t_in;
+            float _e34 = t_in;
+            t_in = crosses ? metal::max(_e34, metal::min(ta, tb)) : _e33;
+            float _e39 = t_out;
+            float _e40 = t_out;
+            t_out = crosses ? metal::min(_e40, metal::max(ta, tb)) : _e39;
+        }
+    }
+    float _e47 = t_in;
+    float _e48 = t_out;
+    float _e49 = t_in;
+    return 0.5 * (_e47 + metal::max(_e48, _e49));
+}
+
+metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
+    metal::float2 p_4
+) {
+    metal::float2 ndc = metal::float2(((2.0 * p_4.x) / static_cast<float>(f_3.sizes.x)) - 1.0, 1.0 - ((2.0 * p_4.y) / static_cast<float>(f_3.sizes.y)));
+    float t_4 = f_3.cam_forward.w;
+    return metal::normalize((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_4) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_4)));
+}
+
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
+    uint row_1
+) {
+    float a_10 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
+    metal::float2 ax = f_4.fan_origin.zw;
+    metal::float2 u_3 = metal::float2((ax.x * metal::cos(a_10)) - (ax.y * metal::sin(a_10)), (ax.y * metal::cos(a_10)) + (ax.x * metal::sin(a_10)));
+    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_3, _e32);
+    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, f_4.fan_origin.xy + (u_3 * _e33));
+    return metal::atan2(metal::dot(_e36, f_4.e2_.xyz), metal::dot(_e36, f_4.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
+    uint row_2
+) {
+    float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return (f_5.fan_angles.z > 0.5) ? _e3 : _e2;
+}
+
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float theta,
     float lo_1,
@@ -416,38 +500,38 @@ float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6
 ) {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, metal::uint4(f_2.sizes2_.x, 0u, 0u, 0u)};
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f_6.sm_right, f_6.sm_up, f_6.sm_forward, f_6.sm_origin, f_6.sm_proj, metal::uint4(f_6.sizes2_.x, 0u, 0u, 0u)};
 }
 
 float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
     metal::texture2d<float, metal::access::sample> sm_4,
-    metal::float3 p_4,
+    metal::float3 p_5,
     bool spot
 ) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_4, spot);
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
+    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_5, spot);
     return _e5;
 }
 
 float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
     metal::float3 eye_3,
     metal::float3 dir_3,
     float t_1
 ) {
-    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_4.light_pos.xyz, f_4.light_dir.xyz, f_4.light_pos.w, f_4.light_dir.w, f_4.medium);
+    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e13;
 }
 
 float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     metal::texture2d<float, metal::access::sample> sm_5,
     metal::float3 eye_4,
     metal::float3 dir_4,
-    float a_3,
+    float a_4,
     float b_3,
     uint steps,
     bool spot_1
@@ -456,18 +540,18 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     uint k_6 = 0u;
     float t_2 = {};
     float w = {};
-    float h_11 = (b_3 - a_3) / static_cast<float>(steps);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
+    float h_11 = (b_3 - a_4) / static_cast<float>(steps);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e65 = k_6;
             k_6 = _e65 + 1u;
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e15 = k_6;
         if ((_e15 + 1u) <= steps) {
         } else {
@@ -475,7 +559,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         }
         {
             uint _e19 = k_6;
-            t_2 = a_3 + ((static_cast<float>(_e19) + 0.5) * h_11);
+            t_2 = a_4 + ((static_cast<float>(_e19) + 0.5) * h_11);
             w = h_11;
             if (spot_1) {
                 uint _e28 = k_6;
@@ -484,18 +568,18 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
                 w = _e32.y;
             }
             float _e35 = t_2;
-            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_4 + (dir_4 * _e35), spot_1);
+            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, sm_5, eye_4 + (dir_4 * _e35), spot_1);
             if (spot_1) {
                 float _e41 = sum_1;
                 float _e42 = w;
                 float _e44 = t_2;
-                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e44);
+                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_4, dir_4, _e44);
                 sum_1 = _e41 + ((_e39 * _e42) * _e45);
             } else {
                 float _e48 = sum_1;
                 uint _e51 = k_6;
                 uint _e55 = k_6;
-                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, a_3 + (static_cast<float>(_e51) * h_11), a_3 + (static_cast<float>(_e55 + 1u) * h_11));
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4 + (static_cast<float>(_e51) * h_11), a_4 + (static_cast<float>(_e55 + 1u) * h_11));
                 sum_1 = _e48 + (_e39 * _e61);
             }
         }
@@ -505,29 +589,29 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     metal::texture2d<float, metal::access::sample> sm_6,
     metal::float3 eye_5,
     metal::float3 dir_5,
     float s,
     bool spot_2
 ) {
-    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_2);
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, sm_6, eye_5, dir_5, 0.0, s, f_10.sizes2_.y, spot_2);
     if (spot_2) {
         return _e9;
     } else {
-        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(metal::dot(f_6.light_dir.xyz, dir_5)));
-        return (f_6.medium.y * _e18) * _e9;
+        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, -(metal::dot(f_10.light_dir.xyz, dir_5)));
+        return (f_10.medium.y * _e18) * _e9;
     }
 }
 
 bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     metal::float2 pc
 ) {
-    float radius = f_7.epipole.w;
-    bool near_epi = (f_7.epipole.z > 0.5) & (metal::length(pc - f_7.epipole.xy) < radius);
-    bool near_anti = (f_7.anti_epipole.z > 0.5) & (metal::length(pc - f_7.anti_epipole.xy) < radius);
+    float radius = f_11.epipole.w;
+    bool near_epi = (f_11.epipole.z > 0.5) & (metal::length(pc - f_11.epipole.xy) < radius);
+    bool near_anti = (f_11.anti_epipole.z > 0.5) & (metal::length(pc - f_11.anti_epipole.xy) < radius);
     return near_epi | near_anti;
 }
 
@@ -550,39 +634,33 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
     metal::float3 dir_6
 ) {
-    metal::float3 axis_1 = f_8.axis.xyz;
+    metal::float3 axis_1 = f_12.axis.xyz;
     return metal::atan2(metal::length(metal::cross(dir_6, axis_1)), metal::dot(dir_6, axis_1));
 }
 
-metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9
-) {
-    return metal::float2(static_cast<float>(f_9.sizes.x), static_cast<float>(f_9.sizes.y));
-}
-
 float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
     metal::float3 dir_7
 ) {
-    uint rows_1 = f_10.sizes.w;
-    float phi_1 = metal::atan2(metal::dot(dir_7, f_10.e2_.xyz), metal::dot(dir_7, f_10.e1_.xyz));
-    float z_5 = metal::dot(dir_7, f_10.cam_forward.xyz);
-    float t_4 = f_10.cam_forward.w;
-    metal::float2 ndc = metal::float2(metal::dot(dir_7, f_10.cam_right.xyz) / ((z_5 * t_4) * f_10.cam_right.w), metal::dot(dir_7, f_10.cam_up.xyz) / (z_5 * t_4));
-    metal::float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10);
-    metal::float2 p_6 = metal::float2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * _e41;
-    metal::float2 d_2 = p_6 - f_10.fan_origin.xy;
-    metal::float2 ax = f_10.fan_origin.zw;
-    float fan = (metal::atan2((ax.x * d_2.y) - (ax.y * d_2.x), (ax.x * d_2.x) + (ax.y * d_2.y)) - f_10.fan_angles.x) / f_10.fan_angles.y;
-    float yc = (f_10.fan_angles.z > 0.5) ? fan : ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
-    return (f_10.anti_epipole.w > 0.5) ? (yc - (metal::floor(yc / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc, 0.0, static_cast<float>(rows_1));
+    uint rows_1 = f_13.sizes.w;
+    float phi_1 = metal::atan2(metal::dot(dir_7, f_13.e2_.xyz), metal::dot(dir_7, f_13.e1_.xyz));
+    float z_5 = metal::dot(dir_7, f_13.cam_forward.xyz);
+    float t_5 = f_13.cam_forward.w;
+    metal::float2 ndc_1 = metal::float2(metal::dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_5) * f_13.cam_right.w), metal::dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_5));
+    metal::float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13);
+    metal::float2 p_7 = metal::float2((ndc_1.x + 1.0) * 0.5, (1.0 - ndc_1.y) * 0.5) * _e41;
+    metal::float2 d_2 = p_7 - f_13.fan_origin.xy;
+    metal::float2 ax_1 = f_13.fan_origin.zw;
+    float fan = (metal::atan2((ax_1.x * d_2.y) - (ax_1.y * d_2.x), (ax_1.x * d_2.x) + (ax_1.y * d_2.y)) - f_13.fan_angles.x) / f_13.fan_angles.y;
+    float yc = (f_13.fan_angles.z > 0.5) ? fan : ((phi_1 - f_13.e1_.w) / f_13.e2_.w);
+    return (f_13.anti_epipole.w > 0.5) ? (yc - (metal::floor(yc / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc, 0.0, static_cast<float>(rows_1));
 }
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14,
     metal::float3 eye_6,
     metal::float3 dir_8,
     float s_1,
@@ -590,15 +668,15 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_3
 ) {
     if (spot_3) {
-        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_11.light_pos.xyz;
-        metal::float3 to_eye = -(f_11.axis.xyz);
+        metal::float3 q_2 = (eye_6 + (dir_8 * s_1)) - f_14.light_pos.xyz;
+        metal::float3 to_eye = -(f_14.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_2, to_eye)), metal::dot(q_2, to_eye));
     }
     return s_1 * metal::sin(theta_1);
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15,
     float x_2,
     float delta,
     float theta_2,
@@ -618,14 +696,14 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (_e16) {
             return s_2;
         }
-        return metal::min((f_12.axis.w * metal::sin(psi)) / den, s_2);
+        return metal::min((f_15.axis.w * metal::sin(psi)) / den, s_2);
     } else {
         return metal::min((x_2 * delta) / metal::max(metal::sin(theta_2), 0.000001), s_2);
     }
 }
 
 float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16,
     uint x_3,
     uint n_1,
     float delta_1,
@@ -636,19 +714,19 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     if (x_3 >= n_1) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, static_cast<float>(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17,
     metal::float3 eye_7,
     metal::float3 dir_9,
-    float a_4,
+    float a_5,
     float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_14.light_pos.xyz, f_14.light_dir.xyz, f_14.light_pos.w, f_14.light_dir.w, f_14.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
@@ -657,29 +735,29 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18,
     metal::float3 eye_8,
     metal::float3 dir_10,
-    float a_5,
+    float a_6,
     float b_5,
     bool spot_6
 ) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_15.sizes2_.z, 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, metal::max(naga_div(f_18.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, a_5, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
     return _e15;
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_6,
+    float a_7,
     float b_6,
     float depth_break
 ) {
     bool local_10 = {};
-    if (!((a_6 == b_6))) {
-        local_10 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
+    if (!((a_7 == b_6))) {
+        local_10 = metal::abs(a_7 - b_6) <= (depth_break * metal::min(a_7, b_6));
     } else {
         local_10 = true;
     }
@@ -690,11 +768,11 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 metal::float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float3 v_10
 ) {
-    metal::float3 a_9 = metal::min(metal::abs(v_10), metal::float3(65504.0));
-    metal::uint3 u_2 = as_type<metal::uint3>(a_9);
-    metal::float3 normal = as_type<metal::float3>(((u_2 + metal::uint3(4095u)) + ((u_2 >> metal::uint3(13u)) & metal::uint3(1u))) & metal::uint3(4294959104u));
-    metal::float3 subnormal = metal::rint(a_9 * 16777216.0) / metal::float3(16777216.0);
-    return metal::sign(v_10) * metal::select(normal, subnormal, a_9 < metal::float3(0.000061035156));
+    metal::float3 a_11 = metal::min(metal::abs(v_10), metal::float3(65504.0));
+    metal::uint3 u_4 = as_type<metal::uint3>(a_11);
+    metal::float3 normal = as_type<metal::float3>(((u_4 + metal::uint3(4095u)) + ((u_4 >> metal::uint3(13u)) & metal::uint3(1u))) & metal::uint3(4294959104u));
+    metal::float3 subnormal = metal::rint(a_11 * 16777216.0) / metal::float3(16777216.0);
+    return metal::sign(v_10) * metal::select(normal, subnormal, a_11 < metal::float3(0.000061035156));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
@@ -714,14 +792,14 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     bool local_11 = {};
     bool local_12 = {};
     bool local_13 = {};
-    float a_7 = 0.0;
+    float a_8 = 0.0;
     float b_7 = 0.0;
     uint k_7 = 0u;
-    metal::float2 size = static_cast<metal::float2>(screen);
-    metal::float2 centre = 0.5 * size;
+    metal::float2 size_1 = static_cast<metal::float2>(screen);
+    metal::float2 centre = 0.5 * size_1;
     float z_6 = metal::dot(cam.toward, cam.forward);
     metal::float2 q_3 = metal::float2((metal::dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect), (-(metal::dot(cam.toward, cam.up)) * centre.y) / cam.tan_half);
-    float far_3 = EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * metal::max(size.x, size.y);
+    float far_3 = EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * metal::max(size_1.x, size_1.y);
     float lq = metal::length(q_3);
     origin = centre;
     if (lq >= (far_3 * metal::abs(z_6))) {
@@ -738,7 +816,7 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     float lc = metal::length(to_centre);
     l_1.axis = (lc > 0.0) ? (to_centre / metal::float2(metal::max(lc, 0.000000000000000000000000000001))) : metal::float2(1.0, 0.0);
     metal::float2 lo_2 = metal::float2(0.5, 0.5);
-    metal::float2 hi_2 = size - metal::float2(0.5, 0.5);
+    metal::float2 hi_2 = size_1 - metal::float2(0.5, 0.5);
     float _e79 = origin.x;
     if (_e79 >= lo_2.x) {
         float _e83 = origin.x;
@@ -767,16 +845,16 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
         l_1.dphi = 6.2831855 / static_cast<float>(slices);
     } else {
         l_1.wrap = 0u;
-        uint2 loop_bound_3 = uint2(4294967295u);
-        bool loop_init_3 = true;
+        uint2 loop_bound_4 = uint2(4294967295u);
+        bool loop_init_4 = true;
         while(true) {
-            if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-            loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-            if (!loop_init_3) {
+            if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+            loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+            if (!loop_init_4) {
                 uint _e153 = k_7;
                 k_7 = _e153 + 1u;
             }
-            loop_init_3 = false;
+            loop_init_4 = false;
             uint _e118 = k_7;
             if (_e118 < 4u) {
             } else {
@@ -791,20 +869,20 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
                 float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, corner - _e140);
                 uint _e143 = k_7;
                 if (_e143 == 0u) {
-                    a_7 = _e142;
+                    a_8 = _e142;
                     b_7 = _e142;
                 } else {
-                    float _e148 = a_7;
-                    a_7 = metal::min(_e148, _e142);
+                    float _e148 = a_8;
+                    a_8 = metal::min(_e148, _e142);
                     float _e150 = b_7;
                     b_7 = metal::max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_7;
+        float _e156 = a_8;
         l_1.phi_start = _e156;
         float _e158 = b_7;
-        float _e159 = a_7;
+        float _e159 = a_8;
         l_1.dphi = (_e158 - _e159) / static_cast<float>(slices);
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l_1;
@@ -827,51 +905,51 @@ metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::uint2 screen_1,
     uint samples
 ) {
-    float t_in = 0.0;
-    float t_out = 340000000000000000000000000000000000000.0;
-    uint a_8 = 0u;
+    float t_in_1 = 0.0;
+    float t_out_1 = 340000000000000000000000000000000000000.0;
+    uint a_9 = 0u;
     metal::float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     metal::float2 lo_3 = metal::float2(0.5, 0.5);
     metal::float2 hi_3 = static_cast<metal::float2>(screen_1) - metal::float2(0.5, 0.5);
-    uint2 loop_bound_4 = uint2(4294967295u);
-    bool loop_init_4 = true;
+    uint2 loop_bound_5 = uint2(4294967295u);
+    bool loop_init_5 = true;
     while(true) {
-        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
-            uint _e51 = a_8;
-            a_8 = _e51 + 1u;
+        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
+            uint _e51 = a_9;
+            a_9 = _e51 + 1u;
         }
-        loop_init_4 = false;
-        uint _e16 = a_8;
+        loop_init_5 = false;
+        uint _e16 = a_9;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            uint _e19 = a_8;
+            uint _e19 = a_9;
             if (metal::abs(_e5[metal::min(unsigned(_e19), 1u)]) > 0.000000000001) {
-                uint _e24 = a_8;
-                uint _e27 = a_8;
-                uint _e30 = a_8;
-                float ta = (lo_3[metal::min(unsigned(_e24), 1u)] - l_3.origin[metal::min(unsigned(_e27), 1u)]) / _e5[metal::min(unsigned(_e30), 1u)];
-                uint _e33 = a_8;
-                uint _e36 = a_8;
-                uint _e39 = a_8;
-                float tb = (hi_3[metal::min(unsigned(_e33), 1u)] - l_3.origin[metal::min(unsigned(_e36), 1u)]) / _e5[metal::min(unsigned(_e39), 1u)];
-                float _e43 = t_in;
-                t_in = metal::max(_e43, metal::min(ta, tb));
-                float _e47 = t_out;
-                t_out = metal::min(_e47, metal::max(ta, tb));
+                uint _e24 = a_9;
+                uint _e27 = a_9;
+                uint _e30 = a_9;
+                float ta_1 = (lo_3[metal::min(unsigned(_e24), 1u)] - l_3.origin[metal::min(unsigned(_e27), 1u)]) / _e5[metal::min(unsigned(_e30), 1u)];
+                uint _e33 = a_9;
+                uint _e36 = a_9;
+                uint _e39 = a_9;
+                float tb_1 = (hi_3[metal::min(unsigned(_e33), 1u)] - l_3.origin[metal::min(unsigned(_e36), 1u)]) / _e5[metal::min(unsigned(_e39), 1u)];
+                float _e43 = t_in_1;
+                t_in_1 = metal::max(_e43, metal::min(ta_1, tb_1));
+                float _e47 = t_out_1;
+                t_out_1 = metal::min(_e47, metal::max(ta_1, tb_1));
             }
         }
     }
-    float _e53 = t_out;
-    float _e54 = t_in;
-    t_out = metal::max(_e53, _e54);
-    float _e56 = t_in;
-    float _e57 = t_out;
-    float _e58 = t_in;
+    float _e53 = t_out_1;
+    float _e54 = t_in_1;
+    t_out_1 = metal::max(_e53, _e54);
+    float _e56 = t_in_1;
+    float _e57 = t_out_1;
+    float _e58 = t_in_1;
     return metal::float2(_e56, (_e57 - _e58) / static_cast<float>(samples - 1u));
 }
 
@@ -881,14 +959,14 @@ metal::uint2 naga_f2u32(metal::float2 value) {
 
 metal::uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_4,
-    metal::float2 u,
+    metal::float2 u_1,
     metal::float2 span,
     uint k_8,
     metal::uint2 screen_2
 ) {
-    metal::float2 p_7 = l_4.origin + (u * (span.x + (static_cast<float>(k_8) * span.y)));
+    metal::float2 p_8 = l_4.origin + (u_1 * (span.x + (static_cast<float>(k_8) * span.y)));
     metal::float2 last_1 = static_cast<metal::float2>(screen_2) - metal::float2(1.0, 1.0);
-    return naga_f2u32(metal::clamp(metal::floor(p_7), metal::float2(0.0, 0.0), last_1));
+    return naga_f2u32(metal::clamp(metal::floor(p_8), metal::float2(0.0, 0.0), last_1));
 }
 
 metal::float4 factor_at(
@@ -898,12 +976,12 @@ metal::float4 factor_at(
     device type_9 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    float p_8 = metal::min(metal::clamp(x_4, 0.0, 1.0) * 95.0, 95.0);
-    uint j_10 = metal::min(naga_f2u32(metal::floor(p_8)), 94u);
-    float t_5 = p_8 - static_cast<float>(j_10);
+    float p_9 = metal::min(metal::clamp(x_4, 0.0, 1.0) * 95.0, 95.0);
+    uint j_10 = metal::min(naga_f2u32(metal::floor(p_9)), 94u);
+    float t_6 = p_9 - static_cast<float>(j_10);
     metal::float4 _e22 = pst_factors[metal::min(unsigned((base + (2u * j_10)) + h_4), (_buffer_sizes.size5 - 0 - 16) / 16)];
     metal::float4 _e34 = pst_factors[metal::min(unsigned((base + (2u * (j_10 + 1u))) + h_4), (_buffer_sizes.size5 - 0 - 16) / 16)];
-    return (_e22 * (1.0 - t_5)) + (_e34 * t_5);
+    return (_e22 * (1.0 - t_6)) + (_e34 * t_6);
 }
 
 metal::float4 gamma_at(
@@ -929,9 +1007,9 @@ metal::float4 beta_at(
 }
 
 metal::float4 pst_leaf(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19,
     uint i_2,
-    uint row_1,
+    uint row_3,
     float delta_2,
     uint h_7,
     device type_9 const& pst_factors,
@@ -943,19 +1021,19 @@ metal::float4 pst_leaf(
         metal::float4 _e9 = gamma_at(static_cast<float>(i_2) * delta_2, h_7, pst_factors, _buffer_sizes);
         return _e9;
     }
-    float _e12 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, row_1);
-    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e12);
-    metal::float3 axis_2 = f_16.axis.xyz;
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
+    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
+    metal::float3 axis_2 = f_19.axis.xyz;
+    uint2 loop_bound_6 = uint2(4294967295u);
+    bool loop_init_6 = true;
     while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
+        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+        if (!loop_init_6) {
             uint _e56 = g_1;
             g_1 = _e56 + 1u;
         }
-        loop_init_5 = false;
+        loop_init_6 = false;
         uint _e17 = g_1;
         if (_e17 < 2u) {
         } else {
@@ -966,7 +1044,7 @@ metal::float4 pst_leaf(
             float q_4 = (_e20 == 0u) ? -0.57735026 : GL2_;
             float psi_1 = ((static_cast<float>(i_2) + 0.5) + (0.5 * q_4)) * delta_2;
             metal::float3 l_5 = (-(axis_2) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_5, f_16.light_dir.xyz), f_16.light_pos.w, f_16.light_dir.w);
+            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_5, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
             metal::float4 _e48 = leaf;
             metal::float4 _e52 = gamma_at(psi_1, h_7, pst_factors, _buffer_sizes);
             leaf = _e48 + (((0.5 * delta_2) * _e46) * _e52);
@@ -983,30 +1061,30 @@ PstRay pst_ray(
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     PstRay r_1 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
-    metal::float3 eye_9 = f_17.eye.xyz;
-    metal::float2 ndc_1 = metal::float2(((2.0 * pc_1.x) / static_cast<float>(f_17.sizes.x)) - 1.0, 1.0 - ((2.0 * pc_1.y) / static_cast<float>(f_17.sizes.y)));
-    float t_6 = f_17.cam_forward.w;
-    metal::float3 dir_12 = metal::normalize((f_17.cam_forward.xyz + (f_17.cam_right.xyz * ((ndc_1.x * t_6) * f_17.cam_right.w))) + (f_17.cam_up.xyz * (ndc_1.y * t_6)));
-    float s_6 = metal::min(metal::max(z_1, 0.0), f_17.theta.z) / metal::max(metal::dot(dir_12, f_17.cam_forward.xyz), 0.000001);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20 = frame;
+    metal::float3 eye_9 = f_20.eye.xyz;
+    metal::float2 ndc_2 = metal::float2(((2.0 * pc_1.x) / static_cast<float>(f_20.sizes.x)) - 1.0, 1.0 - ((2.0 * pc_1.y) / static_cast<float>(f_20.sizes.y)));
+    float t_7 = f_20.cam_forward.w;
+    metal::float3 dir_12 = metal::normalize((f_20.cam_forward.xyz + (f_20.cam_right.xyz * ((ndc_2.x * t_7) * f_20.cam_right.w))) + (f_20.cam_up.xyz * (ndc_2.y * t_7)));
+    float s_6 = metal::min(metal::max(z_1, 0.0), f_20.theta.z) / metal::max(metal::dot(dir_12, f_20.cam_forward.xyz), 0.000001);
     r_1 = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_9, dir_12, s_6, 0u, 0.0, 0.0, 0.0};
-    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, pc_1);
+    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, pc_1);
     if (_e67) {
         r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e72 = frame;
         float _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_6, true);
-        r_1.color = _e75 * f_17.light_color.xyz;
+        r_1.color = _e75 * f_20.light_color.xyz;
     }
-    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, dir_12);
+    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
     r_1.theta = _e80;
-    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, dir_12);
-    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e82), f_17.sizes.w, f_17.anti_epipole.w > 0.5);
+    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
+    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e82), f_20.sizes.w, f_20.anti_epipole.w > 0.5);
     r_1.row = _e90;
     float _e93 = r_1.theta;
-    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_17.theta.x, f_17.theta.y);
+    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_20.theta.x, f_20.theta.y);
     r_1.d = _e98;
     float _e101 = r_1.theta;
-    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, eye_9, dir_12, s_6, _e101, true);
+    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, eye_9, dir_12, s_6, _e101, true);
     r_1.xs_num = _e102;
     PstRay _e103 = r_1;
     return _e103;
@@ -1024,29 +1102,29 @@ uint pst_columns_crossed(
 
 metal::float2 pst_terms(
     PstRay r_3,
-    uint row_2,
+    uint row_4,
     float delta_4,
     uint n_2,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     metal::texture2d<float, metal::access::sample> rectified
 ) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = frame;
     float sin_theta = metal::max(metal::sin(r_3.theta), 0.000001);
     uint clamped_lod_e16 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-    metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_2)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
+    metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_4)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     if (r_3.d <= _e16.x) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, n_2 - 1u, n_2, delta_4, r_3.theta, r_3.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, n_2 - 1u, n_2, delta_4, r_3.theta, r_3.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return metal::float2(f_18.medium.y / (f_18.axis.w * sin_theta), _e37);
+        return metal::float2(f_21.medium.y / (f_21.axis.w * sin_theta), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.z, -(metal::dot(f_18.light_dir.xyz, r_3.dir)));
-    float sp = f_18.medium.y * _e48;
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, 0.0, delta_4 / sin_theta);
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.z, -(metal::dot(f_21.light_dir.xyz, r_3.dir)));
+    float sp = f_21.medium.y * _e48;
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.x, 0.0, delta_4 / sin_theta);
     float _e56 = tail;
     return metal::float2(sp * _e54, sp * _e56);
 }
@@ -1064,9 +1142,9 @@ metal::float3 pst_sweep_pixel(
 ) {
     float sum_2 = 0.0;
     uint h_8 = 0u;
-    metal::float4 p_5 = {};
+    metal::float4 p_6 = {};
     uint i_3 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = frame;
     uint clamped_lod_e16 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_5) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
@@ -1080,34 +1158,34 @@ metal::float3 pst_sweep_pixel(
     if (_e27 == 0u) {
         return metal::float3(0.0, 0.0, 0.0);
     }
-    uint2 loop_bound_6 = uint2(4294967295u);
-    bool loop_init_6 = true;
+    uint2 loop_bound_7 = uint2(4294967295u);
+    bool loop_init_7 = true;
     while(true) {
-        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-        if (!loop_init_6) {
+        if (metal::all(loop_bound_7 == uint2(0u))) { break; }
+        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+        if (!loop_init_7) {
             uint _e77 = h_8;
             h_8 = _e77 + 1u;
         }
-        loop_init_6 = false;
+        loop_init_7 = false;
         uint _e35 = h_8;
         if (_e35 < RANK_VECS) {
         } else {
             break;
         }
         {
-            p_5 = metal::float4(0.0, 0.0, 0.0, 0.0);
+            p_6 = metal::float4(0.0, 0.0, 0.0, 0.0);
             i_3 = 0u;
-            uint2 loop_bound_7 = uint2(4294967295u);
-            bool loop_init_7 = true;
+            uint2 loop_bound_8 = uint2(4294967295u);
+            bool loop_init_8 = true;
             while(true) {
-                if (metal::all(loop_bound_7 == uint2(0u))) { break; }
-                loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-                if (!loop_init_7) {
+                if (metal::all(loop_bound_8 == uint2(0u))) { break; }
+                loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
+                if (!loop_init_8) {
                     uint _e66 = i_3;
                     i_3 = _e66 + 1u;
                 }
-                loop_init_7 = false;
+                loop_init_8 = false;
                 uint _e46 = i_3;
                 if ((_e46 + 1u) < _e27) {
                 } else {
@@ -1118,16 +1196,16 @@ metal::float3 pst_sweep_pixel(
                     uint clamped_lod_e56 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
                     metal::float4 _e56 = rectified.read(metal::min(metal::uint2(metal::uint2(_e51, _e18.row)), metal::uint2(rectified.get_width(clamped_lod_e56), rectified.get_height(clamped_lod_e56)) - 1), clamped_lod_e56);
                     if (_e18.d <= _e56.x) {
-                        metal::float4 _e59 = p_5;
+                        metal::float4 _e59 = p_6;
                         uint _e60 = i_3;
                         uint _e62 = h_8;
-                        metal::float4 _e63 = pst_leaf(f_19, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
-                        p_5 = _e59 + _e63;
+                        metal::float4 _e63 = pst_leaf(f_22, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
+                        p_6 = _e59 + _e63;
                     }
                 }
             }
             float _e69 = sum_2;
-            metal::float4 _e70 = p_5;
+            metal::float4 _e70 = p_6;
             uint _e72 = h_8;
             metal::float4 _e73 = beta_at(_e18.theta, _e72, pst_factors, _buffer_sizes);
             sum_2 = _e69 + metal::dot(_e70, _e73);
@@ -1135,7 +1213,7 @@ metal::float3 pst_sweep_pixel(
     }
     metal::float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27, frame, rectified);
     float _e84 = sum_2;
-    return f_19.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
+    return f_22.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
 }
 
 float pst_footprint_depth(
@@ -1147,7 +1225,7 @@ float pst_footprint_depth(
     metal::float2 q_5 = metal::clamp(pc_2 - metal::float2(0.5, 0.5), metal::float2(0.0, 0.0), last_2);
     metal::uint2 i0_ = naga_f2u32(metal::floor(q_5));
     metal::uint2 i1_ = metal::min(i0_ + metal::uint2(1u, 1u), screen_3 - metal::uint2(1u, 1u));
-    metal::float2 t_7 = q_5 - metal::floor(q_5);
+    metal::float2 t_8 = q_5 - metal::floor(q_5);
     uint clamped_lod_e30 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e30 = depth.read(metal::min(metal::uint2(i0_), metal::uint2(depth.get_width(clamped_lod_e30), depth.get_height(clamped_lod_e30)) - 1), clamped_lod_e30);
     float z00_ = _e30.x;
@@ -1169,9 +1247,9 @@ float pst_footprint_depth(
     if (lo_4 == hi_4) {
         return lo_4;
     }
-    float w0_ = ((1.0 / z00_) * (1.0 - t_7.x)) + ((1.0 / z10_) * t_7.x);
-    float w1_ = ((1.0 / z01_) * (1.0 - t_7.x)) + ((1.0 / z11_) * t_7.x);
-    return 1.0 / ((w0_ * (1.0 - t_7.y)) + (w1_ * t_7.y));
+    float w0_ = ((1.0 / z00_) * (1.0 - t_8.x)) + ((1.0 / z10_) * t_8.x);
+    float w1_ = ((1.0 / z01_) * (1.0 - t_8.x)) + ((1.0 / z11_) * t_8.x);
+    return 1.0 / ((w0_ * (1.0 - t_8.y)) + (w1_ * t_8.y));
 }
 
 struct pst_sweepInput {
@@ -1261,9 +1339,9 @@ kernel void pst_sweep(
     uint h_3 = {};
     metal::float4 p_1 = {};
     uint j_8 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20 = frame;
-    metal::uint2 screen_4 = metal::uint2(f_20.sizes.x, f_20.sizes.y);
-    uint width = f_20.sizes.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_23 = frame;
+    metal::uint2 screen_4 = metal::uint2(f_23.sizes.x, f_23.sizes.y);
+    uint width = f_23.sizes.z;
     metal::float4 _e13 = frame.cam_forward;
     metal::float4 _e17 = frame.cam_right;
     metal::float4 _e21 = frame.cam_up;
@@ -1284,21 +1362,21 @@ kernel void pst_sweep(
     }
     metal::float2 far_end = _e37.origin + (_e40 * (_e42.x + (255.0 * _e42.y)));
     PstRay _e84 = pst_ray(far_end, 0.0, frame, shadow_map);
-    uint row_3 = _e84.row;
-    metal::float4 _e88 = slices_1[metal::min(unsigned(row_3), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    uint row_5 = _e84.row;
+    metal::float4 _e88 = slices_1[metal::min(unsigned(row_5), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
     float delta_6 = _e89.delta;
     k = li;
-    uint2 loop_bound_8 = uint2(4294967295u);
-    bool loop_init_8 = true;
+    uint2 loop_bound_9 = uint2(4294967295u);
+    bool loop_init_9 = true;
     while(true) {
-        if (metal::all(loop_bound_8 == uint2(0u))) { break; }
-        loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
-        if (!loop_init_8) {
+        if (metal::all(loop_bound_9 == uint2(0u))) { break; }
+        loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
+        if (!loop_init_9) {
             uint _e188 = k;
             k = _e188 + SLICE_LANES;
         }
-        loop_init_8 = false;
+        loop_init_9 = false;
         uint _e92 = k;
         if (_e92 < SLICE_SAMPLES) {
         } else {
@@ -1339,7 +1417,7 @@ kernel void pst_sweep(
                 output.write(metal::float4(_e152.x, _e152.y, _e152.z, z_7), metal::uint2(metal::uint2(_e153, s_7)));
             } else {
                 PstRay _e160 = r;
-                metal::float2 _e161 = pst_terms(_e160, row_3, delta_6, _e136, frame, rectified);
+                metal::float2 _e161 = pst_terms(_e160, row_5, delta_6, _e136, frame, rectified);
                 uint _e163 = k;
                 q_b.inner[metal::min(unsigned(_e163), 255u)] = _e161.y;
                 uint _e167 = k;
@@ -1360,16 +1438,16 @@ kernel void pst_sweep(
     uint v_12 = metal::atomic_load_explicit(&live, metal::memory_order_relaxed);
     uint cw = naga_div((width + TREES) - 1u, TREES);
     if (li < TREES) {
-        uint2 loop_bound_9 = uint2(4294967295u);
-        bool loop_init_9 = true;
+        uint2 loop_bound_10 = uint2(4294967295u);
+        bool loop_init_10 = true;
         while(true) {
-            if (metal::all(loop_bound_9 == uint2(0u))) { break; }
-            loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
-            if (!loop_init_9) {
+            if (metal::all(loop_bound_10 == uint2(0u))) { break; }
+            loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
+            if (!loop_init_10) {
                 uint _e228 = k_1;
                 k_1 = _e228 + 1u;
             }
-            loop_init_9 = false;
+            loop_init_10 = false;
             uint _e202 = k_1;
             if (_e202 < SLICE_SAMPLES) {
             } else {
@@ -1402,10 +1480,10 @@ kernel void pst_sweep(
         }
         bool _e240 = local_2;
         if (_e240) {
-            uint2 loop_bound_10 = uint2(4294967295u);
+            uint2 loop_bound_11 = uint2(4294967295u);
             while(true) {
-                if (metal::all(loop_bound_10 == uint2(0u))) { break; }
-                loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
+                if (metal::all(loop_bound_11 == uint2(0u))) { break; }
+                loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
                 uint _e243 = first;
                 uint _e245 = q_end.inner[metal::min(unsigned(_e243), 255u)];
                 if (_e245 == NONE) {
@@ -1417,10 +1495,10 @@ kernel void pst_sweep(
                     first = _e249 + 1u;
                 }
             }
-            uint2 loop_bound_11 = uint2(4294967295u);
+            uint2 loop_bound_12 = uint2(4294967295u);
             while(true) {
-                if (metal::all(loop_bound_11 == uint2(0u))) { break; }
-                loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
+                if (metal::all(loop_bound_12 == uint2(0u))) { break; }
+                loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
                 uint _e253 = last;
                 uint _e255 = q_end.inner[metal::min(unsigned(_e253), 255u)];
                 if (_e255 == NONE) {
@@ -1437,16 +1515,16 @@ kernel void pst_sweep(
             uint _e266 = last;
             float _e268 = q_d.inner[metal::min(unsigned(_e266), 255u)];
             bool up = _e264 <= _e268;
-            uint2 loop_bound_12 = uint2(4294967295u);
-            bool loop_init_10 = true;
+            uint2 loop_bound_13 = uint2(4294967295u);
+            bool loop_init_11 = true;
             while(true) {
-                if (metal::all(loop_bound_12 == uint2(0u))) { break; }
-                loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
-                if (!loop_init_10) {
+                if (metal::all(loop_bound_13 == uint2(0u))) { break; }
+                loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
+                if (!loop_init_11) {
                     uint _e341 = k_2;
                     k_2 = _e341 + 1u;
                 }
-                loop_init_10 = false;
+                loop_init_11 = false;
                 uint _e271 = k_2;
                 if (_e271 < SLICE_SAMPLES) {
                 } else {
@@ -1460,10 +1538,10 @@ kernel void pst_sweep(
                         float d_3 = q_d.inner[metal::min(unsigned(_e281), 255u)];
                         uint _e285 = m;
                         j = _e285;
-                        uint2 loop_bound_13 = uint2(4294967295u);
+                        uint2 loop_bound_14 = uint2(4294967295u);
                         while(true) {
-                            if (metal::all(loop_bound_13 == uint2(0u))) { break; }
-                            loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
+                            if (metal::all(loop_bound_14 == uint2(0u))) { break; }
+                            loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
                             uint _e287 = j;
                             if (_e287 > 0u) {
                                 uint _e290 = j;
@@ -1503,16 +1581,16 @@ kernel void pst_sweep(
                 }
             }
             if (!(up)) {
-                uint2 loop_bound_14 = uint2(4294967295u);
-                bool loop_init_11 = true;
+                uint2 loop_bound_15 = uint2(4294967295u);
+                bool loop_init_12 = true;
                 while(true) {
-                    if (metal::all(loop_bound_14 == uint2(0u))) { break; }
-                    loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
-                    if (!loop_init_11) {
+                    if (metal::all(loop_bound_15 == uint2(0u))) { break; }
+                    loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
+                    if (!loop_init_12) {
                         uint _e390 = j_1;
                         j_1 = _e390 + 1u;
                     }
-                    loop_init_11 = false;
+                    loop_init_12 = false;
                     uint _e345 = j_1;
                     if (_e345 < naga_div(v_12, 2u)) {
                     } else {
@@ -1542,16 +1620,16 @@ kernel void pst_sweep(
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     if (li < TREES) {
-        uint2 loop_bound_15 = uint2(4294967295u);
-        bool loop_init_12 = true;
+        uint2 loop_bound_16 = uint2(4294967295u);
+        bool loop_init_13 = true;
         while(true) {
-            if (metal::all(loop_bound_15 == uint2(0u))) { break; }
-            loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
-            if (!loop_init_12) {
+            if (metal::all(loop_bound_16 == uint2(0u))) { break; }
+            loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
+            if (!loop_init_13) {
                 uint _e405 = c;
                 c = _e405 + 1u;
             }
-            loop_init_12 = false;
+            loop_init_13 = false;
             uint _e395 = c;
             if (_e395 < li) {
             } else {
@@ -1564,16 +1642,16 @@ kernel void pst_sweep(
                 start = _e398 + _e402;
             }
         }
-        uint2 loop_bound_16 = uint2(4294967295u);
-        bool loop_init_13 = true;
+        uint2 loop_bound_17 = uint2(4294967295u);
+        bool loop_init_14 = true;
         while(true) {
-            if (metal::all(loop_bound_16 == uint2(0u))) { break; }
-            loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
-            if (!loop_init_13) {
+            if (metal::all(loop_bound_17 == uint2(0u))) { break; }
+            loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
+            if (!loop_init_14) {
                 uint _e481 = k_3;
                 k_3 = _e481 + 1u;
             }
-            loop_init_13 = false;
+            loop_init_14 = false;
             uint _e408 = k_3;
             if (_e408 < SLICE_SAMPLES) {
             } else {
@@ -1593,10 +1671,10 @@ kernel void pst_sweep(
                 if (_e428) {
                     uint _e430 = m_1;
                     j_2 = _e430;
-                    uint2 loop_bound_17 = uint2(4294967295u);
+                    uint2 loop_bound_18 = uint2(4294967295u);
                     while(true) {
-                        if (metal::all(loop_bound_17 == uint2(0u))) { break; }
-                        loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
+                        if (metal::all(loop_bound_18 == uint2(0u))) { break; }
+                        loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
                         uint _e432 = j_2;
                         if (_e432 > 0u) {
                             uint _e435 = start;
@@ -1636,16 +1714,16 @@ kernel void pst_sweep(
         }
     }
     j_3 = li;
-    uint2 loop_bound_18 = uint2(4294967295u);
-    bool loop_init_14 = true;
+    uint2 loop_bound_19 = uint2(4294967295u);
+    bool loop_init_15 = true;
     while(true) {
-        if (metal::all(loop_bound_18 == uint2(0u))) { break; }
-        loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
-        if (!loop_init_14) {
+        if (metal::all(loop_bound_19 == uint2(0u))) { break; }
+        loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
+        if (!loop_init_15) {
             uint _e495 = j_3;
             j_3 = _e495 + SLICE_LANES;
         }
-        loop_init_14 = false;
+        loop_init_15 = false;
         uint _e484 = j_3;
         if (_e484 < v_12) {
         } else {
@@ -1660,16 +1738,16 @@ kernel void pst_sweep(
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     j_4 = li;
-    uint2 loop_bound_19 = uint2(4294967295u);
-    bool loop_init_15 = true;
+    uint2 loop_bound_20 = uint2(4294967295u);
+    bool loop_init_16 = true;
     while(true) {
-        if (metal::all(loop_bound_19 == uint2(0u))) { break; }
-        loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
-        if (!loop_init_15) {
+        if (metal::all(loop_bound_20 == uint2(0u))) { break; }
+        loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
+        if (!loop_init_16) {
             uint _e509 = j_4;
             j_4 = _e509 + SLICE_LANES;
         }
-        loop_init_15 = false;
+        loop_init_16 = false;
         uint _e499 = j_4;
         if (_e499 < v_12) {
         } else {
@@ -1685,16 +1763,16 @@ kernel void pst_sweep(
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     uint base_1 = s_7 * width;
     i = li;
-    uint2 loop_bound_20 = uint2(4294967295u);
-    bool loop_init_16 = true;
+    uint2 loop_bound_21 = uint2(4294967295u);
+    bool loop_init_17 = true;
     while(true) {
-        if (metal::all(loop_bound_20 == uint2(0u))) { break; }
-        loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
-        if (!loop_init_16) {
+        if (metal::all(loop_bound_21 == uint2(0u))) { break; }
+        loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
+        if (!loop_init_17) {
             uint _e566 = i;
             i = _e566 + SLICE_LANES;
         }
-        loop_init_16 = false;
+        loop_init_17 = false;
         uint _e514 = i;
         if (_e514 < width) {
         } else {
@@ -1703,14 +1781,14 @@ kernel void pst_sweep(
         {
             uint _e516 = i;
             uint clamped_lod_e520 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e520 = rectified.read(metal::min(metal::uint2(metal::uint2(_e516, row_3)), metal::uint2(rectified.get_width(clamped_lod_e520), rectified.get_height(clamped_lod_e520)) - 1), clamped_lod_e520);
+            metal::float4 _e520 = rectified.read(metal::min(metal::uint2(metal::uint2(_e516, row_5)), metal::uint2(rectified.get_width(clamped_lod_e520), rectified.get_height(clamped_lod_e520)) - 1), clamped_lod_e520);
             float occluder = _e520.x;
             lo = 0u;
             hi = v_12;
-            uint2 loop_bound_21 = uint2(4294967295u);
+            uint2 loop_bound_22 = uint2(4294967295u);
             while(true) {
-                if (metal::all(loop_bound_21 == uint2(0u))) { break; }
-                loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
+                if (metal::all(loop_bound_22 == uint2(0u))) { break; }
+                loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
                 uint _e525 = lo;
                 uint _e526 = hi;
                 if (_e525 < _e526) {
@@ -1735,16 +1813,16 @@ kernel void pst_sweep(
             uint _e544 = lo;
             if (_e544 > 0u) {
                 h = 0u;
-                uint2 loop_bound_22 = uint2(4294967295u);
-                bool loop_init_17 = true;
+                uint2 loop_bound_23 = uint2(4294967295u);
+                bool loop_init_18 = true;
                 while(true) {
-                    if (metal::all(loop_bound_22 == uint2(0u))) { break; }
-                    loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
-                    if (!loop_init_17) {
+                    if (metal::all(loop_bound_23 == uint2(0u))) { break; }
+                    loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
+                    if (!loop_init_18) {
                         uint _e564 = h;
                         h = _e564 + 1u;
                     }
-                    loop_init_17 = false;
+                    loop_init_18 = false;
                     uint _e549 = h;
                     if (_e549 < LEAF_VECS) {
                     } else {
@@ -1755,7 +1833,7 @@ kernel void pst_sweep(
                         uint _e557 = h;
                         uint _e560 = i;
                         uint _e561 = h;
-                        metal::float4 _e562 = pst_leaf(f_20, _e560, row_3, delta_6, _e561, pst_factors, _buffer_sizes);
+                        metal::float4 _e562 = pst_leaf(f_23, _e560, row_5, delta_6, _e561, pst_factors, _buffer_sizes);
                         pst_leaves[metal::min(unsigned(((base_1 + _e552) * LEAF_VECS) + _e557), (_buffer_sizes.size6 - 0 - 16) / 16)] = _e562;
                     }
                 }
@@ -1768,16 +1846,16 @@ kernel void pst_sweep(
     uint partials = trees + 4096u;
     if (li < TREES) {
         uint tree = trees + ((li * SLICE_SAMPLES) * LEAF_VECS);
-        uint2 loop_bound_23 = uint2(4294967295u);
-        bool loop_init_18 = true;
+        uint2 loop_bound_24 = uint2(4294967295u);
+        bool loop_init_19 = true;
         while(true) {
-            if (metal::all(loop_bound_23 == uint2(0u))) { break; }
-            loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
-            if (!loop_init_18) {
+            if (metal::all(loop_bound_24 == uint2(0u))) { break; }
+            loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
+            if (!loop_init_19) {
                 uint _e599 = j_5;
                 j_5 = _e599 + 1u;
             }
-            loop_init_18 = false;
+            loop_init_19 = false;
             uint _e585 = j_5;
             if (_e585 < (v_12 * LEAF_VECS)) {
             } else {
@@ -1791,10 +1869,10 @@ kernel void pst_sweep(
         uint lo_5 = li * cw;
         uint hi_5 = ((li + 1u) == TREES) ? width : metal::min(lo_5 + cw, width);
         top = v_12;
-        uint2 loop_bound_24 = uint2(4294967295u);
+        uint2 loop_bound_25 = uint2(4294967295u);
         while(true) {
-            if (metal::all(loop_bound_24 == uint2(0u))) { break; }
-            loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
+            if (metal::all(loop_bound_25 == uint2(0u))) { break; }
+            loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
             uint _e611 = next;
             uint _e612 = top;
             if (_e611 < _e612) {
@@ -1815,26 +1893,26 @@ kernel void pst_sweep(
             }
         }
         i_1 = lo_5;
-        uint2 loop_bound_25 = uint2(4294967295u);
-        bool loop_init_19 = true;
+        uint2 loop_bound_26 = uint2(4294967295u);
+        bool loop_init_20 = true;
         while(true) {
-            if (metal::all(loop_bound_25 == uint2(0u))) { break; }
-            loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
-            if (!loop_init_19) {
+            if (metal::all(loop_bound_26 == uint2(0u))) { break; }
+            loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
+            if (!loop_init_20) {
                 uint _e772 = i_1;
                 i_1 = _e772 + 1u;
             }
-            loop_init_19 = false;
+            loop_init_20 = false;
             uint _e629 = i_1;
             if (_e629 <= hi_5) {
             } else {
                 break;
             }
             {
-                uint2 loop_bound_26 = uint2(4294967295u);
+                uint2 loop_bound_27 = uint2(4294967295u);
                 while(true) {
-                    if (metal::all(loop_bound_26 == uint2(0u))) { break; }
-                    loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
+                    if (metal::all(loop_bound_27 == uint2(0u))) { break; }
+                    loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
                     uint _e631 = next;
                     if (_e631 < v_12) {
                         uint _e635 = next;
@@ -1869,16 +1947,16 @@ kernel void pst_sweep(
                         uint _e666 = next;
                         next = _e666 + 1u;
                         h_1 = 0u;
-                        uint2 loop_bound_27 = uint2(4294967295u);
-                        bool loop_init_20 = true;
+                        uint2 loop_bound_28 = uint2(4294967295u);
+                        bool loop_init_21 = true;
                         while(true) {
-                            if (metal::all(loop_bound_27 == uint2(0u))) { break; }
-                            loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
-                            if (!loop_init_20) {
+                            if (metal::all(loop_bound_28 == uint2(0u))) { break; }
+                            loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
+                            if (!loop_init_21) {
                                 uint _e717 = h_1;
                                 h_1 = _e717 + 1u;
                             }
-                            loop_init_20 = false;
+                            loop_init_21 = false;
                             uint _e670 = h_1;
                             if (_e670 < LEAF_VECS) {
                             } else {
@@ -1888,10 +1966,10 @@ kernel void pst_sweep(
                                 p = metal::float4(0.0, 0.0, 0.0, 0.0);
                                 uint _e681 = q_rank.inner[metal::min(unsigned(k_10), 255u)];
                                 j_6 = v_12 - _e681;
-                                uint2 loop_bound_28 = uint2(4294967295u);
+                                uint2 loop_bound_29 = uint2(4294967295u);
                                 while(true) {
-                                    if (metal::all(loop_bound_28 == uint2(0u))) { break; }
-                                    loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
+                                    if (metal::all(loop_bound_29 == uint2(0u))) { break; }
+                                    loop_bound_29 -= uint2(loop_bound_29.y == 0u, 1u);
                                     uint _e684 = j_6;
                                     if (_e684 > 0u) {
                                     } else {
@@ -1924,16 +2002,16 @@ kernel void pst_sweep(
                 uint b_8 = pst_columns[metal::min(unsigned(base_1 + _e722), (_buffer_sizes.size8 - 0 - 4) / 4)];
                 if (b_8 > 0u) {
                     h_2 = 0u;
-                    uint2 loop_bound_29 = uint2(4294967295u);
-                    bool loop_init_21 = true;
+                    uint2 loop_bound_30 = uint2(4294967295u);
+                    bool loop_init_22 = true;
                     while(true) {
-                        if (metal::all(loop_bound_29 == uint2(0u))) { break; }
-                        loop_bound_29 -= uint2(loop_bound_29.y == 0u, 1u);
-                        if (!loop_init_21) {
+                        if (metal::all(loop_bound_30 == uint2(0u))) { break; }
+                        loop_bound_30 -= uint2(loop_bound_30.y == 0u, 1u);
+                        if (!loop_init_22) {
                             uint _e769 = h_2;
                             h_2 = _e769 + 1u;
                         }
-                        loop_init_21 = false;
+                        loop_init_22 = false;
                         uint _e730 = h_2;
                         if (_e730 < LEAF_VECS) {
                         } else {
@@ -1944,10 +2022,10 @@ kernel void pst_sweep(
                             uint _e738 = h_2;
                             metal::float4 leaf_1 = pst_leaves[metal::min(unsigned(((base_1 + _e733) * LEAF_VECS) + _e738), (_buffer_sizes.size6 - 0 - 16) / 16)];
                             j_7 = (v_12 - b_8) + 1u;
-                            uint2 loop_bound_30 = uint2(4294967295u);
+                            uint2 loop_bound_31 = uint2(4294967295u);
                             while(true) {
-                                if (metal::all(loop_bound_30 == uint2(0u))) { break; }
-                                loop_bound_30 -= uint2(loop_bound_30.y == 0u, 1u);
+                                if (metal::all(loop_bound_31 == uint2(0u))) { break; }
+                                loop_bound_31 -= uint2(loop_bound_31.y == 0u, 1u);
                                 uint _e746 = j_7;
                                 if (_e746 <= v_12) {
                                 } else {
@@ -1973,16 +2051,16 @@ kernel void pst_sweep(
     metal::threadgroup_barrier(metal::mem_flags::mem_device);
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     x = li;
-    uint2 loop_bound_31 = uint2(4294967295u);
-    bool loop_init_22 = true;
+    uint2 loop_bound_32 = uint2(4294967295u);
+    bool loop_init_23 = true;
     while(true) {
-        if (metal::all(loop_bound_31 == uint2(0u))) { break; }
-        loop_bound_31 -= uint2(loop_bound_31.y == 0u, 1u);
-        if (!loop_init_22) {
+        if (metal::all(loop_bound_32 == uint2(0u))) { break; }
+        loop_bound_32 -= uint2(loop_bound_32.y == 0u, 1u);
+        if (!loop_init_23) {
             uint _e809 = x;
             x = _e809 + SLICE_LANES;
         }
-        loop_init_22 = false;
+        loop_init_23 = false;
         uint _e775 = x;
         if (_e775 < (v_12 * LEAF_VECS)) {
         } else {
@@ -1991,16 +2069,16 @@ kernel void pst_sweep(
         {
             running = metal::float4(0.0, 0.0, 0.0, 0.0);
             c_1 = 0u;
-            uint2 loop_bound_32 = uint2(4294967295u);
-            bool loop_init_23 = true;
+            uint2 loop_bound_33 = uint2(4294967295u);
+            bool loop_init_24 = true;
             while(true) {
-                if (metal::all(loop_bound_32 == uint2(0u))) { break; }
-                loop_bound_32 -= uint2(loop_bound_32.y == 0u, 1u);
-                if (!loop_init_23) {
+                if (metal::all(loop_bound_33 == uint2(0u))) { break; }
+                loop_bound_33 -= uint2(loop_bound_33.y == 0u, 1u);
+                if (!loop_init_24) {
                     uint _e807 = c_1;
                     c_1 = _e807 + 1u;
                 }
-                loop_init_23 = false;
+                loop_init_24 = false;
                 uint _e787 = c_1;
                 if (_e787 < TREES) {
                 } else {
@@ -2022,16 +2100,16 @@ kernel void pst_sweep(
     metal::threadgroup_barrier(metal::mem_flags::mem_device);
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     k_4 = li;
-    uint2 loop_bound_33 = uint2(4294967295u);
-    bool loop_init_24 = true;
+    uint2 loop_bound_34 = uint2(4294967295u);
+    bool loop_init_25 = true;
     while(true) {
-        if (metal::all(loop_bound_33 == uint2(0u))) { break; }
-        loop_bound_33 -= uint2(loop_bound_33.y == 0u, 1u);
-        if (!loop_init_24) {
+        if (metal::all(loop_bound_34 == uint2(0u))) { break; }
+        loop_bound_34 -= uint2(loop_bound_34.y == 0u, 1u);
+        if (!loop_init_25) {
             uint _e924 = k_4;
             k_4 = _e924 + SLICE_LANES;
         }
-        loop_init_24 = false;
+        loop_init_25 = false;
         uint _e813 = k_4;
         if (_e813 < SLICE_SAMPLES) {
         } else {
@@ -2046,16 +2124,16 @@ kernel void pst_sweep(
                 uint tree_1 = trees + ((metal::min(naga_div(_e825, cw), 7u) * SLICE_SAMPLES) * LEAF_VECS);
                 dotp = 0.0;
                 h_3 = 0u;
-                uint2 loop_bound_34 = uint2(4294967295u);
-                bool loop_init_25 = true;
+                uint2 loop_bound_35 = uint2(4294967295u);
+                bool loop_init_26 = true;
                 while(true) {
-                    if (metal::all(loop_bound_34 == uint2(0u))) { break; }
-                    loop_bound_34 -= uint2(loop_bound_34.y == 0u, 1u);
-                    if (!loop_init_25) {
+                    if (metal::all(loop_bound_35 == uint2(0u))) { break; }
+                    loop_bound_35 -= uint2(loop_bound_35.y == 0u, 1u);
+                    if (!loop_init_26) {
                         uint _e892 = h_3;
                         h_3 = _e892 + 1u;
                     }
-                    loop_init_25 = false;
+                    loop_init_26 = false;
                     uint _e838 = h_3;
                     if (_e838 < LEAF_VECS) {
                     } else {
@@ -2069,10 +2147,10 @@ kernel void pst_sweep(
                         uint _e852 = k_4;
                         uint _e854 = q_rank.inner[metal::min(unsigned(_e852), 255u)];
                         j_8 = v_12 - _e854;
-                        uint2 loop_bound_35 = uint2(4294967295u);
+                        uint2 loop_bound_36 = uint2(4294967295u);
                         while(true) {
-                            if (metal::all(loop_bound_35 == uint2(0u))) { break; }
-                            loop_bound_35 -= uint2(loop_bound_35.y == 0u, 1u);
+                            if (metal::all(loop_bound_36 == uint2(0u))) { break; }
+                            loop_bound_36 -= uint2(loop_bound_36.y == 0u, 1u);
                             uint _e857 = j_8;
                             if (_e857 > 0u) {
                             } else {
@@ -2104,7 +2182,7 @@ kernel void pst_sweep(
                 float _e900 = dotp;
                 uint _e905 = k_4;
                 float _e907 = q_b.inner[metal::min(unsigned(_e905), 255u)];
-                metal::float3 _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(f_20.light_color.xyz * (metal::max(_e899 * _e900, 0.0) + _e907));
+                metal::float3 _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(f_23.light_color.xyz * (metal::max(_e899 * _e900, 0.0) + _e907));
                 uint _e911 = k_4;
                 metal::uint2 _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
                 uint clamped_lod_e915 = metal::min(uint(0), depth.get_num_mip_levels() - 1);

@@ -276,11 +276,11 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
                 }
                 {
                     let _e48 = q;
-                    let u_1 = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    let u_2 = tan((mid + ((0.5f * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
                     let _e54 = sum;
                     let _e56 = q;
-                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_9 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u_1 * u_1))));
+                    let _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_9 * u_2)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1f + (u_2 * u_2))));
                 }
                 continuing {
                     let _e72 = q;
@@ -321,33 +321,98 @@ fn axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_1: FrameX_naga_oi
     return (f_1.e1_.w + ((f32(row) + 0.5f) * f_1.e2_.w));
 }
 
+fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
+    return vec2<f32>(f32(f_2.sizes.x), f32(f_2.sizes.y));
+}
+
+fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
+    var t_in: f32 = 0f;
+    var t_out: f32 = 340000000000000000000000000000000000000f;
+    var a_3: u32 = 0u;
+
+    loop {
+        let _e4 = a_3;
+        if (_e4 < 2u) {
+        } else {
+            break;
+        }
+        {
+            let _e8 = a_3;
+            let _e13 = a_3;
+            let ta = ((0.5f - o_1[_e8]) / u[_e13]);
+            let _e17 = a_3;
+            let _e21 = a_3;
+            let _e24 = a_3;
+            let tb = (((size[_e17] - 0.5f) - o_1[_e21]) / u[_e24]);
+            let _e27 = a_3;
+            let crosses = (abs(u[_e27]) > 0.000000000001f);
+            let _e33 = t_in;
+            let _e34 = t_in;
+            t_in = select(_e33, max(_e34, min(ta, tb)), crosses);
+            let _e39 = t_out;
+            let _e40 = t_out;
+            t_out = select(_e39, min(_e40, max(ta, tb)), crosses);
+        }
+        continuing {
+            let _e45 = a_3;
+            a_3 = (_e45 + 1u);
+        }
+    }
+    let _e47 = t_in;
+    let _e48 = t_out;
+    let _e49 = t_in;
+    return (0.5f * (_e47 + max(_e48, _e49)));
+}
+
+fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_4: vec2<f32>) -> vec3<f32> {
+    let ndc = vec2<f32>((((2f * p_4.x) / f32(f_3.sizes.x)) - 1f), (1f - ((2f * p_4.y) / f32(f_3.sizes.y))));
+    let t_4 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_4) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_4))));
+}
+
+fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
+    let a_10 = (f_4.fan_angles.x + ((f32(row_1) + 0.5f) * f_4.fan_angles.y));
+    let ax = f_4.fan_origin.zw;
+    let u_3 = vec2<f32>(((ax.x * cos(a_10)) - (ax.y * sin(a_10))), ((ax.y * cos(a_10)) + (ax.x * sin(a_10))));
+    let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_3, _e32);
+    let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_3 * _e33)));
+    return atan2(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
+}
+
+fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_2: u32) -> f32 {
+    let _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    let _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return select(_e2, _e3, (f_5.fan_angles.z > 0.5f));
+}
+
 fn normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(theta: f32, lo_1: f32, hi_1: f32) -> f32 {
     return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8f * clamp(((theta - lo_1) / max((hi_1 - lo_1), 0.000001f)), 0f, 1f)));
 }
 
-fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, vec4<u32>(f_2.sizes2_.x, 0u, 0u, 0u));
+fn sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_6.sm_right, f_6.sm_up, f_6.sm_forward, f_6.sm_origin, f_6.sm_proj, vec4<u32>(f_6.sizes2_.x, 0u, 0u, 0u));
 }
 
-fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, p_4: vec3<f32>, spot: bool) -> f32 {
-    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    let _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_4, spot);
+fn sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_4: texture_2d<f32>, p_5: vec3<f32>, spot: bool) -> f32 {
+    let _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
+    let _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_5, spot);
     return _e5;
 }
 
-fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_3: vec3<f32>, dir_3: vec3<f32>, t_1: f32) -> f32 {
-    let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_4.light_pos.xyz, f_4.light_dir.xyz, f_4.light_pos.w, f_4.light_dir.w, f_4.medium);
+fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_3: vec3<f32>, dir_3: vec3<f32>, t_1: f32) -> f32 {
+    let _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e13;
 }
 
-fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot_1: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_4: f32, b_3: f32, steps: u32, spot_1: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_6: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
-    let h_11 = ((b_3 - a_3) / f32(steps));
-    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
+    let h_11 = ((b_3 - a_4) / f32(steps));
+    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
     loop {
         let _e15 = k_6;
         if ((_e15 + 1u) <= steps) {
@@ -356,7 +421,7 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_
         }
         {
             let _e19 = k_6;
-            t_2 = (a_3 + ((f32(_e19) + 0.5f) * h_11));
+            t_2 = (a_4 + ((f32(_e19) + 0.5f) * h_11));
             w = h_11;
             if spot_1 {
                 let _e28 = k_6;
@@ -365,18 +430,18 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_
                 w = _e32.y;
             }
             let _e35 = t_2;
-            let _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
+            let _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if spot_1 {
                 let _e41 = sum_1;
                 let _e42 = w;
                 let _e44 = t_2;
-                let _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e44);
+                let _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_4, dir_4, _e44);
                 sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
                 let _e48 = sum_1;
                 let _e51 = k_6;
                 let _e55 = k_6;
-                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (f32(_e51) * h_11)), (a_3 + (f32((_e55 + 1u)) * h_11)));
+                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_4 + (f32(_e51) * h_11)), (a_4 + (f32((_e55 + 1u)) * h_11)));
                 sum_1 = (_e48 + (_e39 * _e61));
             }
         }
@@ -389,20 +454,20 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_
     return _e67;
 }
 
-fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
-    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0f, s, f_6.sizes2_.y, spot_2);
+fn epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_6: texture_2d<f32>, eye_5: vec3<f32>, dir_5: vec3<f32>, s: f32, spot_2: bool) -> f32 {
+    let _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, sm_6, eye_5, dir_5, 0f, s, f_10.sizes2_.y, spot_2);
     if spot_2 {
         return _e9;
     } else {
-        let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
-        return ((f_6.medium.y * _e18) * _e9);
+        let _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, -(dot(f_10.light_dir.xyz, dir_5)));
+        return ((f_10.medium.y * _e18) * _e9);
     }
 }
 
-fn in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, pc: vec2<f32>) -> bool {
-    let radius = f_7.epipole.w;
-    let near_epi = ((f_7.epipole.z > 0.5f) & (length((pc - f_7.epipole.xy)) < radius));
-    let near_anti = ((f_7.anti_epipole.z > 0.5f) & (length((pc - f_7.anti_epipole.xy)) < radius));
+fn in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, pc: vec2<f32>) -> bool {
+    let radius = f_11.epipole.w;
+    let near_epi = ((f_11.epipole.z > 0.5f) & (length((pc - f_11.epipole.xy)) < radius));
+    let near_anti = ((f_11.anti_epipole.z > 0.5f) & (length((pc - f_11.anti_epipole.xy)) < radius));
     return (near_epi | near_anti);
 }
 
@@ -411,40 +476,36 @@ fn row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(j_9: f32, rows: u32, w
     return select(u32(clamp(ji, 0i, (i32(rows) - 1i))), u32((((ji % i32(rows)) + i32(rows)) % i32(rows))), wrap);
 }
 
-fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
-    let axis_1 = f_8.axis.xyz;
+fn ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_6: vec3<f32>) -> f32 {
+    let axis_1 = f_12.axis.xyz;
     return atan2(length(cross(dir_6, axis_1)), dot(dir_6, axis_1));
 }
 
-fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX) -> vec2<f32> {
-    return vec2<f32>(f32(f_9.sizes.x), f32(f_9.sizes.y));
+fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
+    let rows_1 = f_13.sizes.w;
+    let phi_1 = atan2(dot(dir_7, f_13.e2_.xyz), dot(dir_7, f_13.e1_.xyz));
+    let z_5 = dot(dir_7, f_13.cam_forward.xyz);
+    let t_5 = f_13.cam_forward.w;
+    let ndc_1 = vec2<f32>((dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_5) * f_13.cam_right.w)), (dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_5)));
+    let _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13);
+    let p_7 = (vec2<f32>(((ndc_1.x + 1f) * 0.5f), ((1f - ndc_1.y) * 0.5f)) * _e41);
+    let d_2 = (p_7 - f_13.fan_origin.xy);
+    let ax_1 = f_13.fan_origin.zw;
+    let fan = ((atan2(((ax_1.x * d_2.y) - (ax_1.y * d_2.x)), ((ax_1.x * d_2.x) + (ax_1.y * d_2.y))) - f_13.fan_angles.x) / f_13.fan_angles.y);
+    let yc = select(((phi_1 - f_13.e1_.w) / f_13.e2_.w), fan, (f_13.fan_angles.z > 0.5f));
+    return select(clamp(yc, 0f, f32(rows_1)), (yc - (floor((yc / f32(rows_1))) * f32(rows_1))), (f_13.anti_epipole.w > 0.5f));
 }
 
-fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, dir_7: vec3<f32>) -> f32 {
-    let rows_1 = f_10.sizes.w;
-    let phi_1 = atan2(dot(dir_7, f_10.e2_.xyz), dot(dir_7, f_10.e1_.xyz));
-    let z_5 = dot(dir_7, f_10.cam_forward.xyz);
-    let t_4 = f_10.cam_forward.w;
-    let ndc = vec2<f32>((dot(dir_7, f_10.cam_right.xyz) / ((z_5 * t_4) * f_10.cam_right.w)), (dot(dir_7, f_10.cam_up.xyz) / (z_5 * t_4)));
-    let _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10);
-    let p_6 = (vec2<f32>(((ndc.x + 1f) * 0.5f), ((1f - ndc.y) * 0.5f)) * _e41);
-    let d_2 = (p_6 - f_10.fan_origin.xy);
-    let ax = f_10.fan_origin.zw;
-    let fan = ((atan2(((ax.x * d_2.y) - (ax.y * d_2.x)), ((ax.x * d_2.x) + (ax.y * d_2.y))) - f_10.fan_angles.x) / f_10.fan_angles.y);
-    let yc = select(((phi_1 - f_10.e1_.w) / f_10.e2_.w), fan, (f_10.fan_angles.z > 0.5f));
-    return select(clamp(yc, 0f, f32(rows_1)), (yc - (floor((yc / f32(rows_1))) * f32(rows_1))), (f_10.anti_epipole.w > 0.5f));
-}
-
-fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
+fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_6: vec3<f32>, dir_8: vec3<f32>, s_1: f32, theta_1: f32, spot_3: bool) -> f32 {
     if spot_3 {
-        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_11.light_pos.xyz);
-        let to_eye = -(f_11.axis.xyz);
+        let q_2 = ((eye_6 + (dir_8 * s_1)) - f_14.light_pos.xyz);
+        let to_eye = -(f_14.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
+fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_2: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
     var local_9: bool;
 
     if spot_4 {
@@ -459,39 +520,39 @@ fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12: FrameX_naga_oil_mod_
         if _e16 {
             return s_2;
         }
-        return min(((f_12.axis.w * sin(psi)) / den), s_2);
+        return min(((f_15.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_2 * delta) / max(sin(theta_2), 0.000001f)), s_2);
     }
 }
 
-fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
+fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_3: u32, n_1: u32, delta_1: f32, theta_3: f32, s_3: f32, spot_5: bool) -> f32 {
     if (x_3 >= n_1) {
         return s_3;
     }
-    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, f32(x_3), delta_1, theta_3, s_3, spot_5);
+    let _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, f32(x_3), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_14.light_pos.xyz, f_14.light_dir.xyz, f_14.light_pos.w, f_14.light_dir.w, f_14.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_5: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_6: f32, b_5: f32, spot_6: bool) -> f32 {
     if spot_6 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_8, dir_10, a_5, b_5, max((f_15.sizes2_.z / 4u), 1u));
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, max((f_18.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, a_5, b_5);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
     return _e15;
 }
 
-fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_6: f32, b_6: f32, depth_break: f32) -> bool {
+fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_7: f32, b_6: f32, depth_break: f32) -> bool {
     var local_10: bool;
 
-    if !((a_6 == b_6)) {
-        local_10 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
+    if !((a_7 == b_6)) {
+        local_10 = (abs((a_7 - b_6)) <= (depth_break * min(a_7, b_6)));
     } else {
         local_10 = true;
     }
@@ -500,11 +561,11 @@ fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_6: f32, b_6: f32, 
 }
 
 fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_10: vec3<f32>) -> vec3<f32> {
-    let a_9 = min(abs(v_10), vec3(65504f));
-    let u_2 = bitcast<vec3<u32>>(a_9);
-    let normal = bitcast<vec3<f32>>((((u_2 + vec3(4095u)) + ((u_2 >> vec3(13u)) & vec3(1u))) & vec3(4294959104u)));
-    let subnormal = (round((a_9 * 16777216f)) / vec3(16777216f));
-    return (sign(v_10) * select(normal, subnormal, (a_9 < vec3(0.000061035156f))));
+    let a_11 = min(abs(v_10), vec3(65504f));
+    let u_4 = bitcast<vec3<u32>>(a_11);
+    let normal = bitcast<vec3<f32>>((((u_4 + vec3(4095u)) + ((u_4 >> vec3(13u)) & vec3(1u))) & vec3(4294959104u)));
+    let subnormal = (round((a_11 * 16777216f)) / vec3(16777216f));
+    return (sign(v_10) * select(normal, subnormal, (a_11 < vec3(0.000061035156f))));
 }
 
 fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, d: vec2<f32>) -> f32 {
@@ -517,15 +578,15 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     var local_11: bool;
     var local_12: bool;
     var local_13: bool;
-    var a_7: f32 = 0f;
+    var a_8: f32 = 0f;
     var b_7: f32 = 0f;
     var k_7: u32 = 0u;
 
-    let size = vec2<f32>(screen);
-    let centre = (0.5f * size);
+    let size_1 = vec2<f32>(screen);
+    let centre = (0.5f * size_1);
     let z_6 = dot(cam.toward, cam.forward);
     let q_3 = vec2<f32>(((dot(cam.toward, cam.right) * centre.x) / (cam.tan_half * cam.aspect)), ((-(dot(cam.toward, cam.up)) * centre.y) / cam.tan_half));
-    let far_3 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size.x, size.y));
+    let far_3 = (EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX * max(size_1.x, size_1.y));
     let lq = length(q_3);
     origin = centre;
     if (lq >= (far_3 * abs(z_6))) {
@@ -542,7 +603,7 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     let lc = length(to_centre);
     l_1.axis = select(vec2<f32>(1f, 0f), (to_centre / vec2(max(lc, 0.000000000000000000000000000001f))), (lc > 0f));
     let lo_2 = vec2<f32>(0.5f, 0.5f);
-    let hi_2 = (size - vec2<f32>(0.5f, 0.5f));
+    let hi_2 = (size_1 - vec2<f32>(0.5f, 0.5f));
     let _e79 = origin.x;
     if (_e79 >= lo_2.x) {
         let _e83 = origin.x;
@@ -586,11 +647,11 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
                 let _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
                 let _e143 = k_7;
                 if (_e143 == 0u) {
-                    a_7 = _e142;
+                    a_8 = _e142;
                     b_7 = _e142;
                 } else {
-                    let _e148 = a_7;
-                    a_7 = min(_e148, _e142);
+                    let _e148 = a_8;
+                    a_8 = min(_e148, _e142);
                     let _e150 = b_7;
                     b_7 = max(_e150, _e142);
                 }
@@ -600,10 +661,10 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
                 k_7 = (_e153 + 1u);
             }
         }
-        let _e156 = a_7;
+        let _e156 = a_8;
         l_1.phi_start = _e156;
         let _e158 = b_7;
-        let _e159 = a_7;
+        let _e159 = a_8;
         l_1.dphi = ((_e158 - _e159) / f32(slices));
     }
     let _e163 = l_1;
@@ -618,63 +679,63 @@ fn slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLay
 }
 
 fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_5: u32, screen_1: vec2<u32>, samples: u32) -> vec2<f32> {
-    var t_in: f32 = 0f;
-    var t_out: f32 = 340000000000000000000000000000000000000f;
-    var a_8: u32 = 0u;
+    var t_in_1: f32 = 0f;
+    var t_out_1: f32 = 340000000000000000000000000000000000000f;
+    var a_9: u32 = 0u;
 
     let _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     let lo_3 = vec2<f32>(0.5f, 0.5f);
     let hi_3 = (vec2<f32>(screen_1) - vec2<f32>(0.5f, 0.5f));
     loop {
-        let _e16 = a_8;
+        let _e16 = a_9;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            let _e19 = a_8;
+            let _e19 = a_9;
             if (abs(_e5[_e19]) > 0.000000000001f) {
-                let _e24 = a_8;
-                let _e27 = a_8;
-                let _e30 = a_8;
-                let ta = ((lo_3[_e24] - l_3.origin[_e27]) / _e5[_e30]);
-                let _e33 = a_8;
-                let _e36 = a_8;
-                let _e39 = a_8;
-                let tb = ((hi_3[_e33] - l_3.origin[_e36]) / _e5[_e39]);
-                let _e43 = t_in;
-                t_in = max(_e43, min(ta, tb));
-                let _e47 = t_out;
-                t_out = min(_e47, max(ta, tb));
+                let _e24 = a_9;
+                let _e27 = a_9;
+                let _e30 = a_9;
+                let ta_1 = ((lo_3[_e24] - l_3.origin[_e27]) / _e5[_e30]);
+                let _e33 = a_9;
+                let _e36 = a_9;
+                let _e39 = a_9;
+                let tb_1 = ((hi_3[_e33] - l_3.origin[_e36]) / _e5[_e39]);
+                let _e43 = t_in_1;
+                t_in_1 = max(_e43, min(ta_1, tb_1));
+                let _e47 = t_out_1;
+                t_out_1 = min(_e47, max(ta_1, tb_1));
             }
         }
         continuing {
-            let _e51 = a_8;
-            a_8 = (_e51 + 1u);
+            let _e51 = a_9;
+            a_9 = (_e51 + 1u);
         }
     }
-    let _e53 = t_out;
-    let _e54 = t_in;
-    t_out = max(_e53, _e54);
-    let _e56 = t_in;
-    let _e57 = t_out;
-    let _e58 = t_in;
+    let _e53 = t_out_1;
+    let _e54 = t_in_1;
+    t_out_1 = max(_e53, _e54);
+    let _e56 = t_in_1;
+    let _e57 = t_out_1;
+    let _e58 = t_in_1;
     return vec2<f32>(_e56, ((_e57 - _e58) / f32((samples - 1u))));
 }
 
-fn slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_4: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, u: vec2<f32>, span: vec2<f32>, k_8: u32, screen_2: vec2<u32>) -> vec2<u32> {
-    let p_7 = (l_4.origin + (u * (span.x + (f32(k_8) * span.y))));
+fn slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_4: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, u_1: vec2<f32>, span: vec2<f32>, k_8: u32, screen_2: vec2<u32>) -> vec2<u32> {
+    let p_8 = (l_4.origin + (u_1 * (span.x + (f32(k_8) * span.y))));
     let last_1 = (vec2<f32>(screen_2) - vec2<f32>(1f, 1f));
-    return vec2<u32>(clamp(floor(p_7), vec2<f32>(0f, 0f), last_1));
+    return vec2<u32>(clamp(floor(p_8), vec2<f32>(0f, 0f), last_1));
 }
 
 fn factor_at(base: u32, x_4: f32, h_4: u32) -> vec4<f32> {
-    let p_8 = min((clamp(x_4, 0f, 1f) * 95f), 95f);
-    let j_10 = min(u32(floor(p_8)), 94u);
-    let t_5 = (p_8 - f32(j_10));
+    let p_9 = min((clamp(x_4, 0f, 1f) * 95f), 95f);
+    let j_10 = min(u32(floor(p_9)), 94u);
+    let t_6 = (p_9 - f32(j_10));
     let _e22 = pst_factors[((base + (2u * j_10)) + h_4)];
     let _e34 = pst_factors[((base + (2u * (j_10 + 1u))) + h_4)];
-    return ((_e22 * (1f - t_5)) + (_e34 * t_5));
+    return ((_e22 * (1f - t_6)) + (_e34 * t_6));
 }
 
 fn gamma_at(v_11: f32, h_5: u32) -> vec4<f32> {
@@ -689,7 +750,7 @@ fn beta_at(theta_4: f32, h_6: u32) -> vec4<f32> {
     return _e14;
 }
 
-fn pst_leaf(f_16: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, row_1: u32, delta_2: f32, h_7: u32) -> vec4<f32> {
+fn pst_leaf(f_19: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, row_3: u32, delta_2: f32, h_7: u32) -> vec4<f32> {
     var leaf: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var g_1: u32 = 0u;
 
@@ -697,9 +758,9 @@ fn pst_leaf(f_16: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
         let _e9 = gamma_at((f32(i_2) * delta_2), h_7);
         return _e9;
     }
-    let _e12 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, row_1);
-    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e12);
-    let axis_2 = f_16.axis.xyz;
+    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
+    let axis_2 = f_19.axis.xyz;
     loop {
         let _e17 = g_1;
         if (_e17 < 2u) {
@@ -711,7 +772,7 @@ fn pst_leaf(f_16: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
             let q_4 = select(GL2_, -0.57735026f, (_e20 == 0u));
             let psi_1 = (((f32(i_2) + 0.5f) + (0.5f * q_4)) * delta_2);
             let l_5 = ((-(axis_2) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_16.light_dir.xyz), f_16.light_pos.w, f_16.light_dir.w);
+            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
             let _e48 = leaf;
             let _e52 = gamma_at(psi_1, h_7);
             leaf = (_e48 + (((0.5f * delta_2) * _e46) * _e52));
@@ -728,30 +789,30 @@ fn pst_leaf(f_16: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
 fn pst_ray(pc_1: vec2<f32>, z_1: f32) -> PstRay {
     var r_1: PstRay;
 
-    let f_17 = frame;
-    let eye_9 = f_17.eye.xyz;
-    let ndc_1 = vec2<f32>((((2f * pc_1.x) / f32(f_17.sizes.x)) - 1f), (1f - ((2f * pc_1.y) / f32(f_17.sizes.y))));
-    let t_6 = f_17.cam_forward.w;
-    let dir_12 = normalize(((f_17.cam_forward.xyz + (f_17.cam_right.xyz * ((ndc_1.x * t_6) * f_17.cam_right.w))) + (f_17.cam_up.xyz * (ndc_1.y * t_6))));
-    let s_6 = (min(max(z_1, 0f), f_17.theta.z) / max(dot(dir_12, f_17.cam_forward.xyz), 0.000001f));
+    let f_20 = frame;
+    let eye_9 = f_20.eye.xyz;
+    let ndc_2 = vec2<f32>((((2f * pc_1.x) / f32(f_20.sizes.x)) - 1f), (1f - ((2f * pc_1.y) / f32(f_20.sizes.y))));
+    let t_7 = f_20.cam_forward.w;
+    let dir_12 = normalize(((f_20.cam_forward.xyz + (f_20.cam_right.xyz * ((ndc_2.x * t_7) * f_20.cam_right.w))) + (f_20.cam_up.xyz * (ndc_2.y * t_7))));
+    let s_6 = (min(max(z_1, 0f), f_20.theta.z) / max(dot(dir_12, f_20.cam_forward.xyz), 0.000001f));
     r_1 = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_9, dir_12, s_6, 0u, 0f, 0f, 0f);
-    let _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, pc_1);
+    let _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, pc_1);
     if _e67 {
         r_1.marched = true;
         let _e72 = frame;
         let _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_6, true);
-        r_1.color = (_e75 * f_17.light_color.xyz);
+        r_1.color = (_e75 * f_20.light_color.xyz);
     }
-    let _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, dir_12);
+    let _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
     r_1.theta = _e80;
-    let _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, dir_12);
-    let _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_17.sizes.w, (f_17.anti_epipole.w > 0.5f));
+    let _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
+    let _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_20.sizes.w, (f_20.anti_epipole.w > 0.5f));
     r_1.row = _e90;
     let _e93 = r_1.theta;
-    let _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_17.theta.x, f_17.theta.y);
+    let _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_20.theta.x, f_20.theta.y);
     r_1.d = _e98;
     let _e101 = r_1.theta;
-    let _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, eye_9, dir_12, s_6, _e101, true);
+    let _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, eye_9, dir_12, s_6, _e101, true);
     r_1.xs_num = _e102;
     let _e103 = r_1;
     return _e103;
@@ -763,24 +824,24 @@ fn pst_columns_crossed(r_2: PstRay, delta_3: f32) -> u32 {
     return u32(min(ceil(select(0f, xs, (xs > 0f))), f32(_e12)));
 }
 
-fn pst_terms(r_3: PstRay, row_2: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
+fn pst_terms(r_3: PstRay, row_4: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     var tail: f32 = 0f;
 
-    let f_18 = frame;
+    let f_21 = frame;
     let sin_theta = max(sin(r_3.theta), 0.000001f);
-    let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_2), 0i);
+    let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_4), 0i);
     if (r_3.d <= _e16.x) {
-        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
-        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
+        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if true {
         let _e37 = tail;
-        return vec2<f32>((f_18.medium.y / (f_18.axis.w * sin_theta)), _e37);
+        return vec2<f32>((f_21.medium.y / (f_21.axis.w * sin_theta)), _e37);
     }
-    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.z, -(dot(f_18.light_dir.xyz, r_3.dir)));
-    let sp = (f_18.medium.y * _e48);
-    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, 0f, (delta_4 / sin_theta));
+    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.z, -(dot(f_21.light_dir.xyz, r_3.dir)));
+    let sp = (f_21.medium.y * _e48);
+    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.x, 0f, (delta_4 / sin_theta));
     let _e56 = tail;
     return vec2<f32>((sp * _e54), (sp * _e56));
 }
@@ -788,10 +849,10 @@ fn pst_terms(r_3: PstRay, row_2: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
 fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
     var sum_2: f32 = 0f;
     var h_8: u32 = 0u;
-    var p_5: vec4<f32>;
+    var p_6: vec4<f32>;
     var i_3: u32;
 
-    let f_19 = frame;
+    let f_22 = frame;
     let _e16 = textureLoad(depth, vec2<u32>(x_5, y), 0i);
     let _e18 = pst_ray(vec2<f32>((f32(x_5) + 0.5f), (f32(y) + 0.5f)), _e16.x);
     if _e18.marched {
@@ -811,7 +872,7 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
             break;
         }
         {
-            p_5 = vec4<f32>(0f, 0f, 0f, 0f);
+            p_6 = vec4<f32>(0f, 0f, 0f, 0f);
             i_3 = 0u;
             loop {
                 let _e46 = i_3;
@@ -823,11 +884,11 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
                     let _e51 = i_3;
                     let _e56 = textureLoad(rectified, vec2<u32>(_e51, _e18.row), 0i);
                     if (_e18.d <= _e56.x) {
-                        let _e59 = p_5;
+                        let _e59 = p_6;
                         let _e60 = i_3;
                         let _e62 = h_8;
-                        let _e63 = pst_leaf(f_19, _e60, _e18.row, delta_5, _e62);
-                        p_5 = (_e59 + _e63);
+                        let _e63 = pst_leaf(f_22, _e60, _e18.row, delta_5, _e62);
+                        p_6 = (_e59 + _e63);
                     }
                 }
                 continuing {
@@ -836,7 +897,7 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
                 }
             }
             let _e69 = sum_2;
-            let _e70 = p_5;
+            let _e70 = p_6;
             let _e72 = h_8;
             let _e73 = beta_at(_e18.theta, _e72);
             sum_2 = (_e69 + dot(_e70, _e73));
@@ -848,7 +909,7 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
     }
     let _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     let _e84 = sum_2;
-    return (f_19.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
+    return (f_22.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
 }
 
 fn pst_footprint_depth(pc_2: vec2<f32>, screen_3: vec2<u32>) -> f32 {
@@ -856,7 +917,7 @@ fn pst_footprint_depth(pc_2: vec2<f32>, screen_3: vec2<u32>) -> f32 {
     let q_5 = clamp((pc_2 - vec2<f32>(0.5f, 0.5f)), vec2<f32>(0f, 0f), last_2);
     let i0_ = vec2<u32>(floor(q_5));
     let i1_ = min((i0_ + vec2<u32>(1u, 1u)), (screen_3 - vec2<u32>(1u, 1u)));
-    let t_7 = (q_5 - floor(q_5));
+    let t_8 = (q_5 - floor(q_5));
     let _e30 = textureLoad(depth, i0_, 0i);
     let z00_ = _e30.x;
     let _e37 = textureLoad(depth, vec2<u32>(i1_.x, i0_.y), 0i);
@@ -874,9 +935,9 @@ fn pst_footprint_depth(pc_2: vec2<f32>, screen_3: vec2<u32>) -> f32 {
     if (lo_4 == hi_4) {
         return lo_4;
     }
-    let w0_ = (((1f / z00_) * (1f - t_7.x)) + ((1f / z10_) * t_7.x));
-    let w1_ = (((1f / z01_) * (1f - t_7.x)) + ((1f / z11_) * t_7.x));
-    return (1f / ((w0_ * (1f - t_7.y)) + (w1_ * t_7.y)));
+    let w0_ = (((1f / z00_) * (1f - t_8.x)) + ((1f / z10_) * t_8.x));
+    let w1_ = (((1f / z01_) * (1f - t_8.x)) + ((1f / z11_) * t_8.x));
+    return (1f / ((w0_ * (1f - t_8.y)) + (w1_ * t_8.y)));
 }
 
 @compute @workgroup_size(32, 1, 1) 
@@ -930,9 +991,9 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     var p_1: vec4<f32>;
     var j_8: u32;
 
-    let f_20 = frame;
-    let screen_4 = vec2<u32>(f_20.sizes.x, f_20.sizes.y);
-    let width = f_20.sizes.z;
+    let f_23 = frame;
+    let screen_4 = vec2<u32>(f_23.sizes.x, f_23.sizes.y);
+    let width = f_23.sizes.z;
     let _e13 = frame.cam_forward;
     let _e17 = frame.cam_right;
     let _e21 = frame.cam_up;
@@ -953,8 +1014,8 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     }
     let far_end = (_e37.origin + (_e40 * (_e42.x + (255f * _e42.y))));
     let _e84 = pst_ray(far_end, 0f);
-    let row_3 = _e84.row;
-    let _e88 = slices_1[row_3];
+    let row_5 = _e84.row;
+    let _e88 = slices_1[row_5];
     let _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
     let delta_6 = _e89.delta;
     k = li;
@@ -998,7 +1059,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                 textureStore(output, vec2<u32>(_e153, s_7), vec4<f32>(_e152.x, _e152.y, _e152.z, z_7));
             } else {
                 let _e160 = r;
-                let _e161 = pst_terms(_e160, row_3, delta_6, _e136);
+                let _e161 = pst_terms(_e160, row_5, delta_6, _e136);
                 let _e163 = k;
                 q_b[_e163] = _e161.y;
                 let _e167 = k;
@@ -1309,7 +1370,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         }
         {
             let _e516 = i;
-            let _e520 = textureLoad(rectified, vec2<u32>(_e516, row_3), 0i);
+            let _e520 = textureLoad(rectified, vec2<u32>(_e516, row_5), 0i);
             let occluder = _e520.x;
             lo = 0u;
             hi = v_12;
@@ -1349,7 +1410,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                         let _e557 = h;
                         let _e560 = i;
                         let _e561 = h;
-                        let _e562 = pst_leaf(f_20, _e560, row_3, delta_6, _e561);
+                        let _e562 = pst_leaf(f_23, _e560, row_5, delta_6, _e561);
                         pst_leaves[(((base_1 + _e552) * LEAF_VECS) + _e557)] = _e562;
                     }
                     continuing {
@@ -1647,7 +1708,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
                 let _e900 = dotp;
                 let _e905 = k_4;
                 let _e907 = q_b[_e905];
-                let _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_20.light_color.xyz * (max((_e899 * _e900), 0f) + _e907)));
+                let _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_23.light_color.xyz * (max((_e899 * _e900), 0f) + _e907)));
                 let _e911 = k_4;
                 let _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
                 let _e915 = textureLoad(depth, _e912, 0i);

@@ -277,11 +277,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
                 }
                 {
                     uint _e48 = q;
-                    float u = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e48), 3u)])));
+                    float u_1 = tan((mid + ((0.5 * w_1) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e48), 3u)])));
                     float _e54 = sum;
                     uint _e56 = q;
-                    const float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e56), 3u)] * _e64) * (1.0 + (u * u))));
+                    const float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[min(uint(_e56), 3u)] * _e64) * (1.0 + (u_1 * u_1))));
                 }
             }
         }
@@ -339,6 +339,81 @@ float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_
     return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
 }
 
+float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2)
+{
+    return float2(float(f_2.sizes.x), float(f_2.sizes.y));
+}
+
+float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float2 o_1, float2 u, float2 size)
+{
+    float t_in = 0.0;
+    float t_out = 3.4e38;
+    uint a_3 = 0u;
+
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e45 = a_3;
+            a_3 = (_e45 + 1u);
+        }
+        loop_init_2 = false;
+        uint _e4 = a_3;
+        if ((_e4 < 2u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = a_3;
+            uint _e13 = a_3;
+            float ta = ((0.5 - o_1[min(uint(_e8), 1u)]) / u[min(uint(_e13), 1u)]);
+            uint _e17 = a_3;
+            uint _e21 = a_3;
+            uint _e24 = a_3;
+            float tb = (((size[min(uint(_e17), 1u)] - 0.5) - o_1[min(uint(_e21), 1u)]) / u[min(uint(_e24), 1u)]);
+            uint _e27 = a_3;
+            bool crosses = (abs(u[min(uint(_e27), 1u)]) > 1e-12);
+            float _e33 = t_in;
+            float _e34 = t_in;
+            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
+            float _e39 = t_out;
+            float _e40 = t_out;
+            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
+        }
+    }
+    float _e47 = t_in;
+    float _e48 = t_out;
+    float _e49 = t_in;
+    return (0.5 * (_e47 + max(_e48, _e49)));
+}
+
+float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, float2 p_2)
+{
+    float2 ndc = float2((((2.0 * p_2.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_3.sizes.y))));
+    float t_4 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_4) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_4))));
+}
+
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1)
+{
+    float a_7 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    float2 ax = f_4.fan_origin.zw;
+    float2 u_2 = float2(((ax.x * cos(a_7)) - (ax.y * sin(a_7))), ((ax.y * cos(a_7)) + (ax.x * sin(a_7))));
+    const float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    const float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    const float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan2(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, uint row_2)
+{
+    const float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    const float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return ((f_5.fan_angles.z > 0.5) ? _e3 : _e2);
+}
+
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi)
 {
     return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
@@ -355,44 +430,44 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX ConstructShadowMapViewX_n
     return ret;
 }
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2)
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6)
 {
-    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx = ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, uint4(f_2.sizes2_.x, 0u, 0u, 0u));
+    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx = ConstructShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_6.sm_right, f_6.sm_up, f_6.sm_forward, f_6.sm_origin, f_6.sm_proj, uint4(f_6.sizes2_.x, 0u, 0u, 0u));
     return shadowmapviewx_naga_oil_mod_xonrwc5dumvzduottnbqwi33xx;
 }
 
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, Texture2D<float4> sm_4, float3 p_2, bool spot)
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, Texture2D<float4> sm_4, float3 p_3, bool spot)
 {
-    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    const float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_2, spot);
+    const ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
+    const float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_3, spot);
     return _e5;
 }
 
-float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, float3 eye_3, float3 dir_3, float t_1)
+float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 eye_3, float3 dir_3, float t_1)
 {
-    const float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_4.light_pos.xyz, f_4.light_dir.xyz, f_4.light_pos.w, f_4.light_dir.w, f_4.medium);
+    const float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, Texture2D<float4> sm_5, float3 eye_4, float3 dir_4, float a_3, float b_3, uint steps, bool spot_1)
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, Texture2D<float4> sm_5, float3 eye_4, float3 dir_4, float a_4, float b_3, uint steps, bool spot_1)
 {
     float sum_1 = 0.0;
     uint k_1 = 0u;
     float t_2 = (float)0;
     float w = (float)0;
 
-    float h_7 = ((b_3 - a_3) / float(steps));
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
-    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
-    bool loop_init_2 = true;
+    float h_7 = ((b_3 - a_4) / float(steps));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
+    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
+        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e65 = k_1;
             k_1 = (_e65 + 1u);
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e15 = k_1;
         if (((_e15 + 1u) <= steps)) {
         } else {
@@ -400,7 +475,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
         }
         {
             uint _e19 = k_1;
-            t_2 = (a_3 + ((float(_e19) + 0.5) * h_7));
+            t_2 = (a_4 + ((float(_e19) + 0.5) * h_7));
             w = h_7;
             if (spot_1) {
                 uint _e28 = k_1;
@@ -409,18 +484,18 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
                 w = _e32.y;
             }
             float _e35 = t_2;
-            const float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
+            const float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if (spot_1) {
                 float _e41 = sum_1;
                 float _e42 = w;
                 float _e44 = t_2;
-                const float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e44);
+                const float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_4, dir_4, _e44);
                 sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
                 float _e48 = sum_1;
                 uint _e51 = k_1;
                 uint _e55 = k_1;
-                const float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (float(_e51) * h_7)), (a_3 + (float((_e55 + 1u)) * h_7)));
+                const float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_4 + (float(_e51) * h_7)), (a_4 + (float((_e55 + 1u)) * h_7)));
                 sum_1 = (_e48 + (_e39 * _e61));
             }
         }
@@ -429,22 +504,22 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return _e67;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, Texture2D<float4> sm_6, float3 eye_5, float3 dir_5, float s, bool spot_2)
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, Texture2D<float4> sm_6, float3 eye_5, float3 dir_5, float s, bool spot_2)
 {
-    const float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_2);
+    const float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, sm_6, eye_5, dir_5, 0.0, s, f_10.sizes2_.y, spot_2);
     if (spot_2) {
         return _e9;
     } else {
-        const float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
-        return ((f_6.medium.y * _e18) * _e9);
+        const float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, -(dot(f_10.light_dir.xyz, dir_5)));
+        return ((f_10.medium.y * _e18) * _e9);
     }
 }
 
-bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, float2 pc)
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float2 pc)
 {
-    float radius = f_7.epipole.w;
-    bool near_epi = ((f_7.epipole.z > 0.5) & (length((pc - f_7.epipole.xy)) < radius));
-    bool near_anti = ((f_7.anti_epipole.z > 0.5) & (length((pc - f_7.anti_epipole.xy)) < radius));
+    float radius = f_11.epipole.w;
+    bool near_epi = ((f_11.epipole.z > 0.5) & (length((pc - f_11.epipole.xy)) < radius));
+    bool near_anti = ((f_11.anti_epipole.z > 0.5) & (length((pc - f_11.anti_epipole.xy)) < radius));
     return (near_epi | near_anti);
 }
 
@@ -463,44 +538,39 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j, uint rows, 
     return (wrap ? uint(naga_mod(asint(asuint(naga_mod(ji, int(rows))) + asuint(int(rows))), int(rows))) : uint(clamp(ji, int(0), asint(asuint(int(rows)) - asuint(int(1))))));
 }
 
-float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, float3 dir_6)
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float3 dir_6)
 {
-    float3 axis = f_8.axis.xyz;
+    float3 axis = f_12.axis.xyz;
     return atan2(length(cross(dir_6, axis)), dot(dir_6, axis));
 }
 
-float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9)
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, float3 dir_7)
 {
-    return float2(float(f_9.sizes.x), float(f_9.sizes.y));
+    uint rows_1 = f_13.sizes.w;
+    float phi_1 = atan2(dot(dir_7, f_13.e2_.xyz), dot(dir_7, f_13.e1_.xyz));
+    float z_5 = dot(dir_7, f_13.cam_forward.xyz);
+    float t_5 = f_13.cam_forward.w;
+    float2 ndc_1 = float2((dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_5) * f_13.cam_right.w)), (dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_5)));
+    const float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13);
+    float2 p_5 = (float2(((ndc_1.x + 1.0) * 0.5), ((1.0 - ndc_1.y) * 0.5)) * _e41);
+    float2 d_1 = (p_5 - f_13.fan_origin.xy);
+    float2 ax_1 = f_13.fan_origin.zw;
+    float fan = ((atan2(((ax_1.x * d_1.y) - (ax_1.y * d_1.x)), ((ax_1.x * d_1.x) + (ax_1.y * d_1.y))) - f_13.fan_angles.x) / f_13.fan_angles.y);
+    float yc = ((f_13.fan_angles.z > 0.5) ? fan : ((phi_1 - f_13.e1_.w) / f_13.e2_.w));
+    return ((f_13.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, float3 dir_7)
-{
-    uint rows_1 = f_10.sizes.w;
-    float phi_1 = atan2(dot(dir_7, f_10.e2_.xyz), dot(dir_7, f_10.e1_.xyz));
-    float z_5 = dot(dir_7, f_10.cam_forward.xyz);
-    float t_4 = f_10.cam_forward.w;
-    float2 ndc = float2((dot(dir_7, f_10.cam_right.xyz) / ((z_5 * t_4) * f_10.cam_right.w)), (dot(dir_7, f_10.cam_up.xyz) / (z_5 * t_4)));
-    const float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10);
-    float2 p_4 = (float2(((ndc.x + 1.0) * 0.5), ((1.0 - ndc.y) * 0.5)) * _e41);
-    float2 d_1 = (p_4 - f_10.fan_origin.xy);
-    float2 ax = f_10.fan_origin.zw;
-    float fan = ((atan2(((ax.x * d_1.y) - (ax.y * d_1.x)), ((ax.x * d_1.x) + (ax.y * d_1.y))) - f_10.fan_angles.x) / f_10.fan_angles.y);
-    float yc = ((f_10.fan_angles.z > 0.5) ? fan : ((phi_1 - f_10.e1_.w) / f_10.e2_.w));
-    return ((f_10.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
-}
-
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_3)
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, float3 eye_6, float3 dir_8, float s_1, float theta_1, bool spot_3)
 {
     if (spot_3) {
-        float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_11.light_pos.xyz);
-        float3 to_eye = -(f_11.axis.xyz);
+        float3 q_2 = ((eye_6 + (dir_8 * s_1)) - f_14.light_pos.xyz);
+        float3 to_eye = -(f_14.axis.xyz);
         return atan2(length(cross(q_2, to_eye)), dot(q_2, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float x_1, float delta, float theta_2, float s_2, bool spot_4)
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, float x_1, float delta, float theta_2, float s_2, bool spot_4)
 {
     bool local = (bool)0;
 
@@ -516,24 +586,24 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_12.axis.w * sin(psi)) / den), s_2);
+        return min(((f_15.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_1 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5)
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5)
 {
     if ((x_2 >= n_1)) {
         return s_3;
     }
-    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, float(x_2), delta_1, theta_3, s_3, spot_5);
+    const float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, float(x_2), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, float3 eye_7, float3 dir_9, float a_4, float b_4, uint panels_1)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, float3 eye_7, float3 dir_9, float a_5, float b_4, uint panels_1)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_14.light_pos.xyz, f_14.light_dir.xyz, f_14.light_pos.w, f_14.light_dir.w, f_14.medium);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
@@ -541,24 +611,24 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_6)
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, float3 eye_8, float3 dir_10, float a_6, float b_5, bool spot_6)
 {
     if (spot_6) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_8, dir_10, a_5, b_5, max(naga_div(f_15.sizes2_.z, 4u), 1u));
+        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, max(naga_div(f_18.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, a_5, b_5);
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
     return _e15;
 }
 
 float4 factor_at(uint base, float x_3, uint h)
 {
-    float p_5 = min((clamp(x_3, 0.0, 1.0) * 95.0), 95.0);
-    uint j_1 = min(naga_f2u32(floor(p_5)), 94u);
-    float t_5 = (p_5 - float(j_1));
+    float p_6 = min((clamp(x_3, 0.0, 1.0) * 95.0), 95.0);
+    uint j_1 = min(naga_f2u32(floor(p_6)), 94u);
+    float t_6 = (p_6 - float(j_1));
     float4 _e22 = asfloat(pst_factors.Load4(((base + (2u * j_1)) + h)*16));
     float4 _e34 = asfloat(pst_factors.Load4(((base + (2u * (j_1 + 1u))) + h)*16));
-    return ((_e22 * (1.0 - t_5)) + (_e34 * t_5));
+    return ((_e22 * (1.0 - t_6)) + (_e34 * t_6));
 }
 
 float4 gamma_at(float v_10, uint h_1)
@@ -575,7 +645,7 @@ float4 beta_at(float theta_4, uint h_2)
     return _e14;
 }
 
-float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16, uint i, uint row_1, float delta_2, uint h_3)
+float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint i, uint row_3, float delta_2, uint h_3)
 {
     float4 leaf = float4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
@@ -584,19 +654,19 @@ float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16, uint i,
         const float4 _e9 = gamma_at((float(i) * delta_2), h_3);
         return _e9;
     }
-    const float _e12 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, row_1);
-    const float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e12);
-    float3 axis_1 = f_16.axis.xyz;
-    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
-    bool loop_init_3 = true;
+    const float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    const float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
+    float3 axis_1 = f_19.axis.xyz;
+    uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
             uint _e56 = g_1;
             g_1 = (_e56 + 1u);
         }
-        loop_init_3 = false;
+        loop_init_4 = false;
         uint _e17 = g_1;
         if ((_e17 < 2u)) {
         } else {
@@ -607,7 +677,7 @@ float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16, uint i,
             float q_3 = ((_e20 == 0u) ? -0.57735026 : GL2_);
             float psi_1 = (((float(i) + 0.5) + (0.5 * q_3)) * delta_2);
             float3 l_1 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            const float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_16.light_dir.xyz), f_16.light_pos.w, f_16.light_dir.w);
+            const float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
             float4 _e48 = leaf;
             const float4 _e52 = gamma_at(psi_1, h_3);
             leaf = (_e48 + (((0.5 * delta_2) * _e46) * _e52));
@@ -635,30 +705,30 @@ PstRay pst_ray(float2 pc_1, float z_1)
 {
     PstRay r = (PstRay)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17 = frame;
-    float3 eye_9 = f_17.eye.xyz;
-    float2 ndc_1 = float2((((2.0 * pc_1.x) / float(f_17.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_17.sizes.y))));
-    float t_6 = f_17.cam_forward.w;
-    float3 dir_12 = normalize(((f_17.cam_forward.xyz + (f_17.cam_right.xyz * ((ndc_1.x * t_6) * f_17.cam_right.w))) + (f_17.cam_up.xyz * (ndc_1.y * t_6))));
-    float s_4 = (min(max(z_1, 0.0), f_17.theta.z) / max(dot(dir_12, f_17.cam_forward.xyz), 1e-6));
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20 = frame;
+    float3 eye_9 = f_20.eye.xyz;
+    float2 ndc_2 = float2((((2.0 * pc_1.x) / float(f_20.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_20.sizes.y))));
+    float t_7 = f_20.cam_forward.w;
+    float3 dir_12 = normalize(((f_20.cam_forward.xyz + (f_20.cam_right.xyz * ((ndc_2.x * t_7) * f_20.cam_right.w))) + (f_20.cam_up.xyz * (ndc_2.y * t_7))));
+    float s_4 = (min(max(z_1, 0.0), f_20.theta.z) / max(dot(dir_12, f_20.cam_forward.xyz), 1e-6));
     r = ConstructPstRay(false, float3(0.0, 0.0, 0.0), eye_9, dir_12, s_4, 0u, 0.0, 0.0, 0.0);
-    const bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, pc_1);
+    const bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, pc_1);
     if (_e67) {
         r.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e72 = frame;
         const float _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_4, true);
-        r.color = (_e75 * f_17.light_color.xyz);
+        r.color = (_e75 * f_20.light_color.xyz);
     }
-    const float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, dir_12);
+    const float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
     r.theta = _e80;
-    const float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, dir_12);
-    const uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_17.sizes.w, (f_17.anti_epipole.w > 0.5));
+    const float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
+    const uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_20.sizes.w, (f_20.anti_epipole.w > 0.5));
     r.row = _e90;
     float _e93 = r.theta;
-    const float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_17.theta.x, f_17.theta.y);
+    const float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_20.theta.x, f_20.theta.y);
     r.d = _e98;
     float _e101 = r.theta;
-    const float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17, eye_9, dir_12, s_4, _e101, true);
+    const float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, eye_9, dir_12, s_4, _e101, true);
     r.xs_num = _e102;
     PstRay _e103 = r;
     const PstRay pstray = _e103;
@@ -672,25 +742,25 @@ uint pst_columns_crossed(PstRay r_1, float delta_3)
     return naga_f2u32(min(ceil(((xs > 0.0) ? xs : 0.0)), float(_e12)));
 }
 
-float2 pst_terms(PstRay r_2, uint row_2, float delta_4, uint n_2)
+float2 pst_terms(PstRay r_2, uint row_4, float delta_4, uint n_2)
 {
     float tail = 0.0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = frame;
     float sin_theta = max(sin(r_2.theta), 1e-6);
-    float4 _e16 = rectified.Load(int3(uint2((n_2 - 1u), row_2), int(0)));
+    float4 _e16 = rectified.Load(int3(uint2((n_2 - 1u), row_4), int(0)));
     if ((r_2.d <= _e16.x)) {
-        const float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        const float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        const float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        const float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return float2((f_18.medium.y / (f_18.axis.w * sin_theta)), _e37);
+        return float2((f_21.medium.y / (f_21.axis.w * sin_theta)), _e37);
     }
-    const float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.z, -(dot(f_18.light_dir.xyz, r_2.dir)));
-    float sp = (f_18.medium.y * _e48);
-    const float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, 0.0, (delta_4 / sin_theta));
+    const float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.z, -(dot(f_21.light_dir.xyz, r_2.dir)));
+    float sp = (f_21.medium.y * _e48);
+    const float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.x, 0.0, (delta_4 / sin_theta));
     float _e56 = tail;
     return float2((sp * _e54), (sp * _e56));
 }
@@ -699,10 +769,10 @@ float3 pst_sweep_pixel(uint x_4, uint y)
 {
     float sum_2 = 0.0;
     uint h_4 = 0u;
-    float4 p_3 = (float4)0;
+    float4 p_4 = (float4)0;
     uint i_1 = (uint)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = frame;
     float4 _e16 = depth.Load(int3(uint2(x_4, y), int(0)));
     const PstRay _e18 = pst_ray(float2((float(x_4) + 0.5), (float(y) + 0.5)), _e16.x);
     if (_e18.marched) {
@@ -715,34 +785,34 @@ float3 pst_sweep_pixel(uint x_4, uint y)
     if ((_e27 == 0u)) {
         return float3(0.0, 0.0, 0.0);
     }
-    uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
-    bool loop_init_4 = true;
+    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
+    bool loop_init_5 = true;
     while(true) {
-        if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
+        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
             uint _e77 = h_4;
             h_4 = (_e77 + 1u);
         }
-        loop_init_4 = false;
+        loop_init_5 = false;
         uint _e35 = h_4;
         if ((_e35 < RANK_VECS)) {
         } else {
             break;
         }
         {
-            p_3 = float4(0.0, 0.0, 0.0, 0.0);
+            p_4 = float4(0.0, 0.0, 0.0, 0.0);
             i_1 = 0u;
-            uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
-            bool loop_init_5 = true;
+            uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
+            bool loop_init_6 = true;
             while(true) {
-                if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
-                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-                if (!loop_init_5) {
+                if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
+                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                if (!loop_init_6) {
                     uint _e66 = i_1;
                     i_1 = (_e66 + 1u);
                 }
-                loop_init_5 = false;
+                loop_init_6 = false;
                 uint _e46 = i_1;
                 if (((_e46 + 1u) < _e27)) {
                 } else {
@@ -752,16 +822,16 @@ float3 pst_sweep_pixel(uint x_4, uint y)
                     uint _e51 = i_1;
                     float4 _e56 = rectified.Load(int3(uint2(_e51, _e18.row), int(0)));
                     if ((_e18.d <= _e56.x)) {
-                        float4 _e59 = p_3;
+                        float4 _e59 = p_4;
                         uint _e60 = i_1;
                         uint _e62 = h_4;
-                        const float4 _e63 = pst_leaf(f_19, _e60, _e18.row, delta_5, _e62);
-                        p_3 = (_e59 + _e63);
+                        const float4 _e63 = pst_leaf(f_22, _e60, _e18.row, delta_5, _e62);
+                        p_4 = (_e59 + _e63);
                     }
                 }
             }
             float _e69 = sum_2;
-            float4 _e70 = p_3;
+            float4 _e70 = p_4;
             uint _e72 = h_4;
             const float4 _e73 = beta_at(_e18.theta, _e72);
             sum_2 = (_e69 + dot(_e70, _e73));
@@ -769,7 +839,7 @@ float3 pst_sweep_pixel(uint x_4, uint y)
     }
     const float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
     float _e84 = sum_2;
-    return (f_19.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
+    return (f_22.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
 }
 
 uint2 naga_div(uint2 lhs, uint2 rhs) {
@@ -788,16 +858,16 @@ void pst_sweep_fallback(uint3 id : SV_DispatchThreadID)
     uint _e18 = asuint(fallback_count.Load(0));
     uint n_4 = min(_e18, (screen.x * screen.y));
     e = ((id.y * lanes.x) + id.x);
-    uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
-    bool loop_init_6 = true;
+    uint2 loop_bound_7 = uint2(4294967295u, 4294967295u);
+    bool loop_init_7 = true;
     while(true) {
-        if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
-        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-        if (!loop_init_6) {
+        if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
+        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+        if (!loop_init_7) {
             uint _e54 = e;
             e = (_e54 + (lanes.x * lanes.y));
         }
-        loop_init_6 = false;
+        loop_init_7 = false;
         uint _e30 = e;
         if ((_e30 < n_4)) {
         } else {

@@ -262,11 +262,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
                 }
                 {
                     uint _e48 = q;
-                    float u = tan((mid + ((0.5 * w_3) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
+                    float u_1 = tan((mid + ((0.5 * w_3) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e48])));
                     float _e54 = sum;
                     uint _e56 = q;
-                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u * u))));
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, (t0_ + (h_5 * u_1)), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = (_e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[_e56] * _e64) * (1.0 + (u_1 * u_1))));
                 }
             }
         }
@@ -299,39 +299,105 @@ float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_
     return (f_1.e1_.w + ((float(row) + 0.5) * f_1.e2_.w));
 }
 
+vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2) {
+    return vec2(float(f_2.sizes.x), float(f_2.sizes.y));
+}
+
+float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
+    float t_in = 0.0;
+    float t_out = 3.4e38;
+    uint a_3 = 0u;
+    bool loop_init_2 = true;
+    while(true) {
+        if (!loop_init_2) {
+            uint _e45 = a_3;
+            a_3 = (_e45 + 1u);
+        }
+        loop_init_2 = false;
+        uint _e4 = a_3;
+        if ((_e4 < 2u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = a_3;
+            uint _e13 = a_3;
+            float ta = ((0.5 - o_1[_e8]) / u[_e13]);
+            uint _e17 = a_3;
+            uint _e21 = a_3;
+            uint _e24 = a_3;
+            float tb = (((size[_e17] - 0.5) - o_1[_e21]) / u[_e24]);
+            uint _e27 = a_3;
+            bool crosses = (abs(u[_e27]) > 1e-12);
+            float _e33 = t_in;
+            float _e34 = t_in;
+            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
+            float _e39 = t_out;
+            float _e40 = t_out;
+            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
+        }
+    }
+    float _e47 = t_in;
+    float _e48 = t_out;
+    float _e49 = t_in;
+    return (0.5 * (_e47 + max(_e48, _e49)));
+}
+
+vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_2) {
+    vec2 ndc = vec2((((2.0 * p_2.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_3.sizes.y))));
+    float t_6 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_6) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_6))));
+}
+
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
+    float a_8 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    vec2 ax = f_4.fan_origin.zw;
+    vec2 u_2 = vec2(((ax.x * cos(a_8)) - (ax.y * sin(a_8))), ((ax.y * cos(a_8)) + (ax.x * sin(a_8))));
+    vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
+    return atan(dot(_e36, f_4.e2_.xyz), dot(_e36, f_4.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, uint row_2) {
+    float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return ((f_5.fan_angles.z > 0.5) ? _e3 : _e2);
+}
+
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float theta, float lo, float hi) {
     return (DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX + (0.8 * clamp(((theta - lo) / max((hi - lo), 1e-6)), 0.0, 1.0)));
 }
 
-ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2) {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, uvec4(f_2.sizes2_.x, 0u, 0u, 0u));
+ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6) {
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(f_6.sm_right, f_6.sm_up, f_6.sm_forward, f_6.sm_origin, f_6.sm_proj, uvec4(f_6.sizes2_.x, 0u, 0u, 0u));
 }
 
-float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, sampler2D sm_4, vec3 p_2, bool spot) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_2, spot);
+float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, sampler2D sm_4, vec3 p_3, bool spot) {
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
+    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_3, spot);
     return _e5;
 }
 
-float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, vec3 eye_3, vec3 dir_3, float t_1) {
-    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_4.light_pos.xyz, f_4.light_dir.xyz, f_4.light_pos.w, f_4.light_dir.w, f_4.medium);
+float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 eye_3, vec3 dir_3, float t_1) {
+    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot_1) {
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_4, float b_3, uint steps, bool spot_1) {
     float sum_1 = 0.0;
     uint k_1 = 0u;
     float t_2 = 0.0;
     float w = 0.0;
-    float h_7 = ((b_3 - a_3) / float(steps));
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
-    bool loop_init_2 = true;
+    float h_7 = ((b_3 - a_4) / float(steps));
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
+    bool loop_init_3 = true;
     while(true) {
-        if (!loop_init_2) {
+        if (!loop_init_3) {
             uint _e65 = k_1;
             k_1 = (_e65 + 1u);
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e15 = k_1;
         if (((_e15 + 1u) <= steps)) {
         } else {
@@ -339,7 +405,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
         }
         {
             uint _e19 = k_1;
-            t_2 = (a_3 + ((float(_e19) + 0.5) * h_7));
+            t_2 = (a_4 + ((float(_e19) + 0.5) * h_7));
             w = h_7;
             if (spot_1) {
                 uint _e28 = k_1;
@@ -348,18 +414,18 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
                 w = _e32.y;
             }
             float _e35 = t_2;
-            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
+            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, sm_5, (eye_4 + (dir_4 * _e35)), spot_1);
             if (spot_1) {
                 float _e41 = sum_1;
                 float _e42 = w;
                 float _e44 = t_2;
-                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e44);
+                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_4, dir_4, _e44);
                 sum_1 = (_e41 + ((_e39 * _e42) * _e45));
             } else {
                 float _e48 = sum_1;
                 uint _e51 = k_1;
                 uint _e55 = k_1;
-                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, (a_3 + (float(_e51) * h_7)), (a_3 + (float((_e55 + 1u)) * h_7)));
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_4 + (float(_e51) * h_7)), (a_4 + (float((_e55 + 1u)) * h_7)));
                 sum_1 = (_e48 + (_e39 * _e61));
             }
         }
@@ -368,20 +434,20 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
     return _e67;
 }
 
-float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, sampler2D sm_6, vec3 eye_5, vec3 dir_5, float s, bool spot_2) {
-    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_2);
+float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, sampler2D sm_6, vec3 eye_5, vec3 dir_5, float s, bool spot_2) {
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, sm_6, eye_5, dir_5, 0.0, s, f_10.sizes2_.y, spot_2);
     if (spot_2) {
         return _e9;
     } else {
-        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(dot(f_6.light_dir.xyz, dir_5)));
-        return ((f_6.medium.y * _e18) * _e9);
+        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, -(dot(f_10.light_dir.xyz, dir_5)));
+        return ((f_10.medium.y * _e18) * _e9);
     }
 }
 
-bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, vec2 pc) {
-    float radius = f_7.epipole.w;
-    bool near_epi = ((f_7.epipole.z > 0.5) && (length((pc - f_7.epipole.xy)) < radius));
-    bool near_anti = ((f_7.anti_epipole.z > 0.5) && (length((pc - f_7.anti_epipole.xy)) < radius));
+bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec2 pc) {
+    float radius = f_11.epipole.w;
+    bool near_epi = ((f_11.epipole.z > 0.5) && (length((pc - f_11.epipole.xy)) < radius));
+    bool near_anti = ((f_11.anti_epipole.z > 0.5) && (length((pc - f_11.anti_epipole.xy)) < radius));
     return (near_epi || near_anti);
 }
 
@@ -390,40 +456,36 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float j_1, uint rows
     return (wrap ? uint((((ji % int(rows)) + int(rows)) % int(rows))) : uint(min(max(ji, 0), (int(rows) - 1))));
 }
 
-float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8, vec3 dir_6) {
-    vec3 axis_1 = f_8.axis.xyz;
+float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, vec3 dir_6) {
+    vec3 axis_1 = f_12.axis.xyz;
     return atan(length(cross(dir_6, axis_1)), dot(dir_6, axis_1));
 }
 
-vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9) {
-    return vec2(float(f_9.sizes.x), float(f_9.sizes.y));
+float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, vec3 dir_7) {
+    uint rows_1 = f_13.sizes.w;
+    float phi_1 = atan(dot(dir_7, f_13.e2_.xyz), dot(dir_7, f_13.e1_.xyz));
+    float z_5 = dot(dir_7, f_13.cam_forward.xyz);
+    float t_7 = f_13.cam_forward.w;
+    vec2 ndc_1 = vec2((dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_7) * f_13.cam_right.w)), (dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_7)));
+    vec2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13);
+    vec2 p_7 = (vec2(((ndc_1.x + 1.0) * 0.5), ((1.0 - ndc_1.y) * 0.5)) * _e41);
+    vec2 d_3 = (p_7 - f_13.fan_origin.xy);
+    vec2 ax_1 = f_13.fan_origin.zw;
+    float fan = ((atan(((ax_1.x * d_3.y) - (ax_1.y * d_3.x)), ((ax_1.x * d_3.x) + (ax_1.y * d_3.y))) - f_13.fan_angles.x) / f_13.fan_angles.y);
+    float yc = ((f_13.fan_angles.z > 0.5) ? fan : ((phi_1 - f_13.e1_.w) / f_13.e2_.w));
+    return ((f_13.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
 }
 
-float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10, vec3 dir_7) {
-    uint rows_1 = f_10.sizes.w;
-    float phi_1 = atan(dot(dir_7, f_10.e2_.xyz), dot(dir_7, f_10.e1_.xyz));
-    float z_5 = dot(dir_7, f_10.cam_forward.xyz);
-    float t_6 = f_10.cam_forward.w;
-    vec2 ndc = vec2((dot(dir_7, f_10.cam_right.xyz) / ((z_5 * t_6) * f_10.cam_right.w)), (dot(dir_7, f_10.cam_up.xyz) / (z_5 * t_6)));
-    vec2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10);
-    vec2 p_6 = (vec2(((ndc.x + 1.0) * 0.5), ((1.0 - ndc.y) * 0.5)) * _e41);
-    vec2 d_3 = (p_6 - f_10.fan_origin.xy);
-    vec2 ax = f_10.fan_origin.zw;
-    float fan = ((atan(((ax.x * d_3.y) - (ax.y * d_3.x)), ((ax.x * d_3.x) + (ax.y * d_3.y))) - f_10.fan_angles.x) / f_10.fan_angles.y);
-    float yc = ((f_10.fan_angles.z > 0.5) ? fan : ((phi_1 - f_10.e1_.w) / f_10.e2_.w));
-    return ((f_10.anti_epipole.w > 0.5) ? (yc - (floor((yc / float(rows_1))) * float(rows_1))) : clamp(yc, 0.0, float(rows_1)));
-}
-
-float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
+float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, vec3 eye_6, vec3 dir_8, float s_1, float theta_1, bool spot_3) {
     if (spot_3) {
-        vec3 q_3 = ((eye_6 + (dir_8 * s_1)) - f_11.light_pos.xyz);
-        vec3 to_eye = -(f_11.axis.xyz);
+        vec3 q_3 = ((eye_6 + (dir_8 * s_1)) - f_14.light_pos.xyz);
+        vec3 to_eye = -(f_14.axis.xyz);
         return atan(length(cross(q_3, to_eye)), dot(q_3, to_eye));
     }
     return (s_1 * sin(theta_1));
 }
 
-float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12, float x_1, float delta, float theta_2, float s_2, bool spot_4) {
+float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, float x_1, float delta, float theta_2, float s_2, bool spot_4) {
     bool local_1 = false;
     if (spot_4) {
         float psi = (x_1 * delta);
@@ -437,38 +499,38 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XON
         if (_e16) {
             return s_2;
         }
-        return min(((f_12.axis.w * sin(psi)) / den), s_2);
+        return min(((f_15.axis.w * sin(psi)) / den), s_2);
     } else {
         return min(((x_1 * delta) / max(sin(theta_2), 1e-6)), s_2);
     }
 }
 
-float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
+float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16, uint x_2, uint n_1, float delta_1, float theta_3, float s_3, bool spot_5) {
     if ((x_2 >= n_1)) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, float(x_2), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, float(x_2), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_14.light_pos.xyz, f_14.light_dir.xyz, f_14.light_pos.w, f_14.light_dir.w, f_14.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, vec3 eye_7, vec3 dir_9, float a_5, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, vec3 eye_8, vec3 dir_10, float a_6, float b_5, bool spot_6) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_8, dir_10, a_5, b_5, max((f_15.sizes2_.z / 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, max((f_18.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, a_5, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
     return _e15;
 }
 
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b_6, float depth_break) {
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_7, float b_6, float depth_break) {
     bool local_2 = false;
-    if (!((a_6 == b_6))) {
-        local_2 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
+    if (!((a_7 == b_6))) {
+        local_2 = (abs((a_7 - b_6)) <= (depth_break * min(a_7, b_6)));
     } else {
         local_2 = true;
     }
@@ -486,13 +548,13 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w_1, vec4 de
     uint k_2 = 0u;
     bool local_3 = false;
     bool local_4 = false;
-    bool loop_init_3 = true;
+    bool loop_init_4 = true;
     while(true) {
-        if (!loop_init_3) {
+        if (!loop_init_4) {
             uint _e63 = k_2;
             k_2 = (_e63 + 1u);
         }
-        loop_init_3 = false;
+        loop_init_4 = false;
         uint _e6 = k_2;
         if ((_e6 < 4u)) {
         } else {
@@ -561,19 +623,19 @@ float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec
     return atan(((axis.x * d_1.y) - (axis.y * d_1.x)), ((axis.x * d_1.x) + (axis.y * d_1.y)));
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uvec2 p_3, uint slices) {
+EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uvec2 p_4, uint slices) {
     uint s_lo = 0u;
     float fs = 0.0;
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_3 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
-    vec2 d_4 = ((vec2(p_3) + vec2(0.5, 0.5)) - l_1.origin);
+    vec2 d_4 = ((vec2(p_4) + vec2(0.5, 0.5)) - l_1.origin);
     float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
-    float f_17 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
+    float f_20 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
     if ((l_1.wrap != 0u)) {
-        float fl = floor(f_17);
-        fs = (f_17 - fl);
+        float fl = floor(f_20);
+        fs = (f_20 - fl);
         s_lo = (uint((int(fl) + int(slices))) % slices);
     } else {
-        float fc = clamp(f_17, 0.0, float((slices - 1u)));
+        float fc = clamp(f_20, 0.0, float((slices - 1u)));
         s_lo = min(uint(fc), (slices - 2u));
         uint _e41 = s_lo;
         fs = (fc - float(_e41));
@@ -588,19 +650,19 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     return _e60;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2, uvec2 p_4, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, vec4 line_lo, vec4 line_hi, uint samples) {
+EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2, uvec2 p_5, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, vec4 line_lo, vec4 line_hi, uint samples) {
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_4 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
     uint j_2 = 0u;
-    vec2 d_5 = ((vec2(p_4) + vec2(0.5, 0.5)) - l_2.origin);
+    vec2 d_5 = ((vec2(p_5) + vec2(0.5, 0.5)) - l_2.origin);
     t_4 = pair;
     vec2 ws = pair.w.xy;
-    bool loop_init_4 = true;
+    bool loop_init_5 = true;
     while(true) {
-        if (!loop_init_4) {
+        if (!loop_init_5) {
             uint _e68 = j_2;
             j_2 = (_e68 + 1u);
         }
-        loop_init_4 = false;
+        loop_init_5 = false;
         uint _e15 = j_2;
         if ((_e15 < 2u)) {
         } else {
@@ -677,13 +739,13 @@ void main() {
     int _e59_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
     vec4 line_hi_1 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.y)), ivec2(0), textureSize(_group_0_binding_10_cs, _e59_clamped_lod) - ivec2(1)), _e59_clamped_lod);
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    bool loop_init_5 = true;
+    bool loop_init_6 = true;
     while(true) {
-        if (!loop_init_5) {
+        if (!loop_init_6) {
             uint _e93 = j;
             j = (_e93 + 1u);
         }
-        loop_init_5 = false;
+        loop_init_6 = false;
         uint _e63 = j;
         if ((_e63 < 4u)) {
         } else {

@@ -338,11 +338,11 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
                 }
                 {
                     uint _e48 = q;
-                    float u = metal::tan(mid + ((0.5 * w_3) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
+                    float u_1 = metal::tan(mid + ((0.5 * w_3) * GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e48), 3u)]));
                     float _e54 = sum;
                     uint _e56 = q;
-                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_5 * u), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
-                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u * u)));
+                    float _e64 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1, dir_1, t0_ + (h_5 * u_1), light_pos_1, light_dir_1, cos_inner_2, cos_outer_2, medium_1);
+                    sum = _e54 + ((GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX[metal::min(unsigned(_e56), 3u)] * _e64) * (1.0 + (u_1 * u_1)));
                 }
             }
         }
@@ -393,6 +393,90 @@ float axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     return f_1.e1_.w + ((static_cast<float>(row) + 0.5) * f_1.e2_.w);
 }
 
+metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2
+) {
+    return metal::float2(static_cast<float>(f_2.sizes.x), static_cast<float>(f_2.sizes.y));
+}
+
+float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    metal::float2 o_1,
+    metal::float2 u,
+    metal::float2 size
+) {
+    float t_in = 0.0;
+    float t_out = 340000000000000000000000000000000000000.0;
+    uint a_3 = 0u;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e45 = a_3;
+            a_3 = _e45 + 1u;
+        }
+        loop_init_2 = false;
+        uint _e4 = a_3;
+        if (_e4 < 2u) {
+        } else {
+            break;
+        }
+        {
+            uint _e8 = a_3;
+            uint _e13 = a_3;
+            float ta = (0.5 - o_1[metal::min(unsigned(_e8), 1u)]) / u[metal::min(unsigned(_e13), 1u)];
+            uint _e17 = a_3;
+            uint _e21 = a_3;
+            uint _e24 = a_3;
+            float tb = ((size[metal::min(unsigned(_e17), 1u)] - 0.5) - o_1[metal::min(unsigned(_e21), 1u)]) / u[metal::min(unsigned(_e24), 1u)];
+            uint _e27 = a_3;
+            bool crosses = metal::abs(u[metal::min(unsigned(_e27), 1u)]) > 0.000000000001;
+            float _e33 = t_in;
+            float _e34 = t_in;
+            t_in = crosses ? metal::max(_e34, metal::min(ta, tb)) : _e33;
+            float _e39 = t_out;
+            float _e40 = t_out;
+            t_out = crosses ? metal::min(_e40, metal::max(ta, tb)) : _e39;
+        }
+    }
+    float _e47 = t_in;
+    float _e48 = t_out;
+    float _e49 = t_in;
+    return 0.5 * (_e47 + metal::max(_e48, _e49));
+}
+
+metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
+    metal::float2 p_2
+) {
+    metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_3.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_3.sizes.y)));
+    float t_6 = f_3.cam_forward.w;
+    return metal::normalize((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_6) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_6)));
+}
+
+float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
+    uint row_1
+) {
+    float a_8 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
+    metal::float2 ax = f_4.fan_origin.zw;
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_8)) - (ax.y * metal::sin(a_8)), (ax.y * metal::cos(a_8)) + (ax.x * metal::sin(a_8)));
+    metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
+    float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
+    metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, f_4.fan_origin.xy + (u_2 * _e33));
+    return metal::atan2(metal::dot(_e36, f_4.e2_.xyz), metal::dot(_e36, f_4.e1_.xyz));
+}
+
+float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
+    uint row_2
+) {
+    float _e2 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    float _e3 = fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, row_2);
+    return (f_5.fan_angles.z > 0.5) ? _e3 : _e2;
+}
+
 float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float theta,
     float lo,
@@ -402,38 +486,38 @@ float normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_2
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6
 ) {
-    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f_2.sm_right, f_2.sm_up, f_2.sm_forward, f_2.sm_origin, f_2.sm_proj, metal::uint4(f_2.sizes2_.x, 0u, 0u, 0u)};
+    return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {f_6.sm_right, f_6.sm_up, f_6.sm_forward, f_6.sm_origin, f_6.sm_proj, metal::uint4(f_6.sizes2_.x, 0u, 0u, 0u)};
 }
 
 float sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
     metal::texture2d<float, metal::access::sample> sm_4,
-    metal::float3 p_2,
+    metal::float3 p_3,
     bool spot
 ) {
-    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3);
-    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_2, spot);
+    ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e1 = sm_viewX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7);
+    float _e5 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e1, sm_4, p_3, spot);
     return _e5;
 }
 
 float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
     metal::float3 eye_3,
     metal::float3 dir_3,
     float t_1
 ) {
-    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_4.light_pos.xyz, f_4.light_dir.xyz, f_4.light_pos.w, f_4.light_dir.w, f_4.medium);
+    float _e13 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_3, dir_3, t_1, f_8.light_pos.xyz, f_8.light_dir.xyz, f_8.light_pos.w, f_8.light_dir.w, f_8.medium);
     return _e13;
 }
 
 float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_5,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9,
     metal::texture2d<float, metal::access::sample> sm_5,
     metal::float3 eye_4,
     metal::float3 dir_4,
-    float a_3,
+    float a_4,
     float b_3,
     uint steps,
     bool spot_1
@@ -442,18 +526,18 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     uint k_1 = 0u;
     float t_2 = {};
     float w = {};
-    float h_7 = (b_3 - a_3) / static_cast<float>(steps);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_5.light_pos.xyz, a_3, b_3, steps);
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
+    float h_7 = (b_3 - a_4) / static_cast<float>(steps);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e65 = k_1;
             k_1 = _e65 + 1u;
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e15 = k_1;
         if ((_e15 + 1u) <= steps) {
         } else {
@@ -461,7 +545,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         }
         {
             uint _e19 = k_1;
-            t_2 = a_3 + ((static_cast<float>(_e19) + 0.5) * h_7);
+            t_2 = a_4 + ((static_cast<float>(_e19) + 0.5) * h_7);
             w = h_7;
             if (spot_1) {
                 uint _e28 = k_1;
@@ -470,18 +554,18 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
                 w = _e32.y;
             }
             float _e35 = t_2;
-            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, sm_5, eye_4 + (dir_4 * _e35), spot_1);
+            float _e39 = sm_visibilityX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, sm_5, eye_4 + (dir_4 * _e35), spot_1);
             if (spot_1) {
                 float _e41 = sum_1;
                 float _e42 = w;
                 float _e44 = t_2;
-                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5, eye_4, dir_4, _e44);
+                float _e45 = frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9, eye_4, dir_4, _e44);
                 sum_1 = _e41 + ((_e39 * _e42) * _e45);
             } else {
                 float _e48 = sum_1;
                 uint _e51 = k_1;
                 uint _e55 = k_1;
-                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_5.medium.x, a_3 + (static_cast<float>(_e51) * h_7), a_3 + (static_cast<float>(_e55 + 1u) * h_7));
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4 + (static_cast<float>(_e51) * h_7), a_4 + (static_cast<float>(_e55 + 1u) * h_7));
                 sum_1 = _e48 + (_e39 * _e61);
             }
         }
@@ -491,29 +575,29 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 float epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
     metal::texture2d<float, metal::access::sample> sm_6,
     metal::float3 eye_5,
     metal::float3 dir_5,
     float s,
     bool spot_2
 ) {
-    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_6, sm_6, eye_5, dir_5, 0.0, s, f_6.sizes2_.y, spot_2);
+    float _e9 = span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10, sm_6, eye_5, dir_5, 0.0, s, f_10.sizes2_.y, spot_2);
     if (spot_2) {
         return _e9;
     } else {
-        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_6.medium.z, -(metal::dot(f_6.light_dir.xyz, dir_5)));
-        return (f_6.medium.y * _e18) * _e9;
+        float _e18 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_10.medium.z, -(metal::dot(f_10.light_dir.xyz, dir_5)));
+        return (f_10.medium.y * _e18) * _e9;
     }
 }
 
 bool in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
     metal::float2 pc
 ) {
-    float radius = f_7.epipole.w;
-    bool near_epi = (f_7.epipole.z > 0.5) & (metal::length(pc - f_7.epipole.xy) < radius);
-    bool near_anti = (f_7.anti_epipole.z > 0.5) & (metal::length(pc - f_7.anti_epipole.xy) < radius);
+    float radius = f_11.epipole.w;
+    bool near_epi = (f_11.epipole.z > 0.5) & (metal::length(pc - f_11.epipole.xy) < radius);
+    bool near_anti = (f_11.anti_epipole.z > 0.5) & (metal::length(pc - f_11.anti_epipole.xy) < radius);
     return near_epi | near_anti;
 }
 
@@ -536,39 +620,33 @@ uint row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 float ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_8,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
     metal::float3 dir_6
 ) {
-    metal::float3 axis_1 = f_8.axis.xyz;
+    metal::float3 axis_1 = f_12.axis.xyz;
     return metal::atan2(metal::length(metal::cross(dir_6, axis_1)), metal::dot(dir_6, axis_1));
 }
 
-metal::float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9
-) {
-    return metal::float2(static_cast<float>(f_9.sizes.x), static_cast<float>(f_9.sizes.y));
-}
-
 float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_10,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
     metal::float3 dir_7
 ) {
-    uint rows_1 = f_10.sizes.w;
-    float phi_1 = metal::atan2(metal::dot(dir_7, f_10.e2_.xyz), metal::dot(dir_7, f_10.e1_.xyz));
-    float z_5 = metal::dot(dir_7, f_10.cam_forward.xyz);
-    float t_6 = f_10.cam_forward.w;
-    metal::float2 ndc = metal::float2(metal::dot(dir_7, f_10.cam_right.xyz) / ((z_5 * t_6) * f_10.cam_right.w), metal::dot(dir_7, f_10.cam_up.xyz) / (z_5 * t_6));
-    metal::float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_10);
-    metal::float2 p_6 = metal::float2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * _e41;
-    metal::float2 d_3 = p_6 - f_10.fan_origin.xy;
-    metal::float2 ax = f_10.fan_origin.zw;
-    float fan = (metal::atan2((ax.x * d_3.y) - (ax.y * d_3.x), (ax.x * d_3.x) + (ax.y * d_3.y)) - f_10.fan_angles.x) / f_10.fan_angles.y;
-    float yc = (f_10.fan_angles.z > 0.5) ? fan : ((phi_1 - f_10.e1_.w) / f_10.e2_.w);
-    return (f_10.anti_epipole.w > 0.5) ? (yc - (metal::floor(yc / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc, 0.0, static_cast<float>(rows_1));
+    uint rows_1 = f_13.sizes.w;
+    float phi_1 = metal::atan2(metal::dot(dir_7, f_13.e2_.xyz), metal::dot(dir_7, f_13.e1_.xyz));
+    float z_5 = metal::dot(dir_7, f_13.cam_forward.xyz);
+    float t_7 = f_13.cam_forward.w;
+    metal::float2 ndc_1 = metal::float2(metal::dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_7) * f_13.cam_right.w), metal::dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_7));
+    metal::float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13);
+    metal::float2 p_7 = metal::float2((ndc_1.x + 1.0) * 0.5, (1.0 - ndc_1.y) * 0.5) * _e41;
+    metal::float2 d_3 = p_7 - f_13.fan_origin.xy;
+    metal::float2 ax_1 = f_13.fan_origin.zw;
+    float fan = (metal::atan2((ax_1.x * d_3.y) - (ax_1.y * d_3.x), (ax_1.x * d_3.x) + (ax_1.y * d_3.y)) - f_13.fan_angles.x) / f_13.fan_angles.y;
+    float yc = (f_13.fan_angles.z > 0.5) ? fan : ((phi_1 - f_13.e1_.w) / f_13.e2_.w);
+    return (f_13.anti_epipole.w > 0.5) ? (yc - (metal::floor(yc / static_cast<float>(rows_1)) * static_cast<float>(rows_1))) : metal::clamp(yc, 0.0, static_cast<float>(rows_1));
 }
 
 float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_11,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14,
     metal::float3 eye_6,
     metal::float3 dir_8,
     float s_1,
@@ -576,15 +654,15 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     bool spot_3
 ) {
     if (spot_3) {
-        metal::float3 q_3 = (eye_6 + (dir_8 * s_1)) - f_11.light_pos.xyz;
-        metal::float3 to_eye = -(f_11.axis.xyz);
+        metal::float3 q_3 = (eye_6 + (dir_8 * s_1)) - f_14.light_pos.xyz;
+        metal::float3 to_eye = -(f_14.axis.xyz);
         return metal::atan2(metal::length(metal::cross(q_3, to_eye)), metal::dot(q_3, to_eye));
     }
     return s_1 * metal::sin(theta_1);
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15,
     float x_1,
     float delta,
     float theta_2,
@@ -604,14 +682,14 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         if (_e16) {
             return s_2;
         }
-        return metal::min((f_12.axis.w * metal::sin(psi)) / den, s_2);
+        return metal::min((f_15.axis.w * metal::sin(psi)) / den, s_2);
     } else {
         return metal::min((x_1 * delta) / metal::max(metal::sin(theta_2), 0.000001), s_2);
     }
 }
 
 float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16,
     uint x_2,
     uint n_1,
     float delta_1,
@@ -622,19 +700,19 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     if (x_2 >= n_1) {
         return s_3;
     }
-    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, static_cast<float>(x_2), delta_1, theta_3, s_3, spot_5);
+    float _e9 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, static_cast<float>(x_2), delta_1, theta_3, s_3, spot_5);
     return _e9;
 }
 
 float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_14,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17,
     metal::float3 eye_7,
     metal::float3 dir_9,
-    float a_4,
+    float a_5,
     float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_14.light_pos.xyz, f_14.light_dir.xyz, f_14.light_pos.w, f_14.light_dir.w, f_14.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
@@ -643,29 +721,29 @@ uint naga_div(uint lhs, uint rhs) {
 }
 
 float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18,
     metal::float3 eye_8,
     metal::float3 dir_10,
-    float a_5,
+    float a_6,
     float b_5,
     bool spot_6
 ) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_15.sizes2_.z, 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, metal::max(naga_div(f_18.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_15.medium.x, a_5, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
     return _e15;
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_6,
+    float a_7,
     float b_6,
     float depth_break
 ) {
     bool local_2 = {};
-    if (!((a_6 == b_6))) {
-        local_2 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
+    if (!((a_7 == b_6))) {
+        local_2 = metal::abs(a_7 - b_6) <= (depth_break * metal::min(a_7, b_6));
     } else {
         local_2 = true;
     }
@@ -690,16 +768,16 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     uint k_2 = 0u;
     bool local_3 = {};
     bool local_4 = {};
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
             uint _e63 = k_2;
             k_2 = _e63 + 1u;
         }
-        loop_init_3 = false;
+        loop_init_4 = false;
         uint _e6 = k_2;
         if (_e6 < 4u) {
         } else {
@@ -777,21 +855,21 @@ uint naga_mod(uint lhs, uint rhs) {
 
 EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1,
-    metal::uint2 p_3,
+    metal::uint2 p_4,
     uint slices
 ) {
     uint s_lo = 0u;
     float fs = 0.0;
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_3 = {};
-    metal::float2 d_4 = (static_cast<metal::float2>(p_3) + metal::float2(0.5, 0.5)) - l_1.origin;
+    metal::float2 d_4 = (static_cast<metal::float2>(p_4) + metal::float2(0.5, 0.5)) - l_1.origin;
     float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
-    float f_17 = ((_e12 - l_1.phi_start) / l_1.dphi) - 0.5;
+    float f_20 = ((_e12 - l_1.phi_start) / l_1.dphi) - 0.5;
     if (l_1.wrap != 0u) {
-        float fl = metal::floor(f_17);
-        fs = f_17 - fl;
+        float fl = metal::floor(f_20);
+        fs = f_20 - fl;
         s_lo = naga_mod(static_cast<uint>(as_type<int>(as_type<uint>(naga_f2i32(fl)) + as_type<uint>(static_cast<int>(slices)))), slices);
     } else {
-        float fc = metal::clamp(f_17, 0.0, static_cast<float>(slices - 1u));
+        float fc = metal::clamp(f_20, 0.0, static_cast<float>(slices - 1u));
         s_lo = metal::min(naga_f2u32(fc), slices - 2u);
         uint _e41 = s_lo;
         fs = fc - static_cast<float>(_e41);
@@ -808,7 +886,7 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
 
 EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2,
-    metal::uint2 p_4,
+    metal::uint2 p_5,
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair,
     metal::float4 line_lo,
     metal::float4 line_hi,
@@ -816,19 +894,19 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
 ) {
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_4 = {};
     uint j_2 = 0u;
-    metal::float2 d_5 = (static_cast<metal::float2>(p_4) + metal::float2(0.5, 0.5)) - l_2.origin;
+    metal::float2 d_5 = (static_cast<metal::float2>(p_5) + metal::float2(0.5, 0.5)) - l_2.origin;
     t_4 = pair;
     metal::float2 ws = pair.w.xy;
-    uint2 loop_bound_4 = uint2(4294967295u);
-    bool loop_init_4 = true;
+    uint2 loop_bound_5 = uint2(4294967295u);
+    bool loop_init_5 = true;
     while(true) {
-        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
+        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
             uint _e68 = j_2;
             j_2 = _e68 + 1u;
         }
-        loop_init_4 = false;
+        loop_init_5 = false;
         uint _e15 = j_2;
         if (_e15 < 2u) {
         } else {
@@ -886,12 +964,12 @@ metal::float4 factor_at(
     device type_10 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    float p_7 = metal::min(metal::clamp(x_3, 0.0, 1.0) * 95.0, 95.0);
-    uint j_3 = metal::min(naga_f2u32(metal::floor(p_7)), 94u);
-    float t_7 = p_7 - static_cast<float>(j_3);
+    float p_8 = metal::min(metal::clamp(x_3, 0.0, 1.0) * 95.0, 95.0);
+    uint j_3 = metal::min(naga_f2u32(metal::floor(p_8)), 94u);
+    float t_8 = p_8 - static_cast<float>(j_3);
     metal::float4 _e22 = pst_factors[metal::min(unsigned((base + (2u * j_3)) + h), (_buffer_sizes.size5 - 0 - 16) / 16)];
     metal::float4 _e34 = pst_factors[metal::min(unsigned((base + (2u * (j_3 + 1u))) + h), (_buffer_sizes.size5 - 0 - 16) / 16)];
-    return (_e22 * (1.0 - t_7)) + (_e34 * t_7);
+    return (_e22 * (1.0 - t_8)) + (_e34 * t_8);
 }
 
 metal::float4 gamma_at(
@@ -917,9 +995,9 @@ metal::float4 beta_at(
 }
 
 metal::float4 pst_leaf(
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_16,
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19,
     uint i,
-    uint row_1,
+    uint row_3,
     float delta_2,
     uint h_3,
     device type_10 const& pst_factors,
@@ -931,19 +1009,19 @@ metal::float4 pst_leaf(
         metal::float4 _e9 = gamma_at(static_cast<float>(i) * delta_2, h_3, pst_factors, _buffer_sizes);
         return _e9;
     }
-    float _e12 = axis_row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, row_1);
-    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16, _e12);
-    metal::float3 axis_2 = f_16.axis.xyz;
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
+    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
+    metal::float3 axis_2 = f_19.axis.xyz;
+    uint2 loop_bound_6 = uint2(4294967295u);
+    bool loop_init_6 = true;
     while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
+        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+        if (!loop_init_6) {
             uint _e56 = g_1;
             g_1 = _e56 + 1u;
         }
-        loop_init_5 = false;
+        loop_init_6 = false;
         uint _e17 = g_1;
         if (_e17 < 2u) {
         } else {
@@ -954,7 +1032,7 @@ metal::float4 pst_leaf(
             float q_4 = (_e20 == 0u) ? -0.57735026 : GL2_;
             float psi_1 = ((static_cast<float>(i) + 0.5) + (0.5 * q_4)) * delta_2;
             metal::float3 l_3 = (-(axis_2) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_3, f_16.light_dir.xyz), f_16.light_pos.w, f_16.light_dir.w);
+            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_3, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
             metal::float4 _e48 = leaf;
             metal::float4 _e52 = gamma_at(psi_1, h_3, pst_factors, _buffer_sizes);
             leaf = _e48 + (((0.5 * delta_2) * _e46) * _e52);
@@ -971,30 +1049,30 @@ PstRay pst_ray(
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     PstRay r = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18 = frame;
-    metal::float3 eye_9 = f_18.eye.xyz;
-    metal::float2 ndc_1 = metal::float2(((2.0 * pc_1.x) / static_cast<float>(f_18.sizes.x)) - 1.0, 1.0 - ((2.0 * pc_1.y) / static_cast<float>(f_18.sizes.y)));
-    float t_8 = f_18.cam_forward.w;
-    metal::float3 dir_12 = metal::normalize((f_18.cam_forward.xyz + (f_18.cam_right.xyz * ((ndc_1.x * t_8) * f_18.cam_right.w))) + (f_18.cam_up.xyz * (ndc_1.y * t_8)));
-    float s_4 = metal::min(metal::max(z_1, 0.0), f_18.theta.z) / metal::max(metal::dot(dir_12, f_18.cam_forward.xyz), 0.000001);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = frame;
+    metal::float3 eye_9 = f_21.eye.xyz;
+    metal::float2 ndc_2 = metal::float2(((2.0 * pc_1.x) / static_cast<float>(f_21.sizes.x)) - 1.0, 1.0 - ((2.0 * pc_1.y) / static_cast<float>(f_21.sizes.y)));
+    float t_9 = f_21.cam_forward.w;
+    metal::float3 dir_12 = metal::normalize((f_21.cam_forward.xyz + (f_21.cam_right.xyz * ((ndc_2.x * t_9) * f_21.cam_right.w))) + (f_21.cam_up.xyz * (ndc_2.y * t_9)));
+    float s_4 = metal::min(metal::max(z_1, 0.0), f_21.theta.z) / metal::max(metal::dot(dir_12, f_21.cam_forward.xyz), 0.000001);
     r = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_9, dir_12, s_4, 0u, 0.0, 0.0, 0.0};
-    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, pc_1);
+    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, pc_1);
     if (_e67) {
         r.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e72 = frame;
         float _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_4, true);
-        r.color = _e75 * f_18.light_color.xyz;
+        r.color = _e75 * f_21.light_color.xyz;
     }
-    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, dir_12);
+    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
     r.theta = _e80;
-    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, dir_12);
-    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e82), f_18.sizes.w, f_18.anti_epipole.w > 0.5);
+    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
+    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e82), f_21.sizes.w, f_21.anti_epipole.w > 0.5);
     r.row = _e90;
     float _e93 = r.theta;
-    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_18.theta.x, f_18.theta.y);
+    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_21.theta.x, f_21.theta.y);
     r.d = _e98;
     float _e101 = r.theta;
-    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_9, dir_12, s_4, _e101, true);
+    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, eye_9, dir_12, s_4, _e101, true);
     r.xs_num = _e102;
     PstRay _e103 = r;
     return _e103;
@@ -1012,29 +1090,29 @@ uint pst_columns_crossed(
 
 metal::float2 pst_terms(
     PstRay r_2,
-    uint row_2,
+    uint row_4,
     float delta_4,
     uint n_2,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     metal::texture2d<float, metal::access::sample> rectified
 ) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = frame;
     float sin_theta = metal::max(metal::sin(r_2.theta), 0.000001);
     uint clamped_lod_e16 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-    metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_2)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
+    metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_4)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     if (r_2.d <= _e16.x) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return metal::float2(f_19.medium.y / (f_19.axis.w * sin_theta), _e37);
+        return metal::float2(f_22.medium.y / (f_22.axis.w * sin_theta), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_19.medium.z, -(metal::dot(f_19.light_dir.xyz, r_2.dir)));
-    float sp = f_19.medium.y * _e48;
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_19.medium.x, 0.0, delta_4 / sin_theta);
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.z, -(metal::dot(f_22.light_dir.xyz, r_2.dir)));
+    float sp = f_22.medium.y * _e48;
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.x, 0.0, delta_4 / sin_theta);
     float _e56 = tail;
     return metal::float2(sp * _e54, sp * _e56);
 }
@@ -1052,9 +1130,9 @@ metal::float3 pst_sweep_pixel(
 ) {
     float sum_3 = 0.0;
     uint h_4 = 0u;
-    metal::float4 p_5 = {};
+    metal::float4 p_6 = {};
     uint i_1 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_23 = frame;
     uint clamped_lod_e16 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_4, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_4) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
@@ -1068,34 +1146,34 @@ metal::float3 pst_sweep_pixel(
     if (_e27 == 0u) {
         return metal::float3(0.0, 0.0, 0.0);
     }
-    uint2 loop_bound_6 = uint2(4294967295u);
-    bool loop_init_6 = true;
+    uint2 loop_bound_7 = uint2(4294967295u);
+    bool loop_init_7 = true;
     while(true) {
-        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-        if (!loop_init_6) {
+        if (metal::all(loop_bound_7 == uint2(0u))) { break; }
+        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+        if (!loop_init_7) {
             uint _e77 = h_4;
             h_4 = _e77 + 1u;
         }
-        loop_init_6 = false;
+        loop_init_7 = false;
         uint _e35 = h_4;
         if (_e35 < RANK_VECS) {
         } else {
             break;
         }
         {
-            p_5 = metal::float4(0.0, 0.0, 0.0, 0.0);
+            p_6 = metal::float4(0.0, 0.0, 0.0, 0.0);
             i_1 = 0u;
-            uint2 loop_bound_7 = uint2(4294967295u);
-            bool loop_init_7 = true;
+            uint2 loop_bound_8 = uint2(4294967295u);
+            bool loop_init_8 = true;
             while(true) {
-                if (metal::all(loop_bound_7 == uint2(0u))) { break; }
-                loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-                if (!loop_init_7) {
+                if (metal::all(loop_bound_8 == uint2(0u))) { break; }
+                loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
+                if (!loop_init_8) {
                     uint _e66 = i_1;
                     i_1 = _e66 + 1u;
                 }
-                loop_init_7 = false;
+                loop_init_8 = false;
                 uint _e46 = i_1;
                 if ((_e46 + 1u) < _e27) {
                 } else {
@@ -1106,16 +1184,16 @@ metal::float3 pst_sweep_pixel(
                     uint clamped_lod_e56 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
                     metal::float4 _e56 = rectified.read(metal::min(metal::uint2(metal::uint2(_e51, _e18.row)), metal::uint2(rectified.get_width(clamped_lod_e56), rectified.get_height(clamped_lod_e56)) - 1), clamped_lod_e56);
                     if (_e18.d <= _e56.x) {
-                        metal::float4 _e59 = p_5;
+                        metal::float4 _e59 = p_6;
                         uint _e60 = i_1;
                         uint _e62 = h_4;
-                        metal::float4 _e63 = pst_leaf(f_20, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
-                        p_5 = _e59 + _e63;
+                        metal::float4 _e63 = pst_leaf(f_23, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
+                        p_6 = _e59 + _e63;
                     }
                 }
             }
             float _e69 = sum_3;
-            metal::float4 _e70 = p_5;
+            metal::float4 _e70 = p_6;
             uint _e72 = h_4;
             metal::float4 _e73 = beta_at(_e18.theta, _e72, pst_factors, _buffer_sizes);
             sum_3 = _e69 + metal::dot(_e70, _e73);
@@ -1123,7 +1201,7 @@ metal::float3 pst_sweep_pixel(
     }
     metal::float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27, frame, rectified);
     float _e84 = sum_3;
-    return f_20.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
+    return f_23.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
 }
 
 struct pst_sweep_unwarpInput {
@@ -1166,16 +1244,16 @@ kernel void pst_sweep_unwarp(
     uint clamped_lod_e59 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e59), epipolar_samples.get_height(clamped_lod_e59)) - 1), clamped_lod_e59);
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_5, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    uint2 loop_bound_8 = uint2(4294967295u);
-    bool loop_init_8 = true;
+    uint2 loop_bound_9 = uint2(4294967295u);
+    bool loop_init_9 = true;
     while(true) {
-        if (metal::all(loop_bound_8 == uint2(0u))) { break; }
-        loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
-        if (!loop_init_8) {
+        if (metal::all(loop_bound_9 == uint2(0u))) { break; }
+        loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
+        if (!loop_init_9) {
             uint _e93 = j;
             j = _e93 + 1u;
         }
-        loop_init_8 = false;
+        loop_init_9 = false;
         uint _e63 = j;
         if (_e63 < 4u) {
         } else {

@@ -33,8 +33,7 @@ pub fn row_phi(f: &FrameUniforms, row: u32) -> f32 {
 }
 
 /// Slice angle at the centre of row `row` of rows uniform in the angle around the light
-/// axis: [`row_phi`] of a frame whose rows do not follow the sampling's slices, for the
-/// families that never align them (`pst_sweep`; see the WGSL for why it is its own function).
+/// axis: [`row_phi`] of a frame whose rows do not follow the sampling's slices.
 pub fn axis_row_phi(f: &FrameUniforms, row: u32) -> f32 {
     f.e1[3] + (row as f32 + 0.5) * f.e2[3]
 }

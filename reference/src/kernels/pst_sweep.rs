@@ -14,8 +14,8 @@
 
 use super::common_cookie::{epipole_march_cookie, frame_cookie, lit_span_cookie};
 use super::common_epipolar::{
-    axis_row_phi, edge_t, epipole_march, in_epipole_disc, lit_span, normalised_depth, ray_column,
-    ray_row_coord, ray_theta, row_index, slice_e,
+    edge_t, epipole_march, in_epipole_disc, lit_span, normalised_depth, ray_column, ray_row_coord,
+    ray_theta, row_index, row_phi, slice_e,
 };
 use super::common_model::{clamp, cone_falloff, max, min, phase_hg, select, transmittance_between};
 use super::common_sampling::{
@@ -113,7 +113,7 @@ pub fn pst_leaf(
     if !spot {
         return gamma_at(inp, i as f32 * delta, h);
     }
-    let e = slice_e(f, axis_row_phi(f, row));
+    let e = slice_e(f, row_phi(f, row));
     let axis = xyz(f.axis);
     let mut leaf = Vec4::ZERO;
     for g in 0..2u32 {

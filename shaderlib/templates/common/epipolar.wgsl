@@ -114,11 +114,7 @@ fn row_phi(f: Frame, row: u32) -> f32 {
 }
 
 // Slice angle at the centre of row `row` of rows uniform in the angle around the light axis:
-// `row_phi` of a frame whose rows do not follow the sampling's slices, for the kernels of
-// families that never align them (`pst_sweep`: the select's other operand, though never
-// taken, changed how lavapipe compiled its emitted SPIR-V against naga's at run time by
-// 2.8e-4 of the maximum on the cookie spot, where a cookie texel's edge turns an ulp into a
-// step; the foreign engine's exact match caught it).
+// `row_phi` of a frame whose rows do not follow the sampling's slices.
 fn axis_row_phi(f: Frame, row: u32) -> f32 {
     return f.e1_[3] + (f32(row) + 0.5) * f.e2_[3];
 }
