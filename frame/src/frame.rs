@@ -437,7 +437,8 @@ impl Setup {
             (a, b - a)
         };
         let step = range / rows as f64;
-        let even_multiple = slices > 0 && rows % slices == 0 && (rows / slices) % 2 == 0;
+        let even_multiple =
+            slices > 0 && rows.is_multiple_of(slices) && (rows / slices).is_multiple_of(2);
         Fan {
             origin,
             axis,

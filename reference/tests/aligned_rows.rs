@@ -104,7 +104,7 @@ fn check(name: &str, f: &FrameUniforms, k: u32) -> (f32, f32, u32, Vec<String>) 
     let axis_off = (f.fan_origin[2] - layout.axis[0]).hypot(f.fan_origin[3] - layout.axis[1]);
     // The fan's rows: k per slice, half a row back for an even k.
     let step = layout.dphi / k as f32;
-    let start = layout.phi_start - if k % 2 == 0 { 0.5 * step } else { 0.0 };
+    let start = layout.phi_start - if k.is_multiple_of(2) { 0.5 * step } else { 0.0 };
     let range_off = (f.fan_angles[0] - start)
         .abs()
         .max((f.fan_angles[1] - step).abs() * rows as f32);
