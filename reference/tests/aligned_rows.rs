@@ -88,11 +88,11 @@ fn angle_diff(a: f32, b: f32) -> f32 {
     (a - b).sin().atan2((a - b).cos())
 }
 
-/// The worst deviations of one frame: (row angle, row coordinate, points checked), and its
-/// failures.
-fn check(name: &str, f: &FrameUniforms, k: u32) -> (f32, f32, u32, Vec<String>) {
+/// The worst deviations of one frame with `per` rows per slice: (row angle, row coordinate,
+/// points checked), and its failures.
+fn check(name: &str, f: &FrameUniforms, per: u32) -> (f32, f32, u32, Vec<String>) {
     let mut failures = Vec::new();
-    let rows = k * SLICES;
+    let rows = per * SLICES;
     let layout = epipolar_layout(&EpipolarCamera::of_frame(f), SCREEN, SLICES);
     if f.fan_angles[2] <= 0.5 {
         failures.push(format!("{name}: rows not aligned"));
@@ -103,8 +103,13 @@ fn check(name: &str, f: &FrameUniforms, k: u32) -> (f32, f32, u32, Vec<String>) 
     let origin_off = (o[0] - layout.origin[0]).hypot(o[1] - layout.origin[1]);
     let axis_off = (f.fan_origin[2] - layout.axis[0]).hypot(f.fan_origin[3] - layout.axis[1]);
     // The fan's rows: k per slice, half a row back for an even k.
-    let step = layout.dphi / k as f32;
-    let start = layout.phi_start - if k.is_multiple_of(2) { 0.5 * step } else { 0.0 };
+    let step = layout.dphi / per as f32;
+    let start = layout.phi_start
+        - if per.is_multiple_of(2) {
+            0.5 * step
+        } else {
+            0.0
+        };
     let range_off = (f.fan_angles[0] - start)
         .abs()
         .max((f.fan_angles[1] - step).abs() * rows as f32);
@@ -126,7 +131,7 @@ fn check(name: &str, f: &FrameUniforms, k: u32) -> (f32, f32, u32, Vec<String>) 
     let plane_bar = if clamped { CLAMPED_ROW_BAR } else { ROW_BAR };
     let (mut worst_phi, mut worst_row, mut points) = (0.0f32, 0.0f32, 0);
     for s in 0..SLICES {
-        let r = k * s + k / 2;
+        let r = per * s + per / 2;
         let u = slice_direction(&layout, s);
         let span = slice_span(&layout, s, SCREEN, POINTS);
         for k in 0..POINTS {
