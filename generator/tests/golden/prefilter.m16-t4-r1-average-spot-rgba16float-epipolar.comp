@@ -270,43 +270,14 @@ vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
-    float t_in = 0.0;
-    float t_out = 3.4e38;
-    uint a_3 = 0u;
-    bool loop_init_2 = true;
-    while(true) {
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if ((_e4 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = ((0.5 - o_1[_e8]) / u[_e13]);
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = (((size[_e17] - 0.5) - o_1[_e21]) / u[_e24]);
-            uint _e27 = a_3;
-            bool crosses = (abs(u[_e27]) > 1e-12);
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return (0.5 * (_e47 + max(_e48, _e49)));
+    vec2 ta = ((vec2(0.5, 0.5) - o_1) / u);
+    vec2 tb = (((size - vec2(0.5, 0.5)) - o_1) / u);
+    bvec2 crosses = greaterThan(abs(u), vec2(1e-12, 1e-12));
+    vec2 enter = mix(vec2(0.0, 0.0), min(ta, tb), crosses);
+    vec2 leave = mix(vec2(3.4e38, 3.4e38), max(ta, tb), crosses);
+    float t_in = max(0.0, max(enter.x, enter.y));
+    float t_out = min(3.4e38, min(leave.x, leave.y));
+    return (0.5 * (t_in + max(t_out, t_in)));
 }
 
 vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_2) {
@@ -316,9 +287,9 @@ vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
-    float a_6 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    float a_5 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
     vec2 ax = f_4.fan_origin.zw;
-    vec2 u_2 = vec2(((ax.x * cos(a_6)) - (ax.y * sin(a_6))), ((ax.y * cos(a_6)) + (ax.x * sin(a_6))));
+    vec2 u_2 = vec2(((ax.x * cos(a_5)) - (ax.y * sin(a_5))), ((ax.y * cos(a_5)) + (ax.x * sin(a_5))));
     vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
@@ -331,12 +302,12 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_X
     return ((f_5.fan_angles.z > 0.5) ? _e3 : _e2);
 }
 
-vec4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_4, vec2 b_3) {
-    return vec4(a_4.x, a_4.y, b_3.x, b_3.y);
+vec4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_3, vec2 b_3) {
+    return vec4(a_3.x, a_3.y, b_3.x, b_3.y);
 }
 
-vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_5, vec2 b_4) {
-    return vec2(((a_5.x * b_4.y) + (a_5.y * b_4.x)), ((a_5.y * b_4.y) - (a_5.x * b_4.x)));
+vec2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 a_4, vec2 b_4) {
+    return vec2(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
 }
 
 vec2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(vec2 first) {
@@ -454,13 +425,13 @@ void main() {
     uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
     uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, true);
     i = _e42;
-    bool loop_init_3 = true;
+    bool loop_init_2 = true;
     while(true) {
-        if (!loop_init_3) {
+        if (!loop_init_2) {
             uint _e149 = i;
             i = (_e149 + 1u);
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e48 = i;
         if ((_e48 < _e46)) {
         } else {
@@ -494,13 +465,13 @@ void main() {
             vec2 _e94 = angle;
             vec2 _e95 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e94);
             k = 0u;
-            bool loop_init_4 = true;
+            bool loop_init_3 = true;
             while(true) {
-                if (!loop_init_4) {
+                if (!loop_init_3) {
                     uint _e107 = k;
                     k = (_e107 + 1u);
                 }
-                loop_init_4 = false;
+                loop_init_3 = false;
                 uint _e98 = k;
                 if ((_e98 < ((2u * thread) * 1u))) {
                 } else {
@@ -513,13 +484,13 @@ void main() {
                 }
             }
             q = 0u;
-            bool loop_init_5 = true;
+            bool loop_init_4 = true;
             while(true) {
-                if (!loop_init_5) {
+                if (!loop_init_4) {
                     uint _e146 = q;
                     q = (_e146 + 1u);
                 }
-                loop_init_5 = false;
+                loop_init_4 = false;
                 uint _e111 = q;
                 if ((_e111 < 1u)) {
                 } else {
@@ -535,9 +506,9 @@ void main() {
                     vec2 _e120 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e95);
                     angle = _e120;
                     uint _e122 = q;
-                    vec4 a_7 = acc[_e122];
+                    vec4 a_6 = acc[_e122];
                     uint _e125 = q;
-                    acc[_e125] = ((a_7 * (1.0 - blend)) + (_e119 * blend));
+                    acc[_e125] = ((a_6 * (1.0 - blend)) + (_e119 * blend));
                     uint _e132 = q;
                     vec4 _e134 = acc[_e132];
                     vec4 stored = ((_e134 * 0.5) + vec4(0.5));

@@ -371,46 +371,14 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float2 u,
     metal::float2 size
 ) {
-    float t_in = 0.0;
-    float t_out = 340000000000000000000000000000000000000.0;
-    uint a_3 = 0u;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = _e45 + 1u;
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if (_e4 < 2u) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = (0.5 - o_1[metal::min(unsigned(_e8), 1u)]) / u[metal::min(unsigned(_e13), 1u)];
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = ((size[metal::min(unsigned(_e17), 1u)] - 0.5) - o_1[metal::min(unsigned(_e21), 1u)]) / u[metal::min(unsigned(_e24), 1u)];
-            uint _e27 = a_3;
-            bool crosses = metal::abs(u[metal::min(unsigned(_e27), 1u)]) > 0.000000000001;
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = crosses ? metal::max(_e34, metal::min(ta, tb)) : _e33;
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = crosses ? metal::min(_e40, metal::max(ta, tb)) : _e39;
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return 0.5 * (_e47 + metal::max(_e48, _e49));
+    metal::float2 ta = (metal::float2(0.5, 0.5) - o_1) / u;
+    metal::float2 tb = ((size - metal::float2(0.5, 0.5)) - o_1) / u;
+    metal::bool2 crosses = metal::abs(u) > metal::float2(0.000000000001, 0.000000000001);
+    metal::float2 enter = metal::select(metal::float2(0.0, 0.0), metal::min(ta, tb), crosses);
+    metal::float2 leave = metal::select(metal::float2(340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0), metal::max(ta, tb), crosses);
+    float t_in = metal::max(0.0, metal::max(enter.x, enter.y));
+    float t_out = metal::min(340000000000000000000000000000000000000.0, metal::min(leave.x, leave.y));
+    return 0.5 * (t_in + metal::max(t_out, t_in));
 }
 
 metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -426,9 +394,9 @@ float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
     uint row_1
 ) {
-    float a_6 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
+    float a_5 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
     metal::float2 ax = f_4.fan_origin.zw;
-    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_6)) - (ax.y * metal::sin(a_6)), (ax.y * metal::cos(a_6)) + (ax.x * metal::sin(a_6)));
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_5)) - (ax.y * metal::sin(a_5)), (ax.y * metal::cos(a_5)) + (ax.x * metal::sin(a_5)));
     metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, f_4.fan_origin.xy + (u_2 * _e33));
@@ -445,17 +413,17 @@ float row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
 }
 
 metal::float4 basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float2 a_4,
+    metal::float2 a_3,
     metal::float2 b_3
 ) {
-    return metal::float4(a_4.x, a_4.y, b_3.x, b_3.y);
+    return metal::float4(a_3.x, a_3.y, b_3.x, b_3.y);
 }
 
 metal::float2 turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
-    metal::float2 a_5,
+    metal::float2 a_4,
     metal::float2 b_4
 ) {
-    return metal::float2((a_5.x * b_4.y) + (a_5.y * b_4.x), (a_5.y * b_4.y) - (a_5.x * b_4.x));
+    return metal::float2((a_4.x * b_4.y) + (a_4.y * b_4.x), (a_4.y * b_4.y) - (a_4.x * b_4.x));
 }
 
 metal::float2 fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
@@ -632,16 +600,16 @@ kernel void prefilter(
     uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, true);
     uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, true);
     i = _e42;
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e149 = i;
             i = _e149 + 1u;
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e48 = i;
         if (_e48 < _e46) {
         } else {
@@ -675,16 +643,16 @@ kernel void prefilter(
             metal::float2 _e94 = angle;
             metal::float2 _e95 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e94);
             k = 0u;
-            uint2 loop_bound_4 = uint2(4294967295u);
-            bool loop_init_4 = true;
+            uint2 loop_bound_3 = uint2(4294967295u);
+            bool loop_init_3 = true;
             while(true) {
-                if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-                if (!loop_init_4) {
+                if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+                loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+                if (!loop_init_3) {
                     uint _e107 = k;
                     k = _e107 + 1u;
                 }
-                loop_init_4 = false;
+                loop_init_3 = false;
                 uint _e98 = k;
                 if (_e98 < ((2u * thread_) * 1u)) {
                 } else {
@@ -697,16 +665,16 @@ kernel void prefilter(
                 }
             }
             q = 0u;
-            uint2 loop_bound_5 = uint2(4294967295u);
-            bool loop_init_5 = true;
+            uint2 loop_bound_4 = uint2(4294967295u);
+            bool loop_init_4 = true;
             while(true) {
-                if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-                if (!loop_init_5) {
+                if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+                if (!loop_init_4) {
                     uint _e146 = q;
                     q = _e146 + 1u;
                 }
-                loop_init_5 = false;
+                loop_init_4 = false;
                 uint _e111 = q;
                 if (_e111 < 1u) {
                 } else {
@@ -722,9 +690,9 @@ kernel void prefilter(
                     metal::float2 _e120 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e95);
                     angle = _e120;
                     uint _e122 = q;
-                    metal::float4 a_7 = acc.inner[metal::min(unsigned(_e122), 0u)];
+                    metal::float4 a_6 = acc.inner[metal::min(unsigned(_e122), 0u)];
                     uint _e125 = q;
-                    acc.inner[metal::min(unsigned(_e125), 0u)] = (a_7 * (1.0 - blend)) + (_e119 * blend);
+                    acc.inner[metal::min(unsigned(_e125), 0u)] = (a_6 * (1.0 - blend)) + (_e119 * blend);
                     uint _e132 = q;
                     metal::float4 _e134 = acc.inner[metal::min(unsigned(_e132), 0u)];
                     metal::float4 stored = (_e134 * 0.5) + metal::float4(0.5);

@@ -265,42 +265,14 @@ fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil
 }
 
 fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
-    var t_in: f32 = 0f;
-    var t_out: f32 = 340000000000000000000000000000000000000f;
-    var a_3: u32 = 0u;
-
-    loop {
-        let _e4 = a_3;
-        if (_e4 < 2u) {
-        } else {
-            break;
-        }
-        {
-            let _e8 = a_3;
-            let _e13 = a_3;
-            let ta = ((0.5f - o_1[_e8]) / u[_e13]);
-            let _e17 = a_3;
-            let _e21 = a_3;
-            let _e24 = a_3;
-            let tb = (((size[_e17] - 0.5f) - o_1[_e21]) / u[_e24]);
-            let _e27 = a_3;
-            let crosses = (abs(u[_e27]) > 0.000000000001f);
-            let _e33 = t_in;
-            let _e34 = t_in;
-            t_in = select(_e33, max(_e34, min(ta, tb)), crosses);
-            let _e39 = t_out;
-            let _e40 = t_out;
-            t_out = select(_e39, min(_e40, max(ta, tb)), crosses);
-        }
-        continuing {
-            let _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-    }
-    let _e47 = t_in;
-    let _e48 = t_out;
-    let _e49 = t_in;
-    return (0.5f * (_e47 + max(_e48, _e49)));
+    let ta = ((vec2<f32>(0.5f, 0.5f) - o_1) / u);
+    let tb = (((size - vec2<f32>(0.5f, 0.5f)) - o_1) / u);
+    let crosses = (abs(u) > vec2<f32>(0.000000000001f, 0.000000000001f));
+    let enter = select(vec2<f32>(0f, 0f), min(ta, tb), crosses);
+    let leave = select(vec2<f32>(340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f), max(ta, tb), crosses);
+    let t_in = max(0f, max(enter.x, enter.y));
+    let t_out = min(340000000000000000000000000000000000000f, min(leave.x, leave.y));
+    return (0.5f * (t_in + max(t_out, t_in)));
 }
 
 fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
@@ -310,9 +282,9 @@ fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_
 }
 
 fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
-    let a_6 = (f_4.fan_angles.x + ((f32(row_1) + 0.5f) * f_4.fan_angles.y));
+    let a_5 = (f_4.fan_angles.x + ((f32(row_1) + 0.5f) * f_4.fan_angles.y));
     let ax = f_4.fan_origin.zw;
-    let u_2 = vec2<f32>(((ax.x * cos(a_6)) - (ax.y * sin(a_6))), ((ax.y * cos(a_6)) + (ax.x * sin(a_6))));
+    let u_2 = vec2<f32>(((ax.x * cos(a_5)) - (ax.y * sin(a_5))), ((ax.y * cos(a_5)) + (ax.x * sin(a_5))));
     let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
@@ -325,12 +297,12 @@ fn row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_5: FrameX_naga_oil_mod
     return select(_e2, _e3, (f_5.fan_angles.z > 0.5f));
 }
 
-fn basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_4: vec2<f32>, b_3: vec2<f32>) -> vec4<f32> {
-    return vec4<f32>(a_4.x, a_4.y, b_3.x, b_3.y);
+fn basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_3: vec2<f32>, b_3: vec2<f32>) -> vec4<f32> {
+    return vec4<f32>(a_3.x, a_3.y, b_3.x, b_3.y);
 }
 
-fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_5: vec2<f32>, b_4: vec2<f32>) -> vec2<f32> {
-    return vec2<f32>(((a_5.x * b_4.y) + (a_5.y * b_4.x)), ((a_5.y * b_4.y) - (a_5.x * b_4.x)));
+fn turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(a_4: vec2<f32>, b_4: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(((a_4.x * b_4.y) + (a_4.y * b_4.x)), ((a_4.y * b_4.y) - (a_4.x * b_4.x)));
 }
 
 fn fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(first: vec2<f32>) -> vec2<f32> {
@@ -524,9 +496,9 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
                     let _e120 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e95);
                     angle = _e120;
                     let _e122 = q;
-                    let a_7 = acc[_e122];
+                    let a_6 = acc[_e122];
                     let _e125 = q;
-                    acc[_e125] = ((a_7 * (1f - blend)) + (_e119 * blend));
+                    acc[_e125] = ((a_6 * (1f - blend)) + (_e119 * blend));
                     let _e132 = q;
                     let _e134 = acc[_e132];
                     let stored = ((_e134 * 0.5f) + vec4(0.5f));

@@ -337,43 +337,14 @@ vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
-    float t_in = 0.0;
-    float t_out = 3.4e38;
-    uint a_3 = 0u;
-    bool loop_init_2 = true;
-    while(true) {
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if ((_e4 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = ((0.5 - o_1[_e8]) / u[_e13]);
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = (((size[_e17] - 0.5) - o_1[_e21]) / u[_e24]);
-            uint _e27 = a_3;
-            bool crosses = (abs(u[_e27]) > 1e-12);
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return (0.5 * (_e47 + max(_e48, _e49)));
+    vec2 ta = ((vec2(0.5, 0.5) - o_1) / u);
+    vec2 tb = (((size - vec2(0.5, 0.5)) - o_1) / u);
+    bvec2 crosses = greaterThan(abs(u), vec2(1e-12, 1e-12));
+    vec2 enter = mix(vec2(0.0, 0.0), min(ta, tb), crosses);
+    vec2 leave = mix(vec2(3.4e38, 3.4e38), max(ta, tb), crosses);
+    float t_in_1 = max(0.0, max(enter.x, enter.y));
+    float t_out_1 = min(3.4e38, min(leave.x, leave.y));
+    return (0.5 * (t_in_1 + max(t_out_1, t_in_1)));
 }
 
 vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_4) {
@@ -383,9 +354,9 @@ vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
-    float a_10 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    float a_9 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
     vec2 ax = f_4.fan_origin.zw;
-    vec2 u_3 = vec2(((ax.x * cos(a_10)) - (ax.y * sin(a_10))), ((ax.y * cos(a_10)) + (ax.x * sin(a_10))));
+    vec2 u_3 = vec2(((ax.x * cos(a_9)) - (ax.y * sin(a_9))), ((ax.y * cos(a_9)) + (ax.x * sin(a_9))));
     vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_3, _e32);
     vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_3 * _e33)));
@@ -417,20 +388,20 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_4, float b_3, uint steps, bool spot_1) {
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot_1) {
     float sum_1 = 0.0;
     uint k_6 = 0u;
     float t_2 = 0.0;
     float w = 0.0;
-    float h_11 = ((b_3 - a_4) / float(steps));
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
-    bool loop_init_3 = true;
+    float h_11 = ((b_3 - a_3) / float(steps));
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_3, b_3, steps);
+    bool loop_init_2 = true;
     while(true) {
-        if (!loop_init_3) {
+        if (!loop_init_2) {
             uint _e65 = k_6;
             k_6 = (_e65 + 1u);
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e15 = k_6;
         if (((_e15 + 1u) <= steps)) {
         } else {
@@ -438,7 +409,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
         }
         {
             uint _e19 = k_6;
-            t_2 = (a_4 + ((float(_e19) + 0.5) * h_11));
+            t_2 = (a_3 + ((float(_e19) + 0.5) * h_11));
             w = h_11;
             if (spot_1) {
                 uint _e28 = k_6;
@@ -458,7 +429,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
                 float _e48 = sum_1;
                 uint _e51 = k_6;
                 uint _e55 = k_6;
-                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_4 + (float(_e51) * h_11)), (a_4 + (float((_e55 + 1u)) * h_11)));
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_3 + (float(_e51) * h_11)), (a_3 + (float((_e55 + 1u)) * h_11)));
                 sum_1 = (_e48 + (_e39 * _e61));
             }
         }
@@ -546,24 +517,24 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XO
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, vec3 eye_7, vec3 dir_9, float a_5, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, vec3 eye_8, vec3 dir_10, float a_6, float b_5, bool spot_6) {
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, max((f_18.sizes2_.z / 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_5, b_5, max((f_18.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_5, b_5);
     return _e15;
 }
 
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_7, float b_6, float depth_break) {
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b_6, float depth_break) {
     bool local_10 = false;
-    if (!((a_7 == b_6))) {
-        local_10 = (abs((a_7 - b_6)) <= (depth_break * min(a_7, b_6)));
+    if (!((a_6 == b_6))) {
+        local_10 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
         local_10 = true;
     }
@@ -572,11 +543,11 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_7, float b
 }
 
 vec3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec3 v_10) {
-    vec3 a_11 = min(abs(v_10), vec3(65504.0));
-    uvec3 u_4 = floatBitsToUint(a_11);
+    vec3 a_10 = min(abs(v_10), vec3(65504.0));
+    uvec3 u_4 = floatBitsToUint(a_10);
     vec3 normal = uintBitsToFloat((((u_4 + uvec3(4095u)) + ((u_4 >> uvec3(13u)) & uvec3(1u))) & uvec3(4294959104u)));
-    vec3 subnormal = (roundEven((a_11 * 16777216.0)) / vec3(16777216.0));
-    return (sign(v_10) * mix(normal, subnormal, lessThan(a_11, vec3(6.1035156e-5))));
+    vec3 subnormal = (roundEven((a_10 * 16777216.0)) / vec3(16777216.0));
+    return (sign(v_10) * mix(normal, subnormal, lessThan(a_10, vec3(6.1035156e-5))));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec2 d) {
@@ -589,7 +560,7 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     bool local_11 = false;
     bool local_12 = false;
     bool local_13 = false;
-    float a_8 = 0.0;
+    float a_7 = 0.0;
     float b_7 = 0.0;
     uint k_7 = 0u;
     vec2 size_1 = vec2(screen);
@@ -642,13 +613,13 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
         l_1.dphi = (6.2831855 / float(slices));
     } else {
         l_1.wrap = 0u;
-        bool loop_init_4 = true;
+        bool loop_init_3 = true;
         while(true) {
-            if (!loop_init_4) {
+            if (!loop_init_3) {
                 uint _e153 = k_7;
                 k_7 = (_e153 + 1u);
             }
-            loop_init_4 = false;
+            loop_init_3 = false;
             uint _e118 = k_7;
             if ((_e118 < 4u)) {
             } else {
@@ -663,20 +634,20 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
                 float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
                 uint _e143 = k_7;
                 if ((_e143 == 0u)) {
-                    a_8 = _e142;
+                    a_7 = _e142;
                     b_7 = _e142;
                 } else {
-                    float _e148 = a_8;
-                    a_8 = min(_e148, _e142);
+                    float _e148 = a_7;
+                    a_7 = min(_e148, _e142);
                     float _e150 = b_7;
                     b_7 = max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_8;
+        float _e156 = a_7;
         l_1.phi_start = _e156;
         float _e158 = b_7;
-        float _e159 = a_8;
+        float _e159 = a_7;
         l_1.dphi = ((_e158 - _e159) / float(slices));
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l_1;
@@ -691,48 +662,48 @@ vec2 slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayout
 }
 
 vec2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_3, uint s_5, uvec2 screen_1, uint samples) {
-    float t_in_1 = 0.0;
-    float t_out_1 = 3.4e38;
-    uint a_9 = 0u;
+    float t_in = 0.0;
+    float t_out = 3.4e38;
+    uint a_8 = 0u;
     vec2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     vec2 lo_3 = vec2(0.5, 0.5);
     vec2 hi_3 = (vec2(screen_1) - vec2(0.5, 0.5));
-    bool loop_init_5 = true;
+    bool loop_init_4 = true;
     while(true) {
-        if (!loop_init_5) {
-            uint _e51 = a_9;
-            a_9 = (_e51 + 1u);
+        if (!loop_init_4) {
+            uint _e51 = a_8;
+            a_8 = (_e51 + 1u);
         }
-        loop_init_5 = false;
-        uint _e16 = a_9;
+        loop_init_4 = false;
+        uint _e16 = a_8;
         if ((_e16 < 2u)) {
         } else {
             break;
         }
         {
-            uint _e19 = a_9;
+            uint _e19 = a_8;
             if ((abs(_e5[_e19]) > 1e-12)) {
-                uint _e24 = a_9;
-                uint _e27 = a_9;
-                uint _e30 = a_9;
+                uint _e24 = a_8;
+                uint _e27 = a_8;
+                uint _e30 = a_8;
                 float ta_1 = ((lo_3[_e24] - l_3.origin[_e27]) / _e5[_e30]);
-                uint _e33 = a_9;
-                uint _e36 = a_9;
-                uint _e39 = a_9;
+                uint _e33 = a_8;
+                uint _e36 = a_8;
+                uint _e39 = a_8;
                 float tb_1 = ((hi_3[_e33] - l_3.origin[_e36]) / _e5[_e39]);
-                float _e43 = t_in_1;
-                t_in_1 = max(_e43, min(ta_1, tb_1));
-                float _e47 = t_out_1;
-                t_out_1 = min(_e47, max(ta_1, tb_1));
+                float _e43 = t_in;
+                t_in = max(_e43, min(ta_1, tb_1));
+                float _e47 = t_out;
+                t_out = min(_e47, max(ta_1, tb_1));
             }
         }
     }
-    float _e53 = t_out_1;
-    float _e54 = t_in_1;
-    t_out_1 = max(_e53, _e54);
-    float _e56 = t_in_1;
-    float _e57 = t_out_1;
-    float _e58 = t_in_1;
+    float _e53 = t_out;
+    float _e54 = t_in;
+    t_out = max(_e53, _e54);
+    float _e56 = t_in;
+    float _e57 = t_out;
+    float _e58 = t_in;
     return vec2(_e56, ((_e57 - _e58) / float((samples - 1u))));
 }
 
@@ -773,13 +744,13 @@ vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint i_2,
     float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
     vec3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
     vec3 axis_2 = f_19.axis.xyz;
-    bool loop_init_6 = true;
+    bool loop_init_5 = true;
     while(true) {
-        if (!loop_init_6) {
+        if (!loop_init_5) {
             uint _e56 = g_1;
             g_1 = (_e56 + 1u);
         }
-        loop_init_6 = false;
+        loop_init_5 = false;
         uint _e17 = g_1;
         if ((_e17 < 2u)) {
         } else {
@@ -878,13 +849,13 @@ vec3 pst_sweep_pixel(uint x_5, uint y) {
     if ((_e27 == 0u)) {
         return vec3(0.0, 0.0, 0.0);
     }
-    bool loop_init_7 = true;
+    bool loop_init_6 = true;
     while(true) {
-        if (!loop_init_7) {
+        if (!loop_init_6) {
             uint _e77 = h_8;
             h_8 = (_e77 + 1u);
         }
-        loop_init_7 = false;
+        loop_init_6 = false;
         uint _e35 = h_8;
         if ((_e35 < RANK_VECS)) {
         } else {
@@ -893,13 +864,13 @@ vec3 pst_sweep_pixel(uint x_5, uint y) {
         {
             p_6 = vec4(0.0, 0.0, 0.0, 0.0);
             i_3 = 0u;
-            bool loop_init_8 = true;
+            bool loop_init_7 = true;
             while(true) {
-                if (!loop_init_8) {
+                if (!loop_init_7) {
                     uint _e66 = i_3;
                     i_3 = (_e66 + 1u);
                 }
-                loop_init_8 = false;
+                loop_init_7 = false;
                 uint _e46 = i_3;
                 if (((_e46 + 1u) < _e27)) {
                 } else {
@@ -1054,13 +1025,13 @@ void main() {
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
     float delta_6 = _e89.delta;
     k = li;
-    bool loop_init_9 = true;
+    bool loop_init_8 = true;
     while(true) {
-        if (!loop_init_9) {
+        if (!loop_init_8) {
             uint _e188 = k;
             k = (_e188 + SLICE_LANES);
         }
-        loop_init_9 = false;
+        loop_init_8 = false;
         uint _e92 = k;
         if ((_e92 < SLICE_SAMPLES)) {
         } else {
@@ -1123,13 +1094,13 @@ void main() {
     uint v_12 = atomicOr(live, 0u);
     uint cw = (((width + TREES) - 1u) / TREES);
     if ((li < TREES)) {
-        bool loop_init_10 = true;
+        bool loop_init_9 = true;
         while(true) {
-            if (!loop_init_10) {
+            if (!loop_init_9) {
                 uint _e228 = k_1;
                 k_1 = (_e228 + 1u);
             }
-            loop_init_10 = false;
+            loop_init_9 = false;
             uint _e202 = k_1;
             if ((_e202 < SLICE_SAMPLES)) {
             } else {
@@ -1191,13 +1162,13 @@ void main() {
             uint _e266 = last;
             float _e268 = q_d[_e266];
             bool up = (_e264 <= _e268);
-            bool loop_init_11 = true;
+            bool loop_init_10 = true;
             while(true) {
-                if (!loop_init_11) {
+                if (!loop_init_10) {
                     uint _e341 = k_2;
                     k_2 = (_e341 + 1u);
                 }
-                loop_init_11 = false;
+                loop_init_10 = false;
                 uint _e271 = k_2;
                 if ((_e271 < SLICE_SAMPLES)) {
                 } else {
@@ -1251,13 +1222,13 @@ void main() {
                 }
             }
             if (!(up)) {
-                bool loop_init_12 = true;
+                bool loop_init_11 = true;
                 while(true) {
-                    if (!loop_init_12) {
+                    if (!loop_init_11) {
                         uint _e390 = j_1;
                         j_1 = (_e390 + 1u);
                     }
-                    loop_init_12 = false;
+                    loop_init_11 = false;
                     uint _e345 = j_1;
                     if ((_e345 < (v_12 / 2u))) {
                     } else {
@@ -1288,13 +1259,13 @@ void main() {
     memoryBarrierShared();
     barrier();
     if ((li < TREES)) {
-        bool loop_init_13 = true;
+        bool loop_init_12 = true;
         while(true) {
-            if (!loop_init_13) {
+            if (!loop_init_12) {
                 uint _e405 = c;
                 c = (_e405 + 1u);
             }
-            loop_init_13 = false;
+            loop_init_12 = false;
             uint _e395 = c;
             if ((_e395 < li)) {
             } else {
@@ -1307,13 +1278,13 @@ void main() {
                 start = (_e398 + _e402);
             }
         }
-        bool loop_init_14 = true;
+        bool loop_init_13 = true;
         while(true) {
-            if (!loop_init_14) {
+            if (!loop_init_13) {
                 uint _e481 = k_3;
                 k_3 = (_e481 + 1u);
             }
-            loop_init_14 = false;
+            loop_init_13 = false;
             uint _e408 = k_3;
             if ((_e408 < SLICE_SAMPLES)) {
             } else {
@@ -1373,13 +1344,13 @@ void main() {
         }
     }
     j_3 = li;
-    bool loop_init_15 = true;
+    bool loop_init_14 = true;
     while(true) {
-        if (!loop_init_15) {
+        if (!loop_init_14) {
             uint _e495 = j_3;
             j_3 = (_e495 + SLICE_LANES);
         }
-        loop_init_15 = false;
+        loop_init_14 = false;
         uint _e484 = j_3;
         if ((_e484 < v_12)) {
         } else {
@@ -1395,13 +1366,13 @@ void main() {
     memoryBarrierShared();
     barrier();
     j_4 = li;
-    bool loop_init_16 = true;
+    bool loop_init_15 = true;
     while(true) {
-        if (!loop_init_16) {
+        if (!loop_init_15) {
             uint _e509 = j_4;
             j_4 = (_e509 + SLICE_LANES);
         }
-        loop_init_16 = false;
+        loop_init_15 = false;
         uint _e499 = j_4;
         if ((_e499 < v_12)) {
         } else {
@@ -1418,13 +1389,13 @@ void main() {
     barrier();
     uint base_1 = (s_7 * width);
     i = li;
-    bool loop_init_17 = true;
+    bool loop_init_16 = true;
     while(true) {
-        if (!loop_init_17) {
+        if (!loop_init_16) {
             uint _e566 = i;
             i = (_e566 + SLICE_LANES);
         }
-        loop_init_17 = false;
+        loop_init_16 = false;
         uint _e514 = i;
         if ((_e514 < width)) {
         } else {
@@ -1462,13 +1433,13 @@ void main() {
             uint _e544 = lo;
             if ((_e544 > 0u)) {
                 h = 0u;
-                bool loop_init_18 = true;
+                bool loop_init_17 = true;
                 while(true) {
-                    if (!loop_init_18) {
+                    if (!loop_init_17) {
                         uint _e564 = h;
                         h = (_e564 + 1u);
                     }
-                    loop_init_18 = false;
+                    loop_init_17 = false;
                     uint _e549 = h;
                     if ((_e549 < LEAF_VECS)) {
                     } else {
@@ -1494,13 +1465,13 @@ void main() {
     uint partials = (trees + 4096u);
     if ((li < TREES)) {
         uint tree = (trees + ((li * SLICE_SAMPLES) * LEAF_VECS));
-        bool loop_init_19 = true;
+        bool loop_init_18 = true;
         while(true) {
-            if (!loop_init_19) {
+            if (!loop_init_18) {
                 uint _e599 = j_5;
                 j_5 = (_e599 + 1u);
             }
-            loop_init_19 = false;
+            loop_init_18 = false;
             uint _e585 = j_5;
             if ((_e585 < (v_12 * LEAF_VECS))) {
             } else {
@@ -1535,13 +1506,13 @@ void main() {
             }
         }
         i_1 = lo_5;
-        bool loop_init_20 = true;
+        bool loop_init_19 = true;
         while(true) {
-            if (!loop_init_20) {
+            if (!loop_init_19) {
                 uint _e772 = i_1;
                 i_1 = (_e772 + 1u);
             }
-            loop_init_20 = false;
+            loop_init_19 = false;
             uint _e629 = i_1;
             if ((_e629 <= hi_5)) {
             } else {
@@ -1583,13 +1554,13 @@ void main() {
                         uint _e666 = next;
                         next = (_e666 + 1u);
                         h_1 = 0u;
-                        bool loop_init_21 = true;
+                        bool loop_init_20 = true;
                         while(true) {
-                            if (!loop_init_21) {
+                            if (!loop_init_20) {
                                 uint _e717 = h_1;
                                 h_1 = (_e717 + 1u);
                             }
-                            loop_init_21 = false;
+                            loop_init_20 = false;
                             uint _e670 = h_1;
                             if ((_e670 < LEAF_VECS)) {
                             } else {
@@ -1632,13 +1603,13 @@ void main() {
                 uint b_8 = _group_0_binding_8_cs[(base_1 + _e722)];
                 if ((b_8 > 0u)) {
                     h_2 = 0u;
-                    bool loop_init_22 = true;
+                    bool loop_init_21 = true;
                     while(true) {
-                        if (!loop_init_22) {
+                        if (!loop_init_21) {
                             uint _e769 = h_2;
                             h_2 = (_e769 + 1u);
                         }
-                        loop_init_22 = false;
+                        loop_init_21 = false;
                         uint _e730 = h_2;
                         if ((_e730 < LEAF_VECS)) {
                         } else {
@@ -1677,13 +1648,13 @@ void main() {
     memoryBarrierShared();
     barrier();
     x = li;
-    bool loop_init_23 = true;
+    bool loop_init_22 = true;
     while(true) {
-        if (!loop_init_23) {
+        if (!loop_init_22) {
             uint _e809 = x;
             x = (_e809 + SLICE_LANES);
         }
-        loop_init_23 = false;
+        loop_init_22 = false;
         uint _e775 = x;
         if ((_e775 < (v_12 * LEAF_VECS))) {
         } else {
@@ -1692,13 +1663,13 @@ void main() {
         {
             running = vec4(0.0, 0.0, 0.0, 0.0);
             c_1 = 0u;
-            bool loop_init_24 = true;
+            bool loop_init_23 = true;
             while(true) {
-                if (!loop_init_24) {
+                if (!loop_init_23) {
                     uint _e807 = c_1;
                     c_1 = (_e807 + 1u);
                 }
-                loop_init_24 = false;
+                loop_init_23 = false;
                 uint _e787 = c_1;
                 if ((_e787 < TREES)) {
                 } else {
@@ -1722,13 +1693,13 @@ void main() {
     memoryBarrierShared();
     barrier();
     k_4 = li;
-    bool loop_init_25 = true;
+    bool loop_init_24 = true;
     while(true) {
-        if (!loop_init_25) {
+        if (!loop_init_24) {
             uint _e924 = k_4;
             k_4 = (_e924 + SLICE_LANES);
         }
-        loop_init_25 = false;
+        loop_init_24 = false;
         uint _e813 = k_4;
         if ((_e813 < SLICE_SAMPLES)) {
         } else {
@@ -1743,13 +1714,13 @@ void main() {
                 uint tree_1 = (trees + ((min((_e825 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0.0;
                 h_3 = 0u;
-                bool loop_init_26 = true;
+                bool loop_init_25 = true;
                 while(true) {
-                    if (!loop_init_26) {
+                    if (!loop_init_25) {
                         uint _e892 = h_3;
                         h_3 = (_e892 + 1u);
                     }
-                    loop_init_26 = false;
+                    loop_init_25 = false;
                     uint _e838 = h_3;
                     if ((_e838 < LEAF_VECS)) {
                     } else {

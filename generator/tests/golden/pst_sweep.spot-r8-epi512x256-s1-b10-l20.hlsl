@@ -383,47 +383,14 @@ float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float2 o_1, float2 u, float2 size)
 {
-    float t_in = 0.0;
-    float t_out = 3.4e38;
-    uint a_3 = 0u;
-
-    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if ((_e4 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = ((0.5 - o_1[min(uint(_e8), 1u)]) / u[min(uint(_e13), 1u)]);
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = (((size[min(uint(_e17), 1u)] - 0.5) - o_1[min(uint(_e21), 1u)]) / u[min(uint(_e24), 1u)]);
-            uint _e27 = a_3;
-            bool crosses = (abs(u[min(uint(_e27), 1u)]) > 1e-12);
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return (0.5 * (_e47 + max(_e48, _e49)));
+    float2 ta = ((float2(0.5, 0.5) - o_1) / u);
+    float2 tb = (((size - float2(0.5, 0.5)) - o_1) / u);
+    bool2 crosses = (abs(u) > float2(1e-12, 1e-12));
+    float2 enter = (crosses ? min(ta, tb) : float2(0.0, 0.0));
+    float2 leave = (crosses ? max(ta, tb) : float2(3.4e38, 3.4e38));
+    float t_in_1 = max(0.0, max(enter.x, enter.y));
+    float t_out_1 = min(3.4e38, min(leave.x, leave.y));
+    return (0.5 * (t_in_1 + max(t_out_1, t_in_1)));
 }
 
 float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, float2 p_4)
@@ -435,9 +402,9 @@ float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_m
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1)
 {
-    float a_10 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    float a_9 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
     float2 ax = f_4.fan_origin.zw;
-    float2 u_3 = float2(((ax.x * cos(a_10)) - (ax.y * sin(a_10))), ((ax.y * cos(a_10)) + (ax.x * sin(a_10))));
+    float2 u_3 = float2(((ax.x * cos(a_9)) - (ax.y * sin(a_9))), ((ax.y * cos(a_9)) + (ax.x * sin(a_9))));
     const float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     const float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_3, _e32);
     const float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_3 * _e33)));
@@ -486,25 +453,25 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, Texture2D<float4> sm_5, float3 eye_4, float3 dir_4, float a_4, float b_3, uint steps, bool spot_1)
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, Texture2D<float4> sm_5, float3 eye_4, float3 dir_4, float a_3, float b_3, uint steps, bool spot_1)
 {
     float sum_1 = 0.0;
     uint k_6 = 0u;
     float t_2 = (float)0;
     float w = (float)0;
 
-    float h_11 = ((b_3 - a_4) / float(steps));
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
-    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
-    bool loop_init_3 = true;
+    float h_11 = ((b_3 - a_3) / float(steps));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_3, b_3, steps);
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e65 = k_6;
             k_6 = (_e65 + 1u);
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e15 = k_6;
         if (((_e15 + 1u) <= steps)) {
         } else {
@@ -512,7 +479,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
         }
         {
             uint _e19 = k_6;
-            t_2 = (a_4 + ((float(_e19) + 0.5) * h_11));
+            t_2 = (a_3 + ((float(_e19) + 0.5) * h_11));
             w = h_11;
             if (spot_1) {
                 uint _e28 = k_6;
@@ -532,7 +499,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
                 float _e48 = sum_1;
                 uint _e51 = k_6;
                 uint _e55 = k_6;
-                const float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_4 + (float(_e51) * h_11)), (a_4 + (float((_e55 + 1u)) * h_11)));
+                const float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_3 + (float(_e51) * h_11)), (a_3 + (float((_e55 + 1u)) * h_11)));
                 sum_1 = (_e48 + (_e39 * _e61));
             }
         }
@@ -638,9 +605,9 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XO
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, float3 eye_7, float3 dir_9, float a_5, float b_4, uint panels_1)
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, float3 eye_7, float3 dir_9, float a_4, float b_4, uint panels_1)
 {
-    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
+    const float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
@@ -648,22 +615,22 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, float3 eye_8, float3 dir_10, float a_6, float b_5, bool spot_6)
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, float3 eye_8, float3 dir_10, float a_5, float b_5, bool spot_6)
 {
     if (spot_6) {
-        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, max(naga_div(f_18.sizes2_.z, 4u), 1u));
+        const float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_5, b_5, max(naga_div(f_18.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
+    const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_5, b_5);
     return _e15;
 }
 
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_7, float b_6, float depth_break)
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b_6, float depth_break)
 {
     bool local_10 = (bool)0;
 
-    if (!((a_7 == b_6))) {
-        local_10 = (abs((a_7 - b_6)) <= (depth_break * min(a_7, b_6)));
+    if (!((a_6 == b_6))) {
+        local_10 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
         local_10 = true;
     }
@@ -673,11 +640,11 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_7, float b
 
 float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 v_10)
 {
-    float3 a_11 = min(abs(v_10), (65504.0).xxx);
-    uint3 u_4 = asuint(a_11);
+    float3 a_10 = min(abs(v_10), (65504.0).xxx);
+    uint3 u_4 = asuint(a_10);
     float3 normal = asfloat((((u_4 + (4095u).xxx) + ((u_4 >> (13u).xxx) & (1u).xxx)) & (4294959104u).xxx));
-    float3 subnormal = (round((a_11 * 16777216.0)) / (16777216.0).xxx);
-    return (sign(v_10) * ((a_11 < (6.1035156e-5).xxx) ? subnormal : normal));
+    float3 subnormal = (round((a_10 * 16777216.0)) / (16777216.0).xxx);
+    return (sign(v_10) * ((a_10 < (6.1035156e-5).xxx) ? subnormal : normal));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float2 axis, float2 d)
@@ -692,7 +659,7 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     bool local_11 = (bool)0;
     bool local_12 = (bool)0;
     bool local_13 = (bool)0;
-    float a_8 = 0.0;
+    float a_7 = 0.0;
     float b_7 = 0.0;
     uint k_7 = 0u;
 
@@ -746,16 +713,16 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
         l_1.dphi = (6.2831855 / float(slices));
     } else {
         l_1.wrap = 0u;
-        uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
-        bool loop_init_4 = true;
+        uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
+        bool loop_init_3 = true;
         while(true) {
-            if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
-            loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-            if (!loop_init_4) {
+            if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
+            loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+            if (!loop_init_3) {
                 uint _e153 = k_7;
                 k_7 = (_e153 + 1u);
             }
-            loop_init_4 = false;
+            loop_init_3 = false;
             uint _e118 = k_7;
             if ((_e118 < 4u)) {
             } else {
@@ -770,20 +737,20 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
                 const float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
                 uint _e143 = k_7;
                 if ((_e143 == 0u)) {
-                    a_8 = _e142;
+                    a_7 = _e142;
                     b_7 = _e142;
                 } else {
-                    float _e148 = a_8;
-                    a_8 = min(_e148, _e142);
+                    float _e148 = a_7;
+                    a_7 = min(_e148, _e142);
                     float _e150 = b_7;
                     b_7 = max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_8;
+        float _e156 = a_7;
         l_1.phi_start = _e156;
         float _e158 = b_7;
-        float _e159 = a_8;
+        float _e159 = a_7;
         l_1.dphi = ((_e158 - _e159) / float(slices));
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l_1;
@@ -801,52 +768,52 @@ float2 slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayo
 
 float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_3, uint s_5, uint2 screen_1, uint samples)
 {
-    float t_in_1 = 0.0;
-    float t_out_1 = 3.4e38;
-    uint a_9 = 0u;
+    float t_in = 0.0;
+    float t_out = 3.4e38;
+    uint a_8 = 0u;
 
     const float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     float2 lo_3 = float2(0.5, 0.5);
     float2 hi_3 = (float2(screen_1) - float2(0.5, 0.5));
-    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
-    bool loop_init_5 = true;
+    uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
-            uint _e51 = a_9;
-            a_9 = (_e51 + 1u);
+        if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
+            uint _e51 = a_8;
+            a_8 = (_e51 + 1u);
         }
-        loop_init_5 = false;
-        uint _e16 = a_9;
+        loop_init_4 = false;
+        uint _e16 = a_8;
         if ((_e16 < 2u)) {
         } else {
             break;
         }
         {
-            uint _e19 = a_9;
+            uint _e19 = a_8;
             if ((abs(_e5[min(uint(_e19), 1u)]) > 1e-12)) {
-                uint _e24 = a_9;
-                uint _e27 = a_9;
-                uint _e30 = a_9;
+                uint _e24 = a_8;
+                uint _e27 = a_8;
+                uint _e30 = a_8;
                 float ta_1 = ((lo_3[min(uint(_e24), 1u)] - l_3.origin[min(uint(_e27), 1u)]) / _e5[min(uint(_e30), 1u)]);
-                uint _e33 = a_9;
-                uint _e36 = a_9;
-                uint _e39 = a_9;
+                uint _e33 = a_8;
+                uint _e36 = a_8;
+                uint _e39 = a_8;
                 float tb_1 = ((hi_3[min(uint(_e33), 1u)] - l_3.origin[min(uint(_e36), 1u)]) / _e5[min(uint(_e39), 1u)]);
-                float _e43 = t_in_1;
-                t_in_1 = max(_e43, min(ta_1, tb_1));
-                float _e47 = t_out_1;
-                t_out_1 = min(_e47, max(ta_1, tb_1));
+                float _e43 = t_in;
+                t_in = max(_e43, min(ta_1, tb_1));
+                float _e47 = t_out;
+                t_out = min(_e47, max(ta_1, tb_1));
             }
         }
     }
-    float _e53 = t_out_1;
-    float _e54 = t_in_1;
-    t_out_1 = max(_e53, _e54);
-    float _e56 = t_in_1;
-    float _e57 = t_out_1;
-    float _e58 = t_in_1;
+    float _e53 = t_out;
+    float _e54 = t_in;
+    t_out = max(_e53, _e54);
+    float _e56 = t_in;
+    float _e57 = t_out;
+    float _e58 = t_in;
     return float2(_e56, ((_e57 - _e58) / float((samples - 1u))));
 }
 
@@ -897,16 +864,16 @@ float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint i_
     const float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
     const float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
     float3 axis_2 = f_19.axis.xyz;
-    uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
-    bool loop_init_6 = true;
+    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
+    bool loop_init_5 = true;
     while(true) {
-        if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
-        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-        if (!loop_init_6) {
+        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
             uint _e56 = g_1;
             g_1 = (_e56 + 1u);
         }
-        loop_init_6 = false;
+        loop_init_5 = false;
         uint _e17 = g_1;
         if ((_e17 < 2u)) {
         } else {
@@ -1025,16 +992,16 @@ float3 pst_sweep_pixel(uint x_5, uint y)
     if ((_e27 == 0u)) {
         return float3(0.0, 0.0, 0.0);
     }
-    uint2 loop_bound_7 = uint2(4294967295u, 4294967295u);
-    bool loop_init_7 = true;
+    uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
+    bool loop_init_6 = true;
     while(true) {
-        if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
-        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-        if (!loop_init_7) {
+        if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
+        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+        if (!loop_init_6) {
             uint _e77 = h_8;
             h_8 = (_e77 + 1u);
         }
-        loop_init_7 = false;
+        loop_init_6 = false;
         uint _e35 = h_8;
         if ((_e35 < RANK_VECS)) {
         } else {
@@ -1043,16 +1010,16 @@ float3 pst_sweep_pixel(uint x_5, uint y)
         {
             p_6 = float4(0.0, 0.0, 0.0, 0.0);
             i_3 = 0u;
-            uint2 loop_bound_8 = uint2(4294967295u, 4294967295u);
-            bool loop_init_8 = true;
+            uint2 loop_bound_7 = uint2(4294967295u, 4294967295u);
+            bool loop_init_7 = true;
             while(true) {
-                if (all(loop_bound_8 == uint2(0u, 0u))) { break; }
-                loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
-                if (!loop_init_8) {
+                if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
+                loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+                if (!loop_init_7) {
                     uint _e66 = i_3;
                     i_3 = (_e66 + 1u);
                 }
-                loop_init_8 = false;
+                loop_init_7 = false;
                 uint _e46 = i_3;
                 if (((_e46 + 1u) < _e27)) {
                 } else {
@@ -1218,16 +1185,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
     float delta_6 = _e89.delta;
     k = li;
-    uint2 loop_bound_9 = uint2(4294967295u, 4294967295u);
-    bool loop_init_9 = true;
+    uint2 loop_bound_8 = uint2(4294967295u, 4294967295u);
+    bool loop_init_8 = true;
     while(true) {
-        if (all(loop_bound_9 == uint2(0u, 0u))) { break; }
-        loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
-        if (!loop_init_9) {
+        if (all(loop_bound_8 == uint2(0u, 0u))) { break; }
+        loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
+        if (!loop_init_8) {
             uint _e188 = k;
             k = (_e188 + SLICE_LANES);
         }
-        loop_init_9 = false;
+        loop_init_8 = false;
         uint _e92 = k;
         if ((_e92 < SLICE_SAMPLES)) {
         } else {
@@ -1288,16 +1255,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     uint v_12; InterlockedOr(live, 0, v_12);
     uint cw = naga_div(((width + TREES) - 1u), TREES);
     if ((li < TREES)) {
-        uint2 loop_bound_10 = uint2(4294967295u, 4294967295u);
-        bool loop_init_10 = true;
+        uint2 loop_bound_9 = uint2(4294967295u, 4294967295u);
+        bool loop_init_9 = true;
         while(true) {
-            if (all(loop_bound_10 == uint2(0u, 0u))) { break; }
-            loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
-            if (!loop_init_10) {
+            if (all(loop_bound_9 == uint2(0u, 0u))) { break; }
+            loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
+            if (!loop_init_9) {
                 uint _e228 = k_1;
                 k_1 = (_e228 + 1u);
             }
-            loop_init_10 = false;
+            loop_init_9 = false;
             uint _e202 = k_1;
             if ((_e202 < SLICE_SAMPLES)) {
             } else {
@@ -1330,10 +1297,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
         bool _e240 = local_2;
         if (_e240) {
-            uint2 loop_bound_11 = uint2(4294967295u, 4294967295u);
+            uint2 loop_bound_10 = uint2(4294967295u, 4294967295u);
             while(true) {
-                if (all(loop_bound_11 == uint2(0u, 0u))) { break; }
-                loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
+                if (all(loop_bound_10 == uint2(0u, 0u))) { break; }
+                loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
                 uint _e243 = first;
                 uint _e245 = q_end[min(uint(_e243), 255u)];
                 if ((_e245 == NONE)) {
@@ -1345,10 +1312,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     first = (_e249 + 1u);
                 }
             }
-            uint2 loop_bound_12 = uint2(4294967295u, 4294967295u);
+            uint2 loop_bound_11 = uint2(4294967295u, 4294967295u);
             while(true) {
-                if (all(loop_bound_12 == uint2(0u, 0u))) { break; }
-                loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
+                if (all(loop_bound_11 == uint2(0u, 0u))) { break; }
+                loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
                 uint _e253 = last;
                 uint _e255 = q_end[min(uint(_e253), 255u)];
                 if ((_e255 == NONE)) {
@@ -1365,16 +1332,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             uint _e266 = last;
             float _e268 = q_d[min(uint(_e266), 255u)];
             bool up = (_e264 <= _e268);
-            uint2 loop_bound_13 = uint2(4294967295u, 4294967295u);
-            bool loop_init_11 = true;
+            uint2 loop_bound_12 = uint2(4294967295u, 4294967295u);
+            bool loop_init_10 = true;
             while(true) {
-                if (all(loop_bound_13 == uint2(0u, 0u))) { break; }
-                loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
-                if (!loop_init_11) {
+                if (all(loop_bound_12 == uint2(0u, 0u))) { break; }
+                loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
+                if (!loop_init_10) {
                     uint _e341 = k_2;
                     k_2 = (_e341 + 1u);
                 }
-                loop_init_11 = false;
+                loop_init_10 = false;
                 uint _e271 = k_2;
                 if ((_e271 < SLICE_SAMPLES)) {
                 } else {
@@ -1388,10 +1355,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                         float d_3 = q_d[min(uint(_e281), 255u)];
                         uint _e285 = m;
                         j = _e285;
-                        uint2 loop_bound_14 = uint2(4294967295u, 4294967295u);
+                        uint2 loop_bound_13 = uint2(4294967295u, 4294967295u);
                         while(true) {
-                            if (all(loop_bound_14 == uint2(0u, 0u))) { break; }
-                            loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
+                            if (all(loop_bound_13 == uint2(0u, 0u))) { break; }
+                            loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
                             uint _e287 = j;
                             if ((_e287 > 0u)) {
                                 uint _e290 = j;
@@ -1431,16 +1398,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 }
             }
             if (!(up)) {
-                uint2 loop_bound_15 = uint2(4294967295u, 4294967295u);
-                bool loop_init_12 = true;
+                uint2 loop_bound_14 = uint2(4294967295u, 4294967295u);
+                bool loop_init_11 = true;
                 while(true) {
-                    if (all(loop_bound_15 == uint2(0u, 0u))) { break; }
-                    loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
-                    if (!loop_init_12) {
+                    if (all(loop_bound_14 == uint2(0u, 0u))) { break; }
+                    loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
+                    if (!loop_init_11) {
                         uint _e390 = j_1;
                         j_1 = (_e390 + 1u);
                     }
-                    loop_init_12 = false;
+                    loop_init_11 = false;
                     uint _e345 = j_1;
                     if ((_e345 < naga_div(v_12, 2u))) {
                     } else {
@@ -1470,16 +1437,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     }
     GroupMemoryBarrierWithGroupSync();
     if ((li < TREES)) {
-        uint2 loop_bound_16 = uint2(4294967295u, 4294967295u);
-        bool loop_init_13 = true;
+        uint2 loop_bound_15 = uint2(4294967295u, 4294967295u);
+        bool loop_init_12 = true;
         while(true) {
-            if (all(loop_bound_16 == uint2(0u, 0u))) { break; }
-            loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
-            if (!loop_init_13) {
+            if (all(loop_bound_15 == uint2(0u, 0u))) { break; }
+            loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
+            if (!loop_init_12) {
                 uint _e405 = c;
                 c = (_e405 + 1u);
             }
-            loop_init_13 = false;
+            loop_init_12 = false;
             uint _e395 = c;
             if ((_e395 < li)) {
             } else {
@@ -1492,16 +1459,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 start = (_e398 + _e402);
             }
         }
-        uint2 loop_bound_17 = uint2(4294967295u, 4294967295u);
-        bool loop_init_14 = true;
+        uint2 loop_bound_16 = uint2(4294967295u, 4294967295u);
+        bool loop_init_13 = true;
         while(true) {
-            if (all(loop_bound_17 == uint2(0u, 0u))) { break; }
-            loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
-            if (!loop_init_14) {
+            if (all(loop_bound_16 == uint2(0u, 0u))) { break; }
+            loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
+            if (!loop_init_13) {
                 uint _e481 = k_3;
                 k_3 = (_e481 + 1u);
             }
-            loop_init_14 = false;
+            loop_init_13 = false;
             uint _e408 = k_3;
             if ((_e408 < SLICE_SAMPLES)) {
             } else {
@@ -1521,10 +1488,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 if (_e428) {
                     uint _e430 = m_1;
                     j_2 = _e430;
-                    uint2 loop_bound_18 = uint2(4294967295u, 4294967295u);
+                    uint2 loop_bound_17 = uint2(4294967295u, 4294967295u);
                     while(true) {
-                        if (all(loop_bound_18 == uint2(0u, 0u))) { break; }
-                        loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
+                        if (all(loop_bound_17 == uint2(0u, 0u))) { break; }
+                        loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
                         uint _e432 = j_2;
                         if ((_e432 > 0u)) {
                             uint _e435 = start;
@@ -1564,16 +1531,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         }
     }
     j_3 = li;
-    uint2 loop_bound_19 = uint2(4294967295u, 4294967295u);
-    bool loop_init_15 = true;
+    uint2 loop_bound_18 = uint2(4294967295u, 4294967295u);
+    bool loop_init_14 = true;
     while(true) {
-        if (all(loop_bound_19 == uint2(0u, 0u))) { break; }
-        loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
-        if (!loop_init_15) {
+        if (all(loop_bound_18 == uint2(0u, 0u))) { break; }
+        loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
+        if (!loop_init_14) {
             uint _e495 = j_3;
             j_3 = (_e495 + SLICE_LANES);
         }
-        loop_init_15 = false;
+        loop_init_14 = false;
         uint _e484 = j_3;
         if ((_e484 < v_12)) {
         } else {
@@ -1588,16 +1555,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     }
     GroupMemoryBarrierWithGroupSync();
     j_4 = li;
-    uint2 loop_bound_20 = uint2(4294967295u, 4294967295u);
-    bool loop_init_16 = true;
+    uint2 loop_bound_19 = uint2(4294967295u, 4294967295u);
+    bool loop_init_15 = true;
     while(true) {
-        if (all(loop_bound_20 == uint2(0u, 0u))) { break; }
-        loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
-        if (!loop_init_16) {
+        if (all(loop_bound_19 == uint2(0u, 0u))) { break; }
+        loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
+        if (!loop_init_15) {
             uint _e509 = j_4;
             j_4 = (_e509 + SLICE_LANES);
         }
-        loop_init_16 = false;
+        loop_init_15 = false;
         uint _e499 = j_4;
         if ((_e499 < v_12)) {
         } else {
@@ -1613,16 +1580,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     GroupMemoryBarrierWithGroupSync();
     uint base_1 = (s_7 * width);
     i = li;
-    uint2 loop_bound_21 = uint2(4294967295u, 4294967295u);
-    bool loop_init_17 = true;
+    uint2 loop_bound_20 = uint2(4294967295u, 4294967295u);
+    bool loop_init_16 = true;
     while(true) {
-        if (all(loop_bound_21 == uint2(0u, 0u))) { break; }
-        loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
-        if (!loop_init_17) {
+        if (all(loop_bound_20 == uint2(0u, 0u))) { break; }
+        loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
+        if (!loop_init_16) {
             uint _e566 = i;
             i = (_e566 + SLICE_LANES);
         }
-        loop_init_17 = false;
+        loop_init_16 = false;
         uint _e514 = i;
         if ((_e514 < width)) {
         } else {
@@ -1634,10 +1601,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             float occluder = _e520.x;
             lo = 0u;
             hi = v_12;
-            uint2 loop_bound_22 = uint2(4294967295u, 4294967295u);
+            uint2 loop_bound_21 = uint2(4294967295u, 4294967295u);
             while(true) {
-                if (all(loop_bound_22 == uint2(0u, 0u))) { break; }
-                loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
+                if (all(loop_bound_21 == uint2(0u, 0u))) { break; }
+                loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
                 uint _e525 = lo;
                 uint _e526 = hi;
                 if ((_e525 < _e526)) {
@@ -1662,16 +1629,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             uint _e544 = lo;
             if ((_e544 > 0u)) {
                 h = 0u;
-                uint2 loop_bound_23 = uint2(4294967295u, 4294967295u);
-                bool loop_init_18 = true;
+                uint2 loop_bound_22 = uint2(4294967295u, 4294967295u);
+                bool loop_init_17 = true;
                 while(true) {
-                    if (all(loop_bound_23 == uint2(0u, 0u))) { break; }
-                    loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
-                    if (!loop_init_18) {
+                    if (all(loop_bound_22 == uint2(0u, 0u))) { break; }
+                    loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
+                    if (!loop_init_17) {
                         uint _e564 = h;
                         h = (_e564 + 1u);
                     }
-                    loop_init_18 = false;
+                    loop_init_17 = false;
                     uint _e549 = h;
                     if ((_e549 < LEAF_VECS)) {
                     } else {
@@ -1695,16 +1662,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     uint partials = (trees + 4096u);
     if ((li < TREES)) {
         uint tree = (trees + ((li * SLICE_SAMPLES) * LEAF_VECS));
-        uint2 loop_bound_24 = uint2(4294967295u, 4294967295u);
-        bool loop_init_19 = true;
+        uint2 loop_bound_23 = uint2(4294967295u, 4294967295u);
+        bool loop_init_18 = true;
         while(true) {
-            if (all(loop_bound_24 == uint2(0u, 0u))) { break; }
-            loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
-            if (!loop_init_19) {
+            if (all(loop_bound_23 == uint2(0u, 0u))) { break; }
+            loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
+            if (!loop_init_18) {
                 uint _e599 = j_5;
                 j_5 = (_e599 + 1u);
             }
-            loop_init_19 = false;
+            loop_init_18 = false;
             uint _e585 = j_5;
             if ((_e585 < (v_12 * LEAF_VECS))) {
             } else {
@@ -1718,10 +1685,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         uint lo_5 = (li * cw);
         uint hi_5 = (((li + 1u) == TREES) ? width : min((lo_5 + cw), width));
         top = v_12;
-        uint2 loop_bound_25 = uint2(4294967295u, 4294967295u);
+        uint2 loop_bound_24 = uint2(4294967295u, 4294967295u);
         while(true) {
-            if (all(loop_bound_25 == uint2(0u, 0u))) { break; }
-            loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
+            if (all(loop_bound_24 == uint2(0u, 0u))) { break; }
+            loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
             uint _e611 = next;
             uint _e612 = top;
             if ((_e611 < _e612)) {
@@ -1742,26 +1709,26 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             }
         }
         i_1 = lo_5;
-        uint2 loop_bound_26 = uint2(4294967295u, 4294967295u);
-        bool loop_init_20 = true;
+        uint2 loop_bound_25 = uint2(4294967295u, 4294967295u);
+        bool loop_init_19 = true;
         while(true) {
-            if (all(loop_bound_26 == uint2(0u, 0u))) { break; }
-            loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
-            if (!loop_init_20) {
+            if (all(loop_bound_25 == uint2(0u, 0u))) { break; }
+            loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
+            if (!loop_init_19) {
                 uint _e772 = i_1;
                 i_1 = (_e772 + 1u);
             }
-            loop_init_20 = false;
+            loop_init_19 = false;
             uint _e629 = i_1;
             if ((_e629 <= hi_5)) {
             } else {
                 break;
             }
             {
-                uint2 loop_bound_27 = uint2(4294967295u, 4294967295u);
+                uint2 loop_bound_26 = uint2(4294967295u, 4294967295u);
                 while(true) {
-                    if (all(loop_bound_27 == uint2(0u, 0u))) { break; }
-                    loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
+                    if (all(loop_bound_26 == uint2(0u, 0u))) { break; }
+                    loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
                     uint _e631 = next;
                     if ((_e631 < v_12)) {
                         uint _e635 = next;
@@ -1796,16 +1763,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                         uint _e666 = next;
                         next = (_e666 + 1u);
                         h_1 = 0u;
-                        uint2 loop_bound_28 = uint2(4294967295u, 4294967295u);
-                        bool loop_init_21 = true;
+                        uint2 loop_bound_27 = uint2(4294967295u, 4294967295u);
+                        bool loop_init_20 = true;
                         while(true) {
-                            if (all(loop_bound_28 == uint2(0u, 0u))) { break; }
-                            loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
-                            if (!loop_init_21) {
+                            if (all(loop_bound_27 == uint2(0u, 0u))) { break; }
+                            loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
+                            if (!loop_init_20) {
                                 uint _e717 = h_1;
                                 h_1 = (_e717 + 1u);
                             }
-                            loop_init_21 = false;
+                            loop_init_20 = false;
                             uint _e670 = h_1;
                             if ((_e670 < LEAF_VECS)) {
                             } else {
@@ -1815,10 +1782,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                                 p = float4(0.0, 0.0, 0.0, 0.0);
                                 uint _e681 = q_rank[min(uint(k_10), 255u)];
                                 j_6 = (v_12 - _e681);
-                                uint2 loop_bound_29 = uint2(4294967295u, 4294967295u);
+                                uint2 loop_bound_28 = uint2(4294967295u, 4294967295u);
                                 while(true) {
-                                    if (all(loop_bound_29 == uint2(0u, 0u))) { break; }
-                                    loop_bound_29 -= uint2(loop_bound_29.y == 0u, 1u);
+                                    if (all(loop_bound_28 == uint2(0u, 0u))) { break; }
+                                    loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
                                     uint _e684 = j_6;
                                     if ((_e684 > 0u)) {
                                     } else {
@@ -1851,16 +1818,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 uint b_8 = asuint(pst_columns.Load((base_1 + _e722)*4));
                 if ((b_8 > 0u)) {
                     h_2 = 0u;
-                    uint2 loop_bound_30 = uint2(4294967295u, 4294967295u);
-                    bool loop_init_22 = true;
+                    uint2 loop_bound_29 = uint2(4294967295u, 4294967295u);
+                    bool loop_init_21 = true;
                     while(true) {
-                        if (all(loop_bound_30 == uint2(0u, 0u))) { break; }
-                        loop_bound_30 -= uint2(loop_bound_30.y == 0u, 1u);
-                        if (!loop_init_22) {
+                        if (all(loop_bound_29 == uint2(0u, 0u))) { break; }
+                        loop_bound_29 -= uint2(loop_bound_29.y == 0u, 1u);
+                        if (!loop_init_21) {
                             uint _e769 = h_2;
                             h_2 = (_e769 + 1u);
                         }
-                        loop_init_22 = false;
+                        loop_init_21 = false;
                         uint _e730 = h_2;
                         if ((_e730 < LEAF_VECS)) {
                         } else {
@@ -1871,10 +1838,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                             uint _e738 = h_2;
                             float4 leaf_1 = asfloat(pst_leaves.Load4((((base_1 + _e733) * LEAF_VECS) + _e738)*16));
                             j_7 = ((v_12 - b_8) + 1u);
-                            uint2 loop_bound_31 = uint2(4294967295u, 4294967295u);
+                            uint2 loop_bound_30 = uint2(4294967295u, 4294967295u);
                             while(true) {
-                                if (all(loop_bound_31 == uint2(0u, 0u))) { break; }
-                                loop_bound_31 -= uint2(loop_bound_31.y == 0u, 1u);
+                                if (all(loop_bound_30 == uint2(0u, 0u))) { break; }
+                                loop_bound_30 -= uint2(loop_bound_30.y == 0u, 1u);
                                 uint _e746 = j_7;
                                 if ((_e746 <= v_12)) {
                                 } else {
@@ -1900,16 +1867,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     DeviceMemoryBarrierWithGroupSync();
     GroupMemoryBarrierWithGroupSync();
     x = li;
-    uint2 loop_bound_32 = uint2(4294967295u, 4294967295u);
-    bool loop_init_23 = true;
+    uint2 loop_bound_31 = uint2(4294967295u, 4294967295u);
+    bool loop_init_22 = true;
     while(true) {
-        if (all(loop_bound_32 == uint2(0u, 0u))) { break; }
-        loop_bound_32 -= uint2(loop_bound_32.y == 0u, 1u);
-        if (!loop_init_23) {
+        if (all(loop_bound_31 == uint2(0u, 0u))) { break; }
+        loop_bound_31 -= uint2(loop_bound_31.y == 0u, 1u);
+        if (!loop_init_22) {
             uint _e809 = x;
             x = (_e809 + SLICE_LANES);
         }
-        loop_init_23 = false;
+        loop_init_22 = false;
         uint _e775 = x;
         if ((_e775 < (v_12 * LEAF_VECS))) {
         } else {
@@ -1918,16 +1885,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         {
             running = float4(0.0, 0.0, 0.0, 0.0);
             c_1 = 0u;
-            uint2 loop_bound_33 = uint2(4294967295u, 4294967295u);
-            bool loop_init_24 = true;
+            uint2 loop_bound_32 = uint2(4294967295u, 4294967295u);
+            bool loop_init_23 = true;
             while(true) {
-                if (all(loop_bound_33 == uint2(0u, 0u))) { break; }
-                loop_bound_33 -= uint2(loop_bound_33.y == 0u, 1u);
-                if (!loop_init_24) {
+                if (all(loop_bound_32 == uint2(0u, 0u))) { break; }
+                loop_bound_32 -= uint2(loop_bound_32.y == 0u, 1u);
+                if (!loop_init_23) {
                     uint _e807 = c_1;
                     c_1 = (_e807 + 1u);
                 }
-                loop_init_24 = false;
+                loop_init_23 = false;
                 uint _e787 = c_1;
                 if ((_e787 < TREES)) {
                 } else {
@@ -1949,16 +1916,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     DeviceMemoryBarrierWithGroupSync();
     GroupMemoryBarrierWithGroupSync();
     k_4 = li;
-    uint2 loop_bound_34 = uint2(4294967295u, 4294967295u);
-    bool loop_init_25 = true;
+    uint2 loop_bound_33 = uint2(4294967295u, 4294967295u);
+    bool loop_init_24 = true;
     while(true) {
-        if (all(loop_bound_34 == uint2(0u, 0u))) { break; }
-        loop_bound_34 -= uint2(loop_bound_34.y == 0u, 1u);
-        if (!loop_init_25) {
+        if (all(loop_bound_33 == uint2(0u, 0u))) { break; }
+        loop_bound_33 -= uint2(loop_bound_33.y == 0u, 1u);
+        if (!loop_init_24) {
             uint _e924 = k_4;
             k_4 = (_e924 + SLICE_LANES);
         }
-        loop_init_25 = false;
+        loop_init_24 = false;
         uint _e813 = k_4;
         if ((_e813 < SLICE_SAMPLES)) {
         } else {
@@ -1973,16 +1940,16 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 uint tree_1 = (trees + ((min(naga_div(_e825, cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0.0;
                 h_3 = 0u;
-                uint2 loop_bound_35 = uint2(4294967295u, 4294967295u);
-                bool loop_init_26 = true;
+                uint2 loop_bound_34 = uint2(4294967295u, 4294967295u);
+                bool loop_init_25 = true;
                 while(true) {
-                    if (all(loop_bound_35 == uint2(0u, 0u))) { break; }
-                    loop_bound_35 -= uint2(loop_bound_35.y == 0u, 1u);
-                    if (!loop_init_26) {
+                    if (all(loop_bound_34 == uint2(0u, 0u))) { break; }
+                    loop_bound_34 -= uint2(loop_bound_34.y == 0u, 1u);
+                    if (!loop_init_25) {
                         uint _e892 = h_3;
                         h_3 = (_e892 + 1u);
                     }
-                    loop_init_26 = false;
+                    loop_init_25 = false;
                     uint _e838 = h_3;
                     if ((_e838 < LEAF_VECS)) {
                     } else {
@@ -1996,10 +1963,10 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                         uint _e852 = k_4;
                         uint _e854 = q_rank[min(uint(_e852), 255u)];
                         j_8 = (v_12 - _e854);
-                        uint2 loop_bound_36 = uint2(4294967295u, 4294967295u);
+                        uint2 loop_bound_35 = uint2(4294967295u, 4294967295u);
                         while(true) {
-                            if (all(loop_bound_36 == uint2(0u, 0u))) { break; }
-                            loop_bound_36 -= uint2(loop_bound_36.y == 0u, 1u);
+                            if (all(loop_bound_35 == uint2(0u, 0u))) { break; }
+                            loop_bound_35 -= uint2(loop_bound_35.y == 0u, 1u);
                             uint _e857 = j_8;
                             if ((_e857 > 0u)) {
                             } else {

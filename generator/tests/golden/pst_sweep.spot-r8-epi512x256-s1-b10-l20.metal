@@ -418,46 +418,14 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float2 u,
     metal::float2 size
 ) {
-    float t_in = 0.0;
-    float t_out = 340000000000000000000000000000000000000.0;
-    uint a_3 = 0u;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = _e45 + 1u;
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if (_e4 < 2u) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = (0.5 - o_1[metal::min(unsigned(_e8), 1u)]) / u[metal::min(unsigned(_e13), 1u)];
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = ((size[metal::min(unsigned(_e17), 1u)] - 0.5) - o_1[metal::min(unsigned(_e21), 1u)]) / u[metal::min(unsigned(_e24), 1u)];
-            uint _e27 = a_3;
-            bool crosses = metal::abs(u[metal::min(unsigned(_e27), 1u)]) > 0.000000000001;
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = crosses ? metal::max(_e34, metal::min(ta, tb)) : _e33;
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = crosses ? metal::min(_e40, metal::max(ta, tb)) : _e39;
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return 0.5 * (_e47 + metal::max(_e48, _e49));
+    metal::float2 ta = (metal::float2(0.5, 0.5) - o_1) / u;
+    metal::float2 tb = ((size - metal::float2(0.5, 0.5)) - o_1) / u;
+    metal::bool2 crosses = metal::abs(u) > metal::float2(0.000000000001, 0.000000000001);
+    metal::float2 enter = metal::select(metal::float2(0.0, 0.0), metal::min(ta, tb), crosses);
+    metal::float2 leave = metal::select(metal::float2(340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0), metal::max(ta, tb), crosses);
+    float t_in_1 = metal::max(0.0, metal::max(enter.x, enter.y));
+    float t_out_1 = metal::min(340000000000000000000000000000000000000.0, metal::min(leave.x, leave.y));
+    return 0.5 * (t_in_1 + metal::max(t_out_1, t_in_1));
 }
 
 metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -473,9 +441,9 @@ float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
     uint row_1
 ) {
-    float a_10 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
+    float a_9 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
     metal::float2 ax = f_4.fan_origin.zw;
-    metal::float2 u_3 = metal::float2((ax.x * metal::cos(a_10)) - (ax.y * metal::sin(a_10)), (ax.y * metal::cos(a_10)) + (ax.x * metal::sin(a_10)));
+    metal::float2 u_3 = metal::float2((ax.x * metal::cos(a_9)) - (ax.y * metal::sin(a_9)), (ax.y * metal::cos(a_9)) + (ax.x * metal::sin(a_9)));
     metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_3, _e32);
     metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, f_4.fan_origin.xy + (u_3 * _e33));
@@ -531,7 +499,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::texture2d<float, metal::access::sample> sm_5,
     metal::float3 eye_4,
     metal::float3 dir_4,
-    float a_4,
+    float a_3,
     float b_3,
     uint steps,
     bool spot_1
@@ -540,18 +508,18 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     uint k_6 = 0u;
     float t_2 = {};
     float w = {};
-    float h_11 = (b_3 - a_4) / static_cast<float>(steps);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
+    float h_11 = (b_3 - a_3) / static_cast<float>(steps);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_3, b_3, steps);
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e65 = k_6;
             k_6 = _e65 + 1u;
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e15 = k_6;
         if ((_e15 + 1u) <= steps) {
         } else {
@@ -559,7 +527,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         }
         {
             uint _e19 = k_6;
-            t_2 = a_4 + ((static_cast<float>(_e19) + 0.5) * h_11);
+            t_2 = a_3 + ((static_cast<float>(_e19) + 0.5) * h_11);
             w = h_11;
             if (spot_1) {
                 uint _e28 = k_6;
@@ -579,7 +547,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
                 float _e48 = sum_1;
                 uint _e51 = k_6;
                 uint _e55 = k_6;
-                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4 + (static_cast<float>(_e51) * h_11), a_4 + (static_cast<float>(_e55 + 1u) * h_11));
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3 + (static_cast<float>(_e51) * h_11), a_3 + (static_cast<float>(_e55 + 1u) * h_11));
                 sum_1 = _e48 + (_e39 * _e61);
             }
         }
@@ -722,11 +690,11 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17,
     metal::float3 eye_7,
     metal::float3 dir_9,
-    float a_5,
+    float a_4,
     float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
@@ -738,26 +706,26 @@ float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18,
     metal::float3 eye_8,
     metal::float3 dir_10,
-    float a_6,
+    float a_5,
     float b_5,
     bool spot_6
 ) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, metal::max(naga_div(f_18.sizes2_.z, 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_18.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_5, b_5);
     return _e15;
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
-    float a_7,
+    float a_6,
     float b_6,
     float depth_break
 ) {
     bool local_10 = {};
-    if (!((a_7 == b_6))) {
-        local_10 = metal::abs(a_7 - b_6) <= (depth_break * metal::min(a_7, b_6));
+    if (!((a_6 == b_6))) {
+        local_10 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
     } else {
         local_10 = true;
     }
@@ -768,11 +736,11 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 metal::float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float3 v_10
 ) {
-    metal::float3 a_11 = metal::min(metal::abs(v_10), metal::float3(65504.0));
-    metal::uint3 u_4 = as_type<metal::uint3>(a_11);
+    metal::float3 a_10 = metal::min(metal::abs(v_10), metal::float3(65504.0));
+    metal::uint3 u_4 = as_type<metal::uint3>(a_10);
     metal::float3 normal = as_type<metal::float3>(((u_4 + metal::uint3(4095u)) + ((u_4 >> metal::uint3(13u)) & metal::uint3(1u))) & metal::uint3(4294959104u));
-    metal::float3 subnormal = metal::rint(a_11 * 16777216.0) / metal::float3(16777216.0);
-    return metal::sign(v_10) * metal::select(normal, subnormal, a_11 < metal::float3(0.000061035156));
+    metal::float3 subnormal = metal::rint(a_10 * 16777216.0) / metal::float3(16777216.0);
+    return metal::sign(v_10) * metal::select(normal, subnormal, a_10 < metal::float3(0.000061035156));
 }
 
 float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
@@ -792,7 +760,7 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
     bool local_11 = {};
     bool local_12 = {};
     bool local_13 = {};
-    float a_8 = 0.0;
+    float a_7 = 0.0;
     float b_7 = 0.0;
     uint k_7 = 0u;
     metal::float2 size_1 = static_cast<metal::float2>(screen);
@@ -845,16 +813,16 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
         l_1.dphi = 6.2831855 / static_cast<float>(slices);
     } else {
         l_1.wrap = 0u;
-        uint2 loop_bound_4 = uint2(4294967295u);
-        bool loop_init_4 = true;
+        uint2 loop_bound_3 = uint2(4294967295u);
+        bool loop_init_3 = true;
         while(true) {
-            if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-            loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-            if (!loop_init_4) {
+            if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+            loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+            if (!loop_init_3) {
                 uint _e153 = k_7;
                 k_7 = _e153 + 1u;
             }
-            loop_init_4 = false;
+            loop_init_3 = false;
             uint _e118 = k_7;
             if (_e118 < 4u) {
             } else {
@@ -869,20 +837,20 @@ EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_layoutX_nag
                 float _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, corner - _e140);
                 uint _e143 = k_7;
                 if (_e143 == 0u) {
-                    a_8 = _e142;
+                    a_7 = _e142;
                     b_7 = _e142;
                 } else {
-                    float _e148 = a_8;
-                    a_8 = metal::min(_e148, _e142);
+                    float _e148 = a_7;
+                    a_7 = metal::min(_e148, _e142);
                     float _e150 = b_7;
                     b_7 = metal::max(_e150, _e142);
                 }
             }
         }
-        float _e156 = a_8;
+        float _e156 = a_7;
         l_1.phi_start = _e156;
         float _e158 = b_7;
-        float _e159 = a_8;
+        float _e159 = a_7;
         l_1.dphi = (_e158 - _e159) / static_cast<float>(slices);
     }
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e163 = l_1;
@@ -905,51 +873,51 @@ metal::float2 slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::uint2 screen_1,
     uint samples
 ) {
-    float t_in_1 = 0.0;
-    float t_out_1 = 340000000000000000000000000000000000000.0;
-    uint a_9 = 0u;
+    float t_in = 0.0;
+    float t_out = 340000000000000000000000000000000000000.0;
+    uint a_8 = 0u;
     metal::float2 _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     metal::float2 lo_3 = metal::float2(0.5, 0.5);
     metal::float2 hi_3 = static_cast<metal::float2>(screen_1) - metal::float2(0.5, 0.5);
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
-            uint _e51 = a_9;
-            a_9 = _e51 + 1u;
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
+            uint _e51 = a_8;
+            a_8 = _e51 + 1u;
         }
-        loop_init_5 = false;
-        uint _e16 = a_9;
+        loop_init_4 = false;
+        uint _e16 = a_8;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            uint _e19 = a_9;
+            uint _e19 = a_8;
             if (metal::abs(_e5[metal::min(unsigned(_e19), 1u)]) > 0.000000000001) {
-                uint _e24 = a_9;
-                uint _e27 = a_9;
-                uint _e30 = a_9;
+                uint _e24 = a_8;
+                uint _e27 = a_8;
+                uint _e30 = a_8;
                 float ta_1 = (lo_3[metal::min(unsigned(_e24), 1u)] - l_3.origin[metal::min(unsigned(_e27), 1u)]) / _e5[metal::min(unsigned(_e30), 1u)];
-                uint _e33 = a_9;
-                uint _e36 = a_9;
-                uint _e39 = a_9;
+                uint _e33 = a_8;
+                uint _e36 = a_8;
+                uint _e39 = a_8;
                 float tb_1 = (hi_3[metal::min(unsigned(_e33), 1u)] - l_3.origin[metal::min(unsigned(_e36), 1u)]) / _e5[metal::min(unsigned(_e39), 1u)];
-                float _e43 = t_in_1;
-                t_in_1 = metal::max(_e43, metal::min(ta_1, tb_1));
-                float _e47 = t_out_1;
-                t_out_1 = metal::min(_e47, metal::max(ta_1, tb_1));
+                float _e43 = t_in;
+                t_in = metal::max(_e43, metal::min(ta_1, tb_1));
+                float _e47 = t_out;
+                t_out = metal::min(_e47, metal::max(ta_1, tb_1));
             }
         }
     }
-    float _e53 = t_out_1;
-    float _e54 = t_in_1;
-    t_out_1 = metal::max(_e53, _e54);
-    float _e56 = t_in_1;
-    float _e57 = t_out_1;
-    float _e58 = t_in_1;
+    float _e53 = t_out;
+    float _e54 = t_in;
+    t_out = metal::max(_e53, _e54);
+    float _e56 = t_in;
+    float _e57 = t_out;
+    float _e58 = t_in;
     return metal::float2(_e56, (_e57 - _e58) / static_cast<float>(samples - 1u));
 }
 
@@ -1024,16 +992,16 @@ metal::float4 pst_leaf(
     float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
     metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
     metal::float3 axis_2 = f_19.axis.xyz;
-    uint2 loop_bound_6 = uint2(4294967295u);
-    bool loop_init_6 = true;
+    uint2 loop_bound_5 = uint2(4294967295u);
+    bool loop_init_5 = true;
     while(true) {
-        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-        if (!loop_init_6) {
+        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
             uint _e56 = g_1;
             g_1 = _e56 + 1u;
         }
-        loop_init_6 = false;
+        loop_init_5 = false;
         uint _e17 = g_1;
         if (_e17 < 2u) {
         } else {
@@ -1158,16 +1126,16 @@ metal::float3 pst_sweep_pixel(
     if (_e27 == 0u) {
         return metal::float3(0.0, 0.0, 0.0);
     }
-    uint2 loop_bound_7 = uint2(4294967295u);
-    bool loop_init_7 = true;
+    uint2 loop_bound_6 = uint2(4294967295u);
+    bool loop_init_6 = true;
     while(true) {
-        if (metal::all(loop_bound_7 == uint2(0u))) { break; }
-        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-        if (!loop_init_7) {
+        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+        if (!loop_init_6) {
             uint _e77 = h_8;
             h_8 = _e77 + 1u;
         }
-        loop_init_7 = false;
+        loop_init_6 = false;
         uint _e35 = h_8;
         if (_e35 < RANK_VECS) {
         } else {
@@ -1176,16 +1144,16 @@ metal::float3 pst_sweep_pixel(
         {
             p_6 = metal::float4(0.0, 0.0, 0.0, 0.0);
             i_3 = 0u;
-            uint2 loop_bound_8 = uint2(4294967295u);
-            bool loop_init_8 = true;
+            uint2 loop_bound_7 = uint2(4294967295u);
+            bool loop_init_7 = true;
             while(true) {
-                if (metal::all(loop_bound_8 == uint2(0u))) { break; }
-                loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
-                if (!loop_init_8) {
+                if (metal::all(loop_bound_7 == uint2(0u))) { break; }
+                loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+                if (!loop_init_7) {
                     uint _e66 = i_3;
                     i_3 = _e66 + 1u;
                 }
-                loop_init_8 = false;
+                loop_init_7 = false;
                 uint _e46 = i_3;
                 if ((_e46 + 1u) < _e27) {
                 } else {
@@ -1367,16 +1335,16 @@ kernel void pst_sweep(
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
     float delta_6 = _e89.delta;
     k = li;
-    uint2 loop_bound_9 = uint2(4294967295u);
-    bool loop_init_9 = true;
+    uint2 loop_bound_8 = uint2(4294967295u);
+    bool loop_init_8 = true;
     while(true) {
-        if (metal::all(loop_bound_9 == uint2(0u))) { break; }
-        loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
-        if (!loop_init_9) {
+        if (metal::all(loop_bound_8 == uint2(0u))) { break; }
+        loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
+        if (!loop_init_8) {
             uint _e188 = k;
             k = _e188 + SLICE_LANES;
         }
-        loop_init_9 = false;
+        loop_init_8 = false;
         uint _e92 = k;
         if (_e92 < SLICE_SAMPLES) {
         } else {
@@ -1438,16 +1406,16 @@ kernel void pst_sweep(
     uint v_12 = metal::atomic_load_explicit(&live, metal::memory_order_relaxed);
     uint cw = naga_div((width + TREES) - 1u, TREES);
     if (li < TREES) {
-        uint2 loop_bound_10 = uint2(4294967295u);
-        bool loop_init_10 = true;
+        uint2 loop_bound_9 = uint2(4294967295u);
+        bool loop_init_9 = true;
         while(true) {
-            if (metal::all(loop_bound_10 == uint2(0u))) { break; }
-            loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
-            if (!loop_init_10) {
+            if (metal::all(loop_bound_9 == uint2(0u))) { break; }
+            loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
+            if (!loop_init_9) {
                 uint _e228 = k_1;
                 k_1 = _e228 + 1u;
             }
-            loop_init_10 = false;
+            loop_init_9 = false;
             uint _e202 = k_1;
             if (_e202 < SLICE_SAMPLES) {
             } else {
@@ -1480,10 +1448,10 @@ kernel void pst_sweep(
         }
         bool _e240 = local_2;
         if (_e240) {
-            uint2 loop_bound_11 = uint2(4294967295u);
+            uint2 loop_bound_10 = uint2(4294967295u);
             while(true) {
-                if (metal::all(loop_bound_11 == uint2(0u))) { break; }
-                loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
+                if (metal::all(loop_bound_10 == uint2(0u))) { break; }
+                loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
                 uint _e243 = first;
                 uint _e245 = q_end.inner[metal::min(unsigned(_e243), 255u)];
                 if (_e245 == NONE) {
@@ -1495,10 +1463,10 @@ kernel void pst_sweep(
                     first = _e249 + 1u;
                 }
             }
-            uint2 loop_bound_12 = uint2(4294967295u);
+            uint2 loop_bound_11 = uint2(4294967295u);
             while(true) {
-                if (metal::all(loop_bound_12 == uint2(0u))) { break; }
-                loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
+                if (metal::all(loop_bound_11 == uint2(0u))) { break; }
+                loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
                 uint _e253 = last;
                 uint _e255 = q_end.inner[metal::min(unsigned(_e253), 255u)];
                 if (_e255 == NONE) {
@@ -1515,16 +1483,16 @@ kernel void pst_sweep(
             uint _e266 = last;
             float _e268 = q_d.inner[metal::min(unsigned(_e266), 255u)];
             bool up = _e264 <= _e268;
-            uint2 loop_bound_13 = uint2(4294967295u);
-            bool loop_init_11 = true;
+            uint2 loop_bound_12 = uint2(4294967295u);
+            bool loop_init_10 = true;
             while(true) {
-                if (metal::all(loop_bound_13 == uint2(0u))) { break; }
-                loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
-                if (!loop_init_11) {
+                if (metal::all(loop_bound_12 == uint2(0u))) { break; }
+                loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
+                if (!loop_init_10) {
                     uint _e341 = k_2;
                     k_2 = _e341 + 1u;
                 }
-                loop_init_11 = false;
+                loop_init_10 = false;
                 uint _e271 = k_2;
                 if (_e271 < SLICE_SAMPLES) {
                 } else {
@@ -1538,10 +1506,10 @@ kernel void pst_sweep(
                         float d_3 = q_d.inner[metal::min(unsigned(_e281), 255u)];
                         uint _e285 = m;
                         j = _e285;
-                        uint2 loop_bound_14 = uint2(4294967295u);
+                        uint2 loop_bound_13 = uint2(4294967295u);
                         while(true) {
-                            if (metal::all(loop_bound_14 == uint2(0u))) { break; }
-                            loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
+                            if (metal::all(loop_bound_13 == uint2(0u))) { break; }
+                            loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
                             uint _e287 = j;
                             if (_e287 > 0u) {
                                 uint _e290 = j;
@@ -1581,16 +1549,16 @@ kernel void pst_sweep(
                 }
             }
             if (!(up)) {
-                uint2 loop_bound_15 = uint2(4294967295u);
-                bool loop_init_12 = true;
+                uint2 loop_bound_14 = uint2(4294967295u);
+                bool loop_init_11 = true;
                 while(true) {
-                    if (metal::all(loop_bound_15 == uint2(0u))) { break; }
-                    loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
-                    if (!loop_init_12) {
+                    if (metal::all(loop_bound_14 == uint2(0u))) { break; }
+                    loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
+                    if (!loop_init_11) {
                         uint _e390 = j_1;
                         j_1 = _e390 + 1u;
                     }
-                    loop_init_12 = false;
+                    loop_init_11 = false;
                     uint _e345 = j_1;
                     if (_e345 < naga_div(v_12, 2u)) {
                     } else {
@@ -1620,16 +1588,16 @@ kernel void pst_sweep(
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     if (li < TREES) {
-        uint2 loop_bound_16 = uint2(4294967295u);
-        bool loop_init_13 = true;
+        uint2 loop_bound_15 = uint2(4294967295u);
+        bool loop_init_12 = true;
         while(true) {
-            if (metal::all(loop_bound_16 == uint2(0u))) { break; }
-            loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
-            if (!loop_init_13) {
+            if (metal::all(loop_bound_15 == uint2(0u))) { break; }
+            loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
+            if (!loop_init_12) {
                 uint _e405 = c;
                 c = _e405 + 1u;
             }
-            loop_init_13 = false;
+            loop_init_12 = false;
             uint _e395 = c;
             if (_e395 < li) {
             } else {
@@ -1642,16 +1610,16 @@ kernel void pst_sweep(
                 start = _e398 + _e402;
             }
         }
-        uint2 loop_bound_17 = uint2(4294967295u);
-        bool loop_init_14 = true;
+        uint2 loop_bound_16 = uint2(4294967295u);
+        bool loop_init_13 = true;
         while(true) {
-            if (metal::all(loop_bound_17 == uint2(0u))) { break; }
-            loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
-            if (!loop_init_14) {
+            if (metal::all(loop_bound_16 == uint2(0u))) { break; }
+            loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
+            if (!loop_init_13) {
                 uint _e481 = k_3;
                 k_3 = _e481 + 1u;
             }
-            loop_init_14 = false;
+            loop_init_13 = false;
             uint _e408 = k_3;
             if (_e408 < SLICE_SAMPLES) {
             } else {
@@ -1671,10 +1639,10 @@ kernel void pst_sweep(
                 if (_e428) {
                     uint _e430 = m_1;
                     j_2 = _e430;
-                    uint2 loop_bound_18 = uint2(4294967295u);
+                    uint2 loop_bound_17 = uint2(4294967295u);
                     while(true) {
-                        if (metal::all(loop_bound_18 == uint2(0u))) { break; }
-                        loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
+                        if (metal::all(loop_bound_17 == uint2(0u))) { break; }
+                        loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
                         uint _e432 = j_2;
                         if (_e432 > 0u) {
                             uint _e435 = start;
@@ -1714,16 +1682,16 @@ kernel void pst_sweep(
         }
     }
     j_3 = li;
-    uint2 loop_bound_19 = uint2(4294967295u);
-    bool loop_init_15 = true;
+    uint2 loop_bound_18 = uint2(4294967295u);
+    bool loop_init_14 = true;
     while(true) {
-        if (metal::all(loop_bound_19 == uint2(0u))) { break; }
-        loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
-        if (!loop_init_15) {
+        if (metal::all(loop_bound_18 == uint2(0u))) { break; }
+        loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
+        if (!loop_init_14) {
             uint _e495 = j_3;
             j_3 = _e495 + SLICE_LANES;
         }
-        loop_init_15 = false;
+        loop_init_14 = false;
         uint _e484 = j_3;
         if (_e484 < v_12) {
         } else {
@@ -1738,16 +1706,16 @@ kernel void pst_sweep(
     }
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     j_4 = li;
-    uint2 loop_bound_20 = uint2(4294967295u);
-    bool loop_init_16 = true;
+    uint2 loop_bound_19 = uint2(4294967295u);
+    bool loop_init_15 = true;
     while(true) {
-        if (metal::all(loop_bound_20 == uint2(0u))) { break; }
-        loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
-        if (!loop_init_16) {
+        if (metal::all(loop_bound_19 == uint2(0u))) { break; }
+        loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
+        if (!loop_init_15) {
             uint _e509 = j_4;
             j_4 = _e509 + SLICE_LANES;
         }
-        loop_init_16 = false;
+        loop_init_15 = false;
         uint _e499 = j_4;
         if (_e499 < v_12) {
         } else {
@@ -1763,16 +1731,16 @@ kernel void pst_sweep(
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     uint base_1 = s_7 * width;
     i = li;
-    uint2 loop_bound_21 = uint2(4294967295u);
-    bool loop_init_17 = true;
+    uint2 loop_bound_20 = uint2(4294967295u);
+    bool loop_init_16 = true;
     while(true) {
-        if (metal::all(loop_bound_21 == uint2(0u))) { break; }
-        loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
-        if (!loop_init_17) {
+        if (metal::all(loop_bound_20 == uint2(0u))) { break; }
+        loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
+        if (!loop_init_16) {
             uint _e566 = i;
             i = _e566 + SLICE_LANES;
         }
-        loop_init_17 = false;
+        loop_init_16 = false;
         uint _e514 = i;
         if (_e514 < width) {
         } else {
@@ -1785,10 +1753,10 @@ kernel void pst_sweep(
             float occluder = _e520.x;
             lo = 0u;
             hi = v_12;
-            uint2 loop_bound_22 = uint2(4294967295u);
+            uint2 loop_bound_21 = uint2(4294967295u);
             while(true) {
-                if (metal::all(loop_bound_22 == uint2(0u))) { break; }
-                loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
+                if (metal::all(loop_bound_21 == uint2(0u))) { break; }
+                loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
                 uint _e525 = lo;
                 uint _e526 = hi;
                 if (_e525 < _e526) {
@@ -1813,16 +1781,16 @@ kernel void pst_sweep(
             uint _e544 = lo;
             if (_e544 > 0u) {
                 h = 0u;
-                uint2 loop_bound_23 = uint2(4294967295u);
-                bool loop_init_18 = true;
+                uint2 loop_bound_22 = uint2(4294967295u);
+                bool loop_init_17 = true;
                 while(true) {
-                    if (metal::all(loop_bound_23 == uint2(0u))) { break; }
-                    loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
-                    if (!loop_init_18) {
+                    if (metal::all(loop_bound_22 == uint2(0u))) { break; }
+                    loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
+                    if (!loop_init_17) {
                         uint _e564 = h;
                         h = _e564 + 1u;
                     }
-                    loop_init_18 = false;
+                    loop_init_17 = false;
                     uint _e549 = h;
                     if (_e549 < LEAF_VECS) {
                     } else {
@@ -1846,16 +1814,16 @@ kernel void pst_sweep(
     uint partials = trees + 4096u;
     if (li < TREES) {
         uint tree = trees + ((li * SLICE_SAMPLES) * LEAF_VECS);
-        uint2 loop_bound_24 = uint2(4294967295u);
-        bool loop_init_19 = true;
+        uint2 loop_bound_23 = uint2(4294967295u);
+        bool loop_init_18 = true;
         while(true) {
-            if (metal::all(loop_bound_24 == uint2(0u))) { break; }
-            loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
-            if (!loop_init_19) {
+            if (metal::all(loop_bound_23 == uint2(0u))) { break; }
+            loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
+            if (!loop_init_18) {
                 uint _e599 = j_5;
                 j_5 = _e599 + 1u;
             }
-            loop_init_19 = false;
+            loop_init_18 = false;
             uint _e585 = j_5;
             if (_e585 < (v_12 * LEAF_VECS)) {
             } else {
@@ -1869,10 +1837,10 @@ kernel void pst_sweep(
         uint lo_5 = li * cw;
         uint hi_5 = ((li + 1u) == TREES) ? width : metal::min(lo_5 + cw, width);
         top = v_12;
-        uint2 loop_bound_25 = uint2(4294967295u);
+        uint2 loop_bound_24 = uint2(4294967295u);
         while(true) {
-            if (metal::all(loop_bound_25 == uint2(0u))) { break; }
-            loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
+            if (metal::all(loop_bound_24 == uint2(0u))) { break; }
+            loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
             uint _e611 = next;
             uint _e612 = top;
             if (_e611 < _e612) {
@@ -1893,26 +1861,26 @@ kernel void pst_sweep(
             }
         }
         i_1 = lo_5;
-        uint2 loop_bound_26 = uint2(4294967295u);
-        bool loop_init_20 = true;
+        uint2 loop_bound_25 = uint2(4294967295u);
+        bool loop_init_19 = true;
         while(true) {
-            if (metal::all(loop_bound_26 == uint2(0u))) { break; }
-            loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
-            if (!loop_init_20) {
+            if (metal::all(loop_bound_25 == uint2(0u))) { break; }
+            loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
+            if (!loop_init_19) {
                 uint _e772 = i_1;
                 i_1 = _e772 + 1u;
             }
-            loop_init_20 = false;
+            loop_init_19 = false;
             uint _e629 = i_1;
             if (_e629 <= hi_5) {
             } else {
                 break;
             }
             {
-                uint2 loop_bound_27 = uint2(4294967295u);
+                uint2 loop_bound_26 = uint2(4294967295u);
                 while(true) {
-                    if (metal::all(loop_bound_27 == uint2(0u))) { break; }
-                    loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
+                    if (metal::all(loop_bound_26 == uint2(0u))) { break; }
+                    loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
                     uint _e631 = next;
                     if (_e631 < v_12) {
                         uint _e635 = next;
@@ -1947,16 +1915,16 @@ kernel void pst_sweep(
                         uint _e666 = next;
                         next = _e666 + 1u;
                         h_1 = 0u;
-                        uint2 loop_bound_28 = uint2(4294967295u);
-                        bool loop_init_21 = true;
+                        uint2 loop_bound_27 = uint2(4294967295u);
+                        bool loop_init_20 = true;
                         while(true) {
-                            if (metal::all(loop_bound_28 == uint2(0u))) { break; }
-                            loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
-                            if (!loop_init_21) {
+                            if (metal::all(loop_bound_27 == uint2(0u))) { break; }
+                            loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
+                            if (!loop_init_20) {
                                 uint _e717 = h_1;
                                 h_1 = _e717 + 1u;
                             }
-                            loop_init_21 = false;
+                            loop_init_20 = false;
                             uint _e670 = h_1;
                             if (_e670 < LEAF_VECS) {
                             } else {
@@ -1966,10 +1934,10 @@ kernel void pst_sweep(
                                 p = metal::float4(0.0, 0.0, 0.0, 0.0);
                                 uint _e681 = q_rank.inner[metal::min(unsigned(k_10), 255u)];
                                 j_6 = v_12 - _e681;
-                                uint2 loop_bound_29 = uint2(4294967295u);
+                                uint2 loop_bound_28 = uint2(4294967295u);
                                 while(true) {
-                                    if (metal::all(loop_bound_29 == uint2(0u))) { break; }
-                                    loop_bound_29 -= uint2(loop_bound_29.y == 0u, 1u);
+                                    if (metal::all(loop_bound_28 == uint2(0u))) { break; }
+                                    loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
                                     uint _e684 = j_6;
                                     if (_e684 > 0u) {
                                     } else {
@@ -2002,16 +1970,16 @@ kernel void pst_sweep(
                 uint b_8 = pst_columns[metal::min(unsigned(base_1 + _e722), (_buffer_sizes.size8 - 0 - 4) / 4)];
                 if (b_8 > 0u) {
                     h_2 = 0u;
-                    uint2 loop_bound_30 = uint2(4294967295u);
-                    bool loop_init_22 = true;
+                    uint2 loop_bound_29 = uint2(4294967295u);
+                    bool loop_init_21 = true;
                     while(true) {
-                        if (metal::all(loop_bound_30 == uint2(0u))) { break; }
-                        loop_bound_30 -= uint2(loop_bound_30.y == 0u, 1u);
-                        if (!loop_init_22) {
+                        if (metal::all(loop_bound_29 == uint2(0u))) { break; }
+                        loop_bound_29 -= uint2(loop_bound_29.y == 0u, 1u);
+                        if (!loop_init_21) {
                             uint _e769 = h_2;
                             h_2 = _e769 + 1u;
                         }
-                        loop_init_22 = false;
+                        loop_init_21 = false;
                         uint _e730 = h_2;
                         if (_e730 < LEAF_VECS) {
                         } else {
@@ -2022,10 +1990,10 @@ kernel void pst_sweep(
                             uint _e738 = h_2;
                             metal::float4 leaf_1 = pst_leaves[metal::min(unsigned(((base_1 + _e733) * LEAF_VECS) + _e738), (_buffer_sizes.size6 - 0 - 16) / 16)];
                             j_7 = (v_12 - b_8) + 1u;
-                            uint2 loop_bound_31 = uint2(4294967295u);
+                            uint2 loop_bound_30 = uint2(4294967295u);
                             while(true) {
-                                if (metal::all(loop_bound_31 == uint2(0u))) { break; }
-                                loop_bound_31 -= uint2(loop_bound_31.y == 0u, 1u);
+                                if (metal::all(loop_bound_30 == uint2(0u))) { break; }
+                                loop_bound_30 -= uint2(loop_bound_30.y == 0u, 1u);
                                 uint _e746 = j_7;
                                 if (_e746 <= v_12) {
                                 } else {
@@ -2051,16 +2019,16 @@ kernel void pst_sweep(
     metal::threadgroup_barrier(metal::mem_flags::mem_device);
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     x = li;
-    uint2 loop_bound_32 = uint2(4294967295u);
-    bool loop_init_23 = true;
+    uint2 loop_bound_31 = uint2(4294967295u);
+    bool loop_init_22 = true;
     while(true) {
-        if (metal::all(loop_bound_32 == uint2(0u))) { break; }
-        loop_bound_32 -= uint2(loop_bound_32.y == 0u, 1u);
-        if (!loop_init_23) {
+        if (metal::all(loop_bound_31 == uint2(0u))) { break; }
+        loop_bound_31 -= uint2(loop_bound_31.y == 0u, 1u);
+        if (!loop_init_22) {
             uint _e809 = x;
             x = _e809 + SLICE_LANES;
         }
-        loop_init_23 = false;
+        loop_init_22 = false;
         uint _e775 = x;
         if (_e775 < (v_12 * LEAF_VECS)) {
         } else {
@@ -2069,16 +2037,16 @@ kernel void pst_sweep(
         {
             running = metal::float4(0.0, 0.0, 0.0, 0.0);
             c_1 = 0u;
-            uint2 loop_bound_33 = uint2(4294967295u);
-            bool loop_init_24 = true;
+            uint2 loop_bound_32 = uint2(4294967295u);
+            bool loop_init_23 = true;
             while(true) {
-                if (metal::all(loop_bound_33 == uint2(0u))) { break; }
-                loop_bound_33 -= uint2(loop_bound_33.y == 0u, 1u);
-                if (!loop_init_24) {
+                if (metal::all(loop_bound_32 == uint2(0u))) { break; }
+                loop_bound_32 -= uint2(loop_bound_32.y == 0u, 1u);
+                if (!loop_init_23) {
                     uint _e807 = c_1;
                     c_1 = _e807 + 1u;
                 }
-                loop_init_24 = false;
+                loop_init_23 = false;
                 uint _e787 = c_1;
                 if (_e787 < TREES) {
                 } else {
@@ -2100,16 +2068,16 @@ kernel void pst_sweep(
     metal::threadgroup_barrier(metal::mem_flags::mem_device);
     metal::threadgroup_barrier(metal::mem_flags::mem_threadgroup);
     k_4 = li;
-    uint2 loop_bound_34 = uint2(4294967295u);
-    bool loop_init_25 = true;
+    uint2 loop_bound_33 = uint2(4294967295u);
+    bool loop_init_24 = true;
     while(true) {
-        if (metal::all(loop_bound_34 == uint2(0u))) { break; }
-        loop_bound_34 -= uint2(loop_bound_34.y == 0u, 1u);
-        if (!loop_init_25) {
+        if (metal::all(loop_bound_33 == uint2(0u))) { break; }
+        loop_bound_33 -= uint2(loop_bound_33.y == 0u, 1u);
+        if (!loop_init_24) {
             uint _e924 = k_4;
             k_4 = _e924 + SLICE_LANES;
         }
-        loop_init_25 = false;
+        loop_init_24 = false;
         uint _e813 = k_4;
         if (_e813 < SLICE_SAMPLES) {
         } else {
@@ -2124,16 +2092,16 @@ kernel void pst_sweep(
                 uint tree_1 = trees + ((metal::min(naga_div(_e825, cw), 7u) * SLICE_SAMPLES) * LEAF_VECS);
                 dotp = 0.0;
                 h_3 = 0u;
-                uint2 loop_bound_35 = uint2(4294967295u);
-                bool loop_init_26 = true;
+                uint2 loop_bound_34 = uint2(4294967295u);
+                bool loop_init_25 = true;
                 while(true) {
-                    if (metal::all(loop_bound_35 == uint2(0u))) { break; }
-                    loop_bound_35 -= uint2(loop_bound_35.y == 0u, 1u);
-                    if (!loop_init_26) {
+                    if (metal::all(loop_bound_34 == uint2(0u))) { break; }
+                    loop_bound_34 -= uint2(loop_bound_34.y == 0u, 1u);
+                    if (!loop_init_25) {
                         uint _e892 = h_3;
                         h_3 = _e892 + 1u;
                     }
-                    loop_init_26 = false;
+                    loop_init_25 = false;
                     uint _e838 = h_3;
                     if (_e838 < LEAF_VECS) {
                     } else {
@@ -2147,10 +2115,10 @@ kernel void pst_sweep(
                         uint _e852 = k_4;
                         uint _e854 = q_rank.inner[metal::min(unsigned(_e852), 255u)];
                         j_8 = v_12 - _e854;
-                        uint2 loop_bound_36 = uint2(4294967295u);
+                        uint2 loop_bound_35 = uint2(4294967295u);
                         while(true) {
-                            if (metal::all(loop_bound_36 == uint2(0u))) { break; }
-                            loop_bound_36 -= uint2(loop_bound_36.y == 0u, 1u);
+                            if (metal::all(loop_bound_35 == uint2(0u))) { break; }
+                            loop_bound_35 -= uint2(loop_bound_35.y == 0u, 1u);
                             uint _e857 = j_8;
                             if (_e857 > 0u) {
                             } else {

@@ -326,42 +326,14 @@ fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil
 }
 
 fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
-    var t_in: f32 = 0f;
-    var t_out: f32 = 340000000000000000000000000000000000000f;
-    var a_3: u32 = 0u;
-
-    loop {
-        let _e4 = a_3;
-        if (_e4 < 2u) {
-        } else {
-            break;
-        }
-        {
-            let _e8 = a_3;
-            let _e13 = a_3;
-            let ta = ((0.5f - o_1[_e8]) / u[_e13]);
-            let _e17 = a_3;
-            let _e21 = a_3;
-            let _e24 = a_3;
-            let tb = (((size[_e17] - 0.5f) - o_1[_e21]) / u[_e24]);
-            let _e27 = a_3;
-            let crosses = (abs(u[_e27]) > 0.000000000001f);
-            let _e33 = t_in;
-            let _e34 = t_in;
-            t_in = select(_e33, max(_e34, min(ta, tb)), crosses);
-            let _e39 = t_out;
-            let _e40 = t_out;
-            t_out = select(_e39, min(_e40, max(ta, tb)), crosses);
-        }
-        continuing {
-            let _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-    }
-    let _e47 = t_in;
-    let _e48 = t_out;
-    let _e49 = t_in;
-    return (0.5f * (_e47 + max(_e48, _e49)));
+    let ta = ((vec2<f32>(0.5f, 0.5f) - o_1) / u);
+    let tb = (((size - vec2<f32>(0.5f, 0.5f)) - o_1) / u);
+    let crosses = (abs(u) > vec2<f32>(0.000000000001f, 0.000000000001f));
+    let enter = select(vec2<f32>(0f, 0f), min(ta, tb), crosses);
+    let leave = select(vec2<f32>(340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f), max(ta, tb), crosses);
+    let t_in_1 = max(0f, max(enter.x, enter.y));
+    let t_out_1 = min(340000000000000000000000000000000000000f, min(leave.x, leave.y));
+    return (0.5f * (t_in_1 + max(t_out_1, t_in_1)));
 }
 
 fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_4: vec2<f32>) -> vec3<f32> {
@@ -371,9 +343,9 @@ fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_
 }
 
 fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
-    let a_10 = (f_4.fan_angles.x + ((f32(row_1) + 0.5f) * f_4.fan_angles.y));
+    let a_9 = (f_4.fan_angles.x + ((f32(row_1) + 0.5f) * f_4.fan_angles.y));
     let ax = f_4.fan_origin.zw;
-    let u_3 = vec2<f32>(((ax.x * cos(a_10)) - (ax.y * sin(a_10))), ((ax.y * cos(a_10)) + (ax.x * sin(a_10))));
+    let u_3 = vec2<f32>(((ax.x * cos(a_9)) - (ax.y * sin(a_9))), ((ax.y * cos(a_9)) + (ax.x * sin(a_9))));
     let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_3, _e32);
     let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_3 * _e33)));
@@ -405,14 +377,14 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX
     return _e13;
 }
 
-fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_4: f32, b_3: f32, steps: u32, spot_1: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot_1: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_6: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
-    let h_11 = ((b_3 - a_4) / f32(steps));
-    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
+    let h_11 = ((b_3 - a_3) / f32(steps));
+    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_6;
         if ((_e15 + 1u) <= steps) {
@@ -421,7 +393,7 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_
         }
         {
             let _e19 = k_6;
-            t_2 = (a_4 + ((f32(_e19) + 0.5f) * h_11));
+            t_2 = (a_3 + ((f32(_e19) + 0.5f) * h_11));
             w = h_11;
             if spot_1 {
                 let _e28 = k_6;
@@ -441,7 +413,7 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_
                 let _e48 = sum_1;
                 let _e51 = k_6;
                 let _e55 = k_6;
-                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_4 + (f32(_e51) * h_11)), (a_4 + (f32((_e55 + 1u)) * h_11)));
+                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_3 + (f32(_e51) * h_11)), (a_3 + (f32((_e55 + 1u)) * h_11)));
                 sum_1 = (_e48 + (_e39 * _e61));
             }
         }
@@ -534,25 +506,25 @@ fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16: FrameX_naga_oil_mod
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_5: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_6: f32, b_5: f32, spot_6: bool) -> f32 {
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
     if spot_6 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, max((f_18.sizes2_.z / 4u), 1u));
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_5, b_5, max((f_18.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_5, b_5);
     return _e15;
 }
 
-fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_7: f32, b_6: f32, depth_break: f32) -> bool {
+fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_6: f32, b_6: f32, depth_break: f32) -> bool {
     var local_10: bool;
 
-    if !((a_7 == b_6)) {
-        local_10 = (abs((a_7 - b_6)) <= (depth_break * min(a_7, b_6)));
+    if !((a_6 == b_6)) {
+        local_10 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
         local_10 = true;
     }
@@ -561,11 +533,11 @@ fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_7: f32, b_6: f32, 
 }
 
 fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_10: vec3<f32>) -> vec3<f32> {
-    let a_11 = min(abs(v_10), vec3(65504f));
-    let u_4 = bitcast<vec3<u32>>(a_11);
+    let a_10 = min(abs(v_10), vec3(65504f));
+    let u_4 = bitcast<vec3<u32>>(a_10);
     let normal = bitcast<vec3<f32>>((((u_4 + vec3(4095u)) + ((u_4 >> vec3(13u)) & vec3(1u))) & vec3(4294959104u)));
-    let subnormal = (round((a_11 * 16777216f)) / vec3(16777216f));
-    return (sign(v_10) * select(normal, subnormal, (a_11 < vec3(0.000061035156f))));
+    let subnormal = (round((a_10 * 16777216f)) / vec3(16777216f));
+    return (sign(v_10) * select(normal, subnormal, (a_10 < vec3(0.000061035156f))));
 }
 
 fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, d: vec2<f32>) -> f32 {
@@ -578,7 +550,7 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
     var local_11: bool;
     var local_12: bool;
     var local_13: bool;
-    var a_8: f32 = 0f;
+    var a_7: f32 = 0f;
     var b_7: f32 = 0f;
     var k_7: u32 = 0u;
 
@@ -647,11 +619,11 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
                 let _e142 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e139, (corner - _e140));
                 let _e143 = k_7;
                 if (_e143 == 0u) {
-                    a_8 = _e142;
+                    a_7 = _e142;
                     b_7 = _e142;
                 } else {
-                    let _e148 = a_8;
-                    a_8 = min(_e148, _e142);
+                    let _e148 = a_7;
+                    a_7 = min(_e148, _e142);
                     let _e150 = b_7;
                     b_7 = max(_e150, _e142);
                 }
@@ -661,10 +633,10 @@ fn epipolar_layoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(cam: EpipolarCam
                 k_7 = (_e153 + 1u);
             }
         }
-        let _e156 = a_8;
+        let _e156 = a_7;
         l_1.phi_start = _e156;
         let _e158 = b_7;
-        let _e159 = a_8;
+        let _e159 = a_7;
         l_1.dphi = ((_e158 - _e159) / f32(slices));
     }
     let _e163 = l_1;
@@ -679,47 +651,47 @@ fn slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLay
 }
 
 fn slice_spanX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, s_5: u32, screen_1: vec2<u32>, samples: u32) -> vec2<f32> {
-    var t_in_1: f32 = 0f;
-    var t_out_1: f32 = 340000000000000000000000000000000000000f;
-    var a_9: u32 = 0u;
+    var t_in: f32 = 0f;
+    var t_out: f32 = 340000000000000000000000000000000000000f;
+    var a_8: u32 = 0u;
 
     let _e5 = slice_directionX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3, s_5);
     let lo_3 = vec2<f32>(0.5f, 0.5f);
     let hi_3 = (vec2<f32>(screen_1) - vec2<f32>(0.5f, 0.5f));
     loop {
-        let _e16 = a_9;
+        let _e16 = a_8;
         if (_e16 < 2u) {
         } else {
             break;
         }
         {
-            let _e19 = a_9;
+            let _e19 = a_8;
             if (abs(_e5[_e19]) > 0.000000000001f) {
-                let _e24 = a_9;
-                let _e27 = a_9;
-                let _e30 = a_9;
+                let _e24 = a_8;
+                let _e27 = a_8;
+                let _e30 = a_8;
                 let ta_1 = ((lo_3[_e24] - l_3.origin[_e27]) / _e5[_e30]);
-                let _e33 = a_9;
-                let _e36 = a_9;
-                let _e39 = a_9;
+                let _e33 = a_8;
+                let _e36 = a_8;
+                let _e39 = a_8;
                 let tb_1 = ((hi_3[_e33] - l_3.origin[_e36]) / _e5[_e39]);
-                let _e43 = t_in_1;
-                t_in_1 = max(_e43, min(ta_1, tb_1));
-                let _e47 = t_out_1;
-                t_out_1 = min(_e47, max(ta_1, tb_1));
+                let _e43 = t_in;
+                t_in = max(_e43, min(ta_1, tb_1));
+                let _e47 = t_out;
+                t_out = min(_e47, max(ta_1, tb_1));
             }
         }
         continuing {
-            let _e51 = a_9;
-            a_9 = (_e51 + 1u);
+            let _e51 = a_8;
+            a_8 = (_e51 + 1u);
         }
     }
-    let _e53 = t_out_1;
-    let _e54 = t_in_1;
-    t_out_1 = max(_e53, _e54);
-    let _e56 = t_in_1;
-    let _e57 = t_out_1;
-    let _e58 = t_in_1;
+    let _e53 = t_out;
+    let _e54 = t_in;
+    t_out = max(_e53, _e54);
+    let _e56 = t_in;
+    let _e57 = t_out;
+    let _e58 = t_in;
     return vec2<f32>(_e56, ((_e57 - _e58) / f32((samples - 1u))));
 }
 

@@ -298,43 +298,14 @@ vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
-    float t_in = 0.0;
-    float t_out = 3.4e38;
-    uint a_3 = 0u;
-    bool loop_init_2 = true;
-    while(true) {
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if ((_e4 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = ((0.5 - o_1[_e8]) / u[_e13]);
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = (((size[_e17] - 0.5) - o_1[_e21]) / u[_e24]);
-            uint _e27 = a_3;
-            bool crosses = (abs(u[_e27]) > 1e-12);
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return (0.5 * (_e47 + max(_e48, _e49)));
+    vec2 ta = ((vec2(0.5, 0.5) - o_1) / u);
+    vec2 tb = (((size - vec2(0.5, 0.5)) - o_1) / u);
+    bvec2 crosses = greaterThan(abs(u), vec2(1e-12, 1e-12));
+    vec2 enter = mix(vec2(0.0, 0.0), min(ta, tb), crosses);
+    vec2 leave = mix(vec2(3.4e38, 3.4e38), max(ta, tb), crosses);
+    float t_in = max(0.0, max(enter.x, enter.y));
+    float t_out = min(3.4e38, min(leave.x, leave.y));
+    return (0.5 * (t_in + max(t_out, t_in)));
 }
 
 vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_2) {
@@ -344,9 +315,9 @@ vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
-    float a_7 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    float a_6 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
     vec2 ax = f_4.fan_origin.zw;
-    vec2 u_2 = vec2(((ax.x * cos(a_7)) - (ax.y * sin(a_7))), ((ax.y * cos(a_7)) + (ax.x * sin(a_7))));
+    vec2 u_2 = vec2(((ax.x * cos(a_6)) - (ax.y * sin(a_6))), ((ax.y * cos(a_6)) + (ax.x * sin(a_6))));
     vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
@@ -378,20 +349,20 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_4, float b_3, uint steps, bool spot_1) {
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot_1) {
     float sum_1 = 0.0;
     uint k_1 = 0u;
     float t_2 = 0.0;
     float w = 0.0;
-    float h_7 = ((b_3 - a_4) / float(steps));
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
-    bool loop_init_3 = true;
+    float h_7 = ((b_3 - a_3) / float(steps));
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_3, b_3, steps);
+    bool loop_init_2 = true;
     while(true) {
-        if (!loop_init_3) {
+        if (!loop_init_2) {
             uint _e65 = k_1;
             k_1 = (_e65 + 1u);
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e15 = k_1;
         if (((_e15 + 1u) <= steps)) {
         } else {
@@ -399,7 +370,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
         }
         {
             uint _e19 = k_1;
-            t_2 = (a_4 + ((float(_e19) + 0.5) * h_7));
+            t_2 = (a_3 + ((float(_e19) + 0.5) * h_7));
             w = h_7;
             if (spot_1) {
                 uint _e28 = k_1;
@@ -419,7 +390,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
                 float _e48 = sum_1;
                 uint _e51 = k_1;
                 uint _e55 = k_1;
-                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_4 + (float(_e51) * h_7)), (a_4 + (float((_e55 + 1u)) * h_7)));
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_3 + (float(_e51) * h_7)), (a_3 + (float((_e55 + 1u)) * h_7)));
                 sum_1 = (_e48 + (_e39 * _e61));
             }
         }
@@ -507,17 +478,17 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XO
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, vec3 eye_7, vec3 dir_9, float a_5, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, vec3 eye_8, vec3 dir_10, float a_6, float b_5, bool spot_6) {
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, max((f_18.sizes2_.z / 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_5, b_5, max((f_18.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -552,13 +523,13 @@ vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint i, u
     float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
     vec3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
     vec3 axis_1 = f_19.axis.xyz;
-    bool loop_init_4 = true;
+    bool loop_init_3 = true;
     while(true) {
-        if (!loop_init_4) {
+        if (!loop_init_3) {
             uint _e56 = g_1;
             g_1 = (_e56 + 1u);
         }
-        loop_init_4 = false;
+        loop_init_3 = false;
         uint _e17 = g_1;
         if ((_e17 < 2u)) {
         } else {
@@ -657,13 +628,13 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
     if ((_e27 == 0u)) {
         return vec3(0.0, 0.0, 0.0);
     }
-    bool loop_init_5 = true;
+    bool loop_init_4 = true;
     while(true) {
-        if (!loop_init_5) {
+        if (!loop_init_4) {
             uint _e77 = h_4;
             h_4 = (_e77 + 1u);
         }
-        loop_init_5 = false;
+        loop_init_4 = false;
         uint _e35 = h_4;
         if ((_e35 < RANK_VECS)) {
         } else {
@@ -672,13 +643,13 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
         {
             p_4 = vec4(0.0, 0.0, 0.0, 0.0);
             i_1 = 0u;
-            bool loop_init_6 = true;
+            bool loop_init_5 = true;
             while(true) {
-                if (!loop_init_6) {
+                if (!loop_init_5) {
                     uint _e66 = i_1;
                     i_1 = (_e66 + 1u);
                 }
-                loop_init_6 = false;
+                loop_init_5 = false;
                 uint _e46 = i_1;
                 if (((_e46 + 1u) < _e27)) {
                 } else {
@@ -719,13 +690,13 @@ void main() {
     uint _e18 = _group_0_binding_11_cs;
     uint n_4 = min(_e18, (screen.x * screen.y));
     e = ((id.y * lanes.x) + id.x);
-    bool loop_init_7 = true;
+    bool loop_init_6 = true;
     while(true) {
-        if (!loop_init_7) {
+        if (!loop_init_6) {
             uint _e54 = e;
             e = (_e54 + (lanes.x * lanes.y));
         }
-        loop_init_7 = false;
+        loop_init_6 = false;
         uint _e30 = e;
         if ((_e30 < n_4)) {
         } else {

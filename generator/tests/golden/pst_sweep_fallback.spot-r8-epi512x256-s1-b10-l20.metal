@@ -388,46 +388,14 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float2 u,
     metal::float2 size
 ) {
-    float t_in = 0.0;
-    float t_out = 340000000000000000000000000000000000000.0;
-    uint a_3 = 0u;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = _e45 + 1u;
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if (_e4 < 2u) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = (0.5 - o_1[metal::min(unsigned(_e8), 1u)]) / u[metal::min(unsigned(_e13), 1u)];
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = ((size[metal::min(unsigned(_e17), 1u)] - 0.5) - o_1[metal::min(unsigned(_e21), 1u)]) / u[metal::min(unsigned(_e24), 1u)];
-            uint _e27 = a_3;
-            bool crosses = metal::abs(u[metal::min(unsigned(_e27), 1u)]) > 0.000000000001;
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = crosses ? metal::max(_e34, metal::min(ta, tb)) : _e33;
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = crosses ? metal::min(_e40, metal::max(ta, tb)) : _e39;
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return 0.5 * (_e47 + metal::max(_e48, _e49));
+    metal::float2 ta = (metal::float2(0.5, 0.5) - o_1) / u;
+    metal::float2 tb = ((size - metal::float2(0.5, 0.5)) - o_1) / u;
+    metal::bool2 crosses = metal::abs(u) > metal::float2(0.000000000001, 0.000000000001);
+    metal::float2 enter = metal::select(metal::float2(0.0, 0.0), metal::min(ta, tb), crosses);
+    metal::float2 leave = metal::select(metal::float2(340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0), metal::max(ta, tb), crosses);
+    float t_in = metal::max(0.0, metal::max(enter.x, enter.y));
+    float t_out = metal::min(340000000000000000000000000000000000000.0, metal::min(leave.x, leave.y));
+    return 0.5 * (t_in + metal::max(t_out, t_in));
 }
 
 metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -443,9 +411,9 @@ float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
     uint row_1
 ) {
-    float a_7 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
+    float a_6 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
     metal::float2 ax = f_4.fan_origin.zw;
-    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_7)) - (ax.y * metal::sin(a_7)), (ax.y * metal::cos(a_7)) + (ax.x * metal::sin(a_7)));
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_6)) - (ax.y * metal::sin(a_6)), (ax.y * metal::cos(a_6)) + (ax.x * metal::sin(a_6)));
     metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, f_4.fan_origin.xy + (u_2 * _e33));
@@ -501,7 +469,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::texture2d<float, metal::access::sample> sm_5,
     metal::float3 eye_4,
     metal::float3 dir_4,
-    float a_4,
+    float a_3,
     float b_3,
     uint steps,
     bool spot_1
@@ -510,18 +478,18 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     uint k_1 = 0u;
     float t_2 = {};
     float w = {};
-    float h_7 = (b_3 - a_4) / static_cast<float>(steps);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
+    float h_7 = (b_3 - a_3) / static_cast<float>(steps);
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_3, b_3, steps);
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e65 = k_1;
             k_1 = _e65 + 1u;
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e15 = k_1;
         if ((_e15 + 1u) <= steps) {
         } else {
@@ -529,7 +497,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
         }
         {
             uint _e19 = k_1;
-            t_2 = a_4 + ((static_cast<float>(_e19) + 0.5) * h_7);
+            t_2 = a_3 + ((static_cast<float>(_e19) + 0.5) * h_7);
             w = h_7;
             if (spot_1) {
                 uint _e28 = k_1;
@@ -549,7 +517,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
                 float _e48 = sum_1;
                 uint _e51 = k_1;
                 uint _e55 = k_1;
-                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_4 + (static_cast<float>(_e51) * h_7), a_4 + (static_cast<float>(_e55 + 1u) * h_7));
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, a_3 + (static_cast<float>(_e51) * h_7), a_3 + (static_cast<float>(_e55 + 1u) * h_7));
                 sum_1 = _e48 + (_e39 * _e61);
             }
         }
@@ -692,11 +660,11 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17,
     metal::float3 eye_7,
     metal::float3 dir_9,
-    float a_5,
+    float a_4,
     float b_4,
     uint panels_1
 ) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
@@ -708,15 +676,15 @@ float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18,
     metal::float3 eye_8,
     metal::float3 dir_10,
-    float a_6,
+    float a_5,
     float b_5,
     bool spot_6
 ) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, metal::max(naga_div(f_18.sizes2_.z, 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_5, b_5, metal::max(naga_div(f_18.sizes2_.z, 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_5, b_5);
     return _e15;
 }
 
@@ -775,16 +743,16 @@ metal::float4 pst_leaf(
     float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
     metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
     metal::float3 axis_1 = f_19.axis.xyz;
-    uint2 loop_bound_4 = uint2(4294967295u);
-    bool loop_init_4 = true;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e56 = g_1;
             g_1 = _e56 + 1u;
         }
-        loop_init_4 = false;
+        loop_init_3 = false;
         uint _e17 = g_1;
         if (_e17 < 2u) {
         } else {
@@ -909,16 +877,16 @@ metal::float3 pst_sweep_pixel(
     if (_e27 == 0u) {
         return metal::float3(0.0, 0.0, 0.0);
     }
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
             uint _e77 = h_4;
             h_4 = _e77 + 1u;
         }
-        loop_init_5 = false;
+        loop_init_4 = false;
         uint _e35 = h_4;
         if (_e35 < RANK_VECS) {
         } else {
@@ -927,16 +895,16 @@ metal::float3 pst_sweep_pixel(
         {
             p_4 = metal::float4(0.0, 0.0, 0.0, 0.0);
             i_1 = 0u;
-            uint2 loop_bound_6 = uint2(4294967295u);
-            bool loop_init_6 = true;
+            uint2 loop_bound_5 = uint2(4294967295u);
+            bool loop_init_5 = true;
             while(true) {
-                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                if (!loop_init_6) {
+                if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+                loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+                if (!loop_init_5) {
                     uint _e66 = i_1;
                     i_1 = _e66 + 1u;
                 }
-                loop_init_6 = false;
+                loop_init_5 = false;
                 uint _e46 = i_1;
                 if ((_e46 + 1u) < _e27) {
                 } else {
@@ -994,16 +962,16 @@ kernel void pst_sweep_fallback(
     uint _e18 = fallback_count;
     uint n_4 = metal::min(_e18, screen.x * screen.y);
     e = (id.y * lanes.x) + id.x;
-    uint2 loop_bound_7 = uint2(4294967295u);
-    bool loop_init_7 = true;
+    uint2 loop_bound_6 = uint2(4294967295u);
+    bool loop_init_6 = true;
     while(true) {
-        if (metal::all(loop_bound_7 == uint2(0u))) { break; }
-        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-        if (!loop_init_7) {
+        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+        if (!loop_init_6) {
             uint _e54 = e;
             e = _e54 + (lanes.x * lanes.y);
         }
-        loop_init_7 = false;
+        loop_init_6 = false;
         uint _e30 = e;
         if (_e30 < n_4) {
         } else {

@@ -304,43 +304,14 @@ vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
-    float t_in = 0.0;
-    float t_out = 3.4e38;
-    uint a_3 = 0u;
-    bool loop_init_2 = true;
-    while(true) {
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if ((_e4 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = ((0.5 - o_1[_e8]) / u[_e13]);
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = (((size[_e17] - 0.5) - o_1[_e21]) / u[_e24]);
-            uint _e27 = a_3;
-            bool crosses = (abs(u[_e27]) > 1e-12);
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return (0.5 * (_e47 + max(_e48, _e49)));
+    vec2 ta = ((vec2(0.5, 0.5) - o_1) / u);
+    vec2 tb = (((size - vec2(0.5, 0.5)) - o_1) / u);
+    bvec2 crosses = greaterThan(abs(u), vec2(1e-12, 1e-12));
+    vec2 enter = mix(vec2(0.0, 0.0), min(ta, tb), crosses);
+    vec2 leave = mix(vec2(3.4e38, 3.4e38), max(ta, tb), crosses);
+    float t_in = max(0.0, max(enter.x, enter.y));
+    float t_out = min(3.4e38, min(leave.x, leave.y));
+    return (0.5 * (t_in + max(t_out, t_in)));
 }
 
 vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_2) {
@@ -350,9 +321,9 @@ vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
-    float a_8 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    float a_7 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
     vec2 ax = f_4.fan_origin.zw;
-    vec2 u_2 = vec2(((ax.x * cos(a_8)) - (ax.y * sin(a_8))), ((ax.y * cos(a_8)) + (ax.x * sin(a_8))));
+    vec2 u_2 = vec2(((ax.x * cos(a_7)) - (ax.y * sin(a_7))), ((ax.y * cos(a_7)) + (ax.x * sin(a_7))));
     vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
@@ -384,20 +355,20 @@ float frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_n
     return _e13;
 }
 
-float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_4, float b_3, uint steps, bool spot_1) {
+float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_9, sampler2D sm_5, vec3 eye_4, vec3 dir_4, float a_3, float b_3, uint steps, bool spot_1) {
     float sum_1 = 0.0;
     uint k_1 = 0u;
     float t_2 = 0.0;
     float w = 0.0;
-    float h_7 = ((b_3 - a_4) / float(steps));
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
-    bool loop_init_3 = true;
+    float h_7 = ((b_3 - a_3) / float(steps));
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_3, b_3, steps);
+    bool loop_init_2 = true;
     while(true) {
-        if (!loop_init_3) {
+        if (!loop_init_2) {
             uint _e65 = k_1;
             k_1 = (_e65 + 1u);
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e15 = k_1;
         if (((_e15 + 1u) <= steps)) {
         } else {
@@ -405,7 +376,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
         }
         {
             uint _e19 = k_1;
-            t_2 = (a_4 + ((float(_e19) + 0.5) * h_7));
+            t_2 = (a_3 + ((float(_e19) + 0.5) * h_7));
             w = h_7;
             if (spot_1) {
                 uint _e28 = k_1;
@@ -425,7 +396,7 @@ float span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
                 float _e48 = sum_1;
                 uint _e51 = k_1;
                 uint _e55 = k_1;
-                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_4 + (float(_e51) * h_7)), (a_4 + (float((_e55 + 1u)) * h_7)));
+                float _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_3 + (float(_e51) * h_7)), (a_3 + (float((_e55 + 1u)) * h_7)));
                 sum_1 = (_e48 + (_e39 * _e61));
             }
         }
@@ -513,24 +484,24 @@ float edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XO
     return _e9;
 }
 
-float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, vec3 eye_7, vec3 dir_9, float a_5, float b_4, uint panels_1) {
-    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
+float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_17, vec3 eye_7, vec3 dir_9, float a_4, float b_4, uint panels_1) {
+    float _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
-float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, vec3 eye_8, vec3 dir_10, float a_6, float b_5, bool spot_6) {
+float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_18, vec3 eye_8, vec3 dir_10, float a_5, float b_5, bool spot_6) {
     if (spot_6) {
-        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, max((f_18.sizes2_.z / 4u), 1u));
+        float _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_5, b_5, max((f_18.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
+    float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_5, b_5);
     return _e15;
 }
 
-bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_7, float b_6, float depth_break) {
+bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b_6, float depth_break) {
     bool local_2 = false;
-    if (!((a_7 == b_6))) {
-        local_2 = (abs((a_7 - b_6)) <= (depth_break * min(a_7, b_6)));
+    if (!((a_6 == b_6))) {
+        local_2 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
         local_2 = true;
     }
@@ -548,13 +519,13 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w_1, vec4 de
     uint k_2 = 0u;
     bool local_3 = false;
     bool local_4 = false;
-    bool loop_init_4 = true;
+    bool loop_init_3 = true;
     while(true) {
-        if (!loop_init_4) {
+        if (!loop_init_3) {
             uint _e63 = k_2;
             k_2 = (_e63 + 1u);
         }
-        loop_init_4 = false;
+        loop_init_3 = false;
         uint _e6 = k_2;
         if ((_e6 < 4u)) {
         } else {
@@ -656,13 +627,13 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
     vec2 d_5 = ((vec2(p_5) + vec2(0.5, 0.5)) - l_2.origin);
     t_4 = pair;
     vec2 ws = pair.w.xy;
-    bool loop_init_5 = true;
+    bool loop_init_4 = true;
     while(true) {
-        if (!loop_init_5) {
+        if (!loop_init_4) {
             uint _e68 = j_2;
             j_2 = (_e68 + 1u);
         }
-        loop_init_5 = false;
+        loop_init_4 = false;
         uint _e15 = j_2;
         if ((_e15 < 2u)) {
         } else {
@@ -739,13 +710,13 @@ void main() {
     int _e59_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
     vec4 line_hi_1 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.y)), ivec2(0), textureSize(_group_0_binding_10_cs, _e59_clamped_lod) - ivec2(1)), _e59_clamped_lod);
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    bool loop_init_6 = true;
+    bool loop_init_5 = true;
     while(true) {
-        if (!loop_init_6) {
+        if (!loop_init_5) {
             uint _e93 = j;
             j = (_e93 + 1u);
         }
-        loop_init_6 = false;
+        loop_init_5 = false;
         uint _e63 = j;
         if ((_e63 < 4u)) {
         } else {

@@ -310,42 +310,14 @@ fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil
 }
 
 fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
-    var t_in: f32 = 0f;
-    var t_out: f32 = 340000000000000000000000000000000000000f;
-    var a_3: u32 = 0u;
-
-    loop {
-        let _e4 = a_3;
-        if (_e4 < 2u) {
-        } else {
-            break;
-        }
-        {
-            let _e8 = a_3;
-            let _e13 = a_3;
-            let ta = ((0.5f - o_1[_e8]) / u[_e13]);
-            let _e17 = a_3;
-            let _e21 = a_3;
-            let _e24 = a_3;
-            let tb = (((size[_e17] - 0.5f) - o_1[_e21]) / u[_e24]);
-            let _e27 = a_3;
-            let crosses = (abs(u[_e27]) > 0.000000000001f);
-            let _e33 = t_in;
-            let _e34 = t_in;
-            t_in = select(_e33, max(_e34, min(ta, tb)), crosses);
-            let _e39 = t_out;
-            let _e40 = t_out;
-            t_out = select(_e39, min(_e40, max(ta, tb)), crosses);
-        }
-        continuing {
-            let _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-    }
-    let _e47 = t_in;
-    let _e48 = t_out;
-    let _e49 = t_in;
-    return (0.5f * (_e47 + max(_e48, _e49)));
+    let ta = ((vec2<f32>(0.5f, 0.5f) - o_1) / u);
+    let tb = (((size - vec2<f32>(0.5f, 0.5f)) - o_1) / u);
+    let crosses = (abs(u) > vec2<f32>(0.000000000001f, 0.000000000001f));
+    let enter = select(vec2<f32>(0f, 0f), min(ta, tb), crosses);
+    let leave = select(vec2<f32>(340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f), max(ta, tb), crosses);
+    let t_in = max(0f, max(enter.x, enter.y));
+    let t_out = min(340000000000000000000000000000000000000f, min(leave.x, leave.y));
+    return (0.5f * (t_in + max(t_out, t_in)));
 }
 
 fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
@@ -355,9 +327,9 @@ fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_
 }
 
 fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
-    let a_8 = (f_4.fan_angles.x + ((f32(row_1) + 0.5f) * f_4.fan_angles.y));
+    let a_7 = (f_4.fan_angles.x + ((f32(row_1) + 0.5f) * f_4.fan_angles.y));
     let ax = f_4.fan_origin.zw;
-    let u_2 = vec2<f32>(((ax.x * cos(a_8)) - (ax.y * sin(a_8))), ((ax.y * cos(a_8)) + (ax.x * sin(a_8))));
+    let u_2 = vec2<f32>(((ax.x * cos(a_7)) - (ax.y * sin(a_7))), ((ax.y * cos(a_7)) + (ax.x * sin(a_7))));
     let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
@@ -389,14 +361,14 @@ fn frame_spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_8: FrameX
     return _e13;
 }
 
-fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_4: f32, b_3: f32, steps: u32, spot_1: bool) -> f32 {
+fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, sm_5: texture_2d<f32>, eye_4: vec3<f32>, dir_4: vec3<f32>, a_3: f32, b_3: f32, steps: u32, spot_1: bool) -> f32 {
     var sum_1: f32 = 0f;
     var k_1: u32 = 0u;
     var t_2: f32;
     var w: f32;
 
-    let h_7 = ((b_3 - a_4) / f32(steps));
-    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_4, b_3, steps);
+    let h_7 = ((b_3 - a_3) / f32(steps));
+    let _e13 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_4, dir_4, f_9.light_pos.xyz, a_3, b_3, steps);
     loop {
         let _e15 = k_1;
         if ((_e15 + 1u) <= steps) {
@@ -405,7 +377,7 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_
         }
         {
             let _e19 = k_1;
-            t_2 = (a_4 + ((f32(_e19) + 0.5f) * h_7));
+            t_2 = (a_3 + ((f32(_e19) + 0.5f) * h_7));
             w = h_7;
             if spot_1 {
                 let _e28 = k_1;
@@ -425,7 +397,7 @@ fn span_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_9: FrameX_naga_oil_
                 let _e48 = sum_1;
                 let _e51 = k_1;
                 let _e55 = k_1;
-                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_4 + (f32(_e51) * h_7)), (a_4 + (f32((_e55 + 1u)) * h_7)));
+                let _e61 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_9.medium.x, (a_3 + (f32(_e51) * h_7)), (a_3 + (f32((_e55 + 1u)) * h_7)));
                 sum_1 = (_e48 + (_e39 * _e61));
             }
         }
@@ -518,25 +490,25 @@ fn edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_16: FrameX_naga_oil_mod
     return _e9;
 }
 
-fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_5: f32, b_4: f32, panels_1: u32) -> f32 {
-    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_5, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
+fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_17: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_7: vec3<f32>, dir_9: vec3<f32>, a_4: f32, b_4: f32, panels_1: u32) -> f32 {
+    let _e15 = spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_7, dir_9, a_4, b_4, panels_1, f_17.light_pos.xyz, f_17.light_dir.xyz, f_17.light_pos.w, f_17.light_dir.w, f_17.medium);
     return _e15;
 }
 
-fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_6: f32, b_5: f32, spot_6: bool) -> f32 {
+fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, eye_8: vec3<f32>, dir_10: vec3<f32>, a_5: f32, b_5: f32, spot_6: bool) -> f32 {
     if spot_6 {
-        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_6, b_5, max((f_18.sizes2_.z / 4u), 1u));
+        let _e12 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18, eye_8, dir_10, a_5, b_5, max((f_18.sizes2_.z / 4u), 1u));
         return _e12;
     }
-    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_6, b_5);
+    let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_18.medium.x, a_5, b_5);
     return _e15;
 }
 
-fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_7: f32, b_6: f32, depth_break: f32) -> bool {
+fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_6: f32, b_6: f32, depth_break: f32) -> bool {
     var local_2: bool;
 
-    if !((a_7 == b_6)) {
-        local_2 = (abs((a_7 - b_6)) <= (depth_break * min(a_7, b_6)));
+    if !((a_6 == b_6)) {
+        local_2 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
         local_2 = true;
     }

@@ -362,46 +362,14 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float2 u,
     metal::float2 size
 ) {
-    float t_in = 0.0;
-    float t_out = 340000000000000000000000000000000000000.0;
-    uint a_3 = 0u;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = _e45 + 1u;
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if (_e4 < 2u) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = (0.5 - o_1[metal::min(unsigned(_e8), 1u)]) / u[metal::min(unsigned(_e13), 1u)];
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = ((size[metal::min(unsigned(_e17), 1u)] - 0.5) - o_1[metal::min(unsigned(_e21), 1u)]) / u[metal::min(unsigned(_e24), 1u)];
-            uint _e27 = a_3;
-            bool crosses = metal::abs(u[metal::min(unsigned(_e27), 1u)]) > 0.000000000001;
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = crosses ? metal::max(_e34, metal::min(ta, tb)) : _e33;
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = crosses ? metal::min(_e40, metal::max(ta, tb)) : _e39;
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return 0.5 * (_e47 + metal::max(_e48, _e49));
+    metal::float2 ta = (metal::float2(0.5, 0.5) - o_1) / u;
+    metal::float2 tb = ((size - metal::float2(0.5, 0.5)) - o_1) / u;
+    metal::bool2 crosses = metal::abs(u) > metal::float2(0.000000000001, 0.000000000001);
+    metal::float2 enter = metal::select(metal::float2(0.0, 0.0), metal::min(ta, tb), crosses);
+    metal::float2 leave = metal::select(metal::float2(340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0), metal::max(ta, tb), crosses);
+    float t_in = metal::max(0.0, metal::max(enter.x, enter.y));
+    float t_out = metal::min(340000000000000000000000000000000000000.0, metal::min(leave.x, leave.y));
+    return 0.5 * (t_in + metal::max(t_out, t_in));
 }
 
 metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -417,9 +385,9 @@ float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
     uint row_1
 ) {
-    float a_4 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
+    float a_3 = f_4.fan_angles.x + ((static_cast<float>(row_1) + 0.5) * f_4.fan_angles.y);
     metal::float2 ax = f_4.fan_origin.zw;
-    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_4)) - (ax.y * metal::sin(a_4)), (ax.y * metal::cos(a_4)) + (ax.x * metal::sin(a_4)));
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_3)) - (ax.y * metal::sin(a_3)), (ax.y * metal::cos(a_3)) + (ax.x * metal::sin(a_3)));
     metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, f_4.fan_origin.xy + (u_2 * _e33));
@@ -553,16 +521,16 @@ kernel void rectify(
     uint _e35 = frame.sizes.z;
     uint end = metal::min(first + TEXELS, _e35);
     x = first;
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e51 = x;
             x = _e51 + 1u;
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e38 = x;
         if (_e38 < end) {
         } else {

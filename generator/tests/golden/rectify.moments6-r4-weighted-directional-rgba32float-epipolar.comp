@@ -266,43 +266,14 @@ vec2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
 }
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u, vec2 size) {
-    float t_in = 0.0;
-    float t_out = 3.4e38;
-    uint a_3 = 0u;
-    bool loop_init_2 = true;
-    while(true) {
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if ((_e4 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = ((0.5 - o_1[_e8]) / u[_e13]);
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = (((size[_e17] - 0.5) - o_1[_e21]) / u[_e24]);
-            uint _e27 = a_3;
-            bool crosses = (abs(u[_e27]) > 1e-12);
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return (0.5 * (_e47 + max(_e48, _e49)));
+    vec2 ta = ((vec2(0.5, 0.5) - o_1) / u);
+    vec2 tb = (((size - vec2(0.5, 0.5)) - o_1) / u);
+    bvec2 crosses = greaterThan(abs(u), vec2(1e-12, 1e-12));
+    vec2 enter = mix(vec2(0.0, 0.0), min(ta, tb), crosses);
+    vec2 leave = mix(vec2(3.4e38, 3.4e38), max(ta, tb), crosses);
+    float t_in = max(0.0, max(enter.x, enter.y));
+    float t_out = min(3.4e38, min(leave.x, leave.y));
+    return (0.5 * (t_in + max(t_out, t_in)));
 }
 
 vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_2) {
@@ -312,9 +283,9 @@ vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
-    float a_4 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    float a_3 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
     vec2 ax = f_4.fan_origin.zw;
-    vec2 u_2 = vec2(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
+    vec2 u_2 = vec2(((ax.x * cos(a_3)) - (ax.y * sin(a_3))), ((ax.y * cos(a_3)) + (ax.x * sin(a_3))));
     vec2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     vec3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
@@ -411,13 +382,13 @@ void main() {
     uint _e35 = _group_0_binding_0_cs.sizes.z;
     uint end = min((first + TEXELS), _e35);
     x = first;
-    bool loop_init_3 = true;
+    bool loop_init_2 = true;
     while(true) {
-        if (!loop_init_3) {
+        if (!loop_init_2) {
             uint _e51 = x;
             x = (_e51 + 1u);
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e38 = x;
         if ((_e38 < end)) {
         } else {

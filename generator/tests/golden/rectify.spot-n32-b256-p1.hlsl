@@ -313,47 +313,14 @@ float2 screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_
 
 float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float2 o_1, float2 u, float2 size)
 {
-    float t_in = 0.0;
-    float t_out = 3.4e38;
-    uint a_3 = 0u;
-
-    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if ((_e4 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = ((0.5 - o_1[min(uint(_e8), 1u)]) / u[min(uint(_e13), 1u)]);
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = (((size[min(uint(_e17), 1u)] - 0.5) - o_1[min(uint(_e21), 1u)]) / u[min(uint(_e24), 1u)]);
-            uint _e27 = a_3;
-            bool crosses = (abs(u[min(uint(_e27), 1u)]) > 1e-12);
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = (crosses ? max(_e34, min(ta, tb)) : _e33);
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = (crosses ? min(_e40, max(ta, tb)) : _e39);
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return (0.5 * (_e47 + max(_e48, _e49)));
+    float2 ta = ((float2(0.5, 0.5) - o_1) / u);
+    float2 tb = (((size - float2(0.5, 0.5)) - o_1) / u);
+    bool2 crosses = (abs(u) > float2(1e-12, 1e-12));
+    float2 enter = (crosses ? min(ta, tb) : float2(0.0, 0.0));
+    float2 leave = (crosses ? max(ta, tb) : float2(3.4e38, 3.4e38));
+    float t_in = max(0.0, max(enter.x, enter.y));
+    float t_out = min(3.4e38, min(leave.x, leave.y));
+    return (0.5 * (t_in + max(t_out, t_in)));
 }
 
 float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, float2 p_2)
@@ -365,9 +332,9 @@ float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_m
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1)
 {
-    float a_4 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
+    float a_3 = (f_4.fan_angles.x + ((float(row_1) + 0.5) * f_4.fan_angles.y));
     float2 ax = f_4.fan_origin.zw;
-    float2 u_2 = float2(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
+    float2 u_2 = float2(((ax.x * cos(a_3)) - (ax.y * sin(a_3))), ((ax.y * cos(a_3)) + (ax.x * sin(a_3))));
     const float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     const float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     const float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));
@@ -486,16 +453,16 @@ void rectify(uint3 id : SV_DispatchThreadID)
     uint _e35 = frame.sizes.z;
     uint end = min((first + TEXELS), _e35);
     x = first;
-    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
-    bool loop_init_3 = true;
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e51 = x;
             x = (_e51 + 1u);
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e38 = x;
         if ((_e38 < end)) {
         } else {

@@ -355,46 +355,14 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float2 u,
     metal::float2 size
 ) {
-    float t_in = 0.0;
-    float t_out = 340000000000000000000000000000000000000.0;
-    uint a_3 = 0u;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
-    while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e45 = a_3;
-            a_3 = _e45 + 1u;
-        }
-        loop_init_2 = false;
-        uint _e4 = a_3;
-        if (_e4 < 2u) {
-        } else {
-            break;
-        }
-        {
-            uint _e8 = a_3;
-            uint _e13 = a_3;
-            float ta = (0.5 - o_1[metal::min(unsigned(_e8), 1u)]) / u[metal::min(unsigned(_e13), 1u)];
-            uint _e17 = a_3;
-            uint _e21 = a_3;
-            uint _e24 = a_3;
-            float tb = ((size[metal::min(unsigned(_e17), 1u)] - 0.5) - o_1[metal::min(unsigned(_e21), 1u)]) / u[metal::min(unsigned(_e24), 1u)];
-            uint _e27 = a_3;
-            bool crosses = metal::abs(u[metal::min(unsigned(_e27), 1u)]) > 0.000000000001;
-            float _e33 = t_in;
-            float _e34 = t_in;
-            t_in = crosses ? metal::max(_e34, metal::min(ta, tb)) : _e33;
-            float _e39 = t_out;
-            float _e40 = t_out;
-            t_out = crosses ? metal::min(_e40, metal::max(ta, tb)) : _e39;
-        }
-    }
-    float _e47 = t_in;
-    float _e48 = t_out;
-    float _e49 = t_in;
-    return 0.5 * (_e47 + metal::max(_e48, _e49));
+    metal::float2 ta = (metal::float2(0.5, 0.5) - o_1) / u;
+    metal::float2 tb = ((size - metal::float2(0.5, 0.5)) - o_1) / u;
+    metal::bool2 crosses = metal::abs(u) > metal::float2(0.000000000001, 0.000000000001);
+    metal::float2 enter = metal::select(metal::float2(0.0, 0.0), metal::min(ta, tb), crosses);
+    metal::float2 leave = metal::select(metal::float2(340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0), metal::max(ta, tb), crosses);
+    float t_in = metal::max(0.0, metal::max(enter.x, enter.y));
+    float t_out = metal::min(340000000000000000000000000000000000000.0, metal::min(leave.x, leave.y));
+    return 0.5 * (t_in + metal::max(t_out, t_in));
 }
 
 metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -410,9 +378,9 @@ float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4,
     uint row_2
 ) {
-    float a_4 = f_4.fan_angles.x + ((static_cast<float>(row_2) + 0.5) * f_4.fan_angles.y);
+    float a_3 = f_4.fan_angles.x + ((static_cast<float>(row_2) + 0.5) * f_4.fan_angles.y);
     metal::float2 ax = f_4.fan_origin.zw;
-    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_4)) - (ax.y * metal::sin(a_4)), (ax.y * metal::cos(a_4)) + (ax.x * metal::sin(a_4)));
+    metal::float2 u_2 = metal::float2((ax.x * metal::cos(a_3)) - (ax.y * metal::sin(a_3)), (ax.y * metal::cos(a_3)) + (ax.x * metal::sin(a_3)));
     metal::float2 _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     float _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     metal::float3 _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, f_4.fan_origin.xy + (u_2 * _e33));
@@ -471,16 +439,16 @@ kernel void slice_fit(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7 = frame;
     float far_3 = f_7.theta.z;
     x = lid;
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e19 = x;
             x = _e19 + THREADS;
         }
-        loop_init_3 = false;
+        loop_init_2 = false;
         uint _e8 = x;
         if (_e8 < f_7.sizes.x) {
         } else {
@@ -495,16 +463,16 @@ kernel void slice_fit(
     }
     float _e24 = z;
     deepest.inner[metal::min(unsigned(lid), 255u)] = _e24;
-    uint2 loop_bound_4 = uint2(4294967295u);
-    bool loop_init_4 = true;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e42 = half_;
             half_ = naga_div(_e42, 2u);
         }
-        loop_init_4 = false;
+        loop_init_3 = false;
         uint _e26 = half_;
         if (_e26 > 0u) {
         } else {
@@ -538,16 +506,16 @@ kernel void slice_fit(
     float cols = static_cast<float>(f_7.sizes.z);
     float dist_1 = f_7.axis.w;
     row = lid;
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
             uint _e128 = row;
             row = _e128 + THREADS;
         }
-        loop_init_5 = false;
+        loop_init_4 = false;
         uint _e68 = row;
         if (_e68 < rows) {
         } else {
@@ -563,16 +531,16 @@ kernel void slice_fit(
                 float _e81 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_7, _e80);
                 extent = 0.0;
                 k = 0u;
-                uint2 loop_bound_6 = uint2(4294967295u);
-                bool loop_init_6 = true;
+                uint2 loop_bound_5 = uint2(4294967295u);
+                bool loop_init_5 = true;
                 while(true) {
-                    if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-                    loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                    if (!loop_init_6) {
+                    if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+                    loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+                    if (!loop_init_5) {
                         uint _e104 = k;
                         k = _e104 + 1u;
                     }
-                    loop_init_6 = false;
+                    loop_init_5 = false;
                     uint _e86 = k;
                     if (_e86 <= SPOT_SAMPLES) {
                     } else {

@@ -249,42 +249,14 @@ fn screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_2: FrameX_naga_oil
 }
 
 fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: vec2<f32>, size: vec2<f32>) -> f32 {
-    var t_in: f32 = 0f;
-    var t_out: f32 = 340000000000000000000000000000000000000f;
-    var a_3: u32 = 0u;
-
-    loop {
-        let _e4 = a_3;
-        if (_e4 < 2u) {
-        } else {
-            break;
-        }
-        {
-            let _e8 = a_3;
-            let _e13 = a_3;
-            let ta = ((0.5f - o_1[_e8]) / u[_e13]);
-            let _e17 = a_3;
-            let _e21 = a_3;
-            let _e24 = a_3;
-            let tb = (((size[_e17] - 0.5f) - o_1[_e21]) / u[_e24]);
-            let _e27 = a_3;
-            let crosses = (abs(u[_e27]) > 0.000000000001f);
-            let _e33 = t_in;
-            let _e34 = t_in;
-            t_in = select(_e33, max(_e34, min(ta, tb)), crosses);
-            let _e39 = t_out;
-            let _e40 = t_out;
-            t_out = select(_e39, min(_e40, max(ta, tb)), crosses);
-        }
-        continuing {
-            let _e45 = a_3;
-            a_3 = (_e45 + 1u);
-        }
-    }
-    let _e47 = t_in;
-    let _e48 = t_out;
-    let _e49 = t_in;
-    return (0.5f * (_e47 + max(_e48, _e49)));
+    let ta = ((vec2<f32>(0.5f, 0.5f) - o_1) / u);
+    let tb = (((size - vec2<f32>(0.5f, 0.5f)) - o_1) / u);
+    let crosses = (abs(u) > vec2<f32>(0.000000000001f, 0.000000000001f));
+    let enter = select(vec2<f32>(0f, 0f), min(ta, tb), crosses);
+    let leave = select(vec2<f32>(340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f), max(ta, tb), crosses);
+    let t_in = max(0f, max(enter.x, enter.y));
+    let t_out = min(340000000000000000000000000000000000000f, min(leave.x, leave.y));
+    return (0.5f * (t_in + max(t_out, t_in)));
 }
 
 fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
@@ -294,9 +266,9 @@ fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_
 }
 
 fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_2: u32) -> f32 {
-    let a_4 = (f_4.fan_angles.x + ((f32(row_2) + 0.5f) * f_4.fan_angles.y));
+    let a_3 = (f_4.fan_angles.x + ((f32(row_2) + 0.5f) * f_4.fan_angles.y));
     let ax = f_4.fan_origin.zw;
-    let u_2 = vec2<f32>(((ax.x * cos(a_4)) - (ax.y * sin(a_4))), ((ax.y * cos(a_4)) + (ax.x * sin(a_4))));
+    let u_2 = vec2<f32>(((ax.x * cos(a_3)) - (ax.y * sin(a_3))), ((ax.y * cos(a_3)) + (ax.x * sin(a_3))));
     let _e32 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4);
     let _e33 = fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4.fan_origin.xy, u_2, _e32);
     let _e36 = screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4, (f_4.fan_origin.xy + (u_2 * _e33)));

@@ -55,18 +55,23 @@ pub fn screen_dir(f: &FrameUniforms, p: [f32; 2]) -> Vec3 {
 }
 
 /// Distance from `o` along `u` of the midpoint of the line's part inside the rectangle of
-/// pixel centres of a screen of `size` pixels (its nearest point when it misses it).
+/// pixel centres of a screen of `size` pixels (its nearest point when it misses it). Both
+/// axes at once, each kept where the line crosses it, as the kernel computes it (without a
+/// loop over the axes: see `fan_line_mid` in common/epipolar.wgsl).
 fn fan_line_mid(o: [f32; 2], u: [f32; 2], size: [f32; 2]) -> f32 {
-    let mut t_in = 0.0f32;
-    let mut t_out = 3.4e38f32;
-    for a in 0..2 {
+    let axis = |a: usize| {
+        let ta = (0.5 - o[a]) / u[a];
+        let tb = (size[a] - 0.5 - o[a]) / u[a];
         if u[a].abs() > 1e-12 {
-            let ta = (0.5 - o[a]) / u[a];
-            let tb = (size[a] - 0.5 - o[a]) / u[a];
-            t_in = max(t_in, ta.min(tb));
-            t_out = t_out.min(ta.max(tb));
+            (ta.min(tb), ta.max(tb))
+        } else {
+            (0.0, 3.4e38)
         }
-    }
+    };
+    // (enter, leave) along x and along y.
+    let (x, y) = (axis(0), axis(1));
+    let t_in = max(0.0, max(x.0, y.0));
+    let t_out = 3.4e38f32.min(x.1.min(y.1));
     0.5 * (t_in + max(t_out, t_in))
 }
 
