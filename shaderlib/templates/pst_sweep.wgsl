@@ -105,15 +105,25 @@ fn beta_at(theta: f32, h: u32) -> vec4<f32> {
     return factor_at(1u + 2u * GRID, (theta - head.y) / max(head.z - head.y, 1e-12), h);
 }
 
-// Leaf of column i of `row` (spacing `delta`), bases 4h ..: the sun's gamma(i delta); a spot's
+// The direction `e` of row `row`'s plane of light rays (`slice_e` of its `row_phi`), which a
+// spot's leaves read: once per row (a slice's sweep, a fallback pixel), not per column and
+// channel (`row_phi` with the rows on the slices is a cos, a sin, an atan2 and a normalize).
+// The sun's leaves do not read it.
+fn pst_row_e(f: Frame, row: u32) -> vec3<f32> {
+    if !{{ spot }} {
+        return vec3<f32>(0.0, 0.0, 0.0);
+    }
+    return slice_e(f, row_phi(f, row));
+}
+
+// Leaf of column i of the row whose plane is `e` (`pst_row_e`; spacing `delta`), bases 4h ..: the sun's gamma(i delta); a spot's
 // integral over the column's light-ray angles of gamma(psi) cone(psi) (2-point Gauss-Legendre){% if cookie %};
 // with the cookie, entry h < LEAF_VECS is channel h / RANK_VECS's: the integrand times that
 // channel of the node's light ray's cookie, bases 4 (h % RANK_VECS) ..{% endif %}.
-fn pst_leaf(f: Frame, i: u32, row: u32, delta: f32, h: u32) -> vec4<f32> {
+fn pst_leaf(f: Frame, i: u32, e: vec3<f32>, delta: f32, h: u32) -> vec4<f32> {
     if !{{ spot }} {
         return gamma_at(f32(i) * delta, h);
     }
-    let e = slice_e(f, row_phi(f, row));
     let axis = f.axis.xyz;
     var leaf = vec4<f32>(0.0, 0.0, 0.0, 0.0);
     for (var g = 0u; g < 2u; g++) {
@@ -225,6 +235,7 @@ fn pst_sweep_pixel(x: u32, y: u32) -> vec3<f32> {
         return r.color;
     }
     let delta = slice_params(slices[r.row]).delta;
+    let row_e = pst_row_e(f, r.row);
     let n = pst_columns_crossed(r, delta);
     if n == 0u {
         return vec3<f32>(0.0, 0.0, 0.0);
@@ -235,7 +246,7 @@ fn pst_sweep_pixel(x: u32, y: u32) -> vec3<f32> {
         var p = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         for (var i = 0u; i + 1u < n; i++) {
             if r.d <= textureLoad(rectified, vec2<u32>(i, r.row), 0).x {
-                p += pst_leaf(f, i, r.row, delta, h);
+                p += pst_leaf(f, i, row_e, delta, h);
             }
         }
         sum[h / RANK_VECS] += dot(p, beta_at(r.theta, h % RANK_VECS));
@@ -248,7 +259,7 @@ fn pst_sweep_pixel(x: u32, y: u32) -> vec3<f32> {
         var p = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         for (var i = 0u; i + 1u < n; i++) {
             if r.d <= textureLoad(rectified, vec2<u32>(i, r.row), 0).x {
-                p += pst_leaf(f, i, r.row, delta, h);
+                p += pst_leaf(f, i, row_e, delta, h);
             }
         }
         sum += dot(p, beta_at(r.theta, h));
@@ -335,6 +346,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     let far_end = lines.origin + u * (span.x + f32(SLICE_SAMPLES - 1u) * span.y);
     let row = pst_ray(far_end, 0.0).row;
     let delta = slice_params(slices[row]).delta;
+    let row_e = pst_row_e(f, row);
 
     // 1. The samples: marched ones and rays without a column are written now. A sample's ray
     // runs through its point on the line to the depth the 2 x 2 pixels around the point give
@@ -475,7 +487,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         pst_columns[base + i] = lo;
         if lo > 0u {
             for (var h = 0u; h < LEAF_VECS; h++) {
-                pst_leaves[(base + i) * LEAF_VECS + h] = pst_leaf(f, i, row, delta, h);
+                pst_leaves[(base + i) * LEAF_VECS + h] = pst_leaf(f, i, row_e, delta, h);
             }
         }
     }

@@ -734,69 +734,76 @@ vec4 beta_at(float theta_4, uint h_6) {
     return _e14;
 }
 
-vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint i_2, uint row_3, float delta_2, uint h_7) {
+vec3 pst_row_e(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint row_3) {
+    if (false) {
+        return vec3(0.0, 0.0, 0.0);
+    }
+    float _e7 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    vec3 _e8 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e7);
+    return _e8;
+}
+
+vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20, uint i_2, vec3 e_1, float delta_2, uint h_7) {
     vec4 leaf = vec4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
     if (false) {
         vec4 _e9 = gamma_at((float(i_2) * delta_2), h_7);
         return _e9;
     }
-    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
-    vec3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
-    vec3 axis_2 = f_19.axis.xyz;
+    vec3 axis_2 = f_20.axis.xyz;
     bool loop_init_5 = true;
     while(true) {
         if (!loop_init_5) {
-            uint _e56 = g_1;
-            g_1 = (_e56 + 1u);
+            uint _e54 = g_1;
+            g_1 = (_e54 + 1u);
         }
         loop_init_5 = false;
-        uint _e17 = g_1;
-        if ((_e17 < 2u)) {
+        uint _e14 = g_1;
+        if ((_e14 < 2u)) {
         } else {
             break;
         }
         {
-            uint _e20 = g_1;
-            float q_4 = ((_e20 == 0u) ? -0.57735026 : GL2_);
+            uint _e17 = g_1;
+            float q_4 = ((_e17 == 0u) ? -0.57735026 : GL2_);
             float psi_1 = (((float(i_2) + 0.5) + (0.5 * q_4)) * delta_2);
-            vec3 l_5 = ((-(axis_2) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
-            vec4 _e48 = leaf;
-            vec4 _e52 = gamma_at(psi_1, h_7);
-            leaf = (_e48 + (((0.5 * delta_2) * _e46) * _e52));
+            vec3 l_5 = ((-(axis_2) * cos(psi_1)) + (e_1 * sin(psi_1)));
+            float _e44 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_20.light_dir.xyz), f_20.light_pos.w, f_20.light_dir.w);
+            vec4 _e46 = leaf;
+            vec4 _e50 = gamma_at(psi_1, h_7);
+            leaf = (_e46 + (((0.5 * delta_2) * _e44) * _e50));
         }
     }
-    vec4 _e58 = leaf;
-    return _e58;
+    vec4 _e56 = leaf;
+    return _e56;
 }
 
 PstRay pst_ray(vec2 pc_1, float z_1) {
     PstRay r_1 = PstRay(false, vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0u, 0.0, 0.0, 0.0);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20 = _group_0_binding_0_cs;
-    vec3 eye_9 = f_20.eye.xyz;
-    vec2 ndc_2 = vec2((((2.0 * pc_1.x) / float(f_20.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_20.sizes.y))));
-    float t_7 = f_20.cam_forward.w;
-    vec3 dir_12 = normalize(((f_20.cam_forward.xyz + (f_20.cam_right.xyz * ((ndc_2.x * t_7) * f_20.cam_right.w))) + (f_20.cam_up.xyz * (ndc_2.y * t_7))));
-    float s_6 = (min(max(z_1, 0.0), f_20.theta.z) / max(dot(dir_12, f_20.cam_forward.xyz), 1e-6));
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = _group_0_binding_0_cs;
+    vec3 eye_9 = f_21.eye.xyz;
+    vec2 ndc_2 = vec2((((2.0 * pc_1.x) / float(f_21.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_21.sizes.y))));
+    float t_7 = f_21.cam_forward.w;
+    vec3 dir_12 = normalize(((f_21.cam_forward.xyz + (f_21.cam_right.xyz * ((ndc_2.x * t_7) * f_21.cam_right.w))) + (f_21.cam_up.xyz * (ndc_2.y * t_7))));
+    float s_6 = (min(max(z_1, 0.0), f_21.theta.z) / max(dot(dir_12, f_21.cam_forward.xyz), 1e-6));
     r_1 = PstRay(false, vec3(0.0, 0.0, 0.0), eye_9, dir_12, s_6, 0u, 0.0, 0.0, 0.0);
-    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, pc_1);
+    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, pc_1);
     if (_e67) {
         r_1.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e72 = _group_0_binding_0_cs;
         float _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, _group_0_binding_3_cs, eye_9, dir_12, s_6, true);
-        r_1.color = (_e75 * f_20.light_color.xyz);
+        r_1.color = (_e75 * f_21.light_color.xyz);
     }
-    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
+    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
     r_1.theta = _e80;
-    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
-    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_20.sizes.w, (f_20.anti_epipole.w > 0.5));
+    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
+    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_21.sizes.w, (f_21.anti_epipole.w > 0.5));
     r_1.row = _e90;
     float _e93 = r_1.theta;
-    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_20.theta.x, f_20.theta.y);
+    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_21.theta.x, f_21.theta.y);
     r_1.d = _e98;
     float _e101 = r_1.theta;
-    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, eye_9, dir_12, s_6, _e101, true);
+    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, eye_9, dir_12, s_6, _e101, true);
     r_1.xs_num = _e102;
     PstRay _e103 = r_1;
     return _e103;
@@ -810,22 +817,22 @@ uint pst_columns_crossed(PstRay r_2, float delta_3) {
 
 vec2 pst_terms(PstRay r_3, uint row_4, float delta_4, uint n_2) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = _group_0_binding_0_cs;
     float sin_theta = max(sin(r_3.theta), 1e-6);
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 _e16 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((n_2 - 1u), row_4)), ivec2(0), textureSize(_group_0_binding_4_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
     if ((r_3.d <= _e16.x)) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return vec2((f_21.medium.y / (f_21.axis.w * sin_theta)), _e37);
+        return vec2((f_22.medium.y / (f_22.axis.w * sin_theta)), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.z, -(dot(f_21.light_dir.xyz, r_3.dir)));
-    float sp = (f_21.medium.y * _e48);
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.x, 0.0, (delta_4 / sin_theta));
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.z, -(dot(f_22.light_dir.xyz, r_3.dir)));
+    float sp = (f_22.medium.y * _e48);
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.x, 0.0, (delta_4 / sin_theta));
     float _e56 = tail;
     return vec2((sp * _e54), (sp * _e56));
 }
@@ -835,7 +842,7 @@ vec3 pst_sweep_pixel(uint x_5, uint y) {
     uint h_8 = 0u;
     vec4 p_6 = vec4(0.0);
     uint i_3 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_23 = _group_0_binding_0_cs;
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e16 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_5, y)), ivec2(0), textureSize(_group_0_binding_2_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
     PstRay _e18 = pst_ray(vec2((float(x_5) + 0.5), (float(y) + 0.5)), _e16.x);
@@ -845,19 +852,20 @@ vec3 pst_sweep_pixel(uint x_5, uint y) {
     vec4 _e24 = _group_0_binding_1_cs[_e18.row];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e25 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24);
     float delta_5 = _e25.delta;
-    uint _e27 = pst_columns_crossed(_e18, delta_5);
-    if ((_e27 == 0u)) {
+    vec3 _e28 = pst_row_e(f_23, _e18.row);
+    uint _e29 = pst_columns_crossed(_e18, delta_5);
+    if ((_e29 == 0u)) {
         return vec3(0.0, 0.0, 0.0);
     }
     bool loop_init_6 = true;
     while(true) {
         if (!loop_init_6) {
-            uint _e77 = h_8;
-            h_8 = (_e77 + 1u);
+            uint _e78 = h_8;
+            h_8 = (_e78 + 1u);
         }
         loop_init_6 = false;
-        uint _e35 = h_8;
-        if ((_e35 < RANK_VECS)) {
+        uint _e37 = h_8;
+        if ((_e37 < RANK_VECS)) {
         } else {
             break;
         }
@@ -867,38 +875,38 @@ vec3 pst_sweep_pixel(uint x_5, uint y) {
             bool loop_init_7 = true;
             while(true) {
                 if (!loop_init_7) {
-                    uint _e66 = i_3;
-                    i_3 = (_e66 + 1u);
+                    uint _e67 = i_3;
+                    i_3 = (_e67 + 1u);
                 }
                 loop_init_7 = false;
-                uint _e46 = i_3;
-                if (((_e46 + 1u) < _e27)) {
+                uint _e48 = i_3;
+                if (((_e48 + 1u) < _e29)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e51 = i_3;
-                    int _e56_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e56 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e51, _e18.row)), ivec2(0), textureSize(_group_0_binding_4_cs, _e56_clamped_lod) - ivec2(1)), _e56_clamped_lod);
-                    if ((_e18.d <= _e56.x)) {
-                        vec4 _e59 = p_6;
-                        uint _e60 = i_3;
-                        uint _e62 = h_8;
-                        vec4 _e63 = pst_leaf(f_22, _e60, _e18.row, delta_5, _e62);
-                        p_6 = (_e59 + _e63);
+                    uint _e53 = i_3;
+                    int _e58_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                    vec4 _e58 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e53, _e18.row)), ivec2(0), textureSize(_group_0_binding_4_cs, _e58_clamped_lod) - ivec2(1)), _e58_clamped_lod);
+                    if ((_e18.d <= _e58.x)) {
+                        vec4 _e61 = p_6;
+                        uint _e62 = i_3;
+                        uint _e63 = h_8;
+                        vec4 _e64 = pst_leaf(f_23, _e62, _e28, delta_5, _e63);
+                        p_6 = (_e61 + _e64);
                     }
                 }
             }
-            float _e69 = sum_2;
-            vec4 _e70 = p_6;
-            uint _e72 = h_8;
-            vec4 _e73 = beta_at(_e18.theta, _e72);
-            sum_2 = (_e69 + dot(_e70, _e73));
+            float _e70 = sum_2;
+            vec4 _e71 = p_6;
+            uint _e73 = h_8;
+            vec4 _e74 = beta_at(_e18.theta, _e73);
+            sum_2 = (_e70 + dot(_e71, _e74));
         }
     }
-    vec2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
-    float _e84 = sum_2;
-    return (f_22.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
+    vec2 _e81 = pst_terms(_e18, _e18.row, delta_5, _e29);
+    float _e85 = sum_2;
+    return (f_23.light_color.xyz * (max((_e81.x * _e85), 0.0) + _e81.y));
 }
 
 float pst_footprint_depth(vec2 pc_2, uvec2 screen_3) {
@@ -997,9 +1005,9 @@ void main() {
     uint h_3 = 0u;
     vec4 p_1 = vec4(0.0);
     uint j_8 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_23 = _group_0_binding_0_cs;
-    uvec2 screen_4 = uvec2(f_23.sizes.x, f_23.sizes.y);
-    uint width = f_23.sizes.z;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_24 = _group_0_binding_0_cs;
+    uvec2 screen_4 = uvec2(f_24.sizes.x, f_24.sizes.y);
+    uint width = f_24.sizes.z;
     vec4 _e13 = _group_0_binding_0_cs.cam_forward;
     vec4 _e17 = _group_0_binding_0_cs.cam_right;
     vec4 _e21 = _group_0_binding_0_cs.cam_up;
@@ -1024,68 +1032,69 @@ void main() {
     vec4 _e88 = _group_0_binding_1_cs[row_5];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
     float delta_6 = _e89.delta;
+    vec3 _e91 = pst_row_e(f_24, row_5);
     k = li;
     bool loop_init_8 = true;
     while(true) {
         if (!loop_init_8) {
-            uint _e188 = k;
-            k = (_e188 + SLICE_LANES);
+            uint _e189 = k;
+            k = (_e189 + SLICE_LANES);
         }
         loop_init_8 = false;
-        uint _e92 = k;
-        if ((_e92 < SLICE_SAMPLES)) {
+        uint _e93 = k;
+        if ((_e93 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e95 = k;
-            uvec2 _e96 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e95, screen_4);
-            int _e99_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-            vec4 _e99 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e96), ivec2(0), textureSize(_group_0_binding_2_cs, _e99_clamped_lod) - ivec2(1)), _e99_clamped_lod);
-            float z_7 = _e99.x;
-            uint _e103 = k;
-            float _e110 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (float(_e103) * _e42.y)))), screen_4);
+            uint _e96 = k;
+            uvec2 _e97 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e96, screen_4);
+            int _e100_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+            vec4 _e100 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e97), ivec2(0), textureSize(_group_0_binding_2_cs, _e100_clamped_lod) - ivec2(1)), _e100_clamped_lod);
+            float z_7 = _e100.x;
+            uint _e104 = k;
+            float _e111 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (float(_e104) * _e42.y)))), screen_4);
             r = PstRay(false, vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0u, 0.0, 0.0, 0.0);
-            if ((_e110 < 0.0)) {
-                PstRay _e124 = pst_ray(vec2((float(_e96.x) + 0.5), (float(_e96.y) + 0.5)), z_7);
-                r = _e124;
+            if ((_e111 < 0.0)) {
+                PstRay _e125 = pst_ray(vec2((float(_e97.x) + 0.5), (float(_e97.y) + 0.5)), z_7);
+                r = _e125;
             } else {
-                uint _e127 = k;
-                PstRay _e134 = pst_ray((_e37.origin + (_e40 * (_e42.x + (float(_e127) * _e42.y)))), _e110);
-                r = _e134;
+                uint _e128 = k;
+                PstRay _e135 = pst_ray((_e37.origin + (_e40 * (_e42.x + (float(_e128) * _e42.y)))), _e111);
+                r = _e135;
             }
-            PstRay _e135 = r;
-            uint _e136 = pst_columns_crossed(_e135, delta_6);
-            uint _e138 = k;
-            q_end[_e138] = NONE;
-            bool _e142 = r.marched;
-            if (!(_e142)) {
-                local = (_e136 == 0u);
+            PstRay _e136 = r;
+            uint _e137 = pst_columns_crossed(_e136, delta_6);
+            uint _e139 = k;
+            q_end[_e139] = NONE;
+            bool _e143 = r.marched;
+            if (!(_e143)) {
+                local = (_e137 == 0u);
             } else {
                 local = true;
             }
-            bool _e149 = local;
-            if (_e149) {
-                vec3 _e151 = r.color;
-                vec3 _e152 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e151);
-                uint _e153 = k;
-                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e153, s_7)), vec4(_e152.x, _e152.y, _e152.z, z_7));
+            bool _e150 = local;
+            if (_e150) {
+                vec3 _e152 = r.color;
+                vec3 _e153 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e152);
+                uint _e154 = k;
+                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e154, s_7)), vec4(_e153.x, _e153.y, _e153.z, z_7));
             } else {
-                PstRay _e160 = r;
-                vec2 _e161 = pst_terms(_e160, row_5, delta_6, _e136);
-                uint _e163 = k;
-                q_b[_e163] = _e161.y;
-                uint _e167 = k;
-                q_end[_e167] = (_e136 - 1u);
-                uint _e172 = k;
-                float _e175 = r.d;
-                q_d[_e172] = _e175;
-                uint _e177 = k;
-                float _e180 = r.theta;
-                q_theta[_e177] = _e180;
-                uint _e182 = k;
-                q_a[_e182] = _e161.x;
-                uint _e187 = atomicAdd(live, 1u);
+                PstRay _e161 = r;
+                vec2 _e162 = pst_terms(_e161, row_5, delta_6, _e137);
+                uint _e164 = k;
+                q_b[_e164] = _e162.y;
+                uint _e168 = k;
+                q_end[_e168] = (_e137 - 1u);
+                uint _e173 = k;
+                float _e176 = r.d;
+                q_d[_e173] = _e176;
+                uint _e178 = k;
+                float _e181 = r.theta;
+                q_theta[_e178] = _e181;
+                uint _e183 = k;
+                q_a[_e183] = _e162.x;
+                uint _e188 = atomicAdd(live, 1u);
             }
         }
     }
@@ -1097,127 +1106,127 @@ void main() {
         bool loop_init_9 = true;
         while(true) {
             if (!loop_init_9) {
-                uint _e228 = k_1;
-                k_1 = (_e228 + 1u);
+                uint _e229 = k_1;
+                k_1 = (_e229 + 1u);
             }
             loop_init_9 = false;
-            uint _e202 = k_1;
-            if ((_e202 < SLICE_SAMPLES)) {
+            uint _e203 = k_1;
+            if ((_e203 < SLICE_SAMPLES)) {
             } else {
                 break;
             }
             {
-                uint _e206 = k_1;
-                uint _e208 = q_end[_e206];
-                if ((_e208 != NONE)) {
-                    uint _e212 = k_1;
-                    uint _e214 = q_end[_e212];
-                    local_1 = (min((_e214 / cw), 7u) == li);
+                uint _e207 = k_1;
+                uint _e209 = q_end[_e207];
+                if ((_e209 != NONE)) {
+                    uint _e213 = k_1;
+                    uint _e215 = q_end[_e213];
+                    local_1 = (min((_e215 / cw), 7u) == li);
                 } else {
                     local_1 = false;
                 }
-                bool _e222 = local_1;
-                if (_e222) {
-                    uint _e225 = count;
-                    count = (_e225 + 1u);
+                bool _e223 = local_1;
+                if (_e223) {
+                    uint _e226 = count;
+                    count = (_e226 + 1u);
                 }
             }
         }
-        uint _e232 = count;
-        bucket[li] = _e232;
+        uint _e233 = count;
+        bucket[li] = _e233;
     } else {
         if ((li == TREES)) {
             local_2 = (v_12 > 0u);
         } else {
             local_2 = false;
         }
-        bool _e240 = local_2;
-        if (_e240) {
+        bool _e241 = local_2;
+        if (_e241) {
             while(true) {
-                uint _e243 = first;
-                uint _e245 = q_end[_e243];
-                if ((_e245 == NONE)) {
+                uint _e244 = first;
+                uint _e246 = q_end[_e244];
+                if ((_e246 == NONE)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e249 = first;
-                    first = (_e249 + 1u);
+                    uint _e250 = first;
+                    first = (_e250 + 1u);
                 }
             }
             while(true) {
-                uint _e253 = last;
-                uint _e255 = q_end[_e253];
-                if ((_e255 == NONE)) {
+                uint _e254 = last;
+                uint _e256 = q_end[_e254];
+                if ((_e256 == NONE)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e259 = last;
-                    last = (_e259 - 1u);
+                    uint _e260 = last;
+                    last = (_e260 - 1u);
                 }
             }
-            uint _e262 = first;
-            float _e264 = q_d[_e262];
-            uint _e266 = last;
-            float _e268 = q_d[_e266];
-            bool up = (_e264 <= _e268);
+            uint _e263 = first;
+            float _e265 = q_d[_e263];
+            uint _e267 = last;
+            float _e269 = q_d[_e267];
+            bool up = (_e265 <= _e269);
             bool loop_init_10 = true;
             while(true) {
                 if (!loop_init_10) {
-                    uint _e341 = k_2;
-                    k_2 = (_e341 + 1u);
+                    uint _e342 = k_2;
+                    k_2 = (_e342 + 1u);
                 }
                 loop_init_10 = false;
-                uint _e271 = k_2;
-                if ((_e271 < SLICE_SAMPLES)) {
+                uint _e272 = k_2;
+                if ((_e272 < SLICE_SAMPLES)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e275 = k_2;
-                    uint _e277 = q_end[_e275];
-                    if ((_e277 != NONE)) {
-                        uint _e281 = k_2;
-                        float d_3 = q_d[_e281];
-                        uint _e285 = m;
-                        j = _e285;
+                    uint _e276 = k_2;
+                    uint _e278 = q_end[_e276];
+                    if ((_e278 != NONE)) {
+                        uint _e282 = k_2;
+                        float d_3 = q_d[_e282];
+                        uint _e286 = m;
+                        j = _e286;
                         while(true) {
-                            uint _e287 = j;
-                            if ((_e287 > 0u)) {
-                                uint _e290 = j;
-                                float _e295 = q_d[(_e290 - 1u)];
-                                uint _e297 = j;
-                                float _e302 = q_d[(_e297 - 1u)];
-                                local_3 = (up ? (_e302 > d_3) : (_e295 < d_3));
+                            uint _e288 = j;
+                            if ((_e288 > 0u)) {
+                                uint _e291 = j;
+                                float _e296 = q_d[(_e291 - 1u)];
+                                uint _e298 = j;
+                                float _e303 = q_d[(_e298 - 1u)];
+                                local_3 = (up ? (_e303 > d_3) : (_e296 < d_3));
                             } else {
                                 local_3 = false;
                             }
-                            bool _e308 = local_3;
-                            if (_e308) {
+                            bool _e309 = local_3;
+                            if (_e309) {
                             } else {
                                 break;
                             }
                             {
-                                uint _e310 = j;
-                                uint _e312 = j;
-                                float _e317 = q_d[(_e312 - 1u)];
-                                q_d[_e310] = _e317;
-                                uint _e319 = j;
-                                uint _e321 = j;
-                                uint _e326 = q_rank[(_e321 - 1u)];
-                                q_rank[_e319] = _e326;
-                                uint _e328 = j;
-                                j = (_e328 - 1u);
+                                uint _e311 = j;
+                                uint _e313 = j;
+                                float _e318 = q_d[(_e313 - 1u)];
+                                q_d[_e311] = _e318;
+                                uint _e320 = j;
+                                uint _e322 = j;
+                                uint _e327 = q_rank[(_e322 - 1u)];
+                                q_rank[_e320] = _e327;
+                                uint _e329 = j;
+                                j = (_e329 - 1u);
                             }
                         }
-                        uint _e331 = j;
-                        q_d[_e331] = d_3;
-                        uint _e334 = j;
-                        uint _e336 = k_2;
-                        q_rank[_e334] = _e336;
-                        uint _e338 = m;
-                        m = (_e338 + 1u);
+                        uint _e332 = j;
+                        q_d[_e332] = d_3;
+                        uint _e335 = j;
+                        uint _e337 = k_2;
+                        q_rank[_e335] = _e337;
+                        uint _e339 = m;
+                        m = (_e339 + 1u);
                     }
                 }
             }
@@ -1225,32 +1234,32 @@ void main() {
                 bool loop_init_11 = true;
                 while(true) {
                     if (!loop_init_11) {
-                        uint _e390 = j_1;
-                        j_1 = (_e390 + 1u);
+                        uint _e391 = j_1;
+                        j_1 = (_e391 + 1u);
                     }
                     loop_init_11 = false;
-                    uint _e345 = j_1;
-                    if ((_e345 < (v_12 / 2u))) {
+                    uint _e346 = j_1;
+                    if ((_e346 < (v_12 / 2u))) {
                     } else {
                         break;
                     }
                     {
-                        uint _e350 = j_1;
-                        float d_4 = q_d[_e350];
-                        uint _e354 = j_1;
-                        uint _e359 = j_1;
-                        float _e362 = q_d[((v_12 - 1u) - _e359)];
-                        q_d[_e354] = _e362;
-                        uint _e366 = j_1;
-                        q_d[((v_12 - 1u) - _e366)] = d_4;
-                        uint _e370 = j_1;
-                        uint k_9 = q_rank[_e370];
-                        uint _e374 = j_1;
-                        uint _e379 = j_1;
-                        uint _e382 = q_rank[((v_12 - 1u) - _e379)];
-                        q_rank[_e374] = _e382;
-                        uint _e386 = j_1;
-                        q_rank[((v_12 - 1u) - _e386)] = k_9;
+                        uint _e351 = j_1;
+                        float d_4 = q_d[_e351];
+                        uint _e355 = j_1;
+                        uint _e360 = j_1;
+                        float _e363 = q_d[((v_12 - 1u) - _e360)];
+                        q_d[_e355] = _e363;
+                        uint _e367 = j_1;
+                        q_d[((v_12 - 1u) - _e367)] = d_4;
+                        uint _e371 = j_1;
+                        uint k_9 = q_rank[_e371];
+                        uint _e375 = j_1;
+                        uint _e380 = j_1;
+                        uint _e383 = q_rank[((v_12 - 1u) - _e380)];
+                        q_rank[_e375] = _e383;
+                        uint _e387 = j_1;
+                        q_rank[((v_12 - 1u) - _e387)] = k_9;
                     }
                 }
             }
@@ -1262,83 +1271,83 @@ void main() {
         bool loop_init_12 = true;
         while(true) {
             if (!loop_init_12) {
-                uint _e405 = c;
-                c = (_e405 + 1u);
+                uint _e406 = c;
+                c = (_e406 + 1u);
             }
             loop_init_12 = false;
-            uint _e395 = c;
-            if ((_e395 < li)) {
+            uint _e396 = c;
+            if ((_e396 < li)) {
             } else {
                 break;
             }
             {
-                uint _e398 = start;
-                uint _e400 = c;
-                uint _e402 = bucket[_e400];
-                start = (_e398 + _e402);
+                uint _e399 = start;
+                uint _e401 = c;
+                uint _e403 = bucket[_e401];
+                start = (_e399 + _e403);
             }
         }
         bool loop_init_13 = true;
         while(true) {
             if (!loop_init_13) {
-                uint _e481 = k_3;
-                k_3 = (_e481 + 1u);
+                uint _e482 = k_3;
+                k_3 = (_e482 + 1u);
             }
             loop_init_13 = false;
-            uint _e408 = k_3;
-            if ((_e408 < SLICE_SAMPLES)) {
+            uint _e409 = k_3;
+            if ((_e409 < SLICE_SAMPLES)) {
             } else {
                 break;
             }
             {
-                uint _e412 = k_3;
-                uint _e414 = q_end[_e412];
-                if ((_e414 != NONE)) {
-                    uint _e418 = k_3;
-                    uint _e420 = q_end[_e418];
-                    local_4 = (min((_e420 / cw), 7u) == li);
+                uint _e413 = k_3;
+                uint _e415 = q_end[_e413];
+                if ((_e415 != NONE)) {
+                    uint _e419 = k_3;
+                    uint _e421 = q_end[_e419];
+                    local_4 = (min((_e421 / cw), 7u) == li);
                 } else {
                     local_4 = false;
                 }
-                bool _e428 = local_4;
-                if (_e428) {
-                    uint _e430 = m_1;
-                    j_2 = _e430;
+                bool _e429 = local_4;
+                if (_e429) {
+                    uint _e431 = m_1;
+                    j_2 = _e431;
                     while(true) {
-                        uint _e432 = j_2;
-                        if ((_e432 > 0u)) {
-                            uint _e435 = start;
-                            uint _e436 = j_2;
-                            uint _e443 = by_end[((_e435 + _e436) - 1u)];
-                            uint _e445 = q_end[_e443];
-                            uint _e447 = k_3;
-                            uint _e449 = q_end[_e447];
-                            local_5 = (_e445 > _e449);
+                        uint _e433 = j_2;
+                        if ((_e433 > 0u)) {
+                            uint _e436 = start;
+                            uint _e437 = j_2;
+                            uint _e444 = by_end[((_e436 + _e437) - 1u)];
+                            uint _e446 = q_end[_e444];
+                            uint _e448 = k_3;
+                            uint _e450 = q_end[_e448];
+                            local_5 = (_e446 > _e450);
                         } else {
                             local_5 = false;
                         }
-                        bool _e454 = local_5;
-                        if (_e454) {
+                        bool _e455 = local_5;
+                        if (_e455) {
                         } else {
                             break;
                         }
                         {
-                            uint _e456 = start;
-                            uint _e457 = j_2;
-                            uint _e460 = start;
-                            uint _e461 = j_2;
-                            uint _e467 = by_end[((_e460 + _e461) - 1u)];
-                            by_end[(_e456 + _e457)] = _e467;
-                            uint _e469 = j_2;
-                            j_2 = (_e469 - 1u);
+                            uint _e457 = start;
+                            uint _e458 = j_2;
+                            uint _e461 = start;
+                            uint _e462 = j_2;
+                            uint _e468 = by_end[((_e461 + _e462) - 1u)];
+                            by_end[(_e457 + _e458)] = _e468;
+                            uint _e470 = j_2;
+                            j_2 = (_e470 - 1u);
                         }
                     }
-                    uint _e472 = start;
-                    uint _e473 = j_2;
-                    uint _e476 = k_3;
-                    by_end[(_e472 + _e473)] = _e476;
-                    uint _e478 = m_1;
-                    m_1 = (_e478 + 1u);
+                    uint _e473 = start;
+                    uint _e474 = j_2;
+                    uint _e477 = k_3;
+                    by_end[(_e473 + _e474)] = _e477;
+                    uint _e479 = m_1;
+                    m_1 = (_e479 + 1u);
                 }
             }
         }
@@ -1347,20 +1356,20 @@ void main() {
     bool loop_init_14 = true;
     while(true) {
         if (!loop_init_14) {
-            uint _e495 = j_3;
-            j_3 = (_e495 + SLICE_LANES);
+            uint _e496 = j_3;
+            j_3 = (_e496 + SLICE_LANES);
         }
         loop_init_14 = false;
-        uint _e484 = j_3;
-        if ((_e484 < v_12)) {
+        uint _e485 = j_3;
+        if ((_e485 < v_12)) {
         } else {
             break;
         }
         {
-            uint _e486 = j_3;
-            uint _e492 = j_3;
-            uint _e494 = q_rank[_e492];
-            mine[(_e486 / SLICE_LANES)] = _e494;
+            uint _e487 = j_3;
+            uint _e493 = j_3;
+            uint _e495 = q_rank[_e493];
+            mine[(_e487 / SLICE_LANES)] = _e495;
         }
     }
     memoryBarrierShared();
@@ -1369,20 +1378,20 @@ void main() {
     bool loop_init_15 = true;
     while(true) {
         if (!loop_init_15) {
-            uint _e509 = j_4;
-            j_4 = (_e509 + SLICE_LANES);
+            uint _e510 = j_4;
+            j_4 = (_e510 + SLICE_LANES);
         }
         loop_init_15 = false;
-        uint _e499 = j_4;
-        if ((_e499 < v_12)) {
+        uint _e500 = j_4;
+        if ((_e500 < v_12)) {
         } else {
             break;
         }
         {
-            uint _e501 = j_4;
-            uint _e506 = mine[(_e501 / SLICE_LANES)];
-            uint _e508 = j_4;
-            q_rank[_e506] = _e508;
+            uint _e502 = j_4;
+            uint _e507 = mine[(_e502 / SLICE_LANES)];
+            uint _e509 = j_4;
+            q_rank[_e507] = _e509;
         }
     }
     memoryBarrierShared();
@@ -1392,66 +1401,66 @@ void main() {
     bool loop_init_16 = true;
     while(true) {
         if (!loop_init_16) {
-            uint _e566 = i;
-            i = (_e566 + SLICE_LANES);
+            uint _e567 = i;
+            i = (_e567 + SLICE_LANES);
         }
         loop_init_16 = false;
-        uint _e514 = i;
-        if ((_e514 < width)) {
+        uint _e515 = i;
+        if ((_e515 < width)) {
         } else {
             break;
         }
         {
-            uint _e516 = i;
-            int _e520_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-            vec4 _e520 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e516, row_5)), ivec2(0), textureSize(_group_0_binding_4_cs, _e520_clamped_lod) - ivec2(1)), _e520_clamped_lod);
-            float occluder = _e520.x;
+            uint _e517 = i;
+            int _e521_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+            vec4 _e521 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e517, row_5)), ivec2(0), textureSize(_group_0_binding_4_cs, _e521_clamped_lod) - ivec2(1)), _e521_clamped_lod);
+            float occluder = _e521.x;
             lo = 0u;
             hi = v_12;
             while(true) {
-                uint _e525 = lo;
-                uint _e526 = hi;
-                if ((_e525 < _e526)) {
+                uint _e526 = lo;
+                uint _e527 = hi;
+                if ((_e526 < _e527)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e528 = lo;
-                    uint _e529 = hi;
-                    uint mid_1 = ((_e528 + _e529) / 2u);
-                    float _e535 = q_d[mid_1];
-                    if ((_e535 <= occluder)) {
+                    uint _e529 = lo;
+                    uint _e530 = hi;
+                    uint mid_1 = ((_e529 + _e530) / 2u);
+                    float _e536 = q_d[mid_1];
+                    if ((_e536 <= occluder)) {
                         lo = (mid_1 + 1u);
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            uint _e540 = i;
-            uint _e543 = lo;
-            _group_0_binding_8_cs[(base_1 + _e540)] = _e543;
+            uint _e541 = i;
             uint _e544 = lo;
-            if ((_e544 > 0u)) {
+            _group_0_binding_8_cs[(base_1 + _e541)] = _e544;
+            uint _e545 = lo;
+            if ((_e545 > 0u)) {
                 h = 0u;
                 bool loop_init_17 = true;
                 while(true) {
                     if (!loop_init_17) {
-                        uint _e564 = h;
-                        h = (_e564 + 1u);
+                        uint _e565 = h;
+                        h = (_e565 + 1u);
                     }
                     loop_init_17 = false;
-                    uint _e549 = h;
-                    if ((_e549 < LEAF_VECS)) {
+                    uint _e550 = h;
+                    if ((_e550 < LEAF_VECS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e552 = i;
-                        uint _e557 = h;
-                        uint _e560 = i;
-                        uint _e561 = h;
-                        vec4 _e562 = pst_leaf(f_23, _e560, row_5, delta_6, _e561);
-                        _group_0_binding_6_cs[(((base_1 + _e552) * LEAF_VECS) + _e557)] = _e562;
+                        uint _e553 = i;
+                        uint _e558 = h;
+                        uint _e561 = i;
+                        uint _e562 = h;
+                        vec4 _e563 = pst_leaf(f_24, _e561, _e91, delta_6, _e562);
+                        _group_0_binding_6_cs[(((base_1 + _e553) * LEAF_VECS) + _e558)] = _e563;
                     }
                 }
             }
@@ -1468,37 +1477,37 @@ void main() {
         bool loop_init_18 = true;
         while(true) {
             if (!loop_init_18) {
-                uint _e599 = j_5;
-                j_5 = (_e599 + 1u);
+                uint _e600 = j_5;
+                j_5 = (_e600 + 1u);
             }
             loop_init_18 = false;
-            uint _e585 = j_5;
-            if ((_e585 < (v_12 * LEAF_VECS))) {
+            uint _e586 = j_5;
+            if ((_e586 < (v_12 * LEAF_VECS))) {
             } else {
                 break;
             }
             {
-                uint _e590 = j_5;
-                _group_0_binding_7_cs[(tree + _e590)] = vec4(0.0, 0.0, 0.0, 0.0);
+                uint _e591 = j_5;
+                _group_0_binding_7_cs[(tree + _e591)] = vec4(0.0, 0.0, 0.0, 0.0);
             }
         }
         uint lo_5 = (li * cw);
         uint hi_5 = (((li + 1u) == TREES) ? width : min((lo_5 + cw), width));
         top = v_12;
         while(true) {
-            uint _e611 = next;
-            uint _e612 = top;
-            if ((_e611 < _e612)) {
+            uint _e612 = next;
+            uint _e613 = top;
+            if ((_e612 < _e613)) {
             } else {
                 break;
             }
             {
-                uint _e614 = next;
-                uint _e615 = top;
-                uint mid_2 = ((_e614 + _e615) / 2u);
-                uint _e622 = by_end[mid_2];
-                uint _e624 = q_end[_e622];
-                if ((_e624 < lo_5)) {
+                uint _e615 = next;
+                uint _e616 = top;
+                uint mid_2 = ((_e615 + _e616) / 2u);
+                uint _e623 = by_end[mid_2];
+                uint _e625 = q_end[_e623];
+                if ((_e625 < lo_5)) {
                     next = (mid_2 + 1u);
                 } else {
                     top = mid_2;
@@ -1509,132 +1518,132 @@ void main() {
         bool loop_init_19 = true;
         while(true) {
             if (!loop_init_19) {
-                uint _e772 = i_1;
-                i_1 = (_e772 + 1u);
+                uint _e773 = i_1;
+                i_1 = (_e773 + 1u);
             }
             loop_init_19 = false;
-            uint _e629 = i_1;
-            if ((_e629 <= hi_5)) {
+            uint _e630 = i_1;
+            if ((_e630 <= hi_5)) {
             } else {
                 break;
             }
             {
                 while(true) {
-                    uint _e631 = next;
-                    if ((_e631 < v_12)) {
-                        uint _e635 = next;
-                        uint _e637 = by_end[_e635];
-                        uint _e639 = q_end[_e637];
-                        uint _e640 = i_1;
-                        local_6 = (_e639 == _e640);
+                    uint _e632 = next;
+                    if ((_e632 < v_12)) {
+                        uint _e636 = next;
+                        uint _e638 = by_end[_e636];
+                        uint _e640 = q_end[_e638];
+                        uint _e641 = i_1;
+                        local_6 = (_e640 == _e641);
                     } else {
                         local_6 = false;
                     }
-                    bool _e645 = local_6;
-                    if (_e645) {
-                        uint _e646 = i_1;
-                        if (!((_e646 < hi_5))) {
+                    bool _e646 = local_6;
+                    if (_e646) {
+                        uint _e647 = i_1;
+                        if (!((_e647 < hi_5))) {
                             local_8 = ((li + 1u) == TREES);
                         } else {
                             local_8 = true;
                         }
-                        bool _e656 = local_8;
-                        local_7 = _e656;
+                        bool _e657 = local_8;
+                        local_7 = _e657;
                     } else {
                         local_7 = false;
                     }
-                    bool _e660 = local_7;
-                    if (_e660) {
+                    bool _e661 = local_7;
+                    if (_e661) {
                     } else {
                         break;
                     }
                     {
-                        uint _e662 = next;
-                        uint k_10 = by_end[_e662];
-                        uint _e666 = next;
-                        next = (_e666 + 1u);
+                        uint _e663 = next;
+                        uint k_10 = by_end[_e663];
+                        uint _e667 = next;
+                        next = (_e667 + 1u);
                         h_1 = 0u;
                         bool loop_init_20 = true;
                         while(true) {
                             if (!loop_init_20) {
-                                uint _e717 = h_1;
-                                h_1 = (_e717 + 1u);
+                                uint _e718 = h_1;
+                                h_1 = (_e718 + 1u);
                             }
                             loop_init_20 = false;
-                            uint _e670 = h_1;
-                            if ((_e670 < LEAF_VECS)) {
+                            uint _e671 = h_1;
+                            if ((_e671 < LEAF_VECS)) {
                             } else {
                                 break;
                             }
                             {
                                 p = vec4(0.0, 0.0, 0.0, 0.0);
-                                uint _e681 = q_rank[k_10];
-                                j_6 = (v_12 - _e681);
+                                uint _e682 = q_rank[k_10];
+                                j_6 = (v_12 - _e682);
                                 while(true) {
-                                    uint _e684 = j_6;
-                                    if ((_e684 > 0u)) {
+                                    uint _e685 = j_6;
+                                    if ((_e685 > 0u)) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        vec4 _e687 = p;
-                                        uint _e688 = j_6;
-                                        uint _e695 = h_1;
-                                        vec4 _e698 = _group_0_binding_7_cs[((tree + ((_e688 - 1u) * LEAF_VECS)) + _e695)];
-                                        p = (_e687 + _e698);
-                                        uint _e700 = j_6;
+                                        vec4 _e688 = p;
+                                        uint _e689 = j_6;
+                                        uint _e696 = h_1;
+                                        vec4 _e699 = _group_0_binding_7_cs[((tree + ((_e689 - 1u) * LEAF_VECS)) + _e696)];
+                                        p = (_e688 + _e699);
                                         uint _e701 = j_6;
                                         uint _e702 = j_6;
-                                        j_6 = (_e700 - (_e701 & (~(_e702) + 1u)));
+                                        uint _e703 = j_6;
+                                        j_6 = (_e701 - (_e702 & (~(_e703) + 1u)));
                                     }
                                 }
-                                uint _e712 = h_1;
-                                vec4 _e715 = p;
-                                _group_0_binding_7_cs[((partials + (k_10 * LEAF_VECS)) + _e712)] = _e715;
+                                uint _e713 = h_1;
+                                vec4 _e716 = p;
+                                _group_0_binding_7_cs[((partials + (k_10 * LEAF_VECS)) + _e713)] = _e716;
                             }
                         }
                     }
                 }
-                uint _e719 = i_1;
-                if ((_e719 == hi_5)) {
+                uint _e720 = i_1;
+                if ((_e720 == hi_5)) {
                     break;
                 }
-                uint _e722 = i_1;
-                uint b_8 = _group_0_binding_8_cs[(base_1 + _e722)];
+                uint _e723 = i_1;
+                uint b_8 = _group_0_binding_8_cs[(base_1 + _e723)];
                 if ((b_8 > 0u)) {
                     h_2 = 0u;
                     bool loop_init_21 = true;
                     while(true) {
                         if (!loop_init_21) {
-                            uint _e769 = h_2;
-                            h_2 = (_e769 + 1u);
+                            uint _e770 = h_2;
+                            h_2 = (_e770 + 1u);
                         }
                         loop_init_21 = false;
-                        uint _e730 = h_2;
-                        if ((_e730 < LEAF_VECS)) {
+                        uint _e731 = h_2;
+                        if ((_e731 < LEAF_VECS)) {
                         } else {
                             break;
                         }
                         {
-                            uint _e733 = i_1;
-                            uint _e738 = h_2;
-                            vec4 leaf_1 = _group_0_binding_6_cs[(((base_1 + _e733) * LEAF_VECS) + _e738)];
+                            uint _e734 = i_1;
+                            uint _e739 = h_2;
+                            vec4 leaf_1 = _group_0_binding_6_cs[(((base_1 + _e734) * LEAF_VECS) + _e739)];
                             j_7 = ((v_12 - b_8) + 1u);
                             while(true) {
-                                uint _e746 = j_7;
-                                if ((_e746 <= v_12)) {
+                                uint _e747 = j_7;
+                                if ((_e747 <= v_12)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    uint _e748 = j_7;
-                                    uint _e755 = h_2;
-                                    vec4 _e758 = _group_0_binding_7_cs[((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755)];
-                                    _group_0_binding_7_cs[((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755)] = (_e758 + leaf_1);
-                                    uint _e760 = j_7;
+                                    uint _e749 = j_7;
+                                    uint _e756 = h_2;
+                                    vec4 _e759 = _group_0_binding_7_cs[((tree + ((_e749 - 1u) * LEAF_VECS)) + _e756)];
+                                    _group_0_binding_7_cs[((tree + ((_e749 - 1u) * LEAF_VECS)) + _e756)] = (_e759 + leaf_1);
                                     uint _e761 = j_7;
                                     uint _e762 = j_7;
-                                    j_7 = (_e760 + (_e761 & (~(_e762) + 1u)));
+                                    uint _e763 = j_7;
+                                    j_7 = (_e761 + (_e762 & (~(_e763) + 1u)));
                                 }
                             }
                         }
@@ -1651,12 +1660,12 @@ void main() {
     bool loop_init_22 = true;
     while(true) {
         if (!loop_init_22) {
-            uint _e809 = x;
-            x = (_e809 + SLICE_LANES);
+            uint _e810 = x;
+            x = (_e810 + SLICE_LANES);
         }
         loop_init_22 = false;
-        uint _e775 = x;
-        if ((_e775 < (v_12 * LEAF_VECS))) {
+        uint _e776 = x;
+        if ((_e776 < (v_12 * LEAF_VECS))) {
         } else {
             break;
         }
@@ -1666,24 +1675,24 @@ void main() {
             bool loop_init_23 = true;
             while(true) {
                 if (!loop_init_23) {
-                    uint _e807 = c_1;
-                    c_1 = (_e807 + 1u);
+                    uint _e808 = c_1;
+                    c_1 = (_e808 + 1u);
                 }
                 loop_init_23 = false;
-                uint _e787 = c_1;
-                if ((_e787 < TREES)) {
+                uint _e788 = c_1;
+                if ((_e788 < TREES)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e790 = c_1;
-                    uint _e796 = x;
-                    uint at = ((trees + ((_e790 * SLICE_SAMPLES) * LEAF_VECS)) + _e796);
+                    uint _e791 = c_1;
+                    uint _e797 = x;
+                    uint at = ((trees + ((_e791 * SLICE_SAMPLES) * LEAF_VECS)) + _e797);
                     vec4 own = _group_0_binding_7_cs[at];
-                    vec4 _e803 = running;
-                    _group_0_binding_7_cs[at] = _e803;
                     vec4 _e804 = running;
-                    running = (_e804 + own);
+                    _group_0_binding_7_cs[at] = _e804;
+                    vec4 _e805 = running;
+                    running = (_e805 + own);
                 }
             }
         }
@@ -1696,84 +1705,84 @@ void main() {
     bool loop_init_24 = true;
     while(true) {
         if (!loop_init_24) {
-            uint _e924 = k_4;
-            k_4 = (_e924 + SLICE_LANES);
+            uint _e925 = k_4;
+            k_4 = (_e925 + SLICE_LANES);
         }
         loop_init_24 = false;
-        uint _e813 = k_4;
-        if ((_e813 < SLICE_SAMPLES)) {
+        uint _e814 = k_4;
+        if ((_e814 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e817 = k_4;
-            uint _e819 = q_end[_e817];
-            if ((_e819 != NONE)) {
-                uint _e823 = k_4;
-                uint _e825 = q_end[_e823];
-                uint tree_1 = (trees + ((min((_e825 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
+            uint _e818 = k_4;
+            uint _e820 = q_end[_e818];
+            if ((_e820 != NONE)) {
+                uint _e824 = k_4;
+                uint _e826 = q_end[_e824];
+                uint tree_1 = (trees + ((min((_e826 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0.0;
                 h_3 = 0u;
                 bool loop_init_25 = true;
                 while(true) {
                     if (!loop_init_25) {
-                        uint _e892 = h_3;
-                        h_3 = (_e892 + 1u);
+                        uint _e893 = h_3;
+                        h_3 = (_e893 + 1u);
                     }
                     loop_init_25 = false;
-                    uint _e838 = h_3;
-                    if ((_e838 < LEAF_VECS)) {
+                    uint _e839 = h_3;
+                    if ((_e839 < LEAF_VECS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e841 = k_4;
-                        uint _e846 = h_3;
-                        vec4 _e849 = _group_0_binding_7_cs[((partials + (_e841 * LEAF_VECS)) + _e846)];
-                        p_1 = _e849;
-                        uint _e852 = k_4;
-                        uint _e854 = q_rank[_e852];
-                        j_8 = (v_12 - _e854);
+                        uint _e842 = k_4;
+                        uint _e847 = h_3;
+                        vec4 _e850 = _group_0_binding_7_cs[((partials + (_e842 * LEAF_VECS)) + _e847)];
+                        p_1 = _e850;
+                        uint _e853 = k_4;
+                        uint _e855 = q_rank[_e853];
+                        j_8 = (v_12 - _e855);
                         while(true) {
-                            uint _e857 = j_8;
-                            if ((_e857 > 0u)) {
+                            uint _e858 = j_8;
+                            if ((_e858 > 0u)) {
                             } else {
                                 break;
                             }
                             {
-                                vec4 _e860 = p_1;
-                                uint _e861 = j_8;
-                                uint _e868 = h_3;
-                                vec4 _e871 = _group_0_binding_7_cs[((tree_1 + ((_e861 - 1u) * LEAF_VECS)) + _e868)];
-                                p_1 = (_e860 + _e871);
-                                uint _e873 = j_8;
+                                vec4 _e861 = p_1;
+                                uint _e862 = j_8;
+                                uint _e869 = h_3;
+                                vec4 _e872 = _group_0_binding_7_cs[((tree_1 + ((_e862 - 1u) * LEAF_VECS)) + _e869)];
+                                p_1 = (_e861 + _e872);
                                 uint _e874 = j_8;
                                 uint _e875 = j_8;
-                                j_8 = (_e873 - (_e874 & (~(_e875) + 1u)));
+                                uint _e876 = j_8;
+                                j_8 = (_e874 - (_e875 & (~(_e876) + 1u)));
                             }
                         }
-                        float _e881 = dotp;
-                        vec4 _e882 = p_1;
-                        uint _e884 = k_4;
-                        float _e886 = q_theta[_e884];
-                        uint _e887 = h_3;
-                        vec4 _e888 = beta_at(_e886, _e887);
-                        dotp = (_e881 + dot(_e882, _e888));
+                        float _e882 = dotp;
+                        vec4 _e883 = p_1;
+                        uint _e885 = k_4;
+                        float _e887 = q_theta[_e885];
+                        uint _e888 = h_3;
+                        vec4 _e889 = beta_at(_e887, _e888);
+                        dotp = (_e882 + dot(_e883, _e889));
                     }
                 }
-                uint _e897 = k_4;
-                float _e899 = q_a[_e897];
-                float _e900 = dotp;
-                uint _e905 = k_4;
-                float _e907 = q_b[_e905];
-                vec3 _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_23.light_color.xyz * (max((_e899 * _e900), 0.0) + _e907)));
-                uint _e911 = k_4;
-                uvec2 _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
-                int _e915_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-                vec4 _e915 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e912), ivec2(0), textureSize(_group_0_binding_2_cs, _e915_clamped_lod) - ivec2(1)), _e915_clamped_lod);
-                float z_8 = _e915.x;
-                uint _e917 = k_4;
-                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e917, s_7)), vec4(_e910.x, _e910.y, _e910.z, z_8));
+                uint _e898 = k_4;
+                float _e900 = q_a[_e898];
+                float _e901 = dotp;
+                uint _e906 = k_4;
+                float _e908 = q_b[_e906];
+                vec3 _e911 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_24.light_color.xyz * (max((_e900 * _e901), 0.0) + _e908)));
+                uint _e912 = k_4;
+                uvec2 _e913 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e912, screen_4);
+                int _e916_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+                vec4 _e916 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e913), ivec2(0), textureSize(_group_0_binding_2_cs, _e916_clamped_lod) - ivec2(1)), _e916_clamped_lod);
+                float z_8 = _e916.x;
+                uint _e918 = k_4;
+                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e918, s_7)), vec4(_e911.x, _e911.y, _e911.z, z_8));
             }
         }
     }

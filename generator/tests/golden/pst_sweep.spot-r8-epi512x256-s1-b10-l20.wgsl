@@ -722,7 +722,16 @@ fn beta_at(theta_4: f32, h_6: u32) -> vec4<f32> {
     return _e14;
 }
 
-fn pst_leaf(f_19: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, row_3: u32, delta_2: f32, h_7: u32) -> vec4<f32> {
+fn pst_row_e(f_19: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_3: u32) -> vec3<f32> {
+    if false {
+        return vec3<f32>(0f, 0f, 0f);
+    }
+    let _e7 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    let _e8 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e7);
+    return _e8;
+}
+
+fn pst_leaf(f_20: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, e_1: vec3<f32>, delta_2: f32, h_7: u32) -> vec4<f32> {
     var leaf: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var g_1: u32 = 0u;
 
@@ -730,61 +739,59 @@ fn pst_leaf(f_19: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, 
         let _e9 = gamma_at((f32(i_2) * delta_2), h_7);
         return _e9;
     }
-    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
-    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
-    let axis_2 = f_19.axis.xyz;
+    let axis_2 = f_20.axis.xyz;
     loop {
-        let _e17 = g_1;
-        if (_e17 < 2u) {
+        let _e14 = g_1;
+        if (_e14 < 2u) {
         } else {
             break;
         }
         {
-            let _e20 = g_1;
-            let q_4 = select(GL2_, -0.57735026f, (_e20 == 0u));
+            let _e17 = g_1;
+            let q_4 = select(GL2_, -0.57735026f, (_e17 == 0u));
             let psi_1 = (((f32(i_2) + 0.5f) + (0.5f * q_4)) * delta_2);
-            let l_5 = ((-(axis_2) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
-            let _e48 = leaf;
-            let _e52 = gamma_at(psi_1, h_7);
-            leaf = (_e48 + (((0.5f * delta_2) * _e46) * _e52));
+            let l_5 = ((-(axis_2) * cos(psi_1)) + (e_1 * sin(psi_1)));
+            let _e44 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_5, f_20.light_dir.xyz), f_20.light_pos.w, f_20.light_dir.w);
+            let _e46 = leaf;
+            let _e50 = gamma_at(psi_1, h_7);
+            leaf = (_e46 + (((0.5f * delta_2) * _e44) * _e50));
         }
         continuing {
-            let _e56 = g_1;
-            g_1 = (_e56 + 1u);
+            let _e54 = g_1;
+            g_1 = (_e54 + 1u);
         }
     }
-    let _e58 = leaf;
-    return _e58;
+    let _e56 = leaf;
+    return _e56;
 }
 
 fn pst_ray(pc_1: vec2<f32>, z_1: f32) -> PstRay {
     var r_1: PstRay;
 
-    let f_20 = frame;
-    let eye_9 = f_20.eye.xyz;
-    let ndc_2 = vec2<f32>((((2f * pc_1.x) / f32(f_20.sizes.x)) - 1f), (1f - ((2f * pc_1.y) / f32(f_20.sizes.y))));
-    let t_7 = f_20.cam_forward.w;
-    let dir_12 = normalize(((f_20.cam_forward.xyz + (f_20.cam_right.xyz * ((ndc_2.x * t_7) * f_20.cam_right.w))) + (f_20.cam_up.xyz * (ndc_2.y * t_7))));
-    let s_6 = (min(max(z_1, 0f), f_20.theta.z) / max(dot(dir_12, f_20.cam_forward.xyz), 0.000001f));
+    let f_21 = frame;
+    let eye_9 = f_21.eye.xyz;
+    let ndc_2 = vec2<f32>((((2f * pc_1.x) / f32(f_21.sizes.x)) - 1f), (1f - ((2f * pc_1.y) / f32(f_21.sizes.y))));
+    let t_7 = f_21.cam_forward.w;
+    let dir_12 = normalize(((f_21.cam_forward.xyz + (f_21.cam_right.xyz * ((ndc_2.x * t_7) * f_21.cam_right.w))) + (f_21.cam_up.xyz * (ndc_2.y * t_7))));
+    let s_6 = (min(max(z_1, 0f), f_21.theta.z) / max(dot(dir_12, f_21.cam_forward.xyz), 0.000001f));
     r_1 = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_9, dir_12, s_6, 0u, 0f, 0f, 0f);
-    let _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, pc_1);
+    let _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, pc_1);
     if _e67 {
         r_1.marched = true;
         let _e72 = frame;
         let _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_6, true);
-        r_1.color = (_e75 * f_20.light_color.xyz);
+        r_1.color = (_e75 * f_21.light_color.xyz);
     }
-    let _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
+    let _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
     r_1.theta = _e80;
-    let _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
-    let _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_20.sizes.w, (f_20.anti_epipole.w > 0.5f));
+    let _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
+    let _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_21.sizes.w, (f_21.anti_epipole.w > 0.5f));
     r_1.row = _e90;
     let _e93 = r_1.theta;
-    let _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_20.theta.x, f_20.theta.y);
+    let _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_21.theta.x, f_21.theta.y);
     r_1.d = _e98;
     let _e101 = r_1.theta;
-    let _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, eye_9, dir_12, s_6, _e101, true);
+    let _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, eye_9, dir_12, s_6, _e101, true);
     r_1.xs_num = _e102;
     let _e103 = r_1;
     return _e103;
@@ -799,21 +806,21 @@ fn pst_columns_crossed(r_2: PstRay, delta_3: f32) -> u32 {
 fn pst_terms(r_3: PstRay, row_4: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     var tail: f32 = 0f;
 
-    let f_21 = frame;
+    let f_22 = frame;
     let sin_theta = max(sin(r_3.theta), 0.000001f);
     let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_4), 0i);
     if (r_3.d <= _e16.x) {
-        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
-        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, r_3.eye, r_3.dir, _e25, r_3.s, true);
+        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, (n_2 - 1u), n_2, delta_4, r_3.theta, r_3.s, true);
+        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, r_3.eye, r_3.dir, _e25, r_3.s, true);
         tail = _e29;
     }
     if true {
         let _e37 = tail;
-        return vec2<f32>((f_21.medium.y / (f_21.axis.w * sin_theta)), _e37);
+        return vec2<f32>((f_22.medium.y / (f_22.axis.w * sin_theta)), _e37);
     }
-    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.z, -(dot(f_21.light_dir.xyz, r_3.dir)));
-    let sp = (f_21.medium.y * _e48);
-    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.x, 0f, (delta_4 / sin_theta));
+    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.z, -(dot(f_22.light_dir.xyz, r_3.dir)));
+    let sp = (f_22.medium.y * _e48);
+    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.x, 0f, (delta_4 / sin_theta));
     let _e56 = tail;
     return vec2<f32>((sp * _e54), (sp * _e56));
 }
@@ -824,7 +831,7 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
     var p_6: vec4<f32>;
     var i_3: u32;
 
-    let f_22 = frame;
+    let f_23 = frame;
     let _e16 = textureLoad(depth, vec2<u32>(x_5, y), 0i);
     let _e18 = pst_ray(vec2<f32>((f32(x_5) + 0.5f), (f32(y) + 0.5f)), _e16.x);
     if _e18.marched {
@@ -833,13 +840,14 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
     let _e24 = slices_1[_e18.row];
     let _e25 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24);
     let delta_5 = _e25.delta;
-    let _e27 = pst_columns_crossed(_e18, delta_5);
-    if (_e27 == 0u) {
+    let _e28 = pst_row_e(f_23, _e18.row);
+    let _e29 = pst_columns_crossed(_e18, delta_5);
+    if (_e29 == 0u) {
         return vec3<f32>(0f, 0f, 0f);
     }
     loop {
-        let _e35 = h_8;
-        if (_e35 < RANK_VECS) {
+        let _e37 = h_8;
+        if (_e37 < RANK_VECS) {
         } else {
             break;
         }
@@ -847,41 +855,41 @@ fn pst_sweep_pixel(x_5: u32, y: u32) -> vec3<f32> {
             p_6 = vec4<f32>(0f, 0f, 0f, 0f);
             i_3 = 0u;
             loop {
-                let _e46 = i_3;
-                if ((_e46 + 1u) < _e27) {
+                let _e48 = i_3;
+                if ((_e48 + 1u) < _e29) {
                 } else {
                     break;
                 }
                 {
-                    let _e51 = i_3;
-                    let _e56 = textureLoad(rectified, vec2<u32>(_e51, _e18.row), 0i);
-                    if (_e18.d <= _e56.x) {
-                        let _e59 = p_6;
-                        let _e60 = i_3;
-                        let _e62 = h_8;
-                        let _e63 = pst_leaf(f_22, _e60, _e18.row, delta_5, _e62);
-                        p_6 = (_e59 + _e63);
+                    let _e53 = i_3;
+                    let _e58 = textureLoad(rectified, vec2<u32>(_e53, _e18.row), 0i);
+                    if (_e18.d <= _e58.x) {
+                        let _e61 = p_6;
+                        let _e62 = i_3;
+                        let _e63 = h_8;
+                        let _e64 = pst_leaf(f_23, _e62, _e28, delta_5, _e63);
+                        p_6 = (_e61 + _e64);
                     }
                 }
                 continuing {
-                    let _e66 = i_3;
-                    i_3 = (_e66 + 1u);
+                    let _e67 = i_3;
+                    i_3 = (_e67 + 1u);
                 }
             }
-            let _e69 = sum_2;
-            let _e70 = p_6;
-            let _e72 = h_8;
-            let _e73 = beta_at(_e18.theta, _e72);
-            sum_2 = (_e69 + dot(_e70, _e73));
+            let _e70 = sum_2;
+            let _e71 = p_6;
+            let _e73 = h_8;
+            let _e74 = beta_at(_e18.theta, _e73);
+            sum_2 = (_e70 + dot(_e71, _e74));
         }
         continuing {
-            let _e77 = h_8;
-            h_8 = (_e77 + 1u);
+            let _e78 = h_8;
+            h_8 = (_e78 + 1u);
         }
     }
-    let _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
-    let _e84 = sum_2;
-    return (f_22.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
+    let _e81 = pst_terms(_e18, _e18.row, delta_5, _e29);
+    let _e85 = sum_2;
+    return (f_23.light_color.xyz * (max((_e81.x * _e85), 0f) + _e81.y));
 }
 
 fn pst_footprint_depth(pc_2: vec2<f32>, screen_3: vec2<u32>) -> f32 {
@@ -963,9 +971,9 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     var p_1: vec4<f32>;
     var j_8: u32;
 
-    let f_23 = frame;
-    let screen_4 = vec2<u32>(f_23.sizes.x, f_23.sizes.y);
-    let width = f_23.sizes.z;
+    let f_24 = frame;
+    let screen_4 = vec2<u32>(f_24.sizes.x, f_24.sizes.y);
+    let width = f_24.sizes.z;
     let _e13 = frame.cam_forward;
     let _e17 = frame.cam_right;
     let _e21 = frame.cam_up;
@@ -990,66 +998,67 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     let _e88 = slices_1[row_5];
     let _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
     let delta_6 = _e89.delta;
+    let _e91 = pst_row_e(f_24, row_5);
     k = li;
     loop {
-        let _e92 = k;
-        if (_e92 < SLICE_SAMPLES) {
+        let _e93 = k;
+        if (_e93 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e95 = k;
-            let _e96 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e95, screen_4);
-            let _e99 = textureLoad(depth, _e96, 0i);
-            let z_7 = _e99.x;
-            let _e103 = k;
-            let _e110 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (f32(_e103) * _e42.y)))), screen_4);
+            let _e96 = k;
+            let _e97 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e96, screen_4);
+            let _e100 = textureLoad(depth, _e97, 0i);
+            let z_7 = _e100.x;
+            let _e104 = k;
+            let _e111 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (f32(_e104) * _e42.y)))), screen_4);
             r = PstRay();
-            if (_e110 < 0f) {
-                let _e124 = pst_ray(vec2<f32>((f32(_e96.x) + 0.5f), (f32(_e96.y) + 0.5f)), z_7);
-                r = _e124;
+            if (_e111 < 0f) {
+                let _e125 = pst_ray(vec2<f32>((f32(_e97.x) + 0.5f), (f32(_e97.y) + 0.5f)), z_7);
+                r = _e125;
             } else {
-                let _e127 = k;
-                let _e134 = pst_ray((_e37.origin + (_e40 * (_e42.x + (f32(_e127) * _e42.y)))), _e110);
-                r = _e134;
+                let _e128 = k;
+                let _e135 = pst_ray((_e37.origin + (_e40 * (_e42.x + (f32(_e128) * _e42.y)))), _e111);
+                r = _e135;
             }
-            let _e135 = r;
-            let _e136 = pst_columns_crossed(_e135, delta_6);
-            let _e138 = k;
-            q_end[_e138] = NONE;
-            let _e142 = r.marched;
-            if !(_e142) {
-                local = (_e136 == 0u);
+            let _e136 = r;
+            let _e137 = pst_columns_crossed(_e136, delta_6);
+            let _e139 = k;
+            q_end[_e139] = NONE;
+            let _e143 = r.marched;
+            if !(_e143) {
+                local = (_e137 == 0u);
             } else {
                 local = true;
             }
-            let _e149 = local;
-            if _e149 {
-                let _e151 = r.color;
-                let _e152 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e151);
-                let _e153 = k;
-                textureStore(output, vec2<u32>(_e153, s_7), vec4<f32>(_e152.x, _e152.y, _e152.z, z_7));
+            let _e150 = local;
+            if _e150 {
+                let _e152 = r.color;
+                let _e153 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e152);
+                let _e154 = k;
+                textureStore(output, vec2<u32>(_e154, s_7), vec4<f32>(_e153.x, _e153.y, _e153.z, z_7));
             } else {
-                let _e160 = r;
-                let _e161 = pst_terms(_e160, row_5, delta_6, _e136);
-                let _e163 = k;
-                q_b[_e163] = _e161.y;
-                let _e167 = k;
-                q_end[_e167] = (_e136 - 1u);
-                let _e172 = k;
-                let _e175 = r.d;
-                q_d[_e172] = _e175;
-                let _e177 = k;
-                let _e180 = r.theta;
-                q_theta[_e177] = _e180;
-                let _e182 = k;
-                q_a[_e182] = _e161.x;
-                let _e187 = atomicAdd((&live), 1u);
+                let _e161 = r;
+                let _e162 = pst_terms(_e161, row_5, delta_6, _e137);
+                let _e164 = k;
+                q_b[_e164] = _e162.y;
+                let _e168 = k;
+                q_end[_e168] = (_e137 - 1u);
+                let _e173 = k;
+                let _e176 = r.d;
+                q_d[_e173] = _e176;
+                let _e178 = k;
+                let _e181 = r.theta;
+                q_theta[_e178] = _e181;
+                let _e183 = k;
+                q_a[_e183] = _e162.x;
+                let _e188 = atomicAdd((&live), 1u);
             }
         }
         continuing {
-            let _e188 = k;
-            k = (_e188 + SLICE_LANES);
+            let _e189 = k;
+            k = (_e189 + SLICE_LANES);
         }
     }
     workgroupBarrier();
@@ -1057,156 +1066,156 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     let cw = (((width + TREES) - 1u) / TREES);
     if (li < TREES) {
         loop {
-            let _e202 = k_1;
-            if (_e202 < SLICE_SAMPLES) {
+            let _e203 = k_1;
+            if (_e203 < SLICE_SAMPLES) {
             } else {
                 break;
             }
             {
-                let _e206 = k_1;
-                let _e208 = q_end[_e206];
-                if (_e208 != NONE) {
-                    let _e212 = k_1;
-                    let _e214 = q_end[_e212];
-                    local_1 = (min((_e214 / cw), 7u) == li);
+                let _e207 = k_1;
+                let _e209 = q_end[_e207];
+                if (_e209 != NONE) {
+                    let _e213 = k_1;
+                    let _e215 = q_end[_e213];
+                    local_1 = (min((_e215 / cw), 7u) == li);
                 } else {
                     local_1 = false;
                 }
-                let _e222 = local_1;
-                if _e222 {
-                    let _e225 = count;
-                    count = (_e225 + 1u);
+                let _e223 = local_1;
+                if _e223 {
+                    let _e226 = count;
+                    count = (_e226 + 1u);
                 }
             }
             continuing {
-                let _e228 = k_1;
-                k_1 = (_e228 + 1u);
+                let _e229 = k_1;
+                k_1 = (_e229 + 1u);
             }
         }
-        let _e232 = count;
-        bucket[li] = _e232;
+        let _e233 = count;
+        bucket[li] = _e233;
     } else {
         if (li == TREES) {
             local_2 = (v_12 > 0u);
         } else {
             local_2 = false;
         }
-        let _e240 = local_2;
-        if _e240 {
+        let _e241 = local_2;
+        if _e241 {
             loop {
-                let _e243 = first;
-                let _e245 = q_end[_e243];
-                if (_e245 == NONE) {
+                let _e244 = first;
+                let _e246 = q_end[_e244];
+                if (_e246 == NONE) {
                 } else {
                     break;
                 }
                 {
-                    let _e249 = first;
-                    first = (_e249 + 1u);
+                    let _e250 = first;
+                    first = (_e250 + 1u);
                 }
             }
             loop {
-                let _e253 = last;
-                let _e255 = q_end[_e253];
-                if (_e255 == NONE) {
+                let _e254 = last;
+                let _e256 = q_end[_e254];
+                if (_e256 == NONE) {
                 } else {
                     break;
                 }
                 {
-                    let _e259 = last;
-                    last = (_e259 - 1u);
+                    let _e260 = last;
+                    last = (_e260 - 1u);
                 }
             }
-            let _e262 = first;
-            let _e264 = q_d[_e262];
-            let _e266 = last;
-            let _e268 = q_d[_e266];
-            let up = (_e264 <= _e268);
+            let _e263 = first;
+            let _e265 = q_d[_e263];
+            let _e267 = last;
+            let _e269 = q_d[_e267];
+            let up = (_e265 <= _e269);
             loop {
-                let _e271 = k_2;
-                if (_e271 < SLICE_SAMPLES) {
+                let _e272 = k_2;
+                if (_e272 < SLICE_SAMPLES) {
                 } else {
                     break;
                 }
                 {
-                    let _e275 = k_2;
-                    let _e277 = q_end[_e275];
-                    if (_e277 != NONE) {
-                        let _e281 = k_2;
-                        let d_3 = q_d[_e281];
-                        let _e285 = m;
-                        j = _e285;
+                    let _e276 = k_2;
+                    let _e278 = q_end[_e276];
+                    if (_e278 != NONE) {
+                        let _e282 = k_2;
+                        let d_3 = q_d[_e282];
+                        let _e286 = m;
+                        j = _e286;
                         loop {
-                            let _e287 = j;
-                            if (_e287 > 0u) {
-                                let _e290 = j;
-                                let _e295 = q_d[(_e290 - 1u)];
-                                let _e297 = j;
-                                let _e302 = q_d[(_e297 - 1u)];
-                                local_3 = select((_e295 < d_3), (_e302 > d_3), up);
+                            let _e288 = j;
+                            if (_e288 > 0u) {
+                                let _e291 = j;
+                                let _e296 = q_d[(_e291 - 1u)];
+                                let _e298 = j;
+                                let _e303 = q_d[(_e298 - 1u)];
+                                local_3 = select((_e296 < d_3), (_e303 > d_3), up);
                             } else {
                                 local_3 = false;
                             }
-                            let _e308 = local_3;
-                            if _e308 {
+                            let _e309 = local_3;
+                            if _e309 {
                             } else {
                                 break;
                             }
                             {
-                                let _e310 = j;
-                                let _e312 = j;
-                                let _e317 = q_d[(_e312 - 1u)];
-                                q_d[_e310] = _e317;
-                                let _e319 = j;
-                                let _e321 = j;
-                                let _e326 = q_rank[(_e321 - 1u)];
-                                q_rank[_e319] = _e326;
-                                let _e328 = j;
-                                j = (_e328 - 1u);
+                                let _e311 = j;
+                                let _e313 = j;
+                                let _e318 = q_d[(_e313 - 1u)];
+                                q_d[_e311] = _e318;
+                                let _e320 = j;
+                                let _e322 = j;
+                                let _e327 = q_rank[(_e322 - 1u)];
+                                q_rank[_e320] = _e327;
+                                let _e329 = j;
+                                j = (_e329 - 1u);
                             }
                         }
-                        let _e331 = j;
-                        q_d[_e331] = d_3;
-                        let _e334 = j;
-                        let _e336 = k_2;
-                        q_rank[_e334] = _e336;
-                        let _e338 = m;
-                        m = (_e338 + 1u);
+                        let _e332 = j;
+                        q_d[_e332] = d_3;
+                        let _e335 = j;
+                        let _e337 = k_2;
+                        q_rank[_e335] = _e337;
+                        let _e339 = m;
+                        m = (_e339 + 1u);
                     }
                 }
                 continuing {
-                    let _e341 = k_2;
-                    k_2 = (_e341 + 1u);
+                    let _e342 = k_2;
+                    k_2 = (_e342 + 1u);
                 }
             }
             if !(up) {
                 loop {
-                    let _e345 = j_1;
-                    if (_e345 < (v_12 / 2u)) {
+                    let _e346 = j_1;
+                    if (_e346 < (v_12 / 2u)) {
                     } else {
                         break;
                     }
                     {
-                        let _e350 = j_1;
-                        let d_4 = q_d[_e350];
-                        let _e354 = j_1;
-                        let _e359 = j_1;
-                        let _e362 = q_d[((v_12 - 1u) - _e359)];
-                        q_d[_e354] = _e362;
-                        let _e366 = j_1;
-                        q_d[((v_12 - 1u) - _e366)] = d_4;
-                        let _e370 = j_1;
-                        let k_9 = q_rank[_e370];
-                        let _e374 = j_1;
-                        let _e379 = j_1;
-                        let _e382 = q_rank[((v_12 - 1u) - _e379)];
-                        q_rank[_e374] = _e382;
-                        let _e386 = j_1;
-                        q_rank[((v_12 - 1u) - _e386)] = k_9;
+                        let _e351 = j_1;
+                        let d_4 = q_d[_e351];
+                        let _e355 = j_1;
+                        let _e360 = j_1;
+                        let _e363 = q_d[((v_12 - 1u) - _e360)];
+                        q_d[_e355] = _e363;
+                        let _e367 = j_1;
+                        q_d[((v_12 - 1u) - _e367)] = d_4;
+                        let _e371 = j_1;
+                        let k_9 = q_rank[_e371];
+                        let _e375 = j_1;
+                        let _e380 = j_1;
+                        let _e383 = q_rank[((v_12 - 1u) - _e380)];
+                        q_rank[_e375] = _e383;
+                        let _e387 = j_1;
+                        q_rank[((v_12 - 1u) - _e387)] = k_9;
                     }
                     continuing {
-                        let _e390 = j_1;
-                        j_1 = (_e390 + 1u);
+                        let _e391 = j_1;
+                        j_1 = (_e391 + 1u);
                     }
                 }
             }
@@ -1215,186 +1224,186 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     workgroupBarrier();
     if (li < TREES) {
         loop {
-            let _e395 = c;
-            if (_e395 < li) {
+            let _e396 = c;
+            if (_e396 < li) {
             } else {
                 break;
             }
             {
-                let _e398 = start;
-                let _e400 = c;
-                let _e402 = bucket[_e400];
-                start = (_e398 + _e402);
+                let _e399 = start;
+                let _e401 = c;
+                let _e403 = bucket[_e401];
+                start = (_e399 + _e403);
             }
             continuing {
-                let _e405 = c;
-                c = (_e405 + 1u);
+                let _e406 = c;
+                c = (_e406 + 1u);
             }
         }
         loop {
-            let _e408 = k_3;
-            if (_e408 < SLICE_SAMPLES) {
+            let _e409 = k_3;
+            if (_e409 < SLICE_SAMPLES) {
             } else {
                 break;
             }
             {
-                let _e412 = k_3;
-                let _e414 = q_end[_e412];
-                if (_e414 != NONE) {
-                    let _e418 = k_3;
-                    let _e420 = q_end[_e418];
-                    local_4 = (min((_e420 / cw), 7u) == li);
+                let _e413 = k_3;
+                let _e415 = q_end[_e413];
+                if (_e415 != NONE) {
+                    let _e419 = k_3;
+                    let _e421 = q_end[_e419];
+                    local_4 = (min((_e421 / cw), 7u) == li);
                 } else {
                     local_4 = false;
                 }
-                let _e428 = local_4;
-                if _e428 {
-                    let _e430 = m_1;
-                    j_2 = _e430;
+                let _e429 = local_4;
+                if _e429 {
+                    let _e431 = m_1;
+                    j_2 = _e431;
                     loop {
-                        let _e432 = j_2;
-                        if (_e432 > 0u) {
-                            let _e435 = start;
-                            let _e436 = j_2;
-                            let _e443 = by_end[((_e435 + _e436) - 1u)];
-                            let _e445 = q_end[_e443];
-                            let _e447 = k_3;
-                            let _e449 = q_end[_e447];
-                            local_5 = (_e445 > _e449);
+                        let _e433 = j_2;
+                        if (_e433 > 0u) {
+                            let _e436 = start;
+                            let _e437 = j_2;
+                            let _e444 = by_end[((_e436 + _e437) - 1u)];
+                            let _e446 = q_end[_e444];
+                            let _e448 = k_3;
+                            let _e450 = q_end[_e448];
+                            local_5 = (_e446 > _e450);
                         } else {
                             local_5 = false;
                         }
-                        let _e454 = local_5;
-                        if _e454 {
+                        let _e455 = local_5;
+                        if _e455 {
                         } else {
                             break;
                         }
                         {
-                            let _e456 = start;
-                            let _e457 = j_2;
-                            let _e460 = start;
-                            let _e461 = j_2;
-                            let _e467 = by_end[((_e460 + _e461) - 1u)];
-                            by_end[(_e456 + _e457)] = _e467;
-                            let _e469 = j_2;
-                            j_2 = (_e469 - 1u);
+                            let _e457 = start;
+                            let _e458 = j_2;
+                            let _e461 = start;
+                            let _e462 = j_2;
+                            let _e468 = by_end[((_e461 + _e462) - 1u)];
+                            by_end[(_e457 + _e458)] = _e468;
+                            let _e470 = j_2;
+                            j_2 = (_e470 - 1u);
                         }
                     }
-                    let _e472 = start;
-                    let _e473 = j_2;
-                    let _e476 = k_3;
-                    by_end[(_e472 + _e473)] = _e476;
-                    let _e478 = m_1;
-                    m_1 = (_e478 + 1u);
+                    let _e473 = start;
+                    let _e474 = j_2;
+                    let _e477 = k_3;
+                    by_end[(_e473 + _e474)] = _e477;
+                    let _e479 = m_1;
+                    m_1 = (_e479 + 1u);
                 }
             }
             continuing {
-                let _e481 = k_3;
-                k_3 = (_e481 + 1u);
+                let _e482 = k_3;
+                k_3 = (_e482 + 1u);
             }
         }
     }
     j_3 = li;
     loop {
-        let _e484 = j_3;
-        if (_e484 < v_12) {
+        let _e485 = j_3;
+        if (_e485 < v_12) {
         } else {
             break;
         }
         {
-            let _e486 = j_3;
-            let _e492 = j_3;
-            let _e494 = q_rank[_e492];
-            mine[(_e486 / SLICE_LANES)] = _e494;
+            let _e487 = j_3;
+            let _e493 = j_3;
+            let _e495 = q_rank[_e493];
+            mine[(_e487 / SLICE_LANES)] = _e495;
         }
         continuing {
-            let _e495 = j_3;
-            j_3 = (_e495 + SLICE_LANES);
+            let _e496 = j_3;
+            j_3 = (_e496 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     j_4 = li;
     loop {
-        let _e499 = j_4;
-        if (_e499 < v_12) {
+        let _e500 = j_4;
+        if (_e500 < v_12) {
         } else {
             break;
         }
         {
-            let _e501 = j_4;
-            let _e506 = mine[(_e501 / SLICE_LANES)];
-            let _e508 = j_4;
-            q_rank[_e506] = _e508;
+            let _e502 = j_4;
+            let _e507 = mine[(_e502 / SLICE_LANES)];
+            let _e509 = j_4;
+            q_rank[_e507] = _e509;
         }
         continuing {
-            let _e509 = j_4;
-            j_4 = (_e509 + SLICE_LANES);
+            let _e510 = j_4;
+            j_4 = (_e510 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let base_1 = (s_7 * width);
     i = li;
     loop {
-        let _e514 = i;
-        if (_e514 < width) {
+        let _e515 = i;
+        if (_e515 < width) {
         } else {
             break;
         }
         {
-            let _e516 = i;
-            let _e520 = textureLoad(rectified, vec2<u32>(_e516, row_5), 0i);
-            let occluder = _e520.x;
+            let _e517 = i;
+            let _e521 = textureLoad(rectified, vec2<u32>(_e517, row_5), 0i);
+            let occluder = _e521.x;
             lo = 0u;
             hi = v_12;
             loop {
-                let _e525 = lo;
-                let _e526 = hi;
-                if (_e525 < _e526) {
+                let _e526 = lo;
+                let _e527 = hi;
+                if (_e526 < _e527) {
                 } else {
                     break;
                 }
                 {
-                    let _e528 = lo;
-                    let _e529 = hi;
-                    let mid_1 = ((_e528 + _e529) / 2u);
-                    let _e535 = q_d[mid_1];
-                    if (_e535 <= occluder) {
+                    let _e529 = lo;
+                    let _e530 = hi;
+                    let mid_1 = ((_e529 + _e530) / 2u);
+                    let _e536 = q_d[mid_1];
+                    if (_e536 <= occluder) {
                         lo = (mid_1 + 1u);
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            let _e540 = i;
-            let _e543 = lo;
-            pst_columns[(base_1 + _e540)] = _e543;
+            let _e541 = i;
             let _e544 = lo;
-            if (_e544 > 0u) {
+            pst_columns[(base_1 + _e541)] = _e544;
+            let _e545 = lo;
+            if (_e545 > 0u) {
                 h = 0u;
                 loop {
-                    let _e549 = h;
-                    if (_e549 < LEAF_VECS) {
+                    let _e550 = h;
+                    if (_e550 < LEAF_VECS) {
                     } else {
                         break;
                     }
                     {
-                        let _e552 = i;
-                        let _e557 = h;
-                        let _e560 = i;
-                        let _e561 = h;
-                        let _e562 = pst_leaf(f_23, _e560, row_5, delta_6, _e561);
-                        pst_leaves[(((base_1 + _e552) * LEAF_VECS) + _e557)] = _e562;
+                        let _e553 = i;
+                        let _e558 = h;
+                        let _e561 = i;
+                        let _e562 = h;
+                        let _e563 = pst_leaf(f_24, _e561, _e91, delta_6, _e562);
+                        pst_leaves[(((base_1 + _e553) * LEAF_VECS) + _e558)] = _e563;
                     }
                     continuing {
-                        let _e564 = h;
-                        h = (_e564 + 1u);
+                        let _e565 = h;
+                        h = (_e565 + 1u);
                     }
                 }
             }
         }
         continuing {
-            let _e566 = i;
-            i = (_e566 + SLICE_LANES);
+            let _e567 = i;
+            i = (_e567 + SLICE_LANES);
         }
     }
     storageBarrier();
@@ -1404,37 +1413,37 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     if (li < TREES) {
         let tree = (trees + ((li * SLICE_SAMPLES) * LEAF_VECS));
         loop {
-            let _e585 = j_5;
-            if (_e585 < (v_12 * LEAF_VECS)) {
+            let _e586 = j_5;
+            if (_e586 < (v_12 * LEAF_VECS)) {
             } else {
                 break;
             }
             {
-                let _e590 = j_5;
-                pst_tree[(tree + _e590)] = vec4<f32>(0f, 0f, 0f, 0f);
+                let _e591 = j_5;
+                pst_tree[(tree + _e591)] = vec4<f32>(0f, 0f, 0f, 0f);
             }
             continuing {
-                let _e599 = j_5;
-                j_5 = (_e599 + 1u);
+                let _e600 = j_5;
+                j_5 = (_e600 + 1u);
             }
         }
         let lo_5 = (li * cw);
         let hi_5 = select(min((lo_5 + cw), width), width, ((li + 1u) == TREES));
         top = v_12;
         loop {
-            let _e611 = next;
-            let _e612 = top;
-            if (_e611 < _e612) {
+            let _e612 = next;
+            let _e613 = top;
+            if (_e612 < _e613) {
             } else {
                 break;
             }
             {
-                let _e614 = next;
-                let _e615 = top;
-                let mid_2 = ((_e614 + _e615) / 2u);
-                let _e622 = by_end[mid_2];
-                let _e624 = q_end[_e622];
-                if (_e624 < lo_5) {
+                let _e615 = next;
+                let _e616 = top;
+                let mid_2 = ((_e615 + _e616) / 2u);
+                let _e623 = by_end[mid_2];
+                let _e625 = q_end[_e623];
+                if (_e625 < lo_5) {
                     next = (mid_2 + 1u);
                 } else {
                     top = mid_2;
@@ -1443,133 +1452,133 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         }
         i_1 = lo_5;
         loop {
-            let _e629 = i_1;
-            if (_e629 <= hi_5) {
+            let _e630 = i_1;
+            if (_e630 <= hi_5) {
             } else {
                 break;
             }
             {
                 loop {
-                    let _e631 = next;
-                    if (_e631 < v_12) {
-                        let _e635 = next;
-                        let _e637 = by_end[_e635];
-                        let _e639 = q_end[_e637];
-                        let _e640 = i_1;
-                        local_6 = (_e639 == _e640);
+                    let _e632 = next;
+                    if (_e632 < v_12) {
+                        let _e636 = next;
+                        let _e638 = by_end[_e636];
+                        let _e640 = q_end[_e638];
+                        let _e641 = i_1;
+                        local_6 = (_e640 == _e641);
                     } else {
                         local_6 = false;
                     }
-                    let _e645 = local_6;
-                    if _e645 {
-                        let _e646 = i_1;
-                        if !((_e646 < hi_5)) {
+                    let _e646 = local_6;
+                    if _e646 {
+                        let _e647 = i_1;
+                        if !((_e647 < hi_5)) {
                             local_8 = ((li + 1u) == TREES);
                         } else {
                             local_8 = true;
                         }
-                        let _e656 = local_8;
-                        local_7 = _e656;
+                        let _e657 = local_8;
+                        local_7 = _e657;
                     } else {
                         local_7 = false;
                     }
-                    let _e660 = local_7;
-                    if _e660 {
+                    let _e661 = local_7;
+                    if _e661 {
                     } else {
                         break;
                     }
                     {
-                        let _e662 = next;
-                        let k_10 = by_end[_e662];
-                        let _e666 = next;
-                        next = (_e666 + 1u);
+                        let _e663 = next;
+                        let k_10 = by_end[_e663];
+                        let _e667 = next;
+                        next = (_e667 + 1u);
                         h_1 = 0u;
                         loop {
-                            let _e670 = h_1;
-                            if (_e670 < LEAF_VECS) {
+                            let _e671 = h_1;
+                            if (_e671 < LEAF_VECS) {
                             } else {
                                 break;
                             }
                             {
                                 p = vec4<f32>(0f, 0f, 0f, 0f);
-                                let _e681 = q_rank[k_10];
-                                j_6 = (v_12 - _e681);
+                                let _e682 = q_rank[k_10];
+                                j_6 = (v_12 - _e682);
                                 loop {
-                                    let _e684 = j_6;
-                                    if (_e684 > 0u) {
+                                    let _e685 = j_6;
+                                    if (_e685 > 0u) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        let _e687 = p;
-                                        let _e688 = j_6;
-                                        let _e695 = h_1;
-                                        let _e698 = pst_tree[((tree + ((_e688 - 1u) * LEAF_VECS)) + _e695)];
-                                        p = (_e687 + _e698);
-                                        let _e700 = j_6;
+                                        let _e688 = p;
+                                        let _e689 = j_6;
+                                        let _e696 = h_1;
+                                        let _e699 = pst_tree[((tree + ((_e689 - 1u) * LEAF_VECS)) + _e696)];
+                                        p = (_e688 + _e699);
                                         let _e701 = j_6;
                                         let _e702 = j_6;
-                                        j_6 = (_e700 - (_e701 & (~(_e702) + 1u)));
+                                        let _e703 = j_6;
+                                        j_6 = (_e701 - (_e702 & (~(_e703) + 1u)));
                                     }
                                 }
-                                let _e712 = h_1;
-                                let _e715 = p;
-                                pst_tree[((partials + (k_10 * LEAF_VECS)) + _e712)] = _e715;
+                                let _e713 = h_1;
+                                let _e716 = p;
+                                pst_tree[((partials + (k_10 * LEAF_VECS)) + _e713)] = _e716;
                             }
                             continuing {
-                                let _e717 = h_1;
-                                h_1 = (_e717 + 1u);
+                                let _e718 = h_1;
+                                h_1 = (_e718 + 1u);
                             }
                         }
                     }
                 }
-                let _e719 = i_1;
-                if (_e719 == hi_5) {
+                let _e720 = i_1;
+                if (_e720 == hi_5) {
                     break;
                 }
-                let _e722 = i_1;
-                let b_8 = pst_columns[(base_1 + _e722)];
+                let _e723 = i_1;
+                let b_8 = pst_columns[(base_1 + _e723)];
                 if (b_8 > 0u) {
                     h_2 = 0u;
                     loop {
-                        let _e730 = h_2;
-                        if (_e730 < LEAF_VECS) {
+                        let _e731 = h_2;
+                        if (_e731 < LEAF_VECS) {
                         } else {
                             break;
                         }
                         {
-                            let _e733 = i_1;
-                            let _e738 = h_2;
-                            let leaf_1 = pst_leaves[(((base_1 + _e733) * LEAF_VECS) + _e738)];
+                            let _e734 = i_1;
+                            let _e739 = h_2;
+                            let leaf_1 = pst_leaves[(((base_1 + _e734) * LEAF_VECS) + _e739)];
                             j_7 = ((v_12 - b_8) + 1u);
                             loop {
-                                let _e746 = j_7;
-                                if (_e746 <= v_12) {
+                                let _e747 = j_7;
+                                if (_e747 <= v_12) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    let _e748 = j_7;
-                                    let _e755 = h_2;
-                                    let _e758 = pst_tree[((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755)];
-                                    pst_tree[((tree + ((_e748 - 1u) * LEAF_VECS)) + _e755)] = (_e758 + leaf_1);
-                                    let _e760 = j_7;
+                                    let _e749 = j_7;
+                                    let _e756 = h_2;
+                                    let _e759 = pst_tree[((tree + ((_e749 - 1u) * LEAF_VECS)) + _e756)];
+                                    pst_tree[((tree + ((_e749 - 1u) * LEAF_VECS)) + _e756)] = (_e759 + leaf_1);
                                     let _e761 = j_7;
                                     let _e762 = j_7;
-                                    j_7 = (_e760 + (_e761 & (~(_e762) + 1u)));
+                                    let _e763 = j_7;
+                                    j_7 = (_e761 + (_e762 & (~(_e763) + 1u)));
                                 }
                             }
                         }
                         continuing {
-                            let _e769 = h_2;
-                            h_2 = (_e769 + 1u);
+                            let _e770 = h_2;
+                            h_2 = (_e770 + 1u);
                         }
                     }
                 }
             }
             continuing {
-                let _e772 = i_1;
-                i_1 = (_e772 + 1u);
+                let _e773 = i_1;
+                i_1 = (_e773 + 1u);
             }
         }
     }
@@ -1577,8 +1586,8 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     workgroupBarrier();
     x = li;
     loop {
-        let _e775 = x;
-        if (_e775 < (v_12 * LEAF_VECS)) {
+        let _e776 = x;
+        if (_e776 < (v_12 * LEAF_VECS)) {
         } else {
             break;
         }
@@ -1586,112 +1595,112 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
             running = vec4<f32>(0f, 0f, 0f, 0f);
             c_1 = 0u;
             loop {
-                let _e787 = c_1;
-                if (_e787 < TREES) {
+                let _e788 = c_1;
+                if (_e788 < TREES) {
                 } else {
                     break;
                 }
                 {
-                    let _e790 = c_1;
-                    let _e796 = x;
-                    let at = ((trees + ((_e790 * SLICE_SAMPLES) * LEAF_VECS)) + _e796);
+                    let _e791 = c_1;
+                    let _e797 = x;
+                    let at = ((trees + ((_e791 * SLICE_SAMPLES) * LEAF_VECS)) + _e797);
                     let own = pst_tree[at];
-                    let _e803 = running;
-                    pst_tree[at] = _e803;
                     let _e804 = running;
-                    running = (_e804 + own);
+                    pst_tree[at] = _e804;
+                    let _e805 = running;
+                    running = (_e805 + own);
                 }
                 continuing {
-                    let _e807 = c_1;
-                    c_1 = (_e807 + 1u);
+                    let _e808 = c_1;
+                    c_1 = (_e808 + 1u);
                 }
             }
         }
         continuing {
-            let _e809 = x;
-            x = (_e809 + SLICE_LANES);
+            let _e810 = x;
+            x = (_e810 + SLICE_LANES);
         }
     }
     storageBarrier();
     workgroupBarrier();
     k_4 = li;
     loop {
-        let _e813 = k_4;
-        if (_e813 < SLICE_SAMPLES) {
+        let _e814 = k_4;
+        if (_e814 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e817 = k_4;
-            let _e819 = q_end[_e817];
-            if (_e819 != NONE) {
-                let _e823 = k_4;
-                let _e825 = q_end[_e823];
-                let tree_1 = (trees + ((min((_e825 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
+            let _e818 = k_4;
+            let _e820 = q_end[_e818];
+            if (_e820 != NONE) {
+                let _e824 = k_4;
+                let _e826 = q_end[_e824];
+                let tree_1 = (trees + ((min((_e826 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0f;
                 h_3 = 0u;
                 loop {
-                    let _e838 = h_3;
-                    if (_e838 < LEAF_VECS) {
+                    let _e839 = h_3;
+                    if (_e839 < LEAF_VECS) {
                     } else {
                         break;
                     }
                     {
-                        let _e841 = k_4;
-                        let _e846 = h_3;
-                        let _e849 = pst_tree[((partials + (_e841 * LEAF_VECS)) + _e846)];
-                        p_1 = _e849;
-                        let _e852 = k_4;
-                        let _e854 = q_rank[_e852];
-                        j_8 = (v_12 - _e854);
+                        let _e842 = k_4;
+                        let _e847 = h_3;
+                        let _e850 = pst_tree[((partials + (_e842 * LEAF_VECS)) + _e847)];
+                        p_1 = _e850;
+                        let _e853 = k_4;
+                        let _e855 = q_rank[_e853];
+                        j_8 = (v_12 - _e855);
                         loop {
-                            let _e857 = j_8;
-                            if (_e857 > 0u) {
+                            let _e858 = j_8;
+                            if (_e858 > 0u) {
                             } else {
                                 break;
                             }
                             {
-                                let _e860 = p_1;
-                                let _e861 = j_8;
-                                let _e868 = h_3;
-                                let _e871 = pst_tree[((tree_1 + ((_e861 - 1u) * LEAF_VECS)) + _e868)];
-                                p_1 = (_e860 + _e871);
-                                let _e873 = j_8;
+                                let _e861 = p_1;
+                                let _e862 = j_8;
+                                let _e869 = h_3;
+                                let _e872 = pst_tree[((tree_1 + ((_e862 - 1u) * LEAF_VECS)) + _e869)];
+                                p_1 = (_e861 + _e872);
                                 let _e874 = j_8;
                                 let _e875 = j_8;
-                                j_8 = (_e873 - (_e874 & (~(_e875) + 1u)));
+                                let _e876 = j_8;
+                                j_8 = (_e874 - (_e875 & (~(_e876) + 1u)));
                             }
                         }
-                        let _e881 = dotp;
-                        let _e882 = p_1;
-                        let _e884 = k_4;
-                        let _e886 = q_theta[_e884];
-                        let _e887 = h_3;
-                        let _e888 = beta_at(_e886, _e887);
-                        dotp = (_e881 + dot(_e882, _e888));
+                        let _e882 = dotp;
+                        let _e883 = p_1;
+                        let _e885 = k_4;
+                        let _e887 = q_theta[_e885];
+                        let _e888 = h_3;
+                        let _e889 = beta_at(_e887, _e888);
+                        dotp = (_e882 + dot(_e883, _e889));
                     }
                     continuing {
-                        let _e892 = h_3;
-                        h_3 = (_e892 + 1u);
+                        let _e893 = h_3;
+                        h_3 = (_e893 + 1u);
                     }
                 }
-                let _e897 = k_4;
-                let _e899 = q_a[_e897];
-                let _e900 = dotp;
-                let _e905 = k_4;
-                let _e907 = q_b[_e905];
-                let _e910 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_23.light_color.xyz * (max((_e899 * _e900), 0f) + _e907)));
-                let _e911 = k_4;
-                let _e912 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e911, screen_4);
-                let _e915 = textureLoad(depth, _e912, 0i);
-                let z_8 = _e915.x;
-                let _e917 = k_4;
-                textureStore(output, vec2<u32>(_e917, s_7), vec4<f32>(_e910.x, _e910.y, _e910.z, z_8));
+                let _e898 = k_4;
+                let _e900 = q_a[_e898];
+                let _e901 = dotp;
+                let _e906 = k_4;
+                let _e908 = q_b[_e906];
+                let _e911 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_24.light_color.xyz * (max((_e900 * _e901), 0f) + _e908)));
+                let _e912 = k_4;
+                let _e913 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e912, screen_4);
+                let _e916 = textureLoad(depth, _e913, 0i);
+                let z_8 = _e916.x;
+                let _e918 = k_4;
+                textureStore(output, vec2<u32>(_e918, s_7), vec4<f32>(_e911.x, _e911.y, _e911.z, z_8));
             }
         }
         continuing {
-            let _e924 = k_4;
-            k_4 = (_e924 + SLICE_LANES);
+            let _e925 = k_4;
+            k_4 = (_e925 + SLICE_LANES);
         }
     }
     return;

@@ -513,69 +513,76 @@ vec4 beta_at(float theta_4, uint h_2) {
     return _e14;
 }
 
-vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint i, uint row_3, float delta_2, uint h_3) {
+vec3 pst_row_e(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint row_3) {
+    if (false) {
+        return vec3(0.0, 0.0, 0.0);
+    }
+    float _e7 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    vec3 _e8 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e7);
+    return _e8;
+}
+
+vec4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20, uint i, vec3 e_2, float delta_2, uint h_3) {
     vec4 leaf = vec4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
     if (false) {
         vec4 _e9 = gamma_at((float(i) * delta_2), h_3);
         return _e9;
     }
-    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
-    vec3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
-    vec3 axis_1 = f_19.axis.xyz;
+    vec3 axis_1 = f_20.axis.xyz;
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e56 = g_1;
-            g_1 = (_e56 + 1u);
+            uint _e54 = g_1;
+            g_1 = (_e54 + 1u);
         }
         loop_init_3 = false;
-        uint _e17 = g_1;
-        if ((_e17 < 2u)) {
+        uint _e14 = g_1;
+        if ((_e14 < 2u)) {
         } else {
             break;
         }
         {
-            uint _e20 = g_1;
-            float q_3 = ((_e20 == 0u) ? -0.57735026 : GL2_);
+            uint _e17 = g_1;
+            float q_3 = ((_e17 == 0u) ? -0.57735026 : GL2_);
             float psi_1 = (((float(i) + 0.5) + (0.5 * q_3)) * delta_2);
-            vec3 l_1 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
-            vec4 _e48 = leaf;
-            vec4 _e52 = gamma_at(psi_1, h_3);
-            leaf = (_e48 + (((0.5 * delta_2) * _e46) * _e52));
+            vec3 l_1 = ((-(axis_1) * cos(psi_1)) + (e_2 * sin(psi_1)));
+            float _e44 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_20.light_dir.xyz), f_20.light_pos.w, f_20.light_dir.w);
+            vec4 _e46 = leaf;
+            vec4 _e50 = gamma_at(psi_1, h_3);
+            leaf = (_e46 + (((0.5 * delta_2) * _e44) * _e50));
         }
     }
-    vec4 _e58 = leaf;
-    return _e58;
+    vec4 _e56 = leaf;
+    return _e56;
 }
 
 PstRay pst_ray(vec2 pc_1, float z_1) {
     PstRay r = PstRay(false, vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0u, 0.0, 0.0, 0.0);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20 = _group_0_binding_0_cs;
-    vec3 eye_9 = f_20.eye.xyz;
-    vec2 ndc_2 = vec2((((2.0 * pc_1.x) / float(f_20.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_20.sizes.y))));
-    float t_7 = f_20.cam_forward.w;
-    vec3 dir_12 = normalize(((f_20.cam_forward.xyz + (f_20.cam_right.xyz * ((ndc_2.x * t_7) * f_20.cam_right.w))) + (f_20.cam_up.xyz * (ndc_2.y * t_7))));
-    float s_4 = (min(max(z_1, 0.0), f_20.theta.z) / max(dot(dir_12, f_20.cam_forward.xyz), 1e-6));
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = _group_0_binding_0_cs;
+    vec3 eye_9 = f_21.eye.xyz;
+    vec2 ndc_2 = vec2((((2.0 * pc_1.x) / float(f_21.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_21.sizes.y))));
+    float t_7 = f_21.cam_forward.w;
+    vec3 dir_12 = normalize(((f_21.cam_forward.xyz + (f_21.cam_right.xyz * ((ndc_2.x * t_7) * f_21.cam_right.w))) + (f_21.cam_up.xyz * (ndc_2.y * t_7))));
+    float s_4 = (min(max(z_1, 0.0), f_21.theta.z) / max(dot(dir_12, f_21.cam_forward.xyz), 1e-6));
     r = PstRay(false, vec3(0.0, 0.0, 0.0), eye_9, dir_12, s_4, 0u, 0.0, 0.0, 0.0);
-    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, pc_1);
+    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, pc_1);
     if (_e67) {
         r.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e72 = _group_0_binding_0_cs;
         float _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, _group_0_binding_3_cs, eye_9, dir_12, s_4, true);
-        r.color = (_e75 * f_20.light_color.xyz);
+        r.color = (_e75 * f_21.light_color.xyz);
     }
-    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
+    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
     r.theta = _e80;
-    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
-    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_20.sizes.w, (f_20.anti_epipole.w > 0.5));
+    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
+    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_21.sizes.w, (f_21.anti_epipole.w > 0.5));
     r.row = _e90;
     float _e93 = r.theta;
-    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_20.theta.x, f_20.theta.y);
+    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_21.theta.x, f_21.theta.y);
     r.d = _e98;
     float _e101 = r.theta;
-    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, eye_9, dir_12, s_4, _e101, true);
+    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, eye_9, dir_12, s_4, _e101, true);
     r.xs_num = _e102;
     PstRay _e103 = r;
     return _e103;
@@ -589,22 +596,22 @@ uint pst_columns_crossed(PstRay r_1, float delta_3) {
 
 vec2 pst_terms(PstRay r_2, uint row_4, float delta_4, uint n_2) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = _group_0_binding_0_cs;
     float sin_theta = max(sin(r_2.theta), 1e-6);
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 _e16 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((n_2 - 1u), row_4)), ivec2(0), textureSize(_group_0_binding_4_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
     if ((r_2.d <= _e16.x)) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return vec2((f_21.medium.y / (f_21.axis.w * sin_theta)), _e37);
+        return vec2((f_22.medium.y / (f_22.axis.w * sin_theta)), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.z, -(dot(f_21.light_dir.xyz, r_2.dir)));
-    float sp = (f_21.medium.y * _e48);
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.x, 0.0, (delta_4 / sin_theta));
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.z, -(dot(f_22.light_dir.xyz, r_2.dir)));
+    float sp = (f_22.medium.y * _e48);
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.x, 0.0, (delta_4 / sin_theta));
     float _e56 = tail;
     return vec2((sp * _e54), (sp * _e56));
 }
@@ -614,7 +621,7 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
     uint h_4 = 0u;
     vec4 p_4 = vec4(0.0);
     uint i_1 = 0u;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_23 = _group_0_binding_0_cs;
     int _e16_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e16 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(x_4, y)), ivec2(0), textureSize(_group_0_binding_2_cs, _e16_clamped_lod) - ivec2(1)), _e16_clamped_lod);
     PstRay _e18 = pst_ray(vec2((float(x_4) + 0.5), (float(y) + 0.5)), _e16.x);
@@ -624,19 +631,20 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
     vec4 _e24 = _group_0_binding_1_cs[_e18.row];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e25 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24);
     float delta_5 = _e25.delta;
-    uint _e27 = pst_columns_crossed(_e18, delta_5);
-    if ((_e27 == 0u)) {
+    vec3 _e28 = pst_row_e(f_23, _e18.row);
+    uint _e29 = pst_columns_crossed(_e18, delta_5);
+    if ((_e29 == 0u)) {
         return vec3(0.0, 0.0, 0.0);
     }
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e77 = h_4;
-            h_4 = (_e77 + 1u);
+            uint _e78 = h_4;
+            h_4 = (_e78 + 1u);
         }
         loop_init_4 = false;
-        uint _e35 = h_4;
-        if ((_e35 < RANK_VECS)) {
+        uint _e37 = h_4;
+        if ((_e37 < RANK_VECS)) {
         } else {
             break;
         }
@@ -646,38 +654,38 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
             bool loop_init_5 = true;
             while(true) {
                 if (!loop_init_5) {
-                    uint _e66 = i_1;
-                    i_1 = (_e66 + 1u);
+                    uint _e67 = i_1;
+                    i_1 = (_e67 + 1u);
                 }
                 loop_init_5 = false;
-                uint _e46 = i_1;
-                if (((_e46 + 1u) < _e27)) {
+                uint _e48 = i_1;
+                if (((_e48 + 1u) < _e29)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e51 = i_1;
-                    int _e56_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-                    vec4 _e56 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e51, _e18.row)), ivec2(0), textureSize(_group_0_binding_4_cs, _e56_clamped_lod) - ivec2(1)), _e56_clamped_lod);
-                    if ((_e18.d <= _e56.x)) {
-                        vec4 _e59 = p_4;
-                        uint _e60 = i_1;
-                        uint _e62 = h_4;
-                        vec4 _e63 = pst_leaf(f_22, _e60, _e18.row, delta_5, _e62);
-                        p_4 = (_e59 + _e63);
+                    uint _e53 = i_1;
+                    int _e58_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+                    vec4 _e58 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e53, _e18.row)), ivec2(0), textureSize(_group_0_binding_4_cs, _e58_clamped_lod) - ivec2(1)), _e58_clamped_lod);
+                    if ((_e18.d <= _e58.x)) {
+                        vec4 _e61 = p_4;
+                        uint _e62 = i_1;
+                        uint _e63 = h_4;
+                        vec4 _e64 = pst_leaf(f_23, _e62, _e28, delta_5, _e63);
+                        p_4 = (_e61 + _e64);
                     }
                 }
             }
-            float _e69 = sum_2;
-            vec4 _e70 = p_4;
-            uint _e72 = h_4;
-            vec4 _e73 = beta_at(_e18.theta, _e72);
-            sum_2 = (_e69 + dot(_e70, _e73));
+            float _e70 = sum_2;
+            vec4 _e71 = p_4;
+            uint _e73 = h_4;
+            vec4 _e74 = beta_at(_e18.theta, _e73);
+            sum_2 = (_e70 + dot(_e71, _e74));
         }
     }
-    vec2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
-    float _e84 = sum_2;
-    return (f_22.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
+    vec2 _e81 = pst_terms(_e18, _e18.row, delta_5, _e29);
+    float _e85 = sum_2;
+    return (f_23.light_color.xyz * (max((_e81.x * _e85), 0.0) + _e81.y));
 }
 
 void main() {

@@ -612,7 +612,17 @@ float4 beta_at(float theta_4, uint h_2)
     return _e14;
 }
 
-float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint i, uint row_3, float delta_2, uint h_3)
+float3 pst_row_e(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint row_3)
+{
+    if (false) {
+        return float3(0.0, 0.0, 0.0);
+    }
+    const float _e7 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    const float3 _e8 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e7);
+    return _e8;
+}
+
+float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20, uint i, float3 e_2, float delta_2, uint h_3)
 {
     float4 leaf = float4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
@@ -621,37 +631,35 @@ float4 pst_leaf(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint i,
         const float4 _e9 = gamma_at((float(i) * delta_2), h_3);
         return _e9;
     }
-    const float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
-    const float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
-    float3 axis_1 = f_19.axis.xyz;
+    float3 axis_1 = f_20.axis.xyz;
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e56 = g_1;
-            g_1 = (_e56 + 1u);
+            uint _e54 = g_1;
+            g_1 = (_e54 + 1u);
         }
         loop_init_3 = false;
-        uint _e17 = g_1;
-        if ((_e17 < 2u)) {
+        uint _e14 = g_1;
+        if ((_e14 < 2u)) {
         } else {
             break;
         }
         {
-            uint _e20 = g_1;
-            float q_3 = ((_e20 == 0u) ? -0.57735026 : GL2_);
+            uint _e17 = g_1;
+            float q_3 = ((_e17 == 0u) ? -0.57735026 : GL2_);
             float psi_1 = (((float(i) + 0.5) + (0.5 * q_3)) * delta_2);
-            float3 l_1 = ((-(axis_1) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            const float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
-            float4 _e48 = leaf;
-            const float4 _e52 = gamma_at(psi_1, h_3);
-            leaf = (_e48 + (((0.5 * delta_2) * _e46) * _e52));
+            float3 l_1 = ((-(axis_1) * cos(psi_1)) + (e_2 * sin(psi_1)));
+            const float _e44 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_20.light_dir.xyz), f_20.light_pos.w, f_20.light_dir.w);
+            float4 _e46 = leaf;
+            const float4 _e50 = gamma_at(psi_1, h_3);
+            leaf = (_e46 + (((0.5 * delta_2) * _e44) * _e50));
         }
     }
-    float4 _e58 = leaf;
-    return _e58;
+    float4 _e56 = leaf;
+    return _e56;
 }
 
 PstRay ConstructPstRay(bool arg0, float3 arg1, float3 arg2, float3 arg3, float arg4, uint arg5, float arg6, float arg7, float arg8) {
@@ -672,30 +680,30 @@ PstRay pst_ray(float2 pc_1, float z_1)
 {
     PstRay r = (PstRay)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20 = frame;
-    float3 eye_9 = f_20.eye.xyz;
-    float2 ndc_2 = float2((((2.0 * pc_1.x) / float(f_20.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_20.sizes.y))));
-    float t_7 = f_20.cam_forward.w;
-    float3 dir_12 = normalize(((f_20.cam_forward.xyz + (f_20.cam_right.xyz * ((ndc_2.x * t_7) * f_20.cam_right.w))) + (f_20.cam_up.xyz * (ndc_2.y * t_7))));
-    float s_4 = (min(max(z_1, 0.0), f_20.theta.z) / max(dot(dir_12, f_20.cam_forward.xyz), 1e-6));
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = frame;
+    float3 eye_9 = f_21.eye.xyz;
+    float2 ndc_2 = float2((((2.0 * pc_1.x) / float(f_21.sizes.x)) - 1.0), (1.0 - ((2.0 * pc_1.y) / float(f_21.sizes.y))));
+    float t_7 = f_21.cam_forward.w;
+    float3 dir_12 = normalize(((f_21.cam_forward.xyz + (f_21.cam_right.xyz * ((ndc_2.x * t_7) * f_21.cam_right.w))) + (f_21.cam_up.xyz * (ndc_2.y * t_7))));
+    float s_4 = (min(max(z_1, 0.0), f_21.theta.z) / max(dot(dir_12, f_21.cam_forward.xyz), 1e-6));
     r = ConstructPstRay(false, float3(0.0, 0.0, 0.0), eye_9, dir_12, s_4, 0u, 0.0, 0.0, 0.0);
-    const bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, pc_1);
+    const bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, pc_1);
     if (_e67) {
         r.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e72 = frame;
         const float _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_4, true);
-        r.color = (_e75 * f_20.light_color.xyz);
+        r.color = (_e75 * f_21.light_color.xyz);
     }
-    const float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
+    const float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
     r.theta = _e80;
-    const float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, dir_12);
-    const uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_20.sizes.w, (f_20.anti_epipole.w > 0.5));
+    const float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
+    const uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_21.sizes.w, (f_21.anti_epipole.w > 0.5));
     r.row = _e90;
     float _e93 = r.theta;
-    const float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_20.theta.x, f_20.theta.y);
+    const float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_21.theta.x, f_21.theta.y);
     r.d = _e98;
     float _e101 = r.theta;
-    const float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_20, eye_9, dir_12, s_4, _e101, true);
+    const float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, eye_9, dir_12, s_4, _e101, true);
     r.xs_num = _e102;
     PstRay _e103 = r;
     const PstRay pstray = _e103;
@@ -713,21 +721,21 @@ float2 pst_terms(PstRay r_2, uint row_4, float delta_4, uint n_2)
 {
     float tail = 0.0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = frame;
     float sin_theta = max(sin(r_2.theta), 1e-6);
     float4 _e16 = rectified.Load(int3(uint2((n_2 - 1u), row_4), int(0)));
     if ((r_2.d <= _e16.x)) {
-        const float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        const float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        const float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        const float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return float2((f_21.medium.y / (f_21.axis.w * sin_theta)), _e37);
+        return float2((f_22.medium.y / (f_22.axis.w * sin_theta)), _e37);
     }
-    const float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.z, -(dot(f_21.light_dir.xyz, r_2.dir)));
-    float sp = (f_21.medium.y * _e48);
-    const float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_21.medium.x, 0.0, (delta_4 / sin_theta));
+    const float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.z, -(dot(f_22.light_dir.xyz, r_2.dir)));
+    float sp = (f_22.medium.y * _e48);
+    const float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.x, 0.0, (delta_4 / sin_theta));
     float _e56 = tail;
     return float2((sp * _e54), (sp * _e56));
 }
@@ -739,7 +747,7 @@ float3 pst_sweep_pixel(uint x_4, uint y)
     float4 p_4 = (float4)0;
     uint i_1 = (uint)0;
 
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_23 = frame;
     float4 _e16 = depth.Load(int3(uint2(x_4, y), int(0)));
     const PstRay _e18 = pst_ray(float2((float(x_4) + 0.5), (float(y) + 0.5)), _e16.x);
     if (_e18.marched) {
@@ -748,8 +756,9 @@ float3 pst_sweep_pixel(uint x_4, uint y)
     float4 _e24 = asfloat(slices.Load4(_e18.row*16));
     const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e25 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24);
     float delta_5 = _e25.delta;
-    const uint _e27 = pst_columns_crossed(_e18, delta_5);
-    if ((_e27 == 0u)) {
+    const float3 _e28 = pst_row_e(f_23, _e18.row);
+    const uint _e29 = pst_columns_crossed(_e18, delta_5);
+    if ((_e29 == 0u)) {
         return float3(0.0, 0.0, 0.0);
     }
     uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
@@ -758,12 +767,12 @@ float3 pst_sweep_pixel(uint x_4, uint y)
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e77 = h_4;
-            h_4 = (_e77 + 1u);
+            uint _e78 = h_4;
+            h_4 = (_e78 + 1u);
         }
         loop_init_4 = false;
-        uint _e35 = h_4;
-        if ((_e35 < RANK_VECS)) {
+        uint _e37 = h_4;
+        if ((_e37 < RANK_VECS)) {
         } else {
             break;
         }
@@ -776,37 +785,37 @@ float3 pst_sweep_pixel(uint x_4, uint y)
                 if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
                 loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                 if (!loop_init_5) {
-                    uint _e66 = i_1;
-                    i_1 = (_e66 + 1u);
+                    uint _e67 = i_1;
+                    i_1 = (_e67 + 1u);
                 }
                 loop_init_5 = false;
-                uint _e46 = i_1;
-                if (((_e46 + 1u) < _e27)) {
+                uint _e48 = i_1;
+                if (((_e48 + 1u) < _e29)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e51 = i_1;
-                    float4 _e56 = rectified.Load(int3(uint2(_e51, _e18.row), int(0)));
-                    if ((_e18.d <= _e56.x)) {
-                        float4 _e59 = p_4;
-                        uint _e60 = i_1;
-                        uint _e62 = h_4;
-                        const float4 _e63 = pst_leaf(f_22, _e60, _e18.row, delta_5, _e62);
-                        p_4 = (_e59 + _e63);
+                    uint _e53 = i_1;
+                    float4 _e58 = rectified.Load(int3(uint2(_e53, _e18.row), int(0)));
+                    if ((_e18.d <= _e58.x)) {
+                        float4 _e61 = p_4;
+                        uint _e62 = i_1;
+                        uint _e63 = h_4;
+                        const float4 _e64 = pst_leaf(f_23, _e62, _e28, delta_5, _e63);
+                        p_4 = (_e61 + _e64);
                     }
                 }
             }
-            float _e69 = sum_2;
-            float4 _e70 = p_4;
-            uint _e72 = h_4;
-            const float4 _e73 = beta_at(_e18.theta, _e72);
-            sum_2 = (_e69 + dot(_e70, _e73));
+            float _e70 = sum_2;
+            float4 _e71 = p_4;
+            uint _e73 = h_4;
+            const float4 _e74 = beta_at(_e18.theta, _e73);
+            sum_2 = (_e70 + dot(_e71, _e74));
         }
     }
-    const float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
-    float _e84 = sum_2;
-    return (f_22.light_color.xyz * (max((_e80.x * _e84), 0.0) + _e80.y));
+    const float2 _e81 = pst_terms(_e18, _e18.row, delta_5, _e29);
+    float _e85 = sum_2;
+    return (f_23.light_color.xyz * (max((_e81.x * _e85), 0.0) + _e81.y));
 }
 
 uint2 naga_div(uint2 lhs, uint2 rhs) {

@@ -600,13 +600,13 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_3 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
     vec2 d_4 = ((vec2(p_4) + vec2(0.5, 0.5)) - l_1.origin);
     float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
-    float f_20 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
+    float f_21 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
     if ((l_1.wrap != 0u)) {
-        float fl = floor(f_20);
-        fs = (f_20 - fl);
+        float fl = floor(f_21);
+        fs = (f_21 - fl);
         s_lo = (uint((int(fl) + int(slices))) % slices);
     } else {
-        float fc = clamp(f_20, 0.0, float((slices - 1u)));
+        float fc = clamp(f_21, 0.0, float((slices - 1u)));
         s_lo = min(uint(fc), (slices - 2u));
         uint _e41 = s_lo;
         fs = (fc - float(_e41));
@@ -672,6 +672,15 @@ void unwarp_pixel(uvec2 q_1, vec4 w_2, vec4 depths_2, vec3 light_2[4]) {
         imageStore(_group_0_binding_9_cs, ivec2(q_1), _e10);
         return;
     }
+}
+
+vec3 pst_row_e(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint row_3) {
+    if (false) {
+        return vec3(0.0, 0.0, 0.0);
+    }
+    float _e7 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    vec3 _e8 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e7);
+    return _e8;
 }
 
 uint pst_columns_crossed(PstRay r_1, float delta_3) {

@@ -716,13 +716,13 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
 
     float2 d_4 = ((float2(p_4) + float2(0.5, 0.5)) - l_1.origin);
     const float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
-    float f_20 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
+    float f_21 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
     if ((l_1.wrap != 0u)) {
-        float fl = floor(f_20);
-        fs = (f_20 - fl);
+        float fl = floor(f_21);
+        fs = (f_21 - fl);
         s_lo = naga_mod(uint(asint(asuint(naga_f2i32(fl)) + asuint(int(slices)))), slices);
     } else {
-        float fc = clamp(f_20, 0.0, float((slices - 1u)));
+        float fc = clamp(f_21, 0.0, float((slices - 1u)));
         s_lo = min(naga_f2u32(fc), (slices - 2u));
         uint _e41 = s_lo;
         fs = (fc - float(_e41));
@@ -795,6 +795,16 @@ void unwarp_pixel(uint2 q_1, float4 w_2, float4 depths_2, float3 light_2[4])
         output[q_1] = _e10;
         return;
     }
+}
+
+float3 pst_row_e(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19, uint row_3)
+{
+    if (false) {
+        return float3(0.0, 0.0, 0.0);
+    }
+    const float _e7 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    const float3 _e8 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e7);
+    return _e8;
 }
 
 uint pst_columns_crossed(PstRay r_1, float delta_3)

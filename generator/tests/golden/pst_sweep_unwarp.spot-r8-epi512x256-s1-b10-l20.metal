@@ -831,13 +831,13 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_
     EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_3 = {};
     metal::float2 d_4 = (static_cast<metal::float2>(p_4) + metal::float2(0.5, 0.5)) - l_1.origin;
     float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
-    float f_20 = ((_e12 - l_1.phi_start) / l_1.dphi) - 0.5;
+    float f_21 = ((_e12 - l_1.phi_start) / l_1.dphi) - 0.5;
     if (l_1.wrap != 0u) {
-        float fl = metal::floor(f_20);
-        fs = f_20 - fl;
+        float fl = metal::floor(f_21);
+        fs = f_21 - fl;
         s_lo = naga_mod(static_cast<uint>(as_type<int>(as_type<uint>(naga_f2i32(fl)) + as_type<uint>(static_cast<int>(slices)))), slices);
     } else {
-        float fc = metal::clamp(f_20, 0.0, static_cast<float>(slices - 1u));
+        float fc = metal::clamp(f_21, 0.0, static_cast<float>(slices - 1u));
         s_lo = metal::min(naga_f2u32(fc), slices - 2u);
         uint _e41 = s_lo;
         fs = fc - static_cast<float>(_e41);
@@ -962,10 +962,22 @@ metal::float4 beta_at(
     return _e14;
 }
 
-metal::float4 pst_leaf(
+metal::float3 pst_row_e(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_19,
+    uint row_3
+) {
+    if (false) {
+        return metal::float3(0.0, 0.0, 0.0);
+    }
+    float _e7 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    metal::float3 _e8 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e7);
+    return _e8;
+}
+
+metal::float4 pst_leaf(
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20,
     uint i,
-    uint row_3,
+    metal::float3 e_1,
     float delta_2,
     uint h_3,
     device type_10 const& pst_factors,
@@ -977,37 +989,35 @@ metal::float4 pst_leaf(
         metal::float4 _e9 = gamma_at(static_cast<float>(i) * delta_2, h_3, pst_factors, _buffer_sizes);
         return _e9;
     }
-    float _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
-    metal::float3 _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
-    metal::float3 axis_2 = f_19.axis.xyz;
+    metal::float3 axis_2 = f_20.axis.xyz;
     uint2 loop_bound_5 = uint2(4294967295u);
     bool loop_init_5 = true;
     while(true) {
         if (metal::all(loop_bound_5 == uint2(0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e56 = g_1;
-            g_1 = _e56 + 1u;
+            uint _e54 = g_1;
+            g_1 = _e54 + 1u;
         }
         loop_init_5 = false;
-        uint _e17 = g_1;
-        if (_e17 < 2u) {
+        uint _e14 = g_1;
+        if (_e14 < 2u) {
         } else {
             break;
         }
         {
-            uint _e20 = g_1;
-            float q_4 = (_e20 == 0u) ? -0.57735026 : GL2_;
+            uint _e17 = g_1;
+            float q_4 = (_e17 == 0u) ? -0.57735026 : GL2_;
             float psi_1 = ((static_cast<float>(i) + 0.5) + (0.5 * q_4)) * delta_2;
-            metal::float3 l_3 = (-(axis_2) * metal::cos(psi_1)) + (_e13 * metal::sin(psi_1));
-            float _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_3, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
-            metal::float4 _e48 = leaf;
-            metal::float4 _e52 = gamma_at(psi_1, h_3, pst_factors, _buffer_sizes);
-            leaf = _e48 + (((0.5 * delta_2) * _e46) * _e52);
+            metal::float3 l_3 = (-(axis_2) * metal::cos(psi_1)) + (e_1 * metal::sin(psi_1));
+            float _e44 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_3, f_20.light_dir.xyz), f_20.light_pos.w, f_20.light_dir.w);
+            metal::float4 _e46 = leaf;
+            metal::float4 _e50 = gamma_at(psi_1, h_3, pst_factors, _buffer_sizes);
+            leaf = _e46 + (((0.5 * delta_2) * _e44) * _e50);
         }
     }
-    metal::float4 _e58 = leaf;
-    return _e58;
+    metal::float4 _e56 = leaf;
+    return _e56;
 }
 
 PstRay pst_ray(
@@ -1017,30 +1027,30 @@ PstRay pst_ray(
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     PstRay r = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_21 = frame;
-    metal::float3 eye_9 = f_21.eye.xyz;
-    metal::float2 ndc_2 = metal::float2(((2.0 * pc_1.x) / static_cast<float>(f_21.sizes.x)) - 1.0, 1.0 - ((2.0 * pc_1.y) / static_cast<float>(f_21.sizes.y)));
-    float t_9 = f_21.cam_forward.w;
-    metal::float3 dir_12 = metal::normalize((f_21.cam_forward.xyz + (f_21.cam_right.xyz * ((ndc_2.x * t_9) * f_21.cam_right.w))) + (f_21.cam_up.xyz * (ndc_2.y * t_9)));
-    float s_4 = metal::min(metal::max(z_1, 0.0), f_21.theta.z) / metal::max(metal::dot(dir_12, f_21.cam_forward.xyz), 0.000001);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = frame;
+    metal::float3 eye_9 = f_22.eye.xyz;
+    metal::float2 ndc_2 = metal::float2(((2.0 * pc_1.x) / static_cast<float>(f_22.sizes.x)) - 1.0, 1.0 - ((2.0 * pc_1.y) / static_cast<float>(f_22.sizes.y)));
+    float t_9 = f_22.cam_forward.w;
+    metal::float3 dir_12 = metal::normalize((f_22.cam_forward.xyz + (f_22.cam_right.xyz * ((ndc_2.x * t_9) * f_22.cam_right.w))) + (f_22.cam_up.xyz * (ndc_2.y * t_9)));
+    float s_4 = metal::min(metal::max(z_1, 0.0), f_22.theta.z) / metal::max(metal::dot(dir_12, f_22.cam_forward.xyz), 0.000001);
     r = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_9, dir_12, s_4, 0u, 0.0, 0.0, 0.0};
-    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, pc_1);
+    bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, pc_1);
     if (_e67) {
         r.marched = true;
         FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e72 = frame;
         float _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_4, true);
-        r.color = _e75 * f_21.light_color.xyz;
+        r.color = _e75 * f_22.light_color.xyz;
     }
-    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
+    float _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, dir_12);
     r.theta = _e80;
-    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
-    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e82), f_21.sizes.w, f_21.anti_epipole.w > 0.5);
+    float _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, dir_12);
+    uint _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(_e82), f_22.sizes.w, f_22.anti_epipole.w > 0.5);
     r.row = _e90;
     float _e93 = r.theta;
-    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_21.theta.x, f_21.theta.y);
+    float _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_22.theta.x, f_22.theta.y);
     r.d = _e98;
     float _e101 = r.theta;
-    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, eye_9, dir_12, s_4, _e101, true);
+    float _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, eye_9, dir_12, s_4, _e101, true);
     r.xs_num = _e102;
     PstRay _e103 = r;
     return _e103;
@@ -1065,22 +1075,22 @@ metal::float2 pst_terms(
     metal::texture2d<float, metal::access::sample> rectified
 ) {
     float tail = 0.0;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_23 = frame;
     float sin_theta = metal::max(metal::sin(r_2.theta), 0.000001);
     uint clamped_lod_e16 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
     metal::float4 _e16 = rectified.read(metal::min(metal::uint2(metal::uint2(n_2 - 1u, row_4)), metal::uint2(rectified.get_width(clamped_lod_e16), rectified.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     if (r_2.d <= _e16.x) {
-        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
-        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        float _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_23, n_2 - 1u, n_2, delta_4, r_2.theta, r_2.s, true);
+        float _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_23, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if (true) {
         float _e37 = tail;
-        return metal::float2(f_22.medium.y / (f_22.axis.w * sin_theta), _e37);
+        return metal::float2(f_23.medium.y / (f_23.axis.w * sin_theta), _e37);
     }
-    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.z, -(metal::dot(f_22.light_dir.xyz, r_2.dir)));
-    float sp = f_22.medium.y * _e48;
-    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.x, 0.0, delta_4 / sin_theta);
+    float _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_23.medium.z, -(metal::dot(f_23.light_dir.xyz, r_2.dir)));
+    float sp = f_23.medium.y * _e48;
+    float _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_23.medium.x, 0.0, delta_4 / sin_theta);
     float _e56 = tail;
     return metal::float2(sp * _e54, sp * _e56);
 }
@@ -1100,7 +1110,7 @@ metal::float3 pst_sweep_pixel(
     uint h_4 = 0u;
     metal::float4 p_6 = {};
     uint i_1 = {};
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_23 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_24 = frame;
     uint clamped_lod_e16 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_4, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
     PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_4) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
@@ -1110,8 +1120,9 @@ metal::float3 pst_sweep_pixel(
     metal::float4 _e24 = slices_1[metal::min(unsigned(_e18.row), (_buffer_sizes.size1 - 0 - 16) / 16)];
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e25 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24);
     float delta_5 = _e25.delta;
-    uint _e27 = pst_columns_crossed(_e18, delta_5, frame);
-    if (_e27 == 0u) {
+    metal::float3 _e28 = pst_row_e(f_24, _e18.row);
+    uint _e29 = pst_columns_crossed(_e18, delta_5, frame);
+    if (_e29 == 0u) {
         return metal::float3(0.0, 0.0, 0.0);
     }
     uint2 loop_bound_6 = uint2(4294967295u);
@@ -1120,12 +1131,12 @@ metal::float3 pst_sweep_pixel(
         if (metal::all(loop_bound_6 == uint2(0u))) { break; }
         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
         if (!loop_init_6) {
-            uint _e77 = h_4;
-            h_4 = _e77 + 1u;
+            uint _e78 = h_4;
+            h_4 = _e78 + 1u;
         }
         loop_init_6 = false;
-        uint _e35 = h_4;
-        if (_e35 < RANK_VECS) {
+        uint _e37 = h_4;
+        if (_e37 < RANK_VECS) {
         } else {
             break;
         }
@@ -1138,38 +1149,38 @@ metal::float3 pst_sweep_pixel(
                 if (metal::all(loop_bound_7 == uint2(0u))) { break; }
                 loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
                 if (!loop_init_7) {
-                    uint _e66 = i_1;
-                    i_1 = _e66 + 1u;
+                    uint _e67 = i_1;
+                    i_1 = _e67 + 1u;
                 }
                 loop_init_7 = false;
-                uint _e46 = i_1;
-                if ((_e46 + 1u) < _e27) {
+                uint _e48 = i_1;
+                if ((_e48 + 1u) < _e29) {
                 } else {
                     break;
                 }
                 {
-                    uint _e51 = i_1;
-                    uint clamped_lod_e56 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-                    metal::float4 _e56 = rectified.read(metal::min(metal::uint2(metal::uint2(_e51, _e18.row)), metal::uint2(rectified.get_width(clamped_lod_e56), rectified.get_height(clamped_lod_e56)) - 1), clamped_lod_e56);
-                    if (_e18.d <= _e56.x) {
-                        metal::float4 _e59 = p_6;
-                        uint _e60 = i_1;
-                        uint _e62 = h_4;
-                        metal::float4 _e63 = pst_leaf(f_23, _e60, _e18.row, delta_5, _e62, pst_factors, _buffer_sizes);
-                        p_6 = _e59 + _e63;
+                    uint _e53 = i_1;
+                    uint clamped_lod_e58 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+                    metal::float4 _e58 = rectified.read(metal::min(metal::uint2(metal::uint2(_e53, _e18.row)), metal::uint2(rectified.get_width(clamped_lod_e58), rectified.get_height(clamped_lod_e58)) - 1), clamped_lod_e58);
+                    if (_e18.d <= _e58.x) {
+                        metal::float4 _e61 = p_6;
+                        uint _e62 = i_1;
+                        uint _e63 = h_4;
+                        metal::float4 _e64 = pst_leaf(f_24, _e62, _e28, delta_5, _e63, pst_factors, _buffer_sizes);
+                        p_6 = _e61 + _e64;
                     }
                 }
             }
-            float _e69 = sum_3;
-            metal::float4 _e70 = p_6;
-            uint _e72 = h_4;
-            metal::float4 _e73 = beta_at(_e18.theta, _e72, pst_factors, _buffer_sizes);
-            sum_3 = _e69 + metal::dot(_e70, _e73);
+            float _e70 = sum_3;
+            metal::float4 _e71 = p_6;
+            uint _e73 = h_4;
+            metal::float4 _e74 = beta_at(_e18.theta, _e73, pst_factors, _buffer_sizes);
+            sum_3 = _e70 + metal::dot(_e71, _e74);
         }
     }
-    metal::float2 _e80 = pst_terms(_e18, _e18.row, delta_5, _e27, frame, rectified);
-    float _e84 = sum_3;
-    return f_23.light_color.xyz * (metal::max(_e80.x * _e84, 0.0) + _e80.y);
+    metal::float2 _e81 = pst_terms(_e18, _e18.row, delta_5, _e29, frame, rectified);
+    float _e85 = sum_3;
+    return f_24.light_color.xyz * (metal::max(_e81.x * _e85, 0.0) + _e81.y);
 }
 
 struct pst_sweep_unwarpInput {

@@ -607,13 +607,13 @@ fn epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLay
 
     let d_4 = ((vec2<f32>(p_4) + vec2<f32>(0.5f, 0.5f)) - l_1.origin);
     let _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
-    let f_20 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5f);
+    let f_21 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5f);
     if (l_1.wrap != 0u) {
-        let fl = floor(f_20);
-        fs = (f_20 - fl);
+        let fl = floor(f_21);
+        fs = (f_21 - fl);
         s_lo = (u32((i32(fl) + i32(slices))) % slices);
     } else {
-        let fc = clamp(f_20, 0f, f32((slices - 1u)));
+        let fc = clamp(f_21, 0f, f32((slices - 1u)));
         s_lo = min(u32(fc), (slices - 2u));
         let _e41 = s_lo;
         fs = (fc - f32(_e41));
@@ -700,7 +700,16 @@ fn beta_at(theta_4: f32, h_2: u32) -> vec4<f32> {
     return _e14;
 }
 
-fn pst_leaf(f_19: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, row_3: u32, delta_2: f32, h_3: u32) -> vec4<f32> {
+fn pst_row_e(f_19: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_3: u32) -> vec3<f32> {
+    if false {
+        return vec3<f32>(0f, 0f, 0f);
+    }
+    let _e7 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
+    let _e8 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e7);
+    return _e8;
+}
+
+fn pst_leaf(f_20: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, e_1: vec3<f32>, delta_2: f32, h_3: u32) -> vec4<f32> {
     var leaf: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var g_1: u32 = 0u;
 
@@ -708,61 +717,59 @@ fn pst_leaf(f_19: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, ro
         let _e9 = gamma_at((f32(i) * delta_2), h_3);
         return _e9;
     }
-    let _e12 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, row_3);
-    let _e13 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_19, _e12);
-    let axis_2 = f_19.axis.xyz;
+    let axis_2 = f_20.axis.xyz;
     loop {
-        let _e17 = g_1;
-        if (_e17 < 2u) {
+        let _e14 = g_1;
+        if (_e14 < 2u) {
         } else {
             break;
         }
         {
-            let _e20 = g_1;
-            let q_4 = select(GL2_, -0.57735026f, (_e20 == 0u));
+            let _e17 = g_1;
+            let q_4 = select(GL2_, -0.57735026f, (_e17 == 0u));
             let psi_1 = (((f32(i) + 0.5f) + (0.5f * q_4)) * delta_2);
-            let l_3 = ((-(axis_2) * cos(psi_1)) + (_e13 * sin(psi_1)));
-            let _e46 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_3, f_19.light_dir.xyz), f_19.light_pos.w, f_19.light_dir.w);
-            let _e48 = leaf;
-            let _e52 = gamma_at(psi_1, h_3);
-            leaf = (_e48 + (((0.5f * delta_2) * _e46) * _e52));
+            let l_3 = ((-(axis_2) * cos(psi_1)) + (e_1 * sin(psi_1)));
+            let _e44 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_3, f_20.light_dir.xyz), f_20.light_pos.w, f_20.light_dir.w);
+            let _e46 = leaf;
+            let _e50 = gamma_at(psi_1, h_3);
+            leaf = (_e46 + (((0.5f * delta_2) * _e44) * _e50));
         }
         continuing {
-            let _e56 = g_1;
-            g_1 = (_e56 + 1u);
+            let _e54 = g_1;
+            g_1 = (_e54 + 1u);
         }
     }
-    let _e58 = leaf;
-    return _e58;
+    let _e56 = leaf;
+    return _e56;
 }
 
 fn pst_ray(pc_1: vec2<f32>, z_1: f32) -> PstRay {
     var r: PstRay;
 
-    let f_21 = frame;
-    let eye_9 = f_21.eye.xyz;
-    let ndc_2 = vec2<f32>((((2f * pc_1.x) / f32(f_21.sizes.x)) - 1f), (1f - ((2f * pc_1.y) / f32(f_21.sizes.y))));
-    let t_9 = f_21.cam_forward.w;
-    let dir_12 = normalize(((f_21.cam_forward.xyz + (f_21.cam_right.xyz * ((ndc_2.x * t_9) * f_21.cam_right.w))) + (f_21.cam_up.xyz * (ndc_2.y * t_9))));
-    let s_4 = (min(max(z_1, 0f), f_21.theta.z) / max(dot(dir_12, f_21.cam_forward.xyz), 0.000001f));
+    let f_22 = frame;
+    let eye_9 = f_22.eye.xyz;
+    let ndc_2 = vec2<f32>((((2f * pc_1.x) / f32(f_22.sizes.x)) - 1f), (1f - ((2f * pc_1.y) / f32(f_22.sizes.y))));
+    let t_9 = f_22.cam_forward.w;
+    let dir_12 = normalize(((f_22.cam_forward.xyz + (f_22.cam_right.xyz * ((ndc_2.x * t_9) * f_22.cam_right.w))) + (f_22.cam_up.xyz * (ndc_2.y * t_9))));
+    let s_4 = (min(max(z_1, 0f), f_22.theta.z) / max(dot(dir_12, f_22.cam_forward.xyz), 0.000001f));
     r = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_9, dir_12, s_4, 0u, 0f, 0f, 0f);
-    let _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, pc_1);
+    let _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, pc_1);
     if _e67 {
         r.marched = true;
         let _e72 = frame;
         let _e75 = epipole_marchX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e72, shadow_map, eye_9, dir_12, s_4, true);
-        r.color = (_e75 * f_21.light_color.xyz);
+        r.color = (_e75 * f_22.light_color.xyz);
     }
-    let _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
+    let _e80 = ray_thetaX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, dir_12);
     r.theta = _e80;
-    let _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, dir_12);
-    let _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_21.sizes.w, (f_21.anti_epipole.w > 0.5f));
+    let _e82 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, dir_12);
+    let _e90 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(_e82), f_22.sizes.w, (f_22.anti_epipole.w > 0.5f));
     r.row = _e90;
     let _e93 = r.theta;
-    let _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_21.theta.x, f_21.theta.y);
+    let _e98 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e93, f_22.theta.x, f_22.theta.y);
     r.d = _e98;
     let _e101 = r.theta;
-    let _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_21, eye_9, dir_12, s_4, _e101, true);
+    let _e102 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, eye_9, dir_12, s_4, _e101, true);
     r.xs_num = _e102;
     let _e103 = r;
     return _e103;
@@ -777,21 +784,21 @@ fn pst_columns_crossed(r_1: PstRay, delta_3: f32) -> u32 {
 fn pst_terms(r_2: PstRay, row_4: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     var tail: f32 = 0f;
 
-    let f_22 = frame;
+    let f_23 = frame;
     let sin_theta = max(sin(r_2.theta), 0.000001f);
     let _e16 = textureLoad(rectified, vec2<u32>((n_2 - 1u), row_4), 0i);
     if (r_2.d <= _e16.x) {
-        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
-        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, r_2.eye, r_2.dir, _e25, r_2.s, true);
+        let _e25 = edge_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_23, (n_2 - 1u), n_2, delta_4, r_2.theta, r_2.s, true);
+        let _e29 = lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_23, r_2.eye, r_2.dir, _e25, r_2.s, true);
         tail = _e29;
     }
     if true {
         let _e37 = tail;
-        return vec2<f32>((f_22.medium.y / (f_22.axis.w * sin_theta)), _e37);
+        return vec2<f32>((f_23.medium.y / (f_23.axis.w * sin_theta)), _e37);
     }
-    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.z, -(dot(f_22.light_dir.xyz, r_2.dir)));
-    let sp = (f_22.medium.y * _e48);
-    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_22.medium.x, 0f, (delta_4 / sin_theta));
+    let _e48 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_23.medium.z, -(dot(f_23.light_dir.xyz, r_2.dir)));
+    let sp = (f_23.medium.y * _e48);
+    let _e54 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_23.medium.x, 0f, (delta_4 / sin_theta));
     let _e56 = tail;
     return vec2<f32>((sp * _e54), (sp * _e56));
 }
@@ -802,7 +809,7 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
     var p_6: vec4<f32>;
     var i_1: u32;
 
-    let f_23 = frame;
+    let f_24 = frame;
     let _e16 = textureLoad(depth, vec2<u32>(x_4, y), 0i);
     let _e18 = pst_ray(vec2<f32>((f32(x_4) + 0.5f), (f32(y) + 0.5f)), _e16.x);
     if _e18.marched {
@@ -811,13 +818,14 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
     let _e24 = slices_1[_e18.row];
     let _e25 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e24);
     let delta_5 = _e25.delta;
-    let _e27 = pst_columns_crossed(_e18, delta_5);
-    if (_e27 == 0u) {
+    let _e28 = pst_row_e(f_24, _e18.row);
+    let _e29 = pst_columns_crossed(_e18, delta_5);
+    if (_e29 == 0u) {
         return vec3<f32>(0f, 0f, 0f);
     }
     loop {
-        let _e35 = h_4;
-        if (_e35 < RANK_VECS) {
+        let _e37 = h_4;
+        if (_e37 < RANK_VECS) {
         } else {
             break;
         }
@@ -825,41 +833,41 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
             p_6 = vec4<f32>(0f, 0f, 0f, 0f);
             i_1 = 0u;
             loop {
-                let _e46 = i_1;
-                if ((_e46 + 1u) < _e27) {
+                let _e48 = i_1;
+                if ((_e48 + 1u) < _e29) {
                 } else {
                     break;
                 }
                 {
-                    let _e51 = i_1;
-                    let _e56 = textureLoad(rectified, vec2<u32>(_e51, _e18.row), 0i);
-                    if (_e18.d <= _e56.x) {
-                        let _e59 = p_6;
-                        let _e60 = i_1;
-                        let _e62 = h_4;
-                        let _e63 = pst_leaf(f_23, _e60, _e18.row, delta_5, _e62);
-                        p_6 = (_e59 + _e63);
+                    let _e53 = i_1;
+                    let _e58 = textureLoad(rectified, vec2<u32>(_e53, _e18.row), 0i);
+                    if (_e18.d <= _e58.x) {
+                        let _e61 = p_6;
+                        let _e62 = i_1;
+                        let _e63 = h_4;
+                        let _e64 = pst_leaf(f_24, _e62, _e28, delta_5, _e63);
+                        p_6 = (_e61 + _e64);
                     }
                 }
                 continuing {
-                    let _e66 = i_1;
-                    i_1 = (_e66 + 1u);
+                    let _e67 = i_1;
+                    i_1 = (_e67 + 1u);
                 }
             }
-            let _e69 = sum_3;
-            let _e70 = p_6;
-            let _e72 = h_4;
-            let _e73 = beta_at(_e18.theta, _e72);
-            sum_3 = (_e69 + dot(_e70, _e73));
+            let _e70 = sum_3;
+            let _e71 = p_6;
+            let _e73 = h_4;
+            let _e74 = beta_at(_e18.theta, _e73);
+            sum_3 = (_e70 + dot(_e71, _e74));
         }
         continuing {
-            let _e77 = h_4;
-            h_4 = (_e77 + 1u);
+            let _e78 = h_4;
+            h_4 = (_e78 + 1u);
         }
     }
-    let _e80 = pst_terms(_e18, _e18.row, delta_5, _e27);
-    let _e84 = sum_3;
-    return (f_23.light_color.xyz * (max((_e80.x * _e84), 0f) + _e80.y));
+    let _e81 = pst_terms(_e18, _e18.row, delta_5, _e29);
+    let _e85 = sum_3;
+    return (f_24.light_color.xyz * (max((_e81.x * _e85), 0f) + _e81.y));
 }
 
 @compute @workgroup_size(8, 8, 1) 

@@ -98,13 +98,23 @@ fn beta_at(inp: &PstInputs, theta: f32, h: u32) -> Vec4 {
     )
 }
 
-/// Leaf of column `i` of `row` (spacing `delta`), bases `4h ..`; with a cookie (`tint`) entry
-/// `h` is channel `h / rank_vecs`'s, bases `4 (h % rank_vecs) ..`.
+/// The direction `e` of row `row`'s plane of light rays (`slice_e` of its `row_phi`), which a
+/// spot's leaves read: once per row, not per column (WGSL `pst_row_e`); zero for the sun.
+pub fn pst_row_e(f: &FrameUniforms, spot: bool, row: u32) -> Vec3 {
+    if !spot {
+        return Vec3::ZERO;
+    }
+    slice_e(f, row_phi(f, row))
+}
+
+/// Leaf of column `i` of the row whose plane is `e` ([`pst_row_e`]; spacing `delta`), bases
+/// `4h ..`; with a cookie (`tint`) entry `h` is channel `h / rank_vecs`'s, bases
+/// `4 (h % rank_vecs) ..`.
 pub fn pst_leaf(
     inp: &PstInputs,
     spot: bool,
     i: u32,
-    row: u32,
+    e: Vec3,
     delta: f32,
     h: u32,
     tint: Option<Tint>,
@@ -113,7 +123,6 @@ pub fn pst_leaf(
     if !spot {
         return gamma_at(inp, i as f32 * delta, h);
     }
-    let e = slice_e(f, row_phi(f, row));
     let axis = xyz(f.axis);
     let mut leaf = Vec4::ZERO;
     for g in 0..2u32 {
@@ -303,6 +312,7 @@ pub fn pst_sweep_pixel(
         return r.color.to_array();
     }
     let delta = inp.slices[r.row as usize].delta;
+    let row_e = pst_row_e(f, spot, r.row);
     let n = pst_columns_crossed(f, &r, delta);
     if n == 0 {
         return [0.0; 3];
@@ -313,7 +323,7 @@ pub fn pst_sweep_pixel(
         let mut p = Vec4::ZERO;
         for i in 0..n - 1 {
             if r.d <= inp.rectified.load(i, r.row) {
-                p += pst_leaf(inp, spot, i, r.row, delta, h, tint);
+                p += pst_leaf(inp, spot, i, row_e, delta, h, tint);
             }
         }
         sum[(h / rv) as usize] += p.dot(beta_at(inp, r.theta, h % rv));
@@ -364,6 +374,7 @@ pub fn pst_sweep(
             };
             let row = pst_ray(inp, spot, at(m - 1), 0.0, tint).row;
             let delta = inp.slices[row as usize].delta;
+            let row_e = pst_row_e(f, spot, row);
             let mut counts = SweepCounts::default();
 
             // 1. The samples.
@@ -442,7 +453,8 @@ pub fn pst_sweep(
                 columns[i as usize] = b;
                 if b > 0 {
                     for h in 0..rv {
-                        leaves[(i * rv + h) as usize] = pst_leaf(inp, spot, i, row, delta, h, tint);
+                        leaves[(i * rv + h) as usize] =
+                            pst_leaf(inp, spot, i, row_e, delta, h, tint);
                     }
                 }
             }
