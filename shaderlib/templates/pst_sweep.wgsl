@@ -116,8 +116,9 @@ fn pst_row_e(f: Frame, row: u32) -> vec3<f32> {
     return slice_e(f, row_phi(f, row));
 }
 
-// Leaf of column i of the row whose plane is `e` (`pst_row_e`; spacing `delta`), bases 4h ..: the sun's gamma(i delta); a spot's
-// integral over the column's light-ray angles of gamma(psi) cone(psi) (2-point Gauss-Legendre){% if cookie %};
+// Leaf of column i of the row whose plane is `e` (`pst_row_e`; spacing `delta`), bases
+// 4h ..: the sun's gamma(i delta); a spot's integral over the column's light-ray angles of
+// gamma(psi) cone(psi) (2-point Gauss-Legendre){% if cookie %};
 // with the cookie, entry h < LEAF_VECS is channel h / RANK_VECS's: the integrand times that
 // channel of the node's light ray's cookie, bases 4 (h % RANK_VECS) ..{% endif %}.
 fn pst_leaf(f: Frame, i: u32, e: vec3<f32>, delta: f32, h: u32) -> vec4<f32> {
