@@ -391,14 +391,14 @@ fn stage_trial(
             tap_max = light[j].iter().copied().fold(tap_max, f32::max);
         }
         let d = depth.load(q[0], q[1]);
-        let blend = lowres_blend(t.w, t.w, depths, light, d, depth_break, light_break);
+        let blend = lowres_blend(t.w, depths, light, d, depth_break, light_break);
         // The light criterion compares a spread of the taps' light with a share of their
         // largest: where the two sides are within rounding of each other, either decision
         // is right ([`LIGHT_BREAK_EDGE`]).
         let edge = LIGHT_BREAK_EDGE * light_break;
-        let ambiguous = lowres_blend(t.w, t.w, depths, light, d, depth_break, light_break - edge)
+        let ambiguous = lowres_blend(t.w, depths, light, d, depth_break, light_break - edge)
             .is_some()
-            != lowres_blend(t.w, t.w, depths, light, d, depth_break, light_break + edge).is_some();
+            != lowres_blend(t.w, depths, light, d, depth_break, light_break + edge).is_some();
         if ambiguous {
             may_list += 1;
         } else if blend.is_none() {
@@ -407,7 +407,6 @@ fn stage_trial(
         if ambiguous {
             let own = at(q);
             let other = blend.or(lowres_blend(
-                t.w,
                 t.w,
                 depths,
                 light,
