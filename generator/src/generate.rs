@@ -153,7 +153,8 @@ pub fn emit_kernel(
 /// The workgroup count of `invocations` in workgroups of `size`, as a manifest formula. An
 /// invocation count that is itself `ceil(a / n)` (n an integer: `rectify`'s columns, a lowres
 /// grid) gives `ceil(a / (n size))`, the same integer for positive sizes, so that no formula
-/// nests `ceil` (MANIFEST.md's grammar).
+/// nests `ceil` (MANIFEST.md's grammar); one that is `k * rest` with k a multiple of the size
+/// gives `k / size * rest`.
 fn workgroups(invocations: &str, size: u32) -> String {
     let size = size.max(1);
     if let Some((a, n)) = invocations
@@ -164,6 +165,17 @@ fn workgroups(invocations: &str, size: u32) -> String {
         .filter(|(a, _)| !a.contains('('))
     {
         return format!("ceil({a} / {})", n * size);
+    }
+    // `k * rest` with k a multiple of the size (the fallback's bound): `k / size * rest`.
+    if let Some((k, rest)) = invocations
+        .split_once(" * ")
+        .and_then(|(k, rest)| Some((k.parse::<u32>().ok()?, rest)))
+        .filter(|(k, _)| k % size == 0)
+    {
+        return match k / size {
+            1 => rest.to_owned(),
+            m => format!("{m} * {rest}"),
+        };
     }
     match invocations.parse::<u32>() {
         Ok(n) => n.div_ceil(size).to_string(),
@@ -311,6 +323,7 @@ fn pass_entry(
         workgroup_size: out.workgroup_size,
         dispatch,
         skip_when: pass.skip_when,
+        indirect: pass.indirect,
         bindings,
         files,
     })

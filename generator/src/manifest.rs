@@ -156,6 +156,11 @@ pub struct ManifestPass {
     /// A per-frame condition under which the pass does not run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub skip_when: Option<&'static str>,
+    /// Where the pass is dispatched indirectly: the buffer and byte offset of its three u32
+    /// workgroup counts, written by an earlier pass (`dispatch` then gives the most they can
+    /// be, for an engine that dispatches directly).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub indirect: Option<crate::family::Indirect>,
     /// Every binding the kernel uses.
     pub bindings: Vec<ManifestBinding>,
     /// The kernel's file per target.

@@ -455,6 +455,7 @@ impl Executor {
                     "storage" => wgpu::BufferUsages::STORAGE,
                     "copy_dst" => wgpu::BufferUsages::COPY_DST,
                     "copy_src" => wgpu::BufferUsages::COPY_SRC,
+                    "indirect" => wgpu::BufferUsages::INDIRECT,
                     other => {
                         return Err(plan_error(
                             first,
@@ -642,8 +643,18 @@ impl Executor {
             });
             cpass.set_pipeline(&pass.pipeline.pipeline);
             cpass.set_bind_group(0, &group, &[]);
-            let [x, y, z] = pass.workgroups;
-            cpass.dispatch_workgroups(x, y, z);
+            if let Some(indirect) = pass.plan.indirect {
+                // Workgroup counts an earlier pass wrote (`pass.workgroups` is their most).
+                match self.owned(indirect.buffer) {
+                    Some(Owned::Buffer(buffer)) => {
+                        cpass.dispatch_workgroups_indirect(buffer, indirect.offset_bytes);
+                    }
+                    _ => return Err(self.missing(indirect.buffer, "indirect dispatch buffer")),
+                }
+            } else {
+                let [x, y, z] = pass.workgroups;
+                cpass.dispatch_workgroups(x, y, z);
+            }
         }
         if let Some(timer) = self.timer.as_ref().filter(|_| timestamps) {
             timer.resolve(encoder);

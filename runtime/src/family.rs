@@ -135,7 +135,7 @@ pub(crate) fn read_fallback_count(
         .and_then(|b| b.try_into().ok())
         .ok_or_else(|| RuntimeError::Readback {
             kernel,
-            message: format!("fallback_count holds {} bytes, not 4", bytes.len()),
+            message: format!("fallback_count holds {} bytes, fewer than 4", bytes.len()),
         })?;
     Ok(Some(u32::from_le_bytes(count)))
 }

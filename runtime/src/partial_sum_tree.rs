@@ -14,7 +14,7 @@
 //! | `rectify` | 0 uniform `Frame`, 1 slices, 2 shadow map, 3 rectified (storage, write) | `ceil(Wr/64) x Hr x 1` |
 //! | `pst_sweep` | 0 `Frame`, 1 slices, 2 depth, 3 shadow map, 4 rectified, 5 pst_factors, 6-8 scratch, 9 epipolar_samples (rgba32float, write), 11 fallback_count | `slices x 1 x 1` (32 lanes each) |
 //! | `pst_sweep_unwarp` | 0 `Frame`, 2 depth, 9 output, 10 epipolar_samples, 11 fallback_count, 12 fallback_pixels | `ceil(W/8) x ceil(H/8) x 1` |
-//! | `pst_sweep_fallback` | 0-5, 9 output, 11 fallback_count, 12 fallback_pixels | `ceil(W/64) x ceil(H/64) x 1` |
+//! | `pst_sweep_fallback` | 0-5, 9 output, 11 fallback_count, 12 fallback_pixels | indirect from `fallback_count` (byte 4): one invocation per listed pixel, workgroups of 64 |
 
 use std::time::{Duration, Instant};
 

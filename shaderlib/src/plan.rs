@@ -324,8 +324,21 @@ pub struct PassPlan {
     pub invocations: [Formula; 3],
     /// A per-frame condition under which the pass does not run.
     pub skip_when: Option<&'static str>,
+    /// Where the pass is dispatched indirectly: the buffer holding its workgroup counts
+    /// (`invocations` then give the most it can be, for an engine that dispatches directly).
+    pub indirect: Option<Indirect>,
     /// What each binding of group 0 gets.
     pub bindings: Vec<BindingSource>,
+}
+
+/// An indirect dispatch's arguments: three `u32` workgroup counts (x, y, z) written by an
+/// earlier pass into `buffer` at byte `offset` (a multiple of 4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Indirect {
+    /// The buffer resource.
+    pub buffer: &'static str,
+    /// The arguments' byte offset in it.
+    pub offset_bytes: u64,
 }
 
 /// Everything about a variant that the IR does not say.

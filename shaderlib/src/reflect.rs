@@ -159,7 +159,7 @@ pub enum Shape {
     },
     /// A nested struct (demangled name).
     Struct(String),
-    /// Anything C and Rust cannot express here (runtime arrays, atomics, bool).
+    /// Anything C and Rust cannot express here (runtime arrays, bool).
     Unsupported(String),
 }
 
@@ -466,6 +466,8 @@ impl Cx<'_> {
         let t = &self.module.types[ty];
         match &t.inner {
             TypeInner::Scalar(s) if s.kind != ScalarKind::Bool => Shape::Scalar(scalar_name(*s)),
+            // The host sees an atomic as its scalar (same size and alignment).
+            TypeInner::Atomic(s) => Shape::Scalar(scalar_name(*s)),
             TypeInner::Vector { size, scalar } if scalar.kind != ScalarKind::Bool => {
                 Shape::Vector(scalar_name(*scalar), vector_len(*size))
             }

@@ -32,8 +32,8 @@ pub(crate) struct SamplingView {
     pub step: u32,
     /// Invocations per slice of the epipolar samples pass ([`SLICE_LANES`]).
     pub slice_lanes: u32,
-    /// Pixels per axis per invocation of the `_fallback` pass ([`FALLBACK_TILE`]).
-    pub fallback_tile: u32,
+    /// Workgroups per row of the `_fallback` pass's dispatch ([`FALLBACK_ROW_GROUPS`]).
+    pub fallback_row_groups: u32,
     /// The kernel's entry point.
     pub entry: &'static str,
     /// The family kernel's entry point (`entry` without `_unwarp` or `_fallback`).
@@ -94,7 +94,7 @@ impl SamplingView {
             slice_samples: knobs.slice_samples,
             step: knobs.step,
             slice_lanes: SLICE_LANES,
-            fallback_tile: FALLBACK_TILE,
+            fallback_row_groups: FALLBACK_ROW_GROUPS,
             entry: kernel.name(),
             family_entry: family_kernel.name(),
             pixel: format!("{}_pixel", family_kernel.name()),
@@ -299,6 +299,7 @@ pub fn unwarp_pass(
             ]
         },
         skip_when: family.skip_when,
+        indirect: None,
         bindings,
     }
 }
@@ -320,9 +321,10 @@ pub fn unwarp_block(knobs: &SamplingKnobs) -> u32 {
 
 /// The `_fallback` pass `kernel` of a family kernel's sampled pass `family`: the same
 /// bindings with `output` where `family` writes the samples texture, and `fallback_count`
-/// and `fallback_pixels` read at `binding + 1` and `+ 2`; one invocation per
-/// [`FALLBACK_TILE`] x [`FALLBACK_TILE`] pixels, each evaluating every `invocations`-th listed
-/// pixel.
+/// and `fallback_pixels` read at `binding + 1` and `+ 2`; dispatched indirectly from
+/// `fallback_count` (byte [`FALLBACK_GROUPS_OFFSET`]: one invocation per listed pixel, in
+/// workgroups of 8 x 8, [`FALLBACK_ROW_GROUPS`] per row), its `invocations` the most that can
+/// be (every pixel listed) for an engine that dispatches directly.
 pub fn fallback_pass(
     family: crate::plan::PassPlan,
     kernel: Kernel,
@@ -331,14 +333,19 @@ pub fn fallback_pass(
     let mut bindings = family_bindings(&family);
     bindings.push(crate::plan::bind(binding + 1, FALLBACK_COUNT));
     bindings.push(crate::plan::bind(binding + 2, FALLBACK_PIXELS));
+    // Rows of FALLBACK_ROW_GROUPS workgroups of 8 x 8 (65536 entries each) for every pixel.
     crate::plan::PassPlan {
         kernel,
         invocations: [
-            format!("ceil(screen.width / {FALLBACK_TILE})"),
-            format!("ceil(screen.height / {FALLBACK_TILE})"),
+            (8 * FALLBACK_ROW_GROUPS).to_string(),
+            "8 * ceil(screen.width / 256) * ceil(screen.height / 256)".into(),
             "1".into(),
         ],
         skip_when: family.skip_when,
+        indirect: Some(crate::plan::Indirect {
+            buffer: FALLBACK_COUNT,
+            offset_bytes: FALLBACK_GROUPS_OFFSET,
+        }),
         bindings,
     }
 }
@@ -360,14 +367,18 @@ pub fn fallback_buffers(knobs: &SamplingKnobs) -> Vec<crate::plan::Resource> {
     vec![
         buffer(
             FALLBACK_COUNT,
-            "sampling = lowres | epipolar: how many pixels the _unwarp pass listed in fallback_pixels              (zeroed by the family's samples pass, incremented by the _unwarp pass, read by              the _fallback pass; no host upload or clear; copy it back to report how many \
-             pixels fell back)",
+            "sampling = lowres | epipolar: 4 u32: how many pixels the _unwarp pass listed in \
+             fallback_pixels, then the _fallback pass's indirect dispatch (workgroups x, y, z \
+             at byte 4) (reset by the family's samples pass, written by the _unwarp pass, \
+             read by the _fallback pass; no host upload or clear; copy the first 4 bytes back \
+             to report how many pixels fell back)",
             None,
-            vec!["storage", "copy_src"],
+            vec!["storage", "indirect", "copy_src"],
         ),
         buffer(
             FALLBACK_PIXELS,
-            "sampling = lowres | epipolar: the pixels no sample stands for, packed x | y << 16, in no              particular order (written by the _unwarp pass, evaluated by the _fallback pass)",
+            "sampling = lowres | epipolar: the pixels no sample stands for, packed x | y << 16, in \
+             no particular order (written by the _unwarp pass, evaluated by the _fallback pass)",
             Some("screen.width * screen.height"),
             vec!["storage"],
         ),
@@ -378,15 +389,22 @@ pub fn fallback_buffers(knobs: &SamplingKnobs) -> Vec<crate::plan::Resource> {
 pub const FALLBACK_COUNT: &str = "fallback_count";
 /// The fallback list's pixels.
 pub const FALLBACK_PIXELS: &str = "fallback_pixels";
-/// The `_fallback` pass runs one invocation per `FALLBACK_TILE` x `FALLBACK_TILE` pixels (40 x 23
-/// at 1280x720: 15 workgroups of 64). llvmpipe runs a loop's body once for every 8-lane batch
-/// of a workgroup even where no lane takes it, so every batch of an empty stretch of the list
-/// cost one evaluation of the family's body: with one invocation per 8 x 8 pixels (240
-/// workgroups) the pass took 1.1 ms (`scatter_fallback`) and 2.5 ms (`minmax_traverse_fallback`)
-/// on `sphere` with a few hundred pixels listed, 0.3 and 0.2 ms with 32 x 32; on `foliage`
-/// (1.3 % of the pixels listed) 3.2-5.1 and 4.6-5.2 ms against 2.1-2.2 and 2.4 (stop 46,
-/// docs/roofline.md). A list of 1 % of a 1920x1080 screen is 10 pixels per invocation.
-pub const FALLBACK_TILE: u32 = 32;
+/// The byte offset of the `_fallback` pass's indirect dispatch arguments in `fallback_count`
+/// (after the list's count).
+pub const FALLBACK_GROUPS_OFFSET: u64 = 4;
+/// Workgroups (of 8 x 8 invocations) per row of the `_fallback` pass's indirect dispatch: the
+/// unwarp that lists entry `e` raises the dispatch to cover workgroup `e / 64` (x up to this,
+/// then rows), so 1024 x 65535 workgroups cover any screen.
+///
+/// One invocation per listed pixel, not a fixed grid each taking every N-th entry: a fixed
+/// grid either runs the family's body once per idle 8-lane batch (llvmpipe runs a loop's
+/// body under an empty mask; one invocation per 8 x 8 pixels cost `minmax_traverse_fallback`
+/// 2.5 ms on `sphere` with a few hundred pixels listed, stop 46) or, kept small (one per
+/// 32 x 32 pixels until stop 53), gives an invocation hundreds of pixels where many are
+/// listed, past llvmpipe's 65535 loop trips per invocation (`lp_exec_endloop`: every loop of
+/// the inlined shader then exits): minmax's pass at 320x180 with every pixel listed wrote a
+/// quarter of them (stop 52, docs/roofline.md).
+pub const FALLBACK_ROW_GROUPS: u32 = 1024;
 
 /// Invocations (one workgroup) per slice of the epipolar samples pass: one 8-lane batch of
 /// llvmpipe's (256-bit vectors). llvmpipe runs a loop's body at least once for every 8-lane

@@ -39,7 +39,7 @@
 // | 7       | pst_tree    | var<storage, read_write> array<vec4<f32>> (SLICES x (TREES + 1) x SLICE_SAMPLES x {{ leaf_vecs }}) | read_write |
 // | 8       | pst_columns | var<storage, read_write> array<u32> (SLICES x Wr) | read_write |
 // | 9       | output      | texture_storage_2d<rgba32float, write> (epipolar_samples) | textureStore |
-// | 11      | fallback_count | var<storage, read_write> atomic<u32> | read_write   |
+// | 11      | fallback_count | var<storage, read_write> FallbackCount (16 bytes) | read_write |
 {%- if cookie %}
 // | {{ cookie_binding }}      | cookie      | texture_2d<f32> (rgba, linear RGB)      | textureLoad  |
 {%- endif %}
@@ -332,7 +332,7 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         if s == 0u {
             // An empty fallback list for the unwarp (no host clear), and the layout in the
             // last row, so that the unwarp loads it instead of computing it per pixel.
-            atomicStore(&fallback_count, 0u);
+            fallback_list_reset();
             textureStore(output, vec2<u32>(0u, SLICES), vec4<f32>(lines.origin, lines.axis));
             textureStore(output, vec2<u32>(1u, SLICES), vec4<f32>(lines.phi_start, lines.dphi, f32(lines.wrap), 0.0));
         }

@@ -123,6 +123,9 @@ struct PassPlan {
     layouts: Vec<wgpu::BindGroupLayout>,
     bindings: Vec<BindingPlan>,
     workgroups: [u32; 3],
+    /// The buffer and byte offset of the workgroup counts of an indirect dispatch
+    /// (`workgroups` is then their most).
+    indirect: Option<(String, u64)>,
     skip_when: Option<Condition>,
 }
 
@@ -519,6 +522,31 @@ impl Engine {
                 )?;
             }
 
+            // An indirect dispatch reads a buffer of the manifest's at a 4-byte aligned offset.
+            let indirect = match &pass.indirect {
+                None => None,
+                Some(i) => {
+                    let buffer = variant
+                        .resources
+                        .iter()
+                        .find(|r| r.name == i.buffer)
+                        .and_then(|r| r.buffer.as_ref())
+                        .ok_or_else(|| {
+                            EngineError::Inconsistent(format!(
+                                "pass {} is dispatched indirectly from `{}`, which is no buffer of the variant",
+                                pass.kernel, i.buffer
+                            ))
+                        })?;
+                    if !buffer.usage.iter().any(|u| u == "indirect") || i.offset_bytes % 4 != 0 {
+                        return Err(EngineError::Inconsistent(format!(
+                            "pass {} is dispatched indirectly from `{}` at byte {}: the buffer needs `indirect` usage and the offset a multiple of 4",
+                            pass.kernel, i.buffer, i.offset_bytes
+                        )));
+                    }
+                    Some((i.buffer.clone(), i.offset_bytes))
+                }
+            };
+
             let label = Some(pass.kernel.as_str());
             let max_group = entries.keys().next_back().copied().unwrap_or(0);
             let (pipeline, layouts) = scoped(device, context("pipeline creation"), || {
@@ -556,6 +584,7 @@ impl Engine {
                 layouts,
                 bindings: plans,
                 workgroups,
+                indirect,
                 skip_when,
             });
         }
@@ -693,8 +722,23 @@ impl Engine {
             for (group, bg) in (0u32..).zip(&groups) {
                 cpass.set_bind_group(group, bg, &[]);
             }
-            let [x, y, z] = pass.workgroups;
-            cpass.dispatch_workgroups(x, y, z);
+            match &pass.indirect {
+                Some((name, offset)) => match self.resources.get(name) {
+                    Some((_, Gpu::Buffer { buffer, .. })) => {
+                        cpass.dispatch_workgroups_indirect(buffer, *offset);
+                    }
+                    _ => {
+                        return Err(EngineError::Inconsistent(format!(
+                            "pass {} is dispatched indirectly from `{name}`, which was not created as a buffer",
+                            pass.kernel
+                        )));
+                    }
+                },
+                None => {
+                    let [x, y, z] = pass.workgroups;
+                    cpass.dispatch_workgroups(x, y, z);
+                }
+            }
             drop(cpass);
             run.dispatched.push((pass.kernel.clone(), pass.workgroups));
         }
@@ -1007,6 +1051,7 @@ fn create_resource(
                     "storage" => wgpu::BufferUsages::STORAGE,
                     "copy_dst" => wgpu::BufferUsages::COPY_DST,
                     "copy_src" => wgpu::BufferUsages::COPY_SRC,
+                    "indirect" => wgpu::BufferUsages::INDIRECT,
                     other => return Err(unsupported(ctx("usage"), "buffer usage", other)),
                 };
             }

@@ -187,10 +187,22 @@ pub struct Pass {
     /// Per-frame condition under which the pass does not run.
     #[serde(default)]
     pub skip_when: Option<String>,
+    /// Where the pass is dispatched indirectly (`dispatch` then gives the most).
+    #[serde(default)]
+    pub indirect: Option<Indirect>,
     /// Every binding the kernel uses.
     pub bindings: Vec<Binding>,
     /// Per target.
     pub files: BTreeMap<String, PassFile>,
+}
+
+/// `passes[].indirect`: three u32 workgroup counts an earlier pass wrote.
+#[derive(Clone, Debug, Deserialize)]
+pub struct Indirect {
+    /// The buffer resource.
+    pub buffer: String,
+    /// Their byte offset in it.
+    pub offset_bytes: u64,
 }
 
 /// `passes[].dispatch[]`.

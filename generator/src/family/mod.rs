@@ -23,7 +23,7 @@ use serde::Serialize;
 
 pub use scatter_shaderlib::family::{Family, FamilyVariant, KernelFamily, KnobSet};
 pub use scatter_shaderlib::plan::{
-    Alternative, BindingSource, BufferDesc, Formula, Parameter, PassPlan, Plan, Resource,
+    Alternative, BindingSource, BufferDesc, Formula, Indirect, Parameter, PassPlan, Plan, Resource,
     SamplerDesc, TextureDesc,
 };
 

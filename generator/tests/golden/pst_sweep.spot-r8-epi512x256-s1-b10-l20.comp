@@ -69,6 +69,12 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     float dphi;
     uint wrap;
 };
+struct FallbackCount {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
 struct PstRay {
     bool marched;
     vec3 color;
@@ -93,6 +99,7 @@ const uint STEP = 1u;
 const uint SLICE_RUNS = 256u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
+const uint FALLBACK_ROW_GROUPS = 1024u;
 const uint RANK_VECS = 2u;
 const uint LEAF_VECS = 2u;
 const uint TREES = 8u;
@@ -102,7 +109,7 @@ const uint NONE = 4294967295u;
 
 layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _group_0_binding_0_cs; };
 
-layout(std430, binding = 1) readonly buffer type_9_block_1Compute { vec4 _group_0_binding_1_cs[]; };
+layout(std430, binding = 1) readonly buffer type_10_block_1Compute { vec4 _group_0_binding_1_cs[]; };
 
 layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
@@ -110,17 +117,17 @@ layout(binding = 3) uniform sampler2D _group_0_binding_3_cs;
 
 layout(binding = 4) uniform sampler2D _group_0_binding_4_cs;
 
-layout(std430, binding = 5) readonly buffer type_9_block_2Compute { vec4 _group_0_binding_5_cs[]; };
+layout(std430, binding = 5) readonly buffer type_10_block_2Compute { vec4 _group_0_binding_5_cs[]; };
 
-layout(std430, binding = 6) buffer type_9_block_3Compute { vec4 _group_0_binding_6_cs[]; };
+layout(std430, binding = 6) buffer type_10_block_3Compute { vec4 _group_0_binding_6_cs[]; };
 
-layout(std430, binding = 7) buffer type_9_block_4Compute { vec4 _group_0_binding_7_cs[]; };
+layout(std430, binding = 7) buffer type_10_block_4Compute { vec4 _group_0_binding_7_cs[]; };
 
-layout(std430, binding = 8) buffer type_10_block_5Compute { uint _group_0_binding_8_cs[]; };
+layout(std430, binding = 8) buffer type_11_block_5Compute { uint _group_0_binding_8_cs[]; };
 
 layout(binding = 9,rgba32f) writeonly uniform image2D _group_0_binding_9_cs;
 
-layout(std430, binding = 11) buffer type_12_block_6Compute { uint _group_0_binding_11_cs; };
+layout(std430, binding = 11) buffer FallbackCount_block_6Compute { FallbackCount _group_0_binding_11_cs; };
 
 shared uint q_end[256];
 
@@ -713,6 +720,14 @@ uvec2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLa
     return uvec2(clamp(floor(p_8), vec2(0.0, 0.0), last_1));
 }
 
+void fallback_list_reset() {
+    atomicExchange(_group_0_binding_11_cs.listed, 0u);
+    atomicExchange(_group_0_binding_11_cs.groups_x, 0u);
+    atomicExchange(_group_0_binding_11_cs.groups_y, 0u);
+    _group_0_binding_11_cs.groups_z = 1u;
+    return;
+}
+
 vec4 factor_at(uint base, float x_4, uint h_4) {
     float p_9 = min((clamp(x_4, 0.0, 1.0) * 95.0), 95.0);
     uint j_10 = min(uint(floor(p_9)), 94u);
@@ -1021,80 +1036,80 @@ void main() {
     if ((li == 0u)) {
         imageStore(_group_0_binding_9_cs, ivec2(uvec2(SLICE_SAMPLES, s_7)), vec4(_e40.x, _e40.y, _e42.x, _e42.y));
         if ((s_7 == 0u)) {
-            atomicExchange(_group_0_binding_11_cs, 0u);
+            fallback_list_reset();
             imageStore(_group_0_binding_9_cs, ivec2(uvec2(0u, 512u)), vec4(_e37.origin, _e37.axis));
             imageStore(_group_0_binding_9_cs, ivec2(uvec2(1u, 512u)), vec4(_e37.phi_start, _e37.dphi, float(_e37.wrap), 0.0));
         }
     }
     vec2 far_end = (_e37.origin + (_e40 * (_e42.x + (255.0 * _e42.y))));
-    PstRay _e84 = pst_ray(far_end, 0.0);
-    uint row_5 = _e84.row;
-    vec4 _e88 = _group_0_binding_1_cs[row_5];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
-    float delta_6 = _e89.delta;
-    vec3 _e91 = pst_row_e(f_24, row_5);
+    PstRay _e82 = pst_ray(far_end, 0.0);
+    uint row_5 = _e82.row;
+    vec4 _e86 = _group_0_binding_1_cs[row_5];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e87 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e86);
+    float delta_6 = _e87.delta;
+    vec3 _e89 = pst_row_e(f_24, row_5);
     k = li;
     bool loop_init_8 = true;
     while(true) {
         if (!loop_init_8) {
-            uint _e189 = k;
-            k = (_e189 + SLICE_LANES);
+            uint _e187 = k;
+            k = (_e187 + SLICE_LANES);
         }
         loop_init_8 = false;
-        uint _e93 = k;
-        if ((_e93 < SLICE_SAMPLES)) {
+        uint _e91 = k;
+        if ((_e91 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e96 = k;
-            uvec2 _e97 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e96, screen_4);
-            int _e100_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-            vec4 _e100 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e97), ivec2(0), textureSize(_group_0_binding_2_cs, _e100_clamped_lod) - ivec2(1)), _e100_clamped_lod);
-            float z_7 = _e100.x;
-            uint _e104 = k;
-            float _e111 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (float(_e104) * _e42.y)))), screen_4);
+            uint _e94 = k;
+            uvec2 _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e94, screen_4);
+            int _e98_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+            vec4 _e98 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e95), ivec2(0), textureSize(_group_0_binding_2_cs, _e98_clamped_lod) - ivec2(1)), _e98_clamped_lod);
+            float z_7 = _e98.x;
+            uint _e102 = k;
+            float _e109 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (float(_e102) * _e42.y)))), screen_4);
             r = PstRay(false, vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0u, 0.0, 0.0, 0.0);
-            if ((_e111 < 0.0)) {
-                PstRay _e125 = pst_ray(vec2((float(_e97.x) + 0.5), (float(_e97.y) + 0.5)), z_7);
-                r = _e125;
+            if ((_e109 < 0.0)) {
+                PstRay _e123 = pst_ray(vec2((float(_e95.x) + 0.5), (float(_e95.y) + 0.5)), z_7);
+                r = _e123;
             } else {
-                uint _e128 = k;
-                PstRay _e135 = pst_ray((_e37.origin + (_e40 * (_e42.x + (float(_e128) * _e42.y)))), _e111);
-                r = _e135;
+                uint _e126 = k;
+                PstRay _e133 = pst_ray((_e37.origin + (_e40 * (_e42.x + (float(_e126) * _e42.y)))), _e109);
+                r = _e133;
             }
-            PstRay _e136 = r;
-            uint _e137 = pst_columns_crossed(_e136, delta_6);
-            uint _e139 = k;
-            q_end[_e139] = NONE;
-            bool _e143 = r.marched;
-            if (!(_e143)) {
-                local = (_e137 == 0u);
+            PstRay _e134 = r;
+            uint _e135 = pst_columns_crossed(_e134, delta_6);
+            uint _e137 = k;
+            q_end[_e137] = NONE;
+            bool _e141 = r.marched;
+            if (!(_e141)) {
+                local = (_e135 == 0u);
             } else {
                 local = true;
             }
-            bool _e150 = local;
-            if (_e150) {
-                vec3 _e152 = r.color;
-                vec3 _e153 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e152);
-                uint _e154 = k;
-                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e154, s_7)), vec4(_e153.x, _e153.y, _e153.z, z_7));
+            bool _e148 = local;
+            if (_e148) {
+                vec3 _e150 = r.color;
+                vec3 _e151 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e150);
+                uint _e152 = k;
+                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e152, s_7)), vec4(_e151.x, _e151.y, _e151.z, z_7));
             } else {
-                PstRay _e161 = r;
-                vec2 _e162 = pst_terms(_e161, row_5, delta_6, _e137);
-                uint _e164 = k;
-                q_b[_e164] = _e162.y;
-                uint _e168 = k;
-                q_end[_e168] = (_e137 - 1u);
-                uint _e173 = k;
-                float _e176 = r.d;
-                q_d[_e173] = _e176;
-                uint _e178 = k;
-                float _e181 = r.theta;
-                q_theta[_e178] = _e181;
-                uint _e183 = k;
-                q_a[_e183] = _e162.x;
-                uint _e188 = atomicAdd(live, 1u);
+                PstRay _e159 = r;
+                vec2 _e160 = pst_terms(_e159, row_5, delta_6, _e135);
+                uint _e162 = k;
+                q_b[_e162] = _e160.y;
+                uint _e166 = k;
+                q_end[_e166] = (_e135 - 1u);
+                uint _e171 = k;
+                float _e174 = r.d;
+                q_d[_e171] = _e174;
+                uint _e176 = k;
+                float _e179 = r.theta;
+                q_theta[_e176] = _e179;
+                uint _e181 = k;
+                q_a[_e181] = _e160.x;
+                uint _e186 = atomicAdd(live, 1u);
             }
         }
     }
@@ -1106,127 +1121,127 @@ void main() {
         bool loop_init_9 = true;
         while(true) {
             if (!loop_init_9) {
-                uint _e229 = k_1;
-                k_1 = (_e229 + 1u);
+                uint _e227 = k_1;
+                k_1 = (_e227 + 1u);
             }
             loop_init_9 = false;
-            uint _e203 = k_1;
-            if ((_e203 < SLICE_SAMPLES)) {
+            uint _e201 = k_1;
+            if ((_e201 < SLICE_SAMPLES)) {
             } else {
                 break;
             }
             {
-                uint _e207 = k_1;
-                uint _e209 = q_end[_e207];
-                if ((_e209 != NONE)) {
-                    uint _e213 = k_1;
-                    uint _e215 = q_end[_e213];
-                    local_1 = (min((_e215 / cw), 7u) == li);
+                uint _e205 = k_1;
+                uint _e207 = q_end[_e205];
+                if ((_e207 != NONE)) {
+                    uint _e211 = k_1;
+                    uint _e213 = q_end[_e211];
+                    local_1 = (min((_e213 / cw), 7u) == li);
                 } else {
                     local_1 = false;
                 }
-                bool _e223 = local_1;
-                if (_e223) {
-                    uint _e226 = count;
-                    count = (_e226 + 1u);
+                bool _e221 = local_1;
+                if (_e221) {
+                    uint _e224 = count;
+                    count = (_e224 + 1u);
                 }
             }
         }
-        uint _e233 = count;
-        bucket[li] = _e233;
+        uint _e231 = count;
+        bucket[li] = _e231;
     } else {
         if ((li == TREES)) {
             local_2 = (v_12 > 0u);
         } else {
             local_2 = false;
         }
-        bool _e241 = local_2;
-        if (_e241) {
+        bool _e239 = local_2;
+        if (_e239) {
             while(true) {
-                uint _e244 = first;
-                uint _e246 = q_end[_e244];
-                if ((_e246 == NONE)) {
+                uint _e242 = first;
+                uint _e244 = q_end[_e242];
+                if ((_e244 == NONE)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e250 = first;
-                    first = (_e250 + 1u);
+                    uint _e248 = first;
+                    first = (_e248 + 1u);
                 }
             }
             while(true) {
-                uint _e254 = last;
-                uint _e256 = q_end[_e254];
-                if ((_e256 == NONE)) {
+                uint _e252 = last;
+                uint _e254 = q_end[_e252];
+                if ((_e254 == NONE)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e260 = last;
-                    last = (_e260 - 1u);
+                    uint _e258 = last;
+                    last = (_e258 - 1u);
                 }
             }
-            uint _e263 = first;
-            float _e265 = q_d[_e263];
-            uint _e267 = last;
-            float _e269 = q_d[_e267];
-            bool up = (_e265 <= _e269);
+            uint _e261 = first;
+            float _e263 = q_d[_e261];
+            uint _e265 = last;
+            float _e267 = q_d[_e265];
+            bool up = (_e263 <= _e267);
             bool loop_init_10 = true;
             while(true) {
                 if (!loop_init_10) {
-                    uint _e342 = k_2;
-                    k_2 = (_e342 + 1u);
+                    uint _e340 = k_2;
+                    k_2 = (_e340 + 1u);
                 }
                 loop_init_10 = false;
-                uint _e272 = k_2;
-                if ((_e272 < SLICE_SAMPLES)) {
+                uint _e270 = k_2;
+                if ((_e270 < SLICE_SAMPLES)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e276 = k_2;
-                    uint _e278 = q_end[_e276];
-                    if ((_e278 != NONE)) {
-                        uint _e282 = k_2;
-                        float d_3 = q_d[_e282];
-                        uint _e286 = m;
-                        j = _e286;
+                    uint _e274 = k_2;
+                    uint _e276 = q_end[_e274];
+                    if ((_e276 != NONE)) {
+                        uint _e280 = k_2;
+                        float d_3 = q_d[_e280];
+                        uint _e284 = m;
+                        j = _e284;
                         while(true) {
-                            uint _e288 = j;
-                            if ((_e288 > 0u)) {
-                                uint _e291 = j;
-                                float _e296 = q_d[(_e291 - 1u)];
-                                uint _e298 = j;
-                                float _e303 = q_d[(_e298 - 1u)];
-                                local_3 = (up ? (_e303 > d_3) : (_e296 < d_3));
+                            uint _e286 = j;
+                            if ((_e286 > 0u)) {
+                                uint _e289 = j;
+                                float _e294 = q_d[(_e289 - 1u)];
+                                uint _e296 = j;
+                                float _e301 = q_d[(_e296 - 1u)];
+                                local_3 = (up ? (_e301 > d_3) : (_e294 < d_3));
                             } else {
                                 local_3 = false;
                             }
-                            bool _e309 = local_3;
-                            if (_e309) {
+                            bool _e307 = local_3;
+                            if (_e307) {
                             } else {
                                 break;
                             }
                             {
+                                uint _e309 = j;
                                 uint _e311 = j;
-                                uint _e313 = j;
-                                float _e318 = q_d[(_e313 - 1u)];
-                                q_d[_e311] = _e318;
+                                float _e316 = q_d[(_e311 - 1u)];
+                                q_d[_e309] = _e316;
+                                uint _e318 = j;
                                 uint _e320 = j;
-                                uint _e322 = j;
-                                uint _e327 = q_rank[(_e322 - 1u)];
-                                q_rank[_e320] = _e327;
-                                uint _e329 = j;
-                                j = (_e329 - 1u);
+                                uint _e325 = q_rank[(_e320 - 1u)];
+                                q_rank[_e318] = _e325;
+                                uint _e327 = j;
+                                j = (_e327 - 1u);
                             }
                         }
-                        uint _e332 = j;
-                        q_d[_e332] = d_3;
-                        uint _e335 = j;
-                        uint _e337 = k_2;
-                        q_rank[_e335] = _e337;
-                        uint _e339 = m;
-                        m = (_e339 + 1u);
+                        uint _e330 = j;
+                        q_d[_e330] = d_3;
+                        uint _e333 = j;
+                        uint _e335 = k_2;
+                        q_rank[_e333] = _e335;
+                        uint _e337 = m;
+                        m = (_e337 + 1u);
                     }
                 }
             }
@@ -1234,32 +1249,32 @@ void main() {
                 bool loop_init_11 = true;
                 while(true) {
                     if (!loop_init_11) {
-                        uint _e391 = j_1;
-                        j_1 = (_e391 + 1u);
+                        uint _e389 = j_1;
+                        j_1 = (_e389 + 1u);
                     }
                     loop_init_11 = false;
-                    uint _e346 = j_1;
-                    if ((_e346 < (v_12 / 2u))) {
+                    uint _e344 = j_1;
+                    if ((_e344 < (v_12 / 2u))) {
                     } else {
                         break;
                     }
                     {
-                        uint _e351 = j_1;
-                        float d_4 = q_d[_e351];
-                        uint _e355 = j_1;
-                        uint _e360 = j_1;
-                        float _e363 = q_d[((v_12 - 1u) - _e360)];
-                        q_d[_e355] = _e363;
-                        uint _e367 = j_1;
-                        q_d[((v_12 - 1u) - _e367)] = d_4;
-                        uint _e371 = j_1;
-                        uint k_9 = q_rank[_e371];
-                        uint _e375 = j_1;
-                        uint _e380 = j_1;
-                        uint _e383 = q_rank[((v_12 - 1u) - _e380)];
-                        q_rank[_e375] = _e383;
-                        uint _e387 = j_1;
-                        q_rank[((v_12 - 1u) - _e387)] = k_9;
+                        uint _e349 = j_1;
+                        float d_4 = q_d[_e349];
+                        uint _e353 = j_1;
+                        uint _e358 = j_1;
+                        float _e361 = q_d[((v_12 - 1u) - _e358)];
+                        q_d[_e353] = _e361;
+                        uint _e365 = j_1;
+                        q_d[((v_12 - 1u) - _e365)] = d_4;
+                        uint _e369 = j_1;
+                        uint k_9 = q_rank[_e369];
+                        uint _e373 = j_1;
+                        uint _e378 = j_1;
+                        uint _e381 = q_rank[((v_12 - 1u) - _e378)];
+                        q_rank[_e373] = _e381;
+                        uint _e385 = j_1;
+                        q_rank[((v_12 - 1u) - _e385)] = k_9;
                     }
                 }
             }
@@ -1271,83 +1286,83 @@ void main() {
         bool loop_init_12 = true;
         while(true) {
             if (!loop_init_12) {
-                uint _e406 = c;
-                c = (_e406 + 1u);
+                uint _e404 = c;
+                c = (_e404 + 1u);
             }
             loop_init_12 = false;
-            uint _e396 = c;
-            if ((_e396 < li)) {
+            uint _e394 = c;
+            if ((_e394 < li)) {
             } else {
                 break;
             }
             {
-                uint _e399 = start;
-                uint _e401 = c;
-                uint _e403 = bucket[_e401];
-                start = (_e399 + _e403);
+                uint _e397 = start;
+                uint _e399 = c;
+                uint _e401 = bucket[_e399];
+                start = (_e397 + _e401);
             }
         }
         bool loop_init_13 = true;
         while(true) {
             if (!loop_init_13) {
-                uint _e482 = k_3;
-                k_3 = (_e482 + 1u);
+                uint _e480 = k_3;
+                k_3 = (_e480 + 1u);
             }
             loop_init_13 = false;
-            uint _e409 = k_3;
-            if ((_e409 < SLICE_SAMPLES)) {
+            uint _e407 = k_3;
+            if ((_e407 < SLICE_SAMPLES)) {
             } else {
                 break;
             }
             {
-                uint _e413 = k_3;
-                uint _e415 = q_end[_e413];
-                if ((_e415 != NONE)) {
-                    uint _e419 = k_3;
-                    uint _e421 = q_end[_e419];
-                    local_4 = (min((_e421 / cw), 7u) == li);
+                uint _e411 = k_3;
+                uint _e413 = q_end[_e411];
+                if ((_e413 != NONE)) {
+                    uint _e417 = k_3;
+                    uint _e419 = q_end[_e417];
+                    local_4 = (min((_e419 / cw), 7u) == li);
                 } else {
                     local_4 = false;
                 }
-                bool _e429 = local_4;
-                if (_e429) {
-                    uint _e431 = m_1;
-                    j_2 = _e431;
+                bool _e427 = local_4;
+                if (_e427) {
+                    uint _e429 = m_1;
+                    j_2 = _e429;
                     while(true) {
-                        uint _e433 = j_2;
-                        if ((_e433 > 0u)) {
-                            uint _e436 = start;
-                            uint _e437 = j_2;
-                            uint _e444 = by_end[((_e436 + _e437) - 1u)];
-                            uint _e446 = q_end[_e444];
-                            uint _e448 = k_3;
-                            uint _e450 = q_end[_e448];
-                            local_5 = (_e446 > _e450);
+                        uint _e431 = j_2;
+                        if ((_e431 > 0u)) {
+                            uint _e434 = start;
+                            uint _e435 = j_2;
+                            uint _e442 = by_end[((_e434 + _e435) - 1u)];
+                            uint _e444 = q_end[_e442];
+                            uint _e446 = k_3;
+                            uint _e448 = q_end[_e446];
+                            local_5 = (_e444 > _e448);
                         } else {
                             local_5 = false;
                         }
-                        bool _e455 = local_5;
-                        if (_e455) {
+                        bool _e453 = local_5;
+                        if (_e453) {
                         } else {
                             break;
                         }
                         {
-                            uint _e457 = start;
-                            uint _e458 = j_2;
-                            uint _e461 = start;
-                            uint _e462 = j_2;
-                            uint _e468 = by_end[((_e461 + _e462) - 1u)];
-                            by_end[(_e457 + _e458)] = _e468;
-                            uint _e470 = j_2;
-                            j_2 = (_e470 - 1u);
+                            uint _e455 = start;
+                            uint _e456 = j_2;
+                            uint _e459 = start;
+                            uint _e460 = j_2;
+                            uint _e466 = by_end[((_e459 + _e460) - 1u)];
+                            by_end[(_e455 + _e456)] = _e466;
+                            uint _e468 = j_2;
+                            j_2 = (_e468 - 1u);
                         }
                     }
-                    uint _e473 = start;
-                    uint _e474 = j_2;
-                    uint _e477 = k_3;
-                    by_end[(_e473 + _e474)] = _e477;
-                    uint _e479 = m_1;
-                    m_1 = (_e479 + 1u);
+                    uint _e471 = start;
+                    uint _e472 = j_2;
+                    uint _e475 = k_3;
+                    by_end[(_e471 + _e472)] = _e475;
+                    uint _e477 = m_1;
+                    m_1 = (_e477 + 1u);
                 }
             }
         }
@@ -1356,20 +1371,20 @@ void main() {
     bool loop_init_14 = true;
     while(true) {
         if (!loop_init_14) {
-            uint _e496 = j_3;
-            j_3 = (_e496 + SLICE_LANES);
+            uint _e494 = j_3;
+            j_3 = (_e494 + SLICE_LANES);
         }
         loop_init_14 = false;
-        uint _e485 = j_3;
-        if ((_e485 < v_12)) {
+        uint _e483 = j_3;
+        if ((_e483 < v_12)) {
         } else {
             break;
         }
         {
-            uint _e487 = j_3;
-            uint _e493 = j_3;
-            uint _e495 = q_rank[_e493];
-            mine[(_e487 / SLICE_LANES)] = _e495;
+            uint _e485 = j_3;
+            uint _e491 = j_3;
+            uint _e493 = q_rank[_e491];
+            mine[(_e485 / SLICE_LANES)] = _e493;
         }
     }
     memoryBarrierShared();
@@ -1378,20 +1393,20 @@ void main() {
     bool loop_init_15 = true;
     while(true) {
         if (!loop_init_15) {
-            uint _e510 = j_4;
-            j_4 = (_e510 + SLICE_LANES);
+            uint _e508 = j_4;
+            j_4 = (_e508 + SLICE_LANES);
         }
         loop_init_15 = false;
-        uint _e500 = j_4;
-        if ((_e500 < v_12)) {
+        uint _e498 = j_4;
+        if ((_e498 < v_12)) {
         } else {
             break;
         }
         {
-            uint _e502 = j_4;
-            uint _e507 = mine[(_e502 / SLICE_LANES)];
-            uint _e509 = j_4;
-            q_rank[_e507] = _e509;
+            uint _e500 = j_4;
+            uint _e505 = mine[(_e500 / SLICE_LANES)];
+            uint _e507 = j_4;
+            q_rank[_e505] = _e507;
         }
     }
     memoryBarrierShared();
@@ -1401,66 +1416,66 @@ void main() {
     bool loop_init_16 = true;
     while(true) {
         if (!loop_init_16) {
-            uint _e567 = i;
-            i = (_e567 + SLICE_LANES);
+            uint _e565 = i;
+            i = (_e565 + SLICE_LANES);
         }
         loop_init_16 = false;
-        uint _e515 = i;
-        if ((_e515 < width)) {
+        uint _e513 = i;
+        if ((_e513 < width)) {
         } else {
             break;
         }
         {
-            uint _e517 = i;
-            int _e521_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-            vec4 _e521 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e517, row_5)), ivec2(0), textureSize(_group_0_binding_4_cs, _e521_clamped_lod) - ivec2(1)), _e521_clamped_lod);
-            float occluder = _e521.x;
+            uint _e515 = i;
+            int _e519_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+            vec4 _e519 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(_e515, row_5)), ivec2(0), textureSize(_group_0_binding_4_cs, _e519_clamped_lod) - ivec2(1)), _e519_clamped_lod);
+            float occluder = _e519.x;
             lo = 0u;
             hi = v_12;
             while(true) {
-                uint _e526 = lo;
-                uint _e527 = hi;
-                if ((_e526 < _e527)) {
+                uint _e524 = lo;
+                uint _e525 = hi;
+                if ((_e524 < _e525)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e529 = lo;
-                    uint _e530 = hi;
-                    uint mid_1 = ((_e529 + _e530) / 2u);
-                    float _e536 = q_d[mid_1];
-                    if ((_e536 <= occluder)) {
+                    uint _e527 = lo;
+                    uint _e528 = hi;
+                    uint mid_1 = ((_e527 + _e528) / 2u);
+                    float _e534 = q_d[mid_1];
+                    if ((_e534 <= occluder)) {
                         lo = (mid_1 + 1u);
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            uint _e541 = i;
-            uint _e544 = lo;
-            _group_0_binding_8_cs[(base_1 + _e541)] = _e544;
-            uint _e545 = lo;
-            if ((_e545 > 0u)) {
+            uint _e539 = i;
+            uint _e542 = lo;
+            _group_0_binding_8_cs[(base_1 + _e539)] = _e542;
+            uint _e543 = lo;
+            if ((_e543 > 0u)) {
                 h = 0u;
                 bool loop_init_17 = true;
                 while(true) {
                     if (!loop_init_17) {
-                        uint _e565 = h;
-                        h = (_e565 + 1u);
+                        uint _e563 = h;
+                        h = (_e563 + 1u);
                     }
                     loop_init_17 = false;
-                    uint _e550 = h;
-                    if ((_e550 < LEAF_VECS)) {
+                    uint _e548 = h;
+                    if ((_e548 < LEAF_VECS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e553 = i;
-                        uint _e558 = h;
-                        uint _e561 = i;
-                        uint _e562 = h;
-                        vec4 _e563 = pst_leaf(f_24, _e561, _e91, delta_6, _e562);
-                        _group_0_binding_6_cs[(((base_1 + _e553) * LEAF_VECS) + _e558)] = _e563;
+                        uint _e551 = i;
+                        uint _e556 = h;
+                        uint _e559 = i;
+                        uint _e560 = h;
+                        vec4 _e561 = pst_leaf(f_24, _e559, _e89, delta_6, _e560);
+                        _group_0_binding_6_cs[(((base_1 + _e551) * LEAF_VECS) + _e556)] = _e561;
                     }
                 }
             }
@@ -1477,37 +1492,37 @@ void main() {
         bool loop_init_18 = true;
         while(true) {
             if (!loop_init_18) {
-                uint _e600 = j_5;
-                j_5 = (_e600 + 1u);
+                uint _e598 = j_5;
+                j_5 = (_e598 + 1u);
             }
             loop_init_18 = false;
-            uint _e586 = j_5;
-            if ((_e586 < (v_12 * LEAF_VECS))) {
+            uint _e584 = j_5;
+            if ((_e584 < (v_12 * LEAF_VECS))) {
             } else {
                 break;
             }
             {
-                uint _e591 = j_5;
-                _group_0_binding_7_cs[(tree + _e591)] = vec4(0.0, 0.0, 0.0, 0.0);
+                uint _e589 = j_5;
+                _group_0_binding_7_cs[(tree + _e589)] = vec4(0.0, 0.0, 0.0, 0.0);
             }
         }
         uint lo_5 = (li * cw);
         uint hi_5 = (((li + 1u) == TREES) ? width : min((lo_5 + cw), width));
         top = v_12;
         while(true) {
-            uint _e612 = next;
-            uint _e613 = top;
-            if ((_e612 < _e613)) {
+            uint _e610 = next;
+            uint _e611 = top;
+            if ((_e610 < _e611)) {
             } else {
                 break;
             }
             {
-                uint _e615 = next;
-                uint _e616 = top;
-                uint mid_2 = ((_e615 + _e616) / 2u);
-                uint _e623 = by_end[mid_2];
-                uint _e625 = q_end[_e623];
-                if ((_e625 < lo_5)) {
+                uint _e613 = next;
+                uint _e614 = top;
+                uint mid_2 = ((_e613 + _e614) / 2u);
+                uint _e621 = by_end[mid_2];
+                uint _e623 = q_end[_e621];
+                if ((_e623 < lo_5)) {
                     next = (mid_2 + 1u);
                 } else {
                     top = mid_2;
@@ -1518,132 +1533,132 @@ void main() {
         bool loop_init_19 = true;
         while(true) {
             if (!loop_init_19) {
-                uint _e773 = i_1;
-                i_1 = (_e773 + 1u);
+                uint _e771 = i_1;
+                i_1 = (_e771 + 1u);
             }
             loop_init_19 = false;
-            uint _e630 = i_1;
-            if ((_e630 <= hi_5)) {
+            uint _e628 = i_1;
+            if ((_e628 <= hi_5)) {
             } else {
                 break;
             }
             {
                 while(true) {
-                    uint _e632 = next;
-                    if ((_e632 < v_12)) {
-                        uint _e636 = next;
-                        uint _e638 = by_end[_e636];
-                        uint _e640 = q_end[_e638];
-                        uint _e641 = i_1;
-                        local_6 = (_e640 == _e641);
+                    uint _e630 = next;
+                    if ((_e630 < v_12)) {
+                        uint _e634 = next;
+                        uint _e636 = by_end[_e634];
+                        uint _e638 = q_end[_e636];
+                        uint _e639 = i_1;
+                        local_6 = (_e638 == _e639);
                     } else {
                         local_6 = false;
                     }
-                    bool _e646 = local_6;
-                    if (_e646) {
-                        uint _e647 = i_1;
-                        if (!((_e647 < hi_5))) {
+                    bool _e644 = local_6;
+                    if (_e644) {
+                        uint _e645 = i_1;
+                        if (!((_e645 < hi_5))) {
                             local_8 = ((li + 1u) == TREES);
                         } else {
                             local_8 = true;
                         }
-                        bool _e657 = local_8;
-                        local_7 = _e657;
+                        bool _e655 = local_8;
+                        local_7 = _e655;
                     } else {
                         local_7 = false;
                     }
-                    bool _e661 = local_7;
-                    if (_e661) {
+                    bool _e659 = local_7;
+                    if (_e659) {
                     } else {
                         break;
                     }
                     {
-                        uint _e663 = next;
-                        uint k_10 = by_end[_e663];
-                        uint _e667 = next;
-                        next = (_e667 + 1u);
+                        uint _e661 = next;
+                        uint k_10 = by_end[_e661];
+                        uint _e665 = next;
+                        next = (_e665 + 1u);
                         h_1 = 0u;
                         bool loop_init_20 = true;
                         while(true) {
                             if (!loop_init_20) {
-                                uint _e718 = h_1;
-                                h_1 = (_e718 + 1u);
+                                uint _e716 = h_1;
+                                h_1 = (_e716 + 1u);
                             }
                             loop_init_20 = false;
-                            uint _e671 = h_1;
-                            if ((_e671 < LEAF_VECS)) {
+                            uint _e669 = h_1;
+                            if ((_e669 < LEAF_VECS)) {
                             } else {
                                 break;
                             }
                             {
                                 p = vec4(0.0, 0.0, 0.0, 0.0);
-                                uint _e682 = q_rank[k_10];
-                                j_6 = (v_12 - _e682);
+                                uint _e680 = q_rank[k_10];
+                                j_6 = (v_12 - _e680);
                                 while(true) {
-                                    uint _e685 = j_6;
-                                    if ((_e685 > 0u)) {
+                                    uint _e683 = j_6;
+                                    if ((_e683 > 0u)) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        vec4 _e688 = p;
-                                        uint _e689 = j_6;
-                                        uint _e696 = h_1;
-                                        vec4 _e699 = _group_0_binding_7_cs[((tree + ((_e689 - 1u) * LEAF_VECS)) + _e696)];
-                                        p = (_e688 + _e699);
+                                        vec4 _e686 = p;
+                                        uint _e687 = j_6;
+                                        uint _e694 = h_1;
+                                        vec4 _e697 = _group_0_binding_7_cs[((tree + ((_e687 - 1u) * LEAF_VECS)) + _e694)];
+                                        p = (_e686 + _e697);
+                                        uint _e699 = j_6;
+                                        uint _e700 = j_6;
                                         uint _e701 = j_6;
-                                        uint _e702 = j_6;
-                                        uint _e703 = j_6;
-                                        j_6 = (_e701 - (_e702 & (~(_e703) + 1u)));
+                                        j_6 = (_e699 - (_e700 & (~(_e701) + 1u)));
                                     }
                                 }
-                                uint _e713 = h_1;
-                                vec4 _e716 = p;
-                                _group_0_binding_7_cs[((partials + (k_10 * LEAF_VECS)) + _e713)] = _e716;
+                                uint _e711 = h_1;
+                                vec4 _e714 = p;
+                                _group_0_binding_7_cs[((partials + (k_10 * LEAF_VECS)) + _e711)] = _e714;
                             }
                         }
                     }
                 }
-                uint _e720 = i_1;
-                if ((_e720 == hi_5)) {
+                uint _e718 = i_1;
+                if ((_e718 == hi_5)) {
                     break;
                 }
-                uint _e723 = i_1;
-                uint b_8 = _group_0_binding_8_cs[(base_1 + _e723)];
+                uint _e721 = i_1;
+                uint b_8 = _group_0_binding_8_cs[(base_1 + _e721)];
                 if ((b_8 > 0u)) {
                     h_2 = 0u;
                     bool loop_init_21 = true;
                     while(true) {
                         if (!loop_init_21) {
-                            uint _e770 = h_2;
-                            h_2 = (_e770 + 1u);
+                            uint _e768 = h_2;
+                            h_2 = (_e768 + 1u);
                         }
                         loop_init_21 = false;
-                        uint _e731 = h_2;
-                        if ((_e731 < LEAF_VECS)) {
+                        uint _e729 = h_2;
+                        if ((_e729 < LEAF_VECS)) {
                         } else {
                             break;
                         }
                         {
-                            uint _e734 = i_1;
-                            uint _e739 = h_2;
-                            vec4 leaf_1 = _group_0_binding_6_cs[(((base_1 + _e734) * LEAF_VECS) + _e739)];
+                            uint _e732 = i_1;
+                            uint _e737 = h_2;
+                            vec4 leaf_1 = _group_0_binding_6_cs[(((base_1 + _e732) * LEAF_VECS) + _e737)];
                             j_7 = ((v_12 - b_8) + 1u);
                             while(true) {
-                                uint _e747 = j_7;
-                                if ((_e747 <= v_12)) {
+                                uint _e745 = j_7;
+                                if ((_e745 <= v_12)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    uint _e749 = j_7;
-                                    uint _e756 = h_2;
-                                    vec4 _e759 = _group_0_binding_7_cs[((tree + ((_e749 - 1u) * LEAF_VECS)) + _e756)];
-                                    _group_0_binding_7_cs[((tree + ((_e749 - 1u) * LEAF_VECS)) + _e756)] = (_e759 + leaf_1);
+                                    uint _e747 = j_7;
+                                    uint _e754 = h_2;
+                                    vec4 _e757 = _group_0_binding_7_cs[((tree + ((_e747 - 1u) * LEAF_VECS)) + _e754)];
+                                    _group_0_binding_7_cs[((tree + ((_e747 - 1u) * LEAF_VECS)) + _e754)] = (_e757 + leaf_1);
+                                    uint _e759 = j_7;
+                                    uint _e760 = j_7;
                                     uint _e761 = j_7;
-                                    uint _e762 = j_7;
-                                    uint _e763 = j_7;
-                                    j_7 = (_e761 + (_e762 & (~(_e763) + 1u)));
+                                    j_7 = (_e759 + (_e760 & (~(_e761) + 1u)));
                                 }
                             }
                         }
@@ -1660,12 +1675,12 @@ void main() {
     bool loop_init_22 = true;
     while(true) {
         if (!loop_init_22) {
-            uint _e810 = x;
-            x = (_e810 + SLICE_LANES);
+            uint _e808 = x;
+            x = (_e808 + SLICE_LANES);
         }
         loop_init_22 = false;
-        uint _e776 = x;
-        if ((_e776 < (v_12 * LEAF_VECS))) {
+        uint _e774 = x;
+        if ((_e774 < (v_12 * LEAF_VECS))) {
         } else {
             break;
         }
@@ -1675,24 +1690,24 @@ void main() {
             bool loop_init_23 = true;
             while(true) {
                 if (!loop_init_23) {
-                    uint _e808 = c_1;
-                    c_1 = (_e808 + 1u);
+                    uint _e806 = c_1;
+                    c_1 = (_e806 + 1u);
                 }
                 loop_init_23 = false;
-                uint _e788 = c_1;
-                if ((_e788 < TREES)) {
+                uint _e786 = c_1;
+                if ((_e786 < TREES)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e791 = c_1;
-                    uint _e797 = x;
-                    uint at = ((trees + ((_e791 * SLICE_SAMPLES) * LEAF_VECS)) + _e797);
+                    uint _e789 = c_1;
+                    uint _e795 = x;
+                    uint at = ((trees + ((_e789 * SLICE_SAMPLES) * LEAF_VECS)) + _e795);
                     vec4 own = _group_0_binding_7_cs[at];
-                    vec4 _e804 = running;
-                    _group_0_binding_7_cs[at] = _e804;
-                    vec4 _e805 = running;
-                    running = (_e805 + own);
+                    vec4 _e802 = running;
+                    _group_0_binding_7_cs[at] = _e802;
+                    vec4 _e803 = running;
+                    running = (_e803 + own);
                 }
             }
         }
@@ -1705,84 +1720,84 @@ void main() {
     bool loop_init_24 = true;
     while(true) {
         if (!loop_init_24) {
-            uint _e925 = k_4;
-            k_4 = (_e925 + SLICE_LANES);
+            uint _e923 = k_4;
+            k_4 = (_e923 + SLICE_LANES);
         }
         loop_init_24 = false;
-        uint _e814 = k_4;
-        if ((_e814 < SLICE_SAMPLES)) {
+        uint _e812 = k_4;
+        if ((_e812 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e818 = k_4;
-            uint _e820 = q_end[_e818];
-            if ((_e820 != NONE)) {
-                uint _e824 = k_4;
-                uint _e826 = q_end[_e824];
-                uint tree_1 = (trees + ((min((_e826 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
+            uint _e816 = k_4;
+            uint _e818 = q_end[_e816];
+            if ((_e818 != NONE)) {
+                uint _e822 = k_4;
+                uint _e824 = q_end[_e822];
+                uint tree_1 = (trees + ((min((_e824 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0.0;
                 h_3 = 0u;
                 bool loop_init_25 = true;
                 while(true) {
                     if (!loop_init_25) {
-                        uint _e893 = h_3;
-                        h_3 = (_e893 + 1u);
+                        uint _e891 = h_3;
+                        h_3 = (_e891 + 1u);
                     }
                     loop_init_25 = false;
-                    uint _e839 = h_3;
-                    if ((_e839 < LEAF_VECS)) {
+                    uint _e837 = h_3;
+                    if ((_e837 < LEAF_VECS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e842 = k_4;
-                        uint _e847 = h_3;
-                        vec4 _e850 = _group_0_binding_7_cs[((partials + (_e842 * LEAF_VECS)) + _e847)];
-                        p_1 = _e850;
-                        uint _e853 = k_4;
-                        uint _e855 = q_rank[_e853];
-                        j_8 = (v_12 - _e855);
+                        uint _e840 = k_4;
+                        uint _e845 = h_3;
+                        vec4 _e848 = _group_0_binding_7_cs[((partials + (_e840 * LEAF_VECS)) + _e845)];
+                        p_1 = _e848;
+                        uint _e851 = k_4;
+                        uint _e853 = q_rank[_e851];
+                        j_8 = (v_12 - _e853);
                         while(true) {
-                            uint _e858 = j_8;
-                            if ((_e858 > 0u)) {
+                            uint _e856 = j_8;
+                            if ((_e856 > 0u)) {
                             } else {
                                 break;
                             }
                             {
-                                vec4 _e861 = p_1;
-                                uint _e862 = j_8;
-                                uint _e869 = h_3;
-                                vec4 _e872 = _group_0_binding_7_cs[((tree_1 + ((_e862 - 1u) * LEAF_VECS)) + _e869)];
-                                p_1 = (_e861 + _e872);
+                                vec4 _e859 = p_1;
+                                uint _e860 = j_8;
+                                uint _e867 = h_3;
+                                vec4 _e870 = _group_0_binding_7_cs[((tree_1 + ((_e860 - 1u) * LEAF_VECS)) + _e867)];
+                                p_1 = (_e859 + _e870);
+                                uint _e872 = j_8;
+                                uint _e873 = j_8;
                                 uint _e874 = j_8;
-                                uint _e875 = j_8;
-                                uint _e876 = j_8;
-                                j_8 = (_e874 - (_e875 & (~(_e876) + 1u)));
+                                j_8 = (_e872 - (_e873 & (~(_e874) + 1u)));
                             }
                         }
-                        float _e882 = dotp;
-                        vec4 _e883 = p_1;
-                        uint _e885 = k_4;
-                        float _e887 = q_theta[_e885];
-                        uint _e888 = h_3;
-                        vec4 _e889 = beta_at(_e887, _e888);
-                        dotp = (_e882 + dot(_e883, _e889));
+                        float _e880 = dotp;
+                        vec4 _e881 = p_1;
+                        uint _e883 = k_4;
+                        float _e885 = q_theta[_e883];
+                        uint _e886 = h_3;
+                        vec4 _e887 = beta_at(_e885, _e886);
+                        dotp = (_e880 + dot(_e881, _e887));
                     }
                 }
-                uint _e898 = k_4;
-                float _e900 = q_a[_e898];
-                float _e901 = dotp;
-                uint _e906 = k_4;
-                float _e908 = q_b[_e906];
-                vec3 _e911 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_24.light_color.xyz * (max((_e900 * _e901), 0.0) + _e908)));
-                uint _e912 = k_4;
-                uvec2 _e913 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e912, screen_4);
-                int _e916_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-                vec4 _e916 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e913), ivec2(0), textureSize(_group_0_binding_2_cs, _e916_clamped_lod) - ivec2(1)), _e916_clamped_lod);
-                float z_8 = _e916.x;
-                uint _e918 = k_4;
-                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e918, s_7)), vec4(_e911.x, _e911.y, _e911.z, z_8));
+                uint _e896 = k_4;
+                float _e898 = q_a[_e896];
+                float _e899 = dotp;
+                uint _e904 = k_4;
+                float _e906 = q_b[_e904];
+                vec3 _e909 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_24.light_color.xyz * (max((_e898 * _e899), 0.0) + _e906)));
+                uint _e910 = k_4;
+                uvec2 _e911 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e910, screen_4);
+                int _e914_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+                vec4 _e914 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(_e911), ivec2(0), textureSize(_group_0_binding_2_cs, _e914_clamped_lod) - ivec2(1)), _e914_clamped_lod);
+                float z_8 = _e914.x;
+                uint _e916 = k_4;
+                imageStore(_group_0_binding_9_cs, ivec2(uvec2(_e916, s_7)), vec4(_e909.x, _e909.y, _e909.z, z_8));
             }
         }
     }

@@ -77,6 +77,13 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     int _end_pad_0;
 };
 
+struct FallbackCount {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
+
 struct PstRay {
     bool marched;
     int _pad1_0;
@@ -107,6 +114,7 @@ static const uint STEP = 1u;
 static const uint SLICE_RUNS = 256u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
+static const uint FALLBACK_ROW_GROUPS = 1024u;
 static const uint RANK_VECS = 2u;
 static const uint LEAF_VECS = 2u;
 static const uint TREES = 8u;
@@ -828,6 +836,15 @@ uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLa
     return naga_f2u32(clamp(floor(p_8), float2(0.0, 0.0), last_1));
 }
 
+void fallback_list_reset()
+{
+    { uint dummy = 0; fallback_count.InterlockedExchange(0, 0u, dummy); }
+    { uint dummy_1 = 0; fallback_count.InterlockedExchange(4, 0u, dummy_1); }
+    { uint dummy_2 = 0; fallback_count.InterlockedExchange(8, 0u, dummy_2); }
+    fallback_count.Store(12, asuint(1u));
+    return;
+}
+
 float4 factor_at(uint base, float x_4, uint h_4)
 {
     float p_9 = min((clamp(x_4, 0.0, 1.0) * 95.0), 95.0);
@@ -1182,18 +1199,18 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     if ((li == 0u)) {
         output[uint2(SLICE_SAMPLES, s_7)] = float4(_e40.x, _e40.y, _e42.x, _e42.y);
         if ((s_7 == 0u)) {
-            { uint dummy = 0; fallback_count.InterlockedExchange(0, 0u, dummy); }
+            fallback_list_reset();
             output[uint2(0u, 512u)] = float4(_e37.origin, _e37.axis);
             output[uint2(1u, 512u)] = float4(_e37.phi_start, _e37.dphi, float(_e37.wrap), 0.0);
         }
     }
     float2 far_end = (_e37.origin + (_e40 * (_e42.x + (255.0 * _e42.y))));
-    const PstRay _e84 = pst_ray(far_end, 0.0);
-    uint row_5 = _e84.row;
-    float4 _e88 = asfloat(slices_1.Load4(row_5*16));
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
-    float delta_6 = _e89.delta;
-    const float3 _e91 = pst_row_e(f_24, row_5);
+    const PstRay _e82 = pst_ray(far_end, 0.0);
+    uint row_5 = _e82.row;
+    float4 _e86 = asfloat(slices_1.Load4(row_5*16));
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e87 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e86);
+    float delta_6 = _e87.delta;
+    const float3 _e89 = pst_row_e(f_24, row_5);
     k = li;
     uint2 loop_bound_8 = uint2(4294967295u, 4294967295u);
     bool loop_init_8 = true;
@@ -1201,63 +1218,63 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_8 == uint2(0u, 0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
         if (!loop_init_8) {
-            uint _e189 = k;
-            k = (_e189 + SLICE_LANES);
+            uint _e187 = k;
+            k = (_e187 + SLICE_LANES);
         }
         loop_init_8 = false;
-        uint _e93 = k;
-        if ((_e93 < SLICE_SAMPLES)) {
+        uint _e91 = k;
+        if ((_e91 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e96 = k;
-            const uint2 _e97 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e96, screen_4);
-            float4 _e100 = depth.Load(int3(_e97, int(0)));
-            float z_7 = _e100.x;
-            uint _e104 = k;
-            const float _e111 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (float(_e104) * _e42.y)))), screen_4);
+            uint _e94 = k;
+            const uint2 _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e94, screen_4);
+            float4 _e98 = depth.Load(int3(_e95, int(0)));
+            float z_7 = _e98.x;
+            uint _e102 = k;
+            const float _e109 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (float(_e102) * _e42.y)))), screen_4);
             r = ZeroValuePstRay();
-            if ((_e111 < 0.0)) {
-                const PstRay _e125 = pst_ray(float2((float(_e97.x) + 0.5), (float(_e97.y) + 0.5)), z_7);
-                r = _e125;
+            if ((_e109 < 0.0)) {
+                const PstRay _e123 = pst_ray(float2((float(_e95.x) + 0.5), (float(_e95.y) + 0.5)), z_7);
+                r = _e123;
             } else {
-                uint _e128 = k;
-                const PstRay _e135 = pst_ray((_e37.origin + (_e40 * (_e42.x + (float(_e128) * _e42.y)))), _e111);
-                r = _e135;
+                uint _e126 = k;
+                const PstRay _e133 = pst_ray((_e37.origin + (_e40 * (_e42.x + (float(_e126) * _e42.y)))), _e109);
+                r = _e133;
             }
-            PstRay _e136 = r;
-            const uint _e137 = pst_columns_crossed(_e136, delta_6);
-            uint _e139 = k;
-            q_end[min(uint(_e139), 255u)] = NONE;
-            bool _e143 = r.marched;
-            if (!(_e143)) {
-                local = (_e137 == 0u);
+            PstRay _e134 = r;
+            const uint _e135 = pst_columns_crossed(_e134, delta_6);
+            uint _e137 = k;
+            q_end[min(uint(_e137), 255u)] = NONE;
+            bool _e141 = r.marched;
+            if (!(_e141)) {
+                local = (_e135 == 0u);
             } else {
                 local = true;
             }
-            bool _e150 = local;
-            if (_e150) {
-                float3 _e152 = r.color;
-                const float3 _e153 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e152);
-                uint _e154 = k;
-                output[uint2(_e154, s_7)] = float4(_e153.x, _e153.y, _e153.z, z_7);
+            bool _e148 = local;
+            if (_e148) {
+                float3 _e150 = r.color;
+                const float3 _e151 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e150);
+                uint _e152 = k;
+                output[uint2(_e152, s_7)] = float4(_e151.x, _e151.y, _e151.z, z_7);
             } else {
-                PstRay _e161 = r;
-                const float2 _e162 = pst_terms(_e161, row_5, delta_6, _e137);
-                uint _e164 = k;
-                q_b[min(uint(_e164), 255u)] = _e162.y;
-                uint _e168 = k;
-                q_end[min(uint(_e168), 255u)] = (_e137 - 1u);
-                uint _e173 = k;
-                float _e176 = r.d;
-                q_d[min(uint(_e173), 255u)] = _e176;
-                uint _e178 = k;
-                float _e181 = r.theta;
-                q_theta[min(uint(_e178), 255u)] = _e181;
-                uint _e183 = k;
-                q_a[min(uint(_e183), 255u)] = _e162.x;
-                uint _e188; InterlockedAdd(live, 1u, _e188);
+                PstRay _e159 = r;
+                const float2 _e160 = pst_terms(_e159, row_5, delta_6, _e135);
+                uint _e162 = k;
+                q_b[min(uint(_e162), 255u)] = _e160.y;
+                uint _e166 = k;
+                q_end[min(uint(_e166), 255u)] = (_e135 - 1u);
+                uint _e171 = k;
+                float _e174 = r.d;
+                q_d[min(uint(_e171), 255u)] = _e174;
+                uint _e176 = k;
+                float _e179 = r.theta;
+                q_theta[min(uint(_e176), 255u)] = _e179;
+                uint _e181 = k;
+                q_a[min(uint(_e181), 255u)] = _e160.x;
+                uint _e186; InterlockedAdd(live, 1u, _e186);
             }
         }
     }
@@ -1271,139 +1288,139 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             if (all(loop_bound_9 == uint2(0u, 0u))) { break; }
             loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
             if (!loop_init_9) {
-                uint _e229 = k_1;
-                k_1 = (_e229 + 1u);
+                uint _e227 = k_1;
+                k_1 = (_e227 + 1u);
             }
             loop_init_9 = false;
-            uint _e203 = k_1;
-            if ((_e203 < SLICE_SAMPLES)) {
+            uint _e201 = k_1;
+            if ((_e201 < SLICE_SAMPLES)) {
             } else {
                 break;
             }
             {
-                uint _e207 = k_1;
-                uint _e209 = q_end[min(uint(_e207), 255u)];
-                if ((_e209 != NONE)) {
-                    uint _e213 = k_1;
-                    uint _e215 = q_end[min(uint(_e213), 255u)];
-                    local_1 = (min(naga_div(_e215, cw), 7u) == li);
+                uint _e205 = k_1;
+                uint _e207 = q_end[min(uint(_e205), 255u)];
+                if ((_e207 != NONE)) {
+                    uint _e211 = k_1;
+                    uint _e213 = q_end[min(uint(_e211), 255u)];
+                    local_1 = (min(naga_div(_e213, cw), 7u) == li);
                 } else {
                     local_1 = false;
                 }
-                bool _e223 = local_1;
-                if (_e223) {
-                    uint _e226 = count;
-                    count = (_e226 + 1u);
+                bool _e221 = local_1;
+                if (_e221) {
+                    uint _e224 = count;
+                    count = (_e224 + 1u);
                 }
             }
         }
-        uint _e233 = count;
-        bucket[min(uint(li), 7u)] = _e233;
+        uint _e231 = count;
+        bucket[min(uint(li), 7u)] = _e231;
     } else {
         if ((li == TREES)) {
             local_2 = (v_12 > 0u);
         } else {
             local_2 = false;
         }
-        bool _e241 = local_2;
-        if (_e241) {
+        bool _e239 = local_2;
+        if (_e239) {
             uint2 loop_bound_10 = uint2(4294967295u, 4294967295u);
             while(true) {
                 if (all(loop_bound_10 == uint2(0u, 0u))) { break; }
                 loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
-                uint _e244 = first;
-                uint _e246 = q_end[min(uint(_e244), 255u)];
-                if ((_e246 == NONE)) {
+                uint _e242 = first;
+                uint _e244 = q_end[min(uint(_e242), 255u)];
+                if ((_e244 == NONE)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e250 = first;
-                    first = (_e250 + 1u);
+                    uint _e248 = first;
+                    first = (_e248 + 1u);
                 }
             }
             uint2 loop_bound_11 = uint2(4294967295u, 4294967295u);
             while(true) {
                 if (all(loop_bound_11 == uint2(0u, 0u))) { break; }
                 loop_bound_11 -= uint2(loop_bound_11.y == 0u, 1u);
-                uint _e254 = last;
-                uint _e256 = q_end[min(uint(_e254), 255u)];
-                if ((_e256 == NONE)) {
+                uint _e252 = last;
+                uint _e254 = q_end[min(uint(_e252), 255u)];
+                if ((_e254 == NONE)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e260 = last;
-                    last = (_e260 - 1u);
+                    uint _e258 = last;
+                    last = (_e258 - 1u);
                 }
             }
-            uint _e263 = first;
-            float _e265 = q_d[min(uint(_e263), 255u)];
-            uint _e267 = last;
-            float _e269 = q_d[min(uint(_e267), 255u)];
-            bool up = (_e265 <= _e269);
+            uint _e261 = first;
+            float _e263 = q_d[min(uint(_e261), 255u)];
+            uint _e265 = last;
+            float _e267 = q_d[min(uint(_e265), 255u)];
+            bool up = (_e263 <= _e267);
             uint2 loop_bound_12 = uint2(4294967295u, 4294967295u);
             bool loop_init_10 = true;
             while(true) {
                 if (all(loop_bound_12 == uint2(0u, 0u))) { break; }
                 loop_bound_12 -= uint2(loop_bound_12.y == 0u, 1u);
                 if (!loop_init_10) {
-                    uint _e342 = k_2;
-                    k_2 = (_e342 + 1u);
+                    uint _e340 = k_2;
+                    k_2 = (_e340 + 1u);
                 }
                 loop_init_10 = false;
-                uint _e272 = k_2;
-                if ((_e272 < SLICE_SAMPLES)) {
+                uint _e270 = k_2;
+                if ((_e270 < SLICE_SAMPLES)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e276 = k_2;
-                    uint _e278 = q_end[min(uint(_e276), 255u)];
-                    if ((_e278 != NONE)) {
-                        uint _e282 = k_2;
-                        float d_3 = q_d[min(uint(_e282), 255u)];
-                        uint _e286 = m;
-                        j = _e286;
+                    uint _e274 = k_2;
+                    uint _e276 = q_end[min(uint(_e274), 255u)];
+                    if ((_e276 != NONE)) {
+                        uint _e280 = k_2;
+                        float d_3 = q_d[min(uint(_e280), 255u)];
+                        uint _e284 = m;
+                        j = _e284;
                         uint2 loop_bound_13 = uint2(4294967295u, 4294967295u);
                         while(true) {
                             if (all(loop_bound_13 == uint2(0u, 0u))) { break; }
                             loop_bound_13 -= uint2(loop_bound_13.y == 0u, 1u);
-                            uint _e288 = j;
-                            if ((_e288 > 0u)) {
-                                uint _e291 = j;
-                                float _e296 = q_d[min(uint((_e291 - 1u)), 255u)];
-                                uint _e298 = j;
-                                float _e303 = q_d[min(uint((_e298 - 1u)), 255u)];
-                                local_3 = (up ? (_e303 > d_3) : (_e296 < d_3));
+                            uint _e286 = j;
+                            if ((_e286 > 0u)) {
+                                uint _e289 = j;
+                                float _e294 = q_d[min(uint((_e289 - 1u)), 255u)];
+                                uint _e296 = j;
+                                float _e301 = q_d[min(uint((_e296 - 1u)), 255u)];
+                                local_3 = (up ? (_e301 > d_3) : (_e294 < d_3));
                             } else {
                                 local_3 = false;
                             }
-                            bool _e309 = local_3;
-                            if (_e309) {
+                            bool _e307 = local_3;
+                            if (_e307) {
                             } else {
                                 break;
                             }
                             {
+                                uint _e309 = j;
                                 uint _e311 = j;
-                                uint _e313 = j;
-                                float _e318 = q_d[min(uint((_e313 - 1u)), 255u)];
-                                q_d[min(uint(_e311), 255u)] = _e318;
+                                float _e316 = q_d[min(uint((_e311 - 1u)), 255u)];
+                                q_d[min(uint(_e309), 255u)] = _e316;
+                                uint _e318 = j;
                                 uint _e320 = j;
-                                uint _e322 = j;
-                                uint _e327 = q_rank[min(uint((_e322 - 1u)), 255u)];
-                                q_rank[min(uint(_e320), 255u)] = _e327;
-                                uint _e329 = j;
-                                j = (_e329 - 1u);
+                                uint _e325 = q_rank[min(uint((_e320 - 1u)), 255u)];
+                                q_rank[min(uint(_e318), 255u)] = _e325;
+                                uint _e327 = j;
+                                j = (_e327 - 1u);
                             }
                         }
-                        uint _e332 = j;
-                        q_d[min(uint(_e332), 255u)] = d_3;
-                        uint _e335 = j;
-                        uint _e337 = k_2;
-                        q_rank[min(uint(_e335), 255u)] = _e337;
-                        uint _e339 = m;
-                        m = (_e339 + 1u);
+                        uint _e330 = j;
+                        q_d[min(uint(_e330), 255u)] = d_3;
+                        uint _e333 = j;
+                        uint _e335 = k_2;
+                        q_rank[min(uint(_e333), 255u)] = _e335;
+                        uint _e337 = m;
+                        m = (_e337 + 1u);
                     }
                 }
             }
@@ -1414,32 +1431,32 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     if (all(loop_bound_14 == uint2(0u, 0u))) { break; }
                     loop_bound_14 -= uint2(loop_bound_14.y == 0u, 1u);
                     if (!loop_init_11) {
-                        uint _e391 = j_1;
-                        j_1 = (_e391 + 1u);
+                        uint _e389 = j_1;
+                        j_1 = (_e389 + 1u);
                     }
                     loop_init_11 = false;
-                    uint _e346 = j_1;
-                    if ((_e346 < naga_div(v_12, 2u))) {
+                    uint _e344 = j_1;
+                    if ((_e344 < naga_div(v_12, 2u))) {
                     } else {
                         break;
                     }
                     {
-                        uint _e351 = j_1;
-                        float d_4 = q_d[min(uint(_e351), 255u)];
-                        uint _e355 = j_1;
-                        uint _e360 = j_1;
-                        float _e363 = q_d[min(uint(((v_12 - 1u) - _e360)), 255u)];
-                        q_d[min(uint(_e355), 255u)] = _e363;
-                        uint _e367 = j_1;
-                        q_d[min(uint(((v_12 - 1u) - _e367)), 255u)] = d_4;
-                        uint _e371 = j_1;
-                        uint k_9 = q_rank[min(uint(_e371), 255u)];
-                        uint _e375 = j_1;
-                        uint _e380 = j_1;
-                        uint _e383 = q_rank[min(uint(((v_12 - 1u) - _e380)), 255u)];
-                        q_rank[min(uint(_e375), 255u)] = _e383;
-                        uint _e387 = j_1;
-                        q_rank[min(uint(((v_12 - 1u) - _e387)), 255u)] = k_9;
+                        uint _e349 = j_1;
+                        float d_4 = q_d[min(uint(_e349), 255u)];
+                        uint _e353 = j_1;
+                        uint _e358 = j_1;
+                        float _e361 = q_d[min(uint(((v_12 - 1u) - _e358)), 255u)];
+                        q_d[min(uint(_e353), 255u)] = _e361;
+                        uint _e365 = j_1;
+                        q_d[min(uint(((v_12 - 1u) - _e365)), 255u)] = d_4;
+                        uint _e369 = j_1;
+                        uint k_9 = q_rank[min(uint(_e369), 255u)];
+                        uint _e373 = j_1;
+                        uint _e378 = j_1;
+                        uint _e381 = q_rank[min(uint(((v_12 - 1u) - _e378)), 255u)];
+                        q_rank[min(uint(_e373), 255u)] = _e381;
+                        uint _e385 = j_1;
+                        q_rank[min(uint(((v_12 - 1u) - _e385)), 255u)] = k_9;
                     }
                 }
             }
@@ -1453,20 +1470,20 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             if (all(loop_bound_15 == uint2(0u, 0u))) { break; }
             loop_bound_15 -= uint2(loop_bound_15.y == 0u, 1u);
             if (!loop_init_12) {
-                uint _e406 = c;
-                c = (_e406 + 1u);
+                uint _e404 = c;
+                c = (_e404 + 1u);
             }
             loop_init_12 = false;
-            uint _e396 = c;
-            if ((_e396 < li)) {
+            uint _e394 = c;
+            if ((_e394 < li)) {
             } else {
                 break;
             }
             {
-                uint _e399 = start;
-                uint _e401 = c;
-                uint _e403 = bucket[min(uint(_e401), 7u)];
-                start = (_e399 + _e403);
+                uint _e397 = start;
+                uint _e399 = c;
+                uint _e401 = bucket[min(uint(_e399), 7u)];
+                start = (_e397 + _e401);
             }
         }
         uint2 loop_bound_16 = uint2(4294967295u, 4294967295u);
@@ -1475,67 +1492,67 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             if (all(loop_bound_16 == uint2(0u, 0u))) { break; }
             loop_bound_16 -= uint2(loop_bound_16.y == 0u, 1u);
             if (!loop_init_13) {
-                uint _e482 = k_3;
-                k_3 = (_e482 + 1u);
+                uint _e480 = k_3;
+                k_3 = (_e480 + 1u);
             }
             loop_init_13 = false;
-            uint _e409 = k_3;
-            if ((_e409 < SLICE_SAMPLES)) {
+            uint _e407 = k_3;
+            if ((_e407 < SLICE_SAMPLES)) {
             } else {
                 break;
             }
             {
-                uint _e413 = k_3;
-                uint _e415 = q_end[min(uint(_e413), 255u)];
-                if ((_e415 != NONE)) {
-                    uint _e419 = k_3;
-                    uint _e421 = q_end[min(uint(_e419), 255u)];
-                    local_4 = (min(naga_div(_e421, cw), 7u) == li);
+                uint _e411 = k_3;
+                uint _e413 = q_end[min(uint(_e411), 255u)];
+                if ((_e413 != NONE)) {
+                    uint _e417 = k_3;
+                    uint _e419 = q_end[min(uint(_e417), 255u)];
+                    local_4 = (min(naga_div(_e419, cw), 7u) == li);
                 } else {
                     local_4 = false;
                 }
-                bool _e429 = local_4;
-                if (_e429) {
-                    uint _e431 = m_1;
-                    j_2 = _e431;
+                bool _e427 = local_4;
+                if (_e427) {
+                    uint _e429 = m_1;
+                    j_2 = _e429;
                     uint2 loop_bound_17 = uint2(4294967295u, 4294967295u);
                     while(true) {
                         if (all(loop_bound_17 == uint2(0u, 0u))) { break; }
                         loop_bound_17 -= uint2(loop_bound_17.y == 0u, 1u);
-                        uint _e433 = j_2;
-                        if ((_e433 > 0u)) {
-                            uint _e436 = start;
-                            uint _e437 = j_2;
-                            uint _e444 = by_end[min(uint(((_e436 + _e437) - 1u)), 255u)];
-                            uint _e446 = q_end[min(uint(_e444), 255u)];
-                            uint _e448 = k_3;
-                            uint _e450 = q_end[min(uint(_e448), 255u)];
-                            local_5 = (_e446 > _e450);
+                        uint _e431 = j_2;
+                        if ((_e431 > 0u)) {
+                            uint _e434 = start;
+                            uint _e435 = j_2;
+                            uint _e442 = by_end[min(uint(((_e434 + _e435) - 1u)), 255u)];
+                            uint _e444 = q_end[min(uint(_e442), 255u)];
+                            uint _e446 = k_3;
+                            uint _e448 = q_end[min(uint(_e446), 255u)];
+                            local_5 = (_e444 > _e448);
                         } else {
                             local_5 = false;
                         }
-                        bool _e455 = local_5;
-                        if (_e455) {
+                        bool _e453 = local_5;
+                        if (_e453) {
                         } else {
                             break;
                         }
                         {
-                            uint _e457 = start;
-                            uint _e458 = j_2;
-                            uint _e461 = start;
-                            uint _e462 = j_2;
-                            uint _e468 = by_end[min(uint(((_e461 + _e462) - 1u)), 255u)];
-                            by_end[min(uint((_e457 + _e458)), 255u)] = _e468;
-                            uint _e470 = j_2;
-                            j_2 = (_e470 - 1u);
+                            uint _e455 = start;
+                            uint _e456 = j_2;
+                            uint _e459 = start;
+                            uint _e460 = j_2;
+                            uint _e466 = by_end[min(uint(((_e459 + _e460) - 1u)), 255u)];
+                            by_end[min(uint((_e455 + _e456)), 255u)] = _e466;
+                            uint _e468 = j_2;
+                            j_2 = (_e468 - 1u);
                         }
                     }
-                    uint _e473 = start;
-                    uint _e474 = j_2;
-                    uint _e477 = k_3;
-                    by_end[min(uint((_e473 + _e474)), 255u)] = _e477;
-                    uint _e479 = m_1;
-                    m_1 = (_e479 + 1u);
+                    uint _e471 = start;
+                    uint _e472 = j_2;
+                    uint _e475 = k_3;
+                    by_end[min(uint((_e471 + _e472)), 255u)] = _e475;
+                    uint _e477 = m_1;
+                    m_1 = (_e477 + 1u);
                 }
             }
         }
@@ -1547,20 +1564,20 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_18 == uint2(0u, 0u))) { break; }
         loop_bound_18 -= uint2(loop_bound_18.y == 0u, 1u);
         if (!loop_init_14) {
-            uint _e496 = j_3;
-            j_3 = (_e496 + SLICE_LANES);
+            uint _e494 = j_3;
+            j_3 = (_e494 + SLICE_LANES);
         }
         loop_init_14 = false;
-        uint _e485 = j_3;
-        if ((_e485 < v_12)) {
+        uint _e483 = j_3;
+        if ((_e483 < v_12)) {
         } else {
             break;
         }
         {
-            uint _e487 = j_3;
-            uint _e493 = j_3;
-            uint _e495 = q_rank[min(uint(_e493), 255u)];
-            mine[min(uint(naga_div(_e487, SLICE_LANES)), 7u)] = _e495;
+            uint _e485 = j_3;
+            uint _e491 = j_3;
+            uint _e493 = q_rank[min(uint(_e491), 255u)];
+            mine[min(uint(naga_div(_e485, SLICE_LANES)), 7u)] = _e493;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -1571,20 +1588,20 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_19 == uint2(0u, 0u))) { break; }
         loop_bound_19 -= uint2(loop_bound_19.y == 0u, 1u);
         if (!loop_init_15) {
-            uint _e510 = j_4;
-            j_4 = (_e510 + SLICE_LANES);
+            uint _e508 = j_4;
+            j_4 = (_e508 + SLICE_LANES);
         }
         loop_init_15 = false;
-        uint _e500 = j_4;
-        if ((_e500 < v_12)) {
+        uint _e498 = j_4;
+        if ((_e498 < v_12)) {
         } else {
             break;
         }
         {
-            uint _e502 = j_4;
-            uint _e507 = mine[min(uint(naga_div(_e502, SLICE_LANES)), 7u)];
-            uint _e509 = j_4;
-            q_rank[min(uint(_e507), 255u)] = _e509;
+            uint _e500 = j_4;
+            uint _e505 = mine[min(uint(naga_div(_e500, SLICE_LANES)), 7u)];
+            uint _e507 = j_4;
+            q_rank[min(uint(_e505), 255u)] = _e507;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -1596,48 +1613,48 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_20 == uint2(0u, 0u))) { break; }
         loop_bound_20 -= uint2(loop_bound_20.y == 0u, 1u);
         if (!loop_init_16) {
-            uint _e567 = i;
-            i = (_e567 + SLICE_LANES);
+            uint _e565 = i;
+            i = (_e565 + SLICE_LANES);
         }
         loop_init_16 = false;
-        uint _e515 = i;
-        if ((_e515 < width)) {
+        uint _e513 = i;
+        if ((_e513 < width)) {
         } else {
             break;
         }
         {
-            uint _e517 = i;
-            float4 _e521 = rectified.Load(int3(uint2(_e517, row_5), int(0)));
-            float occluder = _e521.x;
+            uint _e515 = i;
+            float4 _e519 = rectified.Load(int3(uint2(_e515, row_5), int(0)));
+            float occluder = _e519.x;
             lo = 0u;
             hi = v_12;
             uint2 loop_bound_21 = uint2(4294967295u, 4294967295u);
             while(true) {
                 if (all(loop_bound_21 == uint2(0u, 0u))) { break; }
                 loop_bound_21 -= uint2(loop_bound_21.y == 0u, 1u);
-                uint _e526 = lo;
-                uint _e527 = hi;
-                if ((_e526 < _e527)) {
+                uint _e524 = lo;
+                uint _e525 = hi;
+                if ((_e524 < _e525)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e529 = lo;
-                    uint _e530 = hi;
-                    uint mid_1 = naga_div((_e529 + _e530), 2u);
-                    float _e536 = q_d[min(uint(mid_1), 255u)];
-                    if ((_e536 <= occluder)) {
+                    uint _e527 = lo;
+                    uint _e528 = hi;
+                    uint mid_1 = naga_div((_e527 + _e528), 2u);
+                    float _e534 = q_d[min(uint(mid_1), 255u)];
+                    if ((_e534 <= occluder)) {
                         lo = (mid_1 + 1u);
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            uint _e541 = i;
-            uint _e544 = lo;
-            pst_columns.Store((base_1 + _e541)*4, asuint(_e544));
-            uint _e545 = lo;
-            if ((_e545 > 0u)) {
+            uint _e539 = i;
+            uint _e542 = lo;
+            pst_columns.Store((base_1 + _e539)*4, asuint(_e542));
+            uint _e543 = lo;
+            if ((_e543 > 0u)) {
                 h = 0u;
                 uint2 loop_bound_22 = uint2(4294967295u, 4294967295u);
                 bool loop_init_17 = true;
@@ -1645,22 +1662,22 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     if (all(loop_bound_22 == uint2(0u, 0u))) { break; }
                     loop_bound_22 -= uint2(loop_bound_22.y == 0u, 1u);
                     if (!loop_init_17) {
-                        uint _e565 = h;
-                        h = (_e565 + 1u);
+                        uint _e563 = h;
+                        h = (_e563 + 1u);
                     }
                     loop_init_17 = false;
-                    uint _e550 = h;
-                    if ((_e550 < LEAF_VECS)) {
+                    uint _e548 = h;
+                    if ((_e548 < LEAF_VECS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e553 = i;
-                        uint _e558 = h;
-                        uint _e561 = i;
-                        uint _e562 = h;
-                        const float4 _e563 = pst_leaf(f_24, _e561, _e91, delta_6, _e562);
-                        pst_leaves.Store4((((base_1 + _e553) * LEAF_VECS) + _e558)*16, asuint(_e563));
+                        uint _e551 = i;
+                        uint _e556 = h;
+                        uint _e559 = i;
+                        uint _e560 = h;
+                        const float4 _e561 = pst_leaf(f_24, _e559, _e89, delta_6, _e560);
+                        pst_leaves.Store4((((base_1 + _e551) * LEAF_VECS) + _e556)*16, asuint(_e561));
                     }
                 }
             }
@@ -1678,18 +1695,18 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             if (all(loop_bound_23 == uint2(0u, 0u))) { break; }
             loop_bound_23 -= uint2(loop_bound_23.y == 0u, 1u);
             if (!loop_init_18) {
-                uint _e600 = j_5;
-                j_5 = (_e600 + 1u);
+                uint _e598 = j_5;
+                j_5 = (_e598 + 1u);
             }
             loop_init_18 = false;
-            uint _e586 = j_5;
-            if ((_e586 < (v_12 * LEAF_VECS))) {
+            uint _e584 = j_5;
+            if ((_e584 < (v_12 * LEAF_VECS))) {
             } else {
                 break;
             }
             {
-                uint _e591 = j_5;
-                pst_tree.Store4((tree + _e591)*16, asuint(float4(0.0, 0.0, 0.0, 0.0)));
+                uint _e589 = j_5;
+                pst_tree.Store4((tree + _e589)*16, asuint(float4(0.0, 0.0, 0.0, 0.0)));
             }
         }
         uint lo_5 = (li * cw);
@@ -1699,19 +1716,19 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         while(true) {
             if (all(loop_bound_24 == uint2(0u, 0u))) { break; }
             loop_bound_24 -= uint2(loop_bound_24.y == 0u, 1u);
-            uint _e612 = next;
-            uint _e613 = top;
-            if ((_e612 < _e613)) {
+            uint _e610 = next;
+            uint _e611 = top;
+            if ((_e610 < _e611)) {
             } else {
                 break;
             }
             {
-                uint _e615 = next;
-                uint _e616 = top;
-                uint mid_2 = naga_div((_e615 + _e616), 2u);
-                uint _e623 = by_end[min(uint(mid_2), 255u)];
-                uint _e625 = q_end[min(uint(_e623), 255u)];
-                if ((_e625 < lo_5)) {
+                uint _e613 = next;
+                uint _e614 = top;
+                uint mid_2 = naga_div((_e613 + _e614), 2u);
+                uint _e621 = by_end[min(uint(mid_2), 255u)];
+                uint _e623 = q_end[min(uint(_e621), 255u)];
+                if ((_e623 < lo_5)) {
                     next = (mid_2 + 1u);
                 } else {
                     top = mid_2;
@@ -1725,12 +1742,12 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
             if (all(loop_bound_25 == uint2(0u, 0u))) { break; }
             loop_bound_25 -= uint2(loop_bound_25.y == 0u, 1u);
             if (!loop_init_19) {
-                uint _e773 = i_1;
-                i_1 = (_e773 + 1u);
+                uint _e771 = i_1;
+                i_1 = (_e771 + 1u);
             }
             loop_init_19 = false;
-            uint _e630 = i_1;
-            if ((_e630 <= hi_5)) {
+            uint _e628 = i_1;
+            if ((_e628 <= hi_5)) {
             } else {
                 break;
             }
@@ -1739,39 +1756,39 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 while(true) {
                     if (all(loop_bound_26 == uint2(0u, 0u))) { break; }
                     loop_bound_26 -= uint2(loop_bound_26.y == 0u, 1u);
-                    uint _e632 = next;
-                    if ((_e632 < v_12)) {
-                        uint _e636 = next;
-                        uint _e638 = by_end[min(uint(_e636), 255u)];
-                        uint _e640 = q_end[min(uint(_e638), 255u)];
-                        uint _e641 = i_1;
-                        local_6 = (_e640 == _e641);
+                    uint _e630 = next;
+                    if ((_e630 < v_12)) {
+                        uint _e634 = next;
+                        uint _e636 = by_end[min(uint(_e634), 255u)];
+                        uint _e638 = q_end[min(uint(_e636), 255u)];
+                        uint _e639 = i_1;
+                        local_6 = (_e638 == _e639);
                     } else {
                         local_6 = false;
                     }
-                    bool _e646 = local_6;
-                    if (_e646) {
-                        uint _e647 = i_1;
-                        if (!((_e647 < hi_5))) {
+                    bool _e644 = local_6;
+                    if (_e644) {
+                        uint _e645 = i_1;
+                        if (!((_e645 < hi_5))) {
                             local_8 = ((li + 1u) == TREES);
                         } else {
                             local_8 = true;
                         }
-                        bool _e657 = local_8;
-                        local_7 = _e657;
+                        bool _e655 = local_8;
+                        local_7 = _e655;
                     } else {
                         local_7 = false;
                     }
-                    bool _e661 = local_7;
-                    if (_e661) {
+                    bool _e659 = local_7;
+                    if (_e659) {
                     } else {
                         break;
                     }
                     {
-                        uint _e663 = next;
-                        uint k_10 = by_end[min(uint(_e663), 255u)];
-                        uint _e667 = next;
-                        next = (_e667 + 1u);
+                        uint _e661 = next;
+                        uint k_10 = by_end[min(uint(_e661), 255u)];
+                        uint _e665 = next;
+                        next = (_e665 + 1u);
                         h_1 = 0u;
                         uint2 loop_bound_27 = uint2(4294967295u, 4294967295u);
                         bool loop_init_20 = true;
@@ -1779,53 +1796,53 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                             if (all(loop_bound_27 == uint2(0u, 0u))) { break; }
                             loop_bound_27 -= uint2(loop_bound_27.y == 0u, 1u);
                             if (!loop_init_20) {
-                                uint _e718 = h_1;
-                                h_1 = (_e718 + 1u);
+                                uint _e716 = h_1;
+                                h_1 = (_e716 + 1u);
                             }
                             loop_init_20 = false;
-                            uint _e671 = h_1;
-                            if ((_e671 < LEAF_VECS)) {
+                            uint _e669 = h_1;
+                            if ((_e669 < LEAF_VECS)) {
                             } else {
                                 break;
                             }
                             {
                                 p = float4(0.0, 0.0, 0.0, 0.0);
-                                uint _e682 = q_rank[min(uint(k_10), 255u)];
-                                j_6 = (v_12 - _e682);
+                                uint _e680 = q_rank[min(uint(k_10), 255u)];
+                                j_6 = (v_12 - _e680);
                                 uint2 loop_bound_28 = uint2(4294967295u, 4294967295u);
                                 while(true) {
                                     if (all(loop_bound_28 == uint2(0u, 0u))) { break; }
                                     loop_bound_28 -= uint2(loop_bound_28.y == 0u, 1u);
-                                    uint _e685 = j_6;
-                                    if ((_e685 > 0u)) {
+                                    uint _e683 = j_6;
+                                    if ((_e683 > 0u)) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        float4 _e688 = p;
-                                        uint _e689 = j_6;
-                                        uint _e696 = h_1;
-                                        float4 _e699 = asfloat(pst_tree.Load4(((tree + ((_e689 - 1u) * LEAF_VECS)) + _e696)*16));
-                                        p = (_e688 + _e699);
+                                        float4 _e686 = p;
+                                        uint _e687 = j_6;
+                                        uint _e694 = h_1;
+                                        float4 _e697 = asfloat(pst_tree.Load4(((tree + ((_e687 - 1u) * LEAF_VECS)) + _e694)*16));
+                                        p = (_e686 + _e697);
+                                        uint _e699 = j_6;
+                                        uint _e700 = j_6;
                                         uint _e701 = j_6;
-                                        uint _e702 = j_6;
-                                        uint _e703 = j_6;
-                                        j_6 = (_e701 - (_e702 & (~(_e703) + 1u)));
+                                        j_6 = (_e699 - (_e700 & (~(_e701) + 1u)));
                                     }
                                 }
-                                uint _e713 = h_1;
-                                float4 _e716 = p;
-                                pst_tree.Store4(((partials + (k_10 * LEAF_VECS)) + _e713)*16, asuint(_e716));
+                                uint _e711 = h_1;
+                                float4 _e714 = p;
+                                pst_tree.Store4(((partials + (k_10 * LEAF_VECS)) + _e711)*16, asuint(_e714));
                             }
                         }
                     }
                 }
-                uint _e720 = i_1;
-                if ((_e720 == hi_5)) {
+                uint _e718 = i_1;
+                if ((_e718 == hi_5)) {
                     break;
                 }
-                uint _e723 = i_1;
-                uint b_8 = asuint(pst_columns.Load((base_1 + _e723)*4));
+                uint _e721 = i_1;
+                uint b_8 = asuint(pst_columns.Load((base_1 + _e721)*4));
                 if ((b_8 > 0u)) {
                     h_2 = 0u;
                     uint2 loop_bound_29 = uint2(4294967295u, 4294967295u);
@@ -1834,38 +1851,38 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                         if (all(loop_bound_29 == uint2(0u, 0u))) { break; }
                         loop_bound_29 -= uint2(loop_bound_29.y == 0u, 1u);
                         if (!loop_init_21) {
-                            uint _e770 = h_2;
-                            h_2 = (_e770 + 1u);
+                            uint _e768 = h_2;
+                            h_2 = (_e768 + 1u);
                         }
                         loop_init_21 = false;
-                        uint _e731 = h_2;
-                        if ((_e731 < LEAF_VECS)) {
+                        uint _e729 = h_2;
+                        if ((_e729 < LEAF_VECS)) {
                         } else {
                             break;
                         }
                         {
-                            uint _e734 = i_1;
-                            uint _e739 = h_2;
-                            float4 leaf_1 = asfloat(pst_leaves.Load4((((base_1 + _e734) * LEAF_VECS) + _e739)*16));
+                            uint _e732 = i_1;
+                            uint _e737 = h_2;
+                            float4 leaf_1 = asfloat(pst_leaves.Load4((((base_1 + _e732) * LEAF_VECS) + _e737)*16));
                             j_7 = ((v_12 - b_8) + 1u);
                             uint2 loop_bound_30 = uint2(4294967295u, 4294967295u);
                             while(true) {
                                 if (all(loop_bound_30 == uint2(0u, 0u))) { break; }
                                 loop_bound_30 -= uint2(loop_bound_30.y == 0u, 1u);
-                                uint _e747 = j_7;
-                                if ((_e747 <= v_12)) {
+                                uint _e745 = j_7;
+                                if ((_e745 <= v_12)) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    uint _e749 = j_7;
-                                    uint _e756 = h_2;
-                                    float4 _e759 = asfloat(pst_tree.Load4(((tree + ((_e749 - 1u) * LEAF_VECS)) + _e756)*16));
-                                    pst_tree.Store4(((tree + ((_e749 - 1u) * LEAF_VECS)) + _e756)*16, asuint((_e759 + leaf_1)));
+                                    uint _e747 = j_7;
+                                    uint _e754 = h_2;
+                                    float4 _e757 = asfloat(pst_tree.Load4(((tree + ((_e747 - 1u) * LEAF_VECS)) + _e754)*16));
+                                    pst_tree.Store4(((tree + ((_e747 - 1u) * LEAF_VECS)) + _e754)*16, asuint((_e757 + leaf_1)));
+                                    uint _e759 = j_7;
+                                    uint _e760 = j_7;
                                     uint _e761 = j_7;
-                                    uint _e762 = j_7;
-                                    uint _e763 = j_7;
-                                    j_7 = (_e761 + (_e762 & (~(_e763) + 1u)));
+                                    j_7 = (_e759 + (_e760 & (~(_e761) + 1u)));
                                 }
                             }
                         }
@@ -1883,12 +1900,12 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_31 == uint2(0u, 0u))) { break; }
         loop_bound_31 -= uint2(loop_bound_31.y == 0u, 1u);
         if (!loop_init_22) {
-            uint _e810 = x;
-            x = (_e810 + SLICE_LANES);
+            uint _e808 = x;
+            x = (_e808 + SLICE_LANES);
         }
         loop_init_22 = false;
-        uint _e776 = x;
-        if ((_e776 < (v_12 * LEAF_VECS))) {
+        uint _e774 = x;
+        if ((_e774 < (v_12 * LEAF_VECS))) {
         } else {
             break;
         }
@@ -1901,24 +1918,24 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 if (all(loop_bound_32 == uint2(0u, 0u))) { break; }
                 loop_bound_32 -= uint2(loop_bound_32.y == 0u, 1u);
                 if (!loop_init_23) {
-                    uint _e808 = c_1;
-                    c_1 = (_e808 + 1u);
+                    uint _e806 = c_1;
+                    c_1 = (_e806 + 1u);
                 }
                 loop_init_23 = false;
-                uint _e788 = c_1;
-                if ((_e788 < TREES)) {
+                uint _e786 = c_1;
+                if ((_e786 < TREES)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e791 = c_1;
-                    uint _e797 = x;
-                    uint at = ((trees + ((_e791 * SLICE_SAMPLES) * LEAF_VECS)) + _e797);
+                    uint _e789 = c_1;
+                    uint _e795 = x;
+                    uint at = ((trees + ((_e789 * SLICE_SAMPLES) * LEAF_VECS)) + _e795);
                     float4 own = asfloat(pst_tree.Load4(at*16));
-                    float4 _e804 = running;
-                    pst_tree.Store4(at*16, asuint(_e804));
-                    float4 _e805 = running;
-                    running = (_e805 + own);
+                    float4 _e802 = running;
+                    pst_tree.Store4(at*16, asuint(_e802));
+                    float4 _e803 = running;
+                    running = (_e803 + own);
                 }
             }
         }
@@ -1932,22 +1949,22 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_33 == uint2(0u, 0u))) { break; }
         loop_bound_33 -= uint2(loop_bound_33.y == 0u, 1u);
         if (!loop_init_24) {
-            uint _e925 = k_4;
-            k_4 = (_e925 + SLICE_LANES);
+            uint _e923 = k_4;
+            k_4 = (_e923 + SLICE_LANES);
         }
         loop_init_24 = false;
-        uint _e814 = k_4;
-        if ((_e814 < SLICE_SAMPLES)) {
+        uint _e812 = k_4;
+        if ((_e812 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e818 = k_4;
-            uint _e820 = q_end[min(uint(_e818), 255u)];
-            if ((_e820 != NONE)) {
-                uint _e824 = k_4;
-                uint _e826 = q_end[min(uint(_e824), 255u)];
-                uint tree_1 = (trees + ((min(naga_div(_e826, cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
+            uint _e816 = k_4;
+            uint _e818 = q_end[min(uint(_e816), 255u)];
+            if ((_e818 != NONE)) {
+                uint _e822 = k_4;
+                uint _e824 = q_end[min(uint(_e822), 255u)];
+                uint tree_1 = (trees + ((min(naga_div(_e824, cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0.0;
                 h_3 = 0u;
                 uint2 loop_bound_34 = uint2(4294967295u, 4294967295u);
@@ -1956,65 +1973,65 @@ void pst_sweep(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                     if (all(loop_bound_34 == uint2(0u, 0u))) { break; }
                     loop_bound_34 -= uint2(loop_bound_34.y == 0u, 1u);
                     if (!loop_init_25) {
-                        uint _e893 = h_3;
-                        h_3 = (_e893 + 1u);
+                        uint _e891 = h_3;
+                        h_3 = (_e891 + 1u);
                     }
                     loop_init_25 = false;
-                    uint _e839 = h_3;
-                    if ((_e839 < LEAF_VECS)) {
+                    uint _e837 = h_3;
+                    if ((_e837 < LEAF_VECS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e842 = k_4;
-                        uint _e847 = h_3;
-                        float4 _e850 = asfloat(pst_tree.Load4(((partials + (_e842 * LEAF_VECS)) + _e847)*16));
-                        p_1 = _e850;
-                        uint _e853 = k_4;
-                        uint _e855 = q_rank[min(uint(_e853), 255u)];
-                        j_8 = (v_12 - _e855);
+                        uint _e840 = k_4;
+                        uint _e845 = h_3;
+                        float4 _e848 = asfloat(pst_tree.Load4(((partials + (_e840 * LEAF_VECS)) + _e845)*16));
+                        p_1 = _e848;
+                        uint _e851 = k_4;
+                        uint _e853 = q_rank[min(uint(_e851), 255u)];
+                        j_8 = (v_12 - _e853);
                         uint2 loop_bound_35 = uint2(4294967295u, 4294967295u);
                         while(true) {
                             if (all(loop_bound_35 == uint2(0u, 0u))) { break; }
                             loop_bound_35 -= uint2(loop_bound_35.y == 0u, 1u);
-                            uint _e858 = j_8;
-                            if ((_e858 > 0u)) {
+                            uint _e856 = j_8;
+                            if ((_e856 > 0u)) {
                             } else {
                                 break;
                             }
                             {
-                                float4 _e861 = p_1;
-                                uint _e862 = j_8;
-                                uint _e869 = h_3;
-                                float4 _e872 = asfloat(pst_tree.Load4(((tree_1 + ((_e862 - 1u) * LEAF_VECS)) + _e869)*16));
-                                p_1 = (_e861 + _e872);
+                                float4 _e859 = p_1;
+                                uint _e860 = j_8;
+                                uint _e867 = h_3;
+                                float4 _e870 = asfloat(pst_tree.Load4(((tree_1 + ((_e860 - 1u) * LEAF_VECS)) + _e867)*16));
+                                p_1 = (_e859 + _e870);
+                                uint _e872 = j_8;
+                                uint _e873 = j_8;
                                 uint _e874 = j_8;
-                                uint _e875 = j_8;
-                                uint _e876 = j_8;
-                                j_8 = (_e874 - (_e875 & (~(_e876) + 1u)));
+                                j_8 = (_e872 - (_e873 & (~(_e874) + 1u)));
                             }
                         }
-                        float _e882 = dotp;
-                        float4 _e883 = p_1;
-                        uint _e885 = k_4;
-                        float _e887 = q_theta[min(uint(_e885), 255u)];
-                        uint _e888 = h_3;
-                        const float4 _e889 = beta_at(_e887, _e888);
-                        dotp = (_e882 + dot(_e883, _e889));
+                        float _e880 = dotp;
+                        float4 _e881 = p_1;
+                        uint _e883 = k_4;
+                        float _e885 = q_theta[min(uint(_e883), 255u)];
+                        uint _e886 = h_3;
+                        const float4 _e887 = beta_at(_e885, _e886);
+                        dotp = (_e880 + dot(_e881, _e887));
                     }
                 }
-                uint _e898 = k_4;
-                float _e900 = q_a[min(uint(_e898), 255u)];
-                float _e901 = dotp;
-                uint _e906 = k_4;
-                float _e908 = q_b[min(uint(_e906), 255u)];
-                const float3 _e911 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_24.light_color.xyz * (max((_e900 * _e901), 0.0) + _e908)));
-                uint _e912 = k_4;
-                const uint2 _e913 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e912, screen_4);
-                float4 _e916 = depth.Load(int3(_e913, int(0)));
-                float z_8 = _e916.x;
-                uint _e918 = k_4;
-                output[uint2(_e918, s_7)] = float4(_e911.x, _e911.y, _e911.z, z_8);
+                uint _e896 = k_4;
+                float _e898 = q_a[min(uint(_e896), 255u)];
+                float _e899 = dotp;
+                uint _e904 = k_4;
+                float _e906 = q_b[min(uint(_e904), 255u)];
+                const float3 _e909 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_24.light_color.xyz * (max((_e898 * _e899), 0.0) + _e906)));
+                uint _e910 = k_4;
+                const uint2 _e911 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e910, screen_4);
+                float4 _e914 = depth.Load(int3(_e911, int(0)));
+                float z_8 = _e914.x;
+                uint _e916 = k_4;
+                output[uint2(_e916, s_7)] = float4(_e909.x, _e909.y, _e909.z, z_8);
             }
         }
     }

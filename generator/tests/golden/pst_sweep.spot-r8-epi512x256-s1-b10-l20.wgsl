@@ -70,6 +70,13 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     wrap: u32,
 }
 
+struct FallbackCount {
+    listed: atomic<u32>,
+    groups_x: atomic<u32>,
+    groups_y: atomic<u32>,
+    groups_z: u32,
+}
+
 struct PstRay {
     marched: bool,
     color: vec3<f32>,
@@ -95,6 +102,7 @@ const STEP: u32 = 1u;
 const SLICE_RUNS: u32 = 256u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
+const FALLBACK_ROW_GROUPS: u32 = 1024u;
 const RANK_VECS: u32 = 2u;
 const LEAF_VECS: u32 = 2u;
 const TREES: u32 = 8u;
@@ -123,7 +131,7 @@ var<storage, read_write> pst_columns: array<u32>;
 @group(0) @binding(9) 
 var output: texture_storage_2d<rgba32float,write>;
 @group(0) @binding(11) 
-var<storage, read_write> fallback_count: atomic<u32>;
+var<storage, read_write> fallback_count: FallbackCount;
 var<workgroup> q_end: array<u32, 256>;
 var<workgroup> q_rank: array<u32, 256>;
 var<workgroup> q_d: array<f32, 256>;
@@ -701,6 +709,14 @@ fn slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_4: Epipolar
     return vec2<u32>(clamp(floor(p_8), vec2<f32>(0f, 0f), last_1));
 }
 
+fn fallback_list_reset() {
+    atomicStore((&fallback_count.listed), 0u);
+    atomicStore((&fallback_count.groups_x), 0u);
+    atomicStore((&fallback_count.groups_y), 0u);
+    fallback_count.groups_z = 1u;
+    return;
+}
+
 fn factor_at(base: u32, x_4: f32, h_4: u32) -> vec4<f32> {
     let p_9 = min((clamp(x_4, 0f, 1f) * 95f), 95f);
     let j_10 = min(u32(floor(p_9)), 94u);
@@ -987,78 +1003,78 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     if (li == 0u) {
         textureStore(output, vec2<u32>(SLICE_SAMPLES, s_7), vec4<f32>(_e40.x, _e40.y, _e42.x, _e42.y));
         if (s_7 == 0u) {
-            atomicStore((&fallback_count), 0u);
+            fallback_list_reset();
             textureStore(output, vec2<u32>(0u, 512u), vec4<f32>(_e37.origin, _e37.axis));
             textureStore(output, vec2<u32>(1u, 512u), vec4<f32>(_e37.phi_start, _e37.dphi, f32(_e37.wrap), 0f));
         }
     }
     let far_end = (_e37.origin + (_e40 * (_e42.x + (255f * _e42.y))));
-    let _e84 = pst_ray(far_end, 0f);
-    let row_5 = _e84.row;
-    let _e88 = slices_1[row_5];
-    let _e89 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e88);
-    let delta_6 = _e89.delta;
-    let _e91 = pst_row_e(f_24, row_5);
+    let _e82 = pst_ray(far_end, 0f);
+    let row_5 = _e82.row;
+    let _e86 = slices_1[row_5];
+    let _e87 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e86);
+    let delta_6 = _e87.delta;
+    let _e89 = pst_row_e(f_24, row_5);
     k = li;
     loop {
-        let _e93 = k;
-        if (_e93 < SLICE_SAMPLES) {
+        let _e91 = k;
+        if (_e91 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e96 = k;
-            let _e97 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e96, screen_4);
-            let _e100 = textureLoad(depth, _e97, 0i);
-            let z_7 = _e100.x;
-            let _e104 = k;
-            let _e111 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (f32(_e104) * _e42.y)))), screen_4);
+            let _e94 = k;
+            let _e95 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e94, screen_4);
+            let _e98 = textureLoad(depth, _e95, 0i);
+            let z_7 = _e98.x;
+            let _e102 = k;
+            let _e109 = pst_footprint_depth((_e37.origin + (_e40 * (_e42.x + (f32(_e102) * _e42.y)))), screen_4);
             r = PstRay();
-            if (_e111 < 0f) {
-                let _e125 = pst_ray(vec2<f32>((f32(_e97.x) + 0.5f), (f32(_e97.y) + 0.5f)), z_7);
-                r = _e125;
+            if (_e109 < 0f) {
+                let _e123 = pst_ray(vec2<f32>((f32(_e95.x) + 0.5f), (f32(_e95.y) + 0.5f)), z_7);
+                r = _e123;
             } else {
-                let _e128 = k;
-                let _e135 = pst_ray((_e37.origin + (_e40 * (_e42.x + (f32(_e128) * _e42.y)))), _e111);
-                r = _e135;
+                let _e126 = k;
+                let _e133 = pst_ray((_e37.origin + (_e40 * (_e42.x + (f32(_e126) * _e42.y)))), _e109);
+                r = _e133;
             }
-            let _e136 = r;
-            let _e137 = pst_columns_crossed(_e136, delta_6);
-            let _e139 = k;
-            q_end[_e139] = NONE;
-            let _e143 = r.marched;
-            if !(_e143) {
-                local = (_e137 == 0u);
+            let _e134 = r;
+            let _e135 = pst_columns_crossed(_e134, delta_6);
+            let _e137 = k;
+            q_end[_e137] = NONE;
+            let _e141 = r.marched;
+            if !(_e141) {
+                local = (_e135 == 0u);
             } else {
                 local = true;
             }
-            let _e150 = local;
-            if _e150 {
-                let _e152 = r.color;
-                let _e153 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e152);
-                let _e154 = k;
-                textureStore(output, vec2<u32>(_e154, s_7), vec4<f32>(_e153.x, _e153.y, _e153.z, z_7));
+            let _e148 = local;
+            if _e148 {
+                let _e150 = r.color;
+                let _e151 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e150);
+                let _e152 = k;
+                textureStore(output, vec2<u32>(_e152, s_7), vec4<f32>(_e151.x, _e151.y, _e151.z, z_7));
             } else {
-                let _e161 = r;
-                let _e162 = pst_terms(_e161, row_5, delta_6, _e137);
-                let _e164 = k;
-                q_b[_e164] = _e162.y;
-                let _e168 = k;
-                q_end[_e168] = (_e137 - 1u);
-                let _e173 = k;
-                let _e176 = r.d;
-                q_d[_e173] = _e176;
-                let _e178 = k;
-                let _e181 = r.theta;
-                q_theta[_e178] = _e181;
-                let _e183 = k;
-                q_a[_e183] = _e162.x;
-                let _e188 = atomicAdd((&live), 1u);
+                let _e159 = r;
+                let _e160 = pst_terms(_e159, row_5, delta_6, _e135);
+                let _e162 = k;
+                q_b[_e162] = _e160.y;
+                let _e166 = k;
+                q_end[_e166] = (_e135 - 1u);
+                let _e171 = k;
+                let _e174 = r.d;
+                q_d[_e171] = _e174;
+                let _e176 = k;
+                let _e179 = r.theta;
+                q_theta[_e176] = _e179;
+                let _e181 = k;
+                q_a[_e181] = _e160.x;
+                let _e186 = atomicAdd((&live), 1u);
             }
         }
         continuing {
-            let _e189 = k;
-            k = (_e189 + SLICE_LANES);
+            let _e187 = k;
+            k = (_e187 + SLICE_LANES);
         }
     }
     workgroupBarrier();
@@ -1066,156 +1082,156 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     let cw = (((width + TREES) - 1u) / TREES);
     if (li < TREES) {
         loop {
-            let _e203 = k_1;
-            if (_e203 < SLICE_SAMPLES) {
+            let _e201 = k_1;
+            if (_e201 < SLICE_SAMPLES) {
             } else {
                 break;
             }
             {
-                let _e207 = k_1;
-                let _e209 = q_end[_e207];
-                if (_e209 != NONE) {
-                    let _e213 = k_1;
-                    let _e215 = q_end[_e213];
-                    local_1 = (min((_e215 / cw), 7u) == li);
+                let _e205 = k_1;
+                let _e207 = q_end[_e205];
+                if (_e207 != NONE) {
+                    let _e211 = k_1;
+                    let _e213 = q_end[_e211];
+                    local_1 = (min((_e213 / cw), 7u) == li);
                 } else {
                     local_1 = false;
                 }
-                let _e223 = local_1;
-                if _e223 {
-                    let _e226 = count;
-                    count = (_e226 + 1u);
+                let _e221 = local_1;
+                if _e221 {
+                    let _e224 = count;
+                    count = (_e224 + 1u);
                 }
             }
             continuing {
-                let _e229 = k_1;
-                k_1 = (_e229 + 1u);
+                let _e227 = k_1;
+                k_1 = (_e227 + 1u);
             }
         }
-        let _e233 = count;
-        bucket[li] = _e233;
+        let _e231 = count;
+        bucket[li] = _e231;
     } else {
         if (li == TREES) {
             local_2 = (v_12 > 0u);
         } else {
             local_2 = false;
         }
-        let _e241 = local_2;
-        if _e241 {
+        let _e239 = local_2;
+        if _e239 {
             loop {
-                let _e244 = first;
-                let _e246 = q_end[_e244];
-                if (_e246 == NONE) {
+                let _e242 = first;
+                let _e244 = q_end[_e242];
+                if (_e244 == NONE) {
                 } else {
                     break;
                 }
                 {
-                    let _e250 = first;
-                    first = (_e250 + 1u);
+                    let _e248 = first;
+                    first = (_e248 + 1u);
                 }
             }
             loop {
-                let _e254 = last;
-                let _e256 = q_end[_e254];
-                if (_e256 == NONE) {
+                let _e252 = last;
+                let _e254 = q_end[_e252];
+                if (_e254 == NONE) {
                 } else {
                     break;
                 }
                 {
-                    let _e260 = last;
-                    last = (_e260 - 1u);
+                    let _e258 = last;
+                    last = (_e258 - 1u);
                 }
             }
-            let _e263 = first;
-            let _e265 = q_d[_e263];
-            let _e267 = last;
-            let _e269 = q_d[_e267];
-            let up = (_e265 <= _e269);
+            let _e261 = first;
+            let _e263 = q_d[_e261];
+            let _e265 = last;
+            let _e267 = q_d[_e265];
+            let up = (_e263 <= _e267);
             loop {
-                let _e272 = k_2;
-                if (_e272 < SLICE_SAMPLES) {
+                let _e270 = k_2;
+                if (_e270 < SLICE_SAMPLES) {
                 } else {
                     break;
                 }
                 {
-                    let _e276 = k_2;
-                    let _e278 = q_end[_e276];
-                    if (_e278 != NONE) {
-                        let _e282 = k_2;
-                        let d_3 = q_d[_e282];
-                        let _e286 = m;
-                        j = _e286;
+                    let _e274 = k_2;
+                    let _e276 = q_end[_e274];
+                    if (_e276 != NONE) {
+                        let _e280 = k_2;
+                        let d_3 = q_d[_e280];
+                        let _e284 = m;
+                        j = _e284;
                         loop {
-                            let _e288 = j;
-                            if (_e288 > 0u) {
-                                let _e291 = j;
-                                let _e296 = q_d[(_e291 - 1u)];
-                                let _e298 = j;
-                                let _e303 = q_d[(_e298 - 1u)];
-                                local_3 = select((_e296 < d_3), (_e303 > d_3), up);
+                            let _e286 = j;
+                            if (_e286 > 0u) {
+                                let _e289 = j;
+                                let _e294 = q_d[(_e289 - 1u)];
+                                let _e296 = j;
+                                let _e301 = q_d[(_e296 - 1u)];
+                                local_3 = select((_e294 < d_3), (_e301 > d_3), up);
                             } else {
                                 local_3 = false;
                             }
-                            let _e309 = local_3;
-                            if _e309 {
+                            let _e307 = local_3;
+                            if _e307 {
                             } else {
                                 break;
                             }
                             {
+                                let _e309 = j;
                                 let _e311 = j;
-                                let _e313 = j;
-                                let _e318 = q_d[(_e313 - 1u)];
-                                q_d[_e311] = _e318;
+                                let _e316 = q_d[(_e311 - 1u)];
+                                q_d[_e309] = _e316;
+                                let _e318 = j;
                                 let _e320 = j;
-                                let _e322 = j;
-                                let _e327 = q_rank[(_e322 - 1u)];
-                                q_rank[_e320] = _e327;
-                                let _e329 = j;
-                                j = (_e329 - 1u);
+                                let _e325 = q_rank[(_e320 - 1u)];
+                                q_rank[_e318] = _e325;
+                                let _e327 = j;
+                                j = (_e327 - 1u);
                             }
                         }
-                        let _e332 = j;
-                        q_d[_e332] = d_3;
-                        let _e335 = j;
-                        let _e337 = k_2;
-                        q_rank[_e335] = _e337;
-                        let _e339 = m;
-                        m = (_e339 + 1u);
+                        let _e330 = j;
+                        q_d[_e330] = d_3;
+                        let _e333 = j;
+                        let _e335 = k_2;
+                        q_rank[_e333] = _e335;
+                        let _e337 = m;
+                        m = (_e337 + 1u);
                     }
                 }
                 continuing {
-                    let _e342 = k_2;
-                    k_2 = (_e342 + 1u);
+                    let _e340 = k_2;
+                    k_2 = (_e340 + 1u);
                 }
             }
             if !(up) {
                 loop {
-                    let _e346 = j_1;
-                    if (_e346 < (v_12 / 2u)) {
+                    let _e344 = j_1;
+                    if (_e344 < (v_12 / 2u)) {
                     } else {
                         break;
                     }
                     {
-                        let _e351 = j_1;
-                        let d_4 = q_d[_e351];
-                        let _e355 = j_1;
-                        let _e360 = j_1;
-                        let _e363 = q_d[((v_12 - 1u) - _e360)];
-                        q_d[_e355] = _e363;
-                        let _e367 = j_1;
-                        q_d[((v_12 - 1u) - _e367)] = d_4;
-                        let _e371 = j_1;
-                        let k_9 = q_rank[_e371];
-                        let _e375 = j_1;
-                        let _e380 = j_1;
-                        let _e383 = q_rank[((v_12 - 1u) - _e380)];
-                        q_rank[_e375] = _e383;
-                        let _e387 = j_1;
-                        q_rank[((v_12 - 1u) - _e387)] = k_9;
+                        let _e349 = j_1;
+                        let d_4 = q_d[_e349];
+                        let _e353 = j_1;
+                        let _e358 = j_1;
+                        let _e361 = q_d[((v_12 - 1u) - _e358)];
+                        q_d[_e353] = _e361;
+                        let _e365 = j_1;
+                        q_d[((v_12 - 1u) - _e365)] = d_4;
+                        let _e369 = j_1;
+                        let k_9 = q_rank[_e369];
+                        let _e373 = j_1;
+                        let _e378 = j_1;
+                        let _e381 = q_rank[((v_12 - 1u) - _e378)];
+                        q_rank[_e373] = _e381;
+                        let _e385 = j_1;
+                        q_rank[((v_12 - 1u) - _e385)] = k_9;
                     }
                     continuing {
-                        let _e391 = j_1;
-                        j_1 = (_e391 + 1u);
+                        let _e389 = j_1;
+                        j_1 = (_e389 + 1u);
                     }
                 }
             }
@@ -1224,186 +1240,186 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     workgroupBarrier();
     if (li < TREES) {
         loop {
-            let _e396 = c;
-            if (_e396 < li) {
+            let _e394 = c;
+            if (_e394 < li) {
             } else {
                 break;
             }
             {
-                let _e399 = start;
-                let _e401 = c;
-                let _e403 = bucket[_e401];
-                start = (_e399 + _e403);
+                let _e397 = start;
+                let _e399 = c;
+                let _e401 = bucket[_e399];
+                start = (_e397 + _e401);
             }
             continuing {
-                let _e406 = c;
-                c = (_e406 + 1u);
+                let _e404 = c;
+                c = (_e404 + 1u);
             }
         }
         loop {
-            let _e409 = k_3;
-            if (_e409 < SLICE_SAMPLES) {
+            let _e407 = k_3;
+            if (_e407 < SLICE_SAMPLES) {
             } else {
                 break;
             }
             {
-                let _e413 = k_3;
-                let _e415 = q_end[_e413];
-                if (_e415 != NONE) {
-                    let _e419 = k_3;
-                    let _e421 = q_end[_e419];
-                    local_4 = (min((_e421 / cw), 7u) == li);
+                let _e411 = k_3;
+                let _e413 = q_end[_e411];
+                if (_e413 != NONE) {
+                    let _e417 = k_3;
+                    let _e419 = q_end[_e417];
+                    local_4 = (min((_e419 / cw), 7u) == li);
                 } else {
                     local_4 = false;
                 }
-                let _e429 = local_4;
-                if _e429 {
-                    let _e431 = m_1;
-                    j_2 = _e431;
+                let _e427 = local_4;
+                if _e427 {
+                    let _e429 = m_1;
+                    j_2 = _e429;
                     loop {
-                        let _e433 = j_2;
-                        if (_e433 > 0u) {
-                            let _e436 = start;
-                            let _e437 = j_2;
-                            let _e444 = by_end[((_e436 + _e437) - 1u)];
-                            let _e446 = q_end[_e444];
-                            let _e448 = k_3;
-                            let _e450 = q_end[_e448];
-                            local_5 = (_e446 > _e450);
+                        let _e431 = j_2;
+                        if (_e431 > 0u) {
+                            let _e434 = start;
+                            let _e435 = j_2;
+                            let _e442 = by_end[((_e434 + _e435) - 1u)];
+                            let _e444 = q_end[_e442];
+                            let _e446 = k_3;
+                            let _e448 = q_end[_e446];
+                            local_5 = (_e444 > _e448);
                         } else {
                             local_5 = false;
                         }
-                        let _e455 = local_5;
-                        if _e455 {
+                        let _e453 = local_5;
+                        if _e453 {
                         } else {
                             break;
                         }
                         {
-                            let _e457 = start;
-                            let _e458 = j_2;
-                            let _e461 = start;
-                            let _e462 = j_2;
-                            let _e468 = by_end[((_e461 + _e462) - 1u)];
-                            by_end[(_e457 + _e458)] = _e468;
-                            let _e470 = j_2;
-                            j_2 = (_e470 - 1u);
+                            let _e455 = start;
+                            let _e456 = j_2;
+                            let _e459 = start;
+                            let _e460 = j_2;
+                            let _e466 = by_end[((_e459 + _e460) - 1u)];
+                            by_end[(_e455 + _e456)] = _e466;
+                            let _e468 = j_2;
+                            j_2 = (_e468 - 1u);
                         }
                     }
-                    let _e473 = start;
-                    let _e474 = j_2;
-                    let _e477 = k_3;
-                    by_end[(_e473 + _e474)] = _e477;
-                    let _e479 = m_1;
-                    m_1 = (_e479 + 1u);
+                    let _e471 = start;
+                    let _e472 = j_2;
+                    let _e475 = k_3;
+                    by_end[(_e471 + _e472)] = _e475;
+                    let _e477 = m_1;
+                    m_1 = (_e477 + 1u);
                 }
             }
             continuing {
-                let _e482 = k_3;
-                k_3 = (_e482 + 1u);
+                let _e480 = k_3;
+                k_3 = (_e480 + 1u);
             }
         }
     }
     j_3 = li;
     loop {
-        let _e485 = j_3;
-        if (_e485 < v_12) {
+        let _e483 = j_3;
+        if (_e483 < v_12) {
         } else {
             break;
         }
         {
-            let _e487 = j_3;
-            let _e493 = j_3;
-            let _e495 = q_rank[_e493];
-            mine[(_e487 / SLICE_LANES)] = _e495;
+            let _e485 = j_3;
+            let _e491 = j_3;
+            let _e493 = q_rank[_e491];
+            mine[(_e485 / SLICE_LANES)] = _e493;
         }
         continuing {
-            let _e496 = j_3;
-            j_3 = (_e496 + SLICE_LANES);
+            let _e494 = j_3;
+            j_3 = (_e494 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     j_4 = li;
     loop {
-        let _e500 = j_4;
-        if (_e500 < v_12) {
+        let _e498 = j_4;
+        if (_e498 < v_12) {
         } else {
             break;
         }
         {
-            let _e502 = j_4;
-            let _e507 = mine[(_e502 / SLICE_LANES)];
-            let _e509 = j_4;
-            q_rank[_e507] = _e509;
+            let _e500 = j_4;
+            let _e505 = mine[(_e500 / SLICE_LANES)];
+            let _e507 = j_4;
+            q_rank[_e505] = _e507;
         }
         continuing {
-            let _e510 = j_4;
-            j_4 = (_e510 + SLICE_LANES);
+            let _e508 = j_4;
+            j_4 = (_e508 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let base_1 = (s_7 * width);
     i = li;
     loop {
-        let _e515 = i;
-        if (_e515 < width) {
+        let _e513 = i;
+        if (_e513 < width) {
         } else {
             break;
         }
         {
-            let _e517 = i;
-            let _e521 = textureLoad(rectified, vec2<u32>(_e517, row_5), 0i);
-            let occluder = _e521.x;
+            let _e515 = i;
+            let _e519 = textureLoad(rectified, vec2<u32>(_e515, row_5), 0i);
+            let occluder = _e519.x;
             lo = 0u;
             hi = v_12;
             loop {
-                let _e526 = lo;
-                let _e527 = hi;
-                if (_e526 < _e527) {
+                let _e524 = lo;
+                let _e525 = hi;
+                if (_e524 < _e525) {
                 } else {
                     break;
                 }
                 {
-                    let _e529 = lo;
-                    let _e530 = hi;
-                    let mid_1 = ((_e529 + _e530) / 2u);
-                    let _e536 = q_d[mid_1];
-                    if (_e536 <= occluder) {
+                    let _e527 = lo;
+                    let _e528 = hi;
+                    let mid_1 = ((_e527 + _e528) / 2u);
+                    let _e534 = q_d[mid_1];
+                    if (_e534 <= occluder) {
                         lo = (mid_1 + 1u);
                     } else {
                         hi = mid_1;
                     }
                 }
             }
-            let _e541 = i;
-            let _e544 = lo;
-            pst_columns[(base_1 + _e541)] = _e544;
-            let _e545 = lo;
-            if (_e545 > 0u) {
+            let _e539 = i;
+            let _e542 = lo;
+            pst_columns[(base_1 + _e539)] = _e542;
+            let _e543 = lo;
+            if (_e543 > 0u) {
                 h = 0u;
                 loop {
-                    let _e550 = h;
-                    if (_e550 < LEAF_VECS) {
+                    let _e548 = h;
+                    if (_e548 < LEAF_VECS) {
                     } else {
                         break;
                     }
                     {
-                        let _e553 = i;
-                        let _e558 = h;
-                        let _e561 = i;
-                        let _e562 = h;
-                        let _e563 = pst_leaf(f_24, _e561, _e91, delta_6, _e562);
-                        pst_leaves[(((base_1 + _e553) * LEAF_VECS) + _e558)] = _e563;
+                        let _e551 = i;
+                        let _e556 = h;
+                        let _e559 = i;
+                        let _e560 = h;
+                        let _e561 = pst_leaf(f_24, _e559, _e89, delta_6, _e560);
+                        pst_leaves[(((base_1 + _e551) * LEAF_VECS) + _e556)] = _e561;
                     }
                     continuing {
-                        let _e565 = h;
-                        h = (_e565 + 1u);
+                        let _e563 = h;
+                        h = (_e563 + 1u);
                     }
                 }
             }
         }
         continuing {
-            let _e567 = i;
-            i = (_e567 + SLICE_LANES);
+            let _e565 = i;
+            i = (_e565 + SLICE_LANES);
         }
     }
     storageBarrier();
@@ -1413,37 +1429,37 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     if (li < TREES) {
         let tree = (trees + ((li * SLICE_SAMPLES) * LEAF_VECS));
         loop {
-            let _e586 = j_5;
-            if (_e586 < (v_12 * LEAF_VECS)) {
+            let _e584 = j_5;
+            if (_e584 < (v_12 * LEAF_VECS)) {
             } else {
                 break;
             }
             {
-                let _e591 = j_5;
-                pst_tree[(tree + _e591)] = vec4<f32>(0f, 0f, 0f, 0f);
+                let _e589 = j_5;
+                pst_tree[(tree + _e589)] = vec4<f32>(0f, 0f, 0f, 0f);
             }
             continuing {
-                let _e600 = j_5;
-                j_5 = (_e600 + 1u);
+                let _e598 = j_5;
+                j_5 = (_e598 + 1u);
             }
         }
         let lo_5 = (li * cw);
         let hi_5 = select(min((lo_5 + cw), width), width, ((li + 1u) == TREES));
         top = v_12;
         loop {
-            let _e612 = next;
-            let _e613 = top;
-            if (_e612 < _e613) {
+            let _e610 = next;
+            let _e611 = top;
+            if (_e610 < _e611) {
             } else {
                 break;
             }
             {
-                let _e615 = next;
-                let _e616 = top;
-                let mid_2 = ((_e615 + _e616) / 2u);
-                let _e623 = by_end[mid_2];
-                let _e625 = q_end[_e623];
-                if (_e625 < lo_5) {
+                let _e613 = next;
+                let _e614 = top;
+                let mid_2 = ((_e613 + _e614) / 2u);
+                let _e621 = by_end[mid_2];
+                let _e623 = q_end[_e621];
+                if (_e623 < lo_5) {
                     next = (mid_2 + 1u);
                 } else {
                     top = mid_2;
@@ -1452,133 +1468,133 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         }
         i_1 = lo_5;
         loop {
-            let _e630 = i_1;
-            if (_e630 <= hi_5) {
+            let _e628 = i_1;
+            if (_e628 <= hi_5) {
             } else {
                 break;
             }
             {
                 loop {
-                    let _e632 = next;
-                    if (_e632 < v_12) {
-                        let _e636 = next;
-                        let _e638 = by_end[_e636];
-                        let _e640 = q_end[_e638];
-                        let _e641 = i_1;
-                        local_6 = (_e640 == _e641);
+                    let _e630 = next;
+                    if (_e630 < v_12) {
+                        let _e634 = next;
+                        let _e636 = by_end[_e634];
+                        let _e638 = q_end[_e636];
+                        let _e639 = i_1;
+                        local_6 = (_e638 == _e639);
                     } else {
                         local_6 = false;
                     }
-                    let _e646 = local_6;
-                    if _e646 {
-                        let _e647 = i_1;
-                        if !((_e647 < hi_5)) {
+                    let _e644 = local_6;
+                    if _e644 {
+                        let _e645 = i_1;
+                        if !((_e645 < hi_5)) {
                             local_8 = ((li + 1u) == TREES);
                         } else {
                             local_8 = true;
                         }
-                        let _e657 = local_8;
-                        local_7 = _e657;
+                        let _e655 = local_8;
+                        local_7 = _e655;
                     } else {
                         local_7 = false;
                     }
-                    let _e661 = local_7;
-                    if _e661 {
+                    let _e659 = local_7;
+                    if _e659 {
                     } else {
                         break;
                     }
                     {
-                        let _e663 = next;
-                        let k_10 = by_end[_e663];
-                        let _e667 = next;
-                        next = (_e667 + 1u);
+                        let _e661 = next;
+                        let k_10 = by_end[_e661];
+                        let _e665 = next;
+                        next = (_e665 + 1u);
                         h_1 = 0u;
                         loop {
-                            let _e671 = h_1;
-                            if (_e671 < LEAF_VECS) {
+                            let _e669 = h_1;
+                            if (_e669 < LEAF_VECS) {
                             } else {
                                 break;
                             }
                             {
                                 p = vec4<f32>(0f, 0f, 0f, 0f);
-                                let _e682 = q_rank[k_10];
-                                j_6 = (v_12 - _e682);
+                                let _e680 = q_rank[k_10];
+                                j_6 = (v_12 - _e680);
                                 loop {
-                                    let _e685 = j_6;
-                                    if (_e685 > 0u) {
+                                    let _e683 = j_6;
+                                    if (_e683 > 0u) {
                                     } else {
                                         break;
                                     }
                                     {
-                                        let _e688 = p;
-                                        let _e689 = j_6;
-                                        let _e696 = h_1;
-                                        let _e699 = pst_tree[((tree + ((_e689 - 1u) * LEAF_VECS)) + _e696)];
-                                        p = (_e688 + _e699);
+                                        let _e686 = p;
+                                        let _e687 = j_6;
+                                        let _e694 = h_1;
+                                        let _e697 = pst_tree[((tree + ((_e687 - 1u) * LEAF_VECS)) + _e694)];
+                                        p = (_e686 + _e697);
+                                        let _e699 = j_6;
+                                        let _e700 = j_6;
                                         let _e701 = j_6;
-                                        let _e702 = j_6;
-                                        let _e703 = j_6;
-                                        j_6 = (_e701 - (_e702 & (~(_e703) + 1u)));
+                                        j_6 = (_e699 - (_e700 & (~(_e701) + 1u)));
                                     }
                                 }
-                                let _e713 = h_1;
-                                let _e716 = p;
-                                pst_tree[((partials + (k_10 * LEAF_VECS)) + _e713)] = _e716;
+                                let _e711 = h_1;
+                                let _e714 = p;
+                                pst_tree[((partials + (k_10 * LEAF_VECS)) + _e711)] = _e714;
                             }
                             continuing {
-                                let _e718 = h_1;
-                                h_1 = (_e718 + 1u);
+                                let _e716 = h_1;
+                                h_1 = (_e716 + 1u);
                             }
                         }
                     }
                 }
-                let _e720 = i_1;
-                if (_e720 == hi_5) {
+                let _e718 = i_1;
+                if (_e718 == hi_5) {
                     break;
                 }
-                let _e723 = i_1;
-                let b_8 = pst_columns[(base_1 + _e723)];
+                let _e721 = i_1;
+                let b_8 = pst_columns[(base_1 + _e721)];
                 if (b_8 > 0u) {
                     h_2 = 0u;
                     loop {
-                        let _e731 = h_2;
-                        if (_e731 < LEAF_VECS) {
+                        let _e729 = h_2;
+                        if (_e729 < LEAF_VECS) {
                         } else {
                             break;
                         }
                         {
-                            let _e734 = i_1;
-                            let _e739 = h_2;
-                            let leaf_1 = pst_leaves[(((base_1 + _e734) * LEAF_VECS) + _e739)];
+                            let _e732 = i_1;
+                            let _e737 = h_2;
+                            let leaf_1 = pst_leaves[(((base_1 + _e732) * LEAF_VECS) + _e737)];
                             j_7 = ((v_12 - b_8) + 1u);
                             loop {
-                                let _e747 = j_7;
-                                if (_e747 <= v_12) {
+                                let _e745 = j_7;
+                                if (_e745 <= v_12) {
                                 } else {
                                     break;
                                 }
                                 {
-                                    let _e749 = j_7;
-                                    let _e756 = h_2;
-                                    let _e759 = pst_tree[((tree + ((_e749 - 1u) * LEAF_VECS)) + _e756)];
-                                    pst_tree[((tree + ((_e749 - 1u) * LEAF_VECS)) + _e756)] = (_e759 + leaf_1);
+                                    let _e747 = j_7;
+                                    let _e754 = h_2;
+                                    let _e757 = pst_tree[((tree + ((_e747 - 1u) * LEAF_VECS)) + _e754)];
+                                    pst_tree[((tree + ((_e747 - 1u) * LEAF_VECS)) + _e754)] = (_e757 + leaf_1);
+                                    let _e759 = j_7;
+                                    let _e760 = j_7;
                                     let _e761 = j_7;
-                                    let _e762 = j_7;
-                                    let _e763 = j_7;
-                                    j_7 = (_e761 + (_e762 & (~(_e763) + 1u)));
+                                    j_7 = (_e759 + (_e760 & (~(_e761) + 1u)));
                                 }
                             }
                         }
                         continuing {
-                            let _e770 = h_2;
-                            h_2 = (_e770 + 1u);
+                            let _e768 = h_2;
+                            h_2 = (_e768 + 1u);
                         }
                     }
                 }
             }
             continuing {
-                let _e773 = i_1;
-                i_1 = (_e773 + 1u);
+                let _e771 = i_1;
+                i_1 = (_e771 + 1u);
             }
         }
     }
@@ -1586,8 +1602,8 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
     workgroupBarrier();
     x = li;
     loop {
-        let _e776 = x;
-        if (_e776 < (v_12 * LEAF_VECS)) {
+        let _e774 = x;
+        if (_e774 < (v_12 * LEAF_VECS)) {
         } else {
             break;
         }
@@ -1595,112 +1611,112 @@ fn pst_sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
             running = vec4<f32>(0f, 0f, 0f, 0f);
             c_1 = 0u;
             loop {
-                let _e788 = c_1;
-                if (_e788 < TREES) {
+                let _e786 = c_1;
+                if (_e786 < TREES) {
                 } else {
                     break;
                 }
                 {
-                    let _e791 = c_1;
-                    let _e797 = x;
-                    let at = ((trees + ((_e791 * SLICE_SAMPLES) * LEAF_VECS)) + _e797);
+                    let _e789 = c_1;
+                    let _e795 = x;
+                    let at = ((trees + ((_e789 * SLICE_SAMPLES) * LEAF_VECS)) + _e795);
                     let own = pst_tree[at];
-                    let _e804 = running;
-                    pst_tree[at] = _e804;
-                    let _e805 = running;
-                    running = (_e805 + own);
+                    let _e802 = running;
+                    pst_tree[at] = _e802;
+                    let _e803 = running;
+                    running = (_e803 + own);
                 }
                 continuing {
-                    let _e808 = c_1;
-                    c_1 = (_e808 + 1u);
+                    let _e806 = c_1;
+                    c_1 = (_e806 + 1u);
                 }
             }
         }
         continuing {
-            let _e810 = x;
-            x = (_e810 + SLICE_LANES);
+            let _e808 = x;
+            x = (_e808 + SLICE_LANES);
         }
     }
     storageBarrier();
     workgroupBarrier();
     k_4 = li;
     loop {
-        let _e814 = k_4;
-        if (_e814 < SLICE_SAMPLES) {
+        let _e812 = k_4;
+        if (_e812 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e818 = k_4;
-            let _e820 = q_end[_e818];
-            if (_e820 != NONE) {
-                let _e824 = k_4;
-                let _e826 = q_end[_e824];
-                let tree_1 = (trees + ((min((_e826 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
+            let _e816 = k_4;
+            let _e818 = q_end[_e816];
+            if (_e818 != NONE) {
+                let _e822 = k_4;
+                let _e824 = q_end[_e822];
+                let tree_1 = (trees + ((min((_e824 / cw), 7u) * SLICE_SAMPLES) * LEAF_VECS));
                 dotp = 0f;
                 h_3 = 0u;
                 loop {
-                    let _e839 = h_3;
-                    if (_e839 < LEAF_VECS) {
+                    let _e837 = h_3;
+                    if (_e837 < LEAF_VECS) {
                     } else {
                         break;
                     }
                     {
-                        let _e842 = k_4;
-                        let _e847 = h_3;
-                        let _e850 = pst_tree[((partials + (_e842 * LEAF_VECS)) + _e847)];
-                        p_1 = _e850;
-                        let _e853 = k_4;
-                        let _e855 = q_rank[_e853];
-                        j_8 = (v_12 - _e855);
+                        let _e840 = k_4;
+                        let _e845 = h_3;
+                        let _e848 = pst_tree[((partials + (_e840 * LEAF_VECS)) + _e845)];
+                        p_1 = _e848;
+                        let _e851 = k_4;
+                        let _e853 = q_rank[_e851];
+                        j_8 = (v_12 - _e853);
                         loop {
-                            let _e858 = j_8;
-                            if (_e858 > 0u) {
+                            let _e856 = j_8;
+                            if (_e856 > 0u) {
                             } else {
                                 break;
                             }
                             {
-                                let _e861 = p_1;
-                                let _e862 = j_8;
-                                let _e869 = h_3;
-                                let _e872 = pst_tree[((tree_1 + ((_e862 - 1u) * LEAF_VECS)) + _e869)];
-                                p_1 = (_e861 + _e872);
+                                let _e859 = p_1;
+                                let _e860 = j_8;
+                                let _e867 = h_3;
+                                let _e870 = pst_tree[((tree_1 + ((_e860 - 1u) * LEAF_VECS)) + _e867)];
+                                p_1 = (_e859 + _e870);
+                                let _e872 = j_8;
+                                let _e873 = j_8;
                                 let _e874 = j_8;
-                                let _e875 = j_8;
-                                let _e876 = j_8;
-                                j_8 = (_e874 - (_e875 & (~(_e876) + 1u)));
+                                j_8 = (_e872 - (_e873 & (~(_e874) + 1u)));
                             }
                         }
-                        let _e882 = dotp;
-                        let _e883 = p_1;
-                        let _e885 = k_4;
-                        let _e887 = q_theta[_e885];
-                        let _e888 = h_3;
-                        let _e889 = beta_at(_e887, _e888);
-                        dotp = (_e882 + dot(_e883, _e889));
+                        let _e880 = dotp;
+                        let _e881 = p_1;
+                        let _e883 = k_4;
+                        let _e885 = q_theta[_e883];
+                        let _e886 = h_3;
+                        let _e887 = beta_at(_e885, _e886);
+                        dotp = (_e880 + dot(_e881, _e887));
                     }
                     continuing {
-                        let _e893 = h_3;
-                        h_3 = (_e893 + 1u);
+                        let _e891 = h_3;
+                        h_3 = (_e891 + 1u);
                     }
                 }
-                let _e898 = k_4;
-                let _e900 = q_a[_e898];
-                let _e901 = dotp;
-                let _e906 = k_4;
-                let _e908 = q_b[_e906];
-                let _e911 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_24.light_color.xyz * (max((_e900 * _e901), 0f) + _e908)));
-                let _e912 = k_4;
-                let _e913 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e912, screen_4);
-                let _e916 = textureLoad(depth, _e913, 0i);
-                let z_8 = _e916.x;
-                let _e918 = k_4;
-                textureStore(output, vec2<u32>(_e918, s_7), vec4<f32>(_e911.x, _e911.y, _e911.z, z_8));
+                let _e896 = k_4;
+                let _e898 = q_a[_e896];
+                let _e899 = dotp;
+                let _e904 = k_4;
+                let _e906 = q_b[_e904];
+                let _e909 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX((f_24.light_color.xyz * (max((_e898 * _e899), 0f) + _e906)));
+                let _e910 = k_4;
+                let _e911 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e37, _e40, _e42, _e910, screen_4);
+                let _e914 = textureLoad(depth, _e911, 0i);
+                let z_8 = _e914.x;
+                let _e916 = k_4;
+                textureStore(output, vec2<u32>(_e916, s_7), vec4<f32>(_e909.x, _e909.y, _e909.z, z_8));
             }
         }
         continuing {
-            let _e925 = k_4;
-            k_4 = (_e925 + SLICE_LANES);
+            let _e923 = k_4;
+            k_4 = (_e923 + SLICE_LANES);
         }
     }
     return;

@@ -54,6 +54,12 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_lo;
     float theta_hi;
 };
+struct FallbackCountRead {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
 struct PstRay {
     bool marched;
     vec3 color;
@@ -77,6 +83,7 @@ const uint STEP = 1u;
 const uint SLICE_RUNS = 256u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
+const uint FALLBACK_ROW_GROUPS = 1024u;
 const uint RANK_VECS = 2u;
 const uint LEAF_VECS = 2u;
 const uint TREES = 8u;
@@ -97,7 +104,7 @@ layout(std430, binding = 5) readonly buffer type_9_block_2Compute { vec4 _group_
 
 layout(binding = 9,rgba16f) writeonly uniform image2D _group_0_binding_9_cs;
 
-layout(std430, binding = 11) readonly buffer type_8_block_3Compute { uint _group_0_binding_11_cs; };
+layout(std430, binding = 11) readonly buffer FallbackCountRead_block_3Compute { FallbackCountRead _group_0_binding_11_cs; };
 
 layout(std430, binding = 12) readonly buffer type_11_block_4Compute { uint _group_0_binding_12_cs[]; };
 
@@ -451,16 +458,16 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, float x_1, float delta, float theta_2, float s_2, bool spot_4) {
-    bool local = false;
+    bool local_1 = false;
     if (spot_4) {
         float psi = (x_1 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_1 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local = true;
+            local_1 = true;
         }
-        bool _e16 = local;
+        bool _e16 = local_1;
         if (_e16) {
             return s_2;
         }
@@ -690,34 +697,43 @@ vec3 pst_sweep_pixel(uint x_4, uint y) {
 
 void main() {
     uvec3 id = gl_GlobalInvocationID;
+    bool local = false;
     uint e = 0u;
     uint _e3 = _group_0_binding_0_cs.sizes.x;
     uint _e7 = _group_0_binding_0_cs.sizes.y;
     uvec2 screen = uvec2(_e3, _e7);
-    uvec2 lanes = (8u * ((screen + uvec2(255u)) / uvec2(256u)));
-    uint _e18 = _group_0_binding_11_cs;
-    uint n_4 = min(_e18, (screen.x * screen.y));
+    uint _e11 = _group_0_binding_11_cs.groups_x;
+    uint _e15 = _group_0_binding_11_cs.groups_y;
+    uvec2 lanes = (8u * uvec2(_e11, _e15));
+    if ((id.x < lanes.x)) {
+        local = (id.y < lanes.y);
+    } else {
+        local = false;
+    }
+    bool inside = local;
+    uint _e32 = _group_0_binding_11_cs.listed;
+    uint n_4 = (inside ? min(_e32, (screen.x * screen.y)) : 0u);
     e = ((id.y * lanes.x) + id.x);
     bool loop_init_6 = true;
     while(true) {
         if (!loop_init_6) {
-            uint _e54 = e;
-            e = (_e54 + (lanes.x * lanes.y));
+            uint _e68 = e;
+            e = (_e68 + (lanes.x * lanes.y));
         }
         loop_init_6 = false;
-        uint _e30 = e;
-        if ((_e30 < n_4)) {
+        uint _e44 = e;
+        if ((_e44 < n_4)) {
         } else {
             break;
         }
         {
-            uint _e33 = e;
-            uint _e35 = _group_0_binding_12_cs[_e33];
-            uint _e39 = e;
-            uint _e41 = _group_0_binding_12_cs[_e39];
-            uvec2 q_4 = uvec2((_e35 & 65535u), (_e41 >> 16u));
-            vec3 _e47 = pst_sweep_pixel(q_4.x, q_4.y);
-            imageStore(_group_0_binding_9_cs, ivec2(q_4), vec4(_e47.x, _e47.y, _e47.z, 1.0));
+            uint _e47 = e;
+            uint _e49 = _group_0_binding_12_cs[_e47];
+            uint _e53 = e;
+            uint _e55 = _group_0_binding_12_cs[_e53];
+            uvec2 q_4 = uvec2((_e49 & 65535u), (_e55 >> 16u));
+            vec3 _e61 = pst_sweep_pixel(q_4.x, q_4.y);
+            imageStore(_group_0_binding_9_cs, ivec2(q_4), vec4(_e61.x, _e61.y, _e61.z, 1.0));
         }
     }
     return;

@@ -53,6 +53,13 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_hi;
 };
 
+struct FallbackCountRead {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
+
 struct PstRay {
     bool marched;
     int _pad1_0;
@@ -82,6 +89,7 @@ static const uint STEP = 1u;
 static const uint SLICE_RUNS = 256u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
+static const uint FALLBACK_ROW_GROUPS = 1024u;
 static const uint RANK_VECS = 2u;
 static const uint LEAF_VECS = 2u;
 static const uint TREES = 8u;
@@ -539,17 +547,17 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, float x_1, float delta, float theta_2, float s_2, bool spot_4)
 {
-    bool local = (bool)0;
+    bool local_1 = (bool)0;
 
     if (spot_4) {
         float psi = (x_1 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_1 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local = true;
+            local_1 = true;
         }
-        bool _e16 = local;
+        bool _e16 = local_1;
         if (_e16) {
             return s_2;
         }
@@ -818,21 +826,26 @@ float3 pst_sweep_pixel(uint x_4, uint y)
     return (f_23.light_color.xyz * (max((_e81.x * _e85), 0.0) + _e81.y));
 }
 
-uint2 naga_div(uint2 lhs, uint2 rhs) {
-    return lhs / (rhs == 0u ? 1u : rhs);
-}
-
 [numthreads(8, 8, 1)]
 void pst_sweep_fallback(uint3 id : SV_DispatchThreadID)
 {
+    bool local = (bool)0;
     uint e = (uint)0;
 
     uint _e3 = frame.sizes.x;
     uint _e7 = frame.sizes.y;
     uint2 screen = uint2(_e3, _e7);
-    uint2 lanes = (8u * naga_div((screen + (255u).xx), (256u).xx));
-    uint _e18 = asuint(fallback_count.Load(0));
-    uint n_4 = min(_e18, (screen.x * screen.y));
+    uint _e11 = asuint(fallback_count.Load(4));
+    uint _e15 = asuint(fallback_count.Load(8));
+    uint2 lanes = (8u * uint2(_e11, _e15));
+    if ((id.x < lanes.x)) {
+        local = (id.y < lanes.y);
+    } else {
+        local = false;
+    }
+    bool inside = local;
+    uint _e32 = asuint(fallback_count.Load(0));
+    uint n_4 = (inside ? min(_e32, (screen.x * screen.y)) : 0u);
     e = ((id.y * lanes.x) + id.x);
     uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
     bool loop_init_6 = true;
@@ -840,23 +853,23 @@ void pst_sweep_fallback(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
         if (!loop_init_6) {
-            uint _e54 = e;
-            e = (_e54 + (lanes.x * lanes.y));
+            uint _e68 = e;
+            e = (_e68 + (lanes.x * lanes.y));
         }
         loop_init_6 = false;
-        uint _e30 = e;
-        if ((_e30 < n_4)) {
+        uint _e44 = e;
+        if ((_e44 < n_4)) {
         } else {
             break;
         }
         {
-            uint _e33 = e;
-            uint _e35 = asuint(fallback_pixels.Load(_e33*4));
-            uint _e39 = e;
-            uint _e41 = asuint(fallback_pixels.Load(_e39*4));
-            uint2 q_4 = uint2((_e35 & 65535u), (_e41 >> 16u));
-            const float3 _e47 = pst_sweep_pixel(q_4.x, q_4.y);
-            output[q_4] = float4(_e47.x, _e47.y, _e47.z, 1.0);
+            uint _e47 = e;
+            uint _e49 = asuint(fallback_pixels.Load(_e47*4));
+            uint _e53 = e;
+            uint _e55 = asuint(fallback_pixels.Load(_e53*4));
+            uint2 q_4 = uint2((_e49 & 65535u), (_e55 >> 16u));
+            const float3 _e61 = pst_sweep_pixel(q_4.x, q_4.y);
+            output[q_4] = float4(_e61.x, _e61.y, _e61.z, 1.0);
         }
     }
     return;

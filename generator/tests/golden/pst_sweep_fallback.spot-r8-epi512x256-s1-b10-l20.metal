@@ -61,6 +61,12 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     float theta_lo;
     float theta_hi;
 };
+struct FallbackCountRead {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
 struct PstRay {
     bool marched;
     char _pad1[15];
@@ -87,6 +93,7 @@ constant uint STEP = 1u;
 constant uint SLICE_RUNS = 256u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
+constant uint FALLBACK_ROW_GROUPS = 1024u;
 constant uint RANK_VECS = 2u;
 constant uint LEAF_VECS = 2u;
 constant uint TREES = 8u;
@@ -621,16 +628,16 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float s_2,
     bool spot_4
 ) {
-    bool local = {};
+    bool local_1 = {};
     if (spot_4) {
         float psi = x_1 * delta;
         float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
-            local = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_1 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local = true;
+            local_1 = true;
         }
-        bool _e16 = local;
+        bool _e16 = local_1;
         if (_e16) {
             return s_2;
         }
@@ -945,10 +952,6 @@ metal::float3 pst_sweep_pixel(
     float _e85 = sum_2;
     return f_23.light_color.xyz * (metal::max(_e81.x * _e85, 0.0) + _e81.y);
 }
-metal::uint2 naga_div(metal::uint2 lhs, metal::uint2 rhs) {
-    return lhs / metal::select(rhs, 1u, rhs == 0u);
-}
-
 
 struct pst_sweep_fallbackInput {
 };
@@ -961,17 +964,26 @@ kernel void pst_sweep_fallback(
 , metal::texture2d<float, metal::access::sample> rectified [[texture(2)]]
 , device type_9 const& pst_factors [[buffer(2)]]
 , metal::texture2d<float, metal::access::write> output [[texture(3)]]
-, device uint const& fallback_count [[buffer(3)]]
+, device FallbackCountRead const& fallback_count [[buffer(3)]]
 , device type_11 const& fallback_pixels [[buffer(4)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(5)]]
 ) {
+    bool local = {};
     uint e = {};
     uint _e3 = frame.sizes.x;
     uint _e7 = frame.sizes.y;
     metal::uint2 screen = metal::uint2(_e3, _e7);
-    metal::uint2 lanes = 8u * naga_div(screen + metal::uint2(255u), metal::uint2(256u));
-    uint _e18 = fallback_count;
-    uint n_4 = metal::min(_e18, screen.x * screen.y);
+    uint _e11 = fallback_count.groups_x;
+    uint _e15 = fallback_count.groups_y;
+    metal::uint2 lanes = 8u * metal::uint2(_e11, _e15);
+    if (id.x < lanes.x) {
+        local = id.y < lanes.y;
+    } else {
+        local = false;
+    }
+    bool inside = local;
+    uint _e32 = fallback_count.listed;
+    uint n_4 = inside ? metal::min(_e32, screen.x * screen.y) : 0u;
     e = (id.y * lanes.x) + id.x;
     uint2 loop_bound_6 = uint2(4294967295u);
     bool loop_init_6 = true;
@@ -979,23 +991,23 @@ kernel void pst_sweep_fallback(
         if (metal::all(loop_bound_6 == uint2(0u))) { break; }
         loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
         if (!loop_init_6) {
-            uint _e54 = e;
-            e = _e54 + (lanes.x * lanes.y);
+            uint _e68 = e;
+            e = _e68 + (lanes.x * lanes.y);
         }
         loop_init_6 = false;
-        uint _e30 = e;
-        if (_e30 < n_4) {
+        uint _e44 = e;
+        if (_e44 < n_4) {
         } else {
             break;
         }
         {
-            uint _e33 = e;
-            uint _e35 = fallback_pixels[metal::min(unsigned(_e33), (_buffer_sizes.size8 - 0 - 4) / 4)];
-            uint _e39 = e;
-            uint _e41 = fallback_pixels[metal::min(unsigned(_e39), (_buffer_sizes.size8 - 0 - 4) / 4)];
-            metal::uint2 q_4 = metal::uint2(_e35 & 65535u, _e41 >> 16u);
-            metal::float3 _e47 = pst_sweep_pixel(q_4.x, q_4.y, frame, slices, depth, shadow_map, rectified, pst_factors, _buffer_sizes);
-            output.write(metal::float4(_e47.x, _e47.y, _e47.z, 1.0), metal::uint2(q_4));
+            uint _e47 = e;
+            uint _e49 = fallback_pixels[metal::min(unsigned(_e47), (_buffer_sizes.size8 - 0 - 4) / 4)];
+            uint _e53 = e;
+            uint _e55 = fallback_pixels[metal::min(unsigned(_e53), (_buffer_sizes.size8 - 0 - 4) / 4)];
+            metal::uint2 q_4 = metal::uint2(_e49 & 65535u, _e55 >> 16u);
+            metal::float3 _e61 = pst_sweep_pixel(q_4.x, q_4.y, frame, slices, depth, shadow_map, rectified, pst_factors, _buffer_sizes);
+            output.write(metal::float4(_e61.x, _e61.y, _e61.z, 1.0), metal::uint2(q_4));
         }
     }
     return;

@@ -53,6 +53,13 @@ struct SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX {
     theta_hi: f32,
 }
 
+struct FallbackCountRead {
+    listed: u32,
+    groups_x: u32,
+    groups_y: u32,
+    groups_z: u32,
+}
+
 struct PstRay {
     marched: bool,
     color: vec3<f32>,
@@ -77,6 +84,7 @@ const STEP: u32 = 1u;
 const SLICE_RUNS: u32 = 256u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
+const FALLBACK_ROW_GROUPS: u32 = 1024u;
 const RANK_VECS: u32 = 2u;
 const LEAF_VECS: u32 = 2u;
 const TREES: u32 = 8u;
@@ -98,7 +106,7 @@ var<storage> pst_factors: array<vec4<f32>>;
 @group(0) @binding(9) 
 var output: texture_storage_2d<rgba16float,write>;
 @group(0) @binding(11) 
-var<storage> fallback_count: u32;
+var<storage> fallback_count: FallbackCountRead;
 @group(0) @binding(12) 
 var<storage> fallback_pixels: array<u32>;
 
@@ -446,17 +454,17 @@ fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14: FrameX_naga_oil
 }
 
 fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
-    var local: bool;
+    var local_1: bool;
 
     if spot_4 {
         let psi = (x_1 * delta);
         let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
-            local = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_1 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local = true;
+            local_1 = true;
         }
-        let _e16 = local;
+        let _e16 = local_1;
         if _e16 {
             return s_2;
         }
@@ -681,33 +689,42 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8, 1) 
 fn pst_sweep_fallback(@builtin(global_invocation_id) id: vec3<u32>) {
+    var local: bool;
     var e: u32;
 
     let _e3 = frame.sizes.x;
     let _e7 = frame.sizes.y;
     let screen = vec2<u32>(_e3, _e7);
-    let lanes = (8u * ((screen + vec2(255u)) / vec2(256u)));
-    let _e18 = fallback_count;
-    let n_4 = min(_e18, (screen.x * screen.y));
+    let _e11 = fallback_count.groups_x;
+    let _e15 = fallback_count.groups_y;
+    let lanes = (8u * vec2<u32>(_e11, _e15));
+    if (id.x < lanes.x) {
+        local = (id.y < lanes.y);
+    } else {
+        local = false;
+    }
+    let inside = local;
+    let _e32 = fallback_count.listed;
+    let n_4 = select(0u, min(_e32, (screen.x * screen.y)), inside);
     e = ((id.y * lanes.x) + id.x);
     loop {
-        let _e30 = e;
-        if (_e30 < n_4) {
+        let _e44 = e;
+        if (_e44 < n_4) {
         } else {
             break;
         }
         {
-            let _e33 = e;
-            let _e35 = fallback_pixels[_e33];
-            let _e39 = e;
-            let _e41 = fallback_pixels[_e39];
-            let q_4 = vec2<u32>((_e35 & 65535u), (_e41 >> 16u));
-            let _e47 = pst_sweep_pixel(q_4.x, q_4.y);
-            textureStore(output, q_4, vec4<f32>(_e47.x, _e47.y, _e47.z, 1f));
+            let _e47 = e;
+            let _e49 = fallback_pixels[_e47];
+            let _e53 = e;
+            let _e55 = fallback_pixels[_e53];
+            let q_4 = vec2<u32>((_e49 & 65535u), (_e55 >> 16u));
+            let _e61 = pst_sweep_pixel(q_4.x, q_4.y);
+            textureStore(output, q_4, vec4<f32>(_e61.x, _e61.y, _e61.z, 1f));
         }
         continuing {
-            let _e54 = e;
-            e = (_e54 + (lanes.x * lanes.y));
+            let _e68 = e;
+            e = (_e68 + (lanes.x * lanes.y));
         }
     }
     return;

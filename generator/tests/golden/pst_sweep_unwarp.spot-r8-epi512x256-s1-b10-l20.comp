@@ -66,6 +66,12 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uvec2 k;
     vec4 w;
 };
+struct FallbackCount {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
 struct PstRay {
     bool marched;
     vec3 color;
@@ -89,6 +95,7 @@ const uint STEP = 1u;
 const uint SLICE_RUNS = 256u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
+const uint FALLBACK_ROW_GROUPS = 1024u;
 const uint RANK_VECS = 2u;
 const uint LEAF_VECS = 2u;
 const uint TREES = 8u;
@@ -103,7 +110,7 @@ layout(binding = 9,rgba16f) writeonly uniform image2D _group_0_binding_9_cs;
 
 layout(binding = 10) uniform sampler2D _group_0_binding_10_cs;
 
-layout(std430, binding = 11) buffer type_12_block_1Compute { uint _group_0_binding_11_cs; };
+layout(std430, binding = 11) buffer FallbackCount_block_1Compute { FallbackCount _group_0_binding_11_cs; };
 
 layout(std430, binding = 12) buffer type_13_block_2Compute { uint _group_0_binding_12_cs[]; };
 
@@ -660,14 +667,29 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
     return _e70;
 }
 
+void fallback_list_reset() {
+    atomicExchange(_group_0_binding_11_cs.listed, 0u);
+    atomicExchange(_group_0_binding_11_cs.groups_x, 0u);
+    atomicExchange(_group_0_binding_11_cs.groups_y, 0u);
+    _group_0_binding_11_cs.groups_z = 1u;
+    return;
+}
+
 void unwarp_pixel(uvec2 q_1, vec4 w_2, vec4 depths_2, vec3 light_2[4]) {
     int _e3_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e3 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(q_1), ivec2(0), textureSize(_group_0_binding_2_cs, _e3_clamped_lod) - ivec2(1)), _e3_clamped_lod);
     vec4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
     if ((_e10.w == 0.0)) {
-        uint _e16 = atomicAdd(_group_0_binding_11_cs, 1u);
-        _group_0_binding_12_cs[_e16] = (q_1.x | (q_1.y << 16u));
-        return;
+        uint _e17 = atomicAdd(_group_0_binding_11_cs.listed, 1u);
+        _group_0_binding_12_cs[_e17] = (q_1.x | (q_1.y << 16u));
+        if (((_e17 % 64u) == 0u)) {
+            uint g_3 = ((_e17 / 64u) + 1u);
+            uint _e37 = atomicMax(_group_0_binding_11_cs.groups_x, min(g_3, FALLBACK_ROW_GROUPS));
+            uint _e46 = atomicMax(_group_0_binding_11_cs.groups_y, (((g_3 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+            return;
+        } else {
+            return;
+        }
     } else {
         imageStore(_group_0_binding_9_cs, ivec2(q_1), _e10);
         return;

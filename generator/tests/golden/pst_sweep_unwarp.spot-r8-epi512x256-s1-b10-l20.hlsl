@@ -68,6 +68,13 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     float4 w;
 };
 
+struct FallbackCount {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
+
 struct PstRay {
     bool marched;
     int _pad1_0;
@@ -97,6 +104,7 @@ static const uint STEP = 1u;
 static const uint SLICE_RUNS = 256u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
+static const uint FALLBACK_ROW_GROUPS = 1024u;
 static const uint RANK_VECS = 2u;
 static const uint LEAF_VECS = 2u;
 static const uint TREES = 8u;
@@ -783,14 +791,30 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
     return epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1;
 }
 
+void fallback_list_reset()
+{
+    { uint dummy = 0; fallback_count.InterlockedExchange(0, 0u, dummy); }
+    { uint dummy_1 = 0; fallback_count.InterlockedExchange(4, 0u, dummy_1); }
+    { uint dummy_2 = 0; fallback_count.InterlockedExchange(8, 0u, dummy_2); }
+    fallback_count.Store(12, asuint(1u));
+    return;
+}
+
 void unwarp_pixel(uint2 q_1, float4 w_2, float4 depths_2, float3 light_2[4])
 {
     float4 _e3 = depth.Load(int3(q_1, int(0)));
     const float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
     if ((_e10.w == 0.0)) {
-        uint _e16; fallback_count.InterlockedAdd(0, 1u, _e16);
-        fallback_pixels.Store(_e16*4, asuint((q_1.x | (q_1.y << 16u))));
-        return;
+        uint _e17; fallback_count.InterlockedAdd(0, 1u, _e17);
+        fallback_pixels.Store(_e17*4, asuint((q_1.x | (q_1.y << 16u))));
+        if ((naga_mod(_e17, 64u) == 0u)) {
+            uint g_3 = (naga_div(_e17, 64u) + 1u);
+            uint _e37; fallback_count.InterlockedMax(4, min(g_3, FALLBACK_ROW_GROUPS), _e37);
+            uint _e46; fallback_count.InterlockedMax(8, naga_div(((g_3 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e46);
+            return;
+        } else {
+            return;
+        }
     } else {
         output[q_1] = _e10;
         return;

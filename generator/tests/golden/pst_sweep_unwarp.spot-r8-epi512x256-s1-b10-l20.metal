@@ -77,6 +77,12 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     metal::uint2 k;
     metal::float4 w;
 };
+struct FallbackCount {
+    metal::atomic_uint listed;
+    metal::atomic_uint groups_x;
+    metal::atomic_uint groups_y;
+    uint groups_z;
+};
 struct PstRay {
     bool marched;
     char _pad1[15];
@@ -89,7 +95,7 @@ struct PstRay {
     float d;
     float xs_num;
 };
-typedef metal::float4 type_10[1];
+typedef metal::float4 type_11[1];
 typedef uint type_13[1];
 constant float NO_OCCLUDERX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX = 1000000000000000000000000000000.0;
 constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
@@ -103,6 +109,7 @@ constant uint STEP = 1u;
 constant uint SLICE_RUNS = 256u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
+constant uint FALLBACK_ROW_GROUPS = 1024u;
 constant uint RANK_VECS = 2u;
 constant uint LEAF_VECS = 2u;
 constant uint TREES = 8u;
@@ -901,6 +908,16 @@ EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oi
     return _e70;
 }
 
+void fallback_list_reset(
+    device FallbackCount& fallback_count
+) {
+    metal::atomic_store_explicit(&fallback_count.listed, 0u, metal::memory_order_relaxed);
+    metal::atomic_store_explicit(&fallback_count.groups_x, 0u, metal::memory_order_relaxed);
+    metal::atomic_store_explicit(&fallback_count.groups_y, 0u, metal::memory_order_relaxed);
+    fallback_count.groups_z = 1u;
+    return;
+}
+
 void unwarp_pixel(
     metal::uint2 q_1,
     metal::float4 w_2,
@@ -908,7 +925,7 @@ void unwarp_pixel(
     type_9 light_2,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::write> output,
-    device metal::atomic_uint& fallback_count,
+    device FallbackCount& fallback_count,
     device type_13& fallback_pixels,
     constant _mslBufferSizes& _buffer_sizes
 ) {
@@ -916,9 +933,16 @@ void unwarp_pixel(
     metal::float4 _e3 = depth.read(metal::min(metal::uint2(q_1), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
     metal::float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
     if (_e10.w == 0.0) {
-        uint _e16 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e16), (_buffer_sizes.size9 - 0 - 4) / 4)] = q_1.x | (q_1.y << 16u);
-        return;
+        uint _e17 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
+        fallback_pixels[metal::min(unsigned(_e17), (_buffer_sizes.size9 - 0 - 4) / 4)] = q_1.x | (q_1.y << 16u);
+        if (naga_mod(_e17, 64u) == 0u) {
+            uint g_3 = naga_div(_e17, 64u) + 1u;
+            uint _e37 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_3, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+            uint _e46 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_3 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+            return;
+        } else {
+            return;
+        }
     } else {
         output.write(_e10, metal::uint2(q_1));
         return;
@@ -929,7 +953,7 @@ metal::float4 factor_at(
     uint base,
     float x_3,
     uint h,
-    device type_10 const& pst_factors,
+    device type_11 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float p_8 = metal::min(metal::clamp(x_3, 0.0, 1.0) * 95.0, 95.0);
@@ -943,7 +967,7 @@ metal::float4 factor_at(
 metal::float4 gamma_at(
     float v_10,
     uint h_1,
-    device type_10 const& pst_factors,
+    device type_11 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float _e4 = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)].x;
@@ -954,7 +978,7 @@ metal::float4 gamma_at(
 metal::float4 beta_at(
     float theta_4,
     uint h_2,
-    device type_10 const& pst_factors,
+    device type_11 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 head = pst_factors[metal::min(unsigned(0), (_buffer_sizes.size5 - 0 - 16) / 16)];
@@ -980,7 +1004,7 @@ metal::float4 pst_leaf(
     metal::float3 e_1,
     float delta_2,
     uint h_3,
-    device type_10 const& pst_factors,
+    device type_11 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     metal::float4 leaf = metal::float4(0.0, 0.0, 0.0, 0.0);
@@ -1099,11 +1123,11 @@ metal::float3 pst_sweep_pixel(
     uint x_4,
     uint y,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
-    device type_10 const& slices_1,
+    device type_11 const& slices_1,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::sample> shadow_map,
     metal::texture2d<float, metal::access::sample> rectified,
-    device type_10 const& pst_factors,
+    device type_11 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float sum_3 = 0.0;
@@ -1191,7 +1215,7 @@ kernel void pst_sweep_unwarp(
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::write> output [[texture(1)]]
 , metal::texture2d<float, metal::access::sample> epipolar_samples [[texture(2)]]
-, device metal::atomic_uint& fallback_count [[buffer(1)]]
+, device FallbackCount& fallback_count [[buffer(1)]]
 , device type_13& fallback_pixels [[buffer(2)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {

@@ -67,6 +67,13 @@ struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     w: vec4<f32>,
 }
 
+struct FallbackCount {
+    listed: atomic<u32>,
+    groups_x: atomic<u32>,
+    groups_y: atomic<u32>,
+    groups_z: u32,
+}
+
 struct PstRay {
     marched: bool,
     color: vec3<f32>,
@@ -91,6 +98,7 @@ const STEP: u32 = 1u;
 const SLICE_RUNS: u32 = 256u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
+const FALLBACK_ROW_GROUPS: u32 = 1024u;
 const RANK_VECS: u32 = 2u;
 const LEAF_VECS: u32 = 2u;
 const TREES: u32 = 8u;
@@ -114,7 +122,7 @@ var output: texture_storage_2d<rgba16float,write>;
 @group(0) @binding(10) 
 var epipolar_samples: texture_2d<f32>;
 @group(0) @binding(11) 
-var<storage, read_write> fallback_count: atomic<u32>;
+var<storage, read_write> fallback_count: FallbackCount;
 @group(0) @binding(12) 
 var<storage, read_write> fallback_pixels: array<u32>;
 
@@ -666,13 +674,28 @@ fn epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayou
     return _e70;
 }
 
+fn fallback_list_reset() {
+    atomicStore((&fallback_count.listed), 0u);
+    atomicStore((&fallback_count.groups_x), 0u);
+    atomicStore((&fallback_count.groups_y), 0u);
+    fallback_count.groups_z = 1u;
+    return;
+}
+
 fn unwarp_pixel(q_1: vec2<u32>, w_2: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
     let _e3 = textureLoad(depth, q_1, 0i);
     let _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
     if (_e10.w == 0f) {
-        let _e16 = atomicAdd((&fallback_count), 1u);
-        fallback_pixels[_e16] = (q_1.x | (q_1.y << 16u));
-        return;
+        let _e17 = atomicAdd((&fallback_count.listed), 1u);
+        fallback_pixels[_e17] = (q_1.x | (q_1.y << 16u));
+        if ((_e17 % 64u) == 0u) {
+            let g_3 = ((_e17 / 64u) + 1u);
+            let _e37 = atomicMax((&fallback_count.groups_x), min(g_3, FALLBACK_ROW_GROUPS));
+            let _e46 = atomicMax((&fallback_count.groups_y), (((g_3 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+            return;
+        } else {
+            return;
+        }
     } else {
         textureStore(output, q_1, _e10);
         return;

@@ -58,6 +58,13 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     int _end_pad_0;
 };
 
+struct FallbackCount {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
+
 static const float EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX = 100.0;
 static const uint SLICES = 256u;
 static const uint SLICE_SAMPLES = 256u;
@@ -66,6 +73,7 @@ static const uint STEP = 8u;
 static const uint SLICE_RUNS = 32u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
+static const uint FALLBACK_ROW_GROUPS = 1024u;
 
 cbuffer frame : register(b0) { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX frame; }
 Texture2D<float4> depth : register(t1);
@@ -452,6 +460,15 @@ uint2 slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLa
     return naga_f2u32(clamp(floor(p_2), float2(0.0, 0.0), last));
 }
 
+void fallback_list_reset()
+{
+    { uint dummy = 0; fallback_count.InterlockedExchange(0, 0u, dummy); }
+    { uint dummy_1 = 0; fallback_count.InterlockedExchange(4, 0u, dummy_1); }
+    { uint dummy_2 = 0; fallback_count.InterlockedExchange(8, 0u, dummy_2); }
+    fallback_count.Store(12, asuint(1u));
+    return;
+}
+
 uint naga_mod(uint lhs, uint rhs) {
     return lhs % (rhs == 0u ? 1u : rhs);
 }
@@ -611,7 +628,7 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
     if ((li == 0u)) {
         output[uint2(SLICE_SAMPLES, s_3)] = float4(_e39.x, _e39.y, _e41.x, _e41.y);
         if ((s_3 == 0u)) {
-            { uint dummy = 0; fallback_count.InterlockedExchange(0, 0u, dummy); }
+            fallback_list_reset();
             output[uint2(0u, 256u)] = float4(_e36.origin, _e36.axis);
             output[uint2(1u, 256u)] = float4(_e36.phi_start, _e36.dphi, float(_e36.wrap), 0.0);
         }
@@ -623,21 +640,21 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e87 = k;
-            k = (_e87 + SLICE_LANES);
+            uint _e85 = k;
+            k = (_e85 + SLICE_LANES);
         }
         loop_init_3 = false;
-        uint _e75 = k;
-        if ((_e75 < SLICE_SAMPLES)) {
+        uint _e73 = k;
+        if ((_e73 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e78 = k;
-            const uint2 _e79 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e78, screen_3);
-            uint _e81 = k;
-            float4 _e85 = depth.Load(int3(_e79, int(0)));
-            line_depth[min(uint(_e81), 255u)] = _e85.x;
+            uint _e76 = k;
+            const uint2 _e77 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e76, screen_3);
+            uint _e79 = k;
+            float4 _e83 = depth.Load(int3(_e77, int(0)));
+            line_depth[min(uint(_e79), 255u)] = _e83.x;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -648,18 +665,18 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e220 = g;
-            g = (_e220 + SLICE_LANES);
+            uint _e218 = g;
+            g = (_e218 + SLICE_LANES);
         }
         loop_init_4 = false;
-        uint _e91 = g;
-        if ((_e91 < SLICE_RUNS)) {
+        uint _e89 = g;
+        if ((_e89 < SLICE_RUNS)) {
         } else {
             break;
         }
         {
-            uint _e94 = g;
-            uint s0_ = (_e94 * STEP);
+            uint _e92 = g;
+            uint s0_ = (_e92 * STEP);
             uint e_3 = min((s0_ + STEP), SLICE_SAMPLES);
             a = s0_;
             k_1 = s0_;
@@ -669,68 +686,68 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
                 loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                 if (!loop_init_5) {
-                    uint _e183 = k_1;
-                    k_1 = (_e183 + 1u);
+                    uint _e181 = k_1;
+                    k_1 = (_e181 + 1u);
                 }
                 loop_init_5 = false;
-                uint _e103 = k_1;
-                if ((_e103 < e_3)) {
+                uint _e101 = k_1;
+                if ((_e101 < e_3)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e105 = k_1;
-                    if (!((naga_mod(_e105, STEP) == 0u))) {
-                        uint _e111 = k_1;
-                        local = (_e111 == 255u);
+                    uint _e103 = k_1;
+                    if (!((naga_mod(_e103, STEP) == 0u))) {
+                        uint _e109 = k_1;
+                        local = (_e109 == 255u);
                     } else {
                         local = true;
                     }
-                    bool _e117 = local;
-                    marked = _e117;
-                    uint _e119 = k_1;
-                    if ((_e119 > 0u)) {
-                        uint _e122 = k_1;
-                        float _e127 = line_depth[min(uint((_e122 - 1u)), 255u)];
-                        uint _e129 = k_1;
-                        float _e131 = line_depth[min(uint(_e129), 255u)];
-                        const bool _e133 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e127, _e131, DEPTH_BREAK);
-                        local_1 = !(_e133);
+                    bool _e115 = local;
+                    marked = _e115;
+                    uint _e117 = k_1;
+                    if ((_e117 > 0u)) {
+                        uint _e120 = k_1;
+                        float _e125 = line_depth[min(uint((_e120 - 1u)), 255u)];
+                        uint _e127 = k_1;
+                        float _e129 = line_depth[min(uint(_e127), 255u)];
+                        const bool _e131 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e125, _e129, DEPTH_BREAK);
+                        local_1 = !(_e131);
                     } else {
                         local_1 = false;
                     }
-                    bool _e138 = local_1;
-                    if (_e138) {
+                    bool _e136 = local_1;
+                    if (_e136) {
                         marked = true;
                     }
-                    uint _e140 = k_1;
-                    if (((_e140 + 1u) < SLICE_SAMPLES)) {
-                        uint _e146 = k_1;
-                        float _e148 = line_depth[min(uint(_e146), 255u)];
-                        uint _e149 = k_1;
-                        float _e154 = line_depth[min(uint((_e149 + 1u)), 255u)];
-                        const bool _e156 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e148, _e154, DEPTH_BREAK);
-                        local_2 = !(_e156);
+                    uint _e138 = k_1;
+                    if (((_e138 + 1u) < SLICE_SAMPLES)) {
+                        uint _e144 = k_1;
+                        float _e146 = line_depth[min(uint(_e144), 255u)];
+                        uint _e147 = k_1;
+                        float _e152 = line_depth[min(uint((_e147 + 1u)), 255u)];
+                        const bool _e154 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e146, _e152, DEPTH_BREAK);
+                        local_2 = !(_e154);
                     } else {
                         local_2 = false;
                     }
-                    bool _e161 = local_2;
-                    if (_e161) {
+                    bool _e159 = local_2;
+                    if (_e159) {
                         marked = true;
                     }
-                    bool _e163 = marked;
-                    if (_e163) {
-                        uint _e164 = k_1;
-                        a = _e164;
-                        uint _e167; InterlockedAdd(line_count, 1u, _e167);
-                        uint _e170 = k_1;
-                        line_list[min(uint(_e167), 255u)] = _e170;
+                    bool _e161 = marked;
+                    if (_e161) {
+                        uint _e162 = k_1;
+                        a = _e162;
+                        uint _e165; InterlockedAdd(line_count, 1u, _e165);
+                        uint _e168 = k_1;
+                        line_list[min(uint(_e165), 255u)] = _e168;
                     }
-                    uint _e172 = k_1;
-                    uint _e174 = a;
-                    uint _e176 = k_1;
-                    bool _e177 = marked;
-                    line_ab[min(uint(_e172), 255u)] = (_e174 | ((_e177 ? _e176 : 65535u) << 16u));
+                    uint _e170 = k_1;
+                    uint _e172 = a;
+                    uint _e174 = k_1;
+                    bool _e175 = marked;
+                    line_ab[min(uint(_e170), 255u)] = (_e172 | ((_e175 ? _e174 : 65535u) << 16u));
                 }
             }
             b = min(e_3, 255u);
@@ -741,26 +758,26 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
                 if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
                 loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                 if (!loop_init_6) {
-                    uint _e218 = k_2;
-                    k_2 = (_e218 - 1u);
+                    uint _e216 = k_2;
+                    k_2 = (_e216 - 1u);
                 }
                 loop_init_6 = false;
-                uint _e189 = k_2;
-                if ((_e189 > s0_)) {
+                uint _e187 = k_2;
+                if ((_e187 > s0_)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e191 = k_2;
-                    uint v_9 = line_ab[min(uint((_e191 - 1u)), 255u)];
-                    uint _e199 = k_2;
-                    if (((v_9 & 65535u) == (_e199 - 1u))) {
-                        uint _e203 = k_2;
-                        b = (_e203 - 1u);
+                    uint _e189 = k_2;
+                    uint v_9 = line_ab[min(uint((_e189 - 1u)), 255u)];
+                    uint _e197 = k_2;
+                    if (((v_9 & 65535u) == (_e197 - 1u))) {
+                        uint _e201 = k_2;
+                        b = (_e201 - 1u);
                     } else {
-                        uint _e206 = k_2;
-                        uint _e213 = b;
-                        line_ab[min(uint((_e206 - 1u)), 255u)] = ((v_9 & 65535u) | (_e213 << 16u));
+                        uint _e204 = k_2;
+                        uint _e211 = b;
+                        line_ab[min(uint((_e204 - 1u)), 255u)] = ((v_9 & 65535u) | (_e211 << 16u));
                     }
                 }
             }
@@ -775,22 +792,22 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_7 == uint2(0u, 0u))) { break; }
         loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
         if (!loop_init_7) {
-            uint _e239 = e;
-            e = (_e239 + SLICE_LANES);
+            uint _e237 = e;
+            e = (_e237 + SLICE_LANES);
         }
         loop_init_7 = false;
-        uint _e226 = e;
-        if ((_e226 < n_3)) {
+        uint _e224 = e;
+        if ((_e224 < n_3)) {
         } else {
             break;
         }
         {
-            uint _e229 = e;
-            uint k_9 = line_list[min(uint(_e229), 255u)];
-            const uint2 _e232 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_9, screen_3);
-            const float3 _e237 = raymarch_pixel(_e232.x, _e232.y);
-            const float3 _e238 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e237);
-            line_light[min(uint(k_9), 255u)] = _e238;
+            uint _e227 = e;
+            uint k_9 = line_list[min(uint(_e227), 255u)];
+            const uint2 _e230 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_9, screen_3);
+            const float3 _e235 = raymarch_pixel(_e230.x, _e230.y);
+            const float3 _e236 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e235);
+            line_light[min(uint(k_9), 255u)] = _e236;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -801,31 +818,31 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_8 == uint2(0u, 0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
         if (!loop_init_8) {
-            uint _e262 = k_3;
-            k_3 = (_e262 + SLICE_LANES);
+            uint _e260 = k_3;
+            k_3 = (_e260 + SLICE_LANES);
         }
         loop_init_8 = false;
-        uint _e243 = k_3;
-        if ((_e243 < SLICE_SAMPLES)) {
+        uint _e241 = k_3;
+        if ((_e241 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e246 = k_3;
-            const bool _e247 = line_marked(_e246);
-            if (!(_e247)) {
-                uint _e249 = k_3;
-                const uint2 _e250 = line_bracket(_e249);
-                const bool _e251 = line_spread_over(_e250);
-                local_3 = _e251;
+            uint _e244 = k_3;
+            const bool _e245 = line_marked(_e244);
+            if (!(_e245)) {
+                uint _e247 = k_3;
+                const uint2 _e248 = line_bracket(_e247);
+                const bool _e249 = line_spread_over(_e248);
+                local_3 = _e249;
             } else {
                 local_3 = false;
             }
-            bool _e255 = local_3;
-            if (_e255) {
-                uint _e258; InterlockedAdd(line_count_light, 1u, _e258);
-                uint _e261 = k_3;
-                line_list[min(uint(_e258), 255u)] = _e261;
+            bool _e253 = local_3;
+            if (_e253) {
+                uint _e256; InterlockedAdd(line_count_light, 1u, _e256);
+                uint _e259 = k_3;
+                line_list[min(uint(_e256), 255u)] = _e259;
             }
         }
     }
@@ -838,22 +855,22 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_9 == uint2(0u, 0u))) { break; }
         loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
         if (!loop_init_9) {
-            uint _e281 = e_1;
-            e_1 = (_e281 + SLICE_LANES);
+            uint _e279 = e_1;
+            e_1 = (_e279 + SLICE_LANES);
         }
         loop_init_9 = false;
-        uint _e268 = e_1;
-        if ((_e268 < n2_)) {
+        uint _e266 = e_1;
+        if ((_e266 < n2_)) {
         } else {
             break;
         }
         {
-            uint _e271 = e_1;
-            uint k_10 = line_list[min(uint(_e271), 255u)];
-            const uint2 _e274 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_10, screen_3);
-            const float3 _e279 = raymarch_pixel(_e274.x, _e274.y);
-            const float3 _e280 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e279);
-            line_light[min(uint(k_10), 255u)] = _e280;
+            uint _e269 = e_1;
+            uint k_10 = line_list[min(uint(_e269), 255u)];
+            const uint2 _e272 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_10, screen_3);
+            const float3 _e277 = raymarch_pixel(_e272.x, _e272.y);
+            const float3 _e278 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e277);
+            line_light[min(uint(k_10), 255u)] = _e278;
         }
     }
     GroupMemoryBarrierWithGroupSync();
@@ -864,40 +881,40 @@ void raymarch(uint3 wid : SV_GroupID, uint li : SV_GroupIndex)
         if (all(loop_bound_10 == uint2(0u, 0u))) { break; }
         loop_bound_10 -= uint2(loop_bound_10.y == 0u, 1u);
         if (!loop_init_10) {
-            uint _e336 = k_4;
-            k_4 = (_e336 + SLICE_LANES);
+            uint _e334 = k_4;
+            k_4 = (_e334 + SLICE_LANES);
         }
         loop_init_10 = false;
-        uint _e285 = k_4;
-        if ((_e285 < SLICE_SAMPLES)) {
+        uint _e283 = k_4;
+        if ((_e283 < SLICE_SAMPLES)) {
         } else {
             break;
         }
         {
-            uint _e289 = k_4;
-            float3 _e291 = line_light[min(uint(_e289), 255u)];
-            c = _e291;
-            uint _e293 = k_4;
-            const bool _e294 = line_marked(_e293);
-            if (!(_e294)) {
-                uint _e296 = k_4;
-                const uint2 _e297 = line_bracket(_e296);
-                const bool _e298 = line_spread_over(_e297);
-                if (!(_e298)) {
-                    uint _e300 = k_4;
-                    float t_4 = (float((_e300 - _e297.x)) / float((_e297.y - _e297.x)));
-                    float3 _e312 = line_light[min(uint(_e297.x), 255u)];
-                    float3 _e319 = line_light[min(uint(_e297.y), 255u)];
-                    c = ((_e312 * (1.0 - t_4)) + (_e319 * t_4));
+            uint _e287 = k_4;
+            float3 _e289 = line_light[min(uint(_e287), 255u)];
+            c = _e289;
+            uint _e291 = k_4;
+            const bool _e292 = line_marked(_e291);
+            if (!(_e292)) {
+                uint _e294 = k_4;
+                const uint2 _e295 = line_bracket(_e294);
+                const bool _e296 = line_spread_over(_e295);
+                if (!(_e296)) {
+                    uint _e298 = k_4;
+                    float t_4 = (float((_e298 - _e295.x)) / float((_e295.y - _e295.x)));
+                    float3 _e310 = line_light[min(uint(_e295.x), 255u)];
+                    float3 _e317 = line_light[min(uint(_e295.y), 255u)];
+                    c = ((_e310 * (1.0 - t_4)) + (_e317 * t_4));
                 }
             }
-            uint _e322 = k_4;
-            float _e325 = c.x;
-            float _e327 = c.y;
-            float _e329 = c.z;
-            uint _e331 = k_4;
-            float _e333 = line_depth[min(uint(_e331), 255u)];
-            output[uint2(_e322, s_3)] = float4(_e325, _e327, _e329, _e333);
+            uint _e320 = k_4;
+            float _e323 = c.x;
+            float _e325 = c.y;
+            float _e327 = c.z;
+            uint _e329 = k_4;
+            float _e331 = line_depth[min(uint(_e329), 255u)];
+            output[uint2(_e320, s_3)] = float4(_e323, _e325, _e327, _e331);
         }
     }
     return;

@@ -51,6 +51,13 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     wrap: u32,
 }
 
+struct FallbackCount {
+    listed: atomic<u32>,
+    groups_x: atomic<u32>,
+    groups_y: atomic<u32>,
+    groups_z: u32,
+}
+
 const EPIPOLE_FARX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX: f32 = 100f;
 const SLICES: u32 = 256u;
 const SLICE_SAMPLES: u32 = 256u;
@@ -59,6 +66,7 @@ const STEP: u32 = 8u;
 const SLICE_RUNS: u32 = 32u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
+const FALLBACK_ROW_GROUPS: u32 = 1024u;
 
 @group(0) @binding(0) 
 var<uniform> frame: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX;
@@ -69,7 +77,7 @@ var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) 
 var output: texture_storage_2d<rgba32float,write>;
 @group(0) @binding(5) 
-var<storage, read_write> fallback_count: atomic<u32>;
+var<storage, read_write> fallback_count: FallbackCount;
 var<workgroup> line_depth: array<f32, 256>;
 var<workgroup> line_ab: array<u32, 256>;
 var<workgroup> line_light: array<vec3<f32>, 256>;
@@ -385,6 +393,14 @@ fn slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_3: Epipolar
     return vec2<u32>(clamp(floor(p_2), vec2<f32>(0f, 0f), last));
 }
 
+fn fallback_list_reset() {
+    atomicStore((&fallback_count.listed), 0u);
+    atomicStore((&fallback_count.groups_x), 0u);
+    atomicStore((&fallback_count.groups_y), 0u);
+    fallback_count.groups_z = 1u;
+    return;
+}
+
 fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     var sum: f32 = 0f;
     var j: u32;
@@ -510,253 +526,253 @@ fn raymarch(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_ind
     if (li == 0u) {
         textureStore(output, vec2<u32>(SLICE_SAMPLES, s_3), vec4<f32>(_e39.x, _e39.y, _e41.x, _e41.y));
         if (s_3 == 0u) {
-            atomicStore((&fallback_count), 0u);
+            fallback_list_reset();
             textureStore(output, vec2<u32>(0u, 256u), vec4<f32>(_e36.origin, _e36.axis));
             textureStore(output, vec2<u32>(1u, 256u), vec4<f32>(_e36.phi_start, _e36.dphi, f32(_e36.wrap), 0f));
         }
     }
     k = li;
     loop {
-        let _e75 = k;
-        if (_e75 < SLICE_SAMPLES) {
+        let _e73 = k;
+        if (_e73 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e78 = k;
-            let _e79 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e78, screen_3);
-            let _e81 = k;
-            let _e85 = textureLoad(depth, _e79, 0i);
-            line_depth[_e81] = _e85.x;
+            let _e76 = k;
+            let _e77 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, _e76, screen_3);
+            let _e79 = k;
+            let _e83 = textureLoad(depth, _e77, 0i);
+            line_depth[_e79] = _e83.x;
         }
         continuing {
-            let _e87 = k;
-            k = (_e87 + SLICE_LANES);
+            let _e85 = k;
+            k = (_e85 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     g = li;
     loop {
-        let _e91 = g;
-        if (_e91 < SLICE_RUNS) {
+        let _e89 = g;
+        if (_e89 < SLICE_RUNS) {
         } else {
             break;
         }
         {
-            let _e94 = g;
-            let s0_ = (_e94 * STEP);
+            let _e92 = g;
+            let s0_ = (_e92 * STEP);
             let e_3 = min((s0_ + STEP), SLICE_SAMPLES);
             a = s0_;
             k_1 = s0_;
             loop {
-                let _e103 = k_1;
-                if (_e103 < e_3) {
+                let _e101 = k_1;
+                if (_e101 < e_3) {
                 } else {
                     break;
                 }
                 {
-                    let _e105 = k_1;
-                    if !(((_e105 % STEP) == 0u)) {
-                        let _e111 = k_1;
-                        local = (_e111 == 255u);
+                    let _e103 = k_1;
+                    if !(((_e103 % STEP) == 0u)) {
+                        let _e109 = k_1;
+                        local = (_e109 == 255u);
                     } else {
                         local = true;
                     }
-                    let _e117 = local;
-                    marked = _e117;
-                    let _e119 = k_1;
-                    if (_e119 > 0u) {
-                        let _e122 = k_1;
-                        let _e127 = line_depth[(_e122 - 1u)];
-                        let _e129 = k_1;
-                        let _e131 = line_depth[_e129];
-                        let _e133 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e127, _e131, DEPTH_BREAK);
-                        local_1 = !(_e133);
+                    let _e115 = local;
+                    marked = _e115;
+                    let _e117 = k_1;
+                    if (_e117 > 0u) {
+                        let _e120 = k_1;
+                        let _e125 = line_depth[(_e120 - 1u)];
+                        let _e127 = k_1;
+                        let _e129 = line_depth[_e127];
+                        let _e131 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e125, _e129, DEPTH_BREAK);
+                        local_1 = !(_e131);
                     } else {
                         local_1 = false;
                     }
-                    let _e138 = local_1;
-                    if _e138 {
+                    let _e136 = local_1;
+                    if _e136 {
                         marked = true;
                     }
-                    let _e140 = k_1;
-                    if ((_e140 + 1u) < SLICE_SAMPLES) {
-                        let _e146 = k_1;
-                        let _e148 = line_depth[_e146];
-                        let _e149 = k_1;
-                        let _e154 = line_depth[(_e149 + 1u)];
-                        let _e156 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e148, _e154, DEPTH_BREAK);
-                        local_2 = !(_e156);
+                    let _e138 = k_1;
+                    if ((_e138 + 1u) < SLICE_SAMPLES) {
+                        let _e144 = k_1;
+                        let _e146 = line_depth[_e144];
+                        let _e147 = k_1;
+                        let _e152 = line_depth[(_e147 + 1u)];
+                        let _e154 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e146, _e152, DEPTH_BREAK);
+                        local_2 = !(_e154);
                     } else {
                         local_2 = false;
                     }
-                    let _e161 = local_2;
-                    if _e161 {
+                    let _e159 = local_2;
+                    if _e159 {
                         marked = true;
                     }
-                    let _e163 = marked;
-                    if _e163 {
-                        let _e164 = k_1;
-                        a = _e164;
-                        let _e167 = atomicAdd((&line_count), 1u);
-                        let _e170 = k_1;
-                        line_list[_e167] = _e170;
+                    let _e161 = marked;
+                    if _e161 {
+                        let _e162 = k_1;
+                        a = _e162;
+                        let _e165 = atomicAdd((&line_count), 1u);
+                        let _e168 = k_1;
+                        line_list[_e165] = _e168;
                     }
-                    let _e172 = k_1;
-                    let _e174 = a;
-                    let _e176 = k_1;
-                    let _e177 = marked;
-                    line_ab[_e172] = (_e174 | (select(65535u, _e176, _e177) << 16u));
+                    let _e170 = k_1;
+                    let _e172 = a;
+                    let _e174 = k_1;
+                    let _e175 = marked;
+                    line_ab[_e170] = (_e172 | (select(65535u, _e174, _e175) << 16u));
                 }
                 continuing {
-                    let _e183 = k_1;
-                    k_1 = (_e183 + 1u);
+                    let _e181 = k_1;
+                    k_1 = (_e181 + 1u);
                 }
             }
             b = min(e_3, 255u);
             k_2 = e_3;
             loop {
-                let _e189 = k_2;
-                if (_e189 > s0_) {
+                let _e187 = k_2;
+                if (_e187 > s0_) {
                 } else {
                     break;
                 }
                 {
-                    let _e191 = k_2;
-                    let v_9 = line_ab[(_e191 - 1u)];
-                    let _e199 = k_2;
-                    if ((v_9 & 65535u) == (_e199 - 1u)) {
-                        let _e203 = k_2;
-                        b = (_e203 - 1u);
+                    let _e189 = k_2;
+                    let v_9 = line_ab[(_e189 - 1u)];
+                    let _e197 = k_2;
+                    if ((v_9 & 65535u) == (_e197 - 1u)) {
+                        let _e201 = k_2;
+                        b = (_e201 - 1u);
                     } else {
-                        let _e206 = k_2;
-                        let _e213 = b;
-                        line_ab[(_e206 - 1u)] = ((v_9 & 65535u) | (_e213 << 16u));
+                        let _e204 = k_2;
+                        let _e211 = b;
+                        line_ab[(_e204 - 1u)] = ((v_9 & 65535u) | (_e211 << 16u));
                     }
                 }
                 continuing {
-                    let _e218 = k_2;
-                    k_2 = (_e218 - 1u);
+                    let _e216 = k_2;
+                    k_2 = (_e216 - 1u);
                 }
             }
         }
         continuing {
-            let _e220 = g;
-            g = (_e220 + SLICE_LANES);
+            let _e218 = g;
+            g = (_e218 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let n_3 = atomicLoad((&line_count));
     e = li;
     loop {
-        let _e226 = e;
-        if (_e226 < n_3) {
+        let _e224 = e;
+        if (_e224 < n_3) {
         } else {
             break;
         }
         {
-            let _e229 = e;
-            let k_9 = line_list[_e229];
-            let _e232 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_9, screen_3);
-            let _e237 = raymarch_pixel(_e232.x, _e232.y);
-            let _e238 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e237);
-            line_light[k_9] = _e238;
+            let _e227 = e;
+            let k_9 = line_list[_e227];
+            let _e230 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_9, screen_3);
+            let _e235 = raymarch_pixel(_e230.x, _e230.y);
+            let _e236 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e235);
+            line_light[k_9] = _e236;
         }
         continuing {
-            let _e239 = e;
-            e = (_e239 + SLICE_LANES);
+            let _e237 = e;
+            e = (_e237 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     k_3 = li;
     loop {
-        let _e243 = k_3;
-        if (_e243 < SLICE_SAMPLES) {
+        let _e241 = k_3;
+        if (_e241 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e246 = k_3;
-            let _e247 = line_marked(_e246);
-            if !(_e247) {
-                let _e249 = k_3;
-                let _e250 = line_bracket(_e249);
-                let _e251 = line_spread_over(_e250);
-                local_3 = _e251;
+            let _e244 = k_3;
+            let _e245 = line_marked(_e244);
+            if !(_e245) {
+                let _e247 = k_3;
+                let _e248 = line_bracket(_e247);
+                let _e249 = line_spread_over(_e248);
+                local_3 = _e249;
             } else {
                 local_3 = false;
             }
-            let _e255 = local_3;
-            if _e255 {
-                let _e258 = atomicAdd((&line_count_light), 1u);
-                let _e261 = k_3;
-                line_list[_e258] = _e261;
+            let _e253 = local_3;
+            if _e253 {
+                let _e256 = atomicAdd((&line_count_light), 1u);
+                let _e259 = k_3;
+                line_list[_e256] = _e259;
             }
         }
         continuing {
-            let _e262 = k_3;
-            k_3 = (_e262 + SLICE_LANES);
+            let _e260 = k_3;
+            k_3 = (_e260 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     let n2_ = atomicLoad((&line_count_light));
     e_1 = li;
     loop {
-        let _e268 = e_1;
-        if (_e268 < n2_) {
+        let _e266 = e_1;
+        if (_e266 < n2_) {
         } else {
             break;
         }
         {
-            let _e271 = e_1;
-            let k_10 = line_list[_e271];
-            let _e274 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_10, screen_3);
-            let _e279 = raymarch_pixel(_e274.x, _e274.y);
-            let _e280 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e279);
-            line_light[k_10] = _e280;
+            let _e269 = e_1;
+            let k_10 = line_list[_e269];
+            let _e272 = slice_sample_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e36, _e39, _e41, k_10, screen_3);
+            let _e277 = raymarch_pixel(_e272.x, _e272.y);
+            let _e278 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e277);
+            line_light[k_10] = _e278;
         }
         continuing {
-            let _e281 = e_1;
-            e_1 = (_e281 + SLICE_LANES);
+            let _e279 = e_1;
+            e_1 = (_e279 + SLICE_LANES);
         }
     }
     workgroupBarrier();
     k_4 = li;
     loop {
-        let _e285 = k_4;
-        if (_e285 < SLICE_SAMPLES) {
+        let _e283 = k_4;
+        if (_e283 < SLICE_SAMPLES) {
         } else {
             break;
         }
         {
-            let _e289 = k_4;
-            let _e291 = line_light[_e289];
-            c = _e291;
-            let _e293 = k_4;
-            let _e294 = line_marked(_e293);
-            if !(_e294) {
-                let _e296 = k_4;
-                let _e297 = line_bracket(_e296);
-                let _e298 = line_spread_over(_e297);
-                if !(_e298) {
-                    let _e300 = k_4;
-                    let t_4 = (f32((_e300 - _e297.x)) / f32((_e297.y - _e297.x)));
-                    let _e312 = line_light[_e297.x];
-                    let _e319 = line_light[_e297.y];
-                    c = ((_e312 * (1f - t_4)) + (_e319 * t_4));
+            let _e287 = k_4;
+            let _e289 = line_light[_e287];
+            c = _e289;
+            let _e291 = k_4;
+            let _e292 = line_marked(_e291);
+            if !(_e292) {
+                let _e294 = k_4;
+                let _e295 = line_bracket(_e294);
+                let _e296 = line_spread_over(_e295);
+                if !(_e296) {
+                    let _e298 = k_4;
+                    let t_4 = (f32((_e298 - _e295.x)) / f32((_e295.y - _e295.x)));
+                    let _e310 = line_light[_e295.x];
+                    let _e317 = line_light[_e295.y];
+                    c = ((_e310 * (1f - t_4)) + (_e317 * t_4));
                 }
             }
-            let _e322 = k_4;
-            let _e325 = c.x;
-            let _e327 = c.y;
-            let _e329 = c.z;
-            let _e331 = k_4;
-            let _e333 = line_depth[_e331];
-            textureStore(output, vec2<u32>(_e322, s_3), vec4<f32>(_e325, _e327, _e329, _e333));
+            let _e320 = k_4;
+            let _e323 = c.x;
+            let _e325 = c.y;
+            let _e327 = c.z;
+            let _e329 = k_4;
+            let _e331 = line_depth[_e329];
+            textureStore(output, vec2<u32>(_e320, s_3), vec4<f32>(_e323, _e325, _e327, _e331));
         }
         continuing {
-            let _e336 = k_4;
-            k_4 = (_e336 + SLICE_LANES);
+            let _e334 = k_4;
+            k_4 = (_e334 + SLICE_LANES);
         }
     }
     return;

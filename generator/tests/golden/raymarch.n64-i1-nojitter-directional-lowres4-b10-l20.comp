@@ -36,9 +36,16 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float theta_a;
     float dtheta;
 };
+struct FallbackCount {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
 const uint SCALE = 4u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
+const uint FALLBACK_ROW_GROUPS = 1024u;
 
 layout(std140, binding = 0) uniform RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX_block_0Compute { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX _group_0_binding_0_cs; };
 
@@ -48,7 +55,7 @@ layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
 layout(binding = 3,rgba32f) writeonly uniform image2D _group_0_binding_3_cs;
 
-layout(std430, binding = 5) buffer type_10_block_1Compute { uint _group_0_binding_5_cs; };
+layout(std430, binding = 5) buffer FallbackCount_block_1Compute { FallbackCount _group_0_binding_5_cs; };
 
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m) {
@@ -194,6 +201,14 @@ vec3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec3 v_7) {
     return (sign(v_7) * mix(normal, subnormal, lessThan(a_2, vec3(6.1035156e-5))));
 }
 
+void fallback_list_reset() {
+    atomicExchange(_group_0_binding_5_cs.listed, 0u);
+    atomicExchange(_group_0_binding_5_cs.groups_x, 0u);
+    atomicExchange(_group_0_binding_5_cs.groups_y, 0u);
+    _group_0_binding_5_cs.groups_z = 1u;
+    return;
+}
+
 vec3 raymarch_pixel(uint x_3, uint y_2) {
     float sum = 0.0;
     uint j = 0u;
@@ -282,24 +297,24 @@ void main() {
     }
     bool _e19 = local;
     if (_e19) {
-        atomicExchange(_group_0_binding_5_cs, 0u);
+        fallback_list_reset();
     }
-    uvec2 _e23 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
-    if (!((id.x >= _e23.x))) {
-        local_1 = (id.y >= _e23.y);
+    uvec2 _e21 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
+    if (!((id.x >= _e21.x))) {
+        local_1 = (id.y >= _e21.y);
     } else {
         local_1 = true;
     }
-    bool _e34 = local_1;
-    if (_e34) {
+    bool _e32 = local_1;
+    if (_e32) {
         return;
     }
-    uvec2 _e37 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
-    vec3 _e40 = raymarch_pixel(_e37.x, _e37.y);
-    vec3 _e41 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e40);
-    int _e48_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
-    vec4 _e48 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(_e37), ivec2(0), textureSize(_group_0_binding_1_cs, _e48_clamped_lod) - ivec2(1)), _e48_clamped_lod);
-    imageStore(_group_0_binding_3_cs, ivec2(id.xy), vec4(_e41.x, _e41.y, _e41.z, _e48.x));
+    uvec2 _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
+    vec3 _e38 = raymarch_pixel(_e35.x, _e35.y);
+    vec3 _e39 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e38);
+    int _e46_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
+    vec4 _e46 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(_e35), ivec2(0), textureSize(_group_0_binding_1_cs, _e46_clamped_lod) - ivec2(1)), _e46_clamped_lod);
+    imageStore(_group_0_binding_3_cs, ivec2(id.xy), vec4(_e39.x, _e39.y, _e39.z, _e46.x));
     return;
 }
 

@@ -34,9 +34,17 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float dtheta;
 };
 
+struct FallbackCount {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
+
 static const uint SCALE = 4u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
+static const uint FALLBACK_ROW_GROUPS = 1024u;
 
 cbuffer frame : register(b0) { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX frame; }
 Texture2D<float4> depth : register(t1);
@@ -237,6 +245,15 @@ float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float3 v_7)
     return (sign(v_7) * ((a_2 < (6.1035156e-5).xxx) ? subnormal : normal));
 }
 
+void fallback_list_reset()
+{
+    { uint dummy = 0; fallback_count.InterlockedExchange(0, 0u, dummy); }
+    { uint dummy_1 = 0; fallback_count.InterlockedExchange(4, 0u, dummy_1); }
+    { uint dummy_2 = 0; fallback_count.InterlockedExchange(8, 0u, dummy_2); }
+    fallback_count.Store(12, asuint(1u));
+    return;
+}
+
 uint naga_mod(uint lhs, uint rhs) {
     return lhs % (rhs == 0u ? 1u : rhs);
 }
@@ -335,22 +352,22 @@ void raymarch(uint3 id : SV_DispatchThreadID)
     }
     bool _e19 = local;
     if (_e19) {
-        { uint dummy = 0; fallback_count.InterlockedExchange(0, 0u, dummy); }
+        fallback_list_reset();
     }
-    const uint2 _e23 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
-    if (!((id.x >= _e23.x))) {
-        local_1 = (id.y >= _e23.y);
+    const uint2 _e21 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
+    if (!((id.x >= _e21.x))) {
+        local_1 = (id.y >= _e21.y);
     } else {
         local_1 = true;
     }
-    bool _e34 = local_1;
-    if (_e34) {
+    bool _e32 = local_1;
+    if (_e32) {
         return;
     }
-    const uint2 _e37 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
-    const float3 _e40 = raymarch_pixel(_e37.x, _e37.y);
-    const float3 _e41 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e40);
-    float4 _e48 = depth.Load(int3(_e37, int(0)));
-    output[id.xy] = float4(_e41.x, _e41.y, _e41.z, _e48.x);
+    const uint2 _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
+    const float3 _e38 = raymarch_pixel(_e35.x, _e35.y);
+    const float3 _e39 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e38);
+    float4 _e46 = depth.Load(int3(_e35, int(0)));
+    output[id.xy] = float4(_e39.x, _e39.y, _e39.z, _e46.x);
     return;
 }

@@ -37,9 +37,16 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float theta_a;
     float dtheta;
 };
+struct FallbackCount {
+    metal::atomic_uint listed;
+    metal::atomic_uint groups_x;
+    metal::atomic_uint groups_y;
+    uint groups_z;
+};
 constant uint SCALE = 4u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
+constant uint FALLBACK_ROW_GROUPS = 1024u;
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m
@@ -266,6 +273,16 @@ metal::float3 round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     return metal::sign(v_7) * metal::select(normal, subnormal, a_2 < metal::float3(0.000061035156));
 }
 
+void fallback_list_reset(
+    device FallbackCount& fallback_count
+) {
+    metal::atomic_store_explicit(&fallback_count.listed, 0u, metal::memory_order_relaxed);
+    metal::atomic_store_explicit(&fallback_count.groups_x, 0u, metal::memory_order_relaxed);
+    metal::atomic_store_explicit(&fallback_count.groups_y, 0u, metal::memory_order_relaxed);
+    fallback_count.groups_z = 1u;
+    return;
+}
+
 uint naga_mod(uint lhs, uint rhs) {
     return lhs % metal::select(rhs, 1u, rhs == 0u);
 }
@@ -361,7 +378,7 @@ kernel void raymarch(
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
 , metal::texture2d<float, metal::access::write> output [[texture(2)]]
-, device metal::atomic_uint& fallback_count [[buffer(1)]]
+, device FallbackCount& fallback_count [[buffer(1)]]
 ) {
     bool local = {};
     bool local_1 = {};
@@ -375,23 +392,23 @@ kernel void raymarch(
     }
     bool _e19 = local;
     if (_e19) {
-        metal::atomic_store_explicit(&fallback_count, 0u, metal::memory_order_relaxed);
+        fallback_list_reset(fallback_count);
     }
-    metal::uint2 _e23 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
-    if (!((id.x >= _e23.x))) {
-        local_1 = id.y >= _e23.y;
+    metal::uint2 _e21 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
+    if (!((id.x >= _e21.x))) {
+        local_1 = id.y >= _e21.y;
     } else {
         local_1 = true;
     }
-    bool _e34 = local_1;
-    if (_e34) {
+    bool _e32 = local_1;
+    if (_e32) {
         return;
     }
-    metal::uint2 _e37 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
-    metal::float3 _e40 = raymarch_pixel(_e37.x, _e37.y, frame, depth, shadow_map);
-    metal::float3 _e41 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e40);
-    uint clamped_lod_e48 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e48 = depth.read(metal::min(metal::uint2(_e37), metal::uint2(depth.get_width(clamped_lod_e48), depth.get_height(clamped_lod_e48)) - 1), clamped_lod_e48);
-    output.write(metal::float4(_e41.x, _e41.y, _e41.z, _e48.x), metal::uint2(id.xy));
+    metal::uint2 _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
+    metal::float3 _e38 = raymarch_pixel(_e35.x, _e35.y, frame, depth, shadow_map);
+    metal::float3 _e39 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e38);
+    uint clamped_lod_e46 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e46 = depth.read(metal::min(metal::uint2(_e35), metal::uint2(depth.get_width(clamped_lod_e46), depth.get_height(clamped_lod_e46)) - 1), clamped_lod_e46);
+    output.write(metal::float4(_e39.x, _e39.y, _e39.z, _e46.x), metal::uint2(id.xy));
     return;
 }

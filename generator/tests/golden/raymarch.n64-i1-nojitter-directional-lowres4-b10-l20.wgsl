@@ -34,9 +34,17 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     dtheta: f32,
 }
 
+struct FallbackCount {
+    listed: atomic<u32>,
+    groups_x: atomic<u32>,
+    groups_y: atomic<u32>,
+    groups_z: u32,
+}
+
 const SCALE: u32 = 4u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
+const FALLBACK_ROW_GROUPS: u32 = 1024u;
 
 @group(0) @binding(0) 
 var<uniform> frame: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX;
@@ -47,7 +55,7 @@ var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) 
 var output: texture_storage_2d<rgba32float,write>;
 @group(0) @binding(5) 
-var<storage, read_write> fallback_count: atomic<u32>;
+var<storage, read_write> fallback_count: FallbackCount;
 
 fn raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX) -> ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX {
     return ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(m.sm_right, m.sm_up, m.sm_forward, m.sm_origin, m.sm_proj, vec4<u32>(m.sizes.z, 0u, 0u, 0u));
@@ -192,6 +200,14 @@ fn round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(v_7: vec3<f32>) -> vec
     return (sign(v_7) * select(normal, subnormal, (a_2 < vec3(0.000061035156f))));
 }
 
+fn fallback_list_reset() {
+    atomicStore((&fallback_count.listed), 0u);
+    atomicStore((&fallback_count.groups_x), 0u);
+    atomicStore((&fallback_count.groups_y), 0u);
+    fallback_count.groups_z = 1u;
+    return;
+}
+
 fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     var sum: f32 = 0f;
     var j: u32;
@@ -279,22 +295,22 @@ fn raymarch(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let _e19 = local;
     if _e19 {
-        atomicStore((&fallback_count), 0u);
+        fallback_list_reset();
     }
-    let _e23 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
-    if !((id.x >= _e23.x)) {
-        local_1 = (id.y >= _e23.y);
+    let _e21 = lowres_gridX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(screen_2, SCALE);
+    if !((id.x >= _e21.x)) {
+        local_1 = (id.y >= _e21.y);
     } else {
         local_1 = true;
     }
-    let _e34 = local_1;
-    if _e34 {
+    let _e32 = local_1;
+    if _e32 {
         return;
     }
-    let _e37 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
-    let _e40 = raymarch_pixel(_e37.x, _e37.y);
-    let _e41 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e40);
-    let _e48 = textureLoad(depth, _e37, 0i);
-    textureStore(output, id.xy, vec4<f32>(_e41.x, _e41.y, _e41.z, _e48.x));
+    let _e35 = lowres_pixelX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(id.xy, screen_2, SCALE);
+    let _e38 = raymarch_pixel(_e35.x, _e35.y);
+    let _e39 = round_f16X_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e38);
+    let _e46 = textureLoad(depth, _e35, 0i);
+    textureStore(output, id.xy, vec4<f32>(_e39.x, _e39.y, _e39.z, _e46.x));
     return;
 }

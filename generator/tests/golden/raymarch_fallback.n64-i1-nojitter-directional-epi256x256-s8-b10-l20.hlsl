@@ -34,6 +34,13 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float dtheta;
 };
 
+struct FallbackCountRead {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
+
 static const uint SLICES = 256u;
 static const uint SLICE_SAMPLES = 256u;
 static const uint SLICE_LANES = 8u;
@@ -41,6 +48,7 @@ static const uint STEP = 8u;
 static const uint SLICE_RUNS = 32u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
+static const uint FALLBACK_ROW_GROUPS = 1024u;
 
 cbuffer frame : register(b0) { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX frame; }
 Texture2D<float4> depth : register(t1);
@@ -301,21 +309,26 @@ float3 raymarch_pixel(uint x_3, uint y_2)
     return c;
 }
 
-uint2 naga_div(uint2 lhs, uint2 rhs) {
-    return lhs / (rhs == 0u ? 1u : rhs);
-}
-
 [numthreads(8, 8, 1)]
 void raymarch_fallback(uint3 id : SV_DispatchThreadID)
 {
+    bool local = (bool)0;
     uint e = (uint)0;
 
     uint _e3 = frame.sizes.x;
     uint _e7 = frame.sizes.y;
     uint2 screen = uint2(_e3, _e7);
-    uint2 lanes = (8u * naga_div((screen + (255u).xx), (256u).xx));
-    uint _e18 = asuint(fallback_count.Load(0));
-    uint n_3 = min(_e18, (screen.x * screen.y));
+    uint _e11 = asuint(fallback_count.Load(4));
+    uint _e15 = asuint(fallback_count.Load(8));
+    uint2 lanes = (8u * uint2(_e11, _e15));
+    if ((id.x < lanes.x)) {
+        local = (id.y < lanes.y);
+    } else {
+        local = false;
+    }
+    bool inside = local;
+    uint _e32 = asuint(fallback_count.Load(0));
+    uint n_3 = (inside ? min(_e32, (screen.x * screen.y)) : 0u);
     e = ((id.y * lanes.x) + id.x);
     uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
     bool loop_init_1 = true;
@@ -323,23 +336,23 @@ void raymarch_fallback(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
         loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
         if (!loop_init_1) {
-            uint _e54 = e;
-            e = (_e54 + (lanes.x * lanes.y));
+            uint _e68 = e;
+            e = (_e68 + (lanes.x * lanes.y));
         }
         loop_init_1 = false;
-        uint _e30 = e;
-        if ((_e30 < n_3)) {
+        uint _e44 = e;
+        if ((_e44 < n_3)) {
         } else {
             break;
         }
         {
-            uint _e33 = e;
-            uint _e35 = asuint(fallback_pixels.Load(_e33*4));
-            uint _e39 = e;
-            uint _e41 = asuint(fallback_pixels.Load(_e39*4));
-            uint2 q_1 = uint2((_e35 & 65535u), (_e41 >> 16u));
-            const float3 _e47 = raymarch_pixel(q_1.x, q_1.y);
-            output[q_1] = float4(_e47.x, _e47.y, _e47.z, 1.0);
+            uint _e47 = e;
+            uint _e49 = asuint(fallback_pixels.Load(_e47*4));
+            uint _e53 = e;
+            uint _e55 = asuint(fallback_pixels.Load(_e53*4));
+            uint2 q_1 = uint2((_e49 & 65535u), (_e55 >> 16u));
+            const float3 _e61 = raymarch_pixel(q_1.x, q_1.y);
+            output[q_1] = float4(_e61.x, _e61.y, _e61.z, 1.0);
         }
     }
     return;

@@ -41,6 +41,12 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float theta_a;
     float dtheta;
 };
+struct FallbackCountRead {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
 typedef uint type_10[1];
 constant uint SLICES = 256u;
 constant uint SLICE_SAMPLES = 256u;
@@ -49,6 +55,7 @@ constant uint STEP = 8u;
 constant uint SLICE_RUNS = 32u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
+constant uint FALLBACK_ROW_GROUPS = 1024u;
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m
@@ -332,10 +339,6 @@ metal::float3 raymarch_pixel(
     metal::float3 c = m_2.light_color.xyz * _e120;
     return c;
 }
-metal::uint2 naga_div(metal::uint2 lhs, metal::uint2 rhs) {
-    return lhs / metal::select(rhs, 1u, rhs == 0u);
-}
-
 
 struct raymarch_fallbackInput {
 };
@@ -345,17 +348,26 @@ kernel void raymarch_fallback(
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::sample> shadow_map [[texture(1)]]
 , metal::texture2d<float, metal::access::write> output [[texture(2)]]
-, device uint const& fallback_count [[buffer(1)]]
+, device FallbackCountRead const& fallback_count [[buffer(1)]]
 , device type_10 const& fallback_pixels [[buffer(2)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {
+    bool local = {};
     uint e = {};
     uint _e3 = frame.sizes.x;
     uint _e7 = frame.sizes.y;
     metal::uint2 screen = metal::uint2(_e3, _e7);
-    metal::uint2 lanes = 8u * naga_div(screen + metal::uint2(255u), metal::uint2(256u));
-    uint _e18 = fallback_count;
-    uint n_3 = metal::min(_e18, screen.x * screen.y);
+    uint _e11 = fallback_count.groups_x;
+    uint _e15 = fallback_count.groups_y;
+    metal::uint2 lanes = 8u * metal::uint2(_e11, _e15);
+    if (id.x < lanes.x) {
+        local = id.y < lanes.y;
+    } else {
+        local = false;
+    }
+    bool inside = local;
+    uint _e32 = fallback_count.listed;
+    uint n_3 = inside ? metal::min(_e32, screen.x * screen.y) : 0u;
     e = (id.y * lanes.x) + id.x;
     uint2 loop_bound_1 = uint2(4294967295u);
     bool loop_init_1 = true;
@@ -363,23 +375,23 @@ kernel void raymarch_fallback(
         if (metal::all(loop_bound_1 == uint2(0u))) { break; }
         loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
         if (!loop_init_1) {
-            uint _e54 = e;
-            e = _e54 + (lanes.x * lanes.y);
+            uint _e68 = e;
+            e = _e68 + (lanes.x * lanes.y);
         }
         loop_init_1 = false;
-        uint _e30 = e;
-        if (_e30 < n_3) {
+        uint _e44 = e;
+        if (_e44 < n_3) {
         } else {
             break;
         }
         {
-            uint _e33 = e;
-            uint _e35 = fallback_pixels[metal::min(unsigned(_e33), (_buffer_sizes.size5 - 0 - 4) / 4)];
-            uint _e39 = e;
-            uint _e41 = fallback_pixels[metal::min(unsigned(_e39), (_buffer_sizes.size5 - 0 - 4) / 4)];
-            metal::uint2 q_1 = metal::uint2(_e35 & 65535u, _e41 >> 16u);
-            metal::float3 _e47 = raymarch_pixel(q_1.x, q_1.y, frame, depth, shadow_map);
-            output.write(metal::float4(_e47.x, _e47.y, _e47.z, 1.0), metal::uint2(q_1));
+            uint _e47 = e;
+            uint _e49 = fallback_pixels[metal::min(unsigned(_e47), (_buffer_sizes.size5 - 0 - 4) / 4)];
+            uint _e53 = e;
+            uint _e55 = fallback_pixels[metal::min(unsigned(_e53), (_buffer_sizes.size5 - 0 - 4) / 4)];
+            metal::uint2 q_1 = metal::uint2(_e49 & 65535u, _e55 >> 16u);
+            metal::float3 _e61 = raymarch_pixel(q_1.x, q_1.y, frame, depth, shadow_map);
+            output.write(metal::float4(_e61.x, _e61.y, _e61.z, 1.0), metal::uint2(q_1));
         }
     }
     return;

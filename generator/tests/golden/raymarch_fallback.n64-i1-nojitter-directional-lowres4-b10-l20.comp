@@ -36,9 +36,16 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float theta_a;
     float dtheta;
 };
+struct FallbackCountRead {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
 const uint SCALE = 4u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
+const uint FALLBACK_ROW_GROUPS = 1024u;
 
 layout(std140, binding = 0) uniform RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX_block_0Compute { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX _group_0_binding_0_cs; };
 
@@ -48,7 +55,7 @@ layout(binding = 2) uniform sampler2D _group_0_binding_2_cs;
 
 layout(binding = 3,rgba16f) writeonly uniform image2D _group_0_binding_3_cs;
 
-layout(std430, binding = 5) readonly buffer type_2_block_1Compute { uint _group_0_binding_5_cs; };
+layout(std430, binding = 5) readonly buffer FallbackCountRead_block_1Compute { FallbackCountRead _group_0_binding_5_cs; };
 
 layout(std430, binding = 6) readonly buffer type_10_block_2Compute { uint _group_0_binding_6_cs[]; };
 
@@ -256,34 +263,43 @@ vec3 raymarch_pixel(uint x_3, uint y_2) {
 
 void main() {
     uvec3 id = gl_GlobalInvocationID;
+    bool local = false;
     uint e = 0u;
     uint _e3 = _group_0_binding_0_cs.sizes.x;
     uint _e7 = _group_0_binding_0_cs.sizes.y;
     uvec2 screen = uvec2(_e3, _e7);
-    uvec2 lanes = (8u * ((screen + uvec2(255u)) / uvec2(256u)));
-    uint _e18 = _group_0_binding_5_cs;
-    uint n_3 = min(_e18, (screen.x * screen.y));
+    uint _e11 = _group_0_binding_5_cs.groups_x;
+    uint _e15 = _group_0_binding_5_cs.groups_y;
+    uvec2 lanes = (8u * uvec2(_e11, _e15));
+    if ((id.x < lanes.x)) {
+        local = (id.y < lanes.y);
+    } else {
+        local = false;
+    }
+    bool inside = local;
+    uint _e32 = _group_0_binding_5_cs.listed;
+    uint n_3 = (inside ? min(_e32, (screen.x * screen.y)) : 0u);
     e = ((id.y * lanes.x) + id.x);
     bool loop_init_1 = true;
     while(true) {
         if (!loop_init_1) {
-            uint _e54 = e;
-            e = (_e54 + (lanes.x * lanes.y));
+            uint _e68 = e;
+            e = (_e68 + (lanes.x * lanes.y));
         }
         loop_init_1 = false;
-        uint _e30 = e;
-        if ((_e30 < n_3)) {
+        uint _e44 = e;
+        if ((_e44 < n_3)) {
         } else {
             break;
         }
         {
-            uint _e33 = e;
-            uint _e35 = _group_0_binding_6_cs[_e33];
-            uint _e39 = e;
-            uint _e41 = _group_0_binding_6_cs[_e39];
-            uvec2 q_1 = uvec2((_e35 & 65535u), (_e41 >> 16u));
-            vec3 _e47 = raymarch_pixel(q_1.x, q_1.y);
-            imageStore(_group_0_binding_3_cs, ivec2(q_1), vec4(_e47.x, _e47.y, _e47.z, 1.0));
+            uint _e47 = e;
+            uint _e49 = _group_0_binding_6_cs[_e47];
+            uint _e53 = e;
+            uint _e55 = _group_0_binding_6_cs[_e53];
+            uvec2 q_1 = uvec2((_e49 & 65535u), (_e55 >> 16u));
+            vec3 _e61 = raymarch_pixel(q_1.x, q_1.y);
+            imageStore(_group_0_binding_3_cs, ivec2(q_1), vec4(_e61.x, _e61.y, _e61.z, 1.0));
         }
     }
     return;

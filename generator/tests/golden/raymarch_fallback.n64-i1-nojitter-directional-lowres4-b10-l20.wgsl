@@ -34,9 +34,17 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     dtheta: f32,
 }
 
+struct FallbackCountRead {
+    listed: u32,
+    groups_x: u32,
+    groups_y: u32,
+    groups_z: u32,
+}
+
 const SCALE: u32 = 4u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
+const FALLBACK_ROW_GROUPS: u32 = 1024u;
 
 @group(0) @binding(0) 
 var<uniform> frame: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX;
@@ -47,7 +55,7 @@ var shadow_map: texture_2d<f32>;
 @group(0) @binding(3) 
 var output: texture_storage_2d<rgba16float,write>;
 @group(0) @binding(5) 
-var<storage> fallback_count: u32;
+var<storage> fallback_count: FallbackCountRead;
 @group(0) @binding(6) 
 var<storage> fallback_pixels: array<u32>;
 
@@ -252,33 +260,42 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8, 1) 
 fn raymarch_fallback(@builtin(global_invocation_id) id: vec3<u32>) {
+    var local: bool;
     var e: u32;
 
     let _e3 = frame.sizes.x;
     let _e7 = frame.sizes.y;
     let screen = vec2<u32>(_e3, _e7);
-    let lanes = (8u * ((screen + vec2(255u)) / vec2(256u)));
-    let _e18 = fallback_count;
-    let n_3 = min(_e18, (screen.x * screen.y));
+    let _e11 = fallback_count.groups_x;
+    let _e15 = fallback_count.groups_y;
+    let lanes = (8u * vec2<u32>(_e11, _e15));
+    if (id.x < lanes.x) {
+        local = (id.y < lanes.y);
+    } else {
+        local = false;
+    }
+    let inside = local;
+    let _e32 = fallback_count.listed;
+    let n_3 = select(0u, min(_e32, (screen.x * screen.y)), inside);
     e = ((id.y * lanes.x) + id.x);
     loop {
-        let _e30 = e;
-        if (_e30 < n_3) {
+        let _e44 = e;
+        if (_e44 < n_3) {
         } else {
             break;
         }
         {
-            let _e33 = e;
-            let _e35 = fallback_pixels[_e33];
-            let _e39 = e;
-            let _e41 = fallback_pixels[_e39];
-            let q_1 = vec2<u32>((_e35 & 65535u), (_e41 >> 16u));
-            let _e47 = raymarch_pixel(q_1.x, q_1.y);
-            textureStore(output, q_1, vec4<f32>(_e47.x, _e47.y, _e47.z, 1f));
+            let _e47 = e;
+            let _e49 = fallback_pixels[_e47];
+            let _e53 = e;
+            let _e55 = fallback_pixels[_e53];
+            let q_1 = vec2<u32>((_e49 & 65535u), (_e55 >> 16u));
+            let _e61 = raymarch_pixel(q_1.x, q_1.y);
+            textureStore(output, q_1, vec4<f32>(_e61.x, _e61.y, _e61.z, 1f));
         }
         continuing {
-            let _e54 = e;
-            e = (_e54 + (lanes.x * lanes.y));
+            let _e68 = e;
+            e = (_e68 + (lanes.x * lanes.y));
         }
     }
     return;

@@ -48,6 +48,12 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float theta_a;
     float dtheta;
 };
+struct FallbackCount {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
 const uint SLICES = 256u;
 const uint SLICE_SAMPLES = 256u;
 const uint SLICE_LANES = 8u;
@@ -55,6 +61,7 @@ const uint STEP = 8u;
 const uint SLICE_RUNS = 32u;
 const float DEPTH_BREAK = 0.1;
 const float LIGHT_BREAK = 0.2;
+const uint FALLBACK_ROW_GROUPS = 1024u;
 
 layout(std140, binding = 0) uniform RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX_block_0Compute { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX _group_0_binding_0_cs; };
 
@@ -64,7 +71,7 @@ layout(binding = 3,rgba16f) writeonly uniform image2D _group_0_binding_3_cs;
 
 layout(binding = 4) uniform sampler2D _group_0_binding_4_cs;
 
-layout(std430, binding = 5) buffer type_11_block_1Compute { uint _group_0_binding_5_cs; };
+layout(std430, binding = 5) buffer FallbackCount_block_1Compute { FallbackCount _group_0_binding_5_cs; };
 
 layout(std430, binding = 6) buffer type_12_block_2Compute { uint _group_0_binding_6_cs[]; };
 
@@ -358,14 +365,29 @@ float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapVi
     return ((depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0);
 }
 
+void fallback_list_reset() {
+    atomicExchange(_group_0_binding_5_cs.listed, 0u);
+    atomicExchange(_group_0_binding_5_cs.groups_x, 0u);
+    atomicExchange(_group_0_binding_5_cs.groups_y, 0u);
+    _group_0_binding_5_cs.groups_z = 1u;
+    return;
+}
+
 void unwarp_pixel(uvec2 q, vec4 w_1, vec4 depths_2, vec3 light_2[4]) {
     int _e3_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
     vec4 _e3 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q), ivec2(0), textureSize(_group_0_binding_1_cs, _e3_clamped_lod) - ivec2(1)), _e3_clamped_lod);
     vec4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
     if ((_e10.w == 0.0)) {
-        uint _e16 = atomicAdd(_group_0_binding_5_cs, 1u);
-        _group_0_binding_6_cs[_e16] = (q.x | (q.y << 16u));
-        return;
+        uint _e17 = atomicAdd(_group_0_binding_5_cs.listed, 1u);
+        _group_0_binding_6_cs[_e17] = (q.x | (q.y << 16u));
+        if (((_e17 % 64u) == 0u)) {
+            uint g_2 = ((_e17 / 64u) + 1u);
+            uint _e37 = atomicMax(_group_0_binding_5_cs.groups_x, min(g_2, FALLBACK_ROW_GROUPS));
+            uint _e46 = atomicMax(_group_0_binding_5_cs.groups_y, (((g_2 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+            return;
+        } else {
+            return;
+        }
     } else {
         imageStore(_group_0_binding_3_cs, ivec2(q), _e10);
         return;

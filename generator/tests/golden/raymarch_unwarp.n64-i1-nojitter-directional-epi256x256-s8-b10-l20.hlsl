@@ -49,6 +49,13 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float dtheta;
 };
 
+struct FallbackCount {
+    uint listed;
+    uint groups_x;
+    uint groups_y;
+    uint groups_z;
+};
+
 static const uint SLICES = 256u;
 static const uint SLICE_SAMPLES = 256u;
 static const uint SLICE_LANES = 8u;
@@ -56,6 +63,7 @@ static const uint STEP = 8u;
 static const uint SLICE_RUNS = 32u;
 static const float DEPTH_BREAK = 0.1;
 static const float LIGHT_BREAK = 0.2;
+static const uint FALLBACK_ROW_GROUPS = 1024u;
 
 cbuffer frame : register(b0) { RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX frame; }
 Texture2D<float4> depth : register(t1);
@@ -421,22 +429,38 @@ float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapVi
     return ((depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0);
 }
 
+void fallback_list_reset()
+{
+    { uint dummy = 0; fallback_count.InterlockedExchange(0, 0u, dummy); }
+    { uint dummy_1 = 0; fallback_count.InterlockedExchange(4, 0u, dummy_1); }
+    { uint dummy_2 = 0; fallback_count.InterlockedExchange(8, 0u, dummy_2); }
+    fallback_count.Store(12, asuint(1u));
+    return;
+}
+
+uint naga_div(uint lhs, uint rhs) {
+    return lhs / (rhs == 0u ? 1u : rhs);
+}
+
 void unwarp_pixel(uint2 q, float4 w_1, float4 depths_2, float3 light_2[4])
 {
     float4 _e3 = depth.Load(int3(q, int(0)));
     const float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
     if ((_e10.w == 0.0)) {
-        uint _e16; fallback_count.InterlockedAdd(0, 1u, _e16);
-        fallback_pixels.Store(_e16*4, asuint((q.x | (q.y << 16u))));
-        return;
+        uint _e17; fallback_count.InterlockedAdd(0, 1u, _e17);
+        fallback_pixels.Store(_e17*4, asuint((q.x | (q.y << 16u))));
+        if ((naga_mod(_e17, 64u) == 0u)) {
+            uint g_2 = (naga_div(_e17, 64u) + 1u);
+            uint _e37; fallback_count.InterlockedMax(4, min(g_2, FALLBACK_ROW_GROUPS), _e37);
+            uint _e46; fallback_count.InterlockedMax(8, naga_div(((g_2 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e46);
+            return;
+        } else {
+            return;
+        }
     } else {
         output[q] = _e10;
         return;
     }
-}
-
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / (rhs == 0u ? 1u : rhs);
 }
 
 EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX ConstructEpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float2 arg0, float2 arg1, float arg2, float arg3, uint arg4) {

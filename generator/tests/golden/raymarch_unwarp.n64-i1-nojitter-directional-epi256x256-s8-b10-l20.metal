@@ -57,6 +57,12 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float theta_a;
     float dtheta;
 };
+struct FallbackCount {
+    metal::atomic_uint listed;
+    metal::atomic_uint groups_x;
+    metal::atomic_uint groups_y;
+    uint groups_z;
+};
 typedef uint type_12[1];
 constant uint SLICES = 256u;
 constant uint SLICE_SAMPLES = 256u;
@@ -65,6 +71,7 @@ constant uint STEP = 8u;
 constant uint SLICE_RUNS = 32u;
 constant float DEPTH_BREAK = 0.1;
 constant float LIGHT_BREAK = 0.2;
+constant uint FALLBACK_ROW_GROUPS = 1024u;
 
 ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m
@@ -463,6 +470,20 @@ float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     return (depth_2 <= (_e28 + (_e33 / (far - near)))) ? 1.0 : 0.0;
 }
 
+void fallback_list_reset(
+    device FallbackCount& fallback_count
+) {
+    metal::atomic_store_explicit(&fallback_count.listed, 0u, metal::memory_order_relaxed);
+    metal::atomic_store_explicit(&fallback_count.groups_x, 0u, metal::memory_order_relaxed);
+    metal::atomic_store_explicit(&fallback_count.groups_y, 0u, metal::memory_order_relaxed);
+    fallback_count.groups_z = 1u;
+    return;
+}
+
+uint naga_div(uint lhs, uint rhs) {
+    return lhs / metal::select(rhs, 1u, rhs == 0u);
+}
+
 void unwarp_pixel(
     metal::uint2 q,
     metal::float4 w_1,
@@ -470,7 +491,7 @@ void unwarp_pixel(
     type_6 light_2,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::write> output,
-    device metal::atomic_uint& fallback_count,
+    device FallbackCount& fallback_count,
     device type_12& fallback_pixels,
     constant _mslBufferSizes& _buffer_sizes
 ) {
@@ -478,9 +499,16 @@ void unwarp_pixel(
     metal::float4 _e3 = depth.read(metal::min(metal::uint2(q), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
     metal::float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
     if (_e10.w == 0.0) {
-        uint _e16 = metal::atomic_fetch_add_explicit(&fallback_count, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e16), (_buffer_sizes.size6 - 0 - 4) / 4)] = q.x | (q.y << 16u);
-        return;
+        uint _e17 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
+        fallback_pixels[metal::min(unsigned(_e17), (_buffer_sizes.size6 - 0 - 4) / 4)] = q.x | (q.y << 16u);
+        if (naga_mod(_e17, 64u) == 0u) {
+            uint g_2 = naga_div(_e17, 64u) + 1u;
+            uint _e37 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_2, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+            uint _e46 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_2 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+            return;
+        } else {
+            return;
+        }
     } else {
         output.write(_e10, metal::uint2(q));
         return;
@@ -569,10 +597,6 @@ metal::float3 raymarch_pixel(
     metal::float3 c_1 = m_2.light_color.xyz * _e120;
     return c_1;
 }
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / metal::select(rhs, 1u, rhs == 0u);
-}
-
 
 struct raymarch_unwarpInput {
 };
@@ -582,7 +606,7 @@ kernel void raymarch_unwarp(
 , metal::texture2d<float, metal::access::sample> depth [[texture(0)]]
 , metal::texture2d<float, metal::access::write> output [[texture(1)]]
 , metal::texture2d<float, metal::access::sample> epipolar_samples [[texture(2)]]
-, device metal::atomic_uint& fallback_count [[buffer(1)]]
+, device FallbackCount& fallback_count [[buffer(1)]]
 , device type_12& fallback_pixels [[buffer(2)]]
 , constant _mslBufferSizes& _buffer_sizes [[buffer(3)]]
 ) {

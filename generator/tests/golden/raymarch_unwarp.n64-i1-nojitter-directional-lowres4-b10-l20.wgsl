@@ -40,9 +40,17 @@ struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     dtheta: f32,
 }
 
+struct FallbackCount {
+    listed: atomic<u32>,
+    groups_x: atomic<u32>,
+    groups_y: atomic<u32>,
+    groups_z: u32,
+}
+
 const SCALE: u32 = 4u;
 const DEPTH_BREAK: f32 = 0.1f;
 const LIGHT_BREAK: f32 = 0.2f;
+const FALLBACK_ROW_GROUPS: u32 = 1024u;
 
 @group(0) @binding(0) 
 var<uniform> frame: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX;
@@ -55,7 +63,7 @@ var output: texture_storage_2d<rgba16float,write>;
 @group(0) @binding(4) 
 var lowres_samples: texture_2d<f32>;
 @group(0) @binding(5) 
-var<storage, read_write> fallback_count: atomic<u32>;
+var<storage, read_write> fallback_count: FallbackCount;
 @group(0) @binding(6) 
 var<storage, read_write> fallback_pixels: array<u32>;
 
@@ -302,13 +310,28 @@ fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMap
     return select(0f, 1f, (depth_2 <= (_e28 + (_e33 / (far - near)))));
 }
 
+fn fallback_list_reset() {
+    atomicStore((&fallback_count.listed), 0u);
+    atomicStore((&fallback_count.groups_x), 0u);
+    atomicStore((&fallback_count.groups_y), 0u);
+    fallback_count.groups_z = 1u;
+    return;
+}
+
 fn unwarp_pixel(q: vec2<u32>, w_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
     let _e3 = textureLoad(depth, q, 0i);
     let _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
     if (_e10.w == 0f) {
-        let _e16 = atomicAdd((&fallback_count), 1u);
-        fallback_pixels[_e16] = (q.x | (q.y << 16u));
-        return;
+        let _e17 = atomicAdd((&fallback_count.listed), 1u);
+        fallback_pixels[_e17] = (q.x | (q.y << 16u));
+        if ((_e17 % 64u) == 0u) {
+            let g_1 = ((_e17 / 64u) + 1u);
+            let _e37 = atomicMax((&fallback_count.groups_x), min(g_1, FALLBACK_ROW_GROUPS));
+            let _e46 = atomicMax((&fallback_count.groups_y), (((g_1 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+            return;
+        } else {
+            return;
+        }
     } else {
         textureStore(output, q, _e10);
         return;

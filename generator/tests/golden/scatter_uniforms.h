@@ -241,6 +241,32 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, proj_g2_) == 384, "Sc
 SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, fan_origin) == 400, "ScatterPartialSumTreeFrame.fan_origin offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFrame, fan_angles) == 416, "ScatterPartialSumTreeFrame.fan_angles offset");
 
+/* WGSL `FallbackCount` of family partial_sum_tree (kernel module), 16 bytes, alignment 4. */
+typedef struct ScatterPartialSumTreeFallbackCount {
+    uint32_t listed; /* atomic<u32>, offset 0 */
+    uint32_t groups_x; /* atomic<u32>, offset 4 */
+    uint32_t groups_y; /* atomic<u32>, offset 8 */
+    uint32_t groups_z; /* u32, offset 12 */
+} ScatterPartialSumTreeFallbackCount;
+SCATTER_STATIC_ASSERT(sizeof(ScatterPartialSumTreeFallbackCount) == 16, "ScatterPartialSumTreeFallbackCount size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFallbackCount, listed) == 0, "ScatterPartialSumTreeFallbackCount.listed offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFallbackCount, groups_x) == 4, "ScatterPartialSumTreeFallbackCount.groups_x offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFallbackCount, groups_y) == 8, "ScatterPartialSumTreeFallbackCount.groups_y offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFallbackCount, groups_z) == 12, "ScatterPartialSumTreeFallbackCount.groups_z offset");
+
+/* WGSL `FallbackCountRead` of family partial_sum_tree (kernel module), 16 bytes, alignment 4. */
+typedef struct ScatterPartialSumTreeFallbackCountRead {
+    uint32_t listed; /* u32, offset 0 */
+    uint32_t groups_x; /* u32, offset 4 */
+    uint32_t groups_y; /* u32, offset 8 */
+    uint32_t groups_z; /* u32, offset 12 */
+} ScatterPartialSumTreeFallbackCountRead;
+SCATTER_STATIC_ASSERT(sizeof(ScatterPartialSumTreeFallbackCountRead) == 16, "ScatterPartialSumTreeFallbackCountRead size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFallbackCountRead, listed) == 0, "ScatterPartialSumTreeFallbackCountRead.listed offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFallbackCountRead, groups_x) == 4, "ScatterPartialSumTreeFallbackCountRead.groups_x offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFallbackCountRead, groups_y) == 8, "ScatterPartialSumTreeFallbackCountRead.groups_y offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterPartialSumTreeFallbackCountRead, groups_z) == 12, "ScatterPartialSumTreeFallbackCountRead.groups_z offset");
+
 /* WGSL `Frame` of family prefiltered (scatter::epipolar), 432 bytes, alignment 16. */
 typedef struct ScatterPrefilteredFrame {
     float eye[4]; /* vec4<f32>, offset 0 */
@@ -334,5 +360,31 @@ SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, sm_origin) == 176, 
 SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, sm_proj) == 192, "ScatterRaymarchRaymarchFrame.sm_proj offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, sizes) == 208, "ScatterRaymarchRaymarchFrame.sizes offset");
 SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchRaymarchFrame, interleave) == 224, "ScatterRaymarchRaymarchFrame.interleave offset");
+
+/* WGSL `FallbackCount` of family raymarch (kernel module), 16 bytes, alignment 4. */
+typedef struct ScatterRaymarchFallbackCount {
+    uint32_t listed; /* atomic<u32>, offset 0 */
+    uint32_t groups_x; /* atomic<u32>, offset 4 */
+    uint32_t groups_y; /* atomic<u32>, offset 8 */
+    uint32_t groups_z; /* u32, offset 12 */
+} ScatterRaymarchFallbackCount;
+SCATTER_STATIC_ASSERT(sizeof(ScatterRaymarchFallbackCount) == 16, "ScatterRaymarchFallbackCount size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchFallbackCount, listed) == 0, "ScatterRaymarchFallbackCount.listed offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchFallbackCount, groups_x) == 4, "ScatterRaymarchFallbackCount.groups_x offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchFallbackCount, groups_y) == 8, "ScatterRaymarchFallbackCount.groups_y offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchFallbackCount, groups_z) == 12, "ScatterRaymarchFallbackCount.groups_z offset");
+
+/* WGSL `FallbackCountRead` of family raymarch (kernel module), 16 bytes, alignment 4. */
+typedef struct ScatterRaymarchFallbackCountRead {
+    uint32_t listed; /* u32, offset 0 */
+    uint32_t groups_x; /* u32, offset 4 */
+    uint32_t groups_y; /* u32, offset 8 */
+    uint32_t groups_z; /* u32, offset 12 */
+} ScatterRaymarchFallbackCountRead;
+SCATTER_STATIC_ASSERT(sizeof(ScatterRaymarchFallbackCountRead) == 16, "ScatterRaymarchFallbackCountRead size");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchFallbackCountRead, listed) == 0, "ScatterRaymarchFallbackCountRead.listed offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchFallbackCountRead, groups_x) == 4, "ScatterRaymarchFallbackCountRead.groups_x offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchFallbackCountRead, groups_y) == 8, "ScatterRaymarchFallbackCountRead.groups_y offset");
+SCATTER_STATIC_ASSERT(offsetof(ScatterRaymarchFallbackCountRead, groups_z) == 12, "ScatterRaymarchFallbackCountRead.groups_z offset");
 
 #endif /* SCATTER_UNIFORMS_H */

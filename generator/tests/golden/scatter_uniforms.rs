@@ -368,6 +368,48 @@ pub mod partial_sum_tree {
         assert!(::core::mem::offset_of!(Frame, fan_origin) == 400);
         assert!(::core::mem::offset_of!(Frame, fan_angles) == 416);
     };
+    /// WGSL `FallbackCount` (kernel module), 16 bytes, alignment 4.
+    #[repr(C)]
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct FallbackCount {
+        /// `atomic<u32>` at byte 0.
+        pub listed: u32,
+        /// `atomic<u32>` at byte 4.
+        pub groups_x: u32,
+        /// `atomic<u32>` at byte 8.
+        pub groups_y: u32,
+        /// `u32` at byte 12.
+        pub groups_z: u32,
+    }
+
+    const _: () = {
+        assert!(::core::mem::size_of::<FallbackCount>() == 16);
+        assert!(::core::mem::offset_of!(FallbackCount, listed) == 0);
+        assert!(::core::mem::offset_of!(FallbackCount, groups_x) == 4);
+        assert!(::core::mem::offset_of!(FallbackCount, groups_y) == 8);
+        assert!(::core::mem::offset_of!(FallbackCount, groups_z) == 12);
+    };
+    /// WGSL `FallbackCountRead` (kernel module), 16 bytes, alignment 4.
+    #[repr(C)]
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct FallbackCountRead {
+        /// `u32` at byte 0.
+        pub listed: u32,
+        /// `u32` at byte 4.
+        pub groups_x: u32,
+        /// `u32` at byte 8.
+        pub groups_y: u32,
+        /// `u32` at byte 12.
+        pub groups_z: u32,
+    }
+
+    const _: () = {
+        assert!(::core::mem::size_of::<FallbackCountRead>() == 16);
+        assert!(::core::mem::offset_of!(FallbackCountRead, listed) == 0);
+        assert!(::core::mem::offset_of!(FallbackCountRead, groups_x) == 4);
+        assert!(::core::mem::offset_of!(FallbackCountRead, groups_y) == 8);
+        assert!(::core::mem::offset_of!(FallbackCountRead, groups_z) == 12);
+    };
 }
 
 /// Uniform structs of the `prefiltered` kernels.
@@ -521,5 +563,47 @@ pub mod raymarch {
         assert!(::core::mem::offset_of!(RaymarchFrame, sm_proj) == 192);
         assert!(::core::mem::offset_of!(RaymarchFrame, sizes) == 208);
         assert!(::core::mem::offset_of!(RaymarchFrame, interleave) == 224);
+    };
+    /// WGSL `FallbackCount` (kernel module), 16 bytes, alignment 4.
+    #[repr(C)]
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct FallbackCount {
+        /// `atomic<u32>` at byte 0.
+        pub listed: u32,
+        /// `atomic<u32>` at byte 4.
+        pub groups_x: u32,
+        /// `atomic<u32>` at byte 8.
+        pub groups_y: u32,
+        /// `u32` at byte 12.
+        pub groups_z: u32,
+    }
+
+    const _: () = {
+        assert!(::core::mem::size_of::<FallbackCount>() == 16);
+        assert!(::core::mem::offset_of!(FallbackCount, listed) == 0);
+        assert!(::core::mem::offset_of!(FallbackCount, groups_x) == 4);
+        assert!(::core::mem::offset_of!(FallbackCount, groups_y) == 8);
+        assert!(::core::mem::offset_of!(FallbackCount, groups_z) == 12);
+    };
+    /// WGSL `FallbackCountRead` (kernel module), 16 bytes, alignment 4.
+    #[repr(C)]
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct FallbackCountRead {
+        /// `u32` at byte 0.
+        pub listed: u32,
+        /// `u32` at byte 4.
+        pub groups_x: u32,
+        /// `u32` at byte 8.
+        pub groups_y: u32,
+        /// `u32` at byte 12.
+        pub groups_z: u32,
+    }
+
+    const _: () = {
+        assert!(::core::mem::size_of::<FallbackCountRead>() == 16);
+        assert!(::core::mem::offset_of!(FallbackCountRead, listed) == 0);
+        assert!(::core::mem::offset_of!(FallbackCountRead, groups_x) == 4);
+        assert!(::core::mem::offset_of!(FallbackCountRead, groups_y) == 8);
+        assert!(::core::mem::offset_of!(FallbackCountRead, groups_z) == 12);
     };
 }

@@ -134,6 +134,7 @@ pub fn pass(v: &AreaIvsvVariant, kernel: Kernel) -> Option<PassPlan> {
             kernel,
             invocations: [f("128"), v.theta.to_string(), v.vpls.to_string()],
             skip_when: None,
+            indirect: None,
             bindings: vec![
                 bind(0, "frame"),
                 bind(1, "vpls"),
@@ -145,6 +146,7 @@ pub fn pass(v: &AreaIvsvVariant, kernel: Kernel) -> Option<PassPlan> {
             kernel,
             invocations: [(4 * v.theta).to_string(), v.vpls.to_string(), f("1")],
             skip_when: None,
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "marks"), bind(2, "volume")],
         }),
         Kernel::IvsvGather => Some(sampled_pass(
@@ -153,6 +155,7 @@ pub fn pass(v: &AreaIvsvVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations(&v.sampling_knobs()),
                 skip_when: None,
+                indirect: None,
                 bindings: vec![
                     bind(0, "frame"),
                     bind(1, "vpls"),
@@ -180,6 +183,7 @@ pub fn pass(v: &AreaIvsvVariant, kernel: Kernel) -> Option<PassPlan> {
             kernel,
             invocations: [f("screen.width"), f("screen.height"), f("1")],
             skip_when: None,
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "partial"), bind(2, "output")],
         }),
         _ => None,

@@ -128,6 +128,7 @@ pub fn pass(v: &HybridVolumeVariant, kernel: Kernel) -> Option<PassPlan> {
             kernel,
             invocations: [f("64"), f("rectified.height"), f("1")],
             skip_when: None,
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "rectified"), bind(2, "crossings")],
         }),
         Kernel::VolumeMarch => Some(sampled_pass(
@@ -136,6 +137,7 @@ pub fn pass(v: &HybridVolumeVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations(&v.sampling_knobs()),
                 skip_when: None,
+                indirect: None,
                 bindings: [
                     bind(0, "frame"),
                     bind(1, "slices"),

@@ -120,12 +120,14 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
             kernel,
             invocations: [f("screen.width"), f("1"), f("1")],
             skip_when: None,
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "depth"), bind(2, "column_depth")],
         }),
         Kernel::SliceFit => Some(PassPlan {
             kernel,
             invocations: [f("256"), f("1"), f("1")],
             skip_when: None,
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "slices"), bind(2, "column_depth")],
         }),
         Kernel::Rectify => Some(PassPlan {
@@ -136,6 +138,7 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
                 f("1"),
             ],
             skip_when: None,
+            indirect: None,
             bindings: vec![
                 bind(0, "frame"),
                 bind(1, "slices"),
@@ -147,6 +150,7 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
             kernel,
             invocations: [f("128"), f("rectified.height"), f("1")],
             skip_when: None,
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "rectified"), bind(2, "tree")],
         }),
         Kernel::MinmaxTraverse => Some(sampled_pass(
@@ -155,6 +159,7 @@ pub fn pass(v: &MinmaxVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations(&v.sampling_knobs()),
                 skip_when: None,
+                indirect: None,
                 bindings: [
                     bind(0, "frame"),
                     bind(1, "slices"),

@@ -154,12 +154,14 @@ pub fn pass(v: &PartialSumTreeVariant, kernel: Kernel) -> Option<PassPlan> {
             kernel,
             invocations: [f("screen.width"), f("1"), f("1")],
             skip_when: None,
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "depth"), bind(2, "column_depth")],
         }),
         Kernel::SliceFit => Some(PassPlan {
             kernel,
             invocations: [f("256"), f("1"), f("1")],
             skip_when: None,
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "slices"), bind(2, "column_depth")],
         }),
         Kernel::Rectify => Some(PassPlan {
@@ -170,6 +172,7 @@ pub fn pass(v: &PartialSumTreeVariant, kernel: Kernel) -> Option<PassPlan> {
                 f("1"),
             ],
             skip_when: None,
+            indirect: None,
             bindings: vec![
                 bind(0, "frame"),
                 bind(1, "slices"),
@@ -183,6 +186,7 @@ pub fn pass(v: &PartialSumTreeVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations_with_lanes(&knobs, super::SWEEP_LANES),
                 skip_when: None,
+                indirect: None,
                 bindings: [
                     bind(0, "frame"),
                     bind(1, "slices"),

@@ -249,18 +249,21 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
             kernel,
             invocations: [f("screen.width"), f("1"), f("1")],
             skip_when: projective.then_some(PROJECTIVE_FRAME),
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "depth"), bind(2, "column_depth")],
         }),
         Kernel::SliceFit => Some(PassPlan {
             kernel,
             invocations: [f("256"), f("1"), f("1")],
             skip_when: projective.then_some(PROJECTIVE_FRAME),
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "slices"), bind(2, "column_depth")],
         }),
         Kernel::Rectify => Some(PassPlan {
             kernel,
             invocations: [rectify_columns(), f("rectified.height"), f("1")],
             skip_when: projective.then_some(PROJECTIVE_FRAME),
+            indirect: None,
             bindings: vec![
                 bind(0, "frame"),
                 bind(1, "slices"),
@@ -276,6 +279,7 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                 v.threads_per_row_region().to_string(),
             ],
             skip_when: None,
+            indirect: None,
             bindings: [
                 bind(0, "frame"),
                 bind(1, "slices"),
@@ -300,6 +304,7 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations(&v.sampling_knobs()),
                 skip_when: None,
+                indirect: None,
                 bindings: [
                     bind(0, "frame"),
                     bind(1, "slices"),

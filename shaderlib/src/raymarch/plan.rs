@@ -79,6 +79,7 @@ pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
                 kernel,
                 invocations: sampling_invocations(&v.sampling_knobs()),
                 skip_when: None,
+                indirect: None,
                 bindings: [
                     bind(0, "frame"),
                     bind(1, "depth"),
@@ -106,6 +107,7 @@ pub fn pass(v: &RaymarchVariant, kernel: Kernel) -> Option<PassPlan> {
             kernel,
             invocations: screen(),
             skip_when: None,
+            indirect: None,
             bindings: vec![bind(0, "frame"), bind(1, "partial"), bind(2, "output")],
         }),
         _ => None,

@@ -29,12 +29,38 @@ const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 {%- endif %}
 {%- if sampling.fallback %}
 // The pixels no sample stands for (listed by `{{ sampling.family_entry }}_unwarp`, packed
-// x | y << 16) and their count.
-@group(0) @binding({{ sampling.binding + 1 }}) var<storage, read> fallback_count: u32;
+// x | y << 16) and their count (then this pass's indirect dispatch; `FallbackCount` read
+// only: the same layout without atomics).
+struct FallbackCountRead {
+    listed: u32,
+    groups_x: u32,
+    groups_y: u32,
+    groups_z: u32,
+}
+@group(0) @binding({{ sampling.binding + 1 }}) var<storage, read> fallback_count: FallbackCountRead;
 @group(0) @binding({{ sampling.binding + 2 }}) var<storage, read> fallback_pixels: array<u32>;
+// Workgroups (of 8 x 8) per row of this pass's dispatch.
+const FALLBACK_ROW_GROUPS: u32 = {{ sampling.fallback_row_groups }}u;
 {%- else if sampling.lowres || sampling.epipolar %}
-// How many pixels `{{ sampling.family_entry }}_unwarp` listed for `{{ sampling.family_entry }}_fallback` (zeroed by `{{ sampling.family_entry }}`).
-@group(0) @binding({{ sampling.binding + 1 }}) var<storage, read_write> fallback_count: atomic<u32>;
+// How many pixels `{{ sampling.family_entry }}_unwarp` listed for `{{ sampling.family_entry }}_fallback`, and the
+// workgroups of 8 x 8 that `{{ sampling.family_entry }}_fallback` is dispatched with (indirectly, from byte 4:
+// `groups_x` up to FALLBACK_ROW_GROUPS, then rows); reset by `{{ sampling.family_entry }}`.
+struct FallbackCount {
+    listed: atomic<u32>,
+    groups_x: atomic<u32>,
+    groups_y: atomic<u32>,
+    groups_z: u32,
+}
+@group(0) @binding({{ sampling.binding + 1 }}) var<storage, read_write> fallback_count: FallbackCount;
+const FALLBACK_ROW_GROUPS: u32 = {{ sampling.fallback_row_groups }}u;
+
+// An empty list, and no workgroups for the fallback (no host clear).
+fn fallback_list_reset() {
+    atomicStore(&fallback_count.listed, 0u);
+    atomicStore(&fallback_count.groups_x, 0u);
+    atomicStore(&fallback_count.groups_y, 0u);
+    fallback_count.groups_z = 1u;
+}
 {%- endif %}
 {%- if sampling.unwarp %}
 // The pixels no sample stands for, packed x | y << 16, for `{{ sampling.family_entry }}_fallback`.
@@ -47,7 +73,14 @@ const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 fn unwarp_pixel(q: vec2<u32>, w: vec4<f32>, depths: vec4<f32>, light: array<vec3<f32>, 4>) {
     let c = lowres_blend(w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
     if c.w == 0.0 {
-        fallback_pixels[atomicAdd(&fallback_count, 1u)] = q.x | (q.y << 16u);
+        let e = atomicAdd(&fallback_count.listed, 1u);
+        fallback_pixels[e] = q.x | (q.y << 16u);
+        if e % 64u == 0u {
+            // The first entry of workgroup e / 64 of the fallback's dispatch: cover it.
+            let g = e / 64u + 1u;
+            atomicMax(&fallback_count.groups_x, min(g, FALLBACK_ROW_GROUPS));
+            atomicMax(&fallback_count.groups_y, (g + FALLBACK_ROW_GROUPS - 1u) / FALLBACK_ROW_GROUPS);
+        }
     } else {
         textureStore(output, q, c);
     }

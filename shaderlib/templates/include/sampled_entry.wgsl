@@ -16,7 +16,7 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
     if id.x == 0u && id.y == 0u {
         // An empty fallback list for the unwarp (no host clear).
-        atomicStore(&fallback_count, 0u);
+        fallback_list_reset();
     }
     let grid = lowres_grid(screen, SCALE);
     if id.x >= grid.x || id.y >= grid.y {
@@ -122,7 +122,7 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
         if s == 0u {
             // An empty fallback list for the unwarp (no host clear), and the layout in the
             // last row, so that the unwarp loads it instead of computing it per pixel.
-            atomicStore(&fallback_count, 0u);
+            fallback_list_reset();
             textureStore(output, vec2<u32>(0u, SLICES), vec4<f32>(lines.origin, lines.axis));
             textureStore(output, vec2<u32>(1u, SLICES), vec4<f32>(lines.phi_start, lines.dphi, f32(lines.wrap), 0.0));
         }
@@ -238,17 +238,23 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
 {%- else if sampling.fallback %}
 
 // Sampling pass 3 (`sampling = lowres | epipolar`, scatter::sampling): the pixels the unwarp listed
-// in `fallback_pixels`, evaluated with the family's per-pixel body: invocation i of the N
-// takes entries i, i + N, ... (one invocation per T x T pixels, T = {{ sampling.fallback_tile }}
-// (`scatter_shaderlib::sampling::FALLBACK_TILE`): a fixed dispatch, no indirect one; where
-// nothing is listed each 8-lane batch runs the body once under an empty mask, so the
-// dispatch is kept small). Dispatch: (ceil(ceil(W / T) / 8), ceil(ceil(H / T) / 8), 1)
-// workgroups of (8, 8, 1).
+// in `fallback_pixels`, evaluated with the family's per-pixel body, one per invocation.
+// Dispatched indirectly from `fallback_count` (byte 4: the unwarp raised its workgroup
+// counts to cover the list, `groups_x` up to FALLBACK_ROW_GROUPS, then rows;
+// `scatter_shaderlib::sampling::FALLBACK_ROW_GROUPS`): invocation (x, y) of the
+// (8 groups_x, 8 groups_y) grid takes entry y 8 groups_x + x. One pixel per invocation keeps
+// each within llvmpipe's 65535 loop trips per invocation, and nothing listed dispatches
+// nothing. Written as a loop striding over the grid (it takes one trip): with the body
+// after an early `return` instead, llvmpipe re-specialised the pass at every dispatch (2.2
+// ms for `minmax_traverse_fallback` with no workgroup dispatched, 0.2 ms as a loop; not a
+// uniform-only branch that `uniform_branches` finds). An engine without indirect dispatch
+// may dispatch the manifest's bound instead: the invocations outside the grid take nothing.
 @compute @workgroup_size(8, 8, 1)
 fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
-    let lanes = 8u * ((screen + {{ 8 * sampling.fallback_tile - 1 }}u) / {{ 8 * sampling.fallback_tile }}u);
-    let n = min(fallback_count, screen.x * screen.y);
+    let lanes = 8u * vec2<u32>(fallback_count.groups_x, fallback_count.groups_y);
+    let inside = id.x < lanes.x && id.y < lanes.y;
+    let n = select(0u, min(fallback_count.listed, screen.x * screen.y), inside);
     for (var e = id.y * lanes.x + id.x; e < n; e += lanes.x * lanes.y) {
         let q = vec2<u32>(fallback_pixels[e] & 0xffffu, fallback_pixels[e] >> 16u);
         let c = {{ sampling.pixel }}(q.x, q.y);
